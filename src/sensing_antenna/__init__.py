@@ -1,0 +1,19 @@
+"""sensing-antenna: contact-point estimation for robotic sensing antennae.
+
+Subpackages and modules, one concept each:
+
+- :mod:`sensing_antenna.antenna`: antenna parameters as data (TOML, built-in ``paper-2021``).
+- :mod:`sensing_antenna.beam`: contact-mode beam physics (frequencies, modes, statics, inverse).
+- :mod:`sensing_antenna.recording`: the recording format (read, write, validate).
+- :mod:`sensing_antenna.simulator`: the 2-DOF device simulator that writes recordings.
+- :mod:`sensing_antenna.estimation`: contact instant, Estimators 1 and 2, fusion, baselines.
+- :mod:`sensing_antenna.calibration`: fitting T_e and the free-motion observer.
+- :mod:`sensing_antenna.campaign`: declarative experiment campaigns and their reports.
+- :mod:`sensing_antenna.plotting`: every figure, kept apart from computation.
+- :mod:`sensing_antenna.cli`: the ``antenna`` command; parses arguments and calls the library.
+"""
+
+from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
+
+__all__ = ["Antenna", "load_antenna", "paper_antenna"]
+__version__ = "0.1.0"

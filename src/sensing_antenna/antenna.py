@@ -1,0 +1,396 @@
+"""Antenna parameters as data: the flexible link, the two motors and the free-motion observer.
+
+The built-in set ``paper-2021`` is the antenna of the paper (Table 2 for the link, Table 1 for the
+motors, Eq. 15 for the free-motion observer). Any other antenna is a TOML file that either defines
+every field or names a ``base`` set and overrides some fields::
+
+    base = "paper-2021"
+    name = "short-link"
+    [link]
+    length = 0.5
+
+All values are SI. Derived quantities (E I, m_b, T) are computed, never stored.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from sensing_antenna.errors import SensingAntennaError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+__all__ = [
+    "BUILTIN_ANTENNAS",
+    "Antenna",
+    "AntennaConfigError",
+    "FreeMotionObserver",
+    "Link",
+    "Motor",
+    "antenna_to_toml",
+    "load_antenna",
+    "paper_antenna",
+    "save_antenna",
+]
+
+#: Standard gravity (m/s^2), used for the gravity terms of Section 4.2.
+STANDARD_GRAVITY = 9.80665
+
+
+class AntennaConfigError(SensingAntennaError, ValueError):
+    """An antenna parameter is missing, unknown or out of range.
+
+    The message always names the field (``link.length``) and, when known, the file.
+    """
+
+    def __init__(self, field_name: str, problem: str, source: str | None = None) -> None:
+        self.field_name = field_name
+        self.problem = problem
+        self.source = source
+        where = f"{source}: " if source else ""
+        super().__init__(f"{where}{field_name}: {problem}")
+
+
+def _require_positive(owner: str, name: str, value: float) -> None:
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise AntennaConfigError(f"{owner}.{name}", f"must be a finite number > 0, got {value!r}")
+
+
+def _require_non_negative(owner: str, name: str, value: float) -> None:
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+        raise AntennaConfigError(f"{owner}.{name}", f"must be a finite number >= 0, got {value!r}")
+
+
+@dataclass(frozen=True)
+class Link:
+    """Uniform flexible link (Table 2 of the paper), Euler-Bernoulli beam.
+
+    Parameters
+    ----------
+    length : float
+        Equivalent length l (m).
+    radius : float
+        Radius r of the circular cross-section (m).
+    youngs_modulus : float
+        Young's modulus E (Pa).
+    linear_density : float
+        Mass per unit length rho (kg/m).
+    tip_mass : float
+        Payload m_t at the tip (kg); 0 for the paper's antenna.
+    second_moment : float or None
+        Second moment of area I (m^4); computed as pi r^4 / 4 when None.
+    calibrated_t : float or None
+        Calibrated T_e (s / m^2) of Section 5.1; replaces the theoretical T where given.
+    """
+
+    length: float
+    radius: float
+    youngs_modulus: float
+    linear_density: float
+    tip_mass: float = 0.0
+    second_moment: float | None = None
+    calibrated_t: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("length", "radius", "youngs_modulus", "linear_density"):
+            _require_positive("link", name, getattr(self, name))
+        _require_non_negative("link", "tip_mass", self.tip_mass)
+        if self.second_moment is not None:
+            _require_positive("link", "second_moment", self.second_moment)
+        if self.calibrated_t is not None:
+            _require_positive("link", "calibrated_t", self.calibrated_t)
+
+    @property
+    def area_moment(self) -> float:
+        """Second moment of area I (m^4)."""
+        if self.second_moment is not None:
+            return self.second_moment
+        return math.pi * self.radius**4 / 4.0
+
+    @property
+    def flexural_rigidity(self) -> float:
+        """Bending stiffness E I (N m^2)."""
+        return self.youngs_modulus * self.area_moment
+
+    @property
+    def mass(self) -> float:
+        """Link mass m_b = rho l (kg)."""
+        return self.linear_density * self.length
+
+    @property
+    def tip_mass_ratio(self) -> float:
+        """R_m = m_t / m_b of Eq. 4 (dimensionless)."""
+        return self.tip_mass / self.mass
+
+    @property
+    def theoretical_t(self) -> float:
+        """T = sqrt(rho / (E I)) from the material data (s / m^2)."""
+        return math.sqrt(self.linear_density / self.flexural_rigidity)
+
+    @property
+    def t_param(self) -> float:
+        """T used by the frequency model: T_e if calibrated, else the theoretical T (s / m^2).
+
+        The natural frequencies are omega_i = (beta_i l)^2 / (T l^2) rad/s.
+        """
+        return self.calibrated_t if self.calibrated_t is not None else self.theoretical_t
+
+    def check_contact_point(self, x_c: float) -> None:
+        """Raise AntennaConfigError unless 0 < x_c <= l (m)."""
+        if not (math.isfinite(x_c) and 0.0 < x_c <= self.length):
+            raise AntennaConfigError(
+                "x_c", f"contact point must lie in (0, {self.length:g}] m, got {x_c!r}"
+            )
+
+
+@dataclass(frozen=True)
+class Motor:
+    """DC servomotor with harmonic drive (Table 1 and Eq. 1 of the paper).
+
+    Parameters
+    ----------
+    torque_constant : float
+        K_m, motor torque per input volt before the gear (N m / V).
+    inertia : float
+        J, rotational inertia seen at the joint (kg m^2).
+    viscous_friction : float
+        v, viscous friction coefficient at the joint (N m s / rad).
+    coulomb_voltage : float
+        V^nlc, Coulomb friction expressed as an input voltage (V).
+    gear_ratio : float
+        n, reduction ratio 1:n.
+    """
+
+    torque_constant: float
+    inertia: float
+    viscous_friction: float
+    coulomb_voltage: float
+    gear_ratio: float
+
+    def __post_init__(self) -> None:
+        for name in ("torque_constant", "inertia", "gear_ratio"):
+            _require_positive("motor", name, getattr(self, name))
+        _require_non_negative("motor", "viscous_friction", self.viscous_friction)
+        _require_non_negative("motor", "coulomb_voltage", self.coulomb_voltage)
+
+    @property
+    def coulomb_torque(self) -> float:
+        """Coulomb friction torque at the joint, n K_m V^nlc (N m)."""
+        return self.gear_ratio * self.torque_constant * self.coulomb_voltage
+
+    def joint_torque(self, voltage: float) -> float:
+        """Eq. 1: joint torque n K_m u (N m) for an input voltage u (V)."""
+        return self.gear_ratio * self.torque_constant * voltage
+
+
+@dataclass(frozen=True)
+class FreeMotionObserver:
+    """Observer of the first free-motion mode, Eq. 15: gain s^2 / (s^2 + damping s + omega^2).
+
+    Maps a motor angle (rad) to the coupling torque it causes in free motion (N m).
+
+    Parameters
+    ----------
+    gain : float
+        Numerator gain (N m s^2 / rad).
+    natural_frequency : float
+        omega, the free-motion first-mode frequency (rad/s).
+    damping : float
+        Coefficient of s in the denominator, 2 zeta omega (1/s).
+    contact_threshold : float
+        Threshold on the filtered residual of Eq. 16 (N m).
+    """
+
+    gain: float
+    natural_frequency: float
+    damping: float
+    contact_threshold: float
+
+    def __post_init__(self) -> None:
+        _require_positive("observer", "gain", self.gain)
+        _require_positive("observer", "natural_frequency", self.natural_frequency)
+        _require_non_negative("observer", "damping", self.damping)
+        _require_positive("observer", "contact_threshold", self.contact_threshold)
+
+    @property
+    def damping_ratio(self) -> float:
+        """zeta = damping / (2 omega) (dimensionless)."""
+        return self.damping / (2.0 * self.natural_frequency)
+
+
+@dataclass(frozen=True)
+class Antenna:
+    """A complete sensing antenna: link, azimuth motor (1), elevation motor (2), observer."""
+
+    name: str
+    link: Link
+    azimuth_motor: Motor
+    elevation_motor: Motor
+    observer: FreeMotionObserver
+    description: str = ""
+    extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def motors(self) -> tuple[Motor, Motor]:
+        """(azimuth, elevation) motors, indexed like theta1, theta2."""
+        return (self.azimuth_motor, self.elevation_motor)
+
+    def gravity_force(self, theta2: float) -> tuple[float, float, float]:
+        """F_g^m of Section 4.2: link weight in the motor frame (N)."""
+        w = self.link.mass * STANDARD_GRAVITY
+        return (-w * math.sin(theta2), 0.0, -w * math.cos(theta2))
+
+    def gravity_torque(self, theta2: float) -> tuple[float, float, float]:
+        """Gamma_g^m of Section 4.2: torque of the link weight about O, motor frame (N m)."""
+        w = self.link.mass * STANDARD_GRAVITY
+        return (0.0, 0.5 * w * self.link.length * math.cos(theta2), 0.0)
+
+    def with_calibrated_t(self, t_e: float) -> Antenna:
+        """A copy whose frequency model uses the calibrated T_e."""
+        return replace(self, link=replace(self.link, calibrated_t=t_e))
+
+
+_SECTIONS: dict[str, type] = {
+    "link": Link,
+    "azimuth_motor": Motor,
+    "elevation_motor": Motor,
+    "observer": FreeMotionObserver,
+}
+_TOP_LEVEL_KEYS = {"name", "base", "description", *_SECTIONS}
+
+#: Names of the antenna sets shipped with the package.
+BUILTIN_ANTENNAS = ("paper-2021", "paper-2021-calibrated")
+
+
+def _builtin_text(name: str) -> str:
+    if name not in BUILTIN_ANTENNAS:
+        raise AntennaConfigError(
+            "antenna", f"unknown built-in set {name!r}; known: {', '.join(BUILTIN_ANTENNAS)}"
+        )
+    return resources.files("sensing_antenna").joinpath(f"data/{name}.toml").read_text("utf-8")
+
+
+def _parse_toml(text: str, source: str) -> dict[str, Any]:
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise AntennaConfigError("file", f"not valid TOML ({exc})", source) from exc
+
+
+def _merge(base: dict[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
+    merged = {k: (dict(v) if isinstance(v, dict) else v) for k, v in base.items()}
+    for key, value in override.items():
+        if isinstance(value, Mapping) and isinstance(merged.get(key), dict):
+            merged[key] = {**merged[key], **value}
+        else:
+            merged[key] = value
+    return merged
+
+
+def _build(data: Mapping[str, Any], source: str) -> Antenna:
+    unknown = set(data) - _TOP_LEVEL_KEYS
+    if unknown:
+        raise AntennaConfigError(sorted(unknown)[0], "unknown key", source)
+    parts: dict[str, Any] = {}
+    for section, cls in _SECTIONS.items():
+        values = data.get(section)
+        if not isinstance(values, Mapping):
+            raise AntennaConfigError(section, "missing section", source)
+        allowed = {f.name for f in fields(cls)}
+        for key, value in values.items():
+            if key not in allowed:
+                raise AntennaConfigError(f"{section}.{key}", "unknown key", source)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise AntennaConfigError(
+                    f"{section}.{key}", f"must be a number, got {value!r}", source
+                )
+        try:
+            parts[section] = cls(**{k: float(v) for k, v in values.items()})
+        except AntennaConfigError as exc:
+            raise AntennaConfigError(
+                f"{section}.{exc.field_name.split('.', 1)[-1]}", exc.problem, source
+            ) from exc
+        except TypeError as exc:
+            raise AntennaConfigError(section, f"missing field ({exc})", source) from exc
+    name = data.get("name", "unnamed")
+    if not isinstance(name, str) or not name:
+        raise AntennaConfigError("name", "must be a non-empty string", source)
+    return Antenna(
+        name=name,
+        description=str(data.get("description", "")),
+        link=parts["link"],
+        azimuth_motor=parts["azimuth_motor"],
+        elevation_motor=parts["elevation_motor"],
+        observer=parts["observer"],
+    )
+
+
+def load_antenna(spec: str | Path | None = None) -> Antenna:
+    """Load an antenna by built-in name or from a TOML file (None: ``paper-2021``).
+
+    Raises
+    ------
+    AntennaConfigError
+        Naming the file and the field for any missing, unknown or invalid value.
+    """
+    if spec is None:
+        spec = "paper-2021"
+    if isinstance(spec, str) and spec in BUILTIN_ANTENNAS:
+        return _build(_parse_toml(_builtin_text(spec), spec), spec)
+    path = Path(spec)
+    source = str(path)
+    if not path.is_file():
+        raise AntennaConfigError(
+            "antenna",
+            f"no such file, and not a built-in set ({', '.join(BUILTIN_ANTENNAS)})",
+            source,
+        )
+    data = _parse_toml(path.read_text("utf-8"), source)
+    base_name = data.get("base")
+    if base_name is not None:
+        if not isinstance(base_name, str) or base_name not in BUILTIN_ANTENNAS:
+            raise AntennaConfigError(
+                "base", f"must name a built-in set ({', '.join(BUILTIN_ANTENNAS)})", source
+            )
+        base = _parse_toml(_builtin_text(base_name), base_name)
+        data = _merge(base, {k: v for k, v in data.items() if k != "base"})
+    return _build(data, source)
+
+
+def paper_antenna() -> Antenna:
+    """The paper's antenna (Tables 1 and 2, Eq. 15) with the theoretical T."""
+    return load_antenna("paper-2021")
+
+
+def antenna_to_toml(antenna: Antenna) -> str:
+    """Serialise an antenna to TOML text that :func:`load_antenna` reads back unchanged."""
+    lines = [f"name = {_toml_str(antenna.name)}"]
+    if antenna.description:
+        lines.append(f"description = {_toml_str(antenna.description)}")
+    for section in _SECTIONS:
+        lines.append("")
+        lines.append(f"[{section}]")
+        obj = getattr(antenna, section)
+        for f in fields(obj):
+            value = getattr(obj, f.name)
+            if value is not None:
+                lines.append(f"{f.name} = {float(value)!r}")
+    return "\n".join(lines) + "\n"
+
+
+def save_antenna(antenna: Antenna, path: str | Path) -> None:
+    """Write an antenna as a TOML file that every command accepts with ``--antenna``."""
+    Path(path).write_text(antenna_to_toml(antenna), encoding="utf-8")
+
+
+def _toml_str(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
