@@ -1,0 +1,1 @@
+"""Experiment campaigns: declarative specs, parallel runs, tables and reports (Section 5)."""
