@@ -1,0 +1,604 @@
+"""Recordings: the CSV format of ``shared/spec/recording-format.md`` (version 1).
+
+A recording holds the two motor angles and the six force/torque components at the base of the link,
+one row per sample, plus ``# key: value`` metadata lines before the header. Forces and torques are
+exerted BY the link ON the head, in the motor frame, torque about the base point O (SI units).
+
+The reader never guesses: every malformed file raises :class:`RecordingError` naming the file,
+the line (1-based) and the column or metadata key. Irregular sampling is not an error; it is
+described by :class:`SamplingDiagnostics` (``Recording.sampling``), and :func:`resample_uniform`
+puts a recording on a uniform grid for estimators that need one.
+
+Ground truth written by simulators (metadata keys starting with ``true_``, plus ``seed`` and
+``simulation``) must never be read by estimators; :meth:`Recording.without_ground_truth` drops it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sensing_antenna.errors import SensingAntennaError
+
+__all__ = [
+    "FORMAT_NAME",
+    "GROUND_TRUTH_KEYS",
+    "GROUND_TRUTH_PREFIX",
+    "REQUIRED_COLUMNS",
+    "Recording",
+    "RecordingError",
+    "SamplingDiagnostics",
+    "check_sampling",
+    "is_ground_truth_key",
+    "read_recording",
+    "resample_uniform",
+    "write_recording",
+]
+
+#: Value of the ``format`` metadata key written by :func:`write_recording`.
+FORMAT_NAME = "sensing-antenna-recording/1"
+_FORMAT_FAMILY = "sensing-antenna-recording/"
+
+#: Required columns, in the order :func:`write_recording` writes them.
+REQUIRED_COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
+
+#: Metadata keys that hold ground truth besides those starting with :data:`GROUND_TRUTH_PREFIX`.
+GROUND_TRUTH_KEYS = frozenset({"seed", "simulation"})
+#: Prefix of ground-truth metadata keys and extra columns (``true_xc``).
+GROUND_TRUTH_PREFIX = "true_"
+
+#: A recording is "irregular" when a time step departs from a multiple of the nominal period by
+#: more than this fraction of the period (1 %: at 1 kHz, 10 microseconds of jitter), or when
+#: samples are missing. Decimal time stamps written with 6 or more significant digits stay far
+#: below it.
+JITTER_TOLERANCE = 0.01
+
+#: ``sample_period`` metadata counts as consistent with the data when the median time step is
+#: within this fraction of it (2 %).
+PERIOD_CONSISTENCY = 0.02
+
+
+def is_ground_truth_key(key: str) -> bool:
+    """True if a metadata key (or extra column name) holds ground truth estimators must not read."""
+    return key.startswith(GROUND_TRUTH_PREFIX) or key in GROUND_TRUTH_KEYS
+
+
+class RecordingError(SensingAntennaError, ValueError):
+    """A recording file or object is malformed.
+
+    Attributes
+    ----------
+    path : str or None
+        File concerned (None for a recording built in memory).
+    line : int or None
+        1-based line number in the file, when one line is at fault.
+    field : str or None
+        Column name or metadata key at fault, when known (the message says which).
+    problem : str
+        What is wrong.
+    """
+
+    def __init__(
+        self,
+        path: str | None,
+        line: int | None,
+        field: str | None,
+        problem: str,
+        *,
+        metadata: bool = False,
+    ) -> None:
+        self.path = path
+        self.line = line
+        self.field = field
+        self.problem = problem
+        where = path if path is not None else "<recording>"
+        if line is not None:
+            where += f":{line}"
+        what = ""
+        if field is not None:
+            what = f" {'metadata key' if metadata else 'column'} {field!r}:"
+        super().__init__(f"{where}:{what} {problem}")
+
+
+@dataclass(frozen=True)
+class SamplingDiagnostics:
+    """How regular the time stamps of a recording are.
+
+    Parameters
+    ----------
+    nominal_period : float
+        Nominal sample period T_s (s) the steps are compared with.
+    median_period : float
+        Median time step (s).
+    max_jitter : float
+        Largest departure of a time step from the nearest multiple of the nominal period (s).
+    n_dropped : int
+        Number of missing samples (a step of k periods counts k - 1).
+    irregular : bool
+        True when samples are missing or the jitter exceeds ``JITTER_TOLERANCE`` of the period.
+    """
+
+    nominal_period: float
+    median_period: float
+    max_jitter: float
+    n_dropped: int
+    irregular: bool
+
+
+def check_sampling(
+    t: ArrayLike, nominal: float | None = None, tolerance: float = JITTER_TOLERANCE
+) -> SamplingDiagnostics:
+    """Diagnose jitter and dropped samples in strictly increasing time stamps.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Sample times (s), strictly increasing, n >= 2.
+    nominal : float, optional
+        Nominal period (s); the median time step when None.
+    tolerance : float
+        Jitter above ``tolerance * nominal`` makes the sampling irregular (dimensionless).
+
+    Returns
+    -------
+    SamplingDiagnostics
+    """
+    times = np.asarray(t, dtype=np.float64)
+    if times.ndim != 1 or times.size < 2:
+        raise ValueError("check_sampling needs at least two time stamps in a 1-D array")
+    steps = np.diff(times)
+    median = float(np.median(steps))
+    period = median if nominal is None else float(nominal)
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError(f"nominal period must be finite and > 0, got {period!r}")
+    multiples = np.maximum(np.rint(steps / period), 1.0)
+    jitter = float(np.max(np.abs(steps - multiples * period)))
+    dropped = int(np.sum(multiples - 1.0))
+    return SamplingDiagnostics(
+        nominal_period=period,
+        median_period=median,
+        max_jitter=jitter,
+        n_dropped=dropped,
+        irregular=dropped > 0 or jitter > tolerance * period,
+    )
+
+
+def _frozen_array(values: ArrayLike, shape_tail: tuple[int, ...], name: str) -> NDArray[np.float64]:
+    array = np.array(values, dtype=np.float64, copy=True)
+    if array.ndim != 1 + len(shape_tail) or array.shape[1:] != shape_tail:
+        expected = "(n" + "".join(f", {k}" for k in shape_tail) + ")"
+        raise RecordingError(None, None, name, f"shape must be {expected}, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise RecordingError(None, None, name, "NaN or infinite value")
+    array.flags.writeable = False
+    return array
+
+
+def _check_name(name: str, what: str) -> None:
+    if (
+        not isinstance(name, str)
+        or not name
+        or name != name.strip()
+        or any(c in name for c in ",\r\n")
+        or name.startswith("#")
+    ):
+        raise RecordingError(None, None, None, f"invalid {what} {name!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class Recording:
+    """One manoeuvre: motor angles and base force/torque sampled over time.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Sample times (s), strictly increasing, n >= 2.
+    theta : ndarray, shape (n, 2)
+        Motor angles (rad): theta1 azimuth, theta2 elevation.
+    force : ndarray, shape (n, 3)
+        Force by the link on the head, motor frame (N).
+    torque : ndarray, shape (n, 3)
+        Torque by the link on the head about O, motor frame (N m).
+    metadata : Mapping[str, str]
+        ``# key: value`` lines, values as text, order kept.
+    extra : Mapping[str, ndarray]
+        Extra columns, shape (n,) each (``theta1_ref``), order kept.
+    source : str or None
+        File the recording was read from; not part of equality.
+
+    Equality compares every array exactly, the metadata (with order) and the extra columns.
+    """
+
+    t: NDArray[np.float64]
+    theta: NDArray[np.float64]
+    force: NDArray[np.float64]
+    torque: NDArray[np.float64]
+    metadata: Mapping[str, str] = field(default_factory=dict)
+    extra: Mapping[str, NDArray[np.float64]] = field(default_factory=dict)
+    source: str | None = None
+
+    def __post_init__(self) -> None:
+        t = _frozen_array(self.t, (), "t")
+        n = t.shape[0]
+        if n < 2:
+            raise RecordingError(self.source, None, "t", f"need at least 2 samples, got {n}")
+        steps = np.diff(t)
+        if not np.all(steps > 0):
+            k = int(np.argmin(steps > 0)) + 1
+            raise RecordingError(self.source, None, "t", f"not strictly increasing at sample {k}")
+        arrays = {"t": t}
+        for name, tail in (("theta", (2,)), ("force", (3,)), ("torque", (3,))):
+            arrays[name] = _frozen_array(getattr(self, name), tail, name)
+            if arrays[name].shape[0] != n:
+                raise RecordingError(
+                    self.source, None, name, f"has {arrays[name].shape[0]} samples, t has {n}"
+                )
+        metadata: dict[str, str] = {}
+        for key, value in self.metadata.items():
+            _check_name(key, "metadata key")
+            if ":" in key:
+                raise RecordingError(
+                    self.source, None, key, "key must not contain ':'", metadata=True
+                )
+            text = str(value)
+            if text != text.strip() or "\n" in text or "\r" in text:
+                raise RecordingError(
+                    self.source,
+                    None,
+                    key,
+                    "value must be one line without edge spaces",
+                    metadata=True,
+                )
+            metadata[key] = text
+        extra: dict[str, NDArray[np.float64]] = {}
+        for name, values in self.extra.items():
+            _check_name(name, "column name")
+            if name in REQUIRED_COLUMNS:
+                raise RecordingError(self.source, None, name, "extra column shadows a required one")
+            extra[name] = _frozen_array(values, (), name)
+            if extra[name].shape[0] != n:
+                raise RecordingError(
+                    self.source, None, name, f"has {extra[name].shape[0]} samples, t has {n}"
+                )
+        for name, array in arrays.items():
+            object.__setattr__(self, name, array)
+        object.__setattr__(self, "metadata", MappingProxyType(metadata))
+        object.__setattr__(self, "extra", MappingProxyType(extra))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Recording):
+            return NotImplemented
+        return (
+            all(
+                np.array_equal(getattr(self, name), getattr(other, name))
+                for name in ("t", "theta", "force", "torque")
+            )
+            and list(self.metadata.items()) == list(other.metadata.items())
+            and list(self.extra) == list(other.extra)
+            and all(np.array_equal(v, other.extra[k]) for k, v in self.extra.items())
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples n."""
+        return int(self.t.shape[0])
+
+    @property
+    def duration(self) -> float:
+        """t[-1] - t[0] (s)."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def nominal_period(self) -> float | None:
+        """The ``sample_period`` metadata value (s), or None when absent."""
+        text = self.metadata.get("sample_period")
+        if text is None:
+            return None
+        value = _parse_period(text)
+        if value is None:
+            raise RecordingError(
+                self.source,
+                None,
+                "sample_period",
+                f"must be a number > 0, got {text!r}",
+                metadata=True,
+            )
+        return value
+
+    @property
+    def sample_period(self) -> float:
+        """Sample period T_s (s): the metadata value when present and consistent with the data
+        (median step within ``PERIOD_CONSISTENCY``), else the median time step."""
+        median = float(np.median(np.diff(self.t)))
+        nominal = self.nominal_period
+        if nominal is not None and abs(median - nominal) <= PERIOD_CONSISTENCY * nominal:
+            return nominal
+        return median
+
+    @property
+    def sampling(self) -> SamplingDiagnostics:
+        """Jitter and dropped samples relative to :attr:`sample_period`."""
+        return check_sampling(self.t, self.sample_period)
+
+    def without_ground_truth(self) -> Recording:
+        """A copy without ground-truth metadata keys and extra columns (see
+        :func:`is_ground_truth_key`)."""
+        return Recording(
+            t=self.t,
+            theta=self.theta,
+            force=self.force,
+            torque=self.torque,
+            metadata={k: v for k, v in self.metadata.items() if not is_ground_truth_key(k)},
+            extra={k: v for k, v in self.extra.items() if not is_ground_truth_key(k)},
+            source=self.source,
+        )
+
+    def with_metadata(self, **values: Any) -> Recording:
+        """A copy with metadata keys set (existing keys keep their place, new ones go last)."""
+        metadata = dict(self.metadata)
+        metadata.update({k: str(v) for k, v in values.items()})
+        return Recording(
+            t=self.t,
+            theta=self.theta,
+            force=self.force,
+            torque=self.torque,
+            metadata=metadata,
+            extra=self.extra,
+            source=self.source,
+        )
+
+
+def _parse_period(text: str) -> float | None:
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return value if math.isfinite(value) and value > 0 else None
+
+
+def _parse_metadata(lines: list[str], source: str) -> tuple[dict[str, str], int]:
+    """Metadata from the leading ``#`` lines; returns it and the index of the header line."""
+    metadata: dict[str, str] = {}
+    index = 0
+    while index < len(lines) and lines[index].startswith("#"):
+        body = lines[index][1:]
+        key, sep, value = body.partition(":")
+        key = key.strip()
+        if not sep or not key:
+            raise RecordingError(source, index + 1, None, "metadata line must read '# key: value'")
+        if key in metadata:
+            raise RecordingError(source, index + 1, key, "duplicate metadata key", metadata=True)
+        metadata[key] = value.strip()
+        index += 1
+    _check_known_metadata(metadata, lines, source)
+    return metadata, index
+
+
+def _check_known_metadata(metadata: Mapping[str, str], lines: list[str], source: str) -> None:
+    def line_of(key: str) -> int:
+        for number, text in enumerate(lines, start=1):
+            if text.startswith("#") and text[1:].partition(":")[0].strip() == key:
+                return number
+        return 0  # pragma: no cover - the key came from these lines
+
+    fmt = metadata.get("format")
+    if fmt is not None and fmt != FORMAT_NAME:
+        problem = (
+            f"unsupported version {fmt!r} (this reader knows {FORMAT_NAME!r})"
+            if fmt.startswith(_FORMAT_FAMILY)
+            else f"not a sensing-antenna recording ({fmt!r})"
+        )
+        raise RecordingError(source, line_of("format"), "format", problem, metadata=True)
+    period = metadata.get("sample_period")
+    if period is not None and _parse_period(period) is None:
+        raise RecordingError(
+            source,
+            line_of("sample_period"),
+            "sample_period",
+            f"must be a number > 0 ({period!r})",
+            metadata=True,
+        )
+
+
+def _parse_header(line: str, number: int, source: str) -> list[str]:
+    names = [cell.strip() for cell in line.split(",")]
+    seen: set[str] = set()
+    for name in names:
+        if not name:
+            raise RecordingError(source, number, None, "empty column name in header")
+        if name in seen:
+            raise RecordingError(source, number, name, "duplicate column")
+        seen.add(name)
+    for name in REQUIRED_COLUMNS:
+        if name not in seen:
+            raise RecordingError(source, number, name, "required column missing from header")
+    return names
+
+
+def _locate_bad_cell(
+    rows: list[str], first_line: int, names: list[str], source: str
+) -> RecordingError:
+    """Find the first malformed row or cell (slow path, only after the fast parse failed)."""
+    for offset, row in enumerate(rows):
+        cells = row.split(",")
+        number = first_line + offset
+        if len(cells) != len(names):
+            return RecordingError(
+                source,
+                number,
+                None,
+                f"expected {len(names)} cells, found {len(cells)}"
+                + (" (truncated last row)" if offset == len(rows) - 1 else ""),
+            )
+        for name, cell in zip(names, cells, strict=True):
+            try:
+                float(cell)
+            except ValueError:
+                return RecordingError(source, number, name, f"not a number ({cell.strip()!r})")
+    return RecordingError(source, None, None, "could not be parsed as numbers")  # pragma: no cover
+
+
+def read_recording(path: str | Path) -> Recording:
+    """Read a recording file (spec: ``shared/spec/recording-format.md``).
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV file, UTF-8, any line endings.
+
+    Returns
+    -------
+    Recording
+        With ``source`` set to ``str(path)``.
+
+    Raises
+    ------
+    RecordingError
+        For a missing or unreadable file, bad metadata, a missing required column, a non-numeric,
+        NaN or infinite cell, a wrong number of cells (truncated row), non-increasing time, an empty
+        file or a header without rows; the message names the file, the line and the field.
+    """
+    source = str(path)
+    try:
+        raw = Path(path).read_bytes()
+    except OSError as exc:
+        raise RecordingError(source, None, None, f"cannot read file ({exc.strerror})") from exc
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise RecordingError(source, line, None, "not UTF-8 text") from exc
+    lines = text.splitlines()
+    while lines and not lines[-1].strip():
+        lines.pop()
+    if not lines:
+        raise RecordingError(source, None, None, "empty file")
+    metadata, header_index = _parse_metadata(lines, source)
+    if header_index == len(lines):
+        raise RecordingError(source, None, None, "no header row after the metadata")
+    names = _parse_header(lines[header_index], header_index + 1, source)
+    rows = lines[header_index + 1 :]
+    first_line = header_index + 2
+    if not rows:
+        raise RecordingError(source, header_index + 1, None, "header but no data rows")
+    try:
+        data = np.loadtxt(rows, delimiter=",", dtype=np.float64, comments=None, ndmin=2)
+    except ValueError as exc:
+        raise _locate_bad_cell(rows, first_line, names, source) from exc
+    if data.shape[1] != len(names):
+        raise _locate_bad_cell(rows, first_line, names, source)
+    finite = np.isfinite(data)
+    if not np.all(finite):
+        row, col = np.argwhere(~finite)[0]
+        raise RecordingError(
+            source, first_line + int(row), names[col], f"{data[row, col]!r} is not a finite number"
+        )
+    column = {name: data[:, k] for k, name in enumerate(names)}
+    t = column["t"]
+    if t.shape[0] < 2:
+        raise RecordingError(source, first_line, None, "need at least 2 data rows")
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise RecordingError(
+            source,
+            first_line + k,
+            "t",
+            f"time does not increase ({t[k]!r} after {t[k - 1]!r})",
+        )
+    return Recording(
+        t=t,
+        theta=np.column_stack([column["theta1"], column["theta2"]]),
+        force=np.column_stack([column["fx"], column["fy"], column["fz"]]),
+        torque=np.column_stack([column["tx"], column["ty"], column["tz"]]),
+        metadata=metadata,
+        extra={name: column[name] for name in names if name not in REQUIRED_COLUMNS},
+        source=source,
+    )
+
+
+def _metadata_lines(recording: Recording) -> Iterable[str]:
+    sample_period = recording.metadata.get("sample_period", repr(recording.sample_period))
+    yield f"# format: {FORMAT_NAME}"
+    yield f"# sample_period: {sample_period}"
+    for key, value in recording.metadata.items():
+        if key not in ("format", "sample_period"):
+            yield f"# {key}: {value}" if value else f"# {key}:"
+
+
+def write_recording(recording: Recording, path: str | Path) -> None:
+    """Write a recording so that :func:`read_recording` gives it back exactly.
+
+    ``# format`` and ``# sample_period`` come first (the metadata value if present, else the
+    median step), then the other metadata in order, the header (required columns, then extra
+    columns) and one row per sample with floats at ``repr`` precision. The same recording always
+    gives the same bytes (``\\n`` line endings).
+
+    Parameters
+    ----------
+    recording : Recording
+    path : str or Path
+        Destination file, overwritten.
+    """
+    table = np.column_stack(
+        [
+            recording.t,
+            recording.theta,
+            recording.force,
+            recording.torque,
+            *[values[:, None] for values in recording.extra.values()],
+        ]
+    )
+    header = ",".join([*REQUIRED_COLUMNS, *recording.extra])
+    body = "\n".join(",".join(map(repr, row)) for row in table.tolist())
+    text = "\n".join([*_metadata_lines(recording), header, body]) + "\n"
+    Path(path).write_text(text, encoding="utf-8", newline="")
+
+
+def resample_uniform(recording: Recording, period: float | None = None) -> Recording:
+    """Linear interpolation of every column onto a uniform time grid.
+
+    Parameters
+    ----------
+    recording : Recording
+    period : float, optional
+        Grid step (s); :attr:`Recording.sample_period` when None.
+
+    Returns
+    -------
+    Recording
+        Samples at t[0] + k * period for every k with t[0] + k * period <= t[-1] (plus a rounding
+        margin of 1e-9 periods); ``sample_period`` metadata set to the step; same source.
+    """
+    step = recording.sample_period if period is None else float(period)
+    if not (math.isfinite(step) and step > 0):
+        raise ValueError(f"period must be finite and > 0, got {period!r}")
+    count = math.floor(recording.duration / step + 1e-9) + 1
+    grid = recording.t[0] + step * np.arange(count)
+    grid[-1] = min(grid[-1], recording.t[-1])
+
+    def interp(values: NDArray[np.float64]) -> NDArray[np.float64]:
+        if values.ndim == 1:
+            return np.interp(grid, recording.t, values)
+        return np.column_stack([np.interp(grid, recording.t, col) for col in values.T])
+
+    metadata = dict(recording.metadata)
+    metadata["sample_period"] = repr(step)
+    return Recording(
+        t=grid,
+        theta=interp(recording.theta),
+        force=interp(recording.force),
+        torque=interp(recording.torque),
+        metadata=metadata,
+        extra={k: interp(v) for k, v in recording.extra.items()},
+        source=recording.source,
+    )

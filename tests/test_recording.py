@@ -1,0 +1,298 @@
+"""Tests of the recording format (spec: /work/shared/spec/recording-format.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.recording import (
+    FORMAT_NAME,
+    Recording,
+    RecordingError,
+    check_sampling,
+    is_ground_truth_key,
+    read_recording,
+    resample_uniform,
+    write_recording,
+)
+
+DATA = Path(__file__).parent / "data"
+
+
+def _recording(n: int = 5, period: float = 1e-3, **kwargs: object) -> Recording:
+    rng = np.random.default_rng(7)
+    t = period * np.arange(n)
+    return Recording(
+        t=t,
+        theta=rng.normal(size=(n, 2)),
+        force=rng.normal(size=(n, 3)),
+        torque=rng.normal(size=(n, 3)),
+        **kwargs,  # type: ignore[arg-type]
+    )
+
+
+def test_spec_sign_check_example_matches_gravity_terms() -> None:
+    # Spec "Sign check": theta2 = 0, at rest, nothing touching: F ~ (0, 0, -m_b g) and torque ~
+    # (0, +0.5 m_b g l, 0), i.e. F_g^m and Gamma_g^m of Section 4.2. The file holds them rounded
+    # to 3 significant digits, hence the 1e-4 absolute tolerance (N, N m).
+    rec = read_recording(DATA / "rec_sign_check.csv")
+    antenna = paper_antenna()
+    np.testing.assert_allclose(rec.force[0], antenna.gravity_force(0.0), atol=1e-4)
+    np.testing.assert_allclose(rec.torque[0], antenna.gravity_torque(0.0), atol=1e-4)
+    assert rec.metadata["format"] == FORMAT_NAME
+    assert list(rec.metadata) == ["format", "sample_period", "antenna", "description"]
+    assert rec.sample_period == 0.001
+    assert rec.source == str(DATA / "rec_sign_check.csv")
+    assert not rec.sampling.irregular
+
+
+def test_no_metadata_columns_in_other_order_and_extra_column() -> None:
+    rec = read_recording(DATA / "rec_no_metadata_reordered.csv")
+    assert dict(rec.metadata) == {}
+    np.testing.assert_array_equal(rec.t, [0.0, 0.001, 0.002])
+    np.testing.assert_array_equal(rec.theta[1], [0.02, 0.03])
+    np.testing.assert_array_equal(rec.force[2], [-0.12, -0.22, -0.32])
+    np.testing.assert_array_equal(rec.torque[0], [0.1, 0.2, 0.3])
+    assert list(rec.extra) == ["theta1_ref"]
+    np.testing.assert_array_equal(rec.extra["theta1_ref"], [0.015, 0.025, 0.035])
+    assert rec.sample_period == pytest.approx(0.001, rel=1e-12)
+
+
+def test_crlf_line_endings() -> None:
+    rec = read_recording(DATA / "rec_crlf.csv")
+    assert rec.metadata["antenna"] == "paper-2021"
+    assert rec.n_samples == 2
+    np.testing.assert_array_equal(rec.theta[1], [0.1, 0.2])
+
+
+@pytest.mark.parametrize(
+    ("name", "line", "field", "words"),
+    [
+        ("bad_not_a_number.csv", 4, "fx", "not a number ('abc')"),
+        ("bad_empty_cell.csv", 3, "fy", "not a number"),
+        ("bad_missing_column.csv", 1, "tz", "missing"),
+        ("bad_nan.csv", 3, "ty", "not a finite number"),
+        ("bad_inf.csv", 3, "theta2", "not a finite number"),
+        ("bad_time_not_increasing.csv", 4, "t", "does not increase"),
+        ("bad_truncated.csv", 5, None, "truncated"),
+        ("bad_empty.csv", None, None, "empty file"),
+        ("bad_header_only.csv", 2, None, "no data rows"),
+        ("bad_metadata_line.csv", 2, None, "# key: value"),
+        ("bad_sample_period.csv", 1, "sample_period", "number > 0"),
+        ("bad_format_version.csv", 1, "format", "unsupported version"),
+        ("bad_duplicate_column.csv", 1, "fx", "duplicate column"),
+        ("no_such_file.csv", None, None, "cannot read"),
+    ],
+)
+def test_bad_input_names_file_line_and_field(
+    name: str, line: int | None, field: str | None, words: str
+) -> None:
+    path = DATA / name
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    err = info.value
+    assert err.path == str(path)
+    assert err.line == line
+    assert err.field == field
+    assert words in err.problem
+    message = str(err)
+    assert message.startswith(str(path) + (f":{line}:" if line is not None else ":"))
+    if field is not None:
+        assert repr(field) in message
+
+
+def test_error_message_format_of_the_brief() -> None:
+    err = RecordingError("rec.csv", 17, "fx", "not a number ('abc')")
+    assert str(err) == "rec.csv:17: column 'fx': not a number ('abc')"
+    err = RecordingError("rec.csv", 2, "sample_period", "must be a number > 0", metadata=True)
+    assert str(err) == "rec.csv:2: metadata key 'sample_period': must be a number > 0"
+
+
+def test_non_utf8_file(tmp_path: Path) -> None:
+    path = tmp_path / "latin1.csv"
+    path.write_bytes(b"# description: caf\xe9\nt,theta1\n")
+    with pytest.raises(RecordingError, match=r"latin1.csv:1: not UTF-8"):
+        read_recording(path)
+
+
+def test_write_puts_format_and_period_first_and_is_deterministic(tmp_path: Path) -> None:
+    rec = _recording(metadata={"antenna": "paper-2021", "true_xc": "0.5"})
+    first, second = tmp_path / "a.csv", tmp_path / "b.csv"
+    write_recording(rec, first)
+    write_recording(read_recording(first), second)
+    lines = first.read_text("utf-8").splitlines()
+    assert lines[0] == f"# format: {FORMAT_NAME}"
+    assert lines[1] == "# sample_period: 0.001"
+    assert lines[4] == "t,theta1,theta2,fx,fy,fz,tx,ty,tz"
+    assert first.read_bytes() == second.read_bytes()
+
+
+_finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
+_key = st.text(alphabet="abcdefghijklmnopqrstuvwxyz_0123456789", min_size=1, max_size=12)
+_value = st.text(
+    alphabet=st.characters(blacklist_categories=("Cs", "Cc", "Zl", "Zp")), max_size=20
+).map(str.strip)
+
+
+@st.composite
+def _recordings(draw: st.DrawFn) -> Recording:
+    n = draw(st.integers(min_value=2, max_value=12))
+    steps = draw(
+        st.lists(
+            st.floats(min_value=1e-6, max_value=1.0, allow_nan=False),
+            min_size=n - 1,
+            max_size=n - 1,
+        )
+    )
+    t = draw(st.floats(min_value=-10.0, max_value=10.0)) + np.concatenate([[0.0], np.cumsum(steps)])
+    if not np.all(np.diff(t) > 0):
+        t = np.arange(n, dtype=float)
+    grid = st.lists(_finite, min_size=n, max_size=n)
+    columns = [draw(grid) for _ in range(8)]
+    keys = draw(st.lists(_key.filter(lambda k: k not in ("format", "sample_period")), unique=True))
+    metadata = {"format": FORMAT_NAME, "sample_period": repr(float(np.median(np.diff(t))))}
+    metadata.update({k: draw(_value) for k in keys})
+    extra_names = draw(
+        st.lists(st.sampled_from(["theta1_ref", "theta2_ref", "true_x"]), unique=True)
+    )
+    return Recording(
+        t=t,
+        theta=np.column_stack(columns[0:2]),
+        force=np.column_stack(columns[2:5]),
+        torque=np.column_stack(columns[5:8]),
+        metadata=metadata,
+        extra={name: np.asarray(draw(grid)) for name in extra_names},
+    )
+
+
+@settings(max_examples=60, deadline=None)
+@given(rec=_recordings())
+def test_round_trip_is_exact(rec: Recording, tmp_path_factory: pytest.TempPathFactory) -> None:
+    path = tmp_path_factory.mktemp("rt") / "rec.csv"
+    write_recording(rec, path)
+    back = read_recording(path)
+    assert back == rec
+    assert back.source == str(path)
+
+
+def test_writer_adds_period_when_metadata_lacks_it(tmp_path: Path) -> None:
+    rec = _recording(metadata={"antenna": "x"})
+    write_recording(rec, tmp_path / "r.csv")
+    back = read_recording(tmp_path / "r.csv")
+    assert list(back.metadata) == ["format", "sample_period", "antenna"]
+    assert float(back.metadata["sample_period"]) == rec.sample_period
+    np.testing.assert_array_equal(back.torque, rec.torque)
+
+
+def test_ground_truth_keys_and_without_ground_truth() -> None:
+    assert is_ground_truth_key("true_xc")
+    assert is_ground_truth_key("seed")
+    assert is_ground_truth_key("simulation")
+    assert not is_ground_truth_key("sample_period")
+    assert not is_ground_truth_key("antenna")
+    rec = _recording(
+        metadata={"antenna": "a", "true_xc": "0.4", "seed": "3", "simulation": "{}"},
+        extra={"theta1_ref": np.zeros(5), "true_contact": np.ones(5)},
+    )
+    clean = rec.without_ground_truth()
+    assert dict(clean.metadata) == {"antenna": "a"}
+    assert list(clean.extra) == ["theta1_ref"]
+    np.testing.assert_array_equal(clean.theta, rec.theta)
+
+
+def test_with_metadata_keeps_order_and_appends() -> None:
+    rec = _recording(metadata={"a": "1", "b": "2"}).with_metadata(a=3, c="x")
+    assert list(rec.metadata.items()) == [("a", "3"), ("b", "2"), ("c", "x")]
+
+
+def test_recording_is_immutable() -> None:
+    rec = _recording()
+    with pytest.raises(ValueError, match="read-only"):
+        rec.theta[0, 0] = 1.0
+    with pytest.raises(TypeError):
+        rec.metadata["x"] = "y"  # type: ignore[index]
+
+
+def test_recording_validation() -> None:
+    with pytest.raises(RecordingError, match="strictly increasing"):
+        Recording(
+            t=[0.0, 0.0], theta=np.zeros((2, 2)), force=np.zeros((2, 3)), torque=np.zeros((2, 3))
+        )
+    with pytest.raises(RecordingError, match="shape"):
+        Recording(
+            t=[0.0, 1.0], theta=np.zeros((2, 3)), force=np.zeros((2, 3)), torque=np.zeros((2, 3))
+        )
+    with pytest.raises(RecordingError, match="NaN"):
+        Recording(
+            t=[0.0, 1.0],
+            theta=np.zeros((2, 2)),
+            force=np.full((2, 3), np.nan),
+            torque=np.zeros((2, 3)),
+        )
+    with pytest.raises(RecordingError, match="edge spaces"):
+        _recording(metadata={"a": " padded"})
+
+
+def test_check_sampling_regular_jitter_and_drops() -> None:
+    t = 1e-3 * np.arange(100)
+    regular = check_sampling(t)
+    assert not regular.irregular
+    assert regular.n_dropped == 0
+    assert regular.median_period == pytest.approx(1e-3, rel=1e-12)
+    rng = np.random.default_rng(1)
+    jittered = t + rng.uniform(-5e-5, 5e-5, size=t.size)  # +-5 % of the period
+    diag = check_sampling(jittered, nominal=1e-3)
+    assert diag.irregular
+    assert diag.n_dropped == 0
+    assert 1e-5 < diag.max_jitter <= 1e-4 + 1e-12  # two +-5e-5 shifts at most
+    dropped = np.delete(t, [10, 50, 51])
+    diag = check_sampling(dropped)
+    assert diag.irregular
+    assert diag.n_dropped == 3
+    assert diag.max_jitter < 1e-15
+
+
+def test_sample_period_falls_back_to_median_when_metadata_inconsistent() -> None:
+    rec = _recording(metadata={"sample_period": "0.002"})
+    assert rec.sample_period == pytest.approx(1e-3, rel=1e-12)
+    assert _recording(metadata={"sample_period": "0.00101"}).sample_period == 0.00101
+
+
+def test_resample_uniform_is_exact_on_linear_signals() -> None:
+    # Linear interpolation reproduces a linear signal exactly (to rounding): a clear reference.
+    t = 1e-3 * np.delete(np.arange(50), [7, 20, 21]) + np.linspace(0, 2e-5, 47)
+    theta = np.column_stack([2.0 * t, -3.0 * t + 1.0])
+    force = np.column_stack([t, t, t])
+    rec = Recording(
+        t=t,
+        theta=theta,
+        force=force,
+        torque=force,
+        metadata={"sample_period": "0.001"},
+        extra={"theta1_ref": 5.0 * t},
+    )
+    assert rec.sampling.irregular
+    uniform = resample_uniform(rec)
+    assert not uniform.sampling.irregular
+    assert uniform.t[0] == t[0]
+    assert uniform.t[-1] <= t[-1]
+    np.testing.assert_allclose(np.diff(uniform.t), 1e-3, rtol=1e-9)
+    np.testing.assert_allclose(uniform.theta[:, 0], 2.0 * uniform.t, atol=1e-12)
+    np.testing.assert_allclose(uniform.theta[:, 1], -3.0 * uniform.t + 1.0, atol=1e-12)
+    np.testing.assert_allclose(uniform.extra["theta1_ref"], 5.0 * uniform.t, atol=1e-12)
+    assert uniform.metadata["sample_period"] == "0.001"
+
+
+def test_reads_5000_rows(tmp_path: Path) -> None:
+    # Functional check of the fast path on a 5 s, 1 kHz file; speed is measured in benchmarks.
+    rec = _recording(n=5000)
+    write_recording(rec, tmp_path / "big.csv")
+    back = read_recording(tmp_path / "big.csv")
+    assert back.n_samples == 5000
+    for name in ("t", "theta", "force", "torque"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(rec, name))
