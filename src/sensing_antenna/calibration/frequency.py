@@ -1,0 +1,326 @@
+"""Calibration of the frequency model: the equivalent parameter T_e of Section 5.1.
+
+The contact-mode frequency model is omega_1(x_c) = (beta_1 l)^2 / (T l^2), where beta_1 l depends
+only on x_c / l (the pinned-clamped-free problem of Eqs. 3 and 4) and T = sqrt(rho / (E I)) is in
+s / m^2. Section 5.1 replaces the theoretical T by an equivalent T_e that fits the fundamental
+frequencies measured at known contact points in the least-squares sense.
+
+The model is linear in u = 1 / T: omega_1 = k(x_c) u with k = beta_1(x_c)^2 (1 / m^2), so the
+ordinary least-squares solution is closed form, u = sum(k omega) / sum(k^2). A robust loss
+(``soft_l1`` by default) keeps one bad frequency measurement from pulling the fit; it is solved
+with :func:`scipy.optimize.least_squares` starting from the closed form.
+
+``fit`` (this module) and ``apply`` (:meth:`~sensing_antenna.antenna.Antenna.with_calibrated_t`)
+are separate steps.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
+
+from sensing_antenna.antenna import Antenna, Link
+from sensing_antenna.errors import SensingAntennaError
+
+__all__ = [
+    "CALIBRATION_BAND",
+    "LOSSES",
+    "CalibrationError",
+    "FrequencyCalibration",
+    "calibrate_from_recordings",
+    "calibrate_t_e",
+    "fit_inverse_t",
+    "model_beta1_squared",
+]
+
+#: Robust losses accepted by :func:`fit_inverse_t` (those of scipy.optimize.least_squares).
+LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
+
+#: Band (rad/s) searched for the fundamental frequency during calibration. It is deliberately
+#: wide (1.6 Hz to 64 Hz) and not derived from the model being fitted: it holds the paper's measured
+#: range 31.4 to 106.8 rad/s (Section 5.1) with a factor 3 of margin on each side.
+CALIBRATION_BAND = (10.0, 400.0)
+
+#: Floor of the robust loss scale, relative to the median measured frequency. With noise-free data
+#: the MAD of the residuals is 0, which would make the robust scale zero; 1e-6 of the frequency
+#: scale is far below any measurement resolution (an FFT bin of a 1 s window is 6.3 rad/s).
+_RELATIVE_SCALE_FLOOR = 1e-6
+
+#: 1.4826 MAD estimates the standard deviation of Gaussian residuals.
+_MAD_TO_SIGMA = 1.4826
+
+
+class CalibrationError(SensingAntennaError, ValueError):
+    """Calibration input that cannot be used: too few points, bad values, missing contact points."""
+
+
+@dataclass(frozen=True, eq=False)
+class FrequencyCalibration:
+    """Result of the T_e fit of Section 5.1.
+
+    Attributes
+    ----------
+    t_e : float
+        Fitted equivalent parameter T_e (s / m^2).
+    t_e_std_error : float
+        Standard error of T_e (s / m^2) from the linearised fit; NaN with fewer than 2 points.
+    t_theoretical : float
+        T = sqrt(rho / (E I)) of the starting link (s / m^2), for comparison.
+    contact_points : ndarray, shape (n,)
+        Known contact points x_c (m).
+    omega1_measured : ndarray, shape (n,)
+        Measured fundamental frequencies (rad/s); NaN where no frequency could be measured.
+    omega1_fitted : ndarray, shape (n,)
+        Model frequencies with T_e at the same contact points (rad/s).
+    used : ndarray of bool, shape (n,)
+        Points that entered the fit.
+    loss : str
+        Loss used by the fit.
+    sources : tuple of str
+        Where each point came from (file names), same order as ``contact_points``.
+    notes : tuple of str
+        Why points were left out, one note per excluded point.
+    """
+
+    t_e: float
+    t_e_std_error: float
+    t_theoretical: float
+    contact_points: NDArray[np.float64]
+    omega1_measured: NDArray[np.float64]
+    omega1_fitted: NDArray[np.float64]
+    used: NDArray[np.bool_]
+    loss: str = "soft_l1"
+    sources: tuple[str, ...] = ()
+    notes: tuple[str, ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        n = self.contact_points.shape
+        for name in ("omega1_measured", "omega1_fitted", "used"):
+            if getattr(self, name).shape != n:
+                raise CalibrationError(f"{name}: shape {getattr(self, name).shape} != {n}")
+        if not (math.isfinite(self.t_e) and self.t_e > 0):
+            raise CalibrationError(f"t_e: must be finite and > 0, got {self.t_e!r}")
+
+    @property
+    def residuals(self) -> NDArray[np.float64]:
+        """Measured minus fitted omega_1 (rad/s), shape (n,); NaN where not measured."""
+        return self.omega1_measured - self.omega1_fitted
+
+    @property
+    def rms_residual(self) -> float:
+        """Root-mean-square residual over the points used (rad/s)."""
+        r = self.residuals[self.used]
+        return float(np.sqrt(np.mean(r**2))) if r.size else math.nan
+
+    @property
+    def relative_difference(self) -> float:
+        """(T_e - T) / T, dimensionless (the paper reports 7 %)."""
+        return (self.t_e - self.t_theoretical) / self.t_theoretical
+
+    def apply(self, antenna: Antenna) -> Antenna:
+        """The antenna with this T_e as its calibrated T."""
+        return antenna.with_calibrated_t(self.t_e)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-ready summary (SI units)."""
+        return {
+            "t_e": self.t_e,
+            "t_e_std_error": self.t_e_std_error,
+            "t_theoretical": self.t_theoretical,
+            "relative_difference": self.relative_difference,
+            "rms_residual": self.rms_residual,
+            "loss": self.loss,
+            "points": [
+                {
+                    "source": self.sources[i] if i < len(self.sources) else "",
+                    "x_c": float(self.contact_points[i]),
+                    "omega1_measured": float(self.omega1_measured[i]),
+                    "omega1_fitted": float(self.omega1_fitted[i]),
+                    "used": bool(self.used[i]),
+                }
+                for i in range(self.contact_points.size)
+            ],
+            "notes": list(self.notes),
+        }
+
+
+def fit_inverse_t(
+    beta1_squared: ArrayLike, omega1: ArrayLike, *, loss: str = "soft_l1"
+) -> tuple[float, float]:
+    """Fit u = 1 / T_e in omega_1 = beta_1^2 u; return (T_e, standard error of T_e).
+
+    Parameters
+    ----------
+    beta1_squared : array_like, shape (n,)
+        beta_1(x_c)^2 of the model at each contact point (1 / m^2), all > 0.
+    omega1 : array_like, shape (n,)
+        Measured fundamental frequencies (rad/s), finite.
+    loss : str
+        ``"linear"`` for ordinary least squares (closed form), or a robust loss of
+        :func:`scipy.optimize.least_squares`.
+
+    Returns
+    -------
+    t_e : float
+        Equivalent T_e (s / m^2).
+    std_error : float
+        Standard error of T_e (s / m^2): residual variance s^2 = sum(r^2) / (n - 1), var(u) =
+        s^2 / sum(k^2), propagated to T = 1 / u by the delta method; NaN when n < 2.
+    """
+    k = np.asarray(beta1_squared, dtype=float).ravel()
+    w = np.asarray(omega1, dtype=float).ravel()
+    if loss not in LOSSES:
+        raise CalibrationError(f"loss: unknown {loss!r}; known: {', '.join(LOSSES)}")
+    if k.shape != w.shape:
+        raise CalibrationError(f"omega1: {w.size} frequencies for {k.size} contact points")
+    if k.size == 0:
+        raise CalibrationError("omega1: no measured frequency to fit")
+    if not (np.all(np.isfinite(k)) and np.all(k > 0)):
+        raise CalibrationError("beta1_squared: must be finite and > 0")
+    if not (np.all(np.isfinite(w)) and np.all(w > 0)):
+        raise CalibrationError("omega1: measured frequencies must be finite and > 0")
+    # Section 5.1, linear in u = 1 / T: least-squares normal equation u = sum(k w) / sum(k^2)
+    u = float(np.dot(k, w) / np.dot(k, k))
+    if loss != "linear" and k.size >= 3:
+        r0 = k * u - w
+        scale = max(
+            _MAD_TO_SIGMA * float(np.median(np.abs(r0 - np.median(r0)))),
+            _RELATIVE_SCALE_FLOOR * float(np.median(w)),
+        )
+        sol = least_squares(lambda x: k * x[0] - w, x0=[u], loss=loss, f_scale=scale)
+        u = float(sol.x[0])
+    residuals = k * u - w
+    if k.size < 2:
+        return 1.0 / u, math.nan
+    variance = float(np.dot(residuals, residuals)) / (k.size - 1)
+    std_u = math.sqrt(variance / float(np.dot(k, k)))
+    # Delta method for T = 1 / u: sigma_T = sigma_u / u^2
+    return 1.0 / u, std_u / u**2
+
+
+def model_beta1_squared(link: Link, contact_points: ArrayLike) -> NDArray[np.float64]:
+    """beta_1(x_c)^2 (1 / m^2) of the contact-mode model, so that omega_1 = beta_1^2 / T.
+
+    Computed with :func:`sensing_antenna.beam.natural_frequencies` on a copy of the link whose T
+    is 1 s / m^2, where omega_1 in rad/s equals beta_1^2 in 1 / m^2 numerically.
+
+    Returns
+    -------
+    ndarray, shape of ``contact_points``
+    """
+    from sensing_antenna.beam import natural_frequencies
+
+    unit_link = replace(link, calibrated_t=1.0)
+    x_c = np.asarray(contact_points, dtype=float)
+    omega = np.asarray(natural_frequencies(unit_link, x_c, 1), dtype=float)
+    return np.asarray(omega[..., 0], dtype=float)
+
+
+def calibrate_t_e(
+    contact_points: ArrayLike,
+    omega1: ArrayLike,
+    link: Link,
+    *,
+    loss: str = "soft_l1",
+    sources: Sequence[str] = (),
+    notes: Sequence[str] = (),
+) -> FrequencyCalibration:
+    """Fit T_e of Section 5.1 to measured fundamental frequencies at known contact points.
+
+    Parameters
+    ----------
+    contact_points : array_like, shape (n,)
+        Known contact points x_c (m), each in (0, l].
+    omega1 : array_like, shape (n,)
+        Measured fundamental frequencies (rad/s); NaN marks a point without a measurement
+        (left out of the fit, kept in the result).
+    link : Link
+        The link whose geometry (l) defines the model; its T is reported as ``t_theoretical``.
+    loss : str
+        See :func:`fit_inverse_t`.
+    sources, notes : sequence of str
+        Provenance of each point, and reasons for points left out (kept in the result).
+    """
+    x_c = np.asarray(contact_points, dtype=float).ravel()
+    w = np.asarray(omega1, dtype=float).ravel()
+    if x_c.shape != w.shape:
+        raise CalibrationError(f"omega1: {w.size} frequencies for {x_c.size} contact points")
+    for i, x in enumerate(x_c):
+        if not (math.isfinite(x) and 0.0 < x <= link.length):
+            label = sources[i] if i < len(sources) else f"point {i}"
+            raise CalibrationError(f"{label}: x_c: must lie in (0, {link.length:g}] m, got {x!r}")
+    used = np.isfinite(w) & (w > 0)
+    if int(used.sum()) < 2:
+        raise CalibrationError(
+            f"omega1: need at least 2 measured frequencies to fit T_e, got {int(used.sum())}"
+        )
+    k = model_beta1_squared(link, x_c)
+    t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
+    return FrequencyCalibration(
+        t_e=t_e,
+        t_e_std_error=std_error,
+        t_theoretical=link.theoretical_t,
+        contact_points=x_c,
+        omega1_measured=w,
+        # Section 5.1 model: omega_1 = (beta_1 l)^2 / (T_e l^2) = beta_1^2 / T_e
+        omega1_fitted=k / t_e,
+        used=used,
+        loss=loss,
+        sources=tuple(sources),
+        notes=tuple(notes),
+    )
+
+
+def calibrate_from_recordings(
+    recordings: Sequence[Any],
+    antenna: Antenna,
+    contact_points: Sequence[float],
+    *,
+    sources: Sequence[str] = (),
+    band: tuple[float, float] = CALIBRATION_BAND,
+    loss: str = "soft_l1",
+) -> FrequencyCalibration:
+    """Measure omega_1 in each recording and fit T_e (Section 5.1).
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        Contact manoeuvres at known contact points.
+    antenna : Antenna
+        The antenna the recordings were made with (its link's T is the starting value).
+    contact_points : sequence of float
+        Known x_c (m) of each recording, same order.
+    band : (float, float)
+        Search band for the fundamental frequency (rad/s); wide by default so that the measured
+        frequencies do not presuppose the model being fitted.
+    """
+    from sensing_antenna.estimation import measure_omega1
+
+    if len(recordings) != len(contact_points):
+        raise CalibrationError(
+            f"contact points: {len(contact_points)} given for {len(recordings)} recordings"
+        )
+    names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
+    omega = np.full(len(recordings), math.nan)
+    notes: list[str] = []
+    for i, recording in enumerate(recordings):
+        measurement = measure_omega1(recording, antenna, band=band)
+        value = float(measurement.omega1)
+        if math.isfinite(value) and value > 0:
+            omega[i] = value
+        else:
+            notes.append(f"{names[i]}: no fundamental frequency found ({_describe(measurement)})")
+    return calibrate_t_e(contact_points, omega, antenna.link, loss=loss, sources=names, notes=notes)
+
+
+def _describe(measurement: Any) -> str:
+    quality = getattr(measurement, "quality", None)
+    if isinstance(quality, Mapping):
+        return ", ".join(f"{k}={v}" for k, v in quality.items())
+    return f"quality={quality!r}"

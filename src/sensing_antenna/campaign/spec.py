@@ -1,0 +1,450 @@
+"""Declarative campaign specifications (TOML) and their expansion into individual runs.
+
+A campaign is the experiment plan of Section 5.6 of the paper: for each case (azimuthal or vertical
+movement), each contact point and each repeat, one simulated contact manoeuvre, estimated by every
+method. The built-in spec ``paper-2021`` reproduces the paper: 15 contact points x 5 repeats x 2
+cases = 150 runs. A spec file looks like::
+
+    name = "small"
+    antenna = "paper-2021"          # built-in name, or a TOML file relative to this spec
+    cases = ["azimuthal", "vertical"]
+    contact_points = [0.3, 0.6, 0.9] # m
+    repeats = 2
+    base_seed = 7
+    methods = ["paper", "ratio", "two-frequency"]
+
+    [scenario]                      # keyword arguments of simulator.Scenario, SI units
+    noise_scale = 1.0
+    damping_ratio = 0.005
+
+    [free_motion]                   # optional: identify the Eq. 15 observer first (Section 5.2)
+    identify = true
+    duration = 4.0                  # s
+
+Seeds are derived from ``base_seed`` and the run index with :class:`numpy.random.SeedSequence`, so
+every run's seed is fixed by the spec alone and independent of the order runs execute in.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sensing_antenna.antenna import Antenna, load_antenna
+from sensing_antenna.errors import SensingAntennaError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+__all__ = [
+    "CASES",
+    "DEFAULT_SPEC_NAME",
+    "METHODS",
+    "CampaignSpec",
+    "CampaignSpecError",
+    "FreeMotionStep",
+    "RunSpec",
+    "default_campaign_spec",
+    "derive_seed",
+    "expand_runs",
+    "load_campaign_spec",
+    "parse_campaign_spec",
+]
+
+#: Manoeuvres of Section 5.6: Case 1 azimuthal movement, Case 2 vertical movement.
+CASES = ("azimuthal", "vertical")
+
+#: Estimation methods: the paper's fused estimator and the two baselines.
+METHODS = ("paper", "ratio", "two-frequency")
+
+#: Name of the built-in spec that reproduces Section 5.6.
+DEFAULT_SPEC_NAME = "paper-2021"
+
+#: Scenario keys the campaign sets itself for every run.
+_RESERVED_SCENARIO_KEYS = ("case", "contact_point", "seed")
+
+_TOP_LEVEL_KEYS = (
+    "name",
+    "description",
+    "antenna",
+    "cases",
+    "contact_points",
+    "repeats",
+    "base_seed",
+    "methods",
+    "scenario",
+    "free_motion",
+)
+
+
+class CampaignSpecError(SensingAntennaError, ValueError):
+    """A campaign spec field is missing, unknown or invalid; the message names file and field."""
+
+    def __init__(self, field_name: str, problem: str, source: str | None = None) -> None:
+        self.field_name = field_name
+        self.problem = problem
+        self.source = source
+        where = f"{source}: " if source else ""
+        super().__init__(f"{where}{field_name}: {problem}")
+
+
+@dataclass(frozen=True)
+class FreeMotionStep:
+    """Optional first step: simulate a free motion and identify the Eq. 15 observer from it.
+
+    Parameters
+    ----------
+    identify : bool
+        Whether to run the step.
+    duration : float
+        Length of the simulated free motion (s).
+    case : str
+        Manoeuvre of the free motion (``"free"``).
+    """
+
+    identify: bool = False
+    duration: float = 4.0
+    case: str = "free"
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.duration) and self.duration > 0):
+            raise CampaignSpecError("free_motion.duration", f"must be > 0 s, got {self.duration!r}")
+
+
+@dataclass(frozen=True)
+class CampaignSpec:
+    """A validated campaign: what to simulate and which methods estimate each recording.
+
+    Parameters
+    ----------
+    name : str
+        Campaign name, used in the report title.
+    antenna : str
+        Built-in antenna name or path of an antenna TOML file (absolute or relative to the
+        current directory once loaded).
+    cases : tuple of str
+        Manoeuvres among :data:`CASES`.
+    contact_points : tuple of float
+        True contact points x_c (m), distinct, each in (0, l].
+    repeats : int
+        Runs per (case, contact point), each with its own seed.
+    base_seed : int
+        Seed from which each run's seed is derived (>= 0).
+    methods : tuple of str
+        Estimation methods among :data:`METHODS`; each run is estimated by all of them.
+    scenario : mapping
+        Extra keyword arguments of ``simulator.Scenario`` (SI units), same for every run.
+    free_motion : FreeMotionStep
+        Optional observer identification step.
+    description : str
+        Free text for the report.
+    source : str
+        Where the spec came from (file path or built-in name), for messages.
+    """
+
+    name: str
+    antenna: str
+    cases: tuple[str, ...]
+    contact_points: tuple[float, ...]
+    repeats: int
+    base_seed: int
+    methods: tuple[str, ...] = METHODS
+    scenario: Mapping[str, Any] = field(default_factory=dict)
+    free_motion: FreeMotionStep = field(default_factory=FreeMotionStep)
+    description: str = ""
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        src = self.source or None
+        if not self.name:
+            raise CampaignSpecError("name", "must be a non-empty string", src)
+        _check_choices("cases", self.cases, CASES, src)
+        _check_choices("methods", self.methods, METHODS, src)
+        if not self.contact_points:
+            raise CampaignSpecError("contact_points", "must list at least one point (m)", src)
+        for i, x in enumerate(self.contact_points):
+            if not (math.isfinite(x) and x > 0):
+                raise CampaignSpecError(
+                    f"contact_points[{i}]", f"must be a finite length > 0 m, got {x!r}", src
+                )
+        if len({round(x * 1e6) for x in self.contact_points}) != len(self.contact_points):
+            raise CampaignSpecError("contact_points", "must be distinct", src)
+        if self.repeats < 1:
+            raise CampaignSpecError("repeats", f"must be >= 1, got {self.repeats!r}", src)
+        if self.base_seed < 0:
+            raise CampaignSpecError("base_seed", f"must be >= 0, got {self.base_seed!r}", src)
+        for key in self.scenario:
+            if key in _RESERVED_SCENARIO_KEYS:
+                raise CampaignSpecError(
+                    f"scenario.{key}", "is set by the campaign for each run; remove it", src
+                )
+
+    @property
+    def n_runs(self) -> int:
+        """Number of simulated runs (cases x contact points x repeats)."""
+        return len(self.cases) * len(self.contact_points) * self.repeats
+
+    def load_antenna(self) -> Antenna:
+        """The campaign's antenna; checks every contact point lies on its link."""
+        antenna = load_antenna(self.antenna)
+        for i, x in enumerate(self.contact_points):
+            if x > antenna.link.length:
+                raise CampaignSpecError(
+                    f"contact_points[{i}]",
+                    f"{x!r} m is beyond the link length {antenna.link.length:g} m",
+                    self.source or None,
+                )
+        return antenna
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data (JSON/TOML-ready) that :func:`parse_campaign_spec` reads back."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "antenna": self.antenna,
+            "cases": list(self.cases),
+            "contact_points": list(self.contact_points),
+            "repeats": self.repeats,
+            "base_seed": self.base_seed,
+            "methods": list(self.methods),
+            "scenario": dict(self.scenario),
+            "free_motion": {
+                "identify": self.free_motion.identify,
+                "duration": self.free_motion.duration,
+                "case": self.free_motion.case,
+            },
+        }
+
+    def fingerprint(self) -> str:
+        """Short hash of everything that determines the results (not name or description)."""
+        data = self.to_dict()
+        data.pop("name")
+        data.pop("description")
+        text = json.dumps(data, sort_keys=True)
+        return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Everything one run needs: picklable, so it can travel to a worker process or a Dask worker.
+
+    Parameters
+    ----------
+    index : int
+        Position of the run in the campaign (0-based).
+    run_id : str
+        Stable, file-name-safe identifier, e.g. ``azimuthal-x0300mm-r1``.
+    case : str
+        Manoeuvre (:data:`CASES`).
+    contact_point : float
+        True contact point x_c (m).
+    repeat : int
+        Repeat number, 1-based.
+    seed : int
+        Seed of this run's simulation (derived from the base seed and ``index``).
+    antenna : Antenna
+        Antenna used to simulate and to estimate.
+    methods : tuple of str
+        Methods that estimate the recording.
+    scenario : mapping
+        Extra keyword arguments of ``simulator.Scenario``.
+    """
+
+    index: int
+    run_id: str
+    case: str
+    contact_point: float
+    repeat: int
+    seed: int
+    antenna: Antenna
+    methods: tuple[str, ...]
+    scenario: Mapping[str, Any] = field(default_factory=dict)
+
+
+def derive_seed(base_seed: int, index: int, stream: int = 0) -> int:
+    """Seed of run ``index``: SeedSequence(base_seed, spawn_key=(stream, index)), first word.
+
+    Stream 0 holds the contact runs, stream 1 the free-motion identification step, so the two never
+    share a seed.
+    """
+    state = np.random.SeedSequence(base_seed, spawn_key=(stream, index)).generate_state(1)
+    return int(state[0])
+
+
+def expand_runs(spec: CampaignSpec, antenna: Antenna) -> list[RunSpec]:
+    """All runs of a campaign in a fixed order: case, then contact point, then repeat.
+
+    Parameters
+    ----------
+    spec : CampaignSpec
+    antenna : Antenna
+        The antenna to simulate and estimate with (the spec's, possibly with an identified
+        observer).
+    """
+    runs: list[RunSpec] = []
+    for case in spec.cases:
+        for x_c in spec.contact_points:
+            for repeat in range(1, spec.repeats + 1):
+                index = len(runs)
+                runs.append(
+                    RunSpec(
+                        index=index,
+                        run_id=f"{case}-x{round(x_c * 1000):04d}mm-r{repeat}",
+                        case=case,
+                        contact_point=float(x_c),
+                        repeat=repeat,
+                        seed=derive_seed(spec.base_seed, index),
+                        antenna=antenna,
+                        methods=spec.methods,
+                        scenario=dict(spec.scenario),
+                    )
+                )
+    return runs
+
+
+def _check_choices(
+    name: str, values: tuple[str, ...], allowed: tuple[str, ...], src: str | None
+) -> None:
+    if not values:
+        raise CampaignSpecError(name, f"must list at least one of {', '.join(allowed)}", src)
+    for i, value in enumerate(values):
+        if value not in allowed:
+            raise CampaignSpecError(
+                f"{name}[{i}]", f"unknown {value!r}; known: {', '.join(allowed)}", src
+            )
+    if len(set(values)) != len(values):
+        raise CampaignSpecError(name, "must not repeat a value", src)
+
+
+def _get(data: Mapping[str, Any], key: str, kind: type | tuple[type, ...], src: str) -> Any:
+    if key not in data:
+        raise CampaignSpecError(key, "missing", src)
+    value = data[key]
+    if (isinstance(value, bool) and kind is not bool) or not isinstance(value, kind):
+        raise CampaignSpecError(key, f"wrong type: got {value!r}", src)
+    return value
+
+
+def _str_list(data: Mapping[str, Any], key: str, src: str) -> tuple[str, ...]:
+    value = _get(data, key, list, src)
+    for i, item in enumerate(value):
+        if not isinstance(item, str):
+            raise CampaignSpecError(f"{key}[{i}]", f"must be a string, got {item!r}", src)
+    return tuple(value)
+
+
+def parse_campaign_spec(
+    data: Mapping[str, Any], source: str, base_dir: Path | None = None
+) -> CampaignSpec:
+    """Validate plain data (from TOML) into a :class:`CampaignSpec`.
+
+    Parameters
+    ----------
+    data : mapping
+        Parsed TOML.
+    source : str
+        File name or built-in name, used in error messages.
+    base_dir : Path or None
+        Directory relative antenna paths are resolved against.
+    """
+    for key in data:
+        if key not in _TOP_LEVEL_KEYS:
+            raise CampaignSpecError(
+                key, f"unknown key; known: {', '.join(_TOP_LEVEL_KEYS)}", source
+            )
+    name = _get(data, "name", str, source)
+    antenna = data.get("antenna", "paper-2021")
+    if not isinstance(antenna, str) or not antenna:
+        raise CampaignSpecError("antenna", "must be a built-in name or a file path", source)
+    if base_dir is not None and not antenna.startswith("paper-2021"):
+        candidate = base_dir / antenna
+        if candidate.is_file():
+            antenna = str(candidate)
+    raw_points = _get(data, "contact_points", list, source)
+    points: list[float] = []
+    for i, x in enumerate(raw_points):
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            raise CampaignSpecError(
+                f"contact_points[{i}]", f"must be a number (m), got {x!r}", source
+            )
+        points.append(float(x))
+    repeats = _get(data, "repeats", int, source)
+    base_seed = _get(data, "base_seed", int, source)
+    methods = _str_list(data, "methods", source) if "methods" in data else METHODS
+    scenario = data.get("scenario", {})
+    if not isinstance(scenario, Mapping):
+        raise CampaignSpecError("scenario", "must be a table of Scenario fields", source)
+    free = data.get("free_motion", {})
+    if not isinstance(free, Mapping):
+        raise CampaignSpecError("free_motion", "must be a table", source)
+    for key in free:
+        if key not in ("identify", "duration", "case"):
+            raise CampaignSpecError(f"free_motion.{key}", "unknown key", source)
+    identify = free.get("identify", False)
+    if not isinstance(identify, bool):
+        raise CampaignSpecError("free_motion.identify", "must be true or false", source)
+    duration = free.get("duration", 4.0)
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)):
+        raise CampaignSpecError("free_motion.duration", "must be a number (s)", source)
+    try:
+        free_step = FreeMotionStep(
+            identify=identify, duration=float(duration), case=str(free.get("case", "free"))
+        )
+        return CampaignSpec(
+            name=name,
+            description=str(data.get("description", "")),
+            antenna=antenna,
+            cases=_str_list(data, "cases", source),
+            contact_points=tuple(points),
+            repeats=repeats,
+            base_seed=base_seed,
+            methods=methods,
+            scenario=dict(scenario),
+            free_motion=free_step,
+            source=source,
+        )
+    except CampaignSpecError as exc:
+        if exc.source is None:
+            raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
+        raise
+
+
+def load_campaign_spec(path: str | Path | None = None) -> CampaignSpec:
+    """Load a campaign spec from a TOML file, or the built-in ``paper-2021`` spec when None.
+
+    Raises
+    ------
+    CampaignSpecError
+        Naming the file and the field for any missing, unknown or invalid value.
+    """
+    if path is None or str(path) == DEFAULT_SPEC_NAME:
+        return default_campaign_spec()
+    file = Path(path)
+    if not file.is_file():
+        raise CampaignSpecError("spec", "no such file", str(file))
+    try:
+        data = tomllib.loads(file.read_text("utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise CampaignSpecError("file", f"not valid TOML ({exc})", str(file)) from exc
+    return parse_campaign_spec(data, str(file), base_dir=file.parent)
+
+
+def default_campaign_spec() -> CampaignSpec:
+    """The built-in campaign of Section 5.6: 15 points x 5 repeats x 2 cases, all methods."""
+    text = (
+        resources.files("sensing_antenna")
+        .joinpath(f"data/campaign-{DEFAULT_SPEC_NAME}.toml")
+        .read_text("utf-8")
+    )
+    return parse_campaign_spec(tomllib.loads(text), DEFAULT_SPEC_NAME)

@@ -1,0 +1,153 @@
+"""The on-disk layout of a campaign, written so that an interrupted campaign can resume.
+
+::
+
+    OUT/
+      campaign.json        the spec and its fingerprint (a resume must use the same spec)
+      antenna.toml         the antenna every run used (with the identified observer, if any)
+      runs/<run_id>.json   one file per finished run, written atomically (temp file + os.replace)
+      runs.csv             every run x method, rebuilt from runs/ (SI units)
+      report.md, figures/  written by :mod:`sensing_antenna.campaign.report`
+
+A run file either exists complete or not at all, so killing the campaign at any moment loses at
+most the runs in progress; they are redone on the next start.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
+from sensing_antenna.campaign.records import CSV_COLUMNS, RunResult, result_rows
+from sensing_antenna.campaign.spec import CampaignSpec, parse_campaign_spec
+from sensing_antenna.errors import SensingAntennaError
+
+__all__ = [
+    "ANTENNA_FILE",
+    "CSV_FILE",
+    "MANIFEST_FILE",
+    "RUNS_DIR",
+    "CampaignStoreError",
+    "atomic_write_text",
+    "load_run_results",
+    "read_manifest",
+    "read_stored_antenna",
+    "write_manifest",
+    "write_run_result",
+    "write_runs_csv",
+    "write_stored_antenna",
+]
+
+MANIFEST_FILE = "campaign.json"
+ANTENNA_FILE = "antenna.toml"
+RUNS_DIR = "runs"
+CSV_FILE = "runs.csv"
+
+
+class CampaignStoreError(SensingAntennaError, ValueError):
+    """A campaign directory that cannot be used: wrong spec, damaged run file, missing files."""
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write ``text`` to ``path``: readers see either the old file or the complete new one."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "w", encoding="utf-8") as handle:
+        handle.write(text)
+        handle.flush()
+        os.fsync(handle.fileno())
+    os.replace(tmp, path)
+
+
+def write_manifest(out_dir: Path, spec: CampaignSpec) -> None:
+    """Record the spec in ``out_dir``; refuse a directory holding results of a different spec."""
+    path = out_dir / MANIFEST_FILE
+    if path.is_file():
+        stored = read_manifest(out_dir)
+        if stored.fingerprint() != spec.fingerprint():
+            raise CampaignStoreError(
+                f"{path}: fingerprint: the runs stored here come from a different campaign spec "
+                f"({stored.name!r}); use another output directory"
+            )
+        return
+    data = {"fingerprint": spec.fingerprint(), "spec": spec.to_dict(), "source": spec.source}
+    atomic_write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
+
+
+def read_manifest(out_dir: Path) -> CampaignSpec:
+    """The spec stored in ``out_dir/campaign.json``."""
+    path = out_dir / MANIFEST_FILE
+    if not path.is_file():
+        raise CampaignStoreError(f"{path}: no such file; is {out_dir} a campaign directory?")
+    try:
+        data = json.loads(path.read_text("utf-8"))
+        spec_data = data["spec"]
+    except (json.JSONDecodeError, KeyError, TypeError) as exc:
+        raise CampaignStoreError(f"{path}: spec: damaged manifest ({exc})") from exc
+    return parse_campaign_spec(spec_data, str(path))
+
+
+def write_stored_antenna(out_dir: Path, antenna: Antenna) -> None:
+    """Save the antenna the runs use, atomically."""
+    atomic_write_text(out_dir / ANTENNA_FILE, antenna_to_toml(antenna))
+
+
+def read_stored_antenna(out_dir: Path) -> Antenna | None:
+    """The antenna stored by an earlier start, or None."""
+    path = out_dir / ANTENNA_FILE
+    return load_antenna(path) if path.is_file() else None
+
+
+def write_run_result(out_dir: Path, result: RunResult) -> Path:
+    """Store one finished run as ``runs/<run_id>.json`` (atomic)."""
+    runs = out_dir / RUNS_DIR
+    runs.mkdir(parents=True, exist_ok=True)
+    path = runs / f"{result.run_id}.json"
+    atomic_write_text(path, json.dumps(result.to_dict(), indent=1, allow_nan=False) + "\n")
+    return path
+
+
+def load_run_results(out_dir: Path) -> dict[str, RunResult]:
+    """Every finished run stored in ``out_dir/runs``, keyed by run id (temp files ignored)."""
+    runs = out_dir / RUNS_DIR
+    results: dict[str, RunResult] = {}
+    if not runs.is_dir():
+        return results
+    for path in sorted(runs.glob("*.json")):
+        try:
+            result = RunResult.from_dict(json.loads(path.read_text("utf-8")))
+        except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+            raise CampaignStoreError(
+                f"{path}: damaged run file ({exc}); delete it to redo that run"
+            ) from exc
+        if result.run_id != path.stem:
+            raise CampaignStoreError(f"{path}: run_id: file holds run {result.run_id!r}")
+        results[result.run_id] = result
+    return results
+
+
+def write_runs_csv(path: Path, results: Iterable[RunResult], methods: Sequence[str]) -> Path:
+    """Write the run x method table (:data:`~sensing_antenna.campaign.records.CSV_COLUMNS`)."""
+    ordered = sorted(results, key=lambda r: r.index)
+    lines: list[dict[str, Any]] = []
+    for result in ordered:
+        lines.extend(result_rows(result, methods))
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "w", encoding="utf-8", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(CSV_COLUMNS), lineterminator="\n")
+        writer.writeheader()
+        for row in lines:
+            writer.writerow({k: _cell(v) for k, v in row.items()})
+    os.replace(tmp, path)
+    return path
+
+
+def _cell(value: Any) -> Any:
+    if isinstance(value, float):
+        return "" if not math.isfinite(value) else repr(value)
+    return value

@@ -1,0 +1,291 @@
+"""Campaign runner: parallel execution, resume after interruption, failure recording, Dask.
+
+These tests use a small real run function of their own (a seeded noisy "estimator" of the true
+contact point), so the runner is tested without the simulator; the simulate+estimate run function
+is exercised in test_campaign_simulated.py.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import Antenna, paper_antenna
+from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, MethodOutcome, RunResult
+from sensing_antenna.campaign.runner import execute_safely, run_campaign
+from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
+from sensing_antenna.campaign.store import CampaignStoreError, load_run_results
+
+#: Columns that depend on wall-clock time and may differ between identical campaigns.
+TIMING_COLUMNS = ("simulate_s", "estimate_s")
+
+
+def small_spec(**changes: object) -> CampaignSpec:
+    values: dict[str, object] = {
+        "name": "small",
+        "antenna": "paper-2021",
+        "cases": ("azimuthal", "vertical"),
+        "contact_points": (0.3, 0.6, 0.9),
+        "repeats": 2,
+        "base_seed": 11,
+        "methods": ("paper", "ratio"),
+    }
+    values.update(changes)
+    return CampaignSpec(**values)  # type: ignore[arg-type]
+
+
+def noisy_run(run: RunSpec) -> RunResult:
+    """Deterministic toy run: each method estimates x_c with seeded Gaussian noise (1 cm)."""
+    rng = np.random.default_rng(run.seed)
+    outcomes = [
+        MethodOutcome(
+            method=m,
+            status="ok",
+            x_c=run.contact_point + float(rng.normal(0.0, 0.01)),
+            elapsed_s=0.0,
+        )
+        for m in run.methods
+    ]
+    return RunResult.for_run(run, outcomes, simulate_s=0.0)
+
+
+def failing_at_06(run: RunSpec) -> RunResult:
+    """Like :func:`noisy_run`, but every run at x_c = 0.6 m raises."""
+    if math.isclose(run.contact_point, 0.6):
+        raise RuntimeError(f"simulator diverged at {run.contact_point} m")
+    return noisy_run(run)
+
+
+class Interrupted(BaseException):
+    """Stands in for Ctrl-C / SIGTERM: not an Exception, so the runner does not record it."""
+
+
+def same_antenna(spec: CampaignSpec) -> Antenna:
+    return paper_antenna()
+
+
+def read_rows(path: Path) -> list[dict[str, str]]:
+    with open(path, encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    for row in rows:
+        for column in TIMING_COLUMNS:
+            row.pop(column)
+    return rows
+
+
+def test_inline_campaign_writes_one_file_per_run_and_a_row_per_method(tmp_path: Path) -> None:
+    spec = small_spec()
+    outcome = run_campaign(
+        spec, tmp_path, run_one=noisy_run, prepare_antenna=same_antenna, workers=1, progress=False
+    )
+    assert (outcome.n_runs, outcome.n_executed, outcome.n_failed) == (12, 12, 0)
+    assert len(list((tmp_path / "runs").glob("*.json"))) == 12
+    rows = read_rows(outcome.csv_path)
+    assert len(rows) == 12 * 2
+    first = rows[0]
+    assert first["run_id"] == "azimuthal-x0300mm-r1"
+    assert first["method"] == "paper"
+    # error is estimate minus truth, in metres
+    estimate = float(first["x_c_estimate_m"])
+    assert float(first["error_m"]) == pytest.approx(estimate - 0.3, abs=1e-12)
+
+
+def test_process_pool_gives_the_same_results_as_inline(tmp_path: Path) -> None:
+    spec = small_spec()
+    inline = run_campaign(
+        spec,
+        tmp_path / "inline",
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=1,
+        progress=False,
+    )
+    pooled = run_campaign(
+        spec,
+        tmp_path / "pool",
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=2,
+        progress=False,
+    )
+    assert read_rows(inline.csv_path) == read_rows(pooled.csv_path)
+
+
+def test_interrupted_campaign_resumes_without_redoing_or_losing_runs(tmp_path: Path) -> None:
+    spec = small_spec()
+    reference = run_campaign(
+        spec,
+        tmp_path / "ref",
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=1,
+        progress=False,
+    )
+    calls: list[str] = []
+
+    def stop_after_five(run: RunSpec) -> RunResult:
+        if len(calls) == 5:
+            raise Interrupted
+        calls.append(run.run_id)
+        return noisy_run(run)
+
+    out = tmp_path / "resumed"
+    with pytest.raises(Interrupted):
+        run_campaign(
+            spec,
+            out,
+            run_one=stop_after_five,
+            prepare_antenna=same_antenna,
+            workers=1,
+            progress=False,
+        )
+    stored_first = {p.name: p.stat().st_mtime_ns for p in (out / "runs").glob("*.json")}
+    assert len(stored_first) == 5
+
+    second: list[str] = []
+
+    def counting(run: RunSpec) -> RunResult:
+        second.append(run.run_id)
+        return noisy_run(run)
+
+    outcome = run_campaign(
+        spec, out, run_one=counting, prepare_antenna=same_antenna, workers=1, progress=False
+    )
+    assert (outcome.n_previously_done, outcome.n_executed) == (5, 7)
+    assert set(second).isdisjoint(calls), "finished runs must not be redone"
+    for name, mtime in stored_first.items():
+        assert (out / "runs" / name).stat().st_mtime_ns == mtime, f"{name} was rewritten"
+    assert read_rows(outcome.csv_path) == read_rows(reference.csv_path)
+
+
+def test_a_failing_run_is_recorded_and_the_others_finish(tmp_path: Path) -> None:
+    spec = small_spec()
+    outcome = run_campaign(
+        spec,
+        tmp_path,
+        run_one=failing_at_06,
+        prepare_antenna=same_antenna,
+        workers=2,
+        progress=False,
+    )
+    # 2 cases x 2 repeats at 0.6 m fail; the other 8 runs succeed
+    assert (outcome.n_executed, outcome.n_failed) == (12, 4)
+    results = load_run_results(tmp_path)
+    failed = [r for r in results.values() if r.status == RUN_FAILED]
+    assert {r.contact_point for r in failed} == {0.6}
+    assert all("RuntimeError: simulator diverged" in r.error for r in failed)
+    assert all("Traceback" in r.detail for r in failed)
+    assert sum(r.status == RUN_OK for r in results.values()) == 8
+    rows = read_rows(outcome.csv_path)
+    failed_rows = [row for row in rows if row["run_status"] == RUN_FAILED]
+    assert len(failed_rows) == 4 * 2
+    assert all(row["status"] == "run-failed" and row["x_c_estimate_m"] == "" for row in failed_rows)
+
+
+def test_failed_runs_are_kept_on_resume_and_redone_when_asked(tmp_path: Path) -> None:
+    spec = small_spec()
+    run_campaign(
+        spec,
+        tmp_path,
+        run_one=failing_at_06,
+        prepare_antenna=same_antenna,
+        workers=1,
+        progress=False,
+    )
+    again = run_campaign(
+        spec, tmp_path, run_one=noisy_run, prepare_antenna=same_antenna, workers=1, progress=False
+    )
+    assert (again.n_executed, again.n_failed) == (0, 4)
+    retried = run_campaign(
+        spec,
+        tmp_path,
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=1,
+        retry_failed=True,
+        progress=False,
+    )
+    assert (retried.n_executed, retried.n_failed) == (4, 0)
+
+
+def test_execute_safely_turns_an_exception_into_a_failed_result() -> None:
+    run = small_spec().contact_points  # noqa: F841 - the spec is valid
+    from sensing_antenna.campaign.spec import expand_runs
+
+    spec_run = expand_runs(small_spec(), paper_antenna())[2]
+    result = execute_safely(failing_at_06, spec_run)
+    assert result.status == RUN_FAILED
+    assert result.run_id == spec_run.run_id
+
+
+def test_a_directory_of_another_spec_is_refused(tmp_path: Path) -> None:
+    run_campaign(
+        small_spec(),
+        tmp_path,
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=1,
+        progress=False,
+    )
+    with pytest.raises(CampaignStoreError, match=r"campaign\.json: fingerprint"):
+        run_campaign(
+            small_spec(repeats=3),
+            tmp_path,
+            run_one=noisy_run,
+            prepare_antenna=same_antenna,
+            workers=1,
+            progress=False,
+        )
+
+
+def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:
+    run_campaign(
+        small_spec(),
+        tmp_path,
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=1,
+        progress=False,
+    )
+    damaged = tmp_path / "runs" / "vertical-x0900mm-r2.json"
+    damaged.write_text(json.dumps({"run_id": "vertical-x0900mm-r2"}), encoding="utf-8")
+    with pytest.raises(CampaignStoreError, match=r"vertical-x0900mm-r2\.json: damaged run file"):
+        load_run_results(tmp_path)
+
+
+def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:
+    distributed = pytest.importorskip("distributed")
+    spec = small_spec()
+    inline = run_campaign(
+        spec,
+        tmp_path / "inline",
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=1,
+        progress=False,
+    )
+    with distributed.LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=False,
+        host="127.0.0.1",
+        protocol="tcp://",
+        dashboard_address=None,
+    ) as cluster:
+        on_dask = run_campaign(
+            spec,
+            tmp_path / "dask",
+            run_one=failing_at_06,
+            prepare_antenna=same_antenna,
+            scheduler=cluster.scheduler_address,
+            progress=False,
+        )
+    assert on_dask.n_failed == 4
+    ok_rows = [row for row in read_rows(on_dask.csv_path) if row["run_status"] == RUN_OK]
+    expected = [row for row in read_rows(inline.csv_path) if float(row["x_c_true_m"]) != 0.6]
+    assert ok_rows == expected
