@@ -1,0 +1,138 @@
+"""Every tunable of the contact-point pipeline, with its unit and the reason for its default.
+
+Variants are made with :func:`dataclasses.replace`; a config is validated when built.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from sensing_antenna.errors import SensingAntennaError
+
+__all__ = ["EstimatorConfig", "EstimatorConfigError"]
+
+
+class EstimatorConfigError(SensingAntennaError, ValueError):
+    """An estimator setting is out of range; the message names the field."""
+
+
+@dataclass(frozen=True)
+class EstimatorConfig:
+    """Settings of the estimation pipeline (SI units).
+
+    Parameters
+    ----------
+    rest_window : float
+        Offline t_1 (s): the head is at rest at t_1 when, for this long after t_1, neither motor
+        angle moves by more than the rest tolerance. 50 ms is 2.5 % of the slowest contact
+        vibration period and 10 time constants of the paper's servo (poles of Eq. 14 are fast),
+        long enough not to mistake a slow crossing of a turning point for rest.
+    rest_angle_tolerance : float
+        Floor of the rest tolerance (rad, peak-to-peak over ``rest_window``). 1e-4 rad is 0.1 mm
+        at the tip of a 1 m link, while a head still pushing at 0.01 rad/s moves 5e-4 rad in
+        50 ms.
+    rest_noise_factor : float
+        The rest tolerance is at least this many times the angle noise estimated from the
+        recording (robust standard deviation of second differences), so encoder noise alone never
+        prevents rest. 8 sigma peak-to-peak over 50 samples is exceeded by Gaussian noise with
+        probability below 1e-6.
+    frame_window : float
+        Average of force and angles over [t_1, t_1 + frame_window] (s) that defines the contact
+        frame; 20 ms averages 20 samples (noise / 4.5) while staying well inside the hold.
+    spectrum_window : float
+        Delta t_e1 (s), the record after t_1 analysed by Estimator 1. 1 s holds 5 periods of the
+        lowest fundamental in the working range (31 rad/s, period 0.2 s) and gives a DFT bin of
+        6.3 rad/s that zero padding and interpolation refine far below the bin.
+    zero_padding : int
+        The spectrum is computed on ``zero_padding`` times the window length (power of two above),
+        so that the parabolic peak interpolation has a negligible bias (< 1e-3 bin at 16).
+    contact_range : tuple of float
+        Fractions of the link length (min, max) where a contact is searched for; (0.2, 1.0)
+        covers the paper's tested range 0.3 to 0.98 m with room below.
+    band_margin : float
+        Relative margin added on both sides of the omega_1 band the sensing curve allows, for
+        calibration error; 0.15 covers the 7 % T vs T_e difference of Section 5.1 twice.
+    min_peak_quality : float
+        A spectral peak is clear when its power exceeds this many times the median power of the
+        band (10 dB). White noise exceeds 10 times its median power with probability
+        exp(-10 ln 2) ~ 1e-3 per bin.
+    component_agreement : float
+        Relative tolerance between the peaks found in the two perpendicular torque components
+        (when both are clear); beyond it the diagnostics flag the disagreement. 0.05 is several
+        times the interpolation error of a clear peak.
+    lowpass_cutoff : float
+        omega_c of the Eq. 20 low-pass filter (rad/s); 5 rad/s as in Section 5.1, six times below
+        the lowest fundamental.
+    convergence_window : float
+        Estimator 2 has converged at t when the ratio stayed within ``convergence_tolerance`` over
+        [t - window, t] (s). 0.2 s is one filter time constant 1 / omega_c and one period of the
+        slowest vibration.
+    convergence_tolerance : float
+        Peak-to-peak band of the converged ratio (m); 1 cm is the paper's typical accuracy.
+    max_ratio_wait : float
+        If the ratio has not converged this long after t_1 (s), the estimate is given with
+        ``slip_suspected``; 3 s is 15 filter time constants.
+    disagreement_tolerance : float
+        Largest accepted distance between the chosen frequency candidate and the ratio estimate
+        (m). 0.1 m (10 % of the paper's link) is above the ratio estimator's errors reported by
+        the paper (0.914 m for 0.85 m in Figure 14b, 3 % of length for prior methods).
+    max_deflection_ratio : float
+        Largest static deflection y_c / x_c at the contact consistent with Assumption 1 (10 %).
+    max_direction_drift : float
+        Largest angle (rad) between the filtered contact-force direction at t_1 + settle and at t_e
+        before a slip is suspected; 0.15 rad (8.6 deg) is well above noise at gentle pushes.
+    max_ratio_drift : float
+        Largest change (m) of the filtered ratio over the last ``convergence_window`` before t_e
+        tolerated as a steady hold; beyond it the contact is drifting (slip). 2 cm.
+    min_push_force : float
+        Smallest contact force (N) at t_1, gravity removed, for a push to count as reached;
+        5 mN is a tenth of the link weight (0.045 N) and far above F/T sensor noise averaged over
+        ``frame_window``.
+    min_nyquist_factor : float
+        The Nyquist frequency pi / T_s must exceed this factor times the top of the omega_1 band;
+        below it the recording cannot show the vibration (bad_input). 2 keeps the peak away from
+        the anti-aliasing roll-off.
+    """
+
+    rest_window: float = 0.05
+    rest_angle_tolerance: float = 1.0e-4
+    rest_noise_factor: float = 8.0
+    frame_window: float = 0.02
+    spectrum_window: float = 1.0
+    zero_padding: int = 16
+    contact_range: tuple[float, float] = (0.2, 1.0)
+    band_margin: float = 0.15
+    min_peak_quality: float = 10.0
+    component_agreement: float = 0.05
+    lowpass_cutoff: float = 5.0
+    convergence_window: float = 0.2
+    convergence_tolerance: float = 0.01
+    max_ratio_wait: float = 3.0
+    disagreement_tolerance: float = 0.1
+    max_deflection_ratio: float = 0.1
+    max_direction_drift: float = 0.15
+    max_ratio_drift: float = 0.02
+    min_push_force: float = 0.005
+    min_nyquist_factor: float = 2.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "contact_range":
+                low, high = value
+                if not (0.0 <= low < high <= 1.0):
+                    raise EstimatorConfigError(
+                        f"contact_range: must satisfy 0 <= min < max <= 1, got {value!r}"
+                    )
+                continue
+            if f.name == "zero_padding":
+                if not (isinstance(value, int) and value >= 1):
+                    raise EstimatorConfigError(
+                        f"zero_padding: must be an integer >= 1, got {value!r}"
+                    )
+                continue
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise EstimatorConfigError(f"{f.name}: must be a finite number > 0, got {value!r}")
+        if self.max_ratio_wait < self.convergence_window:
+            raise EstimatorConfigError("max_ratio_wait: must be >= convergence_window")

@@ -1,0 +1,243 @@
+"""The instant t_1 found in the recording, and the contact frame X^c Y^c Z^c (Section 5.3).
+
+Offline, t_1 is the instant the head comes to rest after the contact: from t_1 on, for
+``rest_window`` seconds, neither motor angle moves by more than a tolerance that is the larger of a
+fixed floor, a multiple of the angle noise and a few encoder steps, both measured on the samples
+before the contact. This uses no knowledge of the device's push criterion, so it works on recordings
+from devices that stop their motors on other criteria. The test is causal (it needs the samples up
+to t_1 + rest_window), so the streaming estimator applies exactly the same rule.
+
+The frame (Section 5.3) is built from averages over [t_1, t_1 + frame_window]:
+
+- Y^c along the reaction of the object on the antenna, R = F - F_g^m. With the recording
+  convention (F is exerted by the link on the head) the link's equilibrium is
+  -F + R + W = 0, and F_g^m is W in the motor frame, so R = F - F_g^m. Gravity matters: the link
+  weight m_b g = 0.045 N is comparable to gentle pushes.
+- Z^c along OP_r x Y^c, with P_r = l X^m the tip of the rigid link from the motor angles.
+- X^c = Y^c x Z^c (equal to X^m when the reaction is perpendicular to the link).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
+from sensing_antenna.estimation.config import EstimatorConfig
+
+__all__ = [
+    "ContactFrame",
+    "angle_noise",
+    "contact_frame",
+    "first_rest_index",
+    "gravity_force_m",
+    "gravity_torque_m",
+    "motor_axes",
+    "rest_tolerance",
+    "to_absolute",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+def motor_axes(theta: FloatArray) -> FloatArray:
+    """Rows X^m, Y^m, Z^m of the motor frame in absolute coordinates.
+
+    Parameters
+    ----------
+    theta : array, shape (2,)
+        Motor angles theta1 (azimuth), theta2 (elevation) (rad).
+
+    Returns
+    -------
+    array, shape (3, 3)
+    """
+    c1, s1 = np.cos(theta[0]), np.sin(theta[0])
+    c2, s2 = np.cos(theta[1]), np.sin(theta[1])
+    return np.array(
+        [
+            [c2 * c1, c2 * s1, s2],
+            [-s1, c1, 0.0],
+            [-s2 * c1, -s2 * s1, c2],
+        ]
+    )
+
+
+def to_absolute(vector_m: FloatArray, theta: FloatArray) -> FloatArray:
+    """A vector given in the motor frame, in absolute coordinates, shape (3,) or (n, 3)."""
+    return np.asarray(vector_m, dtype=float) @ motor_axes(theta)
+
+
+def gravity_force_m(antenna: Antenna, theta2: FloatArray) -> FloatArray:
+    """F_g^m of Section 4.2 for each elevation angle (N), shape theta2.shape + (3,)."""
+    theta2 = np.asarray(theta2, dtype=float)
+    weight = antenna.link.mass * STANDARD_GRAVITY
+    out = np.zeros((*theta2.shape, 3))
+    # Section 4.2: F_g^m = (-m_b g sin theta2, 0, -m_b g cos theta2)
+    out[..., 0] = -weight * np.sin(theta2)
+    out[..., 2] = -weight * np.cos(theta2)
+    return out
+
+
+def gravity_torque_m(antenna: Antenna, theta2: FloatArray) -> FloatArray:
+    """Gamma_g^m of Section 4.2 for each elevation angle (N m), shape theta2.shape + (3,)."""
+    theta2 = np.asarray(theta2, dtype=float)
+    weight = antenna.link.mass * STANDARD_GRAVITY
+    out = np.zeros((*theta2.shape, 3))
+    # Section 4.2: Gamma_g^m = (0, 0.5 m_b g l cos theta2, 0)
+    out[..., 1] = 0.5 * weight * antenna.link.length * np.cos(theta2)
+    return out
+
+
+def angle_noise(theta: FloatArray) -> tuple[float, float]:
+    """Angle noise and encoder step estimated from samples, the larger over both motors (rad).
+
+    The noise is the robust standard deviation of the second differences divided by sqrt(6)
+    (the second difference of white noise of variance s^2 has variance 6 s^2; a smooth trajectory
+    sampled at 1 kHz contributes only acceleration * T_s^2). The encoder step is the smallest
+    non-zero first difference (0 when there are fewer than 3 samples).
+
+    Parameters
+    ----------
+    theta : array, shape (n, 2)
+        Motor angles (rad).
+
+    Returns
+    -------
+    (noise, step) : tuple of float
+    """
+    theta = np.asarray(theta, dtype=float)
+    if theta.shape[0] < 3:
+        return 0.0, 0.0
+    second = np.diff(theta, n=2, axis=0)
+    mad = np.median(np.abs(second - np.median(second, axis=0)), axis=0)
+    noise = float(np.max(mad / 0.6745 / np.sqrt(6.0)))
+    first = np.abs(np.diff(theta, axis=0))
+    nonzero = first[first > 0.0]
+    step = float(nonzero.min()) if nonzero.size else 0.0
+    return noise, step
+
+
+def rest_tolerance(theta_before_contact: FloatArray, config: EstimatorConfig) -> float:
+    """Peak-to-peak angle tolerance (rad) below which the head counts as at rest.
+
+    The largest of the floor ``config.rest_angle_tolerance``, ``rest_noise_factor`` times the
+    angle noise, and three encoder steps (a quantised angle at rest flickers by one or two steps).
+    """
+    noise, step = angle_noise(theta_before_contact)
+    return max(config.rest_angle_tolerance, config.rest_noise_factor * noise, 3.0 * step)
+
+
+def first_rest_index(
+    theta: FloatArray, start: int, window_samples: int, tolerance: float
+) -> int | None:
+    """First index i >= start with both angles within ``tolerance`` peak-to-peak on [i, i + w].
+
+    Parameters
+    ----------
+    theta : array, shape (n, 2)
+        Motor angles (rad).
+    start : int
+        First candidate index (the contact index).
+    window_samples : int
+        w, the number of sample intervals in the rest window.
+    tolerance : float
+        Peak-to-peak tolerance (rad).
+
+    Returns
+    -------
+    int or None
+        The index of t_1, or None when the head never rests in the samples.
+    """
+    theta = np.asarray(theta, dtype=float)
+    segment = theta[start:]
+    if segment.shape[0] < window_samples + 1:
+        return None
+    windows = np.lib.stride_tricks.sliding_window_view(segment, window_samples + 1, axis=0)
+    spread = windows.max(axis=-1) - windows.min(axis=-1)
+    at_rest = np.all(spread <= tolerance, axis=1)
+    hits = np.flatnonzero(at_rest)
+    return start + int(hits[0]) if hits.size else None
+
+
+@dataclass(frozen=True)
+class ContactFrame:
+    """The frame attached to the contact at t_1 (Section 5.3).
+
+    Attributes
+    ----------
+    axes_m : array, shape (3, 3)
+        Rows X^c, Y^c, Z^c in motor coordinates.
+    motor_axes_a : array, shape (3, 3)
+        Rows X^m, Y^m, Z^m in absolute coordinates at t_1.
+    theta : array, shape (2,)
+        Motor angles averaged over the frame window (rad).
+    reaction_m : array, shape (3,)
+        Reaction of the object on the antenna R = F - F_g^m, motor frame (N).
+    """
+
+    axes_m: FloatArray
+    motor_axes_a: FloatArray
+    theta: FloatArray
+    reaction_m: FloatArray
+
+    @property
+    def axes_a(self) -> FloatArray:
+        """Rows X^c, Y^c, Z^c in absolute coordinates, shape (3, 3)."""
+        return self.axes_m @ self.motor_axes_a
+
+    @property
+    def push_force(self) -> float:
+        """|R| (N)."""
+        return float(np.linalg.norm(self.reaction_m))
+
+    @property
+    def axial_fraction(self) -> float:
+        """|R . X^m| / |R|: share of the reaction along the undeflected link (dimensionless)."""
+        norm = self.push_force
+        return float(abs(self.reaction_m[0]) / norm) if norm > 0 else float("nan")
+
+
+def contact_frame(
+    theta: FloatArray, reaction_m: FloatArray, link_length: float
+) -> ContactFrame | None:
+    """Build the contact frame from samples around t_1.
+
+    Parameters
+    ----------
+    theta : array, shape (k, 2)
+        Motor angles over the frame window (rad).
+    reaction_m : array, shape (k, 3)
+        Reaction of the object on the antenna R = F - F_g^m over the frame window, motor frame
+        (N); see :func:`sensing_antenna.estimation.ratio.contact_loads`.
+    link_length : float
+        l (m), for the rigid tip P_r = l X^m.
+
+    Returns
+    -------
+    ContactFrame or None
+        None when the reaction is zero or along the link, where Y^c or Z^c is undefined.
+    """
+    theta_mean = np.mean(np.asarray(theta, dtype=float), axis=0)
+    # Section 5.3: Y^c along the reaction of the object on the antenna, averaged over the window
+    reaction = np.mean(np.asarray(reaction_m, dtype=float), axis=0)
+    norm = float(np.linalg.norm(reaction))
+    if norm == 0.0:
+        return None
+    y_c = reaction / norm
+    # Section 5.3: Z^c along OP_r x Y^c, OP_r = l X^m = (l, 0, 0) in motor coordinates
+    z_raw = np.cross(np.array([link_length, 0.0, 0.0]), y_c)
+    z_norm = float(np.linalg.norm(z_raw))
+    if z_norm < 1e-6 * link_length:
+        return None
+    z_c = z_raw / z_norm
+    # Section 5.3: X^c = Y^c x Z^c
+    x_c = np.cross(y_c, z_c)
+    return ContactFrame(
+        axes_m=np.vstack([x_c, y_c, z_c]),
+        motor_axes_a=motor_axes(theta_mean),
+        theta=theta_mean,
+        reaction_m=reaction,
+    )

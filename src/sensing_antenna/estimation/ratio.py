@@ -1,0 +1,167 @@
+"""Estimator 2 (Sections 4.4 and 5.5): the torque/force ratio of the low-pass filtered loads.
+
+Statics of the link (recording convention: F and Gamma are exerted by the link on the head, torque
+about O). With R the reaction of the object on the antenna, applied at the contact point
+r_c = x_c X^m + d (d the static deflection, along R), and W the link weight:
+
+    F = R + W,            Gamma = r_c x R + Gamma_W
+
+so the contact part of the loads is R = F - F_g^m and r_c x R = Gamma - Gamma_g^m (Section 4.2).
+Because d is parallel to R, |Gamma - Gamma_g^m| = x_c |X^m x R| = x_c |R_perp|, where R_perp is the
+part of R perpendicular to the link. Eq. 19 divides by |R| instead, which equals |R_perp| when the
+reaction is normal to the link (the paper's Assumption 4) and underestimates x_c by the factor
+cos(angle) otherwise. The paper method divides by |R_perp| (exact for any axial friction); the
+``ratio`` baseline keeps Eq. 21 as printed.
+
+Filter start. Eq. 21 filters F and Gamma (Eq. 20) and subtracts the gravity terms afterwards.
+Here gravity is subtracted sample by sample before the filter: the filter is linear, so the two
+agree exactly while theta2 is constant (after t_1) and this one is also right while the head moves.
+The filter runs continuously from the first sample, started in steady state: before the contact the
+contact loads are zero (apart from the inertial loads of the free motion), and while the push
+builds up R(t) = r(t) u and r_c x R(t) = x_c r(t) (X^m x u) grow in proportion, so the filtered
+ratio already equals x_c at t_1; only the vibration and the decaying inertial loads remain, and
+they fade with the filter. Starting the filter from zero at t_1 (and subtracting gravity after the
+filter, as in Eq. 21) would instead bias the ratio for several 1/omega_c.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import Antenna
+from sensing_antenna.estimation.contact_frame import gravity_force_m, gravity_torque_m
+from sensing_antenna.estimation.filters import low_pass
+
+__all__ = [
+    "contact_loads",
+    "converged_index",
+    "filtered_contact_loads",
+    "paper_ratio",
+    "perpendicular_ratio",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+def contact_loads(
+    theta: FloatArray, force_m: FloatArray, torque_m: FloatArray, antenna: Antenna
+) -> tuple[FloatArray, FloatArray]:
+    """Loads of the contact alone: R = F - F_g^m and Gamma - Gamma_g^m (Section 4.2).
+
+    Parameters
+    ----------
+    theta : array, shape (n, 2)
+        Motor angles (rad).
+    force_m, torque_m : array, shape (n, 3)
+        Measured force (N) and torque (N m), motor frame.
+    antenna : Antenna
+
+    Returns
+    -------
+    reaction_m : array, shape (n, 3)
+        Reaction of the object on the antenna (N).
+    contact_torque_m : array, shape (n, 3)
+        Its moment about O (N m).
+    """
+    theta2 = np.asarray(theta, dtype=float)[:, 1]
+    # Section 4.2 / Eq. 19: remove the gravity force and torque of the link
+    reaction = np.asarray(force_m, dtype=float) - gravity_force_m(antenna, theta2)
+    moment = np.asarray(torque_m, dtype=float) - gravity_torque_m(antenna, theta2)
+    return reaction, moment
+
+
+def filtered_contact_loads(
+    theta: FloatArray,
+    force_m: FloatArray,
+    torque_m: FloatArray,
+    antenna: Antenna,
+    cutoff: float,
+    sample_period: float,
+) -> tuple[FloatArray, FloatArray]:
+    """Contact loads through the low-pass filter of Eq. 20, from the first sample in steady state.
+
+    Returns
+    -------
+    reaction_f, torque_f : array, shape (n, 3)
+        Filtered R (N) and filtered Gamma - Gamma_g^m (N m), motor frame.
+    """
+    reaction, moment = contact_loads(theta, force_m, torque_m, antenna)
+    # Eq. 20: G(s) = 1 / (1 + s / omega_c) on all six channels
+    both = low_pass(np.hstack([reaction, moment]), cutoff, sample_period)
+    return both[:, :3], both[:, 3:]
+
+
+def perpendicular_ratio(reaction_f: FloatArray, torque_f: FloatArray) -> FloatArray:
+    """x_c(t) = |Gamma_f - Gamma_g| / |R_f perpendicular to the link| (m), shape (n,).
+
+    The variant of Eq. 21 used by the paper method (see the module notes); NaN where the
+    perpendicular force is exactly zero.
+    """
+    reaction_f = np.asarray(reaction_f, dtype=float)
+    torque_norm = np.linalg.norm(np.asarray(torque_f, dtype=float), axis=-1)
+    perpendicular = np.hypot(reaction_f[..., 1], reaction_f[..., 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # Eq. 21 with |R_perp| in the denominator: x_c = |Gamma_f - Gamma_g| / |R_f,perp|
+        ratio = torque_norm / perpendicular
+    return np.where(perpendicular > 0.0, ratio, np.nan)
+
+
+def paper_ratio(
+    theta: FloatArray,
+    force_m: FloatArray,
+    torque_m: FloatArray,
+    antenna: Antenna,
+    cutoff: float,
+    sample_period: float,
+) -> FloatArray:
+    """Eq. 21 exactly as printed: filter F and Gamma, then subtract the gravity terms (m), (n,).
+
+    This is the estimator of the paper's reference [17], used by the ``ratio`` baseline.
+    """
+    theta2 = np.asarray(theta, dtype=float)[:, 1]
+    # Eq. 20: filter the measured force and torque
+    filtered = low_pass(
+        np.hstack([np.asarray(force_m, dtype=float), np.asarray(torque_m, dtype=float)]),
+        cutoff,
+        sample_period,
+    )
+    # Eq. 21: x_c(t) = |Gamma_f - Gamma_g| / |F_f - F_g|
+    numerator = np.linalg.norm(filtered[:, 3:] - gravity_torque_m(antenna, theta2), axis=-1)
+    denominator = np.linalg.norm(filtered[:, :3] - gravity_force_m(antenna, theta2), axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = numerator / denominator
+    return np.where(denominator > 0.0, ratio, np.nan)
+
+
+def converged_index(
+    ratio: FloatArray, start: int, window_samples: int, tolerance: float
+) -> int | None:
+    """First index j >= start + w where ratio[j - w : j + 1] stays within ``tolerance``.
+
+    The test is causal: it uses samples up to j only, so a streaming estimator declares
+    convergence at the same sample.
+
+    Parameters
+    ----------
+    ratio : array, shape (n,)
+        x_c(t) (m).
+    start : int
+        Index of t_1: the window never reaches before it.
+    window_samples : int
+        w, the window length in sample intervals.
+    tolerance : float
+        Largest peak-to-peak spread (m).
+
+    Returns
+    -------
+    int or None
+        The convergence index (t_1 + Delta t_e2), None if the ratio never converges.
+    """
+    segment = np.asarray(ratio, dtype=float)[start:]
+    if segment.shape[0] < window_samples + 1:
+        return None
+    windows = np.lib.stride_tricks.sliding_window_view(segment, window_samples + 1)
+    spread = windows.max(axis=-1) - windows.min(axis=-1)
+    hits = np.flatnonzero(spread <= tolerance)
+    return start + window_samples + int(hits[0]) if hits.size else None
