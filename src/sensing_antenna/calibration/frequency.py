@@ -16,9 +16,11 @@ are separate steps.
 
 from __future__ import annotations
 
+import csv
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -37,6 +39,7 @@ __all__ = [
     "calibrate_t_e",
     "fit_inverse_t",
     "model_beta1_squared",
+    "read_contact_points",
 ]
 
 #: Robust losses accepted by :func:`fit_inverse_t` (those of scipy.optimize.least_squares).
@@ -317,6 +320,72 @@ def calibrate_from_recordings(
         else:
             notes.append(f"{names[i]}: no fundamental frequency found ({_describe(measurement)})")
     return calibrate_t_e(contact_points, omega, antenna.link, loss=loss, sources=names, notes=notes)
+
+
+def read_contact_points(
+    paths: Sequence[Path], recordings: Sequence[Any], table: Path | None = None
+) -> list[float]:
+    """Known contact points (m) of calibration recordings, from a table or their metadata.
+
+    With ``table``, a CSV file with columns ``file`` and ``x_c`` (m); a row matches a recording by
+    its path as given or by its file name. Without it, each recording's ground-truth metadata
+    ``true_xc`` is used: calibration is the one place where ground truth is an input, since the
+    contact points of a calibration are known by construction.
+
+    Raises
+    ------
+    CalibrationError
+        Naming the file, line or recording and what is missing or wrong.
+    """
+    if table is not None:
+        known = _read_points_table(table)
+        points = []
+        for path in paths:
+            value = known.get(str(path), known.get(path.name))
+            if value is None:
+                raise CalibrationError(f"{table}: file: no row for recording {path}")
+            points.append(value)
+        return points
+    points = []
+    for path, recording in zip(paths, recordings, strict=True):
+        text = recording.metadata.get("true_xc")
+        if text is None:
+            raise CalibrationError(
+                f"{path}: true_xc: no known contact point; give --points TABLE.csv (file,x_c)"
+            )
+        try:
+            points.append(float(text))
+        except ValueError as exc:
+            raise CalibrationError(f"{path}: true_xc: not a number: {text!r}") from exc
+    return points
+
+
+def _read_points_table(table: Path) -> dict[str, float]:
+    if not table.is_file():
+        raise CalibrationError(f"{table}: no such file")
+    with open(table, encoding="utf-8", newline="") as handle:
+        reader = csv.DictReader(handle)
+        columns = reader.fieldnames or []
+        for column in ("file", "x_c"):
+            if column not in columns:
+                raise CalibrationError(f"{table}: line 1: missing column {column!r}")
+        known: dict[str, float] = {}
+        for row in reader:
+            line = reader.line_num
+            try:
+                value = float(row["x_c"])
+            except (TypeError, ValueError) as exc:
+                raise CalibrationError(
+                    f"{table}: line {line}: x_c: not a number: {row['x_c']!r}"
+                ) from exc
+            if not math.isfinite(value):
+                raise CalibrationError(f"{table}: line {line}: x_c: not finite")
+            name = (row["file"] or "").strip()
+            if not name:
+                raise CalibrationError(f"{table}: line {line}: file: empty")
+            known[name] = value
+            known.setdefault(Path(name).name, value)
+    return known
 
 
 def _describe(measurement: Any) -> str:

@@ -47,6 +47,7 @@ CSV_COLUMNS = (
     "error_m",
     "abs_error_m",
     "omega1_rad_s",
+    "peak_quality",
     "ratio_estimate_m",
     "candidates_m",
     "t_c_s",
@@ -56,7 +57,7 @@ CSV_COLUMNS = (
     "estimate_s",
 )
 
-_FLOAT_FIELDS = ("x_c", "omega1", "ratio_estimate", "t_c", "t_1", "t_e")
+_FLOAT_FIELDS = ("x_c", "omega1", "peak_quality", "ratio_estimate", "t_c", "t_1", "t_e")
 
 
 def _as_float(value: Any) -> float:
@@ -89,6 +90,8 @@ class MethodOutcome:
         Estimated contact point (m); NaN when none.
     omega1 : float
         Measured fundamental frequency (rad/s); NaN when the method does not measure it.
+    peak_quality : float
+        Spectral peak power over the band's median power (dimensionless); NaN when not measured.
     ratio_estimate : float
         Torque/force ratio estimate of Eq. 21 (m); NaN when not used.
     candidates : tuple of float
@@ -104,6 +107,7 @@ class MethodOutcome:
     reason: str = ""
     x_c: float = math.nan
     omega1: float = math.nan
+    peak_quality: float = math.nan
     ratio_estimate: float = math.nan
     candidates: tuple[float, ...] = ()
     t_c: float = math.nan
@@ -281,6 +285,7 @@ def result_rows(result: RunResult, methods: Sequence[str]) -> list[dict[str, Any
                 "error_m": error,
                 "abs_error_m": abs(error),
                 "omega1_rad_s": outcome.omega1,
+                "peak_quality": outcome.peak_quality,
                 "ratio_estimate_m": outcome.ratio_estimate,
                 "candidates_m": ";".join(f"{c:.6g}" for c in outcome.candidates),
                 "t_c_s": outcome.t_c,

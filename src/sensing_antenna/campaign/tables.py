@@ -1,0 +1,207 @@
+"""Tables of a campaign: per-point statistics in the layout of Tables 3 and 4, method summaries.
+
+Statistics are computed in SI (m) over the runs where a method returned a finite estimate; the
+columns follow the paper (Section 5.6): mean estimate, mean absolute error, maximum absolute
+error and standard deviation of the (signed) error at each contact point. The paper's own tables
+ship with the package (``data/paper-2021-table3-azimuthal.csv`` and
+``data/paper-2021-table4-vertical.csv``, copied from Tables 3 and 4 of Feliu-Talegon et al.,
+Sensors 2021) and are read by :func:`paper_table`.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections import Counter
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from typing import Any
+
+import numpy as np
+
+from sensing_antenna.campaign.records import RunResult, result_rows
+
+__all__ = [
+    "PAPER_TABLE_FILES",
+    "MethodSummary",
+    "PaperRow",
+    "PointStats",
+    "campaign_rows",
+    "method_summaries",
+    "paper_row_at",
+    "paper_table",
+    "point_table",
+]
+
+#: Package data files holding Tables 3 (Case 1, azimuthal) and 4 (Case 2, vertical) of the paper.
+PAPER_TABLE_FILES = {
+    "azimuthal": "data/paper-2021-table3-azimuthal.csv",
+    "vertical": "data/paper-2021-table4-vertical.csv",
+}
+
+#: Contact points of the paper and of a campaign are matched to this tolerance (m): the paper
+#: lists them in whole centimetres.
+_POINT_MATCH_TOLERANCE = 1e-4
+
+
+@dataclass(frozen=True)
+class PointStats:
+    """Statistics of one method at one contact point of one case (SI units: m).
+
+    Attributes
+    ----------
+    x_c : float
+        True contact point (m).
+    n_runs : int
+        Runs at this point (including failed ones and runs without an estimate).
+    n_estimates : int
+        Runs with a finite estimate; the statistics are over these.
+    mean_estimate, mean_abs_error, max_error, std_error : float
+        Mean estimate, mean |error|, max |error| and sample standard deviation (ddof = 1) of the
+        signed error, all in m; NaN without estimates (std: with fewer than 2).
+    """
+
+    x_c: float
+    n_runs: int
+    n_estimates: int
+    mean_estimate: float
+    mean_abs_error: float
+    max_error: float
+    std_error: float
+
+
+@dataclass(frozen=True)
+class PaperRow:
+    """One row of Table 3 or 4 of the paper, converted to SI (m)."""
+
+    x_c: float
+    mean_estimate: float
+    mean_abs_error: float
+    max_error: float
+    std_error: float
+
+
+@dataclass(frozen=True)
+class MethodSummary:
+    """One method over one case: error statistics (m) and how many runs ended in each status.
+
+    Attributes
+    ----------
+    case, method : str
+    n_runs : int
+        Runs of this case.
+    n_estimates : int
+        Runs with a finite estimate.
+    mean_abs_error, max_abs_error, rms_error : float
+        Over all estimates of the case (m); NaN without estimates.
+    status_counts : mapping of str to int
+        Runs per status (the estimator's status, ``run-failed`` or ``error``).
+    """
+
+    case: str
+    method: str
+    n_runs: int
+    n_estimates: int
+    mean_abs_error: float
+    max_abs_error: float
+    rms_error: float
+    status_counts: Mapping[str, int]
+
+
+def campaign_rows(results: Iterable[RunResult], methods: Sequence[str]) -> list[dict[str, Any]]:
+    """Every run x method row (see :data:`~sensing_antenna.campaign.records.CSV_COLUMNS`)."""
+    rows: list[dict[str, Any]] = []
+    for result in sorted(results, key=lambda r: r.index):
+        rows.extend(result_rows(result, methods))
+    return rows
+
+
+def _select(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> list[Mapping[str, Any]]:
+    return [r for r in rows if r["case"] == case and r["method"] == method]
+
+
+def point_table(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> list[PointStats]:
+    """Per-contact-point statistics of ``method`` in ``case`` (Tables 3 and 4 layout), by x_c."""
+    selected = _select(rows, case, method)
+    points = sorted({float(r["x_c_true_m"]) for r in selected})
+    table = []
+    for x_c in points:
+        at_point = [r for r in selected if float(r["x_c_true_m"]) == x_c]
+        estimates = np.array([float(r["x_c_estimate_m"]) for r in at_point], dtype=float)
+        estimates = estimates[np.isfinite(estimates)]
+        errors = estimates - x_c
+        n = estimates.size
+        table.append(
+            PointStats(
+                x_c=x_c,
+                n_runs=len(at_point),
+                n_estimates=n,
+                mean_estimate=float(np.mean(estimates)) if n else math.nan,
+                mean_abs_error=float(np.mean(np.abs(errors))) if n else math.nan,
+                max_error=float(np.max(np.abs(errors))) if n else math.nan,
+                std_error=float(np.std(errors, ddof=1)) if n >= 2 else math.nan,
+            )
+        )
+    return table
+
+
+def method_summaries(
+    rows: Iterable[Mapping[str, Any]], cases: Sequence[str], methods: Sequence[str]
+) -> list[MethodSummary]:
+    """One :class:`MethodSummary` per case and method, in the given order."""
+    all_rows = list(rows)
+    summaries = []
+    for case in cases:
+        for method in methods:
+            selected = _select(all_rows, case, method)
+            errors = np.array([float(r["error_m"]) for r in selected], dtype=float)
+            errors = errors[np.isfinite(errors)]
+            n = errors.size
+            summaries.append(
+                MethodSummary(
+                    case=case,
+                    method=method,
+                    n_runs=len(selected),
+                    n_estimates=n,
+                    mean_abs_error=float(np.mean(np.abs(errors))) if n else math.nan,
+                    max_abs_error=float(np.max(np.abs(errors))) if n else math.nan,
+                    rms_error=float(np.sqrt(np.mean(errors**2))) if n else math.nan,
+                    status_counts=dict(Counter(str(r["status"]) for r in selected)),
+                )
+            )
+    return summaries
+
+
+def paper_table(case: str) -> list[PaperRow]:
+    """Table 3 (``"azimuthal"``) or Table 4 (``"vertical"``) of the paper, in m.
+
+    Returns an empty list for a case the paper has no table for.
+    """
+    name = PAPER_TABLE_FILES.get(case)
+    if name is None:
+        return []
+    text = resources.files("sensing_antenna").joinpath(name).read_text("utf-8")
+    lines = [line for line in text.splitlines() if line and not line.startswith("#")]
+    cm = 0.01
+    rows = []
+    for record in csv.DictReader(io.StringIO("\n".join(lines))):
+        rows.append(
+            PaperRow(
+                x_c=float(record["xc"]) * cm,
+                mean_estimate=float(record["mean_estimate"]) * cm,
+                mean_abs_error=float(record["mean_abs_error"]) * cm,
+                max_error=float(record["max_error"]) * cm,
+                std_error=float(record["std_error"]) * cm,
+            )
+        )
+    return rows
+
+
+def paper_row_at(case: str, x_c: float) -> PaperRow | None:
+    """The paper's row at contact point ``x_c`` (m), or None if the paper has none there."""
+    for row in paper_table(case):
+        if abs(row.x_c - x_c) <= _POINT_MATCH_TOLERANCE:
+            return row
+    return None

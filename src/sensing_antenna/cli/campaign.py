@@ -1,0 +1,62 @@
+"""``antenna campaign run|report``: run an experiment campaign and build its report."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+
+def register(subparsers: Any) -> None:
+    """Add ``antenna campaign`` with its ``run`` and ``report`` subcommands."""
+    parser = subparsers.add_parser(
+        "campaign", help="run experiment campaigns (Section 5.6) and build their reports"
+    )
+    actions = parser.add_subparsers(dest="action", metavar="ACTION", parser_class=type(parser))
+    actions.required = True
+
+    run = actions.add_parser(
+        "run",
+        help="simulate and estimate every run of a campaign (resumes an interrupted one)",
+        description="Without SPEC, runs the built-in paper-2021 campaign of Section 5.6.",
+    )
+    run.add_argument("spec", nargs="?", default=None, help="campaign TOML file (default: paper)")
+    run.add_argument("--out", type=Path, required=True, help="campaign directory")
+    run.add_argument("--workers", type=int, default=None, help="local processes (default: cores)")
+    run.add_argument("--scheduler", default=None, help="Dask scheduler address tcp://HOST:PORT")
+    run.add_argument("--retry-failed", action="store_true", help="redo runs stored as failed")
+    run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    run.set_defaults(func=_run)
+
+    report = actions.add_parser("report", help="rebuild tables, figures and report.md")
+    report.add_argument("directory", type=Path, help="campaign directory")
+    report.set_defaults(func=_report)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from sensing_antenna.campaign.report import build_report
+    from sensing_antenna.campaign.runner import run_campaign
+    from sensing_antenna.campaign.spec import load_campaign_spec
+
+    spec = load_campaign_spec(args.spec)
+    outcome = run_campaign(
+        spec,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        retry_failed=args.retry_failed,
+        progress=not args.no_progress,
+    )
+    print(
+        f"{outcome.n_runs} runs: {outcome.n_previously_done} already done, "
+        f"{outcome.n_executed} run now, {outcome.n_failed} failed"
+    )
+    print(build_report(outcome.out_dir))
+    return 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    from sensing_antenna.campaign.report import build_report
+
+    print(build_report(args.directory))
+    return 0

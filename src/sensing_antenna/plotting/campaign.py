@@ -1,0 +1,172 @@
+"""Figures of a campaign (Section 5.6): Figures 16 and 17, Figure 18 and a method comparison.
+
+Every function takes the run x method rows of a campaign (dicts with the columns of
+:data:`~sensing_antenna.campaign.records.CSV_COLUMNS`, SI units), writes PNG files into an output
+directory (created if missing) and returns their paths. Lengths are shown in cm and frequencies in
+rad/s, as in the paper.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from sensing_antenna.antenna import Antenna
+from sensing_antenna.campaign.tables import paper_table, point_table
+
+__all__ = [
+    "CASE_FIGURES",
+    "plot_campaign",
+    "plot_case_estimates",
+    "plot_frequencies",
+    "plot_method_errors",
+]
+
+#: Figure number of the paper for each case (estimated vs real x_c, absolute errors).
+CASE_FIGURES = {"azimuthal": 16, "vertical": 17}
+
+_CM = 100.0
+_METHOD_STYLE = {
+    "paper": {"color": "tab:blue", "marker": "o"},
+    "ratio": {"color": "tab:orange", "marker": "s"},
+    "two-frequency": {"color": "tab:green", "marker": "^"},
+}
+
+
+def _finite(rows: Iterable[Mapping[str, Any]], case: str, method: str, column: str) -> Any:
+    selected = [r for r in rows if r["case"] == case and r["method"] == method]
+    x = np.array([float(r["x_c_true_m"]) for r in selected], dtype=float)
+    y = np.array([float(r[column]) for r in selected], dtype=float)
+    keep = np.isfinite(y)
+    return x[keep], y[keep]
+
+
+def plot_case_estimates(
+    rows: Sequence[Mapping[str, Any]], case: str, out_dir: str | Path, method: str = "paper"
+) -> Path:
+    """Figure 16 (azimuthal) or 17 (vertical): (a) estimated vs real x_c, (b) absolute errors."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    x, estimate = _finite(rows, case, method, "x_c_estimate_m")
+    fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(10, 4.2))
+    line = np.array([0.0, max(1.0, float(x.max(initial=0.0)))])
+    ax_a.plot(line * _CM, line * _CM, color="0.6", lw=1, label="x_c,e = x_c")
+    ax_a.plot(x * _CM, estimate * _CM, "o", ms=4, mfc="none", label=f"{method} ({x.size} runs)")
+    ax_a.set_xlabel("real contact point x_c (cm)")
+    ax_a.set_ylabel("estimated contact point x_c,e (cm)")
+    ax_a.set_title("(a) estimated vs real")
+    ax_a.legend(loc="upper left")
+    ax_b.plot(x * _CM, np.abs(estimate - x) * _CM, "o", ms=4, mfc="none", label="this campaign")
+    paper = paper_table(case)
+    if paper:
+        ax_b.plot(
+            [p.x_c * _CM for p in paper],
+            [p.max_error * _CM for p in paper],
+            "k_",
+            ms=12,
+            label="paper: max error",
+        )
+    ax_b.set_xlabel("real contact point x_c (cm)")
+    ax_b.set_ylabel("absolute error |x_c,e - x_c| (cm)")
+    ax_b.set_title("(b) absolute errors")
+    ax_b.legend(loc="upper left")
+    number = CASE_FIGURES.get(case)
+    title = f"Figure {number}: " if number else ""
+    fig.suptitle(f"{title}{case} movement, method {method}")
+    fig.tight_layout()
+    path = out / f"figure{number or ''}-{case}-{method}.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_frequencies(
+    rows: Sequence[Mapping[str, Any]], antenna: Antenna, out_dir: str | Path
+) -> Path:
+    """Figure 18: measured omega_1 vs x_c in each case, over the sensing curve of ``antenna``."""
+    from sensing_antenna.beam import natural_frequencies
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    link = antenna.link
+    grid = np.linspace(0.2 * link.length, link.length, 200)
+    curve = np.asarray(natural_frequencies(link, grid, 1), dtype=float)[..., 0]
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    ax.plot(grid * _CM, curve, color="0.3", lw=1.5, label=f"sensing curve, T = {link.t_param:.4g}")
+    for case, marker in (("azimuthal", "o"), ("vertical", "x")):
+        x, omega = _finite(rows, case, "paper", "omega1_rad_s")
+        if x.size:
+            ax.plot(x * _CM, omega, marker, ms=5, mfc="none", label=f"measured, {case}")
+    ax.set_xlabel("contact point x_c (cm)")
+    ax.set_ylabel("fundamental frequency omega_1 (rad/s)")
+    ax.set_title("Figure 18: measured fundamental frequencies over the sensing curve")
+    ax.legend()
+    fig.tight_layout()
+    path = out / "figure18-frequencies.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_method_errors(
+    rows: Sequence[Mapping[str, Any]],
+    cases: Sequence[str],
+    methods: Sequence[str],
+    out_dir: str | Path,
+) -> Path:
+    """Mean absolute error vs x_c for every method (one panel per case), with the paper's."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fig, axes = plt.subplots(1, len(cases), figsize=(5.5 * len(cases), 4.2), squeeze=False)
+    for ax, case in zip(axes[0], cases, strict=True):
+        for method in methods:
+            table = point_table(rows, case, method)
+            style = _METHOD_STYLE.get(method, {"color": None, "marker": "."})
+            ax.plot(
+                [p.x_c * _CM for p in table],
+                [p.mean_abs_error * _CM for p in table],
+                marker=style["marker"],
+                color=style["color"],
+                label=method,
+            )
+        paper = paper_table(case)
+        if paper:
+            ax.plot(
+                [p.x_c * _CM for p in paper],
+                [p.mean_abs_error * _CM for p in paper],
+                "k--",
+                lw=1,
+                label="paper (real device)",
+            )
+        ax.set_yscale("log")
+        ax.set_xlabel("real contact point x_c (cm)")
+        ax.set_ylabel("mean absolute error (cm)")
+        ax.set_title(f"{case} movement")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    fig.suptitle("Error versus contact point, all methods on the same recordings")
+    fig.tight_layout()
+    path = out / "errors-by-method.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_campaign(
+    rows: Sequence[Mapping[str, Any]],
+    cases: Sequence[str],
+    methods: Sequence[str],
+    antenna: Antenna,
+    out_dir: str | Path,
+) -> list[Path]:
+    """Every campaign figure: the method comparison, Figures 16/17 per case, and Figure 18."""
+    main = "paper" if "paper" in methods else methods[0]
+    paths = [plot_method_errors(rows, cases, methods, out_dir)]
+    paths += [plot_case_estimates(rows, case, out_dir, main) for case in cases]
+    if "paper" in methods:
+        paths.append(plot_frequencies(rows, antenna, out_dir))
+    return paths

@@ -1,0 +1,126 @@
+"""Campaign specs: the built-in paper campaign, validation messages, run expansion and seeds."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.campaign.spec import (
+    CampaignSpecError,
+    default_campaign_spec,
+    derive_seed,
+    expand_runs,
+    load_campaign_spec,
+)
+from sensing_antenna.errors import SensingAntennaError
+
+GOOD = """
+name = "small"
+antenna = "paper-2021"
+cases = ["azimuthal"]
+contact_points = [0.3, 0.5]
+repeats = 2
+base_seed = 3
+methods = ["paper", "ratio"]
+[scenario]
+noise_scale = 0.5
+"""
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "spec.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_default_campaign_is_the_paper_section_5_6() -> None:
+    # Section 5.6: x_c = 0.30 to 0.95 m every 5 cm plus 0.98 m, 5 experiments per point, 2 cases
+    spec = default_campaign_spec()
+    assert spec.n_runs == 150
+    assert spec.cases == ("azimuthal", "vertical")
+    expected = [*np.round(np.arange(0.30, 0.951, 0.05), 2), 0.98]
+    np.testing.assert_allclose(spec.contact_points, expected, atol=1e-12)
+    assert spec.repeats == 5
+    assert spec.methods == ("paper", "ratio", "two-frequency")
+    assert load_campaign_spec(None) == spec
+
+
+def test_runs_are_ordered_named_and_seeded_deterministically() -> None:
+    spec = default_campaign_spec()
+    runs = expand_runs(spec, paper_antenna())
+    assert len(runs) == 150
+    assert [r.index for r in runs] == list(range(150))
+    assert runs[0].run_id == "azimuthal-x0300mm-r1"
+    assert runs[-1].run_id == "vertical-x0980mm-r5"
+    assert len({r.run_id for r in runs}) == 150
+    assert len({r.seed for r in runs}) == 150
+    again = expand_runs(spec, paper_antenna())
+    assert [r.seed for r in again] == [r.seed for r in runs]
+    assert runs[7].seed == derive_seed(spec.base_seed, 7)
+    # the free-motion step draws from another stream of the same base seed
+    assert derive_seed(spec.base_seed, 0, stream=1) not in {r.seed for r in runs}
+
+
+def test_a_good_file_loads_with_its_scenario(tmp_path: Path) -> None:
+    spec = load_campaign_spec(write(tmp_path, GOOD))
+    assert spec.n_runs == 4
+    assert spec.scenario == {"noise_scale": 0.5}
+    assert spec.free_motion.identify is False
+
+
+def test_fingerprint_ignores_name_but_not_seeds(tmp_path: Path) -> None:
+    a = load_campaign_spec(write(tmp_path, GOOD))
+    b = load_campaign_spec(write(tmp_path, GOOD.replace('"small"', '"renamed"')))
+    c = load_campaign_spec(write(tmp_path, GOOD.replace("base_seed = 3", "base_seed = 4")))
+    assert a.fingerprint() == b.fingerprint() != c.fingerprint()
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [
+        ('cases = ["azimuthal"]', 'cases = ["sideways"]', "cases[0]"),
+        ("contact_points = [0.3, 0.5]", "contact_points = [0.3, -0.5]", "contact_points[1]"),
+        ("contact_points = [0.3, 0.5]", 'contact_points = [0.3, "a"]', "contact_points[1]"),
+        ("contact_points = [0.3, 0.5]", "contact_points = [0.3, 0.3]", "contact_points"),
+        ("repeats = 2", "repeats = 0", "repeats"),
+        ("repeats = 2", "repeats = 2.5", "repeats"),
+        ("repeats = 2", "", "repeats"),
+        ("base_seed = 3", "base_seed = -1", "base_seed"),
+        ('methods = ["paper", "ratio"]', 'methods = ["magic"]', "methods[0]"),
+        ("noise_scale = 0.5", "seed = 4", "scenario.seed"),
+        ('name = "small"', 'name = "small"\ncolour = "red"', "colour"),
+    ],
+)
+def test_bad_fields_are_named_with_the_file(tmp_path: Path, old: str, new: str, field: str) -> None:
+    path = write(tmp_path, GOOD.replace(old, new))
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: {field}:")) as info:
+        load_campaign_spec(path)
+    assert isinstance(info.value, SensingAntennaError)
+
+
+def test_a_contact_point_beyond_the_link_is_refused(tmp_path: Path) -> None:
+    # Table 2: l = 0.98 m
+    spec = load_campaign_spec(write(tmp_path, GOOD.replace("0.5]", "1.2]")))
+    with pytest.raises(CampaignSpecError, match=r"contact_points\[1\]: 1.2 m is beyond"):
+        spec.load_antenna()
+
+
+def test_missing_file_and_bad_toml_are_reported(tmp_path: Path) -> None:
+    with pytest.raises(CampaignSpecError, match="no such file"):
+        load_campaign_spec(tmp_path / "nope.toml")
+    with pytest.raises(CampaignSpecError, match="not valid TOML"):
+        load_campaign_spec(write(tmp_path, "name = "))
+
+
+def test_antenna_file_is_resolved_next_to_the_spec(tmp_path: Path) -> None:
+    (tmp_path / "short.toml").write_text(
+        'base = "paper-2021"\nname = "short"\n[link]\nlength = 0.6\n', encoding="utf-8"
+    )
+    spec = load_campaign_spec(
+        write(tmp_path, GOOD.replace('antenna = "paper-2021"', 'antenna = "short.toml"'))
+    )
+    assert spec.load_antenna().link.length == 0.6
