@@ -1,0 +1,232 @@
+"""Calibration of T_e (Section 5.1): the fit on synthetic frequencies, then on simulated recordings.
+
+The synthetic frequencies come from an independent solution of the contact-mode frequency problem
+written here (the 8 x 8 boundary-condition determinant of Eqs. 3 and 4 with R_m = 0, solved by
+bracketing and brentq), not from :mod:`sensing_antenna.beam`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.calibration.frequency import (
+    CalibrationError,
+    calibrate_t_e,
+    fit_inverse_t,
+    read_contact_points,
+)
+
+#: The paper's calibrated T_e (Section 5.1), s/m^2.
+PAPER_T_E = 0.2124
+#: Contact points of the paper's calibration: 0.30 to 0.95 m every 5 cm, and 0.98 m (Section 5.1).
+PAPER_POINTS = np.array([*np.round(np.arange(0.30, 0.951, 0.05), 2), 0.98])
+#: brentq tolerance of the independent solver on beta l.
+ROOT_TOLERANCE = 1e-12
+
+
+def _determinant(beta: float, x_c: float, length: float) -> float:
+    """Boundary-condition determinant of Eq. 4 (R_m = 0): clamped at 0, pinned at x_c, free at l.
+
+    Segment 1 on [0, x_c] and segment 2 on [x_c, l] (local coordinate from x_c), each
+    y = A cos + B sin + C cosh + D sinh of beta x; derivatives divided by powers of beta.
+    """
+    a, b = beta * x_c, beta * (length - x_c)
+    c, s, ch, sh = math.cos(a), math.sin(a), math.cosh(a), math.sinh(a)
+    cb, sb, chb, shb = math.cos(b), math.sin(b), math.cosh(b), math.sinh(b)
+    m = np.array(
+        [
+            [1, 0, 1, 0, 0, 0, 0, 0],  # y1(0) = 0
+            [0, 1, 0, 1, 0, 0, 0, 0],  # y1'(0) = 0
+            [c, s, ch, sh, 0, 0, 0, 0],  # y1(x_c) = 0
+            [0, 0, 0, 0, 1, 0, 1, 0],  # y2(x_c) = 0
+            [-s, c, sh, ch, 0, -1, 0, -1],  # slope continuous at x_c
+            [-c, -s, ch, sh, 1, 0, -1, 0],  # moment continuous at x_c
+            [0, 0, 0, 0, -cb, -sb, chb, shb],  # y2''(l) = 0
+            [0, 0, 0, 0, sb, -cb, shb, chb],  # y2'''(l) = 0
+        ],
+        dtype=float,
+    )
+    return float(np.linalg.det(m) / (1.0 + ch * chb))
+
+
+def independent_beta1(x_c: float, length: float) -> float:
+    """Smallest beta > 0 (1/m) of the pinned-clamped-free problem, by scanning and brentq."""
+    grid = np.linspace(0.5, 12.0, 2000) / length
+    values = [_determinant(b, x_c, length) for b in grid]
+    for lo, hi, f_lo, f_hi in zip(grid[:-1], grid[1:], values[:-1], values[1:], strict=True):
+        if f_lo == 0.0 or f_lo * f_hi < 0:
+            return float(brentq(_determinant, lo, hi, args=(x_c, length), xtol=ROOT_TOLERANCE))
+    raise AssertionError("no root found")
+
+
+def test_independent_solver_matches_the_clamped_pinned_beam() -> None:
+    # Blevins, Formulas for Natural Frequency and Mode Shape, Table 8-1: clamped-pinned
+    # beam lambda_1 = 3.92660; with the support at the tip the overhang vanishes.
+    assert independent_beta1(1.0, 1.0) == pytest.approx(3.92660, abs=1e-5)
+
+
+def test_paper_frequency_range_follows_from_t_e() -> None:
+    # Section 5.1: with T_e = 0.2124 the measured fundamental frequency spans 31.4 to 106.8 rad/s
+    # over the calibration points. The model's peak (at x_c = 0.75 m, where the README places the
+    # f1 peak) matches the upper end within 1 %; the lower end (x_c = 0.3 m) is a measurement on
+    # the real device that sits 5.5 % above the model, so it is checked to 6 % only.
+    length = paper_antenna().link.length
+    omega = np.array([independent_beta1(x, length) ** 2 / PAPER_T_E for x in PAPER_POINTS])
+    assert PAPER_POINTS[np.argmax(omega)] == pytest.approx(0.75)
+    assert omega.max() == pytest.approx(106.8, rel=0.01)
+    assert omega.min() == pytest.approx(31.4, rel=0.06)
+
+
+def synthetic_k(points: np.ndarray) -> np.ndarray:
+    length = paper_antenna().link.length
+    return np.array([independent_beta1(x, length) ** 2 for x in points])
+
+
+def test_fit_recovers_t_e_from_exact_frequencies() -> None:
+    k = synthetic_k(PAPER_POINTS)
+    for loss in ("linear", "soft_l1"):
+        t_e, std_error = fit_inverse_t(k, k / PAPER_T_E, loss=loss)
+        # exact data: only float round-off remains
+        assert t_e == pytest.approx(PAPER_T_E, rel=1e-12)
+        assert std_error == pytest.approx(0.0, abs=1e-12)
+
+
+def test_standard_error_matches_the_scatter_of_repeated_fits() -> None:
+    rng = np.random.default_rng(20210515)
+    k = synthetic_k(PAPER_POINTS)
+    truth = k / PAPER_T_E
+    sigma = 1.0  # rad/s of measurement noise
+    fits = [
+        fit_inverse_t(k, truth + rng.normal(0.0, sigma, k.size), loss="linear") for _ in range(400)
+    ]
+    t_values = np.array([f[0] for f in fits])
+    reported = np.array([f[1] for f in fits])
+    # unbiased to well within the scatter of the mean of 400 fits (4 standard errors)
+    assert abs(t_values.mean() - PAPER_T_E) < 4 * t_values.std() / math.sqrt(t_values.size)
+    # the mean reported standard error matches the empirical scatter; 400 fits of 15 points give
+    # about 4 % sampling error on a standard deviation, so 15 % is a safe bound
+    assert reported.mean() == pytest.approx(t_values.std(), rel=0.15)
+
+
+def test_robust_fit_resists_one_bad_frequency() -> None:
+    k = synthetic_k(PAPER_POINTS)
+    rng = np.random.default_rng(7)
+    omega = k / PAPER_T_E + rng.normal(0.0, 0.3, k.size)
+    omega[9] *= 0.5  # x_c = 0.75 m: a wrong peak (half the frequency)
+    robust, _ = fit_inverse_t(k, omega, loss="soft_l1")
+    plain, _ = fit_inverse_t(k, omega, loss="linear")
+    # the 0.5 % target of the task for the robust fit; the outlier moves the plain fit beyond it
+    assert robust == pytest.approx(PAPER_T_E, rel=0.005)
+    assert abs(plain / PAPER_T_E - 1.0) > 0.01
+
+
+@pytest.mark.parametrize(
+    ("k", "omega", "message"),
+    [
+        ([1.0, 2.0], [1.0], "2 contact points"),
+        ([], [], "no measured frequency"),
+        ([1.0, -2.0], [1.0, 2.0], "beta1_squared"),
+        ([1.0, 2.0], [1.0, math.nan], "finite"),
+    ],
+)
+def test_fit_rejects_bad_input(k: list[float], omega: list[float], message: str) -> None:
+    with pytest.raises(CalibrationError, match=message):
+        fit_inverse_t(k, omega)
+
+
+def _has_beam_model() -> bool:
+    try:
+        from sensing_antenna.beam import natural_frequencies  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+needs_beam = pytest.mark.skipif(not _has_beam_model(), reason="needs beam.natural_frequencies")
+
+
+@needs_beam
+def test_calibrate_t_e_with_the_beam_model_recovers_t_e() -> None:
+    link = paper_antenna().link
+    omega = synthetic_k(PAPER_POINTS) / PAPER_T_E
+    omega[3] = math.nan  # a point where no frequency was found is reported, not fitted
+    result = calibrate_t_e(PAPER_POINTS, omega, link)
+    # beam.py and the independent solver agree to their root tolerances (<< 1e-6)
+    assert result.t_e == pytest.approx(PAPER_T_E, rel=1e-6)
+    assert result.t_theoretical == pytest.approx(0.2282, abs=5e-5)  # Section 5.1: T = 0.2282
+    assert result.relative_difference == pytest.approx(PAPER_T_E / link.theoretical_t - 1)
+    assert result.used.sum() == PAPER_POINTS.size - 1
+    assert np.nanmax(np.abs(result.residuals)) < 1e-4
+    calibrated = result.apply(paper_antenna())
+    assert calibrated.link.t_param == result.t_e
+
+
+@needs_beam
+def test_figure_10_is_written(tmp_path: Path) -> None:
+    from sensing_antenna.plotting.calibration import plot_calibration
+
+    link = paper_antenna().link
+    omega = synthetic_k(PAPER_POINTS[::3]) / PAPER_T_E
+    result = calibrate_t_e(PAPER_POINTS[::3], omega, link)
+    path = plot_calibration(result, link, tmp_path / "fig")
+    assert path.name == "figure10-calibration.png" and path.stat().st_size > 1000
+
+
+class _FakeRecording:
+    def __init__(self, metadata: dict[str, str]) -> None:
+        self.metadata = metadata
+
+
+def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
+    paths = [tmp_path / "a.csv", tmp_path / "b.csv"]
+    table = tmp_path / "points.csv"
+    table.write_text("file,x_c\na.csv,0.4\nb.csv,0.8\n", encoding="utf-8")
+    recordings = [_FakeRecording({}), _FakeRecording({})]
+    assert read_contact_points(paths, recordings, table) == [0.4, 0.8]
+    with_truth = [_FakeRecording({"true_xc": "0.45"}), _FakeRecording({"true_xc": "0.9"})]
+    assert read_contact_points(paths, with_truth) == [0.45, 0.9]
+    with pytest.raises(CalibrationError, match=r"b\.csv: true_xc: no known contact point"):
+        read_contact_points(paths, [with_truth[0], _FakeRecording({})])
+    table.write_text("file,x_c\na.csv,0.4\nb.csv,far\n", encoding="utf-8")
+    with pytest.raises(CalibrationError, match=r"points\.csv: line 3: x_c: not a number"):
+        read_contact_points(paths, recordings, table)
+    table.write_text("name,x_c\n", encoding="utf-8")
+    with pytest.raises(CalibrationError, match="missing column 'file'"):
+        read_contact_points(paths, recordings, table)
+
+
+def _has_simulator_and_estimator() -> bool:
+    try:
+        from sensing_antenna.estimation import measure_omega1  # noqa: F401
+        from sensing_antenna.simulator import Scenario, simulate  # noqa: F401
+    except ImportError:
+        return False
+    return _has_beam_model()
+
+
+@pytest.mark.skipif(not _has_simulator_and_estimator(), reason="needs simulator and estimation")
+def test_calibration_recovers_a_known_t_e_from_simulated_recordings() -> None:
+    from sensing_antenna.calibration.frequency import calibrate_from_recordings
+    from sensing_antenna.simulator import Scenario, simulate
+
+    start = paper_antenna()
+    # A device whose link is 12 % stiffer than Table 2: T scales as E^(-1/2), so its true T is
+    # 1 / sqrt(1.12) = 0.945 of paper-2021's (5.5 % apart), like the paper's 7 % (Section 5.1).
+    device = replace(start, link=replace(start.link, youngs_modulus=1.12 * 115e9))
+    true_t = device.link.theoretical_t
+    points = PAPER_POINTS[::2]
+    recordings = [
+        simulate(device, Scenario(case="azimuthal", contact_point=float(x), seed=100 + i))
+        for i, x in enumerate(points)
+    ]
+    result = calibrate_from_recordings(recordings, start, list(points))
+    assert abs(true_t / start.link.theoretical_t - 1) > 0.05
+    # the task's target: T_e within 0.5 % of the device's true T
+    assert result.t_e == pytest.approx(true_t, rel=0.005)
