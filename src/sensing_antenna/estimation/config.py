@@ -134,5 +134,7 @@ class EstimatorConfig:
                 continue
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise EstimatorConfigError(f"{f.name}: must be a finite number > 0, got {value!r}")
+        if self.frame_window > self.rest_window:
+            raise EstimatorConfigError("frame_window: must not exceed rest_window")
         if self.max_ratio_wait < self.convergence_window:
             raise EstimatorConfigError("max_ratio_wait: must be >= convergence_window")

@@ -83,6 +83,8 @@ class FrequencyMeasurement:
         True when ``quality`` reaches the configured threshold.
     peaks : dict
         Peak of each spectrum (None where none was found), keyed by :data:`COMPONENTS`.
+    reason : str or None
+        Why there is no usable measurement (no contact, no push, too short), else None.
     """
 
     omega1: float
@@ -93,6 +95,7 @@ class FrequencyMeasurement:
     band: tuple[float, float]
     clear: bool
     peaks: dict[str, SpectralPeak | None] = field(default_factory=dict)
+    reason: str | None = None
 
     def components_agree(self, relative_tolerance: float) -> bool | None:
         """Whether the y_c and z_c peaks agree within a relative tolerance (None: not both)."""
@@ -137,7 +140,8 @@ def power_spectrum(
     n_fft = 1 << max(0, math.ceil(math.log2(zero_padding * n)))
     spectrum = np.fft.rfft(tapered, n=n_fft, axis=0)
     omega = 2.0 * np.pi * np.fft.rfftfreq(n_fft, d=sample_period)
-    return omega, spectrum.real**2 + spectrum.imag**2
+    power = np.asarray(spectrum.real**2 + spectrum.imag**2, dtype=float)
+    return np.asarray(omega, dtype=float), power
 
 
 def find_peak(

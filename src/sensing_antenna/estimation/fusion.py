@@ -1,0 +1,409 @@
+"""Fusion of the two estimators (Section 4, steps 6 and 7) and the common end of every method.
+
+Estimator 1 gives one or two contact points compatible with the measured omega_1 (the sensing
+curve omega_1(x_c) is not monotonic); Estimator 2 gives one rough value. The estimate is the
+frequency candidate nearest to the ratio value; it is ready at t_e = t_1 + max(dt_e1, dt_e2).
+
+:class:`Evidence` is what the front end of the pipeline knows at t_e; :func:`conclude` adds what
+every method shares (the 3D point and the physical consistency checks that set the status);
+:class:`PaperMethod` is the paper's method. Baselines live in :mod:`.baselines`.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import Antenna, Link
+from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.contact_frame import ContactFrame
+from sensing_antenna.estimation.frequency import FrequencyMeasurement, measure_frequency
+from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
+from sensing_antenna.estimation.touch_point import touched_point
+
+__all__ = [
+    "Evidence",
+    "Fusion",
+    "PaperMethod",
+    "candidates_from_omega1",
+    "conclude",
+    "fuse",
+    "sensing_curve",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Fusion:
+    """Outcome of step 7.
+
+    Attributes
+    ----------
+    x_c : float
+        Chosen contact point (m): the candidate nearest to the ratio estimate, or the ratio
+        estimate itself when there is no candidate; NaN when neither exists.
+    chosen : int or None
+        Index of the chosen candidate, None when the ratio estimate was used.
+    distance : float
+        |chosen candidate - ratio estimate| (m); NaN when one of them is missing.
+    agree : bool
+        True when the distance is within the tolerance.
+    """
+
+    x_c: float
+    chosen: int | None
+    distance: float
+    agree: bool
+
+
+def fuse(candidates: Sequence[float], ratio_estimate: float, tolerance: float) -> Fusion:
+    """Step 7 of Section 4: of the candidates of Estimator 1, the one nearest to Estimator 2.
+
+    Parameters
+    ----------
+    candidates : sequence of float
+        Contact points from the inverse sensing curve (m).
+    ratio_estimate : float
+        x_c from the torque/force ratio (m); NaN when not available.
+    tolerance : float
+        Largest accepted distance between the two estimators (m).
+
+    Returns
+    -------
+    Fusion
+    """
+    have_ratio = math.isfinite(ratio_estimate)
+    if not candidates:
+        x_c = ratio_estimate if have_ratio else math.nan
+        return Fusion(x_c=x_c, chosen=None, distance=math.nan, agree=False)
+    if not have_ratio:
+        # Without Estimator 2 a single candidate is still usable; two are ambiguous.
+        return Fusion(x_c=float(candidates[0]), chosen=0, distance=math.nan, agree=False)
+    # Section 4, step 7: the candidate closest to the torque/force estimate
+    distances = [abs(float(c) - ratio_estimate) for c in candidates]
+    chosen = min(range(len(distances)), key=distances.__getitem__)
+    return Fusion(
+        x_c=float(candidates[chosen]),
+        chosen=chosen,
+        distance=distances[chosen],
+        agree=distances[chosen] <= tolerance,
+    )
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """Everything the pipeline knows at t_e, from the samples up to t_e only.
+
+    Built identically by the batch :func:`~sensing_antenna.estimation.pipeline.estimate` and the
+    streaming :class:`~sensing_antenna.estimation.pipeline.OnlineEstimator`; a method turns it
+    into a :class:`ContactEstimate`.
+
+    Attributes
+    ----------
+    t : array, shape (n,)
+        Sample times up to and including t_e (s).
+    theta, force, torque : array, shape (n, 2), (n, 3), (n, 3)
+        Samples up to t_e (rad, N, N m; motor frame).
+    sample_period : float
+        T_s (s).
+    antenna : Antenna
+    config : EstimatorConfig
+    contact_index, rest_index, end_index : int
+        Indices of t_c, t_1 and t_e (end_index = n - 1).
+    converged_index : int or None
+        Index of t_1 + Delta t_e2, None when the ratio never settled.
+    complete : bool
+        False when the samples ended before the planned t_e (recording too short).
+    frame : ContactFrame
+        Contact frame at t_1.
+    reaction_f, torque_f : array, shape (n, 3)
+        Filtered contact loads (Eq. 20 after removing gravity), motor frame (N, N m).
+    ratio : array, shape (n,)
+        Estimator 2, x_c(t) (m).
+    band : tuple of float
+        omega_1 search band (rad/s).
+    diagnostics : dict
+        Front-end diagnostics (sampling, rest tolerance, ...).
+    """
+
+    t: FloatArray
+    theta: FloatArray
+    force: FloatArray
+    torque: FloatArray
+    sample_period: float
+    antenna: Antenna
+    config: EstimatorConfig
+    contact_index: int
+    rest_index: int
+    end_index: int
+    converged_index: int | None
+    complete: bool
+    frame: ContactFrame
+    reaction_f: FloatArray
+    torque_f: FloatArray
+    ratio: FloatArray
+    band: tuple[float, float]
+    diagnostics: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def spectrum_slice(self) -> slice:
+        """Samples of the Delta t_e1 window after t_1 (shortened if the samples end first)."""
+        n_window = round(self.config.spectrum_window / self.sample_period)
+        return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
+
+    def measure_frequency(self) -> FrequencyMeasurement:
+        """Estimator 1's spectral measurement over Delta t_e1 after t_1."""
+        window = self.spectrum_slice
+        return measure_frequency(
+            self.torque[window],
+            self.frame.axes_m,
+            self.sample_period,
+            self.band,
+            self.config.min_peak_quality,
+            self.config.zero_padding,
+            t_start=float(self.t[window.start]),
+        )
+
+
+def sensing_curve(link: Link) -> Any:
+    """The omega_1(x_c) sensing curve of a link, built once per link."""
+    return _sensing_curve(link)
+
+
+@functools.lru_cache(maxsize=16)
+def _sensing_curve(link: Link) -> Any:
+    from sensing_antenna.beam import SensingCurve
+
+    return SensingCurve.from_link(link)
+
+
+def candidates_from_omega1(
+    link: Link, omega1: float, x_range: tuple[float, float]
+) -> tuple[tuple[float, ...], dict[str, Any]]:
+    """Contact points on the sensing curve with fundamental ``omega1`` (m), and notes.
+
+    When the measured frequency lies above the curve's maximum (calibration error near the top of
+    the curve, where the paper's worst errors are), there is no exact solution; the point of the
+    curve with the nearest frequency inside ``x_range`` is returned instead and flagged.
+    """
+    curve = sensing_curve(link)
+    notes: dict[str, Any] = {}
+    found = tuple(float(c.x_c) for c in curve.contact_points(omega1))
+    inside = tuple(x for x in found if 0.0 < x <= link.length)
+    if inside:
+        slopes = [float(curve.omega1_slope(x)) for x in inside]
+        notes["candidate_slopes"] = slopes
+        return tuple(sorted(inside)), notes
+    grid = np.linspace(x_range[0], x_range[1], 2001)
+    omegas = np.asarray(curve.omega1(grid), dtype=float)
+    k = int(np.argmin(np.abs(omegas - omega1)))
+    notes["off_curve"] = float(omega1 / omegas[k] - 1.0)
+    return (float(grid[k]),), notes
+
+
+def conclude(
+    evidence: Evidence,
+    method: str,
+    x_c: float,
+    candidates: tuple[float, ...] = (),
+    omega1: float = math.nan,
+    peak_quality: float = math.nan,
+    ratio_estimate: float = math.nan,
+    problems: Sequence[tuple[Status, str]] = (),
+    diagnostics: Mapping[str, Any] | None = None,
+) -> ContactEstimate:
+    """Common end of every method: 3D point, physical consistency checks, status.
+
+    Parameters
+    ----------
+    evidence : Evidence
+    method : str
+        Method name for the result.
+    x_c : float
+        The method's best guess (m).
+    candidates, omega1, peak_quality, ratio_estimate
+        Reported as given.
+    problems : sequence of (Status, str)
+        Method-specific doubts (no clear peak, disagreement).
+    diagnostics : mapping, optional
+        Method-specific diagnostics, merged into the front end's.
+
+    Returns
+    -------
+    ContactEstimate
+        Status is the first problem in :data:`STATUS_PRECEDENCE`; the other reasons are kept in
+        ``diagnostics["other_reasons"]``.
+    """
+    cfg = evidence.config
+    e = evidence.end_index
+    found: list[tuple[Status, str]] = list(problems)
+    if not evidence.complete:
+        have = evidence.t[e] - evidence.t[evidence.rest_index]
+        found.append(
+            (
+                Status.RECORDING_TOO_SHORT,
+                f"only {have:.3f} s of samples after t_1; the estimate needs "
+                f"{max(cfg.spectrum_window, cfg.convergence_window):.3f} s or more",
+            )
+        )
+    elif evidence.converged_index is None:
+        found.append(
+            (
+                Status.SLIP_SUSPECTED,
+                f"the torque/force ratio did not stay within {cfg.convergence_tolerance:g} m "
+                f"for {cfg.convergence_window:g} s within {cfg.max_ratio_wait:g} s after t_1",
+            )
+        )
+    reaction_now = evidence.reaction_f[e]
+    # Drift of the contact-force direction between t_1 (Y^c) and t_e: slip along the surface
+    cosine = float(
+        np.dot(reaction_now, evidence.frame.axes_m[1]) / max(np.linalg.norm(reaction_now), 1e-300)
+    )
+    drift = math.acos(min(1.0, max(-1.0, cosine)))
+    if drift > cfg.max_direction_drift:
+        found.append(
+            (
+                Status.SLIP_SUSPECTED,
+                f"the contact force turned by {math.degrees(drift):.1f} deg between t_1 and t_e "
+                f"(limit {math.degrees(cfg.max_direction_drift):.1f} deg)",
+            )
+        )
+    if evidence.converged_index is not None:
+        ratio_drift = abs(evidence.ratio[e] - evidence.ratio[evidence.converged_index])
+        if ratio_drift > cfg.max_ratio_drift:
+            found.append(
+                (
+                    Status.SLIP_SUSPECTED,
+                    f"the torque/force ratio moved by {ratio_drift:.3f} m after it had settled "
+                    f"(limit {cfg.max_ratio_drift:g} m)",
+                )
+            )
+    push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
+    touch = touched_point(x_c, evidence.frame, push_force, evidence.antenna.link)
+    if math.isfinite(touch.deflection_ratio) and touch.deflection_ratio > cfg.max_deflection_ratio:
+        found.append(
+            (
+                Status.SLIP_SUSPECTED,
+                f"the static deflection at the contact is {100 * touch.deflection_ratio:.0f} % "
+                f"of x_c, beyond the {100 * cfg.max_deflection_ratio:.0f} % small-deflection "
+                "limit of Assumption 1: the linear model does not hold and the contact may slide",
+            )
+        )
+    if not math.isfinite(x_c):
+        found.append((Status.NO_CLEAR_PEAK, "no estimate of x_c could be formed"))
+    order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
+    found.sort(key=lambda item: order[item[0]])
+    status, reason = found[0] if found else (Status.OK, None)
+    diag: dict[str, Any] = dict(evidence.diagnostics)
+    diag.update(diagnostics or {})
+    diag.update(
+        {
+            "push_force": push_force,
+            "axial_fraction": evidence.frame.axial_fraction,
+            "direction_drift": drift,
+            "deflection": touch.deflection,
+            "deflection_ratio": touch.deflection_ratio,
+            "axes_c_absolute": evidence.frame.axes_a,
+            "theta_at_t1": evidence.frame.theta,
+            "delta_t_e2": (
+                float(evidence.t[evidence.converged_index] - evidence.t[evidence.rest_index])
+                if evidence.converged_index is not None
+                else None
+            ),
+            "other_reasons": [text for _, text in found[1:]],
+        }
+    )
+    return ContactEstimate(
+        status=status,
+        reason=reason,
+        method=method,
+        x_c=x_c,
+        candidates=candidates,
+        omega1=omega1,
+        peak_quality=peak_quality,
+        ratio_estimate=ratio_estimate,
+        t_c=float(evidence.t[evidence.contact_index]),
+        t_1=float(evidence.t[evidence.rest_index]),
+        t_e=float(evidence.t[e]),
+        contact_point=touch.point_a,
+        diagnostics=diag,
+    )
+
+
+@dataclass(frozen=True)
+class PaperMethod:
+    """The paper's method (Section 4): Estimator 1 candidates, chosen by Estimator 2."""
+
+    name: str = "paper"
+
+    def conclude(self, evidence: Evidence) -> ContactEstimate:
+        """Fuse the frequency candidates with the ratio at t_e."""
+        cfg = evidence.config
+        link = evidence.antenna.link
+        measurement = evidence.measure_frequency()
+        ratio_estimate = float(evidence.ratio[evidence.end_index])
+        problems: list[tuple[Status, str]] = []
+        diag: dict[str, Any] = {
+            "torque_component": measurement.component,
+            "band": measurement.band,
+            "spectrum_window": (measurement.t_start, measurement.t_end),
+            "component_peaks": {
+                name: (None if peak is None else {"omega": peak.omega, "quality": peak.quality})
+                for name, peak in measurement.peaks.items()
+            },
+        }
+        agree = measurement.components_agree(cfg.component_agreement)
+        diag["components_agree"] = agree
+        candidates: tuple[float, ...] = ()
+        if math.isfinite(measurement.omega1):
+            x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
+            candidates, notes = candidates_from_omega1(link, measurement.omega1, x_range)
+            diag.update(notes)
+        if not measurement.clear:
+            problems.append(
+                (
+                    Status.NO_CLEAR_PEAK,
+                    f"no spectral peak in {measurement.band[0]:.1f} to {measurement.band[1]:.1f} "
+                    f"rad/s reaches {cfg.min_peak_quality:g} times the median power "
+                    f"(best {measurement.quality:.1f})",
+                )
+            )
+            candidates_used: tuple[float, ...] = ()
+        else:
+            candidates_used = candidates
+        fusion = fuse(candidates_used, ratio_estimate, cfg.disagreement_tolerance)
+        if candidates_used and math.isfinite(ratio_estimate) and not fusion.agree:
+            problems.append(
+                (
+                    Status.ESTIMATORS_DISAGREE,
+                    f"the frequency candidate nearest to the ratio estimate is "
+                    f"{fusion.distance:.3f} m away from it (tolerance "
+                    f"{cfg.disagreement_tolerance:g} m)",
+                )
+            )
+        if "off_curve" in diag and abs(diag["off_curve"]) > cfg.band_margin:
+            problems.append(
+                (
+                    Status.NO_CLEAR_PEAK,
+                    f"omega_1 = {measurement.omega1:.1f} rad/s is off the sensing curve by "
+                    f"{100 * diag['off_curve']:.0f} %",
+                )
+            )
+        return conclude(
+            evidence,
+            self.name,
+            fusion.x_c,
+            candidates=candidates,
+            omega1=measurement.omega1,
+            peak_quality=measurement.quality,
+            ratio_estimate=ratio_estimate,
+            problems=problems,
+            diagnostics=diag,
+        )

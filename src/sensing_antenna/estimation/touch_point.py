@@ -1,0 +1,73 @@
+"""The touched point in 3D (Section 4, step 7, made explicit).
+
+The contact lies at the abscissa x_c along the link. The link is bent by the reaction R of the
+object, so the contact is displaced from the rigid line x_c X^m by the static deflection of a
+cantilever loaded at x_c, y_c = |R_perp| x_c^3 / (3 E I) (Eq. 13 solved for y_c), in the direction
+of the load R, i.e. along +Y^c: the object holds the contact back while the rigid line of the
+motor angles has moved on into the object. The point is expressed in the absolute frame with the
+motor axes at t_1 (X^m, Y^m, Z^m of the recording format).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import Link
+from sensing_antenna.beam import contact_deflection_from_force
+from sensing_antenna.estimation.contact_frame import ContactFrame
+
+__all__ = ["TouchPoint", "touched_point"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class TouchPoint:
+    """The touched point.
+
+    Attributes
+    ----------
+    point_a : array, shape (3,)
+        Contact point in the absolute frame (m).
+    deflection : float
+        Static deflection y_c at the contact (m).
+    deflection_ratio : float
+        y_c / x_c (dimensionless), to compare with the 10 % limit of Assumption 1.
+    """
+
+    point_a: FloatArray
+    deflection: float
+    deflection_ratio: float
+
+
+def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link) -> TouchPoint:
+    """Absolute position of the touched point.
+
+    Parameters
+    ----------
+    x_c : float
+        Contact point along the link (m).
+    frame : ContactFrame
+        Contact frame at t_1 (axes and motor angles).
+    push_force : float
+        |R_perp|, the reaction perpendicular to the link (N), e.g. filtered at t_e.
+    link : Link
+        Supplies E I.
+
+    Returns
+    -------
+    TouchPoint
+        NaN point when x_c is not a finite point of the link.
+    """
+    if not (math.isfinite(x_c) and 0.0 < x_c <= link.length and math.isfinite(push_force)):
+        return TouchPoint(np.full(3, np.nan), math.nan, math.nan)
+    # Eq. 13 solved for y_c: y_c = |F| x_c^3 / (3 E I)
+    y_c = float(contact_deflection_from_force(link, x_c, push_force))
+    # Rigid abscissa along X^m plus the deflection along Y^c, in motor coordinates
+    point_m = np.array([x_c, 0.0, 0.0]) + y_c * frame.axes_m[1]
+    point_a = point_m @ frame.motor_axes_a
+    return TouchPoint(point_a=point_a, deflection=y_c, deflection_ratio=y_c / x_c)
