@@ -1,0 +1,89 @@
+"""The ``antenna campaign`` and ``antenna calibrate`` commands: reports and one-line errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import Antenna, paper_antenna
+from sensing_antenna.campaign.records import MethodOutcome, RunResult
+from sensing_antenna.campaign.runner import run_campaign
+from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
+from sensing_antenna.cli import main
+from sensing_antenna.recording import Recording, write_recording
+
+
+def toy_run(run: RunSpec) -> RunResult:
+    rng = np.random.default_rng(run.seed)
+    outcomes = [
+        MethodOutcome(method=m, status="ok", x_c=run.contact_point + float(rng.normal(0, 0.02)))
+        for m in run.methods
+    ]
+    return RunResult.for_run(run, outcomes, simulate_s=0.0)
+
+
+def plain(spec: CampaignSpec) -> Antenna:
+    return paper_antenna()
+
+
+def test_campaign_report_rebuilds_from_stored_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = CampaignSpec(
+        name="baselines-only",
+        antenna="paper-2021",
+        cases=("azimuthal",),
+        contact_points=(0.4, 0.7),
+        repeats=2,
+        base_seed=5,
+        methods=("ratio", "two-frequency"),
+    )
+    run_campaign(spec, tmp_path, run_one=toy_run, prepare_antenna=plain, workers=1, progress=False)
+    assert main(["campaign", "report", str(tmp_path)]) == 0
+    printed = capsys.readouterr().out.strip().splitlines()
+    assert printed[-1] == str(tmp_path / "report.md")
+    text = (tmp_path / "report.md").read_text("utf-8")
+    assert "](figures/errors-by-method.png)" in text
+    assert (tmp_path / "figures" / "errors-by-method.png").is_file()
+    assert (tmp_path / "runs.csv").is_file()
+
+
+def test_campaign_run_reports_a_bad_spec_on_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = tmp_path / "bad.toml"
+    spec.write_text(
+        'name = "x"\ncases = ["azimuthal"]\ncontact_points = [0.5]\nrepeats = 0\nbase_seed = 1\n',
+        encoding="utf-8",
+    )
+    assert main(["campaign", "run", str(spec), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"antenna campaign: error: {spec}: repeats: must be >= 1, got 0"
+
+
+def test_campaign_report_on_a_non_campaign_directory_fails_cleanly(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["campaign", "report", str(tmp_path)]) == 2
+    assert "campaign.json: no such file" in capsys.readouterr().err
+
+
+def test_calibrate_without_known_contact_points_fails_cleanly(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    n = 50
+    recording = Recording(
+        t=np.arange(n) * 1e-3,
+        theta=np.zeros((n, 2)),
+        force=np.zeros((n, 3)),
+        torque=np.zeros((n, 3)),
+    )
+    path = tmp_path / "r1.csv"
+    write_recording(recording, path)
+    code = main(["calibrate", str(path), "--out", str(tmp_path / "cal.toml")])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert f"{path}: true_xc: no known contact point" in err
+    assert not (tmp_path / "cal.toml").exists()
