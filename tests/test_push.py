@@ -1,0 +1,193 @@
+"""Tests of the push criterion and the instant t_1 (Section 4 steps 3-4, Section 5.3, Eq. 20).
+
+The synthetic manoeuvre: the azimuth accelerates smoothly from rest to a constant speed, touches an
+object at ``CONTACT`` and keeps turning, so the contact force and torque grow in proportion to the
+rotation past the contact. The free-motion part of the torque comes from the library's observer
+(tested independently in test_contact.py); what is tested here is the criterion itself.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.estimation.contact import ContactDetector, free_motion_torque
+from sensing_antenna.estimation.push import (
+    DEFAULT_ROTATION,
+    PushConfigError,
+    PushCriterion,
+    PushMonitor,
+    detect_push,
+    link_axis_angle,
+)
+from sensing_antenna.recording import Recording
+
+TS = 1e-3  # s
+ANTENNA = paper_antenna()
+SPEED = 0.9  # rad/s, head speed after the ease-in (no sample lands exactly on 0.03 rad)
+CONTACT = 1500  # sample of first touch
+X_C = 0.5  # m, contact point
+# Contact stiffness seen at the joint: F = 3 E I delta / x_c^2 (static cantilever with the tip
+# displaced by x_c delta), torque = F x_c.
+FORCE_PER_RAD = 3 * ANTENNA.link.flexural_rigidity / X_C**2  # N / rad
+
+
+def _manoeuvre(n: int = 2600, theta2: float = 0.0, stop: int | None = None) -> Recording:
+    t = TS * np.arange(n)
+    ramp = np.minimum(t / 1.0, 1.0)
+    speed = SPEED * ramp**3 * (10 - 15 * ramp + 6 * ramp**2)
+    if stop is not None:
+        speed[stop:] = 0.0  # motors stopped abruptly (rotation past contact stays small)
+    theta1 = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * TS)])
+    theta = np.column_stack([theta1, np.full(n, theta2)])
+    past = np.maximum(theta1 - theta1[CONTACT], 0.0)
+    past[:CONTACT] = 0.0
+    contact_force = FORCE_PER_RAD * past  # N, on Y^m (by the link on the head: pushed back)
+    weight = ANTENNA.link.mass * 9.80665
+    force = np.column_stack(
+        [-weight * np.sin(theta[:, 1]), -contact_force, -weight * np.cos(theta[:, 1])]
+    )
+    torque = free_motion_torque(theta, ANTENNA, TS)
+    torque[:, 2] -= X_C * contact_force  # contact force at x_c on -Y^m: torque on -Z^m
+    return Recording(t=t, theta=theta, force=force, torque=torque)
+
+
+def _ramp_filter_lag(slope: float, threshold: float, cutoff: float) -> float:
+    """Time after the start of a ramp at which the ramp through 1 / (1 + s / cutoff) reaches the
+    threshold: slope (u - tau (1 - exp(-u / tau))) = threshold, solved by bisection (s)."""
+    tau = 1.0 / cutoff
+    lo, hi = 0.0, 10.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if slope * (mid - tau * (1 - math.exp(-mid / tau))) > threshold:
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+def test_default_criterion_is_rotation_of_a_few_percent() -> None:
+    crit = PushCriterion()
+    assert crit.kind == "rotation"
+    assert crit.threshold == DEFAULT_ROTATION == 0.03
+    assert crit.unit == "rad"
+    # Small-deflection check (Assumption 1: y_c / x_c below 10 %): y_c / x_c ~ delta_theta.
+    assert crit.threshold < 0.1
+
+
+def test_rotation_criterion_triggers_after_the_right_rotation() -> None:
+    rec = _manoeuvre()
+    result = detect_push(rec, ANTENNA)
+    assert result.status == "pushed"
+    contact = result.contact
+    assert contact.index is not None
+    # Quasi-static contact (no impact transient in this synthetic signal): the residual is the
+    # torque ramp X_C * FORCE_PER_RAD * SPEED = 0.49 N m/s, which reaches 0.02 N m after 41 ms,
+    # plus about 10 ms of residual-filter lag.
+    assert CONTACT + 41 <= contact.index <= CONTACT + 41 + 15
+    # theta2 = 0: the link-axis angle is |delta theta1| exactly (independent of link_axis_angle).
+    turned = rec.theta[:, 0] - rec.theta[contact.index, 0]
+    expected = contact.index + int(np.argmax(turned[contact.index :] > 0.03))
+    assert result.index == expected
+    assert result.t_1 == pytest.approx(rec.t[expected])
+    assert turned[expected] == pytest.approx(0.03, abs=SPEED * TS)
+
+
+def test_force_criterion_matches_filtered_ramp() -> None:
+    # |F - F_g| = FORCE_PER_RAD * SPEED * (t - t_contact) after contact: a ramp through Eq. 20.
+    rec = _manoeuvre()
+    threshold = 0.05  # N
+    result = detect_push(rec, ANTENNA, PushCriterion("force", threshold))
+    assert result.status == "pushed"
+    lag = _ramp_filter_lag(FORCE_PER_RAD * SPEED, threshold, 5.0)
+    assert result.index is not None
+    # Tolerance 2 samples: Tustin vs continuous filter, trapezoidal angle integration.
+    assert abs((result.index - CONTACT) - lag / TS) <= 2
+
+
+def test_torque_criterion_matches_filtered_ramp() -> None:
+    rec = _manoeuvre()
+    threshold = 0.02  # N m
+    result = detect_push(rec, ANTENNA, PushCriterion("torque", threshold))
+    lag = _ramp_filter_lag(X_C * FORCE_PER_RAD * SPEED, threshold, 5.0)
+    assert result.index is not None
+    # Tolerance 5 samples: the free-motion dynamic torque (about 1e-3 N m after the ease-in) is
+    # also in |Gamma - Gamma_g| and shifts the crossing by a few ms at this slope.
+    assert abs((result.index - CONTACT) - lag / TS) <= 5
+
+
+def test_no_push_when_motors_stop_early_and_no_contact_without_touch() -> None:
+    # Detection happens about 51 samples after the touch (see the rotation test); stopping 75
+    # samples after the touch leaves at most 24 samples (0.022 rad) of rotation past t_c.
+    rec = _manoeuvre(stop=CONTACT + 75)
+    result = detect_push(rec, ANTENNA)
+    assert result.contact.status == "contact"
+    assert result.status == "no_push"
+    assert result.t_1 is None
+    free = _manoeuvre(n=CONTACT + 1)
+    result = detect_push(free, ANTENNA)
+    assert result.status == "no_contact"
+    assert result.t_c is None
+
+
+@pytest.mark.parametrize(
+    ("kind", "threshold"), [("rotation", 0.03), ("force", 0.05), ("torque", 0.02)]
+)
+def test_streaming_equals_batch(kind: str, threshold: float) -> None:
+    rec = _manoeuvre(theta2=0.3)
+    crit = PushCriterion(kind, threshold)  # type: ignore[arg-type]
+    batch = detect_push(rec, ANTENNA, crit)
+    assert batch.status == "pushed"
+    monitor = PushMonitor(crit, ANTENNA, TS, ContactDetector(ANTENNA, TS))
+    for _ in range(2):  # the second pass checks reset()
+        monitor.reset()
+        flags, measures = [], []
+        for k in range(rec.n_samples):
+            flags.append(monitor.update(rec.t[k], rec.theta[k], rec.force[k], rec.torque[k]))
+            measures.append(monitor.measure)
+        assert monitor.contact_time == batch.t_c
+        assert monitor.push_time == batch.t_1
+        assert monitor.push_index == batch.index
+        assert flags.index(True) == batch.index
+        assert all(flags[batch.index :])
+        assert batch.index is not None
+        after = slice(batch.contact.index, None)
+        scale = float(np.max(np.abs(batch.measure)))
+        np.testing.assert_allclose(
+            np.asarray(measures)[after], batch.measure[after], rtol=0, atol=1e-12 * scale
+        )
+
+
+def test_link_axis_angle_against_dot_product() -> None:
+    # Reference: arccos of the dot product of the X^m unit vectors, accurate for angles that are
+    # not tiny (here >= 0.05 rad; error of arccos ~ 1e-16 / angle).
+    rng = np.random.default_rng(4)
+    a = rng.uniform(-1.5, 1.5, size=(50, 2))
+    b = a + rng.uniform(0.05, 0.5, size=(50, 2)) * rng.choice([-1, 1], size=(50, 2))
+
+    def axis(th: np.ndarray) -> np.ndarray:
+        return np.column_stack(
+            [
+                np.cos(th[:, 1]) * np.cos(th[:, 0]),
+                np.cos(th[:, 1]) * np.sin(th[:, 0]),
+                np.sin(th[:, 1]),
+            ]
+        )
+
+    reference = np.arccos(np.clip(np.sum(axis(a) * axis(b), axis=1), -1, 1))
+    np.testing.assert_allclose(link_axis_angle(a, b), reference, rtol=1e-9)
+    # Elevated link: an azimuth turn moves the axis by less (cos theta2), the circle of latitude.
+    angle = link_axis_angle(np.array([0.02, 1.0]), np.array([0.0, 1.0]))
+    assert angle == pytest.approx(2 * math.asin(math.cos(1.0) * math.sin(0.01)), rel=1e-12)
+
+
+def test_criterion_validation() -> None:
+    with pytest.raises(PushConfigError, match=r"push\.kind"):
+        PushCriterion("pressure", 1.0)  # type: ignore[arg-type]
+    with pytest.raises(PushConfigError, match=r"push\.threshold"):
+        PushCriterion("force", 0.0)
+    with pytest.raises(PushConfigError, match=r"push\.cutoff"):
+        PushCriterion("force", 0.8, cutoff=float("nan"))
