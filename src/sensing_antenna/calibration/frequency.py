@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -315,10 +315,15 @@ def calibrate_from_recordings(
     for i, recording in enumerate(recordings):
         measurement = measure_omega1(recording, antenna, band=band)
         value = float(measurement.omega1)
-        if math.isfinite(value) and value > 0:
-            omega[i] = value
-        else:
+        if not (math.isfinite(value) and value > 0):
             notes.append(f"{names[i]}: no fundamental frequency found ({_describe(measurement)})")
+        elif getattr(measurement, "clear", True) is False:
+            notes.append(
+                f"{names[i]}: spectral peak at {value:.2f} rad/s not clear of the noise "
+                f"({_describe(measurement)})"
+            )
+        else:
+            omega[i] = value
     return calibrate_t_e(contact_points, omega, antenna.link, loss=loss, sources=names, notes=notes)
 
 
@@ -389,7 +394,7 @@ def _read_points_table(table: Path) -> dict[str, float]:
 
 
 def _describe(measurement: Any) -> str:
-    quality = getattr(measurement, "quality", None)
-    if isinstance(quality, Mapping):
-        return ", ".join(f"{k}={v}" for k, v in quality.items())
-    return f"quality={quality!r}"
+    reason = getattr(measurement, "reason", None)
+    if reason:
+        return str(reason)
+    return f"peak quality {getattr(measurement, 'quality', math.nan):.3g}"
