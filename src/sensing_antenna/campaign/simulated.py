@@ -15,7 +15,13 @@ from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.records import METHOD_ERROR, MethodOutcome, RunResult
 from sensing_antenna.campaign.spec import CampaignSpec, CampaignSpecError, RunSpec, derive_seed
 
-__all__ = ["identify_observer", "make_scenario", "prepare_antenna", "simulate_and_estimate"]
+__all__ = [
+    "check_scenario",
+    "identify_observer",
+    "make_scenario",
+    "prepare_antenna",
+    "simulate_and_estimate",
+]
 
 
 def make_scenario(case: str, contact_point: float | None, seed: int, extra: dict[str, Any]) -> Any:
@@ -88,8 +94,27 @@ def identify_observer(antenna: Antenna, spec: CampaignSpec) -> Antenna:
     return dataclasses.replace(antenna, observer=fit.observer)
 
 
+def check_scenario(spec: CampaignSpec) -> None:
+    """Raise CampaignSpecError (naming the spec file) if the scenario section is not valid."""
+    from sensing_antenna.simulator.scenario import ScenarioError
+
+    try:
+        make_scenario(spec.cases[0], spec.contact_points[0], 0, dict(spec.scenario))
+    except ScenarioError as exc:
+        raise CampaignSpecError(
+            f"scenario.{exc.field_name}", str(exc).split(": ", 1)[-1], spec.source or None
+        ) from exc
+    except TypeError as exc:
+        raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc
+
+
 def prepare_antenna(spec: CampaignSpec) -> Antenna:
-    """The antenna of every run: the spec's antenna, with the identified observer if asked."""
+    """The antenna of every run: the spec's antenna, with the identified observer if asked.
+
+    Checks the spec's scenario section first, so a bad value stops the campaign with one clear
+    error instead of failing every run.
+    """
+    check_scenario(spec)
     antenna = spec.load_antenna()
     if spec.free_motion.identify:
         antenna = identify_observer(antenna, spec)
