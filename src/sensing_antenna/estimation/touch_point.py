@@ -17,7 +17,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.beam import contact_deflection_from_force
 from sensing_antenna.estimation.contact_frame import ContactFrame
 
 __all__ = ["TouchPoint", "touched_point"]
@@ -65,6 +64,8 @@ def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link
     """
     if not (math.isfinite(x_c) and 0.0 < x_c <= link.length and math.isfinite(push_force)):
         return TouchPoint(np.full(3, np.nan), math.nan, math.nan)
+    from sensing_antenna.beam import contact_deflection_from_force
+
     # Eq. 13 solved for y_c: y_c = |F| x_c^3 / (3 E I)
     y_c = float(contact_deflection_from_force(link, x_c, push_force))
     # Rigid abscissa along X^m plus the deflection along Y^c, in motor coordinates

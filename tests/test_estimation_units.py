@@ -1,0 +1,295 @@
+"""Unit tests of the estimation building blocks on closed-form signals (no beam model needed).
+
+Reference values come from closed forms written next to each test: sinusoid frequencies set by
+construction, the statics of a cantilever loaded at x_c (Gamma = r_c x R), the recording format's
+frame definitions and sign check (shared/spec/recording-format.md), and Section 5.4 note (a) of the
+paper (azimuthal push: Y^c = -Y^m).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import STANDARD_GRAVITY, paper_antenna
+from sensing_antenna.estimation.config import EstimatorConfig, EstimatorConfigError
+from sensing_antenna.estimation.contact_frame import (
+    angle_noise,
+    contact_frame,
+    first_rest_index,
+    gravity_force_m,
+    gravity_torque_m,
+    motor_axes,
+    rest_tolerance,
+)
+from sensing_antenna.estimation.frequency import find_peak, measure_frequency, power_spectrum
+from sensing_antenna.estimation.fusion import fuse
+from sensing_antenna.estimation.ratio import (
+    contact_loads,
+    converged_index,
+    filtered_contact_loads,
+    paper_ratio,
+    perpendicular_ratio,
+)
+from sensing_antenna.estimation.result import ContactEstimate, Status
+
+TS = 1e-3
+
+
+def damped(t: np.ndarray, omega: float, zeta: float, amplitude: float, phase: float) -> np.ndarray:
+    return amplitude * np.exp(-zeta * omega * t) * np.sin(omega * t + phase)
+
+
+# ---------------------------------------------------------------- Estimator 1: spectrum
+
+
+@pytest.mark.parametrize("omega", [31.4, 55.0, 70.3, 106.8])
+@pytest.mark.parametrize("zeta", [0.0, 0.03])
+def test_peak_frequency_of_damped_sinusoid_on_trend(omega: float, zeta: float) -> None:
+    # Reference: the sinusoid's own frequency (by construction). Tolerance 0.1 rad/s: 1/60 of
+    # the 6.3 rad/s DFT bin of a 1 s window; the sensing curve's smallest useful slope (~40 rad/s
+    # per m away from its top) turns it into 2.5 mm.
+    rng = np.random.default_rng(1)
+    t = np.arange(1000) * TS
+    signal = 0.03 + 0.004 * t + damped(t, omega, zeta, 1e-3, 0.4)
+    signal += 2e-5 * rng.standard_normal(t.size)
+    freq, power = power_spectrum(signal, TS, 16)
+    peak = find_peak(freq, power, (25.0, 125.0))
+    assert peak is not None
+    assert abs(peak.omega - omega) < 0.1
+    assert peak.quality > 100.0
+
+
+def test_noise_only_has_no_clear_peak() -> None:
+    # White noise: a bin's power is exponential, so it exceeds 20 times the median with
+    # probability exp(-20 ln 2) ~ 1e-6; over ~250 independent bins and three spectra the default
+    # clarity threshold (EstimatorConfig.min_peak_quality = 20) is passed with probability ~1e-3.
+    rng = np.random.default_rng(2)
+    torque = 1e-4 * rng.standard_normal((1000, 3))
+    axes = np.eye(3)
+    m = measure_frequency(torque, axes, TS, (27.0, 123.0), EstimatorConfig().min_peak_quality)
+    assert not m.clear
+
+
+def test_peak_outside_band_is_ignored() -> None:
+    # A strong vibration above the band (a second mode) with a sensor noise floor 60 dB below:
+    # the Hann sidelobes reaching into the band must not make a clear peak.
+    rng = np.random.default_rng(7)
+    t = np.arange(1000) * TS
+    signal = damped(t, 200.0, 0.0, 1.0, 0.0) + 1e-3 * rng.standard_normal(t.size)
+    freq, power = power_spectrum(signal, TS, 16)
+    peak = find_peak(freq, power, (27.0, 123.0))
+    assert peak is None or peak.quality < EstimatorConfig().min_peak_quality
+
+
+@pytest.mark.parametrize("component", ["y_c", "z_c"])
+def test_vibration_found_in_either_perpendicular_component(component: str) -> None:
+    # The vibration is placed in one torque component of the contact frame only; the estimator
+    # must find it whichever it is and say which spectrum it used.
+    rng = np.random.default_rng(3)
+    t = np.arange(1000) * TS
+    axes = motor_axes(np.array([0.3, 0.1]))  # an arbitrary orthonormal frame (rows)
+    column = {"y_c": 1, "z_c": 2}[component]
+    torque_c = 1e-5 * rng.standard_normal((t.size, 3))
+    torque_c[:, column] += damped(t, 48.0, 0.01, 5e-4, 1.0)
+    torque_m = torque_c @ axes  # components along the axes -> motor coordinates
+    m = measure_frequency(torque_m, axes, TS, (27.0, 123.0), min_quality=10.0)
+    assert m.clear
+    assert abs(m.omega1 - 48.0) < 0.05
+    assert m.component in (component, "sum")
+    assert m.peaks[component] is not None
+
+
+# ---------------------------------------------------------------- frames and gravity
+
+
+def test_motor_axes_match_recording_format() -> None:
+    theta = np.array([0.7, -0.4])
+    axes = motor_axes(theta)
+    c1, s1, c2, s2 = math.cos(0.7), math.sin(0.7), math.cos(-0.4), math.sin(-0.4)
+    np.testing.assert_allclose(axes[0], [c2 * c1, c2 * s1, s2], atol=1e-15)
+    np.testing.assert_allclose(axes[1], [-s1, c1, 0.0], atol=1e-15)
+    np.testing.assert_allclose(axes[2], np.cross(axes[0], axes[1]), atol=1e-15)
+    np.testing.assert_allclose(axes @ axes.T, np.eye(3), atol=1e-15)
+
+
+def test_gravity_terms_match_spec_sign_check() -> None:
+    # Spec sign check: theta2 = 0, at rest: F = (0, 0, -m_b g), torque = (0, +0.5 m_b g l, 0).
+    antenna = paper_antenna()
+    w = antenna.link.mass * STANDARD_GRAVITY
+    np.testing.assert_allclose(gravity_force_m(antenna, np.array(0.0)), [0, 0, -w], atol=1e-15)
+    np.testing.assert_allclose(
+        gravity_torque_m(antenna, np.array(0.0)), [0, 0.5 * w * antenna.link.length, 0]
+    )
+    # And the same as the Antenna's own Section 4.2 terms at another angle.
+    np.testing.assert_allclose(gravity_force_m(antenna, np.array(0.3)), antenna.gravity_force(0.3))
+    np.testing.assert_allclose(
+        gravity_torque_m(antenna, np.array(0.3)), antenna.gravity_torque(0.3)
+    )
+
+
+def test_azimuthal_push_frame_is_minus_y_m() -> None:
+    # Paper Section 5.4 (a): pushing azimuthally, Y^c is Y^m in the opposite direction.
+    # The link pushes towards +Y^m, the object reacts along -Y^m.
+    theta = np.tile([0.2, 0.0], (5, 1))
+    reaction = np.tile([0.0, -0.05, 0.0], (5, 1))
+    frame = contact_frame(theta, reaction, 0.98)
+    assert frame is not None
+    np.testing.assert_allclose(frame.axes_m, [[1, 0, 0], [0, -1, 0], [0, 0, -1]], atol=1e-15)
+    np.testing.assert_allclose(frame.axes_a[1], -motor_axes(np.array([0.2, 0.0]))[1], atol=1e-15)
+
+
+def test_frame_is_right_handed_for_oblique_reaction() -> None:
+    rng = np.random.default_rng(4)
+    reaction = rng.normal(size=3)
+    frame = contact_frame(np.zeros((1, 2)), reaction[None, :], 0.98)
+    assert frame is not None
+    axes = frame.axes_m
+    np.testing.assert_allclose(axes @ axes.T, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(np.cross(axes[0], axes[1]), axes[2], atol=1e-12)
+    np.testing.assert_allclose(axes[1], reaction / np.linalg.norm(reaction), atol=1e-12)
+    assert axes[2] @ np.array([1.0, 0.0, 0.0]) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_axial_reaction_gives_no_frame() -> None:
+    assert contact_frame(np.zeros((1, 2)), np.array([[0.1, 0.0, 0.0]]), 0.98) is None
+
+
+def test_rest_found_after_ramp_stops() -> None:
+    # The angle ramps until sample 600 then holds with noise 1e-6 rad: rest starts at 600.
+    rng = np.random.default_rng(5)
+    n = 1000
+    theta = np.zeros((n, 2))
+    theta[:600, 0] = 0.5 * np.arange(600) * TS
+    theta[600:, 0] = theta[599, 0]
+    theta += 1e-6 * rng.standard_normal(theta.shape)
+    tolerance = rest_tolerance(theta[:300], EstimatorConfig())
+    assert tolerance == pytest.approx(1e-4)  # the floor: 8 sigma of 1e-6 rad noise is smaller
+    index = first_rest_index(theta, 300, 50, tolerance)
+    # The head moves 5e-4 rad per sample interval of the ramp... 0.5 rad/s * 1 ms = 5e-4 rad, so
+    # a window may include at most the last sample of the ramp: 599 or 600.
+    assert index in (599, 600)
+    assert first_rest_index(theta[:640], 300, 50, tolerance) is None
+
+
+def test_angle_noise_estimate() -> None:
+    # Reference: the noise standard deviation set below; 10 % tolerance for 5000 samples' MAD.
+    rng = np.random.default_rng(6)
+    t = np.arange(5000) * TS
+    theta = np.column_stack([0.3 * np.sin(2 * t), 0.1 * t]) + 2e-5 * rng.standard_normal((5000, 2))
+    noise, _ = angle_noise(theta)
+    assert noise == pytest.approx(2e-5, rel=0.1)
+    quantised = np.round(theta / 1e-4) * 1e-4
+    _, step = angle_noise(quantised)
+    assert step == pytest.approx(1e-4, rel=1e-6)
+
+
+# ---------------------------------------------------------------- Estimator 2: ratio
+
+
+def static_contact_samples(
+    x_c: float, reaction: np.ndarray, theta2: float, n: int = 50
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Loads of a link pushed at x_c: F = R + W, Gamma = r_c x R + Gamma_W (cantilever statics)."""
+    antenna = paper_antenna()
+    link = antenna.link
+    perpendicular = reaction - reaction[0] * np.array([1.0, 0.0, 0.0])
+    deflection = np.linalg.norm(perpendicular) * x_c**3 / (3 * link.flexural_rigidity)
+    r_c = np.array([x_c, 0.0, 0.0]) + deflection * perpendicular / np.linalg.norm(perpendicular)
+    force = reaction + gravity_force_m(antenna, np.array(theta2))
+    torque = np.cross(r_c, reaction) + gravity_torque_m(antenna, np.array(theta2))
+    theta = np.tile([0.1, theta2], (n, 1))
+    return theta, np.tile(force, (n, 1)), np.tile(torque, (n, 1))
+
+
+@pytest.mark.parametrize("theta2", [0.0, 0.4, -0.3])
+def test_perpendicular_ratio_is_exact_with_axial_friction(theta2: float) -> None:
+    # Statics: |Gamma - Gamma_g| = x_c |R_perp| exactly when the deflection is along R_perp
+    # (module notes of ratio.py), so the ratio returns x_c to rounding; Eq. 21 as printed
+    # divides by |R| and underestimates by |R_perp| / |R|.
+    antenna = paper_antenna()
+    x_c = 0.62
+    reaction = np.array([0.03, -0.08, 0.02])  # with an axial (friction) component
+    theta, force, torque = static_contact_samples(x_c, reaction, theta2)
+    r, g = contact_loads(theta, force, torque, antenna)
+    lateral = math.hypot(reaction[1], reaction[2])
+    # The deflection term r_c x R adds (d R_perp_hat) x R = d R_perp_hat x R_axial, a moment of
+    # d * R_x; tolerance: that moment over |R_perp|.
+    deflection = lateral * x_c**3 / (3 * antenna.link.flexural_rigidity)
+    slack = deflection * abs(reaction[0]) / lateral
+    np.testing.assert_allclose(perpendicular_ratio(r, g), x_c, atol=slack + 1e-12)
+    printed = paper_ratio(theta, force, torque, antenna, 5.0, TS)
+    np.testing.assert_allclose(printed, x_c * lateral / np.linalg.norm(reaction), atol=slack + 1e-9)
+
+
+def test_filtered_ratio_is_exact_while_the_push_grows() -> None:
+    # Linear filter + loads proportional to one growing magnitude: the filtered ratio is x_c from
+    # the first contact sample on (ratio.py notes). Reference x_c set by construction.
+    antenna = paper_antenna()
+    x_c = 0.45
+    n = 400
+    magnitude = np.clip((np.arange(n) - 100) * 5e-4, 0.0, None)  # zero, then a ramp (N)
+    direction = np.array([0.0, -0.8, 0.6])
+    reaction = magnitude[:, None] * direction
+    theta = np.tile([0.0, 0.2], (n, 1))
+    force = reaction + gravity_force_m(antenna, theta[:, 1])
+    torque = np.cross(np.array([x_c, 0.0, 0.0]), reaction) + gravity_torque_m(antenna, theta[:, 1])
+    r_f, g_f = filtered_contact_loads(theta, force, torque, antenna, 5.0, TS)
+    ratio = perpendicular_ratio(r_f, g_f)
+    np.testing.assert_allclose(ratio[110:], x_c, rtol=1e-9)
+
+
+def test_converged_index_is_causal() -> None:
+    ratio = np.concatenate([np.linspace(0.8, 0.5, 300), np.full(300, 0.5)])
+    index = converged_index(ratio, 0, 200, 0.01)
+    # Window [j-200, j] within 1 cm: the ramp falls 1e-3 m per sample, so the window may hold
+    # up to 10 ramp samples (<= 0.01 m above 0.5): j - 200 = 290 -> j = 490.
+    assert index == 490
+    assert converged_index(ratio[:400], 0, 200, 0.01) is None
+    assert converged_index(ratio, 350, 200, 0.01) == 550
+
+
+# ---------------------------------------------------------------- fusion, result, config
+
+
+def test_fusion_picks_candidate_nearest_to_ratio() -> None:
+    fusion = fuse((0.62, 0.91), 0.88, 0.1)
+    assert fusion.x_c == 0.91 and fusion.agree and fusion.distance == pytest.approx(0.03)
+    far = fuse((0.62, 0.91), 0.3, 0.1)
+    assert far.x_c == 0.62 and not far.agree
+    assert fuse((), 0.5, 0.1).x_c == 0.5
+    assert math.isnan(fuse((), math.nan, 0.1).x_c)
+
+
+def test_estimate_to_dict_is_json() -> None:
+    estimate = ContactEstimate(
+        status=Status.NO_CLEAR_PEAK,
+        reason="no peak",
+        method="paper",
+        x_c=0.5,
+        candidates=(0.5,),
+        omega1=math.nan,
+        diagnostics={"band": (27.0, 123.0), "q": np.float64(3.0), "a": np.arange(3)},
+    )
+    data = json.loads(json.dumps(estimate.to_dict(), allow_nan=False))
+    assert data["status"] == "no_clear_peak"
+    assert data["omega1"] is None
+    assert data["contact_point"] == [None, None, None]
+    for key in ("x_c", "candidates", "ratio_estimate", "t_c", "t_1", "t_e", "reason"):
+        assert key in data
+
+
+def test_status_needs_reason() -> None:
+    with pytest.raises(ValueError, match="needs a reason"):
+        ContactEstimate(status=Status.NO_CONTACT, reason=None, method="paper")
+    assert Status("ok") is Status.OK and str(Status.SLIP_SUSPECTED) == "slip_suspected"
+
+
+def test_config_validation_names_the_field() -> None:
+    with pytest.raises(EstimatorConfigError, match="spectrum_window"):
+        EstimatorConfig(spectrum_window=-1.0)
+    with pytest.raises(EstimatorConfigError, match="contact_range"):
+        EstimatorConfig(contact_range=(0.5, 0.4))
