@@ -1,0 +1,51 @@
+"""Contact-mode beam physics of the link (Sections 3.3 and 3.4 of the paper).
+
+- :mod:`~sensing_antenna.beam.characteristic`: the non-dimensional frequency equation, derived
+  from the boundary conditions of Eq. 4 (not the printed Eq. 6), Wittrick-Williams root counting
+  and the eigenvalues beta_i l (xi, R_m).
+- :mod:`~sensing_antenna.beam.modes`: natural frequencies in rad/s and mode shapes of a link.
+- :mod:`~sensing_antenna.beam.sensing`: the sensing curve omega_1(x_c) and its inverse.
+- :mod:`~sensing_antenna.beam.statics`: static deflection, base force and torque (Eqs. 7 to 13).
+"""
+
+from sensing_antenna.beam._validate import BeamInputError
+from sensing_antenna.beam.characteristic import (
+    characteristic_function,
+    eigenvalue_slopes,
+    eigenvalues,
+    mode_count,
+)
+from sensing_antenna.beam.modes import (
+    contact_ratio,
+    frequency_scale,
+    mode_shapes,
+    natural_frequencies,
+)
+from sensing_antenna.beam.sensing import Candidate, Inversion, SensingCurve
+from sensing_antenna.beam.statics import (
+    base_force,
+    base_torque,
+    contact_deflection_from_force,
+    static_deflection,
+    torque_force_ratio,
+)
+
+__all__ = [
+    "BeamInputError",
+    "Candidate",
+    "Inversion",
+    "SensingCurve",
+    "base_force",
+    "base_torque",
+    "characteristic_function",
+    "contact_deflection_from_force",
+    "contact_ratio",
+    "eigenvalue_slopes",
+    "eigenvalues",
+    "frequency_scale",
+    "mode_count",
+    "mode_shapes",
+    "natural_frequencies",
+    "static_deflection",
+    "torque_force_ratio",
+]
