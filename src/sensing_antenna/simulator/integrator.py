@@ -1,0 +1,628 @@
+"""The compiled time loop: hub-and-link dynamics, contact, sensor and 1 kHz servo.
+
+Unknowns ``X = [q_v, q_w, theta1, theta2]``: the finite-element coordinates of the deflection
+along Y^m (v) and Z^m (w) and the two joint angles. Linearised about the moving motor frame
+(small deflection, Assumption 1), the equations of motion are
+
+    M q_v'' + C q_v' + K q_v + cos(theta2) s theta1''          = N(x_c) F_y
+    M q_w'' + C q_w' + K q_w + s theta2''                      = -g cos(theta2) m + N(x_c) F_z
+    (J1 + S2 cos^2 theta2) theta1'' + cos(theta2) s.q_v'' + v1 theta1' + F_c1 = tau1 + Q1
+    (J2 + S2) theta2'' + s.q_w'' + v2 theta2' + F_c2 = tau2 + Q2_gravity + Q2
+
+with ``m = int rho N``, ``s = int rho x N`` and S2 the rigid link's inertia about O (link.py):
+x cos(theta2) theta1'' and x theta2'' are the transverse accelerations of the moving base line.
+The joint rows are Eq. 1 with the coupling torque written out as the link's reaction (hub-beam
+model), so the link loads the motors exactly as the real link loads the real joints. Contact
+forces enter as generalised forces of the force F applied at the continuous abscissa x_c.
+
+Time integration: Newmark average acceleration (beta = 1/4, gamma = 1/2; Newmark 1959),
+unconditionally stable and free of numerical dissipation, with internal step h = T_s / substeps.
+The effective matrix of the link, ``A = 4 M / h^2 + 2 C / h + K``, is inverted once; the joint
+rows border it (Schur complement) and the contact adds a rank-2 term (normal and tangential
+penalty), solved with the Woodbury identity. The Coulomb friction of the motors is regularised,
+``Gamma_nlc tanh(omega / omega_s)``, and linearised at the start of each step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+__all__ = ["P", "run_samples", "sensor_wrench"]
+
+
+class P:
+    """Indices into the packed parameter vector of the compiled loop."""
+
+    STEP = 0
+    SUBSTEPS = 1
+    GRAVITY = 2
+    J1 = 3
+    J2 = 4
+    V1 = 5
+    V2 = 6
+    COULOMB1 = 7
+    COULOMB2 = 8
+    OMEGA_S = 9
+    S1 = 10
+    S2 = 11
+    MASS = 12
+    K_N = 13
+    C_N = 14
+    K_T = 15
+    C_T = 16
+    MU = 17
+    LENGTH = 18
+    X_MIN = 19
+    ENCODER = 20
+    FEEDBACK = 21
+    CONTROL = 22
+    TORQUE_GAIN1 = 23
+    TORQUE_GAIN2 = 24
+    SIZE = 25
+
+
+# The same indices as module constants, for the compiled code.
+_P_STEP = 0
+_P_SUBSTEPS = 1
+_P_GRAVITY = 2
+_P_J1 = 3
+_P_J2 = 4
+_P_V1 = 5
+_P_V2 = 6
+_P_COULOMB1 = 7
+_P_COULOMB2 = 8
+_P_OMEGA_S = 9
+_P_S1 = 10
+_P_S2 = 11
+_P_MASS = 12
+_P_K_N = 13
+_P_C_N = 14
+_P_K_T = 15
+_P_C_T = 16
+_P_MU = 17
+_P_LENGTH = 18
+_P_X_MIN = 19
+_P_ENCODER = 20
+_P_FEEDBACK = 21
+_P_CONTROL = 22
+_P_TORQUE_GAIN1 = 23
+_P_TORQUE_GAIN2 = 24
+_P_SIZE = 25
+
+# Contact state vector layout.
+_ACTIVE = 0
+_STICK = 1
+_ANCHOR = 2  # 3 values, absolute frame
+_XC = 5
+_FORCE_M = 6  # 3 values, force on the link, motor frame
+_POINT_M = 9  # 3 values, contact point, motor frame
+_FIRST_TOUCH = 12
+_NORMAL_FORCE = 13
+CONTACT_STATE_SIZE = 14
+
+
+@njit(cache=True)
+def _frame(theta1: float, theta2: float) -> NDArray[np.float64]:
+    c1 = math.cos(theta1)
+    s1 = math.sin(theta1)
+    c2 = math.cos(theta2)
+    s2 = math.sin(theta2)
+    f = np.empty((3, 3))
+    f[0, 0] = c2 * c1
+    f[0, 1] = c2 * s1
+    f[0, 2] = s2
+    f[1, 0] = -s1
+    f[1, 1] = c1
+    f[1, 2] = 0.0
+    f[2, 0] = -s2 * c1
+    f[2, 1] = -s2 * s1
+    f[2, 2] = c2
+    return f
+
+
+@njit(cache=True)
+def _shape(
+    x: float, n_el: int, h_el: float, out_n: NDArray[np.float64], out_d: NDArray[np.float64]
+) -> int:
+    """Hermite weights (value and slope) at x into out_n/out_d (4,); returns the element index."""
+    e = int(x / h_el)
+    if e < 0:
+        e = 0
+    if e > n_el - 1:
+        e = n_el - 1
+    xi = (x - e * h_el) / h_el
+    if xi < 0.0:
+        xi = 0.0
+    if xi > 1.0:
+        xi = 1.0
+    xi2 = xi * xi
+    xi3 = xi2 * xi
+    out_n[0] = 1.0 - 3.0 * xi2 + 2.0 * xi3
+    out_n[1] = h_el * (xi - 2.0 * xi2 + xi3)
+    out_n[2] = 3.0 * xi2 - 2.0 * xi3
+    out_n[3] = h_el * (xi3 - xi2)
+    out_d[0] = (-6.0 * xi + 6.0 * xi2) / h_el
+    out_d[1] = 1.0 - 4.0 * xi + 3.0 * xi2
+    out_d[2] = (6.0 * xi - 6.0 * xi2) / h_el
+    out_d[3] = 3.0 * xi2 - 2.0 * xi
+    return e
+
+
+@njit(cache=True)
+def _interp(
+    q: NDArray[np.float64], e: int, wn: NDArray[np.float64], wd: NDArray[np.float64]
+) -> tuple[float, float]:
+    """Deflection and slope from plane dofs q (clamped node removed) in element e."""
+    val = 0.0
+    slope = 0.0
+    for j in range(4):
+        idx = 2 * e + j - 2
+        if idx >= 0:
+            val += wn[j] * q[idx]
+            slope += wd[j] * q[idx]
+    return val, slope
+
+
+@njit(cache=True)
+def _gap(
+    x: float,
+    X: NDArray[np.float64],
+    n: int,
+    n_el: int,
+    h_el: float,
+    frame: NDArray[np.float64],
+    obst: NDArray[np.float64],
+    wn: NDArray[np.float64],
+    wd: NDArray[np.float64],
+) -> float:
+    e = _shape(x, n_el, h_el, wn, wd)
+    v, _ = _interp(X[0:n], e, wn, wd)
+    w, _ = _interp(X[n : 2 * n], e, wn, wd)
+    px = x * frame[0, 0] + v * frame[1, 0] + w * frame[2, 0] - obst[1]
+    py = x * frame[0, 1] + v * frame[1, 1] + w * frame[2, 1] - obst[2]
+    pz = x * frame[0, 2] + v * frame[1, 2] + w * frame[2, 2] - obst[3]
+    dpar = px * obst[4] + py * obst[5] + pz * obst[6]
+    if obst[0] == 2.0:
+        return dpar
+    qx = px - dpar * obst[4]
+    qy = py - dpar * obst[5]
+    qz = pz - dpar * obst[6]
+    return math.sqrt(qx * qx + qy * qy + qz * qz) - obst[7]
+
+
+@njit(cache=True)
+def _closest(
+    X: NDArray[np.float64],
+    n: int,
+    n_el: int,
+    h_el: float,
+    frame: NDArray[np.float64],
+    obst: NDArray[np.float64],
+    x_min: float,
+    length: float,
+    wn: NDArray[np.float64],
+    wd: NDArray[np.float64],
+) -> tuple[float, float]:
+    """Abscissa in [x_min, l] of the smallest gap, and that gap (m)."""
+    n_s = 4 * n_el + 1
+    best = 1e300
+    ibest = 0
+    dx = (length - x_min) / (n_s - 1)
+    for i in range(n_s):
+        g = _gap(x_min + i * dx, X, n, n_el, h_el, frame, obst, wn, wd)
+        if g < best:
+            best = g
+            ibest = i
+    if best > 0.05:
+        return x_min + ibest * dx, best
+    lo = x_min + max(ibest - 1, 0) * dx
+    hi = x_min + min(ibest + 1, n_s - 1) * dx
+    ratio = 0.6180339887498949
+    a = hi - ratio * (hi - lo)
+    b = lo + ratio * (hi - lo)
+    ga = _gap(a, X, n, n_el, h_el, frame, obst, wn, wd)
+    gb = _gap(b, X, n, n_el, h_el, frame, obst, wn, wd)
+    for _ in range(40):
+        if ga < gb:
+            hi = b
+            b = a
+            gb = ga
+            a = hi - ratio * (hi - lo)
+            ga = _gap(a, X, n, n_el, h_el, frame, obst, wn, wd)
+        else:
+            lo = a
+            a = b
+            ga = gb
+            b = lo + ratio * (hi - lo)
+            gb = _gap(b, X, n, n_el, h_el, frame, obst, wn, wd)
+    xc = 0.5 * (lo + hi)
+    g = _gap(xc, X, n, n_el, h_el, frame, obst, wn, wd)
+    if best < g:
+        return x_min + ibest * dx, best
+    return xc, g
+
+
+@njit(cache=True)
+def _solve_s0(
+    r: NDArray[np.float64],
+    n: int,
+    ainv: NDArray[np.float64],
+    z: NDArray[np.float64],
+    coef_b1: float,
+    coef_b2: float,
+    sz: float,
+    d1: float,
+    d2: float,
+) -> NDArray[np.float64]:
+    """Solve the bordered system [[A, b1],[b1^T, d1]] (plane v) and likewise for plane w.
+
+    b1 = coef_b1 * s and b2 = coef_b2 * s, with z = A^-1 s and sz = s . z precomputed.
+    """
+    out = np.empty(2 * n + 2)
+    for plane in range(2):
+        off = plane * n
+        coef = coef_b1 if plane == 0 else coef_b2
+        d = d1 if plane == 0 else d2
+        y = ainv @ r[off : off + n]
+        # Schur complement of the joint row
+        theta = (r[2 * n + plane] - coef * (z @ r[off : off + n])) / (d - coef * coef * sz)
+        out[off : off + n] = y - coef * theta * z
+        out[2 * n + plane] = theta
+    return out
+
+
+@njit(cache=True)
+def sensor_wrench(
+    X: NDArray[np.float64],
+    A: NDArray[np.float64],
+    n: int,
+    mq: NDArray[np.float64],
+    sq: NDArray[np.float64],
+    par: NDArray[np.float64],
+    cs: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
+    """Wrench by the link on the head about O, motor frame: out = [F (3), torque (3)].
+
+    From the momentum balance of the link: the head exerts ``F_h = int rho a dx - W - F_c`` and
+    ``tau_h = int rho p x a dx - int p x rho g dx - p_c x F_c``; the sensor reads -F_h, -tau_h.
+    """
+    g = par[_P_GRAVITY]
+    s1 = par[_P_S1]
+    s2m = par[_P_S2]
+    mass = par[_P_MASS]
+    th2 = X[2 * n + 1]
+    c2 = math.cos(th2)
+    sn2 = math.sin(th2)
+    gx = -g * sn2
+    gz = -g * c2
+    acc1 = A[2 * n]
+    acc2 = A[2 * n + 1]
+    mav = mq @ A[0:n]
+    maw = mq @ A[n : 2 * n]
+    sav = sq @ A[0:n]
+    saw = sq @ A[n : 2 * n]
+    mv = mq @ X[0:n]
+    mw = mq @ X[n : 2 * n]
+    fcx = cs[_FORCE_M]
+    fcy = cs[_FORCE_M + 1]
+    fcz = cs[_FORCE_M + 2]
+    px = cs[_POINT_M]
+    py = cs[_POINT_M + 1]
+    pz = cs[_POINT_M + 2]
+    fhx = -mass * gx - fcx
+    fhy = c2 * acc1 * s1 + mav - fcy
+    fhz = acc2 * s1 + maw - mass * gz - fcz
+    thx = -(gz * mv) - (py * fcz - pz * fcy)
+    thy = -(acc2 * s2m + saw) - (gx * mw - gz * s1) - (pz * fcx - px * fcz)
+    thz = c2 * acc1 * s2m + sav - (-gx * mv) - (px * fcy - py * fcx)
+    out[0] = -fhx
+    out[1] = -fhy
+    out[2] = -fhz
+    out[3] = -thx
+    out[4] = -thy
+    out[5] = -thz
+
+
+@njit(cache=True)
+def _biquad(coef: NDArray[np.float64], state: NDArray[np.float64], k: int, x: float) -> float:
+    """Direct form II transposed; coef (2, 3) = [b, a]; state[k], state[k+1]."""
+    y = coef[0, 0] * x + state[k]
+    state[k] = coef[0, 1] * x - coef[1, 1] * y + state[k + 1]
+    state[k + 1] = coef[0, 2] * x - coef[1, 2] * y
+    return y
+
+
+@njit(cache=True)
+def run_samples(
+    k0: int,
+    k1: int,
+    X: NDArray[np.float64],
+    V: NDArray[np.float64],
+    A: NDArray[np.float64],
+    ctrl: NDArray[np.float64],
+    cs: NDArray[np.float64],
+    par: NDArray[np.float64],
+    mass_m: NDArray[np.float64],
+    damp_c: NDArray[np.float64],
+    ainv: NDArray[np.float64],
+    z: NDArray[np.float64],
+    mq: NDArray[np.float64],
+    sq: NDArray[np.float64],
+    n_el: int,
+    obst: NDArray[np.float64],
+    servo: NDArray[np.float64],
+    theta0: NDArray[np.float64],
+    reference: NDArray[np.float64],
+    noise: NDArray[np.float64],
+    bias: NDArray[np.float64],
+    meas_theta: NDArray[np.float64],
+    meas_wrench: NDArray[np.float64],
+    truth: NDArray[np.float64],
+) -> None:
+    """Advance samples k0..k1-1: sense at t_k, command the motors, integrate to t_{k+1}.
+
+    Writes the measured angles (n, 2) and wrench (n, 6) of each sample and the ground truth
+    (n, 9): true angles (2), contact flag, x_c, contact point in the absolute frame (3), normal
+    force, motor voltage of the swept joint... (see run.py for the columns).
+    """
+    n = mass_m.shape[0]
+    nn = 2 * n + 2
+    h = par[_P_STEP]
+    nsub = int(par[_P_SUBSTEPS])
+    g = par[_P_GRAVITY]
+    s1m = par[_P_S1]
+    s2m = par[_P_S2]
+    length = par[_P_LENGTH]
+    h_el = length / n_el
+    s_dot = float(sq @ z)
+    wrench = np.empty(6)
+    wn = np.empty(4)
+    wd = np.empty(4)
+    un = np.zeros(nn)
+    ut = np.zeros(nn)
+    acoef = np.empty(nn)
+    vcoef = np.empty(nn)
+    rhs = np.empty(nn)
+    u0 = np.empty(nn)
+    for k in range(k0, k1):
+        # --- sensor sample at t_k -------------------------------------------------------------
+        sensor_wrench(X, A, n, mq, sq, par, cs, wrench)
+        for i in range(6):
+            meas_wrench[k, i] = wrench[i] + bias[i] + noise[k, i]
+        quantum = par[_P_ENCODER]
+        for j in range(2):
+            th = X[2 * n + j]
+            if quantum > 0.0:
+                th = quantum * math.floor(th / quantum + 0.5)
+            meas_theta[k, j] = th
+        truth[k, 0] = X[2 * n]
+        truth[k, 1] = X[2 * n + 1]
+        truth[k, 2] = cs[_ACTIVE]
+        truth[k, 3] = cs[_XC]
+        fr = _frame(X[2 * n], X[2 * n + 1])
+        for i in range(3):
+            truth[k, 4 + i] = (
+                cs[_POINT_M] * fr[0, i] + cs[_POINT_M + 1] * fr[1, i] + cs[_POINT_M + 2] * fr[2, i]
+            )
+        truth[k, 7] = cs[_NORMAL_FORCE]
+        # --- servo command (Sec. 4.1, Fig. 7): 2-DOF PID plus measured coupling torque -----------
+        c2m = math.cos(meas_theta[k, 1])
+        s2m_ = math.sin(meas_theta[k, 1])
+        # coupling torque about Z^a (joint 1) and about -Y^m (joint 2), from the sensor
+        coup1 = -(s2m_ * meas_wrench[k, 3] + c2m * meas_wrench[k, 5])
+        coup2 = meas_wrench[k, 4]
+        tau = np.zeros(2)
+        if par[_P_CONTROL] > 0.0:
+            for j in range(2):
+                y1 = _biquad(servo[j, 0], ctrl, 4 * j, reference[k, j] - theta0[j])
+                y2 = _biquad(servo[j, 1], ctrl, 4 * j + 2, meas_theta[k, j] - theta0[j])
+                tau[j] = y1 - y2
+            tau[0] += par[_P_FEEDBACK] * coup1
+            tau[1] += par[_P_FEEDBACK] * coup2
+        truth[k, 8] = tau[0] / par[_P_TORQUE_GAIN1]
+        truth[k, 9] = tau[1] / par[_P_TORQUE_GAIN2]
+        # --- internal Newmark steps --------------------------------------------------------------
+        for _ in range(nsub):
+            th1 = X[2 * n]
+            th2 = X[2 * n + 1]
+            c2 = math.cos(th2)
+            sn2 = math.sin(th2)
+            fr = _frame(th1, th2)
+            # regularised Coulomb friction of Eq. 1, linearised at the current speed
+            cf = np.empty(2)
+            fconst = np.empty(2)
+            for j in range(2):
+                om = V[2 * n + j]
+                gc = par[_P_COULOMB1 + j]
+                ws = par[_P_OMEGA_S]
+                th_ = math.tanh(om / ws)
+                cf[j] = gc / ws * (1.0 - th_ * th_)
+                fconst[j] = gc * th_ - cf[j] * om
+            for i in range(nn):
+                acoef[i] = 4.0 / (h * h) * X[i] + 4.0 / h * V[i] + A[i]
+                vcoef[i] = 2.0 / h * X[i] + V[i]
+            j1 = par[_P_J1] + s2m * c2 * c2
+            j2 = par[_P_J2] + s2m
+            # rhs = M_aug acoef + C_aug vcoef + loads
+            rv = mass_m @ acoef[0:n] + damp_c @ vcoef[0:n] + c2 * sq * acoef[2 * n]
+            rw = mass_m @ acoef[n : 2 * n] + damp_c @ vcoef[n : 2 * n] + sq * acoef[2 * n + 1]
+            # gravity on the w plane: -g cos(theta2) int rho N dx
+            rw = rw - g * c2 * mq
+            rhs[0:n] = rv
+            rhs[n : 2 * n] = rw
+            mw = mq @ X[n : 2 * n]
+            rhs[2 * n] = (
+                c2 * (sq @ acoef[0:n])
+                + j1 * acoef[2 * n]
+                + (par[_P_V1] + cf[0]) * vcoef[2 * n]
+                + tau[0]
+                - fconst[0]
+            )
+            # gravity moment about the elevation axis: g_z S1 - g_x int rho w dx
+            q2g = -g * c2 * s1m + g * sn2 * mw
+            rhs[2 * n + 1] = (
+                sq @ acoef[n : 2 * n]
+                + j2 * acoef[2 * n + 1]
+                + (par[_P_V2] + cf[1]) * vcoef[2 * n + 1]
+                + tau[1]
+                - fconst[1]
+                + q2g
+            )
+            cb1 = 4.0 / (h * h) * c2
+            cb2 = 4.0 / (h * h)
+            d1 = 4.0 / (h * h) * j1 + 2.0 / h * (par[_P_V1] + cf[0])
+            d2 = 4.0 / (h * h) * j2 + 2.0 / h * (par[_P_V2] + cf[1])
+            x_new = _solve_s0(rhs, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+            fn = 0.0
+            ft = 0.0
+            nvec = np.zeros(3)
+            tvec = np.zeros(3)
+            pc = np.zeros(3)
+            xc = 0.0
+            active = False
+            if obst[0] > 0.0:
+                xc, g0 = _closest(X, n, n_el, h_el, fr, obst, par[_P_X_MIN], length, wn, wd)
+                e = _shape(xc, n_el, h_el, wn, wd)
+                v_c, dv_c = _interp(X[0:n], e, wn, wd)
+                w_c, dw_c = _interp(X[n : 2 * n], e, wn, wd)
+                for i in range(3):
+                    pc[i] = xc * fr[0, i] + v_c * fr[1, i] + w_c * fr[2, i]
+                if g0 < 0.02:
+                    # outward normal at the contact point
+                    d = pc - obst[1:4]
+                    if obst[0] == 2.0:
+                        nvec[:] = obst[4:7]
+                    else:
+                        dpar = d @ obst[4:7]
+                        nvec[:] = d - dpar * obst[4:7]
+                        nvec /= math.sqrt(nvec @ nvec)
+                    tang = fr[0] + dv_c * fr[1] + dw_c * fr[2]
+                    tvec[0] = nvec[1] * tang[2] - nvec[2] * tang[1]
+                    tvec[1] = nvec[2] * tang[0] - nvec[0] * tang[2]
+                    tvec[2] = nvec[0] * tang[1] - nvec[1] * tang[0]
+                    tvec /= math.sqrt(tvec @ tvec)
+                    # generalised directions: d p_c / d X
+                    dth1 = xc * c2 * fr[1] - v_c * (c2 * fr[0] - sn2 * fr[2]) - w_c * sn2 * fr[1]
+                    dth2 = xc * fr[2] - w_c * fr[0]
+                    ny = nvec @ fr[1]
+                    nz = nvec @ fr[2]
+                    ty = tvec @ fr[1]
+                    tz = tvec @ fr[2]
+                    un[:] = 0.0
+                    ut[:] = 0.0
+                    for jj in range(4):
+                        idx = 2 * e + jj - 2
+                        if idx >= 0:
+                            un[idx] = ny * wn[jj]
+                            un[n + idx] = nz * wn[jj]
+                            ut[idx] = ty * wn[jj]
+                            ut[n + idx] = tz * wn[jj]
+                    un[2 * n] = nvec @ dth1
+                    un[2 * n + 1] = nvec @ dth2
+                    ut[2 * n] = tvec @ dth1
+                    ut[2 * n + 1] = tvec @ dth2
+                    # predicted gap with the contact-free solution
+                    g_free = g0 + un @ (x_new - X)
+                    if g_free < 0.0 or (cs[_ACTIVE] > 0.0 and g0 < 0.0):
+                        active = True
+                    if active:
+                        if cs[_ACTIVE] == 0.0:
+                            cs[_ANCHOR : _ANCHOR + 3] = pc
+                        s0 = tvec @ (pc - cs[_ANCHOR : _ANCHOR + 3])
+                        kn = par[_P_K_N]
+                        cn = par[_P_C_N]
+                        kt = par[_P_K_T]
+                        ct = par[_P_C_T]
+                        un_x = un @ X
+                        ut_x = ut @ X
+                        rn = -kn * (g0 - un_x) + cn * (un @ vcoef)
+                        rt = -kt * (s0 - ut_x) + ct * (ut @ vcoef)
+                        stick = True
+                        for _it in range(3):
+                            for i in range(nn):
+                                u0[i] = rhs[i] + rn * un[i]
+                                if stick:
+                                    u0[i] += rt * ut[i]
+                                else:
+                                    u0[i] += ft * ut[i]
+                            y0 = _solve_s0(u0, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+                            yn = _solve_s0(un, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+                            dn = kn + 2.0 * cn / h
+                            if stick:
+                                yt = _solve_s0(ut, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+                                dt_ = kt + 2.0 * ct / h
+                                # Woodbury: (D^-1 + U^T S0^-1 U)^-1 U^T S0^-1 u0
+                                m00 = 1.0 / dn + un @ yn
+                                m01 = un @ yt
+                                m10 = ut @ yn
+                                m11 = 1.0 / dt_ + ut @ yt
+                                b0 = un @ y0
+                                b1 = ut @ y0
+                                det = m00 * m11 - m01 * m10
+                                c0 = (m11 * b0 - m01 * b1) / det
+                                c1 = (-m10 * b0 + m00 * b1) / det
+                                x_try = y0 - c0 * yn - c1 * yt
+                            else:
+                                c0 = (un @ y0) / (1.0 / dn + un @ yn)
+                                x_try = y0 - c0 * yn
+                            v_try = 2.0 / h * (x_try - X) - V
+                            g_new = g0 + un @ (x_try - X)
+                            fn = -kn * g_new - cn * (un @ v_try)
+                            if fn <= 0.0:
+                                fn = 0.0
+                                active = False
+                                break
+                            if stick:
+                                s_new = s0 + ut @ (x_try - X)
+                                ft_trial = -kt * s_new - ct * (ut @ v_try)
+                                if abs(ft_trial) <= par[_P_MU] * fn:
+                                    ft = ft_trial
+                                    x_new = x_try
+                                    break
+                                stick = False
+                                ft = math.copysign(par[_P_MU] * fn, ft_trial)
+                            else:
+                                x_new = x_try
+                                break
+                        if active:
+                            dp = np.zeros(3)
+                            dx = x_new - X
+                            for i in range(3):
+                                dp[i] = dth1[i] * dx[2 * n] + dth2[i] * dx[2 * n + 1]
+                            v_new, _ = _interp(x_new[0:n], e, wn, wd)
+                            w_new, _ = _interp(x_new[n : 2 * n], e, wn, wd)
+                            for i in range(3):
+                                dp[i] += (v_new - v_c) * fr[1, i] + (w_new - w_c) * fr[2, i]
+                            if not stick:
+                                # slip: move the anchor so the spring carries the Coulomb force
+                                s_new = -ft / kt
+                                cs[_ANCHOR : _ANCHOR + 3] = pc + dp - s_new * tvec
+                            cs[_STICK] = 1.0 if stick else 0.0
+                            for i in range(3):
+                                pc[i] += dp[i]
+            if not active:
+                fn = 0.0
+                ft = 0.0
+                cs[_STICK] = 0.0
+            acc_new = 4.0 / (h * h) * (x_new - X) - 4.0 / h * V - A
+            V[:] = V + 0.5 * h * (A + acc_new)
+            A[:] = acc_new
+            X[:] = x_new
+            cs[_ACTIVE] = 1.0 if active else 0.0
+            cs[_NORMAL_FORCE] = fn
+            if active:
+                if cs[_FIRST_TOUCH] < 0.0:
+                    cs[_FIRST_TOUCH] = k
+                cs[_XC] = xc
+                fr2 = _frame(X[2 * n], X[2 * n + 1])
+                for r in range(3):
+                    cs[_FORCE_M + r] = fr2[r] @ (fn * nvec + ft * tvec)
+                    cs[_POINT_M + r] = fr2[r] @ pc
+            else:
+                for i in range(3):
+                    cs[_FORCE_M + i] = 0.0

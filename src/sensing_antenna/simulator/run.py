@@ -1,0 +1,371 @@
+"""``simulate(antenna, scenario) -> Recording``: the device of Section 3 doing Section 4 steps 1-4.
+
+The controller takes its stop decision online from the simulated sensor samples, through a
+streaming stop rule with ``reset()`` and ``update(t, theta, force, torque) -> bool`` (by default the
+project's :class:`~sensing_antenna.estimation.push.PushMonitor`), exactly as the real controller
+would: the simulator's ground truth is never used to stop.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link, antenna_to_toml
+from sensing_antenna.recording import FORMAT_NAME, Recording
+from sensing_antenna.simulator.contact import Obstacle, place_obstacle
+from sensing_antenna.simulator.integrator import CONTACT_STATE_SIZE, P, run_samples
+from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
+from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
+from sensing_antenna.simulator.motors import design_servo
+from sensing_antenna.simulator.scenario import Scenario
+
+__all__ = ["SAMPLE_PERIOD", "SimulationDetail", "StopRule", "simulate", "simulate_detailed"]
+
+#: Sampling and control period T_s of the paper's device (s).
+SAMPLE_PERIOD = 1e-3
+
+#: Regularisation speed of the motors' Coulomb friction, tanh(omega / omega_s) (rad/s).
+FRICTION_SPEED = 0.05
+
+#: Contact search starts this fraction of l away from the clamp.
+CONTACT_SEARCH_START = 0.02
+
+
+class StopRule(Protocol):
+    """Streaming stop rule of the controller (PushMonitor interface)."""
+
+    def reset(self) -> None: ...
+
+    def update(self, t: float, theta: Any, force: Any, torque: Any) -> bool: ...
+
+
+@dataclass(frozen=True)
+class SimulationDetail:
+    """A recording plus the simulator's internal truth, for tests and diagnostics.
+
+    Attributes
+    ----------
+    recording : Recording
+    true_theta : ndarray, shape (n, 2)
+        Exact joint angles (rad).
+    in_contact : ndarray of bool, shape (n,)
+    contact_abscissa : ndarray, shape (n,)
+        x_c of the current (or last) contact (m).
+    contact_point : ndarray, shape (n, 3)
+        Contact point, absolute frame (m).
+    normal_force : ndarray, shape (n,)
+        Normal contact force (N).
+    voltage : ndarray, shape (n, 2)
+        Motor input voltages u_i (V).
+    stop_index : int or None
+        Sample at which the stop rule fired (t_1), or None.
+    obstacle : Obstacle or None
+    link_model : LinkModel
+    rayleigh : (float, float)
+        Damping coefficients alpha (1/s), beta (s).
+    """
+
+    recording: Recording
+    true_theta: NDArray[np.float64]
+    in_contact: NDArray[np.bool_]
+    contact_abscissa: NDArray[np.float64]
+    contact_point: NDArray[np.float64]
+    normal_force: NDArray[np.float64]
+    voltage: NDArray[np.float64]
+    stop_index: int | None
+    obstacle: Obstacle | None
+    link_model: LinkModel
+    rayleigh: tuple[float, float]
+
+
+@lru_cache(maxsize=16)
+def _link_setup(link: Link, n_elements: int) -> tuple[LinkModel, float, float]:
+    """FE model, first free frequency and highest first contact frequency over [0.3 l, l]."""
+    model = build_link_model(link, n_elements)
+    omega_free = float(model.free_frequencies(1)[0])
+    grid = np.linspace(0.3, 1.0, 15) * link.length
+    omega_contact = max(float(model.pinned_frequencies(x, 1)[0]) for x in grid)
+    return model, omega_free, omega_contact
+
+
+@lru_cache(maxsize=16)
+def _effective_inverse(
+    link: Link, n_elements: int, step: float, alpha: float, beta: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    model, _, _ = _link_setup(link, n_elements)
+    damping = alpha * model.mass + beta * model.stiffness
+    effective = 4.0 / step**2 * model.mass + 2.0 / step * damping + model.stiffness
+    ainv: NDArray[np.float64] = np.linalg.inv(effective).astype(np.float64)
+    z = ainv @ model.rotation_load
+    return damping, ainv, z
+
+
+def _default_stop_rule(antenna: Antenna, push: Any) -> StopRule:
+    from sensing_antenna.estimation.push import PushCriterion, PushMonitor
+
+    criterion = PushCriterion() if push is None else push
+    return PushMonitor(criterion, antenna, SAMPLE_PERIOD)
+
+
+def simulate(
+    antenna: Antenna,
+    scenario: Scenario,
+    progress: Callable[[float], None] | None = None,
+    stop_rule: StopRule | None = None,
+) -> Recording:
+    """Simulate one manoeuvre and return its recording (recording format v1, with ground truth).
+
+    Parameters
+    ----------
+    antenna : Antenna
+        Link and motors of the device (the observer is not used by the physics).
+    scenario : Scenario
+    progress : callable, optional
+        Called with the fraction done (0..1) now and then.
+    stop_rule : object with reset() and update(t, theta, force, torque) -> bool, optional
+        The controller's stop rule; default ``PushMonitor(scenario.push or PushCriterion())``.
+
+    Returns
+    -------
+    Recording
+        Columns t, theta, force, torque plus ``theta1_ref, theta2_ref``; metadata format,
+        sample_period, antenna, description and ground truth (``true_*``, ``seed``,
+        ``simulation``).
+    """
+    return simulate_detailed(antenna, scenario, progress, stop_rule).recording
+
+
+def simulate_detailed(
+    antenna: Antenna,
+    scenario: Scenario,
+    progress: Callable[[float], None] | None = None,
+    stop_rule: StopRule | None = None,
+    gravity: float = STANDARD_GRAVITY,
+) -> SimulationDetail:
+    """Like :func:`simulate`, also returning the simulator's internal truth (tests, plots).
+
+    ``gravity`` (m/s^2) exists for closed-form tests only.
+    """
+    link = antenna.link
+    ts = SAMPLE_PERIOD
+    n_samples = round(scenario.duration / ts)
+    t: NDArray[np.float64] = np.arange(n_samples, dtype=np.float64) * ts
+    model, omega_free, omega_contact = _link_setup(link, scenario.n_elements)
+    alpha, beta = rayleigh_coefficients(scenario.damping_ratio, omega_free, omega_contact)
+    step = ts / scenario.substeps
+    damping, ainv, z = _effective_inverse(link, scenario.n_elements, step, alpha, beta)
+    n = model.n_dof
+
+    # --- reference trajectory (Section 4 step 1) -----------------------------------------------
+    sweep_joint = 1 if scenario.case == "vertical" else 0
+    servo = [design_servo(m, scenario.servo_pole, ts) for m in antenna.motors]
+    lag = 2.0 * servo[sweep_joint].time_constant * scenario.sweep_speed
+    travel = float(
+        ramp_displacement(
+            np.array(scenario.approach_time), scenario.sweep_speed, scenario.accel_time
+        )
+    )
+    theta_touch = (0.0, 0.0)
+    start = [0.0, 0.0]
+    start[sweep_joint] = theta_touch[sweep_joint] - travel + lag
+    reference = np.empty((n_samples, 2))
+    reference[:, 1 - sweep_joint] = start[1 - sweep_joint]
+    stop_after = scenario.approach_time if scenario.case == "free" else None
+    reference[:, sweep_joint] = sweep_reference(
+        t,
+        start[sweep_joint],
+        scenario.sweep_speed,
+        scenario.accel_time,
+        scenario.start_time,
+        stop_after,
+    )
+
+    # --- initial state: static gravity equilibrium ---------------------------------------------
+    c2 = math.cos(start[1])
+    q_w = np.linalg.solve(model.stiffness, -gravity * c2 * model.translation_load)
+    x_state = np.zeros(2 * n + 2)
+    x_state[n : 2 * n] = q_w
+    x_state[2 * n] = start[0]
+    x_state[2 * n + 1] = start[1]
+    v_state = np.zeros_like(x_state)
+    a_state = np.zeros_like(x_state)
+
+    # --- obstacle (placed from x_c on the sagged link at the touch angles) ---------------------
+    obstacle: Obstacle | None = None
+    obst_array = np.zeros(8)
+    kind = scenario.obstacle_kind
+    if kind is not None:
+        assert scenario.contact_point is not None
+        link.check_contact_point(scenario.contact_point)
+        q_sag = np.linalg.solve(
+            model.stiffness, -gravity * math.cos(theta_touch[1]) * model.translation_load
+        )
+        sag = float(model.shape_at(scenario.contact_point) @ q_sag)
+        sag_slope = float(model.slope_at(scenario.contact_point) @ q_sag)
+        obstacle = place_obstacle(
+            kind,
+            scenario.contact_point,
+            link.length,
+            theta_touch,
+            sag,
+            sag_slope,
+            scenario.obstacle_radius,
+            scenario.obstacle_tilt,
+            sweep_joint,
+        )
+        obst_array = obstacle.as_array()
+
+    # --- parameters of the compiled loop -------------------------------------------------------
+    par = np.zeros(P.SIZE)
+    par[P.STEP] = step
+    par[P.SUBSTEPS] = scenario.substeps
+    par[P.GRAVITY] = gravity
+    m1, m2 = antenna.motors
+    par[P.J1], par[P.J2] = m1.inertia, m2.inertia
+    par[P.V1], par[P.V2] = m1.viscous_friction, m2.viscous_friction
+    par[P.COULOMB1], par[P.COULOMB2] = m1.coulomb_torque, m2.coulomb_torque
+    par[P.OMEGA_S] = FRICTION_SPEED
+    par[P.S1] = model.first_moment
+    par[P.S2] = model.second_moment
+    par[P.MASS] = model.total_mass
+    par[P.K_N] = scenario.contact_stiffness
+    par[P.C_N] = scenario.contact_damping
+    par[P.K_T] = scenario.contact_stiffness
+    par[P.C_T] = scenario.contact_damping
+    par[P.MU] = scenario.friction_coefficient
+    par[P.LENGTH] = link.length
+    par[P.X_MIN] = CONTACT_SEARCH_START * link.length
+    counts = scenario.sensor.encoder_counts
+    par[P.ENCODER] = 0.0 if counts == 0 else 2.0 * math.pi / (counts * m1.gear_ratio)
+    par[P.FEEDBACK] = 1.0
+    par[P.CONTROL] = 1.0
+    par[P.TORQUE_GAIN1] = m1.gear_ratio * m1.torque_constant
+    par[P.TORQUE_GAIN2] = m2.gear_ratio * m2.torque_constant
+    servo_array = np.stack([s.discrete() for s in servo])
+
+    # --- randomness: one seeded generator ------------------------------------------------------
+    rng = np.random.default_rng(scenario.seed)
+    scale = scenario.noise_scale
+    bias = rng.normal(size=6) * np.asarray(scenario.sensor.bias_std) * scale
+    noise = rng.normal(size=(n_samples, 6)) * np.asarray(scenario.sensor.wrench_std) * scale
+
+    meas_theta = np.zeros((n_samples, 2))
+    meas_wrench = np.zeros((n_samples, 6))
+    truth = np.zeros((n_samples, 10))
+    ctrl = np.zeros(8)
+    cs = np.zeros(CONTACT_STATE_SIZE)
+    cs[12] = -1.0
+    theta0 = np.array(start)
+
+    def advance(k0: int, k1: int) -> None:
+        run_samples(
+            k0,
+            k1,
+            x_state,
+            v_state,
+            a_state,
+            ctrl,
+            cs,
+            par,
+            model.mass,
+            damping,
+            ainv,
+            z,
+            model.translation_load,
+            model.rotation_load,
+            model.n_elements,
+            obst_array,
+            servo_array,
+            theta0,
+            reference,
+            noise,
+            bias,
+            meas_theta,
+            meas_wrench,
+            truth,
+        )
+
+    stop_index: int | None = None
+    if scenario.case != "free":
+        rule = _default_stop_rule(antenna, scenario.push) if stop_rule is None else stop_rule
+        rule.reset()
+        for k in range(n_samples):
+            advance(k, k + 1)
+            if rule.update(float(t[k]), meas_theta[k], meas_wrench[k, :3], meas_wrench[k, 3:]):
+                stop_index = k
+                # Section 4 step 4: stop the motors, i.e. freeze the reference from t_1 on
+                reference[k + 1 :, sweep_joint] = reference[k, sweep_joint]
+                break
+            if progress is not None and k % 500 == 0:
+                progress(k / n_samples)
+        if stop_index is not None and stop_index + 1 < n_samples:
+            advance(stop_index + 1, n_samples)
+    else:
+        advance(0, n_samples)
+    if progress is not None:
+        progress(1.0)
+
+    in_contact = truth[:, 2] > 0.5
+    first_touch = int(cs[12]) if cs[12] >= 0 else None
+    metadata: dict[str, str] = {
+        "format": FORMAT_NAME,
+        "sample_period": repr(ts),
+        "antenna": antenna.name,
+        "description": scenario.description or _describe(scenario, kind),
+    }
+    if obstacle is not None:
+        last = int(np.nonzero(in_contact)[0][-1]) if in_contact.any() else None
+        metadata["true_xc"] = "nan" if last is None else repr(float(truth[last, 3]))
+        metadata["true_contact_point"] = json.dumps(
+            None if last is None else [float(v) for v in truth[last, 4:7]]
+        )
+        metadata["true_obstacle"] = obstacle.to_json()
+        metadata["true_t_contact"] = "nan" if first_touch is None else repr(first_touch * ts)
+        metadata["true_in_contact_at_end"] = "true" if in_contact[-1] else "false"
+        metadata["true_t_stop"] = "nan" if stop_index is None else repr(float(t[stop_index]))
+    metadata["seed"] = str(scenario.seed)
+    metadata["simulation"] = json.dumps(
+        {
+            "simulator": "sensing_antenna.simulator/1",
+            "scenario": scenario.to_json_dict(),
+            "antenna": antenna_to_toml(antenna),
+            "damping_alpha": alpha,
+            "damping_beta": beta,
+        },
+        sort_keys=True,
+    )
+    recording = Recording(
+        t=t,
+        theta=meas_theta,
+        force=meas_wrench[:, :3],
+        torque=meas_wrench[:, 3:],
+        metadata=metadata,
+        extra={"theta1_ref": reference[:, 0].copy(), "theta2_ref": reference[:, 1].copy()},
+    )
+    return SimulationDetail(
+        recording=recording,
+        true_theta=truth[:, :2].copy(),
+        in_contact=in_contact,
+        contact_abscissa=truth[:, 3].copy(),
+        contact_point=truth[:, 4:7].copy(),
+        normal_force=truth[:, 7].copy(),
+        voltage=truth[:, 8:10].copy(),
+        stop_index=stop_index,
+        obstacle=obstacle,
+        link_model=model,
+        rayleigh=(alpha, beta),
+    )
+
+
+def _describe(scenario: Scenario, kind: str | None) -> str:
+    if kind is None:
+        return f"simulated {scenario.case} sweep, no obstacle"
+    return f"simulated {scenario.case} sweep into a {kind} at x_c = {scenario.contact_point:g} m"

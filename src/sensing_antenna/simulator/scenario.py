@@ -1,0 +1,220 @@
+"""What to simulate: the manoeuvre case, the obstacle, the sensor noise and the numerical settings.
+
+Every parameter is SI. The defaults and their sources are discussed in ``docs/simulator.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
+
+from sensing_antenna.errors import SensingAntennaError
+
+__all__ = [
+    "ATI_NANO17_RESOLUTION",
+    "CASES",
+    "OBSTACLE_KINDS",
+    "Scenario",
+    "ScenarioError",
+    "SensorNoise",
+]
+
+CASES = ("azimuthal", "vertical", "free")
+OBSTACLE_KINDS = ("post", "bar", "plane")
+
+#: Resolution of an ATI Nano17 SI-25-0.25 transducer with a 16-bit DAQ, as published by ATI:
+#: forces 1/160 N (x, y, z), torques 1/32 N mm (x, y, z). (N, N, N, N m, N m, N m)
+ATI_NANO17_RESOLUTION = (
+    1.0 / 160.0,
+    1.0 / 160.0,
+    1.0 / 160.0,
+    1.0 / 32000.0,
+    1.0 / 32000.0,
+    1.0 / 32000.0,
+)
+
+
+class ScenarioError(SensingAntennaError, ValueError):
+    """A scenario parameter is out of range; the message names the field."""
+
+    def __init__(self, field_name: str, problem: str) -> None:
+        self.field_name = field_name
+        super().__init__(f"scenario.{field_name}: {problem}")
+
+
+def _finite(name: str, value: float, low: float | None = None, strict: bool = False) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ScenarioError(name, f"must be a finite number, got {value!r}")
+    if low is not None and (value <= low if strict else value < low):
+        raise ScenarioError(name, f"must be {'>' if strict else '>='} {low:g}, got {value!r}")
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """Force/torque sensor and encoder imperfections.
+
+    Parameters
+    ----------
+    wrench_std : tuple of 6 float
+        Standard deviation of the additive white noise on (fx, fy, fz, tx, ty, tz) per sample
+        (N, N m). Default: one resolution count of an ATI Nano17 SI-25-0.25.
+    bias_std : tuple of 6 float
+        Standard deviation of the constant per-run offset (residual after taring), same units.
+        Default: two resolution counts.
+    encoder_counts : int
+        Encoder counts per motor-shaft revolution (after quadrature); 2000 = 500 lines x 4.
+    """
+
+    wrench_std: tuple[float, float, float, float, float, float] = ATI_NANO17_RESOLUTION
+    bias_std: tuple[float, float, float, float, float, float] = tuple(  # type: ignore[assignment]
+        2.0 * r for r in ATI_NANO17_RESOLUTION
+    )
+    encoder_counts: int = 2000
+
+    def __post_init__(self) -> None:
+        for name in ("wrench_std", "bias_std"):
+            values = getattr(self, name)
+            if len(values) != 6:
+                raise ScenarioError(f"sensor.{name}", f"needs 6 values, got {len(values)}")
+            for value in values:
+                _finite(f"sensor.{name}", value, 0.0)
+        if not isinstance(self.encoder_counts, int) or self.encoder_counts < 0:
+            raise ScenarioError("sensor.encoder_counts", "must be an integer >= 0 (0 = exact)")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One simulated manoeuvre (Section 4 of the paper, steps 1 to 4).
+
+    Parameters
+    ----------
+    case : {"azimuthal", "vertical", "free"}
+        Azimuthal: theta1 sweeps (theta2 = 0) into a vertical post. Vertical: theta2 sweeps up,
+        against gravity, into a horizontal bar. Free: the azimuthal sweep with no obstacle.
+    contact_point : float or None
+        x_c (m) at which the gravity-sagged, otherwise undeflected link would touch the obstacle.
+        Required unless ``case == "free"``.
+    seed : int
+        Seed of the one ``numpy.random.Generator`` that draws every random quantity.
+    duration : float
+        Total recorded time (s).
+    noise_scale : float
+        Multiplies the sensor noise and bias (0: noiseless, exact encoders).
+    damping_ratio : float
+        Structural damping ratio of the link at its first free mode and at the highest first
+        contact-mode frequency (Rayleigh damping, dimensionless).
+    friction_coefficient : float
+        Coulomb friction coefficient mu between link and obstacle.
+    push : object or None
+        The push criterion (``estimation.push.PushCriterion``); None uses its default.
+    obstacle : {"post", "bar", "plane"} or None
+        Obstacle kind; None: post for the azimuthal case, bar for the vertical case.
+    obstacle_radius : float
+        Radius of the post or bar (m).
+    obstacle_tilt : float
+        Misalignment of the obstacle (rad): the post leans along the sweep, the bar rolls about
+        the link, the plane turns its normal out of the sweep plane. Gives the contact normal a
+        component out of the sweep plane.
+    contact_stiffness : float
+        Normal penalty stiffness (N/m); also the tangential stick stiffness.
+    contact_damping : float
+        Normal and tangential contact damping (N s/m).
+    sweep_speed : float
+        Cruise speed of the swept joint (rad/s).
+    accel_time : float
+        Duration of the raised-cosine speed ramp from rest to cruise (s).
+    start_time : float
+        Rest before the sweep starts (s).
+    approach_time : float
+        Time from the start of the sweep to the nominal first touch (s), at least accel_time.
+    servo_pole : float
+        Closed-loop pole p of both servos (rad/s, < 0); Eq. 14 with eps = -1/p.
+    n_elements : int
+        Finite elements of the link.
+    substeps : int
+        Internal Newmark steps per 1 ms sample.
+    sensor : SensorNoise
+        Sensor noise model at noise_scale = 1.
+    description : str
+        Free text copied into the recording.
+    """
+
+    case: Literal["azimuthal", "vertical", "free"] = "azimuthal"
+    contact_point: float | None = None
+    seed: int = 0
+    duration: float = 3.0
+    noise_scale: float = 1.0
+    damping_ratio: float = 0.005
+    friction_coefficient: float = 0.6
+    push: Any = None
+    obstacle: Literal["post", "bar", "plane"] | None = None
+    obstacle_radius: float = 0.01
+    obstacle_tilt: float = 0.02
+    contact_stiffness: float = 1.0e4
+    contact_damping: float = 0.5
+    sweep_speed: float = 0.3
+    accel_time: float = 0.2
+    start_time: float = 0.1
+    approach_time: float = 0.6
+    servo_pole: float = -40.0
+    n_elements: int = 16
+    substeps: int = 2
+    sensor: SensorNoise = field(default_factory=SensorNoise)
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if self.case not in CASES:
+            raise ScenarioError("case", f"must be one of {', '.join(CASES)}, got {self.case!r}")
+        if self.case == "free":
+            if self.contact_point is not None:
+                raise ScenarioError("contact_point", "must be None for the free case")
+        else:
+            if self.contact_point is None:
+                raise ScenarioError("contact_point", f"is required for the {self.case} case")
+            _finite("contact_point", self.contact_point, 0.0, strict=True)
+        if self.obstacle is not None and self.obstacle not in OBSTACLE_KINDS:
+            raise ScenarioError(
+                "obstacle", f"must be one of {', '.join(OBSTACLE_KINDS)}, got {self.obstacle!r}"
+            )
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise ScenarioError("seed", f"must be an integer >= 0, got {self.seed!r}")
+        _finite("duration", self.duration, 0.01, strict=True)
+        for name in ("noise_scale", "damping_ratio", "friction_coefficient", "contact_damping"):
+            _finite(name, getattr(self, name), 0.0)
+        if self.damping_ratio >= 1.0:
+            raise ScenarioError("damping_ratio", "must be < 1 (light structural damping)")
+        for name in ("obstacle_radius", "contact_stiffness", "sweep_speed", "accel_time"):
+            _finite(name, getattr(self, name), 0.0, strict=True)
+        _finite("start_time", self.start_time, 0.0)
+        _finite("obstacle_tilt", self.obstacle_tilt)
+        if abs(self.obstacle_tilt) >= 0.5:
+            raise ScenarioError("obstacle_tilt", "must be below 0.5 rad in magnitude")
+        _finite("approach_time", self.approach_time, self.accel_time)
+        _finite("servo_pole", self.servo_pole)
+        if not self.servo_pole < 0:
+            raise ScenarioError("servo_pole", f"must be < 0 (stable), got {self.servo_pole!r}")
+        if -self.servo_pole * 1e-3 > 0.3:
+            raise ScenarioError("servo_pole", "too fast for the 1 kHz controller (|p| T_s > 0.3)")
+        if not isinstance(self.n_elements, int) or self.n_elements < 4:
+            raise ScenarioError("n_elements", f"must be an integer >= 4, got {self.n_elements!r}")
+        if not isinstance(self.substeps, int) or self.substeps < 1:
+            raise ScenarioError("substeps", f"must be an integer >= 1, got {self.substeps!r}")
+
+    @property
+    def obstacle_kind(self) -> str | None:
+        """The obstacle actually used: None for the free case."""
+        if self.case == "free":
+            return None
+        if self.obstacle is not None:
+            return self.obstacle
+        return "post" if self.case == "azimuthal" else "bar"
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """Every parameter as JSON-compatible values (the push criterion by its repr)."""
+        data = asdict(self)
+        data["push"] = None if self.push is None else repr(self.push)
+        data["sensor"] = {
+            k: list(v) if isinstance(v, tuple) else v for k, v in data["sensor"].items()
+        }
+        return data
