@@ -98,6 +98,8 @@ class MethodSummary:
         Over all estimates of the case (m); NaN without estimates.
     status_counts : mapping of str to int
         Runs per status (the estimator's status, ``run-failed`` or ``error``).
+    ok_mean_abs_error, ok_max_abs_error : float
+        The same over the runs whose status is ``ok`` only (m); NaN without such runs.
     """
 
     case: str
@@ -108,6 +110,8 @@ class MethodSummary:
     max_abs_error: float
     rms_error: float
     status_counts: Mapping[str, int]
+    ok_mean_abs_error: float = math.nan
+    ok_max_abs_error: float = math.nan
 
 
 def campaign_rows(results: Iterable[RunResult], methods: Sequence[str]) -> list[dict[str, Any]]:
@@ -156,8 +160,10 @@ def method_summaries(
     for case in cases:
         for method in methods:
             selected = _select(all_rows, case, method)
-            errors = np.array([float(r["error_m"]) for r in selected], dtype=float)
-            errors = errors[np.isfinite(errors)]
+            all_errors = np.array([float(r["error_m"]) for r in selected], dtype=float)
+            is_ok = np.array([r["status"] == "ok" for r in selected], dtype=bool)
+            errors = all_errors[np.isfinite(all_errors)]
+            ok_errors = np.abs(all_errors[is_ok & np.isfinite(all_errors)])
             n = errors.size
             summaries.append(
                 MethodSummary(
@@ -169,6 +175,8 @@ def method_summaries(
                     max_abs_error=float(np.max(np.abs(errors))) if n else math.nan,
                     rms_error=float(np.sqrt(np.mean(errors**2))) if n else math.nan,
                     status_counts=dict(Counter(str(r["status"]) for r in selected)),
+                    ok_mean_abs_error=float(np.mean(ok_errors)) if ok_errors.size else math.nan,
+                    ok_max_abs_error=float(np.max(ok_errors)) if ok_errors.size else math.nan,
                 )
             )
     return summaries
