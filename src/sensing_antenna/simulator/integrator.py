@@ -424,6 +424,11 @@ def run_samples(
                 tau[j] = y1 - y2
             tau[0] += par[_P_FEEDBACK] * coup1
             tau[1] += par[_P_FEEDBACK] * coup2
+            # feedforward of the modelled Coulomb friction of Eq. 1 from the reference speed
+            if k > 0:
+                for j in range(2):
+                    speed = (reference[k, j] - reference[k - 1, j]) / (h * nsub)
+                    tau[j] += par[_P_COULOMB1 + j] * math.tanh(speed / par[_P_OMEGA_S])
         truth[k, 8] = tau[0] / par[_P_TORQUE_GAIN1]
         truth[k, 9] = tau[1] / par[_P_TORQUE_GAIN2]
         # --- internal Newmark steps --------------------------------------------------------------

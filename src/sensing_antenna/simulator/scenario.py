@@ -157,7 +157,7 @@ class Scenario:
     accel_time: float = 0.2
     start_time: float = 0.1
     approach_time: float = 0.6
-    servo_pole: float = -40.0
+    servo_pole: float = -60.0
     n_elements: int = 16
     substeps: int = 2
     sensor: SensorNoise = field(default_factory=SensorNoise)
