@@ -17,7 +17,7 @@ import pytest
 from sensing_antenna.antenna import STANDARD_GRAVITY, paper_antenna
 from sensing_antenna.estimation.config import EstimatorConfig, EstimatorConfigError
 from sensing_antenna.estimation.contact_frame import (
-    angle_noise,
+    signal_noise,
     contact_frame,
     first_rest_index,
     gravity_force_m,
@@ -175,15 +175,15 @@ def test_rest_found_after_ramp_stops() -> None:
     assert first_rest_index(theta[:640], 300, 50, tolerance) is None
 
 
-def test_angle_noise_estimate() -> None:
+def test_signal_noise_estimate() -> None:
     # Reference: the noise standard deviation set below; 10 % tolerance for 5000 samples' MAD.
     rng = np.random.default_rng(6)
     t = np.arange(5000) * TS
     theta = np.column_stack([0.3 * np.sin(2 * t), 0.1 * t]) + 2e-5 * rng.standard_normal((5000, 2))
-    noise, _ = angle_noise(theta)
+    noise, _ = signal_noise(theta)
     assert noise == pytest.approx(2e-5, rel=0.1)
     quantised = np.round(theta / 1e-4) * 1e-4
-    _, step = angle_noise(quantised)
+    _, step = signal_noise(quantised)
     assert step == pytest.approx(1e-4, rel=1e-6)
 
 

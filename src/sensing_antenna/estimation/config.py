@@ -135,6 +135,11 @@ class EstimatorConfig:
                 continue
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise EstimatorConfigError(f"{f.name}: must be a finite number > 0, got {value!r}")
+        if self.rest_window > self.convergence_window:
+            raise EstimatorConfigError(
+                "rest_window: must not exceed convergence_window (t_1 is known rest_window "
+                "after it, before the first ratio window closes)"
+            )
         if self.frame_window > self.rest_window:
             raise EstimatorConfigError("frame_window: must not exceed rest_window")
         if self.max_ratio_wait < self.convergence_window:

@@ -29,13 +29,13 @@ from sensing_antenna.estimation.config import EstimatorConfig
 
 __all__ = [
     "ContactFrame",
-    "angle_noise",
     "contact_frame",
     "first_rest_index",
     "gravity_force_m",
     "gravity_torque_m",
     "motor_axes",
     "rest_tolerance",
+    "signal_noise",
     "to_absolute",
 ]
 
@@ -91,8 +91,10 @@ def gravity_torque_m(antenna: Antenna, theta2: FloatArray) -> FloatArray:
     return out
 
 
-def angle_noise(theta: FloatArray) -> tuple[float, float]:
-    """Angle noise and encoder step estimated from samples, the larger over both motors (rad).
+def signal_noise(theta: FloatArray) -> tuple[float, float]:
+    """White-noise level and quantisation step of sampled signals, the larger over the channels.
+
+    Used for the motor angles (rad) and for the F/T channels (N or N m).
 
     The noise is the robust standard deviation of the second differences divided by sqrt(6)
     (the second difference of white noise of variance s^2 has variance 6 s^2; a smooth trajectory
@@ -101,8 +103,8 @@ def angle_noise(theta: FloatArray) -> tuple[float, float]:
 
     Parameters
     ----------
-    theta : array, shape (n, 2)
-        Motor angles (rad).
+    theta : array, shape (n, k)
+        Samples, time on axis 0.
 
     Returns
     -------
@@ -126,7 +128,7 @@ def rest_tolerance(theta_before_contact: FloatArray, config: EstimatorConfig) ->
     The largest of the floor ``config.rest_angle_tolerance``, ``rest_noise_factor`` times the
     angle noise, and three encoder steps (a quantised angle at rest flickers by one or two steps).
     """
-    noise, step = angle_noise(theta_before_contact)
+    noise, step = signal_noise(theta_before_contact)
     return max(config.rest_angle_tolerance, config.rest_noise_factor * noise, 3.0 * step)
 
 

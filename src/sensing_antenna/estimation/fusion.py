@@ -127,6 +127,11 @@ class Evidence:
         Filtered contact loads (Eq. 20 after removing gravity), motor frame (N, N m).
     ratio : array, shape (n,)
         Estimator 2, x_c(t) (m).
+    ratio_mean : array, shape (n,)
+        Its causal moving average over ``convergence_window`` from t_1 on (NaN before) (m).
+    ratio_noise : float
+        Expected standard deviation of the ratio from the force noise (m), see
+        :func:`~sensing_antenna.estimation.ratio.ratio_noise`.
     band : tuple of float
         omega_1 search band (rad/s).
     diagnostics : dict
@@ -149,6 +154,8 @@ class Evidence:
     reaction_f: FloatArray
     torque_f: FloatArray
     ratio: FloatArray
+    ratio_mean: FloatArray
+    ratio_noise: float
     band: tuple[float, float]
     diagnostics: dict[str, Any] = field(default_factory=dict)
 
@@ -246,11 +253,14 @@ def conclude(
     found: list[tuple[Status, str]] = list(problems)
     if not evidence.complete:
         have = evidence.t[e] - evidence.t[evidence.rest_index]
+        if evidence.converged_index is None:
+            need = "the torque/force ratio had not settled yet"
+        else:
+            need = f"the spectrum needs {cfg.spectrum_window:g} s"
         found.append(
             (
                 Status.RECORDING_TOO_SHORT,
-                f"only {have:.3f} s of samples after t_1; the estimate needs "
-                f"{max(cfg.spectrum_window, cfg.convergence_window):.3f} s or more",
+                f"only {have:.3f} s of samples after t_1; {need}",
             )
         )
     elif evidence.converged_index is None:
@@ -276,13 +286,15 @@ def conclude(
             )
         )
     if evidence.converged_index is not None:
-        ratio_drift = abs(evidence.ratio[e] - evidence.ratio[evidence.converged_index])
-        if ratio_drift > cfg.max_ratio_drift:
+        ratio_drift = abs(evidence.ratio_mean[e] - evidence.ratio_mean[evidence.converged_index])
+        # Four standard deviations of the ratio's noise, at least the configured drift.
+        drift_limit = max(cfg.max_ratio_drift, 4.0 * evidence.ratio_noise)
+        if ratio_drift > drift_limit:
             found.append(
                 (
                     Status.SLIP_SUSPECTED,
                     f"the torque/force ratio moved by {ratio_drift:.3f} m after it had settled "
-                    f"(limit {cfg.max_ratio_drift:g} m)",
+                    f"(limit {drift_limit:.3f} m)",
                 )
             )
     push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
@@ -348,7 +360,7 @@ class PaperMethod:
         cfg = evidence.config
         link = evidence.antenna.link
         measurement = evidence.measure_frequency()
-        ratio_estimate = float(evidence.ratio[evidence.end_index])
+        ratio_estimate = float(evidence.ratio_mean[evidence.end_index])
         problems: list[tuple[Status, str]] = []
         diag: dict[str, Any] = {
             "torque_component": measurement.component,

@@ -39,6 +39,7 @@ from sensing_antenna.estimation.contact_frame import (
     contact_frame,
     first_rest_index,
     rest_tolerance,
+    signal_noise,
 )
 from sensing_antenna.estimation.filters import FirstOrderLowPass
 from sensing_antenna.estimation.frequency import FrequencyMeasurement, measure_frequency
@@ -47,6 +48,8 @@ from sensing_antenna.estimation.ratio import (
     converged_index,
     filtered_contact_loads,
     perpendicular_ratio,
+    ratio_noise,
+    window_mean,
 )
 from sensing_antenna.estimation.result import ContactEstimate, Status
 from sensing_antenna.recording import Recording, resample_uniform
@@ -177,6 +180,22 @@ def _frame_at(
     return frame, None
 
 
+def _ratio_noise(
+    force: FloatArray, frame: ContactFrame, antenna: Antenna, cfg: EstimatorConfig, ts: float
+) -> tuple[float, float]:
+    """Ratio noise (m) and the convergence tolerance it implies (m), from samples up to the
+    instant t_1 is known (t_1 + rest_window), so both forms compute them on the same samples."""
+    noise = ratio_noise(
+        signal_noise(force)[0],
+        math.hypot(frame.reaction_m[1], frame.reaction_m[2]),
+        antenna.link.length,
+        cfg.lowpass_cutoff,
+        ts,
+    )
+    # The moving average's spread over a window stays within three noise deviations.
+    return noise, max(cfg.convergence_tolerance, 3.0 * noise)
+
+
 def _evidence(
     t: FloatArray,
     theta: FloatArray,
@@ -202,6 +221,9 @@ def _evidence(
     frame, problem = _frame_at(theta, reaction_f, rest_index, antenna, cfg, sample_period)
     if frame is None:
         return problem or "no contact frame"
+    ratio = perpendicular_ratio(reaction_f, torque_f)
+    known = rest_index + _samples(cfg.rest_window, sample_period) + 1
+    noise, _ = _ratio_noise(force[:known], frame, antenna, cfg, sample_period)
     return Evidence(
         t=t,
         theta=theta,
@@ -218,7 +240,9 @@ def _evidence(
         frame=frame,
         reaction_f=reaction_f,
         torque_f=torque_f,
-        ratio=perpendicular_ratio(reaction_f, torque_f),
+        ratio=ratio,
+        ratio_mean=window_mean(ratio, rest_index, _samples(cfg.convergence_window, sample_period)),
+        ratio_noise=noise,
         band=band,
         diagnostics=diagnostics,
     )
@@ -309,13 +333,11 @@ def estimate(
             Status.PUSH_NOT_REACHED, problem or "", impl.name, diagnostics, t_c, float(t[i_1])
         )
     ratio = perpendicular_ratio(reaction_f, torque_f)
+    w_conv = _samples(cfg.convergence_window, sample_period)
+    ratio_mean = window_mean(ratio, i_1, w_conv)
     last_check = i_1 + _samples(cfg.max_ratio_wait, sample_period)
-    converged = converged_index(
-        ratio[: last_check + 1],
-        i_1,
-        _samples(cfg.convergence_window, sample_period),
-        cfg.convergence_tolerance,
-    )
+    _, tolerance_ratio = _ratio_noise(force[: i_1 + w_rest + 1], frame, antenna, cfg, sample_period)
+    converged = converged_index(ratio_mean[: last_check + 1], i_1 + w_conv, w_conv, tolerance_ratio)
     planned = _planned_end(i_1, converged, cfg, sample_period)
     n = t.shape[0]
     end = min(planned, n - 1)
@@ -401,18 +423,20 @@ class OnlineEstimator:
         self._force = np.empty((capacity, 3))
         self._torque = np.empty((capacity, 3))
         self._ratio = np.empty(capacity)
+        self._mean = np.empty(capacity)
         self._n = 0
         self._contact: int | None = None
         self._tolerance = math.nan
         self._rest: int | None = None
         self._converged: int | None = None
+        self._ratio_tolerance = math.nan
         self._planned: int | None = None
         self._done = False
         self.result: ContactEstimate | None = None
 
     def _grow(self) -> None:
         size = 2 * self._t.shape[0]
-        for name in ("_t", "_theta", "_force", "_torque", "_ratio"):
+        for name in ("_t", "_theta", "_force", "_torque", "_ratio", "_mean"):
             old = getattr(self, name)
             new = np.empty((size, *old.shape[1:]))
             new[: self._n] = old[: self._n]
@@ -510,15 +534,21 @@ class OnlineEstimator:
             self._ratio[start : j + 1] = perpendicular_ratio(
                 reaction_f[start : j + 1], torque_f[start : j + 1]
             )
+            _, self._ratio_tolerance = _ratio_noise(
+                self._force[: j + 1], frame, self.antenna, self.config, self.sample_period
+            )
         else:
             perpendicular = math.hypot(r_y, r_z)
             moment = math.sqrt(g_x * g_x + g_y * g_y + g_z * g_z)
             self._ratio[j] = moment / perpendicular if perpendicular > 0.0 else math.nan
         rest = self._rest
-        if self._converged is None and self._planned is None:
-            if j >= rest + self._w_conv:
-                window_ratio = self._ratio[j - self._w_conv : j + 1]
-                if window_ratio.max() - window_ratio.min() <= self.config.convergence_tolerance:
+        w = self._w_conv
+        if self._converged is None and self._planned is None and j >= rest + w:
+            # Moving average of the ratio over the last window, then its spread (ratio.py)
+            self._mean[j] = self._ratio[j - w : j + 1].mean()
+            if j >= rest + 2 * w:
+                means = self._mean[j - w : j + 1]
+                if means.max() - means.min() <= self._ratio_tolerance:
                     self._converged = j
                     self._planned = _planned_end(rest, j, self.config, self.sample_period)
             if self._planned is None and j >= rest + self._n_wait:

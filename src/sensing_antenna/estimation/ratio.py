@@ -39,6 +39,8 @@ __all__ = [
     "filtered_contact_loads",
     "paper_ratio",
     "perpendicular_ratio",
+    "ratio_noise",
+    "window_mean",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -134,20 +136,46 @@ def paper_ratio(
     return np.where(denominator > 0.0, ratio, np.nan)
 
 
-def converged_index(
-    ratio: FloatArray, start: int, window_samples: int, tolerance: float
-) -> int | None:
-    """First index j >= start + w where ratio[j - w : j + 1] stays within ``tolerance``.
+def window_mean(ratio: FloatArray, start: int, window_samples: int) -> FloatArray:
+    """Causal moving average m[j] = mean(ratio[j - w : j + 1]) for j >= start + w, else NaN (m).
 
-    The test is causal: it uses samples up to j only, so a streaming estimator declares
-    convergence at the same sample.
+    The ratio keeps a ripple at the contact vibration (attenuated only omega_c / omega_1 ~ 1/6
+    by Eq. 20 at the lowest fundamental); a window of one period of the slowest vibration
+    (0.2 s) removes most of it, so convergence tests the trend, not the ripple.
 
     Parameters
     ----------
     ratio : array, shape (n,)
         x_c(t) (m).
     start : int
-        Index of t_1: the window never reaches before it.
+        Index of t_1: the average never reaches before it.
+    window_samples : int
+        w, the window length in sample intervals.
+    """
+    ratio = np.asarray(ratio, dtype=float)
+    out = np.full(ratio.shape, np.nan)
+    segment = ratio[start:]
+    if segment.shape[0] >= window_samples + 1:
+        windows = np.lib.stride_tricks.sliding_window_view(segment, window_samples + 1)
+        out[start + window_samples :] = windows.mean(axis=-1)
+    return out
+
+
+def converged_index(
+    ratio: FloatArray, start: int, window_samples: int, tolerance: float
+) -> int | None:
+    """First index j >= start + w where ratio[j - w : j + 1] stays within ``tolerance``.
+
+    The test is causal: it uses samples up to j only, so a streaming estimator declares
+    convergence at the same sample. The pipeline applies it to the :func:`window_mean` of the
+    ratio, from ``start = t_1 index + w``.
+
+    Parameters
+    ----------
+    ratio : array, shape (n,)
+        x_c(t) or its moving average (m).
+    start : int
+        First index the window may include.
     window_samples : int
         w, the window length in sample intervals.
     tolerance : float
@@ -165,3 +193,29 @@ def converged_index(
     spread = windows.max(axis=-1) - windows.min(axis=-1)
     hits = np.flatnonzero(spread <= tolerance)
     return start + window_samples + int(hits[0]) if hits.size else None
+
+
+def ratio_noise(
+    force_noise: float, push_force: float, length: float, cutoff: float, sample_period: float
+) -> float:
+    """Standard deviation of the filtered ratio caused by white force noise (m).
+
+    A first-order low-pass filter (Eq. 20) passes white noise of standard deviation s with
+    standard deviation s sqrt(omega_c T_s / 2) (its noise bandwidth is omega_c / 4 in Hz, of the
+    1 / (2 T_s) Hz of the samples); the ratio x = |Gamma| / |R| then varies by x s_f / |R|, taken
+    at x = l as an upper bound.
+
+    Parameters
+    ----------
+    force_noise : float
+        White noise of one force channel (N).
+    push_force : float
+        |R_perp| at t_1 (N).
+    length : float
+        l (m).
+    cutoff, sample_period : float
+        omega_c (rad/s) and T_s (s).
+    """
+    if push_force <= 0.0:
+        return float("inf")
+    return length * force_noise * float(np.sqrt(0.5 * cutoff * sample_period)) / push_force
