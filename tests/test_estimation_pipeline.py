@@ -215,7 +215,7 @@ def test_doubtful_recordings_get_a_status(spec: Synthetic, status: Status) -> No
     result = estimate(recording, paper_antenna())
     assert result.status is status, result.reason
     assert result.reason
-    given, final = run_online(recording)
+    _, final = run_online(recording)
     assert comparable(final) == comparable(result)
 
 

@@ -17,13 +17,13 @@ import pytest
 from sensing_antenna.antenna import STANDARD_GRAVITY, paper_antenna
 from sensing_antenna.estimation.config import EstimatorConfig, EstimatorConfigError
 from sensing_antenna.estimation.contact_frame import (
-    signal_noise,
     contact_frame,
     first_rest_index,
     gravity_force_m,
     gravity_torque_m,
     motor_axes,
     rest_tolerance,
+    signal_noise,
 )
 from sensing_antenna.estimation.frequency import find_peak, measure_frequency, power_spectrum
 from sensing_antenna.estimation.fusion import fuse
