@@ -9,6 +9,8 @@ times too high (174 Hz instead of 4.4 Hz at x_c = 0.3 m, theoretical T); it is n
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -84,7 +86,7 @@ def _krylov(order: int, mu: float, r: FloatArray, j: int) -> FloatArray:
         power = 4 * n + j - 1 - order
         if power < 0:
             continue
-        total = total + mu ** (4 * n) * r**power / float(np.prod(np.arange(1, power + 1)))
+        total = total + mu ** (4 * n) * r**power / math.factorial(power)
     return total
 
 
