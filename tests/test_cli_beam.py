@@ -1,0 +1,88 @@
+"""Tests of ``antenna beam`` and ``antenna plot sensing-curves`` (cli/beam.py, plotting)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import load_antenna
+from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.cli import main
+
+
+def test_frequencies_json(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["beam", "--xc", "0.3", "0.5", "0.98", "--modes", "3", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["x_c"] for r in rows] == [0.3, 0.5, 0.98]
+    expected = natural_frequencies(load_antenna().link, [0.3, 0.5, 0.98], 3)
+    for row, omega in zip(rows, expected, strict=True):
+        assert set(row) == {"x_c", "omega", "hz"}
+        np.testing.assert_allclose(row["omega"], omega, rtol=1e-12)
+        np.testing.assert_allclose(row["hz"], omega / (2 * np.pi), rtol=1e-12)
+
+
+def test_frequencies_table(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["beam", "--xc", "0.5", "--modes", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "rad/s" in out and "Hz" in out
+    assert len([line for line in out.splitlines() if line.strip().startswith("0.5000")]) == 2
+
+
+def test_contact_points_json(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["beam", "--omega1", "80", "--antenna", "paper-2021-calibrated", "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["omega1"] == 80.0
+    assert len(payload["candidates"]) == 2
+    link = load_antenna("paper-2021-calibrated").link
+    for candidate in payload["candidates"]:
+        assert set(candidate) == {"x_c", "slope"}
+        omega = natural_frequencies(link, candidate["x_c"], 1)[0]
+        assert omega == pytest.approx(80.0, rel=1e-9)
+
+
+def test_out_of_range_frequency_exits_1_with_empty_list(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["beam", "--omega1", "500", "--json"]) == 1
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["candidates"] == []
+    assert "outside the model's range" in captured.err
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["beam", "--xc", "1.5"],
+        ["beam", "--xc", "0"],
+        ["beam", "--xc", "0.3", "--modes", "0"],
+        ["beam", "--omega1", "abc"],
+        ["beam", "--omega1", "nan"],
+        ["beam", "--xc", "0.3", "--omega1", "80"],
+        ["beam"],
+        ["beam", "--xc", "0.3", "--antenna", "no-such-antenna.toml"],
+    ],
+)
+def test_bad_arguments_exit_2_with_one_line(
+    argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    try:
+        code = main(argv)
+    except SystemExit as exc:  # argparse errors exit from inside parse_args
+        code = int(exc.code) if exc.code is not None else 0
+    captured = capsys.readouterr()
+    assert code == 2
+    assert len(captured.err.strip().splitlines()) == 1
+    assert "Traceback" not in captured.err
+
+
+def test_plot_sensing_curves(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "figs"
+    assert main(["plot", "sensing-curves", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out.split()
+    paths = [Path(p) for p in printed]
+    assert [p.name for p in paths] == ["figure8.png", "figure9.png"]
+    for path in paths:
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
