@@ -432,7 +432,7 @@ def run_samples(
         truth[k, 8] = tau[0] / par[_P_TORQUE_GAIN1]
         truth[k, 9] = tau[1] / par[_P_TORQUE_GAIN2]
         # --- internal Newmark steps --------------------------------------------------------------
-        for _ in range(nsub):
+        for sub in range(nsub):
             th1 = X[2 * n]
             th2 = X[2 * n + 1]
             c2 = math.cos(th2)
@@ -622,7 +622,7 @@ def run_samples(
             cs[_NORMAL_FORCE] = fn
             if active:
                 if cs[_FIRST_TOUCH] < 0.0:
-                    cs[_FIRST_TOUCH] = k
+                    cs[_FIRST_TOUCH] = k * h * nsub + (sub + 1) * h
                 cs[_XC] = xc
                 fr2 = _frame(X[2 * n], X[2 * n + 1])
                 for r in range(3):

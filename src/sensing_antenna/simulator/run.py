@@ -314,7 +314,7 @@ def simulate_detailed(
         progress(1.0)
 
     in_contact = truth[:, 2] > 0.5
-    first_touch = int(cs[12]) if cs[12] >= 0 else None
+    first_touch = float(cs[12]) if cs[12] >= 0 else None
     metadata: dict[str, str] = {
         "format": FORMAT_NAME,
         "sample_period": repr(ts),
@@ -328,7 +328,7 @@ def simulate_detailed(
             None if last is None else [float(v) for v in truth[last, 4:7]]
         )
         metadata["true_obstacle"] = obstacle.to_json()
-        metadata["true_t_contact"] = "nan" if first_touch is None else repr(first_touch * ts)
+        metadata["true_t_contact"] = "nan" if first_touch is None else repr(first_touch)
         metadata["true_in_contact_at_end"] = "true" if in_contact[-1] else "false"
         metadata["true_t_stop"] = "nan" if stop_index is None else repr(float(t[stop_index]))
     metadata["seed"] = str(scenario.seed)
