@@ -1,0 +1,171 @@
+"""Tests of sensing_antenna.antenna: built-in sets, derived values, TOML overrides and errors."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import pytest
+
+from sensing_antenna.antenna import (
+    BUILTIN_ANTENNAS,
+    AntennaConfigError,
+    antenna_to_toml,
+    load_antenna,
+    paper_antenna,
+    save_antenna,
+)
+from sensing_antenna.errors import SensingAntennaError
+
+
+@pytest.mark.parametrize("name", BUILTIN_ANTENNAS)
+def test_builtins_load(name: str) -> None:
+    antenna = load_antenna(name)
+    assert antenna.name == name
+    assert antenna.link.length == 0.98
+    assert antenna.link.tip_mass == 0.0
+
+
+def test_default_is_paper_2021() -> None:
+    assert load_antenna() == paper_antenna()
+    assert load_antenna(None).name == "paper-2021"
+
+
+def test_derived_link_values_match_table_2() -> None:
+    """Table 2 / paper README: E I = 0.0903 N m^2, m_b = 4.606 g, T = 0.2282 s/m^2.
+
+    E I: tolerance 5e-4 (four printed digits). m_b = rho l exactly. T: the paper computes it
+    from I rounded to 0.785 mm^4 (0.2282); from pi r^4 / 4 = 0.7854 mm^4 it is 0.22811, so the
+    tolerance is 5e-4 relative (the rounding of I), not the printed digits.
+    """
+    link = paper_antenna().link
+    assert link.area_moment == pytest.approx(0.785e-12, rel=1e-3)  # Table 2, 0.785 mm^4
+    assert link.flexural_rigidity == pytest.approx(0.0903, rel=5e-4)
+    assert link.mass == pytest.approx(4.606e-3, rel=1e-12)
+    assert link.theoretical_t == pytest.approx(0.2282, rel=5e-4)
+    assert link.t_param == link.theoretical_t
+    assert link.tip_mass_ratio == 0.0
+
+
+def test_calibrated_set_uses_t_e() -> None:
+    """Section 5.1: T_e = 0.2124, 7 % below the theoretical T."""
+    link = load_antenna("paper-2021-calibrated").link
+    assert link.t_param == 0.2124
+    assert 1 - link.t_param / link.theoretical_t == pytest.approx(0.07, abs=0.005)
+    assert paper_antenna().with_calibrated_t(0.2124).link == link
+
+
+def test_motor_and_observer_values() -> None:
+    """Table 1 and Eq. 15."""
+    antenna = paper_antenna()
+    assert antenna.azimuth_motor.inertia == 6.2e-3
+    assert antenna.elevation_motor.inertia == 1.8e-3
+    assert antenna.azimuth_motor.coulomb_torque == pytest.approx(100 * 0.003 * 0.48)
+    assert antenna.observer.natural_frequency == 16.4
+    assert antenna.observer.damping_ratio == pytest.approx(0.3 / (2 * 16.4))
+
+
+def test_toml_override_with_base(tmp_path: Path) -> None:
+    path = tmp_path / "short.toml"
+    path.write_text(
+        'base = "paper-2021"\nname = "short-link"\n[link]\nlength = 0.5\ntip_mass = 0.001\n',
+        encoding="utf-8",
+    )
+    antenna = load_antenna(path)
+    assert antenna.name == "short-link"
+    assert antenna.link.length == 0.5
+    assert antenna.link.tip_mass == 0.001
+    assert antenna.link.radius == paper_antenna().link.radius  # inherited
+    assert antenna.azimuth_motor == paper_antenna().azimuth_motor
+    assert antenna.link.tip_mass_ratio == pytest.approx(0.001 / (4.7e-3 * 0.5))
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        ("[link]\nlength = -1.0\n", "link.length"),
+        ("[link]\nlength = 0\n", "link.length"),
+        ('[link]\nradius = "thin"\n', "link.radius"),
+        ("[link]\nyoungs_modulus = true\n", "link.youngs_modulus"),
+        ("[link]\ntip_mass = -0.1\n", "link.tip_mass"),
+        ("[link]\ncalibrated_t = nan\n", "link.calibrated_t"),
+        ("[link]\ncolour = 3.0\n", "link.colour"),
+        ("[motor]\ninertia = 1.0\n", "motor"),
+        ("[azimuth_motor]\ninertia = -1.0\n", "azimuth_motor.inertia"),
+        ("[observer]\nnatural_frequency = 0.0\n", "observer.natural_frequency"),
+    ],
+)
+def test_invalid_values_name_field_and_file(tmp_path: Path, body: str, field: str) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text('base = "paper-2021"\n' + body, encoding="utf-8")
+    with pytest.raises(AntennaConfigError) as info:
+        load_antenna(path)
+    message = str(info.value)
+    assert str(path) in message
+    assert field in message
+    assert info.value.field_name == field
+
+
+def test_errors_are_sensing_antenna_errors() -> None:
+    assert issubclass(AntennaConfigError, SensingAntennaError)
+
+
+def test_missing_section_without_base(tmp_path: Path) -> None:
+    path = tmp_path / "partial.toml"
+    path.write_text('name = "x"\n[link]\nlength = 1.0\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match="missing"):
+        load_antenna(path)
+
+
+def test_missing_field_without_base(tmp_path: Path) -> None:
+    text = antenna_to_toml(paper_antenna()).replace("radius = 0.001\n", "")
+    path = tmp_path / "no-radius.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=r"link: missing field") as info:
+        load_antenna(path)
+    assert str(path) in str(info.value)
+
+
+def test_bad_base_not_a_file_and_bad_toml(tmp_path: Path) -> None:
+    with pytest.raises(AntennaConfigError, match="no such file"):
+        load_antenna(tmp_path / "absent.toml")
+    path = tmp_path / "base.toml"
+    path.write_text('base = "paper-1999"\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match="base"):
+        load_antenna(path)
+    path.write_text("this is = = not toml\n", encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match="not valid TOML"):
+        load_antenna(path)
+
+
+def test_save_load_round_trip(tmp_path: Path) -> None:
+    original = paper_antenna()
+    variant = dataclasses.replace(
+        original,
+        name='odd "name"',
+        description="tip payload",
+        link=dataclasses.replace(original.link, tip_mass=0.0012, calibrated_t=0.21),
+    )
+    for antenna in (original, load_antenna("paper-2021-calibrated"), variant):
+        path = tmp_path / "round.toml"
+        save_antenna(antenna, path)
+        assert load_antenna(path) == antenna
+
+
+def test_check_contact_point() -> None:
+    link = paper_antenna().link
+    link.check_contact_point(0.98)
+    link.check_contact_point(1e-6)
+    for bad in (0.0, -0.1, 0.99, math.inf, math.nan):
+        with pytest.raises(AntennaConfigError, match="x_c"):
+            link.check_contact_point(bad)
+
+
+def test_gravity_terms_section_4_2() -> None:
+    """Section 4.2: F_g = (-m g sin t2, 0, -m g cos t2), Gamma_g = (0, m g l cos t2 / 2, 0)."""
+    antenna = paper_antenna()
+    w = antenna.link.mass * 9.80665
+    fx, fy, fz = antenna.gravity_force(0.0)
+    assert (fx, fy, fz) == pytest.approx((0.0, 0.0, -w))
+    assert antenna.gravity_torque(0.0)[1] == pytest.approx(0.5 * w * 0.98)
