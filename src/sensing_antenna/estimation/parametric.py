@@ -1,0 +1,459 @@
+"""Short-record frequency estimation: damped sinusoids with a static part, fitted jointly.
+
+After t_1 the head is still and the link, clamped at the base and pinned at the contact, rings at
+its contact-mode frequencies (Eq. 3 with the boundary conditions of Eq. 4). Every load channel of
+the F/T sensor sees the same modes with its own amplitude and phase, on top of the static load
+of the push. Over a window of ``n`` samples at t_n = t_0 + n T_s each channel k is modelled as
+
+    y_k(t) = c_k + g_k (t - t_ref) + sum_m exp(-s_m (t - t_ref))
+             * (a_km cos(w_m (t - t_ref)) + b_km sin(w_m (t - t_ref))) + noise_k
+
+with t_ref the centre of the window: c_k is the static load at t_ref, g_k a slow drift (the servo
+still creeps after t_1; the simulated head moves ~1e-2 rad/s), w_m (rad/s) and s_m (1/s) the
+frequencies and decay rates, shared by every channel because they belong to the structure.
+
+Fit (variable projection): for given (w, s) the model is linear in (c, g, a, b), solved by least
+squares for every channel at once; only the 2 M nonlinear parameters go to
+:func:`scipy.optimize.least_squares`. Each channel is weighted by the inverse of its noise
+standard deviation (estimated from the residuals of a first fit, then refitted), so the channels
+are combined as independent measurements. Initial poles come from the matrix pencil method on the
+stacked Hankel matrices of all channels (Hua and Sarkar 1990).
+
+Model order: M = 1 .. ``max_modes`` damped modes; the order with the smallest Bayesian
+information criterion (Schwarz 1978) sum_k n ln(RSS_k / n) + P ln(n K) is kept, P being the
+number of fitted parameters. Extra modes absorb the second contact mode and servo transients that
+would otherwise bias the fundamental or make the residual non-white.
+
+Standard errors: the covariance of every parameter is (J^T J)^-1 with J the Jacobian of the
+weighted residuals at the solution (Gauss-Newton approximation; weights set from the residual
+variance, so the reduced chi-square is 1 by construction). The Cramer-Rao bound of the same record
+(:func:`damped_sinusoid_crb`) is computed from the Fisher information J^T J / sigma^2 of the
+noiseless model.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+__all__ = [
+    "DampedSinusoidFit",
+    "damped_sinusoid_crb",
+    "fit_damped_sinusoids",
+    "matrix_pencil_poles",
+    "select_model_order",
+]
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+
+#: Largest decay rate s a fitted mode may take, as a multiple of pi / T_s (1/s): a mode decaying
+#: faster loses most of its amplitude within a sample and is not a vibration of the link.
+_DECAY_LIMIT_FACTOR = 1.0
+#: Smallest decay rate (1/s): slight growth is allowed (a fit on a short record may need it), more
+#: is not physical for a passive link.
+_MIN_DECAY = -20.0
+
+
+@dataclass(frozen=True)
+class DampedSinusoidFit:
+    """Damped sinusoids plus offset and drift, fitted jointly to several channels.
+
+    Attributes
+    ----------
+    omega : array, shape (M,)
+        Angular frequencies w_m (rad/s), ascending.
+    decay : array, shape (M,)
+        Decay rates s_m (1/s); the damping ratio is about s_m / w_m.
+    omega_se, decay_se : array, shape (M,)
+        Their standard errors (rad/s, 1/s).
+    offsets : array, shape (K,)
+        Static part c_k of each channel at ``t_ref`` (channel units).
+    offset_cov : array, shape (K, K)
+        Covariance of the offsets (channel units squared), including their correlation through
+        the shared nonlinear parameters.
+    drifts : array, shape (K,)
+        Slow drift g_k (channel units per s).
+    amplitudes : array, shape (K, M)
+        Amplitude sqrt(a^2 + b^2) of each mode in each channel at ``t_ref`` (channel units).
+    noise_std : array, shape (K,)
+        Residual standard deviation of each channel (channel units).
+    t_ref : float
+        Reference instant, the centre of the window (s).
+    n_samples : int
+        Samples per channel.
+    sample_period : float
+        T_s (s).
+    bic : float
+        Bayesian information criterion of the fit (smaller is better).
+    converged : bool
+        False when the optimiser stopped without meeting its tolerances or the normal matrix was
+        singular (the standard errors are then NaN).
+    """
+
+    omega: FloatArray
+    decay: FloatArray
+    omega_se: FloatArray
+    decay_se: FloatArray
+    offsets: FloatArray
+    offset_cov: FloatArray
+    drifts: FloatArray
+    amplitudes: FloatArray
+    noise_std: FloatArray
+    t_ref: float
+    n_samples: int
+    sample_period: float
+    bic: float
+    converged: bool
+
+    @property
+    def n_modes(self) -> int:
+        """Number of damped modes M."""
+        return int(self.omega.shape[0])
+
+    @property
+    def duration(self) -> float:
+        """Window length (n - 1) T_s (s)."""
+        return (self.n_samples - 1) * self.sample_period
+
+    def snr(self) -> FloatArray:
+        """Amplitude over noise of each mode, combined over channels, shape (M,)."""
+        ratio = self.amplitudes / self.noise_std[:, None]
+        return np.asarray(np.sqrt(np.sum(ratio**2, axis=0)), dtype=float)
+
+    def strongest_in_band(self, band: tuple[float, float]) -> int | None:
+        """Index of the mode inside ``band`` (rad/s) with the largest combined SNR, or None."""
+        inside = np.flatnonzero((self.omega >= band[0]) & (self.omega <= band[1]))
+        if inside.size == 0:
+            return None
+        return int(inside[np.argmax(self.snr()[inside])])
+
+
+def matrix_pencil_poles(signals: FloatArray, n_poles: int) -> ComplexArray:
+    """Discrete-time poles z shared by several channels, by the matrix pencil method.
+
+    Parameters
+    ----------
+    signals : array, shape (n,) or (n, K)
+        Samples, time on axis 0.
+    n_poles : int
+        Number of poles kept (the rank of the truncated SVD).
+
+    Returns
+    -------
+    array of complex, shape (n_poles,)
+        Poles z = exp((-s + i w) T_s) of the signal model sum_j h_j z_j^n.
+
+    Notes
+    -----
+    Hua and Sarkar (1990): with pencil parameter L = n / 3, the Hankel matrices of every channel
+    (rows y[i : i + L + 1]) are stacked, their right singular vectors V truncated to ``n_poles``
+    and the poles are the eigenvalues of pinv(V[:-1]) V[1:] (shift invariance).
+    """
+    y = np.asarray(signals, dtype=float)
+    if y.ndim == 1:
+        y = y[:, None]
+    n = y.shape[0]
+    pencil = max(n_poles, n // 3)
+    if n - pencil < n_poles:
+        raise ValueError(f"{n} samples are too few for {n_poles} poles")
+    hankel = np.vstack(
+        [np.lib.stride_tricks.sliding_window_view(y[:, k], pencil + 1) for k in range(y.shape[1])]
+    )
+    _, _, vh = np.linalg.svd(hankel, full_matrices=False)
+    v = vh[:n_poles].conj().T
+    # Shift invariance: V2 = V1 Z, the poles are the eigenvalues of pinv(V1) V2
+    shifted = np.linalg.pinv(v[:-1]) @ v[1:]
+    return np.asarray(np.linalg.eigvals(shifted), dtype=complex)
+
+
+def _basis(tau: FloatArray, params: FloatArray) -> FloatArray:
+    """Columns 1, tau, then exp(-s tau) cos(w tau), exp(-s tau) sin(w tau) per mode."""
+    omega, decay = params[0::2], params[1::2]
+    envelope = np.exp(-np.multiply.outer(tau, decay))
+    phase = np.multiply.outer(tau, omega)
+    cols = np.empty((tau.size, 2 + 2 * omega.size))
+    cols[:, 0] = 1.0
+    cols[:, 1] = tau
+    cols[:, 2::2] = envelope * np.cos(phase)
+    cols[:, 3::2] = envelope * np.sin(phase)
+    return cols
+
+
+def _basis_derivatives(tau: FloatArray, params: FloatArray) -> FloatArray:
+    """d basis / d params, shape (n, 2 + 2M, 2M) (only the mode columns depend on params)."""
+    omega, decay = params[0::2], params[1::2]
+    m = omega.size
+    envelope = np.exp(-np.multiply.outer(tau, decay))
+    phase = np.multiply.outer(tau, omega)
+    cos_part, sin_part = envelope * np.cos(phase), envelope * np.sin(phase)
+    out = np.zeros((tau.size, 2 + 2 * m, 2 * m))
+    for j in range(m):
+        # d/dw: tau * (-sin, cos) envelope;  d/ds: -tau * (cos, sin) envelope
+        out[:, 2 + 2 * j, 2 * j] = -tau * sin_part[:, j]
+        out[:, 3 + 2 * j, 2 * j] = tau * cos_part[:, j]
+        out[:, 2 + 2 * j, 2 * j + 1] = -tau * cos_part[:, j]
+        out[:, 3 + 2 * j, 2 * j + 1] = -tau * sin_part[:, j]
+    return out
+
+
+def _projection_residual(params: FloatArray, tau: FloatArray, weighted: FloatArray) -> FloatArray:
+    """Weighted residual after the linear least-squares solve, flattened (variable projection)."""
+    q, _ = np.linalg.qr(_basis(tau, params))
+    residual = weighted - q @ (q.T @ weighted)
+    return np.asarray(residual.ravel(), dtype=float)
+
+
+def _initial_modes(
+    y: FloatArray, n_modes: int, sample_period: float, upper: FloatArray
+) -> FloatArray | None:
+    """(w, s) pairs of the ``n_modes`` strongest oscillatory matrix-pencil poles."""
+    n = y.shape[0]
+    n_poles = min(2 * n_modes + 4, n // 3)
+    if n_poles < 2 * n_modes:
+        return None
+    z = matrix_pencil_poles(y, n_poles)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s_plane = np.log(z) / sample_period
+    keep = np.isfinite(s_plane) & (s_plane.imag > 0.0)
+    s_plane = s_plane[keep]
+    if s_plane.size < n_modes:
+        return None
+    # Amplitude of each pole: least squares on the complex exponentials of all kept poles
+    idx = np.arange(n)
+    vander = np.exp(np.multiply.outer(idx * sample_period, s_plane))
+    basis = np.hstack([np.ones((n, 1)), idx[:, None] * 1.0, vander.real, vander.imag])
+    coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
+    m = s_plane.size
+    power = np.sum(coef[2 : 2 + m] ** 2 + coef[2 + m :] ** 2, axis=1)
+    order = np.argsort(power)[::-1][:n_modes]
+    chosen = s_plane[order]
+    params = np.empty(2 * n_modes)
+    params[0::2] = np.clip(chosen.imag, 1e-3, upper[0] * 0.999)
+    params[1::2] = np.clip(-chosen.real, _MIN_DECAY * 0.999, upper[1] * 0.999)
+    return params
+
+
+def fit_damped_sinusoids(
+    signals: FloatArray,
+    sample_period: float,
+    n_modes: int,
+    t_start: float = 0.0,
+    noise_std: FloatArray | None = None,
+) -> DampedSinusoidFit | None:
+    """Fit ``n_modes`` damped sinusoids with shared poles, plus offset and drift per channel.
+
+    Parameters
+    ----------
+    signals : array, shape (n,) or (n, K)
+        Samples of K channels, time on axis 0 (any units per channel).
+    sample_period : float
+        T_s (s).
+    n_modes : int
+        Number of damped modes M >= 1.
+    t_start : float
+        Time of the first sample (s).
+    noise_std : array, shape (K,), optional
+        Noise standard deviation of each channel; estimated from the residuals when omitted
+        (one fit with unit weights scaled by each channel's spread, then a refit).
+
+    Returns
+    -------
+    DampedSinusoidFit or None
+        None when the record is too short for the model (fewer samples than 3 times the
+        parameters per channel) or the matrix pencil finds no oscillatory pole.
+    """
+    y = np.asarray(signals, dtype=float)
+    if y.ndim == 1:
+        y = y[:, None]
+    n, k = y.shape
+    n_linear = 2 + 2 * n_modes
+    if n < 3 * (n_linear + 2 * n_modes):
+        return None
+    tau = (np.arange(n) - 0.5 * (n - 1)) * sample_period
+    upper = np.array([math.pi / sample_period, _DECAY_LIMIT_FACTOR * math.pi / sample_period])
+    if noise_std is None:
+        # Rough first weights: the spread of the first differences (noise-dominated at 1 kHz)
+        scale = np.std(np.diff(y, axis=0), axis=0) / math.sqrt(2.0)
+        scale = np.where(scale > 0.0, scale, 1.0)
+    else:
+        scale = np.asarray(noise_std, dtype=float)
+    start = _initial_modes(y / scale, n_modes, sample_period, upper)
+    if start is None:
+        return None
+    lower_b = np.tile([1e-3, _MIN_DECAY], n_modes)
+    upper_b = np.tile(upper, n_modes)
+    params, ok = _refine(start, tau, y / scale, lower_b, upper_b)
+    if noise_std is None:
+        residual = _projection_residual(params, tau, y / scale).reshape(n, k) * scale
+        dof = max(n - n_linear - 2 * n_modes, 1)
+        scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
+        scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
+        params, ok = _refine(params, tau, y / scale, lower_b, upper_b)
+    return _summarise(params, ok, tau, y, scale, t_start, sample_period, noise_std is None)
+
+
+def _refine(
+    start: FloatArray, tau: FloatArray, weighted: FloatArray, lower: FloatArray, upper: FloatArray
+) -> tuple[FloatArray, bool]:
+    solution = least_squares(
+        _projection_residual,
+        start,
+        bounds=(lower, upper),
+        args=(tau, weighted),
+        method="trf",
+        x_scale="jac",
+        xtol=1e-10,
+        ftol=1e-10,
+        max_nfev=200,
+    )
+    return np.asarray(solution.x, dtype=float), bool(solution.status > 0)
+
+
+def _summarise(
+    params: FloatArray,
+    converged: bool,
+    tau: FloatArray,
+    y: FloatArray,
+    scale: FloatArray,
+    t_start: float,
+    sample_period: float,
+    scale_from_residuals: bool,
+) -> DampedSinusoidFit:
+    n, k = y.shape
+    m = params.size // 2
+    basis = _basis(tau, params)
+    coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
+    residual = y - basis @ coef
+    n_linear = basis.shape[1]
+    dof = max(n - n_linear - 2 * m, 1)
+    noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale
+    noise = np.where(noise > 0.0, noise, np.finfo(float).tiny)
+    # Full Jacobian of the weighted residuals: shared (w, s) columns, then each channel's block
+    deriv = _basis_derivatives(tau, params)
+    n_par = 2 * m + k * n_linear
+    jac = np.zeros((n * k, n_par))
+    for ch in range(k):
+        rows = slice(ch * n, (ch + 1) * n)
+        jac[rows, : 2 * m] = np.einsum("npq,p->nq", deriv, coef[:, ch]) / noise[ch]
+        jac[rows, 2 * m + ch * n_linear : 2 * m + (ch + 1) * n_linear] = basis / noise[ch]
+    try:
+        cov = np.linalg.inv(jac.T @ jac)
+        ok = converged and bool(np.all(np.isfinite(cov)))
+    except np.linalg.LinAlgError:
+        cov = np.full((n_par, n_par), np.nan)
+        ok = False
+    diag = np.sqrt(np.clip(np.diag(cov)[: 2 * m], 0.0, None))
+    offset_idx = 2 * m + np.arange(k) * n_linear
+    order = np.argsort(params[0::2])
+    rss = np.sum(residual**2, axis=0)
+    tiny = np.finfo(float).tiny
+    # Schwarz (1978): BIC = sum_k n ln(RSS_k / n) + P ln(n K)
+    bic = float(np.sum(n * np.log(np.maximum(rss, tiny) / n)) + n_par * math.log(n * k))
+    amplitudes = np.hypot(coef[2::2], coef[3::2]).T
+    return DampedSinusoidFit(
+        omega=params[0::2][order],
+        decay=params[1::2][order],
+        omega_se=diag[0::2][order],
+        decay_se=diag[1::2][order],
+        offsets=np.asarray(coef[0], dtype=float),
+        offset_cov=cov[np.ix_(offset_idx, offset_idx)],
+        drifts=np.asarray(coef[1], dtype=float),
+        amplitudes=np.asarray(amplitudes[:, order], dtype=float),
+        noise_std=np.asarray(noise, dtype=float),
+        t_ref=t_start + 0.5 * (n - 1) * sample_period,
+        n_samples=n,
+        sample_period=sample_period,
+        bic=bic,
+        converged=ok,
+    )
+
+
+def select_model_order(
+    signals: FloatArray, sample_period: float, max_modes: int = 3, t_start: float = 0.0
+) -> DampedSinusoidFit | None:
+    """The fit with the smallest BIC among M = 1 .. ``max_modes`` damped modes.
+
+    Returns None when no order could be fitted (record too short). The noise of each channel is
+    estimated once, from the residuals of the largest order that fits, and used for every order,
+    so that the BIC compares the orders on the same weights.
+    """
+    fits = []
+    noise: FloatArray | None = None
+    for m in range(max_modes, 0, -1):
+        fit = fit_damped_sinusoids(signals, sample_period, m, t_start, noise)
+        if fit is None:
+            continue
+        if noise is None:
+            noise = fit.noise_std
+            fit = fit_damped_sinusoids(signals, sample_period, m, t_start, noise) or fit
+        fits.append(fit)
+    if not fits:
+        return None
+    return min(fits, key=lambda f: f.bic)
+
+
+def damped_sinusoid_crb(
+    omega: float,
+    decay: float,
+    amplitude: float,
+    phase: float,
+    noise_std: float,
+    n_samples: int,
+    sample_period: float,
+    drift: bool = False,
+) -> FloatArray:
+    """Cramer-Rao bound of (omega, decay, amplitude, phase, offset[, drift]) for a damped sinusoid.
+
+    Model y_n = c + g t_n + A exp(-s t_n) cos(w t_n + phi) + e_n, t_n = n T_s, e_n white Gaussian
+    with standard deviation ``noise_std``; the drift g is a parameter only when ``drift`` is True
+    (as in :func:`fit_damped_sinusoids`). The Fisher information is J^T J / sigma^2 with J the
+    derivatives of the noiseless model; the bound is its inverse.
+
+    Parameters
+    ----------
+    omega : float
+        w (rad/s).
+    decay : float
+        s (1/s).
+    amplitude : float
+        A (signal units).
+    phase : float
+        phi (rad) at the first sample.
+    noise_std : float
+        sigma (signal units).
+    n_samples : int
+        N.
+    sample_period : float
+        T_s (s).
+    drift : bool
+        Whether a linear drift is estimated too (it costs information at short records).
+
+    Returns
+    -------
+    array, shape (5, 5) or (6, 6)
+        Lower bound of the covariance of (w, s, A, phi, c[, g]) (units rad/s, 1/s, signal, rad,
+        signal[, signal/s]).
+    """
+    t = np.arange(n_samples) * sample_period
+    envelope = np.exp(-decay * t)
+    cos_part = np.cos(omega * t + phase)
+    sin_part = np.sin(omega * t + phase)
+    jac = np.column_stack(
+        [
+            -amplitude * t * envelope * sin_part,
+            -amplitude * t * envelope * cos_part,
+            envelope * cos_part,
+            -amplitude * envelope * sin_part,
+            np.ones_like(t),
+        ]
+    )
+    if drift:
+        jac = np.column_stack([jac, t])
+    # Fisher information of Gaussian white noise: J^T J / sigma^2
+    fisher = jac.T @ jac / noise_std**2
+    return np.asarray(np.linalg.inv(fisher), dtype=float)
