@@ -1,0 +1,50 @@
+"""``antenna simulate`` end to end: files, summary line, one-line errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sensing_antenna.cli import main
+from sensing_antenna.recording import read_recording
+
+
+def test_simulate_writes_a_readable_recording(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "rec.csv"
+    code = main(
+        [
+            "simulate",
+            "--case",
+            "azimuthal",
+            "--xc",
+            "0.55",
+            "--duration",
+            "1.5",
+            "--seed",
+            "3",
+            "--out",
+            str(out),
+        ]
+    )
+    assert code == 0
+    line = capsys.readouterr().out.strip()
+    assert line.count("\n") == 0 and "x_c = 0.5" in line
+    rec = read_recording(out)
+    assert rec.n_samples == 1500
+    assert rec.metadata["seed"] == "3"
+    assert "theta1_ref" in rec.extra
+
+
+def test_simulate_bad_input_is_one_line_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(["simulate", "--case", "azimuthal", "--out", str(tmp_path / "r.csv")])
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert "contact_point" in err and err.count("\n") == 0
+    code = main(["simulate", "--case", "vertical", "--xc", "1.5", "--out", str(tmp_path / "r.csv")])
+    assert code == 2
+    assert "x_c" in capsys.readouterr().err
