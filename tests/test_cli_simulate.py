@@ -48,3 +48,17 @@ def test_simulate_bad_input_is_one_line_exit_2(
     code = main(["simulate", "--case", "vertical", "--xc", "1.5", "--out", str(tmp_path / "r.csv")])
     assert code == 2
     assert "x_c" in capsys.readouterr().err
+
+
+def test_plot_recording_writes_pngs(tmp_path: Path) -> None:
+    out = tmp_path / "rec.csv"
+    assert (
+        main(
+            ["simulate", "--case", "vertical", "--xc", "0.8", "--duration", "2", "--out", str(out)]
+        )
+        == 0
+    )
+    assert main(["plot", "recording", str(out), "--out", str(tmp_path / "fig")]) == 0
+    names = sorted(p.name for p in (tmp_path / "fig").iterdir())
+    assert names == ["angles.png", "force.png", "torque.png", "torque_spectrum.png"]
+    assert all((tmp_path / "fig" / n).stat().st_size > 5000 for n in names)
