@@ -47,6 +47,7 @@ class RatioMethod:
             evidence.antenna,
             evidence.config.lowpass_cutoff,
             evidence.sample_period,
+            evidence.load_offset,
         )
         x_c = float(ratio[evidence.end_index])
         return conclude(evidence, self.name, x_c, ratio_estimate=x_c)

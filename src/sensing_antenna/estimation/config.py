@@ -37,6 +37,11 @@ class EstimatorConfig:
         recording (robust standard deviation of second differences), so encoder noise alone never
         prevents rest. 8 sigma peak-to-peak over 50 samples is exceeded by Gaussian noise with
         probability below 1e-6.
+    tare_margin : float
+        When the recording does not start at rest, the sensor offset is the mean contact load over
+        the approach up to this long before t_c (s). 0.3 s: at gentle pushes the torque takes
+        over 0.1 s from the touch to the contact threshold, and the link's free vibration
+        (16.4 rad/s) averages out over the approach.
     frame_window : float
         Average of force and angles over [t_1, t_1 + frame_window] (s) that defines the contact
         frame; 20 ms averages 20 samples (noise / 4.5) while staying well inside the hold.
@@ -76,8 +81,20 @@ class EstimatorConfig:
         ``slip_suspected``; 3 s is 15 filter time constants.
     disagreement_tolerance : float
         Largest accepted distance between the chosen frequency candidate and the ratio estimate
-        (m). 0.1 m (10 % of the paper's link) is above the ratio estimator's errors reported by
-        the paper (0.914 m for 0.85 m in Figure 14b, 3 % of length for prior methods).
+        (m). 0.12 m (12 % of the paper's link) is above the ratio estimator's errors reported by
+        the paper (0.914 m for 0.85 m in Figure 14b, 3 % of length for prior methods) and above
+        its geometric bias at the 10 % deflection limit near the tip: the tilt of the contact
+        normal with the link's slope (1.5 y_c / x_c, Eq. 9) adds a moment y_c R_x, about
+        1.5 (y_c / x_c)^2 x_c, and the gravity sag adds a similar term in the vertical case.
+    ratio_resolution : float
+        The ratio chooses between two frequency candidates only when it is this much closer to
+        one than to the other (m); otherwise the second mode decides if it is clear. 5 cm:
+        the ratio's geometric bias at the 10 % deflection limit is about 1.5 cm at 1 m, and a
+        residual force offset of one sensor count (6 mN) on a 30 mN push near the tip moves it
+        by 3 cm more.
+    omega2_window : float
+        Relative half-width of the search window around each candidate's predicted omega_2;
+        0.05 is a quarter of the 20 % gap between the candidates' omega_2 at the curve's top.
     max_deflection_ratio : float
         Largest static deflection y_c / x_c at the contact consistent with Assumption 1 (10 %).
     max_direction_drift : float
@@ -99,6 +116,7 @@ class EstimatorConfig:
     rest_window: float = 0.05
     rest_angle_tolerance: float = 1.0e-4
     rest_noise_factor: float = 8.0
+    tare_margin: float = 0.3
     frame_window: float = 0.02
     spectrum_window: float = 1.0
     zero_padding: int = 16
@@ -110,7 +128,9 @@ class EstimatorConfig:
     convergence_window: float = 0.2
     convergence_tolerance: float = 0.01
     max_ratio_wait: float = 3.0
-    disagreement_tolerance: float = 0.1
+    disagreement_tolerance: float = 0.12
+    ratio_resolution: float = 0.05
+    omega2_window: float = 0.05
     max_deflection_ratio: float = 0.1
     max_direction_drift: float = 0.15
     max_ratio_drift: float = 0.02

@@ -23,7 +23,12 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna, Link
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.contact_frame import ContactFrame
-from sensing_antenna.estimation.frequency import FrequencyMeasurement, measure_frequency
+from sensing_antenna.estimation.frequency import (
+    FrequencyMeasurement,
+    find_peak,
+    measure_frequency,
+    power_spectrum,
+)
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.estimation.touch_point import touched_point
 
@@ -129,6 +134,9 @@ class Evidence:
         Estimator 2, x_c(t) (m).
     ratio_mean : array, shape (n,)
         Its causal moving average over ``convergence_window`` from t_1 on (NaN before) (m).
+    load_offset : array, shape (6,)
+        Sensor offset removed from the loads (N, N m), see
+        :func:`~sensing_antenna.estimation.ratio.load_offset`.
     ratio_noise : float
         Expected standard deviation of the ratio from the force noise (m), see
         :func:`~sensing_antenna.estimation.ratio.ratio_noise`.
@@ -155,6 +163,7 @@ class Evidence:
     torque_f: FloatArray
     ratio: FloatArray
     ratio_mean: FloatArray
+    load_offset: FloatArray
     ratio_noise: float
     band: tuple[float, float]
     diagnostics: dict[str, Any] = field(default_factory=dict)
@@ -349,6 +358,45 @@ def conclude(
     )
 
 
+def second_mode_choice(
+    evidence: Evidence, component: str, candidates: tuple[float, ...]
+) -> tuple[int | None, dict[str, Any]]:
+    """Which of two omega_1 candidates the second mode supports (None: no clear answer).
+
+    Near the top of the sensing curve the two candidates are a few cm apart, closer than the
+    ratio can resolve; their second natural frequencies differ by 20 % (about 208 against
+    250 rad/s at the paper's top). The spectrum is searched within ``omega2_window`` of each
+    candidate's omega_2; the candidate whose window holds a clear peak (and the other not, or
+    a weaker one) is chosen.
+    """
+    from sensing_antenna.beam import natural_frequencies
+
+    cfg = evidence.config
+    link = evidence.antenna.link
+    window = evidence.spectrum_slice
+    projected = evidence.torque[window] @ evidence.frame.axes_m[1:].T
+    omega, power = power_spectrum(projected, evidence.sample_period, cfg.zero_padding)
+    spectrum = {"y_c": power[:, 0], "z_c": power[:, 1]}.get(component, power.sum(axis=1))
+    predicted = [float(natural_frequencies(link, x, 2)[1]) for x in candidates]
+    low = min(predicted) / (1.0 + 2.0 * cfg.omega2_window)
+    high = max(predicted) * (1.0 + 2.0 * cfg.omega2_window)
+    floor = float(np.median(spectrum[(omega >= low) & (omega <= high)]))
+    qualities: list[float] = []
+    for omega2 in predicted:
+        peak = find_peak(
+            omega,
+            spectrum,
+            (omega2 / (1.0 + cfg.omega2_window), omega2 * (1.0 + cfg.omega2_window)),
+        )
+        qualities.append(peak.power / floor if peak is not None and floor > 0 else 0.0)
+    notes = {"predicted_omega2": predicted, "quality": qualities}
+    best = int(np.argmax(qualities))
+    other = qualities[1 - best]
+    if qualities[best] >= cfg.min_peak_quality and qualities[best] >= 10.0 * other:
+        return best, notes
+    return None, notes
+
+
 @dataclass(frozen=True)
 class PaperMethod:
     """The paper's method (Section 4): Estimator 1 candidates, chosen by Estimator 2."""
@@ -391,6 +439,23 @@ class PaperMethod:
         else:
             candidates_used = candidates
         fusion = fuse(candidates_used, ratio_estimate, cfg.disagreement_tolerance)
+        diag["discriminated_by"] = "ratio" if len(candidates_used) > 1 else None
+        if len(candidates_used) == 2 and math.isfinite(ratio_estimate):
+            margin = abs(
+                abs(candidates_used[0] - ratio_estimate) - abs(candidates_used[1] - ratio_estimate)
+            )
+            if margin < cfg.ratio_resolution:
+                choice, notes = second_mode_choice(evidence, measurement.component, candidates_used)
+                diag["second_mode"] = notes
+                if choice is not None:
+                    x_pick = candidates_used[choice]
+                    fusion = Fusion(
+                        x_c=x_pick,
+                        chosen=choice,
+                        distance=abs(x_pick - ratio_estimate),
+                        agree=abs(x_pick - ratio_estimate) <= cfg.disagreement_tolerance,
+                    )
+                    diag["discriminated_by"] = "omega2"
         if candidates_used and math.isfinite(ratio_estimate) and not fusion.agree:
             problems.append(
                 (

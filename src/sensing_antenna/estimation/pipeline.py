@@ -47,7 +47,9 @@ from sensing_antenna.estimation.fusion import Evidence, PaperMethod, sensing_cur
 from sensing_antenna.estimation.ratio import (
     converged_index,
     filtered_contact_loads,
+    load_offset,
     perpendicular_ratio,
+    perpendicular_ratio_sample,
     ratio_noise,
     window_mean,
 )
@@ -196,6 +198,42 @@ def _ratio_noise(
     return noise, max(cfg.convergence_tolerance, 3.0 * noise)
 
 
+@dataclasses.dataclass(frozen=True)
+class _ContactStart:
+    """What is fixed at the contact sample: rest tolerance and sensor offset."""
+
+    rest_tolerance: float
+    offset: FloatArray
+    tare: str
+
+
+def _at_contact(
+    theta: FloatArray,
+    force: FloatArray,
+    torque: FloatArray,
+    antenna: Antenna,
+    contact_index: int,
+    cfg: EstimatorConfig,
+    ts: float,
+) -> _ContactStart:
+    """Rest tolerance and sensor offset from the samples up to t_c (both forms call this)."""
+    before = slice(0, contact_index + 1)
+    tolerance = rest_tolerance(theta[before], cfg)
+    w_rest = _samples(cfg.rest_window, ts)
+    moved = np.flatnonzero(np.any(np.abs(theta[before] - theta[0]) > tolerance, axis=1))
+    quiet = int(moved[0]) if moved.size else contact_index + 1
+    if quiet >= w_rest + 1:
+        # The head rests at the start: the link hangs still, the mean load is the offset.
+        window, tare = slice(0, quiet), "rest"
+    else:
+        end = contact_index - _samples(cfg.tare_margin, ts)
+        window, tare = slice(0, max(end, 0)), "approach"
+        if end < w_rest + 1:
+            return _ContactStart(tolerance, np.zeros(6), "none")
+    offset = load_offset(theta[window], force[window], torque[window], antenna)
+    return _ContactStart(tolerance, offset, tare)
+
+
 def _evidence(
     t: FloatArray,
     theta: FloatArray,
@@ -215,13 +253,14 @@ def _evidence(
     """Evidence from the samples [0, end_index]: the one function both forms call at t_e."""
     stop = end_index + 1
     t, theta, force, torque = t[:stop], theta[:stop], force[:stop], torque[:stop]
+    start = _at_contact(theta, force, torque, antenna, contact_index, cfg, sample_period)
     reaction_f, torque_f = filtered_contact_loads(
-        theta, force, torque, antenna, cfg.lowpass_cutoff, sample_period
+        theta, force, torque, antenna, cfg.lowpass_cutoff, sample_period, start.offset
     )
     frame, problem = _frame_at(theta, reaction_f, rest_index, antenna, cfg, sample_period)
     if frame is None:
         return problem or "no contact frame"
-    ratio = perpendicular_ratio(reaction_f, torque_f)
+    ratio = perpendicular_ratio(reaction_f, torque_f, antenna.link.flexural_rigidity)
     known = rest_index + _samples(cfg.rest_window, sample_period) + 1
     noise, _ = _ratio_noise(force[:known], frame, antenna, cfg, sample_period)
     return Evidence(
@@ -242,6 +281,7 @@ def _evidence(
         torque_f=torque_f,
         ratio=ratio,
         ratio_mean=window_mean(ratio, rest_index, _samples(cfg.convergence_window, sample_period)),
+        load_offset=start.offset,
         ratio_noise=noise,
         band=band,
         diagnostics=diagnostics,
@@ -311,8 +351,11 @@ def estimate(
         return _early(Status.NO_CONTACT, detection.reason, impl.name, diagnostics)
     i_c = detection.index
     t_c = float(t[i_c])
-    tolerance = rest_tolerance(theta[: i_c + 1], cfg)
-    diagnostics["rest_tolerance"] = tolerance
+    start = _at_contact(theta, force, torque, antenna, i_c, cfg, sample_period)
+    tolerance = start.rest_tolerance
+    diagnostics.update(
+        {"rest_tolerance": tolerance, "tare": start.tare, "load_offset": start.offset}
+    )
     w_rest = _samples(cfg.rest_window, sample_period)
     i_1 = first_rest_index(theta, i_c, w_rest, tolerance)
     if i_1 is None:
@@ -325,14 +368,14 @@ def estimate(
             t_c=t_c,
         )
     reaction_f, torque_f = filtered_contact_loads(
-        theta, force, torque, antenna, cfg.lowpass_cutoff, sample_period
+        theta, force, torque, antenna, cfg.lowpass_cutoff, sample_period, start.offset
     )
     frame, problem = _frame_at(theta, reaction_f, i_1, antenna, cfg, sample_period)
     if frame is None:
         return _early(
             Status.PUSH_NOT_REACHED, problem or "", impl.name, diagnostics, t_c, float(t[i_1])
         )
-    ratio = perpendicular_ratio(reaction_f, torque_f)
+    ratio = perpendicular_ratio(reaction_f, torque_f, antenna.link.flexural_rigidity)
     w_conv = _samples(cfg.convergence_window, sample_period)
     ratio_mean = window_mean(ratio, i_1, w_conv)
     last_check = i_1 + _samples(cfg.max_ratio_wait, sample_period)
@@ -406,6 +449,7 @@ class OnlineEstimator:
         self._n_wait = _samples(cfg.max_ratio_wait, self.sample_period)
         self._weight = antenna.link.mass * STANDARD_GRAVITY
         self._half_moment = 0.5 * self._weight * antenna.link.length
+        self._rigidity = antenna.link.flexural_rigidity
         self._detector = ContactDetector(antenna, self.sample_period)
         self._filters = [
             FirstOrderLowPass(cfg.lowpass_cutoff, self.sample_period) for _ in range(6)
@@ -430,6 +474,8 @@ class OnlineEstimator:
         self._rest: int | None = None
         self._converged: int | None = None
         self._ratio_tolerance = math.nan
+        self._start: _ContactStart | None = None
+        self._offset: tuple[float, ...] = (0.0,) * 6
         self._planned: int | None = None
         self._done = False
         self.result: ContactEstimate | None = None
@@ -482,10 +528,10 @@ class OnlineEstimator:
         # Section 4.2: contact loads R = F - F_g^m, Gamma - Gamma_g^m, then Eq. 20
         sin2, cos2 = math.sin(theta2), math.cos(theta2)
         filters = self._filters
-        filters[0].update(fx + self._weight * sin2)
+        r_x = filters[0].update(fx + self._weight * sin2)
         r_y = filters[1].update(fy)
         r_z = filters[2].update(fz + self._weight * cos2)
-        g_x = filters[3].update(tx)
+        filters[3].update(tx)
         g_y = filters[4].update(ty - self._half_moment * cos2)
         g_z = filters[5].update(tz)
         if self._contact is None:
@@ -493,7 +539,17 @@ class OnlineEstimator:
                 return None
             index = self._detector.contact_index
             self._contact = j if index is None else index
-            self._tolerance = rest_tolerance(self._theta[: self._contact + 1], self.config)
+            self._start = _at_contact(
+                self._theta,
+                self._force,
+                self._torque,
+                self.antenna,
+                self._contact,
+                self.config,
+                self.sample_period,
+            )
+            self._tolerance = self._start.rest_tolerance
+            self._offset = tuple(float(v) for v in self._start.offset)
         contact: int = self._contact
         if self._rest is None:
             start = j - self._w_rest
@@ -511,6 +567,7 @@ class OnlineEstimator:
                 self.antenna,
                 self.config.lowpass_cutoff,
                 self.sample_period,
+                None if self._start is None else self._start.offset,
             )
             frame, problem = _frame_at(
                 self._theta[: j + 1],
@@ -532,15 +589,21 @@ class OnlineEstimator:
                     )
                 )
             self._ratio[start : j + 1] = perpendicular_ratio(
-                reaction_f[start : j + 1], torque_f[start : j + 1]
+                reaction_f[start : j + 1], torque_f[start : j + 1], self._rigidity
             )
             _, self._ratio_tolerance = _ratio_noise(
                 self._force[: j + 1], frame, self.antenna, self.config, self.sample_period
             )
         else:
-            perpendicular = math.hypot(r_y, r_z)
-            moment = math.sqrt(g_x * g_x + g_y * g_y + g_z * g_z)
-            self._ratio[j] = moment / perpendicular if perpendicular > 0.0 else math.nan
+            offset = self._offset
+            self._ratio[j] = perpendicular_ratio_sample(
+                r_x - offset[0],
+                r_y - offset[1],
+                r_z - offset[2],
+                g_y - offset[4],
+                g_z - offset[5],
+                self._rigidity,
+            )
         rest = self._rest
         w = self._w_conv
         if self._converged is None and self._planned is None and j >= rest + w:
@@ -559,8 +622,14 @@ class OnlineEstimator:
 
     def _diagnostics(self) -> dict[str, Any]:
         diag: dict[str, Any] = {"resampled": False}
-        if self._contact is not None:
-            diag["rest_tolerance"] = self._tolerance
+        if self._start is not None:
+            diag.update(
+                {
+                    "rest_tolerance": self._tolerance,
+                    "tare": self._start.tare,
+                    "load_offset": self._start.offset,
+                }
+            )
         return diag
 
     def _emit(self, result: ContactEstimate) -> ContactEstimate:

@@ -26,6 +26,8 @@ filter, as in Eq. 21) would instead bias the ratio for several 1/omega_c.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -39,11 +41,16 @@ __all__ = [
     "filtered_contact_loads",
     "paper_ratio",
     "perpendicular_ratio",
+    "perpendicular_ratio_sample",
     "ratio_noise",
     "window_mean",
 ]
 
 FloatArray = NDArray[np.float64]
+
+#: Fixed-point steps of the deflection correction in :func:`perpendicular_ratio`; four steps
+#: shrink the error of the first estimate by (0.1)^4.
+_FIXED_POINT_STEPS = 4
 
 
 def contact_loads(
@@ -80,8 +87,15 @@ def filtered_contact_loads(
     antenna: Antenna,
     cutoff: float,
     sample_period: float,
+    offset: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Contact loads through the low-pass filter of Eq. 20, from the first sample in steady state.
+
+    Parameters
+    ----------
+    offset : array, shape (6,), optional
+        Sensor offset (N, N m) subtracted after the filter (see :func:`load_offset`); the filter
+        has unit gain at DC and starts in steady state, so this equals filtering tared samples.
 
     Returns
     -------
@@ -91,22 +105,89 @@ def filtered_contact_loads(
     reaction, moment = contact_loads(theta, force_m, torque_m, antenna)
     # Eq. 20: G(s) = 1 / (1 + s / omega_c) on all six channels
     both = low_pass(np.hstack([reaction, moment]), cutoff, sample_period)
+    if offset is not None:
+        both = both - np.asarray(offset, dtype=float)
     return both[:, :3], both[:, 3:]
 
 
-def perpendicular_ratio(reaction_f: FloatArray, torque_f: FloatArray) -> FloatArray:
-    """x_c(t) = |Gamma_f - Gamma_g| / |R_f perpendicular to the link| (m), shape (n,).
+def load_offset(
+    theta: FloatArray, force_m: FloatArray, torque_m: FloatArray, antenna: Antenna
+) -> FloatArray:
+    """Sensor offset: the mean contact loads over samples known to be free of contact.
 
-    The variant of Eq. 21 used by the paper method (see the module notes); NaN where the
-    perpendicular force is exactly zero.
+    F/T sensors keep an offset after taring (a few resolution counts), which matters when the
+    push is gentle: a 10 mN offset is half the push near the tip. Without contact the contact
+    loads R = F - F_g^m and Gamma - Gamma_g^m are zero apart from the offset, the noise and the
+    (zero-mean at rest) free vibration, so their mean is the offset.
+
+    Returns
+    -------
+    array, shape (6,)
+        Offset of (fx, fy, fz, tx, ty, tz) (N, N m).
+    """
+    reaction, moment = contact_loads(theta, force_m, torque_m, antenna)
+    return np.asarray(np.hstack([reaction, moment]).mean(axis=0), dtype=float)
+
+
+def perpendicular_ratio(
+    reaction_f: FloatArray, torque_f: FloatArray, flexural_rigidity: float
+) -> FloatArray:
+    """Estimator 2 of the paper method: x_c(t) from the statics of the pushed link (m), (n,).
+
+    With u the direction of R_perp (the reaction perpendicular to the link), v = X^m x u and the
+    contact displaced by the static deflection y_c along u, the moment of R about O is
+    Gamma' = x_c R_perp v + y_c u x R, whose component along v is x_c R_perp - y_c R_x. Hence
+
+        x_c = (Gamma' . v + y_c R_x) / R_perp,   y_c = R_perp x_c^3 / (3 E I)   (Eq. 13),
+
+    solved by a few fixed-point steps from x_c = Gamma' . v / R_perp (each step contracts by
+    3 |R_x| x_c^2 / (3 E I) < 0.1 for pushes within the small-deflection limit). Without axial
+    force and deflection this is Eq. 21 with |R_perp|; the y_c R_x term removes the bias of
+    Eq. 21 when the contact normal tilts with the link's slope (1.5 y_c / x_c, Eq. 9).
+
+    Parameters
+    ----------
+    reaction_f : array, shape (n, 3)
+        Filtered reaction R (N), motor frame.
+    torque_f : array, shape (n, 3)
+        Filtered Gamma - Gamma_g^m (N m), motor frame.
+    flexural_rigidity : float
+        E I (N m^2).
+
+    Returns
+    -------
+    array, shape (n,)
+        NaN where R_perp is exactly zero.
     """
     reaction_f = np.asarray(reaction_f, dtype=float)
-    torque_norm = np.linalg.norm(np.asarray(torque_f, dtype=float), axis=-1)
-    perpendicular = np.hypot(reaction_f[..., 1], reaction_f[..., 2])
+    torque_f = np.asarray(torque_f, dtype=float)
+    r_x, r_y, r_z = reaction_f[..., 0], reaction_f[..., 1], reaction_f[..., 2]
+    perpendicular = np.hypot(r_y, r_z)
     with np.errstate(divide="ignore", invalid="ignore"):
-        # Eq. 21 with |R_perp| in the denominator: x_c = |Gamma_f - Gamma_g| / |R_f,perp|
-        ratio = torque_norm / perpendicular
-    return np.where(perpendicular > 0.0, ratio, np.nan)
+        # Gamma' . v with v = X^m x R_perp / |R_perp| = (0, -R_z, R_y) / |R_perp|
+        moment_v = (torque_f[..., 2] * r_y - torque_f[..., 1] * r_z) / perpendicular
+        # Eq. 21 with |R_perp|: first estimate
+        x_c = moment_v / perpendicular
+        for _ in range(_FIXED_POINT_STEPS):
+            # Eq. 13: y_c = |R_perp| x_c^3 / (3 E I); statics: x_c = (Gamma'.v + y_c R_x) / R_perp
+            y_c = perpendicular * x_c**3 / (3.0 * flexural_rigidity)
+            x_c = (moment_v + y_c * r_x) / perpendicular
+    return np.where(perpendicular > 0.0, x_c, np.nan)
+
+
+def perpendicular_ratio_sample(
+    r_x: float, r_y: float, r_z: float, g_y: float, g_z: float, flexural_rigidity: float
+) -> float:
+    """:func:`perpendicular_ratio` for one sample, in plain floats (streaming form)."""
+    perpendicular = math.hypot(r_y, r_z)
+    if perpendicular == 0.0:
+        return math.nan
+    moment_v = (g_z * r_y - g_y * r_z) / perpendicular
+    x_c = moment_v / perpendicular
+    for _ in range(_FIXED_POINT_STEPS):
+        y_c = perpendicular * x_c**3 / (3.0 * flexural_rigidity)
+        x_c = (moment_v + y_c * r_x) / perpendicular
+    return x_c
 
 
 def paper_ratio(
@@ -116,10 +197,12 @@ def paper_ratio(
     antenna: Antenna,
     cutoff: float,
     sample_period: float,
+    offset: FloatArray | None = None,
 ) -> FloatArray:
     """Eq. 21 exactly as printed: filter F and Gamma, then subtract the gravity terms (m), (n,).
 
-    This is the estimator of the paper's reference [17], used by the ``ratio`` baseline.
+    This is the estimator of the paper's reference [17], used by the ``ratio`` baseline; the
+    sensor ``offset`` (6,), when given, is removed as for the paper method.
     """
     theta2 = np.asarray(theta, dtype=float)[:, 1]
     # Eq. 20: filter the measured force and torque
@@ -128,6 +211,8 @@ def paper_ratio(
         cutoff,
         sample_period,
     )
+    if offset is not None:
+        filtered = filtered - np.asarray(offset, dtype=float)
     # Eq. 21: x_c(t) = |Gamma_f - Gamma_g| / |F_f - F_g|
     numerator = np.linalg.norm(filtered[:, 3:] - gravity_torque_m(antenna, theta2), axis=-1)
     denominator = np.linalg.norm(filtered[:, :3] - gravity_force_m(antenna, theta2), axis=-1)
