@@ -77,6 +77,10 @@ def run(seeds: int, antenna_name: str) -> dict[str, Any]:
     return {"rows": rows, "seconds": time.perf_counter() - start, "antenna": antenna_name}
 
 
+def _select(rows: list[dict[str, Any]], key: str, **match: Any) -> list[Any]:
+    return [r[key] for r in rows if all(r[k] == v for k, v in match.items())]
+
+
 def summarise(data: dict[str, Any]) -> list[str]:
     rows = data["rows"]
     methods = sorted({r["method"] for r in rows})
@@ -119,7 +123,8 @@ def summarise(data: dict[str, Any]) -> list[str]:
         paper_mean = np.mean([v[0] for v in table.values()])
         paper_max = max(v[1] for v in table.values())
         lines.append(
-            f"  {'paper table':>14}: mean abs {100 * paper_mean:.2f} cm, max {100 * paper_max:.2f} cm"
+            f"  {'paper table':>14}: mean abs {100 * paper_mean:.2f} cm, "
+            f"max {100 * paper_max:.2f} cm"
         )
     lines.append(f"\n{len(rows)} estimates in {data['seconds']:.1f} s (simulation included)")
     return lines
