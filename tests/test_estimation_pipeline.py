@@ -121,11 +121,20 @@ def synthetic_recording(spec: Synthetic, antenna: Antenna | None = None) -> Reco
 
 
 def expected_point(spec: Synthetic, recording: Recording) -> np.ndarray:
-    """Touched point: x_c X^m displaced by y_c against the push direction (towards R)."""
+    """Touched point: x_c X^m displaced by y_c against the push direction (towards R), plus the
+    sag of the link under its own weight (uniformly loaded cantilever, Gere and Timoshenko:
+    v = q x^2 (6 l^2 - 4 l x + x^2) / (24 E I)), which the synthetic device's link also has."""
+    link = paper_antenna().link
     theta = recording.theta[-1]
     axes = motor_axes(theta)
     push_row = 1 if spec.case == "azimuthal" else 2
-    return spec.x_c * axes[0] - spec.deflection_ratio * spec.x_c * axes[push_row]
+    point = spec.x_c * axes[0] - spec.deflection_ratio * spec.x_c * axes[push_row]
+    q = link.linear_density * STANDARD_GRAVITY * math.cos(theta[1])
+    x, length = spec.x_c, link.length
+    sag = q * x**2 * (6 * length**2 - 4 * length * x + x**2) / (24 * link.flexural_rigidity)
+    down = np.array([0.0, 0.0, -1.0])
+    across = down - (down @ axes[0]) * axes[0]
+    return point + sag * across / np.linalg.norm(across)
 
 
 # x_c = 0.85 m has two frequency candidates (the sensing curve peaks near 0.78 m), 0.35 m one.

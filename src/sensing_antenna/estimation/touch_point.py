@@ -4,8 +4,17 @@ The contact lies at the abscissa x_c along the link. The link is bent by the rea
 object, so the contact is displaced from the rigid line x_c X^m by the static deflection of a
 cantilever loaded at x_c, y_c = |R_perp| x_c^3 / (3 E I) (Eq. 13 solved for y_c), in the direction
 of the load R, i.e. along +Y^c: the object holds the contact back while the rigid line of the
-motor angles has moved on into the object. The point is expressed in the absolute frame with the
-motor axes at t_1 (X^m, Y^m, Z^m of the recording format).
+motor angles has moved on into the object. (The brief of this module said "minus Y^c"; the
+cantilever deflects along the load it carries, which is the reaction R, so the sign here is +.)
+
+The link also carries its own weight. The beam is linear (Section 3.3), so the displacement at
+x_c is the sum of the push deflection and the sag of a uniformly loaded cantilever,
+v(x) = q x^2 (6 l^2 - 4 l x + x^2) / (24 E I) with q = rho g cos(theta2) the weight per length
+perpendicular to the link (standard handbook result, e.g. Gere and Timoshenko, Mechanics of
+Materials, cantilever under uniform load), directed along the part of -Z^a perpendicular to X^m.
+Near the tip of the paper's link it reaches 5 cm, as large as the push deflection; the paper's
+Assumption 5 neglects it. The point is expressed in the absolute frame with the motor axes at t_1
+(X^m, Y^m, Z^m of the recording format).
 """
 
 from __future__ import annotations
@@ -16,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import Link
+from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.estimation.contact_frame import ContactFrame
 
 __all__ = ["TouchPoint", "touched_point"]
@@ -36,11 +45,14 @@ class TouchPoint:
         Static deflection y_c at the contact (m).
     deflection_ratio : float
         y_c / x_c (dimensionless), to compare with the 10 % limit of Assumption 1.
+    sag : float
+        Gravity sag of the link at x_c (m).
     """
 
     point_a: FloatArray
     deflection: float
     deflection_ratio: float
+    sag: float = math.nan
 
 
 def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link) -> TouchPoint:
@@ -71,4 +83,21 @@ def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link
     # Rigid abscissa along X^m plus the deflection along Y^c, in motor coordinates
     point_m = np.array([x_c, 0.0, 0.0]) + y_c * frame.axes_m[1]
     point_a = point_m @ frame.motor_axes_a
-    return TouchPoint(point_a=point_a, deflection=y_c, deflection_ratio=y_c / x_c)
+    # Gravity sag: -Z^a without its component along X^m, times the cantilever deflection
+    down = np.array([0.0, 0.0, -1.0])
+    x_axis = frame.motor_axes_a[0]
+    across = down - (down @ x_axis) * x_axis
+    across_norm = float(np.linalg.norm(across))
+    sag = 0.0
+    if across_norm > 0.0:
+        load = link.linear_density * STANDARD_GRAVITY * across_norm
+        length = link.length
+        # Uniformly loaded cantilever: v(x) = q x^2 (6 l^2 - 4 l x + x^2) / (24 E I)
+        sag = (
+            load
+            * x_c**2
+            * (6 * length**2 - 4 * length * x_c + x_c**2)
+            / (24.0 * link.flexural_rigidity)
+        )
+        point_a = point_a + sag * across / across_norm
+    return TouchPoint(point_a=point_a, deflection=y_c, deflection_ratio=y_c / x_c, sag=sag)

@@ -1,0 +1,73 @@
+"""``antenna estimate``: the contact point of one recording (Section 4 pipeline or a baseline)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+
+def register(subparsers: Any) -> None:
+    """Add ``antenna estimate``."""
+    from sensing_antenna.estimation.pipeline import METHODS
+
+    parser = subparsers.add_parser(
+        "estimate", help="estimate the contact point of a recording (CSV)"
+    )
+    parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
+    parser.add_argument(
+        "--method",
+        choices=sorted(METHODS),
+        default="paper",
+        help="paper (Section 4, default), or a baseline for comparison",
+    )
+    parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.set_defaults(func=_run)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.estimation.pipeline import estimate
+    from sensing_antenna.recording import read_recording
+
+    antenna = load_antenna(args.antenna)
+    recording = read_recording(args.recording)
+    result = estimate(recording, antenna, method=args.method)
+    if args.json:
+        data = {"recording": str(args.recording), **result.to_dict()}
+        print(json.dumps(data, allow_nan=False))
+    else:
+        print(summary(str(args.recording), result.to_dict()))
+    return 0
+
+
+def _cm(value: Any) -> str:
+    return "-" if value is None else f"{100 * value:.1f} cm"
+
+
+def _s(value: Any) -> str:
+    return "-" if value is None else f"{value:.3f} s"
+
+
+def summary(name: str, data: dict[str, Any]) -> str:
+    """Human-readable lines for an estimate's ``to_dict()`` (units for display only)."""
+    omega = data["omega1"]
+    omega_text = "-" if omega is None else f"{omega:.2f} rad/s ({omega / (2 * math.pi):.2f} Hz)"
+    point = data["contact_point"]
+    point_text = (
+        "-" if point[0] is None else "(" + ", ".join(f"{100 * v:.1f}" for v in point) + ") cm"
+    )
+    lines = [
+        f"{name}: method {data['method']}",
+        f"  status          {data['status']}" + (f" ({data['reason']})" if data["reason"] else ""),
+        f"  x_c             {_cm(data['x_c'])}",
+        f"  candidates      {', '.join(_cm(c) for c in data['candidates']) or '-'}",
+        f"  omega_1         {omega_text}",
+        f"  ratio estimate  {_cm(data['ratio_estimate'])}",
+        f"  t_c, t_1, t_e   {_s(data['t_c'])}, {_s(data['t_1'])}, {_s(data['t_e'])}",
+        f"  contact point   {point_text} (absolute frame)",
+    ]
+    return "\n".join(lines)
