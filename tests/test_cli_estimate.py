@@ -1,0 +1,72 @@
+"""The ``antenna estimate`` and ``antenna plot estimate`` commands on recording files."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.cli import main
+from sensing_antenna.estimation import METHODS, estimate
+from sensing_antenna.recording import read_recording, write_recording
+from test_estimation_pipeline import Synthetic, synthetic_recording
+
+
+@pytest.fixture(scope="module")
+def recording_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("rec") / "rec.csv"
+    write_recording(synthetic_recording(Synthetic(x_c=0.62, seed=21)), path)
+    return path
+
+
+def test_json_output_matches_library(
+    recording_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["estimate", str(recording_file), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    library = estimate(read_recording(recording_file), paper_antenna()).to_dict()
+    for key in ("x_c", "candidates", "omega1", "ratio_estimate", "t_c", "t_1", "t_e", "status"):
+        assert data[key] == library[key]
+    assert data["reason"] is None and data["status"] == "ok"
+    assert data["x_c"] == pytest.approx(0.62, abs=5e-3)  # built into the recording
+    assert len(data["contact_point"]) == 3
+
+
+@pytest.mark.parametrize("method", sorted(METHODS))
+def test_every_method_and_summary(
+    recording_file: Path, method: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["estimate", str(recording_file), "--method", method]) == 0
+    out = capsys.readouterr().out
+    assert f"method {method}" in out and "status" in out and "x_c" in out
+
+
+def test_malformed_file_is_one_line_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0,0,0\n0.001,0,x,0,0,0,0,0,0\n")
+    assert main(["estimate", str(bad)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "bad.csv" in err and "theta2" in err
+
+
+def test_unknown_method_is_rejected(recording_file: Path) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["estimate", str(recording_file), "--method", "magic"])
+    assert exc.value.code == 2
+
+
+def test_plot_estimate_writes_four_figures(recording_file: Path, tmp_path: Path) -> None:
+    out = tmp_path / "figs"
+    assert main(["plot", "estimate", str(recording_file), "--out", str(out)]) == 0
+    names = sorted(p.name for p in out.glob("*.png"))
+    assert names == [
+        "figure11-contact.png",
+        "figure12-push.png",
+        "figure13-frequency.png",
+        "figure14-ratio.png",
+    ]
+    assert all((out / n).stat().st_size > 10_000 for n in names)
