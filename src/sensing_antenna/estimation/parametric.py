@@ -5,16 +5,20 @@ its contact-mode frequencies (Eq. 3 with the boundary conditions of Eq. 4). Ever
 the F/T sensor sees the same modes with its own amplitude and phase, on top of the static load
 of the push. Over a window of ``n`` samples at t_n = t_0 + n T_s each channel k is modelled as
 
-    y_k(t) = c_k + g_k (t - t_ref) + sum_m exp(-s_m (t - t_ref))
+    y_k(t) = P_k(t - t_ref) + sum_m exp(-s_m (t - t_ref))
              * (a_km cos(w_m (t - t_ref)) + b_km sin(w_m (t - t_ref))) + noise_k
 
-with t_ref the centre of the window: c_k is the static load at t_ref, g_k a slow drift (the servo
-still creeps after t_1; the simulated head moves ~1e-2 rad/s), w_m (rad/s) and s_m (1/s) the
-frequencies and decay rates, shared by every channel because they belong to the structure.
+with t_ref the centre of the window: P_k a low-degree polynomial whose constant term c_k is the
+static load at t_ref and whose other terms absorb slow changes (the servo still creeps after t_1;
+the simulated head drifts by ~1e-2 rad over 0.5 s, a slow oscillation of about 8 rad/s that a
+quadratic follows over a few hundred ms), w_m (rad/s) and s_m (1/s) the frequencies and decay
+rates, shared by every channel because they belong to the structure. Modes are kept above a lowest
+frequency so that they do not compete with the polynomial for the static part.
 
-Fit (variable projection): for given (w, s) the model is linear in (c, g, a, b), solved by least
+Fit (variable projection): for given (w, s) the model is linear in (P, a, b), solved by least
 squares for every channel at once; only the 2 M nonlinear parameters go to
-:func:`scipy.optimize.least_squares`. Each channel is weighted by the inverse of its noise
+:func:`scipy.optimize.least_squares` (with Kaufman's approximation of the Jacobian, Golub and
+Pereyra 2003). Each channel is weighted by the inverse of its noise
 standard deviation (estimated from the residuals of a first fit, then refitted), so the channels
 are combined as independent measurements. Initial poles come from the matrix pencil method on the
 stacked Hankel matrices of all channels (Hua and Sarkar 1990).
@@ -51,9 +55,10 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
-#: Largest decay rate s a fitted mode may take, as a multiple of pi / T_s (1/s): a mode decaying
-#: faster loses most of its amplitude within a sample and is not a vibration of the link.
-_DECAY_LIMIT_FACTOR = 1.0
+#: Largest decay of a fitted mode over the window, s * duration: e^-20 leaves nothing of the mode
+#: in the second half of the window; a faster transient is not a vibration worth fitting, and
+#: the bound keeps exp(-s tau) finite.
+_MAX_WINDOW_DECAY = 20.0
 #: Smallest decay rate (1/s): slight growth is allowed (a fit on a short record may need it), more
 #: is not physical for a passive link.
 _MIN_DECAY = -20.0
@@ -171,47 +176,66 @@ def matrix_pencil_poles(signals: FloatArray, n_poles: int) -> ComplexArray:
     return np.asarray(np.linalg.eigvals(shifted), dtype=complex)
 
 
-def _basis(tau: FloatArray, params: FloatArray) -> FloatArray:
-    """Columns 1, tau, then exp(-s tau) cos(w tau), exp(-s tau) sin(w tau) per mode."""
+def _basis(tau: FloatArray, params: FloatArray, degree: int) -> FloatArray:
+    """Columns tau^0 .. tau^degree, then exp(-s tau) cos(w tau), exp(-s tau) sin(w tau) per mode."""
     omega, decay = params[0::2], params[1::2]
     envelope = np.exp(-np.multiply.outer(tau, decay))
     phase = np.multiply.outer(tau, omega)
-    cols = np.empty((tau.size, 2 + 2 * omega.size))
-    cols[:, 0] = 1.0
-    cols[:, 1] = tau
-    cols[:, 2::2] = envelope * np.cos(phase)
-    cols[:, 3::2] = envelope * np.sin(phase)
+    p = degree + 1
+    cols = np.empty((tau.size, p + 2 * omega.size))
+    for j in range(p):
+        cols[:, j] = tau**j
+    cols[:, p::2] = envelope * np.cos(phase)
+    cols[:, p + 1 :: 2] = envelope * np.sin(phase)
     return cols
 
 
-def _basis_derivatives(tau: FloatArray, params: FloatArray) -> FloatArray:
-    """d basis / d params, shape (n, 2 + 2M, 2M) (only the mode columns depend on params)."""
+def _basis_derivatives(tau: FloatArray, params: FloatArray, degree: int) -> FloatArray:
+    """d basis / d params, shape (n, degree + 1 + 2M, 2M) (only the mode columns depend on them)."""
     omega, decay = params[0::2], params[1::2]
     m = omega.size
+    p = degree + 1
     envelope = np.exp(-np.multiply.outer(tau, decay))
     phase = np.multiply.outer(tau, omega)
     cos_part, sin_part = envelope * np.cos(phase), envelope * np.sin(phase)
-    out = np.zeros((tau.size, 2 + 2 * m, 2 * m))
+    out = np.zeros((tau.size, p + 2 * m, 2 * m))
     for j in range(m):
         # d/dw: tau * (-sin, cos) envelope;  d/ds: -tau * (cos, sin) envelope
-        out[:, 2 + 2 * j, 2 * j] = -tau * sin_part[:, j]
-        out[:, 3 + 2 * j, 2 * j] = tau * cos_part[:, j]
-        out[:, 2 + 2 * j, 2 * j + 1] = -tau * cos_part[:, j]
-        out[:, 3 + 2 * j, 2 * j + 1] = -tau * sin_part[:, j]
+        out[:, p + 2 * j, 2 * j] = -tau * sin_part[:, j]
+        out[:, p + 1 + 2 * j, 2 * j] = tau * cos_part[:, j]
+        out[:, p + 2 * j, 2 * j + 1] = -tau * cos_part[:, j]
+        out[:, p + 1 + 2 * j, 2 * j + 1] = -tau * sin_part[:, j]
     return out
 
 
-def _projection_residual(params: FloatArray, tau: FloatArray, weighted: FloatArray) -> FloatArray:
+def _projection_residual(
+    params: FloatArray, tau: FloatArray, weighted: FloatArray, degree: int
+) -> FloatArray:
     """Weighted residual after the linear least-squares solve, flattened (variable projection)."""
-    q, _ = np.linalg.qr(_basis(tau, params))
+    q, _ = np.linalg.qr(_basis(tau, params, degree))
     residual = weighted - q @ (q.T @ weighted)
     return np.asarray(residual.ravel(), dtype=float)
 
 
+def _projection_jacobian(
+    params: FloatArray, tau: FloatArray, weighted: FloatArray, degree: int
+) -> FloatArray:
+    """Kaufman's approximation of the variable-projection Jacobian: -(I - Q Q^T) dPhi_j C."""
+    basis = _basis(tau, params, degree)
+    q, r = np.linalg.qr(basis)
+    coef = np.linalg.solve(r, q.T @ weighted) if np.all(np.diag(r) != 0) else None
+    if coef is None:
+        coef = np.linalg.lstsq(basis, weighted, rcond=None)[0]
+    deriv = _basis_derivatives(tau, params, degree)
+    cols = np.einsum("npq,pk->qnk", deriv, coef)
+    cols = cols - np.einsum("na,qak->qnk", q, np.einsum("na,qnk->qak", q, cols))
+    return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
+
+
 def _initial_modes(
-    y: FloatArray, n_modes: int, sample_period: float, upper: FloatArray
+    y: FloatArray, n_modes: int, sample_period: float, lower: FloatArray, upper: FloatArray
 ) -> FloatArray | None:
-    """(w, s) pairs of the ``n_modes`` strongest oscillatory matrix-pencil poles."""
+    """(w, s) pairs of the ``n_modes`` strongest oscillatory matrix-pencil poles above lower[0]."""
     n = y.shape[0]
     n_poles = min(2 * n_modes + 4, n // 3)
     if n_poles < 2 * n_modes:
@@ -221,7 +245,7 @@ def _initial_modes(
         s_plane = np.log(z) / sample_period
     keep = np.isfinite(s_plane) & (s_plane.imag > 0.0)
     s_plane = s_plane[keep]
-    if s_plane.size < n_modes:
+    if s_plane.size == 0:
         return None
     # Amplitude of each pole: least squares on the complex exponentials of all kept poles
     idx = np.arange(n)
@@ -230,11 +254,18 @@ def _initial_modes(
     coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
     m = s_plane.size
     power = np.sum(coef[2 : 2 + m] ** 2 + coef[2 + m :] ** 2, axis=1)
-    order = np.argsort(power)[::-1][:n_modes]
-    chosen = s_plane[order]
+    power = np.where(s_plane.imag >= lower[0], power, -1.0)
+    order = list(np.argsort(power)[::-1][:n_modes])
+    omega = [float(s_plane[j].imag) for j in order if power[j] >= 0.0]
+    decay = [float(-s_plane[j].real) for j in order if power[j] >= 0.0]
+    # Too few poles above the lower limit: spread the missing ones over the allowed range
+    spare = np.geomspace(lower[0] * 1.5, upper[0] * 0.5, n_modes + 2)[1:-1]
+    while len(omega) < n_modes:
+        omega.append(float(spare[len(omega)]))
+        decay.append(1.0)
     params = np.empty(2 * n_modes)
-    params[0::2] = np.clip(chosen.imag, 1e-3, upper[0] * 0.999)
-    params[1::2] = np.clip(-chosen.real, _MIN_DECAY * 0.999, upper[1] * 0.999)
+    params[0::2] = np.clip(omega, lower[0] * 1.001, upper[0] * 0.999)
+    params[1::2] = np.clip(decay, lower[1] * 0.999, upper[1] * 0.999)
     return params
 
 
@@ -244,8 +275,10 @@ def fit_damped_sinusoids(
     n_modes: int,
     t_start: float = 0.0,
     noise_std: FloatArray | None = None,
+    min_omega: float = 0.0,
+    degree: int = 1,
 ) -> DampedSinusoidFit | None:
-    """Fit ``n_modes`` damped sinusoids with shared poles, plus offset and drift per channel.
+    """Fit ``n_modes`` damped sinusoids with shared poles, plus a polynomial per channel.
 
     Parameters
     ----------
@@ -259,7 +292,11 @@ def fit_damped_sinusoids(
         Time of the first sample (s).
     noise_std : array, shape (K,), optional
         Noise standard deviation of each channel; estimated from the residuals when omitted
-        (one fit with unit weights scaled by each channel's spread, then a refit).
+        (one fit with weights from each channel's first differences, then a refit).
+    min_omega : float
+        Lowest frequency a mode may take (rad/s); slower content is left to the polynomial.
+    degree : int
+        Degree of the polynomial (offset, drift, ...) of each channel, >= 0.
 
     Returns
     -------
@@ -271,45 +308,52 @@ def fit_damped_sinusoids(
     if y.ndim == 1:
         y = y[:, None]
     n, k = y.shape
-    n_linear = 2 + 2 * n_modes
+    n_linear = degree + 1 + 2 * n_modes
     if n < 3 * (n_linear + 2 * n_modes):
         return None
     tau = (np.arange(n) - 0.5 * (n - 1)) * sample_period
-    upper = np.array([math.pi / sample_period, _DECAY_LIMIT_FACTOR * math.pi / sample_period])
+    lower = np.array([max(min_omega, 1e-3), _MIN_DECAY])
+    upper = np.array([math.pi / sample_period, _MAX_WINDOW_DECAY / ((n - 1) * sample_period)])
     if noise_std is None:
         # Rough first weights: the spread of the first differences (noise-dominated at 1 kHz)
         scale = np.std(np.diff(y, axis=0), axis=0) / math.sqrt(2.0)
         scale = np.where(scale > 0.0, scale, 1.0)
     else:
         scale = np.asarray(noise_std, dtype=float)
-    start = _initial_modes(y / scale, n_modes, sample_period, upper)
+    start = _initial_modes(y / scale, n_modes, sample_period, lower, upper)
     if start is None:
         return None
-    lower_b = np.tile([1e-3, _MIN_DECAY], n_modes)
-    upper_b = np.tile(upper, n_modes)
-    params, ok = _refine(start, tau, y / scale, lower_b, upper_b)
+    if not np.all(np.isfinite(_projection_residual(start, tau, y / scale, degree))):
+        return None
+    bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
+    params, ok = _refine(start, tau, y / scale, bounds, degree)
     if noise_std is None:
-        residual = _projection_residual(params, tau, y / scale).reshape(n, k) * scale
+        residual = _projection_residual(params, tau, y / scale, degree).reshape(n, k) * scale
         dof = max(n - n_linear - 2 * n_modes, 1)
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
-        params, ok = _refine(params, tau, y / scale, lower_b, upper_b)
-    return _summarise(params, ok, tau, y, scale, t_start, sample_period, noise_std is None)
+        params, ok = _refine(params, tau, y / scale, bounds, degree)
+    return _summarise(params, ok, tau, y, scale, t_start, sample_period, degree, noise_std is None)
 
 
 def _refine(
-    start: FloatArray, tau: FloatArray, weighted: FloatArray, lower: FloatArray, upper: FloatArray
+    start: FloatArray,
+    tau: FloatArray,
+    weighted: FloatArray,
+    bounds: tuple[FloatArray, FloatArray],
+    degree: int,
 ) -> tuple[FloatArray, bool]:
     solution = least_squares(
         _projection_residual,
         start,
-        bounds=(lower, upper),
-        args=(tau, weighted),
+        jac=_projection_jacobian,
+        bounds=bounds,
+        args=(tau, weighted, degree),
         method="trf",
         x_scale="jac",
         xtol=1e-10,
         ftol=1e-10,
-        max_nfev=200,
+        max_nfev=100,
     )
     return np.asarray(solution.x, dtype=float), bool(solution.status > 0)
 
@@ -322,11 +366,12 @@ def _summarise(
     scale: FloatArray,
     t_start: float,
     sample_period: float,
+    degree: int,
     scale_from_residuals: bool,
 ) -> DampedSinusoidFit:
     n, k = y.shape
     m = params.size // 2
-    basis = _basis(tau, params)
+    basis = _basis(tau, params, degree)
     coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
     residual = y - basis @ coef
     n_linear = basis.shape[1]
@@ -334,7 +379,7 @@ def _summarise(
     noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale
     noise = np.where(noise > 0.0, noise, np.finfo(float).tiny)
     # Full Jacobian of the weighted residuals: shared (w, s) columns, then each channel's block
-    deriv = _basis_derivatives(tau, params)
+    deriv = _basis_derivatives(tau, params, degree)
     n_par = 2 * m + k * n_linear
     jac = np.zeros((n * k, n_par))
     for ch in range(k):
@@ -354,7 +399,9 @@ def _summarise(
     tiny = np.finfo(float).tiny
     # Schwarz (1978): BIC = sum_k n ln(RSS_k / n) + P ln(n K)
     bic = float(np.sum(n * np.log(np.maximum(rss, tiny) / n)) + n_par * math.log(n * k))
-    amplitudes = np.hypot(coef[2::2], coef[3::2]).T
+    p = degree + 1
+    amplitudes = np.hypot(coef[p::2], coef[p + 1 :: 2]).T
+    drifts = coef[1] if degree >= 1 else np.zeros(k)
     return DampedSinusoidFit(
         omega=params[0::2][order],
         decay=params[1::2][order],
@@ -362,7 +409,7 @@ def _summarise(
         decay_se=diag[1::2][order],
         offsets=np.asarray(coef[0], dtype=float),
         offset_cov=cov[np.ix_(offset_idx, offset_idx)],
-        drifts=np.asarray(coef[1], dtype=float),
+        drifts=np.asarray(drifts, dtype=float),
         amplitudes=np.asarray(amplitudes[:, order], dtype=float),
         noise_std=np.asarray(noise, dtype=float),
         t_ref=t_start + 0.5 * (n - 1) * sample_period,
@@ -374,24 +421,31 @@ def _summarise(
 
 
 def select_model_order(
-    signals: FloatArray, sample_period: float, max_modes: int = 3, t_start: float = 0.0
+    signals: FloatArray,
+    sample_period: float,
+    max_modes: int = 3,
+    t_start: float = 0.0,
+    min_omega: float = 0.0,
+    degree: int = 1,
 ) -> DampedSinusoidFit | None:
     """The fit with the smallest BIC among M = 1 .. ``max_modes`` damped modes.
 
     Returns None when no order could be fitted (record too short). The noise of each channel is
     estimated once, from the residuals of the largest order that fits, and used for every order,
-    so that the BIC compares the orders on the same weights.
+    so that the BIC compares the orders on the same weights. ``min_omega`` and ``degree`` as in
+    :func:`fit_damped_sinusoids`.
     """
     fits = []
     noise: FloatArray | None = None
     for m in range(max_modes, 0, -1):
-        fit = fit_damped_sinusoids(signals, sample_period, m, t_start, noise)
-        if fit is None:
-            continue
         if noise is None:
-            noise = fit.noise_std
-            fit = fit_damped_sinusoids(signals, sample_period, m, t_start, noise) or fit
-        fits.append(fit)
+            fit = fit_damped_sinusoids(signals, sample_period, m, t_start, None, min_omega, degree)
+            if fit is not None:
+                noise = fit.noise_std
+        else:
+            fit = fit_damped_sinusoids(signals, sample_period, m, t_start, noise, min_omega, degree)
+        if fit is not None:
+            fits.append(fit)
     if not fits:
         return None
     return min(fits, key=lambda f: f.bic)
