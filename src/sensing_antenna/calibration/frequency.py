@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -131,19 +131,19 @@ class FrequencyCalibration:
         return antenna.with_calibrated_t(self.t_e)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON-ready summary (SI units)."""
+        """Plain JSON-ready summary (SI units); NaN (no measurement) is stored as None."""
         return {
             "t_e": self.t_e,
-            "t_e_std_error": self.t_e_std_error,
+            "t_e_std_error": _json_float(self.t_e_std_error),
             "t_theoretical": self.t_theoretical,
             "relative_difference": self.relative_difference,
-            "rms_residual": self.rms_residual,
+            "rms_residual": _json_float(self.rms_residual),
             "loss": self.loss,
             "points": [
                 {
                     "source": self.sources[i] if i < len(self.sources) else "",
                     "x_c": float(self.contact_points[i]),
-                    "omega1_measured": float(self.omega1_measured[i]),
+                    "omega1_measured": _json_float(float(self.omega1_measured[i])),
                     "omega1_fitted": float(self.omega1_fitted[i]),
                     "used": bool(self.used[i]),
                 }
@@ -151,6 +151,34 @@ class FrequencyCalibration:
             ],
             "notes": list(self.notes),
         }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> FrequencyCalibration:
+        """Inverse of :meth:`to_dict` (derived values are recomputed, not read).
+
+        Raises
+        ------
+        KeyError, TypeError, ValueError
+            On malformed data; callers name the file.
+        """
+        points = list(data["points"])
+
+        def column(name: str) -> NDArray[np.float64]:
+            values = [math.nan if p[name] is None else float(p[name]) for p in points]
+            return np.array(values, dtype=float)
+
+        return cls(
+            t_e=float(data["t_e"]),
+            t_e_std_error=_float_or_nan(data.get("t_e_std_error")),
+            t_theoretical=float(data["t_theoretical"]),
+            contact_points=column("x_c"),
+            omega1_measured=column("omega1_measured"),
+            omega1_fitted=column("omega1_fitted"),
+            used=np.array([bool(p["used"]) for p in points], dtype=bool),
+            loss=str(data.get("loss", "soft_l1")),
+            sources=tuple(str(p.get("source", "")) for p in points),
+            notes=tuple(str(n) for n in data.get("notes", [])),
+        )
 
 
 def fit_inverse_t(
@@ -391,6 +419,14 @@ def _read_points_table(table: Path) -> dict[str, float]:
             known[name] = value
             known.setdefault(Path(name).name, value)
     return known
+
+
+def _json_float(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def _float_or_nan(value: Any) -> float:
+    return math.nan if value is None else float(value)
 
 
 def _describe(measurement: Any) -> str:

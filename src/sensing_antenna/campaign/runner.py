@@ -26,12 +26,13 @@ from sensing_antenna.campaign.records import RUN_FAILED, RunResult
 from sensing_antenna.campaign.spec import CampaignSpec, RunSpec, expand_runs
 from sensing_antenna.campaign.store import (
     CSV_FILE,
+    Preparation,
     load_run_results,
-    read_stored_antenna,
+    read_preparation,
     write_manifest,
+    write_preparation,
     write_run_result,
     write_runs_csv,
-    write_stored_antenna,
 )
 from sensing_antenna.errors import SensingAntennaError
 
@@ -45,8 +46,9 @@ __all__ = [
 
 #: A run function: pure, picklable (module level), one run in, its result out.
 RunFunction = Callable[[RunSpec], RunResult]
-#: Builds the antenna used by every run from the spec (e.g. identifying the observer first).
-PrepareAntenna = Callable[[CampaignSpec], Antenna]
+#: The steps before the runs: from the spec, the model and device antennas and the calibration
+#: (:class:`~sensing_antenna.campaign.store.Preparation`); an Antenna means device = model.
+PrepareAntenna = Callable[[CampaignSpec], Antenna | Preparation]
 
 
 @dataclass(frozen=True)
@@ -113,9 +115,12 @@ def run_campaign(
         The run function; default simulates and estimates
         (:func:`~sensing_antenna.campaign.simulated.simulate_and_estimate`).
     prepare_antenna : callable, optional
-        Builds the antenna of every run, called once when ``out_dir`` has none stored yet;
-        default :func:`~sensing_antenna.campaign.simulated.prepare_antenna` (loads the spec's
-        antenna and, if asked, identifies the free-motion observer).
+        The steps before the runs, called once when ``out_dir`` holds no complete preparation for
+        this spec; returns a :class:`~sensing_antenna.campaign.store.Preparation` (or an Antenna,
+        used as both device and model). Default
+        :func:`~sensing_antenna.campaign.simulated.prepare_campaign`: loads the model and the
+        device, identifies the free-motion observer on the device and calibrates T_e, as the
+        spec asks.
     workers : int, optional
         Local worker processes; default all cores. 1 runs inline in this process.
     scheduler : str, optional
@@ -135,15 +140,16 @@ def run_campaign(
         from sensing_antenna.campaign import simulated
 
         run_one = run_one or simulated.simulate_and_estimate
-        prepare_antenna = prepare_antenna or simulated.prepare_antenna
+        prepare_antenna = prepare_antenna or simulated.prepare_campaign
     directory = Path(out_dir)
     directory.mkdir(parents=True, exist_ok=True)
     write_manifest(directory, spec)
-    antenna = read_stored_antenna(directory)
-    if antenna is None:
-        antenna = prepare_antenna(spec)
-        write_stored_antenna(directory, antenna)
-    runs = expand_runs(spec, antenna)
+    preparation = read_preparation(directory, spec)
+    if preparation is None:
+        prepared = prepare_antenna(spec)
+        preparation = prepared if isinstance(prepared, Preparation) else Preparation.same(prepared)
+        write_preparation(directory, spec, preparation)
+    runs = expand_runs(spec, preparation.model, preparation.device)
     done = load_run_results(directory)
     if retry_failed:
         done = {k: v for k, v in done.items() if v.status != RUN_FAILED}

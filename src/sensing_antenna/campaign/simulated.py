@@ -1,8 +1,14 @@
 """The real run function: simulate one contact manoeuvre, then estimate it with every method.
 
-Also the optional first step of a campaign (Section 5.2 of the paper): simulate a free motion and
-identify the free-motion observer of Eq. 15 and its contact threshold from it, so that the contact
-detector is tuned to the simulated device rather than to the paper's real one.
+Also the steps before the runs, in the paper's order:
+
+1. free-motion identification (Section 5.2): simulate a free motion on the device and identify
+   the free-motion observer of Eq. 15 and its contact threshold from it, so that the contact
+   detector is tuned to the simulated device rather than to the paper's real one; the device's
+   controller (the simulator's stop rule) and the estimators both use it;
+2. calibration (Section 5.1): simulate contact manoeuvres on the device at known contact points,
+   measure omega_1 in each with a wide band and fit T_e; the estimators use the nominal model
+   with that T_e. The device's own T is never given to the estimators.
 """
 
 from __future__ import annotations
@@ -11,15 +17,27 @@ import dataclasses
 import time
 from typing import Any
 
-from sensing_antenna.antenna import Antenna
+from sensing_antenna.antenna import Antenna, FreeMotionObserver
+from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.campaign.records import METHOD_ERROR, MethodOutcome, RunResult
-from sensing_antenna.campaign.spec import CampaignSpec, CampaignSpecError, RunSpec, derive_seed
+from sensing_antenna.campaign.spec import (
+    CALIBRATION_STREAM,
+    FREE_MOTION_STREAM,
+    CampaignSpec,
+    CampaignSpecError,
+    RunSpec,
+    derive_seed,
+)
+from sensing_antenna.campaign.store import Preparation
 
 __all__ = [
+    "calibrate_on_device",
+    "calibration_runs",
     "check_scenario",
     "identify_observer",
     "make_scenario",
     "prepare_antenna",
+    "prepare_campaign",
     "simulate_and_estimate",
 ]
 
@@ -52,7 +70,7 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
 
     start = time.perf_counter()
     scenario = make_scenario(run.case, run.contact_point, run.seed, dict(run.scenario))
-    recording = simulate(run.antenna, scenario)
+    recording = simulate(run.simulated_antenna, scenario)
     simulate_s = time.perf_counter() - start
     # The estimators get the recording without ground truth (recording format: they must never
     # read it); the run result keeps the true contact point from the run spec.
@@ -76,10 +94,14 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     return RunResult.for_run(run, outcomes, simulate_s)
 
 
-def identify_observer(antenna: Antenna, spec: CampaignSpec) -> Antenna:
-    """Simulate a free motion and return ``antenna`` with the observer identified from it (Eq. 15).
+def identify_observer(
+    device: Antenna, spec: CampaignSpec, model: Antenna | None = None
+) -> FreeMotionObserver:
+    """Simulate a free motion on ``device`` and identify the observer of Eq. 15 from it.
 
-    The free motion uses the spec's scenario settings and its own seed (stream 1 of the base seed).
+    The free motion uses the spec's scenario settings and its own seed (stream 1 of the base
+    seed). The identification starts from what the engineer knows, ``model`` (default: the
+    device itself), and sees only the recording.
     """
     from sensing_antenna.calibration.observer import identify_free_motion
     from sensing_antenna.simulator import simulate
@@ -87,11 +109,51 @@ def identify_observer(antenna: Antenna, spec: CampaignSpec) -> Antenna:
     extra = dict(spec.scenario)
     extra["duration"] = spec.free_motion.duration
     scenario = make_scenario(
-        spec.free_motion.case, None, derive_seed(spec.base_seed, 0, stream=1), extra
+        spec.free_motion.case, None, derive_seed(spec.base_seed, 0, FREE_MOTION_STREAM), extra
     )
-    recording = simulate(antenna, scenario)
-    fit = identify_free_motion(recording, antenna)
-    return dataclasses.replace(antenna, observer=fit.observer)
+    recording = simulate(device, scenario)
+    fit = identify_free_motion(recording.without_ground_truth(), model or device)
+    return fit.observer
+
+
+def calibration_runs(spec: CampaignSpec) -> list[tuple[str, float, int]]:
+    """(name, contact point in m, seed) of each calibration recording, in a fixed order.
+
+    Seeds come from stream 2 of the base seed (:data:`~.spec.CALIBRATION_STREAM`), so they never
+    coincide with the runs' (stream 0) or the free motion's (stream 1).
+    """
+    step = spec.calibration
+    runs: list[tuple[str, float, int]] = []
+    for x_c in step.contact_points:
+        for repeat in range(1, step.repeats + 1):
+            index = len(runs)
+            name = f"calibration-{step.case}-x{round(x_c * 1000):04d}mm-r{repeat}"
+            runs.append((name, float(x_c), derive_seed(spec.base_seed, index, CALIBRATION_STREAM)))
+    return runs
+
+
+def calibrate_on_device(
+    spec: CampaignSpec, device: Antenna, model: Antenna
+) -> FrequencyCalibration:
+    """Section 5.1 on the simulated device: T_e of the frequency model from known contact points.
+
+    Each calibration manoeuvre is simulated on ``device``; omega_1 is measured with the wide band
+    ``calibration.frequency.CALIBRATION_BAND`` by Estimator 1's frequency measurement, using
+    ``model`` (the observer for t_c and t_1); T_e is fitted to the model's beta_1(x_c)^2. The
+    contact points are known by construction (a calibration), so they come from the spec, and the
+    estimators never see the device's T.
+    """
+    from sensing_antenna.calibration.frequency import calibrate_from_recordings
+    from sensing_antenna.simulator import simulate
+
+    step = spec.calibration
+    names, points, recordings = [], [], []
+    for name, x_c, seed in calibration_runs(spec):
+        scenario = make_scenario(step.case, x_c, seed, dict(spec.scenario))
+        recordings.append(simulate(device, scenario).without_ground_truth())
+        names.append(name)
+        points.append(x_c)
+    return calibrate_from_recordings(recordings, model, points, sources=names, loss=step.loss)
 
 
 def check_scenario(spec: CampaignSpec) -> None:
@@ -108,14 +170,29 @@ def check_scenario(spec: CampaignSpec) -> None:
         raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc
 
 
-def prepare_antenna(spec: CampaignSpec) -> Antenna:
-    """The antenna of every run: the spec's antenna, with the identified observer if asked.
+def prepare_campaign(spec: CampaignSpec) -> Preparation:
+    """The steps before the runs: load model and device, identify the observer, calibrate T_e.
 
+    Order (the paper's): free-motion identification on the device (if asked), then calibration
+    on the device (if asked). The identified observer goes to both antennas (the device's
+    controller and the estimators use the same detector); T_e goes to the model only.
     Checks the spec's scenario section first, so a bad value stops the campaign with one clear
     error instead of failing every run.
     """
     check_scenario(spec)
-    antenna = spec.load_antenna()
+    model = spec.load_antenna()
+    device = spec.load_device()
     if spec.free_motion.identify:
-        antenna = identify_observer(antenna, spec)
-    return antenna
+        observer = identify_observer(device, spec, model)
+        device = dataclasses.replace(device, observer=observer)
+        model = dataclasses.replace(model, observer=observer)
+    calibration = None
+    if spec.calibration.enabled:
+        calibration = calibrate_on_device(spec, device, model)
+        model = calibration.apply(model)
+    return Preparation(model=model, device=device, calibration=calibration)
+
+
+def prepare_antenna(spec: CampaignSpec) -> Antenna:
+    """The antenna the estimators of every run use (:func:`prepare_campaign`'s model)."""
+    return prepare_campaign(spec).model

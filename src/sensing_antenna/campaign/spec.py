@@ -21,6 +21,20 @@ cases = 150 runs. A spec file looks like::
     identify = true
     duration = 4.0                  # s
 
+    [device]                        # optional: the simulated hardware, when it is not the model
+    antenna = "paper-2021"          # default: the top-level antenna
+    link.youngs_modulus = 132.65e9  # field overrides, SI
+
+    [calibration]                   # optional: fit T_e on the device first (Section 5.1)
+    enabled = true
+    case = "azimuthal"
+    contact_points = [0.30, 0.35, 0.40]  # m
+    repeats = 1
+    loss = "soft_l1"
+
+The top-level ``antenna`` is the nominal model the estimators start from; ``[device]`` is what the
+simulator uses as the hardware. Without ``[device]`` both are the same.
+
 Seeds are derived from ``base_seed`` and the run index with :class:`numpy.random.SeedSequence`, so
 every run's seed is fixed by the spec alone and independent of the order runs execute in.
 """
@@ -32,14 +46,14 @@ import json
 import math
 import sys
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from sensing_antenna.antenna import Antenna, load_antenna
+from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
 from sensing_antenna.errors import SensingAntennaError
 
 if sys.version_info >= (3, 11):
@@ -48,16 +62,24 @@ else:  # pragma: no cover - exercised on Python 3.10 only
     import tomli as tomllib
 
 __all__ = [
+    "CALIBRATION_STREAM",
     "CASES",
+    "DEFAULT_CALIBRATION_POINTS",
     "DEFAULT_SPEC_NAME",
+    "DEVICE_SECTIONS",
+    "FREE_MOTION_STREAM",
     "METHODS",
+    "RUN_STREAM",
+    "CalibrationStep",
     "CampaignSpec",
     "CampaignSpecError",
+    "DeviceSpec",
     "FreeMotionStep",
     "RunSpec",
     "default_campaign_spec",
     "derive_seed",
     "expand_runs",
+    "known_methods",
     "load_campaign_spec",
     "parse_campaign_spec",
 ]
@@ -65,8 +87,57 @@ __all__ = [
 #: Manoeuvres of Section 5.6: Case 1 azimuthal movement, Case 2 vertical movement.
 CASES = ("azimuthal", "vertical")
 
-#: Estimation methods: the paper's fused estimator and the two baselines.
+#: Default estimation methods: the paper's fused estimator and the two baselines. Any key of
+#: ``sensing_antenna.estimation.METHODS`` is accepted (see :func:`known_methods`).
 METHODS = ("paper", "ratio", "two-frequency")
+
+#: Seed streams of :func:`derive_seed`: contact runs, the free-motion step, the calibration step.
+RUN_STREAM = 0
+FREE_MOTION_STREAM = 1
+CALIBRATION_STREAM = 2
+
+#: Antenna sections a ``[device]`` section may override, with the fields allowed in each. The
+#: link's ``calibrated_t`` is a model parameter, not hardware, so a device cannot set it.
+DEVICE_SECTIONS: dict[str, tuple[str, ...]] = {
+    "link": ("length", "radius", "youngs_modulus", "linear_density", "tip_mass", "second_moment"),
+    "azimuth_motor": (
+        "torque_constant",
+        "inertia",
+        "viscous_friction",
+        "coulomb_voltage",
+        "gear_ratio",
+    ),
+    "elevation_motor": (
+        "torque_constant",
+        "inertia",
+        "viscous_friction",
+        "coulomb_voltage",
+        "gear_ratio",
+    ),
+    "observer": ("gain", "natural_frequency", "damping", "contact_threshold"),
+}
+
+#: Calibration contact points of Section 5.1: 0.30 m to the tip in 5 cm steps, and the tip.
+DEFAULT_CALIBRATION_POINTS = (
+    0.30,
+    0.35,
+    0.40,
+    0.45,
+    0.50,
+    0.55,
+    0.60,
+    0.65,
+    0.70,
+    0.75,
+    0.80,
+    0.85,
+    0.90,
+    0.95,
+    0.98,
+)
+
+#: Losses of the T_e fit (those of scipy.optimize.least_squares; see calibration.frequency).
+_CALIBRATION_LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
 
 #: Name of the built-in spec that reproduces Section 5.6.
 DEFAULT_SPEC_NAME = "paper-2021"
@@ -85,6 +156,8 @@ _TOP_LEVEL_KEYS = (
     "methods",
     "scenario",
     "free_motion",
+    "device",
+    "calibration",
 )
 
 
@@ -123,6 +196,124 @@ class FreeMotionStep:
 
 
 @dataclass(frozen=True)
+class DeviceSpec:
+    """The simulated hardware, when it differs from the nominal model the estimators know.
+
+    Parameters
+    ----------
+    antenna : str or None
+        Built-in antenna name or antenna TOML file of the device; None: the campaign's antenna.
+    overrides : mapping of str to mapping of str to float
+        Field values replacing the base antenna's, by section (:data:`DEVICE_SECTIONS`), SI.
+    """
+
+    antenna: str | None = None
+    overrides: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for section, values in self.overrides.items():
+            allowed = DEVICE_SECTIONS.get(section)
+            if allowed is None:
+                raise CampaignSpecError(
+                    f"device.{section}",
+                    f"unknown section; known: {', '.join(DEVICE_SECTIONS)}",
+                )
+            for key, value in values.items():
+                if key not in allowed:
+                    hint = (
+                        " (T_e is found by the calibration step, not set on the device)"
+                        if key == "calibrated_t"
+                        else f"; known: {', '.join(allowed)}"
+                    )
+                    raise CampaignSpecError(f"device.{section}.{key}", f"unknown field{hint}")
+                if (
+                    isinstance(value, bool)
+                    or not isinstance(value, (int, float))
+                    or not math.isfinite(value)
+                ):
+                    raise CampaignSpecError(
+                        f"device.{section}.{key}", f"must be a finite number (SI), got {value!r}"
+                    )
+
+    @property
+    def is_model(self) -> bool:
+        """True when the device is the campaign's antenna unchanged."""
+        return self.antenna is None and not any(self.overrides.values())
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data in the layout of the TOML section."""
+        data: dict[str, Any] = {}
+        if self.antenna is not None:
+            data["antenna"] = self.antenna
+        for section, values in self.overrides.items():
+            if values:
+                data[section] = {k: float(v) for k, v in values.items()}
+        return data
+
+
+@dataclass(frozen=True)
+class CalibrationStep:
+    """Optional step before the runs: fit T_e of the frequency model on the device (Section 5.1).
+
+    Parameters
+    ----------
+    enabled : bool
+        Whether to run the step.
+    case : str
+        Manoeuvre of the calibration recordings (Section 5.1: azimuthal, a vertical surface).
+    contact_points : tuple of float
+        Known contact points (m); default 0.30 m to 0.95 m every 5 cm and the tip 0.98 m.
+    repeats : int
+        Recordings per contact point.
+    loss : str
+        Loss of the T_e fit (``calibration.frequency.fit_inverse_t``).
+    """
+
+    enabled: bool = False
+    case: str = "azimuthal"
+    contact_points: tuple[float, ...] = DEFAULT_CALIBRATION_POINTS
+    repeats: int = 1
+    loss: str = "soft_l1"
+
+    def __post_init__(self) -> None:
+        if self.case not in CASES:
+            raise CampaignSpecError(
+                "calibration.case", f"unknown {self.case!r}; known: {', '.join(CASES)}"
+            )
+        if len(self.contact_points) < 2:
+            raise CampaignSpecError(
+                "calibration.contact_points", "needs at least 2 points (m) to fit T_e"
+            )
+        for i, x in enumerate(self.contact_points):
+            if not (math.isfinite(x) and x > 0):
+                raise CampaignSpecError(
+                    f"calibration.contact_points[{i}]", f"must be a finite length > 0 m, got {x!r}"
+                )
+        if self.repeats < 1:
+            raise CampaignSpecError("calibration.repeats", f"must be >= 1, got {self.repeats!r}")
+        if self.loss not in _CALIBRATION_LOSSES:
+            raise CampaignSpecError(
+                "calibration.loss",
+                f"unknown {self.loss!r}; known: {', '.join(_CALIBRATION_LOSSES)}",
+            )
+
+    @property
+    def n_recordings(self) -> int:
+        """Calibration recordings (contact points x repeats)."""
+        return len(self.contact_points) * self.repeats
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data in the layout of the TOML section."""
+        return {
+            "enabled": self.enabled,
+            "case": self.case,
+            "contact_points": list(self.contact_points),
+            "repeats": self.repeats,
+            "loss": self.loss,
+        }
+
+
+@dataclass(frozen=True)
 class CampaignSpec:
     """A validated campaign: what to simulate and which methods estimate each recording.
 
@@ -131,8 +322,8 @@ class CampaignSpec:
     name : str
         Campaign name, used in the report title.
     antenna : str
-        Built-in antenna name or path of an antenna TOML file (absolute or relative to the
-        current directory once loaded).
+        The nominal model the estimators start from: built-in antenna name or path of an antenna
+        TOML file (absolute or relative to the current directory once loaded).
     cases : tuple of str
         Manoeuvres among :data:`CASES`.
     contact_points : tuple of float
@@ -142,11 +333,15 @@ class CampaignSpec:
     base_seed : int
         Seed from which each run's seed is derived (>= 0).
     methods : tuple of str
-        Estimation methods among :data:`METHODS`; each run is estimated by all of them.
+        Estimation methods among :func:`known_methods`; each run is estimated by all of them.
     scenario : mapping
         Extra keyword arguments of ``simulator.Scenario`` (SI units), same for every run.
     free_motion : FreeMotionStep
         Optional observer identification step.
+    device : DeviceSpec
+        The simulated hardware; by default the model itself.
+    calibration : CalibrationStep
+        Optional T_e calibration step on the device.
     description : str
         Free text for the report.
     source : str
@@ -162,6 +357,8 @@ class CampaignSpec:
     methods: tuple[str, ...] = METHODS
     scenario: Mapping[str, Any] = field(default_factory=dict)
     free_motion: FreeMotionStep = field(default_factory=FreeMotionStep)
+    device: DeviceSpec = field(default_factory=DeviceSpec)
+    calibration: CalibrationStep = field(default_factory=CalibrationStep)
     description: str = ""
     source: str = ""
 
@@ -170,7 +367,7 @@ class CampaignSpec:
         if not self.name:
             raise CampaignSpecError("name", "must be a non-empty string", src)
         _check_choices("cases", self.cases, CASES, src)
-        _check_choices("methods", self.methods, METHODS, src)
+        _check_choices("methods", self.methods, known_methods(), src)
         if not self.contact_points:
             raise CampaignSpecError("contact_points", "must list at least one point (m)", src)
         for i, x in enumerate(self.contact_points):
@@ -196,16 +393,50 @@ class CampaignSpec:
         return len(self.cases) * len(self.contact_points) * self.repeats
 
     def load_antenna(self) -> Antenna:
-        """The campaign's antenna; checks every contact point lies on its link."""
+        """The campaign's nominal model; checks every contact point lies on its link."""
         antenna = load_antenna(self.antenna)
-        for i, x in enumerate(self.contact_points):
-            if x > antenna.link.length:
-                raise CampaignSpecError(
-                    f"contact_points[{i}]",
-                    f"{x!r} m is beyond the link length {antenna.link.length:g} m",
-                    self.source or None,
-                )
+        self._check_points(antenna, "")
         return antenna
+
+    def load_device(self) -> Antenna:
+        """The simulated hardware: the device's antenna with its overrides applied.
+
+        Raises
+        ------
+        CampaignSpecError
+            Naming ``device.<section>.<field>`` when an override is out of range, or a contact
+            point beyond the device's link.
+        """
+        antenna = load_antenna(self.device.antenna or self.antenna)
+        for section, values in self.device.overrides.items():
+            if not values:
+                continue
+            part = getattr(antenna, section)
+            try:
+                part = replace(part, **{k: float(v) for k, v in values.items()})
+            except AntennaConfigError as exc:
+                name = exc.field_name.split(".", 1)[-1]
+                raise CampaignSpecError(
+                    f"device.{section}.{name}", exc.problem, self.source or None
+                ) from exc
+            antenna = replace(antenna, **{section: part})
+        if not self.device.is_model:
+            antenna = replace(antenna, name=f"{antenna.name} (device)")
+        self._check_points(antenna, "device: ")
+        return antenna
+
+    def _check_points(self, antenna: Antenna, what: str) -> None:
+        checks = [("contact_points", self.contact_points)]
+        if self.calibration.enabled:
+            checks.append(("calibration.contact_points", self.calibration.contact_points))
+        for key, points in checks:
+            for i, x in enumerate(points):
+                if x > antenna.link.length:
+                    raise CampaignSpecError(
+                        f"{key}[{i}]",
+                        f"{what}{x!r} m is beyond the link length {antenna.link.length:g} m",
+                        self.source or None,
+                    )
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON/TOML-ready) that :func:`parse_campaign_spec` reads back."""
@@ -224,7 +455,20 @@ class CampaignSpec:
                 "duration": self.free_motion.duration,
                 "case": self.free_motion.case,
             },
+            "device": self.device.to_dict(),
+            "calibration": self.calibration.to_dict(),
         }
+
+    def preparation_fingerprint(self) -> str:
+        """Short hash of what the preparation steps (identification, calibration) depend on.
+
+        The antennas, the scenario, the base seed and the two steps' sections; not the runs'
+        contact points, repeats or methods.
+        """
+        data = self.to_dict()
+        keys = ("antenna", "scenario", "base_seed", "free_motion", "device", "calibration")
+        text = json.dumps({k: data[k] for k in keys}, sort_keys=True)
+        return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
     def fingerprint(self) -> str:
         """Short hash of everything that determines the results (not name or description)."""
@@ -254,11 +498,13 @@ class RunSpec:
     seed : int
         Seed of this run's simulation (derived from the base seed and ``index``).
     antenna : Antenna
-        Antenna used to simulate and to estimate.
+        The model the estimators use (nominal antenna, identified observer, calibrated T_e).
     methods : tuple of str
         Methods that estimate the recording.
     scenario : mapping
         Extra keyword arguments of ``simulator.Scenario``.
+    device : Antenna or None
+        The simulated hardware (with the observer its controller uses); None: ``antenna``.
     """
 
     index: int
@@ -270,27 +516,37 @@ class RunSpec:
     antenna: Antenna
     methods: tuple[str, ...]
     scenario: Mapping[str, Any] = field(default_factory=dict)
+    device: Antenna | None = None
+
+    @property
+    def simulated_antenna(self) -> Antenna:
+        """The antenna the simulator uses: ``device`` if given, else ``antenna``."""
+        return self.device if self.device is not None else self.antenna
 
 
-def derive_seed(base_seed: int, index: int, stream: int = 0) -> int:
+def derive_seed(base_seed: int, index: int, stream: int = RUN_STREAM) -> int:
     """Seed of run ``index``: SeedSequence(base_seed, spawn_key=(stream, index)), first word.
 
-    Stream 0 holds the contact runs, stream 1 the free-motion identification step, so the two never
-    share a seed.
+    Stream 0 (:data:`RUN_STREAM`) holds the contact runs, stream 1 the free-motion identification
+    step and stream 2 the calibration recordings, so no two of them share a seed sequence.
     """
     state = np.random.SeedSequence(base_seed, spawn_key=(stream, index)).generate_state(1)
     return int(state[0])
 
 
-def expand_runs(spec: CampaignSpec, antenna: Antenna) -> list[RunSpec]:
+def expand_runs(
+    spec: CampaignSpec, antenna: Antenna, device: Antenna | None = None
+) -> list[RunSpec]:
     """All runs of a campaign in a fixed order: case, then contact point, then repeat.
 
     Parameters
     ----------
     spec : CampaignSpec
     antenna : Antenna
-        The antenna to simulate and estimate with (the spec's, possibly with an identified
-        observer).
+        The model the estimators use (the spec's, possibly with an identified observer and a
+        calibrated T_e).
+    device : Antenna, optional
+        The simulated hardware; None simulates with ``antenna``.
     """
     runs: list[RunSpec] = []
     for case in spec.cases:
@@ -308,9 +564,19 @@ def expand_runs(spec: CampaignSpec, antenna: Antenna) -> list[RunSpec]:
                         antenna=antenna,
                         methods=spec.methods,
                         scenario=dict(spec.scenario),
+                        device=device,
                     )
                 )
     return runs
+
+
+def known_methods() -> tuple[str, ...]:
+    """Names of the estimation methods (``sensing_antenna.estimation.METHODS``)."""
+    try:
+        from sensing_antenna.estimation import METHODS as registry
+    except ImportError:  # pragma: no cover - the estimation package is part of the install
+        return METHODS
+    return tuple(registry)
 
 
 def _check_choices(
@@ -367,10 +633,7 @@ def parse_campaign_spec(
     antenna = data.get("antenna", "paper-2021")
     if not isinstance(antenna, str) or not antenna:
         raise CampaignSpecError("antenna", "must be a built-in name or a file path", source)
-    if base_dir is not None and not antenna.startswith("paper-2021"):
-        candidate = base_dir / antenna
-        if candidate.is_file():
-            antenna = str(candidate)
+    antenna = _resolve_antenna(antenna, base_dir)
     raw_points = _get(data, "contact_points", list, source)
     points: list[float] = []
     for i, x in enumerate(raw_points):
@@ -397,6 +660,8 @@ def parse_campaign_spec(
     duration = free.get("duration", 4.0)
     if isinstance(duration, bool) or not isinstance(duration, (int, float)):
         raise CampaignSpecError("free_motion.duration", "must be a number (s)", source)
+    device = _parse_device(data.get("device", {}), source, base_dir)
+    calibration = _parse_calibration(data.get("calibration", {}), source)
     try:
         free_step = FreeMotionStep(
             identify=identify, duration=float(duration), case=str(free.get("case", "free"))
@@ -412,12 +677,99 @@ def parse_campaign_spec(
             methods=methods,
             scenario=dict(scenario),
             free_motion=free_step,
+            device=device,
+            calibration=calibration,
             source=source,
         )
     except CampaignSpecError as exc:
         if exc.source is None:
             raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
         raise
+
+
+def _resolve_antenna(value: str, base_dir: Path | None) -> str:
+    if base_dir is not None and not value.startswith("paper-2021"):
+        candidate = base_dir / value
+        if candidate.is_file():
+            return str(candidate)
+    return value
+
+
+def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
+    if not isinstance(data, Mapping):
+        raise CampaignSpecError("device", "must be a table", source)
+    antenna = data.get("antenna")
+    if antenna is not None:
+        if not isinstance(antenna, str) or not antenna:
+            raise CampaignSpecError(
+                "device.antenna", "must be a built-in name or a file path", source
+            )
+        antenna = _resolve_antenna(antenna, base_dir)
+    overrides: dict[str, dict[str, float]] = {}
+    for key, values in data.items():
+        if key == "antenna":
+            continue
+        if key not in DEVICE_SECTIONS:
+            raise CampaignSpecError(
+                f"device.{key}",
+                f"unknown key; known: antenna, {', '.join(DEVICE_SECTIONS)}",
+                source,
+            )
+        if not isinstance(values, Mapping):
+            raise CampaignSpecError(
+                f"device.{key}",
+                "must be a table of fields (e.g. link.youngs_modulus = 1e11)",
+                source,
+            )
+        overrides[key] = dict(values)
+    try:
+        return DeviceSpec(antenna=antenna, overrides=overrides)
+    except CampaignSpecError as exc:
+        raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
+
+
+def _parse_calibration(data: Any, source: str) -> CalibrationStep:
+    if not isinstance(data, Mapping):
+        raise CampaignSpecError("calibration", "must be a table", source)
+    known = ("enabled", "case", "contact_points", "repeats", "loss")
+    for key in data:
+        if key not in known:
+            raise CampaignSpecError(
+                f"calibration.{key}", f"unknown key; known: {', '.join(known)}", source
+            )
+    enabled = data.get("enabled", False)
+    if not isinstance(enabled, bool):
+        raise CampaignSpecError("calibration.enabled", "must be true or false", source)
+    case = data.get("case", "azimuthal")
+    loss = data.get("loss", "soft_l1")
+    for key, value in (("case", case), ("loss", loss)):
+        if not isinstance(value, str):
+            raise CampaignSpecError(
+                f"calibration.{key}", f"must be a string, got {value!r}", source
+            )
+    repeats = data.get("repeats", 1)
+    if isinstance(repeats, bool) or not isinstance(repeats, int):
+        raise CampaignSpecError(
+            "calibration.repeats", f"must be an integer, got {repeats!r}", source
+        )
+    raw = data.get("contact_points", list(DEFAULT_CALIBRATION_POINTS))
+    if not isinstance(raw, list):
+        raise CampaignSpecError(
+            "calibration.contact_points", "must be a list of lengths (m)", source
+        )
+    points: list[float] = []
+    for i, x in enumerate(raw):
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            raise CampaignSpecError(
+                f"calibration.contact_points[{i}]", f"must be a number (m), got {x!r}", source
+            )
+        points.append(float(x))
+    try:
+        return CalibrationStep(
+            enabled=enabled, case=case, contact_points=tuple(points), repeats=repeats, loss=loss
+        )
+    except CampaignSpecError as exc:
+        raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
 
 
 def load_campaign_spec(path: str | Path | None = None) -> CampaignSpec:

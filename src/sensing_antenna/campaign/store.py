@@ -4,13 +4,18 @@
 
     OUT/
       campaign.json        the spec and its fingerprint (a resume must use the same spec)
-      antenna.toml         the antenna every run used (with the identified observer, if any)
+      antenna.toml         the model every estimator used (identified observer, calibrated T_e)
+      device.toml          the simulated hardware (with the observer its controller used)
+      calibration.json     the T_e calibration of Section 5.1, when the spec asks for it
       runs/<run_id>.json   one file per finished run, written atomically (temp file + os.replace)
       runs.csv             every run x method, rebuilt from runs/ (SI units)
       report.md, figures/  written by :mod:`sensing_antenna.campaign.report`
 
 A run file either exists complete or not at all, so killing the campaign at any moment loses at
-most the runs in progress; they are redone on the next start.
+most the runs in progress; they are redone on the next start. The preparation (observer
+identification, calibration) is written before any run, ``antenna.toml`` last, so its presence
+means the preparation is complete; ``calibration.json`` carries the fingerprint of the spec parts
+it depends on and is redone when they differ.
 """
 
 from __future__ import annotations
@@ -20,25 +25,33 @@ import json
 import math
 import os
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
+from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.campaign.records import CSV_COLUMNS, RunResult, result_rows
 from sensing_antenna.campaign.spec import CampaignSpec, parse_campaign_spec
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [
     "ANTENNA_FILE",
+    "CALIBRATION_FILE",
     "CSV_FILE",
+    "DEVICE_FILE",
     "MANIFEST_FILE",
     "RUNS_DIR",
     "CampaignStoreError",
+    "Preparation",
     "atomic_write_text",
     "load_run_results",
+    "read_calibration",
     "read_manifest",
+    "read_preparation",
     "read_stored_antenna",
     "write_manifest",
+    "write_preparation",
     "write_run_result",
     "write_runs_csv",
     "write_stored_antenna",
@@ -46,6 +59,8 @@ __all__ = [
 
 MANIFEST_FILE = "campaign.json"
 ANTENNA_FILE = "antenna.toml"
+DEVICE_FILE = "device.toml"
+CALIBRATION_FILE = "calibration.json"
 RUNS_DIR = "runs"
 CSV_FILE = "runs.csv"
 
@@ -90,6 +105,79 @@ def read_manifest(out_dir: Path) -> CampaignSpec:
     except (json.JSONDecodeError, KeyError, TypeError) as exc:
         raise CampaignStoreError(f"{path}: spec: damaged manifest ({exc})") from exc
     return parse_campaign_spec(spec_data, str(path))
+
+
+@dataclass(frozen=True)
+class Preparation:
+    """What the steps before the runs produce: the two antennas and the calibration.
+
+    Attributes
+    ----------
+    model : Antenna
+        What the estimators use: the nominal model with the identified observer and, after a
+        calibration, T_e.
+    device : Antenna
+        The simulated hardware, with the observer its controller (the stop rule) uses.
+    calibration : FrequencyCalibration or None
+        The T_e fit of Section 5.1, when the spec asks for it.
+    """
+
+    model: Antenna
+    device: Antenna
+    calibration: FrequencyCalibration | None = None
+
+    @classmethod
+    def same(cls, antenna: Antenna) -> Preparation:
+        """Device and model are the same antenna, no calibration."""
+        return cls(model=antenna, device=antenna)
+
+
+def write_preparation(out_dir: Path, spec: CampaignSpec, preparation: Preparation) -> None:
+    """Store the preparation; ``antenna.toml`` last, so that it marks a complete preparation."""
+    if preparation.calibration is not None:
+        data = {
+            "fingerprint": spec.preparation_fingerprint(),
+            "calibration": preparation.calibration.to_dict(),
+        }
+        text = json.dumps(data, indent=1, allow_nan=False) + "\n"
+        atomic_write_text(out_dir / CALIBRATION_FILE, text)
+    atomic_write_text(out_dir / DEVICE_FILE, antenna_to_toml(preparation.device))
+    write_stored_antenna(out_dir, preparation.model)
+
+
+def read_calibration(out_dir: Path) -> tuple[str, FrequencyCalibration] | None:
+    """The stored calibration and the fingerprint it was made for, or None if there is none."""
+    path = out_dir / CALIBRATION_FILE
+    if not path.is_file():
+        return None
+    try:
+        data = json.loads(path.read_text("utf-8"))
+        return str(data["fingerprint"]), FrequencyCalibration.from_dict(data["calibration"])
+    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+        raise CampaignStoreError(
+            f"{path}: calibration: damaged file ({exc}); delete it to redo the calibration"
+        ) from exc
+
+
+def read_preparation(out_dir: Path, spec: CampaignSpec) -> Preparation | None:
+    """The preparation stored by an earlier start for this spec, or None if it must be made.
+
+    None when ``antenna.toml`` is missing, or when the spec asks for a calibration and
+    ``calibration.json`` is missing or was made for other settings. A directory of an older
+    version without ``device.toml`` simulated with the model antenna.
+    """
+    model = read_stored_antenna(out_dir)
+    if model is None:
+        return None
+    calibration = None
+    if spec.calibration.enabled:
+        stored = read_calibration(out_dir)
+        if stored is None or stored[0] != spec.preparation_fingerprint():
+            return None
+        calibration = stored[1]
+    device_path = out_dir / DEVICE_FILE
+    device = load_antenna(device_path) if device_path.is_file() else model
+    return Preparation(model=model, device=device, calibration=calibration)
 
 
 def write_stored_antenna(out_dir: Path, antenna: Antenna) -> None:
