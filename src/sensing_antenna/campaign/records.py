@@ -53,6 +53,8 @@ CSV_COLUMNS = (
     "t_c_s",
     "t_1_s",
     "t_e_s",
+    "interval_low_m",
+    "interval_high_m",
     "simulate_s",
     "estimate_s",
 )
@@ -67,6 +69,18 @@ def _as_float(value: Any) -> float:
         return float(value)
     except (TypeError, ValueError):
         return math.nan
+
+
+def _interval(diagnostics: Any) -> tuple[float, float]:
+    """(low, high) of ``diagnostics["interval"]`` in m, or (NaN, NaN) when absent or malformed."""
+    if not isinstance(diagnostics, Mapping):
+        return math.nan, math.nan
+    value: Any = diagnostics.get("interval")
+    try:
+        low, high = (float(v) for v in value)
+    except (TypeError, ValueError):
+        return math.nan, math.nan
+    return low, high
 
 
 def _status_text(status: Any) -> str:
@@ -100,6 +114,9 @@ class MethodOutcome:
         Contact instant, push instant and end of estimation (s); NaN when not available.
     elapsed_s : float
         Wall-clock time of this estimate (s).
+    interval_low, interval_high : float
+        Bounds of the method's 95 % interval of x_c (m), for methods that give one (``fast``:
+        ``diagnostics["interval"]``); NaN otherwise.
     """
 
     method: str
@@ -114,18 +131,27 @@ class MethodOutcome:
     t_1: float = math.nan
     t_e: float = math.nan
     elapsed_s: float = math.nan
+    interval_low: float = math.nan
+    interval_high: float = math.nan
 
     @classmethod
     def from_estimate(cls, method: str, estimate: Any, elapsed_s: float) -> MethodOutcome:
-        """Copy the fields of an estimation result (``ContactEstimate``) that tables need."""
+        """Copy the fields of an estimation result (``ContactEstimate``) that tables need.
+
+        Fields a method does not have are NaN; an interval is read from
+        ``diagnostics["interval"]`` (a pair of lengths in m) when the method reports one.
+        """
         values = {name: _as_float(getattr(estimate, name, None)) for name in _FLOAT_FIELDS}
         candidates = getattr(estimate, "candidates", None)
+        low, high = _interval(getattr(estimate, "diagnostics", None))
         return cls(
             method=method,
             status=_status_text(getattr(estimate, "status", "unknown")),
             reason=str(getattr(estimate, "reason", "") or ""),
             candidates=tuple(_as_float(c) for c in (candidates if candidates is not None else ())),
             elapsed_s=float(elapsed_s),
+            interval_low=low,
+            interval_high=high,
             **values,
         )
 
@@ -138,6 +164,7 @@ class MethodOutcome:
             **{name: _json_float(getattr(self, name)) for name in _FLOAT_FIELDS},
             "candidates": [_json_float(c) for c in self.candidates],
             "elapsed_s": _json_float(self.elapsed_s),
+            "interval": [_json_float(self.interval_low), _json_float(self.interval_high)],
         }
 
     @classmethod
@@ -149,6 +176,8 @@ class MethodOutcome:
             reason=str(data.get("reason", "")),
             candidates=tuple(_as_float(c) for c in data.get("candidates", [])),
             elapsed_s=_as_float(data.get("elapsed_s")),
+            interval_low=_interval({"interval": data.get("interval")})[0],
+            interval_high=_interval({"interval": data.get("interval")})[1],
             **{name: _as_float(data.get(name)) for name in _FLOAT_FIELDS},
         )
 
@@ -291,6 +320,8 @@ def result_rows(result: RunResult, methods: Sequence[str]) -> list[dict[str, Any
                 "t_c_s": outcome.t_c,
                 "t_1_s": outcome.t_1,
                 "t_e_s": outcome.t_e,
+                "interval_low_m": outcome.interval_low,
+                "interval_high_m": outcome.interval_high,
                 "estimate_s": outcome.elapsed_s,
             }
         )

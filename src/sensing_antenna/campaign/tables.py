@@ -20,15 +20,18 @@ from importlib import resources
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sensing_antenna.campaign.records import RunResult, result_rows
 
 __all__ = [
     "PAPER_TABLE_FILES",
+    "IntervalSummary",
     "MethodSummary",
     "PaperRow",
     "PointStats",
     "campaign_rows",
+    "interval_summaries",
     "method_summaries",
     "paper_row_at",
     "paper_table",
@@ -114,6 +117,40 @@ class MethodSummary:
     ok_max_abs_error: float = math.nan
 
 
+@dataclass(frozen=True)
+class IntervalSummary:
+    """Per case and method: the 95 % intervals (if the method gives any) and the estimation time.
+
+    Attributes
+    ----------
+    case, method : str
+    n_intervals : int
+        Runs with a finite interval.
+    n_covering : int
+        Of those, runs whose interval contains the true x_c.
+    median_width : float
+        Median interval width (m); NaN without intervals.
+    n_timed : int
+        Runs with finite t_1 and t_e.
+    median_time_to_estimate : float
+        Median of t_e - t_1 (s), how long after the push the estimate was available; NaN when
+        never.
+    """
+
+    case: str
+    method: str
+    n_intervals: int
+    n_covering: int
+    median_width: float
+    n_timed: int
+    median_time_to_estimate: float
+
+    @property
+    def coverage(self) -> float:
+        """Fraction of intervals containing the true x_c (dimensionless); NaN without any."""
+        return self.n_covering / self.n_intervals if self.n_intervals else math.nan
+
+
 def campaign_rows(results: Iterable[RunResult], methods: Sequence[str]) -> list[dict[str, Any]]:
     """Every run x method row (see :data:`~sensing_antenna.campaign.records.CSV_COLUMNS`)."""
     rows: list[dict[str, Any]] = []
@@ -177,6 +214,47 @@ def method_summaries(
                     status_counts=dict(Counter(str(r["status"]) for r in selected)),
                     ok_mean_abs_error=float(np.mean(ok_errors)) if ok_errors.size else math.nan,
                     ok_max_abs_error=float(np.max(ok_errors)) if ok_errors.size else math.nan,
+                )
+            )
+    return summaries
+
+
+def _column(rows: Sequence[Mapping[str, Any]], name: str) -> NDArray[np.float64]:
+    """One column as floats; a missing or empty cell is NaN."""
+    values = []
+    for row in rows:
+        try:
+            values.append(float(row.get(name, math.nan)))
+        except (TypeError, ValueError):
+            values.append(math.nan)
+    return np.array(values, dtype=float)
+
+
+def interval_summaries(
+    rows: Iterable[Mapping[str, Any]], cases: Sequence[str], methods: Sequence[str]
+) -> list[IntervalSummary]:
+    """One :class:`IntervalSummary` per case and method, in the given order."""
+    all_rows = list(rows)
+    summaries = []
+    for case in cases:
+        for method in methods:
+            selected = _select(all_rows, case, method)
+            low = _column(selected, "interval_low_m")
+            high = _column(selected, "interval_high_m")
+            truth = _column(selected, "x_c_true_m")
+            has = np.isfinite(low) & np.isfinite(high)
+            covering = has & (low <= truth) & (truth <= high)
+            delay = _column(selected, "t_e_s") - _column(selected, "t_1_s")
+            delay = delay[np.isfinite(delay)]
+            summaries.append(
+                IntervalSummary(
+                    case=case,
+                    method=method,
+                    n_intervals=int(has.sum()),
+                    n_covering=int(covering.sum()),
+                    median_width=float(np.median(high[has] - low[has])) if has.any() else math.nan,
+                    n_timed=int(delay.size),
+                    median_time_to_estimate=float(np.median(delay)) if delay.size else math.nan,
                 )
             )
     return summaries
