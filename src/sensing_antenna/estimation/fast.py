@@ -101,12 +101,18 @@ class FastConfig:
         Degree of the static polynomial per channel. 2: offset, drift and curvature follow the
         slow creep over the longest window (0.6 s, about 0.8 rad of the 8 rad/s creep).
     frequency_floor : float
-        Relative model error of omega_1 added in quadrature (dimensionless). 0.003: the
-        difference between the link's sensing curve and the frequencies of the finite-element
-        simulator with a compliant contact is up to 0.2 % over the grid (measured with the
-        1 s spectrum on noiseless recordings), and short-window fits on a contact that is still
-        settling differ from the long-record value by a few tenths of a percent. With a
-        calibrated T_e on a real device use the relative scatter of the calibration instead.
+        Relative model error of omega_1 added in quadrature (dimensionless): how well T (or
+        T_e) and the sensing curve predict the frequency. 0.001: the link's sensing curve and
+        the frequencies of the finite-element simulator with a compliant contact differ by 0.01
+        to 0.12 % over the azimuthal grid (1 s spectrum on noiseless recordings, see
+        docs/fast.md). On a real device use the relative scatter of the T_e calibration.
+    resolution_fraction : float
+        Non-stationarity floor of omega_1 as a fraction of the Rayleigh resolution 2 pi / T_w
+        of the window (rad/s), added in quadrature. Content the model does not describe (the
+        servo's slow creep, the contact still settling) leaks into the fitted frequency by an
+        amount that shrinks with the resolution of the record, while the white-noise standard
+        error ignores it. 0.005: noiseless simulated windows of 0.3 s (2 pi / T_w = 21 rad/s)
+        at x_c = 0.3 m scatter by +-0.1 rad/s about the long-record value.
     ratio_geometry_factor : float
         kappa of the ratio's model floor kappa (y_c / x_c) x_c (dimensionless). 0.5: the
         neglected torque of the axial force on the deflection is (y_c / x_c)(R_x / R_perp) x_c,
@@ -127,7 +133,8 @@ class FastConfig:
     max_modes: int = 3
     min_mode_fraction: float = 0.6
     polynomial_degree: int = 2
-    frequency_floor: float = 0.002
+    frequency_floor: float = 0.001
+    resolution_fraction: float = 0.005
     ratio_geometry_factor: float = 0.5
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
@@ -144,7 +151,8 @@ class FastConfig:
                 raise FastConfigError(f"{f.name}: must be a number, got {value!r}")
             if not (math.isfinite(value) and value >= 0.0):
                 raise FastConfigError(f"{f.name}: must be a finite number >= 0, got {value!r}")
-            if value == 0.0 and f.name not in ("frequency_floor", "ratio_geometry_factor"):
+            floors = ("frequency_floor", "resolution_fraction", "ratio_geometry_factor")
+            if value == 0.0 and f.name not in floors:
                 raise FastConfigError(f"{f.name}: must be > 0, got {value!r}")
         if self.first_window > self.cap:
             raise FastConfigError("first_window: must not exceed cap")
@@ -190,7 +198,9 @@ class WindowEstimate:
     fit : DampedSinusoidFit or None
         The chosen fit of the contact-load channels (None: too few samples or no pole).
     omega1, omega1_se : float
-        Fundamental and its statistical standard error (rad/s); NaN when not usable.
+        Fundamental and its standard error (rad/s): the fit's statistical error and the
+        non-stationarity floor in quadrature (the relative model floor is added by the
+        posterior); NaN when not usable.
     statics : StaticRatio or None
         The static torque/force ratio.
     posterior : ContactPosterior
@@ -268,7 +278,10 @@ def evaluate_window(
         elif not (fit.converged and math.isfinite(fit.omega_se[k])):
             notes.append("the fit did not converge")
         else:
-            omega1, omega1_se = float(fit.omega[k]), float(fit.omega_se[k])
+            omega1 = float(fit.omega[k])
+            # Statistical standard error and the non-stationarity floor, in quadrature
+            resolution = 2.0 * math.pi / fit.duration
+            omega1_se = math.hypot(float(fit.omega_se[k]), config.resolution_fraction * resolution)
             periods = fit.duration * omega1 / (2.0 * math.pi)
             if periods < config.min_periods:
                 notes.append(f"the window holds {periods:.2f} periods of omega_1")

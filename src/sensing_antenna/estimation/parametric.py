@@ -62,6 +62,8 @@ _MAX_WINDOW_DECAY = 20.0
 #: Smallest decay rate (1/s): slight growth is allowed (a fit on a short record may need it), more
 #: is not physical for a passive link.
 _MIN_DECAY = -20.0
+#: Largest pencil parameter of the matrix pencil (see :func:`matrix_pencil_poles`).
+_MAX_PENCIL = 64
 
 
 @dataclass(frozen=True)
@@ -126,8 +128,9 @@ class DampedSinusoidFit:
         return (self.n_samples - 1) * self.sample_period
 
     def snr(self) -> FloatArray:
-        """Amplitude over noise of each mode, combined over channels, shape (M,)."""
-        ratio = self.amplitudes / self.noise_std[:, None]
+        """Amplitude at the window start over noise, combined over channels, shape (M,)."""
+        start = self.amplitudes * np.exp(0.5 * self.decay * self.duration)[None, :]
+        ratio = start / self.noise_std[:, None]
         return np.asarray(np.sqrt(np.sum(ratio**2, axis=0)), dtype=float)
 
     def strongest_in_band(self, band: tuple[float, float]) -> int | None:
@@ -155,22 +158,26 @@ def matrix_pencil_poles(signals: FloatArray, n_poles: int) -> ComplexArray:
 
     Notes
     -----
-    Hua and Sarkar (1990): with pencil parameter L = n / 3, the Hankel matrices of every channel
-    (rows y[i : i + L + 1]) are stacked, their right singular vectors V truncated to ``n_poles``
-    and the poles are the eigenvalues of pinv(V[:-1]) V[1:] (shift invariance).
+    Hua and Sarkar (1990): with pencil parameter L = min(n / 3, 64), the Hankel matrices of every
+    channel (rows y[i : i + L + 1]) are stacked, their right singular vectors V (eigenvectors of
+    the Gram matrix) truncated to ``n_poles`` and the poles are the eigenvalues of
+    pinv(V[:-1]) V[1:] (shift invariance). L = n / 3 is the noise-optimal choice; capping it at 64
+    keeps the cost low for long windows and is far above the ten poles ever asked for.
     """
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
         y = y[:, None]
     n = y.shape[0]
-    pencil = max(n_poles, n // 3)
+    pencil = max(n_poles, min(n // 3, _MAX_PENCIL))
     if n - pencil < n_poles:
         raise ValueError(f"{n} samples are too few for {n_poles} poles")
-    hankel = np.vstack(
-        [np.lib.stride_tricks.sliding_window_view(y[:, k], pencil + 1) for k in range(y.shape[1])]
-    )
-    _, _, vh = np.linalg.svd(hankel, full_matrices=False)
-    v = vh[:n_poles].conj().T
+    gram = np.zeros((pencil + 1, pencil + 1))
+    for k in range(y.shape[1]):
+        hankel = np.lib.stride_tricks.sliding_window_view(y[:, k], pencil + 1)
+        gram += hankel.T @ hankel
+    # Right singular vectors of the stacked Hankel matrix = eigenvectors of its Gram matrix
+    _, vectors = np.linalg.eigh(gram)
+    v = vectors[:, ::-1][:, :n_poles]
     # Shift invariance: V2 = V1 Z, the poles are the eigenvalues of pinv(V1) V2
     shifted = np.linalg.pinv(v[:-1]) @ v[1:]
     return np.asarray(np.linalg.eigvals(shifted), dtype=complex)
@@ -232,21 +239,28 @@ def _projection_jacobian(
     return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
 
 
-def _initial_modes(
-    y: FloatArray, n_modes: int, sample_period: float, lower: FloatArray, upper: FloatArray
-) -> FloatArray | None:
-    """(w, s) pairs of the ``n_modes`` strongest oscillatory matrix-pencil poles above lower[0]."""
-    n = y.shape[0]
-    n_poles = min(2 * n_modes + 4, n // 3)
-    if n_poles < 2 * n_modes:
+def _pencil_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
+    """Matrix-pencil poles for up to ``n_modes`` modes plus the polynomial and spare poles."""
+    n_poles = min(2 * n_modes + 4, y.shape[0] // 3)
+    if n_poles < 2:
         return None
-    z = matrix_pencil_poles(y, n_poles)
+    return matrix_pencil_poles(y, n_poles)
+
+
+def _initial_modes(
+    y: FloatArray,
+    z: ComplexArray,
+    n_modes: int,
+    sample_period: float,
+    lower: FloatArray,
+    upper: FloatArray,
+) -> FloatArray:
+    """(w, s) pairs of the ``n_modes`` strongest oscillatory poles ``z`` above lower[0]."""
+    n = y.shape[0]
     with np.errstate(divide="ignore", invalid="ignore"):
         s_plane = np.log(z) / sample_period
     keep = np.isfinite(s_plane) & (s_plane.imag > 0.0)
     s_plane = s_plane[keep]
-    if s_plane.size == 0:
-        return None
     # Amplitude of each pole: least squares on the complex exponentials of all kept poles
     idx = np.arange(n)
     vander = np.exp(np.multiply.outer(idx * sample_period, s_plane))
@@ -277,6 +291,7 @@ def fit_damped_sinusoids(
     noise_std: FloatArray | None = None,
     min_omega: float = 0.0,
     degree: int = 1,
+    poles: ComplexArray | None = None,
 ) -> DampedSinusoidFit | None:
     """Fit ``n_modes`` damped sinusoids with shared poles, plus a polynomial per channel.
 
@@ -297,12 +312,15 @@ def fit_damped_sinusoids(
         Lowest frequency a mode may take (rad/s); slower content is left to the polynomial.
     degree : int
         Degree of the polynomial (offset, drift, ...) of each channel, >= 0.
+    poles : array of complex, optional
+        Discrete-time poles for the initial values (:func:`matrix_pencil_poles` of the weighted
+        channels); computed when omitted.
 
     Returns
     -------
     DampedSinusoidFit or None
         None when the record is too short for the model (fewer samples than 3 times the
-        parameters per channel) or the matrix pencil finds no oscillatory pole.
+        parameters per channel).
     """
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
@@ -320,9 +338,10 @@ def fit_damped_sinusoids(
         scale = np.where(scale > 0.0, scale, 1.0)
     else:
         scale = np.asarray(noise_std, dtype=float)
-    start = _initial_modes(y / scale, n_modes, sample_period, lower, upper)
-    if start is None:
+    z = poles if poles is not None else _pencil_poles(y / scale, n_modes)
+    if z is None:
         return None
+    start = _initial_modes(y / scale, z, n_modes, sample_period, lower, upper)
     if not np.all(np.isfinite(_projection_residual(start, tau, y / scale, degree))):
         return None
     bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
@@ -437,13 +456,18 @@ def select_model_order(
     """
     fits = []
     noise: FloatArray | None = None
+    poles: ComplexArray | None = None
+    y = np.asarray(signals, dtype=float)
     for m in range(max_modes, 0, -1):
         if noise is None:
-            fit = fit_damped_sinusoids(signals, sample_period, m, t_start, None, min_omega, degree)
+            fit = fit_damped_sinusoids(y, sample_period, m, t_start, None, min_omega, degree)
             if fit is not None:
                 noise = fit.noise_std
+                poles = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
         else:
-            fit = fit_damped_sinusoids(signals, sample_period, m, t_start, noise, min_omega, degree)
+            fit = fit_damped_sinusoids(
+                y, sample_period, m, t_start, noise, min_omega, degree, poles
+            )
         if fit is not None:
             fits.append(fit)
     if not fits:
