@@ -124,3 +124,123 @@ def test_antenna_file_is_resolved_next_to_the_spec(tmp_path: Path) -> None:
         write(tmp_path, GOOD.replace('antenna = "paper-2021"', 'antenna = "short.toml"'))
     )
     assert spec.load_antenna().link.length == 0.6
+
+
+DEVICE_AND_CALIBRATION = """
+[device]
+antenna = "paper-2021"
+link.youngs_modulus = 130e9
+azimuth_motor.inertia = 7e-3
+[calibration]
+enabled = true
+case = "azimuthal"
+contact_points = [0.3, 0.5, 0.9]
+repeats = 2
+loss = "linear"
+"""
+
+
+def test_default_campaign_simulates_a_device_with_the_paper_t_e() -> None:
+    spec = default_campaign_spec()
+    model = spec.load_antenna()
+    device = spec.load_device()
+    # Table 2 gives T = 0.2282 (Section 5.1; 0.22812 from the rounded Table 2 values)
+    assert model.link.theoretical_t == pytest.approx(0.2281, abs=1e-4)
+    # the device's E = rho / (T_e^2 I) makes its T the paper's calibrated T_e = 0.2124 (Section
+    # 5.1); 132.65 GPa is E rounded to 4 digits, so T agrees to 1e-5
+    assert device.link.theoretical_t == pytest.approx(0.2124, abs=1e-5)
+    assert device.link.youngs_modulus == pytest.approx(132.6e9, rel=1e-3)
+    # everything but E is the paper's antenna
+    assert device.link.linear_density == model.link.linear_density
+    assert device.motors == model.motors
+    assert spec.calibration.enabled and spec.calibration.case == "azimuthal"
+    # Section 5.1: x_c from 0.3 m to 0.98 m in 5 cm steps, one experiment each
+    np.testing.assert_allclose(spec.calibration.contact_points, spec.contact_points)
+    assert spec.calibration.repeats == 1
+    assert spec.free_motion.identify
+
+
+def test_device_and_calibration_sections_load(tmp_path: Path) -> None:
+    spec = load_campaign_spec(write(tmp_path, GOOD + DEVICE_AND_CALIBRATION))
+    assert spec.device.overrides == {
+        "link": {"youngs_modulus": 130e9},
+        "azimuth_motor": {"inertia": 7e-3},
+    }
+    device = spec.load_device()
+    assert device.link.youngs_modulus == 130e9
+    assert device.azimuth_motor.inertia == 7e-3
+    assert device.elevation_motor == paper_antenna().elevation_motor
+    assert spec.calibration.contact_points == (0.3, 0.5, 0.9)
+    assert spec.calibration.n_recordings == 6
+    assert spec.calibration.loss == "linear"
+    # without the sections: the device is the model and there is no calibration
+    plain = load_campaign_spec(write(tmp_path, GOOD))
+    assert plain.device.is_model and not plain.calibration.enabled
+    assert plain.load_device() == plain.load_antenna()
+
+
+def test_device_and_calibration_change_the_fingerprints(tmp_path: Path) -> None:
+    a = load_campaign_spec(write(tmp_path, GOOD + DEVICE_AND_CALIBRATION))
+    b = load_campaign_spec(write(tmp_path, GOOD + DEVICE_AND_CALIBRATION.replace("130e9", "131e9")))
+    c = load_campaign_spec(
+        write(tmp_path, GOOD.replace("repeats = 2", "repeats = 3") + DEVICE_AND_CALIBRATION)
+    )
+    assert a.fingerprint() != b.fingerprint()
+    assert a.preparation_fingerprint() != b.preparation_fingerprint()
+    # the runs' repeats do not change what the calibration depends on
+    assert a.fingerprint() != c.fingerprint()
+    assert a.preparation_fingerprint() == c.preparation_fingerprint()
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [
+        ("link.youngs_modulus = 130e9", "link.colour = 1.0", "device.link.colour"),
+        ("link.youngs_modulus = 130e9", "link.calibrated_t = 0.2", "device.link.calibrated_t"),
+        ("link.youngs_modulus = 130e9", 'link.youngs_modulus = "stiff"', "device.link"),
+        ("link.youngs_modulus = 130e9", "link.youngs_modulus = nan", "device.link"),
+        ("link.youngs_modulus = 130e9", "wheels.count = 4.0", "device.wheels"),
+        ("link.youngs_modulus = 130e9", "link = 3", "device.link"),
+        ('antenna = "paper-2021"\nlink', "antenna = 3\nlink", "device.antenna"),
+        ("enabled = true", 'enabled = "yes"', "calibration.enabled"),
+        ('case = "azimuthal"', 'case = "sideways"', "calibration.case"),
+        ("[0.3, 0.5, 0.9]", "[0.3, -0.5, 0.9]", "calibration.contact_points[1]"),
+        ("[0.3, 0.5, 0.9]", '[0.3, "a", 0.9]', "calibration.contact_points[1]"),
+        ("[0.3, 0.5, 0.9]", "[0.3]", "calibration.contact_points"),
+        ("repeats = 2\nloss", "repeats = 0\nloss", "calibration.repeats"),
+        ('loss = "linear"', 'loss = "magic"', "calibration.loss"),
+        ('loss = "linear"', 'loss = "linear"\ncolour = 1', "calibration.colour"),
+    ],
+)
+def test_bad_device_and_calibration_fields_are_named(
+    tmp_path: Path, old: str, new: str, field: str
+) -> None:
+    text = GOOD + DEVICE_AND_CALIBRATION.replace(old, new, 1)
+    assert text != GOOD + DEVICE_AND_CALIBRATION
+    path = write(tmp_path, text)
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: {field}")) as info:
+        load_campaign_spec(path)
+    assert isinstance(info.value, SensingAntennaError)
+
+
+def test_device_values_out_of_range_are_named_when_loaded(tmp_path: Path) -> None:
+    path = write(tmp_path, GOOD + DEVICE_AND_CALIBRATION.replace("130e9", "-1.0"))
+    spec = load_campaign_spec(path)
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: device.link.youngs_modulus:")):
+        spec.load_device()
+    # a device link shorter than a calibration point (0.9 m) is refused, naming the point
+    short = write(
+        tmp_path, GOOD + DEVICE_AND_CALIBRATION.replace("130e9", "130e9\nlink.length = 0.8")
+    )
+    with pytest.raises(CampaignSpecError, match=r"calibration\.contact_points\[2\]: device: 0.9 m"):
+        load_campaign_spec(short).load_device()
+
+
+def test_device_antenna_file_is_resolved_next_to_the_spec(tmp_path: Path) -> None:
+    (tmp_path / "stiff.toml").write_text(
+        'base = "paper-2021"\nname = "stiff"\n[link]\nyoungs_modulus = 140e9\n', encoding="utf-8"
+    )
+    text = GOOD + '[device]\nantenna = "stiff.toml"\n'
+    spec = load_campaign_spec(write(tmp_path, text))
+    assert spec.load_device().link.youngs_modulus == 140e9
+    assert spec.load_antenna().link.youngs_modulus == paper_antenna().link.youngs_modulus
