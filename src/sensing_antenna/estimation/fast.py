@@ -32,7 +32,6 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.contact_frame import ContactFrame
 from sensing_antenna.estimation.fusion import Evidence, sensing_curve
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.parametric import DampedSinusoidFit, select_model_order
@@ -88,9 +87,11 @@ class FastConfig:
     min_periods : float
         The window must hold this many periods of the fitted fundamental before an estimate can
         be declared (a shorter record cannot tell a frequency from a drift). 1.5.
-    min_snr : float
-        The fundamental must stand this many noise standard deviations above the noise (combined
-        over channels); below it the frequency is not used. 10.
+    min_detection : float
+        The fundamental is used only when its detection statistic, the amplitude at the window
+        start over the noise (combined over channels) times sqrt(n / 2), reaches this value. For
+        white noise the largest of ~n / 2 independent periodogram ordinates reaches about
+        sqrt(2 ln n) ~ 3.7 standard deviations; 10 leaves no room for a noise peak.
     max_modes : int
         Largest number of damped modes tried (BIC chooses 1 .. max_modes). 3: the fundamental,
         the second contact mode (2.5 to 7 times higher) and one for servo/contact transients.
@@ -98,8 +99,10 @@ class FastConfig:
         Modes are fitted above this fraction of the lower end of the omega_1 band; slower content
         (the servo's slow creep at ~8 rad/s) goes to the polynomial. 0.6 of ~23 rad/s.
     polynomial_degree : int
-        Degree of the static polynomial per channel. 2: offset, drift and curvature follow the
-        slow creep over the longest window (0.6 s, about 0.8 rad of the 8 rad/s creep).
+        Degree of the static polynomial per channel. 4: the servo's slow creep (~8 rad/s) spans
+        up to 0.8 rad of its cycle over the longest window; with degree 2 the fitted omega_1 at
+        x_c = 0.3 m wandered by 1.5 % between windows of 0.3 and 0.6 s (simulated recordings,
+        well beyond its standard error), with degree 4 by 0.1 %.
     frequency_floor : float
         Relative model error of omega_1 added in quadrature (dimensionless): how well T (or
         T_e) and the sensing curve predict the frequency. 0.001: the link's sensing curve and
@@ -122,6 +125,10 @@ class FastConfig:
         Spacing of the x_c grid of the posterior (m). 0.25 mm, a twentieth of the tolerance.
     bias_min_samples : int
         Samples of initial rest needed to estimate the sensor bias; 20 (20 ms).
+    max_direction_drift : float
+        Largest angle (rad) between the perpendicular reaction over the first 20 ms after t_1
+        and the fitted static one at t_e (both with the sensor bias removed) before a slip is
+        suspected; 0.15 rad as the pipeline's ``max_direction_drift``.
     """
 
     tolerance: float = 0.005
@@ -129,15 +136,16 @@ class FastConfig:
     first_window: float = 0.05
     cap: float = 0.6
     min_periods: float = 1.5
-    min_snr: float = 10.0
+    min_detection: float = 10.0
     max_modes: int = 3
     min_mode_fraction: float = 0.6
-    polynomial_degree: int = 2
+    polynomial_degree: int = 4
     frequency_floor: float = 0.001
     resolution_fraction: float = 0.005
     ratio_geometry_factor: float = 0.5
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
+    max_direction_drift: float = 0.15
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -273,8 +281,9 @@ def evaluate_window(
         k = fit.strongest_in_band(band)
         if k is None:
             notes.append("no vibration mode in the omega_1 band")
-        elif fit.snr()[k] < config.min_snr:
-            notes.append(f"the fundamental is only {fit.snr()[k]:.1f} times the noise")
+        elif fit.snr()[k] * math.sqrt(0.5 * fit.n_samples) < config.min_detection:
+            detection = fit.snr()[k] * math.sqrt(0.5 * fit.n_samples)
+            notes.append(f"the fundamental's detection statistic is only {detection:.1f}")
         elif not (fit.converged and math.isfinite(fit.omega_se[k])):
             notes.append("the fit did not converge")
         else:
@@ -421,7 +430,7 @@ class FastMethod:
 
 def _problems(
     result: ScanResult,
-    frame: ContactFrame,
+    reaction_t1: FloatArray,
     config: FastConfig,
     deflection_ratio: float,
     limit: float,
@@ -446,12 +455,13 @@ def _problems(
                 )
             )
     statics = final.statics
-    if statics is not None and statics.perpendicular_force > 0.0:
-        reaction = statics.reaction_m.copy()
-        # Direction of the static reaction at t_e against Y^c at t_1: slip along the surface
-        cosine = float(np.dot(reaction, frame.axes_m[1]) / np.linalg.norm(reaction))
+    norm_t1 = float(np.linalg.norm(reaction_t1))
+    if statics is not None and statics.perpendicular_force > 0.0 and norm_t1 > 0.0:
+        reaction = statics.reaction_m[1:]
+        # Direction of the static perpendicular reaction at t_e against t_1: slip on the surface
+        cosine = float(np.dot(reaction, reaction_t1) / (np.linalg.norm(reaction) * norm_t1))
         drift = math.acos(min(1.0, max(-1.0, cosine)))
-        if drift > 0.15:
+        if drift > config.max_direction_drift:
             found.append(
                 (
                     Status.SLIP_SUSPECTED,
@@ -495,9 +505,17 @@ def conclude_fast(
     statics = final.statics
     push = statics.perpendicular_force if statics is not None else math.nan
     touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link)
+    start = evidence.rest_index
+    channels = contact_channels(
+        evidence.theta[start : start + 21],
+        evidence.force[start : start + 21],
+        evidence.torque[start : start + 21],
+        evidence.antenna,
+    )
+    reaction_t1 = channels[:, :2].mean(axis=0) - bias.bias[:2]
     found = _problems(
         result,
-        evidence.frame,
+        reaction_t1,
         config,
         touch.deflection_ratio,
         evidence.config.max_deflection_ratio,
