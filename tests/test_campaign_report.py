@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from sensing_antenna.campaign.runner import run_campaign
 from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
 from sensing_antenna.campaign.tables import (
     campaign_rows,
+    interval_summaries,
     method_summaries,
     paper_row_at,
     paper_table,
@@ -148,3 +150,62 @@ def test_report_figures_are_written_and_linked(campaign_dir: Path) -> None:
     for name in names:
         assert f"](figures/{name})" in text
         assert (campaign_dir / "figures" / name).stat().st_size > 1000
+
+
+class _FakeEstimate:
+    """Stands in for a ContactEstimate of a method with extra diagnostics (like ``fast``)."""
+
+    status = "ok"
+    reason = None
+    x_c = 0.52
+    candidates = (0.52,)
+    omega1 = 60.0
+    t_1 = 1.0
+    t_e = 1.2
+    diagnostics: ClassVar[dict[str, object]] = {
+        "interval": (0.51, 0.53),
+        "interval_width": 0.02,
+        "model_order": 3,
+    }
+
+
+def test_an_interval_in_the_diagnostics_is_kept_and_summarised() -> None:
+    outcome = MethodOutcome.from_estimate("fast", _FakeEstimate(), 0.01)
+    assert (outcome.interval_low, outcome.interval_high) == (0.51, 0.53)
+    assert MethodOutcome.from_dict(outcome.to_dict()) == outcome
+    # a method without an interval keeps NaN and round-trips too
+    plain_outcome = MethodOutcome(method="paper", status="ok", x_c=0.5)
+    again = MethodOutcome.from_dict(plain_outcome.to_dict())
+    assert math.isnan(again.interval_low) and math.isnan(again.interval_high)
+    runs = [
+        RunSpec(i, f"azimuthal-x0{x * 1000:.0f}mm-r1", "azimuthal", x, 1, i, paper_antenna(), ())
+        for i, x in enumerate((0.5, 0.52, 0.6))
+    ]
+    results = [RunResult.for_run(run, [outcome], 0.0) for run in runs]
+    rows = campaign_rows(results, ["fast"])
+    assert {"interval_low_m", "interval_high_m"} <= set(rows[0])
+    (summary,) = interval_summaries(rows, ["azimuthal"], ["fast"])
+    # the interval [0.51, 0.53] m contains 0.52 only, of 0.5, 0.52 and 0.6
+    assert (summary.n_intervals, summary.n_covering) == (3, 1)
+    assert summary.median_width == pytest.approx(0.02, abs=ROUND_OFF)
+    assert summary.median_time_to_estimate == pytest.approx(0.2, abs=ROUND_OFF)
+
+
+def test_report_renders_a_method_with_intervals(tmp_path: Path) -> None:
+    # the toy "ratio" method here reports the fake estimate's interval and times, as ``fast``
+    # does (its name does not matter to the report, which only reads the stored fields)
+    def with_interval(run: RunSpec) -> RunResult:
+        paper = toy_run(run).methods[0]
+        extra = MethodOutcome.from_estimate("ratio", _FakeEstimate(), 0.01)
+        return RunResult.for_run(run, [paper, extra], simulate_s=0.0)
+
+    run_campaign(
+        spec(), tmp_path, run_one=with_interval, prepare_antenna=plain, workers=1, progress=False
+    )
+    text = build_report(tmp_path).read_text("utf-8")
+    assert "## Time to estimate and uncertainty" in text
+    # [0.51, 0.53] m contains none of the true points 0.3 and 0.5 m; 6 runs per case
+    assert "| azimuthal | ratio | 0.200 | 0/6 (0 %) | 2.00 |" in text
+    assert "| azimuthal | paper | - | - | - |" in text
+    header = (tmp_path / "runs.csv").read_text("utf-8").splitlines()[0].split(",")
+    assert "interval_low_m" in header and "interval_high_m" in header
