@@ -6,8 +6,9 @@ Usage::
 
 Prints a table and writes ``benchmarks/results/campaign.json``. The campaign runs into a fresh
 temporary directory (or ``--keep DIR``, which must not hold a finished campaign), so every run is
-simulated and estimated; the time is split into preparation (observer identification), the runs
-(wall clock, with the per-run simulate and estimate times summed over workers) and the report.
+simulated and estimated; the time is split into preparation (observer identification on the
+device, then the T_e calibration of Section 5.1: 15 simulated recordings, inline), the runs (wall
+clock, with the per-run simulate and estimate times summed over workers) and the report.
 """
 
 from __future__ import annotations
@@ -22,12 +23,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.report import build_report
 from sensing_antenna.campaign.runner import run_campaign
-from sensing_antenna.campaign.simulated import prepare_antenna
+from sensing_antenna.campaign.simulated import prepare_campaign
 from sensing_antenna.campaign.spec import CampaignSpec, load_campaign_spec
-from sensing_antenna.campaign.store import load_run_results
+from sensing_antenna.campaign.store import Preparation, load_run_results
 
 #: The target of the task: the default campaign in under 60 s on 2 cores.
 TARGET_S = 60.0
@@ -59,11 +59,15 @@ def main() -> int:
         out = args.keep or Path(tmp)
         prepared: dict[str, float] = {}
 
-        def timed_prepare(s: CampaignSpec) -> Antenna:
+        def timed_prepare(s: CampaignSpec) -> Preparation:
             begin = time.perf_counter()
-            antenna = prepare_antenna(s)
+            preparation = prepare_campaign(s)
             prepared["s"] = time.perf_counter() - begin
-            return antenna
+            if preparation.calibration is not None:
+                prepared["t_e"] = preparation.calibration.t_e
+                prepared["t_e_std_error"] = preparation.calibration.t_e_std_error
+                prepared["device_t"] = preparation.device.link.theoretical_t
+            return preparation
 
         start = time.perf_counter()
         outcome = run_campaign(
@@ -90,6 +94,10 @@ def main() -> int:
         "python": platform.python_version(),
         "wall_s": end - start,
         "prepare_s": prepare_s,
+        "calibration": {k: v for k, v in prepared.items() if k != "s"},
+        "n_calibration_recordings": spec.calibration.n_recordings
+        if spec.calibration.enabled
+        else 0,
         "runs_wall_s": runs_done - start - prepare_s,
         "report_s": end - runs_done,
         "target_s": TARGET_S,
@@ -104,7 +112,7 @@ def main() -> int:
     print(f"campaign {spec.name}: {outcome.n_runs} runs on {workers} workers")
     print(f"{'part':<28}{'seconds':>10}")
     print(f"{'total (wall)':<28}{record['wall_s']:>10.2f}")
-    print(f"{'  prepare (observer id.)':<28}{prepare_s:>10.2f}")
+    print(f"{'  prepare (id. + calib.)':<28}{prepare_s:>10.2f}")
     print(f"{'  runs (wall)':<28}{record['runs_wall_s']:>10.2f}")
     print(f"{'  report and figures':<28}{record['report_s']:>10.2f}")
     print(f"{'simulate, summed over runs':<28}{sum(simulate):>10.2f}")
@@ -112,6 +120,8 @@ def main() -> int:
         print(f"{'estimate ' + method + ', summed':<28}{sum(values):>10.2f}")
     print(f"target < {TARGET_S:.0f} s: {'met' if record['target_met'] else 'NOT met'}")
     print(f"failed runs: {outcome.n_failed}")
+    if "t_e" in prepared:
+        print(f"T_e = {prepared['t_e']:.5f} (device T = {prepared['device_t']:.5f})")
     print(RESULTS)
     return 0
 

@@ -34,6 +34,7 @@ _METHOD_STYLE = {
     "paper": {"color": "tab:blue", "marker": "o"},
     "ratio": {"color": "tab:orange", "marker": "s"},
     "two-frequency": {"color": "tab:green", "marker": "^"},
+    "fast": {"color": "tab:red", "marker": "D"},
 }
 
 
@@ -96,7 +97,10 @@ def plot_frequencies(
     grid = np.linspace(0.2 * link.length, link.length, 200)
     curve = np.asarray(natural_frequencies(link, grid, 1), dtype=float)[..., 0]
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    ax.plot(grid * _CM, curve, color="0.3", lw=1.5, label=f"sensing curve, T = {link.t_param:.4g}")
+    name = "T_e" if link.calibrated_t is not None else "T"
+    ax.plot(
+        grid * _CM, curve, color="0.3", lw=1.5, label=f"sensing curve, {name} = {link.t_param:.4g}"
+    )
     for case, marker in (("azimuthal", "o"), ("vertical", "x")):
         x, omega = _finite(rows, case, "paper", "omega1_rad_s")
         if x.size:
