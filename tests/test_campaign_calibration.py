@@ -234,3 +234,26 @@ def test_device_is_the_model_without_a_device_section() -> None:
     )
     device: Antenna = spec.load_device()
     assert device == spec.load_antenna()
+
+
+def test_a_failed_calibration_stops_the_campaign_with_one_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import dataclasses
+
+    from sensing_antenna.calibration import frequency
+    from sensing_antenna.campaign.spec import CampaignSpecError
+
+    def no_peaks(*args: object, **kwargs: object) -> FrequencyCalibration:
+        raise frequency.CalibrationError("omega1: need at least 2 measured frequencies, got 0")
+
+    monkeypatch.setattr(frequency, "calibrate_from_recordings", no_peaks)
+    spec = dataclasses.replace(
+        device_spec(True),
+        free_motion=FreeMotionStep(identify=False),
+        calibration=CalibrationStep(enabled=True, contact_points=(0.4, 0.6)),
+        source="cal.toml",
+    )
+    with pytest.raises(CampaignSpecError, match=r"cal\.toml: calibration: .*got 0"):
+        run_campaign(spec, tmp_path, workers=1, progress=False)
+    assert not (tmp_path / "runs").exists()

@@ -143,7 +143,7 @@ def calibrate_on_device(
     contact points are known by construction (a calibration), so they come from the spec, and the
     estimators never see the device's T.
     """
-    from sensing_antenna.calibration.frequency import calibrate_from_recordings
+    from sensing_antenna.calibration.frequency import CalibrationError, calibrate_from_recordings
     from sensing_antenna.simulator import simulate
 
     step = spec.calibration
@@ -153,7 +153,12 @@ def calibrate_on_device(
         recordings.append(simulate(device, scenario).without_ground_truth())
         names.append(name)
         points.append(x_c)
-    return calibrate_from_recordings(recordings, model, points, sources=names, loss=step.loss)
+    try:
+        return calibrate_from_recordings(recordings, model, points, sources=names, loss=step.loss)
+    except CalibrationError as exc:
+        raise CampaignSpecError(
+            "calibration", f"the calibration step failed: {exc}", spec.source or None
+        ) from exc
 
 
 def check_scenario(spec: CampaignSpec) -> None:
