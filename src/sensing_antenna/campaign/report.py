@@ -238,12 +238,12 @@ def _antenna_lines(model: Antenna, device: Antenna) -> list[str]:
         else f"theoretical T = {link.t_param:.4f} s/m^2"
     )
     lines = [
-        f"- Model (what the estimators know): {model.name}, E = {link.youngs_modulus / 1e9:.4g} "
+        f"- Model (what the estimators know): {model.name}, E = {link.youngs_modulus / 1e9:.5g} "
         f"GPa, rho = {link.linear_density:.4g} kg/m, I = {link.area_moment:.4g} m^4, "
         f"l = {link.length:g} m, theoretical T = {t_model:.4f} s/m^2; the frequency model uses "
         f"the {used}",
         f"- Device (the simulated hardware): {device.name}, E = "
-        f"{device.link.youngs_modulus / 1e9:.4g} GPa, T = {t_device:.4f} s/m^2"
+        f"{device.link.youngs_modulus / 1e9:.5g} GPa, T = {t_device:.4f} s/m^2"
         + (
             f"; differs from the model in {'; '.join(_differences(device, model))}"
             f" ([{DEVICE_FILE}]({DEVICE_FILE}))"
