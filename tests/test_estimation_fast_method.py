@@ -1,0 +1,173 @@
+"""Posterior over x_c (likelihood.py) and the stop-when-sure fast method (fast.py).
+
+Reference values: the paper link's sensing curve omega_1(x_c) (beam.SensingCurve, tested against
+an independent finite-element solution in tests/test_beam_fem.py) generates the synthetic
+measurements, so the true x_c is known by construction; the statics |Gamma| = x_c |R_perp|.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.fast import (
+    FastConfig,
+    FastConfigError,
+    FastMethod,
+    evaluate_window,
+    scan,
+)
+from sensing_antenna.estimation.fusion import sensing_curve
+from sensing_antenna.estimation.likelihood import contact_posterior
+from sensing_antenna.estimation.pipeline import search_band
+from sensing_antenna.estimation.static_fit import SensorBias
+
+TS = 1e-3
+LINK = paper_antenna().link
+X_RANGE = (0.2 * LINK.length, LINK.length)
+GRID = np.linspace(X_RANGE[0], X_RANGE[1], 3137)
+CURVE = sensing_curve(LINK)
+OMEGA_GRID = np.asarray(CURVE.omega1(GRID), dtype=float)
+EDGES = (X_RANGE[0], *CURVE.extrema, X_RANGE[1])
+
+
+def _posterior(omega: float, omega_se: float, ratio: float, ratio_se: float) -> object:
+    return contact_posterior(
+        OMEGA_GRID, GRID, EDGES, omega, omega_se, ratio, ratio_se, 0.05, 0.09, 0.0, 0.0
+    )
+
+
+def test_ratio_decides_the_branch() -> None:
+    # omega_1 of x_c = 0.95 m is also reached near 0.63 m (two branches of the sensing curve);
+    # a ratio of 0.95 +- 0.01 m puts essentially all the mass on the far branch (the near
+    # candidate is 32 ratio standard errors away).
+    omega = float(CURVE.omega1(0.95))
+    post = _posterior(omega, 0.1, 0.95, 0.01)
+    assert post.branch_probability[1] > 0.999
+    assert post.x_c == pytest.approx(0.95, abs=1e-3)
+    assert post.interval[0] <= 0.95 <= post.interval[1]
+
+
+def test_ambiguous_branches_share_the_mass_without_ratio() -> None:
+    # Without the ratio both candidates fit omega_1 equally well: each branch holds a share
+    # and the 95 % interval spans both (reported as one wide interval, never as sure).
+    omega = float(CURVE.omega1(0.95))
+    post = _posterior(omega, 0.1, math.nan, math.nan)
+    assert 0.2 < post.branch_probability[0] < 0.8
+    assert post.interval[0] < 0.7 and post.interval[1] > 0.9
+
+
+def test_interval_is_wide_near_the_peak_of_the_curve() -> None:
+    # Same omega_1 error: near the peak (0.77 m) the curve is flat and the interval is much
+    # wider than at 0.5 m where the slope is 141 rad/s per m.
+    for_x = {}
+    for x in (0.5, 0.765):
+        post = _posterior(float(CURVE.omega1(x)), 0.2, x, 0.03)
+        for_x[x] = post.width
+    assert for_x[0.765] > 4 * for_x[0.5]
+
+
+def test_interval_coverage_on_synthetic_measurements() -> None:
+    # Measurements drawn from the model itself with known standard errors: the 95 % HPD
+    # interval must hold the truth in 0.92..0.98 of 400 draws (binomial sd 0.011 about 0.95).
+    rng = np.random.default_rng(2024)
+    hits = 0
+    draws = 400
+    for _ in range(draws):
+        x = rng.uniform(0.3, 0.97)
+        omega_se, ratio_se = 0.3, 0.02
+        omega = float(CURVE.omega1(x)) + omega_se * rng.standard_normal()
+        ratio = x + ratio_se * rng.standard_normal()
+        post = _posterior(omega, omega_se, ratio, ratio_se)
+        hits += post.interval[0] <= x <= post.interval[1]
+    assert 0.92 <= hits / draws <= 0.98
+
+
+def _channels(x_c: float, n: int, rng: np.random.Generator, amplitude: float) -> np.ndarray:
+    """Contact loads of a push of 60 mN at x_c ringing at omega_1(x_c), with sensor noise."""
+    t = np.arange(n) * TS
+    omega = float(CURVE.omega1(x_c))
+    r_y = -0.06 * (1.0 + amplitude * np.exp(-0.5 * t) * np.cos(omega * t + 0.3))
+    zeros = np.zeros(n)
+    out = np.column_stack([r_y, zeros, zeros, zeros, x_c * r_y])
+    noise = np.array([6e-3, 6e-3, 3e-5, 3e-5, 3e-5])
+    return out + noise * rng.standard_normal((n, 5))
+
+
+NO_BIAS = SensorBias(np.zeros(5), np.zeros((5, 5)), 0)
+BAND = search_band(LINK, EstimatorConfig())
+
+
+def test_stop_when_sure_is_earlier_on_easy_cases() -> None:
+    # Easy: x_c = 0.6 m (64 rad/s, slope 229 rad/s per m). Hard: x_c = 0.3 m (28 rad/s, slope
+    # 61 rad/s per m): a slower vibration needs a longer record for the same x_c precision.
+    rng = np.random.default_rng(8)
+    cfg = FastConfig()
+    delays = {}
+    for x in (0.6, 0.3):
+        channels = _channels(x, 700, rng, 0.2)
+        result = scan(channels, NO_BIAS, 0, 699, TS, BAND, LINK, X_RANGE, cfg)
+        assert result.final is not None and result.final.sure
+        post = result.final.posterior
+        assert post.width <= cfg.tolerance
+        assert abs(post.x_c - x) <= cfg.tolerance
+        delays[x] = result.final.end_index * TS
+    assert delays[0.6] < delays[0.3]
+    assert delays[0.6] <= 0.25
+
+
+def test_unsure_until_the_cap_near_the_peak() -> None:
+    # At 0.77 m omega_1 hardly depends on x_c and a ratio with 1 cm error cannot reach 5 mm:
+    # the scan must run to the cap and say so, not declare.
+    rng = np.random.default_rng(9)
+    cfg = FastConfig(cap=0.3)
+    channels = _channels(0.77, 400, rng, 0.2)
+    result = scan(channels, NO_BIAS, 0, 399, TS, BAND, LINK, X_RANGE, cfg)
+    assert result.reached_cap
+    assert result.final is not None and not result.final.sure
+
+
+def test_window_shorter_than_the_model_is_not_sure() -> None:
+    rng = np.random.default_rng(10)
+    channels = _channels(0.6, 40, rng, 0.2)
+    window = evaluate_window(channels, NO_BIAS, 0, 30, TS, BAND, LINK, X_RANGE, FastConfig())
+    assert not window.sure
+    assert window.note
+
+
+def test_config_errors_name_the_field() -> None:
+    with pytest.raises(FastConfigError, match="tolerance"):
+        FastConfig(tolerance=-1.0)
+    with pytest.raises(FastConfigError, match="max_modes"):
+        FastConfig(max_modes=0)
+    with pytest.raises(FastConfigError, match="first_window"):
+        FastConfig(first_window=1.0, cap=0.5)
+
+
+def test_offline_and_online_agree_on_a_simulated_recording() -> None:
+    # The pipeline's batch and streaming forms hand the same samples to the method; the fast
+    # method only reads samples up to its own declaration, so both give identical estimates.
+    simulator = pytest.importorskip("sensing_antenna.simulator")
+    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
+
+    antenna = paper_antenna()
+    recording = simulator.simulate(
+        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
+    )
+    offline = estimate(recording, antenna, FastMethod())
+    online = OnlineEstimator(antenna, recording.sample_period, FastMethod())
+    for k in range(recording.t.shape[0]):
+        online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
+    streamed = online.finalize()
+    assert streamed.status == offline.status
+    assert streamed.x_c == offline.x_c
+    assert streamed.t_e == offline.t_e
+    # Reference: the simulator's contact point (0.6 m nominal, the contact moves < 3 mm as the
+    # link bends); the fast estimate must be within the tolerance and well before the paper's
+    # 1 s spectrum window.
+    assert offline.x_c == pytest.approx(0.6, abs=0.008)
+    assert offline.t_e - offline.t_1 < 0.5
