@@ -18,6 +18,7 @@ from sensing_antenna.estimation.contact import (
     free_motion_torque,
 )
 from sensing_antenna.recording import Recording
+from sensing_antenna.simulator import Scenario, simulate
 
 TS = 1e-3  # s, Section 5
 ANTENNA = paper_antenna()
@@ -236,11 +237,9 @@ def test_update_accepts_plain_sequences() -> None:
 
 
 def test_simulated_contact_is_detected_after_the_true_touch() -> None:
-    # The project's simulator as an independent source (skipped while it is not available).
+    # The project's simulator as an independent source.
     # Ground truth is read here only to evaluate; the detector sees the stripped recording.
-    run = pytest.importorskip("sensing_antenna.simulator.run")
-    scenario = pytest.importorskip("sensing_antenna.simulator.scenario")
-    rec = run.simulate(ANTENNA, scenario.Scenario(case="azimuthal", contact_point=0.6, seed=2))
+    rec = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=0.6, seed=2))
     true_touch = float(rec.metadata["true_t_contact"])
     result = detect_contact(rec.without_ground_truth(), ANTENNA)
     assert result.t_c is not None

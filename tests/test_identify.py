@@ -18,6 +18,7 @@ from sensing_antenna.calibration.observer import (
 from sensing_antenna.cli import main
 from sensing_antenna.estimation.contact import detect_contact
 from sensing_antenna.recording import Recording, write_recording
+from sensing_antenna.simulator import Scenario, simulate
 
 TS = 1e-3  # s
 ANTENNA = paper_antenna()
@@ -156,10 +157,8 @@ def test_cli_bad_file_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]
 
 def test_end_to_end_on_simulated_free_motion() -> None:
     # The project's simulator (FE link, servo motors, sensor noise) as an independent source of
-    # free motion; skipped while the simulator package is not available.
-    run = pytest.importorskip("sensing_antenna.simulator.run")
-    scenario = pytest.importorskip("sensing_antenna.simulator.scenario")
-    rec = run.simulate(ANTENNA, scenario.Scenario(case="free", duration=3.0, seed=1))
+    # free motion.
+    rec = simulate(ANTENNA, Scenario(case="free", duration=3.0, seed=1))
     rec = rec.without_ground_truth()
     fit = identify_free_motion(rec, ANTENNA)
     # Clamped-free first mode 1.8751^2 / (T l^2) = 16.05 rad/s for the paper's link; tolerance 2 %
@@ -171,3 +170,12 @@ def test_end_to_end_on_simulated_free_motion() -> None:
     assert fit.gain / fit.natural_frequency**2 == pytest.approx(inertia, rel=0.05)
     # With the observer signs of contact.py, the paper's observer gives no false contact.
     assert detect_contact(rec, ANTENNA).status == "no_contact"
+
+
+def test_contact_recording_is_refused() -> None:
+    # A recording with a contact: the static contact torque cannot be followed by the high-pass
+    # observer of Eq. 15, so identification must refuse it rather than return a threshold
+    # (on this recording an unchecked fit gives ~0.06 N m, three times the paper's 0.02).
+    rec = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=0.6, seed=3))
+    with pytest.raises(IdentificationError, match="really free motion"):
+        identify_free_motion(rec.without_ground_truth(), ANTENNA)

@@ -201,7 +201,7 @@ class FreeMotionObserver:
     Parameters
     ----------
     gain : float
-        Numerator gain (N m s^2 / rad).
+        Numerator gain K (N m / rad; K / omega^2 is the effective inertia, kg m^2).
     natural_frequency : float
         omega, the free-motion first-mode frequency (rad/s).
     damping : float
@@ -354,7 +354,13 @@ def load_antenna(spec: str | Path | None = None) -> Antenna:
             f"no such file, and not a built-in set ({', '.join(BUILTIN_ANTENNAS)})",
             source,
         )
-    data = _parse_toml(path.read_text("utf-8"), source)
+    try:
+        text = path.read_text("utf-8")
+    except UnicodeDecodeError as exc:
+        raise AntennaConfigError("file", f"not UTF-8 text ({exc.reason})", source) from exc
+    except OSError as exc:
+        raise AntennaConfigError("file", f"cannot be read ({exc.strerror or exc})", source) from exc
+    data = _parse_toml(text, source)
     base_name = data.get("base")
     if base_name is not None:
         if not isinstance(base_name, str) or base_name not in BUILTIN_ANTENNAS:
@@ -362,6 +368,9 @@ def load_antenna(spec: str | Path | None = None) -> Antenna:
                 "base", f"must name a built-in set ({', '.join(BUILTIN_ANTENNAS)})", source
             )
         base = _parse_toml(_builtin_text(base_name), base_name)
+        # A variant without its own name is named after its file, never after its base.
+        base["name"] = path.stem
+        base.pop("description", None)
         data = _merge(base, {k: v for k, v in data.items() if k != "base"})
     return _build(data, source)
 

@@ -2,7 +2,8 @@
 
 Each command lives in its own module exposing ``register(subparsers)``; the module sets
 ``func`` on its parser, a callable ``(args) -> int`` returning the exit code. Errors derived from
-:class:`~sensing_antenna.errors.SensingAntennaError` are printed as one line, exit code 2.
+:class:`~sensing_antenna.errors.SensingAntennaError`, and operating-system errors such as an
+unwritable output path, are printed as one line, exit code 2.
 """
 
 from __future__ import annotations
@@ -44,13 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
         dest="command", metavar="COMMAND", parser_class=OneLineParser
     )
     for name in COMMAND_MODULES:
-        try:
-            module = importlib.import_module(f"sensing_antenna.cli.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"sensing_antenna.cli.{name}":
-                continue  # command not built yet
-            raise
-        module.register(subparsers)
+        importlib.import_module(f"sensing_antenna.cli.{name}").register(subparsers)
     return parser
 
 
@@ -65,6 +60,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.func(args))
     except SensingAntennaError as exc:
         print(f"antenna {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # unwritable output, missing directory, disk full, ...
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"antenna {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # pragma: no cover - e.g. piping into head
         return 0

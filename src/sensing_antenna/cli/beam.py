@@ -51,9 +51,14 @@ def run(args: argparse.Namespace) -> int:
     return _contact_points(antenna.link, args.omega1, args.json)
 
 
+#: Largest --modes accepted: beyond a few dozen modes Euler-Bernoulli theory (no shear, no
+#: rotary inertia; Assumption 3 of the paper) no longer describes a real link.
+MAX_MODES = 50
+
+
 def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bool) -> int:
-    if modes < 1:
-        raise BeamInputError("--modes", f"must be an integer >= 1, got {modes}")
+    if not 1 <= modes <= MAX_MODES:
+        raise BeamInputError("--modes", f"must be an integer from 1 to {MAX_MODES}, got {modes}")
     omega = natural_frequencies(link, x_c, modes)
     hz = omega / (2.0 * math.pi)
     if as_json:
@@ -72,6 +77,8 @@ def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bo
 
 
 def _contact_points(link: Any, omega1: float, as_json: bool) -> int:
+    if not (math.isfinite(omega1) and omega1 > 0):
+        raise BeamInputError("--omega1", f"must be a finite frequency > 0 rad/s, got {omega1}")
     curve = SensingCurve.from_link(link)
     candidates = curve.contact_points(omega1)
     low, high = curve.omega1_range()

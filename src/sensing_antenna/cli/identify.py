@@ -40,7 +40,7 @@ def _run(args: argparse.Namespace) -> int:
     save_antenna(replace(antenna, observer=fit.observer), args.out)
     joints = ", ".join(f"theta{j}" for j in fit.joints)
     print(
-        f"gain = {fit.gain:.5g} N m s^2/rad, natural_frequency = {fit.natural_frequency:.5g} "
+        f"gain = {fit.gain:.5g} N m/rad, natural_frequency = {fit.natural_frequency:.5g} "
         f"rad/s ({fit.natural_frequency / (2 * math.pi):.4g} Hz), "
         f"damping = {fit.damping:.4g} 1/s (zeta = {fit.damping_ratio:.3g})"
     )

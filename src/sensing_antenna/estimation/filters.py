@@ -92,7 +92,7 @@ def observer_coefficients(
     Parameters
     ----------
     observer : FreeMotionObserver
-        Gain K (N m s^2 / rad), natural frequency omega (rad/s), damping d (1/s).
+        Gain K (N m / rad), natural frequency omega (rad/s), damping d (1/s).
     sample_period : float
         T_s (s); omega T_s must be below pi.
 

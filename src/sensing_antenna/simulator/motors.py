@@ -40,7 +40,7 @@ class ServoDesign:
     b : float
         Controller pole location (R denominator s (s + b)) (rad/s).
     feedback : tuple of 3 float
-        (a2, a1, a0) of R2 (N m s^2/rad, N m s/rad, N m/rad).
+        (a2, a1, a0) of R2 (N m/rad, N m/(rad s), N m/(rad s^2)).
     feedforward : tuple of 3 float
         (a2, a1, a0) of R1 = J p^2 (s - p)^2 / (s (s + b)).
     sample_period : float
