@@ -54,7 +54,7 @@ def run_one(case: str, x_c: float, seed: int, noise: float) -> list[dict[str, An
         if math.isfinite(result.t_1):
             i1 = round((result.t_1 - recording.t[0]) / recording.sample_period)
             truth = float(np.mean(detail.contact_abscissa[i1 : i1 + 500]))
-        interval = result.diagnostics.get("interval") if name == "fast" else None
+        interval = result.interval
         rows.append(
             {
                 "method": name,
@@ -68,7 +68,7 @@ def run_one(case: str, x_c: float, seed: int, noise: float) -> list[dict[str, An
                 "status": result.status.value,
                 "delay": result.t_e - result.t_1,
                 "interval": list(interval) if interval is not None else None,
-                "branch_probability": result.diagnostics.get("branch_probability"),
+                "branch_probability": result.branch_probability,
                 "cpu": elapsed,
             }
         )

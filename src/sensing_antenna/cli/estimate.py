@@ -21,7 +21,14 @@ def register(subparsers: Any) -> None:
         "--method",
         choices=sorted(METHODS),
         default="paper",
-        help="paper (Section 4, default), or a baseline for comparison",
+        help="paper (Section 4, default), fast (short record, stops when sure), or a baseline",
+    )
+    parser.add_argument(
+        "--tolerance",
+        type=float,
+        default=None,
+        help="fast method: declare when the 95 %% interval of x_c is narrower than this (m, "
+        "default 0.005)",
     )
     parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -33,15 +40,27 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.estimation.pipeline import estimate
     from sensing_antenna.recording import read_recording
 
+    method: Any = args.method
+    if args.tolerance is not None:
+        method = _fast_with_tolerance(args.method, args.tolerance)
     antenna = load_antenna(args.antenna)
     recording = read_recording(args.recording)
-    result = estimate(recording, antenna, method=args.method)
+    result = estimate(recording, antenna, method=method)
     if args.json:
         data = {"recording": str(args.recording), **result.to_dict()}
         print(json.dumps(data, allow_nan=False))
     else:
         print(summary(str(args.recording), result.to_dict()))
     return 0
+
+
+def _fast_with_tolerance(method: str, tolerance: float) -> Any:
+    from sensing_antenna.errors import SensingAntennaError
+    from sensing_antenna.estimation.fast import FastConfig, FastMethod
+
+    if method != "fast":
+        raise SensingAntennaError(f"--tolerance: only used by --method fast, not {method!r}")
+    return FastMethod(FastConfig(tolerance=tolerance))
 
 
 def _cm(value: Any) -> str:
@@ -70,4 +89,10 @@ def summary(name: str, data: dict[str, Any]) -> str:
         f"  t_c, t_1, t_e   {_s(data['t_c'])}, {_s(data['t_1'])}, {_s(data['t_e'])}",
         f"  contact point   {point_text} (absolute frame)",
     ]
+    interval = data.get("interval")
+    if interval is not None:
+        lines.append(f"  95 % interval   {_cm(interval[0])} to {_cm(interval[1])}")
+    probability = data.get("branch_probability")
+    if probability:
+        lines.append("  branch prob.    " + ", ".join(f"{p:.3f}" for p in probability))
     return "\n".join(lines)

@@ -53,7 +53,6 @@ __all__ = [
     "WindowEstimate",
     "evaluate_window",
     "scan",
-    "uncertain_status",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -164,19 +163,6 @@ class FastConfig:
                 raise FastConfigError(f"{f.name}: must be > 0, got {value!r}")
         if self.first_window > self.cap:
             raise FastConfigError("first_window: must not exceed cap")
-
-
-def uncertain_status() -> Status:
-    """``Status.UNCERTAIN`` when the result module has it, else the nearest existing status.
-
-    The fast method reports ``uncertain`` when its interval never became narrow enough; until
-    ``uncertain`` is part of :class:`Status` the estimate carries ``estimators_disagree`` with a
-    reason that starts with "uncertain".
-    """
-    try:
-        return Status("uncertain")
-    except ValueError:
-        return Status.ESTIMATORS_DISAGREE
 
 
 @dataclass(frozen=True)
@@ -388,16 +374,16 @@ def scan(
 class FastMethod:
     """The fast method as a pipeline method: ``estimate(recording, antenna, FastMethod())``.
 
-    The pipeline hands over the samples up to its own t_e; this method searches them from t_1
-    on and declares at its own, earlier instant (reported as ``t_e``), using only the samples up
-    to that instant.
+    Offline the pipeline hands over the samples up to its own t_e; this method searches them
+    from t_1 on and declares at its own, earlier instant (reported as ``t_e``), using only the
+    samples up to that instant. Online the pipeline asks :meth:`due` after every sample and, on
+    the cadence grid, :meth:`ready`; it concludes at the first ready sample, the same one.
     """
 
     config: FastConfig = field(default_factory=FastConfig)
     name: str = "fast"
 
-    def conclude(self, evidence: Evidence) -> ContactEstimate:
-        """Scan the evidence from t_1 and give the first sure estimate (or the capped one)."""
+    def _prepare(self, evidence: Evidence) -> tuple[FloatArray, SensorBias, tuple[float, float]]:
         link = evidence.antenna.link
         channels = contact_channels(
             evidence.theta, evidence.force, evidence.torque, evidence.antenna
@@ -414,6 +400,36 @@ class FastMethod:
             evidence.config.contact_range[0] * link.length,
             evidence.config.contact_range[1] * link.length,
         )
+        return channels, bias, x_range
+
+    def due(self, samples_since_t1: int, sample_period: float) -> bool:
+        """Whether the online form should evaluate after this sample (the cadence grid)."""
+        first, step, last = evaluation_indices(0, sample_period, self.config)
+        k = samples_since_t1
+        return first <= k <= last and (k - first) % step == 0
+
+    def ready(self, evidence: Evidence) -> bool:
+        """Whether the window ending at ``evidence.end_index`` is sure or at the cap."""
+        channels, bias, x_range = self._prepare(evidence)
+        _, _, last = evaluation_indices(evidence.rest_index, evidence.sample_period, self.config)
+        if evidence.end_index >= last:
+            return True
+        window = evaluate_window(
+            channels,
+            bias,
+            evidence.rest_index,
+            evidence.end_index,
+            evidence.sample_period,
+            evidence.band,
+            evidence.antenna.link,
+            x_range,
+            self.config,
+        )
+        return window.sure
+
+    def conclude(self, evidence: Evidence) -> ContactEstimate:
+        """Scan the evidence from t_1 and give the first sure estimate (or the capped one)."""
+        channels, bias, x_range = self._prepare(evidence)
         result = scan(
             channels,
             bias,
@@ -421,7 +437,7 @@ class FastMethod:
             evidence.end_index,
             evidence.sample_period,
             evidence.band,
-            link,
+            evidence.antenna.link,
             x_range,
             self.config,
         )
@@ -443,7 +459,7 @@ def _problems(
         if result.reached_cap:
             found.append(
                 (
-                    uncertain_status(),
+                    Status.UNCERTAIN,
                     f"uncertain: not sure within {config.cap:g} s after t_1 ({final.note})",
                 )
             )
@@ -535,11 +551,9 @@ def conclude_fast(
     branch_of = [post.branch_of(c) for c in candidates]
     diag.update(
         {
-            "interval": post.interval,
             "interval_width": post.width,
             "branch_edges": post.branch_edges,
             "branch_probability_by_branch": post.branch_probability,
-            "branch_probability": [post.branch_probability[b] for b in branch_of],
             "omega1_se": final.omega1_se,
             "ratio_se": statics.standard_error if statics is not None else math.nan,
             "model_order": final.fit.n_modes if final.fit is not None else 0,
@@ -563,4 +577,6 @@ def conclude_fast(
         t_e=float(t[final.end_index]),
         contact_point=touch.point_a,
         diagnostics=diag,
+        interval=post.interval,
+        branch_probability=tuple(post.branch_probability[b] for b in branch_of),
     )

@@ -10,9 +10,13 @@ Front end (shared by every method, causal, so both forms reach the same indices)
 4. t_e = t_1 + max(Delta t_e1, Delta t_e2) (Section 4, step 6).
 
 At t_e the samples up to t_e are handed, as :class:`~.fusion.Evidence`, to the method, which
-returns a :class:`~.result.ContactEstimate`. Methods are looked up by name in :data:`METHODS`;
-a new method is an object with a ``name`` and ``conclude(evidence)``, added to
-``_BUILTIN_METHODS``; the command line lists whatever :data:`METHODS` holds.
+returns a :class:`~.result.ContactEstimate`. A method that can stop earlier (``fast``) also has
+``due(samples_since_t1, sample_period)`` (cheap, is this an evaluation instant?) and
+``ready(evidence)``; the online form asks it on its cadence and concludes at the first ready
+sample, the offline form lets the method find that same sample in the longer evidence. Methods
+are looked up by name in :data:`METHODS`; a new method is an object with a ``name`` and
+``conclude(evidence)``, added to ``_BUILTIN_METHODS``; the command line lists whatever
+:data:`METHODS` holds.
 
 The online form keeps only cheap per-sample state (detector, Eq. 20 filters, two sliding-window
 tests) and, at t_e, calls the very function the offline form calls on the same samples.
@@ -41,6 +45,7 @@ from sensing_antenna.estimation.contact_frame import (
     rest_tolerance,
     signal_noise,
 )
+from sensing_antenna.estimation.fast import FastMethod
 from sensing_antenna.estimation.filters import FirstOrderLowPass
 from sensing_antenna.estimation.frequency import FrequencyMeasurement, measure_frequency
 from sensing_antenna.estimation.fusion import Evidence, PaperMethod, sensing_curve
@@ -86,6 +91,7 @@ _BUILTIN_METHODS: tuple[EstimationMethod, ...] = (
     PaperMethod(),
     RatioMethod(),
     TwoFrequencyMethod(),
+    FastMethod(),
 )
 
 #: Available methods by name (read-only).
@@ -318,7 +324,7 @@ def estimate(
     antenna : Antenna
         Link, observer and (calibrated) T of the sensing curve.
     method : str or EstimationMethod
-        A key of :data:`METHODS` (``"paper"``, ``"ratio"``, ``"two-frequency"``).
+        A key of :data:`METHODS` (``"paper"``, ``"ratio"``, ``"two-frequency"``, ``"fast"``).
     config : EstimatorConfig, optional
         Defaults to ``EstimatorConfig()``.
 
@@ -618,6 +624,13 @@ class OnlineEstimator:
                 self._planned = _planned_end(rest, None, self.config, self.sample_period)
         if self._planned is not None and j >= self._planned:
             return self._emit(self._conclude(complete=True))
+        # A method that can stop early (``fast``) is asked on its own cadence, causally
+        due = getattr(self.method, "due", None)
+        if due is not None and due(j - rest, self.sample_period):
+            evidence = self._evidence_now(complete=True)
+            ready = getattr(self.method, "ready", None)
+            if not isinstance(evidence, str) and ready is not None and ready(evidence):
+                return self._emit(self.method.conclude(evidence))
         return None
 
     def _diagnostics(self) -> dict[str, Any]:
@@ -637,10 +650,9 @@ class OnlineEstimator:
         self._done = True
         return result
 
-    def _conclude(self, complete: bool) -> ContactEstimate:
+    def _evidence_now(self, complete: bool) -> Evidence | str:
         assert self._contact is not None and self._rest is not None
-        end = self._n - 1
-        evidence = _evidence(
+        return _evidence(
             self._t,
             self._theta,
             self._force,
@@ -652,10 +664,14 @@ class OnlineEstimator:
             self._contact,
             self._rest,
             self._converged,
-            end,
+            self._n - 1,
             complete,
             self._diagnostics(),
         )
+
+    def _conclude(self, complete: bool) -> ContactEstimate:
+        assert self._contact is not None and self._rest is not None
+        evidence = self._evidence_now(complete)
         if isinstance(evidence, str):
             return _early(
                 Status.PUSH_NOT_REACHED,

@@ -37,6 +37,9 @@ class Status(str, enum.Enum):
     SLIP_SUSPECTED = "slip_suspected"
     #: The samples cannot be used at all (sampling too coarse, dead sensor channels, ...).
     BAD_INPUT = "bad_input"
+    #: The method's interval never became narrower than the requested tolerance before its cap
+    #: (``fast`` method); x_c is the best estimate at the cap.
+    UNCERTAIN = "uncertain"
 
     def __str__(self) -> str:
         return self.value
@@ -51,6 +54,7 @@ STATUS_PRECEDENCE: tuple[Status, ...] = (
     Status.SLIP_SUSPECTED,
     Status.NO_CLEAR_PEAK,
     Status.ESTIMATORS_DISAGREE,
+    Status.UNCERTAIN,
     Status.OK,
 )
 
@@ -105,6 +109,11 @@ class ContactEstimate:
         Instant the estimate became available (s); NaN if never.
     contact_point : numpy.ndarray
         Touched point in the absolute frame, shape (3,) (m); NaN if unknown.
+    interval : tuple of float or None
+        95 % interval (low, high) of x_c (m) from methods that give one (``fast``), else None.
+    branch_probability : tuple of float or None
+        Posterior probability of each candidate's branch of the sensing curve, aligned with
+        ``candidates``, from methods that give one (``fast``), else None.
     diagnostics : Mapping
         Everything else worth knowing (sampling report, torque component used, frame axes, ...).
     """
@@ -122,6 +131,8 @@ class ContactEstimate:
     t_e: float = math.nan
     contact_point: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
     diagnostics: Mapping[str, Any] = field(default_factory=dict)
+    interval: tuple[float, float] | None = None
+    branch_probability: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "status", Status(self.status))
@@ -154,5 +165,7 @@ class ContactEstimate:
             "t_1": _json_value(self.t_1),
             "t_e": _json_value(self.t_e),
             "contact_point": _json_value(self.contact_point),
+            "interval": _json_value(self.interval),
+            "branch_probability": _json_value(self.branch_probability),
             "diagnostics": _json_value(self.diagnostics),
         }
