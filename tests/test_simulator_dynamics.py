@@ -13,7 +13,7 @@ from scipy import optimize, signal
 from _simulator_helpers import dominant_frequency
 from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.simulator import Scenario, simulate_detailed
-from sensing_antenna.simulator.integrator import CONTACT_STATE_SIZE, P, run_samples
+from sensing_antenna.simulator.integrator import CONTACT_STATE_SIZE, TRUTH_COLUMNS, P, run_samples
 from sensing_antenna.simulator.link import build_link_model
 from sensing_antenna.simulator.motors import design_servo
 
@@ -192,7 +192,7 @@ def _run_free_hub(n_el: int, step: float, n_samples: int) -> tuple[np.ndarray, l
         np.zeros(6),
         out_theta,
         np.zeros((n_samples, 6)),
-        np.zeros((n_samples, 10)),
+        np.zeros((n_samples, TRUTH_COLUMNS)),
     )
     return out_theta, [e0, energy()]
 

@@ -64,7 +64,7 @@ __all__ = [
 ]
 
 #: Default head rotation past t_c (rad): y_c / x_c stays near 3 % (module docstring).
-DEFAULT_ROTATION = 0.03
+DEFAULT_ROTATION = 0.02
 
 PushKind = Literal["rotation", "force", "torque"]
 _KINDS = ("rotation", "force", "torque")

@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-__all__ = ["P", "run_samples", "sensor_wrench"]
+__all__ = ["TRUTH_COLUMNS", "P", "run_samples", "sensor_wrench"]
 
 
 class P:
@@ -103,6 +103,11 @@ _POINT_M = 9  # 3 values, contact point, motor frame
 _FIRST_TOUCH = 12
 _NORMAL_FORCE = 13
 CONTACT_STATE_SIZE = 14
+
+#: Columns of the ground-truth array written by :func:`run_samples`: true angles (2), contact
+#: flag, x_c, contact point in the absolute frame (3), normal force, motor voltages (2), contact
+#: force on the link in the motor frame (3), stick flag.
+TRUTH_COLUMNS = 14
 
 
 @njit(cache=True)
@@ -367,8 +372,9 @@ def run_samples(
     """Advance samples k0..k1-1: sense at t_k, command the motors, integrate to t_{k+1}.
 
     Writes the measured angles (n, 2) and wrench (n, 6) of each sample and the ground truth
-    (n, 9): true angles (2), contact flag, x_c, contact point in the absolute frame (3), normal
-    force, motor voltage of the swept joint... (see run.py for the columns).
+    (n, TRUTH_COLUMNS): true angles (2), contact flag, x_c, contact point in the absolute frame
+    (3), normal force, motor voltages (2), contact force on the link in the motor frame (3) and
+    the stick flag (1 sticking, 0 slipping or no contact).
     """
     n = mass_m.shape[0]
     nn = 2 * n + 2
@@ -410,6 +416,9 @@ def run_samples(
                 cs[_POINT_M] * fr[0, i] + cs[_POINT_M + 1] * fr[1, i] + cs[_POINT_M + 2] * fr[2, i]
             )
         truth[k, 7] = cs[_NORMAL_FORCE]
+        for i in range(3):
+            truth[k, 10 + i] = cs[_FORCE_M + i]
+        truth[k, 13] = cs[_STICK]
         # --- servo command (Sec. 4.1, Fig. 7): 2-DOF PID plus measured coupling torque -----------
         c2m = math.cos(meas_theta[k, 1])
         s2m_ = math.sin(meas_theta[k, 1])

@@ -21,13 +21,29 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link, antenna_to_toml
 from sensing_antenna.recording import FORMAT_NAME, Recording
 from sensing_antenna.simulator.contact import Obstacle, place_obstacle
-from sensing_antenna.simulator.integrator import CONTACT_STATE_SIZE, P, run_samples
+from sensing_antenna.simulator.integrator import (
+    CONTACT_STATE_SIZE,
+    TRUTH_COLUMNS,
+    P,
+    run_samples,
+)
 from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
 from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
 from sensing_antenna.simulator.motors import design_servo
-from sensing_antenna.simulator.scenario import Scenario
+from sensing_antenna.simulator.scenario import Scenario, ScenarioError
 
-__all__ = ["SAMPLE_PERIOD", "SimulationDetail", "StopRule", "simulate", "simulate_detailed"]
+__all__ = [
+    "FINAL_AVERAGE_TIME",
+    "MIN_STIFFNESS_RATIO",
+    "SAMPLE_PERIOD",
+    "SMALL_DEFLECTION_LIMIT",
+    "SimulationDetail",
+    "StopRule",
+    "deflection_warning",
+    "minimum_contact_point",
+    "simulate",
+    "simulate_detailed",
+]
 
 #: Sampling and control period T_s of the paper's device (s).
 SAMPLE_PERIOD = 1e-3
@@ -37,6 +53,16 @@ FRICTION_SPEED = 0.05
 
 #: Contact search starts this fraction of l away from the clamp.
 CONTACT_SEARCH_START = 0.02
+
+#: Assumption 1 of the paper: the deflection y_c / x_c stays below 10 %.
+SMALL_DEFLECTION_LIMIT = 0.1
+
+#: The final deflection is averaged over this last part of the recording (s).
+FINAL_AVERAGE_TIME = 0.5
+
+#: The penalty contact must be at least this many times stiffer than the link's local stiffness
+#: 3 E I / x_c^3, or it is no support at all (docs/simulator.md, "Smallest contact point").
+MIN_STIFFNESS_RATIO = 10.0
 
 
 class StopRule(Protocol):
@@ -63,6 +89,13 @@ class SimulationDetail:
         Contact point, absolute frame (m).
     normal_force : ndarray, shape (n,)
         Normal contact force (N).
+    contact_force : ndarray, shape (n, 3)
+        Contact force exerted by the obstacle on the link, motor frame (N); zero without contact.
+    sticking : ndarray of bool, shape (n,)
+        True while the contact sticks, False while it slips or there is no contact.
+    contact_deflection : ndarray, shape (n,)
+        Deflection of the link at the contact point, |(v, w - w_g)(x_c)| with w_g the static
+        gravity sag at the current theta2 (m); NaN without contact.
     voltage : ndarray, shape (n, 2)
         Motor input voltages u_i (V).
     stop_index : int or None
@@ -79,6 +112,9 @@ class SimulationDetail:
     contact_abscissa: NDArray[np.float64]
     contact_point: NDArray[np.float64]
     normal_force: NDArray[np.float64]
+    contact_force: NDArray[np.float64]
+    sticking: NDArray[np.bool_]
+    contact_deflection: NDArray[np.float64]
     voltage: NDArray[np.float64]
     stop_index: int | None
     obstacle: Obstacle | None
@@ -94,6 +130,67 @@ def _link_setup(link: Link, n_elements: int) -> tuple[LinkModel, float, float]:
     grid = np.linspace(0.3, 1.0, 15) * link.length
     omega_contact = max(float(model.pinned_frequencies(x, 1)[0]) for x in grid)
     return model, omega_free, omega_contact
+
+
+@lru_cache(maxsize=16)
+def _unit_sag(link: Link, n_elements: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Static sag of the link under 1 m/s^2 of transverse gravity on a grid of abscissae.
+
+    Returns (x, w): the grid (m), shape (401,), and the FE deflection there (m per m/s^2),
+    negative (the load points along -Z^m). Linear interpolation on this 2.5 mm grid is exact to
+    < 1e-7 m for the paper link.
+    """
+    model, _, _ = _link_setup(link, n_elements)
+    q = np.linalg.solve(model.stiffness, -model.translation_load)
+    x = np.linspace(0.0, link.length, 401)
+    w = np.array([float(model.shape_at(float(xi)) @ q) for xi in x])
+    return x, w
+
+
+def minimum_contact_point(link: Link, contact_stiffness: float) -> float:
+    """Smallest x_c (m) the simulator accepts: where ``contact_stiffness`` (N/m) is
+    ``MIN_STIFFNESS_RATIO`` times the link's local stiffness 3 E I / x_c^3.
+
+    Below it the penalty contact no longer acts as a support (the link's own stiffness is
+    comparable with the penalty), and the push forces 3 E I y_c / x_c^3 grow past the range of
+    a small force sensor (paper link, default 1e4 N/m: x_c >= 0.065 m, where y_c / x_c = 3 %
+    takes 1.9 N; at 0.02 m it would take 20 N).
+    """
+    ratio = MIN_STIFFNESS_RATIO * 3.0 * link.flexural_rigidity / contact_stiffness
+    return float(ratio ** (1.0 / 3.0))
+
+
+def _contact_deflection(
+    link: Link, n_elements: int, truth: NDArray[np.float64], gravity: float
+) -> NDArray[np.float64]:
+    """|(v, w - w_g)| at the contact point of each sample (m), NaN without contact."""
+    theta1, theta2 = truth[:, 0], truth[:, 1]
+    c1, s1, c2, s2 = np.cos(theta1), np.sin(theta1), np.cos(theta2), np.sin(theta2)
+    point = truth[:, 4:7]
+    # motor frame (recording format): Y^m = (-s1, c1, 0), Z^m = (-s2 c1, -s2 s1, c2)
+    v = -s1 * point[:, 0] + c1 * point[:, 1]
+    w = -s2 * c1 * point[:, 0] - s2 * s1 * point[:, 1] + c2 * point[:, 2]
+    grid, unit = _unit_sag(link, n_elements)
+    sag = gravity * c2 * np.interp(truth[:, 3], grid, unit)
+    deflection = np.hypot(v, w - sag)
+    return np.where(truth[:, 2] > 0.5, deflection, np.nan)
+
+
+def deflection_warning(recording: Recording) -> str | None:
+    """A one-line warning when the recording's ``true_deflection_ratio`` exceeds
+    ``SMALL_DEFLECTION_LIMIT`` (Assumption 1), else None (also when the key is absent)."""
+    text = recording.metadata.get("true_deflection_ratio")
+    if text is None:
+        return None
+    ratio = float(text)
+    if not ratio > SMALL_DEFLECTION_LIMIT:
+        return None
+    return (
+        f"warning: final contact deflection y_c / x_c = {100 * ratio:.1f} % exceeds the"
+        f" {100 * SMALL_DEFLECTION_LIMIT:.0f} % small-deflection limit (Assumption 1): the"
+        " contact was detected late; identify the device's observer and contact threshold"
+        " (antenna identify) and simulate with that antenna"
+    )
 
 
 @lru_cache(maxsize=16)
@@ -205,6 +302,15 @@ def simulate_detailed(
     if kind is not None:
         assert scenario.contact_point is not None
         link.check_contact_point(scenario.contact_point)
+        x_min = minimum_contact_point(link, scenario.contact_stiffness)
+        if scenario.contact_point < x_min:
+            raise ScenarioError(
+                "contact_point",
+                f"{scenario.contact_point:g} m is below {x_min:.3g} m, where the contact"
+                f" stiffness {scenario.contact_stiffness:g} N/m is {MIN_STIFFNESS_RATIO:g} times"
+                " the link's local stiffness 3 E I / x_c^3 (the contact would be no support and"
+                " the push force would leave the sensor's range)",
+            )
         q_sag = np.linalg.solve(
             model.stiffness, -gravity * math.cos(theta_touch[1]) * model.translation_load
         )
@@ -259,7 +365,7 @@ def simulate_detailed(
 
     meas_theta = np.zeros((n_samples, 2))
     meas_wrench = np.zeros((n_samples, 6))
-    truth = np.zeros((n_samples, 10))
+    truth = np.zeros((n_samples, TRUTH_COLUMNS))
     ctrl = np.zeros(8)
     cs = np.zeros(CONTACT_STATE_SIZE)
     cs[12] = -1.0
@@ -301,8 +407,13 @@ def simulate_detailed(
             advance(k, k + 1)
             if rule.update(float(t[k]), meas_theta[k], meas_wrench[k, :3], meas_wrench[k, 3:]):
                 stop_index = k
-                # Section 4 step 4: stop the motors, i.e. freeze the reference from t_1 on
-                reference[k + 1 :, sweep_joint] = reference[k, sweep_joint]
+                # Section 4 step 4: stop the motors, i.e. freeze the reference from t_1 on;
+                # Eq. 14 lag of a ramp, 2 eps omega*: the joint comes to rest where it is now
+                hold = reference[k, sweep_joint]
+                if scenario.compensate_servo_lag and k > 0:
+                    speed = (reference[k, sweep_joint] - reference[k - 1, sweep_joint]) / ts
+                    hold -= 2.0 * servo[sweep_joint].time_constant * speed
+                reference[k + 1 :, sweep_joint] = hold
                 break
             if progress is not None and k % 500 == 0:
                 progress(k / n_samples)
@@ -314,6 +425,7 @@ def simulate_detailed(
         progress(1.0)
 
     in_contact = truth[:, 2] > 0.5
+    deflection = _contact_deflection(link, scenario.n_elements, truth, gravity)
     first_touch = float(cs[12]) if cs[12] >= 0 else None
     metadata: dict[str, str] = {
         "format": FORMAT_NAME,
@@ -331,6 +443,9 @@ def simulate_detailed(
         metadata["true_t_contact"] = "nan" if first_touch is None else repr(first_touch)
         metadata["true_in_contact_at_end"] = "true" if in_contact[-1] else "false"
         metadata["true_t_stop"] = "nan" if stop_index is None else repr(float(t[stop_index]))
+        metadata["true_deflection_ratio"] = repr(
+            _final_deflection_ratio(deflection, truth[:, 3], in_contact)
+        )
     metadata["seed"] = str(scenario.seed)
     metadata["simulation"] = json.dumps(
         {
@@ -357,12 +472,28 @@ def simulate_detailed(
         contact_abscissa=truth[:, 3].copy(),
         contact_point=truth[:, 4:7].copy(),
         normal_force=truth[:, 7].copy(),
+        contact_force=truth[:, 10:13].copy(),
+        sticking=truth[:, 13] > 0.5,
+        contact_deflection=deflection,
         voltage=truth[:, 8:10].copy(),
         stop_index=stop_index,
         obstacle=obstacle,
         link_model=model,
         rayleigh=(alpha, beta),
     )
+
+
+def _final_deflection_ratio(
+    deflection: NDArray[np.float64],
+    abscissa: NDArray[np.float64],
+    in_contact: NDArray[np.bool_],
+) -> float:
+    """Mean y_c / x_c over the last ``FINAL_AVERAGE_TIME`` (the hold), NaN unless the link is
+    in contact over all of it (the mean over a few periods removes most of the vibration)."""
+    n = max(1, round(FINAL_AVERAGE_TIME / SAMPLE_PERIOD))
+    if not in_contact[-n:].all():
+        return math.nan
+    return float(np.mean(deflection[-n:] / abscissa[-n:]))
 
 
 def _describe(scenario: Scenario, kind: str | None) -> str:

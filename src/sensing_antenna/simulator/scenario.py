@@ -130,6 +130,10 @@ class Scenario:
         Time from the start of the sweep to the nominal first touch (s), at least accel_time.
     servo_pole : float
         Closed-loop pole p of both servos (rad/s, < 0); Eq. 14 with eps = -1/p.
+    compensate_servo_lag : bool
+        At the stop (t_1) freeze the reference at r(t_1) - 2 eps omega*(t_1) instead of r(t_1),
+        so that the joint comes to rest where it was at t_1 instead of 2 eps omega* further
+        (the ramp lag of Eq. 14); see ``docs/simulator.md``, "The push criterion".
     n_elements : int
         Finite elements of the link.
     substeps : int
@@ -158,6 +162,7 @@ class Scenario:
     start_time: float = 0.1
     approach_time: float = 0.6
     servo_pole: float = -60.0
+    compensate_servo_lag: bool = True
     n_elements: int = 16
     substeps: int = 2
     sensor: SensorNoise = field(default_factory=SensorNoise)
@@ -196,6 +201,10 @@ class Scenario:
             raise ScenarioError("servo_pole", f"must be < 0 (stable), got {self.servo_pole!r}")
         if -self.servo_pole * 1e-3 > 0.3:
             raise ScenarioError("servo_pole", "too fast for the 1 kHz controller (|p| T_s > 0.3)")
+        if not isinstance(self.compensate_servo_lag, bool):
+            raise ScenarioError(
+                "compensate_servo_lag", f"must be true or false, got {self.compensate_servo_lag!r}"
+            )
         if not isinstance(self.n_elements, int) or self.n_elements < 4:
             raise ScenarioError("n_elements", f"must be an integer >= 4, got {self.n_elements!r}")
         if not isinstance(self.substeps, int) or self.substeps < 1:
