@@ -162,6 +162,7 @@ class _FakeEstimate:
     omega1 = 60.0
     t_1 = 1.0
     t_e = 1.2
+    interval: tuple[float, float] | None = None
     diagnostics: ClassVar[dict[str, object]] = {
         "interval": (0.51, 0.53),
         "interval_width": 0.02,
@@ -172,6 +173,10 @@ class _FakeEstimate:
 def test_an_interval_in_the_diagnostics_is_kept_and_summarised() -> None:
     outcome = MethodOutcome.from_estimate("fast", _FakeEstimate(), 0.01)
     assert (outcome.interval_low, outcome.interval_high) == (0.51, 0.53)
+    # the result's own ``interval`` attribute wins over the diagnostics
+    direct = _FakeEstimate()
+    direct.interval = (0.50, 0.54)
+    assert MethodOutcome.from_estimate("fast", direct, 0.0).interval_low == 0.50
     assert MethodOutcome.from_dict(outcome.to_dict()) == outcome
     # a method without an interval keeps NaN and round-trips too
     plain_outcome = MethodOutcome(method="paper", status="ok", x_c=0.5)

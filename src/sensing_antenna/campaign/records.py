@@ -115,8 +115,8 @@ class MethodOutcome:
     elapsed_s : float
         Wall-clock time of this estimate (s).
     interval_low, interval_high : float
-        Bounds of the method's 95 % interval of x_c (m), for methods that give one (``fast``:
-        ``diagnostics["interval"]``); NaN otherwise.
+        Bounds of the method's 95 % interval of x_c (m), for methods that give one (``fast``);
+        NaN otherwise.
     """
 
     method: str
@@ -138,12 +138,14 @@ class MethodOutcome:
     def from_estimate(cls, method: str, estimate: Any, elapsed_s: float) -> MethodOutcome:
         """Copy the fields of an estimation result (``ContactEstimate``) that tables need.
 
-        Fields a method does not have are NaN; an interval is read from
-        ``diagnostics["interval"]`` (a pair of lengths in m) when the method reports one.
+        Fields a method does not have are NaN; an interval (a pair of lengths in m) is read from
+        the result's ``interval`` or, failing that, ``diagnostics["interval"]``.
         """
         values = {name: _as_float(getattr(estimate, name, None)) for name in _FLOAT_FIELDS}
         candidates = getattr(estimate, "candidates", None)
-        low, high = _interval(getattr(estimate, "diagnostics", None))
+        low, high = _interval({"interval": getattr(estimate, "interval", None)})
+        if math.isnan(low):
+            low, high = _interval(getattr(estimate, "diagnostics", None))
         return cls(
             method=method,
             status=_status_text(getattr(estimate, "status", "unknown")),
