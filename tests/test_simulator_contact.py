@@ -1,19 +1,39 @@
 """Contact physics: contact-mode frequency vs the beam model (Eq. 4), torque/force ratio (Eq. 18),
-penalty convergence, unilateral contact."""
+the default push depth, penalty convergence, bounce-off, friction slip."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from _simulator_helpers import RotationAfterForceStop, dominant_frequency
-from sensing_antenna.antenna import STANDARD_GRAVITY, paper_antenna
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
-from sensing_antenna.simulator import Scenario, simulate_detailed
+from sensing_antenna.calibration.observer import identify_free_motion
+from sensing_antenna.recording import Recording
+from sensing_antenna.simulator import Scenario, ScenarioError, simulate, simulate_detailed
+from sensing_antenna.simulator.contact import motor_frame
+from sensing_antenna.simulator.run import (
+    SMALL_DEFLECTION_LIMIT,
+    deflection_warning,
+    minimum_contact_point,
+)
 
 CONTACT_POINTS = [0.3, 0.55, 0.8, 0.98]
+
+
+@pytest.fixture(scope="module")
+def identified() -> Antenna:
+    """The paper antenna with the observer and contact threshold identified on a simulated free
+    motion (Section 5.2), as ``antenna identify`` and the campaign do: the device's own
+    threshold (about 0.0009 N m) instead of the paper's 0.02 N m."""
+    antenna = paper_antenna()
+    free = simulate(antenna, Scenario(case="free", duration=4.0, seed=11))
+    fit = identify_free_motion(free.without_ground_truth(), antenna)
+    return dataclasses.replace(antenna, observer=fit.observer)
 
 
 def _shallow_stop() -> RotationAfterForceStop:
@@ -44,38 +64,155 @@ def test_contact_frequency_matches_beam_model(case: str, x_c: float) -> None:
     assert omega == pytest.approx(expected, rel=0.01), (case, x_c, channel)
 
 
+@pytest.mark.parametrize(("case", "x_c"), [("azimuthal", 0.8), ("vertical", 0.98)])
+def test_contact_frequency_with_the_default_stop_rule(
+    identified: Antenna, case: str, x_c: float
+) -> None:
+    """The same 1 % check with the controller's default stop rule (PushMonitor, 0.02 rad past
+    the detected contact, servo lag compensated) and the identified observer."""
+    scenario = Scenario(case=case, contact_point=x_c, noise_scale=0.0, duration=3.5)
+    detail = simulate_detailed(identified, scenario)
+    rec = detail.recording
+    assert detail.stop_index is not None
+    assert rec.metadata["true_in_contact_at_end"] == "true"
+    expected = float(natural_frequencies(identified.link, float(rec.metadata["true_xc"]), 1)[0])
+    tail = rec.torque[detail.stop_index + 300 :]
+    channel = int(np.argmax(np.ptp(tail, axis=0)))
+    omega = dominant_frequency(tail[:, channel], 1e-3, 0.6 * expected)
+    # 1 %: the brief's requirement (measured < 0.1 %).
+    assert omega == pytest.approx(expected, rel=0.01)
+
+
+@pytest.mark.parametrize("case", ["azimuthal", "vertical"])
+@pytest.mark.parametrize("x_c", [0.3, 0.6, 0.98])
+def test_default_push_keeps_the_deflection_small(
+    identified: Antenna, case: str, x_c: float
+) -> None:
+    """Issue 3 item 5: with an identified observer the default push ends at y_c / x_c of a few
+    percent over the whole link (push.py docstring: 2.9 % at 0.3 m to 4.0 % at the tip)."""
+    scenario = Scenario(case=case, contact_point=x_c, seed=1, duration=2.0)
+    detail = simulate_detailed(identified, scenario)
+    ratio = float(detail.recording.metadata["true_deflection_ratio"])
+    # [1 %, 5 %]: the issue's band around the 3 % target; Assumption 1 allows 10 %.
+    assert 0.01 <= ratio <= 0.05, (case, x_c, ratio)
+    assert deflection_warning(detail.recording) is None
+    # Independent check: the link is held at x_c, so y_c / x_c equals the head's final rotation
+    # past the touch angle 0 (first order); 1e-3 for the rolling of the contact on the 1 cm
+    # post or bar and the residual vibration in the averaging window.
+    joint = 1 if case == "vertical" else 0
+    turned = float(detail.true_theta[-500:, joint].mean())
+    assert ratio == pytest.approx(turned, abs=1e-3)
+
+
+def test_servo_lag_compensation_stops_the_joint_where_it_was_at_t1(identified: Antenna) -> None:
+    """Eq. 14 ramp lag: freezing the reference at r(t_1) the joint travels 2 eps omega* further;
+    freezing it at r(t_1) - 2 eps omega* it comes back to rest at theta(t_1) after an overshoot of
+    eps omega* / e (the response of 1 / (1 + eps s)^2 to that input, docs/simulator.md)."""
+    eps = 1.0 / 60.0  # s, default servo pole -60 rad/s
+    speed = 0.3  # rad/s, default sweep
+    travel = []
+    overshoot = []
+    for compensate in (False, True):
+        scenario = Scenario(
+            case="azimuthal",
+            contact_point=0.55,
+            noise_scale=0.0,
+            duration=2.0,
+            compensate_servo_lag=compensate,
+        )
+        detail = simulate_detailed(identified, scenario)
+        assert detail.stop_index is not None
+        theta = detail.true_theta[:, 0]
+        travel.append(float(theta[-1] - theta[detail.stop_index]))
+        overshoot.append(float(theta[detail.stop_index :].max() - theta[detail.stop_index]))
+    # 10 % / 0.5 mrad: Coulomb friction of Table 1 (stick-slip, < 1 % of a move) and the contact
+    # load, which the coupling-torque feedback cancels only up to the sensor noise.
+    assert travel[0] == pytest.approx(2 * eps * speed, rel=0.1)
+    assert travel[1] == pytest.approx(0.0, abs=5e-4)
+    assert overshoot[1] <= eps * speed / math.e + 5e-4
+
+
+def test_deep_push_is_flagged_and_tiny_contact_points_are_rejected() -> None:
+    ok = Recording(
+        t=np.arange(3) * 1e-3,
+        theta=np.zeros((3, 2)),
+        force=np.zeros((3, 3)),
+        torque=np.zeros((3, 3)),
+        metadata={"true_deflection_ratio": "0.04"},
+    )
+    deep = dataclasses.replace(ok, metadata={"true_deflection_ratio": "0.12"})
+    assert deflection_warning(ok) is None
+    message = deflection_warning(deep)
+    assert message is not None and "12.0 %" in message and "antenna identify" in message
+    assert SMALL_DEFLECTION_LIMIT == 0.1  # Assumption 1 of the paper
+    antenna = paper_antenna()
+    # x_min = (10 * 3 E I / k)^(1/3) = (10 * 3 * 0.0903 / 1e4)^(1/3) = 0.0647 m
+    assert minimum_contact_point(antenna.link, 1e4) == pytest.approx(0.0647, abs=1e-4)
+    with pytest.raises(ScenarioError, match=r"scenario\.contact_point: 0\.02 m is below"):
+        simulate(antenna, Scenario(case="azimuthal", contact_point=0.02, duration=0.1))
+
+
 @pytest.mark.parametrize(
-    ("case", "x_c"), [("azimuthal", 0.3), ("azimuthal", 0.8), ("vertical", 0.55)]
+    ("case", "x_c"),
+    [("azimuthal", 0.3), ("azimuthal", 0.8), ("vertical", 0.55), ("vertical", 0.98)],
 )
-def test_static_torque_force_ratio_equals_contact_point(case: str, x_c: float) -> None:
+def test_static_torque_force_ratio(case: str, x_c: float) -> None:
     """Eq. 18 with gravity removed (Eq. 19) once the vibration has died out (heavy damping here
-    only to shorten the wait; the static state does not depend on it)."""
+    only to shorten the wait; the static state does not depend on it), against the exact static
+    expectation from the simulator's own state, and its deviation from x_c."""
     antenna = paper_antenna()
     scenario = Scenario(
         case=case, contact_point=x_c, noise_scale=0.0, duration=3.0, damping_ratio=0.1
     )
     detail = simulate_detailed(antenna, scenario, stop_rule=_shallow_stop())
     rec = detail.recording
-    force = rec.force[-300:].mean(axis=0)
-    torque = rec.torque[-300:].mean(axis=0)
+    window = slice(-300, None)
+    force = rec.force[window].mean(axis=0)
+    torque = rec.torque[window].mean(axis=0)
     theta2 = rec.theta[-1, 1]
     weight = antenna.link.mass * STANDARD_GRAVITY
     force_g = weight * np.array([-math.sin(theta2), 0.0, -math.cos(theta2)])
     torque_g = np.array([0.0, 0.5 * weight * antenna.link.length * math.cos(theta2), 0.0])
     ratio = np.linalg.norm(torque - torque_g) / np.linalg.norm(force - force_g)
+
+    # Exact statics of the simulated link (independent of the sensor code): the link's torque on
+    # the head about O is p_c x F_c (true contact point and force, motor frame) plus the moment
+    # of the deflected link's weight, int rho (x, v, w) x g dx, whose straight-link part is the
+    # Gamma_g removed above; what remains is (g_z V, g_x W, -g_x V), V = int rho v, W = int rho w.
+    point_m = np.array(
+        [
+            motor_frame(*th) @ p
+            for th, p in zip(detail.true_theta, detail.contact_point, strict=True)
+        ]
+    )
+    contact_force = detail.contact_force[window]
+    moment = np.cross(point_m[window], contact_force).mean(axis=0)
+    v_integral, w_integral = detail.link_model.translation_load @ detail.final_deflection.T
+    true_theta2 = detail.true_theta[-1, 1]
+    g_x = -STANDARD_GRAVITY * math.sin(true_theta2)
+    g_z = -STANDARD_GRAVITY * math.cos(true_theta2)
+    weight_moment = np.array([g_z * v_integral, g_x * w_integral, -g_x * v_integral])
+    mean_force = contact_force.mean(axis=0)
+    expected = np.linalg.norm(moment + weight_moment) / np.linalg.norm(mean_force)
+    # 0.1 %, inside the issue's 0.5 %: the residual vibration and the dynamic part of the force
+    # (measured <= 0.05 %).
+    assert ratio == pytest.approx(expected, rel=1e-3)
+    # The moment arm of the contact force alone, |p_c x F_c| / |F_c|: the contact point sits off
+    # the straight axis (sag, deflection) and the normal is tilted by the sag slope.
+    arm = np.linalg.norm(moment) / np.linalg.norm(mean_force)
+
+    # Deviation from x_c, a physical effect the estimators live with (docs/simulator.md,
+    # "Neglected effects"): azimuthal < 0.5 % (the issue's tolerance; measured < 0.1 %);
+    # vertical < 1 % (measured 0.5 % at 0.55 m and 0.9 % at 0.98 m, of which the moment arm
+    # gives 0.2 % / 0.3 % and the weight of the deflected, raised link the rest).
     true_xc = float(rec.metadata["true_xc"])
-    # Azimuthal: 0.5 % (the brief's requirement); the second-order geometry of the bent link
-    # (slope y' = 1.5 y_c / x_c at the contact) adds about 0.4 (y_c / x_c)^2, ~0.1 % here.
-    # Vertical: the 2 cm gravity sag at the contact tilts the contact normal and adds a moment
-    # arm (x_c + w w') / sqrt(1 + w'^2): ~0.6 % at x_c = 0.55 m, so 1 % (docs/simulator.md).
-    tolerance = 5e-3 if case == "azimuthal" else 1e-2
-    assert ratio == pytest.approx(true_xc, rel=tolerance)
+    assert abs(arm / true_xc - 1) < 5e-3
+    assert ratio == pytest.approx(true_xc, rel=5e-3 if case == "azimuthal" else 1e-2)
 
 
 def test_contact_frequency_converges_with_penalty_stiffness() -> None:
     antenna = paper_antenna()
     x_c = 0.55
-    expected = float(natural_frequencies(antenna.link, x_c, 1)[0])
     errors = []
     for stiffness in (30.0, 300.0, 3000.0):
         scenario = Scenario(
@@ -86,28 +223,89 @@ def test_contact_frequency_converges_with_penalty_stiffness() -> None:
             contact_stiffness=stiffness,
         )
         detail = simulate_detailed(antenna, scenario, stop_rule=_shallow_stop())
+        assert detail.stop_index is not None
         tail = detail.recording.torque[detail.stop_index + 300 :, 2]
         true_xc = float(detail.recording.metadata["true_xc"])
         reference = float(natural_frequencies(antenna.link, true_xc, 1)[0])
         errors.append(abs(dominant_frequency(tail, 1e-3, 20.0) / reference - 1))
     # a soft support lowers the frequency; the error falls roughly as 1/k
     assert errors[0] > errors[1] > errors[2]
+    assert errors[0] / errors[2] > 10.0
     assert errors[2] < 0.01
-    assert expected > 0
 
 
-def test_contact_is_unilateral_without_push() -> None:
-    """A stop rule that never fires keeps the sweep going; with a frictionless post the link
-    slides past... here we check only that the normal force is never negative (no adhesion)."""
+def test_link_bounces_off_after_a_fast_impact() -> None:
+    """Unilateral contact: a fast sweep (1 rad/s, 0.8 m/s at the contact) with little contact
+    damping hits the post; the normal force falls back to zero and the link leaves the post for
+    tens of ms before the push re-establishes the contact. The normal force is never negative
+    (no adhesion)."""
     antenna = paper_antenna()
-    scenario = Scenario(case="azimuthal", contact_point=0.8, noise_scale=0.0, duration=1.5)
-    detail = simulate_detailed(antenna, scenario, stop_rule=_shallow_stop())
+    scenario = Scenario(
+        case="azimuthal",
+        contact_point=0.8,
+        noise_scale=0.0,
+        duration=1.5,
+        sweep_speed=1.0,
+        contact_damping=0.05,
+    )
+    # The 1 rad/s ramp's inertial force (about 20 mN) would trip a 12 mN force threshold.
+    detail = simulate_detailed(
+        antenna, scenario, stop_rule=RotationAfterForceStop(antenna, 0.1, 0.03)
+    )
     assert np.all(detail.normal_force >= 0.0)
-    assert detail.in_contact.any()
     first = int(np.argmax(detail.in_contact))
+    assert detail.in_contact[first]
+    assert detail.normal_force[first] > 0.1  # N, the impact
+    after = detail.in_contact[first:]
+    # longest run of samples without contact after the first touch
+    runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[1], after.astype(int), [1]])) != 0))
+    longest_gap = int(runs[1::2].max()) if runs.size > 1 else 0
+    assert longest_gap >= 20  # ms: the link has left the post, not a one-sample chatter
+    assert np.all(detail.normal_force[first:][~after] == 0.0)
+    assert detail.recording.metadata["true_in_contact_at_end"] == "true"
     # the first touch happens inside the 1 ms before the first sample that shows it
     t_contact = float(detail.recording.metadata["true_t_contact"])
     assert (first - 1) * 1e-3 < t_contact <= first * 1e-3 + 1e-12
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.6])
+def test_friction_slip_on_a_leaning_post(mu: float) -> None:
+    """A post leaning by phi = 0.3 rad along the sweep: the link pushes horizontally, so a stuck
+    contact needs a tangential (along-the-post) force of tan(phi) = 0.31 times the normal force.
+    With mu = 0.6 the contact sticks and ends at that ratio; with mu = 0.1 it slips along the
+    post with |F_t| = mu F_n until the link's own bending carries the along-post load."""
+    antenna = paper_antenna()
+    tilt = 0.3
+    scenario = Scenario(
+        case="azimuthal",
+        contact_point=0.55,
+        noise_scale=0.0,
+        duration=2.0,
+        friction_coefficient=mu,
+        obstacle_tilt=tilt,
+    )
+    detail = simulate_detailed(
+        antenna, scenario, stop_rule=RotationAfterForceStop(antenna, 0.012, 0.03)
+    )
+    contact = detail.in_contact
+    normal = detail.normal_force
+    tangential = np.sqrt(np.maximum(np.sum(detail.contact_force**2, axis=1) - normal**2, 0.0))
+    # Coulomb cone, every sample (1e-9: round-off)
+    assert np.all(tangential[contact] <= mu * normal[contact] * (1 + 1e-9))
+    slipping = contact & ~detail.sticking
+    along_post = 1000.0 * np.ptp(detail.contact_point[contact, 2])  # mm, vertical travel
+    final = tangential[-1] / normal[-1]
+    if mu > math.tan(tilt):
+        assert slipping.sum() <= 0.01 * contact.sum()  # a few samples at the impact
+        assert along_post < 0.1
+        # stuck: the link's force is horizontal, ratio tan(phi); 1 % for the sag and the
+        # out-of-plane bending of the link
+        assert final == pytest.approx(math.tan(tilt), rel=0.01)
+    else:
+        assert slipping.sum() >= 0.1 * contact.sum()
+        np.testing.assert_allclose(tangential[slipping], mu * normal[slipping], rtol=1e-9)
+        assert along_post > 2.0  # mm along the post
+        assert final <= mu
 
 
 def test_obstacle_tilt_turns_the_contact_normal() -> None:

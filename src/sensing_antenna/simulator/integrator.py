@@ -395,6 +395,7 @@ def run_samples(
     vcoef = np.empty(nn)
     rhs = np.empty(nn)
     u0 = np.empty(nn)
+    ub = np.empty(nn)
     for k in range(k0, k1):
         # --- sensor sample at t_k -------------------------------------------------------------
         sensor_wrench(X, A, n, mq, sq, par, cs, wrench)
@@ -557,17 +558,15 @@ def run_samples(
                         rn = -kn * (g0 - un_x) + cn * (un @ vcoef)
                         rt = -kt * (s0 - ut_x) + ct * (ut @ vcoef)
                         stick = True
-                        for _it in range(3):
-                            for i in range(nn):
-                                u0[i] = rhs[i] + rn * un[i]
-                                if stick:
-                                    u0[i] += rt * ut[i]
-                                else:
-                                    u0[i] += ft * ut[i]
-                            y0 = _solve_s0(u0, n, ainv, z, cb1, cb2, s_dot, d1, d2)
-                            yn = _solve_s0(un, n, ainv, z, cb1, cb2, s_dot, d1, d2)
-                            dn = kn + 2.0 * cn / h
+                        slip_sign = 0.0
+                        mu = par[_P_MU]
+                        dn = kn + 2.0 * cn / h
+                        for _it in range(2):
                             if stick:
+                                for i in range(nn):
+                                    u0[i] = rhs[i] + rn * un[i] + rt * ut[i]
+                                y0 = _solve_s0(u0, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+                                yn = _solve_s0(un, n, ainv, z, cb1, cb2, s_dot, d1, d2)
                                 yt = _solve_s0(ut, n, ainv, z, cb1, cb2, s_dot, d1, d2)
                                 dt_ = kt + 2.0 * ct / h
                                 # Woodbury: (D^-1 + U^T S0^-1 U)^-1 U^T S0^-1 u0
@@ -582,8 +581,15 @@ def run_samples(
                                 c1 = (-m10 * b0 + m00 * b1) / det
                                 x_try = y0 - c0 * yn - c1 * yt
                             else:
-                                c0 = (un @ y0) / (1.0 / dn + un @ yn)
-                                x_try = y0 - c0 * yn
+                                # slip: F_t = sign mu F_n with F_n = rn - dn un.x, so the contact
+                                # force acts along ub = un + sign mu ut (Sherman-Morrison)
+                                for i in range(nn):
+                                    ub[i] = un[i] + slip_sign * mu * ut[i]
+                                    u0[i] = rhs[i] + rn * ub[i]
+                                y0 = _solve_s0(u0, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+                                yb = _solve_s0(ub, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+                                c0 = (un @ y0) / (1.0 / dn + un @ yb)
+                                x_try = y0 - c0 * yb
                             v_try = 2.0 / h * (x_try - X) - V
                             g_new = g0 + un @ (x_try - X)
                             fn = -kn * g_new - cn * (un @ v_try)
@@ -594,13 +600,14 @@ def run_samples(
                             if stick:
                                 s_new = s0 + ut @ (x_try - X)
                                 ft_trial = -kt * s_new - ct * (ut @ v_try)
-                                if abs(ft_trial) <= par[_P_MU] * fn:
+                                if abs(ft_trial) <= mu * fn:
                                     ft = ft_trial
                                     x_new = x_try
                                     break
                                 stick = False
-                                ft = math.copysign(par[_P_MU] * fn, ft_trial)
+                                slip_sign = math.copysign(1.0, ft_trial)
                             else:
+                                ft = slip_sign * mu * fn
                                 x_new = x_try
                                 break
                         if active:

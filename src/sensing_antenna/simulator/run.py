@@ -98,6 +98,9 @@ class SimulationDetail:
         gravity sag at the current theta2 (m); NaN without contact.
     voltage : ndarray, shape (n, 2)
         Motor input voltages u_i (V).
+    final_deflection : ndarray, shape (2, n_dof)
+        Finite-element coordinates of v (row 0) and w (row 1) at the end of the run (m, rad);
+        ``link_model.shape_at(x) @ final_deflection[0]`` is v(x).
     stop_index : int or None
         Sample at which the stop rule fired (t_1), or None.
     obstacle : Obstacle or None
@@ -116,6 +119,7 @@ class SimulationDetail:
     sticking: NDArray[np.bool_]
     contact_deflection: NDArray[np.float64]
     voltage: NDArray[np.float64]
+    final_deflection: NDArray[np.float64]
     stop_index: int | None
     obstacle: Obstacle | None
     link_model: LinkModel
@@ -476,6 +480,7 @@ def simulate_detailed(
         sticking=truth[:, 13] > 0.5,
         contact_deflection=deflection,
         voltage=truth[:, 8:10].copy(),
+        final_deflection=x_state[: 2 * n].reshape(2, n).copy(),
         stop_index=stop_index,
         obstacle=obstacle,
         link_model=model,
