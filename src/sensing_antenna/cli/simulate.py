@@ -23,9 +23,12 @@ def register(subparsers: Any) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    import sys
+
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.recording import write_recording
     from sensing_antenna.simulator import Scenario, simulate
+    from sensing_antenna.simulator.run import deflection_warning
 
     antenna = load_antenna(args.antenna)
     scenario = Scenario(
@@ -42,7 +45,11 @@ def _run(args: argparse.Namespace) -> int:
     if "true_xc" in meta:
         summary += (
             f", x_c = {float(meta['true_xc']):.4f} m, first touch {meta['true_t_contact']} s,"
-            f" stop {meta['true_t_stop']} s"
+            f" stop {meta['true_t_stop']} s,"
+            f" y_c / x_c = {100 * float(meta['true_deflection_ratio']):.1f} %"
         )
     print(summary)
+    warning = deflection_warning(recording)
+    if warning is not None:
+        print(warning, file=sys.stderr)
     return 0
