@@ -121,7 +121,10 @@ def test_calibration_recovers_the_device_t_and_is_stored(calibrated: Path) -> No
     # and the model's theoretical T is what it is compared with, 5 % away
     assert calibration.t_theoretical == pytest.approx(paper_antenna().link.theoretical_t)
     assert calibration.relative_difference == pytest.approx(T_RATIO - 1, abs=0.005)
-    assert calibration.used.all()
+    # points without a measurable push are left out with a note (with the simulator's default
+    # push depth some near-tip points push with less than the estimator's 5 mN); enough remain
+    assert calibration.used.sum() >= 3
+    assert len(calibration.notes) == int((~calibration.used).sum())
     np.testing.assert_allclose(calibration.contact_points, CALIBRATION_POINTS)
     # the standard error is a real, small number (15 points in the paper, 6 here)
     assert 0 < calibration.t_e_std_error < 0.005 * calibration.t_e
@@ -192,7 +195,11 @@ def test_calibration_makes_the_paper_method_much_better(
 ) -> None:
     with_cal = np.abs(paper_errors(calibrated))
     without = np.abs(paper_errors(uncalibrated))
-    assert np.all(np.isfinite(with_cal)) and np.all(np.isfinite(without))
+    # same recordings in both campaigns, so the same runs have estimates; compare those (a run
+    # without a measurable push has none in either)
+    both = np.isfinite(with_cal) & np.isfinite(without)
+    assert both.sum() >= 3
+    with_cal, without = with_cal[both], without[both]
     # without calibration the 5 % T error shows: x_c follows omega_1 = beta_1^2 / T, and a 5 %
     # frequency error moves x_c by centimetres (measured: 1.3 to 2.7 cm at these points)
     assert without.mean() > 0.01
@@ -203,7 +210,9 @@ def test_calibration_makes_the_paper_method_much_better(
     b = load_run_results(uncalibrated)
     assert {k: v.seed for k, v in a.items()} == {k: v.seed for k, v in b.items()}
     assert all(
-        math.isclose(a[k].methods[0].omega1, b[k].methods[0].omega1, rel_tol=0.02) for k in a
+        math.isclose(a[k].methods[0].omega1, b[k].methods[0].omega1, rel_tol=0.02)
+        for k in a
+        if math.isfinite(a[k].methods[0].omega1)
     )
 
 
