@@ -23,8 +23,9 @@ __all__ = [
 CASES = ("azimuthal", "vertical", "free")
 OBSTACLE_KINDS = ("post", "bar", "plane")
 
-#: Resolution of an ATI Nano17 SI-25-0.25 transducer with a 16-bit DAQ, as published by ATI:
-#: forces 1/160 N (x, y, z), torques 1/32 N mm (x, y, z). (N, N, N, N m, N m, N m)
+#: Resolution of an ATI Nano17 SI-25-0.25 transducer with a 16-bit DAQ as recalled from ATI's
+#: catalogue, NOT verified against the data sheet (docs/simulator.md): forces 1/160 N (x, y, z),
+#: torques 1/32 N mm (x, y, z). (N, N, N, N m, N m, N m). A resolution, not a noise RMS.
 ATI_NANO17_RESOLUTION = (
     1.0 / 160.0,
     1.0 / 160.0,
@@ -58,7 +59,8 @@ class SensorNoise:
     ----------
     wrench_std : tuple of 6 float
         Standard deviation of the additive white noise on (fx, fy, fz, tx, ty, tz) per sample
-        (N, N m). Default: one resolution count of an ATI Nano17 SI-25-0.25.
+        (N, N m). Default: one resolution count of an ATI Nano17 SI-25-0.25 taken as the 1-sigma
+        noise, a modelling assumption (unverified figures; docs/simulator.md).
     bias_std : tuple of 6 float
         Standard deviation of the constant per-run offset (residual after taring), same units.
         Default: two resolution counts.
