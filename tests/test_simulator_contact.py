@@ -162,11 +162,13 @@ def test_static_torque_force_ratio(case: str, x_c: float) -> None:
     expectation from the simulator's own state, and its deviation from x_c."""
     antenna = paper_antenna()
     scenario = Scenario(
-        case=case, contact_point=x_c, noise_scale=0.0, duration=3.0, damping_ratio=0.1
+        case=case, contact_point=x_c, noise_scale=0.0, duration=3.5, damping_ratio=0.1
     )
     detail = simulate_detailed(antenna, scenario, stop_rule=_shallow_stop())
     rec = detail.recording
-    window = slice(-300, None)
+    # The last second: long against the servo's slow hunting about its hold angle (Coulomb
+    # friction), whose inertial share of the wrench swings the ratio by +-0.3 % over 0.3 s.
+    window = slice(-1000, None)
     force = rec.force[window].mean(axis=0)
     torque = rec.torque[window].mean(axis=0)
     theta2 = rec.theta[-1, 1]
@@ -246,6 +248,8 @@ def test_link_bounces_off_after_a_fast_impact() -> None:
         noise_scale=0.0,
         duration=1.5,
         sweep_speed=1.0,
+        accel_time=0.2,
+        approach_time=0.6,
         contact_damping=0.05,
     )
     # The 1 rad/s ramp's inertial force (about 20 mN) would trip a 12 mN force threshold.

@@ -260,6 +260,8 @@ def simulate_detailed(
     n_samples = round(scenario.duration / ts)
     t: NDArray[np.float64] = np.arange(n_samples, dtype=np.float64) * ts
     model, omega_free, omega_contact = _link_setup(link, scenario.n_elements)
+    scenario = scenario.resolved(omega_free)
+    assert scenario.accel_time is not None and scenario.approach_time is not None
     alpha, beta = rayleigh_coefficients(scenario.damping_ratio, omega_free, omega_contact)
     step = ts / scenario.substeps
     damping, ainv, z = _effective_inverse(link, scenario.n_elements, step, alpha, beta)

@@ -6,7 +6,7 @@ Every parameter is SI. The defaults and their sources are discussed in ``docs/si
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
 from sensing_antenna.errors import SensingAntennaError
@@ -22,6 +22,10 @@ __all__ = [
 
 CASES = ("azimuthal", "vertical", "free")
 OBSTACLE_KINDS = ("post", "bar", "plane")
+
+#: Cruise at constant speed between the end of the speed ramp and the nominal first touch (s):
+#: lets the servo settle on its ramp lag (2 eps omega*, Eq. 14; 5 eps = 0.08 s) before the contact.
+CRUISE_BEFORE_TOUCH = 0.1
 
 #: Resolution of an ATI Nano17 SI-25-0.25 transducer with a 16-bit DAQ as recalled from ATI's
 #: catalogue, NOT verified against the data sheet (docs/simulator.md): forces 1/160 N (x, y, z),
@@ -124,12 +128,18 @@ class Scenario:
         Normal and tangential contact damping (N s/m).
     sweep_speed : float
         Cruise speed of the swept joint (rad/s).
-    accel_time : float
-        Duration of the raised-cosine speed ramp from rest to cruise (s).
+    accel_time : float or None
+        Duration of the raised-cosine speed ramp from rest to cruise (s). None: the vibration-free
+        ramp, 1.5 periods of the link's first free mode (3 pi / omega_1,free; 0.59 s for the paper
+        antenna). Its half-sine acceleration has no spectral content at omega_1,free, so the
+        sweep leaves the link (almost) still, as the paper's free-motion control does (Section 1,
+        ref. [17]); a short ramp leaves the link ringing and the contact is then hit while
+        vibrating.
     start_time : float
         Rest before the sweep starts (s).
-    approach_time : float
+    approach_time : float or None
         Time from the start of the sweep to the nominal first touch (s), at least accel_time.
+        None: accel_time + ``CRUISE_BEFORE_TOUCH``.
     servo_pole : float
         Closed-loop pole p of both servos (rad/s, < 0); Eq. 14 with eps = -1/p.
     compensate_servo_lag : bool
@@ -149,7 +159,7 @@ class Scenario:
     case: Literal["azimuthal", "vertical", "free"] = "azimuthal"
     contact_point: float | None = None
     seed: int = 0
-    duration: float = 3.0
+    duration: float = 3.5
     noise_scale: float = 1.0
     damping_ratio: float = 0.005
     friction_coefficient: float = 0.6
@@ -160,9 +170,9 @@ class Scenario:
     contact_stiffness: float = 1.0e4
     contact_damping: float = 0.5
     sweep_speed: float = 0.3
-    accel_time: float = 0.2
+    accel_time: float | None = None
     start_time: float = 0.1
-    approach_time: float = 0.6
+    approach_time: float | None = None
     servo_pole: float = -60.0
     compensate_servo_lag: bool = True
     n_elements: int = 16
@@ -191,13 +201,16 @@ class Scenario:
             _finite(name, getattr(self, name), 0.0)
         if self.damping_ratio >= 1.0:
             raise ScenarioError("damping_ratio", "must be < 1 (light structural damping)")
-        for name in ("obstacle_radius", "contact_stiffness", "sweep_speed", "accel_time"):
+        for name in ("obstacle_radius", "contact_stiffness", "sweep_speed"):
             _finite(name, getattr(self, name), 0.0, strict=True)
+        if self.accel_time is not None:
+            _finite("accel_time", self.accel_time, 0.0, strict=True)
         _finite("start_time", self.start_time, 0.0)
         _finite("obstacle_tilt", self.obstacle_tilt)
         if abs(self.obstacle_tilt) >= 0.5:
             raise ScenarioError("obstacle_tilt", "must be below 0.5 rad in magnitude")
-        _finite("approach_time", self.approach_time, self.accel_time)
+        if self.approach_time is not None:
+            _finite("approach_time", self.approach_time, self.accel_time or 0.0)
         _finite("servo_pole", self.servo_pole)
         if not self.servo_pole < 0:
             raise ScenarioError("servo_pole", f"must be < 0 (stable), got {self.servo_pole!r}")
@@ -211,6 +224,24 @@ class Scenario:
             raise ScenarioError("n_elements", f"must be an integer >= 4, got {self.n_elements!r}")
         if not isinstance(self.substeps, int) or self.substeps < 1:
             raise ScenarioError("substeps", f"must be an integer >= 1, got {self.substeps!r}")
+
+    def resolved(self, omega_free: float) -> Scenario:
+        """This scenario with the default ramp times made explicit.
+
+        Parameters
+        ----------
+        omega_free : float
+            First free-mode frequency of the link (rad/s).
+        """
+        accel = self.accel_time if self.accel_time is not None else 3.0 * math.pi / omega_free
+        approach = (
+            self.approach_time if self.approach_time is not None else accel + CRUISE_BEFORE_TOUCH
+        )
+        if approach < accel:
+            raise ScenarioError(
+                "approach_time", f"must be >= accel_time ({accel:.3g} s), got {approach!r}"
+            )
+        return replace(self, accel_time=accel, approach_time=approach)
 
     @property
     def obstacle_kind(self) -> str | None:
