@@ -125,6 +125,11 @@ class FastConfig:
         Spacing of the x_c grid of the posterior (m). 0.25 mm, a twentieth of the tolerance.
     bias_min_samples : int
         Samples of initial rest needed to estimate the sensor bias; 20 (20 ms).
+    peak_margin : float
+        No declaration while omega_1 is less than this many standard deviations below the
+        maximum of the sensing curve (the interval there rests on the curve's flat top). 3: in
+        the simulator a 0.12 s window at x_c = 0.80 m read omega_1 0.5 % high and the interval
+        collapsed onto the peak, 27 mm from the truth.
     max_direction_drift : float
         Largest angle (rad) between the perpendicular reaction over the first 20 ms after t_1
         and the fitted static one at t_e (both with the sensor bias removed) before a slip is
@@ -146,6 +151,7 @@ class FastConfig:
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
     max_direction_drift: float = 0.15
+    peak_margin: float = 3.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -298,6 +304,17 @@ def evaluate_window(
         config.frequency_floor,
         config.ratio_geometry_factor,
     )
+    if not notes and math.isfinite(omega1):
+        # Near the top of omega_1(x_c) the inverse is singular: a frequency bias e moves x_c by
+        # sqrt(2 e / |omega_1''|) and the Gaussian interval can collapse onto the peak; so no
+        # declaration while omega_1 is within peak_margin standard deviations of the maximum.
+        sigma = math.hypot(omega1_se, config.frequency_floor * omega1)
+        top = float(table.omega1.max())
+        if top - omega1 < config.peak_margin * sigma:
+            notes.append(
+                f"omega_1 = {omega1:.2f} rad/s is within {config.peak_margin:g} standard "
+                f"deviations of the top of the sensing curve ({top:.2f} rad/s)"
+            )
     if not notes and posterior.width > config.tolerance:
         notes.append(
             f"the 95 % interval is {1000 * posterior.width:.1f} mm wide "
