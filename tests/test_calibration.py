@@ -141,18 +141,6 @@ def test_fit_rejects_bad_input(k: list[float], omega: list[float], message: str)
         fit_inverse_t(k, omega)
 
 
-def _has_beam_model() -> bool:
-    try:
-        from sensing_antenna.beam import natural_frequencies  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-needs_beam = pytest.mark.skipif(not _has_beam_model(), reason="needs beam.natural_frequencies")
-
-
-@needs_beam
 def test_calibrate_t_e_with_the_beam_model_recovers_t_e() -> None:
     link = paper_antenna().link
     omega = synthetic_k(PAPER_POINTS) / PAPER_T_E
@@ -169,7 +157,6 @@ def test_calibrate_t_e_with_the_beam_model_recovers_t_e() -> None:
     assert calibrated.link.t_param == result.t_e
 
 
-@needs_beam
 def test_figure_10_is_written(tmp_path: Path) -> None:
     from sensing_antenna.plotting.calibration import plot_calibration
 
@@ -203,16 +190,6 @@ def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
         read_contact_points(paths, recordings, table)
 
 
-def _has_simulator_and_estimator() -> bool:
-    try:
-        from sensing_antenna.estimation import measure_omega1  # noqa: F401
-        from sensing_antenna.simulator import Scenario, simulate  # noqa: F401
-    except ImportError:
-        return False
-    return _has_beam_model()
-
-
-@pytest.mark.skipif(not _has_simulator_and_estimator(), reason="needs simulator and estimation")
 def test_calibration_recovers_a_known_t_e_from_simulated_recordings() -> None:
     from sensing_antenna.calibration.frequency import calibrate_from_recordings
     from sensing_antenna.simulator import Scenario, simulate

@@ -36,19 +36,6 @@ from sensing_antenna.campaign.store import (
     read_stored_antenna,
 )
 
-
-def _has_pipeline() -> bool:
-    try:
-        from sensing_antenna.calibration.observer import identify_free_motion  # noqa: F401
-        from sensing_antenna.estimation import estimate, measure_omega1  # noqa: F401
-        from sensing_antenna.simulator import simulate  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-pytestmark = pytest.mark.skipif(not _has_pipeline(), reason="needs simulator and estimation")
-
 #: Ratio T_device / T_model of the test device: 5 % apart, like the paper's 7 % (Section 5.1).
 T_RATIO = 0.95
 MODEL_E = paper_antenna().link.youngs_modulus

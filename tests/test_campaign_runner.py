@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from distributed import LocalCluster
 
 from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, MethodOutcome, RunResult
@@ -259,7 +260,6 @@ def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:
 
 
 def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:
-    distributed = pytest.importorskip("distributed")
     spec = small_spec()
     inline = run_campaign(
         spec,
@@ -269,7 +269,7 @@ def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:
         workers=1,
         progress=False,
     )
-    with distributed.LocalCluster(
+    with LocalCluster(
         n_workers=2,
         threads_per_worker=1,
         processes=False,

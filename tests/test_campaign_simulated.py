@@ -17,27 +17,6 @@ from sensing_antenna.campaign.spec import (
 )
 
 
-def _available(*modules_and_names: tuple[str, str]) -> bool:
-    import importlib
-
-    for module, name in modules_and_names:
-        try:
-            getattr(importlib.import_module(module), name)
-        except (ImportError, AttributeError):
-            return False
-    return True
-
-
-HAS_PIPELINE = _available(
-    ("sensing_antenna.simulator", "simulate"),
-    ("sensing_antenna.estimation", "estimate"),
-)
-HAS_IDENTIFICATION = HAS_PIPELINE and _available(
-    ("sensing_antenna.calibration.observer", "identify_free_motion")
-)
-needs_pipeline = pytest.mark.skipif(not HAS_PIPELINE, reason="needs simulator and estimation")
-
-
 def one_point_spec(**changes: object) -> CampaignSpec:
     values: dict[str, object] = {
         "name": "one",
@@ -52,7 +31,6 @@ def one_point_spec(**changes: object) -> CampaignSpec:
     return CampaignSpec(**values)  # type: ignore[arg-type]
 
 
-@needs_pipeline
 def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> None:
     from sensing_antenna.campaign.simulated import make_scenario, simulate_and_estimate
     from sensing_antenna.estimation import estimate
@@ -74,7 +52,6 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
         )
 
 
-@needs_pipeline
 def test_a_bad_scenario_field_stops_the_campaign_with_one_error(tmp_path: Path) -> None:
     from sensing_antenna.campaign.runner import run_campaign
 
@@ -86,7 +63,6 @@ def test_a_bad_scenario_field_stops_the_campaign_with_one_error(tmp_path: Path) 
         run_campaign(spec, tmp_path / "b", workers=1, progress=False)
 
 
-@pytest.mark.skipif(not HAS_IDENTIFICATION, reason="needs identify_free_motion")
 def test_free_motion_step_identifies_the_observer_once_and_stores_it(tmp_path: Path) -> None:
     from sensing_antenna.campaign.simulated import prepare_antenna
     from sensing_antenna.campaign.store import read_stored_antenna

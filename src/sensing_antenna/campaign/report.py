@@ -432,7 +432,7 @@ def render_report(
         "- Contact points (cm): " + ", ".join(_cm(x, 0) for x in spec.contact_points),
         f"- Methods: {', '.join(spec.methods)} (each estimates the same recordings)",
         *_antenna_lines(antenna, device),
-        f"- Free-motion observer (Eq. 15): gain {obs.gain:.4g} N m s^2/rad, omega "
+        f"- Free-motion observer (Eq. 15): gain {obs.gain:.4g} N m/rad, omega "
         f"{obs.natural_frequency:.4g} rad/s, damping {obs.damping:.4g} 1/s, contact threshold "
         f"{obs.contact_threshold:.4g} N m"
         + (
