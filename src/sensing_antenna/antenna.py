@@ -15,7 +15,6 @@ All values are SI. Derived quantities (E I, m_b, T) are computed, never stored.
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from importlib import resources
@@ -23,11 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from sensing_antenna.errors import SensingAntennaError
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
+from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
     "BUILTIN_ANTENNAS",
@@ -280,10 +275,7 @@ def _builtin_text(name: str) -> str:
 
 
 def _parse_toml(text: str, source: str) -> dict[str, Any]:
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise AntennaConfigError("file", f"not valid TOML ({exc})", source) from exc
+    return parse_toml_text(text, lambda field, problem: AntennaConfigError(field, problem, source))
 
 
 def _merge(base: dict[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
@@ -354,13 +346,7 @@ def load_antenna(spec: str | Path | None = None) -> Antenna:
             f"no such file, and not a built-in set ({', '.join(BUILTIN_ANTENNAS)})",
             source,
         )
-    try:
-        text = path.read_text("utf-8")
-    except UnicodeDecodeError as exc:
-        raise AntennaConfigError("file", f"not UTF-8 text ({exc.reason})", source) from exc
-    except OSError as exc:
-        raise AntennaConfigError("file", f"cannot be read ({exc.strerror or exc})", source) from exc
-    data = _parse_toml(text, source)
+    data = parse_toml_file(path, lambda field, problem: AntennaConfigError(field, problem, source))
     base_name = data.get("base")
     if base_name is not None:
         if not isinstance(base_name, str) or base_name not in BUILTIN_ANTENNAS:

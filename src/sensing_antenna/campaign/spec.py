@@ -44,7 +44,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from importlib import resources
@@ -55,11 +54,7 @@ import numpy as np
 
 from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
 from sensing_antenna.errors import SensingAntennaError
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
+from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
     "CALIBRATION_STREAM",
@@ -785,10 +780,9 @@ def load_campaign_spec(path: str | Path | None = None) -> CampaignSpec:
     file = Path(path)
     if not file.is_file():
         raise CampaignSpecError("spec", "no such file", str(file))
-    try:
-        data = tomllib.loads(file.read_text("utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignSpecError("file", f"not valid TOML ({exc})", str(file)) from exc
+    data = parse_toml_file(
+        file, lambda field, problem: CampaignSpecError(field, problem, str(file))
+    )
     return parse_campaign_spec(data, str(file), base_dir=file.parent)
 
 
@@ -799,4 +793,7 @@ def default_campaign_spec() -> CampaignSpec:
         .joinpath(f"data/campaign-{DEFAULT_SPEC_NAME}.toml")
         .read_text("utf-8")
     )
-    return parse_campaign_spec(tomllib.loads(text), DEFAULT_SPEC_NAME)
+    data = parse_toml_text(
+        text, lambda field, problem: CampaignSpecError(field, problem, DEFAULT_SPEC_NAME)
+    )
+    return parse_campaign_spec(data, DEFAULT_SPEC_NAME)
