@@ -30,6 +30,9 @@ __all__ = [
 CASE_FIGURES = {"azimuthal": 16, "vertical": 17}
 
 _CM = 100.0
+#: Lowest error drawn on the log axis of the error-versus-x_c figure (cm): 10 micrometres, far
+#: below any physical resolution of the device.
+_ERROR_FLOOR_CM = 1e-3
 _METHOD_STYLE = {
     "paper": {"color": "tab:blue", "marker": "o"},
     "ratio": {"color": "tab:orange", "marker": "s"},
@@ -132,7 +135,9 @@ def plot_method_errors(
             style = _METHOD_STYLE.get(method, {"color": None, "marker": "."})
             ax.plot(
                 [p.x_c * _CM for p in table],
-                [p.mean_abs_error * _CM for p in table],
+                # errors below the display floor (e.g. an estimate that lands on a grid point of
+                # the truth) are drawn on the floor, not as a dive to 1e-14 cm
+                [max(p.mean_abs_error * _CM, _ERROR_FLOOR_CM) for p in table],
                 marker=style["marker"],
                 color=style["color"],
                 label=method,
@@ -147,6 +152,7 @@ def plot_method_errors(
                 label="paper (real device)",
             )
         ax.set_yscale("log")
+        ax.set_ylim(bottom=_ERROR_FLOOR_CM)
         ax.set_xlabel("real contact point x_c (cm)")
         ax.set_ylabel("mean absolute error (cm)")
         ax.set_title(f"{case} movement")
