@@ -18,8 +18,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.estimation.frequency import find_peak, power_spectrum
-from sensing_antenna.estimation.fusion import Evidence, conclude
+from sensing_antenna.estimation.evidence import Evidence
+from sensing_antenna.estimation.frequency import find_peak
+from sensing_antenna.estimation.fusion import conclude
 from sensing_antenna.estimation.ratio import paper_ratio
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
@@ -90,13 +91,10 @@ class TwoFrequencyMethod:
         omega2 = math.nan
         x_c = math.nan
         if measurement.clear and measurement.component in ("y_c", "z_c", "sum"):
-            window = evidence.spectrum_slice
-            projected = evidence.torque[window] @ evidence.frame.axes_m[1:].T
-            omega, power = power_spectrum(projected, evidence.sample_period, cfg.zero_padding)
-            spectra = {"y_c": power[:, 0], "z_c": power[:, 1], "sum": power.sum(axis=1)}
+            omega, spectrum = evidence.component_spectrum(measurement.component)
             low = max(float(omegas[:, 1].min()) / (1.0 + cfg.band_margin), 1.3 * measurement.omega1)
             high = float(omegas[:, 1].max()) * (1.0 + cfg.band_margin)
-            peak2 = find_peak(omega, spectra[measurement.component], (low, high))
+            peak2 = find_peak(omega, spectrum, (low, high))
             if peak2 is not None and peak2.quality >= cfg.min_peak_quality:
                 omega2 = peak2.omega
                 diag["omega2_quality"] = peak2.quality

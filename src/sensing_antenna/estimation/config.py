@@ -43,8 +43,27 @@ class EstimatorConfig:
         over 0.1 s from the touch to the contact threshold, and the link's free vibration
         (16.4 rad/s) averages out over the approach.
     frame_window : float
-        Average of force and angles over [t_1, t_1 + frame_window] (s) that defines the contact
-        frame; 20 ms averages 20 samples (noise / 4.5) while staying well inside the hold.
+        Hold window (s) after t_1 over which the static push is judged and the contact frame
+        built from the mean reaction and angles. 0.2 s: near the tip the link rebounds on the
+        obstacle for 0.1 to 0.45 s after the stop (a preload of 8 mN against the impact), so the
+        force at one instant can be near zero while the static push is not; 0.2 s holds one
+        period of the slowest contact vibration (31 rad/s), which then averages out, and ends
+        before the first convergence test of the ratio (t_1 + 2 convergence_window) needs it.
+    min_push_significance : float
+        A push counts when the mean perpendicular reaction over the hold exceeds this many
+        standard errors of that mean (sigma_F / sqrt(N), sigma_F measured in the recording).
+        The magnitude of a two-component Gaussian mean with no push exceeds k standard errors
+        with probability exp(-k^2 / 2): 4e-6 for 5.
+    loss_window : float
+        Length (s) of the short means in which contact losses (rebounds) are looked for in the
+        hold; 10 ms is a quarter of the fastest rebound seen on the simulator (40 ms).
+    loss_significance : float
+        A short mean of the reaction along the push below this many of its standard errors is a
+        contact loss (reported in the diagnostics); 3 standard errors.
+    max_gap : int
+        Largest number of consecutive missing samples inside [t_1, t_e] that linear
+        interpolation may fill; 3 samples is a tenth of the fastest vibration period in the
+        band (about 25 ms at 250 rad/s), longer gaps give ``bad_input``.
     spectrum_window : float
         Delta t_e1 (s), the record after t_1 analysed by Estimator 1. 1 s holds 5 periods of the
         lowest fundamental in the working range (31 rad/s, period 0.2 s) and gives a DFT bin of
@@ -79,19 +98,20 @@ class EstimatorConfig:
     max_ratio_wait : float
         If the ratio has not converged this long after t_1 (s), the estimate is given with
         ``slip_suspected``; 3 s is 15 filter time constants.
-    disagreement_tolerance : float
-        Largest accepted distance between the chosen frequency candidate and the ratio estimate
-        (m). 0.12 m (12 % of the paper's link) is above the ratio estimator's errors reported by
-        the paper (0.914 m for 0.85 m in Figure 14b, 3 % of length for prior methods) and above
-        its geometric bias at the 10 % deflection limit near the tip: the tilt of the contact
-        normal with the link's slope (1.5 y_c / x_c, Eq. 9) adds a moment y_c R_x, about
-        1.5 (y_c / x_c)^2 x_c, and the gravity sag adds a similar term in the vertical case.
-    ratio_resolution : float
-        The ratio chooses between two frequency candidates only when it is this much closer to
-        one than to the other (m); otherwise the second mode decides if it is clear. 5 cm:
-        the ratio's geometric bias at the 10 % deflection limit is about 1.5 cm at 1 m, and a
-        residual force offset of one sensor count (6 mN) on a 30 mN push near the tip moves it
-        by 3 cm more.
+    disagreement_sigmas : float
+        The chosen frequency candidate and the ratio estimate disagree when they are more than
+        this many standard uncertainties of the ratio apart (``Evidence.ratio_uncertainty``:
+        force noise through Eq. 20, residual sensor offset, small-deflection model). 4: a
+        Gaussian exceeds 4 sigma with probability 6e-5.
+    ratio_resolution_sigmas : float
+        The ratio chooses between two frequency candidates only when it is this many of its
+        standard uncertainties closer to one than to the other; otherwise the second mode
+        decides if it is clear. 2 (a wrong choice with probability about 2 % on a Gaussian).
+    ratio_model_factor : float
+        Coefficient of the small-deflection model term of the ratio uncertainty,
+        factor (y_c / x_c) x_c: the neglected moments are the axial force times the link's
+        slope (1.5 y_c / x_c, Eq. 9, times R_x / R_perp up to the friction coefficient 0.6)
+        and the weight of the bent link; 1.0 bounds 1.5 x 0.6 = 0.9.
     omega2_window : float
         Relative half-width of the search window around each candidate's predicted omega_2;
         0.05 is a quarter of the 20 % gap between the candidates' omega_2 at the curve's top.
@@ -103,10 +123,6 @@ class EstimatorConfig:
     max_ratio_drift : float
         Largest change (m) of the filtered ratio over the last ``convergence_window`` before t_e
         tolerated as a steady hold; beyond it the contact is drifting (slip). 2 cm.
-    min_push_force : float
-        Smallest contact force (N) at t_1, gravity removed, for a push to count as reached;
-        5 mN is a tenth of the link weight (0.045 N) and far above F/T sensor noise averaged over
-        ``frame_window``.
     min_nyquist_factor : float
         The Nyquist frequency pi / T_s must exceed this factor times the top of the omega_1 band;
         below it the recording cannot show the vibration (bad_input). 2 keeps the peak away from
@@ -117,7 +133,11 @@ class EstimatorConfig:
     rest_angle_tolerance: float = 1.0e-4
     rest_noise_factor: float = 8.0
     tare_margin: float = 0.3
-    frame_window: float = 0.02
+    frame_window: float = 0.2
+    min_push_significance: float = 5.0
+    loss_window: float = 0.01
+    loss_significance: float = 3.0
+    max_gap: int = 3
     spectrum_window: float = 1.0
     zero_padding: int = 16
     contact_range: tuple[float, float] = (0.2, 1.0)
@@ -128,13 +148,13 @@ class EstimatorConfig:
     convergence_window: float = 0.2
     convergence_tolerance: float = 0.01
     max_ratio_wait: float = 3.0
-    disagreement_tolerance: float = 0.12
-    ratio_resolution: float = 0.05
+    disagreement_sigmas: float = 4.0
+    ratio_resolution_sigmas: float = 2.0
+    ratio_model_factor: float = 1.0
     omega2_window: float = 0.05
     max_deflection_ratio: float = 0.1
     max_direction_drift: float = 0.15
     max_ratio_drift: float = 0.02
-    min_push_force: float = 0.005
     min_nyquist_factor: float = 2.0
 
     def __post_init__(self) -> None:
@@ -147,11 +167,9 @@ class EstimatorConfig:
                         f"contact_range: must satisfy 0 <= min < max <= 1, got {value!r}"
                     )
                 continue
-            if f.name == "zero_padding":
+            if f.name in ("zero_padding", "max_gap"):
                 if not (isinstance(value, int) and value >= 1):
-                    raise EstimatorConfigError(
-                        f"zero_padding: must be an integer >= 1, got {value!r}"
-                    )
+                    raise EstimatorConfigError(f"{f.name}: must be an integer >= 1, got {value!r}")
                 continue
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise EstimatorConfigError(f"{f.name}: must be a finite number > 0, got {value!r}")
@@ -160,7 +178,10 @@ class EstimatorConfig:
                 "rest_window: must not exceed convergence_window (t_1 is known rest_window "
                 "after it, before the first ratio window closes)"
             )
-        if self.frame_window > self.rest_window:
-            raise EstimatorConfigError("frame_window: must not exceed rest_window")
+        if self.frame_window > self.convergence_window:
+            raise EstimatorConfigError(
+                "frame_window: must not exceed convergence_window (the ratio's tolerance needs "
+                "the hold's push before the first convergence test)"
+            )
         if self.max_ratio_wait < self.convergence_window:
             raise EstimatorConfigError("max_ratio_wait: must be >= convergence_window")

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.fusion import Evidence, sensing_curve
+from sensing_antenna.estimation.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.parametric import DampedSinusoidFit, select_model_order
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
@@ -371,12 +371,19 @@ def scan(
     link: Link,
     x_range: tuple[float, float],
     config: FastConfig,
+    earliest: int = 0,
 ) -> ScanResult:
-    """Evaluate the growing window every ``cadence`` until sure, the cap or the samples' end."""
+    """Evaluate the growing window every ``cadence`` until sure, the cap or the samples' end.
+
+    Evaluations are on the grid t_1 + first_window + k cadence, from the first grid index at or
+    after ``earliest`` (the end of the pipeline's hold, before which there is no contact frame).
+    """
     first, step, last = evaluation_indices(rest_index, sample_period, config)
     final: WindowEstimate | None = None
     count = 0
     j = first
+    if earliest > j:
+        j += -(-(earliest - j) // step) * step
     while j <= min(last, last_available):
         final = evaluate_window(
             channels, bias, rest_index, j, sample_period, band, link, x_range, config
@@ -458,6 +465,7 @@ class FastMethod:
             evidence.antenna.link,
             x_range,
             self.config,
+            earliest=evidence.hold_end,
         )
         return conclude_fast(evidence, result, bias, self.config, self.name)
 
@@ -554,6 +562,8 @@ def conclude_fast(
         touch.deflection_ratio,
         evidence.config.max_deflection_ratio,
     )
+    if evidence.gap is not None:
+        found.append((Status.BAD_INPUT, evidence.gap))
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)

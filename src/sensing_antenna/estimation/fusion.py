@@ -11,24 +11,17 @@ every method shares (the 3D point and the physical consistency checks that set t
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import Antenna, Link
-from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.contact_frame import ContactFrame
-from sensing_antenna.estimation.frequency import (
-    FrequencyMeasurement,
-    find_peak,
-    measure_frequency,
-    power_spectrum,
-)
+from sensing_antenna.antenna import Link
+from sensing_antenna.estimation.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.frequency import find_peak
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.estimation.touch_point import touched_point
 
@@ -102,104 +95,6 @@ def fuse(candidates: Sequence[float], ratio_estimate: float, tolerance: float) -
     )
 
 
-@dataclass(frozen=True)
-class Evidence:
-    """Everything the pipeline knows at t_e, from the samples up to t_e only.
-
-    Built identically by the batch :func:`~sensing_antenna.estimation.pipeline.estimate` and the
-    streaming :class:`~sensing_antenna.estimation.pipeline.OnlineEstimator`; a method turns it
-    into a :class:`ContactEstimate`.
-
-    Attributes
-    ----------
-    t : array, shape (n,)
-        Sample times up to and including t_e (s).
-    theta, force, torque : array, shape (n, 2), (n, 3), (n, 3)
-        Samples up to t_e (rad, N, N m; motor frame).
-    sample_period : float
-        T_s (s).
-    antenna : Antenna
-    config : EstimatorConfig
-    contact_index, rest_index, end_index : int
-        Indices of t_c, t_1 and t_e (end_index = n - 1).
-    converged_index : int or None
-        Index of t_1 + Delta t_e2, None when the ratio never settled.
-    complete : bool
-        False when the samples ended before the planned t_e (recording too short).
-    frame : ContactFrame
-        Contact frame at t_1.
-    reaction_f, torque_f : array, shape (n, 3)
-        Filtered contact loads (Eq. 20 after removing gravity), motor frame (N, N m).
-    ratio : array, shape (n,)
-        Estimator 2, x_c(t) (m).
-    ratio_mean : array, shape (n,)
-        Its causal moving average over ``convergence_window`` from t_1 on (NaN before) (m).
-    load_offset : array, shape (6,)
-        Sensor offset removed from the loads (N, N m), see
-        :func:`~sensing_antenna.estimation.ratio.load_offset`.
-    ratio_noise : float
-        Expected standard deviation of the ratio from the force noise (m), see
-        :func:`~sensing_antenna.estimation.ratio.ratio_noise`.
-    band : tuple of float
-        omega_1 search band (rad/s).
-    diagnostics : dict
-        Front-end diagnostics (sampling, rest tolerance, ...).
-    """
-
-    t: FloatArray
-    theta: FloatArray
-    force: FloatArray
-    torque: FloatArray
-    sample_period: float
-    antenna: Antenna
-    config: EstimatorConfig
-    contact_index: int
-    rest_index: int
-    end_index: int
-    converged_index: int | None
-    complete: bool
-    frame: ContactFrame
-    reaction_f: FloatArray
-    torque_f: FloatArray
-    ratio: FloatArray
-    ratio_mean: FloatArray
-    load_offset: FloatArray
-    ratio_noise: float
-    band: tuple[float, float]
-    diagnostics: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def spectrum_slice(self) -> slice:
-        """Samples of the Delta t_e1 window after t_1 (shortened if the samples end first)."""
-        n_window = round(self.config.spectrum_window / self.sample_period)
-        return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
-
-    def measure_frequency(self) -> FrequencyMeasurement:
-        """Estimator 1's spectral measurement over Delta t_e1 after t_1."""
-        window = self.spectrum_slice
-        return measure_frequency(
-            self.torque[window],
-            self.frame.axes_m,
-            self.sample_period,
-            self.band,
-            self.config.min_peak_quality,
-            self.config.zero_padding,
-            t_start=float(self.t[window.start]),
-        )
-
-
-def sensing_curve(link: Link) -> Any:
-    """The omega_1(x_c) sensing curve of a link, built once per link."""
-    return _sensing_curve(link)
-
-
-@functools.lru_cache(maxsize=16)
-def _sensing_curve(link: Link) -> Any:
-    from sensing_antenna.beam import SensingCurve
-
-    return SensingCurve.from_link(link)
-
-
 def candidates_from_omega1(
     link: Link, omega1: float, x_range: tuple[float, float]
 ) -> tuple[tuple[float, ...], dict[str, Any]]:
@@ -260,6 +155,8 @@ def conclude(
     cfg = evidence.config
     e = evidence.end_index
     found: list[tuple[Status, str]] = list(problems)
+    if evidence.gap is not None:
+        found.append((Status.BAD_INPUT, evidence.gap))
     if not evidence.complete:
         have = evidence.t[e] - evidence.t[evidence.rest_index]
         if evidence.converged_index is None:
@@ -373,10 +270,7 @@ def second_mode_choice(
 
     cfg = evidence.config
     link = evidence.antenna.link
-    window = evidence.spectrum_slice
-    projected = evidence.torque[window] @ evidence.frame.axes_m[1:].T
-    omega, power = power_spectrum(projected, evidence.sample_period, cfg.zero_padding)
-    spectrum = {"y_c": power[:, 0], "z_c": power[:, 1]}.get(component, power.sum(axis=1))
+    omega, spectrum = evidence.component_spectrum(component)
     predicted = [float(natural_frequencies(link, x, 2)[1]) for x in candidates]
     low = min(predicted) / (1.0 + 2.0 * cfg.omega2_window)
     high = max(predicted) * (1.0 + 2.0 * cfg.omega2_window)
@@ -438,13 +332,17 @@ class PaperMethod:
             candidates_used: tuple[float, ...] = ()
         else:
             candidates_used = candidates
-        fusion = fuse(candidates_used, ratio_estimate, cfg.disagreement_tolerance)
+        # Tolerances from the ratio's own uncertainty (noise, tare, small-deflection model)
+        sigma_ratio = evidence.ratio_uncertainty(ratio_estimate)
+        tolerance = cfg.disagreement_sigmas * sigma_ratio
+        diag["ratio_uncertainty"] = sigma_ratio
+        fusion = fuse(candidates_used, ratio_estimate, tolerance)
         diag["discriminated_by"] = "ratio" if len(candidates_used) > 1 else None
         if len(candidates_used) == 2 and math.isfinite(ratio_estimate):
             margin = abs(
                 abs(candidates_used[0] - ratio_estimate) - abs(candidates_used[1] - ratio_estimate)
             )
-            if margin < cfg.ratio_resolution:
+            if margin < cfg.ratio_resolution_sigmas * sigma_ratio:
                 choice, notes = second_mode_choice(evidence, measurement.component, candidates_used)
                 diag["second_mode"] = notes
                 if choice is not None:
@@ -453,16 +351,17 @@ class PaperMethod:
                         x_c=x_pick,
                         chosen=choice,
                         distance=abs(x_pick - ratio_estimate),
-                        agree=abs(x_pick - ratio_estimate) <= cfg.disagreement_tolerance,
+                        agree=abs(x_pick - ratio_estimate) <= tolerance,
                     )
                     diag["discriminated_by"] = "omega2"
         if candidates_used and math.isfinite(ratio_estimate) and not fusion.agree:
             problems.append(
                 (
                     Status.ESTIMATORS_DISAGREE,
-                    f"the frequency candidate nearest to the ratio estimate is "
-                    f"{fusion.distance:.3f} m away from it (tolerance "
-                    f"{cfg.disagreement_tolerance:g} m)",
+                    f"the frequency candidate {fusion.x_c:.3f} m is {fusion.distance:.3f} m from "
+                    f"the ratio estimate {ratio_estimate:.3f} m, more than "
+                    f"{cfg.disagreement_sigmas:g} times the ratio's uncertainty "
+                    f"({sigma_ratio:.3f} m: noise, tare, small-deflection model)",
                 )
             )
         if "off_curve" in diag and abs(diag["off_curve"]) > cfg.band_margin:
