@@ -145,9 +145,17 @@ def power_spectrum(
 
 
 def find_peak(
-    omega: FloatArray, power: FloatArray, band: tuple[float, float]
+    omega: FloatArray,
+    power: FloatArray,
+    band: tuple[float, float],
+    lowest_clear: tuple[float, float] | None = None,
 ) -> SpectralPeak | None:
     """Highest local maximum of a power spectrum inside a band, refined by interpolation.
+
+    With ``lowest_clear = (min_quality, isolation)``, the lowest-frequency local maximum that is
+    clear (quality >= min_quality) and isolated (the largest power within +-isolation rad/s, so
+    not a side lobe of a stronger peak) is returned instead, when there is one: the fundamental
+    is the lowest mode, and a wide band may also hold the second mode, stronger in the torque.
 
     Parameters
     ----------
@@ -173,6 +181,14 @@ def find_peak(
         return None
     k = int(local[np.argmax(p[local])])
     floor = float(np.median(p[inside]))
+    if lowest_clear is not None and floor > 0.0:
+        min_quality, isolation = lowest_clear
+        reach = max(1, round(isolation / float(omega[1] - omega[0])))
+        for j in local:
+            lo, hi = max(0, j - reach), min(p.size, j + reach + 1)
+            if p[j] >= min_quality * floor and p[j] >= p[lo:hi].max():
+                k = int(j)
+                break
     if p[k] <= 0.0:
         return None
     tiny = np.finfo(float).tiny
@@ -223,7 +239,11 @@ def measure_frequency(
     projected = torque @ np.asarray(axes_m, dtype=float)[1:].T
     omega, power = power_spectrum(projected, sample_period, zero_padding)
     spectra = {"y_c": power[:, 0], "z_c": power[:, 1], "sum": power[:, 0] + power[:, 1]}
-    peaks = {name: find_peak(omega, spectra[name], band) for name in COMPONENTS}
+    # A side lobe of the Hann window is within 8 DFT bins of its peak (-50 dB beyond)
+    isolation = 8.0 * 2.0 * math.pi / (torque.shape[0] * sample_period)
+    peaks = {
+        name: find_peak(omega, spectra[name], band, (min_quality, isolation)) for name in COMPONENTS
+    }
     found = {name: peak for name, peak in peaks.items() if peak is not None}
     t_end = t_start + (torque.shape[0] - 1) * sample_period
     if not found:
