@@ -79,10 +79,13 @@ def summary(name: str, data: dict[str, Any]) -> str:
     point_text = (
         "-" if point[0] is None else "(" + ", ".join(f"{100 * v:.1f}" for v in point) + ") cm"
     )
+    x_c_text = _cm(data["x_c"])
+    if data["status"] != "ok" and data["x_c"] is not None:
+        x_c_text += f" (best guess, not confirmed: {data['reason']})"
     lines = [
         f"{name}: method {data['method']}",
         f"  status          {data['status']}" + (f" ({data['reason']})" if data["reason"] else ""),
-        f"  x_c             {_cm(data['x_c'])}",
+        f"  x_c             {x_c_text}",
         f"  candidates      {', '.join(_cm(c) for c in data['candidates']) or '-'}",
         f"  omega_1         {omega_text}",
         f"  ratio estimate  {_cm(data['ratio_estimate'])}",

@@ -443,7 +443,8 @@ class Evidence:
 
         Three independent terms, added in quadrature:
 
-        - the white force noise through the Eq. 20 filter (``ratio_noise``, taken at x = l);
+        - the white force noise through the Eq. 20 filter (``ratio_noise``, given at x = l, here
+          scaled to x_c: the ratio's error is x e_F / R_perp);
         - the residual sensor offset after the tare: errors e_F on R_perp and e_T on Gamma'
           move x = Gamma' / R_perp by x e_F / R_perp and e_T / R_perp;
         - the small-deflection model: the statics neglect terms of order (y_c / x_c) x_c
@@ -461,7 +462,8 @@ class Evidence:
         # Eq. 13: y_c / x_c = |R_perp| x_c^2 / (3 E I)
         deflection_ratio = push * x_c**2 / (3.0 * link.flexural_rigidity)
         model_term = self.config.ratio_model_factor * deflection_ratio * x_c
-        return math.sqrt(self.ratio_noise**2 + offset_term**2 + model_term**2)
+        noise_term = self.ratio_noise * x_c / link.length
+        return math.sqrt(noise_term**2 + offset_term**2 + model_term**2)
 
 
 def build_evidence(

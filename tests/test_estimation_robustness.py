@@ -1,0 +1,133 @@
+"""Robustness of the pipeline to real contact dynamics and model error (issue 4 follow-up).
+
+- the push is judged by the mean contact force over the hold after t_1, not at one instant
+  (near the tip the link rebounds on the obstacle after the stop);
+- a frequency candidate inconsistent with the ratio beyond the ratio's uncertainty is
+  ``estimators_disagree``, e.g. when T of the sensing curve is 7 % off (Section 5.1);
+- gaps of missing samples after t_1 are ``bad_input``;
+- the human-readable output of a doubtful estimate says it is a best guess.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import load_antenna, paper_antenna
+from sensing_antenna.cli.estimate import summary
+from sensing_antenna.estimation import OnlineEstimator, Status, estimate
+from sensing_antenna.recording import Recording
+from test_estimation_pipeline import Synthetic, comparable, synthetic_recording
+
+
+def test_push_judged_over_the_hold_despite_rebounds() -> None:
+    # The case of the issue: seed 5, x_c = 0.9 m, observer identified on a free sweep. Near
+    # the tip the link bounces on the post after the stop: the filtered force at t_1 was 1.9 mN
+    # and the push "not reached", while the static preload is about 10 mN (simulator truth).
+    from sensing_antenna.calibration.observer import identify_free_motion
+    from sensing_antenna.simulator import Scenario, simulate
+
+    antenna = paper_antenna()
+    fit = identify_free_motion(
+        simulate(antenna, Scenario(case="free", duration=3.0, seed=1)), antenna
+    )
+    antenna = dataclasses.replace(antenna, observer=fit.observer)
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.9, seed=5))
+    result = estimate(recording, antenna)
+    assert result.status is Status.OK, result.reason
+    true_xc = float(recording.metadata["true_xc"])
+    # The paper method's 1 cm mean error of issue 4; here one run, far below it.
+    assert result.x_c == pytest.approx(true_xc, abs=0.01)
+    assert result.diagnostics["rebounds"]["count"] >= 0
+
+
+def test_gentle_push_is_measured_against_noise_not_a_fixed_force() -> None:
+    # 0.2 % deflection at 0.9 m: |R| = 3 E I y_c / x_c^3 = 0.7 mN, far below the 5 mN of the
+    # old absolute rule but 20 standard errors of the hold mean (3.1 mN noise / sqrt(201)).
+    spec = Synthetic(x_c=0.9, deflection_ratio=0.002, seed=3)
+    result = estimate(synthetic_recording(spec), paper_antenna())
+    assert result.status is not Status.PUSH_NOT_REACHED, result.reason
+    # With a tenth of that push, the mean is within the noise: no push.
+    faint = Synthetic(x_c=0.9, deflection_ratio=0.00002, in_plane=400.0, out_of_plane=400.0)
+    result = estimate(synthetic_recording(faint), paper_antenna())
+    assert result.status in (Status.PUSH_NOT_REACHED, Status.NO_CONTACT), result.reason
+
+
+def test_model_error_gives_disagreement_not_a_confident_answer() -> None:
+    # Recording built with the theoretical T of the paper's link, estimated with the paper's
+    # calibrated T_e, 7 % lower (Section 5.1): the inverse sensing curve of T_e puts the
+    # measured omega_1 at 0.266 m for 0.3 m (3.4 cm off). The ratio does not depend on T; with a
+    # 2 % deflection (60 mN push) its uncertainty is about 6 mm, so 3.4 cm is beyond 3 sigma.
+    spec = Synthetic(x_c=0.3, deflection_ratio=0.02, seed=11)
+    recording = synthetic_recording(spec)
+    right = estimate(recording, paper_antenna())
+    assert right.status is Status.OK, right.reason
+    assert right.x_c == pytest.approx(0.3, abs=5e-3)
+    wrong = estimate(recording, load_antenna("paper-2021-calibrated"))
+    assert wrong.status is Status.ESTIMATORS_DISAGREE
+    reason = wrong.reason or ""
+    assert f"{wrong.x_c:.3f}" in reason and f"{wrong.ratio_estimate:.3f}" in reason
+    # the distance is more than the stated number of the ratio's standard uncertainties
+    sigma = wrong.diagnostics["ratio_uncertainty"]
+    assert abs(wrong.x_c - wrong.ratio_estimate) > 3.0 * sigma
+    assert math.isfinite(wrong.x_c)  # the best guess is still reported
+
+
+def _drop(recording: Recording, start: int, count: int) -> Recording:
+    keep = np.ones(recording.n_samples, dtype=bool)
+    keep[start : start + count] = False
+    return Recording(
+        t=recording.t[keep],
+        theta=recording.theta[keep],
+        force=recording.force[keep],
+        torque=recording.torque[keep],
+        metadata={"sample_period": "0.001"},
+    )
+
+
+def test_gap_after_t1_is_bad_input_online_and_offline() -> None:
+    recording = synthetic_recording(Synthetic(x_c=0.45, seed=2))
+    whole = estimate(recording, paper_antenna())
+    assert whole.ok
+    i_1 = int(np.searchsorted(recording.t, whole.t_1))
+    gapped = _drop(recording, i_1 + 300, 200)
+    result = estimate(gapped, paper_antenna())
+    assert result.status is Status.BAD_INPUT
+    assert "200 samples missing" in (result.reason or "")
+    online = OnlineEstimator(paper_antenna(), 1e-3)
+    for k in range(gapped.n_samples):
+        online.update(gapped.t[k], gapped.theta[k], gapped.force[k], gapped.torque[k])
+    final = online.finalize()
+    assert final.status is Status.BAD_INPUT and "200 samples missing" in (final.reason or "")
+    # A few missing samples are interpolated (3 in a row at most).
+    short = estimate(_drop(recording, i_1 + 300, 3), paper_antenna())
+    assert short.ok and short.x_c == pytest.approx(whole.x_c, abs=1e-3)
+
+
+def test_gap_before_contact_is_interpolated() -> None:
+    recording = synthetic_recording(Synthetic(x_c=0.45, seed=2))
+    result = estimate(_drop(recording, 200, 50), paper_antenna())
+    assert result.ok, result.reason
+
+
+def test_online_equals_offline_near_the_tip_with_a_gentle_push() -> None:
+    spec = Synthetic(x_c=0.95, deflection_ratio=0.01, seed=7, in_plane=2.0, out_of_plane=2.0)
+    recording = synthetic_recording(spec)
+    offline = estimate(recording, paper_antenna())
+    online = OnlineEstimator(paper_antenna(), 1e-3)
+    for k in range(recording.n_samples):
+        online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
+    assert comparable(online.finalize()) == comparable(offline)
+
+
+def test_human_output_says_best_guess_for_doubtful_estimates() -> None:
+    recording = synthetic_recording(Synthetic(x_c=0.3, deflection_ratio=0.02, seed=11))
+    wrong = estimate(recording, load_antenna("paper-2021-calibrated"))
+    text = summary("rec.csv", wrong.to_dict())
+    assert "best guess, not confirmed: " + (wrong.reason or "") in text
+    right = estimate(recording, paper_antenna())
+    assert "best guess" not in summary("rec.csv", right.to_dict())
+    assert wrong.to_dict()["x_c"] == wrong.x_c  # JSON keeps the best guess
