@@ -9,7 +9,6 @@
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -17,20 +16,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import Link
-from sensing_antenna.estimation.evidence import Evidence
+from sensing_antenna.estimation.evidence import Evidence, two_frequency_curve
 from sensing_antenna.estimation.frequency import find_peak
 from sensing_antenna.estimation.fusion import conclude
 from sensing_antenna.estimation.ratio import paper_ratio
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
-__all__ = ["RatioMethod", "TwoFrequencyMethod", "two_frequency_curve"]
+__all__ = ["RatioMethod", "TwoFrequencyMethod"]
 
 FloatArray = NDArray[np.float64]
-
-#: Spacing of the x_c grid on which the (omega_1, omega_2) curve is tabulated (m); 0.5 mm is
-#: twenty times finer than the paper's typical error.
-_GRID_STEP = 5e-4
 
 
 @dataclass(frozen=True)
@@ -52,25 +46,6 @@ class RatioMethod:
         )
         x_c = float(ratio[evidence.end_index])
         return conclude(evidence, self.name, x_c, ratio_estimate=x_c)
-
-
-@functools.lru_cache(maxsize=16)
-def two_frequency_curve(link: Link, x_min: float, x_max: float) -> tuple[FloatArray, FloatArray]:
-    """Tabulated sensing curve (omega_1, omega_2)(x_c) of Figure 9.
-
-    Returns
-    -------
-    x : array, shape (m,)
-        Contact points (m).
-    omegas : array, shape (m, 2)
-        First two natural frequencies in contact (rad/s).
-    """
-    from sensing_antenna.beam import natural_frequencies
-
-    x = np.arange(x_min, x_max + 0.5 * _GRID_STEP, _GRID_STEP)
-    x = x[(x > 0.0) & (x <= link.length)]
-    omegas = np.asarray(natural_frequencies(link, x, 2), dtype=float)
-    return x, omegas
 
 
 @dataclass(frozen=True)

@@ -63,6 +63,7 @@ __all__ = [
     "search_band",
     "sensing_curve",
     "time_gaps",
+    "two_frequency_curve",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -83,6 +84,30 @@ def _sensing_curve(link: Link) -> Any:
     from sensing_antenna.beam import SensingCurve
 
     return SensingCurve.from_link(link)
+
+
+#: Spacing of the x_c grid on which the (omega_1, omega_2) curve is tabulated (m); 0.5 mm is
+#: twenty times finer than the paper's typical error.
+TWO_FREQUENCY_GRID_STEP = 5e-4
+
+
+@functools.lru_cache(maxsize=16)
+def two_frequency_curve(link: Link, x_min: float, x_max: float) -> tuple[FloatArray, FloatArray]:
+    """Tabulated sensing curve (omega_1, omega_2)(x_c) of Figure 9.
+
+    Returns
+    -------
+    x : array, shape (m,)
+        Contact points (m).
+    omegas : array, shape (m, 2)
+        First two natural frequencies in contact (rad/s).
+    """
+    from sensing_antenna.beam import natural_frequencies
+
+    x = np.arange(x_min, x_max + 0.5 * TWO_FREQUENCY_GRID_STEP, TWO_FREQUENCY_GRID_STEP)
+    x = x[(x > 0.0) & (x <= link.length)]
+    omegas = np.asarray(natural_frequencies(link, x, 2), dtype=float)
+    return x, omegas
 
 
 def search_band(link: Link, config: EstimatorConfig) -> tuple[float, float]:

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.estimation.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.evidence import Evidence, sensing_curve, two_frequency_curve
 from sensing_antenna.estimation.frequency import find_peak
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.estimation.touch_point import touched_point
@@ -266,12 +266,15 @@ def second_mode_choice(
     candidate's omega_2; the candidate whose window holds a clear peak (and the other not, or
     a weaker one) is chosen.
     """
-    from sensing_antenna.beam import natural_frequencies
-
     cfg = evidence.config
     link = evidence.antenna.link
     omega, spectrum = evidence.component_spectrum(component)
-    predicted = [float(natural_frequencies(link, x, 2)[1]) for x in candidates]
+    # omega_2 at each candidate from the tabulated (omega_1, omega_2) curve (0.5 mm grid, far
+    # finer than the omega2_window search) instead of solving the beam model at t_e
+    grid, omegas = two_frequency_curve(
+        link, cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length
+    )
+    predicted = [float(np.interp(x, grid, omegas[:, 1])) for x in candidates]
     low = min(predicted) / (1.0 + 2.0 * cfg.omega2_window)
     high = max(predicted) * (1.0 + 2.0 * cfg.omega2_window)
     floor = float(np.median(spectrum[(omega >= low) & (omega <= high)]))
