@@ -12,6 +12,7 @@ from scipy import signal
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.estimation.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
+    DEFAULT_TARE_TIME,
     ContactConfigError,
     ContactDetector,
     detect_contact,
@@ -247,3 +248,23 @@ def test_simulated_contact_is_detected_after_the_true_touch() -> None:
     # 3 E I / x_c * speed = 0.14 N m/s at 0.3 rad/s, reaching 0.02 N m within 0.15 s
     # (plus 10 ms of filter lag).
     assert true_touch <= result.t_c <= true_touch + 0.16
+
+
+def test_sensor_offset_is_tared_out(free_motion: tuple[np.ndarray, np.ndarray]) -> None:
+    # A constant torque offset of 0.05 N m per axis (2.5 times the paper's 0.02 N m threshold,
+    # the kind of strain-gauge offset that drifts between runs) would cross the threshold at the
+    # first sample; taring over the first DEFAULT_TARE_TIME removes it, in both forms.
+    theta, torque = free_motion
+    rng = np.random.default_rng(5)
+    offset = np.array([0.05, -0.05, 0.05])
+    assert np.linalg.norm(offset) > ANTENNA.observer.contact_threshold  # precondition
+    rec = _recording(torque + offset + rng.normal(scale=NOISE, size=torque.shape), theta)
+    result = detect_contact(rec, ANTENNA)
+    assert result.status == "no_contact"
+    n_tare = round(DEFAULT_TARE_TIME / TS)
+    assert np.all(result.filtered_residual_norm[:n_tare] == 0.0)  # no decision while taring
+    detector = ContactDetector(ANTENNA, TS)
+    assert not any(
+        detector.update(rec.t[k], rec.theta[k], rec.force[k], rec.torque[k])
+        for k in range(rec.n_samples)
+    )
