@@ -22,7 +22,7 @@ What the final y_c / x_c adds up to (simulated device, vibration-free 0.3 rad/s 
   0.02 N m that is 0.022 rad at 0.3 m and 0.073 rad at the tip: shallow pushes near the tip are
   then impossible, and the device's threshold must be identified (``antenna identify``,
   Section 5.2). With an observer identified on a simulated free motion (threshold about
-  0.0003 N m) the delay is a few ms, under 0.002 rad;
+  0.0002 N m after taring) the delay is a few ms, under 0.002 rad;
 - ``DEFAULT_ROTATION`` = 0.03 rad;
 - the servo's travel after the reference freezes: 2 eps omega* = 0.01 rad for Eq. 14 with
   eps = 16.7 ms at 0.3 rad/s. The simulated controller compensates it by freezing the reference
