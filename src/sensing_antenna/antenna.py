@@ -21,7 +21,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import FieldError
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
@@ -41,18 +41,11 @@ __all__ = [
 STANDARD_GRAVITY = 9.80665
 
 
-class AntennaConfigError(SensingAntennaError, ValueError):
+class AntennaConfigError(FieldError):
     """An antenna parameter is missing, unknown or out of range.
 
     The message always names the field (``link.length``) and, when known, the file.
     """
-
-    def __init__(self, field_name: str, problem: str, source: str | None = None) -> None:
-        self.field_name = field_name
-        self.problem = problem
-        self.source = source
-        where = f"{source}: " if source else ""
-        super().__init__(f"{where}{field_name}: {problem}")
 
 
 def _require_positive(owner: str, name: str, value: float) -> None:

@@ -53,7 +53,7 @@ from typing import Any
 import numpy as np
 
 from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import FieldError
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
@@ -156,15 +156,8 @@ _TOP_LEVEL_KEYS = (
 )
 
 
-class CampaignSpecError(SensingAntennaError, ValueError):
+class CampaignSpecError(FieldError):
     """A campaign spec field is missing, unknown or invalid; the message names file and field."""
-
-    def __init__(self, field_name: str, problem: str, source: str | None = None) -> None:
-        self.field_name = field_name
-        self.problem = problem
-        self.source = source
-        where = f"{source}: " if source else ""
-        super().__init__(f"{where}{field_name}: {problem}")
 
 
 @dataclass(frozen=True)

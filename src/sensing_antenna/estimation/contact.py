@@ -255,25 +255,15 @@ def detect_contact(
     estimated, residual, norm = contact_residual(uniform, antenna, residual_cutoff, tare_time)
     above = np.flatnonzero(norm > limit)
     note = " (irregular sampling: linearly resampled first)" if resampled else ""
-    if above.size == 0:
-        return ContactDetection(
-            status="no_contact",
-            reason=f"filtered residual stays at or below {limit:g} N m{note}",
-            t_c=None,
-            index=None,
-            t=uniform.t,
-            residual=residual,
-            filtered_residual_norm=norm,
-            estimated_torque=estimated,
-            threshold=limit,
-            residual_cutoff=residual_cutoff,
-            resampled=resampled,
-        )
-    index = int(above[0])
-    t_c = float(uniform.t[index])
+    index = int(above[0]) if above.size else None
+    t_c = float(uniform.t[index]) if index is not None else None
     return ContactDetection(
-        status="contact",
-        reason=f"filtered residual exceeds {limit:g} N m at t = {t_c:g} s{note}",
+        status="no_contact" if t_c is None else "contact",
+        reason=(
+            f"filtered residual stays at or below {limit:g} N m{note}"
+            if t_c is None
+            else f"filtered residual exceeds {limit:g} N m at t = {t_c:g} s{note}"
+        ),
         t_c=t_c,
         index=index,
         t=uniform.t,

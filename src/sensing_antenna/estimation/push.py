@@ -98,7 +98,7 @@ class PushCriterion:
         What is compared with ``threshold`` (module docstring).
     threshold : float
         rad of head rotation past t_c, N of filtered |F - F_g|, or N m of filtered
-        |Gamma - Gamma_g|. Default 0.02 rad.
+        |Gamma - Gamma_g|. Default ``DEFAULT_ROTATION`` (0.03 rad).
     cutoff : float
         omega_c of the Eq. 20 low-pass filter for the force and torque kinds (rad/s); 5 rad/s as
         in the paper.
@@ -249,7 +249,7 @@ def detect_push(
         Irregular sampling is handled by linear resampling first, as in ``detect_contact``.
     antenna : Antenna
     criterion : PushCriterion, optional
-        Default ``PushCriterion()`` (0.02 rad of rotation).
+        Default ``PushCriterion()`` (``DEFAULT_ROTATION`` of rotation).
     threshold, residual_cutoff
         Passed to :func:`~sensing_antenna.estimation.contact.detect_contact`.
 
