@@ -13,6 +13,7 @@ Usage::
 
     python benchmarks/eval_fast.py            # full grid, noise 0.5 / 1 / 2, 2 seeds
     python benchmarks/eval_fast.py --quick    # 4 positions, noise 1, 1 seed
+    python benchmarks/eval_fast.py --cache /tmp/fast_cache   # reuse simulated recordings
 
 Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
 """
@@ -22,12 +23,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import pickle
 import statistics
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.estimation.fast import FastMethod
@@ -37,14 +40,36 @@ from sensing_antenna.simulator import Scenario, simulate_detailed
 GRID = (*np.round(np.arange(0.30, 0.951, 0.05), 2), 0.98)
 QUICK_GRID = (0.30, 0.60, 0.78, 0.98)
 OUT = Path(__file__).parent / "results" / "fast.json"
+FloatArray = NDArray[np.float64]
 
 
-def run_one(case: str, x_c: float, seed: int, noise: float) -> list[dict[str, Any]]:
+def simulated(
+    case: str, x_c: float, seed: int, noise: float, cache: Path | None
+) -> tuple[Any, FloatArray]:
+    """The recording and the simulator's contact abscissa, from ``cache`` when stored there."""
     antenna = paper_antenna()
-    detail = simulate_detailed(
-        antenna, Scenario(case=case, contact_point=float(x_c), seed=seed, noise_scale=noise)
-    )
-    recording = detail.recording
+    scenario = Scenario(case=case, contact_point=float(x_c), seed=seed, noise_scale=noise)
+    path = None
+    if cache is not None:
+        path = cache / f"{case}_{x_c:.2f}_{seed}_{noise:g}.pkl"
+        if path.exists():
+            with path.open("rb") as handle:
+                stored: tuple[Any, FloatArray] = pickle.load(handle)
+            return stored
+    detail = simulate_detailed(antenna, scenario)
+    pair = (detail.recording, np.asarray(detail.contact_abscissa, dtype=float))
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.open("wb") as handle:
+            pickle.dump(pair, handle)
+    return pair
+
+
+def run_one(
+    case: str, x_c: float, seed: int, noise: float, cache: Path | None = None
+) -> list[dict[str, Any]]:
+    antenna = paper_antenna()
+    recording, contact_abscissa = simulated(case, x_c, seed, noise, cache)
     rows = []
     for name, method in (("paper", "paper"), ("fast", FastMethod())):
         start = time.perf_counter()
@@ -53,7 +78,7 @@ def run_one(case: str, x_c: float, seed: int, noise: float) -> list[dict[str, An
         truth = math.nan
         if math.isfinite(result.t_1):
             i1 = round((result.t_1 - recording.t[0]) / recording.sample_period)
-            truth = float(np.mean(detail.contact_abscissa[i1 : i1 + 500]))
+            truth = float(np.mean(contact_abscissa[i1 : i1 + 500]))
         interval = result.interval
         rows.append(
             {
@@ -120,6 +145,10 @@ def main() -> None:
         default=200,
         help="first seed (100: the seeds used to set FastConfig.resolution_fraction)",
     )
+    parser.add_argument(
+        "--cache", type=Path, default=None, help="directory of stored simulated recordings"
+    )
+    parser.add_argument("--out", type=Path, default=OUT, help="JSON output")
     args = parser.parse_args()
     grid = QUICK_GRID if args.quick else GRID
     seeds = range(1) if args.quick else range(args.seeds)
@@ -129,7 +158,7 @@ def main() -> None:
         for case in ("azimuthal", "vertical"):
             for x_c in grid:
                 for seed in seeds:
-                    rows.extend(run_one(case, float(x_c), args.seed_base + seed, noise))
+                    rows.extend(run_one(case, float(x_c), args.seed_base + seed, noise, args.cache))
     table = summarise(rows)
     header = (
         f"{'method':7} {'noise':>5} {'runs':>4} {'med t_e-t_1':>11} {'MAE mm':>7} "
@@ -162,9 +191,9 @@ def main() -> None:
             f"err={1000 * r['error']:+.1f} mm status={r['status']} delay={r['delay']:.3f} s "
             f"interval={r['interval']}"
         )
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps({"summary": table, "runs": rows}, indent=1, default=float))
-    print(f"wrote {OUT}")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps({"summary": table, "runs": rows}, indent=1, default=float))
+    print(f"wrote {args.out}")
 
 
 if __name__ == "__main__":
