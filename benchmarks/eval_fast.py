@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.estimation.fast import FastMethod
 from sensing_antenna.estimation.pipeline import estimate
+from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate_detailed
 
 GRID = (*np.round(np.arange(0.30, 0.951, 0.05), 2), 0.98)
@@ -45,7 +46,7 @@ FloatArray = NDArray[np.float64]
 
 def simulated(
     case: str, x_c: float, seed: int, noise: float, cache: Path | None
-) -> tuple[Any, FloatArray]:
+) -> tuple[Recording, FloatArray]:
     """The recording and the simulator's contact abscissa, from ``cache`` when stored there."""
     antenna = paper_antenna()
     scenario = Scenario(case=case, contact_point=float(x_c), seed=seed, noise_scale=noise)
@@ -54,14 +55,24 @@ def simulated(
         path = cache / f"{case}_{x_c:.2f}_{seed}_{noise:g}.pkl"
         if path.exists():
             with path.open("rb") as handle:
-                stored: tuple[Any, FloatArray] = pickle.load(handle)
-            return stored
+                fields, abscissa = pickle.load(handle)
+            return Recording(**fields), abscissa
     detail = simulate_detailed(antenna, scenario)
     pair = (detail.recording, np.asarray(detail.contact_abscissa, dtype=float))
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         with path.open("wb") as handle:
-            pickle.dump(pair, handle)
+            record = detail.recording
+            fields = {
+                "t": record.t,
+                "theta": record.theta,
+                "force": record.force,
+                "torque": record.torque,
+                "metadata": dict(record.metadata),
+                "extra": dict(record.extra),
+                "source": record.source,
+            }
+            pickle.dump((fields, pair[1]), handle)
     return pair
 
 
