@@ -28,8 +28,10 @@ from sensing_antenna.estimation import (
     estimate,
     measure_omega1,
 )
+from sensing_antenna.estimation.config import EstimatorConfigError
 from sensing_antenna.estimation.contact_frame import motor_axes
 from sensing_antenna.recording import Recording
+from sensing_antenna.simulator import Scenario, simulate
 
 TS = 1e-3
 #: One resolution count of an ATI Nano17 (N, N m), the sensor noise of the synthetic device.
@@ -310,3 +312,33 @@ def test_config_changes_delta_t_e1() -> None:
     long = estimate(recording, paper_antenna(), config=EstimatorConfig(spectrum_window=1.2))
     assert short.t_e < long.t_e
     assert long.t_e - long.t_1 == pytest.approx(1.2, abs=2e-3)
+
+
+def test_t1_from_the_push_criterion_is_the_controllers_stop_and_online_equals_offline() -> None:
+    """Section 4 step 4: with t1_source = "push" the pipeline's t_1 is the push criterion's
+    decision. The simulator's controller stops its motors with the same criterion
+    (PushMonitor, default PushCriterion) on the same samples, so t_1 must be the simulator's
+    recorded stop instant exactly (an independent check), and online equals offline."""
+    antenna = paper_antenna()
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.55, seed=4))
+    stop = float(recording.metadata["true_t_stop"])  # read for evaluation only
+    blind = recording.without_ground_truth()
+    config = EstimatorConfig(t1_source="push")
+    offline = estimate(blind, antenna, config=config)
+    assert offline.t_1 == pytest.approx(stop, abs=1e-12)
+    online = OnlineEstimator(antenna, blind.sample_period, config=config)
+    result = None
+    for k in range(blind.n_samples):
+        result = online.update(blind.t[k], blind.theta[k], blind.force[k], blind.torque[k])
+        if result is not None:
+            break
+    assert result is not None
+    assert comparable(result) == comparable(offline)  # the whole-file sampling report aside
+    rest = estimate(blind, antenna)  # the default rest rule finds the same stop a little later
+    assert 0.0 <= rest.t_1 - offline.t_1 < 0.03
+    assert abs(rest.x_c - offline.x_c) < 0.005
+
+
+def test_t1_source_is_validated() -> None:
+    with pytest.raises(EstimatorConfigError, match="t1_source"):
+        EstimatorConfig(t1_source="later")  # type: ignore[arg-type]

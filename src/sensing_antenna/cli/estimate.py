@@ -30,6 +30,13 @@ def register(subparsers: Any) -> None:
         help="fast method: declare when the 95 %% interval of x_c is narrower than this (m, "
         "default 0.005)",
     )
+    parser.add_argument(
+        "--t1",
+        choices=("rest", "push"),
+        default="rest",
+        help="t_1 from the head coming to rest (default: any device) or from the default push "
+        "criterion's decision (a device that stops with it, such as our simulator)",
+    )
     parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)
@@ -37,6 +44,7 @@ def register(subparsers: Any) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.estimation.pipeline import estimate
     from sensing_antenna.recording import read_recording
 
@@ -45,7 +53,7 @@ def _run(args: argparse.Namespace) -> int:
         method = _fast_with_tolerance(args.method, args.tolerance)
     antenna = load_antenna(args.antenna)
     recording = read_recording(args.recording)
-    result = estimate(recording, antenna, method=method)
+    result = estimate(recording, antenna, method=method, config=EstimatorConfig(t1_source=args.t1))
     if args.json:
         data = {"recording": str(args.recording), **result.to_dict()}
         print(json.dumps(data, allow_nan=False))

@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Literal
 
 from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.estimation.push import PushCriterion
 
-__all__ = ["EstimatorConfig", "EstimatorConfigError"]
+__all__ = ["EstimatorConfig", "EstimatorConfigError", "no_t1_reason"]
 
 
 class EstimatorConfigError(SensingAntennaError, ValueError):
@@ -23,6 +25,15 @@ class EstimatorConfig:
 
     Parameters
     ----------
+    t1_source : {"rest", "push"}
+        How t_1 is found. ``"rest"`` (default): the instant the head comes to rest after the
+        contact, read from the angles, which works on any recording whatever push criterion
+        stopped its motors. ``"push"``: the push criterion's own decision (``push_criterion``,
+        Section 4 step 4), as the controller that stops the motors takes it; use it when the
+        recording comes from a device whose stop rule is that criterion. Both forms (batch and
+        streaming) use the same rule, so they stay identical.
+    push_criterion : PushCriterion or None
+        The criterion for ``t1_source = "push"``; None: ``PushCriterion()``.
     rest_window : float
         Offline t_1 (s): the head is at rest at t_1 when, for this long after t_1, neither motor
         angle moves by more than the rest tolerance. 50 ms is 2.5 % of the slowest contact
@@ -131,6 +142,8 @@ class EstimatorConfig:
         the anti-aliasing roll-off.
     """
 
+    t1_source: Literal["rest", "push"] = "rest"
+    push_criterion: PushCriterion | None = None
     rest_window: float = 0.05
     rest_angle_tolerance: float = 1.0e-4
     rest_noise_factor: float = 8.0
@@ -160,8 +173,18 @@ class EstimatorConfig:
     min_nyquist_factor: float = 2.0
 
     def __post_init__(self) -> None:
+        if self.t1_source not in ("rest", "push"):
+            raise EstimatorConfigError(
+                f"t1_source: must be 'rest' or 'push', got {self.t1_source!r}"
+            )
+        if self.push_criterion is not None and not isinstance(self.push_criterion, PushCriterion):
+            raise EstimatorConfigError(
+                f"push_criterion: must be a PushCriterion or None, got {self.push_criterion!r}"
+            )
         for f in fields(self):
             value = getattr(self, f.name)
+            if f.name in ("t1_source", "push_criterion"):
+                continue
             if f.name == "contact_range":
                 low, high = value
                 if not (0.0 <= low < high <= 1.0):
@@ -187,3 +210,17 @@ class EstimatorConfig:
             )
         if self.max_ratio_wait < self.convergence_window:
             raise EstimatorConfigError("max_ratio_wait: must be >= convergence_window")
+
+
+def no_t1_reason(config: EstimatorConfig, rest_tolerance: float) -> str:
+    """Why t_1 was not found after t_c, in words, for either ``t1_source``."""
+    if config.t1_source == "push":
+        rule = config.push_criterion or PushCriterion()
+        return (
+            f"the push criterion ({rule.kind} above {rule.threshold:g} {rule.unit}) is never "
+            "met after t_c"
+        )
+    return (
+        f"the head never came to rest after t_c (angles within {rest_tolerance:.2g} rad for "
+        f"{config.rest_window:g} s)"
+    )

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
-from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
 from sensing_antenna.estimation.contact import ContactDetector
 from sensing_antenna.estimation.evidence import (
     ContactStart,
@@ -31,6 +31,7 @@ from sensing_antenna.estimation.evidence import (
 )
 from sensing_antenna.estimation.filters import FirstOrderLowPass
 from sensing_antenna.estimation.methods import EstimationMethod, resolve_method
+from sensing_antenna.estimation.push import PushCriterion, PushMonitor
 from sensing_antenna.estimation.ratio import (
     filtered_contact_loads,
     perpendicular_ratio,
@@ -108,6 +109,17 @@ class OnlineEstimator:
         self._half_moment = 0.5 * self._weight * antenna.link.length
         self._rigidity = antenna.link.flexural_rigidity
         self._detector = ContactDetector(antenna, self.sample_period)
+        # t1_source = "push": the push criterion's decision, with the same contact detector inside
+        self._push = (
+            PushMonitor(
+                cfg.push_criterion or PushCriterion(),
+                antenna,
+                self.sample_period,
+                contact_detector=self._detector,
+            )
+            if cfg.t1_source == "push"
+            else None
+        )
         self._filters = [
             FirstOrderLowPass(cfg.lowpass_cutoff, self.sample_period) for _ in range(6)
         ]
@@ -115,7 +127,9 @@ class OnlineEstimator:
 
     def reset(self) -> None:
         """Forget every sample: ready for a new manoeuvre."""
-        self._detector.reset()
+        self._detector.reset()  # the push monitor, if any, shares it
+        if self._push is not None:
+            self._push.reset()
         for low_pass in self._filters:
             low_pass.reset()
         capacity = 4096
@@ -195,8 +209,15 @@ class OnlineEstimator:
         filters[3].update(tx)
         g_y = filters[4].update(ty - self._half_moment * cos2)
         g_z = filters[5].update(tz)
+        pushed = False
+        if self._push is not None and self._rest is None:
+            pushed = self._push.update(t, (theta1, theta2), force, torque)
         if self._contact is None:
-            if not self._detector.update(t, (theta1, theta2), force, torque):
+            if self._push is not None:
+                detected = self._detector.detected
+            else:
+                detected = self._detector.update(t, (theta1, theta2), force, torque)
+            if not detected:
                 return None
             index = self._detector.contact_index
             self._contact = j if index is None else index
@@ -212,7 +233,11 @@ class OnlineEstimator:
             self._tolerance = self._start.rest_tolerance
             self._offset = tuple(float(v) for v in self._start.offset)
         if self._rest is None:
-            if not self._rest_found(j):
+            if self._push is not None:
+                if not pushed:
+                    return None
+                self._begin_hold(j, j)
+            elif not self._rest_found(j):
                 return None
         else:
             offset = self._offset
@@ -264,6 +289,11 @@ class OnlineEstimator:
         spread = window.max(axis=0) - window.min(axis=0)
         if not (spread[0] <= self._tolerance and spread[1] <= self._tolerance):
             return False
+        self._begin_hold(start, j)
+        return True
+
+    def _begin_hold(self, start: int, j: int) -> None:
+        """t_1 is sample ``start`` (known at sample j): fill the ratio from there."""
         self._rest = start
         reaction_f, torque_f = filtered_contact_loads(
             self._theta[: j + 1],
@@ -277,7 +307,6 @@ class OnlineEstimator:
         self._ratio[start : j + 1] = perpendicular_ratio(
             reaction_f[start : j + 1], torque_f[start : j + 1], self._rigidity
         )
-        return True
 
     def _judge_hold(self, j: int) -> ContactEstimate | None:
         """The push over the hold (same function as offline); a result when there is none."""
@@ -383,12 +412,10 @@ class OnlineEstimator:
             )
         t_c = float(self._t[self._contact])
         if self._rest is None:
-            cfg = self.config
             return self._emit(
                 early_result(
                     Status.PUSH_NOT_REACHED,
-                    f"the head never came to rest after t_c (angles within "
-                    f"{self._tolerance:.2g} rad for {cfg.rest_window:g} s)",
+                    no_t1_reason(self.config, self._tolerance),
                     name,
                     self._diagnostics(),
                     t_c=t_c,

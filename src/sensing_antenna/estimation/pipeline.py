@@ -21,7 +21,7 @@ import math
 from typing import Any
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
 from sensing_antenna.estimation.contact import detect_contact
 from sensing_antenna.estimation.contact_frame import first_rest_index
 from sensing_antenna.estimation.evidence import (
@@ -44,6 +44,7 @@ from sensing_antenna.estimation.methods import (
     resolve_method,
 )
 from sensing_antenna.estimation.online import OnlineEstimator, early_result
+from sensing_antenna.estimation.push import detect_push
 from sensing_antenna.estimation.ratio import (
     converged_index,
     filtered_contact_loads,
@@ -120,13 +121,15 @@ def estimate(
     diagnostics.update(
         {"rest_tolerance": tolerance, "tare": start.tare, "load_offset": start.offset}
     )
-    w_rest = samples(cfg.rest_window, sample_period)
-    i_1 = first_rest_index(theta, i_c, w_rest, tolerance)
+    if cfg.t1_source == "push":
+        # Section 4 step 4: t_1 is the push criterion's decision (same detector as t_c)
+        i_1 = detect_push(uniform, antenna, cfg.push_criterion).index
+    else:
+        i_1 = first_rest_index(theta, i_c, samples(cfg.rest_window, sample_period), tolerance)
     if i_1 is None:
         return early_result(
             Status.PUSH_NOT_REACHED,
-            f"the head never came to rest after t_c (angles within {tolerance:.2g} rad for "
-            f"{cfg.rest_window:g} s)",
+            no_t1_reason(cfg, tolerance),
             impl.name,
             diagnostics,
             t_c=t_c,
