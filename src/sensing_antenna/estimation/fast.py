@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
+from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
@@ -137,6 +138,13 @@ class FastConfig:
         Largest angle (rad) between the perpendicular reaction over the first 20 ms after t_1
         and the fitted static one at t_e (both with the sensor bias removed) before a slip is
         suspected; 0.15 rad as the pipeline's ``max_direction_drift``.
+    higher_mode_floor : float
+        Relative model error of the higher contact modes (2 and 3) against their pinned-contact
+        sensing curves (dimensionless), added in quadrature. 0.005: the compliant contact of the
+        finite-element simulator lowers them by 0.2 to 0.35 % (0.5 s fits at noise 1, seed 200
+        of benchmarks/eval_fast.py, 30 runs; see docs/fast.md), a stiffer contact less; the
+        floor covers that bias at about 1.5 standard deviations. On a real device use the
+        scatter of a calibration of the higher modes.
     """
 
     tolerance: float = 0.005
@@ -155,6 +163,7 @@ class FastConfig:
     bias_min_samples: int = 20
     max_direction_drift: float = 0.15
     peak_margin: float = 3.0
+    higher_mode_floor: float = 0.005
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -180,6 +189,7 @@ class _Curve:
     grid: FloatArray
     omega1: FloatArray
     edges: tuple[float, ...]
+    higher: FloatArray
 
 
 @functools.lru_cache(maxsize=16)
@@ -188,7 +198,9 @@ def _curve_table(link: Link, low: float, high: float, step: float) -> _Curve:
     n = max(2, round((high - low) / step) + 1)
     grid = np.linspace(low, high, n)
     inner = tuple(x for x in curve.extrema if low < x < high)
-    return _Curve(grid, np.asarray(curve.omega1(grid), dtype=float), (low, *inner, high))
+    # Contact modes 2 and 3 (Eq. 3 with the boundary conditions of Eq. 4), shape (G, 2)
+    higher = np.asarray(natural_frequencies(link, grid, 3), dtype=float)[:, 1:]
+    return _Curve(grid, np.asarray(curve.omega1(grid), dtype=float), (low, *inner, high), higher)
 
 
 @dataclass(frozen=True)
@@ -291,6 +303,9 @@ def evaluate_window(
             if periods < config.min_periods:
                 notes.append(f"the window holds {periods:.2f} periods of omega_1")
     table = _curve_table(link, x_range[0], x_range[1], config.grid_step)
+    omega_h = omega_h_se = math.nan
+    if fit is not None and math.isfinite(omega1):
+        omega_h, omega_h_se = _higher_mode(fit, omega1, table.higher, config)
     ratio = statics.ratio if statics is not None else math.nan
     ratio_se = statics.standard_error if statics is not None else math.nan
     push = statics.perpendicular_force if statics is not None else 0.0
@@ -306,11 +321,16 @@ def evaluate_window(
         link.flexural_rigidity,
         config.frequency_floor,
         config.ratio_geometry_factor,
+        higher_modes_of_x=table.higher,
+        omega_higher=omega_h,
+        omega_higher_se=omega_h_se,
+        higher_mode_floor=config.higher_mode_floor,
     )
-    if not notes and math.isfinite(omega1):
+    if not notes and math.isfinite(omega1) and not math.isfinite(omega_h):
         # Near the top of omega_1(x_c) the inverse is singular: a frequency bias e moves x_c by
         # sqrt(2 e / |omega_1''|) and the Gaussian interval can collapse onto the peak; so no
-        # declaration while omega_1 is within peak_margin standard deviations of the maximum.
+        # declaration while omega_1 is within peak_margin standard deviations of the maximum,
+        # unless a higher contact mode (whose curves do not peak there) enters the posterior.
         sigma = math.hypot(omega1_se, config.frequency_floor * omega1)
         top = float(table.omega1.max())
         if top - omega1 < config.peak_margin * sigma:
@@ -332,6 +352,35 @@ def evaluate_window(
         posterior=posterior,
         sure=not notes,
         note="; ".join(notes),
+    )
+
+
+def _higher_mode(
+    fit: DampedSinusoidFit, omega1: float, higher: FloatArray, config: FastConfig
+) -> tuple[float, float]:
+    """The strongest detected mode above omega_1 within the range of contact modes 2 and 3.
+
+    Returns its frequency and standard error (rad/s), the non-stationarity floor in quadrature
+    as for omega_1; NaN when there is none.
+    """
+    low, high = float(higher.min()), float(higher.max())
+    detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)
+    usable = [
+        k
+        for k in range(fit.n_modes)
+        if fit.omega[k] > 1.5 * omega1
+        and low * (1.0 - 5.0 * config.higher_mode_floor)
+        <= fit.omega[k]
+        <= high * (1.0 + 5.0 * config.higher_mode_floor)
+        and detection[k] >= config.min_detection
+        and math.isfinite(fit.omega_se[k])
+    ]
+    if not usable or not fit.converged:
+        return math.nan, math.nan
+    k = max(usable, key=lambda i: float(detection[i]))
+    resolution = 2.0 * math.pi / fit.duration
+    return float(fit.omega[k]), math.hypot(
+        float(fit.omega_se[k]), config.resolution_fraction * resolution
     )
 
 

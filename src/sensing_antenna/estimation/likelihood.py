@@ -6,7 +6,11 @@ Two measurements, each with a standard error:
   the forward sensing curve omega_1(x_c) (Eq. 3 with the boundary conditions of Eq. 4). Using
   the forward model, not the linearised inverse, keeps the right shape near the peak of
   omega_1(x_c) (x_c ~ 0.77 l), where dx_c/d omega_1 diverges and both sides of the peak fit;
-- the torque/force ratio r (m), with likelihood N(r_hat; x_c, sigma_r^2).
+- the torque/force ratio r (m), with likelihood N(r_hat; x_c, sigma_r^2);
+- optionally a higher contact mode omega_h (rad/s) fitted beside the fundamental, with a mixture
+  likelihood sum_j N(omega_h; omega_j(x_c), sigma_h^2) / J over the candidate contact modes j
+  (2 and 3: which one the fit holds is not known). Its sensing curves peak elsewhere than
+  omega_1's, so near the top of omega_1(x_c) it carries the information the fundamental lacks.
 
 Model-error floors are added in quadrature to the statistical standard errors:
 
@@ -101,6 +105,10 @@ def contact_posterior(
     frequency_floor: float,
     ratio_geometry_factor: float,
     level: float = 0.95,
+    higher_modes_of_x: FloatArray | None = None,
+    omega_higher: float = math.nan,
+    omega_higher_se: float = math.nan,
+    higher_mode_floor: float = 0.0,
 ) -> ContactPosterior:
     """Posterior over x_c on ``grid`` from omega_1 and the torque/force ratio.
 
@@ -126,6 +134,12 @@ def contact_posterior(
         kappa of the ratio floor (dimensionless).
     level : float
         Mass of the highest-density interval.
+    higher_modes_of_x : array, shape (G, J), optional
+        Sensing curves of the candidate higher contact modes at each grid point (rad/s).
+    omega_higher, omega_higher_se : float
+        Measured higher mode and its statistical standard error (rad/s); NaN: not measured.
+    higher_mode_floor : float
+        Relative model error of the higher modes (dimensionless).
 
     Returns
     -------
@@ -141,6 +155,15 @@ def contact_posterior(
         deflection_ratio = perpendicular_force * grid**2 / (3.0 * flexural_rigidity)
         sigma_r = np.sqrt(ratio_se**2 + (ratio_geometry_factor * deflection_ratio * grid) ** 2)
         log_like += -0.5 * ((ratio - grid) / sigma_r) ** 2 - np.log(sigma_r)
+    if (
+        higher_modes_of_x is not None
+        and math.isfinite(omega_higher)
+        and math.isfinite(omega_higher_se)
+    ):
+        # Mixture over the candidate contact modes, relative model floor in quadrature
+        sigma_h = math.sqrt(omega_higher_se**2 + (higher_mode_floor * omega_higher) ** 2)
+        z = (omega_higher - np.asarray(higher_modes_of_x, dtype=float)) / sigma_h
+        log_like += np.logaddexp.reduce(-0.5 * z**2, axis=1)
     weights = np.exp(log_like - log_like.max())
     density = weights / weights.sum()
     k = int(np.argmax(density))
