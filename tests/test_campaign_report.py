@@ -211,3 +211,34 @@ def test_report_renders_a_method_with_intervals(tmp_path: Path) -> None:
     assert "| azimuthal | paper | - | - | - |" in text
     header = (tmp_path / "runs.csv").read_text("utf-8").splitlines()[0].split(",")
     assert "interval_low_m" in header and "interval_high_m" in header
+
+
+def test_report_with_fast_has_the_error_and_delay_figure(
+    tmp_path: Path, campaign_dir: Path
+) -> None:
+    # Issue 6: with ``fast`` among the methods the report gets x_c error and t_e - t_1 against
+    # x_c for all methods; without it (the paper/ratio toy campaign) the figure is not drawn.
+    def with_fast(run: RunSpec) -> RunResult:
+        paper = toy_run(run).methods[0]
+        fast = MethodOutcome.from_estimate("fast", _FakeEstimate(), 0.01)
+        return RunResult.for_run(run, [paper, fast], simulate_s=0.0)
+
+    fast_spec = CampaignSpec(
+        name="toy-fast",
+        antenna="paper-2021",
+        cases=("azimuthal", "vertical"),
+        contact_points=(0.3, 0.5),
+        repeats=1,
+        base_seed=1,
+        methods=("paper", "fast"),
+    )
+    out = tmp_path / "with-fast"
+    run_campaign(
+        fast_spec, out, run_one=with_fast, prepare_antenna=plain, workers=1, progress=False
+    )
+    text = build_report(out).read_text("utf-8")
+    figure = out / "figures" / "error-and-delay-by-method.png"
+    assert figure.stat().st_size > 1000
+    assert "](figures/error-and-delay-by-method.png)" in text
+    build_report(campaign_dir)
+    assert not (campaign_dir / "figures" / "error-and-delay-by-method.png").exists()

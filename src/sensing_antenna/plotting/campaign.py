@@ -22,6 +22,7 @@ __all__ = [
     "CASE_FIGURES",
     "plot_campaign",
     "plot_case_estimates",
+    "plot_error_and_delay",
     "plot_frequencies",
     "plot_method_errors",
 ]
@@ -166,6 +167,69 @@ def plot_method_errors(
     return path
 
 
+def _per_run(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> Any:
+    """x_c, signed error and t_e - t_1 of every run of ``method`` with a finite estimate."""
+    selected = [r for r in rows if r["case"] == case and r["method"] == method]
+    x = np.array([float(r["x_c_true_m"]) for r in selected], dtype=float)
+    error = np.array([float(r["error_m"]) for r in selected], dtype=float)
+    delay = np.array([float(r["t_e_s"]) - float(r["t_1_s"]) for r in selected], dtype=float)
+    keep = np.isfinite(error) & np.isfinite(delay)
+    return x[keep], error[keep], delay[keep]
+
+
+def plot_error_and_delay(
+    rows: Sequence[Mapping[str, Any]],
+    cases: Sequence[str],
+    methods: Sequence[str],
+    out_dir: str | Path,
+) -> Path:
+    """Per run and method: |x_c error| (top) and t_e - t_1 (bottom) against x_c, per case."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fig, axes = plt.subplots(
+        2, len(cases), figsize=(5.5 * len(cases), 7.0), squeeze=False, sharex="col"
+    )
+    for col, case in enumerate(cases):
+        ax_e, ax_t = axes[0][col], axes[1][col]
+        for method in methods:
+            x, error, delay = _per_run(rows, case, method)
+            style = _METHOD_STYLE.get(method, {"color": None, "marker": "."})
+            ax_e.plot(
+                x * _CM,
+                np.maximum(np.abs(error) * _CM, _ERROR_FLOOR_CM),
+                style["marker"],
+                color=style["color"],
+                ms=4,
+                mfc="none",
+                label=method,
+            )
+            ax_t.plot(
+                x * _CM,
+                delay,
+                style["marker"],
+                color=style["color"],
+                ms=4,
+                mfc="none",
+                label=method,
+            )
+        ax_e.set_yscale("log")
+        ax_e.set_ylim(bottom=_ERROR_FLOOR_CM)
+        ax_e.set_ylabel("|x_c,e - x_c| (cm)")
+        ax_e.set_title(f"{case} movement")
+        ax_e.grid(True, which="both", alpha=0.3)
+        ax_e.legend()
+        ax_t.set_xlabel("real contact point x_c (cm)")
+        ax_t.set_ylabel("t_e - t_1 (s)")
+        ax_t.set_ylim(bottom=0.0)
+        ax_t.grid(True, alpha=0.3)
+    fig.suptitle("Error and time to estimate per run, all methods on the same recordings")
+    fig.tight_layout()
+    path = out / "error-and-delay-by-method.png"
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def plot_campaign(
     rows: Sequence[Mapping[str, Any]],
     cases: Sequence[str],
@@ -173,9 +237,15 @@ def plot_campaign(
     antenna: Antenna,
     out_dir: str | Path,
 ) -> list[Path]:
-    """Every campaign figure: the method comparison, Figures 16/17 per case, and Figure 18."""
+    """Every campaign figure: the method comparison, Figures 16/17 per case, and Figure 18.
+
+    With the ``fast`` method among ``methods``, also the error and t_e - t_1 of every run
+    against x_c (:func:`plot_error_and_delay`).
+    """
     main = "paper" if "paper" in methods else methods[0]
     paths = [plot_method_errors(rows, cases, methods, out_dir)]
+    if "fast" in methods:
+        paths.append(plot_error_and_delay(rows, cases, methods, out_dir))
     paths += [plot_case_estimates(rows, case, out_dir, main) for case in cases]
     if "paper" in methods:
         paths.append(plot_frequencies(rows, antenna, out_dir))
