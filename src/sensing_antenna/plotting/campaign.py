@@ -42,6 +42,14 @@ _METHOD_STYLE = {
 }
 
 
+def _save(fig: Any, path: Path) -> Path:
+    """Lay out, write (120 dpi) and close a figure; returns its path."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def _finite(rows: Iterable[Mapping[str, Any]], case: str, method: str, column: str) -> Any:
     selected = [r for r in rows if r["case"] == case and r["method"] == method]
     x = np.array([float(r["x_c_true_m"]) for r in selected], dtype=float)
@@ -82,11 +90,7 @@ def plot_case_estimates(
     number = CASE_FIGURES.get(case)
     title = f"Figure {number}: " if number else ""
     fig.suptitle(f"{title}{case} movement, method {method}")
-    fig.tight_layout()
-    path = out / f"figure{number or ''}-{case}-{method}.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, out / f"figure{number or ''}-{case}-{method}.png")
 
 
 def plot_frequencies(
@@ -113,11 +117,7 @@ def plot_frequencies(
     ax.set_ylabel("fundamental frequency omega_1 (rad/s)")
     ax.set_title("Figure 18: measured fundamental frequencies over the sensing curve")
     ax.legend()
-    fig.tight_layout()
-    path = out / "figure18-frequencies.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, out / "figure18-frequencies.png")
 
 
 def plot_method_errors(
@@ -160,11 +160,7 @@ def plot_method_errors(
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
     fig.suptitle("Error versus contact point, all methods on the same recordings")
-    fig.tight_layout()
-    path = out / "errors-by-method.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, out / "errors-by-method.png")
 
 
 def _per_run(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> Any:
@@ -223,11 +219,7 @@ def plot_error_and_delay(
         ax_t.set_ylim(bottom=0.0)
         ax_t.grid(True, alpha=0.3)
     fig.suptitle("Error and time to estimate per run, all methods on the same recordings")
-    fig.tight_layout()
-    path = out / "error-and-delay-by-method.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, out / "error-and-delay-by-method.png")
 
 
 def plot_campaign(
