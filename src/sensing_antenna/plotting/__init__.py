@@ -5,6 +5,21 @@ Matplotlib is used with the non-interactive Agg backend so plots work on machine
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import matplotlib
 
 matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+
+__all__ = ["save_figure"]
+
+
+def save_figure(fig: Any, path: Path, dpi: int = 120) -> Path:
+    """Lay out, write and close a figure; returns ``path``."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path

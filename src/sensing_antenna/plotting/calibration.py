@@ -9,6 +9,7 @@ import numpy as np
 
 from sensing_antenna.antenna import Link
 from sensing_antenna.calibration.frequency import FrequencyCalibration, model_beta1_squared
+from sensing_antenna.plotting import save_figure
 
 __all__ = ["plot_calibration"]
 
@@ -54,8 +55,4 @@ def plot_calibration(calibration: FrequencyCalibration, link: Link, out_dir: str
     ax_r.plot(x[used], calibration.residuals[used], "o", mfc="none")
     ax_r.set_xlabel("contact point x_c (cm)")
     ax_r.set_ylabel("residual (rad/s)")
-    fig.tight_layout()
-    path = out / "figure10-calibration.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, out / "figure10-calibration.png")

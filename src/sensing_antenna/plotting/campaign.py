@@ -17,6 +17,7 @@ import numpy as np
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.tables import paper_table, point_table
+from sensing_antenna.plotting import save_figure
 
 __all__ = [
     "CASE_FIGURES",
@@ -40,14 +41,6 @@ _METHOD_STYLE = {
     "two-frequency": {"color": "tab:green", "marker": "^"},
     "fast": {"color": "tab:red", "marker": "D"},
 }
-
-
-def _save(fig: Any, path: Path) -> Path:
-    """Lay out, write (120 dpi) and close a figure; returns its path."""
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
 
 
 def _finite(rows: Iterable[Mapping[str, Any]], case: str, method: str, column: str) -> Any:
@@ -90,7 +83,7 @@ def plot_case_estimates(
     number = CASE_FIGURES.get(case)
     title = f"Figure {number}: " if number else ""
     fig.suptitle(f"{title}{case} movement, method {method}")
-    return _save(fig, out / f"figure{number or ''}-{case}-{method}.png")
+    return save_figure(fig, out / f"figure{number or ''}-{case}-{method}.png")
 
 
 def plot_frequencies(
@@ -117,7 +110,7 @@ def plot_frequencies(
     ax.set_ylabel("fundamental frequency omega_1 (rad/s)")
     ax.set_title("Figure 18: measured fundamental frequencies over the sensing curve")
     ax.legend()
-    return _save(fig, out / "figure18-frequencies.png")
+    return save_figure(fig, out / "figure18-frequencies.png")
 
 
 def plot_method_errors(
@@ -160,7 +153,7 @@ def plot_method_errors(
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
     fig.suptitle("Error versus contact point, all methods on the same recordings")
-    return _save(fig, out / "errors-by-method.png")
+    return save_figure(fig, out / "errors-by-method.png")
 
 
 def _per_run(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> Any:
@@ -219,7 +212,7 @@ def plot_error_and_delay(
         ax_t.set_ylim(bottom=0.0)
         ax_t.grid(True, alpha=0.3)
     fig.suptitle("Error and time to estimate per run, all methods on the same recordings")
-    return _save(fig, out / "error-and-delay-by-method.png")
+    return save_figure(fig, out / "error-and-delay-by-method.png")
 
 
 def plot_campaign(

@@ -27,6 +27,7 @@ from sensing_antenna.estimation.ratio import (
     perpendicular_ratio,
 )
 from sensing_antenna.estimation.result import ContactEstimate
+from sensing_antenna.plotting import save_figure
 from sensing_antenna.recording import Recording, resample_uniform
 
 __all__ = ["plot_estimate"]
@@ -103,11 +104,7 @@ def _figure11(rec: Recording, antenna: Antenna, result: ContactEstimate, out: Pa
     ax_r.set_xlabel("t (s)")
     ax_r.set_ylabel("residual (N m)")
     ax_r.legend(fontsize=7)
-    path = out / "figure11-contact.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, out / "figure11-contact.png")
 
 
 def _offset(result: ContactEstimate) -> np.ndarray:
@@ -136,11 +133,7 @@ def _figure12(
     ax_a.set_xlabel("t (s)")
     ax_a.set_ylabel("motor angle (rad)")
     ax_a.legend(fontsize=7)
-    path = out / "figure12-push.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, out / "figure12-push.png")
 
 
 def _axes_m(result: ContactEstimate) -> np.ndarray:
@@ -180,11 +173,7 @@ def _figure13(rec: Recording, result: ContactEstimate, cfg: EstimatorConfig, out
     ax_s.set_xlabel("omega (rad/s)")
     ax_s.set_ylabel("power (N^2 m^2)")
     ax_s.legend(fontsize=7)
-    path = out / "figure13-frequency.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, out / "figure13-frequency.png")
 
 
 def _figure14(
@@ -217,8 +206,4 @@ def _figure14(
     ax.set_ylabel("x_c (cm)")
     ax.legend(fontsize=7)
     ax.set_title("Figure 14 - " + _title(result), fontsize=9)
-    path = out / "figure14-ratio.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, out / "figure14-ratio.png")

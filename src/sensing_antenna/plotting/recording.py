@@ -13,6 +13,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from sensing_antenna.plotting import save_figure
 from sensing_antenna.recording import Recording
 
 __all__ = ["plot_recording"]
@@ -54,7 +55,7 @@ def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
         if f"{name}_ref" in recording.extra:
             ax.plot(t, np.degrees(recording.extra[f"{name}_ref"]), "--", label=f"{name} ref")
     _finish(ax, "motor angle (deg)", title, stop)
-    paths.append(_save(fig, out / "angles.png"))
+    paths.append(save_figure(fig, out / "angles.png", dpi=110))
 
     for name, data, unit in (("force", recording.force, "N"), ("torque", recording.torque, "N m")):
         fig, axes = plt.subplots(3, 1, figsize=(7, 6), sharex=True)
@@ -63,7 +64,7 @@ def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
             _finish(axes[i], f"{name[0].upper()}_{axis_name}^m ({unit})", None, stop)
         axes[0].set_title(f"{name} by the link on the head (motor frame): {title}", fontsize=9)
         axes[-1].set_xlabel("t (s)")
-        paths.append(_save(fig, out / f"{name}.png"))
+        paths.append(save_figure(fig, out / f"{name}.png", dpi=110))
 
     start = int(np.searchsorted(t, stop)) + 100 if stop is not None else t.size // 2
     if t.size - start >= 64:
@@ -79,7 +80,7 @@ def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
         ax.set_ylabel("|FFT| (N m)")
         ax.set_title("torque spectrum after the stop", fontsize=9)
         ax.legend(fontsize=8)
-        paths.append(_save(fig, out / "torque_spectrum.png"))
+        paths.append(save_figure(fig, out / "torque_spectrum.png", dpi=110))
     return paths
 
 
@@ -92,10 +93,3 @@ def _finish(ax: plt.Axes, ylabel: str, title: str | None, stop: float | None) ->
         ax.set_title(title, fontsize=9)
         ax.set_xlabel("t (s)")
         ax.legend(fontsize=8)
-
-
-def _save(fig: plt.Figure, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path

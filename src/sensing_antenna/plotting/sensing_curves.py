@@ -10,6 +10,7 @@ import numpy as np
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.plotting import save_figure
 
 __all__ = ["PAPER_FUNDAMENTAL_RANGE", "PAPER_T_E", "plot_sensing_curves"]
 
@@ -73,10 +74,7 @@ def plot_sensing_curves(antenna: Antenna, out_dir: str | Path) -> list[Path]:
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left", fontsize=8)
-    fig.tight_layout()
-    path8 = out / "figure8.png"
-    fig.savefig(path8, dpi=120)
-    plt.close(fig)
+    path8 = save_figure(fig, out / "figure8.png")
 
     points = np.stack([hz[:, 0], hz[:, 1] - hz[:, 0]], axis=1)
     near = _nearest_self_approach(x, points)
@@ -92,8 +90,5 @@ def plot_sensing_curves(antenna: Antenna, out_dir: str | Path) -> list[Path]:
     ax.set_title(f"Figure 9: sensing curve f2 - f1 ({antenna.name})")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
-    path9 = out / "figure9.png"
-    fig.savefig(path9, dpi=120)
-    plt.close(fig)
+    path9 = save_figure(fig, out / "figure9.png")
     return [path8, path9]
