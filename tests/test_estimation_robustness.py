@@ -41,7 +41,9 @@ def test_push_judged_over_the_hold_despite_rebounds() -> None:
     true_xc = float(recording.metadata["true_xc"])
     # The paper method's 1 cm mean error of issue 4; here one run, far below it.
     assert result.x_c == pytest.approx(true_xc, abs=0.01)
-    assert result.diagnostics["rebounds"]["count"] >= 0
+    # The link does leave the post after the stop here (the simulator's contact flag is off for
+    # 42 of the first 200 samples after it): the diagnostics must report rebounds, not hide them.
+    assert result.diagnostics["rebounds"]["count"] >= 1
 
 
 def test_gentle_push_is_measured_against_noise_not_a_fixed_force() -> None:
