@@ -217,6 +217,10 @@ class WindowEstimate:
         Fundamental and its standard error (rad/s): the fit's statistical error and the
         non-stationarity floor in quadrature (the relative model floor is added by the
         posterior); NaN when not usable.
+    omega1_crb : float
+        Cramer-Rao bound of omega_1 for this record length and noise (rad/s): the square root
+        of the inverse Fisher information of the fitted model at the fitted parameters and the
+        residual noise (the statistical part of ``omega1_se``); NaN when not usable.
     statics : StaticRatio or None
         The static torque/force ratio.
     posterior : ContactPosterior
@@ -230,6 +234,7 @@ class WindowEstimate:
     fit: DampedSinusoidFit | None
     omega1: float
     omega1_se: float
+    omega1_crb: float
     statics: StaticRatio | None
     posterior: ContactPosterior
     sure: bool
@@ -279,7 +284,7 @@ def evaluate_window(
         min_omega=config.min_mode_fraction * band[0],
         degree=config.polynomial_degree,
     )
-    omega1 = omega1_se = math.nan
+    omega1 = omega1_se = omega1_crb = math.nan
     statics: StaticRatio | None = None
     notes: list[str] = []
     if fit is None:
@@ -296,6 +301,7 @@ def evaluate_window(
             notes.append("the fit did not converge")
         else:
             omega1 = float(fit.omega[k])
+            omega1_crb = float(fit.omega_se[k])
             # Statistical standard error and the non-stationarity floor, in quadrature
             resolution = 2.0 * math.pi / fit.duration
             omega1_se = math.hypot(float(fit.omega_se[k]), config.resolution_fraction * resolution)
@@ -348,6 +354,7 @@ def evaluate_window(
         fit=fit,
         omega1=omega1,
         omega1_se=omega1_se,
+        omega1_crb=omega1_crb,
         statics=statics,
         posterior=posterior,
         sure=not notes,
@@ -635,6 +642,7 @@ def conclude_fast(
             "branch_edges": post.branch_edges,
             "branch_probability_by_branch": post.branch_probability,
             "omega1_se": final.omega1_se,
+            "omega1_crb": final.omega1_crb,
             "ratio_se": statics.standard_error if statics is not None else math.nan,
             "model_order": final.fit.n_modes if final.fit is not None else 0,
             "modes": final.fit.omega if final.fit is not None else (),
