@@ -259,6 +259,26 @@ def _pencil_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
     return matrix_pencil_poles(y, n_poles)
 
 
+def _periodogram_peak(y: FloatArray, sample_period: float, band: tuple[float, float]) -> float:
+    """Frequency (rad/s) of the largest peak inside ``band`` of the channels' summed periodogram.
+
+    Linear trends are removed and a Hann window applied first; zero padding to 8 times the
+    record puts the grid well inside the main lobe (4 pi / (n T_s) wide).
+    """
+    n = y.shape[0]
+    tau = np.arange(n) - 0.5 * (n - 1)
+    trend = np.column_stack([np.ones(n), tau])
+    coef, *_ = np.linalg.lstsq(trend, y, rcond=None)
+    detrended = (y - trend @ coef) * np.hanning(n)[:, None]
+    size = 1 << math.ceil(math.log2(8 * n))
+    power = np.sum(np.abs(np.fft.rfft(detrended, size, axis=0)) ** 2, axis=1)
+    omega = 2.0 * math.pi * np.fft.rfftfreq(size, sample_period)
+    inside = (omega >= band[0]) & (omega <= band[1])
+    if not inside.any():
+        return 0.5 * (band[0] + band[1])
+    return float(omega[inside][np.argmax(power[inside])])
+
+
 def _initial_modes(
     y: FloatArray,
     z: ComplexArray,
@@ -266,8 +286,14 @@ def _initial_modes(
     sample_period: float,
     lower: FloatArray,
     upper: FloatArray,
+    target_band: tuple[float, float] | None = None,
 ) -> FloatArray:
-    """(w, s) pairs of the ``n_modes`` strongest oscillatory poles ``z`` above lower[0]."""
+    """(w, s) pairs of the ``n_modes`` strongest oscillatory poles ``z`` above lower[0].
+
+    With ``target_band`` (rad/s) the first pair is the strongest pole inside that band or, when
+    the pencil has none there (a weak mode beside strong ones), the largest periodogram peak
+    inside it; the other pairs are the strongest remaining poles.
+    """
     n = y.shape[0]
     with np.errstate(divide="ignore", invalid="ignore"):
         s_plane = np.log(z) / sample_period
@@ -281,9 +307,21 @@ def _initial_modes(
     m = s_plane.size
     power = np.sum(coef[2 : 2 + m] ** 2 + coef[2 + m :] ** 2, axis=1)
     power = np.where(s_plane.imag >= lower[0], power, -1.0)
-    order = list(np.argsort(power)[::-1][:n_modes])
-    omega = [float(s_plane[j].imag) for j in order if power[j] >= 0.0]
-    decay = [float(-s_plane[j].real) for j in order if power[j] >= 0.0]
+    omega: list[float] = []
+    decay: list[float] = []
+    if target_band is not None:
+        inside = (s_plane.imag >= target_band[0]) & (s_plane.imag <= target_band[1]) & (power >= 0)
+        if inside.any():
+            j = int(np.argmax(np.where(inside, power, -1.0)))
+            omega.append(float(s_plane[j].imag))
+            decay.append(float(-s_plane[j].real))
+            power[j] = -1.0
+        else:
+            omega.append(_periodogram_peak(y, sample_period, target_band))
+            decay.append(1.0)
+    order = list(np.argsort(power)[::-1][: n_modes - len(omega)])
+    omega += [float(s_plane[j].imag) for j in order if power[j] >= 0.0]
+    decay += [float(-s_plane[j].real) for j in order if power[j] >= 0.0]
     # Too few poles above the lower limit: spread the missing ones over the allowed range
     spare = np.geomspace(lower[0] * 1.5, upper[0] * 0.5, n_modes + 2)[1:-1]
     while len(omega) < n_modes:
@@ -304,6 +342,7 @@ def fit_damped_sinusoids(
     min_omega: float = 0.0,
     degree: int = 1,
     poles: ComplexArray | None = None,
+    target_band: tuple[float, float] | None = None,
 ) -> DampedSinusoidFit | None:
     """Fit ``n_modes`` damped sinusoids with shared poles, plus a polynomial per channel.
 
@@ -327,6 +366,9 @@ def fit_damped_sinusoids(
     poles : array of complex, optional
         Discrete-time poles for the initial values (:func:`matrix_pencil_poles` of the weighted
         channels); computed when omitted.
+    target_band : tuple of float, optional
+        Band (rad/s) where one mode is known to lie (the fundamental): one mode starts there
+        even when stronger modes elsewhere would otherwise take every initial slot.
 
     Returns
     -------
@@ -353,7 +395,7 @@ def fit_damped_sinusoids(
     z = poles if poles is not None else _pencil_poles(y / scale, n_modes)
     if z is None:
         return None
-    start = _initial_modes(y / scale, z, n_modes, sample_period, lower, upper)
+    start = _initial_modes(y / scale, z, n_modes, sample_period, lower, upper, target_band)
     if not np.all(np.isfinite(_projection_residual(start, tau, y / scale, degree))):
         return None
     bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
@@ -459,13 +501,14 @@ def select_model_order(
     t_start: float = 0.0,
     min_omega: float = 0.0,
     degree: int = 1,
+    target_band: tuple[float, float] | None = None,
 ) -> DampedSinusoidFit | None:
     """The fit with the smallest BIC among M = 1 .. ``max_modes`` damped modes.
 
     Returns None when no order could be fitted (record too short). The noise of each channel is
     estimated once, from the residuals of the largest order that fits, and used for every order,
     so that the BIC compares the orders on the same weights. ``min_omega`` and ``degree`` as in
-    :func:`fit_damped_sinusoids`.
+    :func:`fit_damped_sinusoids`; ``target_band`` too.
     """
     fits = []
     noise: FloatArray | None = None
@@ -473,13 +516,15 @@ def select_model_order(
     y = np.asarray(signals, dtype=float)
     for m in range(max_modes, 0, -1):
         if noise is None:
-            fit = fit_damped_sinusoids(y, sample_period, m, t_start, None, min_omega, degree)
+            fit = fit_damped_sinusoids(
+                y, sample_period, m, t_start, None, min_omega, degree, None, target_band
+            )
             if fit is not None:
                 noise = fit.noise_std
                 poles = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
         else:
             fit = fit_damped_sinusoids(
-                y, sample_period, m, t_start, noise, min_omega, degree, poles
+                y, sample_period, m, t_start, noise, min_omega, degree, poles, target_band
             )
         if fit is not None:
             fits.append(fit)
