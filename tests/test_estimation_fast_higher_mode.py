@@ -116,11 +116,12 @@ def _two_mode_channels(x_c: float, n: int, rng: np.random.Generator) -> np.ndarr
 
 def test_scan_declares_at_the_peak_with_the_second_mode() -> None:
     # Where omega_1 alone stays unsure until the cap (test_unsure_until_the_cap_near_the_peak
-    # in test_estimation_fast_method.py), the second mode lets the scan declare within the
+    # in test_estimation_fast_method.py), the second mode (opt-in: higher_modes=True) lets the
+    # scan declare within the
     # tolerance. 8 mm, not the default 5 mm: the 0.5 % floor alone (1.1 rad/s at 0.8 rad/s
     # per mm) gives a 95 % width of about 5.5 mm at this point.
     rng = np.random.default_rng(12)
-    cfg = FastConfig(cap=0.4, tolerance=0.008)
+    cfg = FastConfig(cap=0.4, tolerance=0.008, higher_modes=True)
     channels = _two_mode_channels(0.77, 500, rng)
     band = search_band(LINK, EstimatorConfig())
     no_bias = SensorBias(np.zeros(5), np.zeros((5, 5)), 0)

@@ -29,7 +29,7 @@ Without an initial rest the bias is taken as zero and the diagnostics say so.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -71,12 +71,15 @@ class StaticRatio:
         window (it is not part of the fit).
     torque_m : array, shape (3,)
         Static contact torque (N m).
+    force_cov : array, shape (2, 2)
+        Covariance of the static (R_y, R_z) (N^2), the bias's included.
     """
 
     ratio: float
     standard_error: float
     reaction_m: FloatArray
     torque_m: FloatArray
+    force_cov: FloatArray = field(default_factory=lambda: np.zeros((2, 2)))
 
     @property
     def perpendicular_force(self) -> float:
@@ -134,8 +137,9 @@ def static_ratio(
     f_norm = float(np.linalg.norm(force))
     g_norm = float(np.linalg.norm(torque))
     reaction = np.array([axial_force, force[0], force[1]])
+    force_cov = cov[np.ix_(FORCE_CHANNELS, FORCE_CHANNELS)]
     if f_norm == 0.0:
-        return StaticRatio(math.nan, math.nan, reaction, torque)
+        return StaticRatio(math.nan, math.nan, reaction, torque, force_cov)
     # Eq. 21 with the perpendicular force: x_c = |Gamma - Gamma_g| / |R_perp|
     ratio = g_norm / f_norm
     gradient = np.zeros(c.size)
@@ -144,7 +148,7 @@ def static_ratio(
         gradient[list(TORQUE_CHANNELS)] = torque / (g_norm * f_norm)
     variance = float(gradient @ cov @ gradient)
     se = math.sqrt(variance) if variance >= 0.0 and math.isfinite(variance) else math.nan
-    return StaticRatio(ratio, se, reaction, torque)
+    return StaticRatio(ratio, se, reaction, torque, force_cov)
 
 
 @dataclass(frozen=True)
