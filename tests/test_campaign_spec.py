@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.campaign.spec import (
+    NOISE_SWEEP_STREAM,
     CampaignSpecError,
     default_campaign_spec,
     derive_seed,
@@ -40,7 +42,9 @@ def write(tmp_path: Path, text: str) -> Path:
 def test_default_campaign_is_the_paper_section_5_6() -> None:
     # Section 5.6: x_c = 0.30 to 0.95 m every 5 cm plus 0.98 m, 5 experiments per point, 2 cases
     spec = default_campaign_spec()
-    assert spec.n_runs == 150
+    assert spec.n_main_runs == 150
+    # plus the noise sweep: 4 levels x 8 points x 2 cases x 1 repeat
+    assert spec.n_sweep_runs == 64 and spec.n_runs == 214
     assert spec.cases == ("azimuthal", "vertical")
     expected = [*np.round(np.arange(0.30, 0.951, 0.05), 2), 0.98]
     np.testing.assert_allclose(spec.contact_points, expected, atol=1e-12)
@@ -51,15 +55,16 @@ def test_default_campaign_is_the_paper_section_5_6() -> None:
 
 def test_runs_are_ordered_named_and_seeded_deterministically() -> None:
     spec = default_campaign_spec()
-    runs = expand_runs(spec, paper_antenna())
-    assert len(runs) == 150
+    every = expand_runs(spec, paper_antenna())
+    runs = every[:150]  # the main runs come first
     assert [r.index for r in runs] == list(range(150))
     assert runs[0].run_id == "azimuthal-x0300mm-r1"
     assert runs[-1].run_id == "vertical-x0980mm-r5"
     assert len({r.run_id for r in runs}) == 150
     assert len({r.seed for r in runs}) == 150
     again = expand_runs(spec, paper_antenna())
-    assert [r.seed for r in again] == [r.seed for r in runs]
+    assert [r.seed for r in again] == [r.seed for r in every]
+    assert len({r.seed for r in every}) == len(every) == 214
     assert runs[7].seed == derive_seed(spec.base_seed, 7)
     # the free-motion step draws from another stream of the same base seed
     assert derive_seed(spec.base_seed, 0, stream=1) not in {r.seed for r in runs}
@@ -244,3 +249,95 @@ def test_device_antenna_file_is_resolved_next_to_the_spec(tmp_path: Path) -> Non
     spec = load_campaign_spec(write(tmp_path, text))
     assert spec.load_device().link.youngs_modulus == 140e9
     assert spec.load_antenna().link.youngs_modulus == paper_antenna().link.youngs_modulus
+
+
+SWEEP = (
+    GOOD
+    + """
+[noise_sweep]
+noise_scales = [0.25, 2.0]
+contact_points = [0.4]
+cases = ["azimuthal", "vertical"]
+"""
+)
+
+
+def test_a_noise_sweep_adds_runs_after_the_main_ones_with_their_own_seeds(
+    tmp_path: Path,
+) -> None:
+    spec = load_campaign_spec(write(tmp_path, SWEEP))
+    # main: 1 case x 2 points x 2 repeats; sweep: 2 levels x 2 cases x 1 point x 2 repeats
+    assert (spec.n_main_runs, spec.n_sweep_runs, spec.n_runs) == (4, 8, 12)
+    assert spec.noise_scale == 0.5
+    runs = expand_runs(spec, paper_antenna())
+    main, sweep = runs[:4], runs[4:]
+    # the main runs are what they were without a sweep
+    plain = expand_runs(load_campaign_spec(write(tmp_path, GOOD)), paper_antenna())
+    assert [(r.run_id, r.seed, r.noise_scale) for r in main] == [
+        (r.run_id, r.seed, r.noise_scale) for r in plain
+    ]
+    assert [r.index for r in runs] == list(range(12))
+    assert sweep[0].run_id == "azimuthal-x0400mm-r1-n0.25"
+    assert sweep[-1].run_id == "vertical-x0400mm-r2-n2.00"
+    assert [r.noise_scale for r in sweep] == [0.25] * 4 + [2.0] * 4
+    assert all(r.scenario["noise_scale"] == r.noise_scale for r in sweep)
+    assert all(r.methods == ("paper", "ratio") for r in sweep)  # every method, same recordings
+    assert len({r.run_id for r in runs}) == 12
+    assert len({r.seed for r in runs}) == 12
+    assert sweep[3].seed == derive_seed(spec.base_seed, 3, NOISE_SWEEP_STREAM)
+    others = {derive_seed(spec.base_seed, i, stream) for i in range(20) for stream in (0, 1, 2)}
+    assert not others & {r.seed for r in sweep}
+
+
+def test_the_sweep_defaults_to_the_main_points_repeats_and_cases(tmp_path: Path) -> None:
+    text = GOOD + "[noise_sweep]\nnoise_scales = [2]\n"
+    spec = load_campaign_spec(write(tmp_path, text))
+    assert spec.sweep_cases == ("azimuthal",)
+    assert spec.sweep_contact_points == (0.3, 0.5)
+    assert spec.sweep_repeats == 2 and spec.n_sweep_runs == 4
+
+
+def test_the_sweep_is_in_the_fingerprint_only_when_present(tmp_path: Path) -> None:
+    plain = load_campaign_spec(write(tmp_path, GOOD))
+    swept = load_campaign_spec(write(tmp_path, SWEEP))
+    assert "noise_sweep" not in plain.to_dict()  # stored campaigns without a sweep still resume
+    assert plain.fingerprint() != swept.fingerprint()
+    assert plain.preparation_fingerprint() == swept.preparation_fingerprint()
+    again = load_campaign_spec(write(tmp_path, SWEEP.replace("2.0]", "4.0]")))
+    assert again.fingerprint() != swept.fingerprint()
+    from sensing_antenna.campaign.spec import parse_campaign_spec
+
+    assert parse_campaign_spec(swept.to_dict(), "copy") == replace(swept, source="copy")
+
+
+@pytest.mark.parametrize(
+    ("section", "field"),
+    [
+        ("noise_scales = [0.5, -1.0]", "noise_sweep.noise_scales[1]"),
+        ('noise_scales = ["loud"]', "noise_sweep.noise_scales[0]"),
+        ("noise_scales = []", "noise_sweep.noise_scales"),
+        ("noise_scales = 2.0", "noise_sweep.noise_scales"),
+        ("noise_scales = [2.0, 2.0]", "noise_sweep.noise_scales"),
+        ("noise_scales = [2.0, 0.5]", "noise_sweep.noise_scales[1]"),  # the main level
+        ("repeats = 2", "noise_sweep.noise_scales"),  # missing
+        ("noise_scales = [2.0]\nrepeats = 0", "noise_sweep.repeats"),
+        ("noise_scales = [2.0]\nrepeats = 1.5", "noise_sweep.repeats"),
+        ("noise_scales = [2.0]\ncontact_points = [0.3, 0.0]", "noise_sweep.contact_points[1]"),
+        ("noise_scales = [2.0]\ncontact_points = []", "noise_sweep.contact_points"),
+        ('noise_scales = [2.0]\ncases = ["sideways"]', "noise_sweep.cases[0]"),
+        ("noise_scales = [2.0]\nseeds = 3", "noise_sweep.seeds"),
+    ],
+)
+def test_bad_noise_sweep_fields_are_named_with_the_file(
+    tmp_path: Path, section: str, field: str
+) -> None:
+    path = write(tmp_path, GOOD + "[noise_sweep]\n" + section + "\n")
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: {field}:")):
+        load_campaign_spec(path)
+
+
+def test_a_sweep_point_beyond_the_link_is_named(tmp_path: Path) -> None:
+    text = GOOD + "[noise_sweep]\nnoise_scales = [2.0]\ncontact_points = [0.4, 1.3]\n"
+    spec = load_campaign_spec(write(tmp_path, text))
+    with pytest.raises(CampaignSpecError, match=r"noise_sweep\.contact_points\[1\]: 1.3 m"):
+        spec.load_antenna()

@@ -32,6 +32,12 @@ cases = 150 runs. A spec file looks like::
     repeats = 1
     loss = "soft_l1"
 
+    [noise_sweep]                   # optional: extra runs at other sensor noise levels
+    noise_scales = [0.5, 2.0]       # multiples of the simulator's nominal noise
+    contact_points = [0.3, 0.6]     # default: the main contact points
+    repeats = 1                     # default: the main repeats
+    cases = ["azimuthal"]           # default: the main cases
+
 The top-level ``antenna`` is the nominal model the estimators start from; ``[device]`` is what the
 simulator uses as the hardware. Without ``[device]`` both are the same.
 
@@ -64,12 +70,15 @@ __all__ = [
     "DEVICE_SECTIONS",
     "FREE_MOTION_STREAM",
     "METHODS",
+    "NOISE_SWEEP_STREAM",
     "RUN_STREAM",
+    "SCENARIO_NOISE_SCALE",
     "CalibrationStep",
     "CampaignSpec",
     "CampaignSpecError",
     "DeviceSpec",
     "FreeMotionStep",
+    "NoiseSweep",
     "RunSpec",
     "default_campaign_spec",
     "derive_seed",
@@ -86,10 +95,16 @@ CASES = ("azimuthal", "vertical")
 #: ``sensing_antenna.estimation.METHODS`` is accepted (see :func:`known_methods`).
 METHODS = ("paper", "ratio", "two-frequency")
 
-#: Seed streams of :func:`derive_seed`: contact runs, the free-motion step, the calibration step.
+#: Seed streams of :func:`derive_seed`: contact runs, the free-motion step, the calibration step,
+#: the runs of the noise sweep.
 RUN_STREAM = 0
 FREE_MOTION_STREAM = 1
 CALIBRATION_STREAM = 2
+NOISE_SWEEP_STREAM = 3
+
+#: ``simulator.Scenario.noise_scale`` when the spec's ``[scenario]`` does not set it: the
+#: simulator's nominal sensor noise.
+SCENARIO_NOISE_SCALE = 1.0
 
 #: Antenna sections a ``[device]`` section may override, with the fields allowed in each. The
 #: link's ``calibrated_t`` is a model parameter, not hardware, so a device cannot set it.
@@ -153,7 +168,10 @@ _TOP_LEVEL_KEYS = (
     "free_motion",
     "device",
     "calibration",
+    "noise_sweep",
 )
+
+_NOISE_SWEEP_KEYS = ("noise_scales", "contact_points", "repeats", "cases")
 
 
 class CampaignSpecError(FieldError):
@@ -302,6 +320,82 @@ class CalibrationStep:
 
 
 @dataclass(frozen=True)
+class NoiseSweep:
+    """Optional extra runs at other sensor noise levels (issue 6: accuracy against noise).
+
+    Each level repeats the sweep's cases x contact points x repeats with the scenario's
+    ``noise_scale`` replaced by that level; every method estimates the same recordings. The main
+    runs count as the level of ``[scenario]`` and are not repeated here.
+
+    Parameters
+    ----------
+    noise_scales : tuple of float
+        Levels, multiples of the simulator's nominal sensor noise (``Scenario.noise_scale``),
+        each finite and >= 0, distinct. Empty: no sweep.
+    contact_points : tuple of float or None
+        Contact points x_c (m) of the sweep; None: the main contact points.
+    repeats : int or None
+        Runs per (level, case, contact point); None: the main repeats.
+    cases : tuple of str or None
+        Manoeuvres; None: the main cases.
+    """
+
+    noise_scales: tuple[float, ...] = ()
+    contact_points: tuple[float, ...] | None = None
+    repeats: int | None = None
+    cases: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        for i, s in enumerate(self.noise_scales):
+            if not (math.isfinite(s) and s >= 0):
+                raise CampaignSpecError(
+                    f"noise_sweep.noise_scales[{i}]", f"must be a finite number >= 0, got {s!r}"
+                )
+        if len({_level_key(s) for s in self.noise_scales}) != len(self.noise_scales):
+            raise CampaignSpecError(
+                "noise_sweep.noise_scales", "must be distinct (to 0.01, as in the run ids)"
+            )
+        if self.contact_points is not None:
+            if not self.contact_points:
+                raise CampaignSpecError(
+                    "noise_sweep.contact_points", "must list at least one point (m)"
+                )
+            for i, x in enumerate(self.contact_points):
+                if not (math.isfinite(x) and x > 0):
+                    raise CampaignSpecError(
+                        f"noise_sweep.contact_points[{i}]",
+                        f"must be a finite length > 0 m, got {x!r}",
+                    )
+            if len({round(x * 1e6) for x in self.contact_points}) != len(self.contact_points):
+                raise CampaignSpecError("noise_sweep.contact_points", "must be distinct")
+        if self.repeats is not None and self.repeats < 1:
+            raise CampaignSpecError("noise_sweep.repeats", f"must be >= 1, got {self.repeats!r}")
+        if self.cases is not None:
+            _check_choices("noise_sweep.cases", self.cases, CASES, None)
+
+    @property
+    def enabled(self) -> bool:
+        """True when the sweep has at least one noise level."""
+        return bool(self.noise_scales)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data in the layout of the TOML section (only the fields that are set)."""
+        data: dict[str, Any] = {"noise_scales": [float(s) for s in self.noise_scales]}
+        if self.contact_points is not None:
+            data["contact_points"] = list(self.contact_points)
+        if self.repeats is not None:
+            data["repeats"] = self.repeats
+        if self.cases is not None:
+            data["cases"] = list(self.cases)
+        return data
+
+
+def _level_key(noise_scale: float) -> int:
+    """A noise level as it appears in run ids (hundredths)."""
+    return round(noise_scale * 100)
+
+
+@dataclass(frozen=True)
 class CampaignSpec:
     """A validated campaign: what to simulate and which methods estimate each recording.
 
@@ -330,6 +424,8 @@ class CampaignSpec:
         The simulated hardware; by default the model itself.
     calibration : CalibrationStep
         Optional T_e calibration step on the device.
+    noise_sweep : NoiseSweep
+        Optional extra runs at other sensor noise levels; by default none.
     description : str
         Free text for the report.
     source : str
@@ -347,6 +443,7 @@ class CampaignSpec:
     free_motion: FreeMotionStep = field(default_factory=FreeMotionStep)
     device: DeviceSpec = field(default_factory=DeviceSpec)
     calibration: CalibrationStep = field(default_factory=CalibrationStep)
+    noise_sweep: NoiseSweep = field(default_factory=NoiseSweep)
     description: str = ""
     source: str = ""
 
@@ -374,11 +471,66 @@ class CampaignSpec:
                 raise CampaignSpecError(
                     f"scenario.{key}", "is set by the campaign for each run; remove it", src
                 )
+        main = self.noise_scale
+        for i, s in enumerate(self.noise_sweep.noise_scales):
+            if math.isfinite(main) and _level_key(s) == _level_key(main):
+                raise CampaignSpecError(
+                    f"noise_sweep.noise_scales[{i}]",
+                    f"{s!r} is the main runs' level (scenario.noise_scale = {main!r}), which "
+                    "already counts in the sweep; remove it",
+                    src,
+                )
+
+    @property
+    def noise_scale(self) -> float:
+        """Sensor noise level of the main runs (``scenario.noise_scale``, default 1)."""
+        value = self.scenario.get("noise_scale", SCENARIO_NOISE_SCALE)
+        try:
+            return float(value)
+        except (TypeError, ValueError):
+            return math.nan  # reported by the scenario check before any run
+
+    @property
+    def sweep_cases(self) -> tuple[str, ...]:
+        """Cases of the noise sweep (its own or the main ones)."""
+        return self.noise_sweep.cases if self.noise_sweep.cases is not None else self.cases
+
+    @property
+    def sweep_contact_points(self) -> tuple[float, ...]:
+        """Contact points of the noise sweep (its own or the main ones), m."""
+        points = self.noise_sweep.contact_points
+        return points if points is not None else self.contact_points
+
+    @property
+    def sweep_repeats(self) -> int:
+        """Repeats of the noise sweep (its own or the main ones)."""
+        repeats = self.noise_sweep.repeats
+        return repeats if repeats is not None else self.repeats
+
+    @property
+    def n_main_runs(self) -> int:
+        """Runs at the main noise level (cases x contact points x repeats)."""
+        return len(self.cases) * len(self.contact_points) * self.repeats
+
+    @property
+    def n_sweep_runs(self) -> int:
+        """Extra runs of the noise sweep (levels x its cases x points x repeats)."""
+        return (
+            len(self.noise_sweep.noise_scales)
+            * len(self.sweep_cases)
+            * len(self.sweep_contact_points)
+            * self.sweep_repeats
+        )
 
     @property
     def n_runs(self) -> int:
-        """Number of simulated runs (cases x contact points x repeats)."""
-        return len(self.cases) * len(self.contact_points) * self.repeats
+        """Number of simulated runs: the main runs and those of the noise sweep."""
+        return self.n_main_runs + self.n_sweep_runs
+
+    @property
+    def all_cases(self) -> tuple[str, ...]:
+        """Every case of the campaign, main runs first, then any only the sweep has."""
+        return self.cases + tuple(c for c in self.sweep_cases if c not in self.cases)
 
     def load_antenna(self) -> Antenna:
         """The campaign's nominal model; checks every contact point lies on its link."""
@@ -415,6 +567,8 @@ class CampaignSpec:
 
     def _check_points(self, antenna: Antenna, what: str) -> None:
         checks = [("contact_points", self.contact_points)]
+        if self.noise_sweep.enabled and self.noise_sweep.contact_points is not None:
+            checks.append(("noise_sweep.contact_points", self.noise_sweep.contact_points))
         if self.calibration.enabled:
             checks.append(("calibration.contact_points", self.calibration.contact_points))
         for key, points in checks:
@@ -427,8 +581,12 @@ class CampaignSpec:
                     )
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data (JSON/TOML-ready) that :func:`parse_campaign_spec` reads back."""
-        return {
+        """Plain data (JSON/TOML-ready) that :func:`parse_campaign_spec` reads back.
+
+        ``noise_sweep`` appears only when the sweep is enabled, so the fingerprint of a spec
+        without one is what it was before sweeps existed (stored campaigns still resume).
+        """
+        data = {
             "name": self.name,
             "description": self.description,
             "antenna": self.antenna,
@@ -446,6 +604,9 @@ class CampaignSpec:
             "device": self.device.to_dict(),
             "calibration": self.calibration.to_dict(),
         }
+        if self.noise_sweep.enabled:
+            data["noise_sweep"] = self.noise_sweep.to_dict()
+        return data
 
     def preparation_fingerprint(self) -> str:
         """Short hash of what the preparation steps (identification, calibration) depend on.
@@ -476,7 +637,8 @@ class RunSpec:
     index : int
         Position of the run in the campaign (0-based).
     run_id : str
-        Stable, file-name-safe identifier, e.g. ``azimuthal-x0300mm-r1``.
+        Stable, file-name-safe identifier, e.g. ``azimuthal-x0300mm-r1``; a run of the noise
+        sweep ends in its level, e.g. ``azimuthal-x0300mm-r1-n2.00``.
     case : str
         Manoeuvre (:data:`CASES`).
     contact_point : float
@@ -484,13 +646,15 @@ class RunSpec:
     repeat : int
         Repeat number, 1-based.
     seed : int
-        Seed of this run's simulation (derived from the base seed and ``index``).
+        Seed of this run's simulation (derived from the base seed and the run's position: stream
+        :data:`RUN_STREAM` for the main runs, :data:`NOISE_SWEEP_STREAM` for the sweep's).
     antenna : Antenna
         The model the estimators use (nominal antenna, identified observer, calibrated T_e).
     methods : tuple of str
         Methods that estimate the recording.
     scenario : mapping
-        Extra keyword arguments of ``simulator.Scenario``.
+        Extra keyword arguments of ``simulator.Scenario`` (a sweep run's holds its
+        ``noise_scale``).
     device : Antenna or None
         The simulated hardware (with the observer its controller uses); None: ``antenna``.
     """
@@ -507,6 +671,11 @@ class RunSpec:
     device: Antenna | None = None
 
     @property
+    def noise_scale(self) -> float:
+        """Sensor noise level of this run (``scenario["noise_scale"]``, default 1)."""
+        return float(self.scenario.get("noise_scale", SCENARIO_NOISE_SCALE))
+
+    @property
     def simulated_antenna(self) -> Antenna:
         """The antenna the simulator uses: ``device`` if given, else ``antenna``."""
         return self.device if self.device is not None else self.antenna
@@ -516,7 +685,8 @@ def derive_seed(base_seed: int, index: int, stream: int = RUN_STREAM) -> int:
     """Seed of run ``index``: SeedSequence(base_seed, spawn_key=(stream, index)), first word.
 
     Stream 0 (:data:`RUN_STREAM`) holds the contact runs, stream 1 the free-motion identification
-    step and stream 2 the calibration recordings, so no two of them share a seed sequence.
+    step, stream 2 the calibration recordings and stream 3 the runs of the noise sweep, so no two
+    of them share a seed sequence.
     """
     state = np.random.SeedSequence(base_seed, spawn_key=(stream, index)).generate_state(1)
     return int(state[0])
@@ -526,6 +696,10 @@ def expand_runs(
     spec: CampaignSpec, antenna: Antenna, device: Antenna | None = None
 ) -> list[RunSpec]:
     """All runs of a campaign in a fixed order: case, then contact point, then repeat.
+
+    The main runs come first (indices and ids as without a sweep); then, if the spec has a noise
+    sweep, its runs ordered by level, case, contact point and repeat, with ids ending in
+    ``-n<level>`` and seeds from :data:`NOISE_SWEEP_STREAM` (position within the sweep).
 
     Parameters
     ----------
@@ -555,6 +729,30 @@ def expand_runs(
                         device=device,
                     )
                 )
+    sweep = 0
+    for level in spec.noise_sweep.noise_scales:
+        scenario = {**spec.scenario, "noise_scale": float(level)}
+        for case in spec.sweep_cases:
+            for x_c in spec.sweep_contact_points:
+                for repeat in range(1, spec.sweep_repeats + 1):
+                    runs.append(
+                        RunSpec(
+                            index=len(runs),
+                            run_id=(
+                                f"{case}-x{round(x_c * 1000):04d}mm-r{repeat}"
+                                f"-n{_level_key(level) / 100:.2f}"
+                            ),
+                            case=case,
+                            contact_point=float(x_c),
+                            repeat=repeat,
+                            seed=derive_seed(spec.base_seed, sweep, NOISE_SWEEP_STREAM),
+                            antenna=antenna,
+                            methods=spec.methods,
+                            scenario=dict(scenario),
+                            device=device,
+                        )
+                    )
+                    sweep += 1
     return runs
 
 
@@ -650,6 +848,7 @@ def parse_campaign_spec(
         raise CampaignSpecError("free_motion.duration", "must be a number (s)", source)
     device = _parse_device(data.get("device", {}), source, base_dir)
     calibration = _parse_calibration(data.get("calibration", {}), source)
+    noise_sweep = _parse_noise_sweep(data.get("noise_sweep", {}), source)
     try:
         free_step = FreeMotionStep(
             identify=identify, duration=float(duration), case=str(free.get("case", "free"))
@@ -667,6 +866,7 @@ def parse_campaign_spec(
             free_motion=free_step,
             device=device,
             calibration=calibration,
+            noise_sweep=noise_sweep,
             source=source,
         )
     except CampaignSpecError as exc:
@@ -756,6 +956,55 @@ def _parse_calibration(data: Any, source: str) -> CalibrationStep:
         return CalibrationStep(
             enabled=enabled, case=case, contact_points=tuple(points), repeats=repeats, loss=loss
         )
+    except CampaignSpecError as exc:
+        raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
+
+
+def _numbers(data: Mapping[str, Any], key: str, what: str, source: str) -> tuple[float, ...]:
+    raw = data[key]
+    if not isinstance(raw, list):
+        raise CampaignSpecError(f"noise_sweep.{key}", f"must be a list of {what}", source)
+    values: list[float] = []
+    for i, x in enumerate(raw):
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            raise CampaignSpecError(
+                f"noise_sweep.{key}[{i}]", f"must be a number ({what}), got {x!r}", source
+            )
+        values.append(float(x))
+    return tuple(values)
+
+
+def _parse_noise_sweep(data: Any, source: str) -> NoiseSweep:
+    if not isinstance(data, Mapping):
+        raise CampaignSpecError("noise_sweep", "must be a table", source)
+    if not data:
+        return NoiseSweep()
+    for key in data:
+        if key not in _NOISE_SWEEP_KEYS:
+            raise CampaignSpecError(
+                f"noise_sweep.{key}", f"unknown key; known: {', '.join(_NOISE_SWEEP_KEYS)}", source
+            )
+    if "noise_scales" not in data:
+        raise CampaignSpecError("noise_sweep.noise_scales", "missing", source)
+    scales = _numbers(data, "noise_scales", "noise multiples", source)
+    if not scales:
+        raise CampaignSpecError(
+            "noise_sweep.noise_scales", "must list at least one level (or drop the table)", source
+        )
+    points = _numbers(data, "contact_points", "m", source) if "contact_points" in data else None
+    repeats = data.get("repeats")
+    if repeats is not None and (isinstance(repeats, bool) or not isinstance(repeats, int)):
+        raise CampaignSpecError(
+            "noise_sweep.repeats", f"must be an integer, got {repeats!r}", source
+        )
+    cases = None
+    if "cases" in data:
+        raw = data["cases"]
+        if not isinstance(raw, list) or not all(isinstance(c, str) for c in raw):
+            raise CampaignSpecError("noise_sweep.cases", "must be a list of case names", source)
+        cases = tuple(raw)
+    try:
+        return NoiseSweep(noise_scales=scales, contact_points=points, repeats=repeats, cases=cases)
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
 
