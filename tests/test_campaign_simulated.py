@@ -43,6 +43,10 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
     assert [m.method for m in result.methods] == ["paper", "ratio", "two-frequency"]
     # the same seed gives the same recording; the estimators see it without ground truth
     recording = simulate(antenna, make_scenario(run.case, run.contact_point, run.seed, {}))
+    # the contact abscissa is the recording's ground truth, kept beside the nominal x_c
+    assert result.contact_abscissa == float(recording.metadata["true_xc"])
+    assert 0.0 < run.contact_point - result.contact_abscissa < 0.005
+    assert result.noise_scale == 1.0
     for outcome in result.methods:
         direct = estimate(recording.without_ground_truth(), antenna, method=outcome.method)
         assert outcome.status == str(direct.status)

@@ -57,6 +57,12 @@ CSV_COLUMNS = (
     "interval_high_m",
     "simulate_s",
     "estimate_s",
+    "noise_scale",
+    "x_c_contact_m",
+    "error_contact_m",
+    "abs_error_contact_m",
+    "omega1_se_rad_s",
+    "omega1_crb_rad_s",
 )
 
 _FLOAT_FIELDS = ("x_c", "omega1", "peak_quality", "ratio_estimate", "t_c", "t_1", "t_e")
@@ -81,6 +87,13 @@ def _interval(diagnostics: Any) -> tuple[float, float]:
     except (TypeError, ValueError):
         return math.nan, math.nan
     return low, high
+
+
+def _diagnostic(diagnostics: Any, key: str) -> float:
+    """``diagnostics[key]`` as a float, NaN when absent or not a number."""
+    if not isinstance(diagnostics, Mapping):
+        return math.nan
+    return _as_float(diagnostics.get(key))
 
 
 def _status_text(status: Any) -> str:
@@ -117,6 +130,12 @@ class MethodOutcome:
     interval_low, interval_high : float
         Bounds of the method's 95 % interval of x_c (m), for methods that give one (``fast``);
         NaN otherwise.
+    omega1_se : float
+        The method's reported standard error of omega_1 (rad/s, ``diagnostics["omega1_se"]``);
+        NaN for methods that report none.
+    omega1_crb : float
+        Cramer-Rao bound of omega_1 for the method's own fit (rad/s,
+        ``diagnostics["omega1_crb"]``); NaN for methods that report none.
     """
 
     method: str
@@ -133,19 +152,24 @@ class MethodOutcome:
     elapsed_s: float = math.nan
     interval_low: float = math.nan
     interval_high: float = math.nan
+    omega1_se: float = math.nan
+    omega1_crb: float = math.nan
 
     @classmethod
     def from_estimate(cls, method: str, estimate: Any, elapsed_s: float) -> MethodOutcome:
         """Copy the fields of an estimation result (``ContactEstimate``) that tables need.
 
         Fields a method does not have are NaN; an interval (a pair of lengths in m) is read from
-        the result's ``interval`` or, failing that, ``diagnostics["interval"]``.
+        the result's ``interval`` or, failing that, ``diagnostics["interval"]``; the standard
+        error and Cramer-Rao bound of omega_1 from ``diagnostics["omega1_se"]`` and
+        ``diagnostics["omega1_crb"]``.
         """
+        diagnostics = getattr(estimate, "diagnostics", None)
         values = {name: _as_float(getattr(estimate, name, None)) for name in _FLOAT_FIELDS}
         candidates = getattr(estimate, "candidates", None)
         low, high = _interval({"interval": getattr(estimate, "interval", None)})
         if math.isnan(low):
-            low, high = _interval(getattr(estimate, "diagnostics", None))
+            low, high = _interval(diagnostics)
         return cls(
             method=method,
             status=_status_text(getattr(estimate, "status", "unknown")),
@@ -154,6 +178,8 @@ class MethodOutcome:
             elapsed_s=float(elapsed_s),
             interval_low=low,
             interval_high=high,
+            omega1_se=_diagnostic(diagnostics, "omega1_se"),
+            omega1_crb=_diagnostic(diagnostics, "omega1_crb"),
             **values,
         )
 
@@ -167,6 +193,8 @@ class MethodOutcome:
             "candidates": [_json_float(c) for c in self.candidates],
             "elapsed_s": _json_float(self.elapsed_s),
             "interval": [_json_float(self.interval_low), _json_float(self.interval_high)],
+            "omega1_se": _json_float(self.omega1_se),
+            "omega1_crb": _json_float(self.omega1_crb),
         }
 
     @classmethod
@@ -180,6 +208,8 @@ class MethodOutcome:
             elapsed_s=_as_float(data.get("elapsed_s")),
             interval_low=_interval({"interval": data.get("interval")})[0],
             interval_high=_interval({"interval": data.get("interval")})[1],
+            omega1_se=_as_float(data.get("omega1_se")),
+            omega1_crb=_as_float(data.get("omega1_crb")),
             **{name: _as_float(data.get(name)) for name in _FLOAT_FIELDS},
         )
 
@@ -202,6 +232,14 @@ class RunResult:
         Wall-clock time spent producing the recording (s).
     methods : tuple of MethodOutcome
         One entry per estimation method.
+    contact_abscissa : float
+        Where the link actually touched (m): the simulator's ground truth ``true_xc``, the
+        contact abscissa along the link at the last in-contact sample (it sits a little nearer
+        the base than the nominal ``contact_point``). NaN when unknown (no contact, or a run
+        stored before this field existed).
+    noise_scale : float
+        Sensor noise level of the run (``Scenario.noise_scale``); NaN for a run stored before
+        this field existed (those are all at the campaign's main level).
     """
 
     run_id: str
@@ -215,6 +253,8 @@ class RunResult:
     detail: str = ""
     simulate_s: float = math.nan
     methods: tuple[MethodOutcome, ...] = field(default=())
+    contact_abscissa: float = math.nan
+    noise_scale: float = math.nan
 
     @classmethod
     def failed(cls, run: RunSpec, error: str, detail: str = "") -> RunResult:
@@ -229,13 +269,18 @@ class RunResult:
             status=RUN_FAILED,
             error=error,
             detail=detail,
+            noise_scale=run.noise_scale,
         )
 
     @classmethod
     def for_run(
-        cls, run: RunSpec, methods: Sequence[MethodOutcome], simulate_s: float
+        cls,
+        run: RunSpec,
+        methods: Sequence[MethodOutcome],
+        simulate_s: float,
+        contact_abscissa: float = math.nan,
     ) -> RunResult:
-        """A successful result for ``run``."""
+        """A successful result for ``run``; ``contact_abscissa`` is the recording's true x_c."""
         return cls(
             run_id=run.run_id,
             index=run.index,
@@ -246,6 +291,8 @@ class RunResult:
             status=RUN_OK,
             simulate_s=float(simulate_s),
             methods=tuple(methods),
+            contact_abscissa=float(contact_abscissa),
+            noise_scale=run.noise_scale,
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -262,11 +309,16 @@ class RunResult:
             "detail": self.detail,
             "simulate_s": _json_float(self.simulate_s),
             "methods": [m.to_dict() for m in self.methods],
+            "contact_abscissa": _json_float(self.contact_abscissa),
+            "noise_scale": _json_float(self.noise_scale),
         }
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RunResult:
-        """Inverse of :meth:`to_dict`; raises KeyError or TypeError on malformed data."""
+        """Inverse of :meth:`to_dict`; raises KeyError or TypeError on malformed data.
+
+        Runs stored before ``contact_abscissa`` and ``noise_scale`` existed read them as NaN.
+        """
         return cls(
             run_id=str(data["run_id"]),
             index=int(data["index"]),
@@ -279,6 +331,8 @@ class RunResult:
             detail=str(data.get("detail", "")),
             simulate_s=_as_float(data.get("simulate_s")),
             methods=tuple(MethodOutcome.from_dict(m) for m in data.get("methods", [])),
+            contact_abscissa=_as_float(data.get("contact_abscissa")),
+            noise_scale=_as_float(data.get("noise_scale")),
         )
 
 
@@ -286,7 +340,8 @@ def result_rows(result: RunResult, methods: Sequence[str]) -> list[dict[str, Any
     """Rows of the run x method table (:data:`CSV_COLUMNS`) for one run.
 
     A failed run gives one row per expected method with status ``run-failed`` and the error as
-    reason, so every run x method appears in the table.
+    reason, so every run x method appears in the table. ``error_m`` is against the nominal x_c
+    (as in the paper's tables), ``error_contact_m`` against the contact abscissa.
     """
     base = {
         "run_id": result.run_id,
@@ -297,6 +352,8 @@ def result_rows(result: RunResult, methods: Sequence[str]) -> list[dict[str, Any
         "seed": result.seed,
         "run_status": result.status,
         "simulate_s": result.simulate_s,
+        "noise_scale": result.noise_scale,
+        "x_c_contact_m": result.contact_abscissa,
     }
     by_method = {m.method: m for m in result.methods}
     rows = []
@@ -306,6 +363,7 @@ def result_rows(result: RunResult, methods: Sequence[str]) -> list[dict[str, Any
             reason = result.error if result.status == RUN_FAILED else "method not run"
             outcome = MethodOutcome(method=method, status="run-failed", reason=reason)
         error = outcome.x_c - result.contact_point
+        error_contact = outcome.x_c - result.contact_abscissa
         rows.append(
             {
                 **base,
@@ -325,6 +383,10 @@ def result_rows(result: RunResult, methods: Sequence[str]) -> list[dict[str, Any
                 "interval_low_m": outcome.interval_low,
                 "interval_high_m": outcome.interval_high,
                 "estimate_s": outcome.elapsed_s,
+                "error_contact_m": error_contact,
+                "abs_error_contact_m": abs(error_contact),
+                "omega1_se_rad_s": outcome.omega1_se,
+                "omega1_crb_rad_s": outcome.omega1_crb,
             }
         )
     return rows

@@ -14,7 +14,9 @@ Also the steps before the runs, in the paper's order:
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
+from collections.abc import Mapping
 from typing import Any
 
 from sensing_antenna.antenna import Antenna, FreeMotionObserver
@@ -73,7 +75,9 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     recording = simulate(run.simulated_antenna, scenario)
     simulate_s = time.perf_counter() - start
     # The estimators get the recording without ground truth (recording format: they must never
-    # read it); the run result keeps the true contact point from the run spec.
+    # read it); the run result keeps the nominal contact point from the run spec and the contact
+    # abscissa the simulator reports (where the link touched at the last in-contact sample).
+    contact_abscissa = _true_contact_abscissa(recording.metadata)
     blind = recording.without_ground_truth()
     outcomes = []
     for method in run.methods:
@@ -91,7 +95,15 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
             )
             continue
         outcomes.append(MethodOutcome.from_estimate(method, result, time.perf_counter() - begin))
-    return RunResult.for_run(run, outcomes, simulate_s)
+    return RunResult.for_run(run, outcomes, simulate_s, contact_abscissa)
+
+
+def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:
+    """The recording's ground-truth ``true_xc`` (m), NaN when absent or not a number."""
+    try:
+        return float(metadata.get("true_xc", "nan"))
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def identify_observer(
