@@ -25,6 +25,7 @@ from sensing_antenna.campaign.tables import (
     paper_row_at,
     paper_table,
     point_table,
+    target_summary,
 )
 
 #: Offsets (m) of the "paper" toy estimates for repeats 1, 2, 3: errors of +1, -2 and +4 mm.
@@ -164,6 +165,8 @@ class _FakeEstimate:
         "interval": (0.51, 0.53),
         "interval_width": 0.02,
         "model_order": 3,
+        "omega1_se": 0.2,
+        "omega1_crb": 0.15,
     }
 
 
@@ -207,8 +210,8 @@ def test_report_renders_a_method_with_intervals(tmp_path: Path) -> None:
     text = build_report(tmp_path).read_text("utf-8")
     assert "## Time to estimate and uncertainty" in text
     # [0.51, 0.53] m contains none of the true points 0.3 and 0.5 m; 6 runs per case
-    assert "| azimuthal | ratio | 0.200 | 0/6 (0 %) | 2.00 |" in text
-    assert "| azimuthal | paper | - | - | - |" in text
+    assert "| azimuthal | ratio | 0.200 | 0/6 (0 %) | 0/6 (0 %) | 2.00 |" in text
+    assert "| azimuthal | paper | - | - | - | - |" in text
     header = (tmp_path / "runs.csv").read_text("utf-8").splitlines()[0].split(",")
     assert "interval_low_m" in header and "interval_high_m" in header
 
@@ -242,3 +245,133 @@ def test_report_with_fast_has_the_error_and_delay_figure(
     assert "](figures/error-and-delay-by-method.png)" in text
     build_report(campaign_dir)
     assert not (campaign_dir / "figures" / "error-and-delay-by-method.png").exists()
+
+
+def test_the_frequency_bound_and_standard_error_are_kept() -> None:
+    outcome = MethodOutcome.from_estimate("fast", _FakeEstimate(), 0.01)
+    assert (outcome.omega1_se, outcome.omega1_crb) == (0.2, 0.15)
+    assert MethodOutcome.from_dict(outcome.to_dict()) == outcome
+    paper = MethodOutcome(method="paper", status="ok", x_c=0.5, omega1=60.0)
+    assert math.isnan(paper.omega1_se) and math.isnan(paper.omega1_crb)
+
+
+def test_a_run_stored_before_the_contact_abscissa_existed_still_loads() -> None:
+    run = RunSpec(0, "azimuthal-x0500mm-r1", "azimuthal", 0.5, 1, 7, paper_antenna(), ())
+    outcome = MethodOutcome(method="paper", status="ok", x_c=0.499)
+    result = RunResult.for_run(run, [outcome], 0.1, contact_abscissa=0.4985)
+    data = result.to_dict()
+    assert RunResult.from_dict(data) == result
+    assert (result.contact_abscissa, result.noise_scale) == (0.4985, 1.0)
+    old = {k: v for k, v in data.items() if k not in ("contact_abscissa", "noise_scale")}
+    for m in old["methods"]:
+        m.pop("omega1_se"), m.pop("omega1_crb")
+    loaded = RunResult.from_dict(old)
+    assert math.isnan(loaded.contact_abscissa) and math.isnan(loaded.noise_scale)
+    (row,) = campaign_rows([loaded], ["paper"])
+    assert row["error_m"] == pytest.approx(-0.001, abs=ROUND_OFF)
+    assert math.isnan(row["error_contact_m"])
+    (row,) = campaign_rows([result], ["paper"])
+    assert row["error_contact_m"] == pytest.approx(0.0005, abs=ROUND_OFF)
+    assert (row["x_c_contact_m"], row["noise_scale"]) == (0.4985, 1.0)
+
+
+def test_coverage_is_judged_against_the_contact_abscissa() -> None:
+    # interval [0.51, 0.53] m: the nominal points 0.5 and 0.535 m lie outside it, their contact
+    # abscissae 0.512 and 0.528 m inside; a run without a contact abscissa falls back to the
+    # nominal 0.52 m (inside) and is counted as judged against the nominal point
+    estimate = MethodOutcome.from_estimate("fast", _FakeEstimate(), 0.01)
+    runs = [
+        RunSpec(i, f"azimuthal-r{i}", "azimuthal", x, 1, i, paper_antenna(), ())
+        for i, x in enumerate((0.5, 0.535, 0.52))
+    ]
+    contact = (0.512, 0.528, math.nan)
+    results = [
+        RunResult.for_run(run, [estimate], 0.0, contact_abscissa=c)
+        for run, c in zip(runs, contact, strict=True)
+    ]
+    rows = campaign_rows(results, ["fast"])
+    (summary,) = interval_summaries(rows, ["azimuthal"], ["fast"])
+    assert (summary.n_intervals, summary.n_covering) == (3, 3)
+    assert (summary.n_covering_nominal, summary.n_judged_nominal) == (1, 1)
+    target = target_summary(rows, "all", "fast", "paper")
+    assert (target.n_intervals, target.n_covering) == (3, 3)
+    assert "coverage outside 93%-97%" in target.missed()
+
+
+def _sweep_run(run: RunSpec) -> RunResult:
+    """Paper off by 1 mm, fast by noise_scale x 2 mm from the contact abscissa (2 mm nearer
+    the base than nominal), fast sure at t_1 + 0.25 s, paper at t_1 + 1 s; omega_1 off by 0.1 %
+    (paper) and noise_scale x 0.2 % (fast) from the paper link's fundamental."""
+    from sensing_antenna.beam import natural_frequencies
+
+    contact = run.contact_point - 0.002
+    true = float(natural_frequencies(paper_antenna().link, contact, 1)[0])
+    paper = MethodOutcome(
+        method="paper", status="ok", x_c=contact + 0.001, omega1=true * 1.001, t_1=1.0, t_e=2.0
+    )
+    fast = MethodOutcome(
+        method="fast",
+        status="ok",
+        x_c=contact + 0.002 * run.noise_scale,
+        omega1=true * (1 + 0.002 * run.noise_scale),
+        t_1=1.0,
+        t_e=1.25,
+        interval_low=contact - 0.003,
+        interval_high=contact + 0.003,
+        omega1_se=true * 0.002 * run.noise_scale,
+        omega1_crb=true * 0.001 * run.noise_scale,
+    )
+    return RunResult.for_run(run, [paper, fast], 0.0, contact_abscissa=contact)
+
+
+def test_report_with_a_noise_sweep_and_fast_has_its_sections_and_figures(tmp_path: Path) -> None:
+    from sensing_antenna.campaign.spec import NoiseSweep
+
+    swept = CampaignSpec(
+        name="toy-sweep",
+        antenna="paper-2021",
+        cases=("azimuthal",),
+        contact_points=(0.4, 0.6),
+        repeats=2,
+        base_seed=1,
+        methods=("paper", "fast"),
+        noise_sweep=NoiseSweep(noise_scales=(0.5, 3.0), repeats=1),
+    )
+    run_campaign(
+        swept, tmp_path, run_one=_sweep_run, prepare_antenna=plain, workers=1, progress=False
+    )
+    text = build_report(tmp_path).read_text("utf-8")
+    assert "Runs stored: 8 of 8; failed: 0 (4 main runs at noise 1, 4 in the noise sweep)" in text
+    # main runs only in the comparison: fast 2 mm from the contact abscissa, 0 mm from nominal
+    assert "## Nominal x_c and the contact abscissa" in text
+    assert "2.00 mm nearer the base than the nominal x_c" in text
+    assert "| azimuthal | fast | 0.00 | 0.00 | 2.00 | 2.00 | 4/4 |" in text
+    assert "| azimuthal | paper | 1.00 | 1.00 | 1.00 | 1.00 | 4/4 |" in text
+    # issue 6 table: ratio 0.25 / 1 = 0.25, fast MAE 2 mm > paper's 1 mm
+    assert "## Fast method against the targets of issue 6" in text
+    assert (
+        "| all main runs | 4 | 0.250 / 1.000 | 0.25 | 2.00 / 1.00 | 2.00 / 1.00 | 0.00 / 1.00 | "
+        "0.00 / 1.00 | 4/4 (100 %) | 0 | ok 4 | missed: MAE > paper's; max > paper's; coverage "
+        "outside 93%-97% |"
+    ) in text
+    # per noise level: fast error noise x 2 mm, 3 -> 6 mm (no absolute target off the default)
+    assert "| noise 3 | 2 | 0.250 / 1.000 | 0.25 | 6.00 / 1.00 | 6.00 / 1.00 |" in text
+    assert "| noise 1 (main runs) | 4 |" in text
+    # noise section: error per level and method; omega_1 against the truth, with CRB and SE
+    assert "## Noise sweep" in text
+    assert "| 0.5 | fast | 2/2 | 1.00 | 1.00 | 0.250 | 2 |" in text
+    assert "| 3 | fast | 2 | 0.600 | 0.600 | 0.3000 | 0.6000 |" in text
+    assert "| 3 | paper | 2 | 0.100 | 0.100 | - | - |" in text
+    figure = tmp_path / "figures" / "frequency-error-vs-noise.png"
+    assert figure.stat().st_size > 1000
+    assert "](figures/frequency-error-vs-noise.png)" in text
+    assert "](figures/error-and-delay-by-method.png)" in text
+    header = (tmp_path / "runs.csv").read_text("utf-8").splitlines()[0].split(",")
+    assert {"noise_scale", "x_c_contact_m", "error_contact_m", "omega1_crb_rad_s"} <= set(header)
+
+
+def test_a_report_without_fast_or_sweep_has_neither_section(campaign_dir: Path) -> None:
+    text = build_report(campaign_dir, figures=False).read_text("utf-8")
+    assert "## Noise sweep" not in text
+    assert "issue 6" not in text
+    assert "## Nominal x_c and the contact abscissa" in text
