@@ -200,7 +200,9 @@ def _execute(
 def _execute_pool(
     task: Callable[[RunSpec], RunResult], pending: Sequence[RunSpec], workers: int
 ) -> Iterator[RunResult]:
-    executor = ProcessPoolExecutor(max_workers=min(workers, len(pending)))
+    executor = ProcessPoolExecutor(
+        max_workers=min(workers, len(pending)), initializer=_one_thread_per_worker
+    )
     futures: dict[Future[RunResult], RunSpec] = {}
     try:
         futures = {executor.submit(task, run): run for run in pending}
@@ -211,6 +213,18 @@ def _execute_pool(
                 yield _result_of(future, futures[future])
     finally:
         executor.shutdown(wait=True, cancel_futures=True)
+
+
+def _one_thread_per_worker() -> None:
+    """Limit BLAS/OpenMP to one thread in a worker process.
+
+    The pool already runs one process per core; multi-threaded linear algebra inside each (the
+    fast method's least squares) made them fight for the cores: 7 to 73 s per recording on 2
+    cores instead of about 1 s.
+    """
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1)
 
 
 def _result_of(future: Future[RunResult], run: RunSpec) -> RunResult:
