@@ -87,3 +87,13 @@ def test_calibrate_without_known_contact_points_fails_cleanly(
     err = capsys.readouterr().err
     assert f"{path}: true_xc: no known contact point" in err
     assert not (tmp_path / "cal.toml").exists()
+
+
+def test_methods_option_replaces_the_spec_methods_and_names_bad_ones(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    from sensing_antenna.cli import main
+
+    assert main(["campaign", "run", "--methods", "paper,bogus", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "methods" in err and "bogus" in err

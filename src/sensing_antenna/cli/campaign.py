@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +27,11 @@ def register(subparsers: Any) -> None:
     run.add_argument("--scheduler", default=None, help="Dask scheduler address tcp://HOST:PORT")
     run.add_argument("--retry-failed", action="store_true", help="redo runs stored as failed")
     run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    run.add_argument(
+        "--methods",
+        default=None,
+        help="comma-separated methods instead of the spec's, e.g. paper,ratio,two-frequency,fast",
+    )
     run.set_defaults(func=_run)
 
     report = actions.add_parser("report", help="rebuild tables, figures and report.md")
@@ -39,6 +45,10 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.campaign.spec import load_campaign_spec
 
     spec = load_campaign_spec(args.spec)
+    if args.methods is not None:
+        methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
+        # CampaignSpec validates the names (an unknown one is an error naming --methods' field)
+        spec = dataclasses.replace(spec, methods=methods)
     outcome = run_campaign(
         spec,
         args.out,
