@@ -669,10 +669,11 @@ def _noise_section(
             "every run with an omega_1 (any status). CRB: median over runs of the Cramer-Rao "
             "bound of omega_1 the method reports for its own fit (`fast`: the window it declared "
             "on); SE: median of its reported standard error, which adds a resolution floor. "
-            "The bound falls in proportion to the noise, while the error cannot fall below the "
-            "model bias (the simulator's compliant contact and finite elements against the "
-            "pinned-contact beam model), so at low noise the error stays above the bound by that "
-            "bias; the paper method's 1 s spectrum has no bound reported here.",
+            "For a fixed record the bound is proportional to the noise, but `fast` stops when "
+            "sure, so its record lengthens with the noise and its bound stays nearly level; "
+            "the error cannot fall below the model bias (the simulator's compliant contact and "
+            "finite elements against the pinned-contact beam model, and the unmodelled modes "
+            "of docs/fast.md); the paper method's 1 s spectrum has no bound reported here.",
             "",
             *_table(
                 [
