@@ -44,6 +44,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from sensing_antenna.estimation.frequency import find_peak, power_spectrum
+
 __all__ = [
     "DampedSinusoidFit",
     "damped_sinusoid_crb",
@@ -260,23 +262,14 @@ def _pencil_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
 
 
 def _periodogram_peak(y: FloatArray, sample_period: float, band: tuple[float, float]) -> float:
-    """Frequency (rad/s) of the largest peak inside ``band`` of the channels' summed periodogram.
+    """Frequency (rad/s) of the largest peak inside ``band`` of the channels' summed spectrum.
 
-    Linear trends are removed and a Hann window applied first; zero padding to 8 times the
-    record puts the grid well inside the main lobe (4 pi / (n T_s) wide).
+    The spectrum of Estimator 1 (:func:`~.frequency.power_spectrum`: detrended, Hann window,
+    zero padded); the middle of the band when it holds no peak.
     """
-    n = y.shape[0]
-    tau = np.arange(n) - 0.5 * (n - 1)
-    trend = np.column_stack([np.ones(n), tau])
-    coef, *_ = np.linalg.lstsq(trend, y, rcond=None)
-    detrended = (y - trend @ coef) * np.hanning(n)[:, None]
-    size = 1 << math.ceil(math.log2(8 * n))
-    power = np.sum(np.abs(np.fft.rfft(detrended, size, axis=0)) ** 2, axis=1)
-    omega = 2.0 * math.pi * np.fft.rfftfreq(size, sample_period)
-    inside = (omega >= band[0]) & (omega <= band[1])
-    if not inside.any():
-        return 0.5 * (band[0] + band[1])
-    return float(omega[inside][np.argmax(power[inside])])
+    omega, power = power_spectrum(y, sample_period, zero_padding=8)
+    peak = find_peak(omega, power.sum(axis=1) if power.ndim == 2 else power, band)
+    return peak.omega if peak is not None else 0.5 * (band[0] + band[1])
 
 
 def _initial_modes(
