@@ -215,7 +215,9 @@ def test_drift_check_widens_the_frequency_error_only_when_the_record_disagrees()
     close[:, 4] += x * beat
     cfg = FastConfig()
     plain = evaluate_window(clean, NO_BIAS, 0, 420, TS, BAND, LINK, X_RANGE, cfg, {})
-    assert plain.omega1_se < 1.1 * math.hypot(plain.omega1_crb, 0.0035 * 2 * math.pi / 0.42)
+    assert plain.fit is not None
+    floor = cfg.resolution_fraction * 2 * math.pi / plain.fit.duration
+    assert plain.omega1_se < 1.1 * math.hypot(plain.omega1_crb, floor)
     beating = evaluate_window(close, NO_BIAS, 0, 420, TS, BAND, LINK, X_RANGE, cfg, {})
     assert beating.omega1_drift > 0.0
     assert beating.omega1_se > 2.0 * beating.omega1_crb

@@ -6,18 +6,21 @@ from t_1:
 
 1. the five contact-load channels (R_y, R_z, Gamma - Gamma_g^m; gravity removed as in Eq. 21,
    sensor bias from the initial rest removed, :mod:`.static_fit`) are fitted with damped
-   sinusoids with shared poles plus a quadratic (:mod:`.parametric`): omega_1 with its standard
-   error, and the static loads with their covariance, without filter lag;
+   sinusoids with shared poles plus a polynomial of degree 2 to 4 (:mod:`.parametric`, order and
+   degree by BIC): omega_1 with its standard error (widened by its drift between the window and
+   its first 2/3), and the static loads with their covariance, without filter lag;
 2. the torque/force ratio of the static loads gives x_c with its standard error;
 3. both become a posterior over x_c on a 0.25 mm grid (:mod:`.likelihood`);
 4. the estimate is declared at the first evaluation whose 95 % interval is narrower than
-   ``tolerance``. Evaluations run every ``cadence`` (10 ms) from ``first_window`` (50 ms) after
-   t_1, so t_e adapts to how easy the case is; at ``cap`` (0.6 s) after t_1 the best estimate is
-   given with status ``uncertain``.
+   ``tolerance`` and where the ratio agrees with it. Evaluations run on a geometric grid
+   (:func:`evaluation_offsets`) from ``first_window`` (50 ms) after t_1, so t_e adapts to how
+   easy the case is; at ``cap`` (1 s) after t_1 the best estimate is given with status
+   ``uncertain``.
 
-Every evaluation uses the samples up to its own instant only, so the streaming form
-(:class:`FastOnlineEstimator`) and the batch form (:class:`FastMethod` in the pipeline, or
-:func:`scan`) declare at the same sample with the same numbers.
+Every evaluation uses the samples up to its own instant only, so the streaming form (the
+pipeline's ``OnlineEstimator`` asking :meth:`FastMethod.due` and :meth:`FastMethod.ready`) and
+the batch form (:class:`FastMethod` in ``estimate``, or :func:`scan`) declare at the same sample
+with the same numbers.
 """
 
 from __future__ import annotations
@@ -251,9 +254,9 @@ class WindowEstimate:
     fit : DampedSinusoidFit or None
         The chosen fit of the contact-load channels (None: too few samples or no pole).
     omega1, omega1_se : float
-        Fundamental and its standard error (rad/s): the fit's statistical error and the
-        non-stationarity floor in quadrature (the relative model floor is added by the
-        posterior); NaN when not usable.
+        Fundamental and its standard error (rad/s): the fit's statistical error, the
+        resolution floor and ``drift_factor`` times the drift, in quadrature (the relative model
+        floor is added by the posterior); NaN when not usable.
     omega1_crb : float
         Cramer-Rao bound of omega_1 for this record length and noise (rad/s): the square root
         of the inverse Fisher information of the fitted model at the fitted parameters and the
@@ -265,6 +268,13 @@ class WindowEstimate:
         True when the interval is narrower than the tolerance and the window is long enough.
     note : str
         Why the frequency was not used or why it is not sure (empty when sure).
+    omega1_drift : float
+        Change of omega_1 from the window's first 2/3 beyond what the noise explains (rad/s).
+    early_statics : StaticRatio or None
+        Statics of the window's first half (the slip reference); None when that half is too
+        short for the model.
+    ratio_z : float
+        Distance of the ratio from the MAP x_c in its standard deviations.
     """
 
     end_index: int
