@@ -48,6 +48,8 @@ from sensing_antenna.campaign.tables import (
     paper_row_at,
     paper_table,
     point_table,
+    rows_at_level,
+    same_level,
     target_summary,
 )
 
@@ -537,12 +539,8 @@ def _targets_section(
     table = [_target_row(target_summary(g, label, "fast", reference), True) for label, g in groups]
     if spec.noise_sweep.enabled:
         for level in noise_levels(every, spec.noise_scale):
-            selected = [
-                r
-                for r in every
-                if round(_level_or(r, spec.noise_scale) * 100) == round(level * 100)
-            ]
-            default = round(level * 100) == round(spec.noise_scale * 100)
+            selected = rows_at_level(every, level, spec.noise_scale)
+            default = same_level(level, spec.noise_scale)
             label = f"noise {_level(level)}" + (" (main runs)" if default else "")
             table.append(_target_row(target_summary(selected, label, "fast", reference), default))
     low, high = COVERAGE_TARGET
@@ -579,11 +577,6 @@ def _targets_section(
     ]
 
 
-def _level_or(row: Mapping[str, Any], main: float) -> float:
-    value = _as_float(row.get("noise_scale"))
-    return value if math.isfinite(value) else main
-
-
 def _noise_section(
     spec: CampaignSpec,
     every: Sequence[Mapping[str, Any]],
@@ -596,9 +589,7 @@ def _noise_section(
     levels = noise_levels(every, spec.noise_scale)
     rows = []
     for level in levels:
-        at_level = [
-            r for r in every if round(_level_or(r, spec.noise_scale) * 100) == round(level * 100)
-        ]
+        at_level = rows_at_level(every, level, spec.noise_scale)
         for method in spec.methods:
             mine = [r for r in at_level if r["method"] == method]
             errors = [abs(_as_float(r.get("error_contact_m"))) for r in mine]
@@ -611,8 +602,7 @@ def _noise_section(
             n_ok = sum(1 for r in mine if r["status"] == "ok")
             rows.append(
                 [
-                    _level(level)
-                    + (" (main)" if round(level * 100) == round(spec.noise_scale * 100) else ""),
+                    _level(level) + (" (main)" if same_level(level, spec.noise_scale) else ""),
                     method,
                     f"{len(errors)}/{len(mine)}",
                     _mm(sum(errors) / len(errors)) if errors else "-",

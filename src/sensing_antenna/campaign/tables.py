@@ -42,6 +42,8 @@ __all__ = [
     "paper_row_at",
     "paper_table",
     "point_table",
+    "rows_at_level",
+    "same_level",
     "target_summary",
 ]
 
@@ -297,8 +299,22 @@ def _float(value: Any) -> float:
         return math.nan
 
 
-def _same_level(a: float, b: float) -> bool:
+def same_level(a: float, b: float) -> bool:
+    """Whether two noise levels are the same to 0.01 (as in the run ids)."""
     return round(a * 100) == round(b * 100)
+
+
+def _level(row: Mapping[str, Any], main: float) -> float:
+    """The row's noise level; ``main`` for a row without one (stored before noise sweeps)."""
+    level = _float(row.get("noise_scale"))
+    return level if math.isfinite(level) else main
+
+
+def rows_at_level(
+    rows: Iterable[Mapping[str, Any]], level: float, main: float
+) -> list[Mapping[str, Any]]:
+    """The rows at noise ``level``; a row without a level counts as ``main``."""
+    return [row for row in rows if same_level(_level(row, main), level)]
 
 
 def main_rows(rows: Iterable[Mapping[str, Any]], noise_scale: float) -> list[Mapping[str, Any]]:
@@ -306,33 +322,16 @@ def main_rows(rows: Iterable[Mapping[str, Any]], noise_scale: float) -> list[Map
 
     A row without a noise level (a run stored before noise sweeps existed) is a main run.
     """
-    selected = []
-    for row in rows:
-        level = _float(row.get("noise_scale"))
-        if not math.isfinite(level) or _same_level(level, noise_scale):
-            selected.append(row)
-    return selected
+    return rows_at_level(rows, noise_scale, noise_scale)
 
 
 def noise_levels(rows: Iterable[Mapping[str, Any]], main: float) -> list[float]:
     """Distinct noise levels of the rows, ascending; a row without one counts as ``main``."""
     levels: dict[int, float] = {}
     for row in rows:
-        level = _float(row.get("noise_scale"))
-        level = level if math.isfinite(level) else main
+        level = _level(row, main)
         levels.setdefault(round(level * 100), level)
     return [levels[k] for k in sorted(levels)]
-
-
-def _at_level(
-    rows: Iterable[Mapping[str, Any]], level: float, main: float
-) -> list[Mapping[str, Any]]:
-    out = []
-    for row in rows:
-        value = _float(row.get("noise_scale"))
-        if _same_level(value if math.isfinite(value) else main, level):
-            out.append(row)
-    return out
 
 
 def point_table(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> list[PointStats]:
@@ -513,7 +512,7 @@ def frequency_error_summaries(
     all_rows = list(rows)
     summaries = []
     for level in noise_levels(all_rows, main):
-        at_level = _at_level(all_rows, level, main)
+        at_level = rows_at_level(all_rows, level, main)
         for method in methods:
             selected = [r for r in at_level if r["method"] == method]
             omega = _column(selected, "omega1_rad_s")
