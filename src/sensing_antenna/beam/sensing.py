@@ -205,16 +205,9 @@ class SensingCurve:
         x0, x1 = self.xi[k], self.xi[k + 1]
         width = x1 - x0
         t = (xi - x0) / width
-        t2, t3 = t * t, t * t * t
         y0, y1 = self.lam[k], self.lam[k + 1]
         m0, m1 = self.lam_slope[k] * width, self.lam_slope[k + 1] * width
-        value = (
-            (2 * t3 - 3 * t2 + 1) * y0
-            + (t3 - 2 * t2 + t) * m0
-            + (-2 * t3 + 3 * t2) * y1
-            + (t3 - t2) * m1
-        )
-        deriv = (6 * t2 - 6 * t) * (y0 - y1) + (3 * t2 - 4 * t + 1) * m0 + (3 * t2 - 2 * t) * m1
+        value, deriv = _hermite_array(t, y0, y1, m0, m1)
         return value, deriv / width
 
     def omega1(self, x_c: ArrayLike) -> FloatArray:
