@@ -684,6 +684,15 @@ def _noise_section(
     return lines
 
 
+def _frequency_summaries(
+    spec: CampaignSpec, every: Sequence[Mapping[str, Any]], device: Antenna
+) -> list[FrequencyErrorSummary]:
+    """omega_1 errors per noise level against the device's link; none without a noise sweep."""
+    if not spec.noise_sweep.enabled:
+        return []
+    return frequency_error_summaries(every, device.link, spec.methods, spec.noise_scale)
+
+
 def render_report(
     spec: CampaignSpec,
     antenna: Antenna,
@@ -694,6 +703,7 @@ def render_report(
     calibration: FrequencyCalibration | None = None,
     calibration_figure: Path | None = None,
     noise_figure: Path | None = None,
+    frequency: Sequence[FrequencyErrorSummary] | None = None,
 ) -> str:
     """The Markdown text of the report (figure links relative to ``out_dir``).
 
@@ -715,6 +725,9 @@ def render_report(
         Figure 10 of the calibration.
     noise_figure : Path, optional
         omega_1 error against the noise level (noise sweep).
+    frequency : sequence of FrequencyErrorSummary, optional
+        The noise sweep's omega_1 errors if already computed (for the figure); None: computed
+        here.
 
     The method comparison, status counts, intervals, figures and the tables per case use the
     main runs only (the noise level of ``[scenario]``); the noise sweep has its own section.
@@ -723,11 +736,8 @@ def render_report(
     every = campaign_rows(results, spec.methods)
     rows = main_rows(every, spec.noise_scale)
     summaries = method_summaries(rows, spec.cases, spec.methods)
-    frequency = (
-        frequency_error_summaries(every, device.link, spec.methods, spec.noise_scale)
-        if spec.noise_sweep.enabled
-        else []
-    )
+    if frequency is None:
+        frequency = _frequency_summaries(spec, every, device)
     n_failed = sum(1 for r in results if r.status == RUN_FAILED)
     obs = antenna.observer
     lines = [
@@ -813,6 +823,8 @@ def build_report(out_dir: str | Path, *, figures: bool = True) -> Path:
     stored = load_run_results(directory)
     results = sorted(stored.values(), key=lambda r: r.index)
     write_runs_csv(directory / CSV_FILE, results, spec.methods)
+    every = campaign_rows(results, spec.methods)
+    frequency = _frequency_summaries(spec, every, device)
     paths: list[Path] = []
     calibration_figure = None
     noise_figure = None
@@ -823,17 +835,12 @@ def build_report(out_dir: str | Path, *, figures: bool = True) -> Path:
     if figures and results:
         from sensing_antenna.plotting.campaign import plot_campaign
 
-        every = campaign_rows(results, spec.methods)
         rows = main_rows(every, spec.noise_scale)
         paths = plot_campaign(rows, spec.cases, spec.methods, antenna, directory / FIGURES_DIR)
-        if spec.noise_sweep.enabled:
+        if frequency:
             from sensing_antenna.plotting.campaign import plot_frequency_error_vs_noise
 
-            frequency = frequency_error_summaries(
-                every, device.link, spec.methods, spec.noise_scale
-            )
-            if frequency:
-                noise_figure = plot_frequency_error_vs_noise(frequency, directory / FIGURES_DIR)
+            noise_figure = plot_frequency_error_vs_noise(frequency, directory / FIGURES_DIR)
     report = directory / REPORT_FILE
     text = render_report(
         spec,
@@ -845,6 +852,7 @@ def build_report(out_dir: str | Path, *, figures: bool = True) -> Path:
         calibration,
         calibration_figure,
         noise_figure=noise_figure,
+        frequency=frequency,
     )
     atomic_write_text(report, text)
     return report
