@@ -60,8 +60,6 @@ FIGURES_DIR = "figures"
 
 _CM = 100.0
 _MM = 1000.0
-#: File name of the figure of omega_1 error against noise level (in ``figures/``).
-NOISE_FIGURE = "frequency-error-vs-noise.png"
 
 #: Section 5.1 of the paper: theoretical T from Table 2 and the calibrated T_e (s/m^2); the paper
 #: quotes their relative difference as 7 %.
