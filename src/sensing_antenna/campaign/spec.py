@@ -50,7 +50,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
@@ -356,18 +356,7 @@ class NoiseSweep:
                 "noise_sweep.noise_scales", "must be distinct (to 0.01, as in the run ids)"
             )
         if self.contact_points is not None:
-            if not self.contact_points:
-                raise CampaignSpecError(
-                    "noise_sweep.contact_points", "must list at least one point (m)"
-                )
-            for i, x in enumerate(self.contact_points):
-                if not (math.isfinite(x) and x > 0):
-                    raise CampaignSpecError(
-                        f"noise_sweep.contact_points[{i}]",
-                        f"must be a finite length > 0 m, got {x!r}",
-                    )
-            if len({round(x * 1e6) for x in self.contact_points}) != len(self.contact_points):
-                raise CampaignSpecError("noise_sweep.contact_points", "must be distinct")
+            _check_contact_points("noise_sweep.contact_points", self.contact_points, None)
         if self.repeats is not None and self.repeats < 1:
             raise CampaignSpecError("noise_sweep.repeats", f"must be >= 1, got {self.repeats!r}")
         if self.cases is not None:
@@ -388,6 +377,19 @@ class NoiseSweep:
         if self.cases is not None:
             data["cases"] = list(self.cases)
         return data
+
+
+def _check_contact_points(key: str, points: Sequence[float], source: str | None) -> None:
+    """At least one contact point, each a finite length > 0 m, all distinct (to 1 um)."""
+    if not points:
+        raise CampaignSpecError(key, "must list at least one point (m)", source)
+    for i, x in enumerate(points):
+        if not (math.isfinite(x) and x > 0):
+            raise CampaignSpecError(
+                f"{key}[{i}]", f"must be a finite length > 0 m, got {x!r}", source
+            )
+    if len({round(x * 1e6) for x in points}) != len(points):
+        raise CampaignSpecError(key, "must be distinct", source)
 
 
 def _level_key(noise_scale: float) -> int:
@@ -453,15 +455,7 @@ class CampaignSpec:
             raise CampaignSpecError("name", "must be a non-empty string", src)
         _check_choices("cases", self.cases, CASES, src)
         _check_choices("methods", self.methods, known_methods(), src)
-        if not self.contact_points:
-            raise CampaignSpecError("contact_points", "must list at least one point (m)", src)
-        for i, x in enumerate(self.contact_points):
-            if not (math.isfinite(x) and x > 0):
-                raise CampaignSpecError(
-                    f"contact_points[{i}]", f"must be a finite length > 0 m, got {x!r}", src
-                )
-        if len({round(x * 1e6) for x in self.contact_points}) != len(self.contact_points):
-            raise CampaignSpecError("contact_points", "must be distinct", src)
+        _check_contact_points("contact_points", self.contact_points, src)
         if self.repeats < 1:
             raise CampaignSpecError("repeats", f"must be >= 1, got {self.repeats!r}", src)
         if self.base_seed < 0:
@@ -820,14 +814,7 @@ def parse_campaign_spec(
     if not isinstance(antenna, str) or not antenna:
         raise CampaignSpecError("antenna", "must be a built-in name or a file path", source)
     antenna = _resolve_antenna(antenna, base_dir)
-    raw_points = _get(data, "contact_points", list, source)
-    points: list[float] = []
-    for i, x in enumerate(raw_points):
-        if isinstance(x, bool) or not isinstance(x, (int, float)):
-            raise CampaignSpecError(
-                f"contact_points[{i}]", f"must be a number (m), got {x!r}", source
-            )
-        points.append(float(x))
+    points = _numbers(_get(data, "contact_points", list, source), "contact_points", "m", source)
     repeats = _get(data, "repeats", int, source)
     base_seed = _get(data, "base_seed", int, source)
     methods = _str_list(data, "methods", source) if "methods" in data else METHODS
@@ -858,7 +845,7 @@ def parse_campaign_spec(
             description=str(data.get("description", "")),
             antenna=antenna,
             cases=_str_list(data, "cases", source),
-            contact_points=tuple(points),
+            contact_points=points,
             repeats=repeats,
             base_seed=base_seed,
             methods=methods,
@@ -941,35 +928,23 @@ def _parse_calibration(data: Any, source: str) -> CalibrationStep:
             "calibration.repeats", f"must be an integer, got {repeats!r}", source
         )
     raw = data.get("contact_points", list(DEFAULT_CALIBRATION_POINTS))
-    if not isinstance(raw, list):
-        raise CampaignSpecError(
-            "calibration.contact_points", "must be a list of lengths (m)", source
-        )
-    points: list[float] = []
-    for i, x in enumerate(raw):
-        if isinstance(x, bool) or not isinstance(x, (int, float)):
-            raise CampaignSpecError(
-                f"calibration.contact_points[{i}]", f"must be a number (m), got {x!r}", source
-            )
-        points.append(float(x))
+    points = _numbers(raw, "calibration.contact_points", "m", source)
     try:
         return CalibrationStep(
-            enabled=enabled, case=case, contact_points=tuple(points), repeats=repeats, loss=loss
+            enabled=enabled, case=case, contact_points=points, repeats=repeats, loss=loss
         )
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
 
 
-def _numbers(data: Mapping[str, Any], key: str, what: str, source: str) -> tuple[float, ...]:
-    raw = data[key]
+def _numbers(raw: Any, key: str, unit: str, source: str) -> tuple[float, ...]:
+    """A TOML list of numbers (``unit`` names them in messages); field ``key[i]`` on error."""
     if not isinstance(raw, list):
-        raise CampaignSpecError(f"noise_sweep.{key}", f"must be a list of {what}", source)
+        raise CampaignSpecError(key, f"must be a list of numbers ({unit})", source)
     values: list[float] = []
     for i, x in enumerate(raw):
         if isinstance(x, bool) or not isinstance(x, (int, float)):
-            raise CampaignSpecError(
-                f"noise_sweep.{key}[{i}]", f"must be a number ({what}), got {x!r}", source
-            )
+            raise CampaignSpecError(f"{key}[{i}]", f"must be a number ({unit}), got {x!r}", source)
         values.append(float(x))
     return tuple(values)
 
@@ -986,12 +961,16 @@ def _parse_noise_sweep(data: Any, source: str) -> NoiseSweep:
             )
     if "noise_scales" not in data:
         raise CampaignSpecError("noise_sweep.noise_scales", "missing", source)
-    scales = _numbers(data, "noise_scales", "noise multiples", source)
+    scales = _numbers(data["noise_scales"], "noise_sweep.noise_scales", "noise multiples", source)
     if not scales:
         raise CampaignSpecError(
             "noise_sweep.noise_scales", "must list at least one level (or drop the table)", source
         )
-    points = _numbers(data, "contact_points", "m", source) if "contact_points" in data else None
+    points = (
+        _numbers(data["contact_points"], "noise_sweep.contact_points", "m", source)
+        if "contact_points" in data
+        else None
+    )
     repeats = data.get("repeats")
     if repeats is not None and (isinstance(repeats, bool) or not isinstance(repeats, int)):
         raise CampaignSpecError(
