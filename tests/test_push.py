@@ -27,7 +27,7 @@ from sensing_antenna.recording import Recording
 
 TS = 1e-3  # s
 ANTENNA = paper_antenna()
-SPEED = 0.9  # rad/s, head speed after the ease-in (no sample lands exactly on 0.02 rad)
+SPEED = 0.9  # rad/s, head speed after the ease-in (no sample lands exactly on 0.03 rad)
 CONTACT = 1500  # sample of first touch
 X_C = 0.5  # m, contact point
 # Contact stiffness seen at the joint: F = 3 E I delta / x_c^2 (static cantilever with the tip
@@ -121,7 +121,8 @@ def test_torque_criterion_matches_filtered_ramp() -> None:
 
 def test_no_push_when_motors_stop_early_and_no_contact_without_touch() -> None:
     # Detection happens about 51 samples after the touch (see the rotation test); stopping 65
-    # samples after the touch leaves at most 14 samples (0.013 rad < 0.02 rad) past t_c.
+    # samples after the touch leaves at most 14 samples (0.013 rad < DEFAULT_ROTATION = 0.03 rad)
+    # past t_c.
     rec = _manoeuvre(stop=CONTACT + 65)
     result = detect_push(rec, ANTENNA)
     assert result.contact.status == "contact"
