@@ -397,13 +397,13 @@ def method_summaries(
 
 def _column(rows: Sequence[Mapping[str, Any]], name: str) -> NDArray[np.float64]:
     """One column as floats; a missing or empty cell is NaN."""
-    values = []
-    for row in rows:
-        try:
-            values.append(float(row.get(name, math.nan)))
-        except (TypeError, ValueError):
-            values.append(math.nan)
-    return np.array(values, dtype=float)
+    return np.array([_float(row.get(name, math.nan)) for row in rows], dtype=float)
+
+
+def _truth(rows: Sequence[Mapping[str, Any]]) -> NDArray[np.float64]:
+    """Where each run's link touched: the contact abscissa, the nominal x_c when unknown (m)."""
+    contact = _column(rows, "x_c_contact_m")
+    return np.where(np.isfinite(contact), contact, _column(rows, "x_c_true_m"))
 
 
 def interval_summaries(
@@ -419,7 +419,7 @@ def interval_summaries(
             high = _column(selected, "interval_high_m")
             nominal = _column(selected, "x_c_true_m")
             contact = _column(selected, "x_c_contact_m")
-            truth = np.where(np.isfinite(contact), contact, nominal)
+            truth = _truth(selected)
             has = np.isfinite(low) & np.isfinite(high)
             covering = has & (low <= truth) & (truth <= high)
             covering_nominal = has & (low <= nominal) & (nominal <= high)
@@ -469,8 +469,7 @@ def target_summary(
     mine = [r for r in all_rows if r["method"] == method]
     ref = [r for r in all_rows if r["method"] == reference]
     low, high = _column(mine, "interval_low_m"), _column(mine, "interval_high_m")
-    contact, nominal = _column(mine, "x_c_contact_m"), _column(mine, "x_c_true_m")
-    truth = np.where(np.isfinite(contact), contact, nominal)
+    truth = _truth(mine)
     has = np.isfinite(low) & np.isfinite(high)
     error = np.abs(_column(mine, "x_c_estimate_m") - truth)
     is_ok = np.array([r["status"] == "ok" for r in mine], dtype=bool)
@@ -519,8 +518,7 @@ def frequency_error_summaries(
             keep = np.isfinite(omega)
             if not keep.any():
                 continue
-            contact = _column(selected, "x_c_contact_m")
-            x = np.where(np.isfinite(contact), contact, _column(selected, "x_c_true_m"))[keep]
+            x = _truth(selected)[keep]
             true = np.asarray(natural_frequencies(link, x, 1), dtype=float)[..., 0]
             rel = omega[keep] / true - 1.0
             crb = _column(selected, "omega1_crb_rad_s")[keep] / true
