@@ -18,7 +18,7 @@ from distributed import LocalCluster
 
 from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, MethodOutcome, RunResult
-from sensing_antenna.campaign.runner import execute_safely, run_campaign
+from sensing_antenna.campaign.runner import CampaignOutcome, execute_safely, run_campaign
 from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
 from sensing_antenna.campaign.store import CampaignStoreError, load_run_results
 
@@ -79,11 +79,16 @@ def read_rows(path: Path) -> list[dict[str, str]]:
     return rows
 
 
+def run_inline(spec: CampaignSpec, out: Path) -> CampaignOutcome:
+    """The toy campaign (noisy_run, the spec's antenna unchanged) in-process, without progress."""
+    return run_campaign(
+        spec, out, run_one=noisy_run, prepare_antenna=same_antenna, workers=1, progress=False
+    )
+
+
 def test_inline_campaign_writes_one_file_per_run_and_a_row_per_method(tmp_path: Path) -> None:
     spec = small_spec()
-    outcome = run_campaign(
-        spec, tmp_path, run_one=noisy_run, prepare_antenna=same_antenna, workers=1, progress=False
-    )
+    outcome = run_inline(spec, tmp_path)
     assert (outcome.n_runs, outcome.n_executed, outcome.n_failed) == (12, 12, 0)
     assert len(list((tmp_path / "runs").glob("*.json"))) == 12
     rows = read_rows(outcome.csv_path)
@@ -98,14 +103,7 @@ def test_inline_campaign_writes_one_file_per_run_and_a_row_per_method(tmp_path: 
 
 def test_process_pool_gives_the_same_results_as_inline(tmp_path: Path) -> None:
     spec = small_spec()
-    inline = run_campaign(
-        spec,
-        tmp_path / "inline",
-        run_one=noisy_run,
-        prepare_antenna=same_antenna,
-        workers=1,
-        progress=False,
-    )
+    inline = run_inline(spec, tmp_path / "inline")
     pooled = run_campaign(
         spec,
         tmp_path / "pool",
@@ -119,14 +117,7 @@ def test_process_pool_gives_the_same_results_as_inline(tmp_path: Path) -> None:
 
 def test_interrupted_campaign_resumes_without_redoing_or_losing_runs(tmp_path: Path) -> None:
     spec = small_spec()
-    reference = run_campaign(
-        spec,
-        tmp_path / "ref",
-        run_one=noisy_run,
-        prepare_antenna=same_antenna,
-        workers=1,
-        progress=False,
-    )
+    reference = run_inline(spec, tmp_path / "ref")
     calls: list[str] = []
 
     def stop_after_five(run: RunSpec) -> RunResult:
@@ -198,9 +189,7 @@ def test_failed_runs_are_kept_on_resume_and_redone_when_asked(tmp_path: Path) ->
         workers=1,
         progress=False,
     )
-    again = run_campaign(
-        spec, tmp_path, run_one=noisy_run, prepare_antenna=same_antenna, workers=1, progress=False
-    )
+    again = run_inline(spec, tmp_path)
     assert (again.n_executed, again.n_failed) == (0, 4)
     retried = run_campaign(
         spec,
@@ -225,34 +214,13 @@ def test_execute_safely_turns_an_exception_into_a_failed_result() -> None:
 
 
 def test_a_directory_of_another_spec_is_refused(tmp_path: Path) -> None:
-    run_campaign(
-        small_spec(),
-        tmp_path,
-        run_one=noisy_run,
-        prepare_antenna=same_antenna,
-        workers=1,
-        progress=False,
-    )
+    run_inline(small_spec(), tmp_path)
     with pytest.raises(CampaignStoreError, match=r"campaign\.json: fingerprint"):
-        run_campaign(
-            small_spec(repeats=3),
-            tmp_path,
-            run_one=noisy_run,
-            prepare_antenna=same_antenna,
-            workers=1,
-            progress=False,
-        )
+        run_inline(small_spec(repeats=3), tmp_path)
 
 
 def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:
-    run_campaign(
-        small_spec(),
-        tmp_path,
-        run_one=noisy_run,
-        prepare_antenna=same_antenna,
-        workers=1,
-        progress=False,
-    )
+    run_inline(small_spec(), tmp_path)
     damaged = tmp_path / "runs" / "vertical-x0900mm-r2.json"
     damaged.write_text(json.dumps({"run_id": "vertical-x0900mm-r2"}), encoding="utf-8")
     with pytest.raises(CampaignStoreError, match=r"vertical-x0900mm-r2\.json: damaged run file"):
@@ -261,14 +229,7 @@ def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:
 
 def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:
     spec = small_spec()
-    inline = run_campaign(
-        spec,
-        tmp_path / "inline",
-        run_one=noisy_run,
-        prepare_antenna=same_antenna,
-        workers=1,
-        progress=False,
-    )
+    inline = run_inline(spec, tmp_path / "inline")
     with LocalCluster(
         n_workers=2,
         threads_per_worker=1,
