@@ -231,10 +231,17 @@ def test_irregular_sampling_is_resampled(free_motion: tuple[np.ndarray, np.ndarr
 
 def test_update_accepts_plain_sequences() -> None:
     detector = ContactDetector(ANTENNA, TS)
-    at_rest = list(ANTENNA.gravity_torque(0.0))  # spec sign check: link at rest, theta2 = 0
+    at_rest = list(ANTENNA.gravity_torque(0.0))  # link at rest, theta2 = 0
     assert detector.update(0.0, (0.0, 0.0), (0.0, 0.0, 0.0), at_rest) is False
     assert detector.n_samples == 1
     assert detector.residual.shape == (3,)
+    # Spec sign check: the measured gravity torque is exactly what the model expects at rest,
+    # so the residual is zero; with the opposite sign it would be twice the gravity torque
+    # (0.044 N m, above the 0.02 N m threshold).
+    np.testing.assert_allclose(detector.residual, 0.0, atol=1e-12)
+    flipped = ContactDetector(ANTENNA, TS)
+    flipped.update(0.0, (0.0, 0.0), (0.0, 0.0, 0.0), [-v for v in at_rest])
+    np.testing.assert_allclose(np.abs(flipped.residual[1]), 2.0 * abs(at_rest[1]), rtol=1e-12)
 
 
 def test_simulated_contact_is_detected_after_the_true_touch() -> None:
