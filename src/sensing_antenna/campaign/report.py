@@ -8,6 +8,7 @@ image links. Lengths are shown in cm (the display edge); everything stored stays
 from __future__ import annotations
 
 import math
+import statistics
 from collections.abc import Mapping, Sequence
 from dataclasses import fields
 from pathlib import Path
@@ -429,7 +430,7 @@ def _interval_section(summaries: Sequence[IntervalSummary]) -> list[str]:
 
 
 def _truth_section(
-    spec: CampaignSpec, rows: Sequence[Mapping[str, Any]], summaries: Sequence[MethodSummary]
+    rows: Sequence[Mapping[str, Any]], summaries: Sequence[MethodSummary]
 ) -> list[str]:
     """Errors against the nominal x_c and against the contact abscissa, side by side."""
     offsets = []
@@ -443,7 +444,7 @@ def _truth_section(
             offsets.append(contact - nominal)
     if offsets:
         ordered = sorted(offsets)
-        median = ordered[len(ordered) // 2]
+        median = statistics.median(ordered)
         where = (
             f"On the {len(offsets)} main runs with a known contact abscissa it lies "
             f"{_mm(abs(median))} mm {'nearer the base than' if median < 0 else 'beyond'} the "
@@ -605,7 +606,7 @@ def _noise_section(
                     f"{len(errors)}/{len(mine)}",
                     _mm(sum(errors) / len(errors)) if errors else "-",
                     _mm(max(errors)) if errors else "-",
-                    _seconds(delays[len(delays) // 2]) if delays else "-",
+                    _seconds(statistics.median(delays)) if delays else "-",
                     str(n_ok),
                 ]
             )
@@ -776,7 +777,7 @@ def render_report(
         *_calibration_section(calibration, spec, device, calibration_figure, out_dir),
         *_summary_section(spec, summaries, antenna.link.length),
         *_status_section(spec, summaries),
-        *_truth_section(spec, rows, summaries),
+        *_truth_section(rows, summaries),
         *_interval_section(interval_summaries(rows, spec.cases, spec.methods)),
         *_targets_section(spec, rows, every),
         *_noise_section(spec, every, frequency, noise_figure, out_dir),
