@@ -1,4 +1,4 @@
-"""Benchmark: the default 150-run campaign (Section 5.6) end to end; target under 60 s on 2 cores.
+"""Benchmark: the default campaign end to end (Section 5.6 plus its noise sweep); target 60 s.
 
 Usage::
 
