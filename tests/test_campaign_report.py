@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import Antenna, paper_antenna
-from sensing_antenna.campaign.records import MethodOutcome, RunResult
+from sensing_antenna.campaign.records import MethodOutcome, RunResult, float_or_nan
 from sensing_antenna.campaign.report import build_report
 from sensing_antenna.campaign.runner import run_campaign
 from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
@@ -273,6 +273,20 @@ def test_a_run_stored_before_the_contact_abscissa_existed_still_loads() -> None:
     (row,) = campaign_rows([result], ["paper"])
     assert row["error_contact_m"] == pytest.approx(0.0005, abs=ROUND_OFF)
     assert (row["x_c_contact_m"], row["noise_scale"]) == (0.4985, 1.0)
+
+
+@pytest.mark.parametrize(
+    ("stored", "expected"),
+    [(0.5, 0.5), ("0.5", 0.5), ("-1e-3", -1e-3), (3, 3.0), ("inf", math.inf)],
+)
+def test_a_stored_number_reads_as_that_float(stored: object, expected: float) -> None:
+    assert float_or_nan(stored) == expected
+
+
+@pytest.mark.parametrize("stored", [None, "", "nan", "NaN", "n/a", [0.5], {}])
+def test_a_stored_gap_or_text_reads_as_nan(stored: object) -> None:
+    # JSON null, an empty CSV cell, written NaN and anything else that is not a number
+    assert math.isnan(float_or_nan(stored))
 
 
 def test_coverage_is_judged_against_the_contact_abscissa() -> None:

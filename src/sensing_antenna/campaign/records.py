@@ -21,6 +21,7 @@ __all__ = [
     "RUN_OK",
     "MethodOutcome",
     "RunResult",
+    "float_or_nan",
     "result_rows",
 ]
 
@@ -68,12 +69,22 @@ CSV_COLUMNS = (
 _FLOAT_FIELDS = ("x_c", "omega1", "peak_quality", "ratio_estimate", "t_c", "t_1", "t_e")
 
 
-def _as_float(value: Any) -> float:
-    if value is None:
-        return math.nan
+def float_or_nan(value: Any) -> float:
+    """A stored value (JSON number or null, CSV text) as a float, NaN when missing or not a number.
+
+    Parameters
+    ----------
+    value : Any
+        ``None``, ``""``, a number or its text (``"0.5"``, ``"nan"``, ``"inf"``), or anything else.
+
+    Returns
+    -------
+    float
+        ``float(value)``, or NaN when ``float`` cannot convert it.
+    """
     try:
         return float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError):  # None, "", "n/a", a list...
         return math.nan
 
 
@@ -93,7 +104,7 @@ def _diagnostic(diagnostics: Any, key: str) -> float:
     """``diagnostics[key]`` as a float, NaN when absent or not a number."""
     if not isinstance(diagnostics, Mapping):
         return math.nan
-    return _as_float(diagnostics.get(key))
+    return float_or_nan(diagnostics.get(key))
 
 
 def _status_text(status: Any) -> str:
@@ -165,7 +176,7 @@ class MethodOutcome:
         ``diagnostics["omega1_crb"]``.
         """
         diagnostics = getattr(estimate, "diagnostics", None)
-        values = {name: _as_float(getattr(estimate, name, None)) for name in _FLOAT_FIELDS}
+        values = {name: float_or_nan(getattr(estimate, name, None)) for name in _FLOAT_FIELDS}
         candidates = getattr(estimate, "candidates", None)
         low, high = _interval({"interval": getattr(estimate, "interval", None)})
         if math.isnan(low):
@@ -174,7 +185,9 @@ class MethodOutcome:
             method=method,
             status=_status_text(getattr(estimate, "status", "unknown")),
             reason=str(getattr(estimate, "reason", "") or ""),
-            candidates=tuple(_as_float(c) for c in (candidates if candidates is not None else ())),
+            candidates=tuple(
+                float_or_nan(c) for c in (candidates if candidates is not None else ())
+            ),
             elapsed_s=float(elapsed_s),
             interval_low=low,
             interval_high=high,
@@ -204,13 +217,13 @@ class MethodOutcome:
             method=str(data["method"]),
             status=str(data["status"]),
             reason=str(data.get("reason", "")),
-            candidates=tuple(_as_float(c) for c in data.get("candidates", [])),
-            elapsed_s=_as_float(data.get("elapsed_s")),
+            candidates=tuple(float_or_nan(c) for c in data.get("candidates", [])),
+            elapsed_s=float_or_nan(data.get("elapsed_s")),
             interval_low=_interval({"interval": data.get("interval")})[0],
             interval_high=_interval({"interval": data.get("interval")})[1],
-            omega1_se=_as_float(data.get("omega1_se")),
-            omega1_crb=_as_float(data.get("omega1_crb")),
-            **{name: _as_float(data.get(name)) for name in _FLOAT_FIELDS},
+            omega1_se=float_or_nan(data.get("omega1_se")),
+            omega1_crb=float_or_nan(data.get("omega1_crb")),
+            **{name: float_or_nan(data.get(name)) for name in _FLOAT_FIELDS},
         )
 
 
@@ -329,10 +342,10 @@ class RunResult:
             status=str(data["status"]),
             error=str(data.get("error", "")),
             detail=str(data.get("detail", "")),
-            simulate_s=_as_float(data.get("simulate_s")),
+            simulate_s=float_or_nan(data.get("simulate_s")),
             methods=tuple(MethodOutcome.from_dict(m) for m in data.get("methods", [])),
-            contact_abscissa=_as_float(data.get("contact_abscissa")),
-            noise_scale=_as_float(data.get("noise_scale")),
+            contact_abscissa=float_or_nan(data.get("contact_abscissa")),
+            noise_scale=float_or_nan(data.get("noise_scale")),
         )
 
 

@@ -16,7 +16,7 @@ from typing import Any
 
 from sensing_antenna.antenna import Antenna, load_antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
-from sensing_antenna.campaign.records import RUN_FAILED, RunResult
+from sensing_antenna.campaign.records import RUN_FAILED, RunResult, float_or_nan
 from sensing_antenna.campaign.spec import CampaignSpec
 from sensing_antenna.campaign.store import (
     CALIBRATION_FILE,
@@ -439,7 +439,7 @@ def _truth_section(
         if row["run_id"] in seen:
             continue
         seen.add(row["run_id"])
-        contact, nominal = _as_float(row.get("x_c_contact_m")), _as_float(row["x_c_true_m"])
+        contact, nominal = float_or_nan(row.get("x_c_contact_m")), float_or_nan(row["x_c_true_m"])
         if math.isfinite(contact):
             offsets.append(contact - nominal)
     if offsets:
@@ -489,13 +489,6 @@ def _truth_section(
         ),
         "",
     ]
-
-
-def _as_float(value: Any) -> float:
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def _statuses(counts: Mapping[str, int]) -> str:
@@ -591,11 +584,11 @@ def _noise_section(
         at_level = rows_at_level(every, level, spec.noise_scale)
         for method in spec.methods:
             mine = [r for r in at_level if r["method"] == method]
-            errors = [abs(_as_float(r.get("error_contact_m"))) for r in mine]
+            errors = [abs(float_or_nan(r.get("error_contact_m"))) for r in mine]
             errors = [e for e in errors if math.isfinite(e)]
             delays = sorted(
                 d
-                for d in (_as_float(r["t_e_s"]) - _as_float(r["t_1_s"]) for r in mine)
+                for d in (float_or_nan(r["t_e_s"]) - float_or_nan(r["t_1_s"]) for r in mine)
                 if math.isfinite(d)
             )
             n_ok = sum(1 for r in mine if r["status"] == "ok")

@@ -14,14 +14,13 @@ Also the steps before the runs, in the paper's order:
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections.abc import Mapping
 from typing import Any
 
 from sensing_antenna.antenna import Antenna, FreeMotionObserver
 from sensing_antenna.calibration.frequency import FrequencyCalibration
-from sensing_antenna.campaign.records import METHOD_ERROR, MethodOutcome, RunResult
+from sensing_antenna.campaign.records import METHOD_ERROR, MethodOutcome, RunResult, float_or_nan
 from sensing_antenna.campaign.spec import (
     CALIBRATION_STREAM,
     FREE_MOTION_STREAM,
@@ -100,10 +99,7 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
 
 def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:
     """The recording's ground-truth ``true_xc`` (m), NaN when absent or not a number."""
-    try:
-        return float(metadata.get("true_xc", "nan"))
-    except (TypeError, ValueError):
-        return math.nan
+    return float_or_nan(metadata.get("true_xc"))
 
 
 def identify_observer(

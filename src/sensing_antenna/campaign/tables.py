@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.campaign.records import RunResult, result_rows
+from sensing_antenna.campaign.records import RunResult, float_or_nan, result_rows
 
 __all__ = [
     "OK_ERROR_LIMIT",
@@ -292,13 +292,6 @@ def _select(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> list[M
     return [r for r in rows if r["case"] == case and r["method"] == method]
 
 
-def _float(value: Any) -> float:
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        return math.nan
-
-
 def same_level(a: float, b: float) -> bool:
     """Whether two noise levels are the same to 0.01 (as in the run ids)."""
     return round(a * 100) == round(b * 100)
@@ -306,7 +299,7 @@ def same_level(a: float, b: float) -> bool:
 
 def _level(row: Mapping[str, Any], main: float) -> float:
     """The row's noise level; ``main`` for a row without one (stored before noise sweeps)."""
-    level = _float(row.get("noise_scale"))
+    level = float_or_nan(row.get("noise_scale"))
     return level if math.isfinite(level) else main
 
 
@@ -397,7 +390,7 @@ def method_summaries(
 
 def _column(rows: Sequence[Mapping[str, Any]], name: str) -> NDArray[np.float64]:
     """One column as floats; a missing or empty cell is NaN."""
-    return np.array([_float(row.get(name, math.nan)) for row in rows], dtype=float)
+    return np.array([float_or_nan(row.get(name, math.nan)) for row in rows], dtype=float)
 
 
 def _truth(rows: Sequence[Mapping[str, Any]]) -> NDArray[np.float64]:

@@ -16,6 +16,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.campaign.records import float_or_nan
 from sensing_antenna.campaign.tables import FrequencyErrorSummary, paper_table, point_table
 from sensing_antenna.plotting import save_figure
 
@@ -165,7 +166,7 @@ def _per_run(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> Any:
     """
     selected = [r for r in rows if r["case"] == case and r["method"] == method]
     x = np.array([float(r["x_c_true_m"]) for r in selected], dtype=float)
-    error = np.array([_float(r.get("error_contact_m")) for r in selected], dtype=float)
+    error = np.array([float_or_nan(r.get("error_contact_m")) for r in selected], dtype=float)
     nominal = np.array([float(r["error_m"]) for r in selected], dtype=float)
     error = np.where(np.isfinite(error), error, nominal)
     delay = np.array([float(r["t_e_s"]) - float(r["t_1_s"]) for r in selected], dtype=float)
@@ -224,13 +225,6 @@ def plot_error_and_delay(
         ax_t.grid(True, alpha=0.3)
     fig.suptitle("Error and time to estimate per run, all methods on the same recordings")
     return save_figure(fig, out / "error-and-delay-by-method.png")
-
-
-def _float(value: Any) -> float:
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        return float("nan")
 
 
 def plot_frequency_error_vs_noise(
