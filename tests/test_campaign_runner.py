@@ -14,9 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from distributed import LocalCluster
+from distributed import Client, LocalCluster
+from threadpoolctl import threadpool_limits
 
 from sensing_antenna.antenna import Antenna, paper_antenna
+from sensing_antenna.campaign.dask_plugin import OneBlasThreadPerDaskWorker
 from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, MethodOutcome, RunResult
 from sensing_antenna.campaign.runner import CampaignOutcome, execute_safely, run_campaign
 from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
@@ -230,14 +232,20 @@ def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:
 def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:
     spec = small_spec()
     inline = run_inline(spec, tmp_path / "inline")
-    with LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        processes=False,
-        host="127.0.0.1",
-        protocol="tcp://",
-        dashboard_address=None,
-    ) as cluster:
+    # These workers run in this process (processes=False) and take its BLAS down to one thread:
+    # threadpool_limits(limits=None) changes nothing on entry and gives the other tests their
+    # thread count back on exit.
+    with (
+        threadpool_limits(limits=None),
+        LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=False,
+            host="127.0.0.1",
+            protocol="tcp://",
+            dashboard_address=None,
+        ) as cluster,
+    ):
         on_dask = run_campaign(
             spec,
             tmp_path / "dask",
@@ -246,6 +254,11 @@ def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:
             scheduler=cluster.scheduler_address,
             progress=False,
         )
+        with Client(cluster.scheduler_address, set_as_default=False) as client:
+            plugins = client.run(lambda dask_worker: list(dask_worker.plugins))
+    # Every worker got the local pool's one-BLAS-thread limit.
+    assert len(plugins) == 2
+    assert all(OneBlasThreadPerDaskWorker.name in names for names in plugins.values())
     assert on_dask.n_failed == 4
     ok_rows = [row for row in read_rows(on_dask.csv_path) if row["run_status"] == RUN_OK]
     expected = [row for row in read_rows(inline.csv_path) if float(row["x_c_true_m"]) != 0.6]

@@ -34,6 +34,7 @@ from sensing_antenna.campaign.store import (
     write_run_result,
     write_runs_csv,
 )
+from sensing_antenna.campaign.worker_threads import limit_to_one_blas_thread
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [
@@ -201,7 +202,7 @@ def _execute_pool(
     task: Callable[[RunSpec], RunResult], pending: Sequence[RunSpec], workers: int
 ) -> Iterator[RunResult]:
     executor = ProcessPoolExecutor(
-        max_workers=min(workers, len(pending)), initializer=_one_thread_per_worker
+        max_workers=min(workers, len(pending)), initializer=limit_to_one_blas_thread
     )
     futures: dict[Future[RunResult], RunSpec] = {}
     try:
@@ -213,18 +214,6 @@ def _execute_pool(
                 yield _result_of(future, futures[future])
     finally:
         executor.shutdown(wait=True, cancel_futures=True)
-
-
-def _one_thread_per_worker() -> None:
-    """Limit BLAS/OpenMP to one thread in a worker process.
-
-    The pool already runs one process per core; multi-threaded linear algebra inside each (the
-    fast method's least squares) made them fight for the cores: 7 to 73 s per recording on 2
-    cores instead of about 1 s.
-    """
-    from threadpoolctl import threadpool_limits
-
-    threadpool_limits(limits=1)
 
 
 def _result_of(future: Future[RunResult], run: RunSpec) -> RunResult:
@@ -239,6 +228,8 @@ def _execute_dask(
 ) -> Iterator[RunResult]:
     from distributed import Client, as_completed
 
+    from sensing_antenna.campaign.dask_plugin import OneBlasThreadPerDaskWorker
+
     try:
         client = Client(scheduler, timeout="10s", set_as_default=False)
     except OSError as exc:
@@ -246,6 +237,7 @@ def _execute_dask(
             f"--scheduler: cannot reach Dask scheduler {scheduler!r} ({exc})"
         ) from exc
     try:
+        client.register_plugin(OneBlasThreadPerDaskWorker())
         with client.as_current():
             futures = client.map(task, list(pending), pure=False)
             runs = {future.key: run for future, run in zip(futures, pending, strict=True)}
