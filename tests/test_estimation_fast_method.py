@@ -63,6 +63,18 @@ def test_ambiguous_branches_share_the_mass_without_ratio() -> None:
     assert post.interval[0] < 0.7 and post.interval[1] > 0.9
 
 
+def test_conditioning_on_a_branch_keeps_only_its_mass() -> None:
+    # The ambiguous posterior above conditioned on the far branch: all the mass there, the MAP
+    # at the far candidate and an interval that no longer reaches the near one (0.63 m).
+    omega = float(CURVE.omega1(0.95))
+    post = _posterior(omega, 0.1, math.nan, math.nan)
+    far = post.given_branch(post.branch_of(0.95))
+    assert far.branch_probability == (0.0, 1.0)
+    assert float(far.density.sum()) == pytest.approx(1.0)
+    assert far.x_c == pytest.approx(0.95, abs=1e-3)
+    assert far.interval[0] > EDGES[1] and far.interval[0] <= 0.95 <= far.interval[1]
+
+
 def test_interval_is_wide_near_the_peak_of_the_curve() -> None:
     # Same omega_1 error: near the peak (0.77 m) the curve is flat and the interval is much
     # wider than at 0.5 m where the slope is 141 rad/s per m.
@@ -173,6 +185,32 @@ def test_offline_and_online_agree_on_a_simulated_recording() -> None:
     # 1 s spectrum window.
     assert offline.x_c == pytest.approx(0.6, abs=0.008)
     assert offline.t_e - offline.t_1 < 0.5
+
+
+def test_second_mode_chooses_the_branch_at_the_cap_near_the_peak() -> None:
+    # At 0.75 m omega_1 is 0.5 % below the top of the curve: its two candidates (0.75 and
+    # 0.79 m) are closer than the ratio resolves and the fast method stays unsure to the cap.
+    # There the 1 s record lets the second contact mode (228 against 258 rad/s at the two
+    # candidates) choose: the estimate must sit on the simulator's contact branch, with the
+    # interval on that branch holding its contact abscissa.
+    simulator = pytest.importorskip("sensing_antenna.simulator")
+    from sensing_antenna.estimation.pipeline import estimate
+
+    antenna = paper_antenna()
+    recording = simulator.simulate(
+        antenna, simulator.Scenario(case="vertical", contact_point=0.75, seed=3)
+    )
+    truth = float(recording.metadata["true_xc"])
+    result = estimate(recording.without_ground_truth(), antenna, FastMethod())
+    assert result.status.value == "uncertain"
+    assert result.diagnostics["branch_chosen_by"] == "omega2"
+    assert len(result.candidates) == 2
+    # The other candidate is 5 cm away; within the tolerance means the right branch
+    assert result.x_c == pytest.approx(truth, abs=FastConfig().tolerance)
+    assert result.interval is not None
+    assert result.interval[0] <= truth <= result.interval[1]
+    assert max(result.branch_probability) == 1.0
+    assert "second contact mode" in (result.reason or "")
 
 
 def test_cli_json_has_interval_and_branch_probability(

@@ -25,6 +25,7 @@ with the same numbers.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field, fields
@@ -37,6 +38,7 @@ from sensing_antenna.antenna import Link
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.fusion import second_mode_choice
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.parametric import DampedSinusoidFit, select_model_order
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
@@ -761,6 +763,36 @@ def _problems(
     return found
 
 
+def _branch_by_second_mode(
+    evidence: Evidence, posterior: ContactPosterior, omega1: float
+) -> tuple[ContactPosterior, dict[str, Any]]:
+    """At the cap, let the second contact mode choose between two branches the ratio cannot.
+
+    Near the top of omega_1(x_c) the two candidates are a few cm apart, closer than the
+    torque/force ratio resolves, and their second modes differ by about 20 %. By the cap the
+    record is as long as the paper's spectrum, so the paper's own test applies
+    (:func:`~.fusion.second_mode_choice`: a clear spectral peak near one candidate's omega_2 and
+    none near the other's). When it is decisive the posterior is conditioned on that branch;
+    otherwise it is unchanged.
+    """
+    if not math.isfinite(omega1) or max(posterior.branch_probability) >= posterior.level:
+        return posterior, {}
+    low, high = posterior.branch_edges[0], posterior.branch_edges[-1]
+    candidates = tuple(
+        float(c.x_c)
+        for c in sensing_curve(evidence.antenna.link).contact_points(omega1)
+        if low <= c.x_c <= high
+    )
+    if len(candidates) != 2:
+        return posterior, {}
+    measurement = evidence.measure_frequency()
+    choice, notes = second_mode_choice(evidence, measurement.component, candidates)
+    if choice is None:
+        return posterior, {"second_mode": notes}
+    chosen = posterior.given_branch(posterior.branch_of(candidates[choice]))
+    return chosen, {"second_mode": notes, "branch_chosen_by": "omega2"}
+
+
 def conclude_fast(
     evidence: Evidence, result: ScanResult, bias: SensorBias, config: FastConfig, name: str
 ) -> ContactEstimate:
@@ -783,6 +815,11 @@ def conclude_fast(
             diagnostics=diag,
         )
     post = final.posterior
+    if result.reached_cap and not final.sure:
+        # Only the samples up to this method's own t_e (the cap), online and offline alike
+        until_cap = dataclasses.replace(evidence, end_index=final.end_index)
+        post, second_mode = _branch_by_second_mode(until_cap, post, final.omega1)
+        diag.update(second_mode)
     statics = final.statics
     push = statics.perpendicular_force if statics is not None else math.nan
     touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link)
@@ -797,6 +834,11 @@ def conclude_fast(
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)
+    if reason is not None and "branch_chosen_by" in diag:
+        reason += (
+            f"; the second contact mode then chose the branch of x_c = {post.x_c:.3f} m, and "
+            "the interval is given on that branch"
+        )
     candidates = tuple(
         float(c.x_c)
         for c in (

@@ -30,7 +30,7 @@ probabilities are the posterior mass on each monotone branch of omega_1(x_c).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -80,6 +80,33 @@ class ContactPosterior:
         """Index of the branch holding ``x_c``."""
         inner = self.branch_edges[1:-1]
         return int(np.searchsorted(np.asarray(inner), x_c))
+
+    def given_branch(self, branch: int) -> ContactPosterior:
+        """The posterior conditioned on x_c lying on ``branch`` (another measurement chose it).
+
+        The density is set to zero off the branch and renormalised; x_c, the interval and the
+        branch probabilities (1 on ``branch``) follow. Unchanged when the branch holds no mass.
+        """
+        on_branch = _branch_indices(self.branch_edges, self.grid) == branch
+        mass = float(self.density[on_branch].sum())
+        if mass <= 0.0:
+            return self
+        density = np.where(on_branch, self.density, 0.0) / mass
+        count = len(self.branch_probability)
+        probability = tuple(1.0 if b == branch else 0.0 for b in range(count))
+        return replace(
+            self,
+            density=density,
+            x_c=float(self.grid[int(np.argmax(density))]),
+            interval=_hpd_bounds(density, self.grid, self.level),
+            branch_probability=probability,
+        )
+
+
+def _branch_indices(branch_edges: tuple[float, ...], grid: FloatArray) -> NDArray[np.int_]:
+    """Index of the monotone branch holding each grid point."""
+    edges = np.asarray(branch_edges, dtype=float)
+    return np.asarray(np.clip(np.searchsorted(edges[1:-1], grid), 0, edges.size - 2), dtype=int)
 
 
 def _hpd_bounds(density: FloatArray, grid: FloatArray, level: float) -> tuple[float, float]:
@@ -169,8 +196,9 @@ def contact_posterior(
     k = int(np.argmax(density))
     interval = _hpd_bounds(density, grid, level)
     edges = np.asarray(branch_edges, dtype=float)
-    branch = np.clip(np.searchsorted(edges[1:-1], grid), 0, edges.size - 2)
-    mass = np.bincount(branch, weights=density, minlength=edges.size - 1)
+    mass = np.bincount(
+        _branch_indices(branch_edges, grid), weights=density, minlength=edges.size - 1
+    )
     return ContactPosterior(
         grid=grid,
         density=density,
