@@ -42,10 +42,18 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
     assert result.status == RUN_OK
     assert [m.method for m in result.methods] == ["paper", "ratio", "two-frequency"]
     # the same seed gives the same recording; the estimators see it without ground truth
-    recording = simulate(antenna, make_scenario(run.case, run.contact_point, run.seed, {}))
+    scenario = make_scenario(run.case, run.contact_point, run.seed, {})
+    recording = simulate(antenna, scenario)
     # the contact abscissa is the recording's ground truth, kept beside the nominal x_c
     assert result.contact_abscissa == float(recording.metadata["true_xc"])
-    assert 0.0 < run.contact_point - result.contact_abscissa < 0.005
+    # Pushed on until y_c = d x_c, the base has turned by about d: the fixed obstacle, x_c from
+    # the base, sits x_c cos d ~ x_c (1 - d^2 / 2) along the turned link, and the bent link
+    # (slope d - 3 d / 2 at x_c, cantilever under an end load) touches the cylinder R d / 2
+    # nearer the base. With d = 0.072 here that is 1.44 + 0.36 = 1.80 mm; the arc length of the
+    # bend and the sag, left out, moved it by under 4 % from 0.3 to 0.9 m: 10 %.
+    turn = float(recording.metadata["true_deflection_ratio"])
+    slide = run.contact_point * turn**2 / 2 + scenario.obstacle_radius * turn / 2
+    assert run.contact_point - result.contact_abscissa == pytest.approx(slide, rel=0.1)
     assert result.noise_scale == 1.0
     for outcome in result.methods:
         direct = estimate(recording.without_ground_truth(), antenna, method=outcome.method)
