@@ -15,7 +15,8 @@ from t_1:
    ``tolerance`` and where the ratio agrees with it. Evaluations run on a geometric grid
    (:func:`evaluation_offsets`) from ``first_window`` (50 ms) after t_1, so t_e adapts to how
    easy the case is; at ``cap`` (1 s) after t_1 the best estimate is given with status
-   ``uncertain``.
+   ``uncertain``, on the branch the second contact mode chooses when the posterior is split
+   between two branches (:func:`_branch_by_second_mode`).
 
 Every evaluation uses the samples up to its own instant only, so the streaming form (the
 pipeline's ``OnlineEstimator`` asking :meth:`FastMethod.due` and :meth:`FastMethod.ready`) and
