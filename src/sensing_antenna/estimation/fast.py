@@ -30,7 +30,7 @@ import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -630,7 +630,8 @@ class FastMethod:
     config: FastConfig = field(default_factory=FastConfig)
     name: str = "fast"
 
-    def _prepare(self, evidence: Evidence) -> tuple[FloatArray, SensorBias, tuple[float, float]]:
+    def _prepare(self, evidence: Evidence) -> _ScanInputs:
+        """What :func:`evaluate_window` and :func:`scan` share, from the pipeline's evidence."""
         link = evidence.antenna.link
         channels = contact_channels(
             evidence.theta, evidence.force, evidence.torque, evidence.antenna
@@ -647,7 +648,17 @@ class FastMethod:
             evidence.config.contact_range[0] * link.length,
             evidence.config.contact_range[1] * link.length,
         )
-        return channels, bias, x_range
+        return _ScanInputs(
+            channels,
+            bias,
+            evidence.rest_index,
+            evidence.end_index,
+            evidence.sample_period,
+            evidence.band,
+            link,
+            x_range,
+            self.config,
+        )
 
     def due(self, samples_since_t1: int, sample_period: float) -> bool:
         """Whether the online form should evaluate after this sample (the evaluation grid)."""
@@ -657,39 +668,30 @@ class FastMethod:
 
     def ready(self, evidence: Evidence) -> bool:
         """Whether the window ending at ``evidence.end_index`` is sure or at the cap."""
-        channels, bias, x_range = self._prepare(evidence)
         offsets = evaluation_offsets(evidence.sample_period, self.config)
         if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
             return True
-        window = evaluate_window(
-            channels,
-            bias,
-            evidence.rest_index,
-            evidence.end_index,
-            evidence.sample_period,
-            evidence.band,
-            evidence.antenna.link,
-            x_range,
-            self.config,
-        )
-        return window.sure
+        return evaluate_window(*self._prepare(evidence)).sure
 
     def conclude(self, evidence: Evidence) -> ContactEstimate:
         """Scan the evidence from t_1 and give the first sure estimate (or the capped one)."""
-        channels, bias, x_range = self._prepare(evidence)
-        result = scan(
-            channels,
-            bias,
-            evidence.rest_index,
-            evidence.end_index,
-            evidence.sample_period,
-            evidence.band,
-            evidence.antenna.link,
-            x_range,
-            self.config,
-            earliest=evidence.hold_end,
-        )
-        return conclude_fast(evidence, result, bias, self.config, self.name)
+        inputs = self._prepare(evidence)
+        result = scan(*inputs, earliest=evidence.hold_end)
+        return conclude_fast(evidence, result, inputs.bias, self.config, self.name)
+
+
+class _ScanInputs(NamedTuple):
+    """The leading arguments of :func:`evaluate_window` and :func:`scan`, in their order."""
+
+    channels: FloatArray
+    bias: SensorBias
+    rest_index: int
+    end_index: int
+    sample_period: float
+    band: tuple[float, float]
+    link: Link
+    x_range: tuple[float, float]
+    config: FastConfig
 
 
 def _direction_change(early: StaticRatio, late: StaticRatio) -> tuple[float, float]:
