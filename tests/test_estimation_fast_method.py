@@ -187,6 +187,40 @@ def test_offline_and_online_agree_on_a_simulated_recording() -> None:
     assert offline.t_e - offline.t_1 < 0.5
 
 
+def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:
+    # history() evaluates the same grid without stopping: its first sure window at or after the
+    # end of the hold is the one conclude() declares (same sample, same x_c); from_t1 starts
+    # first_window after t_1; the last window is the cap (the recording runs past it).
+    simulator = pytest.importorskip("sensing_antenna.simulator")
+    from sensing_antenna.estimation.evidence import Evidence
+    from sensing_antenna.estimation.pipeline import estimate
+
+    kept: list[Evidence] = []
+
+    class Keep(FastMethod):
+        def conclude(self, evidence: Evidence) -> object:  # type: ignore[override]
+            kept.append(evidence)
+            return super().conclude(evidence)
+
+    antenna = paper_antenna()
+    recording = simulator.simulate(
+        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
+    )
+    result = estimate(recording.without_ground_truth(), antenna, Keep())
+    evidence = kept[0]
+    config = FastConfig()
+    history = FastMethod().history(evidence)
+    declared = next(w for w in history if w.sure)
+    assert history[0].end_index >= evidence.hold_end
+    assert evidence.t[declared.end_index] == result.t_e
+    assert declared.posterior.x_c == result.x_c
+    since_t1 = FastMethod().history(evidence, from_t1=True)
+    offsets = [w.end_index - evidence.rest_index for w in since_t1]
+    assert offsets[0] == round(config.first_window / evidence.sample_period)
+    assert offsets[-1] == round(config.cap / evidence.sample_period)
+    assert offsets == sorted(set(offsets))
+
+
 def test_second_mode_chooses_the_branch_at_the_cap_near_the_peak() -> None:
     # At 0.75 m omega_1 is 0.5 % below the top of the curve: its two candidates (0.75 and
     # 0.79 m) are closer than the ratio resolves and the fast method stays unsure to the cap.

@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field, fields
 from typing import Any, NamedTuple
 
@@ -59,6 +60,7 @@ __all__ = [
     "ScanResult",
     "WindowEstimate",
     "evaluate_window",
+    "evaluations",
     "scan",
 ]
 
@@ -580,6 +582,36 @@ class ScanResult:
     reached_cap: bool
 
 
+def evaluations(
+    channels: FloatArray,
+    bias: SensorBias,
+    rest_index: int,
+    last_available: int,
+    sample_period: float,
+    band: tuple[float, float],
+    link: Link,
+    x_range: tuple[float, float],
+    config: FastConfig,
+    earliest: int = 0,
+) -> Iterator[WindowEstimate]:
+    """Every window [t_1, t_j] of the evaluation grid from ``earliest`` to the cap, in order.
+
+    The grid is t_1 + :func:`evaluation_offsets`; evaluation starts at the first grid point at or
+    after ``earliest`` and ends at the cap or at ``last_available``, whichever comes first. The
+    fits of one recording are cached, so the drift check's shorter windows are fitted once.
+    """
+    cache: FitCache = {}
+    for offset in evaluation_offsets(sample_period, config):
+        j = rest_index + int(offset)
+        if j < earliest:
+            continue
+        if j > last_available:
+            return
+        yield evaluate_window(
+            channels, bias, rest_index, j, sample_period, band, link, x_range, config, cache
+        )
+
+
 def scan(
     channels: FloatArray,
     bias: SensorBias,
@@ -594,23 +626,24 @@ def scan(
 ) -> ScanResult:
     """Evaluate the growing window on the evaluation grid until sure, the cap or the samples' end.
 
-    The grid is t_1 + :func:`evaluation_offsets`; evaluation starts at the first grid point at or
-    after ``earliest`` (the end of the pipeline's hold, before which there is no contact frame).
+    The windows are those of :func:`evaluations`; ``earliest`` is the end of the pipeline's hold,
+    before which there is no contact frame.
     """
-    offsets = evaluation_offsets(sample_period, config)
-    last = rest_index + int(offsets[-1])
+    last = rest_index + int(evaluation_offsets(sample_period, config)[-1])
     final: WindowEstimate | None = None
     count = 0
-    cache: FitCache = {}
-    for offset in offsets:
-        j = rest_index + int(offset)
-        if j < earliest:
-            continue
-        if j > last_available:
-            break
-        final = evaluate_window(
-            channels, bias, rest_index, j, sample_period, band, link, x_range, config, cache
-        )
+    for final in evaluations(
+        channels,
+        bias,
+        rest_index,
+        last_available,
+        sample_period,
+        band,
+        link,
+        x_range,
+        config,
+        earliest,
+    ):
         count += 1
         if final.sure:
             return ScanResult(final, count, False)
@@ -672,6 +705,18 @@ class FastMethod:
         if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
             return True
         return evaluate_window(*self._prepare(evidence)).sure
+
+    def history(self, evidence: Evidence, from_t1: bool = False) -> tuple[WindowEstimate, ...]:
+        """Every evaluation of the growing window up to the cap, without stopping when sure.
+
+        For studying the method (how the interval narrows, which check holds the declaration
+        back): the first ``sure`` element at or after the end of the pipeline's hold is the
+        one :meth:`conclude` declares. ``from_t1`` starts at ``first_window`` after t_1 instead
+        of at the end of the hold.
+        """
+        inputs = self._prepare(evidence)
+        earliest = inputs.rest_index if from_t1 else evidence.hold_end
+        return tuple(evaluations(*inputs, earliest=earliest))
 
     def conclude(self, evidence: Evidence) -> ContactEstimate:
         """Scan the evidence from t_1 and give the first sure estimate (or the capped one)."""
