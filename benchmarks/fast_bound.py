@@ -1,0 +1,230 @@
+"""How early could ``--method fast`` declare? Its delay against an information bound.
+
+Issue 6 asks for a median t_e - t_1 of at most 25 % of the paper method's. This script asks how
+much of the fast method's delay is the information in the record and how much is its own
+caution. For every case, contact point of the paper's grid and seed, one recording of the paper
+antenna is simulated and the fast method's growing window is evaluated at every instant of its
+grid from ``first_window`` after t_1 to the cap (:meth:`FastMethod.history`), without stopping.
+Four instants are read off each history, as t - t_1 (s):
+
+- ``declared``: the first sure window after the pipeline's hold, the method's own t_e;
+- ``no_hold``: the first sure window at any time (the hold of ``frame_window`` after t_1, where
+  the pipeline builds its contact frame, lifted);
+- ``width``: the first window whose 95 % interval is narrower than the tolerance, every other
+  check (periods in the window, drift, peak margin, ratio agreement) ignored; floors kept;
+- ``bound``: the same with the standard error of omega_1 at its Cramer-Rao bound for the
+  window's fitted model and noise, no model floors: the earliest instant the record's
+  fundamental and torque/force ratio could give a 5 mm interval to an efficient estimator
+  that trusted the linear model completely.
+
+A window that never qualifies before the cap counts as the cap. The medians are compared with
+the paper method's median t_e - t_1 on the same recordings. Results go to
+``benchmarks/results/fast_bound.json`` and a figure of the four instants against x_c to
+``benchmarks/results/fast_bound.png``.
+
+Usage::
+
+    python benchmarks/fast_bound.py             # full grid, noise 1, 2 seeds (about 4 min)
+    python benchmarks/fast_bound.py --quick     # 4 positions, 1 seed
+
+Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import time
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from eval_fast import GRID, QUICK_GRID, simulated
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.estimation.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.fast import FastConfig, FastMethod, WindowEstimate
+from sensing_antenna.estimation.likelihood import contact_posterior
+from sensing_antenna.estimation.pipeline import estimate
+from sensing_antenna.estimation.result import ContactEstimate
+
+OUT = Path(__file__).parent / "results" / "fast_bound.json"
+INSTANTS = ("declared", "no_hold", "width", "bound")
+
+
+@dataclass(frozen=True)
+class _Recorder(FastMethod):
+    """The fast method, keeping the evidence it was handed (one recording per instance)."""
+
+    kept: list[Evidence] | None = None
+
+    def conclude(self, evidence: Evidence) -> ContactEstimate:
+        if self.kept is not None:
+            self.kept.append(evidence)
+        return super().conclude(evidence)
+
+
+def bound_width(window: WindowEstimate, evidence: Evidence, config: FastConfig) -> float:
+    """Width (m) of the 95 % interval with omega_1 at its Cramer-Rao bound and no floors."""
+    statics = window.statics
+    if statics is None or not math.isfinite(window.omega1_crb):
+        return math.nan
+    link = evidence.antenna.link
+    low, high = (f * link.length for f in evidence.config.contact_range)
+    grid = np.linspace(low, high, max(2, round((high - low) / config.grid_step) + 1))
+    curve = sensing_curve(link)
+    edges = (low, *(x for x in curve.extrema if low < x < high), high)
+    posterior = contact_posterior(
+        np.asarray(curve.omega1(grid), dtype=float),
+        grid,
+        edges,
+        window.omega1,
+        window.omega1_crb,
+        statics.ratio,
+        statics.standard_error,
+        statics.perpendicular_force,
+        link.flexural_rigidity,
+        frequency_floor=0.0,
+        ratio_geometry_factor=0.0,
+    )
+    return posterior.width
+
+
+def run_one(case: str, x_c: float, seed: int, noise: float) -> dict[str, Any]:
+    """The four instants (s after t_1) of one recording and the paper method's delay."""
+    antenna = paper_antenna()
+    recording, _ = simulated(case, x_c, seed, noise, None)
+    config = FastConfig()
+    kept: list[Evidence] = []
+    start = time.perf_counter()
+    fast = estimate(recording, antenna, _Recorder(config=config, kept=kept))
+    paper = estimate(recording, antenna, "paper")
+    row: dict[str, Any] = {
+        "case": case,
+        "x_nominal": x_c,
+        "seed": seed,
+        "noise": noise,
+        "status": fast.status.value,
+        "paper_delay": paper.t_e - paper.t_1,
+        "fast_delay": fast.t_e - fast.t_1,
+    }
+    if not kept:
+        row.update({name: math.nan for name in INSTANTS})
+        return row
+    evidence = kept[0]
+    t_1 = float(evidence.t[evidence.rest_index])
+    history = FastMethod(config).history(evidence, from_t1=True)
+    cap = config.cap
+
+    def first(test: Any) -> float:
+        for w in history:
+            if test(w):
+                return float(evidence.t[w.end_index]) - t_1
+        return cap
+
+    row["declared"] = first(lambda w: w.sure and w.end_index >= evidence.hold_end)
+    row["no_hold"] = first(lambda w: w.sure)
+    row["width"] = first(lambda w: w.posterior.width <= config.tolerance)
+    row["bound"] = first(lambda w: bound_width(w, evidence, config) <= config.tolerance)
+    row["cpu"] = time.perf_counter() - start
+    return row
+
+
+def _job(args: tuple[str, float, int, float]) -> dict[str, Any]:
+    return run_one(*args)
+
+
+def summarise(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """Medians of the four instants, overall and per case, and as fractions of the paper's."""
+    paper = statistics.median(r["paper_delay"] for r in rows)
+    summary: dict[str, Any] = {"runs": len(rows), "paper_median_delay": paper}
+    for name in INSTANTS:
+        values = [r[name] for r in rows if math.isfinite(r[name])]
+        median = statistics.median(values) if values else math.nan
+        summary[name] = {
+            "median": median,
+            "fraction_of_paper": median / paper,
+            "at_most_25_percent": sum(v <= 0.25 * paper for v in values) / max(1, len(values)),
+        }
+    return summary
+
+
+def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
+    """t - t_1 of the four instants against x_c, one panel per case (medians over seeds)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cases = sorted({r["case"] for r in rows})
+    fig, axes = plt.subplots(1, len(cases), figsize=(5.5 * len(cases), 4), sharey=True)
+    for ax, case in zip(np.atleast_1d(axes), cases, strict=True):
+        points = sorted({r["x_nominal"] for r in rows if r["case"] == case})
+        for name, style in zip(INSTANTS, ("o-", "s--", "^:", "v-"), strict=True):
+            medians = [
+                statistics.median(
+                    r[name] for r in rows if r["case"] == case and r["x_nominal"] == x
+                )
+                for x in points
+            ]
+            ax.plot(points, medians, style, label=name)
+        paper = statistics.median(r["paper_delay"] for r in rows)
+        ax.axhline(0.25 * paper, color="k", lw=0.8, label="25 % of the paper's t_e - t_1")
+        ax.set_title(f"{case}: fast method's delay and its information bound")
+        ax.set_xlabel("contact point x_c (m)")
+        ax.grid(alpha=0.3)
+    np.atleast_1d(axes)[0].set_ylabel("t - t_1 (s)")
+    np.atleast_1d(axes)[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="4 positions, 1 seed")
+    parser.add_argument("--seeds", type=int, default=2, help="seeds per point")
+    parser.add_argument("--seed-base", type=int, default=400, help="first seed")
+    parser.add_argument("--noise", type=float, default=1.0, help="sensor noise scale")
+    parser.add_argument("--workers", type=int, default=None, help="processes (default: cores)")
+    parser.add_argument("--out", type=Path, default=OUT, help="JSON output")
+    args = parser.parse_args()
+    grid = QUICK_GRID if args.quick else GRID
+    seeds = range(1) if args.quick else range(args.seeds)
+    jobs = [
+        (case, float(x), args.seed_base + s, args.noise)
+        for case in ("azimuthal", "vertical")
+        for x in grid
+        for s in seeds
+    ]
+    rows: list[dict[str, Any]] = []
+    with ProcessPoolExecutor(args.workers) as pool:
+        for k, row in enumerate(pool.map(_job, jobs), start=1):
+            rows.append(row)
+            print(
+                f"[{k}/{len(jobs)}] {row['case']:9} x={row['x_nominal']:.2f} seed {row['seed']}: "
+                + " ".join(f"{n}={row[n]:.3f}" for n in INSTANTS),
+                flush=True,
+            )
+    summary = summarise(rows)
+    print(f"\npaper method: median t_e - t_1 = {summary['paper_median_delay']:.3f} s")
+    print(f"{'instant':9} {'median s':>9} {'/ paper':>8} {'runs <= 25 %':>12}")
+    for name in INSTANTS:
+        s = summary[name]
+        print(
+            f"{name:9} {s['median']:9.3f} {s['fraction_of_paper']:8.3f} "
+            f"{s['at_most_25_percent']:12.2f}"
+        )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps({"summary": summary, "rows": rows}, indent=1) + "\n")
+    plot(rows, args.out.with_suffix(".png"))
+    print(f"wrote {args.out} and {args.out.with_suffix('.png')}")
+
+
+if __name__ == "__main__":
+    main()
