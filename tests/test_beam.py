@@ -409,3 +409,19 @@ def test_link_is_not_mutated() -> None:
     SensingCurve.from_link(PAPER, n_points=101)
     assert dataclasses.asdict(PAPER) == before
     assert isinstance(PAPER, Link)
+
+
+@pytest.mark.parametrize(
+    ("x_c", "expected"),
+    [(0.30, -1.411), (0.55, -1.923), (0.75, -0.213), (0.90, 0.637), (0.95, 0.681), (0.98, 0.687)],
+)
+def test_contact_to_base_shear_matches_an_independent_solution(x_c: float, expected: float) -> None:
+    # Reference: the exact two-span Euler-Bernoulli solution (6 x 6 determinant of clamped,
+    # pin and free-end conditions, solved separately from this package) for the paper link
+    # (l = 0.98 m, no tip mass), checked there against a 400-element Hermite finite-element
+    # model's constraint reactions to 3e-6; printed to 3 decimals, hence the 1e-3 tolerance.
+    # At x_c = l the link is clamped-pinned and the whole shear at the pin is the contact force.
+    from sensing_antenna.antenna import paper_antenna
+    from sensing_antenna.beam.modes import contact_to_base_shear
+
+    assert contact_to_base_shear(paper_antenna().link, x_c) == pytest.approx(expected, abs=1e-3)

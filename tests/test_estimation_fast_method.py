@@ -221,6 +221,43 @@ def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:
     assert offsets == sorted(set(offsets))
 
 
+def test_an_opening_contact_moves_the_window_start_to_the_end_of_the_hold() -> None:
+    # The opening check's mechanism: with max_opening = 1e-9 every window from t_1 counts as
+    # opened, so each window at least first_window past the hold is refitted from the hold's
+    # end, and the estimate from those windows still holds the contact. With the default (1)
+    # this recording (azimuthal, 0.6 m: the contact force vibrates at a fraction of the push)
+    # keeps t_1 as the start.
+    simulator = pytest.importorskip("sensing_antenna.simulator")
+    from sensing_antenna.estimation.evidence import Evidence
+    from sensing_antenna.estimation.pipeline import estimate
+
+    kept: list[Evidence] = []
+
+    class Keep(FastMethod):
+        def conclude(self, evidence: Evidence) -> object:  # type: ignore[override]
+            kept.append(evidence)
+            return super().conclude(evidence)
+
+    antenna = paper_antenna()
+    recording = simulator.simulate(
+        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
+    )
+    estimate(recording.without_ground_truth(), antenna, Keep())
+    evidence = kept[0]
+    default = FastMethod().history(evidence)
+    assert all(w.start_index == evidence.rest_index for w in default)
+    assert all(w.opening < 1.0 for w in default)
+    moved = FastMethod(FastConfig(max_opening=1e-9)).history(evidence)
+    first = round(FastConfig().first_window / evidence.sample_period)
+    late = [w for w in moved if w.end_index - evidence.hold_end >= first]
+    assert late and all(w.start_index == evidence.hold_end for w in late)
+    # The windows from the hold also see the (slight) vibration: never sure, and the cap's
+    # posterior still holds the contact (0.6 m, the contact moves < 3 mm as the link bends)
+    assert not any(w.sure for w in late)
+    low, high = late[-1].posterior.interval
+    assert low - 0.003 <= 0.6 <= high + 0.003
+
+
 def test_second_mode_chooses_the_branch_at_the_cap_near_the_peak() -> None:
     # At 0.75 m omega_1 is 0.5 % below the top of the curve: its two candidates (0.75 and
     # 0.79 m) are closer than the ratio resolves and the fast method stays unsure to the cap.

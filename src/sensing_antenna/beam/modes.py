@@ -20,6 +20,7 @@ from sensing_antenna.beam.characteristic import eigenvalues
 
 __all__ = [
     "contact_ratio",
+    "contact_to_base_shear",
     "frequency_scale",
     "mode_shapes",
     "natural_frequencies",
@@ -217,3 +218,29 @@ def mode_shapes(link: Link, x_c: float, x: ArrayLike, n_modes: int = 3) -> Float
         pieces = _mode_coefficients(float(lam), xi, ratio)
         out[:, i] = _evaluate(float(lam), pieces, s) * _normalise(float(lam), pieces, ratio)
     return out
+
+
+def contact_to_base_shear(link: Link, x_c: float) -> float:
+    """Amplitude of the contact force over that of the base shear force in the first contact mode.
+
+    Both are shear forces of the mode shape phi (Eq. 3 with the boundary conditions of Eq. 4):
+    the contact force is the jump E I (phi'''(x_c+) - phi'''(x_c-)) at the pin (phi'''(x_c+) = 0
+    when the contact is at the tip) and the base shear is E I phi'''(0); E I cancels. Negative:
+    they are in antiphase. The F/T sensor sees the base shear, so this ratio turns a measured
+    vibration amplitude into the vibration of the contact force (dimensionless).
+    """
+    xi_arr = contact_ratio(link, x_c)
+    if xi_arr.ndim != 0:
+        raise BeamInputError("x_c", f"must be a single contact point, got shape {xi_arr.shape}")
+    xi = float(xi_arr)
+    ratio = link.tip_mass_ratio
+    lam = float(eigenvalues(xi, 1, ratio)[0])
+    pieces = _mode_coefficients(lam, xi, ratio)
+    zero = np.zeros(1)
+    first_length, first = pieces[0]
+    base = float(_basis(3, lam, first_length, zero)[0] @ first)
+    left = float(_basis(3, lam, first_length, np.array([first_length]))[0] @ first)
+    right = 0.0
+    if len(pieces) > 1:
+        right = float(_basis(3, lam, pieces[1][0], zero)[0] @ pieces[1][1])
+    return (right - left) / base
