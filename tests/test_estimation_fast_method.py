@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -187,10 +188,8 @@ def test_offline_and_online_agree_on_a_simulated_recording() -> None:
     assert offline.t_e - offline.t_1 < 0.5
 
 
-def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:
-    # history() evaluates the same grid without stopping: its first sure window at or after the
-    # end of the hold is the one conclude() declares (same sample, same x_c); from_t1 starts
-    # first_window after t_1; the last window is the cap (the recording runs past it).
+def _simulated_evidence() -> tuple[Any, Any]:
+    """The evidence the pipeline hands the fast method, and its estimate (azimuthal, 0.6 m)."""
     simulator = pytest.importorskip("sensing_antenna.simulator")
     from sensing_antenna.estimation.evidence import Evidence
     from sensing_antenna.estimation.pipeline import estimate
@@ -207,7 +206,14 @@ def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:
         antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
     )
     result = estimate(recording.without_ground_truth(), antenna, Keep())
-    evidence = kept[0]
+    return kept[0], result
+
+
+def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:
+    # history() evaluates the same grid without stopping: its first sure window at or after the
+    # end of the hold is the one conclude() declares (same sample, same x_c); from_t1 starts
+    # first_window after t_1; the last window is the cap (the recording runs past it).
+    evidence, result = _simulated_evidence()
     config = FastConfig()
     history = FastMethod().history(evidence)
     declared = next(w for w in history if w.sure)
@@ -227,23 +233,7 @@ def test_an_opening_contact_moves_the_window_start_to_the_end_of_the_hold() -> N
     # end, and the estimate from those windows still holds the contact. With the default (1)
     # this recording (azimuthal, 0.6 m: the contact force vibrates at a fraction of the push)
     # keeps t_1 as the start.
-    simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.evidence import Evidence
-    from sensing_antenna.estimation.pipeline import estimate
-
-    kept: list[Evidence] = []
-
-    class Keep(FastMethod):
-        def conclude(self, evidence: Evidence) -> object:  # type: ignore[override]
-            kept.append(evidence)
-            return super().conclude(evidence)
-
-    antenna = paper_antenna()
-    recording = simulator.simulate(
-        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
-    )
-    estimate(recording.without_ground_truth(), antenna, Keep())
-    evidence = kept[0]
+    evidence, _ = _simulated_evidence()
     default = FastMethod().history(evidence)
     assert all(w.start_index == evidence.rest_index for w in default)
     assert all(w.opening < 1.0 for w in default)
