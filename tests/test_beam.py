@@ -418,8 +418,9 @@ def test_link_is_not_mutated() -> None:
 def test_contact_to_base_shear_matches_an_independent_solution(x_c: float, expected: float) -> None:
     # Reference: the exact two-span Euler-Bernoulli solution (6 x 6 determinant of clamped,
     # pin and free-end conditions, solved separately from this package) for the paper link
-    # (l = 0.98 m, no tip mass), checked there against a 400-element Hermite finite-element
-    # model's constraint reactions to 3e-6; printed to 3 decimals, hence the 1e-3 tolerance.
+    # (l = 0.98 m, no tip mass), printed to 3 decimals, hence the 1e-3 tolerance. The same
+    # quantity is checked against finite-element constraint forces over the whole link in
+    # tests/test_beam_fem.py (test_contact_to_base_shear_matches_finite_element_reactions).
     # At x_c = l the link is clamped-pinned and the whole shear at the pin is the contact force.
     from sensing_antenna.antenna import paper_antenna
     from sensing_antenna.beam.modes import contact_to_base_shear

@@ -17,6 +17,7 @@ from sensing_antenna.beam.characteristic import (
 )
 from sensing_antenna.beam.modes import (
     contact_ratio,
+    contact_to_base_shear,
     frequency_scale,
     mode_shapes,
     natural_frequencies,
@@ -40,6 +41,7 @@ __all__ = [
     "characteristic_function",
     "contact_deflection_from_force",
     "contact_ratio",
+    "contact_to_base_shear",
     "eigenvalue_slopes",
     "eigenvalues",
     "frequency_scale",

@@ -37,8 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.beam import natural_frequencies
-from sensing_antenna.beam.modes import contact_to_base_shear
+from sensing_antenna.beam import contact_to_base_shear, natural_frequencies
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.fusion import second_mode_choice
