@@ -263,10 +263,12 @@ def _curve_table(link: Link, low: float, high: float, step: float) -> _Curve:
 
 @dataclass(frozen=True)
 class WindowEstimate:
-    """One evaluation of the growing window [t_1, t_j].
+    """One evaluation of the growing window [t_s, t_j] (t_s: t_1, or the end of the hold).
 
     Attributes
     ----------
+    start_index : int
+        First sample of the window: t_1, or the end of the hold after an opening.
     end_index : int
         j, the last sample used.
     fit : DampedSinusoidFit or None
@@ -296,10 +298,9 @@ class WindowEstimate:
     opening : float
         Predicted vibration amplitude of the contact force over the static push at the window
         start (> 1: the contact opens); NaN when not computed.
-    start_index : int
-        First sample of the window (t_1, or the end of the hold after an opening); -1: t_1.
     """
 
+    start_index: int
     end_index: int
     fit: DampedSinusoidFit | None
     omega1: float
@@ -313,7 +314,6 @@ class WindowEstimate:
     early_statics: StaticRatio | None = None
     ratio_z: float = math.nan
     opening: float = math.nan
-    start_index: int = -1
 
 
 #: Cache of window fits within one recording, keyed by the window's last index.
@@ -527,6 +527,7 @@ def evaluate_window(
             f"(tolerance {1000 * config.tolerance:g} mm)"
         )
     return WindowEstimate(
+        start_index=rest_index,
         end_index=end_index,
         fit=fit,
         omega1=omega1,
@@ -540,7 +541,6 @@ def evaluate_window(
         early_statics=early,
         ratio_z=ratio_z,
         opening=opening,
-        start_index=rest_index,
     )
 
 
@@ -552,12 +552,12 @@ def _contact_to_base_shear(link: Link, x_c: float) -> float:
 def _opening(fit: DampedSinusoidFit, k: int, push: float, link: Link, x_c: float) -> float:
     """Fundamental's contact-force amplitude at the window start over the static push |R_perp|.
 
-    The base-force amplitude (R_y and R_z channels) is carried back to the window start with the
-    fitted decay and turned into the contact force by the first mode's shape.
+    The base-force amplitude (R_y and R_z channels) at the window start is turned into the
+    contact force by the first mode's shape.
     """
-    base = math.hypot(float(fit.amplitudes[0, k]), float(fit.amplitudes[1, k]))
-    start = base * math.exp(min(0.5 * float(fit.decay[k]) * fit.duration, 50.0))
-    return abs(_contact_to_base_shear(link, x_c)) * start / push
+    start = fit.start_amplitudes()
+    base = math.hypot(float(start[0, k]), float(start[1, k]))
+    return abs(_contact_to_base_shear(link, x_c)) * base / push
 
 
 def evaluate_from_t1_or_hold(

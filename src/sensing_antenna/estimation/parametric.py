@@ -129,10 +129,17 @@ class DampedSinusoidFit:
         """Window length (n - 1) T_s (s)."""
         return (self.n_samples - 1) * self.sample_period
 
+    def start_amplitudes(self) -> FloatArray:
+        """Amplitude of each mode in each channel at the window start (channel units), (K, M).
+
+        ``amplitudes`` are at the window centre; the decay carries them back half a window
+        (at most e^(_MAX_WINDOW_DECAY / 2) by the fit's bound on s_m times the duration).
+        """
+        return self.amplitudes * np.exp(0.5 * self.decay * self.duration)[None, :]
+
     def snr(self) -> FloatArray:
         """Amplitude at the window start over noise, combined over channels, shape (M,)."""
-        start = self.amplitudes * np.exp(0.5 * self.decay * self.duration)[None, :]
-        ratio = start / self.noise_std[:, None]
+        ratio = self.start_amplitudes() / self.noise_std[:, None]
         return np.asarray(np.sqrt(np.sum(ratio**2, axis=0)), dtype=float)
 
     def strongest_in_band(self, band: tuple[float, float]) -> int | None:
