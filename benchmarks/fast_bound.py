@@ -39,50 +39,33 @@ import statistics
 import time
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from eval_fast import GRID, QUICK_GRID, simulated
-from sensing_antenna.antenna import paper_antenna
-from sensing_antenna.estimation.evidence import Evidence, sensing_curve
-from sensing_antenna.estimation.fast import FastConfig, FastMethod, WindowEstimate
+from sensing_antenna.antenna import Link, paper_antenna
+from sensing_antenna.estimation.evidence import Evidence
+from sensing_antenna.estimation.fast import FastConfig, FastMethod, WindowEstimate, curve_table
 from sensing_antenna.estimation.likelihood import contact_posterior
-from sensing_antenna.estimation.pipeline import estimate
-from sensing_antenna.estimation.result import ContactEstimate
+from sensing_antenna.estimation.pipeline import estimate, gather_evidence
 
 OUT = Path(__file__).parent / "results" / "fast_bound.json"
 INSTANTS = ("declared", "no_hold", "width", "bound")
 
 
-@dataclass(frozen=True)
-class _Recorder(FastMethod):
-    """The fast method, keeping the evidence it was handed (one recording per instance)."""
-
-    kept: list[Evidence] | None = None
-
-    def conclude(self, evidence: Evidence) -> ContactEstimate:
-        if self.kept is not None:
-            self.kept.append(evidence)
-        return super().conclude(evidence)
-
-
-def bound_width(window: WindowEstimate, evidence: Evidence, config: FastConfig) -> float:
+def bound_width(window: WindowEstimate, link: Link, config: FastConfig) -> float:
     """Width (m) of the 95 % interval with omega_1 at its Cramer-Rao bound and no floors."""
     statics = window.statics
     if statics is None or not math.isfinite(window.omega1_crb):
         return math.nan
-    link = evidence.antenna.link
-    low, high = (f * link.length for f in evidence.config.contact_range)
-    grid = np.linspace(low, high, max(2, round((high - low) / config.grid_step) + 1))
-    curve = sensing_curve(link)
-    edges = (low, *(x for x in curve.extrema if low < x < high), high)
+    grid = window.posterior.grid
+    table = curve_table(link, float(grid[0]), float(grid[-1]), config.grid_step)
     posterior = contact_posterior(
-        np.asarray(curve.omega1(grid), dtype=float),
-        grid,
-        edges,
+        table.omega1,
+        table.grid,
+        table.edges,
         window.omega1,
         window.omega1_crb,
         statics.ratio,
@@ -100,9 +83,8 @@ def run_one(case: str, x_c: float, seed: int, noise: float) -> dict[str, Any]:
     antenna = paper_antenna()
     recording, _ = simulated(case, x_c, seed, noise, None)
     config = FastConfig()
-    kept: list[Evidence] = []
     start = time.perf_counter()
-    fast = estimate(recording, antenna, _Recorder(config=config, kept=kept))
+    fast = estimate(recording, antenna, FastMethod(config))
     paper = estimate(recording, antenna, "paper")
     row: dict[str, Any] = {
         "case": case,
@@ -113,10 +95,10 @@ def run_one(case: str, x_c: float, seed: int, noise: float) -> dict[str, Any]:
         "paper_delay": paper.t_e - paper.t_1,
         "fast_delay": fast.t_e - fast.t_1,
     }
-    if not kept:
+    evidence = gather_evidence(recording, antenna)
+    if not isinstance(evidence, Evidence):
         row.update({name: math.nan for name in INSTANTS})
         return row
-    evidence = kept[0]
     t_1 = float(evidence.t[evidence.rest_index])
     history = FastMethod(config).history(evidence, from_t1=True)
     cap = config.cap
@@ -128,9 +110,15 @@ def run_one(case: str, x_c: float, seed: int, noise: float) -> dict[str, Any]:
         return cap
 
     row["declared"] = first(lambda w: w.sure and w.end_index >= evidence.hold_end)
+    if abs(row["declared"] - row["fast_delay"]) > 0.5 * recording.sample_period:
+        # The history must hold the method's own declaration; a mismatch is a bug, not a result
+        raise RuntimeError(
+            f"history declares at {row['declared']}, the method at {row['fast_delay']}"
+        )
     row["no_hold"] = first(lambda w: w.sure)
     row["width"] = first(lambda w: w.posterior.width <= config.tolerance)
-    row["bound"] = first(lambda w: bound_width(w, evidence, config) <= config.tolerance)
+    link = antenna.link
+    row["bound"] = first(lambda w: bound_width(w, link, config) <= config.tolerance)
     row["cpu"] = time.perf_counter() - start
     return row
 
@@ -140,7 +128,7 @@ def _job(args: tuple[str, float, int, float]) -> dict[str, Any]:
 
 
 def summarise(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """Medians of the four instants, overall and per case, and as fractions of the paper's."""
+    """Medians of the four instants over ``rows``, as fractions of the paper method's median."""
     paper = statistics.median(r["paper_delay"] for r in rows)
     summary: dict[str, Any] = {"runs": len(rows), "paper_median_delay": paper}
     for name in INSTANTS:

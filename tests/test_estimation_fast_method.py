@@ -192,21 +192,15 @@ def _simulated_evidence() -> tuple[Any, Any]:
     """The evidence the pipeline hands the fast method, and its estimate (azimuthal, 0.6 m)."""
     simulator = pytest.importorskip("sensing_antenna.simulator")
     from sensing_antenna.estimation.evidence import Evidence
-    from sensing_antenna.estimation.pipeline import estimate
-
-    kept: list[Evidence] = []
-
-    class Keep(FastMethod):
-        def conclude(self, evidence: Evidence) -> object:  # type: ignore[override]
-            kept.append(evidence)
-            return super().conclude(evidence)
+    from sensing_antenna.estimation.pipeline import estimate, gather_evidence
 
     antenna = paper_antenna()
     recording = simulator.simulate(
         antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
-    )
-    result = estimate(recording.without_ground_truth(), antenna, Keep())
-    return kept[0], result
+    ).without_ground_truth()
+    evidence = gather_evidence(recording, antenna)
+    assert isinstance(evidence, Evidence)
+    return evidence, estimate(recording, antenna, FastMethod())
 
 
 def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:

@@ -238,6 +238,13 @@ def test_no_contact() -> None:
     assert math.isnan(result.x_c)
     _, final = run_online(recording)
     assert final.status is Status.NO_CONTACT
+    # Without a contact there is no evidence to study: gather_evidence gives the early result
+    from sensing_antenna.estimation.evidence import Evidence
+    from sensing_antenna.estimation.pipeline import gather_evidence
+
+    early = gather_evidence(recording, paper_antenna())
+    assert not isinstance(early, Evidence)
+    assert early.status is Status.NO_CONTACT
 
 
 def test_push_too_gentle_is_not_a_push() -> None:

@@ -54,11 +54,13 @@ from sensing_antenna.estimation.static_fit import (
 from sensing_antenna.estimation.touch_point import touched_point
 
 __all__ = [
+    "CurveTable",
     "FastConfig",
     "FastConfigError",
     "FastMethod",
     "ScanResult",
     "WindowEstimate",
+    "curve_table",
     "evaluate_from_t1_or_hold",
     "evaluate_window",
     "evaluations",
@@ -243,7 +245,21 @@ class FastConfig:
 
 
 @dataclass(frozen=True)
-class _Curve:
+class CurveTable:
+    """The sensing curves on the posterior's grid.
+
+    Attributes
+    ----------
+    grid : array, shape (G,)
+        Contact points (m).
+    omega1 : array, shape (G,)
+        omega_1 at each (rad/s).
+    edges : tuple of float
+        Range limits and the extrema of omega_1 inside (m), ascending: the branch edges.
+    higher : array, shape (G, 2)
+        Contact modes 2 and 3 at each (rad/s).
+    """
+
     grid: FloatArray
     omega1: FloatArray
     edges: tuple[float, ...]
@@ -251,14 +267,17 @@ class _Curve:
 
 
 @functools.lru_cache(maxsize=16)
-def _curve_table(link: Link, low: float, high: float, step: float) -> _Curve:
+def curve_table(link: Link, low: float, high: float, step: float) -> CurveTable:
+    """:class:`CurveTable` of ``link`` on [low, high] (m) every ``step`` (m); cached."""
     curve = sensing_curve(link)
     n = max(2, round((high - low) / step) + 1)
     grid = np.linspace(low, high, n)
     inner = tuple(x for x in curve.extrema if low < x < high)
     # Contact modes 2 and 3 (Eq. 3 with the boundary conditions of Eq. 4), shape (G, 2)
     higher = np.asarray(natural_frequencies(link, grid, 3), dtype=float)[:, 1:]
-    return _Curve(grid, np.asarray(curve.omega1(grid), dtype=float), (low, *inner, high), higher)
+    return CurveTable(
+        grid, np.asarray(curve.omega1(grid), dtype=float), (low, *inner, high), higher
+    )
 
 
 @dataclass(frozen=True)
@@ -465,7 +484,7 @@ def evaluate_window(
             # Statics of a window too short for the model are not a reference (mode and offset
             # are confounded below a period or so)
             early = static_ratio(half_fit, bias)
-    table = _curve_table(link, x_range[0], x_range[1], config.grid_step)
+    table = curve_table(link, x_range[0], x_range[1], config.grid_step)
     omega_h = omega_h_se = math.nan
     if config.higher_modes and fit is not None and math.isfinite(omega1):
         omega_h, omega_h_se = _higher_mode(fit, omega1, table.higher, config)
@@ -546,7 +565,7 @@ def evaluate_window(
 
 @functools.lru_cache(maxsize=4096)
 def _contact_to_base_shear(link: Link, x_c: float) -> float:
-    return contact_to_base_shear(link, x_c)
+    return float(contact_to_base_shear(link, x_c))
 
 
 def _opening(fit: DampedSinusoidFit, k: int, push: float, link: Link, x_c: float) -> float:

@@ -60,6 +60,7 @@ __all__ = [
     "OnlineEstimator",
     "UnknownMethodError",
     "estimate",
+    "gather_evidence",
     "measure_omega1",
     "search_band",
 ]
@@ -220,6 +221,31 @@ def measure_omega1(
         clear=False,
         reason=result.reason,
     )
+
+
+def gather_evidence(
+    recording: Recording, antenna: Antenna, config: EstimatorConfig | None = None
+) -> Evidence | ContactEstimate:
+    """What the pipeline hands a method at t_e, for studying a method on a recording.
+
+    Returns the :class:`Evidence` (e.g. for :meth:`~.fast.FastMethod.history`), or the early
+    result (no contact, no push, bad input) when the pipeline stops before building it.
+    """
+    result = estimate(recording, antenna, _EvidenceOnly(), config)
+    evidence = result.diagnostics.get("evidence")
+    return evidence if isinstance(evidence, Evidence) else result
+
+
+@dataclasses.dataclass(frozen=True)
+class _EvidenceOnly:
+    """Internal method for :func:`gather_evidence`: keeps the evidence, estimates nothing."""
+
+    name: str = "evidence"
+
+    def conclude(self, evidence: Evidence) -> ContactEstimate:
+        return ContactEstimate(
+            status=Status.OK, reason=None, method=self.name, diagnostics={"evidence": evidence}
+        )
 
 
 @dataclasses.dataclass(frozen=True)
