@@ -220,27 +220,39 @@ def mode_shapes(link: Link, x_c: float, x: ArrayLike, n_modes: int = 3) -> Float
     return out
 
 
-def contact_to_base_shear(link: Link, x_c: float) -> float:
+def contact_to_base_shear(link: Link, x_c: ArrayLike) -> FloatArray:
     """Amplitude of the contact force over that of the base shear force in the first contact mode.
 
     Both are shear forces of the mode shape phi (Eq. 3 with the boundary conditions of Eq. 4):
     the contact force is the jump E I (phi'''(x_c+) - phi'''(x_c-)) at the pin (phi'''(x_c+) = 0
     when the contact is at the tip) and the base shear is E I phi'''(0); E I cancels. Negative:
     they are in antiphase. The F/T sensor sees the base shear, so this ratio turns a measured
-    vibration amplitude into the vibration of the contact force (dimensionless).
+    vibration amplitude into the vibration of the contact force.
+
+    Parameters
+    ----------
+    link : Link
+    x_c : array_like
+        Contact points in (0, l] (m).
+
+    Returns
+    -------
+    ndarray
+        Dimensionless, shape ``x_c.shape``.
     """
-    xi_arr = contact_ratio(link, x_c)
-    if xi_arr.ndim != 0:
-        raise BeamInputError("x_c", f"must be a single contact point, got shape {xi_arr.shape}")
-    xi = float(xi_arr)
+    xi = contact_ratio(link, x_c)
     ratio = link.tip_mass_ratio
-    lam = float(eigenvalues(xi, 1, ratio)[0])
-    pieces = _mode_coefficients(lam, xi, ratio)
+    lams = eigenvalues(xi, 1, ratio)[..., 0]
+    out = np.empty(xi.shape)
     zero = np.zeros(1)
-    first_length, first = pieces[0]
-    base = float(_basis(3, lam, first_length, zero)[0] @ first)
-    left = float(_basis(3, lam, first_length, np.array([first_length]))[0] @ first)
-    right = 0.0
-    if len(pieces) > 1:
-        right = float(_basis(3, lam, pieces[1][0], zero)[0] @ pieces[1][1])
-    return (right - left) / base
+    for index in np.ndindex(xi.shape):
+        lam = float(lams[index])
+        pieces = _mode_coefficients(lam, float(xi[index]), ratio)
+        first_length, first = pieces[0]
+        base = float(_basis(3, lam, first_length, zero)[0] @ first)
+        left = float(_basis(3, lam, first_length, np.array([first_length]))[0] @ first)
+        right = 0.0
+        if len(pieces) > 1:
+            right = float(_basis(3, lam, pieces[1][0], zero)[0] @ pieces[1][1])
+        out[index] = (right - left) / base
+    return out
