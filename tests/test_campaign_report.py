@@ -6,6 +6,7 @@ paper's numbers are Tables 3 and 4 of Feliu-Talegon et al., Sensors 2021 (the pa
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from typing import ClassVar
@@ -310,6 +311,17 @@ def test_coverage_is_judged_against_the_contact_abscissa() -> None:
     target = target_summary(rows, "all", "fast", "paper")
     assert (target.n_intervals, target.n_covering) == (3, 3)
     assert "coverage outside 93%-97%" in target.missed()
+    # all 3 covering: the exact interval's lower end solves p^3 = 0.025, the upper is 1
+    low, high = target.coverage_interval
+    assert low == pytest.approx(0.025 ** (1 / 3), rel=1e-9) and high == 1.0
+
+
+def test_coverage_interval_is_the_exact_binomial_one() -> None:
+    # none covering out of n: upper end 1 - 0.025^(1/n) (closed form of Clopper-Pearson)
+    summary = target_summary([], "none", "fast", "paper")
+    assert all(math.isnan(v) for v in summary.coverage_interval)
+    zero = dataclasses.replace(summary, n_intervals=20, n_covering=0)
+    assert zero.coverage_interval == pytest.approx((0.0, 1 - 0.025 ** (1 / 20)), rel=1e-9)
 
 
 def _sweep_run(run: RunSpec) -> RunResult:
@@ -365,7 +377,8 @@ def test_report_with_a_noise_sweep_and_fast_has_its_sections_and_figures(tmp_pat
     assert "## Fast method against the targets of issue 6" in text
     assert (
         "| all main runs | 4 | 0.250 / 1.000 | 0.25 | 2.00 / 1.00 | 2.00 / 1.00 | 0.00 / 1.00 | "
-        "0.00 / 1.00 | 4/4 (100 %) | 0 | ok 4 | missed: MAE > paper's; max > paper's; coverage "
+        "0.00 / 1.00 | 4/4 (100 %, 40 to 100 %) | 0 | ok 4 | missed: MAE > paper's; max > "
+        "paper's; coverage "
         "outside 93%-97% |"
     ) in text
     # per noise level: fast error noise x 2 mm, 3 -> 6 mm (no absolute target off the default)

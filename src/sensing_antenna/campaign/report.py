@@ -497,9 +497,13 @@ def _statuses(counts: Mapping[str, int]) -> str:
 
 def _target_row(t: TargetSummary, default_noise: bool) -> list[str]:
     ratio = f"{t.delay_ratio:.2f}" if math.isfinite(t.delay_ratio) else "-"
-    coverage = (
-        f"{t.n_covering}/{t.n_intervals} ({100 * t.coverage:.0f} %)" if t.n_intervals else "-"
-    )
+    coverage = "-"
+    if t.n_intervals:
+        low, high = t.coverage_interval
+        coverage = (
+            f"{t.n_covering}/{t.n_intervals} ({100 * t.coverage:.0f} %, "
+            f"{100 * low:.0f} to {100 * high:.0f} %)"
+        )
     missed = t.missed(default_noise)
     return [
         t.label,
@@ -546,7 +550,9 @@ def _targets_section(
         f"95 % interval in {low:.0%} to {high:.0%} of runs; no run reported ok with an error "
         f"over {_cm(OK_ERROR_LIMIT, 0)} cm. Errors over every run with an estimate (any status), "
         "in mm, against the contact abscissa (the targets) and the nominal x_c; coverage and the "
-        "ok count against the contact abscissa. Computed from the stored runs.",
+        "ok count against the contact abscissa, coverage with its exact 95 % confidence "
+        "interval (Clopper-Pearson: what the run count alone leaves open). Computed from the "
+        "stored runs.",
         "",
         *_table(
             [
