@@ -219,6 +219,12 @@ def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:
     assert offsets[0] == round(config.first_window / evidence.sample_period)
     assert offsets[-1] == round(config.cap / evidence.sample_period)
     assert offsets == sorted(set(offsets))
+    # sure = every other check passed and the interval within the tolerance; a window failing
+    # a check (the early ones: too few periods) is not sure at any tolerance
+    assert all(
+        w.sure == (w.checks_passed and w.posterior.width <= config.tolerance) for w in since_t1
+    )
+    assert not since_t1[0].checks_passed and since_t1[0].note
 
 
 def test_an_opening_contact_moves_the_window_start_to_the_end_of_the_hold() -> None:

@@ -305,6 +305,10 @@ class WindowEstimate:
     posterior : ContactPosterior
     sure : bool
         True when the interval is narrower than the tolerance and the window is long enough.
+    checks_passed : bool
+        True when every check but the interval's width passes (usable frequency, periods in
+        the window, drift, ratio agreement, contact closed, away from the top of the curve):
+        ``sure`` at any tolerance at least the interval's width.
     note : str
         Why the frequency was not used or why it is not sure (empty when sure).
     omega1_drift : float
@@ -328,6 +332,7 @@ class WindowEstimate:
     statics: StaticRatio | None
     posterior: ContactPosterior
     sure: bool
+    checks_passed: bool
     note: str
     omega1_drift: float = math.nan
     early_statics: StaticRatio | None = None
@@ -540,6 +545,7 @@ def evaluate_window(
                 f"omega_1 = {omega1:.2f} rad/s is within {config.peak_margin:g} standard "
                 f"deviations of the top of the sensing curve ({top:.2f} rad/s)"
             )
+    checks_passed = not notes
     if not notes and posterior.width > config.tolerance:
         notes.append(
             f"the 95 % interval is {1000 * posterior.width:.1f} mm wide "
@@ -555,6 +561,7 @@ def evaluate_window(
         statics=statics,
         posterior=posterior,
         sure=not notes,
+        checks_passed=checks_passed,
         note="; ".join(notes),
         omega1_drift=drift,
         early_statics=early,
