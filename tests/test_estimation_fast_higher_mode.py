@@ -14,7 +14,7 @@ import numpy as np
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.fast import FastConfig, scan
+from sensing_antenna.estimation.fast import FastConfig, ScanInputs, scan
 from sensing_antenna.estimation.fusion import sensing_curve
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.pipeline import search_band
@@ -125,6 +125,6 @@ def test_scan_declares_at_the_peak_with_the_second_mode() -> None:
     channels = _two_mode_channels(0.77, 500, rng)
     band = search_band(LINK, EstimatorConfig())
     no_bias = SensorBias(np.zeros(5), np.zeros((5, 5)), 0)
-    result = scan(channels, no_bias, 0, 499, TS, band, LINK, X_RANGE, cfg)
+    result = scan(ScanInputs(channels, no_bias, 0, 499, TS, band, LINK, X_RANGE, cfg))
     assert result.final is not None and result.final.sure
     assert abs(result.final.posterior.x_c - 0.77) <= cfg.tolerance

@@ -21,6 +21,7 @@ from sensing_antenna.estimation.fast import (
     FastConfig,
     FastConfigError,
     FastMethod,
+    ScanInputs,
     evaluate_window,
     scan,
 )
@@ -125,7 +126,7 @@ def test_stop_when_sure_is_earlier_on_easy_cases() -> None:
     delays = {}
     for x in (0.6, 0.3):
         channels = _channels(x, 700, rng, 0.2)
-        result = scan(channels, NO_BIAS, 0, 699, TS, BAND, LINK, X_RANGE, cfg)
+        result = scan(ScanInputs(channels, NO_BIAS, 0, 699, TS, BAND, LINK, X_RANGE, cfg))
         assert result.final is not None and result.final.sure
         post = result.final.posterior
         assert post.width <= cfg.tolerance
@@ -141,7 +142,7 @@ def test_unsure_until_the_cap_near_the_peak() -> None:
     rng = np.random.default_rng(9)
     cfg = FastConfig(cap=0.3)
     channels = _channels(0.77, 400, rng, 0.2)
-    result = scan(channels, NO_BIAS, 0, 399, TS, BAND, LINK, X_RANGE, cfg)
+    result = scan(ScanInputs(channels, NO_BIAS, 0, 399, TS, BAND, LINK, X_RANGE, cfg))
     assert result.reached_cap
     assert result.final is not None and not result.final.sure
 

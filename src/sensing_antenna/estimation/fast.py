@@ -58,6 +58,7 @@ __all__ = [
     "FastConfig",
     "FastConfigError",
     "FastMethod",
+    "ScanInputs",
     "ScanResult",
     "WindowEstimate",
     "curve_table",
@@ -667,6 +668,24 @@ def evaluation_offsets(sample_period: float, config: FastConfig) -> NDArray[np.i
     )
 
 
+class ScanInputs(NamedTuple):
+    """The samples and model a scan reads: :func:`evaluate_window`'s leading arguments, in order.
+
+    ``end_index`` is the last sample available; :func:`evaluations` replaces it by each
+    window's end.
+    """
+
+    channels: FloatArray
+    bias: SensorBias
+    rest_index: int
+    end_index: int
+    sample_period: float
+    band: tuple[float, float]
+    link: Link
+    x_range: tuple[float, float]
+    config: FastConfig
+
+
 @dataclass(frozen=True)
 class ScanResult:
     """Outcome of the growing-window search.
@@ -687,86 +706,40 @@ class ScanResult:
 
 
 def evaluations(
-    channels: FloatArray,
-    bias: SensorBias,
-    rest_index: int,
-    last_available: int,
-    sample_period: float,
-    band: tuple[float, float],
-    link: Link,
-    x_range: tuple[float, float],
-    config: FastConfig,
-    earliest: int = 0,
-    hold_end: int = -1,
+    inputs: ScanInputs, earliest: int = 0, hold_end: int = -1
 ) -> Iterator[WindowEstimate]:
     """Every window ending on the evaluation grid from ``earliest`` to the cap, in order.
 
     The grid is t_1 + :func:`evaluation_offsets`; evaluation starts at the first grid point at or
-    after ``earliest`` and ends at the cap or at ``last_available``, whichever comes first. Each
+    after ``earliest`` and ends at the cap or at ``inputs.end_index``, whichever comes first. Each
     window starts at t_1, or at ``hold_end`` when the contact opened
     (:func:`evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are cached, so
     the drift check's shorter windows are fitted once.
     """
     caches: tuple[FitCache, FitCache] = ({}, {})
-    for offset in evaluation_offsets(sample_period, config):
-        j = rest_index + int(offset)
+    for offset in evaluation_offsets(inputs.sample_period, inputs.config):
+        j = inputs.rest_index + int(offset)
         if j < earliest:
             continue
-        if j > last_available:
+        if j > inputs.end_index:
             return
-        yield evaluate_from_t1_or_hold(
-            channels,
-            bias,
-            rest_index,
-            j,
-            sample_period,
-            band,
-            link,
-            x_range,
-            config,
-            hold_end,
-            caches,
-        )
+        yield evaluate_from_t1_or_hold(*inputs._replace(end_index=j), hold_end, caches)
 
 
-def scan(
-    channels: FloatArray,
-    bias: SensorBias,
-    rest_index: int,
-    last_available: int,
-    sample_period: float,
-    band: tuple[float, float],
-    link: Link,
-    x_range: tuple[float, float],
-    config: FastConfig,
-    earliest: int = 0,
-    hold_end: int = -1,
-) -> ScanResult:
+def scan(inputs: ScanInputs, earliest: int = 0, hold_end: int = -1) -> ScanResult:
     """Evaluate the growing window on the evaluation grid until sure, the cap or the samples' end.
 
     The windows are those of :func:`evaluations`; ``earliest`` is the end of the pipeline's hold,
     before which there is no contact frame.
     """
-    last = rest_index + int(evaluation_offsets(sample_period, config)[-1])
+    last = inputs.rest_index + int(evaluation_offsets(inputs.sample_period, inputs.config)[-1])
     final: WindowEstimate | None = None
     count = 0
-    for final in evaluations(
-        channels,
-        bias,
-        rest_index,
-        last_available,
-        sample_period,
-        band,
-        link,
-        x_range,
-        config,
-        earliest,
-        hold_end,
-    ):
+    for final in evaluations(inputs, earliest, hold_end):
         count += 1
         if final.sure:
             return ScanResult(final, count, False)
-    return ScanResult(final, count, last <= last_available)
+    return ScanResult(final, count, last <= inputs.end_index)
 
 
 @dataclass(frozen=True)
@@ -782,7 +755,7 @@ class FastMethod:
     config: FastConfig = field(default_factory=FastConfig)
     name: str = "fast"
 
-    def _prepare(self, evidence: Evidence) -> _ScanInputs:
+    def _prepare(self, evidence: Evidence) -> ScanInputs:
         """What :func:`evaluate_window` and :func:`scan` share, from the pipeline's evidence."""
         link = evidence.antenna.link
         channels = contact_channels(
@@ -800,7 +773,7 @@ class FastMethod:
             evidence.config.contact_range[0] * link.length,
             evidence.config.contact_range[1] * link.length,
         )
-        return _ScanInputs(
+        return ScanInputs(
             channels,
             bias,
             evidence.rest_index,
@@ -836,27 +809,13 @@ class FastMethod:
         """
         inputs = self._prepare(evidence)
         earliest = inputs.rest_index if from_t1 else evidence.hold_end
-        return tuple(evaluations(*inputs, earliest=earliest, hold_end=evidence.hold_end))
+        return tuple(evaluations(inputs, earliest=earliest, hold_end=evidence.hold_end))
 
     def conclude(self, evidence: Evidence) -> ContactEstimate:
         """Scan the evidence from t_1 and give the first sure estimate (or the capped one)."""
         inputs = self._prepare(evidence)
-        result = scan(*inputs, earliest=evidence.hold_end, hold_end=evidence.hold_end)
+        result = scan(inputs, earliest=evidence.hold_end, hold_end=evidence.hold_end)
         return conclude_fast(evidence, result, inputs.bias, self.config, self.name)
-
-
-class _ScanInputs(NamedTuple):
-    """The leading arguments of :func:`evaluate_window` and :func:`scan`, in their order."""
-
-    channels: FloatArray
-    bias: SensorBias
-    rest_index: int
-    end_index: int
-    sample_period: float
-    band: tuple[float, float]
-    link: Link
-    x_range: tuple[float, float]
-    config: FastConfig
 
 
 def _direction_change(early: StaticRatio, late: StaticRatio) -> tuple[float, float]:
