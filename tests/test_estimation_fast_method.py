@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.fast import (
     FastConfig,
@@ -145,6 +146,34 @@ def test_unsure_until_the_cap_near_the_peak() -> None:
     result = scan(ScanInputs(channels, NO_BIAS, 0, 399, TS, BAND, LINK, X_RANGE, cfg))
     assert result.reached_cap
     assert result.final is not None and not result.final.sure
+
+
+def test_a_higher_mode_of_the_other_branch_stops_a_declaration() -> None:
+    # omega_1 of x_c = 0.70 m (91.04 rad/s) is also omega_1 of 0.854 m. A torque/force ratio
+    # biased to 0.854 m (as on one simulated vertical run at 0.70 m whose ratio read 0.80 m)
+    # puts the posterior on the far branch. The record also rings at contact mode 2 of 0.70 m
+    # (199.2 rad/s; that of 0.854 m is 281.5 rad/s, 29 % away): without the mode check the far
+    # branch is declared, 15 cm off; with it no window on that branch is sure.
+    rng = np.random.default_rng(11)
+    n = 500
+    t = np.arange(n) * TS
+    omega2 = float(natural_frequencies(LINK, 0.70, 2)[1])
+    vibration = 0.2 * np.exp(-0.5 * t) * np.cos(float(CURVE.omega1(0.70)) * t + 0.3)
+    vibration += 0.1 * np.exp(-1.0 * t) * np.cos(omega2 * t + 1.0)
+    r_y = -0.06 * (1.0 + vibration)
+    zeros = np.zeros(n)
+    clean = np.column_stack([r_y, zeros, zeros, zeros, 0.854 * r_y])
+    noise = np.array([6e-3, 6e-3, 3e-5, 3e-5, 3e-5]) * rng.standard_normal((n, 5))
+    inputs = ScanInputs(
+        clean + noise, NO_BIAS, 0, n - 1, TS, BAND, LINK, X_RANGE, FastConfig(cadence=0.02)
+    )
+    unchecked = scan(inputs._replace(config=FastConfig(cadence=0.02, branch_mode_tolerance=1e3)))
+    assert unchecked.final is not None and unchecked.final.sure
+    assert unchecked.final.posterior.x_c == pytest.approx(0.854, abs=0.005)
+    checked = scan(inputs)
+    assert checked.final is not None and not checked.final.sure
+    assert checked.final.branch_contradicted
+    assert "199." in checked.final.note and "x_c = 0.700 m" in checked.final.note
 
 
 def test_window_shorter_than_the_model_is_not_sure() -> None:

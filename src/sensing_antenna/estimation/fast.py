@@ -195,6 +195,16 @@ class FastConfig:
         of benchmarks/eval_fast.py, 30 runs; see docs/fast.md), a stiffer contact less; the
         floor covers that bias at about 1.5 standard deviations. On a real device use the
         scatter of a calibration of the higher modes.
+    branch_mode_tolerance : float
+        Relative distance (dimensionless) within which a fitted higher mode is taken as contact
+        mode 2 or 3 of a candidate x_c. When omega_1 fits candidates on two branches, the window
+        is not declared while a higher mode in its fit lies farther than this from both modes of
+        the candidate on the posterior's branch and at most half as far from another
+        candidate's: the modes say the ratio chose the wrong branch. 0.025: on the simulated
+        device (calibrated T_e) the fitted modes 2 and 3 sat 0.1 to 0.4 % and 0.5 to 2.3 % below
+        their pinned-contact curves; candidates on two branches differ by 13 % or more in
+        mode 2 (0.75 against 0.79 m) and 4 % in mode 3 (0.70 against 0.855 m). Used whether or
+        not ``higher_modes`` is on.
     """
 
     tolerance: float = 0.005
@@ -219,6 +229,7 @@ class FastConfig:
     max_opening: float = 1.0
     higher_modes: bool = False
     higher_mode_floor: float = 0.005
+    branch_mode_tolerance: float = 0.025
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -322,6 +333,8 @@ class WindowEstimate:
     opening : float
         Predicted vibration amplitude of the contact force over the static push at the window
         start (> 1: the contact opens); NaN when not computed.
+    branch_contradicted : bool
+        True when a higher mode of the fit points to another branch than the posterior's.
     """
 
     start_index: int
@@ -339,6 +352,7 @@ class WindowEstimate:
     early_statics: StaticRatio | None = None
     ratio_z: float = math.nan
     opening: float = math.nan
+    branch_contradicted: bool = False
 
 
 #: Cache of window fits within one recording, keyed by the window's last index.
@@ -534,6 +548,11 @@ def evaluate_window(
                 f"the contact opens: the predicted vibration of the contact force is "
                 f"{opening:.2f} times the static push at the window start"
             )
+    contradiction = ""
+    if fit is not None and k is not None:
+        contradiction = _branch_contradiction(fit, k, posterior, table, link, config)
+        if contradiction:
+            notes.append(contradiction)
     if not notes and math.isfinite(omega1) and not math.isfinite(omega_h):
         # Near the top of omega_1(x_c) the inverse is singular: a frequency bias e moves x_c by
         # sqrt(2 e / |omega_1''|) and the Gaussian interval can collapse onto the peak; so no
@@ -568,6 +587,7 @@ def evaluate_window(
         early_statics=early,
         ratio_z=ratio_z,
         opening=opening,
+        branch_contradicted=bool(contradiction),
     )
 
 
@@ -585,6 +605,53 @@ def _opening(fit: DampedSinusoidFit, k: int, push: float, link: Link, x_c: float
     start = fit.start_amplitudes()
     base = math.hypot(float(start[0, k]), float(start[1, k]))
     return abs(_contact_to_base_shear(link, x_c)) * base / push
+
+
+def _branch_contradiction(
+    fit: DampedSinusoidFit,
+    k: int,
+    posterior: ContactPosterior,
+    table: CurveTable,
+    link: Link,
+    config: FastConfig,
+) -> str:
+    """Why a higher mode of ``fit`` says the posterior's branch is wrong ("" if it does not).
+
+    Each candidate x_c whose omega_1 is the fitted fundamental ``fit.omega[k]`` predicts its
+    contact modes 2 and 3. A detected mode above 1.5 omega_1 farther than
+    ``branch_mode_tolerance`` from both modes of the posterior's candidate, and at most half as
+    far from those of a candidate on another branch, contradicts the branch the ratio chose.
+    """
+    omega1 = float(fit.omega[k])
+    candidates = _candidates(link, omega1, posterior)
+    chosen = posterior.branch_of(posterior.x_c)
+    own = [c for c in candidates if posterior.branch_of(c) == chosen]
+    others = [c for c in candidates if posterior.branch_of(c) != chosen]
+    if not own or not others:
+        return ""
+    detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)
+
+    def mismatch(omega: float, x_c: float) -> tuple[float, int]:
+        # Relative distance to the nearer of the candidate's modes 2 and 3, and which one
+        modes = [float(np.interp(x_c, table.grid, table.higher[:, j])) for j in (0, 1)]
+        distances = [abs(omega / m - 1.0) for m in modes]
+        j = int(np.argmin(distances))
+        return distances[j], j + 2
+
+    for m in range(fit.n_modes):
+        omega = float(fit.omega[m])
+        if m == k or omega < 1.5 * omega1 or detection[m] < config.min_detection:
+            continue
+        mine = min(mismatch(omega, c)[0] for c in own)
+        other = min(others, key=lambda c: mismatch(omega, c)[0])
+        theirs, mode = mismatch(omega, other)
+        if mine > config.branch_mode_tolerance and theirs <= 0.5 * mine:
+            return (
+                f"the contact mode at {omega:.1f} rad/s is {100 * theirs:.1f} % from mode "
+                f"{mode} of x_c = {other:.3f} m and {100 * mine:.1f} % from those of the "
+                f"posterior's branch (x_c = {posterior.x_c:.3f} m)"
+            )
+    return ""
 
 
 def evaluate_from_t1_or_hold(
@@ -901,7 +968,10 @@ def _candidates(link: Link, omega1: float, posterior: ContactPosterior) -> tuple
 
 
 def _branch_by_second_mode(
-    evidence: Evidence, posterior: ContactPosterior, candidates: tuple[float, ...]
+    evidence: Evidence,
+    posterior: ContactPosterior,
+    candidates: tuple[float, ...],
+    contradicted: bool = False,
 ) -> tuple[ContactPosterior, dict[str, Any]]:
     """At the cap, let the second contact mode choose between two branches the ratio cannot.
 
@@ -911,9 +981,12 @@ def _branch_by_second_mode(
     record is as long as the paper's spectrum, so the paper's own test applies
     (:func:`~.fusion.second_mode_choice`: a clear spectral peak near one candidate's omega_2 and
     none near the other's). When it is decisive the posterior is conditioned on that branch;
-    otherwise it is unchanged.
+    otherwise it is unchanged. It is asked when the posterior holds both branches, or when the
+    last window's higher mode ``contradicted`` the branch the posterior holds.
     """
-    if len(candidates) != 2 or max(posterior.branch_probability) >= posterior.level:
+    if len(candidates) != 2 or (
+        max(posterior.branch_probability) >= posterior.level and not contradicted
+    ):
         return posterior, {}
     measurement = evidence.measure_frequency()
     choice, notes = second_mode_choice(evidence, measurement.component, candidates)
@@ -950,7 +1023,9 @@ def conclude_fast(
     if result.reached_cap and not final.sure:
         # Only the samples up to this method's own t_e (the cap), online and offline alike
         until_cap = dataclasses.replace(evidence, end_index=final.end_index)
-        post, second_mode = _branch_by_second_mode(until_cap, post, candidates)
+        post, second_mode = _branch_by_second_mode(
+            until_cap, post, candidates, final.branch_contradicted
+        )
         diag.update(second_mode)
     statics = final.statics
     push = statics.perpendicular_force if statics is not None else math.nan
