@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +24,8 @@ from sensing_antenna.estimation.fast import (
     FastConfigError,
     FastMethod,
     ScanInputs,
+    _branch_contradiction,
+    curve_table,
     evaluate_window,
     scan,
 )
@@ -174,6 +177,49 @@ def test_a_higher_mode_of_the_other_branch_stops_a_declaration() -> None:
     assert checked.final is not None and not checked.final.sure
     assert checked.final.branch_contradicted
     assert "199." in checked.final.note and "x_c = 0.700 m" in checked.final.note
+
+
+@dataclass(frozen=True)
+class _FittedModes:
+    """The part of a DampedSinusoidFit the branch check reads: frequencies, all detected."""
+
+    omega: np.ndarray
+    n_samples: int = 400
+
+    @property
+    def n_modes(self) -> int:
+        return int(self.omega.size)
+
+    def snr(self) -> np.ndarray:
+        return np.full(self.omega.size, 10.0)  # detection 10 sqrt(200) = 141, far above 10
+
+
+def _contradiction(x_c: float, ratio: float, higher: float) -> str:
+    """The branch check on omega_1(x_c), a ratio of ``ratio`` +- 1 cm and one higher mode."""
+    omega1 = float(CURVE.omega1(x_c))
+    table = curve_table(LINK, X_RANGE[0], X_RANGE[1], FastConfig().grid_step)
+    posterior = contact_posterior(
+        table.omega1, table.grid, table.edges, omega1, 0.05, ratio, 0.01, 0.05, 0.09, 0.0, 0.0
+    )
+    fit = _FittedModes(np.array([omega1, higher]))
+    return _branch_contradiction(fit, 0, posterior, table, LINK, FastConfig())  # type: ignore[arg-type]
+
+
+def test_the_branch_check_speaks_only_for_a_mode_of_the_other_candidate() -> None:
+    # omega_1(0.70 m) = omega_1(0.854 m) = 91.04 rad/s; contact mode 2 is 199.2 rad/s at 0.70 m
+    # and 281.5 rad/s at 0.854 m (beam.natural_frequencies). The ratio puts the posterior on
+    # the far branch.
+    near, far = natural_frequencies(LINK, np.array([0.70, 0.854]), 2)[:, 1]
+    assert "x_c = 0.700 m" in _contradiction(0.70, 0.854, float(near))
+    assert _contradiction(0.70, 0.854, float(far)) == ""
+    # 170 rad/s is 15 % from 0.70 m's mode 2 and 40 % from 0.854 m's: it is no contact mode of
+    # either candidate, so it says nothing (it is not a multiple of omega_1 either)
+    assert _contradiction(0.70, 0.854, 170.0) == ""
+    # At 0.71 m 3 omega_1 = 280.44 rad/s sits on mode 2 of the other candidate (0.839 m,
+    # 280.35 rad/s): it may be a harmonic of a clipping contact, so it is skipped (without
+    # that rule it would stop a declaration on the right branch); there the check is blind
+    omega1 = float(CURVE.omega1(0.71))
+    assert _contradiction(0.71, 0.71, 3.0 * omega1) == ""
 
 
 def test_window_shorter_than_the_model_is_not_sure() -> None:

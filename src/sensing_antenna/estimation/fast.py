@@ -198,13 +198,14 @@ class FastConfig:
     branch_mode_tolerance : float
         Relative distance (dimensionless) within which a fitted higher mode is taken as contact
         mode 2 or 3 of a candidate x_c. When omega_1 fits candidates on two branches, the window
-        is not declared while a higher mode in its fit lies farther than this from both modes of
-        the candidate on the posterior's branch and at most half as far from another
-        candidate's: the modes say the ratio chose the wrong branch. 0.025: on the simulated
-        device (calibrated T_e) the fitted modes 2 and 3 sat 0.1 to 0.4 % and 0.5 to 2.3 % below
-        their pinned-contact curves; candidates on two branches differ by 13 % or more in
-        mode 2 (0.75 against 0.79 m) and 4 % in mode 3 (0.70 against 0.855 m). Used whether or
-        not ``higher_modes`` is on.
+        is not declared while a higher mode in its fit lies within this of a mode of another
+        branch's candidate and farther than this (and than twice that distance) from both modes
+        of the posterior's branch's candidate: the modes say the ratio chose the wrong branch.
+        0.025: on the simulated device (calibrated T_e) the fitted modes 2 and 3 sat 0.1 to
+        0.4 % and 0.5 to 2.3 % below their pinned-contact curves. How far apart the candidates'
+        modes are depends on the pair (paper link): mode 2 by 14 to 41 % from 0.65 / 0.935 m to
+        0.75 / 0.787 m and by 6 % at 0.76 / 0.776 m; mode 3 by 0 to 7 %, nothing where the two
+        branches' curves cross (0.66 / 0.92 m). Used whether or not ``higher_modes`` is on.
     """
 
     tolerance: float = 0.005
@@ -316,7 +317,7 @@ class WindowEstimate:
         The static torque/force ratio.
     posterior : ContactPosterior
     sure : bool
-        True when the interval is narrower than the tolerance and the window is long enough.
+        ``checks_passed`` and the interval no wider than the tolerance.
     checks_passed : bool
         True when every check but the interval's width passes (usable frequency, periods in
         the window, drift, ratio agreement, contact closed, away from the top of the curve):
@@ -618,11 +619,15 @@ def _branch_contradiction(
     """Why a higher mode of ``fit`` says the posterior's branch is wrong ("" if it does not).
 
     Each candidate x_c whose omega_1 is the fitted fundamental ``fit.omega[k]`` predicts its
-    contact modes 2 and 3. A detected mode above 1.5 omega_1 farther than
-    ``branch_mode_tolerance`` from both modes of the posterior's candidate, and at most half as
-    far from those of a candidate on another branch, contradicts the branch the ratio chose.
+    contact modes 2 and 3. A detected mode above 1.5 omega_1 contradicts the branch the ratio
+    chose when it lies within ``branch_mode_tolerance`` of a mode of a candidate on another
+    branch, farther than that from both modes of the posterior's branch's candidate, and at
+    least twice as far from those as from the other's. A mode within the tolerance of a
+    multiple of omega_1 is skipped: a contact that bounces or clips makes harmonics, so it may
+    be one. No check without a candidate on the posterior's branch and one on another.
     """
     omega1 = float(fit.omega[k])
+    tolerance = config.branch_mode_tolerance
     candidates = _candidates(link, omega1, posterior)
     chosen = posterior.branch_of(posterior.x_c)
     own = [c for c in candidates if posterior.branch_of(c) == chosen]
@@ -640,16 +645,22 @@ def _branch_contradiction(
 
     for m in range(fit.n_modes):
         omega = float(fit.omega[m])
-        if m == k or omega < 1.5 * omega1 or detection[m] < config.min_detection:
+        harmonic = round(omega / omega1) * omega1
+        if (
+            m == k
+            or omega < 1.5 * omega1
+            or not detection[m] >= config.min_detection  # NaN: not detected
+            or abs(omega - harmonic) <= tolerance * omega
+        ):
             continue
-        mine = min(mismatch(omega, c)[0] for c in own)
-        other = min(others, key=lambda c: mismatch(omega, c)[0])
-        theirs, mode = mismatch(omega, other)
-        if mine > config.branch_mode_tolerance and theirs <= 0.5 * mine:
+        mine, candidate = min((mismatch(omega, c)[0], c) for c in own)
+        theirs, other = min((mismatch(omega, c)[0], c) for c in others)
+        if mine > tolerance and theirs <= min(tolerance, 0.5 * mine):
+            mode = mismatch(omega, other)[1]
             return (
                 f"the contact mode at {omega:.1f} rad/s is {100 * theirs:.1f} % from mode "
-                f"{mode} of x_c = {other:.3f} m and {100 * mine:.1f} % from those of the "
-                f"posterior's branch (x_c = {posterior.x_c:.3f} m)"
+                f"{mode} of x_c = {other:.3f} m and {100 * mine:.1f} % from modes 2 and 3 of "
+                f"x_c = {candidate:.3f} m, the candidate on the posterior's branch"
             )
     return ""
 
