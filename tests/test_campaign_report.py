@@ -377,7 +377,7 @@ def test_report_with_a_noise_sweep_and_fast_has_its_sections_and_figures(tmp_pat
     assert "## Fast method against the targets of issue 6" in text
     assert (
         "| all main runs | 4 | 0.250 / 1.000 | 0.25 | 2.00 / 1.00 | 2.00 / 1.00 | 0.00 / 1.00 | "
-        "0.00 / 1.00 | 4/4 (100 %, 40 to 100 %) | 0 | ok 4 | missed: MAE > paper's; max > "
+        "0.00 / 1.00 | 4/4 (100 %, 39.8 to 100.0 %) | 0 | ok 4 | missed: MAE > paper's; max > "
         "paper's; coverage "
         "outside 93%-97% |"
     ) in text

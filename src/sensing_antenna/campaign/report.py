@@ -502,7 +502,7 @@ def _target_row(t: TargetSummary, default_noise: bool) -> list[str]:
         low, high = t.coverage_interval
         coverage = (
             f"{t.n_covering}/{t.n_intervals} ({100 * t.coverage:.0f} %, "
-            f"{100 * low:.0f} to {100 * high:.0f} %)"
+            f"{100 * low:.1f} to {100 * high:.1f} %)"
         )
     missed = t.missed(default_noise)
     return [
