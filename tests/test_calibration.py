@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.antenna import load_antenna, paper_antenna, save_antenna
 from sensing_antenna.calibration.frequency import (
     CalibrationError,
     calibrate_t_e,
@@ -155,6 +155,42 @@ def test_calibrate_t_e_with_the_beam_model_recovers_t_e() -> None:
     assert np.nanmax(np.abs(result.residuals)) < 1e-4
     calibrated = result.apply(paper_antenna())
     assert calibrated.link.t_param == result.t_e
+
+
+def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
+    tmp_path: Path,
+) -> None:
+    # Frequencies alternately 0.2 % above and below the model: a departure T_e cannot absorb
+    # (T_e moves by the pattern's weighted mean, < 0.02 %), so the residuals stay +-0.2 %
+    link = paper_antenna().link
+    k = synthetic_k(PAPER_POINTS)
+    signs = np.where(np.arange(k.size) % 2 == 0, 1.0, -1.0)
+    omega = k / PAPER_T_E * (1.0 + 0.002 * signs)
+    assert calibrate_t_e(PAPER_POINTS, omega, link).relative_scatter == pytest.approx(
+        0.002, rel=0.1
+    )
+    # One wrong peak at half the frequency: left out of the scatter (not 50 %), but it pulls the
+    # robust T_e by offset (0.4 %), and every residual of the calibrated model carries that
+    omega[9] *= 0.5
+    result = calibrate_t_e(PAPER_POINTS, omega, link)
+    offset = result.t_e / PAPER_T_E - 1.0
+    assert 0.001 < abs(offset) < 0.01
+    # measured / fitted - 1 = (1 + pattern) T_e / T_e,true - 1 at the 14 other points, rms with
+    # 13 degrees of freedom
+    kept = np.delete((1.0 + 0.002 * signs) * (1.0 + offset) - 1.0, 9)
+    expected = math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
+    assert result.relative_scatter == pytest.approx(expected, rel=1e-6)
+    calibrated = result.apply(paper_antenna())
+    assert calibrated.link.calibration_scatter == result.relative_scatter
+    # written and read back with the antenna, as the campaign's antenna.toml is
+    save_antenna(calibrated, tmp_path / "calibrated.toml")
+    assert load_antenna(tmp_path / "calibrated.toml").link == calibrated.link
+    # exact frequencies: no model error; two points: too few to say (none is set)
+    exact = calibrate_t_e(PAPER_POINTS, k / PAPER_T_E, link)
+    assert exact.relative_scatter < 1e-6
+    two = calibrate_t_e(PAPER_POINTS[:2], k[:2] / PAPER_T_E, link)
+    assert math.isnan(two.relative_scatter)
+    assert two.apply(paper_antenna()).link.calibration_scatter is None
 
 
 def test_figure_10_is_written(tmp_path: Path) -> None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +27,7 @@ from sensing_antenna.estimation.fast import (
     _branch_contradiction,
     curve_table,
     evaluate_window,
+    model_floor,
     scan,
 )
 from sensing_antenna.estimation.fusion import sensing_curve
@@ -220,6 +221,22 @@ def test_the_branch_check_speaks_only_for_a_mode_of_the_other_candidate() -> Non
     # that rule it would stop a declaration on the right branch); there the check is blind
     omega1 = float(CURVE.omega1(0.71))
     assert _contradiction(0.71, 0.71, 3.0 * omega1) == ""
+
+
+def test_a_calibration_scatter_above_the_floor_widens_the_interval() -> None:
+    # The model floor on omega_1 is the config's 0.1 % or the link's calibration scatter,
+    # whichever is larger; at 0.6 m a 0.5 % floor (0.32 rad/s) widens the 95 % interval
+    cfg = FastConfig()
+    scattered = replace(LINK, calibration_scatter=0.005)
+    assert model_floor(LINK, cfg) == cfg.frequency_floor
+    assert model_floor(replace(LINK, calibration_scatter=0.0005), cfg) == cfg.frequency_floor
+    assert model_floor(scattered, cfg) == 0.005
+    channels = _channels(0.6, 500, np.random.default_rng(12), 0.2)
+    widths = [
+        evaluate_window(channels, NO_BIAS, 0, 499, TS, BAND, link, X_RANGE, cfg).posterior.width
+        for link in (LINK, scattered)
+    ]
+    assert widths[1] > 1.5 * widths[0]
 
 
 def test_window_shorter_than_the_model_is_not_sure() -> None:

@@ -78,6 +78,10 @@ class Link:
         Second moment of area I (m^4); computed as pi r^4 / 4 when None.
     calibrated_t : float or None
         Calibrated T_e (s / m^2) of Section 5.1; replaces the theoretical T where given.
+    calibration_scatter : float or None
+        Relative error of omega_1(x_c) with that T_e, from the calibration's residuals
+        (dimensionless, e.g. 0.001 for 0.1 %); the fast method's model floor on omega_1 is at
+        least this. None: not measured.
     """
 
     length: float
@@ -87,6 +91,7 @@ class Link:
     tip_mass: float = 0.0
     second_moment: float | None = None
     calibrated_t: float | None = None
+    calibration_scatter: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("length", "radius", "youngs_modulus", "linear_density"):
@@ -96,6 +101,8 @@ class Link:
             _require_positive("link", "second_moment", self.second_moment)
         if self.calibrated_t is not None:
             _require_positive("link", "calibrated_t", self.calibrated_t)
+        if self.calibration_scatter is not None:
+            _require_non_negative("link", "calibration_scatter", self.calibration_scatter)
 
     @property
     def area_moment(self) -> float:
@@ -242,9 +249,9 @@ class Antenna:
         w = self.link.mass * STANDARD_GRAVITY
         return (0.0, 0.5 * w * self.link.length * math.cos(theta2), 0.0)
 
-    def with_calibrated_t(self, t_e: float) -> Antenna:
-        """A copy whose frequency model uses the calibrated T_e."""
-        return replace(self, link=replace(self.link, calibrated_t=t_e))
+    def with_calibrated_t(self, t_e: float, scatter: float | None = None) -> Antenna:
+        """A copy whose frequency model uses the calibrated T_e (and its relative scatter)."""
+        return replace(self, link=replace(self.link, calibrated_t=t_e, calibration_scatter=scatter))
 
 
 _SECTIONS: dict[str, type] = {

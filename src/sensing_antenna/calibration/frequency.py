@@ -33,6 +33,8 @@ from sensing_antenna.errors import SensingAntennaError
 __all__ = [
     "CALIBRATION_BAND",
     "LOSSES",
+    "OUTLIER_SCALE_FLOOR",
+    "OUTLIER_SPREADS",
     "CalibrationError",
     "FrequencyCalibration",
     "calibrate_from_recordings",
@@ -57,6 +59,13 @@ _RELATIVE_SCALE_FLOOR = 1e-6
 
 #: 1.4826 MAD estimates the standard deviation of Gaussian residuals.
 _MAD_TO_SIGMA = 1.4826
+
+#: A calibration point whose relative residual is more than this many robust standard deviations
+#: from the median is a wrong peak, not model error (:attr:`FrequencyCalibration.relative_scatter`).
+OUTLIER_SPREADS = 5.0
+#: Least robust standard deviation of the relative residuals (dimensionless): points within
+#: 5 x 0.1 % of the median are never outliers, however close the others lie.
+OUTLIER_SCALE_FLOOR = 1e-3
 
 
 class CalibrationError(SensingAntennaError, ValueError):
@@ -122,13 +131,39 @@ class FrequencyCalibration:
         return float(np.sqrt(np.mean(r**2))) if r.size else math.nan
 
     @property
+    def relative_scatter(self) -> float:
+        """Relative error of the calibrated model omega_1(x_c), dimensionless; NaN if unknown.
+
+        The root-mean-square relative residual (measured / fitted - 1) over the points used,
+        with n - 1 degrees of freedom (T_e is fitted). It measures how far the device departs
+        from the one-parameter model along the link (a compliant contact, a base that is not a
+        clamp), which T_e cannot absorb. Points more than :data:`OUTLIER_SPREADS` robust
+        standard deviations (1.4826 MAD, at least :data:`OUTLIER_SCALE_FLOOR`) from the median
+        are left out as wrong peaks, as the robust fit leaves them; NaN with fewer than 3 left.
+        """
+        relative = (self.omega1_measured / self.omega1_fitted - 1.0)[self.used]
+        relative = relative[np.isfinite(relative)]
+        if relative.size < 3:
+            return math.nan
+        centre = float(np.median(relative))
+        spread = max(
+            _MAD_TO_SIGMA * float(np.median(np.abs(relative - centre))), OUTLIER_SCALE_FLOOR
+        )
+        inliers = relative[np.abs(relative - centre) <= OUTLIER_SPREADS * spread]
+        if inliers.size < 3:
+            return math.nan
+        return math.sqrt(float(np.sum(inliers**2)) / (inliers.size - 1))
+
+    @property
     def relative_difference(self) -> float:
         """(T_e - T) / T, dimensionless (the paper reports 7 %)."""
         return (self.t_e - self.t_theoretical) / self.t_theoretical
 
     def apply(self, antenna: Antenna) -> Antenna:
-        """The antenna with this T_e as its calibrated T."""
-        return antenna.with_calibrated_t(self.t_e)
+        """The antenna with this T_e as its calibrated T and :attr:`relative_scatter` as its
+        calibration scatter (none when unknown)."""
+        scatter = self.relative_scatter
+        return antenna.with_calibrated_t(self.t_e, scatter if math.isfinite(scatter) else None)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready summary (SI units); NaN (no measurement) is stored as None."""
@@ -137,6 +172,7 @@ class FrequencyCalibration:
             "t_e_std_error": _json_float(self.t_e_std_error),
             "t_theoretical": self.t_theoretical,
             "relative_difference": self.relative_difference,
+            "relative_scatter": _json_float(self.relative_scatter),
             "rms_residual": _json_float(self.rms_residual),
             "loss": self.loss,
             "points": [

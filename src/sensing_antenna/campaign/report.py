@@ -247,7 +247,7 @@ def _differences(device: Antenna, model: Antenna) -> list[str]:
     for section in ("link", "azimuth_motor", "elevation_motor"):
         a, b = getattr(device, section), getattr(model, section)
         for f in fields(a):
-            if f.name == "calibrated_t":
+            if f.name in ("calibrated_t", "calibration_scatter"):
                 continue
             x, y = getattr(a, f.name), getattr(b, f.name)
             if x != y:
@@ -279,6 +279,19 @@ def _antenna_lines(model: Antenna, device: Antenna) -> list[str]:
         ),
     ]
     return lines
+
+
+def _scatter_lines(calibration: FrequencyCalibration) -> list[str]:
+    scatter = calibration.relative_scatter
+    if not math.isfinite(scatter):
+        return []
+    return [
+        f"The measured omega_1 scatter by {100 * scatter:.3f} % (rms, relative) about the "
+        "calibrated model: the departure along the link that one T_e cannot absorb. The model "
+        "carries it as `calibration_scatter`, and the fast method's model floor on omega_1 is at "
+        "least this.",
+        "",
+    ]
 
 
 def _plain_statement(
@@ -373,6 +386,7 @@ def _calibration_section(
         f"Check available on the simulator only: the device's true T is {t_device:.4f} s/m^2; "
         f"T_e is {100 * (calibration.t_e - t_device) / t_device:+.2f} % from it.",
         "",
+        *_scatter_lines(calibration),
     ]
     if calibration.notes:
         lines += ["Points left out of the fit:", ""]

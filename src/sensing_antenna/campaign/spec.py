@@ -107,7 +107,8 @@ NOISE_SWEEP_STREAM = 3
 SCENARIO_NOISE_SCALE = 1.0
 
 #: Antenna sections a ``[device]`` section may override, with the fields allowed in each. The
-#: link's ``calibrated_t`` is a model parameter, not hardware, so a device cannot set it.
+#: link's ``calibrated_t`` and ``calibration_scatter`` are model parameters, not hardware, so a
+#: device cannot set them.
 DEVICE_SECTIONS: dict[str, tuple[str, ...]] = {
     "link": ("length", "radius", "youngs_modulus", "linear_density", "tip_mass", "second_moment"),
     "azimuth_motor": (
@@ -228,7 +229,7 @@ class DeviceSpec:
                 if key not in allowed:
                     hint = (
                         " (T_e is found by the calibration step, not set on the device)"
-                        if key == "calibrated_t"
+                        if key in ("calibrated_t", "calibration_scatter")
                         else f"; known: {', '.join(allowed)}"
                     )
                     raise CampaignSpecError(f"device.{section}.{key}", f"unknown field{hint}")
