@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -55,6 +56,13 @@ def _run(args: argparse.Namespace) -> int:
         f"{100.0 * calibration.relative_difference:+.2f} %), "
         f"rms residual {calibration.rms_residual:.3g} rad/s over {int(calibration.used.sum())} "
         "points"
+    )
+    scatter = calibration.relative_scatter
+    print(
+        f"model scatter {100.0 * scatter:.3f} % (rms relative residual; written as "
+        "link.calibration_scatter)"
+        if math.isfinite(scatter)
+        else "model scatter: not measured (fewer than 3 points)"
     )
     for i, x_c in enumerate(calibration.contact_points):
         print(
