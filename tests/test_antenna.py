@@ -90,6 +90,8 @@ def test_toml_override_with_base(tmp_path: Path) -> None:
         ("[link]\nyoungs_modulus = true\n", "link.youngs_modulus"),
         ("[link]\ntip_mass = -0.1\n", "link.tip_mass"),
         ("[link]\ncalibrated_t = nan\n", "link.calibrated_t"),
+        ("[link]\ncalibration_scatter = -0.001\n", "link.calibration_scatter"),
+        ("[link]\ncalibration_scatter = nan\n", "link.calibration_scatter"),
         ("[link]\ncolour = 3.0\n", "link.colour"),
         ("[motor]\ninertia = 1.0\n", "motor"),
         ("[azimuth_motor]\ninertia = -1.0\n", "azimuth_motor.inertia"),

@@ -180,6 +180,12 @@ def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     kept = np.delete((1.0 + 0.002 * signs) * (1.0 + offset) - 1.0, 9)
     expected = math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
     assert result.relative_scatter == pytest.approx(expected, rel=1e-6)
+    assert result.wrong_peaks == 1
+    # A departure of about 1 % on three points near the tip (a soft contact) is model error,
+    # not wrong peaks: it stays in the scatter
+    tip = k / PAPER_T_E * np.where(PAPER_POINTS >= 0.9, 0.99, 1.0)
+    soft = calibrate_t_e(PAPER_POINTS, tip, link)
+    assert soft.wrong_peaks == 0 and soft.relative_scatter > 0.004
     calibrated = result.apply(paper_antenna())
     assert calibrated.link.calibration_scatter == result.relative_scatter
     # written and read back with the antenna, as the campaign's antenna.toml is

@@ -130,6 +130,7 @@ def test_estimators_get_the_model_with_t_e_and_the_simulator_the_device(calibrat
     device = load_antenna(calibrated / DEVICE_FILE)
     assert model is not None
     assert model.link.calibrated_t == stored[1].t_e
+    assert model.link.calibration_scatter == pytest.approx(stored[1].relative_scatter)
     assert model.link.youngs_modulus == MODEL_E  # the estimators never see the device's E
     assert device.link.youngs_modulus == DEVICE_E
     assert device.link.calibrated_t is None

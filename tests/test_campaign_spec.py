@@ -202,6 +202,11 @@ def test_device_and_calibration_change_the_fingerprints(tmp_path: Path) -> None:
     [
         ("link.youngs_modulus = 130e9", "link.colour = 1.0", "device.link.colour"),
         ("link.youngs_modulus = 130e9", "link.calibrated_t = 0.2", "device.link.calibrated_t"),
+        (
+            "link.youngs_modulus = 130e9",
+            "link.calibration_scatter = 0.001",
+            "device.link.calibration_scatter",
+        ),
         ("link.youngs_modulus = 130e9", 'link.youngs_modulus = "stiff"', "device.link"),
         ("link.youngs_modulus = 130e9", "link.youngs_modulus = nan", "device.link"),
         ("link.youngs_modulus = 130e9", "wheels.count = 4.0", "device.wheels"),

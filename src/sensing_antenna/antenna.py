@@ -250,7 +250,11 @@ class Antenna:
         return (0.0, 0.5 * w * self.link.length * math.cos(theta2), 0.0)
 
     def with_calibrated_t(self, t_e: float, scatter: float | None = None) -> Antenna:
-        """A copy whose frequency model uses the calibrated T_e (and its relative scatter)."""
+        """A copy whose frequency model uses the calibrated T_e and its relative scatter.
+
+        A new T_e replaces the whole calibration: without ``scatter`` the copy has none (the
+        old one described the old T_e).
+        """
         return replace(self, link=replace(self.link, calibrated_t=t_e, calibration_scatter=scatter))
 
 

@@ -33,8 +33,7 @@ from sensing_antenna.errors import SensingAntennaError
 __all__ = [
     "CALIBRATION_BAND",
     "LOSSES",
-    "OUTLIER_SCALE_FLOOR",
-    "OUTLIER_SPREADS",
+    "WRONG_PEAK",
     "CalibrationError",
     "FrequencyCalibration",
     "calibrate_from_recordings",
@@ -60,12 +59,12 @@ _RELATIVE_SCALE_FLOOR = 1e-6
 #: 1.4826 MAD estimates the standard deviation of Gaussian residuals.
 _MAD_TO_SIGMA = 1.4826
 
-#: A calibration point whose relative residual is more than this many robust standard deviations
-#: from the median is a wrong peak, not model error (:attr:`FrequencyCalibration.relative_scatter`).
-OUTLIER_SPREADS = 5.0
-#: Least robust standard deviation of the relative residuals (dimensionless): points within
-#: 5 x 0.1 % of the median are never outliers, however close the others lie.
-OUTLIER_SCALE_FLOOR = 1e-3
+#: A calibration point whose relative residual is farther than this from the median is a wrong
+#: spectral peak, not model error (:attr:`FrequencyCalibration.relative_scatter`). 5 %: wrong
+#: peaks are another mode or a harmonic (the nearest, 2 omega_1 or mode 2, is 100 % or more away),
+#: while a compliant contact or the contact's offset from the given point moved the simulated
+#: device's omega_1 by at most 1 %.
+WRONG_PEAK = 0.05
 
 
 class CalibrationError(SensingAntennaError, ValueError):
@@ -137,22 +136,30 @@ class FrequencyCalibration:
         The root-mean-square relative residual (measured / fitted - 1) over the points used,
         with n - 1 degrees of freedom (T_e is fitted). It measures how far the device departs
         from the one-parameter model along the link (a compliant contact, a base that is not a
-        clamp), which T_e cannot absorb. Points more than :data:`OUTLIER_SPREADS` robust
-        standard deviations (1.4826 MAD, at least :data:`OUTLIER_SCALE_FLOOR`) from the median
-        are left out as wrong peaks, as the robust fit leaves them; NaN with fewer than 3 left.
+        clamp, contacts away from the given points), which T_e cannot absorb. A point more than
+        :data:`WRONG_PEAK` from the median is a wrong spectral peak, not model error, and is
+        left out (:attr:`wrong_peaks`); NaN with fewer than 3 points left.
         """
+        kept = self._relative_residuals()
+        kept = kept[~self._wrong_peak_mask(kept)]
+        if kept.size < 3:
+            return math.nan
+        return math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
+
+    @property
+    def wrong_peaks(self) -> int:
+        """Points used by the fit but left out of :attr:`relative_scatter` as wrong peaks."""
+        return int(self._wrong_peak_mask(self._relative_residuals()).sum())
+
+    def _relative_residuals(self) -> NDArray[np.float64]:
         relative = (self.omega1_measured / self.omega1_fitted - 1.0)[self.used]
-        relative = relative[np.isfinite(relative)]
-        if relative.size < 3:
-            return math.nan
-        centre = float(np.median(relative))
-        spread = max(
-            _MAD_TO_SIGMA * float(np.median(np.abs(relative - centre))), OUTLIER_SCALE_FLOOR
-        )
-        inliers = relative[np.abs(relative - centre) <= OUTLIER_SPREADS * spread]
-        if inliers.size < 3:
-            return math.nan
-        return math.sqrt(float(np.sum(inliers**2)) / (inliers.size - 1))
+        return np.asarray(relative[np.isfinite(relative)], dtype=float)
+
+    @staticmethod
+    def _wrong_peak_mask(relative: NDArray[np.float64]) -> NDArray[np.bool_]:
+        if relative.size == 0:
+            return np.zeros(0, dtype=bool)
+        return np.asarray(np.abs(relative - np.median(relative)) > WRONG_PEAK, dtype=bool)
 
     @property
     def relative_difference(self) -> float:
@@ -173,6 +180,7 @@ class FrequencyCalibration:
             "t_theoretical": self.t_theoretical,
             "relative_difference": self.relative_difference,
             "relative_scatter": _json_float(self.relative_scatter),
+            "wrong_peaks": self.wrong_peaks,
             "rms_residual": _json_float(self.rms_residual),
             "loss": self.loss,
             "points": [

@@ -281,17 +281,28 @@ def _antenna_lines(model: Antenna, device: Antenna) -> list[str]:
     return lines
 
 
-def _scatter_lines(calibration: FrequencyCalibration) -> list[str]:
+def _scatter_lines(calibration: FrequencyCalibration, applied: float | None) -> list[str]:
     scatter = calibration.relative_scatter
     if not math.isfinite(scatter):
         return []
-    return [
+    dropped = calibration.wrong_peaks
+    text = (
         f"The measured omega_1 scatter by {100 * scatter:.3f} % (rms, relative) about the "
-        "calibrated model: the departure along the link that one T_e cannot absorb. The model "
-        "carries it as `calibration_scatter`, and the fast method's model floor on omega_1 is at "
-        "least this.",
-        "",
-    ]
+        "calibrated model: the departure along the link that one T_e cannot absorb"
+        + (f" ({dropped} wrong peak(s) left out)" if dropped else "")
+        + ". "
+    )
+    if applied is None:
+        text += (
+            "The model the runs used does not carry it (prepared before it was measured), so "
+            "the fast method's floor on omega_1 was its default."
+        )
+    else:
+        text += (
+            f"The model carries it as `calibration_scatter` ({100 * applied:.3f} %), and the "
+            "fast method's model floor on omega_1 is at least this."
+        )
+    return [text, ""]
 
 
 def _plain_statement(
@@ -329,6 +340,7 @@ def _plain_statement(
 def _calibration_section(
     calibration: FrequencyCalibration | None,
     spec: CampaignSpec,
+    model: Antenna,
     device: Antenna,
     figure: Path | None,
     out_dir: Path,
@@ -386,7 +398,7 @@ def _calibration_section(
         f"Check available on the simulator only: the device's true T is {t_device:.4f} s/m^2; "
         f"T_e is {100 * (calibration.t_e - t_device) / t_device:+.2f} % from it.",
         "",
-        *_scatter_lines(calibration),
+        *_scatter_lines(calibration, model.link.calibration_scatter),
     ]
     if calibration.notes:
         lines += ["Points left out of the fit:", ""]
@@ -787,7 +799,7 @@ def render_report(
         "comparison shows whether the method behaves as reported, not a reproduction of the "
         "device.",
         "",
-        *_calibration_section(calibration, spec, device, calibration_figure, out_dir),
+        *_calibration_section(calibration, spec, antenna, device, calibration_figure, out_dir),
         *_summary_section(spec, summaries, antenna.link.length),
         *_status_section(spec, summaries),
         *_truth_section(rows, summaries),

@@ -228,7 +228,7 @@ class DeviceSpec:
             for key, value in values.items():
                 if key not in allowed:
                     hint = (
-                        " (T_e is found by the calibration step, not set on the device)"
+                        " (a model value found by the calibration step, not set on the device)"
                         if key in ("calibrated_t", "calibration_scatter")
                         else f"; known: {', '.join(allowed)}"
                     )

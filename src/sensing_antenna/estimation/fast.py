@@ -596,13 +596,13 @@ def evaluate_window(
     )
 
 
-@functools.lru_cache(maxsize=4096)
 def model_floor(link: Link, config: FastConfig) -> float:
     """Relative model error of omega_1 (dimensionless): the config's floor, or the link's
     calibration scatter when that is larger."""
     return max(config.frequency_floor, link.calibration_scatter or 0.0)
 
 
+@functools.lru_cache(maxsize=4096)
 def _contact_to_base_shear(link: Link, x_c: float) -> float:
     return float(contact_to_base_shear(link, x_c))
 
