@@ -180,6 +180,36 @@ def test_a_higher_mode_of_the_other_branch_stops_a_declaration() -> None:
     assert "199." in checked.final.note and "x_c = 0.700 m" in checked.final.note
 
 
+def test_a_ratio_on_the_wrong_branch_is_caught_and_the_second_mode_chooses_at_the_cap() -> None:
+    # The calibrated-device run that was declared ok 15.7 cm off (benchmarks/fast_bound.py
+    # --campaign paper-2021, vertical, 0.70 m, seed 400), rebuilt from the campaign's identified
+    # observer and calibration (rounded): the sensor-bias estimate from the rest is 3 standard
+    # errors off in R_z, the ratio reads 0.80 m, the posterior leans 0.98 to 0.855 m. The fit's
+    # mode 3 (532 rad/s) is that of 0.70 m, 4 % from that of 0.855 m.
+    from sensing_antenna.antenna import FreeMotionObserver
+    from sensing_antenna.estimation.pipeline import estimate
+    from sensing_antenna.estimation.result import Status
+    from sensing_antenna.simulator import Scenario, simulate
+
+    base = paper_antenna()
+    observer = FreeMotionObserver(
+        gain=0.435, natural_frequency=17.26, damping=0.182, contact_threshold=1.72e-4
+    )
+    device = replace(base, observer=observer, link=replace(base.link, youngs_modulus=132.65e9))
+    model = replace(base, observer=observer).with_calibrated_t(0.21252, 0.00118)
+    scenario = Scenario(case="vertical", contact_point=0.7, seed=400, damping_ratio=0.005)
+    recording = simulate(device, scenario)
+    truth = float(recording.metadata["true_xc"])
+    blind = recording.without_ground_truth()
+    unchecked = estimate(blind, model, FastMethod(FastConfig(branch_mode_tolerance=1e3)))
+    assert unchecked.status is Status.OK and unchecked.x_c > 0.84  # the failure, without it
+    checked = estimate(blind, model, FastMethod())
+    assert checked.status is Status.UNCERTAIN
+    assert "mode 3" in (checked.reason or "")
+    assert checked.diagnostics.get("branch_chosen_by") == "omega2"
+    assert checked.x_c == pytest.approx(truth, abs=0.003)
+
+
 @dataclass(frozen=True)
 class _FittedModes:
     """The part of a DampedSinusoidFit the branch check reads: frequencies, all detected."""
