@@ -207,7 +207,8 @@ def test_a_ratio_on_the_wrong_branch_is_caught_and_the_second_mode_chooses_at_th
     assert checked.status is Status.UNCERTAIN
     assert "mode 3" in (checked.reason or "")
     assert checked.diagnostics.get("branch_chosen_by") == "omega2"
-    assert checked.x_c == pytest.approx(truth, abs=0.003)
+    # within the 5 mm tolerance's half-width: the branch's own omega_1 places it (0.699 m)
+    assert checked.x_c == pytest.approx(truth, abs=0.0025)
 
 
 @dataclass(frozen=True)

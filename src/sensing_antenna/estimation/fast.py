@@ -663,10 +663,9 @@ def _branch_contradiction(
             or abs(omega - harmonic) <= tolerance * omega
         ):
             continue
-        mine, candidate = min((mismatch(omega, c)[0], c) for c in own)
-        theirs, other = min((mismatch(omega, c)[0], c) for c in others)
+        mine, _, candidate = min((*mismatch(omega, c), c) for c in own)
+        theirs, mode, other = min((*mismatch(omega, c), c) for c in others)
         if mine > tolerance and theirs <= min(tolerance, 0.5 * mine):
-            mode = mismatch(omega, other)[1]
             return (
                 f"the contact mode at {omega:.1f} rad/s is {100 * theirs:.1f} % from mode "
                 f"{mode} of x_c = {other:.3f} m and {100 * mine:.1f} % from modes 2 and 3 of "
@@ -676,19 +675,10 @@ def _branch_contradiction(
 
 
 def evaluate_from_t1_or_hold(
-    channels: FloatArray,
-    bias: SensorBias,
-    rest_index: int,
-    end_index: int,
-    sample_period: float,
-    band: tuple[float, float],
-    link: Link,
-    x_range: tuple[float, float],
-    config: FastConfig,
-    hold_end: int,
-    caches: tuple[FitCache, FitCache] | None = None,
+    inputs: ScanInputs, hold_end: int, caches: tuple[FitCache, FitCache] | None = None
 ) -> WindowEstimate:
-    """:func:`evaluate_window` from t_1; from the end of the hold when the contact opened.
+    """:func:`evaluate_window` on [t_1, ``inputs.end_index``]; from the end of the hold when the
+    contact opened.
 
     When the window from t_1 shows the contact opening (``max_opening``), the link was bouncing
     on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
@@ -696,14 +686,13 @@ def evaluate_from_t1_or_hold(
     sure). ``caches`` holds the fits of the two kinds of window (offline); None refits.
     """
     early, late = caches if caches is not None else (None, None)
-    window = evaluate_window(
-        channels, bias, rest_index, end_index, sample_period, band, link, x_range, config, early
-    )
-    first = round(config.first_window / sample_period)
-    if window.opening > config.max_opening and rest_index < hold_end <= end_index - first:
-        return evaluate_window(
-            channels, bias, hold_end, end_index, sample_period, band, link, x_range, config, late
-        )
+    window = evaluate_window(*inputs, early)
+    first = round(inputs.config.first_window / inputs.sample_period)
+    if (
+        window.opening > inputs.config.max_opening
+        and inputs.rest_index < hold_end <= inputs.end_index - first
+    ):
+        return evaluate_window(*inputs._replace(rest_index=hold_end), late)
     return window
 
 
@@ -757,7 +746,7 @@ def evaluation_offsets(sample_period: float, config: FastConfig) -> NDArray[np.i
 
 
 class ScanInputs(NamedTuple):
-    """The samples and model a scan reads: :func:`evaluate_window`'s leading arguments, in order.
+    """The samples and model a window reads: :func:`evaluate_window`'s leading arguments, in order.
 
     ``end_index`` is the last sample available; :func:`evaluations` replaces it by each
     window's end.
@@ -811,7 +800,7 @@ def evaluations(
             continue
         if j > inputs.end_index:
             return
-        yield evaluate_from_t1_or_hold(*inputs._replace(end_index=j), hold_end, caches)
+        yield evaluate_from_t1_or_hold(inputs._replace(end_index=j), hold_end, caches)
 
 
 def scan(inputs: ScanInputs, earliest: int = 0, hold_end: int = -1) -> ScanResult:
@@ -885,7 +874,7 @@ class FastMethod:
         if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
             return True
         inputs = self._prepare(evidence)
-        return evaluate_from_t1_or_hold(*inputs, hold_end=evidence.hold_end).sure
+        return evaluate_from_t1_or_hold(inputs, hold_end=evidence.hold_end).sure
 
     def history(self, evidence: Evidence, from_t1: bool = False) -> tuple[WindowEstimate, ...]:
         """Every evaluation of the growing window up to the cap, without stopping when sure.
