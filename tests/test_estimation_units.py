@@ -19,8 +19,6 @@ from sensing_antenna.estimation.config import EstimatorConfig, EstimatorConfigEr
 from sensing_antenna.estimation.contact_frame import (
     contact_frame,
     first_rest_index,
-    gravity_force_m,
-    gravity_torque_m,
     motor_axes,
     rest_tolerance,
     signal_noise,
@@ -120,15 +118,16 @@ def test_gravity_terms_match_spec_sign_check() -> None:
     # Spec sign check: theta2 = 0, at rest: F = (0, 0, -m_b g), torque = (0, +0.5 m_b g l, 0).
     antenna = paper_antenna()
     w = antenna.link.mass * STANDARD_GRAVITY
-    np.testing.assert_allclose(gravity_force_m(antenna, np.array(0.0)), [0, 0, -w], atol=1e-15)
+    np.testing.assert_allclose(antenna.gravity_force(np.array(0.0)), [0, 0, -w], atol=1e-15)
     np.testing.assert_allclose(
-        gravity_torque_m(antenna, np.array(0.0)), [0, 0.5 * w * antenna.link.length, 0]
+        antenna.gravity_torque(np.array(0.0)), [0, 0.5 * w * antenna.link.length, 0]
     )
-    # And the same as the Antenna's own Section 4.2 terms at another angle.
-    np.testing.assert_allclose(gravity_force_m(antenna, np.array(0.3)), antenna.gravity_force(0.3))
-    np.testing.assert_allclose(
-        gravity_torque_m(antenna, np.array(0.3)), antenna.gravity_torque(0.3)
+    # Vectorised over theta2: one row per angle, the same as angle by angle
+    angles = np.array([-0.1, 0.0, 0.3])
+    np.testing.assert_array_equal(
+        antenna.gravity_torque(angles), [antenna.gravity_torque(a) for a in angles]
     )
+    assert antenna.gravity_force(angles).shape == (3, 3)
 
 
 def test_azimuthal_push_frame_is_minus_y_m() -> None:
@@ -199,8 +198,8 @@ def static_contact_samples(
     perpendicular = reaction - reaction[0] * np.array([1.0, 0.0, 0.0])
     deflection = np.linalg.norm(perpendicular) * x_c**3 / (3 * link.flexural_rigidity)
     r_c = np.array([x_c, 0.0, 0.0]) + deflection * perpendicular / np.linalg.norm(perpendicular)
-    force = reaction + gravity_force_m(antenna, np.array(theta2))
-    torque = np.cross(r_c, reaction) + gravity_torque_m(antenna, np.array(theta2))
+    force = reaction + antenna.gravity_force(theta2)
+    torque = np.cross(r_c, reaction) + antenna.gravity_torque(theta2)
     theta = np.tile([0.1, theta2], (n, 1))
     return theta, np.tile(force, (n, 1)), np.tile(torque, (n, 1))
 
@@ -236,8 +235,8 @@ def test_filtered_ratio_is_exact_while_the_push_grows() -> None:
     direction = np.array([0.0, -0.8, 0.6])
     reaction = magnitude[:, None] * direction
     theta = np.tile([0.0, 0.2], (n, 1))
-    force = reaction + gravity_force_m(antenna, theta[:, 1])
-    torque = np.cross(np.array([x_c, 0.0, 0.0]), reaction) + gravity_torque_m(antenna, theta[:, 1])
+    force = reaction + antenna.gravity_force(theta[:, 1])
+    torque = np.cross(np.array([x_c, 0.0, 0.0]), reaction) + antenna.gravity_torque(theta[:, 1])
     r_f, g_f = filtered_contact_loads(theta, force, torque, antenna, 5.0, TS)
     ratio = perpendicular_ratio(r_f, g_f, 1e12)  # loads at x_c without deflection: stiff link
     np.testing.assert_allclose(ratio[110:], x_c, rtol=1e-9)

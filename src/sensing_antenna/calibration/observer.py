@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, FreeMotionObserver
+from sensing_antenna.antenna import Antenna, FreeMotionObserver
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
@@ -152,9 +152,8 @@ def _targets(recording: Recording, antenna: Antenna) -> NDArray[np.float64]:
     """Measured Gamma_e,1 and Gamma_e,2 (N m), shape (n, 2): the torques with the link weight
     removed, mapped back through the signs of Section 4.2 (``OBSERVER_TORQUE_SIGNS``)."""
     sign_y, sign_z = OBSERVER_TORQUE_SIGNS
-    weight_moment = 0.5 * antenna.link.mass * STANDARD_GRAVITY * antenna.link.length
     # Section 4.2: Gamma^m - Gamma_g^m on Y^m and Z^m
-    dynamic_y = recording.torque[:, 1] - weight_moment * np.cos(recording.theta[:, 1])
+    dynamic_y = recording.torque[:, 1] - antenna.link.gravity_moment(recording.theta[:, 1])
     dynamic_z = recording.torque[:, 2]
     return np.column_stack([sign_z * dynamic_z, sign_y * dynamic_y])
 

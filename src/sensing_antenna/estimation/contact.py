@@ -45,7 +45,7 @@ from typing import Literal, TypeAlias
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.filters import (
     FirstOrderLowPass,
@@ -100,11 +100,6 @@ def tare_samples(tare_time: float, sample_period: float) -> int:
     return max(1, round(tare_time / sample_period))
 
 
-def _half_weight_moment(antenna: Antenna) -> float:
-    """m_b g l / 2 (N m), the amplitude of Gamma_g^m."""
-    return 0.5 * antenna.link.mass * STANDARD_GRAVITY * antenna.link.length
-
-
 def free_motion_torque(
     theta: ArrayLike, antenna: Antenna, sample_period: float
 ) -> NDArray[np.float64]:
@@ -133,8 +128,8 @@ def free_motion_torque(
     # Section 4.2: Gamma_e^m = (0, +Gamma_e,2, -Gamma_e,1) (signs: module docstring)
     torque[:, 1] = sign_y * gamma_e[:, 1]
     torque[:, 2] = sign_z * gamma_e[:, 0]
-    # Section 4.2: Gamma_g^m = (0, m_b g l cos(theta2) / 2, 0)
-    torque[:, 1] += _half_weight_moment(antenna) * np.cos(angles[:, 1])
+    # Section 4.2: Gamma_g^m = (0, m_b g l cos(theta2) / 2, 0), with tip mass and sag
+    torque[:, 1] += antenna.link.gravity_moment(angles[:, 1])
     return torque
 
 
@@ -327,7 +322,7 @@ class ContactDetector:
             FreeMotionObserverFilter(antenna.observer, sample_period),
         )
         self._filters = tuple(FirstOrderLowPass(residual_cutoff, sample_period) for _ in range(3))
-        self._half_weight = _half_weight_moment(antenna)
+        self._link = antenna.link
         self._sign_y, self._sign_z = OBSERVER_TORQUE_SIGNS
         self.reset()
 
@@ -378,7 +373,8 @@ class ContactDetector:
         gamma_e1 = self._observers[0].update(theta1)
         gamma_e2 = self._observers[1].update(theta2)
         # Section 4.2: Gamma_e^m + Gamma_g^m = (0, +Gamma_e,2 + m_b g l cos(theta2) / 2, -Gamma_e,1)
-        est_y = self._sign_y * gamma_e2 + self._half_weight * math.cos(theta2)
+        # (the weight's moment with tip mass and sag: Link.gravity_moment)
+        est_y = self._sign_y * gamma_e2 + float(self._link.gravity_moment(theta2))
         est_z = self._sign_z * gamma_e1
         # Eq. 16: r^m = Gamma^m - (Gamma_e^m + Gamma_g^m)
         r_x = float(torque[0])

@@ -24,15 +24,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.estimation.config import EstimatorConfig
 
 __all__ = [
     "ContactFrame",
     "contact_frame",
     "first_rest_index",
-    "gravity_force_m",
-    "gravity_torque_m",
     "motor_axes",
     "rest_tolerance",
     "signal_noise",
@@ -68,27 +65,6 @@ def motor_axes(theta: FloatArray) -> FloatArray:
 def to_absolute(vector_m: FloatArray, theta: FloatArray) -> FloatArray:
     """A vector given in the motor frame, in absolute coordinates, shape (3,) or (n, 3)."""
     return np.asarray(vector_m, dtype=float) @ motor_axes(theta)
-
-
-def gravity_force_m(antenna: Antenna, theta2: FloatArray) -> FloatArray:
-    """F_g^m of Section 4.2 for each elevation angle (N), shape theta2.shape + (3,)."""
-    theta2 = np.asarray(theta2, dtype=float)
-    weight = antenna.link.mass * STANDARD_GRAVITY
-    out = np.zeros((*theta2.shape, 3))
-    # Section 4.2: F_g^m = (-m_b g sin theta2, 0, -m_b g cos theta2)
-    out[..., 0] = -weight * np.sin(theta2)
-    out[..., 2] = -weight * np.cos(theta2)
-    return out
-
-
-def gravity_torque_m(antenna: Antenna, theta2: FloatArray) -> FloatArray:
-    """Gamma_g^m of Section 4.2 for each elevation angle (N m), shape theta2.shape + (3,)."""
-    theta2 = np.asarray(theta2, dtype=float)
-    weight = antenna.link.mass * STANDARD_GRAVITY
-    out = np.zeros((*theta2.shape, 3))
-    # Section 4.2: Gamma_g^m = (0, 0.5 m_b g l cos theta2, 0)
-    out[..., 1] = 0.5 * weight * antenna.link.length * np.cos(theta2)
-    return out
 
 
 def signal_noise(theta: FloatArray) -> tuple[float, float]:

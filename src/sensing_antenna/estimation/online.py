@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
 from sensing_antenna.estimation.contact import ContactDetector
 from sensing_antenna.estimation.evidence import (
@@ -105,8 +105,8 @@ class OnlineEstimator:
         self._w_hold = max(samples(cfg.frame_window, self.sample_period), self._w_rest)
         self._w_conv = samples(cfg.convergence_window, self.sample_period)
         self._n_wait = samples(cfg.max_ratio_wait, self.sample_period)
-        self._weight = antenna.link.mass * STANDARD_GRAVITY
-        self._half_moment = 0.5 * self._weight * antenna.link.length
+        self._link = antenna.link
+        self._weight = antenna.link.weight
         self._rigidity = antenna.link.flexural_rigidity
         self._detector = ContactDetector(antenna, self.sample_period)
         # t1_source = "push": the push criterion's decision, with the same contact detector inside
@@ -207,7 +207,7 @@ class OnlineEstimator:
         r_y = filters[1].update(fy)
         r_z = filters[2].update(fz + self._weight * cos2)
         filters[3].update(tx)
-        g_y = filters[4].update(ty - self._half_moment * cos2)
+        g_y = filters[4].update(ty - float(self._link.gravity_moment(theta2)))
         g_z = filters[5].update(tz)
         pushed = False
         if self._push is not None and self._rest is None:

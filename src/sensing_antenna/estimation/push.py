@@ -52,7 +52,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
@@ -158,15 +158,10 @@ def _gravity_free_magnitudes(
     recording: Recording, antenna: Antenna
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """|F^m - F_g^m| (N) and |Gamma^m - Gamma_g^m| (N m), shape (n,) each."""
-    weight = antenna.link.mass * STANDARD_GRAVITY
     theta2 = recording.theta[:, 1]
-    # Section 4.2: F_g^m = (-m_b g sin(theta2), 0, -m_b g cos(theta2))
-    force = recording.force - np.column_stack(
-        [-weight * np.sin(theta2), np.zeros_like(theta2), -weight * np.cos(theta2)]
-    )
-    # Section 4.2: Gamma_g^m = (0, m_b g l cos(theta2) / 2, 0)
-    torque = recording.torque.copy()
-    torque[:, 1] -= 0.5 * weight * antenna.link.length * np.cos(theta2)
+    # Section 4.2: F^m - F_g^m and Gamma^m - Gamma_g^m
+    force = recording.force - antenna.gravity_force(theta2)
+    torque = recording.torque - antenna.gravity_torque(theta2)
     return np.sqrt(np.sum(force**2, axis=1)), np.sqrt(np.sum(torque**2, axis=1))
 
 
@@ -328,8 +323,8 @@ class PushMonitor:
             else contact_detector
         )
         self._filter = FirstOrderLowPass(criterion.cutoff, sample_period)
-        self._weight = antenna.link.mass * STANDARD_GRAVITY
-        self._half_weight_moment = 0.5 * self._weight * antenna.link.length
+        self._link = antenna.link
+        self._weight = antenna.link.weight
         self.reset()
 
     def reset(self) -> None:
@@ -384,10 +379,11 @@ class PushMonitor:
             # Eq. 20: low-pass filtered |F^m - F_g^m|
             self.measure = self._filter.update(math.sqrt(fx * fx + fy * fy + fz * fz))
         else:
-            # Section 4.2: Gamma^m - Gamma_g^m, Gamma_g^m = (0, m_b g l cos theta2 / 2, 0)
+            # Section 4.2: Gamma^m - Gamma_g^m, Gamma_g^m = (0, m_b g l cos theta2 / 2, 0) with
+            # tip mass and sag (Link.gravity_moment)
             g = torque
             gx = float(g[0])
-            gy = float(g[1]) - self._half_weight_moment * math.cos(theta2)
+            gy = float(g[1]) - float(self._link.gravity_moment(theta2))
             gz = float(g[2])
             # Eq. 20: low-pass filtered |Gamma^m - Gamma_g^m|
             self.measure = self._filter.update(math.sqrt(gx * gx + gy * gy + gz * gz))

@@ -32,7 +32,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.estimation.contact_frame import gravity_force_m, gravity_torque_m
 from sensing_antenna.estimation.filters import low_pass
 
 __all__ = [
@@ -75,8 +74,8 @@ def contact_loads(
     """
     theta2 = np.asarray(theta, dtype=float)[:, 1]
     # Section 4.2 / Eq. 19: remove the gravity force and torque of the link
-    reaction = np.asarray(force_m, dtype=float) - gravity_force_m(antenna, theta2)
-    moment = np.asarray(torque_m, dtype=float) - gravity_torque_m(antenna, theta2)
+    reaction = np.asarray(force_m, dtype=float) - antenna.gravity_force(theta2)
+    moment = np.asarray(torque_m, dtype=float) - antenna.gravity_torque(theta2)
     return reaction, moment
 
 
@@ -214,8 +213,8 @@ def paper_ratio(
     if offset is not None:
         filtered = filtered - np.asarray(offset, dtype=float)
     # Eq. 21: x_c(t) = |Gamma_f - Gamma_g| / |F_f - F_g|
-    numerator = np.linalg.norm(filtered[:, 3:] - gravity_torque_m(antenna, theta2), axis=-1)
-    denominator = np.linalg.norm(filtered[:, :3] - gravity_force_m(antenna, theta2), axis=-1)
+    numerator = np.linalg.norm(filtered[:, 3:] - antenna.gravity_torque(theta2), axis=-1)
+    denominator = np.linalg.norm(filtered[:, :3] - antenna.gravity_force(theta2), axis=-1)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = numerator / denominator
     return np.where(denominator > 0.0, ratio, np.nan)
