@@ -293,3 +293,25 @@ def test_config_validation_names_the_field() -> None:
         EstimatorConfig(spectrum_window=-1.0)
     with pytest.raises(EstimatorConfigError, match="contact_range"):
         EstimatorConfig(contact_range=(0.5, 0.4))
+
+
+def test_touched_point_sag_is_the_finite_element_cantilever_sag_with_a_tip_mass() -> None:
+    # The touched point sits on the link sagged under its weight and its tip mass; at theta = 0
+    # the closed-form cantilever sag at x_c equals the simulator's finite-element static sag
+    # (20 cubic Hermite elements: exact at their nodes for these loads, within q h^4 / (384 E I)
+    # = 1e-8 m between them, so 1e-5 relative on sags of 1.8 to 8.8 cm with a 2 g tip mass).
+    from dataclasses import replace
+
+    from sensing_antenna.estimation.contact_frame import ContactFrame, motor_axes
+    from sensing_antenna.estimation.touch_point import touched_point
+    from sensing_antenna.simulator.run import _unit_sag
+
+    link = replace(paper_antenna().link, tip_mass=0.002)
+    theta = np.zeros(2)
+    frame = ContactFrame(np.eye(3), motor_axes(theta), theta, np.array([0.0, -1e-9, 0.0]))
+    grid, unit = _unit_sag(link, 20)
+    for k in (122, 245, 400):  # x_c = 0.30, 0.60, 0.98 m, points of the finite-element grid
+        point = touched_point(float(grid[k]), frame, 0.0, link)
+        expected = STANDARD_GRAVITY * float(unit[k])  # negative: down
+        assert point.sag == pytest.approx(-expected, rel=1e-5)
+        assert point.point_a[2] == pytest.approx(expected, rel=1e-5)
