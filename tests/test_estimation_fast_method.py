@@ -19,6 +19,7 @@ import pytest
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.evidence import Evidence
 from sensing_antenna.estimation.fast import (
     FastConfig,
     FastConfigError,
@@ -446,3 +447,26 @@ def test_drift_check_widens_the_frequency_error_only_when_the_record_disagrees()
     assert beating.omega1_se > 2.0 * beating.omega1_crb
     # The widened error covers the fit's actual offset from the ring's frequency
     assert abs(beating.omega1 - float(CURVE.omega1(x))) < 2.0 * beating.omega1_se
+
+
+@pytest.mark.parametrize("case", ["vertical", "azimuthal"])
+def test_the_rest_bias_of_a_noiseless_device_is_zero(case: str) -> None:
+    # No sensor offset, no noise, a device 15 % stiffer than the nominal link and a model with
+    # the calibrated T_e: what the rest's mean holds besides the offset is the model's error.
+    # With the guard and the sag from T_e it is under 1e-6 (N, N m); without the guard the
+    # sweep's start adds 2e-5 N and 8e-6 N m, and the sag from the nominal E I 1.4e-5 N m
+    # (vertical). 2e-6 is under the rest mean's noise standard error at noise 1 (3e-6 N m).
+    from sensing_antenna.estimation.pipeline import gather_evidence
+    from sensing_antenna.simulator import Scenario, simulate
+
+    base = paper_antenna()
+    device = replace(base, link=replace(base.link, youngs_modulus=132.65e9))
+    model = base.with_calibrated_t(device.link.theoretical_t)
+    recording = simulate(device, Scenario(case=case, contact_point=0.7, seed=0, noise_scale=0.0))
+    evidence = gather_evidence(recording.without_ground_truth(), model)
+    assert isinstance(evidence, Evidence)
+    bias = FastMethod()._prepare(evidence).bias
+    assert bias.n_samples > 50
+    np.testing.assert_allclose(bias.bias, 0.0, atol=2e-6)
+    unguarded = FastMethod(FastConfig(bias_guard=1e-9))._prepare(evidence).bias
+    assert np.max(np.abs(unguarded.bias)) > 5e-6

@@ -146,12 +146,15 @@ class Link:
         from the tip mass. The part along the link, g sin(theta2) per kg, acts on those
         displaced masses: kappa = g^2 int u dm = g^2 (rho^2 l^5 / 20 + rho m_t l^4 / 4 +
         m_t^2 l^3 / 3) / (E I). Paper link: 1.06e-3 N m (a 5.9 cm tip sag), so 1.1e-4 N m
-        between theta2 = -0.10 and +0.03 rad.
+        between theta2 = -0.10 and +0.03 rad. E I is taken as rho / T^2 with the frequency
+        model's T (:attr:`t_param`): a calibrated T_e measures the same ratio of stiffness to
+        mass that the sag depends on.
         """
         rho, m_t, length = self.linear_density, self.tip_mass, self.length
+        compliance = self.t_param**2 / rho  # 1 / (E I)
         integral = (
             rho**2 * length**5 / 20.0 + rho * m_t * length**4 / 4.0 + m_t**2 * length**3 / 3.0
-        ) / self.flexural_rigidity
+        ) * compliance
         return STANDARD_GRAVITY**2 * integral
 
     def gravity_moment(self, theta2: ArrayLike) -> NDArray[np.float64]:

@@ -158,6 +158,12 @@ class FastConfig:
         Spacing of the x_c grid of the posterior (m). 0.25 mm, a twentieth of the tolerance.
     bias_min_samples : int
         Samples of initial rest needed to estimate the sensor bias; 20 (20 ms).
+    bias_guard : float
+        Time (s) of the initial rest left out before the head is seen to move: the sweep's start
+        loads the sensor (inertia) while the angles are still within the rest tolerance. 0.05 s:
+        on the simulated device the loads leave the rest 60 ms before the move is seen (1e-6
+        N m then, 5e-5 N m 10 ms before it), which biased the rest mean by 2 to 3 standard
+        errors in Gamma_z (azimuthal) without the guard.
     peak_margin : float
         No declaration while omega_1 is less than this many standard deviations below the
         maximum of the sensing curve (the interval there rests on the curve's flat top). 3: in
@@ -227,6 +233,7 @@ class FastConfig:
     ratio_geometry_factor: float = 0.5
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
+    bias_guard: float = 0.05
     max_direction_drift: float = 0.15
     peak_margin: float = 3.0
     max_disagreement: float = 3.0
@@ -845,6 +852,7 @@ class FastMethod:
             evidence.contact_index,
             tolerance,
             self.config.bias_min_samples,
+            guard=round(self.config.bias_guard / evidence.sample_period),
         )
         x_range = (
             evidence.config.contact_range[0] * link.length,

@@ -176,6 +176,7 @@ def sensor_bias(
     contact_index: int,
     tolerance: float,
     min_samples: int = 20,
+    guard: int = 0,
 ) -> SensorBias:
     """Bias of the contact-load channels from the initial rest before the sweep.
 
@@ -191,6 +192,9 @@ def sensor_bias(
         The head rests while both angles stay within this distance of their first value (rad).
     min_samples : int
         Fewer rest samples than this give no bias (zero, ``n_samples = 0``).
+    guard : int
+        Samples left out before the first one where the head has moved, or before t_c (the
+        motion, or the touch, loads the sensor before it is detected).
 
     Returns
     -------
@@ -198,7 +202,7 @@ def sensor_bias(
     """
     theta = np.asarray(theta, dtype=float)
     moved = np.flatnonzero(np.any(np.abs(theta[:contact_index] - theta[0]) > tolerance, axis=1))
-    stop = int(moved[0]) if moved.size else contact_index
+    stop = (int(moved[0]) if moved.size else contact_index) - guard
     k = channels.shape[1]
     if stop < min_samples:
         return SensorBias(np.zeros(k), np.zeros((k, k)), 0)
