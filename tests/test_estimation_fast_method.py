@@ -468,5 +468,5 @@ def test_the_rest_bias_of_a_noiseless_device_is_zero(case: str) -> None:
     bias = FastMethod()._prepare(evidence).bias
     assert bias.n_samples > 50
     np.testing.assert_allclose(bias.bias, 0.0, atol=2e-6)
-    unguarded = FastMethod(FastConfig(bias_guard=1e-9))._prepare(evidence).bias
+    unguarded = FastMethod(FastConfig(bias_guard=0.0))._prepare(evidence).bias
     assert np.max(np.abs(unguarded.bias)) > 5e-6

@@ -14,6 +14,7 @@ All values are SI. Derived quantities (E I, m_b, T) are computed, never stored.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
@@ -124,37 +125,51 @@ class Link:
         """Link mass m_b = rho l (kg)."""
         return self.linear_density * self.length
 
-    @property
+    @functools.cached_property
     def weight(self) -> float:
         """Weight of the link and its tip mass, (m_b + m_t) g (N)."""
         return (self.mass + self.tip_mass) * STANDARD_GRAVITY
 
-    @property
+    @functools.cached_property
     def weight_moment(self) -> float:
         """Moment of that weight about the joint, straight link held horizontal,
         (m_b l / 2 + m_t l) g (N m)."""
         return (0.5 * self.mass + self.tip_mass) * self.length * STANDARD_GRAVITY
 
     @property
+    def bending_compliance(self) -> float:
+        """1 / (E I) (1 / (N m^2)) of the gravity sag: rho / T^2 with the frequency model's T
+        (:attr:`t_param`), since a calibrated T_e measures the ratio of stiffness to mass the
+        sag depends on."""
+        return self.t_param**2 / self.linear_density
+
+    def unit_sag(self, x: ArrayLike) -> NDArray[np.float64]:
+        """u(x): the free cantilever's deflection under 1 m/s^2 across it (m per m/s^2).
+
+        rho x^2 (6 l^2 - 4 l x + x^2) / (24 E I) from the link, m_t x^2 (3 l - x) / (6 E I) from
+        the tip mass; ``x`` in m, 0 <= x <= l, any shape.
+        """
+        x = np.asarray(x, dtype=float)
+        length = self.length
+        link = self.linear_density * x**2 * (6 * length**2 - 4 * length * x + x**2) / 24.0
+        tip = self.tip_mass * x**2 * (3 * length - x) / 6.0
+        return np.asarray((link + tip) * self.bending_compliance)
+
+    @functools.cached_property
     def sag_moment(self) -> float:
         """kappa (N m): the free link's own sag adds kappa sin(theta2) cos(theta2) to the moment
         of its weight about the elevation axis.
 
         The weight's part across the link, g cos(theta2) per kg, bends the cantilever by
-        u(x) g cos(theta2), with u the deflection under a unit transverse acceleration:
-        rho x^2 (6 l^2 - 4 l x + x^2) / (24 E I) from the link, m_t x^2 (3 l - x) / (6 E I)
-        from the tip mass. The part along the link, g sin(theta2) per kg, acts on those
-        displaced masses: kappa = g^2 int u dm = g^2 (rho^2 l^5 / 20 + rho m_t l^4 / 4 +
+        g cos(theta2) :meth:`unit_sag`. The part along the link, g sin(theta2) per kg, acts on
+        those displaced masses: kappa = g^2 int u dm = g^2 (rho^2 l^5 / 20 + rho m_t l^4 / 4 +
         m_t^2 l^3 / 3) / (E I). Paper link: 1.06e-3 N m (a 5.9 cm tip sag), so 1.1e-4 N m
-        between theta2 = -0.10 and +0.03 rad. E I is taken as rho / T^2 with the frequency
-        model's T (:attr:`t_param`): a calibrated T_e measures the same ratio of stiffness to
-        mass that the sag depends on.
+        between theta2 = -0.10 and +0.03 rad.
         """
         rho, m_t, length = self.linear_density, self.tip_mass, self.length
-        compliance = self.t_param**2 / rho  # 1 / (E I)
         integral = (
             rho**2 * length**5 / 20.0 + rho * m_t * length**4 / 4.0 + m_t**2 * length**3 / 3.0
-        ) * compliance
+        ) * self.bending_compliance
         return STANDARD_GRAVITY**2 * integral
 
     def gravity_moment(self, theta2: ArrayLike) -> NDArray[np.float64]:

@@ -258,8 +258,13 @@ class FastConfig:
                 raise FastConfigError(f"{f.name}: must be a number, got {value!r}")
             if not (math.isfinite(value) and value >= 0.0):
                 raise FastConfigError(f"{f.name}: must be a finite number >= 0, got {value!r}")
-            floors = ("frequency_floor", "resolution_fraction", "ratio_geometry_factor")
-            if value == 0.0 and f.name not in floors:
+            may_be_zero = (
+                "frequency_floor",
+                "resolution_fraction",
+                "ratio_geometry_factor",
+                "bias_guard",
+            )
+            if value == 0.0 and f.name not in may_be_zero:
                 raise FastConfigError(f"{f.name}: must be > 0, got {value!r}")
         if self.first_window > self.cap:
             raise FastConfigError("first_window: must not exceed cap")

@@ -90,18 +90,7 @@ def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link
     across_norm = float(np.linalg.norm(across))
     sag = 0.0
     if across_norm > 0.0:
-        g_across = STANDARD_GRAVITY * across_norm
-        length = link.length
-        compliance = link.t_param**2 / link.linear_density  # 1 / (E I), as in Link.sag_moment
-        # Cantilever under its weight: rho g x^2 (6 l^2 - 4 l x + x^2) / (24 E I), and under the
-        # tip mass: m_t g x^2 (3 l - x) / (6 E I)
-        sag = (
-            g_across
-            * compliance
-            * (
-                link.linear_density * x_c**2 * (6 * length**2 - 4 * length * x_c + x_c**2) / 24.0
-                + link.tip_mass * x_c**2 * (3 * length - x_c) / 6.0
-            )
-        )
+        # The cantilever's sag at x_c under the weight's part across the link
+        sag = STANDARD_GRAVITY * across_norm * float(link.unit_sag(x_c))
         point_a = point_a + sag * across / across_norm
     return TouchPoint(point_a=point_a, deflection=y_c, deflection_ratio=y_c / x_c, sag=sag)
