@@ -110,7 +110,8 @@ class FastConfig:
         standard error (docs/fast.md).
     min_periods : float
         The window must hold this many periods of the fitted fundamental before an estimate can
-        be declared (a shorter record cannot tell a frequency from a drift). 1.5.
+        be declared (a shorter record cannot tell a frequency from a drift), and so must the
+        drift check's window of 2/3 the length (so at least 2.25 periods in all). 1.5.
     min_detection : float
         The fundamental is used only when its detection statistic, the amplitude at the window
         start over the noise (combined over channels) times sqrt(n / 2), reaches this value. For
@@ -500,6 +501,13 @@ def evaluate_window(
         k_ref, _ = _fundamental(ref_fit, band, config)
         if ref_fit is None or k_ref is None:
             notes.append("no fundamental on the shorter window to check its drift")
+        elif ref_fit.duration * omega1 < 2.0 * math.pi * config.min_periods:
+            # Below min_periods the shorter window's own fundamental is too loose to see a
+            # drift of the size that matters here: "no change seen" would mean nothing
+            notes.append(
+                f"the shorter window that checks the drift holds "
+                f"{ref_fit.duration * omega1 / (2.0 * math.pi):.2f} periods of omega_1"
+            )
         else:
             # Nested windows: the change of an efficient estimate has variance se_ref^2 - se^2
             # from noise alone; only the excess over that is drift
