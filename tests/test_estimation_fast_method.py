@@ -109,11 +109,23 @@ def test_interval_coverage_on_synthetic_measurements() -> None:
     assert 0.92 <= hits / draws <= 0.98
 
 
-def _channels(x_c: float, n: int, rng: np.random.Generator, amplitude: float) -> np.ndarray:
-    """Contact loads of a push of 60 mN at x_c ringing at omega_1(x_c), with sensor noise."""
+def _channels(
+    x_c: float,
+    n: int,
+    rng: np.random.Generator,
+    amplitude: float,
+    excess: float = 0.0,
+    relaxation: float = 0.08,
+) -> np.ndarray:
+    """Contact loads of a push of 60 mN at x_c ringing at omega_1(x_c), with sensor noise.
+
+    ``excess``: the ring's frequency starts this fraction above omega_1 and relaxes to it with
+    time constant ``relaxation`` (s).
+    """
     t = np.arange(n) * TS
     omega = float(CURVE.omega1(x_c))
-    r_y = -0.06 * (1.0 + amplitude * np.exp(-0.5 * t) * np.cos(omega * t + 0.3))
+    phase = omega * t + omega * excess * relaxation * (1.0 - np.exp(-t / relaxation))
+    r_y = -0.06 * (1.0 + amplitude * np.exp(-0.5 * t) * np.cos(phase + 0.3))
     zeros = np.zeros(n)
     out = np.column_stack([r_y, zeros, zeros, zeros, x_c * r_y])
     noise = np.array([6e-3, 6e-3, 3e-5, 3e-5, 3e-5])
@@ -481,12 +493,7 @@ def test_an_early_frequency_excess_waits_for_a_reference_window_that_can_see_it(
     # min_periods; the declared interval covers x_c.
     x = 0.45
     omega = float(CURVE.omega1(x))
-    t = np.arange(1000) * TS
-    phase = omega * t + omega * 0.03 * 0.08 * (1.0 - np.exp(-t / 0.08))
-    r_y = -0.06 * (1.0 + 0.2 * np.exp(-0.5 * t) * np.cos(phase + 0.3))
-    clean = np.column_stack([r_y, 0 * t, 0 * t, 0 * t, x * r_y])
-    noise = np.array([6e-3, 6e-3, 3e-5, 3e-5, 3e-5])
-    channels = clean + noise * np.random.default_rng(0).standard_normal((1000, 5))
+    channels = _channels(x, 1000, np.random.default_rng(0), 0.2, excess=0.03, relaxation=0.08)
     cfg = FastConfig()
     early = evaluate_window(channels, NO_BIAS, 0, 237, TS, BAND, LINK, X_RANGE, cfg, {})
     assert early.omega1 > 1.005 * omega

@@ -499,14 +499,15 @@ def evaluate_window(
             else _fit_window(channels, rest_index, ref, sample_period, band, config, cache)
         )
         k_ref, _ = _fundamental(ref_fit, band, config)
+        ref_periods = math.nan if ref_fit is None else ref_fit.duration * omega1 / (2.0 * math.pi)
         if ref_fit is None or k_ref is None:
             notes.append("no fundamental on the shorter window to check its drift")
-        elif ref_fit.duration * omega1 < 2.0 * math.pi * config.min_periods:
+        elif ref_periods < config.min_periods:
             # Below min_periods the shorter window's own fundamental is too loose to see a
             # drift of the size that matters here: "no change seen" would mean nothing
             notes.append(
-                f"the shorter window that checks the drift holds "
-                f"{ref_fit.duration * omega1 / (2.0 * math.pi):.2f} periods of omega_1"
+                f"the shorter window that checks the drift holds {ref_periods:.2f} periods of "
+                "omega_1"
             )
         else:
             # Nested windows: the change of an efficient estimate has variance se_ref^2 - se^2
