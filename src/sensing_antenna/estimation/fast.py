@@ -919,7 +919,7 @@ class FastMethod:
 
 def _direction_change(early: StaticRatio, late: StaticRatio) -> tuple[float, float]:
     """Angle (rad) between two static perpendicular reactions and its standard error (rad)."""
-    a, b = early.reaction_m[1:], late.reaction_m[1:]
+    a, b = early.reaction_perp, late.reaction_perp
     norm_a, norm_b = float(np.linalg.norm(a)), float(np.linalg.norm(b))
     if norm_a == 0.0 or norm_b == 0.0:
         return math.nan, math.nan

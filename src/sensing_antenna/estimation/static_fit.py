@@ -66,9 +66,9 @@ class StaticRatio:
         |Gamma - Gamma_g^m| / |R_perp| at the window centre (m); NaN when R_perp is zero.
     standard_error : float
         Its standard error from the offsets' covariance (m).
-    reaction_m : array, shape (3,)
-        Static reaction (R_x, R_y, R_z) of the object on the link (N); R_x is the mean over the
-        window (it is not part of the fit).
+    reaction_perp : array, shape (2,)
+        Static perpendicular reaction (R_y, R_z) of the object on the link (N). The axial R_x
+        is not fitted (it does not enter the ratio).
     torque_m : array, shape (3,)
         Static contact torque (N m).
     force_cov : array, shape (2, 2)
@@ -77,14 +77,14 @@ class StaticRatio:
 
     ratio: float
     standard_error: float
-    reaction_m: FloatArray
+    reaction_perp: FloatArray
     torque_m: FloatArray
     force_cov: FloatArray = field(default_factory=lambda: np.zeros((2, 2)))
 
     @property
     def perpendicular_force(self) -> float:
         """|R_perp| (N)."""
-        return float(math.hypot(self.reaction_m[1], self.reaction_m[2]))
+        return float(math.hypot(self.reaction_perp[0], self.reaction_perp[1]))
 
 
 def contact_channels(
@@ -109,9 +109,7 @@ def contact_channels(
     return np.column_stack([reaction[:, 1:], moment])
 
 
-def static_ratio(
-    fit: DampedSinusoidFit, bias: SensorBias | None = None, axial_force: float = 0.0
-) -> StaticRatio:
+def static_ratio(fit: DampedSinusoidFit, bias: SensorBias | None = None) -> StaticRatio:
     """The torque/force ratio of the fitted offsets, with its standard error.
 
     Parameters
@@ -120,8 +118,6 @@ def static_ratio(
         A fit of the five :func:`contact_channels`.
     bias : SensorBias, optional
         Subtracted from the offsets, its covariance added.
-    axial_force : float
-        R_x over the window (N), only reported.
 
     Returns
     -------
@@ -136,7 +132,7 @@ def static_ratio(
     torque = c[list(TORQUE_CHANNELS)]
     f_norm = float(np.linalg.norm(force))
     g_norm = float(np.linalg.norm(torque))
-    reaction = np.array([axial_force, force[0], force[1]])
+    reaction = np.array(force, dtype=float)
     force_cov = cov[np.ix_(FORCE_CHANNELS, FORCE_CHANNELS)]
     if f_norm == 0.0:
         return StaticRatio(math.nan, math.nan, reaction, torque, force_cov)
