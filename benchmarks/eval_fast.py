@@ -154,7 +154,7 @@ def main() -> None:
         "--seed-base",
         type=int,
         default=200,
-        help="first seed (100: the seeds used to set FastConfig.resolution_fraction)",
+        help="first seed (100: the seeds once used to set a since removed floor)",
     )
     parser.add_argument(
         "--cache", type=Path, default=None, help="directory of stored simulated recordings"

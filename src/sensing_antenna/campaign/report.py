@@ -682,7 +682,7 @@ def _noise_section(
             "abscissa (`beam.natural_frequencies` of the device's link), relative, in %, over "
             "every run with an omega_1 (any status). CRB: median over runs of the Cramer-Rao "
             "bound of omega_1 the method reports for its own fit (`fast`: the window it declared "
-            "on); SE: median of its reported standard error, which adds a resolution floor. "
+            "on); SE: median of its reported standard error, which adds the drift check's term. "
             "For a fixed record the bound is proportional to the noise, but `fast` stops when "
             "sure, so its record lengthens with the noise and its bound stays nearly level; "
             "the error cannot fall below the model bias (the simulator's compliant contact and "

@@ -107,7 +107,9 @@ class FastConfig:
         as 1 / T_w (the leakage of a close unmodelled mode, a slow transient) is at T_w twice
         its change from 2/3 T_w to T_w. Near the peak of omega_1(x_c) on the simulator a close
         mode biased 0.3 s windows by 1.6 % and 1 s windows by 0.15 %, far beyond the white-noise
-        standard error (docs/fast.md).
+        standard error (docs/fast.md). The check measures such leakage on the record itself, so
+        there is no fixed floor proportional to 2 pi / T_w (docs/fast.md, "Posterior and
+        floors", says why the one there was is gone).
     min_periods : float
         The window must hold this many periods of the fitted fundamental before an estimate can
         be declared (a shorter record cannot tell a frequency from a drift), and so must the
@@ -142,14 +144,6 @@ class FastConfig:
         docs/fast.md). A link whose calibration measured a larger relative scatter
         (``Link.calibration_scatter``) uses that instead: on the simulated device with a
         contact three times softer the calibration residuals reached 0.46 % near the tip.
-    resolution_fraction : float
-        Non-stationarity floor of omega_1 as a fraction of the Rayleigh resolution 2 pi / T_w
-        of the window (rad/s), added in quadrature. Content the model does not describe (the
-        servo's slow creep, the contact still settling) leaks into the fitted frequency by an
-        amount that shrinks with the resolution of the record, while the white-noise standard
-        error ignores it. 0.0035: chosen so that the 95 % intervals cover 95 % of simulated runs
-        (seeds 100 and 101 of benchmarks/eval_fast.py, 180 runs; 0.005 gave 98 %, |z| at the
-        95th percentile 1.4 to 1.7); checked on other seeds, see docs/fast.md.
     ratio_geometry_factor : float
         kappa of the ratio's model floor kappa (y_c / x_c) x_c (dimensionless). 0.5: the
         neglected torque of the axial force on the deflection is (y_c / x_c)(R_x / R_perp) x_c,
@@ -230,7 +224,6 @@ class FastConfig:
     min_mode_fraction: float = 0.6
     polynomial_degree: int = 4
     frequency_floor: float = 0.001
-    resolution_fraction: float = 0.0035
     ratio_geometry_factor: float = 0.5
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
@@ -261,7 +254,6 @@ class FastConfig:
                 raise FastConfigError(f"{f.name}: must be a finite number >= 0, got {value!r}")
             may_be_zero = (
                 "frequency_floor",
-                "resolution_fraction",
                 "ratio_geometry_factor",
                 "bias_guard",
             )
@@ -322,9 +314,9 @@ class WindowEstimate:
     fit : DampedSinusoidFit or None
         The chosen fit of the contact-load channels (None: too few samples or no pole).
     omega1, omega1_se : float
-        Fundamental and its standard error (rad/s): the fit's statistical error, the
-        resolution floor and ``drift_factor`` times the drift, in quadrature (the relative model
-        floor is added by the posterior); NaN when not usable.
+        Fundamental and its standard error (rad/s): the fit's statistical error and
+        ``drift_factor`` times the drift, in quadrature (the relative model floor is added by
+        the posterior); NaN when not usable.
     omega1_crb : float
         Cramer-Rao bound of omega_1 for this record length and noise (rad/s): the square root
         of the inverse Fisher information of the fitted model at the fitted parameters and the
@@ -484,9 +476,7 @@ def evaluate_window(
     if fit is not None and k is not None:
         omega1 = float(fit.omega[k])
         omega1_crb = float(fit.omega_se[k])
-        # Statistical standard error and the non-stationarity floor, in quadrature
-        resolution = 2.0 * math.pi / fit.duration
-        omega1_se = math.hypot(omega1_crb, config.resolution_fraction * resolution)
+        omega1_se = omega1_crb
         periods = fit.duration * omega1 / (2.0 * math.pi)
         if periods < config.min_periods:
             notes.append(f"the window holds {periods:.2f} periods of omega_1")
@@ -740,10 +730,7 @@ def _higher_mode(
     if not usable or not fit.converged:
         return math.nan, math.nan
     k = max(usable, key=lambda i: float(detection[i]))
-    resolution = 2.0 * math.pi / fit.duration
-    return float(fit.omega[k]), math.hypot(
-        float(fit.omega_se[k]), config.resolution_fraction * resolution
-    )
+    return float(fit.omega[k]), float(fit.omega_se[k])
 
 
 @functools.lru_cache(maxsize=32)
