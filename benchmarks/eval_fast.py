@@ -154,7 +154,7 @@ def main() -> None:
         "--seed-base",
         type=int,
         default=200,
-        help="first seed (100: the seeds once used to set a since removed floor)",
+        help="first seed (100: the seeds a floor, since removed, was set on)",
     )
     parser.add_argument(
         "--cache", type=Path, default=None, help="directory of stored simulated recordings"

@@ -107,9 +107,9 @@ class FastConfig:
         as 1 / T_w (the leakage of a close unmodelled mode, a slow transient) is at T_w twice
         its change from 2/3 T_w to T_w. Near the peak of omega_1(x_c) on the simulator a close
         mode biased 0.3 s windows by 1.6 % and 1 s windows by 0.15 %, far beyond the white-noise
-        standard error (docs/fast.md). The check measures such leakage on the record itself, so
-        there is no fixed floor proportional to 2 pi / T_w (docs/fast.md, "Posterior and
-        floors", says why the one there was is gone).
+        standard error (docs/fast.md). The check measures such leakage on the record itself;
+        the fixed floor proportional to 2 pi / T_w that once stood for it was removed
+        (docs/fast.md, "Posterior and floors").
     min_periods : float
         The window must hold this many periods of the fitted fundamental before an estimate can
         be declared (a shorter record cannot tell a frequency from a drift), and so must the
