@@ -76,7 +76,8 @@ REPORTED = (*PLOTTED, *(f"tolerance_{1e3 * t:g}mm" for t in TOLERANCES))
 
 
 def bound_width(window: WindowEstimate, link: Link, config: FastConfig) -> float:
-    """Width (m) of the 95 % interval with omega_1 at its Cramer-Rao bound and no floors."""
+    """Width (m) of the 95 % interval with omega_1 at its Cramer-Rao bound and no floors (on
+    the branch the second contact mode chose, when it chose one)."""
     statics = window.statics
     if statics is None or not math.isfinite(window.omega1_crb):
         return math.nan
@@ -95,6 +96,9 @@ def bound_width(window: WindowEstimate, link: Link, config: FastConfig) -> float
         frequency_floor=0.0,
         ratio_geometry_factor=0.0,
     )
+    if window.branch_chosen_by_second_mode:
+        # The same branch the method's own posterior was conditioned on
+        posterior = posterior.given_branch(posterior.branch_of(window.posterior.x_c))
     return posterior.width
 
 

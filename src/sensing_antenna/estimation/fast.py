@@ -15,8 +15,8 @@ from t_1:
    ``tolerance`` and where the ratio agrees with it. Evaluations run on a geometric grid
    (:func:`evaluation_offsets`) from ``first_window`` (50 ms) after t_1, so t_e adapts to how
    easy the case is; at ``cap`` (1 s) after t_1 the best estimate is given with status
-   ``uncertain``, on the branch the second contact mode chooses when the posterior is split
-   between two branches (:func:`_branch_by_second_mode`).
+   ``uncertain``. Whenever the posterior is split between two branches of omega_1(x_c), the
+   second contact mode may choose one (:func:`second_mode_chooser`).
 
 Every evaluation uses the samples up to its own instant only, so the streaming form (the
 pipeline's ``OnlineEstimator`` asking :meth:`FastMethod.due` and :meth:`FastMethod.ready`) and
@@ -354,9 +354,11 @@ class WindowEstimate:
         start (> 1: the contact opens); NaN when not computed.
     branch_contradicted : bool
         True when a higher mode of the fit points to another branch than the posterior's.
-    branch_by_second_mode : bool
+    branch_chosen_by_second_mode : bool
         True when the posterior held two branches and the second contact mode chose one
         (``FastConfig.branch_by_second_mode``); ``posterior`` is then conditioned on it.
+    second_mode : dict
+        What the second contact mode's test reported when it was asked (empty otherwise).
     """
 
     start_index: int
@@ -375,12 +377,14 @@ class WindowEstimate:
     ratio_z: float = math.nan
     opening: float = math.nan
     branch_contradicted: bool = False
-    branch_by_second_mode: bool = False
+    branch_chosen_by_second_mode: bool = False
+    second_mode: dict[str, Any] = field(default_factory=dict)
 
 
-#: Which of two candidate contact points (m) the record up to a sample index supports: 0, 1, or
-#: None when it does not say (see :func:`second_mode_chooser`).
-BranchChooser = Callable[[int, tuple[float, ...]], "int | None"]
+#: Which of two candidate contact points (m) the window [start, end] (sample indices) with
+#: fundamental omega_1 (rad/s) supports: 0, 1 or None when it does not say, and the test's
+#: report (see :func:`second_mode_chooser`).
+BranchChooser = Callable[[int, int, float, tuple[float, ...]], "tuple[int | None, dict[str, Any]]"]
 
 #: Cache of window fits within one recording, keyed by the window's last index.
 FitCache = dict[int, "DampedSinusoidFit | None"]
@@ -479,10 +483,10 @@ def evaluate_window(
     cache : dict, optional
         Fits of this recording's windows by last index; the drift check's shorter windows are
         taken from it (and added to it). Offline the scan passes one; online None (refitted).
-    choose_branch : callable, optional
+    choose_branch : BranchChooser, optional
         When the posterior holds two branches of omega_1(x_c), asked which candidate the
-        record up to ``end_index`` supports (:func:`second_mode_chooser`); the posterior is
-        conditioned on its answer before the checks. None: not asked.
+        window supports (:func:`second_mode_chooser`); the posterior is conditioned on its
+        answer before the checks. None: not asked.
 
     Returns
     -------
@@ -568,16 +572,18 @@ def evaluate_window(
         higher_mode_floor=config.higher_mode_floor,
     )
     chosen = False
+    second_mode: dict[str, Any] = {}
     if (
         choose_branch is not None
         and config.branch_by_second_mode
         and max(posterior.branch_probability) < posterior.level
     ):
         candidates = _candidates(link, omega1, posterior)
-        choice = choose_branch(end_index, candidates) if len(candidates) == 2 else None
-        if choice is not None:
-            posterior = posterior.given_branch(posterior.branch_of(candidates[choice]))
-            chosen = True
+        if len(candidates) == 2:
+            choice, second_mode = choose_branch(rest_index, end_index, omega1, candidates)
+            conditioned = _on_chosen_branch(posterior, candidates, choice)
+            chosen = conditioned is not None
+            posterior = conditioned or posterior
     ratio_z = math.nan
     if statics is not None and math.isfinite(omega1):
         ratio_z, disagreement = _ratio_check(statics, posterior.x_c, link, config)
@@ -631,7 +637,8 @@ def evaluate_window(
         ratio_z=ratio_z,
         opening=opening,
         branch_contradicted=bool(contradiction),
-        branch_by_second_mode=chosen,
+        branch_chosen_by_second_mode=chosen,
+        second_mode=second_mode,
     )
 
 
@@ -1054,48 +1061,78 @@ def _candidates(link: Link, omega1: float, posterior: ContactPosterior) -> tuple
 
 
 def second_mode_chooser(evidence: Evidence) -> BranchChooser:
-    """The second contact mode's answer on the record up to a window's end (a BranchChooser).
+    """The second contact mode's answer on a window of the evidence (a :data:`BranchChooser`).
 
     The paper's test (:func:`~.fusion.second_mode_choice`: a clear spectral peak within
     ``omega2_window`` of one candidate's omega_2, ten times stronger than near the other's) on
-    the spectrum of [t_1, t_j], with only the samples up to j, online and offline alike.
+    the spectrum of the window's own samples [start, end], online and offline alike. It is not
+    asked (no answer) when the window's Hann main lobe, +-4 pi / T_w, is as wide as the gap
+    between the candidates' omega_2 (the other candidate's search window would lie on the
+    lobe's slope and hold no peak whatever the truth). An answer whose search window holds 2 or
+    3 omega_1 is dropped: a clipping contact's harmonic may be what it saw (at 0.70 m on the
+    paper link 3 omega_1 is 2.9 % from the other candidate's omega_2).
     """
+    link = evidence.antenna.link
+    tolerance = evidence.config.omega2_window
 
-    def choose(end_index: int, candidates: tuple[float, ...]) -> int | None:
-        until = dataclasses.replace(evidence, end_index=end_index)
-        choice, _ = second_mode_choice(until, until.measure_frequency().component, candidates)
-        return choice
+    def choose(
+        start: int, end: int, omega1: float, candidates: tuple[float, ...]
+    ) -> tuple[int | None, dict[str, Any]]:
+        omega2 = [float(natural_frequencies(link, x, 2)[1]) for x in candidates]
+        lobe = 4.0 * math.pi / ((end - start) * evidence.sample_period)
+        if lobe >= abs(omega2[0] - omega2[1]):
+            return None, {"not_asked": f"main lobe +-{lobe:.0f} rad/s spans the candidates"}
+        window = dataclasses.replace(evidence, rest_index=start, end_index=end)
+        component = window.measure_frequency().component
+        choice, notes = second_mode_choice(window, component, candidates)
+        if choice is not None:
+            low, high = omega2[choice] / (1.0 + tolerance), omega2[choice] * (1.0 + tolerance)
+            harmonics = [h for h in (2.0 * omega1, 3.0 * omega1) if low <= h <= high]
+            if harmonics:
+                notes = {**notes, "dropped": f"{harmonics[0]:.0f} rad/s, a harmonic of omega_1"}
+                return None, notes
+        return choice, notes
 
     return choose
 
 
+def _on_chosen_branch(
+    posterior: ContactPosterior, candidates: tuple[float, ...], choice: int | None
+) -> ContactPosterior | None:
+    """``posterior`` conditioned on the branch of ``candidates[choice]``; None when there is no
+    choice or that branch holds no mass."""
+    if choice is None:
+        return None
+    branch = posterior.branch_of(candidates[choice])
+    if posterior.branch_probability[branch] <= 0.0:
+        return None
+    return posterior.given_branch(branch)
+
+
 def _branch_by_second_mode(
     evidence: Evidence,
-    posterior: ContactPosterior,
+    window: WindowEstimate,
     candidates: tuple[float, ...],
-    contradicted: bool = False,
 ) -> tuple[ContactPosterior, dict[str, Any]]:
     """At the cap, let the second contact mode choose between two branches the ratio cannot.
 
-    Near the top of omega_1(x_c) the two candidates are a few cm apart, closer than the
-    torque/force ratio resolves, and their second modes differ by 12 to 20 % (228 against
-    258 rad/s at 0.75 m). By the cap the
-    record is as long as the paper's spectrum, so the paper's own test applies
-    (:func:`~.fusion.second_mode_choice`: a clear spectral peak near one candidate's omega_2 and
-    none near the other's). When it is decisive the posterior is conditioned on that branch;
-    otherwise it is unchanged. It is asked when the posterior holds both branches, or when the
-    last window's higher mode ``contradicted`` the branch the posterior holds.
+    Asked (:func:`second_mode_chooser`, on the final window) when the posterior still holds
+    both branches, or when the window's higher mode contradicted the branch it holds; with
+    ``branch_by_second_mode`` on, the first case has been asked at the window already. When
+    decisive the posterior is conditioned on that branch; otherwise it is unchanged.
     """
-    if len(candidates) != 2 or (
-        max(posterior.branch_probability) >= posterior.level and not contradicted
-    ):
+    posterior = window.posterior
+    split = max(posterior.branch_probability) < posterior.level
+    if len(candidates) != 2 or not (split or window.branch_contradicted):
         return posterior, {}
-    measurement = evidence.measure_frequency()
-    choice, notes = second_mode_choice(evidence, measurement.component, candidates)
-    if choice is None:
+    if window.branch_chosen_by_second_mode or (split and window.second_mode):
+        return posterior, {}
+    choose = second_mode_chooser(evidence)
+    choice, notes = choose(window.start_index, window.end_index, window.omega1, candidates)
+    conditioned = _on_chosen_branch(posterior, candidates, choice)
+    if conditioned is None:
         return posterior, {"second_mode": notes}
-    chosen = posterior.given_branch(posterior.branch_of(candidates[choice]))
-    return chosen, {"second_mode": notes, "branch_chosen_by": "omega2"}
+    return conditioned, {"second_mode": notes, "branch_chosen_by": "omega2"}
 
 
 def conclude_fast(
@@ -1122,15 +1159,19 @@ def conclude_fast(
     post = final.posterior
     # The branch edges do not change with conditioning: the candidates serve before and after
     candidates = _candidates(evidence.antenna.link, final.omega1, post)
-    if final.branch_by_second_mode:
+    if final.second_mode:
+        diag["second_mode"] = final.second_mode
+    if final.branch_chosen_by_second_mode:
         diag["branch_chosen_by"] = "omega2"
     if result.reached_cap and not final.sure:
-        # Only the samples up to this method's own t_e (the cap), online and offline alike
-        until_cap = dataclasses.replace(evidence, end_index=final.end_index)
-        post, second_mode = _branch_by_second_mode(
-            until_cap, post, candidates, final.branch_contradicted
-        )
+        # The final window's samples only (up to the cap), online and offline alike
+        post, second_mode = _branch_by_second_mode(evidence, final, candidates)
         diag.update(second_mode)
+        if post is not final.posterior and final.statics is not None:
+            # The ratio's agreement is judged again at the chosen branch's maximum
+            ratio_z, _ = _ratio_check(final.statics, post.x_c, evidence.antenna.link, config)
+            final = dataclasses.replace(final, posterior=post, ratio_z=ratio_z)
+            result = dataclasses.replace(result, final=final)
     statics = final.statics
     push = statics.perpendicular_force if statics is not None else math.nan
     touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link)
