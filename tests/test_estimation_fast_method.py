@@ -587,3 +587,36 @@ def test_the_second_mode_declares_a_noisy_far_contact_online_as_offline() -> Non
     declared = next(w for w in FastMethod().history(evidence) if w.sure)
     assert declared.branch_chosen_by_second_mode
     assert evidence.t[declared.end_index] == offline.t_e
+
+
+def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is_dropped() -> None:
+    # The noisy 0.9 m synthetic recording above: its second mode sits at the 0.9 m candidate's
+    # omega_2, so on the window [t_1, t_1 + 0.5 s] the chooser picks that candidate. On 0.1 s the
+    # Hann main lobe (+-126 rad/s) is wider than the candidates' omega_2 gap (~100 rad/s): not
+    # asked. With a fundamental of half the peak's frequency the peak is 2 omega_1 itself,
+    # which a clipping contact would make: the answer is dropped.
+    from sensing_antenna.estimation.fast import second_mode_chooser
+    from sensing_antenna.estimation.frequency import find_peak
+    from sensing_antenna.estimation.pipeline import gather_evidence
+    from test_estimation_pipeline import Synthetic, synthetic_recording
+
+    antenna = paper_antenna()
+    evidence = gather_evidence(synthetic_recording(Synthetic(x_c=0.9, seed=1, noise=8.0)), antenna)
+    assert isinstance(evidence, Evidence)
+    omega1 = float(CURVE.omega1(0.9))
+    candidates = tuple(float(c.x_c) for c in CURVE.contact_points(omega1))
+    assert len(candidates) == 2
+    choose = second_mode_chooser(evidence)
+    start = evidence.rest_index
+    choice, _ = choose(start, start + 500, omega1, candidates)
+    assert choice is not None and candidates[choice] == pytest.approx(0.9, abs=1e-3)
+    short, short_notes = choose(start, start + 100, omega1, candidates)
+    assert short is None and "not_asked" in short_notes
+    # The peak the answer rests on, found as the chooser finds it
+    window = replace(evidence, end_index=start + 500)
+    omega, power = window.component_spectrum(window.measure_frequency().component)
+    omega2 = float(natural_frequencies(LINK, candidates[choice], 2)[1])
+    peak = find_peak(omega, power, (omega2 / 1.05, omega2 * 1.05))
+    assert peak is not None and abs(peak.omega - omega2) < 0.01 * omega2
+    dropped, dropped_notes = choose(start, start + 500, 0.5 * peak.omega, candidates)
+    assert dropped is None and "dropped" in dropped_notes

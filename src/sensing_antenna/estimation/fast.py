@@ -40,6 +40,7 @@ from sensing_antenna.antenna import Link
 from sensing_antenna.beam import contact_to_base_shear, natural_frequencies
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.frequency import find_peak
 from sensing_antenna.estimation.fusion import second_mode_choice
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.parametric import DampedSinusoidFit, select_model_order
@@ -1068,9 +1069,10 @@ def second_mode_chooser(evidence: Evidence) -> BranchChooser:
     the spectrum of the window's own samples [start, end], online and offline alike. It is not
     asked (no answer) when the window's Hann main lobe, +-4 pi / T_w, is as wide as the gap
     between the candidates' omega_2 (the other candidate's search window would lie on the
-    lobe's slope and hold no peak whatever the truth). An answer whose search window holds 2 or
-    3 omega_1 is dropped: a clipping contact's harmonic may be what it saw (at 0.70 m on the
-    paper link 3 omega_1 is 2.9 % from the other candidate's omega_2).
+    lobe's slope and hold no peak whatever the truth). An answer whose peak lies nearer 2 or 3
+    omega_1 than the chosen candidate's omega_2 is dropped: a clipping contact's harmonic may be
+    what it saw (at 0.70 m on the paper link 3 omega_1 is 2.9 % from the other candidate's
+    omega_2).
     """
     link = evidence.antenna.link
     tolerance = evidence.config.omega2_window
@@ -1085,12 +1087,19 @@ def second_mode_chooser(evidence: Evidence) -> BranchChooser:
         window = dataclasses.replace(evidence, rest_index=start, end_index=end)
         component = window.measure_frequency().component
         choice, notes = second_mode_choice(window, component, candidates)
-        if choice is not None:
-            low, high = omega2[choice] / (1.0 + tolerance), omega2[choice] * (1.0 + tolerance)
-            harmonics = [h for h in (2.0 * omega1, 3.0 * omega1) if low <= h <= high]
-            if harmonics:
-                notes = {**notes, "dropped": f"{harmonics[0]:.0f} rad/s, a harmonic of omega_1"}
-                return None, notes
+        if choice is None:
+            return choice, notes
+        # The peak the answer rests on, nearer a harmonic than the candidate's omega_2?
+        expected = omega2[choice]
+        omega, power = window.component_spectrum(component)
+        peak = find_peak(omega, power, (expected / (1.0 + tolerance), expected * (1.0 + tolerance)))
+        for harmonic in (2.0 * omega1, 3.0 * omega1):
+            if peak is not None and abs(peak.omega - harmonic) < abs(peak.omega - expected):
+                dropped = (
+                    f"the peak at {peak.omega:.1f} rad/s is nearer {harmonic:.1f} rad/s, a "
+                    "harmonic of omega_1"
+                )
+                return None, {**notes, "dropped": dropped}
         return choice, notes
 
     return choose
