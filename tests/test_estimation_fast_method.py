@@ -612,7 +612,8 @@ def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is
     assert choice is not None and candidates[choice] == pytest.approx(0.9, abs=1e-3)
     short, short_notes = choose(start, start + 100, omega1, candidates)
     assert short is None and "not_asked" in short_notes
-    # The peak the answer rests on, found as the chooser finds it
+    # The peak the answer rests on, found as the chooser finds it: the synthetic mode 2 is at
+    # the link's omega_2, so within 1 % (the 0.5 s window's zero-padded peak, interpolated)
     window = replace(evidence, end_index=start + 500)
     omega, power = window.component_spectrum(window.measure_frequency().component)
     omega2 = float(natural_frequencies(LINK, candidates[choice], 2)[1])

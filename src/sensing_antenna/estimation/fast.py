@@ -40,8 +40,7 @@ from sensing_antenna.antenna import Link
 from sensing_antenna.beam import contact_to_base_shear, natural_frequencies
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.evidence import Evidence, sensing_curve
-from sensing_antenna.estimation.frequency import find_peak
-from sensing_antenna.estimation.fusion import second_mode_choice
+from sensing_antenna.estimation.fusion import predicted_omega2, second_mode_choice
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.parametric import DampedSinusoidFit, select_model_order
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
@@ -1074,13 +1073,11 @@ def second_mode_chooser(evidence: Evidence) -> BranchChooser:
     what it saw (at 0.70 m on the paper link 3 omega_1 is 2.9 % from the other candidate's
     omega_2).
     """
-    link = evidence.antenna.link
-    tolerance = evidence.config.omega2_window
 
     def choose(
         start: int, end: int, omega1: float, candidates: tuple[float, ...]
     ) -> tuple[int | None, dict[str, Any]]:
-        omega2 = [float(natural_frequencies(link, x, 2)[1]) for x in candidates]
+        omega2 = predicted_omega2(evidence, candidates)
         lobe = 4.0 * math.pi / ((end - start) * evidence.sample_period)
         if lobe >= abs(omega2[0] - omega2[1]):
             return None, {"not_asked": f"main lobe +-{lobe:.0f} rad/s spans the candidates"}
@@ -1090,13 +1087,11 @@ def second_mode_chooser(evidence: Evidence) -> BranchChooser:
         if choice is None:
             return choice, notes
         # The peak the answer rests on, nearer a harmonic than the candidate's omega_2?
-        expected = omega2[choice]
-        omega, power = window.component_spectrum(component)
-        peak = find_peak(omega, power, (expected / (1.0 + tolerance), expected * (1.0 + tolerance)))
+        peak = notes["peak_omega"][choice]
         for harmonic in (2.0 * omega1, 3.0 * omega1):
-            if peak is not None and abs(peak.omega - harmonic) < abs(peak.omega - expected):
+            if abs(peak - harmonic) < abs(peak - omega2[choice]):
                 dropped = (
-                    f"the peak at {peak.omega:.1f} rad/s is nearer {harmonic:.1f} rad/s, a "
+                    f"the peak at {peak:.1f} rad/s is nearer {harmonic:.1f} rad/s, a "
                     "harmonic of omega_1"
                 )
                 return None, {**notes, "dropped": dropped}

@@ -255,6 +255,18 @@ def conclude(
     )
 
 
+def predicted_omega2(evidence: Evidence, candidates: Sequence[float]) -> list[float]:
+    """omega_2 (rad/s) at each candidate contact point (m), from the tabulated (omega_1,
+    omega_2) curve (0.5 mm grid, far finer than the ``omega2_window`` search) instead of solving
+    the beam model at t_e."""
+    cfg = evidence.config
+    link = evidence.antenna.link
+    grid, omegas = two_frequency_curve(
+        link, cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length
+    )
+    return [float(np.interp(x, grid, omegas[:, 1])) for x in candidates]
+
+
 def second_mode_choice(
     evidence: Evidence, component: str, candidates: tuple[float, ...]
 ) -> tuple[int | None, dict[str, Any]]:
@@ -264,21 +276,17 @@ def second_mode_choice(
     ratio can resolve; their second natural frequencies differ by 20 % (about 208 against
     250 rad/s at the paper's top). The spectrum is searched within ``omega2_window`` of each
     candidate's omega_2; the candidate whose window holds a clear peak (and the other not, or
-    a weaker one) is chosen.
+    a weaker one) is chosen. The notes hold the predicted omega_2, each window's peak quality
+    and the peak's frequency (rad/s, NaN without a peak).
     """
     cfg = evidence.config
-    link = evidence.antenna.link
     omega, spectrum = evidence.component_spectrum(component)
-    # omega_2 at each candidate from the tabulated (omega_1, omega_2) curve (0.5 mm grid, far
-    # finer than the omega2_window search) instead of solving the beam model at t_e
-    grid, omegas = two_frequency_curve(
-        link, cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length
-    )
-    predicted = [float(np.interp(x, grid, omegas[:, 1])) for x in candidates]
+    predicted = predicted_omega2(evidence, candidates)
     low = min(predicted) / (1.0 + 2.0 * cfg.omega2_window)
     high = max(predicted) * (1.0 + 2.0 * cfg.omega2_window)
     floor = float(np.median(spectrum[(omega >= low) & (omega <= high)]))
     qualities: list[float] = []
+    peaks: list[float] = []
     for omega2 in predicted:
         peak = find_peak(
             omega,
@@ -286,7 +294,8 @@ def second_mode_choice(
             (omega2 / (1.0 + cfg.omega2_window), omega2 * (1.0 + cfg.omega2_window)),
         )
         qualities.append(peak.power / floor if peak is not None and floor > 0 else 0.0)
-    notes = {"predicted_omega2": predicted, "quality": qualities}
+        peaks.append(peak.omega if peak is not None else math.nan)
+    notes = {"predicted_omega2": predicted, "quality": qualities, "peak_omega": peaks}
     best = int(np.argmax(qualities))
     other = qualities[1 - best]
     if qualities[best] >= cfg.min_peak_quality and qualities[best] >= 10.0 * other:
