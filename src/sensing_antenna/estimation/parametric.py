@@ -224,40 +224,54 @@ def _basis_derivatives(tau: FloatArray, params: FloatArray, degree: int) -> Floa
     return out
 
 
-def _projection_residual(
-    params: FloatArray, tau: FloatArray, weighted: FloatArray, degree: int
-) -> FloatArray:
-    """Weighted residual after the linear least-squares solve, flattened (variable projection)."""
-    q, _ = np.linalg.qr(_basis(tau, params, degree))
-    residual = weighted - q @ (q.T @ weighted)
-    return np.asarray(residual.ravel(), dtype=float)
+class _Projection:
+    """Variable projection of one weighted record: its residual and Jacobian at (w, s).
 
+    The basis and its QR factors at the last parameters asked are kept: the solver asks the
+    Jacobian at the point whose residual it has just computed, and factoring once serves both.
+    """
 
-def _projection_jacobian(
-    params: FloatArray, tau: FloatArray, weighted: FloatArray, degree: int
-) -> FloatArray:
-    """Kaufman's approximation of the variable-projection Jacobian: -(I - Q Q^T) dPhi_j C."""
-    basis = _basis(tau, params, degree)
-    q, r = np.linalg.qr(basis)
-    coef = np.linalg.solve(r, q.T @ weighted) if np.all(np.diag(r) != 0) else None
-    if coef is None:
-        coef = np.linalg.lstsq(basis, weighted, rcond=None)[0]
-    # Only the two columns of mode j depend on (w_j, s_j): d Phi_j C built per mode directly
-    # (same values as contracting _basis_derivatives with C, without its zero blocks).
-    p = degree + 1
-    omega, decay = params[0::2], params[1::2]
-    envelope = np.exp(-np.multiply.outer(tau, decay))
-    phase = np.multiply.outer(tau, omega)
-    cos_part = (envelope * np.cos(phase))[:, :, None]
-    sin_part = (envelope * np.sin(phase))[:, :, None]
-    a, b = coef[p::2][None], coef[p + 1 :: 2][None]
-    t3 = tau[:, None, None]
-    cols = np.empty((2 * omega.size, tau.size, coef.shape[1]))
-    # d/dw: tau (-a sin + b cos) envelope;  d/ds: -tau (a cos + b sin) envelope
-    cols[0::2] = np.moveaxis(t3 * (b * cos_part - a * sin_part), 1, 0)
-    cols[1::2] = np.moveaxis(-t3 * (a * cos_part + b * sin_part), 1, 0)
-    cols -= q @ (q.T @ cols)
-    return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
+    def __init__(self, tau: FloatArray, weighted: FloatArray, degree: int) -> None:
+        self.tau, self.weighted, self.degree = tau, weighted, degree
+        self._at: FloatArray | None = None
+        self._basis = self._q = self._r = np.empty((0, 0))
+
+    def _factor(self, params: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        if self._at is None or not np.array_equal(params, self._at):
+            self._basis = _basis(self.tau, params, self.degree)
+            self._q, self._r = np.linalg.qr(self._basis)
+            self._at = np.array(params, dtype=float)
+        return self._basis, self._q, self._r
+
+    def residual(self, params: FloatArray) -> FloatArray:
+        """Weighted residual after the linear least-squares solve, flattened."""
+        _, q, _ = self._factor(params)
+        residual = self.weighted - q @ (q.T @ self.weighted)
+        return np.asarray(residual.ravel(), dtype=float)
+
+    def jacobian(self, params: FloatArray) -> FloatArray:
+        """Kaufman's approximation of the Jacobian: -(I - Q Q^T) dPhi_j C."""
+        basis, q, r = self._factor(params)
+        tau, weighted, degree = self.tau, self.weighted, self.degree
+        coef = np.linalg.solve(r, q.T @ weighted) if np.all(np.diag(r) != 0) else None
+        if coef is None:
+            coef = np.linalg.lstsq(basis, weighted, rcond=None)[0]
+        # Only the two columns of mode j depend on (w_j, s_j): d Phi_j C built per mode directly
+        # (same values as contracting _basis_derivatives with C, without its zero blocks).
+        p = degree + 1
+        omega, decay = params[0::2], params[1::2]
+        envelope = np.exp(-np.multiply.outer(tau, decay))
+        phase = np.multiply.outer(tau, omega)
+        cos_part = (envelope * np.cos(phase))[:, :, None]
+        sin_part = (envelope * np.sin(phase))[:, :, None]
+        a, b = coef[p::2][None], coef[p + 1 :: 2][None]
+        t3 = tau[:, None, None]
+        cols = np.empty((2 * omega.size, tau.size, coef.shape[1]))
+        # d/dw: tau (-a sin + b cos) envelope;  d/ds: -tau (a cos + b sin) envelope
+        cols[0::2] = np.moveaxis(t3 * (b * cos_part - a * sin_part), 1, 0)
+        cols[1::2] = np.moveaxis(-t3 * (a * cos_part + b * sin_part), 1, 0)
+        cols -= q @ (q.T @ cols)
+        return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
 
 
 def _pencil_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
@@ -396,12 +410,12 @@ def fit_damped_sinusoids(
     if z is None:
         return None
     start = _initial_modes(y / scale, z, n_modes, sample_period, lower, upper, target_band)
-    if not np.all(np.isfinite(_projection_residual(start, tau, y / scale, degree))):
+    if not np.all(np.isfinite(_Projection(tau, y / scale, degree).residual(start))):
         return None
     bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
     params, ok = _refine(start, tau, y / scale, bounds, degree)
     if noise_std is None:
-        residual = _projection_residual(params, tau, y / scale, degree).reshape(n, k) * scale
+        residual = _Projection(tau, y / scale, degree).residual(params).reshape(n, k) * scale
         dof = max(n - n_linear - 2 * n_modes, 1)
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
@@ -416,12 +430,12 @@ def _refine(
     bounds: tuple[FloatArray, FloatArray],
     degree: int,
 ) -> tuple[FloatArray, bool]:
+    projection = _Projection(tau, weighted, degree)
     solution = least_squares(
-        _projection_residual,
+        projection.residual,
         start,
-        jac=_projection_jacobian,
+        jac=projection.jacobian,
         bounds=bounds,
-        args=(tau, weighted, degree),
         method="trf",
         x_scale="jac",
         # Relative steps of 1e-8 are 1e-5 of the smallest standard error of omega_1 (~1e-3)
