@@ -304,10 +304,15 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(first_window=1.0, cap=0.5)
 
 
-def test_offline_and_online_agree_on_a_simulated_recording() -> None:
+def test_offline_and_online_agree_on_a_simulated_recording(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     # The pipeline's batch and streaming forms hand the same samples to the method; the fast
     # method only reads samples up to its own declaration, so both give identical estimates.
+    # Online, each window (first sample, last sample, polynomial degree) is fitted once: the
+    # session keeps the fits between evaluations and the conclusion does not scan again.
     simulator = pytest.importorskip("sensing_antenna.simulator")
+    import sensing_antenna.estimation.fast as fast_module
     from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
 
     antenna = paper_antenna()
@@ -315,6 +320,14 @@ def test_offline_and_online_agree_on_a_simulated_recording() -> None:
         antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
     )
     offline = estimate(recording, antenna, FastMethod())
+    fitted: list[tuple[float, int, int]] = []
+    select = fast_module.select_model_order
+
+    def counting(signals: Any, sample_period: float, *args: Any, **kwargs: Any) -> Any:
+        fitted.append((args[1], len(signals), kwargs["degree"]))
+        return select(signals, sample_period, *args, **kwargs)
+
+    monkeypatch.setattr(fast_module, "select_model_order", counting)
     online = OnlineEstimator(antenna, recording.sample_period, FastMethod())
     for k in range(recording.t.shape[0]):
         online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
@@ -322,6 +335,7 @@ def test_offline_and_online_agree_on_a_simulated_recording() -> None:
     assert streamed.status == offline.status
     assert streamed.x_c == offline.x_c
     assert streamed.t_e == offline.t_e
+    assert fitted and len(fitted) == len(set(fitted)), "a window was fitted twice online"
     # Reference: the simulator's contact point (0.6 m nominal, the contact moves < 3 mm as the
     # link bends); the fast estimate must be within the tolerance and well before the paper's
     # 1 s spectrum window.
@@ -621,3 +635,45 @@ def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is
     assert peak is not None and abs(peak.omega - omega2) < 0.01 * omega2
     dropped, dropped_notes = choose(start, start + 500, 0.5 * peak.omega, candidates)
     assert dropped is None and "dropped" in dropped_notes
+
+
+def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant() -> None:
+    # update_block feeds what arrived together (a real-time loop that fell behind): the fast
+    # method is asked at the block's last grid instant only. Blocks of one sample are update()
+    # and give the offline estimate.
+    simulator = pytest.importorskip("sensing_antenna.simulator")
+    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
+
+    antenna = paper_antenna()
+    recording = simulator.simulate(
+        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
+    )
+    offline = estimate(recording, antenna, FastMethod())
+    t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
+    single = OnlineEstimator(antenna, recording.sample_period, FastMethod())
+    for k in range(t.shape[0]):
+        single.update_block(t[k : k + 1], theta[k : k + 1], force[k : k + 1], torque[k : k + 1])
+    assert (single.finalize().x_c, single.finalize().t_e) == (offline.x_c, offline.t_e)
+
+    asked: list[int] = []
+
+    class Counting(FastMethod):
+        def evaluate_last(self, evidence: Evidence, caches: Any = None) -> Any:
+            asked.append(evidence.end_index)
+            return super().evaluate_last(evidence, caches)
+
+    # The samples from t_1 + 0.2 s (the hold's end) to t_1 + 0.3 s arrive together; the
+    # estimate is that of the window asked (sure there), not of an earlier grid instant
+    t_1_index = int(np.searchsorted(t, offline.t_1))
+    first, last = t_1_index + 200, t_1_index + 300
+    blocked = OnlineEstimator(antenna, recording.sample_period, Counting())
+    out = None
+    for k in range(first):
+        out = blocked.update(t[k], theta[k], force[k], torque[k]) or out
+    assert out is None
+    out = blocked.update_block(
+        t[first:last], theta[first:last], force[first:last], torque[first:last]
+    )
+    assert len(asked) == 1, "one question per block"
+    assert asked[0] <= last - 1
+    assert out is not None and out.t_e == t[asked[0]]

@@ -58,6 +58,7 @@ __all__ = [
     "FastConfig",
     "FastConfigError",
     "FastMethod",
+    "FastSession",
     "ScanInputs",
     "ScanResult",
     "WindowEstimate",
@@ -482,7 +483,7 @@ def evaluate_window(
     config : FastConfig
     cache : dict, optional
         Fits of this recording's windows by last index; the drift check's shorter windows are
-        taken from it (and added to it). Offline the scan passes one; online None (refitted).
+        taken from it (and added to it). The scan and an online session pass one; None refits.
     choose_branch : BranchChooser, optional
         When the posterior holds two branches of omega_1(x_c), asked which candidate the
         window supports (:func:`second_mode_chooser`); the posterior is conditioned on its
@@ -752,7 +753,7 @@ def evaluate_from_t1_or_hold(
     When the window from t_1 shows the contact opening (``max_opening``), the link was bouncing
     on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
     once it is at least ``first_window`` long (before that the one from t_1 is returned, not
-    sure). ``caches`` holds the fits of the two kinds of window (offline); None refits.
+    sure). ``caches`` holds the fits of the two kinds of window; None refits.
     ``choose_branch`` as in :func:`evaluate_window`.
     """
     early, late = caches if caches is not None else (None, None)
@@ -854,6 +855,7 @@ def evaluations(
     earliest: int = 0,
     hold_end: int = -1,
     choose_branch: BranchChooser | None = None,
+    caches: tuple[FitCache, FitCache] | None = None,
 ) -> Iterator[WindowEstimate]:
     """Every window ending on the evaluation grid from ``earliest`` to the cap, in order.
 
@@ -861,10 +863,12 @@ def evaluations(
     after ``earliest`` and ends at the cap or at ``inputs.end_index``, whichever comes first. Each
     window starts at t_1, or at ``hold_end`` when the contact opened
     (:func:`evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are cached, so
-    the drift check's shorter windows are fitted once. ``choose_branch`` as in
+    the drift check's shorter windows are fitted once; ``caches`` (windows from t_1, windows from
+    the hold's end) are used and filled when given, else new ones. ``choose_branch`` as in
     :func:`evaluate_window`.
     """
-    caches: tuple[FitCache, FitCache] = ({}, {})
+    if caches is None:
+        caches = ({}, {})
     for offset in evaluation_offsets(inputs.sample_period, inputs.config):
         j = inputs.rest_index + int(offset)
         if j < earliest:
@@ -881,16 +885,17 @@ def scan(
     earliest: int = 0,
     hold_end: int = -1,
     choose_branch: BranchChooser | None = None,
+    caches: tuple[FitCache, FitCache] | None = None,
 ) -> ScanResult:
     """Evaluate the growing window on the evaluation grid until sure, the cap or the samples' end.
 
-    The windows are those of :func:`evaluations`; ``earliest`` is the end of the pipeline's hold,
-    before which there is no contact frame.
+    The windows are those of :func:`evaluations` (``caches`` as there); ``earliest`` is the end
+    of the pipeline's hold, before which there is no contact frame.
     """
     last = inputs.rest_index + int(evaluation_offsets(inputs.sample_period, inputs.config)[-1])
     final: WindowEstimate | None = None
     count = 0
-    for final in evaluations(inputs, earliest, hold_end, choose_branch):
+    for final in evaluations(inputs, earliest, hold_end, choose_branch, caches):
         count += 1
         if final.sure:
             return ScanResult(final, count, False)
@@ -947,15 +952,32 @@ class FastMethod:
         k = int(np.searchsorted(offsets, samples_since_t1))
         return k < offsets.size and int(offsets[k]) == samples_since_t1
 
-    def ready(self, evidence: Evidence) -> bool:
-        """Whether the window ending at ``evidence.end_index`` is sure or at the cap."""
+    def session(self) -> FastSession:
+        """A fresh online run of this method: keeps the window fits of one manoeuvre."""
+        return FastSession(self)
+
+    def ready(self, evidence: Evidence, caches: tuple[FitCache, FitCache] | None = None) -> bool:
+        """Whether the window ending at ``evidence.end_index`` is sure or at the cap.
+
+        ``caches`` as in :func:`evaluations` (None: every window it reads is fitted again).
+        """
+        window = self.evaluate_last(evidence, caches)
+        return window is None or window.sure
+
+    def evaluate_last(
+        self, evidence: Evidence, caches: tuple[FitCache, FitCache] | None = None
+    ) -> WindowEstimate | None:
+        """The window ending at ``evidence.end_index``; None at or after the cap (not evaluated).
+
+        ``caches`` as in :func:`evaluations`.
+        """
         offsets = evaluation_offsets(evidence.sample_period, self.config)
         if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
-            return True
+            return None
         inputs = self._prepare(evidence)
         return evaluate_from_t1_or_hold(
-            inputs, evidence.hold_end, choose_branch=second_mode_chooser(evidence)
-        ).sure
+            inputs, evidence.hold_end, caches, second_mode_chooser(evidence)
+        )
 
     def history(self, evidence: Evidence, from_t1: bool = False) -> tuple[WindowEstimate, ...]:
         """Every evaluation of the growing window up to the cap, without stopping when sure.
@@ -971,11 +993,74 @@ class FastMethod:
             evaluations(inputs, earliest, evidence.hold_end, second_mode_chooser(evidence))
         )
 
-    def conclude(self, evidence: Evidence) -> ContactEstimate:
-        """Scan the evidence from t_1 and give the first sure estimate (or the capped one)."""
+    def conclude(
+        self, evidence: Evidence, caches: tuple[FitCache, FitCache] | None = None
+    ) -> ContactEstimate:
+        """Scan the evidence from t_1 and give the first sure estimate (or the capped one).
+
+        ``caches`` as in :func:`evaluations`.
+        """
         inputs = self._prepare(evidence)
-        result = scan(inputs, evidence.hold_end, evidence.hold_end, second_mode_chooser(evidence))
+        result = scan(
+            inputs, evidence.hold_end, evidence.hold_end, second_mode_chooser(evidence), caches
+        )
         return conclude_fast(evidence, result, inputs.bias, self.config, self.name)
+
+
+@dataclass
+class FastSession:
+    """The fast method over one manoeuvre online (:meth:`FastMethod.session`).
+
+    The samples of a window do not change once they have arrived, so the fits of every window
+    evaluated so far are kept and the next evaluation fits only its own window (its drift
+    check's shorter windows are earlier grid windows). :meth:`conclude` declares the window
+    :meth:`ready` has just found sure; otherwise (the cap, the pipeline's own end) it scans
+    with the kept fits. Asked at every grid instant, it gives the answers of the method
+    without a session. The fits are forgotten when t_c, t_1 or the hold's end change (another
+    manoeuvre).
+    """
+
+    method: FastMethod
+    _key: tuple[int, int, int] | None = None
+    _caches: tuple[FitCache, FitCache] = field(default_factory=lambda: ({}, {}))
+    _last: WindowEstimate | None = None
+    _evaluated: int = 0
+
+    @property
+    def name(self) -> str:
+        """The method's name."""
+        return self.method.name
+
+    def _caches_for(self, evidence: Evidence) -> tuple[FitCache, FitCache]:
+        key = (evidence.contact_index, evidence.rest_index, evidence.hold_end)
+        if key != self._key:
+            self._key, self._caches = key, ({}, {})
+            self._last, self._evaluated = None, 0
+        return self._caches
+
+    def due(self, samples_since_t1: int, sample_period: float) -> bool:
+        """As :meth:`FastMethod.due`."""
+        return self.method.due(samples_since_t1, sample_period)
+
+    def ready(self, evidence: Evidence) -> bool:
+        """As :meth:`FastMethod.ready`, with this manoeuvre's fits."""
+        self._last = self.method.evaluate_last(evidence, self._caches_for(evidence))
+        if self._last is None:
+            return True
+        self._evaluated += 1
+        return self._last.sure
+
+    def conclude(self, evidence: Evidence) -> ContactEstimate:
+        """The window :meth:`ready` found sure at ``evidence.end_index``; else as
+        :meth:`FastMethod.conclude`, with this manoeuvre's fits."""
+        caches = self._caches_for(evidence)
+        last = self._last
+        if last is None or not last.sure or last.end_index != evidence.end_index:
+            return self.method.conclude(evidence, caches)
+        method = self.method
+        bias = method._prepare(evidence).bias
+        result = ScanResult(last, self._evaluated, False)
+        return conclude_fast(evidence, result, bias, method.config, method.name)
 
 
 def _direction_change(early: StaticRatio, late: StaticRatio) -> tuple[float, float]:

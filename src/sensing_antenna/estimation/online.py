@@ -1,4 +1,5 @@
-"""The streaming form of the pipeline: :class:`OnlineEstimator`, one update per sample.
+"""The streaming form of the pipeline: :class:`OnlineEstimator`, one update per sample (or per
+block of samples that arrived together).
 
 It keeps only cheap per-sample state (contact detector, Eq. 20 filters, the rest test, the
 moving mean of the ratio and its spread) and, at t_1 + hold and at t_e, calls the very functions
@@ -151,7 +152,12 @@ class OnlineEstimator:
         self._offset: tuple[float, ...] = (0.0,) * 6
         self._planned: int | None = None
         self._done = False
+        self._pending: tuple[int, int | None, int] | None = None
         self.result: ContactEstimate | None = None
+        # A method that keeps state over one manoeuvre (``fast``: its window fits) runs as a
+        # session of its own; the others are used as they are
+        session = getattr(self.method, "session", None)
+        self._run: EstimationMethod = session() if session is not None else self.method
 
     def _grow(self) -> None:
         size = 2 * self._t.shape[0]
@@ -186,6 +192,65 @@ class OnlineEstimator:
         """
         if self._done:
             return None
+        out = self._take(t, theta, force, torque)
+        if out is None and self._pending is not None:
+            return self._ask_pending()
+        return out
+
+    def update_block(
+        self, t: FloatArray, theta: FloatArray, force: FloatArray, torque: FloatArray
+    ) -> ContactEstimate | None:
+        """Feed the samples that arrived together; returns the estimate at t_e (once), else None.
+
+        Every sample goes through the per-sample steps of :meth:`update`, but a method that
+        stops early (``fast``) is asked only at the last of its evaluation instants in the
+        block. A real-time loop that feeds whatever arrived since its previous call therefore
+        falls behind by at most one evaluation, however long an evaluation takes on its
+        machine; the estimate is that of the grid instant asked (``t_e``), which may be later
+        than the first sure instant sample-by-sample feeding would give.
+
+        Parameters
+        ----------
+        t : array, shape (n,)
+            Sample times (s).
+        theta : array, shape (n, 2)
+            Motor angles (rad).
+        force, torque : array, shape (n, 3)
+            F/T sensor samples, motor frame (N, N m).
+        """
+        t, theta = np.asarray(t, dtype=float), np.asarray(theta, dtype=float)
+        force, torque = np.asarray(force, dtype=float), np.asarray(torque, dtype=float)
+        for k in range(t.shape[0]):
+            if self._done:
+                return None
+            out = self._take(float(t[k]), theta[k], force[k], torque[k])
+            if out is not None:
+                return out
+        if self._pending is not None and not self._done:
+            return self._ask_pending()
+        return None
+
+    def _ask_pending(self) -> ContactEstimate | None:
+        """Ask the method at the evaluation instant remembered by :meth:`_take`."""
+        assert self._pending is not None
+        end, converged, n_gaps = self._pending
+        self._pending = None
+        evidence = self._evidence_now(True, end, converged, n_gaps)
+        ready = getattr(self._run, "ready", None)
+        if not isinstance(evidence, str) and ready is not None and ready(evidence):
+            return self._emit(self._run.conclude(evidence))
+        return None
+
+    def _take(
+        self,
+        t: float,
+        theta: Sequence[float] | FloatArray,
+        force: Sequence[float] | FloatArray,
+        torque: Sequence[float] | FloatArray,
+    ) -> ContactEstimate | None:
+        """The per-sample steps of :meth:`update`; an evaluation instant of a method that stops
+        early is remembered in ``_pending`` (with the state the evidence then needs), not asked.
+        """
         j = self._n
         if j == self._t.shape[0]:
             self._grow()
@@ -270,13 +335,12 @@ class OnlineEstimator:
                 self._planned = planned_end(rest, None, self.config, self.sample_period)
         if self._planned is not None and j >= self._planned:
             return self._emit(self._conclude(complete=True))
-        # A method that can stop early (``fast``) is asked on its own cadence, causally
-        due = getattr(self.method, "due", None)
+        # A method that can stop early (``fast``) is asked on its own cadence, causally: the
+        # instant is remembered here and asked by the caller (update: at once; update_block: the
+        # block's last one)
+        due = getattr(self._run, "due", None)
         if due is not None and due(j - rest, self.sample_period):
-            evidence = self._evidence_now(complete=True)
-            ready = getattr(self.method, "ready", None)
-            if not isinstance(evidence, str) and ready is not None and ready(evidence):
-                return self._emit(self.method.conclude(evidence))
+            self._pending = (j, self._converged, len(self._gaps))
         return None
 
     def _rest_found(self, j: int) -> bool:
@@ -353,8 +417,18 @@ class OnlineEstimator:
         self._done = True
         return result
 
-    def _evidence_now(self, complete: bool) -> Evidence | str:
+    def _evidence_now(
+        self,
+        complete: bool,
+        end: int | None = None,
+        converged: int | None = None,
+        n_gaps: int | None = None,
+    ) -> Evidence | str:
+        """Evidence from the samples up to ``end`` (default: the last fed), with the ratio's
+        convergence index and the gaps as they were then (default: now)."""
         assert self._contact is not None and self._rest is not None
+        if end is None:
+            end, converged, n_gaps = self._n - 1, self._converged, len(self._gaps)
         return build_evidence(
             self._t,
             self._theta,
@@ -366,10 +440,10 @@ class OnlineEstimator:
             self._band,
             self._contact,
             self._rest,
-            self._converged,
-            self._n - 1,
+            converged,
+            end,
             complete,
-            self._gaps,
+            self._gaps[:n_gaps],
             self._diagnostics(),
         )
 
@@ -385,7 +459,7 @@ class OnlineEstimator:
                 float(self._t[self._contact]),
                 float(self._t[self._rest]),
             )
-        return self.method.conclude(evidence)
+        return self._run.conclude(evidence)
 
     def finalize(self) -> ContactEstimate:
         """Close the run at the end of the samples; returns the estimate (given or final)."""
