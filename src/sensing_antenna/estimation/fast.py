@@ -19,9 +19,10 @@ from t_1:
    second contact mode may choose one (:func:`second_mode_chooser`).
 
 Every evaluation uses the samples up to its own instant only, so the streaming form (the
-pipeline's ``OnlineEstimator`` asking :meth:`FastMethod.due` and :meth:`FastMethod.ready`) and
-the batch form (:class:`FastMethod` in ``estimate``, or :func:`scan`) declare at the same sample
-with the same numbers.
+pipeline's ``OnlineEstimator`` asking a :class:`FastSession`'s ``due`` and ``ready`` at every
+sample) and the batch form (:class:`FastMethod` in ``estimate``, or :func:`scan`) declare at the
+same sample with the same numbers. Fed in blocks (``OnlineEstimator.update_block``), the
+streaming form asks at each block's last evaluation instant only.
 """
 
 from __future__ import annotations
