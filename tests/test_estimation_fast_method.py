@@ -28,6 +28,7 @@ from sensing_antenna.estimation.fast import (
     _branch_contradiction,
     curve_table,
     evaluate_window,
+    evaluation_offsets,
     model_floor,
     scan,
 )
@@ -637,43 +638,139 @@ def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is
     assert dropped is None and "dropped" in dropped_notes
 
 
-def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant() -> None:
-    # update_block feeds what arrived together (a real-time loop that fell behind): the fast
-    # method is asked at the block's last grid instant only. Blocks of one sample are update()
-    # and give the offline estimate.
+def _azimuthal_06() -> Any:
     simulator = pytest.importorskip("sensing_antenna.simulator")
+    return simulator.simulate(
+        paper_antenna(), simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
+    )
+
+
+def _evaluated_windows(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """Last indices of every window the fast method evaluates from now on."""
+    import sensing_antenna.estimation.fast as fast_module
+
+    ends: list[int] = []
+    evaluate = fast_module.evaluate_from_t1_or_hold
+
+    def recording(inputs: ScanInputs, *args: Any, **kwargs: Any) -> Any:
+        ends.append(inputs.end_index)
+        return evaluate(inputs, *args, **kwargs)
+
+    monkeypatch.setattr(fast_module, "evaluate_from_t1_or_hold", recording)
+    return ends
+
+
+def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # update_block feeds what arrived together (a real-time loop that fell behind): the fast
+    # method evaluates one window, the block's last grid instant, and the estimate is that
+    # window's. Blocks of one sample are update(), and one block holding every sample asks
+    # nothing before the pipeline's own end, so both give the offline estimate.
     from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
 
     antenna = paper_antenna()
-    recording = simulator.simulate(
-        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
-    )
+    recording = _azimuthal_06()
     offline = estimate(recording, antenna, FastMethod())
     t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
     single = OnlineEstimator(antenna, recording.sample_period, FastMethod())
     for k in range(t.shape[0]):
         single.update_block(t[k : k + 1], theta[k : k + 1], force[k : k + 1], torque[k : k + 1])
     assert (single.finalize().x_c, single.finalize().t_e) == (offline.x_c, offline.t_e)
+    whole = OnlineEstimator(antenna, recording.sample_period, FastMethod())
+    assert whole.update_block(t, theta, force, torque) is not None
+    assert (whole.result.x_c, whole.result.t_e) == (offline.x_c, offline.t_e)  # type: ignore[union-attr]
 
-    asked: list[int] = []
-
-    class Counting(FastMethod):
-        def evaluate_last(self, evidence: Evidence, caches: Any = None) -> Any:
-            asked.append(evidence.end_index)
-            return super().evaluate_last(evidence, caches)
-
-    # The samples from t_1 + 0.2 s (the hold's end) to t_1 + 0.3 s arrive together; the
-    # estimate is that of the window asked (sure there), not of an earlier grid instant
+    # The samples from t_1 + 0.2 s (the hold's end) to t_1 + 0.3 s arrive together
     t_1_index = int(np.searchsorted(t, offline.t_1))
     first, last = t_1_index + 200, t_1_index + 300
-    blocked = OnlineEstimator(antenna, recording.sample_period, Counting())
-    out = None
+    blocked = OnlineEstimator(antenna, recording.sample_period, FastMethod())
     for k in range(first):
-        out = blocked.update(t[k], theta[k], force[k], torque[k]) or out
-    assert out is None
+        assert blocked.update(t[k], theta[k], force[k], torque[k]) is None
+    ends = _evaluated_windows(monkeypatch)
     out = blocked.update_block(
         t[first:last], theta[first:last], force[first:last], torque[first:last]
     )
-    assert len(asked) == 1, "one question per block"
-    assert asked[0] <= last - 1
-    assert out is not None and out.t_e == t[asked[0]]
+    assert len(set(ends)) == 1, "one window per block"
+    assert first <= ends[0] < last
+    assert out is not None and out.t_e == t[ends[0]]
+    with pytest.raises(ValueError, match="force has shape"):
+        OnlineEstimator(antenna, recording.sample_period).update_block(
+            t[:3], theta[:3], force[:2], torque[:3]
+        )
+
+
+def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # A tolerance no window meets: every run ends uncertain at the cap. Fed in blocks of 100
+    # samples the method evaluates one window per block and then the cap's, not the skipped
+    # instants (a real-time loop would otherwise spend seconds at the cap), and the capped
+    # estimate is the offline one (the same window on the same samples).
+    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
+    from sensing_antenna.estimation.result import Status
+
+    antenna = paper_antenna()
+    recording = _azimuthal_06()
+    method = FastMethod(FastConfig(tolerance=1e-6))
+    offline = estimate(recording, antenna, method)
+    assert offline.status is Status.UNCERTAIN
+    t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
+    ends = _evaluated_windows(monkeypatch)
+    online = OnlineEstimator(antenna, recording.sample_period, method)
+    out = None
+    for k in range(0, t.shape[0], 100):
+        out = online.update_block(
+            t[k : k + 100], theta[k : k + 100], force[k : k + 100], torque[k : k + 100]
+        )
+        if out is not None:
+            break
+    assert out is not None
+    assert (out.status, out.x_c, out.t_e, out.interval) == (
+        offline.status,
+        offline.x_c,
+        offline.t_e,
+        offline.interval,
+    )
+    grid = evaluation_offsets(recording.sample_period, method.config)
+    assert len(set(ends)) <= 10 < int(np.sum(grid >= 200)), "skipped instants were fitted"
+    assert out.diagnostics["evaluations"] == len(set(ends))
+
+
+def test_a_session_never_serves_the_fits_of_other_samples() -> None:
+    # Two recordings with the same t_c, t_1 and hold, the second with Gamma_y 3 % larger after
+    # the hold: a session (online, after reset(); or handed to estimate) gives each the answer
+    # of a fresh method.
+    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
+
+    antenna = paper_antenna()
+    first = _azimuthal_06()
+    t_1 = estimate(first, antenna, FastMethod()).t_1
+    torque = first.torque.copy()
+    after = first.t > t_1 + 0.2
+    torque[after, 1] *= 1.03
+    second = replace(first, torque=torque)
+    fresh = [estimate(r, antenna, FastMethod()) for r in (first, second)]
+    assert fresh[0].ratio_estimate != fresh[1].ratio_estimate
+    session = FastMethod().session()
+    for recording, expected in zip((first, second), fresh, strict=True):
+        offline = estimate(recording, antenna, session)
+        assert (offline.x_c, offline.t_e, offline.interval, offline.ratio_estimate) == (
+            expected.x_c,
+            expected.t_e,
+            expected.interval,
+            expected.ratio_estimate,
+        )
+    online = OnlineEstimator(antenna, first.sample_period, session)
+    for recording, expected in zip((first, second), fresh, strict=True):
+        online.reset()
+        for k in range(recording.t.shape[0]):
+            online.update(
+                recording.t[k], recording.theta[k], recording.force[k], recording.torque[k]
+            )
+        streamed = online.finalize()
+        assert (streamed.x_c, streamed.t_e, streamed.ratio_estimate) == (
+            expected.x_c,
+            expected.t_e,
+            expected.ratio_estimate,
+        )

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import hashlib
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, fields
@@ -100,7 +101,7 @@ class FastConfig:
     cap : float
         Last evaluation this long after t_1 (s); if still unsure, the estimate is given with
         status ``uncertain``. 1 s, the record of the paper's spectrum: an unsure case is never
-        slower than the paper method and has at least its information.
+        later than the paper method in data time and has at least its information.
     drift_factor : float
         Non-stationarity of omega_1 measured on the recording itself: the fundamental of the
         window [t_1, t] is compared with that of [t_1, t_1 + 2/3 (t - t_1)]; ``drift_factor``
@@ -388,8 +389,23 @@ class WindowEstimate:
 #: report (see :func:`second_mode_chooser`).
 BranchChooser = Callable[[int, int, float, tuple[float, ...]], "tuple[int | None, dict[str, Any]]"]
 
-#: Cache of window fits within one recording, keyed by the window's last index.
-FitCache = dict[int, "DampedSinusoidFit | None"]
+#: Cache of window fits, keyed by :func:`_window_key` (the window's samples themselves, so a
+#: cache can never serve a fit of other data).
+FitCache = dict[tuple[int, int, bytes], "DampedSinusoidFit | None"]
+
+
+def _window_key(
+    channels: FloatArray,
+    rest_index: int,
+    end_index: int,
+    sample_period: float,
+    band: tuple[float, float],
+) -> tuple[int, int, bytes]:
+    """Cache key of the window [rest_index, end_index]: its indices and a digest of its samples,
+    of T_s and of the band."""
+    digest = hashlib.blake2b(channels[rest_index : end_index + 1].tobytes(), digest_size=16)
+    digest.update(np.array([sample_period, *band]).tobytes())
+    return rest_index, end_index, digest.digest()
 
 
 def _fit_window(
@@ -401,8 +417,9 @@ def _fit_window(
     config: FastConfig,
     cache: FitCache | None,
 ) -> DampedSinusoidFit | None:
-    if cache is not None and end_index in cache:
-        return cache[end_index]
+    key = _window_key(channels, rest_index, end_index, sample_period, band)
+    if cache is not None and key in cache:
+        return cache[key]
     fits = [
         select_model_order(
             channels[rest_index : end_index + 1],
@@ -419,7 +436,7 @@ def _fit_window(
     usable = [f for f in fits if f is not None]
     fit = min(usable, key=lambda f: f.bic) if usable else None
     if cache is not None:
-        cache[end_index] = fit
+        cache[key] = fit
     return fit
 
 
@@ -909,8 +926,9 @@ class FastMethod:
 
     Offline the pipeline hands over the samples up to its own t_e; this method searches them
     from t_1 on and declares at its own, earlier instant (reported as ``t_e``), using only the
-    samples up to that instant. Online the pipeline asks :meth:`due` after every sample and, on
-    the cadence grid, :meth:`ready`; it concludes at the first ready sample, the same one.
+    samples up to that instant. Online the pipeline takes a :meth:`session` per manoeuvre and
+    asks its ``due`` after every sample and, on the cadence grid, its ``ready``; it concludes
+    at the first ready sample, the same one.
     """
 
     config: FastConfig = field(default_factory=FastConfig)
@@ -957,28 +975,9 @@ class FastMethod:
         """A fresh online run of this method: keeps the window fits of one manoeuvre."""
         return FastSession(self)
 
-    def ready(self, evidence: Evidence, caches: tuple[FitCache, FitCache] | None = None) -> bool:
-        """Whether the window ending at ``evidence.end_index`` is sure or at the cap.
-
-        ``caches`` as in :func:`evaluations` (None: every window it reads is fitted again).
-        """
-        window = self.evaluate_last(evidence, caches)
-        return window is None or window.sure
-
-    def evaluate_last(
-        self, evidence: Evidence, caches: tuple[FitCache, FitCache] | None = None
-    ) -> WindowEstimate | None:
-        """The window ending at ``evidence.end_index``; None at or after the cap (not evaluated).
-
-        ``caches`` as in :func:`evaluations`.
-        """
-        offsets = evaluation_offsets(evidence.sample_period, self.config)
-        if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
-            return None
-        inputs = self._prepare(evidence)
-        return evaluate_from_t1_or_hold(
-            inputs, evidence.hold_end, caches, second_mode_chooser(evidence)
-        )
+    def ready(self, evidence: Evidence) -> bool:
+        """Whether the window ending at ``evidence.end_index`` is sure or at the cap."""
+        return self.session().ready(evidence)
 
     def history(self, evidence: Evidence, from_t1: bool = False) -> tuple[WindowEstimate, ...]:
         """Every evaluation of the growing window up to the cap, without stopping when sure.
@@ -1008,60 +1007,93 @@ class FastMethod:
         return conclude_fast(evidence, result, inputs.bias, self.config, self.name)
 
 
-@dataclass
 class FastSession:
     """The fast method over one manoeuvre online (:meth:`FastMethod.session`).
 
     The samples of a window do not change once they have arrived, so the fits of every window
-    evaluated so far are kept and the next evaluation fits only its own window (its drift
-    check's shorter windows are earlier grid windows). :meth:`conclude` declares the window
-    :meth:`ready` has just found sure; otherwise (the cap, the pipeline's own end) it scans
-    with the kept fits. Asked at every grid instant, it gives the answers of the method
-    without a session. The fits are forgotten when t_c, t_1 or the hold's end change (another
-    manoeuvre).
+    evaluated so far are kept (by the window's own samples: never served for other data) and
+    the next evaluation fits only its own window (its drift check's shorter windows are earlier
+    grid windows). :meth:`conclude` evaluates one window only: the last grid instant at or
+    before the end of the samples (the one :meth:`ready` has just found sure, or the cap, or
+    the last before the samples ended). Asked at every grid instant, it gives the answers of
+    the method without a session; asked at fewer (``OnlineEstimator.update_block``), the
+    windows it skipped are never fitted.
     """
 
-    method: FastMethod
-    _key: tuple[int, int, int] | None = None
-    _caches: tuple[FitCache, FitCache] = field(default_factory=lambda: ({}, {}))
-    _last: WindowEstimate | None = None
-    _evaluated: int = 0
+    def __init__(self, method: FastMethod) -> None:
+        self.method = method
+        self._caches: tuple[FitCache, FitCache] = ({}, {})
+        # Digest of each window asked, by its last index (for the evaluation count)
+        self._asked: dict[int, bytes] = {}
 
     @property
     def name(self) -> str:
         """The method's name."""
         return self.method.name
 
-    def _caches_for(self, evidence: Evidence) -> tuple[FitCache, FitCache]:
-        key = (evidence.contact_index, evidence.rest_index, evidence.hold_end)
-        if key != self._key:
-            self._key, self._caches = key, ({}, {})
-            self._last, self._evaluated = None, 0
-        return self._caches
+    def session(self) -> FastSession:
+        """A fresh session of the same method (an online estimator takes one per manoeuvre)."""
+        return self.method.session()
 
     def due(self, samples_since_t1: int, sample_period: float) -> bool:
         """As :meth:`FastMethod.due`."""
         return self.method.due(samples_since_t1, sample_period)
 
+    def _evaluate(self, inputs: ScanInputs, evidence: Evidence, end: int) -> WindowEstimate:
+        """:func:`evaluate_from_t1_or_hold` on the window ending at ``end``, remembered."""
+        window = evaluate_from_t1_or_hold(
+            inputs._replace(end_index=end),
+            evidence.hold_end,
+            self._caches,
+            second_mode_chooser(evidence),
+        )
+        self._asked[end] = _window_key(
+            inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band
+        )[2]
+        return window
+
     def ready(self, evidence: Evidence) -> bool:
         """As :meth:`FastMethod.ready`, with this manoeuvre's fits."""
-        self._last = self.method.evaluate_last(evidence, self._caches_for(evidence))
-        if self._last is None:
+        offsets = evaluation_offsets(evidence.sample_period, self.method.config)
+        if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
             return True
-        self._evaluated += 1
-        return self._last.sure
+        inputs = self.method._prepare(evidence)
+        return self._evaluate(inputs, evidence, evidence.end_index).sure
+
+    def _asked_here(self, inputs: ScanInputs) -> set[int]:
+        """Last indices of the windows asked on these very samples."""
+        return {
+            end
+            for end, digest in self._asked.items()
+            if end <= inputs.end_index
+            and digest
+            == _window_key(
+                inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band
+            )[2]
+        }
 
     def conclude(self, evidence: Evidence) -> ContactEstimate:
-        """The window :meth:`ready` found sure at ``evidence.end_index``; else as
-        :meth:`FastMethod.conclude`, with this manoeuvre's fits."""
-        caches = self._caches_for(evidence)
-        last = self._last
-        if last is None or not last.sure or last.end_index != evidence.end_index:
-            return self.method.conclude(evidence, caches)
+        """The estimate at the last grid instant at or before ``evidence.end_index``.
+
+        When :meth:`ready` was asked on these samples, one window is evaluated: that instant's
+        (the one just found sure, or the cap, or the last before the samples ended), with
+        status, evaluation count (windows asked) and cap as :meth:`FastMethod.conclude` gives
+        them when every earlier instant was unsure, so the same estimate when asked at every
+        instant. When it was not (offline, or other samples), as :meth:`FastMethod.conclude`.
+        """
         method = self.method
-        bias = method._prepare(evidence).bias
-        result = ScanResult(last, self._evaluated, False)
-        return conclude_fast(evidence, result, bias, method.config, method.name)
+        inputs = method._prepare(evidence)
+        asked = self._asked_here(inputs)
+        offsets = evaluation_offsets(evidence.sample_period, method.config)
+        instants = inputs.rest_index + offsets
+        instants = instants[(instants >= evidence.hold_end) & (instants <= evidence.end_index)]
+        if not asked or instants.size == 0:
+            return method.conclude(evidence, self._caches)
+        window = self._evaluate(inputs, evidence, int(instants[-1]))
+        count = len(asked | {window.end_index})
+        reached_cap = inputs.rest_index + int(offsets[-1]) <= evidence.end_index
+        result = ScanResult(window, count, reached_cap and not window.sure)
+        return conclude_fast(evidence, result, inputs.bias, method.config, method.name)
 
 
 def _direction_change(early: StaticRatio, late: StaticRatio) -> tuple[float, float]:

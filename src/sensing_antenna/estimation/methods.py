@@ -3,9 +3,9 @@
 A method is an object with a ``name`` and ``conclude(evidence) -> ContactEstimate``; a method that
 can stop earlier (``fast``) also has ``due(samples_since_t1, sample_period)`` (cheap: is this an
 evaluation instant?) and ``ready(evidence)``; one that keeps state over a manoeuvre online has
-``session()``, which gives a fresh object with the same methods (the online estimator takes one
-per manoeuvre). A new method is added to ``_BUILTIN_METHODS``; the
-command line lists whatever :data:`METHODS` holds.
+``session()``, which gives a fresh object with ``name``, ``due``, ``ready``, ``conclude`` and
+``session`` (the online estimator takes one per manoeuvre). A new method is added to
+``_BUILTIN_METHODS``; the command line lists whatever :data:`METHODS` holds.
 """
 
 from __future__ import annotations

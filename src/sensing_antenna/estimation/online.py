@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,6 +43,14 @@ from sensing_antenna.estimation.result import ContactEstimate, Status
 __all__ = ["OnlineEstimator", "early_result"]
 
 FloatArray = NDArray[np.float64]
+
+
+class _Instant(NamedTuple):
+    """An evaluation instant and the streaming state the evidence then needs."""
+
+    end: int  # index of its last sample
+    converged: int | None  # index where the ratio had converged, if it had
+    n_gaps: int  # gaps found up to it
 
 
 def early_result(
@@ -152,7 +160,7 @@ class OnlineEstimator:
         self._offset: tuple[float, ...] = (0.0,) * 6
         self._planned: int | None = None
         self._done = False
-        self._pending: tuple[int, int | None, int] | None = None
+        self._pending: _Instant | None = None
         self.result: ContactEstimate | None = None
         # A method that keeps state over one manoeuvre (``fast``: its window fits) runs as a
         # session of its own; the others are used as they are
@@ -205,9 +213,10 @@ class OnlineEstimator:
         Every sample goes through the per-sample steps of :meth:`update`, but a method that
         stops early (``fast``) is asked only at the last of its evaluation instants in the
         block. A real-time loop that feeds whatever arrived since its previous call therefore
-        falls behind by at most one evaluation, however long an evaluation takes on its
-        machine; the estimate is that of the grid instant asked (``t_e``), which may be later
-        than the first sure instant sample-by-sample feeding would give.
+        falls behind by about one evaluation, however long an evaluation takes on its machine;
+        the estimate is that of the grid instant asked (``t_e``), which may be later than the
+        first sure instant sample-by-sample feeding would give. A block that reaches the
+        pipeline's own end before any instant was asked concludes as the offline method does.
 
         Parameters
         ----------
@@ -218,9 +227,16 @@ class OnlineEstimator:
         force, torque : array, shape (n, 3)
             F/T sensor samples, motor frame (N, N m).
         """
-        t, theta = np.asarray(t, dtype=float), np.asarray(theta, dtype=float)
+        t, theta = np.atleast_1d(np.asarray(t, dtype=float)), np.asarray(theta, dtype=float)
         force, torque = np.asarray(force, dtype=float), np.asarray(torque, dtype=float)
-        for k in range(t.shape[0]):
+        n = t.shape[0]
+        for name, value, width in (("theta", theta, 2), ("force", force, 3), ("torque", torque, 3)):
+            if value.shape != (n, width):
+                raise ValueError(
+                    f"update_block: {name} has shape {value.shape}, expected ({n}, {width}) for "
+                    f"{n} sample times"
+                )
+        for k in range(n):
             if self._done:
                 return None
             out = self._take(float(t[k]), theta[k], force[k], torque[k])
@@ -233,9 +249,8 @@ class OnlineEstimator:
     def _ask_pending(self) -> ContactEstimate | None:
         """Ask the method at the evaluation instant remembered by :meth:`_take`."""
         assert self._pending is not None
-        end, converged, n_gaps = self._pending
+        evidence = self._evidence_now(True, self._pending)
         self._pending = None
-        evidence = self._evidence_now(True, end, converged, n_gaps)
         ready = getattr(self._run, "ready", None)
         if not isinstance(evidence, str) and ready is not None and ready(evidence):
             return self._emit(self._run.conclude(evidence))
@@ -340,7 +355,7 @@ class OnlineEstimator:
         # block's last one)
         due = getattr(self._run, "due", None)
         if due is not None and due(j - rest, self.sample_period):
-            self._pending = (j, self._converged, len(self._gaps))
+            self._pending = _Instant(j, self._converged, len(self._gaps))
         return None
 
     def _rest_found(self, j: int) -> bool:
@@ -417,18 +432,12 @@ class OnlineEstimator:
         self._done = True
         return result
 
-    def _evidence_now(
-        self,
-        complete: bool,
-        end: int | None = None,
-        converged: int | None = None,
-        n_gaps: int | None = None,
-    ) -> Evidence | str:
-        """Evidence from the samples up to ``end`` (default: the last fed), with the ratio's
-        convergence index and the gaps as they were then (default: now)."""
+    def _evidence_now(self, complete: bool, at: _Instant | None = None) -> Evidence | str:
+        """Evidence from the samples up to the instant ``at`` with the state it remembers
+        (None: the last sample fed, and the state now)."""
         assert self._contact is not None and self._rest is not None
-        if end is None:
-            end, converged, n_gaps = self._n - 1, self._converged, len(self._gaps)
+        if at is None:
+            at = _Instant(self._n - 1, self._converged, len(self._gaps))
         return build_evidence(
             self._t,
             self._theta,
@@ -440,10 +449,10 @@ class OnlineEstimator:
             self._band,
             self._contact,
             self._rest,
-            converged,
-            end,
+            at.converged,
+            at.end,
             complete,
-            self._gaps[:n_gaps],
+            self._gaps[: at.n_gaps],
             self._diagnostics(),
         )
 
