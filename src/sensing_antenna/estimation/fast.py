@@ -44,7 +44,11 @@ from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.fusion import predicted_omega2, second_mode_choice
 from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
-from sensing_antenna.estimation.parametric import DampedSinusoidFit, select_model_order
+from sensing_antenna.estimation.parametric import (
+    DampedSinusoidFit,
+    first_poles,
+    select_model_order,
+)
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.estimation.static_fit import (
     SensorBias,
@@ -420,17 +424,24 @@ def _fit_window(
     key = _window_key(channels, rest_index, end_index, sample_period, band)
     if cache is not None and key in cache:
         return cache[key]
+    signals = channels[rest_index : end_index + 1]
+    lowest = min(2, config.polynomial_degree)
+    # The matrix pencil every degree starts from, once (when the record holds the smallest
+    # model at all; otherwise each fit finds out for itself)
+    fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * config.max_modes)
+    poles = first_poles(signals, config.max_modes) if fits_at_all else None
     fits = [
         select_model_order(
-            channels[rest_index : end_index + 1],
+            signals,
             sample_period,
             config.max_modes,
             rest_index * sample_period,
             min_omega=config.min_mode_fraction * band[0],
             degree=degree,
             target_band=band,
+            poles=poles,
         )
-        for degree in range(min(2, config.polynomial_degree), config.polynomial_degree + 1)
+        for degree in range(lowest, config.polynomial_degree + 1)
     ]
     # BIC over the polynomial degree too (it is computed on the unweighted residuals)
     usable = [f for f in fits if f is not None]
@@ -481,6 +492,7 @@ def evaluate_window(
     config: FastConfig,
     cache: FitCache | None = None,
     choose_branch: BranchChooser | None = None,
+    early_statics: bool = True,
 ) -> WindowEstimate:
     """Fit the window [rest_index, end_index] and form the posterior over x_c.
 
@@ -506,6 +518,10 @@ def evaluate_window(
         When the posterior holds two branches of omega_1(x_c), asked which candidate the
         window supports (:func:`second_mode_chooser`); the posterior is conditioned on its
         answer before the checks. None: not asked.
+    early_statics : bool
+        Fit the window of half the length for the statics the slip check compares
+        (``WindowEstimate.early_statics``); they do not enter the posterior or ``sure``, so a
+        window that will not be declared may skip them (False: None).
 
     Returns
     -------
@@ -555,7 +571,7 @@ def evaluate_window(
         half = reference_index(rest_index, end_index, 0.5, sample_period, config)
         half_fit = (
             None
-            if half is None
+            if half is None or not early_statics
             else _fit_window(channels, rest_index, half, sample_period, band, config, cache)
         )
         if (
@@ -764,6 +780,7 @@ def evaluate_from_t1_or_hold(
     hold_end: int,
     caches: tuple[FitCache, FitCache] | None = None,
     choose_branch: BranchChooser | None = None,
+    early_statics: bool = True,
 ) -> WindowEstimate:
     """:func:`evaluate_window` on [t_1, ``inputs.end_index``]; from the end of the hold when the
     contact opened.
@@ -772,16 +789,18 @@ def evaluate_from_t1_or_hold(
     on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
     once it is at least ``first_window`` long (before that the one from t_1 is returned, not
     sure). ``caches`` holds the fits of the two kinds of window; None refits.
-    ``choose_branch`` as in :func:`evaluate_window`.
+    ``choose_branch`` and ``early_statics`` as in :func:`evaluate_window`.
     """
     early, late = caches if caches is not None else (None, None)
-    window = evaluate_window(*inputs, early, choose_branch)
+    window = evaluate_window(*inputs, early, choose_branch, early_statics)
     first = round(inputs.config.first_window / inputs.sample_period)
     if (
         window.opening > inputs.config.max_opening
         and inputs.rest_index < hold_end <= inputs.end_index - first
     ):
-        return evaluate_window(*inputs._replace(rest_index=hold_end), late, choose_branch)
+        return evaluate_window(
+            *inputs._replace(rest_index=hold_end), late, choose_branch, early_statics
+        )
     return window
 
 
@@ -1039,13 +1058,17 @@ class FastSession:
         """As :meth:`FastMethod.due`."""
         return self.method.due(samples_since_t1, sample_period)
 
-    def _evaluate(self, inputs: ScanInputs, evidence: Evidence, end: int) -> WindowEstimate:
-        """:func:`evaluate_from_t1_or_hold` on the window ending at ``end``, remembered."""
+    def _evaluate(
+        self, inputs: ScanInputs, evidence: Evidence, end: int, final: bool
+    ) -> WindowEstimate:
+        """:func:`evaluate_from_t1_or_hold` on the window ending at ``end``, remembered; the
+        slip check's early statics only for the ``final`` window (the one concluded on)."""
         window = evaluate_from_t1_or_hold(
             inputs._replace(end_index=end),
             evidence.hold_end,
             self._caches,
             second_mode_chooser(evidence),
+            early_statics=final,
         )
         self._asked[end] = _window_key(
             inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band
@@ -1058,7 +1081,7 @@ class FastSession:
         if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
             return True
         inputs = self.method._prepare(evidence)
-        return self._evaluate(inputs, evidence, evidence.end_index).sure
+        return self._evaluate(inputs, evidence, evidence.end_index, final=False).sure
 
     def _asked_here(self, inputs: ScanInputs) -> set[int]:
         """Last indices of the windows asked on these very samples."""
@@ -1089,7 +1112,7 @@ class FastSession:
         instants = instants[(instants >= evidence.hold_end) & (instants <= evidence.end_index)]
         if not asked or instants.size == 0:
             return method.conclude(evidence, self._caches)
-        window = self._evaluate(inputs, evidence, int(instants[-1]))
+        window = self._evaluate(inputs, evidence, int(instants[-1]), final=True)
         count = len(asked | {window.end_index})
         reached_cap = inputs.rest_index + int(offsets[-1]) <= evidence.end_index
         result = ScanResult(window, count, reached_cap and not window.sure)

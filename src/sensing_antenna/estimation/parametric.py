@@ -49,6 +49,8 @@ from sensing_antenna.estimation.frequency import find_peak, power_spectrum
 __all__ = [
     "DampedSinusoidFit",
     "damped_sinusoid_crb",
+    "difference_scale",
+    "first_poles",
     "fit_damped_sinusoids",
     "matrix_pencil_poles",
     "select_model_order",
@@ -274,6 +276,22 @@ class _Projection:
         return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
 
 
+def difference_scale(y: FloatArray) -> FloatArray:
+    """Rough noise standard deviation of each channel of ``y`` (n, K): the spread of the first
+    differences over sqrt(2) (noise-dominated at 1 kHz); 1 where a channel is constant."""
+    scale = np.std(np.diff(y, axis=0), axis=0) / math.sqrt(2.0)
+    return np.where(scale > 0.0, scale, 1.0)
+
+
+def first_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
+    """The matrix-pencil poles :func:`fit_damped_sinusoids` starts from without ``noise_std``
+    (channels weighted by :func:`difference_scale`): the same for every polynomial degree."""
+    y = np.asarray(y, dtype=float)
+    if y.ndim == 1:
+        y = y[:, None]
+    return _pencil_poles(y / difference_scale(y), n_modes)
+
+
 def _pencil_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
     """Matrix-pencil poles for up to ``n_modes`` modes plus the polynomial and spare poles."""
     n_poles = min(2 * n_modes + 4, y.shape[0] // 3)
@@ -401,9 +419,7 @@ def fit_damped_sinusoids(
     lower = np.array([max(min_omega, 1e-3), _MIN_DECAY])
     upper = np.array([math.pi / sample_period, _MAX_WINDOW_DECAY / ((n - 1) * sample_period)])
     if noise_std is None:
-        # Rough first weights: the spread of the first differences (noise-dominated at 1 kHz)
-        scale = np.std(np.diff(y, axis=0), axis=0) / math.sqrt(2.0)
-        scale = np.where(scale > 0.0, scale, 1.0)
+        scale = difference_scale(y)
     else:
         scale = np.asarray(noise_std, dtype=float)
     z = poles if poles is not None else _pencil_poles(y / scale, n_modes)
@@ -516,29 +532,33 @@ def select_model_order(
     min_omega: float = 0.0,
     degree: int = 1,
     target_band: tuple[float, float] | None = None,
+    poles: ComplexArray | None = None,
 ) -> DampedSinusoidFit | None:
     """The fit with the smallest BIC among M = 1 .. ``max_modes`` damped modes.
 
     Returns None when no order could be fitted (record too short). The noise of each channel is
     estimated once, from the residuals of the largest order that fits, and used for every order,
     so that the BIC compares the orders on the same weights. ``min_omega`` and ``degree`` as in
-    :func:`fit_damped_sinusoids`; ``target_band`` too.
+    :func:`fit_damped_sinusoids`; ``target_band`` too. ``poles``: :func:`first_poles` of the
+    signals for ``max_modes`` when already at hand (they do not depend on the degree).
     """
     fits = []
     noise: FloatArray | None = None
-    poles: ComplexArray | None = None
+    first = poles
+    weighted: ComplexArray | None = None
     y = np.asarray(signals, dtype=float)
     for m in range(max_modes, 0, -1):
         if noise is None:
             fit = fit_damped_sinusoids(
-                y, sample_period, m, t_start, None, min_omega, degree, None, target_band
+                y, sample_period, m, t_start, None, min_omega, degree, first, target_band
             )
+            first = None  # the next order, if this one did not fit, starts from its own
             if fit is not None:
                 noise = fit.noise_std
-                poles = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
+                weighted = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
         else:
             fit = fit_damped_sinusoids(
-                y, sample_period, m, t_start, noise, min_omega, degree, poles, target_band
+                y, sample_period, m, t_start, noise, min_omega, degree, weighted, target_band
             )
         if fit is not None:
             fits.append(fit)
