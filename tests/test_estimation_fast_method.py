@@ -660,6 +660,21 @@ def _evaluated_windows(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     return ends
 
 
+def _concluded_windows(monkeypatch: pytest.MonkeyPatch) -> list[tuple[Any, Any]]:
+    """(window, scan result) of every conclusion of the fast method from now on."""
+    import sensing_antenna.estimation.fast as fast_module
+
+    finals: list[tuple[Any, Any]] = []
+    conclude = fast_module.conclude_fast
+
+    def recording(evidence: Any, result: Any, *args: Any, **kwargs: Any) -> Any:
+        finals.append((result.final, result))
+        return conclude(evidence, result, *args, **kwargs)
+
+    monkeypatch.setattr(fast_module, "conclude_fast", recording)
+    return finals
+
+
 def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
@@ -713,6 +728,7 @@ def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
     antenna = paper_antenna()
     recording = _azimuthal_06()
     method = FastMethod(FastConfig(tolerance=1e-6))
+    finals = _concluded_windows(monkeypatch)
     offline = estimate(recording, antenna, method)
     assert offline.status is Status.UNCERTAIN
     t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
@@ -735,6 +751,13 @@ def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
     grid = evaluation_offsets(recording.sample_period, method.config)
     assert len(set(ends)) <= 10 < int(np.sum(grid >= 200)), "skipped instants were fitted"
     assert out.diagnostics["evaluations"] == len(set(ends))
+    # Online the windows asked skip the slip check's early statics; the one concluded on has
+    # them, as offline (the capped 1 s window's first half holds several periods)
+    concluded = [window for window, _ in finals]
+    assert len(concluded) == 2 and concluded[0].early_statics is not None
+    online_early, offline_early = concluded[1].early_statics, concluded[0].early_statics
+    assert online_early.ratio == offline_early.ratio
+    assert np.array_equal(online_early.reaction_perp, offline_early.reaction_perp)
 
 
 def test_a_session_never_serves_the_fits_of_other_samples() -> None:

@@ -352,8 +352,8 @@ class WindowEstimate:
     omega1_drift : float
         Change of omega_1 from the window's first 2/3 beyond what the noise explains (rad/s).
     early_statics : StaticRatio or None
-        Statics of the window's first half (the slip reference); None when that half is too
-        short for the model.
+        Statics of the window's first half (the slip reference); None when that half holds
+        fewer than ``min_periods`` periods, or when not asked for (``with_early_statics``).
     ratio_z : float
         Distance of the ratio from the MAP x_c in its standard deviations.
     opening : float
@@ -426,8 +426,8 @@ def _fit_window(
         return cache[key]
     signals = channels[rest_index : end_index + 1]
     lowest = min(2, config.polynomial_degree)
-    # The matrix pencil every degree starts from, once (when the record holds the smallest
-    # model at all; otherwise each fit finds out for itself)
+    # The matrix pencil every degree starts from, once: where the lowest degree's largest
+    # model order fits the record (each fit computes it itself otherwise, as it always did)
     fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * config.max_modes)
     poles = first_poles(signals, config.max_modes) if fits_at_all else None
     fits = [
@@ -492,7 +492,7 @@ def evaluate_window(
     config: FastConfig,
     cache: FitCache | None = None,
     choose_branch: BranchChooser | None = None,
-    early_statics: bool = True,
+    with_early_statics: bool = True,
 ) -> WindowEstimate:
     """Fit the window [rest_index, end_index] and form the posterior over x_c.
 
@@ -518,7 +518,7 @@ def evaluate_window(
         When the posterior holds two branches of omega_1(x_c), asked which candidate the
         window supports (:func:`second_mode_chooser`); the posterior is conditioned on its
         answer before the checks. None: not asked.
-    early_statics : bool
+    with_early_statics : bool
         Fit the window of half the length for the statics the slip check compares
         (``WindowEstimate.early_statics``); they do not enter the posterior or ``sure``, so a
         window that will not be declared may skip them (False: None).
@@ -571,7 +571,7 @@ def evaluate_window(
         half = reference_index(rest_index, end_index, 0.5, sample_period, config)
         half_fit = (
             None
-            if half is None or not early_statics
+            if half is None or not with_early_statics
             else _fit_window(channels, rest_index, half, sample_period, band, config, cache)
         )
         if (
@@ -780,7 +780,7 @@ def evaluate_from_t1_or_hold(
     hold_end: int,
     caches: tuple[FitCache, FitCache] | None = None,
     choose_branch: BranchChooser | None = None,
-    early_statics: bool = True,
+    with_early_statics: bool = True,
 ) -> WindowEstimate:
     """:func:`evaluate_window` on [t_1, ``inputs.end_index``]; from the end of the hold when the
     contact opened.
@@ -789,17 +789,17 @@ def evaluate_from_t1_or_hold(
     on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
     once it is at least ``first_window`` long (before that the one from t_1 is returned, not
     sure). ``caches`` holds the fits of the two kinds of window; None refits.
-    ``choose_branch`` and ``early_statics`` as in :func:`evaluate_window`.
+    ``choose_branch`` and ``with_early_statics`` as in :func:`evaluate_window`.
     """
     early, late = caches if caches is not None else (None, None)
-    window = evaluate_window(*inputs, early, choose_branch, early_statics)
+    window = evaluate_window(*inputs, early, choose_branch, with_early_statics)
     first = round(inputs.config.first_window / inputs.sample_period)
     if (
         window.opening > inputs.config.max_opening
         and inputs.rest_index < hold_end <= inputs.end_index - first
     ):
         return evaluate_window(
-            *inputs._replace(rest_index=hold_end), late, choose_branch, early_statics
+            *inputs._replace(rest_index=hold_end), late, choose_branch, with_early_statics
         )
     return window
 
@@ -1068,7 +1068,7 @@ class FastSession:
             evidence.hold_end,
             self._caches,
             second_mode_chooser(evidence),
-            early_statics=final,
+            with_early_statics=final,
         )
         self._asked[end] = _window_key(
             inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band

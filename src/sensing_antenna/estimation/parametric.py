@@ -422,7 +422,13 @@ def fit_damped_sinusoids(
         scale = difference_scale(y)
     else:
         scale = np.asarray(noise_std, dtype=float)
-    z = poles if poles is not None else _pencil_poles(y / scale, n_modes)
+    z: ComplexArray | None
+    if poles is not None:
+        z = poles
+    elif noise_std is None:
+        z = first_poles(y, n_modes)  # weights difference_scale(y), as above
+    else:
+        z = _pencil_poles(y / scale, n_modes)
     if z is None:
         return None
     start = _initial_modes(y / scale, z, n_modes, sample_period, lower, upper, target_band)
