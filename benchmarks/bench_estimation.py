@@ -11,7 +11,8 @@ arrived (``update_block``) and the clock advances by the measured processing (CP
 Reported per recording: t_e - t_1 (data time), the answer's arrival - t_1 (the delay a robot
 sees), and the mean and largest time of one evaluation; the paper method's arrival beside it.
 One run with a tolerance no window meets shows the answer at the cap.
-Prints tables and writes ``benchmarks/results/estimation.json``.
+Prints tables and writes ``benchmarks/results/estimation.json`` and, for the real-time loop,
+``estimation_realtime.png``.
 Run: ``python benchmarks/bench_estimation.py`` (about a minute).
 """
 
@@ -129,6 +130,37 @@ def fast_realtime(antenna_name: str) -> dict[str, dict[str, Any]]:
     return rows
 
 
+def plot_realtime(rows: dict[str, dict[str, Any]], path: Path) -> None:
+    """Per recording: the fast method's t_e offline and in the loop, its answer, the paper's."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = list(rows)
+    y = np.arange(len(names))
+    fig, ax = plt.subplots(figsize=(7.5, 0.35 * len(names) + 1.6))
+    series = (
+        ("offline_t_e_minus_t_1", "fast: t_e offline", "o", "tab:blue"),
+        ("t_e_minus_t_1", "fast: t_e in the loop", "s", "tab:cyan"),
+        ("answer_minus_t_1", "fast: answer in the loop", "D", "tab:red"),
+        ("paper_answer_minus_t_1", "paper: answer in the loop", "x", "black"),
+    )
+    for key, label, marker, color in series:
+        ax.plot([rows[n][key] for n in names], y, marker, color=color, label=label)
+    for n, k in zip(names, y, strict=True):
+        ax.plot([rows[n]["t_e_minus_t_1"], rows[n]["answer_minus_t_1"]], [k, k], color="tab:red")
+    ax.set_yticks(y, names)
+    ax.invert_yaxis()
+    ax.set_xlabel("time after t_1 (s)")
+    ax.set_title("Real-time loop on a model clock (CPU time of each block)")
+    ax.grid(axis="x", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main() -> None:
     antenna_name = "paper-2021"
     antenna = load_antenna(antenna_name)
@@ -204,7 +236,9 @@ def main() -> None:
         "fast_realtime": {"recordings": realtime, "medians": medians},
     }
     RESULTS.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
-    print(f"wrote {RESULTS}")
+    figure = RESULTS.with_name("estimation_realtime.png")
+    plot_realtime(realtime, figure)
+    print(f"wrote {RESULTS} and {figure}")
 
 
 if __name__ == "__main__":
