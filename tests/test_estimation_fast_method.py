@@ -18,6 +18,7 @@ import pytest
 
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.evidence import Evidence
 from sensing_antenna.estimation.fast import (
@@ -709,7 +710,7 @@ def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
     assert len(set(ends)) == 1, "one window per block"
     assert first <= ends[0] < last
     assert out is not None and out.t_e == t[ends[0]]
-    with pytest.raises(ValueError, match="force has shape"):
+    with pytest.raises(FieldError, match=r"update_block: force: shape \(2, 3\), expected \(3, 3\)"):
         OnlineEstimator(antenna, recording.sample_period).update_block(
             t[:3], theta[:3], force[:2], torque[:3]
         )

@@ -512,8 +512,9 @@ def evaluate_window(
         Prior range of x_c (m).
     config : FastConfig
     cache : dict, optional
-        Fits of this recording's windows by last index; the drift check's shorter windows are
-        taken from it (and added to it). The scan and an online session pass one; None refits.
+        Window fits keyed by the windows' own samples (:data:`FitCache`); the drift check's
+        shorter windows are taken from it (and added to it). The scan and an online session
+        pass one; None refits.
     choose_branch : BranchChooser, optional
         When the posterior holds two branches of omega_1(x_c), asked which candidate the
         window supports (:func:`second_mode_chooser`); the posterior is conditioned on its

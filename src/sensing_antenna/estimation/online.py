@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
 from sensing_antenna.estimation.contact import ContactDetector
 from sensing_antenna.estimation.evidence import (
@@ -232,9 +233,10 @@ class OnlineEstimator:
         n = t.shape[0]
         for name, value, width in (("theta", theta, 2), ("force", force, 3), ("torque", torque, 3)):
             if value.shape != (n, width):
-                raise ValueError(
-                    f"update_block: {name} has shape {value.shape}, expected ({n}, {width}) for "
-                    f"{n} sample times"
+                raise FieldError(
+                    name,
+                    f"shape {value.shape}, expected ({n}, {width}) for {n} sample times",
+                    "OnlineEstimator.update_block",
                 )
         for k in range(n):
             if self._done:
