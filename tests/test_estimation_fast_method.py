@@ -749,6 +749,8 @@ def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
         offline.t_e,
         offline.interval,
     )
+    # Blocks of 0.1 s from the hold's end (t_1 + 0.2 s) to the cap (t_1 + 1 s): at most nine
+    # blocks ask, and the cap's window is evaluated once more; the grid holds 18 instants there
     grid = evaluation_offsets(recording.sample_period, method.config)
     assert len(set(ends)) <= 10 < int(np.sum(grid >= 200)), "skipped instants were fitted"
     assert out.diagnostics["evaluations"] == len(set(ends))

@@ -219,13 +219,14 @@ class FastConfig:
         branches' curves cross (0.66 / 0.92 m). Used whether or not ``higher_modes`` is on.
     branch_by_second_mode : bool
         Whether, at every window whose posterior holds two branches of omega_1(x_c), the
-        paper's second-mode test (:func:`~.fusion.second_mode_choice` on the spectrum of
-        [t_1, t_j]) may choose the branch; the posterior is then conditioned on it before the
-        other checks. On by default: on simulated recordings at 0.65 to 0.98 m (192: the
-        calibrated-device campaign's device at noise 1 and 2, the paper antenna, a contact
-        three times softer; windows of 0.3 to 1 s) it never chose the wrong branch; it said
-        nothing on 155 of the 192 windows of 0.3 s and on 22 of the 24 runs at 0.98 m
-        (docs/fast.md). Off, the second mode is asked at the cap only.
+        paper's second-mode test (:func:`~.fusion.second_mode_choice` on the spectrum of the
+        window's own samples, :func:`second_mode_chooser`) may choose the branch; the
+        posterior is then conditioned on it before the other checks. On by default: on
+        simulated recordings at 0.65 to 0.98 m (192: the calibrated-device campaign's device at
+        noise 1 and 2, the paper antenna, a contact three times softer; windows of 0.3 to 1 s)
+        it never chose the wrong branch; it said nothing on 155 of the 192 windows of 0.3 s and
+        on 22 of the 24 runs at 0.98 m (docs/fast.md). Off, the second mode is asked at the cap
+        only.
     """
 
     tolerance: float = 0.005

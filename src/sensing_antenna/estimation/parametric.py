@@ -49,7 +49,6 @@ from sensing_antenna.estimation.frequency import find_peak, power_spectrum
 __all__ = [
     "DampedSinusoidFit",
     "damped_sinusoid_crb",
-    "difference_scale",
     "first_poles",
     "fit_damped_sinusoids",
     "matrix_pencil_poles",
@@ -276,7 +275,7 @@ class _Projection:
         return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
 
 
-def difference_scale(y: FloatArray) -> FloatArray:
+def _difference_scale(y: FloatArray) -> FloatArray:
     """Rough noise standard deviation of each channel of ``y`` (n, K): the spread of the first
     differences over sqrt(2) (noise-dominated at 1 kHz); 1 where a channel is constant."""
     scale = np.std(np.diff(y, axis=0), axis=0) / math.sqrt(2.0)
@@ -285,11 +284,11 @@ def difference_scale(y: FloatArray) -> FloatArray:
 
 def first_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
     """The matrix-pencil poles :func:`fit_damped_sinusoids` starts from without ``noise_std``
-    (channels weighted by :func:`difference_scale`): the same for every polynomial degree."""
+    (channels weighted by :func:`_difference_scale`): the same for every polynomial degree."""
     y = np.asarray(y, dtype=float)
     if y.ndim == 1:
         y = y[:, None]
-    return _pencil_poles(y / difference_scale(y), n_modes)
+    return _pencil_poles(y / _difference_scale(y), n_modes)
 
 
 def _pencil_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
@@ -419,14 +418,14 @@ def fit_damped_sinusoids(
     lower = np.array([max(min_omega, 1e-3), _MIN_DECAY])
     upper = np.array([math.pi / sample_period, _MAX_WINDOW_DECAY / ((n - 1) * sample_period)])
     if noise_std is None:
-        scale = difference_scale(y)
+        scale = _difference_scale(y)
     else:
         scale = np.asarray(noise_std, dtype=float)
     z: ComplexArray | None
     if poles is not None:
         z = poles
     elif noise_std is None:
-        z = first_poles(y, n_modes)  # weights difference_scale(y), as above
+        z = first_poles(y, n_modes)  # weights _difference_scale(y), as above
     else:
         z = _pencil_poles(y / scale, n_modes)
     if z is None:
