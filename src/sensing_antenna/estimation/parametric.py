@@ -103,6 +103,9 @@ class DampedSinusoidFit:
     converged : bool
         False when the optimiser stopped without meeting its tolerances or the normal matrix was
         singular (the standard errors are then NaN).
+    restart : int or None
+        Sample of the window from which the modes' amplitudes hold (``amplitudes`` are those
+        of the vibration after it); None: the whole window.
     """
 
     omega: FloatArray
@@ -119,6 +122,7 @@ class DampedSinusoidFit:
     sample_period: float
     bic: float
     converged: bool
+    restart: int | None = None
 
     @property
     def n_modes(self) -> int:
@@ -131,12 +135,16 @@ class DampedSinusoidFit:
         return (self.n_samples - 1) * self.sample_period
 
     def start_amplitudes(self) -> FloatArray:
-        """Amplitude of each mode in each channel at the window start (channel units), (K, M).
+        """Amplitude of each mode in each channel at the window start, or at the restart when
+        there is one (channel units), (K, M).
 
-        ``amplitudes`` are at the window centre; the decay carries them back half a window
+        ``amplitudes`` are at the window centre; the decay carries them back to that instant
         (at most e^(_MAX_WINDOW_DECAY / 2) by the fit's bound on s_m times the duration).
         """
-        return self.amplitudes * np.exp(0.5 * self.decay * self.duration)[None, :]
+        if self.restart is None:
+            return self.amplitudes * np.exp(0.5 * self.decay * self.duration)[None, :]
+        lead = (0.5 * (self.n_samples - 1) - self.restart) * self.sample_period
+        return self.amplitudes * np.exp(self.decay * lead)[None, :]
 
     def snr(self) -> FloatArray:
         """Amplitude at the window start over noise, combined over channels, shape (M,)."""
@@ -193,36 +201,127 @@ def matrix_pencil_poles(signals: FloatArray, n_poles: int) -> ComplexArray:
     return np.asarray(np.linalg.eigvals(shifted), dtype=complex)
 
 
-def _basis(tau: FloatArray, params: FloatArray, degree: int) -> FloatArray:
-    """Columns tau^0 .. tau^degree, then exp(-s tau) cos(w tau), exp(-s tau) sin(w tau) per mode."""
-    omega, decay = params[0::2], params[1::2]
-    envelope = np.exp(-np.multiply.outer(tau, decay))
-    phase = np.multiply.outer(tau, omega)
-    p = degree + 1
-    cols = np.empty((tau.size, p + 2 * omega.size))
-    for j in range(p):
-        cols[:, j] = tau**j
-    cols[:, p::2] = envelope * np.cos(phase)
-    cols[:, p + 1 :: 2] = envelope * np.sin(phase)
-    return cols
+class _Design:
+    """The columns of one window's model: polynomial, regressors, then the modes.
 
+    Columns: tau^0 .. tau^degree, the ``regressors`` (centred on t_ref), then per mode
+    exp(-s tau) cos(w tau), exp(-s tau) sin(w tau); with a ``restart`` index, per mode also the
+    same pair started at that sample (time from it, zero before): a change of the modes'
+    amplitudes and phases there, as an impulsive load on the structure makes (the head stopping).
+    """
 
-def _basis_derivatives(tau: FloatArray, params: FloatArray, degree: int) -> FloatArray:
-    """d basis / d params, shape (n, degree + 1 + 2M, 2M) (only the mode columns depend on them)."""
-    omega, decay = params[0::2], params[1::2]
-    m = omega.size
-    p = degree + 1
-    envelope = np.exp(-np.multiply.outer(tau, decay))
-    phase = np.multiply.outer(tau, omega)
-    cos_part, sin_part = envelope * np.cos(phase), envelope * np.sin(phase)
-    out = np.zeros((tau.size, p + 2 * m, 2 * m))
-    for j in range(m):
-        # d/dw: tau * (-sin, cos) envelope;  d/ds: -tau * (cos, sin) envelope
-        out[:, p + 2 * j, 2 * j] = -tau * sin_part[:, j]
-        out[:, p + 1 + 2 * j, 2 * j] = tau * cos_part[:, j]
-        out[:, p + 2 * j, 2 * j + 1] = -tau * cos_part[:, j]
-        out[:, p + 1 + 2 * j, 2 * j + 1] = -tau * sin_part[:, j]
-    return out
+    def __init__(
+        self,
+        n: int,
+        sample_period: float,
+        degree: int,
+        regressors: FloatArray | None = None,
+        restart: int | None = None,
+    ) -> None:
+        self.tau: FloatArray = (np.arange(n, dtype=float) - 0.5 * (n - 1)) * sample_period
+        self.degree = degree
+        fixed = [self.tau[:, None] ** j for j in range(degree + 1)]
+        if regressors is not None:
+            r = np.asarray(regressors, dtype=float).reshape(n, -1)
+            # zero at t_ref, so the constant term stays the static load at the window centre
+            fixed.append(r - 0.5 * (r[(n - 1) // 2] + r[n // 2]))
+        self.fixed = np.hstack(fixed)
+        self.restart = restart
+        self.since: FloatArray | None = (
+            None if restart is None else (np.arange(n, dtype=float) - restart) * sample_period
+        )
+        self.after: NDArray[np.bool_] | None = (
+            None if restart is None else (np.arange(n) >= restart)[:, None]
+        )
+
+    @property
+    def n_fixed(self) -> int:
+        """Columns that do not depend on (w, s)."""
+        return int(self.fixed.shape[1])
+
+    @property
+    def pairs(self) -> int:
+        """Column pairs per mode: 1, or 2 with a restart."""
+        return 1 if self.restart is None else 2
+
+    def n_linear(self, n_modes: int) -> int:
+        """Columns of the model with ``n_modes`` modes."""
+        return self.n_fixed + 2 * self.pairs * n_modes
+
+    def _times(self) -> list[tuple[FloatArray, NDArray[np.bool_] | None]]:
+        times: list[tuple[FloatArray, NDArray[np.bool_] | None]] = [(self.tau, None)]
+        if self.since is not None:
+            times.append((self.since, self.after))
+        return times
+
+    def _parts(self, params: FloatArray) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
+        """(time, envelope cos, envelope sin) of each column pair, shapes (n,), (n, M), (n, M)."""
+        omega, decay = params[0::2], params[1::2]
+        parts = []
+        for time, mask in self._times():
+            envelope = np.exp(-np.multiply.outer(time, decay))
+            if mask is not None:
+                envelope = np.where(mask, envelope, 0.0)
+            phase = np.multiply.outer(time, omega)
+            parts.append((time, envelope * np.cos(phase), envelope * np.sin(phase)))
+        return parts
+
+    def basis(self, params: FloatArray) -> FloatArray:
+        """All columns at (w, s), shape (n, n_linear)."""
+        m = params.size // 2
+        cols = np.empty((self.tau.size, self.n_linear(m)))
+        cols[:, : self.n_fixed] = self.fixed
+        for i, (_, cos_part, sin_part) in enumerate(self._parts(params)):
+            first = self.n_fixed + 2 * m * i
+            cols[:, first : first + 2 * m : 2] = cos_part
+            cols[:, first + 1 : first + 2 * m : 2] = sin_part
+        return cols
+
+    def derivative_times_coef(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
+        """d(basis @ coef) / d(w_j, s_j), shape (2M, n, K): only mode j's columns depend on them."""
+        m = params.size // 2
+        out = np.zeros((2 * m, self.tau.size, coef.shape[1]))
+        for i, (time, cos_part, sin_part) in enumerate(self._parts(params)):
+            first = self.n_fixed + 2 * m * i
+            a = coef[first : first + 2 * m : 2][None]
+            b = coef[first + 1 : first + 2 * m : 2][None]
+            t3 = time[:, None, None]
+            c3, s3 = cos_part[:, :, None], sin_part[:, :, None]
+            # d/dw: t (-a sin + b cos) envelope;  d/ds: -t (a cos + b sin) envelope
+            out[0::2] += np.moveaxis(t3 * (b * c3 - a * s3), 1, 0)
+            out[1::2] += np.moveaxis(-t3 * (a * c3 + b * s3), 1, 0)
+        return out
+
+    def basis_derivatives(self, params: FloatArray) -> FloatArray:
+        """d basis / d params, shape (n, n_linear, 2M) (only the mode columns depend on them)."""
+        m = params.size // 2
+        out = np.zeros((self.tau.size, self.n_linear(m), 2 * m))
+        for i, (time, cos_part, sin_part) in enumerate(self._parts(params)):
+            first = self.n_fixed + 2 * m * i
+            for j in range(m):
+                # d/dw: t * (-sin, cos) envelope;  d/ds: -t * (cos, sin) envelope
+                out[:, first + 2 * j, 2 * j] = -time * sin_part[:, j]
+                out[:, first + 1 + 2 * j, 2 * j] = time * cos_part[:, j]
+                out[:, first + 2 * j, 2 * j + 1] = -time * cos_part[:, j]
+                out[:, first + 1 + 2 * j, 2 * j + 1] = -time * sin_part[:, j]
+        return out
+
+    def free_amplitudes(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
+        """Amplitude at t_ref of each mode's vibration after the restart (or of the only one),
+        shape (K, M): the restarted pair carried to the origin tau = 0 and added."""
+        m = params.size // 2
+        first = self.n_fixed
+        a, b = coef[first : first + 2 * m : 2], coef[first + 1 : first + 2 * m : 2]
+        if self.since is not None:
+            omega, decay = params[0::2][:, None], params[1::2][:, None]
+            lag = -float(self.since[0] - self.tau[0])  # t_restart - t_ref
+            second = first + 2 * m
+            a2, b2 = coef[second : second + 2 * m : 2], coef[second + 1 : second + 2 * m : 2]
+            gain = np.exp(decay * lag)
+            cos_lag, sin_lag = np.cos(omega * lag), np.sin(omega * lag)
+            a = a + gain * (a2 * cos_lag - b2 * sin_lag)
+            b = b + gain * (a2 * sin_lag + b2 * cos_lag)
+        return np.asarray(np.hypot(a, b).T, dtype=float)
 
 
 class _Projection:
@@ -232,14 +331,14 @@ class _Projection:
     Jacobian at the point whose residual it has just computed, and factoring once serves both.
     """
 
-    def __init__(self, tau: FloatArray, weighted: FloatArray, degree: int) -> None:
-        self.tau, self.weighted, self.degree = tau, weighted, degree
+    def __init__(self, design: _Design, weighted: FloatArray) -> None:
+        self.design, self.weighted = design, weighted
         self._at: FloatArray | None = None
         self._basis = self._q = self._r = np.empty((0, 0))
 
     def _factor(self, params: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         if self._at is None or not np.array_equal(params, self._at):
-            self._basis = _basis(self.tau, params, self.degree)
+            self._basis = self.design.basis(params)
             self._q, self._r = np.linalg.qr(self._basis)
             self._at = np.array(params, dtype=float)
         return self._basis, self._q, self._r
@@ -253,24 +352,11 @@ class _Projection:
     def jacobian(self, params: FloatArray) -> FloatArray:
         """Kaufman's approximation of the Jacobian: -(I - Q Q^T) dPhi_j C."""
         basis, q, r = self._factor(params)
-        tau, weighted, degree = self.tau, self.weighted, self.degree
+        weighted = self.weighted
         coef = np.linalg.solve(r, q.T @ weighted) if np.all(np.diag(r) != 0) else None
         if coef is None:
             coef = np.linalg.lstsq(basis, weighted, rcond=None)[0]
-        # Only the two columns of mode j depend on (w_j, s_j): d Phi_j C built per mode directly
-        # (same values as contracting _basis_derivatives with C, without its zero blocks).
-        p = degree + 1
-        omega, decay = params[0::2], params[1::2]
-        envelope = np.exp(-np.multiply.outer(tau, decay))
-        phase = np.multiply.outer(tau, omega)
-        cos_part = (envelope * np.cos(phase))[:, :, None]
-        sin_part = (envelope * np.sin(phase))[:, :, None]
-        a, b = coef[p::2][None], coef[p + 1 :: 2][None]
-        t3 = tau[:, None, None]
-        cols = np.empty((2 * omega.size, tau.size, coef.shape[1]))
-        # d/dw: tau (-a sin + b cos) envelope;  d/ds: -tau (a cos + b sin) envelope
-        cols[0::2] = np.moveaxis(t3 * (b * cos_part - a * sin_part), 1, 0)
-        cols[1::2] = np.moveaxis(-t3 * (a * cos_part + b * sin_part), 1, 0)
+        cols = self.design.derivative_times_coef(params, coef)
         cols -= q @ (q.T @ cols)
         return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
 
@@ -374,6 +460,8 @@ def fit_damped_sinusoids(
     degree: int = 1,
     poles: ComplexArray | None = None,
     target_band: tuple[float, float] | None = None,
+    regressors: FloatArray | None = None,
+    restart: int | None = None,
 ) -> DampedSinusoidFit | None:
     """Fit ``n_modes`` damped sinusoids with shared poles, plus a polynomial per channel.
 
@@ -400,6 +488,12 @@ def fit_damped_sinusoids(
     target_band : tuple of float, optional
         Band (rad/s) where one mode is known to lie (the fundamental): one mode starts there
         even when stronger modes elsewhere would otherwise take every initial slot.
+    regressors : array, shape (n,) or (n, R), optional
+        Known slow inputs the static part follows linearly (e.g. the head's angle while it
+        pushes), one coefficient per channel each, beside the polynomial.
+    restart : int, optional
+        Sample from which every mode's amplitude and phase may change (the head stopping);
+        ``amplitudes`` are then those after it. None: one vibration over the whole window.
 
     Returns
     -------
@@ -411,10 +505,10 @@ def fit_damped_sinusoids(
     if y.ndim == 1:
         y = y[:, None]
     n, k = y.shape
-    n_linear = degree + 1 + 2 * n_modes
+    design = _Design(n, sample_period, degree, regressors, restart)
+    n_linear = design.n_linear(n_modes)
     if n < 3 * (n_linear + 2 * n_modes):
         return None
-    tau = (np.arange(n) - 0.5 * (n - 1)) * sample_period
     lower = np.array([max(min_omega, 1e-3), _MIN_DECAY])
     upper = np.array([math.pi / sample_period, _MAX_WINDOW_DECAY / ((n - 1) * sample_period)])
     if noise_std is None:
@@ -431,27 +525,26 @@ def fit_damped_sinusoids(
     if z is None:
         return None
     start = _initial_modes(y / scale, z, n_modes, sample_period, lower, upper, target_band)
-    if not np.all(np.isfinite(_Projection(tau, y / scale, degree).residual(start))):
+    if not np.all(np.isfinite(_Projection(design, y / scale).residual(start))):
         return None
     bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
-    params, ok = _refine(start, tau, y / scale, bounds, degree)
+    params, ok = _refine(start, design, y / scale, bounds)
     if noise_std is None:
-        residual = _Projection(tau, y / scale, degree).residual(params).reshape(n, k) * scale
+        residual = _Projection(design, y / scale).residual(params).reshape(n, k) * scale
         dof = max(n - n_linear - 2 * n_modes, 1)
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
-        params, ok = _refine(params, tau, y / scale, bounds, degree)
-    return _summarise(params, ok, tau, y, scale, t_start, sample_period, degree, noise_std is None)
+        params, ok = _refine(params, design, y / scale, bounds)
+    return _summarise(params, ok, design, y, scale, t_start, sample_period, noise_std is None)
 
 
 def _refine(
     start: FloatArray,
-    tau: FloatArray,
+    design: _Design,
     weighted: FloatArray,
     bounds: tuple[FloatArray, FloatArray],
-    degree: int,
 ) -> tuple[FloatArray, bool]:
-    projection = _Projection(tau, weighted, degree)
+    projection = _Projection(design, weighted)
     solution = least_squares(
         projection.residual,
         start,
@@ -470,17 +563,16 @@ def _refine(
 def _summarise(
     params: FloatArray,
     converged: bool,
-    tau: FloatArray,
+    design: _Design,
     y: FloatArray,
     scale: FloatArray,
     t_start: float,
     sample_period: float,
-    degree: int,
     scale_from_residuals: bool,
 ) -> DampedSinusoidFit:
     n, k = y.shape
     m = params.size // 2
-    basis = _basis(tau, params, degree)
+    basis = design.basis(params)
     coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
     residual = y - basis @ coef
     n_linear = basis.shape[1]
@@ -488,7 +580,7 @@ def _summarise(
     noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale
     noise = np.where(noise > 0.0, noise, np.finfo(float).tiny)
     # Full Jacobian of the weighted residuals: shared (w, s) columns, then each channel's block
-    deriv = _basis_derivatives(tau, params, degree)
+    deriv = design.basis_derivatives(params)
     n_par = 2 * m + k * n_linear
     jac = np.zeros((n * k, n_par))
     for ch in range(k):
@@ -508,9 +600,8 @@ def _summarise(
     tiny = np.finfo(float).tiny
     # Schwarz (1978): BIC = sum_k n ln(RSS_k / n) + P ln(n K)
     bic = float(np.sum(n * np.log(np.maximum(rss, tiny) / n)) + n_par * math.log(n * k))
-    p = degree + 1
-    amplitudes = np.hypot(coef[p::2], coef[p + 1 :: 2]).T
-    drifts = coef[1] if degree >= 1 else np.zeros(k)
+    amplitudes = design.free_amplitudes(params, coef)
+    drifts = coef[1] if design.degree >= 1 else np.zeros(k)
     return DampedSinusoidFit(
         omega=params[0::2][order],
         decay=params[1::2][order],
@@ -526,6 +617,7 @@ def _summarise(
         sample_period=sample_period,
         bic=bic,
         converged=ok,
+        restart=design.restart,
     )
 
 
@@ -538,14 +630,17 @@ def select_model_order(
     degree: int = 1,
     target_band: tuple[float, float] | None = None,
     poles: ComplexArray | None = None,
+    regressors: FloatArray | None = None,
+    restart: int | None = None,
 ) -> DampedSinusoidFit | None:
     """The fit with the smallest BIC among M = 1 .. ``max_modes`` damped modes.
 
     Returns None when no order could be fitted (record too short). The noise of each channel is
     estimated once, from the residuals of the largest order that fits, and used for every order,
-    so that the BIC compares the orders on the same weights. ``min_omega`` and ``degree`` as in
-    :func:`fit_damped_sinusoids`; ``target_band`` too. ``poles``: :func:`first_poles` of the
-    signals for ``max_modes`` when already at hand (they do not depend on the degree).
+    so that the BIC compares the orders on the same weights. ``min_omega``, ``degree``,
+    ``target_band``, ``regressors`` and ``restart`` as in :func:`fit_damped_sinusoids`.
+    ``poles``: :func:`first_poles` of the signals for ``max_modes`` when already at hand (they
+    do not depend on the degree).
     """
     fits = []
     noise: FloatArray | None = None
@@ -555,7 +650,17 @@ def select_model_order(
     for m in range(max_modes, 0, -1):
         if noise is None:
             fit = fit_damped_sinusoids(
-                y, sample_period, m, t_start, None, min_omega, degree, first, target_band
+                y,
+                sample_period,
+                m,
+                t_start,
+                None,
+                min_omega,
+                degree,
+                first,
+                target_band,
+                regressors,
+                restart,
             )
             first = None  # the next order, if this one did not fit, starts from its own
             if fit is not None:
@@ -563,7 +668,17 @@ def select_model_order(
                 weighted = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
         else:
             fit = fit_damped_sinusoids(
-                y, sample_period, m, t_start, noise, min_omega, degree, weighted, target_band
+                y,
+                sample_period,
+                m,
+                t_start,
+                noise,
+                min_omega,
+                degree,
+                weighted,
+                target_band,
+                regressors,
+                restart,
             )
         if fit is not None:
             fits.append(fit)
