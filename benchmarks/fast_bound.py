@@ -49,7 +49,7 @@ import statistics
 import time
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -109,6 +109,7 @@ class Setup:
     model: Antenna
     device: Antenna
     scenario: dict[str, Any]
+    config: FastConfig = field(default_factory=FastConfig)
 
 
 def paper_setup(noise: float) -> Setup:
@@ -134,7 +135,7 @@ def run_one(setup: Setup, case: str, x_c: float, seed: int) -> dict[str, Any]:
     recorded = simulate(setup.device, make_scenario(case, x_c, seed, dict(setup.scenario)))
     truth = float(recorded.metadata["true_xc"])
     recording = recorded.without_ground_truth()
-    config = FastConfig()
+    config = setup.config
     start = time.perf_counter()
     fast = estimate(recording, antenna, FastMethod(config))
     paper = estimate(recording, antenna, "paper")
@@ -262,6 +263,11 @@ def main() -> None:
         default=None,
         help="campaign spec (file, or paper-2021): its device, scenario and prepared model",
     )
+    parser.add_argument(
+        "--no-push-phase",
+        action="store_true",
+        help="windows from t_1 only (FastConfig.push_phase off)",
+    )
     parser.add_argument("--out", type=Path, default=None, help="JSON output")
     args = parser.parse_args()
     grid = QUICK_GRID if args.quick else GRID
@@ -275,6 +281,7 @@ def main() -> None:
         model_t, device_t = setup.model.link.t_param, setup.device.link.t_param
         print(f"model T = {model_t:.5f} s/m^2, device T = {device_t:.5f} s/m^2")
     out = args.out or out
+    setup = replace(setup, config=FastConfig(push_phase=not args.no_push_phase))
     jobs = [
         (setup, case, float(x), args.seed_base + s)
         for case in ("azimuthal", "vertical")
