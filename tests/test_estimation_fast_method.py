@@ -11,6 +11,7 @@ import json
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -862,12 +863,37 @@ def test_the_push_must_pass_the_same_checks_be_more_precise_and_agree() -> None:
     from_t1 = _Frequency(None, 0, 35.0, 0.6, 0.5, 0.1, (), None)
     config = FastConfig()
 
-    def through(omega: float, se: float = 0.1, notes: tuple[str, ...] = ()) -> Any:
-        return _Frequency(None, 0, omega, se, 0.1, 0.0, notes, None)
+    def through(omega: float, se: float = 0.1, failed: frozenset[str] = frozenset()) -> Any:
+        return _Frequency(None, 0, omega, se, 0.1, 0.0, tuple(failed), None, failed)
 
+    periods, drift = frozenset({"periods"}), frozenset({"drift_reference"})
     assert _push_agrees(through(36.4), from_t1, config)
     assert not _push_agrees(through(36.5), from_t1, config)
     assert not _push_agrees(through(35.0, se=0.7), from_t1, config)  # less precise in all
-    assert not _push_agrees(through(35.0, notes=("few periods",)), from_t1, config)
+    assert not _push_agrees(through(35.0, failed=periods), from_t1, config)
     assert not _push_agrees(through(35.0), from_t1._replace(mode=None), config)
-    assert _push_agrees(through(35.0, notes=("a",)), from_t1._replace(notes=("b",)), config)
+    assert _push_agrees(through(35.0, failed=periods), from_t1._replace(failed=periods), config)
+    assert not _push_agrees(through(35.0, failed=drift), from_t1._replace(failed=periods), config)
+
+
+def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # When the contact opened, the window restarts at the end of the hold, long after t_1:
+    # the push is not part of it (the modes restart there on their own).
+    import sensing_antenna.estimation.fast as fast_module
+    from sensing_antenna.estimation.fast import PushPhase, evaluate_from_t1_or_hold
+
+    calls: list[tuple[int, Any]] = []
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        calls.append((args[2], args[9]))
+        return SimpleNamespace(opening=math.inf)
+
+    monkeypatch.setattr(fast_module, "evaluate_window", spy)
+    push = PushPhase(0, np.zeros(600))
+    inputs = ScanInputs(
+        np.zeros((600, 5)), NO_BIAS, 100, 500, TS, BAND, LINK, X_RANGE, FastConfig(), push
+    )
+    evaluate_from_t1_or_hold(inputs, hold_end=300)
+    assert calls == [(100, push), (300, None)]

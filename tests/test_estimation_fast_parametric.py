@@ -186,27 +186,31 @@ def test_a_weak_fundamental_beside_strong_higher_modes_is_found() -> None:
     assert abs(fit.omega[k] - 69.0) < 4.0 * fit.omega_se[k]
 
 
-def _push_then_stop(rng: np.random.Generator, n: int, stop: int) -> tuple[np.ndarray, ...]:
+def _push_then_stop(
+    rng: np.random.Generator, n: int, stop: int, noisy: bool = True
+) -> tuple[np.ndarray, ...]:
     """Two load channels of a head pushing at 0.3 rad/s until sample ``stop``, then still.
 
     Static part: offset plus gains times the head's angle (relative to its final pose). The
-    contact mode (35 rad/s, decay 1.5 1/s) rings from the first sample; the stop kicks its
-    velocity, adding a sine that starts at ``stop``. Returns the samples, the angle and the
-    amplitude of the vibration at the stop.
+    contact mode (35 rad/s, decay 1.5 1/s) rings from the first sample; the stop changes its
+    amplitude and phase, adding a damped cosine of phase 0.7 rad that starts at ``stop``.
+    Returns the samples, the angle and the amplitude of the vibration at the stop.
     """
     t = np.arange(n) * TS
     t_stop = stop * TS
     omega, decay = 35.0, 1.5
     angle = np.where(t < t_stop, 0.3 * (t - t_stop), 0.0)
     ring = np.exp(-decay * t) * np.cos(omega * t + 0.4)
-    kick = np.where(t >= t_stop, np.exp(-decay * (t - t_stop)) * np.sin(omega * (t - t_stop)), 0)
+    since = t - t_stop
+    kick = np.where(t >= t_stop, np.exp(-decay * since) * np.cos(omega * since + 0.7), 0.0)
     gains, offsets = np.array([2.0, -0.5]), np.array([0.1, 0.02])
     rings, kicks = np.array([4e-3, 1e-3]), np.array([6e-3, -2e-3])
     y = offsets + np.outer(angle, gains) + np.outer(ring, rings) + np.outer(kick, kicks)
-    y = y + np.array([2e-4, 5e-5]) * rng.standard_normal((n, 2))
-    # complex amplitude at the stop: the ring's phasor plus the kick's, sin = cos shifted -pi/2
+    if noisy:
+        y = y + np.array([2e-4, 5e-5]) * rng.standard_normal((n, 2))
+    # complex amplitude at the stop: the ring's phasor plus the kick's
     ring_at_stop = np.exp(-decay * t_stop) * np.exp(1j * (omega * t_stop + 0.4))
-    at_stop = np.abs(rings * ring_at_stop - 1j * kicks)
+    at_stop = np.abs(rings * ring_at_stop + kicks * np.exp(0.7j))
     return y, angle, at_stop
 
 
@@ -248,3 +252,17 @@ def test_without_the_stop_in_the_model_the_push_biases_the_frequency() -> None:
     assert plain is not None and full is not None
     assert abs(full.omega[0] - 35.0) < 3 * full.omega_se[0]
     assert abs(plain.omega[0] - 35.0) > 5 * plain.omega_se[0]
+
+
+def test_a_noiseless_push_and_stop_is_fitted_exactly() -> None:
+    # Without noise the model through the push is exact: the frequency to 1e-6 rad/s, the
+    # offsets (the static loads at the window centre, after the stop: offset plus gain times
+    # an angle of 0) to 1e-9 and the amplitudes at the restart to 1e-6 relative, whatever the
+    # angle's origin (here 0.01 rad off: the regressor is centred on the window's centre). A
+    # restart one sample off would leave a residual.
+    y, angle, at_stop = _push_then_stop(np.random.default_rng(0), 250, 100, noisy=False)
+    fit = fit_damped_sinusoids(y, TS, 1, regressors=angle + 0.01, restart=100, degree=0)
+    assert fit is not None
+    assert fit.omega[0] == pytest.approx(35.0, abs=1e-6)
+    assert fit.offsets == pytest.approx([0.1, 0.02], abs=1e-9)
+    assert fit.start_amplitudes()[:, 0] == pytest.approx(at_stop, rel=1e-6)

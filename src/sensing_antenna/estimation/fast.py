@@ -563,7 +563,8 @@ def reference_index(
 
 class _Frequency(NamedTuple):
     """The fundamental of one window and the checks on it (see :func:`_frequency`); ``mode``
-    is its index in ``fit``."""
+    is its index in ``fit``; ``failed`` names the checks that failed ("fundamental",
+    "periods", "drift_reference"), ``notes`` says why."""
 
     fit: DampedSinusoidFit | None
     mode: int | None
@@ -573,6 +574,7 @@ class _Frequency(NamedTuple):
     drift: float
     notes: tuple[str, ...]
     early_statics: StaticRatio | None
+    failed: frozenset[str] = frozenset()
 
 
 def _frequency(
@@ -595,6 +597,7 @@ def _frequency(
     early: StaticRatio | None = None
     k, note = _fundamental(fit, band, config)
     notes = [note] if note else []
+    failed = {"fundamental"} if note else set()
     if fit is not None and k is not None:
         omega1 = float(fit.omega[k])
         omega1_crb = float(fit.omega_se[k])
@@ -602,6 +605,7 @@ def _frequency(
         periods = fit.duration * omega1 / (2.0 * math.pi)
         if periods < config.min_periods:
             notes.append(f"the window holds {periods:.2f} periods of omega_1")
+            failed.add("periods")
         # The same fundamental on a window of 2/3 the length: its change measures how far
         # unmodelled content still moves the estimate (drift_factor times it, in quadrature)
         ref = reference_index(rest_index, end_index, 2.0 / 3.0, sample_period, config)
@@ -614,6 +618,7 @@ def _frequency(
         ref_periods = math.nan if ref_fit is None else ref_fit.duration * omega1 / (2.0 * math.pi)
         if ref_fit is None or k_ref is None:
             notes.append("no fundamental on the shorter window to check its drift")
+            failed.add("drift_reference")
         elif ref_periods < config.min_periods:
             # Below min_periods the shorter window's own fundamental is too loose to see a
             # drift of the size that matters here: "no change seen" would mean nothing
@@ -621,6 +626,7 @@ def _frequency(
                 f"the shorter window that checks the drift holds {ref_periods:.2f} periods of "
                 "omega_1"
             )
+            failed.add("drift_reference")
         else:
             # Nested windows: the change of an efficient estimate has variance se_ref^2 - se^2
             # from noise alone; only the excess over that is drift
@@ -641,7 +647,9 @@ def _frequency(
             # Statics of a window too short for the model are not a reference (mode and offset
             # are confounded below a period or so)
             early = static_ratio(half_fit, bias)
-    return _Frequency(fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), early)
+    return _Frequency(
+        fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), early, frozenset(failed)
+    )
 
 
 def _push_agrees(through: _Frequency, from_t1: _Frequency, config: FastConfig) -> bool:
@@ -653,12 +661,13 @@ def _push_agrees(through: _Frequency, from_t1: _Frequency, config: FastConfig) -
     omega_1 their difference has variance se_t1^2 - se_push^2 (statistical parts); a
     difference beyond ``max_disagreement`` of its standard deviations means the push holds
     content the model does not describe (a bouncing contact, modes beyond
-    ``push_max_modes``) that moved it. Without a fundamental from t_1 there is nothing to
-    check it against, and it may not stand.
+    ``push_max_modes``) that moved it (and when its statistical part is not the smaller, none
+    is allowed). Without a fundamental from t_1 there is nothing to check it against, and it
+    may not stand.
     """
     if through.mode is None or from_t1.mode is None:
         return False
-    if through.notes and not from_t1.notes:
+    if not through.failed <= from_t1.failed:
         return False
     spread = math.sqrt(max(from_t1.omega1_crb**2 - through.omega1_crb**2, 0.0))
     return (
@@ -720,16 +729,21 @@ def evaluate_window(
     WindowEstimate
     """
     args = (channels, rest_index, end_index, sample_period, band, config, cache)
-    frequency = _frequency(*args, None, with_early_statics, bias)
+    from_t1 = _frequency(*args, None, with_early_statics, bias)
+    frequency = from_t1
     if push is not None:
-        through = _frequency(*args, push, with_early_statics, bias)
-        if _push_agrees(through, frequency, config):
+        through = _frequency(*args, push, False, bias)
+        if _push_agrees(through, from_t1, config):
             frequency = through
     fit, k = frequency.fit, frequency.mode
     omega1, omega1_se, omega1_crb = frequency.omega1, frequency.omega1_se, frequency.omega1_crb
-    drift, early = frequency.drift, frequency.early_statics
+    drift = frequency.drift
     notes = list(frequency.notes)
-    statics = static_ratio(fit, bias) if fit is not None else None
+    # The statics from the window from t_1 always: a fit through the push has its static part
+    # at the centre of [t_c, t], inside the push for short windows, while the opening check
+    # compares it with the vibration at t_1
+    statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
+    early = from_t1.early_statics
     table = curve_table(link, x_range[0], x_range[1], config.grid_step)
     frequency_floor = model_floor(link, config)
     omega_h = omega_h_se = math.nan
@@ -1232,7 +1246,7 @@ class FastSession:
             with_early_statics=final,
         )
         self._asked[end] = _window_key(
-            inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band
+            inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band, inputs.push
         )[2]
         return window
 
@@ -1252,7 +1266,12 @@ class FastSession:
             if end <= inputs.end_index
             and digest
             == _window_key(
-                inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band
+                inputs.channels,
+                inputs.rest_index,
+                end,
+                inputs.sample_period,
+                inputs.band,
+                inputs.push,
             )[2]
         }
 
