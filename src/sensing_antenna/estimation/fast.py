@@ -488,22 +488,7 @@ def _fit_window(
     key = _window_key(channels, rest_index, end_index, sample_period, band, push)
     if cache is not None and key in cache:
         return cache[key]
-    fit = _best_fit(channels, rest_index, end_index, sample_period, band, config, push)
-    if cache is not None:
-        cache[key] = fit
-    return fit
-
-
-def _best_fit(
-    channels: FloatArray,
-    rest_index: int,
-    end_index: int,
-    sample_period: float,
-    band: tuple[float, float],
-    config: FastConfig,
-    push: PushPhase | None,
-) -> DampedSinusoidFit | None:
-    """The fit with the smallest BIC over the polynomial degrees and model orders."""
+    # The fit with the smallest BIC over the polynomial degrees and model orders
     start = rest_index if push is None else push.start
     max_modes = config.max_modes if push is None else config.push_max_modes
     signals = channels[start : end_index + 1]
@@ -529,7 +514,10 @@ def _best_fit(
     ]
     # BIC over the polynomial degree too (it is computed on the unweighted residuals)
     usable = [f for f in fits if f is not None]
-    return min(usable, key=lambda f: f.bic) if usable else None
+    fit = min(usable, key=lambda f: f.bic) if usable else None
+    if cache is not None:
+        cache[key] = fit
+    return fit
 
 
 def _fundamental(
