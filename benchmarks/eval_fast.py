@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import paper_antenna
-from sensing_antenna.estimation.fast import FastMethod
+from sensing_antenna.estimation.fast import FastConfig, FastMethod
 from sensing_antenna.estimation.pipeline import estimate
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate_detailed
@@ -77,12 +77,18 @@ def simulated(
 
 
 def run_one(
-    case: str, x_c: float, seed: int, noise: float, cache: Path | None = None
+    case: str,
+    x_c: float,
+    seed: int,
+    noise: float,
+    cache: Path | None = None,
+    push_phase: bool = False,
 ) -> list[dict[str, Any]]:
     antenna = paper_antenna()
     recording, contact_abscissa = simulated(case, x_c, seed, noise, cache)
     rows = []
-    for name, method in (("paper", "paper"), ("fast", FastMethod())):
+    fast = FastMethod(FastConfig(push_phase=push_phase))
+    for name, method in (("paper", "paper"), ("fast", fast)):
         start = time.perf_counter()
         result = estimate(recording, antenna, method)
         elapsed = time.perf_counter() - start
@@ -159,6 +165,11 @@ def main() -> None:
     parser.add_argument(
         "--cache", type=Path, default=None, help="directory of stored simulated recordings"
     )
+    parser.add_argument(
+        "--push-phase",
+        action="store_true",
+        help="windows also through the push from t_c (FastConfig.push_phase)",
+    )
     parser.add_argument("--out", type=Path, default=OUT, help="JSON output")
     args = parser.parse_args()
     grid = QUICK_GRID if args.quick else GRID
@@ -169,7 +180,16 @@ def main() -> None:
         for case in ("azimuthal", "vertical"):
             for x_c in grid:
                 for seed in seeds:
-                    rows.extend(run_one(case, float(x_c), args.seed_base + seed, noise, args.cache))
+                    rows.extend(
+                        run_one(
+                            case,
+                            float(x_c),
+                            args.seed_base + seed,
+                            noise,
+                            args.cache,
+                            args.push_phase,
+                        )
+                    )
     table = summarise(rows)
     header = (
         f"{'method':7} {'noise':>5} {'runs':>4} {'med t_e-t_1':>11} {'MAE mm':>7} "

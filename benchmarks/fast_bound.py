@@ -264,9 +264,9 @@ def main() -> None:
         help="campaign spec (file, or paper-2021): its device, scenario and prepared model",
     )
     parser.add_argument(
-        "--no-push-phase",
+        "--push-phase",
         action="store_true",
-        help="windows from t_1 only (FastConfig.push_phase off)",
+        help="windows also through the push from t_c (FastConfig.push_phase)",
     )
     parser.add_argument("--out", type=Path, default=None, help="JSON output")
     args = parser.parse_args()
@@ -281,7 +281,7 @@ def main() -> None:
         model_t, device_t = setup.model.link.t_param, setup.device.link.t_param
         print(f"model T = {model_t:.5f} s/m^2, device T = {device_t:.5f} s/m^2")
     out = args.out or out
-    setup = replace(setup, config=FastConfig(push_phase=not args.no_push_phase))
+    setup = replace(setup, config=FastConfig(push_phase=args.push_phase))
     jobs = [
         (setup, case, float(x), args.seed_base + s)
         for case in ("azimuthal", "vertical")

@@ -307,8 +307,9 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(first_window=1.0, cap=0.5)
 
 
+@pytest.mark.parametrize("push_phase", [False, True])
 def test_offline_and_online_agree_on_a_simulated_recording(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, push_phase: bool
 ) -> None:
     # The pipeline's batch and streaming forms hand the same samples to the method; the fast
     # method only reads samples up to its own declaration, so both give identical estimates.
@@ -322,7 +323,8 @@ def test_offline_and_online_agree_on_a_simulated_recording(
     recording = simulator.simulate(
         antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
     )
-    offline = estimate(recording, antenna, FastMethod())
+    method = FastMethod(FastConfig(push_phase=push_phase))
+    offline = estimate(recording, antenna, method)
     fitted: list[tuple[float, int, int]] = []
     select = fast_module.select_model_order
 
@@ -331,7 +333,7 @@ def test_offline_and_online_agree_on_a_simulated_recording(
         return select(signals, sample_period, *args, **kwargs)
 
     monkeypatch.setattr(fast_module, "select_model_order", counting)
-    online = OnlineEstimator(antenna, recording.sample_period, FastMethod())
+    online = OnlineEstimator(antenna, recording.sample_period, method)
     for k in range(recording.t.shape[0]):
         online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
     streamed = online.finalize()

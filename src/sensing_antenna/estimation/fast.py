@@ -237,8 +237,10 @@ class FastConfig:
         for the window only when its fundamental is more precise than that of the window from
         t_1 and agrees with it within ``max_disagreement`` standard deviations of their
         difference (the touch can leave content the model does not describe: a bouncing
-        contact, more modes); otherwise the window from t_1 is used. On: on the paper
-        antenna the median delay fell from 0.316 to 0.261 s with coverage kept (docs/fast.md).
+        contact, more modes); otherwise the window from t_1 is used. Off by default: on the
+        paper antenna it brings the median delay from 0.316 to 0.261 s, but every window is
+        fitted twice and the CPU per recording is about 5 times larger, so in a real-time loop
+        on a two-core machine the answer came later than without it (docs/fast.md).
     push_max_modes : int
         Largest number of modes tried on a window through the push (the touch excites contact
         modes the stop hardly does). 3.
@@ -268,7 +270,7 @@ class FastConfig:
     higher_mode_floor: float = 0.005
     branch_mode_tolerance: float = 0.025
     branch_by_second_mode: bool = True
-    push_phase: bool = True
+    push_phase: bool = False
     push_max_modes: int = 3
 
     def __post_init__(self) -> None:
