@@ -14,6 +14,8 @@ Usage::
     python benchmarks/eval_fast.py            # full grid, noise 0.5 / 1 / 2, 2 seeds
     python benchmarks/eval_fast.py --quick    # 4 positions, noise 1, 1 seed
     python benchmarks/eval_fast.py --cache /tmp/fast_cache   # reuse simulated recordings
+    python benchmarks/eval_fast.py --push-phase --out benchmarks/results/fast_push.json
+                                              # windows also through the push (opt-in)
 
 Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
 """

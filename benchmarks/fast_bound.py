@@ -36,6 +36,8 @@ Usage::
     python benchmarks/fast_bound.py             # full grid, noise 1, 2 seeds (about 2 min)
     python benchmarks/fast_bound.py --quick     # 4 positions, 1 seed
     python benchmarks/fast_bound.py --campaign paper-2021   # its calibrated device (3 min)
+    python benchmarks/fast_bound.py --push-phase --out benchmarks/results/fast_bound_push.json
+                                                # windows also through the push (opt-in)
 
 Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
 """

@@ -307,24 +307,29 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(first_window=1.0, cap=0.5)
 
 
-@pytest.mark.parametrize("push_phase", [False, True])
+@pytest.mark.parametrize(
+    ("case", "x_c", "seed", "push_phase"),
+    [("azimuthal", 0.6, 5, False), ("vertical", 0.4, 400, True)],
+)
 def test_offline_and_online_agree_on_a_simulated_recording(
-    monkeypatch: pytest.MonkeyPatch, push_phase: bool
+    monkeypatch: pytest.MonkeyPatch, case: str, x_c: float, seed: int, push_phase: bool
 ) -> None:
     # The pipeline's batch and streaming forms hand the same samples to the method; the fast
     # method only reads samples up to its own declaration, so both give identical estimates.
     # Online, each window (first sample, last sample, polynomial degree) is fitted once: the
-    # session keeps the fits between evaluations and the conclusion does not scan again.
+    # session keeps the fits between evaluations and the conclusion does not scan again. With
+    # the push phase, on a recording whose declared window is the one through the push.
     simulator = pytest.importorskip("sensing_antenna.simulator")
     import sensing_antenna.estimation.fast as fast_module
     from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
 
     antenna = paper_antenna()
     recording = simulator.simulate(
-        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
+        antenna, simulator.Scenario(case=case, contact_point=x_c, seed=seed)
     )
     method = FastMethod(FastConfig(push_phase=push_phase))
     offline = estimate(recording, antenna, method)
+    assert offline.diagnostics["fit_through_push"] is push_phase
     fitted: list[tuple[float, int, int]] = []
     select = fast_module.select_model_order
 
@@ -341,10 +346,10 @@ def test_offline_and_online_agree_on_a_simulated_recording(
     assert streamed.x_c == offline.x_c
     assert streamed.t_e == offline.t_e
     assert fitted and len(fitted) == len(set(fitted)), "a window was fitted twice online"
-    # Reference: the simulator's contact point (0.6 m nominal, the contact moves < 3 mm as the
-    # link bends); the fast estimate must be within the tolerance and well before the paper's
-    # 1 s spectrum window.
-    assert offline.x_c == pytest.approx(0.6, abs=0.008)
+    # Reference: the simulator's contact point (nominal, the contact moves < 3 mm as the link
+    # bends); the fast estimate must be within the tolerance and well before the paper's 1 s
+    # spectrum window.
+    assert offline.x_c == pytest.approx(x_c, abs=0.008)
     assert offline.t_e - offline.t_1 < 0.5
 
 
@@ -835,8 +840,6 @@ def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any
         inputs.config,
         {},
         None,
-        False,
-        inputs.bias,
     )
     return window, alone, truth
 
@@ -862,11 +865,11 @@ def test_the_push_must_pass_the_same_checks_be_more_precise_and_agree() -> None:
     # t_1 alone 0.5 rad/s, so their difference may be 3 sqrt(0.5^2 - 0.1^2) = 1.47 rad/s.
     from sensing_antenna.estimation.fast import _Frequency, _push_agrees
 
-    from_t1 = _Frequency(None, 0, 35.0, 0.6, 0.5, 0.1, (), None)
+    from_t1 = _Frequency(None, 0, 35.0, 0.6, 0.5, 0.1, ())
     config = FastConfig()
 
     def through(omega: float, se: float = 0.1, failed: frozenset[str] = frozenset()) -> Any:
-        return _Frequency(None, 0, omega, se, 0.1, 0.0, tuple(failed), None, failed)
+        return _Frequency(None, 0, omega, se, 0.1, 0.0, tuple(failed), failed)
 
     periods, drift = frozenset({"periods"}), frozenset({"drift_reference"})
     assert _push_agrees(through(36.4), from_t1, config)

@@ -233,11 +233,12 @@ class FastConfig:
         Also fit every window from t_c, through the push: the contact modes ring from the
         touch on, so the push (about 0.1 s) adds periods to every window. The static loads
         follow the head's angle along the push (a regressor beside the polynomial) and every
-        mode's amplitude and phase may change at t_1, where the head stops. That fit stands
-        for the window only when its fundamental is more precise than that of the window from
-        t_1 and agrees with it within ``max_disagreement`` standard deviations of their
+        mode's amplitude and phase may change at t_1, where the head stops. That fit gives
+        omega_1 only when it passes every kind of check the window from t_1 passes, is more
+        precise, and agrees with it within ``max_disagreement`` standard deviations of their
         difference (the touch can leave content the model does not describe: a bouncing
-        contact, more modes); otherwise the window from t_1 is used. Off by default: on the
+        contact, more modes); otherwise the window from t_1 does. The statics always come from
+        the window from t_1. Off by default: on the
         paper antenna it brings the median delay from 0.316 to 0.261 s, but every window is
         fitted twice and the CPU per recording is about 5 times larger, so in a real-time loop
         on a two-core machine the answer came later than without it (docs/fast.md).
@@ -563,7 +564,6 @@ class _Frequency(NamedTuple):
     omega1_crb: float
     drift: float
     notes: tuple[str, ...]
-    early_statics: StaticRatio | None
     failed: frozenset[str] = frozenset()
 
 
@@ -576,15 +576,12 @@ def _frequency(
     config: FastConfig,
     cache: FitCache | None,
     push: PushPhase | None,
-    with_early_statics: bool,
-    bias: SensorBias,
 ) -> _Frequency:
     """Fit the window (through the push when given) and measure its fundamental: its standard
-    error with the drift check's term, the period checks, and the early statics of its first
-    half (arguments as in :func:`evaluate_window`)."""
+    error with the drift check's term, and the period checks (arguments as in
+    :func:`evaluate_window`)."""
     fit = _fit_window(channels, rest_index, end_index, sample_period, band, config, cache, push)
     omega1 = omega1_se = omega1_crb = drift = math.nan
-    early: StaticRatio | None = None
     k, note = _fundamental(fit, band, config)
     notes = [note] if note else []
     failed = {"fundamental"} if note else set()
@@ -624,22 +621,33 @@ def _frequency(
             noise_part = max(float(ref_fit.omega_se[k_ref]) ** 2 - omega1_crb**2, 0.0)
             drift = math.sqrt(max(change**2 - noise_part, 0.0))
             omega1_se = math.hypot(omega1_se, config.drift_factor * drift)
-        half = reference_index(rest_index, end_index, 0.5, sample_period, config)
-        half_fit = (
-            None
-            if half is None or not with_early_statics
-            else _fit_window(channels, rest_index, half, sample_period, band, config, cache, push)
-        )
-        if (
-            half_fit is not None
-            and half_fit.duration * omega1 >= 2.0 * math.pi * config.min_periods
-        ):
-            # Statics of a window too short for the model are not a reference (mode and offset
-            # are confounded below a period or so)
-            early = static_ratio(half_fit, bias)
-    return _Frequency(
-        fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), early, frozenset(failed)
+    return _Frequency(fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), frozenset(failed))
+
+
+def _early_statics(
+    channels: FloatArray,
+    rest_index: int,
+    end_index: int,
+    sample_period: float,
+    band: tuple[float, float],
+    config: FastConfig,
+    cache: FitCache | None,
+    omega1: float,
+    bias: SensorBias,
+) -> StaticRatio | None:
+    """Statics of the window's first half from t_1, the slip check's reference; None when that
+    half holds fewer than ``min_periods`` periods of ``omega1`` (rad/s) or is not on the grid."""
+    half = reference_index(rest_index, end_index, 0.5, sample_period, config)
+    half_fit = (
+        None
+        if half is None
+        else _fit_window(channels, rest_index, half, sample_period, band, config, cache)
     )
+    if half_fit is None or half_fit.duration * omega1 < 2.0 * math.pi * config.min_periods:
+        # Statics of a window too short for the model are not a reference (mode and offset
+        # are confounded below a period or so)
+        return None
+    return static_ratio(half_fit, bias)
 
 
 def _push_agrees(through: _Frequency, from_t1: _Frequency, config: FastConfig) -> bool:
@@ -719,10 +727,10 @@ def evaluate_window(
     WindowEstimate
     """
     args = (channels, rest_index, end_index, sample_period, band, config, cache)
-    from_t1 = _frequency(*args, None, with_early_statics, bias)
+    from_t1 = _frequency(*args, None)
     frequency = from_t1
     if push is not None:
-        through = _frequency(*args, push, False, bias)
+        through = _frequency(*args, push)
         if _push_agrees(through, from_t1, config):
             frequency = through
     fit, k = frequency.fit, frequency.mode
@@ -733,7 +741,11 @@ def evaluate_window(
     # at the centre of [t_c, t], inside the push for short windows, while the opening check
     # compares it with the vibration at t_1
     statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
-    early = from_t1.early_statics
+    early = (
+        _early_statics(*args, from_t1.omega1, bias)
+        if with_early_statics and from_t1.mode is not None
+        else None
+    )
     table = curve_table(link, x_range[0], x_range[1], config.grid_step)
     frequency_floor = model_floor(link, config)
     omega_h = omega_h_se = math.nan

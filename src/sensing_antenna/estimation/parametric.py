@@ -227,38 +227,26 @@ class _Design:
             fixed.append(r - 0.5 * (r[(n - 1) // 2] + r[n // 2]))
         self.fixed = np.hstack(fixed)
         self.restart = restart
-        self.since: FloatArray | None = (
-            None if restart is None else (np.arange(n, dtype=float) - restart) * sample_period
-        )
-        self.after: NDArray[np.bool_] | None = (
-            None if restart is None else (np.arange(n) >= restart)[:, None]
-        )
+        # Time axis of each column pair and where it is on: the window, then the restart's
+        self.times: list[tuple[FloatArray, NDArray[np.bool_] | None]] = [(self.tau, None)]
+        if restart is not None:
+            since = (np.arange(n, dtype=float) - restart) * sample_period
+            self.times.append((since, (np.arange(n) >= restart)[:, None]))
 
     @property
     def n_fixed(self) -> int:
         """Columns that do not depend on (w, s)."""
         return int(self.fixed.shape[1])
 
-    @property
-    def pairs(self) -> int:
-        """Column pairs per mode: 1, or 2 with a restart."""
-        return 1 if self.restart is None else 2
-
     def n_linear(self, n_modes: int) -> int:
-        """Columns of the model with ``n_modes`` modes."""
-        return self.n_fixed + 2 * self.pairs * n_modes
-
-    def _times(self) -> list[tuple[FloatArray, NDArray[np.bool_] | None]]:
-        times: list[tuple[FloatArray, NDArray[np.bool_] | None]] = [(self.tau, None)]
-        if self.since is not None:
-            times.append((self.since, self.after))
-        return times
+        """Columns of the model with ``n_modes`` modes (one column pair per mode and time axis)."""
+        return self.n_fixed + 2 * len(self.times) * n_modes
 
     def _parts(self, params: FloatArray) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
         """(time, envelope cos, envelope sin) of each column pair, shapes (n,), (n, M), (n, M)."""
         omega, decay = params[0::2], params[1::2]
         parts = []
-        for time, mask in self._times():
+        for time, mask in self.times:
             envelope = np.exp(-np.multiply.outer(time, decay))
             if mask is not None:
                 envelope = np.where(mask, envelope, 0.0)
@@ -312,9 +300,9 @@ class _Design:
         m = params.size // 2
         first = self.n_fixed
         a, b = coef[first : first + 2 * m : 2], coef[first + 1 : first + 2 * m : 2]
-        if self.since is not None:
+        if len(self.times) > 1:
             omega, decay = params[0::2][:, None], params[1::2][:, None]
-            lag = -float(self.since[0] - self.tau[0])  # t_restart - t_ref
+            lag = float(self.tau[0] - self.times[1][0][0])  # t_restart - t_ref
             second = first + 2 * m
             a2, b2 = coef[second : second + 2 * m : 2], coef[second + 1 : second + 2 * m : 2]
             gain = np.exp(decay * lag)
