@@ -817,7 +817,7 @@ def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any
     evaluated with the push phase, the fundamental of the window from t_1 alone and the true
     omega_1 (sensing curve at the simulator's contact abscissa)."""
     simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.fast import _frequency
+    from sensing_antenna.estimation.fast import _frequency, _Window
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     antenna = paper_antenna()
@@ -832,13 +832,15 @@ def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any
     inputs = inputs._replace(end_index=inputs.rest_index + round(after_t1 / TS))
     window = evaluate_window(*inputs, cache={})
     alone = _frequency(
-        inputs.channels,
-        inputs.rest_index,
-        inputs.end_index,
-        TS,
-        inputs.band,
-        inputs.config,
-        {},
+        _Window(
+            inputs.channels,
+            inputs.rest_index,
+            inputs.end_index,
+            TS,
+            inputs.band,
+            inputs.config,
+            {},
+        ),
         None,
     )
     return window, alone, truth

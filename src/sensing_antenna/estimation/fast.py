@@ -567,20 +567,24 @@ class _Frequency(NamedTuple):
     failed: frozenset[str] = frozenset()
 
 
-def _frequency(
-    channels: FloatArray,
-    rest_index: int,
-    end_index: int,
-    sample_period: float,
-    band: tuple[float, float],
-    config: FastConfig,
-    cache: FitCache | None,
-    push: PushPhase | None,
-) -> _Frequency:
+class _Window(NamedTuple):
+    """The window [rest_index, end_index] and what its fits need: :func:`_fit_window`'s
+    leading arguments, in order (as in :func:`evaluate_window`)."""
+
+    channels: FloatArray
+    rest_index: int
+    end_index: int
+    sample_period: float
+    band: tuple[float, float]
+    config: FastConfig
+    cache: FitCache | None
+
+
+def _frequency(window: _Window, push: PushPhase | None) -> _Frequency:
     """Fit the window (through the push when given) and measure its fundamental: its standard
-    error with the drift check's term, and the period checks (arguments as in
-    :func:`evaluate_window`)."""
-    fit = _fit_window(channels, rest_index, end_index, sample_period, band, config, cache, push)
+    error with the drift check's term, and the period checks."""
+    config, band = window.config, window.band
+    fit = _fit_window(*window, push)
     omega1 = omega1_se = omega1_crb = drift = math.nan
     k, note = _fundamental(fit, band, config)
     notes = [note] if note else []
@@ -595,12 +599,10 @@ def _frequency(
             failed.add("periods")
         # The same fundamental on a window of 2/3 the length: its change measures how far
         # unmodelled content still moves the estimate (drift_factor times it, in quadrature)
-        ref = reference_index(rest_index, end_index, 2.0 / 3.0, sample_period, config)
-        ref_fit = (
-            None
-            if ref is None
-            else _fit_window(channels, rest_index, ref, sample_period, band, config, cache, push)
+        ref = reference_index(
+            window.rest_index, window.end_index, 2.0 / 3.0, window.sample_period, config
         )
+        ref_fit = None if ref is None else _fit_window(*window._replace(end_index=ref), push)
         k_ref, _ = _fundamental(ref_fit, band, config)
         ref_periods = math.nan if ref_fit is None else ref_fit.duration * omega1 / (2.0 * math.pi)
         if ref_fit is None or k_ref is None:
@@ -624,25 +626,12 @@ def _frequency(
     return _Frequency(fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), frozenset(failed))
 
 
-def _early_statics(
-    channels: FloatArray,
-    rest_index: int,
-    end_index: int,
-    sample_period: float,
-    band: tuple[float, float],
-    config: FastConfig,
-    cache: FitCache | None,
-    omega1: float,
-    bias: SensorBias,
-) -> StaticRatio | None:
+def _early_statics(window: _Window, omega1: float, bias: SensorBias) -> StaticRatio | None:
     """Statics of the window's first half from t_1, the slip check's reference; None when that
     half holds fewer than ``min_periods`` periods of ``omega1`` (rad/s) or is not on the grid."""
-    half = reference_index(rest_index, end_index, 0.5, sample_period, config)
-    half_fit = (
-        None
-        if half is None
-        else _fit_window(channels, rest_index, half, sample_period, band, config, cache)
-    )
+    config = window.config
+    half = reference_index(window.rest_index, window.end_index, 0.5, window.sample_period, config)
+    half_fit = None if half is None else _fit_window(*window._replace(end_index=half))
     if half_fit is None or half_fit.duration * omega1 < 2.0 * math.pi * config.min_periods:
         # Statics of a window too short for the model are not a reference (mode and offset
         # are confounded below a period or so)
@@ -726,11 +715,11 @@ def evaluate_window(
     -------
     WindowEstimate
     """
-    args = (channels, rest_index, end_index, sample_period, band, config, cache)
-    from_t1 = _frequency(*args, None)
+    window = _Window(channels, rest_index, end_index, sample_period, band, config, cache)
+    from_t1 = _frequency(window, None)
     frequency = from_t1
     if push is not None:
-        through = _frequency(*args, push)
+        through = _frequency(window, push)
         if _push_agrees(through, from_t1, config):
             frequency = through
     fit, k = frequency.fit, frequency.mode
@@ -742,7 +731,7 @@ def evaluate_window(
     # compares it with the vibration at t_1
     statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
     early = (
-        _early_statics(*args, from_t1.omega1, bias)
+        _early_statics(window, from_t1.omega1, bias)
         if with_early_statics and from_t1.mode is not None
         else None
     )
