@@ -13,7 +13,9 @@ sees), and the mean and largest time of one evaluation; the paper method's arriv
 One run with a tolerance no window meets shows the answer at the cap.
 Prints tables and writes ``benchmarks/results/estimation.json`` and, for the real-time loop,
 ``estimation_realtime.png``.
-Run: ``python benchmarks/bench_estimation.py`` (about a minute).
+Run: ``python benchmarks/bench_estimation.py`` (about a minute);
+``python benchmarks/bench_estimation.py --push-phase --out benchmarks/results/estimation_push.json``
+runs the fast method with its windows also through the push (``FastConfig.push_phase``).
 """
 
 from __future__ import annotations
@@ -23,10 +25,12 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")  # one core, set before numpy loads
 
+import argparse  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import platform  # noqa: E402
 import time  # noqa: E402
+from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
@@ -105,17 +109,18 @@ def realtime_run(
     }
 
 
-def fast_realtime(antenna_name: str) -> dict[str, dict[str, Any]]:
-    """:func:`realtime_run` of the fast and paper methods on ten simulated recordings, and of a
-    fast method that is never sure (tolerance 1 um: the answer at the cap) on one of them."""
+def fast_realtime(antenna_name: str, config: FastConfig) -> dict[str, dict[str, Any]]:
+    """:func:`realtime_run` of the fast method (``config``) and the paper method on ten simulated
+    recordings, and of a fast method that is never sure (tolerance 1 um: the answer at the cap)
+    on one of them."""
     antenna = load_antenna(antenna_name)
-    never_sure = FastMethod(FastConfig(tolerance=1e-6))
+    never_sure = FastMethod(replace(config, tolerance=1e-6))
     rows: dict[str, dict[str, Any]] = {}
     runs = [(case, x_c, "fast") for case in ("azimuthal", "vertical") for x_c in POINTS]
     runs.append(("azimuthal", 0.6, "never sure"))
     for case, x_c, kind in runs:
         recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=0, duration=3.0))
-        method = never_sure if kind == "never sure" else FastMethod()
+        method = never_sure if kind == "never sure" else FastMethod(config)
         estimate(recording, antenna, method=method)  # warm caches (curve table, ...)
         fast = realtime_run(recording, antenna_name, method)
         paper = realtime_run(recording, antenna_name, "paper")
@@ -162,6 +167,14 @@ def plot_realtime(rows: dict[str, dict[str, Any]], path: Path) -> None:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--push-phase",
+        action="store_true",
+        help="fast method's windows also through the push from t_c (FastConfig.push_phase)",
+    )
+    parser.add_argument("--out", type=Path, default=RESULTS, help="JSON output")
+    args = parser.parse_args()
     antenna_name = "paper-2021"
     antenna = load_antenna(antenna_name)
     recordings = {
@@ -198,7 +211,7 @@ def main() -> None:
             ok = "yes" if value <= target else "NO"
             print(f"{case:10s} {name:32s} {value * 1e3:9.4f} ms {target * 1e3:9.3f} ms {ok:>4s}")
     print("fast method in a real-time loop (model clock; times after t_1 in s):")
-    realtime = fast_realtime(antenna_name)
+    realtime = fast_realtime(antenna_name, FastConfig(push_phase=args.push_phase))
     print(
         f"{'recording':28s} {'status':14s} {'t_e offline':>11s} {'t_e':>7s} {'answer':>7s} "
         f"{'paper':>7s} {'evals':>5s} {'mean eval':>9s} {'max eval':>9s}"
@@ -223,7 +236,8 @@ def main() -> None:
         )
     }
     print("median: " + ", ".join(f"{key} {value:.3f}" for key, value in medians.items()))
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    out: Path = args.out
+    out.parent.mkdir(parents=True, exist_ok=True)
     data = {
         "machine": {"python": platform.python_version(), "processor": platform.processor()},
         "note": "shared 2-core machine under load; best of repeated runs",
@@ -235,10 +249,10 @@ def main() -> None:
         "results": rows,
         "fast_realtime": {"recordings": realtime, "medians": medians},
     }
-    RESULTS.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
-    figure = RESULTS.with_name("estimation_realtime.png")
+    out.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
+    figure = out.with_name(out.stem.replace("estimation", "estimation_realtime") + ".png")
     plot_realtime(realtime, figure)
-    print(f"wrote {RESULTS} and {figure}")
+    print(f"wrote {out} and {figure}")
 
 
 if __name__ == "__main__":

@@ -38,6 +38,7 @@ Usage::
     python benchmarks/fast_bound.py --campaign paper-2021   # its calibrated device (3 min)
     python benchmarks/fast_bound.py --push-phase --out benchmarks/results/fast_bound_push.json
                                                 # windows also through the push (opt-in)
+    python benchmarks/fast_bound.py --set max_modes=3 --out /tmp/fb.json   # any FastConfig field
 
 Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
 """
@@ -51,7 +52,7 @@ import statistics
 import time
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -253,6 +254,21 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
     plt.close(fig)
 
 
+def config_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """``FIELD=VALUE`` strings as FastConfig keyword arguments (each value read as JSON)."""
+    names = {f.name for f in fields(FastConfig)}
+    overrides: dict[str, Any] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or name not in names:
+            raise SystemExit(f"--set {item!r}: expected FIELD=VALUE with a FastConfig field")
+        try:
+            overrides[name] = json.loads(value)
+        except json.JSONDecodeError as error:
+            raise SystemExit(f"--set {item!r}: the value is not JSON ({error})") from None
+    return overrides
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="4 positions, 1 seed")
@@ -270,8 +286,16 @@ def main() -> None:
         action="store_true",
         help="windows also through the push from t_c (FastConfig.push_phase)",
     )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="FIELD=VALUE",
+        help="another FastConfig setting (JSON value, e.g. max_modes=3); repeatable",
+    )
     parser.add_argument("--out", type=Path, default=None, help="JSON output")
     args = parser.parse_args()
+    overrides = config_overrides(args.set)
     grid = QUICK_GRID if args.quick else GRID
     seeds = range(1) if args.quick else range(args.seeds)
     if args.campaign is None:
@@ -283,7 +307,7 @@ def main() -> None:
         model_t, device_t = setup.model.link.t_param, setup.device.link.t_param
         print(f"model T = {model_t:.5f} s/m^2, device T = {device_t:.5f} s/m^2")
     out = args.out or out
-    setup = replace(setup, config=FastConfig(push_phase=args.push_phase))
+    setup = replace(setup, config=FastConfig(**{"push_phase": args.push_phase, **overrides}))
     jobs = [
         (setup, case, float(x), args.seed_base + s)
         for case in ("azimuthal", "vertical")
@@ -315,7 +339,10 @@ def main() -> None:
             f" mm, ok over 2 cm: {a['ok_over_2cm']}, coverage {a['coverage']:.3f}"
         )
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"summary": summary, "rows": rows}, indent=1) + "\n")
+    settings = {"push_phase": args.push_phase, **overrides}
+    out.write_text(
+        json.dumps({"summary": summary, "settings": settings, "rows": rows}, indent=1) + "\n"
+    )
     plot(rows, out.with_suffix(".png"))
     print(f"wrote {out} and {out.with_suffix('.png')}")
 

@@ -305,6 +305,8 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(max_modes=0)
     with pytest.raises(FastConfigError, match="first_window"):
         FastConfig(first_window=1.0, cap=0.5)
+    with pytest.raises(FastConfigError, match="push_polynomial_degree"):
+        FastConfig(push_polynomial_degree=-1)
 
 
 @pytest.mark.parametrize(
@@ -904,3 +906,29 @@ def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push(
     )
     evaluate_from_t1_or_hold(inputs, hold_end=300)
     assert calls == [(100, push), (300, None)]
+
+
+@pytest.mark.parametrize(("push_degree", "expected"), [(2, [2]), (3, [2, 3]), (1, [1])])
+def test_windows_through_the_push_fit_their_own_polynomial_degrees(
+    monkeypatch: pytest.MonkeyPatch, push_degree: int, expected: list[int]
+) -> None:
+    # The window from t_1 tries degrees 2 to polynomial_degree; the one through the push up to
+    # push_polynomial_degree (the head's angle carries the push's static growth), with the
+    # push's angle and the restart at t_1 passed on.
+    import sensing_antenna.estimation.fast as fast_module
+    from sensing_antenna.estimation.fast import PushPhase, _fit_window
+
+    calls: list[tuple[int, bool, int | None]] = []
+
+    def spy(*args: Any, **kwargs: Any) -> None:
+        calls.append((kwargs["degree"], kwargs["regressors"] is not None, kwargs["restart"]))
+        return None
+
+    monkeypatch.setattr(fast_module, "select_model_order", spy)
+    config = FastConfig(push_polynomial_degree=push_degree)
+    channels = np.zeros((600, 5))
+    _fit_window(channels, 100, 400, TS, BAND, config, None)
+    assert calls == [(d, False, None) for d in (2, 3, 4)]
+    calls.clear()
+    _fit_window(channels, 100, 400, TS, BAND, config, None, PushPhase(40, np.zeros(600)))
+    assert calls == [(d, True, 60) for d in expected]
