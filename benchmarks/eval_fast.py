@@ -16,6 +16,7 @@ Usage::
     python benchmarks/eval_fast.py --cache /tmp/fast_cache   # reuse simulated recordings
     python benchmarks/eval_fast.py --push-phase --out benchmarks/results/fast_push.json
                                               # windows also through the push (opt-in)
+    python benchmarks/eval_fast.py --set max_modes=3 --out /tmp/fast.json   # any FastConfig field
 
 Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
 """
@@ -28,6 +29,8 @@ import math
 import pickle
 import statistics
 import time
+from collections.abc import Sequence
+from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
@@ -84,12 +87,12 @@ def run_one(
     seed: int,
     noise: float,
     cache: Path | None = None,
-    push_phase: bool = False,
+    config: FastConfig | None = None,
 ) -> list[dict[str, Any]]:
     antenna = paper_antenna()
     recording, contact_abscissa = simulated(case, x_c, seed, noise, cache)
     rows = []
-    fast = FastMethod(FastConfig(push_phase=push_phase))
+    fast = FastMethod(config or FastConfig())
     for name, method in (("paper", "paper"), ("fast", fast)):
         start = time.perf_counter()
         result = estimate(recording, antenna, method)
@@ -153,6 +156,21 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return table
 
 
+def config_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """``FIELD=VALUE`` strings as FastConfig keyword arguments (each value read as JSON)."""
+    names = {f.name for f in fields(FastConfig)}
+    overrides: dict[str, Any] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or name not in names:
+            raise SystemExit(f"--set {item!r}: expected FIELD=VALUE with a FastConfig field")
+        try:
+            overrides[name] = json.loads(value)
+        except json.JSONDecodeError as error:
+            raise SystemExit(f"--set {item!r}: the value is not JSON ({error})") from None
+    return overrides
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="4 positions, noise 1, 1 seed")
@@ -172,8 +190,17 @@ def main() -> None:
         action="store_true",
         help="windows also through the push from t_c (FastConfig.push_phase)",
     )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="FIELD=VALUE",
+        help="another FastConfig setting (JSON value, e.g. max_modes=3); repeatable",
+    )
     parser.add_argument("--out", type=Path, default=OUT, help="JSON output")
     args = parser.parse_args()
+    settings = {"push_phase": args.push_phase, **config_overrides(args.set)}
+    config = FastConfig(**settings)
     grid = QUICK_GRID if args.quick else GRID
     seeds = range(1) if args.quick else range(args.seeds)
     noises = [1.0] if args.quick else args.noise
@@ -189,7 +216,7 @@ def main() -> None:
                             args.seed_base + seed,
                             noise,
                             args.cache,
-                            args.push_phase,
+                            config,
                         )
                     )
     table = summarise(rows)
@@ -225,7 +252,9 @@ def main() -> None:
             f"interval={r['interval']}"
         )
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps({"summary": table, "runs": rows}, indent=1, default=float))
+    args.out.write_text(
+        json.dumps({"summary": table, "settings": settings, "runs": rows}, indent=1, default=float)
+    )
     print(f"wrote {args.out}")
 
 

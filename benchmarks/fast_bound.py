@@ -52,13 +52,13 @@ import statistics
 import time
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from eval_fast import GRID, QUICK_GRID
+from eval_fast import GRID, QUICK_GRID, config_overrides
 from sensing_antenna.antenna import Antenna, Link, paper_antenna
 from sensing_antenna.campaign.simulated import make_scenario, prepare_campaign
 from sensing_antenna.campaign.spec import load_campaign_spec
@@ -252,21 +252,6 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
-
-
-def config_overrides(items: Sequence[str]) -> dict[str, Any]:
-    """``FIELD=VALUE`` strings as FastConfig keyword arguments (each value read as JSON)."""
-    names = {f.name for f in fields(FastConfig)}
-    overrides: dict[str, Any] = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        if not sep or name not in names:
-            raise SystemExit(f"--set {item!r}: expected FIELD=VALUE with a FastConfig field")
-        try:
-            overrides[name] = json.loads(value)
-        except json.JSONDecodeError as error:
-            raise SystemExit(f"--set {item!r}: the value is not JSON ({error})") from None
-    return overrides
 
 
 def main() -> None:
