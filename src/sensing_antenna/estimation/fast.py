@@ -129,11 +129,16 @@ class FastConfig:
         white noise the largest of ~n / 2 independent periodogram ordinates reaches about
         sqrt(2 ln n) ~ 3.7 standard deviations; 10 leaves no room for a noise peak.
     max_modes : int
-        Largest number of damped modes tried (BIC chooses 1 .. max_modes). 2: the fundamental
-        and the second contact mode (2.5 to 7 times higher); the slow servo and contact
-        transients go to the polynomial. With 3 the third mode cost half of the CPU time and,
-        on simulator runs at 0.3 to 0.95 m, did not improve x_c (at 0.6 m, seed 2, it left the
-        estimate unsure at the cap, 1 cm off; with 2 it was declared, 1 mm off).
+        Largest number of damped modes tried (BIC chooses 1 .. max_modes). 3: the fundamental
+        and the two strongest modes above it. The touch and the stop excite contact modes 2
+        and 3 and modes of the link moving along the surface (calibrated-device campaign,
+        vertical 0.5 m: fitted at 50, 395 and 430 rad/s over 0.2 s after t_1, the two upper
+        ones the stronger; contact mode 3 is at 437 rad/s). With room for one of them only,
+        short windows read omega_1 up to 2 % high (50.9 against 49.8 rad/s at 0.215 s; 50.1
+        with three modes) and the drift check held them back. Against 2 (docs/fast.md, "Three
+        modes"): median t_e - t_1 0.421 to 0.383 s on the calibrated device and 0.316 to
+        0.302 s on the paper antenna, MAE 0.77 to 0.59 mm and 0.37 to 0.23 mm, coverage
+        unchanged; about 1.6 times the CPU.
     min_mode_fraction : float
         Modes are fitted above this fraction of the lower end of the omega_1 band; slower content
         (the servo's slow creep at ~8 rad/s) goes to the polynomial. 0.6 of ~23 rad/s.
@@ -261,7 +266,7 @@ class FastConfig:
     drift_factor: float = 2.0
     min_periods: float = 1.5
     min_detection: float = 10.0
-    max_modes: int = 2
+    max_modes: int = 3
     min_mode_fraction: float = 0.6
     polynomial_degree: int = 4
     frequency_floor: float = 0.001
@@ -385,7 +390,8 @@ class WindowEstimate:
         Change of omega_1 from the window's first 2/3 beyond what the noise explains (rad/s).
     early_statics : StaticRatio or None
         Statics of the window's first half (the slip reference); None when that half holds
-        fewer than ``min_periods`` periods, or when not asked for (``with_early_statics``).
+        fewer than ``min_periods`` periods, reads another fundamental than the whole window, or
+        when not asked for (``with_early_statics``).
     ratio_z : float
         Distance of the ratio from the MAP x_c in its standard deviations.
     opening : float
@@ -636,15 +642,27 @@ def _frequency(window: _Window, push: PushPhase | None) -> _Frequency:
     return _Frequency(fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), frozenset(failed))
 
 
-def _early_statics(window: _Window, omega1: float, bias: SensorBias) -> StaticRatio | None:
+def _early_statics(
+    window: _Window, omega1: float, omega1_se: float, bias: SensorBias
+) -> StaticRatio | None:
     """Statics of the window's first half from t_1, the slip check's reference; None when that
-    half holds fewer than ``min_periods`` periods of ``omega1`` (rad/s) or is not on the grid."""
+    half holds fewer than ``min_periods`` periods of ``omega1`` (rad/s), is not on the grid, or
+    does not find the same fundamental: within ``max_disagreement`` standard errors of the two
+    (``omega1_se``: the whole window's statistical one, rad/s)."""
     config = window.config
     half = reference_index(window.rest_index, window.end_index, 0.5, window.sample_period, config)
     half_fit = None if half is None else _fit_window(*window._replace(end_index=half))
     if half_fit is None or half_fit.duration * omega1 < 2.0 * math.pi * config.min_periods:
         # Statics of a window too short for the model are not a reference (mode and offset
         # are confounded below a period or so)
+        return None
+    k, _ = _fundamental(half_fit, window.band, config)
+    if k is None:
+        return None
+    # A half that read another fundamental has put part of the vibration in its static part
+    # (a slow, fast-decaying mode in its place): its statics are no reference either
+    spread = math.hypot(float(half_fit.omega_se[k]), omega1_se)
+    if not abs(float(half_fit.omega[k]) - omega1) <= config.max_disagreement * spread:
         return None
     return static_ratio(half_fit, bias)
 
@@ -741,7 +759,7 @@ def evaluate_window(
     # compares it with the vibration at t_1
     statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
     early = (
-        _early_statics(window, from_t1.omega1, bias)
+        _early_statics(window, from_t1.omega1, from_t1.omega1_crb, bias)
         if with_early_statics and from_t1.mode is not None
         else None
     )
