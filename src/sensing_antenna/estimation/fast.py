@@ -85,6 +85,15 @@ class FastConfigError(SensingAntennaError, ValueError):
     """A setting of the fast method is out of range; the message names the field."""
 
 
+#: Largest relative distance (dimensionless) between the fundamental of the slip check's half
+#: window and the whole window's for the two to be the same mode. 0.1: short windows read
+#: omega_1 up to about 2 % off (docs/fast.md, "Three modes"), and 0.2 to 1.5 % off at 3 to 7 of
+#: their standard errors on the half windows of the paper antenna (so no test in standard
+#: errors); the nearest other contact mode is at least 2.2 times omega_1, and the mode that
+#: once took the fundamental's place was 53 % off.
+_SAME_MODE = 0.1
+
+
 @dataclass(frozen=True)
 class FastConfig:
     """Settings of the fast method (SI units).
@@ -134,11 +143,13 @@ class FastConfig:
         and 3 and modes of the link moving along the surface (calibrated-device campaign,
         vertical 0.5 m: fitted at 50, 395 and 430 rad/s over 0.2 s after t_1, the two upper
         ones the stronger; contact mode 3 is at 437 rad/s). With room for one of them only,
-        short windows read omega_1 up to 2 % high (50.9 against 49.8 rad/s at 0.215 s; 50.1
+        short windows read omega_1 up to 2 % high (50.9 against 49.7 rad/s at 0.215 s; 50.1
         with three modes) and the drift check held them back. Against 2 (docs/fast.md, "Three
-        modes"): median t_e - t_1 0.421 to 0.383 s on the calibrated device and 0.316 to
-        0.302 s on the paper antenna, MAE 0.77 to 0.59 mm and 0.37 to 0.23 mm, coverage
-        unchanged; about 1.6 times the CPU.
+        modes"): median t_e - t_1 0.421 to 0.383 s on the calibrated-device campaign and 0.316
+        to 0.302 s on the paper antenna, MAE 0.73 to 0.65 mm and 0.37 to 0.23 mm, coverage
+        149/150 on the campaign as before. It costs about 1.6 times the CPU: in the real-time
+        loop of a two-core machine the answer came 0.667 s after t_1 instead of 0.490 s, so
+        where the CPU is that slow 2 gives the earlier answer.
     min_mode_fraction : float
         Modes are fitted above this fraction of the lower end of the omega_1 band; slower content
         (the servo's slow creep at ~8 rad/s) goes to the polynomial. 0.6 of ~23 rad/s.
@@ -390,7 +401,7 @@ class WindowEstimate:
         Change of omega_1 from the window's first 2/3 beyond what the noise explains (rad/s).
     early_statics : StaticRatio or None
         Statics of the window's first half (the slip reference); None when that half holds
-        fewer than ``min_periods`` periods, reads another fundamental than the whole window, or
+        fewer than ``min_periods`` periods, has no mode near the whole window's fundamental, or
         when not asked for (``with_early_statics``).
     ratio_z : float
         Distance of the ratio from the MAP x_c in its standard deviations.
@@ -642,13 +653,11 @@ def _frequency(window: _Window, push: PushPhase | None) -> _Frequency:
     return _Frequency(fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), frozenset(failed))
 
 
-def _early_statics(
-    window: _Window, omega1: float, omega1_se: float, bias: SensorBias
-) -> StaticRatio | None:
+def _early_statics(window: _Window, omega1: float, bias: SensorBias) -> StaticRatio | None:
     """Statics of the window's first half from t_1, the slip check's reference; None when that
     half holds fewer than ``min_periods`` periods of ``omega1`` (rad/s), is not on the grid, or
-    does not find the same fundamental: within ``max_disagreement`` standard errors of the two
-    (``omega1_se``: the whole window's statistical one, rad/s)."""
+    has no mode within :data:`_SAME_MODE` of ``omega1`` in the band (another mode took the
+    fundamental's place)."""
     config = window.config
     half = reference_index(window.rest_index, window.end_index, 0.5, window.sample_period, config)
     half_fit = None if half is None else _fit_window(*window._replace(end_index=half))
@@ -656,13 +665,10 @@ def _early_statics(
         # Statics of a window too short for the model are not a reference (mode and offset
         # are confounded below a period or so)
         return None
-    k, _ = _fundamental(half_fit, window.band, config)
-    if k is None:
-        return None
     # A half that read another fundamental has put part of the vibration in its static part
     # (a slow, fast-decaying mode in its place): its statics are no reference either
-    spread = math.hypot(float(half_fit.omega_se[k]), omega1_se)
-    if not abs(float(half_fit.omega[k]) - omega1) <= config.max_disagreement * spread:
+    k = half_fit.strongest_in_band(window.band)
+    if k is None or not abs(float(half_fit.omega[k]) - omega1) <= _SAME_MODE * omega1:
         return None
     return static_ratio(half_fit, bias)
 
@@ -759,7 +765,7 @@ def evaluate_window(
     # compares it with the vibration at t_1
     statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
     early = (
-        _early_statics(window, from_t1.omega1, from_t1.omega1_crb, bias)
+        _early_statics(window, from_t1.omega1, bias)
         if with_early_statics and from_t1.mode is not None
         else None
     )
