@@ -15,7 +15,8 @@ Prints tables and writes ``benchmarks/results/estimation.json`` and, for the rea
 ``estimation_realtime.png``.
 Run: ``python benchmarks/bench_estimation.py`` (about a minute);
 ``python benchmarks/bench_estimation.py --push-phase --out benchmarks/results/estimation_push.json``
-runs the fast method with its windows also through the push (``FastConfig.push_phase``).
+runs the fast method with its windows also through the push (``FastConfig.push_phase``);
+``--set FIELD=VALUE`` sets any other ``FastConfig`` field (``fast_settings.py``).
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from fast_settings import add_fast_arguments, fast_settings  # noqa: E402
 from sensing_antenna.antenna import load_antenna  # noqa: E402
 from sensing_antenna.estimation import OnlineEstimator, estimate  # noqa: E402
 from sensing_antenna.estimation.fast import FastConfig, FastMethod  # noqa: E402
@@ -168,13 +170,10 @@ def plot_realtime(rows: dict[str, dict[str, Any]], path: Path) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument(
-        "--push-phase",
-        action="store_true",
-        help="fast method's windows also through the push from t_c (FastConfig.push_phase)",
-    )
+    add_fast_arguments(parser)
     parser.add_argument("--out", type=Path, default=RESULTS, help="JSON output")
     args = parser.parse_args()
+    config, settings = fast_settings(args)
     antenna_name = "paper-2021"
     antenna = load_antenna(antenna_name)
     recordings = {
@@ -211,7 +210,7 @@ def main() -> None:
             ok = "yes" if value <= target else "NO"
             print(f"{case:10s} {name:32s} {value * 1e3:9.4f} ms {target * 1e3:9.3f} ms {ok:>4s}")
     print("fast method in a real-time loop (model clock; times after t_1 in s):")
-    realtime = fast_realtime(antenna_name, FastConfig(push_phase=args.push_phase))
+    realtime = fast_realtime(antenna_name, config)
     print(
         f"{'recording':28s} {'status':14s} {'t_e offline':>11s} {'t_e':>7s} {'answer':>7s} "
         f"{'paper':>7s} {'evals':>5s} {'mean eval':>9s} {'max eval':>9s}"
@@ -247,10 +246,11 @@ def main() -> None:
             "offline_5s": OFFLINE_TARGET_S,
         },
         "results": rows,
+        "fast_settings": settings,
         "fast_realtime": {"recordings": realtime, "medians": medians},
     }
     out.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
-    figure = out.with_name(out.stem.replace("estimation", "estimation_realtime") + ".png")
+    figure = out.with_name(out.stem.replace("estimation", "estimation_realtime", 1) + ".png")
     plot_realtime(realtime, figure)
     print(f"wrote {out} and {figure}")
 

@@ -16,7 +16,7 @@ Usage::
     python benchmarks/eval_fast.py --cache /tmp/fast_cache   # reuse simulated recordings
     python benchmarks/eval_fast.py --push-phase --out benchmarks/results/fast_push.json
                                               # windows also through the push (opt-in)
-    python benchmarks/eval_fast.py --set max_modes=3 --out /tmp/fast.json   # any FastConfig field
+    python benchmarks/eval_fast.py --set max_modes=2 --out /tmp/fast.json   # any FastConfig field
 
 Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
 """
@@ -29,14 +29,13 @@ import math
 import pickle
 import statistics
 import time
-from collections.abc import Sequence
-from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from fast_settings import add_fast_arguments, fast_settings
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.estimation.fast import FastConfig, FastMethod
 from sensing_antenna.estimation.pipeline import estimate
@@ -156,21 +155,6 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return table
 
 
-def config_overrides(items: Sequence[str]) -> dict[str, Any]:
-    """``FIELD=VALUE`` strings as FastConfig keyword arguments (each value read as JSON)."""
-    names = {f.name for f in fields(FastConfig)}
-    overrides: dict[str, Any] = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        if not sep or name not in names:
-            raise SystemExit(f"--set {item!r}: expected FIELD=VALUE with a FastConfig field")
-        try:
-            overrides[name] = json.loads(value)
-        except json.JSONDecodeError as error:
-            raise SystemExit(f"--set {item!r}: the value is not JSON ({error})") from None
-    return overrides
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="4 positions, noise 1, 1 seed")
@@ -185,22 +169,10 @@ def main() -> None:
     parser.add_argument(
         "--cache", type=Path, default=None, help="directory of stored simulated recordings"
     )
-    parser.add_argument(
-        "--push-phase",
-        action="store_true",
-        help="windows also through the push from t_c (FastConfig.push_phase)",
-    )
-    parser.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="FIELD=VALUE",
-        help="another FastConfig setting (JSON value, e.g. max_modes=3); repeatable",
-    )
+    add_fast_arguments(parser)
     parser.add_argument("--out", type=Path, default=OUT, help="JSON output")
     args = parser.parse_args()
-    settings = {"push_phase": args.push_phase, **config_overrides(args.set)}
-    config = FastConfig(**settings)
+    config, settings = fast_settings(args)
     grid = QUICK_GRID if args.quick else GRID
     seeds = range(1) if args.quick else range(args.seeds)
     noises = [1.0] if args.quick else args.noise

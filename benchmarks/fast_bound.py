@@ -38,7 +38,7 @@ Usage::
     python benchmarks/fast_bound.py --campaign paper-2021   # its calibrated device (3 min)
     python benchmarks/fast_bound.py --push-phase --out benchmarks/results/fast_bound_push.json
                                                 # windows also through the push (opt-in)
-    python benchmarks/fast_bound.py --set max_modes=3 --out /tmp/fb.json   # any FastConfig field
+    python benchmarks/fast_bound.py --set max_modes=2 --out /tmp/fb.json   # any FastConfig field
 
 Set OMP_NUM_THREADS=1 on a shared machine: the fits are small and BLAS threads only contend.
 """
@@ -58,7 +58,8 @@ from typing import Any
 
 import numpy as np
 
-from eval_fast import GRID, QUICK_GRID, config_overrides
+from eval_fast import GRID, QUICK_GRID
+from fast_settings import add_fast_arguments, fast_settings
 from sensing_antenna.antenna import Antenna, Link, paper_antenna
 from sensing_antenna.campaign.simulated import make_scenario, prepare_campaign
 from sensing_antenna.campaign.spec import load_campaign_spec
@@ -266,21 +267,10 @@ def main() -> None:
         default=None,
         help="campaign spec (file, or paper-2021): its device, scenario and prepared model",
     )
-    parser.add_argument(
-        "--push-phase",
-        action="store_true",
-        help="windows also through the push from t_c (FastConfig.push_phase)",
-    )
-    parser.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="FIELD=VALUE",
-        help="another FastConfig setting (JSON value, e.g. max_modes=3); repeatable",
-    )
+    add_fast_arguments(parser)
     parser.add_argument("--out", type=Path, default=None, help="JSON output")
     args = parser.parse_args()
-    overrides = config_overrides(args.set)
+    config, settings = fast_settings(args)  # before the campaign's preparation: fail early
     grid = QUICK_GRID if args.quick else GRID
     seeds = range(1) if args.quick else range(args.seeds)
     if args.campaign is None:
@@ -292,7 +282,7 @@ def main() -> None:
         model_t, device_t = setup.model.link.t_param, setup.device.link.t_param
         print(f"model T = {model_t:.5f} s/m^2, device T = {device_t:.5f} s/m^2")
     out = args.out or out
-    setup = replace(setup, config=FastConfig(**{"push_phase": args.push_phase, **overrides}))
+    setup = replace(setup, config=config)
     jobs = [
         (setup, case, float(x), args.seed_base + s)
         for case in ("azimuthal", "vertical")
@@ -324,7 +314,6 @@ def main() -> None:
             f" mm, ok over 2 cm: {a['ok_over_2cm']}, coverage {a['coverage']:.3f}"
         )
     out.parent.mkdir(parents=True, exist_ok=True)
-    settings = {"push_phase": args.push_phase, **overrides}
     out.write_text(
         json.dumps({"summary": summary, "settings": settings, "rows": rows}, indent=1) + "\n"
     )
