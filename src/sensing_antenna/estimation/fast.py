@@ -197,9 +197,10 @@ class FastConfig:
         0.29 s window) the product can still be narrow on the wrong branch: 3 of 150 campaign
         runs at 0.98 m were declared at 0.62 m, 3.4 ratio deviations from the ratio.
     max_direction_drift : float
-        Largest angle (rad) between the perpendicular reaction over the first 20 ms after t_1
-        and the fitted static one at t_e (both with the sensor bias removed) before a slip is
-        suspected; 0.15 rad as the pipeline's ``max_direction_drift``.
+        Largest angle (rad) between the fitted static perpendicular reaction of the window's
+        first half from t_1 (``WindowEstimate.early_statics``) and that of the whole window at
+        t_e (both with the sensor bias removed) before a slip is suspected, or 3 standard
+        errors of that angle when larger; 0.15 rad as the pipeline's ``max_direction_drift``.
     max_opening : float
         Largest predicted vibration of the contact force over the static push at the window
         start. The obstacle can only push: when the fundamental's contact force (its base-force
@@ -255,9 +256,10 @@ class FastConfig:
         difference (the touch can leave content the model does not describe: a bouncing
         contact, more modes); otherwise the window from t_1 does. The statics always come from
         the window from t_1. Off by default: on the
-        paper antenna it brings the median delay from 0.316 to 0.261 s, but every window is
-        fitted twice and the CPU per recording is about 5 times larger, so in a real-time loop
-        on a two-core machine the answer came later than without it (docs/fast.md).
+        paper antenna it brings the median delay from 0.302 to 0.261 s (on the calibrated
+        device it stays 0.383 s), but every window is fitted twice and the CPU per
+        recording is about 1.7 times larger, so in a real-time loop on a two-core machine the
+        answer came later than without it (0.964 against 0.667 s after t_1, docs/fast.md).
     push_max_modes : int
         Largest number of modes tried on a window through the push (the touch excites contact
         modes the stop hardly does). 3.
