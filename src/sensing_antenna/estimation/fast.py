@@ -147,7 +147,7 @@ class FastConfig:
         with three modes) and the drift check held them back. Against 2 (docs/fast.md, "Three
         modes"): median t_e - t_1 0.421 to 0.383 s on the calibrated-device campaign and 0.316
         to 0.302 s on the paper antenna, MAE 0.73 to 0.65 mm and 0.37 to 0.23 mm, coverage
-        149/150 on the campaign as before. It costs about 1.6 times the CPU: in the real-time
+        149/150 on the campaign as before. It costs 1.5 to 1.8 times the CPU: in the real-time
         loop of a two-core machine the answer came 0.667 s after t_1 instead of 0.490 s, so
         where the CPU is that slow 2 gives the earlier answer.
     min_mode_fraction : float
