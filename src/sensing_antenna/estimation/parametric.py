@@ -280,20 +280,6 @@ class _Design:
             out[1::2] += np.moveaxis(-t3 * (a * c3 + b * s3), 1, 0)
         return out
 
-    def basis_derivatives(self, params: FloatArray) -> FloatArray:
-        """d basis / d params, shape (n, n_linear, 2M) (only the mode columns depend on them)."""
-        m = params.size // 2
-        out = np.zeros((self.tau.size, self.n_linear(m), 2 * m))
-        for i, (time, cos_part, sin_part) in enumerate(self._parts(params)):
-            first = self.n_fixed + 2 * m * i
-            for j in range(m):
-                # d/dw: t * (-sin, cos) envelope;  d/ds: -t * (cos, sin) envelope
-                out[:, first + 2 * j, 2 * j] = -time * sin_part[:, j]
-                out[:, first + 1 + 2 * j, 2 * j] = time * cos_part[:, j]
-                out[:, first + 2 * j, 2 * j + 1] = -time * cos_part[:, j]
-                out[:, first + 1 + 2 * j, 2 * j + 1] = -time * sin_part[:, j]
-        return out
-
     def free_amplitudes(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
         """Amplitude at t_ref of each mode's vibration after the restart (or of the only one),
         shape (K, M): the restarted pair carried to the origin tau = 0 and added."""
@@ -568,12 +554,12 @@ def _summarise(
     noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale
     noise = np.where(noise > 0.0, noise, np.finfo(float).tiny)
     # Full Jacobian of the weighted residuals: shared (w, s) columns, then each channel's block
-    deriv = design.basis_derivatives(params)
+    deriv = design.derivative_times_coef(params, coef)  # (2M, n, K)
     n_par = 2 * m + k * n_linear
     jac = np.zeros((n * k, n_par))
     for ch in range(k):
         rows = slice(ch * n, (ch + 1) * n)
-        jac[rows, : 2 * m] = np.einsum("npq,p->nq", deriv, coef[:, ch]) / noise[ch]
+        jac[rows, : 2 * m] = deriv[:, :, ch].T / noise[ch]
         jac[rows, 2 * m + ch * n_linear : 2 * m + (ch + 1) * n_linear] = basis / noise[ch]
     try:
         cov = np.linalg.inv(jac.T @ jac)
