@@ -16,12 +16,13 @@ rates, shared by every channel because they belong to the structure. Modes are k
 frequency so that they do not compete with the polynomial for the static part.
 
 Fit (variable projection): for given (w, s) the model is linear in (P, a, b), solved by least
-squares for every channel at once; only the 2 M nonlinear parameters go to
-:func:`scipy.optimize.least_squares` (with Kaufman's approximation of the Jacobian, Golub and
-Pereyra 2003). Each channel is weighted by the inverse of its noise
-standard deviation (estimated from the residuals of a first fit, then refitted), so the channels
-are combined as independent measurements. Initial poles come from the matrix pencil method on the
-stacked Hankel matrices of all channels (Hua and Sarkar 1990).
+squares for every channel at once; only the 2 M nonlinear parameters go to a bounded
+trust-region Levenberg-Marquardt solver (with Kaufman's approximation of the Jacobian, Golub and
+Pereyra 2003), compiled with the residual and Jacobian in :mod:`.varpro`. Each channel is
+weighted by the inverse of its noise standard deviation (estimated from the residuals of a first
+fit, then refitted), so the channels are combined as independent measurements. Initial poles
+come from the matrix pencil method on the stacked Hankel matrices of all channels (Hua and
+Sarkar 1990).
 
 Model order: M = 1 .. ``max_modes`` damped modes; the order with the smallest Bayesian
 information criterion (Schwarz 1978) sum_k n ln(RSS_k / n) + P ln(n K) is kept, P being the
@@ -42,9 +43,14 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import least_squares
 
 from sensing_antenna.estimation.frequency import find_peak, power_spectrum
+from sensing_antenna.estimation.varpro import (
+    bounded_levenberg_marquardt,
+    mode_columns,
+    mode_derivatives,
+    projected_residual,
+)
 
 __all__ = [
     "DampedSinusoidFit",
@@ -208,6 +214,8 @@ class _Design:
     exp(-s tau) cos(w tau), exp(-s tau) sin(w tau); with a ``restart`` index, per mode also the
     same pair started at that sample (time from it, zero before): a change of the modes'
     amplitudes and phases there, as an impulsive load on the structure makes (the head stopping).
+    The mode columns are computed by the compiled kernels of :mod:`.varpro` (``axes``, ``starts``:
+    its layout).
     """
 
     def __init__(
@@ -225,13 +233,16 @@ class _Design:
             r = np.asarray(regressors, dtype=float).reshape(n, -1)
             # zero at t_ref, so the constant term stays the static load at the window centre
             fixed.append(r - 0.5 * (r[(n - 1) // 2] + r[n // 2]))
-        self.fixed = np.hstack(fixed)
+        self.fixed: FloatArray = np.ascontiguousarray(np.hstack(fixed))
         self.restart = restart
-        # Time axis of each column pair and where it is on: the window, then the restart's
-        self.times: list[tuple[FloatArray, NDArray[np.bool_] | None]] = [(self.tau, None)]
+        # Time axis of each column pair and the sample from which it is on: the window, then
+        # the restart's (time from the restart sample)
+        axes, starts = [self.tau], [0]
         if restart is not None:
-            since = (np.arange(n, dtype=float) - restart) * sample_period
-            self.times.append((since, (np.arange(n) >= restart)[:, None]))
+            axes.append((np.arange(n, dtype=float) - restart) * sample_period)
+            starts.append(restart)
+        self.axes: FloatArray = np.vstack(axes)
+        self.starts: NDArray[np.int64] = np.array(starts, dtype=np.int64)
 
     @property
     def n_fixed(self) -> int:
@@ -240,45 +251,23 @@ class _Design:
 
     def n_linear(self, n_modes: int) -> int:
         """Columns of the model with ``n_modes`` modes (one column pair per mode and time axis)."""
-        return self.n_fixed + 2 * len(self.times) * n_modes
-
-    def _parts(self, params: FloatArray) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
-        """(time, envelope cos, envelope sin) of each column pair, shapes (n,), (n, M), (n, M)."""
-        omega, decay = params[0::2], params[1::2]
-        parts = []
-        for time, mask in self.times:
-            envelope = np.exp(-np.multiply.outer(time, decay))
-            if mask is not None:
-                envelope = np.where(mask, envelope, 0.0)
-            phase = np.multiply.outer(time, omega)
-            parts.append((time, envelope * np.cos(phase), envelope * np.sin(phase)))
-        return parts
+        return self.n_fixed + 2 * self.axes.shape[0] * n_modes
 
     def basis(self, params: FloatArray) -> FloatArray:
         """All columns at (w, s), shape (n, n_linear)."""
-        m = params.size // 2
-        cols = np.empty((self.tau.size, self.n_linear(m)))
-        cols[:, : self.n_fixed] = self.fixed
-        for i, (_, cos_part, sin_part) in enumerate(self._parts(params)):
-            first = self.n_fixed + 2 * m * i
-            cols[:, first : first + 2 * m : 2] = cos_part
-            cols[:, first + 1 : first + 2 * m : 2] = sin_part
-        return cols
+        return np.asarray(mode_columns(self.fixed, self.axes, self.starts, params), dtype=float)
 
     def derivative_times_coef(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
         """d(basis @ coef) / d(w_j, s_j), shape (2M, n, K): only mode j's columns depend on them."""
-        m = params.size // 2
-        out = np.zeros((2 * m, self.tau.size, coef.shape[1]))
-        for i, (time, cos_part, sin_part) in enumerate(self._parts(params)):
-            first = self.n_fixed + 2 * m * i
-            a = coef[first : first + 2 * m : 2][None]
-            b = coef[first + 1 : first + 2 * m : 2][None]
-            t3 = time[:, None, None]
-            c3, s3 = cos_part[:, :, None], sin_part[:, :, None]
-            # d/dw: t (-a sin + b cos) envelope;  d/ds: -t (a cos + b sin) envelope
-            out[0::2] += np.moveaxis(t3 * (b * c3 - a * s3), 1, 0)
-            out[1::2] += np.moveaxis(-t3 * (a * c3 + b * s3), 1, 0)
-        return out
+        derivatives = mode_derivatives(
+            self.axes, self.starts, self.n_fixed, params, np.ascontiguousarray(coef, dtype=float)
+        )
+        return np.asarray(derivatives, dtype=float)
+
+    def residual(self, params: FloatArray, weighted: FloatArray) -> FloatArray:
+        """Residual of ``weighted`` (n, K) after the linear least-squares solve, flattened."""
+        residual = projected_residual(self.fixed, self.axes, self.starts, params, weighted)
+        return np.asarray(residual, dtype=float)
 
     def free_amplitudes(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
         """Amplitude at t_ref of each mode's vibration after the restart (or of the only one),
@@ -286,9 +275,9 @@ class _Design:
         m = params.size // 2
         first = self.n_fixed
         a, b = coef[first : first + 2 * m : 2], coef[first + 1 : first + 2 * m : 2]
-        if len(self.times) > 1:
+        if self.axes.shape[0] > 1:
             omega, decay = params[0::2][:, None], params[1::2][:, None]
-            lag = float(self.tau[0] - self.times[1][0][0])  # t_restart - t_ref
+            lag = float(self.tau[0] - self.axes[1, 0])  # t_restart - t_ref
             second = first + 2 * m
             a2, b2 = coef[second : second + 2 * m : 2], coef[second + 1 : second + 2 * m : 2]
             gain = np.exp(decay * lag)
@@ -296,43 +285,6 @@ class _Design:
             a = a + gain * (a2 * cos_lag - b2 * sin_lag)
             b = b + gain * (a2 * sin_lag + b2 * cos_lag)
         return np.asarray(np.hypot(a, b).T, dtype=float)
-
-
-class _Projection:
-    """Variable projection of one weighted record: its residual and Jacobian at (w, s).
-
-    The basis and its QR factors at the last parameters asked are kept: the solver asks the
-    Jacobian at the point whose residual it has just computed, and factoring once serves both.
-    """
-
-    def __init__(self, design: _Design, weighted: FloatArray) -> None:
-        self.design, self.weighted = design, weighted
-        self._at: FloatArray | None = None
-        self._basis = self._q = self._r = np.empty((0, 0))
-
-    def _factor(self, params: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        if self._at is None or not np.array_equal(params, self._at):
-            self._basis = self.design.basis(params)
-            self._q, self._r = np.linalg.qr(self._basis)
-            self._at = np.array(params, dtype=float)
-        return self._basis, self._q, self._r
-
-    def residual(self, params: FloatArray) -> FloatArray:
-        """Weighted residual after the linear least-squares solve, flattened."""
-        _, q, _ = self._factor(params)
-        residual = self.weighted - q @ (q.T @ self.weighted)
-        return np.asarray(residual.ravel(), dtype=float)
-
-    def jacobian(self, params: FloatArray) -> FloatArray:
-        """Kaufman's approximation of the Jacobian: -(I - Q Q^T) dPhi_j C."""
-        basis, q, r = self._factor(params)
-        weighted = self.weighted
-        coef = np.linalg.solve(r, q.T @ weighted) if np.all(np.diag(r) != 0) else None
-        if coef is None:
-            coef = np.linalg.lstsq(basis, weighted, rcond=None)[0]
-        cols = self.design.derivative_times_coef(params, coef)
-        cols -= q @ (q.T @ cols)
-        return np.asarray(-cols.reshape(cols.shape[0], -1).T, dtype=float)
 
 
 def _difference_scale(y: FloatArray) -> FloatArray:
@@ -499,16 +451,17 @@ def fit_damped_sinusoids(
     if z is None:
         return None
     start = _initial_modes(y / scale, z, n_modes, sample_period, lower, upper, target_band)
-    if not np.all(np.isfinite(_Projection(design, y / scale).residual(start))):
+    weighted = np.ascontiguousarray(y / scale)
+    if not np.all(np.isfinite(design.residual(start, weighted))):
         return None
     bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
-    params, ok = _refine(start, design, y / scale, bounds)
+    params, ok = _refine(start, design, weighted, bounds)
     if noise_std is None:
-        residual = _Projection(design, y / scale).residual(params).reshape(n, k) * scale
+        residual = design.residual(params, weighted).reshape(n, k) * scale
         dof = max(n - n_linear - 2 * n_modes, 1)
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
-        params, ok = _refine(params, design, y / scale, bounds)
+        params, ok = _refine(params, design, np.ascontiguousarray(y / scale), bounds)
     return _summarise(params, ok, design, y, scale, t_start, sample_period, noise_std is None)
 
 
@@ -518,20 +471,22 @@ def _refine(
     weighted: FloatArray,
     bounds: tuple[FloatArray, FloatArray],
 ) -> tuple[FloatArray, bool]:
-    projection = _Projection(design, weighted)
-    solution = least_squares(
-        projection.residual,
-        start,
-        jac=projection.jacobian,
-        bounds=bounds,
-        method="trf",
-        x_scale="jac",
+    """The least-squares (w, s) from ``start`` and whether the solver converged."""
+    params, status = bounded_levenberg_marquardt(
+        design.fixed,
+        design.axes,
+        design.starts,
+        weighted,
+        np.asarray(start, dtype=float),
+        bounds[0],
+        bounds[1],
         # Relative steps of 1e-8 are 1e-5 of the smallest standard error of omega_1 (~1e-3)
-        xtol=1e-8,
-        ftol=1e-8,
-        max_nfev=100,
+        1e-8,
+        1e-8,
+        1e-8,
+        100,
     )
-    return np.asarray(solution.x, dtype=float), bool(solution.status > 0)
+    return np.asarray(params, dtype=float), bool(status > 0)
 
 
 def _summarise(
@@ -553,16 +508,22 @@ def _summarise(
     dof = max(n - n_linear - 2 * m, 1)
     noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale
     noise = np.where(noise > 0.0, noise, np.finfo(float).tiny)
-    # Full Jacobian of the weighted residuals: shared (w, s) columns, then each channel's block
+    # J^T J of the weighted residuals, J = [shared (w, s) columns | each channel's basis block]:
+    # built by blocks, as every channel shares the basis (its Gram matrix is computed once)
     deriv = design.derivative_times_coef(params, coef)  # (2M, n, K)
     n_par = 2 * m + k * n_linear
-    jac = np.zeros((n * k, n_par))
+    weight = 1.0 / noise**2
+    normal = np.zeros((n_par, n_par))
+    normal[: 2 * m, : 2 * m] = np.einsum("pik,qik,k->pq", deriv, deriv, weight)
+    gram = basis.T @ basis
     for ch in range(k):
-        rows = slice(ch * n, (ch + 1) * n)
-        jac[rows, : 2 * m] = deriv[:, :, ch].T / noise[ch]
-        jac[rows, 2 * m + ch * n_linear : 2 * m + (ch + 1) * n_linear] = basis / noise[ch]
+        block = slice(2 * m + ch * n_linear, 2 * m + (ch + 1) * n_linear)
+        cross = (deriv[:, :, ch] @ basis) * weight[ch]
+        normal[: 2 * m, block] = cross
+        normal[block, : 2 * m] = cross.T
+        normal[block, block] = gram * weight[ch]
     try:
-        cov = np.linalg.inv(jac.T @ jac)
+        cov = np.linalg.inv(normal)
         ok = converged and bool(np.all(np.isfinite(cov)))
     except np.linalg.LinAlgError:
         cov = np.full((n_par, n_par), np.nan)
