@@ -65,8 +65,10 @@ def test_columns_and_their_derivatives_match_the_closed_form_and_finite_differen
         up[p] += h
         down[p] -= h
         numeric = (
-            mode_columns(fixed, axes, starts, up) - mode_columns(fixed, axes, starts, down)
-        ) @ coef / (2 * h)
+            (mode_columns(fixed, axes, starts, up) - mode_columns(fixed, axes, starts, down))
+            @ coef
+            / (2 * h)
+        )
         np.testing.assert_allclose(derivatives[p], numeric, rtol=1e-6, atol=1e-9)
 
 
