@@ -73,6 +73,11 @@ _MAX_WINDOW_DECAY = 20.0
 _MIN_DECAY = -20.0
 #: Largest pencil parameter of the matrix pencil (see :func:`matrix_pencil_poles`).
 _MAX_PENCIL = 64
+#: Solver tolerances (those of least_squares, used before): relative steps of 1e-8 are 1e-5 of
+#: the smallest standard error of omega_1 (~1e-3); cost changes of 1e-8 relative; scaled
+#: gradient 1e-8; at most 100 residual evaluations.
+_XTOL = _FTOL = _GTOL = 1e-8
+_MAX_EVALUATIONS = 100
 
 
 @dataclass(frozen=True)
@@ -257,10 +262,11 @@ class _Design:
         """All columns at (w, s), shape (n, n_linear)."""
         return np.asarray(mode_columns(self.fixed, self.axes, self.starts, params), dtype=float)
 
-    def derivative_times_coef(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
-        """d(basis @ coef) / d(w_j, s_j), shape (2M, n, K): only mode j's columns depend on them."""
+    def derivative_times_coef(self, columns: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
+        """d(basis @ coef) / d(w_j, s_j), shape (2M, n, K), from the basis ``columns`` at (w, s):
+        only mode j's columns depend on them."""
         derivatives = mode_derivatives(
-            self.axes, self.starts, self.n_fixed, params, np.ascontiguousarray(coef, dtype=float)
+            columns, self.axes, self.starts, self.n_fixed, np.ascontiguousarray(coef, dtype=float)
         )
         return np.asarray(derivatives, dtype=float)
 
@@ -480,11 +486,10 @@ def _refine(
         np.asarray(start, dtype=float),
         bounds[0],
         bounds[1],
-        # Relative steps of 1e-8 are 1e-5 of the smallest standard error of omega_1 (~1e-3)
-        1e-8,
-        1e-8,
-        1e-8,
-        100,
+        xtol=_XTOL,
+        ftol=_FTOL,
+        gtol=_GTOL,
+        max_evaluations=_MAX_EVALUATIONS,
     )
     return np.asarray(params, dtype=float), bool(status > 0)
 
@@ -510,7 +515,7 @@ def _summarise(
     noise = np.where(noise > 0.0, noise, np.finfo(float).tiny)
     # J^T J of the weighted residuals, J = [shared (w, s) columns | each channel's basis block]:
     # built by blocks, as every channel shares the basis (its Gram matrix is computed once)
-    deriv = design.derivative_times_coef(params, coef)  # (2M, n, K)
+    deriv = design.derivative_times_coef(basis, coef)  # (2M, n, K)
     n_par = 2 * m + k * n_linear
     weight = 1.0 / noise**2
     normal = np.zeros((n_par, n_par))

@@ -33,15 +33,27 @@ IntArray = NDArray[np.int64]
 
 __all__ = [
     "bounded_levenberg_marquardt",
+    "kaufman_jacobian",
     "mode_columns",
     "mode_derivatives",
     "projected_residual",
     "residual_and_jacobian",
 ]
 
-#: Status of :func:`bounded_levenberg_marquardt` (as ``least_squares``' ``status``: > 0 means a
-#: tolerance was met): evaluations used up, gradient, cost, step, trust region collapsed.
-MAX_EVALUATIONS, GRADIENT, COST, STEP, REGION = 0, 1, 2, 3, 4
+#: Status of :func:`bounded_levenberg_marquardt`: 0 the evaluations ran out (not converged);
+#: > 0 converged (as for ``least_squares``' status, whose codes differ): the scaled gradient,
+#: the cost's change, the step's length, or the trust region collapsed.
+NOT_CONVERGED, GRADIENT, COST, STEP, REGION = 0, 1, 2, 3, 4
+
+# Trust region (Moré 1978; the values of least_squares' trf): shrink to a quarter of the step
+# when the cost fell by less than a quarter of the predicted reduction, double when by more than
+# three quarters and the step reached the radius; accept any step with a ratio above 1e-4
+_SHRINK_BELOW, _GROW_ABOVE, _AT_RADIUS, _ACCEPT_ABOVE = 0.25, 0.75, 0.95, 1e-4
+# Damping search: ||u(mu)|| within 1e-3 of the radius, at most 60 Newton or bisection steps;
+# eigenvalues floored at 1e-12 of the largest so a singular direction stays finite
+_RADIUS_MATCH, _DAMPING_ITERATIONS, _EIGEN_FLOOR = 1e-3, 60, 1e-12
+# The radius has collapsed when below 1e-15 of the scaled parameters
+_COLLAPSED = 1e-15
 
 
 @njit(cache=True)
@@ -67,23 +79,21 @@ def mode_columns(
 
 @njit(cache=True)
 def mode_derivatives(
-    axes: FloatArray, starts: IntArray, n_fixed: int, params: FloatArray, coef: FloatArray
+    columns: FloatArray, axes: FloatArray, starts: IntArray, n_fixed: int, coef: FloatArray
 ) -> FloatArray:
-    """d(columns @ coef) / d(w_j, s_j), shape (2M, n, K); ``coef`` (n_columns, K)."""
-    n = axes.shape[1]
-    n_modes = params.size // 2
-    n_channels = coef.shape[1]
-    out = np.zeros((2 * n_modes, n, n_channels))
-    for a in range(axes.shape[0]):
+    """d(columns @ coef) / d(w_j, s_j), shape (2M, n, K), from the ``columns`` of
+    :func:`mode_columns` at (w, s) and ``coef`` (n_columns, K)."""
+    n = columns.shape[0]
+    n_axes = axes.shape[0]
+    n_modes = (columns.shape[1] - n_fixed) // (2 * n_axes)
+    out = np.zeros((2 * n_modes, n, coef.shape[1]))
+    for a in range(n_axes):
         first = n_fixed + 2 * n_modes * a
         for j in range(n_modes):
-            omega, decay = params[2 * j], params[2 * j + 1]
             for i in range(starts[a], n):
                 t = axes[a, i]
-                envelope = math.exp(-decay * t)
-                c = envelope * math.cos(omega * t)
-                s = envelope * math.sin(omega * t)
-                for k in range(n_channels):
+                c, s = columns[i, first + 2 * j], columns[i, first + 2 * j + 1]
+                for k in range(coef.shape[1]):
                     a_k, b_k = coef[first + 2 * j, k], coef[first + 2 * j + 1, k]
                     # d/dw: t (b cos - a sin) envelope;  d/ds: -t (a cos + b sin) envelope
                     out[2 * j, i, k] += t * (b_k * c - a_k * s)
@@ -92,26 +102,11 @@ def mode_derivatives(
 
 
 @njit(cache=True)
-def _projection(
-    fixed: FloatArray, axes: FloatArray, starts: IntArray, params: FloatArray, weighted: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Q, R of the columns at (w, s), Q^T ``weighted`` and the residual (n, K) after the linear
-    least-squares solve."""
-    q, r = np.linalg.qr(mode_columns(fixed, axes, starts, params))
-    q = np.ascontiguousarray(q)
-    projected = np.ascontiguousarray(q.T) @ weighted
-    return q, r, projected, weighted - q @ projected
-
-
-@njit(cache=True)
 def _back_substitution(upper: FloatArray, rhs: FloatArray) -> FloatArray:
-    """Solution of ``upper`` x = ``rhs`` (upper triangular, shape (P, P); rhs (P, K)); an
-    unknown whose pivot is exactly zero (columns linearly dependent) is set to zero."""
+    """Solution of ``upper`` x = ``rhs``: upper triangular (P, P) with no zero pivot, rhs (P, K)."""
     size, n_rhs = rhs.shape
     out = np.zeros((size, n_rhs))
     for i in range(size - 1, -1, -1):
-        if upper[i, i] == 0.0:
-            continue
         for k in range(n_rhs):
             acc = rhs[i, k]
             for j in range(i + 1, size):
@@ -121,28 +116,77 @@ def _back_substitution(upper: FloatArray, rhs: FloatArray) -> FloatArray:
 
 
 @njit(cache=True)
+def _projection(
+    fixed: FloatArray, axes: FloatArray, starts: IntArray, params: FloatArray, weighted: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The linear least-squares solve of ``weighted`` (n, K) at (w, s).
+
+    Returns the columns (n, P), an orthonormal basis Q of their span (n, R), the coefficients
+    (P, K) and the residual (n, K). QR when every pivot of R is above max(n, P) eps times the
+    largest; otherwise (linearly dependent columns: a regressor that is constant, a mode pair
+    restarted at the last sample) from the eigen-decomposition of the Gram matrix, keeping the
+    directions above max(n, P) eps of the largest eigenvalue, with the minimum-norm
+    coefficients. Columns that are not finite give an infinite residual (and empty Q).
+    """
+    columns = mode_columns(fixed, axes, starts, params)
+    n, size = columns.shape
+    if not np.all(np.isfinite(columns)):
+        return columns, np.empty((n, 0)), np.empty((size, 0)), np.full(weighted.shape, np.inf)
+    q, r = np.linalg.qr(columns)
+    pivots = np.abs(np.diag(r))
+    tolerance = max(n, size) * np.finfo(np.float64).eps
+    if pivots.min() > tolerance * pivots.max():
+        q = np.ascontiguousarray(q)
+        projected = np.ascontiguousarray(q.T) @ weighted
+        coef = _back_substitution(r, projected)
+    else:
+        eigenvalues, vectors = np.linalg.eigh(columns.T @ columns)
+        keep = eigenvalues > tolerance * eigenvalues.max()
+        kept = np.ascontiguousarray(vectors[:, keep])
+        root = np.sqrt(eigenvalues[keep])
+        q = (columns @ kept) / root
+        projected = np.ascontiguousarray(q.T) @ weighted
+        coef = kept @ (projected / root.reshape(-1, 1))
+    return columns, q, coef, weighted - q @ projected
+
+
+@njit(cache=True)
 def projected_residual(
     fixed: FloatArray, axes: FloatArray, starts: IntArray, params: FloatArray, weighted: FloatArray
 ) -> FloatArray:
-    """Residual of ``weighted`` (n, K) after the linear least-squares solve at (w, s), (n K,)."""
+    """Residual of ``weighted`` (n, K) after the linear least-squares solve at (w, s), (n K,)
+    (sample-major, as ``ravel``)."""
     return _projection(fixed, axes, starts, params, weighted)[3].ravel()
+
+
+@njit(cache=True)
+def kaufman_jacobian(
+    columns: FloatArray,
+    axes: FloatArray,
+    starts: IntArray,
+    n_fixed: int,
+    q: FloatArray,
+    coef: FloatArray,
+) -> FloatArray:
+    """Kaufman's approximation of the residual's Jacobian, -(I - Q Q^T) dPhi_j C (Kaufman
+    1975), shape (n K, 2M), rows in the residual's order; from :func:`_projection`'s parts."""
+    derivatives = mode_derivatives(columns, axes, starts, n_fixed, coef)
+    n_channels = coef.shape[1]
+    qt = np.ascontiguousarray(q.T)
+    jacobian = np.empty((columns.shape[0] * n_channels, derivatives.shape[0]))
+    for p in range(derivatives.shape[0]):
+        column = derivatives[p] - q @ (qt @ derivatives[p])
+        jacobian[:, p] = -column.ravel()
+    return jacobian
 
 
 @njit(cache=True)
 def residual_and_jacobian(
     fixed: FloatArray, axes: FloatArray, starts: IntArray, params: FloatArray, weighted: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
-    """The residual of :func:`projected_residual` and Kaufman's approximation of its Jacobian,
-    -(I - Q Q^T) dPhi_j C, shape (n K, 2M) (rows in the residual's order, sample-major)."""
-    q, r, projected, residual = _projection(fixed, axes, starts, params, weighted)
-    coef = _back_substitution(r, projected)
-    derivatives = mode_derivatives(axes, starts, fixed.shape[1], params, coef)
-    qt = np.ascontiguousarray(q.T)
-    jacobian = np.empty((residual.size, params.size))
-    for p in range(params.size):
-        column = derivatives[p] - q @ (qt @ derivatives[p])
-        jacobian[:, p] = -column.ravel()
-    return residual.ravel(), jacobian
+    """The residual of :func:`projected_residual` and its :func:`kaufman_jacobian`."""
+    columns, q, coef, residual = _projection(fixed, axes, starts, params, weighted)
+    return residual.ravel(), kaufman_jacobian(columns, axes, starts, fixed.shape[1], q, coef)
 
 
 @njit(cache=True)
@@ -157,8 +201,8 @@ def _trust_region_step(
 
     Minimises the Gauss-Newton model g^T p + p^T (J^T J) p / 2 in the scaled variables
     u = scale * p: the eigen-decomposition of the scaled normal matrix gives ||u(mu)|| for any
-    damping mu in closed form, and mu is found by Newton's method on ||u(mu)|| = radius
-    (Moré 1978), bracketed.
+    damping mu in closed form, and mu is found by Newton's method on 1 / ||u(mu)|| (Moré
+    1978), kept inside a bracket. Held parameters do not move.
     """
     index = np.flatnonzero(free)
     m = index.size
@@ -173,16 +217,15 @@ def _trust_region_step(
             scaled_normal[a, b] = normal[index[a], index[b]] / (scale[index[a]] * scale[index[b]])
     eigenvalues, vectors = np.linalg.eigh(scaled_normal)
     eigenvalues = np.maximum(eigenvalues, 0.0)
-    # A floor keeps a singular direction finite (it is then limited by the radius)
-    floor = 1e-12 * max(eigenvalues[-1], 1e-300)
+    floor = _EIGEN_FLOOR * max(eigenvalues[-1], 1e-300)
     weights = vectors.T @ scaled_gradient
     mu = 0.0
     if math.sqrt(np.sum((weights / (eigenvalues + floor)) ** 2)) > radius:
         low, high = 0.0, math.sqrt(np.sum(weights**2)) / radius
         mu = high
-        for _ in range(60):
+        for _ in range(_DAMPING_ITERATIONS):
             length = math.sqrt(np.sum((weights / (eigenvalues + mu + floor)) ** 2))
-            if abs(length - radius) <= 1e-3 * radius:
+            if abs(length - radius) <= _RADIUS_MATCH * radius:
                 break
             if length > radius:
                 low = mu
@@ -196,6 +239,39 @@ def _trust_region_step(
     for a in range(m):
         step[index[a]] = scaled_step[a] / scale[index[a]]
     return step
+
+
+@njit(cache=True)
+def _free_parameters(
+    params: FloatArray, gradient: FloatArray, lower: FloatArray, upper: FloatArray
+) -> NDArray[np.bool_]:
+    """False for a parameter on a bound that the cost's descent (-gradient) would leave by."""
+    held_low = (params <= lower) & (gradient > 0.0)
+    held_high = (params >= upper) & (gradient < 0.0)
+    return ~(held_low | held_high)
+
+
+@njit(cache=True)
+def _updated_radius(radius: float, ratio: float, step_length: float) -> float:
+    """The trust radius after a step of scaled length ``step_length`` whose actual reduction of
+    the cost was ``ratio`` times the predicted one."""
+    if ratio < _SHRINK_BELOW:
+        return _SHRINK_BELOW * (step_length if step_length > 0.0 else radius)
+    if ratio > _GROW_ABOVE and step_length > _AT_RADIUS * radius:
+        return 2.0 * radius
+    return radius
+
+
+@njit(cache=True)
+def _updated_scale(scale: FloatArray, jacobian: FloatArray) -> FloatArray:
+    """Marquardt's scale: each column norm of ``jacobian``, never below the previous scale
+    (ones for zero columns at the start, when ``scale`` is all zeros)."""
+    out = np.empty(scale.size)
+    for p in range(scale.size):
+        out[p] = max(scale[p], math.sqrt(np.sum(jacobian[:, p] ** 2)))
+        if out[p] == 0.0:
+            out[p] = 1.0
+    return out
 
 
 @njit(cache=True)
@@ -216,66 +292,57 @@ def bounded_levenberg_marquardt(
 
     A trust-region Levenberg-Marquardt method with Marquardt's scaling (the Jacobian's column
     norms, never decreasing) and the initial radius ||scale * start||, as ``least_squares``
-    with ``x_scale="jac"``. Bounds: a parameter at a bound whose gradient points outwards is
-    held there for the step, and the step is clipped to the box. Stops as ``least_squares``
-    does: gradient (scaled, over the free parameters) below ``gtol``; an accepted step that
-    lowers the cost by less than ``ftol`` of it; a step shorter than
-    ``xtol * (xtol + ||params||)``; or ``max_evaluations`` residual evaluations.
+    with ``x_scale="jac"``. Bounds: a parameter on a bound whose gradient points outwards is
+    held there for the step (:func:`_free_parameters`), and the step is clipped to the box.
+    Converged when the largest |g_p| / scale_p over the free parameters is below ``gtol``; when
+    an accepted step lowers the cost by less than ``ftol`` of it (with a ratio above 1/4); when
+    a step is shorter than ``xtol * (xtol + ||params||)``; or when the radius collapses. Not
+    converged after ``max_evaluations`` residual evaluations, or when the start's residual is
+    not finite.
 
     Returns
     -------
     params : array, shape (2M,)
     status : int
-        :data:`MAX_EVALUATIONS` (0, not converged) or the test met (> 0).
+        :data:`NOT_CONVERGED` (0) or the test met (> 0).
     """
+    n_fixed = fixed.shape[1]
     params = np.minimum(np.maximum(start, lower), upper)
-    residual, jacobian = residual_and_jacobian(fixed, axes, starts, params, weighted)
+    columns, q, coef, residual_2d = _projection(fixed, axes, starts, params, weighted)
+    residual = residual_2d.ravel()
     cost = 0.5 * (residual @ residual)
+    if not np.isfinite(cost):
+        return params, NOT_CONVERGED
+    jacobian = kaufman_jacobian(columns, axes, starts, n_fixed, q, coef)
     evaluations = 1
-    n_par = params.size
-    scale = np.empty(n_par)
-    for p in range(n_par):
-        norm = math.sqrt(np.sum(jacobian[:, p] ** 2))
-        scale[p] = norm if norm > 0.0 else 1.0
+    scale = _updated_scale(np.zeros(params.size), jacobian)
     normal = jacobian.T @ jacobian
     gradient = jacobian.T @ residual
     radius = math.sqrt(np.sum((scale * params) ** 2))
     if radius == 0.0:
         radius = 1.0
     while evaluations < max_evaluations:
-        free = np.ones(n_par, dtype=np.bool_)
-        largest = 0.0
-        for p in range(n_par):
-            held_low = params[p] <= lower[p] and gradient[p] > 0.0
-            held_high = params[p] >= upper[p] and gradient[p] < 0.0
-            if held_low or held_high:
-                free[p] = False
-            else:
-                largest = max(largest, abs(gradient[p]) / scale[p])
-        if largest < gtol:
+        free = _free_parameters(params, gradient, lower, upper)
+        if np.max(np.where(free, np.abs(gradient) / scale, 0.0)) < gtol:
             return params, GRADIENT
         step = _trust_region_step(normal, gradient, scale, free, radius)
         trial = np.minimum(np.maximum(params + step, lower), upper)
         step = trial - params
-        trial_residual = projected_residual(fixed, axes, starts, trial, weighted)
+        columns, q, coef, residual_2d = _projection(fixed, axes, starts, trial, weighted)
         evaluations += 1
+        trial_residual = residual_2d.ravel()
         trial_cost = 0.5 * (trial_residual @ trial_residual)
+        # The Gauss-Newton model's reduction for the (clipped) step
         predicted = -(gradient @ step + 0.5 * (step @ (normal @ step)))
         actual = cost - trial_cost if np.isfinite(trial_cost) else -1.0
         ratio = actual / predicted if predicted > 0.0 else -1.0
-        step_length = math.sqrt(np.sum((scale * step) ** 2))
-        if ratio < 0.25:
-            radius = 0.25 * (step_length if step_length > 0.0 else radius)
-        elif ratio > 0.75 and step_length > 0.95 * radius:
-            radius *= 2.0
-        small_step = math.sqrt(step @ step) < xtol * (xtol + math.sqrt(trial @ trial))
-        if actual > 0.0 and ratio > 1e-4:
-            small_change = actual < ftol * cost and ratio > 0.25
-            params = trial
-            residual, jacobian = residual_and_jacobian(fixed, axes, starts, params, weighted)
-            cost = trial_cost
-            for p in range(n_par):
-                scale[p] = max(scale[p], math.sqrt(np.sum(jacobian[:, p] ** 2)))
+        radius = _updated_radius(radius, ratio, math.sqrt(np.sum((scale * step) ** 2)))
+        small_step = math.sqrt(step @ step) < xtol * (xtol + math.sqrt(params @ params))
+        if actual > 0.0 and ratio > _ACCEPT_ABOVE:
+            small_change = actual < ftol * cost and ratio > _SHRINK_BELOW
+            params, residual, cost = trial, trial_residual, trial_cost
+            jacobian = kaufman_jacobian(columns, axes, starts, n_fixed, q, coef)
+            scale = _updated_scale(scale, jacobian)
             normal = jacobian.T @ jacobian
             gradient = jacobian.T @ residual
             if small_change:
@@ -284,6 +351,6 @@ def bounded_levenberg_marquardt(
                 return params, STEP
         elif small_step:
             return params, STEP
-        elif radius < 1e-15 * max(math.sqrt(np.sum((scale * params) ** 2)), 1.0):
+        elif radius < _COLLAPSED * max(math.sqrt(np.sum((scale * params) ** 2)), 1.0):
             return params, REGION
-    return params, MAX_EVALUATIONS
+    return params, NOT_CONVERGED
