@@ -146,11 +146,12 @@ def test_solver_reports_when_it_runs_out_of_evaluations() -> None:
     assert status == NOT_CONVERGED
 
 
-@pytest.mark.parametrize("restart", [None, 90])
+@pytest.mark.parametrize("restart", [None, 90, 0])
 def test_kaufman_jacobian_matches_finite_differences_at_zero_residual(restart: int | None) -> None:
     # At a zero residual the term Kaufman's approximation drops vanishes, so it equals the exact
     # Jacobian there; central differences with step 1e-6 relative (truncation ~1e-12, rounding
-    # ~1e-10 of the residual's scale) within 1e-5.
+    # ~1e-10 of the residual's scale) within 1e-5. A restart at sample 0 makes every restarted
+    # pair a combination of the window's own pair (linearly dependent columns).
     n, params = 240, np.array([60.0, 3.0, 210.0, 12.0])
     y = _signals(params, n, restart, seed=6)
     fixed, axes, starts = _layout(n, restart)
@@ -183,6 +184,33 @@ def test_a_zero_column_changes_neither_residual_nor_jacobian() -> None:
     reference_residual, reference_jacobian = residual_and_jacobian(fixed, axes, starts, params, y)
     np.testing.assert_allclose(residual, reference_residual, atol=1e-9)
     np.testing.assert_allclose(jacobian, reference_jacobian, rtol=1e-6, atol=1e-9)
+
+
+def _lstsq_residual(columns: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return (y - columns @ np.linalg.lstsq(columns, y, rcond=None)[0]).ravel()
+
+
+def test_dependent_columns_give_the_least_squares_residual() -> None:
+    # Two bases whose columns are linearly dependent, against numpy's lstsq (SVD, the same rank
+    # tolerance): a mode on the Nyquist frequency (its sine column is zero to rounding) beside a
+    # quartic and a fast-decaying mode on a short window, where the weak tau^3, tau^4 directions
+    # must be kept; and a fixed column 1e3 times larger than the others that is a combination
+    # of them (a rounding-level pivot far below its own norm).
+    rng = np.random.default_rng(12)
+    n = 51
+    tau = (np.arange(n) - 0.5 * (n - 1)) * TS
+    quartic = np.ascontiguousarray(np.column_stack([tau**j for j in range(5)]))
+    axes, starts = tau[None, :].copy(), np.zeros(1, dtype=np.int64)
+    y = np.ascontiguousarray(rng.normal(size=(n, 3)))
+    params = np.array([np.pi / TS, 5.0, 300.0, 400.0])
+    columns = mode_columns(quartic, axes, starts, params)
+    residual = projected_residual(quartic, axes, starts, params, y)
+    np.testing.assert_allclose(residual, _lstsq_residual(columns, y), atol=1e-9)
+    scaled = np.ascontiguousarray(np.column_stack([quartic[:, :3], 1e3 * (3 + 50 * tau)]))
+    params = np.array([200.0, 5.0])
+    columns = mode_columns(scaled, axes, starts, params)
+    residual = projected_residual(scaled, axes, starts, params, y)
+    np.testing.assert_allclose(residual, _lstsq_residual(columns, y), atol=1e-9)
 
 
 def test_columns_that_overflow_give_an_infinite_residual() -> None:
@@ -267,13 +295,19 @@ def test_cost_never_rises_and_the_solver_converges_from_afar() -> None:
     y = np.ascontiguousarray(_signals(truth, n, None, seed=11) + 0.05 * rng.normal(size=(n, 3)))
     start = truth * np.array([1.3, 4.0, 0.9, 0.2])
     lower, upper = np.array([10.0, -20.0] * 2), np.array([3000.0, 300.0] * 2)
-    costs = []
+    costs, statuses = [], []
     for evaluations in range(1, 40):
-        params, _ = bounded_levenberg_marquardt(
+        params, status = bounded_levenberg_marquardt(
             fixed, axes, starts, y, start, lower, upper, 1e-10, 1e-10, 1e-10, evaluations
         )
         costs.append(np.sum(projected_residual(fixed, axes, starts, params, y) ** 2))
+        statuses.append(status)
     assert np.all(np.diff(costs) <= 0.0)
+    # At least one step was rejected before convergence: the cost stood still while unconverged
+    rejected = [
+        i for i in range(1, len(costs)) if costs[i] == costs[i - 1] and statuses[i] == NOT_CONVERGED
+    ]
+    assert rejected
     params, status = bounded_levenberg_marquardt(
         fixed, axes, starts, y, start, lower, upper, 1e-10, 1e-10, 1e-10, 200
     )

@@ -33,7 +33,6 @@ IntArray = NDArray[np.int64]
 
 __all__ = [
     "bounded_levenberg_marquardt",
-    "kaufman_jacobian",
     "mode_columns",
     "mode_derivatives",
     "projected_residual",
@@ -46,9 +45,10 @@ __all__ = [
 NOT_CONVERGED, GRADIENT, COST, STEP, REGION = 0, 1, 2, 3, 4
 
 # Trust region (Moré 1978; the values of least_squares' trf): shrink to a quarter of the step
-# when the cost fell by less than a quarter of the predicted reduction, double when by more than
-# three quarters and the step reached the radius; accept any step with a ratio above 1e-4
-_SHRINK_BELOW, _GROW_ABOVE, _AT_RADIUS, _ACCEPT_ABOVE = 0.25, 0.75, 0.95, 1e-4
+# when the cost fell by less than a quarter of the predicted reduction (such a step does not
+# count for the cost test either), double when by more than three quarters and the step reached
+# the radius; accept any step with a ratio above 1e-4
+_SHRINK_BELOW, _SHRINK_FACTOR, _GROW_ABOVE, _AT_RADIUS, _ACCEPT_ABOVE = 0.25, 0.25, 0.75, 0.95, 1e-4
 # Damping search: ||u(mu)|| within 1e-3 of the radius, at most 60 Newton or bisection steps;
 # eigenvalues floored at 1e-12 of the largest so a singular direction stays finite
 _RADIUS_MATCH, _DAMPING_ITERATIONS, _EIGEN_FLOOR = 1e-3, 60, 1e-12
@@ -123,30 +123,31 @@ def _projection(
 
     Returns the columns (n, P), an orthonormal basis Q of their span (n, R), the coefficients
     (P, K) and the residual (n, K). QR when every pivot of R is above max(n, P) eps times the
-    largest; otherwise (linearly dependent columns: a regressor that is constant, a mode pair
-    restarted at the last sample) from the eigen-decomposition of the Gram matrix, keeping the
-    directions above max(n, P) eps of the largest eigenvalue, with the minimum-norm
-    coefficients. Columns that are not finite give an infinite residual (and empty Q).
+    largest column norm; otherwise (linearly dependent columns: a regressor that is constant, a
+    mode pair restarted at the first or last sample, a mode on the Nyquist frequency, whose sine
+    column vanishes) from the singular value decomposition, keeping the directions above that
+    tolerance of the largest singular value, with the minimum-norm coefficients (as
+    ``numpy.linalg.lstsq``). Columns that are not finite give an infinite residual, an empty Q
+    and NaN coefficients.
     """
     columns = mode_columns(fixed, axes, starts, params)
     n, size = columns.shape
     if not np.all(np.isfinite(columns)):
-        return columns, np.empty((n, 0)), np.empty((size, 0)), np.full(weighted.shape, np.inf)
+        nan_coef = np.full((size, weighted.shape[1]), np.nan)
+        return columns, np.empty((n, 0)), nan_coef, np.full(weighted.shape, np.inf)
     q, r = np.linalg.qr(columns)
-    pivots = np.abs(np.diag(r))
     tolerance = max(n, size) * np.finfo(np.float64).eps
-    if pivots.min() > tolerance * pivots.max():
+    largest_norm = math.sqrt(np.max(np.sum(columns**2, axis=0)))
+    if np.abs(np.diag(r)).min() > tolerance * largest_norm:
         q = np.ascontiguousarray(q)
         projected = np.ascontiguousarray(q.T) @ weighted
         coef = _back_substitution(r, projected)
     else:
-        eigenvalues, vectors = np.linalg.eigh(columns.T @ columns)
-        keep = eigenvalues > tolerance * eigenvalues.max()
-        kept = np.ascontiguousarray(vectors[:, keep])
-        root = np.sqrt(eigenvalues[keep])
-        q = (columns @ kept) / root
+        u, singular, vt = np.linalg.svd(columns, full_matrices=False)
+        keep = singular > tolerance * singular[0]
+        q = np.ascontiguousarray(u[:, keep])
         projected = np.ascontiguousarray(q.T) @ weighted
-        coef = kept @ (projected / root.reshape(-1, 1))
+        coef = np.ascontiguousarray(vt[keep].T) @ (projected / singular[keep].reshape(-1, 1))
     return columns, q, coef, weighted - q @ projected
 
 
@@ -160,7 +161,7 @@ def projected_residual(
 
 
 @njit(cache=True)
-def kaufman_jacobian(
+def _kaufman_jacobian(
     columns: FloatArray,
     axes: FloatArray,
     starts: IntArray,
@@ -184,9 +185,9 @@ def kaufman_jacobian(
 def residual_and_jacobian(
     fixed: FloatArray, axes: FloatArray, starts: IntArray, params: FloatArray, weighted: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
-    """The residual of :func:`projected_residual` and its :func:`kaufman_jacobian`."""
+    """The residual of :func:`projected_residual` and its :func:`_kaufman_jacobian`."""
     columns, q, coef, residual = _projection(fixed, axes, starts, params, weighted)
-    return residual.ravel(), kaufman_jacobian(columns, axes, starts, fixed.shape[1], q, coef)
+    return residual.ravel(), _kaufman_jacobian(columns, axes, starts, fixed.shape[1], q, coef)
 
 
 @njit(cache=True)
@@ -256,7 +257,7 @@ def _updated_radius(radius: float, ratio: float, step_length: float) -> float:
     """The trust radius after a step of scaled length ``step_length`` whose actual reduction of
     the cost was ``ratio`` times the predicted one."""
     if ratio < _SHRINK_BELOW:
-        return _SHRINK_BELOW * (step_length if step_length > 0.0 else radius)
+        return _SHRINK_FACTOR * (step_length if step_length > 0.0 else radius)
     if ratio > _GROW_ABOVE and step_length > _AT_RADIUS * radius:
         return 2.0 * radius
     return radius
@@ -313,7 +314,7 @@ def bounded_levenberg_marquardt(
     cost = 0.5 * (residual @ residual)
     if not np.isfinite(cost):
         return params, NOT_CONVERGED
-    jacobian = kaufman_jacobian(columns, axes, starts, n_fixed, q, coef)
+    jacobian = _kaufman_jacobian(columns, axes, starts, n_fixed, q, coef)
     evaluations = 1
     scale = _updated_scale(np.zeros(params.size), jacobian)
     normal = jacobian.T @ jacobian
@@ -341,7 +342,7 @@ def bounded_levenberg_marquardt(
         if actual > 0.0 and ratio > _ACCEPT_ABOVE:
             small_change = actual < ftol * cost and ratio > _SHRINK_BELOW
             params, residual, cost = trial, trial_residual, trial_cost
-            jacobian = kaufman_jacobian(columns, axes, starts, n_fixed, q, coef)
+            jacobian = _kaufman_jacobian(columns, axes, starts, n_fixed, q, coef)
             scale = _updated_scale(scale, jacobian)
             normal = jacobian.T @ jacobian
             gradient = jacobian.T @ residual
