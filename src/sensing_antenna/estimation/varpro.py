@@ -309,12 +309,10 @@ def bounded_levenberg_marquardt(
     """
     n_fixed = fixed.shape[1]
     params = np.minimum(np.maximum(start, lower), upper)
-    columns, q, coef, residual_2d = _projection(fixed, axes, starts, params, weighted)
-    residual = residual_2d.ravel()
+    residual, jacobian = residual_and_jacobian(fixed, axes, starts, params, weighted)
     cost = 0.5 * (residual @ residual)
     if not np.isfinite(cost):
         return params, NOT_CONVERGED
-    jacobian = _kaufman_jacobian(columns, axes, starts, n_fixed, q, coef)
     evaluations = 1
     scale = _updated_scale(np.zeros(params.size), jacobian)
     normal = jacobian.T @ jacobian
