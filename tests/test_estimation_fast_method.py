@@ -775,6 +775,43 @@ def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
     assert np.array_equal(online_early.reaction_perp, offline_early.reaction_perp)
 
 
+def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_window_only(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The early statics decide neither the posterior nor sure, so the scan skips their
+    # half-length fit on every window it passes and adds it to the one it concludes on: the
+    # same window as history() gives, with the same early statics, fitted once.
+    import sensing_antenna.estimation.fast as fast_module
+    from sensing_antenna.estimation.pipeline import gather_evidence
+
+    evidence = gather_evidence(_azimuthal_06(), paper_antenna())
+    method = FastMethod(FastConfig(tolerance=1e-6))  # never sure: every window to the cap
+    history = {w.end_index: w for w in method.history(evidence)}
+    calls: list[int] = []
+    early_statics = fast_module._early_statics
+
+    def counted(window: Any, *args: Any) -> Any:
+        calls.append(window.end_index)
+        return early_statics(window, *args)
+
+    monkeypatch.setattr(fast_module, "_early_statics", counted)
+    inputs = method._prepare(evidence)
+    result = fast_module.scan(
+        inputs, evidence.hold_end, evidence.hold_end, fast_module.second_mode_chooser(evidence)
+    )
+    final = result.final
+    assert result.reached_cap and result.evaluations == len(history) > 10
+    assert calls == [final.end_index]
+    expected = history[final.end_index]
+    assert final.early_statics is not None and expected.early_statics is not None
+    assert final.early_statics.ratio == expected.early_statics.ratio
+    assert (final.posterior.x_c, final.omega1, final.note) == (
+        expected.posterior.x_c,
+        expected.omega1,
+        expected.note,
+    )
+
+
 def test_a_session_never_serves_the_fits_of_other_samples() -> None:
     # Two recordings with the same t_c, t_1 and hold, the second with Gamma_y 3 % larger after
     # the hold: a session (online, after reset(); or handed to estimate) gives each the answer

@@ -1089,6 +1089,7 @@ def evaluations(
     hold_end: int = -1,
     choose_branch: BranchChooser | None = None,
     caches: tuple[FitCache, FitCache] | None = None,
+    with_early_statics: bool = True,
 ) -> Iterator[WindowEstimate]:
     """Every window ending on the evaluation grid from ``earliest`` to the cap, in order.
 
@@ -1097,8 +1098,8 @@ def evaluations(
     window starts at t_1, or at ``hold_end`` when the contact opened
     (:func:`evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are cached, so
     the drift check's shorter windows are fitted once; ``caches`` (windows from t_1, windows from
-    the hold's end) are used and filled when given, else new ones. ``choose_branch`` as in
-    :func:`evaluate_window`.
+    the hold's end) are used and filled when given, else new ones. ``choose_branch`` and
+    ``with_early_statics`` as in :func:`evaluate_window`.
     """
     if caches is None:
         caches = ({}, {})
@@ -1109,7 +1110,7 @@ def evaluations(
         if j > inputs.end_index:
             return
         yield evaluate_from_t1_or_hold(
-            inputs._replace(end_index=j), hold_end, caches, choose_branch
+            inputs._replace(end_index=j), hold_end, caches, choose_branch, with_early_statics
         )
 
 
@@ -1123,16 +1124,25 @@ def scan(
     """Evaluate the growing window on the evaluation grid until sure, the cap or the samples' end.
 
     The windows are those of :func:`evaluations` (``caches`` as there); ``earliest`` is the end
-    of the pipeline's hold, before which there is no contact frame.
+    of the pipeline's hold, before which there is no contact frame. Only the window concluded on
+    gets the slip check's early statics (they do not decide ``sure``); it is evaluated again for
+    them from the cached fits.
     """
+    if caches is None:
+        caches = ({}, {})
     last = inputs.rest_index + int(evaluation_offsets(inputs.sample_period, inputs.config)[-1])
     final: WindowEstimate | None = None
     count = 0
-    for final in evaluations(inputs, earliest, hold_end, choose_branch, caches):
+    for final in evaluations(inputs, earliest, hold_end, choose_branch, caches, False):
         count += 1
         if final.sure:
-            return ScanResult(final, count, False)
-    return ScanResult(final, count, last <= inputs.end_index)
+            break
+    if final is None:
+        return ScanResult(None, 0, last <= inputs.end_index)
+    final = evaluate_from_t1_or_hold(
+        inputs._replace(end_index=final.end_index), hold_end, caches, choose_branch
+    )
+    return ScanResult(final, count, not final.sure and last <= inputs.end_index)
 
 
 @dataclass(frozen=True)
