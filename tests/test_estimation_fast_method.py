@@ -318,7 +318,7 @@ def test_offline_and_online_agree_on_a_simulated_recording(
 ) -> None:
     # The pipeline's batch and streaming forms hand the same samples to the method; the fast
     # method only reads samples up to its own declaration, so both give identical estimates.
-    # Online, each window (first sample, last sample, polynomial degree) is fitted once: the
+    # Online, each window (first sample, last sample, with or without the push) is fitted once: the
     # session keeps the fits between evaluations and the conclusion does not scan again. With
     # the push phase, on a recording whose declared window is the one through the push.
     simulator = pytest.importorskip("sensing_antenna.simulator")
@@ -332,14 +332,14 @@ def test_offline_and_online_agree_on_a_simulated_recording(
     method = FastMethod(FastConfig(push_phase=push_phase))
     offline = estimate(recording, antenna, method)
     assert offline.diagnostics["fit_through_push"] is push_phase
-    fitted: list[tuple[float, int, int]] = []
-    select = fast_module.select_model_order
+    fitted: list[tuple[float, int, bool]] = []
+    select = fast_module.select_model
 
     def counting(signals: Any, sample_period: float, *args: Any, **kwargs: Any) -> Any:
-        fitted.append((args[1], len(signals), kwargs["degree"]))
+        fitted.append((args[2], len(signals), kwargs["regressors"] is None))
         return select(signals, sample_period, *args, **kwargs)
 
-    monkeypatch.setattr(fast_module, "select_model_order", counting)
+    monkeypatch.setattr(fast_module, "select_model", counting)
     online = OnlineEstimator(antenna, recording.sample_period, method)
     for k in range(recording.t.shape[0]):
         online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
@@ -957,20 +957,20 @@ def test_windows_through_the_push_fit_their_own_polynomial_degrees(
     import sensing_antenna.estimation.fast as fast_module
     from sensing_antenna.estimation.fast import PushPhase, _fit_window
 
-    calls: list[tuple[int, bool, int | None]] = []
+    calls: list[tuple[list[int], bool, int | None]] = []
 
     def spy(*args: Any, **kwargs: Any) -> None:
-        calls.append((kwargs["degree"], kwargs["regressors"] is not None, kwargs["restart"]))
+        calls.append((list(args[3]), kwargs["regressors"] is not None, kwargs["restart"]))
         return None
 
-    monkeypatch.setattr(fast_module, "select_model_order", spy)
+    monkeypatch.setattr(fast_module, "select_model", spy)
     config = FastConfig(push_polynomial_degree=push_degree)
     channels = np.zeros((600, 5))
     _fit_window(channels, 100, 400, TS, BAND, config, None)
-    assert calls == [(d, False, None) for d in (2, 3, 4)]
+    assert calls == [([2, 3, 4], False, None)]
     calls.clear()
     _fit_window(channels, 100, 400, TS, BAND, config, None, PushPhase(40, np.zeros(600)))
-    assert calls == [(d, True, 60) for d in expected]
+    assert calls == [(expected, True, 60)]
 
 
 def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window(

@@ -21,6 +21,7 @@ from sensing_antenna.estimation.parametric import (
     damped_sinusoid_crb,
     fit_damped_sinusoids,
     matrix_pencil_poles,
+    select_model,
     select_model_order,
 )
 from sensing_antenna.estimation.static_fit import SensorBias, sensor_bias, static_ratio
@@ -118,6 +119,27 @@ def test_model_order_adds_a_second_mode_when_present() -> None:
     k = fit.strongest_in_band((30.0, 120.0))
     assert k is not None
     assert fit.omega[k] == pytest.approx(45.0, abs=4 * fit.omega_se[k])
+
+
+def test_the_model_over_several_degrees_is_the_degree_with_the_smallest_bic() -> None:
+    # select_model compares every degree and order by the BIC and computes the covariance of
+    # the winner only: the same fit, to the last bit, as the per-degree selections' best.
+    rng = np.random.default_rng(8)
+    t = np.arange(300) * TS
+    creep = 1e-3 * (t / t[-1]) ** 3  # slow content a quadratic does not follow: degree 3 wins
+    ring = 1e-3 * np.exp(-t) * np.cos(45 * t) + 5e-4 * np.exp(-3 * t) * np.cos(260 * t + 1)
+    y = np.column_stack([ring + creep, -0.5 * ring + creep]) + 3e-5 * rng.standard_normal(
+        (t.size, 2)
+    )
+    per_degree = [select_model_order(y, TS, 3, min_omega=10.0, degree=d) for d in (2, 3, 4)]
+    best = min((f for f in per_degree if f is not None), key=lambda f: f.bic)
+    assert best is per_degree[1]
+    fit = select_model(y, TS, 3, (2, 3, 4), min_omega=10.0)
+    assert fit is not None
+    for name in ("omega", "decay", "omega_se", "decay_se", "offsets", "offset_cov", "amplitudes"):
+        assert np.array_equal(getattr(fit, name), getattr(best, name)), name
+    assert (fit.bic, fit.converged) == (best.bic, best.converged)
+    assert select_model(y[:10], TS, 3, (2, 3, 4)) is None  # too short for any order
 
 
 def _loads(

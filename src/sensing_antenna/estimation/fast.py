@@ -47,7 +47,7 @@ from sensing_antenna.estimation.likelihood import ContactPosterior, contact_post
 from sensing_antenna.estimation.parametric import (
     DampedSinusoidFit,
     first_poles,
-    select_model_order,
+    select_model,
 )
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.estimation.static_fit import (
@@ -529,24 +529,18 @@ def _fit_window(
     # model order fits the record (each fit computes it itself otherwise, as it always did)
     fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * max_modes)
     poles = first_poles(signals, max_modes) if fits_at_all else None
-    fits = [
-        select_model_order(
-            signals,
-            sample_period,
-            max_modes,
-            start * sample_period,
-            min_omega=config.min_mode_fraction * band[0],
-            degree=degree,
-            target_band=band,
-            poles=poles,
-            regressors=None if push is None else push.angle[start : end_index + 1],
-            restart=None if push is None else rest_index - start,
-        )
-        for degree in range(lowest, highest + 1)
-    ]
-    # BIC over the polynomial degree too (it is computed on the unweighted residuals)
-    usable = [f for f in fits if f is not None]
-    fit = min(usable, key=lambda f: f.bic) if usable else None
+    fit = select_model(
+        signals,
+        sample_period,
+        max_modes,
+        range(lowest, highest + 1),
+        start * sample_period,
+        min_omega=config.min_mode_fraction * band[0],
+        target_band=band,
+        poles=poles,
+        regressors=None if push is None else push.angle[start : end_index + 1],
+        restart=None if push is None else rest_index - start,
+    )
     if cache is not None:
         cache[key] = fit
     return fit

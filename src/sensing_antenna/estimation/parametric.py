@@ -39,6 +39,7 @@ noiseless model.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,6 +59,7 @@ __all__ = [
     "first_poles",
     "fit_damped_sinusoids",
     "matrix_pencil_poles",
+    "select_model",
     "select_model_order",
 ]
 
@@ -232,6 +234,7 @@ class _Design:
         restart: int | None = None,
     ) -> None:
         self.tau: FloatArray = (np.arange(n, dtype=float) - 0.5 * (n - 1)) * sample_period
+        self.sample_period = sample_period
         self.degree = degree
         fixed = [self.tau[:, None] ** j for j in range(degree + 1)]
         if regressors is not None:
@@ -433,6 +436,36 @@ def fit_damped_sinusoids(
         None when the record is too short for the model (fewer samples than 3 times the
         parameters per channel).
     """
+    candidate = _fit_candidate(
+        signals,
+        sample_period,
+        n_modes,
+        t_start,
+        noise_std,
+        min_omega,
+        degree,
+        poles,
+        target_band,
+        regressors,
+        restart,
+    )
+    return None if candidate is None else candidate.summary()
+
+
+def _fit_candidate(
+    signals: FloatArray,
+    sample_period: float,
+    n_modes: int,
+    t_start: float,
+    noise_std: FloatArray | None,
+    min_omega: float,
+    degree: int,
+    poles: ComplexArray | None,
+    target_band: tuple[float, float] | None,
+    regressors: FloatArray | None,
+    restart: int | None,
+) -> _Candidate | None:
+    """:func:`fit_damped_sinusoids` up to its solution and BIC, without the covariance."""
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
         y = y[:, None]
@@ -468,7 +501,7 @@ def fit_damped_sinusoids(
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
         params, ok = _refine(params, design, np.ascontiguousarray(y / scale), bounds)
-    return _summarise(params, ok, design, y, scale, t_start, sample_period, noise_std is None)
+    return _candidate(params, ok, design, y, scale, t_start, noise_std is None)
 
 
 def _refine(
@@ -494,71 +527,107 @@ def _refine(
     return np.asarray(params, dtype=float), bool(status > 0)
 
 
-def _summarise(
+@dataclass(frozen=True)
+class _Candidate:
+    """A solved fit before its covariance: what the BIC compares orders and degrees on.
+
+    ``coef`` (L, K) are the linear coefficients of ``basis`` (n, L) for the unweighted signals
+    ``y`` (n, K); ``noise`` (K,) the channels' noise standard deviations the fit was weighted
+    with (from its residuals when ``scale_from_residuals``); ``bic`` Schwarz's criterion.
+    """
+
+    params: FloatArray
+    converged: bool
+    design: _Design
+    y: FloatArray
+    basis: FloatArray
+    coef: FloatArray
+    noise: FloatArray
+    t_start: float
+    bic: float
+
+    def summary(self) -> DampedSinusoidFit:
+        """The fit with the standard errors of (J^T J)^-1 of the weighted residuals."""
+        params, design, basis, coef, noise = (
+            self.params,
+            self.design,
+            self.basis,
+            self.coef,
+            self.noise,
+        )
+        n, k = self.y.shape
+        m = params.size // 2
+        n_linear = basis.shape[1]
+        # J^T J of the weighted residuals, J = [shared (w, s) columns | each channel's basis
+        # block]: built by blocks, as every channel shares the basis (its Gram matrix once)
+        deriv = design.derivative_times_coef(basis, coef)  # (2M, n, K)
+        n_par = 2 * m + k * n_linear
+        weight = 1.0 / noise**2
+        normal = np.zeros((n_par, n_par))
+        normal[: 2 * m, : 2 * m] = np.einsum("pik,qik,k->pq", deriv, deriv, weight)
+        gram = basis.T @ basis
+        for ch in range(k):
+            block = slice(2 * m + ch * n_linear, 2 * m + (ch + 1) * n_linear)
+            cross = (deriv[:, :, ch] @ basis) * weight[ch]
+            normal[: 2 * m, block] = cross
+            normal[block, : 2 * m] = cross.T
+            normal[block, block] = gram * weight[ch]
+        try:
+            cov = np.linalg.inv(normal)
+            ok = self.converged and bool(np.all(np.isfinite(cov)))
+        except np.linalg.LinAlgError:
+            cov = np.full((n_par, n_par), np.nan)
+            ok = False
+        diag = np.sqrt(np.clip(np.diag(cov)[: 2 * m], 0.0, None))
+        offset_idx = 2 * m + np.arange(k) * n_linear
+        order = np.argsort(params[0::2])
+        amplitudes = design.free_amplitudes(params, coef)
+        drifts = coef[1] if design.degree >= 1 else np.zeros(k)
+        sample_period = design.sample_period
+        return DampedSinusoidFit(
+            omega=params[0::2][order],
+            decay=params[1::2][order],
+            omega_se=diag[0::2][order],
+            decay_se=diag[1::2][order],
+            offsets=np.asarray(coef[0], dtype=float),
+            offset_cov=cov[np.ix_(offset_idx, offset_idx)],
+            drifts=np.asarray(drifts, dtype=float),
+            amplitudes=np.asarray(amplitudes[:, order], dtype=float),
+            noise_std=np.asarray(noise, dtype=float),
+            t_ref=self.t_start + 0.5 * (n - 1) * sample_period,
+            n_samples=n,
+            sample_period=sample_period,
+            bic=self.bic,
+            converged=ok,
+            restart=design.restart,
+        )
+
+
+def _candidate(
     params: FloatArray,
     converged: bool,
     design: _Design,
     y: FloatArray,
     scale: FloatArray,
     t_start: float,
-    sample_period: float,
     scale_from_residuals: bool,
-) -> DampedSinusoidFit:
+) -> _Candidate:
+    """The linear part, residual, noise and BIC of the solution ``params``."""
     n, k = y.shape
     m = params.size // 2
     basis = design.basis(params)
-    coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
+    coef = np.asarray(np.linalg.lstsq(basis, y, rcond=None)[0], dtype=np.float64)
     residual = y - basis @ coef
     n_linear = basis.shape[1]
     dof = max(n - n_linear - 2 * m, 1)
     noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale
-    noise = np.where(noise > 0.0, noise, np.finfo(float).tiny)
-    # J^T J of the weighted residuals, J = [shared (w, s) columns | each channel's basis block]:
-    # built by blocks, as every channel shares the basis (its Gram matrix is computed once)
-    deriv = design.derivative_times_coef(basis, coef)  # (2M, n, K)
+    noise = np.asarray(np.where(noise > 0.0, noise, np.finfo(float).tiny), dtype=float)
     n_par = 2 * m + k * n_linear
-    weight = 1.0 / noise**2
-    normal = np.zeros((n_par, n_par))
-    normal[: 2 * m, : 2 * m] = np.einsum("pik,qik,k->pq", deriv, deriv, weight)
-    gram = basis.T @ basis
-    for ch in range(k):
-        block = slice(2 * m + ch * n_linear, 2 * m + (ch + 1) * n_linear)
-        cross = (deriv[:, :, ch] @ basis) * weight[ch]
-        normal[: 2 * m, block] = cross
-        normal[block, : 2 * m] = cross.T
-        normal[block, block] = gram * weight[ch]
-    try:
-        cov = np.linalg.inv(normal)
-        ok = converged and bool(np.all(np.isfinite(cov)))
-    except np.linalg.LinAlgError:
-        cov = np.full((n_par, n_par), np.nan)
-        ok = False
-    diag = np.sqrt(np.clip(np.diag(cov)[: 2 * m], 0.0, None))
-    offset_idx = 2 * m + np.arange(k) * n_linear
-    order = np.argsort(params[0::2])
     rss = np.sum(residual**2, axis=0)
     tiny = np.finfo(float).tiny
     # Schwarz (1978): BIC = sum_k n ln(RSS_k / n) + P ln(n K)
     bic = float(np.sum(n * np.log(np.maximum(rss, tiny) / n)) + n_par * math.log(n * k))
-    amplitudes = design.free_amplitudes(params, coef)
-    drifts = coef[1] if design.degree >= 1 else np.zeros(k)
-    return DampedSinusoidFit(
-        omega=params[0::2][order],
-        decay=params[1::2][order],
-        omega_se=diag[0::2][order],
-        decay_se=diag[1::2][order],
-        offsets=np.asarray(coef[0], dtype=float),
-        offset_cov=cov[np.ix_(offset_idx, offset_idx)],
-        drifts=np.asarray(drifts, dtype=float),
-        amplitudes=np.asarray(amplitudes[:, order], dtype=float),
-        noise_std=np.asarray(noise, dtype=float),
-        t_ref=t_start + 0.5 * (n - 1) * sample_period,
-        n_samples=n,
-        sample_period=sample_period,
-        bic=bic,
-        converged=ok,
-        restart=design.restart,
-    )
+    return _Candidate(params, converged, design, y, basis, coef, noise, t_start, bic)
 
 
 def select_model_order(
@@ -582,14 +651,80 @@ def select_model_order(
     ``poles``: :func:`first_poles` of the signals for ``max_modes`` when already at hand (they
     do not depend on the degree).
     """
-    fits = []
+    return select_model(
+        signals,
+        sample_period,
+        max_modes,
+        (degree,),
+        t_start,
+        min_omega,
+        target_band,
+        poles,
+        regressors,
+        restart,
+    )
+
+
+def select_model(
+    signals: FloatArray,
+    sample_period: float,
+    max_modes: int,
+    degrees: Sequence[int],
+    t_start: float = 0.0,
+    min_omega: float = 0.0,
+    target_band: tuple[float, float] | None = None,
+    poles: ComplexArray | None = None,
+    regressors: FloatArray | None = None,
+    restart: int | None = None,
+) -> DampedSinusoidFit | None:
+    """The fit with the smallest BIC over the polynomial ``degrees`` and M = 1 .. ``max_modes``.
+
+    Each degree's orders as in :func:`select_model_order` (the BIC is computed on the unweighted
+    residuals, so it compares degrees too); only the chosen fit's covariance is computed. None
+    when no degree and order could be fitted.
+    """
+    y = np.asarray(signals, dtype=float)
+    candidates = [
+        candidate
+        for degree in degrees
+        for candidate in _order_candidates(
+            y,
+            sample_period,
+            max_modes,
+            t_start,
+            min_omega,
+            degree,
+            target_band,
+            poles,
+            regressors,
+            restart,
+        )
+    ]
+    if not candidates:
+        return None
+    return min(candidates, key=lambda c: c.bic).summary()
+
+
+def _order_candidates(
+    y: FloatArray,
+    sample_period: float,
+    max_modes: int,
+    t_start: float,
+    min_omega: float,
+    degree: int,
+    target_band: tuple[float, float] | None,
+    poles: ComplexArray | None,
+    regressors: FloatArray | None,
+    restart: int | None,
+) -> list[_Candidate]:
+    """The solved fits of M = ``max_modes`` .. 1 at one degree (those the record allows)."""
+    candidates = []
     noise: FloatArray | None = None
     first = poles
     weighted: ComplexArray | None = None
-    y = np.asarray(signals, dtype=float)
     for m in range(max_modes, 0, -1):
         if noise is None:
-            fit = fit_damped_sinusoids(
+            candidate = _fit_candidate(
                 y,
                 sample_period,
                 m,
@@ -603,11 +738,11 @@ def select_model_order(
                 restart,
             )
             first = None  # the next order, if this one did not fit, starts from its own
-            if fit is not None:
-                noise = fit.noise_std
+            if candidate is not None:
+                noise = candidate.noise
                 weighted = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
         else:
-            fit = fit_damped_sinusoids(
+            candidate = _fit_candidate(
                 y,
                 sample_period,
                 m,
@@ -620,11 +755,9 @@ def select_model_order(
                 regressors,
                 restart,
             )
-        if fit is not None:
-            fits.append(fit)
-    if not fits:
-        return None
-    return min(fits, key=lambda f: f.bic)
+        if candidate is not None:
+            candidates.append(candidate)
+    return candidates
 
 
 def damped_sinusoid_crb(
