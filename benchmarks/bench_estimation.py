@@ -13,7 +13,7 @@ sees), and the mean and largest time of one evaluation; the paper method's arriv
 One run with a tolerance no window meets shows the answer at the cap.
 Prints tables and writes ``benchmarks/results/estimation.json`` and, for the real-time loop,
 ``estimation_realtime.png``.
-Run: ``python benchmarks/bench_estimation.py`` (about a minute);
+Run: ``python benchmarks/bench_estimation.py`` (about 20 s once the kernels are compiled);
 ``python benchmarks/bench_estimation.py --push-phase --out benchmarks/results/estimation_push.json``
 runs the fast method with its windows also through the push (``FastConfig.push_phase``);
 ``--set FIELD=VALUE`` sets any other ``FastConfig`` field (``fast_settings.py``).

@@ -148,8 +148,8 @@ class FastConfig:
         modes"): median t_e - t_1 0.421 to 0.383 s on the calibrated-device campaign and 0.316
         to 0.302 s on the paper antenna, MAE 0.73 to 0.65 mm and 0.37 to 0.23 mm, coverage
         149/150 on the campaign as before. It costs 1.5 to 1.8 times the CPU; with the
-        compiled fit the real-time loop of a two-core machine answers 0.438 s after t_1
-        (docs/fast.md, "Online, in real time").
+        compiled fit the real-time loop of a two-core machine answers 0.43 to 0.46 s after
+        t_1 (docs/fast.md, "Online, in real time").
     min_mode_fraction : float
         Modes are fitted above this fraction of the lower end of the omega_1 band; slower content
         (the servo's slow creep at ~8 rad/s) goes to the polynomial. 0.6 of ~23 rad/s.
@@ -259,7 +259,8 @@ class FastConfig:
         paper antenna it brings the median delay from 0.302 to 0.261 s (on the calibrated
         device it stays 0.383 s), but every window is fitted twice and the CPU per
         recording is about 1.4 times larger, so in a real-time loop on a two-core machine the
-        answer comes later than without it (0.500 against 0.438 s after t_1, docs/fast.md).
+        answer comes later than without it (0.519 against 0.43 to 0.46 s after t_1,
+        docs/fast.md).
     push_max_modes : int
         Largest number of modes tried on a window through the push (the touch excites contact
         modes the stop hardly does). 3.
