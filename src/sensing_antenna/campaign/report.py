@@ -531,15 +531,16 @@ def _target_row(t: TargetSummary, default_noise: bool) -> list[str]:
             f"{100 * low:.1f} to {100 * high:.1f} %)"
         )
     missed = t.missed(default_noise)
+    mine, ref = t.errors, t.ref_errors
     return [
         t.label,
         str(t.n_runs),
         f"{_seconds(t.median_delay)} / {_seconds(t.ref_median_delay)}",
         ratio,
-        f"{_mm(t.mae_contact)} / {_mm(t.ref_mae_contact)}",
-        f"{_mm(t.max_contact)} / {_mm(t.ref_max_contact)}",
-        f"{_mm(t.mae_nominal)} / {_mm(t.ref_mae_nominal)}",
-        f"{_mm(t.max_nominal)} / {_mm(t.ref_max_nominal)}",
+        f"{_mm(mine.contact.mae)} / {_mm(ref.contact.mae)}",
+        f"{_mm(mine.contact.max)} / {_mm(ref.contact.max)}",
+        f"{_mm(mine.nominal.mae)} / {_mm(ref.nominal.mae)}",
+        f"{_mm(mine.nominal.max)} / {_mm(ref.nominal.max)}",
         coverage,
         str(t.n_ok_over_limit),
         _statuses(t.status_counts),

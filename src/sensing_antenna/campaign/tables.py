@@ -17,7 +17,7 @@ from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,8 +28,10 @@ from sensing_antenna.campaign.records import RunResult, float_or_nan, result_row
 __all__ = [
     "OK_ERROR_LIMIT",
     "PAPER_TABLE_FILES",
+    "ErrorStats",
     "FrequencyErrorSummary",
     "IntervalSummary",
+    "MethodErrors",
     "MethodSummary",
     "PaperRow",
     "PointStats",
@@ -187,26 +189,34 @@ class IntervalSummary:
         return self.n_covering_nominal / self.n_intervals if self.n_intervals else math.nan
 
 
+class ErrorStats(NamedTuple):
+    """Mean and largest absolute error of x_c over a group of runs (m); NaN without any."""
+
+    mae: float
+    max: float
+
+
+class MethodErrors(NamedTuple):
+    """A method's x_c errors against the contact abscissa and against the nominal x_c."""
+
+    contact: ErrorStats
+    nominal: ErrorStats
+
+
 @dataclass(frozen=True)
 class TargetSummary:
     """The fast method against the targets of issue 6 on one group of runs (SI: m, s).
 
-    Errors ``*_contact`` are against the contact abscissa, ``*_nominal`` against the nominal
-    x_c; ``ref_*`` are the reference method's (the paper's) on the same recordings.
+    ``errors`` are the method's, ``ref_errors`` the reference method's (the paper's) on the
+    same recordings.
     """
 
     label: str
     n_runs: int
     median_delay: float
     ref_median_delay: float
-    mae_contact: float
-    max_contact: float
-    ref_mae_contact: float
-    ref_max_contact: float
-    mae_nominal: float
-    max_nominal: float
-    ref_mae_nominal: float
-    ref_max_nominal: float
+    errors: MethodErrors
+    ref_errors: MethodErrors
     n_intervals: int
     n_covering: int
     n_ok_over_limit: int
@@ -246,15 +256,16 @@ class TargetSummary:
         found = []
         if math.isfinite(self.delay_ratio) and self.delay_ratio > DELAY_RATIO_TARGET:
             found.append(f"t_e ratio > {DELAY_RATIO_TARGET:g}")
-        if math.isfinite(self.mae_contact):
-            if default_noise and self.mae_contact > MAE_TARGET:
+        mine, ref = self.errors.contact, self.ref_errors.contact
+        if math.isfinite(mine.mae):
+            if default_noise and mine.mae > MAE_TARGET:
                 found.append(f"MAE > {MAE_TARGET * 1e3:g} mm")
-            if math.isfinite(self.ref_mae_contact) and self.mae_contact > self.ref_mae_contact:
+            if math.isfinite(ref.mae) and mine.mae > ref.mae:
                 found.append("MAE > paper's")
-        if math.isfinite(self.max_contact):
-            if default_noise and self.max_contact > MAX_ERROR_TARGET:
+        if math.isfinite(mine.max):
+            if default_noise and mine.max > MAX_ERROR_TARGET:
                 found.append(f"max > {MAX_ERROR_TARGET * 1e3:g} mm")
-            if math.isfinite(self.ref_max_contact) and self.max_contact > self.ref_max_contact:
+            if math.isfinite(ref.max) and mine.max > ref.max:
                 found.append("max > paper's")
         low, high = COVERAGE_TARGET
         if self.n_intervals and not (low <= self.coverage <= high):
@@ -447,13 +458,18 @@ def interval_summaries(
     return summaries
 
 
-def _errors(selected: Sequence[Mapping[str, Any]], column: str) -> tuple[float, float]:
+def _errors(selected: Sequence[Mapping[str, Any]], column: str) -> ErrorStats:
     """Mean and max of |column| over finite values (m); NaN without any."""
     values = np.abs(_column(selected, column))
     values = values[np.isfinite(values)]
     if not values.size:
-        return math.nan, math.nan
-    return float(np.mean(values)), float(np.max(values))
+        return ErrorStats(math.nan, math.nan)
+    return ErrorStats(float(np.mean(values)), float(np.max(values)))
+
+
+def _method_errors(selected: Sequence[Mapping[str, Any]]) -> MethodErrors:
+    """|x_c error| against the contact abscissa and the nominal x_c (m)."""
+    return MethodErrors(_errors(selected, "error_contact_m"), _errors(selected, "error_m"))
 
 
 def _median_delay(selected: Sequence[Mapping[str, Any]]) -> float:
@@ -479,23 +495,13 @@ def target_summary(
     has = np.isfinite(low) & np.isfinite(high)
     error = np.abs(_column(mine, "x_c_estimate_m") - truth)
     is_ok = np.array([r["status"] == "ok" for r in mine], dtype=bool)
-    mae_c, max_c = _errors(mine, "error_contact_m")
-    ref_mae_c, ref_max_c = _errors(ref, "error_contact_m")
-    mae_n, max_n = _errors(mine, "error_m")
-    ref_mae_n, ref_max_n = _errors(ref, "error_m")
     return TargetSummary(
         label=label,
         n_runs=len(mine),
         median_delay=_median_delay(mine),
         ref_median_delay=_median_delay(ref),
-        mae_contact=mae_c,
-        max_contact=max_c,
-        ref_mae_contact=ref_mae_c,
-        ref_max_contact=ref_max_c,
-        mae_nominal=mae_n,
-        max_nominal=max_n,
-        ref_mae_nominal=ref_mae_n,
-        ref_max_nominal=ref_max_n,
+        errors=_method_errors(mine),
+        ref_errors=_method_errors(ref),
         n_intervals=int(has.sum()),
         n_covering=int((has & (low <= truth) & (truth <= high)).sum()),
         n_ok_over_limit=int((is_ok & np.isfinite(error) & (error > OK_ERROR_LIMIT)).sum()),
