@@ -775,41 +775,94 @@ def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
     assert np.array_equal(online_early.reaction_perp, offline_early.reaction_perp)
 
 
+def _counted_early_statics(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, int]]:
+    """(first, last index) of every window whose early statics are fitted from now on."""
+    import sensing_antenna.estimation.fast as fast_module
+
+    calls: list[tuple[int, int]] = []
+    early_statics = fast_module._early_statics
+
+    def counted(window: Any, *args: Any) -> Any:
+        calls.append((window.rest_index, window.end_index))
+        return early_statics(window, *args)
+
+    monkeypatch.setattr(fast_module, "_early_statics", counted)
+    return calls
+
+
+def _early_statics_as_evaluate_window_gives(inputs: ScanInputs, window: Any) -> Any:
+    """The early statics evaluate_window computes itself for ``window``'s span."""
+    from sensing_antenna.estimation.fast import evaluate_window
+
+    start, end = window.start_index, window.end_index
+    span = inputs._replace(rest_index=start, end_index=end)
+    if start != inputs.rest_index:
+        span = span._replace(push=None)
+    return evaluate_window(*span, with_early_statics=True).early_statics
+
+
+@pytest.mark.parametrize("tolerance", [1e-6, 0.005])
 def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_window_only(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, tolerance: float
 ) -> None:
     # The early statics decide neither the posterior nor sure, so the scan skips their
-    # half-length fit on every window it passes and adds it to the one it concludes on: the
-    # same window as history() gives, with the same early statics, fitted once.
+    # half-length fit on every window it passes and adds it to the one it concludes on (the
+    # first sure one, or the cap's when none is): fitted once, the same as evaluate_window
+    # computes them itself.
     import sensing_antenna.estimation.fast as fast_module
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     evidence = gather_evidence(_azimuthal_06(), paper_antenna())
-    method = FastMethod(FastConfig(tolerance=1e-6))  # never sure: every window to the cap
-    history = {w.end_index: w for w in method.history(evidence)}
-    calls: list[int] = []
-    early_statics = fast_module._early_statics
-
-    def counted(window: Any, *args: Any) -> Any:
-        calls.append(window.end_index)
-        return early_statics(window, *args)
-
-    monkeypatch.setattr(fast_module, "_early_statics", counted)
+    method = FastMethod(FastConfig(tolerance=tolerance))
+    history = method.history(evidence)
+    expected = next((w for w in history if w.sure), history[-1])
+    calls = _counted_early_statics(monkeypatch)
     inputs = method._prepare(evidence)
     result = fast_module.scan(
         inputs, evidence.hold_end, evidence.hold_end, fast_module.second_mode_chooser(evidence)
     )
     final = result.final
-    assert result.reached_cap and result.evaluations == len(history) > 10
-    assert calls == [final.end_index]
-    expected = history[final.end_index]
-    assert final.early_statics is not None and expected.early_statics is not None
-    assert final.early_statics.ratio == expected.early_statics.ratio
+    assert final is not None and calls == [(final.start_index, final.end_index)]
+    assert final.end_index == expected.end_index and final.sure == expected.sure
+    assert result.evaluations == 1 + history.index(expected)
+    assert result.reached_cap == (not expected.sure)
     assert (final.posterior.x_c, final.omega1, final.note) == (
         expected.posterior.x_c,
         expected.omega1,
         expected.note,
     )
+    # The sure window (0.237 s) is too short for a reference (its half holds 1.2 periods);
+    # the cap's 1 s window has one
+    statics = _early_statics_as_evaluate_window_gives(inputs, final)
+    assert (statics is None) == expected.sure
+    if statics is None:
+        assert final.early_statics is None
+    else:
+        assert final.early_statics is not None
+        assert final.early_statics.ratio == statics.ratio
+        assert np.array_equal(final.early_statics.reaction_perp, statics.reaction_perp)
+
+
+def test_a_window_restarted_at_the_end_of_the_hold_fits_only_its_own_early_statics(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Every window "opens" (max_opening tiny), so each is restarted at the hold's end: the
+    # window from t_1 that was set aside does not get its half window fitted, the restarted
+    # one does, with the statics evaluate_window gives it.
+    from sensing_antenna.estimation.fast import evaluate_from_t1_or_hold
+    from sensing_antenna.estimation.pipeline import gather_evidence
+
+    evidence = gather_evidence(_azimuthal_06(), paper_antenna())
+    method = FastMethod(FastConfig(max_opening=1e-9))
+    inputs = method._prepare(evidence)
+    end = inputs.rest_index + 1000
+    calls = _counted_early_statics(monkeypatch)
+    window = evaluate_from_t1_or_hold(inputs._replace(end_index=end), evidence.hold_end, ({}, {}))
+    assert (window.start_index, window.end_index) == (evidence.hold_end, end)
+    assert calls == [(evidence.hold_end, end)]
+    statics = _early_statics_as_evaluate_window_gives(inputs, window)
+    assert window.early_statics is not None and statics is not None
+    assert window.early_statics.ratio == statics.ratio
 
 
 def test_a_session_never_serves_the_fits_of_other_samples() -> None:
@@ -943,7 +996,7 @@ def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push(
     inputs = ScanInputs(
         np.zeros((600, 5)), NO_BIAS, 100, 500, TS, BAND, LINK, X_RANGE, FastConfig(), push
     )
-    evaluate_from_t1_or_hold(inputs, hold_end=300)
+    evaluate_from_t1_or_hold(inputs, hold_end=300, with_early_statics=False)
     assert calls == [(100, push), (300, None)]
 
 

@@ -140,6 +140,11 @@ def test_the_model_over_several_degrees_is_the_degree_with_the_smallest_bic() ->
         assert np.array_equal(getattr(fit, name), getattr(best, name)), name
     assert (fit.bic, fit.converged) == (best.bic, best.converged)
     assert select_model(y[:10], TS, 3, (2, 3, 4)) is None  # too short for any order
+    # Every order is weighted with the noise of the largest order's residuals, so the BIC
+    # compares them on the same weights: the two-mode winner carries the three-mode fit's noise
+    largest = fit_damped_sinusoids(y, TS, 3, min_omega=10.0, degree=3)
+    assert fit.n_modes == 2 and largest is not None
+    assert np.array_equal(fit.noise_std, largest.noise_std)
 
 
 def _loads(

@@ -974,24 +974,50 @@ def evaluate_from_t1_or_hold(
     on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
     once it is at least ``first_window`` long (before that the one from t_1 is returned, not
     sure). ``caches`` holds the fits of the two kinds of window; None refits.
-    ``choose_branch`` and ``with_early_statics`` as in :func:`evaluate_window`.
+    ``choose_branch`` and ``with_early_statics`` as in :func:`evaluate_window` (only the window
+    returned gets them).
     """
     early, late = caches if caches is not None else (None, None)
     window = evaluate_window(
-        *inputs, cache=early, choose_branch=choose_branch, with_early_statics=with_early_statics
+        *inputs, cache=early, choose_branch=choose_branch, with_early_statics=False
     )
     first = round(inputs.config.first_window / inputs.sample_period)
     if (
         window.opening > inputs.config.max_opening
         and inputs.rest_index < hold_end <= inputs.end_index - first
     ):
-        return evaluate_window(
+        window = evaluate_window(
             *inputs._replace(rest_index=hold_end, push=None),
             cache=late,
             choose_branch=choose_branch,
-            with_early_statics=with_early_statics,
+            with_early_statics=False,
         )
-    return window
+    return with_early_statics_of(inputs, window, caches) if with_early_statics else window
+
+
+def with_early_statics_of(
+    inputs: ScanInputs,
+    estimate: WindowEstimate,
+    caches: tuple[FitCache, FitCache] | None = None,
+) -> WindowEstimate:
+    """``estimate`` (a window of :func:`evaluate_from_t1_or_hold` on ``inputs``' samples) with
+    the slip check's early statics, as :func:`evaluate_window` computes them; its own fits and
+    the drift check's come from ``caches`` (the window from t_1's or, when it was restarted,
+    the window from the hold's end's); None refits them."""
+    restarted = estimate.start_index != inputs.rest_index
+    cache = None if caches is None else caches[1 if restarted else 0]
+    window = _Window(
+        inputs.channels,
+        estimate.start_index,
+        estimate.end_index,
+        inputs.sample_period,
+        inputs.band,
+        inputs.config,
+        cache,
+    )
+    from_t1 = _frequency(window, None)
+    early = None if from_t1.mode is None else _early_statics(window, from_t1.omega1, inputs.bias)
+    return dataclasses.replace(estimate, early_statics=early)
 
 
 def _higher_mode(
@@ -1068,7 +1094,8 @@ class ScanResult:
     final : WindowEstimate or None
         The declared evaluation (sure), or the last one (unsure); None if none could run.
     evaluations : int
-        Number of windows evaluated.
+        Number of grid windows evaluated (the concluded window's early statics, added after,
+        are not another evaluation).
     reached_cap : bool
         True when the search stopped at the cap without being sure.
     """
@@ -1120,8 +1147,8 @@ def scan(
 
     The windows are those of :func:`evaluations` (``caches`` as there); ``earliest`` is the end
     of the pipeline's hold, before which there is no contact frame. Only the window concluded on
-    gets the slip check's early statics (they do not decide ``sure``); it is evaluated again for
-    them from the cached fits.
+    gets the slip check's early statics (they do not decide ``sure``), added after from the
+    cached fits (:func:`with_early_statics_of`).
     """
     if caches is None:
         caches = ({}, {})
@@ -1134,9 +1161,7 @@ def scan(
             break
     if final is None:
         return ScanResult(None, 0, last <= inputs.end_index)
-    final = evaluate_from_t1_or_hold(
-        inputs._replace(end_index=final.end_index), hold_end, caches, choose_branch
-    )
+    final = with_early_statics_of(inputs._replace(end_index=final.end_index), final, caches)
     return ScanResult(final, count, not final.sure and last <= inputs.end_index)
 
 

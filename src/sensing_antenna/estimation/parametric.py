@@ -26,7 +26,8 @@ Sarkar 1990).
 
 Model order: M = 1 .. ``max_modes`` damped modes; the order with the smallest Bayesian
 information criterion (Schwarz 1978) sum_k n ln(RSS_k / n) + P ln(n K) is kept, P being the
-number of fitted parameters. Extra modes absorb the second contact mode and servo transients that
+number of fitted parameters (:func:`select_model` chooses the polynomial degree by the same
+criterion). Extra modes absorb the second contact mode and servo transients that
 would otherwise bias the fundamental or make the residual non-white.
 
 Standard errors: the covariance of every parameter is (J^T J)^-1 with J the Jacobian of the
@@ -531,9 +532,27 @@ def _refine(
 class _Candidate:
     """A solved fit before its covariance: what the BIC compares orders and degrees on.
 
-    ``coef`` (L, K) are the linear coefficients of ``basis`` (n, L) for the unweighted signals
-    ``y`` (n, K); ``noise`` (K,) the channels' noise standard deviations the fit was weighted
-    with (from its residuals when ``scale_from_residuals``); ``bic`` Schwarz's criterion.
+    Attributes
+    ----------
+    params : array, shape (2M,)
+        The solution, interleaved (w_m rad/s, s_m 1/s).
+    converged : bool
+        The solver's flag (:meth:`summary` also needs a finite covariance).
+    design : _Design
+        The window's model columns.
+    y : array, shape (n, K)
+        The unweighted signals.
+    basis : array, shape (n, L)
+        ``design``'s columns at ``params``.
+    coef : array, shape (L, K)
+        Their least-squares coefficients for ``y``.
+    noise : array, shape (K,)
+        Each channel's noise standard deviation: from this solution's residuals when it was
+        estimated (the fit itself was weighted with a first fit's), else the one given.
+    t_start : float
+        Time of the first sample (s).
+    bic : float
+        Schwarz's criterion of the unweighted residuals.
     """
 
     params: FloatArray
@@ -612,7 +631,8 @@ def _candidate(
     t_start: float,
     scale_from_residuals: bool,
 ) -> _Candidate:
-    """The linear part, residual, noise and BIC of the solution ``params``."""
+    """The linear part, noise and BIC of the solution ``params`` (noise from its residuals when
+    ``scale_from_residuals``, else ``scale``)."""
     n, k = y.shape
     m = params.size // 2
     basis = design.basis(params)
@@ -680,8 +700,35 @@ def select_model(
     """The fit with the smallest BIC over the polynomial ``degrees`` and M = 1 .. ``max_modes``.
 
     Each degree's orders as in :func:`select_model_order` (the BIC is computed on the unweighted
-    residuals, so it compares degrees too); only the chosen fit's covariance is computed. None
-    when no degree and order could be fitted.
+    residuals, so it compares degrees too); only the chosen fit's covariance is computed. On a
+    tie the earlier degree, then the larger order, wins.
+
+    Parameters
+    ----------
+    signals : array, shape (n,) or (n, K)
+        Samples of K channels, time on axis 0.
+    sample_period : float
+        T_s (s).
+    max_modes : int
+        Largest number of damped modes M tried at each degree.
+    degrees : sequence of int
+        Polynomial degrees tried (>= 0).
+    t_start : float
+        Time of the first sample (s).
+    min_omega : float
+        Lowest frequency a mode may take (rad/s).
+    target_band : tuple of float, optional
+        Band of the fundamental (rad/s), as in :func:`fit_damped_sinusoids`.
+    poles : array of complex, optional
+        :func:`first_poles` of the signals for ``max_modes``, shared by every degree (they do
+        not depend on it); computed per degree when omitted.
+    regressors, restart
+        As in :func:`fit_damped_sinusoids`.
+
+    Returns
+    -------
+    DampedSinusoidFit or None
+        None when no degree and order could be fitted (record too short).
     """
     y = np.asarray(signals, dtype=float)
     candidates = [
