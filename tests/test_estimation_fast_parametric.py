@@ -147,6 +147,23 @@ def test_the_model_over_several_degrees_is_the_degree_with_the_smallest_bic() ->
     assert np.array_equal(fit.noise_std, largest.noise_std)
 
 
+def test_a_fit_whose_solver_stopped_early_is_not_converged(monkeypatch: pytest.MonkeyPatch) -> None:
+    # The solver's flag reaches the fit (the fast method drops a fundamental that did not
+    # converge): with one residual evaluation allowed the solver stops before any criterion
+    # holds, with the default 100 it converges on the same record.
+    import sensing_antenna.estimation.parametric as parametric
+
+    t = np.arange(300) * TS
+    y = 1e-3 * np.exp(-t) * np.cos(45 * t + 0.3) + 3e-5 * np.random.default_rng(2).standard_normal(
+        t.size
+    )
+    fit = fit_damped_sinusoids(y, TS, 1)
+    assert fit is not None and fit.converged
+    monkeypatch.setattr(parametric, "_MAX_EVALUATIONS", 1)
+    stopped = fit_damped_sinusoids(y, TS, 1)
+    assert stopped is not None and not stopped.converged
+
+
 def _loads(
     x_c: float, force: float, n: int, rng: np.random.Generator, bias: np.ndarray
 ) -> np.ndarray:
