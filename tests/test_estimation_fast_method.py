@@ -790,15 +790,23 @@ def _counted_early_statics(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, i
     return calls
 
 
-def _early_statics_as_evaluate_window_gives(inputs: ScanInputs, window: Any) -> Any:
-    """The early statics evaluate_window computes itself for ``window``'s span."""
-    from sensing_antenna.estimation.fast import evaluate_window
+def _early_statics_refitted(inputs: ScanInputs, window: Any) -> Any:
+    """The early statics of ``window``'s span, every fit done afresh (no cache)."""
+    from sensing_antenna.estimation.fast import _early_statics, _frequency, _Window
 
-    start, end = window.start_index, window.end_index
-    span = inputs._replace(rest_index=start, end_index=end)
-    if start != inputs.rest_index:
-        span = span._replace(push=None)
-    return evaluate_window(*span, with_early_statics=True).early_statics
+    span = _Window(
+        inputs.channels,
+        window.start_index,
+        window.end_index,
+        inputs.sample_period,
+        inputs.band,
+        inputs.config,
+        None,
+    )
+    fundamental = _frequency(span, None)
+    if fundamental.mode is None:
+        return None
+    return _early_statics(span, fundamental.omega1, inputs.bias)
 
 
 @pytest.mark.parametrize("tolerance", [1e-6, 0.005])
@@ -807,8 +815,8 @@ def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_win
 ) -> None:
     # The early statics decide neither the posterior nor sure, so the scan skips their
     # half-length fit on every window it passes and adds it to the one it concludes on (the
-    # first sure one, or the cap's when none is): fitted once, the same as evaluate_window
-    # computes them itself.
+    # first sure one, or the cap's when none is): fitted once, and the same as a computation
+    # from scratch gives.
     import sensing_antenna.estimation.fast as fast_module
     from sensing_antenna.estimation.pipeline import gather_evidence
 
@@ -833,7 +841,7 @@ def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_win
     )
     # The sure window (0.237 s) is too short for a reference (its half holds 1.2 periods);
     # the cap's 1 s window has one
-    statics = _early_statics_as_evaluate_window_gives(inputs, final)
+    statics = _early_statics_refitted(inputs, final)
     assert (statics is None) == expected.sure
     if statics is None:
         assert final.early_statics is None
@@ -848,7 +856,7 @@ def test_a_window_restarted_at_the_end_of_the_hold_fits_only_its_own_early_stati
 ) -> None:
     # Every window "opens" (max_opening tiny), so each is restarted at the hold's end: the
     # window from t_1 that was set aside does not get its half window fitted, the restarted
-    # one does, with the statics evaluate_window gives it.
+    # one does, with the statics a computation from scratch gives.
     from sensing_antenna.estimation.fast import evaluate_from_t1_or_hold
     from sensing_antenna.estimation.pipeline import gather_evidence
 
@@ -860,7 +868,7 @@ def test_a_window_restarted_at_the_end_of_the_hold_fits_only_its_own_early_stati
     window = evaluate_from_t1_or_hold(inputs._replace(end_index=end), evidence.hold_end, ({}, {}))
     assert (window.start_index, window.end_index) == (evidence.hold_end, end)
     assert calls == [(evidence.hold_end, end)]
-    statics = _early_statics_as_evaluate_window_gives(inputs, window)
+    statics = _early_statics_refitted(inputs, window)
     assert window.early_statics is not None and statics is not None
     assert window.early_statics.ratio == statics.ratio
 

@@ -405,7 +405,7 @@ class WindowEstimate:
     early_statics : StaticRatio or None
         Statics of the window's first half (the slip reference); None when that half holds
         fewer than ``min_periods`` periods, has no mode near the whole window's fundamental, or
-        when not asked for (``with_early_statics``).
+        when not added (:func:`evaluate_window` leaves them to :func:`with_early_statics_of`).
     ratio_z : float
         Distance of the ratio from the MAP x_c in its standard deviations.
     opening : float
@@ -707,9 +707,12 @@ def evaluate_window(
     push: PushPhase | None = None,
     cache: FitCache | None = None,
     choose_branch: BranchChooser | None = None,
-    with_early_statics: bool = True,
 ) -> WindowEstimate:
     """Fit the window [rest_index, end_index] and form the posterior over x_c.
+
+    The slip check's early statics (the fit of the window's first half) enter neither the
+    posterior nor ``sure``: they are left out (None), and :func:`with_early_statics_of` adds
+    them to the window that is concluded on.
 
     Parameters
     ----------
@@ -737,10 +740,6 @@ def evaluate_window(
         When the posterior holds two branches of omega_1(x_c), asked which candidate the
         window supports (:func:`second_mode_chooser`); the posterior is conditioned on its
         answer before the checks. None: not asked.
-    with_early_statics : bool
-        Fit the window of half the length for the statics the slip check compares
-        (``WindowEstimate.early_statics``); they do not enter the posterior or ``sure``, so a
-        window that will not be declared may skip them (False: None).
 
     Returns
     -------
@@ -761,11 +760,6 @@ def evaluate_window(
     # at the centre of [t_c, t], inside the push for short windows, while the opening check
     # compares it with the vibration at t_1
     statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
-    early = (
-        _early_statics(window, from_t1.omega1, bias)
-        if with_early_statics and from_t1.mode is not None
-        else None
-    )
     table = curve_table(link, x_range[0], x_range[1], config.grid_step)
     frequency_floor = model_floor(link, config)
     omega_h = omega_h_se = math.nan
@@ -853,7 +847,7 @@ def evaluate_window(
         checks_passed=checks_passed,
         note="; ".join(notes),
         omega1_drift=drift,
-        early_statics=early,
+        early_statics=None,
         ratio_z=ratio_z,
         opening=opening,
         branch_contradicted=bool(contradiction),
@@ -974,13 +968,11 @@ def evaluate_from_t1_or_hold(
     on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
     once it is at least ``first_window`` long (before that the one from t_1 is returned, not
     sure). ``caches`` holds the fits of the two kinds of window; None refits.
-    ``choose_branch`` and ``with_early_statics`` as in :func:`evaluate_window` (only the window
-    returned gets them).
+    ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
+    gets the slip check's early statics (:func:`with_early_statics_of`).
     """
     early, late = caches if caches is not None else (None, None)
-    window = evaluate_window(
-        *inputs, cache=early, choose_branch=choose_branch, with_early_statics=False
-    )
+    window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
     first = round(inputs.config.first_window / inputs.sample_period)
     if (
         window.opening > inputs.config.max_opening
@@ -990,7 +982,6 @@ def evaluate_from_t1_or_hold(
             *inputs._replace(rest_index=hold_end, push=None),
             cache=late,
             choose_branch=choose_branch,
-            with_early_statics=False,
         )
     return with_early_statics_of(inputs, window, caches) if with_early_statics else window
 
@@ -1001,9 +992,9 @@ def with_early_statics_of(
     caches: tuple[FitCache, FitCache] | None = None,
 ) -> WindowEstimate:
     """``estimate`` (a window of :func:`evaluate_from_t1_or_hold` on ``inputs``' samples) with
-    the slip check's early statics, as :func:`evaluate_window` computes them; its own fits and
-    the drift check's come from ``caches`` (the window from t_1's or, when it was restarted,
-    the window from the hold's end's); None refits them."""
+    the slip check's early statics: those of its first half, with the fundamental of its fit
+    from its own start (never through the push). Its fits come from ``caches`` (the windows
+    from t_1 or, when it was restarted, those from the hold's end); None refits them."""
     restarted = estimate.start_index != inputs.rest_index
     cache = None if caches is None else caches[1 if restarted else 0]
     window = _Window(
@@ -1121,7 +1112,7 @@ def evaluations(
     (:func:`evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are cached, so
     the drift check's shorter windows are fitted once; ``caches`` (windows from t_1, windows from
     the hold's end) are used and filled when given, else new ones. ``choose_branch`` and
-    ``with_early_statics`` as in :func:`evaluate_window`.
+    ``with_early_statics`` as in :func:`evaluate_from_t1_or_hold`.
     """
     if caches is None:
         caches = ({}, {})
