@@ -1152,7 +1152,7 @@ def scan(
             break
     if final is None:
         return ScanResult(None, 0, last <= inputs.end_index)
-    final = with_early_statics_of(inputs._replace(end_index=final.end_index), final, caches)
+    final = with_early_statics_of(inputs, final, caches)
     return ScanResult(final, count, not final.sure and last <= inputs.end_index)
 
 

@@ -767,41 +767,28 @@ def _order_candidates(
     """The solved fits of M = ``max_modes`` .. 1 at one degree (those the record allows)."""
     candidates = []
     noise: FloatArray | None = None
-    first = poles
-    weighted: ComplexArray | None = None
+    # The largest order that fits starts from ``poles`` (or its own pencil) and sets the noise;
+    # the smaller ones start from the pencil of the signals weighted by that noise
+    initial_poles = poles
     for m in range(max_modes, 0, -1):
+        candidate = _fit_candidate(
+            y,
+            sample_period,
+            m,
+            t_start,
+            noise,
+            min_omega,
+            degree,
+            initial_poles,
+            target_band,
+            regressors,
+            restart,
+        )
         if noise is None:
-            candidate = _fit_candidate(
-                y,
-                sample_period,
-                m,
-                t_start,
-                None,
-                min_omega,
-                degree,
-                first,
-                target_band,
-                regressors,
-                restart,
-            )
-            first = None  # the next order, if this one did not fit, starts from its own
+            initial_poles = None  # the next order, if this one did not fit, starts from its own
             if candidate is not None:
                 noise = candidate.noise
-                weighted = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
-        else:
-            candidate = _fit_candidate(
-                y,
-                sample_period,
-                m,
-                t_start,
-                noise,
-                min_omega,
-                degree,
-                weighted,
-                target_band,
-                regressors,
-                restart,
-            )
+                initial_poles = _pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
         if candidate is not None:
             candidates.append(candidate)
     return candidates
