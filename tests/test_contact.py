@@ -10,7 +10,7 @@ import pytest
 from scipy import signal
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
-from sensing_antenna.estimation.contact import (
+from sensing_antenna.detection.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
     DEFAULT_TARE_TIME,
     ContactConfigError,

@@ -14,11 +14,11 @@ import numpy as np
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.fast import FastConfig, ScanInputs, scan
-from sensing_antenna.estimation.fusion import sensing_curve
-from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
+from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior, contact_posterior
+from sensing_antenna.estimation.methods.fast.method import FastConfig, ScanInputs, scan
+from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
+from sensing_antenna.estimation.methods.paper.fusion import sensing_curve
 from sensing_antenna.estimation.pipeline import search_band
-from sensing_antenna.estimation.static_fit import SensorBias
 
 TS = 1e-3
 LINK = paper_antenna().link

@@ -21,8 +21,9 @@ from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.evidence import Evidence
-from sensing_antenna.estimation.fast import (
+from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
+from sensing_antenna.estimation.methods.fast.method import (
     FastConfig,
     FastConfigError,
     FastMethod,
@@ -34,10 +35,9 @@ from sensing_antenna.estimation.fast import (
     model_floor,
     scan,
 )
-from sensing_antenna.estimation.fusion import sensing_curve
-from sensing_antenna.estimation.likelihood import contact_posterior
+from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
+from sensing_antenna.estimation.methods.paper.fusion import sensing_curve
 from sensing_antenna.estimation.pipeline import search_band
-from sensing_antenna.estimation.static_fit import SensorBias
 
 TS = 1e-3
 LINK = paper_antenna().link
@@ -322,7 +322,7 @@ def test_offline_and_online_agree_on_a_simulated_recording(
     # session keeps the fits between evaluations and the conclusion does not scan again. With
     # the push phase, on a recording whose declared window is the one through the push.
     simulator = pytest.importorskip("sensing_antenna.simulator")
-    import sensing_antenna.estimation.fast as fast_module
+    import sensing_antenna.estimation.methods.fast.method as fast_module
     from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
 
     antenna = paper_antenna()
@@ -358,7 +358,7 @@ def test_offline_and_online_agree_on_a_simulated_recording(
 def _simulated_evidence() -> tuple[Any, Any]:
     """The evidence the pipeline hands the fast method, and its estimate (azimuthal, 0.6 m)."""
     simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.evidence import Evidence
+    from sensing_antenna.estimation.front.evidence import Evidence
     from sensing_antenna.estimation.pipeline import estimate, gather_evidence
 
     antenna = paper_antenna()
@@ -623,8 +623,12 @@ def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is
     # Hann main lobe (+-126 rad/s) is wider than the candidates' omega_2 gap (~100 rad/s): not
     # asked. With a fundamental of half the peak's frequency the peak is 2 omega_1 itself,
     # which a clipping contact would make: the answer is dropped.
-    from sensing_antenna.estimation.fast import second_mode_chooser
-    from sensing_antenna.estimation.frequency import find_peak
+    from sensing_antenna.estimation.methods.fast.method import second_mode_chooser
+    from sensing_antenna.estimation.methods.paper.frequency import (
+        evidence_frequency,
+        evidence_spectrum,
+        find_peak,
+    )
     from sensing_antenna.estimation.pipeline import gather_evidence
     from test_estimation_pipeline import Synthetic, synthetic_recording
 
@@ -643,7 +647,7 @@ def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is
     # The peak the answer rests on, found as the chooser finds it: the synthetic mode 2 is at
     # the link's omega_2, so within 1 % (the 0.5 s window's zero-padded peak, interpolated)
     window = replace(evidence, end_index=start + 500)
-    omega, power = window.component_spectrum(window.measure_frequency().component)
+    omega, power = evidence_spectrum(window, evidence_frequency(window).component)
     omega2 = float(natural_frequencies(LINK, candidates[choice], 2)[1])
     peak = find_peak(omega, power, (omega2 / 1.05, omega2 * 1.05))
     assert peak is not None and abs(peak.omega - omega2) < 0.01 * omega2
@@ -660,7 +664,7 @@ def _azimuthal_06() -> Any:
 
 def _evaluated_windows(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     """Last indices of every window the fast method evaluates from now on."""
-    import sensing_antenna.estimation.fast as fast_module
+    import sensing_antenna.estimation.methods.fast.method as fast_module
 
     ends: list[int] = []
     evaluate = fast_module.evaluate_from_t1_or_hold
@@ -675,7 +679,7 @@ def _evaluated_windows(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
 def _concluded_windows(monkeypatch: pytest.MonkeyPatch) -> list[tuple[Any, Any]]:
     """(window, scan result) of every conclusion of the fast method from now on."""
-    import sensing_antenna.estimation.fast as fast_module
+    import sensing_antenna.estimation.methods.fast.method as fast_module
 
     finals: list[tuple[Any, Any]] = []
     conclude = fast_module.conclude_fast
@@ -777,7 +781,7 @@ def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
 
 def _counted_early_statics(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, int]]:
     """(first, last index) of every window whose early statics are fitted from now on."""
-    import sensing_antenna.estimation.fast as fast_module
+    import sensing_antenna.estimation.methods.fast.method as fast_module
 
     calls: list[tuple[int, int]] = []
     early_statics = fast_module._early_statics
@@ -792,7 +796,7 @@ def _counted_early_statics(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, i
 
 def _early_statics_refitted(inputs: ScanInputs, window: Any) -> Any:
     """The early statics of ``window``'s span, every fit done afresh (no cache)."""
-    from sensing_antenna.estimation.fast import _early_statics, _frequency, _Window
+    from sensing_antenna.estimation.methods.fast.method import _early_statics, _frequency, _Window
 
     span = _Window(
         inputs.channels,
@@ -817,7 +821,7 @@ def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_win
     # half-length fit on every window it passes and adds it to the one it concludes on (the
     # first sure one, or the cap's when none is): fitted once, and the same as a computation
     # from scratch gives.
-    import sensing_antenna.estimation.fast as fast_module
+    import sensing_antenna.estimation.methods.fast.method as fast_module
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     evidence = gather_evidence(_azimuthal_06(), paper_antenna())
@@ -857,7 +861,7 @@ def test_a_window_restarted_at_the_end_of_the_hold_fits_only_its_own_early_stati
     # Every window "opens" (max_opening tiny), so each is restarted at the hold's end: the
     # window from t_1 that was set aside does not get its half window fitted, the restarted
     # one does, with the statics a computation from scratch gives.
-    from sensing_antenna.estimation.fast import evaluate_from_t1_or_hold
+    from sensing_antenna.estimation.methods.fast.method import evaluate_from_t1_or_hold
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     evidence = gather_evidence(_azimuthal_06(), paper_antenna())
@@ -917,7 +921,7 @@ def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any
     evaluated with the push phase, the fundamental of the window from t_1 alone and the true
     omega_1 (sensing curve at the simulator's contact abscissa)."""
     simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.fast import _frequency, _Window
+    from sensing_antenna.estimation.methods.fast.method import _frequency, _Window
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     antenna = paper_antenna()
@@ -967,7 +971,7 @@ def test_a_window_through_the_push_stands_when_it_tells_omega1_better() -> None:
 def test_the_push_must_pass_the_same_checks_be_more_precise_and_agree() -> None:
     # The rule on made-up fundamentals: through the push 0.1 rad/s statistical error, from
     # t_1 alone 0.5 rad/s, so their difference may be 3 sqrt(0.5^2 - 0.1^2) = 1.47 rad/s.
-    from sensing_antenna.estimation.fast import _Frequency, _push_agrees
+    from sensing_antenna.estimation.methods.fast.method import _Frequency, _push_agrees
 
     from_t1 = _Frequency(None, 0, 35.0, 0.6, 0.5, 0.1, ())
     config = FastConfig()
@@ -990,8 +994,8 @@ def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push(
 ) -> None:
     # When the contact opened, the window restarts at the end of the hold, long after t_1:
     # the push is not part of it (the modes restart there on their own).
-    import sensing_antenna.estimation.fast as fast_module
-    from sensing_antenna.estimation.fast import PushPhase, evaluate_from_t1_or_hold
+    import sensing_antenna.estimation.methods.fast.method as fast_module
+    from sensing_antenna.estimation.methods.fast.method import PushPhase, evaluate_from_t1_or_hold
 
     calls: list[tuple[int, Any]] = []
 
@@ -1015,8 +1019,8 @@ def test_windows_through_the_push_fit_their_own_polynomial_degrees(
     # The window from t_1 tries degrees 2 to polynomial_degree; the one through the push up to
     # push_polynomial_degree (the head's angle carries the push's static growth), with the
     # push's angle and the restart at t_1 passed on.
-    import sensing_antenna.estimation.fast as fast_module
-    from sensing_antenna.estimation.fast import PushPhase, _fit_window
+    import sensing_antenna.estimation.methods.fast.method as fast_module
+    from sensing_antenna.estimation.methods.fast.method import PushPhase, _fit_window
 
     calls: list[tuple[list[int], bool, int | None]] = []
 
@@ -1043,9 +1047,9 @@ def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window(
     # azimuthal 0.70 m: 46 +- 12.5 rad/s over 0.12 s against 97.5 over 0.24 s, and a "slip" of
     # 170 degrees): no reference then. A half window that reads the fundamental a little off,
     # as short windows do, is one however small its standard error.
-    import sensing_antenna.estimation.fast as fast_module
-    from sensing_antenna.estimation.fast import _early_statics, _Window
-    from sensing_antenna.estimation.parametric import DampedSinusoidFit
+    import sensing_antenna.estimation.methods.fast.method as fast_module
+    from sensing_antenna.estimation.methods.fast.method import _early_statics, _Window
+    from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 
     def half_fit(omega: float, se: float) -> DampedSinusoidFit:
         one = np.ones(1)

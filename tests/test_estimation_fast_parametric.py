@@ -17,14 +17,14 @@ import math
 import numpy as np
 import pytest
 
-from sensing_antenna.estimation.parametric import (
+from sensing_antenna.estimation.methods.fast.parametric import (
     damped_sinusoid_crb,
     fit_damped_sinusoids,
     matrix_pencil_poles,
     select_model,
     select_model_order,
 )
-from sensing_antenna.estimation.static_fit import SensorBias, sensor_bias, static_ratio
+from sensing_antenna.estimation.methods.fast.static_fit import SensorBias, sensor_bias, static_ratio
 
 TS = 1e-3
 
@@ -151,7 +151,7 @@ def test_a_fit_whose_solver_stopped_early_is_not_converged(monkeypatch: pytest.M
     # The solver's flag reaches the fit (the fast method drops a fundamental that did not
     # converge): with one residual evaluation allowed the solver stops before any criterion
     # holds, with the default 100 it converges on the same record.
-    import sensing_antenna.estimation.parametric as parametric
+    import sensing_antenna.estimation.methods.fast.parametric as parametric
 
     t = np.arange(300) * TS
     y = 1e-3 * np.exp(-t) * np.cos(45 * t + 0.3) + 3e-5 * np.random.default_rng(2).standard_normal(

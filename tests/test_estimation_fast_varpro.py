@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from sensing_antenna.estimation.varpro import (
+from sensing_antenna.estimation.methods.fast.varpro import (
     NOT_CONVERGED,
     _free_parameters,
     _trust_region_step,

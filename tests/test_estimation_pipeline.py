@@ -29,7 +29,7 @@ from sensing_antenna.estimation import (
     measure_omega1,
 )
 from sensing_antenna.estimation.config import EstimatorConfigError
-from sensing_antenna.estimation.contact_frame import motor_axes
+from sensing_antenna.estimation.front.contact_frame import motor_axes
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate
 
@@ -239,7 +239,7 @@ def test_no_contact() -> None:
     _, final = run_online(recording)
     assert final.status is Status.NO_CONTACT
     # Without a contact there is no evidence to study: gather_evidence gives the early result
-    from sensing_antenna.estimation.evidence import Evidence
+    from sensing_antenna.estimation.front.evidence import Evidence
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     early = gather_evidence(recording, paper_antenna())

@@ -16,22 +16,26 @@ import pytest
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, paper_antenna
 from sensing_antenna.estimation.config import EstimatorConfig, EstimatorConfigError
-from sensing_antenna.estimation.contact_frame import (
+from sensing_antenna.estimation.front.contact_frame import (
     contact_frame,
     first_rest_index,
     motor_axes,
     rest_tolerance,
     signal_noise,
 )
-from sensing_antenna.estimation.frequency import find_peak, measure_frequency, power_spectrum
-from sensing_antenna.estimation.fusion import fuse
-from sensing_antenna.estimation.ratio import (
+from sensing_antenna.estimation.front.ratio import (
     contact_loads,
     converged_index,
     filtered_contact_loads,
     paper_ratio,
     perpendicular_ratio,
 )
+from sensing_antenna.estimation.methods.paper.frequency import (
+    find_peak,
+    measure_frequency,
+    power_spectrum,
+)
+from sensing_antenna.estimation.methods.paper.fusion import fuse
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
 TS = 1e-3
@@ -302,8 +306,8 @@ def test_touched_point_sag_is_the_finite_element_cantilever_sag_with_a_tip_mass(
     # = 1e-8 m between them, so 1e-5 relative on sags of 1.8 to 8.8 cm with a 2 g tip mass).
     from dataclasses import replace
 
-    from sensing_antenna.estimation.contact_frame import ContactFrame, motor_axes
-    from sensing_antenna.estimation.touch_point import touched_point
+    from sensing_antenna.estimation.front.contact_frame import ContactFrame, motor_axes
+    from sensing_antenna.estimation.methods.touch_point import touched_point
     from sensing_antenna.simulator.run import _unit_sag
 
     link = replace(paper_antenna().link, tip_mass=0.002)

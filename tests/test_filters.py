@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from scipy import signal
 
 from sensing_antenna.antenna import FreeMotionObserver, paper_antenna
-from sensing_antenna.estimation.filters import (
+from sensing_antenna.detection.filters import (
     FilterConfigError,
     FirstOrderLowPass,
     FreeMotionObserverFilter,

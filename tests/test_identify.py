@@ -16,7 +16,7 @@ from sensing_antenna.calibration.observer import (
     initial_guess,
 )
 from sensing_antenna.cli import main
-from sensing_antenna.estimation.contact import detect_contact
+from sensing_antenna.detection.contact import detect_contact
 from sensing_antenna.recording import Recording, write_recording
 from sensing_antenna.simulator import Scenario, simulate
 

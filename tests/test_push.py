@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
-from sensing_antenna.estimation.contact import ContactDetector, free_motion_torque
-from sensing_antenna.estimation.push import (
+from sensing_antenna.detection.contact import ContactDetector, free_motion_torque
+from sensing_antenna.detection.push import (
     DEFAULT_ROTATION,
     PushConfigError,
     PushCriterion,

@@ -29,13 +29,13 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from sensing_antenna.antenna import Antenna, FreeMotionObserver
-from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.contact import (
+from sensing_antenna.detection.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
     OBSERVER_TORQUE_SIGNS,
     contact_residual,
 )
-from sensing_antenna.estimation.filters import observe_free_motion
+from sensing_antenna.detection.filters import observe_free_motion
+from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
 
 __all__ = [

@@ -1,7 +1,7 @@
 """Contact-point estimation: contact instant, push, Estimators 1 and 2, fusion, baselines.
 
 Public entry points (imported lazily, so that importing one submodule such as
-``sensing_antenna.estimation.filters`` does not load the whole pipeline):
+``sensing_antenna.detection.filters`` does not load the whole pipeline):
 
 - :func:`estimate` (offline) and :class:`OnlineEstimator` (streaming), :data:`METHODS`;
 - :func:`measure_omega1`, Estimator 1's frequency measurement alone;
@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.estimation.frequency import FrequencyMeasurement
+    from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
     from sensing_antenna.estimation.pipeline import (
         METHODS,
         OnlineEstimator,

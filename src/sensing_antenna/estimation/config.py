@@ -9,8 +9,8 @@ import math
 from dataclasses import dataclass, fields
 from typing import Literal
 
+from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.push import PushCriterion
 
 __all__ = ["EstimatorConfig", "EstimatorConfigError", "no_t1_reason"]
 

@@ -16,10 +16,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.detection.contact import ContactDetector
+from sensing_antenna.detection.filters import FirstOrderLowPass
+from sensing_antenna.detection.push import PushCriterion, PushMonitor
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
-from sensing_antenna.estimation.contact import ContactDetector
-from sensing_antenna.estimation.evidence import (
+from sensing_antenna.estimation.front.evidence import (
     ContactStart,
     Evidence,
     at_contact,
@@ -31,14 +33,12 @@ from sensing_antenna.estimation.evidence import (
     samples,
     search_band,
 )
-from sensing_antenna.estimation.filters import FirstOrderLowPass
-from sensing_antenna.estimation.methods import EstimationMethod, resolve_method
-from sensing_antenna.estimation.push import PushCriterion, PushMonitor
-from sensing_antenna.estimation.ratio import (
+from sensing_antenna.estimation.front.ratio import (
     filtered_contact_loads,
     perpendicular_ratio,
     perpendicular_ratio_sample,
 )
+from sensing_antenna.estimation.methods import EstimationMethod, resolve_method
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = ["OnlineEstimator", "early_result"]

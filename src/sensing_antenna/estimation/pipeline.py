@@ -21,10 +21,11 @@ import math
 from typing import Any
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.detection.contact import detect_contact
+from sensing_antenna.detection.push import detect_push
 from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
-from sensing_antenna.estimation.contact import detect_contact
-from sensing_antenna.estimation.contact_frame import first_rest_index
-from sensing_antenna.estimation.evidence import (
+from sensing_antenna.estimation.front.contact_frame import first_rest_index
+from sensing_antenna.estimation.front.evidence import (
     Evidence,
     at_contact,
     bad_input,
@@ -36,21 +37,23 @@ from sensing_antenna.estimation.evidence import (
     search_band,
     time_gaps,
 )
-from sensing_antenna.estimation.frequency import FrequencyMeasurement, measure_frequency
+from sensing_antenna.estimation.front.ratio import (
+    converged_index,
+    filtered_contact_loads,
+    perpendicular_ratio,
+    window_mean,
+)
 from sensing_antenna.estimation.methods import (
     METHODS,
     EstimationMethod,
     UnknownMethodError,
     resolve_method,
 )
-from sensing_antenna.estimation.online import OnlineEstimator, early_result
-from sensing_antenna.estimation.push import detect_push
-from sensing_antenna.estimation.ratio import (
-    converged_index,
-    filtered_contact_loads,
-    perpendicular_ratio,
-    window_mean,
+from sensing_antenna.estimation.methods.paper.frequency import (
+    FrequencyMeasurement,
+    evidence_frequency,
 )
+from sensing_antenna.estimation.online import OnlineEstimator, early_result
 from sensing_antenna.estimation.result import ContactEstimate, Status
 from sensing_antenna.recording import Recording, resample_uniform
 
@@ -256,16 +259,7 @@ class _FrequencyOnly:
     name: str = "frequency"
 
     def conclude(self, evidence: Evidence) -> ContactEstimate:
-        window = evidence.spectrum_slice
-        measurement = measure_frequency(
-            evidence.torque[window],
-            evidence.frame.axes_m,
-            evidence.sample_period,
-            self.band,
-            evidence.config.min_peak_quality,
-            evidence.config.zero_padding,
-            t_start=float(evidence.t[window.start]),
-        )
+        measurement = evidence_frequency(evidence, self.band)
         status, reason = Status.OK, None
         if evidence.gap is not None:
             status, reason = Status.BAD_INPUT, evidence.gap

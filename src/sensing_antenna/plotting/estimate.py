@@ -16,16 +16,16 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.detection.contact import detect_contact
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.contact import detect_contact
-from sensing_antenna.estimation.contact_frame import motor_axes
-from sensing_antenna.estimation.frequency import power_spectrum
-from sensing_antenna.estimation.pipeline import estimate
-from sensing_antenna.estimation.ratio import (
+from sensing_antenna.estimation.front.contact_frame import motor_axes
+from sensing_antenna.estimation.front.ratio import (
     contact_loads,
     filtered_contact_loads,
     perpendicular_ratio,
 )
+from sensing_antenna.estimation.methods.paper.frequency import power_spectrum
+from sensing_antenna.estimation.pipeline import estimate
 from sensing_antenna.estimation.result import ContactEstimate
 from sensing_antenna.plotting import save_figure
 from sensing_antenna.recording import Recording, resample_uniform

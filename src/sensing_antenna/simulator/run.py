@@ -2,7 +2,7 @@
 
 The controller takes its stop decision online from the simulated sensor samples, through a
 streaming stop rule with ``reset()`` and ``update(t, theta, force, torque) -> bool`` (by default the
-project's :class:`~sensing_antenna.estimation.push.PushMonitor`), exactly as the real controller
+project's :class:`~sensing_antenna.detection.push.PushMonitor`), exactly as the real controller
 would: the simulator's ground truth is never used to stop.
 """
 
@@ -210,7 +210,7 @@ def _effective_inverse(
 
 
 def _default_stop_rule(antenna: Antenna, push: Any) -> StopRule:
-    from sensing_antenna.estimation.push import PushCriterion, PushMonitor
+    from sensing_antenna.detection.push import PushCriterion, PushMonitor
 
     criterion = PushCriterion() if push is None else push
     return PushMonitor(criterion, antenna, SAMPLE_PERIOD)

@@ -113,7 +113,7 @@ class Scenario:
     friction_coefficient : float
         Coulomb friction coefficient mu between link and obstacle.
     push : object or None
-        The push criterion (``estimation.push.PushCriterion``); None uses its default.
+        The push criterion (``detection.push.PushCriterion``); None uses its default.
     obstacle : {"post", "bar", "plane"} or None
         Obstacle kind; None: post for the azimuthal case, bar for the vertical case.
     obstacle_radius : float

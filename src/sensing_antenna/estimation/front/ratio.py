@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.estimation.filters import low_pass
+from sensing_antenna.detection.filters import low_pass
 
 __all__ = [
     "contact_loads",

@@ -25,14 +25,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from sensing_antenna.estimation.front.evidence import Evidence
 
 __all__ = [
     "COMPONENTS",
     "FrequencyMeasurement",
     "SpectralPeak",
+    "evidence_frequency",
+    "evidence_spectrum",
     "find_peak",
     "measure_frequency",
     "power_spectrum",
@@ -262,3 +268,40 @@ def measure_frequency(
         clear=peak.quality >= min_quality,
         peaks=peaks,
     )
+
+
+def evidence_frequency(
+    evidence: Evidence, band: tuple[float, float] | None = None
+) -> FrequencyMeasurement:
+    """Estimator 1 over the Delta t_e1 window of the evidence after t_1.
+
+    ``band`` (rad/s) defaults to the evidence's own omega_1 band.
+    """
+    window = evidence.spectrum_slice
+    return measure_frequency(
+        evidence.torque[window],
+        evidence.frame.axes_m,
+        evidence.sample_period,
+        evidence.band if band is None else band,
+        evidence.config.min_peak_quality,
+        evidence.config.zero_padding,
+        t_start=float(evidence.t[window.start]),
+    )
+
+
+def evidence_spectrum(evidence: Evidence, component: str) -> tuple[FloatArray, FloatArray]:
+    """Power spectrum of the torque about Y^c (``"y_c"``), Z^c (``"z_c"``) or their sum.
+
+    Over the Delta t_e1 window of the evidence, as Estimator 1 computes it.
+
+    Returns
+    -------
+    omega : array, shape (m,)
+        Angular frequencies (rad/s).
+    power : array, shape (m,)
+    """
+    window = evidence.spectrum_slice
+    projected = evidence.torque[window] @ evidence.frame.axes_m[1:].T
+    omega, power = power_spectrum(projected, evidence.sample_period, evidence.config.zero_padding)
+    spectra = {"y_c": power[:, 0], "z_c": power[:, 1]}
+    return omega, spectra.get(component, power.sum(axis=1))

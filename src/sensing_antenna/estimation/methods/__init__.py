@@ -15,10 +15,10 @@ from types import MappingProxyType
 from typing import Protocol
 
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.baselines import RatioMethod, TwoFrequencyMethod
-from sensing_antenna.estimation.evidence import Evidence
-from sensing_antenna.estimation.fast import FastMethod
-from sensing_antenna.estimation.fusion import PaperMethod
+from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.methods.baselines import RatioMethod, TwoFrequencyMethod
+from sensing_antenna.estimation.methods.fast.method import FastMethod
+from sensing_antenna.estimation.methods.paper.fusion import PaperMethod
 from sensing_antenna.estimation.result import ContactEstimate
 
 __all__ = ["METHODS", "EstimationMethod", "UnknownMethodError", "resolve_method"]

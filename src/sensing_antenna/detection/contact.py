@@ -46,13 +46,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.filters import (
+from sensing_antenna.detection.filters import (
     FirstOrderLowPass,
     FreeMotionObserverFilter,
     low_pass,
     observe_free_motion,
 )
+from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
 
 __all__ = [

@@ -53,15 +53,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.contact import (
+from sensing_antenna.detection.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
     ContactDetection,
     ContactDetector,
     SampleVector,
     detect_contact,
 )
-from sensing_antenna.estimation.filters import PAPER_LOW_PASS_CUTOFF, FirstOrderLowPass, low_pass
+from sensing_antenna.detection.filters import PAPER_LOW_PASS_CUTOFF, FirstOrderLowPass, low_pass
+from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
 
 __all__ = [
@@ -246,7 +246,7 @@ def detect_push(
     criterion : PushCriterion, optional
         Default ``PushCriterion()`` (``DEFAULT_ROTATION`` of rotation).
     threshold, residual_cutoff
-        Passed to :func:`~sensing_antenna.estimation.contact.detect_contact`.
+        Passed to :func:`~sensing_antenna.detection.contact.detect_contact`.
 
     Returns
     -------

@@ -189,7 +189,7 @@ def contact_frame(
         Motor angles over the frame window (rad).
     reaction_m : array, shape (k, 3)
         Reaction of the object on the antenna R = F - F_g^m over the frame window, motor frame
-        (N); see :func:`sensing_antenna.estimation.ratio.contact_loads`.
+        (N); see :func:`sensing_antenna.estimation.front.ratio.contact_loads`.
     link_length : float
         l (m), for the rigid tip P_r = l X^m.
 

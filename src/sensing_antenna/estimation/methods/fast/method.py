@@ -41,23 +41,24 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Link
 from sensing_antenna.beam import contact_to_base_shear, natural_frequencies
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.evidence import Evidence, sensing_curve
-from sensing_antenna.estimation.fusion import predicted_omega2, second_mode_choice
-from sensing_antenna.estimation.likelihood import ContactPosterior, contact_posterior
-from sensing_antenna.estimation.parametric import (
+from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior, contact_posterior
+from sensing_antenna.estimation.methods.fast.parametric import (
     DampedSinusoidFit,
     first_poles,
     select_model,
 )
-from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
-from sensing_antenna.estimation.static_fit import (
+from sensing_antenna.estimation.methods.fast.static_fit import (
     SensorBias,
     StaticRatio,
     contact_channels,
     sensor_bias,
     static_ratio,
 )
-from sensing_antenna.estimation.touch_point import touched_point
+from sensing_antenna.estimation.methods.paper.frequency import evidence_frequency
+from sensing_antenna.estimation.methods.paper.fusion import predicted_omega2, second_mode_choice
+from sensing_antenna.estimation.methods.touch_point import touched_point
+from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 
 __all__ = [
     "CurveTable",
@@ -1451,7 +1452,7 @@ def second_mode_chooser(evidence: Evidence) -> BranchChooser:
         if lobe >= abs(omega2[0] - omega2[1]):
             return None, {"not_asked": f"main lobe +-{lobe:.0f} rad/s spans the candidates"}
         window = dataclasses.replace(evidence, rest_index=start, end_index=end)
-        component = window.measure_frequency().component
+        component = evidence_frequency(window).component
         choice, notes = second_mode_choice(window, component, candidates)
         if choice is None:
             return choice, notes

@@ -16,10 +16,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.estimation.evidence import Evidence, two_frequency_curve
-from sensing_antenna.estimation.frequency import find_peak
-from sensing_antenna.estimation.fusion import conclude
-from sensing_antenna.estimation.ratio import paper_ratio
+from sensing_antenna.estimation.front.evidence import Evidence, two_frequency_curve
+from sensing_antenna.estimation.front.ratio import paper_ratio
+from sensing_antenna.estimation.methods.paper.frequency import (
+    evidence_frequency,
+    evidence_spectrum,
+    find_peak,
+)
+from sensing_antenna.estimation.methods.paper.fusion import conclude
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = ["RatioMethod", "TwoFrequencyMethod"]
@@ -58,7 +62,7 @@ class TwoFrequencyMethod:
         """Measure omega_1 and omega_2 and locate them on the curve."""
         cfg = evidence.config
         link = evidence.antenna.link
-        measurement = evidence.measure_frequency()
+        measurement = evidence_frequency(evidence)
         problems: list[tuple[Status, str]] = []
         diag: dict[str, Any] = {"torque_component": measurement.component}
         x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
@@ -66,7 +70,7 @@ class TwoFrequencyMethod:
         omega2 = math.nan
         x_c = math.nan
         if measurement.clear and measurement.component in ("y_c", "z_c", "sum"):
-            omega, spectrum = evidence.component_spectrum(measurement.component)
+            omega, spectrum = evidence_spectrum(evidence, measurement.component)
             low = max(float(omegas[:, 1].min()) / (1.0 + cfg.band_margin), 1.3 * measurement.omega1)
             high = float(omegas[:, 1].max()) * (1.0 + cfg.band_margin)
             peak2 = find_peak(omega, spectrum, (low, high))

@@ -46,13 +46,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.estimation.frequency import find_peak, power_spectrum
-from sensing_antenna.estimation.varpro import (
+from sensing_antenna.estimation.methods.fast.varpro import (
     bounded_levenberg_marquardt,
     mode_columns,
     mode_derivatives,
     projected_residual,
 )
+from sensing_antenna.estimation.methods.paper.frequency import find_peak, power_spectrum
 
 __all__ = [
     "DampedSinusoidFit",

@@ -35,8 +35,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.estimation.parametric import DampedSinusoidFit
-from sensing_antenna.estimation.ratio import contact_loads
+from sensing_antenna.estimation.front.ratio import contact_loads
+from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 
 __all__ = [
     "FORCE_CHANNELS",

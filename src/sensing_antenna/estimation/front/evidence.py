@@ -28,18 +28,13 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna, Link
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.contact_frame import (
+from sensing_antenna.estimation.front.contact_frame import (
     ContactFrame,
     contact_frame,
     rest_tolerance,
     signal_noise,
 )
-from sensing_antenna.estimation.frequency import (
-    FrequencyMeasurement,
-    measure_frequency,
-    power_spectrum,
-)
-from sensing_antenna.estimation.ratio import (
+from sensing_antenna.estimation.front.ratio import (
     contact_loads,
     filtered_contact_loads,
     load_offset,
@@ -384,10 +379,10 @@ class Evidence:
         Its causal moving average over ``convergence_window`` from t_1 on (NaN before) (m).
     load_offset : array, shape (6,)
         Sensor offset removed from the loads (N, N m), see
-        :func:`~sensing_antenna.estimation.ratio.load_offset`.
+        :func:`~sensing_antenna.estimation.front.ratio.load_offset`.
     ratio_noise : float
         Expected standard deviation of the ratio from the force noise (m), see
-        :func:`~sensing_antenna.estimation.ratio.ratio_noise`.
+        :func:`~sensing_antenna.estimation.front.ratio.ratio_noise`.
     band : tuple of float
         omega_1 search band (rad/s).
     hold_end : int
@@ -432,36 +427,6 @@ class Evidence:
         """Samples of the Delta t_e1 window after t_1 (shortened if the samples end first)."""
         n_window = round(self.config.spectrum_window / self.sample_period)
         return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
-
-    def measure_frequency(self) -> FrequencyMeasurement:
-        """Estimator 1's spectral measurement over Delta t_e1 after t_1."""
-        window = self.spectrum_slice
-        return measure_frequency(
-            self.torque[window],
-            self.frame.axes_m,
-            self.sample_period,
-            self.band,
-            self.config.min_peak_quality,
-            self.config.zero_padding,
-            t_start=float(self.t[window.start]),
-        )
-
-    def component_spectrum(self, component: str) -> tuple[FloatArray, FloatArray]:
-        """Power spectrum of the torque about Y^c (``"y_c"``), Z^c (``"z_c"``) or their sum.
-
-        Over the Delta t_e1 window, as Estimator 1 computes it.
-
-        Returns
-        -------
-        omega : array, shape (m,)
-            Angular frequencies (rad/s).
-        power : array, shape (m,)
-        """
-        window = self.spectrum_slice
-        projected = self.torque[window] @ self.frame.axes_m[1:].T
-        omega, power = power_spectrum(projected, self.sample_period, self.config.zero_padding)
-        spectra = {"y_c": power[:, 0], "z_c": power[:, 1]}
-        return omega, spectra.get(component, power.sum(axis=1))
 
     def ratio_uncertainty(self, x_c: float) -> float:
         """Standard uncertainty (m) of the ratio estimate at a contact point ``x_c``.

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Link
-from sensing_antenna.estimation.contact_frame import ContactFrame
+from sensing_antenna.estimation.front.contact_frame import ContactFrame
 
 __all__ = ["TouchPoint", "touched_point"]
 

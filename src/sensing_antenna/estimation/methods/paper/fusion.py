@@ -20,10 +20,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.estimation.evidence import Evidence, sensing_curve, two_frequency_curve
-from sensing_antenna.estimation.frequency import find_peak
+from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve, two_frequency_curve
+from sensing_antenna.estimation.methods.paper.frequency import (
+    evidence_frequency,
+    evidence_spectrum,
+    find_peak,
+)
+from sensing_antenna.estimation.methods.touch_point import touched_point
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
-from sensing_antenna.estimation.touch_point import touched_point
 
 __all__ = [
     "Evidence",
@@ -280,7 +284,7 @@ def second_mode_choice(
     and the peak's frequency (rad/s, NaN without a peak).
     """
     cfg = evidence.config
-    omega, spectrum = evidence.component_spectrum(component)
+    omega, spectrum = evidence_spectrum(evidence, component)
     predicted = predicted_omega2(evidence, candidates)
     low = min(predicted) / (1.0 + 2.0 * cfg.omega2_window)
     high = max(predicted) * (1.0 + 2.0 * cfg.omega2_window)
@@ -313,7 +317,7 @@ class PaperMethod:
         """Fuse the frequency candidates with the ratio at t_e."""
         cfg = evidence.config
         link = evidence.antenna.link
-        measurement = evidence.measure_frequency()
+        measurement = evidence_frequency(evidence)
         ratio_estimate = float(evidence.ratio_mean[evidence.end_index])
         problems: list[tuple[Status, str]] = []
         diag: dict[str, Any] = {
