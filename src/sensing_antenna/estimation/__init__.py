@@ -15,11 +15,13 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from sensing_antenna.estimation.config import EstimatorConfig
+    from sensing_antenna.estimation.front.evidence import Evidence
     from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
     from sensing_antenna.estimation.pipeline import (
         METHODS,
         OnlineEstimator,
         estimate,
+        gather,
         measure_omega1,
     )
     from sensing_antenna.estimation.result import ContactEstimate, Status
@@ -28,10 +30,12 @@ __all__ = [
     "METHODS",
     "ContactEstimate",
     "EstimatorConfig",
+    "Evidence",
     "FrequencyMeasurement",
     "OnlineEstimator",
     "Status",
     "estimate",
+    "gather",
     "measure_omega1",
 ]
 
@@ -39,11 +43,13 @@ _WHERE = {
     "METHODS": "pipeline",
     "OnlineEstimator": "pipeline",
     "estimate": "pipeline",
+    "gather": "pipeline",
     "measure_omega1": "pipeline",
     "ContactEstimate": "result",
     "Status": "result",
     "EstimatorConfig": "config",
-    "FrequencyMeasurement": "frequency",
+    "Evidence": "front.evidence",
+    "FrequencyMeasurement": "methods.paper.frequency",
 }
 
 

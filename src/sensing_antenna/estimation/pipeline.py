@@ -63,6 +63,7 @@ __all__ = [
     "OnlineEstimator",
     "UnknownMethodError",
     "estimate",
+    "gather",
     "gather_evidence",
     "measure_omega1",
     "search_band",
@@ -237,6 +238,10 @@ def gather_evidence(
     result = estimate(recording, antenna, _EvidenceOnly(), config)
     evidence = result.diagnostics.get("evidence")
     return evidence if isinstance(evidence, Evidence) else result
+
+
+#: The front end alone: the evidence at t_e, or the early result.
+gather = gather_evidence
 
 
 @dataclasses.dataclass(frozen=True)
