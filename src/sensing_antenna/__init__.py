@@ -11,9 +11,28 @@ Subpackages and modules, one concept each:
 - :mod:`sensing_antenna.campaign`: declarative experiment campaigns and their reports.
 - :mod:`sensing_antenna.plotting`: every figure, kept apart from computation.
 - :mod:`sensing_antenna.cli`: the ``antenna`` command; parses arguments and calls the library.
+
+The names below are imported on first use, so that importing one light module (the command
+line, :mod:`sensing_antenna.errors`) does not load NumPy.
 """
 
-from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
 
 __all__ = ["Antenna", "load_antenna", "paper_antenna"]
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str) -> Any:
+    if name not in __all__:
+        raise AttributeError(f"module 'sensing_antenna' has no attribute {name!r}")
+    return getattr(importlib.import_module("sensing_antenna.antenna"), name)
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

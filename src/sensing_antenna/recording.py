@@ -1,4 +1,4 @@
-"""Recordings: the CSV format of ``shared/spec/recording-format.md`` (version 1).
+"""Recordings: the CSV format of ``docs/recording-format.md`` (version 1).
 
 A recording holds the two motor angles and the six force/torque components at the base of the link,
 one row per sample, plus ``# key: value`` metadata lines before the header. Forces and torques are
@@ -448,7 +448,7 @@ def _locate_bad_cell(
 
 
 def read_recording(path: str | Path) -> Recording:
-    """Read a recording file (spec: ``shared/spec/recording-format.md``).
+    """Read a recording file (format: ``docs/recording-format.md``).
 
     Parameters
     ----------

@@ -16,9 +16,6 @@ import math
 import sys
 from typing import Any
 
-from sensing_antenna.antenna import load_antenna
-from sensing_antenna.beam import BeamInputError, SensingCurve, natural_frequencies
-
 #: Exit code when the frequency has no consistent contact point.
 EXIT_OUT_OF_RANGE = 1
 
@@ -45,6 +42,8 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Execute the command for parsed ``args``; returns the exit code."""
+    from sensing_antenna.antenna import load_antenna
+
     antenna = load_antenna(args.antenna)
     if args.xc is not None:
         return _frequencies(antenna.name, antenna.link, args.xc, args.modes, args.json)
@@ -57,6 +56,8 @@ MAX_MODES = 50
 
 
 def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bool) -> int:
+    from sensing_antenna.beam import BeamInputError, natural_frequencies
+
     if not 1 <= modes <= MAX_MODES:
         raise BeamInputError("--modes", f"must be an integer from 1 to {MAX_MODES}, got {modes}")
     omega = natural_frequencies(link, x_c, modes)
@@ -77,6 +78,8 @@ def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bo
 
 
 def _contact_points(link: Any, omega1: float, as_json: bool) -> int:
+    from sensing_antenna.beam import BeamInputError, SensingCurve
+
     if not (math.isfinite(omega1) and omega1 > 0):
         raise BeamInputError("--omega1", f"must be a finite frequency > 0 rad/s, got {omega1}")
     curve = SensingCurve.from_link(link)

@@ -8,18 +8,22 @@ import math
 from pathlib import Path
 from typing import Any
 
+#: The names of :data:`sensing_antenna.estimation.METHODS`, in the order ``--help`` lists them.
+#: Written out so that parsing arguments does not import the estimators (``antenna estimate
+#: --help`` and an argument error answer at once); ``tests/test_cli_estimate.py`` checks that
+#: they are the registry's names.
+METHOD_NAMES = ("fast", "paper", "ratio", "two-frequency")
+
 
 def register(subparsers: Any) -> None:
     """Add ``antenna estimate``."""
-    from sensing_antenna.estimation.pipeline import METHODS
-
     parser = subparsers.add_parser(
         "estimate", help="estimate the contact point of a recording (CSV)"
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
     parser.add_argument(
         "--method",
-        choices=sorted(METHODS),
+        choices=METHOD_NAMES,
         default="paper",
         help="paper (Section 4, default), fast (short record, stops when sure), or a baseline",
     )

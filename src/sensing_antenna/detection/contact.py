@@ -7,7 +7,7 @@ r^m = Gamma^m - (Gamma_e^m + Gamma_g^m), stays small in free motion and grows at
 first sample where the norm of the low-pass filtered residual exceeds a threshold.
 
 Signs (re-derived; the paper's are opposite). Recordings hold the torque exerted BY the link ON the
-head (``shared/spec/recording-format.md``). At low frequency Eq. 15 reduces to
+head (``docs/recording-format.md``). At low frequency Eq. 15 reduces to
 (K / omega^2) theta_ddot, the inertial torque of a rigid link (K / omega^2 ~ m_b l^2 / 3).
 Turning the head with angular acceleration alpha about an axis u needs a torque J alpha u on the
 link, so the link exerts -J alpha u on the head. The azimuth turns about Z^a (= Z^m when
