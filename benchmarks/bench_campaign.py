@@ -23,10 +23,11 @@ import tempfile
 import time
 from pathlib import Path
 
+from sensing_antenna.campaign.parsing import load_campaign_spec
 from sensing_antenna.campaign.report import build_report
 from sensing_antenna.campaign.runner import run_campaign
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.simulated import prepare_campaign
-from sensing_antenna.campaign.spec import CampaignSpec, load_campaign_spec
 from sensing_antenna.campaign.store import Preparation, load_run_results
 
 #: The target of the task: the default campaign in under 60 s on 2 cores.

@@ -18,14 +18,12 @@ import pytest
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.campaign.runner import run_campaign
-from sensing_antenna.campaign.spec import (
-    CALIBRATION_STREAM,
+from sensing_antenna.campaign.runs import CALIBRATION_STREAM, derive_seed, expand_runs
+from sensing_antenna.campaign.schema import (
     CalibrationStep,
     CampaignSpec,
     DeviceSpec,
     FreeMotionStep,
-    derive_seed,
-    expand_runs,
 )
 from sensing_antenna.campaign.store import (
     CALIBRATION_FILE,
@@ -168,7 +166,7 @@ def test_a_stale_calibration_is_redone(calibrated: Path, tmp_path: Path) -> None
 
 
 def test_calibration_seeds_have_their_own_stream() -> None:
-    from sensing_antenna.campaign.simulated import calibration_runs
+    from sensing_antenna.campaign.runs import calibration_runs
 
     spec = device_spec(True)
     seeds = [seed for _, _, seed in calibration_runs(spec)]
@@ -239,7 +237,7 @@ def test_a_failed_calibration_stops_the_campaign_with_one_error(
     import dataclasses
 
     from sensing_antenna.calibration import frequency
-    from sensing_antenna.campaign.spec import CampaignSpecError
+    from sensing_antenna.campaign.schema import CampaignSpecError
 
     def no_peaks(*args: object, **kwargs: object) -> FrequencyCalibration:
         raise frequency.CalibrationError("omega1: need at least 2 measured frequencies, got 0")

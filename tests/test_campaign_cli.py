@@ -10,7 +10,8 @@ import pytest
 from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign.records import MethodOutcome, RunResult
 from sensing_antenna.campaign.runner import run_campaign
-from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
+from sensing_antenna.campaign.runs import RunSpec
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.cli import main
 from sensing_antenna.recording import Recording, write_recording
 

@@ -18,7 +18,8 @@ from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign.records import MethodOutcome, RunResult, float_or_nan
 from sensing_antenna.campaign.report import build_report
 from sensing_antenna.campaign.runner import run_campaign
-from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
+from sensing_antenna.campaign.runs import RunSpec
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.tables import (
     campaign_rows,
     interval_summaries,
@@ -351,7 +352,7 @@ def _sweep_run(run: RunSpec) -> RunResult:
 
 
 def test_report_with_a_noise_sweep_and_fast_has_its_sections_and_figures(tmp_path: Path) -> None:
-    from sensing_antenna.campaign.spec import NoiseSweep
+    from sensing_antenna.campaign.schema import NoiseSweep
 
     swept = CampaignSpec(
         name="toy-sweep",

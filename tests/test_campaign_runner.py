@@ -21,7 +21,8 @@ from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign.dask_plugin import OneBlasThreadPerDaskWorker
 from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, MethodOutcome, RunResult
 from sensing_antenna.campaign.runner import CampaignOutcome, execute_safely, run_campaign
-from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
+from sensing_antenna.campaign.runs import RunSpec
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import CampaignStoreError, load_run_results
 
 #: Columns that depend on wall-clock time and may differ between identical campaigns.
@@ -207,7 +208,7 @@ def test_failed_runs_are_kept_on_resume_and_redone_when_asked(tmp_path: Path) ->
 
 def test_execute_safely_turns_an_exception_into_a_failed_result() -> None:
     run = small_spec().contact_points  # noqa: F841 - the spec is valid
-    from sensing_antenna.campaign.spec import expand_runs
+    from sensing_antenna.campaign.runs import expand_runs
 
     spec_run = expand_runs(small_spec(), paper_antenna())[2]
     result = execute_safely(failing_at_06, spec_run)

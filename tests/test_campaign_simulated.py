@@ -9,12 +9,8 @@ import pytest
 
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.campaign.records import RUN_OK
-from sensing_antenna.campaign.spec import (
-    CampaignSpec,
-    CampaignSpecError,
-    FreeMotionStep,
-    expand_runs,
-)
+from sensing_antenna.campaign.runs import expand_runs
+from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError, FreeMotionStep
 
 
 def one_point_spec(**changes: object) -> CampaignSpec:

@@ -12,7 +12,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from sensing_antenna.campaign.spec import RunSpec
+from sensing_antenna.campaign.runs import RunSpec
 
 __all__ = [
     "CSV_COLUMNS",
@@ -234,7 +234,7 @@ class RunResult:
     Parameters
     ----------
     run_id, index, case, contact_point, repeat, seed
-        Copied from the :class:`~sensing_antenna.campaign.spec.RunSpec` (SI units).
+        Copied from the :class:`~sensing_antenna.campaign.runs.RunSpec` (SI units).
     status : str
         :data:`RUN_OK` or :data:`RUN_FAILED`.
     error : str

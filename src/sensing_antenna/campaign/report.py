@@ -17,7 +17,7 @@ from typing import Any
 from sensing_antenna.antenna import Antenna, load_antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.campaign.records import RUN_FAILED, RunResult, float_or_nan
-from sensing_antenna.campaign.spec import CampaignSpec
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import (
     CALIBRATION_FILE,
     CSV_FILE,

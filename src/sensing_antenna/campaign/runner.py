@@ -23,7 +23,8 @@ from tqdm import tqdm
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.records import RUN_FAILED, RunResult
-from sensing_antenna.campaign.spec import CampaignSpec, RunSpec, expand_runs
+from sensing_antenna.campaign.runs import RunSpec, expand_runs
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import (
     CSV_FILE,
     Preparation,

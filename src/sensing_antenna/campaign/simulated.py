@@ -21,19 +21,17 @@ from typing import Any
 from sensing_antenna.antenna import Antenna, FreeMotionObserver
 from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.campaign.records import METHOD_ERROR, MethodOutcome, RunResult, float_or_nan
-from sensing_antenna.campaign.spec import (
-    CALIBRATION_STREAM,
+from sensing_antenna.campaign.runs import (
     FREE_MOTION_STREAM,
-    CampaignSpec,
-    CampaignSpecError,
     RunSpec,
+    calibration_runs,
     derive_seed,
 )
+from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
 
 __all__ = [
     "calibrate_on_device",
-    "calibration_runs",
     "check_scenario",
     "identify_observer",
     "make_scenario",
@@ -122,22 +120,6 @@ def identify_observer(
     recording = simulate(device, scenario)
     fit = identify_free_motion(recording.without_ground_truth(), model or device)
     return fit.observer
-
-
-def calibration_runs(spec: CampaignSpec) -> list[tuple[str, float, int]]:
-    """(name, contact point in m, seed) of each calibration recording, in a fixed order.
-
-    Seeds come from stream 2 of the base seed (:data:`~.spec.CALIBRATION_STREAM`), so they never
-    coincide with the runs' (stream 0) or the free motion's (stream 1).
-    """
-    step = spec.calibration
-    runs: list[tuple[str, float, int]] = []
-    for x_c in step.contact_points:
-        for repeat in range(1, step.repeats + 1):
-            index = len(runs)
-            name = f"calibration-{step.case}-x{round(x_c * 1000):04d}mm-r{repeat}"
-            runs.append((name, float(x_c), derive_seed(spec.base_seed, index, CALIBRATION_STREAM)))
-    return runs
 
 
 def calibrate_on_device(

@@ -31,8 +31,9 @@ from typing import Any
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
+from sensing_antenna.campaign.parsing import parse_campaign_spec
 from sensing_antenna.campaign.records import CSV_COLUMNS, RunResult, result_rows
-from sensing_antenna.campaign.spec import CampaignSpec, parse_campaign_spec
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [
