@@ -20,7 +20,7 @@ from typing import Any
 
 from sensing_antenna.antenna import Antenna, FreeMotionObserver
 from sensing_antenna.calibration.frequency import FrequencyCalibration
-from sensing_antenna.campaign.records import METHOD_ERROR, MethodOutcome, RunResult, float_or_nan
+from sensing_antenna.campaign.records import CampaignRow, RunResult, float_or_nan
 from sensing_antenna.campaign.runs import (
     FREE_MOTION_STREAM,
     RunSpec,
@@ -72,27 +72,26 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     recording = simulate(run.simulated_antenna, scenario)
     simulate_s = time.perf_counter() - start
     # The estimators get the recording without ground truth (recording format: they must never
-    # read it); the run result keeps the nominal contact point from the run spec and the contact
+    # read it); the rows keep the nominal contact point from the run spec and the contact
     # abscissa the simulator reports (where the link touched at the last in-contact sample).
-    contact_abscissa = _true_contact_abscissa(recording.metadata)
+    truth = {
+        "contact_abscissa": _true_contact_abscissa(recording.metadata),
+        "simulate_s": simulate_s,
+    }
     blind = recording.without_ground_truth()
-    outcomes = []
+    rows = []
     for method in run.methods:
         begin = time.perf_counter()
         try:
             result = estimate(blind, run.antenna, method=method)
         except Exception as exc:  # recorded per method: one broken estimator must not hide others
-            outcomes.append(
-                MethodOutcome(
-                    method=method,
-                    status=METHOD_ERROR,
-                    reason=f"{type(exc).__name__}: {exc}",
-                    elapsed_s=time.perf_counter() - begin,
-                )
-            )
+            elapsed = time.perf_counter() - begin
+            reason = f"{type(exc).__name__}: {exc}"
+            rows.append(CampaignRow.of_error(run, method, reason, **truth, estimate_s=elapsed))
             continue
-        outcomes.append(MethodOutcome.from_estimate(method, result, time.perf_counter() - begin))
-    return RunResult.for_run(run, outcomes, simulate_s, contact_abscissa)
+        elapsed = time.perf_counter() - begin
+        rows.append(CampaignRow.of_estimate(run, result, **truth, estimate_s=elapsed))
+    return RunResult(rows=tuple(rows))
 
 
 def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:
