@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.campaign.records import RUN_OK, CampaignRow
-from sensing_antenna.campaign.runs import expand_runs
+from sensing_antenna.campaign.runs import RunSpec, expand_runs
 from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError, FreeMotionStep
 
 
@@ -52,10 +53,11 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
     turn = float(recording.metadata["true_deflection_ratio"])
     slide = run.contact_point * turn**2 / 2 + scenario.obstacle_radius * turn / 2
     assert run.contact_point - contact == pytest.approx(slide, rel=0.1)
-    # each method's row holds what ``estimate`` gives on the recording without ground truth
+    # the front end ran once for all methods; each method's estimate is what ``estimate`` gives
     blind = recording.without_ground_truth()
     for row in result.rows:
         assert row.noise_scale == 1.0 and row.x_c_contact_m == contact
+        assert 0 < row.front_end_s <= row.estimate_s
         assert row == CampaignRow.of_estimate(
             run,
             estimate(blind, antenna, method=row.method),
@@ -64,6 +66,32 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
             front_end_s=row.front_end_s,
             estimate_s=row.estimate_s,
         )
+
+
+def test_a_run_the_front_end_stops_early_and_a_method_that_raises_are_recorded() -> None:
+    from sensing_antenna.campaign.simulated import simulate_and_estimate
+
+    # 0.5 s of recording ends before the contact (about 0.75 s into the default manoeuvre): the
+    # front end stops at no contact and every method reports it; an unknown method raises
+    run = RunSpec(
+        0,
+        "short",
+        "azimuthal",
+        0.5,
+        1,
+        3,
+        paper_antenna(),
+        ("paper", "bogus", "fast"),
+        {"duration": 0.5},
+    )
+    paper, bogus, fast = simulate_and_estimate(run).rows
+    assert [(r.method, r.status) for r in (paper, fast)] == [
+        ("paper", "no_contact"),
+        ("fast", "no_contact"),
+    ]
+    assert paper.reason == fast.reason != ""
+    assert (bogus.status, bogus.reason) == ("error", "KeyError: 'bogus'")
+    assert math.isnan(bogus.x_c_estimate_m) and bogus.run_status == RUN_OK
 
 
 def test_a_bad_scenario_field_stops_the_campaign_with_one_error(tmp_path: Path) -> None:
