@@ -58,9 +58,20 @@ class PointTable:
     method: str
     points: tuple[PointStats, ...]
 
-    def column(self, name: str) -> NDArray[np.float64]:
-        """One statistic over the points, shape (n_points,), e.g. ``column("mean_abs_error")``."""
-        return np.array([getattr(p, name) for p in self.points], dtype=float)
+    @property
+    def x_c(self) -> NDArray[np.float64]:
+        """Contact points (m), shape (n_points,)."""
+        return np.array([p.x_c for p in self.points], dtype=float)
+
+    @property
+    def mean_abs_error(self) -> NDArray[np.float64]:
+        """Mean absolute error at each point (m), shape (n_points,)."""
+        return np.array([p.mean_abs_error for p in self.points], dtype=float)
+
+    @property
+    def max_error(self) -> NDArray[np.float64]:
+        """Maximum absolute error at each point (m), shape (n_points,)."""
+        return np.array([p.max_error for p in self.points], dtype=float)
 
 
 @dataclass(frozen=True, eq=False)

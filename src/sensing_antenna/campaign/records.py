@@ -196,7 +196,7 @@ class CampaignRow:
         return cls(
             **_run_fields(run, RUN_OK, contact_abscissa, simulate_s, front_end_s),
             method=estimate.method,
-            status=str(getattr(estimate.status, "value", estimate.status)),
+            status=estimate.status.value,
             reason=estimate.reason or "",
             x_c_estimate_m=estimate.x_c,
             omega1_rad_s=estimate.omega1,

@@ -77,8 +77,8 @@ def plot_case_estimates(points: RunPoints, paper: PointTable | None, out_dir: st
     ax_b.plot(x * _CM, np.abs(estimate - x) * _CM, "o", ms=4, mfc="none", label="this campaign")
     if paper is not None and paper.points:
         ax_b.plot(
-            paper.column("x_c") * _CM,
-            paper.column("max_error") * _CM,
+            paper.x_c * _CM,
+            paper.max_error * _CM,
             "k_",
             ms=12,
             label="paper: max error",
@@ -155,18 +155,18 @@ def plot_method_errors(
         for table in (t for t in tables if t.case == case):
             style = _style(table.method)
             ax.plot(
-                table.column("x_c") * _CM,
+                table.x_c * _CM,
                 # errors below the display floor (e.g. an estimate that lands on a grid point of
                 # the truth) are drawn on the floor, not as a dive to 1e-14 cm
-                np.maximum(table.column("mean_abs_error") * _CM, _ERROR_FLOOR_CM),
+                np.maximum(table.mean_abs_error * _CM, _ERROR_FLOOR_CM),
                 marker=style["marker"],
                 color=style["color"],
                 label=table.method,
             )
         for reference in (t for t in paper if t.case == case and t.points):
             ax.plot(
-                reference.column("x_c") * _CM,
-                reference.column("mean_abs_error") * _CM,
+                reference.x_c * _CM,
+                reference.mean_abs_error * _CM,
                 "k--",
                 lw=1,
                 label="paper (real device)",
