@@ -97,8 +97,10 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
         begin = time.perf_counter()
         try:
             conclude = METHODS[method].conclude
-            if isinstance(evidence, ContactEstimate):  # the front end stopped early: no
-                estimate = dataclasses.replace(evidence, method=method)  # contact, no push...
+            if isinstance(evidence, ContactEstimate):
+                # the front end stopped early (no contact, no push, bad input): that result is
+                # every method's, under its own name
+                estimate = dataclasses.replace(evidence, method=method)
             else:
                 estimate = conclude(evidence)
         except Exception as exc:  # recorded per method: one broken estimator must not hide others
