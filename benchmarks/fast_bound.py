@@ -61,8 +61,8 @@ import numpy as np
 from eval_fast import GRID, QUICK_GRID
 from fast_settings import add_fast_arguments, fast_settings
 from sensing_antenna.antenna import Antenna, Link, paper_antenna
+from sensing_antenna.campaign.parsing import load_campaign_spec
 from sensing_antenna.campaign.simulated import make_scenario, prepare_campaign
-from sensing_antenna.campaign.spec import load_campaign_spec
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
 from sensing_antenna.estimation.methods.fast.method import (

@@ -17,15 +17,14 @@ import pytest
 
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
+from sensing_antenna.campaign.records import CampaignRow
 from sensing_antenna.campaign.runner import run_campaign
-from sensing_antenna.campaign.spec import (
-    CALIBRATION_STREAM,
+from sensing_antenna.campaign.runs import CALIBRATION_STREAM, derive_seed, expand_runs
+from sensing_antenna.campaign.schema import (
     CalibrationStep,
     CampaignSpec,
     DeviceSpec,
     FreeMotionStep,
-    derive_seed,
-    expand_runs,
 )
 from sensing_antenna.campaign.store import (
     CALIBRATION_FILE,
@@ -83,9 +82,13 @@ def uncalibrated(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+def paper_rows(out: Path) -> list[CampaignRow]:
+    results = sorted(load_run_results(out, ("paper",)).values(), key=lambda r: r.index)
+    return [r.rows[0] for r in results]
+
+
 def paper_errors(out: Path) -> np.ndarray:
-    results = sorted(load_run_results(out).values(), key=lambda r: r.index)
-    return np.array([r.methods[0].x_c - r.contact_point for r in results])
+    return np.array([row.error_m for row in paper_rows(out)])
 
 
 def test_the_test_device_really_differs_from_the_model() -> None:
@@ -168,7 +171,7 @@ def test_a_stale_calibration_is_redone(calibrated: Path, tmp_path: Path) -> None
 
 
 def test_calibration_seeds_have_their_own_stream() -> None:
-    from sensing_antenna.campaign.simulated import calibration_runs
+    from sensing_antenna.campaign.runs import calibration_runs
 
     spec = device_spec(True)
     seeds = [seed for _, _, seed in calibration_runs(spec)]
@@ -194,13 +197,12 @@ def test_calibration_makes_the_paper_method_much_better(
     # with T_e the error is a fraction of that (measured about 0.1 cm); a clear ratio of 5
     assert without.mean() > 5 * with_cal.mean()
     # same recordings: the seeds and the device are the same in both campaigns
-    a = load_run_results(calibrated)
-    b = load_run_results(uncalibrated)
-    assert {k: v.seed for k, v in a.items()} == {k: v.seed for k, v in b.items()}
+    a, b = paper_rows(calibrated), paper_rows(uncalibrated)
+    assert [r.seed for r in a] == [r.seed for r in b]
     assert all(
-        math.isclose(a[k].methods[0].omega1, b[k].methods[0].omega1, rel_tol=0.02)
-        for k in a
-        if math.isfinite(a[k].methods[0].omega1)
+        math.isclose(x.omega1_rad_s, y.omega1_rad_s, rel_tol=0.02)
+        for x, y in zip(a, b, strict=True)
+        if math.isfinite(x.omega1_rad_s)
     )
 
 
@@ -239,7 +241,7 @@ def test_a_failed_calibration_stops_the_campaign_with_one_error(
     import dataclasses
 
     from sensing_antenna.calibration import frequency
-    from sensing_antenna.campaign.spec import CampaignSpecError
+    from sensing_antenna.campaign.schema import CampaignSpecError
 
     def no_peaks(*args: object, **kwargs: object) -> FrequencyCalibration:
         raise frequency.CalibrationError("omega1: need at least 2 measured frequencies, got 0")

@@ -8,20 +8,30 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import Antenna, paper_antenna
-from sensing_antenna.campaign.records import MethodOutcome, RunResult
+from sensing_antenna.campaign.records import CampaignRow, RunResult
 from sensing_antenna.campaign.runner import run_campaign
-from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
+from sensing_antenna.campaign.runs import RunSpec
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.cli import main
+from sensing_antenna.estimation import ContactEstimate
 from sensing_antenna.recording import Recording, write_recording
 
 
 def toy_run(run: RunSpec) -> RunResult:
     rng = np.random.default_rng(run.seed)
-    outcomes = [
-        MethodOutcome(method=m, status="ok", x_c=run.contact_point + float(rng.normal(0, 0.02)))
+    rows = tuple(
+        CampaignRow.of_estimate(
+            run,
+            ContactEstimate(
+                status="ok",
+                reason=None,
+                method=m,
+                x_c=run.contact_point + float(rng.normal(0, 0.02)),
+            ),
+        )
         for m in run.methods
-    ]
-    return RunResult.for_run(run, outcomes, simulate_s=0.0)
+    )
+    return RunResult(rows=rows)
 
 
 def plain(spec: CampaignSpec) -> Antenna:
@@ -92,7 +102,6 @@ def test_calibrate_without_known_contact_points_fails_cleanly(
 def test_methods_option_replaces_the_spec_methods_and_names_bad_ones(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    from sensing_antenna.cli import main
 
     assert main(["campaign", "run", "--methods", "paper,bogus", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err

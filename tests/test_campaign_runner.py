@@ -19,13 +19,15 @@ from threadpoolctl import threadpool_limits
 
 from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign.dask_plugin import OneBlasThreadPerDaskWorker
-from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, MethodOutcome, RunResult
+from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, CampaignRow, RunResult
 from sensing_antenna.campaign.runner import CampaignOutcome, execute_safely, run_campaign
-from sensing_antenna.campaign.spec import CampaignSpec, RunSpec
+from sensing_antenna.campaign.runs import RunSpec, expand_runs
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import CampaignStoreError, load_run_results
+from sensing_antenna.estimation import ContactEstimate
 
 #: Columns that depend on wall-clock time and may differ between identical campaigns.
-TIMING_COLUMNS = ("simulate_s", "estimate_s")
+TIMING_COLUMNS = ("simulate_s", "estimate_s", "front_end_s")
 
 
 def small_spec(**changes: object) -> CampaignSpec:
@@ -45,16 +47,21 @@ def small_spec(**changes: object) -> CampaignSpec:
 def noisy_run(run: RunSpec) -> RunResult:
     """Deterministic toy run: each method estimates x_c with seeded Gaussian noise (1 cm)."""
     rng = np.random.default_rng(run.seed)
-    outcomes = [
-        MethodOutcome(
-            method=m,
-            status="ok",
-            x_c=run.contact_point + float(rng.normal(0.0, 0.01)),
-            elapsed_s=0.0,
+    rows = tuple(
+        CampaignRow.of_estimate(
+            run,
+            ContactEstimate(
+                status="ok",
+                reason=None,
+                method=m,
+                x_c=run.contact_point + float(rng.normal(0.0, 0.01)),
+            ),
+            simulate_s=0.0,
+            estimate_s=0.0,
         )
         for m in run.methods
-    ]
-    return RunResult.for_run(run, outcomes, simulate_s=0.0)
+    )
+    return RunResult(rows=rows)
 
 
 def failing_at_06(run: RunSpec) -> RunResult:
@@ -169,9 +176,9 @@ def test_a_failing_run_is_recorded_and_the_others_finish(tmp_path: Path) -> None
     )
     # 2 cases x 2 repeats at 0.6 m fail; the other 8 runs succeed
     assert (outcome.n_executed, outcome.n_failed) == (12, 4)
-    results = load_run_results(tmp_path)
+    results = load_run_results(tmp_path, spec.methods)
     failed = [r for r in results.values() if r.status == RUN_FAILED]
-    assert {r.contact_point for r in failed} == {0.6}
+    assert {r.rows[0].x_c_true_m for r in failed} == {0.6}
     assert all("RuntimeError: simulator diverged" in r.error for r in failed)
     assert all("Traceback" in r.detail for r in failed)
     assert sum(r.status == RUN_OK for r in results.values()) == 8
@@ -206,13 +213,22 @@ def test_failed_runs_are_kept_on_resume_and_redone_when_asked(tmp_path: Path) ->
 
 
 def test_execute_safely_turns_an_exception_into_a_failed_result() -> None:
-    run = small_spec().contact_points  # noqa: F841 - the spec is valid
-    from sensing_antenna.campaign.spec import expand_runs
-
     spec_run = expand_runs(small_spec(), paper_antenna())[2]
     result = execute_safely(failing_at_06, spec_run)
     assert result.status == RUN_FAILED
     assert result.run_id == spec_run.run_id
+    assert result.methods == spec_run.methods
+
+
+def test_a_result_without_a_row_per_method_is_a_failed_run() -> None:
+    spec_run = expand_runs(small_spec(), paper_antenna())[0]
+
+    def paper_only(run: RunSpec) -> RunResult:
+        return RunResult(rows=noisy_run(run).rows[:1])
+
+    result = execute_safely(paper_only, spec_run)
+    assert result.status == RUN_FAILED
+    assert "('paper',) for methods ('paper', 'ratio')" in result.error
 
 
 def test_a_directory_of_another_spec_is_refused(tmp_path: Path) -> None:
@@ -226,7 +242,7 @@ def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:
     damaged = tmp_path / "runs" / "vertical-x0900mm-r2.json"
     damaged.write_text(json.dumps({"run_id": "vertical-x0900mm-r2"}), encoding="utf-8")
     with pytest.raises(CampaignStoreError, match=r"vertical-x0900mm-r2\.json: damaged run file"):
-        load_run_results(tmp_path)
+        load_run_results(tmp_path, small_spec().methods)
 
 
 def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:

@@ -8,13 +8,9 @@ from pathlib import Path
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
-from sensing_antenna.campaign.records import RUN_OK
-from sensing_antenna.campaign.spec import (
-    CampaignSpec,
-    CampaignSpecError,
-    FreeMotionStep,
-    expand_runs,
-)
+from sensing_antenna.campaign.records import RUN_OK, CampaignRow
+from sensing_antenna.campaign.runs import RunSpec, expand_runs
+from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError, FreeMotionStep
 
 
 def one_point_spec(**changes: object) -> CampaignSpec:
@@ -37,15 +33,18 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
     from sensing_antenna.simulator import simulate
 
     antenna = paper_antenna()
-    run = expand_runs(one_point_spec(), antenna)[0]
+    run = expand_runs(one_point_spec(methods=("paper", "ratio", "two-frequency", "fast")), antenna)[
+        0
+    ]
     result = simulate_and_estimate(run)
     assert result.status == RUN_OK
-    assert [m.method for m in result.methods] == ["paper", "ratio", "two-frequency"]
+    assert result.methods == ("paper", "ratio", "two-frequency", "fast")
     # the same seed gives the same recording; the estimators see it without ground truth
     scenario = make_scenario(run.case, run.contact_point, run.seed, {})
     recording = simulate(antenna, scenario)
     # the contact abscissa is the recording's ground truth, kept beside the nominal x_c
-    assert result.contact_abscissa == float(recording.metadata["true_xc"])
+    contact = result.rows[0].x_c_contact_m
+    assert contact == float(recording.metadata["true_xc"])
     # Pushed on until y_c = d x_c, the base has turned by about d: the fixed obstacle, x_c from
     # the base, sits x_c cos d ~ x_c (1 - d^2 / 2) along the turned link, and the bent link
     # (slope d - 3 d / 2 at x_c, cantilever under an end load) touches the cylinder R d / 2
@@ -53,15 +52,46 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
     # bend and the sag, left out, moved it by under 4 % from 0.3 to 0.9 m: 10 %.
     turn = float(recording.metadata["true_deflection_ratio"])
     slide = run.contact_point * turn**2 / 2 + scenario.obstacle_radius * turn / 2
-    assert run.contact_point - result.contact_abscissa == pytest.approx(slide, rel=0.1)
-    assert result.noise_scale == 1.0
-    for outcome in result.methods:
-        direct = estimate(recording.without_ground_truth(), antenna, method=outcome.method)
-        assert outcome.status == str(direct.status)
-        assert (math.isnan(direct.x_c) and math.isnan(outcome.x_c)) or outcome.x_c == direct.x_c
-        assert (math.isnan(direct.omega1) and math.isnan(outcome.omega1)) or (
-            outcome.omega1 == direct.omega1
+    assert run.contact_point - contact == pytest.approx(slide, rel=0.1)
+    # the front end ran once for all methods; each method's estimate is what ``estimate`` gives
+    blind = recording.without_ground_truth()
+    for row in result.rows:
+        assert row.noise_scale == 1.0 and row.x_c_contact_m == contact
+        assert 0 < row.front_end_s <= row.estimate_s
+        assert row == CampaignRow.of_estimate(
+            run,
+            estimate(blind, antenna, method=row.method),
+            contact_abscissa=contact,
+            simulate_s=row.simulate_s,
+            front_end_s=row.front_end_s,
+            estimate_s=row.estimate_s,
         )
+
+
+def test_a_run_the_front_end_stops_early_and_a_method_that_raises_are_recorded() -> None:
+    from sensing_antenna.campaign.simulated import simulate_and_estimate
+
+    # 0.5 s of recording ends before the contact (about 0.75 s into the default manoeuvre): the
+    # front end stops at no contact and every method reports it; an unknown method raises
+    run = RunSpec(
+        0,
+        "short",
+        "azimuthal",
+        0.5,
+        1,
+        3,
+        paper_antenna(),
+        ("paper", "bogus", "fast"),
+        {"duration": 0.5},
+    )
+    paper, bogus, fast = simulate_and_estimate(run).rows
+    assert [(r.method, r.status) for r in (paper, fast)] == [
+        ("paper", "no_contact"),
+        ("fast", "no_contact"),
+    ]
+    assert paper.reason == fast.reason != ""
+    assert (bogus.status, bogus.reason) == ("error", "KeyError: 'bogus'")
+    assert math.isnan(bogus.x_c_estimate_m) and bogus.run_status == RUN_OK
 
 
 def test_a_bad_scenario_field_stops_the_campaign_with_one_error(tmp_path: Path) -> None:

@@ -10,14 +10,9 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
-from sensing_antenna.campaign.spec import (
-    NOISE_SWEEP_STREAM,
-    CampaignSpecError,
-    default_campaign_spec,
-    derive_seed,
-    expand_runs,
-    load_campaign_spec,
-)
+from sensing_antenna.campaign.parsing import default_campaign_spec, load_campaign_spec
+from sensing_antenna.campaign.runs import NOISE_SWEEP_STREAM, derive_seed, expand_runs
+from sensing_antenna.campaign.schema import CampaignSpecError
 from sensing_antenna.errors import SensingAntennaError
 
 GOOD = """
@@ -310,7 +305,7 @@ def test_the_sweep_is_in_the_fingerprint_only_when_present(tmp_path: Path) -> No
     assert plain.preparation_fingerprint() == swept.preparation_fingerprint()
     again = load_campaign_spec(write(tmp_path, SWEEP.replace("2.0]", "4.0]")))
     assert again.fingerprint() != swept.fingerprint()
-    from sensing_antenna.campaign.spec import parse_campaign_spec
+    from sensing_antenna.campaign.parsing import parse_campaign_spec
 
     assert parse_campaign_spec(swept.to_dict(), "copy") == replace(swept, source="copy")
 
@@ -320,7 +315,6 @@ def test_the_sweep_is_in_the_fingerprint_only_when_present(tmp_path: Path) -> No
     [
         ("noise_scales = [0.5, -1.0]", "noise_sweep.noise_scales[1]"),
         ('noise_scales = ["loud"]', "noise_sweep.noise_scales[0]"),
-        ("noise_scales = []", "noise_sweep.noise_scales"),
         ("noise_scales = 2.0", "noise_sweep.noise_scales"),
         ("noise_scales = [2.0, 2.0]", "noise_sweep.noise_scales"),
         ("noise_scales = [2.0, 0.5]", "noise_sweep.noise_scales[1]"),  # the main level
@@ -346,3 +340,95 @@ def test_a_sweep_point_beyond_the_link_is_named(tmp_path: Path) -> None:
     spec = load_campaign_spec(write(tmp_path, text))
     with pytest.raises(CampaignSpecError, match=r"noise_sweep\.contact_points\[1\]: 1.3 m"):
         spec.load_antenna()
+
+
+def test_an_empty_noise_sweep_means_none(tmp_path: Path) -> None:
+    text = GOOD + "[noise_sweep]\nnoise_scales = []\ncontact_points = [0.4]\n"
+    spec = load_campaign_spec(write(tmp_path, text))
+    assert not spec.noise_sweep.enabled and spec.n_sweep_runs == 0
+    assert spec.fingerprint() == load_campaign_spec(write(tmp_path, GOOD)).fingerprint()
+
+
+def test_a_campaign_may_start_from_the_built_in_one(tmp_path: Path) -> None:
+    path = tmp_path / "fewer.toml"
+    path.write_text('base = "default"\nrepeats = 2\n', encoding="utf-8")
+    spec = load_campaign_spec(path)
+    # everything else is the built-in campaign's; named after the file, no inherited text
+    expected = replace(
+        default_campaign_spec(), name="fewer", description="", repeats=2, source=str(path)
+    )
+    assert spec == expected
+    assert spec.n_main_runs == 2 * 15 * 2
+    path.write_text('base = "paper-2021"\nrepeats = 2\n', encoding="utf-8")
+    assert load_campaign_spec(path) == expected
+
+
+def test_a_nested_table_merges_into_the_base_table(tmp_path: Path) -> None:
+    path = tmp_path / "heavier.toml"
+    path.write_text(
+        'base = "default"\nname = "heavier"\n'
+        "[scenario]\ndamping_ratio = 0.01\n"
+        "[device]\nlink.linear_density = 5e-3\n",
+        encoding="utf-8",
+    )
+    spec = load_campaign_spec(path)
+    base = default_campaign_spec()
+    assert spec.scenario == {**base.scenario, "damping_ratio": 0.01}
+    # the base's device (paper-2021 with E = 132.65 GPa) keeps its E and gains a density
+    assert spec.device.antenna == base.device.antenna
+    assert spec.device.overrides == {"link": {"youngs_modulus": 132.65e9, "linear_density": 5e-3}}
+    assert spec.load_device().link.linear_density == 5e-3
+    assert (spec.calibration, spec.noise_sweep) == (base.calibration, base.noise_sweep)
+
+
+def test_a_base_file_is_read_next_to_the_spec_with_its_own_paths(tmp_path: Path) -> None:
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    (shared / "short.toml").write_text(
+        'base = "paper-2021"\nname = "short"\n[link]\nlength = 0.6\n', encoding="utf-8"
+    )
+    (shared / "base.toml").write_text(GOOD.replace('"paper-2021"', '"short.toml"'), "utf-8")
+    own = tmp_path / "mine"
+    own.mkdir()
+    path = own / "variant.toml"
+    path.write_text('base = "../shared/base.toml"\nbase_seed = 9\n', encoding="utf-8")
+    spec = load_campaign_spec(path)
+    # the base's antenna file resolves next to the base, not next to this file
+    assert spec.load_antenna().link.length == 0.6
+    assert (spec.base_seed, spec.repeats, spec.name) == (9, 2, "variant")
+    # dropping the base's noise sweep
+    (shared / "base.toml").write_text(SWEEP, encoding="utf-8")
+    path.write_text(
+        'base = "../shared/base.toml"\n[noise_sweep]\nnoise_scales = []\n', encoding="utf-8"
+    )
+    assert not load_campaign_spec(path).noise_sweep.enabled
+
+
+def test_an_unknown_base_is_one_error_naming_the_file_and_field(tmp_path: Path) -> None:
+    path = write(tmp_path, 'base = "paper-2019"\nrepeats = 2\n')
+    with pytest.raises(CampaignSpecError) as info:
+        load_campaign_spec(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: base: unknown 'paper-2019': not a built-in campaign")
+    assert "\n" not in message
+    path = write(tmp_path, "base = 3\n")
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: base: must name")):
+        load_campaign_spec(path)
+
+
+def test_errors_in_a_base_name_the_base_file_and_cycles_are_refused(tmp_path: Path) -> None:
+    bad = tmp_path / "bad-base.toml"
+    bad.write_text(GOOD.replace("repeats = 2", "repeats = 0"), encoding="utf-8")
+    path = tmp_path / "variant.toml"
+    path.write_text('base = "bad-base.toml"\n', encoding="utf-8")
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{bad}: repeats: must be >= 1")):
+        load_campaign_spec(path)
+    # an override is checked like any field, naming this file
+    path.write_text('base = "default"\nrepeats = 0\n', encoding="utf-8")
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: repeats: must be >= 1")):
+        load_campaign_spec(path)
+    a, b = tmp_path / "a.toml", tmp_path / "b.toml"
+    a.write_text('base = "b.toml"\n', encoding="utf-8")
+    b.write_text('base = "a.toml"\n', encoding="utf-8")
+    with pytest.raises(CampaignSpecError, match=r"b\.toml: base: 'a\.toml' is based on this file"):
+        load_campaign_spec(a)

@@ -23,7 +23,8 @@ from tqdm import tqdm
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.records import RUN_FAILED, RunResult
-from sensing_antenna.campaign.spec import CampaignSpec, RunSpec, expand_runs
+from sensing_antenna.campaign.runs import RunSpec, expand_runs
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import (
     CSV_FILE,
     Preparation,
@@ -81,7 +82,11 @@ class CampaignOutcome:
 
 
 def execute_safely(run_one: RunFunction, run: RunSpec) -> RunResult:
-    """Call ``run_one(run)``; an exception becomes a failed RunResult with its traceback."""
+    """Call ``run_one(run)``; an exception becomes a failed RunResult with its traceback.
+
+    A result for another run, or without one row per method of the run in order, is recorded
+    as a failed run too.
+    """
     try:
         result = run_one(run)
     except Exception as exc:  # a failing run is recorded and must not stop the others
@@ -89,6 +94,10 @@ def execute_safely(run_one: RunFunction, run: RunSpec) -> RunResult:
     if result.run_id != run.run_id:
         return RunResult.failed(
             run, f"run function returned run_id {result.run_id!r} for {run.run_id!r}"
+        )
+    if result.methods != run.methods:
+        return RunResult.failed(
+            run, f"run function returned rows of {result.methods} for methods {run.methods}"
         )
     return result
 
@@ -151,7 +160,7 @@ def run_campaign(
         preparation = prepared if isinstance(prepared, Preparation) else Preparation.same(prepared)
         write_preparation(directory, spec, preparation)
     runs = expand_runs(spec, preparation.model, preparation.device)
-    done = load_run_results(directory)
+    done = load_run_results(directory, spec.methods)
     if retry_failed:
         done = {k: v for k, v in done.items() if v.status != RUN_FAILED}
     pending = [run for run in runs if run.run_id not in done]
@@ -169,8 +178,8 @@ def run_campaign(
             write_run_result(directory, result)
             executed += 1
             bar.update(1)
-    stored = load_run_results(directory)
-    csv_path = write_runs_csv(directory / CSV_FILE, stored.values(), spec.methods)
+    stored = load_run_results(directory, spec.methods)
+    csv_path = write_runs_csv(directory / CSV_FILE, stored.values())
     return CampaignOutcome(
         out_dir=directory,
         csv_path=csv_path,

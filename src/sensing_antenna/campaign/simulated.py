@@ -20,20 +20,18 @@ from typing import Any
 
 from sensing_antenna.antenna import Antenna, FreeMotionObserver
 from sensing_antenna.calibration.frequency import FrequencyCalibration
-from sensing_antenna.campaign.records import METHOD_ERROR, MethodOutcome, RunResult, float_or_nan
-from sensing_antenna.campaign.spec import (
-    CALIBRATION_STREAM,
+from sensing_antenna.campaign.records import CampaignRow, RunResult, float_or_nan
+from sensing_antenna.campaign.runs import (
     FREE_MOTION_STREAM,
-    CampaignSpec,
-    CampaignSpecError,
     RunSpec,
+    calibration_runs,
     derive_seed,
 )
+from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
 
 __all__ = [
     "calibrate_on_device",
-    "calibration_runs",
     "check_scenario",
     "identify_observer",
     "make_scenario",
@@ -62,11 +60,14 @@ def make_scenario(case: str, contact_point: float | None, seed: int, extra: dict
 def simulate_and_estimate(run: RunSpec) -> RunResult:
     """Simulate the run's manoeuvre and estimate the recording with each of ``run.methods``.
 
-    An estimator that raises is recorded for that method (status ``"error"``) and the other
-    methods still run; an exception from the simulator propagates (the runner records the run as
-    failed).
+    The estimation front end runs once on the recording (``estimation.gather``) and every
+    method concludes from its evidence, which gives each method the estimate ``estimate``
+    gives. Timing (wall clock): ``front_end_s`` is the front end's, ``estimate_s`` of a method
+    is that plus its own conclusion. An estimator that raises is recorded for that method
+    (status ``"error"``) and the other methods still run; an exception from the simulator
+    propagates (the runner records the run as failed).
     """
-    from sensing_antenna.estimation import estimate
+    from sensing_antenna.estimation import METHODS, ContactEstimate, gather
     from sensing_antenna.simulator import simulate
 
     start = time.perf_counter()
@@ -74,27 +75,50 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     recording = simulate(run.simulated_antenna, scenario)
     simulate_s = time.perf_counter() - start
     # The estimators get the recording without ground truth (recording format: they must never
-    # read it); the run result keeps the nominal contact point from the run spec and the contact
+    # read it); the rows keep the nominal contact point from the run spec and the contact
     # abscissa the simulator reports (where the link touched at the last in-contact sample).
-    contact_abscissa = _true_contact_abscissa(recording.metadata)
+    truth = {
+        "contact_abscissa": _true_contact_abscissa(recording.metadata),
+        "simulate_s": simulate_s,
+    }
     blind = recording.without_ground_truth()
-    outcomes = []
+    begin = time.perf_counter()
+    try:
+        evidence = gather(blind, run.antenna)
+    except Exception as exc:  # every method would raise the same: recorded for each
+        front_end_s = time.perf_counter() - begin
+        reason = f"{type(exc).__name__}: {exc}"
+        timing = {"front_end_s": front_end_s, "estimate_s": front_end_s}
+        rows = [CampaignRow.of_error(run, m, reason, **truth, **timing) for m in run.methods]
+        return RunResult(rows=tuple(rows))
+    front_end_s = time.perf_counter() - begin
+    rows = []
     for method in run.methods:
         begin = time.perf_counter()
         try:
-            result = estimate(blind, run.antenna, method=method)
+            conclude = METHODS[method].conclude
+            if isinstance(evidence, ContactEstimate):
+                # the front end stopped early (no contact, no push, bad input): that result is
+                # every method's, under its own name
+                estimate = dataclasses.replace(evidence, method=method)
+            else:
+                estimate = conclude(evidence)
         except Exception as exc:  # recorded per method: one broken estimator must not hide others
-            outcomes.append(
-                MethodOutcome(
-                    method=method,
-                    status=METHOD_ERROR,
-                    reason=f"{type(exc).__name__}: {exc}",
-                    elapsed_s=time.perf_counter() - begin,
+            elapsed = front_end_s + time.perf_counter() - begin
+            reason = f"{type(exc).__name__}: {exc}"
+            rows.append(
+                CampaignRow.of_error(
+                    run, method, reason, **truth, front_end_s=front_end_s, estimate_s=elapsed
                 )
             )
             continue
-        outcomes.append(MethodOutcome.from_estimate(method, result, time.perf_counter() - begin))
-    return RunResult.for_run(run, outcomes, simulate_s, contact_abscissa)
+        elapsed = front_end_s + time.perf_counter() - begin
+        rows.append(
+            CampaignRow.of_estimate(
+                run, estimate, **truth, front_end_s=front_end_s, estimate_s=elapsed
+            )
+        )
+    return RunResult(rows=tuple(rows))
 
 
 def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:
@@ -122,22 +146,6 @@ def identify_observer(
     recording = simulate(device, scenario)
     fit = identify_free_motion(recording.without_ground_truth(), model or device)
     return fit.observer
-
-
-def calibration_runs(spec: CampaignSpec) -> list[tuple[str, float, int]]:
-    """(name, contact point in m, seed) of each calibration recording, in a fixed order.
-
-    Seeds come from stream 2 of the base seed (:data:`~.spec.CALIBRATION_STREAM`), so they never
-    coincide with the runs' (stream 0) or the free motion's (stream 1).
-    """
-    step = spec.calibration
-    runs: list[tuple[str, float, int]] = []
-    for x_c in step.contact_points:
-        for repeat in range(1, step.repeats + 1):
-            index = len(runs)
-            name = f"calibration-{step.case}-x{round(x_c * 1000):04d}mm-r{repeat}"
-            runs.append((name, float(x_c), derive_seed(spec.base_seed, index, CALIBRATION_STREAM)))
-    return runs
 
 
 def calibrate_on_device(

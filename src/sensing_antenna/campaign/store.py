@@ -22,17 +22,16 @@ from __future__ import annotations
 
 import csv
 import json
-import math
 import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
-from sensing_antenna.campaign.records import CSV_COLUMNS, RunResult, result_rows
-from sensing_antenna.campaign.spec import CampaignSpec, parse_campaign_spec
+from sensing_antenna.campaign.parsing import parse_campaign_spec
+from sensing_antenna.campaign.records import CSV_COLUMNS, RUN_FILE_FORMAT, CampaignRow, RunResult
+from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [
@@ -49,7 +48,9 @@ __all__ = [
     "read_calibration",
     "read_manifest",
     "read_preparation",
+    "read_runs_csv",
     "read_stored_antenna",
+    "read_stored_device",
     "write_manifest",
     "write_preparation",
     "write_run_result",
@@ -163,8 +164,8 @@ def read_preparation(out_dir: Path, spec: CampaignSpec) -> Preparation | None:
     """The preparation stored by an earlier start for this spec, or None if it must be made.
 
     None when ``antenna.toml`` is missing, or when the spec asks for a calibration and
-    ``calibration.json`` is missing or was made for other settings. A directory of an older
-    version without ``device.toml`` simulated with the model antenna.
+    ``calibration.json`` is missing or was made for other settings. A directory without
+    ``device.toml`` simulated with the model antenna.
     """
     model = read_stored_antenna(out_dir)
     if model is None:
@@ -175,8 +176,7 @@ def read_preparation(out_dir: Path, spec: CampaignSpec) -> Preparation | None:
         if stored is None or stored[0] != spec.preparation_fingerprint():
             return None
         calibration = stored[1]
-    device_path = out_dir / DEVICE_FILE
-    device = load_antenna(device_path) if device_path.is_file() else model
+    device = read_stored_device(out_dir) or model
     return Preparation(model=model, device=device, calibration=calibration)
 
 
@@ -186,8 +186,14 @@ def write_stored_antenna(out_dir: Path, antenna: Antenna) -> None:
 
 
 def read_stored_antenna(out_dir: Path) -> Antenna | None:
-    """The antenna stored by an earlier start, or None."""
+    """The model stored by an earlier start, or None."""
     path = out_dir / ANTENNA_FILE
+    return load_antenna(path) if path.is_file() else None
+
+
+def read_stored_device(out_dir: Path) -> Antenna | None:
+    """The simulated hardware stored by an earlier start, or None."""
+    path = out_dir / DEVICE_FILE
     return load_antenna(path) if path.is_file() else None
 
 
@@ -200,15 +206,27 @@ def write_run_result(out_dir: Path, result: RunResult) -> Path:
     return path
 
 
-def load_run_results(out_dir: Path) -> dict[str, RunResult]:
-    """Every finished run stored in ``out_dir/runs``, keyed by run id (temp files ignored)."""
+def load_run_results(out_dir: Path, methods: Sequence[str]) -> dict[str, RunResult]:
+    """Every finished run stored in ``out_dir/runs``, keyed by run id (temp files ignored).
+
+    ``methods`` are the campaign's (the spec's): run files of format 1 hold no row for a
+    method of a failed run, and get one (see :meth:`RunResult.from_dict`).
+    """
     runs = out_dir / RUNS_DIR
     results: dict[str, RunResult] = {}
     if not runs.is_dir():
         return results
     for path in sorted(runs.glob("*.json")):
         try:
-            result = RunResult.from_dict(json.loads(path.read_text("utf-8")))
+            data = json.loads(path.read_text("utf-8"))
+            if isinstance(data, dict) and data.get("format", 1) not in (1, RUN_FILE_FORMAT):
+                raise CampaignStoreError(
+                    f"{path}: format: {data['format']!r} is not one this version reads (1 to "
+                    f"{RUN_FILE_FORMAT}); use the version of sensing-antenna that wrote it"
+                )
+            result = RunResult.from_dict(data, methods)
+        except CampaignStoreError:
+            raise
         except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
             raise CampaignStoreError(
                 f"{path}: damaged run file ({exc}); delete it to redo that run"
@@ -219,23 +237,37 @@ def load_run_results(out_dir: Path) -> dict[str, RunResult]:
     return results
 
 
-def write_runs_csv(path: Path, results: Iterable[RunResult], methods: Sequence[str]) -> Path:
-    """Write the run x method table (:data:`~sensing_antenna.campaign.records.CSV_COLUMNS`)."""
-    ordered = sorted(results, key=lambda r: r.index)
-    lines: list[dict[str, Any]] = []
-    for result in ordered:
-        lines.extend(result_rows(result, methods))
+def write_runs_csv(path: Path, results: Iterable[RunResult]) -> Path:
+    """Write every run's rows, by run index, as runs.csv (:data:`~.records.CSV_COLUMNS`)."""
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     with open(tmp, "w", encoding="utf-8", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=list(CSV_COLUMNS), lineterminator="\n")
         writer.writeheader()
-        for row in lines:
-            writer.writerow({k: _cell(v) for k, v in row.items()})
+        for result in sorted(results, key=lambda r: r.index):
+            writer.writerows(row.to_csv() for row in result.rows)
     os.replace(tmp, path)
     return path
 
 
-def _cell(value: Any) -> Any:
-    if isinstance(value, float):
-        return "" if not math.isfinite(value) else repr(value)
-    return value
+def read_runs_csv(path: Path) -> list[CampaignRow]:
+    """The rows of a runs.csv, as written (candidates to 6 significant digits).
+
+    Raises
+    ------
+    CampaignStoreError
+        Naming the file and line of a row that cannot be read.
+    """
+    try:
+        with open(path, encoding="utf-8", newline="") as handle:
+            reader = csv.DictReader(handle)
+            rows = []
+            for record in reader:
+                try:
+                    rows.append(CampaignRow.from_csv(record))
+                except (KeyError, TypeError, ValueError) as exc:
+                    raise CampaignStoreError(
+                        f"{path}: line {reader.line_num}: cannot be read ({exc})"
+                    ) from exc
+    except OSError as exc:
+        raise CampaignStoreError(f"{path}: cannot be read ({exc.strerror or exc})") from exc
+    return rows

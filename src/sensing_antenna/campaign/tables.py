@@ -1,11 +1,12 @@
-"""Tables of a campaign: per-point statistics in the layout of Tables 3 and 4, method summaries.
+"""Tables of a campaign, computed from its rows: per point (Tables 3 and 4), per method, per level.
 
-Statistics are computed in SI (m) over the runs where a method returned a finite estimate; the
-columns follow the paper (Section 5.6): mean estimate, mean absolute error, maximum absolute
-error and standard deviation of the (signed) error at each contact point. The paper's own tables
+Every function takes :class:`~sensing_antenna.campaign.records.CampaignRow` objects and returns
+typed summaries in SI (m, s, rad/s). Statistics are over the runs where a method returned a
+finite value; the per-point columns follow the paper (Section 5.6): mean estimate, mean absolute
+error, maximum absolute error and standard deviation of the signed error. The paper's own tables
 ship with the package (``data/paper-2021-table3-azimuthal.csv`` and
-``data/paper-2021-table4-vertical.csv``, copied from Tables 3 and 4 of Feliu-Talegon et al.,
-Sensors 2021) and are read by :func:`paper_table`.
+``data/paper-2021-table4-vertical.csv``, copied from Tables 3 and 4 of Mérida-Calvo,
+Feliu-Talegón and Feliu-Batlle, Sensors 2021) and are read by :func:`paper_table`.
 """
 
 from __future__ import annotations
@@ -13,41 +14,46 @@ from __future__ import annotations
 import csv
 import io
 import math
+import statistics
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
-from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.stats import binomtest
 
-from sensing_antenna.campaign.records import RunResult, float_or_nan, result_rows
+from sensing_antenna.accuracy import FrequencyErrorSummary, PointStats, PointTable, RunPoints
+from sensing_antenna.antenna import Link
+from sensing_antenna.campaign.records import CampaignRow
+from sensing_antenna.campaign.schema import noise_level_key, same_noise_level
 
 __all__ = [
-    "OK_ERROR_LIMIT",
+    "PAPER_EXPERIMENTS_PER_POINT",
     "PAPER_TABLE_FILES",
-    "ErrorStats",
-    "FrequencyErrorSummary",
+    "CaseRow",
+    "CaseTable",
+    "ContactOffset",
     "IntervalSummary",
-    "MethodErrors",
     "MethodSummary",
-    "PaperRow",
-    "PointStats",
-    "TargetSummary",
-    "campaign_rows",
+    "NoiseLevelErrors",
+    "PaperOverall",
+    "case_table",
+    "contact_offset",
     "frequency_error_summaries",
     "interval_summaries",
     "main_rows",
     "method_summaries",
+    "noise_level_errors",
     "noise_levels",
+    "paper_overall",
     "paper_row_at",
     "paper_table",
     "point_table",
     "rows_at_level",
-    "same_level",
-    "target_summary",
+    "run_points",
+    "select",
+    "truth",
 ]
 
 #: Package data files holding Tables 3 (Case 1, azimuthal) and 4 (Case 2, vertical) of the paper.
@@ -55,57 +61,12 @@ PAPER_TABLE_FILES = {
     "azimuthal": "data/paper-2021-table3-azimuthal.csv",
     "vertical": "data/paper-2021-table4-vertical.csv",
 }
+#: Experiments per contact point behind the paper's Tables 3 and 4 (Section 5.6).
+PAPER_EXPERIMENTS_PER_POINT = 5
 
 #: Contact points of the paper and of a campaign are matched to this tolerance (m): the paper
 #: lists them in whole centimetres.
 _POINT_MATCH_TOLERANCE = 1e-4
-
-#: Issue 6: no run reported ``ok`` may be off by more than this (m).
-OK_ERROR_LIMIT = 0.02
-#: Issue 6 targets of the fast method: median t_e - t_1 at most this fraction of the paper
-#: method's; mean absolute and maximum error at most these (m) at the default noise; coverage of
-#: the 95 % intervals within these bounds.
-DELAY_RATIO_TARGET = 0.25
-MAE_TARGET = 0.003
-MAX_ERROR_TARGET = 0.010
-COVERAGE_TARGET = (0.93, 0.97)
-
-
-@dataclass(frozen=True)
-class PointStats:
-    """Statistics of one method at one contact point of one case (SI units: m).
-
-    Attributes
-    ----------
-    x_c : float
-        True contact point (m).
-    n_runs : int
-        Runs at this point (including failed ones and runs without an estimate).
-    n_estimates : int
-        Runs with a finite estimate; the statistics are over these.
-    mean_estimate, mean_abs_error, max_error, std_error : float
-        Mean estimate, mean |error|, max |error| and sample standard deviation (ddof = 1) of the
-        signed error, all in m; NaN without estimates (std: with fewer than 2).
-    """
-
-    x_c: float
-    n_runs: int
-    n_estimates: int
-    mean_estimate: float
-    mean_abs_error: float
-    max_error: float
-    std_error: float
-
-
-@dataclass(frozen=True)
-class PaperRow:
-    """One row of Table 3 or 4 of the paper, converted to SI (m)."""
-
-    x_c: float
-    mean_estimate: float
-    mean_abs_error: float
-    max_error: float
-    std_error: float
 
 
 @dataclass(frozen=True)
@@ -120,7 +81,7 @@ class MethodSummary:
     n_estimates : int
         Runs with a finite estimate.
     mean_abs_error, max_abs_error, rms_error : float
-        Over all estimates of the case (m); NaN without estimates.
+        Over all estimates of the case, against the nominal x_c (m); NaN without estimates.
     status_counts : mapping of str to int
         Runs per status (the estimator's status, ``run-failed`` or ``error``).
     ok_mean_abs_error, ok_max_abs_error : float
@@ -157,8 +118,8 @@ class IntervalSummary:
     n_intervals : int
         Runs with a finite interval.
     n_covering : int
-        Of those, runs whose interval contains the contact abscissa (where the link touched;
-        the nominal x_c for runs without one, counted in ``n_judged_nominal``).
+        Of those, runs whose interval contains where the link touched (the contact abscissa; the
+        nominal x_c for runs without one, counted in ``n_judged_nominal``).
     median_width : float
         Median interval width (m); NaN without intervals.
     n_timed : int
@@ -166,6 +127,10 @@ class IntervalSummary:
     median_time_to_estimate : float
         Median of t_e - t_1 (s), how long after the push the estimate was available; NaN when
         never.
+    n_judged_nominal : int
+        Intervals of runs without a known contact abscissa.
+    n_covering_nominal : int
+        Intervals containing the nominal x_c.
     """
 
     case: str
@@ -189,204 +154,166 @@ class IntervalSummary:
         return self.n_covering_nominal / self.n_intervals if self.n_intervals else math.nan
 
 
-class ErrorStats(NamedTuple):
-    """Mean and largest absolute error of x_c over a group of runs (m); NaN without any."""
-
-    mae: float
-    max: float
-
-
-class MethodErrors(NamedTuple):
-    """A method's x_c errors against the contact abscissa and against the nominal x_c."""
-
-    contact: ErrorStats
-    nominal: ErrorStats
-
-
 @dataclass(frozen=True)
-class TargetSummary:
-    """The fast method against the targets of issue 6 on one group of runs (SI: m, s).
-
-    ``errors`` are the method's, ``ref_errors`` the reference method's (the paper's) on the
-    same recordings.
-    """
-
-    label: str
-    n_runs: int
-    median_delay: float
-    ref_median_delay: float
-    errors: MethodErrors
-    ref_errors: MethodErrors
-    n_intervals: int
-    n_covering: int
-    n_ok_over_limit: int
-    status_counts: Mapping[str, int]
-
-    @property
-    def delay_ratio(self) -> float:
-        """Median t_e - t_1 of the method over the reference's; NaN when either is missing."""
-        if not (math.isfinite(self.median_delay) and math.isfinite(self.ref_median_delay)):
-            return math.nan
-        return self.median_delay / self.ref_median_delay if self.ref_median_delay else math.nan
-
-    @property
-    def coverage(self) -> float:
-        """Fraction of 95 % intervals containing the contact abscissa; NaN without intervals."""
-        return self.n_covering / self.n_intervals if self.n_intervals else math.nan
-
-    @property
-    def coverage_interval(self) -> tuple[float, float]:
-        """Exact (Clopper-Pearson) 95 % confidence interval of the coverage; NaNs without intervals.
-
-        How far the counted coverage could be from the method's true one by chance alone: 148
-        of 150 covering is 98.7 %, its interval 95.3 to 99.8 %.
-        """
-        if not self.n_intervals:
-            return (math.nan, math.nan)
-        ci = binomtest(self.n_covering, self.n_intervals).proportion_ci(0.95, method="exact")
-        return (float(ci.low), float(ci.high))
-
-    def missed(self, default_noise: bool = True) -> list[str]:
-        """The issue-6 targets this group misses (empty: all met; unknown ones are skipped).
-
-        The absolute error targets (MAE <= 3 mm, max <= 10 mm) are stated at the default noise,
-        so they are checked only when ``default_noise``; "no worse than the paper method" and
-        the rest everywhere.
-        """
-        found = []
-        if math.isfinite(self.delay_ratio) and self.delay_ratio > DELAY_RATIO_TARGET:
-            found.append(f"t_e ratio > {DELAY_RATIO_TARGET:g}")
-        mine, ref = self.errors.contact, self.ref_errors.contact
-        if math.isfinite(mine.mae):
-            if default_noise and mine.mae > MAE_TARGET:
-                found.append(f"MAE > {MAE_TARGET * 1e3:g} mm")
-            if math.isfinite(ref.mae) and mine.mae > ref.mae:
-                found.append("MAE > paper's")
-        if math.isfinite(mine.max):
-            if default_noise and mine.max > MAX_ERROR_TARGET:
-                found.append(f"max > {MAX_ERROR_TARGET * 1e3:g} mm")
-            if math.isfinite(ref.max) and mine.max > ref.max:
-                found.append("max > paper's")
-        low, high = COVERAGE_TARGET
-        if self.n_intervals and not (low <= self.coverage <= high):
-            found.append(f"coverage outside {low:.0%}-{high:.0%}")
-        if self.n_ok_over_limit:
-            found.append(f"ok with error > {OK_ERROR_LIMIT * 100:g} cm")
-        return found
-
-
-@dataclass(frozen=True)
-class FrequencyErrorSummary:
-    """One method's omega_1 against the device's true fundamental at one noise level.
-
-    Relative errors are (omega_1 - omega_1,true) / omega_1,true, with omega_1,true the device's
-    contact-mode fundamental at the run's contact abscissa (nominal x_c if unknown).
+class NoiseLevelErrors:
+    """One method at one noise level: |estimate - contact abscissa| (m), delay (s), statuses.
 
     Attributes
     ----------
-    method : str
     noise_scale : float
-    n : int
-        Runs with a finite omega_1.
-    rms_relative_error, median_abs_relative_error : float
-        Over those runs; NaN without any.
-    median_relative_crb, median_relative_se : float
-        Median over runs of the method's Cramer-Rao bound and reported standard error of
-        omega_1, relative to omega_1,true; NaN for methods that report none.
+    method : str
+    n_runs : int
+        Runs at this level.
+    n_estimates : int
+        Runs with a finite error against a known contact abscissa.
+    mean_abs_error, max_abs_error : float
+        Over those (m); NaN without any.
+    median_delay : float
+        Median t_e - t_1 (s); NaN when never timed.
+    n_ok : int
+        Runs with status ``ok``.
     """
 
-    method: str
     noise_scale: float
+    method: str
+    n_runs: int
+    n_estimates: int
+    mean_abs_error: float
+    max_abs_error: float
+    median_delay: float
+    n_ok: int
+
+
+@dataclass(frozen=True)
+class ContactOffset:
+    """Contact abscissa minus nominal x_c over the runs that know it (m); NaN without any.
+
+    Attributes
+    ----------
+    n : int
+        Runs with a known contact abscissa.
+    median, low, high : float
+        Median, smallest and largest offset (m).
+    """
+
     n: int
-    rms_relative_error: float
-    median_abs_relative_error: float
-    median_relative_crb: float
-    median_relative_se: float
+    median: float
+    low: float
+    high: float
 
 
-def campaign_rows(results: Iterable[RunResult], methods: Sequence[str]) -> list[dict[str, Any]]:
-    """Every run x method row (see :data:`~sensing_antenna.campaign.records.CSV_COLUMNS`)."""
-    rows: list[dict[str, Any]] = []
-    for result in sorted(results, key=lambda r: r.index):
-        rows.extend(result_rows(result, methods))
-    return rows
+@dataclass(frozen=True)
+class PaperOverall:
+    """The paper's overall figures for one case (m): mean of its per-point mean |error| (equal
+    runs per point) and its largest maximum error; ``n_runs`` experiments in all."""
+
+    case: str
+    mean_abs_error: float
+    max_error: float
+    n_runs: int
 
 
-def _select(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> list[Mapping[str, Any]]:
-    return [r for r in rows if r["case"] == case and r["method"] == method]
+@dataclass(frozen=True)
+class CaseRow:
+    """One contact point of a case table: the main method's statistics, the paper's at that
+    point (None where it has none) and each baseline's mean |error| (m; NaN without)."""
+
+    ours: PointStats
+    paper: PointStats | None
+    baseline_mean_abs_error: tuple[float, ...]
 
 
-def same_level(a: float, b: float) -> bool:
-    """Whether two noise levels are the same to 0.01 (as in the run ids)."""
-    return round(a * 100) == round(b * 100)
+@dataclass(frozen=True)
+class CaseTable:
+    """A case in the layout of Tables 3 and 4: ``method`` per point, beside the paper and the
+    ``baselines`` (in the order of ``CaseRow.baseline_mean_abs_error``)."""
+
+    case: str
+    method: str
+    baselines: tuple[str, ...]
+    rows: tuple[CaseRow, ...]
 
 
-def _level(row: Mapping[str, Any], main: float) -> float:
-    """The row's noise level; ``main`` for a row without one (stored before noise sweeps)."""
-    level = float_or_nan(row.get("noise_scale"))
-    return level if math.isfinite(level) else main
+def select(
+    rows: Iterable[CampaignRow], case: str | None = None, method: str | None = None
+) -> list[CampaignRow]:
+    """The rows of ``case`` and ``method`` (None: any)."""
+    return [
+        r
+        for r in rows
+        if (case is None or r.case == case) and (method is None or r.method == method)
+    ]
 
 
-def rows_at_level(
-    rows: Iterable[Mapping[str, Any]], level: float, main: float
-) -> list[Mapping[str, Any]]:
-    """The rows at noise ``level``; a row without a level counts as ``main``."""
-    return [row for row in rows if same_level(_level(row, main), level)]
+def _level(row: CampaignRow, main: float) -> float:
+    """The row's noise level; ``main`` for a row without one."""
+    return row.noise_scale if math.isfinite(row.noise_scale) else main
 
 
-def main_rows(rows: Iterable[Mapping[str, Any]], noise_scale: float) -> list[Mapping[str, Any]]:
+def rows_at_level(rows: Iterable[CampaignRow], level: float, main: float) -> list[CampaignRow]:
+    """The rows at noise ``level`` (to 0.01); a row without a level counts as ``main``."""
+    return [row for row in rows if same_noise_level(_level(row, main), level)]
+
+
+def main_rows(rows: Iterable[CampaignRow], noise_scale: float) -> list[CampaignRow]:
     """The rows of the main runs: those at ``noise_scale`` (the ``[scenario]`` level).
 
-    A row without a noise level (a run stored before noise sweeps existed) is a main run.
+    A row without a noise level (its run file did not record one) is a main run.
     """
     return rows_at_level(rows, noise_scale, noise_scale)
 
 
-def noise_levels(rows: Iterable[Mapping[str, Any]], main: float) -> list[float]:
+def noise_levels(rows: Iterable[CampaignRow], main: float) -> list[float]:
     """Distinct noise levels of the rows, ascending; a row without one counts as ``main``."""
     levels: dict[int, float] = {}
     for row in rows:
         level = _level(row, main)
-        levels.setdefault(round(level * 100), level)
+        levels.setdefault(noise_level_key(level), level)
     return [levels[k] for k in sorted(levels)]
 
 
-def point_table(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> list[PointStats]:
+def _column(rows: Sequence[CampaignRow], name: str) -> NDArray[np.float64]:
+    """One float field of the rows, shape (n_rows,)."""
+    return np.array([getattr(row, name) for row in rows], dtype=float)
+
+
+def _stats(x_c: float, n_runs: int, estimates: NDArray[np.float64]) -> PointStats:
+    estimates = estimates[np.isfinite(estimates)]
+    errors = estimates - x_c
+    n = estimates.size
+    return PointStats(
+        x_c=x_c,
+        n_runs=n_runs,
+        n_estimates=n,
+        mean_estimate=float(np.mean(estimates)) if n else math.nan,
+        mean_abs_error=float(np.mean(np.abs(errors))) if n else math.nan,
+        max_error=float(np.max(np.abs(errors))) if n else math.nan,
+        std_error=float(np.std(errors, ddof=1)) if n >= 2 else math.nan,
+    )
+
+
+def point_table(rows: Iterable[CampaignRow], case: str, method: str) -> PointTable:
     """Per-contact-point statistics of ``method`` in ``case`` (Tables 3 and 4 layout), by x_c."""
-    selected = _select(rows, case, method)
-    points = sorted({float(r["x_c_true_m"]) for r in selected})
+    selected = select(rows, case, method)
+    points = sorted({r.x_c_true_m for r in selected})
     table = []
     for x_c in points:
-        at_point = [r for r in selected if float(r["x_c_true_m"]) == x_c]
-        estimates = np.array([float(r["x_c_estimate_m"]) for r in at_point], dtype=float)
-        estimates = estimates[np.isfinite(estimates)]
-        errors = estimates - x_c
-        n = estimates.size
-        table.append(
-            PointStats(
-                x_c=x_c,
-                n_runs=len(at_point),
-                n_estimates=n,
-                mean_estimate=float(np.mean(estimates)) if n else math.nan,
-                mean_abs_error=float(np.mean(np.abs(errors))) if n else math.nan,
-                max_error=float(np.max(np.abs(errors))) if n else math.nan,
-                std_error=float(np.std(errors, ddof=1)) if n >= 2 else math.nan,
-            )
-        )
-    return table
+        at_point = [r for r in selected if r.x_c_true_m == x_c]
+        table.append(_stats(x_c, len(at_point), _column(at_point, "x_c_estimate_m")))
+    return PointTable(case=case, method=method, points=tuple(table))
 
 
 def method_summaries(
-    rows: Iterable[Mapping[str, Any]], cases: Sequence[str], methods: Sequence[str]
+    rows: Iterable[CampaignRow], cases: Sequence[str], methods: Sequence[str]
 ) -> list[MethodSummary]:
     """One :class:`MethodSummary` per case and method, in the given order."""
     all_rows = list(rows)
     summaries = []
     for case in cases:
         for method in methods:
-            selected = _select(all_rows, case, method)
-            all_errors = np.array([float(r["error_m"]) for r in selected], dtype=float)
-            is_ok = np.array([r["status"] == "ok" for r in selected], dtype=bool)
+            selected = select(all_rows, case, method)
+            all_errors = _column(selected, "error_m")
+            is_ok = np.array([r.status == "ok" for r in selected], dtype=bool)
             errors = all_errors[np.isfinite(all_errors)]
             ok_errors = np.abs(all_errors[is_ok & np.isfinite(all_errors)])
             contact = np.abs(_column(selected, "error_contact_m"))
@@ -401,7 +328,7 @@ def method_summaries(
                     mean_abs_error=float(np.mean(np.abs(errors))) if n else math.nan,
                     max_abs_error=float(np.max(np.abs(errors))) if n else math.nan,
                     rms_error=float(np.sqrt(np.mean(errors**2))) if n else math.nan,
-                    status_counts=dict(Counter(str(r["status"]) for r in selected)),
+                    status_counts=dict(Counter(r.status for r in selected)),
                     ok_mean_abs_error=float(np.mean(ok_errors)) if ok_errors.size else math.nan,
                     ok_max_abs_error=float(np.max(ok_errors)) if ok_errors.size else math.nan,
                     contact_mean_abs_error=float(np.mean(contact)) if contact.size else math.nan,
@@ -412,33 +339,27 @@ def method_summaries(
     return summaries
 
 
-def _column(rows: Sequence[Mapping[str, Any]], name: str) -> NDArray[np.float64]:
-    """One column as floats; a missing or empty cell is NaN."""
-    return np.array([float_or_nan(row.get(name, math.nan)) for row in rows], dtype=float)
-
-
-def _truth(rows: Sequence[Mapping[str, Any]]) -> NDArray[np.float64]:
-    """Where each run's link touched: the contact abscissa, the nominal x_c when unknown (m)."""
-    contact = _column(rows, "x_c_contact_m")
-    return np.where(np.isfinite(contact), contact, _column(rows, "x_c_true_m"))
+def truth(rows: Sequence[CampaignRow]) -> NDArray[np.float64]:
+    """Where each run's link touched (m): the contact abscissa, the nominal x_c when unknown."""
+    return np.array([row.truth_m for row in rows], dtype=float)
 
 
 def interval_summaries(
-    rows: Iterable[Mapping[str, Any]], cases: Sequence[str], methods: Sequence[str]
+    rows: Iterable[CampaignRow], cases: Sequence[str], methods: Sequence[str]
 ) -> list[IntervalSummary]:
     """One :class:`IntervalSummary` per case and method, in the given order."""
     all_rows = list(rows)
     summaries = []
     for case in cases:
         for method in methods:
-            selected = _select(all_rows, case, method)
+            selected = select(all_rows, case, method)
             low = _column(selected, "interval_low_m")
             high = _column(selected, "interval_high_m")
             nominal = _column(selected, "x_c_true_m")
             contact = _column(selected, "x_c_contact_m")
-            truth = _truth(selected)
+            touched = truth(selected)
             has = np.isfinite(low) & np.isfinite(high)
-            covering = has & (low <= truth) & (truth <= high)
+            covering = has & (low <= touched) & (touched <= high)
             covering_nominal = has & (low <= nominal) & (nominal <= high)
             delay = _column(selected, "t_e_s") - _column(selected, "t_1_s")
             delay = delay[np.isfinite(delay)]
@@ -458,59 +379,69 @@ def interval_summaries(
     return summaries
 
 
-def _errors(selected: Sequence[Mapping[str, Any]], column: str) -> ErrorStats:
-    """Mean and max of |column| over finite values (m); NaN without any."""
-    values = np.abs(_column(selected, column))
-    values = values[np.isfinite(values)]
-    if not values.size:
-        return ErrorStats(math.nan, math.nan)
-    return ErrorStats(float(np.mean(values)), float(np.max(values)))
+def run_points(rows: Iterable[CampaignRow], case: str, method: str) -> RunPoints:
+    """Every run of ``method`` in ``case`` as arrays (:class:`~sensing_antenna.accuracy.RunPoints`).
 
-
-def _method_errors(selected: Sequence[Mapping[str, Any]]) -> MethodErrors:
-    """|x_c error| against the contact abscissa and the nominal x_c (m)."""
-    return MethodErrors(_errors(selected, "error_contact_m"), _errors(selected, "error_m"))
-
-
-def _median_delay(selected: Sequence[Mapping[str, Any]]) -> float:
-    delay = _column(selected, "t_e_s") - _column(selected, "t_1_s")
-    delay = delay[np.isfinite(delay)]
-    return float(np.median(delay)) if delay.size else math.nan
-
-
-def target_summary(
-    rows: Iterable[Mapping[str, Any]], label: str, method: str = "fast", reference: str = "paper"
-) -> TargetSummary:
-    """``method`` against the issue-6 targets on ``rows``, beside ``reference`` on the same runs.
-
-    Errors over every run with a finite estimate (any status); the "ok with error over 2 cm"
-    count uses the contact abscissa (the nominal x_c when it is unknown); coverage is judged
-    against the contact abscissa the same way.
+    The error is against the contact abscissa when the run knows it, else the nominal x_c.
     """
-    all_rows = list(rows)
-    mine = [r for r in all_rows if r["method"] == method]
-    ref = [r for r in all_rows if r["method"] == reference]
-    low, high = _column(mine, "interval_low_m"), _column(mine, "interval_high_m")
-    truth = _truth(mine)
-    has = np.isfinite(low) & np.isfinite(high)
-    error = np.abs(_column(mine, "x_c_estimate_m") - truth)
-    is_ok = np.array([r["status"] == "ok" for r in mine], dtype=bool)
-    return TargetSummary(
-        label=label,
-        n_runs=len(mine),
-        median_delay=_median_delay(mine),
-        ref_median_delay=_median_delay(ref),
-        errors=_method_errors(mine),
-        ref_errors=_method_errors(ref),
-        n_intervals=int(has.sum()),
-        n_covering=int((has & (low <= truth) & (truth <= high)).sum()),
-        n_ok_over_limit=int((is_ok & np.isfinite(error) & (error > OK_ERROR_LIMIT)).sum()),
-        status_counts=dict(Counter(str(r["status"]) for r in mine)),
+    selected = select(rows, case, method)
+    contact = _column(selected, "error_contact_m")
+    return RunPoints(
+        case=case,
+        method=method,
+        x_c=_column(selected, "x_c_true_m"),
+        estimate=_column(selected, "x_c_estimate_m"),
+        error=np.where(np.isfinite(contact), contact, _column(selected, "error_m")),
+        delay=_column(selected, "t_e_s") - _column(selected, "t_1_s"),
+        omega1=_column(selected, "omega1_rad_s"),
     )
 
 
+def noise_level_errors(
+    rows: Iterable[CampaignRow], methods: Sequence[str], main: float
+) -> list[NoiseLevelErrors]:
+    """Per noise level (ascending) and method: errors against the contact abscissa, delays."""
+    all_rows = list(rows)
+    table = []
+    for level in noise_levels(all_rows, main):
+        at_level = rows_at_level(all_rows, level, main)
+        for method in methods:
+            mine = select(at_level, method=method)
+            errors = [r.abs_error_contact_m for r in mine if math.isfinite(r.abs_error_contact_m)]
+            delays = sorted(r.delay_s for r in mine if math.isfinite(r.delay_s))
+            table.append(
+                NoiseLevelErrors(
+                    noise_scale=level,
+                    method=method,
+                    n_runs=len(mine),
+                    n_estimates=len(errors),
+                    mean_abs_error=sum(errors) / len(errors) if errors else math.nan,
+                    max_abs_error=max(errors) if errors else math.nan,
+                    median_delay=statistics.median(delays) if delays else math.nan,
+                    n_ok=sum(1 for r in mine if r.status == "ok"),
+                )
+            )
+    return table
+
+
+def contact_offset(rows: Iterable[CampaignRow]) -> ContactOffset:
+    """Contact abscissa minus nominal x_c, once per run, over runs that know it (m)."""
+    offsets = []
+    seen: set[str] = set()
+    for row in rows:
+        if row.run_id in seen:
+            continue
+        seen.add(row.run_id)
+        if math.isfinite(row.x_c_contact_m):
+            offsets.append(row.x_c_contact_m - row.x_c_true_m)
+    if not offsets:
+        return ContactOffset(0, math.nan, math.nan, math.nan)
+    ordered = sorted(offsets)
+    return ContactOffset(len(ordered), statistics.median(ordered), ordered[0], ordered[-1])
+
+
 def frequency_error_summaries(
-    rows: Iterable[Mapping[str, Any]], link: Any, methods: Sequence[str], main: float
+    rows: Iterable[CampaignRow], link: Link, methods: Sequence[str], main: float
 ) -> list[FrequencyErrorSummary]:
     """omega_1 errors of every method that reports one, per noise level (ascending).
 
@@ -525,12 +456,12 @@ def frequency_error_summaries(
     for level in noise_levels(all_rows, main):
         at_level = rows_at_level(all_rows, level, main)
         for method in methods:
-            selected = [r for r in at_level if r["method"] == method]
+            selected = select(at_level, method=method)
             omega = _column(selected, "omega1_rad_s")
             keep = np.isfinite(omega)
             if not keep.any():
                 continue
-            x = _truth(selected)[keep]
+            x = truth(selected)[keep]
             true = np.asarray(natural_frequencies(link, x, 1), dtype=float)[..., 0]
             rel = omega[keep] / true - 1.0
             crb = _column(selected, "omega1_crb_rad_s")[keep] / true
@@ -554,34 +485,68 @@ def _nanmedian(values: NDArray[np.float64]) -> float:
     return float(np.median(finite)) if finite.size else math.nan
 
 
-def paper_table(case: str) -> list[PaperRow]:
+def paper_table(case: str) -> PointTable:
     """Table 3 (``"azimuthal"``) or Table 4 (``"vertical"``) of the paper, in m.
 
-    Returns an empty list for a case the paper has no table for.
+    Each point counts :data:`PAPER_EXPERIMENTS_PER_POINT` runs; a case the paper has no table
+    for gives no points.
     """
     name = PAPER_TABLE_FILES.get(case)
     if name is None:
-        return []
+        return PointTable(case=case, method="paper, real device", points=())
     text = resources.files("sensing_antenna").joinpath(name).read_text("utf-8")
     lines = [line for line in text.splitlines() if line and not line.startswith("#")]
     cm = 0.01
-    rows = []
-    for record in csv.DictReader(io.StringIO("\n".join(lines))):
-        rows.append(
-            PaperRow(
-                x_c=float(record["xc"]) * cm,
-                mean_estimate=float(record["mean_estimate"]) * cm,
-                mean_abs_error=float(record["mean_abs_error"]) * cm,
-                max_error=float(record["max_error"]) * cm,
-                std_error=float(record["std_error"]) * cm,
-            )
+    n = PAPER_EXPERIMENTS_PER_POINT
+    points = tuple(
+        PointStats(
+            x_c=float(record["xc"]) * cm,
+            n_runs=n,
+            n_estimates=n,
+            mean_estimate=float(record["mean_estimate"]) * cm,
+            mean_abs_error=float(record["mean_abs_error"]) * cm,
+            max_error=float(record["max_error"]) * cm,
+            std_error=float(record["std_error"]) * cm,
         )
-    return rows
+        for record in csv.DictReader(io.StringIO("\n".join(lines)))
+    )
+    return PointTable(case=case, method="paper, real device", points=points)
 
 
-def paper_row_at(case: str, x_c: float) -> PaperRow | None:
+def paper_row_at(case: str, x_c: float) -> PointStats | None:
     """The paper's row at contact point ``x_c`` (m), or None if the paper has none there."""
-    for row in paper_table(case):
+    for row in paper_table(case).points:
         if abs(row.x_c - x_c) <= _POINT_MATCH_TOLERANCE:
             return row
     return None
+
+
+def paper_overall(case: str) -> PaperOverall:
+    """Mean of the paper's per-point mean |error| and its largest max error (m); NaN without a
+    table."""
+    points = paper_table(case).points
+    if not points:
+        return PaperOverall(case, math.nan, math.nan, 0)
+    return PaperOverall(
+        case=case,
+        mean_abs_error=sum(p.mean_abs_error for p in points) / len(points),
+        max_error=max(p.max_error for p in points),
+        n_runs=sum(p.n_runs for p in points),
+    )
+
+
+def case_table(rows: Iterable[CampaignRow], case: str, methods: Sequence[str]) -> CaseTable:
+    """``case`` in the layout of Tables 3 and 4: the paper method (else the first) per point,
+    the paper's values at each point and every other method's mean |error|."""
+    all_rows = list(rows)
+    main = "paper" if "paper" in methods else methods[0]
+    baselines = tuple(m for m in methods if m != main)
+    by_point = {m: {p.x_c: p for p in point_table(all_rows, case, m).points} for m in baselines}
+    table = []
+    for point in point_table(all_rows, case, main).points:
+        baseline = tuple(
+            by_point[m][point.x_c].mean_abs_error if point.x_c in by_point[m] else math.nan
+            for m in baselines
+        )
+        table.append(CaseRow(point, paper_row_at(case, point.x_c), baseline))
+    return CaseTable(case=case, method=main, baselines=baselines, rows=tuple(table))

@@ -40,9 +40,9 @@ def register(subparsers: Any) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from sensing_antenna.campaign.parsing import load_campaign_spec
     from sensing_antenna.campaign.report import build_report
     from sensing_antenna.campaign.runner import run_campaign
-    from sensing_antenna.campaign.spec import load_campaign_spec
 
     spec = load_campaign_spec(args.spec)
     if args.methods is not None:

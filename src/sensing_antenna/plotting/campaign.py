@@ -1,28 +1,24 @@
-"""Figures of a campaign (Section 5.6): Figures 16 and 17, Figure 18 and a method comparison.
+"""Figures of a campaign (Section 5.6): Figures 16 and 17, Figure 18 and method comparisons.
 
-Every function takes the run x method rows of a campaign (dicts with the columns of
-:data:`~sensing_antenna.campaign.records.CSV_COLUMNS`, SI units), writes PNG files into an output
-directory (created if missing) and returns their paths. Lengths are shown in cm and frequencies in
-rad/s, as in the paper.
+Every function takes summaries of a campaign (:mod:`sensing_antenna.accuracy`: per-point tables
+and per-run arrays, SI units), writes a PNG file into an output directory (created if missing)
+and returns its path. Lengths are shown in cm and frequencies in rad/s, as in the paper.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from sensing_antenna.antenna import Antenna
-from sensing_antenna.campaign.records import float_or_nan
-from sensing_antenna.campaign.tables import FrequencyErrorSummary, paper_table, point_table
+from sensing_antenna.accuracy import FrequencyErrorSummary, PointTable, RunPoints
+from sensing_antenna.antenna import Link
 from sensing_antenna.plotting import save_figure
 
 __all__ = [
     "CASE_FIGURES",
-    "plot_campaign",
     "plot_case_estimates",
     "plot_error_and_delay",
     "plot_frequencies",
@@ -34,7 +30,7 @@ __all__ = [
 CASE_FIGURES = {"azimuthal": 16, "vertical": 17}
 
 _CM = 100.0
-#: Lowest error drawn on the log axis of the error-versus-x_c figure (cm): 10 micrometres, far
+#: Lowest error drawn on the log axis of the error-versus-x_c figures (cm): 10 micrometres, far
 #: below any physical resolution of the device.
 _ERROR_FLOOR_CM = 1e-3
 _METHOD_STYLE = {
@@ -43,23 +39,33 @@ _METHOD_STYLE = {
     "two-frequency": {"color": "tab:green", "marker": "^"},
     "fast": {"color": "tab:red", "marker": "D"},
 }
+_CASE_MARKERS = {"azimuthal": "o", "vertical": "x"}
 
 
-def _finite(rows: Iterable[Mapping[str, Any]], case: str, method: str, column: str) -> Any:
-    selected = [r for r in rows if r["case"] == case and r["method"] == method]
-    x = np.array([float(r["x_c_true_m"]) for r in selected], dtype=float)
-    y = np.array([float(r[column]) for r in selected], dtype=float)
-    keep = np.isfinite(y)
-    return x[keep], y[keep]
+def _style(method: str) -> dict[str, str | None]:
+    return dict(_METHOD_STYLE.get(method, {"color": None, "marker": "."}))
 
 
-def plot_case_estimates(
-    rows: Sequence[Mapping[str, Any]], case: str, out_dir: str | Path, method: str = "paper"
-) -> Path:
-    """Figure 16 (azimuthal) or 17 (vertical): (a) estimated vs real x_c, (b) absolute errors."""
+def _cases(items: Sequence[PointTable] | Sequence[RunPoints]) -> list[str]:
+    return list(dict.fromkeys(item.case for item in items))
+
+
+def plot_case_estimates(points: RunPoints, paper: PointTable | None, out_dir: str | Path) -> Path:
+    """Figure 16 (azimuthal) or 17 (vertical): (a) estimated vs real x_c, (b) absolute errors.
+
+    Parameters
+    ----------
+    points : RunPoints
+        Every run of one method in one case.
+    paper : PointTable, optional
+        The paper's table of that case; its maximum errors are drawn beside ours.
+    out_dir : str or Path
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    x, estimate = _finite(rows, case, method, "x_c_estimate_m")
+    keep = np.isfinite(points.estimate)
+    x, estimate = points.x_c[keep], points.estimate[keep]
+    case, method = points.case, points.method
     fig, (ax_a, ax_b) = plt.subplots(1, 2, figsize=(10, 4.2))
     line = np.array([0.0, max(1.0, float(x.max(initial=0.0)))])
     ax_a.plot(line * _CM, line * _CM, color="0.6", lw=1, label="x_c,e = x_c")
@@ -69,11 +75,10 @@ def plot_case_estimates(
     ax_a.set_title("(a) estimated vs real")
     ax_a.legend(loc="upper left")
     ax_b.plot(x * _CM, np.abs(estimate - x) * _CM, "o", ms=4, mfc="none", label="this campaign")
-    paper = paper_table(case)
-    if paper:
+    if paper is not None and paper.points:
         ax_b.plot(
-            [p.x_c * _CM for p in paper],
-            [p.max_error * _CM for p in paper],
+            paper.x_c * _CM,
+            paper.max_error * _CM,
             "k_",
             ms=12,
             label="paper: max error",
@@ -88,15 +93,21 @@ def plot_case_estimates(
     return save_figure(fig, out / f"figure{number or ''}-{case}-{method}.png")
 
 
-def plot_frequencies(
-    rows: Sequence[Mapping[str, Any]], antenna: Antenna, out_dir: str | Path
-) -> Path:
-    """Figure 18: measured omega_1 vs x_c in each case, over the sensing curve of ``antenna``."""
+def plot_frequencies(points: Sequence[RunPoints], link: Link, out_dir: str | Path) -> Path:
+    """Figure 18: measured omega_1 vs x_c, one series per case, over the sensing curve of ``link``.
+
+    Parameters
+    ----------
+    points : sequence of RunPoints
+        The runs of the method whose omega_1 is drawn (the paper's), one entry per case.
+    link : Link
+        The model's link (its calibrated T_e when it has one).
+    out_dir : str or Path
+    """
     from sensing_antenna.beam import natural_frequencies
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    link = antenna.link
     grid = np.linspace(0.2 * link.length, link.length, 200)
     curve = np.asarray(natural_frequencies(link, grid, 1), dtype=float)[..., 0]
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
@@ -104,10 +115,18 @@ def plot_frequencies(
     ax.plot(
         grid * _CM, curve, color="0.3", lw=1.5, label=f"sensing curve, {name} = {link.t_param:.4g}"
     )
-    for case, marker in (("azimuthal", "o"), ("vertical", "x")):
-        x, omega = _finite(rows, case, "paper", "omega1_rad_s")
-        if x.size:
-            ax.plot(x * _CM, omega, marker, ms=5, mfc="none", label=f"measured, {case}")
+    for series in points:
+        keep = np.isfinite(series.omega1)
+        if keep.any():
+            marker = _CASE_MARKERS.get(series.case, ".")
+            ax.plot(
+                series.x_c[keep] * _CM,
+                series.omega1[keep],
+                marker,
+                ms=5,
+                mfc="none",
+                label=f"measured, {series.case}",
+            )
     ax.set_xlabel("contact point x_c (cm)")
     ax.set_ylabel("fundamental frequency omega_1 (rad/s)")
     ax.set_title("Figure 18: measured fundamental frequencies over the sensing curve")
@@ -116,33 +135,38 @@ def plot_frequencies(
 
 
 def plot_method_errors(
-    rows: Sequence[Mapping[str, Any]],
-    cases: Sequence[str],
-    methods: Sequence[str],
-    out_dir: str | Path,
+    tables: Sequence[PointTable], paper: Sequence[PointTable], out_dir: str | Path
 ) -> Path:
-    """Mean absolute error vs x_c for every method (one panel per case), with the paper's."""
+    """Mean absolute error vs x_c of every method (one panel per case), with the paper's.
+
+    Parameters
+    ----------
+    tables : sequence of PointTable
+        One per case and method; the panels follow the cases in order of appearance.
+    paper : sequence of PointTable
+        The paper's tables, drawn in the panel of their case.
+    out_dir : str or Path
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    cases = _cases(tables)
     fig, axes = plt.subplots(1, len(cases), figsize=(5.5 * len(cases), 4.2), squeeze=False)
     for ax, case in zip(axes[0], cases, strict=True):
-        for method in methods:
-            table = point_table(rows, case, method)
-            style = _METHOD_STYLE.get(method, {"color": None, "marker": "."})
+        for table in (t for t in tables if t.case == case):
+            style = _style(table.method)
             ax.plot(
-                [p.x_c * _CM for p in table],
+                table.x_c * _CM,
                 # errors below the display floor (e.g. an estimate that lands on a grid point of
                 # the truth) are drawn on the floor, not as a dive to 1e-14 cm
-                [max(p.mean_abs_error * _CM, _ERROR_FLOOR_CM) for p in table],
+                np.maximum(table.mean_abs_error * _CM, _ERROR_FLOOR_CM),
                 marker=style["marker"],
                 color=style["color"],
-                label=method,
+                label=table.method,
             )
-        paper = paper_table(case)
-        if paper:
+        for reference in (t for t in paper if t.case == case and t.points):
             ax.plot(
-                [p.x_c * _CM for p in paper],
-                [p.mean_abs_error * _CM for p in paper],
+                reference.x_c * _CM,
+                reference.mean_abs_error * _CM,
                 "k--",
                 lw=1,
                 label="paper (real device)",
@@ -158,60 +182,30 @@ def plot_method_errors(
     return save_figure(fig, out / "errors-by-method.png")
 
 
-def _per_run(rows: Iterable[Mapping[str, Any]], case: str, method: str) -> Any:
-    """x_c, signed error and t_e - t_1 of every run of ``method`` with a finite estimate.
-
-    The error is against the contact abscissa (where the link touched) when the row has one,
-    else against the nominal x_c.
-    """
-    selected = [r for r in rows if r["case"] == case and r["method"] == method]
-    x = np.array([float(r["x_c_true_m"]) for r in selected], dtype=float)
-    error = np.array([float_or_nan(r.get("error_contact_m")) for r in selected], dtype=float)
-    nominal = np.array([float(r["error_m"]) for r in selected], dtype=float)
-    error = np.where(np.isfinite(error), error, nominal)
-    delay = np.array([float(r["t_e_s"]) - float(r["t_1_s"]) for r in selected], dtype=float)
-    keep = np.isfinite(error) & np.isfinite(delay)
-    return x[keep], error[keep], delay[keep]
-
-
-def plot_error_and_delay(
-    rows: Sequence[Mapping[str, Any]],
-    cases: Sequence[str],
-    methods: Sequence[str],
-    out_dir: str | Path,
-) -> Path:
+def plot_error_and_delay(points: Sequence[RunPoints], out_dir: str | Path) -> Path:
     """Per run and method: |x_c error| (top) and t_e - t_1 (bottom) against x_c, per case.
 
-    The error is against the contact abscissa (the nominal x_c for runs without one); the x axis
-    is the nominal x_c, so the runs of one point line up.
+    The error is ``RunPoints.error`` (against where the link touched); the x axis is the
+    nominal x_c, so the runs of one point line up. Runs without an error or a delay are left
+    out.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    cases = _cases(points)
     fig, axes = plt.subplots(
         2, len(cases), figsize=(5.5 * len(cases), 7.0), squeeze=False, sharex="col"
     )
     for col, case in enumerate(cases):
         ax_e, ax_t = axes[0][col], axes[1][col]
-        for method in methods:
-            x, error, delay = _per_run(rows, case, method)
-            style = _METHOD_STYLE.get(method, {"color": None, "marker": "."})
-            ax_e.plot(
-                x * _CM,
-                np.maximum(np.abs(error) * _CM, _ERROR_FLOOR_CM),
-                style["marker"],
-                color=style["color"],
-                ms=4,
-                mfc="none",
-                label=method,
-            )
+        for series in (p for p in points if p.case == case):
+            keep = np.isfinite(series.error) & np.isfinite(series.delay)
+            x = series.x_c[keep] * _CM
+            style = _style(series.method)
+            marker, color = style["marker"], style["color"]
+            error = np.maximum(np.abs(series.error[keep]) * _CM, _ERROR_FLOOR_CM)
+            ax_e.plot(x, error, marker, color=color, ms=4, mfc="none", label=series.method)
             ax_t.plot(
-                x * _CM,
-                delay,
-                style["marker"],
-                color=style["color"],
-                ms=4,
-                mfc="none",
-                label=method,
+                x, series.delay[keep], marker, color=color, ms=4, mfc="none", label=series.method
             )
         ax_e.set_yscale("log")
         ax_e.set_ylim(bottom=_ERROR_FLOOR_CM)
@@ -282,25 +276,3 @@ def plot_frequency_error_vs_noise(
         ax.legend(fontsize="small")
     fig.suptitle("Frequency error against noise, beside the Cramer-Rao bound of the same record")
     return save_figure(fig, out / "frequency-error-vs-noise.png")
-
-
-def plot_campaign(
-    rows: Sequence[Mapping[str, Any]],
-    cases: Sequence[str],
-    methods: Sequence[str],
-    antenna: Antenna,
-    out_dir: str | Path,
-) -> list[Path]:
-    """Every campaign figure: the method comparison, Figures 16/17 per case, and Figure 18.
-
-    With the ``fast`` method among ``methods``, also the error and t_e - t_1 of every run
-    against x_c (:func:`plot_error_and_delay`).
-    """
-    main = "paper" if "paper" in methods else methods[0]
-    paths = [plot_method_errors(rows, cases, methods, out_dir)]
-    if "fast" in methods:
-        paths.append(plot_error_and_delay(rows, cases, methods, out_dir))
-    paths += [plot_case_estimates(rows, case, out_dir, main) for case in cases]
-    if "paper" in methods:
-        paths.append(plot_frequencies(rows, antenna, out_dir))
-    return paths

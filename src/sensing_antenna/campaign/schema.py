@@ -1,48 +1,13 @@
-"""Declarative campaign specifications (TOML) and their expansion into individual runs.
+"""The campaign spec as data: frozen, validated dataclasses (what to simulate, how to estimate).
 
-A campaign is the experiment plan of Section 5.6 of the paper: for each case (azimuthal or vertical
-movement), each contact point and each repeat, one simulated contact manoeuvre, estimated by every
-method. The built-in spec ``paper-2021`` reproduces the paper: 15 contact points x 5 repeats x 2
-cases = 150 runs. A spec file looks like::
-
-    name = "small"
-    antenna = "paper-2021"          # built-in name, or a TOML file relative to this spec
-    cases = ["azimuthal", "vertical"]
-    contact_points = [0.3, 0.6, 0.9] # m
-    repeats = 2
-    base_seed = 7
-    methods = ["paper", "ratio", "two-frequency"]
-
-    [scenario]                      # keyword arguments of simulator.Scenario, SI units
-    noise_scale = 1.0
-    damping_ratio = 0.005
-
-    [free_motion]                   # optional: identify the Eq. 15 observer first (Section 5.2)
-    identify = true
-    duration = 4.0                  # s
-
-    [device]                        # optional: the simulated hardware, when it is not the model
-    antenna = "paper-2021"          # default: the top-level antenna
-    link.youngs_modulus = 132.65e9  # field overrides, SI
-
-    [calibration]                   # optional: fit T_e on the device first (Section 5.1)
-    enabled = true
-    case = "azimuthal"
-    contact_points = [0.30, 0.35, 0.40]  # m
-    repeats = 1
-    loss = "soft_l1"
-
-    [noise_sweep]                   # optional: extra runs at other sensor noise levels
-    noise_scales = [0.5, 2.0]       # multiples of the simulator's nominal noise
-    contact_points = [0.3, 0.6]     # default: the main contact points
-    repeats = 1                     # default: the main repeats
-    cases = ["azimuthal"]           # default: the main cases
-
-The top-level ``antenna`` is the nominal model the estimators start from; ``[device]`` is what the
-simulator uses as the hardware. Without ``[device]`` both are the same.
-
-Seeds are derived from ``base_seed`` and the run index with :class:`numpy.random.SeedSequence`, so
-every run's seed is fixed by the spec alone and independent of the order runs execute in.
+A :class:`CampaignSpec` is the experiment plan of Section 5.6 of the paper: for each case
+(azimuthal or vertical movement), each contact point and each repeat, one simulated contact
+manoeuvre, estimated by every method, with optional steps before the runs (free-motion
+identification, calibration of T_e), a simulated device that may differ from the nominal model,
+and an optional noise sweep. Every dataclass checks its own fields; a bad value raises
+:class:`CampaignSpecError` naming the field (and the file, when the spec came from one). TOML
+files become specs in :mod:`~sensing_antenna.campaign.parsing`; specs become runs in
+:mod:`~sensing_antenna.campaign.runs`.
 """
 
 from __future__ import annotations
@@ -52,26 +17,16 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from importlib import resources
-from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
 from sensing_antenna.errors import FieldError
-from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
-    "CALIBRATION_STREAM",
     "CASES",
     "DEFAULT_CALIBRATION_POINTS",
-    "DEFAULT_SPEC_NAME",
     "DEVICE_SECTIONS",
-    "FREE_MOTION_STREAM",
     "METHODS",
-    "NOISE_SWEEP_STREAM",
-    "RUN_STREAM",
     "SCENARIO_NOISE_SCALE",
     "CalibrationStep",
     "CampaignSpec",
@@ -79,13 +34,9 @@ __all__ = [
     "DeviceSpec",
     "FreeMotionStep",
     "NoiseSweep",
-    "RunSpec",
-    "default_campaign_spec",
-    "derive_seed",
-    "expand_runs",
     "known_methods",
-    "load_campaign_spec",
-    "parse_campaign_spec",
+    "noise_level_key",
+    "same_noise_level",
 ]
 
 #: Manoeuvres of Section 5.6: Case 1 azimuthal movement, Case 2 vertical movement.
@@ -94,13 +45,6 @@ CASES = ("azimuthal", "vertical")
 #: Default estimation methods: the paper's fused estimator and the two baselines. Any key of
 #: ``sensing_antenna.estimation.METHODS`` is accepted (see :func:`known_methods`).
 METHODS = ("paper", "ratio", "two-frequency")
-
-#: Seed streams of :func:`derive_seed`: contact runs, the free-motion step, the calibration step,
-#: the runs of the noise sweep.
-RUN_STREAM = 0
-FREE_MOTION_STREAM = 1
-CALIBRATION_STREAM = 2
-NOISE_SWEEP_STREAM = 3
 
 #: ``simulator.Scenario.noise_scale`` when the spec's ``[scenario]`` does not set it: the
 #: simulator's nominal sensor noise.
@@ -150,29 +94,8 @@ DEFAULT_CALIBRATION_POINTS = (
 #: Losses of the T_e fit (those of scipy.optimize.least_squares; see calibration.frequency).
 _CALIBRATION_LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
 
-#: Name of the built-in spec that reproduces Section 5.6.
-DEFAULT_SPEC_NAME = "paper-2021"
-
 #: Scenario keys the campaign sets itself for every run.
 _RESERVED_SCENARIO_KEYS = ("case", "contact_point", "seed")
-
-_TOP_LEVEL_KEYS = (
-    "name",
-    "description",
-    "antenna",
-    "cases",
-    "contact_points",
-    "repeats",
-    "base_seed",
-    "methods",
-    "scenario",
-    "free_motion",
-    "device",
-    "calibration",
-    "noise_sweep",
-)
-
-_NOISE_SWEEP_KEYS = ("noise_scales", "contact_points", "repeats", "cases")
 
 
 class CampaignSpecError(FieldError):
@@ -322,7 +245,7 @@ class CalibrationStep:
 
 @dataclass(frozen=True)
 class NoiseSweep:
-    """Optional extra runs at other sensor noise levels (issue 6: accuracy against noise).
+    """Optional extra runs at other sensor noise levels: accuracy against noise.
 
     Each level repeats the sweep's cases x contact points x repeats with the scenario's
     ``noise_scale`` replaced by that level; every method estimates the same recordings. The main
@@ -352,7 +275,7 @@ class NoiseSweep:
                 raise CampaignSpecError(
                     f"noise_sweep.noise_scales[{i}]", f"must be a finite number >= 0, got {s!r}"
                 )
-        if len({_level_key(s) for s in self.noise_scales}) != len(self.noise_scales):
+        if len({noise_level_key(s) for s in self.noise_scales}) != len(self.noise_scales):
             raise CampaignSpecError(
                 "noise_sweep.noise_scales", "must be distinct (to 0.01, as in the run ids)"
             )
@@ -393,9 +316,14 @@ def _check_contact_points(key: str, points: Sequence[float], source: str | None)
         raise CampaignSpecError(key, "must be distinct", source)
 
 
-def _level_key(noise_scale: float) -> int:
-    """A noise level as it appears in run ids (hundredths)."""
+def noise_level_key(noise_scale: float) -> int:
+    """A noise level as it appears in run ids: hundredths of the nominal noise."""
     return round(noise_scale * 100)
+
+
+def same_noise_level(a: float, b: float) -> bool:
+    """Whether two noise levels are the same to 0.01 (as in the run ids)."""
+    return noise_level_key(a) == noise_level_key(b)
 
 
 @dataclass(frozen=True)
@@ -468,7 +396,7 @@ class CampaignSpec:
                 )
         main = self.noise_scale
         for i, s in enumerate(self.noise_sweep.noise_scales):
-            if math.isfinite(main) and _level_key(s) == _level_key(main):
+            if math.isfinite(main) and noise_level_key(s) == noise_level_key(main):
                 raise CampaignSpecError(
                     f"noise_sweep.noise_scales[{i}]",
                     f"{s!r} is the main runs' level (scenario.noise_scale = {main!r}), which "
@@ -578,8 +506,8 @@ class CampaignSpec:
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON/TOML-ready) that :func:`parse_campaign_spec` reads back.
 
-        ``noise_sweep`` appears only when the sweep is enabled, so the fingerprint of a spec
-        without one is what it was before sweeps existed (stored campaigns still resume).
+        ``noise_sweep`` appears only when the sweep is enabled, so a spec without a sweep has
+        the fingerprint of one that never mentions it.
         """
         data = {
             "name": self.name,
@@ -623,134 +551,6 @@ class CampaignSpec:
         return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
 
-@dataclass(frozen=True)
-class RunSpec:
-    """Everything one run needs: picklable, so it can travel to a worker process or a Dask worker.
-
-    Parameters
-    ----------
-    index : int
-        Position of the run in the campaign (0-based).
-    run_id : str
-        Stable, file-name-safe identifier, e.g. ``azimuthal-x0300mm-r1``; a run of the noise
-        sweep ends in its level, e.g. ``azimuthal-x0300mm-r1-n2.00``.
-    case : str
-        Manoeuvre (:data:`CASES`).
-    contact_point : float
-        True contact point x_c (m).
-    repeat : int
-        Repeat number, 1-based.
-    seed : int
-        Seed of this run's simulation (derived from the base seed and the run's position: stream
-        :data:`RUN_STREAM` for the main runs, :data:`NOISE_SWEEP_STREAM` for the sweep's).
-    antenna : Antenna
-        The model the estimators use (nominal antenna, identified observer, calibrated T_e).
-    methods : tuple of str
-        Methods that estimate the recording.
-    scenario : mapping
-        Extra keyword arguments of ``simulator.Scenario`` (a sweep run's holds its
-        ``noise_scale``).
-    device : Antenna or None
-        The simulated hardware (with the observer its controller uses); None: ``antenna``.
-    """
-
-    index: int
-    run_id: str
-    case: str
-    contact_point: float
-    repeat: int
-    seed: int
-    antenna: Antenna
-    methods: tuple[str, ...]
-    scenario: Mapping[str, Any] = field(default_factory=dict)
-    device: Antenna | None = None
-
-    @property
-    def noise_scale(self) -> float:
-        """Sensor noise level of this run (``scenario["noise_scale"]``, default 1)."""
-        return float(self.scenario.get("noise_scale", SCENARIO_NOISE_SCALE))
-
-    @property
-    def simulated_antenna(self) -> Antenna:
-        """The antenna the simulator uses: ``device`` if given, else ``antenna``."""
-        return self.device if self.device is not None else self.antenna
-
-
-def derive_seed(base_seed: int, index: int, stream: int = RUN_STREAM) -> int:
-    """Seed of run ``index``: SeedSequence(base_seed, spawn_key=(stream, index)), first word.
-
-    Stream 0 (:data:`RUN_STREAM`) holds the contact runs, stream 1 the free-motion identification
-    step, stream 2 the calibration recordings and stream 3 the runs of the noise sweep, so no two
-    of them share a seed sequence.
-    """
-    state = np.random.SeedSequence(base_seed, spawn_key=(stream, index)).generate_state(1)
-    return int(state[0])
-
-
-def expand_runs(
-    spec: CampaignSpec, antenna: Antenna, device: Antenna | None = None
-) -> list[RunSpec]:
-    """All runs of a campaign in a fixed order: case, then contact point, then repeat.
-
-    The main runs come first (indices and ids as without a sweep); then, if the spec has a noise
-    sweep, its runs ordered by level, case, contact point and repeat, with ids ending in
-    ``-n<level>`` and seeds from :data:`NOISE_SWEEP_STREAM` (position within the sweep).
-
-    Parameters
-    ----------
-    spec : CampaignSpec
-    antenna : Antenna
-        The model the estimators use (the spec's, possibly with an identified observer and a
-        calibrated T_e).
-    device : Antenna, optional
-        The simulated hardware; None simulates with ``antenna``.
-    """
-    runs: list[RunSpec] = []
-    for case in spec.cases:
-        for x_c in spec.contact_points:
-            for repeat in range(1, spec.repeats + 1):
-                index = len(runs)
-                runs.append(
-                    RunSpec(
-                        index=index,
-                        run_id=f"{case}-x{round(x_c * 1000):04d}mm-r{repeat}",
-                        case=case,
-                        contact_point=float(x_c),
-                        repeat=repeat,
-                        seed=derive_seed(spec.base_seed, index),
-                        antenna=antenna,
-                        methods=spec.methods,
-                        scenario=dict(spec.scenario),
-                        device=device,
-                    )
-                )
-    sweep = 0
-    for level in spec.noise_sweep.noise_scales:
-        scenario = {**spec.scenario, "noise_scale": float(level)}
-        for case in spec.sweep_cases:
-            for x_c in spec.sweep_contact_points:
-                for repeat in range(1, spec.sweep_repeats + 1):
-                    runs.append(
-                        RunSpec(
-                            index=len(runs),
-                            run_id=(
-                                f"{case}-x{round(x_c * 1000):04d}mm-r{repeat}"
-                                f"-n{_level_key(level) / 100:.2f}"
-                            ),
-                            case=case,
-                            contact_point=float(x_c),
-                            repeat=repeat,
-                            seed=derive_seed(spec.base_seed, sweep, NOISE_SWEEP_STREAM),
-                            antenna=antenna,
-                            methods=spec.methods,
-                            scenario=dict(scenario),
-                            device=device,
-                        )
-                    )
-                    sweep += 1
-    return runs
-
-
 def known_methods() -> tuple[str, ...]:
     """Names of the estimation methods (``sensing_antenna.estimation.METHODS``)."""
     try:
@@ -772,250 +572,3 @@ def _check_choices(
             )
     if len(set(values)) != len(values):
         raise CampaignSpecError(name, "must not repeat a value", src)
-
-
-def _get(data: Mapping[str, Any], key: str, kind: type | tuple[type, ...], src: str) -> Any:
-    if key not in data:
-        raise CampaignSpecError(key, "missing", src)
-    value = data[key]
-    if (isinstance(value, bool) and kind is not bool) or not isinstance(value, kind):
-        raise CampaignSpecError(key, f"wrong type: got {value!r}", src)
-    return value
-
-
-def _str_list(data: Mapping[str, Any], key: str, src: str) -> tuple[str, ...]:
-    value = _get(data, key, list, src)
-    for i, item in enumerate(value):
-        if not isinstance(item, str):
-            raise CampaignSpecError(f"{key}[{i}]", f"must be a string, got {item!r}", src)
-    return tuple(value)
-
-
-def parse_campaign_spec(
-    data: Mapping[str, Any], source: str, base_dir: Path | None = None
-) -> CampaignSpec:
-    """Validate plain data (from TOML) into a :class:`CampaignSpec`.
-
-    Parameters
-    ----------
-    data : mapping
-        Parsed TOML.
-    source : str
-        File name or built-in name, used in error messages.
-    base_dir : Path or None
-        Directory relative antenna paths are resolved against.
-    """
-    for key in data:
-        if key not in _TOP_LEVEL_KEYS:
-            raise CampaignSpecError(
-                key, f"unknown key; known: {', '.join(_TOP_LEVEL_KEYS)}", source
-            )
-    name = _get(data, "name", str, source)
-    antenna = data.get("antenna", "paper-2021")
-    if not isinstance(antenna, str) or not antenna:
-        raise CampaignSpecError("antenna", "must be a built-in name or a file path", source)
-    antenna = _resolve_antenna(antenna, base_dir)
-    points = _numbers(_get(data, "contact_points", list, source), "contact_points", "m", source)
-    repeats = _get(data, "repeats", int, source)
-    base_seed = _get(data, "base_seed", int, source)
-    methods = _str_list(data, "methods", source) if "methods" in data else METHODS
-    scenario = data.get("scenario", {})
-    if not isinstance(scenario, Mapping):
-        raise CampaignSpecError("scenario", "must be a table of Scenario fields", source)
-    free = data.get("free_motion", {})
-    if not isinstance(free, Mapping):
-        raise CampaignSpecError("free_motion", "must be a table", source)
-    for key in free:
-        if key not in ("identify", "duration", "case"):
-            raise CampaignSpecError(f"free_motion.{key}", "unknown key", source)
-    identify = free.get("identify", False)
-    if not isinstance(identify, bool):
-        raise CampaignSpecError("free_motion.identify", "must be true or false", source)
-    duration = free.get("duration", 4.0)
-    if isinstance(duration, bool) or not isinstance(duration, (int, float)):
-        raise CampaignSpecError("free_motion.duration", "must be a number (s)", source)
-    device = _parse_device(data.get("device", {}), source, base_dir)
-    calibration = _parse_calibration(data.get("calibration", {}), source)
-    noise_sweep = _parse_noise_sweep(data.get("noise_sweep", {}), source)
-    try:
-        free_step = FreeMotionStep(
-            identify=identify, duration=float(duration), case=str(free.get("case", "free"))
-        )
-        return CampaignSpec(
-            name=name,
-            description=str(data.get("description", "")),
-            antenna=antenna,
-            cases=_str_list(data, "cases", source),
-            contact_points=points,
-            repeats=repeats,
-            base_seed=base_seed,
-            methods=methods,
-            scenario=dict(scenario),
-            free_motion=free_step,
-            device=device,
-            calibration=calibration,
-            noise_sweep=noise_sweep,
-            source=source,
-        )
-    except CampaignSpecError as exc:
-        if exc.source is None:
-            raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
-        raise
-
-
-def _resolve_antenna(value: str, base_dir: Path | None) -> str:
-    if base_dir is not None and not value.startswith("paper-2021"):
-        candidate = base_dir / value
-        if candidate.is_file():
-            return str(candidate)
-    return value
-
-
-def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
-    if not isinstance(data, Mapping):
-        raise CampaignSpecError("device", "must be a table", source)
-    antenna = data.get("antenna")
-    if antenna is not None:
-        if not isinstance(antenna, str) or not antenna:
-            raise CampaignSpecError(
-                "device.antenna", "must be a built-in name or a file path", source
-            )
-        antenna = _resolve_antenna(antenna, base_dir)
-    overrides: dict[str, dict[str, float]] = {}
-    for key, values in data.items():
-        if key == "antenna":
-            continue
-        if key not in DEVICE_SECTIONS:
-            raise CampaignSpecError(
-                f"device.{key}",
-                f"unknown key; known: antenna, {', '.join(DEVICE_SECTIONS)}",
-                source,
-            )
-        if not isinstance(values, Mapping):
-            raise CampaignSpecError(
-                f"device.{key}",
-                "must be a table of fields (e.g. link.youngs_modulus = 1e11)",
-                source,
-            )
-        overrides[key] = dict(values)
-    try:
-        return DeviceSpec(antenna=antenna, overrides=overrides)
-    except CampaignSpecError as exc:
-        raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
-
-
-def _parse_calibration(data: Any, source: str) -> CalibrationStep:
-    if not isinstance(data, Mapping):
-        raise CampaignSpecError("calibration", "must be a table", source)
-    known = ("enabled", "case", "contact_points", "repeats", "loss")
-    for key in data:
-        if key not in known:
-            raise CampaignSpecError(
-                f"calibration.{key}", f"unknown key; known: {', '.join(known)}", source
-            )
-    enabled = data.get("enabled", False)
-    if not isinstance(enabled, bool):
-        raise CampaignSpecError("calibration.enabled", "must be true or false", source)
-    case = data.get("case", "azimuthal")
-    loss = data.get("loss", "soft_l1")
-    for key, value in (("case", case), ("loss", loss)):
-        if not isinstance(value, str):
-            raise CampaignSpecError(
-                f"calibration.{key}", f"must be a string, got {value!r}", source
-            )
-    repeats = data.get("repeats", 1)
-    if isinstance(repeats, bool) or not isinstance(repeats, int):
-        raise CampaignSpecError(
-            "calibration.repeats", f"must be an integer, got {repeats!r}", source
-        )
-    raw = data.get("contact_points", list(DEFAULT_CALIBRATION_POINTS))
-    points = _numbers(raw, "calibration.contact_points", "m", source)
-    try:
-        return CalibrationStep(
-            enabled=enabled, case=case, contact_points=points, repeats=repeats, loss=loss
-        )
-    except CampaignSpecError as exc:
-        raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
-
-
-def _numbers(raw: Any, key: str, unit: str, source: str) -> tuple[float, ...]:
-    """A TOML list of numbers (``unit`` names them in messages); field ``key[i]`` on error."""
-    if not isinstance(raw, list):
-        raise CampaignSpecError(key, f"must be a list of numbers ({unit})", source)
-    values: list[float] = []
-    for i, x in enumerate(raw):
-        if isinstance(x, bool) or not isinstance(x, (int, float)):
-            raise CampaignSpecError(f"{key}[{i}]", f"must be a number ({unit}), got {x!r}", source)
-        values.append(float(x))
-    return tuple(values)
-
-
-def _parse_noise_sweep(data: Any, source: str) -> NoiseSweep:
-    if not isinstance(data, Mapping):
-        raise CampaignSpecError("noise_sweep", "must be a table", source)
-    if not data:
-        return NoiseSweep()
-    for key in data:
-        if key not in _NOISE_SWEEP_KEYS:
-            raise CampaignSpecError(
-                f"noise_sweep.{key}", f"unknown key; known: {', '.join(_NOISE_SWEEP_KEYS)}", source
-            )
-    if "noise_scales" not in data:
-        raise CampaignSpecError("noise_sweep.noise_scales", "missing", source)
-    scales = _numbers(data["noise_scales"], "noise_sweep.noise_scales", "noise multiples", source)
-    if not scales:
-        raise CampaignSpecError(
-            "noise_sweep.noise_scales", "must list at least one level (or drop the table)", source
-        )
-    points = (
-        _numbers(data["contact_points"], "noise_sweep.contact_points", "m", source)
-        if "contact_points" in data
-        else None
-    )
-    repeats = data.get("repeats")
-    if repeats is not None and (isinstance(repeats, bool) or not isinstance(repeats, int)):
-        raise CampaignSpecError(
-            "noise_sweep.repeats", f"must be an integer, got {repeats!r}", source
-        )
-    cases = None
-    if "cases" in data:
-        raw = data["cases"]
-        if not isinstance(raw, list) or not all(isinstance(c, str) for c in raw):
-            raise CampaignSpecError("noise_sweep.cases", "must be a list of case names", source)
-        cases = tuple(raw)
-    try:
-        return NoiseSweep(noise_scales=scales, contact_points=points, repeats=repeats, cases=cases)
-    except CampaignSpecError as exc:
-        raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
-
-
-def load_campaign_spec(path: str | Path | None = None) -> CampaignSpec:
-    """Load a campaign spec from a TOML file, or the built-in ``paper-2021`` spec when None.
-
-    Raises
-    ------
-    CampaignSpecError
-        Naming the file and the field for any missing, unknown or invalid value.
-    """
-    if path is None or str(path) == DEFAULT_SPEC_NAME:
-        return default_campaign_spec()
-    file = Path(path)
-    if not file.is_file():
-        raise CampaignSpecError("spec", "no such file", str(file))
-    data = parse_toml_file(
-        file, lambda field, problem: CampaignSpecError(field, problem, str(file))
-    )
-    return parse_campaign_spec(data, str(file), base_dir=file.parent)
-
-
-def default_campaign_spec() -> CampaignSpec:
-    """The built-in campaign of Section 5.6: 15 points x 5 repeats x 2 cases, all methods."""
-    text = (
-        resources.files("sensing_antenna")
-        .joinpath(f"data/campaign-{DEFAULT_SPEC_NAME}.toml")
-        .read_text("utf-8")
-    )
-    data = parse_toml_text(
-        text, lambda field, problem: CampaignSpecError(field, problem, DEFAULT_SPEC_NAME)
-    )
-    return parse_campaign_spec(data, DEFAULT_SPEC_NAME)
