@@ -22,10 +22,12 @@ from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation import (
     METHODS,
+    EarlyOutcome,
     EstimatorConfig,
     OnlineEstimator,
     Status,
     estimate,
+    gather,
     measure_omega1,
 )
 from sensing_antenna.estimation.config import EstimatorConfigError
@@ -238,13 +240,11 @@ def test_no_contact() -> None:
     assert math.isnan(result.x_c)
     _, final = run_online(recording)
     assert final.status is Status.NO_CONTACT
-    # Without a contact there is no evidence to study: gather_evidence gives the early result
-    from sensing_antenna.estimation.front.evidence import Evidence
-    from sensing_antenna.estimation.pipeline import gather_evidence
-
-    early = gather_evidence(recording, paper_antenna())
-    assert not isinstance(early, Evidence)
+    # Without a contact there is no evidence to study: the front end gives the early outcome
+    early = gather(recording, paper_antenna())
+    assert isinstance(early, EarlyOutcome)
     assert early.status is Status.NO_CONTACT
+    assert early.reason == result.reason
 
 
 def test_push_too_gentle_is_not_a_push() -> None:
