@@ -139,9 +139,12 @@ def free_motion_torque(
 
 
 def block_rows(values: SampleBlock, count: int, width: int) -> NDArray[np.float64]:
-    """``values`` as a fresh C-ordered float array of shape (count, width), the one layout the
-    compiled kernels are built for (a recording's read-only arrays would need another)."""
-    return np.array(values, dtype=np.float64, order="C").reshape(count, width)
+    """``values`` as a writable C-ordered float array of shape (count, width), the one layout
+    the compiled kernels are built for (a recording's read-only arrays would need another):
+    the array itself when it already is one, else a copy."""
+    rows = np.asarray(values, dtype=np.float64).reshape(count, width)
+    flags = rows.flags
+    return rows if flags.c_contiguous and flags.writeable else np.array(rows, order="C")
 
 
 # Layout of the contact kernel's parameters (``par``) and state (``mem``), float64 arrays:

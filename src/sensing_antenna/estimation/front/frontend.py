@@ -149,7 +149,7 @@ class FrontEnd:
         self._mean: FloatArray = np.empty(0)
         self._n = 0
         self._loads_done = self._ratio_done = self._mean_done = 0
-        self._gaps: list[tuple[int, tuple[float, float]]] = []  # (sample known at, interval)
+        self._filled: list[tuple[int, tuple[float, float]]] = []  # (known at sample, interval)
         self._contact: int | None = None
         self._start: ContactStart | None = None
         self._rest: int | None = None
@@ -249,7 +249,7 @@ class FrontEnd:
         ):
             buffer[first:stop] = values
         self._n = stop
-        self._note_gaps(first, stop, filled_gaps)
+        self._filled.extend((first, (float(a), float(b))) for a, b in filled_gaps)
         if self._refused is not None:
             return self._stop(self._early(Status.BAD_INPUT, self._refused))
         if self._monitor is not None:
@@ -270,14 +270,12 @@ class FrontEnd:
             new[: self._n] = old[: self._n]
             setattr(self, name, new)
 
-    def _note_gaps(self, first: int, stop: int, filled: Sequence[tuple[float, float]]) -> None:
-        """Gaps between the stamps of samples first..stop (and the one before), and filled ones."""
-        self._gaps.extend((first, (float(a), float(b))) for a, b in filled)
-        start = max(first - 1, 0)
-        found = time_gaps(self._t[start:stop], self.sample_period, self.config.max_gap)
-        if found:
-            ends = np.searchsorted(self._t[start:stop], [end for _, end in found]) + start
-            self._gaps.extend((int(k), gap) for k, gap in zip(ends, found, strict=True))
+    def _gaps_known(self, end: int) -> list[tuple[float, float]]:
+        """Gaps known at sample ``end``: those the caller filled in the blocks fed by then, and
+        steps of the time stamps up to ``end`` missing more than ``config.max_gap`` samples."""
+        filled = [gap for known, gap in self._filled if known <= end]
+        stamps = time_gaps(self._t[: end + 1], self.sample_period, self.config.max_gap)
+        return filled + list(stamps)
 
     def _advance(self, first: int, stop: int) -> Gathered | None:
         """The steps after the detectors, on samples first..stop (module docstring)."""
@@ -431,7 +429,7 @@ class FrontEnd:
                 "force_noise": hold.force_noise,
             }
         )
-        gaps = [gap for known, gap in self._gaps if known <= end]
+        gaps = self._gaps_known(end)
         t = self._t
         return Evidence(
             t=_read_only(t[:stop]),
@@ -525,6 +523,7 @@ class FrontEnd:
         frame = self._hold.frame if self._hold is not None else None
         return FrontTrace(
             t=_read_only(self._t[:n]),
+            sample_period=self.sample_period,
             theta=_read_only(self._theta[:n]),
             force=_read_only(self._force[:n]),
             torque=_read_only(self._torque[:n]),

@@ -36,6 +36,8 @@ class FrontTrace:
     ----------
     t : array, shape (n,)
         Sample times (s).
+    sample_period : float
+        T_s (s).
     theta, force, torque : array, shape (n, 2), (n, 3), (n, 3)
         Samples (rad, N, N m; motor frame).
     estimated_torque : array, shape (n, 3)
@@ -62,6 +64,7 @@ class FrontTrace:
     """
 
     t: FloatArray
+    sample_period: float
     theta: FloatArray
     force: FloatArray
     torque: FloatArray
