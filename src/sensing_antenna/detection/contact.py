@@ -394,19 +394,8 @@ class ContactDetector:
     def update(
         self, t: float, theta: SampleVector, force: SampleVector, torque: SampleVector
     ) -> bool:
-        """Feed one sample (a block of one); returns True once contact has been detected.
-
-        Parameters
-        ----------
-        t : float
-            Sample time (s).
-        theta : array_like, shape (2,)
-            Motor angles (rad).
-        force : array_like, shape (3,)
-            Force (N); unused by this detector.
-        torque : array_like, shape (3,)
-            Torque by the link on the head about O, motor frame (N m).
-        """
+        """Feed one sample (a block of one: t in s, theta (2,) in rad, force (3,) unused,
+        torque (3,) in N m); returns True once contact has been detected."""
         return self.update_block((t,), theta, force, torque)
 
     @property
@@ -468,15 +457,8 @@ def detect_contact(
     ----------
     recording : Recording
         Irregular sampling is handled by linear resampling at the nominal period first.
-    antenna : Antenna
-        Observer of Eq. 15 and link weight.
-    threshold : float, optional
-        Threshold on the filtered residual norm (N m); ``antenna.observer.contact_threshold``
-        when None.
-    residual_cutoff : float
-        Cut-off of the residual low-pass filter (rad/s).
-    tare_time : float
-        Taring window at the start (s), see the module docstring.
+    antenna, threshold, residual_cutoff, tare_time
+        As for :class:`ContactDetector`.
 
     Returns
     -------

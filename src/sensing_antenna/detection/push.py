@@ -351,19 +351,9 @@ class PushMonitor:
     def update_block(
         self, t: ArrayLike, theta: SampleBlock, force: SampleBlock, torque: SampleBlock
     ) -> bool:
-        """Feed samples; returns True from the block where the criterion is met (t_1) on.
-
-        Parameters
-        ----------
-        t : array_like, shape (n,)
-            Sample times (s).
-        theta : array_like, shape (n, 2)
-            Motor angles (rad).
-        force : array_like, shape (n, 3)
-            Force by the link on the head, motor frame (N).
-        torque : array_like, shape (n, 3)
-            Torque by the link on the head about O, motor frame (N m).
-        """
+        """Feed samples (as :meth:`ContactDetector.update_block`, the force used here: by the
+        link on the head, motor frame, N); returns True from the block where the criterion is
+        met (t_1) on."""
         detector = self.contact_detector
         start = detector.n_samples
         times = np.asarray(t, dtype=np.float64).reshape(-1)
@@ -393,20 +383,8 @@ class PushMonitor:
     def update(
         self, t: float, theta: SampleVector, force: SampleVector, torque: SampleVector
     ) -> bool:
-        """Feed one sample (a block of one); returns True from the sample where the criterion
-        is met (t_1) on.
-
-        Parameters
-        ----------
-        t : float
-            Sample time (s).
-        theta : array_like, shape (2,)
-            Motor angles (rad).
-        force : array_like, shape (3,)
-            Force by the link on the head, motor frame (N).
-        torque : array_like, shape (3,)
-            Torque by the link on the head about O, motor frame (N m).
-        """
+        """Feed one sample (a block of one: t in s, theta (2,) in rad, force (3,) in N, torque
+        (3,) in N m); returns True from the sample where the criterion is met (t_1) on."""
         return self.update_block((t,), theta, force, torque)
 
     def detection(self, resampled: bool = False) -> PushDetection:

@@ -11,13 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 from numpy.typing import ArrayLike
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import Evidence
-from sensing_antenna.estimation.front.frontend import FrontEnd
+from sensing_antenna.estimation.front.frontend import FrontEnd, one_sample
 from sensing_antenna.estimation.methods import (
     EarlyStopping,
     EstimationMethod,
@@ -87,23 +86,9 @@ class OnlineEstimator:
     def update(
         self, t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
     ) -> ContactEstimate | None:
-        """Feed one sample (a block of one); returns the estimate (once), else None.
-
-        Parameters
-        ----------
-        t : float
-            Sample time (s).
-        theta : array_like, shape (2,)
-            Motor angles (rad).
-        force, torque : array_like, shape (3,)
-            F/T sensor sample, motor frame (N, N m).
-        """
-        return self.update_block(
-            np.array([t], dtype=np.float64),
-            np.asarray(theta, dtype=np.float64)[None, :],
-            np.asarray(force, dtype=np.float64)[None, :],
-            np.asarray(torque, dtype=np.float64)[None, :],
-        )
+        """Feed one sample (a block of one: t in s, theta (2,) in rad, force and torque (3,) in
+        N and N m, motor frame); returns the estimate (once), else None."""
+        return self.update_block(*one_sample(t, theta, force, torque))
 
     def update_block(
         self, t: ArrayLike, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
@@ -118,19 +103,10 @@ class OnlineEstimator:
         sample-by-sample feeding would give. A block that reaches the pipeline's own end before
         any instant was asked concludes as the offline method does.
 
-        Parameters
-        ----------
-        t : array_like, shape (n,)
-            Sample times (s).
-        theta : array_like, shape (n, 2)
-            Motor angles (rad).
-        force, torque : array_like, shape (n, 3)
-            F/T sensor samples, motor frame (N, N m).
-
-        Raises
-        ------
-        FieldError
-            When the shapes do not match.
+        The samples are as for :meth:`FrontEnd.update_block
+        <sensing_antenna.estimation.front.frontend.FrontEnd.update_block>`: t (n,) in s, theta
+        (n, 2) in rad, force and torque (n, 3) in N and N m, motor frame; a
+        :class:`~sensing_antenna.errors.FieldError` names a misshapen one.
         """
         front = self._front
         first = front.n_samples

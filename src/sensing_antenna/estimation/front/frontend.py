@@ -60,7 +60,7 @@ from sensing_antenna.estimation.front.steps import (
 from sensing_antenna.estimation.result import Status
 from sensing_antenna.recording import Recording, resample_uniform
 
-__all__ = ["FrontEnd", "gather"]
+__all__ = ["FrontEnd", "Gathered", "gather", "one_sample"]
 
 FloatArray = NDArray[np.float64]
 
@@ -69,6 +69,18 @@ Gathered = Evidence | EarlyOutcome
 
 # The buffers of FrontEnd (set in reset), grown by doubling, NaN where not written.
 _BUFFERS = ("_t", "_theta", "_force", "_torque", "_reaction", "_moment", "_ratio", "_mean")
+
+
+def one_sample(
+    t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """One sample as a block of one: t (1,), theta (1, 2), force and torque (1, 3)."""
+    return (
+        np.array([t], dtype=np.float64),
+        np.asarray(theta, dtype=np.float64)[None, :],
+        np.asarray(force, dtype=np.float64)[None, :],
+        np.asarray(torque, dtype=np.float64)[None, :],
+    )
 
 
 def _read_only(view: FloatArray) -> FloatArray:
@@ -190,16 +202,9 @@ class FrontEnd:
     def update(
         self, t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
     ) -> Gathered | None:
-        """Feed one sample (a block of one); returns the outcome once, else None.
-
-        ``theta`` has shape (2,), ``force`` and ``torque`` (3,) (rad, N, N m; motor frame).
-        """
-        return self.update_block(
-            np.array([t], dtype=np.float64),
-            np.asarray(theta, dtype=np.float64)[None, :],
-            np.asarray(force, dtype=np.float64)[None, :],
-            np.asarray(torque, dtype=np.float64)[None, :],
-        )
+        """Feed one sample (a block of one: t in s, theta (2,) in rad, force and torque (3,) in
+        N and N m, motor frame); returns the outcome once, else None."""
+        return self.update_block(*one_sample(t, theta, force, torque))
 
     def update_block(
         self,
