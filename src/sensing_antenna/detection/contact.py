@@ -51,7 +51,6 @@ from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.filters import (
     df2t_step,
     low_pass_coefficients,
-    observe_free_motion,
     observer_coefficients,
 )
 from sensing_antenna.errors import SensingAntennaError
@@ -105,39 +104,6 @@ def tare_samples(tare_time: float, sample_period: float) -> int:
     return max(1, round(tare_time / sample_period))
 
 
-def free_motion_torque(
-    theta: ArrayLike, antenna: Antenna, sample_period: float
-) -> NDArray[np.float64]:
-    """Observed coupling torque in free motion, Gamma_e^m + Gamma_g^m, motor frame (N m).
-
-    Parameters
-    ----------
-    theta : array_like, shape (n, 2)
-        Motor angles (rad), uniformly sampled.
-    antenna : Antenna
-        Supplies the observer (Eq. 15) and the link weight.
-    sample_period : float
-        T_s (s).
-
-    Returns
-    -------
-    ndarray, shape (n, 3)
-        Torque by the link on the head about O predicted without contact (observer from rest at
-        theta[0]).
-    """
-    angles = np.asarray(theta, dtype=np.float64)
-    # Eq. 15: Gamma_e,i = K s^2 / (s^2 + d s + omega^2) theta_i, per joint
-    gamma_e = observe_free_motion(angles, antenna.observer, sample_period)
-    sign_y, sign_z = OBSERVER_TORQUE_SIGNS
-    torque = np.zeros((angles.shape[0], 3))
-    # Section 4.2: Gamma_e^m = (0, +Gamma_e,2, -Gamma_e,1) (signs: module docstring)
-    torque[:, 1] = sign_y * gamma_e[:, 1]
-    torque[:, 2] = sign_z * gamma_e[:, 0]
-    # Section 4.2: Gamma_g^m = (0, m_b g l cos(theta2) / 2, 0), with tip mass and sag
-    torque[:, 1] += antenna.link.gravity_moment(angles[:, 1])
-    return torque
-
-
 def block_rows(values: SampleBlock, count: int, width: int) -> NDArray[np.float64]:
     """``values`` as a writable C-ordered float array of shape (count, width), the one layout
     the compiled kernels are built for (a recording's read-only arrays would need another):
@@ -169,13 +135,16 @@ def gravity_moment_sample(theta2: float, weight_moment: float, sag_moment: float
 def _contact_block(
     par: NDArray[np.float64],
     mem: NDArray[np.float64],
+    times: NDArray[np.float64],
     theta: NDArray[np.float64],
     torque: NDArray[np.float64],
+    history_t: NDArray[np.float64],
     estimated: NDArray[np.float64],
     residual: NDArray[np.float64],
     norm: NDArray[np.float64],
 ) -> int:
-    """Feed rows of theta (n, 2) and torque (n, 3); write rows count.. of the histories.
+    """Feed times (n,), rows of theta (n, 2) and torque (n, 3); write rows count.. of the
+    histories.
 
     Returns the index of the contact sample (counted since reset), -1 before contact.
     """
@@ -183,6 +152,7 @@ def _contact_block(
     z1, z2, lp_z = mem[_Z1], mem[_Z2], mem[_LP_Z]
     for i in range(theta.shape[0]):
         k = int(mem[_COUNT])
+        history_t[k] = times[i]
         if k == 0:
             mem[_ORIGIN], mem[_ORIGIN + 1] = theta[i, 0], theta[i, 1]
         # Eq. 15: Gamma_e,i = K s^2 / (s^2 + d s + omega^2) (theta_i - theta_i[0])
@@ -322,6 +292,7 @@ class ContactDetector:
         par[_THRESHOLD] = self.threshold
         par[_N_TARE] = tare_samples(tare_time, self.sample_period)
         self._par = par
+        self._time = np.zeros(1)  # the time of one sample, as a block
         self.reset()
 
     def reset(self) -> None:
@@ -379,13 +350,20 @@ class ContactDetector:
     ) -> bool:
         """:meth:`update_block` on arrays already in the kernel's layout (:func:`block_rows`)."""
         count = times.shape[0]
-        self._reserve(count)
-        start = self.n_samples
-        self._t[start : start + count] = times
+        if self.n_samples + count > self._t.shape[0]:
+            self._reserve(count)
         index = _contact_block(
-            self._par, self._mem, angles, moments, self._estimated, self._residual, self._norm
+            self._par,
+            self._mem,
+            times,
+            angles,
+            moments,
+            self._t,
+            self._estimated,
+            self._residual,
+            self._norm,
         )
-        self.n_samples = start + count
+        self.n_samples += count
         if index >= 0 and self.contact_index is None:
             self.contact_index = index
             self.contact_time = float(self._t[index])
@@ -396,7 +374,8 @@ class ContactDetector:
     ) -> bool:
         """Feed one sample (a block of one: t in s, theta (2,) in rad, force (3,) unused,
         torque (3,) in N m); returns True once contact has been detected."""
-        return self.update_block((t,), theta, force, torque)
+        self._time[0] = t
+        return self.update_block(self._time, theta, force, torque)
 
     @property
     def filtered_residual_norm(self) -> float:
@@ -442,6 +421,35 @@ class ContactDetector:
             residual_cutoff=self.residual_cutoff,
             resampled=resampled,
         )
+
+
+def free_motion_torque(
+    theta: ArrayLike, antenna: Antenna, sample_period: float
+) -> NDArray[np.float64]:
+    """Observed coupling torque in free motion, Gamma_e^m + Gamma_g^m, motor frame (N m): the
+    contact detector's estimate (Eq. 15 and the weight), without any measured torque.
+
+    Parameters
+    ----------
+    theta : array_like, shape (n, 2)
+        Motor angles (rad), uniformly sampled.
+    antenna : Antenna
+        Supplies the observer (Eq. 15) and the link weight.
+    sample_period : float
+        T_s (s).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Torque by the link on the head about O predicted without contact (observer from rest at
+        theta[0]).
+    """
+    angles = np.asarray(theta, dtype=np.float64)
+    count = angles.shape[0]
+    detector = ContactDetector(antenna, sample_period)
+    still = np.zeros((count, 3))
+    detector.update_block(sample_period * np.arange(count), angles, still, still)
+    return detector.detection().estimated_torque.copy()
 
 
 def detect_contact(

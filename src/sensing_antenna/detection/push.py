@@ -322,6 +322,7 @@ class PushMonitor:
         par[_WEIGHT_MOMENT] = antenna.link.weight_moment
         par[_SAG_MOMENT] = antenna.link.sag_moment
         self._par = par
+        self._time = np.zeros(1)  # the time of one sample, as a block
         self.reset()
 
     def reset(self) -> None:
@@ -361,7 +362,7 @@ class PushMonitor:
         angles = block_rows(theta, count, 2)
         forces, moments = block_rows(force, count, 3), block_rows(torque, count, 3)
         detector._feed(times, angles, moments)
-        if self._measures.shape[0] < start + count:
+        if start + count > self._measures.shape[0]:
             grown = np.empty(max(start + count, 2 * self._measures.shape[0], 4096))
             grown[:start] = self._measures[:start]
             self._measures = grown
@@ -385,7 +386,8 @@ class PushMonitor:
     ) -> bool:
         """Feed one sample (a block of one: t in s, theta (2,) in rad, force (3,) in N, torque
         (3,) in N m); returns True from the sample where the criterion is met (t_1) on."""
-        return self.update_block((t,), theta, force, torque)
+        self._time[0] = t
+        return self.update_block(self._time, theta, force, torque)
 
     def detection(self, resampled: bool = False) -> PushDetection:
         """The decision over every sample fed since reset (arrays are views, not copies)."""

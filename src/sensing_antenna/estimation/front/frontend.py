@@ -83,6 +83,18 @@ def one_sample(
     )
 
 
+def _rows(name: str, value: ArrayLike, count: int, width: int) -> FloatArray:
+    """``value`` as an array of shape (count, width), or a FieldError naming it."""
+    array = np.asarray(value, dtype=np.float64)
+    if array.shape != (count, width):
+        raise FieldError(
+            name,
+            f"shape {array.shape}, expected ({count}, {width}) for {count} sample times",
+            "FrontEnd.update_block",
+        )
+    return array
+
+
 def _read_only(view: FloatArray) -> FloatArray:
     view.flags.writeable = False
     return view
@@ -235,33 +247,36 @@ class FrontEnd:
         """
         times = np.atleast_1d(np.asarray(t, dtype=np.float64))
         count = times.shape[0]
-        arrays = []
-        for name, value, width in (("theta", theta, 2), ("force", force, 3), ("torque", torque, 3)):
-            array = np.asarray(value, dtype=np.float64)
-            if array.shape != (count, width):
-                raise FieldError(
-                    name,
-                    f"shape {array.shape}, expected ({count}, {width}) for {count} sample times",
-                    "FrontEnd.update_block",
-                )
-            arrays.append(array)
+        angles, forces, moments = (
+            _rows(name, value, count, width)
+            for name, value, width in (
+                ("theta", theta, 2),
+                ("force", force, 3),
+                ("torque", torque, 3),
+            )
+        )
         if self._outcome is not None or count == 0:
             return None
         first, stop = self._n, self._n + count
         self._reserve(stop)
-        for buffer, values in zip(
-            (self._t, self._theta, self._force, self._torque), [times, *arrays], strict=True
-        ):
-            buffer[first:stop] = values
+        # the detectors read the samples where they now lie (writable, C-ordered: no copy)
+        fed = (
+            self._t[first:stop],
+            self._theta[first:stop],
+            self._force[first:stop],
+            self._torque[first:stop],
+        )
+        fed[0][:], fed[1][:], fed[2][:], fed[3][:] = times, angles, forces, moments
         self._n = stop
-        self._filled.extend((first, (float(a), float(b))) for a, b in filled_gaps)
+        if filled_gaps:
+            self._filled.extend((first, (float(a), float(b))) for a, b in filled_gaps)
         if self._refused is not None:
             return self._stop(self._early(Status.BAD_INPUT, self._refused))
         if self._monitor is not None:
-            self._monitor.update_block(times, *arrays)
+            self._monitor.update_block(*fed)
         else:
             assert self._detector is not None
-            self._detector.update_block(times, *arrays)
+            self._detector.update_block(*fed)
         return self._advance(first, stop)
 
     def _reserve(self, stop: int) -> None:
