@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.estimation.front.evidence import Evidence
-    from sensing_antenna.estimation.front.frontend import FrontEnd, gather
+    from sensing_antenna.estimation.front.frontend import FrontEnd
     from sensing_antenna.estimation.front.outcome import EarlyOutcome, FrontTrace
     from sensing_antenna.estimation.methods import (
         METHODS,
@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     )
     from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
     from sensing_antenna.estimation.online import OnlineEstimator
-    from sensing_antenna.estimation.pipeline import conclude, estimate, measure_omega1
+    from sensing_antenna.estimation.pipeline import conclude, estimate, gather, measure_omega1
     from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = [
@@ -63,7 +63,7 @@ _WHERE = {
     "conclude": "pipeline",
     "estimate": "pipeline",
     "measure_omega1": "pipeline",
-    "gather": "front.frontend",
+    "gather": "pipeline",
     "FrontEnd": "front.frontend",
     "EarlyOutcome": "front.outcome",
     "FrontTrace": "front.outcome",

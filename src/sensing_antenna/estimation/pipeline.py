@@ -1,6 +1,7 @@
-"""The contact-point pipeline of Section 4, offline: :func:`estimate` is :func:`~.front.frontend.
-gather` (the front end on the whole recording) then the method's ``conclude``
-(:func:`conclude`); :func:`measure_omega1` is ``gather`` then Estimator 1 alone.
+"""The contact-point pipeline of Section 4, offline: :func:`gather` is the front end
+(:class:`~.front.frontend.FrontEnd`) fed the whole recording as one block; :func:`estimate` is
+``gather`` then the method's ``conclude`` (:func:`conclude`); :func:`measure_omega1` is
+``gather`` then Estimator 1 alone.
 
 The streaming form is :class:`~.online.OnlineEstimator`, on the same front end fed sample by
 sample, so both forms give the same estimate on the same samples.
@@ -14,8 +15,9 @@ import math
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
-from sensing_antenna.estimation.front.frontend import Gathered, gather
+from sensing_antenna.estimation.front.frontend import FrontEnd, Gathered
 from sensing_antenna.estimation.front.outcome import EarlyOutcome
+from sensing_antenna.estimation.front.steps import time_gaps
 from sensing_antenna.estimation.methods import (
     METHODS,
     EstimationMethod,
@@ -27,7 +29,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_frequency,
 )
 from sensing_antenna.estimation.result import ContactEstimate
-from sensing_antenna.recording import Recording
+from sensing_antenna.recording import Recording, resample_uniform
 
 __all__ = [
     "METHODS",
@@ -39,6 +41,41 @@ __all__ = [
     "measure_omega1",
     "search_band",
 ]
+
+
+def gather(
+    recording: Recording, antenna: Antenna, config: EstimatorConfig | None = None
+) -> Gathered:
+    """The front end on a whole recording (batch form of :class:`FrontEnd`).
+
+    Parameters
+    ----------
+    recording : Recording
+        Irregular sampling is resampled linearly onto the nominal grid first (said in the
+        diagnostics, and gaps too long to fill are remembered). Ground truth is never read.
+    antenna : Antenna
+    config : EstimatorConfig, optional
+
+    Returns
+    -------
+    Evidence or EarlyOutcome
+        The evidence at t_e, or why there is none; either carries the
+        :class:`~.outcome.FrontTrace` of the whole recording.
+    """
+    cfg = config if config is not None else EstimatorConfig()
+    sampling = recording.sampling
+    uniform = resample_uniform(recording) if sampling.irregular else recording
+    front = FrontEnd(
+        antenna,
+        uniform.sample_period,
+        cfg,
+        diagnostics={"sampling": dataclasses.asdict(sampling), "resampled": sampling.irregular},
+    )
+    filled = (
+        time_gaps(recording.t, recording.sample_period, cfg.max_gap) if sampling.irregular else ()
+    )
+    front.update_block(uniform.t, uniform.theta, uniform.force, uniform.torque, filled)
+    return front.finish()
 
 
 def estimate(

@@ -86,8 +86,9 @@ class Evidence:
     """Everything the pipeline knows at t_e, from the samples up to t_e only.
 
     Built by :class:`~.frontend.FrontEnd`, identically whether the samples came as one block
-    (:func:`~.frontend.gather`) or one by one (the online estimator); a method turns it into a
-    :class:`~sensing_antenna.estimation.result.ContactEstimate`. Arrays are read-only views.
+    (:func:`~sensing_antenna.estimation.pipeline.gather`) or one by one (the online estimator);
+    a method turns it into a :class:`~sensing_antenna.estimation.result.ContactEstimate`. The
+    sample and ratio arrays are read-only views.
 
     Attributes
     ----------

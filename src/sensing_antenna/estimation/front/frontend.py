@@ -1,4 +1,4 @@
-"""The front end as one streaming object, :class:`FrontEnd`, and its batch form, :func:`gather`.
+"""The front end as one streaming object, :class:`FrontEnd`.
 
 The front end turns samples into the :class:`~.evidence.Evidence` a method concludes from, or into
 an :class:`~.outcome.EarlyOutcome` when no estimate is possible. Its steps (Section 4), each
@@ -12,11 +12,12 @@ causal, so an instant depends only on the samples up to it:
 3. At t_1 + hold: the static push and the contact frame (:func:`.steps.hold_push`).
 4. Estimator 2's ratio, its moving mean and convergence (:mod:`.ratio`); t_e (Section 4, step 6).
 
-Samples come in blocks (:meth:`FrontEnd.update_block`); a block of one is the per-sample form, and
-:func:`gather` feeds a whole recording as one block. The detectors are compiled kernels with their
-state carried; the Eq. 20 filter carries its state too; the ratio and its moving mean are
-elementwise and computed once per sample when first needed. So the evidence, its instants and
-every number in it are the same to the bit however the samples are cut into blocks.
+Samples come in blocks (:meth:`FrontEnd.update_block`); a block of one is the per-sample form,
+and :func:`~sensing_antenna.estimation.pipeline.gather` feeds a whole recording as one block.
+The detectors are compiled kernels with their state carried; the Eq. 20 filter carries its state
+too; the ratio and its moving mean are elementwise and computed once per sample when first
+needed. So the evidence, its instants and every number in it are the same to the bit however the
+samples are cut into blocks.
 """
 
 from __future__ import annotations
@@ -58,9 +59,8 @@ from sensing_antenna.estimation.front.steps import (
     time_gaps,
 )
 from sensing_antenna.estimation.result import Status
-from sensing_antenna.recording import Recording, resample_uniform
 
-__all__ = ["FrontEnd", "Gathered", "gather", "one_sample"]
+__all__ = ["FrontEnd", "Gathered", "one_sample"]
 
 FloatArray = NDArray[np.float64]
 
@@ -561,38 +561,3 @@ class FrontEnd:
             spectrum=None if evidence is None else evidence.spectrum_slice,
             band=self.band,
         )
-
-
-def gather(
-    recording: Recording, antenna: Antenna, config: EstimatorConfig | None = None
-) -> Gathered:
-    """The front end on a whole recording (batch form of :class:`FrontEnd`).
-
-    Parameters
-    ----------
-    recording : Recording
-        Irregular sampling is resampled linearly onto the nominal grid first (said in the
-        diagnostics, and gaps too long to fill are remembered). Ground truth is never read.
-    antenna : Antenna
-    config : EstimatorConfig, optional
-
-    Returns
-    -------
-    Evidence or EarlyOutcome
-        The evidence at t_e, or why there is none; either carries the
-        :class:`~.outcome.FrontTrace` of the whole recording.
-    """
-    cfg = config if config is not None else EstimatorConfig()
-    sampling = recording.sampling
-    uniform = resample_uniform(recording) if sampling.irregular else recording
-    front = FrontEnd(
-        antenna,
-        uniform.sample_period,
-        cfg,
-        diagnostics={"sampling": dataclasses.asdict(sampling), "resampled": sampling.irregular},
-    )
-    filled = (
-        time_gaps(recording.t, recording.sample_period, cfg.max_gap) if sampling.irregular else ()
-    )
-    front.update_block(uniform.t, uniform.theta, uniform.force, uniform.torque, filled)
-    return front.finish()
