@@ -63,7 +63,7 @@ from fast_settings import add_fast_arguments, fast_settings
 from sensing_antenna.antenna import Antenna, Link, paper_antenna
 from sensing_antenna.campaign.parsing import load_campaign_spec
 from sensing_antenna.campaign.simulated import make_scenario, prepare_campaign
-from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation import Evidence, estimate, gather
 from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
 from sensing_antenna.estimation.methods.fast.method import (
     FastConfig,
@@ -71,7 +71,6 @@ from sensing_antenna.estimation.methods.fast.method import (
     WindowEstimate,
     curve_table,
 )
-from sensing_antenna.estimation.pipeline import estimate, gather_evidence
 from sensing_antenna.simulator import simulate
 
 OUT = Path(__file__).parent / "results" / "fast_bound.json"
@@ -165,7 +164,7 @@ def run_one(setup: Setup, case: str, x_c: float, seed: int) -> dict[str, Any]:
         "higher_error": higher.x_c - truth,
         "higher_covered": _covers(higher.interval, truth),
     }
-    evidence = gather_evidence(recording, antenna)
+    evidence = gather(recording, antenna)
     if not isinstance(evidence, Evidence):
         row.update({name: math.nan for name in INSTANTS})
         return row

@@ -20,12 +20,21 @@ import pytest
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.detection.contact import detect_contact
+from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation import (
     METHODS,
+    EarlyOutcome,
+    EarlyStopping,
     EstimatorConfig,
+    Evidence,
+    FrontEnd,
     OnlineEstimator,
+    Sessioned,
     Status,
+    conclude,
     estimate,
+    gather,
     measure_omega1,
 )
 from sensing_antenna.estimation.config import EstimatorConfigError
@@ -238,13 +247,11 @@ def test_no_contact() -> None:
     assert math.isnan(result.x_c)
     _, final = run_online(recording)
     assert final.status is Status.NO_CONTACT
-    # Without a contact there is no evidence to study: gather_evidence gives the early result
-    from sensing_antenna.estimation.front.evidence import Evidence
-    from sensing_antenna.estimation.pipeline import gather_evidence
-
-    early = gather_evidence(recording, paper_antenna())
-    assert not isinstance(early, Evidence)
+    # Without a contact there is no evidence to study: the front end gives the early outcome
+    early = gather(recording, paper_antenna())
+    assert isinstance(early, EarlyOutcome)
     assert early.status is Status.NO_CONTACT
+    assert early.reason == result.reason
 
 
 def test_push_too_gentle_is_not_a_push() -> None:
@@ -365,3 +372,112 @@ def test_t1_from_the_push_criterion_is_the_controllers_stop_and_online_equals_of
 def test_t1_source_is_validated() -> None:
     with pytest.raises(EstimatorConfigError, match="t1_source"):
         EstimatorConfig(t1_source="later")  # type: ignore[arg-type]
+
+
+def _simulated(case: str) -> Recording:
+    """A simulated manoeuvre (the project's simulator, an independent source of samples)."""
+    x_c, seed = (0.45, 7) if case == "azimuthal" else (0.8, 8)
+    scenario = Scenario(case=case, contact_point=x_c, seed=seed)
+    return simulate(paper_antenna(), scenario).without_ground_truth()
+
+
+def _assert_same_evidence(evidence: Evidence, other: Evidence) -> None:
+    """Every field equal to the bit (NaN where NaN), the trace and the whole file's sampling
+    report aside."""
+    for f in dataclasses.fields(Evidence):
+        value, expected = getattr(evidence, f.name), getattr(other, f.name)
+        if f.name == "diagnostics":
+            value, expected = (
+                {k: v for k, v in d.items() if k != "sampling"} for d in (value, expected)
+            )
+        if f.name == "frame":
+            np.testing.assert_equal(dataclasses.asdict(value), dataclasses.asdict(expected))
+        elif f.name != "trace":
+            np.testing.assert_equal(value, expected, err_msg=f.name)
+
+
+@pytest.mark.parametrize("t1_source", ["rest", "push"])
+@pytest.mark.parametrize("case", ["azimuthal", "vertical"])
+def test_front_end_and_estimate_are_the_same_sample_by_sample_in_blocks_and_in_batch(
+    case: str, t1_source: str
+) -> None:
+    """One front end: fed sample by sample, in random blocks or the whole recording at once
+    (gather), it gives the same evidence to the bit, and the online estimate is the offline one."""
+    recording, antenna = _simulated(case), paper_antenna()
+    config = EstimatorConfig(t1_source=t1_source)  # type: ignore[arg-type]
+    batch = gather(recording, antenna, config)
+    assert isinstance(batch, Evidence)
+    t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
+    front = FrontEnd(antenna, recording.sample_period, config)
+    given = [
+        out
+        for k in range(recording.n_samples)
+        if (out := front.update(t[k], theta[k], force[k], torque[k])) is not None
+    ]
+    assert len(given) == 1 and isinstance(given[0], Evidence)
+    _assert_same_evidence(given[0], batch)
+    front.reset()
+    rng = np.random.default_rng(3)
+    cuts = np.sort(rng.choice(np.arange(1, recording.n_samples), size=40, replace=False))
+    outs = [
+        front.update_block(t[p], theta[p], force[p], torque[p])
+        for p in np.split(np.arange(recording.n_samples), cuts)
+    ]
+    blocked = [out for out in outs if out is not None]
+    assert len(blocked) == 1 and isinstance(blocked[0], Evidence)
+    _assert_same_evidence(blocked[0], batch)
+    offline = estimate(recording, antenna, config=config)
+    online = OnlineEstimator(antenna, recording.sample_period, config=config)
+    results = [
+        out
+        for k in range(recording.n_samples)
+        if (out := online.update(t[k], theta[k], force[k], torque[k])) is not None
+    ]
+    assert [r.t_e for r in results] == [offline.t_e] and offline.ok
+    assert comparable(results[0]) == comparable(offline)
+
+
+def test_estimate_is_gather_then_conclude_and_keeps_what_the_front_end_saw() -> None:
+    recording, antenna = synthetic_recording(Synthetic(x_c=0.6, seed=4)), paper_antenna()
+    gathered = gather(recording, antenna)
+    assert isinstance(gathered, Evidence)
+    for method in ("paper", "ratio", "two-frequency"):
+        once = conclude(gathered, method)
+        assert once.to_dict() == estimate(recording, antenna, method).to_dict()
+    result = estimate(recording, antenna)
+    trace = result.trace
+    assert trace is not None and "trace" not in result.to_dict()
+    # The trace covers every sample of the recording, its instants are the estimate's
+    assert trace.t.shape == (recording.n_samples,)
+    assert trace.contact_index is not None and trace.rest_index is not None
+    assert trace.end_index == gathered.end_index
+    assert (trace.t[trace.contact_index], trace.t[trace.rest_index]) == (result.t_c, result.t_1)
+    assert trace.t[gathered.end_index] == result.t_e
+    # Figure 11's signals are the contact detector's (its batch form, an independent call)
+    detection = detect_contact(recording, antenna)
+    np.testing.assert_array_equal(trace.filtered_residual_norm, detection.filtered_residual_norm)
+    np.testing.assert_array_equal(trace.estimated_torque, detection.estimated_torque)
+    assert trace.contact_index == detection.index
+    # Figures 12 to 14: the evidence's loads, ratio, frame and window, continued to the end
+    e = gathered.end_index
+    np.testing.assert_array_equal(trace.reaction_f[: e + 1], gathered.reaction_f)
+    np.testing.assert_array_equal(trace.ratio[: e + 1], gathered.ratio)
+    assert trace.frame is not None and trace.spectrum == gathered.spectrum_slice
+    np.testing.assert_array_equal(trace.frame.axes_m, gathered.frame.axes_m)
+    # An early outcome keeps what was seen too
+    silent = estimate(synthetic_recording(Synthetic(contact_time=50.0, stops=False)), antenna)
+    assert silent.status is Status.NO_CONTACT and silent.trace is not None
+    assert silent.trace.contact_index is None and np.all(np.isnan(silent.trace.ratio))
+
+
+def test_method_abilities_are_typed() -> None:
+    fast, paper = METHODS["fast"], METHODS["paper"]
+    assert isinstance(fast, EarlyStopping) and isinstance(fast, Sessioned)
+    assert isinstance(fast.session(), EarlyStopping)
+    assert not isinstance(paper, EarlyStopping) and not isinstance(paper, Sessioned)
+
+
+def test_front_end_names_a_misshapen_block() -> None:
+    front = FrontEnd(paper_antenna(), TS)
+    with pytest.raises(FieldError, match=r"theta: shape \(2, 3\), expected \(2, 2\)"):
+        front.update_block(np.zeros(2), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)))

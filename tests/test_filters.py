@@ -109,9 +109,7 @@ def test_observer_is_stable_below_nyquist(seed: int, w: float, zeta: float) -> N
     rng = np.random.default_rng(seed)
     x = rng.normal(size=50)
     streaming = FreeMotionObserverFilter(obs, TS)
-    np.testing.assert_allclose(
-        [streaming.update(v) for v in x], observe_free_motion(x, obs, TS), rtol=1e-9, atol=1e-12
-    )
+    np.testing.assert_array_equal([streaming.update(v) for v in x], observe_free_motion(x, obs, TS))
 
 
 def test_nyquist_is_refused() -> None:
@@ -129,7 +127,8 @@ def test_streaming_equals_batch_and_reset() -> None:
     for col in range(3):
         lp = FirstOrderLowPass(5.0, TS)
         out = [lp.update(v) for v in x[:, col]]
-        np.testing.assert_allclose(out, batch[:, col], rtol=1e-12, atol=1e-13)
+        # One recursion in both forms: equal to the bit.
+        np.testing.assert_array_equal(out, batch[:, col])
         lp.reset()
         assert lp.update(x[0, col]) == pytest.approx(x[0, col], rel=1e-14)
     obs = FreeMotionObserverFilter(PAPER_OBSERVER, TS)
@@ -138,11 +137,30 @@ def test_streaming_equals_batch_and_reset() -> None:
     obs.reset()
     second = [obs.update(v) for v in theta]
     assert first == second
-    batch_torque = observe_free_motion(theta, PAPER_OBSERVER, TS)
-    # Same recursion, different evaluation order inside lfilter: rounding only (1e-12 of scale).
-    np.testing.assert_allclose(
-        first, batch_torque, rtol=0, atol=1e-12 * np.max(np.abs(batch_torque))
-    )
+    np.testing.assert_array_equal(first, observe_free_motion(theta, PAPER_OBSERVER, TS))
+
+
+def test_filters_equal_lfilter_to_the_bit_in_any_blocks() -> None:
+    # Reference: scipy.signal.lfilter, an independent implementation of the same direct form II
+    # transposed recursion (started at lfilter_zi times the first sample for the low-pass, at
+    # rest on the angle relative to the first one for the observer). Same coefficients, same
+    # operations in the same order: equal to the bit, however the samples are cut into blocks.
+    rng = np.random.default_rng(8)
+    x = np.cumsum(rng.normal(size=(1000, 6)), axis=0)
+    b, a = low_pass_coefficients(5.0, TS)
+    reference, _ = signal.lfilter(b, a, x, axis=0, zi=signal.lfilter_zi(b, a)[:, None] * x[:1])
+    b_obs, a_obs = observer_coefficients(PAPER_OBSERVER, TS)
+    angles = 1e-3 * x[:, :2]
+    observed = signal.lfilter(b_obs, a_obs, angles - angles[:1], axis=0)
+    np.testing.assert_array_equal(low_pass(x, 5.0, TS), reference)
+    np.testing.assert_array_equal(observe_free_motion(angles, PAPER_OBSERVER, TS), observed)
+    for _ in range(5):
+        cuts = np.sort(rng.choice(np.arange(1, 1000), size=12, replace=False))
+        lp, obs = FirstOrderLowPass(5.0, TS), FreeMotionObserverFilter(PAPER_OBSERVER, TS)
+        blocks = [lp.update_block(part) for part in np.split(x, cuts)]
+        np.testing.assert_array_equal(np.vstack(blocks), reference)
+        blocks = [obs.update_block(part) for part in np.split(angles, cuts)]
+        np.testing.assert_array_equal(np.vstack(blocks), observed)
 
 
 def test_low_pass_starts_in_steady_state_and_has_unit_step_response() -> None:

@@ -32,7 +32,7 @@ from sensing_antenna.antenna import Antenna, FreeMotionObserver
 from sensing_antenna.detection.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
     OBSERVER_TORQUE_SIGNS,
-    contact_residual,
+    detect_contact,
 )
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
@@ -243,8 +243,9 @@ def identify_free_motion(
             "can follow"
         )
     provisional = FreeMotionObserver(gain, omega, damping, contact_threshold=1.0)
-    _, _, norm = contact_residual(uniform, replace(antenna, observer=provisional), residual_cutoff)
-    peak = float(np.max(norm))
+    provisional_antenna = replace(antenna, observer=provisional)
+    detection = detect_contact(uniform, provisional_antenna, residual_cutoff=residual_cutoff)
+    peak = float(np.max(detection.filtered_residual_norm))
     return ObserverFit(
         gain=gain,
         natural_frequency=omega,

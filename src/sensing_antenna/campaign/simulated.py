@@ -67,7 +67,7 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     (status ``"error"``) and the other methods still run; an exception from the simulator
     propagates (the runner records the run as failed).
     """
-    from sensing_antenna.estimation import METHODS, ContactEstimate, gather
+    from sensing_antenna.estimation import conclude, gather
     from sensing_antenna.simulator import simulate
 
     start = time.perf_counter()
@@ -96,13 +96,9 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     for method in run.methods:
         begin = time.perf_counter()
         try:
-            conclude = METHODS[method].conclude
-            if isinstance(evidence, ContactEstimate):
-                # the front end stopped early (no contact, no push, bad input): that result is
-                # every method's, under its own name
-                estimate = dataclasses.replace(evidence, method=method)
-            else:
-                estimate = conclude(evidence)
+            # an early outcome of the front end (no contact, no push, bad input) is every
+            # method's result, under its own name
+            estimate = conclude(evidence, method)
         except Exception as exc:  # recorded per method: one broken estimator must not hide others
             elapsed = front_end_s + time.perf_counter() - begin
             reason = f"{type(exc).__name__}: {exc}"

@@ -43,14 +43,15 @@ from dataclasses import dataclass
 from typing import Literal, TypeAlias
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
+from scipy.signal import lfilter_zi
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.filters import (
-    FirstOrderLowPass,
-    FreeMotionObserverFilter,
-    low_pass,
-    observe_free_motion,
+    df2t_step,
+    low_pass_coefficients,
+    observer_coefficients,
 )
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
@@ -62,14 +63,17 @@ __all__ = [
     "ContactConfigError",
     "ContactDetection",
     "ContactDetector",
+    "SampleBlock",
     "SampleVector",
-    "contact_residual",
     "detect_contact",
     "free_motion_torque",
 ]
 
 #: One sample of a vector signal: a numpy array or a plain sequence of floats.
 SampleVector: TypeAlias = "Sequence[float] | NDArray[np.float64]"
+
+#: Samples of a vector signal, time on axis 0: shape (n, k).
+SampleBlock: TypeAlias = "ArrayLike"
 
 #: Cut-off of the first-order low-pass filter applied to the residual of Eq. 16 (rad/s).
 DEFAULT_RESIDUAL_CUTOFF = 100.0
@@ -100,83 +104,95 @@ def tare_samples(tare_time: float, sample_period: float) -> int:
     return max(1, round(tare_time / sample_period))
 
 
-def free_motion_torque(
-    theta: ArrayLike, antenna: Antenna, sample_period: float
-) -> NDArray[np.float64]:
-    """Observed coupling torque in free motion, Gamma_e^m + Gamma_g^m, motor frame (N m).
+def block_rows(values: SampleBlock, count: int, width: int) -> NDArray[np.float64]:
+    """``values`` as a writable C-ordered float array of shape (count, width), the one layout
+    the compiled kernels are built for (a recording's read-only arrays would need another):
+    the array itself when it already is one, else a copy."""
+    rows = np.asarray(values, dtype=np.float64).reshape(count, width)
+    flags = rows.flags
+    return rows if flags.c_contiguous and flags.writeable else np.array(rows, order="C")
 
-    Parameters
-    ----------
-    theta : array_like, shape (n, 2)
-        Motor angles (rad), uniformly sampled.
-    antenna : Antenna
-        Supplies the observer (Eq. 15) and the link weight.
-    sample_period : float
-        T_s (s).
 
-    Returns
-    -------
-    ndarray, shape (n, 3)
-        Torque by the link on the head about O predicted without contact (observer from rest at
-        theta[0]).
+# Layout of the contact kernel's parameters (``par``) and state (``mem``), float64 arrays:
+# par: observer b (3), a (3); residual low-pass b (2), a (2); its lfilter_zi; signs; weight
+# moments; threshold; taring samples. mem: observer states of both joints (2 + 2); first angles
+# (2); tare sums (3); offset (3); low-pass states (3); samples fed; contact index (-1: none).
+_OBS_B, _OBS_A, _LP_B, _LP_A = slice(0, 3), slice(3, 6), slice(6, 8), slice(8, 10)
+_ZI, _SIGN_Y, _SIGN_Z, _WEIGHT_MOMENT, _SAG_MOMENT, _THRESHOLD, _N_TARE = range(10, 17)
+_N_PAR = 17
+_Z1, _Z2, _LP_Z = slice(0, 2), slice(2, 4), slice(12, 15)
+_ORIGIN, _TARE_SUM, _OFFSET, _COUNT, _INDEX = 4, 6, 9, 15, 16
+_N_MEM = 17
+
+
+@njit(cache=True)
+def gravity_moment_sample(theta2: float, weight_moment: float, sag_moment: float) -> float:
+    """:meth:`Link.gravity_moment` of one angle theta2 (rad), compiled (N m)."""
+    return math.cos(theta2) * (weight_moment + sag_moment * math.sin(theta2))
+
+
+@njit(cache=True)
+def _contact_block(
+    par: NDArray[np.float64],
+    mem: NDArray[np.float64],
+    times: NDArray[np.float64],
+    theta: NDArray[np.float64],
+    torque: NDArray[np.float64],
+    history_t: NDArray[np.float64],
+    estimated: NDArray[np.float64],
+    residual: NDArray[np.float64],
+    norm: NDArray[np.float64],
+) -> int:
+    """Feed times (n,), rows of theta (n, 2) and torque (n, 3); write rows count.. of the
+    histories.
+
+    Returns the index of the contact sample (counted since reset), -1 before contact.
     """
-    angles = np.asarray(theta, dtype=np.float64)
-    # Eq. 15: Gamma_e,i = K s^2 / (s^2 + d s + omega^2) theta_i, per joint
-    gamma_e = observe_free_motion(angles, antenna.observer, sample_period)
-    sign_y, sign_z = OBSERVER_TORQUE_SIGNS
-    torque = np.zeros((angles.shape[0], 3))
-    # Section 4.2: Gamma_e^m = (0, +Gamma_e,2, -Gamma_e,1) (signs: module docstring)
-    torque[:, 1] = sign_y * gamma_e[:, 1]
-    torque[:, 2] = sign_z * gamma_e[:, 0]
-    # Section 4.2: Gamma_g^m = (0, m_b g l cos(theta2) / 2, 0), with tip mass and sag
-    torque[:, 1] += antenna.link.gravity_moment(angles[:, 1])
-    return torque
-
-
-def contact_residual(
-    recording: Recording,
-    antenna: Antenna,
-    residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
-    tare_time: float = DEFAULT_TARE_TIME,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """Residual of Eq. 16 and its filtered norm for a uniformly sampled recording.
-
-    Parameters
-    ----------
-    recording : Recording
-        Uniformly sampled (see :func:`~sensing_antenna.recording.resample_uniform`).
-    antenna : Antenna
-    residual_cutoff : float
-        Cut-off of the residual low-pass filter (rad/s).
-    tare_time : float
-        Taring window at the start (s); its mean residual is the sensor offset.
-
-    Returns
-    -------
-    estimated_torque : ndarray, shape (n, 3)
-        Gamma_e^m + Gamma_g^m (N m).
-    residual : ndarray, shape (n, 3)
-        r^m of Eq. 16 (N m), offset removed after the taring window.
-    filtered_norm : ndarray, shape (n,)
-        |low-pass(r^m)| (N m); zero during the taring window.
-    """
-    period = recording.sample_period
-    estimated = free_motion_torque(recording.theta, antenna, period)
-    # Eq. 16: r^m = Gamma^m - (Gamma_e^m + Gamma_g^m)
-    residual = recording.torque - estimated
-    n_tare = tare_samples(tare_time, period)
-    norm = np.zeros(residual.shape[0])
-    if residual.shape[0] > n_tare:
-        # taring: the mean residual of the first n_tare samples is the sensor offset
-        residual[n_tare:] -= residual[:n_tare].mean(axis=0)
-        filtered = low_pass(residual[n_tare:], residual_cutoff, period)
-        norm[n_tare:] = np.sqrt(np.sum(filtered**2, axis=1))
-    return estimated, residual, norm
+    n_tare = int(par[_N_TARE])
+    z1, z2, lp_z = mem[_Z1], mem[_Z2], mem[_LP_Z]
+    for i in range(theta.shape[0]):
+        k = int(mem[_COUNT])
+        history_t[k] = times[i]
+        if k == 0:
+            mem[_ORIGIN], mem[_ORIGIN + 1] = theta[i, 0], theta[i, 1]
+        # Eq. 15: Gamma_e,i = K s^2 / (s^2 + d s + omega^2) (theta_i - theta_i[0])
+        gamma_e1 = df2t_step(par[_OBS_B], par[_OBS_A], z1, theta[i, 0] - mem[_ORIGIN])
+        gamma_e2 = df2t_step(par[_OBS_B], par[_OBS_A], z2, theta[i, 1] - mem[_ORIGIN + 1])
+        # Section 4.2: Gamma_e^m + Gamma_g^m = (0, +Gamma_e,2 + Gamma_g, -Gamma_e,1)
+        moment = gravity_moment_sample(theta[i, 1], par[_WEIGHT_MOMENT], par[_SAG_MOMENT])
+        est_y = par[_SIGN_Y] * gamma_e2 + moment
+        est_z = par[_SIGN_Z] * gamma_e1
+        estimated[k, 0], estimated[k, 1], estimated[k, 2] = 0.0, est_y, est_z
+        # Eq. 16: r^m = Gamma^m - (Gamma_e^m + Gamma_g^m)
+        r = (torque[i, 0] - 0.0, torque[i, 1] - est_y, torque[i, 2] - est_z)
+        mem[_COUNT] = k + 1
+        if k < n_tare:
+            # taring: the mean residual of the first n_tare samples is the sensor offset
+            for c in range(3):
+                residual[k, c] = r[c]
+                mem[_TARE_SUM + c] += r[c]
+                if k == n_tare - 1:
+                    mem[_OFFSET + c] = mem[_TARE_SUM + c] / n_tare
+            norm[k] = 0.0
+            continue
+        total = 0.0
+        for c in range(3):
+            tared = r[c] - mem[_OFFSET + c]
+            residual[k, c] = tared
+            if k == n_tare:
+                # the residual filter starts in steady state at its first input
+                lp_z[c] = par[_ZI] * tared
+            filtered = df2t_step(par[_LP_B], par[_LP_A], lp_z[c : c + 1], tared)
+            total += filtered * filtered
+        norm[k] = math.sqrt(total)
+        if mem[_INDEX] < 0.0 and norm[k] > par[_THRESHOLD]:
+            mem[_INDEX] = k
+    return int(mem[_INDEX])
 
 
 @dataclass(frozen=True, eq=False)
 class ContactDetection:
-    """Result of :func:`detect_contact`.
+    """Result of :func:`detect_contact` (or of :meth:`ContactDetector.detection`).
 
     Parameters
     ----------
@@ -216,63 +232,8 @@ class ContactDetection:
     resampled: bool
 
 
-def detect_contact(
-    recording: Recording,
-    antenna: Antenna,
-    threshold: float | None = None,
-    residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
-    tare_time: float = DEFAULT_TARE_TIME,
-) -> ContactDetection:
-    """Contact instant t_c of a recording (batch form of :class:`ContactDetector`).
-
-    Parameters
-    ----------
-    recording : Recording
-        Irregular sampling is handled by linear resampling at the nominal period first.
-    antenna : Antenna
-        Observer of Eq. 15 and link weight.
-    threshold : float, optional
-        Threshold on the filtered residual norm (N m); ``antenna.observer.contact_threshold``
-        when None.
-    residual_cutoff : float
-        Cut-off of the residual low-pass filter (rad/s).
-    tare_time : float
-        Taring window at the start (s), see the module docstring.
-
-    Returns
-    -------
-    ContactDetection
-        Identical to running :class:`ContactDetector` over the samples of a regular recording.
-    """
-    limit = _check_threshold(antenna.observer.contact_threshold if threshold is None else threshold)
-    resampled = recording.sampling.irregular
-    uniform = resample_uniform(recording) if resampled else recording
-    estimated, residual, norm = contact_residual(uniform, antenna, residual_cutoff, tare_time)
-    above = np.flatnonzero(norm > limit)
-    note = " (irregular sampling: linearly resampled first)" if resampled else ""
-    index = int(above[0]) if above.size else None
-    t_c = float(uniform.t[index]) if index is not None else None
-    return ContactDetection(
-        status="no_contact" if t_c is None else "contact",
-        reason=(
-            f"filtered residual stays at or below {limit:g} N m{note}"
-            if t_c is None
-            else f"filtered residual exceeds {limit:g} N m at t = {t_c:g} s{note}"
-        ),
-        t_c=t_c,
-        index=index,
-        t=uniform.t,
-        residual=residual,
-        filtered_residual_norm=norm,
-        estimated_torque=estimated,
-        threshold=limit,
-        residual_cutoff=residual_cutoff,
-        resampled=resampled,
-    )
-
-
 class ContactDetector:
-    """Streaming contact-instant detector: one :meth:`update` per sample, plain floats inside.
+    """Streaming contact-instant detector: blocks of samples, or one sample at a time.
 
     Parameters
     ----------
@@ -295,11 +256,15 @@ class ContactDetector:
     contact_time : float or None
         t_c (s).
     contact_index : int or None
-        Index of the contact sample, counted from the first update after reset.
-    filtered_residual_norm : float
-        Latest |low-pass(r^m)| (N m).
+        Index of the contact sample, counted from the first sample after reset.
     n_samples : int
         Number of samples fed since reset.
+
+    Notes
+    -----
+    One compiled kernel runs every sample, whether fed in blocks (:meth:`update_block`) or one by
+    one (:meth:`update`, a block of one): both give the same numbers to the bit, and
+    :func:`detect_contact` is this detector fed one block.
     """
 
     def __init__(
@@ -311,99 +276,206 @@ class ContactDetector:
         tare_time: float = DEFAULT_TARE_TIME,
     ) -> None:
         self.antenna = antenna
-        self._n_tare = tare_samples(tare_time, float(sample_period))
         self.sample_period = float(sample_period)
         self.threshold = _check_threshold(
             antenna.observer.contact_threshold if threshold is None else threshold
         )
         self.residual_cutoff = float(residual_cutoff)
-        self._observers = (
-            FreeMotionObserverFilter(antenna.observer, sample_period),
-            FreeMotionObserverFilter(antenna.observer, sample_period),
-        )
-        self._filters = tuple(FirstOrderLowPass(residual_cutoff, sample_period) for _ in range(3))
-        self._link = antenna.link
-        self._sign_y, self._sign_z = OBSERVER_TORQUE_SIGNS
+        obs_b, obs_a = observer_coefficients(antenna.observer, self.sample_period)
+        lp_b, lp_a = low_pass_coefficients(self.residual_cutoff, self.sample_period)
+        par = np.zeros(_N_PAR)
+        par[_OBS_B], par[_OBS_A], par[_LP_B], par[_LP_A] = obs_b, obs_a, lp_b, lp_a
+        par[_ZI] = lfilter_zi(lp_b, lp_a)[0]
+        par[_SIGN_Y], par[_SIGN_Z] = OBSERVER_TORQUE_SIGNS
+        par[_WEIGHT_MOMENT] = antenna.link.weight_moment
+        par[_SAG_MOMENT] = antenna.link.sag_moment
+        par[_THRESHOLD] = self.threshold
+        par[_N_TARE] = tare_samples(tare_time, self.sample_period)
+        self._par = par
+        self._time = np.zeros(1)  # the time of one sample, as a block
         self.reset()
 
     def reset(self) -> None:
         """Forget everything: the next sample is the first one (observer at rest there)."""
-        for observer in self._observers:
-            observer.reset()
-        for lowpass in self._filters:
-            lowpass.reset()
-        self.detected = False
-        self.contact_time: float | None = None
-        self.contact_index: int | None = None
+        self._mem = np.zeros(_N_MEM)
+        self._mem[_INDEX] = -1.0
+        self._t = np.empty(0)
+        self._estimated = np.empty((0, 3))
+        self._residual = np.empty((0, 3))
+        self._norm = np.empty(0)
         self.n_samples = 0
-        self.filtered_residual_norm = 0.0
-        self._residual = (0.0, 0.0, 0.0)
-        self._estimated = (0.0, 0.0, 0.0)
-        self._tare_sum = [0.0, 0.0, 0.0]
-        self._offset = (0.0, 0.0, 0.0)
+        self.contact_index: int | None = None
+        self.contact_time: float | None = None
 
     @property
-    def residual(self) -> NDArray[np.float64]:
-        """Latest residual r^m of Eq. 16, shape (3,) (N m)."""
-        return np.array(self._residual)
+    def detected(self) -> bool:
+        """True from the contact sample on."""
+        return self.contact_index is not None
 
-    @property
-    def estimated_torque(self) -> NDArray[np.float64]:
-        """Latest Gamma_e^m + Gamma_g^m, shape (3,) (N m)."""
-        return np.array(self._estimated)
+    def _reserve(self, count: int) -> None:
+        """Room in the histories for ``count`` more samples (capacity doubled as needed)."""
+        need = self.n_samples + count
+        size = self._t.shape[0]
+        if need <= size:
+            return
+        size = max(need, 2 * size, 4096)
+        for name in ("_t", "_estimated", "_residual", "_norm"):
+            old = getattr(self, name)
+            new = np.empty((size, *old.shape[1:]))
+            new[: self.n_samples] = old[: self.n_samples]
+            setattr(self, name, new)
+
+    def update_block(
+        self, t: ArrayLike, theta: SampleBlock, force: SampleBlock, torque: SampleBlock
+    ) -> bool:
+        """Feed samples; returns True once contact has been detected.
+
+        Parameters
+        ----------
+        t : array_like, shape (n,)
+            Sample times (s).
+        theta : array_like, shape (n, 2)
+            Motor angles (rad).
+        force : array_like, shape (n, 3)
+            Force (N); unused by this detector, accepted for a uniform interface.
+        torque : array_like, shape (n, 3)
+            Torque by the link on the head about O, motor frame (N m).
+        """
+        times = np.asarray(t, dtype=np.float64).reshape(-1)
+        count = times.shape[0]
+        return self._feed(times, block_rows(theta, count, 2), block_rows(torque, count, 3))
+
+    def _feed(
+        self, times: NDArray[np.float64], angles: NDArray[np.float64], moments: NDArray[np.float64]
+    ) -> bool:
+        """:meth:`update_block` on arrays already in the kernel's layout (:func:`block_rows`)."""
+        count = times.shape[0]
+        if self.n_samples + count > self._t.shape[0]:
+            self._reserve(count)
+        index = _contact_block(
+            self._par,
+            self._mem,
+            times,
+            angles,
+            moments,
+            self._t,
+            self._estimated,
+            self._residual,
+            self._norm,
+        )
+        self.n_samples += count
+        if index >= 0 and self.contact_index is None:
+            self.contact_index = index
+            self.contact_time = float(self._t[index])
+        return self.contact_index is not None
 
     def update(
         self, t: float, theta: SampleVector, force: SampleVector, torque: SampleVector
     ) -> bool:
-        """Feed one sample; returns True once contact has been detected.
+        """Feed one sample (a block of one: t in s, theta (2,) in rad, force (3,) unused,
+        torque (3,) in N m); returns True once contact has been detected."""
+        self._time[0] = t
+        return self.update_block(self._time, theta, force, torque)
 
-        Parameters
-        ----------
-        t : float
-            Sample time (s).
-        theta : array_like, shape (2,)
-            Motor angles (rad).
-        force : array_like, shape (3,)
-            Force (N); unused by this detector, accepted for a uniform estimator interface.
-        torque : array_like, shape (3,)
-            Torque by the link on the head about O, motor frame (N m).
+    @property
+    def filtered_residual_norm(self) -> float:
+        """Latest |low-pass(r^m)| (N m); 0 before the first sample."""
+        return float(self._norm[self.n_samples - 1]) if self.n_samples else 0.0
+
+    @property
+    def residual(self) -> NDArray[np.float64]:
+        """Latest residual r^m of Eq. 16, shape (3,) (N m)."""
+        return self._latest(self._residual)
+
+    @property
+    def estimated_torque(self) -> NDArray[np.float64]:
+        """Latest Gamma_e^m + Gamma_g^m, shape (3,) (N m)."""
+        return self._latest(self._estimated)
+
+    def _latest(self, history: NDArray[np.float64]) -> NDArray[np.float64]:
+        return history[self.n_samples - 1].copy() if self.n_samples else np.zeros(3)
+
+    def detection(self, resampled: bool = False) -> ContactDetection:
+        """The detection over every sample fed since reset (arrays are views, not copies).
+
+        ``resampled`` records that the caller resampled an irregular recording first (said in
+        the reason).
         """
-        theta1, theta2 = float(theta[0]), float(theta[1])
-        # Eq. 15: Gamma_e,i = K s^2 / (s^2 + d s + omega^2) theta_i, per joint
-        gamma_e1 = self._observers[0].update(theta1)
-        gamma_e2 = self._observers[1].update(theta2)
-        # Section 4.2: Gamma_e^m + Gamma_g^m = (0, +Gamma_e,2 + m_b g l cos(theta2) / 2, -Gamma_e,1)
-        # (the weight's moment with tip mass and sag: Link.gravity_moment)
-        est_y = self._sign_y * gamma_e2 + float(self._link.gravity_moment(theta2))
-        est_z = self._sign_z * gamma_e1
-        # Eq. 16: r^m = Gamma^m - (Gamma_e^m + Gamma_g^m)
-        r_x = float(torque[0])
-        r_y = float(torque[1]) - est_y
-        r_z = float(torque[2]) - est_z
-        self._estimated = (0.0, est_y, est_z)
-        if self.n_samples < self._n_tare:
-            # taring: accumulate the offset, no detection yet
-            self._tare_sum[0] += r_x
-            self._tare_sum[1] += r_y
-            self._tare_sum[2] += r_z
-            self._residual = (r_x, r_y, r_z)
-            self.n_samples += 1
-            if self.n_samples == self._n_tare:
-                n = float(self._n_tare)
-                self._offset = (self._tare_sum[0] / n, self._tare_sum[1] / n, self._tare_sum[2] / n)
-            return self.detected
-        r_x -= self._offset[0]
-        r_y -= self._offset[1]
-        r_z -= self._offset[2]
-        f_x = self._filters[0].update(r_x)
-        f_y = self._filters[1].update(r_y)
-        f_z = self._filters[2].update(r_z)
-        norm = math.sqrt(f_x * f_x + f_y * f_y + f_z * f_z)
-        self._residual = (r_x, r_y, r_z)
-        self.filtered_residual_norm = norm
-        if not self.detected and norm > self.threshold:
-            self.detected = True
-            self.contact_time = float(t)
-            self.contact_index = self.n_samples
-        self.n_samples += 1
-        return self.detected
+        n = self.n_samples
+        note = " (irregular sampling: linearly resampled first)" if resampled else ""
+        t_c = self.contact_time
+        return ContactDetection(
+            status="no_contact" if t_c is None else "contact",
+            reason=(
+                f"filtered residual stays at or below {self.threshold:g} N m{note}"
+                if t_c is None
+                else f"filtered residual exceeds {self.threshold:g} N m at t = {t_c:g} s{note}"
+            ),
+            t_c=t_c,
+            index=self.contact_index,
+            t=self._t[:n],
+            residual=self._residual[:n],
+            filtered_residual_norm=self._norm[:n],
+            estimated_torque=self._estimated[:n],
+            threshold=self.threshold,
+            residual_cutoff=self.residual_cutoff,
+            resampled=resampled,
+        )
+
+
+def free_motion_torque(
+    theta: ArrayLike, antenna: Antenna, sample_period: float
+) -> NDArray[np.float64]:
+    """Observed coupling torque in free motion, Gamma_e^m + Gamma_g^m, motor frame (N m): the
+    contact detector's estimate (Eq. 15 and the weight), without any measured torque.
+
+    Parameters
+    ----------
+    theta : array_like, shape (n, 2)
+        Motor angles (rad), uniformly sampled.
+    antenna : Antenna
+        Supplies the observer (Eq. 15) and the link weight.
+    sample_period : float
+        T_s (s).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Torque by the link on the head about O predicted without contact (observer from rest at
+        theta[0]).
+    """
+    angles = np.asarray(theta, dtype=np.float64)
+    count = angles.shape[0]
+    detector = ContactDetector(antenna, sample_period)
+    still = np.zeros((count, 3))
+    detector.update_block(sample_period * np.arange(count), angles, still, still)
+    return detector.detection().estimated_torque.copy()
+
+
+def detect_contact(
+    recording: Recording,
+    antenna: Antenna,
+    threshold: float | None = None,
+    residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
+    tare_time: float = DEFAULT_TARE_TIME,
+) -> ContactDetection:
+    """Contact instant t_c of a recording: a :class:`ContactDetector` fed the whole recording.
+
+    Parameters
+    ----------
+    recording : Recording
+        Irregular sampling is handled by linear resampling at the nominal period first.
+    antenna, threshold, residual_cutoff, tare_time
+        As for :class:`ContactDetector`.
+
+    Returns
+    -------
+    ContactDetection
+    """
+    resampled = recording.sampling.irregular
+    uniform = resample_uniform(recording) if resampled else recording
+    detector = ContactDetector(
+        antenna, uniform.sample_period, threshold, residual_cutoff, tare_time
+    )
+    detector.update_block(uniform.t, uniform.theta, uniform.force, uniform.torque)
+    return detector.detection(resampled)

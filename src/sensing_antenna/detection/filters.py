@@ -1,4 +1,4 @@
-"""Discrete filters shared by the estimators, each as a streaming object and a batch function.
+"""Discrete filters shared by the detectors and the estimators: one streaming object each.
 
 Both filters are discretised with the bilinear (Tustin) transform, prewarped at their
 characteristic frequency omega_p: s -> c (1 - z^-1) / (1 + z^-1), c = omega_p / tan(omega_p T_s/2).
@@ -8,11 +8,16 @@ continuous one exactly at omega_p (the cut-off of Eq. 20, the natural frequency 
 frequency axis is otherwise compressed as omega_d = (2 / T_s) arctan(omega T_s / 2), an error below
 0.1 % for omega < 0.1 pi / T_s (157 rad/s at 1 kHz).
 
-Streaming objects implement exactly the direct form II transposed recursion that
-``scipy.signal.lfilter`` uses, with the same coefficients, so streaming and batch outputs agree to
-rounding. Initial conditions: the low-pass filter starts in steady state at its first input; the
-free-motion observer starts at rest and is fed the angle relative to the first sample (its s^2
-numerator gives zero output for a constant angle, so the first angle is not a start-up step).
+One recursion, :func:`df2t_step`, compiled with numba: the direct form II transposed that
+``scipy.signal.lfilter`` uses, with the same coefficients and the same order of operations, so its
+output equals ``lfilter``'s to the bit. The streaming objects feed it a block of samples at a time
+with the state carried, and a block of one sample is the per-sample form; the batch functions
+(:func:`low_pass`, :func:`observe_free_motion`) feed a fresh object one block, so the forms agree to
+the bit on the same samples however they are cut into blocks. The detectors' compiled kernels call
+:func:`df2t_step` too. Initial conditions: the low-pass filter starts in steady state at its first
+input (``scipy.signal.lfilter_zi``); the free-motion observer starts at rest and is fed the angle
+relative to the first sample (its s^2 numerator gives zero output for a constant angle, so the
+first angle is not a start-up step).
 """
 
 from __future__ import annotations
@@ -20,8 +25,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import lfilter, lfilter_zi
+from scipy.signal import lfilter_zi
 
 from sensing_antenna.antenna import FreeMotionObserver
 from sensing_antenna.errors import SensingAntennaError
@@ -30,6 +36,7 @@ __all__ = [
     "FilterConfigError",
     "FirstOrderLowPass",
     "FreeMotionObserverFilter",
+    "df2t_step",
     "low_pass",
     "low_pass_coefficients",
     "observe_free_motion",
@@ -114,8 +121,95 @@ def observer_coefficients(
     return b, a
 
 
-class FirstOrderLowPass:
-    """Streaming low-pass filter of Eq. 20 on one scalar signal.
+@njit(cache=True)
+def df2t_step(
+    b: NDArray[np.float64], a: NDArray[np.float64], state: NDArray[np.float64], x: float
+) -> float:
+    """One sample x through the direct form II transposed recursion of ``lfilter``.
+
+    ``b``, ``a``: coefficients, shape (order + 1,), a[0] = 1; ``state``: shape (order,), updated
+    in place. Returns the output sample.
+    """
+    order = b.shape[0] - 1
+    # y[k] = b0 x[k] + z0[k-1]
+    y = state[0] + b[0] * x
+    # z_m[k] = z_{m+1}[k-1] + b_{m+1} x[k] - a_{m+1} y[k], the last without z_{m+1}
+    for m in range(order - 1):
+        state[m] = state[m + 1] + x * b[m + 1] - y * a[m + 1]
+    state[order - 1] = x * b[order] - y * a[order]
+    return y
+
+
+@njit(cache=True)
+def _filter_block(
+    b: NDArray[np.float64],
+    a: NDArray[np.float64],
+    state: NDArray[np.float64],
+    x: NDArray[np.float64],
+    y: NDArray[np.float64],
+) -> None:
+    """y[i, c] = df2t_step over the rows of x, shape (n, k), with state (k, order) carried."""
+    for i in range(x.shape[0]):
+        for c in range(x.shape[1]):
+            y[i, c] = df2t_step(b, a, state[c], x[i, c])
+
+
+class _Recursion:
+    """A discrete filter applied channel by channel along axis 0, its state carried between
+    blocks. Subclasses set the start (:meth:`_begin`) at the first sample after a reset."""
+
+    def __init__(self, b: NDArray[np.float64], a: NDArray[np.float64]) -> None:
+        self._b = np.ascontiguousarray(b, dtype=np.float64)
+        self._a = np.ascontiguousarray(a, dtype=np.float64)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the past: the next sample starts the filter again."""
+        self._state: NDArray[np.float64] | None = None
+        self._origin: NDArray[np.float64] | None = None
+        self.output = 0.0
+
+    def _begin(self, first: NDArray[np.float64]) -> None:
+        raise NotImplementedError
+
+    def update_block(self, values: ArrayLike) -> NDArray[np.float64]:
+        """Filter the samples that follow the ones fed so far.
+
+        Parameters
+        ----------
+        values : array_like, shape (n,) or (n, k)
+            Time on axis 0; the channel count k stays that of the first block after a reset.
+
+        Returns
+        -------
+        ndarray, same shape as ``values``
+        """
+        x = np.asarray(values, dtype=np.float64)
+        if x.shape[0] == 0:
+            return x.copy()
+        rows = np.ascontiguousarray(x.reshape(x.shape[0], -1))
+        if self._state is None:
+            self._begin(rows[0])
+        assert self._state is not None
+        if rows.shape[1] != self._state.shape[0]:
+            raise ValueError(
+                f"{rows.shape[1]} channels, but this filter was started on {self._state.shape[0]}"
+            )
+        if self._origin is not None:
+            rows = rows - self._origin
+        out = np.empty_like(rows)
+        _filter_block(self._b, self._a, self._state, rows, out)
+        self.output = float(out[-1, 0]) if out.shape[1] == 1 else out[-1].copy()
+        return out.reshape(x.shape)
+
+    def update(self, value: float) -> float:
+        """Filter one sample of a one-channel signal (a block of one); returns and stores
+        (``output``) the filtered value."""
+        return float(self.update_block(np.array([float(value)]))[0])
+
+
+class FirstOrderLowPass(_Recursion):
+    """Streaming low-pass filter of Eq. 20, channel by channel.
 
     Parameters
     ----------
@@ -126,44 +220,27 @@ class FirstOrderLowPass:
 
     Notes
     -----
-    The first :meth:`update` after :meth:`reset` puts the filter in steady state at its input and
-    returns it unchanged, as :func:`low_pass` does.
+    The first sample after :meth:`reset` puts the filter in steady state at that input
+    (``lfilter_zi``) and comes out unchanged, as in :func:`low_pass`.
     """
 
     def __init__(self, cutoff: float = PAPER_LOW_PASS_CUTOFF, sample_period: float = 1e-3) -> None:
         b, a = low_pass_coefficients(cutoff, sample_period)
         self.cutoff = float(cutoff)
         self.sample_period = float(sample_period)
-        self._b0 = float(b[0])
-        self._b1 = float(b[1])
-        self._a1 = float(a[1])
-        self._state = 0.0
-        self._started = False
-        self.output = 0.0
+        self._steady = lfilter_zi(b, a)
+        super().__init__(b, a)
 
-    def reset(self) -> None:
-        """Forget the past: the next input restarts the filter in steady state."""
-        self._state = 0.0
-        self._started = False
-        self.output = 0.0
-
-    def update(self, value: float) -> float:
-        """Filter one sample; returns (and stores in ``output``) the filtered value."""
-        if not self._started:
-            # Steady state at the first input: y = x and the DF2T state z = (b1 - a1) x.
-            self._started = True
-            self._state = (self._b1 - self._a1) * value
-        # Direct form II transposed, as scipy.signal.lfilter.
-        y = self._b0 * value + self._state
-        self._state = self._b1 * value - self._a1 * y
-        self.output = y
-        return y
+    def _begin(self, first: NDArray[np.float64]) -> None:
+        # steady state at the first input: z = lfilter_zi(b, a) x[0]
+        self._state = np.ascontiguousarray(first[:, None] * self._steady[None, :])
 
 
 def low_pass(
     signal: ArrayLike, cutoff: float = PAPER_LOW_PASS_CUTOFF, sample_period: float = 1e-3
 ) -> NDArray[np.float64]:
-    """Batch low-pass filter of Eq. 20 along axis 0, starting in steady state at the first sample.
+    """Batch low-pass filter of Eq. 20 along axis 0, starting in steady state at the first sample:
+    :class:`FirstOrderLowPass` fed one block.
 
     Parameters
     ----------
@@ -176,20 +253,13 @@ def low_pass(
     Returns
     -------
     ndarray, same shape as ``signal``
-        Identical (to rounding) to :class:`FirstOrderLowPass` run sample by sample.
+        Equal to ``lfilter`` started at ``lfilter_zi`` times the first sample.
     """
-    x = np.asarray(signal, dtype=np.float64)
-    b, a = low_pass_coefficients(cutoff, sample_period)
-    if x.shape[0] == 0:
-        return x.copy()
-    zi_shape = (1,) + (1,) * (x.ndim - 1)
-    zi = lfilter_zi(b, a).reshape(zi_shape) * x[:1]
-    y, _ = lfilter(b, a, x, axis=0, zi=zi)
-    return np.asarray(y, dtype=np.float64)
+    return FirstOrderLowPass(cutoff, sample_period).update_block(signal)
 
 
-class FreeMotionObserverFilter:
-    """Streaming free-motion observer of Eq. 15 for one joint: angle (rad) in, torque (N m) out.
+class FreeMotionObserverFilter(_Recursion):
+    """Streaming free-motion observer of Eq. 15, joint by joint: angle (rad) in, torque (N m) out.
 
     Parameters
     ----------
@@ -200,41 +270,26 @@ class FreeMotionObserverFilter:
     Notes
     -----
     The observer starts at rest; it is fed theta - theta[0] where theta[0] is the first angle
-    after :meth:`reset`, exactly as :func:`observe_free_motion`.
+    after :meth:`reset`, as in :func:`observe_free_motion`.
     """
 
     def __init__(self, observer: FreeMotionObserver, sample_period: float) -> None:
         b, a = observer_coefficients(observer, sample_period)
         self.observer = observer
         self.sample_period = float(sample_period)
-        self._b0, self._b1, self._b2 = (float(v) for v in b)
-        self._a1, self._a2 = float(a[1]), float(a[2])
-        self.reset()
+        super().__init__(b, a)
 
-    def reset(self) -> None:
-        """Back to rest; the next angle becomes the reference angle."""
-        self._z1 = 0.0
-        self._z2 = 0.0
-        self._origin: float | None = None
-        self.output = 0.0
-
-    def update(self, angle: float) -> float:
-        """Observe one angle (rad); returns (and stores in ``output``) the torque (N m)."""
-        if self._origin is None:
-            self._origin = angle
-        x = angle - self._origin
-        # Direct form II transposed, as scipy.signal.lfilter.
-        y = self._b0 * x + self._z1
-        self._z1 = self._b1 * x - self._a1 * y + self._z2
-        self._z2 = self._b2 * x - self._a2 * y
-        self.output = y
-        return y
+    def _begin(self, first: NDArray[np.float64]) -> None:
+        # at rest, relative to the first angle
+        self._origin = first.copy()
+        self._state = np.zeros((first.shape[0], self._b.shape[0] - 1))
 
 
 def observe_free_motion(
     angles: ArrayLike, observer: FreeMotionObserver, sample_period: float
 ) -> NDArray[np.float64]:
-    """Batch free-motion observer of Eq. 15 along axis 0 (from rest, relative to the first angle).
+    """Batch free-motion observer of Eq. 15 along axis 0 (from rest, relative to the first angle):
+    :class:`FreeMotionObserverFilter` fed one block.
 
     Parameters
     ----------
@@ -247,12 +302,6 @@ def observe_free_motion(
     Returns
     -------
     ndarray, same shape as ``angles``
-        Torque K s^2 / (s^2 + d s + omega^2) theta (N m), identical (to rounding) to
-        :class:`FreeMotionObserverFilter`.
+        Torque K s^2 / (s^2 + d s + omega^2) theta (N m).
     """
-    x = np.asarray(angles, dtype=np.float64)
-    b, a = observer_coefficients(observer, sample_period)
-    if x.shape[0] == 0:
-        return x.copy()
-    y = lfilter(b, a, x - x[:1], axis=0)
-    return np.asarray(y, dtype=np.float64)
+    return FreeMotionObserverFilter(observer, sample_period).update_block(angles)

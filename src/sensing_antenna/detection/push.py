@@ -40,7 +40,8 @@ Criteria (``PushCriterion.kind``):
 - ``torque``: Eq. 20 low-pass filtered |Gamma^m - Gamma_g^m| (N m).
 
 Only samples from t_c on can meet the criterion. The force and torque filters run from the first
-sample (steady state there), so the streaming and batch forms agree.
+sample (steady state there). One compiled kernel computes the criterion, whether the samples come
+in blocks or one at a time; :func:`detect_push` is a :class:`PushMonitor` fed one block.
 """
 
 from __future__ import annotations
@@ -50,17 +51,25 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
+from scipy.signal import lfilter_zi
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
     ContactDetection,
     ContactDetector,
+    SampleBlock,
     SampleVector,
-    detect_contact,
+    block_rows,
+    gravity_moment_sample,
 )
-from sensing_antenna.detection.filters import PAPER_LOW_PASS_CUTOFF, FirstOrderLowPass, low_pass
+from sensing_antenna.detection.filters import (
+    PAPER_LOW_PASS_CUTOFF,
+    df2t_step,
+    low_pass_coefficients,
+)
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
 
@@ -72,7 +81,6 @@ __all__ = [
     "PushMonitor",
     "detect_push",
     "link_axis_angle",
-    "push_measure",
 ]
 
 #: Default head rotation past t_c (rad): the final y_c / x_c is about 3 % with an identified
@@ -124,6 +132,27 @@ class PushCriterion:
         return _UNITS[self.kind]
 
 
+@njit(cache=True)
+def _axis_angle(theta1: float, theta2: float, ref1: float, ref2: float) -> float:
+    """Angle between the link axes X^m(theta1, theta2) and X^m(ref1, ref2) (rad)."""
+    # X^m = (cos t2 cos t1, cos t2 sin t1, sin t2)
+    c2, r2 = math.cos(theta2), math.cos(ref2)
+    dx = c2 * math.cos(theta1) - r2 * math.cos(ref1)
+    dy = c2 * math.sin(theta1) - r2 * math.sin(ref1)
+    dz = math.sin(theta2) - math.sin(ref2)
+    # 2 arcsin(|X - X_ref| / 2): accurate for small angles, unlike arccos of the dot product
+    chord = math.sqrt(dx * dx + dy * dy + dz * dz)
+    return 2.0 * math.asin(min(0.5 * chord, 1.0))
+
+
+@njit(cache=True)
+def _axis_angles(
+    theta: NDArray[np.float64], ref: NDArray[np.float64], out: NDArray[np.float64]
+) -> None:
+    for i in range(theta.shape[0]):
+        out[i] = _axis_angle(theta[i, 0], theta[i, 1], ref[i, 0], ref[i, 1])
+
+
 def link_axis_angle(theta: ArrayLike, theta_ref: ArrayLike) -> NDArray[np.float64]:
     """Angle between the link axes X^m(theta) and X^m(theta_ref) (rad).
 
@@ -137,70 +166,81 @@ def link_axis_angle(theta: ArrayLike, theta_ref: ArrayLike) -> NDArray[np.float6
     Returns
     -------
     ndarray, shape (...)
-        2 arcsin(|X - X_ref| / 2), accurate for small angles (unlike arccos of the dot product).
+        2 arcsin(|X - X_ref| / 2), accurate for small angles (unlike arccos of the dot product);
+        the push criterion's own computation.
     """
-    a = np.asarray(theta, dtype=np.float64)
-    b = np.asarray(theta_ref, dtype=np.float64)
-    chord = np.sqrt(
-        (np.cos(a[..., 1]) * np.cos(a[..., 0]) - np.cos(b[..., 1]) * np.cos(b[..., 0])) ** 2
-        + (np.cos(a[..., 1]) * np.sin(a[..., 0]) - np.cos(b[..., 1]) * np.sin(b[..., 0])) ** 2
-        + (np.sin(a[..., 1]) - np.sin(b[..., 1])) ** 2
+    a, b = np.broadcast_arrays(
+        np.asarray(theta, dtype=np.float64), np.asarray(theta_ref, dtype=np.float64)
     )
-    return np.asarray(2.0 * np.arcsin(np.minimum(0.5 * chord, 1.0)), dtype=np.float64)
+    out = np.empty(a.shape[:-1])
+    _axis_angles(block_rows(a, out.size, 2), block_rows(b, out.size, 2), out.reshape(-1))
+    return out
 
 
-def _axis(theta1: float, theta2: float) -> tuple[float, float, float]:
-    c2 = math.cos(theta2)
-    return (c2 * math.cos(theta1), c2 * math.sin(theta1), math.sin(theta2))
+# The push kernel's parameters (``par``) and state (``mem``), float64 arrays. par: low-pass b (2),
+# a (2), its lfilter_zi, kind (0 rotation, 1 force, 2 torque), threshold, weight, weight
+# moments. mem: low-pass state; angles at t_c; samples fed; t_1 index (-1: none); measure.
+_LP_B, _LP_A = slice(0, 2), slice(2, 4)
+_ZI, _KIND, _THRESHOLD, _WEIGHT, _WEIGHT_MOMENT, _SAG_MOMENT = range(4, 10)
+_N_PAR = 10
+_LP_Z = slice(0, 1)
+_THETA_C, _COUNT, _INDEX, _MEASURE = 1, 3, 4, 5
+_N_MEM = 6
 
 
-def _gravity_free_magnitudes(
-    recording: Recording, antenna: Antenna
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """|F^m - F_g^m| (N) and |Gamma^m - Gamma_g^m| (N m), shape (n,) each."""
-    theta2 = recording.theta[:, 1]
-    # Section 4.2: F^m - F_g^m and Gamma^m - Gamma_g^m
-    force = recording.force - antenna.gravity_force(theta2)
-    torque = recording.torque - antenna.gravity_torque(theta2)
-    return np.sqrt(np.sum(force**2, axis=1)), np.sqrt(np.sum(torque**2, axis=1))
-
-
-def push_measure(
-    recording: Recording, antenna: Antenna, criterion: PushCriterion, contact_index: int | None
-) -> NDArray[np.float64]:
-    """The signal a criterion compares with its threshold, for a uniformly sampled recording.
-
-    Parameters
-    ----------
-    recording : Recording
-    antenna : Antenna
-    criterion : PushCriterion
-    contact_index : int or None
-        Sample of t_c; the rotation is measured from there (zero before it, and everywhere if
-        None).
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        rad, N or N m depending on ``criterion.kind``.
-    """
-    if criterion.kind == "rotation":
-        measure = np.zeros(recording.n_samples)
-        if contact_index is not None:
-            measure[contact_index:] = link_axis_angle(
-                recording.theta[contact_index:], recording.theta[contact_index]
-            )
-        return measure
-    force, torque = _gravity_free_magnitudes(recording, antenna)
-    # Eq. 20: G(s) = 1 / (1 + s / omega_c) on the magnitude
-    return low_pass(
-        force if criterion.kind == "force" else torque, criterion.cutoff, recording.sample_period
-    )
+@njit(cache=True)
+def _push_block(
+    par: NDArray[np.float64],
+    mem: NDArray[np.float64],
+    contact: int,
+    theta: NDArray[np.float64],
+    force: NDArray[np.float64],
+    torque: NDArray[np.float64],
+    measures: NDArray[np.float64],
+) -> int:
+    """Feed rows of theta (n, 2), force and torque (n, 3); ``contact`` is the contact index
+    counted since reset (-1: none). Writes rows count.. of ``measures``; returns the t_1 index
+    (-1: none)."""
+    kind = int(par[_KIND])
+    lp_z = mem[_LP_Z]
+    for i in range(theta.shape[0]):
+        k = int(mem[_COUNT])
+        in_contact = 0 <= contact <= k
+        theta2 = theta[i, 1]
+        if kind == 0:
+            if in_contact:
+                if k == contact:
+                    mem[_THETA_C], mem[_THETA_C + 1] = theta[i, 0], theta2
+                mem[_MEASURE] = _axis_angle(theta[i, 0], theta2, mem[_THETA_C], mem[_THETA_C + 1])
+        else:
+            if kind == 1:
+                # Section 4.2: F^m - F_g^m, F_g^m = -m g (sin theta2, 0, cos theta2)
+                x = force[i, 0] + par[_WEIGHT] * math.sin(theta2)
+                y = force[i, 1] - 0.0
+                z = force[i, 2] + par[_WEIGHT] * math.cos(theta2)
+            else:
+                # Section 4.2: Gamma^m - Gamma_g^m, Gamma_g^m on Y^m (Link.gravity_moment)
+                x = torque[i, 0] - 0.0
+                y = torque[i, 1] - gravity_moment_sample(
+                    theta2, par[_WEIGHT_MOMENT], par[_SAG_MOMENT]
+                )
+                z = torque[i, 2] - 0.0
+            magnitude = math.sqrt(x * x + y * y + z * z)
+            if k == 0:
+                # the filter starts in steady state at its first input
+                lp_z[0] = par[_ZI] * magnitude
+            # Eq. 20: low-pass filtered magnitude
+            mem[_MEASURE] = df2t_step(par[_LP_B], par[_LP_A], lp_z, magnitude)
+        measures[k] = mem[_MEASURE]
+        mem[_COUNT] = k + 1
+        if in_contact and mem[_INDEX] < 0.0 and mem[_MEASURE] > par[_THRESHOLD]:
+            mem[_INDEX] = k
+    return int(mem[_INDEX])
 
 
 @dataclass(frozen=True, eq=False)
 class PushDetection:
-    """Result of :func:`detect_push`.
+    """Result of :func:`detect_push` (or of :meth:`PushMonitor.detection`).
 
     Parameters
     ----------
@@ -213,7 +253,7 @@ class PushDetection:
     index : int or None
         Sample index of t_1 in ``contact.t``.
     measure : ndarray, shape (n,)
-        Signal compared with the threshold (``push_measure``).
+        Signal compared with the threshold (rad, N or N m; rotation: zero before t_c).
     criterion : PushCriterion
     contact : ContactDetection
     """
@@ -226,60 +266,6 @@ class PushDetection:
     measure: NDArray[np.float64]
     criterion: PushCriterion
     contact: ContactDetection
-
-
-def detect_push(
-    recording: Recording,
-    antenna: Antenna,
-    criterion: PushCriterion | None = None,
-    threshold: float | None = None,
-    residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
-) -> PushDetection:
-    """Contact instant t_c and push instant t_1 of a recording (batch form of
-    :class:`PushMonitor`).
-
-    Parameters
-    ----------
-    recording : Recording
-        Irregular sampling is handled by linear resampling first, as in ``detect_contact``.
-    antenna : Antenna
-    criterion : PushCriterion, optional
-        Default ``PushCriterion()`` (``DEFAULT_ROTATION`` of rotation).
-    threshold, residual_cutoff
-        Passed to :func:`~sensing_antenna.detection.contact.detect_contact`.
-
-    Returns
-    -------
-    PushDetection
-    """
-    rule = PushCriterion() if criterion is None else criterion
-    contact = detect_contact(recording, antenna, threshold, residual_cutoff)
-    uniform = resample_uniform(recording) if contact.resampled else recording
-    measure = push_measure(uniform, antenna, rule, contact.index)
-
-    def result(status: Literal["pushed", "no_push", "no_contact"], reason: str) -> PushDetection:
-        return PushDetection(status, reason, contact.t_c, None, None, measure, rule, contact)
-
-    if contact.index is None:
-        return result("no_contact", contact.reason)
-    above = np.flatnonzero(measure[contact.index :] > rule.threshold)
-    if above.size == 0:
-        return result(
-            "no_push",
-            f"{rule.kind} stays at or below {rule.threshold:g} {rule.unit} after t_c",
-        )
-    index = contact.index + int(above[0])
-    t_1 = float(uniform.t[index])
-    return PushDetection(
-        status="pushed",
-        reason=f"{rule.kind} exceeds {rule.threshold:g} {rule.unit} at t = {t_1:g} s",
-        t_c=contact.t_c,
-        t_1=t_1,
-        index=index,
-        measure=measure,
-        criterion=rule,
-        contact=contact,
-    )
 
 
 class PushMonitor:
@@ -302,9 +288,14 @@ class PushMonitor:
     contact_time, push_time : float or None
         t_c and t_1 (s).
     push_index : int or None
-        Sample index of t_1 counted from the first update after reset.
+        Sample index of t_1 counted from the first sample after reset.
     measure : float
         Latest value of the criterion's signal (rad, N or N m).
+
+    Notes
+    -----
+    Samples come in blocks (:meth:`update_block`) or one at a time (:meth:`update`, a block of
+    one); one compiled kernel gives the same numbers to the bit either way.
     """
 
     def __init__(
@@ -322,74 +313,131 @@ class PushMonitor:
             if contact_detector is None
             else contact_detector
         )
-        self._filter = FirstOrderLowPass(criterion.cutoff, sample_period)
-        self._link = antenna.link
-        self._weight = antenna.link.weight
+        b, a = low_pass_coefficients(criterion.cutoff, self.sample_period)
+        par = np.zeros(_N_PAR)
+        par[_LP_B], par[_LP_A], par[_ZI] = b, a, lfilter_zi(b, a)[0]
+        par[_KIND] = _KINDS.index(criterion.kind)
+        par[_THRESHOLD] = criterion.threshold
+        par[_WEIGHT] = antenna.link.weight
+        par[_WEIGHT_MOMENT] = antenna.link.weight_moment
+        par[_SAG_MOMENT] = antenna.link.sag_moment
+        self._par = par
+        self._time = np.zeros(1)  # the time of one sample, as a block
         self.reset()
 
     def reset(self) -> None:
         """Forget everything, including the contact detector's state."""
         self.contact_detector.reset()
-        self._filter.reset()
-        self._axis_c: tuple[float, float, float] | None = None
-        self.pushed = False
-        self.push_time: float | None = None
+        self._mem = np.zeros(_N_MEM)
+        self._mem[_INDEX] = -1.0
+        self._measures = np.empty(0)
         self.push_index: int | None = None
-        self.measure = 0.0
-        self._count = 0
+        self.push_time: float | None = None
+
+    @property
+    def pushed(self) -> bool:
+        """True from t_1 on."""
+        return self.push_index is not None
 
     @property
     def contact_time(self) -> float | None:
         """t_c (s), or None before contact."""
         return self.contact_detector.contact_time
 
+    @property
+    def measure(self) -> float:
+        """Latest value of the criterion's signal (rad, N or N m)."""
+        return float(self._mem[_MEASURE])
+
+    def update_block(
+        self, t: ArrayLike, theta: SampleBlock, force: SampleBlock, torque: SampleBlock
+    ) -> bool:
+        """Feed samples (as :meth:`ContactDetector.update_block`, the force used here: by the
+        link on the head, motor frame, N); returns True from the block where the criterion is
+        met (t_1) on."""
+        detector = self.contact_detector
+        start = detector.n_samples
+        times = np.asarray(t, dtype=np.float64).reshape(-1)
+        count = times.shape[0]
+        angles = block_rows(theta, count, 2)
+        forces, moments = block_rows(force, count, 3), block_rows(torque, count, 3)
+        detector._feed(times, angles, moments)
+        if start + count > self._measures.shape[0]:
+            grown = np.empty(max(start + count, 2 * self._measures.shape[0], 4096))
+            grown[:start] = self._measures[:start]
+            self._measures = grown
+        contact = -1 if detector.contact_index is None else detector.contact_index
+        index = _push_block(
+            self._par,
+            self._mem,
+            contact,
+            angles,
+            forces,
+            moments,
+            self._measures,
+        )
+        if index >= 0 and self.push_index is None:
+            self.push_index = index
+            self.push_time = float(times[index - start])
+        return self.push_index is not None
+
     def update(
         self, t: float, theta: SampleVector, force: SampleVector, torque: SampleVector
     ) -> bool:
-        """Feed one sample; returns True from the sample where the criterion is met (t_1) on.
+        """Feed one sample (a block of one: t in s, theta (2,) in rad, force (3,) in N, torque
+        (3,) in N m); returns True from the sample where the criterion is met (t_1) on."""
+        self._time[0] = t
+        return self.update_block(self._time, theta, force, torque)
 
-        Parameters
-        ----------
-        t : float
-            Sample time (s).
-        theta : array_like, shape (2,)
-            Motor angles (rad).
-        force : array_like, shape (3,)
-            Force by the link on the head, motor frame (N).
-        torque : array_like, shape (3,)
-            Torque by the link on the head about O, motor frame (N m).
-        """
-        in_contact = self.contact_detector.update(t, theta, force, torque)
-        theta1, theta2 = float(theta[0]), float(theta[1])
-        kind = self.criterion.kind
-        if kind == "rotation":
-            if in_contact:
-                if self._axis_c is None:
-                    self._axis_c = _axis(theta1, theta2)
-                x, y, z = _axis(theta1, theta2)
-                cx, cy, cz = self._axis_c
-                chord = math.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2)
-                self.measure = 2.0 * math.asin(min(0.5 * chord, 1.0))
-        elif kind == "force":
-            # Section 4.2: F^m - F_g^m, F_g^m = -m_b g (sin theta2, 0, cos theta2)
-            f = force
-            fx = float(f[0]) + self._weight * math.sin(theta2)
-            fy = float(f[1])
-            fz = float(f[2]) + self._weight * math.cos(theta2)
-            # Eq. 20: low-pass filtered |F^m - F_g^m|
-            self.measure = self._filter.update(math.sqrt(fx * fx + fy * fy + fz * fz))
+    def detection(self, resampled: bool = False) -> PushDetection:
+        """The decision over every sample fed since reset (arrays are views, not copies)."""
+        contact = self.contact_detector.detection(resampled)
+        rule = self.criterion
+        measure = self._measures[: self.contact_detector.n_samples]
+        if contact.index is None:
+            status: Literal["pushed", "no_push", "no_contact"] = "no_contact"
+            reason = contact.reason
+        elif self.push_time is None:
+            status = "no_push"
+            reason = f"{rule.kind} stays at or below {rule.threshold:g} {rule.unit} after t_c"
         else:
-            # Section 4.2: Gamma^m - Gamma_g^m, Gamma_g^m = (0, m_b g l cos theta2 / 2, 0) with
-            # tip mass and sag (Link.gravity_moment)
-            g = torque
-            gx = float(g[0])
-            gy = float(g[1]) - float(self._link.gravity_moment(theta2))
-            gz = float(g[2])
-            # Eq. 20: low-pass filtered |Gamma^m - Gamma_g^m|
-            self.measure = self._filter.update(math.sqrt(gx * gx + gy * gy + gz * gz))
-        if in_contact and not self.pushed and self.measure > self.criterion.threshold:
-            self.pushed = True
-            self.push_time = float(t)
-            self.push_index = self._count
-        self._count += 1
-        return self.pushed
+            status = "pushed"
+            reason = (
+                f"{rule.kind} exceeds {rule.threshold:g} {rule.unit} at t = {self.push_time:g} s"
+            )
+        return PushDetection(
+            status, reason, contact.t_c, self.push_time, self.push_index, measure, rule, contact
+        )
+
+
+def detect_push(
+    recording: Recording,
+    antenna: Antenna,
+    criterion: PushCriterion | None = None,
+    threshold: float | None = None,
+    residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
+) -> PushDetection:
+    """Contact instant t_c and push instant t_1 of a recording: a :class:`PushMonitor` fed the
+    whole recording.
+
+    Parameters
+    ----------
+    recording : Recording
+        Irregular sampling is handled by linear resampling first, as in ``detect_contact``.
+    antenna : Antenna
+    criterion : PushCriterion, optional
+        Default ``PushCriterion()`` (``DEFAULT_ROTATION`` of rotation).
+    threshold, residual_cutoff
+        Passed to the :class:`~sensing_antenna.detection.contact.ContactDetector`.
+
+    Returns
+    -------
+    PushDetection
+    """
+    resampled = recording.sampling.irregular
+    uniform = resample_uniform(recording) if resampled else recording
+    period = uniform.sample_period
+    detector = ContactDetector(antenna, period, threshold, residual_cutoff)
+    monitor = PushMonitor(criterion or PushCriterion(), antenna, period, detector)
+    monitor.update_block(uniform.t, uniform.theta, uniform.force, uniform.torque)
+    return monitor.detection(resampled)

@@ -1,11 +1,16 @@
-"""Contact-point estimation: contact instant, push, Estimators 1 and 2, fusion, baselines.
+"""Contact-point estimation: a front end (contact instant, push, contact frame, Estimator 2's
+ratio) and interchangeable methods (the paper's fusion, baselines, ``fast``).
 
-Public entry points (imported lazily, so that importing one submodule such as
-``sensing_antenna.detection.filters`` does not load the whole pipeline):
+Public entry points (imported lazily, so that importing one submodule does not load the whole
+pipeline):
 
 - :func:`estimate` (offline) and :class:`OnlineEstimator` (streaming), :data:`METHODS`;
+- the two steps of ``estimate``: :func:`gather` (the front end on a recording: an
+  :class:`Evidence` or an :class:`EarlyOutcome`) and :func:`conclude` (a method's estimate from
+  it); :class:`FrontEnd`, the front end as a streaming object; :class:`FrontTrace`, what it saw;
 - :func:`measure_omega1`, Estimator 1's frequency measurement alone;
-- :class:`ContactEstimate`, :class:`Status`, :class:`EstimatorConfig`.
+- :class:`ContactEstimate`, :class:`Status`, :class:`EstimatorConfig`;
+- what a method is: :class:`EstimationMethod`, :class:`EarlyStopping`, :class:`Sessioned`.
 """
 
 from __future__ import annotations
@@ -16,35 +21,52 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.estimation.front.evidence import Evidence
-    from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
-    from sensing_antenna.estimation.pipeline import (
+    from sensing_antenna.estimation.front.frontend import FrontEnd
+    from sensing_antenna.estimation.front.outcome import EarlyOutcome, FrontTrace
+    from sensing_antenna.estimation.methods import (
         METHODS,
-        OnlineEstimator,
-        estimate,
-        gather,
-        measure_omega1,
+        EarlyStopping,
+        EstimationMethod,
+        Sessioned,
     )
+    from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
+    from sensing_antenna.estimation.online import OnlineEstimator
+    from sensing_antenna.estimation.pipeline import conclude, estimate, gather, measure_omega1
     from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = [
     "METHODS",
     "ContactEstimate",
+    "EarlyOutcome",
+    "EarlyStopping",
+    "EstimationMethod",
     "EstimatorConfig",
     "Evidence",
     "FrequencyMeasurement",
+    "FrontEnd",
+    "FrontTrace",
     "OnlineEstimator",
+    "Sessioned",
     "Status",
+    "conclude",
     "estimate",
     "gather",
     "measure_omega1",
 ]
 
 _WHERE = {
-    "METHODS": "pipeline",
-    "OnlineEstimator": "pipeline",
+    "METHODS": "methods",
+    "EarlyStopping": "methods",
+    "EstimationMethod": "methods",
+    "Sessioned": "methods",
+    "OnlineEstimator": "online",
+    "conclude": "pipeline",
     "estimate": "pipeline",
-    "gather": "pipeline",
     "measure_omega1": "pipeline",
+    "gather": "pipeline",
+    "FrontEnd": "front.frontend",
+    "EarlyOutcome": "front.outcome",
+    "FrontTrace": "front.outcome",
     "ContactEstimate": "result",
     "Status": "result",
     "EstimatorConfig": "config",

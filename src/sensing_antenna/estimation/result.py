@@ -11,9 +11,12 @@ import enum
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from sensing_antenna.estimation.front.outcome import FrontTrace
 
 __all__ = ["STATUS_PRECEDENCE", "ContactEstimate", "Status"]
 
@@ -116,6 +119,9 @@ class ContactEstimate:
         ``candidates``, from methods that give one (``fast``), else None.
     diagnostics : Mapping
         Everything else worth knowing (sampling report, torque component used, frame axes, ...).
+    trace : FrontTrace or None
+        What the front end saw (signals, instants, frame), for figures; not compared by ``==``
+        and not in :meth:`to_dict`.
     """
 
     status: Status
@@ -133,6 +139,7 @@ class ContactEstimate:
     diagnostics: Mapping[str, Any] = field(default_factory=dict)
     interval: tuple[float, float] | None = None
     branch_probability: tuple[float, ...] | None = None
+    trace: FrontTrace | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "status", Status(self.status))

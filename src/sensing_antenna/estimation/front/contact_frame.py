@@ -38,6 +38,9 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
+#: Candidate instants of t_1 tested per step of :func:`first_rest_index`.
+_REST_CHUNK = 256
+
 
 def motor_axes(theta: FloatArray) -> FloatArray:
     """Rows X^m, Y^m, Z^m of the motor frame in absolute coordinates.
@@ -130,14 +133,17 @@ def first_rest_index(
         The index of t_1, or None when the head never rests in the samples.
     """
     theta = np.asarray(theta, dtype=float)
-    segment = theta[start:]
-    if segment.shape[0] < window_samples + 1:
-        return None
-    windows = np.lib.stride_tricks.sliding_window_view(segment, window_samples + 1, axis=0)
-    spread = windows.max(axis=-1) - windows.min(axis=-1)
-    at_rest = np.all(spread <= tolerance, axis=1)
-    hits = np.flatnonzero(at_rest)
-    return start + int(hits[0]) if hits.size else None
+    w = window_samples
+    # candidates i in [start, n - w), looked at a few hundred at a time: the head usually rests
+    # soon after t_c, and the windows of a whole recording would cost far more
+    for first in range(start, theta.shape[0] - w, _REST_CHUNK):
+        stop = min(first + _REST_CHUNK, theta.shape[0] - w)
+        windows = np.lib.stride_tricks.sliding_window_view(theta[first : stop + w], w + 1, axis=0)
+        spread = windows.max(axis=-1) - windows.min(axis=-1)
+        hits = np.flatnonzero(np.all(spread <= tolerance, axis=1))
+        if hits.size:
+            return first + int(hits[0])
+    return None
 
 
 @dataclass(frozen=True)

@@ -26,13 +26,11 @@ filter, as in Eq. 21) would instead bias the ratio for several 1/omega_c.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.detection.filters import low_pass
+from sensing_antenna.detection.filters import FirstOrderLowPass, low_pass
 
 __all__ = [
     "contact_loads",
@@ -40,7 +38,6 @@ __all__ = [
     "filtered_contact_loads",
     "paper_ratio",
     "perpendicular_ratio",
-    "perpendicular_ratio_sample",
     "ratio_noise",
     "window_mean",
 ]
@@ -87,6 +84,7 @@ def filtered_contact_loads(
     cutoff: float,
     sample_period: float,
     offset: FloatArray | None = None,
+    running: FirstOrderLowPass | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Contact loads through the low-pass filter of Eq. 20, from the first sample in steady state.
 
@@ -95,6 +93,9 @@ def filtered_contact_loads(
     offset : array, shape (6,), optional
         Sensor offset (N, N m) subtracted after the filter (see :func:`load_offset`); the filter
         has unit gain at DC and starts in steady state, so this equals filtering tared samples.
+    running : FirstOrderLowPass, optional
+        The filter to continue (its state carried from the samples it was fed before), for a
+        stream fed block by block; a fresh one (cut-off ``cutoff``) when None.
 
     Returns
     -------
@@ -102,8 +103,9 @@ def filtered_contact_loads(
         Filtered R (N) and filtered Gamma - Gamma_g^m (N m), motor frame.
     """
     reaction, moment = contact_loads(theta, force_m, torque_m, antenna)
+    lowpass = FirstOrderLowPass(cutoff, sample_period) if running is None else running
     # Eq. 20: G(s) = 1 / (1 + s / omega_c) on all six channels
-    both = low_pass(np.hstack([reaction, moment]), cutoff, sample_period)
+    both = lowpass.update_block(np.hstack([reaction, moment]))
     if offset is not None:
         both = both - np.asarray(offset, dtype=float)
     return both[:, :3], both[:, 3:]
@@ -172,21 +174,6 @@ def perpendicular_ratio(
             y_c = perpendicular * x_c**3 / (3.0 * flexural_rigidity)
             x_c = (moment_v + y_c * r_x) / perpendicular
     return np.where(perpendicular > 0.0, x_c, np.nan)
-
-
-def perpendicular_ratio_sample(
-    r_x: float, r_y: float, r_z: float, g_y: float, g_z: float, flexural_rigidity: float
-) -> float:
-    """:func:`perpendicular_ratio` for one sample, in plain floats (streaming form)."""
-    perpendicular = math.hypot(r_y, r_z)
-    if perpendicular == 0.0:
-        return math.nan
-    moment_v = (g_z * r_y - g_y * r_z) / perpendicular
-    x_c = moment_v / perpendicular
-    for _ in range(_FIXED_POINT_STEPS):
-        y_c = perpendicular * x_c**3 / (3.0 * flexural_rigidity)
-        x_c = (moment_v + y_c * r_x) / perpendicular
-    return x_c
 
 
 def paper_ratio(

@@ -1,18 +1,24 @@
-"""The registry of estimation methods: what ``--method`` may name.
+"""The registry of estimation methods (what ``--method`` may name) and what a method is.
 
-A method is an object with a ``name`` and ``conclude(evidence) -> ContactEstimate``; a method that
-can stop earlier (``fast``) also has ``due(samples_since_t1, sample_period)`` (cheap: is this an
-evaluation instant?) and ``ready(evidence)``; one that keeps state over a manoeuvre online has
-``session()``, which gives a fresh object with ``name``, ``due``, ``ready``, ``conclude`` and
-``session`` (the online estimator takes one per manoeuvre). A new method is added to
-``_BUILTIN_METHODS``; the command line lists whatever :data:`METHODS` holds.
+A method is an :class:`EstimationMethod`: a ``name`` and ``conclude(evidence) -> ContactEstimate``.
+Two optional abilities, each a protocol the online estimator checks once per manoeuvre:
+
+- :class:`EarlyStopping` (``fast``): ``due(samples_since_t1, sample_period)`` (cheap: is this an
+  evaluation instant?) and ``ready(evidence)`` (may it conclude from the samples so far?); the
+  online estimator asks ``ready`` on the ``due`` cadence, and ``conclude`` on the evidence at t_e
+  scans the same instants, so both forms stay identical.
+- :class:`Sessioned` (``fast``): ``session()`` gives a fresh method that keeps state over one
+  manoeuvre (its window fits); the online estimator takes one at every reset.
+
+A new method is added to ``_BUILTIN_METHODS``; the command line lists whatever :data:`METHODS`
+holds.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.front.evidence import Evidence
@@ -21,9 +27,17 @@ from sensing_antenna.estimation.methods.fast.method import FastMethod
 from sensing_antenna.estimation.methods.paper.fusion import PaperMethod
 from sensing_antenna.estimation.result import ContactEstimate
 
-__all__ = ["METHODS", "EstimationMethod", "UnknownMethodError", "resolve_method"]
+__all__ = [
+    "METHODS",
+    "EarlyStopping",
+    "EstimationMethod",
+    "Sessioned",
+    "UnknownMethodError",
+    "resolve_method",
+]
 
 
+@runtime_checkable
 class EstimationMethod(Protocol):
     """A way to turn the evidence at t_e into an estimate."""
 
@@ -34,6 +48,29 @@ class EstimationMethod(Protocol):
 
     def conclude(self, evidence: Evidence) -> ContactEstimate:
         """The estimate from the evidence at t_e."""
+        ...
+
+
+@runtime_checkable
+class EarlyStopping(EstimationMethod, Protocol):
+    """A method that may conclude before t_e, from the samples up to an earlier instant."""
+
+    def due(self, samples_since_t1: int, sample_period: float) -> bool:
+        """Whether the instant ``samples_since_t1`` samples after t_1 is one to ask ``ready`` at
+        (T_s = ``sample_period`` in s); cheap."""
+        ...
+
+    def ready(self, evidence: Evidence) -> bool:
+        """Whether the evidence up to its ``end_index`` suffices to conclude now."""
+        ...
+
+
+@runtime_checkable
+class Sessioned(EstimationMethod, Protocol):
+    """A method that keeps state over one manoeuvre when run online."""
+
+    def session(self) -> EstimationMethod:
+        """A fresh method for one manoeuvre (the online estimator takes one at every reset)."""
         ...
 
 

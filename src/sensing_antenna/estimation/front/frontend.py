@@ -1,0 +1,563 @@
+"""The front end as one streaming object, :class:`FrontEnd`.
+
+The front end turns samples into the :class:`~.evidence.Evidence` a method concludes from, or into
+an :class:`~.outcome.EarlyOutcome` when no estimate is possible. Its steps (Section 4), each
+causal, so an instant depends only on the samples up to it:
+
+1. t_c: the contact detector of Section 4.2 (:class:`~sensing_antenna.detection.contact.
+   ContactDetector`); the sensor offset and the rest tolerance from the samples up to t_c.
+2. t_1: the head comes to rest after t_c (:func:`.contact_frame.first_rest_index`), or, with
+   ``t1_source = "push"``, the push criterion's decision (:class:`~sensing_antenna.detection.push.
+   PushMonitor`).
+3. At t_1 + hold: the static push and the contact frame (:func:`.steps.hold_push`).
+4. Estimator 2's ratio, its moving mean and convergence (:mod:`.ratio`); t_e (Section 4, step 6).
+
+Samples come in blocks (:meth:`FrontEnd.update_block`); a block of one is the per-sample form,
+and :func:`~sensing_antenna.estimation.pipeline.gather` feeds a whole recording as one block.
+The detectors are compiled kernels with their state carried; the Eq. 20 filter carries its state
+too; the ratio and its moving mean are elementwise and computed once per sample when first
+needed. So the evidence, its instants and every number in it are the same to the bit however the
+samples are cut into blocks.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sensing_antenna.antenna import Antenna
+from sensing_antenna.detection.contact import ContactDetector
+from sensing_antenna.detection.filters import FirstOrderLowPass
+from sensing_antenna.detection.push import PushCriterion, PushMonitor
+from sensing_antenna.errors import FieldError
+from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
+from sensing_antenna.estimation.front.contact_frame import first_rest_index, signal_noise
+from sensing_antenna.estimation.front.evidence import Evidence, search_band
+from sensing_antenna.estimation.front.outcome import EarlyOutcome, FrontTrace
+from sensing_antenna.estimation.front.ratio import (
+    converged_index,
+    filtered_contact_loads,
+    perpendicular_ratio,
+    window_mean,
+)
+from sensing_antenna.estimation.front.steps import (
+    ContactStart,
+    HoldPush,
+    at_contact,
+    dead_channel,
+    gap_problem,
+    hold_push,
+    planned_end,
+    ratio_tolerance,
+    samples,
+    sampling_problem,
+    time_gaps,
+)
+from sensing_antenna.estimation.result import Status
+
+__all__ = ["FrontEnd", "Gathered", "one_sample"]
+
+FloatArray = NDArray[np.float64]
+
+#: What the front end hands on: the evidence at t_e, or why there is none.
+Gathered = Evidence | EarlyOutcome
+
+# The buffers of FrontEnd (set in reset), grown by doubling, NaN where not written.
+_BUFFERS = ("_t", "_theta", "_force", "_torque", "_reaction", "_moment", "_ratio", "_mean")
+
+
+def one_sample(
+    t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """One sample as a block of one: t (1,), theta (1, 2), force and torque (1, 3)."""
+    return (
+        np.array([t], dtype=np.float64),
+        np.asarray(theta, dtype=np.float64)[None, :],
+        np.asarray(force, dtype=np.float64)[None, :],
+        np.asarray(torque, dtype=np.float64)[None, :],
+    )
+
+
+def _rows(name: str, value: ArrayLike, count: int, width: int) -> FloatArray:
+    """``value`` as an array of shape (count, width), or a FieldError naming it."""
+    array = np.asarray(value, dtype=np.float64)
+    if array.shape != (count, width):
+        raise FieldError(
+            name,
+            f"shape {array.shape}, expected ({count}, {width}) for {count} sample times",
+            "FrontEnd.update_block",
+        )
+    return array
+
+
+def _read_only(view: FloatArray) -> FloatArray:
+    view.flags.writeable = False
+    return view
+
+
+class FrontEnd:
+    """The front end of the estimation pipeline as a streaming object.
+
+    Parameters
+    ----------
+    antenna : Antenna
+        Link, observer and contact threshold.
+    sample_period : float
+        T_s (s) of the uniform samples that will be fed.
+    config : EstimatorConfig, optional
+        Defaults to ``EstimatorConfig()``.
+    diagnostics : Mapping, optional
+        What the caller knows about the samples (the sampling report of a recording), put first
+        in every outcome's diagnostics; ``{"resampled": False}`` when None.
+
+    Notes
+    -----
+    :meth:`update_block` returns the outcome once: the :class:`~.evidence.Evidence` at t_e or an
+    :class:`~.outcome.EarlyOutcome`; later samples are ignored until :meth:`reset`.
+    :meth:`finish` closes a run whose samples ended first. A method that may stop before t_e
+    asks :meth:`evidence_at` for the evidence of an earlier instant.
+    """
+
+    def __init__(
+        self,
+        antenna: Antenna,
+        sample_period: float,
+        config: EstimatorConfig | None = None,
+        *,
+        diagnostics: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.antenna = antenna
+        self.sample_period = ts = float(sample_period)
+        self.config = cfg = config if config is not None else EstimatorConfig()
+        self.band = search_band(antenna.link, cfg)
+        self._notes = dict(diagnostics) if diagnostics is not None else {"resampled": False}
+        self._w_rest = samples(cfg.rest_window, ts)
+        self._w_hold = max(samples(cfg.frame_window, ts), self._w_rest)
+        self._w_conv = samples(cfg.convergence_window, ts)
+        self._n_wait = samples(cfg.max_ratio_wait, ts)
+        # Samples too coarse for the vibration are refused before any filter is built for them
+        self._refused = sampling_problem(ts, self.band[1], cfg)
+        self._detector: ContactDetector | None = None
+        self._monitor: PushMonitor | None = None
+        self._loads_filter: FirstOrderLowPass | None = None
+        if self._refused is None:
+            self._detector = ContactDetector(antenna, ts)
+            if cfg.t1_source == "push":
+                # Section 4 step 4: t_1 is the push criterion's decision, on the same detector
+                rule = cfg.push_criterion or PushCriterion()
+                self._monitor = PushMonitor(rule, antenna, ts, contact_detector=self._detector)
+            self._loads_filter = FirstOrderLowPass(cfg.lowpass_cutoff, ts)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every sample: ready for a new manoeuvre."""
+        if self._monitor is not None:
+            self._monitor.reset()  # and its contact detector
+        elif self._detector is not None:
+            self._detector.reset()
+        if self._loads_filter is not None:
+            self._loads_filter.reset()
+        # samples, the filtered contact loads (offset not removed), the ratio and its mean
+        self._t: FloatArray = np.empty(0)
+        self._theta: FloatArray = np.empty((0, 2))
+        self._force: FloatArray = np.empty((0, 3))
+        self._torque: FloatArray = np.empty((0, 3))
+        self._reaction: FloatArray = np.empty((0, 3))
+        self._moment: FloatArray = np.empty((0, 3))
+        self._ratio: FloatArray = np.empty(0)
+        self._mean: FloatArray = np.empty(0)
+        self._n = 0
+        self._loads_done = self._ratio_done = self._mean_done = 0
+        self._filled: list[tuple[int, tuple[float, float]]] = []  # (known at sample, interval)
+        self._contact: int | None = None
+        self._start: ContactStart | None = None
+        self._rest: int | None = None
+        self._hold: HoldPush | None = None
+        self._ratio_tolerance = math.nan
+        self._converged: int | None = None
+        self._planned: int | None = None
+        self._outcome: Gathered | None = None
+
+    @property
+    def n_samples(self) -> int:
+        """Samples fed since :meth:`reset`."""
+        return self._n
+
+    @property
+    def contact_index(self) -> int | None:
+        """Sample of t_c, once found."""
+        return self._contact
+
+    @property
+    def rest_index(self) -> int | None:
+        """Sample of t_1, once found."""
+        return self._rest
+
+    @property
+    def first_evaluation_index(self) -> int | None:
+        """First sample at which :meth:`evidence_at` may be asked: the end of the hold after t_1,
+        once the push there was judged measurable; None before."""
+        if self._hold is None or self._rest is None:
+            return None
+        return self._rest + self._w_hold
+
+    @property
+    def outcome(self) -> Gathered | None:
+        """The evidence at t_e or the early outcome, once given."""
+        return self._outcome
+
+    def update(
+        self, t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
+    ) -> Gathered | None:
+        """Feed one sample (a block of one: t in s, theta (2,) in rad, force and torque (3,) in
+        N and N m, motor frame); returns the outcome once, else None."""
+        return self.update_block(*one_sample(t, theta, force, torque))
+
+    def update_block(
+        self,
+        t: ArrayLike,
+        theta: ArrayLike,
+        force: ArrayLike,
+        torque: ArrayLike,
+        filled_gaps: Sequence[tuple[float, float]] = (),
+    ) -> Gathered | None:
+        """Feed the samples that follow; returns the outcome once (at t_e or earlier), else None.
+
+        Parameters
+        ----------
+        t : array_like, shape (n,)
+            Sample times (s); steps of more than ``config.max_gap`` missing samples are gaps.
+        theta : array_like, shape (n, 2)
+            Motor angles (rad).
+        force, torque : array_like, shape (n, 3)
+            F/T sensor samples, motor frame (N, N m).
+        filled_gaps : sequence of (float, float)
+            Intervals (s) in which the caller filled missing samples of this block (a resampled
+            recording), known from the block's first sample on.
+
+        Raises
+        ------
+        FieldError
+            When the shapes do not match.
+        """
+        times = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        count = times.shape[0]
+        angles, forces, moments = (
+            _rows(name, value, count, width)
+            for name, value, width in (
+                ("theta", theta, 2),
+                ("force", force, 3),
+                ("torque", torque, 3),
+            )
+        )
+        if self._outcome is not None or count == 0:
+            return None
+        first, stop = self._n, self._n + count
+        self._reserve(stop)
+        # the detectors read the samples where they now lie (writable, C-ordered: no copy)
+        fed = (
+            self._t[first:stop],
+            self._theta[first:stop],
+            self._force[first:stop],
+            self._torque[first:stop],
+        )
+        fed[0][:], fed[1][:], fed[2][:], fed[3][:] = times, angles, forces, moments
+        self._n = stop
+        if filled_gaps:
+            self._filled.extend((first, (float(a), float(b))) for a, b in filled_gaps)
+        if self._refused is not None:
+            return self._stop(self._early(Status.BAD_INPUT, self._refused))
+        if self._monitor is not None:
+            self._monitor.update_block(*fed)
+        else:
+            assert self._detector is not None
+            self._detector.update_block(*fed)
+        return self._advance(first, stop)
+
+    def _reserve(self, stop: int) -> None:
+        size = self._t.shape[0]
+        if stop <= size:
+            return
+        size = max(stop, 2 * size, 4096)
+        for name in _BUFFERS:
+            old = getattr(self, name)
+            new = np.full((size, *old.shape[1:]), np.nan)
+            new[: self._n] = old[: self._n]
+            setattr(self, name, new)
+
+    def _gaps_known(self, end: int) -> list[tuple[float, float]]:
+        """Gaps known at sample ``end``: those the caller filled in the blocks fed by then, and
+        steps of the time stamps up to ``end`` missing more than ``config.max_gap`` samples."""
+        filled = [gap for known, gap in self._filled if known <= end]
+        stamps = time_gaps(self._t[: end + 1], self.sample_period, self.config.max_gap)
+        return filled + list(stamps)
+
+    def _advance(self, first: int, stop: int) -> Gathered | None:
+        """The steps after the detectors, on samples first..stop (module docstring)."""
+        cfg, ts, last = self.config, self.sample_period, stop - 1
+        if self._contact is None:
+            assert self._detector is not None
+            if self._detector.contact_index is None:
+                return None
+            self._contact = self._detector.contact_index
+            self._start = at_contact(
+                self._theta[:stop],
+                self._force[:stop],
+                self._torque[:stop],
+                self.antenna,
+                self._contact,
+                cfg,
+                ts,
+            )
+        assert self._start is not None
+        if self._rest is None:
+            if self._monitor is not None:
+                self._rest = self._monitor.push_index
+            else:
+                # windows [i, i + w] from t_c on, those ending before this block tested already
+                start = max(self._contact, first - self._w_rest)
+                self._rest = first_rest_index(
+                    self._theta[:stop], start, self._w_rest, self._start.rest_tolerance
+                )
+            if self._rest is None:
+                return None
+        rest = self._rest
+        if self._hold is None:
+            judged = rest + self._w_hold
+            if judged > last:
+                return None
+            hold = self._judge_hold(judged)
+            if hold.frame is None:
+                return self._stop(self._early(Status.PUSH_NOT_REACHED, hold.problem or ""))
+            self._hold = hold
+            _, self._ratio_tolerance = ratio_tolerance(hold, self.antenna, cfg, ts)
+        if self._planned is None:
+            self._test_convergence(first, stop)
+        if self._planned is not None and last >= self._planned:
+            return self._stop(self._evidence(self._planned, complete=True))
+        return None
+
+    def _judge_hold(self, end: int) -> HoldPush:
+        """The push over the hold after t_1, from the samples up to ``end``."""
+        assert self._start is not None and self._rest is not None
+        stop = end + 1
+        return hold_push(
+            self._theta[:stop],
+            self._force[:stop],
+            self._torque[:stop],
+            self.antenna,
+            self._start.offset,
+            self._rest,
+            self.config,
+            self.sample_period,
+        )
+
+    def _test_convergence(self, first: int, stop: int) -> None:
+        """Estimator 2's convergence over the windows ending in first..stop; plans t_e."""
+        assert self._rest is not None
+        rest, w = self._rest, self._w_conv
+        # the ratio is tested up to t_1 + max_ratio_wait, its windows of means from t_1 + 2 w on
+        last = min(stop - 1, rest + self._n_wait)
+        first_end = max(first, rest + 2 * w)
+        if last >= first_end:
+            self._fill(last + 1)
+            found = converged_index(self._mean[: last + 1], first_end - w, w, self._ratio_tolerance)
+            if found is not None:
+                self._converged = found
+                self._planned = planned_end(rest, found, self.config, self.sample_period)
+                return
+        if stop - 1 >= rest + self._n_wait:
+            self._planned = planned_end(rest, None, self.config, self.sample_period)
+
+    def _fill(self, stop: int) -> None:
+        """Filtered loads, ratio (once t_c fixed the offset) and its moving mean (from t_1 + w)
+        up to sample ``stop``, each computed once."""
+        if self._loads_done < stop and self._loads_filter is not None:
+            a = self._loads_done
+            self._reaction[a:stop], self._moment[a:stop] = filtered_contact_loads(
+                self._theta[a:stop],
+                self._force[a:stop],
+                self._torque[a:stop],
+                self.antenna,
+                self.config.lowpass_cutoff,
+                self.sample_period,
+                running=self._loads_filter,
+            )
+            self._loads_done = stop
+        if self._start is None:
+            return
+        if self._ratio_done < stop:
+            a, offset = self._ratio_done, self._start.offset
+            # Estimator 2 on the tared loads
+            self._ratio[a:stop] = perpendicular_ratio(
+                self._reaction[a:stop] - offset[:3],
+                self._moment[a:stop] - offset[3:],
+                self.antenna.link.flexural_rigidity,
+            )
+            self._ratio_done = stop
+        if self._rest is None:
+            return
+        w = self._w_conv
+        a = max(self._mean_done, self._rest + w)
+        if a < stop:
+            # m[j] = mean(ratio[j - w : j + 1]), from the w samples before a on
+            self._mean[a:stop] = window_mean(self._ratio[a - w : stop], 0, w)[w:]
+            self._mean_done = stop
+
+    def evidence_at(self, index: int) -> Gathered:
+        """The evidence the samples up to ``index`` give, for a method that may stop before t_e.
+
+        ``index`` lies in [:attr:`first_evaluation_index`, :attr:`n_samples`); the instants and
+        the convergence are those known at ``index``.
+        """
+        first = self.first_evaluation_index
+        if first is None or not first <= index < self._n:
+            raise ValueError(
+                f"index {index}: evidence is available from {first} to {self._n - 1} only"
+            )
+        return self._evidence(index, complete=True)
+
+    def _evidence(self, end: int, complete: bool) -> Gathered:
+        """Evidence from the samples 0..end (or the early outcome they give)."""
+        assert self._contact is not None and self._start is not None and self._rest is not None
+        stop = end + 1
+        problem = dead_channel(self._force[:stop], self._torque[:stop])
+        if problem is not None:
+            return self._early(Status.BAD_INPUT, problem)
+        hold = self._hold if self._hold is not None else self._judge_hold(end)
+        if hold.frame is None:
+            return self._early(Status.PUSH_NOT_REACHED, hold.problem or "")
+        self._fill(stop)
+        cfg, ts, start, rest = self.config, self.sample_period, self._start, self._rest
+        offset = start.offset
+        noise, _ = ratio_tolerance(hold, self.antenna, cfg, ts)
+        # Standard errors of the tare's means; without a tare the offset is taken as one noise
+        # deviation (a sensor tared shortly before, as the simulator's two-count offset).
+        torque_noise = signal_noise(self._torque[: hold.stop])[0]
+        root = math.sqrt(start.count) if start.count else 1.0
+        converged = self._converged
+        diagnostics = self._diagnostics()
+        diagnostics.update(
+            {
+                "rebounds": hold.rebounds,
+                "hold_push_standard_error": hold.standard_error,
+                "force_noise": hold.force_noise,
+            }
+        )
+        gaps = self._gaps_known(end)
+        t = self._t
+        return Evidence(
+            t=_read_only(t[:stop]),
+            theta=_read_only(self._theta[:stop]),
+            force=_read_only(self._force[:stop]),
+            torque=_read_only(self._torque[:stop]),
+            sample_period=ts,
+            antenna=self.antenna,
+            config=cfg,
+            contact_index=self._contact,
+            rest_index=rest,
+            end_index=end,
+            converged_index=converged if converged is not None and converged <= end else None,
+            complete=complete,
+            frame=hold.frame,
+            reaction_f=self._reaction[:stop] - offset[:3],
+            torque_f=self._moment[:stop] - offset[3:],
+            ratio=_read_only(self._ratio[:stop]),
+            ratio_mean=_read_only(self._mean[:stop]),
+            load_offset=offset,
+            ratio_noise=noise,
+            band=self.band,
+            hold_end=hold.stop - 1,
+            offset_error=hold.force_noise / root,
+            torque_offset_error=torque_noise / root,
+            gap=gap_problem(gaps, float(t[rest]), float(t[end]), ts),
+            diagnostics=diagnostics,
+        )
+
+    def _diagnostics(self) -> dict[str, Any]:
+        diagnostics = dict(self._notes)
+        if self._start is not None:
+            diagnostics.update(
+                {
+                    "rest_tolerance": self._start.rest_tolerance,
+                    "tare": self._start.tare,
+                    "load_offset": self._start.offset,
+                }
+            )
+        return diagnostics
+
+    def _early(self, status: Status, reason: str) -> EarlyOutcome:
+        """An outcome without evidence; bad input keeps only what the caller said."""
+        t = self._t
+        return EarlyOutcome(
+            status=status,
+            reason=reason,
+            t_c=math.nan if self._contact is None else float(t[self._contact]),
+            t_1=math.nan if self._rest is None else float(t[self._rest]),
+            diagnostics=dict(self._notes) if status is Status.BAD_INPUT else self._diagnostics(),
+        )
+
+    def _stop(self, outcome: Gathered) -> Gathered:
+        """The outcome, with the trace, given once."""
+        self._outcome = dataclasses.replace(outcome, trace=self.trace(outcome))
+        return self._outcome
+
+    def finish(self) -> Gathered:
+        """Close the run at the end of the samples: the outcome given, or the one they give."""
+        if self._outcome is not None:
+            return self._outcome
+        n = self._n
+        if n == 0:
+            return self._stop(self._early(Status.BAD_INPUT, "no samples"))
+        problem = dead_channel(self._force[:n], self._torque[:n])
+        if problem is not None:
+            return self._stop(self._early(Status.BAD_INPUT, problem))
+        if self._contact is None:
+            assert self._detector is not None
+            reason = f"filtered residual stays at or below {self._detector.threshold:g} N m"
+            return self._stop(self._early(Status.NO_CONTACT, reason))
+        assert self._start is not None
+        if self._rest is None:
+            reason = no_t1_reason(self.config, self._start.rest_tolerance)
+            return self._stop(self._early(Status.PUSH_NOT_REACHED, reason))
+        return self._stop(self._evidence(n - 1, complete=False))
+
+    def trace(self, outcome: Gathered | None = None) -> FrontTrace:
+        """What the front end saw over every sample fed; ``outcome`` (or an evidence from
+        :meth:`evidence_at`) gives t_e, the frame and the spectrum window."""
+        n = self._n
+        self._fill(n)
+        nan3 = np.full((n, 3), np.nan)
+        estimated, norm, threshold = nan3, np.full(n, np.nan), math.nan
+        if self._detector is not None:
+            detection = self._detector.detection()
+            estimated, norm = detection.estimated_torque, detection.filtered_residual_norm
+            threshold = detection.threshold
+        offset = np.zeros(6) if self._start is None else self._start.offset
+        evidence = outcome if isinstance(outcome, Evidence) else None
+        frame = self._hold.frame if self._hold is not None else None
+        return FrontTrace(
+            t=_read_only(self._t[:n]),
+            sample_period=self.sample_period,
+            theta=_read_only(self._theta[:n]),
+            force=_read_only(self._force[:n]),
+            torque=_read_only(self._torque[:n]),
+            estimated_torque=estimated,
+            filtered_residual_norm=norm,
+            contact_threshold=threshold,
+            contact_index=self._contact,
+            rest_index=self._rest,
+            end_index=None if evidence is None else evidence.end_index,
+            load_offset=offset,
+            reaction_f=self._reaction[:n] - offset[:3],
+            torque_f=self._moment[:n] - offset[3:],
+            ratio=_read_only(self._ratio[:n]),
+            frame=frame if evidence is None else evidence.frame,
+            spectrum=None if evidence is None else evidence.spectrum_slice,
+            band=self.band,
+        )
