@@ -22,19 +22,20 @@ from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import Evidence
-from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
-from sensing_antenna.estimation.methods.fast.method import (
+from sensing_antenna.estimation.methods.fast import (
     FastConfig,
     FastConfigError,
     FastMethod,
     ScanInputs,
-    _branch_contradiction,
     curve_table,
     evaluate_window,
     evaluation_offsets,
     model_floor,
     scan,
+    scan_inputs,
 )
+from sensing_antenna.estimation.methods.fast.checks import branch_contradiction
+from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
 from sensing_antenna.estimation.methods.paper.fusion import sensing_curve
 from sensing_antenna.estimation.pipeline import search_band
@@ -254,7 +255,7 @@ def _contradiction(x_c: float, ratio: float, higher: float) -> str:
         table.omega1, table.grid, table.edges, omega1, 0.05, ratio, 0.01, 0.05, 0.09, 0.0, 0.0
     )
     fit = _FittedModes(np.array([omega1, higher]))
-    return _branch_contradiction(fit, 0, posterior, table, LINK, FastConfig())  # type: ignore[arg-type]
+    return branch_contradiction(fit, 0, posterior, table, LINK, FastConfig())  # type: ignore[arg-type]
 
 
 def test_the_branch_check_speaks_only_for_a_mode_of_the_other_candidate() -> None:
@@ -322,7 +323,7 @@ def test_offline_and_online_agree_on_a_simulated_recording(
     # session keeps the fits between evaluations and the conclusion does not scan again. With
     # the push phase, on a recording whose declared window is the one through the push.
     simulator = pytest.importorskip("sensing_antenna.simulator")
-    import sensing_antenna.estimation.methods.fast.method as fast_module
+    import sensing_antenna.estimation.methods.fast.window_fit as fast_module
     from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
 
     antenna = paper_antenna()
@@ -513,10 +514,10 @@ def test_the_rest_bias_of_a_noiseless_device_is_zero(case: str) -> None:
     recording = simulate(device, Scenario(case=case, contact_point=0.7, seed=0, noise_scale=0.0))
     evidence = gather_evidence(recording.without_ground_truth(), model)
     assert isinstance(evidence, Evidence)
-    bias = FastMethod()._prepare(evidence).bias
+    bias = scan_inputs(evidence, FastConfig()).bias
     assert bias.n_samples > 50
     np.testing.assert_allclose(bias.bias, 0.0, atol=2e-6)
-    unguarded = FastMethod(FastConfig(bias_guard=0.0))._prepare(evidence).bias
+    unguarded = scan_inputs(evidence, FastConfig(bias_guard=0.0)).bias
     assert np.max(np.abs(unguarded.bias)) > 5e-6
 
 
@@ -623,7 +624,7 @@ def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is
     # Hann main lobe (+-126 rad/s) is wider than the candidates' omega_2 gap (~100 rad/s): not
     # asked. With a fundamental of half the peak's frequency the peak is 2 omega_1 itself,
     # which a clipping contact would make: the answer is dropped.
-    from sensing_antenna.estimation.methods.fast.method import second_mode_chooser
+    from sensing_antenna.estimation.methods.fast import second_mode_chooser
     from sensing_antenna.estimation.methods.paper.frequency import (
         evidence_frequency,
         evidence_spectrum,
@@ -664,22 +665,25 @@ def _azimuthal_06() -> Any:
 
 def _evaluated_windows(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     """Last indices of every window the fast method evaluates from now on."""
-    import sensing_antenna.estimation.methods.fast.method as fast_module
+    import sensing_antenna.estimation.methods.fast.search as scan_module
+    import sensing_antenna.estimation.methods.fast.session as session_module
 
     ends: list[int] = []
-    evaluate = fast_module.evaluate_from_t1_or_hold
+    evaluate = scan_module.evaluate_from_t1_or_hold
 
     def recording(inputs: ScanInputs, *args: Any, **kwargs: Any) -> Any:
         ends.append(inputs.end_index)
         return evaluate(inputs, *args, **kwargs)
 
-    monkeypatch.setattr(fast_module, "evaluate_from_t1_or_hold", recording)
+    monkeypatch.setattr(scan_module, "evaluate_from_t1_or_hold", recording)
+    monkeypatch.setattr(session_module, "evaluate_from_t1_or_hold", recording)
     return ends
 
 
 def _concluded_windows(monkeypatch: pytest.MonkeyPatch) -> list[tuple[Any, Any]]:
     """(window, scan result) of every conclusion of the fast method from now on."""
     import sensing_antenna.estimation.methods.fast.method as fast_module
+    import sensing_antenna.estimation.methods.fast.session as session_module
 
     finals: list[tuple[Any, Any]] = []
     conclude = fast_module.conclude_fast
@@ -689,6 +693,7 @@ def _concluded_windows(monkeypatch: pytest.MonkeyPatch) -> list[tuple[Any, Any]]
         return conclude(evidence, result, *args, **kwargs)
 
     monkeypatch.setattr(fast_module, "conclude_fast", recording)
+    monkeypatch.setattr(session_module, "conclude_fast", recording)
     return finals
 
 
@@ -781,7 +786,7 @@ def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
 
 def _counted_early_statics(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, int]]:
     """(first, last index) of every window whose early statics are fitted from now on."""
-    import sensing_antenna.estimation.methods.fast.method as fast_module
+    import sensing_antenna.estimation.methods.fast.window as fast_module
 
     calls: list[tuple[int, int]] = []
     early_statics = fast_module._early_statics
@@ -796,9 +801,10 @@ def _counted_early_statics(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, i
 
 def _early_statics_refitted(inputs: ScanInputs, window: Any) -> Any:
     """The early statics of ``window``'s span, every fit done afresh (no cache)."""
-    from sensing_antenna.estimation.methods.fast.method import _early_statics, _frequency, _Window
+    from sensing_antenna.estimation.methods.fast.window import _early_statics
+    from sensing_antenna.estimation.methods.fast.window_fit import WindowSpan, measure_fundamental
 
-    span = _Window(
+    span = WindowSpan(
         inputs.channels,
         window.start_index,
         window.end_index,
@@ -807,7 +813,7 @@ def _early_statics_refitted(inputs: ScanInputs, window: Any) -> Any:
         inputs.config,
         None,
     )
-    fundamental = _frequency(span, None)
+    fundamental = measure_fundamental(span, None)
     if fundamental.mode is None:
         return None
     return _early_statics(span, fundamental.omega1, inputs.bias)
@@ -821,7 +827,7 @@ def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_win
     # half-length fit on every window it passes and adds it to the one it concludes on (the
     # first sure one, or the cap's when none is): fitted once, and the same as a computation
     # from scratch gives.
-    import sensing_antenna.estimation.methods.fast.method as fast_module
+    import sensing_antenna.estimation.methods.fast as fast_module
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     evidence = gather_evidence(_azimuthal_06(), paper_antenna())
@@ -829,7 +835,7 @@ def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_win
     history = method.history(evidence)
     expected = next((w for w in history if w.sure), history[-1])
     calls = _counted_early_statics(monkeypatch)
-    inputs = method._prepare(evidence)
+    inputs = scan_inputs(evidence, method.config)
     result = fast_module.scan(
         inputs, evidence.hold_end, evidence.hold_end, fast_module.second_mode_chooser(evidence)
     )
@@ -861,12 +867,12 @@ def test_a_window_restarted_at_the_end_of_the_hold_fits_only_its_own_early_stati
     # Every window "opens" (max_opening tiny), so each is restarted at the hold's end: the
     # window from t_1 that was set aside does not get its half window fitted, the restarted
     # one does, with the statics a computation from scratch gives.
-    from sensing_antenna.estimation.methods.fast.method import evaluate_from_t1_or_hold
+    from sensing_antenna.estimation.methods.fast.window import evaluate_from_t1_or_hold
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     evidence = gather_evidence(_azimuthal_06(), paper_antenna())
     method = FastMethod(FastConfig(max_opening=1e-9))
-    inputs = method._prepare(evidence)
+    inputs = scan_inputs(evidence, method.config)
     end = inputs.rest_index + 1000
     calls = _counted_early_statics(monkeypatch)
     window = evaluate_from_t1_or_hold(inputs._replace(end_index=end), evidence.hold_end, ({}, {}))
@@ -921,7 +927,7 @@ def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any
     evaluated with the push phase, the fundamental of the window from t_1 alone and the true
     omega_1 (sensing curve at the simulator's contact abscissa)."""
     simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.methods.fast.method import _frequency, _Window
+    from sensing_antenna.estimation.methods.fast.window_fit import WindowSpan, measure_fundamental
     from sensing_antenna.estimation.pipeline import gather_evidence
 
     antenna = paper_antenna()
@@ -931,12 +937,12 @@ def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any
     truth = float(CURVE.omega1(float(recording.metadata["true_xc"])))
     evidence = gather_evidence(recording.without_ground_truth(), antenna)
     assert isinstance(evidence, Evidence)
-    inputs = FastMethod(FastConfig(push_phase=True))._prepare(evidence)
+    inputs = scan_inputs(evidence, FastConfig(push_phase=True))
     assert inputs.push is not None and inputs.push.start == evidence.contact_index
     inputs = inputs._replace(end_index=inputs.rest_index + round(after_t1 / TS))
     window = evaluate_window(*inputs, cache={})
-    alone = _frequency(
-        _Window(
+    alone = measure_fundamental(
+        WindowSpan(
             inputs.channels,
             inputs.rest_index,
             inputs.end_index,
@@ -971,7 +977,8 @@ def test_a_window_through_the_push_stands_when_it_tells_omega1_better() -> None:
 def test_the_push_must_pass_the_same_checks_be_more_precise_and_agree() -> None:
     # The rule on made-up fundamentals: through the push 0.1 rad/s statistical error, from
     # t_1 alone 0.5 rad/s, so their difference may be 3 sqrt(0.5^2 - 0.1^2) = 1.47 rad/s.
-    from sensing_antenna.estimation.methods.fast.method import _Frequency, _push_agrees
+    from sensing_antenna.estimation.methods.fast.checks import push_agrees as _push_agrees
+    from sensing_antenna.estimation.methods.fast.window_fit import Fundamental as _Frequency
 
     from_t1 = _Frequency(None, 0, 35.0, 0.6, 0.5, 0.1, ())
     config = FastConfig()
@@ -994,8 +1001,9 @@ def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push(
 ) -> None:
     # When the contact opened, the window restarts at the end of the hold, long after t_1:
     # the push is not part of it (the modes restart there on their own).
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.methods.fast.method import PushPhase, evaluate_from_t1_or_hold
+    import sensing_antenna.estimation.methods.fast.window as fast_module
+    from sensing_antenna.estimation.methods.fast.window import evaluate_from_t1_or_hold
+    from sensing_antenna.estimation.methods.fast.window_fit import PushPhase
 
     calls: list[tuple[int, Any]] = []
 
@@ -1019,8 +1027,9 @@ def test_windows_through_the_push_fit_their_own_polynomial_degrees(
     # The window from t_1 tries degrees 2 to polynomial_degree; the one through the push up to
     # push_polynomial_degree (the head's angle carries the push's static growth), with the
     # push's angle and the restart at t_1 passed on.
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.methods.fast.method import PushPhase, _fit_window
+    import sensing_antenna.estimation.methods.fast.window_fit as fast_module
+    from sensing_antenna.estimation.methods.fast.window_fit import PushPhase
+    from sensing_antenna.estimation.methods.fast.window_fit import fit_window as _fit_window
 
     calls: list[tuple[list[int], bool, int | None]] = []
 
@@ -1047,9 +1056,10 @@ def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window(
     # azimuthal 0.70 m: 46 +- 12.5 rad/s over 0.12 s against 97.5 over 0.24 s, and a "slip" of
     # 170 degrees): no reference then. A half window that reads the fundamental a little off,
     # as short windows do, is one however small its standard error.
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.methods.fast.method import _early_statics, _Window
+    import sensing_antenna.estimation.methods.fast.window as fast_module
     from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
+    from sensing_antenna.estimation.methods.fast.window import _early_statics
+    from sensing_antenna.estimation.methods.fast.window_fit import WindowSpan as _Window
 
     def half_fit(omega: float, se: float) -> DampedSinusoidFit:
         one = np.ones(1)
@@ -1071,7 +1081,7 @@ def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window(
         )
 
     fitted: list[DampedSinusoidFit] = []
-    monkeypatch.setattr(fast_module, "_fit_window", lambda *args, **kwargs: fitted[-1])
+    monkeypatch.setattr(fast_module, "fit_window", lambda *args, **kwargs: fitted[-1])
     monkeypatch.setattr(fast_module, "static_ratio", lambda fit, bias: "statics")
     band = (20.0, 125.0)
     window = _Window(np.zeros((600, 5)), 100, 337, TS, band, FastConfig(), None)
