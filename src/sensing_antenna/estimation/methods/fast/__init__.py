@@ -16,8 +16,10 @@ Where things live (each module one idea):
 - :mod:`.curves`: the sensing curves on the posterior's grid;
 - :mod:`.likelihood`: the posterior over x_c;
 - :mod:`.static_fit`: the contact-load channels, the sensor bias, the static torque/force ratio;
-- :mod:`.parametric`: the damped-sinusoid fit;
-- :mod:`.varpro`: the fit's compiled kernels and solver.
+- :mod:`.parametric`: the damped-sinusoid fit; :mod:`.model_order` its model order and degree
+  by the BIC; :mod:`.pencil` its initial poles; :mod:`.crb` the Cramer-Rao bound;
+- :mod:`.varpro`: the fit's compiled model, residual and Jacobian; :mod:`.trust_region` its
+  solver.
 
 The names below are imported lazily, so that importing :mod:`.config` alone does not compile the
 fit's kernels.

@@ -22,11 +22,9 @@ from numpy.typing import NDArray
 from sensing_antenna.estimation.methods.fast.checks import drift_check, periods_check
 from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
-from sensing_antenna.estimation.methods.fast.parametric import (
-    DampedSinusoidFit,
-    first_poles,
-    select_model,
-)
+from sensing_antenna.estimation.methods.fast.model_order import select_model
+from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
+from sensing_antenna.estimation.methods.fast.pencil import first_poles
 
 __all__ = [
     "FitCache",
