@@ -68,7 +68,13 @@ class FastSession:
             with_early_statics=final,
         )
         self._asked[end] = window_key(
-            inputs.channels, inputs.rest_index, end, inputs.sample_period, inputs.band, inputs.push
+            inputs.channels,
+            inputs.rest_index,
+            end,
+            inputs.sample_period,
+            inputs.band,
+            inputs.config,
+            inputs.push,
         )[2]
         return window
 
@@ -93,6 +99,7 @@ class FastSession:
                 end,
                 inputs.sample_period,
                 inputs.band,
+                inputs.config,
                 inputs.push,
             )[2]
         }

@@ -40,8 +40,8 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
-#: Cache of window fits, keyed by :func:`window_key` (the window's samples themselves, so a
-#: cache can never serve a fit of other data).
+#: Cache of window fits, keyed by :func:`window_key` (the window's samples themselves and the fit
+#: settings, so a cache can never serve a fit of other data or other settings).
 FitCache = dict[tuple[int, int, bytes], "DampedSinusoidFit | None"]
 
 
@@ -85,13 +85,23 @@ def window_key(
     end_index: int,
     sample_period: float,
     band: tuple[float, float],
+    config: FastConfig,
     push: PushPhase | None = None,
 ) -> tuple[int, int, bytes]:
     """Cache key of the window [rest_index, end_index]: its indices and a digest of its samples,
-    of T_s and of the band (with ``push``, of the samples from its start and its angle)."""
+    of T_s, of the band and of the settings of the fit (with ``push``, of the samples from its
+    start and its angle)."""
     start = rest_index if push is None else push.start
     digest = hashlib.blake2b(channels[start : end_index + 1].tobytes(), digest_size=16)
     digest.update(np.array([sample_period, *band]).tobytes())
+    settings = (
+        config.max_modes,
+        config.polynomial_degree,
+        config.min_mode_fraction,
+        config.push_max_modes,
+        config.push_polynomial_degree,
+    )
+    digest.update(np.array(settings, dtype=float).tobytes())
     if push is not None:
         digest.update(np.array([start, rest_index]).tobytes())
         digest.update(push.angle[start : end_index + 1].tobytes())
@@ -112,7 +122,7 @@ def fit_window(
     as a regressor and the modes restarted at rest_index; from ``cache`` when it holds it."""
     if push is not None and push.start >= rest_index:
         push = None
-    key = window_key(channels, rest_index, end_index, sample_period, band, push)
+    key = window_key(channels, rest_index, end_index, sample_period, band, config, push)
     if cache is not None and key in cache:
         return cache[key]
     # The fit with the smallest BIC over the polynomial degrees and model orders
