@@ -49,11 +49,10 @@ __all__ = [
 ]
 
 #: Largest relative distance (dimensionless) between the fundamental of the slip check's half
-#: window and the whole window's for the two to be the same mode. 0.1: short windows read
-#: omega_1 up to about 2 % off (docs/fast.md, "Three modes"), and 0.2 to 1.5 % off at 3 to 7 of
-#: their standard errors on the half windows of the paper antenna (so no test in standard
-#: errors); the nearest other contact mode is at least 2.2 times omega_1, and the mode that
-#: once took the fundamental's place was 53 % off.
+#: window and the whole window's for the two to be the same mode. 0.1: well above the few per
+#: cent by which short windows misread omega_1 (often at many of their standard errors, so the
+#: test is not in standard errors), well below the distance to the nearest other contact mode
+#: (above twice omega_1 on the paper link's sensing curves).
 _SAME_MODE = 0.1
 
 

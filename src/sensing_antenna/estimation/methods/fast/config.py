@@ -19,13 +19,16 @@ class FastConfigError(SensingAntennaError, ValueError):
 class FastConfig:
     """Settings of the fast method (SI units).
 
+    The measurements behind the defaults are in docs/fast.md.
+
     Parameters
     ----------
     tolerance : float
         Declare when the 95 % interval of x_c is narrower than this (m). 5 mm, half the paper's
         typical 1 cm error.
     cadence : float
-        Shortest time between evaluations of the growing window (s). 10 ms.
+        Shortest time between evaluations of the growing window (s). 10 ms: on short windows
+        the declaration comes at most this late after the first instant that would be sure.
     growth : float
         Evaluations are spaced by the larger of ``cadence`` and (growth - 1) times the window
         length, a geometric grid: the declaration is late by at most 10 % of t_e - t_1, and
@@ -42,13 +45,10 @@ class FastConfig:
         Non-stationarity of omega_1 measured on the recording itself: the fundamental of the
         window [t_1, t] is compared with that of [t_1, t_1 + 2/3 (t - t_1)]; ``drift_factor``
         times the change (its excess over what the noise alone explains, sqrt(max(0, d^2 -
-        (se_short^2 - se^2)))) is added in quadrature to the standard error. 2: an error that falls
-        as 1 / T_w (the leakage of a close unmodelled mode, a slow transient) is at T_w twice
-        its change from 2/3 T_w to T_w. Near the peak of omega_1(x_c) on the simulator a close
-        mode biased 0.3 s windows by 1.6 % and 1 s windows by 0.15 %, far beyond the white-noise
-        standard error (docs/fast.md). The check measures such leakage on the record itself;
-        the fixed floor proportional to 2 pi / T_w that once stood for it was removed
-        (docs/fast.md, "Posterior and floors").
+        (se_short^2 - se^2)))) is added in quadrature to the standard error. The check sees
+        what the white-noise standard error leaves out: the leakage of a close unmodelled
+        mode, a slow transient. 2: an error that falls as 1 / T_w is at T_w twice its change
+        from 2/3 T_w to T_w.
     min_periods : float
         The window must hold this many periods of the fitted fundamental before an estimate can
         be declared (a shorter record cannot tell a frequency from a drift), and so must the
@@ -61,35 +61,26 @@ class FastConfig:
     max_modes : int
         Largest number of damped modes tried (BIC chooses 1 .. max_modes). 3: the fundamental
         and the two strongest modes above it. The touch and the stop excite contact modes 2
-        and 3 and modes of the link moving along the surface (calibrated-device campaign,
-        vertical 0.5 m: fitted at 50, 395 and 430 rad/s over 0.2 s after t_1, the two upper
-        ones the stronger; contact mode 3 is at 437 rad/s). With room for one of them only,
-        short windows read omega_1 up to 2 % high (50.9 against 49.7 rad/s at 0.215 s; 50.1
-        with three modes) and the drift check held them back. Against 2 (docs/fast.md, "Three
-        modes"): median t_e - t_1 0.421 to 0.383 s on the calibrated-device campaign and 0.316
-        to 0.302 s on the paper antenna, MAE 0.73 to 0.65 mm and 0.37 to 0.23 mm, coverage
-        149/150 on the campaign as before. It costs 1.5 to 1.8 times the CPU; with the
-        compiled fit the real-time loop of a two-core machine answers 0.43 to 0.46 s after
-        t_1 (docs/fast.md, "Online, in real time").
+        and 3 and modes of the link moving along the surface, often more than the fundamental;
+        a mode left out of the model leaks into the fundamental of short windows, which then
+        read omega_1 high and are held back by the drift check. Each further mode costs a full
+        set of fits at every degree.
     min_mode_fraction : float
-        Modes are fitted above this fraction of the lower end of the omega_1 band; slower content
-        (the servo's slow creep at ~8 rad/s) goes to the polynomial. 0.6 of ~23 rad/s.
+        Modes are fitted above this fraction of the lower end of the omega_1 band; slower
+        content (the servo's slow creep, ~8 rad/s) goes to the polynomial. 0.6: below the band,
+        above the creep.
     polynomial_degree : int
         Highest degree of the static polynomial per channel; the BIC chooses it from 2 up to
         this together with the number of modes. 4: the servo's slow creep (~8 rad/s) spans up
-        to 0.8 rad of its cycle over the longest window; with degree 2 the fitted omega_1 at
-        x_c = 0.3 m wandered by 1.5 % between windows of 0.3 and 0.6 s (simulated recordings,
-        well beyond its standard error), with degree 4 by 0.1 %. On short windows a quartic
-        takes up part of the vibration itself (at 0.55 m, a 0.215 s window: standard error
-        2.9 rad/s with degree 4, 0.56 with degree 2), which the BIC sees.
+        to 0.8 rad of its cycle over the longest window, more than a quadratic follows; on
+        short windows a quartic would take up part of the vibration itself, and the BIC then
+        chooses a lower degree.
     frequency_floor : float
         Relative model error of omega_1 added in quadrature (dimensionless): how well T (or
-        T_e) and the sensing curve predict the frequency. 0.001: the link's sensing curve and
-        the frequencies of the finite-element simulator with a compliant contact differ by 0.01
-        to 0.12 % over the azimuthal grid (1 s spectrum on noiseless recordings, see
-        docs/fast.md). A link whose calibration measured a larger relative scatter
-        (``Link.calibration_scatter``) uses that instead: on the simulated device with a
-        contact three times softer the calibration residuals reached 0.46 % near the tip.
+        T_e) and the sensing curve predict the frequency. 0.001: the agreement of the link's
+        sensing curve with the frequencies of the finite-element simulator with a compliant
+        contact. A link whose calibration measured a larger relative scatter
+        (``Link.calibration_scatter``) uses that instead (:func:`model_floor`).
     ratio_geometry_factor : float
         kappa of the ratio's model floor kappa (y_c / x_c) x_c (dimensionless). 0.5: the
         neglected torque of the axial force on the deflection is (y_c / x_c)(R_x / R_perp) x_c,
@@ -101,72 +92,63 @@ class FastConfig:
         Samples of initial rest needed to estimate the sensor bias; 20 (20 ms).
     bias_guard : float
         Time (s) of the initial rest left out before the head is seen to move: the sweep's start
-        loads the sensor (inertia) while the angles are still within the rest tolerance. 0.05 s:
-        on the simulated device the loads leave the rest 60 ms before the move is seen (1e-6
-        N m then, 5e-5 N m 10 ms before it), which biased the rest mean by 2 to 3 standard
-        errors in Gamma_z (azimuthal) without the guard.
-    peak_margin : float
-        No declaration while omega_1 is less than this many standard deviations below the
-        maximum of the sensing curve (the interval there rests on the curve's flat top). 3: in
-        the simulator a 0.12 s window at x_c = 0.80 m read omega_1 0.5 % high and the interval
-        collapsed onto the peak, 27 mm from the truth.
-    max_disagreement : float
-        Largest distance, in the ratio's standard deviations (model floor included), between the
-        torque/force ratio and the maximum a posteriori x_c before the two estimators are said
-        to disagree; no declaration while they do. 3. The posterior weighs both, but where one
-        of them is wrong (the fundamental of a chattering tip contact read 1.7 % low on a
-        0.29 s window) the product can still be narrow on the wrong branch: 3 of 150 campaign
-        runs at 0.98 m were declared at 0.62 m, 3.4 ratio deviations from the ratio.
+        loads the sensor (inertia) while the angles are still within the rest tolerance, and
+        those samples would bias the rest's mean. 0.05 s, longer than that lead.
     max_direction_drift : float
         Largest angle (rad) between the fitted static perpendicular reaction of the window's
         first half from t_1 (``WindowEstimate.early_statics``) and that of the whole window at
         t_e (both with the sensor bias removed) before a slip is suspected, or 3 standard
         errors of that angle when larger; 0.15 rad as the pipeline's ``max_direction_drift``.
+    peak_margin : float
+        No declaration while omega_1 is less than this many standard deviations below the
+        maximum of the sensing curve: there the inverse is singular, and a short window's
+        omega_1 a little high makes the interval collapse onto the curve's flat top, far from
+        the truth. 3.
+    max_disagreement : float
+        Largest distance, in the ratio's standard deviations (model floor included), between the
+        torque/force ratio and the maximum a posteriori x_c before the two estimators are said
+        to disagree; no declaration while they do. The posterior weighs both, but where one
+        of them is wrong (the fundamental of a chattering tip contact reads low) the product can
+        still be narrow on the wrong branch. 3.
     max_opening : float
         Largest predicted vibration of the contact force over the static push at the window
         start. The obstacle can only push: when the fundamental's contact force (its base-force
         amplitude times :func:`~sensing_antenna.beam.modes.contact_to_base_shear` at the MAP
         x_c) exceeds the static push, the link bounces on the obstacle and is not pinned over
-        the window, so its frequency is not omega_1(x_c). The window then starts at the end of
-        the pipeline's hold (``frame_window`` after t_1, sized for the rebounds near the tip)
-        and is only declared if the contact stays closed there. 1, the physical limit. On the
-        simulator the bouncing lasted 0.15 to 0.2 s after the stop at 0.95 to 0.98 m, and
-        windows from t_1 read omega_1 2 to 3 % low at 0.2 s (one run declared at 0.62 m for a
-        tip contact at noise 2); windows from 0.2 s read it within 0.4 %.
+        the window, so its frequency is not omega_1(x_c) (windows over the bouncing read it
+        low). The window then starts at the end of the pipeline's hold (``frame_window`` after
+        t_1, sized for the rebounds near the tip) and is only declared if the contact stays
+        closed there. 1, the physical limit.
     higher_modes : bool
-        Whether a fitted contact mode 2 or 3 enters the posterior (off by default). On the
-        simulated paper device the fitted higher modes departed from the pinned-contact curves
-        by 1.4 to 2 % (mode 3, compliant contact) and, in the vertical case, by 7 to 21 %
-        (modes of the link moving along the surface), so a sure interval could rest on a mode
-        the model does not describe; see docs/fast.md.
+        Whether a fitted contact mode 2 or 3 enters the posterior. Off by default: a fitted
+        higher mode may be one the pinned-contact model does not describe (a compliant contact
+        lowers them; the link moving along the surface adds modes of its own), so a sure
+        interval could rest on a wrong match.
     higher_mode_floor : float
         Relative model error of the higher contact modes (2 and 3) against their pinned-contact
-        sensing curves (dimensionless), added in quadrature. 0.005: the compliant contact of the
-        finite-element simulator lowers them by 0.2 to 0.35 % (0.5 s fits at noise 1, seed 200
-        of benchmarks/eval_fast.py, 30 runs; see docs/fast.md), a stiffer contact less; the
-        floor covers that bias at about 1.5 standard deviations. On a real device use the
-        scatter of a calibration of the higher modes.
+        sensing curves (dimensionless), added in quadrature. 0.005: covers the lowering of
+        those modes by the finite-element simulator's compliant contact with a margin (a
+        stiffer contact lowers them less). On a real device use the scatter of a calibration of
+        the higher modes.
     branch_mode_tolerance : float
         Relative distance (dimensionless) within which a fitted higher mode is taken as contact
         mode 2 or 3 of a candidate x_c. When omega_1 fits candidates on two branches, the window
         is not declared while a higher mode in its fit lies within this of a mode of another
         branch's candidate and farther than this (and than twice that distance) from both modes
         of the posterior's branch's candidate: the modes say the ratio chose the wrong branch.
-        0.025: on the simulated device (calibrated T_e) the fitted modes 2 and 3 sat 0.1 to
-        0.4 % and 0.5 to 2.3 % below their pinned-contact curves. How far apart the candidates'
-        modes are depends on the pair (paper link): mode 2 by 14 to 41 % from 0.65 / 0.935 m to
-        0.75 / 0.787 m and by 6 % at 0.76 / 0.776 m; mode 3 by 0 to 7 %, nothing where the two
-        branches' curves cross (0.66 / 0.92 m). Used whether or not ``higher_modes`` is on.
+        0.025: above the offset of fitted modes 2 and 3 from their pinned-contact curves with a
+        compliant contact, below the gap between the two candidates' modes for most pairs (on
+        the paper link mode 2 differs by 6 to 41 % between the candidates, mode 3 by 0 to 7 %,
+        nothing where the two branches' curves cross). Used whether or not ``higher_modes`` is
+        on.
     branch_by_second_mode : bool
         Whether, at every window whose posterior holds two branches of omega_1(x_c), the
         paper's second-mode test (:func:`~.fusion.second_mode_choice` on the spectrum of the
-        window's own samples, :func:`second_mode_chooser`) may choose the branch; the
-        posterior is then conditioned on it before the other checks. On by default: on
-        simulated recordings at 0.65 to 0.98 m (192: the calibrated-device campaign's device at
-        noise 1 and 2, the paper antenna, a contact three times softer; windows of 0.3 to 1 s)
-        it never chose the wrong branch; it said nothing on 155 of the 192 windows of 0.3 s and
-        on 22 of the 24 runs at 0.98 m (docs/fast.md). Off, the second mode is asked at the cap
-        only.
+        window's own samples, :func:`~.second_mode.second_mode_chooser`) may choose the branch;
+        the posterior is then conditioned on it before the other checks. On by default: the
+        test answers only on a clear peak near one candidate's omega_2, and is not asked when
+        the window's spectral resolution cannot separate the candidates. Off, the second mode
+        is asked at the cap only.
     push_phase : bool
         Also fit every window from t_c, through the push: the contact modes ring from the
         touch on, so the push (about 0.1 s) adds periods to every window. The static loads
@@ -176,21 +158,17 @@ class FastConfig:
         precise, and agrees with it within ``max_disagreement`` standard deviations of their
         difference (the touch can leave content the model does not describe: a bouncing
         contact, more modes); otherwise the window from t_1 does. The statics always come from
-        the window from t_1. Off by default: on the
-        paper antenna it brings the median delay from 0.302 to 0.261 s (on the calibrated
-        device it stays 0.383 s), but every window is fitted twice and the CPU per
-        recording is about 1.4 times larger, so in a real-time loop on a two-core machine the
-        answer comes later than without it (0.519 against 0.43 to 0.46 s after t_1,
-        docs/fast.md).
+        the window from t_1. Off by default: every window is fitted twice, so a real-time loop
+        on a small machine may answer later with it than without it, although in data time it
+        declares earlier where the push is clean.
     push_max_modes : int
         Largest number of modes tried on a window through the push (the touch excites contact
         modes the stop hardly does). 3.
     push_polynomial_degree : int
         Highest degree of the static polynomial on a window through the push (the BIC chooses
         it from 2, or from this when lower, up to it, with the number of modes). 2: the head's
-        angle, the regressor, carries the static loads' growth over the push; offered degrees
-        up to 4, the BIC chose 2 on 122 of 132 windows through the push (six paper-antenna
-        recordings at 0.30 to 0.85 m), and each degree costs a full set of fits.
+        angle, the regressor, carries the static loads' growth over the push, and each degree
+        costs a full set of fits.
     """
 
     tolerance: float = 0.005

@@ -309,8 +309,8 @@ def _higher_mode(
 ) -> tuple[float, float]:
     """The strongest detected mode above omega_1 within the range of contact modes 2 and 3.
 
-    Returns its frequency and standard error (rad/s), the non-stationarity floor in quadrature
-    as for omega_1; NaN when there is none.
+    Returns its frequency and the fit's standard error of it (rad/s); NaN when there is none
+    (or the fit did not converge).
     """
     low, high = float(higher.min()), float(higher.max())
     detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)

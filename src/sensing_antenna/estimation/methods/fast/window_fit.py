@@ -131,8 +131,8 @@ def fit_window(
     highest = config.polynomial_degree if push is None else config.push_polynomial_degree
     signals = channels[start : end_index + 1]
     lowest = min(2, highest)
-    # The matrix pencil every degree starts from, once: where the lowest degree's largest
-    # model order fits the record (each fit computes it itself otherwise, as it always did)
+    # The matrix pencil every degree starts from, computed once: where the lowest degree's
+    # largest model order fits the record (otherwise each fit computes its own)
     fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * max_modes)
     poles = first_poles(signals, max_modes) if fits_at_all else None
     fit = select_model(
