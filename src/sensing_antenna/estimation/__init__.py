@@ -5,7 +5,8 @@ Public entry points (imported lazily, so that importing one submodule such as
 
 - :func:`estimate` (offline) and :class:`OnlineEstimator` (streaming), :data:`METHODS`;
 - :func:`measure_omega1`, Estimator 1's frequency measurement alone;
-- :class:`ContactEstimate`, :class:`Status`, :class:`EstimatorConfig`.
+- :class:`ContactEstimate`, :class:`Status`, :class:`EstimatorConfig`;
+- :class:`FastMethod` and :class:`FastConfig`, the fast method and its settings.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.estimation.front.evidence import Evidence
+    from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
     from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
     from sensing_antenna.estimation.pipeline import (
         METHODS,
@@ -31,6 +33,8 @@ __all__ = [
     "ContactEstimate",
     "EstimatorConfig",
     "Evidence",
+    "FastConfig",
+    "FastMethod",
     "FrequencyMeasurement",
     "OnlineEstimator",
     "Status",
@@ -50,6 +54,8 @@ _WHERE = {
     "EstimatorConfig": "config",
     "Evidence": "front.evidence",
     "FrequencyMeasurement": "methods.paper.frequency",
+    "FastMethod": "methods.fast",
+    "FastConfig": "methods.fast",
 }
 
 
