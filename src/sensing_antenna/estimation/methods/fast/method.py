@@ -94,7 +94,7 @@ class FastMethod:
     ) -> ContactEstimate:
         """Scan the evidence from t_1 and give the first sure estimate (or the capped one).
 
-        ``caches`` as in :func:`evaluations`.
+        ``caches`` as in :func:`.search.evaluations`.
         """
         inputs = scan_inputs(evidence, self.config)
         result = scan(

@@ -99,13 +99,14 @@ def evaluations(
 ) -> Iterator[WindowEstimate]:
     """Every window ending on the evaluation grid from ``earliest`` to the cap, in order.
 
-    The grid is t_1 + :func:`evaluation_offsets`; evaluation starts at the first grid point at or
-    after ``earliest`` and ends at the cap or at ``inputs.end_index``, whichever comes first. Each
-    window starts at t_1, or at ``hold_end`` when the contact opened
-    (:func:`evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are cached, so
-    the drift check's shorter windows are fitted once; ``caches`` (windows from t_1, windows from
-    the hold's end) are used and filled when given, else new ones. ``choose_branch`` and
-    ``with_early_statics`` as in :func:`evaluate_from_t1_or_hold`.
+    The grid is t_1 + :func:`~.evaluation_grid.evaluation_offsets`; evaluation starts at the
+    first grid point at or after ``earliest`` and ends at the cap or at ``inputs.end_index``,
+    whichever comes first. Each window starts at t_1, or at ``hold_end`` when the contact opened
+    (:func:`.window.evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are
+    cached, so the drift check's shorter windows are fitted once; ``caches`` (windows from t_1,
+    windows from the hold's end) are used and filled when given, else new ones (a cache never
+    serves a fit made with other settings). ``choose_branch`` and ``with_early_statics`` as in
+    :func:`.window.evaluate_from_t1_or_hold`.
     """
     if caches is None:
         caches = ({}, {})
@@ -132,7 +133,7 @@ def scan(
     The windows are those of :func:`evaluations` (``caches`` as there); ``earliest`` is the end
     of the pipeline's hold, before which there is no contact frame. Only the window concluded on
     gets the slip check's early statics (they do not decide ``sure``), added after from the
-    cached fits (:func:`with_early_statics_of`).
+    cached fits (:func:`.window.with_early_statics_of`).
     """
     if caches is None:
         caches = ({}, {})

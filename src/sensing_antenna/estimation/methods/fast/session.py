@@ -58,7 +58,7 @@ class FastSession:
     def _evaluate(
         self, inputs: ScanInputs, evidence: Evidence, end: int, final: bool
     ) -> WindowEstimate:
-        """:func:`evaluate_from_t1_or_hold` on the window ending at ``end``, remembered; the
+        """:func:`.window.evaluate_from_t1_or_hold` on the window ending at ``end``, remembered; the
         slip check's early statics only for the ``final`` window (the one concluded on)."""
         window = evaluate_from_t1_or_hold(
             inputs._replace(end_index=end),

@@ -62,7 +62,7 @@ FloatArray = NDArray[np.float64]
 class ScanInputs(NamedTuple):
     """The samples and model a window reads: :func:`evaluate_window`'s leading arguments, in order.
 
-    ``end_index`` is the last sample available; :func:`evaluations` replaces it by each
+    ``end_index`` is the last sample available; :func:`.search.evaluations` replaces it by each
     window's end.
     """
 
