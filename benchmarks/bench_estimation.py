@@ -41,7 +41,7 @@ from fast_settings import add_fast_arguments, fast_settings  # noqa: E402
 from sensing_antenna.antenna import load_antenna  # noqa: E402
 from sensing_antenna.estimation import OnlineEstimator, estimate  # noqa: E402
 from sensing_antenna.estimation.methods import EstimationMethod  # noqa: E402
-from sensing_antenna.estimation.methods.fast.method import FastConfig, FastMethod  # noqa: E402
+from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod  # noqa: E402
 from sensing_antenna.recording import Recording  # noqa: E402
 from sensing_antenna.simulator import Scenario, simulate  # noqa: E402
 

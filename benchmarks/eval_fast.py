@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 
 from fast_settings import add_fast_arguments, fast_settings
 from sensing_antenna.antenna import paper_antenna
-from sensing_antenna.estimation.methods.fast.method import FastConfig, FastMethod
+from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
 from sensing_antenna.estimation.pipeline import estimate
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate_detailed

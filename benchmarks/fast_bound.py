@@ -64,13 +64,13 @@ from sensing_antenna.antenna import Antenna, Link, paper_antenna
 from sensing_antenna.campaign.parsing import load_campaign_spec
 from sensing_antenna.campaign.simulated import make_scenario, prepare_campaign
 from sensing_antenna.estimation import Evidence, estimate, gather
-from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
-from sensing_antenna.estimation.methods.fast.method import (
+from sensing_antenna.estimation.methods.fast import (
     FastConfig,
     FastMethod,
     WindowEstimate,
     curve_table,
 )
+from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
 from sensing_antenna.simulator import simulate
 
 OUT = Path(__file__).parent / "results" / "fast_bound.json"

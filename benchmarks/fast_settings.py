@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import fields
 from typing import Any
 
-from sensing_antenna.estimation.methods.fast.method import FastConfig, FastConfigError
+from sensing_antenna.estimation.methods.fast import FastConfig, FastConfigError
 
 
 def add_fast_arguments(parser: argparse.ArgumentParser) -> None:

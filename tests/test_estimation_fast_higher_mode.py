@@ -14,8 +14,8 @@ import numpy as np
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.methods.fast import FastConfig, ScanInputs, scan
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior, contact_posterior
-from sensing_antenna.estimation.methods.fast.method import FastConfig, ScanInputs, scan
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
 from sensing_antenna.estimation.methods.paper.fusion import sensing_curve
 from sensing_antenna.estimation.pipeline import search_band

@@ -1,43 +1,73 @@
-"""Posterior over x_c (likelihood.py) and the stop-when-sure fast method (fast.py).
+"""The fast method (estimation/methods/fast/): the posterior over x_c, the growing-window search,
+its checks, and its batch and online forms.
 
 Reference values: the paper link's sensing curve omega_1(x_c) (beam.SensingCurve, tested against
 an independent finite-element solution in tests/test_beam_fem.py) generates the synthetic
-measurements, so the true x_c is known by construction; the statics |Gamma| = x_c |R_perp|.
+measurements, so the true x_c is known by construction; the statics |Gamma| = x_c |R_perp|; on
+simulated recordings the simulator's contact abscissa (``true_xc``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
-from dataclasses import dataclass, replace
+import re
+from dataclasses import replace
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
 
-from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.antenna import FreeMotionObserver, paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.errors import FieldError
+from sensing_antenna.estimation import (
+    ContactEstimate,
+    Evidence,
+    OnlineEstimator,
+    Status,
+    estimate,
+    gather,
+)
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.front.evidence import Evidence
-from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
-from sensing_antenna.estimation.methods.fast.method import (
+from sensing_antenna.estimation.methods.fast import (
     FastConfig,
     FastConfigError,
     FastMethod,
     ScanInputs,
-    _branch_contradiction,
+    WindowEstimate,
     curve_table,
     evaluate_window,
     evaluation_offsets,
     model_floor,
     scan,
+    scan_inputs,
+    second_mode_chooser,
 )
+from sensing_antenna.estimation.methods.fast.checks import (
+    branch_contradiction,
+    is_slip_reference,
+    push_agrees,
+)
+from sensing_antenna.estimation.methods.fast.likelihood import contact_posterior
+from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
+from sensing_antenna.estimation.methods.fast.window import (
+    with_early_statics_of,
+)
+from sensing_antenna.estimation.methods.fast.window_fit import Fundamental
+from sensing_antenna.estimation.methods.paper.frequency import (
+    evidence_frequency,
+    evidence_spectrum,
+    find_peak,
+)
 from sensing_antenna.estimation.methods.paper.fusion import sensing_curve
 from sensing_antenna.estimation.pipeline import search_band
+from sensing_antenna.recording import Recording, write_recording
+from sensing_antenna.simulator import Scenario, simulate
+from test_estimation_pipeline import Synthetic, synthetic_recording
 
 TS = 1e-3
 LINK = paper_antenna().link
@@ -48,10 +78,69 @@ OMEGA_GRID = np.asarray(CURVE.omega1(GRID), dtype=float)
 EDGES = (X_RANGE[0], *CURVE.extrema, X_RANGE[1])
 
 
-def _posterior(omega: float, omega_se: float, ratio: float, ratio_se: float) -> object:
+def _posterior(omega: float, omega_se: float, ratio: float, ratio_se: float) -> Any:
     return contact_posterior(
         OMEGA_GRID, GRID, EDGES, omega, omega_se, ratio, ratio_se, 0.05, 0.09, 0.0, 0.0
     )
+
+
+def _evidence(recording: Recording, antenna: Any = None) -> Evidence:
+    """What the pipeline hands a method (the front end's step), on a recording that reaches it."""
+    evidence = gather(recording, antenna or paper_antenna())
+    assert isinstance(evidence, Evidence)
+    return evidence
+
+
+# Recordings shared by the tests of this module (simulated once; every test only reads them)
+
+
+@pytest.fixture(scope="module")
+def azimuthal() -> Recording:
+    """Paper antenna, azimuthal sweep onto a post at 0.6 m (seed 5): the fast method declares
+    on a window of 0.237 s; the contact force vibrates at a fraction of the push."""
+    return simulate(paper_antenna(), Scenario(case="azimuthal", contact_point=0.6, seed=5))
+
+
+@pytest.fixture(scope="module")
+def azimuthal_evidence(azimuthal: Recording) -> Evidence:
+    return _evidence(azimuthal.without_ground_truth())
+
+
+@pytest.fixture(scope="module")
+def azimuthal_estimate(azimuthal: Recording) -> ContactEstimate:
+    return estimate(azimuthal, paper_antenna(), FastMethod())
+
+
+@pytest.fixture(scope="module")
+def azimuthal_history(azimuthal_evidence: Evidence) -> tuple[WindowEstimate, ...]:
+    """Every window from the end of the hold to the cap, with the default settings."""
+    return FastMethod().history(azimuthal_evidence)
+
+
+@pytest.fixture(scope="module")
+def noisy_far() -> Recording:
+    """A synthetic recording at 0.9 m with eight times the nominal sensor noise: the ratio
+    leaves both branches of omega_1(x_c) open (the other candidate is near 0.67 m) and the
+    second contact mode, at 30 % of the first's amplitude, sits at the 0.9 m candidate's
+    omega_2."""
+    return synthetic_recording(Synthetic(x_c=0.9, seed=1, noise=8.0))
+
+
+def _online(recording: Recording, method: Any, block: int | None = None) -> ContactEstimate:
+    """The estimate the online form returns while fed ``recording``: sample by sample with
+    ``update`` (``block`` None) or in blocks of ``block`` samples with ``update_block``."""
+    online = OnlineEstimator(paper_antenna(), recording.sample_period, method)
+    t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
+    step = 1 if block is None else block
+    for k in range(0, t.shape[0], step):
+        if block is None:
+            out = online.update(t[k], theta[k], force[k], torque[k])
+        else:
+            s = slice(k, k + block)
+            out = online.update_block(t[s], theta[s], force[s], torque[s])
+        if out is not None:
+            return out
+    raise AssertionError("the online form returned no estimate")
 
 
 def test_ratio_decides_the_branch() -> None:
@@ -119,14 +208,16 @@ def _channels(
     amplitude: float,
     excess: float = 0.0,
     relaxation: float = 0.08,
+    omega: float | None = None,
 ) -> np.ndarray:
     """Contact loads of a push of 60 mN at x_c ringing at omega_1(x_c), with sensor noise.
 
     ``excess``: the ring's frequency starts this fraction above omega_1 and relaxes to it with
-    time constant ``relaxation`` (s).
+    time constant ``relaxation`` (s). ``omega``: the ring's frequency (rad/s) instead of
+    omega_1(x_c), as a biased reading would have it.
     """
     t = np.arange(n) * TS
-    omega = float(CURVE.omega1(x_c))
+    omega = float(CURVE.omega1(x_c)) if omega is None else omega
     phase = omega * t + omega * excess * relaxation * (1.0 - np.exp(-t / relaxation))
     r_y = -0.06 * (1.0 + amplitude * np.exp(-0.5 * t) * np.cos(phase + 0.3))
     zeros = np.zeros(n)
@@ -196,82 +287,36 @@ def test_a_higher_mode_of_the_other_branch_stops_a_declaration() -> None:
     assert "199." in checked.final.note and "x_c = 0.700 m" in checked.final.note
 
 
-def test_the_run_once_declared_on_the_wrong_branch_waits_and_the_second_mode_chooses() -> None:
-    # The calibrated-device run that was declared ok 15.7 cm off (benchmarks/fast_bound.py
-    # --campaign paper-2021, vertical, 0.70 m, seed 400), rebuilt from the campaign's identified
-    # observer and calibration (rounded). Its torque/force ratio read 0.80 m: the rest estimate
-    # of the Gamma_y bias held the link's static sag at theta2 = -0.1 rad (9e-5 N m against a
-    # 17.6 mN push), which the gravity model now holds too (Link.sag_moment). The ratio alone
-    # no longer picks a branch (interval over both, with or without the branch check). The
-    # second mode chooses the right one: at the cap when asked there only, or as soon as the
-    # spectrum of [t_1, t] says so (the default), and the window is then declared.
-    from sensing_antenna.antenna import FreeMotionObserver
-    from sensing_antenna.estimation.pipeline import estimate
-    from sensing_antenna.estimation.result import Status
-    from sensing_antenna.simulator import Scenario, simulate
-
-    base = paper_antenna()
-    observer = FreeMotionObserver(
-        gain=0.435, natural_frequency=17.26, damping=0.182, contact_threshold=1.72e-4
-    )
-    device = replace(base, observer=observer, link=replace(base.link, youngs_modulus=132.65e9))
-    model = replace(base, observer=observer).with_calibrated_t(0.21252, 0.00118)
-    scenario = Scenario(case="vertical", contact_point=0.7, seed=400, damping_ratio=0.005)
-    recording = simulate(device, scenario)
-    truth = float(recording.metadata["true_xc"])
-    blind = recording.without_ground_truth()
-    at_cap = FastConfig(branch_by_second_mode=False)
-    for config in (replace(at_cap, branch_mode_tolerance=1e3), at_cap, FastConfig()):
-        result = estimate(blind, model, FastMethod(config))
-        early = config.branch_by_second_mode
-        assert result.status is (Status.OK if early else Status.UNCERTAIN)
-        assert result.diagnostics.get("branch_chosen_by") == "omega2"
-        # within the 5 mm tolerance's half-width: the branch's own omega_1 places it (0.699 m)
-        assert result.x_c == pytest.approx(truth, abs=0.0025)
-        assert (result.t_e - result.t_1 < 0.5) == early
+def test_a_fundamental_read_above_the_top_of_the_curve_is_not_declared() -> None:
+    # A window whose omega_1 reads 0.5 % above the top of the sensing curve (100.58 rad/s at
+    # 0.768 m, beam.SensingCurve), as a short window near the peak can, for a contact at 0.80 m
+    # (where the ratio puts it): no x_c explains that frequency, and the posterior collapses
+    # onto the peak, narrower than a 1 cm tolerance and 3 cm from the contact. The peak check
+    # keeps the window from being declared.
+    top = float(CURVE.omega1(CURVE.extrema[0]))
+    rng = np.random.default_rng(3)
+    channels = _channels(0.80, 301, rng, 0.2, omega=1.005 * top)
+    config = FastConfig(tolerance=0.01)
+    window = evaluate_window(channels, NO_BIAS, 0, 300, TS, BAND, LINK, X_RANGE, config)
+    low, high = window.posterior.interval
+    assert high - low < config.tolerance and high < 0.80 - 0.02
+    assert not window.sure and "top of the sensing curve" in window.note
 
 
-@dataclass(frozen=True)
-class _FittedModes:
-    """The part of a DampedSinusoidFit the branch check reads: frequencies, all detected."""
-
-    omega: np.ndarray
-    n_samples: int = 400
-
-    @property
-    def n_modes(self) -> int:
-        return int(self.omega.size)
-
-    def snr(self) -> np.ndarray:
-        return np.full(self.omega.size, 10.0)  # detection 10 sqrt(200) = 141, far above 10
-
-
-def _contradiction(x_c: float, ratio: float, higher: float) -> str:
-    """The branch check on omega_1(x_c), a ratio of ``ratio`` +- 1 cm and one higher mode."""
-    omega1 = float(CURVE.omega1(x_c))
-    table = curve_table(LINK, X_RANGE[0], X_RANGE[1], FastConfig().grid_step)
-    posterior = contact_posterior(
-        table.omega1, table.grid, table.edges, omega1, 0.05, ratio, 0.01, 0.05, 0.09, 0.0, 0.0
-    )
-    fit = _FittedModes(np.array([omega1, higher]))
-    return _branch_contradiction(fit, 0, posterior, table, LINK, FastConfig())  # type: ignore[arg-type]
-
-
-def test_the_branch_check_speaks_only_for_a_mode_of_the_other_candidate() -> None:
-    # omega_1(0.70 m) = omega_1(0.854 m) = 91.04 rad/s; contact mode 2 is 199.2 rad/s at 0.70 m
-    # and 281.5 rad/s at 0.854 m (beam.natural_frequencies). The ratio puts the posterior on
-    # the far branch.
-    near, far = natural_frequencies(LINK, np.array([0.70, 0.854]), 2)[:, 1]
-    assert "x_c = 0.700 m" in _contradiction(0.70, 0.854, float(near))
-    assert _contradiction(0.70, 0.854, float(far)) == ""
-    # 170 rad/s is 15 % from 0.70 m's mode 2 and 40 % from 0.854 m's: it is no contact mode of
-    # either candidate, so it says nothing (it is not a multiple of omega_1 either)
-    assert _contradiction(0.70, 0.854, 170.0) == ""
-    # At 0.71 m 3 omega_1 = 280.44 rad/s sits on mode 2 of the other candidate (0.839 m,
-    # 280.35 rad/s): it may be a harmonic of a clipping contact, so it is skipped (without
-    # that rule it would stop a declaration on the right branch); there the check is blind
-    omega1 = float(CURVE.omega1(0.71))
-    assert _contradiction(0.71, 0.71, 3.0 * omega1) == ""
+def test_a_ratio_far_from_the_frequency_s_contact_point_stops_a_declaration() -> None:
+    # A tip contact at 0.98 m whose fundamental reads 1.7 % low (a chattering contact): the only
+    # contact point of that omega_1 in range is near 0.62 m, where the posterior is about 1 mm
+    # wide, while the torque/force ratio (0.98 m +- 8 mm) is 13 of its standard deviations away.
+    # The estimators disagree and the window is not declared; without the check it would be,
+    # 36 cm from the contact.
+    rng = np.random.default_rng(4)
+    channels = _channels(0.98, 401, rng, 0.2, omega=0.983 * float(CURVE.omega1(0.98)))
+    args = (channels, NO_BIAS, 0, 400, TS, BAND, LINK, X_RANGE)
+    checked = evaluate_window(*args, FastConfig())
+    unchecked = evaluate_window(*args, FastConfig(max_disagreement=1e9))
+    assert unchecked.sure and abs(unchecked.posterior.x_c - 0.98) > 0.3
+    assert not checked.sure and checked.ratio_z > FastConfig().max_disagreement
+    assert "torque/force ratio" in checked.note
 
 
 def test_a_calibration_scatter_above_the_floor_widens_the_interval() -> None:
@@ -309,145 +354,6 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(push_polynomial_degree=-1)
 
 
-@pytest.mark.parametrize(
-    ("case", "x_c", "seed", "push_phase"),
-    [("azimuthal", 0.6, 5, False), ("vertical", 0.4, 400, True)],
-)
-def test_offline_and_online_agree_on_a_simulated_recording(
-    monkeypatch: pytest.MonkeyPatch, case: str, x_c: float, seed: int, push_phase: bool
-) -> None:
-    # The pipeline's batch and streaming forms hand the same samples to the method; the fast
-    # method only reads samples up to its own declaration, so both give identical estimates.
-    # Online, each window (first sample, last sample, with or without the push) is fitted once: the
-    # session keeps the fits between evaluations and the conclusion does not scan again. With
-    # the push phase, on a recording whose declared window is the one through the push.
-    simulator = pytest.importorskip("sensing_antenna.simulator")
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
-
-    antenna = paper_antenna()
-    recording = simulator.simulate(
-        antenna, simulator.Scenario(case=case, contact_point=x_c, seed=seed)
-    )
-    method = FastMethod(FastConfig(push_phase=push_phase))
-    offline = estimate(recording, antenna, method)
-    assert offline.diagnostics["fit_through_push"] is push_phase
-    fitted: list[tuple[float, int, bool]] = []
-    select = fast_module.select_model
-
-    def counting(signals: Any, sample_period: float, *args: Any, **kwargs: Any) -> Any:
-        fitted.append((args[2], len(signals), kwargs["regressors"] is None))
-        return select(signals, sample_period, *args, **kwargs)
-
-    monkeypatch.setattr(fast_module, "select_model", counting)
-    online = OnlineEstimator(antenna, recording.sample_period, method)
-    for k in range(recording.t.shape[0]):
-        online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
-    streamed = online.finalize()
-    assert streamed.status == offline.status
-    assert streamed.x_c == offline.x_c
-    assert streamed.t_e == offline.t_e
-    assert fitted and len(fitted) == len(set(fitted)), "a window was fitted twice online"
-    # Reference: the simulator's contact point (nominal, the contact moves < 3 mm as the link
-    # bends); the fast estimate must be within the tolerance and well before the paper's 1 s
-    # spectrum window.
-    assert offline.x_c == pytest.approx(x_c, abs=0.008)
-    assert offline.t_e - offline.t_1 < 0.5
-
-
-def _simulated_evidence() -> tuple[Any, Any]:
-    """The evidence the pipeline hands the fast method, and its estimate (azimuthal, 0.6 m)."""
-    simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.front.evidence import Evidence
-    from sensing_antenna.estimation.pipeline import estimate, gather_evidence
-
-    antenna = paper_antenna()
-    recording = simulator.simulate(
-        antenna, simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
-    ).without_ground_truth()
-    evidence = gather_evidence(recording, antenna)
-    assert isinstance(evidence, Evidence)
-    return evidence, estimate(recording, antenna, FastMethod())
-
-
-def test_history_holds_the_declared_window_and_runs_to_the_cap() -> None:
-    # history() evaluates the same grid without stopping: its first sure window at or after the
-    # end of the hold is the one conclude() declares (same sample, same x_c); from_t1 starts
-    # first_window after t_1; the last window is the cap (the recording runs past it).
-    evidence, result = _simulated_evidence()
-    config = FastConfig()
-    history = FastMethod().history(evidence)
-    declared = next(w for w in history if w.sure)
-    assert history[0].end_index >= evidence.hold_end
-    assert evidence.t[declared.end_index] == result.t_e
-    assert declared.posterior.x_c == result.x_c
-    since_t1 = FastMethod().history(evidence, from_t1=True)
-    offsets = [w.end_index - evidence.rest_index for w in since_t1]
-    assert offsets[0] == round(config.first_window / evidence.sample_period)
-    assert offsets[-1] == round(config.cap / evidence.sample_period)
-    assert offsets == sorted(set(offsets))
-    # sure = every other check passed and the interval within the tolerance; a window failing
-    # a check (the early ones: too few periods) is not sure at any tolerance
-    assert all(
-        w.sure == (w.checks_passed and w.posterior.width <= config.tolerance) for w in since_t1
-    )
-    assert not since_t1[0].checks_passed and since_t1[0].note
-
-
-def test_an_opening_contact_moves_the_window_start_to_the_end_of_the_hold() -> None:
-    # The opening check's mechanism: with max_opening = 1e-9 every window from t_1 counts as
-    # opened, so each window at least first_window past the hold is refitted from the hold's
-    # end, and the estimate from those windows still holds the contact. With the default (1)
-    # this recording (azimuthal, 0.6 m: the contact force vibrates at a fraction of the push)
-    # keeps t_1 as the start.
-    evidence, _ = _simulated_evidence()
-    default = FastMethod().history(evidence)
-    assert all(w.start_index == evidence.rest_index for w in default)
-    assert all(w.opening < 1.0 for w in default)
-    moved = FastMethod(FastConfig(max_opening=1e-9)).history(evidence)
-    first = round(FastConfig().first_window / evidence.sample_period)
-    late = [w for w in moved if w.end_index - evidence.hold_end >= first]
-    assert late and all(w.start_index == evidence.hold_end for w in late)
-    # The windows from the hold also see the (slight) vibration: never sure, and the cap's
-    # posterior still holds the contact (0.6 m, the contact moves < 3 mm as the link bends)
-    assert not any(w.sure for w in late)
-    low, high = late[-1].posterior.interval
-    assert low - 0.003 <= 0.6 <= high + 0.003
-
-
-def test_second_mode_chooses_the_branch_near_the_peak() -> None:
-    # At 0.75 m omega_1 is 0.5 % below the top of the curve: its two candidates (0.75 and
-    # 0.79 m) are closer than the ratio resolves, so the posterior keeps both branches. The
-    # second contact mode (228 against 258 rad/s at the two candidates) chooses: asked at the
-    # cap only, the estimate stays "uncertain" with the branch it chose; asked at every window
-    # (the default), the window is declared once the spectrum of [t_1, t] is clear. Either way
-    # the estimate must sit on the simulator's contact branch, with the interval on that branch
-    # holding its contact abscissa.
-    simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.pipeline import estimate
-
-    antenna = paper_antenna()
-    recording = simulator.simulate(
-        antenna, simulator.Scenario(case="vertical", contact_point=0.75, seed=3)
-    )
-    truth = float(recording.metadata["true_xc"])
-    blind = recording.without_ground_truth()
-    at_cap = estimate(blind, antenna, FastMethod(FastConfig(branch_by_second_mode=False)))
-    early = estimate(blind, antenna, FastMethod())
-    assert at_cap.status.value == "uncertain"
-    assert "second contact mode" in (at_cap.reason or "")
-    assert early.status.value == "ok"
-    assert early.t_e - early.t_1 < 0.5 * (at_cap.t_e - at_cap.t_1)
-    for result in (at_cap, early):
-        assert result.diagnostics["branch_chosen_by"] == "omega2"
-        assert len(result.candidates) == 2
-        # The other candidate is 5 cm away; within the tolerance means the right branch
-        assert result.x_c == pytest.approx(truth, abs=FastConfig().tolerance)
-        assert result.interval is not None
-        assert result.interval[0] <= truth <= result.interval[1]
-        assert max(result.branch_probability) == 1.0
-
-
 def test_cli_json_has_interval_and_branch_probability(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -455,8 +361,6 @@ def test_cli_json_has_interval_and_branch_probability(
     # push built from the statics): the fast method must report an interval holding 0.62 m and
     # one branch probability per candidate; other methods give null.
     from sensing_antenna.cli import main
-    from sensing_antenna.recording import write_recording
-    from test_estimation_pipeline import Synthetic, synthetic_recording
 
     path = tmp_path / "rec.csv"
     write_recording(synthetic_recording(Synthetic(x_c=0.62, seed=21)), path)
@@ -497,36 +401,13 @@ def test_drift_check_widens_the_frequency_error_only_when_the_record_disagrees()
     assert abs(beating.omega1 - float(CURVE.omega1(x))) < 2.0 * beating.omega1_se
 
 
-@pytest.mark.parametrize("case", ["vertical", "azimuthal"])
-def test_the_rest_bias_of_a_noiseless_device_is_zero(case: str) -> None:
-    # No sensor offset, no noise, a device 15 % stiffer than the nominal link and a model with
-    # the calibrated T_e: what the rest's mean holds besides the offset is the model's error.
-    # With the guard and the sag from T_e it is under 1e-6 (N, N m); without the guard the
-    # sweep's start adds 2e-5 N and 8e-6 N m, and the sag from the nominal E I 1.4e-5 N m
-    # (vertical). 2e-6 is under the rest mean's noise standard error at noise 1 (3e-6 N m).
-    from sensing_antenna.estimation.pipeline import gather_evidence
-    from sensing_antenna.simulator import Scenario, simulate
-
-    base = paper_antenna()
-    device = replace(base, link=replace(base.link, youngs_modulus=132.65e9))
-    model = base.with_calibrated_t(device.link.theoretical_t)
-    recording = simulate(device, Scenario(case=case, contact_point=0.7, seed=0, noise_scale=0.0))
-    evidence = gather_evidence(recording.without_ground_truth(), model)
-    assert isinstance(evidence, Evidence)
-    bias = FastMethod()._prepare(evidence).bias
-    assert bias.n_samples > 50
-    np.testing.assert_allclose(bias.bias, 0.0, atol=2e-6)
-    unguarded = FastMethod(FastConfig(bias_guard=0.0))._prepare(evidence).bias
-    assert np.max(np.abs(unguarded.bias)) > 5e-6
-
-
 def test_an_early_frequency_excess_waits_for_a_reference_window_that_can_see_it() -> None:
     # A ring whose frequency starts 3 % high and relaxes with 80 ms (an early phase the linear
     # model ignores: impact, bouncing contact). At 0.237 s the window from t_1 reads omega_1
     # about 0.8 % high; its 2/3 reference window (0.16 s) holds about one period, too few for
-    # its own fundamental to show the change, and before the rule that window was declared
-    # with an interval beside the truth (seeds 0 to 2). Now it waits for a reference of
-    # min_periods; the declared interval covers x_c.
+    # its own fundamental to show the change (declared on it, the interval would lie beside
+    # the truth). The window waits for a reference of min_periods; the declared interval
+    # covers x_c.
     x = 0.45
     omega = float(CURVE.omega1(x))
     channels = _channels(x, 1000, np.random.default_rng(0), 0.2, excess=0.03, relaxation=0.08)
@@ -579,62 +460,222 @@ def test_a_window_whose_posterior_holds_two_branches_asks_the_second_mode() -> N
     assert len(asked) == 1
 
 
-def test_the_second_mode_declares_a_noisy_far_contact_online_as_offline() -> None:
-    # A synthetic recording at 0.9 m with eight times the nominal sensor noise: the ratio
-    # leaves both branches open until the cap, where the second mode (30 % of the first's
-    # amplitude, at the branch's own omega_2) chooses. Asked at every window it chooses
-    # within 0.4 s and the window is declared; the streaming form gives the same estimate,
-    # since the chooser reads only the samples up to the window's end.
-    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
-    from sensing_antenna.estimation.result import Status
-    from test_estimation_pipeline import Synthetic, synthetic_recording
+# On simulated recordings: the batch and online forms, the study form, the second mode
 
+
+def test_on_the_calibrated_device_the_second_mode_chooses_the_branch_the_ratio_cannot() -> None:
+    # The device of the calibrated-device campaign (benchmarks/fast_bound.py --campaign
+    # paper-2021, vertical, 0.70 m, seed 400), rebuilt from its identified observer and
+    # calibration (rounded). omega_1 there is reached on both branches and the torque/force
+    # ratio (0.80 m) does not pick one: the interval spans both, with or without the branch
+    # check of the higher modes, so no window is declared on either. The second mode chooses
+    # the right one: at the cap when asked there only, or as soon as the spectrum of [t_1, t]
+    # says so (the default), and the window is then declared.
+    base = paper_antenna()
+    observer = FreeMotionObserver(
+        gain=0.435, natural_frequency=17.26, damping=0.182, contact_threshold=1.72e-4
+    )
+    device = replace(base, observer=observer, link=replace(base.link, youngs_modulus=132.65e9))
+    model = replace(base, observer=observer).with_calibrated_t(0.21252, 0.00118)
+    scenario = Scenario(case="vertical", contact_point=0.7, seed=400, damping_ratio=0.005)
+    recording = simulate(device, scenario)
+    truth = float(recording.metadata["true_xc"])
+    evidence = _evidence(recording.without_ground_truth(), model)
+    caches: Any = ({}, {})  # the three settings differ in their checks only: one set of fits
+    at_cap = FastConfig(branch_by_second_mode=False)
+    for config in (replace(at_cap, branch_mode_tolerance=1e3), at_cap, FastConfig()):
+        result = FastMethod(config).conclude(evidence, caches)
+        early = config.branch_by_second_mode
+        assert result.status is (Status.OK if early else Status.UNCERTAIN)
+        assert result.diagnostics.get("branch_chosen_by") == "omega2"
+        # within the 5 mm tolerance's half-width: the branch's own omega_1 places it (0.699 m)
+        assert result.x_c == pytest.approx(truth, abs=0.0025)
+        assert (result.t_e - result.t_1 < 0.5) == early
+
+
+@pytest.mark.parametrize(
+    ("case", "x_c", "seed", "push_phase"),
+    [("azimuthal", 0.6, 5, False), ("vertical", 0.4, 400, True)],
+)
+def test_offline_and_online_agree_on_a_simulated_recording(
+    case: str, x_c: float, seed: int, push_phase: bool
+) -> None:
+    # The pipeline's batch and streaming forms hand the same samples to the method; the fast
+    # method only reads samples up to its own declaration, so both give identical estimates.
+    # With the push phase, on a recording whose declared window is the one through the push.
     antenna = paper_antenna()
-    recording = synthetic_recording(Synthetic(x_c=0.9, seed=1, noise=8.0))
-    at_cap = estimate(recording, antenna, FastMethod(FastConfig(branch_by_second_mode=False)))
+    recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=seed))
+    method = FastMethod(FastConfig(push_phase=push_phase))
+    offline = estimate(recording, antenna, method)
+    assert offline.diagnostics["fit_through_push"] is push_phase
+    streamed = _online(recording, method)
+    assert streamed.status == offline.status
+    assert streamed.x_c == offline.x_c
+    assert streamed.t_e == offline.t_e
+    # Reference: the simulator's contact point (nominal, the contact moves < 3 mm as the link
+    # bends); the fast estimate must be within the tolerance and well before the paper's 1 s
+    # spectrum window.
+    assert offline.x_c == pytest.approx(x_c, abs=0.008)
+    assert offline.t_e - offline.t_1 < 0.5
+
+
+def test_history_holds_the_declared_window_and_runs_to_the_cap(
+    azimuthal_evidence: Evidence,
+    azimuthal_estimate: ContactEstimate,
+    azimuthal_history: tuple[WindowEstimate, ...],
+) -> None:
+    # history() evaluates the same grid without stopping: its first sure window at or after the
+    # end of the hold is the one conclude() declares (same sample, same x_c, the windows up to
+    # it counted as its evaluations); from_t1 starts first_window after t_1; the last window
+    # is the cap (the recording runs past it).
+    evidence, history, config = azimuthal_evidence, azimuthal_history, FastConfig()
+    declared = next(w for w in history if w.sure)
+    assert history[0].end_index >= evidence.hold_end
+    assert evidence.t[declared.end_index] == azimuthal_estimate.t_e
+    assert declared.posterior.x_c == azimuthal_estimate.x_c
+    assert azimuthal_estimate.diagnostics["evaluations"] == 1 + history.index(declared)
+    offsets = [w.end_index - evidence.rest_index for w in history]
+    assert offsets[-1] == round(config.cap / evidence.sample_period)
+    assert offsets == sorted(set(offsets))
+    # sure = every other check passed and the interval within the tolerance
+    assert all(
+        w.sure == (w.checks_passed and w.posterior.width <= config.tolerance) for w in history
+    )
+    # From t_1: the windows before the hold's end too, the same ones after it; the first fails
+    # a check (too short for the fundamental) and is not sure at any tolerance
+    declared_at = (declared.end_index - evidence.rest_index) * TS
+    since_t1 = FastMethod(FastConfig(cap=declared_at)).history(evidence, from_t1=True)
+    assert since_t1[0].end_index - evidence.rest_index == round(config.first_window / TS)
+    assert since_t1[0].end_index < evidence.hold_end
+    same_end = {w.end_index: w for w in history}
+    overlap = [w for w in since_t1 if w.end_index in same_end]
+    assert overlap and overlap[-1].end_index == declared.end_index
+    for window in overlap:
+        assert window.posterior.x_c == same_end[window.end_index].posterior.x_c
+        assert window.note == same_end[window.end_index].note
+    assert not since_t1[0].checks_passed and since_t1[0].note
+
+
+def test_an_opening_contact_moves_the_window_start_to_the_end_of_the_hold(
+    azimuthal_evidence: Evidence, azimuthal_history: tuple[WindowEstimate, ...]
+) -> None:
+    # The opening check's mechanism: with max_opening = 1e-9 every window from t_1 counts as
+    # opened, so each window at least first_window past the hold is refitted from the hold's
+    # end, and the estimate from those windows still holds the contact. With the default (1)
+    # this recording (azimuthal, 0.6 m: the contact force vibrates at a fraction of the push)
+    # keeps t_1 as the start.
+    evidence = azimuthal_evidence
+    assert all(w.start_index == evidence.rest_index for w in azimuthal_history)
+    assert all(w.opening < 1.0 for w in azimuthal_history)
+    moved = FastMethod(FastConfig(max_opening=1e-9, cap=0.6)).history(evidence)
+    first = round(FastConfig().first_window / evidence.sample_period)
+    late = [w for w in moved if w.end_index - evidence.hold_end >= first]
+    assert late and all(w.start_index == evidence.hold_end for w in late)
+    # The windows from the hold also see the (slight) vibration: never sure up to 0.6 s, and
+    # the last one's posterior still holds the contact (0.6 m, the contact moves < 3 mm as the
+    # link bends)
+    assert not any(w.sure for w in late)
+    low, high = late[-1].posterior.interval
+    assert low - 0.003 <= 0.6 <= high + 0.003
+    # A restarted window's slip reference is the statics of its own first half (from the
+    # hold's end), the same as the window of that half evaluated on its own
+    cap = late[-1]
+    grid = evaluation_offsets(TS, FastConfig())
+    half = evidence.hold_end + int(
+        grid[np.argmin(np.abs(grid - 0.5 * (cap.end_index - evidence.hold_end)))]
+    )
+    assert cap.early_statics is not None
+    own_half = evaluate_window(
+        *scan_inputs(evidence, FastConfig())._replace(rest_index=evidence.hold_end, end_index=half)
+    )
+    assert own_half.statics is not None
+    assert cap.early_statics.ratio == own_half.statics.ratio
+
+
+def test_second_mode_chooses_the_branch_near_the_peak() -> None:
+    # At 0.75 m omega_1 is 0.5 % below the top of the curve: its two candidates (0.75 and
+    # 0.79 m) are closer than the ratio resolves, so the posterior keeps both branches. The
+    # second contact mode (228 against 258 rad/s at the two candidates) chooses: asked at the
+    # cap only, the estimate stays "uncertain" with the branch it chose; asked at every window
+    # (the default), the window is declared once the spectrum of [t_1, t] is clear. Either way
+    # the estimate must sit on the simulator's contact branch, with the interval on that branch
+    # holding its contact abscissa.
+    antenna = paper_antenna()
+    recording = simulate(antenna, Scenario(case="vertical", contact_point=0.75, seed=3))
+    truth = float(recording.metadata["true_xc"])
+    blind = recording.without_ground_truth()
+    at_cap = estimate(blind, antenna, FastMethod(FastConfig(branch_by_second_mode=False)))
+    early = estimate(blind, antenna, FastMethod())
+    assert at_cap.status is Status.UNCERTAIN
+    assert "second contact mode" in (at_cap.reason or "")
+    assert early.status is Status.OK
+    assert early.t_e - early.t_1 < 0.5 * (at_cap.t_e - at_cap.t_1)
+    for result in (at_cap, early):
+        assert result.diagnostics["branch_chosen_by"] == "omega2"
+        assert len(result.candidates) == 2
+        # The other candidate is 5 cm away; within the tolerance means the right branch
+        assert result.x_c == pytest.approx(truth, abs=FastConfig().tolerance)
+        assert result.interval is not None
+        assert result.interval[0] <= truth <= result.interval[1]
+        assert max(result.branch_probability) == 1.0
+
+
+@pytest.mark.parametrize("case", ["vertical", "azimuthal"])
+def test_the_rest_bias_of_a_noiseless_device_is_zero(case: str) -> None:
+    # No sensor offset, no noise, a device 15 % stiffer than the nominal link and a model with
+    # the calibrated T_e: what the rest's mean holds besides the offset is the model's error.
+    # With the guard and the sag from T_e it is under 1e-6 (N, N m); without the guard the
+    # sweep's start adds 2e-5 N and 8e-6 N m, and the sag from the nominal E I 1.4e-5 N m
+    # (vertical). 2e-6 is under the rest mean's noise standard error at noise 1 (3e-6 N m).
+    base = paper_antenna()
+    device = replace(base, link=replace(base.link, youngs_modulus=132.65e9))
+    model = base.with_calibrated_t(device.link.theoretical_t)
+    recording = simulate(device, Scenario(case=case, contact_point=0.7, seed=0, noise_scale=0.0))
+    evidence = _evidence(recording.without_ground_truth(), model)
+    bias = scan_inputs(evidence, FastConfig()).bias
+    assert bias.n_samples > 50
+    np.testing.assert_allclose(bias.bias, 0.0, atol=2e-6)
+    unguarded = scan_inputs(evidence, FastConfig(bias_guard=0.0)).bias
+    assert np.max(np.abs(unguarded.bias)) > 5e-6
+
+
+def test_the_second_mode_declares_a_noisy_far_contact_online_as_offline(
+    noisy_far: Recording,
+) -> None:
+    # The ratio leaves both branches open until the cap, where the second mode chooses. Asked
+    # at every window it chooses within 0.4 s and the window is declared; the streaming form
+    # gives the same estimate, since the chooser reads only the samples up to the window's end.
+    evidence = _evidence(noisy_far)
+    caches: Any = ({}, {})  # the two settings differ in their checks only: one set of fits
+    at_cap = FastMethod(FastConfig(branch_by_second_mode=False)).conclude(evidence, caches)
     assert at_cap.status is Status.UNCERTAIN and at_cap.t_e - at_cap.t_1 >= 0.99
-    offline = estimate(recording, antenna, FastMethod())
+    offline = FastMethod().conclude(evidence, caches)
     assert offline.status is Status.OK
     assert offline.diagnostics["branch_chosen_by"] == "omega2"
     assert offline.t_e - offline.t_1 < 0.4
     assert offline.x_c == pytest.approx(0.9, abs=FastConfig().tolerance / 2)
-    online = OnlineEstimator(antenna, recording.sample_period, FastMethod())
-    for k in range(recording.t.shape[0]):
-        online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
-    streamed = online.finalize()
+    streamed = _online(noisy_far, FastMethod())
     assert (streamed.status, streamed.x_c, streamed.t_e) == (
         offline.status,
         offline.x_c,
         offline.t_e,
     )
     # The study form holds the declared window, chosen there by the second mode
-    from sensing_antenna.estimation.pipeline import gather_evidence
-
-    evidence = gather_evidence(recording, antenna)
-    assert isinstance(evidence, Evidence)
-    declared = next(w for w in FastMethod().history(evidence) if w.sure)
+    history = FastMethod(FastConfig(cap=offline.t_e - offline.t_1)).history(evidence)
+    declared = next(w for w in history if w.sure)
     assert declared.branch_chosen_by_second_mode
     assert evidence.t[declared.end_index] == offline.t_e
 
 
-def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is_dropped() -> None:
-    # The noisy 0.9 m synthetic recording above: its second mode sits at the 0.9 m candidate's
-    # omega_2, so on the window [t_1, t_1 + 0.5 s] the chooser picks that candidate. On 0.1 s the
-    # Hann main lobe (+-126 rad/s) is wider than the candidates' omega_2 gap (~100 rad/s): not
-    # asked. With a fundamental of half the peak's frequency the peak is 2 omega_1 itself,
-    # which a clipping contact would make: the answer is dropped.
-    from sensing_antenna.estimation.methods.fast.method import second_mode_chooser
-    from sensing_antenna.estimation.methods.paper.frequency import (
-        evidence_frequency,
-        evidence_spectrum,
-        find_peak,
-    )
-    from sensing_antenna.estimation.pipeline import gather_evidence
-    from test_estimation_pipeline import Synthetic, synthetic_recording
-
-    antenna = paper_antenna()
-    evidence = gather_evidence(synthetic_recording(Synthetic(x_c=0.9, seed=1, noise=8.0)), antenna)
-    assert isinstance(evidence, Evidence)
+def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is_dropped(
+    noisy_far: Recording,
+) -> None:
+    # On the window [t_1, t_1 + 0.5 s] the chooser picks the 0.9 m candidate, whose omega_2 the
+    # recording's second mode sits at. On 0.1 s the Hann main lobe (+-126 rad/s) is wider than
+    # the candidates' omega_2 gap (~100 rad/s): not asked. With a fundamental of half the
+    # peak's frequency the peak is 2 omega_1 itself, which a clipping contact would make: the
+    # answer is dropped.
+    evidence = _evidence(noisy_far)
     omega1 = float(CURVE.omega1(0.9))
     candidates = tuple(float(c.x_c) for c in CURVE.contact_points(omega1))
     assert len(candidates) == 2
@@ -655,242 +696,131 @@ def test_the_second_mode_is_not_asked_on_a_short_window_and_a_harmonic_answer_is
     assert dropped is None and "dropped" in dropped_notes
 
 
-def _azimuthal_06() -> Any:
-    simulator = pytest.importorskip("sensing_antenna.simulator")
-    return simulator.simulate(
-        paper_antenna(), simulator.Scenario(case="azimuthal", contact_point=0.6, seed=5)
-    )
-
-
-def _evaluated_windows(monkeypatch: pytest.MonkeyPatch) -> list[int]:
-    """Last indices of every window the fast method evaluates from now on."""
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-
-    ends: list[int] = []
-    evaluate = fast_module.evaluate_from_t1_or_hold
-
-    def recording(inputs: ScanInputs, *args: Any, **kwargs: Any) -> Any:
-        ends.append(inputs.end_index)
-        return evaluate(inputs, *args, **kwargs)
-
-    monkeypatch.setattr(fast_module, "evaluate_from_t1_or_hold", recording)
-    return ends
-
-
-def _concluded_windows(monkeypatch: pytest.MonkeyPatch) -> list[tuple[Any, Any]]:
-    """(window, scan result) of every conclusion of the fast method from now on."""
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-
-    finals: list[tuple[Any, Any]] = []
-    conclude = fast_module.conclude_fast
-
-    def recording(evidence: Any, result: Any, *args: Any, **kwargs: Any) -> Any:
-        finals.append((result.final, result))
-        return conclude(evidence, result, *args, **kwargs)
-
-    monkeypatch.setattr(fast_module, "conclude_fast", recording)
-    return finals
-
-
 def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
-    monkeypatch: pytest.MonkeyPatch,
+    azimuthal: Recording, azimuthal_estimate: ContactEstimate
 ) -> None:
     # update_block feeds what arrived together (a real-time loop that fell behind): the fast
     # method evaluates one window, the block's last grid instant, and the estimate is that
     # window's. Blocks of one sample are update(), and one block holding every sample asks
     # nothing before the pipeline's own end, so both give the offline estimate.
-    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
-
-    antenna = paper_antenna()
-    recording = _azimuthal_06()
-    offline = estimate(recording, antenna, FastMethod())
+    antenna, offline, recording = paper_antenna(), azimuthal_estimate, azimuthal
+    single = _online(recording, FastMethod(), 1)
+    assert (single.x_c, single.t_e) == (offline.x_c, offline.t_e)
+    whole = _online(recording, FastMethod(), recording.t.shape[0])
+    assert (whole.x_c, whole.t_e) == (offline.x_c, offline.t_e)
+    # The samples from t_1 + 0.2 s (the hold's end: nothing asked before) to t_1 + 0.3 s
+    # arrive together: one window asked, the last grid instant in the block
     t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
-    single = OnlineEstimator(antenna, recording.sample_period, FastMethod())
-    for k in range(t.shape[0]):
-        single.update_block(t[k : k + 1], theta[k : k + 1], force[k : k + 1], torque[k : k + 1])
-    assert (single.finalize().x_c, single.finalize().t_e) == (offline.x_c, offline.t_e)
-    whole = OnlineEstimator(antenna, recording.sample_period, FastMethod())
-    assert whole.update_block(t, theta, force, torque) is not None
-    assert (whole.result.x_c, whole.result.t_e) == (offline.x_c, offline.t_e)  # type: ignore[union-attr]
-
-    # The samples from t_1 + 0.2 s (the hold's end) to t_1 + 0.3 s arrive together
     t_1_index = int(np.searchsorted(t, offline.t_1))
     first, last = t_1_index + 200, t_1_index + 300
+    grid = t_1_index + evaluation_offsets(TS, FastConfig())
+    asked = int(grid[(grid >= first) & (grid < last)].max())
     blocked = OnlineEstimator(antenna, recording.sample_period, FastMethod())
     for k in range(first):
         assert blocked.update(t[k], theta[k], force[k], torque[k]) is None
-    ends = _evaluated_windows(monkeypatch)
     out = blocked.update_block(
         t[first:last], theta[first:last], force[first:last], torque[first:last]
     )
-    assert len(set(ends)) == 1, "one window per block"
-    assert first <= ends[0] < last
-    assert out is not None and out.t_e == t[ends[0]]
+    assert out is not None and out.t_e == t[asked]
+    assert out.diagnostics["evaluations"] == 1, "one window per block"
     with pytest.raises(FieldError, match=r"update_block: force: shape \(2, 3\), expected \(3, 3\)"):
         OnlineEstimator(antenna, recording.sample_period).update_block(
             t[:3], theta[:3], force[:2], torque[:3]
         )
 
 
-def test_blocks_that_reach_the_cap_fit_only_the_windows_they_ask(
-    monkeypatch: pytest.MonkeyPatch,
+def _turned(recording: Recording, t_1: float, rate: float) -> Recording:
+    """``recording`` with its contact loads turning about X^m at ``rate`` (rad/s) for 1 s from
+    t_1, as a contact sliding round the obstacle turns them: the force and the torque minus
+    their mean over the initial rest (gravity and sensor bias) rotated in the Y^m-Z^m plane."""
+    angle = rate * np.clip(recording.t - t_1, 0.0, 1.0)
+    cos, sin = np.cos(angle), np.sin(angle)
+    rest = recording.t < 0.1
+    loads = {}
+    for name in ("force", "torque"):
+        values = getattr(recording, name).copy()
+        reference = values[rest].mean(axis=0)
+        y, z = values[:, 1] - reference[1], values[:, 2] - reference[2]
+        values[:, 1] = reference[1] + cos * y - sin * z
+        values[:, 2] = reference[2] + sin * y + cos * z
+        loads[name] = values
+    return dataclasses.replace(recording, **loads)
+
+
+def test_a_contact_force_that_turns_is_reported_as_slip_online_as_offline(
+    azimuthal: Recording, azimuthal_estimate: ContactEstimate
 ) -> None:
-    # A tolerance no window meets: every run ends uncertain at the cap. Fed in blocks of 100
-    # samples the method evaluates one window per block and then the cap's, not the skipped
-    # instants (a real-time loop would otherwise spend seconds at the cap), and the capped
-    # estimate is the offline one (the same window on the same samples).
-    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
-    from sensing_antenna.estimation.result import Status
-
-    antenna = paper_antenna()
-    recording = _azimuthal_06()
+    # The slip check compares the static contact force fitted on the window's first half with
+    # that of the whole window. Turned at 1.2 rad/s from t_1, the force at the centres of
+    # [t_1, t_1 + 0.5 s] and [t_1, t_1 + 1 s] differs by 0.3 rad (17.2 deg), twice
+    # max_direction_drift. With a tolerance no window meets the estimate is the cap's: slip
+    # suspected, by that angle within 3 of its standard errors. Fed online in blocks of 100
+    # samples the method asks one window per block from the hold's end and the cap's, not the
+    # instants skipped (a real-time loop would otherwise spend seconds at the cap), and
+    # concludes on the cap's window with the same slip reference: the same estimate.
     method = FastMethod(FastConfig(tolerance=1e-6))
-    finals = _concluded_windows(monkeypatch)
-    offline = estimate(recording, antenna, method)
-    assert offline.status is Status.UNCERTAIN
-    t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
-    ends = _evaluated_windows(monkeypatch)
-    online = OnlineEstimator(antenna, recording.sample_period, method)
-    out = None
-    for k in range(0, t.shape[0], 100):
-        out = online.update_block(
-            t[k : k + 100], theta[k : k + 100], force[k : k + 100], torque[k : k + 100]
-        )
-        if out is not None:
-            break
-    assert out is not None
-    assert (out.status, out.x_c, out.t_e, out.interval) == (
-        offline.status,
-        offline.x_c,
-        offline.t_e,
-        offline.interval,
-    )
-    # Blocks of 0.1 s from the hold's end (t_1 + 0.2 s) to the cap (t_1 + 1 s): at most nine
-    # blocks ask, and the cap's window is evaluated once more; the grid holds 18 instants there
-    grid = evaluation_offsets(recording.sample_period, method.config)
-    assert len(set(ends)) <= 10 < int(np.sum(grid >= 200)), "skipped instants were fitted"
-    assert out.diagnostics["evaluations"] == len(set(ends))
-    # Online the windows asked skip the slip check's early statics; the one concluded on has
-    # them, as offline (the capped 1 s window's first half holds several periods)
-    concluded = [window for window, _ in finals]
-    assert len(concluded) == 2 and concluded[0].early_statics is not None
-    online_early, offline_early = concluded[1].early_statics, concluded[0].early_statics
-    assert online_early.ratio == offline_early.ratio
-    assert np.array_equal(online_early.reaction_perp, offline_early.reaction_perp)
-
-
-def _counted_early_statics(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, int]]:
-    """(first, last index) of every window whose early statics are fitted from now on."""
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-
-    calls: list[tuple[int, int]] = []
-    early_statics = fast_module._early_statics
-
-    def counted(window: Any, *args: Any) -> Any:
-        calls.append((window.rest_index, window.end_index))
-        return early_statics(window, *args)
-
-    monkeypatch.setattr(fast_module, "_early_statics", counted)
-    return calls
-
-
-def _early_statics_refitted(inputs: ScanInputs, window: Any) -> Any:
-    """The early statics of ``window``'s span, every fit done afresh (no cache)."""
-    from sensing_antenna.estimation.methods.fast.method import _early_statics, _frequency, _Window
-
-    span = _Window(
-        inputs.channels,
-        window.start_index,
-        window.end_index,
-        inputs.sample_period,
-        inputs.band,
-        inputs.config,
-        None,
-    )
-    fundamental = _frequency(span, None)
-    if fundamental.mode is None:
-        return None
-    return _early_statics(span, fundamental.omega1, inputs.bias)
+    turned = _turned(azimuthal, azimuthal_estimate.t_1, 1.2)
+    offline = estimate(turned, paper_antenna(), method)
+    assert offline.status is Status.SLIP_SUSPECTED
+    assert offline.t_e - offline.t_1 == pytest.approx(FastConfig().cap)
+    found = re.search(r"turned by ([\d.]+) deg \(\+- ([\d.]+)\)", offline.reason or "")
+    assert found is not None
+    angle, se = (float(value) for value in found.groups())
+    assert abs(angle - math.degrees(0.3)) < 3 * se
+    online = _online(turned, method, 100)
+    keys = ("status", "x_c", "t_e", "interval", "reason")
+    assert [getattr(online, key) for key in keys] == [getattr(offline, key) for key in keys]
+    assert online.diagnostics["other_reasons"] == offline.diagnostics["other_reasons"]
+    grid = evaluation_offsets(TS, method.config)
+    assert online.diagnostics["evaluations"] <= 10 < int(np.sum(grid >= 200))
 
 
 @pytest.mark.parametrize("tolerance", [1e-6, 0.005])
-def test_the_offline_scan_fits_the_slip_checks_half_window_for_the_concluded_window_only(
-    monkeypatch: pytest.MonkeyPatch, tolerance: float
+def test_the_scan_concludes_on_the_first_sure_window_with_its_slip_reference(
+    azimuthal_evidence: Evidence, azimuthal_history: tuple[WindowEstimate, ...], tolerance: float
 ) -> None:
-    # The early statics decide neither the posterior nor sure, so the scan skips their
-    # half-length fit on every window it passes and adds it to the one it concludes on (the
-    # first sure one, or the cap's when none is): fitted once, and the same as a computation
-    # from scratch gives.
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.pipeline import gather_evidence
-
-    evidence = gather_evidence(_azimuthal_06(), paper_antenna())
-    method = FastMethod(FastConfig(tolerance=tolerance))
-    history = method.history(evidence)
-    expected = next((w for w in history if w.sure), history[-1])
-    calls = _counted_early_statics(monkeypatch)
-    inputs = method._prepare(evidence)
-    result = fast_module.scan(
-        inputs, evidence.hold_end, evidence.hold_end, fast_module.second_mode_chooser(evidence)
+    # The scan stops at the first window sure at its tolerance (a window that passed every
+    # check is sure at any tolerance at least its interval's width), or at the cap. Only the
+    # window concluded on gets the slip check's reference, the statics of its first half, from
+    # the scan's cached fits: the same as a computation from scratch. The window declared at
+    # 0.237 s is too short for one (its half holds 1.2 periods); the cap's 1 s window has one.
+    evidence = azimuthal_evidence
+    config = FastConfig(tolerance=tolerance)
+    expected = next(
+        (w for w in azimuthal_history if w.checks_passed and w.posterior.width <= tolerance),
+        azimuthal_history[-1],
     )
+    inputs = scan_inputs(evidence, config)
+    result = scan(inputs, evidence.hold_end, evidence.hold_end, second_mode_chooser(evidence))
     final = result.final
-    assert final is not None and calls == [(final.start_index, final.end_index)]
-    assert final.end_index == expected.end_index and final.sure == expected.sure
-    assert result.evaluations == 1 + history.index(expected)
-    assert result.reached_cap == (not expected.sure)
-    assert (final.posterior.x_c, final.omega1, final.note) == (
-        expected.posterior.x_c,
-        expected.omega1,
-        expected.note,
-    )
-    # The sure window (0.237 s) is too short for a reference (its half holds 1.2 periods);
-    # the cap's 1 s window has one
-    statics = _early_statics_refitted(inputs, final)
-    assert (statics is None) == expected.sure
-    if statics is None:
+    assert final is not None
+    assert final.end_index == expected.end_index
+    assert final.sure == (expected.checks_passed and expected.posterior.width <= tolerance)
+    assert result.evaluations == 1 + azimuthal_history.index(expected)
+    assert result.reached_cap == (not final.sure)
+    assert (final.posterior.x_c, final.omega1) == (expected.posterior.x_c, expected.omega1)
+    fresh = with_early_statics_of(inputs, dataclasses.replace(final, early_statics=None))
+    assert (fresh.early_statics is None) == final.sure
+    if fresh.early_statics is None:
         assert final.early_statics is None
     else:
         assert final.early_statics is not None
-        assert final.early_statics.ratio == statics.ratio
-        assert np.array_equal(final.early_statics.reaction_perp, statics.reaction_perp)
+        assert final.early_statics.ratio == fresh.early_statics.ratio
+        assert np.array_equal(final.early_statics.reaction_perp, fresh.early_statics.reaction_perp)
 
 
-def test_a_window_restarted_at_the_end_of_the_hold_fits_only_its_own_early_statics(
-    monkeypatch: pytest.MonkeyPatch,
+def test_a_session_never_serves_the_fits_of_other_samples(
+    azimuthal: Recording, azimuthal_estimate: ContactEstimate
 ) -> None:
-    # Every window "opens" (max_opening tiny), so each is restarted at the hold's end: the
-    # window from t_1 that was set aside does not get its half window fitted, the restarted
-    # one does, with the statics a computation from scratch gives.
-    from sensing_antenna.estimation.methods.fast.method import evaluate_from_t1_or_hold
-    from sensing_antenna.estimation.pipeline import gather_evidence
-
-    evidence = gather_evidence(_azimuthal_06(), paper_antenna())
-    method = FastMethod(FastConfig(max_opening=1e-9))
-    inputs = method._prepare(evidence)
-    end = inputs.rest_index + 1000
-    calls = _counted_early_statics(monkeypatch)
-    window = evaluate_from_t1_or_hold(inputs._replace(end_index=end), evidence.hold_end, ({}, {}))
-    assert (window.start_index, window.end_index) == (evidence.hold_end, end)
-    assert calls == [(evidence.hold_end, end)]
-    statics = _early_statics_refitted(inputs, window)
-    assert window.early_statics is not None and statics is not None
-    assert window.early_statics.ratio == statics.ratio
-
-
-def test_a_session_never_serves_the_fits_of_other_samples() -> None:
     # Two recordings with the same t_c, t_1 and hold, the second with Gamma_y 3 % larger after
     # the hold: a session (online, after reset(); or handed to estimate) gives each the answer
     # of a fresh method.
-    from sensing_antenna.estimation.pipeline import OnlineEstimator, estimate
-
-    antenna = paper_antenna()
-    first = _azimuthal_06()
-    t_1 = estimate(first, antenna, FastMethod()).t_1
+    antenna, first = paper_antenna(), azimuthal
     torque = first.torque.copy()
-    after = first.t > t_1 + 0.2
+    after = first.t > azimuthal_estimate.t_1 + 0.2
     torque[after, 1] *= 1.03
     second = replace(first, torque=torque)
-    fresh = [estimate(r, antenna, FastMethod()) for r in (first, second)]
+    fresh = [azimuthal_estimate, estimate(second, antenna, FastMethod())]
     assert fresh[0].ratio_estimate != fresh[1].ratio_estimate
     session = FastMethod().session()
     for recording, expected in zip((first, second), fresh, strict=True):
@@ -916,37 +846,35 @@ def test_a_session_never_serves_the_fits_of_other_samples() -> None:
         )
 
 
+def test_a_fit_cache_never_serves_fits_of_other_settings(
+    azimuthal_evidence: Evidence, azimuthal_estimate: ContactEstimate
+) -> None:
+    # FastMethod.conclude fills and reads the caller's caches. Filled by a method that fits two
+    # modes at most, they give the default method (three) the estimate of a fresh cache, not
+    # one from the two-mode fits (which read omega_1 differently).
+    caches: Any = ({}, {})
+    two_modes = FastMethod(FastConfig(max_modes=2)).conclude(azimuthal_evidence, caches)
+    assert two_modes.omega1 != azimuthal_estimate.omega1
+    shared = FastMethod().conclude(azimuthal_evidence, caches)
+    keys = ("x_c", "t_e", "omega1", "ratio_estimate", "interval")
+    assert [getattr(shared, key) for key in keys] == [
+        getattr(azimuthal_estimate, key) for key in keys
+    ]
+
+
 def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any, ...]:
     """The window ``after_t1`` (s) after t_1 of one simulated recording (paper antenna),
-    evaluated with the push phase, the fundamental of the window from t_1 alone and the true
-    omega_1 (sensing curve at the simulator's contact abscissa)."""
-    simulator = pytest.importorskip("sensing_antenna.simulator")
-    from sensing_antenna.estimation.methods.fast.method import _frequency, _Window
-    from sensing_antenna.estimation.pipeline import gather_evidence
-
+    evaluated with the push phase and without it (from t_1 alone), and the true omega_1
+    (sensing curve at the simulator's contact abscissa)."""
     antenna = paper_antenna()
-    recording = simulator.simulate(
-        antenna, simulator.Scenario(case=case, contact_point=x_c, seed=seed, duration=2.0)
-    )
+    recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=seed, duration=2.0))
     truth = float(CURVE.omega1(float(recording.metadata["true_xc"])))
-    evidence = gather_evidence(recording.without_ground_truth(), antenna)
-    assert isinstance(evidence, Evidence)
-    inputs = FastMethod(FastConfig(push_phase=True))._prepare(evidence)
+    evidence = _evidence(recording.without_ground_truth(), antenna)
+    inputs = scan_inputs(evidence, FastConfig(push_phase=True))
     assert inputs.push is not None and inputs.push.start == evidence.contact_index
     inputs = inputs._replace(end_index=inputs.rest_index + round(after_t1 / TS))
     window = evaluate_window(*inputs, cache={})
-    alone = _frequency(
-        _Window(
-            inputs.channels,
-            inputs.rest_index,
-            inputs.end_index,
-            TS,
-            inputs.band,
-            inputs.config,
-            {},
-        ),
-        None,
-    )
+    alone = evaluate_window(*inputs._replace(push=None), cache={})
     return window, alone, truth
 
 
@@ -961,125 +889,113 @@ def test_a_window_through_the_push_stands_when_it_tells_omega1_better() -> None:
     # the window from t_1 stands.
     window, alone, truth = _push_window("vertical", 0.40, 400, 0.215)
     assert window.fit.restart is not None
-    assert "periods" in alone.failed
+    assert "periods of omega_1" in alone.note
     assert window.omega1_se < alone.omega1_se
     assert abs(window.omega1 - truth) < 3 * math.hypot(window.omega1_se, 1e-3 * truth)
     window, alone, _ = _push_window("azimuthal", 0.65, 400, 0.215)
     assert window.fit.restart is None and window.omega1 == alone.omega1
 
 
+def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push() -> None:
+    # When the contact opened, the window restarts at the end of the hold, long after t_1:
+    # the push is not part of it (the modes restart there on their own). With max_opening
+    # tiny every window at least first_window past the hold restarts there, on the recording
+    # whose windows through the push stand: those windows are fitted from the hold's end
+    # alone, while earlier ones reach back to t_c.
+    recording = simulate(paper_antenna(), Scenario(case="vertical", contact_point=0.4, seed=400))
+    evidence = _evidence(recording.without_ground_truth())
+    config = FastConfig(push_phase=True, max_opening=1e-9, cap=0.35)
+    history = FastMethod(config).history(evidence, from_t1=True)
+    late = [w for w in history if w.start_index == evidence.hold_end]
+    early = [w for w in history if w.start_index == evidence.rest_index]
+    assert late and all(w.fit is None or w.fit.restart is None for w in late)
+    assert any(w.fit is not None and w.fit.restart is not None for w in early)
+
+
+# The rules of the checks, on made-up fits
+
+
+def _fit(omega: list[float], se: float = 0.05, n_samples: int = 400) -> DampedSinusoidFit:
+    """A converged fit of one channel with undamped modes at ``omega`` (rad/s), each detected
+    with a signal-to-noise ratio of 10 (detection statistic 10 sqrt(n / 2), far above 10)."""
+    m = len(omega)
+    return DampedSinusoidFit(
+        omega=np.array(omega),
+        decay=np.zeros(m),
+        omega_se=np.full(m, se),
+        decay_se=np.zeros(m),
+        offsets=np.zeros(1),
+        offset_cov=np.eye(1),
+        drifts=np.zeros(1),
+        amplitudes=np.full((1, m), 10.0),
+        noise_std=np.ones(1),
+        t_ref=0.5 * (n_samples - 1) * TS,
+        n_samples=n_samples,
+        sample_period=TS,
+        bic=0.0,
+        converged=True,
+    )
+
+
+def _contradiction(x_c: float, ratio: float, higher: float) -> str:
+    """The branch check on omega_1(x_c), a ratio of ``ratio`` +- 1 cm and one higher mode."""
+    omega1 = float(CURVE.omega1(x_c))
+    table = curve_table(LINK, X_RANGE[0], X_RANGE[1], FastConfig().grid_step)
+    posterior = contact_posterior(
+        table.omega1, table.grid, table.edges, omega1, 0.05, ratio, 0.01, 0.05, 0.09, 0.0, 0.0
+    )
+    return branch_contradiction(_fit([omega1, higher]), 0, posterior, table, LINK, FastConfig())
+
+
+def test_the_branch_check_speaks_only_for_a_mode_of_the_other_candidate() -> None:
+    # omega_1(0.70 m) = omega_1(0.854 m) = 91.04 rad/s; contact mode 2 is 199.2 rad/s at 0.70 m
+    # and 281.5 rad/s at 0.854 m (beam.natural_frequencies). The ratio puts the posterior on
+    # the far branch.
+    near, far = natural_frequencies(LINK, np.array([0.70, 0.854]), 2)[:, 1]
+    assert "x_c = 0.700 m" in _contradiction(0.70, 0.854, float(near))
+    assert _contradiction(0.70, 0.854, float(far)) == ""
+    # 170 rad/s is 15 % from 0.70 m's mode 2 and 40 % from 0.854 m's: it is no contact mode of
+    # either candidate, so it says nothing (it is not a multiple of omega_1 either)
+    assert _contradiction(0.70, 0.854, 170.0) == ""
+    # At 0.71 m 3 omega_1 = 280.44 rad/s sits on mode 2 of the other candidate (0.839 m,
+    # 280.35 rad/s): it may be a harmonic of a clipping contact, so it is skipped (without
+    # that rule it would stop a declaration on the right branch); there the check is blind
+    omega1 = float(CURVE.omega1(0.71))
+    assert _contradiction(0.71, 0.71, 3.0 * omega1) == ""
+
+
 def test_the_push_must_pass_the_same_checks_be_more_precise_and_agree() -> None:
     # The rule on made-up fundamentals: through the push 0.1 rad/s statistical error, from
     # t_1 alone 0.5 rad/s, so their difference may be 3 sqrt(0.5^2 - 0.1^2) = 1.47 rad/s.
-    from sensing_antenna.estimation.methods.fast.method import _Frequency, _push_agrees
-
-    from_t1 = _Frequency(None, 0, 35.0, 0.6, 0.5, 0.1, ())
+    from_t1 = Fundamental(None, 0, 35.0, 0.6, 0.5, 0.1, ())
     config = FastConfig()
 
     def through(omega: float, se: float = 0.1, failed: frozenset[str] = frozenset()) -> Any:
-        return _Frequency(None, 0, omega, se, 0.1, 0.0, tuple(failed), failed)
+        return Fundamental(None, 0, omega, se, 0.1, 0.0, tuple(failed), failed)
 
     periods, drift = frozenset({"periods"}), frozenset({"drift_reference"})
-    assert _push_agrees(through(36.4), from_t1, config)
-    assert not _push_agrees(through(36.5), from_t1, config)
-    assert not _push_agrees(through(35.0, se=0.7), from_t1, config)  # less precise in all
-    assert not _push_agrees(through(35.0, failed=periods), from_t1, config)
-    assert not _push_agrees(through(35.0), from_t1._replace(mode=None), config)
-    assert _push_agrees(through(35.0, failed=periods), from_t1._replace(failed=periods), config)
-    assert not _push_agrees(through(35.0, failed=drift), from_t1._replace(failed=periods), config)
+    assert push_agrees(through(36.4), from_t1, config)
+    assert not push_agrees(through(36.5), from_t1, config)
+    assert not push_agrees(through(35.0, se=0.7), from_t1, config)  # less precise in all
+    assert not push_agrees(through(35.0, failed=periods), from_t1, config)
+    assert not push_agrees(through(35.0), from_t1._replace(mode=None), config)
+    assert push_agrees(through(35.0, failed=periods), from_t1._replace(failed=periods), config)
+    assert not push_agrees(through(35.0, failed=drift), from_t1._replace(failed=periods), config)
 
 
-def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # When the contact opened, the window restarts at the end of the hold, long after t_1:
-    # the push is not part of it (the modes restart there on their own).
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.methods.fast.method import PushPhase, evaluate_from_t1_or_hold
-
-    calls: list[tuple[int, Any]] = []
-
-    def spy(*args: Any, **kwargs: Any) -> Any:
-        calls.append((args[2], args[9]))
-        return SimpleNamespace(opening=math.inf)
-
-    monkeypatch.setattr(fast_module, "evaluate_window", spy)
-    push = PushPhase(0, np.zeros(600))
-    inputs = ScanInputs(
-        np.zeros((600, 5)), NO_BIAS, 100, 500, TS, BAND, LINK, X_RANGE, FastConfig(), push
-    )
-    evaluate_from_t1_or_hold(inputs, hold_end=300, with_early_statics=False)
-    assert calls == [(100, push), (300, None)]
-
-
-@pytest.mark.parametrize(("push_degree", "expected"), [(2, [2]), (3, [2, 3]), (1, [1])])
-def test_windows_through_the_push_fit_their_own_polynomial_degrees(
-    monkeypatch: pytest.MonkeyPatch, push_degree: int, expected: list[int]
-) -> None:
-    # The window from t_1 tries degrees 2 to polynomial_degree; the one through the push up to
-    # push_polynomial_degree (the head's angle carries the push's static growth), with the
-    # push's angle and the restart at t_1 passed on.
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.methods.fast.method import PushPhase, _fit_window
-
-    calls: list[tuple[list[int], bool, int | None]] = []
-
-    def spy(*args: Any, **kwargs: Any) -> None:
-        calls.append((list(args[3]), kwargs["regressors"] is not None, kwargs["restart"]))
-        return None
-
-    monkeypatch.setattr(fast_module, "select_model", spy)
-    config = FastConfig(push_polynomial_degree=push_degree)
-    channels = np.zeros((600, 5))
-    _fit_window(channels, 100, 400, TS, BAND, config, None)
-    assert calls == [([2, 3, 4], False, None)]
-    calls.clear()
-    _fit_window(channels, 100, 400, TS, BAND, config, None, PushPhase(40, np.zeros(600)))
-    assert calls == [(expected, True, 60)]
-
-
-def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window() -> None:
     # The slip check compares the static loads of the window's first half with the whole
     # window's. A half window whose fit put a slow, fast-decaying mode where the fundamental is
-    # has moved part of the vibration into its static part (calibrated-device campaign,
-    # azimuthal 0.70 m: 46 +- 12.5 rad/s over 0.12 s against 97.5 over 0.24 s, and a "slip" of
-    # 170 degrees): no reference then. A half window that reads the fundamental a little off,
-    # as short windows do, is one however small its standard error.
-    import sensing_antenna.estimation.methods.fast.method as fast_module
-    from sensing_antenna.estimation.methods.fast.method import _early_statics, _Window
-    from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
-
-    def half_fit(omega: float, se: float) -> DampedSinusoidFit:
-        one = np.ones(1)
-        return DampedSinusoidFit(
-            omega=np.array([omega]),
-            decay=one,
-            omega_se=np.array([se]),
-            decay_se=one,
-            offsets=np.zeros(5),
-            offset_cov=np.eye(5),
-            drifts=np.zeros(5),
-            amplitudes=np.ones((5, 1)),
-            noise_std=np.full(5, 1e-3),
-            t_ref=0.06,
-            n_samples=121,
-            sample_period=TS,
-            bic=0.0,
-            converged=True,
-        )
-
-    fitted: list[DampedSinusoidFit] = []
-    monkeypatch.setattr(fast_module, "_fit_window", lambda *args, **kwargs: fitted[-1])
-    monkeypatch.setattr(fast_module, "static_ratio", lambda fit, bias: "statics")
-    band = (20.0, 125.0)
-    window = _Window(np.zeros((600, 5)), 100, 337, TS, band, FastConfig(), None)
-    fitted.append(half_fit(46.0, 12.5))
-    assert _early_statics(window, 97.5, NO_BIAS) is None
-    fitted.append(half_fit(96.0, 0.05))  # 1.5 % off, 30 of its standard errors
-    assert _early_statics(window, 97.5, NO_BIAS) == "statics"
-    fitted.append(half_fit(87.0, 0.05))  # 10.8 % off
-    assert _early_statics(window, 97.5, NO_BIAS) is None
-    fitted.append(half_fit(130.0, 0.05))  # no mode in the band
-    assert _early_statics(window, 97.5, NO_BIAS) is None
+    # has moved part of the vibration into its static part (a simulated azimuthal run at
+    # 0.70 m: 46 +- 12.5 rad/s over 0.12 s against 97.5 over 0.24 s, and a "slip" of 170
+    # degrees): no reference then. A half window that reads the fundamental a little off, as
+    # short windows do, is one however small its standard error; one too short for
+    # min_periods (1.5) periods is none.
+    band, config = (20.0, 125.0), FastConfig()
+    assert not is_slip_reference(_fit([46.0], se=12.5, n_samples=121), 97.5, band, config)
+    assert is_slip_reference(_fit([96.0], n_samples=121), 97.5, band, config)  # 1.5 % off
+    assert not is_slip_reference(_fit([87.0], n_samples=121), 97.5, band, config)  # 10.8 % off
+    assert not is_slip_reference(_fit([130.0], n_samples=121), 97.5, band, config)  # not in band
+    # 1.5 periods of 97.5 rad/s last 96.7 ms: 90 samples hold 1.39 of them
+    assert not is_slip_reference(_fit([97.5], n_samples=90), 97.5, band, config)
+    assert not is_slip_reference(None, 97.5, band, config)

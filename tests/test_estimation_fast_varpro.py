@@ -1,4 +1,5 @@
-"""The compiled kernels of the damped-sinusoid fit (varpro.py) against independent computations.
+"""The compiled kernels and solver of the damped-sinusoid fit (varpro.py, trust_region.py)
+against independent computations.
 
 References: central finite differences of the model columns and of the residual (Kaufman's
 Jacobian at a zero-residual point, where the term it drops vanishes: Kaufman 1975, BIT 15); the
@@ -13,13 +14,15 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from sensing_antenna.estimation.methods.fast.varpro import (
+from sensing_antenna.estimation.methods.fast.trust_region import (
     NOT_CONVERGED,
-    _free_parameters,
-    _trust_region_step,
-    _updated_radius,
-    _updated_scale,
     bounded_levenberg_marquardt,
+    free_parameters,
+    trust_region_step,
+    updated_radius,
+    updated_scale,
+)
+from sensing_antenna.estimation.methods.fast.varpro import (
     mode_columns,
     mode_derivatives,
     projected_residual,
@@ -235,10 +238,10 @@ def test_trust_region_step_is_the_constrained_minimum_of_the_model() -> None:
         free = np.ones(m, dtype=np.bool_)
         gauss_newton = np.linalg.lstsq(jac, -residual, rcond=None)[0]
         full = float(np.linalg.norm(scale * gauss_newton))
-        inside = _trust_region_step(normal, gradient, scale, free, 2 * full)
+        inside = trust_region_step(normal, gradient, scale, free, 2 * full)
         np.testing.assert_allclose(inside, gauss_newton, rtol=1e-8)
         radius = full * 10 ** rng.uniform(-3, -0.1)
-        step = _trust_region_step(normal, gradient, scale, free, radius)
+        step = trust_region_step(normal, gradient, scale, free, radius)
         assert np.linalg.norm(scale * step) == pytest.approx(radius, rel=1.1e-3)
         u = rng.normal(size=(5000, m))
         u *= radius * rng.uniform(size=(5000, 1)) ** (1 / m) / np.linalg.norm(u, axis=1)[:, None]
@@ -250,7 +253,7 @@ def test_trust_region_step_is_the_constrained_minimum_of_the_model() -> None:
 
 def test_held_parameters_do_not_move() -> None:
     normal, gradient = np.array([[2.0, 0.5], [0.5, 1.0]]), np.array([1.0, -1.0])
-    step = _trust_region_step(normal, gradient, np.ones(2), np.array([False, True]), 10.0)
+    step = trust_region_step(normal, gradient, np.ones(2), np.array([False, True]), 10.0)
     assert step[0] == 0.0
     assert step[1] == pytest.approx(1.0)  # the Gauss-Newton step of the free one: -g / H
 
@@ -260,7 +263,7 @@ def test_a_parameter_is_held_only_where_descent_would_leave_the_box() -> None:
     params = np.array([0.0, 0.0, 1.0, 0.5])
     # descent is -gradient: out of the box below, into it, out above, inside
     gradient = np.array([1.0, -1.0, -1.0, 1.0])
-    assert list(_free_parameters(params, gradient, lower, upper)) == [False, True, False, True]
+    assert list(free_parameters(params, gradient, lower, upper)) == [False, True, False, True]
 
 
 @pytest.mark.parametrize(
@@ -274,15 +277,15 @@ def test_a_parameter_is_held_only_where_descent_would_leave_the_box() -> None:
     ],
 )
 def test_radius_follows_the_reduction_ratio(ratio: float, length: float, expected: float) -> None:
-    assert _updated_radius(1.0, ratio, length) == pytest.approx(expected)
+    assert updated_radius(1.0, ratio, length) == pytest.approx(expected)
 
 
 def test_scale_is_the_column_norm_and_never_decreases() -> None:
     jacobian = np.array([[3.0, 0.0, 0.1], [4.0, 0.0, 0.0]])
-    first = _updated_scale(np.zeros(3), jacobian)
+    first = updated_scale(np.zeros(3), jacobian)
     np.testing.assert_allclose(first, [5.0, 1.0, 0.1])
-    np.testing.assert_allclose(_updated_scale(first, 0.5 * jacobian), first)
-    np.testing.assert_allclose(_updated_scale(first, 2 * jacobian), [10.0, 1.0, 0.2])
+    np.testing.assert_allclose(updated_scale(first, 0.5 * jacobian), first)
+    np.testing.assert_allclose(updated_scale(first, 2 * jacobian), [10.0, 1.0, 0.2])
 
 
 def test_cost_never_rises_and_the_solver_converges_from_afar() -> None:

@@ -68,7 +68,7 @@ def _run(args: argparse.Namespace) -> int:
 
 def _fast_with_tolerance(method: str, tolerance: float) -> Any:
     from sensing_antenna.errors import SensingAntennaError
-    from sensing_antenna.estimation.methods.fast.method import FastConfig, FastMethod
+    from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
 
     if method != "fast":
         raise SensingAntennaError(f"--tolerance: only used by --method fast, not {method!r}")

@@ -10,7 +10,8 @@ pipeline):
   it); :class:`FrontEnd`, the front end as a streaming object; :class:`FrontTrace`, what it saw;
 - :func:`measure_omega1`, Estimator 1's frequency measurement alone;
 - :class:`ContactEstimate`, :class:`Status`, :class:`EstimatorConfig`;
-- what a method is: :class:`EstimationMethod`, :class:`EarlyStopping`, :class:`Sessioned`.
+- what a method is: :class:`EstimationMethod`, :class:`EarlyStopping`, :class:`Sessioned`;
+- :class:`FastMethod` and :class:`FastConfig`, the fast method and its settings.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ if TYPE_CHECKING:
         EstimationMethod,
         Sessioned,
     )
+    from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
     from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
     from sensing_antenna.estimation.online import OnlineEstimator
     from sensing_antenna.estimation.pipeline import conclude, estimate, gather, measure_omega1
@@ -42,6 +44,8 @@ __all__ = [
     "EstimationMethod",
     "EstimatorConfig",
     "Evidence",
+    "FastConfig",
+    "FastMethod",
     "FrequencyMeasurement",
     "FrontEnd",
     "FrontTrace",
@@ -72,6 +76,8 @@ _WHERE = {
     "EstimatorConfig": "config",
     "Evidence": "front.evidence",
     "FrequencyMeasurement": "methods.paper.frequency",
+    "FastMethod": "methods.fast",
+    "FastConfig": "methods.fast",
 }
 
 

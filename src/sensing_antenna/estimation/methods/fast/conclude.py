@@ -1,0 +1,119 @@
+"""From the scan's final window to the :class:`~.result.ContactEstimate`.
+
+The status and reason come from the checks' problems (:func:`.checks.problems`, in the order of
+:data:`~.result.STATUS_PRECEDENCE`); at the cap, when the posterior still holds two branches,
+the second contact mode may choose one (:func:`.second_mode.branch_at_cap`); the touched point
+in 3D follows from the maximum a posteriori x_c and the contact frame.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.methods.fast.checks import problems, ratio_check
+from sensing_antenna.estimation.methods.fast.config import FastConfig
+from sensing_antenna.estimation.methods.fast.curves import contact_candidates
+from sensing_antenna.estimation.methods.fast.search import ScanResult
+from sensing_antenna.estimation.methods.fast.second_mode import branch_at_cap
+from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
+from sensing_antenna.estimation.methods.touch_point import touched_point
+from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
+
+__all__ = ["conclude_fast"]
+
+
+def conclude_fast(
+    evidence: Evidence, result: ScanResult, bias: SensorBias, config: FastConfig, name: str
+) -> ContactEstimate:
+    """The :class:`ContactEstimate` of a scan: status, interval, branch probabilities, 3D point."""
+    final = result.final
+    t = evidence.t
+    t_c = float(t[evidence.contact_index])
+    t_1 = float(t[evidence.rest_index])
+    diag: dict[str, Any] = dict(evidence.diagnostics)
+    diag.update({"evaluations": result.evaluations, "bias_samples": bias.n_samples})
+    if bias.n_samples == 0:
+        diag["bias_note"] = "no initial rest: sensor bias not removed"
+    if final is None:
+        return ContactEstimate(
+            status=Status.RECORDING_TOO_SHORT,
+            reason="too few samples after t_1 for a first window",
+            method=name,
+            t_c=t_c,
+            t_1=t_1,
+            diagnostics=diag,
+        )
+    post = final.posterior
+    # The branch edges do not change with conditioning: the candidates serve before and after
+    candidates = contact_candidates(evidence.antenna.link, final.omega1, post)
+    if final.second_mode:
+        diag["second_mode"] = final.second_mode
+    if final.branch_chosen_by_second_mode:
+        diag["branch_chosen_by"] = "omega2"
+    if result.reached_cap and not final.sure:
+        # The final window's samples only (up to the cap), online and offline alike
+        post, second_mode = branch_at_cap(evidence, final, candidates)
+        diag.update(second_mode)
+        if post is not final.posterior and final.statics is not None:
+            # The ratio's agreement is judged again at the chosen branch's maximum
+            ratio_z, _ = ratio_check(final.statics, post.x_c, evidence.antenna.link, config)
+            final = dataclasses.replace(final, posterior=post, ratio_z=ratio_z)
+            result = dataclasses.replace(result, final=final)
+    statics = final.statics
+    push = statics.perpendicular_force if statics is not None else math.nan
+    touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link)
+    found = problems(
+        result,
+        config,
+        touch.deflection_ratio,
+        evidence.config.max_deflection_ratio,
+    )
+    if evidence.gap is not None:
+        found.append((Status.BAD_INPUT, evidence.gap))
+    order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
+    found.sort(key=lambda item: order.get(item[0], len(order)))
+    status, reason = found[0] if found else (Status.OK, None)
+    if reason is not None and "branch_chosen_by" in diag:
+        reason += (
+            f"; the second contact mode then chose the branch of x_c = {post.x_c:.3f} m, and "
+            "the interval is given on that branch"
+        )
+    branch_of = [post.branch_of(c) for c in candidates]
+    diag.update(
+        {
+            "interval_width": post.width,
+            "branch_edges": post.branch_edges,
+            "branch_probability_by_branch": post.branch_probability,
+            "omega1_se": final.omega1_se,
+            "omega1_crb": final.omega1_crb,
+            "omega1_drift": final.omega1_drift,
+            "ratio_z": final.ratio_z,
+            "ratio_se": statics.standard_error if statics is not None else math.nan,
+            "model_order": final.fit.n_modes if final.fit is not None else 0,
+            "fit_through_push": final.fit is not None and final.fit.restart is not None,
+            "modes": final.fit.omega if final.fit is not None else (),
+            "push_force": push,
+            "deflection_ratio": touch.deflection_ratio,
+            "note": final.note,
+            "other_reasons": [text for _, text in found[1:]],
+        }
+    )
+    return ContactEstimate(
+        status=status,
+        reason=reason,
+        method=name,
+        x_c=post.x_c,
+        candidates=candidates,
+        omega1=final.omega1,
+        ratio_estimate=statics.ratio if statics is not None else math.nan,
+        t_c=t_c,
+        t_1=t_1,
+        t_e=float(t[final.end_index]),
+        contact_point=touch.point_a,
+        diagnostics=diag,
+        interval=post.interval,
+        branch_probability=tuple(post.branch_probability[b] for b in branch_of),
+    )

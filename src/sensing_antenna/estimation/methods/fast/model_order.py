@@ -1,0 +1,172 @@
+"""Model order and polynomial degree of the damped-sinusoid fit, by the BIC.
+
+M = 1 .. ``max_modes`` damped modes at each polynomial degree; the fit with the smallest
+Bayesian information criterion (Schwarz 1978) sum_k n ln(RSS_k / n) + P ln(n K) is kept, P
+being the number of fitted parameters. Extra modes absorb the higher contact modes and servo
+transients that would otherwise bias the fundamental or make the residual non-white. The noise
+of each channel is estimated once per degree, from the residuals of the largest order that
+fits, so that the BIC compares the orders on the same weights.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.estimation.methods.fast.parametric import (
+    DampedSinusoidFit,
+    FitCandidate,
+    fit_candidate,
+)
+from sensing_antenna.estimation.methods.fast.pencil import pencil_poles
+
+__all__ = ["select_model", "select_model_order"]
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+
+
+def select_model_order(
+    signals: FloatArray,
+    sample_period: float,
+    max_modes: int = 3,
+    t_start: float = 0.0,
+    min_omega: float = 0.0,
+    degree: int = 1,
+    target_band: tuple[float, float] | None = None,
+    poles: ComplexArray | None = None,
+    regressors: FloatArray | None = None,
+    restart: int | None = None,
+) -> DampedSinusoidFit | None:
+    """The fit with the smallest BIC among M = 1 .. ``max_modes`` damped modes.
+
+    Returns None when no order could be fitted (record too short). The noise of each channel is
+    estimated once, from the residuals of the largest order that fits, and used for every order,
+    so that the BIC compares the orders on the same weights. ``min_omega``, ``degree``,
+    ``target_band``, ``regressors`` and ``restart`` as in :func:`fit_damped_sinusoids`.
+    ``poles``: :func:`first_poles` of the signals for ``max_modes`` when already at hand (they
+    do not depend on the degree).
+    """
+    return select_model(
+        signals,
+        sample_period,
+        max_modes,
+        (degree,),
+        t_start,
+        min_omega,
+        target_band,
+        poles,
+        regressors,
+        restart,
+    )
+
+
+def select_model(
+    signals: FloatArray,
+    sample_period: float,
+    max_modes: int,
+    degrees: Sequence[int],
+    t_start: float = 0.0,
+    min_omega: float = 0.0,
+    target_band: tuple[float, float] | None = None,
+    poles: ComplexArray | None = None,
+    regressors: FloatArray | None = None,
+    restart: int | None = None,
+) -> DampedSinusoidFit | None:
+    """The fit with the smallest BIC over the polynomial ``degrees`` and M = 1 .. ``max_modes``.
+
+    Each degree's orders as in :func:`select_model_order` (the BIC is computed on the unweighted
+    residuals, so it compares degrees too); only the chosen fit's covariance is computed. On a
+    tie the earlier degree, then the larger order, wins.
+
+    Parameters
+    ----------
+    signals : array, shape (n,) or (n, K)
+        Samples of K channels, time on axis 0.
+    sample_period : float
+        T_s (s).
+    max_modes : int
+        Largest number of damped modes M tried at each degree.
+    degrees : sequence of int
+        Polynomial degrees tried (>= 0).
+    t_start : float
+        Time of the first sample (s).
+    min_omega : float
+        Lowest frequency a mode may take (rad/s).
+    target_band : tuple of float, optional
+        Band of the fundamental (rad/s), as in :func:`fit_damped_sinusoids`.
+    poles : array of complex, optional
+        :func:`first_poles` of the signals for ``max_modes``, shared by every degree (they do
+        not depend on it); computed per degree when omitted.
+    regressors, restart
+        As in :func:`fit_damped_sinusoids`.
+
+    Returns
+    -------
+    DampedSinusoidFit or None
+        None when no degree and order could be fitted (record too short).
+    """
+    y = np.asarray(signals, dtype=float)
+    candidates = [
+        candidate
+        for degree in degrees
+        for candidate in _order_candidates(
+            y,
+            sample_period,
+            max_modes,
+            t_start,
+            min_omega,
+            degree,
+            target_band,
+            poles,
+            regressors,
+            restart,
+        )
+    ]
+    if not candidates:
+        return None
+    return min(candidates, key=lambda c: c.bic).summary()
+
+
+def _order_candidates(
+    y: FloatArray,
+    sample_period: float,
+    max_modes: int,
+    t_start: float,
+    min_omega: float,
+    degree: int,
+    target_band: tuple[float, float] | None,
+    poles: ComplexArray | None,
+    regressors: FloatArray | None,
+    restart: int | None,
+) -> list[FitCandidate]:
+    """The solved fits of M = ``max_modes`` .. 1 at one degree (those the record allows)."""
+    candidates = []
+    noise: FloatArray | None = None
+    # The largest order that fits starts from ``poles`` (or its own pencil) and sets the noise;
+    # the smaller ones start from the pencil of the signals weighted by that noise
+    initial_poles = poles
+    for m in range(max_modes, 0, -1):
+        candidate = fit_candidate(
+            y,
+            sample_period,
+            m,
+            t_start,
+            noise,
+            min_omega,
+            degree,
+            initial_poles,
+            target_band,
+            regressors,
+            restart,
+        )
+        if noise is None:
+            initial_poles = None  # the next order, if this one did not fit, starts from its own
+            if candidate is not None:
+                noise = candidate.noise
+                initial_poles = pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
+        if candidate is not None:
+            candidates.append(candidate)
+    return candidates

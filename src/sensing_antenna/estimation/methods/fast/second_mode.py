@@ -1,0 +1,108 @@
+"""The second contact mode chooses between the two branches of omega_1(x_c).
+
+Where omega_1 is reached at two contact points and the torque/force ratio cannot tell them
+apart, the paper's second-mode test (:func:`~.fusion.second_mode_choice`) on the spectrum of the
+window's own samples may choose one: at every window whose posterior holds both branches
+(``FastConfig.branch_by_second_mode``), and at the cap.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
+from sensing_antenna.estimation.methods.paper.frequency import evidence_frequency
+from sensing_antenna.estimation.methods.paper.fusion import predicted_omega2, second_mode_choice
+
+if TYPE_CHECKING:
+    from sensing_antenna.estimation.methods.fast.window import WindowEstimate
+
+__all__ = ["BranchChooser", "branch_at_cap", "on_chosen_branch", "second_mode_chooser"]
+
+#: Which of two candidate contact points (m) the window [start, end] (sample indices) with
+#: fundamental omega_1 (rad/s) supports: 0, 1 or None when it does not say, and the test's
+#: report (see :func:`second_mode_chooser`).
+BranchChooser = Callable[[int, int, float, tuple[float, ...]], "tuple[int | None, dict[str, Any]]"]
+
+
+def second_mode_chooser(evidence: Evidence) -> BranchChooser:
+    """The second contact mode's answer on a window of the evidence (a :data:`BranchChooser`).
+
+    The paper's test (:func:`~.fusion.second_mode_choice`: a clear spectral peak within
+    ``omega2_window`` of one candidate's omega_2, ten times stronger than near the other's) on
+    the spectrum of the window's own samples [start, end], online and offline alike. It is not
+    asked (no answer) when the window's Hann main lobe, +-4 pi / T_w, is as wide as the gap
+    between the candidates' omega_2 (the other candidate's search window would lie on the
+    lobe's slope and hold no peak whatever the truth). An answer whose peak lies nearer 2 or 3
+    omega_1 than the chosen candidate's omega_2 is dropped: a clipping contact's harmonic may be
+    what it saw (at 0.70 m on the paper link 3 omega_1 is 2.9 % from the other candidate's
+    omega_2).
+    """
+
+    def choose(
+        start: int, end: int, omega1: float, candidates: tuple[float, ...]
+    ) -> tuple[int | None, dict[str, Any]]:
+        omega2 = predicted_omega2(evidence, candidates)
+        lobe = 4.0 * math.pi / ((end - start) * evidence.sample_period)
+        if lobe >= abs(omega2[0] - omega2[1]):
+            return None, {"not_asked": f"main lobe +-{lobe:.0f} rad/s spans the candidates"}
+        window = dataclasses.replace(evidence, rest_index=start, end_index=end)
+        component = evidence_frequency(window).component
+        choice, notes = second_mode_choice(window, component, candidates)
+        if choice is None:
+            return choice, notes
+        # The peak the answer rests on, nearer a harmonic than the candidate's omega_2?
+        peak = notes["peak_omega"][choice]
+        for harmonic in (2.0 * omega1, 3.0 * omega1):
+            if abs(peak - harmonic) < abs(peak - omega2[choice]):
+                dropped = (
+                    f"the peak at {peak:.1f} rad/s is nearer {harmonic:.1f} rad/s, a "
+                    "harmonic of omega_1"
+                )
+                return None, {**notes, "dropped": dropped}
+        return choice, notes
+
+    return choose
+
+
+def on_chosen_branch(
+    posterior: ContactPosterior, candidates: tuple[float, ...], choice: int | None
+) -> ContactPosterior | None:
+    """``posterior`` conditioned on the branch of ``candidates[choice]``; None when there is no
+    choice or that branch holds no mass."""
+    if choice is None:
+        return None
+    branch = posterior.branch_of(candidates[choice])
+    if posterior.branch_probability[branch] <= 0.0:
+        return None
+    return posterior.given_branch(branch)
+
+
+def branch_at_cap(
+    evidence: Evidence,
+    window: WindowEstimate,
+    candidates: tuple[float, ...],
+) -> tuple[ContactPosterior, dict[str, Any]]:
+    """At the cap, let the second contact mode choose between two branches the ratio cannot.
+
+    Asked (:func:`second_mode_chooser`, on the final window) when the posterior still holds
+    both branches, or when the window's higher mode contradicted the branch it holds; with
+    ``branch_by_second_mode`` on, the first case has been asked at the window already. When
+    decisive the posterior is conditioned on that branch; otherwise it is unchanged.
+    """
+    posterior = window.posterior
+    split = max(posterior.branch_probability) < posterior.level
+    if len(candidates) != 2 or not (split or window.branch_contradicted):
+        return posterior, {}
+    if window.branch_chosen_by_second_mode or (split and window.second_mode):
+        return posterior, {}
+    choose = second_mode_chooser(evidence)
+    choice, notes = choose(window.start_index, window.end_index, window.omega1, candidates)
+    conditioned = on_chosen_branch(posterior, candidates, choice)
+    if conditioned is None:
+        return posterior, {"second_mode": notes}
+    return conditioned, {"second_mode": notes, "branch_chosen_by": "omega2"}

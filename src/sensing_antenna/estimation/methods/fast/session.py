@@ -1,0 +1,128 @@
+"""The fast method online: one manoeuvre's session, keeping its window fits between evaluations."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.methods.fast.conclude import conclude_fast
+from sensing_antenna.estimation.methods.fast.evaluation_grid import evaluation_offsets
+from sensing_antenna.estimation.methods.fast.search import ScanResult, scan_inputs
+from sensing_antenna.estimation.methods.fast.second_mode import second_mode_chooser
+from sensing_antenna.estimation.methods.fast.window import (
+    ScanInputs,
+    WindowEstimate,
+    evaluate_from_t1_or_hold,
+)
+from sensing_antenna.estimation.methods.fast.window_fit import FitCache, window_key
+from sensing_antenna.estimation.result import ContactEstimate
+
+if TYPE_CHECKING:
+    from sensing_antenna.estimation.methods.fast.method import FastMethod
+
+__all__ = ["FastSession"]
+
+
+class FastSession:
+    """The fast method over one manoeuvre online (:meth:`FastMethod.session`).
+
+    The samples of a window do not change once they have arrived, so the fits of every window
+    evaluated so far are kept (by the window's own samples: never served for other data) and
+    the next evaluation fits only its own window (its drift check's shorter windows are earlier
+    grid windows). :meth:`conclude` evaluates one window only: the last grid instant at or
+    before the end of the samples (the one :meth:`ready` has just found sure, or the cap, or
+    the last before the samples ended). Asked at every grid instant, it gives the answers of
+    the method without a session; asked at fewer (``OnlineEstimator.update_block``), the
+    windows it skipped are never fitted.
+    """
+
+    def __init__(self, method: FastMethod) -> None:
+        self.method = method
+        self._caches: tuple[FitCache, FitCache] = ({}, {})
+        # Digest of each window asked, by its last index (for the evaluation count)
+        self._asked: dict[int, bytes] = {}
+
+    @property
+    def name(self) -> str:
+        """The method's name."""
+        return self.method.name
+
+    def session(self) -> FastSession:
+        """A fresh session of the same method (an online estimator takes one per manoeuvre)."""
+        return self.method.session()
+
+    def due(self, samples_since_t1: int, sample_period: float) -> bool:
+        """As :meth:`FastMethod.due`."""
+        return self.method.due(samples_since_t1, sample_period)
+
+    def _evaluate(
+        self, inputs: ScanInputs, evidence: Evidence, end: int, final: bool
+    ) -> WindowEstimate:
+        """:func:`.window.evaluate_from_t1_or_hold` on the window ending at ``end``, remembered; the
+        slip check's early statics only for the ``final`` window (the one concluded on)."""
+        window = evaluate_from_t1_or_hold(
+            inputs._replace(end_index=end),
+            evidence.hold_end,
+            self._caches,
+            second_mode_chooser(evidence),
+            with_early_statics=final,
+        )
+        self._asked[end] = window_key(
+            inputs.channels,
+            inputs.rest_index,
+            end,
+            inputs.sample_period,
+            inputs.band,
+            inputs.config,
+            inputs.push,
+        )[2]
+        return window
+
+    def ready(self, evidence: Evidence) -> bool:
+        """As :meth:`FastMethod.ready`, with this manoeuvre's fits."""
+        offsets = evaluation_offsets(evidence.sample_period, self.method.config)
+        if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
+            return True
+        inputs = scan_inputs(evidence, self.method.config)
+        return self._evaluate(inputs, evidence, evidence.end_index, final=False).sure
+
+    def _asked_here(self, inputs: ScanInputs) -> set[int]:
+        """Last indices of the windows asked on these very samples."""
+        return {
+            end
+            for end, digest in self._asked.items()
+            if end <= inputs.end_index
+            and digest
+            == window_key(
+                inputs.channels,
+                inputs.rest_index,
+                end,
+                inputs.sample_period,
+                inputs.band,
+                inputs.config,
+                inputs.push,
+            )[2]
+        }
+
+    def conclude(self, evidence: Evidence) -> ContactEstimate:
+        """The estimate at the last grid instant at or before ``evidence.end_index``.
+
+        When :meth:`ready` was asked on these samples, one window is evaluated: that instant's
+        (the one just found sure, or the cap, or the last before the samples ended), with
+        status, evaluation count (windows asked) and cap as :meth:`FastMethod.conclude` gives
+        them when every earlier instant was unsure, so the same estimate when asked at every
+        instant. When it was not (offline, or other samples), as :meth:`FastMethod.conclude`.
+        """
+        method = self.method
+        inputs = scan_inputs(evidence, method.config)
+        asked = self._asked_here(inputs)
+        offsets = evaluation_offsets(evidence.sample_period, method.config)
+        instants = inputs.rest_index + offsets
+        instants = instants[(instants >= evidence.hold_end) & (instants <= evidence.end_index)]
+        if not asked or instants.size == 0:
+            return method.conclude(evidence, self._caches)
+        window = self._evaluate(inputs, evidence, int(instants[-1]), final=True)
+        count = len(asked | {window.end_index})
+        reached_cap = inputs.rest_index + int(offsets[-1]) <= evidence.end_index
+        result = ScanResult(window, count, reached_cap and not window.sure)
+        return conclude_fast(evidence, result, inputs.bias, method.config, method.name)

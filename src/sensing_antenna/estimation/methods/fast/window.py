@@ -1,0 +1,399 @@
+"""One evaluation of the growing window: its fundamental and statics, the posterior over x_c,
+the checks, and whether it is sure.
+
+:func:`evaluate_window` measures the window's fundamental (:mod:`.window_fit`; through the
+push when that fit stands, :func:`.checks.push_agrees`) and its static torque/force ratio
+(:mod:`.static_fit`), forms the posterior over x_c (:mod:`.likelihood`), lets the second
+contact mode choose between two branches (:mod:`.second_mode`) and runs the checks
+(:mod:`.checks`). :func:`evaluate_from_t1_or_hold` restarts the window at the end of the
+pipeline's hold when the contact opened; :func:`with_early_statics_of` adds the slip check's
+reference, the statics of the window's first half.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import Link
+from sensing_antenna.estimation.methods.fast.checks import (
+    branch_contradiction,
+    is_slip_reference,
+    opening_check,
+    peak_check,
+    push_agrees,
+    ratio_check,
+)
+from sensing_antenna.estimation.methods.fast.config import FastConfig, model_floor
+from sensing_antenna.estimation.methods.fast.curves import contact_candidates, curve_table
+from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
+from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior, contact_posterior
+from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
+from sensing_antenna.estimation.methods.fast.second_mode import BranchChooser, on_chosen_branch
+from sensing_antenna.estimation.methods.fast.static_fit import (
+    SensorBias,
+    StaticRatio,
+    static_ratio,
+)
+from sensing_antenna.estimation.methods.fast.window_fit import (
+    FitCache,
+    PushPhase,
+    WindowSpan,
+    fit_window,
+    measure_fundamental,
+)
+
+__all__ = [
+    "ScanInputs",
+    "WindowEstimate",
+    "evaluate_from_t1_or_hold",
+    "evaluate_window",
+    "with_early_statics_of",
+]
+
+FloatArray = NDArray[np.float64]
+
+
+class ScanInputs(NamedTuple):
+    """The samples and model a window reads: :func:`evaluate_window`'s leading arguments, in order.
+
+    ``end_index`` is the last sample available; :func:`.search.evaluations` replaces it by each
+    window's end.
+    """
+
+    channels: FloatArray
+    bias: SensorBias
+    rest_index: int
+    end_index: int
+    sample_period: float
+    band: tuple[float, float]
+    link: Link
+    x_range: tuple[float, float]
+    config: FastConfig
+    push: PushPhase | None = None
+
+
+@dataclass(frozen=True)
+class WindowEstimate:
+    """One evaluation of the growing window [t_s, t_j] (t_s: t_1, or the end of the hold).
+
+    Attributes
+    ----------
+    start_index : int
+        First sample of the window: t_1, or the end of the hold after an opening. A fit
+        through the push (``FastConfig.push_phase``) reaches back to t_c; its ``restart`` is
+        then t_1's place in it.
+    end_index : int
+        j, the last sample used.
+    fit : DampedSinusoidFit or None
+        The chosen fit of the contact-load channels (None: too few samples or no pole).
+    omega1, omega1_se : float
+        Fundamental and its standard error (rad/s): the fit's statistical error and
+        ``drift_factor`` times the drift, in quadrature (the relative model floor is added by
+        the posterior); NaN when not usable.
+    omega1_crb : float
+        Cramer-Rao bound of omega_1 for this record length and noise (rad/s): the square root
+        of the inverse Fisher information of the fitted model at the fitted parameters and the
+        residual noise (the statistical part of ``omega1_se``); NaN when not usable.
+    statics : StaticRatio or None
+        The static torque/force ratio.
+    posterior : ContactPosterior
+    sure : bool
+        ``checks_passed`` and the interval no wider than the tolerance.
+    checks_passed : bool
+        True when every check but the interval's width passes (usable frequency, periods in
+        the window, drift, ratio agreement, contact closed, away from the top of the curve):
+        ``sure`` at any tolerance at least the interval's width.
+    note : str
+        Why the frequency was not used or why it is not sure (empty when sure).
+    omega1_drift : float
+        Change of omega_1 from the window's first 2/3 beyond what the noise explains (rad/s).
+    early_statics : StaticRatio or None
+        Statics of the window's first half (the slip reference); None when that half holds
+        fewer than ``min_periods`` periods, has no mode near the whole window's fundamental, or
+        when not added (:func:`evaluate_window` leaves them to :func:`with_early_statics_of`).
+    ratio_z : float
+        Distance of the ratio from the MAP x_c in its standard deviations.
+    opening : float
+        Predicted vibration amplitude of the contact force over the static push at the window
+        start (> 1: the contact opens); NaN when not computed.
+    branch_contradicted : bool
+        True when a higher mode of the fit points to another branch than the posterior's.
+    branch_chosen_by_second_mode : bool
+        True when the posterior held two branches and the second contact mode chose one
+        (``FastConfig.branch_by_second_mode``); ``posterior`` is then conditioned on it.
+    second_mode : dict
+        What the second contact mode's test reported when it was asked (empty otherwise).
+    """
+
+    start_index: int
+    end_index: int
+    fit: DampedSinusoidFit | None
+    omega1: float
+    omega1_se: float
+    omega1_crb: float
+    statics: StaticRatio | None
+    posterior: ContactPosterior
+    sure: bool
+    checks_passed: bool
+    note: str
+    omega1_drift: float = math.nan
+    early_statics: StaticRatio | None = None
+    ratio_z: float = math.nan
+    opening: float = math.nan
+    branch_contradicted: bool = False
+    branch_chosen_by_second_mode: bool = False
+    second_mode: dict[str, Any] = field(default_factory=dict)
+
+
+def evaluate_window(
+    channels: FloatArray,
+    bias: SensorBias,
+    rest_index: int,
+    end_index: int,
+    sample_period: float,
+    band: tuple[float, float],
+    link: Link,
+    x_range: tuple[float, float],
+    config: FastConfig,
+    push: PushPhase | None = None,
+    cache: FitCache | None = None,
+    choose_branch: BranchChooser | None = None,
+) -> WindowEstimate:
+    """Fit the window [rest_index, end_index] and form the posterior over x_c.
+
+    The slip check's early statics (the fit of the window's first half) enter neither the
+    posterior nor ``sure``: they are left out (None), and :func:`with_early_statics_of` adds
+    them to the window that is concluded on.
+
+    Parameters
+    ----------
+    channels : array, shape (n, 5)
+        :func:`~.static_fit.contact_channels` of the samples (at least up to ``end_index``).
+    bias : SensorBias
+    rest_index, end_index : int
+        Indices of t_1 and of the last sample used.
+    sample_period : float
+        T_s (s).
+    band : tuple of float
+        omega_1 band (rad/s).
+    link : Link
+    x_range : tuple of float
+        Prior range of x_c (m).
+    config : FastConfig
+    push : PushPhase, optional
+        With it, every window fitted here reaches back to the push's start
+        (``FastConfig.push_phase``); None: windows start at ``rest_index``.
+    cache : dict, optional
+        Window fits keyed by the windows' own samples (:data:`FitCache`); the drift check's
+        shorter windows are taken from it (and added to it). The scan and an online session
+        pass one; None refits.
+    choose_branch : BranchChooser, optional
+        When the posterior holds two branches of omega_1(x_c), asked which candidate the
+        window supports (:func:`.second_mode.second_mode_chooser`); the posterior is
+        conditioned on its answer before the checks. None: not asked.
+
+    Returns
+    -------
+    WindowEstimate
+    """
+    span = WindowSpan(channels, rest_index, end_index, sample_period, band, config, cache)
+    from_t1 = measure_fundamental(span, None)
+    frequency = from_t1
+    if push is not None:
+        through = measure_fundamental(span, push)
+        if push_agrees(through, from_t1, config):
+            frequency = through
+    fit, k = frequency.fit, frequency.mode
+    omega1, omega1_se, omega1_crb = frequency.omega1, frequency.omega1_se, frequency.omega1_crb
+    drift = frequency.drift
+    notes = list(frequency.notes)
+    # The statics from the window from t_1 always: a fit through the push has its static part
+    # at the centre of [t_c, t], inside the push for short windows, while the opening check
+    # compares it with the vibration at t_1
+    statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
+    table = curve_table(link, x_range[0], x_range[1], config.grid_step)
+    frequency_floor = model_floor(link, config)
+    omega_h = omega_h_se = math.nan
+    if config.higher_modes and fit is not None and math.isfinite(omega1):
+        omega_h, omega_h_se = _higher_mode(fit, omega1, table.higher, config)
+    ratio = statics.ratio if statics is not None else math.nan
+    ratio_se = statics.standard_error if statics is not None else math.nan
+    push_force = statics.perpendicular_force if statics is not None else 0.0
+    posterior = contact_posterior(
+        table.omega1,
+        table.grid,
+        table.edges,
+        omega1,
+        omega1_se,
+        ratio,
+        ratio_se,
+        push_force,
+        link.flexural_rigidity,
+        frequency_floor,
+        config.ratio_geometry_factor,
+        higher_modes_of_x=table.higher,
+        omega_higher=omega_h,
+        omega_higher_se=omega_h_se,
+        higher_mode_floor=config.higher_mode_floor,
+    )
+    chosen = False
+    second_mode: dict[str, Any] = {}
+    if (
+        choose_branch is not None
+        and config.branch_by_second_mode
+        and max(posterior.branch_probability) < posterior.level
+    ):
+        candidates = contact_candidates(link, omega1, posterior)
+        if len(candidates) == 2:
+            choice, second_mode = choose_branch(rest_index, end_index, omega1, candidates)
+            conditioned = on_chosen_branch(posterior, candidates, choice)
+            chosen = conditioned is not None
+            posterior = conditioned or posterior
+    ratio_z = math.nan
+    if statics is not None and math.isfinite(omega1):
+        ratio_z, disagreement = ratio_check(statics, posterior.x_c, link, config)
+        if disagreement:
+            notes.append(disagreement)
+    opening = math.nan
+    if fit is not None and k is not None and push_force > 0.0:
+        opening, note = opening_check(fit, k, push_force, link, posterior.x_c, config)
+        if note:
+            notes.append(note)
+    contradiction = ""
+    if fit is not None and k is not None:
+        contradiction = branch_contradiction(fit, k, posterior, table, link, config)
+        if contradiction:
+            notes.append(contradiction)
+    if not notes and math.isfinite(omega1) and not math.isfinite(omega_h):
+        # No declaration near the top of omega_1(x_c), unless a higher contact mode (whose
+        # curves do not peak there) enters the posterior
+        note = peak_check(omega1, omega1_se, frequency_floor, float(table.omega1.max()), config)
+        if note:
+            notes.append(note)
+    checks_passed = not notes
+    if not notes and posterior.width > config.tolerance:
+        notes.append(
+            f"the 95 % interval is {1000 * posterior.width:.1f} mm wide "
+            f"(tolerance {1000 * config.tolerance:g} mm)"
+        )
+    return WindowEstimate(
+        start_index=rest_index,
+        end_index=end_index,
+        fit=fit,
+        omega1=omega1,
+        omega1_se=omega1_se,
+        omega1_crb=omega1_crb,
+        statics=statics,
+        posterior=posterior,
+        sure=not notes,
+        checks_passed=checks_passed,
+        note="; ".join(notes),
+        omega1_drift=drift,
+        early_statics=None,
+        ratio_z=ratio_z,
+        opening=opening,
+        branch_contradicted=bool(contradiction),
+        branch_chosen_by_second_mode=chosen,
+        second_mode=second_mode,
+    )
+
+
+def _higher_mode(
+    fit: DampedSinusoidFit, omega1: float, higher: FloatArray, config: FastConfig
+) -> tuple[float, float]:
+    """The strongest detected mode above omega_1 within the range of contact modes 2 and 3.
+
+    Returns its frequency and the fit's standard error of it (rad/s); NaN when there is none
+    (or the fit did not converge).
+    """
+    low, high = float(higher.min()), float(higher.max())
+    detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)
+    usable = [
+        k
+        for k in range(fit.n_modes)
+        if fit.omega[k] > 1.5 * omega1
+        and low * (1.0 - 5.0 * config.higher_mode_floor)
+        <= fit.omega[k]
+        <= high * (1.0 + 5.0 * config.higher_mode_floor)
+        and detection[k] >= config.min_detection
+        and math.isfinite(fit.omega_se[k])
+    ]
+    if not usable or not fit.converged:
+        return math.nan, math.nan
+    k = max(usable, key=lambda i: float(detection[i]))
+    return float(fit.omega[k]), float(fit.omega_se[k])
+
+
+def _early_statics(span: WindowSpan, omega1: float, bias: SensorBias) -> StaticRatio | None:
+    """Statics of the window's first half from t_1, the slip check's reference; None when that
+    half is not on the grid or is no reference (:func:`.checks.is_slip_reference`: too few
+    periods of ``omega1`` (rad/s), or another mode in the fundamental's place)."""
+    config = span.config
+    half = reference_index(span.rest_index, span.end_index, 0.5, span.sample_period, config)
+    half_fit = None if half is None else fit_window(*span._replace(end_index=half))
+    if half_fit is None or not is_slip_reference(half_fit, omega1, span.band, config):
+        return None
+    return static_ratio(half_fit, bias)
+
+
+def evaluate_from_t1_or_hold(
+    inputs: ScanInputs,
+    hold_end: int,
+    caches: tuple[FitCache, FitCache] | None = None,
+    choose_branch: BranchChooser | None = None,
+    with_early_statics: bool = True,
+) -> WindowEstimate:
+    """:func:`evaluate_window` on [t_1, ``inputs.end_index``]; from the end of the hold when the
+    contact opened.
+
+    When the window from t_1 shows the contact opening (``max_opening``), the link was bouncing
+    on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
+    once it is at least ``first_window`` long (before that the one from t_1 is returned, not
+    sure). ``caches`` holds the fits of the two kinds of window; None refits.
+    ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
+    gets the slip check's early statics (:func:`with_early_statics_of`).
+    """
+    early, late = caches if caches is not None else (None, None)
+    window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
+    first = round(inputs.config.first_window / inputs.sample_period)
+    if (
+        window.opening > inputs.config.max_opening
+        and inputs.rest_index < hold_end <= inputs.end_index - first
+    ):
+        window = evaluate_window(
+            *inputs._replace(rest_index=hold_end, push=None),
+            cache=late,
+            choose_branch=choose_branch,
+        )
+    return with_early_statics_of(inputs, window, caches) if with_early_statics else window
+
+
+def with_early_statics_of(
+    inputs: ScanInputs,
+    estimate: WindowEstimate,
+    caches: tuple[FitCache, FitCache] | None = None,
+) -> WindowEstimate:
+    """``estimate`` (a window of :func:`evaluate_from_t1_or_hold` on ``inputs``' samples) with
+    the slip check's early statics: those of its first half, with the fundamental of its fit
+    from its own start (never through the push). Its fits come from ``caches`` (the windows
+    from t_1 or, when it was restarted, those from the hold's end); None refits them."""
+    restarted = estimate.start_index != inputs.rest_index
+    cache = None if caches is None else caches[1 if restarted else 0]
+    span = WindowSpan(
+        inputs.channels,
+        estimate.start_index,
+        estimate.end_index,
+        inputs.sample_period,
+        inputs.band,
+        inputs.config,
+        cache,
+    )
+    from_t1 = measure_fundamental(span, None)
+    early = None if from_t1.mode is None else _early_statics(span, from_t1.omega1, inputs.bias)
+    return dataclasses.replace(estimate, early_statics=early)

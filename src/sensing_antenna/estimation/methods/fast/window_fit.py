@@ -1,0 +1,248 @@
+"""One window's fit: the contact-load channels fitted, and the fundamental measured in it.
+
+A window [t_s, t_j] of the five contact-load channels (:mod:`.static_fit`) is fitted with
+damped sinusoids with shared poles plus a polynomial per channel (:func:`.parametric.select_model`,
+order and degree by BIC). With the push phase (``FastConfig.push_phase``) the window reaches back
+to t_c, with the head's angle along the push as a regressor and every mode restarted at t_1.
+Fits are cached by the window's own samples (:data:`FitCache`), so a cache never serves a fit
+of other data. :func:`measure_fundamental` finds the fundamental in the fit and widens its
+standard error by the drift check (:func:`.checks.drift_check`) against the grid window of 2/3
+the length.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.estimation.methods.fast.checks import drift_check, periods_check
+from sensing_antenna.estimation.methods.fast.config import FastConfig
+from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
+from sensing_antenna.estimation.methods.fast.model_order import select_model
+from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
+from sensing_antenna.estimation.methods.fast.pencil import first_poles
+
+__all__ = [
+    "FitCache",
+    "Fundamental",
+    "PushPhase",
+    "WindowSpan",
+    "find_fundamental",
+    "fit_window",
+    "measure_fundamental",
+    "push_phase",
+    "window_key",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: Cache of window fits, keyed by :func:`window_key` (the window's samples themselves and the fit
+#: settings, so a cache can never serve a fit of other data or other settings).
+FitCache = dict[tuple[int, int, bytes], "DampedSinusoidFit | None"]
+
+
+class PushPhase(NamedTuple):
+    """The push before t_1, for windows that reach back to it (``FastConfig.push_phase``).
+
+    Attributes
+    ----------
+    start : int
+        First sample of such windows (t_c).
+    angle : array, shape (n,)
+        The head's angle along the push, relative to its pose at t_1 (rad): the static loads
+        follow it.
+    """
+
+    start: int
+    angle: FloatArray
+
+
+def push_phase(theta: FloatArray, contact_index: int, rest_index: int) -> PushPhase | None:
+    """The push from t_c to t_1 as :class:`PushPhase`; None when the head did not move.
+
+    Parameters
+    ----------
+    theta : array, shape (n, 2)
+        Motor angles (rad).
+    contact_index, rest_index : int
+        Indices of t_c and t_1.
+    """
+    theta = np.asarray(theta, dtype=float)
+    direction = theta[rest_index] - theta[contact_index]
+    norm = float(np.linalg.norm(direction))
+    if rest_index <= contact_index or norm == 0.0:
+        return None
+    return PushPhase(contact_index, (theta - theta[rest_index]) @ (direction / norm))
+
+
+def window_key(
+    channels: FloatArray,
+    rest_index: int,
+    end_index: int,
+    sample_period: float,
+    band: tuple[float, float],
+    config: FastConfig,
+    push: PushPhase | None = None,
+) -> tuple[int, int, bytes]:
+    """Cache key of the window [rest_index, end_index]: its indices and a digest of its samples,
+    of T_s, of the band and of the settings of the fit (with ``push``, of the samples from its
+    start and its angle)."""
+    start = rest_index if push is None else push.start
+    digest = hashlib.blake2b(channels[start : end_index + 1].tobytes(), digest_size=16)
+    digest.update(np.array([sample_period, *band]).tobytes())
+    settings = (
+        config.max_modes,
+        config.polynomial_degree,
+        config.min_mode_fraction,
+        config.push_max_modes,
+        config.push_polynomial_degree,
+    )
+    digest.update(np.array(settings, dtype=float).tobytes())
+    if push is not None:
+        digest.update(np.array([start, rest_index]).tobytes())
+        digest.update(push.angle[start : end_index + 1].tobytes())
+    return rest_index, end_index, digest.digest()
+
+
+def fit_window(
+    channels: FloatArray,
+    rest_index: int,
+    end_index: int,
+    sample_period: float,
+    band: tuple[float, float],
+    config: FastConfig,
+    cache: FitCache | None,
+    push: PushPhase | None = None,
+) -> DampedSinusoidFit | None:
+    """The fit of [rest_index, end_index], or of [push.start, end_index] with the push's angle
+    as a regressor and the modes restarted at rest_index; from ``cache`` when it holds it."""
+    if push is not None and push.start >= rest_index:
+        push = None
+    key = window_key(channels, rest_index, end_index, sample_period, band, config, push)
+    if cache is not None and key in cache:
+        return cache[key]
+    # The fit with the smallest BIC over the polynomial degrees and model orders
+    start = rest_index if push is None else push.start
+    max_modes = config.max_modes if push is None else config.push_max_modes
+    highest = config.polynomial_degree if push is None else config.push_polynomial_degree
+    signals = channels[start : end_index + 1]
+    lowest = min(2, highest)
+    # The matrix pencil every degree starts from, computed once: where the lowest degree's
+    # largest model order fits the record (otherwise each fit computes its own)
+    fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * max_modes)
+    poles = first_poles(signals, max_modes) if fits_at_all else None
+    fit = select_model(
+        signals,
+        sample_period,
+        max_modes,
+        range(lowest, highest + 1),
+        start * sample_period,
+        min_omega=config.min_mode_fraction * band[0],
+        target_band=band,
+        poles=poles,
+        regressors=None if push is None else push.angle[start : end_index + 1],
+        restart=None if push is None else rest_index - start,
+    )
+    if cache is not None:
+        cache[key] = fit
+    return fit
+
+
+def find_fundamental(
+    fit: DampedSinusoidFit | None, band: tuple[float, float], config: FastConfig
+) -> tuple[int | None, str]:
+    """Index of the fundamental in ``fit`` and, when it cannot be used, why."""
+    if fit is None:
+        return None, "window too short for the model"
+    k = fit.strongest_in_band(band)
+    if k is None:
+        return None, "no vibration mode in the omega_1 band"
+    detection = fit.snr()[k] * math.sqrt(0.5 * fit.n_samples)
+    if detection < config.min_detection:
+        return None, f"the fundamental's detection statistic is only {detection:.1f}"
+    if not (fit.converged and math.isfinite(fit.omega_se[k])):
+        return None, "the fit did not converge"
+    return k, ""
+
+
+class Fundamental(NamedTuple):
+    """The fundamental of one window and the checks on it (see :func:`measure_fundamental`).
+
+    Attributes
+    ----------
+    fit : DampedSinusoidFit or None
+        The window's fit.
+    mode : int or None
+        Index of the fundamental in ``fit``; None when there is none to use.
+    omega1, omega1_se, omega1_crb : float
+        Fundamental, its standard error with the drift term, and the fit's own standard error
+        (the Cramer-Rao value of the fitted model) (rad/s); NaN without a fundamental.
+    drift : float
+        Change of omega_1 from the window of 2/3 the length beyond what the noise explains
+        (rad/s); NaN without a drift reference.
+    notes : tuple of str
+        Why the fundamental cannot be declared on (empty when every check passed).
+    failed : frozenset of str
+        The checks that failed: "fundamental", "periods", "drift_reference".
+    """
+
+    fit: DampedSinusoidFit | None
+    mode: int | None
+    omega1: float
+    omega1_se: float
+    omega1_crb: float
+    drift: float
+    notes: tuple[str, ...]
+    failed: frozenset[str] = frozenset()
+
+
+class WindowSpan(NamedTuple):
+    """The window [rest_index, end_index] and what its fits need: :func:`fit_window`'s leading
+    arguments, in order."""
+
+    channels: FloatArray
+    rest_index: int
+    end_index: int
+    sample_period: float
+    band: tuple[float, float]
+    config: FastConfig
+    cache: FitCache | None
+
+
+def measure_fundamental(span: WindowSpan, push: PushPhase | None) -> Fundamental:
+    """Fit the window (through the push when given) and measure its fundamental: its standard
+    error with the drift check's term, and the period checks."""
+    config, band = span.config, span.band
+    fit = fit_window(*span, push)
+    omega1 = omega1_se = omega1_crb = drift = math.nan
+    k, note = find_fundamental(fit, band, config)
+    notes = [note] if note else []
+    failed = {"fundamental"} if note else set()
+    if fit is not None and k is not None:
+        omega1 = float(fit.omega[k])
+        omega1_crb = float(fit.omega_se[k])
+        omega1_se = omega1_crb
+        note = periods_check(fit, omega1, config)
+        if note:
+            notes.append(note)
+            failed.add("periods")
+        # The same fundamental on a window of 2/3 the length: its change measures how far
+        # unmodelled content still moves the estimate (drift_factor times it, in quadrature)
+        ref = reference_index(
+            span.rest_index, span.end_index, 2.0 / 3.0, span.sample_period, config
+        )
+        ref_fit = None if ref is None else fit_window(*span._replace(end_index=ref), push)
+        k_ref, _ = find_fundamental(ref_fit, band, config)
+        drift, note = drift_check(ref_fit, k_ref, omega1, omega1_crb, config)
+        if note:
+            notes.append(note)
+            failed.add("drift_reference")
+        else:
+            omega1_se = math.hypot(omega1_se, config.drift_factor * drift)
+    return Fundamental(
+        fit, k, omega1, omega1_se, omega1_crb, drift, tuple(notes), frozenset(failed)
+    )
