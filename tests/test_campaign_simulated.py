@@ -90,7 +90,8 @@ def test_a_run_the_front_end_stops_early_and_a_method_that_raises_are_recorded()
         ("fast", "no_contact"),
     ]
     assert paper.reason == fast.reason != ""
-    assert (bogus.status, bogus.reason) == ("error", "KeyError: 'bogus'")
+    assert bogus.status == "error"
+    assert bogus.reason.startswith("UnknownMethodError: method: unknown 'bogus'")
     assert math.isnan(bogus.x_c_estimate_m) and bogus.run_status == RUN_OK
 
 
