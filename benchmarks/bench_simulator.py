@@ -1,5 +1,5 @@
-"""Speed and memory of ``simulate``: a 3 s manoeuvre in under 0.3 s on one core (issue 3), with
-peak memory proportional to the recording.
+"""Speed and memory of ``simulate``: the target is a 3 s manoeuvre in under 0.3 s on one core,
+with peak memory proportional to the recording.
 
 Prints a table and writes ``benchmarks/results/simulator.json``. Run: ``python
 benchmarks/bench_simulator.py``. The first call compiles (or loads from cache) the numba loop and

@@ -1,4 +1,4 @@
-"""Robustness of the pipeline to real contact dynamics and model error (issue 4 follow-up).
+"""Robustness of the pipeline to real contact dynamics and model error.
 
 - the push is judged by the mean contact force over the hold after t_1, not at one instant
   (near the tip the link rebounds on the obstacle after the stop);
@@ -24,7 +24,7 @@ from test_estimation_pipeline import Synthetic, comparable, synthetic_recording
 
 
 def test_push_judged_over_the_hold_despite_rebounds() -> None:
-    # The case of the issue: seed 5, x_c = 0.9 m, observer identified on a free sweep. Near
+    # The case that showed it: seed 5, x_c = 0.9 m, observer identified on a free sweep. Near
     # the tip the link bounces on the post after the stop: the filtered force at t_1 was 1.9 mN
     # and the push "not reached", while the static preload is about 10 mN (simulator truth).
     from sensing_antenna.calibration.observer import identify_free_motion
@@ -39,7 +39,7 @@ def test_push_judged_over_the_hold_despite_rebounds() -> None:
     result = estimate(recording, antenna)
     assert result.status is Status.OK, result.reason
     true_xc = float(recording.metadata["true_xc"])
-    # The paper method's 1 cm mean error of issue 4; here one run, far below it.
+    # The paper reports mean errors under 1 cm (Tables 3 and 4); here one run, far below it.
     assert result.x_c == pytest.approx(true_xc, abs=0.01)
     # The link does leave the post after the stop here (the simulator's contact flag is off for
     # 42 of the first 200 samples after it): the diagnostics must report rebounds, not hide them.

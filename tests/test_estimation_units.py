@@ -2,7 +2,7 @@
 
 Reference values come from closed forms written next to each test: sinusoid frequencies set by
 construction, the statics of a cantilever loaded at x_c (Gamma = r_c x R), the recording format's
-frame definitions and sign check (shared/spec/recording-format.md), and Section 5.4 note (a) of the
+frame definitions and sign check (docs/recording-format.md), and Section 5.4 note (a) of the
 paper (azimuthal push: Y^c = -Y^m).
 """
 

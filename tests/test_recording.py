@@ -1,4 +1,4 @@
-"""Tests of the recording format (spec: /work/shared/spec/recording-format.md)."""
+"""Tests of the recording format (spec: docs/recording-format.md)."""
 
 from __future__ import annotations
 

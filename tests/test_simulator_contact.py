@@ -88,12 +88,12 @@ def test_contact_frequency_with_the_default_stop_rule(
 def test_default_push_keeps_the_deflection_small(
     identified: Antenna, case: str, x_c: float
 ) -> None:
-    """Issue 3 item 5: with an identified observer the default push ends at y_c / x_c of a few
-    percent over the whole link (push.py docstring: 2.9 % at 0.3 m to 4.0 % at the tip)."""
+    """With an identified observer the default push ends at y_c / x_c of a few percent over the
+    whole link (detection/push.py: about 3 %, simulated 2.9 % to 3.1 %)."""
     scenario = Scenario(case=case, contact_point=x_c, seed=1, duration=2.0)
     detail = simulate_detailed(identified, scenario)
     ratio = float(detail.recording.metadata["true_deflection_ratio"])
-    # [1 %, 5 %]: the issue's band around the 3 % target; Assumption 1 allows 10 %.
+    # [1 %, 5 %]: a band around the 3 % the default push aims at; Assumption 1 allows 10 %.
     assert 0.01 <= ratio <= 0.05, (case, x_c, ratio)
     assert deflection_warning(detail.recording) is None
     # Independent check: the link is held at x_c, so y_c / x_c equals the head's final rotation
@@ -196,15 +196,14 @@ def test_static_torque_force_ratio(case: str, x_c: float) -> None:
     weight_moment = np.array([g_z * v_integral, g_x * w_integral, -g_x * v_integral])
     mean_force = contact_force.mean(axis=0)
     expected = np.linalg.norm(moment + weight_moment) / np.linalg.norm(mean_force)
-    # 0.1 %, inside the issue's 0.5 %: the residual vibration and the dynamic part of the force
-    # (measured <= 0.05 %).
+    # 0.1 %: the residual vibration and the dynamic part of the force (measured <= 0.05 %).
     assert ratio == pytest.approx(expected, rel=1e-3)
     # The moment arm of the contact force alone, |p_c x F_c| / |F_c|: the contact point sits off
     # the straight axis (sag, deflection) and the normal is tilted by the sag slope.
     arm = np.linalg.norm(moment) / np.linalg.norm(mean_force)
 
     # Deviation from x_c, a physical effect the estimators live with (docs/simulator.md,
-    # "Neglected effects"): azimuthal < 0.5 % (the issue's tolerance; measured < 0.1 %);
+    # "Neglected effects"): azimuthal < 0.5 % (measured < 0.1 %);
     # vertical < 1 % (measured 0.5 % at 0.55 m and 0.9 % at 0.98 m, of which the moment arm
     # gives 0.2 % / 0.3 % and the weight of the deflected, raised link the rest).
     true_xc = float(rec.metadata["true_xc"])

@@ -5,8 +5,11 @@ Subpackages and modules, one concept each:
 - :mod:`sensing_antenna.antenna`: antenna parameters as data (TOML, built-in ``paper-2021``).
 - :mod:`sensing_antenna.beam`: contact-mode beam physics (frequencies, modes, statics, inverse).
 - :mod:`sensing_antenna.recording`: the recording format (read, write, validate).
+- :mod:`sensing_antenna.detection`: the contact and push detectors and their filters, run online
+  by the simulator's controller and the estimators alike.
 - :mod:`sensing_antenna.simulator`: the 2-DOF device simulator that writes recordings.
-- :mod:`sensing_antenna.estimation`: contact instant, Estimators 1 and 2, fusion, baselines.
+- :mod:`sensing_antenna.estimation`: the front end (t_c, t_1, contact frame, Estimator 2's ratio)
+  and the methods (the paper's fusion, baselines, ``fast``).
 - :mod:`sensing_antenna.calibration`: fitting T_e and the free-motion observer.
 - :mod:`sensing_antenna.campaign`: declarative experiment campaigns and their reports.
 - :mod:`sensing_antenna.plotting`: every figure, kept apart from computation.

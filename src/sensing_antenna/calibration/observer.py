@@ -3,9 +3,9 @@
 From a recording of free motion (nothing touching the link) the gain K, natural frequency omega and
 damping d of Gamma_e,i = K s^2 / (s^2 + d s + omega^2) theta_i are fitted by least squares between
 the measured coupling torques, with the link weight removed, and the output of the discrete
-observer used online (``estimation/filters.py``), so that the fitted model is exactly the model
+observer used online (``detection/filters.py``), so that the fitted model is exactly the model
 the detector runs. The measured torque of joint 1 is the Z^m component and that of joint 2 the
-Y^m component, with the signs of ``estimation/contact.py`` (torque by the link on the head:
+Y^m component, with the signs of ``detection/contact.py`` (torque by the link on the head:
 Z^m = -Gamma_e,1, Y^m = +Gamma_e,2). Only the joints that moved are used.
 
 Start: a physics-based guess (K / omega^2 = rigid-link inertia m_b l^2 / 3 + m_t l^2 about O;

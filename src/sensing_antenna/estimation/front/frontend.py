@@ -4,11 +4,12 @@ The front end turns samples into the :class:`~.evidence.Evidence` a method concl
 an :class:`~.outcome.EarlyOutcome` when no estimate is possible. Its steps (Section 4), each
 causal, so an instant depends only on the samples up to it:
 
-1. t_c: the contact detector of Section 4.2 (:class:`~sensing_antenna.detection.contact.
-   ContactDetector`); the sensor offset and the rest tolerance from the samples up to t_c.
+1. t_c: the contact detector of Section 4.2
+   (:class:`~sensing_antenna.detection.contact.ContactDetector`); the sensor offset and the rest
+   tolerance from the samples up to t_c.
 2. t_1: the head comes to rest after t_c (:func:`.contact_frame.first_rest_index`), or, with
-   ``t1_source = "push"``, the push criterion's decision (:class:`~sensing_antenna.detection.push.
-   PushMonitor`).
+   ``t1_source = "push"``, the push criterion's decision
+   (:class:`~sensing_antenna.detection.push.PushMonitor`).
 3. At t_1 + hold: the static push and the contact frame (:func:`.steps.hold_push`).
 4. Estimator 2's ratio, its moving mean and convergence (:mod:`.ratio`); t_e (Section 4, step 6).
 

@@ -19,7 +19,8 @@ class FastConfigError(SensingAntennaError, ValueError):
 class FastConfig:
     """Settings of the fast method (SI units).
 
-    The measurements behind the defaults are in docs/fast.md.
+    The measurements behind the defaults are in docs/design-notes.md; what a user may change,
+    in docs/fast.md ("Settings").
 
     Parameters
     ----------
