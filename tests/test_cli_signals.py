@@ -44,10 +44,12 @@ def _environment() -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": os.pathsep.join([src, os.environ.get("PYTHONPATH", "")])}
 
 
-def _interrupt(signal_number: int, out: Path) -> subprocess.CompletedProcess[str]:
-    """Start the long command, send ``signal_number`` to it alone once it runs; its ending."""
+def _interrupt(
+    signal_number: int, out: Path, command: list[str] = _LONG_COMMAND
+) -> subprocess.CompletedProcess[str]:
+    """Start ``command``, send ``signal_number`` to its process alone once it runs; its ending."""
     process = subprocess.Popen(
-        [sys.executable, "-c", _ANTENNA, *_LONG_COMMAND, "--out", str(out)],
+        [sys.executable, "-c", _ANTENNA, *command, "--out", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -73,6 +75,19 @@ def test_sigterm_ends_with_one_line_and_143(tmp_path: Path) -> None:
     assert done.returncode == 143
     assert done.stderr.strip() == "antenna simulate: stopped by SIGTERM"
     assert not (tmp_path / "rec.csv").exists()
+
+
+def test_an_interrupted_campaign_says_what_it_keeps(tmp_path: Path) -> None:
+    # the default campaign runs for a minute or more: it is interrupted while it sets up or runs
+    command = ["campaign", "run", "--workers", "1", "--no-progress"]
+    for signal_number, code in ((signal.SIGINT, 130), (signal.SIGTERM, 143)):
+        done = _interrupt(signal_number, tmp_path / "out", command)
+        assert done.returncode == code
+        assert done.stderr.strip() == (
+            f"antenna campaign: {'interrupted' if code == 130 else 'stopped by SIGTERM'}; the "
+            f"runs finished so far are stored in {tmp_path / 'out'}; the same command resumes "
+            "from them"
+        )
 
 
 def test_a_closed_pipe_ends_quietly_with_141() -> None:
