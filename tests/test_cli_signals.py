@@ -2,14 +2,17 @@
 
 Each test runs ``antenna`` in a fresh process and does to it what a person or a machine does:
 Ctrl-C (SIGINT), a supervisor's or batch scheduler's SIGTERM, ``| head`` closing the pipe, a
-memory limit. The expected endings are the shell's conventions, 128 + the signal's number: 130
-for SIGINT, 143 for SIGTERM, 141 for a closed pipe (SIGPIPE), each with at most one line on
-stderr; and for a request too large for the memory, one line and exit code 2.
+memory limit. The expected endings are the shell's conventions: Ctrl-C ends the process by
+SIGINT (the shell reports 130), SIGTERM with 143 and a closed pipe with 141 (128 + SIGPIPE),
+each with at most one line on stderr; a request too large for the memory with one line and
+exit code 2.
 """
 
 from __future__ import annotations
 
 import os
+import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -62,12 +65,37 @@ def _interrupt(
     return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
 
 
-def test_ctrl_c_ends_with_one_line_and_130(tmp_path: Path) -> None:
+def test_ctrl_c_ends_with_one_line_and_by_sigint(tmp_path: Path) -> None:
+    # the process ends by SIGINT itself, as Python ends any interrupted program: the shell
+    # reports 130, and a shell loop running the command stops too (test below)
     done = _interrupt(signal.SIGINT, tmp_path / "rec.csv")
-    assert done.returncode == 130
+    assert done.returncode == -signal.SIGINT
     assert done.stderr.strip() == "antenna simulate: interrupted"
     assert done.stdout == ""
     assert not (tmp_path / "rec.csv").exists()
+
+
+@pytest.mark.skipif(shutil.which("bash") is None, reason="needs bash")
+def test_ctrl_c_stops_the_shell_script_that_runs_the_command(tmp_path: Path) -> None:
+    # Ctrl-C reaches the whole foreground process group: the script and the command. bash
+    # stops the script only if the command died by SIGINT; after a command that exits normally
+    # (even with 130) it goes on with the next line.
+    command = shlex.join([sys.executable, "-c", _ANTENNA, *_LONG_COMMAND])
+    script = f"{command} --out {shlex.quote(str(tmp_path / 'rec.csv'))}; echo went on"
+    process = subprocess.Popen(
+        ["bash", "-c", script],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(),
+        start_new_session=True,
+    )
+    time.sleep(_STARTED)
+    assert process.poll() is None, "the command ended before it could be interrupted"
+    os.killpg(process.pid, signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=60)
+    assert "went on" not in stdout
+    assert stderr.strip() == "antenna simulate: interrupted"
 
 
 def test_sigterm_ends_with_one_line_and_143(tmp_path: Path) -> None:
@@ -80,11 +108,12 @@ def test_sigterm_ends_with_one_line_and_143(tmp_path: Path) -> None:
 def test_an_interrupted_campaign_says_what_it_keeps(tmp_path: Path) -> None:
     # the default campaign runs for a minute or more: it is interrupted while it sets up or runs
     command = ["campaign", "run", "--workers", "1", "--no-progress"]
-    for signal_number, code in ((signal.SIGINT, 130), (signal.SIGTERM, 143)):
+    for signal_number, code in ((signal.SIGINT, -signal.SIGINT), (signal.SIGTERM, 143)):
         done = _interrupt(signal_number, tmp_path / "out", command)
         assert done.returncode == code
+        how = "interrupted" if signal_number == signal.SIGINT else "stopped by SIGTERM"
         assert done.stderr.strip() == (
-            f"antenna campaign: {'interrupted' if code == 130 else 'stopped by SIGTERM'}; the "
+            f"antenna campaign: {how}; the "
             f"runs finished so far are stored in {tmp_path / 'out'}; the same command resumes "
             "from them"
         )

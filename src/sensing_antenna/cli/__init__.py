@@ -16,9 +16,13 @@ How a command ends, whichever it is:
 - 2 on bad input, one line on stderr: an error derived from
   :class:`~sensing_antenna.errors.SensingAntennaError`, an argument error, an operating-system
   error such as an unwritable output path, or not enough memory for what was asked;
-- 130 (128 + SIGINT) on Ctrl-C and 143 (128 + SIGTERM) when asked to stop, one line on stderr;
-  SIGTERM raises :class:`~sensing_antenna.errors.Terminated` where the command is, so clean-ups
-  run as for Ctrl-C;
+- on Ctrl-C, one line on stderr, then the ``KeyboardInterrupt`` goes on up without its
+  traceback: the process ends by SIGINT as Python ends any interrupted program, after its
+  clean-ups, so the shell reports 130 (128 + SIGINT) and a shell loop or script running the
+  command stops as well (bash goes on when a program exits normally after Ctrl-C);
+- 143 (128 + SIGTERM) when asked to stop, one line on stderr; SIGTERM raises
+  :class:`~sensing_antenna.errors.Terminated` where the command is, so clean-ups run as for
+  Ctrl-C;
 - quietly with 141 (128 + SIGPIPE) when whatever reads the output closes it
   (``antenna beam ... | head -2``), what a shell reports for a program stopped by a closed pipe.
 """
@@ -50,8 +54,6 @@ COMMAND_MODULES = (
 
 #: Exit code for bad input: arguments, files, fields.
 EXIT_BAD_INPUT = 2
-#: Exit code after Ctrl-C; SIGTERM gives 128 + its number (143).
-EXIT_INTERRUPTED = 128 + signal.SIGINT
 #: Exit code when the reader of the output closed it.
 EXIT_CLOSED_PIPE = 128 + 13  # SIGPIPE (signal.SIGPIPE does not exist on Windows)
 
@@ -135,7 +137,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``antenna`` console script; returns the exit code."""
+    """Entry point of the ``antenna`` console script; returns the exit code.
+
+    On Ctrl-C it says so in one line and lets the ``KeyboardInterrupt`` go on, without its
+    traceback (see the module's docstring).
+    """
     parser = build_parser()
     prog = parser.prog
     args = argparse.Namespace()
@@ -162,7 +168,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         note = getattr(args, "on_interrupt", None)
         _say(f"{prog}: {how}" + (f"; {note(args)}" if note is not None else ""))
-        return 128 + number
+        if isinstance(exc, Terminated):
+            return 128 + number
+        _without_traceback(exc)
+        raise
     except BrokenPipeError:
         if not _stdout_closed():
             _say(f"{prog}: error: broken pipe")
@@ -185,6 +194,17 @@ def _named_by_flag(exc: SensingAntennaError, flags: Mapping[str, str]) -> str:
         return str(exc)
     problem = getattr(exc, "problem", None) or str(exc).split(": ", 1)[-1]
     return f"{flags[field]}: {problem}"
+
+
+def _without_traceback(interrupt: BaseException) -> None:
+    """Let ``interrupt`` end the interpreter without printing its traceback (already said)."""
+    previous = sys.excepthook
+
+    def hook(kind: type[BaseException], value: BaseException, traceback: Any) -> None:
+        if value is not interrupt:
+            previous(kind, value, traceback)
+
+    sys.excepthook = hook
 
 
 def _say(line: str) -> None:
