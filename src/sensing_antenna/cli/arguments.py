@@ -45,7 +45,8 @@ def number(
     """An argparse ``type``: a finite float with ``low (<|<=) value <= high``.
 
     The error reads ``must be a finite <what> <range> <unit>, got <value>``. With
-    ``finite=False`` any float passes (the command checks it against a range it learns later).
+    ``finite=False`` nan and infinities pass too (``--xc``: the command checks the value against
+    the range of the antenna it loads, and names it there).
     """
     adjective = "finite " if finite else ""
     bounds = _bound_text(low, high, low_open, unit)
