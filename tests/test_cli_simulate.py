@@ -47,10 +47,10 @@ def test_simulate_bad_input_is_one_line_exit_2(
     code = main(["simulate", "--case", "azimuthal", "--out", str(tmp_path / "r.csv")])
     assert code == 2
     err = capsys.readouterr().err.strip()
-    assert "contact_point" in err and err.count("\n") == 0
+    assert "--xc" in err and err.count("\n") == 0
     code = main(["simulate", "--case", "vertical", "--xc", "1.5", "--out", str(tmp_path / "r.csv")])
     assert code == 2
-    assert "x_c" in capsys.readouterr().err
+    assert "--xc" in capsys.readouterr().err
 
 
 def test_simulate_warns_when_the_push_exceeds_the_small_deflection_limit(

@@ -91,13 +91,29 @@ def test_help_loads_no_numerical_package(argv: list[str]) -> None:
         ["estimate", "rec.csv", "--method", "magic"],
         ["estimate", "rec.csv", "--t1", "later"],
         ["campaign", "run"],
+        ["campaign"],
+        ["plot"],
         ["plot", "figure-99", "--out", "figures"],
+        ["beam", "--xc", "0.5", "--modes", "0"],
+        ["beam", "--omega1", "-3"],
+        ["simulate", "--case", "free", "--xc", "near", "--out", "rec.csv"],
+        ["identify", "rec.csv", "--out", "a.toml", "--margin", "0.5"],
+        ["identify", "rec.csv", "--out", "a.toml", "--name", "two\nlines"],
+        ["calibrate", "rec.csv", "--out", "a.toml", "--loss", "square"],
+        ["estimate", "rec.csv", "--method", "fast", "--tolerance", "-1"],
+        ["campaign", "run", "--out", "c", "--workers", "0"],
     ],
     ids=lambda argv: " ".join(argv) or "no arguments",
 )
 def test_argument_errors_load_no_numerical_package(argv: list[str]) -> None:
     code, loaded, _ = _probe(argv)
     assert code == 2
+    assert loaded == []
+
+
+def test_version_loads_no_numerical_package() -> None:
+    code, loaded, out = _probe(["--version"])
+    assert code == 0 and out.startswith("antenna ")
     assert loaded == []
 
 

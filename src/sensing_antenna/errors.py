@@ -1,7 +1,9 @@
-"""Exception types shared by the whole package.
+"""Exception types shared by the whole package, and how messages show values.
 
 Every error a user can cause (bad file, bad field, bad argument) derives from
 :class:`SensingAntennaError`, so the command line can print it as one line without a traceback.
+:class:`Terminated` is how a command stops when the operating system asks it to (SIGTERM): it
+unwinds like Ctrl-C's ``KeyboardInterrupt``, so the same clean-up code handles both.
 """
 
 from __future__ import annotations
@@ -23,3 +25,29 @@ class FieldError(SensingAntennaError, ValueError):
         self.source = source
         where = f"{source}: " if source else ""
         super().__init__(f"{where}{field_name}: {problem}")
+
+
+class Terminated(KeyboardInterrupt):
+    """The process was asked to stop by a signal other than Ctrl-C (SIGTERM).
+
+    The command line raises it in the main thread when the signal arrives. It derives from
+    ``KeyboardInterrupt``, so ``finally`` blocks and ``except KeyboardInterrupt`` clean-ups run
+    for it as for Ctrl-C; the command then exits with 128 + ``signal_number`` (143 for SIGTERM).
+    """
+
+    def __init__(self, signal_number: int) -> None:
+        self.signal_number = signal_number
+        super().__init__(f"terminated by signal {signal_number}")
+
+
+def format_value(value: object) -> str:
+    """A value as an error message shows it: as Python writes it, whatever array library made it.
+
+    A NumPy scalar or 0-d array is shown as the Python number it holds (``nan``, ``-0.3``, ``2``,
+    ``True``), never as ``np.float64(nan)``; anything else by ``repr`` (strings quoted, so an
+    empty or blank value is visible). NumPy is not imported.
+    """
+    item = getattr(value, "item", None)
+    if type(value).__module__ == "numpy" and callable(item) and getattr(value, "ndim", 1) == 0:
+        value = item()
+    return repr(value)

@@ -1,20 +1,45 @@
 """The ``antenna`` command. It only parses arguments and calls the library.
 
 Each command lives in its own module exposing ``register(subparsers)``; the module sets
-``func`` on its parser, a callable ``(args) -> int`` returning the exit code. Errors derived from
-:class:`~sensing_antenna.errors.SensingAntennaError`, and operating-system errors such as an
-unwritable output path, are printed as one line, exit code 2.
+``func`` on its parser, a callable ``(args) -> int`` returning the exit code. Two more defaults a
+command may set with ``set_defaults``:
+
+``flags``
+    ``{library field name: flag}``: an error the library raises about a field the command filled
+    from a flag (``ScenarioError`` about ``contact_point``) is reported under the flag (``--xc``).
+``on_interrupt``
+    ``(args) -> str``: what to add when the command is interrupted, such as what is kept.
+
+How a command ends, whichever it is:
+
+- 0 on success (or the command's own code);
+- 2 on bad input, one line on stderr: an error derived from
+  :class:`~sensing_antenna.errors.SensingAntennaError`, an argument error, an operating-system
+  error such as an unwritable output path, or not enough memory for what was asked;
+- on Ctrl-C, one line on stderr, then the ``KeyboardInterrupt`` goes on up without its
+  traceback: the process ends by SIGINT as Python ends any interrupted program, after its
+  clean-ups, so the shell reports 130 (128 + SIGINT) and a shell loop or script running the
+  command stops as well (bash goes on when a program exits normally after Ctrl-C);
+- 143 (128 + SIGTERM) when asked to stop, one line on stderr; SIGTERM raises
+  :class:`~sensing_antenna.errors.Terminated` where the command is, so clean-ups run as for
+  Ctrl-C;
+- quietly with 141 (128 + SIGPIPE) when whatever reads the output closes it
+  (``antenna beam ... | head -2``), what a shell reports for a program stopped by a closed pipe.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import os
+import signal
 import sys
-from collections.abc import Sequence
-from typing import NoReturn
+from collections.abc import Iterator, Mapping, Sequence
+from types import FrameType
+from typing import Any, NoReturn
 
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, Terminated
 
 #: Command modules, in the order ``antenna --help`` lists them.
 COMMAND_MODULES = (
@@ -27,19 +52,81 @@ COMMAND_MODULES = (
     "plot",
 )
 
+#: Exit code for bad input: arguments, files, fields.
+EXIT_BAD_INPUT = 2
+#: Exit code when the reader of the output closed it.
+EXIT_CLOSED_PIPE = 128 + 13  # SIGPIPE (signal.SIGPIPE does not exist on Windows)
+
+#: The name of the distribution whose version ``antenna --version`` prints.
+DISTRIBUTION = "sensing-antenna"
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Help with each option's default, when it has one worth showing.
+
+    Like ``argparse.ArgumentDefaultsHelpFormatter``, but an option without a value (None) or a
+    switch (False) says nothing: its help says what happens without it.
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        default = action.default
+        if (
+            "%(default)" in text
+            or default is None
+            or default is False
+            or default is argparse.SUPPRESS
+            or not action.option_strings
+        ):
+            return text
+        return f"{text} (default: %(default)s)"
+
 
 class OneLineParser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line on stderr and exit code 2."""
+    """ArgumentParser whose errors are one line on stderr, exit code 2, naming the flag.
+
+    Argument errors read ``--flag: problem``, the form of the errors commands raise about
+    their arguments once running (:class:`~sensing_antenna.cli.arguments.ArgumentError`).
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message.removeprefix('argument ')}\n")
+
+
+class _VersionAction(argparse.Action):
+    """``--version``: the installed package's version, looked up only when asked."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs: Any) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: Any, **kwargs: Any) -> None:
+        from importlib import metadata
+
+        try:
+            version = metadata.version(DISTRIBUTION)
+        except metadata.PackageNotFoundError:
+            version = f"unknown ({DISTRIBUTION} is not installed)"
+        print(f"{parser.prog} {version}")
+        parser.exit(0)
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The full ``antenna`` parser with every available command registered."""
     parser = OneLineParser(
         prog="antenna",
-        description="Sensing-antenna toolkit: beam model, simulator, estimators, campaigns.",
+        description=(
+            "Sensing-antenna toolkit: the beam model of a flexible link touching an object, a "
+            "simulated 2-DOF head with a force/torque sensor, the contact-point estimators, "
+            "calibration of an antenna, and experiment campaigns. Each command has its own "
+            "help: antenna COMMAND --help."
+        ),
+    )
+    parser.add_argument(
+        "--version", action=_VersionAction, help="print the package's version and exit"
     )
     subparsers = parser.add_subparsers(
         dest="command", metavar="COMMAND", parser_class=OneLineParser
@@ -50,23 +137,132 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``antenna`` console script; returns the exit code."""
+    """Entry point of the ``antenna`` console script; returns the exit code.
+
+    On Ctrl-C it says so in one line and lets the ``KeyboardInterrupt`` go on, without its
+    traceback (see the module's docstring).
+    """
     parser = build_parser()
-    args = parser.parse_args(argv)
-    if not hasattr(args, "func"):
-        parser.print_help()
-        return 2
+    prog = parser.prog
+    args = argparse.Namespace()
     try:
-        return int(args.func(args))
-    except SensingAntennaError as exc:
-        print(f"antenna {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        with _terminate_raises():
+            args = parser.parse_args(argv)
+            if not hasattr(args, "func"):
+                parser.print_help()
+                return EXIT_BAD_INPUT
+            prog = f"{parser.prog} {args.command}"
+            try:
+                code = int(args.func(args))
+            except SensingAntennaError as exc:
+                _say(f"{prog}: error: {_named_by_flag(exc, getattr(args, 'flags', {}))}")
+                return EXIT_BAD_INPUT
+            sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
+            return code
+    except KeyboardInterrupt as exc:
+        number = exc.signal_number if isinstance(exc, Terminated) else signal.SIGINT
+        how = (
+            "interrupted"
+            if number == signal.SIGINT
+            else f"stopped by {signal.Signals(number).name}"
+        )
+        note = getattr(args, "on_interrupt", None)
+        _say(f"{prog}: {how}" + (f"; {note(args)}" if note is not None else ""))
+        if isinstance(exc, Terminated):
+            return 128 + number
+        _without_traceback(exc)
+        raise
+    except BrokenPipeError:
+        if not _stdout_closed():
+            _say(f"{prog}: error: broken pipe")
+            return EXIT_BAD_INPUT
+        _discard_stdout()
+        return EXIT_CLOSED_PIPE
     except OSError as exc:  # unwritable output, missing directory, disk full, ...
         where = f"{exc.filename}: " if exc.filename else ""
-        print(f"antenna {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:  # pragma: no cover - e.g. piping into head
-        return 0
+        _say(f"{prog}: error: {where}{exc.strerror or exc}")
+        return EXIT_BAD_INPUT
+    except MemoryError as exc:
+        _say(f"{prog}: error: not enough memory" + (f" ({exc})" if str(exc) else ""))
+        return EXIT_BAD_INPUT
+
+
+def _named_by_flag(exc: SensingAntennaError, flags: Mapping[str, str]) -> str:
+    """The message of ``exc``, under the flag that gave the field when the command says so."""
+    field = getattr(exc, "field_name", None)
+    if not isinstance(field, str) or field not in flags or getattr(exc, "source", None):
+        return str(exc)
+    problem = getattr(exc, "problem", None) or str(exc).split(": ", 1)[-1]
+    return f"{flags[field]}: {problem}"
+
+
+def _without_traceback(interrupt: BaseException) -> None:
+    """Let ``interrupt`` end the interpreter without printing its traceback (already said)."""
+    previous = sys.excepthook
+
+    def hook(kind: type[BaseException], value: BaseException, traceback: Any) -> None:
+        if value is not interrupt:
+            previous(kind, value, traceback)
+
+    sys.excepthook = hook
+
+
+def _say(line: str) -> None:
+    """One line on stderr, after whatever the command wrote there (a progress bar)."""
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.flush()
+    print(line, file=sys.stderr)
+
+
+@contextlib.contextmanager
+def _terminate_raises() -> Iterator[None]:
+    """Within: SIGTERM raises :class:`Terminated` in this process (the main thread).
+
+    Left alone when SIGTERM is already handled or ignored (by whoever started us), or when not
+    in the main thread. A process forked inside (a worker of a pool) inherits the handler; there
+    SIGTERM keeps its default meaning: the process ends at once.
+    """
+    owner = os.getpid()
+
+    def handler(number: int, frame: FrameType | None) -> None:
+        if os.getpid() != owner:
+            signal.signal(number, signal.SIG_DFL)
+            os.kill(os.getpid(), number)
+            return
+        raise Terminated(number)
+
+    try:
+        if signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:
+            yield
+            return
+        previous = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread: signals are not ours to handle
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _stdout_closed() -> bool:
+    """True when the reader of stdout has gone (or stdout is no file whose state is known)."""
+    try:
+        import select
+
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(events & select.POLLERR for _, events in poller.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll (Windows), or not a real file
+        return True
+
+
+def _discard_stdout() -> None:
+    """Send the rest of stdout to the null device, so the interpreter's exit says nothing."""
+    with contextlib.suppress(AttributeError, OSError, ValueError):
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+        os.close(null)
 
 
 if __name__ == "__main__":  # pragma: no cover

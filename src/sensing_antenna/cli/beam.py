@@ -16,8 +16,14 @@ import math
 import sys
 from typing import Any
 
+from sensing_antenna.cli.arguments import check_contact_points, integer, number
+
 #: Exit code when the frequency has no consistent contact point.
 EXIT_OUT_OF_RANGE = 1
+
+#: Largest --modes accepted: beyond a few dozen modes Euler-Bernoulli theory (no shear, no
+#: rotary inertia; Assumption 3 of the paper) no longer describes a real link.
+MAX_MODES = 50
 
 
 def register(subparsers: Any) -> None:
@@ -25,17 +31,37 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "beam",
         help="contact-mode natural frequencies, or contact points for a fundamental frequency",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=(
+            "The beam model of the link pinned at a contact point (Sections 3.3 and 3.4 of the "
+            "paper). With --xc, prints the natural frequencies omega_i (rad/s) and f_i (Hz) of "
+            "the first --modes modes for each contact point. With --omega1, prints every "
+            "contact point whose fundamental frequency is that, with the slope d omega_1 / d x_c, "
+            "and exits with 1 when the frequency lies outside the model's range (the reason goes "
+            "to stderr). --json prints the same as JSON."
+        ),
     )
     group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument(
-        "--xc", type=float, nargs="+", metavar="M", help="contact point(s) in (0, l] (m)"
+        "--xc",
+        type=number(unit="m", finite=False),
+        nargs="+",
+        metavar="M",
+        help="contact point(s), from the base (0, excluded) to the tip (the link's length) (m)",
     )
     group.add_argument(
-        "--omega1", type=float, metavar="RAD_S", help="measured fundamental frequency (rad/s)"
+        "--omega1",
+        type=number(low=0.0, low_open=True, unit="rad/s", what="frequency"),
+        metavar="RAD_S",
+        help="measured fundamental frequency (rad/s)",
     )
-    parser.add_argument("--modes", type=int, default=3, help="number of modes (default 3)")
-    parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
+    parser.add_argument(
+        "--modes",
+        type=integer(1, MAX_MODES),
+        default=3,
+        metavar="N",
+        help=f"number of modes, 1 to {MAX_MODES}",
+    )
+    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -46,20 +72,14 @@ def run(args: argparse.Namespace) -> int:
 
     antenna = load_antenna(args.antenna)
     if args.xc is not None:
+        check_contact_points(antenna.link, args.xc)
         return _frequencies(antenna.name, antenna.link, args.xc, args.modes, args.json)
     return _contact_points(antenna.link, args.omega1, args.json)
 
 
-#: Largest --modes accepted: beyond a few dozen modes Euler-Bernoulli theory (no shear, no
-#: rotary inertia; Assumption 3 of the paper) no longer describes a real link.
-MAX_MODES = 50
-
-
 def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bool) -> int:
-    from sensing_antenna.beam import BeamInputError, natural_frequencies
+    from sensing_antenna.beam import natural_frequencies
 
-    if not 1 <= modes <= MAX_MODES:
-        raise BeamInputError("--modes", f"must be an integer from 1 to {MAX_MODES}, got {modes}")
     omega = natural_frequencies(link, x_c, modes)
     hz = omega / (2.0 * math.pi)
     if as_json:
@@ -78,10 +98,8 @@ def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bo
 
 
 def _contact_points(link: Any, omega1: float, as_json: bool) -> int:
-    from sensing_antenna.beam import BeamInputError, SensingCurve
+    from sensing_antenna.beam import SensingCurve
 
-    if not (math.isfinite(omega1) and omega1 > 0):
-        raise BeamInputError("--omega1", f"must be a finite frequency > 0 rad/s, got {omega1}")
     curve = SensingCurve.from_link(link)
     candidates = curve.contact_points(omega1)
     low, high = curve.omega1_range()

@@ -7,6 +7,12 @@ import math
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.arguments import antenna_name, printable
+
+#: The fit losses of :data:`sensing_antenna.calibration.frequency.LOSSES`, written out so that
+#: parsing arguments does not import the calibration (``tests/test_cli_help.py`` checks them).
+LOSS_NAMES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
+
 
 def register(subparsers: Any) -> None:
     """Add ``antenna calibrate``."""
@@ -16,21 +22,53 @@ def register(subparsers: Any) -> None:
         description=(
             "Measures the fundamental frequency of each recording, fits T_e so that the model "
             "omega_1(x_c) matches them, and writes the antenna with T_e. Contact points come from "
-            "--points (CSV with columns file,x_c in m) or from each recording's true_xc metadata."
+            "--points (CSV with columns file,x_c in m) or from each recording's true_xc metadata. "
+            "The new antenna is named after --out (or --name), its description saying which "
+            "recordings calibrated it."
         ),
     )
     parser.add_argument("recordings", nargs="+", type=Path, help="recording CSV files")
     parser.add_argument("--out", type=Path, required=True, help="calibrated antenna TOML to write")
-    parser.add_argument("--antenna", default=None, help="starting antenna: built-in name or TOML")
-    parser.add_argument("--points", type=Path, default=None, help="CSV table with file,x_c (m)")
-    parser.add_argument("--plot", type=Path, default=None, help="directory for Figure 10")
     parser.add_argument(
-        "--loss", default="soft_l1", help="fit loss: linear, soft_l1, huber, cauchy, arctan"
+        "--name", default=None, help="name of the new antenna (default: the stem of --out)"
+    )
+    parser.add_argument(
+        "--antenna", default="paper-2021", help="starting antenna: built-in name or TOML file"
+    )
+    parser.add_argument(
+        "--points",
+        type=Path,
+        default=None,
+        help="CSV table with columns file,x_c (m) (default: each recording's true_xc)",
+    )
+    parser.add_argument(
+        "--plot", type=Path, default=None, help="directory for Figure 10 (default: no figure)"
+    )
+    parser.add_argument(
+        "--loss",
+        choices=LOSS_NAMES,
+        default="soft_l1",
+        help="fit loss (scipy.optimize.least_squares); a robust one keeps a wrong spectral peak "
+        "from pulling T_e",
     )
     parser.set_defaults(func=_run)
 
 
+def _description(start: str, recordings: list[Path]) -> str:
+    """What the written antenna is: ``start`` with T_e from which recordings (the first three)."""
+    files = [printable(str(path)) for path in recordings]
+    shown = ", ".join(files[:3]) + (f" and {len(files) - 3} more" if len(files) > 3 else "")
+    return (
+        f"antenna {printable(start)} with T_e calibrated by antenna calibrate from "
+        f"{len(files)} recording(s): {shown}"
+    )
+
+
 def _run(args: argparse.Namespace) -> int:
+    name = antenna_name(args.name, args.out)  # before the library loads: an argument error
+
+    from dataclasses import replace
+
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.frequency import (
         calibrate_from_recordings,
@@ -48,7 +86,8 @@ def _run(args: argparse.Namespace) -> int:
         sources=[str(p) for p in args.recordings],
         loss=args.loss,
     )
-    calibrated = calibration.apply(antenna)
+    description = _description(antenna.name, args.recordings)
+    calibrated = replace(calibration.apply(antenna), name=name, description=description)
     save_antenna(calibrated, args.out)
     print(
         f"T_e = {calibration.t_e:.5f} +- {calibration.t_e_std_error:.5f} s/m^2 "

@@ -7,36 +7,74 @@ import dataclasses
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.arguments import add_actions, integer
+
 
 def register(subparsers: Any) -> None:
     """Add ``antenna campaign`` with its ``run`` and ``report`` subcommands."""
     parser = subparsers.add_parser(
-        "campaign", help="run experiment campaigns (Section 5.6) and build their reports"
+        "campaign",
+        help="run experiment campaigns (Section 5.6) and build their reports",
+        description=(
+            "A campaign is a declarative experiment (a TOML spec, docs/campaigns.md): simulated "
+            "manoeuvres at chosen contact points and noise levels, each estimated by the chosen "
+            "methods. run executes every run of a spec into a directory, resuming an "
+            "interrupted one; report rebuilds the tables, figures and report.md of a directory."
+        ),
     )
-    actions = parser.add_subparsers(dest="action", metavar="ACTION", parser_class=type(parser))
-    actions.required = True
+    actions = add_actions(parser, "action", "ACTION")
 
     run = actions.add_parser(
         "run",
         help="simulate and estimate every run of a campaign (resumes an interrupted one)",
-        description="Without SPEC, runs the built-in paper-2021 campaign of Section 5.6.",
+        description=(
+            "Simulates and estimates every run of the campaign SPEC (without SPEC, the built-in "
+            "paper-2021 campaign of Section 5.6) in parallel, storing each finished run in the "
+            "--out directory, then writes the report. Run again on the same directory, it "
+            "resumes: runs already stored are not run again."
+        ),
     )
-    run.add_argument("spec", nargs="?", default=None, help="campaign TOML file (default: paper)")
+    run.add_argument(
+        "spec", nargs="?", default=None, help="campaign TOML file (default: paper-2021's)"
+    )
     run.add_argument("--out", type=Path, required=True, help="campaign directory")
-    run.add_argument("--workers", type=int, default=None, help="local processes (default: cores)")
-    run.add_argument("--scheduler", default=None, help="Dask scheduler address tcp://HOST:PORT")
+    run.add_argument(
+        "--workers",
+        type=integer(low=1),
+        default=None,
+        metavar="N",
+        help="local processes (default: the machine's cores)",
+    )
+    run.add_argument(
+        "--scheduler",
+        default=None,
+        help="Dask scheduler address tcp://HOST:PORT (default: local processes)",
+    )
     run.add_argument("--retry-failed", action="store_true", help="redo runs stored as failed")
     run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     run.add_argument(
         "--methods",
         default=None,
-        help="comma-separated methods instead of the spec's, e.g. paper,ratio,two-frequency,fast",
+        help="comma-separated methods instead of the spec's, e.g. paper,ratio,two-frequency,fast "
+        "(default: the spec's)",
     )
-    run.set_defaults(func=_run)
+    run.set_defaults(func=_run, on_interrupt=_kept)
 
-    report = actions.add_parser("report", help="rebuild tables, figures and report.md")
+    report = actions.add_parser(
+        "report",
+        help="rebuild tables, figures and report.md",
+        description=(
+            "Reads the runs stored in a campaign directory and writes its tables, figures and "
+            "report.md again, without running anything."
+        ),
+    )
     report.add_argument("directory", type=Path, help="campaign directory")
     report.set_defaults(func=_report)
+
+
+def _kept(args: argparse.Namespace) -> str:
+    """What an interrupted ``campaign run`` keeps: every run stored before the interruption."""
+    return f"the runs finished so far are stored in {args.out}; the same command resumes from them"
 
 
 def _run(args: argparse.Namespace) -> int:

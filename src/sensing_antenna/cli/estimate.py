@@ -8,6 +8,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.arguments import number
+
 #: The names of :data:`sensing_antenna.estimation.METHODS`, in the order ``--help`` lists them.
 #: Written out so that parsing arguments does not import the estimators (``antenna estimate
 #: --help`` and an argument error answer at once); ``tests/test_cli_estimate.py`` checks that
@@ -18,30 +20,39 @@ METHOD_NAMES = ("fast", "paper", "ratio", "two-frequency")
 def register(subparsers: Any) -> None:
     """Add ``antenna estimate``."""
     parser = subparsers.add_parser(
-        "estimate", help="estimate the contact point of a recording (CSV)"
+        "estimate",
+        help="estimate the contact point of a recording (CSV)",
+        description=(
+            "Estimates where the link touched from a recording of one contact manoeuvre (the "
+            "format of docs/recording-format.md): the contact instant t_c, the push and its end "
+            "t_1, the vibration after it, and the contact point x_c along the link with its 3D "
+            "point. Prints the status (ok, or why no confirmed estimate), x_c, the candidates, "
+            "the fundamental frequency and the instants; --json prints one JSON object."
+        ),
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
     parser.add_argument(
         "--method",
         choices=METHOD_NAMES,
         default="paper",
-        help="paper (Section 4, default), fast (short record, stops when sure), or a baseline",
+        help="paper (Section 4), fast (short record, stops when sure), or a baseline",
     )
     parser.add_argument(
         "--tolerance",
-        type=float,
+        type=number(low=0.0, unit="m"),
         default=None,
-        help="fast method: declare when the 95 %% interval of x_c is narrower than this (m, "
-        "default 0.005)",
+        metavar="M",
+        help="fast method: declare when the 95 %% interval of x_c is narrower than this (m; "
+        "default: the fast method's, 0.005)",
     )
     parser.add_argument(
         "--t1",
         choices=("rest", "push"),
         default="rest",
-        help="t_1 from the head coming to rest (default: any device) or from the default push "
+        help="t_1 from the head coming to rest (any device) or from the default push "
         "criterion's decision (a device that stops with it, such as our simulator)",
     )
-    parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
+    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)
 

@@ -7,6 +7,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.arguments import antenna_name, number, printable
+
 
 def register(subparsers: Any) -> None:
     """Add ``antenna identify``."""
@@ -16,19 +18,31 @@ def register(subparsers: Any) -> None:
         description=(
             "Fits gain, natural frequency and damping of the free-motion observer to a recording "
             "of free motion (no contact), sets the contact threshold to the largest filtered "
-            "residual times the margin (Section 5.2), and writes the antenna with that observer."
+            "residual times the margin (Section 5.2), and writes the starting antenna with that "
+            "observer as a new antenna: named after --out (or --name), its description saying "
+            "which recording it was identified from."
         ),
     )
     parser.add_argument("recording", type=Path, help="free-motion recording CSV")
     parser.add_argument("--out", type=Path, required=True, help="antenna TOML to write")
-    parser.add_argument("--antenna", default=None, help="starting antenna: built-in name or TOML")
     parser.add_argument(
-        "--margin", type=float, default=1.5, help="safety factor on the residual (default 1.5)"
+        "--name", default=None, help="name of the new antenna (default: the stem of --out)"
+    )
+    parser.add_argument(
+        "--antenna", default="paper-2021", help="starting antenna: built-in name or TOML file"
+    )
+    parser.add_argument(
+        "--margin",
+        type=number(low=1.0),
+        default=1.5,
+        help="safety factor on the largest filtered residual",
     )
     parser.set_defaults(func=_run)
 
 
 def _run(args: argparse.Namespace) -> int:
+    name = antenna_name(args.name, args.out)  # before the library loads: an argument error
+
     from dataclasses import replace
 
     from sensing_antenna.antenna import load_antenna, save_antenna
@@ -37,7 +51,12 @@ def _run(args: argparse.Namespace) -> int:
 
     antenna = load_antenna(args.antenna)
     fit = identify_free_motion(read_recording(args.recording), antenna, margin=args.margin)
-    save_antenna(replace(antenna, observer=fit.observer), args.out)
+    description = (
+        f"antenna {printable(antenna.name)} with the free-motion observer and contact "
+        f"threshold identified by antenna identify from {printable(str(args.recording))}"
+    )
+    identified = replace(antenna, name=name, description=description, observer=fit.observer)
+    save_antenna(identified, args.out)
     joints = ", ".join(f"theta{j}" for j in fit.joints)
     print(
         f"gain = {fit.gain:.5g} N m/rad, natural_frequency = {fit.natural_frequency:.5g} "

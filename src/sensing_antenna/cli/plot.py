@@ -6,12 +6,22 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.arguments import add_actions
+
 
 def register(subparsers: Any) -> None:
     """Add ``antenna plot`` and its kinds."""
-    parser = subparsers.add_parser("plot", help="draw figures as PNG files")
-    kinds = parser.add_subparsers(dest="kind", metavar="KIND", parser_class=type(parser))
-    kinds.required = True
+    parser = subparsers.add_parser(
+        "plot",
+        help="draw figures as PNG files",
+        description=(
+            "Draws figures as PNG files into the --out directory and prints their paths: the "
+            "sensing curves of an antenna, the signals of a recording, or Figures 11 to 14 of "
+            "the paper for the estimate of one recording. Campaign figures come with antenna "
+            "campaign report."
+        ),
+    )
+    kinds = add_actions(parser, "kind", "KIND")
     for add_kind in (_add_sensing_curves, _add_recording, _add_estimate):
         add_kind(kinds)
 
@@ -21,8 +31,15 @@ def _add_out(parser: argparse.ArgumentParser) -> None:
 
 
 def _add_sensing_curves(kinds: Any) -> None:
-    parser = kinds.add_parser("sensing-curves", help="Figures 8 and 9: omega_i(x_c), f2 vs f1")
-    parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
+    parser = kinds.add_parser(
+        "sensing-curves",
+        help="Figures 8 and 9: f_i(x_c), f2 - f1 vs f1",
+        description=(
+            "The sensing curves of an antenna: Figure 8, the natural frequencies f1, f2, f3 (Hz) "
+            "of the link against the contact point; Figure 9, f2 - f1 against f1."
+        ),
+    )
+    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     _add_out(parser)
     parser.set_defaults(func=_run_sensing_curves)
 
@@ -37,8 +54,15 @@ def _run_sensing_curves(args: argparse.Namespace) -> int:
 
 
 def _add_recording(kinds: Any) -> None:
-    parser = kinds.add_parser("recording", help="angles, forces and torques of a recording")
-    parser.add_argument("recording", type=Path)
+    parser = kinds.add_parser(
+        "recording",
+        help="angles, forces and torques of a recording",
+        description=(
+            "The motor angles, the forces and the torques of a recording against time, and the "
+            "spectrum of the torques."
+        ),
+    )
+    parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
     _add_out(parser)
     parser.set_defaults(func=_run_recording)
 
@@ -53,9 +77,17 @@ def _run_recording(args: argparse.Namespace) -> int:
 
 
 def _add_estimate(kinds: Any) -> None:
-    parser = kinds.add_parser("estimate", help="Figures 11 to 14 for one recording")
-    parser.add_argument("recording", type=Path)
-    parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
+    parser = kinds.add_parser(
+        "estimate",
+        help="Figures 11 to 14 for one recording",
+        description=(
+            "Figures 11 to 14 of the paper for the estimate of one recording (the paper's "
+            "method): the contact detection, the push, the frequency spectrum and the "
+            "torque/force ratio."
+        ),
+    )
+    parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
+    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     _add_out(parser)
     parser.set_defaults(func=_run_estimate)
 

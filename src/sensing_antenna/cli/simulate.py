@@ -3,23 +3,60 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
+
+from sensing_antenna.cli.arguments import ArgumentError, check_contact_points, number
+
+#: The cases of :class:`sensing_antenna.simulator.Scenario`, in the order ``--help`` lists them.
+CASES = ("azimuthal", "vertical", "free")
+
+#: The scenario's fields the command fills from its flags: an error about one names the flag.
+FLAGS = {
+    "case": "--case",
+    "contact_point": "--xc",
+    "seed": "--seed",
+    "duration": "--duration",
+    "noise_scale": "--noise",
+}
 
 
 def register(subparsers: Any) -> None:
     """Add ``antenna simulate``."""
     parser = subparsers.add_parser(
-        "simulate", help="simulate one contact manoeuvre and write a recording (CSV)"
+        "simulate",
+        help="simulate one contact manoeuvre and write a recording (CSV)",
+        description=(
+            "Simulates the 2-DOF head of the antenna sweeping its flexible link (azimuthal: "
+            "theta1 into a vertical post; vertical: theta2 up into a horizontal bar; free: the "
+            "azimuthal sweep with nothing to touch, a recording for antenna identify), with "
+            "sensor noise, the motors stopped by the push criterion, and writes the recording "
+            "with its ground truth as metadata. --xc is the nominal contact point, where the "
+            "undeflected link meets the obstacle; the link bends as it pushes, and the line "
+            "printed says where it actually touched (true_xc in the file)."
+        ),
     )
-    parser.add_argument("--case", choices=("azimuthal", "vertical", "free"), required=True)
-    parser.add_argument("--xc", type=float, default=None, help="contact point x_c (m)")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--case", choices=CASES, required=True, help="the manoeuvre")
+    parser.add_argument(
+        "--xc",
+        type=number(unit="m", finite=False),
+        default=None,
+        metavar="M",
+        help="nominal contact point x_c, in (0, l] (m): required for the azimuthal and vertical "
+        "cases, not given for free",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of every random quantity, such as the sensor noise",
+    )
     parser.add_argument("--duration", type=float, default=3.0, help="total time (s)")
     parser.add_argument("--noise", type=float, default=1.0, help="sensor noise scale (0: none)")
-    parser.add_argument("--antenna", default=None, help="built-in name or TOML file")
+    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument("--out", type=Path, required=True, help="output CSV file")
-    parser.set_defaults(func=_run)
+    parser.set_defaults(func=_run, flags=FLAGS)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -31,6 +68,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.simulator.run import deflection_warning
 
     antenna = load_antenna(args.antenna)
+    _check_contact_point(args.case, args.xc, antenna.link)
     scenario = Scenario(
         case=args.case,
         contact_point=args.xc,
@@ -40,16 +78,43 @@ def _run(args: argparse.Namespace) -> int:
     )
     recording = simulate(antenna, scenario)
     write_recording(recording, args.out)
-    meta = recording.metadata
-    summary = f"{args.out}: {recording.n_samples} samples, {args.case}"
-    if "true_xc" in meta:
-        summary += (
-            f", x_c = {float(meta['true_xc']):.4f} m, first touch {meta['true_t_contact']} s,"
-            f" stop {meta['true_t_stop']} s,"
-            f" y_c / x_c = {100 * float(meta['true_deflection_ratio']):.1f} %"
-        )
-    print(summary)
+    print(summary(str(args.out), scenario, recording.n_samples, recording.metadata))
     warning = deflection_warning(recording)
     if warning is not None:
         print(warning, file=sys.stderr)
     return 0
+
+
+def _check_contact_point(case: str, x_c: float | None, link: Any) -> None:
+    """--xc against --case and the link: every message names --xc and the range (0, l] m."""
+    allowed = f"a contact point in (0, {link.length:g}] m"
+    if case == "free" and x_c is not None:
+        raise ArgumentError("--xc", "not used with --case free (the link touches nothing)")
+    if case != "free" and x_c is None:
+        raise ArgumentError("--xc", f"required with --case {case}: {allowed}")
+    if x_c is not None:
+        check_contact_points(link, [x_c])
+
+
+def summary(out: str, scenario: Any, n_samples: int, meta: Any) -> str:
+    """The line printed for a simulated recording: where the link touched, and when.
+
+    ``scenario`` is the :class:`~sensing_antenna.simulator.Scenario` simulated, ``meta`` the
+    recording's metadata (its ``true_*`` keys).
+    """
+    text = f"{out}: {n_samples} samples, {scenario.case}"
+    x_c = scenario.contact_point
+    if x_c is None:
+        return text
+    touched = float(meta.get("true_xc", "nan"))
+    if not math.isfinite(touched):
+        return (
+            f"{text}, no contact: the link did not reach the obstacle (--xc {x_c:g} m) within "
+            f"the {scenario.duration:g} s simulated; a longer --duration lets it"
+        )
+    return (
+        f"{text}, the link touched at x_c = {touched:.4f} m (--xc {x_c:g} m is where the "
+        f"undeflected link meets the obstacle; it bends as it pushes), first touch "
+        f"{meta['true_t_contact']} s, stop {meta['true_t_stop']} s, "
+        f"y_c / x_c = {100 * float(meta['true_deflection_ratio']):.1f} %"
+    )

@@ -1,0 +1,118 @@
+"""The antenna files ``antenna identify`` and ``antenna calibrate`` write: a new antenna of its own.
+
+The file written is not the starting antenna: it is named after ``--out`` (or ``--name``) and
+its description says which command made it from which recordings. A name that is not one line
+of printable text (it would not survive as a one-line TOML string) is refused before anything
+is computed or written.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sensing_antenna.antenna import load_antenna, paper_antenna
+from sensing_antenna.cli import main
+from sensing_antenna.recording import write_recording
+from sensing_antenna.simulator import Scenario, simulate
+
+
+@pytest.fixture(scope="module")
+def free_motion(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A simulated free motion, what ``antenna identify`` fits (as docs/simulator.md suggests)."""
+    path = tmp_path_factory.mktemp("free") / "free-sweep.csv"
+    recording = simulate(paper_antenna(), Scenario(case="free", duration=3.0, seed=1))
+    write_recording(recording.without_ground_truth(), path)
+    return path
+
+
+@pytest.fixture(scope="module")
+def contacts(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    """Three simulated contacts with their true_xc, what ``antenna calibrate`` fits."""
+    folder = tmp_path_factory.mktemp("contacts")
+    paths = []
+    for i, x_c in enumerate((0.4, 0.6, 0.8)):
+        scenario = Scenario(case="azimuthal", contact_point=x_c, duration=2.0, seed=10 + i)
+        paths.append(folder / f"contact-{i}.csv")
+        write_recording(simulate(paper_antenna(), scenario), paths[-1])
+    return paths
+
+
+def test_identify_names_the_antenna_after_its_file(
+    free_motion: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "lab-head.toml"
+    assert main(["identify", str(free_motion), "--out", str(out)]) == 0
+    capsys.readouterr()
+    identified = load_antenna(out)
+    assert identified.name == "lab-head"
+    assert str(free_motion) in identified.description
+    assert "identify" in identified.description and "paper-2021" in identified.description
+    start = paper_antenna()
+    assert identified.description != start.description
+    assert identified.link == start.link and identified.observer != start.observer
+
+
+def test_identify_takes_a_name(
+    free_motion: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "a.toml"
+    assert main(["identify", str(free_motion), "--out", str(out), "--name", "lab head 2"]) == 0
+    capsys.readouterr()
+    assert load_antenna(out).name == "lab head 2"
+
+
+@pytest.mark.parametrize(
+    ("flags", "flag"),
+    [
+        (["--name", "lab\nhead"], "--name"),
+        (["--name", "lab\thead"], "--name"),
+        (["--name", "  "], "--name"),
+        ([], "--out"),  # the stem of --out, "lab\nhead", would be the name
+    ],
+)
+def test_a_name_that_is_not_one_printable_line_is_refused(
+    flags: list[str],
+    flag: str,
+    free_motion: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    out = tmp_path / "lab\nhead.toml" if flag == "--out" else tmp_path / "a.toml"
+    for command in (["identify", str(free_motion)], ["calibrate", str(free_motion)]):
+        assert main([*command, "--out", str(out), *flags]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0
+        assert err.startswith(f"antenna {command[0]}: error: {flag}: ")
+        assert "one line of printable text" in err
+        assert not out.exists()
+
+
+def test_identify_writes_a_valid_file_from_an_antenna_named_over_two_lines(
+    free_motion: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a starting antenna whose TOML name holds a newline (an escape in a TOML string): the new
+    # antenna has its own name, and its description shows the old one on one line
+    start = tmp_path / "start.toml"
+    start.write_text('base = "paper-2021"\nname = "old\\nhead"\n', encoding="utf-8")
+    out = tmp_path / "new.toml"
+    assert main(["identify", str(free_motion), "--antenna", str(start), "--out", str(out)]) == 0
+    capsys.readouterr()
+    identified = load_antenna(out)
+    assert identified.name == "new"
+    assert "old\\nhead" in identified.description and "\n" not in identified.description
+
+
+def test_calibrate_names_the_antenna_after_its_file(
+    contacts: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "lab-calibrated.toml"
+    assert main(["calibrate", *map(str, contacts), "--out", str(out)]) == 0
+    capsys.readouterr()
+    calibrated = load_antenna(out)
+    assert calibrated.name == "lab-calibrated"
+    assert calibrated.link.calibrated_t is not None
+    assert "calibrate" in calibrated.description and "3 recording(s)" in calibrated.description
+    assert all(str(path) in calibrated.description for path in contacts)
+    assert calibrated.description != paper_antenna().description

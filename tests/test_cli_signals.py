@@ -1,0 +1,159 @@
+"""How a command ends: interrupted, asked to stop, its reader gone, or out of memory.
+
+Each test runs ``antenna`` in a fresh process and does to it what a person or a machine does:
+Ctrl-C (SIGINT), a supervisor's or batch scheduler's SIGTERM, ``| head`` closing the pipe, a
+memory limit. The expected endings are the shell's conventions: Ctrl-C ends the process by
+SIGINT (the shell reports 130), SIGTERM with 143 and a closed pipe with 141 (128 + SIGPIPE),
+each with at most one line on stderr; a request too large for the memory with one line and
+exit code 2.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import sensing_antenna
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and pipes")
+
+#: ``antenna`` as the console script runs it. SIGINT gets Python's usual handler even when the
+#: test runner was started with SIGINT ignored (a background job), as a terminal's Ctrl-C finds it.
+_ANTENNA = (
+    "import signal, sys\n"
+    "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+    "from sensing_antenna.cli import main\n"
+    "sys.exit(main())\n"
+)
+
+#: A command that computes for several seconds (60 s of simulated time, about 5 s on a laptop)
+#: and writes nothing before it is done.
+_LONG_COMMAND = ["simulate", "--case", "azimuthal", "--xc", "0.5", "--duration", "60"]
+
+#: Time given to the process to start and enter the command (s): parsing takes 50 ms.
+_STARTED = 1.5
+
+
+def _environment() -> dict[str, str]:
+    src = str(Path(sensing_antenna.__file__).resolve().parents[1])
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([src, os.environ.get("PYTHONPATH", "")])}
+
+
+def _interrupt(
+    signal_number: int, out: Path, command: list[str] = _LONG_COMMAND
+) -> subprocess.CompletedProcess[str]:
+    """Start ``command``, send ``signal_number`` to its process alone once it runs; its ending."""
+    process = subprocess.Popen(
+        [sys.executable, "-c", _ANTENNA, *command, "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(),
+    )
+    time.sleep(_STARTED)
+    assert process.poll() is None, "the command ended before it could be interrupted"
+    process.send_signal(signal_number)
+    stdout, stderr = process.communicate(timeout=60)
+    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+
+
+def test_ctrl_c_ends_with_one_line_and_by_sigint(tmp_path: Path) -> None:
+    # the process ends by SIGINT itself, as Python ends any interrupted program: the shell
+    # reports 130, and a shell loop running the command stops too (test below)
+    done = _interrupt(signal.SIGINT, tmp_path / "rec.csv")
+    assert done.returncode == -signal.SIGINT
+    assert done.stderr.strip() == "antenna simulate: interrupted"
+    assert done.stdout == ""
+    assert not (tmp_path / "rec.csv").exists()
+
+
+@pytest.mark.skipif(shutil.which("bash") is None, reason="needs bash")
+def test_ctrl_c_stops_the_shell_script_that_runs_the_command(tmp_path: Path) -> None:
+    # Ctrl-C reaches the whole foreground process group: the script and the command. bash
+    # stops the script only if the command died by SIGINT; after a command that exits normally
+    # (even with 130) it goes on with the next line.
+    command = shlex.join([sys.executable, "-c", _ANTENNA, *_LONG_COMMAND])
+    script = f"{command} --out {shlex.quote(str(tmp_path / 'rec.csv'))}; echo went on"
+    process = subprocess.Popen(
+        ["bash", "-c", script],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(),
+        start_new_session=True,
+    )
+    time.sleep(_STARTED)
+    assert process.poll() is None, "the command ended before it could be interrupted"
+    os.killpg(process.pid, signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=60)
+    assert "went on" not in stdout
+    assert stderr.strip() == "antenna simulate: interrupted"
+
+
+def test_sigterm_ends_with_one_line_and_143(tmp_path: Path) -> None:
+    done = _interrupt(signal.SIGTERM, tmp_path / "rec.csv")
+    assert done.returncode == 143
+    assert done.stderr.strip() == "antenna simulate: stopped by SIGTERM"
+    assert not (tmp_path / "rec.csv").exists()
+
+
+def test_an_interrupted_campaign_says_what_it_keeps(tmp_path: Path) -> None:
+    # the default campaign runs for a minute or more: it is interrupted while it sets up or runs
+    command = ["campaign", "run", "--workers", "1", "--no-progress"]
+    for signal_number, code in ((signal.SIGINT, -signal.SIGINT), (signal.SIGTERM, 143)):
+        done = _interrupt(signal_number, tmp_path / "out", command)
+        assert done.returncode == code
+        how = "interrupted" if signal_number == signal.SIGINT else "stopped by SIGTERM"
+        assert done.stderr.strip() == (
+            f"antenna campaign: {how}; the "
+            f"runs finished so far are stored in {tmp_path / 'out'}; the same command resumes "
+            "from them"
+        )
+
+
+def test_a_closed_pipe_ends_quietly_with_141() -> None:
+    # `antenna beam --xc ... | head -2` once head has exited: the read end of stdout is closed
+    # before the command writes anything, so every write fails, whatever the timing.
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", _ANTENNA, "beam", "--xc", "0.3", "0.5", "--modes", "50"],
+            stdout=write_end,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=_environment(),
+            check=False,
+            timeout=60,
+        )
+    finally:
+        os.close(write_end)
+    assert done.returncode == 141
+    assert done.stderr == ""
+
+
+def test_a_request_too_large_for_the_memory_is_one_line(tmp_path: Path) -> None:
+    # 1e7 s of simulated time is 1e10 samples, 80 GB per column: more than the 4 GiB of address
+    # space the process is given here, whatever the machine has
+    limited = "import resource\nresource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))\n"
+    argv = [*_LONG_COMMAND[:-1], "1e7", "--out", str(tmp_path / "rec.csv")]
+    done = subprocess.run(
+        [sys.executable, "-c", limited + _ANTENNA, *argv],
+        capture_output=True,
+        text=True,
+        env=_environment(),
+        check=False,
+        timeout=120,
+    )
+    assert done.returncode == 2
+    err = done.stderr.strip()
+    assert err.startswith("antenna simulate: error: ") and err.count("\n") == 0
+    assert not (tmp_path / "rec.csv").exists()
