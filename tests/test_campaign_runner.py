@@ -110,6 +110,15 @@ def test_inline_campaign_writes_one_file_per_run_and_a_row_per_method(tmp_path: 
     assert float(first["error_m"]) == pytest.approx(estimate - 0.3, abs=1e-12)
 
 
+def test_points_half_a_millimetre_apart_are_two_runs_with_two_files(tmp_path: Path) -> None:
+    spec = small_spec(cases=("azimuthal",), contact_points=(0.5, 0.5004), repeats=1)
+    outcome = run_inline(spec, tmp_path)
+    assert (outcome.n_runs, outcome.n_executed) == (2, 2)
+    assert len(list((tmp_path / "runs").glob("*.json"))) == 2
+    truths = sorted({float(row["x_c_true_m"]) for row in read_rows(outcome.csv_path)})
+    assert truths == [0.5, 0.5004]
+
+
 def test_process_pool_gives_the_same_results_as_inline(tmp_path: Path) -> None:
     spec = small_spec()
     inline = run_inline(spec, tmp_path / "inline")

@@ -11,7 +11,12 @@ import pytest
 
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.campaign.parsing import default_campaign_spec, load_campaign_spec
-from sensing_antenna.campaign.runs import NOISE_SWEEP_STREAM, derive_seed, expand_runs
+from sensing_antenna.campaign.runs import (
+    NOISE_SWEEP_STREAM,
+    contact_point_label,
+    derive_seed,
+    expand_runs,
+)
 from sensing_antenna.campaign.schema import CampaignSpecError
 from sensing_antenna.errors import SensingAntennaError
 
@@ -63,6 +68,27 @@ def test_runs_are_ordered_named_and_seeded_deterministically() -> None:
     assert runs[7].seed == derive_seed(spec.base_seed, 7)
     # the free-motion step draws from another stream of the same base seed
     assert derive_seed(spec.base_seed, 0, stream=1) not in {r.seed for r in runs}
+
+
+def test_points_the_check_tells_apart_get_their_own_run_ids(tmp_path: Path) -> None:
+    # 0.5 and 0.5004 m are 0.4 mm apart: two points for the spec, so two runs with two files
+    spec = load_campaign_spec(write(tmp_path, GOOD.replace("0.5]", "0.5, 0.5004, 0.500401]")))
+    ids = [r.run_id for r in expand_runs(spec, paper_antenna())]
+    assert len(set(ids)) == len(ids) == 8
+    # whole millimetres keep the ids every earlier campaign directory has
+    assert ids[2:8:2] == [
+        "azimuthal-x0500mm-r1",
+        "azimuthal-x0500.4mm-r1",
+        "azimuthal-x0500.401mm-r1",
+    ]
+    assert contact_point_label(0.3) == "x0300mm" and contact_point_label(0.98) == "x0980mm"
+
+
+def test_points_one_id_would_name_are_refused_up_front(tmp_path: Path) -> None:
+    # 0.4 um apart: below the 1 um the ids resolve, so the spec must say they are one point
+    path = write(tmp_path, GOOD.replace("0.5]", "0.5, 0.5000004]"))
+    with pytest.raises(CampaignSpecError, match=r"contact_points: must be distinct to 1 um"):
+        load_campaign_spec(path)
 
 
 def test_a_good_file_loads_with_its_scenario(tmp_path: Path) -> None:

@@ -27,6 +27,7 @@ __all__ = [
     "DEFAULT_CALIBRATION_POINTS",
     "DEVICE_SECTIONS",
     "METHODS",
+    "CONTACT_POINT_RESOLUTION",
     "SCENARIO_NOISE_SCALE",
     "CalibrationStep",
     "CampaignSpec",
@@ -34,6 +35,7 @@ __all__ = [
     "DeviceSpec",
     "FreeMotionStep",
     "NoiseSweep",
+    "contact_point_key",
     "known_methods",
     "noise_level_key",
     "same_noise_level",
@@ -49,6 +51,11 @@ METHODS = ("paper", "ratio", "two-frequency")
 #: ``simulator.Scenario.noise_scale`` when the spec's ``[scenario]`` does not set it: the
 #: simulator's nominal sensor noise.
 SCENARIO_NOISE_SCALE = 1.0
+
+#: Contact points are told apart to this resolution (m), in the distinctness checks and in the
+#: run ids alike (:func:`contact_point_key`): 1 micrometre, far below anything the estimators
+#: resolve, so two points a spec means as different are never one run.
+CONTACT_POINT_RESOLUTION = 1e-6
 
 #: Antenna sections a ``[device]`` section may override, with the fields allowed in each. The
 #: link's ``calibrated_t`` and ``calibration_scatter`` are model parameters, not hardware, so a
@@ -312,8 +319,21 @@ def _check_contact_points(key: str, points: Sequence[float], source: str | None)
             raise CampaignSpecError(
                 f"{key}[{i}]", f"must be a finite length > 0 m, got {x!r}", source
             )
-    if len({round(x * 1e6) for x in points}) != len(points):
-        raise CampaignSpecError(key, "must be distinct", source)
+    first: dict[int, int] = {}
+    for i, x in enumerate(points):
+        j = first.setdefault(contact_point_key(x), i)
+        if j != i:
+            raise CampaignSpecError(
+                key,
+                f"must be distinct to {CONTACT_POINT_RESOLUTION * 1e6:g} um (as in the run ids): "
+                f"[{j}] = {points[j]!r} and [{i}] = {x!r} are one point",
+                source,
+            )
+
+
+def contact_point_key(contact_point: float) -> int:
+    """A contact point as the checks and the run ids tell it apart: whole micrometres."""
+    return round(contact_point * 1e6)
 
 
 def noise_level_key(noise_scale: float) -> int:
