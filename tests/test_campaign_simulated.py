@@ -106,6 +106,31 @@ def test_a_bad_scenario_field_stops_the_campaign_with_one_error(tmp_path: Path) 
         run_campaign(spec, tmp_path / "b", workers=1, progress=False)
 
 
+def test_every_run_scenario_is_checked_before_anything_is_written(tmp_path: Path) -> None:
+    from sensing_antenna.campaign.runner import run_campaign
+
+    # The preparation is the caller's (it checks nothing); the runs use the simulator, whose
+    # Scenario refuses a damping ratio of 1.5: one error, no directory, no run stored as failed.
+    spec = one_point_spec(scenario={"damping_ratio": 1.5}, source="bad.toml")
+    out = tmp_path / "out"
+    with pytest.raises(CampaignSpecError, match=r"bad\.toml: scenario\.damping_ratio: must be < 1"):
+        run_campaign(
+            spec, out, prepare_antenna=lambda _: paper_antenna(), workers=1, progress=False
+        )
+    assert not out.exists()
+
+
+def test_the_free_motion_scenario_is_checked_before_anything_is_written(tmp_path: Path) -> None:
+    from sensing_antenna.campaign.simulated import check_scenario
+
+    # a free motion of 0.005 s is below Scenario's shortest recording (0.01 s)
+    spec = one_point_spec(free_motion=FreeMotionStep(identify=True, duration=0.005))
+    with pytest.raises(
+        CampaignSpecError, match=r"free_motion\.duration: the free motion: must be >"
+    ):
+        check_scenario(spec)
+
+
 def test_free_motion_step_identifies_the_observer_once_and_stores_it(tmp_path: Path) -> None:
     from sensing_antenna.campaign.simulated import prepare_antenna
     from sensing_antenna.campaign.store import read_stored_antenna

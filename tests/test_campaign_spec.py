@@ -17,7 +17,13 @@ from sensing_antenna.campaign.runs import (
     derive_seed,
     expand_runs,
 )
-from sensing_antenna.campaign.schema import CampaignSpecError
+from sensing_antenna.campaign.schema import (
+    MAX_CONTACT_POINTS,
+    MAX_RUNS,
+    CalibrationStep,
+    CampaignSpecError,
+    NoiseSweep,
+)
 from sensing_antenna.errors import SensingAntennaError
 
 GOOD = """
@@ -458,3 +464,47 @@ def test_errors_in_a_base_name_the_base_file_and_cycles_are_refused(tmp_path: Pa
     b.write_text('base = "a.toml"\n', encoding="utf-8")
     with pytest.raises(CampaignSpecError, match=r"b\.toml: base: 'a\.toml' is based on this file"):
         load_campaign_spec(a)
+
+
+def test_a_billion_repeats_are_refused_before_any_run_list_is_built(tmp_path: Path) -> None:
+    path = write(tmp_path, GOOD.replace("repeats = 2", "repeats = 1000000000"))
+    with pytest.raises(
+        CampaignSpecError, match=rf"{re.escape(str(path))}: repeats: .*2000000000 runs"
+    ):
+        load_campaign_spec(path)
+    assert MAX_RUNS == 100_000
+
+
+def test_too_many_contact_points_or_noise_levels_are_refused(tmp_path: Path) -> None:
+    many = ", ".join(f"{0.3 + i * 1e-5:.5f}" for i in range(MAX_CONTACT_POINTS + 1))
+    path = write(
+        tmp_path, GOOD.replace("contact_points = [0.3, 0.5]", f"contact_points = [{many}]")
+    )
+    with pytest.raises(CampaignSpecError, match=r"contact_points: 1001 points, more than the 1000"):
+        load_campaign_spec(path)
+    levels = tuple(float(i) for i in range(10**6))
+    with pytest.raises(CampaignSpecError, match=r"noise_sweep\.noise_scales: 1000000 levels"):
+        NoiseSweep(noise_scales=levels)
+    with pytest.raises(CampaignSpecError, match=r"calibration\.repeats: .* = 15000 recordings"):
+        CalibrationStep(enabled=True, repeats=1000)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [
+        ("noise_scale = 0.5", "duration = 1e9", "scenario.duration"),
+        (
+            "noise_scale = 0.5",
+            "noise_scale = 0.5\n[free_motion]\nduration = 1e9",
+            "free_motion.duration",
+        ),
+    ],
+)
+def test_durations_longer_than_a_recording_may_be_are_refused(
+    tmp_path: Path, old: str, new: str, field: str
+) -> None:
+    path = write(tmp_path, GOOD.replace(old, new))
+    with pytest.raises(
+        CampaignSpecError, match=rf"{re.escape(field)}: 1000000000.0 s is longer than the 600 s"
+    ):
+        load_campaign_spec(path)

@@ -149,6 +149,8 @@ def run_campaign(
     if run_one is None or prepare_antenna is None:
         from sensing_antenna.campaign import simulated
 
+        # every scenario the simulation will be given, checked before anything is written
+        simulated.check_scenario(spec)
         run_one = run_one or simulated.simulate_and_estimate
         prepare_antenna = prepare_antenna or simulated.prepare_campaign
     directory = Path(out_dir)

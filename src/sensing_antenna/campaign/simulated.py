@@ -26,6 +26,7 @@ from sensing_antenna.campaign.runs import (
     RunSpec,
     calibration_runs,
     derive_seed,
+    plan_runs,
 )
 from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
@@ -174,17 +175,48 @@ def calibrate_on_device(
 
 
 def check_scenario(spec: CampaignSpec) -> None:
-    """Raise CampaignSpecError (naming the spec file) if the scenario section is not valid."""
+    """Check every scenario the campaign will simulate, before any work.
+
+    Each run's (case, contact point, noise level), the free motion (when identified) and each
+    calibration recording (when calibrating) is made into a ``simulator.Scenario``, whose checks
+    apply; seeds are left out (every derived seed is valid).
+
+    Raises
+    ------
+    CampaignSpecError
+        Naming the spec file and ``scenario.<field>`` (``free_motion.duration`` for the free
+        motion's length), on the first scenario that is not valid.
+    """
     from sensing_antenna.simulator.scenario import ScenarioError
 
-    try:
-        make_scenario(spec.cases[0], spec.contact_points[0], 0, dict(spec.scenario))
-    except ScenarioError as exc:
-        raise CampaignSpecError(
-            f"scenario.{exc.field_name}", str(exc).split(": ", 1)[-1], spec.source or None
-        ) from exc
-    except TypeError as exc:
-        raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc
+    checked: set[tuple[str, float | None, tuple[tuple[str, str], ...]]] = set()
+
+    def check(case: str, x_c: float | None, extra: Mapping[str, Any], prefix: str) -> None:
+        key = (case, x_c, tuple(sorted((k, repr(v)) for k, v in extra.items())))
+        if key in checked:
+            return
+        checked.add(key)
+        try:
+            make_scenario(case, x_c, 0, dict(extra))
+        except ScenarioError as exc:
+            field = exc.field_name
+            name = "free_motion.duration" if prefix and field == "duration" else f"scenario.{field}"
+            raise CampaignSpecError(
+                name, prefix + str(exc).split(": ", 1)[-1], spec.source or None
+            ) from exc
+        except CampaignSpecError as exc:
+            raise CampaignSpecError(exc.field_name, exc.problem, spec.source or None) from exc
+        except TypeError as exc:
+            raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc
+
+    for run in plan_runs(spec):
+        check(run.case, run.contact_point, run.scenario, "")
+    if spec.free_motion.identify:
+        extra = {**spec.scenario, "duration": spec.free_motion.duration}
+        check(spec.free_motion.case, None, extra, "the free motion: ")
+    if spec.calibration.enabled:
+        for _, x_c, _ in calibration_runs(spec):
+            check(spec.calibration.case, x_c, spec.scenario, "")
 
 
 def prepare_campaign(spec: CampaignSpec) -> Preparation:
