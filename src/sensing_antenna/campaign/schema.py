@@ -24,6 +24,7 @@ from sensing_antenna.errors import FieldError
 
 __all__ = [
     "CASES",
+    "CONTACT_POINT_RESOLUTION",
     "DEFAULT_CALIBRATION_POINTS",
     "DEVICE_SECTIONS",
     "MAX_CALIBRATION_RECORDINGS",
@@ -32,7 +33,6 @@ __all__ = [
     "MAX_RUNS",
     "MAX_RUN_DURATION",
     "METHODS",
-    "CONTACT_POINT_RESOLUTION",
     "SCENARIO_NOISE_SCALE",
     "CalibrationStep",
     "CampaignSpec",
