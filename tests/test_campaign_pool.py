@@ -245,3 +245,25 @@ def test_workers_exit_with_a_killed_main_process_and_a_plain_resume_finishes(
     assert resumed.returncode == 0, err
     assert "0 failed" in printed.splitlines()[0]
     assert len(stored_runs(out)) == 40
+
+
+def test_a_second_campaign_on_the_same_directory_is_refused_and_runs_nothing(
+    tmp_path: Path,
+) -> None:
+    spec = tmp_path / "signals.toml"
+    spec.write_text(SPEC, encoding="utf-8")
+    out = tmp_path / "out"
+    first = start_campaign(spec, out)
+    wait_for_runs(out, first, 2)
+    second = start_campaign(spec, out)
+    printed, err = second.communicate(timeout=120)
+    assert second.returncode == 2
+    assert printed == ""
+    assert err.startswith(
+        f"antenna campaign: error: {out}: in use by another campaign (process {first.pid} on "
+    )
+    printed, err = first.communicate(timeout=300)
+    assert first.returncode == 0, err
+    # every run done once, by the first: it ran them all and found none already done
+    assert printed.splitlines()[0] == "40 runs: 0 already done, 40 run now, 0 failed"
+    assert len(stored_runs(out)) == 40

@@ -36,8 +36,10 @@ from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import (
     CSV_FILE,
     Preparation,
-    load_run_results,
+    campaign_lock,
+    load_campaign_results,
     read_preparation,
+    remove_stale_temp_files,
     write_manifest,
     write_preparation,
     write_run_result,
@@ -80,6 +82,9 @@ class CampaignOutcome:
         Runs executed by this call.
     n_failed : int
         Stored runs whose status is failed (all of them, not only this call's).
+    foreign_run_files : tuple of str
+        Ids of valid run files in ``out_dir/runs`` that are not runs of the spec: left out of
+        ``runs.csv`` and the report.
     """
 
     out_dir: Path
@@ -88,6 +93,7 @@ class CampaignOutcome:
     n_previously_done: int
     n_executed: int
     n_failed: int
+    foreign_run_files: tuple[str, ...] = ()
 
 
 class CampaignInterrupted(KeyboardInterrupt):
@@ -246,53 +252,58 @@ def run_campaign(
     try:
         with _stop_signals_interrupt():
             directory.mkdir(parents=True, exist_ok=True)
-            write_manifest(directory, spec)
-            preparation = read_preparation(directory, spec)
-            if preparation is None:
-                prepared = prepare_antenna(spec)
-                preparation = (
-                    prepared if isinstance(prepared, Preparation) else Preparation.same(prepared)
-                )
-                write_preparation(directory, spec, preparation)
-            runs = expand_runs(spec, preparation.model, preparation.device)
-            done = load_run_results(directory, spec.methods)
-            if retry_failed:
-                done = {k: v for k, v in done.items() if v.status != RUN_FAILED}
-            pending = [run for run in runs if run.run_id not in done]
-            n_stored = len(runs) - len(pending)
-            task = functools.partial(execute_safely, run_one)
-            executed = 0
-            with (
-                tqdm(
-                    total=len(runs),
-                    initial=n_stored,
-                    desc=f"campaign {spec.name}",
-                    unit="run",
-                    file=sys.stderr,
-                    disable=not progress,
-                ) as bar,
-                contextlib.closing(
-                    _execute(task, pending, workers, scheduler, bar.write if progress else None)
-                ) as results,
-            ):
-                for result in results:
-                    write_run_result(directory, result)
-                    executed += 1
-                    n_stored += 1
-                    bar.update(1)
+            with campaign_lock(directory):
+                remove_stale_temp_files(directory)
+                write_manifest(directory, spec)
+                preparation = read_preparation(directory, spec)
+                if preparation is None:
+                    prepared = prepare_antenna(spec)
+                    preparation = (
+                        prepared
+                        if isinstance(prepared, Preparation)
+                        else Preparation.same(prepared)
+                    )
+                    write_preparation(directory, spec, preparation)
+                runs = expand_runs(spec, preparation.model, preparation.device)
+                done = load_campaign_results(directory, spec).results
+                if retry_failed:
+                    done = {k: v for k, v in done.items() if v.status != RUN_FAILED}
+                pending = [run for run in runs if run.run_id not in done]
+                n_stored = len(runs) - len(pending)
+                task = functools.partial(execute_safely, run_one)
+                executed = 0
+                with (
+                    tqdm(
+                        total=len(runs),
+                        initial=n_stored,
+                        desc=f"campaign {spec.name}",
+                        unit="run",
+                        file=sys.stderr,
+                        disable=not progress,
+                    ) as bar,
+                    contextlib.closing(
+                        _execute(task, pending, workers, scheduler, bar.write if progress else None)
+                    ) as results,
+                ):
+                    for result in results:
+                        write_run_result(directory, result)
+                        executed += 1
+                        n_stored += 1
+                        bar.update(1)
+                stored = load_campaign_results(directory, spec)
+                csv_path = write_runs_csv(directory / CSV_FILE, stored.results.values())
     except KeyboardInterrupt as exc:
         number = exc.signal_number if isinstance(exc, CampaignInterrupted) else signal.SIGINT
         where = directory if directory.is_dir() else None
         raise CampaignInterrupted(number, where, n_stored, n_runs) from None
-    stored = load_run_results(directory, spec.methods)
-    csv_path = write_runs_csv(directory / CSV_FILE, stored.values())
     return CampaignOutcome(
         out_dir=directory,
         csv_path=csv_path,
         n_runs=len(runs),
         n_previously_done=len(runs) - len(pending),
         n_executed=executed,
-        n_failed=sum(1 for r in stored.values() if r.status == RUN_FAILED),
+        n_failed=sum(1 for r in stored.results.values() if r.status == RUN_FAILED),
+        foreign_run_files=stored.foreign,
     )
 
 

@@ -71,6 +71,15 @@ def _run(args: argparse.Namespace) -> int:
         f"{outcome.n_runs} runs: {outcome.n_previously_done} already done, "
         f"{outcome.n_executed} run now, {outcome.n_failed} failed"
     )
+    foreign = outcome.foreign_run_files
+    if foreign:
+        more = f" and {len(foreign) - 10} more" if len(foreign) > 10 else ""
+        print(
+            f"antenna campaign: left out {len(foreign)} run file(s) in "
+            f"{outcome.out_dir / 'runs'} that are not runs of this spec: "
+            f"{', '.join(foreign[:10])}{more}",
+            file=sys.stderr,
+        )
     print(build_report(outcome.out_dir))
     if outcome.n_failed:
         print(
