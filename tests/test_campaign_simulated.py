@@ -147,3 +147,34 @@ def test_free_motion_step_identifies_the_observer_once_and_stores_it(tmp_path: P
     run_campaign(spec, tmp_path, workers=1, progress=False)
     stored = read_stored_antenna(tmp_path)
     assert stored is not None and stored.observer == antenna.observer
+
+
+def test_a_campaign_says_what_it_does_from_its_first_moment(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from sensing_antenna.campaign.runner import run_campaign
+    from sensing_antenna.campaign.schema import CalibrationStep
+
+    spec = one_point_spec(
+        free_motion=FreeMotionStep(identify=True, duration=2.0),
+        calibration=CalibrationStep(enabled=True, contact_points=(0.4, 0.7)),
+        methods=("ratio",),
+    )
+    run_campaign(spec, tmp_path, workers=1, progress=True)
+    err = capsys.readouterr().err
+    lines = [line for chunk in err.split("\n") for line in chunk.split("\r") if line.strip()]
+    # a line before any work, one per preparation step, the calibration's bar, then the runs'
+    expected = [
+        f"campaign one: 1 runs (1 main) x 1 method(s) (ratio), in {tmp_path}",
+        "preparation: identifying the free-motion observer (Eq. 15) on a 2 s free motion",
+        "preparation: calibrating T_e on 2 contact recordings of the device (Section 5.1)",
+        "calibration: 100%",
+        "runs: 0 of 1 stored already, 1 to run in this process",
+        "campaign one: 100%",
+    ]
+    positions = [next(i for i, line in enumerate(lines) if line.startswith(e)) for e in expected]
+    assert positions == sorted(positions) and positions[0] == 0
+    run_campaign(spec, tmp_path, workers=1, progress=True)
+    again = capsys.readouterr().err
+    assert f"preparation: the one stored in {tmp_path}" in again
+    assert "runs: 1 of 1 stored already, 0 to run (nothing to do)" in again

@@ -18,7 +18,6 @@ import contextlib
 import functools
 import os
 import signal
-import sys
 import threading
 import traceback
 from collections.abc import Callable, Generator, Iterator, Sequence
@@ -26,10 +25,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
 
-from tqdm import tqdm
-
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.pool import run_on_workers
+from sensing_antenna.campaign.progress import Progress
 from sensing_antenna.campaign.records import RUN_FAILED, RunResult
 from sensing_antenna.campaign.runs import RunSpec, expand_runs
 from sensing_antenna.campaign.schema import CampaignSpec
@@ -231,7 +229,8 @@ def run_campaign(
     retry_failed : bool
         Redo runs stored as failed.
     progress : bool
-        Show a progress bar on stderr.
+        Say on stderr what the campaign is doing, from the start: a line for the campaign and
+        for each preparation step, bars for the calibration recordings and the runs.
 
     Returns
     -------
@@ -239,15 +238,23 @@ def run_campaign(
     """
     if workers is not None and workers < 1:
         raise SensingAntennaError(f"--workers: must be >= 1, got {workers}")
+    report = Progress(enabled=progress)
+    directory = Path(out_dir)
+    prepare: PrepareAntenna
     if run_one is None or prepare_antenna is None:
         from sensing_antenna.campaign import simulated
 
         # every scenario the simulation will be given, checked before anything is written
         simulated.check_scenario(spec)
         run_one = run_one or simulated.simulate_and_estimate
-        prepare_antenna = prepare_antenna or simulated.prepare_campaign
-    directory = Path(out_dir)
-    n_runs = spec.n_runs
+        prepare = prepare_antenna or functools.partial(simulated.prepare_campaign, progress=report)
+    else:
+        prepare = prepare_antenna
+    sweep = f", {spec.n_sweep_runs} in the noise sweep" if spec.n_sweep_runs else ""
+    report.line(
+        f"campaign {spec.name}: {spec.n_runs} runs ({spec.n_main_runs} main{sweep}) x "
+        f"{len(spec.methods)} method(s) ({', '.join(spec.methods)}), in {directory}"
+    )
     n_stored = 0
     try:
         with _stop_signals_interrupt():
@@ -255,34 +262,23 @@ def run_campaign(
             with campaign_lock(directory):
                 remove_stale_temp_files(directory)
                 write_manifest(directory, spec)
-                preparation = read_preparation(directory, spec)
-                if preparation is None:
-                    prepared = prepare_antenna(spec)
-                    preparation = (
-                        prepared
-                        if isinstance(prepared, Preparation)
-                        else Preparation.same(prepared)
-                    )
-                    write_preparation(directory, spec, preparation)
+                preparation = _prepared(directory, spec, prepare, report)
                 runs = expand_runs(spec, preparation.model, preparation.device)
                 done = load_campaign_results(directory, spec).results
                 if retry_failed:
                     done = {k: v for k, v in done.items() if v.status != RUN_FAILED}
                 pending = [run for run in runs if run.run_id not in done]
                 n_stored = len(runs) - len(pending)
+                report.line(
+                    f"runs: {n_stored} of {len(runs)} stored already, {len(pending)} to run "
+                    + _where(pending, workers, scheduler)
+                )
                 task = functools.partial(execute_safely, run_one)
                 executed = 0
                 with (
-                    tqdm(
-                        total=len(runs),
-                        initial=n_stored,
-                        desc=f"campaign {spec.name}",
-                        unit="run",
-                        file=sys.stderr,
-                        disable=not progress,
-                    ) as bar,
+                    report.bar(len(runs), f"campaign {spec.name}", initial=n_stored) as bar,
                     contextlib.closing(
-                        _execute(task, pending, workers, scheduler, bar.write if progress else None)
+                        _execute(task, pending, workers, scheduler, report.line)
                     ) as results,
                 ):
                     for result in results:
@@ -295,7 +291,7 @@ def run_campaign(
     except KeyboardInterrupt as exc:
         number = exc.signal_number if isinstance(exc, CampaignInterrupted) else signal.SIGINT
         where = directory if directory.is_dir() else None
-        raise CampaignInterrupted(number, where, n_stored, n_runs) from None
+        raise CampaignInterrupted(number, where, n_stored, spec.n_runs) from None
     return CampaignOutcome(
         out_dir=directory,
         csv_path=csv_path,
@@ -305,6 +301,30 @@ def run_campaign(
         n_failed=sum(1 for r in stored.results.values() if r.status == RUN_FAILED),
         foreign_run_files=stored.foreign,
     )
+
+
+def _prepared(
+    directory: Path, spec: CampaignSpec, prepare: PrepareAntenna, report: Progress
+) -> Preparation:
+    """The preparation stored in ``directory`` for this spec, or made now and stored."""
+    preparation = read_preparation(directory, spec)
+    if preparation is not None:
+        report.line(f"preparation: the one stored in {directory} (model, device, calibration)")
+        return preparation
+    prepared = prepare(spec)
+    preparation = prepared if isinstance(prepared, Preparation) else Preparation.same(prepared)
+    write_preparation(directory, spec, preparation)
+    return preparation
+
+
+def _where(pending: Sequence[RunSpec], workers: int | None, scheduler: str | None) -> str:
+    """Where the pending runs will execute, in words."""
+    if not pending:
+        return "(nothing to do)"
+    if scheduler is not None:
+        return f"on the Dask cluster at {scheduler}"
+    n = min(workers or os.cpu_count() or 1, len(pending))
+    return "in this process" if n == 1 else f"on {n} worker processes"
 
 
 def _execute(
