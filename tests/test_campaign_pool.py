@@ -267,3 +267,16 @@ def test_a_second_campaign_on_the_same_directory_is_refused_and_runs_nothing(
     # every run done once, by the first: it ran them all and found none already done
     assert printed.splitlines()[0] == "40 runs: 0 already done, 40 run now, 0 failed"
     assert len(stored_runs(out)) == 40
+
+
+def test_progress_bars_start_no_thread_in_the_process_that_forks_the_workers() -> None:
+    import io
+    import threading
+
+    from sensing_antenna.campaign.progress import Progress
+
+    before = threading.active_count()
+    with Progress(enabled=True, stream=io.StringIO()).bar(3, "runs") as bar:
+        bar.update(1)
+        # tqdm's own bars start a monitor thread; forking beside a thread can deadlock a worker
+        assert threading.active_count() == before

@@ -16,6 +16,13 @@ from tqdm import tqdm
 __all__ = ["Progress"]
 
 
+class _Bar(tqdm):
+    """A tqdm bar without tqdm's monitor thread: the campaign forks worker processes while its
+    bars are shown, and forking a process that runs other threads can deadlock the child."""
+
+    monitor_interval = 0
+
+
 class Progress:
     """Lines and progress bars for one campaign.
 
@@ -43,7 +50,7 @@ class Progress:
 
     def bar(self, total: int, description: str, unit: str = "run", initial: int = 0) -> tqdm:
         """A progress bar of ``total`` items (use as a context manager, ``update(1)`` per item)."""
-        return tqdm(
+        return _Bar(
             total=total,
             initial=initial,
             desc=description,
