@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.campaign.limits import MAX_CONTACT_POINTS, MAX_RUNS
 from sensing_antenna.campaign.parsing import default_campaign_spec, load_campaign_spec
 from sensing_antenna.campaign.runs import (
     NOISE_SWEEP_STREAM,
@@ -17,13 +18,7 @@ from sensing_antenna.campaign.runs import (
     derive_seed,
     expand_runs,
 )
-from sensing_antenna.campaign.schema import (
-    MAX_CONTACT_POINTS,
-    MAX_RUNS,
-    CalibrationStep,
-    CampaignSpecError,
-    NoiseSweep,
-)
+from sensing_antenna.campaign.schema import CalibrationStep, CampaignSpecError, NoiseSweep
 from sensing_antenna.errors import SensingAntennaError
 
 GOOD = """

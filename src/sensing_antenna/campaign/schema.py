@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
+from sensing_antenna.campaign import limits
 from sensing_antenna.errors import FieldError
 
 __all__ = [
@@ -27,11 +28,6 @@ __all__ = [
     "CONTACT_POINT_RESOLUTION",
     "DEFAULT_CALIBRATION_POINTS",
     "DEVICE_SECTIONS",
-    "MAX_CALIBRATION_RECORDINGS",
-    "MAX_CONTACT_POINTS",
-    "MAX_NOISE_LEVELS",
-    "MAX_RUNS",
-    "MAX_RUN_DURATION",
     "METHODS",
     "SCENARIO_NOISE_SCALE",
     "CalibrationStep",
@@ -61,25 +57,6 @@ SCENARIO_NOISE_SCALE = 1.0
 #: run ids alike (:func:`contact_point_key`): 1 micrometre, far below anything the estimators
 #: resolve, so two points a spec means as different are never one run.
 CONTACT_POINT_RESOLUTION = 1e-6
-
-#: Limits on the size of a campaign, checked when the spec is made, before any work; the reasons
-#: (with measured figures) are in docs/campaigns.md, "Limits".
-#:
-#: Runs in a campaign, main and noise sweep: every stored run is read into memory to resume and
-#: to build the report, and the run list itself is built in memory.
-MAX_RUNS = 100_000
-#: Contact points in one list (main, noise sweep, calibration): the tables in the layout of
-#: Tables 3 and 4 have one row per point; this many is a 1 mm grid on a 1 m link.
-MAX_CONTACT_POINTS = 1_000
-#: Noise levels of the sweep: its tables have one row per level and method.
-MAX_NOISE_LEVELS = 100
-#: Calibration recordings (points x repeats): simulated one after another in the main process
-#: before any run.
-MAX_CALIBRATION_RECORDINGS = 1_000
-#: Simulated duration of one recording (s), ``scenario.duration`` and ``free_motion.duration``:
-#: a worker holds the whole recording and the simulator's history in memory, and a contact
-#: manoeuvre lasts seconds (``simulator.Scenario`` default 3.5 s).
-MAX_RUN_DURATION = 600.0
 
 #: Antenna sections a ``[device]`` section may override, with the fields allowed in each. The
 #: link's ``calibrated_t`` and ``calibration_scatter`` are model parameters, not hardware, so a
@@ -154,7 +131,8 @@ class FreeMotionStep:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.duration) and self.duration > 0):
             raise CampaignSpecError("free_motion.duration", f"must be > 0 s, got {self.duration!r}")
-        _check_duration("free_motion.duration", self.duration, None)
+        if problem := limits.duration_problem(self.duration):
+            raise CampaignSpecError("free_motion.duration", problem)
 
 
 @dataclass(frozen=True)
@@ -246,7 +224,8 @@ class CalibrationStep:
             raise CampaignSpecError(
                 "calibration.contact_points", "needs at least 2 points (m) to fit T_e"
             )
-        _check_count("calibration.contact_points", len(self.contact_points), None)
+        if problem := limits.contact_points_problem(len(self.contact_points)):
+            raise CampaignSpecError("calibration.contact_points", problem)
         for i, x in enumerate(self.contact_points):
             if not (math.isfinite(x) and x > 0):
                 raise CampaignSpecError(
@@ -254,14 +233,8 @@ class CalibrationStep:
                 )
         if self.repeats < 1:
             raise CampaignSpecError("calibration.repeats", f"must be >= 1, got {self.repeats!r}")
-        if self.n_recordings > MAX_CALIBRATION_RECORDINGS:
-            raise CampaignSpecError(
-                "calibration.repeats",
-                f"{len(self.contact_points)} points x {self.repeats} repeats = "
-                f"{self.n_recordings} recordings, more than the {MAX_CALIBRATION_RECORDINGS} a "
-                "calibration may simulate (they run one after another before any run; see "
-                "docs/campaigns.md, Limits)",
-            )
+        if problem := limits.calibration_problem(len(self.contact_points), self.repeats):
+            raise CampaignSpecError("calibration.repeats", problem)
         if self.loss not in _CALIBRATION_LOSSES:
             raise CampaignSpecError(
                 "calibration.loss",
@@ -311,12 +284,8 @@ class NoiseSweep:
     cases: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
-        if len(self.noise_scales) > MAX_NOISE_LEVELS:
-            raise CampaignSpecError(
-                "noise_sweep.noise_scales",
-                f"{len(self.noise_scales)} levels, more than the {MAX_NOISE_LEVELS} a sweep may "
-                "have (its tables have a row per level and method; see docs/campaigns.md, Limits)",
-            )
+        if problem := limits.noise_levels_problem(len(self.noise_scales)):
+            raise CampaignSpecError("noise_sweep.noise_scales", problem)
         for i, s in enumerate(self.noise_scales):
             if not (math.isfinite(s) and s >= 0):
                 raise CampaignSpecError(
@@ -354,7 +323,8 @@ def _check_contact_points(key: str, points: Sequence[float], source: str | None)
     """At least one contact point, each a finite length > 0 m, all distinct (to 1 um)."""
     if not points:
         raise CampaignSpecError(key, "must list at least one point (m)", source)
-    _check_count(key, len(points), source)
+    if problem := limits.contact_points_problem(len(points)):
+        raise CampaignSpecError(key, problem, source)
     for i, x in enumerate(points):
         if not (math.isfinite(x) and x > 0):
             raise CampaignSpecError(
@@ -370,32 +340,6 @@ def _check_contact_points(key: str, points: Sequence[float], source: str | None)
                 f"[{j}] = {points[j]!r} and [{i}] = {x!r} are one point",
                 source,
             )
-
-
-def _check_count(key: str, n_points: int, source: str | None) -> None:
-    if n_points > MAX_CONTACT_POINTS:
-        raise CampaignSpecError(
-            key,
-            f"{n_points} points, more than the {MAX_CONTACT_POINTS} a list may have (one table "
-            "row per point; see docs/campaigns.md, Limits)",
-            source,
-        )
-
-
-def _check_duration(key: str, duration: object, source: str | None) -> None:
-    """A simulated duration no longer than :data:`MAX_RUN_DURATION` (other checks: Scenario)."""
-    if (
-        isinstance(duration, (int, float))
-        and not isinstance(duration, bool)
-        and duration > MAX_RUN_DURATION
-    ):
-        raise CampaignSpecError(
-            key,
-            f"{duration!r} s is longer than the {MAX_RUN_DURATION:g} s a campaign simulates per "
-            "recording (a worker holds the whole recording in memory; see docs/campaigns.md, "
-            "Limits)",
-            source,
-        )
 
 
 def contact_point_key(contact_point: float) -> int:
@@ -476,16 +420,11 @@ class CampaignSpec:
             raise CampaignSpecError("repeats", f"must be >= 1, got {self.repeats!r}", src)
         if self.base_seed < 0:
             raise CampaignSpecError("base_seed", f"must be >= 0, got {self.base_seed!r}", src)
-        if self.n_runs > MAX_RUNS:
-            raise CampaignSpecError(
-                "repeats" if self.n_main_runs > MAX_RUNS else "noise_sweep",
-                f"the campaign would have {self.n_runs} runs ({self.n_main_runs} main, "
-                f"{self.n_sweep_runs} in the noise sweep), more than the {MAX_RUNS} a campaign may "
-                "have (every run is held in memory to resume and to report; see "
-                "docs/campaigns.md, Limits); split it into several campaigns",
-                src,
-            )
-        _check_duration("scenario.duration", self.scenario.get("duration"), src)
+        if problem := limits.runs_problem(self.n_main_runs, self.n_sweep_runs):
+            field_name = "repeats" if self.n_main_runs > limits.MAX_RUNS else "noise_sweep"
+            raise CampaignSpecError(field_name, problem, src)
+        if problem := limits.duration_problem(self.scenario.get("duration")):
+            raise CampaignSpecError("scenario.duration", problem, src)
         for key in self.scenario:
             if key in _RESERVED_SCENARIO_KEYS:
                 raise CampaignSpecError(
