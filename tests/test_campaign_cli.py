@@ -106,3 +106,37 @@ def test_methods_option_replaces_the_spec_methods_and_names_bad_ones(
     assert main(["campaign", "run", "--methods", "paper,bogus", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert "methods" in err and "bogus" in err
+
+
+def test_campaign_run_exits_non_zero_while_runs_are_left_failed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec_file = tmp_path / "one.toml"
+    spec_file.write_text(
+        'name = "one"\nantenna = "paper-2021"\ncases = ["azimuthal"]\ncontact_points = [0.4, 0.7]\n'
+        'repeats = 1\nbase_seed = 5\nmethods = ["ratio"]\n',
+        encoding="utf-8",
+    )
+    from sensing_antenna.campaign.parsing import load_campaign_spec
+
+    def fails_at_04(run: RunSpec) -> RunResult:
+        if run.contact_point == 0.4:
+            raise RuntimeError("diverged")
+        return toy_run(run)
+
+    out = tmp_path / "out"
+    run_campaign(
+        load_campaign_spec(spec_file),
+        out,
+        run_one=fails_at_04,
+        prepare_antenna=plain,
+        workers=1,
+        progress=False,
+    )
+    # a plain resume leaves the failed run as it is: the command must not say all is well
+    assert main(["campaign", "run", str(spec_file), "--out", str(out), "--no-progress"]) == 1
+    captured = capsys.readouterr()
+    assert captured.out.splitlines()[0] == "2 runs: 2 already done, 0 run now, 1 failed"
+    assert captured.err.splitlines() == [
+        "antenna campaign: 1 run(s) failed (listed in the report); --retry-failed runs them again"
+    ]

@@ -227,7 +227,9 @@ def test_report_renders_a_method_with_intervals(tmp_path: Path) -> None:
     assert "## Time to estimate and uncertainty" in text
     # [0.51, 0.53] m contains none of the true points 0.3 and 0.5 m; 6 runs per case
     assert "| azimuthal | ratio | 0.200 | 0/6 (0 %) | 0/6 (0 %) | 2.00 |" in text
-    assert "| azimuthal | paper | - | - | - | - |" in text
+    # the toy paper method records no times and no interval: no row of dashes, a sentence
+    assert "| azimuthal | paper |" not in text.split("## Time to estimate")[1].split("##")[0]
+    assert "paper: no t_1, t_e or interval recorded." in text
     header = (tmp_path / "runs.csv").read_text("utf-8").splitlines()[0].split(",")
     assert "interval_low_m" in header and "interval_high_m" in header
 
@@ -350,7 +352,7 @@ def test_report_with_a_noise_sweep_and_fast_has_its_sections_and_figures(tmp_pat
     assert "| noise 1 (main runs) | 4 |" in text
     # noise section: error per level and method; omega_1 against the truth, with CRB and SE
     assert "## Noise sweep" in text
-    assert "| 0.5 | fast | 2/2 | 1.00 | 1.00 | 0.250 | 2 |" in text
+    assert "| 0.5 | fast | 2/2 | 1.00 | 1.00 | 0.250 | ok 2 |" in text
     assert "| 3 | fast | 2 | 0.600 | 0.600 | 0.3000 | 0.6000 |" in text
     assert "| 3 | paper | 2 | 0.100 | 0.100 | - | - |" in text
     figure = tmp_path / "figures" / "frequency-error-vs-noise.png"
@@ -366,3 +368,139 @@ def test_a_report_without_fast_or_sweep_has_neither_section(campaign_dir: Path) 
     assert "## Noise sweep" not in text
     assert "## Fast method against its targets" not in text
     assert "## Nominal x_c and the contact abscissa" in text
+
+
+def _fixed_window_run(run: RunSpec) -> RunResult:
+    """paper and ratio conclude 1 s after the push, as the default methods do; at noise 4 the
+    second contact point never reaches the push (no estimate, status push_not_reached), and
+    ratio lands exactly on the truth at 0.3 m (an error of exactly 0)."""
+    contact = run.contact_point
+    if run.noise_scale == 4.0 and math.isclose(contact, 0.6):
+        stopped = [
+            ContactEstimate(status="push_not_reached", reason="no push", method=m)
+            for m in ("paper", "ratio")
+        ]
+        return result_of(run, stopped, contact_abscissa=contact)
+    ratio_x = contact if math.isclose(contact, 0.3) else contact + 0.01
+    estimates = [
+        ok("paper", contact + 0.001, t_1=1.0, t_e=2.0, omega1=50.0),
+        ok("ratio", ratio_x, t_1=1.0, t_e=2.0),
+    ]
+    return result_of(run, estimates, contact_abscissa=contact)
+
+
+@pytest.fixture
+def fixed_window_dir(tmp_path: Path) -> Path:
+    swept = CampaignSpec(
+        name="fixed-window",
+        antenna="paper-2021",
+        cases=("azimuthal",),
+        contact_points=(0.3, 0.6),
+        repeats=2,
+        base_seed=1,
+        methods=("paper", "ratio"),
+        noise_sweep=NoiseSweep(noise_scales=(4.0,), repeats=1),
+    )
+    run_campaign(
+        swept,
+        tmp_path,
+        run_one=_fixed_window_run,
+        prepare_antenna=plain,
+        workers=1,
+        progress=False,
+    )
+    return tmp_path
+
+
+def test_the_report_says_why_methods_have_a_fixed_time_instead_of_a_column_of_ones(
+    fixed_window_dir: Path,
+) -> None:
+    text = build_report(fixed_window_dir, figures=False).read_text("utf-8")
+    section = text.split("## Time to estimate and uncertainty")[1].split("\n## ")[0]
+    assert (
+        "paper and ratio conclude 1.000 s after the push in every run (t_e - t_1 is fixed: the "
+        "end of the spectrum window, `EstimatorConfig.spectrum_window`) and give no interval, so "
+        "the table has no row for them."
+    ) in section
+    assert "| case |" not in section
+    noise = text.split("## Noise sweep")[1]
+    assert "t_e - t_1 is 1.000 s in every run of every method" in noise
+    assert "median t_e - t_1" not in noise
+
+
+def test_a_noise_row_says_what_became_of_the_runs_without_an_estimate(
+    fixed_window_dir: Path,
+) -> None:
+    text = build_report(fixed_window_dir, figures=False).read_text("utf-8")
+    # noise 4: of 2 runs, 1 reached the push; the other is counted under its status
+    assert "| 4 | paper | 1/2 | 1.00 | 1.00 | ok 1, push_not_reached 1 |" in text
+    assert "| 1 (main) | ratio | 4/4 | 5.00 | 10.00 | ok 4 |" in text
+
+
+def test_the_report_labels_the_largest_absolute_error_as_such(fixed_window_dir: Path) -> None:
+    text = build_report(fixed_window_dir, figures=False).read_text("utf-8")
+    assert "max e" not in text
+    assert "| max abs e |" in text and "| paper: max abs e |" in text
+    assert "max abs e is the largest |e| (the paper's e_max)" in text
+    assert "max abs e, nominal (mm)" in text and "max abs e (mm)" in text
+
+
+class DrawnFigures:
+    """Every matplotlib figure saved while in use, by file name (public Figure.savefig wrapped)."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch) -> None:
+        from matplotlib.figure import Figure
+
+        self.saved: dict[str, Figure] = {}
+        original = Figure.savefig
+
+        def keep(figure: Figure, path: object, *args: object, **kwargs: object) -> None:
+            self.saved[Path(str(path)).name] = figure
+            original(figure, path, *args, **kwargs)
+
+        monkeypatch.setattr(Figure, "savefig", keep)
+
+    def texts(self, name: str) -> list[str]:
+        from matplotlib.text import Text
+
+        return [t.get_text() for t in self.saved[name].findobj(Text) if t.get_text()]
+
+
+def test_a_zero_error_is_drawn_at_zero_not_on_a_log_floor(
+    fixed_window_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    drawn = DrawnFigures(monkeypatch)
+    build_report(fixed_window_dir)
+    (axes,) = drawn.saved["errors-by-method.png"].axes
+    assert axes.get_yscale() == "symlog" and axes.get_ylim()[0] == 0.0
+    (ratio,) = [line for line in axes.get_lines() if line.get_label() == "ratio"]
+    # ratio's mean |error| at 0.3 m is exactly 0 (the toy lands on the truth); at 0.6 m 1 cm
+    ydata = ratio.get_ydata()
+    assert ydata[0] == 0.0 and ydata[1] == pytest.approx(1.0, abs=ROUND_OFF * 100)
+    assert "linear below 0.001 cm, log above" in drawn.texts("errors-by-method.png")
+
+
+def test_the_frequency_figure_promises_a_bound_only_when_it_draws_one(
+    fixed_window_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    drawn = DrawnFigures(monkeypatch)
+    build_report(fixed_window_dir)
+    titles = drawn.texts("frequency-error-vs-noise.png")
+    assert "Frequency error against noise (no method here reports a Cramer-Rao bound)" in titles
+    assert not any("CRB" in t for t in titles)
+    swept = CampaignSpec(
+        name="toy-sweep",
+        antenna="paper-2021",
+        cases=("azimuthal",),
+        contact_points=(0.4, 0.6),
+        repeats=1,
+        base_seed=1,
+        methods=("paper", "fast"),
+        noise_sweep=NoiseSweep(noise_scales=(3.0,), repeats=1),
+    )
+    out = tmp_path / "with-fast"
+    run_campaign(swept, out, run_one=_sweep_run, prepare_antenna=plain, workers=1, progress=False)
+    build_report(out)
+    titles = drawn.texts("frequency-error-vs-noise.png")
+    assert "Frequency error against noise, beside the Cramer-Rao bound reported by fast" in titles
+    assert "fast: CRB (median)" in titles

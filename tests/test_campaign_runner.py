@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -20,10 +21,11 @@ from threadpoolctl import threadpool_limits
 from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign.dask_plugin import OneBlasThreadPerDaskWorker
 from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, CampaignRow, RunResult
+from sensing_antenna.campaign.report import build_report
 from sensing_antenna.campaign.runner import CampaignOutcome, execute_safely, run_campaign
 from sensing_antenna.campaign.runs import RunSpec, expand_runs
 from sensing_antenna.campaign.schema import CampaignSpec
-from sensing_antenna.campaign.store import CampaignStoreError, load_run_results
+from sensing_antenna.campaign.store import CampaignStoreError, campaign_lock, load_run_results
 from sensing_antenna.estimation import ContactEstimate
 
 #: Columns that depend on wall-clock time and may differ between identical campaigns.
@@ -108,6 +110,15 @@ def test_inline_campaign_writes_one_file_per_run_and_a_row_per_method(tmp_path: 
     # error is estimate minus truth, in metres
     estimate = float(first["x_c_estimate_m"])
     assert float(first["error_m"]) == pytest.approx(estimate - 0.3, abs=1e-12)
+
+
+def test_points_half_a_millimetre_apart_are_two_runs_with_two_files(tmp_path: Path) -> None:
+    spec = small_spec(cases=("azimuthal",), contact_points=(0.5, 0.5004), repeats=1)
+    outcome = run_inline(spec, tmp_path)
+    assert (outcome.n_runs, outcome.n_executed) == (2, 2)
+    assert len(list((tmp_path / "runs").glob("*.json"))) == 2
+    truths = sorted({float(row["x_c_true_m"]) for row in read_rows(outcome.csv_path)})
+    assert truths == [0.5, 0.5004]
 
 
 def test_process_pool_gives_the_same_results_as_inline(tmp_path: Path) -> None:
@@ -243,6 +254,48 @@ def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:
     damaged.write_text(json.dumps({"run_id": "vertical-x0900mm-r2"}), encoding="utf-8")
     with pytest.raises(CampaignStoreError, match=r"vertical-x0900mm-r2\.json: damaged run file"):
         load_run_results(tmp_path, small_spec().methods)
+
+
+def test_a_run_file_not_in_the_spec_is_left_out_and_named(tmp_path: Path) -> None:
+    other = run_inline(small_spec(contact_points=(0.45,)), tmp_path / "other")
+    assert other.n_executed == 4
+    out = tmp_path / "out"
+    run_inline(small_spec(), out)
+    stray = out / "runs" / "azimuthal-x0450mm-r1.json"
+    stray.write_bytes((tmp_path / "other" / "runs" / stray.name).read_bytes())
+    outcome = run_inline(small_spec(), out)
+    assert outcome.foreign_run_files == ("azimuthal-x0450mm-r1",)
+    assert outcome.n_executed == 0
+    rows = read_rows(outcome.csv_path)
+    assert len(rows) == 12 * 2 and all(row["x_c_true_m"] != "0.45" for row in rows)
+    report = build_report(out, figures=False).read_text("utf-8")
+    assert "- Left out: 1 run file(s) in `runs/` that are not runs of this spec" in report
+    assert "`azimuthal-x0450mm-r1`" in report
+
+
+def test_temp_files_of_writers_that_are_gone_are_removed_at_start(tmp_path: Path) -> None:
+    run_inline(small_spec(), tmp_path)
+    # a pid above Linux's pid_max (2^22) belongs to no process; the parent of this test is alive
+    gone = tmp_path / "runs" / ".azimuthal-x0300mm-r1.json.99999999.tmp"
+    gone_csv = tmp_path / ".runs.csv.99999999.tmp"
+    alive = tmp_path / f".report.md.{os.getppid()}.tmp"
+    for path in (gone, gone_csv, alive):
+        path.write_text("half written", encoding="utf-8")
+    run_inline(small_spec(), tmp_path)
+    assert not gone.exists() and not gone_csv.exists()
+    assert alive.exists()
+
+
+def test_a_directory_in_use_by_another_campaign_is_refused(tmp_path: Path) -> None:
+    run_inline(small_spec(repeats=1), tmp_path)
+    with campaign_lock(tmp_path):  # as the other campaign holds it
+        with pytest.raises(
+            CampaignStoreError, match=rf"in use by another campaign \(process {os.getpid()} on "
+        ):
+            run_inline(small_spec(), tmp_path)
+    # the lock ends with its holder; the file it leaves behind is no lock
+    assert (tmp_path / ".lock").is_file()
+    assert run_inline(small_spec(repeats=1), tmp_path).n_executed == 0
 
 
 def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:

@@ -106,6 +106,31 @@ def test_a_bad_scenario_field_stops_the_campaign_with_one_error(tmp_path: Path) 
         run_campaign(spec, tmp_path / "b", workers=1, progress=False)
 
 
+def test_every_run_scenario_is_checked_before_anything_is_written(tmp_path: Path) -> None:
+    from sensing_antenna.campaign.runner import run_campaign
+
+    # The preparation is the caller's (it checks nothing); the runs use the simulator, whose
+    # Scenario refuses a damping ratio of 1.5: one error, no directory, no run stored as failed.
+    spec = one_point_spec(scenario={"damping_ratio": 1.5}, source="bad.toml")
+    out = tmp_path / "out"
+    with pytest.raises(CampaignSpecError, match=r"bad\.toml: scenario\.damping_ratio: must be < 1"):
+        run_campaign(
+            spec, out, prepare_antenna=lambda _: paper_antenna(), workers=1, progress=False
+        )
+    assert not out.exists()
+
+
+def test_the_free_motion_scenario_is_checked_before_anything_is_written(tmp_path: Path) -> None:
+    from sensing_antenna.campaign.simulated import check_scenario
+
+    # a free motion of 0.005 s is below Scenario's shortest recording (0.01 s)
+    spec = one_point_spec(free_motion=FreeMotionStep(identify=True, duration=0.005))
+    with pytest.raises(
+        CampaignSpecError, match=r"free_motion\.duration: the free motion: must be >"
+    ):
+        check_scenario(spec)
+
+
 def test_free_motion_step_identifies_the_observer_once_and_stores_it(tmp_path: Path) -> None:
     from sensing_antenna.campaign.simulated import prepare_antenna
     from sensing_antenna.campaign.store import read_stored_antenna
@@ -122,3 +147,34 @@ def test_free_motion_step_identifies_the_observer_once_and_stores_it(tmp_path: P
     run_campaign(spec, tmp_path, workers=1, progress=False)
     stored = read_stored_antenna(tmp_path)
     assert stored is not None and stored.observer == antenna.observer
+
+
+def test_a_campaign_says_what_it_does_from_its_first_moment(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from sensing_antenna.campaign.runner import run_campaign
+    from sensing_antenna.campaign.schema import CalibrationStep
+
+    spec = one_point_spec(
+        free_motion=FreeMotionStep(identify=True, duration=2.0),
+        calibration=CalibrationStep(enabled=True, contact_points=(0.4, 0.7)),
+        methods=("ratio",),
+    )
+    run_campaign(spec, tmp_path, workers=1, progress=True)
+    err = capsys.readouterr().err
+    lines = [line for chunk in err.split("\n") for line in chunk.split("\r") if line.strip()]
+    # a line before any work, one per preparation step, the calibration's bar, then the runs'
+    expected = [
+        f"campaign one: 1 runs (1 main) x 1 method(s) (ratio), in {tmp_path}",
+        "preparation: identifying the free-motion observer (Eq. 15) on a 2 s free motion",
+        "preparation: calibrating T_e on 2 contact recordings of the device (Section 5.1)",
+        "calibration: 100%",
+        "runs: 0 of 1 stored already, 1 to run in this process",
+        "campaign one: 100%",
+    ]
+    positions = [next(i for i, line in enumerate(lines) if line.startswith(e)) for e in expected]
+    assert positions == sorted(positions) and positions[0] == 0
+    run_campaign(spec, tmp_path, workers=1, progress=True)
+    again = capsys.readouterr().err
+    assert f"preparation: the one stored in {tmp_path}" in again
+    assert "runs: 1 of 1 stored already, 0 to run (nothing to do)" in again

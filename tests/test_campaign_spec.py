@@ -10,9 +10,15 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.campaign.limits import MAX_CONTACT_POINTS, MAX_RUNS
 from sensing_antenna.campaign.parsing import default_campaign_spec, load_campaign_spec
-from sensing_antenna.campaign.runs import NOISE_SWEEP_STREAM, derive_seed, expand_runs
-from sensing_antenna.campaign.schema import CampaignSpecError
+from sensing_antenna.campaign.runs import (
+    NOISE_SWEEP_STREAM,
+    contact_point_label,
+    derive_seed,
+    expand_runs,
+)
+from sensing_antenna.campaign.schema import CalibrationStep, CampaignSpecError, NoiseSweep
 from sensing_antenna.errors import SensingAntennaError
 
 GOOD = """
@@ -63,6 +69,27 @@ def test_runs_are_ordered_named_and_seeded_deterministically() -> None:
     assert runs[7].seed == derive_seed(spec.base_seed, 7)
     # the free-motion step draws from another stream of the same base seed
     assert derive_seed(spec.base_seed, 0, stream=1) not in {r.seed for r in runs}
+
+
+def test_points_the_check_tells_apart_get_their_own_run_ids(tmp_path: Path) -> None:
+    # 0.5 and 0.5004 m are 0.4 mm apart: two points for the spec, so two runs with two files
+    spec = load_campaign_spec(write(tmp_path, GOOD.replace("0.5]", "0.5, 0.5004, 0.500401]")))
+    ids = [r.run_id for r in expand_runs(spec, paper_antenna())]
+    assert len(set(ids)) == len(ids) == 8
+    # whole millimetres keep the ids every earlier campaign directory has
+    assert ids[2:8:2] == [
+        "azimuthal-x0500mm-r1",
+        "azimuthal-x0500.4mm-r1",
+        "azimuthal-x0500.401mm-r1",
+    ]
+    assert contact_point_label(0.3) == "x0300mm" and contact_point_label(0.98) == "x0980mm"
+
+
+def test_points_one_id_would_name_are_refused_up_front(tmp_path: Path) -> None:
+    # 0.4 um apart: below the 1 um the ids resolve, so the spec must say they are one point
+    path = write(tmp_path, GOOD.replace("0.5]", "0.5, 0.5000004]"))
+    with pytest.raises(CampaignSpecError, match=r"contact_points: must be distinct to 1 um"):
+        load_campaign_spec(path)
 
 
 def test_a_good_file_loads_with_its_scenario(tmp_path: Path) -> None:
@@ -432,3 +459,47 @@ def test_errors_in_a_base_name_the_base_file_and_cycles_are_refused(tmp_path: Pa
     b.write_text('base = "a.toml"\n', encoding="utf-8")
     with pytest.raises(CampaignSpecError, match=r"b\.toml: base: 'a\.toml' is based on this file"):
         load_campaign_spec(a)
+
+
+def test_a_billion_repeats_are_refused_before_any_run_list_is_built(tmp_path: Path) -> None:
+    path = write(tmp_path, GOOD.replace("repeats = 2", "repeats = 1000000000"))
+    with pytest.raises(
+        CampaignSpecError, match=rf"{re.escape(str(path))}: repeats: .*2000000000 runs"
+    ):
+        load_campaign_spec(path)
+    assert MAX_RUNS == 100_000
+
+
+def test_too_many_contact_points_or_noise_levels_are_refused(tmp_path: Path) -> None:
+    many = ", ".join(f"{0.3 + i * 1e-5:.5f}" for i in range(MAX_CONTACT_POINTS + 1))
+    path = write(
+        tmp_path, GOOD.replace("contact_points = [0.3, 0.5]", f"contact_points = [{many}]")
+    )
+    with pytest.raises(CampaignSpecError, match=r"contact_points: 1001 points, more than the 1000"):
+        load_campaign_spec(path)
+    levels = tuple(float(i) for i in range(10**6))
+    with pytest.raises(CampaignSpecError, match=r"noise_sweep\.noise_scales: 1000000 levels"):
+        NoiseSweep(noise_scales=levels)
+    with pytest.raises(CampaignSpecError, match=r"calibration\.repeats: .* = 15000 recordings"):
+        CalibrationStep(enabled=True, repeats=1000)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [
+        ("noise_scale = 0.5", "duration = 1e9", "scenario.duration"),
+        (
+            "noise_scale = 0.5",
+            "noise_scale = 0.5\n[free_motion]\nduration = 1e9",
+            "free_motion.duration",
+        ),
+    ],
+)
+def test_durations_longer_than_a_recording_may_be_are_refused(
+    tmp_path: Path, old: str, new: str, field: str
+) -> None:
+    path = write(tmp_path, GOOD.replace(old, new))
+    with pytest.raises(
+        CampaignSpecError, match=rf"{re.escape(field)}: 1000000000.0 s is longer than the 600 s"
+    ):
+        load_campaign_spec(path)

@@ -2,10 +2,12 @@
 
 Modules, in the order a campaign goes through them:
 
-- :mod:`.schema` (the spec as frozen dataclasses), :mod:`.parsing` (TOML files to specs),
-  :mod:`.runs` (seeds and the runs of a spec);
+- :mod:`.schema` (the spec as frozen dataclasses) with :mod:`.limits` (its size limits),
+  :mod:`.parsing` (TOML files to specs), :mod:`.runs` (seeds and the runs of a spec);
 - :mod:`.simulated` (the preparation steps and the run function: simulate, then estimate),
-  :mod:`.runner` (parallel, resumable execution), :mod:`.store` (the campaign directory);
+  :mod:`.runner` (parallel, resumable execution) with :mod:`.pool` (the local worker
+  processes) and :mod:`.progress` (what it tells the person waiting), :mod:`.store` (the
+  campaign directory);
 - :mod:`.records` (:class:`CampaignRow`, one run x method, from estimate to file to table);
 - :mod:`.tables` and :mod:`.targets` (statistics of the rows), :mod:`.summary` (every number
   the report shows), :mod:`.report` with :mod:`.report_sections` and :mod:`.figures` (the

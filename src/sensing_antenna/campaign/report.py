@@ -9,6 +9,7 @@ formats and lays out; lengths are shown in cm (the display edge), everything sto
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 from sensing_antenna.antenna import Antenna
@@ -32,9 +33,10 @@ from sensing_antenna.campaign.store import (
     CALIBRATION_FILE,
     CSV_FILE,
     DEVICE_FILE,
+    RUNS_DIR,
     CampaignStoreError,
     atomic_write_text,
-    load_run_results,
+    load_campaign_results,
     read_calibration,
     read_manifest,
     read_stored_antenna,
@@ -53,6 +55,8 @@ __all__ = ["FIGURES_DIR", "REPORT_FILE", "build_report", "render_report"]
 
 REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
+#: Ids of left-out run files the report names before it only counts the rest.
+_FOREIGN_SHOWN = 10
 
 
 def _antenna_lines(model: Antenna, device: Antenna, summary: CampaignSummary) -> list[str]:
@@ -198,8 +202,23 @@ def _calibration_section(
     return lines
 
 
+def _left_out_lines(foreign: Sequence[str]) -> list[str]:
+    if not foreign:
+        return []
+    shown = ", ".join(f"`{run_id}`" for run_id in foreign[:_FOREIGN_SHOWN])
+    more = f" and {len(foreign) - _FOREIGN_SHOWN} more" if len(foreign) > _FOREIGN_SHOWN else ""
+    return [
+        f"- Left out: {len(foreign)} run file(s) in `{RUNS_DIR}/` that are not runs of this spec "
+        f"({shown}{more}); nothing in this report or in [{CSV_FILE}]({CSV_FILE}) comes from them"
+    ]
+
+
 def _settings_lines(
-    spec: CampaignSpec, summary: CampaignSummary, model: Antenna, device: Antenna
+    spec: CampaignSpec,
+    summary: CampaignSummary,
+    model: Antenna,
+    device: Antenna,
+    foreign: Sequence[str],
 ) -> list[str]:
     obs = model.observer
     return [
@@ -215,6 +234,7 @@ def _settings_lines(
             if summary.n_results == spec.n_runs
             else " (campaign incomplete: run it again to finish)"
         ),
+        *_left_out_lines(foreign),
         f"- Cases: {', '.join(spec.cases)}; repeats: {spec.repeats}; base seed: {spec.base_seed}",
         "- Contact points (cm): " + ", ".join(cm(x, 0) for x in spec.contact_points),
         f"- Methods: {', '.join(spec.methods)} (each estimates the same recordings)",
@@ -241,6 +261,7 @@ def render_report(
     device: Antenna | None = None,
     figures: ReportFigures | None = None,
     out_dir: Path | None = None,
+    foreign_run_files: Sequence[str] = (),
 ) -> str:
     """The Markdown text of the report.
 
@@ -257,6 +278,8 @@ def render_report(
         The figures to link; None: none.
     out_dir : Path, optional
         Campaign directory the figure links are relative to (needed with figures).
+    foreign_run_files : sequence of str
+        Ids of run files in the directory that are not runs of the spec (left out; said so).
 
     The method comparison, status counts, intervals, figures and the tables per case cover the
     main runs only (the noise level of ``[scenario]``); the noise sweep has its own section.
@@ -269,7 +292,7 @@ def render_report(
         "",
         spec.description,
         "",
-        *_settings_lines(spec, summary, model, device),
+        *_settings_lines(spec, summary, model, device, foreign_run_files),
         "",
         *_plain_statement(summary),
         "The recordings are simulated; the paper's numbers come from its real device, so the "
@@ -317,9 +340,10 @@ def build_report(out_dir: str | Path, *, figures: bool = True) -> Path:
     if model is None:
         raise CampaignStoreError(f"{directory / 'antenna.toml'}: no such file")
     device = read_stored_device(directory) or model
-    stored = read_calibration(directory)
-    calibration = stored[1] if stored is not None else None
-    results = list(load_run_results(directory, spec.methods).values())
+    kept = read_calibration(directory)
+    calibration = kept[1] if kept is not None else None
+    stored = load_campaign_results(directory, spec)
+    results = list(stored.results.values())
     write_runs_csv(directory / CSV_FILE, results)
     summary = summarize_campaign(spec, results, model, device, calibration)
     drawn = (
@@ -328,5 +352,6 @@ def build_report(out_dir: str | Path, *, figures: bool = True) -> Path:
         else ReportFigures()
     )
     report = directory / REPORT_FILE
-    atomic_write_text(report, render_report(spec, summary, model, device, drawn, directory))
+    text = render_report(spec, summary, model, device, drawn, directory, stored.foreign)
+    atomic_write_text(report, text)
     return report

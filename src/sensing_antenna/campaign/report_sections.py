@@ -189,9 +189,9 @@ def truth_section(summary: CampaignSummary) -> list[str]:
                 "case",
                 "method",
                 "mean abs e, nominal (mm)",
-                "max e, nominal (mm)",
+                "max abs e, nominal (mm)",
                 "mean abs e, contact (mm)",
-                "max e, contact (mm)",
+                "max abs e, contact (mm)",
                 "n (contact known)",
             ],
             rows,
@@ -200,10 +200,38 @@ def truth_section(summary: CampaignSummary) -> list[str]:
     ]
 
 
+def _join(names: Sequence[str]) -> str:
+    return ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
+
+
 def interval_section(summaries: Sequence[IntervalSummary]) -> list[str]:
-    """Median time to the estimate and the coverage and width of the 95 % intervals."""
-    rows = []
+    """Time to the estimate and the coverage and width of the 95 % intervals.
+
+    A method without intervals whose t_e - t_1 is the same in every run has no row: the
+    sentence above the table gives its fixed delay instead (a column of equal numbers says
+    nothing about the method); likewise a method with neither times nor intervals.
+    """
+    shown = [s for s in summaries if s.n_intervals or (s.n_timed and not s.fixed_delay)]
+    fixed: dict[str, list[str]] = {}
     for s in summaries:
+        if s in shown:
+            continue
+        key = f"{s.median_time_to_estimate:.3f}" if s.n_timed else ""
+        if s.method not in fixed.setdefault(key, []):
+            fixed[key].append(s.method)
+    notes = []
+    for delay, methods in fixed.items():
+        if delay:
+            notes.append(
+                f"{_join(methods)} conclude{'s' if len(methods) == 1 else ''} {delay} s after "
+                "the push in every run (t_e - t_1 is fixed: the end of the spectrum window, "
+                "`EstimatorConfig.spectrum_window`) and give no interval, so the table has no "
+                "row for them."
+            )
+        else:
+            notes.append(f"{_join(methods)}: no t_1, t_e or interval recorded.")
+    rows = []
+    for s in shown:
         coverage = (
             f"{s.n_covering}/{s.n_intervals} ({100 * s.coverage:.0f} %)" if s.n_intervals else "-"
         )
@@ -223,7 +251,7 @@ def interval_section(summaries: Sequence[IntervalSummary]) -> list[str]:
         if judged_nominal
         else ""
     )
-    return [
+    lines = [
         "## Time to estimate and uncertainty",
         "",
         "Median time from the push (t_1) to the estimate (t_e), and, for methods that give a 95 % "
@@ -231,19 +259,25 @@ def interval_section(summaries: Sequence[IntervalSummary]) -> list[str]:
         "the interval is a claim about that point) and, for comparison, the nominal x_c; and "
         f"its median width.{note}",
         "",
-        *markdown_table(
-            [
-                "case",
-                "method",
-                "median t_e - t_1 (s)",
-                "95 % interval contains the contact abscissa",
-                "contains the nominal x_c",
-                "median width (cm)",
-            ],
-            rows,
-        ),
-        "",
     ]
+    if notes:
+        lines += [" ".join(notes), ""]
+    if rows:
+        lines += [
+            *markdown_table(
+                [
+                    "case",
+                    "method",
+                    "median t_e - t_1 (s)",
+                    "95 % interval contains the contact abscissa",
+                    "contains the nominal x_c",
+                    "median width (cm)",
+                ],
+                rows,
+            ),
+            "",
+        ]
+    return lines
 
 
 def _statuses(counts: Mapping[str, int]) -> str:
@@ -337,40 +371,56 @@ def targets_section(targets: Sequence[TargetSummary]) -> list[str]:
     ]
 
 
-def _noise_row(n: NoiseLevelErrors, main: float) -> list[str]:
+def _noise_row(n: NoiseLevelErrors, main: float, with_delay: bool) -> list[str]:
     return [
         level(n.noise_scale) + (" (main)" if same_noise_level(n.noise_scale, main) else ""),
         n.method,
         f"{n.n_estimates}/{n.n_runs}",
         mm(n.mean_abs_error),
         mm(n.max_abs_error),
-        _seconds(n.median_delay),
-        str(n.n_ok),
+        *([_seconds(n.median_delay)] if with_delay else []),
+        _statuses(n.status_counts),
     ]
 
 
-def _frequency_row(f: FrequencyErrorSummary) -> list[str]:
+def _frequency_row(f: FrequencyErrorSummary, with_bounds: bool) -> list[str]:
     def percent(value: float, digits: int) -> str:
         return "-" if not math.isfinite(value) else f"{100 * value:.{digits}f}"
 
+    bounds = [percent(f.median_relative_crb, 4), percent(f.median_relative_se, 4)]
     return [
         level(f.noise_scale),
         f.method,
         str(f.n),
         percent(f.rms_relative_error, 3),
         percent(f.median_abs_relative_error, 3),
-        percent(f.median_relative_crb, 4),
-        percent(f.median_relative_se, 4),
+        *(bounds if with_bounds else []),
     ]
 
 
 def noise_section(
     spec: CampaignSpec, summary: CampaignSummary, figure: Path | None, out_dir: Path
 ) -> list[str]:
-    """The noise sweep: every method's error per level, and omega_1 against the truth."""
+    """The noise sweep: every method's error per level, and omega_1 against the truth.
+
+    The statuses of each row say why runs have no estimate (e.g. ``push_not_reached``). The
+    t_e - t_1 column is left out when every run of every method has the same delay (then a
+    sentence gives it), and the bound columns when no method reports a Cramer-Rao bound or
+    standard error.
+    """
     if not spec.noise_sweep.enabled:
         return []
     sweep = spec.noise_sweep
+    timed = [n for n in summary.noise if math.isfinite(n.median_delay)]
+    delays = {f"{n.median_delay:.3f}" for n in timed}
+    with_delay = bool(timed) and not (all(n.fixed_delay for n in timed) and len(delays) == 1)
+    delay_note = (
+        f" t_e - t_1 is {delays.pop()} s in every run of every method (a fixed time after the "
+        "push: the end of the spectrum window, `EstimatorConfig.spectrum_window`), so it has "
+        "no column."
+        if timed and not with_delay
+        else ""
+    )
     lines = [
         "## Noise sweep",
         "",
@@ -381,7 +431,9 @@ def noise_section(
         f"repeat(s), {spec.n_sweep_runs} runs, seeds on their own stream; every method estimates "
         f"the same recordings. The main runs count as level {level(spec.noise_scale)} (with "
         "their own contact points and repeats, so that level has more runs). The tables and "
-        "figures above use the main runs only. Errors against the contact abscissa, in mm:",
+        "figures above use the main runs only. Errors against the contact abscissa, in mm, over "
+        "the runs with an estimate (n: runs with an estimate / runs); the statuses say what "
+        f"became of every run, those without an estimate included.{delay_note}",
         "",
         *markdown_table(
             [
@@ -389,26 +441,38 @@ def noise_section(
                 "method",
                 "n",
                 "mean abs e (mm)",
-                "max e (mm)",
-                "median t_e - t_1 (s)",
-                "status ok",
+                "max abs e (mm)",
+                *(["median t_e - t_1 (s)"] if with_delay else []),
+                "statuses",
             ],
-            [_noise_row(n, spec.noise_scale) for n in summary.noise],
+            [_noise_row(n, spec.noise_scale, with_delay) for n in summary.noise],
         ),
         "",
     ]
     if summary.frequency:
+        with_bounds = any(
+            math.isfinite(f.median_relative_crb) or math.isfinite(f.median_relative_se)
+            for f in summary.frequency
+        )
+        bounds_text = (
+            "CRB: median over runs of the Cramer-Rao bound of omega_1 the method reports for its "
+            "own fit (`fast`: the window it declared on); SE: median of its reported standard "
+            "error, which adds the drift check's term. For a fixed record the bound is "
+            "proportional to the noise, but `fast` stops when sure, so its record lengthens "
+            "with the noise and its bound stays nearly level; the error cannot fall below the "
+            "model bias (the simulator's compliant contact and finite elements against the "
+            "pinned-contact beam model, and the unmodelled modes of docs/fast.md); the paper "
+            "method's 1 s spectrum has no bound reported here."
+            if with_bounds
+            else "None of these methods reports a Cramer-Rao bound or a standard error of "
+            "omega_1 (`fast` does), so there are no bound columns; the error cannot fall below "
+            "the model bias (the simulator's compliant contact and finite elements against the "
+            "pinned-contact beam model)."
+        )
         lines += [
             "omega_1 against the device's contact-mode fundamental at each run's contact "
             "abscissa (`beam.natural_frequencies` of the device's link), relative, in %, over "
-            "every run with an omega_1 (any status). CRB: median over runs of the Cramer-Rao "
-            "bound of omega_1 the method reports for its own fit (`fast`: the window it declared "
-            "on); SE: median of its reported standard error, which adds the drift check's term. "
-            "For a fixed record the bound is proportional to the noise, but `fast` stops when "
-            "sure, so its record lengthens with the noise and its bound stays nearly level; "
-            "the error cannot fall below the model bias (the simulator's compliant contact and "
-            "finite elements against the pinned-contact beam model, and the unmodelled modes "
-            "of docs/fast.md); the paper method's 1 s spectrum has no bound reported here.",
+            f"every run with an omega_1 (any status). {bounds_text}",
             "",
             *markdown_table(
                 [
@@ -417,10 +481,9 @@ def noise_section(
                     "n",
                     "RMS rel. error (%)",
                     "median abs rel. error (%)",
-                    "CRB (median, %)",
-                    "SE (median, %)",
+                    *(["CRB (median, %)", "SE (median, %)"] if with_bounds else []),
                 ],
-                [_frequency_row(f) for f in summary.frequency],
+                [_frequency_row(f, with_bounds) for f in summary.frequency],
             ),
             "",
         ]
@@ -435,11 +498,11 @@ def case_section(table: CaseTable) -> list[str]:
         "x_c (cm)",
         "mean x_c,e",
         "mean abs e",
-        "max e",
+        "max abs e",
         "std e",
         "paper: mean x_c,e",
         "paper: mean abs e",
-        "paper: max e",
+        "paper: max abs e",
         "paper: std e",
         *[f"{m}: mean abs e" for m in table.baselines],
         "n",
@@ -472,8 +535,9 @@ def case_section(table: CaseTable) -> list[str]:
     return [
         f"## {_CASE_TITLES.get(table.case, table.case)}",
         "",
-        f"Method **{table.method}**, all values in cm; e = x_c,e - x_c; std with ddof = 1. The "
-        "paper's numbers are from the real device (5 experiments per point).",
+        f"Method **{table.method}**, all values in cm; e = x_c,e - x_c; max abs e is the largest "
+        "|e| (the paper's e_max); std with ddof = 1. The paper's numbers are from the real "
+        "device (5 experiments per point).",
         "",
         *markdown_table(header, lines),
         "",

@@ -2,34 +2,42 @@
 
 The runner is independent of what a run does: it takes a pure function ``run_one(RunSpec) ->
 RunResult`` (by default :func:`sensing_antenna.campaign.simulated.simulate_and_estimate`). Runs
-execute inline (one worker), on a local process pool (default: all cores) or on a Dask cluster
-(``scheduler="tcp://host:port"``). Each finished run is stored at once (see
-:mod:`~sensing_antenna.campaign.store`), so a campaign started again skips what is done. A run
-whose function raises is stored as failed with its error, and the others continue.
+execute inline (one worker), on local worker processes (default: all cores;
+:mod:`~sensing_antenna.campaign.pool`) or on a Dask cluster (``scheduler="tcp://host:port"``).
+Each finished run is stored at once (see :mod:`~sensing_antenna.campaign.store`), so a campaign
+started again skips what is done. A run whose function raises is stored as failed with its
+error, and the others continue; a run whose worker process dies is tried again on a fresh one.
+
+Ctrl-C (SIGINT), SIGTERM and SIGHUP stop the campaign cleanly: the workers are stopped, every
+finished run stays stored, and :class:`CampaignInterrupted` says how many.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
-import sys
+import signal
+import threading
 import traceback
-from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-
-from tqdm import tqdm
+from types import FrameType
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.campaign.pool import run_on_workers
+from sensing_antenna.campaign.progress import Progress
 from sensing_antenna.campaign.records import RUN_FAILED, RunResult
 from sensing_antenna.campaign.runs import RunSpec, expand_runs
 from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import (
     CSV_FILE,
     Preparation,
-    load_run_results,
+    campaign_lock,
+    load_campaign_results,
     read_preparation,
+    remove_stale_temp_files,
     write_manifest,
     write_preparation,
     write_run_result,
@@ -39,6 +47,7 @@ from sensing_antenna.campaign.worker_threads import limit_to_one_blas_thread
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [
+    "CampaignInterrupted",
     "CampaignOutcome",
     "PrepareAntenna",
     "RunFunction",
@@ -71,6 +80,9 @@ class CampaignOutcome:
         Runs executed by this call.
     n_failed : int
         Stored runs whose status is failed (all of them, not only this call's).
+    foreign_run_files : tuple of str
+        Ids of valid run files in ``out_dir/runs`` that are not runs of the spec: left out of
+        ``runs.csv`` and the report.
     """
 
     out_dir: Path
@@ -79,6 +91,85 @@ class CampaignOutcome:
     n_previously_done: int
     n_executed: int
     n_failed: int
+    foreign_run_files: tuple[str, ...] = ()
+
+
+class CampaignInterrupted(KeyboardInterrupt):
+    """A campaign stopped by a signal; every run finished before it is stored.
+
+    A KeyboardInterrupt, so that code which stops on Ctrl-C stops on it too.
+
+    Attributes
+    ----------
+    signal_number : int
+        SIGINT (Ctrl-C), SIGTERM or SIGHUP.
+    out_dir : Path or None
+        The campaign directory, once known.
+    n_stored : int
+        Runs stored in ``out_dir`` (finished, including those of earlier starts).
+    n_runs : int
+        Runs in the campaign (0 when it stopped before they were counted).
+    """
+
+    def __init__(
+        self,
+        signal_number: int,
+        out_dir: Path | None = None,
+        n_stored: int = 0,
+        n_runs: int = 0,
+    ) -> None:
+        self.signal_number = signal_number
+        self.out_dir = out_dir
+        self.n_stored = n_stored
+        self.n_runs = n_runs
+        super().__init__(self.message)
+
+    @property
+    def signal_name(self) -> str:
+        """The signal's name, e.g. ``SIGINT``."""
+        try:
+            return signal.Signals(self.signal_number).name
+        except ValueError:
+            return f"signal {self.signal_number}"
+
+    @property
+    def message(self) -> str:
+        """One line: what stopped the campaign and what is kept."""
+        if self.out_dir is None:
+            return f"interrupted by {self.signal_name} before any run"
+        return (
+            f"interrupted by {self.signal_name}: {self.n_stored} of {self.n_runs} runs are stored "
+            f"in {self.out_dir}; the same command again runs the others"
+        )
+
+
+#: Signals that stop a campaign cleanly besides SIGINT: a supervisor's or batch scheduler's
+#: SIGTERM, a closed terminal's SIGHUP.
+_STOP_SIGNALS = tuple(
+    getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)
+)
+
+
+@contextlib.contextmanager
+def _stop_signals_interrupt() -> Iterator[None]:
+    """While inside, the stop signals raise CampaignInterrupted (main thread only; a signal the
+    process ignores, e.g. SIGHUP under nohup, stays ignored)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signal_number: int, _frame: FrameType | None) -> None:
+        raise CampaignInterrupted(signal_number)
+
+    previous = {}
+    for number in _STOP_SIGNALS:
+        if signal.getsignal(number) is signal.SIG_DFL:
+            previous[number] = signal.signal(number, interrupt)
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 def execute_safely(run_one: RunFunction, run: RunSpec) -> RunResult:
@@ -138,7 +229,8 @@ def run_campaign(
     retry_failed : bool
         Redo runs stored as failed.
     progress : bool
-        Show a progress bar on stderr.
+        Say on stderr what the campaign is doing, from the start: a line for the campaign and
+        for each preparation step, bars for the calibration recordings and the runs.
 
     Returns
     -------
@@ -146,48 +238,93 @@ def run_campaign(
     """
     if workers is not None and workers < 1:
         raise SensingAntennaError(f"--workers: must be >= 1, got {workers}")
+    report = Progress(enabled=progress)
+    directory = Path(out_dir)
+    prepare: PrepareAntenna
     if run_one is None or prepare_antenna is None:
         from sensing_antenna.campaign import simulated
 
+        # every scenario the simulation will be given, checked before anything is written
+        simulated.check_scenario(spec)
         run_one = run_one or simulated.simulate_and_estimate
-        prepare_antenna = prepare_antenna or simulated.prepare_campaign
-    directory = Path(out_dir)
-    directory.mkdir(parents=True, exist_ok=True)
-    write_manifest(directory, spec)
-    preparation = read_preparation(directory, spec)
-    if preparation is None:
-        prepared = prepare_antenna(spec)
-        preparation = prepared if isinstance(prepared, Preparation) else Preparation.same(prepared)
-        write_preparation(directory, spec, preparation)
-    runs = expand_runs(spec, preparation.model, preparation.device)
-    done = load_run_results(directory, spec.methods)
-    if retry_failed:
-        done = {k: v for k, v in done.items() if v.status != RUN_FAILED}
-    pending = [run for run in runs if run.run_id not in done]
-    task = functools.partial(execute_safely, run_one)
-    executed = 0
-    with tqdm(
-        total=len(runs),
-        initial=len(runs) - len(pending),
-        desc=f"campaign {spec.name}",
-        unit="run",
-        file=sys.stderr,
-        disable=not progress,
-    ) as bar:
-        for result in _execute(task, pending, workers, scheduler):
-            write_run_result(directory, result)
-            executed += 1
-            bar.update(1)
-    stored = load_run_results(directory, spec.methods)
-    csv_path = write_runs_csv(directory / CSV_FILE, stored.values())
+        prepare = prepare_antenna or functools.partial(simulated.prepare_campaign, progress=report)
+    else:
+        prepare = prepare_antenna
+    sweep = f", {spec.n_sweep_runs} in the noise sweep" if spec.n_sweep_runs else ""
+    report.line(
+        f"campaign {spec.name}: {spec.n_runs} runs ({spec.n_main_runs} main{sweep}) x "
+        f"{len(spec.methods)} method(s) ({', '.join(spec.methods)}), in {directory}"
+    )
+    n_stored = 0
+    try:
+        with _stop_signals_interrupt():
+            directory.mkdir(parents=True, exist_ok=True)
+            with campaign_lock(directory):
+                remove_stale_temp_files(directory)
+                write_manifest(directory, spec)
+                preparation = _prepared(directory, spec, prepare, report)
+                runs = expand_runs(spec, preparation.model, preparation.device)
+                done = load_campaign_results(directory, spec).results
+                if retry_failed:
+                    done = {k: v for k, v in done.items() if v.status != RUN_FAILED}
+                pending = [run for run in runs if run.run_id not in done]
+                n_stored = len(runs) - len(pending)
+                report.line(
+                    f"runs: {n_stored} of {len(runs)} stored already, {len(pending)} to run "
+                    + _where(pending, workers, scheduler)
+                )
+                task = functools.partial(execute_safely, run_one)
+                executed = 0
+                with (
+                    report.bar(len(runs), f"campaign {spec.name}", initial=n_stored) as bar,
+                    contextlib.closing(
+                        _execute(task, pending, workers, scheduler, report.line)
+                    ) as results,
+                ):
+                    for result in results:
+                        write_run_result(directory, result)
+                        executed += 1
+                        n_stored += 1
+                        bar.update(1)
+                stored = load_campaign_results(directory, spec)
+                csv_path = write_runs_csv(directory / CSV_FILE, stored.results.values())
+    except KeyboardInterrupt as exc:
+        number = exc.signal_number if isinstance(exc, CampaignInterrupted) else signal.SIGINT
+        where = directory if directory.is_dir() else None
+        raise CampaignInterrupted(number, where, n_stored, spec.n_runs) from None
     return CampaignOutcome(
         out_dir=directory,
         csv_path=csv_path,
         n_runs=len(runs),
         n_previously_done=len(runs) - len(pending),
         n_executed=executed,
-        n_failed=sum(1 for r in stored.values() if r.status == RUN_FAILED),
+        n_failed=sum(1 for r in stored.results.values() if r.status == RUN_FAILED),
+        foreign_run_files=stored.foreign,
     )
+
+
+def _prepared(
+    directory: Path, spec: CampaignSpec, prepare: PrepareAntenna, report: Progress
+) -> Preparation:
+    """The preparation stored in ``directory`` for this spec, or made now and stored."""
+    preparation = read_preparation(directory, spec)
+    if preparation is not None:
+        report.line(f"preparation: the one stored in {directory} (model, device, calibration)")
+        return preparation
+    prepared = prepare(spec)
+    preparation = prepared if isinstance(prepared, Preparation) else Preparation.same(prepared)
+    write_preparation(directory, spec, preparation)
+    return preparation
+
+
+def _where(pending: Sequence[RunSpec], workers: int | None, scheduler: str | None) -> str:
+    """Where the pending runs will execute, in words."""
+    if not pending:
+        return "(nothing to do)"
+    if scheduler is not None:
+        return f"on the Dask cluster at {scheduler}"
+    n = min(workers or os.cpu_count() or 1, len(pending))
+    return "in this process" if n == 1 else f"on {n} worker processes"
 
 
 def _execute(
@@ -195,7 +332,8 @@ def _execute(
     pending: Sequence[RunSpec],
     workers: int | None,
     scheduler: str | None,
-) -> Iterator[RunResult]:
+    note: Callable[[str], None] | None,
+) -> Generator[RunResult, None, None]:
     if not pending:
         return
     if scheduler is not None:
@@ -204,38 +342,20 @@ def _execute(
         for run in pending:
             yield task(run)
     else:
-        yield from _execute_pool(task, pending, workers or os.cpu_count() or 1)
-
-
-def _execute_pool(
-    task: Callable[[RunSpec], RunResult], pending: Sequence[RunSpec], workers: int
-) -> Iterator[RunResult]:
-    executor = ProcessPoolExecutor(
-        max_workers=min(workers, len(pending)), initializer=limit_to_one_blas_thread
-    )
-    futures: dict[Future[RunResult], RunSpec] = {}
-    try:
-        futures = {executor.submit(task, run): run for run in pending}
-        remaining = set(futures)
-        while remaining:
-            finished, remaining = wait(remaining, return_when=FIRST_COMPLETED)
-            for future in finished:
-                yield _result_of(future, futures[future])
-    finally:
-        executor.shutdown(wait=True, cancel_futures=True)
-
-
-def _result_of(future: Future[RunResult], run: RunSpec) -> RunResult:
-    try:
-        return future.result()
-    except Exception as exc:  # e.g. a worker process died: record it against this run
-        return RunResult.failed(run, f"{type(exc).__name__}: {exc}")
+        yield from run_on_workers(
+            task,
+            pending,
+            workers or os.cpu_count() or 1,
+            initializer=limit_to_one_blas_thread,
+            on_event=note,
+        )
 
 
 def _execute_dask(
     task: Callable[[RunSpec], RunResult], pending: Sequence[RunSpec], scheduler: str
-) -> Iterator[RunResult]:
+) -> Generator[RunResult, None, None]:
     from distributed import Client, as_completed
+    from distributed.scheduler import KilledWorker
 
     from sensing_antenna.campaign.dask_plugin import OneBlasThreadPerDaskWorker
 
@@ -253,8 +373,14 @@ def _execute_dask(
             for future in as_completed(futures):
                 try:
                     result = future.result()
-                except Exception as exc:  # worker lost or task could not run remotely
+                except KilledWorker as exc:  # Dask tried it on several workers; each died
                     result = RunResult.failed(runs[future.key], f"{type(exc).__name__}: {exc}")
+                except Exception as exc:  # the cluster, not the run: store nothing, stop
+                    raise SensingAntennaError(
+                        f"--scheduler: the Dask cluster at {scheduler} could not run "
+                        f"{runs[future.key].run_id} ({type(exc).__name__}: {exc}); the finished "
+                        "runs are stored, the same command again runs the others"
+                    ) from exc
                 yield result
     finally:
         client.close()

@@ -7,24 +7,34 @@ alone, independent of the order runs execute in, and no two kinds share a seed.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.campaign.schema import SCENARIO_NOISE_SCALE, CampaignSpec, noise_level_key
+from sensing_antenna.campaign.schema import (
+    SCENARIO_NOISE_SCALE,
+    CampaignSpec,
+    CampaignSpecError,
+    contact_point_key,
+    noise_level_key,
+)
 
 __all__ = [
     "CALIBRATION_STREAM",
     "FREE_MOTION_STREAM",
     "NOISE_SWEEP_STREAM",
     "RUN_STREAM",
+    "PlannedRun",
     "RunSpec",
     "calibration_runs",
+    "contact_point_label",
     "derive_seed",
     "expand_runs",
+    "plan_runs",
+    "run_ids",
 ]
 
 #: Seed streams of :func:`derive_seed`: the main runs, the free-motion step, the calibration
@@ -44,8 +54,9 @@ class RunSpec:
     index : int
         Position of the run in the campaign (0-based).
     run_id : str
-        Stable, file-name-safe identifier, e.g. ``azimuthal-x0300mm-r1``; a run of the noise
-        sweep ends in its level, e.g. ``azimuthal-x0300mm-r1-n2.00``.
+        Stable, file-name-safe identifier, e.g. ``azimuthal-x0300mm-r1`` (``x0500.4mm`` for a
+        point off the millimetre, :func:`contact_point_label`); a run of the noise sweep ends
+        in its level, e.g. ``azimuthal-x0300mm-r1-n2.00``.
     case : str
         Manoeuvre (:data:`~sensing_antenna.campaign.schema.CASES`).
     contact_point : float
@@ -99,6 +110,104 @@ def derive_seed(base_seed: int, index: int, stream: int = RUN_STREAM) -> int:
     return int(state[0])
 
 
+def contact_point_label(contact_point: float) -> str:
+    """A contact point as run ids name it: ``x0300mm``, or ``x0500.4mm`` off the millimetre.
+
+    Whole millimetres keep four digits; a point between them carries its micrometres, so two
+    points get one label exactly when the distinctness check of the spec
+    (:func:`~sensing_antenna.campaign.schema.contact_point_key`) calls them one point.
+    """
+    micrometres = contact_point_key(contact_point)
+    millimetres, rest = divmod(micrometres, 1000)
+    fraction = f".{rest:03d}".rstrip("0") if rest else ""
+    return f"x{millimetres:04d}{fraction}mm"
+
+
+@dataclass(frozen=True)
+class PlannedRun:
+    """One run of a spec before any antenna is known: where it sits, its id and its settings.
+
+    Attributes
+    ----------
+    index : int
+        Position in the campaign (0-based).
+    run_id : str
+    case : str
+    contact_point : float
+        Nominal x_c (m).
+    repeat : int
+        1-based.
+    stream : int
+        Seed stream (:data:`RUN_STREAM` or :data:`NOISE_SWEEP_STREAM`).
+    position : int
+        Position within that stream.
+    scenario : mapping
+        The run's extra ``simulator.Scenario`` fields.
+    """
+
+    index: int
+    run_id: str
+    case: str
+    contact_point: float
+    repeat: int
+    stream: int
+    position: int
+    scenario: Mapping[str, Any]
+
+
+def plan_runs(spec: CampaignSpec) -> Iterator[PlannedRun]:
+    """Every run of ``spec`` in the campaign's order (see :func:`expand_runs`), without seeds."""
+    index = 0
+    for case in spec.cases:
+        for x_c in spec.contact_points:
+            for repeat in range(1, spec.repeats + 1):
+                run_id = f"{case}-{contact_point_label(x_c)}-r{repeat}"
+                yield PlannedRun(
+                    index, run_id, case, float(x_c), repeat, RUN_STREAM, index, spec.scenario
+                )
+                index += 1
+    position = 0
+    for level in spec.noise_sweep.noise_scales:
+        scenario = {**spec.scenario, "noise_scale": float(level)}
+        suffix = f"-n{noise_level_key(level) / 100:.2f}"
+        for case in spec.sweep_cases:
+            for x_c in spec.sweep_contact_points:
+                for repeat in range(1, spec.sweep_repeats + 1):
+                    run_id = f"{case}-{contact_point_label(x_c)}-r{repeat}{suffix}"
+                    yield PlannedRun(
+                        index,
+                        run_id,
+                        case,
+                        float(x_c),
+                        repeat,
+                        NOISE_SWEEP_STREAM,
+                        position,
+                        scenario,
+                    )
+                    index += 1
+                    position += 1
+
+
+def run_ids(spec: CampaignSpec) -> list[str]:
+    """The run ids of ``spec`` in order; two runs that would share an id are refused.
+
+    Raises
+    ------
+    CampaignSpecError
+        When two runs would have one id (and so one run file).
+    """
+    ids: dict[str, int] = {}
+    for run in plan_runs(spec):
+        other = ids.setdefault(run.run_id, run.index)
+        if other != run.index:
+            raise CampaignSpecError(
+                "contact_points",
+                f"runs {other} and {run.index} would share the id {run.run_id!r} (one run file)",
+                spec.source or None,
+            )
+    return list(ids)
+
+
 def expand_runs(
     spec: CampaignSpec, antenna: Antenna, device: Antenna | None = None
 ) -> list[RunSpec]:
@@ -107,7 +216,8 @@ def expand_runs(
     The main runs come first; then, if the spec has a noise sweep, its runs ordered by level,
     case, contact point and repeat, with ids ending in ``-n<level>`` and seeds from
     :data:`NOISE_SWEEP_STREAM` (position within the sweep). Adding a sweep leaves the main runs'
-    indices, ids and seeds as they are.
+    indices, ids and seeds as they are. Run ids name the contact point with
+    :func:`contact_point_label`.
 
     Parameters
     ----------
@@ -117,48 +227,28 @@ def expand_runs(
         calibrated T_e).
     device : Antenna, optional
         The simulated hardware; None simulates with ``antenna``.
-    """
 
-    def run(
-        index: int,
-        suffix: str,
-        case: str,
-        x_c: float,
-        repeat: int,
-        seed: int,
-        scenario: Mapping[str, Any],
-    ) -> RunSpec:
-        return RunSpec(
-            index=index,
-            run_id=f"{case}-x{round(x_c * 1000):04d}mm-r{repeat}{suffix}",
-            case=case,
-            contact_point=float(x_c),
-            repeat=repeat,
-            seed=seed,
+    Raises
+    ------
+    CampaignSpecError
+        When two runs would share an id (see :func:`run_ids`).
+    """
+    run_ids(spec)
+    return [
+        RunSpec(
+            index=run.index,
+            run_id=run.run_id,
+            case=run.case,
+            contact_point=run.contact_point,
+            repeat=run.repeat,
+            seed=derive_seed(spec.base_seed, run.position, run.stream),
             antenna=antenna,
             methods=spec.methods,
-            scenario=dict(scenario),
+            scenario=dict(run.scenario),
             device=device,
         )
-
-    runs: list[RunSpec] = []
-    for case in spec.cases:
-        for x_c in spec.contact_points:
-            for repeat in range(1, spec.repeats + 1):
-                index = len(runs)
-                seed = derive_seed(spec.base_seed, index, RUN_STREAM)
-                runs.append(run(index, "", case, x_c, repeat, seed, spec.scenario))
-    position = 0
-    for level in spec.noise_sweep.noise_scales:
-        scenario = {**spec.scenario, "noise_scale": float(level)}
-        suffix = f"-n{noise_level_key(level) / 100:.2f}"
-        for case in spec.sweep_cases:
-            for x_c in spec.sweep_contact_points:
-                for repeat in range(1, spec.sweep_repeats + 1):
-                    seed = derive_seed(spec.base_seed, position, NOISE_SWEEP_STREAM)
-                    runs.append(run(len(runs), suffix, case, x_c, repeat, seed, scenario))
-                    position += 1
-    return runs
+        for run in plan_runs(spec)
+    ]
 
 
 def calibration_runs(spec: CampaignSpec) -> list[tuple[str, float, int]]:
@@ -171,7 +261,7 @@ def calibration_runs(spec: CampaignSpec) -> list[tuple[str, float, int]]:
     runs: list[tuple[str, float, int]] = []
     for x_c in step.contact_points:
         for repeat in range(1, step.repeats + 1):
-            name = f"calibration-{step.case}-x{round(x_c * 1000):04d}mm-r{repeat}"
+            name = f"calibration-{step.case}-{contact_point_label(x_c)}-r{repeat}"
             seed = derive_seed(spec.base_seed, len(runs), CALIBRATION_STREAM)
             runs.append((name, float(x_c), seed))
     return runs

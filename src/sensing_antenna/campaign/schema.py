@@ -20,10 +20,12 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
+from sensing_antenna.campaign import limits
 from sensing_antenna.errors import FieldError
 
 __all__ = [
     "CASES",
+    "CONTACT_POINT_RESOLUTION",
     "DEFAULT_CALIBRATION_POINTS",
     "DEVICE_SECTIONS",
     "METHODS",
@@ -34,6 +36,7 @@ __all__ = [
     "DeviceSpec",
     "FreeMotionStep",
     "NoiseSweep",
+    "contact_point_key",
     "known_methods",
     "noise_level_key",
     "same_noise_level",
@@ -49,6 +52,11 @@ METHODS = ("paper", "ratio", "two-frequency")
 #: ``simulator.Scenario.noise_scale`` when the spec's ``[scenario]`` does not set it: the
 #: simulator's nominal sensor noise.
 SCENARIO_NOISE_SCALE = 1.0
+
+#: Contact points are told apart to this resolution (m), in the distinctness checks and in the
+#: run ids alike (:func:`contact_point_key`): 1 micrometre, far below anything the estimators
+#: resolve, so two points a spec means as different are never one run.
+CONTACT_POINT_RESOLUTION = 1e-6
 
 #: Antenna sections a ``[device]`` section may override, with the fields allowed in each. The
 #: link's ``calibrated_t`` and ``calibration_scatter`` are model parameters, not hardware, so a
@@ -123,6 +131,8 @@ class FreeMotionStep:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.duration) and self.duration > 0):
             raise CampaignSpecError("free_motion.duration", f"must be > 0 s, got {self.duration!r}")
+        if problem := limits.duration_problem(self.duration):
+            raise CampaignSpecError("free_motion.duration", problem)
 
 
 @dataclass(frozen=True)
@@ -214,6 +224,8 @@ class CalibrationStep:
             raise CampaignSpecError(
                 "calibration.contact_points", "needs at least 2 points (m) to fit T_e"
             )
+        if problem := limits.contact_points_problem(len(self.contact_points)):
+            raise CampaignSpecError("calibration.contact_points", problem)
         for i, x in enumerate(self.contact_points):
             if not (math.isfinite(x) and x > 0):
                 raise CampaignSpecError(
@@ -221,6 +233,8 @@ class CalibrationStep:
                 )
         if self.repeats < 1:
             raise CampaignSpecError("calibration.repeats", f"must be >= 1, got {self.repeats!r}")
+        if problem := limits.calibration_problem(len(self.contact_points), self.repeats):
+            raise CampaignSpecError("calibration.repeats", problem)
         if self.loss not in _CALIBRATION_LOSSES:
             raise CampaignSpecError(
                 "calibration.loss",
@@ -270,6 +284,8 @@ class NoiseSweep:
     cases: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        if problem := limits.noise_levels_problem(len(self.noise_scales)):
+            raise CampaignSpecError("noise_sweep.noise_scales", problem)
         for i, s in enumerate(self.noise_scales):
             if not (math.isfinite(s) and s >= 0):
                 raise CampaignSpecError(
@@ -307,13 +323,28 @@ def _check_contact_points(key: str, points: Sequence[float], source: str | None)
     """At least one contact point, each a finite length > 0 m, all distinct (to 1 um)."""
     if not points:
         raise CampaignSpecError(key, "must list at least one point (m)", source)
+    if problem := limits.contact_points_problem(len(points)):
+        raise CampaignSpecError(key, problem, source)
     for i, x in enumerate(points):
         if not (math.isfinite(x) and x > 0):
             raise CampaignSpecError(
                 f"{key}[{i}]", f"must be a finite length > 0 m, got {x!r}", source
             )
-    if len({round(x * 1e6) for x in points}) != len(points):
-        raise CampaignSpecError(key, "must be distinct", source)
+    first: dict[int, int] = {}
+    for i, x in enumerate(points):
+        j = first.setdefault(contact_point_key(x), i)
+        if j != i:
+            raise CampaignSpecError(
+                key,
+                f"must be distinct to {CONTACT_POINT_RESOLUTION * 1e6:g} um (as in the run ids): "
+                f"[{j}] = {points[j]!r} and [{i}] = {x!r} are one point",
+                source,
+            )
+
+
+def contact_point_key(contact_point: float) -> int:
+    """A contact point as the checks and the run ids tell it apart: whole micrometres."""
+    return round(contact_point * 1e6)
 
 
 def noise_level_key(noise_scale: float) -> int:
@@ -389,6 +420,11 @@ class CampaignSpec:
             raise CampaignSpecError("repeats", f"must be >= 1, got {self.repeats!r}", src)
         if self.base_seed < 0:
             raise CampaignSpecError("base_seed", f"must be >= 0, got {self.base_seed!r}", src)
+        if problem := limits.runs_problem(self.n_main_runs, self.n_sweep_runs):
+            field_name = "repeats" if self.n_main_runs > limits.MAX_RUNS else "noise_sweep"
+            raise CampaignSpecError(field_name, problem, src)
+        if problem := limits.duration_problem(self.scenario.get("duration")):
+            raise CampaignSpecError("scenario.duration", problem, src)
         for key in self.scenario:
             if key in _RESERVED_SCENARIO_KEYS:
                 raise CampaignSpecError(

@@ -20,12 +20,14 @@ from typing import Any
 
 from sensing_antenna.antenna import Antenna, FreeMotionObserver
 from sensing_antenna.calibration.frequency import FrequencyCalibration
+from sensing_antenna.campaign.progress import Progress
 from sensing_antenna.campaign.records import CampaignRow, RunResult, float_or_nan
 from sensing_antenna.campaign.runs import (
     FREE_MOTION_STREAM,
     RunSpec,
     calibration_runs,
     derive_seed,
+    plan_runs,
 )
 from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
@@ -145,7 +147,7 @@ def identify_observer(
 
 
 def calibrate_on_device(
-    spec: CampaignSpec, device: Antenna, model: Antenna
+    spec: CampaignSpec, device: Antenna, model: Antenna, progress: Progress | None = None
 ) -> FrequencyCalibration:
     """Section 5.1 on the simulated device: T_e of the frequency model from known contact points.
 
@@ -153,18 +155,22 @@ def calibrate_on_device(
     ``calibration.frequency.CALIBRATION_BAND`` by Estimator 1's frequency measurement, using
     ``model`` (the observer for t_c and t_1); T_e is fitted to the model's beta_1(x_c)^2. The
     contact points are known by construction (a calibration), so they come from the spec, and the
-    estimators never see the device's T.
+    estimators never see the device's T. ``progress`` shows a bar of the recordings.
     """
     from sensing_antenna.calibration.frequency import CalibrationError, calibrate_from_recordings
     from sensing_antenna.simulator import simulate
 
     step = spec.calibration
     names, points, recordings = [], [], []
-    for name, x_c, seed in calibration_runs(spec):
-        scenario = make_scenario(step.case, x_c, seed, dict(spec.scenario))
-        recordings.append(simulate(device, scenario).without_ground_truth())
-        names.append(name)
-        points.append(x_c)
+    planned = calibration_runs(spec)
+    bar = (progress or Progress(enabled=False)).bar(len(planned), "calibration", "recording")
+    with bar:
+        for name, x_c, seed in planned:
+            scenario = make_scenario(step.case, x_c, seed, dict(spec.scenario))
+            recordings.append(simulate(device, scenario).without_ground_truth())
+            names.append(name)
+            points.append(x_c)
+            bar.update(1)
     try:
         return calibrate_from_recordings(recordings, model, points, sources=names, loss=step.loss)
     except CalibrationError as exc:
@@ -174,38 +180,79 @@ def calibrate_on_device(
 
 
 def check_scenario(spec: CampaignSpec) -> None:
-    """Raise CampaignSpecError (naming the spec file) if the scenario section is not valid."""
+    """Check every scenario the campaign will simulate, before any work.
+
+    Each run's (case, contact point, noise level), the free motion (when identified) and each
+    calibration recording (when calibrating) is made into a ``simulator.Scenario``, whose checks
+    apply; seeds are left out (every derived seed is valid).
+
+    Raises
+    ------
+    CampaignSpecError
+        Naming the spec file and ``scenario.<field>`` (``free_motion.duration`` for the free
+        motion's length), on the first scenario that is not valid.
+    """
     from sensing_antenna.simulator.scenario import ScenarioError
 
-    try:
-        make_scenario(spec.cases[0], spec.contact_points[0], 0, dict(spec.scenario))
-    except ScenarioError as exc:
-        raise CampaignSpecError(
-            f"scenario.{exc.field_name}", str(exc).split(": ", 1)[-1], spec.source or None
-        ) from exc
-    except TypeError as exc:
-        raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc
+    checked: set[tuple[str, float | None, tuple[tuple[str, str], ...]]] = set()
+
+    def check(case: str, x_c: float | None, extra: Mapping[str, Any], prefix: str) -> None:
+        key = (case, x_c, tuple(sorted((k, repr(v)) for k, v in extra.items())))
+        if key in checked:
+            return
+        checked.add(key)
+        try:
+            make_scenario(case, x_c, 0, dict(extra))
+        except ScenarioError as exc:
+            field = exc.field_name
+            name = "free_motion.duration" if prefix and field == "duration" else f"scenario.{field}"
+            raise CampaignSpecError(
+                name, prefix + str(exc).split(": ", 1)[-1], spec.source or None
+            ) from exc
+        except CampaignSpecError as exc:
+            raise CampaignSpecError(exc.field_name, exc.problem, spec.source or None) from exc
+        except TypeError as exc:
+            raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc
+
+    for run in plan_runs(spec):
+        check(run.case, run.contact_point, run.scenario, "")
+    if spec.free_motion.identify:
+        extra = {**spec.scenario, "duration": spec.free_motion.duration}
+        check(spec.free_motion.case, None, extra, "the free motion: ")
+    if spec.calibration.enabled:
+        for _, x_c, _ in calibration_runs(spec):
+            check(spec.calibration.case, x_c, spec.scenario, "")
 
 
-def prepare_campaign(spec: CampaignSpec) -> Preparation:
+def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Preparation:
     """The steps before the runs: load model and device, identify the observer, calibrate T_e.
 
     Order (the paper's): free-motion identification on the device (if asked), then calibration
     on the device (if asked). The identified observer goes to both antennas (the device's
     controller and the estimators use the same detector); T_e goes to the model only.
     Checks the spec's scenario section first, so a bad value stops the campaign with one clear
-    error instead of failing every run.
+    error instead of failing every run. ``progress`` gets a line per step and the calibration's
+    bar.
     """
+    progress = progress or Progress(enabled=False)
     check_scenario(spec)
     model = spec.load_antenna()
     device = spec.load_device()
     if spec.free_motion.identify:
+        progress.line(
+            f"preparation: identifying the free-motion observer (Eq. 15) on a "
+            f"{spec.free_motion.duration:g} s free motion of the device"
+        )
         observer = identify_observer(device, spec, model)
         device = dataclasses.replace(device, observer=observer)
         model = dataclasses.replace(model, observer=observer)
     calibration = None
     if spec.calibration.enabled:
-        calibration = calibrate_on_device(spec, device, model)
+        progress.line(
+            f"preparation: calibrating T_e on {spec.calibration.n_recordings} contact "
+            "recordings of the device (Section 5.1)"
+        )
+        calibration = calibrate_on_device(spec, device, model, progress)
         model = calibration.apply(model)
     return Preparation(model=model, device=device, calibration=calibration)
 

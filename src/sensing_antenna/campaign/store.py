@@ -10,20 +10,26 @@
       runs/<run_id>.json   one file per finished run, written atomically (temp file + os.replace)
       runs.csv             every run x method, rebuilt from runs/ (SI units)
       report.md, figures/  written by :mod:`sensing_antenna.campaign.report`
+      .lock                held (``flock``) by the campaign running here, with its pid
 
 A run file either exists complete or not at all, so killing the campaign at any moment loses at
 most the runs in progress; they are redone on the next start. The preparation (observer
 identification, calibration) is written before any run, ``antenna.toml`` last, so its presence
 means the preparation is complete; ``calibration.json`` carries the fingerprint of the spec parts
-it depends on and is redone when they differ.
+it depends on and is redone when they differ. One campaign at a time runs in a directory
+(:func:`campaign_lock`); the temp files of writers that are gone are removed when it starts. Run
+files of runs the spec does not have are left out (:func:`load_campaign_results`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
-from collections.abc import Iterable, Sequence
+import socket
+import time
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,6 +37,7 @@ from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.campaign.parsing import parse_campaign_spec
 from sensing_antenna.campaign.records import CSV_COLUMNS, RUN_FILE_FORMAT, CampaignRow, RunResult
+from sensing_antenna.campaign.runs import run_ids
 from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.errors import SensingAntennaError
 
@@ -39,11 +46,15 @@ __all__ = [
     "CALIBRATION_FILE",
     "CSV_FILE",
     "DEVICE_FILE",
+    "LOCK_FILE",
     "MANIFEST_FILE",
     "RUNS_DIR",
     "CampaignStoreError",
     "Preparation",
+    "StoredRuns",
     "atomic_write_text",
+    "campaign_lock",
+    "load_campaign_results",
     "load_run_results",
     "read_calibration",
     "read_manifest",
@@ -51,6 +62,7 @@ __all__ = [
     "read_runs_csv",
     "read_stored_antenna",
     "read_stored_device",
+    "remove_stale_temp_files",
     "write_manifest",
     "write_preparation",
     "write_run_result",
@@ -64,10 +76,88 @@ DEVICE_FILE = "device.toml"
 CALIBRATION_FILE = "calibration.json"
 RUNS_DIR = "runs"
 CSV_FILE = "runs.csv"
+LOCK_FILE = ".lock"
 
 
 class CampaignStoreError(SensingAntennaError, ValueError):
     """A campaign directory that cannot be used: wrong spec, damaged run file, missing files."""
+
+
+@contextlib.contextmanager
+def campaign_lock(out_dir: Path) -> Iterator[None]:
+    """Hold ``out_dir`` for this campaign: another campaign on it is refused while inside.
+
+    An exclusive ``flock`` on ``out_dir/.lock``, which also records the holder's pid, host and
+    start time for the message. The kernel releases the lock when the holder's process (and any
+    worker process it forked) ends, however it ends, so a lock file left by a killed campaign
+    is no lock: there is no stale lock to detect. On a system without ``fcntl`` (Windows) the
+    directory is not locked.
+
+    Raises
+    ------
+    CampaignStoreError
+        Naming the directory and the process that holds it.
+    """
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    path = out_dir / LOCK_FILE
+    handle = open(path, "a+", encoding="utf-8")
+    try:
+        try:
+            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            holder = handle.read().strip() or "another process"
+            raise CampaignStoreError(
+                f"{out_dir}: in use by another campaign ({holder}); wait for it to end, or use "
+                "another output directory"
+            ) from None
+        handle.seek(0)
+        handle.truncate()
+        started = time.strftime("%Y-%m-%d %H:%M:%S")
+        handle.write(f"process {os.getpid()} on {socket.gethostname()}, started {started}\n")
+        handle.flush()
+        try:
+            yield
+        finally:
+            # explicitly: a worker process forked meanwhile shares the lock until it exits
+            fcntl.flock(handle.fileno(), fcntl.LOCK_UN)
+    finally:
+        handle.close()
+
+
+def remove_stale_temp_files(out_dir: Path) -> list[Path]:
+    """Remove the temp files (``.<name>.<pid>.tmp``) whose writing process is gone.
+
+    Run under :func:`campaign_lock`; a temp file of a live process (a ``campaign report``
+    rebuilding ``runs.csv`` meanwhile) is left alone. Returns the files removed.
+    """
+    removed = []
+    for folder in (out_dir, out_dir / RUNS_DIR):
+        if not folder.is_dir():
+            continue
+        for path in folder.glob(".*.tmp"):
+            pid = path.name[: -len(".tmp")].rsplit(".", 1)[-1]
+            if not pid.isdigit() or (int(pid) != os.getpid() and _process_exists(int(pid))):
+                continue
+            path.unlink(missing_ok=True)
+            removed.append(path)
+    return removed
+
+
+def _process_exists(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    except OverflowError:  # not a pid at all
+        return False
+    return True
 
 
 def atomic_write_text(path: Path, text: str) -> None:
@@ -235,6 +325,31 @@ def load_run_results(out_dir: Path, methods: Sequence[str]) -> dict[str, RunResu
             raise CampaignStoreError(f"{path}: run_id: file holds run {result.run_id!r}")
         results[result.run_id] = result
     return results
+
+
+@dataclass(frozen=True)
+class StoredRuns:
+    """The stored runs of a campaign directory that belong to its spec.
+
+    Attributes
+    ----------
+    results : dict of str to RunResult
+        By run id, only runs of the spec.
+    foreign : tuple of str
+        Ids of valid run files in ``runs/`` that are not runs of the spec (copied in, or left
+        by hand): left out of ``runs.csv`` and the report, which say so.
+    """
+
+    results: dict[str, RunResult]
+    foreign: tuple[str, ...] = ()
+
+
+def load_campaign_results(out_dir: Path, spec: CampaignSpec) -> StoredRuns:
+    """The stored runs of ``spec`` in ``out_dir``, and the ids of run files it does not have."""
+    stored = load_run_results(out_dir, spec.methods)
+    ids = set(run_ids(spec))
+    foreign = tuple(sorted(k for k in stored if k not in ids))
+    return StoredRuns({k: v for k, v in stored.items() if k in ids}, foreign)
 
 
 def write_runs_csv(path: Path, results: Iterable[RunResult]) -> Path:

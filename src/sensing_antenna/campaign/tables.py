@@ -17,7 +17,7 @@ import math
 import statistics
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 
 import numpy as np
@@ -29,6 +29,7 @@ from sensing_antenna.campaign.records import CampaignRow
 from sensing_antenna.campaign.schema import noise_level_key, same_noise_level
 
 __all__ = [
+    "FIXED_DELAY_TOLERANCE",
     "PAPER_EXPERIMENTS_PER_POINT",
     "PAPER_TABLE_FILES",
     "CaseRow",
@@ -67,6 +68,11 @@ PAPER_EXPERIMENTS_PER_POINT = 5
 #: Contact points of the paper and of a campaign are matched to this tolerance (m): the paper
 #: lists them in whole centimetres.
 _POINT_MATCH_TOLERANCE = 1e-4
+
+#: Delays t_e - t_1 of one method that differ by less than this (s) are one fixed delay: a
+#: method that concludes a fixed time after the push. A microsecond, far below the 1 ms sample
+#: period and far above the round-off of a difference of two times.
+FIXED_DELAY_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -131,6 +137,8 @@ class IntervalSummary:
         Intervals of runs without a known contact abscissa.
     n_covering_nominal : int
         Intervals containing the nominal x_c.
+    shortest_time_to_estimate, longest_time_to_estimate : float
+        Smallest and largest t_e - t_1 (s); NaN when never timed.
     """
 
     case: str
@@ -142,6 +150,14 @@ class IntervalSummary:
     median_time_to_estimate: float
     n_judged_nominal: int = 0
     n_covering_nominal: int = 0
+    shortest_time_to_estimate: float = math.nan
+    longest_time_to_estimate: float = math.nan
+
+    @property
+    def fixed_delay(self) -> bool:
+        """Whether every timed run has the same t_e - t_1 (:data:`FIXED_DELAY_TOLERANCE`)."""
+        spread = self.longest_time_to_estimate - self.shortest_time_to_estimate
+        return self.n_timed > 0 and spread <= FIXED_DELAY_TOLERANCE
 
     @property
     def coverage(self) -> float:
@@ -172,6 +188,11 @@ class NoiseLevelErrors:
         Median t_e - t_1 (s); NaN when never timed.
     n_ok : int
         Runs with status ``ok``.
+    status_counts : mapping of str to int
+        Runs per status (the estimator's, ``run-failed`` or ``error``): why runs have no
+        estimate, e.g. ``push_not_reached``.
+    fixed_delay : bool
+        Whether every timed run has the same t_e - t_1 (:data:`FIXED_DELAY_TOLERANCE`).
     """
 
     noise_scale: float
@@ -182,6 +203,8 @@ class NoiseLevelErrors:
     max_abs_error: float
     median_delay: float
     n_ok: int
+    status_counts: Mapping[str, int] = field(default_factory=dict)
+    fixed_delay: bool = False
 
 
 @dataclass(frozen=True)
@@ -363,6 +386,7 @@ def interval_summaries(
             covering_nominal = has & (low <= nominal) & (nominal <= high)
             delay = _column(selected, "t_e_s") - _column(selected, "t_1_s")
             delay = delay[np.isfinite(delay)]
+            timed = delay.size > 0
             summaries.append(
                 IntervalSummary(
                     case=case,
@@ -374,6 +398,8 @@ def interval_summaries(
                     median_time_to_estimate=float(np.median(delay)) if delay.size else math.nan,
                     n_judged_nominal=int((has & ~np.isfinite(contact)).sum()),
                     n_covering_nominal=int(covering_nominal.sum()),
+                    shortest_time_to_estimate=float(delay.min()) if timed else math.nan,
+                    longest_time_to_estimate=float(delay.max()) if timed else math.nan,
                 )
             )
     return summaries
@@ -419,6 +445,8 @@ def noise_level_errors(
                     max_abs_error=max(errors) if errors else math.nan,
                     median_delay=statistics.median(delays) if delays else math.nan,
                     n_ok=sum(1 for r in mine if r.status == "ok"),
+                    status_counts=dict(Counter(r.status for r in mine)),
+                    fixed_delay=bool(delays) and delays[-1] - delays[0] <= FIXED_DELAY_TOLERANCE,
                 )
             )
     return table

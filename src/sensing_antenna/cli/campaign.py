@@ -4,10 +4,16 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 from pathlib import Path
 from typing import Any
 
 from sensing_antenna.cli.arguments import add_actions, integer
+
+#: Exit code of ``campaign run`` when every run was tried but some are stored as failed.
+EXIT_RUNS_FAILED = 1
+#: A campaign stopped by signal N exits with 128 + N, as a shell reports it (Ctrl-C: 130).
+EXIT_SIGNAL_BASE = 128
 
 
 def register(subparsers: Any) -> None:
@@ -80,26 +86,46 @@ def _kept(args: argparse.Namespace) -> str:
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.campaign.parsing import load_campaign_spec
     from sensing_antenna.campaign.report import build_report
-    from sensing_antenna.campaign.runner import run_campaign
+    from sensing_antenna.campaign.runner import CampaignInterrupted, run_campaign
 
     spec = load_campaign_spec(args.spec)
     if args.methods is not None:
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
         # CampaignSpec validates the names (an unknown one is an error naming --methods' field)
         spec = dataclasses.replace(spec, methods=methods)
-    outcome = run_campaign(
-        spec,
-        args.out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        retry_failed=args.retry_failed,
-        progress=not args.no_progress,
-    )
+    try:
+        outcome = run_campaign(
+            spec,
+            args.out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            retry_failed=args.retry_failed,
+            progress=not args.no_progress,
+        )
+    except CampaignInterrupted as stop:
+        print(f"antenna campaign: {stop.message}", file=sys.stderr)
+        return EXIT_SIGNAL_BASE + stop.signal_number
     print(
         f"{outcome.n_runs} runs: {outcome.n_previously_done} already done, "
         f"{outcome.n_executed} run now, {outcome.n_failed} failed"
     )
+    foreign = outcome.foreign_run_files
+    if foreign:
+        more = f" and {len(foreign) - 10} more" if len(foreign) > 10 else ""
+        print(
+            f"antenna campaign: left out {len(foreign)} run file(s) in "
+            f"{outcome.out_dir / 'runs'} that are not runs of this spec: "
+            f"{', '.join(foreign[:10])}{more}",
+            file=sys.stderr,
+        )
     print(build_report(outcome.out_dir))
+    if outcome.n_failed:
+        print(
+            f"antenna campaign: {outcome.n_failed} run(s) failed (listed in the report); "
+            "--retry-failed runs them again",
+            file=sys.stderr,
+        )
+        return EXIT_RUNS_FAILED
     return 0
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -30,9 +31,10 @@ __all__ = [
 CASE_FIGURES = {"azimuthal": 16, "vertical": 17}
 
 _CM = 100.0
-#: Lowest error drawn on the log axis of the error-versus-x_c figures (cm): 10 micrometres, far
-#: below any physical resolution of the device.
-_ERROR_FLOOR_CM = 1e-3
+#: Errors in the error-versus-x_c figures are drawn on a symmetric-log axis (cm): linear from 0
+#: to 10 micrometres, far below any physical resolution of the device, logarithmic above, so an
+#: error of exactly zero (an estimate on the grid point of the truth) is drawn at 0, as it is.
+_ERROR_LINEAR_BELOW_CM = 1e-3
 _METHOD_STYLE = {
     "paper": {"color": "tab:blue", "marker": "o"},
     "ratio": {"color": "tab:orange", "marker": "s"},
@@ -46,8 +48,28 @@ def _style(method: str) -> dict[str, str | None]:
     return dict(_METHOD_STYLE.get(method, {"color": None, "marker": "."}))
 
 
+def _join(names: Sequence[str]) -> str:
+    return ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
+
+
 def _cases(items: Sequence[PointTable] | Sequence[RunPoints]) -> list[str]:
     return list(dict.fromkeys(item.case for item in items))
+
+
+def _error_axis(ax: Any) -> None:
+    """Absolute errors in cm: symmetric-log, linear below 10 um so that 0 is drawn at 0."""
+    ax.set_yscale("symlog", linthresh=_ERROR_LINEAR_BELOW_CM, linscale=0.5)
+    ax.set_ylim(bottom=0.0)
+    ax.text(
+        0.99,
+        0.01,
+        f"linear below {_ERROR_LINEAR_BELOW_CM:g} cm, log above",
+        transform=ax.transAxes,
+        ha="right",
+        va="bottom",
+        fontsize="x-small",
+        color="0.4",
+    )
 
 
 def plot_case_estimates(points: RunPoints, paper: PointTable | None, out_dir: str | Path) -> Path:
@@ -156,9 +178,7 @@ def plot_method_errors(
             style = _style(table.method)
             ax.plot(
                 table.x_c * _CM,
-                # errors below the display floor (e.g. an estimate that lands on a grid point of
-                # the truth) are drawn on the floor, not as a dive to 1e-14 cm
-                np.maximum(table.mean_abs_error * _CM, _ERROR_FLOOR_CM),
+                table.mean_abs_error * _CM,
                 marker=style["marker"],
                 color=style["color"],
                 label=table.method,
@@ -171,8 +191,7 @@ def plot_method_errors(
                 lw=1,
                 label="paper (real device)",
             )
-        ax.set_yscale("log")
-        ax.set_ylim(bottom=_ERROR_FLOOR_CM)
+        _error_axis(ax)
         ax.set_xlabel("real contact point x_c (cm)")
         ax.set_ylabel("mean absolute error (cm)")
         ax.set_title(f"{case} movement")
@@ -202,13 +221,12 @@ def plot_error_and_delay(points: Sequence[RunPoints], out_dir: str | Path) -> Pa
             x = series.x_c[keep] * _CM
             style = _style(series.method)
             marker, color = style["marker"], style["color"]
-            error = np.maximum(np.abs(series.error[keep]) * _CM, _ERROR_FLOOR_CM)
+            error = np.abs(series.error[keep]) * _CM
             ax_e.plot(x, error, marker, color=color, ms=4, mfc="none", label=series.method)
             ax_t.plot(
                 x, series.delay[keep], marker, color=color, ms=4, mfc="none", label=series.method
             )
-        ax_e.set_yscale("log")
-        ax_e.set_ylim(bottom=_ERROR_FLOOR_CM)
+        _error_axis(ax_e)
         ax_e.set_ylabel("|x_c,e - contact abscissa| (cm)")
         ax_e.set_title(f"{case} movement")
         ax_e.grid(True, which="both", alpha=0.3)
@@ -232,12 +250,18 @@ def plot_frequency_error_vs_noise(
     standard error. For a fixed record the bound is proportional to the noise; the fast method
     stops when sure, so its record lengthens with the noise and its bound stays nearly level.
     The error cannot fall below the model bias (the simulator's compliant contact and finite
-    elements against the pinned-contact beam model).
+    elements against the pinned-contact beam model). The title names the methods whose bound is
+    drawn, or says that none reports one.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.4), squeeze=False)
     methods = list(dict.fromkeys(s.method for s in summaries))
+    bound = [
+        m
+        for m in methods
+        if any(np.isfinite(s.median_relative_crb) for s in summaries if s.method == m)
+    ]
     for ax, attr, title in (
         (axes[0][0], "rms_relative_error", "RMS relative error of omega_1"),
         (axes[0][1], "median_abs_relative_error", "median |relative error| of omega_1"),
@@ -274,5 +298,9 @@ def plot_frequency_error_vs_noise(
         ax.set_title(title)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize="small")
-    fig.suptitle("Frequency error against noise, beside the Cramer-Rao bound of the same record")
+    fig.suptitle(
+        f"Frequency error against noise, beside the Cramer-Rao bound reported by {_join(bound)}"
+        if bound
+        else "Frequency error against noise (no method here reports a Cramer-Rao bound)"
+    )
     return save_figure(fig, out / "frequency-error-vs-noise.png")

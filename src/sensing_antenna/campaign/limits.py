@@ -1,0 +1,96 @@
+"""How big a campaign may be: limits on its size, checked when its spec is made, before any work.
+
+Each limit has a reason, and docs/campaigns.md ("Limits") gives the measured figures behind it.
+The functions return the problem in words, or None within the limit; the spec's dataclasses
+(:mod:`~sensing_antenna.campaign.schema`) raise it as an error naming the file and the field.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "MAX_CALIBRATION_RECORDINGS",
+    "MAX_CONTACT_POINTS",
+    "MAX_NOISE_LEVELS",
+    "MAX_RUNS",
+    "MAX_RUN_DURATION",
+    "calibration_problem",
+    "contact_points_problem",
+    "duration_problem",
+    "noise_levels_problem",
+    "runs_problem",
+]
+
+#: Runs in a campaign, main and noise sweep: every stored run is read into memory to resume and
+#: to build the report, and the run list itself is built in memory.
+MAX_RUNS = 100_000
+#: Contact points in one list (main, noise sweep, calibration): the tables in the layout of
+#: Tables 3 and 4 have one row per point; this many is a 1 mm grid on a 1 m link.
+MAX_CONTACT_POINTS = 1_000
+#: Noise levels of the sweep: its tables have one row per level and method.
+MAX_NOISE_LEVELS = 100
+#: Calibration recordings (points x repeats): simulated one after another in the main process
+#: before any run.
+MAX_CALIBRATION_RECORDINGS = 1_000
+#: Simulated duration of one recording (s), ``scenario.duration`` and ``free_motion.duration``:
+#: a worker holds the whole recording and the simulator's history in memory, and a contact
+#: manoeuvre lasts seconds (``simulator.Scenario`` default 3.5 s).
+MAX_RUN_DURATION = 600.0
+
+_SEE = "see docs/campaigns.md, Limits"
+
+
+def runs_problem(n_main: int, n_sweep: int) -> str | None:
+    """Too many runs (:data:`MAX_RUNS`)?"""
+    if n_main + n_sweep <= MAX_RUNS:
+        return None
+    return (
+        f"the campaign would have {n_main + n_sweep} runs ({n_main} main, {n_sweep} in the noise "
+        f"sweep), more than the {MAX_RUNS} a campaign may have (every run is held in memory to "
+        f"resume and to report; {_SEE}); split it into several campaigns"
+    )
+
+
+def contact_points_problem(n_points: int) -> str | None:
+    """Too many contact points in one list (:data:`MAX_CONTACT_POINTS`)?"""
+    if n_points <= MAX_CONTACT_POINTS:
+        return None
+    return (
+        f"{n_points} points, more than the {MAX_CONTACT_POINTS} a list may have (one table row "
+        f"per point; {_SEE})"
+    )
+
+
+def noise_levels_problem(n_levels: int) -> str | None:
+    """Too many noise levels in the sweep (:data:`MAX_NOISE_LEVELS`)?"""
+    if n_levels <= MAX_NOISE_LEVELS:
+        return None
+    return (
+        f"{n_levels} levels, more than the {MAX_NOISE_LEVELS} a sweep may have (its tables have a "
+        f"row per level and method; {_SEE})"
+    )
+
+
+def calibration_problem(n_points: int, repeats: int) -> str | None:
+    """Too many calibration recordings (:data:`MAX_CALIBRATION_RECORDINGS`)?"""
+    n = n_points * repeats
+    if n <= MAX_CALIBRATION_RECORDINGS:
+        return None
+    return (
+        f"{n_points} points x {repeats} repeats = {n} recordings, more than the "
+        f"{MAX_CALIBRATION_RECORDINGS} a calibration may simulate (they run one after another "
+        f"before any run; {_SEE})"
+    )
+
+
+def duration_problem(duration: object) -> str | None:
+    """A simulated duration longer than :data:`MAX_RUN_DURATION`? (Other checks: Scenario's.)"""
+    if (
+        isinstance(duration, (int, float))
+        and not isinstance(duration, bool)
+        and duration > MAX_RUN_DURATION
+    ):
+        return (
+            f"{duration!r} s is longer than the {MAX_RUN_DURATION:g} s a campaign simulates per "
+            f"recording (a worker holds the whole recording in memory; {_SEE})"
+        )
+    return None
