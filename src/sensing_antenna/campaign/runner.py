@@ -289,7 +289,9 @@ def run_campaign(
                 stored = load_campaign_results(directory, spec)
                 csv_path = write_runs_csv(directory / CSV_FILE, stored.results.values())
     except KeyboardInterrupt as exc:
-        number = exc.signal_number if isinstance(exc, CampaignInterrupted) else signal.SIGINT
+        # Ctrl-C, or a stop signal turned into an interruption here or by the caller (the
+        # command line's SIGTERM)
+        number = int(getattr(exc, "signal_number", signal.SIGINT))
         where = directory if directory.is_dir() else None
         raise CampaignInterrupted(number, where, n_stored, spec.n_runs) from None
     return CampaignOutcome(

@@ -7,8 +7,6 @@ command may set with ``set_defaults``:
 ``flags``
     ``{library field name: flag}``: an error the library raises about a field the command filled
     from a flag (``ScenarioError`` about ``contact_point``) is reported under the flag (``--xc``).
-``on_interrupt``
-    ``(args) -> str``: what to add when the command is interrupted, such as what is kept.
 
 How a command ends, whichever it is:
 
@@ -16,13 +14,14 @@ How a command ends, whichever it is:
 - 2 on bad input, one line on stderr: an error derived from
   :class:`~sensing_antenna.errors.SensingAntennaError`, an argument error, an operating-system
   error such as an unwritable output path, or not enough memory for what was asked;
-- on Ctrl-C, one line on stderr, then the ``KeyboardInterrupt`` goes on up without its
+- on Ctrl-C, one line on stderr (the interruption's own ``message`` when it carries one, as a
+  stopped campaign says what it keeps), then the ``KeyboardInterrupt`` goes on up without its
   traceback: the process ends by SIGINT as Python ends any interrupted program, after its
   clean-ups, so the shell reports 130 (128 + SIGINT) and a shell loop or script running the
   command stops as well (bash goes on when a program exits normally after Ctrl-C);
 - 143 (128 + SIGTERM) when asked to stop, one line on stderr; SIGTERM raises
   :class:`~sensing_antenna.errors.Terminated` where the command is, so clean-ups run as for
-  Ctrl-C;
+  Ctrl-C (any interruption that carries another ``signal_number`` ends with 128 + it);
 - quietly with 141 (128 + SIGPIPE) when whatever reads the output closes it
   (``antenna beam ... | head -2``), what a shell reports for a program stopped by a closed pipe.
 """
@@ -160,18 +159,19 @@ def main(argv: Sequence[str] | None = None) -> int:
             sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
             return code
     except KeyboardInterrupt as exc:
-        number = exc.signal_number if isinstance(exc, Terminated) else signal.SIGINT
-        how = (
+        number = int(getattr(exc, "signal_number", signal.SIGINT))
+        how = getattr(exc, "message", None) or (
             "interrupted"
             if number == signal.SIGINT
             else f"stopped by {signal.Signals(number).name}"
         )
-        note = getattr(args, "on_interrupt", None)
-        _say(f"{prog}: {how}" + (f"; {note(args)}" if note is not None else ""))
-        if isinstance(exc, Terminated):
+        _say(f"{prog}: {how}")
+        if number != signal.SIGINT:
             return 128 + number
-        _without_traceback(exc)
-        raise
+        # the interpreter ends by SIGINT only for a plain KeyboardInterrupt, not a subclass
+        interrupt = exc if type(exc) is KeyboardInterrupt else KeyboardInterrupt()
+        _without_traceback(interrupt)
+        raise interrupt from None
     except BrokenPipeError:
         if not _stdout_closed():
             _say(f"{prog}: error: broken pipe")

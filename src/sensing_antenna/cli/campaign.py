@@ -12,8 +12,6 @@ from sensing_antenna.cli.arguments import add_actions, integer
 
 #: Exit code of ``campaign run`` when every run was tried but some are stored as failed.
 EXIT_RUNS_FAILED = 1
-#: A campaign stopped by signal N exits with 128 + N, as a shell reports it (Ctrl-C: 130).
-EXIT_SIGNAL_BASE = 128
 
 
 def register(subparsers: Any) -> None:
@@ -64,7 +62,7 @@ def register(subparsers: Any) -> None:
         help="comma-separated methods instead of the spec's, e.g. paper,ratio,two-frequency,fast "
         "(default: the spec's)",
     )
-    run.set_defaults(func=_run, on_interrupt=_kept)
+    run.set_defaults(func=_run)
 
     report = actions.add_parser(
         "report",
@@ -78,33 +76,26 @@ def register(subparsers: Any) -> None:
     report.set_defaults(func=_report)
 
 
-def _kept(args: argparse.Namespace) -> str:
-    """What an interrupted ``campaign run`` keeps: every run stored before the interruption."""
-    return f"the runs finished so far are stored in {args.out}; the same command resumes from them"
-
-
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.campaign.parsing import load_campaign_spec
     from sensing_antenna.campaign.report import build_report
-    from sensing_antenna.campaign.runner import CampaignInterrupted, run_campaign
+    from sensing_antenna.campaign.runner import run_campaign
 
     spec = load_campaign_spec(args.spec)
     if args.methods is not None:
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
         # CampaignSpec validates the names (an unknown one is an error naming --methods' field)
         spec = dataclasses.replace(spec, methods=methods)
-    try:
-        outcome = run_campaign(
-            spec,
-            args.out,
-            workers=args.workers,
-            scheduler=args.scheduler,
-            retry_failed=args.retry_failed,
-            progress=not args.no_progress,
-        )
-    except CampaignInterrupted as stop:
-        print(f"antenna campaign: {stop.message}", file=sys.stderr)
-        return EXIT_SIGNAL_BASE + stop.signal_number
+    # a signal stops the campaign as CampaignInterrupted, whose message says what is kept; the
+    # command line ends on it as on any interruption
+    outcome = run_campaign(
+        spec,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        retry_failed=args.retry_failed,
+        progress=not args.no_progress,
+    )
     print(
         f"{outcome.n_runs} runs: {outcome.n_previously_done} already done, "
         f"{outcome.n_executed} run now, {outcome.n_failed} failed"
