@@ -285,8 +285,8 @@ def test_absurd_values_are_refused_in_one_line_or_usable(
 def test_values_that_overflowed_the_estimators_are_refused_at_load(
     tmp_path: Path, field: str, value: float
 ) -> None:
-    # Each of these loaded, and then an estimator raised OverflowError or an overflow warning
-    # (a fuzzed run of estimate with every method on a simulated recording).
+    # Each of these, were it loaded, makes an estimator raise OverflowError or an overflow
+    # warning (estimate with every method on a simulated recording).
     path = tmp_path / "overflow.toml"
     path.write_text(f'base = "paper-2021"\n[link]\n{field} = {value!r}\n', encoding="utf-8")
     with pytest.raises(AntennaConfigError) as info:

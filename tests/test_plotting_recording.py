@@ -37,7 +37,7 @@ def test_magnitudes_up_to_the_limit_are_drawn(tmp_path: Path) -> None:
 
 
 def test_a_magnitude_beyond_the_limit_is_refused_in_one_line(tmp_path: Path) -> None:
-    # 1e308 in fx made matplotlib's tick locator raise OverflowError (a traceback).
+    # Drawn, 1e308 in fx makes matplotlib's tick locator raise OverflowError.
     recording = _recording()
     force = recording.force.copy()
     force[123, 0] = 1e308
