@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.errors import FieldError
+from sensing_antenna.errors import FieldError, format_value
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
@@ -65,24 +65,17 @@ class AntennaConfigError(FieldError):
     """
 
 
-def _plain(value: object) -> str:
-    """A value as plain text for messages: numbers as ``0.98``, ``1e+300``, ``nan``."""
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return repr(float(value))
-    return repr(value)
-
-
 def _require_positive(owner: str, name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise AntennaConfigError(
-            f"{owner}.{name}", f"must be a finite number > 0, got {_plain(value)}"
+            f"{owner}.{name}", f"must be a finite number > 0, got {format_value(value)}"
         )
 
 
 def _require_non_negative(owner: str, name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
         raise AntennaConfigError(
-            f"{owner}.{name}", f"must be a finite number >= 0, got {_plain(value)}"
+            f"{owner}.{name}", f"must be a finite number >= 0, got {format_value(value)}"
         )
 
 
@@ -111,7 +104,7 @@ class ParameterRange:
             unit = f" {self.unit}" if self.unit else ""
             raise AntennaConfigError(
                 field_name,
-                f"{_plain(value)}{unit} is outside {self.low:g} to {self.high:g}{unit}"
+                f"{format_value(value)}{unit} is outside {self.low:g} to {self.high:g}{unit}"
                 f" ({self.reason})",
             )
 
@@ -234,8 +227,8 @@ class Link:
         if not bulk_range.low <= bulk <= bulk_range.high:
             raise AntennaConfigError(
                 "link.linear_density",
-                f"{_plain(self.linear_density)} kg/m over a section of radius"
-                f" {_plain(self.radius)} m is a bulk density of {bulk:.4g} kg/m^3, outside"
+                f"{format_value(self.linear_density)} kg/m over a section of radius"
+                f" {format_value(self.radius)} m is a bulk density of {bulk:.4g} kg/m^3, outside"
                 f" {bulk_range.low:g} to {bulk_range.high:g} kg/m^3 ({bulk_range.reason})",
             )
         for name in ("calibrated_t", "calibration_scatter"):
@@ -245,16 +238,16 @@ class Link:
         if self.length < MIN_SLENDERNESS * self.radius:
             raise AntennaConfigError(
                 "link.radius",
-                f"{_plain(self.radius)} m is more than 1/{MIN_SLENDERNESS:g} of the length"
-                f" {_plain(self.length)} m: Euler-Bernoulli theory, which every model here uses,"
-                " needs a slender link",
+                f"{format_value(self.radius)} m is more than 1/{MIN_SLENDERNESS:g} of the"
+                f" length {format_value(self.length)} m: Euler-Bernoulli theory, which every"
+                " model here uses, needs a slender link",
             )
         sag = self.static_sag
         if not sag <= self.length:
             raise AntennaConfigError(
                 "link",
                 f"its tip would sag {sag:.3g} m under its own weight in linear beam theory,"
-                f" more than its length {_plain(self.length)} m: too long, heavy or soft for"
+                f" more than its length {format_value(self.length)} m: too long, heavy or soft for"
                 " the models here (length, linear_density, tip_mass, youngs_modulus, radius,"
                 " second_moment)",
             )
@@ -363,7 +356,7 @@ class Link:
         """Raise AntennaConfigError unless 0 < x_c <= l (m)."""
         if not (math.isfinite(x_c) and 0.0 < x_c <= self.length):
             raise AntennaConfigError(
-                "x_c", f"contact point must lie in (0, {self.length:g}] m, got {_plain(x_c)}"
+                "x_c", f"contact point must lie in (0, {self.length:g}] m, got {format_value(x_c)}"
             )
 
 
@@ -461,12 +454,12 @@ class Antenna:
         if not (isinstance(name, str) and name and name == name.strip() and name.isprintable()):
             raise AntennaConfigError(
                 "name",
-                f"must be one line of printable text without edge spaces, got {_plain(name)}"
+                f"must be one line of printable text without edge spaces, got {format_value(name)}"
                 " (it is written into every recording's metadata)",
             )
         if not isinstance(self.description, str):
             raise AntennaConfigError(
-                "description", f"must be a string, got {_plain(self.description)}"
+                "description", f"must be a string, got {format_value(self.description)}"
             )
 
     @property

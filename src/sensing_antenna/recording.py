@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
     "FORMAT_NAME",
@@ -97,11 +97,6 @@ MAX_PERIODS_PER_SAMPLE = 100
 #: Bytes read at a time: a NUL byte, invalid UTF-8 or a size above the limit is found within one
 #: chunk of where it starts.
 _CHUNK_BYTES = 2**20
-
-
-def _number(value: float) -> str:
-    """A number as plain text for messages: ``0.001``, ``1e+308``, ``nan``, ``inf``."""
-    return repr(float(value))
 
 
 def is_ground_truth_key(key: str) -> bool:
@@ -196,7 +191,7 @@ def check_sampling(
     median = float(np.median(steps))
     period = median if nominal is None else float(nominal)
     if not (math.isfinite(period) and period > 0):
-        raise ValueError(f"nominal period must be finite and > 0, got {_number(period)}")
+        raise ValueError(f"nominal period must be finite and > 0, got {format_value(period)}")
     multiples = np.maximum(np.rint(steps / period), 1.0)
     jitter = float(np.max(np.abs(steps - multiples * period)))
     dropped = int(np.sum(multiples - 1.0))
@@ -224,7 +219,8 @@ def _time_span_problem(t: NDArray[np.float64], period: float) -> tuple[int, str]
     if n > MAX_SAMPLES:
         return n - 1, f"{n} samples, more than the limit of {MAX_SAMPLES}"
     if not math.isfinite(periods):
-        return n - 1, f"time stamps from {_number(t[0])} to {_number(t[-1])} s: no finite span"
+        first, last = format_value(t[0]), format_value(t[-1])
+        return n - 1, f"time stamps from {first} to {last} s: no finite span"
     with np.errstate(over="ignore"):
         steps = np.diff(t)
     k = int(np.argmax(steps)) + 1
@@ -234,8 +230,9 @@ def _time_span_problem(t: NDArray[np.float64], period: float) -> tuple[int, str]
         else f"{MAX_PERIODS_PER_SAMPLE} per sample for its {n} samples"
     )
     problem = (
-        f"time jumps from {_number(t[k - 1])} to {_number(t[k])} s, {steps[k - 1] / period:.4g}"
-        f" sample periods of {_number(period)} s in one step: an outlier time stamp or a gap"
+        f"time jumps from {format_value(t[k - 1])} to {format_value(t[k])} s,"
+        f" {steps[k - 1] / period:.4g} sample periods of {format_value(period)} s in one step:"
+        " an outlier time stamp or a gap"
         f" (the recording spans {periods:.4g} periods, more than {limit})"
     )
     return (0 if k == 1 else k), problem
@@ -638,7 +635,7 @@ def read_recording(path: str | Path) -> Recording:
             source,
             first_line + int(row),
             names[col],
-            f"{_number(data[row, col])} is not a finite number",
+            f"{format_value(data[row, col])} is not a finite number",
         )
     column = {name: data[:, k] for k, name in enumerate(names)}
     t = column["t"]
@@ -652,7 +649,7 @@ def read_recording(path: str | Path) -> Recording:
             source,
             first_line + k,
             "t",
-            f"time does not increase ({_number(t[k])} after {_number(t[k - 1])})",
+            f"time does not increase ({format_value(t[k])} after {format_value(t[k - 1])})",
         )
     nominal = metadata.get("sample_period")
     span = _time_span_problem(t, _period_of(t, None if nominal is None else _parse_period(nominal)))
@@ -731,15 +728,15 @@ def resample_uniform(recording: Recording, period: float | None = None) -> Recor
     """
     step = recording.sample_period if period is None else float(period)
     if not (math.isfinite(step) and step > 0):
-        raise ValueError(f"period must be finite and > 0, got {_number(step)}")
+        raise ValueError(f"period must be finite and > 0, got {format_value(step)}")
     periods = recording.duration / step
     if periods >= MAX_SAMPLES:
         raise RecordingError(
             recording.source,
             None,
             "t",
-            f"a grid of step {_number(step)} s over {_number(recording.duration)} s would hold"
-            f" {periods + 1:.4g} samples, more than the limit of {MAX_SAMPLES}",
+            f"a grid of step {format_value(step)} s over {format_value(recording.duration)} s"
+            f" would hold {periods + 1:.4g} samples, more than the limit of {MAX_SAMPLES}",
         )
     count = math.floor(periods + 1e-9) + 1
     grid = recording.t[0] + step * np.arange(count)

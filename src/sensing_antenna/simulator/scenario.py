@@ -9,7 +9,7 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
     "ATI_NANO17_RESOLUTION",
@@ -84,13 +84,6 @@ _UPPER_LIMITS: dict[str, tuple[float, str, str]] = {
 }
 
 
-def _plain(value: object) -> str:
-    """A value as plain text for messages: numbers as ``3.5``, ``1e+09``, ``nan``."""
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return repr(value) if isinstance(value, int) else repr(float(value))
-    return repr(value)
-
-
 def duration_problem(duration: object) -> str | None:
     """Why ``duration`` (s) cannot be the recorded time of a simulated manoeuvre, or None.
 
@@ -102,13 +95,14 @@ def duration_problem(duration: object) -> str | None:
         or not isinstance(duration, (int, float))
         or not math.isfinite(duration)
     ):
-        return f"must be a finite number, got {_plain(duration)}"
+        return f"must be a finite number, got {format_value(duration)}"
     if not duration > 0.01:
-        return f"must be > 0.01 s, got {_plain(duration)}"
+        return f"must be > 0.01 s, got {format_value(duration)}"
     if duration > MAX_DURATION:
         return (
-            f"{_plain(duration)} s is more than {MAX_DURATION:g} s: {MAX_SIMULATED_SAMPLES} samples"
-            " at 1 kHz, the limit that keeps a simulation's memory and its recording bounded"
+            f"{format_value(duration)} s is more than {MAX_DURATION:g} s:"
+            f" {MAX_SIMULATED_SAMPLES} samples at 1 kHz, the limit that keeps a simulation's"
+            " memory and its recording bounded"
         )
     return None
 
@@ -123,9 +117,10 @@ class ScenarioError(SensingAntennaError, ValueError):
 
 def _finite(name: str, value: float, low: float | None = None, strict: bool = False) -> None:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ScenarioError(name, f"must be a finite number, got {_plain(value)}")
+        raise ScenarioError(name, f"must be a finite number, got {format_value(value)}")
     if low is not None and (value <= low if strict else value < low):
-        raise ScenarioError(name, f"must be {'>' if strict else '>='} {low:g}, got {_plain(value)}")
+        relation = ">" if strict else ">="
+        raise ScenarioError(name, f"must be {relation} {low:g}, got {format_value(value)}")
 
 
 @dataclass(frozen=True)
@@ -256,7 +251,7 @@ class Scenario:
     def __post_init__(self) -> None:
         if self.case not in CASES:
             raise ScenarioError(
-                "case", f"must be one of {', '.join(CASES)}, got {_plain(self.case)}"
+                "case", f"must be one of {', '.join(CASES)}, got {format_value(self.case)}"
             )
         if self.case == "free":
             if self.contact_point is not None:
@@ -268,10 +263,10 @@ class Scenario:
         if self.obstacle is not None and self.obstacle not in OBSTACLE_KINDS:
             raise ScenarioError(
                 "obstacle",
-                f"must be one of {', '.join(OBSTACLE_KINDS)}, got {_plain(self.obstacle)}",
+                f"must be one of {', '.join(OBSTACLE_KINDS)}, got {format_value(self.obstacle)}",
             )
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise ScenarioError("seed", f"must be an integer >= 0, got {_plain(self.seed)}")
+            raise ScenarioError("seed", f"must be an integer >= 0, got {format_value(self.seed)}")
         problem = duration_problem(self.duration)
         if problem is not None:
             raise ScenarioError("duration", problem)
@@ -293,19 +288,19 @@ class Scenario:
             value = getattr(self, name)
             if value is not None and value > high:
                 raise ScenarioError(
-                    name, f"{_plain(value)} {unit} is more than {high:g} {unit} ({reason})"
+                    name, f"{format_value(value)} {unit} is more than {high:g} {unit} ({reason})"
                 )
         _finite("servo_pole", self.servo_pole)
         if not self.servo_pole < 0:
             raise ScenarioError(
-                "servo_pole", f"must be < 0 (stable), got {_plain(self.servo_pole)}"
+                "servo_pole", f"must be < 0 (stable), got {format_value(self.servo_pole)}"
             )
         if -self.servo_pole * 1e-3 > 0.3:
             raise ScenarioError("servo_pole", "too fast for the 1 kHz controller (|p| T_s > 0.3)")
         if not isinstance(self.compensate_servo_lag, bool):
             raise ScenarioError(
                 "compensate_servo_lag",
-                f"must be true or false, got {_plain(self.compensate_servo_lag)}",
+                f"must be true or false, got {format_value(self.compensate_servo_lag)}",
             )
         if (
             isinstance(self.n_elements, bool)
@@ -314,7 +309,7 @@ class Scenario:
         ):
             raise ScenarioError(
                 "n_elements",
-                f"must be an integer from 4 to {MAX_ELEMENTS}, got {_plain(self.n_elements)}",
+                f"must be an integer from 4 to {MAX_ELEMENTS}, got {format_value(self.n_elements)}",
             )
         if (
             isinstance(self.substeps, bool)
@@ -323,7 +318,7 @@ class Scenario:
         ):
             raise ScenarioError(
                 "substeps",
-                f"must be an integer from 1 to {MAX_SUBSTEPS}, got {_plain(self.substeps)}",
+                f"must be an integer from 1 to {MAX_SUBSTEPS}, got {format_value(self.substeps)}",
             )
         description = self.description
         if not isinstance(description, str) or (
@@ -337,7 +332,7 @@ class Scenario:
             raise ScenarioError(
                 "description",
                 "must be one line of text without edge spaces (it is written into the"
-                f" recording's metadata), got {_plain(description)}",
+                f" recording's metadata), got {format_value(description)}",
             )
 
     def resolved(self, omega_free: float) -> Scenario:
@@ -354,7 +349,8 @@ class Scenario:
         )
         if approach < accel:
             raise ScenarioError(
-                "approach_time", f"must be >= accel_time ({accel:.3g} s), got {_plain(approach)}"
+                "approach_time",
+                f"must be >= accel_time ({accel:.3g} s), got {format_value(approach)}",
             )
         return replace(self, accel_time=accel, approach_time=approach)
 
