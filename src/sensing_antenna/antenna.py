@@ -138,7 +138,8 @@ PARAMETER_RANGES: Mapping[str, ParameterRange] = MappingProxyType(
             1e-30,
             math.pi / 4.0,
             "m^4",
-            "up to that of a solid section of the largest radius, 1 m; far below a 1 um fibre's",
+            "from far below a solid 1 um fibre's (7.9e-25 m^4) to a solid section of the"
+            " largest radius, 1 m",
         ),
         "link.calibrated_t": ParameterRange(
             1e-12,
