@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sensing_antenna.antenna import (
     BUILTIN_ANTENNAS,
+    PARAMETER_RANGES,
     AntennaConfigError,
     antenna_to_toml,
     load_antenna,
@@ -215,3 +219,157 @@ def test_gravity_torque_is_what_the_simulated_sensor_reads_at_rest(tip_mass: flo
     np.testing.assert_allclose(recording.force[0], antenna.gravity_force(theta2), atol=1e-5)
     rigid = 0.5 * base.link.mass * 9.80665 * base.link.length * math.cos(theta2)
     assert abs(recording.torque[0, 1] - rigid) > 1e-4  # the test would see either term missing
+
+
+_FIELDS = {
+    "link": (
+        "length",
+        "radius",
+        "youngs_modulus",
+        "linear_density",
+        "tip_mass",
+        "second_moment",
+        "calibrated_t",
+        "calibration_scatter",
+    ),
+    "azimuth_motor": (
+        "torque_constant",
+        "inertia",
+        "viscous_friction",
+        "coulomb_voltage",
+        "gear_ratio",
+    ),
+    "observer": ("gain", "natural_frequency", "damping", "contact_threshold"),
+}
+
+
+@pytest.mark.parametrize(
+    ("section", "name"), [(section, name) for section, names in _FIELDS.items() for name in names]
+)
+@pytest.mark.parametrize("value", [1e300, 1e-300, 1e30, 1e-30])
+def test_absurd_values_are_refused_in_one_line_or_usable(
+    tmp_path: Path, section: str, name: str, value: float
+) -> None:
+    # Valid floats, absurd values: either one line naming the file and the field (or the link
+    # as a whole), or an antenna the beam model computes with.
+    from sensing_antenna.beam import SensingCurve, natural_frequencies
+
+    path = tmp_path / "absurd.toml"
+    path.write_text(f'base = "paper-2021"\n[{section}]\n{name} = {value!r}\n', encoding="utf-8")
+    try:
+        antenna = load_antenna(path)
+    except AntennaConfigError as exc:
+        message = str(exc)
+        assert "\n" not in message
+        assert message.startswith(f"{path}: {section}")
+        assert "np." not in message
+        return
+    link = antenna.link
+    assert np.all(np.isfinite(natural_frequencies(link, 0.5 * link.length, 3)))
+    SensingCurve.from_link(link).contact_points(50.0)
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("length", 1e30),
+        ("radius", 1e-30),
+        ("youngs_modulus", 1e-30),
+        ("linear_density", 1e30),
+        ("tip_mass", 1e30),
+        ("second_moment", 1e-30),
+        ("calibrated_t", 1e30),
+        ("calibration_scatter", 1e300),
+    ],
+)
+def test_values_that_overflowed_the_estimators_are_refused_at_load(
+    tmp_path: Path, field: str, value: float
+) -> None:
+    # Each of these, were it loaded, makes an estimator raise OverflowError or an overflow
+    # warning (estimate with every method on a simulated recording).
+    path = tmp_path / "overflow.toml"
+    path.write_text(f'base = "paper-2021"\n[link]\n{field} = {value!r}\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError) as info:
+        load_antenna(path)
+    assert info.value.field_name in (f"link.{field}", "link")
+
+
+def test_link_length_limits_name_the_file_and_field(tmp_path: Path) -> None:
+    path = tmp_path / "long.toml"
+    for value, shown in ((1e300, "1e+300 m"), (1e-300, "1e-300 m")):
+        path.write_text(f'base = "paper-2021"\n[link]\nlength = {value!r}\n', encoding="utf-8")
+        with pytest.raises(AntennaConfigError) as info:
+            load_antenna(path)
+        assert str(info.value).startswith(f"{path}: link.length: {shown} is outside 0.001 to 100 m")
+
+
+@pytest.mark.parametrize("key", sorted(PARAMETER_RANGES))
+def test_every_range_has_a_reason_and_refuses_just_outside(key: str) -> None:
+    limits = PARAMETER_RANGES[key]
+    assert limits.reason and limits.low < limits.high
+    section, name = key.split(".")
+    base = paper_antenna()
+    field = "linear_density" if name == "bulk_density" else name
+    for bad in (limits.low * (1 - 1e-9) if limits.low > 0 else -1.0, limits.high * (1 + 1e-9)):
+        if name == "bulk_density":
+            bad = bad * math.pi * base.link.radius**2
+        part = base.link if section == "link" else base.azimuth_motor
+        with pytest.raises(AntennaConfigError) as info:
+            dataclasses.replace(part, **{field: bad})
+        assert info.value.field_name == f"{section}.{field}"
+
+
+def test_static_sag_and_the_links_that_would_sag_more_than_their_length() -> None:
+    # Handbook cantilever (Roark, Table 8.1, cases 1a and 2a): w l^4 / (8 E I) + P l^3 / (3 E I).
+    # Paper link (Table 2): w = 4.7e-3 * g, E I = 115e9 * pi (1e-3)^4 / 4, l = 0.98: 5.9 cm.
+    link = paper_antenna().link
+    ei = 115e9 * math.pi * 1e-12 / 4
+    expected = 4.7e-3 * 9.80665 * 0.98**4 / (8 * ei)
+    assert link.static_sag == pytest.approx(expected, rel=1e-12)
+    assert link.static_sag == pytest.approx(0.059, abs=5e-4)
+    with_tip = dataclasses.replace(link, tip_mass=0.002)
+    assert with_tip.static_sag == pytest.approx(expected + 0.002 * 9.80665 * 0.98**3 / (3 * ei))
+    # Three metres of it would sag 0.0589 (3 / 0.98)^4 = 5.17 m in linear theory: refused.
+    with pytest.raises(AntennaConfigError, match=r"^link: its tip would sag 5\.17 m"):
+        dataclasses.replace(link, length=3.0)
+    with pytest.raises(AntennaConfigError, match=r"^link\.radius: .* slender"):
+        dataclasses.replace(link, radius=0.15, linear_density=100.0)
+
+
+@pytest.mark.parametrize("name", ["two\nlines", "tab\there", " padded", "", "sep\u2028arator"])
+def test_names_that_cannot_be_one_metadata_line_are_refused(tmp_path: Path, name: str) -> None:
+    # The name goes into every recording's "# antenna:" line; TOML can carry it escaped, but a
+    # recording cannot.
+    path = tmp_path / "named.toml"
+    path.write_text(f'base = "paper-2021"\nname = {json.dumps(name)}\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError) as info:
+        load_antenna(path)
+    assert str(info.value).startswith(f"{path}: name:")
+    with pytest.raises(AntennaConfigError, match=r"^name:"):
+        dataclasses.replace(paper_antenna(), name=name)
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    name=st.text(st.characters(blacklist_categories=("Cs",)), min_size=1, max_size=20).filter(
+        lambda s: s.isprintable() and s == s.strip() and s != ""
+    ),
+    description=st.text(st.characters(blacklist_categories=("Cs",)), max_size=30),
+)
+def test_any_valid_name_and_description_round_trip(
+    tmp_path_factory: pytest.TempPathFactory, name: str, description: str
+) -> None:
+    # read(write(a)) == a: quotes, backslashes, control characters in the description and any
+    # Unicode are escaped as TOML basic strings.
+    antenna = dataclasses.replace(paper_antenna(), name=name, description=description)
+    path = tmp_path_factory.mktemp("rt") / "a.toml"
+    save_antenna(antenna, path)
+    back = load_antenna(path)
+    assert back == antenna
+    assert (back.name, back.description) == (name, description)
+
+
+def test_contact_point_message_shows_plain_numbers() -> None:
+    with pytest.raises(AntennaConfigError) as info:
+        paper_antenna().link.check_contact_point(np.float64("nan"))
+    assert str(info.value) == "x_c: contact point must lie in (0, 0.98] m, got nan"

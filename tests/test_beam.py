@@ -168,15 +168,19 @@ def test_mode_shapes_satisfy_the_boundary_conditions() -> None:
 
 @settings(max_examples=25, deadline=None)
 @given(
-    e_factor=st.floats(0.2, 5.0),
-    rho_factor=st.floats(0.2, 5.0),
-    l_factor=st.floats(0.2, 5.0),
+    e_factor=st.floats(0.5, 5.0),
+    rho_factor=st.floats(0.2, 2.0),
+    l_factor=st.floats(0.2, 1.5),
     xi=st.floats(0.01, 1.0),
 )
 def test_frequencies_scale_with_sqrt_ei_over_rho_over_length_squared(
     e_factor: float, rho_factor: float, l_factor: float, xi: float
 ) -> None:
-    """omega scales as sqrt(E I / rho) / l^2 at fixed x_c / l (tolerance 1e-12: same roots)."""
+    """omega scales as sqrt(E I / rho) / l^2 at fixed x_c / l (tolerance 1e-12: same roots).
+
+    The factors keep the link a physical one: its static sag, 6 % of its length for the paper's
+    link, grows as rho l^3 / E, at most 13.5 times here, within the length (Link.static_sag).
+    """
     other = dataclasses.replace(
         PAPER,
         youngs_modulus=PAPER.youngs_modulus * e_factor,

@@ -89,19 +89,19 @@ def test_a_name_that_is_not_one_printable_line_is_refused(
         assert not out.exists()
 
 
-def test_identify_writes_a_valid_file_from_an_antenna_named_over_two_lines(
+def test_identify_refuses_a_starting_antenna_named_over_two_lines(
     free_motion: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # a starting antenna whose TOML name holds a newline (an escape in a TOML string): the new
-    # antenna has its own name, and its description shows the old one on one line
+    # a TOML name holding a newline (an escape in a TOML string) could not be the one-line
+    # "# antenna:" metadata of a recording: the antenna file is refused, naming it and the field
     start = tmp_path / "start.toml"
     start.write_text('base = "paper-2021"\nname = "old\\nhead"\n', encoding="utf-8")
     out = tmp_path / "new.toml"
-    assert main(["identify", str(free_motion), "--antenna", str(start), "--out", str(out)]) == 0
-    capsys.readouterr()
-    identified = load_antenna(out)
-    assert identified.name == "new"
-    assert "old\\nhead" in identified.description and "\n" not in identified.description
+    assert main(["identify", str(free_motion), "--antenna", str(start), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0
+    assert err.startswith(f"antenna identify: error: {start}: name: must be one line")
+    assert not out.exists()
 
 
 def test_calibrate_names_the_antenna_after_its_file(

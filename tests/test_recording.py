@@ -12,6 +12,9 @@ from hypothesis import strategies as st
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.recording import (
     FORMAT_NAME,
+    MAX_FILE_BYTES,
+    MAX_PERIODS_PER_SAMPLE,
+    MAX_SAMPLES,
     Recording,
     RecordingError,
     check_sampling,
@@ -142,13 +145,13 @@ _value = st.text(
 @st.composite
 def _recordings(draw: st.DrawFn) -> Recording:
     n = draw(st.integers(min_value=2, max_value=12))
-    steps = draw(
-        st.lists(
-            st.floats(min_value=1e-6, max_value=1.0, allow_nan=False),
-            min_size=n - 1,
-            max_size=n - 1,
-        )
+    # Irregular steps (jitter, drops) around any period: a quarter to four periods each, so the
+    # span stays within MAX_PERIODS_PER_SAMPLE of the median step, as the format requires.
+    period = draw(st.floats(min_value=1e-6, max_value=1.0))
+    multiples = draw(
+        st.lists(st.floats(min_value=0.25, max_value=4.0), min_size=n - 1, max_size=n - 1)
     )
+    steps = [period * m for m in multiples]
     t = draw(st.floats(min_value=-10.0, max_value=10.0)) + np.concatenate([[0.0], np.cumsum(steps)])
     if not np.all(np.diff(t) > 0):
         t = np.arange(n, dtype=float)
@@ -296,3 +299,113 @@ def test_reads_5000_rows(tmp_path: Path) -> None:
     assert back.n_samples == 5000
     for name in ("t", "theta", "force", "torque"):
         np.testing.assert_array_equal(getattr(back, name), getattr(rec, name))
+
+
+def _write_rows(path: Path, t: np.ndarray, period: float = 1e-3) -> None:
+    rows = "".join(f"{v!r},0,0,0,0,-0.0451,0,0.0221,0\n" for v in t.tolist())
+    path.write_text(
+        f"# sample_period: {period!r}\nt,theta1,theta2,fx,fy,fz,tx,ty,tz\n{rows}", encoding="utf-8"
+    )
+
+
+def test_an_outlier_time_stamp_is_refused_at_its_line(tmp_path: Path) -> None:
+    # One last stamp at 1e6 s in a 1 kHz file: its resampled grid would hold 1e9 samples per
+    # column. The reader refuses it up front, naming the line (header on line 2, so sample k
+    # is on line k + 3), the column t and the step.
+    t = 1e-3 * np.arange(3000)
+    t[-1] = 1e6
+    path = tmp_path / "outlier.csv"
+    _write_rows(path, t)
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    err = info.value
+    assert (err.line, err.field) == (3002, "t")
+    assert "outlier time stamp or a gap" in err.problem
+    assert "from 2.998 to 1000000.0 s" in err.problem
+    assert f"limit of {MAX_SAMPLES} samples" in err.problem
+
+
+def test_a_mostly_empty_span_is_refused_at_its_gap(tmp_path: Path) -> None:
+    # 1000 samples at 1 ms, then a jump of 1000 s and 1000 more: the span holds 1e6 periods for
+    # 2000 samples, 500 per sample, more than MAX_PERIODS_PER_SAMPLE; the gap ends on line 1003.
+    t = np.concatenate([1e-3 * np.arange(1000), 1000.0 + 1e-3 * np.arange(1000)])
+    path = tmp_path / "gap.csv"
+    _write_rows(path, t)
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    assert (info.value.line, info.value.field) == (1003, "t")
+    assert f"{MAX_PERIODS_PER_SAMPLE} per sample for its 2000 samples" in info.value.problem
+    # A first stamp far before the others is named on its own line (line 3).
+    t = 1e-3 * np.arange(2000)
+    t[0] = -1e4
+    _write_rows(path, t)
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    assert info.value.line == 3
+    # The bound itself: 20 samples, 19 of them 1 ms apart, may span up to 100 * 20 = 2000
+    # periods: a last stamp at 1.9 s (1900 periods) is a gap the estimators handle, 2.1 s is not.
+    t = 1e-3 * np.arange(20)
+    t[-1] = 1.9
+    _write_rows(path, t)
+    assert read_recording(path).sampling.n_dropped == 1900 - 19
+    t[-1] = 2.1
+    _write_rows(path, t)
+    with pytest.raises(RecordingError, match="2100 periods"):
+        read_recording(path)
+
+
+def test_recordings_in_memory_and_the_resampler_refuse_the_same_spans() -> None:
+    t = 1e-3 * np.arange(3000)
+    t[-1] = 1e6
+    with pytest.raises(RecordingError, match=r"column 't': sample 2999: time jumps"):
+        Recording(
+            t=t, theta=np.zeros((3000, 2)), force=np.zeros((3000, 3)), torque=np.zeros((3000, 3))
+        )
+    rec = _recording(n=1000)
+    with pytest.raises(RecordingError, match=f"more than the limit of {MAX_SAMPLES}"):
+        resample_uniform(rec, period=1e-12)
+
+
+def test_binary_content_is_not_a_recording(tmp_path: Path) -> None:
+    path = tmp_path / "nul.csv"
+    path.write_bytes(b"# antenna: x\nt,theta1\n0.0\x00,1\n")
+    with pytest.raises(RecordingError, match=r"nul.csv:3: not a recording: binary content"):
+        read_recording(path)
+
+
+@pytest.mark.skipif(not Path("/dev/zero").exists(), reason="needs /dev/zero")
+def test_an_endless_device_is_refused_at_once() -> None:
+    # /dev/zero never ends: read whole, it exhausts memory; its first byte is a NUL.
+    with pytest.raises(RecordingError, match=r"/dev/zero:1: not a recording"):
+        read_recording("/dev/zero")
+
+
+def test_a_file_above_the_size_limit_is_refused_before_reading(tmp_path: Path) -> None:
+    path = tmp_path / "large.csv"
+    with path.open("wb") as stream:  # sparse: no disk space used
+        stream.truncate(MAX_FILE_BYTES + 1)
+    with pytest.raises(RecordingError, match=f"larger than the reader's limit of {MAX_FILE_BYTES}"):
+        read_recording(path)
+
+
+@pytest.mark.parametrize(("cell", "shown"), [("nan", "nan"), ("-inf", "-inf"), ("1e400", "inf")])
+def test_messages_show_plain_numbers(tmp_path: Path, cell: str, shown: str) -> None:
+    path = tmp_path / "r.csv"
+    path.write_text(f"t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,{cell},0,0,0,0,0\n", "utf-8")
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    assert str(info.value) == f"{path}:2: column 'fx': {shown} is not a finite number"
+    path.write_text(
+        "t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0.5,0,0,0,0,0,0,0,0\n0.25,0,0,0,0,0,0,0,0\n"
+    )
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    assert info.value.problem == "time does not increase (0.25 after 0.5)"
+
+
+@pytest.mark.parametrize("value", ["a\u2028b", "a\x0cb", "a\x85b", "a\x00b"])
+def test_metadata_that_would_not_read_back_is_refused(value: str, tmp_path: Path) -> None:
+    # str.splitlines (the reader) breaks lines at these characters, and a NUL is binary content:
+    # written, they would not read back as one metadata value.
+    with pytest.raises(RecordingError, match="one line"):
+        _recording(metadata={"description": value})

@@ -10,6 +10,15 @@ every field or names a ``base`` set and overrides some fields::
     length = 0.5
 
 All values are SI. Derived quantities (E I, m_b, T) are computed, never stored.
+
+Every physical parameter must lie in a documented range (:data:`PARAMETER_RANGES`, each with its
+reason), and the link as a whole must be one the linear beam theory of every model here can
+describe: slender (l / r >= :data:`MIN_SLENDERNESS`) and stiff enough not to sag, in that theory,
+by more than its own length under its weight (:meth:`Link.static_sag`). Values outside give one
+line naming the file and the field, before any model computes with them (a length of 1e300 m
+would overflow, one of 1e-300 m divide by zero). The observer's parameters are fitted, not
+measured: they must be finite and positive (the damping may be zero), and its frequency below the
+Nyquist frequency of the recording it is used on, which the estimators check.
 """
 
 from __future__ import annotations
@@ -20,21 +29,25 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from importlib import resources
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.errors import FieldError
+from sensing_antenna.errors import FieldError, format_value
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
     "BUILTIN_ANTENNAS",
+    "MIN_SLENDERNESS",
+    "PARAMETER_RANGES",
     "Antenna",
     "AntennaConfigError",
     "FreeMotionObserver",
     "Link",
     "Motor",
+    "ParameterRange",
     "antenna_to_toml",
     "load_antenna",
     "paper_antenna",
@@ -54,12 +67,111 @@ class AntennaConfigError(FieldError):
 
 def _require_positive(owner: str, name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise AntennaConfigError(f"{owner}.{name}", f"must be a finite number > 0, got {value!r}")
+        raise AntennaConfigError(
+            f"{owner}.{name}", f"must be a finite number > 0, got {format_value(value)}"
+        )
 
 
 def _require_non_negative(owner: str, name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-        raise AntennaConfigError(f"{owner}.{name}", f"must be a finite number >= 0, got {value!r}")
+        raise AntennaConfigError(
+            f"{owner}.{name}", f"must be a finite number >= 0, got {format_value(value)}"
+        )
+
+
+@dataclass(frozen=True)
+class ParameterRange:
+    """The values a physical parameter may take, and why.
+
+    Parameters
+    ----------
+    low, high : float
+        Smallest and largest value accepted, both included (in ``unit``).
+    unit : str
+        SI unit of the parameter, for messages.
+    reason : str
+        Why the range ends where it does.
+    """
+
+    low: float
+    high: float
+    unit: str
+    reason: str
+
+    def check(self, field_name: str, value: float) -> None:
+        """Raise AntennaConfigError naming ``field_name`` unless low <= value <= high."""
+        if not self.low <= value <= self.high:
+            unit = f" {self.unit}" if self.unit else ""
+            raise AntennaConfigError(
+                field_name,
+                f"{format_value(value)}{unit} is outside {self.low:g} to {self.high:g}{unit}"
+                f" ({self.reason})",
+            )
+
+
+#: Accepted range of each physical parameter, by ``section.field`` (``motor`` for both motors).
+#: The linear density is bounded through the bulk density it implies over the full circular
+#: section, rho / (pi r^2), so that a hollow tube passes; the link as a whole must also be
+#: slender and stiff enough (:data:`MIN_SLENDERNESS`, :meth:`Link.static_sag`).
+PARAMETER_RANGES: Mapping[str, ParameterRange] = MappingProxyType(
+    {
+        "link.length": ParameterRange(
+            1e-3, 100.0, "m", "from a millimetre whisker to a 100 m pole"
+        ),
+        "link.radius": ParameterRange(
+            1e-6, 1.0, "m", "from a single fibre (carbon filaments are 3 to 4 um) to a 1 m shaft"
+        ),
+        "link.youngs_modulus": ParameterRange(
+            1e5, 2e12, "Pa", "from soft rubber to beyond diamond, the stiffest solid (1.1e12 Pa)"
+        ),
+        "link.bulk_density": ParameterRange(
+            1.0,
+            25e3,
+            "kg/m^3",
+            "rho / (pi r^2): lighter than air even as a hollow tube, or denser than osmium,"
+            " the densest element (22,590 kg/m^3)",
+        ),
+        "link.tip_mass": ParameterRange(
+            0.0, 100.0, "kg", "more than any sensing head carries on a cantilever"
+        ),
+        "link.second_moment": ParameterRange(
+            1e-30,
+            math.pi / 4.0,
+            "m^4",
+            "from far below a solid 1 um fibre's (7.9e-25 m^4) to a solid section of the"
+            " largest radius, 1 m",
+        ),
+        "link.calibrated_t": ParameterRange(
+            1e-12,
+            1e5,
+            "s/m^2",
+            "the span of T = sqrt(rho / (E I)) over the links the other ranges admit",
+        ),
+        "link.calibration_scatter": ParameterRange(
+            0.0, 1.0, "", "a relative scatter: above 1 (100 %) the calibration says nothing"
+        ),
+        "motor.torque_constant": ParameterRange(
+            1e-6, 10.0, "N m/V", "from a micromotor to a large servomotor, before its gear"
+        ),
+        "motor.inertia": ParameterRange(
+            1e-9, 1e3, "kg m^2", "at the joint, from a miniature head to a large robot joint"
+        ),
+        "motor.viscous_friction": ParameterRange(
+            0.0, 1e3, "N m s/rad", "at the joint; the paper's head has 0.03 (Table 1)"
+        ),
+        "motor.coulomb_voltage": ParameterRange(
+            0.0, 1e3, "V", "an input voltage: no servo amplifier of such a head gives more"
+        ),
+        "motor.gear_ratio": ParameterRange(
+            1.0, 1e4, "", "n of a 1:n reduction, from direct drive to several stages"
+        ),
+    }
+)
+
+#: Smallest length-to-radius ratio l / r of a link (10): Euler-Bernoulli theory, which every
+#: model here uses (Assumption 3 of the paper), needs a slender beam; below, shear and rotary
+#: inertia, which it neglects, are no longer small.
+MIN_SLENDERNESS = 10.0
 
 
 @dataclass(frozen=True)
@@ -107,6 +219,39 @@ class Link:
             _require_positive("link", "calibrated_t", self.calibrated_t)
         if self.calibration_scatter is not None:
             _require_non_negative("link", "calibration_scatter", self.calibration_scatter)
+        for name in ("length", "radius", "youngs_modulus", "tip_mass", "second_moment"):
+            value = getattr(self, name)
+            if value is not None:
+                PARAMETER_RANGES[f"link.{name}"].check(f"link.{name}", value)
+        bulk = self.linear_density / (math.pi * self.radius**2)
+        bulk_range = PARAMETER_RANGES["link.bulk_density"]
+        if not bulk_range.low <= bulk <= bulk_range.high:
+            raise AntennaConfigError(
+                "link.linear_density",
+                f"{format_value(self.linear_density)} kg/m over a section of radius"
+                f" {format_value(self.radius)} m is a bulk density of {bulk:.4g} kg/m^3, outside"
+                f" {bulk_range.low:g} to {bulk_range.high:g} kg/m^3 ({bulk_range.reason})",
+            )
+        for name in ("calibrated_t", "calibration_scatter"):
+            value = getattr(self, name)
+            if value is not None:
+                PARAMETER_RANGES[f"link.{name}"].check(f"link.{name}", value)
+        if self.length < MIN_SLENDERNESS * self.radius:
+            raise AntennaConfigError(
+                "link.radius",
+                f"{format_value(self.radius)} m is more than 1/{MIN_SLENDERNESS:g} of the"
+                f" length {format_value(self.length)} m: Euler-Bernoulli theory, which every"
+                " model here uses, needs a slender link",
+            )
+        sag = self.static_sag
+        if not sag <= self.length:
+            raise AntennaConfigError(
+                "link",
+                f"its tip would sag {sag:.3g} m under its own weight in linear beam theory,"
+                f" more than its length {format_value(self.length)} m: too long, heavy or soft for"
+                " the models here (length, linear_density, tip_mass, youngs_modulus, radius,"
+                " second_moment)",
+            )
 
     @property
     def area_moment(self) -> float:
@@ -114,6 +259,15 @@ class Link:
         if self.second_moment is not None:
             return self.second_moment
         return math.pi * self.radius**4 / 4.0
+
+    @property
+    def static_sag(self) -> float:
+        """Tip deflection (m) of the link held horizontal under its weight and the tip mass,
+        in linear beam theory: g (rho l^4 / 8 + m_t l^3 / 3) / (E I), from the material data
+        (a calibrated T_e does not enter). Paper link: 5.9 cm."""
+        rho, m_t, length = self.linear_density, self.tip_mass, self.length
+        load = rho * length**4 / 8.0 + m_t * length**3 / 3.0
+        return STANDARD_GRAVITY * load / self.flexural_rigidity
 
     @property
     def flexural_rigidity(self) -> float:
@@ -203,7 +357,7 @@ class Link:
         """Raise AntennaConfigError unless 0 < x_c <= l (m)."""
         if not (math.isfinite(x_c) and 0.0 < x_c <= self.length):
             raise AntennaConfigError(
-                "x_c", f"contact point must lie in (0, {self.length:g}] m, got {x_c!r}"
+                "x_c", f"contact point must lie in (0, {self.length:g}] m, got {format_value(x_c)}"
             )
 
 
@@ -236,6 +390,8 @@ class Motor:
             _require_positive("motor", name, getattr(self, name))
         _require_non_negative("motor", "viscous_friction", self.viscous_friction)
         _require_non_negative("motor", "coulomb_voltage", self.coulomb_voltage)
+        for f in fields(self):
+            PARAMETER_RANGES[f"motor.{f.name}"].check(f"motor.{f.name}", getattr(self, f.name))
 
     @property
     def coulomb_torque(self) -> float:
@@ -293,6 +449,19 @@ class Antenna:
     observer: FreeMotionObserver
     description: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        name = self.name
+        if not (isinstance(name, str) and name and name == name.strip() and name.isprintable()):
+            raise AntennaConfigError(
+                "name",
+                f"must be one line of printable text without edge spaces, got {format_value(name)}"
+                " (it is written into every recording's metadata)",
+            )
+        if not isinstance(self.description, str):
+            raise AntennaConfigError(
+                "description", f"must be a string, got {format_value(self.description)}"
+            )
 
     @property
     def motors(self) -> tuple[Motor, Motor]:
@@ -386,22 +555,26 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
         try:
             parts[section] = cls(**{k: float(v) for k, v in values.items()})
         except AntennaConfigError as exc:
-            raise AntennaConfigError(
-                f"{section}.{exc.field_name.split('.', 1)[-1]}", exc.problem, source
-            ) from exc
+            # "motor.inertia" is "azimuth_motor.inertia" here; "link" (the whole) stays itself
+            _, dot, name = exc.field_name.partition(".")
+            field_name = f"{section}.{name}" if dot else section
+            raise AntennaConfigError(field_name, exc.problem, source) from exc
         except TypeError as exc:
             raise AntennaConfigError(section, f"missing field ({exc})", source) from exc
     name = data.get("name", "unnamed")
     if not isinstance(name, str) or not name:
         raise AntennaConfigError("name", "must be a non-empty string", source)
-    return Antenna(
-        name=name,
-        description=str(data.get("description", "")),
-        link=parts["link"],
-        azimuth_motor=parts["azimuth_motor"],
-        elevation_motor=parts["elevation_motor"],
-        observer=parts["observer"],
-    )
+    try:
+        return Antenna(
+            name=name,
+            description=str(data.get("description", "")),
+            link=parts["link"],
+            azimuth_motor=parts["azimuth_motor"],
+            elevation_motor=parts["elevation_motor"],
+            observer=parts["observer"],
+        )
+    except AntennaConfigError as exc:
+        raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
 
 
 def load_antenna(spec: str | Path | None = None) -> Antenna:
@@ -465,5 +638,26 @@ def save_antenna(antenna: Antenna, path: str | Path) -> None:
     Path(path).write_text(antenna_to_toml(antenna), encoding="utf-8")
 
 
+#: TOML basic-string escapes (TOML 1.0, "String"); other control characters become \uXXXX.
+_TOML_ESCAPES = {
+    "\\": "\\\\",
+    '"': '\\"',
+    "\b": "\\b",
+    "\t": "\\t",
+    "\n": "\\n",
+    "\f": "\\f",
+    "\r": "\\r",
+}
+
+
 def _toml_str(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    """``text`` as a TOML basic string that any TOML reader gives back unchanged."""
+    out = []
+    for char in text:
+        if char in _TOML_ESCAPES:
+            out.append(_TOML_ESCAPES[char])
+        elif ord(char) < 0x20 or ord(char) == 0x7F:
+            out.append(f"\\u{ord(char):04X}")
+        else:
+            out.append(char)
+    return '"' + "".join(out) + '"'

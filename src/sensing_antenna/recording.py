@@ -11,11 +11,19 @@ puts a recording on a uniform grid for estimators that need one.
 
 Ground truth written by simulators (metadata keys starting with ``true_``, plus ``seed`` and
 ``simulation``) must never be read by estimators; :meth:`Recording.without_ground_truth` drops it.
+
+Sizes are bounded before anything large is allocated: a file above :data:`MAX_FILE_BYTES` (or a
+stream that does not end) is refused while it is read, a NUL byte at once, and time stamps that
+span more than :data:`MAX_SAMPLES` sample periods, or more than :data:`MAX_PERIODS_PER_SAMPLE`
+periods per sample (an outlier time stamp or a gap), are refused naming the step at fault.
 """
 
 from __future__ import annotations
 
+import codecs
 import math
+import os
+import stat
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,12 +33,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
     "FORMAT_NAME",
     "GROUND_TRUTH_KEYS",
     "GROUND_TRUTH_PREFIX",
+    "MAX_FILE_BYTES",
+    "MAX_PERIODS_PER_SAMPLE",
+    "MAX_SAMPLES",
     "REQUIRED_COLUMNS",
     "Recording",
     "RecordingError",
@@ -63,6 +74,29 @@ JITTER_TOLERANCE = 0.01
 #: ``sample_period`` metadata counts as consistent with the data when the median time step is
 #: within this fraction of it (2 %).
 PERIOD_CONSISTENCY = 0.02
+
+#: Largest file :func:`read_recording` reads (bytes): 256 MiB. One sample of the simulator's
+#: eleven columns at full precision takes about 190 bytes, so this holds more than 20 minutes at
+#: 1 kHz, where one manoeuvre lasts seconds; reading takes about four times the file's size in
+#: memory (text, lines, arrays), so the limit keeps that near a gigabyte and stops a stream that
+#: never ends (a device such as ``/dev/zero``, a pipe) before it exhausts memory.
+MAX_FILE_BYTES = 256 * 2**20
+
+#: Largest number of samples a recording may hold or span on its sample period: 10 million,
+#: 2.8 hours at 1 kHz. Resampling onto the uniform grid allocates this many values per column
+#: (80 MB each, 720 MB for the nine required columns), so the bound holds every estimator's
+#: memory whatever the time stamps say.
+MAX_SAMPLES = 10_000_000
+
+#: A recording's time span may hold at most this many sample periods per sample it has (100: at
+#: least 1 % of the grid's samples present). Dropped samples are handled (the sampling
+#: diagnostics, the estimators' gap check), but a file whose span is mostly empty has an outlier
+#: time stamp or a gap its resampling would fill with straight lines.
+MAX_PERIODS_PER_SAMPLE = 100
+
+#: Bytes read at a time: a NUL byte, invalid UTF-8 or a size above the limit is found within one
+#: chunk of where it starts.
+_CHUNK_BYTES = 2**20
 
 
 def is_ground_truth_key(key: str) -> bool:
@@ -157,7 +191,7 @@ def check_sampling(
     median = float(np.median(steps))
     period = median if nominal is None else float(nominal)
     if not (math.isfinite(period) and period > 0):
-        raise ValueError(f"nominal period must be finite and > 0, got {period!r}")
+        raise ValueError(f"nominal period must be finite and > 0, got {format_value(period)}")
     multiples = np.maximum(np.rint(steps / period), 1.0)
     jitter = float(np.max(np.abs(steps - multiples * period)))
     dropped = int(np.sum(multiples - 1.0))
@@ -168,6 +202,40 @@ def check_sampling(
         n_dropped=dropped,
         irregular=dropped > 0 or jitter > tolerance * period,
     )
+
+
+def _time_span_problem(t: NDArray[np.float64], period: float) -> tuple[int, str] | None:
+    """Why strictly increasing time stamps ``t`` (s) cannot be put on a grid of step ``period``
+    (s) within :data:`MAX_SAMPLES` and :data:`MAX_PERIODS_PER_SAMPLE`, or None when they can.
+
+    Returns the index of the sample at fault (the one after the largest step, or the first sample
+    when the largest step is the first) and the problem.
+    """
+    n = t.shape[0]
+    span = float(t[-1]) - float(t[0])
+    periods = span / period
+    if n <= MAX_SAMPLES and periods < min(MAX_SAMPLES, MAX_PERIODS_PER_SAMPLE * n):
+        return None
+    if n > MAX_SAMPLES:
+        return n - 1, f"{n} samples, more than the limit of {MAX_SAMPLES}"
+    if not math.isfinite(periods):
+        first, last = format_value(t[0]), format_value(t[-1])
+        return n - 1, f"time stamps from {first} to {last} s: no finite span"
+    with np.errstate(over="ignore"):
+        steps = np.diff(t)
+    k = int(np.argmax(steps)) + 1
+    limit = (
+        f"the limit of {MAX_SAMPLES} samples"
+        if periods >= MAX_SAMPLES
+        else f"{MAX_PERIODS_PER_SAMPLE} per sample for its {n} samples"
+    )
+    problem = (
+        f"time jumps from {format_value(t[k - 1])} to {format_value(t[k])} s,"
+        f" {steps[k - 1] / period:.4g} sample periods of {format_value(period)} s in one step:"
+        " an outlier time stamp or a gap"
+        f" (the recording spans {periods:.4g} periods, more than {limit})"
+    )
+    return (0 if k == 1 else k), problem
 
 
 def _frozen_array(values: ArrayLike, shape_tail: tuple[int, ...], name: str) -> NDArray[np.float64]:
@@ -181,12 +249,20 @@ def _frozen_array(values: ArrayLike, shape_tail: tuple[int, ...], name: str) -> 
     return array
 
 
+def _is_one_line(text: str) -> bool:
+    """True unless ``text`` holds a NUL byte (binary content to the reader) or a character at
+    which :meth:`str.splitlines`, and so the reader, breaks lines: line feed, carriage return,
+    form feed, U+2028 and the others."""
+    return "\0" not in text and (not text or text.splitlines() == [text])
+
+
 def _check_name(name: str, what: str) -> None:
     if (
         not isinstance(name, str)
         or not name
         or name != name.strip()
-        or any(c in name for c in ",\r\n")
+        or "," in name
+        or not _is_one_line(name)
         or name.startswith("#")
     ):
         raise RecordingError(None, None, None, f"invalid {what} {name!r}")
@@ -229,7 +305,8 @@ class Recording:
         n = t.shape[0]
         if n < 2:
             raise RecordingError(self.source, None, "t", f"need at least 2 samples, got {n}")
-        steps = np.diff(t)
+        with np.errstate(over="ignore"):
+            steps = np.diff(t)
         if not np.all(steps > 0):
             k = int(np.argmin(steps > 0)) + 1
             raise RecordingError(self.source, None, "t", f"not strictly increasing at sample {k}")
@@ -248,7 +325,7 @@ class Recording:
                     self.source, None, key, "key must not contain ':'", metadata=True
                 )
             text = str(value)
-            if text != text.strip() or "\n" in text or "\r" in text:
+            if text != text.strip() or not _is_one_line(text):
                 raise RecordingError(
                     self.source,
                     None,
@@ -271,6 +348,10 @@ class Recording:
             object.__setattr__(self, name, array)
         object.__setattr__(self, "metadata", MappingProxyType(metadata))
         object.__setattr__(self, "extra", MappingProxyType(extra))
+        span = _time_span_problem(t, self.sample_period)
+        if span is not None:
+            k, problem = span
+            raise RecordingError(self.source, None, "t", f"sample {k}: {problem}")
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Recording):
@@ -318,11 +399,7 @@ class Recording:
     def sample_period(self) -> float:
         """Sample period T_s (s): the metadata value when present and consistent with the data
         (median step within ``PERIOD_CONSISTENCY``), else the median time step."""
-        median = float(np.median(np.diff(self.t)))
-        nominal = self.nominal_period
-        if nominal is not None and abs(median - nominal) <= PERIOD_CONSISTENCY * nominal:
-            return nominal
-        return median
+        return _period_of(self.t, self.nominal_period)
 
     @property
     def sampling(self) -> SamplingDiagnostics:
@@ -355,6 +432,16 @@ class Recording:
             extra=self.extra,
             source=self.source,
         )
+
+
+def _period_of(t: NDArray[np.float64], nominal: float | None) -> float:
+    """The sample period (s) of time stamps ``t``: ``nominal`` when the median step is within
+    ``PERIOD_CONSISTENCY`` of it, else the median step."""
+    with np.errstate(over="ignore"):
+        median = float(np.median(np.diff(t)))
+    if nominal is not None and abs(median - nominal) <= PERIOD_CONSISTENCY * nominal:
+        return nominal
+    return median
 
 
 def _parse_period(text: str) -> float | None:
@@ -447,6 +534,57 @@ def _locate_bad_cell(
     return RecordingError(source, None, None, "could not be parsed as numbers")  # pragma: no cover
 
 
+def _read_text(path: str | Path, source: str) -> str:
+    """The file's text, read in chunks: refused at the first NUL byte, invalid UTF-8 or byte
+    beyond :data:`MAX_FILE_BYTES` (a regular file above it before reading anything)."""
+    decoder = codecs.getincrementaldecoder("utf-8-sig")()
+    parts: list[str] = []
+    size = 0
+    newlines = 0
+    try:
+        with open(path, "rb") as stream:
+            status = os.fstat(stream.fileno())
+            if stat.S_ISREG(status.st_mode) and status.st_size > MAX_FILE_BYTES:
+                raise RecordingError(
+                    source,
+                    None,
+                    None,
+                    f"file of {status.st_size} bytes is larger than the reader's limit of"
+                    f" {MAX_FILE_BYTES} bytes ({MAX_FILE_BYTES // 2**20} MiB)",
+                )
+            while chunk := stream.read(_CHUNK_BYTES):
+                size += len(chunk)
+                if size > MAX_FILE_BYTES:
+                    raise RecordingError(
+                        source,
+                        None,
+                        None,
+                        f"more than the reader's limit of {MAX_FILE_BYTES} bytes"
+                        f" ({MAX_FILE_BYTES // 2**20} MiB) and not a regular file"
+                        " (a stream or device that does not end?)",
+                    )
+                nul = chunk.find(b"\0")
+                if nul >= 0:
+                    line = newlines + chunk.count(b"\n", 0, nul) + 1
+                    raise RecordingError(
+                        source, line, None, "not a recording: binary content (a NUL byte)"
+                    )
+                try:
+                    parts.append(decoder.decode(chunk))
+                except UnicodeDecodeError as exc:
+                    # exc.object is the decoder's undecoded tail (no line feed) plus this chunk
+                    line = newlines + exc.object[: exc.start].count(b"\n") + 1
+                    raise RecordingError(source, line, None, "not UTF-8 text") from exc
+                newlines += chunk.count(b"\n")
+    except OSError as exc:
+        raise RecordingError(source, None, None, f"cannot read file ({exc.strerror})") from exc
+    try:
+        parts.append(decoder.decode(b"", final=True))
+    except UnicodeDecodeError as exc:
+        raise RecordingError(source, newlines + 1, None, "not UTF-8 text (cut off)") from exc
+    return "".join(parts)
+
+
 def read_recording(path: str | Path) -> Recording:
     """Read a recording file (format: ``docs/recording-format.md``).
 
@@ -463,20 +601,14 @@ def read_recording(path: str | Path) -> Recording:
     Raises
     ------
     RecordingError
-        For a missing or unreadable file, bad metadata, a missing required column, a non-numeric,
-        NaN or infinite cell, a wrong number of cells (truncated row), non-increasing time, an empty
-        file or a header without rows; the message names the file, the line and the field.
+        For a missing or unreadable file, a file above :data:`MAX_FILE_BYTES` or with a NUL byte,
+        bad metadata, a missing required column, a non-numeric, NaN or infinite cell, a wrong
+        number of cells (truncated row), non-increasing time, time stamps that span too many
+        sample periods (:data:`MAX_SAMPLES`, :data:`MAX_PERIODS_PER_SAMPLE`), an empty file or a
+        header without rows; the message names the file, the line and the field.
     """
     source = str(path)
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as exc:
-        raise RecordingError(source, None, None, f"cannot read file ({exc.strerror})") from exc
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise RecordingError(source, line, None, "not UTF-8 text") from exc
+    text = _read_text(path, source)
     lines = text.splitlines()
     while lines and not lines[-1].strip():
         lines.pop()
@@ -500,21 +632,30 @@ def read_recording(path: str | Path) -> Recording:
     if not np.all(finite):
         row, col = np.argwhere(~finite)[0]
         raise RecordingError(
-            source, first_line + int(row), names[col], f"{data[row, col]!r} is not a finite number"
+            source,
+            first_line + int(row),
+            names[col],
+            f"{format_value(data[row, col])} is not a finite number",
         )
     column = {name: data[:, k] for k, name in enumerate(names)}
     t = column["t"]
     if t.shape[0] < 2:
         raise RecordingError(source, first_line, None, "need at least 2 data rows")
-    bad = np.flatnonzero(np.diff(t) <= 0)
+    with np.errstate(over="ignore"):
+        bad = np.flatnonzero(np.diff(t) <= 0)
     if bad.size:
         k = int(bad[0]) + 1
         raise RecordingError(
             source,
             first_line + k,
             "t",
-            f"time does not increase ({t[k]!r} after {t[k - 1]!r})",
+            f"time does not increase ({format_value(t[k])} after {format_value(t[k - 1])})",
         )
+    nominal = metadata.get("sample_period")
+    span = _time_span_problem(t, _period_of(t, None if nominal is None else _parse_period(nominal)))
+    if span is not None:
+        k, problem = span
+        raise RecordingError(source, first_line + k, "t", problem)
     return Recording(
         t=t,
         theta=np.column_stack([column["theta1"], column["theta2"]]),
@@ -578,11 +719,26 @@ def resample_uniform(recording: Recording, period: float | None = None) -> Recor
     Recording
         Samples at t[0] + k * period for every k with t[0] + k * period <= t[-1] (plus a rounding
         margin of 1e-9 periods); ``sample_period`` metadata set to the step; same source.
+
+    Raises
+    ------
+    RecordingError
+        When that grid would hold :data:`MAX_SAMPLES` samples or more (a recording's own sample
+        period never does: the recording would have been refused).
     """
     step = recording.sample_period if period is None else float(period)
     if not (math.isfinite(step) and step > 0):
-        raise ValueError(f"period must be finite and > 0, got {period!r}")
-    count = math.floor(recording.duration / step + 1e-9) + 1
+        raise ValueError(f"period must be finite and > 0, got {format_value(step)}")
+    periods = recording.duration / step
+    if periods >= MAX_SAMPLES:
+        raise RecordingError(
+            recording.source,
+            None,
+            "t",
+            f"a grid of step {format_value(step)} s over {format_value(recording.duration)} s"
+            f" would hold {periods + 1:.4g} samples, more than the limit of {MAX_SAMPLES}",
+        )
+    count = math.floor(periods + 1e-9) + 1
     grid = recording.t[0] + step * np.arange(count)
     grid[-1] = min(grid[-1], recording.t[-1])
 

@@ -8,7 +8,7 @@
 - :mod:`~sensing_antenna.beam.statics`: static deflection, base force and torque (Eqs. 7 to 13).
 """
 
-from sensing_antenna.beam._validate import BeamInputError
+from sensing_antenna.beam._validate import MAX_MODES, BeamInputError
 from sensing_antenna.beam.characteristic import (
     characteristic_function,
     eigenvalue_slopes,
@@ -32,6 +32,7 @@ from sensing_antenna.beam.statics import (
 )
 
 __all__ = [
+    "MAX_MODES",
     "BeamInputError",
     "Candidate",
     "Inversion",

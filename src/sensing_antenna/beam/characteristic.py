@@ -39,7 +39,12 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.beam._validate import BeamInputError, as_finite_array, check_mode_count
+from sensing_antenna.beam._validate import (
+    BeamInputError,
+    as_finite_array,
+    check_mode_count,
+)
+from sensing_antenna.errors import format_value
 
 __all__ = [
     "characteristic_function",
@@ -170,11 +175,11 @@ def _count(lam: FloatArray, xi: FloatArray, ratio: float) -> NDArray[np.int64]:
 def _check_ratio(tip_mass_ratio: float) -> float:
     if not (isinstance(tip_mass_ratio, (int, float, np.floating)) and tip_mass_ratio >= 0):
         raise BeamInputError(
-            "tip_mass_ratio", f"must be a finite number >= 0, got {tip_mass_ratio!r}"
+            "tip_mass_ratio", f"must be a finite number >= 0, got {format_value(tip_mass_ratio)}"
         )
     if not math.isfinite(tip_mass_ratio):
         raise BeamInputError(
-            "tip_mass_ratio", f"must be a finite number >= 0, got {tip_mass_ratio!r}"
+            "tip_mass_ratio", f"must be a finite number >= 0, got {format_value(tip_mass_ratio)}"
         )
     return float(tip_mass_ratio)
 

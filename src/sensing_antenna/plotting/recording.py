@@ -14,9 +14,42 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from sensing_antenna.plotting import save_figure
-from sensing_antenna.recording import Recording
+from sensing_antenna.recording import REQUIRED_COLUMNS, Recording, RecordingError
 
-__all__ = ["plot_recording"]
+__all__ = ["PLOT_LIMIT", "plot_recording"]
+
+#: Largest magnitude drawn (1e300, in the columns' SI units): below it the figure's arithmetic
+#: (degrees, axis margins and tick spacing, the spectrum's sums over up to
+#: ``recording.MAX_SAMPLES`` samples) stays finite, and no reading in SI units comes near it.
+#: A recording beyond it is refused rather than clipped: a clipped curve would look like a real
+#: reading at the clip level, and the message names the sample the figure would have shown.
+PLOT_LIMIT = 1e300
+
+
+def _check_plottable(recording: Recording) -> None:
+    """Raise RecordingError naming the first column and sample beyond :data:`PLOT_LIMIT`."""
+    columns = {
+        "t": recording.t,
+        **{name: recording.theta[:, j] for j, name in enumerate(REQUIRED_COLUMNS[1:3])},
+        **{name: recording.force[:, j] for j, name in enumerate(REQUIRED_COLUMNS[3:6])},
+        **{name: recording.torque[:, j] for j, name in enumerate(REQUIRED_COLUMNS[6:9])},
+        **{
+            name: recording.extra[name]
+            for name in ("theta1_ref", "theta2_ref")
+            if name in recording.extra
+        },
+    }
+    for name, values in columns.items():
+        beyond = np.flatnonzero(np.abs(values) > PLOT_LIMIT)
+        if beyond.size:
+            k = int(beyond[0])
+            raise RecordingError(
+                recording.source,
+                None,
+                name,
+                f"{float(values[k])!r} at sample {k} (t = {float(recording.t[k])!r} s) is beyond"
+                f" +-{PLOT_LIMIT:g}: too large to plot",
+            )
 
 
 def _stop_time(recording: Recording) -> float | None:
@@ -41,7 +74,14 @@ def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
     -------
     list of Path
         The PNG files written.
+
+    Raises
+    ------
+    RecordingError
+        When a plotted column holds a magnitude above :data:`PLOT_LIMIT`, naming the column and
+        the sample.
     """
+    _check_plottable(recording)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     t = recording.t

@@ -9,15 +9,20 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
     "ATI_NANO17_RESOLUTION",
     "CASES",
+    "MAX_DURATION",
+    "MAX_ELEMENTS",
+    "MAX_SIMULATED_SAMPLES",
+    "MAX_SUBSTEPS",
     "OBSTACLE_KINDS",
     "Scenario",
     "ScenarioError",
     "SensorNoise",
+    "duration_problem",
 ]
 
 CASES = ("azimuthal", "vertical", "free")
@@ -40,6 +45,68 @@ ATI_NANO17_RESOLUTION = (
 )
 
 
+#: Largest number of samples one simulated manoeuvre may record: 600,000, ten minutes at the
+#: simulator's 1 kHz, where a manoeuvre lasts seconds (3.5 s by default). Memory grows with the
+#: samples (references, measurements, ground truth, the recording and its text), so this keeps
+#: ``antenna simulate`` under a gigabyte (docs/simulator.md, "Scenario limits"), and the recording
+#: it writes, at most 275 bytes per sample (eleven columns of at most 24 characters), within the
+#: reader's ``recording.MAX_FILE_BYTES``.
+MAX_SIMULATED_SAMPLES = 600_000
+
+#: Longest ``duration`` (s): :data:`MAX_SIMULATED_SAMPLES` at the simulator's 1 kHz
+#: (``simulator.run.SAMPLE_PERIOD``), 600 s.
+MAX_DURATION = MAX_SIMULATED_SAMPLES * 1e-3
+
+#: Most finite elements of the link: 128. The first free frequency converges as h^4 and 16
+#: elements already give 1e-6 (docs/simulator.md), so 128 give about 2e-10; each time step costs
+#: the square of the element count, 64 times the default's at 128.
+MAX_ELEMENTS = 128
+
+#: Most internal Newmark steps per 1 ms sample: 100 (a 10 us step). The integrator is
+#: unconditionally stable, so more steps only refine the step error; the cost grows with them.
+MAX_SUBSTEPS = 100
+
+
+#: Largest value of the scenario's unbounded physical fields, with the reason. Past them the
+#: simulator overflows (a sweep of 1e300 rad/s, a post of 1e300 m) long before the values mean
+#: anything; within them it has been run (docs/simulator.md, "Scenario limits").
+_UPPER_LIMITS: dict[str, tuple[float, str, str]] = {
+    "obstacle_radius": (10.0, "m", "a post or bar thicker than that is a wall: the plane"),
+    "contact_stiffness": (
+        1e10,
+        "N/m",
+        "over 1e9 times the paper link's own stiffness 3 E I / x_c^3 at mid-length: rigid",
+    ),
+    "sweep_speed": (100.0, "rad/s", "950 rpm: no sensing head sweeps faster"),
+    "accel_time": (MAX_DURATION, "s", "no phase of a manoeuvre outlasts the longest one"),
+    "start_time": (MAX_DURATION, "s", "no phase of a manoeuvre outlasts the longest one"),
+    "approach_time": (MAX_DURATION, "s", "no phase of a manoeuvre outlasts the longest one"),
+}
+
+
+def duration_problem(duration: object) -> str | None:
+    """Why ``duration`` (s) cannot be the recorded time of a simulated manoeuvre, or None.
+
+    It must be a finite number above 0.01 s and at most :data:`MAX_DURATION`. A campaign checks
+    its spec's durations with it before running anything, naming its own field.
+    """
+    if (
+        isinstance(duration, bool)
+        or not isinstance(duration, (int, float))
+        or not math.isfinite(duration)
+    ):
+        return f"must be a finite number, got {format_value(duration)}"
+    if not duration > 0.01:
+        return f"must be > 0.01 s, got {format_value(duration)}"
+    if duration > MAX_DURATION:
+        return (
+            f"{format_value(duration)} s is more than {MAX_DURATION:g} s:"
+            f" {MAX_SIMULATED_SAMPLES} samples at 1 kHz, the limit that keeps a simulation's"
+            " memory and its recording bounded"
+        )
+    return None
+
+
 class ScenarioError(SensingAntennaError, ValueError):
     """A scenario parameter is out of range; the message names the field."""
 
@@ -50,9 +117,10 @@ class ScenarioError(SensingAntennaError, ValueError):
 
 def _finite(name: str, value: float, low: float | None = None, strict: bool = False) -> None:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ScenarioError(name, f"must be a finite number, got {value!r}")
+        raise ScenarioError(name, f"must be a finite number, got {format_value(value)}")
     if low is not None and (value <= low if strict else value < low):
-        raise ScenarioError(name, f"must be {'>' if strict else '>='} {low:g}, got {value!r}")
+        relation = ">" if strict else ">="
+        raise ScenarioError(name, f"must be {relation} {low:g}, got {format_value(value)}")
 
 
 @dataclass(frozen=True)
@@ -182,7 +250,9 @@ class Scenario:
 
     def __post_init__(self) -> None:
         if self.case not in CASES:
-            raise ScenarioError("case", f"must be one of {', '.join(CASES)}, got {self.case!r}")
+            raise ScenarioError(
+                "case", f"must be one of {', '.join(CASES)}, got {format_value(self.case)}"
+            )
         if self.case == "free":
             if self.contact_point is not None:
                 raise ScenarioError("contact_point", "must be None for the free case")
@@ -192,11 +262,14 @@ class Scenario:
             _finite("contact_point", self.contact_point, 0.0, strict=True)
         if self.obstacle is not None and self.obstacle not in OBSTACLE_KINDS:
             raise ScenarioError(
-                "obstacle", f"must be one of {', '.join(OBSTACLE_KINDS)}, got {self.obstacle!r}"
+                "obstacle",
+                f"must be one of {', '.join(OBSTACLE_KINDS)}, got {format_value(self.obstacle)}",
             )
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise ScenarioError("seed", f"must be an integer >= 0, got {self.seed!r}")
-        _finite("duration", self.duration, 0.01, strict=True)
+            raise ScenarioError("seed", f"must be an integer >= 0, got {format_value(self.seed)}")
+        problem = duration_problem(self.duration)
+        if problem is not None:
+            raise ScenarioError("duration", problem)
         for name in ("noise_scale", "damping_ratio", "friction_coefficient", "contact_damping"):
             _finite(name, getattr(self, name), 0.0)
         if self.damping_ratio >= 1.0:
@@ -211,19 +284,56 @@ class Scenario:
             raise ScenarioError("obstacle_tilt", "must be below 0.5 rad in magnitude")
         if self.approach_time is not None:
             _finite("approach_time", self.approach_time, self.accel_time or 0.0)
+        for name, (high, unit, reason) in _UPPER_LIMITS.items():
+            value = getattr(self, name)
+            if value is not None and value > high:
+                raise ScenarioError(
+                    name, f"{format_value(value)} {unit} is more than {high:g} {unit} ({reason})"
+                )
         _finite("servo_pole", self.servo_pole)
         if not self.servo_pole < 0:
-            raise ScenarioError("servo_pole", f"must be < 0 (stable), got {self.servo_pole!r}")
+            raise ScenarioError(
+                "servo_pole", f"must be < 0 (stable), got {format_value(self.servo_pole)}"
+            )
         if -self.servo_pole * 1e-3 > 0.3:
             raise ScenarioError("servo_pole", "too fast for the 1 kHz controller (|p| T_s > 0.3)")
         if not isinstance(self.compensate_servo_lag, bool):
             raise ScenarioError(
-                "compensate_servo_lag", f"must be true or false, got {self.compensate_servo_lag!r}"
+                "compensate_servo_lag",
+                f"must be true or false, got {format_value(self.compensate_servo_lag)}",
             )
-        if not isinstance(self.n_elements, int) or self.n_elements < 4:
-            raise ScenarioError("n_elements", f"must be an integer >= 4, got {self.n_elements!r}")
-        if not isinstance(self.substeps, int) or self.substeps < 1:
-            raise ScenarioError("substeps", f"must be an integer >= 1, got {self.substeps!r}")
+        if (
+            isinstance(self.n_elements, bool)
+            or not isinstance(self.n_elements, int)
+            or not 4 <= self.n_elements <= MAX_ELEMENTS
+        ):
+            raise ScenarioError(
+                "n_elements",
+                f"must be an integer from 4 to {MAX_ELEMENTS}, got {format_value(self.n_elements)}",
+            )
+        if (
+            isinstance(self.substeps, bool)
+            or not isinstance(self.substeps, int)
+            or not 1 <= self.substeps <= MAX_SUBSTEPS
+        ):
+            raise ScenarioError(
+                "substeps",
+                f"must be an integer from 1 to {MAX_SUBSTEPS}, got {format_value(self.substeps)}",
+            )
+        description = self.description
+        if not isinstance(description, str) or (
+            description
+            and (
+                description != description.strip()
+                or description.splitlines() != [description]
+                or "\0" in description
+            )
+        ):
+            raise ScenarioError(
+                "description",
+                "must be one line of text without edge spaces (it is written into the"
+                f" recording's metadata), got {format_value(description)}",
+            )
 
     def resolved(self, omega_free: float) -> Scenario:
         """This scenario with the default ramp times made explicit.
@@ -239,7 +349,8 @@ class Scenario:
         )
         if approach < accel:
             raise ScenarioError(
-                "approach_time", f"must be >= accel_time ({accel:.3g} s), got {approach!r}"
+                "approach_time",
+                f"must be >= accel_time ({accel:.3g} s), got {format_value(approach)}",
             )
         return replace(self, accel_time=accel, approach_time=approach)
 

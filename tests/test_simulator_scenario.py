@@ -1,0 +1,84 @@
+"""Scenario validation: every field checked up front, limits that bound a simulation's size."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensing_antenna.recording import MAX_FILE_BYTES, MAX_SAMPLES
+from sensing_antenna.simulator import Scenario, ScenarioError
+from sensing_antenna.simulator.run import SAMPLE_PERIOD
+from sensing_antenna.simulator.scenario import (
+    MAX_DURATION,
+    MAX_ELEMENTS,
+    MAX_SIMULATED_SAMPLES,
+    MAX_SUBSTEPS,
+    duration_problem,
+)
+
+#: Longest row write_recording can give the simulator's eleven columns: 24 characters per
+#: number (repr of a double, e.g. -2.2250738585072014e-308), ten commas and a line feed.
+LONGEST_ROW = 11 * 24 + 11
+
+
+@pytest.mark.parametrize("case", ["azimuthal", "free"])
+def test_a_duration_past_the_budget_is_refused_up_front(case: str) -> None:
+    # A duration of 1e9 s would ask the simulator for arrays of 1e12 samples: every run of a
+    # campaign would fail. It is refused before anything is simulated.
+    contact = None if case == "free" else 0.5
+    with pytest.raises(ScenarioError) as info:
+        Scenario(case=case, contact_point=contact, duration=1e9)  # type: ignore[arg-type]
+    assert str(info.value) == (
+        "scenario.duration: 1000000000.0 s is more than 600 s: 600000 samples at 1 kHz, the"
+        " limit that keeps a simulation's memory and its recording bounded"
+    )
+    assert Scenario(case=case, contact_point=contact, duration=MAX_DURATION).duration == 600.0  # type: ignore[arg-type]
+
+
+def test_duration_problem_is_the_check_a_campaign_runs_on_its_own_fields() -> None:
+    assert duration_problem(3.5) is None
+    assert duration_problem(MAX_DURATION) is None
+    assert "more than 600 s" in str(duration_problem(math.nextafter(MAX_DURATION, math.inf)))
+    assert duration_problem(0.01) == "must be > 0.01 s, got 0.01"
+    assert duration_problem(np.float64("nan")) == "must be a finite number, got nan"
+    assert duration_problem("long") == "must be a finite number, got 'long'"
+    assert duration_problem(True) == "must be a finite number, got True"
+
+
+def test_the_budget_fits_the_simulator_and_the_recording_reader() -> None:
+    # The longest simulation records MAX_SIMULATED_SAMPLES at the simulator's period, a recording
+    # the reader accepts both by sample count and by file size (with 64 KiB for the metadata).
+    assert round(MAX_DURATION / SAMPLE_PERIOD) == MAX_SIMULATED_SAMPLES
+    assert MAX_SIMULATED_SAMPLES <= MAX_SAMPLES
+    assert MAX_SIMULATED_SAMPLES * LONGEST_ROW + 2**16 <= MAX_FILE_BYTES
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "words"),
+    [
+        ("n_elements", MAX_ELEMENTS + 1, f"from 4 to {MAX_ELEMENTS}"),
+        ("n_elements", 3, f"from 4 to {MAX_ELEMENTS}"),
+        ("substeps", MAX_SUBSTEPS + 1, f"from 1 to {MAX_SUBSTEPS}"),
+        ("substeps", True, f"from 1 to {MAX_SUBSTEPS}"),
+        ("sweep_speed", 1e300, "1e+300 rad/s is more than 100 rad/s"),
+        ("obstacle_radius", 1e300, "1e+300 m is more than 10 m"),
+        ("contact_stiffness", 1e300, "1e+300 N/m is more than 1e+10 N/m"),
+        ("accel_time", 1e300, "1e+300 s is more than 600 s"),
+        ("approach_time", 1e300, "1e+300 s is more than 600 s"),
+        ("start_time", 1e300, "1e+300 s is more than 600 s"),
+        ("description", "two\nlines", "one line"),
+        ("description", " padded", "one line"),
+        ("noise_scale", np.float64("nan"), "must be a finite number, got nan"),
+    ],
+)
+def test_each_limit_names_its_field_in_one_line(field: str, value: object, words: str) -> None:
+    # At 1e300, sweep speed, obstacle radius, contact stiffness and the ramp times make the
+    # simulator overflow (a traceback, or a recording of NaN refused as "<recording>: NaN").
+    with pytest.raises(ScenarioError) as info:
+        Scenario(case="azimuthal", contact_point=0.5, **{field: value})  # type: ignore[arg-type]
+    message = str(info.value)
+    assert message.startswith(f"scenario.{field}: ")
+    assert words in message
+    assert "\n" not in message and "np." not in message

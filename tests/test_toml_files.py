@@ -1,0 +1,32 @@
+"""Tests of sensing_antenna.toml_files, through the readers that use it (antennae here)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from sensing_antenna.antenna import AntennaConfigError, load_antenna
+from sensing_antenna.toml_files import MAX_KEY_PARTS, MAX_TOML_BYTES
+
+
+def test_deep_or_huge_toml_is_refused_naming_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "deep.toml"
+    path.write_text("x = " + "{a = " * 100_000 + "1" + "}" * 100_000 + "\n", encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=r"deep.toml: file: .*nested too deeply"):
+        load_antenna(path)
+    path.write_text("x = " + "[" * 100_000 + "1" + "]" * 100_000 + "\n", encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=r"deep.toml: file: .*nested too deeply"):
+        load_antenna(path)
+    # Python's TOML parser keeps every prefix of a dotted key: memory grows with the square of
+    # its length. A key of 1000 parts (4 MB to parse) stands for the 100,000 (40 GB).
+    path.write_text("[link]\nx" + ".a" * 999 + " = 1\n", encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=r"deep.toml: file: line 2: a key of 1000 dotted"):
+        load_antenna(path)
+    path.write_text("[" + ".".join(["a"] * 40) + "]\n", encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=f"40 dotted parts, more than .* {MAX_KEY_PARTS}"):
+        load_antenna(path)
+    with path.open("wb") as stream:
+        stream.truncate(MAX_TOML_BYTES + 1)
+    with pytest.raises(AntennaConfigError, match=r"deep.toml: file: .* larger than the limit"):
+        load_antenna(path)
