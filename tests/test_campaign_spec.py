@@ -500,6 +500,6 @@ def test_durations_longer_than_a_recording_may_be_are_refused(
 ) -> None:
     path = write(tmp_path, GOOD.replace(old, new))
     with pytest.raises(
-        CampaignSpecError, match=rf"{re.escape(field)}: 1000000000.0 s is longer than the 600 s"
+        CampaignSpecError, match=rf"{re.escape(field)}: 1000000000.0 s is more than 600 s"
     ):
         load_campaign_spec(path)

@@ -1,6 +1,8 @@
 """How big a campaign may be: limits on its size, checked when its spec is made, before any work.
 
 Each limit has a reason, and docs/campaigns.md ("Limits") gives the measured figures behind it.
+The length of a simulated recording is the simulator's own limit
+(:func:`sensing_antenna.simulator.scenario.duration_problem`), checked under the spec's field.
 The functions return the problem in words, or None within the limit; the spec's dataclasses
 (:mod:`~sensing_antenna.campaign.schema`) raise it as an error naming the file and the field.
 """
@@ -12,10 +14,8 @@ __all__ = [
     "MAX_CONTACT_POINTS",
     "MAX_NOISE_LEVELS",
     "MAX_RUNS",
-    "MAX_RUN_DURATION",
     "calibration_problem",
     "contact_points_problem",
-    "duration_problem",
     "noise_levels_problem",
     "runs_problem",
 ]
@@ -31,11 +31,6 @@ MAX_NOISE_LEVELS = 100
 #: Calibration recordings (points x repeats): simulated one after another in the main process
 #: before any run.
 MAX_CALIBRATION_RECORDINGS = 1_000
-#: Simulated duration of one recording (s), ``scenario.duration`` and ``free_motion.duration``:
-#: a worker holds the whole recording and the simulator's history in memory, and a contact
-#: manoeuvre lasts seconds (``simulator.Scenario`` default 3.5 s).
-MAX_RUN_DURATION = 600.0
-
 _SEE = "see docs/campaigns.md, Limits"
 
 
@@ -80,17 +75,3 @@ def calibration_problem(n_points: int, repeats: int) -> str | None:
         f"{MAX_CALIBRATION_RECORDINGS} a calibration may simulate (they run one after another "
         f"before any run; {_SEE})"
     )
-
-
-def duration_problem(duration: object) -> str | None:
-    """A simulated duration longer than :data:`MAX_RUN_DURATION`? (Other checks: Scenario's.)"""
-    if (
-        isinstance(duration, (int, float))
-        and not isinstance(duration, bool)
-        and duration > MAX_RUN_DURATION
-    ):
-        return (
-            f"{duration!r} s is longer than the {MAX_RUN_DURATION:g} s a campaign simulates per "
-            f"recording (a worker holds the whole recording in memory; {_SEE})"
-        )
-    return None

@@ -22,6 +22,7 @@ from typing import Any
 from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
 from sensing_antenna.campaign import limits
 from sensing_antenna.errors import FieldError
+from sensing_antenna.simulator.scenario import duration_problem
 
 __all__ = [
     "CASES",
@@ -129,9 +130,7 @@ class FreeMotionStep:
     case: str = "free"
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.duration) and self.duration > 0):
-            raise CampaignSpecError("free_motion.duration", f"must be > 0 s, got {self.duration!r}")
-        if problem := limits.duration_problem(self.duration):
+        if problem := duration_problem(self.duration):
             raise CampaignSpecError("free_motion.duration", problem)
 
 
@@ -423,7 +422,8 @@ class CampaignSpec:
         if problem := limits.runs_problem(self.n_main_runs, self.n_sweep_runs):
             field_name = "repeats" if self.n_main_runs > limits.MAX_RUNS else "noise_sweep"
             raise CampaignSpecError(field_name, problem, src)
-        if problem := limits.duration_problem(self.scenario.get("duration")):
+        duration = self.scenario.get("duration")
+        if duration is not None and (problem := duration_problem(duration)):
             raise CampaignSpecError("scenario.duration", problem, src)
         for key in self.scenario:
             if key in _RESERVED_SCENARIO_KEYS:
