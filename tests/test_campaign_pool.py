@@ -123,7 +123,7 @@ def test_a_run_that_always_kills_its_worker_fails_alone_after_its_attempts(
 # --- the command in a child process, signalled from here ---------------------------------------
 
 #: A real campaign of 40 cheap runs (one case, the ratio method, no preparation steps): long
-#: enough to be caught in the middle, short enough to finish.
+#: enough for a second command to start while it runs, short enough to finish.
 SPEC = """
 name = "signals"
 antenna = "paper-2021"
@@ -133,6 +133,10 @@ repeats = 5
 base_seed = 4
 methods = ["ratio"]
 """
+#: The same with 16 runs (about 1.5 s of work on two idle cores after the first two are stored):
+#: enough to be caught in the middle by a signal sent as soon as two are stored.
+SHORT_SPEC = SPEC.replace("repeats = 5", "repeats = 2")
+N_SHORT = 16
 
 
 def start_campaign(spec: Path, out: Path) -> subprocess.Popen[str]:
@@ -202,7 +206,7 @@ def test_a_signal_to_the_main_process_alone_stops_it_and_keeps_every_finished_ru
     tmp_path: Path, stop: signal.Signals, exit_code: int
 ) -> None:
     spec = tmp_path / "signals.toml"
-    spec.write_text(SPEC, encoding="utf-8")
+    spec.write_text(SHORT_SPEC, encoding="utf-8")
     out = tmp_path / "out"
     process = start_campaign(spec, out)
     wait_for_runs(out, process, 2)
@@ -214,7 +218,7 @@ def test_a_signal_to_the_main_process_alone_stops_it_and_keeps_every_finished_ru
     assert process.returncode == exit_code
     n_stored = len(stored_runs(out))
     assert err.splitlines() == [
-        f"antenna campaign: interrupted by {stop.name}: {n_stored} of 40 runs are stored in "
+        f"antenna campaign: interrupted by {stop.name}: {n_stored} of {N_SHORT} runs are stored in "
         f"{out}; the same command again runs the others"
     ]
     assert all_gone(workers, within=5.0), "a worker outlived its campaign"
@@ -224,7 +228,7 @@ def test_a_signal_to_the_main_process_alone_stops_it_and_keeps_every_finished_ru
     assert resumed.returncode == 0, err
     assert (
         printed.splitlines()[0]
-        == f"40 runs: {n_stored} already done, {40 - n_stored} run now, 0 failed"
+        == f"{N_SHORT} runs: {n_stored} already done, {N_SHORT - n_stored} run now, 0 failed"
     )
     assert all((out / "runs" / name).stat().st_mtime_ns == t for name, t in before.items())
 
@@ -234,7 +238,7 @@ def test_workers_exit_with_a_killed_main_process_and_a_plain_resume_finishes(
     tmp_path: Path,
 ) -> None:
     spec = tmp_path / "signals.toml"
-    spec.write_text(SPEC, encoding="utf-8")
+    spec.write_text(SHORT_SPEC, encoding="utf-8")
     out = tmp_path / "out"
     process = start_campaign(spec, out)
     wait_for_runs(out, process, 2)
@@ -247,7 +251,7 @@ def test_workers_exit_with_a_killed_main_process_and_a_plain_resume_finishes(
     printed, err = resumed.communicate(timeout=300)
     assert resumed.returncode == 0, err
     assert "0 failed" in printed.splitlines()[0]
-    assert len(stored_runs(out)) == 40
+    assert len(stored_runs(out)) == N_SHORT
 
 
 def test_a_second_campaign_on_the_same_directory_is_refused_and_runs_nothing(
