@@ -10,9 +10,9 @@ glitch of 1e300 break them.
 
 :func:`rest_reading` compares the mean loads over a window at rest with the weight;
 :func:`initial_rest` finds the samples at rest at the start of a recording; :func:`angle_problem`
-checks the angles. The estimation front end (at t_c, on the window its tare averages),
-``antenna identify`` and ``antenna calibrate`` all use these, so every command judges a
-recording's units the same way.
+checks the angles; :func:`recording_problem` is the angles and the rest at the start together.
+The estimation front end (at t_c, on the window its tare averages), ``antenna identify`` and
+``antenna calibrate`` all use these, so every command judges a recording's units the same way.
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ __all__ = [
     "RestReading",
     "angle_problem",
     "initial_rest",
+    "recording_problem",
     "rest_reading",
 ]
 
@@ -193,7 +194,10 @@ def rest_reading(
     problems = []
     # The torque first: its offset is small against the weight's moment, so it is the sharper
     if not math.isfinite(torque_off):
-        problems.append(f"columns {_TORQUE_COLUMNS}: the mean torque over {duration} is not finite")
+        problems.append(
+            f"columns {_TORQUE_COLUMNS}: the mean torque over {duration} overflows (values "
+            "beyond 1e300?)"
+        )
     elif torque_off > torque_tolerance:
         problems.append(
             f"columns {_TORQUE_COLUMNS}: over {duration} the torque reads "
@@ -202,7 +206,10 @@ def rest_reading(
             f"than {torque_tolerance:.3g} N m away): torques in N mm, scaled, or a sign flipped?"
         )
     if not math.isfinite(force_off):
-        problems.append(f"columns {_FORCE_COLUMNS}: the mean force over {duration} is not finite")
+        problems.append(
+            f"columns {_FORCE_COLUMNS}: the mean force over {duration} overflows (values "
+            "beyond 1e300?)"
+        )
     elif force_off > force_tolerance:
         problems.append(
             f"columns {_FORCE_COLUMNS}: over {duration} the force reads {_vector(mean_force)} N, "
@@ -254,3 +261,31 @@ def angle_problem(theta: FloatArray) -> str | None:
                     f"{k + 1} and {k + 2} (at most {MAX_ANGLE_STEP:.4f} rad per sample)"
                 )
     return None
+
+
+def recording_problem(
+    theta: FloatArray,
+    force: FloatArray,
+    torque: FloatArray,
+    antenna: Antenna,
+    rest_tolerance: float,
+    min_rest_samples: int,
+) -> str | None:
+    """Why a whole recording is not in the format's units and signs, or None.
+
+    The angles (:func:`angle_problem`), then the loads over the samples at rest at the start
+    (:func:`initial_rest` within ``rest_tolerance`` rad) against the link's weight
+    (:func:`rest_reading`), when the head rests for at least ``min_rest_samples`` samples (a
+    recording that starts moving is not judged by its rest). Shapes (n, 2), (n, 3), (n, 3).
+    """
+    problem = angle_problem(theta)
+    if problem is not None:
+        return problem
+    rest = initial_rest(theta, rest_tolerance)
+    if rest < min_rest_samples:
+        return None
+    window = slice(0, rest)
+    reading = rest_reading(
+        theta[window], force[window], torque[window], antenna, "at rest at the start"
+    )
+    return reading.problem
