@@ -59,12 +59,15 @@ def all_methods(recording: Recording, antenna: Antenna) -> dict[str, object]:
 
 
 def assert_on_link_or_none(result, antenna: Antenna) -> None:  # type: ignore[no-untyped-def]
-    """x_c, the touched point and the interval are either absent or on the link."""
+    """x_c, the touched point and the interval are either absent or on the link (the point
+    within the link's reach, l plus the 10 % deflection of Assumption 1)."""
     length = antenna.link.length
     if math.isnan(result.x_c):
         assert np.all(np.isnan(result.contact_point))
     else:
         assert 0.0 < result.x_c <= length, result
+    if not np.all(np.isnan(result.contact_point)):
+        assert np.linalg.norm(result.contact_point) <= 1.1 * length, result.contact_point
     if result.interval is not None:
         assert 0.0 <= result.interval[0] <= result.interval[1] <= length
     assert all(0.0 < c <= length for c in result.candidates)

@@ -26,17 +26,20 @@ The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the metho
 the rest go to ``diagnostics["other_reasons"]``. Whatever the status, a best guess outside
 (0, l] or not finite is not reported: x_c is NaN, as are the touched point and the interval, and
 the reason gives the dropped value. An interval is cut to the link [0, l] (the contact lies on
-it), or dropped when it is not finite or lies off the link.
+it), or dropped when it is not finite or lies off the link; a touched point farther from the base
+than the link can reach is dropped.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import Any
 
 import numpy as np
 
+from sensing_antenna.antenna import Link
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1
@@ -84,9 +87,12 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
         )
     found.extend(_vibration_problems(evidence, estimate, end, notes))
     interval = _on_link(estimate.interval, link.length)
+    point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
         if interval != estimate.interval:
             notes["interval"] = interval
+        if not point_ok:
+            notes["contact_point"] = np.full(3, np.nan)
         return _with_notes(estimate, notes)
     problems = sorted(found, key=lambda item: _RANK[item[0]])
     if estimate.status is not Status.OK:
@@ -108,8 +114,11 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
                 f"(0, {link.length:g}] m"
             )
         changes.update(x_c=math.nan, contact_point=np.full(3, np.nan), interval=None)
-    elif interval != estimate.interval:
-        changes["interval"] = interval
+    else:
+        if interval != estimate.interval:
+            changes["interval"] = interval
+        if not point_ok:
+            changes["contact_point"] = np.full(3, np.nan)
     kept = tuple(c for c in estimate.candidates if math.isfinite(c) and 0.0 < c <= link.length)
     if kept != estimate.candidates:
         changes["candidates"] = kept
@@ -118,11 +127,27 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
 
 def _with_notes(estimate: ContactEstimate, notes: dict[str, Any]) -> ContactEstimate:
     changes: dict[str, Any] = {}
-    if "interval" in notes:
-        changes["interval"] = notes.pop("interval")
+    for name in ("interval", "contact_point"):
+        if name in notes:
+            changes[name] = notes.pop(name)
     if notes:
         changes["diagnostics"] = {**estimate.diagnostics, **notes}
     return dataclasses.replace(estimate, **changes) if changes else estimate
+
+
+def _within_reach(point: np.ndarray, evidence: Evidence) -> bool:
+    """Whether a touched point (m, absolute frame) can be a point of the link: within
+    l (1 + ``max_deflection_ratio``) of the base. An inextensible link reaches no farther than
+    l; the linear model adds the push deflection (at most that ratio of x_c under Assumption 1)
+    and the sag (6 % of l at the paper link's tip) across the link, 1.007 l at most together.
+    A point beyond comes from loads far outside the model (forces in mN: 20 m away). A point
+    not computed (NaN) stays as it is."""
+    if np.all(np.isnan(point)):
+        return True
+    reach = evidence.antenna.link.length * (1.0 + evidence.config.max_deflection_ratio)
+    with np.errstate(over="ignore", invalid="ignore"):
+        distance = float(np.linalg.norm(point))
+    return math.isfinite(distance) and distance <= reach
 
 
 def _on_link(interval: tuple[float, float] | None, length: float) -> tuple[float, float] | None:
@@ -201,12 +226,17 @@ def _vibration_points(evidence: Evidence, omega1: float) -> tuple[float, ...]:
     link = evidence.antenna.link
     x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
     candidates, _ = candidates_from_omega1(link, omega1, x_range)
-    curve = sensing_curve(link)
-    at_tip = float(curve.omega1(link.length))
-    falling = float(curve.omega1_slope(link.length)) < 0.0
+    at_tip, falling = _tip(link)
     if falling and at_tip / (1.0 + cfg.band_margin) <= omega1 < at_tip:
         candidates = (*candidates, link.length)
     return candidates
+
+
+@functools.lru_cache(maxsize=16)
+def _tip(link: Link) -> tuple[float, bool]:
+    """omega_1 (rad/s) of a contact at the tip, and whether the sensing curve falls there."""
+    curve = sensing_curve(link)
+    return float(curve.omega1(link.length)), float(curve.omega1_slope(link.length)) < 0.0
 
 
 def _scale_problem(evidence: Evidence, value: float, nearest: float, omega1: float) -> str | None:
