@@ -171,6 +171,35 @@ def test_a_synthetic_sine_as_the_wrench_is_no_contact(
         assert_on_link_or_none(result, antenna)
 
 
+@pytest.mark.parametrize(
+    ("case", "theta", "force"),
+    [
+        ("azimuthal", (-1.0, 1.0), (1.0, 1.0, 1.0)),  # theta1's sign flipped
+        ("vertical", (1.0, -1.0), (1.0, 1.0, 1.0)),  # theta2's
+        ("azimuthal", (1.0, 1.0), (1.0, -1.0, -1.0)),  # the forces across the link
+    ],
+    ids=["theta1", "theta2", "forces"],
+)
+def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
+    request: pytest.FixtureRequest,
+    antenna: Antenna,
+    case: str,
+    theta: tuple[float, ...],
+    force: tuple[float, ...],
+) -> None:
+    # The obstacle can only push back: the mean reaction over the hold opposes the head's turn
+    # from t_c to t_1 (Y^c = -Y^m for an azimuthal push, Section 5.4 note (a)); a flipped sign
+    # turns one against the other, while the ratio (|R|) and the frequency do not see it
+    original: Recording = request.getfixturevalue(case)
+    recording = dataclasses.replace(
+        original, theta=original.theta * np.array(theta), force=original.force * np.array(force)
+    )
+    for name, result in all_methods(recording, antenna).items():
+        assert not result.ok, name
+        assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        assert "does not oppose the head's turn" in (result.reason or "")
+
+
 def test_a_best_guess_past_the_tip_is_dropped_with_the_reason(
     azimuthal: Recording, antenna: Antenna
 ) -> None:

@@ -6,10 +6,11 @@ evidence it concluded from, offline and online alike, so ``paper``, ``ratio``,
 Every check reads only the samples up to the estimate's own t_e, so the batch and the streaming
 forms agree.
 
-1. The recording's units (``implausible_input``): the loads at rest before t_c against the
-   link's weight and the free motion against the observer (found by the front end at t_c,
-   ``Evidence.input_problem``), and the angles up to t_e
-   (:func:`~sensing_antenna.units_check.angle_problem`).
+1. The recording's units and signs (``implausible_input``): the loads at rest before t_c
+   against the link's weight and the free motion against the observer (found by the front end
+   at t_c, ``Evidence.input_problem``), the angles up to t_e
+   (:func:`~sensing_antenna.units_check.angle_problem`), and the push against the head's turn
+   into the contact (an obstacle only pushes back).
 2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``).
 3. A real vibration: the fundamental omega_1 that the method measured, or, for a method that
    measures none (``ratio``), Estimator 1 on the samples from t_1 to t_e, must be a clear peak
@@ -76,6 +77,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     angles = angle_problem(evidence.theta[: end + 1])
     if angles is not None:
         found.append((Status.IMPLAUSIBLE_INPUT, angles))
+    push = _push_direction_problem(evidence)
+    if push is not None:
+        found.append((Status.IMPLAUSIBLE_INPUT, push))
     x_c = estimate.x_c
     on_link = math.isfinite(x_c) and 0.0 < x_c <= link.length
     if math.isfinite(x_c) and not on_link:
@@ -123,6 +127,37 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if kept != estimate.candidates:
         changes["candidates"] = kept
     return dataclasses.replace(estimate, **changes)
+
+
+def _push_direction_problem(evidence: Evidence) -> str | None:
+    """Why the push does not oppose the head's motion into the contact, or None.
+
+    An obstacle can only push back: from t_c to t_1 the head turns into it by dtheta, which moves
+    the link along d = (0, dtheta_1 cos theta_2, dtheta_2) in the motor frame (the azimuth about
+    Z^a moves X^m along cos theta_2 Y^m, the elevation along Z^m), and the mean reaction over the
+    hold must have R . d < 0 (Y^c = -Y^m for an azimuthal push, Section 5.4). A sign flipped in
+    one angle or in the forces turns it. Not judged when the head turned by less than the rest
+    tolerance.
+    """
+    theta = evidence.theta
+    turn = theta[evidence.rest_index] - theta[evidence.contact_index]
+    direction = np.array([0.0, turn[0] * math.cos(theta[evidence.rest_index, 1]), turn[1]])
+    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
+    if float(np.max(np.abs(turn))) <= tolerance:
+        return None
+    reaction = evidence.frame.reaction_m
+    if float(reaction @ direction) < 0.0:
+        return None
+    return (
+        f"columns 'theta1', 'theta2', 'fx', 'fy', 'fz': the mean contact force over the hold "
+        f"{_vector(reaction)} N does not oppose the head's turn into the contact "
+        f"({_vector(turn)} rad from t_c to t_1); an obstacle can only push back: a sign "
+        "flipped in an angle or in the forces?"
+    )
+
+
+def _vector(values: np.ndarray) -> str:
+    return "(" + ", ".join(f"{v:.3g}" for v in values) + ")"
 
 
 def _with_notes(estimate: ContactEstimate, notes: dict[str, Any]) -> ContactEstimate:
