@@ -200,6 +200,19 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
         assert "does not oppose the head's turn" in (result.reason or "")
 
 
+def test_a_torque_column_of_1e300_gives_a_status_not_a_traceback(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # tx scaled by 1e300: the tare's torque noise is 1e297 N m, whose square overflows a float
+    # (an OverflowError in the ratio's uncertainty); the rest reading names the columns instead
+    recording = dataclasses.replace(
+        azimuthal, torque=azimuthal.torque * np.array([1e300, 1.0, 1.0])
+    )
+    for name, result in all_methods(recording, antenna).items():
+        assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        assert_on_link_or_none(result, antenna)
+
+
 def test_a_best_guess_past_the_tip_is_dropped_with_the_reason(
     azimuthal: Recording, antenna: Antenna
 ) -> None:

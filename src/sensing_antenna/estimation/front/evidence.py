@@ -203,4 +203,5 @@ class Evidence:
         deflection_ratio = push * x_c**2 / (3.0 * link.flexural_rigidity)
         model_term = self.config.ratio_model_factor * deflection_ratio * x_c if model else 0.0
         noise_term = self.ratio_noise * x_c / link.length
-        return math.sqrt(noise_term**2 + offset_term**2 + model_term**2)
+        # in quadrature without squaring (a torque noise of 1e297 N m must not overflow)
+        return math.hypot(noise_term, offset_term, model_term)
