@@ -232,6 +232,49 @@ def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
         read_contact_points(paths, recordings, table)
 
 
+def test_points_table_that_is_not_utf8_is_one_line(tmp_path: Path) -> None:
+    table = tmp_path / "points.csv"
+    table.write_bytes(b"file,x_c\na.csv,0.4\n\xff\xfe.csv,0.8\n")
+    with pytest.raises(CalibrationError, match=r"points\.csv: not UTF-8 text") as raised:
+        read_contact_points([tmp_path / "a.csv"], [_FakeRecording({})], table)
+    assert "\n" not in str(raised.value)
+
+
+def test_points_table_with_two_rows_for_one_file_is_refused(tmp_path: Path) -> None:
+    # The last row used to win silently (a T_e 1.86 % off when it was the wrong one)
+    table = tmp_path / "points.csv"
+    table.write_text("file,x_c\na.csv,0.4\nb.csv,0.8\na.csv,0.45\n", encoding="utf-8")
+    with pytest.raises(
+        CalibrationError, match=r"points\.csv: lines 2 and 4: two rows for file 'a\.csv'"
+    ):
+        read_contact_points([tmp_path / "a.csv"], [_FakeRecording({})], table)
+
+
+def test_points_table_matching_one_file_name_twice_is_refused(tmp_path: Path) -> None:
+    # Two directories, one file name: the recording given as a.csv matches both rows by name
+    table = tmp_path / "points.csv"
+    table.write_text("file,x_c\nday1/a.csv,0.4\nday2/a.csv,0.45\n", encoding="utf-8")
+    with pytest.raises(CalibrationError, match=r"lines 2 and 3: 2 rows match recording a\.csv"):
+        read_contact_points([Path("a.csv")], [_FakeRecording({})], table)
+    # given by its path, each finds its own row
+    paths = [Path("day1/a.csv"), Path("day2/a.csv")]
+    assert read_contact_points(paths, [_FakeRecording({})] * 2, table) == [0.4, 0.45]
+
+
+def test_calibration_refuses_a_recording_not_in_the_format_units() -> None:
+    from sensing_antenna.calibration.frequency import calibrate_from_recordings
+    from sensing_antenna.simulator import Scenario, simulate
+
+    antenna = paper_antenna()
+    recordings = [
+        simulate(antenna, Scenario(case="azimuthal", contact_point=x, seed=3)) for x in (0.5, 0.7)
+    ]
+    # Torques in N mm: at rest the second reads 1000 times the link's weight moment (0.0221 N m)
+    recordings[1] = replace(recordings[1], torque=1000.0 * recordings[1].torque)
+    with pytest.raises(CalibrationError, match=r"^b\.csv: columns 'tx', 'ty', 'tz': "):
+        calibrate_from_recordings(recordings, antenna, [0.5, 0.7], sources=["a.csv", "b.csv"])
+
+
 def test_calibration_recovers_a_known_t_e_from_simulated_recordings(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -5,7 +5,8 @@ swept motor follows a raised-cosine speed profile, touches at a chosen abscissa,
 static deflection is a set fraction of x_c, stops; the loads are the cantilever statics of the
 ratio module's notes (R = F - F_g^m, Gamma - Gamma_g^m = r_c x R with |R| = 3 E I y_c / x_c^3,
 Eq. 13) plus damped vibrations at the beam model's omega_1(x_c) and omega_2(x_c) in chosen
-directions, plus sensor noise of one ATI Nano17 count. Because the vibration frequency is taken
+directions, plus the free link's coupling torque while the head turns (Eq. 15), plus sensor noise
+of one ATI Nano17 count. Because the vibration frequency is taken
 from the same beam model the estimator inverts, these tests check the pipeline (signs, frames,
 instants, fusion, statuses), not the beam model (tested in test_beam*).
 """
@@ -17,6 +18,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.signal import lsim
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
@@ -120,6 +122,19 @@ def synthetic_recording(spec: Synthetic, antenna: Antenna | None = None) -> Reco
     s2, c2 = np.sin(theta[:, 1]), np.cos(theta[:, 1])
     gravity_force = np.column_stack([-weight * s2, 0 * s2, -weight * c2])
     gravity_torque = np.column_stack([0 * s2, 0.5 * weight * link.length * c2, 0 * s2])
+    # The free link's first mode resists the head's turn: Eq. 15 of the paper,
+    # Gamma_e = K s^2 / (s^2 + d s + omega^2) theta with the paper's K, omega, d, integrated by
+    # scipy (not the project's discrete observer). By the link on the head it acts about -Z^m
+    # for the azimuth (theta2 = 0) and about +Y^m for a rising elevation (docs/develop.md).
+    # Until the touch only: the contact pins the link, whose modes are then the contact modes.
+    observer = antenna.observer
+    numerator = [observer.gain, 0.0, 0.0]
+    denominator = [1.0, observer.damping, observer.natural_frequency**2]
+    _, coupling, _ = lsim((numerator, denominator), theta[:, column] - theta[0, column], t)
+    coupling = np.where(t < spec.contact_time, coupling, 0.0)
+    moment[:, 2 if spec.case == "azimuthal" else 1] += (
+        -coupling if spec.case == "azimuthal" else coupling
+    )
     force = reaction + gravity_force + spec.noise * FORCE_NOISE * rng.standard_normal((n, 3))
     torque = moment + gravity_torque + spec.noise * TORQUE_NOISE * rng.standard_normal((n, 3))
     return Recording(
@@ -226,7 +241,9 @@ def test_online_and_offline_agree(method: str) -> None:
         (Synthetic(stops=False, speed=0.05), Status.PUSH_NOT_REACHED),
         (Synthetic(in_plane=0.0, out_of_plane=0.0), Status.NO_CLEAR_PEAK),
         (Synthetic(x_c=0.5, ratio_lever=0.75), Status.ESTIMATORS_DISAGREE),
-        (Synthetic(x_c=0.5, slip_speed=0.1), Status.SLIP_SUSPECTED),
+        # 5 cm/s: the ratio settles, then moves by 2.8 cm (limit 2 cm) whatever the seed; at
+        # 10 cm/s it sat on the edge of settling at all within the recording (seed-dependent)
+        (Synthetic(x_c=0.4, slip_speed=0.05), Status.SLIP_SUSPECTED),
     ],
     ids=["too_short", "no_stop", "no_vibration", "lever_mismatch", "slip"],
 )

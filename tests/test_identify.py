@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -179,3 +180,77 @@ def test_contact_recording_is_refused() -> None:
     rec = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=0.6, seed=3))
     with pytest.raises(IdentificationError, match="really free motion"):
         identify_free_motion(rec.without_ground_truth(), ANTENNA)
+
+
+@pytest.fixture(scope="module")
+def simulated_free(tmp_path_factory: pytest.TempPathFactory) -> Recording:
+    """A simulated free sweep (azimuth only, theta2 = 0), written and read back so that it
+    carries its file name."""
+    from sensing_antenna.recording import read_recording
+
+    path = tmp_path_factory.mktemp("identify") / "free.csv"
+    write_recording(simulate(ANTENNA, Scenario(case="free", duration=3.0, seed=1)), path)
+    return read_recording(path).without_ground_truth()
+
+
+def _scaled(recording: Recording, wrench: float = 1.0, angle: float = 1.0) -> Recording:
+    return dataclasses.replace(
+        recording,
+        force=recording.force * wrench,
+        torque=recording.torque * wrench,
+        theta=recording.theta * angle,
+    )
+
+
+def test_a_wrench_in_mn_and_n_mm_is_refused(simulated_free: Recording) -> None:
+    # At rest the link's weight moment is 0.0221 N m (docs/recording-format.md); this file reads
+    # 22.1: an unchecked fit wrote a gain 1000 times the device's
+    with pytest.raises(IdentificationError) as raised:
+        identify_free_motion(_scaled(simulated_free, wrench=1000.0), ANTENNA)
+    message = str(raised.value)
+    assert message.startswith(f"{simulated_free.source}: columns 'tx', 'ty', 'tz': ")
+    assert "N mm" in message
+
+
+def test_angles_in_degrees_are_refused(simulated_free: Recording) -> None:
+    # theta2 = 0 throughout, so the weight at rest cannot tell; the fitted inertia K / omega^2 is
+    # 1/57 of the rigid link's m_b l^2 / 3 (0.99 of it in radians, test above)
+    with pytest.raises(IdentificationError, match="degrees") as raised:
+        identify_free_motion(_scaled(simulated_free, angle=180.0 / math.pi), ANTENNA)
+    assert str(raised.value).startswith(f"{simulated_free.source}: columns 'theta1'")
+
+
+def _glitch(recording: Recording) -> Recording:
+    theta = recording.theta.copy()
+    theta[1500, 0] = 1e300
+    return dataclasses.replace(recording, theta=theta)
+
+
+@pytest.mark.parametrize(
+    ("make", "column"),
+    [
+        (lambda r: _scaled(r, wrench=1e-300), "'tx', 'ty', 'tz'"),
+        (lambda r: _scaled(r, wrench=1e300), "'tx', 'ty', 'tz'"),
+        (_glitch, "'theta1'"),
+        # no rest at the start to read the weight from: the fit itself must not overflow
+        (
+            lambda r: dataclasses.replace(
+                r,
+                t=r.t[300:],
+                theta=r.theta[300:],
+                force=r.force[300:],
+                torque=1e300 * r.torque[300:],
+                extra={},
+            ),
+            "'theta1', 'theta2', 'ty', 'tz'",
+        ),
+    ],
+    ids=["wrench-1e-300", "wrench-1e300", "angle-1e300", "no-rest-wrench-1e300"],
+)
+def test_absurd_scales_are_one_line_errors(simulated_free: Recording, make, column: str) -> None:  # type: ignore[no-untyped-def]
+    with pytest.raises(IdentificationError) as raised:
+        identify_free_motion(make(simulated_free), ANTENNA)
+    message = str(raised.value)
+    assert message.startswith(f"{simulated_free.source}: column")
+    assert column in message
+    assert "\n" not in message

@@ -65,3 +65,25 @@ def test_rayleigh_coefficients_hit_both_frequencies() -> None:
     for omega in (16.0, 100.0):
         assert alpha / (2 * omega) + beta * omega / 2 == pytest.approx(0.005, rel=1e-12)
     assert math.isfinite(alpha) and alpha > 0 and beta > 0
+
+
+def test_a_calibrated_antenna_is_simulated_with_its_t_e() -> None:
+    # paper-2021-calibrated: T_e = 0.2124 s/m^2 (Section 5.1), 7 % below Table 2's T. The device
+    # it describes vibrates with T_e, so simulating it and estimating with the same antenna
+    # must find where the link touched (the theoretical T put it 2 cm off).
+    from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.estimation import estimate
+    from sensing_antenna.simulator import Scenario, simulate
+    from sensing_antenna.simulator.run import device_link
+
+    antenna = load_antenna("paper-2021-calibrated")
+    link = device_link(antenna.link)
+    # T = sqrt(rho / (E I)) of the built link is T_e exactly; the weight is kept
+    assert link.theoretical_t == pytest.approx(0.2124, rel=1e-12)
+    assert link.linear_density == antenna.link.linear_density
+    assert link.calibrated_t is None
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.55, seed=2))
+    truth = float(recording.metadata["true_xc"])
+    result = estimate(recording.without_ground_truth(), antenna)
+    # docs/estimation.md: the paper method's error on a model-exact device is 0.01 to 0.06 cm
+    assert result.x_c == pytest.approx(truth, abs=2e-3), result.reason

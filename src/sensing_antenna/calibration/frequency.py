@@ -374,7 +374,14 @@ def calibrate_from_recordings(
     band : (float, float)
         Search band for the fundamental frequency (rad/s); wide by default so that the measured
         frequencies do not presuppose the model being fitted.
+
+    Raises
+    ------
+    CalibrationError
+        Naming the recording, when it is not in the format's units (its angles, or its loads at
+        rest against the link's weight: :func:`~.observer.units_problem`).
     """
+    from sensing_antenna.calibration.observer import units_problem
     from sensing_antenna.estimation import measure_omega1
 
     if len(recordings) != len(contact_points):
@@ -385,6 +392,9 @@ def calibrate_from_recordings(
     omega = np.full(len(recordings), math.nan)
     notes: list[str] = []
     for i, recording in enumerate(recordings):
+        problem = units_problem(recording, antenna)
+        if problem is not None:
+            raise CalibrationError(f"{names[i]}: {problem}")
         measurement = measure_omega1(recording, antenna, band=band)
         value = float(measurement.omega1)
         if not (math.isfinite(value) and value > 0):
@@ -404,10 +414,12 @@ def read_contact_points(
 ) -> list[float]:
     """Known contact points (m) of calibration recordings, from a table or their metadata.
 
-    With ``table``, a CSV file with columns ``file`` and ``x_c`` (m); a row matches a recording by
-    its path as given or by its file name. Without it, each recording's ground-truth metadata
-    ``true_xc`` is used: calibration is the one place where ground truth is an input, since the
-    contact points of a calibration are known by construction.
+    With ``table``, a CSV file (UTF-8) with columns ``file`` and ``x_c`` (m); a row matches a
+    recording by its path as given or by its file name. Two rows for one ``file``, or a file name
+    two rows match, are refused (naming the lines): which would win is not the user's intent.
+    Without it, each recording's ground-truth metadata ``true_xc`` is used: calibration is the
+    one place where ground truth is an input, since the contact points of a calibration are known
+    by construction.
 
     Raises
     ------
@@ -415,14 +427,8 @@ def read_contact_points(
         Naming the file, line or recording and what is missing or wrong.
     """
     if table is not None:
-        known = _read_points_table(table)
-        points = []
-        for path in paths:
-            value = known.get(str(path), known.get(path.name))
-            if value is None:
-                raise CalibrationError(f"{table}: file: no row for recording {path}")
-            points.append(value)
-        return points
+        rows = _read_points_table(table)
+        return [_point_of(table, rows, path) for path in paths]
     points = []
     for path, recording in zip(paths, recordings, strict=True):
         text = recording.metadata.get("true_xc")
@@ -437,32 +443,77 @@ def read_contact_points(
     return points
 
 
-def _read_points_table(table: Path) -> dict[str, float]:
+@dataclass(frozen=True)
+class _PointRow:
+    """One row of a ``--points`` table: its line, the ``file`` text and x_c (m)."""
+
+    line: int
+    file: str
+    x_c: float
+
+
+def _read_points_table(table: Path) -> list[_PointRow]:
+    """The rows of a ``--points`` table; two rows for one ``file`` are refused."""
     if not table.is_file():
         raise CalibrationError(f"{table}: no such file")
-    with open(table, encoding="utf-8", newline="") as handle:
-        reader = csv.DictReader(handle)
-        columns = reader.fieldnames or []
-        for column in ("file", "x_c"):
-            if column not in columns:
-                raise CalibrationError(f"{table}: line 1: missing column {column!r}")
-        known: dict[str, float] = {}
-        for row in reader:
-            line = reader.line_num
-            try:
-                value = float(row["x_c"])
-            except (TypeError, ValueError) as exc:
-                raise CalibrationError(
-                    f"{table}: line {line}: x_c: not a number: {row['x_c']!r}"
-                ) from exc
-            if not math.isfinite(value):
-                raise CalibrationError(f"{table}: line {line}: x_c: not finite")
-            name = (row["file"] or "").strip()
-            if not name:
-                raise CalibrationError(f"{table}: line {line}: file: empty")
-            known[name] = value
-            known.setdefault(Path(name).name, value)
-    return known
+    rows: list[_PointRow] = []
+    try:
+        with open(table, encoding="utf-8-sig", newline="") as handle:
+            reader = csv.DictReader(handle)
+            columns = reader.fieldnames or []
+            for column in ("file", "x_c"):
+                if column not in columns:
+                    raise CalibrationError(f"{table}: line 1: missing column {column!r}")
+            for record in reader:
+                rows.append(_point_row(table, reader.line_num, record))
+    except UnicodeDecodeError as exc:
+        raise CalibrationError(
+            f"{table}: not UTF-8 text (byte {exc.start}: {exc.reason})"
+        ) from None
+    except (OSError, csv.Error) as exc:
+        raise CalibrationError(f"{table}: cannot be read ({exc})") from None
+    first: dict[str, _PointRow] = {}
+    for row in rows:
+        if row.file in first:
+            earlier = first[row.file]
+            raise CalibrationError(
+                f"{table}: lines {earlier.line} and {row.line}: two rows for file {row.file!r} "
+                f"(x_c = {earlier.x_c:g} and {row.x_c:g} m); keep one"
+            )
+        first[row.file] = row
+    return rows
+
+
+def _point_row(table: Path, line: int, row: dict[str | Any, Any]) -> _PointRow:
+    text: Any = row.get("x_c")
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise CalibrationError(f"{table}: line {line}: x_c: not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise CalibrationError(f"{table}: line {line}: x_c: not finite")
+    name = (row.get("file") or "").strip()
+    if not name:
+        raise CalibrationError(f"{table}: line {line}: file: empty")
+    return _PointRow(line, name, value)
+
+
+def _point_of(table: Path, rows: Sequence[_PointRow], path: Path) -> float:
+    """x_c of the row for recording ``path``: its path as given, else its file name; a name
+    that two rows match is ambiguous and refused."""
+    exact = [row for row in rows if row.file == str(path)]
+    if exact:
+        return exact[0].x_c
+    named = [row for row in rows if Path(row.file).name == path.name]
+    if not named:
+        raise CalibrationError(f"{table}: file: no row for recording {path}")
+    if len(named) > 1:
+        lines = " and ".join(str(row.line) for row in named)
+        raise CalibrationError(
+            f"{table}: lines {lines}: {len(named)} rows match recording {path} by its file name "
+            f"({', '.join(repr(row.file) for row in named)}); give its path as passed"
+        )
+    return named[0].x_c
 
 
 def _json_float(value: float) -> float | None:

@@ -13,6 +13,11 @@ omega = 1.8751^2 / (T l^2), the first clamped-free mode), refined by a grid sear
 the damping ratio with K solved linearly at each point (the model is linear in K), then
 ``scipy.optimize.least_squares`` over (K, omega, d).
 
+Units (the recording's own check, ``units_check``): before the fit, the angles' limits and the
+loads at rest at the start against the link's weight (a wrench in mN and N mm, or scaled by
+1e-300, reads no weight); after it, the fitted effective inertia K / omega^2 against the rigid
+link's (angles in degrees give 1/57 of it).
+
 Threshold (Section 5.2): the maximum of the filtered residual norm of Eq. 16 over the free-motion
 recording, computed with the fitted observer and the detector's residual filter, times a safety
 margin of 1.5 ("the maximum residual obtained during free movements plus a security margin of
@@ -37,14 +42,17 @@ from sensing_antenna.detection.contact import (
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
+from sensing_antenna.units_check import recording_problem
 
 __all__ = [
     "CLAMPED_FREE_BETA_L",
     "DEFAULT_MARGIN",
+    "MAX_INERTIA_FACTOR",
     "IdentificationError",
     "ObserverFit",
     "identify_free_motion",
     "initial_guess",
+    "units_problem",
 ]
 
 #: beta_1 l of the first clamped-free bending mode (root of 1 + cos x cosh x = 0).
@@ -124,6 +132,16 @@ class ObserverFit:
         return self.damping / (2.0 * self.natural_frequency)
 
 
+#: Largest factor between the fitted effective inertia K / omega^2 and the rigid link's
+#: m_b l^2 / 3 + m_t l^2 (Eq. 15 tends to K / omega^2 theta'' at low frequency, the rigid link's
+#: inertial torque). A simulated free sweep of the paper's link fits 0.99 of it; angles in
+#: degrees give 1/57, a wrench in mN and N mm 1000. 5 sits well between and leaves room for a
+#: head whose link is not quite the antenna file's.
+MAX_INERTIA_FACTOR = 5.0
+
+#: Lower bound of the fitted gain K (N m / rad), 1e-11 of the paper's 0.37: keeps it positive.
+_MIN_GAIN = 1e-12
+
 #: Largest accepted ratio of the fit's residual rms to the coupling torque's rms. A simulated free
 #: sweep of the paper antenna fits to about 1 %; a recording with a contact, whose static torque
 #: the high-pass observer cannot follow, leaves about 100 %. Half sits safely between the two.
@@ -158,6 +176,95 @@ def _targets(recording: Recording, antenna: Antenna) -> NDArray[np.float64]:
     return np.column_stack([sign_z * dynamic_z, sign_y * dynamic_y])
 
 
+def _fit(
+    angles: NDArray[np.float64],
+    measured: NDArray[np.float64],
+    period: float,
+    guess: tuple[float, float, float],
+    where: str,
+) -> tuple[float, float, float, float]:
+    """(K, omega, d) of Eq. 15 fitted to the measured coupling torques, and the residual rms
+    (N m): a grid over omega and zeta with K solved linearly, then least squares. Raises
+    IdentificationError when Eq. 15 explains the torque poorly (not free motion)."""
+    nyquist = math.pi / period
+    k0, w0, d0 = guess
+
+    def unit_response(omega: float, damping: float) -> NDArray[np.float64]:
+        observer = FreeMotionObserver(1.0, omega, damping, 1.0)
+        # Eq. 15 with K = 1, discretised as online
+        return observe_free_motion(angles, observer, period)
+
+    best = (math.inf, k0, min(w0, 0.5 * nyquist), d0)
+    for omega in w0 * np.geomspace(0.4, 2.5, 49):
+        if omega >= 0.5 * nyquist:
+            continue
+        for zeta in _ZETA_GRID:
+            u = unit_response(float(omega), 2.0 * zeta * float(omega))
+            gain = float(np.sum(u * measured) / np.sum(u * u))
+            cost = float(np.sum((measured - gain * u) ** 2))
+            if gain > 0 and cost < best[0]:
+                best = (cost, gain, float(omega), 2.0 * zeta * float(omega))
+
+    def residuals(params: NDArray[np.float64]) -> NDArray[np.float64]:
+        gain, omega, damping = params
+        return (measured - gain * unit_response(omega, damping)).ravel()
+
+    rigid = k0 / w0**2
+    if best[1] < _MIN_GAIN:
+        # torques (or angles) on a scale no fit starts from: the inertia says which
+        _check_inertia(best[1] / best[2] ** 2, rigid, where)
+    start = np.array(best[1:])
+    fit = least_squares(
+        residuals,
+        start,
+        bounds=([_MIN_GAIN, 1e-6, 0.0], [np.inf, 0.9 * nyquist, np.inf]),
+        x_scale=np.maximum(np.abs(start), 1e-6),
+    )
+    gain, omega, damping = (float(v) for v in fit.x)
+    rms = float(np.sqrt(np.mean(fit.fun**2)))
+    signal_rms = float(np.sqrt(np.mean(measured**2)))
+    if rms > MAX_RELATIVE_RESIDUAL * signal_rms:
+        raise IdentificationError(
+            f"{where}: columns 'tx', 'ty', 'tz': Eq. 15 explains the coupling torque poorly "
+            f"(residual rms {rms:.3g} N m against a signal rms of {signal_rms:.3g} N m); is this "
+            "really free motion? A contact leaves a static torque that no free-motion observer "
+            "can follow"
+        )
+    return gain, omega, damping, rms
+
+
+def _check_inertia(inertia: float, rigid: float, where: str) -> None:
+    """IdentificationError unless the effective inertia K / omega^2 (kg m^2) lies within
+    ``MAX_INERTIA_FACTOR`` of the rigid link's ``rigid`` (kg m^2)."""
+    if 1.0 / MAX_INERTIA_FACTOR <= inertia / rigid <= MAX_INERTIA_FACTOR:
+        return
+    raise IdentificationError(
+        f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the observer's inertia "
+        f"K / omega^2 = {inertia:.3g} kg m^2 is {inertia / rigid:.3g} times the rigid link's "
+        f"{rigid:.3g} kg m^2 (more than a factor {MAX_INERTIA_FACTOR:g}): angles in degrees, "
+        "or torques scaled?"
+    )
+
+
+def units_problem(recording: Recording, antenna: Antenna) -> str | None:
+    """Why a recording is not in the format's units, or None: its angles and its loads at rest at
+    the start (:func:`~sensing_antenna.units_check.recording_problem`), at rest as the
+    estimators judge it (the rest tolerance and window of ``EstimatorConfig``). Identification
+    and calibration both ask it."""
+    from sensing_antenna.estimation.config import EstimatorConfig
+    from sensing_antenna.estimation.front.contact_frame import rest_tolerance
+
+    config = EstimatorConfig()
+    return recording_problem(
+        recording.theta,
+        recording.force,
+        recording.torque,
+        antenna,
+        rest_tolerance(recording.theta, config),
+        round(config.rest_window / recording.sample_period) + 1,
+    )
+
+
 def identify_free_motion(
     recording: Recording,
     antenna: Antenna,
@@ -184,15 +291,21 @@ def identify_free_motion(
     Raises
     ------
     IdentificationError
-        When no joint moved by more than ``MIN_MOTION``, ``margin`` is not a number >= 1, or the
-        fitted observer leaves more than ``MAX_RELATIVE_RESIDUAL`` of the torque unexplained
-        (not a free motion).
+        When no joint moved by more than ``MIN_MOTION``, ``margin`` is not a number >= 1, the
+        recording is not in the format's units (its angles, or its loads at rest against the
+        link's weight, :func:`~sensing_antenna.units_check.recording_problem`), the fitted
+        observer leaves more than ``MAX_RELATIVE_RESIDUAL`` of the torque unexplained (not a
+        free motion), or its effective inertia is more than ``MAX_INERTIA_FACTOR`` from the
+        rigid link's.
     """
     where = recording.source or "<recording>"
     if not (math.isfinite(margin) and margin >= 1.0):
         raise IdentificationError(f"margin: must be a number >= 1, got {margin!r}")
     uniform = resample_uniform(recording) if recording.sampling.irregular else recording
     period = uniform.sample_period
+    problem = units_problem(uniform, antenna)
+    if problem is not None:
+        raise IdentificationError(f"{where}: {problem}")
     span = np.ptp(uniform.theta, axis=0)
     joints = tuple(j for j in (0, 1) if span[j] > MIN_MOTION)
     if not joints:
@@ -202,46 +315,17 @@ def identify_free_motion(
         )
     angles = uniform.theta[:, joints]
     measured = _targets(uniform, antenna)[:, joints]
-    nyquist = math.pi / period
-
-    def unit_response(omega: float, damping: float) -> NDArray[np.float64]:
-        observer = FreeMotionObserver(1.0, omega, damping, 1.0)
-        # Eq. 15 with K = 1, discretised as online
-        return observe_free_motion(angles, observer, period)
-
     k0, w0, d0 = initial_guess(antenna)
-    best = (math.inf, k0, min(w0, 0.5 * nyquist), d0)
-    for omega in w0 * np.geomspace(0.4, 2.5, 49):
-        if omega >= 0.5 * nyquist:
-            continue
-        for zeta in _ZETA_GRID:
-            u = unit_response(float(omega), 2.0 * zeta * float(omega))
-            gain = float(np.sum(u * measured) / np.sum(u * u))
-            cost = float(np.sum((measured - gain * u) ** 2))
-            if gain > 0 and cost < best[0]:
-                best = (cost, gain, float(omega), 2.0 * zeta * float(omega))
-
-    def residuals(params: NDArray[np.float64]) -> NDArray[np.float64]:
-        gain, omega, damping = params
-        return (measured - gain * unit_response(omega, damping)).ravel()
-
-    start = np.array(best[1:])
-    fit = least_squares(
-        residuals,
-        start,
-        bounds=([1e-12, 1e-6, 0.0], [np.inf, 0.9 * nyquist, np.inf]),
-        x_scale=np.maximum(np.abs(start), 1e-6),
-    )
-    gain, omega, damping = (float(v) for v in fit.x)
-    rms = float(np.sqrt(np.mean(fit.fun**2)))
-    signal_rms = float(np.sqrt(np.mean(measured**2)))
-    if rms > MAX_RELATIVE_RESIDUAL * signal_rms:
+    try:
+        # Arithmetic that overflows means values no link gives (a wrench of 1e300 N m)
+        with np.errstate(over="raise"):
+            gain, omega, damping, rms = _fit(angles, measured, period, (k0, w0, d0), where)
+    except FloatingPointError:
         raise IdentificationError(
-            f"{where}: columns 'tx', 'ty', 'tz': Eq. 15 explains the coupling torque poorly "
-            f"(residual rms {rms:.3g} N m against a signal rms of {signal_rms:.3g} N m); is this "
-            "really free motion? A contact leaves a static torque that no free-motion observer "
-            "can follow"
-        )
+            f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the fit of Eq. 15 overflows: "
+            "angles or torques far beyond a head's (units?)"
+        ) from None
+    _check_inertia(gain / omega**2, k0 / w0**2, where)
     provisional = FreeMotionObserver(gain, omega, damping, contact_threshold=1.0)
     provisional_antenna = replace(antenna, observer=provisional)
     detection = detect_contact(uniform, provisional_antenna, residual_cutoff=residual_cutoff)

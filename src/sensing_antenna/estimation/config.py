@@ -140,6 +140,20 @@ class EstimatorConfig:
         The Nyquist frequency pi / T_s must exceed this factor times the top of the omega_1 band;
         below it the recording cannot show the vibration (bad_input). 2 keeps the peak away from
         the anti-aliasing roll-off.
+    max_scale_mismatch : float
+        Plausibility (``model_mismatch``): the torque/force ratio and the answer must lie within
+        this factor of the contact point the vibration gives (the nearest point of the sensing
+        curve with the measured omega_1), unless ``disagreement_sigmas`` of the ratio's
+        uncertainty cover the difference. A unit or scale error of the forces or torques is a
+        factor 2 or more (doubled, halved, 10^3), while on the default campaign, noise sweep
+        included (four times the nominal noise), the ratio lies within 0.87 to 1.16 times that
+        point. 1.5 sits between.
+    free_motion_gain_factor : float
+        Plausibility (``implausible_input``): the torque of the free motion before t_c must be
+        at least 1 / this factor of what the observer predicts from the angles (root-mean-square
+        ratio, :func:`~.front.steps.free_motion_gain`). Angles in degrees give 1/57; the
+        simulated device gives 0.8 to 3 with the paper's observer (the touch adds torque before
+        t_c). 10 sits between.
     """
 
     t1_source: Literal["rest", "push"] = "rest"
@@ -171,6 +185,8 @@ class EstimatorConfig:
     max_direction_drift: float = 0.15
     max_ratio_drift: float = 0.02
     min_nyquist_factor: float = 2.0
+    max_scale_mismatch: float = 1.5
+    free_motion_gain_factor: float = 10.0
 
     def __post_init__(self) -> None:
         if self.t1_source not in ("rest", "push"):
@@ -198,6 +214,11 @@ class EstimatorConfig:
                 continue
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise EstimatorConfigError(f"{f.name}: must be a finite number > 0, got {value!r}")
+        for name in ("max_scale_mismatch", "free_motion_gain_factor"):
+            if getattr(self, name) <= 1.0:
+                raise EstimatorConfigError(
+                    f"{name}: must be a factor > 1, got {getattr(self, name)!r}"
+                )
         if self.rest_window > self.convergence_window:
             raise EstimatorConfigError(
                 "rest_window: must not exceed convergence_window (t_1 is known rest_window "

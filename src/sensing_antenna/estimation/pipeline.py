@@ -12,6 +12,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
+
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
@@ -28,6 +30,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     FrequencyMeasurement,
     evidence_frequency,
 )
+from sensing_antenna.estimation.plausibility import review
 from sensing_antenna.estimation.result import ContactEstimate
 from sensing_antenna.recording import Recording, resample_uniform
 
@@ -116,9 +119,11 @@ def estimate(
 def conclude(gathered: Gathered, method: str | EstimationMethod = "paper") -> ContactEstimate:
     """The estimate of ``method`` from what the front end gathered (:func:`gather`).
 
-    The evidence goes to ``method.conclude``; an early outcome becomes the estimate without a
-    contact point. Either way the front end's trace rides on the result. One ``gather`` serves
-    any number of methods.
+    The evidence goes to ``method.conclude``, and its estimate through the plausibility layer
+    (:func:`~.plausibility.review`: the recording's units, the answer on the link, a real
+    vibration, one scale for the loads and the vibration) before it may be ``ok``; an early
+    outcome becomes the estimate without a contact point. Either way the front end's trace rides
+    on the result. One ``gather`` serves any number of methods.
 
     Raises
     ------
@@ -128,7 +133,14 @@ def conclude(gathered: Gathered, method: str | EstimationMethod = "paper") -> Co
     impl = resolve_method(method)
     if isinstance(gathered, EarlyOutcome):
         return gathered.estimate(impl.name)
-    return dataclasses.replace(impl.conclude(gathered), trace=gathered.trace)
+    if gathered.input_problem is None:
+        reviewed = review(gathered, impl.conclude(gathered))
+    else:
+        # Loads known to be off the format's units (1e300 N m) overflow the arithmetic of the
+        # method and the review; the status says so already, warnings would only repeat it
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+            reviewed = review(gathered, impl.conclude(gathered))
+    return dataclasses.replace(reviewed, trace=gathered.trace)
 
 
 def measure_omega1(

@@ -40,6 +40,14 @@ class Status(str, enum.Enum):
     SLIP_SUSPECTED = "slip_suspected"
     #: The samples cannot be used at all (sampling too coarse, dead sensor channels, ...).
     BAD_INPUT = "bad_input"
+    #: The recording is not in the format's units and signs by its own physics: the loads at
+    #: rest are not the link's weight (mN, N mm, scaled, a sign flipped), the angles are not
+    #: those of a head in radians, or the free motion's torque is not what the angles predict.
+    IMPLAUSIBLE_INPUT = "implausible_input"
+    #: The evidence does not fit the physics of a contact: the answer lies outside the link
+    #: (0, l], or the torque/force ratio or the answer is a factor away from where the measured
+    #: vibration puts the contact.
+    MODEL_MISMATCH = "model_mismatch"
     #: The method's interval never became narrower than the requested tolerance before its cap
     #: (``fast`` method); x_c is the best estimate at the cap.
     UNCERTAIN = "uncertain"
@@ -51,11 +59,13 @@ class Status(str, enum.Enum):
 #: When several problems are found, the first one in this order is the status.
 STATUS_PRECEDENCE: tuple[Status, ...] = (
     Status.BAD_INPUT,
+    Status.IMPLAUSIBLE_INPUT,
     Status.NO_CONTACT,
     Status.PUSH_NOT_REACHED,
     Status.RECORDING_TOO_SHORT,
     Status.SLIP_SUSPECTED,
     Status.NO_CLEAR_PEAK,
+    Status.MODEL_MISMATCH,
     Status.ESTIMATORS_DISAGREE,
     Status.UNCERTAIN,
     Status.OK,
@@ -95,7 +105,9 @@ class ContactEstimate:
     method : str
         Name of the method that produced the estimate (``"paper"``, ``"ratio"``, ...).
     x_c : float
-        Estimated contact point along the link (m); NaN when there is no guess at all.
+        Estimated contact point along the link (m), within (0, l] whatever the status (the
+        pipeline drops a best guess outside the link and says so in the reason); NaN when
+        there is no guess.
     candidates : tuple of float
         Contact points compatible with the measured fundamental frequency (m), ascending.
     omega1 : float

@@ -194,8 +194,8 @@ def build_link_model(link: Link, n_elements: int = 20) -> LinkModel:
     Parameters
     ----------
     link : Link
-        Length, E I, rho and tip mass are used. The frequency model's calibrated T_e is not: the
-        simulator stands for the device, whose physics is set by the material data.
+        Length, E I, rho and tip mass are used; a calibrated T_e is not read here (``simulate``
+        passes a calibrated link as the E I that gives its T_e, ``run.device_link``).
     n_elements : int
         Number of equal Hermite elements (>= 2).
 

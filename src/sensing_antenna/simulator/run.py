@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any, Protocol
 
@@ -40,6 +40,7 @@ __all__ = [
     "SimulationDetail",
     "StopRule",
     "deflection_warning",
+    "device_link",
     "minimum_contact_point",
     "simulate",
     "simulate_detailed",
@@ -63,6 +64,21 @@ FINAL_AVERAGE_TIME = 0.5
 #: The penalty contact must be at least this many times stiffer than the link's local stiffness
 #: 3 E I / x_c^3, or it is no support at all (docs/simulator.md, "Smallest contact point").
 MIN_STIFFNESS_RATIO = 10.0
+
+
+def device_link(link: Link) -> Link:
+    """The link the simulator builds for ``link``: a calibrated one vibrates with its T_e.
+
+    A calibrated T_e (Section 5.1) is the device's measured ratio of mass to stiffness,
+    T_e = sqrt(rho / (E I)); the simulator stands for that device, so it takes the flexural
+    rigidity E I = rho / T_e^2 that gives it, keeping rho (the weight) and I (E changes), and
+    drops the calibration. A link without one is built as it is (T from the material data).
+    """
+    if link.calibrated_t is None:
+        return link
+    # T_e = sqrt(rho / (E I)) solved for E with rho and I kept
+    youngs = link.linear_density / (link.calibrated_t**2 * link.area_moment)
+    return replace(link, youngs_modulus=youngs, calibrated_t=None, calibration_scatter=None)
 
 
 class StopRule(Protocol):
@@ -227,7 +243,8 @@ def simulate(
     Parameters
     ----------
     antenna : Antenna
-        Link and motors of the device (the observer is not used by the physics).
+        Link and motors of the device (the observer is not used by the physics). A link with a
+        calibrated T_e is built with the flexural rigidity that gives it (:func:`device_link`).
     scenario : Scenario
     progress : callable, optional
         Called with the fraction done (0..1) now and then.
@@ -255,7 +272,7 @@ def simulate_detailed(
 
     ``gravity`` (m/s^2) exists for closed-form tests only.
     """
-    link = antenna.link
+    link = device_link(antenna.link)
     ts = SAMPLE_PERIOD
     n_samples = round(scenario.duration / ts)
     t: NDArray[np.float64] = np.arange(n_samples, dtype=np.float64) * ts

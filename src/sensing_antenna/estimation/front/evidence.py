@@ -129,6 +129,10 @@ class Evidence:
         Standard errors of the force (N) and torque (N m) offsets removed by the tare.
     gap : str or None
         A gap of missing samples inside [t_1, t_e] (bad input), described.
+    input_problem : str or None
+        Why the samples up to t_c are not in the format's units and signs (the loads at rest
+        against the link's weight, the free motion against the observer), None when they are;
+        the plausibility layer makes it the status ``implausible_input``.
     diagnostics : dict
         Front-end diagnostics (sampling, rest tolerance, rebounds, ...).
     trace : FrontTrace or None
@@ -159,6 +163,7 @@ class Evidence:
     offset_error: float = 0.0
     torque_offset_error: float = 0.0
     gap: str | None = None
+    input_problem: str | None = None
     diagnostics: dict[str, Any] = field(default_factory=dict)
     trace: FrontTrace | None = field(default=None, compare=False, repr=False)
 
@@ -168,7 +173,7 @@ class Evidence:
         n_window = round(self.config.spectrum_window / self.sample_period)
         return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
 
-    def ratio_uncertainty(self, x_c: float) -> float:
+    def ratio_uncertainty(self, x_c: float, model: bool = True) -> float:
         """Standard uncertainty (m) of the ratio estimate at a contact point ``x_c``.
 
         Three independent terms, added in quadrature:
@@ -180,17 +185,23 @@ class Evidence:
         - the small-deflection model: the statics neglect terms of order (y_c / x_c) x_c
           (the moment of the axial force with the link's slope, the weight moment of the bent
           link); y_c / x_c = |R_perp| x_c^2 / (3 E I) (Eq. 13), scaled by
-          ``ratio_model_factor``.
+          ``ratio_model_factor``; left out with ``model=False`` (the statistical part alone,
+          which does not grow with the loads' scale).
+
+        The model holds on the link only: a reading outside it (a ratio of 10^5 m from torques
+        in N mm) is judged at the nearest point of [0, l], where the terms stay finite.
         """
         if not math.isfinite(x_c):
             return math.inf
         link = self.antenna.link
+        x_c = min(max(x_c, 0.0), link.length)
         push = math.hypot(self.frame.reaction_m[1], self.frame.reaction_m[2])
         if push <= 0.0:
             return math.inf
         offset_term = math.hypot(x_c * self.offset_error, self.torque_offset_error) / push
         # Eq. 13: y_c / x_c = |R_perp| x_c^2 / (3 E I)
         deflection_ratio = push * x_c**2 / (3.0 * link.flexural_rigidity)
-        model_term = self.config.ratio_model_factor * deflection_ratio * x_c
+        model_term = self.config.ratio_model_factor * deflection_ratio * x_c if model else 0.0
         noise_term = self.ratio_noise * x_c / link.length
-        return math.sqrt(noise_term**2 + offset_term**2 + model_term**2)
+        # in quadrature without squaring (a torque noise of 1e297 N m must not overflow)
+        return math.hypot(noise_term, offset_term, model_term)

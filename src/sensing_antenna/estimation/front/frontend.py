@@ -314,6 +314,7 @@ class FrontEnd:
                 self._contact,
                 cfg,
                 ts,
+                self._detector.detection().estimated_torque,
             )
         assert self._start is not None
         if self._rest is None:
@@ -477,6 +478,7 @@ class FrontEnd:
             offset_error=hold.force_noise / root,
             torque_offset_error=torque_noise / root,
             gap=gap_problem(gaps, float(t[rest]), float(t[end]), ts),
+            input_problem=start.input_problem,
             diagnostics=diagnostics,
         )
 
@@ -488,19 +490,27 @@ class FrontEnd:
                     "rest_tolerance": self._start.rest_tolerance,
                     "tare": self._start.tare,
                     "load_offset": self._start.offset,
+                    **self._start.checks,
                 }
             )
         return diagnostics
 
     def _early(self, status: Status, reason: str) -> EarlyOutcome:
-        """An outcome without evidence; bad input keeps only what the caller said."""
+        """An outcome without evidence; bad input keeps only what the caller said. A recording
+        not in the format's units (found at t_c) says so first: the push or its absence was
+        judged on loads of the wrong scale."""
         t = self._t
+        diagnostics = dict(self._notes) if status is Status.BAD_INPUT else self._diagnostics()
+        problem = None if self._start is None else self._start.input_problem
+        if problem is not None and status is not Status.BAD_INPUT:
+            diagnostics["other_reasons"] = [reason]
+            status, reason = Status.IMPLAUSIBLE_INPUT, problem
         return EarlyOutcome(
             status=status,
             reason=reason,
             t_c=math.nan if self._contact is None else float(t[self._contact]),
             t_1=math.nan if self._rest is None else float(t[self._rest]),
-            diagnostics=dict(self._notes) if status is Status.BAD_INPUT else self._diagnostics(),
+            diagnostics=diagnostics,
         )
 
     def _stop(self, outcome: Gathered) -> Gathered:

@@ -1,7 +1,10 @@
 """The causal steps of the front end, each a function of the samples up to the instant it needs.
 
 1. Sampling and sensor checks (:func:`sampling_problem`, :func:`dead_channel`).
-2. Sensor offset (tare) and rest tolerance from the samples up to t_c (:func:`at_contact`).
+2. Sensor offset (tare) and rest tolerance from the samples up to t_c (:func:`at_contact`), and
+   the recording's own units check there: the loads the tare averages against the link's weight
+   (:func:`sensing_antenna.units_check.rest_reading`), the free motion before t_c against the
+   observer (:func:`free_motion_gain`).
 3. The static push over the hold window [t_1, t_1 + frame_window] (:func:`hold_push`): the mean
    contact force, not the force at one instant, because near the tip the link bounces on the
    obstacle for a few tenths of a second after the stop while the static preload is small
@@ -17,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -32,12 +35,14 @@ from sensing_antenna.estimation.front.contact_frame import (
     signal_noise,
 )
 from sensing_antenna.estimation.front.ratio import contact_loads, load_offset, ratio_noise
+from sensing_antenna.units_check import initial_rest, rest_reading
 
 __all__ = [
     "ContactStart",
     "HoldPush",
     "at_contact",
     "dead_channel",
+    "free_motion_gain",
     "gap_problem",
     "hold_push",
     "planned_end",
@@ -120,12 +125,16 @@ def gap_problem(
 @dataclass(frozen=True)
 class ContactStart:
     """What is fixed at the contact sample: rest tolerance (rad), sensor offset (N, N m), the
-    kind of tare and the number of samples it averaged."""
+    kind of tare and the number of samples it averaged, and the units check of the samples up
+    to t_c: ``input_problem`` (why the recording's loads or angles are not in the format's units
+    and signs, None when they are) and ``checks`` (its numbers, for the diagnostics)."""
 
     rest_tolerance: float
     offset: FloatArray
     tare: str
     count: int
+    input_problem: str | None = None
+    checks: dict[str, Any] = field(default_factory=dict)
 
 
 def at_contact(
@@ -136,23 +145,96 @@ def at_contact(
     contact_index: int,
     cfg: EstimatorConfig,
     ts: float,
+    predicted_torque: FloatArray | None = None,
 ) -> ContactStart:
-    """Rest tolerance and sensor offset from the samples up to t_c (both forms call this)."""
+    """Rest tolerance, sensor offset and units check from the samples up to t_c (both forms call
+    this). ``predicted_torque`` (n, 3) is the contact detector's free-motion torque
+    Gamma_e^m + Gamma_g^m (N m) up to t_c, for :func:`free_motion_gain`."""
     before = slice(0, contact_index + 1)
     tolerance = rest_tolerance(theta[before], cfg)
     w_rest = samples(cfg.rest_window, ts)
-    moved = np.flatnonzero(np.any(np.abs(theta[before] - theta[0]) > tolerance, axis=1))
-    quiet = int(moved[0]) if moved.size else contact_index + 1
+    quiet = initial_rest(theta[before], tolerance)
+    problems: list[str] = []
+    checks: dict[str, Any] = {}
+    if predicted_torque is not None:
+        gain, problem = free_motion_gain(
+            theta[before], torque[before], predicted_torque[before], antenna, cfg
+        )
+        checks["free_motion_gain"] = gain
+        if problem is not None:
+            problems.append(problem)
     if quiet >= w_rest + 1:
         # The head rests at the start: the link hangs still, the mean load is the offset.
-        window, tare = slice(0, quiet), "rest"
+        window, tare, where = slice(0, quiet), "rest", "at rest before the contact"
     else:
         end = contact_index - samples(cfg.tare_margin, ts)
         window, tare = slice(0, max(end, 0)), "approach"
+        where = "of the approach before the contact"
         if end < w_rest + 1:
-            return ContactStart(tolerance, np.zeros(6), "none", 0)
+            return ContactStart(tolerance, np.zeros(6), "none", 0, _joined(problems), checks)
+    reading = rest_reading(theta[window], force[window], torque[window], antenna, where)
+    checks["rest_reading"] = reading.as_dict()
+    if reading.problem is not None:
+        problems.insert(0, reading.problem)
     offset = load_offset(theta[window], force[window], torque[window], antenna)
-    return ContactStart(tolerance, offset, tare, window.stop)
+    return ContactStart(tolerance, offset, tare, window.stop, _joined(problems), checks)
+
+
+def _joined(problems: list[str]) -> str | None:
+    return "; ".join(problems) if problems else None
+
+
+def free_motion_gain(
+    theta: FloatArray,
+    torque: FloatArray,
+    predicted_torque: FloatArray,
+    antenna: Antenna,
+    cfg: EstimatorConfig,
+) -> tuple[float, str | None]:
+    """How large the measured coupling torque before t_c is against the observer's prediction.
+
+    The observer of Eq. 15 predicts, from the angles, the torque the link exerts on the head
+    while the head turns in free motion; a recording in the format's units reads at least that
+    torque. The gain is the ratio of root-mean-square values over the samples up to t_c of the
+    measured dynamic torque m = Gamma - Gamma_g^m and the predicted one p = Gamma_e^m (Y^m and
+    Z^m, each less its mean): about 1 in free motion, more when the touch builds up torque
+    before t_c, 1/57 with angles in degrees (the observer then predicts 57 times the torque).
+    Only a gain below 1 / ``free_motion_gain_factor`` is a problem: the contact's torque before
+    t_c can only raise it, and torques too large are the rest reading's to find.
+
+    Parameters
+    ----------
+    theta : array, shape (n, 2)
+        Angles up to t_c (rad).
+    torque, predicted_torque : array, shape (n, 3)
+        Measured torque and the detector's Gamma_e^m + Gamma_g^m up to t_c (N m).
+    antenna : Antenna
+    cfg : EstimatorConfig
+
+    Returns
+    -------
+    (gain, problem) : tuple of float and str or None
+        NaN gain when the observer predicts no motion (nothing to compare); ``problem`` names
+        the columns and the gain.
+    """
+    gravity = antenna.gravity_torque(np.asarray(theta, dtype=float)[:, 1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        predicted = (np.asarray(predicted_torque, dtype=float) - gravity)[:, 1:]
+        measured = (np.asarray(torque, dtype=float) - gravity)[:, 1:]
+        # less their means: the sensor's offset is not the link's inertia
+        predicted_rms = float(np.sqrt(np.mean((predicted - predicted.mean(axis=0)) ** 2)))
+        measured_rms = float(np.sqrt(np.mean((measured - measured.mean(axis=0)) ** 2)))
+    if not (math.isfinite(predicted_rms) and predicted_rms > 0.0):
+        return math.nan, None
+    gain = measured_rms / predicted_rms
+    factor = cfg.free_motion_gain_factor
+    if not math.isfinite(gain) or gain >= 1.0 / factor:
+        return gain, None
+    return gain, (
+        f"columns 'theta1', 'theta2', 'ty', 'tz': the torque of the free motion before the "
+        f"contact is {gain:.3g} times what the observer predicts from the angles (at least "
+        f"1/{factor:g}): angles not in radians (degrees give 1/57)?"
+    )
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,293 @@
+"""The plausibility layer: what every method's estimate passes through before it may be ``ok``.
+
+:func:`~sensing_antenna.estimation.pipeline.conclude` hands each method's estimate here with the
+evidence it concluded from, offline and online alike, so ``paper``, ``ratio``,
+``two-frequency``, ``fast`` and any method registered later are judged by the same physics.
+Every check reads only the samples up to the estimate's own t_e, so the batch and the streaming
+forms agree.
+
+1. The recording's units and signs (``implausible_input``): the loads at rest before t_c
+   against the link's weight and the free motion against the observer (found by the front end
+   at t_c, ``Evidence.input_problem``), the angles up to t_e
+   (:func:`~sensing_antenna.units_check.angle_problem`), and the push against the head's turn
+   into the contact (an obstacle only pushes back).
+2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``).
+3. A real vibration: the fundamental omega_1 that the method measured, or, for a method that
+   measures none (``ratio``), Estimator 1 on the samples from t_1 to t_e, must be a clear peak
+   (``no_clear_peak``).
+4. One scale (``model_mismatch``): the vibration puts the contact at the point of the sensing
+   curve with that omega_1 (the nearest of its candidates); the front end's torque/force ratio at
+   t_e and the answer must lie within ``max_scale_mismatch`` of it, unless
+   ``disagreement_sigmas`` statistical uncertainties of the ratio (noise and tare, which do not
+   grow with the loads' scale) cover the difference. The frequency does
+   not depend on the scale of the loads, the ratio does: forces doubled halve the ratio, a
+   synthetic sine in the wrench matches no contact point with both.
+
+The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the method's own included;
+the rest go to ``diagnostics["other_reasons"]``. Whatever the status, a best guess outside
+(0, l] or not finite is not reported: x_c is NaN, as are the touched point and the interval, and
+the reason gives the dropped value. An interval is cut to the link [0, l] (the contact lies on
+it), or dropped when it is not finite or lies off the link; a touched point farther from the base
+than the link can reach is dropped.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from typing import Any
+
+import numpy as np
+
+from sensing_antenna.antenna import Link
+from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
+from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1
+from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
+from sensing_antenna.units_check import angle_problem
+
+__all__ = ["review"]
+
+_RANK = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
+
+
+def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
+    """The estimate after the plausibility checks (module docstring).
+
+    Parameters
+    ----------
+    evidence : Evidence
+        What the method concluded from.
+    estimate : ContactEstimate
+        The method's estimate; its ``t_e`` bounds the samples the checks read.
+
+    Returns
+    -------
+    ContactEstimate
+        The same estimate when every check passes and its guess lies on the link; otherwise the
+        status of the first problem, the others in ``diagnostics["other_reasons"]``.
+    """
+    link = evidence.antenna.link
+    end = _index_at(evidence, estimate.t_e)
+    notes: dict[str, Any] = {}
+    found: list[tuple[Status, str]] = []
+    if evidence.input_problem is not None:
+        found.append((Status.IMPLAUSIBLE_INPUT, evidence.input_problem))
+    angles = angle_problem(evidence.theta[: end + 1])
+    if angles is not None:
+        found.append((Status.IMPLAUSIBLE_INPUT, angles))
+    push = _push_direction_problem(evidence)
+    if push is not None:
+        found.append((Status.IMPLAUSIBLE_INPUT, push))
+    x_c = estimate.x_c
+    on_link = math.isfinite(x_c) and 0.0 < x_c <= link.length
+    if math.isfinite(x_c) and not on_link:
+        found.append(
+            (
+                Status.MODEL_MISMATCH,
+                f"x_c = {x_c:.4g} m lies outside the link, (0, {link.length:g}] m",
+            )
+        )
+    found.extend(_vibration_problems(evidence, estimate, end, notes))
+    interval = _on_link(estimate.interval, link.length)
+    point_ok = _within_reach(estimate.contact_point, evidence)
+    if not found and on_link:
+        if interval != estimate.interval:
+            notes["interval"] = interval
+        if not point_ok:
+            notes["contact_point"] = np.full(3, np.nan)
+        return _with_notes(estimate, notes)
+    problems = sorted(found, key=lambda item: _RANK[item[0]])
+    if estimate.status is not Status.OK:
+        assert estimate.reason is not None
+        problems.insert(0, (estimate.status, estimate.reason))
+        problems.sort(key=lambda item: _RANK[item[0]])
+    status, reason = problems[0] if problems else (Status.OK, None)
+    diagnostics = dict(estimate.diagnostics)
+    diagnostics.update(notes)
+    diagnostics["other_reasons"] = [text for _, text in problems[1:]] + list(
+        diagnostics.get("other_reasons", [])
+    )
+    changes: dict[str, Any] = {"status": status, "reason": reason, "diagnostics": diagnostics}
+    if not on_link:
+        # No guess off the link: neither the number, nor the point or interval built on it
+        if math.isfinite(x_c) and reason is not None and "lies outside the link" not in reason:
+            changes["reason"] = (
+                f"{reason}; best guess x_c = {x_c:.4g} m dropped: outside the link, "
+                f"(0, {link.length:g}] m"
+            )
+        changes.update(x_c=math.nan, contact_point=np.full(3, np.nan), interval=None)
+    else:
+        if interval != estimate.interval:
+            changes["interval"] = interval
+        if not point_ok:
+            changes["contact_point"] = np.full(3, np.nan)
+    kept = tuple(c for c in estimate.candidates if math.isfinite(c) and 0.0 < c <= link.length)
+    if kept != estimate.candidates:
+        changes["candidates"] = kept
+    return dataclasses.replace(estimate, **changes)
+
+
+def _push_direction_problem(evidence: Evidence) -> str | None:
+    """Why the push does not oppose the head's motion into the contact, or None.
+
+    An obstacle can only push back: from t_c to t_1 the head turns into it by dtheta, which moves
+    the link along d = (0, dtheta_1 cos theta_2, dtheta_2) in the motor frame (the azimuth about
+    Z^a moves X^m along cos theta_2 Y^m, the elevation along Z^m), and the mean reaction over the
+    hold must have R . d < 0 (Y^c = -Y^m for an azimuthal push, Section 5.4). A sign flipped in
+    one angle or in the forces turns it. Not judged when the head turned by less than the rest
+    tolerance.
+    """
+    theta = evidence.theta
+    turn = theta[evidence.rest_index] - theta[evidence.contact_index]
+    direction = np.array([0.0, turn[0] * math.cos(theta[evidence.rest_index, 1]), turn[1]])
+    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
+    if float(np.max(np.abs(turn))) <= tolerance:
+        return None
+    reaction = evidence.frame.reaction_m
+    if float(reaction @ direction) < 0.0:
+        return None
+    return (
+        f"columns 'theta1', 'theta2', 'fx', 'fy', 'fz': the mean contact force over the hold "
+        f"{_vector(reaction)} N does not oppose the head's turn into the contact "
+        f"({_vector(turn)} rad from t_c to t_1); an obstacle can only push back: a sign "
+        "flipped in an angle or in the forces?"
+    )
+
+
+def _vector(values: np.ndarray) -> str:
+    return "(" + ", ".join(f"{v:.3g}" for v in values) + ")"
+
+
+def _with_notes(estimate: ContactEstimate, notes: dict[str, Any]) -> ContactEstimate:
+    changes: dict[str, Any] = {}
+    for name in ("interval", "contact_point"):
+        if name in notes:
+            changes[name] = notes.pop(name)
+    if notes:
+        changes["diagnostics"] = {**estimate.diagnostics, **notes}
+    return dataclasses.replace(estimate, **changes) if changes else estimate
+
+
+def _within_reach(point: np.ndarray, evidence: Evidence) -> bool:
+    """Whether a touched point (m, absolute frame) can be a point of the link: within
+    l (1 + ``max_deflection_ratio``) of the base. An inextensible link reaches no farther than
+    l; the linear model adds the push deflection (at most that ratio of x_c under Assumption 1)
+    and the sag (6 % of l at the paper link's tip) across the link, 1.007 l at most together.
+    A point beyond comes from loads far outside the model (forces in mN: 20 m away). A point
+    not computed (NaN) stays as it is."""
+    if np.all(np.isnan(point)):
+        return True
+    reach = evidence.antenna.link.length * (1.0 + evidence.config.max_deflection_ratio)
+    with np.errstate(over="ignore", invalid="ignore"):
+        distance = float(np.linalg.norm(point))
+    return math.isfinite(distance) and distance <= reach
+
+
+def _on_link(interval: tuple[float, float] | None, length: float) -> tuple[float, float] | None:
+    """An interval (m) cut to the link [0, l]; None when not finite or off the link."""
+    if interval is None:
+        return None
+    low, high = interval
+    if not (math.isfinite(low) and math.isfinite(high)) or high < 0.0 or low > length:
+        return None
+    if 0.0 <= low and high <= length:
+        return interval
+    return (max(low, 0.0), min(high, length))
+
+
+def _index_at(evidence: Evidence, t_e: float) -> int:
+    """Index of the sample at ``t_e`` (s) in the evidence; its end when t_e is not known."""
+    if not math.isfinite(t_e):
+        return evidence.end_index
+    index = int(np.searchsorted(evidence.t, t_e))
+    return min(max(index, evidence.rest_index), evidence.end_index)
+
+
+def _vibration_problems(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> list[tuple[Status, str]]:
+    """Checks 3 and 4 of the module docstring."""
+    cfg = evidence.config
+    link = evidence.antenna.link
+    omega1 = estimate.omega1
+    if not math.isfinite(omega1):
+        # Estimator 1 over the samples from t_1 to the estimate's t_e (at most Delta t_e1)
+        stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
+        window = slice(evidence.rest_index, stop + 1)
+        measurement = measure_frequency(
+            evidence.torque[window],
+            evidence.frame.axes_m,
+            evidence.sample_period,
+            evidence.band,
+            cfg.min_peak_quality,
+            cfg.zero_padding,
+            t_start=float(evidence.t[window.start]),
+        )
+        notes["plausibility_omega1"] = measurement.omega1
+        notes["plausibility_peak_quality"] = measurement.quality
+        if not measurement.clear:
+            return [
+                (
+                    Status.NO_CLEAR_PEAK,
+                    f"no clear vibration of the link in contact: no spectral peak in "
+                    f"{evidence.band[0]:.1f} to {evidence.band[1]:.1f} rad/s reaches "
+                    f"{cfg.min_peak_quality:g} times the median power "
+                    f"(best {measurement.quality:.1f})",
+                )
+            ]
+        omega1 = measurement.omega1
+    candidates = _vibration_points(evidence, omega1)
+    found: list[tuple[Status, str]] = []
+    ratio = float(evidence.ratio_mean[end])
+    for value, what in ((ratio, "the torque/force ratio"), (estimate.x_c, "the answer")):
+        if not math.isfinite(value) or (what == "the answer" and not 0.0 < value <= link.length):
+            continue
+        nearest = min(candidates, key=lambda c: abs(c - value))
+        notes.setdefault("vibration_contact_point", nearest)
+        problem = _scale_problem(evidence, value, nearest, omega1)
+        if problem is not None:
+            found.append((Status.MODEL_MISMATCH, f"{what} {problem}"))
+    return found
+
+
+def _vibration_points(evidence: Evidence, omega1: float) -> tuple[float, ...]:
+    """Where the vibration puts the contact: the points of the sensing curve with ``omega1``
+    (rad/s), the nearest point when it lies above the curve, and the link's end l when the curve
+    falls towards the tip and ``omega1`` lies below its value there by less than
+    ``band_margin`` (a tip contact measured a little low has no exact point on the link)."""
+    cfg = evidence.config
+    link = evidence.antenna.link
+    x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
+    candidates, _ = candidates_from_omega1(link, omega1, x_range)
+    at_tip, falling = _tip(link)
+    if falling and at_tip / (1.0 + cfg.band_margin) <= omega1 < at_tip:
+        candidates = (*candidates, link.length)
+    return candidates
+
+
+@functools.lru_cache(maxsize=16)
+def _tip(link: Link) -> tuple[float, bool]:
+    """omega_1 (rad/s) of a contact at the tip, and whether the sensing curve falls there."""
+    curve = sensing_curve(link)
+    return float(curve.omega1(link.length)), float(curve.omega1_slope(link.length)) < 0.0
+
+
+def _scale_problem(evidence: Evidence, value: float, nearest: float, omega1: float) -> str | None:
+    """Why ``value`` (m) is not the contact point ``nearest`` (m) the vibration gives, or None."""
+    cfg = evidence.config
+    factor = cfg.max_scale_mismatch
+    quotient = value / nearest
+    if 1.0 / factor <= quotient <= factor:
+        return None
+    # Noise and tare only: the model term grows with the push, so with the push scaled too
+    sigma = evidence.ratio_uncertainty(nearest, model=False)
+    if abs(value - nearest) <= cfg.disagreement_sigmas * sigma:
+        return None
+    return (
+        f"{value:.4g} m is {quotient:.3g} times the contact point {nearest:.3f} m where the "
+        f"vibration (omega_1 = {omega1:.1f} rad/s) puts it (more than a factor {factor:g}, and "
+        f"{cfg.disagreement_sigmas:g} statistical uncertainties of the ratio, {sigma:.3f} m, "
+        "do not cover it): forces or torques scaled, or a wrench that is no contact?"
+    )
