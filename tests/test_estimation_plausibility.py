@@ -17,7 +17,16 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import Antenna, paper_antenna
-from sensing_antenna.estimation import METHODS, OnlineEstimator, Status, conclude, estimate, gather
+from sensing_antenna.detection.push import PushCriterion
+from sensing_antenna.estimation import (
+    METHODS,
+    Evidence,
+    OnlineEstimator,
+    Status,
+    conclude,
+    estimate,
+    gather,
+)
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate
 
@@ -223,6 +232,41 @@ def test_a_best_guess_past_the_tip_is_dropped_with_the_reason(
     assert np.all(np.isnan(result.contact_point))
     assert "outside the link" in (result.reason or "")
     assert result.ratio_estimate > antenna.link.length  # the raw reading stays a diagnostic
+
+
+@pytest.fixture(scope="module")
+def gentle_tip(antenna: Antenna) -> Recording:
+    # A contact at the very tip pushed gently (0.015 rad past the contact): the ratio's reading
+    # is noisy there and lands a few centimetres past the tip
+    push = PushCriterion("rotation", 0.015)
+    scenario = Scenario(case="azimuthal", contact_point=0.98, seed=5, push=push)
+    return simulate(antenna, scenario).without_ground_truth()
+
+
+def test_a_reading_just_past_the_tip_is_a_contact_at_the_tip(
+    gentle_tip: Recording, antenna: Antenna
+) -> None:
+    length = antenna.link.length
+    gathered = gather(gentle_tip, antenna)
+    result = conclude(gathered, "ratio")
+    past = result.diagnostics["x_c_past_tip"]
+    # within three statistical uncertainties of the ratio past the tip: the contact cannot lie
+    # beyond l, so the estimate constrained to the link is l
+    assert isinstance(gathered, Evidence)
+    assert length < past <= length + 3.0 * gathered.ratio_uncertainty(length, model=False)
+    assert result.status is Status.OK
+    assert result.x_c == length
+    assert abs(np.linalg.norm(result.contact_point) - length) < 0.1 * length
+
+
+def test_a_reading_well_past_the_tip_is_a_model_mismatch(
+    gentle_tip: Recording, antenna: Antenna
+) -> None:
+    # torques 20 % high (within the rest check's tolerance): the ratio reads 1.2 m
+    result = estimate(scaled(gentle_tip, torque=1.2), antenna, method="ratio")
+    assert result.status is Status.MODEL_MISMATCH
+    assert math.isnan(result.x_c)
+    assert "outside the link" in (result.reason or "")
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))

@@ -11,7 +11,14 @@ forms agree.
    at t_c, ``Evidence.input_problem``), the angles up to t_e
    (:func:`~sensing_antenna.units_check.angle_problem`), and the push against the head's turn
    into the contact (an obstacle only pushes back).
-2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``).
+2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``). An answer past the tip by
+   no more than ``disagreement_sigmas`` statistical uncertainties of the ratio at the tip (noise
+   and tare, :meth:`~.evidence.Evidence.ratio_uncertainty` without its model term, which grows
+   with the push and would admit any reading near the tip) is a contact at the tip measured a
+   little long: the contact cannot lie beyond l, so the estimate constrained to the link is l,
+   reported so (the method's own value in ``diagnostics["x_c_past_tip"]``, the touched point
+   recomputed at l from the hold's push, and the small-deflection limit judged there as the
+   methods judge it at their own x_c, ``slip_suspected``).
 3. A real vibration: the fundamental omega_1 that the method measured, or, for a method that
    measures none (``ratio``), Estimator 1 on the samples from t_1 to t_e, must be a clear peak
    (``no_clear_peak``).
@@ -44,6 +51,7 @@ from sensing_antenna.antenna import Link
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1
+from sensing_antenna.estimation.methods.touch_point import touched_point
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.units_check import angle_problem
 
@@ -80,6 +88,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     push = _push_direction_problem(evidence)
     if push is not None:
         found.append((Status.IMPLAUSIBLE_INPUT, push))
+    estimate, at_tip = _at_tip_when_just_past(evidence, estimate)
+    if at_tip is not None:
+        found.append((Status.SLIP_SUSPECTED, at_tip))
     x_c = estimate.x_c
     on_link = math.isfinite(x_c) and 0.0 < x_c <= link.length
     if math.isfinite(x_c) and not on_link:
@@ -127,6 +138,39 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if kept != estimate.candidates:
         changes["candidates"] = kept
     return dataclasses.replace(estimate, **changes)
+
+
+def _at_tip_when_just_past(
+    evidence: Evidence, estimate: ContactEstimate
+) -> tuple[ContactEstimate, str | None]:
+    """``estimate`` with x_c = l when it lies past the tip by no more than
+    ``disagreement_sigmas`` statistical uncertainties of the ratio at l (otherwise unchanged),
+    and why the deflection at l is beyond the small-deflection limit, or None."""
+    link = evidence.antenna.link
+    excess = estimate.x_c - link.length
+    if not (math.isfinite(excess) and excess > 0.0):
+        return estimate, None
+    sigma = evidence.ratio_uncertainty(link.length, model=False)
+    allowed = evidence.config.disagreement_sigmas * sigma
+    if not excess <= allowed:
+        return estimate, None
+    push = math.hypot(evidence.frame.reaction_m[1], evidence.frame.reaction_m[2])
+    touch = touched_point(link.length, evidence.frame, push, link)
+    diagnostics = {
+        **estimate.diagnostics,
+        "x_c_past_tip": estimate.x_c,
+        "deflection_ratio": touch.deflection_ratio,
+    }
+    at_tip = dataclasses.replace(
+        estimate, x_c=link.length, contact_point=touch.point_a, diagnostics=diagnostics
+    )
+    limit = evidence.config.max_deflection_ratio
+    if not touch.deflection_ratio > limit:
+        return at_tip, None
+    return at_tip, (
+        f"the static deflection at the tip is {100 * touch.deflection_ratio:.0f} % of l, beyond "
+        f"the {100 * limit:.0f} % small-deflection limit of Assumption 1"
+    )
 
 
 def _push_direction_problem(evidence: Evidence) -> str | None:
