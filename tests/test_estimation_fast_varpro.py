@@ -16,6 +16,7 @@ from scipy.optimize import least_squares
 
 from sensing_antenna.estimation.methods.fast.trust_region import (
     NOT_CONVERGED,
+    NOT_FINITE,
     bounded_levenberg_marquardt,
     free_parameters,
     trust_region_step,
@@ -147,6 +148,29 @@ def test_solver_reports_when_it_runs_out_of_evaluations() -> None:
         fixed, axes, starts, y, np.array([60.0, 1.0]), *bounds, 1e-12, 1e-12, 1e-12, 2
     )
     assert status == NOT_CONVERGED
+
+
+def test_solver_reports_a_start_whose_residual_is_not_finite() -> None:
+    # exp(-s t) overflows for s = -1e6 over a window of +-0.1 s: the solver returns the start
+    # unsolved with its own status, so a caller need not evaluate the start beforehand.
+    fixed, axes, starts = _layout(200, None)
+    y = np.ascontiguousarray(np.ones((200, 3)))
+    start = np.array([50.0, -1e6])
+    params, status = bounded_levenberg_marquardt(
+        fixed,
+        axes,
+        starts,
+        y,
+        start,
+        np.array([10.0, -2e6]),
+        np.array([3000.0, 300.0]),
+        1e-8,
+        1e-8,
+        1e-8,
+        100,
+    )
+    assert status == NOT_FINITE
+    np.testing.assert_array_equal(params, start)
 
 
 @pytest.mark.parametrize("restart", [None, 90, 0])

@@ -20,7 +20,7 @@ from sensing_antenna.estimation.methods.fast.parametric import (
     FitCandidate,
     fit_candidate,
 )
-from sensing_antenna.estimation.methods.fast.pencil import pencil_poles
+from sensing_antenna.estimation.methods.fast.pencil import StrengthMemo, pencil_poles
 
 __all__ = ["select_model", "select_model_order"]
 
@@ -109,6 +109,9 @@ def select_model(
         None when no degree and order could be fitted (record too short).
     """
     y = np.asarray(signals, dtype=float)
+    # The largest order of every degree starts from the same poles and weights, and the smaller
+    # orders of one degree from the same pencil and weights: their pole strengths once
+    memo: StrengthMemo = {}
     candidates = [
         candidate
         for degree in degrees
@@ -123,6 +126,7 @@ def select_model(
             poles,
             regressors,
             restart,
+            memo,
         )
     ]
     if not candidates:
@@ -141,8 +145,10 @@ def _order_candidates(
     poles: ComplexArray | None,
     regressors: FloatArray | None,
     restart: int | None,
+    memo: StrengthMemo,
 ) -> list[FitCandidate]:
-    """The solved fits of M = ``max_modes`` .. 1 at one degree (those the record allows)."""
+    """The solved fits of M = ``max_modes`` .. 1 at one degree (those the record allows);
+    ``memo`` as in :func:`.parametric.fit_candidate`."""
     candidates = []
     noise: FloatArray | None = None
     # The largest order that fits starts from ``poles`` (or its own pencil) and sets the noise;
@@ -161,6 +167,7 @@ def _order_candidates(
             target_band,
             regressors,
             restart,
+            memo=memo,
         )
         if noise is None:
             initial_poles = None  # the next order, if this one did not fit, starts from its own

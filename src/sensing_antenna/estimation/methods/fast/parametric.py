@@ -42,12 +42,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.estimation.methods.fast.pencil import (
+    StrengthMemo,
     difference_scale,
     first_poles,
     initial_modes,
     pencil_poles,
+    pole_strengths,
 )
-from sensing_antenna.estimation.methods.fast.trust_region import bounded_levenberg_marquardt
+from sensing_antenna.estimation.methods.fast.trust_region import (
+    NOT_FINITE,
+    bounded_levenberg_marquardt,
+)
 from sensing_antenna.estimation.methods.fast.varpro import (
     mode_columns,
     mode_derivatives,
@@ -330,8 +335,13 @@ def fit_candidate(
     regressors: FloatArray | None,
     restart: int | None,
     max_evaluations: int = _MAX_EVALUATIONS,
+    memo: StrengthMemo | None = None,
 ) -> FitCandidate | None:
-    """:func:`fit_damped_sinusoids` up to its solution and BIC, without the covariance."""
+    """:func:`fit_damped_sinusoids` up to its solution and BIC, without the covariance.
+
+    ``memo``: the pole strengths already computed for these signals
+    (:data:`.pencil.StrengthMemo`), filled with those computed here; None: computed afresh.
+    """
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
         y = y[:, None]
@@ -355,20 +365,28 @@ def fit_candidate(
         z = pencil_poles(y / scale, n_modes)
     if z is None:
         return None
-    start = initial_modes(y / scale, z, n_modes, sample_period, lower, upper, target_band)
     weighted = np.ascontiguousarray(y / scale)
-    if not np.all(np.isfinite(design.residual(start, weighted))):
-        return None
+    key = (scale.tobytes(), z.tobytes(), float(lower[0]))
+    strengths = None if memo is None else memo.get(key)
+    if strengths is None:
+        strengths = pole_strengths(weighted, z, sample_period, lower[0], target_band)
+        if memo is not None:
+            memo[key] = strengths
+    start = initial_modes(strengths, n_modes, lower, upper, target_band)
     bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
-    params, ok = _refine(start, design, weighted, bounds, max_evaluations)
+    params, status = _refine(start, design, weighted, bounds, max_evaluations)
+    if status == NOT_FINITE:
+        return None  # the model at the start is not finite (a mode's envelope overflows)
+    ok = status > 0
     if noise_std is None:
         residual = design.residual(params, weighted).reshape(n, k) * scale
         dof = max(n - n_linear - 2 * n_modes, 1)
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
-        params, ok = _refine(
+        params, status = _refine(
             params, design, np.ascontiguousarray(y / scale), bounds, max_evaluations
         )
+        ok = status > 0
     return _candidate(params, ok, design, y, scale, t_start, noise_std is None)
 
 
@@ -378,8 +396,9 @@ def _refine(
     weighted: FloatArray,
     bounds: tuple[FloatArray, FloatArray],
     max_evaluations: int,
-) -> tuple[FloatArray, bool]:
-    """The least-squares (w, s) from ``start`` and whether the solver converged."""
+) -> tuple[FloatArray, int]:
+    """The least-squares (w, s) from ``start`` and the solver's status (> 0 converged,
+    :data:`.trust_region.NOT_FINITE` when the residual at ``start`` is not finite)."""
     params, status = bounded_levenberg_marquardt(
         design.fixed,
         design.axes,
@@ -393,7 +412,7 @@ def _refine(
         gtol=_GTOL,
         max_evaluations=max_evaluations,
     )
-    return np.asarray(params, dtype=float), bool(status > 0)
+    return np.asarray(params, dtype=float), int(status)
 
 
 @dataclass(frozen=True)
