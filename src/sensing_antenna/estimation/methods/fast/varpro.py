@@ -41,24 +41,45 @@ __all__ = [
 ]
 
 
+#: Samples between direct evaluations of a mode column (:func:`mode_columns`): between them
+#: the column is carried by a complex product, whose relative rounding error grows by about
+#: 1e-16 per sample, so it stays below about 1e-14 of the envelope.
+_ANCHOR = 64
+
+
 @njit(cache=True)
 def mode_columns(
     fixed: FloatArray, axes: FloatArray, starts: IntArray, params: FloatArray
 ) -> FloatArray:
-    """Every column of the model at (w, s), shape (n, F + 2 M A)."""
+    """Every column of the model at (w, s), shape (n, F + 2 M A); each axis evenly spaced.
+
+    exp((-s + i w) t) is carried from sample to sample by the factor exp((-s + i w) dt), one
+    complex product instead of an exponential, a cosine and a sine per sample, and evaluated
+    directly every :data:`_ANCHOR` samples.
+    """
     n, n_fixed = fixed.shape
     n_modes = params.size // 2
     out = np.zeros((n, n_fixed + 2 * n_modes * axes.shape[0]))
     out[:, :n_fixed] = fixed
     for a in range(axes.shape[0]):
         first = n_fixed + 2 * n_modes * a
+        dt = axes[a, 1] - axes[a, 0] if n > 1 else 0.0
         for j in range(n_modes):
             omega, decay = params[2 * j], params[2 * j + 1]
+            # exp((-s + i w) dt)
+            step_re = math.exp(-decay * dt) * math.cos(omega * dt)
+            step_im = math.exp(-decay * dt) * math.sin(omega * dt)
+            re = im = 0.0
             for i in range(starts[a], n):
-                t = axes[a, i]
-                envelope = math.exp(-decay * t)
-                out[i, first + 2 * j] = envelope * math.cos(omega * t)
-                out[i, first + 2 * j + 1] = envelope * math.sin(omega * t)
+                if (i - starts[a]) % _ANCHOR == 0:
+                    t = axes[a, i]
+                    envelope = math.exp(-decay * t)
+                    re = envelope * math.cos(omega * t)
+                    im = envelope * math.sin(omega * t)
+                else:
+                    re, im = re * step_re - im * step_im, re * step_im + im * step_re
+                out[i, first + 2 * j] = re
+                out[i, first + 2 * j + 1] = im
     return out
 
 
@@ -155,14 +176,22 @@ def kaufman_jacobian(
     coef: FloatArray,
 ) -> FloatArray:
     """Kaufman's approximation of the residual's Jacobian, -(I - Q Q^T) dPhi_j C (Kaufman
-    1975), shape (n K, 2M), rows in the residual's order; from :func:`projection`'s parts."""
+    1975), shape (n K, 2M), rows in the residual's order; from :func:`projection`'s parts.
+    Every derivative is projected in one pair of matrix products (columns p K + k)."""
     derivatives = mode_derivatives(columns, axes, starts, n_fixed, coef)
-    n_channels = coef.shape[1]
-    qt = np.ascontiguousarray(q.T)
-    jacobian = np.empty((columns.shape[0] * n_channels, derivatives.shape[0]))
-    for p in range(derivatives.shape[0]):
-        column = derivatives[p] - q @ (qt @ derivatives[p])
-        jacobian[:, p] = -column.ravel()
+    n_par, n, n_channels = derivatives.shape
+    stacked = np.empty((n, n_par * n_channels))
+    for p in range(n_par):
+        for i in range(n):
+            for k in range(n_channels):
+                stacked[i, p * n_channels + k] = derivatives[p, i, k]
+    projected = q @ (np.ascontiguousarray(q.T) @ stacked)
+    jacobian = np.empty((n * n_channels, n_par))
+    for i in range(n):
+        for k in range(n_channels):
+            for p in range(n_par):
+                column = p * n_channels + k
+                jacobian[i * n_channels + k, p] = projected[i, column] - stacked[i, column]
     return jacobian
 
 
