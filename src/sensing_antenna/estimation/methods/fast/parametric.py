@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from sensing_antenna.estimation.methods.fast.design import ModelDesign
 from sensing_antenna.estimation.methods.fast.pencil import (
     StrengthMemo,
     difference_scale,
@@ -52,11 +53,6 @@ from sensing_antenna.estimation.methods.fast.pencil import (
 from sensing_antenna.estimation.methods.fast.trust_region import (
     NOT_FINITE,
     bounded_levenberg_marquardt,
-)
-from sensing_antenna.estimation.methods.fast.varpro import (
-    mode_columns,
-    mode_derivatives,
-    projected_residual,
 )
 
 __all__ = ["DampedSinusoidFit", "FitCandidate", "fit_candidate", "fit_damped_sinusoids"]
@@ -168,88 +164,6 @@ class DampedSinusoidFit:
         return int(inside[np.argmax(self.snr()[inside])])
 
 
-class _Design:
-    """The columns of one window's model: polynomial, regressors, then the modes.
-
-    Columns: tau^0 .. tau^degree, the ``regressors`` (centred on t_ref), then per mode
-    exp(-s tau) cos(w tau), exp(-s tau) sin(w tau); with a ``restart`` index, per mode also the
-    same pair started at that sample (time from it, zero before): a change of the modes'
-    amplitudes and phases there, as an impulsive load on the structure makes (the head stopping).
-    The mode columns are computed by the compiled kernels of :mod:`.varpro` (``axes``, ``starts``:
-    its layout).
-    """
-
-    def __init__(
-        self,
-        n: int,
-        sample_period: float,
-        degree: int,
-        regressors: FloatArray | None = None,
-        restart: int | None = None,
-    ) -> None:
-        self.tau: FloatArray = (np.arange(n, dtype=float) - 0.5 * (n - 1)) * sample_period
-        self.sample_period = sample_period
-        self.degree = degree
-        fixed = [self.tau[:, None] ** j for j in range(degree + 1)]
-        if regressors is not None:
-            r = np.asarray(regressors, dtype=float).reshape(n, -1)
-            # zero at t_ref, so the constant term stays the static load at the window centre
-            fixed.append(r - 0.5 * (r[(n - 1) // 2] + r[n // 2]))
-        self.fixed: FloatArray = np.ascontiguousarray(np.hstack(fixed))
-        self.restart = restart
-        # Time axis of each column pair and the sample from which it is on: the window, then
-        # the restart's (time from the restart sample)
-        axes, starts = [self.tau], [0]
-        if restart is not None:
-            axes.append((np.arange(n, dtype=float) - restart) * sample_period)
-            starts.append(restart)
-        self.axes: FloatArray = np.vstack(axes)
-        self.starts: NDArray[np.int64] = np.array(starts, dtype=np.int64)
-
-    @property
-    def n_fixed(self) -> int:
-        """Columns that do not depend on (w, s)."""
-        return int(self.fixed.shape[1])
-
-    def n_linear(self, n_modes: int) -> int:
-        """Columns of the model with ``n_modes`` modes (one column pair per mode and time axis)."""
-        return self.n_fixed + 2 * self.axes.shape[0] * n_modes
-
-    def basis(self, params: FloatArray) -> FloatArray:
-        """All columns at (w, s), shape (n, n_linear)."""
-        return np.asarray(mode_columns(self.fixed, self.axes, self.starts, params), dtype=float)
-
-    def derivative_times_coef(self, columns: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
-        """d(basis @ coef) / d(w_j, s_j), shape (2M, n, K), from the basis ``columns`` at (w, s):
-        only mode j's columns depend on them."""
-        derivatives = mode_derivatives(
-            columns, self.axes, self.starts, self.n_fixed, np.ascontiguousarray(coef, dtype=float)
-        )
-        return np.asarray(derivatives, dtype=float)
-
-    def residual(self, params: FloatArray, weighted: FloatArray) -> FloatArray:
-        """Residual of ``weighted`` (n, K) after the linear least-squares solve, flattened."""
-        residual = projected_residual(self.fixed, self.axes, self.starts, params, weighted)
-        return np.asarray(residual, dtype=float)
-
-    def free_amplitudes(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
-        """Amplitude at t_ref of each mode's vibration after the restart (or of the only one),
-        shape (K, M): the restarted pair carried to the origin tau = 0 and added."""
-        m = params.size // 2
-        first = self.n_fixed
-        a, b = coef[first : first + 2 * m : 2], coef[first + 1 : first + 2 * m : 2]
-        if self.axes.shape[0] > 1:
-            omega, decay = params[0::2][:, None], params[1::2][:, None]
-            lag = float(self.tau[0] - self.axes[1, 0])  # t_restart - t_ref
-            second = first + 2 * m
-            a2, b2 = coef[second : second + 2 * m : 2], coef[second + 1 : second + 2 * m : 2]
-            gain = np.exp(decay * lag)
-            cos_lag, sin_lag = np.cos(omega * lag), np.sin(omega * lag)
-            a = a + gain * (a2 * cos_lag - b2 * sin_lag)
-            b = b + gain * (a2 * sin_lag + b2 * cos_lag)
-        return np.asarray(np.hypot(a, b).T, dtype=float)
-
-
 def fit_damped_sinusoids(
     signals: FloatArray,
     sample_period: float,
@@ -346,7 +260,7 @@ def fit_candidate(
     if y.ndim == 1:
         y = y[:, None]
     n, k = y.shape
-    design = _Design(n, sample_period, degree, regressors, restart)
+    design = ModelDesign(n, sample_period, degree, regressors, restart)
     n_linear = design.n_linear(n_modes)
     if n < 3 * (n_linear + 2 * n_modes):
         return None
@@ -392,7 +306,7 @@ def fit_candidate(
 
 def _refine(
     start: FloatArray,
-    design: _Design,
+    design: ModelDesign,
     weighted: FloatArray,
     bounds: tuple[FloatArray, FloatArray],
     max_evaluations: int,
@@ -425,8 +339,8 @@ class FitCandidate:
         The solution, interleaved (w_m rad/s, s_m 1/s).
     converged : bool
         The solver's flag (:meth:`summary` also needs a finite covariance).
-    design : _Design
-        The window's model columns.
+    design : ModelDesign
+        The window's model columns (:mod:`.design`).
     y : array, shape (n, K)
         The unweighted signals.
     basis : array, shape (n, L)
@@ -444,7 +358,7 @@ class FitCandidate:
 
     params: FloatArray
     converged: bool
-    design: _Design
+    design: ModelDesign
     y: FloatArray
     basis: FloatArray
     coef: FloatArray
@@ -512,7 +426,7 @@ class FitCandidate:
 def _candidate(
     params: FloatArray,
     converged: bool,
-    design: _Design,
+    design: ModelDesign,
     y: FloatArray,
     scale: FloatArray,
     t_start: float,
