@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.estimation.methods.fast.varpro import (
+    linear_fit,
     mode_columns,
     mode_derivatives,
     projected_residual,
@@ -74,6 +75,21 @@ class ModelDesign:
     def basis(self, params: FloatArray) -> FloatArray:
         """All columns at (w, s), shape (n, n_linear)."""
         return np.asarray(mode_columns(self.fixed, self.axes, self.starts, params), dtype=float)
+
+    def linear_fit(
+        self, params: FloatArray, signals: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The columns at (w, s) (n, n_linear), the least-squares coefficients of ``signals``
+        (n, K) on them (n_linear, K) and the residual (n, K), in one compiled call
+        (:func:`.varpro.linear_fit`)."""
+        columns, coef, residual = linear_fit(
+            self.fixed, self.axes, self.starts, params, np.ascontiguousarray(signals, dtype=float)
+        )
+        return (
+            np.asarray(columns, dtype=float),
+            np.asarray(coef, dtype=float),
+            np.asarray(residual, dtype=float),
+        )
 
     def derivative_times_coef(self, columns: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
         """d(basis @ coef) / d(w_j, s_j), shape (2M, n, K), from the basis ``columns`` at (w, s):

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from sensing_antenna.estimation.methods.fast.design import ModelDesign
 from sensing_antenna.estimation.methods.fast.parametric import (
     DampedSinusoidFit,
     FitCandidate,
@@ -151,6 +152,7 @@ def _order_candidates(
     ``memo`` as in :func:`.parametric.fit_candidate`."""
     candidates = []
     noise: FloatArray | None = None
+    design = ModelDesign(y.shape[0], sample_period, degree, regressors, restart)
     # The largest order that fits starts from ``poles`` (or its own pencil) and sets the noise;
     # the smaller ones start from the pencil of the signals weighted by that noise
     initial_poles = poles
@@ -168,6 +170,7 @@ def _order_candidates(
             regressors,
             restart,
             memo=memo,
+            design=design,
         )
         if noise is None:
             initial_poles = None  # the next order, if this one did not fit, starts from its own

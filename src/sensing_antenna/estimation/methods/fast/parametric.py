@@ -250,17 +250,21 @@ def fit_candidate(
     restart: int | None,
     max_evaluations: int = _MAX_EVALUATIONS,
     memo: StrengthMemo | None = None,
+    design: ModelDesign | None = None,
 ) -> FitCandidate | None:
     """:func:`fit_damped_sinusoids` up to its solution and BIC, without the covariance.
 
     ``memo``: the pole strengths already computed for these signals
     (:data:`.pencil.StrengthMemo`), filled with those computed here; None: computed afresh.
+    ``design``: the model's columns for these samples, ``degree``, ``regressors`` and
+    ``restart`` when already built (they do not depend on the number of modes).
     """
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
         y = y[:, None]
     n, k = y.shape
-    design = ModelDesign(n, sample_period, degree, regressors, restart)
+    if design is None:
+        design = ModelDesign(n, sample_period, degree, regressors, restart)
     n_linear = design.n_linear(n_modes)
     if n < 3 * (n_linear + 2 * n_modes):
         return None
@@ -436,9 +440,7 @@ def _candidate(
     ``scale_from_residuals``, else ``scale``)."""
     n, k = y.shape
     m = params.size // 2
-    basis = design.basis(params)
-    coef = np.asarray(np.linalg.lstsq(basis, y, rcond=None)[0], dtype=np.float64)
-    residual = y - basis @ coef
+    basis, coef, residual = design.linear_fit(params, y)
     n_linear = basis.shape[1]
     dof = max(n - n_linear - 2 * m, 1)
     noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale

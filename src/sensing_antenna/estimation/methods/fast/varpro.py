@@ -33,6 +33,7 @@ IntArray = NDArray[np.int64]
 
 __all__ = [
     "kaufman_jacobian",
+    "linear_fit",
     "mode_columns",
     "mode_derivatives",
     "projected_residual",
@@ -155,6 +156,17 @@ def projection(
         projected = np.ascontiguousarray(q.T) @ weighted
         coef = np.ascontiguousarray(vt[keep].T) @ (projected / singular[keep].reshape(-1, 1))
     return columns, q, coef, weighted - q @ projected
+
+
+@njit(cache=True)
+def linear_fit(
+    fixed: FloatArray, axes: FloatArray, starts: IntArray, params: FloatArray, signals: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The columns at (w, s) (n, P), the least-squares coefficients of ``signals`` (n, K) on
+    them (P, K; minimum norm when the columns are dependent, as ``numpy.linalg.lstsq``) and
+    the residual (n, K): :func:`projection` without its orthonormal basis."""
+    columns, _, coef, residual = projection(fixed, axes, starts, params, signals)
+    return columns, coef, residual
 
 
 @njit(cache=True)
