@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from threadpoolctl import threadpool_info, threadpool_limits
 
 from sensing_antenna.antenna import FreeMotionObserver, paper_antenna
 from sensing_antenna.beam import natural_frequencies
@@ -341,6 +342,34 @@ def test_window_shorter_than_the_model_is_not_sure() -> None:
     window = evaluate_window(channels, NO_BIAS, 0, 30, TS, BAND, LINK, X_RANGE, FastConfig())
     assert not window.sure
     assert window.note
+
+
+def _blas_threads() -> int:
+    return max(lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas")
+
+
+def test_a_window_is_fitted_with_one_blas_thread_whatever_the_process_allows(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The fits multiply matrices of a few hundred rows by ten to twenty columns: more BLAS
+    # threads only contend for the cores. With two allowed to the process, the matrix pencil
+    # inside every fit (numpy's eigvals, which the method calls nowhere else) must see one,
+    # and the process gets its two back after the fit.
+    channels = _channels(0.6, 300, np.random.default_rng(3), 0.2)
+    seen: list[int] = []
+    eigvals = np.linalg.eigvals
+
+    def spy(matrix: Any) -> Any:
+        seen.append(_blas_threads())
+        return eigvals(matrix)
+
+    monkeypatch.setattr(np.linalg, "eigvals", spy)
+    with threadpool_limits(limits=2, user_api="blas"):
+        if _blas_threads() < 2:
+            pytest.skip("this process's BLAS was started with one thread")
+        evaluate_window(channels, NO_BIAS, 0, 299, TS, BAND, LINK, X_RANGE, FastConfig())
+        assert _blas_threads() == 2
+    assert seen and set(seen) == {1}
 
 
 def test_config_errors_name_the_field() -> None:

@@ -1,23 +1,26 @@
 """One window's fit: the contact-load channels fitted, and the fundamental measured in it.
 
 A window [t_s, t_j] of the five contact-load channels (:mod:`.static_fit`) is fitted with
-damped sinusoids with shared poles plus a polynomial per channel (:func:`.parametric.select_model`,
-order and degree by BIC). With the push phase (``FastConfig.push_phase``) the window reaches back
-to t_c, with the head's angle along the push as a regressor and every mode restarted at t_1.
-Fits are cached by the window's own samples (:data:`FitCache`), so a cache never serves a fit
-of other data. :func:`measure_fundamental` finds the fundamental in the fit and widens its
-standard error by the drift check (:func:`.checks.drift_check`) against the grid window of 2/3
-the length.
+damped sinusoids with shared poles plus a polynomial per channel
+(:func:`.model_order.select_model`, order and degree by BIC), with one BLAS thread whatever the
+process allows. With the push phase (``FastConfig.push_phase``) the window reaches back to t_c,
+with the head's angle along the push as a regressor and every mode restarted at t_1. Fits are
+cached by the window's own samples (:data:`FitCache`), so a cache never serves a fit of other
+data. :func:`measure_fundamental` finds the fundamental in the fit and widens its standard
+error by the drift check (:func:`.checks.drift_check`) against the grid window of 2/3 the
+length.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
+from threadpoolctl import ThreadpoolController
 
 from sensing_antenna.estimation.methods.fast.checks import drift_check, periods_check
 from sensing_antenna.estimation.methods.fast.config import FastConfig
@@ -134,22 +137,35 @@ def fit_window(
     # The matrix pencil every degree starts from, computed once: where the lowest degree's
     # largest model order fits the record (otherwise each fit computes its own)
     fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * max_modes)
-    poles = first_poles(signals, max_modes) if fits_at_all else None
-    fit = select_model(
-        signals,
-        sample_period,
-        max_modes,
-        range(lowest, highest + 1),
-        start * sample_period,
-        min_omega=config.min_mode_fraction * band[0],
-        target_band=band,
-        poles=poles,
-        regressors=None if push is None else push.angle[start : end_index + 1],
-        restart=None if push is None else rest_index - start,
-    )
+    # One BLAS thread for the fit's small matrices (a few hundred rows by ten to twenty
+    # columns): more threads only contend for the cores and spin, the more so when the
+    # process or the machine already runs one thread per core
+    with _blas_libraries().limit(limits=1, user_api="blas"):
+        poles = first_poles(signals, max_modes) if fits_at_all else None
+        fit = select_model(
+            signals,
+            sample_period,
+            max_modes,
+            range(lowest, highest + 1),
+            start * sample_period,
+            min_omega=config.min_mode_fraction * band[0],
+            target_band=band,
+            poles=poles,
+            regressors=None if push is None else push.angle[start : end_index + 1],
+            restart=None if push is None else rest_index - start,
+        )
     if cache is not None:
         cache[key] = fit
     return fit
+
+
+@functools.cache
+def _blas_libraries() -> ThreadpoolController:
+    """The BLAS libraries loaded in this process, found once, when a fit first needs them:
+    numpy's, and scipy's, whose LAPACK the compiled solver calls."""
+    import scipy.linalg  # noqa: F401  (loads scipy's BLAS, so the controller sees it)
+
+    return ThreadpoolController()
 
 
 def find_fundamental(
