@@ -17,7 +17,6 @@ from sensing_antenna.estimation.methods.fast.varpro import (
     linear_fit,
     mode_columns,
     mode_derivatives,
-    projected_residual,
 )
 
 __all__ = ["ModelDesign"]
@@ -98,11 +97,6 @@ class ModelDesign:
             columns, self.axes, self.starts, self.n_fixed, np.ascontiguousarray(coef, dtype=float)
         )
         return np.asarray(derivatives, dtype=float)
-
-    def residual(self, params: FloatArray, weighted: FloatArray) -> FloatArray:
-        """Residual of ``weighted`` (n, K) after the linear least-squares solve, flattened."""
-        residual = projected_residual(self.fixed, self.axes, self.starts, params, weighted)
-        return np.asarray(residual, dtype=float)
 
     def free_amplitudes(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
         """Amplitude at t_ref of each mode's vibration after the restart (or of the only one),

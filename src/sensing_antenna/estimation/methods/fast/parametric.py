@@ -262,7 +262,7 @@ def fit_candidate(
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
         y = y[:, None]
-    n, k = y.shape
+    n = y.shape[0]
     if design is None:
         design = ModelDesign(n, sample_period, degree, regressors, restart)
     n_linear = design.n_linear(n_modes)
@@ -297,7 +297,7 @@ def fit_candidate(
         return None  # the model at the start is not finite (a mode's envelope overflows)
     ok = status > 0
     if noise_std is None:
-        residual = design.residual(params, weighted).reshape(n, k) * scale
+        residual = design.linear_fit(params, weighted)[2] * scale
         dof = max(n - n_linear - 2 * n_modes, 1)
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
