@@ -31,6 +31,8 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
+_EPS = float(np.finfo(np.float64).eps)
+
 __all__ = [
     "kaufman_jacobian",
     "linear_fit",
@@ -143,18 +145,31 @@ def projection(
         nan_coef = np.full((size, weighted.shape[1]), np.nan)
         return columns, np.empty((n, 0)), nan_coef, np.full(weighted.shape, np.inf)
     q, r = np.linalg.qr(columns)
-    tolerance = max(n, size) * np.finfo(np.float64).eps
-    largest_norm = math.sqrt(np.max(np.sum(columns**2, axis=0)))
-    if np.abs(np.diag(r)).min() > tolerance * largest_norm:
+    tolerance = max(n, size) * _EPS
+    # Plain loops and slices rather than reductions and boolean masks: the same numbers, and a
+    # shorter first compilation
+    largest_norm = 0.0
+    for j in range(size):
+        largest_norm = max(largest_norm, math.sqrt(np.sum(columns[:, j] ** 2)))
+    smallest_pivot = math.inf
+    for j in range(size):
+        smallest_pivot = min(smallest_pivot, abs(r[j, j]))
+    if smallest_pivot > tolerance * largest_norm:
         q = np.ascontiguousarray(q)
         projected = np.ascontiguousarray(q.T) @ weighted
         coef = _back_substitution(r, projected)
     else:
         u, singular, vt = np.linalg.svd(columns, full_matrices=False)
-        keep = singular > tolerance * singular[0]
-        q = np.ascontiguousarray(u[:, keep])
+        # The singular values descend: the directions kept are the leading ones
+        rank = 0
+        while rank < singular.size and singular[rank] > tolerance * singular[0]:
+            rank += 1
+        q = np.ascontiguousarray(u[:, :rank])
         projected = np.ascontiguousarray(q.T) @ weighted
-        coef = np.ascontiguousarray(vt[keep].T) @ (projected / singular[keep].reshape(-1, 1))
+        scaled = projected.copy()
+        for i in range(rank):
+            scaled[i] /= singular[i]
+        coef = np.ascontiguousarray(vt[:rank].T) @ scaled
     return columns, q, coef, weighted - q @ projected
 
 
