@@ -67,10 +67,16 @@ _MAX_WINDOW_DECAY = 20.0
 #: Smallest decay rate (1/s): slight growth is allowed (a fit on a short record may need it), more
 #: is not physical for a passive link.
 _MIN_DECAY = -20.0
-#: Solver tolerances (the defaults of scipy's least_squares): relative steps of 1e-8 are 1e-5
-#: of the smallest standard error of omega_1 (~1e-3); cost changes of 1e-8 relative; scaled
-#: gradient 1e-8; at most 100 residual evaluations per solve.
-_XTOL = _FTOL = _GTOL = 1e-8
+#: Solver tolerances. Relative steps of 1e-8 (scipy's least_squares' default) are 1e-5 of the
+#: smallest standard error of omega_1 (~1e-3 relative); scaled gradient 1e-8; at most 100
+#: residual evaluations per solve. A solve ends when an accepted step lowers the cost by less
+#: than 1e-6 of it: in the noise-weighted units the cost is about n K / 2, and a parameter
+#: delta standard errors from the minimum adds delta^2 / 2 to it, so what such a step leaves
+#: is a change of at most sqrt(1e-6 n K) standard errors, 0.07 on the longest window (1 s,
+#: five channels). The fundamental settles in the first steps; the last ones polish the weak
+#: modes' decay rates, where the solver converges linearly (a few tenths of the rest per step).
+_XTOL = _GTOL = 1e-8
+_FTOL = 1e-6
 _MAX_EVALUATIONS = 100
 
 
