@@ -381,6 +381,8 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(first_window=1.0, cap=0.5)
     with pytest.raises(FastConfigError, match="push_polynomial_degree"):
         FastConfig(push_polynomial_degree=-1)
+    with pytest.raises(FastConfigError, match="warm_start_after"):
+        FastConfig(warm_start_after=-0.1)
 
 
 def test_cli_json_has_interval_and_branch_probability(
@@ -836,6 +838,25 @@ def test_the_scan_concludes_on_the_first_sure_window_with_its_slip_reference(
         assert final.early_statics is not None
         assert final.early_statics.ratio == fresh.early_statics.ratio
         assert np.array_equal(final.early_statics.reaction_perp, fresh.early_statics.reaction_perp)
+
+
+def test_windows_started_warm_declare_what_windows_started_from_the_pencil_declare(
+    azimuthal: Recording, azimuthal_estimate: ContactEstimate
+) -> None:
+    # An easy recording (azimuthal 0.6 m): the windows after the hold fitted from the solutions
+    # of their drift references (the default) and from the matrix pencil (warm_start_after 0)
+    # reach nearly the same optimum: omega_1 differs (another start) by a fraction of its
+    # standard error, and both declarations are ok, each x_c inside the other's interval and
+    # both intervals holding the simulator's contact point.
+    cold = estimate(azimuthal, paper_antenna(), FastMethod(FastConfig(warm_start_after=0.0)))
+    warm = azimuthal_estimate
+    truth = float(azimuthal.metadata["true_xc"])
+    assert warm.omega1 != cold.omega1
+    assert abs(warm.omega1 - cold.omega1) < 0.1 * cold.diagnostics["omega1_se"]
+    for one, other in ((warm, cold), (cold, warm)):
+        assert one.status is Status.OK and one.interval is not None
+        low, high = one.interval
+        assert low <= other.x_c <= high and low <= truth <= high
 
 
 def test_a_session_never_serves_the_fits_of_other_samples(

@@ -54,6 +54,7 @@ from sensing_antenna.estimation.methods.fast.trust_region import (
     NOT_FINITE,
     bounded_levenberg_marquardt,
 )
+from sensing_antenna.estimation.methods.fast.warm_start import start_inside
 
 __all__ = ["DampedSinusoidFit", "FitCandidate", "fit_candidate", "fit_damped_sinusoids"]
 
@@ -257,6 +258,7 @@ def fit_candidate(
     max_evaluations: int = _MAX_EVALUATIONS,
     memo: StrengthMemo | None = None,
     design: ModelDesign | None = None,
+    warm: tuple[FloatArray, FloatArray] | None = None,
 ) -> FitCandidate | None:
     """:func:`fit_damped_sinusoids` up to its solution and BIC, without the covariance.
 
@@ -264,6 +266,9 @@ def fit_candidate(
     (:data:`.pencil.StrengthMemo`), filled with those computed here; None: computed afresh.
     ``design``: the model's columns for these samples, ``degree``, ``regressors`` and
     ``restart`` when already built (they do not depend on the number of modes).
+    ``warm``: the (w, s) to start from and the channel noise to weight with when ``noise_std``
+    is not given (the solution of the same model on a shorter window of the same record,
+    :mod:`.warm_start`): one solve from there instead of two from the matrix pencil.
     """
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
@@ -276,6 +281,16 @@ def fit_candidate(
         return None
     lower = np.array([max(min_omega, 1e-3), _MIN_DECAY])
     upper = np.array([math.pi / sample_period, _MAX_WINDOW_DECAY / ((n - 1) * sample_period)])
+    bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
+    if warm is not None:
+        scale = np.asarray(warm[1] if noise_std is None else noise_std, dtype=float)
+        start = start_inside(warm[0], lower, upper)
+        params, status = _refine(
+            start, design, np.ascontiguousarray(y / scale), bounds, max_evaluations
+        )
+        if status == NOT_FINITE:
+            return None
+        return _candidate(params, status > 0, design, y, scale, t_start, noise_std is None)
     if noise_std is None:
         scale = difference_scale(y)
     else:
@@ -297,7 +312,6 @@ def fit_candidate(
         if memo is not None:
             memo[key] = strengths
     start = initial_modes(strengths, n_modes, lower, upper, target_band)
-    bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
     params, status = _refine(start, design, weighted, bounds, max_evaluations)
     if status == NOT_FINITE:
         return None  # the model at the start is not finite (a mode's envelope overflows)
