@@ -383,6 +383,8 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(push_polynomial_degree=-1)
     with pytest.raises(FastConfigError, match="warm_start_after"):
         FastConfig(warm_start_after=-0.1)
+    with pytest.raises(FastConfigError, match="long_window_min_modes"):
+        FastConfig(long_window_min_modes=0)
 
 
 def test_cli_json_has_interval_and_branch_probability(

@@ -182,6 +182,11 @@ class FastConfig:
         this. 0: every window from the pencil. Windows through the push (``push_phase``) always
         start from the pencil: their reference holds relatively more of the touch's ringing,
         and a start from it can settle in a worse optimum.
+    long_window_min_modes : int
+        Fewest damped modes tried on the windows that start warm (``warm_start_after``);
+        shorter windows try from one. 2: the touch and the stop excite contact modes 2 and 3
+        as well as the fundamental, so on windows that long the BIC almost never chooses a
+        single mode, and each order costs a fit at every degree.
     """
 
     tolerance: float = 0.005
@@ -212,6 +217,7 @@ class FastConfig:
     push_max_modes: int = 3
     push_polynomial_degree: int = 2
     warm_start_after: float = 0.2
+    long_window_min_modes: int = 2
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -220,7 +226,7 @@ class FastConfig:
                 if not isinstance(value, bool):
                     raise FastConfigError(f"{f.name}: must be true or false, got {value!r}")
                 continue
-            counts = ("max_modes", "bias_min_samples", "push_max_modes")
+            counts = ("max_modes", "bias_min_samples", "push_max_modes", "long_window_min_modes")
             degrees = ("polynomial_degree", "push_polynomial_degree")
             if f.name in counts + degrees:
                 low = 0 if f.name in degrees else 1

@@ -136,8 +136,10 @@ def select_model_solutions(
     regressors: FloatArray | None = None,
     restart: int | None = None,
     warm: Solutions | None = None,
+    min_modes: int = 1,
 ) -> tuple[DampedSinusoidFit | None, Solutions]:
-    """:func:`select_model`, with every candidate's solution (:data:`.warm_start.Solutions`).
+    """:func:`select_model` over M = ``min_modes`` .. ``max_modes``, with every candidate's
+    solution (:data:`.warm_start.Solutions`).
 
     Each (degree, number of modes) found in ``warm`` (the solutions of a shorter window of the
     same record) starts from there, with one solve, the largest order weighted by the noise
@@ -164,6 +166,7 @@ def select_model_solutions(
             restart,
             memo,
             warm or {},
+            min_modes,
         )
     ]
     solutions = {(c.design.degree, c.params.size // 2): (c.params, c.noise) for c in candidates}
@@ -185,9 +188,10 @@ def _order_candidates(
     restart: int | None,
     memo: StrengthMemo,
     warm: Solutions,
+    min_modes: int = 1,
 ) -> list[FitCandidate]:
-    """The solved fits of M = ``max_modes`` .. 1 at one degree (those the record allows);
-    ``memo`` as in :func:`.parametric.fit_candidate`, ``warm`` as in
+    """The solved fits of M = ``max_modes`` .. ``min_modes`` at one degree (those the record
+    allows); ``memo`` as in :func:`.parametric.fit_candidate`, ``warm`` as in
     :func:`select_model_solutions`."""
     candidates = []
     noise: FloatArray | None = None
@@ -195,7 +199,7 @@ def _order_candidates(
     # The largest order that fits starts from ``poles`` (or its own pencil) and sets the noise;
     # the smaller ones start from the pencil of the signals weighted by that noise
     initial_poles = poles
-    for m in range(max_modes, 0, -1):
+    for m in range(max_modes, min_modes - 1, -1):
         candidate = fit_candidate(
             y,
             sample_period,
@@ -217,7 +221,7 @@ def _order_candidates(
             if candidate is not None:
                 noise = candidate.noise
                 # The pencil of the smaller orders, unless every one of them starts warm
-                if any((degree, smaller) not in warm for smaller in range(1, m)):
+                if any((degree, smaller) not in warm for smaller in range(min_modes, m)):
                     weighted = y / noise if y.ndim == 2 else y[:, None] / noise
                     initial_poles = pencil_poles(weighted, m)
         if candidate is not None:

@@ -9,6 +9,8 @@ evaluation grid (:func:`.evaluation_grid.reference_index`), which the drift chec
 one solve, weighted by the noise found there. The reference is a function of the window alone
 (:func:`warm_reference`), so a window has the same fit whichever windows were fitted before it,
 offline and online. Windows through the push always start from the pencil (``FastConfig``).
+Windows that start warm try two modes or more (``FastConfig.long_window_min_modes``), shorter
+ones one or more (:func:`fewest_modes`).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from numpy.typing import NDArray
 from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
 
-__all__ = ["Solutions", "start_inside", "warm_reference"]
+__all__ = ["Solutions", "fewest_modes", "start_inside", "starts_warm", "warm_reference"]
 
 FloatArray = NDArray[np.float64]
 
@@ -28,6 +30,34 @@ FloatArray = NDArray[np.float64]
 #: fit was weighted with or found, shape (K,)). What a longer window of the same record starts
 #: from.
 Solutions = dict[tuple[int, int], tuple[FloatArray, FloatArray]]
+
+
+def starts_warm(
+    rest_index: int,
+    end_index: int,
+    sample_period: float,
+    config: FastConfig,
+    through_push: bool = False,
+) -> bool:
+    """Whether the window [rest_index, end_index] is long enough to start warm: at least
+    ``config.warm_start_after`` (s, > 0) and not fitted ``through_push``."""
+    if through_push or config.warm_start_after <= 0.0:
+        return False
+    return (end_index - rest_index) * sample_period >= config.warm_start_after
+
+
+def fewest_modes(
+    rest_index: int,
+    end_index: int,
+    sample_period: float,
+    config: FastConfig,
+    through_push: bool = False,
+) -> int:
+    """The fewest damped modes tried on the window: ``config.long_window_min_modes`` (at most
+    the most tried) on a window that starts warm (:func:`starts_warm`), else 1."""
+    if starts_warm(rest_index, end_index, sample_period, config, through_push):
+        return min(config.long_window_min_modes, config.max_modes)
+    return 1
 
 
 def warm_reference(
@@ -40,13 +70,10 @@ def warm_reference(
     """Last index of the window whose :data:`Solutions` the fits of [rest_index, end_index]
     start from; None when they start from the matrix pencil.
 
-    The window starts warm when it is at least ``config.warm_start_after`` long (s) and not
-    fitted ``through_push``; its reference is the drift check's, the grid window nearest to 2/3
-    of it (None when there is none on the grid).
+    A window that starts warm (:func:`starts_warm`) has the drift check's reference, the grid
+    window nearest to 2/3 of it (None when there is none on the grid).
     """
-    if through_push or config.warm_start_after <= 0.0:
-        return None
-    if (end_index - rest_index) * sample_period < config.warm_start_after:
+    if not starts_warm(rest_index, end_index, sample_period, config, through_push):
         return None
     return reference_index(rest_index, end_index, 2.0 / 3.0, sample_period, config)
 

@@ -28,7 +28,11 @@ from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_in
 from sensing_antenna.estimation.methods.fast.model_order import select_model_solutions
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 from sensing_antenna.estimation.methods.fast.pencil import first_poles
-from sensing_antenna.estimation.methods.fast.warm_start import Solutions, warm_reference
+from sensing_antenna.estimation.methods.fast.warm_start import (
+    Solutions,
+    fewest_modes,
+    warm_reference,
+)
 
 __all__ = [
     "FitCache",
@@ -106,6 +110,7 @@ def window_key(
         config.push_max_modes,
         config.push_polynomial_degree,
         config.warm_start_after,
+        config.long_window_min_modes,
     )
     digest.update(np.array(settings, dtype=float).tobytes())
     if push is not None:
@@ -129,7 +134,8 @@ def fit_window(
 
     A window from its start (t_1, or the end of the hold) at least ``warm_start_after`` long
     starts every candidate from the solutions of its drift check's reference window
-    (:mod:`.warm_start`), fitted first (and cached) when not at hand.
+    (:mod:`.warm_start`), fitted first (and cached) when not at hand, and tries
+    ``long_window_min_modes`` modes or more.
     """
     span = WindowSpan(
         channels, rest_index, end_index, sample_period, band, config, {} if cache is None else cache
@@ -181,6 +187,7 @@ def _fit_and_solutions(
             regressors=None if push is None else push.angle[start : end_index + 1],
             restart=None if push is None else rest_index - start,
             warm=warm,
+            min_modes=fewest_modes(rest_index, end_index, sample_period, config, push is not None),
         )
     cache[key] = result
     return result
