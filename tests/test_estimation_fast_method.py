@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from threadpoolctl import threadpool_info, threadpool_limits
 
 from sensing_antenna.antenna import FreeMotionObserver, paper_antenna
 from sensing_antenna.beam import natural_frequencies
@@ -343,6 +344,34 @@ def test_window_shorter_than_the_model_is_not_sure() -> None:
     assert window.note
 
 
+def _blas_threads() -> int:
+    return max(lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas")
+
+
+def test_a_window_is_fitted_with_one_blas_thread_whatever_the_process_allows(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The fits multiply matrices of a few hundred rows by ten to twenty columns: more BLAS
+    # threads only contend for the cores. With two allowed to the process, the matrix pencil
+    # inside every fit (numpy's eigvals, which the method calls nowhere else) must see one,
+    # and the process gets its two back after the fit.
+    channels = _channels(0.6, 300, np.random.default_rng(3), 0.2)
+    seen: list[int] = []
+    eigvals = np.linalg.eigvals
+
+    def spy(matrix: Any) -> Any:
+        seen.append(_blas_threads())
+        return eigvals(matrix)
+
+    monkeypatch.setattr(np.linalg, "eigvals", spy)
+    with threadpool_limits(limits=2, user_api="blas"):
+        if _blas_threads() < 2:
+            pytest.skip("this process's BLAS was started with one thread")
+        evaluate_window(channels, NO_BIAS, 0, 299, TS, BAND, LINK, X_RANGE, FastConfig())
+        assert _blas_threads() == 2
+    assert seen and set(seen) == {1}
+
+
 def test_config_errors_name_the_field() -> None:
     with pytest.raises(FastConfigError, match="tolerance"):
         FastConfig(tolerance=-1.0)
@@ -352,6 +381,10 @@ def test_config_errors_name_the_field() -> None:
         FastConfig(first_window=1.0, cap=0.5)
     with pytest.raises(FastConfigError, match="push_polynomial_degree"):
         FastConfig(push_polynomial_degree=-1)
+    with pytest.raises(FastConfigError, match="warm_start_after"):
+        FastConfig(warm_start_after=-0.1)
+    with pytest.raises(FastConfigError, match="long_window_min_modes"):
+        FastConfig(long_window_min_modes=0)
 
 
 def test_cli_json_has_interval_and_branch_probability(
@@ -807,6 +840,25 @@ def test_the_scan_concludes_on_the_first_sure_window_with_its_slip_reference(
         assert final.early_statics is not None
         assert final.early_statics.ratio == fresh.early_statics.ratio
         assert np.array_equal(final.early_statics.reaction_perp, fresh.early_statics.reaction_perp)
+
+
+def test_windows_started_warm_declare_what_windows_started_from_the_pencil_declare(
+    azimuthal: Recording, azimuthal_estimate: ContactEstimate
+) -> None:
+    # An easy recording (azimuthal 0.6 m): the windows after the hold fitted from the solutions
+    # of their drift references (the default) and from the matrix pencil (warm_start_after 0)
+    # reach nearly the same optimum: omega_1 differs (another start) by a fraction of its
+    # standard error, and both declarations are ok, each x_c inside the other's interval and
+    # both intervals holding the simulator's contact point.
+    cold = estimate(azimuthal, paper_antenna(), FastMethod(FastConfig(warm_start_after=0.0)))
+    warm = azimuthal_estimate
+    truth = float(azimuthal.metadata["true_xc"])
+    assert warm.omega1 != cold.omega1
+    assert abs(warm.omega1 - cold.omega1) < 0.1 * cold.diagnostics["omega1_se"]
+    for one, other in ((warm, cold), (cold, warm)):
+        assert one.status is Status.OK and one.interval is not None
+        low, high = one.interval
+        assert low <= other.x_c <= high and low <= truth <= high
 
 
 def test_a_session_never_serves_the_fits_of_other_samples(

@@ -16,6 +16,7 @@ from scipy.optimize import least_squares
 
 from sensing_antenna.estimation.methods.fast.trust_region import (
     NOT_CONVERGED,
+    NOT_FINITE,
     bounded_levenberg_marquardt,
     free_parameters,
     trust_region_step,
@@ -23,6 +24,7 @@ from sensing_antenna.estimation.methods.fast.trust_region import (
     updated_scale,
 )
 from sensing_antenna.estimation.methods.fast.varpro import (
+    linear_fit,
     mode_columns,
     mode_derivatives,
     projected_residual,
@@ -79,6 +81,28 @@ def test_columns_and_their_derivatives_match_the_closed_form_and_finite_differen
             / (2 * h)
         )
         np.testing.assert_allclose(derivatives[p], numeric, rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize("restart", [None, 333])
+def test_columns_of_a_long_window_match_the_closed_form(restart: int | None) -> None:
+    # A 1.5 s window (the longest the method fits is 1 s, the cap, plus the push): the columns
+    # are carried from sample to sample between direct evaluations, so their rounding must
+    # stay at the level of the closed form's own (an argument w t of up to 2200 rad holds
+    # about 2e-13 rad of rounding): within 1e-12 of the envelope, for a decaying mode and for
+    # the fastest growth the fit allows (-20 1/s) near the Nyquist frequency.
+    n, params = 1500, np.array([61.7, 12.0, 2900.0, -20.0])
+    fixed, axes, starts = _layout(n, restart)
+    columns = mode_columns(fixed, axes, starts, params)
+    for a in range(axes.shape[0]):
+        t = axes[a]
+        on = np.arange(n) >= starts[a]
+        for j in range(2):
+            omega, decay = params[2 * j], params[2 * j + 1]
+            envelope = np.where(on, np.exp(-decay * t), 0.0)
+            first = 3 + 4 * a + 2 * j
+            for column, wave in ((first, np.cos(omega * t)), (first + 1, np.sin(omega * t))):
+                error = np.abs(columns[:, column] - envelope * wave)
+                assert np.all(error <= 1e-12 * np.maximum(envelope, 1e-300))
 
 
 def test_projected_residual_is_the_linear_least_squares_residual() -> None:
@@ -149,6 +173,29 @@ def test_solver_reports_when_it_runs_out_of_evaluations() -> None:
     assert status == NOT_CONVERGED
 
 
+def test_solver_reports_a_start_whose_residual_is_not_finite() -> None:
+    # exp(-s t) overflows for s = -1e6 over a window of +-0.1 s: the solver returns the start
+    # unsolved with its own status, so a caller need not evaluate the start beforehand.
+    fixed, axes, starts = _layout(200, None)
+    y = np.ascontiguousarray(np.ones((200, 3)))
+    start = np.array([50.0, -1e6])
+    params, status = bounded_levenberg_marquardt(
+        fixed,
+        axes,
+        starts,
+        y,
+        start,
+        np.array([10.0, -2e6]),
+        np.array([3000.0, 300.0]),
+        1e-8,
+        1e-8,
+        1e-8,
+        100,
+    )
+    assert status == NOT_FINITE
+    np.testing.assert_array_equal(params, start)
+
+
 @pytest.mark.parametrize("restart", [None, 90, 0])
 def test_kaufman_jacobian_matches_finite_differences_at_zero_residual(restart: int | None) -> None:
     # At a zero residual the term Kaufman's approximation drops vanishes, so it equals the exact
@@ -214,6 +261,25 @@ def test_dependent_columns_give_the_least_squares_residual() -> None:
     columns = mode_columns(scaled, axes, starts, params)
     residual = projected_residual(scaled, axes, starts, params, y)
     np.testing.assert_allclose(residual, _lstsq_residual(columns, y), atol=1e-9)
+
+
+def test_linear_fit_gives_the_least_squares_coefficients() -> None:
+    # Against numpy's lstsq (SVD): full-rank columns with a restart, and columns of which one
+    # is another's copy, where both give the minimum-norm solution (the copy's coefficient
+    # split in two halves). Coefficients to 1e-10 relative of their largest (the columns'
+    # condition number is about 1e3), residuals to 1e-10 on unit-variance data.
+    rng = np.random.default_rng(13)
+    n, params = 200, np.array([45.0, 2.0, 160.0, 8.0])
+    y = np.ascontiguousarray(rng.normal(size=(n, 3)))
+    fixed, axes, starts = _layout(n, 70)
+    plain, plain_axes, plain_starts = _layout(n, None)
+    doubled = np.ascontiguousarray(np.column_stack([plain, plain[:, 1]]))
+    for layout in ((fixed, axes, starts), (doubled, plain_axes, plain_starts)):
+        columns, coef, residual = linear_fit(*layout, params, y)
+        np.testing.assert_array_equal(columns, mode_columns(*layout, params))
+        reference = np.linalg.lstsq(columns, y, rcond=None)[0]
+        np.testing.assert_allclose(coef, reference, atol=1e-10 * np.abs(reference).max())
+        np.testing.assert_allclose(residual, y - columns @ reference, atol=1e-10)
 
 
 def test_columns_that_overflow_give_an_infinite_residual() -> None:

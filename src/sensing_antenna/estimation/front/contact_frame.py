@@ -132,15 +132,22 @@ def first_rest_index(
     int or None
         The index of t_1, or None when the head never rests in the samples.
     """
+    from scipy.ndimage import maximum_filter1d, minimum_filter1d
+
     theta = np.asarray(theta, dtype=float)
     w = window_samples
+    # The largest and smallest angle over every [i, i + w] by running filters, O(n) whatever w
+    # (the window starts at i: origin -(w + 1) // 2); max and min are exact, so the spread is
+    # the same number as over each window's own samples
+    size, origin = w + 1, -((w + 1) // 2)
     # candidates i in [start, n - w), looked at a few hundred at a time: the head usually rests
-    # soon after t_c, and the windows of a whole recording would cost far more
+    # soon after t_c
     for first in range(start, theta.shape[0] - w, _REST_CHUNK):
         stop = min(first + _REST_CHUNK, theta.shape[0] - w)
-        windows = np.lib.stride_tricks.sliding_window_view(theta[first : stop + w], w + 1, axis=0)
-        spread = windows.max(axis=-1) - windows.min(axis=-1)
-        hits = np.flatnonzero(np.all(spread <= tolerance, axis=1))
+        segment = theta[first : stop + w]
+        highest = maximum_filter1d(segment, size, axis=0, origin=origin)[: stop - first]
+        lowest = minimum_filter1d(segment, size, axis=0, origin=origin)[: stop - first]
+        hits = np.flatnonzero(np.all(highest - lowest <= tolerance, axis=1))
         if hits.size:
             return first + int(hits[0])
     return None

@@ -170,6 +170,23 @@ class FastConfig:
         it from 2, or from this when lower, up to it, with the number of modes). 2: the head's
         angle, the regressor, carries the static loads' growth over the push, and each degree
         costs a full set of fits.
+    warm_start_after : float
+        Windows at least this long (s, from their start: t_1, or the end of the hold where the
+        window restarts there) start every fit, each polynomial degree and number of modes,
+        from the solution of the same model on their drift check's reference window (the grid
+        window of about 2/3 their length, fitted anyway), with one solve weighted by the noise
+        found there, instead of two solves from the matrix pencil (:mod:`.warm_start`). A rule
+        of the window alone, so a window has the same fit offline and online, whichever windows
+        were fitted before. 0.2 s, the pipeline's hold: every window evaluated after the hold
+        starts warm, from references that themselves start from the pencil while shorter than
+        this. 0: every window from the pencil. Windows through the push (``push_phase``) always
+        start from the pencil: their reference holds relatively more of the touch's ringing,
+        and a start from it can settle in a worse optimum.
+    long_window_min_modes : int
+        Fewest damped modes tried on the windows that start warm (``warm_start_after``);
+        shorter windows try from one. 2: the touch and the stop excite contact modes 2 and 3
+        as well as the fundamental, so on windows that long the BIC almost never chooses a
+        single mode, and each order costs a fit at every degree.
     """
 
     tolerance: float = 0.005
@@ -199,6 +216,8 @@ class FastConfig:
     push_phase: bool = False
     push_max_modes: int = 3
     push_polynomial_degree: int = 2
+    warm_start_after: float = 0.2
+    long_window_min_modes: int = 2
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -207,7 +226,7 @@ class FastConfig:
                 if not isinstance(value, bool):
                     raise FastConfigError(f"{f.name}: must be true or false, got {value!r}")
                 continue
-            counts = ("max_modes", "bias_min_samples", "push_max_modes")
+            counts = ("max_modes", "bias_min_samples", "push_max_modes", "long_window_min_modes")
             degrees = ("polynomial_degree", "push_polynomial_degree")
             if f.name in counts + degrees:
                 low = 0 if f.name in degrees else 1
@@ -219,6 +238,7 @@ class FastConfig:
             if not (math.isfinite(value) and value >= 0.0):
                 raise FastConfigError(f"{f.name}: must be a finite number >= 0, got {value!r}")
             may_be_zero = (
+                "warm_start_after",
                 "frequency_floor",
                 "ratio_geometry_factor",
                 "bias_guard",

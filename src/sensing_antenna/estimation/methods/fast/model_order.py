@@ -15,14 +15,16 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from sensing_antenna.estimation.methods.fast.design import ModelDesign
 from sensing_antenna.estimation.methods.fast.parametric import (
     DampedSinusoidFit,
     FitCandidate,
     fit_candidate,
 )
-from sensing_antenna.estimation.methods.fast.pencil import pencil_poles
+from sensing_antenna.estimation.methods.fast.pencil import StrengthMemo, pencil_poles
+from sensing_antenna.estimation.methods.fast.warm_start import Solutions
 
-__all__ = ["select_model", "select_model_order"]
+__all__ = ["select_model", "select_model_order", "select_model_solutions"]
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -108,7 +110,46 @@ def select_model(
     DampedSinusoidFit or None
         None when no degree and order could be fitted (record too short).
     """
+    return select_model_solutions(
+        signals,
+        sample_period,
+        max_modes,
+        degrees,
+        t_start,
+        min_omega,
+        target_band,
+        poles,
+        regressors,
+        restart,
+    )[0]
+
+
+def select_model_solutions(
+    signals: FloatArray,
+    sample_period: float,
+    max_modes: int,
+    degrees: Sequence[int],
+    t_start: float = 0.0,
+    min_omega: float = 0.0,
+    target_band: tuple[float, float] | None = None,
+    poles: ComplexArray | None = None,
+    regressors: FloatArray | None = None,
+    restart: int | None = None,
+    warm: Solutions | None = None,
+    min_modes: int = 1,
+) -> tuple[DampedSinusoidFit | None, Solutions]:
+    """:func:`select_model` over M = ``min_modes`` .. ``max_modes``, with every candidate's
+    solution (:data:`.warm_start.Solutions`).
+
+    Each (degree, number of modes) found in ``warm`` (the solutions of a shorter window of the
+    same record) starts from there, with one solve, the largest order weighted by the noise
+    found there, instead of from the matrix pencil (:mod:`.warm_start`); the others as in
+    :func:`select_model`. The other parameters as there.
+    """
     y = np.asarray(signals, dtype=float)
+    # The largest order of every degree starts from the same poles and weights, and the smaller
+    # orders of one degree from the same pencil and weights: their pole strengths once
+    memo: StrengthMemo = {}
     candidates = [
         candidate
         for degree in degrees
@@ -123,11 +164,15 @@ def select_model(
             poles,
             regressors,
             restart,
+            memo,
+            warm or {},
+            min_modes,
         )
     ]
+    solutions = {(c.design.degree, c.params.size // 2): (c.params, c.noise) for c in candidates}
     if not candidates:
-        return None
-    return min(candidates, key=lambda c: c.bic).summary()
+        return None, solutions
+    return min(candidates, key=lambda c: c.bic).summary(), solutions
 
 
 def _order_candidates(
@@ -141,14 +186,20 @@ def _order_candidates(
     poles: ComplexArray | None,
     regressors: FloatArray | None,
     restart: int | None,
+    memo: StrengthMemo,
+    warm: Solutions,
+    min_modes: int = 1,
 ) -> list[FitCandidate]:
-    """The solved fits of M = ``max_modes`` .. 1 at one degree (those the record allows)."""
+    """The solved fits of M = ``max_modes`` .. ``min_modes`` at one degree (those the record
+    allows); ``memo`` as in :func:`.parametric.fit_candidate`, ``warm`` as in
+    :func:`select_model_solutions`."""
     candidates = []
     noise: FloatArray | None = None
+    design = ModelDesign(y.shape[0], sample_period, degree, regressors, restart)
     # The largest order that fits starts from ``poles`` (or its own pencil) and sets the noise;
     # the smaller ones start from the pencil of the signals weighted by that noise
     initial_poles = poles
-    for m in range(max_modes, 0, -1):
+    for m in range(max_modes, min_modes - 1, -1):
         candidate = fit_candidate(
             y,
             sample_period,
@@ -161,12 +212,18 @@ def _order_candidates(
             target_band,
             regressors,
             restart,
+            memo=memo,
+            design=design,
+            warm=warm.get((degree, m)),
         )
         if noise is None:
             initial_poles = None  # the next order, if this one did not fit, starts from its own
             if candidate is not None:
                 noise = candidate.noise
-                initial_poles = pencil_poles(y / noise if y.ndim == 2 else y[:, None] / noise, m)
+                # The pencil of the smaller orders, unless every one of them starts warm
+                if any((degree, smaller) not in warm for smaller in range(min_modes, m)):
+                    weighted = y / noise if y.ndim == 2 else y[:, None] / noise
+                    initial_poles = pencil_poles(weighted, m)
         if candidate is not None:
             candidates.append(candidate)
     return candidates

@@ -41,18 +41,20 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from sensing_antenna.estimation.methods.fast.design import ModelDesign
 from sensing_antenna.estimation.methods.fast.pencil import (
+    StrengthMemo,
     difference_scale,
     first_poles,
     initial_modes,
     pencil_poles,
+    pole_strengths,
 )
-from sensing_antenna.estimation.methods.fast.trust_region import bounded_levenberg_marquardt
-from sensing_antenna.estimation.methods.fast.varpro import (
-    mode_columns,
-    mode_derivatives,
-    projected_residual,
+from sensing_antenna.estimation.methods.fast.trust_region import (
+    NOT_FINITE,
+    bounded_levenberg_marquardt,
 )
+from sensing_antenna.estimation.methods.fast.warm_start import start_inside
 
 __all__ = ["DampedSinusoidFit", "FitCandidate", "fit_candidate", "fit_damped_sinusoids"]
 
@@ -66,10 +68,16 @@ _MAX_WINDOW_DECAY = 20.0
 #: Smallest decay rate (1/s): slight growth is allowed (a fit on a short record may need it), more
 #: is not physical for a passive link.
 _MIN_DECAY = -20.0
-#: Solver tolerances (the defaults of scipy's least_squares): relative steps of 1e-8 are 1e-5
-#: of the smallest standard error of omega_1 (~1e-3); cost changes of 1e-8 relative; scaled
-#: gradient 1e-8; at most 100 residual evaluations per solve.
-_XTOL = _FTOL = _GTOL = 1e-8
+#: Solver tolerances. Relative steps of 1e-8 (scipy's least_squares' default) are 1e-5 of the
+#: smallest standard error of omega_1 (~1e-3 relative); scaled gradient 1e-8; at most 100
+#: residual evaluations per solve. A solve ends when an accepted step lowers the cost by less
+#: than 1e-6 of it: in the noise-weighted units the cost is about n K / 2, and a parameter
+#: delta standard errors from the minimum adds delta^2 / 2 to it, so what such a step leaves
+#: is a change of at most sqrt(1e-6 n K) standard errors, 0.07 on the longest window (1 s,
+#: five channels). The fundamental settles in the first steps; the last ones polish the weak
+#: modes' decay rates, where the solver converges linearly (a few tenths of the rest per step).
+_XTOL = _GTOL = 1e-8
+_FTOL = 1e-6
 _MAX_EVALUATIONS = 100
 
 
@@ -163,88 +171,6 @@ class DampedSinusoidFit:
         return int(inside[np.argmax(self.snr()[inside])])
 
 
-class _Design:
-    """The columns of one window's model: polynomial, regressors, then the modes.
-
-    Columns: tau^0 .. tau^degree, the ``regressors`` (centred on t_ref), then per mode
-    exp(-s tau) cos(w tau), exp(-s tau) sin(w tau); with a ``restart`` index, per mode also the
-    same pair started at that sample (time from it, zero before): a change of the modes'
-    amplitudes and phases there, as an impulsive load on the structure makes (the head stopping).
-    The mode columns are computed by the compiled kernels of :mod:`.varpro` (``axes``, ``starts``:
-    its layout).
-    """
-
-    def __init__(
-        self,
-        n: int,
-        sample_period: float,
-        degree: int,
-        regressors: FloatArray | None = None,
-        restart: int | None = None,
-    ) -> None:
-        self.tau: FloatArray = (np.arange(n, dtype=float) - 0.5 * (n - 1)) * sample_period
-        self.sample_period = sample_period
-        self.degree = degree
-        fixed = [self.tau[:, None] ** j for j in range(degree + 1)]
-        if regressors is not None:
-            r = np.asarray(regressors, dtype=float).reshape(n, -1)
-            # zero at t_ref, so the constant term stays the static load at the window centre
-            fixed.append(r - 0.5 * (r[(n - 1) // 2] + r[n // 2]))
-        self.fixed: FloatArray = np.ascontiguousarray(np.hstack(fixed))
-        self.restart = restart
-        # Time axis of each column pair and the sample from which it is on: the window, then
-        # the restart's (time from the restart sample)
-        axes, starts = [self.tau], [0]
-        if restart is not None:
-            axes.append((np.arange(n, dtype=float) - restart) * sample_period)
-            starts.append(restart)
-        self.axes: FloatArray = np.vstack(axes)
-        self.starts: NDArray[np.int64] = np.array(starts, dtype=np.int64)
-
-    @property
-    def n_fixed(self) -> int:
-        """Columns that do not depend on (w, s)."""
-        return int(self.fixed.shape[1])
-
-    def n_linear(self, n_modes: int) -> int:
-        """Columns of the model with ``n_modes`` modes (one column pair per mode and time axis)."""
-        return self.n_fixed + 2 * self.axes.shape[0] * n_modes
-
-    def basis(self, params: FloatArray) -> FloatArray:
-        """All columns at (w, s), shape (n, n_linear)."""
-        return np.asarray(mode_columns(self.fixed, self.axes, self.starts, params), dtype=float)
-
-    def derivative_times_coef(self, columns: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
-        """d(basis @ coef) / d(w_j, s_j), shape (2M, n, K), from the basis ``columns`` at (w, s):
-        only mode j's columns depend on them."""
-        derivatives = mode_derivatives(
-            columns, self.axes, self.starts, self.n_fixed, np.ascontiguousarray(coef, dtype=float)
-        )
-        return np.asarray(derivatives, dtype=float)
-
-    def residual(self, params: FloatArray, weighted: FloatArray) -> FloatArray:
-        """Residual of ``weighted`` (n, K) after the linear least-squares solve, flattened."""
-        residual = projected_residual(self.fixed, self.axes, self.starts, params, weighted)
-        return np.asarray(residual, dtype=float)
-
-    def free_amplitudes(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
-        """Amplitude at t_ref of each mode's vibration after the restart (or of the only one),
-        shape (K, M): the restarted pair carried to the origin tau = 0 and added."""
-        m = params.size // 2
-        first = self.n_fixed
-        a, b = coef[first : first + 2 * m : 2], coef[first + 1 : first + 2 * m : 2]
-        if self.axes.shape[0] > 1:
-            omega, decay = params[0::2][:, None], params[1::2][:, None]
-            lag = float(self.tau[0] - self.axes[1, 0])  # t_restart - t_ref
-            second = first + 2 * m
-            a2, b2 = coef[second : second + 2 * m : 2], coef[second + 1 : second + 2 * m : 2]
-            gain = np.exp(decay * lag)
-            cos_lag, sin_lag = np.cos(omega * lag), np.sin(omega * lag)
-            a = a + gain * (a2 * cos_lag - b2 * sin_lag)
-            b = b + gain * (a2 * sin_lag + b2 * cos_lag)
-        return np.asarray(np.hypot(a, b).T, dtype=float)
-
-
 def fit_damped_sinusoids(
     signals: FloatArray,
     sample_period: float,
@@ -330,18 +256,41 @@ def fit_candidate(
     regressors: FloatArray | None,
     restart: int | None,
     max_evaluations: int = _MAX_EVALUATIONS,
+    memo: StrengthMemo | None = None,
+    design: ModelDesign | None = None,
+    warm: tuple[FloatArray, FloatArray] | None = None,
 ) -> FitCandidate | None:
-    """:func:`fit_damped_sinusoids` up to its solution and BIC, without the covariance."""
+    """:func:`fit_damped_sinusoids` up to its solution and BIC, without the covariance.
+
+    ``memo``: the pole strengths already computed for these signals
+    (:data:`.pencil.StrengthMemo`), filled with those computed here; None: computed afresh.
+    ``design``: the model's columns for these samples, ``degree``, ``regressors`` and
+    ``restart`` when already built (they do not depend on the number of modes).
+    ``warm``: the (w, s) to start from and the channel noise to weight with when ``noise_std``
+    is not given (the solution of the same model on a shorter window of the same record,
+    :mod:`.warm_start`): one solve from there instead of two from the matrix pencil.
+    """
     y = np.asarray(signals, dtype=float)
     if y.ndim == 1:
         y = y[:, None]
-    n, k = y.shape
-    design = _Design(n, sample_period, degree, regressors, restart)
+    n = y.shape[0]
+    if design is None:
+        design = ModelDesign(n, sample_period, degree, regressors, restart)
     n_linear = design.n_linear(n_modes)
     if n < 3 * (n_linear + 2 * n_modes):
         return None
     lower = np.array([max(min_omega, 1e-3), _MIN_DECAY])
     upper = np.array([math.pi / sample_period, _MAX_WINDOW_DECAY / ((n - 1) * sample_period)])
+    bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
+    if warm is not None:
+        scale = np.asarray(warm[1] if noise_std is None else noise_std, dtype=float)
+        start = start_inside(warm[0], lower, upper)
+        params, status = _refine(
+            start, design, np.ascontiguousarray(y / scale), bounds, max_evaluations
+        )
+        if status == NOT_FINITE:
+            return None
+        return _candidate(params, status > 0, design, y, scale, t_start, noise_std is None)
     if noise_std is None:
         scale = difference_scale(y)
     else:
@@ -355,31 +304,39 @@ def fit_candidate(
         z = pencil_poles(y / scale, n_modes)
     if z is None:
         return None
-    start = initial_modes(y / scale, z, n_modes, sample_period, lower, upper, target_band)
     weighted = np.ascontiguousarray(y / scale)
-    if not np.all(np.isfinite(design.residual(start, weighted))):
-        return None
-    bounds = (np.tile(lower, n_modes), np.tile(upper, n_modes))
-    params, ok = _refine(start, design, weighted, bounds, max_evaluations)
+    key = (scale.tobytes(), z.tobytes(), float(lower[0]))
+    strengths = None if memo is None else memo.get(key)
+    if strengths is None:
+        strengths = pole_strengths(weighted, z, sample_period, lower[0], target_band)
+        if memo is not None:
+            memo[key] = strengths
+    start = initial_modes(strengths, n_modes, lower, upper, target_band)
+    params, status = _refine(start, design, weighted, bounds, max_evaluations)
+    if status == NOT_FINITE:
+        return None  # the model at the start is not finite (a mode's envelope overflows)
+    ok = status > 0
     if noise_std is None:
-        residual = design.residual(params, weighted).reshape(n, k) * scale
+        residual = design.linear_fit(params, weighted)[2] * scale
         dof = max(n - n_linear - 2 * n_modes, 1)
         scale = np.sqrt(np.sum(residual**2, axis=0) / dof)
         scale = np.where(scale > 0.0, scale, np.finfo(float).tiny)
-        params, ok = _refine(
+        params, status = _refine(
             params, design, np.ascontiguousarray(y / scale), bounds, max_evaluations
         )
+        ok = status > 0
     return _candidate(params, ok, design, y, scale, t_start, noise_std is None)
 
 
 def _refine(
     start: FloatArray,
-    design: _Design,
+    design: ModelDesign,
     weighted: FloatArray,
     bounds: tuple[FloatArray, FloatArray],
     max_evaluations: int,
-) -> tuple[FloatArray, bool]:
-    """The least-squares (w, s) from ``start`` and whether the solver converged."""
+) -> tuple[FloatArray, int]:
+    """The least-squares (w, s) from ``start`` and the solver's status (> 0 converged,
+    :data:`.trust_region.NOT_FINITE` when the residual at ``start`` is not finite)."""
     params, status = bounded_levenberg_marquardt(
         design.fixed,
         design.axes,
@@ -393,7 +350,7 @@ def _refine(
         gtol=_GTOL,
         max_evaluations=max_evaluations,
     )
-    return np.asarray(params, dtype=float), bool(status > 0)
+    return np.asarray(params, dtype=float), int(status)
 
 
 @dataclass(frozen=True)
@@ -406,8 +363,8 @@ class FitCandidate:
         The solution, interleaved (w_m rad/s, s_m 1/s).
     converged : bool
         The solver's flag (:meth:`summary` also needs a finite covariance).
-    design : _Design
-        The window's model columns.
+    design : ModelDesign
+        The window's model columns (:mod:`.design`).
     y : array, shape (n, K)
         The unweighted signals.
     basis : array, shape (n, L)
@@ -425,7 +382,7 @@ class FitCandidate:
 
     params: FloatArray
     converged: bool
-    design: _Design
+    design: ModelDesign
     y: FloatArray
     basis: FloatArray
     coef: FloatArray
@@ -493,7 +450,7 @@ class FitCandidate:
 def _candidate(
     params: FloatArray,
     converged: bool,
-    design: _Design,
+    design: ModelDesign,
     y: FloatArray,
     scale: FloatArray,
     t_start: float,
@@ -503,9 +460,7 @@ def _candidate(
     ``scale_from_residuals``, else ``scale``)."""
     n, k = y.shape
     m = params.size // 2
-    basis = design.basis(params)
-    coef = np.asarray(np.linalg.lstsq(basis, y, rcond=None)[0], dtype=np.float64)
-    residual = y - basis @ coef
+    basis, coef, residual = design.linear_fit(params, y)
     n_linear = basis.shape[1]
     dof = max(n - n_linear - 2 * m, 1)
     noise = np.sqrt(np.sum(residual**2, axis=0) / dof) if scale_from_residuals else scale

@@ -9,6 +9,7 @@ poles, with one mode in the band of the fundamental when one is asked for.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,11 +17,14 @@ from numpy.typing import NDArray
 from sensing_antenna.estimation.methods.paper.frequency import find_peak, power_spectrum
 
 __all__ = [
+    "PoleStrengths",
+    "StrengthMemo",
     "difference_scale",
     "first_poles",
     "initial_modes",
     "matrix_pencil_poles",
     "pencil_poles",
+    "pole_strengths",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -107,26 +111,51 @@ def _periodogram_peak(y: FloatArray, sample_period: float, band: tuple[float, fl
     return peak.omega if peak is not None else 0.5 * (band[0] + band[1])
 
 
-def initial_modes(
+class PoleStrengths(NamedTuple):
+    """The oscillatory poles of a pencil and what :func:`initial_modes` ranks them by
+    (:func:`pole_strengths`).
+
+    Attributes
+    ----------
+    s_plane : array of complex, shape (P,)
+        Continuous-time poles (-s + i w, 1/s and rad/s) with w > 0.
+    power : array, shape (P,)
+        Each pole's power in the weighted channels (sum over channels of the squared
+        coefficients of its exponential); -1 for a pole below the lowest frequency allowed.
+    band_peak : float
+        The largest periodogram peak inside the target band (rad/s) when no pole above the
+        lowest frequency lies in that band; NaN otherwise (or without a band).
+    """
+
+    s_plane: ComplexArray
+    power: FloatArray
+    band_peak: float
+
+
+#: Pole strengths already computed for one set of channels, keyed by the channel weights and
+#: the poles (their bytes) and the lowest frequency (rad/s): a model selection
+#: (:func:`.model_order.select_model`) starts up to nine fits from the same poles and weights.
+StrengthMemo = dict[tuple[bytes, bytes, float], PoleStrengths]
+
+
+def pole_strengths(
     y: FloatArray,
     z: ComplexArray,
-    n_modes: int,
     sample_period: float,
-    lower: FloatArray,
-    upper: FloatArray,
+    lowest: float,
     target_band: tuple[float, float] | None = None,
-) -> FloatArray:
-    """(w, s) pairs of the ``n_modes`` strongest oscillatory poles ``z`` above lower[0].
-
-    With ``target_band`` (rad/s) the first pair is the strongest pole inside that band or, when
-    the pencil has none there (a weak mode beside strong ones), the largest periodogram peak
-    inside it; the other pairs are the strongest remaining poles.
+) -> PoleStrengths:
+    """The oscillatory poles of ``z`` and the power of each in ``y`` (n, K), the weighted
+    channels: least squares on the complex exponentials of all of them, with an offset and a
+    drift. Poles below ``lowest`` (rad/s) get power -1. They depend neither on the model order
+    nor on the polynomial degree, so one model selection computes them once per pencil and
+    weighting (:data:`StrengthMemo`).
     """
     n = y.shape[0]
     with np.errstate(divide="ignore", invalid="ignore"):
-        s_plane = np.log(z) / sample_period
-    keep = np.isfinite(s_plane) & (s_plane.imag > 0.0)
-    s_plane = s_plane[keep]
+        every = np.log(z) / sample_period
+    keep = np.isfinite(every) & (every.imag > 0.0)
+    s_plane: ComplexArray = np.asarray(every[keep], dtype=np.complex128)
     # Amplitude of each pole: least squares on the complex exponentials of all kept poles
     idx = np.arange(n)
     vander = np.exp(np.multiply.outer(idx * sample_period, s_plane))
@@ -134,7 +163,31 @@ def initial_modes(
     coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
     m = s_plane.size
     power = np.sum(coef[2 : 2 + m] ** 2 + coef[2 + m :] ** 2, axis=1)
-    power = np.where(s_plane.imag >= lower[0], power, -1.0)
+    power = np.asarray(np.where(s_plane.imag >= lowest, power, -1.0), dtype=float)
+    band_peak = math.nan
+    if target_band is not None:
+        inside = (s_plane.imag >= target_band[0]) & (s_plane.imag <= target_band[1]) & (power >= 0)
+        if not inside.any():
+            band_peak = _periodogram_peak(y, sample_period, target_band)
+    return PoleStrengths(s_plane, power, band_peak)
+
+
+def initial_modes(
+    strengths: PoleStrengths,
+    n_modes: int,
+    lower: FloatArray,
+    upper: FloatArray,
+    target_band: tuple[float, float] | None = None,
+) -> FloatArray:
+    """(w, s) pairs of the ``n_modes`` strongest oscillatory poles above lower[0]
+    (``strengths``, computed with that lowest frequency and the same ``target_band``).
+
+    With ``target_band`` (rad/s) the first pair is the strongest pole inside that band or, when
+    the pencil has none there (a weak mode beside strong ones), the largest periodogram peak
+    inside it; the other pairs are the strongest remaining poles.
+    """
+    s_plane = strengths.s_plane
+    power = strengths.power.copy()
     omega: list[float] = []
     decay: list[float] = []
     if target_band is not None:
@@ -145,7 +198,7 @@ def initial_modes(
             decay.append(float(-s_plane[j].real))
             power[j] = -1.0
         else:
-            omega.append(_periodogram_peak(y, sample_period, target_band))
+            omega.append(strengths.band_peak)
             decay.append(1.0)
     order = list(np.argsort(power)[::-1][: n_modes - len(omega)])
     omega += [float(s_plane[j].imag) for j in order if power[j] >= 0.0]

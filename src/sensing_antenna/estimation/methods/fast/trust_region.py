@@ -30,6 +30,7 @@ __all__ = [
     "COST",
     "GRADIENT",
     "NOT_CONVERGED",
+    "NOT_FINITE",
     "REGION",
     "STEP",
     "bounded_levenberg_marquardt",
@@ -39,10 +40,11 @@ __all__ = [
     "updated_scale",
 ]
 
-#: Status of :func:`bounded_levenberg_marquardt`: 0 the evaluations ran out (not converged);
-#: > 0 converged (as for ``least_squares``' status, whose codes differ): the scaled gradient,
-#: the cost's change, the step's length, or the trust region collapsed.
-NOT_CONVERGED, GRADIENT, COST, STEP, REGION = 0, 1, 2, 3, 4
+#: Status of :func:`bounded_levenberg_marquardt`: -1 the residual at the start is not finite
+#: (nothing was solved); 0 the evaluations ran out (not converged); > 0 converged (as for
+#: ``least_squares``' status, whose codes differ): the scaled gradient, the cost's change, the
+#: step's length, or the trust region collapsed.
+NOT_FINITE, NOT_CONVERGED, GRADIENT, COST, STEP, REGION = -1, 0, 1, 2, 3, 4
 
 # Trust region (Moré 1978; the values of least_squares' trf): shrink to a quarter of the step
 # when the cost fell by less than a quarter of the predicted reduction (such a step does not
@@ -164,18 +166,20 @@ def bounded_levenberg_marquardt(
     Converged when the largest |g_p| / scale_p over the free parameters is below ``gtol``; when
     an accepted step lowers the cost by less than ``ftol`` of it (with a ratio above 1/4); when
     a step is shorter than ``xtol * (xtol + ||params||)``; or when the radius collapses. Not
-    converged after ``max_evaluations`` residual evaluations, or when the start's residual is
-    not finite.
+    converged after ``max_evaluations`` residual evaluations; :data:`NOT_FINITE` when the
+    start's residual is not finite (the caller's check of its start, at no extra cost).
 
     Returns
     -------
     params : array, shape (2M,)
     status : int
-        :data:`NOT_CONVERGED` (0) or the test met (> 0).
+        :data:`NOT_FINITE` (-1), :data:`NOT_CONVERGED` (0) or the test met (> 0).
     """
     n_fixed = fixed.shape[1]
     params = np.minimum(np.maximum(start, lower), upper)
     residual, jacobian = residual_and_jacobian(fixed, axes, starts, params, weighted)
+    if not np.all(np.isfinite(residual)):
+        return params, NOT_FINITE
     cost = 0.5 * (residual @ residual)
     if not np.isfinite(cost):
         return params, NOT_CONVERGED

@@ -1,30 +1,38 @@
 """One window's fit: the contact-load channels fitted, and the fundamental measured in it.
 
 A window [t_s, t_j] of the five contact-load channels (:mod:`.static_fit`) is fitted with
-damped sinusoids with shared poles plus a polynomial per channel (:func:`.parametric.select_model`,
-order and degree by BIC). With the push phase (``FastConfig.push_phase``) the window reaches back
-to t_c, with the head's angle along the push as a regressor and every mode restarted at t_1.
-Fits are cached by the window's own samples (:data:`FitCache`), so a cache never serves a fit
-of other data. :func:`measure_fundamental` finds the fundamental in the fit and widens its
-standard error by the drift check (:func:`.checks.drift_check`) against the grid window of 2/3
-the length.
+damped sinusoids with shared poles plus a polynomial per channel
+(:func:`.model_order.select_model`, order and degree by BIC), with one BLAS thread whatever the
+process allows. With the push phase (``FastConfig.push_phase``) the window reaches back to t_c,
+with the head's angle along the push as a regressor and every mode restarted at t_1. Fits are
+cached by the window's own samples (:data:`FitCache`), so a cache never serves a fit of other
+data. :func:`measure_fundamental` finds the fundamental in the fit and widens its standard
+error by the drift check (:func:`.checks.drift_check`) against the grid window of 2/3 the
+length.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
+from threadpoolctl import ThreadpoolController
 
 from sensing_antenna.estimation.methods.fast.checks import drift_check, periods_check
 from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
-from sensing_antenna.estimation.methods.fast.model_order import select_model
+from sensing_antenna.estimation.methods.fast.model_order import select_model_solutions
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 from sensing_antenna.estimation.methods.fast.pencil import first_poles
+from sensing_antenna.estimation.methods.fast.warm_start import (
+    Solutions,
+    fewest_modes,
+    warm_reference,
+)
 
 __all__ = [
     "FitCache",
@@ -40,9 +48,10 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
-#: Cache of window fits, keyed by :func:`window_key` (the window's samples themselves and the fit
+#: Cache of window fits, each with its candidates' solutions (what longer windows start from,
+#: :mod:`.warm_start`), keyed by :func:`window_key` (the window's samples themselves and the fit
 #: settings, so a cache can never serve a fit of other data or other settings).
-FitCache = dict[tuple[int, int, bytes], "DampedSinusoidFit | None"]
+FitCache = dict[tuple[int, int, bytes], "tuple[DampedSinusoidFit | None, Solutions]"]
 
 
 class PushPhase(NamedTuple):
@@ -100,6 +109,8 @@ def window_key(
         config.min_mode_fraction,
         config.push_max_modes,
         config.push_polynomial_degree,
+        config.warm_start_after,
+        config.long_window_min_modes,
     )
     digest.update(np.array(settings, dtype=float).tobytes())
     if push is not None:
@@ -119,37 +130,76 @@ def fit_window(
     push: PushPhase | None = None,
 ) -> DampedSinusoidFit | None:
     """The fit of [rest_index, end_index], or of [push.start, end_index] with the push's angle
-    as a regressor and the modes restarted at rest_index; from ``cache`` when it holds it."""
+    as a regressor and the modes restarted at rest_index; from ``cache`` when it holds it.
+
+    A window from its start (t_1, or the end of the hold) at least ``warm_start_after`` long
+    starts every candidate from the solutions of its drift check's reference window
+    (:mod:`.warm_start`), fitted first (and cached) when not at hand, and tries
+    ``long_window_min_modes`` modes or more.
+    """
+    span = WindowSpan(
+        channels, rest_index, end_index, sample_period, band, config, {} if cache is None else cache
+    )
+    return _fit_and_solutions(span, push)[0]
+
+
+def _fit_and_solutions(
+    span: WindowSpan, push: PushPhase | None
+) -> tuple[DampedSinusoidFit | None, Solutions]:
+    """:func:`fit_window` (``span.cache`` not None) with every candidate's solution."""
+    channels, rest_index, end_index, sample_period, band, config, cache = span
+    assert cache is not None
     if push is not None and push.start >= rest_index:
         push = None
     key = window_key(channels, rest_index, end_index, sample_period, band, config, push)
-    if cache is not None and key in cache:
+    if key in cache:
         return cache[key]
+    reference = warm_reference(rest_index, end_index, sample_period, config, push is not None)
+    warm = None
+    if reference is not None:
+        warm = _fit_and_solutions(span._replace(end_index=reference), None)[1]
     # The fit with the smallest BIC over the polynomial degrees and model orders
     start = rest_index if push is None else push.start
     max_modes = config.max_modes if push is None else config.push_max_modes
     highest = config.polynomial_degree if push is None else config.push_polynomial_degree
     signals = channels[start : end_index + 1]
     lowest = min(2, highest)
+    degrees = range(lowest, highest + 1)
     # The matrix pencil every degree starts from, computed once: where the lowest degree's
-    # largest model order fits the record (otherwise each fit computes its own)
+    # largest model order fits the record (otherwise each fit computes its own) and some
+    # degree's largest order does not start warm
     fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * max_modes)
-    poles = first_poles(signals, max_modes) if fits_at_all else None
-    fit = select_model(
-        signals,
-        sample_period,
-        max_modes,
-        range(lowest, highest + 1),
-        start * sample_period,
-        min_omega=config.min_mode_fraction * band[0],
-        target_band=band,
-        poles=poles,
-        regressors=None if push is None else push.angle[start : end_index + 1],
-        restart=None if push is None else rest_index - start,
-    )
-    if cache is not None:
-        cache[key] = fit
-    return fit
+    cold = warm is None or any((degree, max_modes) not in warm for degree in degrees)
+    # One BLAS thread for the fit's small matrices (a few hundred rows by ten to twenty
+    # columns): more threads only contend for the cores and spin, the more so when the
+    # process or the machine already runs one thread per core
+    with _blas_libraries().limit(limits=1, user_api="blas"):
+        poles = first_poles(signals, max_modes) if fits_at_all and cold else None
+        result = select_model_solutions(
+            signals,
+            sample_period,
+            max_modes,
+            degrees,
+            start * sample_period,
+            min_omega=config.min_mode_fraction * band[0],
+            target_band=band,
+            poles=poles,
+            regressors=None if push is None else push.angle[start : end_index + 1],
+            restart=None if push is None else rest_index - start,
+            warm=warm,
+            min_modes=fewest_modes(rest_index, end_index, sample_period, config, push is not None),
+        )
+    cache[key] = result
+    return result
+
+
+@functools.cache
+def _blas_libraries() -> ThreadpoolController:
+    """The BLAS libraries loaded in this process, found once, when a fit first needs them:
+    numpy's, and scipy's, whose LAPACK the compiled solver calls."""
+    import scipy.linalg  # noqa: F401  (loads scipy's BLAS, so the controller sees it)
+
+    return ThreadpoolController()
 
 
 def find_fundamental(
