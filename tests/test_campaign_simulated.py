@@ -120,15 +120,11 @@ def test_every_run_scenario_is_checked_before_anything_is_written(tmp_path: Path
     assert not out.exists()
 
 
-def test_the_free_motion_scenario_is_checked_before_anything_is_written(tmp_path: Path) -> None:
-    from sensing_antenna.campaign.simulated import check_scenario
-
-    # a free motion of 0.005 s is below Scenario's shortest recording (0.01 s)
-    spec = one_point_spec(free_motion=FreeMotionStep(identify=True, duration=0.005))
-    with pytest.raises(
-        CampaignSpecError, match=r"free_motion\.duration: the free motion: must be >"
-    ):
-        check_scenario(spec)
+def test_the_free_motion_duration_is_checked_when_the_spec_is_made() -> None:
+    # a free motion of 0.005 s is below the simulator's shortest recording (0.01 s): refused
+    # with the spec, before any campaign could write anything
+    with pytest.raises(CampaignSpecError, match=r"free_motion\.duration: must be > 0\.01 s"):
+        FreeMotionStep(identify=True, duration=0.005)
 
 
 def test_free_motion_step_identifies_the_observer_once_and_stores_it(tmp_path: Path) -> None:

@@ -50,7 +50,7 @@ def test_default_campaign_is_the_paper_section_5_6() -> None:
     expected = [*np.round(np.arange(0.30, 0.951, 0.05), 2), 0.98]
     np.testing.assert_allclose(spec.contact_points, expected, atol=1e-12)
     assert spec.repeats == 5
-    assert spec.methods == ("paper", "ratio", "two-frequency")
+    assert spec.methods == ("paper", "ratio", "two-frequency", "fast")
     assert load_campaign_spec(None) == spec
 
 

@@ -241,12 +241,15 @@ def run_campaign(
     report = Progress(enabled=progress)
     directory = Path(out_dir)
     prepare: PrepareAntenna
+    compile_methods: Callable[[Preparation], None] | None = None
     if run_one is None or prepare_antenna is None:
         from sensing_antenna.campaign import simulated
 
         # every scenario the simulation will be given, checked before anything is written
         simulated.check_scenario(spec)
-        run_one = run_one or simulated.simulate_and_estimate
+        if run_one is None:
+            run_one = simulated.simulate_and_estimate
+            compile_methods = functools.partial(simulated.compile_methods, spec, progress=report)
         prepare = prepare_antenna or functools.partial(simulated.prepare_campaign, progress=report)
     else:
         prepare = prepare_antenna
@@ -273,6 +276,9 @@ def run_campaign(
                     f"runs: {n_stored} of {len(runs)} stored already, {len(pending)} to run "
                     + _where(pending, workers, scheduler)
                 )
+                # worker processes start with the methods compiled (inline, the first run does it)
+                if compile_methods is not None and pending and scheduler is None and workers != 1:
+                    compile_methods(preparation)
                 task = functools.partial(execute_safely, run_one)
                 executed = 0
                 with (

@@ -257,6 +257,32 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
     return Preparation(model=model, device=device, calibration=calibration)
 
 
+def compile_methods(
+    spec: CampaignSpec, preparation: Preparation, progress: Progress | None = None
+) -> None:
+    """Estimate one manoeuvre of the device with every method of ``spec``, in this process.
+
+    The methods' compiled kernels (numba) then exist before the workers start: workers forked
+    from this process inherit them, others load them from numba's cache, instead of every
+    worker compiling them at once on its first run. The estimates are thrown away.
+    """
+    from sensing_antenna.estimation import conclude, gather
+    from sensing_antenna.simulator import simulate
+
+    cases = [case for case in spec.cases if case != "free"]
+    if not cases:
+        return
+    (progress or Progress(enabled=False)).line(
+        "preparation: compiling the methods on one manoeuvre of the device"
+    )
+    point = spec.contact_points[len(spec.contact_points) // 2]
+    scenario = make_scenario(cases[0], point, spec.base_seed, dict(spec.scenario))
+    recording = simulate(preparation.device, scenario).without_ground_truth()
+    gathered = gather(recording, preparation.model)
+    for method in spec.methods:
+        conclude(gathered, method)
+
+
 def prepare_antenna(spec: CampaignSpec) -> Antenna:
     """The antenna the estimators of every run use (:func:`prepare_campaign`'s model)."""
     return prepare_campaign(spec).model
