@@ -116,3 +116,29 @@ def test_calibrate_names_the_antenna_after_its_file(
     assert "calibrate" in calibrated.description and "3 recording(s)" in calibrated.description
     assert all(str(path) in calibrated.description for path in contacts)
     assert calibrated.description != paper_antenna().description
+
+
+def test_calibrate_goes_on_without_a_file_it_cannot_use(
+    contacts: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A contact at the tip written as the sum of an abscissa and a rounding, a file that is not a
+    # recording, and one without a known contact point: the set is calibrated from the rest
+    tip = tmp_path / "tip.csv"
+    text = contacts[2].read_text(encoding="utf-8")
+    start = text.index("# true_xc:")
+    end = text.index("\n", start)
+    tip.write_text(f"{text[:start]}# true_xc: 0.9800000000000002{text[end:]}", encoding="utf-8")
+    broken = tmp_path / "broken.csv"
+    broken.write_text("not, a recording\n", encoding="utf-8")
+    unknown = tmp_path / "unknown.csv"
+    unknown.write_text(text[:start] + text[end + 1 :], encoding="utf-8")
+    out = tmp_path / "set.toml"
+    files = [*contacts[:2], tip, broken, unknown]
+    assert main(["calibrate", *map(str, files), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"{tip}: x_c = 0.9800 m" in printed
+    left_out = [line for line in printed.splitlines() if "left out:" in line]
+    assert len(left_out) == 2
+    assert str(broken) in left_out[0] and f"{unknown}: no known contact point" in left_out[1]
+    assert "np.float64" not in printed
+    assert "3 recording(s)" in load_antenna(out).description

@@ -311,7 +311,8 @@ def calibrate_t_e(
     Parameters
     ----------
     contact_points : array_like, shape (n,)
-        Known contact points x_c (m), each in (0, l].
+        Known contact points x_c (m). A point not on (0, l] (NaN: not known) is left out of the
+        fit with a note naming it; one a few ulp past l (:data:`END_ULPS`) is the tip, l.
     omega1 : array_like, shape (n,)
         Measured fundamental frequencies (rad/s); NaN marks a point without a measurement
         (left out of the fit, kept in the result).
@@ -326,16 +327,19 @@ def calibrate_t_e(
     w = np.asarray(omega1, dtype=float).ravel()
     if x_c.shape != w.shape:
         raise CalibrationError(f"omega1: {w.size} frequencies for {x_c.size} contact points")
-    for i, x in enumerate(x_c):
-        if not (math.isfinite(x) and 0.0 < x <= link.length):
-            label = sources[i] if i < len(sources) else f"point {i}"
-            raise CalibrationError(f"{label}: x_c: must lie in (0, {link.length:g}] m, got {x!r}")
-    used = np.isfinite(w) & (w > 0)
+    x_c, on_link, left_out = _points_on_link(x_c, link.length, sources)
+    used = on_link & np.isfinite(w) & (w > 0)
     if int(used.sum()) < 2:
+        reasons = [*left_out, *notes]
+        why = ""
+        if reasons:
+            more = f"; and {len(reasons) - 1} more" if len(reasons) > 1 else ""
+            why = f" (left out: {reasons[0]}{more})"
         raise CalibrationError(
-            f"omega1: need at least 2 measured frequencies to fit T_e, got {int(used.sum())}"
+            f"omega1: need at least 2 measured frequencies to fit T_e, got {int(used.sum())}{why}"
         )
-    k = model_beta1_squared(link, x_c)
+    k = np.full(x_c.shape, math.nan)
+    k[on_link] = model_beta1_squared(link, x_c[on_link])
     t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
     return FrequencyCalibration(
         t_e=t_e,
@@ -348,8 +352,33 @@ def calibrate_t_e(
         used=used,
         loss=loss,
         sources=tuple(sources),
-        notes=tuple(notes),
+        notes=(*left_out, *notes),
     )
+
+
+#: Contact points this many ulp of l past the link's end are at the end: a point written as
+#: ``0.9800000000000002`` (the sum of an abscissa and a rounding) is the tip of a 0.98 m link.
+END_ULPS = 4
+
+
+def _points_on_link(
+    x_c: NDArray[np.float64], length: float, sources: Sequence[str]
+) -> tuple[NDArray[np.float64], NDArray[np.bool_], list[str]]:
+    """Points (m) with those a few ulp past the end set to l, which lie on (0, l], and a note
+    naming each one that does not."""
+    at_end = (x_c > length) & (x_c <= length + END_ULPS * math.ulp(length))
+    x_c = np.where(at_end, length, x_c)
+    on_link = np.isfinite(x_c) & (x_c > 0.0) & (x_c <= length)
+    notes = []
+    for i in map(int, np.flatnonzero(~on_link)):
+        label = sources[i] if i < len(sources) else f"point {i}"
+        where = (
+            "no known contact point (no true_xc metadata and no --points row)"
+            if math.isnan(x_c[i])
+            else f"x_c = {float(x_c[i])!r} m is not on the link (0, {length:g}] m"
+        )
+        notes.append(f"{label}: {where}")
+    return x_c, np.asarray(on_link, dtype=bool), notes
 
 
 def calibrate_from_recordings(
@@ -375,11 +404,15 @@ def calibrate_from_recordings(
         Search band for the fundamental frequency (rad/s); wide by default so that the measured
         frequencies do not presuppose the model being fitted.
 
+    A recording that cannot be used is left out with a note naming it and why (not in the
+    format's units: its angles, or its loads at rest against the link's weight,
+    :func:`~.observer.units_problem`; no clear fundamental; no known contact point), and the fit
+    goes on with the others.
+
     Raises
     ------
     CalibrationError
-        Naming the recording, when it is not in the format's units (its angles, or its loads at
-        rest against the link's weight: :func:`~.observer.units_problem`).
+        When fewer than two recordings are left to fit.
     """
     from sensing_antenna.calibration.observer import units_problem
     from sensing_antenna.estimation import measure_omega1
@@ -394,7 +427,8 @@ def calibrate_from_recordings(
     for i, recording in enumerate(recordings):
         problem = units_problem(recording, antenna)
         if problem is not None:
-            raise CalibrationError(f"{names[i]}: {problem}")
+            notes.append(f"{names[i]}: {problem}")
+            continue
         measurement = measure_omega1(recording, antenna, band=band)
         value = float(measurement.omega1)
         if not (math.isfinite(value) and value > 0):
@@ -417,9 +451,10 @@ def read_contact_points(
     With ``table``, a CSV file (UTF-8) with columns ``file`` and ``x_c`` (m); a row matches a
     recording by its path as given or by its file name. Two rows for one ``file``, or a file name
     two rows match, are refused (naming the lines): which would win is not the user's intent.
-    Without it, each recording's ground-truth metadata ``true_xc`` is used: calibration is the
-    one place where ground truth is an input, since the contact points of a calibration are known
-    by construction.
+    Without it, each recording's ground-truth metadata ``true_xc`` is used (NaN where it is
+    absent or not a number; the calibration leaves that recording out with a note): calibration
+    is the one place where ground truth is an input, since the contact points of a calibration
+    are known by construction.
 
     Raises
     ------
@@ -429,18 +464,7 @@ def read_contact_points(
     if table is not None:
         rows = _read_points_table(table)
         return [_point_of(table, rows, path) for path in paths]
-    points = []
-    for path, recording in zip(paths, recordings, strict=True):
-        text = recording.metadata.get("true_xc")
-        if text is None:
-            raise CalibrationError(
-                f"{path}: true_xc: no known contact point; give --points TABLE.csv (file,x_c)"
-            )
-        try:
-            points.append(float(text))
-        except ValueError as exc:
-            raise CalibrationError(f"{path}: true_xc: not a number: {text!r}") from exc
-    return points
+    return [_metadata_point(recording.metadata.get("true_xc")) for recording in recordings]
 
 
 @dataclass(frozen=True)
@@ -522,6 +546,14 @@ def _json_float(value: float) -> float | None:
 
 def _float_or_nan(value: Any) -> float:
     return math.nan if value is None else float(value)
+
+
+def _metadata_point(text: str | None) -> float:
+    """``true_xc`` metadata as a contact point (m); NaN when absent or not a number."""
+    try:
+        return math.nan if text is None else float(text)
+    except ValueError:
+        return math.nan
 
 
 def _describe(measurement: Any) -> str:

@@ -71,22 +71,30 @@ def _run(args: argparse.Namespace) -> int:
 
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.frequency import (
+        CalibrationError,
         calibrate_from_recordings,
         read_contact_points,
     )
+    from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.recording import read_recording
 
     antenna = load_antenna(args.antenna)
-    recordings = [read_recording(path) for path in args.recordings]
-    points = read_contact_points(args.recordings, recordings, args.points)
+    paths, recordings, unread = [], [], []
+    for path in args.recordings:
+        try:
+            recordings.append(read_recording(path))
+        except SensingAntennaError as exc:
+            unread.append(str(exc))  # one bad file does not sink the set
+        else:
+            paths.append(path)
+    if len(recordings) < 2 and unread:
+        raise CalibrationError(f"{unread[0]} (and fewer than 2 readable recordings left)")
+    points = read_contact_points(paths, recordings, args.points)
     calibration = calibrate_from_recordings(
-        recordings,
-        antenna,
-        points,
-        sources=[str(p) for p in args.recordings],
-        loss=args.loss,
+        recordings, antenna, points, sources=[str(p) for p in paths], loss=args.loss
     )
-    description = _description(antenna.name, args.recordings)
+    fitted = [path for path, used in zip(paths, calibration.used, strict=True) if used]
+    description = _description(antenna.name, fitted)
     calibrated = replace(calibration.apply(antenna), name=name, description=description)
     save_antenna(calibrated, args.out)
     print(
@@ -108,7 +116,7 @@ def _run(args: argparse.Namespace) -> int:
             f"  {calibration.sources[i]}: x_c = {x_c:.4f} m, omega_1 measured "
             f"{calibration.omega1_measured[i]:.3f}, fitted {calibration.omega1_fitted[i]:.3f} rad/s"
         )
-    for note in calibration.notes:
+    for note in (*unread, *calibration.notes):
         print(f"  left out: {note}")
     if args.plot is not None:
         from sensing_antenna.plotting.calibration import plot_calibration
