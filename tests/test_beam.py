@@ -303,6 +303,28 @@ def test_single_candidate_and_out_of_range(curve: SensingCurve) -> None:
     assert peak[0].x_c == pytest.approx(curve.extrema[0], abs=1e-12)
 
 
+def test_tip_is_a_candidate_within_the_tolerance_below_its_frequency(
+    curve: SensingCurve,
+) -> None:
+    """Pinned at the tip, a tip mass does not move: beta_1 l is the clamped-pinned 3.92660
+    (Blevins, Table 8-1), omega_1(l) = 3.92660^2 / (T l^2). Just below it no point of the link
+    has that frequency (the falling branch would need x_c > l); the tip is the candidate of
+    that branch within the tolerance, and not beyond it."""
+    link = CALIBRATED
+    tip = 3.92660**2 / (link.t_param * link.length**2)
+    assert float(curve.omega1(link.length)) == pytest.approx(tip, rel=1e-5)
+    below = tip - 0.05
+    assert len(curve.contact_points(below)) == 1
+    found = curve.contact_points(below, tolerance=0.1)
+    assert len(found) == 2 and found[1].x_c == link.length
+    assert found[1].slope == pytest.approx(float(curve.omega1_slope(link.length)), rel=1e-12)
+    assert len(curve.contact_points(below, tolerance=0.04)) == 1
+    # above the tip's frequency the falling branch answers by itself, the tolerance adds nothing
+    assert curve.contact_points(tip + 0.05, 0.1) == curve.contact_points(tip + 0.05)
+    with pytest.raises(BeamInputError, match="tolerance"):
+        curve.contact_points(below, tolerance=-1.0)
+
+
 def test_vectorised_inverse_agrees_with_scalar(curve: SensingCurve) -> None:
     omega = np.random.default_rng(5).uniform(10.0, 115.0, (4, 25))
     inv = curve.invert(omega)

@@ -43,6 +43,17 @@ def test_contact_points_json(capsys: pytest.CaptureFixture[str]) -> None:
         assert omega == pytest.approx(80.0, rel=1e-9)
 
 
+def test_the_tip_frequency_as_printed_finds_the_tip(capsys: pytest.CaptureFixture[str]) -> None:
+    # omega_1 of a contact at the tip, 70.37633 rad/s, given to three decimals: a hair below it,
+    # where only a contact past the end would ring; within the default tolerance it is the tip
+    assert main(["beam", "--omega1", "70.376", "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert [round(c["x_c"], 3) for c in payload["candidates"]] == [0.624, 0.98]
+    assert payload["tolerance"] == pytest.approx(0.070376)
+    assert main(["beam", "--omega1", "70.376", "--tolerance", "0", "--json"]) == 0
+    assert len(json.loads(capsys.readouterr().out)["candidates"]) == 1
+
+
 def test_out_of_range_frequency_exits_1_with_empty_list(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

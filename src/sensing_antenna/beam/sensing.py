@@ -259,11 +259,21 @@ class SensingCurve:
     def _target(self, omega1: float) -> float:
         return math.sqrt(omega1 / self._scale) if omega1 > 0 else -1.0
 
-    def contact_points(self, omega1: float) -> tuple[Candidate, ...]:
+    def contact_points(self, omega1: float, tolerance: float = 0.0) -> tuple[Candidate, ...]:
         """Every contact point whose fundamental frequency is ``omega1`` (rad/s), by x_c.
 
         Returns an empty tuple when ``omega1`` lies outside the model's range. Fast scalar path
-        (pure Python, no array allocation); agrees with :meth:`invert`.
+        (pure Python, no array allocation); agrees with :meth:`invert` when ``tolerance`` is 0.
+
+        Parameters
+        ----------
+        omega1 : float
+            Measured fundamental frequency (rad/s).
+        tolerance : float
+            Uncertainty of ``omega1`` (rad/s, >= 0). The curve ends at the tip, where the last
+            branch stops short of the frequencies just beyond omega_1(l) (they would need a
+            contact past the link's end): within ``tolerance`` of omega_1(l) on that side, the
+            tip x_c = l is the candidate of that branch.
         """
         try:
             value = float(omega1)
@@ -291,7 +301,23 @@ class SensingCurve:
             if found and found[-1].x_c == x_c:
                 continue  # exactly at an extremum: both branches meet there
             found.append(Candidate(x_c=x_c, slope=slope))
+        tip = self._tip_within(target, value, tolerance)
+        if tip is not None and all(c.x_c != tip.x_c for c in found):
+            found.append(tip)
         return tuple(sorted(found, key=lambda c: c.x_c))
+
+    def _tip_within(self, target: float, omega1: float, tolerance: float) -> Candidate | None:
+        """The tip as a candidate when ``omega1`` misses the last branch by <= ``tolerance``."""
+        if not (math.isfinite(tolerance) and tolerance >= 0.0):
+            raise BeamInputError("tolerance", f"must be >= 0, got {format_value(tolerance)}")
+        last = self._branches[-1]
+        if tolerance == 0.0 or _in_branch(target, last):
+            return None
+        omega_tip = self._lam_list[-1] ** 2 * self._scale
+        if abs(omega1 - omega_tip) > tolerance:
+            return None
+        slope = 2.0 * self._lam_list[-1] * self._slope_list[-1] * self._scale / self.link.length
+        return Candidate(x_c=self.link.length, slope=slope)
 
     def invert(self, omega1: ArrayLike) -> Inversion:
         """Vectorised inverse: candidates per monotone branch for every frequency (rad/s).

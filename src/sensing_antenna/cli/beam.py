@@ -2,7 +2,9 @@
 
 ``antenna beam --xc 0.3 0.5 0.98 [--modes 3]`` prints omega_i (rad/s) and f_i (Hz) per contact
 point; ``antenna beam --omega1 80`` prints every contact point whose fundamental frequency is
-80 rad/s with the slope d omega_1 / d x_c. ``--json`` prints machine-readable output instead.
+80 rad/s with the slope d omega_1 / d x_c (the tip too when 80 rad/s lies within ``--tolerance``
+of its frequency, on the side no point of the link reaches). ``--json`` prints machine-readable
+output instead.
 
 Exit codes: 0 on success; 1 when ``--omega1`` lies outside the model's range (the empty candidate
 list is still printed, the reason goes to stderr); 2 for bad arguments.
@@ -20,6 +22,11 @@ from sensing_antenna.cli.arguments import check_contact_points, integer, number
 
 #: Exit code when the frequency has no consistent contact point.
 EXIT_OUT_OF_RANGE = 1
+
+#: Default uncertainty of --omega1, relative: 0.1 %, the order of a calibrated model's scatter
+#: about the measured frequencies (link.calibration_scatter) and of a frequency printed with
+#: four significant digits.
+DEFAULT_TOLERANCE = 1e-3
 
 #: Largest --modes accepted: beyond a few dozen modes Euler-Bernoulli theory (no shear, no
 #: rotary inertia; Assumption 3 of the paper) no longer describes a real link.
@@ -61,6 +68,14 @@ def register(subparsers: Any) -> None:
         metavar="N",
         help=f"number of modes, 1 to {MAX_MODES}",
     )
+    parser.add_argument(
+        "--tolerance",
+        type=number(low=0.0, unit="rad/s"),
+        metavar="RAD_S",
+        help="uncertainty of --omega1 (rad/s): a frequency this close to the tip's, on the side "
+        "no point of the link reaches, is a contact at the tip (default: "
+        f"{100 * DEFAULT_TOLERANCE:g} %% of --omega1)",
+    )
     parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
@@ -74,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
     if args.xc is not None:
         check_contact_points(antenna.link, args.xc)
         return _frequencies(antenna.name, antenna.link, args.xc, args.modes, args.json)
-    return _contact_points(antenna.link, args.omega1, args.json)
+    tolerance = DEFAULT_TOLERANCE * args.omega1 if args.tolerance is None else args.tolerance
+    return _contact_points(antenna.link, args.omega1, tolerance, args.json)
 
 
 def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bool) -> int:
@@ -97,21 +113,22 @@ def _frequencies(name: str, link: Any, x_c: list[float], modes: int, as_json: bo
     return 0
 
 
-def _contact_points(link: Any, omega1: float, as_json: bool) -> int:
+def _contact_points(link: Any, omega1: float, tolerance: float, as_json: bool) -> int:
     from sensing_antenna.beam import SensingCurve
 
     curve = SensingCurve.from_link(link)
-    candidates = curve.contact_points(omega1)
+    candidates = curve.contact_points(omega1, tolerance)
     low, high = curve.omega1_range()
     if as_json:
         payload = {
             "omega1": omega1,
+            "tolerance": tolerance,
             "candidates": [{"x_c": c.x_c, "slope": c.slope} for c in candidates],
         }
         print(json.dumps(payload, indent=2))
     else:
         print(
-            f"omega1 = {omega1:g} rad/s (f1 = {omega1 / (2 * math.pi):.4g} Hz): "
+            f"omega1 = {omega1:g} +- {tolerance:.3g} rad/s (f1 = {omega1 / (2 * math.pi):.4g} Hz): "
             f"{len(candidates)} candidate contact point(s)"
         )
         if candidates:

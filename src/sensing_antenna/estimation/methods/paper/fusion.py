@@ -100,17 +100,19 @@ def fuse(candidates: Sequence[float], ratio_estimate: float, tolerance: float) -
 
 
 def candidates_from_omega1(
-    link: Link, omega1: float, x_range: tuple[float, float]
+    link: Link, omega1: float, x_range: tuple[float, float], tolerance: float = 0.0
 ) -> tuple[tuple[float, ...], dict[str, Any]]:
     """Contact points on the sensing curve with fundamental ``omega1`` (m), and notes.
 
     When the measured frequency lies above the curve's maximum (calibration error near the top of
     the curve, where the paper's worst errors are), there is no exact solution; the point of the
-    curve with the nearest frequency inside ``x_range`` is returned instead and flagged.
+    curve with the nearest frequency inside ``x_range`` is returned instead and flagged. Within
+    ``tolerance`` (rad/s) past the tip's frequency, the tip is a candidate
+    (:meth:`~sensing_antenna.beam.SensingCurve.contact_points`).
     """
     curve = sensing_curve(link)
     notes: dict[str, Any] = {}
-    found = tuple(float(c.x_c) for c in curve.contact_points(omega1))
+    found = tuple(float(c.x_c) for c in curve.contact_points(omega1, tolerance))
     inside = tuple(x for x in found if 0.0 < x <= link.length)
     if inside:
         slopes = [float(curve.omega1_slope(x)) for x in inside]
@@ -334,7 +336,11 @@ class PaperMethod:
         candidates: tuple[float, ...] = ()
         if math.isfinite(measurement.omega1):
             x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
-            candidates, notes = candidates_from_omega1(link, measurement.omega1, x_range)
+            scatter = link.calibration_scatter
+            if scatter is None:
+                scatter = cfg.model_frequency_scatter
+            tolerance = cfg.disagreement_sigmas * scatter * measurement.omega1
+            candidates, notes = candidates_from_omega1(link, measurement.omega1, x_range, tolerance)
             diag.update(notes)
         if not measurement.clear:
             problems.append(
