@@ -12,6 +12,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sensing_antenna.antenna import paper_antenna
@@ -33,7 +34,7 @@ DOCUMENTED_COLUMNS = (
     "x_c_estimate_m, error_m, abs_error_m, omega1_rad_s, peak_quality, ratio_estimate_m, "
     "candidates_m, t_c_s, t_1_s, t_e_s, interval_low_m, interval_high_m, simulate_s, "
     "estimate_s, noise_scale, x_c_contact_m, error_contact_m, abs_error_contact_m, "
-    "omega1_se_rad_s, omega1_crb_rad_s, front_end_s"
+    "omega1_se_rad_s, omega1_crb_rad_s, front_end_s, point_error_m"
 ).split(", ")
 
 RUN = RunSpec(3, "vertical-x0500mm-r2", "vertical", 0.5, 2, 1327166134, paper_antenna(), ())
@@ -83,6 +84,18 @@ def result() -> RunResult:
 
 def test_the_csv_columns_are_the_row_fields_in_the_documented_order() -> None:
     assert list(CSV_COLUMNS) == DOCUMENTED_COLUMNS
+
+
+def test_a_row_scores_the_touched_point_in_3d() -> None:
+    paper = dataclasses.replace(estimates()[0], contact_point=np.array([0.3, 0.4, 0.1]))
+    # a 3-4-5 triangle: 5 mm from the estimate to where the link touched
+    row = CampaignRow.of_estimate(RUN, paper, contact_point=(0.3, 0.403, 0.104))
+    assert row.point_error_m == pytest.approx(0.005, rel=1e-12)
+    assert CampaignRow.from_csv(row.to_csv()).point_error_m == row.point_error_m
+    assert math.isnan(CampaignRow.of_estimate(RUN, paper).point_error_m)  # truth unknown
+    assert math.isnan(
+        CampaignRow.of_estimate(RUN, estimates()[0], contact_point=(0, 0, 0)).point_error_m
+    )
 
 
 def test_a_row_copies_the_estimate_and_computes_the_errors() -> None:

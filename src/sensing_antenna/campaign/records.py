@@ -111,6 +111,9 @@ class CampaignRow:
     front_end_s : float
         Wall-clock time of the estimation front end on the recording (s), run once per run and
         shared by its methods; ``estimate_s - front_end_s`` is the method's own time.
+    point_error_m : float
+        Distance (m) from the estimate's touched point in 3D (``ContactEstimate.contact_point``,
+        absolute frame) to where the link touched (the simulator's ``true_contact_point``).
     """
 
     run_id: str
@@ -144,6 +147,7 @@ class CampaignRow:
     omega1_se_rad_s: float = math.nan
     omega1_crb_rad_s: float = math.nan
     front_end_s: float = math.nan
+    point_error_m: float = math.nan
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -185,11 +189,13 @@ class CampaignRow:
         simulate_s: float = math.nan,
         front_end_s: float = math.nan,
         estimate_s: float = math.nan,
+        contact_point: Sequence[float] | None = None,
     ) -> CampaignRow:
         """The row of one method's estimate on ``run`` (the method named by the estimate).
 
         The standard error and Cramer-Rao bound of omega_1 come from the estimate's
-        ``diagnostics["omega1_se"]`` and ``diagnostics["omega1_crb"]`` (``fast``).
+        ``diagnostics["omega1_se"]`` and ``diagnostics["omega1_crb"]`` (``fast``);
+        ``contact_point`` is where the link touched (absolute frame, m, shape (3,)), if known.
         """
         low, high = estimate.interval if estimate.interval is not None else (math.nan, math.nan)
         diagnostics = estimate.diagnostics
@@ -211,6 +217,7 @@ class CampaignRow:
             estimate_s=estimate_s,
             omega1_se_rad_s=float_or_nan(diagnostics.get("omega1_se")),
             omega1_crb_rad_s=float_or_nan(diagnostics.get("omega1_crb")),
+            point_error_m=_distance(estimate.contact_point, contact_point),
         )
 
     @classmethod
@@ -282,6 +289,13 @@ class CampaignRow:
             else:
                 values[f.name] = text
         return cls(**values)
+
+
+def _distance(point: Any, truth: Sequence[float] | None) -> float:
+    """|point - truth| (m); NaN when either is unknown."""
+    if truth is None:
+        return math.nan
+    return float_or_nan(math.dist(tuple(point), tuple(truth)))
 
 
 #: Columns of runs.csv, in order: the fields of :class:`CampaignRow`.

@@ -14,6 +14,7 @@ Also the steps before the runs, in the paper's order:
 from __future__ import annotations
 
 import dataclasses
+import json
 import time
 from collections.abc import Mapping
 from typing import Any
@@ -83,6 +84,7 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
         "contact_abscissa": _true_contact_abscissa(recording.metadata),
         "simulate_s": simulate_s,
     }
+    touched = _true_contact_point(recording.metadata)
     blind = recording.without_ground_truth()
     begin = time.perf_counter()
     try:
@@ -113,10 +115,26 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
         elapsed = front_end_s + time.perf_counter() - begin
         rows.append(
             CampaignRow.of_estimate(
-                run, estimate, **truth, front_end_s=front_end_s, estimate_s=elapsed
+                run,
+                estimate,
+                **truth,
+                front_end_s=front_end_s,
+                estimate_s=elapsed,
+                contact_point=touched,
             )
         )
     return RunResult(rows=tuple(rows))
+
+
+def _true_contact_point(metadata: Mapping[str, str]) -> tuple[float, ...] | None:
+    """The recording's ground-truth ``true_contact_point`` (m, absolute frame), None when
+    absent or not three numbers."""
+    try:
+        point = json.loads(metadata.get("true_contact_point", "null"))
+        values = tuple(float(v) for v in point)
+    except (TypeError, ValueError):
+        return None
+    return values if len(values) == 3 else None
 
 
 def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:

@@ -97,6 +97,11 @@ class MethodSummary:
         known; NaN without any.
     n_contact : int
         Runs with a finite estimate and a known contact abscissa.
+    point_mean_error, point_max_error : float
+        Mean and max distance (m) from the estimated touched point in 3D to where the link
+        touched, over the runs with both; NaN without any.
+    n_point : int
+        Runs with both points known.
     """
 
     case: str
@@ -112,6 +117,9 @@ class MethodSummary:
     contact_mean_abs_error: float = math.nan
     contact_max_abs_error: float = math.nan
     n_contact: int = 0
+    point_mean_error: float = math.nan
+    point_max_error: float = math.nan
+    n_point: int = 0
 
 
 @dataclass(frozen=True)
@@ -341,6 +349,8 @@ def method_summaries(
             ok_errors = np.abs(all_errors[is_ok & np.isfinite(all_errors)])
             contact = np.abs(_column(selected, "error_contact_m"))
             contact = contact[np.isfinite(contact)]
+            point = _column(selected, "point_error_m")
+            point = point[np.isfinite(point)]
             n = errors.size
             summaries.append(
                 MethodSummary(
@@ -357,6 +367,9 @@ def method_summaries(
                     contact_mean_abs_error=float(np.mean(contact)) if contact.size else math.nan,
                     contact_max_abs_error=float(np.max(contact)) if contact.size else math.nan,
                     n_contact=int(contact.size),
+                    point_mean_error=float(np.mean(point)) if point.size else math.nan,
+                    point_max_error=float(np.max(point)) if point.size else math.nan,
+                    n_point=int(point.size),
                 )
             )
     return summaries
