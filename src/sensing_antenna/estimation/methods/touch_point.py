@@ -67,7 +67,8 @@ def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link
     push_force : float
         |R_perp|, the reaction perpendicular to the link (N), e.g. filtered at t_e.
     link : Link
-        Supplies E I.
+        Supplies 1 / (E I) (:attr:`~sensing_antenna.antenna.Link.bending_compliance`, the
+        stiffness the frequency model and the sag use).
 
     Returns
     -------
@@ -76,10 +77,9 @@ def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link
     """
     if not (math.isfinite(x_c) and 0.0 < x_c <= link.length and math.isfinite(push_force)):
         return TouchPoint(np.full(3, np.nan), math.nan, math.nan)
-    from sensing_antenna.beam import contact_deflection_from_force
-
-    # Eq. 13 solved for y_c: y_c = |F| x_c^3 / (3 E I)
-    y_c = float(contact_deflection_from_force(link, x_c, push_force))
+    # Eq. 13 solved for y_c: y_c = |F| x_c^3 / (3 E I), with the E I of the sag below (the
+    # link's bending compliance: a calibrated T_e measures the stiffness of both)
+    y_c = push_force * x_c**3 * link.bending_compliance / 3.0
     # Rigid abscissa along X^m plus the deflection along Y^c, in motor coordinates
     point_m = np.array([x_c, 0.0, 0.0]) + y_c * frame.axes_m[1]
     point_a = point_m @ frame.motor_axes_a
