@@ -12,10 +12,11 @@ from scipy import optimize, signal
 
 from _simulator_helpers import dominant_frequency
 from sensing_antenna.antenna import Antenna, paper_antenna
+from sensing_antenna.control import design_servo
+from sensing_antenna.control.servo import JOINT_STATE_SIZE
 from sensing_antenna.simulator import Scenario, simulate_detailed
 from sensing_antenna.simulator.integrator import CONTACT_STATE_SIZE, TRUTH_COLUMNS, P, run_samples
 from sensing_antenna.simulator.link import build_link_model
-from sensing_antenna.simulator.motors import design_servo
 
 # Clamped-free first root (Blevins, Table 8-1).
 CLAMPED_FREE_ROOT = 1.87510407
@@ -178,7 +179,7 @@ def _run_free_hub(n_el: int, step: float, n_samples: int) -> tuple[np.ndarray, l
         x,
         v,
         a,
-        np.zeros(8),
+        np.zeros((2, JOINT_STATE_SIZE)),
         np.zeros(CONTACT_STATE_SIZE),
         par,
         model.mass,
@@ -190,7 +191,6 @@ def _run_free_hub(n_el: int, step: float, n_samples: int) -> tuple[np.ndarray, l
         model.n_elements,
         np.zeros(8),
         np.zeros((2, 2, 2, 3)),
-        np.zeros(2),
         np.zeros((n_samples, 2)),
         np.zeros((n_samples, 6)),
         np.zeros(6),

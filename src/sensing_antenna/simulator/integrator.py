@@ -31,6 +31,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from sensing_antenna.control.servo import joint_coupling_torques, joint_servo_step
+
 __all__ = ["TRUTH_COLUMNS", "P", "run_samples", "sensor_wrench"]
 
 
@@ -334,15 +336,6 @@ def sensor_wrench(
 
 
 @njit(cache=True)
-def _biquad(coef: NDArray[np.float64], state: NDArray[np.float64], k: int, x: float) -> float:
-    """Direct form II transposed; coef (2, 3) = [b, a]; state[k], state[k+1]."""
-    y = coef[0, 0] * x + state[k]
-    state[k] = coef[0, 1] * x - coef[1, 1] * y + state[k + 1]
-    state[k + 1] = coef[0, 2] * x - coef[1, 2] * y
-    return y
-
-
-@njit(cache=True)
 def run_samples(
     k0: int,
     k1: int,
@@ -361,7 +354,6 @@ def run_samples(
     n_el: int,
     obst: NDArray[np.float64],
     servo: NDArray[np.float64],
-    theta0: NDArray[np.float64],
     reference: NDArray[np.float64],
     noise: NDArray[np.float64],
     bias: NDArray[np.float64],
@@ -374,12 +366,15 @@ def run_samples(
     Writes the measured angles (n, 2) and wrench (n, 6) of each sample and the ground truth
     (n, TRUTH_COLUMNS): true angles (2), contact flag, x_c, contact point in the absolute frame
     (3), normal force, motor voltages (2), contact force on the link in the motor frame (3) and
-    the stick flag (1 sticking, 0 slipping or no contact).
+    the stick flag (1 sticking, 0 slipping or no contact). The servo runs the controller's
+    compiled step on ``ctrl`` (2, JOINT_STATE_SIZE) with the coefficients ``servo`` (2, 2, 2, 3)
+    of :class:`~sensing_antenna.control.servo.ServoDesign`.
     """
     n = mass_m.shape[0]
     nn = 2 * n + 2
     h = par[_P_STEP]
     nsub = int(par[_P_SUBSTEPS])
+    period = h * nsub
     g = par[_P_GRAVITY]
     s1m = par[_P_S1]
     s2m = par[_P_S2]
@@ -420,25 +415,23 @@ def run_samples(
         for i in range(3):
             truth[k, 10 + i] = cs[_FORCE_M + i]
         truth[k, 13] = cs[_STICK]
-        # --- servo command (Sec. 4.1, Fig. 7): 2-DOF PID plus measured coupling torque -----------
-        c2m = math.cos(meas_theta[k, 1])
-        s2m_ = math.sin(meas_theta[k, 1])
+        # --- servo command (Sec. 4.1, Fig. 7): the library's step, control/servo.py -----------
         # coupling torque about Z^a (joint 1) and about -Y^m (joint 2), from the sensor
-        coup1 = -(s2m_ * meas_wrench[k, 3] + c2m * meas_wrench[k, 5])
-        coup2 = meas_wrench[k, 4]
+        coupling = joint_coupling_torques(meas_theta[k, 1], meas_wrench[k, 3:6])
         tau = np.zeros(2)
         if par[_P_CONTROL] > 0.0:
             for j in range(2):
-                y1 = _biquad(servo[j, 0], ctrl, 4 * j, reference[k, j] - theta0[j])
-                y2 = _biquad(servo[j, 1], ctrl, 4 * j + 2, meas_theta[k, j] - theta0[j])
-                tau[j] = y1 - y2
-            tau[0] += par[_P_FEEDBACK] * coup1
-            tau[1] += par[_P_FEEDBACK] * coup2
-            # feedforward of the modelled Coulomb friction of Eq. 1 from the reference speed
-            if k > 0:
-                for j in range(2):
-                    speed = (reference[k, j] - reference[k - 1, j]) / (h * nsub)
-                    tau[j] += par[_P_COULOMB1 + j] * math.tanh(speed / par[_P_OMEGA_S])
+                tau[j] = joint_servo_step(
+                    servo[j],
+                    ctrl[j],
+                    reference[k, j],
+                    meas_theta[k, j],
+                    coupling[j],
+                    par[_P_FEEDBACK],
+                    par[_P_COULOMB1 + j],
+                    par[_P_OMEGA_S],
+                    period,
+                )
         truth[k, 8] = tau[0] / par[_P_TORQUE_GAIN1]
         truth[k, 9] = tau[1] / par[_P_TORQUE_GAIN2]
         # --- internal Newmark steps --------------------------------------------------------------

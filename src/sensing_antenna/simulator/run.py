@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link, antenna_to_toml
+from sensing_antenna.control.servo import FRICTION_SPEED, design_servo, initial_servo_state
 from sensing_antenna.recording import FORMAT_NAME, Recording
 from sensing_antenna.simulator.contact import Obstacle, place_obstacle
 from sensing_antenna.simulator.integrator import (
@@ -29,7 +30,6 @@ from sensing_antenna.simulator.integrator import (
 )
 from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
 from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
-from sensing_antenna.simulator.motors import design_servo
 from sensing_antenna.simulator.scenario import Scenario, ScenarioError
 
 __all__ = [
@@ -48,9 +48,6 @@ __all__ = [
 
 #: Sampling and control period T_s of the paper's device (s).
 SAMPLE_PERIOD = 1e-3
-
-#: Regularisation speed of the motors' Coulomb friction, tanh(omega / omega_s) (rad/s).
-FRICTION_SPEED = 0.05
 
 #: Contact search starts this fraction of l away from the clamp.
 CONTACT_SEARCH_START = 0.02
@@ -389,10 +386,9 @@ def simulate_detailed(
     meas_theta = np.zeros((n_samples, 2))
     meas_wrench = np.zeros((n_samples, 6))
     truth = np.zeros((n_samples, TRUTH_COLUMNS))
-    ctrl = np.zeros(8)
+    ctrl = np.stack([initial_servo_state(angle) for angle in start])
     cs = np.zeros(CONTACT_STATE_SIZE)
     cs[12] = -1.0
-    theta0 = np.array(start)
 
     def advance(k0: int, k1: int) -> None:
         run_samples(
@@ -413,7 +409,6 @@ def simulate_detailed(
             model.n_elements,
             obst_array,
             servo_array,
-            theta0,
             reference,
             noise,
             bias,

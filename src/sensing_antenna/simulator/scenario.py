@@ -9,6 +9,7 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
+from sensing_antenna.control.servo import DEFAULT_SERVO_POLE
 from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
@@ -209,7 +210,8 @@ class Scenario:
         Time from the start of the sweep to the nominal first touch (s), at least accel_time.
         None: accel_time + ``CRUISE_BEFORE_TOUCH``.
     servo_pole : float
-        Closed-loop pole p of both servos (rad/s, < 0); Eq. 14 with eps = -1/p.
+        Closed-loop pole p of both servos (rad/s, < 0); Eq. 14 with eps = -1/p (the
+        controller's ``DEFAULT_SERVO_POLE``, -60).
     compensate_servo_lag : bool
         At the stop (t_1) freeze the reference at r(t_1) - 2 eps omega*(t_1) instead of r(t_1),
         so that the joint comes to rest where it was at t_1 instead of 2 eps omega* further
@@ -241,7 +243,7 @@ class Scenario:
     accel_time: float | None = None
     start_time: float = 0.1
     approach_time: float | None = None
-    servo_pole: float = -60.0
+    servo_pole: float = DEFAULT_SERVO_POLE
     compensate_servo_lag: bool = True
     n_elements: int = 16
     substeps: int = 2
