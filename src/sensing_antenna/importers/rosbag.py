@@ -319,7 +319,8 @@ def read_rosbag(
         raise
     except Exception as exc:  # rosbags' own errors on a damaged or foreign file
         raise ImporterError(
-            f"{source}: cannot read the bag ({type(exc).__name__}: {exc})".replace("\n", " ")
+            f"{source}: not a readable ROS 1 .bag file or ROS 2 bag directory"
+            f" ({type(exc).__name__}: {exc})".replace("\n", " ")
         ) from None
     clock = put_on_clock(wrench, joints, source=source, period=sample_period, max_gap=max_gap)
     force, torque = axes.to_motor(clock.wrench[:, :3], clock.wrench[:, 3:])
