@@ -61,8 +61,7 @@ def _add_rosbag(formats: Any) -> None:
     parser.add_argument(
         "--joint2",
         metavar="NAME",
-        help="joint read as theta2, the elevation (default: the second name of the first "
-        "message)",
+        help="joint read as theta2, the elevation (default: the second name of the first message)",
     )
     parser.add_argument(
         "--frame",

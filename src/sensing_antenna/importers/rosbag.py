@@ -109,9 +109,7 @@ def _load_rosbags() -> Any:
     try:
         from rosbags import highlevel
     except ImportError:
-        raise ImporterError(
-            f"reading ROS bags needs the rosbags library: {INSTALL_HINT}"
-        ) from None
+        raise ImporterError(f"reading ROS bags needs the rosbags library: {INSTALL_HINT}") from None
     return highlevel
 
 
