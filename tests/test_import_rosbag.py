@@ -52,13 +52,15 @@ def _write_bag(
     names: Sequence[str] = ("pan", "tilt"),
     sensor: NDArray[np.float64] | None = None,
     wrench_type: str = "geometry_msgs/msg/WrenchStamped",
+    headers_unset: bool = False,
 ) -> Path:
     """Write the recording as a bag: one WrenchStamped and one JointState message per sample.
 
     ``wrench_ns``/``joints_ns`` are the header stamps (default: EPOCH_NS + t in ns);
     ``wrench_kept`` the samples whose wrench message is written (default all); ``names`` the
     joints of each JointState message, where ``pan`` carries theta1 and ``tilt`` theta2 and any
-    other name 0; ``sensor`` R with v_sensor = R @ v_motor (default the identity).
+    other name 0; ``sensor`` R with v_sensor = R @ v_motor (default the identity);
+    ``headers_unset`` writes every header stamp as 0, the stamps only as the bag's record times.
     """
     store = get_typestore(Stores.ROS2_HUMBLE if ros == 2 else Stores.ROS1_NOETIC)
     types = store.types
@@ -72,6 +74,7 @@ def _write_bag(
     vector = types["geometry_msgs/msg/Vector3"]
 
     def header(k: int, stamp: int) -> object:
+        stamp = 0 if headers_unset else stamp
         time = types["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9)
         fields = {"stamp": time, "frame_id": "sensor"}
         return types["std_msgs/msg/Header"](**fields, **({"seq": k} if ros == 1 else {}))
@@ -226,6 +229,26 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     assert np.any(error > 0)
     text = "\n".join(result.report.lines())
     assert "1 sample(s) without their own wrench message, interpolated; 10 left out" in text
+
+
+def test_unset_header_stamps_are_refused_unless_the_bag_s_times_are_asked_for(
+    recording: Recording, tmp_path: Path
+) -> None:
+    bag = _write_bag(_bag_path(tmp_path, 1), recording, 1, headers_unset=True)
+    with pytest.raises(ImporterError, match=r"message 0 has no header stamp \(0\); use the bag's"):
+        read_rosbag(bag, WRENCH, JOINTS)
+    _assert_same_samples(read_rosbag(bag, WRENCH, JOINTS, stamps="bag").recording, recording)
+
+
+def test_a_ros2_bag_may_be_named_by_its_metadata_file_and_a_ros1_bag_needs_its_suffix(
+    bag: Path, recording: Recording, tmp_path: Path
+) -> None:
+    by_metadata = read_rosbag(bag / "metadata.yaml", WRENCH, JOINTS).recording
+    _assert_same_samples(by_metadata, _first(recording, 50))
+    ros1 = _write_bag(tmp_path / "short.bag", _first(recording, 50), 1)
+    renamed = ros1.rename(tmp_path / "short.log")
+    with pytest.raises(ImporterError, match=r"a ROS 1 bag .* does not end in \.bag"):
+        read_rosbag(renamed, WRENCH, JOINTS)
 
 
 def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:

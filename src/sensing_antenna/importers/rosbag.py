@@ -47,6 +47,7 @@ JOINTS_TYPE = "sensor_msgs/msg/JointState"
 INSTALL_HINT = "pip install 'sensing-antenna[ros]'"
 
 _NS = 10**9
+_ROS1_MAGIC = b"#ROSBAG V2.0"
 
 
 @dataclass(frozen=True)
@@ -249,6 +250,23 @@ def _choose_joints(
     return chosen[0], chosen[1]
 
 
+def _bag_path(path: Path, source: str) -> Path:
+    """The path rosbags opens: a ROS 2 bag's directory when given its ``metadata.yaml``; a ROS 1
+    bag only under a name ending in ``.bag`` (rosbags tells the two apart by that suffix)."""
+    if not path.exists():
+        raise ImporterError(f"{source}: no such file or directory")
+    if path.name == "metadata.yaml":
+        return path.parent
+    if path.is_file() and path.suffix != ".bag":
+        with path.open("rb") as file:
+            if file.read(len(_ROS1_MAGIC)) == _ROS1_MAGIC:
+                raise ImporterError(
+                    f"{source}: a ROS 1 bag (its first line says so) under a name that does not"
+                    " end in .bag, which rosbags needs to read it as one: rename or link it"
+                )
+    return path
+
+
 def read_rosbag(
     path: str | Path,
     wrench_topic: str,
@@ -267,7 +285,7 @@ def read_rosbag(
     Parameters
     ----------
     path : str or Path
-        A ROS 1 bag (a ``.bag`` file) or a ROS 2 bag (its directory).
+        A ROS 1 bag (a ``.bag`` file) or a ROS 2 bag (its directory or its ``metadata.yaml``).
     wrench_topic : str
         Topic of ``geometry_msgs/WrenchStamped`` messages: force (N), torque (N m).
     joints_topic : str
@@ -303,9 +321,7 @@ def read_rosbag(
     source = str(path)
     highlevel = _load_rosbags()
     axes = SensorAxes() if axes is None else axes
-    bag = Path(path)
-    if not bag.exists():
-        raise ImporterError(f"{source}: no such file or directory")
+    bag = _bag_path(Path(path), source)
     try:
         reader = highlevel.AnyReader([bag])
         with reader:
