@@ -187,8 +187,8 @@ def test_the_sensor_s_axes_and_the_reaction_are_turned_back_onto_the_motor_frame
 def test_jittered_stamps_and_dropped_messages_are_reported(
     recording: Recording, tmp_path: Path
 ) -> None:
-    """Stamps jittered by up to 0.2 ms (a logger's, not the sensor's): every wrench message keeps
-    its own slot and value. One dropped message is bridged; ten in a row are a gap whose
+    """Stamps jittered by up to 0.2 ms (a logger's, not the sensor's): the clock keeps the
+    sensor's period and every wrench message its own slot and value. One dropped message is bridged; ten in a row are a gap whose
     samples are left out, so the recording shows them as dropped."""
     rng = np.random.default_rng(11)
     n = recording.n_samples
@@ -205,8 +205,10 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
         joints_ns=joints_ns,
         wrench_kept=kept,
     )
-    result = read_rosbag(bag, WRENCH, JOINTS, sample_period=0.001)
+    result = read_rosbag(bag, WRENCH, JOINTS)
     clock = result.report.clock
+    # the clock's period: the span over its 3499 periods, off by the jitter of its two ends
+    assert abs(clock.period - 0.001) <= 0.0004 / 3499
     assert clock.wrench_report.n_messages == n - len(dropped)
     assert clock.wrench_report.n_gaps == 1
     assert 0.0106 <= clock.wrench_report.largest_step <= 0.0114  # 11 steps of 1 ms, +-0.4 ms
@@ -216,7 +218,7 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     # slot 0 is the first wrench message both topics cover; as the stamps' jitter relative to
     # it stays under half a period, slot s holds sample first + s
     first = int(np.argmax(wrench_ns >= max(wrench_ns[0], joints_ns[0])))
-    slots = np.rint(result.recording.t / 0.001).astype(int) + first
+    slots = np.rint(result.recording.t / clock.period).astype(int) + first
     assert set(range(first, slots[-1] + 1)) - set(slots) == set(range(1000, 1010))
     own = np.isin(slots, kept)
     np.testing.assert_array_equal(result.recording.force[own], recording.force[slots[own]])

@@ -2,8 +2,9 @@
 
 A lab's log holds the force/torque sensor and the joint angles as separate streams, each with its
 own time stamps, rate, jitter and dropped messages. A recording has one clock. :func:`put_on_clock`
-lays a grid of step T_s over the time both streams cover, starting at the first wrench message
-in it, and fills each slot k (time k T_s):
+lays a grid of step T_s (by default the wrench stream's span over the number of sample periods it
+holds, which stamp jitter barely moves) over the time both streams cover, starting at the first
+wrench message in it, and fills each slot k (time k T_s):
 
 - the wrench with the sensor's own sample: the message whose stamp is nearest to the slot, when
   it lies within T_s / 2 (stamp jitter moves no value; nothing is interpolated). A slot with
@@ -214,7 +215,8 @@ def put_on_clock(
     source : str
         The log's name, for messages.
     period : float, optional
-        T_s (s); the wrench stream's median step when None.
+        T_s (s); when None, the wrench stream's span over the number of periods it holds
+        (each step counted as the whole number of median steps nearest to it).
     max_gap : float
         Steps longer than this many median steps of their stream are gaps (> 1).
 
@@ -241,7 +243,7 @@ def put_on_clock(
             f"{source}: {wrench.name!r} ({_span(wrench)}) and {joints.name!r} ({_span(joints)})"
             " do not overlap in time"
         )
-    step = wrench_report.median_period if period is None else float(period)
+    step = _mean_period(wrench.stamps) if period is None else float(period)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"period must be finite and > 0, got {step!r}")
     step_ns = step * _NS
@@ -303,6 +305,18 @@ def put_on_clock(
         joints_report=joints_report,
         max_gap=max_gap,
     )
+
+
+def _mean_period(stamps: NDArray[np.int64]) -> float:
+    """A stream's sample period (s): its span over the number of periods it holds, each step
+    counted as the whole number of median steps nearest to it (a dropped message makes a step
+    of two). Stamp jitter enters only through the first and last stamps, so the error is at most
+    twice the jitter over the span; the median of jittered steps can be off by far more, and a
+    clock that runs fast or slow slips past the sensor's samples over a long log."""
+    steps = np.diff(stamps)
+    median = float(np.median(steps))
+    periods = np.maximum(np.rint(steps / median), 1.0)
+    return float(stamps[-1] - stamps[0]) / float(np.sum(periods)) / _NS
 
 
 def _span(stream: Stream) -> str:
