@@ -130,8 +130,8 @@ def test_a_bag_at_the_recording_s_instants_gives_the_same_recording_and_estimate
     assert result.recording.sample_period == recording.sample_period == 0.001
     report = result.report
     assert report.ros_version == ros and report.joint_names == ("pan", "tilt")
-    assert report.clock.wrench_report.n_messages == recording.n_samples
-    assert report.clock.wrench_report.median_rate == pytest.approx(1000.0, rel=1e-12)
+    assert report.clock.wrench.n_messages == recording.n_samples
+    assert report.clock.wrench.median_rate == pytest.approx(1000.0, rel=1e-12)
     assert report.clock.n_interpolated == report.clock.n_left_out == 0
     antenna = paper_antenna()
     expected = estimate(recording, antenna, method="paper").to_dict()
@@ -188,8 +188,9 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     recording: Recording, tmp_path: Path
 ) -> None:
     """Stamps jittered by up to 0.2 ms (a logger's, not the sensor's): the clock keeps the
-    sensor's period and every wrench message its own slot and value. One dropped message is bridged; ten in a row are a gap whose
-    samples are left out, so the recording shows them as dropped."""
+    sensor's period and every wrench message its own slot and value. One dropped message is
+    bridged; ten in a row are a gap whose samples are left out, so the recording shows them as
+    dropped."""
     rng = np.random.default_rng(11)
     n = recording.n_samples
     exact = EPOCH_NS + np.arange(n, dtype=np.int64) * 1_000_000
@@ -209,9 +210,9 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     clock = result.report.clock
     # the clock's period: the span over its 3499 periods, off by the jitter of its two ends
     assert abs(clock.period - 0.001) <= 0.0004 / 3499
-    assert clock.wrench_report.n_messages == n - len(dropped)
-    assert clock.wrench_report.n_gaps == 1
-    assert 0.0106 <= clock.wrench_report.largest_step <= 0.0114  # 11 steps of 1 ms, +-0.4 ms
+    assert clock.wrench.n_messages == n - len(dropped)
+    assert clock.wrench.n_gaps == 1
+    assert 0.0106 <= clock.wrench.largest_step <= 0.0114  # 11 steps of 1 ms, +-0.4 ms
     assert clock.n_interpolated == 1 and clock.n_left_out == 10
     # the clock starts at a jittered stamp: a message lies within twice the jitter of its slot
     assert 0.0 < clock.largest_offset <= 0.0004

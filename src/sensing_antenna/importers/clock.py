@@ -33,6 +33,7 @@ from sensing_antenna.recording import MAX_SAMPLES
 
 __all__ = [
     "DEFAULT_MAX_GAP",
+    "ClockReport",
     "ClockedStreams",
     "ImporterError",
     "Stream",
@@ -115,6 +116,58 @@ class StreamReport:
 
 
 @dataclass(frozen=True)
+class ClockReport:
+    """How two streams were put on one clock.
+
+    Parameters
+    ----------
+    wrench, joints : StreamReport
+        The two streams' rates and gaps.
+    period : float
+        T_s (s).
+    origin_ns : int
+        Stamp (ns) of the grid's slot 0, t = 0.
+    n_slots : int
+        Slots of the grid over the time both streams cover, kept or not.
+    n_samples : int
+        Slots kept: the samples of the recording.
+    n_interpolated : int
+        Samples without a wrench message within T_s / 2, filled by a straight line.
+    n_left_out : int
+        Slots left out, inside a gap of either stream.
+    largest_offset : float
+        Largest distance between a wrench message used as it is and its slot (s): the stamps'
+        jitter against the clock.
+    max_gap : float
+        The gap threshold used (median steps).
+    """
+
+    wrench: StreamReport
+    joints: StreamReport
+    period: float
+    origin_ns: int
+    n_slots: int
+    n_samples: int
+    n_interpolated: int
+    n_left_out: int
+    largest_offset: float
+    max_gap: float
+
+    def lines(self) -> list[str]:
+        """Lines for a person: each stream, the clock, the samples filled and left out."""
+        span = (self.n_slots - 1) * self.period
+        return [
+            f"wrench {self.wrench.line()}",
+            f"joints {self.joints.line()}",
+            f"clock: {self.n_samples} samples every {self.period:.6g} s"
+            f" ({1.0 / self.period:.6g} Hz) over {span:.6g} s; wrench stamps within"
+            f" {self.largest_offset:.3g} s of it",
+            f"{self.n_interpolated} sample(s) without their own wrench message, interpolated;"
+            f" {self.n_left_out} left out in gaps longer than {self.max_gap:g} median steps",
+        ]
+
+
+@dataclass(frozen=True)
 class ClockedStreams:
     """The wrench and the joints on one uniform clock.
 
@@ -126,36 +179,13 @@ class ClockedStreams:
         The wrench stream's values at those slots.
     joints : ndarray, shape (m, j)
         The joint stream's values at those slots.
-    period : float
-        T_s (s).
-    origin_ns : int
-        Stamp (ns) of the grid's slot 0, t = 0.
-    n_slots : int
-        Slots of the grid over the overlap, kept or not.
-    n_interpolated : int
-        Kept slots without a wrench message within T_s / 2, filled by a straight line.
-    n_left_out : int
-        Slots left out, inside a gap of either stream.
-    largest_offset : float
-        Largest distance between a wrench message used as it is and its slot (s): the stamps'
-        jitter against the clock.
-    wrench_report, joints_report : StreamReport
-    max_gap : float
-        The gap threshold used (median steps).
+    report : ClockReport
     """
 
     t: NDArray[np.float64]
     wrench: NDArray[np.float64]
     joints: NDArray[np.float64]
-    period: float
-    origin_ns: int
-    n_slots: int
-    n_interpolated: int
-    n_left_out: int
-    largest_offset: float
-    wrench_report: StreamReport
-    joints_report: StreamReport
-    max_gap: float
+    report: ClockReport
 
 
 def _check_stream(stream: Stream, source: str) -> None:
@@ -291,19 +321,23 @@ def put_on_clock(
         )
     used = own_message[has_own]
     largest_offset = float(np.max(offset[used])) / _NS if used.size else 0.0
+    report = ClockReport(
+        wrench=wrench_report,
+        joints=joints_report,
+        period=step,
+        origin_ns=origin,
+        n_slots=n_slots,
+        n_samples=int(kept.shape[0]),
+        n_interpolated=int(np.sum(~has_own[kept])),
+        n_left_out=int(np.sum(left_out)),
+        largest_offset=largest_offset,
+        max_gap=max_gap,
+    )
     return ClockedStreams(
         t=kept.astype(np.float64) * step,
         wrench=wrench_values[kept],
         joints=joint_values[kept],
-        period=step,
-        origin_ns=origin,
-        n_slots=n_slots,
-        n_interpolated=int(np.sum(~has_own[kept])),
-        n_left_out=int(np.sum(left_out)),
-        largest_offset=largest_offset,
-        wrench_report=wrench_report,
-        joints_report=joints_report,
-        max_gap=max_gap,
+        report=report,
     )
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from sensing_antenna.importers.axes import SensorAxes
 from sensing_antenna.importers.clock import (
     DEFAULT_MAX_GAP,
-    ClockedStreams,
+    ClockReport,
     ImporterError,
     Stream,
     put_on_clock,
@@ -64,9 +64,9 @@ class ImportReport:
         The joints read as theta1 and theta2.
     n_skipped_joint_messages : int
         Joint messages that did not name both joints (another publisher's), left aside.
-    clock : ClockedStreams
-        Both topics' reports (``wrench_report``, ``joints_report``), the period, the origin, and
-        the counts of slots interpolated and left out.
+    clock : ClockReport
+        Both topics' rates and gaps, the clock's period and origin, the samples interpolated and
+        left out.
     axes : SensorAxes
         The sensor's axes on the motor frame.
     """
@@ -75,27 +75,21 @@ class ImportReport:
     ros_version: int
     joint_names: tuple[str, str]
     n_skipped_joint_messages: int
-    clock: ClockedStreams
+    clock: ClockReport
     axes: SensorAxes
 
     def lines(self) -> list[str]:
         """A few lines for a person: each topic, the joints, the frame, the clock, the gaps."""
-        clock = self.clock
         skipped = self.n_skipped_joint_messages
-        lines = [
+        wrench, joints, *clock = self.clock.lines()
+        return [
             f"{self.source}: ROS {self.ros_version} bag",
-            f"  wrench {clock.wrench_report.line()}",
-            f"  joints {clock.joints_report.line()}"
-            + (f"; {skipped} without both joints left aside" if skipped else ""),
+            f"  {wrench}",
+            f"  {joints}" + (f"; {skipped} without both joints left aside" if skipped else ""),
             f"  theta1 <- joint {self.joint_names[0]!r}, theta2 <- joint"
             f" {self.joint_names[1]!r}; sensor axes on X^m, Y^m, Z^m: {self.axes.describe()}",
-            f"  clock: {clock.t.shape[0]} samples every {clock.period:.6g} s"
-            f" ({1.0 / clock.period:.6g} Hz) over {clock.t[-1] - clock.t[0]:.6g} s; wrench"
-            f" stamps within {clock.largest_offset:.3g} s of it",
-            f"  {clock.n_interpolated} sample(s) without their own wrench message, interpolated;"
-            f" {clock.n_left_out} left out in gaps longer than {clock.max_gap:g} median steps",
+            *(f"  {line}" for line in clock),
         ]
-        return lines
 
 
 @dataclass(frozen=True)
@@ -336,8 +330,9 @@ def read_rosbag(
             f"{source}: not a readable ROS 1 .bag file or ROS 2 bag directory"
             f" ({type(exc).__name__}: {exc})".replace("\n", " ")
         ) from None
-    clock = put_on_clock(wrench, joints, source=source, period=sample_period, max_gap=max_gap)
-    force, torque = axes.to_motor(clock.wrench[:, :3], clock.wrench[:, 3:])
+    clocked = put_on_clock(wrench, joints, source=source, period=sample_period, max_gap=max_gap)
+    clock = clocked.report
+    force, torque = axes.to_motor(clocked.wrench[:, :3], clocked.wrench[:, 3:])
     own = {
         "sample_period": repr(clock.period),
         "ros_bag": bag.name,
@@ -348,8 +343,8 @@ def read_rosbag(
         "ros_time_origin": f"{clock.origin_ns // _NS}.{clock.origin_ns % _NS:09d}",
     }
     recording = Recording(
-        t=clock.t,
-        theta=clock.joints,
+        t=clocked.t,
+        theta=clocked.joints,
         force=force,
         torque=torque,
         metadata={**own, **(metadata or {})},
