@@ -63,7 +63,7 @@ def _write_bag(
     other name 0; ``sensor`` R with v_sensor = R @ v_motor (default the identity);
     ``headers_unset`` writes every header stamp as 0, the stamps only as the bag's record times;
     ``other_publisher_every`` > 0 adds, every so many samples, a JointState message of another
-    publisher on the same topic, naming only a ``gripper`` joint.
+    publisher on the same topic, 1 ns before the head's, naming only a ``gripper`` joint.
     """
     store = get_typestore(Stores.ROS2_HUMBLE if ros == 2 else Stores.ROS1_NOETIC)
     types = store.types
@@ -113,14 +113,14 @@ def _write_bag(
             writer.write(joints_connection, int(joints_ns[k]), data)
             if other_publisher_every and k % other_publisher_every == 0:
                 other = types["sensor_msgs/msg/JointState"](
-                    header=header(k, int(joints_ns[k]) + 1),
+                    header=header(k, int(joints_ns[k]) - 1),
                     name=["gripper"],
                     position=np.array([0.5]),
                     velocity=np.zeros(0),
                     effort=np.zeros(0),
                 )
                 data = serialize(other, "sensor_msgs/msg/JointState")
-                writer.write(joints_connection, int(joints_ns[k]) + 1, data)
+                writer.write(joints_connection, int(joints_ns[k]) - 1, data)
     return path
 
 
@@ -185,10 +185,22 @@ def test_messages_of_another_publisher_on_the_joint_topic_are_left_aside(
     recording: Recording, tmp_path: Path
 ) -> None:
     bag = _write_bag(_bag_path(tmp_path, 1), recording, 1, other_publisher_every=10)
-    result = read_rosbag(bag, WRENCH, JOINTS)
+    # the topic's first message is the other publisher's: the joints must be named
+    with pytest.raises(ImporterError, match=r"the first message names 1 joint\(s\) \('gripper'\)"):
+        read_rosbag(bag, WRENCH, JOINTS)
+    result = read_rosbag(bag, WRENCH, JOINTS, joint1="pan", joint2="tilt")
     _assert_same_samples(result.recording, recording)
     assert result.report.n_skipped_joint_messages == recording.n_samples // 10
     assert "; 350 without both joints left aside" in "\n".join(result.report.lines())
+
+
+def test_a_nan_in_a_message_is_refused_naming_the_topic_and_the_message(
+    recording: Recording, tmp_path: Path
+) -> None:
+    unreadable = np.full((3, 3), np.nan)  # the sensor reads NaN on every axis
+    bag = _write_bag(_bag_path(tmp_path, 2), _first(recording, 20), 2, sensor=unreadable)
+    with pytest.raises(ImporterError, match=f"{WRENCH!r}: message 0 holds a NaN or infinite"):
+        read_rosbag(bag, WRENCH, JOINTS)
 
 
 def test_two_messages_of_a_topic_at_one_stamp_are_refused(
@@ -365,8 +377,8 @@ def test_a_missing_joint_and_a_missing_bag_are_one_line(
 ) -> None:
     err = _run(_import(bag, "--wrench", WRENCH, "--joints", JOINTS, "--joint2", "elbow"), capsys)
     assert err == (
-        f"antenna import: error: {bag}: topic {JOINTS!r}: no joint 'elbow' in the first message"
-        " (it names 'pan', 'tilt')"
+        f"antenna import: error: {bag}: topic {JOINTS!r}: 0 message(s) name both joints 'pan'"
+        " and 'elbow', at least 2 needed (the topic's joints: 'pan', 'tilt')"
     )
     missing = bag.parent / "nothing"
     err = _run(_import(missing, "--wrench", WRENCH, "--joints", JOINTS), capsys)

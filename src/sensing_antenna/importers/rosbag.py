@@ -148,13 +148,13 @@ def _sorted(
             f"{source}: topic {topic!r}: message {k} has no header stamp (0); use the bag's"
             " record times (--stamps bag)"
         )
+    value_array = np.array(values, dtype=np.float64).reshape(len(values), -1)
+    finite = np.all(np.isfinite(value_array), axis=1)
+    if not np.all(finite):
+        k = int(np.argmin(finite))
+        raise ImporterError(f"{source}: topic {topic!r}: message {k} holds a NaN or infinite value")
     order = np.argsort(stamp_array, kind="stable")
-    return Stream(
-        name=topic,
-        kind=kind,
-        stamps=stamp_array[order],
-        values=np.array(values, dtype=np.float64).reshape(len(values), -1)[order],
-    )
+    return Stream(name=topic, kind=kind, stamps=stamp_array[order], values=value_array[order])
 
 
 def _read_streams(
@@ -179,7 +179,6 @@ def _read_streams(
     indices: dict[tuple[str, ...], tuple[int, int] | None] = {}
     joint_stamps: list[int] = []
     joint_values: list[tuple[float, float]] = []
-    skipped = 0
     for number, (connection, bag_time, raw) in enumerate(
         reader.messages(connections=joints_info.connections)
     ):
@@ -195,7 +194,6 @@ def _read_streams(
             )
         pair = indices[message_names]
         if pair is None:
-            skipped += 1
             continue
         position = message.position
         if len(position) != len(message_names):
@@ -207,10 +205,13 @@ def _read_streams(
         joint_values.append((float(position[pair[0]]), float(position[pair[1]])))
     assert names is not None  # the topic has at least two messages
     if len(joint_stamps) < 2:
+        seen = sorted({name for message_names in indices for name in message_names})
+        listed = ", ".join(repr(name) for name in seen) or "none"
         raise ImporterError(
             f"{source}: topic {joints_topic!r}: {len(joint_stamps)} message(s) name both joints"
-            f" {names[0]!r} and {names[1]!r}, at least 2 needed"
+            f" {names[0]!r} and {names[1]!r}, at least 2 needed (the topic's joints: {listed})"
         )
+    skipped = joints_info.msgcount - len(joint_stamps)
     wrench = _sorted(source, wrench_topic, WRENCH_TYPE, wrench_stamps, wrench_values, stamps)
     joints = _sorted(source, joints_topic, JOINTS_TYPE, joint_stamps, joint_values, stamps)
     return wrench, joints, names, skipped
@@ -222,25 +223,21 @@ def _choose_joints(
     source: str,
     topic: str,
 ) -> tuple[str, str]:
-    """The joints read as theta1, theta2: those named, else the first two of the first message."""
+    """The joints read as theta1, theta2: those named, else the first and the second name of
+    the topic's first message."""
     chosen = []
     for position, name in enumerate(wanted):
         if name is None:
             if len(message_names) < 2:
+                listed = ", ".join(repr(n) for n in message_names) or "none"
                 raise ImporterError(
                     f"{source}: topic {topic!r}: the first message names {len(message_names)}"
-                    " joint(s); two are needed (theta1, theta2)"
+                    f" joint(s) ({listed}); name the two to read (theta1, theta2)"
                 )
             name = message_names[position]
-        elif name not in message_names:
-            listed = ", ".join(repr(n) for n in message_names) or "none"
-            raise ImporterError(
-                f"{source}: topic {topic!r}: no joint {name!r} in the first message (it names"
-                f" {listed})"
-            )
         chosen.append(name)
     if chosen[0] == chosen[1]:
-        raise ImporterError(f"{source}: topic {topic!r}: joint {chosen[0]!r} given for both angles")
+        raise ImporterError(f"{source}: topic {topic!r}: joint {chosen[0]!r} read for both angles")
     return chosen[0], chosen[1]
 
 
@@ -285,8 +282,9 @@ def read_rosbag(
     joints_topic : str
         Topic of ``sensor_msgs/JointState`` messages: positions (rad).
     joint1, joint2 : str, optional
-        Joints read as theta1 (azimuth) and theta2 (elevation); the first two names of the
-        topic's first message when None. Messages that do not name both are left aside.
+        Joints read as theta1 (azimuth) and theta2 (elevation); when None, the first and the
+        second name of the topic's first message. Messages that do not name both (another
+        publisher's on the same topic) are left aside.
     axes : SensorAxes, optional
         The sensor's axes on the motor frame; the identity when None.
     sample_period : float, optional
@@ -309,7 +307,8 @@ def read_rosbag(
     ------
     ImporterError
         rosbags missing; the bag unreadable; a topic missing, of another type or with fewer
-        than two messages; a joint missing; two messages of a topic at one stamp; a header
+        than two messages; fewer than two messages naming both joints; a NaN or infinite value;
+        two messages of a topic at one stamp; a header
         stamp of zero; topics that do not overlap in time.
     """
     source = str(path)
