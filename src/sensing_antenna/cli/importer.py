@@ -56,12 +56,14 @@ def _add_rosbag(formats: Any) -> None:
     parser.add_argument(
         "--joint1",
         metavar="NAME",
-        help="joint read as theta1, the azimuth (default: the first name of the first message)",
+        help="joint read as theta1, the azimuth (default: the first name in the topic's first "
+        "message)",
     )
     parser.add_argument(
         "--joint2",
         metavar="NAME",
-        help="joint read as theta2, the elevation (default: the second name of the first message)",
+        help="joint read as theta2, the elevation (default: the second name in the topic's first "
+        "message)",
     )
     parser.add_argument(
         "--frame",
@@ -79,7 +81,8 @@ def _add_rosbag(formats: Any) -> None:
         "--rate",
         type=number(low=0.0, low_open=True, unit="Hz"),
         metavar="HZ",
-        help="the recording's sample rate (Hz; default: the wrench topic's median rate)",
+        help="the recording's sample rate (Hz; default: the wrench topic's, its sample periods "
+        "over its span, dropped messages counted)",
     )
     parser.add_argument(
         "--max-gap",
