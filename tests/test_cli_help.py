@@ -22,6 +22,8 @@ COMMANDS = [
     [],
     ["beam"],
     ["simulate"],
+    ["import"],
+    ["import", "rosbag"],
     ["identify"],
     ["estimate"],
     ["calibrate"],
@@ -102,6 +104,7 @@ def test_a_group_without_its_subcommand_lists_them(capsys: pytest.CaptureFixture
     for group, names in (
         ("campaign", ("run", "report")),
         ("plot", ("sensing-curves", "recording")),
+        ("import", ("rosbag",)),
     ):
         with pytest.raises(SystemExit) as exc:
             main([group])

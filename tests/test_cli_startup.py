@@ -70,6 +70,8 @@ def _probe(argv: list[str]) -> tuple[int, list[str], str]:
         ["plot", "sensing-curves", "--help"],
         ["plot", "recording", "--help"],
         ["plot", "estimate", "--help"],
+        ["import", "--help"],
+        ["import", "rosbag", "--help"],
     ],
     ids=" ".join,
 )
@@ -102,6 +104,8 @@ def test_help_loads_no_numerical_package(argv: list[str]) -> None:
         ["calibrate", "rec.csv", "--out", "a.toml", "--loss", "square"],
         ["estimate", "rec.csv", "--method", "fast", "--tolerance", "-1"],
         ["campaign", "run", "--out", "c", "--workers", "0"],
+        ["import"],
+        ["import", "rosbag", "b.bag", "--wrench", "/w", "--joints", "/j", "--rate", "0"],
     ],
     ids=lambda argv: " ".join(argv) or "no arguments",
 )

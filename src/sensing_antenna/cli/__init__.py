@@ -44,6 +44,7 @@ from sensing_antenna.errors import SensingAntennaError, Terminated
 COMMAND_MODULES = (
     "beam",
     "simulate",
+    "importer",
     "identify",
     "estimate",
     "calibrate",

@@ -1,0 +1,90 @@
+"""Two timed streams onto one uniform clock: the wrench at its own samples, the joints
+interpolated, gaps left out. References are streams built here whose right answer is known: a
+ramp, which linear interpolation gives back exactly, and gaps placed by hand."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sensing_antenna.importers import ImporterError
+from sensing_antenna.importers.clock import Stream, put_on_clock
+
+EPOCH_NS = 1_700_000_000_000_000_000
+MS = 1_000_000  # ns
+
+
+def _wrench(n: int, period_ns: int = MS, start_ns: int = EPOCH_NS) -> Stream:
+    """A 1 kHz wrench whose six values at sample k are k, 2k, ... 6k."""
+    k = np.arange(n)
+    return Stream(
+        name="/wrench",
+        kind="wrench",
+        stamps=start_ns + k.astype(np.int64) * period_ns,
+        values=np.outer(k, np.arange(1, 7)).astype(np.float64),
+    )
+
+
+def _ramp_joints(stamps: np.ndarray) -> Stream:
+    """Joints at the given stamps (ns): theta1 = 0.3 rad/s x t, theta2 = 0.1 - 0.2 rad/s x t."""
+    t = (stamps - EPOCH_NS) / 1e9
+    return Stream(
+        name="/joints",
+        kind="joints",
+        stamps=stamps,
+        values=np.column_stack([0.3 * t, 0.1 - 0.2 * t]),
+    )
+
+
+def test_slower_joints_are_interpolated_linearly_and_the_wrench_kept_as_sampled() -> None:
+    wrench = _wrench(1001)
+    joints = _ramp_joints(EPOCH_NS + np.arange(201, dtype=np.int64) * 5 * MS)  # 200 Hz
+    clocked = put_on_clock(wrench, joints, source="log")
+    report = clocked.report
+    assert report.period == 0.001 and report.n_samples == 1001
+    assert report.joints.median_rate == 200.0 and report.wrench.median_rate == 1000.0
+    np.testing.assert_array_equal(clocked.t, np.arange(1001) * 0.001)
+    np.testing.assert_array_equal(clocked.wrench, wrench.values)
+    expected = np.column_stack([0.3 * clocked.t, 0.1 - 0.2 * clocked.t])
+    np.testing.assert_allclose(clocked.joints, expected, rtol=0, atol=1e-15)  # a ramp, exactly
+
+
+def test_a_clock_faster_than_the_sensor_interpolates_the_samples_between() -> None:
+    wrench = _wrench(101)
+    joints = _ramp_joints(wrench.stamps)
+    clocked = put_on_clock(wrench, joints, source="log", period=0.0005)
+    assert clocked.report.n_samples == 201 and clocked.report.n_interpolated == 100
+    np.testing.assert_array_equal(clocked.wrench[::2], wrench.values)
+    np.testing.assert_allclose(clocked.wrench[1::2], (wrench.values[1:] + wrench.values[:-1]) / 2)
+
+
+def test_the_clock_covers_only_the_time_both_streams_cover() -> None:
+    wrench = _wrench(100)
+    joints = _ramp_joints(EPOCH_NS + np.arange(20, 80, dtype=np.int64) * MS + MS // 3)
+    clocked = put_on_clock(wrench, joints, source="log")
+    # from the first wrench message after the joints start (sample 21) to the joints' end
+    assert clocked.report.origin_ns == int(wrench.stamps[21])
+    np.testing.assert_array_equal(clocked.wrench[0], wrench.values[21])
+    assert clocked.t[-1] == pytest.approx((79 - 21) * 0.001)
+
+
+def test_slots_inside_a_joint_gap_are_left_out() -> None:
+    wrench = _wrench(200)
+    stamps = EPOCH_NS + np.arange(200, dtype=np.int64) * MS
+    joints = _ramp_joints(np.delete(stamps, np.arange(50, 60)))  # 11 ms between 49 and 60
+    clocked = put_on_clock(wrench, joints, source="log")
+    assert clocked.report.joints.n_gaps == 1 and clocked.report.n_left_out == 10
+    kept = np.rint(clocked.t / 0.001).astype(int)
+    assert set(range(200)) - set(kept) == set(range(50, 60))
+    gap = put_on_clock(wrench, joints, source="log", max_gap=12.0)
+    assert gap.report.n_left_out == 0 and gap.report.joints.n_gaps == 0
+
+
+def test_streams_that_do_not_overlap_or_repeat_a_stamp_are_refused() -> None:
+    wrench = _wrench(10)
+    later = _ramp_joints(EPOCH_NS + np.arange(10, 20, dtype=np.int64) * MS)
+    with pytest.raises(ImporterError, match=r"^log: '/wrench' \(.*\) do not overlap in time$"):
+        put_on_clock(wrench, later, source="log")
+    repeated = _ramp_joints(EPOCH_NS + np.array([0, MS, MS, 2 * MS], dtype=np.int64))
+    with pytest.raises(ImporterError, match=r"'/joints': messages 1 and 2 .* same stamp"):
+        put_on_clock(wrench, repeated, source="log")
