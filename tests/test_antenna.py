@@ -373,3 +373,17 @@ def test_contact_point_message_shows_plain_numbers() -> None:
     with pytest.raises(AntennaConfigError) as info:
         paper_antenna().link.check_contact_point(np.float64("nan"))
     assert str(info.value) == "x_c: contact point must lie in (0, 0.98] m, got nan"
+
+
+def test_the_frequency_model_is_as_uncertain_as_what_is_known_of_t() -> None:
+    from sensing_antenna.antenna import CALIBRATED_T_UNCERTAINTY, NOMINAL_T_UNCERTAINTY
+
+    nominal = paper_antenna()
+    assert nominal.link.frequency_uncertainty == NOMINAL_T_UNCERTAINTY == 0.05
+    unmeasured = nominal.with_calibrated_t(0.2124)
+    assert unmeasured.link.frequency_uncertainty == CALIBRATED_T_UNCERTAINTY == 0.01
+    assert nominal.with_calibrated_t(0.2124, 0.0012).link.frequency_uncertainty == 0.0012
+    # its own T as the calibrated one: the same frequency model, now with a measured scatter
+    own = nominal.self_calibrated(0.001)
+    assert own.link.t_param == nominal.link.t_param
+    assert own.link.frequency_uncertainty == 0.001

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_info, threadpool_limits
 
+from _models import calibrated
 from sensing_antenna.antenna import FreeMotionObserver, paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.errors import FieldError
@@ -71,7 +72,7 @@ from sensing_antenna.simulator import Scenario, simulate
 from test_estimation_pipeline import Synthetic, synthetic_recording
 
 TS = 1e-3
-LINK = paper_antenna().link
+LINK = calibrated().link
 X_RANGE = (0.2 * LINK.length, LINK.length)
 GRID = np.linspace(X_RANGE[0], X_RANGE[1], 3137)
 CURVE = sensing_curve(LINK)
@@ -87,7 +88,7 @@ def _posterior(omega: float, omega_se: float, ratio: float, ratio_se: float) -> 
 
 def _evidence(recording: Recording, antenna: Any = None) -> Evidence:
     """What the pipeline hands a method (the front end's step), on a recording that reaches it."""
-    evidence = gather(recording, antenna or paper_antenna())
+    evidence = gather(recording, antenna or calibrated())
     assert isinstance(evidence, Evidence)
     return evidence
 
@@ -99,7 +100,7 @@ def _evidence(recording: Recording, antenna: Any = None) -> Evidence:
 def azimuthal() -> Recording:
     """Paper antenna, azimuthal sweep onto a post at 0.6 m (seed 5): the fast method declares
     on a window of 0.237 s; the contact force vibrates at a fraction of the push."""
-    return simulate(paper_antenna(), Scenario(case="azimuthal", contact_point=0.6, seed=5))
+    return simulate(calibrated(), Scenario(case="azimuthal", contact_point=0.6, seed=5))
 
 
 @pytest.fixture(scope="module")
@@ -109,7 +110,7 @@ def azimuthal_evidence(azimuthal: Recording) -> Evidence:
 
 @pytest.fixture(scope="module")
 def azimuthal_estimate(azimuthal: Recording) -> ContactEstimate:
-    return estimate(azimuthal, paper_antenna(), FastMethod())
+    return estimate(azimuthal, calibrated(), FastMethod())
 
 
 @pytest.fixture(scope="module")
@@ -130,7 +131,7 @@ def noisy_far() -> Recording:
 def _online(recording: Recording, method: Any, block: int | None = None) -> ContactEstimate:
     """The estimate the online form returns while fed ``recording``: sample by sample with
     ``update`` (``block`` None) or in blocks of ``block`` samples with ``update_block``."""
-    online = OnlineEstimator(paper_antenna(), recording.sample_period, method)
+    online = OnlineEstimator(calibrated(), recording.sample_period, method)
     t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
     step = 1 if block is None else block
     for k in range(0, t.shape[0], step):
@@ -536,7 +537,7 @@ def test_offline_and_online_agree_on_a_simulated_recording(
     # The pipeline's batch and streaming forms hand the same samples to the method; the fast
     # method only reads samples up to its own declaration, so both give identical estimates.
     # With the push phase, on a recording whose declared window is the one through the push.
-    antenna = paper_antenna()
+    antenna = calibrated()
     recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=seed))
     method = FastMethod(FastConfig(push_phase=push_phase))
     offline = estimate(recording, antenna, method)
@@ -633,7 +634,7 @@ def test_second_mode_chooses_the_branch_near_the_peak() -> None:
     # (the default), the window is declared once the spectrum of [t_1, t] is clear. Either way
     # the estimate must sit on the simulator's contact branch, with the interval on that branch
     # holding its contact abscissa.
-    antenna = paper_antenna()
+    antenna = calibrated()
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.75, seed=3))
     truth = float(recording.metadata["true_xc"])
     blind = recording.without_ground_truth()
@@ -736,7 +737,7 @@ def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
     # method evaluates one window, the block's last grid instant, and the estimate is that
     # window's. Blocks of one sample are update(), and one block holding every sample asks
     # nothing before the pipeline's own end, so both give the offline estimate.
-    antenna, offline, recording = paper_antenna(), azimuthal_estimate, azimuthal
+    antenna, offline, recording = calibrated(), azimuthal_estimate, azimuthal
     single = _online(recording, FastMethod(), 1)
     assert (single.x_c, single.t_e) == (offline.x_c, offline.t_e)
     whole = _online(recording, FastMethod(), recording.t.shape[0])
@@ -793,7 +794,7 @@ def test_a_contact_force_that_turns_is_reported_as_slip_online_as_offline(
     # concludes on the cap's window with the same slip reference: the same estimate.
     method = FastMethod(FastConfig(tolerance=1e-6))
     turned = _turned(azimuthal, azimuthal_estimate.t_1, 1.2)
-    offline = estimate(turned, paper_antenna(), method)
+    offline = estimate(turned, calibrated(), method)
     assert offline.status is Status.SLIP_SUSPECTED
     assert offline.t_e - offline.t_1 == pytest.approx(FastConfig().cap)
     found = re.search(r"turned by ([\d.]+) deg \(\+- ([\d.]+)\)", offline.reason or "")
@@ -850,7 +851,7 @@ def test_windows_started_warm_declare_what_windows_started_from_the_pencil_decla
     # reach nearly the same optimum: omega_1 differs (another start) by a fraction of its
     # standard error, and both declarations are ok, each x_c inside the other's interval and
     # both intervals holding the simulator's contact point.
-    cold = estimate(azimuthal, paper_antenna(), FastMethod(FastConfig(warm_start_after=0.0)))
+    cold = estimate(azimuthal, calibrated(), FastMethod(FastConfig(warm_start_after=0.0)))
     warm = azimuthal_estimate
     truth = float(azimuthal.metadata["true_xc"])
     assert warm.omega1 != cold.omega1
@@ -867,7 +868,7 @@ def test_a_session_never_serves_the_fits_of_other_samples(
     # Two recordings with the same t_c, t_1 and hold, the second with Gamma_y 3 % larger after
     # the hold: a session (online, after reset(); or handed to estimate) gives each the answer
     # of a fresh method.
-    antenna, first = paper_antenna(), azimuthal
+    antenna, first = calibrated(), azimuthal
     torque = first.torque.copy()
     after = first.t > azimuthal_estimate.t_1 + 0.2
     torque[after, 1] *= 1.03
@@ -918,7 +919,7 @@ def _push_window(case: str, x_c: float, seed: int, after_t1: float) -> tuple[Any
     """The window ``after_t1`` (s) after t_1 of one simulated recording (paper antenna),
     evaluated with the push phase and without it (from t_1 alone), and the true omega_1
     (sensing curve at the simulator's contact abscissa)."""
-    antenna = paper_antenna()
+    antenna = calibrated()
     recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=seed, duration=2.0))
     truth = float(CURVE.omega1(float(recording.metadata["true_xc"])))
     evidence = _evidence(recording.without_ground_truth(), antenna)
@@ -954,7 +955,7 @@ def test_the_windows_from_the_end_of_the_hold_do_not_reach_into_the_push() -> No
     # tiny every window at least first_window past the hold restarts there, on the recording
     # whose windows through the push stand: those windows are fitted from the hold's end
     # alone, while earlier ones reach back to t_c.
-    recording = simulate(paper_antenna(), Scenario(case="vertical", contact_point=0.4, seed=400))
+    recording = simulate(calibrated(), Scenario(case="vertical", contact_point=0.4, seed=400))
     evidence = _evidence(recording.without_ground_truth())
     config = FastConfig(push_phase=True, max_opening=1e-9, cap=0.35)
     history = FastMethod(config).history(evidence, from_t1=True)

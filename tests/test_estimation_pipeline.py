@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 from scipy.signal import lsim
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
+from _models import calibrated
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.detection.contact import detect_contact
 from sensing_antenna.errors import FieldError
@@ -70,7 +71,7 @@ class Synthetic:
 
 
 def synthetic_recording(spec: Synthetic, antenna: Antenna | None = None) -> Recording:
-    antenna = antenna or paper_antenna()
+    antenna = antenna or calibrated()
     link = antenna.link
     rng = np.random.default_rng(spec.seed)
     n = round(spec.duration / TS) + 1
@@ -150,7 +151,7 @@ def expected_point(spec: Synthetic, recording: Recording) -> np.ndarray:
     """Touched point: x_c X^m displaced by y_c against the push direction (towards R), plus the
     sag of the link under its own weight (uniformly loaded cantilever, Gere and Timoshenko:
     v = q x^2 (6 l^2 - 4 l x + x^2) / (24 E I)), which the synthetic device's link also has."""
-    link = paper_antenna().link
+    link = calibrated().link
     theta = recording.theta[-1]
     axes = motor_axes(theta)
     push_row = 1 if spec.case == "azimuthal" else 2
@@ -172,7 +173,7 @@ def test_paper_method_recovers_contact_point(case: str, x_c: float) -> None:
     # units) over the curve slope (> 20 rad/s/m here) and the sensor noise remain.
     spec = Synthetic(x_c=x_c, case=case, seed=11)
     recording = synthetic_recording(spec)
-    result = estimate(recording, paper_antenna())
+    result = estimate(recording, calibrated())
     assert result.status is Status.OK, result.reason
     assert result.x_c == pytest.approx(x_c, abs=5e-3)
     assert result.ratio_estimate == pytest.approx(x_c, abs=0.03)
@@ -183,7 +184,7 @@ def test_paper_method_recovers_contact_point(case: str, x_c: float) -> None:
 
 
 def test_vibration_only_out_of_plane_or_only_in_plane() -> None:
-    antenna = paper_antenna()
+    antenna = calibrated()
     only_out = estimate(synthetic_recording(Synthetic(in_plane=0.0, seed=3)), antenna)
     only_in = estimate(synthetic_recording(Synthetic(out_of_plane=0.0, seed=3)), antenna)
     assert only_out.ok and only_in.ok
@@ -195,15 +196,15 @@ def test_vibration_only_out_of_plane_or_only_in_plane() -> None:
 
 def test_ground_truth_metadata_is_not_read() -> None:
     recording = synthetic_recording(Synthetic(x_c=0.7, seed=5))
-    with_truth = estimate(recording, paper_antenna())
-    without = estimate(recording.without_ground_truth(), paper_antenna())
-    lying = estimate(recording.with_metadata(true_xc="0.2"), paper_antenna())
+    with_truth = estimate(recording, calibrated())
+    without = estimate(recording.without_ground_truth(), calibrated())
+    lying = estimate(recording.with_metadata(true_xc="0.2"), calibrated())
     assert "true_xc" not in recording.without_ground_truth().metadata
     assert with_truth.to_dict() == without.to_dict() == lying.to_dict()
 
 
 def run_online(recording: Recording, method: str = "paper"):
-    online = OnlineEstimator(paper_antenna(), recording.sample_period, method=method)
+    online = OnlineEstimator(calibrated(), recording.sample_period, method=method)
     given = []
     for k in range(recording.n_samples):
         out = online.update(
@@ -225,7 +226,7 @@ def comparable(result) -> dict:
 @pytest.mark.parametrize("method", sorted(METHODS))
 def test_online_and_offline_agree(method: str) -> None:
     recording = synthetic_recording(Synthetic(x_c=0.8, case="vertical", seed=9))
-    offline = estimate(recording, paper_antenna(), method=method)
+    offline = estimate(recording, calibrated(), method=method)
     given, final = run_online(recording, method)
     assert len(given) == 1, "the estimate is given exactly once"
     index, online = given[0]
@@ -249,7 +250,7 @@ def test_online_and_offline_agree(method: str) -> None:
 )
 def test_doubtful_recordings_get_a_status(spec: Synthetic, status: Status) -> None:
     recording = synthetic_recording(spec)
-    result = estimate(recording, paper_antenna())
+    result = estimate(recording, calibrated())
     assert result.status is status, result.reason
     assert result.reason
     _, final = run_online(recording)
@@ -259,13 +260,13 @@ def test_doubtful_recordings_get_a_status(spec: Synthetic, status: Status) -> No
 def test_no_contact() -> None:
     # A free sweep: the obstacle is never reached (contact far beyond the recording).
     recording = synthetic_recording(Synthetic(contact_time=50.0, stops=False, duration=2.0))
-    result = estimate(recording, paper_antenna())
+    result = estimate(recording, calibrated())
     assert result.status is Status.NO_CONTACT
     assert math.isnan(result.x_c)
     _, final = run_online(recording)
     assert final.status is Status.NO_CONTACT
     # Without a contact there is no evidence to study: the front end gives the early outcome
-    early = gather(recording, paper_antenna())
+    early = gather(recording, calibrated())
     assert isinstance(early, EarlyOutcome)
     assert early.status is Status.NO_CONTACT
     assert early.reason == result.reason
@@ -275,7 +276,7 @@ def test_push_too_gentle_is_not_a_push() -> None:
     # 0.2 % deflection at 0.9 m: |R| = 3 E I y / x^3 = 0.7 mN... below the 5 mN push threshold,
     # but the vibration still triggers the contact detector.
     spec = Synthetic(x_c=0.9, deflection_ratio=0.0005, in_plane=40.0, out_of_plane=40.0)
-    result = estimate(synthetic_recording(spec), paper_antenna())
+    result = estimate(synthetic_recording(spec), calibrated())
     assert result.status in (Status.PUSH_NOT_REACHED, Status.NO_CONTACT)
 
 
@@ -287,12 +288,12 @@ def test_bad_input_coarse_sampling_and_dead_sensor() -> None:
         force=recording.force[::25],
         torque=recording.torque[::25],
     )
-    result = estimate(coarse, paper_antenna())
+    result = estimate(coarse, calibrated())
     assert result.status is Status.BAD_INPUT and "Nyquist" in (result.reason or "")
     dead = Recording(
         t=recording.t, theta=recording.theta, force=recording.force, torque=0 * recording.torque
     )
-    assert estimate(dead, paper_antenna()).status is Status.BAD_INPUT
+    assert estimate(dead, calibrated()).status is Status.BAD_INPUT
 
 
 def test_irregular_sampling_is_resampled_and_reported() -> None:
@@ -306,7 +307,7 @@ def test_irregular_sampling_is_resampled_and_reported() -> None:
         torque=recording.torque[keep],
         metadata={"sample_period": "0.001"},
     )
-    result = estimate(dropped, paper_antenna())
+    result = estimate(dropped, calibrated())
     assert result.diagnostics["resampled"] is True
     assert result.diagnostics["sampling"]["n_dropped"] > 0
     assert result.ok and result.x_c == pytest.approx(0.45, abs=5e-3)
@@ -314,9 +315,9 @@ def test_irregular_sampling_is_resampled_and_reported() -> None:
 
 def test_baselines_on_the_same_recording() -> None:
     recording = synthetic_recording(Synthetic(x_c=0.6, seed=4))
-    ratio = estimate(recording, paper_antenna(), method="ratio")
-    two = estimate(recording, paper_antenna(), method="two-frequency")
-    paper = estimate(recording, paper_antenna())
+    ratio = estimate(recording, calibrated(), method="ratio")
+    two = estimate(recording, calibrated(), method="two-frequency")
+    paper = estimate(recording, calibrated())
     assert ratio.t_e == two.t_e == paper.t_e  # same wait for a side-by-side comparison
     # Eq. 21 on cantilever statics: 3 cm (the paper's 3 % of length for prior methods).
     assert ratio.x_c == pytest.approx(0.6, abs=0.03)
@@ -326,8 +327,8 @@ def test_baselines_on_the_same_recording() -> None:
 
 def test_measure_omega1_for_calibration() -> None:
     spec = Synthetic(x_c=0.55, seed=8)
-    measured = measure_omega1(synthetic_recording(spec), paper_antenna(), band=(10.0, 150.0))
-    expected = float(natural_frequencies(paper_antenna().link, 0.55, 1)[0])
+    measured = measure_omega1(synthetic_recording(spec), calibrated(), band=(10.0, 150.0))
+    expected = float(natural_frequencies(calibrated().link, 0.55, 1)[0])
     # Noise: the Cramer-Rao bound of a sinusoid's frequency (Rife and Boorstyn 1974),
     # sqrt(12 sigma^2 / (A^2 T_s^2 N^3)), is 5e-4 rad/s for sigma = 1/64000 N m, rms amplitude
     # A = 3.5e-3 N m over N = 1000 samples; the Hann periodogram spreads about three times that
@@ -338,15 +339,15 @@ def test_measure_omega1_for_calibration() -> None:
     assert measured.reason is None
     silent = measure_omega1(
         synthetic_recording(Synthetic(contact_time=50.0, stops=False, duration=2.0)),
-        paper_antenna(),
+        calibrated(),
     )
     assert math.isnan(silent.omega1) and silent.reason
 
 
 def test_config_changes_delta_t_e1() -> None:
     recording = synthetic_recording(Synthetic(x_c=0.5, seed=1))
-    short = estimate(recording, paper_antenna(), config=EstimatorConfig(spectrum_window=0.5))
-    long = estimate(recording, paper_antenna(), config=EstimatorConfig(spectrum_window=1.2))
+    short = estimate(recording, calibrated(), config=EstimatorConfig(spectrum_window=0.5))
+    long = estimate(recording, calibrated(), config=EstimatorConfig(spectrum_window=1.2))
     assert short.t_e < long.t_e
     # t_e = t_1 + 1200 samples (the ratio converged sooner): times are k T_s, so only float
     # round-off separates them from 1.2 s; half a sample still tells 1200 from 1199 or 1201.
@@ -358,7 +359,7 @@ def test_t1_from_the_push_criterion_is_the_controllers_stop_and_online_equals_of
     decision. The simulator's controller stops its motors with the same criterion
     (PushMonitor, default PushCriterion) on the same samples, so t_1 must be the simulator's
     recorded stop instant exactly (an independent check), and online equals offline."""
-    antenna = paper_antenna()
+    antenna = calibrated()
     scenario = Scenario(case="azimuthal", contact_point=0.55, seed=4)
     recording = simulate(antenna, scenario)
     stop = float(recording.metadata["true_t_stop"])  # read for evaluation only
@@ -395,7 +396,7 @@ def _simulated(case: str) -> Recording:
     """A simulated manoeuvre (the project's simulator, an independent source of samples)."""
     x_c, seed = (0.45, 7) if case == "azimuthal" else (0.8, 8)
     scenario = Scenario(case=case, contact_point=x_c, seed=seed)
-    return simulate(paper_antenna(), scenario).without_ground_truth()
+    return simulate(calibrated(), scenario).without_ground_truth()
 
 
 def _assert_same_evidence(evidence: Evidence, other: Evidence) -> None:
@@ -420,7 +421,7 @@ def test_front_end_and_estimate_are_the_same_sample_by_sample_in_blocks_and_in_b
 ) -> None:
     """One front end: fed sample by sample, in random blocks or the whole recording at once
     (gather), it gives the same evidence to the bit, and the online estimate is the offline one."""
-    recording, antenna = _simulated(case), paper_antenna()
+    recording, antenna = _simulated(case), calibrated()
     config = EstimatorConfig(t1_source=t1_source)  # type: ignore[arg-type]
     batch = gather(recording, antenna, config)
     assert isinstance(batch, Evidence)
@@ -455,7 +456,7 @@ def test_front_end_and_estimate_are_the_same_sample_by_sample_in_blocks_and_in_b
 
 
 def test_estimate_is_gather_then_conclude_and_keeps_what_the_front_end_saw() -> None:
-    recording, antenna = synthetic_recording(Synthetic(x_c=0.6, seed=4)), paper_antenna()
+    recording, antenna = synthetic_recording(Synthetic(x_c=0.6, seed=4)), calibrated()
     gathered = gather(recording, antenna)
     assert isinstance(gathered, Evidence)
     for method in ("paper", "ratio", "two-frequency"):
@@ -495,6 +496,6 @@ def test_method_abilities_are_typed() -> None:
 
 
 def test_front_end_names_a_misshapen_block() -> None:
-    front = FrontEnd(paper_antenna(), TS)
+    front = FrontEnd(calibrated(), TS)
     with pytest.raises(FieldError, match=r"theta: shape \(2, 3\), expected \(2, 2\)"):
         front.update_block(np.zeros(2), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)))

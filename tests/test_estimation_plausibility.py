@@ -16,7 +16,8 @@ import math
 import numpy as np
 import pytest
 
-from sensing_antenna.antenna import Antenna, paper_antenna
+from _models import calibrated
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.estimation import (
     METHODS,
@@ -36,7 +37,7 @@ DEGREES = 180.0 / math.pi
 
 @pytest.fixture(scope="module")
 def antenna() -> Antenna:
-    return paper_antenna()
+    return calibrated()
 
 
 @pytest.fixture(scope="module")

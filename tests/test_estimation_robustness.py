@@ -16,7 +16,8 @@ import math
 import numpy as np
 import pytest
 
-from sensing_antenna.antenna import load_antenna, paper_antenna
+from _models import calibrated
+from sensing_antenna.antenna import load_antenna
 from sensing_antenna.cli.estimate import summary
 from sensing_antenna.estimation import OnlineEstimator, Status, estimate
 from sensing_antenna.recording import Recording
@@ -30,7 +31,7 @@ def test_push_judged_over_the_hold_despite_rebounds() -> None:
     from sensing_antenna.calibration.observer import identify_free_motion
     from sensing_antenna.simulator import Scenario, simulate
 
-    antenna = paper_antenna()
+    antenna = calibrated()
     fit = identify_free_motion(
         simulate(antenna, Scenario(case="free", duration=3.0, seed=1)), antenna
     )
@@ -50,11 +51,11 @@ def test_gentle_push_is_measured_against_noise_not_a_fixed_force() -> None:
     # 0.2 % deflection at 0.9 m: |R| = 3 E I y_c / x_c^3 = 0.7 mN, far below the 5 mN of the
     # old absolute rule but 20 standard errors of the hold mean (3.1 mN noise / sqrt(201)).
     spec = Synthetic(x_c=0.9, deflection_ratio=0.002, seed=3)
-    result = estimate(synthetic_recording(spec), paper_antenna())
+    result = estimate(synthetic_recording(spec), calibrated())
     assert result.status is not Status.PUSH_NOT_REACHED, result.reason
     # With a tenth of that push, the mean is within the noise: no push.
     faint = Synthetic(x_c=0.9, deflection_ratio=0.00002, in_plane=400.0, out_of_plane=400.0)
-    result = estimate(synthetic_recording(faint), paper_antenna())
+    result = estimate(synthetic_recording(faint), calibrated())
     assert result.status in (Status.PUSH_NOT_REACHED, Status.NO_CONTACT), result.reason
 
 
@@ -65,7 +66,7 @@ def test_model_error_gives_disagreement_not_a_confident_answer() -> None:
     # 2 % deflection (60 mN push) its uncertainty is about 6 mm, so 3.4 cm is beyond 3 sigma.
     spec = Synthetic(x_c=0.3, deflection_ratio=0.02, seed=11)
     recording = synthetic_recording(spec)
-    right = estimate(recording, paper_antenna())
+    right = estimate(recording, calibrated())
     assert right.status is Status.OK, right.reason
     assert right.x_c == pytest.approx(0.3, abs=5e-3)
     wrong = estimate(recording, load_antenna("paper-2021-calibrated"))
@@ -92,34 +93,34 @@ def _drop(recording: Recording, start: int, count: int) -> Recording:
 
 def test_gap_after_t1_is_bad_input_online_and_offline() -> None:
     recording = synthetic_recording(Synthetic(x_c=0.45, seed=2))
-    whole = estimate(recording, paper_antenna())
+    whole = estimate(recording, calibrated())
     assert whole.ok
     i_1 = int(np.searchsorted(recording.t, whole.t_1))
     gapped = _drop(recording, i_1 + 300, 200)
-    result = estimate(gapped, paper_antenna())
+    result = estimate(gapped, calibrated())
     assert result.status is Status.BAD_INPUT
     assert "200 samples missing" in (result.reason or "")
-    online = OnlineEstimator(paper_antenna(), 1e-3)
+    online = OnlineEstimator(calibrated(), 1e-3)
     for k in range(gapped.n_samples):
         online.update(gapped.t[k], gapped.theta[k], gapped.force[k], gapped.torque[k])
     final = online.finalize()
     assert final.status is Status.BAD_INPUT and "200 samples missing" in (final.reason or "")
     # A few missing samples are interpolated (3 in a row at most).
-    short = estimate(_drop(recording, i_1 + 300, 3), paper_antenna())
+    short = estimate(_drop(recording, i_1 + 300, 3), calibrated())
     assert short.ok and short.x_c == pytest.approx(whole.x_c, abs=1e-3)
 
 
 def test_gap_before_contact_is_interpolated() -> None:
     recording = synthetic_recording(Synthetic(x_c=0.45, seed=2))
-    result = estimate(_drop(recording, 200, 50), paper_antenna())
+    result = estimate(_drop(recording, 200, 50), calibrated())
     assert result.ok, result.reason
 
 
 def test_online_equals_offline_near_the_tip_with_a_gentle_push() -> None:
     spec = Synthetic(x_c=0.95, deflection_ratio=0.01, seed=7, in_plane=2.0, out_of_plane=2.0)
     recording = synthetic_recording(spec)
-    offline = estimate(recording, paper_antenna())
-    online = OnlineEstimator(paper_antenna(), 1e-3)
+    offline = estimate(recording, calibrated())
+    online = OnlineEstimator(calibrated(), 1e-3)
     for k in range(recording.n_samples):
         online.update(recording.t[k], recording.theta[k], recording.force[k], recording.torque[k])
     assert comparable(online.finalize()) == comparable(offline)
@@ -130,6 +131,6 @@ def test_human_output_says_best_guess_for_doubtful_estimates() -> None:
     wrong = estimate(recording, load_antenna("paper-2021-calibrated"))
     text = summary("rec.csv", wrong.to_dict())
     assert "best guess, not confirmed: " + (wrong.reason or "") in text
-    right = estimate(recording, paper_antenna())
+    right = estimate(recording, calibrated())
     assert "best guess" not in summary("rec.csv", right.to_dict())
     assert wrong.to_dict()["x_c"] == wrong.x_c  # JSON keeps the best guess

@@ -19,7 +19,7 @@ from rosbags.rosbag1 import Writer as Writer1
 from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_typestore
 
-from sensing_antenna.antenna import paper_antenna
+from _models import calibrated
 from sensing_antenna.cli import importer, main
 from sensing_antenna.estimation import estimate
 from sensing_antenna.importers import AxesError, ImporterError, SensorAxes
@@ -38,7 +38,7 @@ def recording() -> Recording:
     """A simulated azimuthal manoeuvre into a post (the project's simulator), without the
     ground truth a device would not have."""
     scenario = Scenario(case="azimuthal", contact_point=0.45, seed=7)
-    return simulate(paper_antenna(), scenario).without_ground_truth()
+    return simulate(calibrated(), scenario).without_ground_truth()
 
 
 def _write_bag(
@@ -146,7 +146,7 @@ def test_a_bag_at_the_recording_s_instants_gives_the_same_recording_and_estimate
     assert report.clock.wrench.n_messages == recording.n_samples
     assert report.clock.wrench.median_rate == pytest.approx(1000.0, rel=1e-12)
     assert report.clock.n_interpolated == report.clock.n_left_out == 0
-    antenna = paper_antenna()
+    antenna = calibrated()
     expected = estimate(recording, antenna, method="paper").to_dict()
     assert expected["status"] == "ok"
     assert estimate(result.recording, antenna, method="paper").to_dict() == expected
@@ -282,7 +282,7 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     # vibration window the estimate is made from; there the loads are the sensor's own values
     # and only the windows' edges move, by the clock's origin (0.2 ms at most, under 1 % of their
     # 1 s): as for the shifted windows of test_estimation_pipeline.py, x_c by under 0.1 mm.
-    antenna = paper_antenna()
+    antenna = calibrated()
     original = estimate(recording, antenna)
     imported = estimate(result.recording, antenna)
     assert original.t_c < 1.0 < 1.01 < original.t_1  # the gap, where the test says it is

@@ -40,7 +40,9 @@ from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
     "BUILTIN_ANTENNAS",
+    "CALIBRATED_T_UNCERTAINTY",
     "MIN_SLENDERNESS",
+    "NOMINAL_T_UNCERTAINTY",
     "PARAMETER_RANGES",
     "Antenna",
     "AntennaConfigError",
@@ -172,6 +174,18 @@ PARAMETER_RANGES: Mapping[str, ParameterRange] = MappingProxyType(
 #: model here uses (Assumption 3 of the paper), needs a slender beam; below, shear and rotary
 #: inertia, which it neglects, are no longer small.
 MIN_SLENDERNESS = 10.0
+
+
+#: Relative standard uncertainty of T (and so of omega_1) for a link known only from its material
+#: data: 5 %. T = sqrt(rho / (E I)) with I = pi r^4 / 4: a Young's modulus known to +-5 to 10 %
+#: (a pultruded carbon-fibre rod's datasheet tolerance) and a radius to +-1 % (four times that in
+#: I) leave about 5 % in T at one standard deviation; the paper's real link was 7 % off its
+#: datasheet T (Section 5.1).
+NOMINAL_T_UNCERTAINTY = 0.05
+
+#: The same for a calibrated link whose calibration did not measure its scatter (fewer than three
+#: points): 1 %, a fifth of the largest residual of the paper's own calibration (Section 5.1).
+CALIBRATED_T_UNCERTAINTY = 0.01
 
 
 @dataclass(frozen=True)
@@ -346,6 +360,21 @@ class Link:
         return math.sqrt(self.linear_density / self.flexural_rigidity)
 
     @property
+    def frequency_uncertainty(self) -> float:
+        """Relative standard uncertainty of the model's omega_1(x_c) (dimensionless).
+
+        A calibrated link: the scatter its calibration measured (``calibration_scatter``), or
+        :data:`CALIBRATED_T_UNCERTAINTY` when that was not measured. A link known only from its
+        material data: :data:`NOMINAL_T_UNCERTAINTY`, the spread of T = sqrt(rho / (E I)) that
+        datasheet tolerances leave (omega_1 scales as 1 / T).
+        """
+        if self.calibrated_t is None:
+            return NOMINAL_T_UNCERTAINTY
+        if self.calibration_scatter is None:
+            return CALIBRATED_T_UNCERTAINTY
+        return self.calibration_scatter
+
+    @property
     def t_param(self) -> float:
         """T used by the frequency model: T_e if calibrated, else the theoretical T (s / m^2).
 
@@ -499,6 +528,13 @@ class Antenna:
         old one described the old T_e).
         """
         return replace(self, link=replace(self.link, calibrated_t=t_e, calibration_scatter=scatter))
+
+    def self_calibrated(self, scatter: float) -> Antenna:
+        """This antenna with its own T as a calibrated T_e and a relative ``scatter``: the model a
+        calibration of a device identical to it gives, for simulation studies that give the
+        estimators the simulated device's own antenna (its T exactly, so a simulated run is
+        unchanged)."""
+        return self.with_calibrated_t(self.link.t_param, scatter)
 
 
 _SECTIONS: dict[str, type] = {

@@ -148,14 +148,11 @@ class EstimatorConfig:
         factor 2 or more (doubled, halved, 10^3), while on the default campaign, noise sweep
         included (four times the nominal noise), the ratio lies within 0.87 to 1.16 times that
         point. 1.5 sits between.
-    model_frequency_scatter : float
-        Relative standard uncertainty of the model's omega_1(x_c) for an antenna without a
-        measured one (``link.calibration_scatter``, written by ``antenna calibrate``). It sets how
-        far past the tip's frequency a measured omega_1 still makes the tip a candidate
-        (``disagreement_sigmas`` of it): the curve ends at x_c = l, and a frequency just beyond
-        omega_1(l) would need a contact past the end. 1 %: ten times what the calibrated
-        simulated device leaves, a fifth of the largest residual of the paper's own calibration
-        (Section 5.1).
+    max_model_spread : float
+        The paper method's answer is ``uncertain`` when the frequency model's own uncertainty
+        (``Link.frequency_uncertainty``: 5 % for a link known from its material data, the
+        calibration's scatter once calibrated) moves the chosen candidate by more than this at
+        two standard deviations (m). 1 cm, the paper's typical accuracy (Tables 3 and 4).
     free_motion_gain_factor : float
         Plausibility (``implausible_input``): the torque of the free motion before t_c must be
         at least 1 / this factor of what the observer predicts from the angles (root-mean-square
@@ -194,7 +191,7 @@ class EstimatorConfig:
     max_ratio_drift: float = 0.02
     min_nyquist_factor: float = 2.0
     max_scale_mismatch: float = 1.5
-    model_frequency_scatter: float = 0.01
+    max_model_spread: float = 0.01
     free_motion_gain_factor: float = 10.0
 
     def __post_init__(self) -> None:

@@ -80,8 +80,9 @@ class FastConfig:
         Relative model error of omega_1 added in quadrature (dimensionless): how well T (or
         T_e) and the sensing curve predict the frequency. 0.001: the agreement of the link's
         sensing curve with the frequencies of the finite-element simulator with a compliant
-        contact. A link whose calibration measured a larger relative scatter
-        (``Link.calibration_scatter``) uses that instead (:func:`model_floor`).
+        contact. A link whose own frequency uncertainty is larger (``Link.frequency_uncertainty``:
+        its calibration's scatter, or the spread of a nominal T when not calibrated) uses that
+        instead (:func:`model_floor`).
     ratio_geometry_factor : float
         kappa of the ratio's model floor kappa (y_c / x_c) x_c (dimensionless). 0.5: the
         neglected torque of the axial force on the deflection is (y_c / x_c)(R_x / R_perp) x_c,
@@ -252,6 +253,7 @@ class FastConfig:
 
 
 def model_floor(link: Link, config: FastConfig) -> float:
-    """Relative model error of omega_1 (dimensionless): the config's floor, or the link's
-    calibration scatter when that is larger."""
-    return max(config.frequency_floor, link.calibration_scatter or 0.0)
+    """Relative model error of omega_1 (dimensionless): the config's floor, or the link's own
+    frequency uncertainty (:attr:`~sensing_antenna.antenna.Link.frequency_uncertainty`: its
+    calibration's scatter, or the spread of a nominal T) when that is larger."""
+    return max(config.frequency_floor, link.frequency_uncertainty)

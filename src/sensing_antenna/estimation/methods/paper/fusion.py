@@ -36,6 +36,7 @@ __all__ = [
     "candidates_from_omega1",
     "conclude",
     "fuse",
+    "model_spread",
     "sensing_curve",
 ]
 
@@ -123,6 +124,31 @@ def candidates_from_omega1(
     k = int(np.argmin(np.abs(omegas - omega1)))
     notes["off_curve"] = float(omega1 / omegas[k] - 1.0)
     return (float(grid[k]),), notes
+
+
+#: Half-width (m) and step (m) of the neighbourhood :func:`model_spread` searches.
+_SPREAD_REACH = 0.25
+_SPREAD_STEP = 5e-4
+
+
+def model_spread(link: Link, x_c: float, relative: float) -> float:
+    """How far (m) from ``x_c`` the contact may lie for the frequency omega_1(x_c) known to a
+    relative ``relative``: the largest |x - x_c| over the points next to x_c, on the link,
+    whose omega_1 lies within that of omega_1(x_c) (the contiguous stretch of the sensing
+    curve; across the curve's maximum when the band reaches it, where the inverse is singular).
+    """
+    curve = sensing_curve(link)
+    omega = float(curve.omega1(x_c))
+    steps = int(_SPREAD_REACH / _SPREAD_STEP)
+    spread = 0.0
+    for sign in (-1.0, 1.0):
+        x = x_c + sign * _SPREAD_STEP * np.arange(1, steps + 1)
+        x = x[(x > 0.0) & (x <= link.length)]
+        inside = np.abs(np.asarray(curve.omega1(x), dtype=float) - omega) <= relative * omega
+        stop = int(np.argmin(inside)) if not inside.all() else inside.size
+        if stop:
+            spread = max(spread, abs(float(x[stop - 1]) - x_c))
+    return spread
 
 
 def conclude(
@@ -336,10 +362,7 @@ class PaperMethod:
         candidates: tuple[float, ...] = ()
         if math.isfinite(measurement.omega1):
             x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
-            scatter = link.calibration_scatter
-            if scatter is None:
-                scatter = cfg.model_frequency_scatter
-            tolerance = cfg.disagreement_sigmas * scatter * measurement.omega1
+            tolerance = cfg.disagreement_sigmas * link.frequency_uncertainty * measurement.omega1
             candidates, notes = candidates_from_omega1(link, measurement.omega1, x_range, tolerance)
             diag.update(notes)
         if not measurement.clear:
@@ -386,6 +409,21 @@ class PaperMethod:
                     f"({sigma_ratio:.3f} m: noise, tare, small-deflection model)",
                 )
             )
+        if candidates_used and math.isfinite(fusion.x_c):
+            spread = model_spread(link, fusion.x_c, 2.0 * link.frequency_uncertainty)
+            diag["model_spread"] = spread
+            if spread > cfg.max_model_spread:
+                problems.append(
+                    (
+                        Status.UNCERTAIN,
+                        f"the frequency model's own uncertainty "
+                        f"({100 * link.frequency_uncertainty:.2g} % of omega_1, "
+                        f"{'the calibration scatter' if link.calibrated_t else 'a nominal T'}) "
+                        f"moves this candidate by up to {100 * spread:.1f} cm at two standard "
+                        f"deviations, more than {100 * cfg.max_model_spread:g} cm"
+                        + ("" if link.calibrated_t else ": calibrate the antenna"),
+                    )
+                )
         if "off_curve" in diag and abs(diag["off_curve"]) > cfg.band_margin:
             problems.append(
                 (
