@@ -336,24 +336,24 @@ def realistic_device(seed: int, length: float = 0.98) -> DeviceImperfections:
     resolution = np.asarray(ATI_NANO17_RESOLUTION)
     gain = 1.0 + rng.uniform(-REALISTIC_GAIN_ERROR, REALISTIC_GAIN_ERROR, size=6)
     rate = rng.uniform(-1.0, 1.0, size=6) * REALISTIC_DRIFT_COUNTS_PER_S * resolution
-    return DeviceImperfections(
-        tip_mass=float(rng.uniform(*REALISTIC_TIP_MASS)),
-        clamp_stiffness=clamp,
-        stiffness_taper=taper,
-        density_taper=math.sqrt(taper),
-        joint_start=float(rng.uniform(*REALISTIC_JOINT_START)) * length,
-        joint_length=float(rng.uniform(*REALISTIC_JOINT_LENGTH)),
-        joint_stiffness_factor=float(rng.uniform(*REALISTIC_JOINT_FACTOR)),
-        joint_density_factor=float(rng.uniform(*REALISTIC_JOINT_FACTOR)),
-        sensor_gain=tuple(float(g) for g in gain),  # type: ignore[arg-type]
-        sensor_coupling=tuple(tuple(float(c) for c in row) for row in coupling),  # type: ignore[arg-type]
-        sensor_drift_rate=tuple(float(r) for r in rate),  # type: ignore[arg-type]
-        sensor_drift_walk=tuple(float(r) for r in REALISTIC_WALK_COUNTS * resolution),  # type: ignore[arg-type]
-        encoder_offset=(
-            float(rng.uniform(-REALISTIC_ENCODER_OFFSET, REALISTIC_ENCODER_OFFSET)),
-            float(rng.uniform(-REALISTIC_ENCODER_OFFSET, REALISTIC_ENCODER_OFFSET)),
+    drawn: dict[str, Any] = {
+        "tip_mass": float(rng.uniform(*REALISTIC_TIP_MASS)),
+        "clamp_stiffness": clamp,
+        "stiffness_taper": taper,
+        "density_taper": math.sqrt(taper),
+        "joint_start": float(rng.uniform(*REALISTIC_JOINT_START)) * length,
+        "joint_length": float(rng.uniform(*REALISTIC_JOINT_LENGTH)),
+        "joint_stiffness_factor": float(rng.uniform(*REALISTIC_JOINT_FACTOR)),
+        "joint_density_factor": float(rng.uniform(*REALISTIC_JOINT_FACTOR)),
+        "sensor_gain": tuple(float(g) for g in gain),
+        "sensor_coupling": tuple(tuple(float(c) for c in row) for row in coupling),
+        "sensor_drift_rate": tuple(float(r) for r in rate),
+        "sensor_drift_walk": tuple(float(r) for r in REALISTIC_WALK_COUNTS * resolution),
+        "encoder_offset": tuple(
+            float(v) for v in rng.uniform(-1.0, 1.0, size=2) * REALISTIC_ENCODER_OFFSET
         ),
-    )
+    }
+    return DeviceImperfections(**drawn)
 
 
 def device_profile(name: str, seed: int, length: float = 0.98) -> DeviceImperfections:
