@@ -304,7 +304,7 @@ def test_realistic_profile_is_reproducible_and_differs_between_seeds() -> None:
     assert realistic_device(12) != first
     for seed in range(20):
         device = realistic_device(seed)
-        assert 0.0 <= device.tip_mass <= 0.2e-3
+        assert 0.0 <= device.tip_mass <= 0.1e-3
         assert device.clamp_stiffness is not None and 15.0 <= device.clamp_stiffness <= 100.0
         assert 0.92 <= device.stiffness_taper <= 1.08
         assert all(abs(g - 1) <= 0.01 for g in device.sensor_gain)

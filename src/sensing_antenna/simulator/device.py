@@ -289,7 +289,7 @@ def device_from_mapping(data: Mapping[str, Any], source: str = "device") -> Devi
 
 #: Spread of the realistic profile (the reasoning and sources of each: docs/simulator.md).
 #: tip mass (kg), uniform
-REALISTIC_TIP_MASS = (0.0, 0.2e-3)
+REALISTIC_TIP_MASS = (0.0, 0.1e-3)
 #: clamp stiffness (N m/rad), log-uniform
 REALISTIC_CLAMP_STIFFNESS = (15.0, 100.0)
 #: E I tip/root ratio, uniform (the density ratio is its square root: d^4 against d^2)
