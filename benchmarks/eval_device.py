@@ -11,7 +11,7 @@ says it is right). A row ``none`` is the nominal device, the control.
 
 Usage::
 
-    python benchmarks/eval_device.py [--points 0.35 0.55 0.8] [--repeats 2]
+    python benchmarks/eval_device.py [--points 0.35 0.55 0.8 0.95] [--repeats 3]
         [--cases azimuthal vertical] [--json benchmarks/results/device.json]
 """
 
@@ -217,8 +217,8 @@ def _clean(value: Any) -> Any:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--points", type=float, nargs="+", default=[0.35, 0.55, 0.8])
-    parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--points", type=float, nargs="+", default=[0.35, 0.55, 0.8, 0.95])
+    parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--cases", nargs="+", default=["azimuthal", "vertical"])
     parser.add_argument("--antenna", default="paper-2021")
     parser.add_argument("--json", type=Path, default=RESULTS)
