@@ -11,17 +11,19 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
-from sensing_antenna.campaign import parse_campaign_spec
+from sensing_antenna.campaign import CampaignSpec, parse_campaign_spec, run_campaign
 from sensing_antenna.campaign.runs import expand_runs
 from sensing_antenna.campaign.schema import CampaignSpecError
+from sensing_antenna.cli import main
 from sensing_antenna.estimation import measure_omega1
 from sensing_antenna.simulator import (
     DeviceError,
@@ -386,3 +388,32 @@ def test_campaign_device_errors_name_the_field(device: dict[str, object], field:
 def test_bad_imperfection_names_its_field(kwargs: dict[str, object], field: str) -> None:
     with pytest.raises(DeviceError, match=f"device.{field}"):
         DeviceImperfections(**kwargs)  # type: ignore[arg-type]
+
+
+def test_campaign_on_the_realistic_profile_runs_and_says_so(tmp_path: Path) -> None:
+    """A campaign with ``[device] profile = "realistic"`` simulates each run on its own draw and
+    its report says the device carries imperfections the model does not know."""
+    spec = parse_campaign_spec(
+        {
+            "name": "realistic",
+            "antenna": "paper-2021",
+            "cases": ["azimuthal"],
+            "contact_points": [0.55],
+            "repeats": 2,
+            "base_seed": 3,
+            "methods": ["paper"],
+            "device": {"profile": "realistic"},
+        },
+        "test",
+    )
+
+    def plain(_: CampaignSpec) -> Antenna:
+        return paper_antenna()
+
+    run_campaign(spec, tmp_path, prepare_antenna=plain, workers=1, progress=False)
+    assert main(["campaign", "report", str(tmp_path)]) == 0
+    text = (tmp_path / "report.md").read_text("utf-8")
+    assert "- Device imperfections: profile realistic" in text
+    assert "has exactly the parameters of the model" not in text
+    rows = (tmp_path / "runs.csv").read_text("utf-8").splitlines()
+    assert len(rows) == 3  # header and two runs
