@@ -209,6 +209,25 @@ def print_table(table: list[dict[str, Any]]) -> None:
         )
 
 
+#: Fields of each estimate in the JSON's ``rows`` (one list per estimate, in this order).
+ROW_FIELDS = (
+    "imperfection",
+    "case",
+    "x_c",
+    "seed",
+    "method",
+    "status",
+    "true_xc",
+    "estimate",
+    "error",
+)
+
+
+def _short(value: Any) -> Any:
+    """Floats to 7 significant digits (0.1 micrometre at the link's scale)."""
+    return float(f"{value:.7g}") if isinstance(value, float) else value
+
+
 def _clean(value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None
@@ -237,11 +256,27 @@ def main() -> None:
         "seconds": result["seconds"],
         "python": platform.python_version(),
         "summary": [{k: _clean(v) for k, v in row.items()} for row in table],
-        "rows": [{k: _clean(v) for k, v in row.items()} for row in result["rows"]],
+        "row_fields": list(ROW_FIELDS),
+        "rows": [[_clean(_short(row[k])) for k in ROW_FIELDS] for row in result["rows"]],
     }
     args.json.parent.mkdir(parents=True, exist_ok=True)
-    args.json.write_text(json.dumps(payload, indent=1) + "\n", encoding="utf-8")
+    args.json.write_text(to_json(payload), encoding="utf-8")
     print(f"wrote {args.json}")
+
+
+def to_json(payload: dict[str, Any]) -> str:
+    """``payload`` as JSON with one line per summary row and per estimate."""
+    lines = ["{"]
+    items = list(payload.items())
+    for i, (key, value) in enumerate(items):
+        end = "," if i < len(items) - 1 else ""
+        if isinstance(value, list) and value and isinstance(value[0], (dict, list)):
+            rows = ",\n".join("  " + json.dumps(row) for row in value)
+            lines.append(f" {json.dumps(key)}: [\n{rows}\n ]{end}")
+        else:
+            lines.append(f" {json.dumps(key)}: {json.dumps(value)}{end}")
+    lines.append("}")
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

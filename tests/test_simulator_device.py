@@ -417,3 +417,11 @@ def test_campaign_on_the_realistic_profile_runs_and_says_so(tmp_path: Path) -> N
     assert "has exactly the parameters of the model" not in text
     rows = (tmp_path / "runs.csv").read_text("utf-8").splitlines()
     assert len(rows) == 3  # header and two runs
+
+
+def test_a_joint_off_the_link_is_refused() -> None:
+    antenna = paper_antenna()
+    device = DeviceImperfections(joint_start=1.2, joint_length=0.02, joint_stiffness_factor=2.0)
+    scenario = Scenario(case="azimuthal", contact_point=0.5, device=device)
+    with pytest.raises(DeviceError, match=r"device\.joint_start"):
+        simulate(antenna, scenario)

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from scipy.linalg import eigh
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.simulator.device import DeviceImperfections
+from sensing_antenna.simulator.device import DeviceError, DeviceImperfections
 
 __all__ = [
     "LinkModel",
@@ -236,6 +236,11 @@ def build_link_model(
             k_full[sl, sl] += k_e
             m_full[sl, sl] += m_e
     else:
+        if device.joint_length > 0.0 and device.joint_start >= length:
+            raise DeviceError(
+                "joint_start",
+                f"{device.joint_start!r} m is not on the link (length {length:g} m)",
+            )
         stiffness_factor, density_factor = device.element_factors(nodes)
         for e in range(n_elements):
             k_e, m_e = _element_matrices(
