@@ -3,11 +3,12 @@
 A measurement, not a tuning: the simulated device carries one imperfection at a time
 (``simulator.DeviceImperfections``: tip mass, compliant clamp, taper, joint, sensor gain,
 cross-axis coupling, drift, encoder offsets) at a few magnitudes, or a draw of the realistic
-profile per run (``simulator.realistic_device``), while every method estimates with the nominal
-antenna. For each imperfection and method it reports the mean and maximum absolute error
-against the simulator's ``true_xc`` over the runs with a finite estimate, the number of runs
-``ok``, and the number ``ok`` with an error over 2 cm (the worst outcome: a wrong answer that
-says it is right). A row ``none`` is the nominal device, the control.
+profile per run (``simulator.realistic_device``), or meets a soft or slippery obstacle (the
+``Scenario`` contact fields), while every method estimates with the nominal antenna. For each
+imperfection and method it reports the mean and maximum absolute error against the simulator's
+``true_xc`` over the runs with a finite estimate, the number of runs ``ok``, and the number
+``ok`` with an error over 2 cm (the worst outcome: a wrong answer that says it is right). A
+row ``none`` is the nominal device, the control.
 
 Usage::
 
@@ -127,11 +128,25 @@ def imperfections() -> list[tuple[str, str, float, DeviceImperfections | None]]:
     return settings
 
 
+#: Obstacle and contact settings that are already ``Scenario`` fields (not device
+#: imperfections): a soft obstacle, and a friction low enough for the contact to slip on the
+#: default post's 0.02 rad lean (mu < tan 0.02).
+CONTACT_SETTINGS: tuple[tuple[str, str, float, dict[str, float]], ...] = (
+    ("soft obstacle 1e3 N/m", "contact_stiffness", 1e3, {"contact_stiffness": 1e3}),
+    ("friction mu 0.01 (slips)", "friction", 0.01, {"friction_coefficient": 0.01}),
+)
+
+
 def run(points: list[float], repeats: int, cases: list[str], antenna_name: str) -> dict[str, Any]:
     antenna = load_antenna(antenna_name)
     rows: list[dict[str, Any]] = []
     start = time.perf_counter()
-    for label, kind, magnitude, fixed in imperfections():
+    settings = [(*s, {}) for s in imperfections()]
+    settings += [
+        (label, kind, value, DeviceImperfections(), extra)
+        for label, kind, value, extra in CONTACT_SETTINGS
+    ]
+    for label, kind, magnitude, fixed, extra in settings:
         for case in cases:
             for x_c in points:
                 for repeat in range(repeats):
@@ -139,7 +154,9 @@ def run(points: list[float], repeats: int, cases: list[str], antenna_name: str) 
                     device = (
                         fixed if fixed is not None else realistic_device(seed, antenna.link.length)
                     )
-                    scenario = Scenario(case=case, contact_point=x_c, seed=seed, device=device)
+                    scenario = Scenario(
+                        case=case, contact_point=x_c, seed=seed, device=device, **extra
+                    )
                     recording = simulate(antenna, scenario)
                     truth = float(recording.metadata["true_xc"])
                     evidence = gather(recording.without_ground_truth(), antenna)
