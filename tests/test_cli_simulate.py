@@ -86,3 +86,55 @@ def test_plot_recording_writes_pngs(tmp_path: Path) -> None:
     names = sorted(p.name for p in (tmp_path / "fig").iterdir())
     assert names == ["angles.png", "force.png", "torque.png", "torque_spectrum.png"]
     assert all((tmp_path / "fig" / n).stat().st_size > 5000 for n in names)
+
+
+def _device_of(path: Path) -> dict[str, object]:
+    import json
+
+    simulation = json.loads(read_recording(path).metadata["simulation"])
+    device: dict[str, object] = simulation["scenario"]["device"]
+    return device
+
+
+def test_simulate_device_profile_and_file(tmp_path: Path) -> None:
+    """--device realistic draws from --seed (same seed, same device); a TOML file sets fields
+    over the profile it names; both are written in the recording's simulation metadata."""
+    base = ["simulate", "--case", "free", "--duration", "0.5"]
+    first, again, other = tmp_path / "a.csv", tmp_path / "b.csv", tmp_path / "c.csv"
+    assert main([*base, "--device", "realistic", "--seed", "4", "--out", str(first)]) == 0
+    assert main([*base, "--device", "realistic", "--seed", "4", "--out", str(again)]) == 0
+    assert main([*base, "--device", "realistic", "--seed", "5", "--out", str(other)]) == 0
+    assert _device_of(first) == _device_of(again) != _device_of(other)
+    assert _device_of(first)["clamp_stiffness"] is not None
+    spec = tmp_path / "device.toml"
+    spec.write_text('[device]\nprofile = "realistic"\ntip_mass = 2e-4\n', encoding="utf-8")
+    out = tmp_path / "d.csv"
+    assert main([*base, "--device", str(spec), "--seed", "4", "--out", str(out)]) == 0
+    device = _device_of(out)
+    assert device["tip_mass"] == 2e-4
+    assert device["clamp_stiffness"] == _device_of(first)["clamp_stiffness"]
+    nominal = tmp_path / "n.csv"
+    assert main([*base, "--out", str(nominal)]) == 0
+    assert _device_of(nominal)["clamp_stiffness"] is None
+
+
+@pytest.mark.parametrize(
+    "content, expected",
+    [
+        ("tip_mas = 1e-4\n", "device.tip_mas"),
+        ("tip_mass = -1.0\n", "device.tip_mass"),
+        ('profile = "perfect"\n', "profile"),
+        ("tip_mass = [\n", "not a TOML file"),
+    ],
+)
+def test_simulate_bad_device_file_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: str, expected: str
+) -> None:
+    spec = tmp_path / "device.toml"
+    spec.write_text(content, encoding="utf-8")
+    code = main(
+        ["simulate", "--case", "free", "--device", str(spec), "--out", str(tmp_path / "r.csv")]
+    )
+    assert code != 0
+    err = capsys.readouterr().err.strip()
+    assert expected in err and err.count("\n") == 0

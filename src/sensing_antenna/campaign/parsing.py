@@ -21,6 +21,8 @@ A spec file looks like::
     [device]                        # optional: the simulated hardware, when it is not the model
     antenna = "paper-2021"          # default: the top-level antenna
     link.youngs_modulus = 132.65e9  # field overrides, SI
+    profile = "realistic"           # imperfections drawn per run ("nominal": none)
+    imperfections.tip_mass = 1e-4   # simulator.DeviceImperfections fields, set on every run
 
     [calibration]                   # optional: fit T_e on the device first (Section 5.1)
     enabled = true
@@ -299,13 +301,24 @@ def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
             )
         antenna = _resolve_antenna(antenna, base_dir)
     overrides: dict[str, dict[str, float]] = {}
+    profile = data.get("profile", "nominal")
+    if not isinstance(profile, str):
+        raise CampaignSpecError("device.profile", "must be a string", source)
+    imperfections = data.get("imperfections", {})
+    if not isinstance(imperfections, Mapping):
+        raise CampaignSpecError(
+            "device.imperfections",
+            "must be a table of fields (e.g. imperfections.tip_mass = 1e-4)",
+            source,
+        )
     for key, values in data.items():
-        if key == "antenna":
+        if key in ("antenna", "profile", "imperfections"):
             continue
         if key not in DEVICE_SECTIONS:
             raise CampaignSpecError(
                 f"device.{key}",
-                f"unknown key; known: antenna, {', '.join(DEVICE_SECTIONS)}",
+                "unknown key; known: antenna, profile, imperfections,"
+                f" {', '.join(DEVICE_SECTIONS)}",
                 source,
             )
         if not isinstance(values, Mapping):
@@ -316,7 +329,12 @@ def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
             )
         overrides[key] = dict(values)
     try:
-        return DeviceSpec(antenna=antenna, overrides=overrides)
+        return DeviceSpec(
+            antenna=antenna,
+            overrides=overrides,
+            profile=profile,
+            imperfections=dict(imperfections),
+        )
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
 

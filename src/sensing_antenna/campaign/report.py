@@ -84,8 +84,28 @@ def _antenna_lines(model: Antenna, device: Antenna, summary: CampaignSummary) ->
     ]
 
 
-def _plain_statement(summary: CampaignSummary) -> list[str]:
+def _imperfection_lines(spec: CampaignSpec) -> list[str]:
+    """The device's imperfections the model does not know, when the spec sets any."""
+    if not spec.device.has_imperfections:
+        return []
+    fixed = ", ".join(f"{k} = {v}" for k, v in sorted(spec.device.imperfections.items()))
+    profile = (
+        "realistic (one set drawn per manoeuvre from its seed)"
+        if spec.device.profile == "realistic"
+        else spec.device.profile
+    )
+    return [f"- Device imperfections: profile {profile}" + (f"; set: {fixed}" if fixed else "")]
+
+
+def _plain_statement(summary: CampaignSummary, spec: CampaignSpec) -> list[str]:
     device, check = summary.device, summary.calibration
+    if spec.device.has_imperfections:
+        return [
+            "The simulated device carries imperfections the model does not know (see "
+            "Settings, device imperfections; docs/simulator.md): the estimators are never told "
+            "of them, and the errors include what they do.",
+            "",
+        ]
     if not device.differences:
         text = (
             "The simulated device has exactly the parameters of the model the estimators use, "
@@ -250,6 +270,7 @@ def _settings_lines(
         ),
         "- Scenario: "
         + (", ".join(f"{k} = {v}" for k, v in sorted(spec.scenario.items())) or "defaults"),
+        *_imperfection_lines(spec),
         f"- Per-run results: [{CSV_FILE}]({CSV_FILE}) (SI units, one row per run and method)",
     ]
 
@@ -294,7 +315,7 @@ def render_report(
         "",
         *_settings_lines(spec, summary, model, device, foreign_run_files),
         "",
-        *_plain_statement(summary),
+        *_plain_statement(summary, spec),
         "The recordings are simulated; the paper's numbers come from its real device, so the "
         "comparison shows whether the method behaves as reported, not a reproduction of the "
         "device.",

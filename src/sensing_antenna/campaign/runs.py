@@ -35,6 +35,7 @@ __all__ = [
     "expand_runs",
     "plan_runs",
     "run_ids",
+    "with_device",
 ]
 
 #: Seed streams of :func:`derive_seed`: the main runs, the free-motion step, the calibration
@@ -226,7 +227,8 @@ def expand_runs(
         The model the estimators use (the spec's, possibly with an identified observer and a
         calibrated T_e).
     device : Antenna, optional
-        The simulated hardware; None simulates with ``antenna``.
+        The simulated hardware; None simulates with ``antenna``. Its imperfections (the spec's
+        ``[device]`` profile and table) go into each run's scenario (:func:`with_device`).
 
     Raises
     ------
@@ -234,21 +236,37 @@ def expand_runs(
         When two runs would share an id (see :func:`run_ids`).
     """
     run_ids(spec)
-    return [
-        RunSpec(
-            index=run.index,
-            run_id=run.run_id,
-            case=run.case,
-            contact_point=run.contact_point,
-            repeat=run.repeat,
-            seed=derive_seed(spec.base_seed, run.position, run.stream),
-            antenna=antenna,
-            methods=spec.methods,
-            scenario=dict(run.scenario),
-            device=device,
+    length = (device or antenna).link.length
+    runs = []
+    for run in plan_runs(spec):
+        seed = derive_seed(spec.base_seed, run.position, run.stream)
+        runs.append(
+            RunSpec(
+                index=run.index,
+                run_id=run.run_id,
+                case=run.case,
+                contact_point=run.contact_point,
+                repeat=run.repeat,
+                seed=seed,
+                antenna=antenna,
+                methods=spec.methods,
+                scenario=with_device(spec, run.scenario, seed, length),
+                device=device,
+            )
         )
-        for run in plan_runs(spec)
-    ]
+    return runs
+
+
+def with_device(
+    spec: CampaignSpec, scenario: Mapping[str, Any], seed: int, length: float
+) -> dict[str, Any]:
+    """``scenario`` with the ``device`` imperfections of the manoeuvre of seed ``seed`` (the
+    spec's ``[device]`` profile and table, ``simulator.DeviceImperfections``), unchanged when the
+    spec sets none; ``length`` (m) is the simulated link's, to place a joint."""
+    extra = dict(scenario)
+    if spec.device.has_imperfections:
+        extra["device"] = spec.device.imperfections_for(seed, length)
+    return extra
 
 
 def calibration_runs(spec: CampaignSpec) -> list[tuple[str, float, int]]:

@@ -22,6 +22,13 @@ from typing import Any
 from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
 from sensing_antenna.campaign import limits
 from sensing_antenna.errors import FieldError
+from sensing_antenna.simulator.device import (
+    DEVICE_PROFILES,
+    DeviceError,
+    DeviceImperfections,
+    device_from_mapping,
+    device_profile,
+)
 from sensing_antenna.simulator.scenario import duration_problem
 
 __all__ = [
@@ -104,7 +111,7 @@ DEFAULT_CALIBRATION_POINTS = (
 _CALIBRATION_LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
 
 #: Scenario keys the campaign sets itself for every run.
-_RESERVED_SCENARIO_KEYS = ("case", "contact_point", "seed")
+_RESERVED_SCENARIO_KEYS = ("case", "contact_point", "seed", "device")
 
 
 class CampaignSpecError(FieldError):
@@ -144,12 +151,32 @@ class DeviceSpec:
         Built-in antenna name or antenna TOML file of the device; None: the campaign's antenna.
     overrides : mapping of str to mapping of str to float
         Field values replacing the base antenna's, by section (:data:`DEVICE_SECTIONS`), SI.
+    profile : {"nominal", "realistic"}
+        Imperfections of the device the model does not know: "nominal" none (besides
+        ``imperfections``), "realistic" one set drawn per simulated manoeuvre from its seed
+        (``simulator.realistic_device``).
+    imperfections : mapping of str to value
+        Fields of ``simulator.DeviceImperfections`` set on every manoeuvre (over the profile's
+        draw), e.g. ``tip_mass = 1e-4``.
     """
 
     antenna: str | None = None
     overrides: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    profile: str = "nominal"
+    imperfections: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if self.profile not in DEVICE_PROFILES:
+            raise CampaignSpecError(
+                "device.profile",
+                f"must be one of {', '.join(DEVICE_PROFILES)}, got {self.profile!r}",
+            )
+        try:
+            device_from_mapping(self.imperfections, "device.imperfections")
+        except DeviceError as exc:
+            raise CampaignSpecError(
+                f"device.imperfections.{exc.field_name}", str(exc).split(": ", 1)[-1]
+            ) from exc
         for section, values in self.overrides.items():
             allowed = DEVICE_SECTIONS.get(section)
             if allowed is None:
@@ -179,14 +206,34 @@ class DeviceSpec:
         """True when the device is the campaign's antenna unchanged."""
         return self.antenna is None and not any(self.overrides.values())
 
+    @property
+    def has_imperfections(self) -> bool:
+        """True when some manoeuvre's device departs from the nominal one (profile or table)."""
+        return self.profile != "nominal" or bool(self.imperfections)
+
+    def imperfections_for(self, seed: int, length: float) -> DeviceImperfections:
+        """The imperfections of the manoeuvre of seed ``seed`` on a link of ``length`` (m): the
+        profile's draw with the ``imperfections`` table set over it."""
+        drawn = device_profile(self.profile, seed, length)
+        if not self.imperfections:
+            return drawn
+        fixed = device_from_mapping(self.imperfections, "device.imperfections")
+        given = {key: getattr(fixed, key) for key in self.imperfections}
+        return replace(drawn, **given)
+
     def to_dict(self) -> dict[str, Any]:
-        """Plain data in the layout of the TOML section."""
+        """Plain data in the layout of the TOML section (the profile and imperfections only
+        when set, so a spec without them keeps its fingerprint)."""
         data: dict[str, Any] = {}
         if self.antenna is not None:
             data["antenna"] = self.antenna
         for section, values in self.overrides.items():
             if values:
                 data[section] = {k: float(v) for k, v in values.items()}
+        if self.profile != "nominal":
+            data["profile"] = self.profile
+        if self.imperfections:
+            data["imperfections"] = dict(self.imperfections)
         return data
 
 
@@ -427,9 +474,12 @@ class CampaignSpec:
             raise CampaignSpecError("scenario.duration", problem, src)
         for key in self.scenario:
             if key in _RESERVED_SCENARIO_KEYS:
-                raise CampaignSpecError(
-                    f"scenario.{key}", "is set by the campaign for each run; remove it", src
+                where = (
+                    "comes from [device] (profile, imperfections)"
+                    if key == "device"
+                    else "is set by the campaign for each run"
                 )
+                raise CampaignSpecError(f"scenario.{key}", f"{where}; remove it", src)
         main = self.noise_scale
         for i, s in enumerate(self.noise_sweep.noise_scales):
             if math.isfinite(main) and noise_level_key(s) == noise_level_key(main):

@@ -29,6 +29,7 @@ from sensing_antenna.campaign.runs import (
     calibration_runs,
     derive_seed,
     plan_runs,
+    with_device,
 )
 from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
@@ -154,11 +155,10 @@ def identify_observer(
     from sensing_antenna.calibration.observer import identify_free_motion
     from sensing_antenna.simulator import simulate
 
-    extra = dict(spec.scenario)
+    seed = derive_seed(spec.base_seed, 0, FREE_MOTION_STREAM)
+    extra = with_device(spec, spec.scenario, seed, device.link.length)
     extra["duration"] = spec.free_motion.duration
-    scenario = make_scenario(
-        spec.free_motion.case, None, derive_seed(spec.base_seed, 0, FREE_MOTION_STREAM), extra
-    )
+    scenario = make_scenario(spec.free_motion.case, None, seed, extra)
     recording = simulate(device, scenario)
     fit = identify_free_motion(recording.without_ground_truth(), model or device)
     return fit.observer
@@ -184,7 +184,8 @@ def calibrate_on_device(
     bar = (progress or Progress(enabled=False)).bar(len(planned), "calibration", "recording")
     with bar:
         for name, x_c, seed in planned:
-            scenario = make_scenario(step.case, x_c, seed, dict(spec.scenario))
+            extra = with_device(spec, spec.scenario, seed, device.link.length)
+            scenario = make_scenario(step.case, x_c, seed, extra)
             recordings.append(simulate(device, scenario).without_ground_truth())
             names.append(name)
             points.append(x_c)
@@ -294,7 +295,8 @@ def compile_methods(
         "preparation: compiling the methods on one manoeuvre of the device"
     )
     point = spec.contact_points[len(spec.contact_points) // 2]
-    scenario = make_scenario(cases[0], point, spec.base_seed, dict(spec.scenario))
+    extra = with_device(spec, spec.scenario, spec.base_seed, preparation.device.link.length)
+    scenario = make_scenario(cases[0], point, spec.base_seed, extra)
     recording = simulate(preparation.device, scenario).without_ground_truth()
     gathered = gather(recording, preparation.model)
     for method in spec.methods:

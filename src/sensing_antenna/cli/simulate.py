@@ -19,6 +19,7 @@ FLAGS = {
     "seed": "--seed",
     "duration": "--duration",
     "noise_scale": "--noise",
+    "device": "--device",
 }
 
 
@@ -55,6 +56,14 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--duration", type=float, default=3.0, help="total time (s)")
     parser.add_argument("--noise", type=float, default=1.0, help="sensor noise scale (0: none)")
     parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
+    parser.add_argument(
+        "--device",
+        default="nominal",
+        metavar="PROFILE|FILE",
+        help="imperfections of the simulated device that the antenna does not know: nominal "
+        "(none), realistic (one set drawn from --seed, docs/simulator.md) or a TOML file of "
+        'DeviceImperfections fields (optionally with profile = "realistic" under them)',
+    )
     parser.add_argument("--out", type=Path, required=True, help="output CSV file")
     parser.set_defaults(func=_run, flags=FLAGS)
 
@@ -69,12 +78,14 @@ def _run(args: argparse.Namespace) -> int:
 
     antenna = load_antenna(args.antenna)
     _check_contact_point(args.case, args.xc, antenna.link)
+    device = load_device(args.device, args.seed, antenna.link.length)
     scenario = Scenario(
         case=args.case,
         contact_point=args.xc,
         seed=args.seed,
         duration=args.duration,
         noise_scale=args.noise,
+        device=device,
     )
     recording = simulate(antenna, scenario)
     write_recording(recording, args.out)
@@ -83,6 +94,44 @@ def _run(args: argparse.Namespace) -> int:
     if warning is not None:
         print(warning, file=sys.stderr)
     return 0
+
+
+def load_device(value: str, seed: int, length: float) -> Any:
+    """The ``DeviceImperfections`` of ``--device``: a profile name or a TOML file.
+
+    A file holds ``DeviceImperfections`` fields at its top level or in a ``[device]`` table,
+    and may name a ``profile`` whose draw (from ``seed``) its fields are set over.
+    """
+    from dataclasses import replace
+
+    import tomllib
+
+    from sensing_antenna.simulator import DEVICE_PROFILES, device_from_mapping, device_profile
+
+    if value in DEVICE_PROFILES:
+        return device_profile(value, seed, length)
+    path = Path(value)
+    if not path.is_file():
+        raise ArgumentError(
+            "--device", f"{value!r} is neither a profile ({', '.join(DEVICE_PROFILES)}) nor a file"
+        )
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ArgumentError("--device", f"{value}: not a TOML file ({exc})") from exc
+    table = data.get("device", data)
+    if not isinstance(table, dict):
+        raise ArgumentError("--device", f"{value}: [device] must be a table")
+    table = dict(table)
+    profile = table.pop("profile", "nominal")
+    if profile not in DEVICE_PROFILES:
+        raise ArgumentError(
+            "--device",
+            f"{value}: profile must be one of {', '.join(DEVICE_PROFILES)}, got {profile!r}",
+        )
+    fixed = device_from_mapping(table, value)
+    given = {key: getattr(fixed, key) for key in table}
+    return replace(device_profile(profile, seed, length), **given)
 
 
 def _check_contact_point(case: str, x_c: float | None, link: Any) -> None:

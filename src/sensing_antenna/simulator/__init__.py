@@ -6,14 +6,28 @@ bending in two planes (finite elements), rigid obstacles with friction, and a no
 See ``docs/simulator.md``.
 """
 
+from sensing_antenna.simulator.device import (
+    DEVICE_PROFILES,
+    DeviceError,
+    DeviceImperfections,
+    device_from_mapping,
+    device_profile,
+    realistic_device,
+)
 from sensing_antenna.simulator.run import SimulationDetail, simulate, simulate_detailed
 from sensing_antenna.simulator.scenario import Scenario, ScenarioError, SensorNoise
 
 __all__ = [
+    "DEVICE_PROFILES",
+    "DeviceError",
+    "DeviceImperfections",
     "Scenario",
     "ScenarioError",
     "SensorNoise",
     "SimulationDetail",
+    "device_from_mapping",
+    "device_profile",
+    "realistic_device",
     "simulate",
     "simulate_detailed",
 ]

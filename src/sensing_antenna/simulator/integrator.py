@@ -161,13 +161,14 @@ def _shape(
 
 @njit(cache=True)
 def _interp(
-    q: NDArray[np.float64], e: int, wn: NDArray[np.float64], wd: NDArray[np.float64]
+    q: NDArray[np.float64], e: int, wn: NDArray[np.float64], wd: NDArray[np.float64], drop: int
 ) -> tuple[float, float]:
-    """Deflection and slope from plane dofs q (clamped node removed) in element e."""
+    """Deflection and slope from plane dofs q in element e; the clamp removed the first ``drop``
+    dofs of node 0 (2 rigid, 1 compliant: the root slope stays)."""
     val = 0.0
     slope = 0.0
     for j in range(4):
-        idx = 2 * e + j - 2
+        idx = 2 * e + j - drop
         if idx >= 0:
             val += wn[j] * q[idx]
             slope += wd[j] * q[idx]
@@ -187,8 +188,9 @@ def _gap(
     wd: NDArray[np.float64],
 ) -> float:
     e = _shape(x, n_el, h_el, wn, wd)
-    v, _ = _interp(X[0:n], e, wn, wd)
-    w, _ = _interp(X[n : 2 * n], e, wn, wd)
+    drop = 2 * n_el + 2 - n
+    v, _ = _interp(X[0:n], e, wn, wd, drop)
+    w, _ = _interp(X[n : 2 * n], e, wn, wd, drop)
     px = x * frame[0, 0] + v * frame[1, 0] + w * frame[2, 0] - obst[1]
     py = x * frame[0, 1] + v * frame[1, 1] + w * frame[2, 1] - obst[2]
     pz = x * frame[0, 2] + v * frame[1, 2] + w * frame[2, 2] - obst[3]
@@ -380,6 +382,7 @@ def run_samples(
     s2m = par[_P_S2]
     length = par[_P_LENGTH]
     h_el = length / n_el
+    drop = 2 * n_el + 2 - n
     s_dot = float(sq @ z)
     wrench = np.empty(6)
     wn = np.empty(4)
@@ -496,8 +499,8 @@ def run_samples(
             if obst[0] > 0.0:
                 xc, g0 = _closest(X, n, n_el, h_el, fr, obst, par[_P_X_MIN], length, wn, wd)
                 e = _shape(xc, n_el, h_el, wn, wd)
-                v_c, dv_c = _interp(X[0:n], e, wn, wd)
-                w_c, dw_c = _interp(X[n : 2 * n], e, wn, wd)
+                v_c, dv_c = _interp(X[0:n], e, wn, wd, drop)
+                w_c, dw_c = _interp(X[n : 2 * n], e, wn, wd, drop)
                 for i in range(3):
                     pc[i] = xc * fr[0, i] + v_c * fr[1, i] + w_c * fr[2, i]
                 if g0 < 0.02:
@@ -524,7 +527,7 @@ def run_samples(
                     un[:] = 0.0
                     ut[:] = 0.0
                     for jj in range(4):
-                        idx = 2 * e + jj - 2
+                        idx = 2 * e + jj - drop
                         if idx >= 0:
                             un[idx] = ny * wn[jj]
                             un[n + idx] = nz * wn[jj]
@@ -608,8 +611,8 @@ def run_samples(
                             dx = x_new - X
                             for i in range(3):
                                 dp[i] = dth1[i] * dx[2 * n] + dth2[i] * dx[2 * n + 1]
-                            v_new, _ = _interp(x_new[0:n], e, wn, wd)
-                            w_new, _ = _interp(x_new[n : 2 * n], e, wn, wd)
+                            v_new, _ = _interp(x_new[0:n], e, wn, wd, drop)
+                            w_new, _ = _interp(x_new[n : 2 * n], e, wn, wd, drop)
                             for i in range(3):
                                 dp[i] += (v_new - v_c) * fr[1, i] + (w_new - w_c) * fr[2, i]
                             if not stick:

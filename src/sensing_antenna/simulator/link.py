@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from scipy.linalg import eigh
 
 from sensing_antenna.antenna import Link
+from sensing_antenna.simulator.device import DeviceError, DeviceImperfections
 
 __all__ = [
     "LinkModel",
@@ -119,6 +120,10 @@ class LinkModel:
         ``int rho x dx + m_t l`` (kg m).
     second_moment : float
         ``int rho x^2 dx + m_t l^2``, the rigid link's inertia about O (kg m^2).
+    root_dofs : int
+        Degrees of freedom of node 0 removed by the clamp: 2 for a rigid clamp, 1 for a
+        compliant clamp (the root slope stays free, against the clamp's spring, and is then the
+        first coordinate: ``[v_0', v_1, v_1', ...]``).
     """
 
     nodes: NDArray[np.float64]
@@ -129,6 +134,7 @@ class LinkModel:
     total_mass: float
     first_moment: float
     second_moment: float
+    root_dofs: int = 2
 
     @property
     def n_elements(self) -> int:
@@ -137,7 +143,8 @@ class LinkModel:
 
     @property
     def n_dof(self) -> int:
-        """Degrees of freedom per bending plane (2 n_elements)."""
+        """Degrees of freedom per bending plane (2 n_elements, or 2 n_elements + 1 with a
+        compliant clamp)."""
         return int(self.mass.shape[0])
 
     @property
@@ -158,9 +165,9 @@ class LinkModel:
         e = min(max(int(x / h), 0), self.n_elements - 1)
         xi = min(max((x - self.nodes[e]) / h, 0.0), 1.0)
         local = hermite_shape_slope(xi, h) if slope else hermite_shape(xi, h)
-        row = np.zeros(self.n_dof + 2)
+        row = np.zeros(self.n_dof + self.root_dofs)
         row[2 * e : 2 * e + 4] = local
-        return row[2:]
+        return row[self.root_dofs :]
 
     def free_frequencies(self, n_modes: int = 3) -> NDArray[np.float64]:
         """Natural frequencies of the clamped-free link (rad/s), ascending, shape (n_modes,)."""
@@ -188,7 +195,9 @@ def _null_space_of_row(row: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.asarray(vt[1:].T)
 
 
-def build_link_model(link: Link, n_elements: int = 20) -> LinkModel:
+def build_link_model(
+    link: Link, n_elements: int = 20, device: DeviceImperfections | None = None
+) -> LinkModel:
     """Assemble the clamped-free finite-element model of ``link``.
 
     Parameters
@@ -198,6 +207,11 @@ def build_link_model(link: Link, n_elements: int = 20) -> LinkModel:
         passes a calibrated link as the E I that gives its T_e, ``run.device_link``).
     n_elements : int
         Number of equal Hermite elements (>= 2).
+    device : DeviceImperfections, optional
+        The device's departures from ``link``: its extra tip mass (added to the tip node), its
+        clamp spring (on the root slope, which then stays a coordinate) and the factors of its
+        taper and joint on each element's E I and rho (``DeviceImperfections.element_factors``).
+        None or the nominal device: the uniform, rigidly clamped ``link``.
 
     Returns
     -------
@@ -212,13 +226,34 @@ def build_link_model(link: Link, n_elements: int = 20) -> LinkModel:
     n_full = 2 * (n_elements + 1)
     k_full = np.zeros((n_full, n_full))
     m_full = np.zeros((n_full, n_full))
-    k_e, m_e = _element_matrices(ei, rho, h)
-    for e in range(n_elements):
-        sl = slice(2 * e, 2 * e + 4)
-        k_full[sl, sl] += k_e
-        m_full[sl, sl] += m_e
-    m_full[n_full - 2, n_full - 2] += link.tip_mass
     nodes = np.linspace(0.0, length, n_elements + 1)
+    tip_mass = link.tip_mass
+    root_dofs = 2
+    if device is None or device.link_is_nominal:
+        k_e, m_e = _element_matrices(ei, rho, h)
+        for e in range(n_elements):
+            sl = slice(2 * e, 2 * e + 4)
+            k_full[sl, sl] += k_e
+            m_full[sl, sl] += m_e
+    else:
+        if device.joint_length > 0.0 and device.joint_start >= length:
+            raise DeviceError(
+                "joint_start",
+                f"{device.joint_start!r} m is not on the link (length {length:g} m)",
+            )
+        stiffness_factor, density_factor = device.element_factors(nodes)
+        for e in range(n_elements):
+            k_e, m_e = _element_matrices(
+                ei * float(stiffness_factor[e]), rho * float(density_factor[e]), h
+            )
+            sl = slice(2 * e, 2 * e + 4)
+            k_full[sl, sl] += k_e
+            m_full[sl, sl] += m_e
+        tip_mass += device.tip_mass
+        if device.clamp_stiffness is not None:
+            k_full[1, 1] += device.clamp_stiffness
+            root_dofs = 1
+    m_full[n_full - 2, n_full - 2] += tip_mass
     translation = np.zeros(n_full)
     translation[0::2] = 1.0
     rotation = np.zeros(n_full)
@@ -226,15 +261,17 @@ def build_link_model(link: Link, n_elements: int = 20) -> LinkModel:
     rotation[1::2] = 1.0
     m_t = m_full @ translation
     m_r = m_full @ rotation
+    free = slice(root_dofs, None)
     return LinkModel(
         nodes=nodes,
-        mass=m_full[2:, 2:].copy(),
-        stiffness=k_full[2:, 2:].copy(),
-        translation_load=m_t[2:].copy(),
-        rotation_load=m_r[2:].copy(),
+        mass=m_full[free, free].copy(),
+        stiffness=k_full[free, free].copy(),
+        translation_load=m_t[free].copy(),
+        rotation_load=m_r[free].copy(),
         total_mass=float(translation @ m_t),
         first_moment=float(translation @ m_r),
         second_moment=float(rotation @ m_r),
+        root_dofs=root_dofs,
     )
 
 

@@ -22,6 +22,7 @@ from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link, antenna_to_
 from sensing_antenna.control.servo import FRICTION_SPEED, design_servo, initial_servo_state
 from sensing_antenna.recording import FORMAT_NAME, Recording
 from sensing_antenna.simulator.contact import Obstacle, place_obstacle
+from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.integrator import (
     CONTACT_STATE_SIZE,
     TRUTH_COLUMNS,
@@ -139,10 +140,29 @@ class SimulationDetail:
     rayleigh: tuple[float, float]
 
 
+def _link_imperfections(device: DeviceImperfections) -> DeviceImperfections | None:
+    """The part of ``device`` the link's model depends on (None: the nominal link), the key of
+    the cached link set-up, so that sensor-only imperfections share the nominal link's."""
+    if device.link_is_nominal:
+        return None
+    return DeviceImperfections(
+        tip_mass=device.tip_mass,
+        clamp_stiffness=device.clamp_stiffness,
+        stiffness_taper=device.stiffness_taper,
+        density_taper=device.density_taper,
+        joint_start=device.joint_start,
+        joint_length=device.joint_length,
+        joint_stiffness_factor=device.joint_stiffness_factor,
+        joint_density_factor=device.joint_density_factor,
+    )
+
+
 @lru_cache(maxsize=16)
-def _link_setup(link: Link, n_elements: int) -> tuple[LinkModel, float, float]:
+def _link_setup(
+    link: Link, n_elements: int, device: DeviceImperfections | None = None
+) -> tuple[LinkModel, float, float]:
     """FE model, first free frequency and highest first contact frequency over [0.3 l, l]."""
-    model = build_link_model(link, n_elements)
+    model = build_link_model(link, n_elements, device)
     omega_free = float(model.free_frequencies(1)[0])
     grid = np.linspace(0.3, 1.0, 15) * link.length
     omega_contact = max(float(model.pinned_frequencies(x, 1)[0]) for x in grid)
@@ -150,14 +170,16 @@ def _link_setup(link: Link, n_elements: int) -> tuple[LinkModel, float, float]:
 
 
 @lru_cache(maxsize=16)
-def _unit_sag(link: Link, n_elements: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _unit_sag(
+    link: Link, n_elements: int, device: DeviceImperfections | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Static sag of the link under 1 m/s^2 of transverse gravity on a grid of abscissae.
 
     Returns (x, w): the grid (m), shape (401,), and the FE deflection there (m per m/s^2),
     negative (the load points along -Z^m). Linear interpolation on this 2.5 mm grid is exact to
     < 1e-7 m for the paper link.
     """
-    model, _, _ = _link_setup(link, n_elements)
+    model, _, _ = _link_setup(link, n_elements, device)
     q = np.linalg.solve(model.stiffness, -model.translation_load)
     x = np.linspace(0.0, link.length, 401)
     w = np.array([float(model.shape_at(float(xi)) @ q) for xi in x])
@@ -178,7 +200,11 @@ def minimum_contact_point(link: Link, contact_stiffness: float) -> float:
 
 
 def _contact_deflection(
-    link: Link, n_elements: int, truth: NDArray[np.float64], gravity: float
+    link: Link,
+    n_elements: int,
+    truth: NDArray[np.float64],
+    gravity: float,
+    device: DeviceImperfections | None = None,
 ) -> NDArray[np.float64]:
     """|(v, w - w_g)| at the contact point of each sample (m), NaN without contact."""
     theta1, theta2 = truth[:, 0], truth[:, 1]
@@ -187,7 +213,7 @@ def _contact_deflection(
     # motor frame (recording format): Y^m = (-s1, c1, 0), Z^m = (-s2 c1, -s2 s1, c2)
     v = -s1 * point[:, 0] + c1 * point[:, 1]
     w = -s2 * c1 * point[:, 0] - s2 * s1 * point[:, 1] + c2 * point[:, 2]
-    grid, unit = _unit_sag(link, n_elements)
+    grid, unit = _unit_sag(link, n_elements, device)
     sag = gravity * c2 * np.interp(truth[:, 3], grid, unit)
     deflection = np.hypot(v, w - sag)
     return np.where(truth[:, 2] > 0.5, deflection, np.nan)
@@ -212,9 +238,14 @@ def deflection_warning(recording: Recording) -> str | None:
 
 @lru_cache(maxsize=16)
 def _effective_inverse(
-    link: Link, n_elements: int, step: float, alpha: float, beta: float
+    link: Link,
+    n_elements: int,
+    step: float,
+    alpha: float,
+    beta: float,
+    device: DeviceImperfections | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    model, _, _ = _link_setup(link, n_elements)
+    model, _, _ = _link_setup(link, n_elements, device)
     damping = alpha * model.mass + beta * model.stiffness
     effective = 4.0 / step**2 * model.mass + 2.0 / step * damping + model.stiffness
     ainv: NDArray[np.float64] = np.linalg.inv(effective).astype(np.float64)
@@ -273,12 +304,13 @@ def simulate_detailed(
     ts = SAMPLE_PERIOD
     n_samples = round(scenario.duration / ts)
     t: NDArray[np.float64] = np.arange(n_samples, dtype=np.float64) * ts
-    model, omega_free, omega_contact = _link_setup(link, scenario.n_elements)
+    imperfect = _link_imperfections(scenario.device)
+    model, omega_free, omega_contact = _link_setup(link, scenario.n_elements, imperfect)
     scenario = scenario.resolved(omega_free)
     assert scenario.accel_time is not None and scenario.approach_time is not None
     alpha, beta = rayleigh_coefficients(scenario.damping_ratio, omega_free, omega_contact)
     step = ts / scenario.substeps
-    damping, ainv, z = _effective_inverse(link, scenario.n_elements, step, alpha, beta)
+    damping, ainv, z = _effective_inverse(link, scenario.n_elements, step, alpha, beta, imperfect)
     n = model.n_dof
 
     # --- reference trajectory (Section 4 step 1) -----------------------------------------------
@@ -389,6 +421,7 @@ def simulate_detailed(
     ctrl = np.stack([initial_servo_state(angle) for angle in start])
     cs = np.zeros(CONTACT_STATE_SIZE)
     cs[12] = -1.0
+    record = _sensor_output(scenario.device, t, scenario.seed, meas_theta, meas_wrench)
 
     def advance(k0: int, k1: int) -> None:
         run_samples(
@@ -416,6 +449,8 @@ def simulate_detailed(
             meas_wrench,
             truth,
         )
+        if record is not None:
+            record(k0, k1)
 
     stop_index: int | None = None
     if scenario.case != "free":
@@ -443,7 +478,7 @@ def simulate_detailed(
         progress(1.0)
 
     in_contact = truth[:, 2] > 0.5
-    deflection = _contact_deflection(link, scenario.n_elements, truth, gravity)
+    deflection = _contact_deflection(link, scenario.n_elements, truth, gravity, imperfect)
     first_touch = float(cs[12]) if cs[12] >= 0 else None
     metadata: dict[str, str] = {
         "format": FORMAT_NAME,
@@ -500,6 +535,35 @@ def simulate_detailed(
         link_model=model,
         rayleigh=(alpha, beta),
     )
+
+
+def _sensor_output(
+    device: DeviceImperfections,
+    t: NDArray[np.float64],
+    seed: int,
+    meas_theta: NDArray[np.float64],
+    meas_wrench: NDArray[np.float64],
+) -> Callable[[int, int], None] | None:
+    """The sensor's and encoders' imperfections, applied in place to samples k0..k1-1 of the
+    measured angles and wrench once the loop has written them (None: an ideal sensor).
+
+    The loop's servo has used the ideal sample; the stop rule and the recording get this one.
+    """
+    matrix = device.sensor_matrix()
+    offsets = device.sensor_offsets(t, seed)
+    encoder = np.asarray(device.encoder_offset)
+    if matrix is None and offsets is None and not encoder.any():
+        return None
+
+    def apply(k0: int, k1: int) -> None:
+        if matrix is not None:
+            meas_wrench[k0:k1] = meas_wrench[k0:k1] @ matrix.T
+        if offsets is not None:
+            meas_wrench[k0:k1] += offsets[k0:k1]
+        if encoder.any():
+            meas_theta[k0:k1] += encoder
+
+    return apply
 
 
 def _final_deflection_ratio(

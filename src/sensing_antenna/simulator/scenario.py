@@ -11,6 +11,7 @@ from typing import Any, Literal
 
 from sensing_antenna.control.servo import DEFAULT_SERVO_POLE
 from sensing_antenna.errors import SensingAntennaError, format_value
+from sensing_antenna.simulator.device import DeviceImperfections
 
 __all__ = [
     "ATI_NANO17_RESOLUTION",
@@ -222,6 +223,10 @@ class Scenario:
         Internal Newmark steps per 1 ms sample.
     sensor : SensorNoise
         Sensor noise model at noise_scale = 1.
+    device : DeviceImperfections
+        What the simulated device does that the antenna (the estimators' model) does not know:
+        tip mass, clamp compliance, non-uniform link, sensor gain, coupling and drift, encoder
+        offsets. Default: none (the exact nominal device).
     description : str
         Free text copied into the recording.
     """
@@ -248,6 +253,7 @@ class Scenario:
     n_elements: int = 16
     substeps: int = 2
     sensor: SensorNoise = field(default_factory=SensorNoise)
+    device: DeviceImperfections = field(default_factory=DeviceImperfections)
     description: str = ""
 
     def __post_init__(self) -> None:
@@ -322,6 +328,10 @@ class Scenario:
                 "substeps",
                 f"must be an integer from 1 to {MAX_SUBSTEPS}, got {format_value(self.substeps)}",
             )
+        if not isinstance(self.device, DeviceImperfections):
+            raise ScenarioError(
+                "device", f"must be a DeviceImperfections, got {format_value(self.device)}"
+            )
         description = self.description
         if not isinstance(description, str) or (
             description
@@ -372,4 +382,5 @@ class Scenario:
         data["sensor"] = {
             k: list(v) if isinstance(v, tuple) else v for k, v in data["sensor"].items()
         }
+        data["device"] = self.device.to_json_dict()
         return data
