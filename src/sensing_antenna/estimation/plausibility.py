@@ -47,10 +47,11 @@ from typing import Any
 
 import numpy as np
 
-from sensing_antenna.antenna import Link
+from sensing_antenna.antenna import STANDARD_GRAVITY, Link
+from sensing_antenna.beam import SensingCurve, natural_frequencies
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
-from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1
+from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import touched_point
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.units_check import angle_problem
@@ -101,6 +102,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
             )
         )
     found.extend(_vibration_problems(evidence, estimate, end, notes))
+    payload = _payload_problem(evidence, estimate, notes)
+    if payload is not None:
+        found.append((Status.MODEL_MISMATCH, payload))
     interval = _on_link(estimate.interval, link.length)
     point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
@@ -171,6 +175,85 @@ def _at_tip_when_just_past(
         f"the static deflection at the tip is {100 * touch.deflection_ratio:.0f} % of l, beyond "
         f"the {100 * limit:.0f} % small-deflection limit of Assumption 1"
     )
+
+
+#: Significance (standard errors of the tare's mean) an unexplained moment at rest needs to be
+#: read as weight the model does not know of.
+_PAYLOAD_SIGMAS = 3.0
+
+#: Fraction of ``max_model_spread`` beyond which the payload's effect is computed on the heavier
+#: link's own sensing curve (a table of its eigenvalues, tens of ms) rather than scaled.
+_EXACT_FROM = 0.25
+
+
+def _payload_problem(
+    evidence: Evidence, estimate: ContactEstimate, notes: dict[str, Any]
+) -> str | None:
+    """Why the link's weight at rest disagrees with the model enough to move the frequency's
+    contact point, or None.
+
+    Before the contact the loads are the link's weight, which the model removes
+    (:func:`~.front.ratio.load_offset` is what remains: the sensor's offset after taring, a few
+    resolution counts). A moment about Y^m left over beyond that is weight the model does not
+    carry, most often a payload at the tip (glue, a marker): a tip mass m_t adds m_t g l
+    cos(theta_2) to it, and lowers omega_1(x_c). The check reads it as such a mass and asks how
+    far that would move the contact point the vibration gives (the point of the sensing curve a
+    link with that mass would read the measured omega_1 at); beyond the paper method's
+    ``max_model_spread`` the answer is a model mismatch. Methods that measure no
+    vibration (``ratio``) are not judged: the weight does not enter the statics of the push.
+    """
+    link = evidence.antenna.link
+    if not (math.isfinite(estimate.omega1) and math.isfinite(estimate.x_c)):
+        return None
+    if not 0.0 < estimate.x_c <= link.length:
+        return None
+    lever = STANDARD_GRAVITY * link.length * math.cos(float(evidence.theta[0, 1]))
+    excess = float(evidence.load_offset[4])
+    if not (lever > 0.0 and excess > _PAYLOAD_SIGMAS * evidence.torque_offset_error):
+        return None  # a lighter reading is no payload: a sensor offset, which weighs nothing
+    mass = excess / lever
+    heavier = dataclasses.replace(link, tip_mass=link.tip_mass + mass)
+    change = float(
+        natural_frequencies(heavier, estimate.x_c, 1)[0]
+        / natural_frequencies(link, estimate.x_c, 1)[0]
+    )
+    # The heavier link rings at omega_1 where the model's rings at omega_1 / change: the point
+    # of the model's curve with that frequency nearest the answer, or, past the curve's top,
+    # the stretch of the curve within the change
+    curve = sensing_curve(link)
+    moved = _on_branch(curve, estimate.x_c, curve.contact_points(estimate.omega1 / change))
+    if moved:
+        spread = min(abs(x - estimate.x_c) for x in moved)
+    else:
+        spread = model_spread(link, estimate.x_c, abs(1.0 - change))
+    limit = evidence.config.max_model_spread
+    if spread > _EXACT_FROM * limit:
+        # Not small: the heavier link's own curve (a tip mass reshapes it near the tip, where
+        # the one scale of the change at the answer does not hold)
+        own = SensingCurve.from_link(heavier)
+        exact = _on_branch(own, estimate.x_c, own.contact_points(estimate.omega1))
+        if exact:
+            spread = min(abs(x - estimate.x_c) for x in exact)
+    notes["payload_moment"] = excess
+    notes["payload_spread"] = spread
+    if not spread > limit:
+        return None
+    return (
+        f"at rest the link's moment ty is {excess:.3g} N m more than the model's weight (the "
+        f"offset a tare leaves is a few sensor counts): {1e3 * mass:.2g} g at the tip that the "
+        f"antenna file does not carry would move the contact point the vibration gives by "
+        f"{100 * spread:.1f} cm, more than {100 * limit:g} cm; give the payload in "
+        "link.tip_mass, or tare the sensor"
+    )
+
+
+def _on_branch(curve: Any, x_c: float, candidates: Any) -> list[float]:
+    """The candidates (m) on the monotone branch of ``curve`` that holds ``x_c``."""
+
+    def branch(x: float) -> int:
+        return sum(1 for extremum in curve.extrema if extremum < x)
+
+    return [c.x_c for c in candidates if branch(c.x_c) == branch(x_c)]
 
 
 def _push_direction_problem(evidence: Evidence) -> str | None:
