@@ -156,3 +156,25 @@ def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
         result = estimate(glitched, paper_antenna(), method)
         assert result.status is not Status.OK, (method, result.x_c)
         assert math.isnan(result.x_c) or 0.0 < result.x_c <= 0.98
+
+
+def test_a_ratio_that_overflows_is_no_reading() -> None:
+    # Torques scaled far beyond any device (1e300, 8e5: 1.8e4 N m for the link's weight)
+    # overflow Eq. 21 and its fixed point to inf; ContactEstimate.ratio_estimate is a length or
+    # NaN, never inf (the JSON writes null for both). Found by the fuzz suite on a simulated
+    # manoeuvre (the synthetic one's ratio stays NaN).
+    from sensing_antenna.simulator import Scenario, simulate
+
+    recording = simulate(paper_antenna(), Scenario(case="azimuthal", contact_point=0.4, seed=1))
+    for torque_scale in (1e300, 8e5):
+        scaled = Recording(
+            t=recording.t,
+            theta=recording.theta,
+            force=recording.force,
+            torque=recording.torque * torque_scale,
+        )
+        for method in ("paper", "ratio", "two-frequency", "fast"):
+            result = estimate(scaled, paper_antenna(), method)
+            assert result.status is Status.IMPLAUSIBLE_INPUT
+            ratio = result.ratio_estimate
+            assert math.isfinite(ratio) or math.isnan(ratio), (method, torque_scale)
