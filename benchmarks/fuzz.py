@@ -67,7 +67,7 @@ def areas(bases: fz.Bases, files: fz.CliFiles) -> dict[str, tuple[Any, Callable[
         "estimators": (fz.perturbations(), lambda p: fz.run_estimators(bases, p)),
         "identify": (fz.identify_inputs(), lambda c: fz.run_identify(bases, c)),
         "calibrate": (fz.calibrate_inputs(), lambda c: fz.run_calibrate(bases, c)),
-        "cli": (fz.cli_arguments(files.paths), fz.run_cli),
+        "cli": (fz.cli_arguments(files.paths), lambda argv: fz.run_cli(argv, files.folder)),
     }
 
 

@@ -28,11 +28,12 @@ import dataclasses
 import io
 import json
 import math
+import os
 import string
 import tempfile
 import traceback
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -394,11 +395,11 @@ def perturbations(draw: st.DrawFn, n_bases: int = 2) -> Perturbation:
 # Area 2: the estimators, every method of the registry
 
 
-def _up_to(recording: Recording, t_e: float) -> Recording:
-    """The samples up to ``t_e`` (s): what an estimate at ``t_e`` has read."""
-    if not math.isfinite(t_e):
+def _up_to(recording: Recording, t_end: float) -> Recording:
+    """The samples up to ``t_end`` (s), at least two."""
+    if not math.isfinite(t_end):
         return recording
-    stop = max(int(np.searchsorted(recording.t, t_e, side="right")), 2)
+    stop = max(int(np.searchsorted(recording.t, t_end, side="right")), 2)
     return Recording(
         t=recording.t[:stop],
         theta=recording.theta[:stop],
@@ -416,6 +417,7 @@ def judge_estimate(estimate: Any, recording: Recording, antenna: Antenna) -> Out
     """The outcome of one estimate (see the module docstring)."""
     from sensing_antenna.calibration.observer import units_problem
     from sensing_antenna.estimation import Status
+    from sensing_antenna.units_check import angle_problem
 
     length = antenna.link.length
     x_c = float(estimate.x_c)
@@ -428,7 +430,10 @@ def judge_estimate(estimate: Any, recording: Recording, antenna: Antenna) -> Out
     if estimate.status is Status.OK:
         if not on_link:
             return Outcome(OK_OUTSIDE_LINK, f"x_c = {x_c!r} m, l = {length} m", label)
-        problem = units_problem(_up_to(recording, estimate.t_e), antenna)
+        # check 1 of the layer: the loads at rest before t_c, the angles up to t_e
+        problem = units_problem(_up_to(recording, estimate.t_c), antenna) or angle_problem(
+            _up_to(recording, estimate.t_e).theta
+        )
         if problem is not None:
             return Outcome(OK_IMPLAUSIBLE, problem, label)
         if "vibration_contact_point" not in estimate.diagnostics:
@@ -931,13 +936,25 @@ def cli_arguments(draw: st.DrawFn, files: Mapping[str, str]) -> list[str]:
     return argv
 
 
-def run_cli(argv: Sequence[str]) -> list[Outcome]:
-    """``antenna *argv`` in this process: exit code 0 or 2 (``beam``: 1 for a frequency out of
-    range), and after 2 one line on stderr; no traceback."""
+@contextlib.contextmanager
+def _working_directory(folder: Path) -> Iterator[None]:
+    """Within: ``folder`` is the working directory (an output named by a word lands there)."""
+    previous = Path.cwd()
+    os.chdir(folder)
+    try:
+        yield
+    finally:
+        os.chdir(previous)
+
+
+def run_cli(argv: Sequence[str], folder: Path) -> list[Outcome]:
+    """``antenna *argv`` in this process, in ``folder``: exit code 0 or 2 (``beam``: 1 for a
+    frequency out of range), and after 2 one line on stderr; no traceback."""
     from sensing_antenna.cli import main
 
     out, err = io.StringIO(), io.StringIO()
     with (
+        _working_directory(folder),
         contextlib.redirect_stdout(out),
         contextlib.redirect_stderr(err),
         warnings.catch_warnings(record=True) as caught,
