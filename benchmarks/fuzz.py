@@ -10,9 +10,9 @@ the link, a command that ends other than with 0 or 2 and one line). Target: no f
 Prints a table (per area, and per method for the estimators: inputs, then outcomes by kind),
 the first findings of each kind, and writes ``benchmarks/results/fuzz.json`` with the date and
 the machine.
-Run: ``OMP_NUM_THREADS=1 python benchmarks/fuzz.py`` (10,000 inputs, about 15 minutes on one
-core); ``--inputs N`` for another total, ``--seed S`` for other inputs, ``--areas reader,cli``
-for some areas only.
+Run: ``OMP_NUM_THREADS=1 python benchmarks/fuzz.py`` (10,000 inputs, about 7 minutes on one
+core of a shared machine); ``--inputs N`` for another total, ``--seed S`` for other inputs,
+``--areas reader,cli`` for some areas only.
 """
 
 from __future__ import annotations

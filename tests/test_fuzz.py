@@ -1,15 +1,17 @@
 """The fuzz suite, a few inputs per area in every test run (``tests/fuzz_inputs.py`` draws and
 judges them; ``benchmarks/fuzz.py`` runs thousands of the same).
 
-Properties, whatever the input: no exception other than a one-line ``SensingAntennaError``;
-an estimate ``ok`` lies on the link (0, l] and comes from samples that pass the units check of
-the plausibility layer, and a best guess under any other status is on the link or NaN; an
-identified observer or a calibrated T_e is finite and positive and comes from recordings that
-pass the same check; an antenna loaded writes back to itself; a campaign loaded lists its runs
-within the limits; ``antenna`` ends with 0 or 2, and after 2 with one line on stderr.
+Properties, whatever the input: no exception other than a one-line ``SensingAntennaError``,
+and no warning (lines on a user's terminal); an estimate ``ok`` lies on the link (0, l] and
+comes from samples that pass the units check of the plausibility layer, and a best guess under
+any other status is on the link or NaN; an identified observer or a calibrated T_e is finite
+and positive and comes from recordings that pass the same check; an antenna loaded writes back
+to itself; a campaign loaded lists its runs within the limits; ``antenna`` ends with 0 or 2,
+and after 2 with one line on stderr.
 
 The examples per area are few, so the suite stays fast; under CI the profile of
-``conftest.py`` derandomizes them (the same examples every run).
+``conftest.py`` derandomizes them (the same examples every run). A finding's example, given to
+the area's ``run_*`` function, reproduces it.
 """
 
 from __future__ import annotations
