@@ -342,3 +342,16 @@ def test_calibration_recovers_a_known_t_e_from_simulated_recordings(
     scatter = load_antenna(out).link.calibration_scatter
     assert scatter is not None and 0.0 < scatter < 0.0015
     assert f"model scatter {100 * scatter:.3f} %" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("loss", ["linear", "soft_l1"])
+@pytest.mark.parametrize(
+    "omega1", [[1e240, 1e240, 2e240], [5e-324] * 3, [30.0, 1e200, 40.0], [1e-320, 2e-320, 1e-320]]
+)
+def test_frequencies_no_link_has_are_refused_in_one_line(omega1: list[float], loss: str) -> None:
+    # Each point alone gives T = beta_1^2 / omega_1; 1e240 rad/s gives 6e-240 s/m^2, 5e-324 rad/s
+    # an infinite T, both outside the span of T over the links the antenna ranges admit. Their
+    # arithmetic overflowed (warnings, OverflowError) or divided by zero. Found by the fuzz suite.
+    link = paper_antenna().link
+    with pytest.raises(CalibrationError, match="not a link's fundamental frequency"):
+        calibrate_t_e([0.3, 0.6, 0.9], omega1, link, loss=loss)

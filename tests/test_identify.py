@@ -254,3 +254,22 @@ def test_absurd_scales_are_one_line_errors(simulated_free: Recording, make, colu
     assert message.startswith(f"{simulated_free.source}: column")
     assert column in message
     assert "\n" not in message
+
+
+@pytest.mark.parametrize("column", [0, 1])
+def test_an_angle_at_the_float_limit_is_named_before_the_rest_is_judged(
+    simulated_free: Recording, column: int
+) -> None:
+    # An angle of 1.8e308 rad: the rest tolerance's second differences of the angles overflowed
+    # (a NumPy warning, an error under the test suite) before the angle check named the column.
+    # identify and calibrate share the check (units_problem). Found by the fuzz suite.
+    from sensing_antenna.calibration.frequency import CalibrationError, calibrate_from_recordings
+
+    theta = simulated_free.theta.copy()
+    theta[1500, column] = -1.7976931348623157e308
+    glitched = dataclasses.replace(simulated_free, theta=theta)
+    name = ("theta1", "theta2")[column]
+    with pytest.raises(IdentificationError, match=f"column '{name}'"):
+        identify_free_motion(glitched, ANTENNA)
+    with pytest.raises(CalibrationError, match=f"column '{name}'"):
+        calibrate_from_recordings([glitched, glitched], ANTENNA, [0.4, 0.6])

@@ -30,3 +30,23 @@ def test_deep_or_huge_toml_is_refused_naming_the_file(tmp_path: Path) -> None:
         stream.truncate(MAX_TOML_BYTES + 1)
     with pytest.raises(AntennaConfigError, match=r"deep.toml: file: .* larger than the limit"):
         load_antenna(path)
+
+
+@pytest.mark.parametrize("key", ['"a\\nb"', '"a\\u2028b"', '"tab\\there"', '"\\u0000"'])
+def test_an_unknown_key_with_a_line_break_is_named_on_one_line(key: str, tmp_path: Path) -> None:
+    # TOML allows any character in a quoted key; the error must stay one line that shows the
+    # key with its escapes (the command line prints one line). Found by the fuzz suite.
+    from sensing_antenna.campaign.parsing import load_campaign_spec
+    from sensing_antenna.campaign.schema import CampaignSpecError
+
+    antenna = tmp_path / "antenna.toml"
+    antenna.write_text(f'base = "paper-2021"\n[link]\n{key} = 1\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError) as caught:
+        load_antenna(antenna)
+    message = str(caught.value)
+    assert message.isprintable() and str(antenna) in message and "unknown key" in message
+    spec = tmp_path / "spec.toml"
+    spec.write_text(f'base = "default"\n{key} = 1\n', encoding="utf-8")
+    with pytest.raises(CampaignSpecError) as caught_spec:
+        load_campaign_spec(spec)
+    assert str(caught_spec.value).isprintable()

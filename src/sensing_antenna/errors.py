@@ -17,6 +17,8 @@ class FieldError(SensingAntennaError, ValueError):
     """A named field of a configuration file is missing, unknown or invalid.
 
     The message reads ``<source>: <field>: <problem>``; the parts stay available as attributes.
+    A field name that is not all printable (a TOML key with a line break or a control character
+    in it) is shown quoted with its escapes, so the message stays one line that shows the key.
     """
 
     def __init__(self, field_name: str, problem: str, source: str | None = None) -> None:
@@ -24,7 +26,8 @@ class FieldError(SensingAntennaError, ValueError):
         self.problem = problem
         self.source = source
         where = f"{source}: " if source else ""
-        super().__init__(f"{where}{field_name}: {problem}")
+        shown = field_name if field_name.isprintable() else repr(field_name)
+        super().__init__(f"{where}{shown}: {problem}")
 
 
 class Terminated(KeyboardInterrupt):

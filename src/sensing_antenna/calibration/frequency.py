@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
-from sensing_antenna.antenna import Antenna, Link
+from sensing_antenna.antenna import PARAMETER_RANGES, Antenna, Link
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [
@@ -260,6 +260,20 @@ def fit_inverse_t(
         raise CalibrationError("beta1_squared: must be finite and > 0")
     if not (np.all(np.isfinite(w)) and np.all(w > 0)):
         raise CalibrationError("omega1: measured frequencies must be finite and > 0")
+    # Each point alone gives T = k / omega_1; one outside the span of any link (1e240 rad/s,
+    # 5e-324 rad/s) is no vibration of a link, and its arithmetic would overflow. The fit lies
+    # between the points' own T, so within the span too.
+    span = PARAMETER_RANGES["link.calibrated_t"]
+    with np.errstate(over="ignore", divide="ignore"):
+        own_t = k / w
+    outside = np.flatnonzero(~((own_t >= span.low) & (own_t <= span.high)))
+    if outside.size:
+        i = int(outside[0])
+        raise CalibrationError(
+            f"omega1: {float(w[i]):.4g} rad/s gives T = beta_1^2 / omega_1 = "
+            f"{float(own_t[i]):.4g} s/m^2, outside {span.low:g} to {span.high:g} s/m^2 "
+            f"({span.reason}): not a link's fundamental frequency"
+        )
     # Section 5.1, linear in u = 1 / T: least-squares normal equation u = sum(k w) / sum(k^2)
     u = float(np.dot(k, w) / np.dot(k, k))
     if loss != "linear" and k.size >= 3:

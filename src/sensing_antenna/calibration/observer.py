@@ -42,7 +42,7 @@ from sensing_antenna.detection.contact import (
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
-from sensing_antenna.units_check import recording_problem
+from sensing_antenna.units_check import angle_problem, recording_problem
 
 __all__ = [
     "CLAMPED_FREE_BETA_L",
@@ -254,6 +254,10 @@ def units_problem(recording: Recording, antenna: Antenna) -> str | None:
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.estimation.front.contact_frame import rest_tolerance
 
+    problem = angle_problem(recording.theta)
+    if problem is not None:
+        # before the rest tolerance, whose angle differences a glitch of 1e308 rad overflows
+        return problem
     config = EstimatorConfig()
     return recording_problem(
         recording.theta,

@@ -133,13 +133,11 @@ def conclude(gathered: Gathered, method: str | EstimationMethod = "paper") -> Co
     impl = resolve_method(method)
     if isinstance(gathered, EarlyOutcome):
         return gathered.estimate(impl.name)
-    if gathered.input_problem is None:
+    # Samples far beyond any device's (loads in wrong units, a glitch of 1e300 N in the hold)
+    # overflow the arithmetic of the method and the review; the statuses judge the non-finite
+    # values that follow, so NumPy's warnings would only put lines on a user's terminal
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
         reviewed = review(gathered, impl.conclude(gathered))
-    else:
-        # Loads known to be off the format's units (1e300 N m) overflow the arithmetic of the
-        # method and the review; the status says so already, warnings would only repeat it
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
-            reviewed = review(gathered, impl.conclude(gathered))
     return dataclasses.replace(reviewed, trace=gathered.trace)
 
 

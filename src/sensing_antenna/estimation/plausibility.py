@@ -33,7 +33,8 @@ forms agree.
 The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the method's own included;
 the rest go to ``diagnostics["other_reasons"]``. Whatever the status, a best guess outside
 (0, l] or not finite is not reported: x_c is NaN, as are the touched point and the interval, and
-the reason gives the dropped value. An interval is cut to the link [0, l] (the contact lies on
+the reason gives the dropped value; an infinite torque/force ratio (loads that overflow Eq. 21)
+is no reading, NaN. An interval is cut to the link [0, l] (the contact lies on
 it), or dropped when it is not finite or lies off the link; a touched point farther from the base
 than the link can reach is dropped.
 """
@@ -79,6 +80,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     """
     link = evidence.antenna.link
     end = _index_at(evidence, estimate.t_e)
+    if math.isinf(estimate.ratio_estimate):
+        # loads beyond float range (torques in N mm, a glitch) overflow Eq. 21: no reading
+        estimate = dataclasses.replace(estimate, ratio_estimate=math.nan)
     notes: dict[str, Any] = {}
     found: list[tuple[Status, str]] = []
     if evidence.input_problem is not None:

@@ -101,6 +101,14 @@ def _read_only(view: FloatArray) -> FloatArray:
     return view
 
 
+def _samples_arithmetic() -> np.errstate:
+    """Arithmetic on the samples: a value far beyond any device's (a glitch of 1e300 N, a wrench
+    in wrong units) overflows to inf or NaN in sums, norms and the ratio's fixed point; the
+    steps judge those values (no push, no convergence, a status), so NumPy's warnings would
+    only put lines on a user's terminal."""
+    return np.errstate(over="ignore", invalid="ignore", divide="ignore")
+
+
 class FrontEnd:
     """The front end of the estimation pipeline as a streaming object.
 
@@ -278,7 +286,8 @@ class FrontEnd:
         else:
             assert self._detector is not None
             self._detector.update_block(*fed)
-        return self._advance(first, stop)
+        with _samples_arithmetic():
+            return self._advance(first, stop)
 
     def _reserve(self, stop: int) -> None:
         size = self._t.shape[0]
@@ -422,7 +431,8 @@ class FrontEnd:
             raise ValueError(
                 f"index {index}: evidence is available from {first} to {self._n - 1} only"
             )
-        return self._evidence(index, complete=True)
+        with _samples_arithmetic():
+            return self._evidence(index, complete=True)
 
     def _evidence(self, end: int, complete: bool) -> Gathered:
         """Evidence from the samples 0..end (or the early outcome they give)."""
@@ -522,6 +532,10 @@ class FrontEnd:
         """Close the run at the end of the samples: the outcome given, or the one they give."""
         if self._outcome is not None:
             return self._outcome
+        with _samples_arithmetic():
+            return self._finish()
+
+    def _finish(self) -> Gathered:
         n = self._n
         if n == 0:
             return self._stop(self._early(Status.BAD_INPUT, "no samples"))
@@ -542,7 +556,8 @@ class FrontEnd:
         """What the front end saw over every sample fed; ``outcome`` (or an evidence from
         :meth:`evidence_at`) gives t_e, the frame and the spectrum window."""
         n = self._n
-        self._fill(n)
+        with _samples_arithmetic():
+            self._fill(n)
         nan3 = np.full((n, 3), np.nan)
         estimated, norm, threshold = nan3, np.full(n, np.nan), math.nan
         if self._detector is not None:
