@@ -145,7 +145,7 @@ def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
     # sums, norms, the ratio's fixed point overflow. The suite runs with warnings as errors, so
     # a NumPy warning here (lines on a user's terminal) fails the test. Found by the fuzz suite.
     recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
-    clean = estimate(recording, paper_antenna())
+    clean = estimate(recording, calibrated())
     assert clean.status is Status.OK, clean.reason
     k = int(np.searchsorted(recording.t, clean.t_1 + 0.05))
     loads = np.hstack([recording.force, recording.torque])
@@ -154,7 +154,7 @@ def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
         t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:]
     )
     for method in ("paper", "ratio", "two-frequency", "fast"):
-        result = estimate(glitched, paper_antenna(), method)
+        result = estimate(glitched, calibrated(), method)
         assert result.status is not Status.OK, (method, result.x_c)
         assert math.isnan(result.x_c) or 0.0 < result.x_c <= 0.98
 
@@ -166,7 +166,7 @@ def test_a_ratio_that_overflows_is_no_reading() -> None:
     # manoeuvre (the synthetic one's ratio stays NaN).
     from sensing_antenna.simulator import Scenario, simulate
 
-    recording = simulate(paper_antenna(), Scenario(case="azimuthal", contact_point=0.4, seed=1))
+    recording = simulate(calibrated(), Scenario(case="azimuthal", contact_point=0.4, seed=1))
     for torque_scale in (1e300, 8e5):
         scaled = Recording(
             t=recording.t,
@@ -175,7 +175,7 @@ def test_a_ratio_that_overflows_is_no_reading() -> None:
             torque=recording.torque * torque_scale,
         )
         for method in ("paper", "ratio", "two-frequency", "fast"):
-            result = estimate(scaled, paper_antenna(), method)
+            result = estimate(scaled, calibrated(), method)
             assert result.status is Status.IMPLAUSIBLE_INPUT
             ratio = result.ratio_estimate
             assert math.isfinite(ratio) or math.isnan(ratio), (method, torque_scale)
