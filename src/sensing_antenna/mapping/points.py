@@ -22,7 +22,7 @@ the deflection model
     direction is as uncertain, by rho radians within the bending plane: rho y_c along the part
     of X^m across Y^c (a bent link also shortens along its line). Without the contact frame
     (a method that does not report it) the deflection's direction is unknown: rho y_c in every
-    direction across the link, and y_c = (y_c / x_c) x_c from the reported ratio.
+    direction, and y_c = (y_c / x_c) x_c from the reported ratio.
 
 the link's thickness
     the estimate is a point of the link's axis, the object is touched by the link's surface: an
@@ -284,8 +284,8 @@ def point_covariance(
             j_direction = deflection * in_plane / norm
             covariance += rho2 * np.outer(j_direction, j_direction)
     else:
-        # direction unknown: rho y_c in every direction across the link, plus the sag's rho s
-        covariance += rho2 * deflection**2 * (np.eye(3) - np.outer(x_m, x_m))
+        # direction unknown: rho y_c in every direction, plus the sag's rho s
+        covariance += rho2 * deflection**2 * np.eye(3)
         covariance += rho2 * sag**2 * np.outer(sag_axis, sag_axis)
     # the link's thickness: r^2 / 2 in each direction across the link
     covariance += 0.5 * link.radius**2 * (np.eye(3) - np.outer(x_m, x_m))
