@@ -50,12 +50,16 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
         if len(points):
             scatter = ax.scatter(*points.T, c=std, cmap="viridis", s=18, depthshade=False)
         ax.view_init(elev=elevation, azim=azimuth)
+        ax.set_aspect("equal")
         ax.set_title(title)
         ax.set_xlabel("x (cm)")
         ax.set_ylabel("y (cm)")
         ax.set_zlabel("z (cm)")
     if scatter is not None:
-        fig.colorbar(scatter, ax=fig.axes, shrink=0.6, label="point sigma, worst direction (mm)")
+        fig.colorbar(
+            scatter, cax=fig.add_axes((0.9, 0.25, 0.02, 0.5)),
+            label="point sigma, worst direction (mm)",
+        )
     decision = "" if contact_map.recognition is None else f": {contact_map.recognition.decision}"
     fig.suptitle(f"{len(used)} contact points{decision}")
     fig.subplots_adjust(left=0.02, right=0.85, wspace=0.1, hspace=0.15)
