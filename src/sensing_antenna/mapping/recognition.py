@@ -54,6 +54,10 @@ UNDECIDED = "undecided"
 #: Robust loss scale, in standard deviations: residuals beyond 3 sigma count linearly.
 ROBUST_SCALE = 3.0
 
+#: Function evaluations per parameter a start may use (twice that for the refined fit): a fit
+#: that has not converged by then is on a class the points do not suit, and its BIC says so.
+MAX_EVALUATIONS = 100
+
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
 MIN_SIZE = 1e-4
 
@@ -276,7 +280,7 @@ def fit_primitive(
         try:
             solution = least_squares(
                 residuals, start, args=(sigma,), bounds=(low, high), loss="soft_l1",
-                f_scale=ROBUST_SCALE, max_nfev=400 * len(start),
+                f_scale=ROBUST_SCALE, max_nfev=MAX_EVALUATIONS * len(start),
             )
         except ValueError:  # a start outside the model's domain
             continue
@@ -287,7 +291,7 @@ def fit_primitive(
     sigma = _normal_sigma(cov, model.normals(best.x, p))
     refined = least_squares(
         residuals, best.x, args=(sigma,), bounds=(low, high), loss="soft_l1",
-        f_scale=ROBUST_SCALE, max_nfev=400 * len(best.x),
+        f_scale=ROBUST_SCALE, max_nfev=2 * MAX_EVALUATIONS * len(best.x),
     )
     x = refined.x
     distance = model.signed_distance(x, p)
@@ -310,13 +314,14 @@ def fit_mesh(
     points: ArrayLike,
     covariances: ArrayLike,
     rng: np.random.Generator | None = None,
-    n_starts: int = 12,
+    n_starts: int = 24,
 ) -> ClassFit:
     """Register a user mesh (its own size, any pose) to the points by ICP and score it.
 
     The points are moved onto the mesh (trimesh.registration.icp, the closest point on the
     mesh for each point: right for points covering only part of the object) from ``n_starts``
-    rotations about the points' centroid placed on the mesh's centre; the lowest cost wins.
+    rotations about the points' centroid placed on the mesh's centre and from the alignment of
+    principal axes (trimesh.registration.mesh_other); the lowest cost wins.
     """
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
@@ -326,18 +331,31 @@ def fit_mesh(
     ]
     centroid = p.mean(axis=0)
     target = mesh.bounding_box.centroid
-    best: tuple[float, FloatArray] | None = None
+    initials = []
     for rotation in rotations:
         initial = np.eye(4)
         initial[:3, :3] = rotation
         initial[:3, 3] = target - rotation @ centroid
+        initials.append(initial)
+    # and the principal axes' alignment (trimesh.registration.mesh_other), inverted
+    mesh_to_points, _ = trimesh.registration.mesh_other(
+        mesh, p, samples=300, scale=False, icp_first=5, icp_final=20, reflection=False,
+        seed=int(generator.integers(2**31)),
+    )
+    initials.append(np.linalg.inv(mesh_to_points))
+    best: tuple[float, FloatArray] | None = None
+    for initial in initials:
         matrix, _, cost = trimesh.registration.icp(
             p, mesh, initial=initial, max_iterations=40, reflection=False, scale=False
         )
         if best is None or cost < best[0]:
             best = (float(cost), np.asarray(matrix))
     assert best is not None
-    points_to_mesh = best[1]
+    # the best start refined to convergence
+    points_to_mesh, _, _ = trimesh.registration.icp(
+        p, mesh, initial=best[1], max_iterations=300, threshold=1e-10, reflection=False,
+        scale=False,
+    )
     moved = trimesh.transform_points(p, points_to_mesh)
     closest, distance, faces = trimesh.proximity.closest_point(mesh, moved)
     pose = np.linalg.inv(points_to_mesh)  # mesh to world
