@@ -18,7 +18,7 @@ than twice the points' spread. The kernel is
 a constant times a squared exponential, its length scale and amplitude fitted by maximum
 marginal likelihood within :attr:`length_scale_bounds`. The predictive standard deviation of f
 (m, near the surface) is the surface's uncertainty; the mesh is the zero level by marching
-cubes (scikit-image), kept where a contact lies within two length scales.
+cubes (scikit-image), kept where a contact lies within one length scale.
 """
 
 from __future__ import annotations
@@ -43,6 +43,10 @@ FloatArray = NDArray[np.float64]
 #: Fewest points a surface is fitted to: the normals need neighbours (3 besides the point).
 MIN_SURFACE_POINTS = 4
 
+#: The mesh is kept within this many length scales of a contact (and a quarter of the points'
+#: spread): beyond, the prior speaks, not the points.
+REACH_LENGTH_SCALES = 1.0
+
 
 @dataclass
 class ImplicitSurface:
@@ -61,9 +65,9 @@ class ImplicitSurface:
         Seed of the marginal-likelihood optimiser's restarts.
     """
 
-    offset: float = 0.01
+    offset: float = 0.005
     length_scale_bounds: tuple[float, float] = (0.01, 1.0)
-    neighbours: int = 6
+    neighbours: int = 8
     random_state: int = 0
 
     def fit(
@@ -146,11 +150,11 @@ class ImplicitSurface:
 
         Marching cubes on a ``resolution``^3 grid over the points' bounding box padded by a
         quarter of their spread (and the offset), kept where a contact lies within the reach:
-        two length scales, at most half the spread. The mesh may be empty when the zero level
+        :data:`REACH_LENGTH_SCALES` length scales, at most a quarter of the spread. The mesh may be empty when the zero level
         does not cross the grid.
         """
         spread = float(np.linalg.norm(self.points_.max(axis=0) - self.points_.min(axis=0)))
-        reach = min(2.0 * self.length_scale_, 0.5 * spread)
+        reach = min(REACH_LENGTH_SCALES * self.length_scale_, 0.25 * spread)
         pad = 0.25 * spread + self.offset_
         low = self.points_.min(axis=0) - pad
         high = self.points_.max(axis=0) + pad
