@@ -58,6 +58,17 @@ ROBUST_SCALE = 3.0
 #: that has not converged by then is on a class the points do not suit, and its BIC says so.
 MAX_EVALUATIONS = 100
 
+#: Largest size a fit may take, in spreads of the points (the diagonal of their bounding box):
+#: a closed object ten times larger than all the touches is a plane by another name, and the
+#: plane class is there for that.
+MAX_SIZE_SPREADS = 10.0
+
+#: Scale of the extent prior (m): a shape's extent along its own axes beyond the points' span
+#: there costs (excess / this)^2, as a residual of this many metres would. Points say nothing
+#: of a shape beyond them (a cylinder's far end, a box's hidden faces): without the prior those
+#: sizes drift freely; with it they stay at the smallest the points allow.
+EXTENT_PRIOR = 0.005
+
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
 MIN_SIZE = 1e-4
 
@@ -230,13 +241,31 @@ def _starts(
     return starts
 
 
-def _bounds(shape: Primitive) -> tuple[FloatArray, FloatArray]:
+def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
+    """How far the shape's extents along its own axes exceed the points' span there (m)."""
+    if name in ("plane", "sphere", "torus"):
+        return np.zeros(0)
+    local = (points - x[0:3]) @ Rotation.from_rotvec(x[3:6]).as_matrix()
+    span = local.max(axis=0) - local.min(axis=0)
+    if name == "box":
+        return np.asarray(np.maximum(x[6:9] - span, 0.0))
+    if name == "capsule":
+        extent = x[7] + 2 * x[6]
+    else:  # cylinder, cone: the height
+        extent = x[7]
+    return np.asarray([max(extent - span[2], 0.0)])
+
+
+def _bounds(shape: Primitive, points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Sizes from :data:`MIN_SIZE` to :data:`MAX_SIZE_SPREADS` times the points' spread."""
     n = len(shape.parameter_names)
     low = np.full(n, -np.inf)
     high = np.full(n, np.inf)
     n_sizes = {"plane": 0, "sphere": 1, "box": 3}.get(shape.name, 2)
+    spread = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
     if n_sizes:
         low[n - n_sizes :] = MIN_SIZE
+        high[n - n_sizes :] = max(MAX_SIZE_SPREADS * spread, 10 * MIN_SIZE)
     return low, high
 
 
@@ -268,11 +297,12 @@ def fit_primitive(
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
     direction = _outward(p, outward)
     generator = rng if rng is not None else np.random.default_rng(0)
-    low, high = _bounds(model)
+    low, high = _bounds(model, p)
     sigma = _isotropic_sigma(cov)
 
     def residuals(x: FloatArray, s: FloatArray) -> FloatArray:
-        return np.asarray(model.signed_distance(x, p) / s)
+        distance = model.signed_distance(x, p) / s
+        return np.concatenate([distance, _extent_excess(model.name, x, p) / EXTENT_PRIOR])
 
     best = None
     for start in _starts(model, p, direction, generator):
