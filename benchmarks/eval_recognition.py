@@ -145,7 +145,7 @@ def run_scene(
     size = rng.uniform(0.04, 0.20)
     mesh, truth = make_object(name, size, rng)
     place(mesh, rng)
-    points, covariances, true_points = contacts(mesh, n_contacts, antenna, deflection_ratio, rng)
+    points, covariances, _ = contacts(mesh, n_contacts, antenna, deflection_ratio, rng)
     start = time.perf_counter()
     result = recognise(points, covariances, outward=-points.mean(axis=0), rng=rng)
     recognition_s = time.perf_counter() - start
@@ -178,9 +178,7 @@ def run_scene(
         "size_error": size_error(name, fit.sizes, truth),
         "sizes_fitted": dict(fit.sizes),
         "point_rms_m": float(np.sqrt(np.mean(point_distance**2))),
-        "median_point_sigma_m": float(
-            np.median(np.sqrt(np.linalg.eigvalsh(covariances)[:, -1]))
-        ),
+        "median_point_sigma_m": float(np.median(np.sqrt(np.linalg.eigvalsh(covariances)[:, -1]))),
         "surface_rms_m": surface_rms,
         "recognition_s": recognition_s,
         "surface_s": surface_s,
@@ -236,7 +234,9 @@ def main() -> None:
         f" {'med size err':>12s} {'points RMS':>10s} {'surface RMS':>11s}"
     )
     for name, s in [*by_class.items(), ("total", total)]:
-        surface = "-" if s["mean_surface_rms_m"] is None else f"{1000 * s['mean_surface_rms_m']:.2f}"
+        surface = (
+            "-" if s["mean_surface_rms_m"] is None else f"{1000 * s['mean_surface_rms_m']:.2f}"
+        )
         print(
             f"{name:9s} {s['scenes']:3d} {100 * s['accuracy']:5.0f}% {s['abstained']:5d}"
             f" {s['confident_wrong']:11d} {100 * s['median_size_error']:11.1f}%"

@@ -124,7 +124,9 @@ def test_covariance_matches_a_monte_carlo_of_the_geometry() -> None:
         direction = y_axis + tilt * in_plane / np.linalg.norm(in_plane)
         down = np.array([0.0, 0.0, -1.0])
         across = down - (down @ xm_i) * xm_i
-        sag = STANDARD_GRAVITY * np.linalg.norm(across) * _sag(x) * (1 + 0.1 * rng.standard_normal())
+        sag = (
+            STANDARD_GRAVITY * np.linalg.norm(across) * _sag(x) * (1 + 0.1 * rng.standard_normal())
+        )
         phi = rng.uniform(0, 2 * math.pi)  # the link's surface, not its axis, touched
         radial = ANTENNA.link.radius * (math.cos(phi) * ym_i + math.sin(phi) * zm_i)
         p = x * xm_i + deflection * direction + sag * across / np.linalg.norm(across) + radial

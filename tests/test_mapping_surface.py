@@ -44,7 +44,8 @@ def test_zero_level_lies_on_the_true_surface_within_the_noise(mesh: trimesh.Trim
     _, distance, _ = trimesh.proximity.closest_point(mesh, zero_level.vertices[near < 0.01])
     assert np.sqrt(np.mean(distance**2)) < 3 * NOISE
     assert std.shape == (len(zero_level.vertices),)
-    _, far_std = surface.predict(surface.points_.mean(axis=0) + [0.0, 0.0, 1.0], return_std=True)
+    far = surface.points_.mean(axis=0) + np.array([0.0, 0.0, 1.0])
+    _, far_std = surface.predict(far, return_std=True)
     assert np.median(std) < far_std[0]
 
 

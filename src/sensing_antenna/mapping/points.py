@@ -203,29 +203,24 @@ def contact_point_from_estimate(
     """
     pose = base_pose if base_pose is not None else BasePose.identity()
     spec = uncertainty if uncertainty is not None else PointUncertainty()
-    truth = (
-        pose.point_to_world(true_point_a)
-        if true_point_a is not None
-        else np.full(3, np.nan)
-    )
+    truth = pose.point_to_world(true_point_a) if true_point_a is not None else np.full(3, np.nan)
     point_a = np.asarray(estimate.contact_point, dtype=float)
     x_c = float(estimate.x_c)
-    common = {
-        "status": estimate.status,
-        "source": source,
-        "method": estimate.method,
-        "x_c": x_c,
-        "base_position": pose.position,
-        "reason": estimate.reason,
-        "true_point": truth,
-    }
-    if not (np.all(np.isfinite(point_a)) and math.isfinite(x_c) and x_c > 0):
-        return ContactPoint(point=np.full(3, np.nan), covariance=np.full((3, 3), np.nan), **common)
-    covariance_a = point_covariance(estimate, antenna, spec)
+    usable = bool(np.all(np.isfinite(point_a)) and math.isfinite(x_c) and x_c > 0)
     return ContactPoint(
-        point=pose.point_to_world(point_a),
-        covariance=pose.covariance_to_world(covariance_a),
-        **common,
+        point=pose.point_to_world(point_a) if usable else np.full(3, np.nan),
+        covariance=(
+            pose.covariance_to_world(point_covariance(estimate, antenna, spec))
+            if usable
+            else np.full((3, 3), np.nan)
+        ),
+        status=estimate.status,
+        source=source,
+        method=estimate.method,
+        x_c=x_c,
+        base_position=pose.position,
+        reason=estimate.reason,
+        true_point=truth,
     )
 
 

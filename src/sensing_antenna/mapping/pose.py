@@ -114,9 +114,7 @@ class BasePose:
 
     def to_json(self) -> str:
         """The metadata value: ``{"position": [...], "rotation": [[...], ...]}``."""
-        return json.dumps(
-            {"position": self.position.tolist(), "rotation": self.rotation.tolist()}
-        )
+        return json.dumps({"position": self.position.tolist(), "rotation": self.rotation.tolist()})
 
 
 def base_pose_from_metadata(metadata: Mapping[str, str], source: str | None = None) -> BasePose:

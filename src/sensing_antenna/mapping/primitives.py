@@ -28,6 +28,7 @@ the k of a model-selection score.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -126,7 +127,7 @@ def _segments_distance(rho: FloatArray, z: FloatArray, profile: FloatArray) -> F
     """Unsigned distance from (rho, z) points to a polyline profile's segments, shape (n,)."""
     best = np.full(rho.shape, np.inf)
     query = np.stack([rho, z], axis=1)
-    for start, end in zip(profile[:-1], profile[1:], strict=True):
+    for start, end in itertools.pairwise(profile):
         edge = end - start
         t = np.clip(((query - start) @ edge) / float(edge @ edge), 0.0, 1.0)
         nearest = start + t[:, None] * edge
@@ -232,7 +233,9 @@ PRIMITIVES: dict[str, Primitive] = {
             ("radius", "length"),
             _capsule,
             lambda p: p[6:8],
-            _with_pose(lambda p: trimesh.creation.capsule(height=p[7], radius=p[6], count=[32, 32])),
+            _with_pose(
+                lambda p: trimesh.creation.capsule(height=p[7], radius=p[6], count=[32, 32])
+            ),
         ),
         Primitive(
             "cone",

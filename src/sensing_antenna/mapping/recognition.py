@@ -204,7 +204,11 @@ def _starts(
     _, spread_sq, axes = np.linalg.svd(centred, full_matrices=False)
     spread = float(max(np.sqrt(spread_sq[0] ** 2 / len(points)) * 2.0, 1e-3))
     centre, radius = _algebraic_sphere(points)
-    if not (math.isfinite(radius) and radius < 5 * spread and np.linalg.norm(centre - centroid) < 5 * spread):
+    if not (
+        math.isfinite(radius)
+        and radius < 5 * spread
+        and np.linalg.norm(centre - centroid) < 5 * spread
+    ):
         radius = spread
         centre = centroid - outward * spread
     if shape.name == "plane":
@@ -309,8 +313,13 @@ def fit_primitive(
         start = np.clip(start, low, high)
         try:
             solution = least_squares(
-                residuals, start, args=(sigma,), bounds=(low, high), loss="soft_l1",
-                f_scale=ROBUST_SCALE, max_nfev=MAX_EVALUATIONS * len(start),
+                residuals,
+                start,
+                args=(sigma,),
+                bounds=(low, high),
+                loss="soft_l1",
+                f_scale=ROBUST_SCALE,
+                max_nfev=MAX_EVALUATIONS * len(start),
             )
         except ValueError:  # a start outside the model's domain
             continue
@@ -320,8 +329,13 @@ def fit_primitive(
     # second pass: each point's sigma along the fitted surface's normal
     sigma = _normal_sigma(cov, model.normals(best.x, p))
     refined = least_squares(
-        residuals, best.x, args=(sigma,), bounds=(low, high), loss="soft_l1",
-        f_scale=ROBUST_SCALE, max_nfev=2 * MAX_EVALUATIONS * len(best.x),
+        residuals,
+        best.x,
+        args=(sigma,),
+        bounds=(low, high),
+        loss="soft_l1",
+        f_scale=ROBUST_SCALE,
+        max_nfev=2 * MAX_EVALUATIONS * len(best.x),
     )
     x = refined.x
     distance = model.signed_distance(x, p)
@@ -369,7 +383,13 @@ def fit_mesh(
         initials.append(initial)
     # and the principal axes' alignment (trimesh.registration.mesh_other), inverted
     mesh_to_points, _ = trimesh.registration.mesh_other(
-        mesh, p, samples=300, scale=False, icp_first=5, icp_final=20, reflection=False,
+        mesh,
+        p,
+        samples=300,
+        scale=False,
+        icp_first=5,
+        icp_final=20,
+        reflection=False,
         seed=int(generator.integers(2**31)),
     )
     initials.append(np.linalg.inv(mesh_to_points))
@@ -383,11 +403,16 @@ def fit_mesh(
     assert best is not None
     # the best start refined to convergence
     points_to_mesh, _, _ = trimesh.registration.icp(
-        p, mesh, initial=best[1], max_iterations=300, threshold=1e-10, reflection=False,
+        p,
+        mesh,
+        initial=best[1],
+        max_iterations=300,
+        threshold=1e-10,
+        reflection=False,
         scale=False,
     )
     moved = trimesh.transform_points(p, points_to_mesh)
-    closest, distance, faces = trimesh.proximity.closest_point(mesh, moved)
+    _, distance, faces = trimesh.proximity.closest_point(mesh, moved)
     pose = np.linalg.inv(points_to_mesh)  # mesh to world
     normals = mesh.face_normals[faces] @ pose[:3, :3].T
     sigma = _normal_sigma(cov, normals)

@@ -77,7 +77,10 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
                     p.method,
                     p.status.value,
                     *(_number(v) for v in p.point),
-                    *(_number(c[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))),
+                    *(
+                        _number(c[i, j])
+                        for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+                    ),
                     _number(p.std),
                     _number(p.x_c),
                     "true" if id(p) in used else "false",
@@ -96,8 +99,12 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
         written.append(path)
     mesh = contact_map.surface_mesh
     if mesh is not None and len(mesh.faces):
-        mesh = mesh.copy()
-        mesh.visual.vertex_colors = _colours(contact_map.surface_std)
+        mesh = trimesh.Trimesh(
+            vertices=mesh.vertices,
+            faces=mesh.faces,
+            vertex_colors=_colours(contact_map.surface_std),
+            process=False,
+        )
         path = out / "surface.ply"
         mesh.export(path)
         written.append(path)

@@ -70,9 +70,7 @@ class ImplicitSurface:
     neighbours: int = 8
     random_state: int = 0
 
-    def fit(
-        self, points: ArrayLike, covariances: ArrayLike, outside: ArrayLike
-    ) -> ImplicitSurface:
+    def fit(self, points: ArrayLike, covariances: ArrayLike, outside: ArrayLike) -> ImplicitSurface:
         """Fit to contact points.
 
         Parameters
@@ -150,8 +148,8 @@ class ImplicitSurface:
 
         Marching cubes on a ``resolution``^3 grid over the points' bounding box padded by a
         quarter of their spread (and the offset), kept where a contact lies within the reach:
-        :data:`REACH_LENGTH_SCALES` length scales, at most a quarter of the spread. The mesh may be empty when the zero level
-        does not cross the grid.
+        :data:`REACH_LENGTH_SCALES` length scales, at most a quarter of the spread. The mesh may
+        be empty when the zero level does not cross the grid.
         """
         spread = float(np.linalg.norm(self.points_.max(axis=0) - self.points_.min(axis=0)))
         reach = min(REACH_LENGTH_SCALES * self.length_scale_, 0.25 * spread)

@@ -40,7 +40,10 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
         ax = fig.add_subplot(2, 2, index, projection="3d")
         if mesh is not None and len(mesh.faces):
             ax.plot_trisurf(
-                *(mesh.vertices * 100.0).T, triangles=mesh.faces, color="0.8", alpha=0.35,
+                *(mesh.vertices * 100.0).T,
+                triangles=mesh.faces,
+                color="0.8",
+                alpha=0.35,
                 linewidth=0,
             )
         if shape is not None and len(shape.faces) < 20000:
@@ -57,7 +60,8 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
         ax.set_zlabel("z (cm)")
     if scatter is not None:
         fig.colorbar(
-            scatter, cax=fig.add_axes((0.9, 0.25, 0.02, 0.5)),
+            scatter,
+            cax=fig.add_axes((0.9, 0.25, 0.02, 0.5)),
             label="point sigma, worst direction (mm)",
         )
     decision = "" if contact_map.recognition is None else f": {contact_map.recognition.decision}"
@@ -66,7 +70,3 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
-
-
-
-
