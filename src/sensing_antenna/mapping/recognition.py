@@ -261,7 +261,8 @@ def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
 
 
 def _bounds(shape: Primitive, points: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Sizes from :data:`MIN_SIZE` to :data:`MAX_SIZE_SPREADS` times the points' spread."""
+    """Sizes from :data:`MIN_SIZE` to :data:`MAX_SIZE_SPREADS` times the points' spread (the
+    torus's major radius to one spread)."""
     n = len(shape.parameter_names)
     low = np.full(n, -np.inf)
     high = np.full(n, np.inf)
@@ -270,6 +271,10 @@ def _bounds(shape: Primitive, points: FloatArray) -> tuple[FloatArray, FloatArra
     if n_sizes:
         low[n - n_sizes :] = MIN_SIZE
         high[n - n_sizes :] = max(MAX_SIZE_SPREADS * spread, 10 * MIN_SIZE)
+    if shape.name == "torus":
+        # a ring larger than all the touches is a bent cylinder, one parameter dearer: the
+        # torus is the class of rings the points go around
+        high[6] = max(spread, 10 * MIN_SIZE)
     return low, high
 
 
