@@ -18,6 +18,7 @@ decision abstains (``undecided``, naming the two leaders) when the runner-up's B
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -508,9 +509,7 @@ def recognise(
     # BIC weights: exp(-(BIC_j - BIC_min) / 2), normalised
     raw = np.exp(-0.5 * (np.array([f.bic for f in fits]) - fits[0].bic))
     weights = raw / raw.sum()
-    fits = [
-        ClassFit(**{**f.__dict__, "weight": float(w)}) for f, w in zip(fits, weights, strict=True)
-    ]
+    fits = [dataclasses.replace(f, weight=float(w)) for f, w in zip(fits, weights, strict=True)]
     delta = fits[1].bic - fits[0].bic if len(fits) > 1 else math.inf
     decision = fits[0].name if delta >= threshold else UNDECIDED
     return Recognition(
