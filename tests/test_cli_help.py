@@ -30,6 +30,7 @@ COMMANDS = [
     ["campaign"],
     ["campaign", "run"],
     ["campaign", "report"],
+    ["map"],
     ["plot"],
     ["plot", "sensing-curves"],
     ["plot", "recording"],

@@ -21,7 +21,7 @@ from sensing_antenna.cli import main
 from sensing_antenna.estimation import METHODS
 
 #: Packages whose import costs a noticeable fraction of a second each.
-HEAVY = ("numpy", "scipy", "matplotlib", "numba", "dask", "tqdm")
+HEAVY = ("numpy", "scipy", "matplotlib", "numba", "dask", "tqdm", "trimesh", "sklearn", "skimage")
 
 #: Run ``main(argv)`` in a fresh interpreter; print its exit code and the heavy packages loaded.
 _PROBE = """
@@ -66,6 +66,7 @@ def _probe(argv: list[str]) -> tuple[int, list[str], str]:
         ["campaign", "--help"],
         ["campaign", "run", "--help"],
         ["campaign", "report", "--help"],
+        ["map", "--help"],
         ["plot", "--help"],
         ["plot", "sensing-curves", "--help"],
         ["plot", "recording", "--help"],
@@ -94,6 +95,8 @@ def test_help_loads_no_numerical_package(argv: list[str]) -> None:
         ["estimate", "rec.csv", "--t1", "later"],
         ["campaign", "run"],
         ["campaign"],
+        ["map", "rec.csv"],
+        ["map", "rec.csv", "--out", "m", "--method", "magic"],
         ["plot"],
         ["plot", "figure-99", "--out", "figures"],
         ["beam", "--xc", "0.5", "--modes", "0"],

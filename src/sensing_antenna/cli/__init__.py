@@ -49,6 +49,7 @@ COMMAND_MODULES = (
     "estimate",
     "calibrate",
     "campaign",
+    "map",
     "plot",
 )
 

@@ -1,0 +1,60 @@
+"""From contact points to a surface and an object (docs/mapping.md).
+
+Above ``estimation/`` (it turns estimates into world points), below ``cli/``:
+
+- :mod:`.pose`: the antenna base's pose in the world (``base_pose`` metadata);
+- :mod:`.points`: :class:`ContactPoint`, a touched point with its covariance;
+- :mod:`.surface`: :class:`ImplicitSurface`, a Gaussian-process implicit surface;
+- :mod:`.primitives`: the shape classes, their exact signed distances and meshes;
+- :mod:`.recognition`: every class fitted, scored by BIC, a decision that may abstain;
+- :mod:`.contact_map`: :func:`build_map` and :func:`points_from_recordings`;
+- :mod:`.store`: the map's directory.
+"""
+
+from sensing_antenna.mapping.contact_map import (
+    ContactMap,
+    build_map,
+    points_from_recordings,
+)
+from sensing_antenna.mapping.points import (
+    ContactPoint,
+    PointUncertainty,
+    contact_point_from_estimate,
+    select_points,
+)
+from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
+from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive
+from sensing_antenna.mapping.recognition import (
+    ABSTAIN_DELTA_BIC,
+    UNDECIDED,
+    ClassFit,
+    Recognition,
+    fit_mesh,
+    fit_primitive,
+    recognise,
+)
+from sensing_antenna.mapping.store import write_map
+from sensing_antenna.mapping.surface import ImplicitSurface
+
+__all__ = [
+    "ABSTAIN_DELTA_BIC",
+    "PRIMITIVES",
+    "UNDECIDED",
+    "BasePose",
+    "ClassFit",
+    "ContactMap",
+    "ContactPoint",
+    "ImplicitSurface",
+    "PointUncertainty",
+    "Primitive",
+    "Recognition",
+    "base_pose_from_metadata",
+    "build_map",
+    "contact_point_from_estimate",
+    "fit_mesh",
+    "fit_primitive",
+    "points_from_recordings",
+    "recognise",
+    "select_points",
+    "write_map",
+]

@@ -1,0 +1,172 @@
+"""A map: contact points from recordings, the surface through them, and what object they are.
+
+:func:`points_from_recordings` estimates each recording and places its point in the world
+(the recording's ``base_pose``); :func:`build_map` keeps the points that may enter a map (status
+``ok``, and ``uncertain`` when asked), fits the implicit surface when there are enough of them
+and recognises the object when there are enough for every class.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import Antenna
+from sensing_antenna.mapping.points import (
+    ContactPoint,
+    PointUncertainty,
+    contact_point_from_estimate,
+    select_points,
+)
+from sensing_antenna.mapping.pose import base_pose_from_metadata
+from sensing_antenna.mapping.recognition import Recognition, recognise
+from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
+
+__all__ = ["MIN_RECOGNITION_POINTS", "ContactMap", "build_map", "points_from_recordings"]
+
+FloatArray = NDArray[np.float64]
+
+#: Fewest points recognition is tried on: one more than the box's 9 parameters.
+MIN_RECOGNITION_POINTS = 10
+
+
+@dataclass(frozen=True)
+class ContactMap:
+    """Everything a map holds.
+
+    Attributes
+    ----------
+    points : tuple of ContactPoint
+        Every point, whatever its status.
+    used : tuple of ContactPoint
+        Those that entered the surface and the recognition.
+    surface : ImplicitSurface or None
+        The fitted surface (None with fewer than :data:`MIN_SURFACE_POINTS` points).
+    surface_mesh : trimesh.Trimesh or None
+        Its zero level.
+    surface_std : array, shape (n_vertices,)
+        Predictive std of the surface function at the mesh's vertices (m).
+    recognition : Recognition or None
+        None with fewer than :data:`MIN_RECOGNITION_POINTS` points.
+    include_uncertain : bool
+        Whether ``uncertain`` points were used.
+    """
+
+    points: tuple[ContactPoint, ...]
+    used: tuple[ContactPoint, ...]
+    surface: ImplicitSurface | None
+    surface_mesh: trimesh.Trimesh | None
+    surface_std: FloatArray
+    recognition: Recognition | None
+    include_uncertain: bool
+
+    @property
+    def point_errors(self) -> FloatArray:
+        """Distance of each used point to its ground truth (m), NaN where unknown."""
+        return np.array([float(np.linalg.norm(p.point - p.true_point)) for p in self.used])
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-able counts and results (SI units)."""
+        errors = self.point_errors
+        known = errors[np.isfinite(errors)]
+        statuses: dict[str, int] = {}
+        for p in self.points:
+            statuses[p.status.value] = statuses.get(p.status.value, 0) + 1
+        return {
+            "n_recordings": len(self.points),
+            "n_used": len(self.used),
+            "include_uncertain": self.include_uncertain,
+            "statuses": statuses,
+            "median_point_std_m": float(np.median([p.std for p in self.used]))
+            if self.used
+            else None,
+            "point_error_rms_m": float(np.sqrt(np.mean(known**2))) if known.size else None,
+            "surface_length_scale_m": None
+            if self.surface is None
+            else float(self.surface.length_scale_),
+            "surface_faces": 0 if self.surface_mesh is None else len(self.surface_mesh.faces),
+            "recognition": None if self.recognition is None else self.recognition.to_dict(),
+        }
+
+
+def points_from_recordings(
+    paths: Sequence[Path],
+    antenna: Antenna,
+    method: Any = "paper",
+    uncertainty: PointUncertainty | None = None,
+    config: Any = None,
+) -> list[ContactPoint]:
+    """Estimate each recording and place its touched point in the world.
+
+    Each recording's ``base_pose`` metadata (docs/recording-format.md) places its absolute frame;
+    a ``true_contact_point`` it carries is kept as ground truth (never used by the map).
+
+    Raises
+    ------
+    RecordingError, FieldError
+        One line naming the file when a recording or its base pose is malformed.
+    """
+    from sensing_antenna.estimation.pipeline import estimate
+    from sensing_antenna.recording import read_recording
+
+    points = []
+    for path in paths:
+        recording = read_recording(path)
+        pose = base_pose_from_metadata(recording.metadata, str(path))
+        truth = _true_point(recording.metadata.get("true_contact_point"))
+        result = estimate(recording.without_ground_truth(), antenna, method=method, config=config)
+        points.append(
+            contact_point_from_estimate(result, antenna, pose, str(path), uncertainty, truth)
+        )
+    return points
+
+
+def build_map(
+    points: Sequence[ContactPoint],
+    include_uncertain: bool = False,
+    meshes: Mapping[str, trimesh.Trimesh] | None = None,
+    surface: ImplicitSurface | None = None,
+    rng: np.random.Generator | None = None,
+) -> ContactMap:
+    """The map from points (module docstring); the surface and recognition when possible."""
+    used = select_points(list(points), include_uncertain)
+    p = np.array([c.point for c in used]).reshape(-1, 3)
+    cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
+    bases = np.array([c.base_position for c in used]).reshape(-1, 3)
+    fitted = None
+    mesh = None
+    std = np.zeros(0)
+    if len(used) >= MIN_SURFACE_POINTS:
+        fitted = (surface if surface is not None else ImplicitSurface()).fit(p, cov, bases)
+        mesh, std = fitted.mesh()
+    recognition = None
+    if len(used) >= MIN_RECOGNITION_POINTS:
+        outward = (bases - p).mean(axis=0)
+        recognition = recognise(p, cov, meshes=meshes, outward=outward, rng=rng)
+    return ContactMap(
+        points=tuple(points),
+        used=tuple(used),
+        surface=fitted,
+        surface_mesh=mesh,
+        surface_std=std,
+        recognition=recognition,
+        include_uncertain=include_uncertain,
+    )
+
+
+def _true_point(text: str | None) -> FloatArray | None:
+    if text is None:
+        return None
+    try:
+        value = np.array(json.loads(text), dtype=float).reshape(3)
+    except (ValueError, TypeError):
+        return None
+    return value if all(math.isfinite(v) for v in value) else None

@@ -1,0 +1,323 @@
+"""Contact points in the world with their covariance: what a map is built from.
+
+An estimate gives the touched point in the recording's absolute frame (``contact_point``),
+p_a = x_c X^m + y_c Y^c + s A, the abscissa x_c along the link's rigid line X^m (at t_1's motor
+angles), bent by the push deflection y_c along Y^c and by the weight's sag s along A (the part of
+-Z^a across the link; estimation/methods/touch_point.py). Its covariance is propagated to first
+order from three independent sources (docs/mapping.md derives each term):
+
+along the link
+    x_c has a standard deviation sigma_x: from the method's 95 % interval, (high - low) / (2 *
+    1.96), or a documented default per method when it gives none (:data:`DEFAULT_ALONG_STD`).
+    dp/dx_c = X^m + (3 y_c / x_c) Y^c + (ds/dx_c) A (y_c grows as x_c^3).
+the encoders
+    each angle is known to one count, q_i = 2 pi / (counts n_i) (n_i the gear ratio), a uniform
+    rounding error of variance q_i^2 / 12. dX^m/dtheta1 = cos(theta2) Y^m and dX^m/dtheta2 = Z^m,
+    so dp/dtheta1 = x_c cos(theta2) Y^m and dp/dtheta2 = x_c Z^m.
+the deflection model
+    y_c and s both scale with the link's compliance 1 / (E I), but they are different load
+    cases of the model (a pinned contact; a uniform weight) and err differently: a relative
+    uncertainty rho moves the point by rho y_c along Y^c and, independently, by rho s along A.
+    The push deflection's
+    direction is as uncertain, by rho radians within the bending plane: rho y_c along the part
+    of X^m across Y^c (a bent link also shortens along its line). Without the contact frame
+    (a method that does not report it) the deflection's direction is unknown: rho y_c in every
+    direction, and y_c = (y_c / x_c) x_c from the reported ratio.
+
+the link's thickness
+    the estimate is a point of the link's axis, the object is touched by the link's surface: an
+    offset of the link's radius r in an unknown direction across the link, variance r^2 / 2 in
+    each of the two directions across it.
+
+Sigma_a = sigma_x^2 J_x J_x^T + sum_i q_i^2 / 12 J_i J_i^T + rho^2 (y_c^2 Y^c Y^cT + s^2 A A^T
++ J_d J_d^T) + r^2 / 2 (I - X^m X^mT), and in the world Sigma_w = R Sigma_a R^T with the base
+pose's rotation R.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
+from sensing_antenna.estimation.front.contact_frame import motor_axes
+from sensing_antenna.estimation.result import ContactEstimate, Status
+from sensing_antenna.mapping.pose import BasePose
+
+__all__ = [
+    "DEFAULT_ALONG_STD",
+    "Z_95",
+    "ContactPoint",
+    "PointUncertainty",
+    "contact_point_from_estimate",
+    "select_points",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: Two-sided 95 % quantile of the standard normal: a 95 % interval is +- 1.96 sigma.
+Z_95 = 1.959963984540054
+
+#: Standard deviation of x_c (m) for methods that give no interval, set from the mean and
+#: maximum abscissa errors of each method on the default simulated campaign (docs/mapping.md):
+#: ``paper`` and ``two-frequency`` stay within about 2 mm of the contact abscissa, the
+#: torque/force ``ratio`` alone errs by centimetres. A method not listed gets ``unknown``.
+DEFAULT_ALONG_STD: Mapping[str, float] = {
+    "paper": 0.001,
+    "two-frequency": 0.0015,
+    "ratio": 0.03,
+    "unknown": 0.01,
+}
+
+
+@dataclass(frozen=True)
+class PointUncertainty:
+    """What the covariance of a contact point is made of, beside the estimate itself.
+
+    Attributes
+    ----------
+    encoder_counts : int
+        Encoder counts per motor-shaft revolution after quadrature (2000: a 500-line encoder,
+        the simulator's default); the joint's resolution divides by the gear ratio.
+    deflection_relative_std : float
+        rho, relative standard deviation of the push deflection and of the sag (both scale with
+        1 / (E I)): 0.1, the Euler-Bernoulli cantilever and a pinned contact against a
+        compliant one, and E I known from a calibrated T_e to a few per cent.
+    along_std : Mapping[str, float]
+        sigma_x (m) per method without an interval (:data:`DEFAULT_ALONG_STD`).
+    """
+
+    encoder_counts: int = 2000
+    deflection_relative_std: float = 0.1
+    along_std: Mapping[str, float] = field(default_factory=lambda: dict(DEFAULT_ALONG_STD))
+
+    def __post_init__(self) -> None:
+        if self.encoder_counts < 0:
+            raise ValueError("encoder_counts must be >= 0 (0: exact encoders)")
+        if not self.deflection_relative_std >= 0:
+            raise ValueError("deflection_relative_std must be >= 0")
+
+    def sigma_along(self, estimate: ContactEstimate) -> float:
+        """sigma_x (m): from the 95 % interval when the estimate has one, else the default."""
+        if estimate.interval is not None:
+            low, high = estimate.interval
+            if math.isfinite(low) and math.isfinite(high) and high >= low:
+                return (high - low) / (2.0 * Z_95)
+        return float(self.along_std.get(estimate.method, self.along_std["unknown"]))
+
+
+@dataclass(frozen=True)
+class ContactPoint:
+    """One touched point in the world frame.
+
+    Attributes
+    ----------
+    point : array, shape (3,)
+        The touched point (m), world frame; NaN without an estimate.
+    covariance : array, shape (3, 3)
+        Its covariance (m^2), world frame; NaN without an estimate.
+    status : Status
+        The estimate's status (only ``ok`` points enter a map by default).
+    source : str
+        Where it came from (the recording's path).
+    method : str
+        The estimation method.
+    x_c : float
+        Contact abscissa along the link (m).
+    base_position : array, shape (3,)
+        The antenna's base point O in the world (m): the link reached the point from there, so
+        it lies on the object's outer side (a surface's outward normal points towards it).
+    reason : str or None
+        Why the status is not ``ok``.
+    true_point : array, shape (3,)
+        The simulator's ground truth (``true_contact_point``) in the world frame when known,
+        else NaN; never used to build the map.
+    """
+
+    point: FloatArray
+    covariance: FloatArray
+    status: Status
+    source: str
+    method: str
+    x_c: float
+    base_position: FloatArray
+    reason: str | None = None
+    true_point: FloatArray = field(default_factory=lambda: np.full(3, np.nan))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "status", Status(self.status))
+        for name, shape in (
+            ("point", (3,)),
+            ("covariance", (3, 3)),
+            ("base_position", (3,)),
+            ("true_point", (3,)),
+        ):
+            array = np.array(getattr(self, name), dtype=float).reshape(shape)
+            array.setflags(write=False)
+            object.__setattr__(self, name, array)
+
+    @property
+    def usable(self) -> bool:
+        """True when the point and its covariance are finite numbers."""
+        return bool(np.all(np.isfinite(self.point)) and np.all(np.isfinite(self.covariance)))
+
+    @property
+    def std(self) -> float:
+        """sqrt of the largest eigenvalue of the covariance (m): the worst-direction sigma."""
+        if not self.usable:
+            return math.nan
+        return float(math.sqrt(max(np.linalg.eigvalsh(self.covariance)[-1], 0.0)))
+
+
+def contact_point_from_estimate(
+    estimate: ContactEstimate,
+    antenna: Antenna,
+    base_pose: BasePose | None = None,
+    source: str = "",
+    uncertainty: PointUncertainty | None = None,
+    true_point_a: FloatArray | None = None,
+) -> ContactPoint:
+    """The world point and covariance of an estimate (see the module's docstring).
+
+    Parameters
+    ----------
+    estimate : ContactEstimate
+        Its ``contact_point`` (absolute frame, m), ``x_c``, ``interval``, ``status`` and the
+        diagnostics ``theta_at_t1`` (rad, shape (2,)), ``deflection`` (m) and
+        ``axes_c_absolute`` (rows X^c, Y^c, Z^c) when present; without the angles the link's
+        direction is taken from the point itself.
+    antenna : Antenna
+        The link (sag) and the gear ratios (encoder resolution).
+    base_pose : BasePose, optional
+        The absolute frame in the world (identity when None).
+    source : str
+        Recorded in the point.
+    uncertainty : PointUncertainty, optional
+        Encoders, deflection model, defaults along the link.
+    true_point_a : array, shape (3,), optional
+        Ground truth in the absolute frame, carried to the world for scoring.
+    """
+    pose = base_pose if base_pose is not None else BasePose.identity()
+    spec = uncertainty if uncertainty is not None else PointUncertainty()
+    truth = pose.point_to_world(true_point_a) if true_point_a is not None else np.full(3, np.nan)
+    point_a = np.asarray(estimate.contact_point, dtype=float)
+    x_c = float(estimate.x_c)
+    usable = bool(np.all(np.isfinite(point_a)) and math.isfinite(x_c) and x_c > 0)
+    return ContactPoint(
+        point=pose.point_to_world(point_a) if usable else np.full(3, np.nan),
+        covariance=(
+            pose.covariance_to_world(point_covariance(estimate, antenna, spec))
+            if usable
+            else np.full((3, 3), np.nan)
+        ),
+        status=estimate.status,
+        source=source,
+        method=estimate.method,
+        x_c=x_c,
+        base_position=pose.position,
+        reason=estimate.reason,
+        true_point=truth,
+    )
+
+
+def point_covariance(
+    estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
+) -> FloatArray:
+    """Sigma_a (m^2), shape (3, 3), in the recording's absolute frame (module docstring)."""
+    x_c = float(estimate.x_c)
+    point_a = np.asarray(estimate.contact_point, dtype=float)
+    diagnostics = estimate.diagnostics
+    theta = _angles(diagnostics.get("theta_at_t1"), point_a)
+    axes_m = motor_axes(theta)  # rows X^m, Y^m, Z^m in the absolute frame
+    x_m, y_m, z_m = axes_m[0], axes_m[1], axes_m[2]
+    deflection = _finite(
+        diagnostics.get("deflection"), _finite(diagnostics.get("deflection_ratio"), 0.0) * x_c
+    )
+    y_c_axis = _contact_y_axis(diagnostics.get("axes_c_absolute"))
+    # the sag's direction A: -Z^a without its part along X^m; s = g |A| u(x_c)
+    down = np.array([0.0, 0.0, -1.0])
+    across = down - (down @ x_m) * x_m
+    across_norm = float(np.linalg.norm(across))
+    link = antenna.link
+    x_in = min(x_c, link.length)
+    sag = STANDARD_GRAVITY * across_norm * float(link.unit_sag(x_in))
+    sag_axis = across / across_norm if across_norm > 0 else np.zeros(3)
+    # ds/dx_c by a central difference of the handbook sag curve (1 mm steps inside the link)
+    step = min(1e-3, 0.5 * x_in)
+    slope = (
+        STANDARD_GRAVITY
+        * across_norm
+        * float(link.unit_sag(min(x_in + step, link.length)) - link.unit_sag(x_in - step))
+        / (min(x_in + step, link.length) - (x_in - step))
+    )
+    # along: dp/dx_c = X^m + (3 y_c / x_c) Y^c + (ds/dx_c) A
+    j_along = x_m + slope * sag_axis
+    if y_c_axis is not None:
+        j_along = j_along + (3.0 * deflection / x_c) * y_c_axis
+    sigma_x = uncertainty.sigma_along(estimate)
+    covariance = sigma_x**2 * np.outer(j_along, j_along)
+    # encoders: dp/dtheta1 = x_c cos(theta2) Y^m, dp/dtheta2 = x_c Z^m; variance q^2 / 12
+    if uncertainty.encoder_counts > 0:
+        for motor, j_angle in zip(
+            antenna.motors, (x_c * math.cos(theta[1]) * y_m, x_c * z_m), strict=True
+        ):
+            quantum = 2.0 * math.pi / (uncertainty.encoder_counts * motor.gear_ratio)
+            covariance += quantum**2 / 12.0 * np.outer(j_angle, j_angle)
+    rho2 = uncertainty.deflection_relative_std**2
+    if y_c_axis is not None:
+        # deflection model: rho y_c along Y^c, and rho s along A
+        covariance += rho2 * deflection**2 * np.outer(y_c_axis, y_c_axis)
+        covariance += rho2 * sag**2 * np.outer(sag_axis, sag_axis)
+        # the deflection's direction: rho y_c along X^m's part across Y^c
+        in_plane = x_m - (x_m @ y_c_axis) * y_c_axis
+        norm = float(np.linalg.norm(in_plane))
+        if norm > 0:
+            j_direction = deflection * in_plane / norm
+            covariance += rho2 * np.outer(j_direction, j_direction)
+    else:
+        # direction unknown: rho y_c in every direction, plus the sag's rho s
+        covariance += rho2 * deflection**2 * np.eye(3)
+        covariance += rho2 * sag**2 * np.outer(sag_axis, sag_axis)
+    # the link's thickness: r^2 / 2 in each direction across the link
+    covariance += 0.5 * link.radius**2 * (np.eye(3) - np.outer(x_m, x_m))
+    return np.asarray(0.5 * (covariance + covariance.T))
+
+
+def select_points(
+    points: list[ContactPoint] | tuple[ContactPoint, ...], include_uncertain: bool = False
+) -> list[ContactPoint]:
+    """The points that enter a map: usable ones with status ``ok`` (and ``uncertain`` if asked)."""
+    allowed = {Status.OK} | ({Status.UNCERTAIN} if include_uncertain else set())
+    return [p for p in points if p.status in allowed and p.usable]
+
+
+def _angles(value: object, point_a: FloatArray) -> FloatArray:
+    try:
+        theta = np.asarray(value, dtype=float).reshape(2)
+        if np.all(np.isfinite(theta)):
+            return theta
+    except (TypeError, ValueError):
+        pass
+    # the link's direction from the point itself (the deflection is a few per cent of x_c)
+    x, y, z = point_a
+    return np.array([math.atan2(y, x), math.atan2(z, math.hypot(x, y))])
+
+
+def _contact_y_axis(value: object) -> FloatArray | None:
+    try:
+        axes = np.asarray(value, dtype=float).reshape(3, 3)
+    except (TypeError, ValueError):
+        return None
+    return np.asarray(axes[1]) if np.all(np.isfinite(axes)) else None
+
+
+def _finite(value: object, default: float) -> float:
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return default
+    return number if math.isfinite(number) else default

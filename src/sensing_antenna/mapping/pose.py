@@ -1,0 +1,164 @@
+"""The antenna base's pose in the world: where a recording's absolute frame sits.
+
+A recording's points are in its absolute frame O-X^a Y^a Z^a (origin at the base point O, Z^a
+up; docs/recording-format.md). A map gathers recordings made from several base poses (a head on
+a robot), so each recording may say where its absolute frame is in the world with the optional
+metadata key ``base_pose``: JSON with ``position`` (m, world frame) and either ``quaternion``
+(``[w, x, y, z]``, unit up to rounding) or ``rotation`` (3 x 3, rows, the absolute frame's axes
+in world coordinates as columns). Absent, the absolute frame is the world frame.
+
+A world point is p_w = R p_a + t.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sensing_antenna.errors import FieldError
+
+__all__ = ["BASE_POSE_KEY", "BasePose", "base_pose_from_metadata"]
+
+#: The recording metadata key holding the base pose.
+BASE_POSE_KEY = "base_pose"
+
+#: How far from orthonormal a given rotation (or from unit a quaternion) may be: rounding of
+#: values written with 6 or more significant digits, well below any real mounting error.
+ORTHONORMAL_TOLERANCE = 1e-4
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class BasePose:
+    """A rigid pose of the antenna's absolute frame in the world.
+
+    Attributes
+    ----------
+    rotation : array, shape (3, 3)
+        R, world coordinates of the absolute frame's axes as columns (orthonormal, det +1).
+    position : array, shape (3,)
+        t, the base point O in the world frame (m).
+    """
+
+    rotation: FloatArray
+    position: FloatArray
+
+    def __post_init__(self) -> None:
+        rotation = np.array(self.rotation, dtype=float).reshape(3, 3)
+        position = np.array(self.position, dtype=float).reshape(3)
+        if not (np.all(np.isfinite(rotation)) and np.all(np.isfinite(position))):
+            raise FieldError(BASE_POSE_KEY, "rotation and position must be finite numbers")
+        error = float(np.abs(rotation @ rotation.T - np.eye(3)).max())
+        if error > ORTHONORMAL_TOLERANCE or np.linalg.det(rotation) < 0:
+            raise FieldError(BASE_POSE_KEY, "rotation must be orthonormal with determinant +1")
+        rotation.setflags(write=False)
+        position.setflags(write=False)
+        object.__setattr__(self, "rotation", rotation)
+        object.__setattr__(self, "position", position)
+
+    @classmethod
+    def identity(cls) -> BasePose:
+        """The absolute frame is the world frame."""
+        return cls(np.eye(3), np.zeros(3))
+
+    @classmethod
+    def from_matrix(cls, matrix: ArrayLike) -> BasePose:
+        """From a 4 x 4 homogeneous transform (world from absolute frame)."""
+        m = np.asarray(matrix, dtype=float)
+        if m.shape != (4, 4):
+            raise FieldError(BASE_POSE_KEY, f"a 4 x 4 matrix is needed, got shape {m.shape}")
+        return cls(m[:3, :3], m[:3, 3])
+
+    @classmethod
+    def from_quaternion(cls, position: ArrayLike, quaternion: Sequence[float]) -> BasePose:
+        """From a position (m) and a unit quaternion ``[w, x, y, z]``."""
+        q = np.asarray(quaternion, dtype=float)
+        if q.shape != (4,) or not np.all(np.isfinite(q)):
+            raise FieldError(BASE_POSE_KEY, "quaternion must be four numbers [w, x, y, z]")
+        norm = float(np.linalg.norm(q))
+        if abs(norm - 1.0) > ORTHONORMAL_TOLERANCE:
+            raise FieldError(BASE_POSE_KEY, f"quaternion must be of unit norm, got {norm:.6g}")
+        w, x, y, z = q / norm
+        # rotation matrix of a unit quaternion (Hamilton convention)
+        rotation = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        return cls(rotation, np.asarray(position, dtype=float))
+
+    @property
+    def matrix(self) -> FloatArray:
+        """The 4 x 4 homogeneous transform, world from absolute frame."""
+        m = np.eye(4)
+        m[:3, :3] = self.rotation
+        m[:3, 3] = self.position
+        return m
+
+    def point_to_world(self, point_a: ArrayLike) -> FloatArray:
+        """p_w = R p_a + t, shape (..., 3) (m)."""
+        return np.asarray(point_a, dtype=float) @ self.rotation.T + self.position
+
+    def covariance_to_world(self, covariance_a: ArrayLike) -> FloatArray:
+        """Sigma_w = R Sigma_a R^T, shape (3, 3) (m^2)."""
+        return np.asarray(self.rotation @ np.asarray(covariance_a, dtype=float) @ self.rotation.T)
+
+    def to_json(self) -> str:
+        """The metadata value: ``{"position": [...], "rotation": [[...], ...]}``."""
+        return json.dumps({"position": self.position.tolist(), "rotation": self.rotation.tolist()})
+
+
+def base_pose_from_metadata(metadata: Mapping[str, str], source: str | None = None) -> BasePose:
+    """The ``base_pose`` of a recording's metadata; identity when the key is absent.
+
+    Raises
+    ------
+    FieldError
+        One line naming the source and the key when the value is not a valid pose.
+    """
+    text = metadata.get(BASE_POSE_KEY)
+    if text is None:
+        return BasePose.identity()
+    try:
+        data: Any = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise FieldError(BASE_POSE_KEY, f"not JSON ({exc.msg})", source) from None
+    try:
+        return _pose_from_json(data)
+    except FieldError as exc:
+        raise FieldError(BASE_POSE_KEY, exc.problem, source) from None
+
+
+def _pose_from_json(data: Any) -> BasePose:
+    if not isinstance(data, dict):
+        raise FieldError(BASE_POSE_KEY, "must be a JSON object with position and rotation")
+    unknown = set(data) - {"position", "quaternion", "rotation"}
+    if unknown:
+        raise FieldError(BASE_POSE_KEY, f"unknown field(s) {', '.join(sorted(unknown))}")
+    position = _numbers(data.get("position"), (3,), "position: three numbers (m)")
+    if ("quaternion" in data) == ("rotation" in data):
+        raise FieldError(BASE_POSE_KEY, "give exactly one of quaternion and rotation")
+    if "quaternion" in data:
+        quaternion = _numbers(data["quaternion"], (4,), "quaternion: four numbers [w, x, y, z]")
+        return BasePose.from_quaternion(position, quaternion.tolist())
+    rotation = _numbers(data["rotation"], (3, 3), "rotation: a 3 x 3 list of rows")
+    return BasePose(rotation, position)
+
+
+def _numbers(value: Any, shape: tuple[int, ...], what: str) -> FloatArray:
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise FieldError(BASE_POSE_KEY, f"{what} expected") from None
+    if array.shape != shape or not all(math.isfinite(v) for v in array.ravel()):
+        raise FieldError(BASE_POSE_KEY, f"{what} expected")
+    return array

@@ -1,0 +1,280 @@
+"""The primitive shape classes a map is recognised as: parameters, signed distance, mesh.
+
+Each class is a :class:`Primitive`: a parameter vector (pose and size, SI units), its signed
+distance d(p) (m, positive outside, negative inside; exact for every class, so that least
+squares on d is the orthogonal fit), the sizes it reports, and the trimesh mesh it stands for.
+Poses are a centre c (m) and a rotation vector w (rad, R = exp([w]x)); the class's axis is the
+local Z. Sizes:
+
+========  ====================================  ==========================================
+class     parameters                            sizes
+========  ====================================  ==========================================
+plane     normal angles (2), offset (1)         none (unbounded)
+sphere    centre (3), radius                    radius
+cylinder  centre (3), rotation (3), radius,     radius, height
+          height
+capsule   centre (3), rotation (3), radius,     radius, length of the axis segment
+          segment length
+cone      base centre (3), rotation (3), base   base radius, height (apex on +Z)
+          radius, height
+torus     centre (3), rotation (3), major R,    major radius, minor radius
+          minor r
+box       centre (3), rotation (3), extents (3) the three edge lengths
+========  ====================================  ==========================================
+
+``dof`` is the number of independent parameters (a rotation about a symmetry axis is not one),
+the k of a model-selection score.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+__all__ = ["PRIMITIVES", "Primitive", "primitive"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Primitive:
+    """One shape class.
+
+    Attributes
+    ----------
+    name : str
+        ``plane``, ``sphere``, ...
+    parameter_names : tuple of str
+        Names of the parameter vector's entries.
+    dof : int
+        Independent parameters (the k of BIC).
+    size_names : tuple of str
+        The sizes :meth:`sizes` returns.
+    """
+
+    name: str
+    parameter_names: tuple[str, ...]
+    dof: int
+    size_names: tuple[str, ...]
+    _distance: Callable[[FloatArray, FloatArray], FloatArray]
+    _sizes: Callable[[FloatArray], FloatArray]
+    _mesh: Callable[[FloatArray], trimesh.Trimesh] | None
+
+    def signed_distance(self, parameters: FloatArray, points: FloatArray) -> FloatArray:
+        """d(p) (m), shape (n,), for points of shape (n, 3) (m)."""
+        return self._distance(np.asarray(parameters, dtype=float), np.asarray(points, float))
+
+    def sizes(self, parameters: FloatArray) -> FloatArray:
+        """The class's sizes (m), in the order of ``size_names``."""
+        return self._sizes(np.asarray(parameters, dtype=float))
+
+    def mesh(self, parameters: FloatArray) -> trimesh.Trimesh | None:
+        """The shape as a trimesh mesh (None for the unbounded plane)."""
+        return None if self._mesh is None else self._mesh(np.asarray(parameters, dtype=float))
+
+    def normals(self, parameters: FloatArray, points: FloatArray, step: float = 1e-5) -> FloatArray:
+        """Unit gradient of d at the points (central differences of ``step`` m), shape (n, 3)."""
+        points = np.asarray(points, dtype=float)
+        gradient = np.empty_like(points)
+        for axis in range(3):
+            shift = np.zeros(3)
+            shift[axis] = step
+            gradient[:, axis] = (
+                self.signed_distance(parameters, points + shift)
+                - self.signed_distance(parameters, points - shift)
+            ) / (2 * step)
+        norm = np.linalg.norm(gradient, axis=1, keepdims=True)
+        return np.asarray(gradient / np.where(norm > 0, norm, 1.0))
+
+
+def _local(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    """Points in the shape's frame: R^T (p - c), with c = parameters[0:3], w = parameters[3:6]."""
+    rotation = Rotation.from_rotvec(parameters[3:6]).as_matrix()
+    return np.asarray((points - parameters[0:3]) @ rotation)
+
+
+def _transform(parameters: FloatArray) -> FloatArray:
+    matrix = np.eye(4)
+    matrix[:3, :3] = Rotation.from_rotvec(parameters[3:6]).as_matrix()
+    matrix[:3, 3] = parameters[0:3]
+    return matrix
+
+
+def _plane_normal(parameters: FloatArray) -> FloatArray:
+    polar, azimuth = parameters[0], parameters[1]
+    return np.array(
+        [np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)]
+    )
+
+
+def _plane(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    # d = n . p - offset
+    return np.asarray(points @ _plane_normal(parameters) - parameters[2])
+
+
+def _sphere(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    # d = |p - c| - r
+    return np.asarray(np.linalg.norm(points - parameters[0:3], axis=1) - parameters[3])
+
+
+def _segments_distance(rho: FloatArray, z: FloatArray, profile: FloatArray) -> FloatArray:
+    """Unsigned distance from (rho, z) points to a polyline profile's segments, shape (n,)."""
+    best = np.full(rho.shape, np.inf)
+    query = np.stack([rho, z], axis=1)
+    for start, end in itertools.pairwise(profile):
+        edge = end - start
+        t = np.clip(((query - start) @ edge) / float(edge @ edge), 0.0, 1.0)
+        nearest = start + t[:, None] * edge
+        best = np.minimum(best, np.linalg.norm(query - nearest, axis=1))
+    return best
+
+
+def _cylinder(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    # the exact distance to a capped cylinder: q = (rho - r, |z| - h / 2)
+    local = _local(parameters, points)
+    radius, height = parameters[6], parameters[7]
+    q_rho = np.hypot(local[:, 0], local[:, 1]) - radius
+    q_z = np.abs(local[:, 2]) - 0.5 * height
+    outside = np.hypot(np.maximum(q_rho, 0.0), np.maximum(q_z, 0.0))
+    return np.asarray(outside + np.minimum(np.maximum(q_rho, q_z), 0.0))
+
+
+def _capsule(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    # distance to the axis segment [-L/2, L/2] along Z, minus r
+    local = _local(parameters, points)
+    radius, length = parameters[6], parameters[7]
+    z = np.clip(local[:, 2], -0.5 * length, 0.5 * length)
+    return np.asarray(np.linalg.norm(local - np.stack([0 * z, 0 * z, z], axis=1), axis=1) - radius)
+
+
+def _cone(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    # the cross-section is the triangle (0, 0), (R, 0), (0, h) in (rho, z): distance to its
+    # base and slant edges, negative inside the triangle
+    local = _local(parameters, points)
+    radius, height = parameters[6], parameters[7]
+    rho = np.hypot(local[:, 0], local[:, 1])
+    z = local[:, 2]
+    profile = np.array([[0.0, 0.0], [radius, 0.0], [0.0, height]])
+    distance = _segments_distance(rho, z, profile)
+    inside = (z >= 0.0) & (rho * height + z * radius <= radius * height)
+    return np.asarray(np.where(inside, -distance, distance))
+
+
+def _torus(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    # d = sqrt((rho - R)^2 + z^2) - r
+    local = _local(parameters, points)
+    major, minor = parameters[6], parameters[7]
+    rho = np.hypot(local[:, 0], local[:, 1])
+    return np.asarray(np.hypot(rho - major, local[:, 2]) - minor)
+
+
+def _box(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    # the exact box distance: q = |p| - e / 2; |max(q, 0)| + min(max_i q_i, 0)
+    local = _local(parameters, points)
+    q = np.abs(local) - 0.5 * parameters[6:9]
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
+    return np.asarray(outside + np.minimum(q.max(axis=1), 0.0))
+
+
+def _cone_mesh(parameters: FloatArray) -> trimesh.Trimesh:
+    mesh = trimesh.creation.cone(radius=parameters[6], height=parameters[7], sections=64)
+    mesh.apply_transform(_transform(parameters))
+    return mesh
+
+
+def _with_pose(make: Callable[[FloatArray], trimesh.Trimesh]) -> Callable[..., trimesh.Trimesh]:
+    def build(parameters: FloatArray) -> trimesh.Trimesh:
+        mesh = make(parameters)
+        mesh.apply_transform(_transform(parameters))
+        return mesh
+
+    return build
+
+
+_POSE = ("cx", "cy", "cz", "wx", "wy", "wz")
+
+#: Every class, by name, in the order reports list them.
+PRIMITIVES: dict[str, Primitive] = {
+    p.name: p
+    for p in (
+        Primitive(
+            "plane", ("polar", "azimuth", "offset"), 3, (), _plane, lambda p: np.zeros(0), None
+        ),
+        Primitive(
+            "sphere",
+            ("cx", "cy", "cz", "radius"),
+            4,
+            ("radius",),
+            _sphere,
+            lambda p: p[3:4],
+            lambda p: trimesh.creation.icosphere(subdivisions=3, radius=p[3]).apply_translation(
+                p[0:3]
+            ),
+        ),
+        Primitive(
+            "cylinder",
+            (*_POSE, "radius", "height"),
+            7,
+            ("radius", "height"),
+            _cylinder,
+            lambda p: p[6:8],
+            _with_pose(lambda p: trimesh.creation.cylinder(radius=p[6], height=p[7], sections=64)),
+        ),
+        Primitive(
+            "capsule",
+            (*_POSE, "radius", "length"),
+            7,
+            ("radius", "length"),
+            _capsule,
+            lambda p: p[6:8],
+            _with_pose(
+                lambda p: trimesh.creation.capsule(height=p[7], radius=p[6], count=[32, 32])
+            ),
+        ),
+        Primitive(
+            "cone",
+            (*_POSE, "radius", "height"),
+            7,
+            ("radius", "height"),
+            _cone,
+            lambda p: p[6:8],
+            _cone_mesh,
+        ),
+        Primitive(
+            "torus",
+            (*_POSE, "major_radius", "minor_radius"),
+            8,
+            ("major_radius", "minor_radius"),
+            _torus,
+            lambda p: p[6:8],
+            _with_pose(
+                lambda p: trimesh.creation.torus(
+                    major_radius=p[6], minor_radius=p[7], major_sections=64, minor_sections=32
+                )
+            ),
+        ),
+        Primitive(
+            "box",
+            (*_POSE, "extent_x", "extent_y", "extent_z"),
+            9,
+            ("extent_x", "extent_y", "extent_z"),
+            _box,
+            lambda p: p[6:9],
+            _with_pose(lambda p: trimesh.creation.box(extents=p[6:9])),
+        ),
+    )
+}
+
+
+def primitive(name: str) -> Primitive:
+    """The class called ``name`` (KeyError naming the known ones otherwise)."""
+    try:
+        return PRIMITIVES[name]
+    except KeyError:
+        raise KeyError(f"unknown shape class {name!r} (known: {', '.join(PRIMITIVES)})") from None

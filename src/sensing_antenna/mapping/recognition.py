@@ -1,0 +1,522 @@
+"""Which object was touched: every shape class fitted to the points, scored, and a decision.
+
+Each primitive class (:mod:`~sensing_antenna.mapping.primitives`) is fitted by robust least
+squares of the point-to-surface distance, d_i / sigma_i, where sigma_i^2 = n_i^T Sigma_i n_i is
+the point's variance along the fitted surface's normal n_i (scipy.optimize.least_squares, soft-L1
+loss so that one bad point does not drag the fit; several starts per class from the points'
+principal axes and an algebraic sphere, keeping the lowest cost). A user mesh is registered to
+the points by iterative closest point (trimesh.registration.icp, from several starting
+rotations) and scored the same way with its six pose parameters.
+
+Score: the Bayesian information criterion BIC = chi^2 + k ln n, with chi^2 = sum (d_i / sigma_i)^2
+(-2 log-likelihood of Gaussian distances up to a constant) and k the class's independent
+parameters; the lowest wins. Confidence: the BIC weight exp(-BIC / 2) normalised over the
+classes, an approximation of the posterior probability of each class under equal priors. The
+decision abstains (``undecided``, naming the two leaders) when the runner-up's BIC is within
+:data:`ABSTAIN_DELTA_BIC` of the best.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import trimesh
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive
+
+__all__ = [
+    "ABSTAIN_DELTA_BIC",
+    "UNDECIDED",
+    "ClassFit",
+    "Recognition",
+    "fit_mesh",
+    "fit_primitive",
+    "recognise",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: A BIC difference below which two classes explain the points equally: 6, where Kass and
+#: Raftery (J. Am. Stat. Assoc. 90, 1995, Section 3.2) put "strong" evidence (a Bayes factor of
+#: 20, a posterior of about 95 % for the better of two under equal priors).
+ABSTAIN_DELTA_BIC = 6.0
+
+#: The decision's name when the leading two classes are not told apart.
+UNDECIDED = "undecided"
+
+#: Robust loss scale, in standard deviations: residuals beyond 3 sigma count linearly.
+ROBUST_SCALE = 3.0
+
+#: Function evaluations per parameter a start may use (twice that for the refined fit): a fit
+#: that has not converged by then is on a class the points do not suit, and its BIC says so.
+MAX_EVALUATIONS = 100
+
+#: Largest size a fit may take, in spreads of the points (the diagonal of their bounding box):
+#: a closed object ten times larger than all the touches is a plane by another name, and the
+#: plane class is there for that.
+MAX_SIZE_SPREADS = 10.0
+
+#: Scale of the extent prior (m): a shape's extent along its own axes beyond the points' span
+#: there costs (excess / this)^2, as a residual of this many metres would. Points say nothing
+#: of a shape beyond them (a cylinder's far end, a box's hidden faces): without the prior those
+#: sizes drift freely; with it they stay at the smallest the points allow.
+EXTENT_PRIOR = 0.005
+
+#: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
+MIN_SIZE = 1e-4
+
+
+@dataclass(frozen=True)
+class ClassFit:
+    """One class's fit to the points.
+
+    Attributes
+    ----------
+    name : str
+        Class name (``sphere``, ...; ``mesh:NAME`` for a user mesh).
+    parameters : Mapping[str, float]
+        Fitted parameters (m, rad; a mesh: its 4 x 4 pose as ``m00`` ... ``m23``).
+    sizes : Mapping[str, float]
+        The class's sizes (m).
+    rms : float
+        RMS of the point-to-surface distances (m).
+    chi2 : float
+        sum (d_i / sigma_i)^2 (dimensionless).
+    bic : float
+        chi2 + dof ln n.
+    dof : int
+        Independent parameters.
+    n_points : int
+        Points fitted.
+    weight : float
+        BIC weight among the classes compared (0 to 1); NaN until compared.
+    """
+
+    name: str
+    parameters: Mapping[str, float]
+    sizes: Mapping[str, float]
+    rms: float
+    chi2: float
+    bic: float
+    dof: int
+    n_points: int
+    weight: float = math.nan
+    vector: FloatArray = field(default_factory=lambda: np.zeros(0), compare=False, repr=False)
+    mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able (SI units)."""
+        return {
+            "class": self.name,
+            "parameters": {k: float(v) for k, v in self.parameters.items()},
+            "sizes": {k: float(v) for k, v in self.sizes.items()},
+            "rms_m": float(self.rms),
+            "chi2": float(self.chi2),
+            "bic": float(self.bic),
+            "dof": self.dof,
+            "n_points": self.n_points,
+            "weight": None if math.isnan(self.weight) else float(self.weight),
+        }
+
+
+@dataclass(frozen=True)
+class Recognition:
+    """The decision and every class's fit.
+
+    Attributes
+    ----------
+    decision : str
+        The best class, or ``undecided``.
+    fits : tuple of ClassFit
+        Every class, best (lowest BIC) first, with weights.
+    candidates : tuple of str
+        The two leading classes.
+    delta_bic : float
+        BIC of the runner-up minus the best's (inf with one class).
+    confidence : float
+        The best class's BIC weight (0 to 1).
+    threshold : float
+        The abstention threshold on delta_bic used.
+    """
+
+    decision: str
+    fits: tuple[ClassFit, ...]
+    candidates: tuple[str, ...]
+    delta_bic: float
+    confidence: float
+    threshold: float
+
+    @property
+    def best(self) -> ClassFit:
+        """The lowest-BIC fit (even when the decision abstains)."""
+        return self.fits[0]
+
+    @property
+    def undecided(self) -> bool:
+        """True when the decision abstains."""
+        return self.decision == UNDECIDED
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able (SI units)."""
+        return {
+            "decision": self.decision,
+            "candidates": list(self.candidates),
+            "delta_bic": None if math.isinf(self.delta_bic) else float(self.delta_bic),
+            "confidence": float(self.confidence),
+            "abstain_delta_bic": float(self.threshold),
+            "fits": [f.to_dict() for f in self.fits],
+        }
+
+
+def _normal_sigma(covariances: FloatArray, normals: FloatArray) -> FloatArray:
+    """sigma_i = sqrt(n_i^T Sigma_i n_i) (m), shape (n,)."""
+    variance = np.einsum("ni,nij,nj->n", normals, covariances, normals)
+    return np.asarray(np.sqrt(np.maximum(variance, 1e-18)))
+
+
+def _isotropic_sigma(covariances: FloatArray) -> FloatArray:
+    return np.asarray(np.sqrt(np.trace(covariances, axis1=1, axis2=2) / 3.0))
+
+
+def _algebraic_sphere(points: FloatArray) -> tuple[FloatArray, float]:
+    """Centre and radius of |p|^2 = 2 c . p + (r^2 - |c|^2) by linear least squares."""
+    a = np.hstack([2.0 * points, np.ones((len(points), 1))])
+    b = np.sum(points**2, axis=1)
+    solution, *_ = np.linalg.lstsq(a, b, rcond=None)
+    centre = solution[:3]
+    radius_sq = solution[3] + centre @ centre
+    return centre, float(math.sqrt(radius_sq)) if radius_sq > 0 else math.inf
+
+
+def _starts(
+    shape: Primitive, points: FloatArray, outward: FloatArray, rng: np.random.Generator
+) -> list[FloatArray]:
+    """Initial parameter vectors for ``shape`` from the points' geometry."""
+    centroid = points.mean(axis=0)
+    centred = points - centroid
+    _, spread_sq, axes = np.linalg.svd(centred, full_matrices=False)
+    spread = float(max(np.sqrt(spread_sq[0] ** 2 / len(points)) * 2.0, 1e-3))
+    centre, radius = _algebraic_sphere(points)
+    if not (
+        math.isfinite(radius)
+        and radius < 5 * spread
+        and np.linalg.norm(centre - centroid) < 5 * spread
+    ):
+        radius = spread
+        centre = centroid - outward * spread
+    if shape.name == "plane":
+        normal = axes[2] if axes[2] @ outward >= 0 else -axes[2]
+        polar = math.acos(float(np.clip(normal[2], -1, 1)))
+        azimuth = math.atan2(normal[1], normal[0])
+        return [np.array([polar, azimuth, float(normal @ centroid)])]
+    if shape.name == "sphere":
+        return [np.array([*centre, radius])]
+    rotations: list[FloatArray] = []
+    for axis in axes:
+        # rotation taking Z to the axis (both senses for the cone)
+        for sense in (1.0, -1.0) if shape.name == "cone" else (1.0,):
+            rotation, _ = Rotation.align_vectors([sense * axis], [[0.0, 0.0, 1.0]])
+            rotations.append(rotation.as_rotvec())
+    if shape.name == "box":
+        frame = axes.T if np.linalg.det(axes.T) > 0 else axes.T * np.array([1, 1, -1])
+        rotations = [Rotation.from_matrix(frame).as_rotvec()]
+        rotations += [Rotation.random(random_state=rng).as_rotvec() for _ in range(5)]
+    size = max(radius, 0.5 * spread)
+    starts = []
+    for rotvec in rotations:
+        z_axis = Rotation.from_rotvec(rotvec).as_matrix()[:, 2]
+        if shape.name == "cylinder":
+            starts.append(np.array([*centre, *rotvec, size, 2 * size]))
+        elif shape.name == "capsule":
+            starts.append(np.array([*centre, *rotvec, size, size]))
+        elif shape.name == "cone":
+            starts.append(np.array([*(centre - 0.5 * size * z_axis), *rotvec, size, 2 * size]))
+        elif shape.name == "torus":
+            starts.append(np.array([*centre, *rotvec, 0.7 * size, 0.3 * size]))
+        else:  # box
+            starts.append(np.array([*centre, *rotvec, 1.5 * size, 1.5 * size, 1.5 * size]))
+    return starts
+
+
+def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
+    """How far the shape's extents along its own axes exceed the points' span there (m)."""
+    if name in ("plane", "sphere", "torus"):
+        return np.zeros(0)
+    local = (points - x[0:3]) @ Rotation.from_rotvec(x[3:6]).as_matrix()
+    span = local.max(axis=0) - local.min(axis=0)
+    if name == "box":
+        return np.asarray(np.maximum(x[6:9] - span, 0.0))
+    if name == "capsule":
+        extent = x[7] + 2 * x[6]
+    else:  # cylinder, cone: the height
+        extent = x[7]
+    return np.asarray([max(extent - span[2], 0.0)])
+
+
+def _bounds(shape: Primitive, points: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Sizes from :data:`MIN_SIZE` to :data:`MAX_SIZE_SPREADS` times the points' spread (the
+    torus's major radius to one spread)."""
+    n = len(shape.parameter_names)
+    low = np.full(n, -np.inf)
+    high = np.full(n, np.inf)
+    n_sizes = {"plane": 0, "sphere": 1, "box": 3}.get(shape.name, 2)
+    spread = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    if n_sizes:
+        low[n - n_sizes :] = MIN_SIZE
+        high[n - n_sizes :] = max(MAX_SIZE_SPREADS * spread, 10 * MIN_SIZE)
+    if shape.name == "torus":
+        # a ring larger than all the touches is a bent cylinder, one parameter dearer: the
+        # torus is the class of rings the points go around
+        high[6] = max(spread, 10 * MIN_SIZE)
+    return low, high
+
+
+def fit_primitive(
+    shape: Primitive | str,
+    points: ArrayLike,
+    covariances: ArrayLike,
+    outward: ArrayLike | None = None,
+    rng: np.random.Generator | None = None,
+) -> ClassFit:
+    """Fit one class to the points (module docstring).
+
+    Parameters
+    ----------
+    shape : Primitive or str
+        The class.
+    points : array, shape (n, 3)
+        World points (m).
+    covariances : array, shape (n, 3, 3)
+        Their covariances (m^2).
+    outward : array, shape (3,), optional
+        A direction from the object towards where the antenna came from (unit), to start the
+        fits on the right side; the mean direction to the centroid's opposite when None.
+    rng : numpy.random.Generator, optional
+        For the extra starting rotations of the box (seeded default).
+    """
+    model = PRIMITIVES[shape] if isinstance(shape, str) else shape
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
+    direction = _outward(p, outward)
+    generator = rng if rng is not None else np.random.default_rng(0)
+    low, high = _bounds(model, p)
+    sigma = _isotropic_sigma(cov)
+
+    def residuals(x: FloatArray, s: FloatArray) -> FloatArray:
+        distance = model.signed_distance(x, p) / s
+        return np.concatenate([distance, _extent_excess(model.name, x, p) / EXTENT_PRIOR])
+
+    best = None
+    for start in _starts(model, p, direction, generator):
+        start = np.clip(start, low, high)
+        try:
+            solution = least_squares(
+                residuals,
+                start,
+                args=(sigma,),
+                bounds=(low, high),
+                loss="soft_l1",
+                f_scale=ROBUST_SCALE,
+                max_nfev=MAX_EVALUATIONS * len(start),
+            )
+        except ValueError:  # a start outside the model's domain
+            continue
+        if best is None or solution.cost < best.cost:
+            best = solution
+    assert best is not None
+    # second pass: each point's sigma along the fitted surface's normal
+    sigma = _normal_sigma(cov, model.normals(best.x, p))
+    refined = least_squares(
+        residuals,
+        best.x,
+        args=(sigma,),
+        bounds=(low, high),
+        loss="soft_l1",
+        f_scale=ROBUST_SCALE,
+        max_nfev=2 * MAX_EVALUATIONS * len(best.x),
+    )
+    x = refined.x
+    distance = model.signed_distance(x, p)
+    sigma = _normal_sigma(cov, model.normals(x, p))
+    return _scored(
+        model.name,
+        dict(zip(model.parameter_names, x.tolist(), strict=True)),
+        dict(zip(model.size_names, model.sizes(x).tolist(), strict=True)),
+        distance,
+        sigma,
+        model.dof,
+        vector=x,
+        mesh=model.mesh(x),
+    )
+
+
+def fit_mesh(
+    name: str,
+    mesh: trimesh.Trimesh,
+    points: ArrayLike,
+    covariances: ArrayLike,
+    rng: np.random.Generator | None = None,
+    n_starts: int = 24,
+) -> ClassFit:
+    """Register a user mesh (its own size, any pose) to the points by ICP and score it.
+
+    The points are moved onto the mesh (trimesh.registration.icp, the closest point on the
+    mesh for each point: right for points covering only part of the object) from ``n_starts``
+    rotations about the points' centroid placed on the mesh's centre and from the alignment of
+    principal axes (trimesh.registration.mesh_other); the lowest cost wins.
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
+    generator = rng if rng is not None else np.random.default_rng(0)
+    rotations = [np.eye(3)] + [
+        Rotation.random(random_state=generator).as_matrix() for _ in range(n_starts - 1)
+    ]
+    centroid = p.mean(axis=0)
+    target = mesh.bounding_box.centroid
+    initials = []
+    for rotation in rotations:
+        initial = np.eye(4)
+        initial[:3, :3] = rotation
+        initial[:3, 3] = target - rotation @ centroid
+        initials.append(initial)
+    # and the principal axes' alignment (trimesh.registration.mesh_other), inverted
+    mesh_to_points, _ = trimesh.registration.mesh_other(
+        mesh,
+        p,
+        samples=300,
+        scale=False,
+        icp_first=5,
+        icp_final=20,
+        reflection=False,
+        seed=int(generator.integers(2**31)),
+    )
+    initials.append(np.linalg.inv(mesh_to_points))
+    best: tuple[float, FloatArray] | None = None
+    for initial in initials:
+        matrix, _, cost = trimesh.registration.icp(
+            p, mesh, initial=initial, max_iterations=40, reflection=False, scale=False
+        )
+        if best is None or cost < best[0]:
+            best = (float(cost), np.asarray(matrix))
+    assert best is not None
+    # the best start refined to convergence
+    points_to_mesh, _, _ = trimesh.registration.icp(
+        p,
+        mesh,
+        initial=best[1],
+        max_iterations=300,
+        threshold=1e-10,
+        reflection=False,
+        scale=False,
+    )
+    moved = trimesh.transform_points(p, points_to_mesh)
+    _, distance, faces = trimesh.proximity.closest_point(mesh, moved)
+    pose = np.linalg.inv(points_to_mesh)  # mesh to world
+    normals = mesh.face_normals[faces] @ pose[:3, :3].T
+    sigma = _normal_sigma(cov, normals)
+    placed = mesh.copy()
+    placed.apply_transform(pose)
+    parameters = {f"m{i}{j}": float(pose[i, j]) for i in range(3) for j in range(4)}
+    extents = mesh.bounding_box.extents
+    sizes = {f"extent_{a}": float(e) for a, e in zip("xyz", extents, strict=True)}
+    return _scored(
+        f"mesh:{name}", parameters, sizes, np.asarray(distance), sigma, 6, pose.ravel(), placed
+    )
+
+
+def _scored(
+    name: str,
+    parameters: dict[str, float],
+    sizes: dict[str, float],
+    distance: FloatArray,
+    sigma: FloatArray,
+    dof: int,
+    vector: FloatArray,
+    mesh: trimesh.Trimesh | None,
+) -> ClassFit:
+    n = len(distance)
+    # chi^2 = sum (d_i / sigma_i)^2; BIC = chi^2 + k ln n
+    chi2 = float(np.sum((distance / sigma) ** 2))
+    return ClassFit(
+        name=name,
+        parameters=parameters,
+        sizes=sizes,
+        rms=float(np.sqrt(np.mean(distance**2))),
+        chi2=chi2,
+        bic=chi2 + dof * math.log(n),
+        dof=dof,
+        n_points=n,
+        vector=vector,
+        mesh=mesh,
+    )
+
+
+def _outward(points: FloatArray, outward: ArrayLike | None) -> FloatArray:
+    if outward is not None:
+        direction = np.asarray(outward, dtype=float).reshape(3)
+    else:
+        direction = points.mean(axis=0) * -1.0  # towards the origin, the usual base
+    norm = float(np.linalg.norm(direction))
+    return direction / norm if norm > 0 else np.array([0.0, 0.0, 1.0])
+
+
+def recognise(
+    points: ArrayLike,
+    covariances: ArrayLike,
+    classes: Sequence[str] | None = None,
+    meshes: Mapping[str, trimesh.Trimesh] | None = None,
+    outward: ArrayLike | None = None,
+    threshold: float = ABSTAIN_DELTA_BIC,
+    rng: np.random.Generator | None = None,
+) -> Recognition:
+    """Fit every class (and mesh) to the points and decide (module docstring).
+
+    Parameters
+    ----------
+    points : array, shape (n, 3)
+        World points (m); at least 10 (more than the largest class's 9 parameters).
+    covariances : array, shape (n, 3, 3)
+        Their covariances (m^2).
+    classes : sequence of str, optional
+        Primitive classes to try (all of :data:`PRIMITIVES` when None).
+    meshes : Mapping[str, trimesh.Trimesh], optional
+        User meshes by name, registered at their own size.
+    outward : array, shape (3,), optional
+        Direction from the object towards the antenna (see :func:`fit_primitive`).
+    threshold : float
+        Abstain when the runner-up's BIC is within this of the best's.
+    rng : numpy.random.Generator, optional
+        Seeded default when None.
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
+    if len(p) < 10:
+        raise ValueError(f"recognition needs at least 10 points, got {len(p)}")
+    generator = rng if rng is not None else np.random.default_rng(0)
+    names = list(classes) if classes is not None else list(PRIMITIVES)
+    fits = [fit_primitive(name, p, cov, outward, generator) for name in names]
+    for name, mesh in (meshes or {}).items():
+        fits.append(fit_mesh(name, mesh, p, cov, generator))
+    fits.sort(key=lambda f: f.bic)
+    # BIC weights: exp(-(BIC_j - BIC_min) / 2), normalised
+    raw = np.exp(-0.5 * (np.array([f.bic for f in fits]) - fits[0].bic))
+    weights = raw / raw.sum()
+    fits = [dataclasses.replace(f, weight=float(w)) for f, w in zip(fits, weights, strict=True)]
+    delta = fits[1].bic - fits[0].bic if len(fits) > 1 else math.inf
+    decision = fits[0].name if delta >= threshold else UNDECIDED
+    return Recognition(
+        decision=decision,
+        fits=tuple(fits),
+        candidates=tuple(f.name for f in fits[:2]),
+        delta_bic=float(delta),
+        confidence=float(weights[0]),
+        threshold=threshold,
+    )

@@ -1,0 +1,171 @@
+"""A map's directory: points.csv, points.ply, surface.ply, recognition.json, report.md.
+
+points.csv has one row per recording: ``source, method, status, x, y, z`` (m, world frame), the
+covariance's six entries ``cov_xx, cov_xy, cov_xz, cov_yy, cov_yz, cov_zz`` (m^2), ``std``
+(the worst-direction sigma, m), ``x_c`` (m), ``used`` (whether it entered the map),
+``true_x, true_y, true_z`` (ground truth when the recording had it) and ``reason``. The PLY
+files colour points and surface vertices by their standard deviation, blue (smallest) to red
+(largest).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+from sensing_antenna.mapping.contact_map import ContactMap
+
+__all__ = ["POINT_COLUMNS", "write_map"]
+
+#: The columns of points.csv, in order.
+POINT_COLUMNS = (
+    "source",
+    "method",
+    "status",
+    "x",
+    "y",
+    "z",
+    "cov_xx",
+    "cov_xy",
+    "cov_xz",
+    "cov_yy",
+    "cov_yz",
+    "cov_zz",
+    "std",
+    "x_c",
+    "used",
+    "true_x",
+    "true_y",
+    "true_z",
+    "reason",
+)
+
+
+def _colours(values: NDArray[np.float64]) -> NDArray[np.uint8]:
+    """RGBA rows from blue (smallest) to red (largest) of ``values``."""
+    v = np.asarray(values, dtype=float)
+    span = float(np.ptp(v)) if v.size else 0.0
+    t = (v - v.min()) / span if span > 0 else np.zeros_like(v)
+    rgba = np.stack([255 * t, 64 * np.ones_like(t), 255 * (1 - t), 255 * np.ones_like(t)], axis=1)
+    return np.asarray(rgba.round(), dtype=np.uint8)
+
+
+def _number(value: float) -> str:
+    return "" if not math.isfinite(value) else f"{value:.9g}"
+
+
+def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
+    """Write the map's files into ``out`` (created); returns the paths written."""
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    used = {id(p) for p in contact_map.used}
+    path = out / "points.csv"
+    with path.open("w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(POINT_COLUMNS)
+        for p in contact_map.points:
+            c = p.covariance
+            writer.writerow(
+                [
+                    p.source,
+                    p.method,
+                    p.status.value,
+                    *(_number(v) for v in p.point),
+                    *(
+                        _number(c[i, j])
+                        for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+                    ),
+                    _number(p.std),
+                    _number(p.x_c),
+                    "true" if id(p) in used else "false",
+                    *(_number(v) for v in p.true_point),
+                    p.reason or "",
+                ]
+            )
+    written.append(path)
+    if contact_map.used:
+        cloud = trimesh.PointCloud(
+            np.array([p.point for p in contact_map.used]),
+            colors=_colours(np.array([p.std for p in contact_map.used])),
+        )
+        path = out / "points.ply"
+        cloud.export(path)
+        written.append(path)
+    mesh = contact_map.surface_mesh
+    if mesh is not None and len(mesh.faces):
+        mesh = trimesh.Trimesh(
+            vertices=mesh.vertices,
+            faces=mesh.faces,
+            vertex_colors=_colours(contact_map.surface_std),
+            process=False,
+        )
+        path = out / "surface.ply"
+        mesh.export(path)
+        written.append(path)
+    path = out / "recognition.json"
+    path.write_text(json.dumps(contact_map.summary(), indent=2, allow_nan=False) + "\n")
+    written.append(path)
+    path = out / "report.md"
+    path.write_text(report(contact_map))
+    written.append(path)
+    return written
+
+
+def report(contact_map: ContactMap) -> str:
+    """A short Markdown report of the map (lengths in mm for reading)."""
+    s = contact_map.summary()
+    statuses = ", ".join(f"{k} {v}" for k, v in sorted(s["statuses"].items()))
+    lines = [
+        "# Contact map",
+        "",
+        f"{s['n_recordings']} recordings ({statuses}); {s['n_used']} points used"
+        + (" (ok and uncertain)" if s["include_uncertain"] else " (status ok)")
+        + ".",
+    ]
+    if s["median_point_std_m"] is not None:
+        lines.append(
+            f"Median worst-direction sigma of a point: {1000 * s['median_point_std_m']:.2f} mm."
+        )
+    if s["point_error_rms_m"] is not None:
+        lines.append(
+            "Distance to the ground truth the recordings carry (RMS): "
+            f"{1000 * s['point_error_rms_m']:.2f} mm."
+        )
+    if s["surface_faces"]:
+        lines.append(
+            f"Surface: {s['surface_faces']} faces, GP length scale "
+            f"{1000 * s['surface_length_scale_m']:.1f} mm (surface.ply)."
+        )
+    else:
+        lines.append("Surface: none (too few points, or no zero level in the grid).")
+    recognition = contact_map.recognition
+    lines.append("")
+    if recognition is None:
+        lines.append("Recognition: not attempted (fewer than 10 points).")
+    else:
+        lines += [
+            f"Recognition: **{recognition.decision}**"
+            + (
+                f" (between {recognition.candidates[0]} and {recognition.candidates[1]})"
+                if recognition.undecided
+                else f" (confidence {recognition.confidence:.3f})"
+            )
+            + f"; BIC gap to the runner-up {recognition.delta_bic:.1f}"
+            f" (abstains below {recognition.threshold:g}).",
+            "",
+            "| class | RMS (mm) | BIC | weight | sizes (mm) |",
+            "|---|---|---|---|---|",
+        ]
+        for fit in recognition.fits:
+            sizes = ", ".join(f"{k} {1000 * v:.1f}" for k, v in fit.sizes.items()) or "-"
+            lines.append(
+                f"| {fit.name} | {1000 * fit.rms:.2f} | {fit.bic:.1f} | {fit.weight:.3f} | "
+                f"{sizes} |"
+            )
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,72 @@
+"""Figures of a contact map: the points from several sides, coloured by their uncertainty.
+
+Each figure has four views (from the front, the side, above, and an oblique view), the points
+(in cm, display edge) coloured by their worst-direction standard deviation (mm), the surface's
+mesh in grey when there is one, and the recognised shape's mesh as a wire frame.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from sensing_antenna.mapping.contact_map import ContactMap
+
+__all__ = ["VIEWS", "plot_map"]
+
+#: (title, elevation, azimuth) of each view, degrees.
+VIEWS = (
+    ("front (along +X)", 0.0, 180.0),
+    ("side (along +Y)", 0.0, -90.0),
+    ("above", 90.0, -90.0),
+    ("oblique", 25.0, -135.0),
+)
+
+
+def plot_map(contact_map: ContactMap, path: Path) -> Path:
+    """Draw the map's points from the four :data:`VIEWS` into ``path``; returns ``path``."""
+    used = contact_map.used
+    fig = plt.figure(figsize=(11, 9))
+    points = np.array([p.point for p in used]).reshape(-1, 3) * 100.0
+    std = np.array([p.std for p in used]) * 1000.0
+    mesh = contact_map.surface_mesh
+    shape = None
+    if contact_map.recognition is not None:
+        shape = contact_map.recognition.best.mesh
+    scatter = None
+    for index, (title, elevation, azimuth) in enumerate(VIEWS, start=1):
+        ax = fig.add_subplot(2, 2, index, projection="3d")
+        if mesh is not None and len(mesh.faces):
+            ax.plot_trisurf(
+                *(mesh.vertices * 100.0).T,
+                triangles=mesh.faces,
+                color="0.8",
+                alpha=0.35,
+                linewidth=0,
+            )
+        if shape is not None and len(shape.faces) < 20000:
+            edges = shape.vertices[shape.edges_unique] * 100.0
+            for a, b in edges[:: max(1, len(edges) // 600)]:
+                ax.plot(*zip(a, b, strict=True), color="tab:green", linewidth=0.4, alpha=0.5)
+        if len(points):
+            scatter = ax.scatter(*points.T, c=std, cmap="viridis", s=18, depthshade=False)
+        ax.view_init(elev=elevation, azim=azimuth)
+        ax.set_aspect("equal")
+        ax.set_title(title)
+        ax.set_xlabel("x (cm)")
+        ax.set_ylabel("y (cm)")
+        ax.set_zlabel("z (cm)")
+    if scatter is not None:
+        fig.colorbar(
+            scatter,
+            cax=fig.add_axes((0.9, 0.25, 0.02, 0.5)),
+            label="point sigma, worst direction (mm)",
+        )
+    decision = "" if contact_map.recognition is None else f": {contact_map.recognition.decision}"
+    fig.suptitle(f"{len(used)} contact points{decision}")
+    fig.subplots_adjust(left=0.02, right=0.85, wspace=0.1, hspace=0.15)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,98 @@
+"""``antenna map`` end to end on simulated recordings, scored against their ground truth."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna.cli import main
+from sensing_antenna.mapping import BasePose
+from sensing_antenna.recording import read_recording, write_recording
+
+#: A base pose for the third recording: turned 30 degrees about Z and lifted onto a robot.
+POSE = BasePose.from_quaternion(
+    [0.2, -0.1, 0.4], [math.cos(math.pi / 12), 0.0, 0.0, math.sin(math.pi / 12)]
+)
+
+
+@pytest.fixture(scope="module")
+def recordings(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    folder = tmp_path_factory.mktemp("map")
+    paths = [folder / "post.csv", folder / "bar.csv", folder / "moved.csv"]
+    for path, case, x_c in ((paths[0], "azimuthal", "0.5"), (paths[1], "vertical", "0.6")):
+        assert main(["simulate", "--case", case, "--xc", x_c, "--out", str(path)]) == 0
+    moved = read_recording(paths[0]).with_metadata(base_pose=POSE.to_json())
+    write_recording(moved, paths[2])
+    return paths
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with path.open() as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_map_writes_points_within_their_covariance_of_the_truth(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "map"
+    assert main(["map", *map(str, recordings), "--out", str(out)]) == 0
+    assert "3 of 3 points used" in capsys.readouterr().out
+    for name in ("points.csv", "points.ply", "recognition.json", "report.md", "map.png"):
+        assert (out / name).stat().st_size > 0
+    rows = _rows(out / "points.csv")
+    assert [row["status"] for row in rows] == ["ok", "ok", "ok"]
+    points = []
+    for row in rows:
+        point = np.array([float(row[k]) for k in ("x", "y", "z")])
+        truth = np.array([float(row[k]) for k in ("true_x", "true_y", "true_z")])
+        c = {k: float(row[f"cov_{k}"]) for k in ("xx", "xy", "xz", "yy", "yz", "zz")}
+        covariance = np.array(
+            [[c["xx"], c["xy"], c["xz"]], [c["xy"], c["yy"], c["yz"]], [c["xz"], c["yz"], c["zz"]]]
+        )
+        error = point - truth
+        # Mahalanobis distance of the truth: below 3.37, the 99 % point of chi with 3 dof
+        assert float(np.sqrt(error @ np.linalg.solve(covariance, error))) < 3.37, row["source"]
+        points.append((point, truth, covariance))
+    # the moved recording is the first one, placed by its base pose: point, truth, covariance
+    assert np.allclose(points[2][0], POSE.point_to_world(points[0][0]))
+    assert np.allclose(points[2][1], POSE.point_to_world(points[0][1]))
+    assert np.allclose(points[2][2], POSE.covariance_to_world(points[0][2]))
+    summary = json.loads((out / "recognition.json").read_text())
+    assert summary["n_used"] == 3 and summary["recognition"] is None  # too few to recognise
+
+
+@pytest.mark.parametrize(
+    ("problem", "words"),
+    [
+        ("missing", "absent.csv: cannot read file"),
+        ("pose", "base_pose: not JSON"),
+        ("mesh", "junk.stl: "),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(
+    problem: str,
+    words: str,
+    recordings: list[Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    argv = ["map", str(recordings[0]), "--out", str(tmp_path / "out")]
+    if problem == "missing":
+        argv[1] = str(tmp_path / "absent.csv")
+    elif problem == "pose":
+        bad = tmp_path / "bad.csv"
+        write_recording(read_recording(recordings[0]).with_metadata(base_pose="{"), bad)
+        argv[1] = str(bad)
+    else:
+        mesh = tmp_path / "junk.stl"
+        mesh.write_text("solid nothing here\nthis is not an stl\n")
+        argv += ["--objects", str(mesh)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("antenna map: error: ") and words in err, err
+    assert "\n" not in err
