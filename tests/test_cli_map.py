@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _models import calibrated
+from sensing_antenna.antenna import save_antenna
 from sensing_antenna.cli import main
 from sensing_antenna.mapping import BasePose
 from sensing_antenna.recording import read_recording, write_recording
@@ -39,8 +41,9 @@ def _rows(path: Path) -> list[dict[str, str]]:
 def test_map_writes_points_within_their_covariance_of_the_truth(
     recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    out = tmp_path / "map"
-    assert main(["map", *map(str, recordings), "--out", str(out)]) == 0
+    out, model = tmp_path / "map", tmp_path / "model.toml"
+    save_antenna(calibrated(), model)  # a calibrated antenna: the datasheet's would be uncertain
+    assert main(["map", *map(str, recordings), "--out", str(out), "--antenna", str(model)]) == 0
     assert "3 of 3 points used" in capsys.readouterr().out
     for name in ("points.csv", "points.ply", "recognition.json", "report.md", "map.png"):
         assert (out / name).stat().st_size > 0
