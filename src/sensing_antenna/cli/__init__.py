@@ -46,6 +46,8 @@ COMMAND_MODULES = (
     "simulate",
     "identify",
     "estimate",
+    "listen",
+    "replay",
     "calibrate",
     "campaign",
     "plot",
