@@ -89,6 +89,15 @@ class Listener:
     clock : callable
         Wall clock (s) the receipt and emission times are read from.
 
+    Attributes
+    ----------
+    dropped : int
+        Samples missing so far (time steps of k sample periods count k - 1).
+    lags : list of float
+        For each block the worker took, the wall time (s) from the receipt of its first sample
+        to the end of its processing (estimator, events, recording): how far the worker runs
+        behind the input.
+
     Notes
     -----
     An exception in the worker (a closed output, an unwritable recording) stops it; the next
@@ -124,6 +133,7 @@ class Listener:
         self._t = _Growing()
         self._received = _Growing()
         self.dropped = 0
+        self.lags: list[float] = []
         self._said: set[str] = set()
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self.error: BaseException | None = None
@@ -208,6 +218,7 @@ class Listener:
         if result is not None:
             self._say_estimate(result, first)
         self._watch_contact(first)
+        self.lags.append(self._latency(first))
 
     def _latency(self, index: int) -> float:
         return self._clock() - float(self._received.values[index])
