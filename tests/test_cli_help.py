@@ -24,6 +24,8 @@ COMMANDS = [
     ["simulate"],
     ["identify"],
     ["estimate"],
+    ["listen"],
+    ["replay"],
     ["calibrate"],
     ["campaign"],
     ["campaign", "run"],
