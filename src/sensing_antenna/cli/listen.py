@@ -29,7 +29,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--udp",
         metavar="HOST:PORT",
-        help="receive UDP datagrams bound to this address (without it: standard input)",
+        help="receive UDP datagrams bound to this address (default: standard input)",
     )
     parser.add_argument("--method", choices=METHOD_NAMES, default="paper", help="as for estimate")
     parser.add_argument("--t1", choices=("rest", "push"), default="rest", help="as for estimate")
@@ -39,13 +39,13 @@ def register(subparsers: Any) -> None:
         type=Path,
         metavar="FILE",
         help="keep what was received as a recording (the stream's next recordings in "
-        "FILE-2, FILE-3, ... before the suffix)",
+        "FILE-2, FILE-3, ... before the suffix; default: not kept)",
     )
     parser.add_argument(
         "--count",
         type=integer(low=1),
         metavar="N",
-        help="stop after N recordings ended (without it: when the input ends; over UDP, on Ctrl-C)",
+        help="stop after N recordings ended (default: when the input ends; over UDP, on Ctrl-C)",
     )
     parser.set_defaults(func=_run)
 

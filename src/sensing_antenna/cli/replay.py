@@ -34,7 +34,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--udp",
         metavar="HOST:PORT",
-        help="send UDP datagrams to this address (without it: standard output)",
+        help="send UDP datagrams to this address (default: standard output)",
     )
     parser.set_defaults(func=_run)
 
