@@ -11,7 +11,8 @@ manoeuvre.
 Reported per method: recordings and samples received, samples dropped (sent but not received),
 whether every recording's estimate equals the offline ``estimate`` of the same recording, the
 latency of the events (wall time from the receipt of the sample an event is at to its
-emission: p50, p99, max over all events, and over the estimates alone) and the worker's lag
+emission: p50, p99, max over all events but the ends, over the estimates alone, and over the
+instants: contact, push, contact lost) and the worker's lag
 (for each block it took, from the receipt of its first sample to the end of its processing).
 The target: no sample dropped, p99 latency under 20 ms.
 
@@ -44,7 +45,14 @@ import numpy as np  # noqa: E402
 
 from sensing_antenna.antenna import paper_antenna  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
-from sensing_antenna.live.events import EndEvent, EstimateEvent, Event  # noqa: E402
+from sensing_antenna.live.events import (  # noqa: E402
+    ContactEvent,
+    ContactLostEvent,
+    EndEvent,
+    EstimateEvent,
+    Event,
+    PushEvent,
+)
 from sensing_antenna.live.inputs import listen_udp  # noqa: E402
 from sensing_antenna.live.listener import Listener  # noqa: E402
 from sensing_antenna.live.wire import StreamHeader  # noqa: E402
@@ -130,6 +138,13 @@ def run_method(method: str, files: list[Path], duration: float) -> dict[str, Any
         "estimates_identical_to_offline": identical,
         "event_latency_s": _percentiles(latencies),
         "estimate_latency_s": _percentiles([e.latency for e in estimates]),
+        "instant_latency_s": _percentiles(
+            [
+                e.latency
+                for e in events
+                if isinstance(e, (ContactEvent, PushEvent, ContactLostEvent))
+            ]
+        ),
         "worker_lag_s": _percentiles([lag for listener in listeners for lag in listener.lags]),
         "skipped": [e.to_dict() for e in events if e.to_dict()["event"] == "skipped"][:5],
     }
@@ -165,6 +180,8 @@ def main() -> None:
                 + "/".join(_ms(row["event_latency_s"][k]) for k in ("p50", "p99", "max"))
                 + "  estimate "
                 + "/".join(_ms(row["estimate_latency_s"][k]) for k in ("p50", "p99", "max"))
+                + "  instants "
+                + "/".join(_ms(row["instant_latency_s"][k]) for k in ("p50", "p99", "max"))
                 + "  lag "
                 + "/".join(_ms(row["worker_lag_s"][k]) for k in ("p50", "p99", "max")),
                 flush=True,
