@@ -274,6 +274,22 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
         main(["listen", "--count", "0"])
     assert exc.value.code == 2
     assert main(["listen", "--udp", "nowhere"]) == 2
+    assert main(["listen", "--udp", "300.1.1.1:5"]) == 2
+    assert main(["replay", str(recordings["azimuthal"]), "--udp", "300.1.1.1:5"]) == 2
+    with pytest.raises(SystemExit) as exc:
+        main(["replay", str(recordings["azimuthal"]), "--speed", "-1"])
+    assert exc.value.code == 2
+
+
+def test_udp_address_errors_name_the_flag(
+    recordings: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    capsys.readouterr()
+    assert main(["listen", "--udp", "300.1.1.1:5"]) == 2
+    assert capsys.readouterr().err.startswith("antenna listen: error: --udp: cannot listen on")
+    assert main(["replay", str(recordings["azimuthal"]), "--udp", "127.0.0.1:70000"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--udp: address must read HOST:PORT" in err
 
 
 def test_lost_samples_and_contact_lost(recordings: dict[str, Path]) -> None:

@@ -90,7 +90,12 @@ def _run(args: argparse.Namespace) -> int:
         socket.AF_INET6 if ":" in address[0] else socket.AF_INET, socket.SOCK_DGRAM
     ) as sock:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
-        sock.bind(address)
+        try:
+            sock.bind(address)
+        except OSError as exc:
+            raise ArgumentError(
+                "--udp", f"cannot listen on {args.udp}: {exc.strerror or exc}"
+            ) from None
         host, port = sock.getsockname()[:2]
         print(f"antenna listen: listening on udp {host}:{port}", file=sys.stderr, flush=True)
         listen_udp(sock, make, emit, args.count)

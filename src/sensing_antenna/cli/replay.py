@@ -60,5 +60,11 @@ def _run(args: argparse.Namespace) -> int:
         return 0
     family = socket.AF_INET6 if ":" in address[0] else socket.AF_INET
     with socket.socket(family, socket.SOCK_DGRAM) as sock:
+        try:
+            socket.getaddrinfo(*address, family, socket.SOCK_DGRAM)
+        except OSError as exc:
+            raise ArgumentError(
+                "--udp", f"cannot send to {args.udp}: {exc.strerror or exc}"
+            ) from None
         replay_datagrams(recording, sock, address, args.speed)
     return 0
