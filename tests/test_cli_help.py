@@ -26,6 +26,8 @@ COMMANDS = [
     ["import", "rosbag"],
     ["identify"],
     ["estimate"],
+    ["listen"],
+    ["replay"],
     ["calibrate"],
     ["campaign"],
     ["campaign", "run"],

@@ -48,6 +48,8 @@ __all__ = [
     "SamplingDiagnostics",
     "check_sampling",
     "is_ground_truth_key",
+    "parse_header",
+    "parse_metadata",
     "read_recording",
     "resample_uniform",
     "write_recording",
@@ -452,8 +454,9 @@ def _parse_period(text: str) -> float | None:
     return value if math.isfinite(value) and value > 0 else None
 
 
-def _parse_metadata(lines: list[str], source: str) -> tuple[dict[str, str], int]:
-    """Metadata from the leading ``#`` lines; returns it and the index of the header line."""
+def parse_metadata(lines: list[str], source: str) -> tuple[dict[str, str], int]:
+    """Metadata from the leading ``#`` lines of ``lines`` (a file's, or a stream's); returns it
+    and the index of the header line. Errors name ``source`` and the 1-based line."""
     metadata: dict[str, str] = {}
     index = 0
     while index < len(lines) and lines[index].startswith("#"):
@@ -496,7 +499,9 @@ def _check_known_metadata(metadata: Mapping[str, str], lines: list[str], source:
         )
 
 
-def _parse_header(line: str, number: int, source: str) -> list[str]:
+def parse_header(line: str, number: int, source: str) -> list[str]:
+    """The column names of a header ``line`` (line ``number`` of ``source``): none empty or
+    repeated, the nine required ones present."""
     names = [cell.strip() for cell in line.split(",")]
     seen: set[str] = set()
     for name in names:
@@ -614,10 +619,10 @@ def read_recording(path: str | Path) -> Recording:
         lines.pop()
     if not lines:
         raise RecordingError(source, None, None, "empty file")
-    metadata, header_index = _parse_metadata(lines, source)
+    metadata, header_index = parse_metadata(lines, source)
     if header_index == len(lines):
         raise RecordingError(source, None, None, "no header row after the metadata")
-    names = _parse_header(lines[header_index], header_index + 1, source)
+    names = parse_header(lines[header_index], header_index + 1, source)
     rows = lines[header_index + 1 :]
     first_line = header_index + 2
     if not rows:

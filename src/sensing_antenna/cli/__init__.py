@@ -47,6 +47,8 @@ COMMAND_MODULES = (
     "importer",
     "identify",
     "estimate",
+    "listen",
+    "replay",
     "calibrate",
     "campaign",
     "map",

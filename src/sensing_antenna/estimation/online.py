@@ -83,6 +83,16 @@ class OnlineEstimator:
         """Samples fed since :meth:`reset`."""
         return self._front.n_samples
 
+    @property
+    def contact_index(self) -> int | None:
+        """Sample of t_c (counted from the first after :meth:`reset`), once found."""
+        return self._front.contact_index
+
+    @property
+    def rest_index(self) -> int | None:
+        """Sample of t_1 (counted from the first after :meth:`reset`), once found."""
+        return self._front.rest_index
+
     def update(
         self, t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
     ) -> ContactEstimate | None:
@@ -91,7 +101,13 @@ class OnlineEstimator:
         return self.update_block(*one_sample(t, theta, force, torque))
 
     def update_block(
-        self, t: ArrayLike, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
+        self,
+        t: ArrayLike,
+        theta: ArrayLike,
+        force: ArrayLike,
+        torque: ArrayLike,
+        *,
+        every_instant: bool = False,
     ) -> ContactEstimate | None:
         """Feed the samples that arrived together; returns the estimate (once), else None.
 
@@ -103,6 +119,12 @@ class OnlineEstimator:
         sample-by-sample feeding would give. A block that reaches the pipeline's own end before
         any instant was asked concludes as the offline method does.
 
+        With ``every_instant`` the method is asked at every evaluation instant of the block in
+        turn, up to the first it is ready at (and before the pipeline's own end when the block
+        reaches it), as feeding the block sample by sample would: the estimate of
+        :func:`~sensing_antenna.estimation.pipeline.estimate` on the same samples however they
+        are cut into blocks, at the cost of evaluating every instant.
+
         The samples are as for :meth:`FrontEnd.update_block
         <sensing_antenna.estimation.front.frontend.FrontEnd.update_block>`: t (n,) in s, theta
         (n, 2) in rad, force and torque (n, 3) in N and N m, motor frame; a
@@ -113,21 +135,30 @@ class OnlineEstimator:
         if self.result is not None:
             return None
         outcome = front.update_block(t, theta, force, torque)
-        if outcome is not None:
+        ask_first = every_instant and isinstance(outcome, Evidence)
+        if outcome is not None and not ask_first:
             return self._emit(conclude(outcome, self._run))
         if self._early is None or front.first_evaluation_index is None:
-            return None
+            return None if outcome is None else self._emit(conclude(outcome, self._run))
         rest = front.rest_index
         assert rest is not None
-        # The last evaluation instant of the block, causally: the evidence up to it only
-        for index in range(front.n_samples - 1, max(first, front.first_evaluation_index) - 1, -1):
+        start = max(first, front.first_evaluation_index)
+        if every_instant:
+            # every instant in turn, before the pipeline's end when the block reaches it
+            stop = outcome.end_index if isinstance(outcome, Evidence) else front.n_samples
+            indices = range(start, stop)
+        else:
+            # the last evaluation instant of the block, causally: the evidence up to it only
+            indices = range(front.n_samples - 1, start - 1, -1)
+        for index in indices:
             if self._early.due(index - rest, self.sample_period):
                 evidence = front.evidence_at(index)
                 if isinstance(evidence, Evidence) and self._early.ready(evidence):
                     traced = dataclasses.replace(evidence, trace=front.trace(evidence))
                     return self._emit(conclude(traced, self._run))
-                break
-        return None
+                if not every_instant:
+                    break
+        return None if outcome is None else self._emit(conclude(outcome, self._run))
 
     def _emit(self, result: ContactEstimate) -> ContactEstimate:
         self.result = result

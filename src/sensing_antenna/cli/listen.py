@@ -1,0 +1,102 @@
+"""``antenna listen``: estimates while the samples arrive (docs/live.md)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+from pathlib import Path
+from typing import Any
+
+from sensing_antenna.cli.arguments import integer
+from sensing_antenna.cli.estimate import METHOD_NAMES
+
+
+def register(subparsers: Any) -> None:
+    """Add ``antenna listen``."""
+    parser = subparsers.add_parser(
+        "listen",
+        help="estimate while the samples of a device arrive (standard input or UDP)",
+        description=(
+            "Reads samples as they arrive, CSV lines on standard input or UDP datagrams on a "
+            "port (the wire formats of docs/live.md: the recording format's metadata, header "
+            "and one sample per line), runs the online estimator in a worker thread, and "
+            "writes one JSON line per event: contact (t_c), push (t_1), estimate (x_c, "
+            "interval, status, t_e), contact_lost, end, and skipped input; each with its "
+            "latency, the wall time from the receipt of the sample it is at to the line."
+        ),
+    )
+    parser.add_argument(
+        "--udp",
+        metavar="HOST:PORT",
+        help="receive UDP datagrams bound to this address (default: standard input)",
+    )
+    parser.add_argument("--method", choices=METHOD_NAMES, default="paper", help="as for estimate")
+    parser.add_argument("--t1", choices=("rest", "push"), default="rest", help="as for estimate")
+    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
+    parser.add_argument(
+        "--record",
+        type=Path,
+        metavar="FILE",
+        help="keep what was received as a recording (the stream's next recordings in "
+        "FILE-2, FILE-3, ... before the suffix; default: not kept)",
+    )
+    parser.add_argument(
+        "--count",
+        type=integer(low=1),
+        metavar="N",
+        help="stop after N recordings ended (default: when the input ends; over UDP, on Ctrl-C)",
+    )
+    parser.set_defaults(func=_run)
+
+
+def _run(args: argparse.Namespace) -> int:
+    import json
+    import socket
+
+    from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.cli.arguments import ArgumentError
+    from sensing_antenna.estimation.config import EstimatorConfig
+    from sensing_antenna.live.events import Event
+    from sensing_antenna.live.inputs import listen_lines, listen_udp, parse_address
+    from sensing_antenna.live.listener import Listener
+    from sensing_antenna.live.record import RecordWriter, numbered_path
+    from sensing_antenna.live.wire import StreamHeader, WireError
+
+    antenna = load_antenna(args.antenna)
+    config = EstimatorConfig(t1_source=args.t1)
+    lock = threading.Lock()
+
+    def emit(event: Event) -> None:
+        line = json.dumps(event.to_dict(), allow_nan=False)
+        with lock:
+            sys.stdout.write(line + "\n")
+            sys.stdout.flush()
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        record = None
+        if args.record is not None:
+            record = RecordWriter(numbered_path(args.record, number), header)
+        return Listener(header, antenna, emit, args.method, config, record, number)
+
+    if args.udp is None:
+        listen_lines(sys.stdin.buffer, make, "<stdin>", args.count)
+        return 0
+    try:
+        address = parse_address(args.udp)
+    except WireError as exc:
+        raise ArgumentError("--udp", str(exc)) from None
+    with socket.socket(
+        socket.AF_INET6 if ":" in address[0] else socket.AF_INET, socket.SOCK_DGRAM
+    ) as sock:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
+        try:
+            sock.bind(address)
+        except OSError as exc:
+            raise ArgumentError(
+                "--udp", f"cannot listen on {args.udp}: {exc.strerror or exc}"
+            ) from None
+        host, port = sock.getsockname()[:2]
+        print(f"antenna listen: listening on udp {host}:{port}", file=sys.stderr, flush=True)
+        listen_udp(sock, make, emit, args.count)
+    return 0

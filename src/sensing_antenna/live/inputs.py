@@ -1,0 +1,254 @@
+"""The readers of a live stream: CSV lines (standard input) and UDP datagrams.
+
+Each reads the wire format of :mod:`.wire`, starts a :class:`~.listener.Listener` for every
+recording the stream carries (through the caller's ``make``), hands it the samples with the
+wall time they arrived, and closes it when the recording ends. A reader only parses: the
+estimates run in each listener's worker thread.
+
+Standard input is trusted as a file is: a malformed line or a time that does not increase
+stops the reader with a :class:`~sensing_antenna.recording.RecordingError` naming the line. A
+UDP port receives whatever anyone sends it: a datagram not in the format, a malformed line, a
+late datagram or a time that does not increase is left out with a
+:class:`~.events.SkippedEvent` saying why, and listening goes on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import time
+from collections.abc import Callable, Iterable
+
+from sensing_antenna.live.events import Event, SkippedEvent
+from sensing_antenna.live.listener import Listener
+from sensing_antenna.live.wire import (
+    MAX_DATAGRAM_BYTES,
+    Datagram,
+    StreamHeader,
+    WireError,
+    decode_datagram,
+    parse_sample,
+    read_header,
+)
+from sensing_antenna.recording import RecordingError
+
+__all__ = ["IDLE_END", "MakeListener", "listen_lines", "listen_udp", "parse_address"]
+
+#: A UDP recording whose sender fell silent for this long (s) is closed as if it had ended: a
+#: sender that stopped without its ``end`` datagram (the datagram lost, the program killed).
+IDLE_END = 2.0
+
+#: How a reader starts the listener of a recording: ``make(header, number)``, number from 1.
+MakeListener = Callable[[StreamHeader, int], Listener]
+
+
+def _close_quietly(listener: Listener | None) -> None:
+    if listener is not None:
+        with contextlib.suppress(Exception):
+            listener.close("interrupted", finish=False)
+
+
+def listen_lines(
+    lines: Iterable[bytes | str],
+    make: MakeListener,
+    source: str = "<stdin>",
+    count: int | None = None,
+    clock: Callable[[], float] = time.perf_counter,
+) -> int:
+    """Read CSV lines until they end (or ``count`` recordings ended); returns the number of
+    recordings ended.
+
+    Raises
+    ------
+    RecordingError
+        At the first malformed line, naming ``source`` and the line: the recording being
+        received is closed without a final estimate.
+    """
+    pending: list[str] = []
+    pending_first = 0
+    current: Listener | None = None
+    ended = 0
+    last_t: float | None = None
+    try:
+        for number, raw in enumerate(lines, start=1):
+            received = clock()
+            line = _text(raw, source, number).rstrip("\r\n")
+            if not line.strip():
+                continue
+            if line.startswith("#"):
+                if current is not None:
+                    current.close("next recording")
+                    current, ended = None, ended + 1
+                    if count is not None and ended >= count:
+                        return ended
+                if not pending:
+                    pending_first = number
+                pending.append(line)
+                continue
+            if current is None:
+                first = pending_first if pending else number
+                header = read_header([*pending, line], source, first_line=first)
+                pending = []
+                current, last_t = make(header, ended + 1), None
+                continue
+            values = parse_sample(line, current.header, number)
+            t = values[current.header.required("t")]
+            if last_t is not None and not t > last_t:
+                raise RecordingError(
+                    source, number, "t", f"time {t!r} s does not increase (previous {last_t!r} s)"
+                )
+            last_t = t
+            current.put([values], received)
+        if current is None and pending:
+            raise RecordingError(
+                source, pending_first + len(pending), None, "no header after the metadata"
+            )
+        if current is not None:
+            current.close("end of input")
+            current, ended = None, ended + 1
+        return ended
+    finally:
+        _close_quietly(current)
+
+
+def _text(raw: bytes | str, source: str, number: int) -> str:
+    """A line as text: UTF-8, no NUL byte (binary content)."""
+    if isinstance(raw, bytes):
+        try:
+            raw = raw.decode("utf-8-sig" if number == 1 else "utf-8")
+        except UnicodeDecodeError:
+            raise RecordingError(source, number, None, "not UTF-8 text") from None
+    if "\0" in raw:
+        raise RecordingError(source, number, None, "NUL byte: binary content, not CSV lines")
+    return raw
+
+
+def parse_address(text: str) -> tuple[str, int]:
+    """``HOST:PORT`` as (host, port); :class:`WireError` when it is not one."""
+    host, sep, port = text.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
+        raise WireError(f"address must read HOST:PORT with a port from 0 to 65535, got {text!r}")
+    return host.strip("[]"), int(port)
+
+
+class _UdpStream:
+    """The recording a UDP reader is receiving: its listener, stream name, next sequence number,
+    last time stamp and datagrams lost."""
+
+    def __init__(self, listener: Listener, datagram: Datagram) -> None:
+        self.listener = listener
+        self.name = datagram.stream
+        self.expected = datagram.seq
+        self.last_t: float | None = None
+        self.lost = 0
+        self.heard = 0.0
+
+    def close(self, reason: str) -> None:
+        if self.lost:
+            reason += f"; {self.lost} samples datagrams lost"
+        self.listener.close(reason)
+
+
+def listen_udp(
+    sock: socket.socket,
+    make: MakeListener,
+    on_event: Callable[[Event], None],
+    count: int | None = None,
+    idle: float = IDLE_END,
+    clock: Callable[[], float] = time.perf_counter,
+) -> int:
+    """Receive datagrams on a bound socket until ``count`` recordings ended (forever when
+    None); returns the number ended. ``on_event`` receives the reader's own
+    :class:`~.events.SkippedEvent`s (from this thread: the listeners' events come from
+    theirs)."""
+    host, port = sock.getsockname()[:2]
+    source = f"udp:{host}:{port}"
+    current: _UdpStream | None = None
+    ended = 0
+    sock.settimeout(min(idle, 0.2))
+
+    def skip(reason: str) -> None:
+        on_event(SkippedEvent(ended + 1, reason))
+
+    try:
+        while count is None or ended < count:
+            try:
+                data = sock.recv(MAX_DATAGRAM_BYTES + 1)
+            except TimeoutError:
+                if current is not None and clock() - current.heard > idle:
+                    current.close(f"no datagram for {idle:g} s")
+                    current, ended = None, ended + 1
+                continue
+            received = clock()
+            try:
+                datagram = decode_datagram(data)
+            except WireError as exc:
+                skip(str(exc))
+                continue
+            ours = current is not None and datagram.stream == current.name
+            if ours:
+                assert current is not None
+                current.heard = received
+            if datagram.kind == "header" and not ours:
+                try:
+                    header = read_header(list(datagram.lines), f"{source} stream {datagram.stream}")
+                except RecordingError as exc:
+                    skip(str(exc))
+                    continue
+                if current is not None:
+                    current.close("another stream began")
+                    current, ended = None, ended + 1
+                    if count is not None and ended >= count:
+                        break
+                current = _UdpStream(make(header, ended + 1), datagram)
+                current.heard = received
+            elif not ours or datagram.kind == "header":
+                continue  # a repeated header, or samples of a stream not joined
+            elif datagram.kind == "end":
+                assert current is not None
+                current.lost += max(0, datagram.seq - current.expected)
+                current.close("end of stream")
+                current, ended = None, ended + 1
+            else:
+                assert current is not None
+                _receive_samples(current, datagram, received, skip)
+        return ended
+    finally:
+        _close_quietly(None if current is None else current.listener)
+
+
+def _receive_samples(
+    current: _UdpStream, datagram: Datagram, received: float, skip: Callable[[str], None]
+) -> None:
+    """The samples of one datagram to the listener, or why (some of) they were left out."""
+    if datagram.seq < current.expected:
+        skip(
+            f"stream {current.name}: datagram {datagram.seq} arrived after"
+            f" {current.expected - 1}: left out"
+        )
+        return
+    current.lost += datagram.seq - current.expected
+    current.expected = datagram.seq + 1
+    header = current.listener.header
+    position = header.required("t")
+    rows = []
+    for line in datagram.lines:
+        try:
+            values = parse_sample(line, header)
+        except RecordingError as exc:
+            skip(
+                f"stream {current.name}: datagram {datagram.seq}: {exc.problem}"
+                + (f" (column {exc.field!r})" if exc.field else "")
+            )
+            continue
+        t = values[position]
+        if current.last_t is not None and not t > current.last_t:
+            skip(
+                f"stream {current.name}: datagram {datagram.seq}: time {t!r} s does not"
+                f" increase (previous {current.last_t!r} s)"
+            )
+            continue
+        current.last_t = t
+        rows.append(values)
+    if rows:
+        current.listener.put(rows, received)

@@ -1,0 +1,278 @@
+"""One recording received live: :class:`Listener`.
+
+The reader of the input (standard input, a UDP socket) hands each sample it parsed to
+:meth:`Listener.put`, which only queues it with the wall time it was received. A worker thread
+takes everything queued since its last turn and feeds it as one block to the
+:class:`~sensing_antenna.estimation.online.OnlineEstimator` (asked at every evaluation instant
+of the block, so the estimate is that of ``antenna estimate`` on the same samples however they
+were cut into blocks), writes it to the recording file if any, and gives the events
+(:mod:`.events`) to a callback. The reader therefore never waits for an estimate: a slow
+evaluation makes the next block longer, not the reader slower.
+"""
+
+from __future__ import annotations
+
+import math
+import queue
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import Antenna
+from sensing_antenna.detection.contact import ContactDetector
+from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.methods import EstimationMethod
+from sensing_antenna.estimation.online import OnlineEstimator
+from sensing_antenna.estimation.result import ContactEstimate
+from sensing_antenna.live.events import (
+    ContactEvent,
+    ContactLostEvent,
+    EndEvent,
+    EstimateEvent,
+    Event,
+    PushEvent,
+)
+from sensing_antenna.live.record import RecordWriter
+from sensing_antenna.live.wire import StreamHeader
+
+__all__ = ["CONTACT_LOST_TIME", "Listener"]
+
+#: Contact counts as lost once the contact detector's filtered residual has stayed at or below
+#: its threshold for this long (s): 0.1 s, at least one period of the link's vibration in
+#: contact (its fundamental lies near 10 Hz on the paper's link touched at its middle, higher
+#: nearer the base), so that the residual swinging through the threshold while the link rings
+#: does not count as a loss.
+CONTACT_LOST_TIME = 0.1
+
+_END = "end"
+_ABORT = "abort"
+
+
+class _Growing:
+    """A 1-D float history grown by doubling."""
+
+    def __init__(self) -> None:
+        self.values = np.empty(4096)
+        self.size = 0
+
+    def extend(self, block: NDArray[np.float64]) -> None:
+        stop = self.size + block.shape[0]
+        if stop > self.values.shape[0]:
+            grown = np.empty(max(stop, 2 * self.values.shape[0]))
+            grown[: self.size] = self.values[: self.size]
+            self.values = grown
+        self.values[self.size : stop] = block
+        self.size = stop
+
+
+class Listener:
+    """One recording received live (module docstring).
+
+    Parameters
+    ----------
+    header : StreamHeader
+        The stream's metadata (``sample_period``, T_s in s) and columns.
+    antenna : Antenna
+    on_event : callable
+        Called in the worker thread with each :data:`~.events.Event`, in order.
+    method : str or EstimationMethod
+        As for :class:`~sensing_antenna.estimation.online.OnlineEstimator`.
+    config : EstimatorConfig, optional
+    record : RecordWriter, optional
+        Where the samples received are written; closed by :meth:`close`.
+    number : int
+        The recording's number in its stream (from 1), carried by its events.
+    clock : callable
+        Wall clock (s) the receipt and emission times are read from.
+
+    Attributes
+    ----------
+    dropped : int
+        Samples missing so far (time steps of k sample periods count k - 1).
+    lags : list of float
+        For each block the worker took, the wall time (s) from the receipt of its first sample
+        to the end of its processing (estimator, events, recording): how far the worker runs
+        behind the input.
+
+    Notes
+    -----
+    An exception in the worker (a closed output, an unwritable recording) stops it; the next
+    :meth:`put` or :meth:`close` raises it in the reader's thread.
+    """
+
+    def __init__(
+        self,
+        header: StreamHeader,
+        antenna: Antenna,
+        on_event: Callable[[Event], None],
+        method: str | EstimationMethod = "paper",
+        config: EstimatorConfig | None = None,
+        record: RecordWriter | None = None,
+        number: int = 1,
+        clock: Callable[[], float] = time.perf_counter,
+    ) -> None:
+        self.header = header
+        self.number = number
+        self._on_event = on_event
+        self._record = record
+        self._clock = clock
+        ts = header.sample_period
+        self._estimator = OnlineEstimator(antenna, ts, method, config)
+        # a detector of its own, the front end's twin, for the residual after t_c (contact lost)
+        self._residual = ContactDetector(antenna, ts)
+        self._quiet_samples = max(1, round(CONTACT_LOST_TIME / ts))
+        self._quiet_from: int | None = None
+        self._columns = [
+            [header.required(name) for name in names]
+            for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
+        ]
+        self._t = _Growing()
+        self._received = _Growing()
+        self.dropped = 0
+        self.lags: list[float] = []
+        self._said: set[str] = set()
+        self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self.error: BaseException | None = None
+        self._thread = threading.Thread(target=self._work, name="antenna-listen", daemon=True)
+        self._thread.start()
+
+    @property
+    def samples(self) -> int:
+        """Samples the worker has taken so far."""
+        return self._t.size
+
+    @property
+    def result(self) -> ContactEstimate | None:
+        """The estimate once declared."""
+        return self._estimator.result
+
+    def put(
+        self, rows: NDArray[np.float64] | list[list[float]], received: float | None = None
+    ) -> None:
+        """Queue samples that arrived together (shape (k, n_columns), the header's order),
+        received at ``received`` (s on the listener's clock; now when None). Never waits."""
+        if self.error is not None:
+            raise self.error
+        self._queue.put((rows, self._clock() if received is None else received))
+
+    def close(self, reason: str = "end of input", finish: bool = True) -> None:
+        """End the recording: the worker takes what is queued, then (``finish``) gives the
+        final estimate if none was declared and the end event. Waits for the worker."""
+        self._queue.put((_END if finish else _ABORT, reason))
+        self._thread.join()
+        if self._record is not None:
+            self._record.close()
+        if self.error is not None:
+            raise self.error
+
+    def _work(self) -> None:
+        try:
+            while True:
+                items = [self._queue.get()]
+                while True:
+                    try:
+                        items.append(self._queue.get_nowait())
+                    except queue.Empty:
+                        break
+                stop = next((k for k, item in enumerate(items) if isinstance(item[0], str)), None)
+                blocks = items if stop is None else items[:stop]
+                if blocks:
+                    self._feed(blocks)
+                if stop is not None:
+                    if items[stop][0] == _END:
+                        self._finish(str(items[stop][1]))
+                    return
+        except BaseException as exc:  # handed to the reader's thread
+            self.error = exc
+
+    def _feed(self, blocks: list[tuple[Any, float]]) -> None:
+        arrays = [
+            np.asarray(rows, dtype=np.float64).reshape(-1, len(self.header.columns))
+            for rows, _ in blocks
+        ]
+        rows = np.concatenate(arrays) if len(arrays) > 1 else arrays[0]
+        if rows.shape[0] == 0:
+            return
+        received = np.repeat([when for _, when in blocks], [a.shape[0] for a in arrays])
+        if self._record is not None:
+            self._record.write(rows)
+        first = self._t.size
+        t = rows[:, self._columns[0][0]]
+        previous = self._t.values[first - 1] if first else None
+        self._t.extend(t)
+        self._received.extend(received)
+        steps = np.diff(t) if previous is None else np.diff(t, prepend=previous)
+        ts = self.header.sample_period
+        self.dropped += int(np.sum(np.maximum(np.rint(steps / ts) - 1.0, 0.0)))
+        theta, force, torque = (rows[:, columns] for columns in self._columns[1:])
+        estimator = self._estimator
+        result = None
+        if estimator.result is None:
+            result = estimator.update_block(t, theta, force, torque, every_instant=True)
+        self._residual.update_block(t, theta, force, torque)
+        self._say_instants(first)
+        if result is not None:
+            self._say_estimate(result, first)
+        self._watch_contact(first)
+        self.lags.append(self._latency(first))
+
+    def _latency(self, index: int) -> float:
+        return self._clock() - float(self._received.values[index])
+
+    def _emit(self, event: Event) -> None:
+        self._on_event(event)
+
+    def _say_instants(self, first: int) -> None:
+        estimator, t = self._estimator, self._t.values
+        contact, rest = estimator.contact_index, estimator.rest_index
+        if contact is not None and "contact" not in self._said:
+            self._said.add("contact")
+            at = max(first, contact)
+            self._emit(ContactEvent(self.number, float(t[contact]), self._latency(at)))
+        if rest is not None and "push" not in self._said:
+            self._said.add("push")
+            at = max(first, rest)
+            self._emit(PushEvent(self.number, float(t[rest]), self._latency(at)))
+
+    def _say_estimate(self, result: ContactEstimate, first: int) -> None:
+        at = first
+        if math.isfinite(result.t_e):
+            at = max(first, int(np.searchsorted(self._t.values[: self._t.size], result.t_e)))
+        self._emit(EstimateEvent(self.number, result, self._latency(min(at, self._t.size - 1))))
+
+    def _watch_contact(self, first: int) -> None:
+        """Contact lost: a run of :data:`CONTACT_LOST_TIME` at or below the threshold after t_c."""
+        contact = self._estimator.contact_index
+        if contact is None or "contact_lost" in self._said:
+            return
+        detection = self._residual.detection()
+        start = max(first, contact + 1)
+        quiet = detection.filtered_residual_norm[start : self._t.size] <= detection.threshold
+        for offset, still in enumerate(quiet.tolist()):
+            index = start + offset
+            if not still:
+                self._quiet_from = None
+                continue
+            if self._quiet_from is None:
+                self._quiet_from = index
+            if index - self._quiet_from + 1 >= self._quiet_samples:
+                self._said.add("contact_lost")
+                t_lost = float(self._t.values[self._quiet_from])
+                self._emit(ContactLostEvent(self.number, t_lost, self._latency(max(first, index))))
+                return
+
+    def _finish(self, reason: str) -> None:
+        estimator = self._estimator
+        last = self._t.size - 1
+        if estimator.result is None:
+            result = estimator.finalize()
+            self._say_instants(max(last, 0))
+            latency = self._latency(last) if last >= 0 else 0.0
+            self._emit(EstimateEvent(self.number, result, latency))
+        t_last = float(self._t.values[last]) if last >= 0 else math.nan
+        latency = self._latency(last) if last >= 0 else 0.0
+        self._emit(EndEvent(self.number, self._t.size, self.dropped, t_last, reason, latency))

@@ -1,0 +1,360 @@
+"""``antenna listen`` and ``antenna replay`` (docs/live.md): the estimate of a recording sent
+live is that of ``antenna estimate`` on the same file, to the bit, whichever input, method and
+case; what was received is kept as the same recording; bad input is one line or a status.
+
+The recordings are made by ``antenna simulate`` (paper antenna, both cases)."""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import socket
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import sensing_antenna
+from sensing_antenna.antenna import paper_antenna
+from sensing_antenna.cli import main
+from sensing_antenna.estimation import METHODS, estimate
+from sensing_antenna.live.events import (
+    ContactEvent,
+    ContactLostEvent,
+    EndEvent,
+    EstimateEvent,
+    Event,
+    PushEvent,
+)
+from sensing_antenna.live.inputs import listen_lines, listen_udp
+from sensing_antenna.live.listener import CONTACT_LOST_TIME, Listener
+from sensing_antenna.live.replay import replay_datagrams, replay_lines, stream_of
+from sensing_antenna.live.wire import (
+    Datagram,
+    StreamHeader,
+    WireError,
+    decode_datagram,
+    pack_samples,
+)
+from sensing_antenna.recording import Recording, read_recording
+
+CASES = {"azimuthal": 0.6, "vertical": 0.7}
+
+
+@pytest.fixture(scope="module")
+def recordings(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """One recording of each case, written by ``antenna simulate``."""
+    folder = tmp_path_factory.mktemp("live")
+    paths = {}
+    for case, x_c in CASES.items():
+        path = folder / f"{case}.csv"
+        assert main(["simulate", "--case", case, "--xc", str(x_c), "--out", str(path)]) == 0
+        paths[case] = path
+    return paths
+
+
+def _lines(recording: Recording) -> list[bytes]:
+    """What ``antenna replay --speed 0`` writes, as the lines a reader of stdin gets."""
+    out = io.StringIO()
+    replay_lines(recording, out.write, out.flush, speed=0)
+    return [line.encode() for line in out.getvalue().splitlines(keepends=True)]
+
+
+def _listen(lines: list[bytes], method: str = "paper", **kwargs: Any) -> list[Event]:
+    events: list[Event] = []
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, paper_antenna(), events.append, method, number=number, **kwargs)
+
+    listen_lines(lines, make)
+    return events
+
+
+def _same_estimate(event: dict[str, Any], reference: dict[str, Any]) -> None:
+    """Every field of the estimate equal (the diagnostics say how the samples came)."""
+    for key, value in reference.items():
+        if key not in ("diagnostics", "recording"):
+            assert event[key] == value, key
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+@pytest.mark.parametrize("method", sorted(METHODS))
+def test_live_estimate_is_the_offline_one_to_the_bit(
+    recordings: dict[str, Path], case: str, method: str
+) -> None:
+    recording = read_recording(recordings[case])
+    offline = estimate(recording, paper_antenna(), method)
+    events = _listen(_lines(recording), method)
+    kinds = [type(e) for e in events]
+    assert kinds == [ContactEvent, PushEvent, EstimateEvent, EndEvent]
+    contact, push, found, end = events
+    assert isinstance(found, EstimateEvent) and isinstance(end, EndEvent)
+    _same_estimate(found.to_dict(), offline.to_dict())
+    assert (found.x_c, found.status, found.t_e, found.method) == (
+        offline.x_c,
+        offline.status.value,
+        offline.t_e,
+        method,
+    )
+    assert isinstance(contact, ContactEvent) and contact.t_c == offline.t_c
+    assert isinstance(push, PushEvent) and push.t_1 == offline.t_1
+    assert (end.samples, end.dropped, end.t_last) == (recording.n_samples, 0, recording.t[-1])
+    assert all(e.latency >= 0 for e in events)
+
+
+#: The ``antenna`` command in a new interpreter.
+_ANTENNA = "import sys; from sensing_antenna.cli import main; sys.exit(main(sys.argv[1:]))"
+
+
+def _cli(*args: str) -> list[str]:
+    return [sys.executable, "-c", _ANTENNA, *args]
+
+
+def _env() -> dict[str, str]:
+    src = str(Path(sensing_antenna.__file__).resolve().parents[1])
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([src, os.environ.get("PYTHONPATH", "")])}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_replay_piped_to_listen_and_recorded(
+    recordings: dict[str, Path], case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # antenna replay rec.csv --speed 0 | antenna listen --method fast --record kept.csv
+    kept = tmp_path / "kept.csv"
+    replay = subprocess.Popen(
+        _cli("replay", str(recordings[case]), "--speed", "0"),
+        stdout=subprocess.PIPE,
+        env=_env(),
+    )
+    listen = subprocess.run(
+        _cli("listen", "--method", "fast", "--record", str(kept)),
+        stdin=replay.stdout,
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=120,
+        check=False,
+    )
+    assert replay.stdout is not None
+    replay.stdout.close()
+    assert replay.wait(timeout=60) == 0 and listen.returncode == 0, listen.stderr
+    events = [json.loads(line) for line in listen.stdout.splitlines()]
+    assert [e["event"] for e in events] == ["contact", "push", "estimate", "end"]
+    assert main(["estimate", str(recordings[case]), "--method", "fast", "--json"]) == 0
+    _same_estimate(events[2], json.loads(capsys.readouterr().out))
+    assert read_recording(kept) == read_recording(recordings[case])
+
+
+def test_udp_on_localhost(recordings: dict[str, Path], tmp_path: Path) -> None:
+    kept = tmp_path / "kept.csv"
+    listen = subprocess.Popen(
+        _cli(
+            "listen",
+            "--udp",
+            "127.0.0.1:0",
+            "--count",
+            "1",
+            "--method",
+            "ratio",
+            "--record",
+            str(kept),
+        ),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_env(),
+    )
+    assert listen.stderr is not None
+    said = listen.stderr.readline()  # antenna listen: listening on udp 127.0.0.1:PORT
+    port = said.strip().rpartition(":")[2]
+    assert port.isdigit(), said
+    path = str(recordings["vertical"])
+    assert main(["replay", path, "--udp", f"127.0.0.1:{port}", "--speed", "4"]) == 0
+    out, err = listen.communicate(timeout=120)
+    assert listen.returncode == 0, err
+    events = [json.loads(line) for line in out.splitlines()]
+    assert [e["event"] for e in events] == ["contact", "push", "estimate", "end"]
+    assert events[-1]["reason"] == "end of stream" and events[-1]["dropped"] == 0
+    recording = read_recording(path)
+    _same_estimate(events[2], estimate(recording, paper_antenna(), "ratio").to_dict())
+    assert read_recording(kept) == recording
+
+
+def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) -> None:
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    row = "0.0,0,0,0,0,-0.0451,0,0.0221,0,0,0"
+    events: list[Event] = []
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, paper_antenna(), events.append, "ratio", number=number)
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        address = sock.getsockname()
+        reader = threading.Thread(target=listen_udp, args=(sock, make, events.append, 2))
+        reader.start()
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+            for datagram in [
+                b"hello",
+                b"sensing-antenna-udp/1 samples b 0\n\xff",
+                Datagram("samples", "b", 0, (row,)).encode(),  # before its header: waits
+                Datagram("header", "b", 0, tuple(header.lines())).encode(),
+                Datagram("samples", "b", 0, (row, "0.001,x")).encode(),
+                Datagram("samples", "b", 2, (row.replace("0.0,", "0.002,", 1),)).encode(),
+                Datagram("samples", "b", 1, (row,)).encode(),  # late
+                Datagram("end", "b", 3).encode(),
+            ]:
+                sender.sendto(datagram, address)
+            replay_datagrams(recording, sender, address, speed=4, stream="s")
+        reader.join(timeout=120)
+    first = [e.to_dict() for e in events if e.to_dict()["recording"] == 1]
+    reasons = " | ".join(e["reason"] for e in first if e["event"] == "skipped")
+    assert "does not begin with 'sensing-antenna-udp/1 KIND STREAM SEQ'" in reasons
+    assert "not UTF-8" in reasons
+    assert "stream b: datagram 0: expected 11 cells, found 2" in reasons
+    assert "stream b: datagram 1 arrived after 2: left out" in reasons
+    end = first[-1]
+    assert end["event"] == "end" and end["samples"] == 2
+    assert end["reason"] == "end of stream; 1 samples datagrams lost"
+    assert [e["status"] for e in first if e["event"] == "estimate"] == ["bad_input"]
+    found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
+    _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
+
+
+def test_datagrams() -> None:
+    lines = [f"{k},1.5" for k in range(400)]
+    packed = pack_samples(lines, "s", 7, max_bytes=200)
+    assert [d.seq for d in packed] == list(range(7, 7 + len(packed)))
+    assert [line for d in packed for line in d.lines] == lines
+    assert all(len(d.encode()) <= 200 for d in packed)
+    assert decode_datagram(packed[0].encode()) == packed[0]
+    for data, problem in [
+        (b"sensing-antenna-udp/1 sample s 0", "unknown kind 'sample'"),
+        (b"sensing-antenna-udp/1 samples s -1", "sequence number must be an integer >= 0"),
+        (b"sensing-antenna-udp/2 samples s 0", "does not begin with"),
+    ]:
+        with pytest.raises(WireError, match=problem):
+            decode_datagram(data)
+
+
+def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
+    text = recordings["azimuthal"].read_text().splitlines(keepends=True)
+    header_at = next(k for k, line in enumerate(text) if not line.startswith("#"))
+    cases = [
+        ([*text[: header_at + 5], "0.1,x\n"], f"<stdin>:{header_at + 6}: expected 11 cells"),
+        (
+            [*text[: header_at + 3], text[header_at + 1]],
+            f"<stdin>:{header_at + 4}: column 't': time 0.0 s does not increase",
+        ),
+        (
+            [line for line in text if not line.startswith("# sample_period")][:header_at],
+            "metadata key 'sample_period': missing",
+        ),
+        (text[:2], "no header after the metadata"),
+    ]
+    for lines, message in cases:
+        done = subprocess.run(
+            _cli("listen"),
+            input="".join(lines),
+            capture_output=True,
+            text=True,
+            env=_env(),
+            timeout=120,
+            check=False,
+        )
+        assert done.returncode == 2, done.stderr
+        assert done.stderr.count("\n") == 1 and message in done.stderr, done.stderr
+    with pytest.raises(SystemExit) as exc:
+        main(["listen", "--count", "0"])
+    assert exc.value.code == 2
+    assert main(["listen", "--udp", "nowhere"]) == 2
+    assert main(["listen", "--udp", "300.1.1.1:5"]) == 2
+    assert main(["replay", str(recordings["azimuthal"]), "--udp", "300.1.1.1:5"]) == 2
+    with pytest.raises(SystemExit) as exc:
+        main(["replay", str(recordings["azimuthal"]), "--speed", "-1"])
+    assert exc.value.code == 2
+
+
+def test_udp_address_errors_name_the_flag(
+    recordings: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    capsys.readouterr()
+    assert main(["listen", "--udp", "300.1.1.1:5"]) == 2
+    assert capsys.readouterr().err.startswith("antenna listen: error: --udp: cannot listen on")
+    assert main(["replay", str(recordings["azimuthal"]), "--udp", "127.0.0.1:70000"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--udp: address must read HOST:PORT" in err
+
+
+def test_lost_samples_and_contact_lost(recordings: dict[str, Path]) -> None:
+    recording = read_recording(recordings["azimuthal"])
+    lines = _lines(recording)
+    header_at = next(k for k, line in enumerate(lines) if not line.startswith(b"#"))
+    # two samples missing before contact, and after 2.2 s the loads of the first sample (the
+    # head at rest, nothing touching): the contact is lost
+    quiet = 2.2
+    gone = set(range(header_at + 101, header_at + 103))
+    start = np.concatenate([recording.force[0], recording.torque[0]]).tolist()
+    kept = []
+    for k, line in enumerate(lines):
+        if k in gone:
+            continue
+        if k > header_at and float(line.split(b",")[0]) >= quiet:
+            cells = line.decode().split(",")
+            cells[3:9] = [repr(v) for v in start]
+            line = ",".join(cells).encode()
+        kept.append(line)
+    events = _listen(kept, "paper")
+    end = events[-1]
+    assert isinstance(end, EndEvent) and (end.dropped, end.samples) == (2, recording.n_samples - 2)
+    lost = [e for e in events if isinstance(e, ContactLostEvent)]
+    assert len(lost) == 1
+    # the residual filter's time constant is 10 ms: quiet well within 0.1 s of the change
+    assert quiet <= lost[0].t <= quiet + 0.1
+    assert events.index(lost[0]) > [type(e) for e in events].index(EstimateEvent)
+    assert CONTACT_LOST_TIME == pytest.approx(0.1)
+
+
+def test_two_recordings_in_one_stream(recordings: dict[str, Path]) -> None:
+    first = _lines(read_recording(recordings["azimuthal"]))
+    second = _lines(read_recording(recordings["vertical"]))
+    events = _listen(first + second, "ratio")
+    ends = [e for e in events if isinstance(e, EndEvent)]
+    assert [(e.recording, e.reason) for e in ends] == [(1, "next recording"), (2, "end of input")]
+    estimates = [e for e in events if isinstance(e, EstimateEvent)]
+    for event, case in zip(estimates, ("azimuthal", "vertical"), strict=True):
+        reference = estimate(read_recording(recordings[case]), paper_antenna(), "ratio")
+        assert event.x_c == reference.x_c
+
+
+def test_replay_keeps_the_recordings_pace(recordings: dict[str, Path]) -> None:
+    recording = read_recording(recordings["vertical"])
+    now = [0.0]
+
+    def sleep(seconds: float) -> None:
+        now[0] += seconds
+
+    sent: list[tuple[float, str]] = []
+    speed = 2.0
+    replay_lines(
+        recording,
+        lambda text: sent.append((now[0], text)),
+        lambda: None,
+        speed,
+        lambda: now[0],
+        sleep,
+    )
+    samples = [(when, line) for when, text in sent for line in text.splitlines()]
+    samples = [(when, line) for when, line in samples if line[0].isdigit()]
+    assert len(samples) == recording.n_samples
+    due = (recording.t - recording.t[0]) / speed
+    sent_at = np.array([when for when, _ in samples])
+    # never early, and never later than the next sample's turn
+    assert np.all(sent_at >= due) and np.all(sent_at[:-1] <= due[1:])
+    assert now[0] == pytest.approx(recording.duration / speed)
