@@ -568,8 +568,8 @@ def calibrate_inputs(draw: st.DrawFn) -> tuple[str, Any]:
 
 
 def run_calibrate(bases: Bases, case: tuple[str, Any]) -> list[Outcome]:
-    """Calibration of T_e; a fitted T_e must be finite and positive, from recordings that pass
-    the units check."""
+    """Calibration of T_e; a fitted T_e must be finite and positive, and no recording that fails
+    the units check may enter the fit (the calibration leaves such a file out, with a note)."""
     from sensing_antenna.calibration.frequency import calibrate_from_recordings, calibrate_t_e
     from sensing_antenna.calibration.observer import units_problem
 
@@ -580,9 +580,9 @@ def run_calibrate(bases: Bases, case: tuple[str, Any]) -> list[Outcome]:
             spoilt, points, loss = data
             recordings = [p.apply(bases.contacts[p.base]) for p in spoilt]
             fit = calibrate_from_recordings(recordings, bases.antenna, points, loss=loss)
-            for recording in recordings:
+            for recording, used in zip(recordings, fit.used, strict=True):
                 problem = units_problem(recording, bases.antenna)
-                if problem is not None:
+                if problem is not None and used:
                     return [Outcome(OK_IMPLAUSIBLE, problem)]
         else:
             points, omega, loss = data
