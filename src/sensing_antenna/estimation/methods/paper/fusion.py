@@ -335,6 +335,20 @@ def second_mode_choice(
     return None, notes
 
 
+def _second_mode_against(notes: dict[str, Any], chosen: int, cfg: Any) -> int | None:
+    """The other candidate when the second mode speaks against ``chosen``, else None.
+
+    A scale error of the loads moves the ratio, not the modes: a peak in the other candidate's
+    omega_2 window ten times stronger than in the chosen one's, and at least half as clear as a
+    peak the method would choose by (``min_peak_quality``), is evidence against the choice.
+    """
+    other = 1 - chosen
+    chosen_q, other_q = notes["quality"][chosen], notes["quality"][other]
+    if other_q >= 0.5 * cfg.min_peak_quality and other_q >= 10.0 * chosen_q:
+        return other
+    return None
+
+
 @dataclass(frozen=True)
 class PaperMethod:
     """The paper's method (Section 4): Estimator 1 candidates, chosen by Estimator 2."""
@@ -387,18 +401,27 @@ class PaperMethod:
             margin = abs(
                 abs(candidates_used[0] - ratio_estimate) - abs(candidates_used[1] - ratio_estimate)
             )
-            if margin < cfg.ratio_resolution_sigmas * sigma_ratio:
-                choice, notes = second_mode_choice(evidence, measurement.component, candidates_used)
-                diag["second_mode"] = notes
-                if choice is not None:
-                    x_pick = candidates_used[choice]
-                    fusion = Fusion(
-                        x_c=x_pick,
-                        chosen=choice,
-                        distance=abs(x_pick - ratio_estimate),
-                        agree=abs(x_pick - ratio_estimate) <= tolerance,
+            choice, notes = second_mode_choice(evidence, measurement.component, candidates_used)
+            diag["second_mode"] = notes
+            if margin < cfg.ratio_resolution_sigmas * sigma_ratio and choice is not None:
+                x_pick = candidates_used[choice]
+                fusion = Fusion(
+                    x_c=x_pick,
+                    chosen=choice,
+                    distance=abs(x_pick - ratio_estimate),
+                    agree=abs(x_pick - ratio_estimate) <= tolerance,
+                )
+                diag["discriminated_by"] = "omega2"
+            contradiction = _second_mode_against(notes, int(fusion.chosen or 0), cfg)
+            if contradiction is not None:
+                problems.append(
+                    (
+                        Status.ESTIMATORS_DISAGREE,
+                        f"the torque/force ratio ({ratio_estimate:.3f} m) chose the candidate "
+                        f"{fusion.x_c:.3f} m, but the second contact mode is that of "
+                        f"{candidates_used[contradiction]:.3f} m",
                     )
-                    diag["discriminated_by"] = "omega2"
+                )
         if candidates_used and math.isfinite(ratio_estimate) and not fusion.agree:
             problems.append(
                 (
