@@ -90,7 +90,9 @@ def test_the_unscaled_recording_is_ok_for_every_method(
     # simulated link touched (0.5496 m); docs/estimation.md: mean errors below 0.1 cm, the ratio
     # alone 0.8 cm, with maxima of 0.2 cm and 3 cm
     for name, result in all_methods(azimuthal, antenna).items():
-        assert result.status is Status.OK, (name, result.reason)
+        # the ratio alone is honest about its uncertainty at the default gentle push (a few cm)
+        expected = Status.UNCERTAIN if name == "ratio" else Status.OK
+        assert result.status is expected, (name, result.reason)
         assert result.x_c == pytest.approx(0.5496, abs=3e-2 if name == "ratio" else 2e-3), name
 
 
@@ -255,7 +257,10 @@ def test_a_reading_just_past_the_tip_is_a_contact_at_the_tip(
     # beyond l, so the estimate constrained to the link is l
     assert isinstance(gathered, Evidence)
     assert length < past <= length + 3.0 * gathered.ratio_uncertainty(length, model=False)
-    assert result.status is Status.OK
+    # no plausibility problem; the ratio alone is uncertain by centimetres at the tip
+    assert result.status is Status.UNCERTAIN and "torque/force ratio is uncertain" in (
+        result.reason or ""
+    )
     assert result.x_c == length
     assert abs(np.linalg.norm(result.contact_point) - length) < 0.1 * length
 

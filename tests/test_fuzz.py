@@ -115,8 +115,9 @@ def test_the_judges_tell_findings(bases: fz.Bases) -> None:
     # and the untouched simulations are estimated ok by every method
     for base in range(len(bases.contacts)):
         outcomes = {o.label: o.kind for o in fz.run_estimators(bases, fz.Perturbation(base=base))}
-        assert outcomes["paper"] == outcomes["ratio"] == outcomes["two-frequency"] == fz.OK
+        assert outcomes["paper"] == outcomes["two-frequency"] == fz.OK
         assert outcomes["fast"] in (fz.OK, "uncertain")
+        assert outcomes["ratio"] == "uncertain"  # a few cm at the default gentle push
 
 
 def test_the_command_line_judge_tells_an_ending(cli_files: fz.CliFiles) -> None:

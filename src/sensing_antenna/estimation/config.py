@@ -152,7 +152,10 @@ class EstimatorConfig:
         The paper method's answer is ``uncertain`` when the frequency model's own uncertainty
         (``Link.frequency_uncertainty``: 5 % for a link known from its material data, the
         calibration's scatter once calibrated) moves the chosen candidate by more than this at
-        two standard deviations (m). 1 cm, the paper's typical accuracy (Tables 3 and 4).
+        two standard deviations (m), and the ratio method's when the ratio's uncertainty
+        (``Evidence.ratio_uncertainty``) exceeds it at two standard deviations; the plausibility
+        layer's payload check uses the same bar. 1 cm, the paper's typical accuracy (Tables 3
+        and 4).
     free_motion_gain_factor : float
         Plausibility (``implausible_input``): the torque of the free motion before t_c must be
         at least 1 / this factor of what the observer predicts from the angles (root-mean-square

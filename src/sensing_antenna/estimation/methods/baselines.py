@@ -49,7 +49,26 @@ class RatioMethod:
             evidence.load_offset,
         )
         x_c = float(ratio[evidence.end_index])
-        return conclude(evidence, self.name, x_c, ratio_estimate=x_c)
+        problems: list[tuple[Status, str]] = []
+        spread = 2.0 * evidence.ratio_uncertainty(x_c) if math.isfinite(x_c) else math.nan
+        if spread > evidence.config.max_model_spread:
+            # the same bar as the paper method's candidate: 1 cm at two standard deviations
+            problems.append(
+                (
+                    Status.UNCERTAIN,
+                    f"the torque/force ratio is uncertain by {100 * spread:.1f} cm at two "
+                    "standard deviations (noise, tare, small-deflection model), more than "
+                    f"{100 * evidence.config.max_model_spread:g} cm: push harder or rest longer",
+                )
+            )
+        return conclude(
+            evidence,
+            self.name,
+            x_c,
+            ratio_estimate=x_c,
+            problems=problems,
+            diagnostics={"ratio_spread": spread},
+        )
 
 
 @dataclass(frozen=True)
