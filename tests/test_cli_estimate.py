@@ -84,3 +84,18 @@ def test_plot_estimate_writes_four_figures(recording_file: Path, tmp_path: Path)
         "figure14-ratio.png",
     ]
     assert all((out / n).stat().st_size > 10_000 for n in names)
+
+
+def test_a_recording_of_another_antenna_estimated_with_the_default_is_warned_of(
+    recording_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    other = tmp_path / "other.csv"
+    write_recording(read_recording(recording_file).with_metadata(antenna="lab-head"), other)
+    assert main(["estimate", str(other)]) == 0
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0
+    assert "recorded with antenna 'lab-head'" in err and "--antenna" in err
+    model = tmp_path / "lab-head.toml"
+    save_antenna(calibrated(), model)
+    assert main(["estimate", str(other), "--antenna", str(model)]) == 0
+    assert capsys.readouterr().err == ""  # the user chose the model

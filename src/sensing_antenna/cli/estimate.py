@@ -5,10 +5,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.cli.arguments import number
+from sensing_antenna.cli.arguments import number, printable
+
+#: The antenna an estimate uses without --antenna.
+DEFAULT_ANTENNA = "paper-2021"
 
 #: The names of :data:`sensing_antenna.estimation.METHODS`, in the order ``--help`` lists them.
 #: Written out so that parsing arguments does not import the estimators (``antenna estimate
@@ -52,7 +56,7 @@ def register(subparsers: Any) -> None:
         help="t_1 from the head coming to rest (any device) or from the default push "
         "criterion's decision (a device that stops with it, such as our simulator)",
     )
-    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
+    parser.add_argument("--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)
 
@@ -68,6 +72,8 @@ def _run(args: argparse.Namespace) -> int:
         method = _fast_with_tolerance(args.method, args.tolerance)
     antenna = load_antenna(args.antenna)
     recording = read_recording(args.recording)
+    if args.antenna == DEFAULT_ANTENNA:
+        warn_if_other_antenna(str(args.recording), recording.metadata, antenna.name)
     result = estimate(recording, antenna, method=method, config=EstimatorConfig(t1_source=args.t1))
     if args.json:
         data = {"recording": str(args.recording), **result.to_dict()}
@@ -75,6 +81,21 @@ def _run(args: argparse.Namespace) -> int:
     else:
         print(summary(str(args.recording), result.to_dict()))
     return 0
+
+
+def warn_if_other_antenna(source: str, metadata: Any, model: str) -> None:
+    """One line on stderr when the recording's ``antenna`` metadata names another antenna than
+    the built-in one the estimate falls back on: the device's observer, threshold and stiffness
+    are in its own file, and estimates with another's can go wrong in ways that look like bad
+    data (a contact missed, a push that seems to turn the wrong way)."""
+    recorded = metadata.get("antenna")
+    if recorded and recorded != model:
+        print(
+            f"antenna: warning: {source} was recorded with antenna {printable(recorded)!r} (its "
+            f"metadata) and is estimated with the default {printable(model)!r}: give that "
+            "antenna's file with --antenna",
+            file=sys.stderr,
+        )
 
 
 def _fast_with_tolerance(method: str, tolerance: float) -> Any:

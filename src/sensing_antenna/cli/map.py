@@ -67,11 +67,22 @@ def _run(args: argparse.Namespace) -> int:
     written = write_map(contact_map, args.out)
     written.append(plot_map(contact_map, args.out / "map.png"))
     summary = contact_map.summary()
-    decision = "-" if contact_map.recognition is None else contact_map.recognition.decision
+    decision = (
+        "not recognised (fewer than 10 points)"
+        if contact_map.recognition is None
+        else contact_map.recognition.decision
+    )
+    statuses = ", ".join(f"{k} {v}" for k, v in sorted(summary["statuses"].items()))
     print(
-        f"{summary['n_used']} of {summary['n_recordings']} points used; "
+        f"{summary['n_used']} of {summary['n_recordings']} points used ({statuses}); "
         f"surface faces {summary['surface_faces']}; object {decision}"
     )
+    if summary["n_used"] == 0 and summary["statuses"].get("uncertain"):
+        print(
+            "  no estimate is ok: an antenna that is not calibrated answers uncertain (give "
+            "--antenna the file antenna calibrate wrote), or let such points in with "
+            "--include-uncertain; each point's reason is in points.csv"
+        )
     for path in written:
         print(f"  {path}")
     return 0

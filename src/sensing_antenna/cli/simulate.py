@@ -164,6 +164,6 @@ def summary(out: str, scenario: Any, n_samples: int, meta: Any) -> str:
     return (
         f"{text}, the link touched at x_c = {touched:.4f} m (--xc {x_c:g} m is where the "
         f"undeflected link meets the obstacle; it bends as it pushes), first touch "
-        f"{meta['true_t_contact']} s, stop {meta['true_t_stop']} s, "
+        f"{float(meta['true_t_contact']):.4g} s, stop {float(meta['true_t_stop']):.4g} s, "
         f"y_c / x_c = {100 * float(meta['true_deflection_ratio']):.1f} %"
     )

@@ -28,9 +28,14 @@ __all__ = ["BASE_POSE_KEY", "BasePose", "base_pose_from_metadata"]
 #: The recording metadata key holding the base pose.
 BASE_POSE_KEY = "base_pose"
 
-#: How far from orthonormal a given rotation (or from unit a quaternion) may be: rounding of
-#: values written with 6 or more significant digits, well below any real mounting error.
+#: How far from orthonormal a given rotation may be: rounding of values written with 6 or more
+#: significant digits, well below any real mounting error.
 ORTHONORMAL_TOLERANCE = 1e-4
+
+#: How far from unit norm a given quaternion may be; it is then normalised. 1 %: a quaternion
+#: written with three decimals is off by up to about 0.2 %, while one that is not a rotation at
+#: all (a typo, another convention's scaling) is off by far more.
+QUATERNION_NORM_TOLERANCE = 0.01
 
 FloatArray = NDArray[np.float64]
 
@@ -78,13 +83,17 @@ class BasePose:
 
     @classmethod
     def from_quaternion(cls, position: ArrayLike, quaternion: Sequence[float]) -> BasePose:
-        """From a position (m) and a unit quaternion ``[w, x, y, z]``."""
+        """From a position (m) and a unit quaternion ``[w, x, y, z]`` (normalised when within
+        :data:`QUATERNION_NORM_TOLERANCE` of unit norm, as a printed one is)."""
         q = np.asarray(quaternion, dtype=float)
         if q.shape != (4,) or not np.all(np.isfinite(q)):
             raise FieldError(BASE_POSE_KEY, "quaternion must be four numbers [w, x, y, z]")
         norm = float(np.linalg.norm(q))
-        if abs(norm - 1.0) > ORTHONORMAL_TOLERANCE:
-            raise FieldError(BASE_POSE_KEY, f"quaternion must be of unit norm, got {norm:.6g}")
+        if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+            raise FieldError(
+                BASE_POSE_KEY,
+                f"quaternion must be of unit norm (within 1 %, then normalised), got {norm:.6g}",
+            )
         w, x, y, z = q / norm
         # rotation matrix of a unit quaternion (Hamilton convention)
         rotation = np.array(
