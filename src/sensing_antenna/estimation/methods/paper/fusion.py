@@ -316,7 +316,11 @@ def second_mode_choice(
     predicted = predicted_omega2(evidence, candidates)
     low = min(predicted) / (1.0 + 2.0 * cfg.omega2_window)
     high = max(predicted) * (1.0 + 2.0 * cfg.omega2_window)
-    floor = float(np.median(spectrum[(omega >= low) & (omega <= high)]))
+    band = spectrum[(omega >= low) & (omega <= high)]
+    if band.size == 0:  # the second modes lie past the spectrum (a coarse sampling)
+        empty = [math.nan, math.nan]
+        return None, {"predicted_omega2": predicted, "quality": [0.0, 0.0], "peak_omega": empty}
+    floor = float(np.median(band))
     qualities: list[float] = []
     peaks: list[float] = []
     for omega2 in predicted:
