@@ -68,6 +68,8 @@ CASES = [
     (f"xc{round(x * 100):03d}-push003", x, 0.03, 3.5)
     for x in (0.30, 0.40, 0.50, 0.60, 0.70, 0.80, 0.90, 0.98)
 ] + [(f"xc{round(x * 100):03d}-push020", x, 0.20, 4.0) for x in (0.30, 0.50, 0.70, 0.90)]
+# appended after the others, so that every case keeps its seed (SEED + its index)
+CASES += [(f"xc{round(x * 100):03d}-push028", x, 0.28, 4.3) for x in (0.50, 0.90)]
 
 
 class _Damper(ea.DamperBase):
