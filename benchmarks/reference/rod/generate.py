@@ -55,8 +55,10 @@ N_ELEMENTS = 40
 FAST_MODE_SCALE = 100.0
 TIME_STEP = 1.25e-5  # s: 80 steps per 1 ms sample
 SAMPLE_PERIOD = 1e-3
-SETTLE_TIME = 0.6  # s of heavy damping before t = 0, so the rod starts at rest, sagged
-SETTLE_DAMPING = 40.0  # 1/s
+#: Settling before t = 0 (s) under a damping (1/s) critical for the first free mode
+#: (2 x 16.05 rad/s): the rod starts at rest in its sag, to 2e-6 of it.
+SETTLE_TIME = 1.0
+SETTLE_DAMPING = 32.0
 #: Velocity damping of the rod during the manoeuvre (1/s): mass-proportional, a damping ratio of
 #: nu / (2 omega) = 0.005 at omega = 100 rad/s, the simulator's damping ratio there.
 DAMPING = 1.0
