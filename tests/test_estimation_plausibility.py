@@ -322,3 +322,25 @@ def test_an_unmodelled_tip_mass_is_a_model_mismatch_for_the_vibration_methods() 
         result = estimate(nominal, device, method)
         assert result.status is Status.OK, result.reason
         assert result.diagnostics.get("payload_spread", 0.0) < 0.003  # absent: read lighter
+
+
+def test_angles_in_degrees_are_caught_with_an_identified_observer() -> None:
+    # An identified observer's contact threshold is low (about 0.2 mN m against the paper's
+    # 20): with the angles in degrees it predicts 57 times the torque, and the detector fires
+    # within the first tens of milliseconds of motion; over that short free motion the measured
+    # torque is about 1/8 of the prediction, not 1/57, and still below 1/5 of it
+    from sensing_antenna.calibration.observer import identify_free_motion
+
+    device = paper_antenna()
+    free = simulate(device, Scenario(case="free", duration=3.0, seed=1)).without_ground_truth()
+    fit = identify_free_motion(free, device)
+    model = dataclasses.replace(calibrated(), observer=fit.observer)
+    recording = simulate(
+        device, Scenario(case="azimuthal", contact_point=0.55, seed=2)
+    ).without_ground_truth()
+    assert estimate(recording, model).status is Status.OK
+    degrees = dataclasses.replace(recording, theta=DEGREES * recording.theta)
+    for method in ("paper", "fast"):
+        result = estimate(degrees, model, method)
+        assert result.status is Status.IMPLAUSIBLE_INPUT, (method, result.reason)
+        assert "angles not in radians" in (result.reason or "")

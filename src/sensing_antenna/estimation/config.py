@@ -159,9 +159,11 @@ class EstimatorConfig:
     free_motion_gain_factor : float
         Plausibility (``implausible_input``): the torque of the free motion before t_c must be
         at least 1 / this factor of what the observer predicts from the angles (root-mean-square
-        ratio, :func:`~.front.steps.free_motion_gain`). Angles in degrees give 1/57; the
-        simulated device gives 0.8 to 3 with the paper's observer (the touch adds torque before
-        t_c). 10 sits between.
+        ratio, :func:`~.front.steps.free_motion_gain`). Angles in degrees give 1/57, or about
+        1/8 when the 57-fold prediction fires the contact detector within the first tens of
+        milliseconds of motion (an identified observer's low threshold); the simulated device
+        gives 0.8 to 3 with the paper's observer (the touch adds torque before t_c) and 1.0 with
+        an identified one. 5 sits between.
     """
 
     t1_source: Literal["rest", "push"] = "rest"
@@ -195,7 +197,7 @@ class EstimatorConfig:
     min_nyquist_factor: float = 2.0
     max_scale_mismatch: float = 1.5
     max_model_spread: float = 0.01
-    free_motion_gain_factor: float = 10.0
+    free_motion_gain_factor: float = 5.0
 
     def __post_init__(self) -> None:
         if self.t1_source not in ("rest", "push"):
