@@ -383,6 +383,8 @@ def test_the_frequency_model_is_as_uncertain_as_what_is_known_of_t() -> None:
     unmeasured = nominal.with_calibrated_t(0.2124)
     assert unmeasured.link.frequency_uncertainty == CALIBRATED_T_UNCERTAINTY == 0.01
     assert nominal.with_calibrated_t(0.2124, 0.0012).link.frequency_uncertainty == 0.0012
+    # a calibration that happened to scatter less than the model can be trusted to: the floor
+    assert nominal.with_calibrated_t(0.2124, 0.0).link.frequency_uncertainty == 0.001
     # its own T as the calibrated one: the same frequency model, now with a measured scatter
     own = nominal.self_calibrated(0.001)
     assert own.link.t_param == nominal.link.t_param

@@ -452,3 +452,16 @@ def test_contact_to_base_shear_matches_an_independent_solution(x_c: float, expec
     from sensing_antenna.beam.modes import contact_to_base_shear
 
     assert contact_to_base_shear(paper_antenna().link, x_c) == pytest.approx(expected, abs=1e-3)
+
+
+def test_the_tip_is_no_candidate_above_the_top_of_a_curve_that_falls_little() -> None:
+    """A heavy tip (half the link's mass) flattens the falling branch: its top lies a few
+    rad/s above the tip's frequency. A frequency above the top is off the curve, not at the
+    tip, however wide the tolerance: the tip answers only on the side the branch cannot reach."""
+    link = dataclasses.replace(PAPER, tip_mass=0.5 * PAPER.mass)
+    heavy = SensingCurve.from_link(link)
+    top = heavy.omega1_range()[1]
+    tip = float(heavy.omega1(link.length))
+    assert 0.0 < top - tip < 10.0
+    assert heavy.contact_points(1.04 * top, tolerance=20.0) == ()
+    assert heavy.contact_points(tip - 0.5, tolerance=1.0)[-1].x_c == link.length

@@ -344,3 +344,28 @@ def test_angles_in_degrees_are_caught_with_an_identified_observer() -> None:
         result = estimate(degrees, model, method)
         assert result.status is Status.IMPLAUSIBLE_INPUT, (method, result.reason)
         assert "angles not in radians" in (result.reason or "")
+
+
+def test_torques_a_hundred_times_too_large_are_implausible_not_a_payload(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # Torques in N cm read as a moment at rest of some 2 N m beyond the link's weight: as a
+    # payload that would be hundreds of grams, which the link could not carry. The units check
+    # says what it is; no method reads it as weight
+    scaled_torques = dataclasses.replace(azimuthal, torque=100.0 * azimuthal.torque)
+    for name, result in all_methods(scaled_torques, antenna).items():
+        assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        assert "payload_spread" not in result.diagnostics
+
+
+def test_a_stiffer_calibration_bends_the_touched_point_less(azimuthal: Recording) -> None:
+    # The push deflection of the touched point uses the stiffness the calibration measured (the
+    # one its sag uses): T_e = 0.9 T makes the link 1 / 0.81 times stiffer, so the same push
+    # deflects it 0.81 times as much
+    own = calibrated()
+    stiffer = own.with_calibrated_t(0.9 * own.link.t_param, 0.001)
+    gathered = gather(azimuthal, own)
+    a, b = conclude(gathered, "paper"), conclude(gather(azimuthal, stiffer), "paper")
+    assert b.diagnostics["deflection"] / a.diagnostics["deflection"] == pytest.approx(
+        0.81 * (b.x_c / a.x_c) ** 3, rel=1e-6
+    )

@@ -42,6 +42,7 @@ __all__ = [
     "BUILTIN_ANTENNAS",
     "CALIBRATED_T_UNCERTAINTY",
     "MIN_SLENDERNESS",
+    "MODEL_FREQUENCY_FLOOR",
     "NOMINAL_T_UNCERTAINTY",
     "PARAMETER_RANGES",
     "Antenna",
@@ -186,6 +187,11 @@ NOMINAL_T_UNCERTAINTY = 0.05
 #: The same for a calibrated link whose calibration did not measure its scatter (fewer than three
 #: points): 1 %, a fifth of the largest residual of the paper's own calibration (Section 5.1).
 CALIBRATED_T_UNCERTAINTY = 0.01
+
+#: The least relative uncertainty of omega_1 a calibration may claim: 0.1 %, how far the sensing
+#: curve of a pinned contact and a finite-element link with a compliant contact differ (a few
+#: calibration points can scatter less than that by chance, or not at all).
+MODEL_FREQUENCY_FLOOR = 0.001
 
 
 @dataclass(frozen=True)
@@ -363,8 +369,9 @@ class Link:
     def frequency_uncertainty(self) -> float:
         """Relative standard uncertainty of the model's omega_1(x_c) (dimensionless).
 
-        A calibrated link: the scatter its calibration measured (``calibration_scatter``), or
-        :data:`CALIBRATED_T_UNCERTAINTY` when that was not measured. A link known only from its
+        A calibrated link: the scatter its calibration measured (``calibration_scatter``), at
+        least :data:`MODEL_FREQUENCY_FLOOR`, or :data:`CALIBRATED_T_UNCERTAINTY` when that was
+        not measured. A link known only from its
         material data: :data:`NOMINAL_T_UNCERTAINTY`, the spread of T = sqrt(rho / (E I)) that
         datasheet tolerances leave (omega_1 scales as 1 / T).
         """
@@ -372,7 +379,7 @@ class Link:
             return NOMINAL_T_UNCERTAINTY
         if self.calibration_scatter is None:
             return CALIBRATED_T_UNCERTAINTY
-        return self.calibration_scatter
+        return max(self.calibration_scatter, MODEL_FREQUENCY_FLOOR)
 
     @property
     def t_param(self) -> float:

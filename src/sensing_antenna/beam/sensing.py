@@ -314,7 +314,11 @@ class SensingCurve:
         if tolerance == 0.0 or _in_branch(target, last):
             return None
         omega_tip = self._lam_list[-1] ** 2 * self._scale
-        if abs(omega1 - omega_tip) > tolerance:
+        # the side of omega_1(l) the last branch does not reach: below it when the branch falls
+        # to the tip, above it when it rises
+        falling = last.nodes[0] == len(self._lam_list) - 1
+        beyond = omega_tip - omega1 if falling else omega1 - omega_tip
+        if not 0.0 < beyond <= tolerance:
             return None
         slope = 2.0 * self._lam_list[-1] * self._slope_list[-1] * self._scale / self.link.length
         return Candidate(x_c=self.link.length, slope=slope)

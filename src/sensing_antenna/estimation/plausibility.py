@@ -50,6 +50,7 @@ import numpy as np
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.beam import SensingCurve, natural_frequencies
+from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
@@ -185,6 +186,11 @@ def _at_tip_when_just_past(
 #: read as weight the model does not know of.
 _PAYLOAD_SIGMAS = 3.0
 
+#: The offset a tare leaves on the torque, in deviations of its noise per sample (about one
+#: resolution count each): a few counts, five at most. A payload of 0.05 g at the tip of the
+#: paper's link reads 15 counts.
+_TARE_COUNTS = 5.0
+
 #: Fraction of ``max_model_spread`` beyond which the payload's effect is computed on the heavier
 #: link's own sensing curve (a table of its eigenvalues, tens of ms) rather than scaled.
 _EXACT_FROM = 0.25
@@ -207,16 +213,28 @@ def _payload_problem(
     vibration (``ratio``) are not judged: the weight does not enter the statics of the push.
     """
     link = evidence.antenna.link
+    if evidence.input_problem is not None:
+        return None  # loads not in the format's units say nothing of a payload
     if not (math.isfinite(estimate.omega1) and math.isfinite(estimate.x_c)):
         return None
     if not 0.0 < estimate.x_c <= link.length:
         return None
     lever = STANDARD_GRAVITY * link.length * math.cos(float(evidence.theta[0, 1]))
     excess = float(evidence.load_offset[4])
-    if not (lever > 0.0 and excess > _PAYLOAD_SIGMAS * evidence.torque_offset_error):
+    # What a tare leaves: the mean's standard error, and an offset of a few counts, counted as
+    # up to _TARE_COUNTS deviations of the torque's noise per sample
+    noise = float(evidence.diagnostics.get("torque_noise", 0.0))
+    allowed = _PAYLOAD_SIGMAS * evidence.torque_offset_error + _TARE_COUNTS * noise
+    if not (lever > 0.0 and excess > allowed):
         return None  # a lighter reading is no payload: a sensor offset, which weighs nothing
     mass = excess / lever
-    heavier = dataclasses.replace(link, tip_mass=link.tip_mass + mass)
+    try:
+        heavier = dataclasses.replace(link, tip_mass=link.tip_mass + mass)
+    except SensingAntennaError:
+        return (
+            f"at rest the link's moment ty is {excess:.3g} N m more than the model's weight: "
+            f"{1e3 * mass:.3g} g at the tip, more than the link could carry; tare the sensor"
+        )
     change = float(
         natural_frequencies(heavier, estimate.x_c, 1)[0]
         / natural_frequencies(link, estimate.x_c, 1)[0]

@@ -459,6 +459,7 @@ class FrontEnd:
                 "rebounds": hold.rebounds,
                 "hold_push_standard_error": hold.standard_error,
                 "force_noise": hold.force_noise,
+                "torque_noise": torque_noise,
             }
         )
         gaps = self._gaps_known(end)

@@ -76,16 +76,16 @@ def conclude_fast(
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)
+    if reason is not None and "branch_chosen_by" in diag:
+        reason += (
+            f"; the second contact mode then chose the branch of x_c = {post.x_c:.3f} m, and "
+            "the interval is given on that branch"
+        )
     link = evidence.antenna.link
     if status is Status.UNCERTAIN and reason is not None and link.calibrated_t is None:
         reason += (
             f"; the antenna is not calibrated: its omega_1 is known to "
             f"{100 * link.frequency_uncertainty:.2g} % only (calibrate the antenna)"
-        )
-    if reason is not None and "branch_chosen_by" in diag:
-        reason += (
-            f"; the second contact mode then chose the branch of x_c = {post.x_c:.3f} m, and "
-            "the interval is given on that branch"
         )
     branch_of = [post.branch_of(c) for c in candidates]
     diag.update(

@@ -339,6 +339,15 @@ def second_mode_choice(
     return None, notes
 
 
+def _uncertainty_source(link: Link) -> str:
+    """Where the link's frequency uncertainty comes from, in words."""
+    if link.calibrated_t is None:
+        return "a nominal T"
+    if link.calibration_scatter is None:
+        return "assumed: the calibration measured no scatter"
+    return "the calibration's scatter"
+
+
 def _second_mode_against(notes: dict[str, Any], chosen: int, cfg: Any) -> int | None:
     """The other candidate when the second mode speaks against ``chosen``, else None.
 
@@ -445,7 +454,7 @@ class PaperMethod:
                         Status.UNCERTAIN,
                         f"the frequency model's own uncertainty "
                         f"({100 * link.frequency_uncertainty:.2g} % of omega_1, "
-                        f"{'the calibration scatter' if link.calibrated_t else 'a nominal T'}) "
+                        f"{_uncertainty_source(link)}) "
                         f"moves this candidate by up to {100 * spread:.1f} cm at two standard "
                         f"deviations, more than {100 * cfg.max_model_spread:g} cm"
                         + ("" if link.calibrated_t else ": calibrate the antenna"),
