@@ -499,3 +499,18 @@ def test_front_end_names_a_misshapen_block() -> None:
     front = FrontEnd(calibrated(), TS)
     with pytest.raises(FieldError, match=r"theta: shape \(2, 3\), expected \(2, 2\)"):
         front.update_block(np.zeros(2), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)))
+
+
+def test_candidates_the_ratio_cannot_tell_apart_without_a_second_mode_are_uncertain() -> None:
+    # Near the top of the sensing curve (x_c = 0.8 m; its maximum near 0.768 l) the two
+    # candidates of omega_1 (0.739 and 0.800 m) lie 6 cm apart, within two of the ratio's
+    # uncertainties there (3.2 cm); with no second mode in the vibration nothing tells them
+    # apart, and the answer is uncertain, not ok; with it, the second mode chooses
+    recording = synthetic_recording(Synthetic(x_c=0.8, second_mode=0.0, seed=3))
+    result = estimate(recording, calibrated())
+    assert len(result.candidates) == 2
+    assert result.status is Status.UNCERTAIN, result.reason
+    assert "cannot tell the candidate" in (result.reason or "")
+    chosen = estimate(synthetic_recording(Synthetic(x_c=0.8, seed=3)), calibrated())
+    assert chosen.status is Status.OK and chosen.diagnostics["discriminated_by"] == "omega2"
+    assert chosen.x_c == pytest.approx(0.8, abs=1e-3)

@@ -425,6 +425,16 @@ class PaperMethod:
                     agree=abs(x_pick - ratio_estimate) <= tolerance,
                 )
                 diag["discriminated_by"] = "omega2"
+            elif margin < cfg.ratio_resolution_sigmas * sigma_ratio:
+                other = candidates_used[1 - int(fusion.chosen or 0)]
+                problems.append(
+                    (
+                        Status.UNCERTAIN,
+                        f"the torque/force ratio ({ratio_estimate:.3f} m, +-{sigma_ratio:.3f} m) "
+                        f"cannot tell the candidate {fusion.x_c:.3f} m from {other:.3f} m and "
+                        "the second contact mode is not clear",
+                    )
+                )
             contradiction = _second_mode_against(notes, int(fusion.chosen or 0), cfg)
             if contradiction is not None:
                 problems.append(
