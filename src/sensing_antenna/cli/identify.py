@@ -65,8 +65,9 @@ def _run(args: argparse.Namespace) -> int:
     )
     print(
         f"contact_threshold = {fit.contact_threshold:.4g} N m "
-        f"({fit.margin:g} x max residual {fit.max_filtered_residual:.4g} N m), "
-        f"rms fit residual {fit.residual_rms:.3g} N m, joints used: {joints}"
+        f"({fit.margin:g} x the largest low-pass filtered residual of Eq. 16, "
+        f"{fit.max_filtered_residual:.4g} N m), rms of the unfiltered fit residual "
+        f"{fit.residual_rms:.3g} N m, joints used: {joints}"
     )
     print(args.out)
     return 0
