@@ -71,6 +71,8 @@ def test_quaternion_and_matrix_metadata_give_one_pose() -> None:
         ('{"position": [0, 0]}', "position"),
         ('{"position": [0, 0, 0]}', "exactly one of"),
         ('{"position": [0, 0, 0], "quaternion": [2, 0, 0, 0]}', "unit norm"),
+        # a base 0.2 m and 0.4 m away written in millimetres
+        ('{"position": [200, 0, 400], "quaternion": [1, 0, 0, 0]}', "in metres?"),
         ('{"position": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, -1]]}', "orthonormal"),
         ('{"position": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0]]}', "3 x 3"),
         ('{"position": [0, 0, 0], "scale": 2}', "unknown"),
@@ -161,3 +163,15 @@ def test_only_ok_points_enter_a_map_unless_uncertain_ones_are_asked_for() -> Non
     none = ContactEstimate(status=Status.NO_CONTACT, reason="no contact", method="paper")
     kept = contact_point_from_estimate(none, ANTENNA, source="empty")
     assert not kept.usable and select_points([kept], include_uncertain=True) == []
+
+
+def test_a_quaternion_printed_to_three_decimals_is_normalised() -> None:
+    # [0.966, 0, 0, 0.259] is a 30 degree turn about Z printed to three decimals (norm 1.00012,
+    # the turn 2 atan2(0.259, 0.966) = 30.01 degrees)
+    pose = base_pose_from_metadata(
+        {"base_pose": '{"position": [0, 0, 0], "quaternion": [0.966, 0, 0, 0.259]}'}
+    )
+    assert np.allclose(pose.rotation @ pose.rotation.T, np.eye(3), atol=1e-12)
+    assert math.degrees(math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])) == pytest.approx(
+        30.0, abs=0.02
+    )

@@ -32,6 +32,11 @@ BASE_POSE_KEY = "base_pose"
 #: significant digits, well below any real mounting error.
 ORTHONORMAL_TOLERANCE = 1e-4
 
+#: Farthest a base may sit from the world's origin (m): 100 m holds a robot's workspace in any
+#: lab or field frame a map of centimetre-sized contacts would use, and refuses a position in
+#: millimetres (a base 0.2 m away written as 200).
+MAX_BASE_DISTANCE = 100.0
+
 #: How far from unit norm a given quaternion may be; it is then normalised. 1 %: a quaternion
 #: written with three decimals is off by up to about 0.2 %, while one that is not a rotation at
 #: all (a typo, another convention's scaling) is off by far more.
@@ -60,6 +65,13 @@ class BasePose:
         position = np.array(self.position, dtype=float).reshape(3)
         if not (np.all(np.isfinite(rotation)) and np.all(np.isfinite(position))):
             raise FieldError(BASE_POSE_KEY, "rotation and position must be finite numbers")
+        distance = float(np.linalg.norm(position))
+        if distance > MAX_BASE_DISTANCE:
+            raise FieldError(
+                BASE_POSE_KEY,
+                f"position is {distance:.4g} m from the world's origin, more than "
+                f"{MAX_BASE_DISTANCE:g} m: in metres? (millimetres read as metres land here)",
+            )
         error = float(np.abs(rotation @ rotation.T - np.eye(3)).max())
         if error > ORTHONORMAL_TOLERANCE or np.linalg.det(rotation) < 0:
             raise FieldError(BASE_POSE_KEY, "rotation must be orthonormal with determinant +1")
