@@ -129,9 +129,10 @@ def test_missing_field_without_base(tmp_path: Path) -> None:
     text = antenna_to_toml(paper_antenna()).replace("radius = 0.001\n", "")
     path = tmp_path / "no-radius.toml"
     path.write_text(text, encoding="utf-8")
-    with pytest.raises(AntennaConfigError, match=r"link: missing field") as info:
+    with pytest.raises(AntennaConfigError, match=r"link\.radius: missing") as info:
         load_antenna(path)
     assert str(path) in str(info.value)
+    assert "__init__" not in str(info.value)  # the field, not Python's internals
 
 
 def test_bad_base_not_a_file_and_bad_toml(tmp_path: Path) -> None:

@@ -26,7 +26,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import MISSING, dataclass, field, fields, replace
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
@@ -588,6 +588,16 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
         if not isinstance(values, Mapping):
             raise AntennaConfigError(section, "missing section", source)
         allowed = {f.name for f in fields(cls)}
+        required = [
+            f.name
+            for f in fields(cls)
+            if f.default is MISSING and f.default_factory is MISSING and f.init
+        ]
+        missing = [name for name in required if name not in values]
+        if missing:
+            raise AntennaConfigError(
+                f"{section}.{missing[0]}", "missing (a number is required here)", source
+            )
         for key, value in values.items():
             if key not in allowed:
                 raise AntennaConfigError(f"{section}.{key}", "unknown key", source)
@@ -602,8 +612,6 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
             _, dot, name = exc.field_name.partition(".")
             field_name = f"{section}.{name}" if dot else section
             raise AntennaConfigError(field_name, exc.problem, source) from exc
-        except TypeError as exc:
-            raise AntennaConfigError(section, f"missing field ({exc})", source) from exc
     name = data.get("name", "unnamed")
     if not isinstance(name, str) or not name:
         raise AntennaConfigError("name", "must be a non-empty string", source)
