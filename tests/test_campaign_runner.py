@@ -332,3 +332,47 @@ def test_dask_local_cluster_gives_the_same_results(tmp_path: Path) -> None:
     ok_rows = [row for row in read_rows(on_dask.csv_path) if row["run_status"] == RUN_OK]
     expected = [row for row in read_rows(inline.csv_path) if float(row["x_c_true_m"]) != 0.6]
     assert ok_rows == expected
+
+
+def test_a_stop_signal_whose_exception_was_lost_stops_the_campaign_at_the_next_run(
+    tmp_path: Path,
+) -> None:
+    # A signal handler's exception is raised wherever the main thread is; compiled code calling
+    # back into Python (numba unpickling a constant in the fast method's solver) drops it, and a
+    # SIGTERM 3.5 s into the default campaign was lost that way: the campaign ran to its end.
+    # The handlers record the signal, and the campaign checks after each run
+    import signal
+
+    from sensing_antenna.campaign.runner import CampaignInterrupted
+    from sensing_antenna.errors import note_signal
+
+    calls: list[str] = []
+
+    def signalled_at_third(run: RunSpec) -> RunResult:
+        calls.append(run.run_id)
+        if len(calls) == 3:
+            note_signal(signal.SIGTERM)  # as the handler does, its exception then lost
+        return noisy_run(run)
+
+    out = tmp_path / "stopped"
+    with pytest.raises(CampaignInterrupted) as stopped:
+        run_campaign(
+            small_spec(),
+            out,
+            run_one=signalled_at_third,
+            prepare_antenna=same_antenna,
+            workers=1,
+            progress=False,
+        )
+    assert stopped.value.signal_number == signal.SIGTERM
+    assert len(calls) == 3 and len(list((out / "runs").glob("*.json"))) == 3
+    # the next campaign starts afresh: the signal was the last one's
+    outcome = run_campaign(
+        small_spec(),
+        out,
+        run_one=noisy_run,
+        prepare_antenna=same_antenna,
+        workers=1,
+        progress=False,
+    )
+    assert outcome.n_previously_done == 3

@@ -51,9 +51,10 @@ def _environment() -> dict[str, str]:
 
 
 def _interrupt(
-    signal_number: int, out: Path, command: list[str] = _LONG_COMMAND
+    signal_number: int, out: Path, command: list[str] = _LONG_COMMAND, started: float = _STARTED
 ) -> subprocess.CompletedProcess[str]:
-    """Start ``command``, send ``signal_number`` to its process alone once it runs; its ending."""
+    """Start ``command``, send ``signal_number`` to its process alone ``started`` seconds after
+    (once it runs); its ending."""
     process = subprocess.Popen(
         [sys.executable, "-c", _ANTENNA, *command, "--out", str(out)],
         stdout=subprocess.PIPE,
@@ -61,7 +62,7 @@ def _interrupt(
         text=True,
         env=_environment(),
     )
-    time.sleep(_STARTED)
+    time.sleep(started)
     assert process.poll() is None, "the command ended before it could be interrupted"
     process.send_signal(signal_number)
     stdout, stderr = process.communicate(timeout=60)
@@ -112,7 +113,8 @@ def test_an_interrupted_campaign_says_what_it_keeps(tmp_path: Path) -> None:
     # the default campaign runs for a minute or more: it is interrupted while it sets up or runs
     command = ["campaign", "run", "--workers", "1", "--no-progress"]
     for signal_number, code in ((signal.SIGINT, -signal.SIGINT), (signal.SIGTERM, 143)):
-        done = _interrupt(signal_number, tmp_path / "out", command)
+        # 1.5 s: while it sets up (identification, calibration)
+        done = _interrupt(signal_number, tmp_path / "out", command, started=1.5)
         assert done.returncode == code
         name = signal.Signals(signal_number).name
         assert re.fullmatch(

@@ -8,6 +8,38 @@ unwinds like Ctrl-C's ``KeyboardInterrupt``, so the same clean-up code handles b
 
 from __future__ import annotations
 
+import signal
+
+#: Stop signals received, in order (signal numbers): a handler records one before it raises, so
+#: that a stop whose exception was swallowed on its way up is still seen
+#: (:func:`raise_if_signalled`).
+_RECEIVED: list[int] = []
+
+
+def note_signal(number: int) -> None:
+    """Record that the stop signal ``number`` arrived (called by signal handlers)."""
+    _RECEIVED.append(number)
+
+
+def forget_signals() -> None:
+    """Forget the stop signals recorded so far (a new piece of work starts)."""
+    _RECEIVED.clear()
+
+
+def raise_if_signalled() -> None:
+    """Raise the interruption of a stop signal that arrived but was lost on the way.
+
+    A signal handler's exception is raised wherever the main thread happens to be, and a few
+    places drop it: compiled code calling back into Python (numba unpickling a constant) ends
+    the callback's error and goes on. Loops that must stop check here between steps.
+    """
+    if _RECEIVED:
+        number = _RECEIVED.pop()
+        _RECEIVED.clear()
+        if number == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise Terminated(number)
+
 
 class SensingAntennaError(Exception):
     """Base class for errors caused by input: files, fields, arguments."""

@@ -44,7 +44,12 @@ from sensing_antenna.campaign.store import (
     write_runs_csv,
 )
 from sensing_antenna.campaign.worker_threads import limit_to_one_blas_thread
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import (
+    SensingAntennaError,
+    forget_signals,
+    note_signal,
+    raise_if_signalled,
+)
 
 __all__ = [
     "CampaignInterrupted",
@@ -159,12 +164,22 @@ def _stop_signals_interrupt() -> Iterator[None]:
         return
 
     def interrupt(signal_number: int, _frame: FrameType | None) -> None:
+        note_signal(signal_number)
         raise CampaignInterrupted(signal_number)
 
+    def keyboard(signal_number: int, _frame: FrameType | None) -> None:
+        note_signal(signal_number)
+        raise KeyboardInterrupt
+
+    forget_signals()
     previous = {}
     for number in _STOP_SIGNALS:
         if signal.getsignal(number) is signal.SIG_DFL:
             previous[number] = signal.signal(number, interrupt)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        # Ctrl-C as Python's own handler, but recorded: a KeyboardInterrupt lost on its way up
+        # (raise_if_signalled) still stops the campaign at the next run
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, keyboard)
     try:
         yield
     finally:
@@ -292,6 +307,7 @@ def run_campaign(
                         executed += 1
                         n_stored += 1
                         bar.update(1)
+                        raise_if_signalled()
                 stored = load_campaign_results(directory, spec)
                 csv_path = write_runs_csv(directory / CSV_FILE, stored.results.values())
     except KeyboardInterrupt as exc:

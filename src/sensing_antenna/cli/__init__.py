@@ -38,7 +38,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from types import FrameType
 from typing import Any, NoReturn
 
-from sensing_antenna.errors import SensingAntennaError, Terminated
+from sensing_antenna.errors import SensingAntennaError, Terminated, note_signal
 
 #: Command modules, in the order ``antenna --help`` lists them.
 COMMAND_MODULES = (
@@ -233,6 +233,7 @@ def _terminate_raises() -> Iterator[None]:
             signal.signal(number, signal.SIG_DFL)
             os.kill(os.getpid(), number)
             return
+        note_signal(number)
         raise Terminated(number)
 
     try:
