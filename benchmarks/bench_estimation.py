@@ -56,7 +56,7 @@ OFFLINE_TARGET_S = 50e-3
 def model_of(antenna_name: str) -> Antenna:
     """The estimators' model of a device simulated with ``antenna_name``: its own T as a
     calibration gives it, with the scatter calibrations of the simulated device measure (0.1 %)."""
-    return load_antenna(antenna_name).self_calibrated(0.001)
+    return load_antenna(antenna_name).self_calibrated()
 
 
 def online_run(recording: Recording, antenna_name: str) -> tuple[float, float, int]:

@@ -47,7 +47,7 @@ from fast_settings import add_fast_arguments, fast_settings  # noqa: E402
 from sensing_antenna.antenna import Antenna, paper_antenna  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
 from sensing_antenna.estimation.methods import EstimationMethod  # noqa: E402
-from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod  # noqa: E402
+from sensing_antenna.estimation.methods.fast import FastMethod  # noqa: E402
 from sensing_antenna.recording import Recording  # noqa: E402
 from sensing_antenna.simulator import Scenario, simulate  # noqa: E402
 
@@ -69,7 +69,7 @@ def paper_set() -> list[Item]:
     estimators get the device's own T as a calibration gives it (the fast method's floor as its
     scatter)."""
     antenna = paper_antenna()
-    model = antenna.self_calibrated(FastConfig().frequency_floor)
+    model = antenna.self_calibrated()
     items = []
     for case in ("azimuthal", "vertical"):
         for x_c in PAPER_POINTS:

@@ -93,7 +93,7 @@ def _percentiles(values: list[float]) -> dict[str, float | None]:
 def run_method(method: str, files: list[Path], duration: float) -> dict[str, Any]:
     """One sustained run of ``method`` (module docstring)."""
     # the estimators' model: the simulated device's own T as a calibration gives it (0.1 %)
-    antenna = paper_antenna().self_calibrated(0.001)
+    antenna = paper_antenna().self_calibrated()
     recordings = [read_recording(path) for path in files]
     offline = [estimate(r, antenna, method).to_dict() for r in recordings]  # also loads kernels
     per_recording = recordings[0].duration + recordings[0].sample_period

@@ -55,7 +55,7 @@ def run(seeds: int, antenna_name: str) -> dict[str, Any]:
     antenna = load_antenna(antenna_name)
     # the estimators get the device's own T as a calibration gives it, with the scatter
     # calibrations of the simulated device measure (0.1 %)
-    model = antenna.self_calibrated(0.001)
+    model = antenna.self_calibrated()
     methods = sorted(METHODS)
     rows: list[dict[str, Any]] = []
     start = time.perf_counter()

@@ -141,7 +141,7 @@ def run(points: list[float], repeats: int, cases: list[str], antenna_name: str) 
     antenna = load_antenna(antenna_name)
     # the estimators' model: the nominal device's own T as a calibration of it gives (0.1 %
     # scatter); the imperfection is what it does not know
-    model = antenna.self_calibrated(0.001)
+    model = antenna.self_calibrated()
     rows: list[dict[str, Any]] = []
     start = time.perf_counter()
     settings = [(*s, {}) for s in imperfections()]

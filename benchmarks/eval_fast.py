@@ -97,7 +97,7 @@ def run_one(
     """
     # the estimators' model: the device's own T as a calibration gives it, with the scatter
     # calibrations of the simulated device measure (the fast method's floor)
-    antenna = paper_antenna().self_calibrated(FastConfig().frequency_floor)
+    antenna = paper_antenna().self_calibrated()
     recording, contact_abscissa = simulated(case, x_c, seed, noise, cache)
     rows = []
     fast = FastMethod(config or FastConfig())

@@ -125,7 +125,7 @@ def paper_setup(noise: float) -> Setup:
     """The paper antenna, simulated, and estimated with its own T as a calibration gives it
     (with the scatter calibrations of the simulated device measure, the fast method's floor)."""
     antenna = paper_antenna()
-    model = antenna.self_calibrated(FastConfig().frequency_floor)
+    model = antenna.self_calibrated()
     return Setup(model, antenna, {"noise_scale": noise})
 
 

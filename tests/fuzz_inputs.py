@@ -290,7 +290,7 @@ def simulate_bases() -> Bases:
     return Bases(
         # the estimators' model: the device's own T as a calibration gives it (0.1 %), so the
         # untouched manoeuvres are ok and a perturbation is what moves them
-        antenna=antenna.self_calibrated(0.001),
+        antenna=antenna.self_calibrated(),
         contacts=tuple(r.without_ground_truth() for r in contacts),
         contact_points=tuple(float(r.metadata["true_xc"]) for r in contacts),
         free=free.without_ground_truth(),

@@ -390,3 +390,4 @@ def test_the_frequency_model_is_as_uncertain_as_what_is_known_of_t() -> None:
     own = nominal.self_calibrated(0.001)
     assert own.link.t_param == nominal.link.t_param
     assert own.link.frequency_uncertainty == 0.001
+    assert nominal.self_calibrated() == own  # by default the floor a calibration may claim
