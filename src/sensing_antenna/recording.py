@@ -503,6 +503,16 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
     """The column names of a header ``line`` (line ``number`` of ``source``): none empty or
     repeated, the nine required ones present."""
     names = [cell.strip() for cell in line.split(",")]
+    if len(names) == 1:
+        for separator, called in ((";", "semicolons"), ("\t", "tabs"), (" ", "spaces")):
+            if separator in names[0]:
+                raise RecordingError(
+                    source,
+                    number,
+                    None,
+                    f"the header is one column separated by {called}; columns are separated "
+                    "by commas (docs/recording-format.md)",
+                )
     seen: set[str] = set()
     for name in names:
         if not name:
