@@ -208,6 +208,15 @@ def test_a_still_recording_fits_no_joint() -> None:
         identify_motors(still, PAPER)
 
 
+def test_a_command_of_the_wrong_sign_is_named() -> None:
+    recording = simulate(PAPER, Scenario(case="free"), record_commands=True)
+    flipped = dict(recording.extra)
+    flipped["u1"] = -flipped["u1"]
+    wrong = dataclasses.replace(recording, extra=flipped, source="flipped.csv")
+    with pytest.raises(IdentificationError, match="not a positive inertia: does column 'u1'"):
+        identify_motors(wrong, PAPER)
+
+
 def test_simulator_writes_commands_only_when_asked() -> None:
     scenario = Scenario(case="azimuthal", contact_point=0.6)
     plain = simulate(PAPER, scenario)

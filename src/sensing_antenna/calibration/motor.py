@@ -189,9 +189,11 @@ def _fit_joint(
     """Eq. 1 of one joint from its angle (n,) and net torque n K_m u - Gamma_coup split into the
     held command part and the smooth coupling part, shape (n, 2) (N m)."""
     angle = theta - theta[0]
+    memory = math.ceil(_MEMORY / (bandwidth * period))
+    if angle.size <= memory + 2 * _SPEED_HALF_WINDOW:
+        return None, f"the recording is too short ({angle.size} samples) for the filter's memory"
     motion = _filtered(angle, period, bandwidth, held=False)
-    window = min(2 * _SPEED_HALF_WINDOW + 1, angle.size - 1 - (angle.size % 2 == 0))
-    speed = signal.savgol_filter(angle, window, 2, deriv=1, delta=period)
+    speed = signal.savgol_filter(angle, 2 * _SPEED_HALF_WINDOW + 1, 2, deriv=1, delta=period)
     friction = _filtered(np.tanh(speed / FRICTION_SPEED), period, bandwidth, held=False)[:, 0]
     target = (
         _filtered(torque[:, 0], period, bandwidth, held=True)[:, 0]
@@ -200,7 +202,6 @@ def _fit_joint(
     design = np.column_stack([motion[:, 2], motion[:, 1], friction])
     # rows whose filter memory saw the joint moving: the friction model there is the sliding one
     slow = np.abs(speed) < MOVING_SPEED_FACTOR * FRICTION_SPEED
-    memory = math.ceil(_MEMORY / (bandwidth * period))
     recent = np.convolve(slow.astype(np.float64), np.ones(memory + 1))[: slow.size]
     rows = recent == 0.0
     if np.count_nonzero(rows) < 3:
@@ -218,7 +219,12 @@ def _fit_joint(
         return None, "its motion cannot separate J, v and Gamma_nlc (a singular fit)"
     errors = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     inertia, viscous, coulomb = (float(v) for v in solution)
-    if not inertia > 0 or not errors[0] < MAX_RELATIVE_ERROR * inertia:
+    if not inertia > 0:
+        return None, (
+            f"the fit gives J = {inertia:.3g} kg m^2, not a positive inertia: does column "
+            f"'u{joint}' hold the voltage that turns theta{joint} positive (its sign, its unit)?"
+        )
+    if not errors[0] < MAX_RELATIVE_ERROR * inertia:
         return None, (
             f"its motion does not determine J (J = {inertia:.3g} +- {errors[0]:.2g} kg m^2): "
             "record moves that accelerate it"
@@ -303,7 +309,7 @@ def identify_motors(
                     period,
                     filter_bandwidth,
                 )
-            except FloatingPointError:
+            except (FloatingPointError, np.linalg.LinAlgError):
                 fit, reason = None, "the fit overflows: commands or torques far beyond a head's"
         if fit is None:
             skipped.append((j + 1, reason))
