@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
+    "COMMAND_COLUMNS",
     "FORMAT_NAME",
     "GROUND_TRUTH_KEYS",
     "GROUND_TRUTH_PREFIX",
@@ -61,6 +62,11 @@ _FORMAT_FAMILY = "sensing-antenna-recording/"
 
 #: Required columns, in the order :func:`write_recording` writes them.
 REQUIRED_COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
+
+#: Optional columns of the motor commands: the voltages u_1, u_2 of Eq. 1 (V), each applied from
+#: its sample's time until the next sample's. Read by ``antenna identify --servo``; a recording
+#: without them is read as before.
+COMMAND_COLUMNS = ("u1", "u2")
 
 #: Metadata keys that hold ground truth besides those starting with :data:`GROUND_TRUTH_PREFIX`.
 GROUND_TRUTH_KEYS = frozenset({"seed", "simulation"})
