@@ -226,6 +226,13 @@ class ElasticaTable:
         return np.ascontiguousarray(self.arc).ravel()
 
     @functools.cached_property
+    def last_valid(self) -> list[int]:
+        """For each beta column, the last q index before the first NaN of ``arc``."""
+        valid = np.isfinite(self.arc)
+        first_bad = np.where(valid.all(axis=0), valid.shape[0], np.argmin(valid, axis=0))
+        return [int(v) - 1 for v in first_bad]
+
+    @functools.cached_property
     def arc_list(self) -> list[float]:
         """``arc_flat`` as Python floats, for the scalar path of :func:`contact_arc`."""
         return [float(v) for v in self.arc_flat]
@@ -385,32 +392,53 @@ def loaded_end(
     if perpendicular == 0.0:
         return ElasticaContact(arc, arc, 0.0, 0.0)
     alpha = perpendicular * arc * arc / flexural_rigidity
-    beta = np.array([axial / perpendicular])
+    beta = axial / perpendicular
     table = elastica_table()
-
-    def alpha_of(q: float) -> float:
-        sigma = table.lookup(np.array([q]), beta)[0][0]
-        return float(q * sigma * sigma)
-
-    # the largest q of the grid up to which the table holds this beta (alpha rises with q)
-    reach = table.lookup(table.q, np.full(table.q.shape, beta[0]))[0]
-    valid = np.isfinite(reach)
-    stop = int(np.argmin(valid)) if not valid.all() else valid.size
-    if stop < 2:
+    nb = table.arc.shape[1]
+    fb = (beta - BETA_RANGE[0]) / BETA_STEP
+    if not 0.0 <= fb <= nb - 1:
         return nan
-    low, high = 0.0, float(table.q[stop - 1])
+    j = min(int(fb), nb - 2)
+    # alpha = q Sigma^2 rises with q up to where the table ends for this beta
+    # (less one: the bilinear weights reach the next row, NaN past it)
+    top = min(table.last_valid[j], table.last_valid[j + 1]) - 1
+    if top < 1:
+        return nan
+    flat = table.arc_list
+
+    def alpha_of(fq: float) -> float:
+        sigma = _bilinear(flat, nb, fq, fb)
+        return fq * Q_STEP * sigma * sigma
+
+    low, high = 0.0, float(top)
     if not alpha_of(high) >= alpha:
         return nan
-    for _ in range(48):
+    for _ in range(40):
         mid = 0.5 * (low + high)
         if alpha_of(mid) < alpha:
             low = mid
         else:
             high = mid
-    q = 0.5 * (low + high)
-    sigma, x, y, slope = (float(v[0]) for v in table.lookup(np.array([q]), beta))
+    q = 0.5 * (low + high) * Q_STEP
+    sigma, x, y, slope = (float(v[0]) for v in table.lookup(np.array([q]), np.array([beta])))
     m = arc / sigma
     return ElasticaContact(arc, x * m, y * m, slope)
+
+
+def _bilinear(flat: list[float], nb: int, fq: float, fb: float) -> float:
+    """Bilinear value of a row-major table (columns nb) at fractional indices (fq, fb)."""
+    i = int(fq)
+    j = int(fb)
+    if i >= (len(flat) // nb) - 1:
+        i -= 1
+    if j >= nb - 1:
+        j -= 1
+    a = fq - i
+    b = fb - j
+    k = i * nb + j
+    low = flat[k] + b * (flat[k + 1] - flat[k])
+    high = flat[k + nb] + b * (flat[k + nb + 1] - flat[k + nb])
+    return low + a * (high - low)
 
 
 def contact_arc(

@@ -125,11 +125,25 @@ class EstimatorConfig:
         factor (y_c / x_c) x_c: the neglected moments are the axial force times the link's
         slope (1.5 y_c / x_c, Eq. 9, times R_x / R_perp up to the friction coefficient 0.6)
         and the weight of the bent link; 1.0 bounds 1.5 x 0.6 = 0.9.
+    bent_link_factor : float
+        Coefficient of the uncertainty a push's deflection adds to a contact point read from
+        the vibration, factor (y_c / x_c)^2 x_c (``Evidence.bent_link_uncertainty``): the
+        sensing curves are the straight link's, and the preload of the bent link shifts the
+        frequencies at second order. 0.6 bounds what the rod recordings show (0.8 cm at
+        22 % deflection, x_c = 0.3 m, against 1.0 cm) and adds 0.5 mm at the default gentle
+        push.
     omega2_window : float
         Relative half-width of the search window around each candidate's predicted omega_2;
         0.05 is a quarter of the 20 % gap between the candidates' omega_2 at the curve's top.
-    max_deflection_ratio : float
-        Largest static deflection y_c / x_c at the contact consistent with Assumption 1 (10 %).
+    max_friction_ratio : float
+        Plausibility (``slip_suspected``): the largest ratio of the reaction's part along the
+        link's tangent at the contact to its part along the contact normal that friction can
+        hold still (mu). The tangent is the elastica's at the answer
+        (:mod:`sensing_antenna.beam.elastica`); a point contact on the link's side has its
+        normal across the tangent. Dry friction of metals, plastics, wood and stone on each
+        other lies below 1 (rubber excepted): 1.0, a cone of 45 deg. A reaction outside the
+        cone by more than 3 of its standard errors cannot be a contact at rest: it slides, or
+        it is not a point contact on the link's side.
     max_direction_drift : float
         Largest angle (rad) between the filtered contact-force direction at t_1 + settle and at t_e
         before a slip is suspected; 0.15 rad (8.6 deg) is well above noise at gentle pushes.
@@ -191,7 +205,8 @@ class EstimatorConfig:
     ratio_resolution_sigmas: float = 2.0
     ratio_model_factor: float = 1.0
     omega2_window: float = 0.05
-    max_deflection_ratio: float = 0.1
+    max_friction_ratio: float = 1.0
+    bent_link_factor: float = 0.6
     max_direction_drift: float = 0.15
     max_ratio_drift: float = 0.02
     min_nyquist_factor: float = 2.0
