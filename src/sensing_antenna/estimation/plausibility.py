@@ -191,12 +191,17 @@ def _statics_problem(
     bent link's on the answer, :meth:`~.front.evidence.Evidence.bent_link_uncertainty`) of the
     answer, as the paper method's fusion asks of its candidate; a method that reads no ratio
     (``two-frequency``) is held to it here. Not judged for ``ratio`` (the answer is a ratio)
-    nor without a settled ratio. Notes ``statics_z`` (the distance in uncertainties).
+    nor before the ratio settled (t_1 + Delta t_e2) at the estimate's t_e. Notes ``statics_z``
+    (the distance in uncertainties).
     """
     x_c = estimate.x_c
     if estimate.method == "ratio" or not math.isfinite(x_c):
         return None
-    reading = float(evidence.ratio_mean[end]) if end < evidence.ratio_mean.shape[0] else math.nan
+    settled = evidence.converged_index
+    if settled is None or settled > end or end >= evidence.ratio_mean.shape[0]:
+        # an answer before the ratio settled (``fast`` stops early) is not judged by it
+        return None
+    reading = float(evidence.ratio_mean[end])
     if not math.isfinite(reading):
         return None
     sigma = math.hypot(evidence.ratio_uncertainty(x_c), evidence.bent_link_uncertainty(x_c))

@@ -194,7 +194,9 @@ class Evidence:
             weight, the weight of the bent link, which is not the free link's the gravity
             model removes: ``ratio_model_factor`` d x_c times the share of the push's
             direction along the vertical (0.7 d x_c measured on the linear simulator at 0.9 m,
-            vertical; nil for a horizontal push, whose bending plane the weight crosses);
+            vertical; nil for a horizontal push, whose bending plane the weight crosses); and
+            a floor, ``ratio_model_floor`` x_c, for what no statics here holds (the contact's
+            own size and compliance, dynamic loads left in the mean);
           - ``statics="small-deflection"`` (Eq. 21 as printed, the ``ratio`` baseline): the
             neglected moments, the axial force times the link's slope and the weight of the
             bent link, ``ratio_model_factor`` d x_c.
@@ -227,7 +229,8 @@ class Evidence:
             )
             vertical = abs(float(self.frame.axes_a[1][2]))
             weight = self.config.ratio_model_factor * deflection_ratio * x_c * vertical
-            model_term = math.hypot(stiffness, weight)
+            floor = self.config.ratio_model_floor * x_c
+            model_term = math.hypot(stiffness, weight, floor)
         noise_term = self.ratio_noise * x_c / link.length
         # in quadrature without squaring (a torque noise of 1e297 N m must not overflow)
         return math.hypot(noise_term, offset_term, model_term)
