@@ -36,7 +36,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import integrate, optimize, special
 
 __all__ = [
     "ElasticaContact",
@@ -94,6 +93,8 @@ def tip_load_cantilever(load: float) -> TipLoadSolution:
     load : float
         alpha = P L^2 / (E I) >= 0.
     """
+    from scipy import optimize, special  # only here: the estimators never need it
+
     if not (math.isfinite(load) and load >= 0.0):
         raise ValueError(f"load must be finite and >= 0, got {load!r}")
     if load == 0.0:
@@ -156,6 +157,8 @@ def shoot_contact(
     max_arc : float, optional
         How far to integrate (m); 3 M_0 / R_perp when None.
     """
+    from scipy import integrate  # only here: the estimators use the table
+
     if not (perpendicular > 0.0 and moment > 0.0 and flexural_rigidity > 0.0):
         return ElasticaContact(math.nan, math.nan, math.nan, math.nan)
     end = 3.0 * moment / perpendicular if max_arc is None else max_arc
@@ -195,7 +198,7 @@ Q_STEP = 0.02
 BETA_STEP = 0.05
 #: Arc-length step of the Runge-Kutta integration, in units of m (global error ~1e-9, far
 #: below the interpolation's).
-_DS = 0.008
+_DS = 0.016
 #: Largest scaled arc length integrated: beyond it M has not vanished (the link curls), NaN.
 _MAX_ARC = 2.0
 
@@ -263,7 +266,7 @@ def elastica_table() -> ElasticaTable:
     """The :class:`ElasticaTable`, built once per process (about 0.3 s on one core).
 
     Scaled by m and E I = 1: x' = cos theta, y' = sin theta, theta' = q (1 - x + beta y), from
-    zero, integrated on every grid point at once by classical Runge-Kutta with step 0.008; the
+    zero, integrated on every grid point at once by classical Runge-Kutta with step 0.016; the
     crossing of M = 1 - x + beta y through zero is placed by the cubic through M and
     M' = -(cos theta - beta sin theta) at the ends of its step, the state there by the same
     cubic (Hermite) on x, y and theta.

@@ -234,7 +234,8 @@ def _friction_problem(
 
     A point contact on the link's side has its normal across the link's tangent there; the
     tangent is the elastica's at x_c under the hold's reaction R (the loaded end of a cantilever
-    of length x_c, :func:`~sensing_antenna.beam.elastica.loaded_end`). At rest the reaction
+    of length x_c, :func:`~sensing_antenna.beam.elastica.loaded_end`; beyond its table the
+    small-deflection slope 3 y_c / (2 x_c), Eq. 9). At rest the reaction
     lies inside the friction cone, |R_t| <= mu R_n (``max_friction_ratio``). Each component of
     the hold's mean reaction carries the tare's standard error and the hold mean's, bounded by
     twice the tare's; the ratio's standard error follows. Notes ``friction_ratio`` (R_t / R_n).
@@ -248,10 +249,11 @@ def _friction_problem(
     across = math.hypot(float(reaction[1]), float(reaction[2]))
     if not across > 0.0:
         return None
-    end = loaded_end(x_c, axial, across, 1.0 / link.bending_compliance)
-    if not math.isfinite(end.slope):
-        return None
-    cos_t, sin_t = math.cos(end.slope), math.sin(end.slope)
+    slope = loaded_end(x_c, axial, across, 1.0 / link.bending_compliance).slope
+    if not math.isfinite(slope):
+        # beyond the elastica's table: the small-deflection slope at the contact, 3 y_c / (2 x_c)
+        slope = math.atan(0.5 * across * x_c**2 * link.bending_compliance)
+    cos_t, sin_t = math.cos(slope), math.sin(slope)
     tangential = axial * cos_t + across * sin_t
     normal = across * cos_t - axial * sin_t
     if not normal > 0.0:
