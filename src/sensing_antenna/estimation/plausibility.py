@@ -17,8 +17,12 @@ forms agree.
    with the push and would admit any reading near the tip) is a contact at the tip measured a
    little long: the contact cannot lie beyond l, so the estimate constrained to the link is l,
    reported so (the method's own value in ``diagnostics["x_c_past_tip"]``, the touched point
-   recomputed at l from the hold's push, and the small-deflection limit judged there as the
-   methods judge it at their own x_c, ``slip_suspected``).
+   recomputed at l from the hold's push).
+   The answer's contact can be at rest: the hold's reaction lies inside a friction cone of
+   ``max_friction_ratio`` about the normal across the link's tangent there (the elastica's;
+   ``slip_suspected``, :func:`_friction_problem`). The answer agrees with the statics: the front
+   end's settled ratio at its t_e lies within ``disagreement_sigmas`` of their uncertainties
+   (``estimators_disagree``; every method but ``ratio``, :func:`_statics_problem`).
 3. A real vibration: the fundamental omega_1 that the method measured, or, for a method that
    measures none (``ratio``), Estimator 1 on the samples from t_1 to t_e, must be a clear peak
    (``no_clear_peak``).

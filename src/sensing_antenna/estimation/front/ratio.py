@@ -1,16 +1,18 @@
 """Estimator 2 (Sections 4.4 and 5.5): the torque/force ratio of the low-pass filtered loads.
 
 Statics of the link (recording convention: F and Gamma are exerted by the link on the head, torque
-about O). With R the reaction of the object on the antenna, applied at the contact point
-r_c = x_c X^m + d (d the static deflection, along R), and W the link weight:
+about O). With R the reaction of the object on the antenna, applied at the contact point r_c, and
+W the link weight:
 
     F = R + W,            Gamma = r_c x R + Gamma_W
 
 so the contact part of the loads is R = F - F_g^m and r_c x R = Gamma - Gamma_g^m (Section 4.2).
-Because d is parallel to R, |Gamma - Gamma_g^m| = x_c |X^m x R| = x_c |R_perp|, where R_perp is the
-part of R perpendicular to the link. Eq. 19 divides by |R| instead, which equals |R_perp| when the
-reaction is normal to the link (the paper's Assumption 4) and underestimates x_c by the factor
-cos(angle) otherwise. The paper method divides by |R_perp| (exact for any axial friction); the
+Where r_c lies follows from the statics of the bent link: the planar elastica loaded at the contact
+alone (:mod:`sensing_antenna.beam.elastica`, :func:`perpendicular_ratio`), which for small
+deflections gives |Gamma - Gamma_g^m| = x_c |R_perp| up to the moment of the axial force through
+the deflection, R_perp the part of R perpendicular to the link. Eq. 19 divides by |R| instead,
+which equals |R_perp| when the reaction is normal to the link (the paper's Assumption 4) and
+underestimates x_c by the factor cos(angle) otherwise. The paper method inverts the elastica; the
 ``ratio`` baseline keeps Eq. 21 as printed.
 
 Filter start. Eq. 21 filters F and Gamma (Eq. 20) and subtracts the gravity terms afterwards.
