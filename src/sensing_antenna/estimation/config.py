@@ -111,8 +111,9 @@ class EstimatorConfig:
         ``slip_suspected``; 3 s is 15 filter time constants.
     disagreement_sigmas : float
         The chosen frequency candidate and the ratio estimate disagree when they are more than
-        this many standard uncertainties of the ratio apart (``Evidence.ratio_uncertainty``:
-        force noise through Eq. 20, residual sensor offset, small-deflection model). 3: a
+        this many standard uncertainties apart (``Evidence.ratio_uncertainty``: force noise
+        through Eq. 20, residual sensor offset, statics model; with the candidate's
+        ``Evidence.bent_link_uncertainty``). 3: a
         Gaussian exceeds 3 sigma with probability 0.27 %, and the model term is an upper bound
         (noise-free simulator: 0.7 of it at x_c = 0.9 m, vertical). With 4, a 7 % error of T
         (x_c = 0.266 m for 0.299 m, ratio 0.299 m +- 0.95 cm) passed as ok.
@@ -121,10 +122,14 @@ class EstimatorConfig:
         standard uncertainties closer to one than to the other; otherwise the second mode
         decides if it is clear. 2 (a wrong choice with probability about 2 % on a Gaussian).
     ratio_model_factor : float
-        Coefficient of the small-deflection model term of the ratio uncertainty,
-        factor (y_c / x_c) x_c: the neglected moments are the axial force times the link's
-        slope (1.5 y_c / x_c, Eq. 9, times R_x / R_perp up to the friction coefficient 0.6)
-        and the weight of the bent link; 1.0 bounds 1.5 x 0.6 = 0.9.
+        Coefficient of the model term factor (y_c / x_c) x_c of the ratio uncertainty
+        (``Evidence.ratio_uncertainty``). For Eq. 21 as printed (the ``ratio`` baseline) the
+        neglected moments are the axial force times the link's slope (1.5 y_c / x_c, Eq. 9,
+        times R_x / R_perp up to the friction coefficient 0.6) and the weight of the bent link;
+        1.0 bounds 1.5 x 0.6 = 0.9. For the elastica's statics (the front end's ratio) only the
+        bent link's weight remains, in a bending plane that holds it: the term is scaled by the
+        push direction's vertical share (0.7 of it measured on the linear simulator at 0.9 m,
+        vertical).
     ratio_model_floor : float
         Relative floor of the elastica statics' model term of the ratio uncertainty
         (``Evidence.ratio_uncertainty``): what no statics here holds, the contact's own size
