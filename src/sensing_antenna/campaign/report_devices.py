@@ -136,6 +136,17 @@ def _preparation_text(summary: CampaignSummary) -> str:
     )
 
 
+def _spread_text(spec: CampaignSpec) -> str:
+    if spec.device.profile != "realistic" or not spec.calibration.enabled:
+        return ""
+    return (
+        " The realistic profile draws one device per manoeuvre, so each calibration recording "
+        "of the main device is a draw of its own (its seed on the calibration's stream): its "
+        "T_e is fitted over the spread, taking up its mean effect on omega_1, and its scatter "
+        "measures the spread (docs/campaigns.md, Second device)."
+    )
+
+
 def devices_section(
     spec: CampaignSpec, summary: CampaignSummary, figure: Path | None, out_dir: Path
 ) -> list[str]:
@@ -158,8 +169,8 @@ def devices_section(
         f"**{second}** instead of **{first}** (docs/simulator.md), the same manoeuvres and "
         "seeds (so the same sensor noise), and a preparation of its own, made as the main "
         f"device's is, with the same seeds: {identify}T_e calibrated on its own recordings. "
-        f"{_preparation_text(summary)} The sections above cover the main device ({first}) "
-        "only.",
+        f"{_preparation_text(summary)}{_spread_text(spec)} The sections above cover the main "
+        f"device ({first}) only.",
         "",
         "Per case and method: `ok` runs, runs with an estimate, the mean / max absolute error "
         "and the standard deviation of the error over every estimate (any status), the same "
