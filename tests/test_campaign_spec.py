@@ -588,3 +588,16 @@ def test_bad_second_device_fields_are_named_with_the_file(
     path = write(tmp_path, SECOND + section + "\n")
     with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: {field}:")):
         load_campaign_spec(path)
+
+
+def test_runs_a_second_device_adds_over_the_limit_are_refused_naming_it(tmp_path: Path) -> None:
+    repeats = MAX_RUNS // 2 + 1  # the main runs fit, with the second device's they do not
+    text = GOOD.replace("contact_points = [0.3, 0.5]", "contact_points = [0.3]").replace(
+        "repeats = 2", f"repeats = {repeats}"
+    )
+    path = write(tmp_path, text + "[second_device]\n")
+    message = f"{2 * repeats} runs ({repeats} main, 0 in the noise sweep, {repeats} on the second"
+    with pytest.raises(
+        CampaignSpecError, match=re.escape(f"{path}: second_device: ") + ".*" + re.escape(message)
+    ):
+        load_campaign_spec(path)

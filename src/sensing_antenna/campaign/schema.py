@@ -520,9 +520,11 @@ class CampaignSpec:
         if self.base_seed < 0:
             raise CampaignSpecError("base_seed", f"must be >= 0, got {self.base_seed!r}", src)
         if problem := limits.runs_problem(
-            self.n_main_runs + self.n_second_device_runs, self.n_sweep_runs
+            self.n_main_runs, self.n_sweep_runs, self.n_second_device_runs
         ):
             field_name = "repeats" if self.n_main_runs > limits.MAX_RUNS else "noise_sweep"
+            if self.n_main_runs + self.n_sweep_runs <= limits.MAX_RUNS:
+                field_name = "second_device"
             raise CampaignSpecError(field_name, problem, src)
         duration = self.scenario.get("duration")
         if duration is not None and (problem := duration_problem(duration)):
