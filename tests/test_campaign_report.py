@@ -35,6 +35,7 @@ from sensing_antenna.campaign.tables import (
     paper_row_at,
     paper_table,
     point_table,
+    run_points,
 )
 from sensing_antenna.campaign.targets import Target, target_summary
 from sensing_antenna.estimation import ContactEstimate
@@ -573,3 +574,12 @@ def test_without_a_second_device_the_report_has_no_device_section(campaign_dir: 
     text = build_report(campaign_dir).read_text("utf-8")
     assert "Both devices" not in text and "errors-by-device" not in text
     assert not (campaign_dir / "figures" / "errors-by-device.png").exists()
+
+
+def test_run_points_say_which_runs_are_ok(campaign_dir: Path) -> None:
+    rows = stored_rows(campaign_dir, ("paper", "ratio"))
+    ratio = run_points(rows, "vertical", "ratio")
+    # x_c = 0.3 m: ok, 3 cm off; x_c = 0.5 m: no_contact, no estimate (toy_run)
+    assert ratio.ok is not None
+    assert ratio.ok.tolist() == [x == 0.3 for x in ratio.x_c]
+    assert np.isnan(ratio.estimate[~ratio.ok]).all()
