@@ -19,6 +19,7 @@ from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.campaign import (
     CampaignRow,
     CampaignSpec,
+    DeviceSpec,
     NoiseSweep,
     RunResult,
     RunSpec,
@@ -26,6 +27,7 @@ from sensing_antenna.campaign import (
     load_run_results,
     run_campaign,
 )
+from sensing_antenna.campaign.schema import SecondDevice
 from sensing_antenna.campaign.summary import campaign_rows
 from sensing_antenna.campaign.tables import (
     interval_summaries,
@@ -33,6 +35,7 @@ from sensing_antenna.campaign.tables import (
     paper_row_at,
     paper_table,
     point_table,
+    run_points,
 )
 from sensing_antenna.campaign.targets import Target, target_summary
 from sensing_antenna.estimation import ContactEstimate
@@ -504,3 +507,79 @@ def test_the_frequency_figure_promises_a_bound_only_when_it_draws_one(
     titles = drawn.texts("frequency-error-vs-noise.png")
     assert "Frequency error against noise, beside the Cramer-Rao bound reported by fast" in titles
     assert "fast: CRB (median)" in titles
+
+
+def _two_device_run(run: RunSpec) -> RunResult:
+    """Main device (realistic imperfections in the scenario): paper off by 5 cm, status
+    model_mismatch, on every run; second device (none): :func:`toy_paper`, ok; ratio 3 cm off
+    and ``uncertain`` on both."""
+    ratio = ContactEstimate(
+        status="uncertain", reason="wide", method="ratio", x_c=run.contact_point + RATIO_OFFSET
+    )
+    if "device" in run.scenario:
+        paper = ContactEstimate(
+            status="model_mismatch", reason="weight", method="paper", x_c=run.contact_point + 0.05
+        )
+    else:
+        paper = toy_paper(run)
+    return result_of(run, [paper, ratio], contact_abscissa=run.contact_point)
+
+
+def test_a_second_device_is_reported_beside_the_main_one_and_the_paper(tmp_path: Path) -> None:
+    two = dataclasses.replace(
+        spec(),
+        device=DeviceSpec(profile="realistic"),
+        second_device=SecondDevice(enabled=True),
+    )
+    calls: list[CampaignSpec] = []
+
+    def prepare(given: CampaignSpec) -> Antenna:
+        calls.append(given)
+        return paper_antenna()
+
+    run_campaign(
+        two, tmp_path, run_one=_two_device_run, prepare_antenna=prepare, workers=1, progress=False
+    )
+    # one preparation per device, the second for the second device's own campaign
+    assert calls == [two, two.second_device_spec()]
+    assert (tmp_path / "second_device" / "antenna.toml").is_file()
+    text = build_report(tmp_path).read_text("utf-8")
+    assert (
+        "Runs stored: 24 of 24; failed: 0 (12 main runs at noise 1, 12 on the second device)"
+        in text
+    )
+    # the main sections keep the main device's runs only: no run ok there
+    assert "| case | method | model_mismatch | uncertain |\n|---|---|---|---|\n" in text
+    assert "| azimuthal | paper | 6 | 0 |" in text
+    assert "## Both devices beside Tables 3 and 4" in text
+    # per case and method: realistic 0/6 ok, 5 cm off on every run (std 0); nominal 6/6 ok,
+    # errors +1, -2, +4 mm at each of 2 points: mean 0.23, max 0.40, std 0.27 cm
+    errors = np.array(PAPER_OFFSETS * 2)
+    std = f"{100 * np.std(errors, ddof=1):.2f}"
+    assert (
+        "| azimuthal | **paper** | 0/6 | 6/6 | 5.00 / 5.00 / 0.00 | - / - | model_mismatch 6 "
+        f"| 6/6 | 6/6 | 0.23 / 0.40 / {std} | 0.23 / 0.40 | ok 6 |"
+    ) in text
+    assert "| vertical | ratio | 0/6 | 6/6 | 3.00 / 3.00 / 0.00 | - / - | uncertain 6 |" in text
+    # per point beside Table 3 (x_c = 30 cm: the paper's 30.5, 0.5, 0.7, 0.20 cm)
+    assert (
+        "| 30 | 35.00 | 5.00 | 5.00 | 0.00 | 0/3 | 30.10 | 0.23 | 0.40 | 0.30 | 3/3 "
+        "| 30.5 | 0.5 | 0.7 | 0.20 |"
+    ) in text
+    figure = tmp_path / "figures" / "errors-by-device.png"
+    assert figure.is_file() and "(figures/errors-by-device.png)" in text
+
+
+def test_without_a_second_device_the_report_has_no_device_section(campaign_dir: Path) -> None:
+    text = build_report(campaign_dir).read_text("utf-8")
+    assert "Both devices" not in text and "errors-by-device" not in text
+    assert not (campaign_dir / "figures" / "errors-by-device.png").exists()
+
+
+def test_run_points_say_which_runs_are_ok(campaign_dir: Path) -> None:
+    rows = stored_rows(campaign_dir, ("paper", "ratio"))
+    ratio = run_points(rows, "vertical", "ratio")
+    # x_c = 0.3 m: ok, 3 cm off; x_c = 0.5 m: no_contact, no estimate (toy_run)
+    assert ratio.ok is not None
+    assert ratio.ok.tolist() == [x == 0.3 for x in ratio.x_c]
+    assert np.isnan(ratio.estimate[~ratio.ok]).all()

@@ -24,7 +24,7 @@ from sensing_antenna.campaign.records import RUN_FAILED, RUN_OK, CampaignRow, Ru
 from sensing_antenna.campaign.report import build_report
 from sensing_antenna.campaign.runner import CampaignOutcome, execute_safely, run_campaign
 from sensing_antenna.campaign.runs import RunSpec, expand_runs
-from sensing_antenna.campaign.schema import CampaignSpec
+from sensing_antenna.campaign.schema import CampaignSpec, SecondDevice
 from sensing_antenna.campaign.store import CampaignStoreError, campaign_lock, load_run_results
 from sensing_antenna.estimation import ContactEstimate
 
@@ -376,3 +376,44 @@ def test_a_stop_signal_whose_exception_was_lost_stops_the_campaign_at_the_next_r
         progress=False,
     )
     assert outcome.n_previously_done == 3
+
+
+def test_a_second_device_is_prepared_once_and_resumes_with_its_stored_preparation(
+    tmp_path: Path,
+) -> None:
+    spec = small_spec(second_device=SecondDevice(enabled=True))
+    calls: list[CampaignSpec] = []
+
+    def prepare(given: CampaignSpec) -> Antenna:
+        calls.append(given)
+        return paper_antenna()
+
+    class Stop(BaseException):
+        pass
+
+    done = 0
+
+    def stop_after_three(run: RunSpec) -> RunResult:
+        nonlocal done
+        if done == 3:
+            raise Stop
+        done += 1
+        return noisy_run(run)
+
+    with pytest.raises(Stop):
+        run_campaign(
+            spec,
+            tmp_path,
+            run_one=stop_after_three,
+            prepare_antenna=prepare,
+            workers=1,
+            progress=False,
+        )
+    assert calls == [spec, spec.second_device_spec()]
+    outcome = run_campaign(
+        spec, tmp_path, run_one=noisy_run, prepare_antenna=prepare, workers=1, progress=False
+    )
+    assert calls == [spec, spec.second_device_spec()]  # both preparations reused
+    assert (outcome.n_runs, outcome.n_previously_done, outcome.n_executed) == (24, 3, 21)
+    ids = [row["run_id"] for row in read_rows(outcome.csv_path)][::2]
+    assert ids[12:] == [f"{run_id}-d2" for run_id in ids[:12]]

@@ -503,3 +503,101 @@ def test_durations_longer_than_a_recording_may_be_are_refused(
         CampaignSpecError, match=rf"{re.escape(field)}: 1000000000.0 s is more than 600 s"
     ):
         load_campaign_spec(path)
+
+
+SECOND = GOOD + '[device]\nprofile = "realistic"\n[second_device]\n'
+
+
+def test_a_second_device_repeats_the_main_runs_with_their_seeds_after_the_others(
+    tmp_path: Path,
+) -> None:
+    spec = load_campaign_spec(write(tmp_path, SECOND + "[noise_sweep]\nnoise_scales = [2.0]\n"))
+    # main: 1 case x 2 points x 2 repeats; sweep: 4 more; second device: the 4 main again
+    assert (spec.n_main_runs, spec.n_sweep_runs, spec.n_second_device_runs) == (4, 4, 4)
+    assert spec.n_runs == 12
+    model, hardware = paper_antenna(), replace(paper_antenna(), name="second")
+    runs = expand_runs(spec, paper_antenna(), second_model=model, second_device=hardware)
+    main, sweep, second = runs[:4], runs[4:8], runs[8:]
+    # the main and sweep runs are what they are without a second device
+    without = load_campaign_spec(
+        write(
+            tmp_path,
+            GOOD + '[device]\nprofile = "realistic"\n[noise_sweep]\nnoise_scales = [2.0]\n',
+        )
+    )
+    assert [(r.run_id, r.seed, dict(r.scenario)) for r in main + sweep] == [
+        (r.run_id, r.seed, dict(r.scenario)) for r in expand_runs(without, paper_antenna())
+    ]
+    assert [r.index for r in runs] == list(range(12))
+    # same manoeuvres and seeds as the main runs, ids with the suffix, the second device's
+    # antennas, and no imperfections (profile nominal) where the main runs draw them
+    assert [r.run_id for r in second] == [f"{r.run_id}-d2" for r in main]
+    assert [(r.case, r.contact_point, r.repeat, r.seed) for r in second] == [
+        (r.case, r.contact_point, r.repeat, r.seed) for r in main
+    ]
+    assert all(r.antenna is model and r.device is hardware for r in second)
+    assert all("device" in r.scenario for r in main)
+    assert all("device" not in r.scenario for r in second)
+
+
+def test_a_second_device_with_its_own_imperfections_draws_them(tmp_path: Path) -> None:
+    text = GOOD + '[second_device]\nprofile = "realistic"\nimperfections.tip_mass = 2e-5\n'
+    spec = load_campaign_spec(write(tmp_path, text))
+    runs = expand_runs(spec, paper_antenna())
+    assert all("device" not in r.scenario for r in runs[:4])
+    drawn = [r.scenario["device"] for r in runs[4:]]
+    assert all(d.tip_mass == 2e-5 for d in drawn)
+    assert len({d.clamp_stiffness for d in drawn}) == 4  # one draw per manoeuvre, by its seed
+
+
+def test_the_second_device_is_in_the_fingerprint_only_when_present(tmp_path: Path) -> None:
+    base = GOOD + '[device]\nprofile = "realistic"\n'
+    plain = load_campaign_spec(write(tmp_path, base))
+    second = load_campaign_spec(write(tmp_path, SECOND))
+    dropped = load_campaign_spec(write(tmp_path, SECOND + "enabled = false\n"))
+    assert "second_device" not in plain.to_dict()  # stored campaigns without one still resume
+    assert dropped == replace(plain, source=dropped.source)
+    assert plain.fingerprint() == dropped.fingerprint() != second.fingerprint()
+    assert plain.preparation_fingerprint() == second.preparation_fingerprint()
+    from sensing_antenna.campaign.parsing import parse_campaign_spec
+
+    assert parse_campaign_spec(second.to_dict(), "copy") == replace(second, source="copy")
+    # the second device's own campaign: its preparation is that of the nominal device
+    nominal = load_campaign_spec(write(tmp_path, GOOD))
+    alone = second.second_device_spec()
+    assert alone.preparation_fingerprint() == nominal.preparation_fingerprint()
+    assert alone.fingerprint() == nominal.fingerprint()
+    with pytest.raises(CampaignSpecError, match="second_device: the spec has no second device"):
+        plain.second_device_spec()
+
+
+@pytest.mark.parametrize(
+    ("section", "field"),
+    [
+        ('profile = "sloppy"', "second_device.profile"),
+        ("profile = 3", "second_device.profile"),
+        ("imperfections.tip_mass = -1.0", "second_device.imperfections.tip_mass"),
+        ("imperfections = 2", "second_device.imperfections"),
+        ('antenna = "paper-2021"', "second_device.antenna"),
+        ('enabled = "yes"', "second_device.enabled"),
+    ],
+)
+def test_bad_second_device_fields_are_named_with_the_file(
+    tmp_path: Path, section: str, field: str
+) -> None:
+    path = write(tmp_path, SECOND + section + "\n")
+    with pytest.raises(CampaignSpecError, match=re.escape(f"{path}: {field}:")):
+        load_campaign_spec(path)
+
+
+def test_runs_a_second_device_adds_over_the_limit_are_refused_naming_it(tmp_path: Path) -> None:
+    repeats = MAX_RUNS // 2 + 1  # the main runs fit, with the second device's they do not
+    text = GOOD.replace("contact_points = [0.3, 0.5]", "contact_points = [0.3]").replace(
+        "repeats = 2", f"repeats = {repeats}"
+    )
+    path = write(tmp_path, text + "[second_device]\n")
+    message = f"{2 * repeats} runs ({repeats} main, 0 in the noise sweep, {repeats} on the second"
+    with pytest.raises(
+        CampaignSpecError, match=re.escape(f"{path}: second_device: ") + ".*" + re.escape(message)
+    ):
+        load_campaign_spec(path)

@@ -92,6 +92,8 @@ class RunPoints:
         t_e - t_1, how long after the push the estimate was available (s).
     omega1 : array
         Measured fundamental frequency (rad/s).
+    ok : array of bool or None
+        Whether each run's status is ``ok``; None when not recorded.
     """
 
     case: str
@@ -101,6 +103,7 @@ class RunPoints:
     error: NDArray[np.float64]
     delay: NDArray[np.float64]
     omega1: NDArray[np.float64]
+    ok: NDArray[np.bool_] | None = None
 
 
 @dataclass(frozen=True)

@@ -9,9 +9,10 @@ Modules, in the order a campaign goes through them:
   processes) and :mod:`.progress` (what it tells the person waiting), :mod:`.store` (the
   campaign directory);
 - :mod:`.records` (:class:`CampaignRow`, one run x method, from estimate to file to table);
-- :mod:`.tables` and :mod:`.targets` (statistics of the rows), :mod:`.summary` (every number
-  the report shows), :mod:`.report` with :mod:`.report_sections` and :mod:`.figures` (the
-  report, formatting only).
+- :mod:`.tables`, :mod:`.targets` and :mod:`.devices` (statistics of the rows; two devices
+  side by side), :mod:`.summary` (every number the report shows), :mod:`.report` with
+  :mod:`.report_sections`, :mod:`.report_devices` and :mod:`.figures` (the report, formatting
+  only).
 
 The names below are imported lazily, so ``import sensing_antenna.campaign`` stays cheap.
 """

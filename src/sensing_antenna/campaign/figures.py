@@ -3,7 +3,8 @@
 Which figures a campaign gets: the error of every method against x_c; with ``fast`` among the
 methods, the error and t_e - t_1 of every run; Figures 16 and 17 per case for the paper method
 (else the first); Figure 18 when the paper method ran; Figure 10 after a calibration; with a
-noise sweep, the omega_1 error against the noise level.
+noise sweep, the omega_1 error against the noise level; with a second device, the error of every
+run against x_c on both devices.
 """
 
 from __future__ import annotations
@@ -29,11 +30,14 @@ class ReportFigures:
         Figure 10, when the campaign calibrated.
     noise : Path or None
         omega_1 error against the noise level, when the campaign has a noise sweep.
+    devices : Path or None
+        Every run's error against x_c on both devices, when the campaign has a second device.
     """
 
     campaign: tuple[Path, ...] = ()
     calibration: Path | None = None
     noise: Path | None = None
+    devices: Path | None = None
 
 
 def draw_figures(
@@ -54,6 +58,7 @@ def draw_figures(
     from sensing_antenna.plotting.campaign import (
         plot_case_estimates,
         plot_error_and_delay,
+        plot_errors_by_device,
         plot_frequencies,
         plot_frequency_error_vs_noise,
         plot_method_errors,
@@ -78,4 +83,9 @@ def draw_figures(
     noise = None
     if summary.frequency:
         noise = plot_frequency_error_vs_noise(summary.frequency, out_dir)
-    return ReportFigures(tuple(paths), calibration, noise)
+    devices = None
+    if summary.devices is not None:
+        devices = plot_errors_by_device(
+            summary.devices.labels, summary.devices.run_points, summary.paper_tables, out_dir
+        )
+    return ReportFigures(tuple(paths), calibration, noise, devices)

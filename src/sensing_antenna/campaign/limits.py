@@ -34,14 +34,16 @@ MAX_CALIBRATION_RECORDINGS = 1_000
 _SEE = "see docs/campaigns.md, Limits"
 
 
-def runs_problem(n_main: int, n_sweep: int) -> str | None:
-    """Too many runs (:data:`MAX_RUNS`)?"""
-    if n_main + n_sweep <= MAX_RUNS:
+def runs_problem(n_main: int, n_sweep: int, n_second: int = 0) -> str | None:
+    """Too many runs (:data:`MAX_RUNS`)? ``n_second``: runs on a second device."""
+    n = n_main + n_sweep + n_second
+    if n <= MAX_RUNS:
         return None
+    second = f", {n_second} on the second device" if n_second else ""
     return (
-        f"the campaign would have {n_main + n_sweep} runs ({n_main} main, {n_sweep} in the noise "
-        f"sweep), more than the {MAX_RUNS} a campaign may have (every run is held in memory to "
-        f"resume and to report; {_SEE}); split it into several campaigns"
+        f"the campaign would have {n} runs ({n_main} main, {n_sweep} in the noise "
+        f"sweep{second}), more than the {MAX_RUNS} a campaign may have (every run is held in "
+        f"memory to resume and to report; {_SEE}); split it into several campaigns"
     )
 
 

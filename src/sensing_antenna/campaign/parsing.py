@@ -37,6 +37,10 @@ A spec file looks like::
     repeats = 1                     # default: the main repeats
     cases = ["azimuthal"]           # default: the main cases
 
+    [second_device]                 # optional: the main runs again on a second device
+    profile = "nominal"             # the [device] hardware with these imperfections instead
+    imperfections.tip_mass = 1e-4   # (default: none); enabled = false drops a base's section
+
 Or a file starts from another campaign and changes some fields, as antenna files do::
 
     base = "default"                # the built-in campaign (also "paper-2021"), or a spec file
@@ -67,6 +71,7 @@ from sensing_antenna.campaign.schema import (
     DeviceSpec,
     FreeMotionStep,
     NoiseSweep,
+    SecondDevice,
 )
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
@@ -100,9 +105,11 @@ _TOP_LEVEL_KEYS = (
     "device",
     "calibration",
     "noise_sweep",
+    "second_device",
 )
 
 _NOISE_SWEEP_KEYS = ("noise_scales", "contact_points", "repeats", "cases")
+_SECOND_DEVICE_KEYS = ("enabled", "profile", "imperfections")
 
 
 def load_campaign_spec(path: str | Path | None = None) -> CampaignSpec:
@@ -255,6 +262,7 @@ def _build(data: Mapping[str, Any], source: str, base_dir: Path | None) -> Campa
     device = _parse_device(data.get("device", {}), source, base_dir)
     calibration = _parse_calibration(data.get("calibration", {}), source)
     noise_sweep = _parse_noise_sweep(data.get("noise_sweep", {}), source)
+    second_device = _parse_second_device(data.get("second_device"), source)
     try:
         free_step = FreeMotionStep(
             identify=identify, duration=float(duration), case=str(free.get("case", "free"))
@@ -273,6 +281,7 @@ def _build(data: Mapping[str, Any], source: str, base_dir: Path | None) -> Campa
             device=device,
             calibration=calibration,
             noise_sweep=noise_sweep,
+            second_device=second_device,
             source=source,
         )
     except CampaignSpecError as exc:
@@ -418,6 +427,41 @@ def _parse_noise_sweep(data: Any, source: str) -> NoiseSweep:
         cases = tuple(raw)
     try:
         return NoiseSweep(noise_scales=scales, contact_points=points, repeats=repeats, cases=cases)
+    except CampaignSpecError as exc:
+        raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
+
+
+def _parse_second_device(data: Any, source: str) -> SecondDevice:
+    """``[second_device]``: present means enabled (unless ``enabled = false``)."""
+    if data is None:
+        return SecondDevice()
+    if not isinstance(data, Mapping):
+        raise CampaignSpecError("second_device", "must be a table", source)
+    for key in data:
+        if key not in _SECOND_DEVICE_KEYS:
+            raise CampaignSpecError(
+                f"second_device.{key}",
+                f"unknown key; known: {', '.join(_SECOND_DEVICE_KEYS)} (the hardware is "
+                "[device]'s)",
+                source,
+            )
+    enabled = data.get("enabled", True)
+    if not isinstance(enabled, bool):
+        raise CampaignSpecError("second_device.enabled", "must be true or false", source)
+    if not enabled:
+        return SecondDevice()
+    profile = data.get("profile", "nominal")
+    if not isinstance(profile, str):
+        raise CampaignSpecError("second_device.profile", "must be a string", source)
+    imperfections = data.get("imperfections", {})
+    if not isinstance(imperfections, Mapping):
+        raise CampaignSpecError(
+            "second_device.imperfections",
+            "must be a table of fields (e.g. imperfections.tip_mass = 1e-4)",
+            source,
+        )
+    try:
+        return SecondDevice(enabled=True, profile=profile, imperfections=dict(imperfections))
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc
 

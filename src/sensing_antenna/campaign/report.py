@@ -14,6 +14,7 @@ from pathlib import Path
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.figures import ReportFigures, draw_figures
+from sensing_antenna.campaign.report_devices import devices_section
 from sensing_antenna.campaign.report_sections import (
     case_section,
     cm,
@@ -34,6 +35,7 @@ from sensing_antenna.campaign.store import (
     CSV_FILE,
     DEVICE_FILE,
     RUNS_DIR,
+    SECOND_DEVICE_DIR,
     CampaignStoreError,
     atomic_write_text,
     load_campaign_results,
@@ -241,19 +243,20 @@ def _settings_lines(
     foreign: Sequence[str],
 ) -> list[str]:
     obs = model.observer
+    second = summary.second_device
+    n_results = summary.n_results + (second.n_results if second is not None else 0)
+    n_failed = summary.n_failed + (second.n_failed if second is not None else 0)
+    parts = []
+    if spec.noise_sweep.enabled or second is not None:
+        parts.append(f"{spec.n_main_runs} main runs at noise {level(spec.noise_scale)}")
+    if spec.noise_sweep.enabled:
+        parts.append(f"{spec.n_sweep_runs} in the noise sweep")
+    if second is not None:
+        parts.append(f"{spec.n_second_device_runs} on the second device")
     return [
-        f"- Runs stored: {summary.n_results} of {spec.n_runs}; failed: {summary.n_failed}"
-        + (
-            f" ({spec.n_main_runs} main runs at noise {level(spec.noise_scale)}, "
-            f"{spec.n_sweep_runs} in the noise sweep)"
-            if spec.noise_sweep.enabled
-            else ""
-        )
-        + (
-            ""
-            if summary.n_results == spec.n_runs
-            else " (campaign incomplete: run it again to finish)"
-        ),
+        f"- Runs stored: {n_results} of {spec.n_runs}; failed: {n_failed}"
+        + (f" ({', '.join(parts)})" if parts else "")
+        + ("" if n_results == spec.n_runs else " (campaign incomplete: run it again to finish)"),
         *_left_out_lines(foreign),
         f"- Cases: {', '.join(spec.cases)}; repeats: {spec.repeats}; base seed: {spec.base_seed}",
         "- Contact points (cm): " + ", ".join(cm(x, 0) for x in spec.contact_points),
@@ -327,6 +330,7 @@ def render_report(
         *interval_section(summary.intervals),
         *targets_section(summary.targets),
         *noise_section(spec, summary, figures.noise, where),
+        *devices_section(spec, summary, figures.devices, where),
         "## Figures",
         "",
         "Main runs only (noise level of `[scenario]`).",
@@ -336,7 +340,10 @@ def render_report(
         lines += figure_lines(path, where)
     for table in summary.cases:
         lines += case_section(table)
-    lines += failures_section(summary.failed)
+    failed = summary.failed
+    if summary.second_device is not None:
+        failed += summary.second_device.failed
+    lines += failures_section(failed)
     return "\n".join(lines).rstrip() + "\n"
 
 
@@ -366,7 +373,23 @@ def build_report(out_dir: str | Path, *, figures: bool = True) -> Path:
     stored = load_campaign_results(directory, spec)
     results = list(stored.results.values())
     write_runs_csv(directory / CSV_FILE, results)
-    summary = summarize_campaign(spec, results, model, device, calibration)
+    second_model = second_device = second_calibration = None
+    if spec.second_device.enabled:
+        folder = directory / SECOND_DEVICE_DIR
+        second_model = read_stored_antenna(folder)
+        second_device = read_stored_device(folder) or second_model
+        kept = read_calibration(folder)
+        second_calibration = kept[1] if kept is not None else None
+    summary = summarize_campaign(
+        spec,
+        results,
+        model,
+        device,
+        calibration,
+        second_model=second_model,
+        second_device=second_device,
+        second_calibration=second_calibration,
+    )
     drawn = (
         draw_figures(summary, spec.methods, model, directory / FIGURES_DIR)
         if figures

@@ -33,6 +33,7 @@ from sensing_antenna.campaign.runs import RunSpec, expand_runs
 from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.store import (
     CSV_FILE,
+    SECOND_DEVICE_DIR,
     Preparation,
     campaign_lock,
     load_campaign_results,
@@ -236,7 +237,8 @@ def run_campaign(
         used as both device and model). Default
         :func:`~sensing_antenna.campaign.simulated.prepare_campaign`: loads the model and the
         device, identifies the free-motion observer on the device and calibrates T_e, as the
-        spec asks.
+        spec asks. With a second device it is called again with
+        ``spec.second_device_spec()`` (stored in ``out_dir/second_device``).
     workers : int, optional
         Local worker processes; default all cores. 1 runs inline in this process.
     scheduler : str, optional
@@ -269,6 +271,8 @@ def run_campaign(
     else:
         prepare = prepare_antenna
     sweep = f", {spec.n_sweep_runs} in the noise sweep" if spec.n_sweep_runs else ""
+    if spec.n_second_device_runs:
+        sweep += f", {spec.n_second_device_runs} on the second device"
     report.line(
         f"campaign {spec.name}: {spec.n_runs} runs ({spec.n_main_runs} main{sweep}) x "
         f"{len(spec.methods)} method(s) ({', '.join(spec.methods)}), in {directory}"
@@ -281,7 +285,19 @@ def run_campaign(
                 remove_stale_temp_files(directory)
                 write_manifest(directory, spec)
                 preparation = _prepared(directory, spec, prepare, report)
-                runs = expand_runs(spec, preparation.model, preparation.device)
+                second = preparation
+                if spec.second_device.enabled:
+                    report.line("preparation of the second device:")
+                    folder = directory / SECOND_DEVICE_DIR
+                    folder.mkdir(exist_ok=True)
+                    second = _prepared(folder, spec.second_device_spec(), prepare, report)
+                runs = expand_runs(
+                    spec,
+                    preparation.model,
+                    preparation.device,
+                    second_model=second.model,
+                    second_device=second.device,
+                )
                 done = load_campaign_results(directory, spec).results
                 if retry_failed:
                     done = {k: v for k, v in done.items() if v.status != RUN_FAILED}

@@ -16,6 +16,7 @@ import numpy as np
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.schema import (
     SCENARIO_NOISE_SCALE,
+    SECOND_DEVICE_SUFFIX,
     CampaignSpec,
     CampaignSpecError,
     contact_point_key,
@@ -35,6 +36,7 @@ __all__ = [
     "expand_runs",
     "plan_runs",
     "run_ids",
+    "second_device_run_ids",
     "with_device",
 ]
 
@@ -144,6 +146,8 @@ class PlannedRun:
         Position within that stream.
     scenario : mapping
         The run's extra ``simulator.Scenario`` fields.
+    second_device : bool
+        Whether the run is on the spec's second device.
     """
 
     index: int
@@ -154,6 +158,7 @@ class PlannedRun:
     stream: int
     position: int
     scenario: Mapping[str, Any]
+    second_device: bool = False
 
 
 def plan_runs(spec: CampaignSpec) -> Iterator[PlannedRun]:
@@ -187,6 +192,19 @@ def plan_runs(spec: CampaignSpec) -> Iterator[PlannedRun]:
                     )
                     index += 1
                     position += 1
+    if spec.second_device.enabled:
+        for main in plan_runs(spec.second_device_spec()):
+            yield PlannedRun(
+                index + main.index,
+                main.run_id + SECOND_DEVICE_SUFFIX,
+                main.case,
+                main.contact_point,
+                main.repeat,
+                main.stream,
+                main.position,
+                main.scenario,
+                second_device=True,
+            )
 
 
 def run_ids(spec: CampaignSpec) -> list[str]:
@@ -209,16 +227,28 @@ def run_ids(spec: CampaignSpec) -> list[str]:
     return list(ids)
 
 
+def second_device_run_ids(spec: CampaignSpec) -> frozenset[str]:
+    """The ids of the runs on the spec's second device (empty without one)."""
+    return frozenset(run.run_id for run in plan_runs(spec) if run.second_device)
+
+
 def expand_runs(
-    spec: CampaignSpec, antenna: Antenna, device: Antenna | None = None
+    spec: CampaignSpec,
+    antenna: Antenna,
+    device: Antenna | None = None,
+    *,
+    second_model: Antenna | None = None,
+    second_device: Antenna | None = None,
 ) -> list[RunSpec]:
     """All runs of a campaign in a fixed order: case, then contact point, then repeat.
 
     The main runs come first; then, if the spec has a noise sweep, its runs ordered by level,
     case, contact point and repeat, with ids ending in ``-n<level>`` and seeds from
-    :data:`NOISE_SWEEP_STREAM` (position within the sweep). Adding a sweep leaves the main runs'
-    indices, ids and seeds as they are. Run ids name the contact point with
-    :func:`contact_point_label`.
+    :data:`NOISE_SWEEP_STREAM` (position within the sweep); then, if the spec has a second
+    device, the main runs again on it, with the main runs' seeds and ids ending in
+    :data:`~sensing_antenna.campaign.schema.SECOND_DEVICE_SUFFIX`. Adding a sweep or a second
+    device leaves the main runs' indices, ids and seeds as they are. Run ids name the contact
+    point with :func:`contact_point_label`.
 
     Parameters
     ----------
@@ -229,6 +259,10 @@ def expand_runs(
     device : Antenna, optional
         The simulated hardware; None simulates with ``antenna``. Its imperfections (the spec's
         ``[device]`` profile and table) go into each run's scenario (:func:`with_device`).
+    second_model, second_device : Antenna, optional
+        The model and hardware of the second device's runs (its own preparation); None: those
+        of the main runs. The second device's imperfections are the spec's
+        ``[second_device]``'s.
 
     Raises
     ------
@@ -236,10 +270,16 @@ def expand_runs(
         When two runs would share an id (see :func:`run_ids`).
     """
     run_ids(spec)
-    length = (device or antenna).link.length
+    second_spec = spec.second_device_spec() if spec.second_device.enabled else spec
     runs = []
     for run in plan_runs(spec):
         seed = derive_seed(spec.base_seed, run.position, run.stream)
+        model, hardware, own = antenna, device, spec
+        if run.second_device:
+            model = second_model or antenna
+            hardware = second_device or device
+            own = second_spec
+        length = (hardware or model).link.length
         runs.append(
             RunSpec(
                 index=run.index,
@@ -248,10 +288,10 @@ def expand_runs(
                 contact_point=run.contact_point,
                 repeat=run.repeat,
                 seed=seed,
-                antenna=antenna,
+                antenna=model,
                 methods=spec.methods,
-                scenario=with_device(spec, run.scenario, seed, length),
-                device=device,
+                scenario=with_device(own, run.scenario, seed, length),
+                device=hardware,
             )
         )
     return runs

@@ -4,9 +4,10 @@ A :class:`CampaignSpec` is the experiment plan of Section 5.6 of the paper: for 
 (azimuthal or vertical movement), each contact point and each repeat, one simulated contact
 manoeuvre, estimated by every method, with optional steps before the runs (free-motion
 identification, calibration of T_e), a simulated device that may differ from the nominal model,
-and an optional noise sweep. Every dataclass checks its own fields; a bad value raises
-:class:`CampaignSpecError` naming the field (and the file, when the spec came from one). TOML
-files become specs in :mod:`~sensing_antenna.campaign.parsing`; specs become runs in
+an optional noise sweep and an optional second device that runs the same manoeuvres. Every
+dataclass checks its own fields; a bad value raises :class:`CampaignSpecError` naming the field
+(and the file, when the spec came from one). TOML files become specs in
+:mod:`~sensing_antenna.campaign.parsing`; specs become runs in
 :mod:`~sensing_antenna.campaign.runs`.
 """
 
@@ -38,12 +39,14 @@ __all__ = [
     "DEVICE_SECTIONS",
     "METHODS",
     "SCENARIO_NOISE_SCALE",
+    "SECOND_DEVICE_SUFFIX",
     "CalibrationStep",
     "CampaignSpec",
     "CampaignSpecError",
     "DeviceSpec",
     "FreeMotionStep",
     "NoiseSweep",
+    "SecondDevice",
     "contact_point_key",
     "known_methods",
     "noise_level_key",
@@ -60,6 +63,9 @@ METHODS = ("paper", "ratio", "two-frequency")
 #: ``simulator.Scenario.noise_scale`` when the spec's ``[scenario]`` does not set it: the
 #: simulator's nominal sensor noise.
 SCENARIO_NOISE_SCALE = 1.0
+
+#: Run ids of the second device's runs end in this (after the main run's id).
+SECOND_DEVICE_SUFFIX = "-d2"
 
 #: Contact points are told apart to this resolution (m), in the distinctness checks and in the
 #: run ids alike (:func:`contact_point_key`): 1 micrometre, far below anything the estimators
@@ -365,6 +371,50 @@ class NoiseSweep:
         return data
 
 
+@dataclass(frozen=True)
+class SecondDevice:
+    """Optional: the main runs again on a second device, for a side-by-side comparison.
+
+    The second device is the ``[device]`` hardware (its antenna and overrides) with its own
+    imperfections: by default none (``profile = "nominal"``), the device the model describes
+    up to its stiffness. Its runs repeat the main runs (cases x contact points x repeats) with
+    the main runs' seeds, so the two devices see the same manoeuvres and sensor noise; its
+    preparation (identification, calibration) is its own, made as the main one is, with the
+    same seeds.
+
+    Parameters
+    ----------
+    enabled : bool
+        Whether the campaign runs the second device.
+    profile : {"nominal", "realistic"}
+        As ``[device] profile``, for the second device.
+    imperfections : mapping of str to value
+        As ``[device] imperfections``, for the second device.
+    """
+
+    enabled: bool = False
+    profile: str = "nominal"
+    imperfections: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        try:
+            DeviceSpec(profile=self.profile, imperfections=self.imperfections)
+        except CampaignSpecError as exc:
+            name = exc.field_name.replace("device.", "second_device.", 1)
+            raise CampaignSpecError(name, exc.problem) from exc
+
+    def device(self, hardware: DeviceSpec) -> DeviceSpec:
+        """The second device's spec: ``hardware``'s antenna and overrides, these imperfections."""
+        return replace(hardware, profile=self.profile, imperfections=dict(self.imperfections))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data in the layout of the TOML section."""
+        data: dict[str, Any] = {"enabled": self.enabled, "profile": self.profile}
+        if self.imperfections:
+            data["imperfections"] = dict(self.imperfections)
+        return data
+
+
 def _check_contact_points(key: str, points: Sequence[float], source: str | None) -> None:
     """At least one contact point, each a finite length > 0 m, all distinct (to 1 um)."""
     if not points:
@@ -434,6 +484,8 @@ class CampaignSpec:
         Optional T_e calibration step on the device.
     noise_sweep : NoiseSweep
         Optional extra runs at other sensor noise levels; by default none.
+    second_device : SecondDevice
+        Optional: the main runs again on a second device; by default none.
     description : str
         Free text for the report.
     source : str
@@ -452,6 +504,7 @@ class CampaignSpec:
     device: DeviceSpec = field(default_factory=DeviceSpec)
     calibration: CalibrationStep = field(default_factory=CalibrationStep)
     noise_sweep: NoiseSweep = field(default_factory=NoiseSweep)
+    second_device: SecondDevice = field(default_factory=SecondDevice)
     description: str = ""
     source: str = ""
 
@@ -466,8 +519,12 @@ class CampaignSpec:
             raise CampaignSpecError("repeats", f"must be >= 1, got {self.repeats!r}", src)
         if self.base_seed < 0:
             raise CampaignSpecError("base_seed", f"must be >= 0, got {self.base_seed!r}", src)
-        if problem := limits.runs_problem(self.n_main_runs, self.n_sweep_runs):
+        if problem := limits.runs_problem(
+            self.n_main_runs, self.n_sweep_runs, self.n_second_device_runs
+        ):
             field_name = "repeats" if self.n_main_runs > limits.MAX_RUNS else "noise_sweep"
+            if self.n_main_runs + self.n_sweep_runs <= limits.MAX_RUNS:
+                field_name = "second_device"
             raise CampaignSpecError(field_name, problem, src)
         duration = self.scenario.get("duration")
         if duration is not None and (problem := duration_problem(duration)):
@@ -532,9 +589,37 @@ class CampaignSpec:
         )
 
     @property
+    def n_second_device_runs(self) -> int:
+        """Runs on the second device (the main runs again), 0 without one."""
+        return self.n_main_runs if self.second_device.enabled else 0
+
+    @property
     def n_runs(self) -> int:
-        """Number of simulated runs: the main runs and those of the noise sweep."""
-        return self.n_main_runs + self.n_sweep_runs
+        """Number of simulated runs: the main runs, the noise sweep's, the second device's."""
+        return self.n_main_runs + self.n_sweep_runs + self.n_second_device_runs
+
+    def second_device_spec(self) -> CampaignSpec:
+        """The campaign of the second device alone: this spec with its device as ``[device]``,
+        without noise sweep or second device.
+
+        Its main runs are this spec's second-device runs (same cases, points, repeats and
+        seeds, ids without the suffix), and its preparation is the second device's.
+
+        Raises
+        ------
+        CampaignSpecError
+            When the spec has no second device.
+        """
+        if not self.second_device.enabled:
+            raise CampaignSpecError(
+                "second_device", "the spec has no second device", self.source or None
+            )
+        return replace(
+            self,
+            device=self.second_device.device(self.device),
+            noise_sweep=NoiseSweep(),
+            second_device=SecondDevice(),
+        )
 
     @property
     def all_cases(self) -> tuple[str, ...]:
@@ -592,8 +677,8 @@ class CampaignSpec:
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON/TOML-ready) that :func:`parse_campaign_spec` reads back.
 
-        ``noise_sweep`` appears only when the sweep is enabled, so a spec without a sweep has
-        the fingerprint of one that never mentions it.
+        ``noise_sweep`` and ``second_device`` appear only when enabled, so a spec without them
+        has the fingerprint of one that never mentions them.
         """
         data = {
             "name": self.name,
@@ -615,6 +700,8 @@ class CampaignSpec:
         }
         if self.noise_sweep.enabled:
             data["noise_sweep"] = self.noise_sweep.to_dict()
+        if self.second_device.enabled:
+            data["second_device"] = self.second_device.to_dict()
         return data
 
     def preparation_fingerprint(self) -> str:

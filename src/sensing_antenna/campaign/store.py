@@ -7,6 +7,8 @@
       antenna.toml         the model every estimator used (identified observer, calibrated T_e)
       device.toml          the simulated hardware (with the observer its controller used)
       calibration.json     the T_e calibration of Section 5.1, when the spec asks for it
+      second_device/       antenna.toml, device.toml, calibration.json of the second device's
+                           own preparation, when the spec has one
       runs/<run_id>.json   one file per finished run, written atomically (temp file + os.replace)
       runs.csv             every run x method, rebuilt from runs/ (SI units)
       report.md, figures/  written by :mod:`sensing_antenna.campaign.report`
@@ -49,6 +51,7 @@ __all__ = [
     "LOCK_FILE",
     "MANIFEST_FILE",
     "RUNS_DIR",
+    "SECOND_DEVICE_DIR",
     "CampaignStoreError",
     "Preparation",
     "StoredRuns",
@@ -75,6 +78,8 @@ ANTENNA_FILE = "antenna.toml"
 DEVICE_FILE = "device.toml"
 CALIBRATION_FILE = "calibration.json"
 RUNS_DIR = "runs"
+#: Subdirectory holding the second device's preparation (the layout of the main one).
+SECOND_DEVICE_DIR = "second_device"
 CSV_FILE = "runs.csv"
 LOCK_FILE = ".lock"
 

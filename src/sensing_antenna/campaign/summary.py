@@ -8,12 +8,14 @@ formats it, and the figures draw its point tables and per-run arrays.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 from sensing_antenna.accuracy import FrequencyErrorSummary, PointTable, RunPoints
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
+from sensing_antenna.campaign.devices import TwoDevices, compare_devices, device_label
 from sensing_antenna.campaign.records import RUN_FAILED, CampaignRow, RunResult
+from sensing_antenna.campaign.runs import second_device_run_ids
 from sensing_antenna.campaign.schema import CampaignSpec
 from sensing_antenna.campaign.tables import (
     CaseTable,
@@ -162,6 +164,12 @@ class CampaignSummary:
         Every main run per case and method.
     device : DeviceComparison
     calibration : CalibrationCheck or None
+    second_device : CampaignSummary or None
+        The second device's runs alone, summarised as the campaign of
+        ``spec.second_device_spec()`` with its own model, device and calibration; None
+        without a second device. Every other field covers the main device's runs only.
+    devices : TwoDevices or None
+        Both devices' main runs side by side; None without a second device.
     """
 
     n_results: int
@@ -180,6 +188,8 @@ class CampaignSummary:
     run_points: tuple[RunPoints, ...]
     device: DeviceComparison
     calibration: CalibrationCheck | None
+    second_device: CampaignSummary | None = None
+    devices: TwoDevices | None = None
 
     def method_summary(self, case: str, method: str) -> MethodSummary:
         """The summary of ``method`` in ``case``."""
@@ -228,6 +238,10 @@ def summarize_campaign(
     model: Antenna,
     device: Antenna | None = None,
     calibration: FrequencyCalibration | None = None,
+    *,
+    second_model: Antenna | None = None,
+    second_device: Antenna | None = None,
+    second_calibration: FrequencyCalibration | None = None,
 ) -> CampaignSummary:
     """Compute everything the report shows from the stored runs.
 
@@ -235,15 +249,52 @@ def summarize_campaign(
     ----------
     spec : CampaignSpec
     results : sequence of RunResult
-        The stored runs (any order).
+        The stored runs (any order), the second device's included.
     model : Antenna
         The model the estimators used (with identified observer and T_e, if any).
     device : Antenna, optional
         The simulated hardware; None: the same as ``model``.
     calibration : FrequencyCalibration, optional
         The calibration step's result.
+    second_model, second_device, second_calibration : optional
+        The same for the second device (its own preparation); None: the main device's
+        model and hardware, no calibration. Used only when the spec has a second device.
     """
     device = device if device is not None else model
+    second_ids = second_device_run_ids(spec)
+    if second_ids:
+        second_spec = spec.second_device_spec()
+        theirs = [r for r in results if r.run_id in second_ids]
+        results = [r for r in results if r.run_id not in second_ids]
+        mine = _summarize(spec, results, model, device, calibration)
+        second = _summarize(
+            second_spec,
+            theirs,
+            second_model or model,
+            second_device or device,
+            second_calibration,
+        )
+        labels = [device_label(spec.device), device_label(second_spec.device)]
+        if labels[0] == labels[1]:
+            labels = [f"{labels[0]}, main", f"{labels[1]}, second"]
+        both = compare_devices(
+            labels,
+            [main_rows(campaign_rows(results), spec.noise_scale), campaign_rows(theirs)],
+            spec.cases,
+            spec.methods,
+        )
+        return replace(mine, second_device=second, devices=both)
+    return _summarize(spec, results, model, device, calibration)
+
+
+def _summarize(
+    spec: CampaignSpec,
+    results: Sequence[RunResult],
+    model: Antenna,
+    device: Antenna,
+    calibration: FrequencyCalibration | None,
+) -> CampaignSummary:
+    """The summary of ``results``, all runs of ``spec``'s main device."""
     every = campaign_rows(results)
     rows = main_rows(every, spec.noise_scale)
     cases, methods = spec.cases, spec.methods

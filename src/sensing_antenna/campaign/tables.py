@@ -433,6 +433,7 @@ def run_points(rows: Iterable[CampaignRow], case: str, method: str) -> RunPoints
         error=np.where(np.isfinite(contact), contact, _column(selected, "error_m")),
         delay=_column(selected, "t_e_s") - _column(selected, "t_1_s"),
         omega1=_column(selected, "omega1_rad_s"),
+        ok=np.array([row.status == "ok" for row in selected], dtype=bool),
     )
 
 

@@ -22,6 +22,7 @@ __all__ = [
     "CASE_FIGURES",
     "plot_case_estimates",
     "plot_error_and_delay",
+    "plot_errors_by_device",
     "plot_frequencies",
     "plot_frequency_error_vs_noise",
     "plot_method_errors",
@@ -35,6 +36,8 @@ _CM = 100.0
 #: to 10 micrometres, far below any physical resolution of the device, logarithmic above, so an
 #: error of exactly zero (an estimate on the grid point of the truth) is drawn at 0, as it is.
 _ERROR_LINEAR_BELOW_CM = 1e-3
+#: Horizontal shift between methods in the per-device error figure (cm).
+_DODGE_CM = 0.5
 _METHOD_STYLE = {
     "paper": {"color": "tab:blue", "marker": "o"},
     "ratio": {"color": "tab:orange", "marker": "s"},
@@ -237,6 +240,83 @@ def plot_error_and_delay(points: Sequence[RunPoints], out_dir: str | Path) -> Pa
         ax_t.grid(True, alpha=0.3)
     fig.suptitle("Error and time to estimate per run, all methods on the same recordings")
     return save_figure(fig, out / "error-and-delay-by-method.png")
+
+
+def plot_errors_by_device(
+    labels: Sequence[str],
+    devices: Sequence[Sequence[RunPoints]],
+    paper: Sequence[PointTable],
+    out_dir: str | Path,
+) -> Path:
+    """|x_c error| of every run and method against x_c, one row of panels per device.
+
+    Filled markers: runs whose status is ``ok``; hollow: the others (an estimate given with a
+    status that says not to trust it). The error is ``RunPoints.error`` (against where the
+    link touched), the x axis the nominal x_c, each method's markers shifted by a few
+    millimetres so that methods do not hide each other. Runs without an estimate are left
+    out; the paper's maximum error per point (its real device) is drawn in the panel of its
+    case.
+
+    Parameters
+    ----------
+    labels : sequence of str
+        Name of each device (the rows' titles).
+    devices : sequence of sequence of RunPoints
+        Per device (in the order of ``labels``), one entry per case and method.
+    paper : sequence of PointTable
+        The paper's tables, drawn in the panel of their case.
+    out_dir : str or Path
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    cases = list(dict.fromkeys(p.case for points in devices for p in points))
+    fig, axes = plt.subplots(
+        len(devices),
+        len(cases),
+        figsize=(5.5 * len(cases), 3.8 * len(devices)),
+        squeeze=False,
+        sharex=True,
+        sharey=True,
+    )
+    for row, (label, points) in enumerate(zip(labels, devices, strict=True)):
+        for col, case in enumerate(cases):
+            ax = axes[row][col]
+            mine = [p for p in points if p.case == case]
+            for k, series in enumerate(mine):
+                shift = (k - (len(mine) - 1) / 2) * _DODGE_CM
+                keep = np.isfinite(series.error)
+                ok = series.ok if series.ok is not None else np.ones_like(keep)
+                style = _style(series.method)
+                marker, color = style["marker"], style["color"]
+                for chosen, fill, suffix in ((ok, color, "ok"), (~ok, "none", "not ok")):
+                    mask = keep & chosen
+                    ax.plot(
+                        series.x_c[mask] * _CM + shift,
+                        np.abs(series.error[mask]) * _CM,
+                        marker,
+                        color=color,
+                        mfc=fill,
+                        ms=4,
+                        label=f"{series.method}, {suffix} ({int(mask.sum())})",
+                    )
+            for reference in (t for t in paper if t.case == case and t.points):
+                ax.plot(
+                    reference.x_c * _CM,
+                    reference.max_error * _CM,
+                    "k_",
+                    ms=12,
+                    label="paper: max error",
+                )
+            _error_axis(ax)
+            ax.set_title(f"{label}: {case} movement")
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize="xx-small", ncol=2)
+            if row == len(devices) - 1:
+                ax.set_xlabel("real contact point x_c (cm)")
+            if col == 0:
+                ax.set_ylabel("|x_c,e - contact abscissa| (cm)")
+    fig.suptitle("Error of every run against x_c on each device (filled: ok, hollow: not ok)")
+    return save_figure(fig, out / "errors-by-device.png")
 
 
 def plot_frequency_error_vs_noise(
