@@ -228,7 +228,10 @@ def ringing_frequency(path: Path) -> dict[str, object]:
         "true_deflection_ratio": float(meta["true_deflection_ratio"]),
         "component": "ty" if vertical else "tz",
     }
-    if meta["true_in_contact_at_end"] != "true" or meta["true_slipping_at_end"] != "false":
+    if (
+        meta["true_in_contact_at_end"] != "true"
+        or meta.get("true_slipping_at_end", "false") != "false"
+    ):
         row["omega1_recording"] = None
         row["note"] = "not in a sticking contact at the end"
         return row
