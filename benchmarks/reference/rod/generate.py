@@ -128,9 +128,10 @@ def _angles(recording: Recording):
 
 def run_case(
     name: str, case: str, x_c: float, push: float, duration: float, seed: int
-) -> tuple[Recording, np.ndarray, float]:
+) -> tuple[Recording, np.ndarray, float, np.ndarray]:
     """One recording, the rod's noiseless wrench on the head at rest at t = 0 (fx, fy, fz, tx,
-    ty, tz: N, N m, motor axes) and theta2 there (rad)."""
+    ty, tz: N, N m, motor axes), theta2 there (rad), and the contact's state at each sample,
+    shape (n, 6): normal force (N), arc coordinate (elements), point (m, x3), 1 when sliding."""
     antenna = paper_antenna()
     scenario = Scenario(
         case=case,
@@ -233,7 +234,7 @@ def run_case(
         torque=np.round(measured[:, 3:], 8),
         metadata=metadata,
     )
-    return recording, sag[3], float(theta0[1])
+    return recording, sag[3], float(theta0[1]), state
 
 
 def _settled_sag(rod, link: RodLink, theta0) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
@@ -294,6 +295,11 @@ def main() -> None:
     parser.add_argument("--only", nargs="*", help="case names to (re)generate")
     parser.add_argument("--case", choices=sorted(SWEEPS), help="only the recordings of this case")
     parser.add_argument("--out", default=str(HERE / "recordings"))
+    parser.add_argument(
+        "--contact",
+        action="store_true",
+        help="also write NAME-contact.csv: t, normal force, arc length, sliding (not a recording)",
+    )
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -303,8 +309,21 @@ def main() -> None:
         if args.case and case != args.case:
             continue
         start = time.time()
-        recording, settled, theta2 = run_case(name, case, x_c, push, duration, SEED + index)
+        recording, settled, theta2, state = run_case(name, case, x_c, push, duration, SEED + index)
         write_recording(recording, out / f"{name}.csv")
+        if args.contact:
+            rod_link = RodLink(length=paper_antenna().link.length)
+            along = [arc_length(rod_link, N_ELEMENTS, c) for c in state[:, 1]]
+            arc = np.where(state[:, 0] > 0.0, along, np.nan)
+            table = np.column_stack([recording.t, state[:, 0], arc, state[:, 5]])
+            np.savetxt(
+                out / f"{name}-contact.csv",
+                table,
+                fmt="%.6g",
+                delimiter=",",
+                header="t,normal_force,arc_length,sliding",
+                comments="",
+            )
         meta = recording.metadata
         print(
             f"{name}: true_xc {meta['true_xc']}, deflection {meta['true_deflection_ratio']},"
