@@ -27,6 +27,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from sensing_antenna import paper_antenna
 from sensing_antenna.calibration.frequency import calibrate_from_recordings
 from sensing_antenna.estimation import METHODS, estimate
@@ -46,6 +48,13 @@ def _number(text: str | None) -> float:
         return float(text) if text is not None else math.nan
     except ValueError:
         return math.nan
+
+
+def _point(text: str | None) -> np.ndarray:
+    try:
+        return np.asarray(json.loads(text), dtype=float) if text else np.full(3, np.nan)
+    except ValueError:
+        return np.full(3, np.nan)
 
 
 def run() -> dict[str, Any]:
@@ -69,6 +78,7 @@ def run() -> dict[str, Any]:
             recording = recordings[name]
             truth = _number(recording.metadata.get("true_xc"))
             ratio = _number(recording.metadata.get("true_deflection_ratio"))
+            true_point = _point(recording.metadata.get("true_contact_point"))
             blind = recording.without_ground_truth()
             for method in sorted(METHODS):
                 result = estimate(blind, model, method=method)
@@ -82,6 +92,9 @@ def run() -> dict[str, Any]:
                         "status": result.status.value,
                         "x_c": result.x_c,
                         "error": result.x_c - truth,
+                        "ratio_estimate": result.ratio_estimate,
+                        "ratio_error": result.ratio_estimate - truth,
+                        "point_error": float(np.linalg.norm(result.contact_point - true_point)),
                         "interval": list(result.interval) if result.interval else None,
                         "interval_holds": (
                             result.interval[0] <= truth <= result.interval[1]

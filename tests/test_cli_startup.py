@@ -147,3 +147,31 @@ def test_an_unknown_method_is_named_with_the_known_ones(
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "'magic'" in err
     assert all(repr(name) in err for name in METHODS)
+
+
+@pytest.mark.parametrize(
+    ("argv", "suggestion"),
+    [
+        (["estimate", "rec.csv", "--metod", "fast"], "--method"),
+        (["--verison"], "--version"),
+        (["simulate", "--case", "free", "--out", "x.csv", "--sed", "1"], "--seed"),
+    ],
+)
+def test_a_mistyped_option_is_answered_with_the_close_one(
+    argv: list[str], suggestion: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and f"(did you mean {suggestion}?)" in err
+
+
+def test_an_unexpected_argument_is_named_without_a_guess(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["estimate", "rec.csv", "extra"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "antenna estimate: error: unrecognized arguments: extra"

@@ -361,11 +361,12 @@ def test_torques_a_hundred_times_too_large_are_implausible_not_a_payload(
 def test_a_stiffer_calibration_bends_the_touched_point_less(azimuthal: Recording) -> None:
     # The push deflection of the touched point uses the stiffness the calibration measured (the
     # one its sag uses): T_e = 0.9 T makes the link 1 / 0.81 times stiffer, so the same push
-    # deflects it 0.81 times as much
+    # deflects it 0.81 times as much, to first order in the deflection (the elastica's second
+    # order terms move that by 3e-4 at this gentle push)
     own = calibrated()
     stiffer = own.with_calibrated_t(0.9 * own.link.t_param, 0.001)
     gathered = gather(azimuthal, own)
     a, b = conclude(gathered, "paper"), conclude(gather(azimuthal, stiffer), "paper")
     assert b.diagnostics["deflection"] / a.diagnostics["deflection"] == pytest.approx(
-        0.81 * (b.x_c / a.x_c) ** 3, rel=1e-6
+        0.81 * (b.x_c / a.x_c) ** 3, rel=1e-3
     )

@@ -409,3 +409,18 @@ def test_metadata_that_would_not_read_back_is_refused(value: str, tmp_path: Path
     # written, they would not read back as one metadata value.
     with pytest.raises(RecordingError, match="one line"):
         _recording(metadata={"description": value})
+
+
+@pytest.mark.parametrize(("separator", "called"), [(";", "semicolons"), ("\t", "tabs")])
+def test_a_header_with_another_separator_says_which(
+    separator: str, called: str, tmp_path: Path
+) -> None:
+    path = tmp_path / "semicolons.csv"
+    write_recording(_recording(), path)
+    lines = path.read_text().splitlines()
+    path.write_text(
+        "\n".join(line if line.startswith("#") else line.replace(",", separator) for line in lines)
+        + "\n"
+    )
+    with pytest.raises(RecordingError, match=f"one column separated by {called}"):
+        read_recording(path)

@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
+    "COMMAND_COLUMNS",
     "FORMAT_NAME",
     "GROUND_TRUTH_KEYS",
     "GROUND_TRUTH_PREFIX",
@@ -61,6 +62,11 @@ _FORMAT_FAMILY = "sensing-antenna-recording/"
 
 #: Required columns, in the order :func:`write_recording` writes them.
 REQUIRED_COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
+
+#: Optional columns of the motor commands: the voltages u_1, u_2 of Eq. 1 (V), each applied from
+#: its sample's time until the next sample's. Read by ``antenna identify --servo``; a recording
+#: without them is read as before.
+COMMAND_COLUMNS = ("u1", "u2")
 
 #: Metadata keys that hold ground truth besides those starting with :data:`GROUND_TRUTH_PREFIX`.
 GROUND_TRUTH_KEYS = frozenset({"seed", "simulation"})
@@ -503,6 +509,16 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
     """The column names of a header ``line`` (line ``number`` of ``source``): none empty or
     repeated, the nine required ones present."""
     names = [cell.strip() for cell in line.split(",")]
+    if len(names) == 1:
+        for separator, called in ((";", "semicolons"), ("\t", "tabs"), (" ", "spaces")):
+            if separator in names[0]:
+                raise RecordingError(
+                    source,
+                    number,
+                    None,
+                    f"the header is one column separated by {called}; columns are separated "
+                    "by commas (docs/recording-format.md)",
+                )
     seen: set[str] = set()
     for name in names:
         if not name:

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import difflib
 import importlib
 import os
 import signal
@@ -94,10 +95,29 @@ class OneLineParser(argparse.ArgumentParser):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("formatter_class", HelpFormatter)
+        self.option_names: list[str] = []
+        self.commands: dict[str, OneLineParser] = {}
         super().__init__(*args, **kwargs)
+
+    def add_argument(self, *args: Any, **kwargs: Any) -> argparse.Action:
+        """``ArgumentParser.add_argument``, remembering the option's names for suggestions."""
+        action = super().add_argument(*args, **kwargs)
+        self.option_names.extend(action.option_strings)
+        return action
 
     def error(self, message: str) -> NoReturn:
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message.removeprefix('argument ')}\n")
+
+    def reject_unknown(self, extras: Sequence[str]) -> NoReturn:
+        """Error on arguments the command does not take, suggesting a close option name."""
+        message = f"unrecognized arguments: {' '.join(extras)}"
+        for extra in extras:
+            if extra.startswith("--"):
+                close = difflib.get_close_matches(extra.split("=", 1)[0], self.option_names, n=1)
+                if close:
+                    message += f" (did you mean {close[0]}?)"
+                    break
+        self.error(message)
 
 
 class _VersionAction(argparse.Action):
@@ -117,7 +137,7 @@ class _VersionAction(argparse.Action):
         parser.exit(0)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser() -> OneLineParser:
     """The full ``antenna`` parser with every available command registered."""
     parser = OneLineParser(
         prog="antenna",
@@ -136,6 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     for name in COMMAND_MODULES:
         importlib.import_module(f"sensing_antenna.cli.{name}").register(subparsers)
+    parser.commands = dict(subparsers.choices)
     return parser
 
 
@@ -150,10 +171,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = argparse.Namespace()
     try:
         with _terminate_raises():
-            args = parser.parse_args(argv)
+            args, extras = parser.parse_known_args(argv)
             if not hasattr(args, "func"):
+                if extras:
+                    parser.reject_unknown(extras)
                 parser.print_help()
                 return EXIT_BAD_INPUT
+            if extras:
+                parser.commands[args.command].reject_unknown(extras)
             prog = f"{parser.prog} {args.command}"
             try:
                 code = int(args.func(args))

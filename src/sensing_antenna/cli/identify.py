@@ -1,4 +1,5 @@
-"""``antenna identify``: fit the free-motion observer (Eq. 15) and the contact threshold."""
+"""``antenna identify``: fit the free-motion observer (Eq. 15) and the contact threshold, and with
+``--servo`` each joint's motor model (Eq. 1) and the servo's gains designed from it."""
 
 from __future__ import annotations
 
@@ -20,7 +21,10 @@ def register(subparsers: Any) -> None:
             "of free motion (no contact), sets the contact threshold to the largest filtered "
             "residual times the margin (Section 5.2), and writes the starting antenna with that "
             "observer as a new antenna: named after --out (or --name), its description saying "
-            "which recording it was identified from."
+            "which recording it was identified from. With --servo it also fits each moving "
+            "joint's Eq. 1 (inertia J, viscous friction v, Coulomb torque) to the motor commands "
+            "the recording carries (columns u1, u2, V), writes them into the motors, and prints "
+            "the servo's gains designed from them (Section 4.1, Eq. 14)."
         ),
     )
     parser.add_argument("recording", type=Path, help="free-motion recording CSV")
@@ -37,6 +41,18 @@ def register(subparsers: Any) -> None:
         default=1.5,
         help="safety factor on the largest filtered residual",
     )
+    parser.add_argument(
+        "--servo",
+        action="store_true",
+        help="also fit each joint's Eq. 1 (J, v, Coulomb torque) to the commands u1, u2 (V) and "
+        "print the servo's gains",
+    )
+    parser.add_argument(
+        "--servo-pole",
+        type=number(high=0.0, unit="rad/s", what="negative number"),
+        default=None,
+        help="closed-loop pole p of the gains printed with --servo (rad/s, < 0; default -60)",
+    )
     parser.set_defaults(func=_run)
 
 
@@ -46,16 +62,30 @@ def _run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from sensing_antenna.antenna import load_antenna, save_antenna
+    from sensing_antenna.calibration.motor import identify_motors
     from sensing_antenna.calibration.observer import identify_free_motion
+    from sensing_antenna.control.servo import DEFAULT_SERVO_POLE, ControlConfigError
     from sensing_antenna.recording import read_recording
 
+    if args.servo_pole is not None and not args.servo:
+        raise ControlConfigError("--servo-pole: the gains are designed with --servo only")
+    pole = DEFAULT_SERVO_POLE if args.servo_pole is None else args.servo_pole
+    if not pole < 0:
+        raise ControlConfigError(f"--servo-pole: must be < 0 rad/s (stable), got {pole!r}")
     antenna = load_antenna(args.antenna)
-    fit = identify_free_motion(read_recording(args.recording), antenna, margin=args.margin)
+    recording = read_recording(args.recording)
+    motor_fit = identify_motors(recording, antenna) if args.servo else None
+    fit = identify_free_motion(recording, antenna, margin=args.margin)
+    what = "the free-motion observer and contact threshold"
+    if motor_fit is not None:
+        fitted = " and ".join(str(j.joint) for j in motor_fit.joints)
+        what += f" and the motors of joint{'s' if len(motor_fit.joints) > 1 else ''} {fitted}"
     description = (
-        f"antenna {printable(antenna.name)} with the free-motion observer and contact "
-        f"threshold identified by antenna identify from {printable(str(args.recording))}"
+        f"antenna {printable(antenna.name)} with {what} identified by antenna identify from "
+        f"{printable(str(args.recording))}"
     )
-    identified = replace(antenna, name=name, description=description, observer=fit.observer)
+    start = antenna if motor_fit is None else motor_fit.antenna(antenna)
+    identified = replace(start, name=name, description=description, observer=fit.observer)
     save_antenna(identified, args.out)
     joints = ", ".join(f"theta{j}" for j in fit.joints)
     print(
@@ -69,5 +99,39 @@ def _run(args: argparse.Namespace) -> int:
         f"{fit.max_filtered_residual:.4g} N m), rms of the unfiltered fit residual "
         f"{fit.residual_rms:.3g} N m, joints used: {joints}"
     )
+    if motor_fit is not None:
+        _print_servo(motor_fit, antenna, pole)
     print(args.out)
     return 0
+
+
+def _print_servo(motor_fit: Any, antenna: Any, pole: float) -> None:
+    """The fitted Eq. 1 of each joint and the servo's gains designed from it."""
+    names = {1: "azimuth", 2: "elevation"}
+    for joint in motor_fit.joints:
+        motor = antenna.motors[joint.joint - 1]
+        volts = joint.coulomb_torque / (motor.gear_ratio * motor.torque_constant)
+        print(
+            f"joint {joint.joint} ({names[joint.joint]}), Eq. 1: "
+            f"J = {joint.inertia:.4g} +- {joint.inertia_error:.2g} kg m^2, "
+            f"v = {joint.viscous_friction:.4g} +- {joint.viscous_error:.2g} N m s/rad, "
+            f"Gamma_nlc = {joint.coulomb_torque:.4g} +- {joint.coulomb_error:.2g} N m "
+            f"(coulomb_voltage {volts:.4g} V), rms of the filtered residual "
+            f"{joint.residual_rms:.3g} N m"
+        )
+    for number_, reason in motor_fit.skipped:
+        print(
+            f"joint {number_} ({names[number_]}), Eq. 1: not fitted, {reason}; the motor of "
+            f"{printable(antenna.name)} is kept"
+        )
+    fitted = {joint.joint for joint in motor_fit.joints}
+    for number_, design in enumerate(motor_fit.designs(antenna, pole), start=1):
+        source = "fitted" if number_ in fitted else "kept"
+        feedback = ", ".join(f"{c:.6g}" for c in design.feedback)
+        feedforward = ", ".join(f"{c:.6g}" for c in design.feedforward)
+        print(
+            f"joint {number_} servo on the {source} motor (Section 4.1, p = {pole:g} rad/s, "
+            f"eps = {1e3 * design.time_constant:.4g} ms): R = (c2 s^2 + c1 s + c0) / "
+            f"(s (s + b)) with b = {design.b:.6g} rad/s, feedback R2 (c2, c1, c0) = "
+            f"({feedback}), feedforward R1 = ({feedforward})"
+        )

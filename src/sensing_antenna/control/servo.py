@@ -18,9 +18,23 @@ The controller runs at 1 kHz. Each R is discretised with the bilinear (Tustin) m
 To the coupling-torque feedback the step adds a feedforward of the modelled Coulomb friction of
 Eq. 1 at the reference speed, ``Gamma_nlc tanh(omega* / omega_s)`` (``FRICTION_SPEED``).
 
+An optional command limit L (N m, per joint) stands for the amplifier's saturation: the command
+applied is clipped to [-L, L], with back-calculation anti-windup in the polynomial form of
+Astrom and Wittenmark (*Computer-Controlled Systems*, "Integrator windup") for a controller whose
+two parts share the denominator A = (1 - q^-1)(1 - z_b q^-1), the Tustin image of s (s + b):
+``A_o v = B1 theta* - B2 theta + (A_o - A) w``, with w the PID's share of the command applied
+(the applied command less the coupling-torque and friction terms) and the observer polynomial
+``A_o = (1 - z_p q^-1)(1 - z_b q^-1)``, z_p the Tustin image of the closed-loop pole p. While
+the command stays inside the limit w = v and this is the unlimited controller; while it is
+clipped, the integrator's pole moves from 1 to z_p: the integral state tracks the command
+applied with the closed loop's time constant eps = -1/p instead of winding up. Without a limit
+(L infinite) the arithmetic is the unlimited controller's, to the bit, and so it is while the
+command stays inside a finite limit.
+
 One implementation: :func:`joint_servo_step`, compiled with numba, advances one joint by one
 sample on a state array (``JOINT_STATE_SIZE`` values: the two biquads' direct form II transposed
-states, the angle origin, the previous reference, a started flag). The simulator's compiled time
+states, the angle origin, the previous reference, a started flag, the command limit and the
+anti-windup's tracking gain). The simulator's compiled time
 loop calls it at every sample, and :class:`HeadController` calls it for a real device's loop
 (per sample with :meth:`HeadController.step`, or a block at a time with
 :meth:`HeadController.step_block`), so both run the same arithmetic to the bit.
@@ -66,15 +80,18 @@ DEFAULT_SERVO_POLE = -60.0
 FRICTION_SPEED = 0.05
 
 #: Values of one joint's servo state (:func:`initial_servo_state`).
-JOINT_STATE_SIZE = 7
+JOINT_STATE_SIZE = 9
 
 # Joint state layout: R1's biquad state (2), R2's (2), the angle origin, the previous reference,
-# 1.0 once a sample has been stepped.
+# 1.0 once a sample has been stepped, the command limit (N m; inf: none), the tracking gain
+# 1 - z_p of the anti-windup.
 _R1 = 0
 _R2 = 2
 _ORIGIN = 4
 _PREVIOUS = 5
 _STARTED = 6
+_LIMIT = 7
+_TRACKING = 8
 
 
 class ControlConfigError(SensingAntennaError, ValueError):
@@ -109,6 +126,14 @@ class ServoDesign:
     def time_constant(self) -> float:
         """eps = -1/p of Eq. 14 (s)."""
         return -1.0 / self.pole
+
+    @property
+    def tracking_gain(self) -> float:
+        """1 - z_p, z_p = (1 + p T_s / 2) / (1 - p T_s / 2) the Tustin image of the pole: the
+        share of the gap between the PID's output and the command applied that its integral
+        state takes on per sample while the command is clipped (dimensionless)."""
+        half = 0.5 * self.pole * self.sample_period
+        return 1.0 - (1.0 + half) / (1.0 - half)
 
     def discrete(self) -> NDArray[np.float64]:
         """Tustin biquads, shape (2, 2, 3): [R1, R2] x [numerator, denominator] in z^-1."""
@@ -175,7 +200,9 @@ def tustin_biquad(
     return bz / az[0], az / az[0]
 
 
-def initial_servo_state(origin: float = math.nan) -> NDArray[np.float64]:
+def initial_servo_state(
+    origin: float = math.nan, limit: float = math.inf, tracking_gain: float = 0.0
+) -> NDArray[np.float64]:
     """A joint's servo state at rest, shape (``JOINT_STATE_SIZE``,).
 
     Parameters
@@ -184,9 +211,23 @@ def initial_servo_state(origin: float = math.nan) -> NDArray[np.float64]:
         Angle (rad) about which the PID starts at rest: the head at rest at ``origin`` with the
         reference ``origin`` gives a zero command. NaN (the default): the first reference
         stepped.
+    limit : float
+        Largest magnitude of the joint torque command n K_m u (N m), > 0; inf (the default):
+        no limit.
+    tracking_gain : float
+        The anti-windup's :attr:`ServoDesign.tracking_gain`, in (0, 1], needed with a finite
+        limit (unused without one).
     """
+    if not limit > 0:
+        raise ControlConfigError(f"limit: must be > 0 N m (inf: none), got {limit!r}")
+    if math.isfinite(limit) and not 0.0 < tracking_gain <= 1.0:
+        raise ControlConfigError(
+            f"tracking_gain: must lie in (0, 1] with a finite limit, got {tracking_gain!r}"
+        )
     state = np.zeros(JOINT_STATE_SIZE)
     state[_ORIGIN] = origin
+    state[_LIMIT] = limit
+    state[_TRACKING] = tracking_gain
     return state
 
 
@@ -212,7 +253,8 @@ def joint_servo_step(
     sample_period: float,
 ) -> float:
     """One joint's command for one sample (Section 4.1, Fig. 7): the 2-DOF PID, the coupling
-    torque and the Coulomb friction feedforward.
+    torque and the Coulomb friction feedforward, clipped to the state's command limit with
+    back-calculation anti-windup (the module's docstring).
 
     Parameters
     ----------
@@ -236,7 +278,7 @@ def joint_servo_step(
     Returns
     -------
     float
-        Joint torque n K_m u (N m), to hold until the next sample.
+        Joint torque n K_m u (N m), to hold until the next sample; within the limit.
     """
     if math.isnan(state[_ORIGIN]):
         state[_ORIGIN] = reference
@@ -252,6 +294,16 @@ def joint_servo_step(
         command += coulomb_torque * math.tanh(speed / friction_speed)
     state[_PREVIOUS] = reference
     state[_STARTED] = 1.0
+    limit = state[_LIMIT]
+    if command > limit or command < -limit:
+        applied = math.copysign(limit, command)
+        # back-calculation, A_o v = B1 r - B2 theta + (A_o - A) w: with A = 1 + a1 q^-1 +
+        # a2 q^-2 (a2 = z_b) and A_o = (1 - z_p q^-1)(1 - z_b q^-1), A_o - A = g q^-1 (1 -
+        # a2 q^-1), g = 1 - z_p; w - v = applied - command enters R1's state (the two share A)
+        excess = state[_TRACKING] * (applied - command)
+        state[_R1] += excess
+        state[_R1 + 1] -= coefficients[0, 1, 2] * excess
+        command = applied
     return command
 
 
@@ -363,6 +415,13 @@ class HeadController:
         Feed the motors' modelled Coulomb torque forward at the reference speed.
     friction_speed : float
         omega_s of the friction model tanh(omega / omega_s) (rad/s).
+    torque_limit : float or array_like of 2 float, optional
+        Largest joint torque each amplifier delivers, |n K_m u| <= L (N m), one for both joints
+        or one per joint; the command is clipped there, with back-calculation anti-windup.
+        None (the default): no limit.
+    voltage_limit : float or array_like of 2 float, optional
+        The same limit given as the amplifier's voltage range |u| <= U (V): L = n K_m U. At most
+        one of ``torque_limit`` and ``voltage_limit``.
 
     Notes
     -----
@@ -379,6 +438,8 @@ class HeadController:
         coupling_feedback: bool = True,
         friction_feedforward: bool = True,
         friction_speed: float = FRICTION_SPEED,
+        torque_limit: float | ArrayLike | None = None,
+        voltage_limit: float | ArrayLike | None = None,
     ) -> None:
         if not (math.isfinite(friction_speed) and friction_speed > 0):
             raise ControlConfigError(
@@ -389,6 +450,8 @@ class HeadController:
         self.sample_period = float(sample_period)
         #: n K_m of each joint (N m / V).
         self.torque_gains = np.array([m.gear_ratio * m.torque_constant for m in motors])
+        #: Command limit of each joint (N m); inf where there is none.
+        self.torque_limits = _limits(torque_limit, voltage_limit, self.torque_gains)
         self._coefficients = np.stack([d.discrete() for d in self.designs])
         self._parameters = np.array(
             [
@@ -417,7 +480,12 @@ class HeadController:
             Angles (rad) at which the head rests; default: the first reference stepped.
         """
         start = (math.nan, math.nan) if origin is None else _pair(origin, "origin")
-        self._state = np.stack([initial_servo_state(float(a)) for a in start])
+        self._state = np.stack(
+            [
+                initial_servo_state(float(a), float(limit), design.tracking_gain)
+                for a, limit, design in zip(start, self.torque_limits, self.designs, strict=True)
+            ]
+        )
 
     def step(
         self, reference: ArrayLike, measured: ArrayLike, coupling: ArrayLike
@@ -487,6 +555,30 @@ class HeadController:
     def voltage(self, torque: ArrayLike) -> NDArray[np.float64]:
         """Motor voltages u = torque / (n K_m) of Eq. 1 (V), shape like ``torque`` (..., 2)."""
         return np.asarray(torque, dtype=np.float64) / self.torque_gains
+
+
+def _limits(
+    torque_limit: float | ArrayLike | None,
+    voltage_limit: float | ArrayLike | None,
+    torque_gains: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Each joint's command limit (N m), shape (2,), inf without one."""
+    if torque_limit is not None and voltage_limit is not None:
+        raise ControlConfigError("torque_limit, voltage_limit: give one of them, not both")
+    if torque_limit is None and voltage_limit is None:
+        return np.full(2, math.inf)
+    name = "torque_limit" if torque_limit is not None else "voltage_limit"
+    given = np.asarray(torque_limit if torque_limit is not None else voltage_limit)
+    try:
+        values = np.broadcast_to(given.astype(np.float64), (2,)).copy()
+    except (TypeError, ValueError):
+        raise ControlConfigError(
+            f"{name}: expected one number or two (joints 1 and 2), got {given!r}"
+        ) from None
+    if not np.all(values > 0):
+        unit = "N m" if name == "torque_limit" else "V"
+        raise ControlConfigError(f"{name}: must be > 0 {unit}, got {values.tolist()}")
+    return values if name == "torque_limit" else values * torque_gains
 
 
 def _pair(values: ArrayLike, name: str) -> NDArray[np.float64]:

@@ -111,8 +111,9 @@ class EstimatorConfig:
         ``slip_suspected``; 3 s is 15 filter time constants.
     disagreement_sigmas : float
         The chosen frequency candidate and the ratio estimate disagree when they are more than
-        this many standard uncertainties of the ratio apart (``Evidence.ratio_uncertainty``:
-        force noise through Eq. 20, residual sensor offset, small-deflection model). 3: a
+        this many standard uncertainties apart (``Evidence.ratio_uncertainty``: force noise
+        through Eq. 20, residual sensor offset, statics model; with the candidate's
+        ``Evidence.bent_link_uncertainty``). 3: a
         Gaussian exceeds 3 sigma with probability 0.27 %, and the model term is an upper bound
         (noise-free simulator: 0.7 of it at x_c = 0.9 m, vertical). With 4, a 7 % error of T
         (x_c = 0.266 m for 0.299 m, ratio 0.299 m +- 0.95 cm) passed as ok.
@@ -121,15 +122,40 @@ class EstimatorConfig:
         standard uncertainties closer to one than to the other; otherwise the second mode
         decides if it is clear. 2 (a wrong choice with probability about 2 % on a Gaussian).
     ratio_model_factor : float
-        Coefficient of the small-deflection model term of the ratio uncertainty,
-        factor (y_c / x_c) x_c: the neglected moments are the axial force times the link's
-        slope (1.5 y_c / x_c, Eq. 9, times R_x / R_perp up to the friction coefficient 0.6)
-        and the weight of the bent link; 1.0 bounds 1.5 x 0.6 = 0.9.
+        Coefficient of the model term factor (y_c / x_c) x_c of the ratio uncertainty
+        (``Evidence.ratio_uncertainty``). For Eq. 21 as printed (the ``ratio`` baseline) the
+        neglected moments are the axial force times the link's slope (1.5 y_c / x_c, Eq. 9,
+        times R_x / R_perp up to the friction coefficient 0.6) and the weight of the bent link;
+        1.0 bounds 1.5 x 0.6 = 0.9. For the elastica's statics (the front end's ratio) only the
+        bent link's weight remains, in a bending plane that holds it: the term is scaled by the
+        push direction's vertical share (0.7 of it measured on the linear simulator at 0.9 m,
+        vertical).
+    ratio_model_floor : float
+        Relative floor of the elastica statics' model term of the ratio uncertainty
+        (``Evidence.ratio_uncertainty``): what no statics here holds, the contact's own size
+        and compliance, dynamic loads left in the ratio's mean. 1 % of x_c, the paper's typical
+        accuracy: the ratio read on the rod recordings lies within 0.02 to 0.9 cm of the
+        contact at pushes of 22 to 33 % deflection, and 1.5 mm from it at 0.3 m on the default
+        campaign at a quarter of its noise.
+    bent_link_factor : float
+        Coefficient of the uncertainty a push's deflection adds to a contact point read from
+        the vibration, factor (y_c / x_c)^2 x_c (``Evidence.bent_link_uncertainty``): the
+        sensing curves are the straight link's, and the preload of the bent link shifts the
+        frequencies at second order. 0.6 bounds what the rod recordings show (0.8 cm at
+        22 % deflection, x_c = 0.3 m, against 1.0 cm) and adds 0.5 mm at the default gentle
+        push.
     omega2_window : float
         Relative half-width of the search window around each candidate's predicted omega_2;
         0.05 is a quarter of the 20 % gap between the candidates' omega_2 at the curve's top.
-    max_deflection_ratio : float
-        Largest static deflection y_c / x_c at the contact consistent with Assumption 1 (10 %).
+    max_friction_ratio : float
+        Plausibility (``slip_suspected``): the largest ratio of the reaction's part along the
+        link's tangent at the contact to its part along the contact normal that friction can
+        hold still (mu). The tangent is the elastica's at the answer
+        (:mod:`sensing_antenna.beam.elastica`); a point contact on the link's side has its
+        normal across the tangent. Dry friction of metals, plastics, wood and stone on each
+        other lies below 1 (rubber excepted): 1.0, a cone of 45 deg. A reaction outside the
+        cone by more than 3 of its standard errors cannot be a contact at rest: it slides, or
+        it is not a point contact on the link's side.
     max_direction_drift : float
         Largest angle (rad) between the filtered contact-force direction at t_1 + settle and at t_e
         before a slip is suspected; 0.15 rad (8.6 deg) is well above noise at gentle pushes.
@@ -191,7 +217,9 @@ class EstimatorConfig:
     ratio_resolution_sigmas: float = 2.0
     ratio_model_factor: float = 1.0
     omega2_window: float = 0.05
-    max_deflection_ratio: float = 0.1
+    max_friction_ratio: float = 1.0
+    bent_link_factor: float = 0.6
+    ratio_model_floor: float = 0.01
     max_direction_drift: float = 0.15
     max_ratio_drift: float = 0.02
     min_nyquist_factor: float = 2.0

@@ -17,8 +17,12 @@ forms agree.
    with the push and would admit any reading near the tip) is a contact at the tip measured a
    little long: the contact cannot lie beyond l, so the estimate constrained to the link is l,
    reported so (the method's own value in ``diagnostics["x_c_past_tip"]``, the touched point
-   recomputed at l from the hold's push, and the small-deflection limit judged there as the
-   methods judge it at their own x_c, ``slip_suspected``).
+   recomputed at l from the hold's push).
+   The answer's contact can be at rest: the hold's reaction lies inside a friction cone of
+   ``max_friction_ratio`` about the normal across the link's tangent there (the elastica's;
+   ``slip_suspected``, :func:`_friction_problem`). The answer agrees with the statics: the front
+   end's settled ratio at its t_e lies within ``disagreement_sigmas`` of their uncertainties
+   (``estimators_disagree``; every method but ``ratio``, :func:`_statics_problem`).
 3. A real vibration: the fundamental omega_1 that the method measured, or, for a method that
    measures none (``ratio``), Estimator 1 on the samples from t_1 to t_e, must be a clear peak
    (``no_clear_peak``).
@@ -50,6 +54,7 @@ import numpy as np
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.beam import SensingCurve, natural_frequencies
+from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
@@ -94,9 +99,7 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     push = _push_direction_problem(evidence)
     if push is not None:
         found.append((Status.IMPLAUSIBLE_INPUT, push))
-    estimate, at_tip = _at_tip_when_just_past(evidence, estimate)
-    if at_tip is not None:
-        found.append((Status.SLIP_SUSPECTED, at_tip))
+    estimate = _at_tip_when_just_past(evidence, estimate)
     x_c = estimate.x_c
     on_link = math.isfinite(x_c) and 0.0 < x_c <= link.length
     if math.isfinite(x_c) and not on_link:
@@ -106,6 +109,12 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
                 f"x_c = {x_c:.4g} m lies outside the link, (0, {link.length:g}] m",
             )
         )
+    friction = _friction_problem(evidence, estimate, notes)
+    if friction is not None:
+        found.append((Status.SLIP_SUSPECTED, friction))
+    statics = _statics_problem(evidence, estimate, end, notes)
+    if statics is not None:
+        found.append((Status.ESTIMATORS_DISAGREE, statics))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
     payload = _payload_problem(evidence, estimate, notes)
     if payload is not None:
@@ -149,36 +158,124 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     return dataclasses.replace(estimate, **changes)
 
 
-def _at_tip_when_just_past(
-    evidence: Evidence, estimate: ContactEstimate
-) -> tuple[ContactEstimate, str | None]:
+def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     """``estimate`` with x_c = l when it lies past the tip by no more than
     ``disagreement_sigmas`` statistical uncertainties of the ratio at l (otherwise unchanged),
-    and why the deflection at l is beyond the small-deflection limit, or None."""
+    the touched point recomputed there."""
     link = evidence.antenna.link
     excess = estimate.x_c - link.length
     if not (math.isfinite(excess) and excess > 0.0):
-        return estimate, None
+        return estimate
     sigma = evidence.ratio_uncertainty(link.length, model=False)
     allowed = evidence.config.disagreement_sigmas * sigma
     if not excess <= allowed:
-        return estimate, None
+        return estimate
     push = math.hypot(evidence.frame.reaction_m[1], evidence.frame.reaction_m[2])
-    touch = touched_point(link.length, evidence.frame, push, link)
+    touch = touched_point(
+        link.length, evidence.frame, push, link, float(evidence.frame.reaction_m[0])
+    )
     diagnostics = {
         **estimate.diagnostics,
         "x_c_past_tip": estimate.x_c,
         "deflection_ratio": touch.deflection_ratio,
     }
-    at_tip = dataclasses.replace(
+    return dataclasses.replace(
         estimate, x_c=link.length, contact_point=touch.point_a, diagnostics=diagnostics
     )
-    limit = evidence.config.max_deflection_ratio
-    if not touch.deflection_ratio > limit:
-        return at_tip, None
-    return at_tip, (
-        f"the static deflection at the tip is {100 * touch.deflection_ratio:.0f} % of l, beyond "
-        f"the {100 * limit:.0f} % small-deflection limit of Assumption 1"
+
+
+def _statics_problem(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> str | None:
+    """Why the answer is not where the statics put the contact, or None.
+
+    The front end's torque/force ratio at the estimate's t_e (the elastica's contact,
+    :func:`~.front.ratio.perpendicular_ratio`) must lie within ``disagreement_sigmas`` of its
+    uncertainty (:meth:`~.front.evidence.Evidence.ratio_uncertainty` at the answer, with the
+    bent link's on the answer, :meth:`~.front.evidence.Evidence.bent_link_uncertainty`) of the
+    answer, as the paper method's fusion asks of its candidate; a method that reads no ratio
+    (``two-frequency``) is held to it here. Not judged for ``ratio`` (the answer is a ratio)
+    nor before the ratio settled (t_1 + Delta t_e2) at the estimate's t_e. Notes ``statics_z``
+    (the distance in uncertainties).
+    """
+    x_c = estimate.x_c
+    if estimate.method == "ratio" or not math.isfinite(x_c):
+        return None
+    settled = evidence.converged_index
+    if settled is None or settled > end or end >= evidence.ratio_mean.shape[0]:
+        # an answer before the ratio settled (``fast`` stops early) is not judged by it
+        return None
+    reading = float(evidence.ratio_mean[end])
+    if not math.isfinite(reading):
+        return None
+    sigma = math.hypot(evidence.ratio_uncertainty(x_c), evidence.bent_link_uncertainty(x_c))
+    if not (math.isfinite(sigma) and sigma > 0.0):
+        return None
+    z = abs(x_c - reading) / sigma
+    notes["statics_z"] = z
+    if z <= evidence.config.disagreement_sigmas:
+        return None
+    return (
+        f"the statics put the contact at {reading:.3f} m (torque/force ratio; +-{sigma:.3f} m "
+        "with the answer's bent link), "
+        f"{abs(x_c - reading):.3f} m from the answer {x_c:.3f} m: more than "
+        f"{evidence.config.disagreement_sigmas:g} of their uncertainties"
+    )
+
+
+#: A contact this close to the tip (m) may be made by the link's end face, whose normal need not
+#: lie across the link: the friction cone is not judged there.
+_TIP_ZONE = 0.005
+
+#: Standard errors of the reaction the friction cone must be left by.
+_FRICTION_SIGMAS = 3.0
+
+
+def _friction_problem(
+    evidence: Evidence, estimate: ContactEstimate, notes: dict[str, Any]
+) -> str | None:
+    """Why the static reaction cannot be held by friction at the answer's contact, or None.
+
+    A point contact on the link's side has its normal across the link's tangent there; the
+    tangent is the elastica's at x_c under the hold's reaction R (the loaded end of a cantilever
+    of length x_c, :func:`~sensing_antenna.beam.elastica.loaded_end`; beyond its table the
+    small-deflection slope 3 y_c / (2 x_c), Eq. 9). At rest the reaction
+    lies inside the friction cone, |R_t| <= mu R_n (``max_friction_ratio``). Each component of
+    the hold's mean reaction carries the tare's standard error and the hold mean's, bounded by
+    twice the tare's; the ratio's standard error follows. Notes ``friction_ratio`` (R_t / R_n).
+    """
+    link = evidence.antenna.link
+    x_c = estimate.x_c
+    if not (math.isfinite(x_c) and 0.0 < x_c <= link.length - _TIP_ZONE):
+        return None
+    reaction = evidence.frame.reaction_m
+    axial = float(reaction[0])
+    across = math.hypot(float(reaction[1]), float(reaction[2]))
+    if not across > 0.0:
+        return None
+    slope = loaded_end(x_c, axial, across, 1.0 / link.bending_compliance).slope
+    if not math.isfinite(slope):
+        # beyond the elastica's table: the small-deflection slope at the contact, 3 y_c / (2 x_c)
+        slope = math.atan(0.5 * across * x_c**2 * link.bending_compliance)
+    cos_t, sin_t = math.cos(slope), math.sin(slope)
+    tangential = axial * cos_t + across * sin_t
+    normal = across * cos_t - axial * sin_t
+    if not normal > 0.0:
+        ratio = math.inf
+        sigma = 0.0
+    else:
+        ratio = tangential / normal
+        component = 2.0 * evidence.offset_error
+        sigma = component * math.hypot(1.0, ratio) / normal
+    notes["friction_ratio"] = ratio
+    mu = evidence.config.max_friction_ratio
+    if abs(ratio) <= mu + _FRICTION_SIGMAS * sigma:
+        return None
+    lean = math.degrees(math.atan2(abs(tangential), normal))
+    return (
+        f"the reaction leans {lean:.0f} deg from the contact normal at x_c = {x_c:.3f} m "
+        f"(tangential / normal {abs(ratio):.2f} +- {sigma:.2f}), outside a friction cone of "
+        f"mu = {mu:g}: the contact slides, or it is not a point contact on the link's side"
     )
 
 
@@ -319,16 +416,19 @@ def _with_notes(estimate: ContactEstimate, notes: dict[str, Any]) -> ContactEsti
     return dataclasses.replace(estimate, **changes) if changes else estimate
 
 
+#: How far past l a touched point may lie from the base (fraction of l). The elastica's contact
+#: lies within x_c <= l of the base; the linear sag (6 % of l at the paper link's tip) across
+#: the link adds 0.2 % of l; 10 % leaves room for a heavier link's sag.
+_REACH_MARGIN = 0.1
+
+
 def _within_reach(point: np.ndarray, evidence: Evidence) -> bool:
     """Whether a touched point (m, absolute frame) can be a point of the link: within
-    l (1 + ``max_deflection_ratio``) of the base. An inextensible link reaches no farther than
-    l; the linear model adds the push deflection (at most that ratio of x_c under Assumption 1)
-    and the sag (6 % of l at the paper link's tip) across the link, 1.007 l at most together.
-    A point beyond comes from loads far outside the model (forces in mN: 20 m away). A point
-    not computed (NaN) stays as it is."""
+    l (1 + :data:`_REACH_MARGIN`) of the base. A point beyond comes from loads far outside the
+    model (forces in mN: 20 m away). A point not computed (NaN) stays as it is."""
     if np.all(np.isnan(point)):
         return True
-    reach = evidence.antenna.link.length * (1.0 + evidence.config.max_deflection_ratio)
+    reach = evidence.antenna.link.length * (1.0 + _REACH_MARGIN)
     with np.errstate(over="ignore", invalid="ignore"):
         distance = float(np.linalg.norm(point))
     return math.isfinite(distance) and distance <= reach

@@ -370,7 +370,8 @@ def run_samples(
     (3), normal force, motor voltages (2), contact force on the link in the motor frame (3) and
     the stick flag (1 sticking, 0 slipping or no contact). The servo runs the controller's
     compiled step on ``ctrl`` (2, JOINT_STATE_SIZE) with the coefficients ``servo`` (2, 2, 2, 3)
-    of :class:`~sensing_antenna.control.servo.ServoDesign`.
+    of :class:`~sensing_antenna.control.servo.ServoDesign`; each joint's command limit, if any,
+    sits in its ``ctrl`` row (``initial_servo_state``).
     """
     n = mass_m.shape[0]
     nn = 2 * n + 2

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link, antenna_to_toml
 from sensing_antenna.control.servo import FRICTION_SPEED, design_servo, initial_servo_state
-from sensing_antenna.recording import FORMAT_NAME, Recording
+from sensing_antenna.recording import COMMAND_COLUMNS, FORMAT_NAME, Recording
 from sensing_antenna.simulator.contact import Obstacle, place_obstacle
 from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.integrator import (
@@ -265,6 +265,9 @@ def simulate(
     scenario: Scenario,
     progress: Callable[[float], None] | None = None,
     stop_rule: StopRule | None = None,
+    *,
+    torque_limit: tuple[float, float] | None = None,
+    record_commands: bool = False,
 ) -> Recording:
     """Simulate one manoeuvre and return its recording (recording format v1, with ground truth).
 
@@ -278,15 +281,29 @@ def simulate(
         Called with the fraction done (0..1) now and then.
     stop_rule : object with reset() and update(t, theta, force, torque) -> bool, optional
         The controller's stop rule; default ``PushMonitor(scenario.push or PushCriterion())``.
+    torque_limit : (float, float), optional
+        A device whose amplifiers saturate: each joint's command limit |n K_m u| (N m), the
+        controller's ``HeadController(torque_limit=...)`` with its anti-windup. None (the
+        default): no limit.
+    record_commands : bool
+        Add the motor voltages as the columns ``u1, u2`` (V, ``recording.COMMAND_COLUMNS``),
+        what ``antenna identify --servo`` fits Eq. 1 with. Off by default.
 
     Returns
     -------
     Recording
-        Columns t, theta, force, torque plus ``theta1_ref, theta2_ref``; metadata format,
-        sample_period, antenna, description and ground truth (``true_*``, ``seed``,
-        ``simulation``).
+        Columns t, theta, force, torque plus ``theta1_ref, theta2_ref`` (and ``u1, u2`` when
+        asked); metadata format, sample_period, antenna, description and ground truth
+        (``true_*``, ``seed``, ``simulation``).
     """
-    return simulate_detailed(antenna, scenario, progress, stop_rule).recording
+    return simulate_detailed(
+        antenna,
+        scenario,
+        progress,
+        stop_rule,
+        torque_limit=torque_limit,
+        record_commands=record_commands,
+    ).recording
 
 
 def simulate_detailed(
@@ -295,11 +312,15 @@ def simulate_detailed(
     progress: Callable[[float], None] | None = None,
     stop_rule: StopRule | None = None,
     gravity: float = STANDARD_GRAVITY,
+    *,
+    torque_limit: tuple[float, float] | None = None,
+    record_commands: bool = False,
 ) -> SimulationDetail:
     """Like :func:`simulate`, also returning the simulator's internal truth (tests, plots).
 
     ``gravity`` (m/s^2) exists for closed-form tests only.
     """
+    limits = (math.inf, math.inf) if torque_limit is None else tuple(map(float, torque_limit))
     link = device_link(antenna.link)
     ts = SAMPLE_PERIOD
     n_samples = round(scenario.duration / ts)
@@ -418,7 +439,12 @@ def simulate_detailed(
     meas_theta = np.zeros((n_samples, 2))
     meas_wrench = np.zeros((n_samples, 6))
     truth = np.zeros((n_samples, TRUTH_COLUMNS))
-    ctrl = np.stack([initial_servo_state(angle) for angle in start])
+    ctrl = np.stack(
+        [
+            initial_servo_state(angle, limit, design.tracking_gain)
+            for angle, limit, design in zip(start, limits, servo, strict=True)
+        ]
+    )
     cs = np.zeros(CONTACT_STATE_SIZE)
     cs[12] = -1.0
     record = _sensor_output(scenario.device, t, scenario.seed, meas_theta, meas_wrench)
@@ -507,16 +533,20 @@ def simulate_detailed(
             "antenna": antenna_to_toml(antenna),
             "damping_alpha": alpha,
             "damping_beta": beta,
+            **({} if torque_limit is None else {"torque_limit": list(limits)}),
         },
         sort_keys=True,
     )
+    extra = {"theta1_ref": reference[:, 0].copy(), "theta2_ref": reference[:, 1].copy()}
+    if record_commands:
+        extra.update({name: truth[:, 8 + j].copy() for j, name in enumerate(COMMAND_COLUMNS)})
     recording = Recording(
         t=t,
         theta=meas_theta,
         force=meas_wrench[:, :3],
         torque=meas_wrench[:, 3:],
         metadata=metadata,
-        extra={"theta1_ref": reference[:, 0].copy(), "theta2_ref": reference[:, 1].copy()},
+        extra=extra,
     )
     return SimulationDetail(
         recording=recording,

@@ -173,7 +173,7 @@ class Evidence:
         n_window = round(self.config.spectrum_window / self.sample_period)
         return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
 
-    def ratio_uncertainty(self, x_c: float, model: bool = True) -> float:
+    def ratio_uncertainty(self, x_c: float, model: bool = True, statics: str = "elastica") -> float:
         """Standard uncertainty (m) of the ratio estimate at a contact point ``x_c``.
 
         Three independent terms, added in quadrature:
@@ -182,11 +182,24 @@ class Evidence:
           scaled to x_c: the ratio's error is x e_F / R_perp);
         - the residual sensor offset after the tare: errors e_F on R_perp and e_T on Gamma'
           move x = Gamma' / R_perp by x e_F / R_perp and e_T / R_perp;
-        - the small-deflection model: the statics neglect terms of order (y_c / x_c) x_c
-          (the moment of the axial force with the link's slope, the weight moment of the bent
-          link); y_c / x_c = |R_perp| x_c^2 / (3 E I) (Eq. 13), scaled by
-          ``ratio_model_factor``; left out with ``model=False`` (the statistical part alone,
-          which does not grow with the loads' scale).
+        - the statics model, left out with ``model=False`` (the statistical part alone, which
+          does not grow with the loads' scale). With d = |R_perp| x_c^2 / (3 E I) (the
+          small-deflection y_c / x_c, Eq. 13; 1 / (E I) the link's bending compliance):
+
+          - ``statics="elastica"`` (the front end's ratio, :func:`.ratio.perpendicular_ratio`):
+            the elastica holds the axial force's moment at any deflection; what it does not
+            hold is the stiffness's own uncertainty, 2 u of E I (u the frequency model's
+            relative uncertainty: E I = rho / T^2), on its corrections |R_x / R_perp| d x_c
+            and 0.6 d^2 x_c (first and second order), and, in a bending plane that holds the
+            weight, the weight of the bent link, which is not the free link's the gravity
+            model removes: ``ratio_model_factor`` d x_c times the share of the push's
+            direction along the vertical (0.7 d x_c measured on the linear simulator at 0.9 m,
+            vertical; nil for a horizontal push, whose bending plane the weight crosses); and
+            a floor, ``ratio_model_floor`` x_c, for what no statics here holds (the contact's
+            own size and compliance, dynamic loads left in the mean);
+          - ``statics="small-deflection"`` (Eq. 21 as printed, the ``ratio`` baseline): the
+            neglected moments, the axial force times the link's slope and the weight of the
+            bent link, ``ratio_model_factor`` d x_c.
 
         The model holds on the link only: a reading outside it (a ratio of 10^5 m from torques
         in N mm) is judged at the nearest point of [0, l], where the terms stay finite.
@@ -195,13 +208,49 @@ class Evidence:
             return math.inf
         link = self.antenna.link
         x_c = min(max(x_c, 0.0), link.length)
-        push = math.hypot(self.frame.reaction_m[1], self.frame.reaction_m[2])
+        reaction = self.frame.reaction_m
+        push = math.hypot(reaction[1], reaction[2])
         if push <= 0.0:
             return math.inf
         offset_term = math.hypot(x_c * self.offset_error, self.torque_offset_error) / push
         # Eq. 13: y_c / x_c = |R_perp| x_c^2 / (3 E I)
-        deflection_ratio = push * x_c**2 / (3.0 * link.flexural_rigidity)
-        model_term = self.config.ratio_model_factor * deflection_ratio * x_c if model else 0.0
+        deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
+        model_term = 0.0
+        if model and statics == "small-deflection":
+            model_term = self.config.ratio_model_factor * deflection_ratio * x_c
+        elif model:
+            axial = abs(float(reaction[0])) / push
+            stiffness = (
+                2.0
+                * link.frequency_uncertainty
+                * (axial + 1.2 * deflection_ratio)
+                * deflection_ratio
+                * x_c
+            )
+            vertical = abs(float(self.frame.axes_a[1][2]))
+            weight = self.config.ratio_model_factor * deflection_ratio * x_c * vertical
+            floor = self.config.ratio_model_floor * x_c
+            model_term = math.hypot(stiffness, weight, floor)
         noise_term = self.ratio_noise * x_c / link.length
         # in quadrature without squaring (a torque noise of 1e297 N m must not overflow)
         return math.hypot(noise_term, offset_term, model_term)
+
+    def bent_link_uncertainty(self, x_c: float) -> float:
+        """Standard uncertainty (m) of a contact point read from the vibration, from the push's
+        deflection alone: ``bent_link_factor`` d^2 x_c, d = |R_perp| x_c^2 / (3 E I).
+
+        The sensing curves are those of the straight link. A push that bends the link also
+        loads it along its bent axis (the reaction tilts with the link's slope), which shifts
+        its contact frequencies at second order in the deflection: on the rod recordings a
+        push deflecting the contact by 22 % of x_c = 0.30 m put the frequency's candidate
+        0.8 cm from the contact (d = 0.24: 0.6 d^2 x_c = 1.0 cm). Negligible at gentle pushes
+        (0.5 mm at d = 0.03, x_c = 1 m).
+        """
+        if not math.isfinite(x_c):
+            return math.inf
+        link = self.antenna.link
+        x_c = min(max(x_c, 0.0), link.length)
+        reaction = self.frame.reaction_m
+        push = math.hypot(reaction[1], reaction[2])
+        deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
+        return self.config.bent_link_factor * deflection_ratio**2 * x_c

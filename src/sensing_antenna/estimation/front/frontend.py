@@ -408,7 +408,7 @@ class FrontEnd:
             self._ratio[a:stop] = perpendicular_ratio(
                 self._reaction[a:stop] - offset[:3],
                 self._moment[a:stop] - offset[3:],
-                self.antenna.link.flexural_rigidity,
+                1.0 / self.antenna.link.bending_compliance,
             )
             self._ratio_done = stop
         if self._rest is None:

@@ -1,16 +1,18 @@
 """Estimator 2 (Sections 4.4 and 5.5): the torque/force ratio of the low-pass filtered loads.
 
 Statics of the link (recording convention: F and Gamma are exerted by the link on the head, torque
-about O). With R the reaction of the object on the antenna, applied at the contact point
-r_c = x_c X^m + d (d the static deflection, along R), and W the link weight:
+about O). With R the reaction of the object on the antenna, applied at the contact point r_c, and
+W the link weight:
 
     F = R + W,            Gamma = r_c x R + Gamma_W
 
 so the contact part of the loads is R = F - F_g^m and r_c x R = Gamma - Gamma_g^m (Section 4.2).
-Because d is parallel to R, |Gamma - Gamma_g^m| = x_c |X^m x R| = x_c |R_perp|, where R_perp is the
-part of R perpendicular to the link. Eq. 19 divides by |R| instead, which equals |R_perp| when the
-reaction is normal to the link (the paper's Assumption 4) and underestimates x_c by the factor
-cos(angle) otherwise. The paper method divides by |R_perp| (exact for any axial friction); the
+Where r_c lies follows from the statics of the bent link: the planar elastica loaded at the contact
+alone (:mod:`sensing_antenna.beam.elastica`, :func:`perpendicular_ratio`), which for small
+deflections gives |Gamma - Gamma_g^m| = x_c |R_perp| up to the moment of the axial force through
+the deflection, R_perp the part of R perpendicular to the link. Eq. 19 divides by |R| instead,
+which equals |R_perp| when the reaction is normal to the link (the paper's Assumption 4) and
+underestimates x_c by the factor cos(angle) otherwise. The paper method inverts the elastica; the
 ``ratio`` baseline keeps Eq. 21 as printed.
 
 Filter start. Eq. 21 filters F and Gamma (Eq. 20) and subtracts the gravity terms afterwards.
@@ -30,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.beam.elastica import contact_arc
 from sensing_antenna.detection.filters import FirstOrderLowPass, low_pass
 
 __all__ = [
@@ -44,8 +47,8 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
-#: Fixed-point steps of the deflection correction in :func:`perpendicular_ratio`; four steps
-#: shrink the error of the first estimate by (0.1)^4.
+#: Fixed-point steps of the small-deflection statics that :func:`perpendicular_ratio` falls back
+#: to beyond the elastica's table; four steps shrink the error of the first estimate by (0.1)^4.
 _FIXED_POINT_STEPS = 4
 
 
@@ -133,18 +136,20 @@ def load_offset(
 def perpendicular_ratio(
     reaction_f: FloatArray, torque_f: FloatArray, flexural_rigidity: float
 ) -> FloatArray:
-    """Estimator 2 of the paper method: x_c(t) from the statics of the pushed link (m), (n,).
+    """Estimator 2 of the paper method: x_c(t), the contact's arc length, from the statics of the
+    pushed link (m), (n,).
 
-    With u the direction of R_perp (the reaction perpendicular to the link), v = X^m x u and the
-    contact displaced by the static deflection y_c along u, the moment of R about O is
-    Gamma' = x_c R_perp v + y_c u x R, whose component along v is x_c R_perp - y_c R_x. Hence
-
-        x_c = (Gamma' . v + y_c R_x) / R_perp,   y_c = R_perp x_c^3 / (3 E I)   (Eq. 13),
-
-    solved by a few fixed-point steps from x_c = Gamma' . v / R_perp (each step contracts by
-    3 |R_x| x_c^2 / (3 E I) < 0.1 for pushes within the small-deflection limit). Without axial
-    force and deflection this is Eq. 21 with |R_perp|; the y_c R_x term removes the bias of
-    Eq. 21 when the contact normal tilts with the link's slope (1.5 y_c / x_c, Eq. 9).
+    With u the direction of R_perp (the reaction perpendicular to the link) and v = X^m x u, the
+    sensor measures the reaction's moment about O in the bending plane, M_0 = Gamma' . v, and
+    R = (R_x, |R_perp|). The link is the planar elastica loaded at the contact alone
+    (:mod:`sensing_antenna.beam.elastica`): E I theta' = M_0 - (r(s) x R) from the base, and the
+    contact is where that moment vanishes. The inversion is tabulated
+    (:func:`~sensing_antenna.beam.elastica.contact_arc`), exact for any deflection the table
+    covers (deflections to about 60 % of x_c). In the small-deflection limit it is the linear
+    statics x_c = (M_0 + y_c R_x) / |R_perp|, y_c = |R_perp| x_c^3 / (3 E I) (Eq. 13); loads
+    beyond the table (a sensor in the wrong units, a glitch) get that linear reading, by a few
+    fixed-point steps from x_c = M_0 / |R_perp|, for the plausibility layer to judge. Without
+    axial force and deflection this is Eq. 21 with |R_perp|.
 
     Parameters
     ----------
@@ -153,7 +158,8 @@ def perpendicular_ratio(
     torque_f : array, shape (n, 3)
         Filtered Gamma - Gamma_g^m (N m), motor frame.
     flexural_rigidity : float
-        E I (N m^2).
+        E I (N m^2), the stiffness the frequency model implies
+        (1 / :attr:`~sensing_antenna.antenna.Link.bending_compliance`).
 
     Returns
     -------
@@ -165,15 +171,28 @@ def perpendicular_ratio(
     r_x, r_y, r_z = reaction_f[..., 0], reaction_f[..., 1], reaction_f[..., 2]
     perpendicular = np.hypot(r_y, r_z)
     with np.errstate(divide="ignore", invalid="ignore"):
-        # Gamma' . v with v = X^m x R_perp / |R_perp| = (0, -R_z, R_y) / |R_perp|
+        # M_0 = Gamma' . v with v = X^m x R_perp / |R_perp| = (0, -R_z, R_y) / |R_perp|
         moment_v = (torque_f[..., 2] * r_y - torque_f[..., 1] * r_z) / perpendicular
-        # Eq. 21 with |R_perp|: first estimate
+    x_c = contact_arc(moment_v, r_x, perpendicular, flexural_rigidity)
+    outside = np.isnan(x_c) & (perpendicular > 0.0)
+    if outside.any():
+        x_c[outside] = _linear_statics(
+            moment_v[outside], r_x[outside], perpendicular[outside], flexural_rigidity
+        )
+    return np.where(perpendicular > 0.0, x_c, np.nan)
+
+
+def _linear_statics(
+    moment_v: FloatArray, r_x: FloatArray, perpendicular: FloatArray, flexural_rigidity: float
+) -> FloatArray:
+    """The small-deflection statics x_c = (M_0 + y_c R_x) / R_perp, y_c = R_perp x_c^3 / (3 E I)
+    (Eq. 13), by fixed-point steps from M_0 / R_perp (m)."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         x_c = moment_v / perpendicular
         for _ in range(_FIXED_POINT_STEPS):
-            # Eq. 13: y_c = |R_perp| x_c^3 / (3 E I); statics: x_c = (Gamma'.v + y_c R_x) / R_perp
             y_c = perpendicular * x_c**3 / (3.0 * flexural_rigidity)
             x_c = (moment_v + y_c * r_x) / perpendicular
-    return np.where(perpendicular > 0.0, x_c, np.nan)
+    return np.asarray(x_c, dtype=float)
 
 
 def paper_ratio(

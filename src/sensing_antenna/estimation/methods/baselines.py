@@ -50,7 +50,11 @@ class RatioMethod:
         )
         x_c = float(ratio[evidence.end_index])
         problems: list[tuple[Status, str]] = []
-        spread = 2.0 * evidence.ratio_uncertainty(x_c) if math.isfinite(x_c) else math.nan
+        spread = (
+            2.0 * evidence.ratio_uncertainty(x_c, statics="small-deflection")
+            if math.isfinite(x_c)
+            else math.nan
+        )
         if spread > evidence.config.max_model_spread:
             # the same bar as the paper method's candidate: 1 cm at two standard deviations
             problems.append(

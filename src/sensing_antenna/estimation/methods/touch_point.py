@@ -1,20 +1,25 @@
 """The touched point in 3D (Section 4, step 7, made explicit).
 
-The contact lies at the abscissa x_c along the link. The link is bent by the reaction R of the
-object, so the contact is displaced from the rigid line x_c X^m by the static deflection of a
-cantilever loaded at x_c, y_c = |R_perp| x_c^3 / (3 E I) (Eq. 13 solved for y_c), in the direction
-of the load R, i.e. along +Y^c: the object holds the contact back while the rigid line of the
-motor angles has moved on into the object. (The brief of this module said "minus Y^c"; the
-cantilever deflects along the load it carries, which is the reaction R, so the sign here is +.)
+The contact lies at the arc length x_c along the link. The link is bent by the reaction R of the
+object, so the contact is displaced from the rigid line x_c X^m: it is the loaded end of a
+cantilever of length x_c under the end load R (the planar elastica,
+:func:`~sensing_antenna.beam.elastica.loaded_end`; exact for any deflection), at x along X^m and
+y_c along u, the direction of the reaction's part across the link: the cantilever deflects along
+the load it carries, i.e. towards where the link came from (the object holds the contact back
+while the rigid line of the motor angles has moved on into the object). In the small-deflection
+limit y_c = |R_perp| x_c^3 / (3 E I) (Eq. 13) and x = x_c; at a deflection of 30 % of x_c the
+contact lies 5 to 6 % of x_c nearer the base along X^m than x_c.
 
-The link also carries its own weight. The beam is linear (Section 3.3), so the displacement at
-x_c is the sum of the push deflection and the sag of a uniformly loaded cantilever,
+The link also carries its own weight: the sag of a uniformly loaded cantilever,
 v(x) = q x^2 (6 l^2 - 4 l x + x^2) / (24 E I) with q = rho g cos(theta2) the weight per length
 perpendicular to the link (standard handbook result, e.g. Gere and Timoshenko, Mechanics of
-Materials, cantilever under uniform load), directed along the part of -Z^a perpendicular to X^m.
-Near the tip of the paper's link it reaches 5 cm, as large as the push deflection; the paper's
-Assumption 5 neglects it. The point is expressed in the absolute frame with the motor axes at t_1
-(X^m, Y^m, Z^m of the recording format).
+Materials, cantilever under uniform load), directed along the part of -Z^a perpendicular to X^m,
+added to the push's displacement (the weight handled as a free link's, as everywhere in the
+estimators). Near the tip of the paper's link it reaches 5 cm, as large as the push deflection;
+the paper's Assumption 5 neglects it. Both use one stiffness, 1 / (E I) =
+:attr:`~sensing_antenna.antenna.Link.bending_compliance` (rho / T^2 with the frequency model's T:
+a calibrated T_e measures it). The point is expressed in the absolute frame with the motor axes
+at t_1 (X^m, Y^m, Z^m of the recording format).
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Link
+from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 
 __all__ = ["TouchPoint", "touched_point"]
@@ -42,9 +48,10 @@ class TouchPoint:
     point_a : array, shape (3,)
         Contact point in the absolute frame (m).
     deflection : float
-        Static deflection y_c at the contact (m).
+        Static deflection y_c at the contact across the link (m).
     deflection_ratio : float
-        y_c / x_c (dimensionless), to compare with the 10 % limit of Assumption 1.
+        y_c / x_c (dimensionless); Assumption 1 of the paper (linear statics) asks for less
+        than 10 %, the elastica here holds beyond.
     sag : float
         Gravity sag of the link at x_c (m).
     """
@@ -55,33 +62,44 @@ class TouchPoint:
     sag: float = math.nan
 
 
-def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link) -> TouchPoint:
+def touched_point(
+    x_c: float, frame: ContactFrame, push_force: float, link: Link, axial_force: float = 0.0
+) -> TouchPoint:
     """Absolute position of the touched point.
 
     Parameters
     ----------
     x_c : float
-        Contact point along the link (m).
+        Contact point along the link, arc length (m).
     frame : ContactFrame
-        Contact frame at t_1 (axes and motor angles).
+        Contact frame at t_1 (axes and motor angles); the push's direction across the link is
+        Y^c without its part along X^m.
     push_force : float
         |R_perp|, the reaction perpendicular to the link (N), e.g. filtered at t_e.
     link : Link
         Supplies 1 / (E I) (:attr:`~sensing_antenna.antenna.Link.bending_compliance`, the
         stiffness the frequency model and the sag use).
+    axial_force : float
+        R_x, the reaction's part along X^m (N); its moment bends the link too.
 
     Returns
     -------
     TouchPoint
-        NaN point when x_c is not a finite point of the link.
+        NaN point when x_c is not a finite point of the link or the push lies beyond the
+        elastica's table.
     """
+    nan = TouchPoint(np.full(3, np.nan), math.nan, math.nan)
     if not (math.isfinite(x_c) and 0.0 < x_c <= link.length and math.isfinite(push_force)):
-        return TouchPoint(np.full(3, np.nan), math.nan, math.nan)
-    # Eq. 13 solved for y_c: y_c = |F| x_c^3 / (3 E I), with the E I of the sag below (the
-    # link's bending compliance: a calibrated T_e measures the stiffness of both)
-    y_c = push_force * x_c**3 * link.bending_compliance / 3.0
-    # Rigid abscissa along X^m plus the deflection along Y^c, in motor coordinates
-    point_m = np.array([x_c, 0.0, 0.0]) + y_c * frame.axes_m[1]
+        return nan
+    axial = axial_force if math.isfinite(axial_force) else 0.0
+    end = loaded_end(x_c, axial, max(push_force, 0.0), 1.0 / link.bending_compliance)
+    if not math.isfinite(end.x):
+        return nan
+    # The push's direction across the link: Y^c without its part along X^m
+    across_push = frame.axes_m[1] - frame.axes_m[1][0] * np.array([1.0, 0.0, 0.0])
+    norm = float(np.linalg.norm(across_push))
+    u = across_push / norm if norm > 0.0 else frame.axes_m[1]
+    point_m = np.array([end.x, 0.0, 0.0]) + end.y * u
     point_a = point_m @ frame.motor_axes_a
     # Gravity sag: -Z^a without its component along X^m, times the cantilever deflection
     down = np.array([0.0, 0.0, -1.0])
@@ -93,4 +111,4 @@ def touched_point(x_c: float, frame: ContactFrame, push_force: float, link: Link
         # The cantilever's sag at x_c under the weight's part across the link
         sag = STANDARD_GRAVITY * across_norm * float(link.unit_sag(x_c))
         point_a = point_a + sag * across / across_norm
-    return TouchPoint(point_a=point_a, deflection=y_c, deflection_ratio=y_c / x_c, sag=sag)
+    return TouchPoint(point_a=point_a, deflection=end.y, deflection_ratio=end.y / x_c, sag=sag)

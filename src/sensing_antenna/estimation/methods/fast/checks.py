@@ -8,7 +8,7 @@ stands only when it passes the same checks, is more precise and agrees. On the p
 stays closed (the predicted vibration of the contact force below the static push); omega_1 is
 away from the top of the sensing curve; no higher mode of the fit points to another branch. On
 the estimate (:func:`problems`): the static force does not turn between the window's first half
-and t_e (slip), and the static deflection stays small (Assumption 1).
+and t_e (slip).
 
 Each check returns a note (empty when it passes) or a value with its note, so the window can
 say why it is not sure.
@@ -290,17 +290,12 @@ def direction_change(early: StaticRatio, late: StaticRatio) -> tuple[float, floa
     return angle, math.sqrt(max(variance, 0.0))
 
 
-def problems(
-    result: ScanResult,
-    config: FastConfig,
-    deflection_ratio: float,
-    limit: float,
-) -> list[tuple[Status, str]]:
+def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]:
     """What is wrong with the scan's final window, as (status, reason) pairs; empty when nothing.
 
     Not sure at the end of the search (the estimators disagree, the cap, or the samples ended);
-    the static contact force turned between the window's first half and t_e (slip); the static
-    ``deflection_ratio`` (deflection at the contact over x_c) beyond ``limit`` (Assumption 1).
+    the static contact force turned between the window's first half and t_e (slip). The
+    plausibility layer adds the checks every method shares (the friction cone among them).
     """
     found: list[tuple[Status, str]] = []
     final = result.final
@@ -341,12 +336,4 @@ def problems(
                     f"(+- {math.degrees(se):.1f}) between the first half of the window and t_e",
                 )
             )
-    if math.isfinite(deflection_ratio) and deflection_ratio > limit:
-        found.append(
-            (
-                Status.SLIP_SUSPECTED,
-                f"the static deflection at the contact is {100 * deflection_ratio:.0f} % of "
-                f"x_c, beyond the {100 * limit:.0f} % small-deflection limit of Assumption 1",
-            )
-        )
     return found

@@ -64,13 +64,10 @@ def conclude_fast(
             result = dataclasses.replace(result, final=final)
     statics = final.statics
     push = statics.perpendicular_force if statics is not None else math.nan
-    touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link)
-    found = problems(
-        result,
-        config,
-        touch.deflection_ratio,
-        evidence.config.max_deflection_ratio,
-    )
+    # the axial part of the push is not fitted: the hold's, from the front end
+    axial = float(evidence.frame.reaction_m[0])
+    touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link, axial)
+    found = problems(result, config)
     if evidence.gap is not None:
         found.append((Status.BAD_INPUT, evidence.gap))
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}

@@ -236,16 +236,9 @@ def conclude(
                 )
             )
     push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
-    touch = touched_point(x_c, evidence.frame, push_force, evidence.antenna.link)
-    if math.isfinite(touch.deflection_ratio) and touch.deflection_ratio > cfg.max_deflection_ratio:
-        found.append(
-            (
-                Status.SLIP_SUSPECTED,
-                f"the static deflection at the contact is {100 * touch.deflection_ratio:.0f} % "
-                f"of x_c, beyond the {100 * cfg.max_deflection_ratio:.0f} % small-deflection "
-                "limit of Assumption 1: the linear model does not hold and the contact may slide",
-            )
-        )
+    touch = touched_point(
+        x_c, evidence.frame, push_force, evidence.antenna.link, float(reaction_now[0])
+    )
     if not math.isfinite(x_c):
         found.append((Status.NO_CLEAR_PEAK, "no estimate of x_c could be formed"))
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
@@ -406,8 +399,11 @@ class PaperMethod:
             candidates_used = candidates
         # Tolerances from the ratio's own uncertainty (noise, tare, small-deflection model)
         sigma_ratio = evidence.ratio_uncertainty(ratio_estimate)
-        tolerance = cfg.disagreement_sigmas * sigma_ratio
+        # the candidate's own uncertainty from the bent link (its deflection's preload)
+        sigma_bent = evidence.bent_link_uncertainty(ratio_estimate)
+        tolerance = cfg.disagreement_sigmas * math.hypot(sigma_ratio, sigma_bent)
         diag["ratio_uncertainty"] = sigma_ratio
+        diag["bent_link_uncertainty"] = sigma_bent
         fusion = fuse(candidates_used, ratio_estimate, tolerance)
         diag["discriminated_by"] = "ratio" if len(candidates_used) > 1 else None
         if len(candidates_used) == 2 and math.isfinite(ratio_estimate):
@@ -451,8 +447,9 @@ class PaperMethod:
                     Status.ESTIMATORS_DISAGREE,
                     f"the frequency candidate {fusion.x_c:.3f} m is {fusion.distance:.3f} m from "
                     f"the ratio estimate {ratio_estimate:.3f} m, more than "
-                    f"{cfg.disagreement_sigmas:g} times the ratio's uncertainty "
-                    f"({sigma_ratio:.3f} m: noise, tare, small-deflection model)",
+                    f"{cfg.disagreement_sigmas:g} times their uncertainty "
+                    f"({math.hypot(sigma_ratio, sigma_bent):.3f} m: noise, tare, statics "
+                    "model, bent link)",
                 )
             )
         if candidates_used and math.isfinite(fusion.x_c):

@@ -1,0 +1,247 @@
+"""Tests of the motor fit of Eq. 1 (calibration/motor.py), `antenna identify --servo`, and the
+simulator's optional command columns and command limit."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, load_antenna, paper_antenna
+from sensing_antenna.calibration.motor import identify_motors
+from sensing_antenna.calibration.observer import IdentificationError
+from sensing_antenna.cli import main
+from sensing_antenna.control import HeadController, coupling_torques
+from sensing_antenna.control.servo import design_servo
+from sensing_antenna.recording import COMMAND_COLUMNS, Recording, read_recording, write_recording
+from sensing_antenna.simulator import Scenario, simulate, simulate_detailed
+
+TS = 1e-3  # s
+PAPER = paper_antenna()
+
+
+def _with_motors(antenna: Antenna, **changes: tuple[float, float]) -> Antenna:
+    """``antenna`` whose motors' fields take the (joint 1, joint 2) values given."""
+    motors = list(antenna.motors)
+    for name, values in changes.items():
+        motors = [dataclasses.replace(m, **{name: v}) for m, v in zip(motors, values, strict=True)]
+    return dataclasses.replace(antenna, azimuth_motor=motors[0], elevation_motor=motors[1])
+
+
+# A head whose motors are not the paper's (Table 1: J = 6.2e-3, 1.8e-3 kg m^2; v = 30.4e-3,
+# 28.5e-3 N m s/rad; V_nlc = 0.48, 0.42 V): the fit must find these, not the starting antenna's.
+TRUE = _with_motors(
+    PAPER,
+    inertia=(8.0e-3, 2.5e-3),
+    viscous_friction=(20.0e-3, 40.0e-3),
+    coulomb_voltage=(0.3, 0.6),
+)
+
+
+def _moves(t: np.ndarray, times: list[float], targets: list[float], duration: float) -> np.ndarray:
+    """Piecewise minimum-jerk moves (rad): from rest, to each target starting at each time."""
+    out = np.zeros_like(t)
+    previous = 0.0
+    for start, target in zip(times, targets, strict=True):
+        s = np.clip((t - start) / duration, 0.0, 1.0)
+        out += (target - previous) * s**3 * (10 - 15 * s + 6 * s**2)
+        previous = target
+    return out
+
+
+def _eq1_recording(antenna: Antenna) -> Recording:
+    """Both joints of Eq. 1 without Coulomb friction, integrated exactly over each held command
+    (matrix exponential), under a HeadController following back-and-forth moves; the elevation
+    carries the link's weight as its coupling torque, measured exactly. Independent of the
+    device simulator: the fit's own bias shows here."""
+    n = 4000
+    t = TS * np.arange(n)
+    reference = np.column_stack(
+        [
+            _moves(t, [0.2, 1.2, 2.2, 3.0], [0.4, -0.2, 0.3, 0.0], 0.5),
+            _moves(t, [0.5, 1.5, 2.5, 3.2], [0.2, -0.1, 0.25, 0.05], 0.4),
+        ]
+    )
+    controller = HeadController(antenna, sample_period=TS)
+    controller.reset(origin=(0.0, 0.0))
+    transitions = [
+        expm(
+            np.array([[0, 1, 0], [0, -m.viscous_friction / m.inertia, 1 / m.inertia], [0, 0, 0]])
+            * TS
+        )
+        for m in antenna.motors
+    ]
+    weight = antenna.link.mass * STANDARD_GRAVITY
+    moment = 0.5 * weight * antenna.link.length
+    state = np.zeros((2, 2))
+    theta = np.zeros((n, 2))
+    voltage = np.zeros((n, 2))
+    for k in range(n):
+        theta[k] = state[:, 0]
+        load = (0.0, moment * np.cos(theta[k, 1]))
+        torque = controller.step(reference[k], theta[k], load)
+        voltage[k] = controller.voltage(torque)
+        for j in range(2):
+            state[j] = (transitions[j] @ [*state[j], torque[j] - load[j]])[:2]
+    force = np.column_stack(
+        [-weight * np.sin(theta[:, 1]), np.zeros(n), -weight * np.cos(theta[:, 1])]
+    )
+    torque_m = np.column_stack([np.zeros(n), moment * np.cos(theta[:, 1]), np.zeros(n)])
+    return Recording(
+        t=t,
+        theta=theta,
+        force=force,
+        torque=torque_m,
+        metadata={"sample_period": "0.001"},
+        extra={"u1": voltage[:, 0], "u2": voltage[:, 1]},
+        source="eq1.csv",
+    )
+
+
+def test_recovers_eq1_of_both_joints_from_exact_data() -> None:
+    truth = _with_motors(TRUE, coulomb_voltage=(0.0, 0.0))
+    fit = identify_motors(_eq1_recording(truth), PAPER)
+    assert [j.joint for j in fit.joints] == [1, 2]
+    for joint, motor in zip(fit.joints, truth.motors, strict=True):
+        # The filter's input between samples is the angle's straight line: a bias of about
+        # (lambda T_s)^2 = 0.25 % at most, 0.02 % measured; 0.1 % leaves room for rounding
+        assert joint.inertia == pytest.approx(motor.inertia, rel=1e-3)
+        assert joint.viscous_friction == pytest.approx(motor.viscous_friction, rel=1e-3)
+        # no Coulomb friction in these data: below 0.1 % of the paper motor's sliding torque
+        assert abs(joint.coulomb_torque) < 1e-3 * PAPER.azimuth_motor.coulomb_torque
+
+
+@pytest.mark.parametrize(
+    ("scenario", "joint"),
+    [
+        (Scenario(case="free"), 1),
+        (Scenario(case="free", sweep_speed=1.0, accel_time=0.2), 1),
+        (Scenario(case="vertical", contact_point=0.5), 2),
+    ],
+    ids=["free-slow", "free-fast", "vertical-contact"],
+)
+def test_recovers_the_simulated_device_motors(scenario: Scenario, joint: int) -> None:
+    """The device simulator (FE link, sensor noise, encoder steps, regularised Coulomb friction)
+    running motors unlike the starting antenna's: the fit finds them within three of its own
+    standard errors, which stay below 10 % of J (the motion is slow: the sweep accelerates at
+    most 0.8 rad/s^2 at the default speed)."""
+    recording = simulate(TRUE, scenario, record_commands=True)
+    fit = identify_motors(recording, PAPER)
+    assert [j.joint for j in fit.joints] == [joint]
+    assert [j for j, _ in fit.skipped] == [3 - joint]
+    found = fit.joints[0]
+    motor = TRUE.motors[joint - 1]
+    assert found.inertia_error < 0.1 * motor.inertia
+    assert abs(found.inertia - motor.inertia) < 3 * found.inertia_error
+    assert abs(found.viscous_friction - motor.viscous_friction) < 3 * found.viscous_error
+    assert abs(found.coulomb_torque - motor.coulomb_torque) < 3 * found.coulomb_error
+    # the fitted antenna: the fitted joint's motor changes, the other stays the starting one's
+    fitted = fit.antenna(PAPER)
+    assert fitted.motors[joint - 1].inertia == found.inertia
+    assert fitted.motors[2 - joint] == PAPER.motors[2 - joint]
+
+
+def test_a_recording_without_commands_is_one_clear_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    recording = simulate(PAPER, Scenario(case="free"))
+    with pytest.raises(IdentificationError, match="'u1', 'u2' missing"):
+        identify_motors(recording, PAPER)
+    path = tmp_path / "free.csv"
+    write_recording(recording, path)
+    out = tmp_path / "x.toml"
+    assert main(["identify", str(path), "--out", str(out), "--servo"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert "free.csv: columns 'u1', 'u2' missing" in err
+    assert "without the motor commands" in err
+    assert not out.exists()
+    # without --servo the same recording identifies the observer as before
+    assert main(["identify", str(path), "--out", str(out)]) == 0
+    assert "Eq. 1:" not in capsys.readouterr().out
+
+
+def test_cli_writes_the_fitted_motors_and_prints_their_gains(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "free.csv"
+    write_recording(simulate(TRUE, Scenario(case="free"), record_commands=True), path)
+    out = tmp_path / "lab.toml"
+    assert main(["identify", str(path), "--out", str(out), "--servo", "--servo-pole", "-40"]) == 0
+    text = capsys.readouterr().out
+    written = load_antenna(out)
+    fit = identify_motors(read_recording(path), PAPER)
+    assert written.azimuth_motor == fit.joints[0].motor(PAPER.azimuth_motor)
+    assert written.elevation_motor == PAPER.elevation_motor
+    assert "joint 2 (elevation), Eq. 1: not fitted" in text
+    # the gains printed are the pole placement on the written motors
+    design = design_servo(written.azimuth_motor, -40.0, TS)
+    assert f"b = {design.b:.6g} rad/s" in text
+    assert f"({', '.join(f'{c:.6g}' for c in design.feedback)})" in text
+    assert "and the motors of joint 1 identified" in written.description
+
+
+def test_servo_pole_needs_servo(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "free.csv"
+    write_recording(simulate(PAPER, Scenario(case="free"), record_commands=True), path)
+    assert (
+        main(["identify", str(path), "--out", str(tmp_path / "x.toml"), "--servo-pole", "-40"]) == 2
+    )
+    assert "--servo-pole" in capsys.readouterr().err
+
+
+def test_a_still_recording_fits_no_joint() -> None:
+    recording = simulate(PAPER, Scenario(case="free"), record_commands=True)
+    still = Recording(
+        t=recording.t[:80],
+        theta=recording.theta[:80],
+        force=recording.force[:80],
+        torque=recording.torque[:80],
+        metadata=recording.without_ground_truth().metadata,
+        extra={name: recording.extra[name][:80] for name in COMMAND_COLUMNS},
+        source="still.csv",
+    )
+    with pytest.raises(IdentificationError, match=r"no joint's Eq\. 1 could be fitted"):
+        identify_motors(still, PAPER)
+
+
+def test_a_command_of_the_wrong_sign_is_named() -> None:
+    recording = simulate(PAPER, Scenario(case="free"), record_commands=True)
+    flipped = dict(recording.extra)
+    flipped["u1"] = -flipped["u1"]
+    wrong = dataclasses.replace(recording, extra=flipped, source="flipped.csv")
+    with pytest.raises(IdentificationError, match="not a positive inertia: does column 'u1'"):
+        identify_motors(wrong, PAPER)
+
+
+def test_simulator_writes_commands_only_when_asked() -> None:
+    scenario = Scenario(case="azimuthal", contact_point=0.6)
+    plain = simulate(PAPER, scenario)
+    detail = simulate_detailed(PAPER, scenario, record_commands=True)
+    assert list(plain.extra) == ["theta1_ref", "theta2_ref"]
+    assert list(detail.recording.extra) == ["theta1_ref", "theta2_ref", "u1", "u2"]
+    np.testing.assert_array_equal(detail.recording.extra["u1"], detail.voltage[:, 0])
+    np.testing.assert_array_equal(detail.recording.extra["u2"], detail.voltage[:, 1])
+    # everything else is the default recording's, to the bit
+    without = dict(detail.recording.extra)
+    del without["u1"], without["u2"]
+    assert dataclasses.replace(detail.recording, extra=without) == plain
+
+
+def test_simulator_limit_runs_the_library_controller_to_the_bit() -> None:
+    # the vertical push needs up to 0.19 N m of the elevation motor: 0.16 clips it
+    limits = (1.0, 0.16)
+    scenario = Scenario(case="vertical", contact_point=0.5)
+    detail = simulate_detailed(PAPER, scenario, torque_limit=limits)
+    rec = detail.recording
+    controller = HeadController(PAPER, scenario.servo_pole, TS, torque_limit=limits)
+    reference = np.column_stack([rec.extra["theta1_ref"], rec.extra["theta2_ref"]])
+    commands = controller.step_block(reference, rec.theta, coupling_torques(rec.theta, rec.torque))
+    np.testing.assert_array_equal(controller.voltage(commands), detail.voltage)
+    assert np.sum(np.abs(commands[:, 1]) == limits[1]) > 10
+    assert '"torque_limit": [1.0, 0.16]' in rec.metadata["simulation"]
+    # without a limit the simulation metadata says nothing of one
+    assert "torque_limit" not in simulate(PAPER, scenario).metadata["simulation"]
