@@ -1,10 +1,12 @@
 """Reference recordings of the paper antenna from an independent rod engine (PyElastica).
 
-Each recording is one azimuthal manoeuvre of the paper's link into a vertical post: the head's
-angles are those of the project's own simulator for the same scenario (a kinematic base: the
-motors are not simulated again), the link is a PyElastica Cosserat rod (geometrically exact:
-large deflection, shear, extension) under gravity, touching the post (the scenario's post,
-``true_obstacle``) by penalty with stick-slip Coulomb friction. The sensor is the section force
+Each recording is one manoeuvre of the paper's link: an azimuthal sweep into a vertical post
+(files ``xc*``), or a vertical sweep up, against gravity, into a horizontal bar (files
+``vertical-xc*``: gravity then acts in the bending plane). The head's angles are those of the
+project's own simulator for the same scenario (a kinematic base: the motors are not simulated
+again), the link is a PyElastica Cosserat rod (geometrically exact: large deflection, shear,
+extension) under gravity, touching the obstacle (the scenario's post or bar, ``true_obstacle``)
+by penalty with stick-slip Coulomb friction. The sensor is the section force
 and moment of the rod at O, resolved on the motor axes, sampled at 1 kHz, with the simulator's
 sensor noise (``SensorNoise`` at scale 1, fixed seed) and encoder resolution. The files follow
 docs/recording-format.md and carry the ground truth the project's simulator writes (``true_xc``
@@ -12,7 +14,7 @@ is where the rod touched, as arc length).
 
 Needs PyElastica (``requirements.txt`` beside this script; not a dependency of the package)::
 
-    PYTHONPATH=src python3 benchmarks/reference/rod/generate.py [--only NAME ...]
+    PYTHONPATH=src python3 benchmarks/reference/rod/generate.py [--only NAME ...] [--case CASE]
 """
 
 from __future__ import annotations
@@ -65,13 +67,27 @@ DAMPING = 1.0
 SEED = 2021
 ENCODER_GEAR = 100.0  # the paper head's gear ratio (Table 1)
 
-#: (name, nominal x_c (m), push threshold (rad of head rotation past the first touch), duration)
+#: (name, case, nominal x_c (m), push threshold (rad of head rotation past the first touch),
+#: duration (s)); azimuthal names carry no case prefix
 CASES = [
-    (f"xc{round(x * 100):03d}-push003", x, 0.03, 3.5)
+    (f"xc{round(x * 100):03d}-push003", "azimuthal", x, 0.03, 3.5)
     for x in (0.30, 0.40, 0.50, 0.60, 0.70, 0.80, 0.90, 0.98)
-] + [(f"xc{round(x * 100):03d}-push020", x, 0.20, 4.0) for x in (0.30, 0.50, 0.70, 0.90)]
+] + [
+    (f"xc{round(x * 100):03d}-push020", "azimuthal", x, 0.20, 4.0) for x in (0.30, 0.50, 0.70, 0.90)
+]
 # appended after the others, so that every case keeps its seed (SEED + its index)
-CASES += [(f"xc{round(x * 100):03d}-push028", x, 0.28, 4.3) for x in (0.50, 0.90)]
+CASES += [(f"xc{round(x * 100):03d}-push028", "azimuthal", x, 0.28, 4.3) for x in (0.50, 0.90)]
+CASES += [
+    (f"vertical-xc{round(x * 100):03d}-push003", "vertical", x, 0.03, 3.5)
+    for x in (0.30, 0.50, 0.70, 0.90, 0.98)
+]
+CASES += [
+    (f"vertical-xc{round(x * 100):03d}-push{round(push * 100):03d}", "vertical", x, push, d)
+    for push, d in ((0.20, 4.0), (0.28, 4.3))
+    for x in (0.50, 0.90)
+]
+#: What each case sweeps into (the recording's description).
+SWEEPS = {"azimuthal": "azimuthal sweep into a post", "vertical": "vertical sweep into a bar"}
 
 
 class _Damper(ea.DamperBase):
@@ -110,10 +126,15 @@ def _angles(recording: Recording):
     return angles
 
 
-def run_case(name: str, x_c: float, push: float, duration: float, seed: int) -> Recording:
+def run_case(
+    name: str, case: str, x_c: float, push: float, duration: float, seed: int
+) -> tuple[Recording, np.ndarray, float, np.ndarray]:
+    """One recording, the rod's noiseless wrench on the head at rest at t = 0 (fx, fy, fz, tx,
+    ty, tz: N, N m, motor axes), theta2 there (rad), and the contact's state at each sample,
+    shape (n, 6): normal force (N), arc coordinate (elements), point (m, x3), 1 when sliding."""
     antenna = paper_antenna()
     scenario = Scenario(
-        case="azimuthal",
+        case=case,
         contact_point=x_c,
         seed=seed,
         duration=duration,
@@ -156,6 +177,7 @@ def run_case(name: str, x_c: float, push: float, duration: float, seed: int) -> 
     while t < -0.5 * TIME_STEP:
         t = stepper.step(sim, t, TIME_STEP)
     t = 0.0
+    sag = _settled_sag(rod, link, theta0)
     n = kinematics.t.size
     wrench = np.zeros((n, 6))
     state = np.zeros((n, 6))
@@ -183,11 +205,11 @@ def run_case(name: str, x_c: float, push: float, duration: float, seed: int) -> 
         "sample_period": "0.001",
         "antenna": "paper-2021",
         "description": (
-            f"PyElastica rod: azimuthal sweep into a post at x_c = {x_c} m,"
+            f"PyElastica rod: {SWEEPS[case]} at x_c = {x_c} m,"
             f" pushed {push} rad past the first touch"
         ),
     }
-    metadata.update(_truth(kinematics, state, touching, dx_arc, x_c, obstacle))
+    metadata.update(_truth(kinematics, state, touching, dx_arc, obstacle, sag))
     metadata["seed"] = str(seed)
     metadata["simulation"] = json.dumps(
         {
@@ -205,16 +227,32 @@ def run_case(name: str, x_c: float, push: float, duration: float, seed: int) -> 
         default=str,
     )
     # rounded far below the sensor's resolution and the encoder's step, to keep the files small
-    return Recording(
+    recording = Recording(
         t=np.round(kinematics.t, 6),
         theta=np.round(theta, 9),
         force=np.round(measured[:, :3], 6),
         torque=np.round(measured[:, 3:], 8),
         metadata=metadata,
     )
+    return recording, sag[3], float(theta0[1]), state
 
 
-def _truth(kinematics, state, touching, arc, x_c, obstacle) -> dict[str, str]:
+def _settled_sag(rod, link: RodLink, theta0) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+    """The rod at rest in its sag at t = 0, before the sweep.
+
+    Returns the nodes' arc lengths from O (m), their deflection along Z^m (m), cos(theta2) at
+    the start, and the noiseless wrench on the head (fx, fy, fz, tx, ty, tz), motor axes.
+    """
+    axes = motor_axes(float(theta0[0]), float(theta0[1]))
+    nodes = np.arange(rod.position_collection.shape[1], dtype=float)
+    arc = np.array([arc_length(link, N_ELEMENTS, c) for c in nodes])
+    w = axes[:, 2] @ rod.position_collection
+    force, moment = base_wrench(rod)
+    wrench = np.concatenate([axes.T @ force, axes.T @ moment])
+    return arc, w, math.cos(float(theta0[1])), wrench
+
+
+def _truth(kinematics, state, touching, arc, obstacle, sag) -> dict[str, str]:
     t = kinematics.t
     truth: dict[str, str] = {}
     if touching.any():
@@ -230,12 +268,21 @@ def _truth(kinematics, state, touching, arc, x_c, obstacle) -> dict[str, str]:
     truth["true_t_stop"] = kinematics.metadata.get("true_t_stop", "nan")
     truth["true_in_contact_at_end"] = "true" if touching[-1] else "false"
     window = t >= t[-1] - 0.5
+    vertical = obstacle["kind"] == "bar"
+    sag_arc, sag_w, sag_cos, _ = sag
     if touching[window].all():
         ratios = []
         for k in np.flatnonzero(window):
-            axes = motor_axes(*(float(v) for v in kinematics.theta[k]))
+            theta1, theta2 = (float(v) for v in kinematics.theta[k])
+            axes = motor_axes(theta1, theta2)
             point = state[k, 2:5]
-            ratios.append(abs(float(axes[:, 1] @ point)) / float(arc[k]))
+            if vertical:
+                # the deflection from the rod's own sag at rest, scaled to the current theta2
+                w_g = np.interp(arc[k], sag_arc, sag_w) * math.cos(theta2) / sag_cos
+                v, w = float(axes[:, 1] @ point), float(axes[:, 2] @ point)
+                ratios.append(math.hypot(v, w - w_g) / float(arc[k]))
+            else:
+                ratios.append(abs(float(axes[:, 1] @ point)) / float(arc[k]))
         truth["true_deflection_ratio"] = repr(float(np.mean(ratios)))
     else:
         truth["true_deflection_ratio"] = "nan"
@@ -246,21 +293,44 @@ def _truth(kinematics, state, touching, arc, x_c, obstacle) -> dict[str, str]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="*", help="case names to (re)generate")
+    parser.add_argument("--case", choices=sorted(SWEEPS), help="only the recordings of this case")
     parser.add_argument("--out", default=str(HERE / "recordings"))
+    parser.add_argument(
+        "--contact",
+        action="store_true",
+        help="also write NAME-contact.csv: t, normal force, arc length, sliding (not a recording)",
+    )
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    for index, (name, x_c, push, duration) in enumerate(CASES):
+    for index, (name, case, x_c, push, duration) in enumerate(CASES):
         if args.only and name not in args.only:
             continue
+        if args.case and case != args.case:
+            continue
         start = time.time()
-        recording = run_case(name, x_c, push, duration, SEED + index)
+        recording, settled, theta2, state = run_case(name, case, x_c, push, duration, SEED + index)
         write_recording(recording, out / f"{name}.csv")
+        if args.contact:
+            rod_link = RodLink(length=paper_antenna().link.length)
+            along = [arc_length(rod_link, N_ELEMENTS, c) for c in state[:, 1]]
+            arc = np.where(state[:, 0] > 0.0, along, np.nan)
+            table = np.column_stack([recording.t, state[:, 0], arc, state[:, 5]])
+            np.savetxt(
+                out / f"{name}-contact.csv",
+                table,
+                fmt="%.6g",
+                delimiter=",",
+                header="t,normal_force,arc_length,sliding",
+                comments="",
+            )
         meta = recording.metadata
         print(
             f"{name}: true_xc {meta['true_xc']}, deflection {meta['true_deflection_ratio']},"
             f" in contact at end {meta['true_in_contact_at_end']},"
-            f" {time.time() - start:.0f} s",
+            f" sliding at end {meta['true_slipping_at_end']},"
+            f" at rest (theta2 {theta2:.6f}) fx {settled[0]:.6f} fz {settled[2]:.6f}"
+            f" ty {settled[4]:.6f}, {time.time() - start:.0f} s",
             flush=True,
         )
 
