@@ -31,6 +31,7 @@ from sensing_antenna.simulator.integrator import (
 )
 from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
 from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
+from sensing_antenna.simulator.nonlinear_link import node_masses, static_equilibrium
 from sensing_antenna.simulator.scenario import Scenario, ScenarioError
 
 __all__ = [
@@ -338,8 +339,17 @@ def simulate_detailed(
     )
 
     # --- initial state: static gravity equilibrium ---------------------------------------------
+    nonlinear = scenario.link_model == "nonlinear"
     c2 = math.cos(start[1])
-    q_w = np.linalg.solve(model.stiffness, -gravity * c2 * model.translation_load)
+    if nonlinear:
+        _, q_w = static_equilibrium(
+            model,
+            np.zeros(n),
+            -gravity * c2 * model.translation_load,
+            axial_gravity=-gravity * math.sin(start[1]),
+        )
+    else:
+        q_w = np.linalg.solve(model.stiffness, -gravity * c2 * model.translation_load)
     x_state = np.zeros(2 * n + 2)
     x_state[n : 2 * n] = q_w
     x_state[2 * n] = start[0]
@@ -407,6 +417,8 @@ def simulate_detailed(
     par[P.CONTROL] = 1.0
     par[P.TORQUE_GAIN1] = m1.gear_ratio * m1.torque_constant
     par[P.TORQUE_GAIN2] = m2.gear_ratio * m2.torque_constant
+    par[P.NONLINEAR] = 1.0 if nonlinear else 0.0
+    lumped = node_masses(model)
     servo_array = np.stack([s.discrete() for s in servo])
 
     # --- randomness: one seeded generator ------------------------------------------------------
@@ -448,6 +460,8 @@ def simulate_detailed(
             meas_theta,
             meas_wrench,
             truth,
+            model.element_rigidity,
+            lumped,
         )
         if record is not None:
             record(k0, k1)
