@@ -717,7 +717,7 @@ def run_samples(
                     if cs[_ACTIVE] == 0.0:
                         s0 = 0.0
                     else:
-                        s0 = tvec @ (pc - cs[_ANCHOR : _ANCHOR + 3])
+                        s0 = float(tvec @ (pc - cs[_ANCHOR : _ANCHOR + 3]))
             # the step: once for the linear link; for the nonlinear one, a fixed-point iteration
             # on its extra forces, evaluated at the iterate (A: the linear step's matrix)
             x_iter = x_new.copy()

@@ -341,6 +341,7 @@ def simulate_detailed(
     # --- initial state: static gravity equilibrium ---------------------------------------------
     nonlinear = scenario.link_model == "nonlinear"
     c2 = math.cos(start[1])
+    q_w: NDArray[np.floating[Any]]
     if nonlinear:
         _, q_w = static_equilibrium(
             model,
