@@ -116,7 +116,8 @@ _FORCE_M = 6  # 3 values, force on the link, motor frame
 _POINT_M = 9  # 3 values, contact point, motor frame
 _FIRST_TOUCH = 12
 _NORMAL_FORCE = 13
-CONTACT_STATE_SIZE = 14
+_ANCHOR_ARC = 14  # nonlinear link: the abscissa of the material point stuck at the contact
+CONTACT_STATE_SIZE = 15
 
 #: Columns of the ground-truth array written by :func:`run_samples`: true angles (2), contact
 #: flag, x_c, contact point in the absolute frame (3), normal force, motor voltages (2), contact
@@ -404,6 +405,119 @@ def _contact_solve(
 
 
 @njit(cache=True)
+def _contact_solve_axial(
+    rhs: NDArray[np.float64],
+    x_free: NDArray[np.float64],
+    X: NDArray[np.float64],
+    V: NDArray[np.float64],
+    vcoef: NDArray[np.float64],
+    g0: float,
+    s0: float,
+    s0a: float,
+    un: NDArray[np.float64],
+    ut: NDArray[np.float64],
+    ua: NDArray[np.float64],
+    par: NDArray[np.float64],
+    h: float,
+    n: int,
+    ainv: NDArray[np.float64],
+    z: NDArray[np.float64],
+    cb1: float,
+    cb2: float,
+    s_dot: float,
+    d1: float,
+    d2: float,
+) -> tuple[NDArray[np.float64], bool, bool, float, float, float]:
+    """:func:`_contact_solve` with friction in the whole tangent plane: a second stick spring
+    along the link (direction ``ua``, stretch ``s0a`` at the start of the step), for the
+    nonlinear link, which can slide along its length through the contact. Stick: rank-3
+    Woodbury update; slip: rank 1 along un + mu (tangential trial force's direction).
+
+    Returns the new coordinates, whether the contact holds, whether it sticks, and the normal,
+    transverse tangential and axial tangential forces (N).
+    """
+    nn = 2 * n + 2
+    u0 = np.empty(nn)
+    ub = np.empty(nn)
+    x_new = x_free
+    kn = par[_P_K_N]
+    cn = par[_P_C_N]
+    kt = par[_P_K_T]
+    ct = par[_P_C_T]
+    rn = -kn * (g0 - un @ X) + cn * (un @ vcoef)
+    rt = -kt * (s0 - ut @ X) + ct * (ut @ vcoef)
+    ra = -kt * (s0a - ua @ X) + ct * (ua @ vcoef)
+    stick = True
+    active = True
+    dir_t = 0.0
+    dir_a = 0.0
+    mu = par[_P_MU]
+    dn = kn + 2.0 * cn / h
+    dt_ = kt + 2.0 * ct / h
+    fn = 0.0
+    ft = 0.0
+    fa = 0.0
+    matrix = np.empty((3, 3))
+    right = np.empty(3)
+    for _it in range(2):
+        if stick:
+            for i in range(nn):
+                u0[i] = rhs[i] + rn * un[i] + rt * ut[i] + ra * ua[i]
+            y0 = _solve_s0(u0, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+            yn = _solve_s0(un, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+            yt = _solve_s0(ut, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+            ya = _solve_s0(ua, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+            # Woodbury: (D^-1 + U^T S0^-1 U) c = U^T S0^-1 u0, x = y0 - S0^-1 U c
+            matrix[0, 0] = 1.0 / dn + un @ yn
+            matrix[0, 1] = un @ yt
+            matrix[0, 2] = un @ ya
+            matrix[1, 0] = ut @ yn
+            matrix[1, 1] = 1.0 / dt_ + ut @ yt
+            matrix[1, 2] = ut @ ya
+            matrix[2, 0] = ua @ yn
+            matrix[2, 1] = ua @ yt
+            matrix[2, 2] = 1.0 / dt_ + ua @ ya
+            right[0] = un @ y0
+            right[1] = ut @ y0
+            right[2] = ua @ y0
+            coef = np.linalg.solve(matrix, right)
+            x_try = y0 - coef[0] * yn - coef[1] * yt - coef[2] * ya
+        else:
+            for i in range(nn):
+                ub[i] = un[i] + mu * (dir_t * ut[i] + dir_a * ua[i])
+                u0[i] = rhs[i] + rn * ub[i]
+            y0 = _solve_s0(u0, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+            yb = _solve_s0(ub, n, ainv, z, cb1, cb2, s_dot, d1, d2)
+            c0 = (un @ y0) / (1.0 / dn + un @ yb)
+            x_try = y0 - c0 * yb
+        v_try = 2.0 / h * (x_try - X) - V
+        g_new = g0 + un @ (x_try - X)
+        fn = -kn * g_new - cn * (un @ v_try)
+        if fn <= 0.0:
+            fn = 0.0
+            active = False
+            break
+        if stick:
+            ft_trial = -kt * (s0 + ut @ (x_try - X)) - ct * (ut @ v_try)
+            fa_trial = -kt * (s0a + ua @ (x_try - X)) - ct * (ua @ v_try)
+            size = math.sqrt(ft_trial * ft_trial + fa_trial * fa_trial)
+            if size <= mu * fn:
+                ft = ft_trial
+                fa = fa_trial
+                x_new = x_try
+                break
+            stick = False
+            dir_t = ft_trial / size
+            dir_a = fa_trial / size
+        else:
+            ft = dir_t * mu * fn
+            fa = dir_a * mu * fn
+            x_new = x_try
+            break
+    return x_new, active, stick, fn, ft, fa
+
+
+@njit(cache=True)
 def sensor_wrench(
     X: NDArray[np.float64],
     A: NDArray[np.float64],
@@ -529,6 +643,8 @@ def run_samples(
     wd = np.empty(4)
     un = np.zeros(nn)
     ut = np.zeros(nn)
+    ua = np.zeros(nn)
+    avec = np.zeros(3)
     acoef = np.empty(nn)
     vcoef = np.empty(nn)
     rhs = np.empty(nn)
@@ -641,6 +757,8 @@ def run_samples(
                 )
             fn = 0.0
             ft = 0.0
+            fa = 0.0
+            s0a = 0.0
             nvec = np.zeros(3)
             tvec = np.zeros(3)
             pc = np.zeros(3)
@@ -718,6 +836,21 @@ def run_samples(
                         s0 = 0.0
                     else:
                         s0 = float(tvec @ (pc - cs[_ANCHOR : _ANCHOR + 3]))
+                    if nonlinear:
+                        # friction along the link too: avec, the tangent in the contact plane;
+                        # the stuck material point sits s0a past the contact along it
+                        avec[:] = tang - (tang @ nvec) * nvec
+                        avec /= math.sqrt(avec @ avec)
+                        ua[:] = 0.0
+                        for jj in range(4):
+                            idx = 2 * e + jj - drop
+                            if idx >= 0:
+                                ua[idx] = (avec @ fr[1]) * wn[jj]
+                                ua[n + idx] = (avec @ fr[2]) * wn[jj]
+                        add_shortening_gradient(xc, X, n, n_el, h_el, -(avec @ fr[0]), ua)
+                        ua[2 * n] = avec @ dth1
+                        ua[2 * n + 1] = avec @ dth2
+                        s0a = cs[_ANCHOR_ARC] - xc if cs[_ACTIVE] > 0.0 else 0.0
             # the step: once for the linear link; for the nonlinear one, a fixed-point iteration
             # on its extra forces, evaluated at the iterate (A: the linear step's matrix)
             x_iter = x_new.copy()
@@ -756,7 +889,31 @@ def run_samples(
                     g_free = g0 + un @ (x_new - X)
                     if g_free < 0.0 or (cs[_ACTIVE] > 0.0 and g0 < 0.0):
                         active = True
-                    if active:
+                    if active and nonlinear:
+                        x_new, active, stick, fn, ft, fa = _contact_solve_axial(
+                            rhs_iter,
+                            x_new,
+                            X,
+                            V,
+                            vcoef,
+                            g0,
+                            s0,
+                            s0a,
+                            un,
+                            ut,
+                            ua,
+                            par,
+                            h,
+                            n,
+                            ainv,
+                            z,
+                            cb1,
+                            cb2,
+                            s_dot,
+                            d1,
+                            d2,
+                        )
+                    elif active:
                         x_new, active, stick, fn, ft = _contact_solve(
                             rhs_iter,
                             x_new,
@@ -789,6 +946,10 @@ def run_samples(
             if active:
                 if cs[_ACTIVE] == 0.0:
                     cs[_ANCHOR : _ANCHOR + 3] = pc
+                    cs[_ANCHOR_ARC] = xc
+                if nonlinear and not stick:
+                    # slip: the stuck material point moves so the axial spring carries fa
+                    cs[_ANCHOR_ARC] += -fa / par[_P_K_T] - (s0a + ua @ (x_new - X))
                 dp = np.zeros(3)
                 dx = x_new - X
                 for i in range(3):
@@ -824,7 +985,10 @@ def run_samples(
                 cs[_XC] = xc
                 fr2 = _frame(X[2 * n], X[2 * n + 1])
                 for r in range(3):
-                    cs[_FORCE_M + r] = fr2[r] @ (fn * nvec + ft * tvec)
+                    if nonlinear:
+                        cs[_FORCE_M + r] = fr2[r] @ (fn * nvec + ft * tvec + fa * avec)
+                    else:
+                        cs[_FORCE_M + r] = fr2[r] @ (fn * nvec + ft * tvec)
                     cs[_POINT_M + r] = fr2[r] @ pc
             else:
                 for i in range(3):
