@@ -853,7 +853,8 @@ def run_samples(
                         s0a = cs[_ANCHOR_ARC] - xc if cs[_ACTIVE] > 0.0 else 0.0
             # the step: once for the linear link; for the nonlinear one, a fixed-point iteration
             # on its extra forces, evaluated at the iterate (A: the linear step's matrix)
-            x_iter = x_new.copy()
+            # first iterate: the Taylor prediction X + h V + h^2 A / 2 (error O(h^3))
+            x_iter = X + h * V + 0.5 * h * h * A
             for _iteration in range(max_iterations):
                 if nonlinear:
                     for i in range(nn):
