@@ -273,3 +273,32 @@ def test_imperfect_link_runs_with_the_nonlinear_model() -> None:
     assert float(exact.metadata["true_xc"]) == pytest.approx(
         float(linear.metadata["true_xc"]), abs=5e-3
     )
+
+
+def test_friction_over_the_tangent_plane_stays_in_the_cone() -> None:
+    # A 24 % push: the link slides through the post along its length while it is pushed; the
+    # tangential force (across and along the link) never exceeds mu F_n, and equals it while
+    # slipping
+    detail = simulate_detailed(
+        paper_antenna(),
+        Scenario(
+            case="azimuthal",
+            contact_point=0.5,
+            seed=1,
+            noise_scale=0.0,
+            duration=2.5,
+            link_model="nonlinear",
+            push=PushCriterion(kind="rotation", threshold=0.2),
+        ),
+    )
+    touching = detail.in_contact
+    normal = detail.normal_force[touching]
+    tangential = np.sqrt(
+        np.maximum((detail.contact_force[touching] ** 2).sum(axis=1) - normal**2, 0.0)
+    )
+    mu = Scenario(case="free").friction_coefficient
+    assert float(detail.recording.metadata["true_deflection_ratio"]) > 0.2
+    assert np.all(tangential <= mu * normal * (1 + 1e-9) + 1e-12)
+    slipping = ~detail.sticking[touching]
+    assert slipping.sum() > 100
+    np.testing.assert_allclose(tangential[slipping], mu * normal[slipping], rtol=1e-9)
