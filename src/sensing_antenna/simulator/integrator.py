@@ -636,6 +636,10 @@ def run_samples(
     axial0 = np.zeros((n_el + 1, 2))
     axial1 = np.zeros((n_el + 1, 2))
     axial_sums = np.zeros(2)
+    axial_ready = False
+    residual = np.zeros(nn)
+    residual_prev = np.zeros(nn)
+    g_prev = np.zeros(nn)
     v_iter = np.zeros(nn)
     a_iter = np.zeros(nn)
     rhs_iter = np.zeros(nn)
@@ -651,12 +655,18 @@ def run_samples(
     for k in range(k0, k1):
         # --- sensor sample at t_k -------------------------------------------------------------
         if nonlinear:
-            link_forces(X, V, A, n, n_el, h_el, rigidity, node_mass, 0.0, True, nl_force, axial0)
+            # the axial motion of the state: from the last step's last iterate (within
+            # ITERATION_TOLERANCE of it), or computed at the start of a call
+            if not axial_ready:
+                link_forces(
+                    X, V, A, n, n_el, h_el, rigidity, node_mass, 0.0, True, nl_force, axial1
+                )
+                axial_ready = True
             axial_sums[0] = 0.0
             axial_sums[1] = 0.0
             for i in range(n_el + 1):
-                axial_sums[0] += node_mass[i] * axial0[i, 0]
-                axial_sums[1] += node_mass[i] * axial0[i, 1]
+                axial_sums[0] += node_mass[i] * axial1[i, 0]
+                axial_sums[1] += node_mass[i] * axial1[i, 1]
         sensor_wrench(X, A, n, mq, sq, par, cs, wrench, axial_sums)
         for i in range(6):
             meas_wrench[k, i] = wrench[i] + bias[i] + noise[k, i]
@@ -752,9 +762,7 @@ def run_samples(
             x_new = _solve_s0(rhs, n, ainv, z, cb1, cb2, s_dot, d1, d2)
             if nonlinear:
                 # shortening of the state at the start of the step, for the contact geometry
-                link_forces(
-                    X, V, A, n, n_el, h_el, rigidity, node_mass, 0.0, False, nl_force, axial0
-                )
+                axial0[:, :] = axial1
             fn = 0.0
             ft = 0.0
             fa = 0.0
@@ -938,12 +946,29 @@ def run_samples(
                         )
                 if not nonlinear:
                     break
+                # residual of the fixed point x = G(x), G the step solved at the iterate
                 change = 0.0
                 for i in range(nn):
-                    change = max(change, abs(x_new[i] - x_iter[i]))
-                    x_iter[i] = x_new[i]
+                    residual[i] = x_new[i] - x_iter[i]
+                    change = max(change, abs(residual[i]))
                 if change < ITERATION_TOLERANCE:
                     break
+                # Anderson acceleration of depth 1 (secant on the residual; Walker and Ni 2011)
+                gamma = 0.0
+                if _iteration > 0:
+                    num = 0.0
+                    den = 0.0
+                    for i in range(nn):
+                        d = residual[i] - residual_prev[i]
+                        num += residual[i] * d
+                        den += d * d
+                    if den > 0.0:
+                        gamma = num / den
+                for i in range(nn):
+                    step_prev = g_prev[i]
+                    g_prev[i] = x_new[i]
+                    residual_prev[i] = residual[i]
+                    x_iter[i] = x_new[i] - gamma * (x_new[i] - step_prev)
             if active:
                 if cs[_ACTIVE] == 0.0:
                     cs[_ANCHOR : _ANCHOR + 3] = pc

@@ -226,8 +226,8 @@ class Scenario:
     link_model : {"linear", "nonlinear"}
         "linear": small-deflection bending about the undeformed line (Assumption 1 of the
         paper). "nonlinear": the geometrically exact inextensible rod (exact curvature, axial
-        shortening; ``simulator.nonlinear_link``), for pushes beyond about 10 % of x_c; about
-        three times slower (docs/simulator.md, "Large deflection").
+        shortening, friction along the link; ``simulator.nonlinear_link``), for pushes beyond
+        about 10 % of x_c; 3 to 6 times slower (docs/simulator.md, "Large deflection").
     substeps : int
         Internal Newmark steps per 1 ms sample.
     sensor : SensorNoise
