@@ -17,6 +17,7 @@ from scipy.optimize import brentq
 from sensing_antenna import paper_antenna
 from sensing_antenna.beam.elastica import tip_load_elastica, tip_load_for_deflection
 from sensing_antenna.beam.modes import natural_frequencies
+from sensing_antenna.control.servo import JOINT_STATE_SIZE
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.recording import Recording, read_recording
 from sensing_antenna.simulator import (
@@ -27,8 +28,15 @@ from sensing_antenna.simulator import (
     simulate_detailed,
 )
 from sensing_antenna.simulator.device import realistic_device
+from sensing_antenna.simulator.integrator import CONTACT_STATE_SIZE, TRUTH_COLUMNS, P, run_samples
 from sensing_antenna.simulator.link import build_link_model
-from sensing_antenna.simulator.nonlinear_link import link_position, static_equilibrium
+from sensing_antenna.simulator.nonlinear_link import (
+    add_shortening_gradient,
+    link_forces,
+    link_position,
+    node_masses,
+    static_equilibrium,
+)
 
 
 def _shooting_elastica(alpha: float) -> tuple[float, float]:
@@ -302,3 +310,133 @@ def test_friction_over_the_tangent_plane_stays_in_the_cone() -> None:
     slipping = ~detail.sticking[touching]
     assert slipping.sum() > 100
     np.testing.assert_allclose(tangential[slipping], mu * normal[slipping], rtol=1e-9)
+
+
+def _nonlinear_energy(model, masses, x, v) -> float:  # type: ignore[no-untyped-def]
+    """Energy of the undamped hub and nonlinear link, no gravity, theta2 = 0: kinetic
+    (transverse, hub, and the lumped axial masses at u_i' = G_i . q') plus the bending energy
+    q^T K q / 2 + U_nl(q), U_nl the path integral of its gradient ``link_forces`` from 0."""
+    n = model.n_dof
+    n_el = model.n_elements
+    h_el = model.length / n_el
+    q = x[: 2 * n]
+    axial = np.zeros((n_el + 1, 2))
+    force = np.zeros(2 * n)
+    nodes, weights = np.polynomial.legendre.leggauss(12)
+    extra = 0.0
+    for s, weight in zip(0.5 * (nodes + 1.0), 0.5 * weights, strict=True):
+        link_forces(
+            s * q, q, q, n, n_el, h_el, model.element_rigidity, masses, 0.0, False, force, axial
+        )
+        extra += weight * float(force @ q)
+    kinetic_axial = 0.0
+    for i in range(1, n_el + 1):
+        gradient = np.zeros(2 * n)
+        add_shortening_gradient(model.nodes[i], q, n, n_el, h_el, 1.0, gradient)
+        kinetic_axial += 0.5 * masses[i] * float(gradient @ v[: 2 * n]) ** 2
+    m_aug = np.zeros((2 * n + 2, 2 * n + 2))
+    m_aug[:n, :n] = m_aug[n : 2 * n, n : 2 * n] = model.mass
+    m_aug[:n, 2 * n] = m_aug[2 * n, :n] = model.rotation_load
+    m_aug[n : 2 * n, 2 * n + 1] = m_aug[2 * n + 1, n : 2 * n] = model.rotation_load
+    antenna = paper_antenna()
+    m_aug[2 * n, 2 * n] = antenna.azimuth_motor.inertia + model.second_moment
+    m_aug[2 * n + 1, 2 * n + 1] = antenna.elevation_motor.inertia + model.second_moment
+    strain = 0.5 * float(q[:n] @ model.stiffness @ q[:n] + q[n:] @ model.stiffness @ q[n:])
+    return 0.5 * float(v @ m_aug @ v) + kinetic_axial + strain + extra
+
+
+def test_large_free_vibration_conserves_energy() -> None:
+    # Released from the elastica of alpha = 1 (tip 30 % of l, tangent at 26 degrees) with no
+    # gravity, damping, friction or control, the hub free: the nonlinear link's forces derive
+    # from its energy and the axial inertia from Lagrange's equations, so the total energy stays
+    # constant up to the trapezoidal rule's bounded error, O((omega h)^2) = 1e-4 at 16 rad/s
+    # and h = 0.5 ms; allow 1e-3 over 0.6 s (10 free periods). A sign error in any nonlinear
+    # term breaks this by far more.
+    antenna = paper_antenna()
+    model = build_link_model(antenna.link, 8)
+    n = model.n_dof
+    masses = node_masses(model)
+    load = antenna.link.flexural_rigidity / antenna.link.length**2
+    q_v, _ = static_equilibrium(model, load * model.shape_at(model.length), np.zeros(n))
+    x = np.zeros(2 * n + 2)
+    x[:n] = q_v
+    v = np.zeros_like(x)
+    a = np.zeros_like(x)
+    step = 0.5e-3
+    par = np.zeros(P.SIZE)
+    par[P.STEP] = step
+    par[P.SUBSTEPS] = 2
+    par[P.J1] = antenna.azimuth_motor.inertia
+    par[P.J2] = antenna.elevation_motor.inertia
+    par[P.OMEGA_S] = 0.05
+    par[P.S1] = model.first_moment
+    par[P.S2] = model.second_moment
+    par[P.MASS] = model.total_mass
+    par[P.LENGTH] = antenna.link.length
+    par[P.TORQUE_GAIN1] = par[P.TORQUE_GAIN2] = 1.0
+    par[P.NONLINEAR] = 1.0
+    effective = 4 / step**2 * model.mass + model.stiffness
+    ainv = np.linalg.inv(effective)
+    # consistent initial acceleration: the released link's elastic force on the mass matrix
+    # (the axial masses' share of it, sum m_i G_i G_i^T, included)
+    force = np.zeros(2 * n)
+    link_forces(
+        x,
+        x,
+        x,
+        n,
+        8,
+        model.length / 8,
+        model.element_rigidity,
+        masses,
+        0.0,
+        False,
+        force,
+        np.zeros((9, 2)),
+    )
+    m_aug = np.zeros((2 * n + 2, 2 * n + 2))
+    m_aug[:n, :n] = m_aug[n : 2 * n, n : 2 * n] = model.mass
+    m_aug[:n, 2 * n] = m_aug[2 * n, :n] = model.rotation_load
+    m_aug[n : 2 * n, 2 * n + 1] = m_aug[2 * n + 1, n : 2 * n] = model.rotation_load
+    m_aug[2 * n, 2 * n] = par[P.J1] + model.second_moment
+    m_aug[2 * n + 1, 2 * n + 1] = par[P.J2] + model.second_moment
+    for i in range(1, 9):
+        gradient = np.zeros(2 * n)
+        add_shortening_gradient(model.nodes[i], x, n, 8, model.length / 8, 1.0, gradient)
+        m_aug[: 2 * n, : 2 * n] += masses[i] * np.outer(gradient, gradient)
+    rest = np.zeros(2 * n + 2)
+    rest[:n] = model.stiffness @ x[:n] + force[:n]
+    a[:] = np.linalg.solve(m_aug, -rest)
+    energies = [_nonlinear_energy(model, masses, x, v)]
+    for k in range(600):
+        run_samples(
+            k,
+            k + 1,
+            x,
+            v,
+            a,
+            np.zeros((2, JOINT_STATE_SIZE)),
+            np.zeros(CONTACT_STATE_SIZE),
+            par,
+            model.mass,
+            np.zeros_like(model.mass),
+            ainv,
+            ainv @ model.rotation_load,
+            model.translation_load,
+            model.rotation_load,
+            8,
+            np.zeros(8),
+            np.zeros((2, 2, 2, 3)),
+            np.zeros((600, 2)),
+            np.zeros((600, 6)),
+            np.zeros(6),
+            np.zeros((600, 2)),
+            np.zeros((600, 6)),
+            np.zeros((600, TRUTH_COLUMNS)),
+            model.element_rigidity,
+            masses,
+        )
+        if k % 20 == 19:
+            energies.append(_nonlinear_energy(model, masses, x, v))
+    drift = np.abs(np.asarray(energies) / energies[0] - 1.0)
+    assert drift.max() < 1e-3
