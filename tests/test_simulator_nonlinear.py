@@ -440,3 +440,19 @@ def test_large_free_vibration_conserves_energy() -> None:
             energies.append(_nonlinear_energy(model, masses, x, v))
     drift = np.abs(np.asarray(energies) / energies[0] - 1.0)
     assert drift.max() < 1e-3
+
+
+def test_a_push_beyond_the_nonlinear_range_is_refused_in_one_line() -> None:
+    # the paper's F_m = 0.8 N at x_c = 0.5 m would bend the link by more than 50 % of x_c (its
+    # tangent past 49 degrees), where the step's fixed point diverges: one line naming the field
+    scenario = Scenario(
+        case="azimuthal",
+        contact_point=0.5,
+        seed=1,
+        noise_scale=0.0,
+        duration=3.0,
+        link_model="nonlinear",
+        push=PushCriterion(kind="force", threshold=0.8),
+    )
+    with pytest.raises(ScenarioError, match=r"link_model: the nonlinear link left its range"):
+        simulate(paper_antenna(), scenario)

@@ -37,6 +37,7 @@ from sensing_antenna.simulator.scenario import Scenario, ScenarioError
 __all__ = [
     "FINAL_AVERAGE_TIME",
     "MIN_STIFFNESS_RATIO",
+    "NONLINEAR_ANGLE_LIMIT_DEG",
     "SAMPLE_PERIOD",
     "SMALL_DEFLECTION_LIMIT",
     "SimulationDetail",
@@ -59,6 +60,11 @@ SMALL_DEFLECTION_LIMIT = 0.1
 
 #: The final deflection is averaged over this last part of the recording (s).
 FINAL_AVERAGE_TIME = 0.5
+
+#: The nonlinear link's step (a fixed point on its extra forces) converges while the link's
+#: tangent stays within about this angle of X^m (measured: the iteration fails at 49 degrees,
+#: its contraction growing as tan^2 of the angle); docs/simulator.md, "Large deflection".
+NONLINEAR_ANGLE_LIMIT_DEG = 45.0
 
 #: The penalty contact must be at least this many times stiffer than the link's local stiffness
 #: 3 E I / x_c^3, or it is no support at all (docs/simulator.md, "Smallest contact point").
@@ -492,6 +498,14 @@ def simulate_detailed(
     if progress is not None:
         progress(1.0)
 
+    if nonlinear and not np.isfinite(meas_wrench).all():
+        bad = int(np.flatnonzero(~np.isfinite(meas_wrench).all(axis=1))[0])
+        raise ScenarioError(
+            "link_model",
+            f"the nonlinear link left its range at t = {t[bad]:.3f} s: its tangent turned"
+            f" about {NONLINEAR_ANGLE_LIMIT_DEG:g} degrees from the head's axis (a push of about"
+            " 50 % of x_c), where its step no longer converges; push less deep",
+        )
     in_contact = truth[:, 2] > 0.5
     deflection = _contact_deflection(link, scenario.n_elements, truth, gravity, imperfect)
     first_touch = float(cs[12]) if cs[12] >= 0 else None
