@@ -39,7 +39,15 @@ from numpy.typing import NDArray
 
 from sensing_antenna.simulator.link import LinkModel
 
-__all__ = ["MIN_AXIAL_COSINE", "link_position", "node_masses", "static_equilibrium"]
+__all__ = [
+    "MIN_AXIAL_COSINE",
+    "add_shortening_gradient",
+    "link_forces",
+    "link_position",
+    "node_masses",
+    "shortening_at",
+    "static_equilibrium",
+]
 
 #: The tangent's cosine to X^m is floored here (the angle is then 89.9 degrees): beyond it the
 #: description by deflections fails, and the floor only keeps a diverging step finite.
@@ -311,8 +319,8 @@ def static_equilibrium(
     """Static equilibrium of the nonlinear link under generalised loads of fixed direction.
 
     Solves ``K q + f_nl(q) = f`` (f_nl: :func:`link_forces`, static) by Newton's method with a
-    finite-difference tangent, starting from the linear solution, in load steps of at most
-    a fifth of the load when the linear tip slope exceeds 0.2.
+    finite-difference tangent, starting from the linear solution, in equal load steps that
+    each add at most 0.2 to the linear solution's tip slope.
 
     Parameters
     ----------
@@ -330,6 +338,11 @@ def static_equilibrium(
     Returns
     -------
     (q_v, q_w) : ndarrays, shape (n_dof,)
+
+    Raises
+    ------
+    ValueError
+        When Newton's method has not converged within ``max_iterations`` in a load step.
     """
     n = model.n_dof
     stiffness = np.zeros((2 * n, 2 * n))
@@ -344,7 +357,12 @@ def static_equilibrium(
     q = q / steps
     for step in range(1, steps + 1):
         target = load * step / steps
-        for _ in range(max_iterations):
+        for iteration in range(max_iterations + 1):
+            if iteration == max_iterations:
+                raise ValueError(
+                    f"static equilibrium: no convergence in {max_iterations} Newton iterations"
+                    f" at load step {step} of {steps} (beyond the nonlinear link's range?)"
+                )
             base = _forces(model, q, axial_gravity)
             residual = stiffness @ q + base - target
             tangent = stiffness.copy()
