@@ -405,6 +405,33 @@ def _contact_solve(
 
 
 @njit(cache=True)
+def _solve3(m: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Solve the 3x3 system m x = b by Cramer's rule (a diverging step gives NaN, which the
+    caller reports, instead of an exception from inside the compiled loop)."""
+    c00 = m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]
+    c01 = m[1, 2] * m[2, 0] - m[1, 0] * m[2, 2]
+    c02 = m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]
+    det = m[0, 0] * c00 + m[0, 1] * c01 + m[0, 2] * c02
+    x = np.empty(3)
+    x[0] = (
+        b[0] * c00
+        + m[0, 1] * (m[1, 2] * b[2] - b[1] * m[2, 2])
+        + m[0, 2] * (b[1] * m[2, 1] - m[1, 1] * b[2])
+    ) / det
+    x[1] = (
+        m[0, 0] * (b[1] * m[2, 2] - m[1, 2] * b[2])
+        + b[0] * c01
+        + m[0, 2] * (m[1, 0] * b[2] - b[1] * m[2, 0])
+    ) / det
+    x[2] = (
+        m[0, 0] * (m[1, 1] * b[2] - b[1] * m[2, 1])
+        + m[0, 1] * (b[1] * m[2, 0] - m[1, 0] * b[2])
+        + b[0] * c02
+    ) / det
+    return x
+
+
+@njit(cache=True)
 def _contact_solve_axial(
     rhs: NDArray[np.float64],
     x_free: NDArray[np.float64],
@@ -480,7 +507,7 @@ def _contact_solve_axial(
             right[0] = un @ y0
             right[1] = ut @ y0
             right[2] = ua @ y0
-            coef = np.linalg.solve(matrix, right)
+            coef = _solve3(matrix, right)
             x_try = y0 - coef[0] * yn - coef[1] * yt - coef[2] * ya
         else:
             for i in range(nn):
