@@ -197,6 +197,8 @@ def _run_free_hub(n_el: int, step: float, n_samples: int) -> tuple[np.ndarray, l
         out_theta,
         np.zeros((n_samples, 6)),
         np.zeros((n_samples, TRUTH_COLUMNS)),
+        model.element_rigidity,
+        np.zeros(model.n_elements + 1),
     )
     return out_theta, [e0, energy()]
 

@@ -47,6 +47,7 @@ __all__ = [
     "loaded_end",
     "shoot_contact",
     "tip_load_cantilever",
+    "tip_load_for_deflection",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -112,6 +113,27 @@ def tip_load_cantilever(load: float) -> TipLoadSolution:
     x = 2.0 * math.sqrt(m) * math.cos(phi1) / root
     y = 1.0 - 2.0 * float(special.ellipe(m) - special.ellipeinc(phi1, m)) / root
     return TipLoadSolution(load=load, x=x, y=y, slope=theta0)
+
+
+def tip_load_for_deflection(deflection: float) -> TipLoadSolution:
+    """The tip-loaded cantilever whose end moves ``deflection`` = y / L across the axis.
+
+    The displacement-controlled push (0, or 1e-6 to 0.9: below, the elliptic integrals' difference
+    loses its digits): ``load`` is then the alpha it takes, against linear theory's
+    ``3 deflection``.
+    """
+    from scipy import optimize  # only here: the estimators never need it
+
+    if not (deflection == 0.0 or 1e-6 <= deflection <= 0.9):
+        raise ValueError(f"deflection must be 0 or in [1e-6, 0.9], got {deflection!r}")
+    if deflection == 0.0:
+        return tip_load_cantilever(0.0)
+    # the elastica needs more load than linear theory for the same deflection: 3 deflection
+    # brackets the root from below
+    alpha = optimize.brentq(
+        lambda a: tip_load_cantilever(a).y - deflection, 3.0 * deflection, 100.0, xtol=1e-14
+    )
+    return tip_load_cantilever(alpha)
 
 
 @dataclass(frozen=True)

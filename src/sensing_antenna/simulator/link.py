@@ -16,7 +16,7 @@ vectors ``M r`` of the rigid translation and rotation are the exact integrals ``
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -124,6 +124,10 @@ class LinkModel:
         Degrees of freedom of node 0 removed by the clamp: 2 for a rigid clamp, 1 for a
         compliant clamp (the root slope stays free, against the clamp's spring, and is then the
         first coordinate: ``[v_0', v_1, v_1', ...]``).
+    element_rigidity : ndarray, shape (n_elements,)
+        E I of each element (N m^2), for the nonlinear link (``simulator.nonlinear_link``).
+    element_density : ndarray, shape (n_elements,)
+        rho of each element (kg/m).
     """
 
     nodes: NDArray[np.float64]
@@ -135,6 +139,8 @@ class LinkModel:
     first_moment: float
     second_moment: float
     root_dofs: int = 2
+    element_rigidity: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    element_density: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n_elements(self) -> int:
@@ -229,6 +235,8 @@ def build_link_model(
     nodes = np.linspace(0.0, length, n_elements + 1)
     tip_mass = link.tip_mass
     root_dofs = 2
+    rigidity = np.full(n_elements, ei)
+    density = np.full(n_elements, rho)
     if device is None or device.link_is_nominal:
         k_e, m_e = _element_matrices(ei, rho, h)
         for e in range(n_elements):
@@ -242,6 +250,8 @@ def build_link_model(
                 f"{device.joint_start!r} m is not on the link (length {length:g} m)",
             )
         stiffness_factor, density_factor = device.element_factors(nodes)
+        rigidity = ei * np.asarray(stiffness_factor, dtype=np.float64)
+        density = rho * np.asarray(density_factor, dtype=np.float64)
         for e in range(n_elements):
             k_e, m_e = _element_matrices(
                 ei * float(stiffness_factor[e]), rho * float(density_factor[e]), h
@@ -272,6 +282,8 @@ def build_link_model(
         first_moment=float(translation @ m_r),
         second_moment=float(rotation @ m_r),
         root_dofs=root_dofs,
+        element_rigidity=rigidity,
+        element_density=density,
     )
 
 

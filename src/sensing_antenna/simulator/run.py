@@ -31,11 +31,13 @@ from sensing_antenna.simulator.integrator import (
 )
 from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
 from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
+from sensing_antenna.simulator.nonlinear_link import node_masses, static_equilibrium
 from sensing_antenna.simulator.scenario import Scenario, ScenarioError
 
 __all__ = [
     "FINAL_AVERAGE_TIME",
     "MIN_STIFFNESS_RATIO",
+    "NONLINEAR_ANGLE_LIMIT_DEG",
     "SAMPLE_PERIOD",
     "SMALL_DEFLECTION_LIMIT",
     "SimulationDetail",
@@ -58,6 +60,11 @@ SMALL_DEFLECTION_LIMIT = 0.1
 
 #: The final deflection is averaged over this last part of the recording (s).
 FINAL_AVERAGE_TIME = 0.5
+
+#: The nonlinear link's step (a fixed point on its extra forces) converges while the link's
+#: tangent stays within about this angle of X^m (measured: the iteration fails at 49 degrees,
+#: its contraction growing as tan^2 of the angle); docs/simulator.md, "Large deflection".
+NONLINEAR_ANGLE_LIMIT_DEG = 45.0
 
 #: The penalty contact must be at least this many times stiffer than the link's local stiffness
 #: 3 E I / x_c^3, or it is no support at all (docs/simulator.md, "Smallest contact point").
@@ -359,8 +366,18 @@ def simulate_detailed(
     )
 
     # --- initial state: static gravity equilibrium ---------------------------------------------
+    nonlinear = scenario.link_model == "nonlinear"
     c2 = math.cos(start[1])
-    q_w = np.linalg.solve(model.stiffness, -gravity * c2 * model.translation_load)
+    q_w: NDArray[np.floating[Any]]
+    if nonlinear:
+        _, q_w = static_equilibrium(
+            model,
+            np.zeros(n),
+            -gravity * c2 * model.translation_load,
+            axial_gravity=-gravity * math.sin(start[1]),
+        )
+    else:
+        q_w = np.linalg.solve(model.stiffness, -gravity * c2 * model.translation_load)
     x_state = np.zeros(2 * n + 2)
     x_state[n : 2 * n] = q_w
     x_state[2 * n] = start[0]
@@ -428,6 +445,8 @@ def simulate_detailed(
     par[P.CONTROL] = 1.0
     par[P.TORQUE_GAIN1] = m1.gear_ratio * m1.torque_constant
     par[P.TORQUE_GAIN2] = m2.gear_ratio * m2.torque_constant
+    par[P.NONLINEAR] = 1.0 if nonlinear else 0.0
+    lumped = node_masses(model)
     servo_array = np.stack([s.discrete() for s in servo])
 
     # --- randomness: one seeded generator ------------------------------------------------------
@@ -474,6 +493,8 @@ def simulate_detailed(
             meas_theta,
             meas_wrench,
             truth,
+            model.element_rigidity,
+            lumped,
         )
         if record is not None:
             record(k0, k1)
@@ -503,6 +524,14 @@ def simulate_detailed(
     if progress is not None:
         progress(1.0)
 
+    if nonlinear and not np.isfinite(meas_wrench).all():
+        bad = int(np.flatnonzero(~np.isfinite(meas_wrench).all(axis=1))[0])
+        raise ScenarioError(
+            "link_model",
+            f"the nonlinear link left its range at t = {t[bad]:.3f} s: its tangent turned"
+            f" about {NONLINEAR_ANGLE_LIMIT_DEG:g} degrees from the head's axis (a push of about"
+            " 50 % of x_c), where its step no longer converges; push less deep",
+        )
     in_contact = truth[:, 2] > 0.5
     deflection = _contact_deflection(link, scenario.n_elements, truth, gravity, imperfect)
     first_touch = float(cs[12]) if cs[12] >= 0 else None

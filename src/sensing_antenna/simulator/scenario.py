@@ -16,6 +16,7 @@ from sensing_antenna.simulator.device import DeviceImperfections
 __all__ = [
     "ATI_NANO17_RESOLUTION",
     "CASES",
+    "LINK_MODELS",
     "MAX_DURATION",
     "MAX_ELEMENTS",
     "MAX_SIMULATED_SAMPLES",
@@ -29,6 +30,9 @@ __all__ = [
 
 CASES = ("azimuthal", "vertical", "free")
 OBSTACLE_KINDS = ("post", "bar", "plane")
+#: The link's mechanics: "linear" (Euler-Bernoulli about the undeformed line, Assumption 1) or
+#: "nonlinear" (geometrically exact inextensible rod, ``simulator.nonlinear_link``).
+LINK_MODELS = ("linear", "nonlinear")
 
 #: Cruise at constant speed between the end of the speed ramp and the nominal first touch (s):
 #: lets the servo settle on its ramp lag (2 eps omega*, Eq. 14; 5 eps = 0.08 s) before the contact.
@@ -219,6 +223,11 @@ class Scenario:
         (the ramp lag of Eq. 14); see ``docs/simulator.md``, "The push criterion".
     n_elements : int
         Finite elements of the link.
+    link_model : {"linear", "nonlinear"}
+        "linear": small-deflection bending about the undeformed line (Assumption 1 of the
+        paper). "nonlinear": the geometrically exact inextensible rod (exact curvature, axial
+        shortening, friction along the link; ``simulator.nonlinear_link``), for pushes beyond
+        about 10 % of x_c; 3 to 6 times slower (docs/simulator.md, "Large deflection").
     substeps : int
         Internal Newmark steps per 1 ms sample.
     sensor : SensorNoise
@@ -252,6 +261,7 @@ class Scenario:
     compensate_servo_lag: bool = True
     n_elements: int = 16
     substeps: int = 2
+    link_model: Literal["linear", "nonlinear"] = "linear"
     sensor: SensorNoise = field(default_factory=SensorNoise)
     device: DeviceImperfections = field(default_factory=DeviceImperfections)
     description: str = ""
@@ -268,6 +278,11 @@ class Scenario:
             if self.contact_point is None:
                 raise ScenarioError("contact_point", f"is required for the {self.case} case")
             _finite("contact_point", self.contact_point, 0.0, strict=True)
+        if self.link_model not in LINK_MODELS:
+            raise ScenarioError(
+                "link_model",
+                f"must be one of {', '.join(LINK_MODELS)}, got {format_value(self.link_model)}",
+            )
         if self.obstacle is not None and self.obstacle not in OBSTACLE_KINDS:
             raise ScenarioError(
                 "obstacle",
