@@ -20,6 +20,7 @@ from sensing_antenna.estimation.front.frontend import FrontEnd, one_sample
 from sensing_antenna.estimation.methods import (
     EarlyStopping,
     EstimationMethod,
+    Preparing,
     Sessioned,
     resolve_method,
 )
@@ -77,6 +78,7 @@ class OnlineEstimator:
         # session of its own; the others are used as they are
         self._run = self.method.session() if isinstance(self.method, Sessioned) else self.method
         self._early = self._run if isinstance(self._run, EarlyStopping) else None
+        self._preparing = self._run if isinstance(self._run, Preparing) else None
 
     @property
     def n_samples(self) -> int:
@@ -159,6 +161,23 @@ class OnlineEstimator:
                 if not every_instant:
                     break
         return None if outcome is None else self._emit(conclude(outcome, self._run))
+
+    def prepare(self) -> bool:
+        """Use a moment the caller has nothing to feed: let a method that can
+        (:class:`~.methods.Preparing`, ``fast``) do one step of the work its next evaluation
+        will need from the samples already fed. Returns whether there was such a step (call
+        again while idle), False when there is nothing to do (cheap). Changes no estimate."""
+        front, preparing = self._front, self._preparing
+        first = front.first_evaluation_index
+        if self.result is not None or preparing is None or first is None:
+            return False
+        last = front.n_samples - 1
+        rest = front.rest_index
+        assert rest is not None
+        if last < first or not preparing.wants_to_prepare(last, rest, first, self.sample_period):
+            return False
+        evidence = front.evidence_at(last)
+        return isinstance(evidence, Evidence) and preparing.prepare(evidence)
 
     def _emit(self, result: ContactEstimate) -> ContactEstimate:
         self.result = result

@@ -7,7 +7,11 @@ takes everything queued since its last turn and feeds it as one block to the
 of the block, so the estimate is that of ``antenna estimate`` on the same samples however they
 were cut into blocks), writes it to the recording file if any, and gives the events
 (:mod:`.events`) to a callback. The reader therefore never waits for an estimate: a slow
-evaluation makes the next block longer, not the reader slower.
+evaluation makes the next block longer, not the reader slower. When nothing is queued the worker
+lets the estimator prepare its next evaluation
+(:meth:`~sensing_antenna.estimation.online.OnlineEstimator.prepare`: ``fast`` fits the shorter
+windows that evaluation reads), one step at a time, so the evaluation at the instant that becomes
+sure does little more than its own window's fit.
 """
 
 from __future__ import annotations
@@ -172,7 +176,14 @@ class Listener:
     def _work(self) -> None:
         try:
             while True:
-                items = [self._queue.get()]
+                try:
+                    first = self._queue.get_nowait()
+                except queue.Empty:
+                    # idle: a step of the next evaluation's work (one window fit), then look again
+                    if self._estimator.prepare():
+                        continue
+                    first = self._queue.get()
+                items = [first]
                 while True:
                     try:
                         items.append(self._queue.get_nowait())

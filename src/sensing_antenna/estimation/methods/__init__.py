@@ -9,6 +9,9 @@ Two optional abilities, each a protocol the online estimator checks once per man
   scans the same instants, so both forms stay identical.
 - :class:`Sessioned` (``fast``): ``session()`` gives a fresh method that keeps state over one
   manoeuvre (its window fits); the online estimator takes one at every reset.
+- :class:`Preparing` (``fast``'s session): ``wants_to_prepare(...)`` (cheap) and
+  ``prepare(evidence)``, one step of the work the next evaluation will need, done while the
+  online estimator's caller has nothing to feed; it changes no answer.
 
 A new method is added to ``_BUILTIN_METHODS``; the command line lists whatever :data:`METHODS`
 holds.
@@ -31,6 +34,7 @@ __all__ = [
     "METHODS",
     "EarlyStopping",
     "EstimationMethod",
+    "Preparing",
     "Sessioned",
     "UnknownMethodError",
     "resolve_method",
@@ -71,6 +75,23 @@ class Sessioned(EstimationMethod, Protocol):
 
     def session(self) -> EstimationMethod:
         """A fresh method for one manoeuvre (the online estimator takes one at every reset)."""
+        ...
+
+
+@runtime_checkable
+class Preparing(EstimationMethod, Protocol):
+    """A method (online: a session) that can do part of its next evaluation's work ahead of time,
+    from the samples already fed, without changing any answer."""
+
+    def wants_to_prepare(
+        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
+    ) -> bool:
+        """Whether :meth:`prepare` has work once the samples up to ``last_index`` have arrived
+        (t_1 at ``rest_index``, the evidence available from ``hold_end``, T_s in s); cheap."""
+        ...
+
+    def prepare(self, evidence: Evidence) -> bool:
+        """One step of that work on the evidence up to the last sample; False when none."""
         ...
 
 

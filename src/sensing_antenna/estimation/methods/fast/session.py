@@ -6,7 +6,10 @@ from typing import TYPE_CHECKING
 
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.conclude import conclude_fast
-from sensing_antenna.estimation.methods.fast.evaluation_grid import evaluation_offsets
+from sensing_antenna.estimation.methods.fast.evaluation_grid import (
+    evaluation_offsets,
+    reference_index,
+)
 from sensing_antenna.estimation.methods.fast.search import ScanResult, scan_inputs
 from sensing_antenna.estimation.methods.fast.second_mode import second_mode_chooser
 from sensing_antenna.estimation.methods.fast.window import (
@@ -14,7 +17,7 @@ from sensing_antenna.estimation.methods.fast.window import (
     WindowEstimate,
     evaluate_from_t1_or_hold,
 )
-from sensing_antenna.estimation.methods.fast.window_fit import FitCache, window_key
+from sensing_antenna.estimation.methods.fast.window_fit import FitCache, fit_window, window_key
 from sensing_antenna.estimation.result import ContactEstimate
 
 if TYPE_CHECKING:
@@ -34,6 +37,12 @@ class FastSession:
     the last before the samples ended). Asked at every grid instant, it gives the answers of
     the method without a session; asked at fewer (``OnlineEstimator.update_block``), the
     windows it skipped are never fitted.
+
+    Between evaluations, :meth:`prepare` fits ahead of time the shorter windows the next one
+    reads (its drift check's reference and, should it be the one declared, the slip check's),
+    so that the evaluation at the instant that becomes sure fits little more than its own
+    window. Every fit is a function of its window's samples alone, so the answers are the same
+    whether or not it was prepared.
     """
 
     def __init__(self, method: FastMethod) -> None:
@@ -41,6 +50,10 @@ class FastSession:
         self._caches: tuple[FitCache, FitCache] = ({}, {})
         # Digest of each window asked, by its last index (for the evaluation count)
         self._asked: dict[int, bytes] = {}
+        # Start of the last window evaluated (t_1, or the end of the hold after an opening)
+        self._start: int | None = None
+        # Windows (start, end, which cache) prepared or found in the caches
+        self._prepared: set[tuple[int, int, int]] = set()
 
     @property
     def name(self) -> str:
@@ -67,6 +80,7 @@ class FastSession:
             second_mode_chooser(evidence),
             with_early_statics=final,
         )
+        self._start = window.start_index
         self._asked[end] = window_key(
             inputs.channels,
             inputs.rest_index,
@@ -85,6 +99,67 @@ class FastSession:
             return True
         inputs = scan_inputs(evidence, self.method.config)
         return self._evaluate(inputs, evidence, evidence.end_index, final=False).sure
+
+    def _to_prepare(
+        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
+    ) -> list[tuple[int, int, int]]:
+        """The windows (start, end, cache: 0 from t_1, 1 from the hold's end) the evaluation at
+        the next grid instant after ``last_index`` reads besides its own, whose samples have
+        all arrived and which are not prepared yet: the drift check's reference of its window
+        from t_1 and, when the last evaluation restarted at the hold's end, of that window;
+        then the slip check's reference of the window the last evaluation kept."""
+        config = self.method.config
+        offsets = rest_index + evaluation_offsets(sample_period, config)
+        following = offsets[(offsets > last_index) & (offsets >= hold_end)]
+        if following.size == 0:
+            return []
+        j = int(following[0])
+        start = rest_index if self._start is None else self._start
+        starts = [(rest_index, 0)] + ([(start, 1)] if start != rest_index else [])
+        wanted = [
+            (begin, reference_index(begin, j, 2.0 / 3.0, sample_period, config), cache)
+            for begin, cache in starts
+        ]
+        kept = starts[-1]
+        wanted.append((kept[0], reference_index(kept[0], j, 0.5, sample_period, config), kept[1]))
+        return [
+            (begin, end, cache)
+            for begin, end, cache in wanted
+            if end is not None and end <= last_index and (begin, end, cache) not in self._prepared
+        ]
+
+    def wants_to_prepare(
+        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
+    ) -> bool:
+        """Whether :meth:`prepare` has a window to fit once the samples up to ``last_index`` have
+        arrived (t_1 at ``rest_index``, the hold ending at ``hold_end``, T_s in s); cheap."""
+        return bool(self._to_prepare(last_index, rest_index, hold_end, sample_period))
+
+    def prepare(self, evidence: Evidence) -> bool:
+        """Fit one window the next evaluation after ``evidence.end_index`` reads (the class
+        docstring), into this session's caches; False when there was none to fit.
+
+        The fit is that of the evaluation itself (the same function of the same samples), so
+        preparing changes no answer, only when its time is spent.
+        """
+        pending = self._to_prepare(
+            evidence.end_index, evidence.rest_index, evidence.hold_end, evidence.sample_period
+        )
+        if not pending:
+            return False
+        begin, end, cache = pending[0]
+        inputs = scan_inputs(evidence, self.method.config)
+        fit_window(
+            inputs.channels,
+            begin,
+            end,
+            inputs.sample_period,
+            inputs.band,
+            inputs.config,
+            self._caches[cache],
+        )
+        self._prepared.add((begin, end, cache))
+        return True
 
     def _asked_here(self, inputs: ScanInputs) -> set[int]:
         """Last indices of the windows asked on these very samples."""
