@@ -775,8 +775,9 @@ def test_preparing_between_samples_changes_no_estimate(
     # evaluation reads; every fit is a function of its window's samples, so an online estimator
     # that prepares whenever it can between samples gives the offline estimate, field by field
     # (evaluation count included); with max_opening = 1e-9 every window is restarted at the
-    # hold's end, whose windows are prepared too. Nothing to prepare before the hold's end
-    # (no evidence yet) nor once the estimate is given.
+    # hold's end, whose windows are prepared too. Preparing starts once the first window the
+    # evaluations read has arrived, before the hold's end (the first evaluation), and there is
+    # nothing to prepare once the estimate is given.
     antenna, recording = calibrated(), azimuthal.without_ground_truth()
     offline = estimate(recording, antenna, FastMethod(config)).to_dict()
     online = OnlineEstimator(antenna, recording.sample_period, FastMethod(config))
@@ -796,10 +797,9 @@ def test_preparing_between_samples_changes_no_estimate(
         if key != "diagnostics":
             assert streamed[key] == offline[key], key
     assert streamed["diagnostics"]["evaluations"] == offline["diagnostics"]["evaluations"]
-    hold_end = int(np.searchsorted(t, out.t_1)) + round(
-        EstimatorConfig().frame_window / recording.sample_period
-    )
-    assert steps and min(steps) > hold_end
+    rest = int(np.searchsorted(t, out.t_1))
+    hold_end = rest + round(EstimatorConfig().frame_window / recording.sample_period)
+    assert steps and rest < min(steps) < hold_end
 
 
 def _turned(recording: Recording, t_1: float, rate: float) -> Recording:

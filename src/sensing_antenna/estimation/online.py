@@ -17,6 +17,7 @@ from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.front.frontend import FrontEnd, one_sample
+from sensing_antenna.estimation.front.steps import samples
 from sensing_antenna.estimation.methods import (
     EarlyStopping,
     EstimationMethod,
@@ -164,20 +165,23 @@ class OnlineEstimator:
 
     def prepare(self) -> bool:
         """Use a moment the caller has nothing to feed: let a method that can
-        (:class:`~.methods.Preparing`, ``fast``) do one step of the work its next evaluation
-        will need from the samples already fed. Returns whether there was such a step (call
-        again while idle), False when there is nothing to do (cheap). Changes no estimate."""
+        (:class:`~.methods.Preparing`, ``fast``) do one step of the work its coming evaluations
+        will need from the samples already fed (from t_1 on). Returns whether there was such a
+        step (call again while idle), False when there is nothing to do (cheap). Changes no
+        estimate."""
         front, preparing = self._front, self._preparing
-        first = front.first_evaluation_index
-        if self.result is not None or preparing is None or first is None:
-            return False
-        last = front.n_samples - 1
         rest = front.rest_index
-        assert rest is not None
-        if last < first or not preparing.wants_to_prepare(last, rest, first, self.sample_period):
+        if self.result is not None or preparing is None or rest is None:
             return False
-        evidence = front.evidence_at(last)
-        return isinstance(evidence, Evidence) and preparing.prepare(evidence)
+        hold_end = front.first_evaluation_index
+        if hold_end is None:
+            # the end of the hold after t_1 the configuration gives, until the front end judges it
+            config, ts = self.config, self.sample_period
+            hold_end = rest + max(samples(config.frame_window, ts), samples(config.rest_window, ts))
+        last = front.n_samples - 1
+        if not preparing.wants_to_prepare(last, rest, hold_end, self.sample_period):
+            return False
+        return preparing.prepare(front.trace(), self.antenna, hold_end)
 
     def _emit(self, result: ContactEstimate) -> ContactEstimate:
         self.result = result

@@ -10,8 +10,8 @@ Two optional abilities, each a protocol the online estimator checks once per man
 - :class:`Sessioned` (``fast``): ``session()`` gives a fresh method that keeps state over one
   manoeuvre (its window fits); the online estimator takes one at every reset.
 - :class:`Preparing` (``fast``'s session): ``wants_to_prepare(...)`` (cheap) and
-  ``prepare(evidence)``, one step of the work the next evaluation will need, done while the
-  online estimator's caller has nothing to feed; it changes no answer.
+  ``prepare(samples, antenna, hold_end)``, one step of the work its coming evaluations will
+  need, done while the online estimator's caller has nothing to feed; it changes no answer.
 
 A new method is added to ``_BUILTIN_METHODS``; the command line lists whatever :data:`METHODS`
 holds.
@@ -23,8 +23,10 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Protocol, runtime_checkable
 
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.front.outcome import FrontTrace
 from sensing_antenna.estimation.methods.baselines import RatioMethod, TwoFrequencyMethod
 from sensing_antenna.estimation.methods.fast.method import FastMethod
 from sensing_antenna.estimation.methods.paper.fusion import PaperMethod
@@ -87,11 +89,11 @@ class Preparing(EstimationMethod, Protocol):
         self, last_index: int, rest_index: int, hold_end: int, sample_period: float
     ) -> bool:
         """Whether :meth:`prepare` has work once the samples up to ``last_index`` have arrived
-        (t_1 at ``rest_index``, the evidence available from ``hold_end``, T_s in s); cheap."""
+        (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s); cheap."""
         ...
 
-    def prepare(self, evidence: Evidence) -> bool:
-        """One step of that work on the evidence up to the last sample; False when none."""
+    def prepare(self, samples: FrontTrace, antenna: Antenna, hold_end: int) -> bool:
+        """One step of that work on the samples fed so far; False when there is none."""
         ...
 
 

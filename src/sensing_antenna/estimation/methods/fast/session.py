@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.front.outcome import FrontTrace
 from sensing_antenna.estimation.methods.fast.conclude import conclude_fast
 from sensing_antenna.estimation.methods.fast.evaluation_grid import (
     evaluation_offsets,
@@ -12,6 +14,7 @@ from sensing_antenna.estimation.methods.fast.evaluation_grid import (
 )
 from sensing_antenna.estimation.methods.fast.search import ScanResult, scan_inputs
 from sensing_antenna.estimation.methods.fast.second_mode import second_mode_chooser
+from sensing_antenna.estimation.methods.fast.static_fit import contact_channels
 from sensing_antenna.estimation.methods.fast.window import (
     ScanInputs,
     WindowEstimate,
@@ -38,11 +41,11 @@ class FastSession:
     the method without a session; asked at fewer (``OnlineEstimator.update_block``), the
     windows it skipped are never fitted.
 
-    Between evaluations, :meth:`prepare` fits ahead of time the shorter windows the next one
-    reads (its drift check's reference and, should it be the one declared, the slip check's),
-    so that the evaluation at the instant that becomes sure fits little more than its own
-    window. Every fit is a function of its window's samples alone, so the answers are the same
-    whether or not it was prepared.
+    Between evaluations, :meth:`prepare` fits ahead of time, as soon as their samples have
+    arrived, the shorter windows the coming evaluations read (their drift check's reference and,
+    should one be declared, its slip check's), so that the evaluation at the instant that
+    becomes sure fits little more than its own window. Every fit is a function of its window's
+    samples alone, so the answers are the same whether or not it was prepared.
     """
 
     def __init__(self, method: FastMethod) -> None:
@@ -50,10 +53,11 @@ class FastSession:
         self._caches: tuple[FitCache, FitCache] = ({}, {})
         # Digest of each window asked, by its last index (for the evaluation count)
         self._asked: dict[int, bytes] = {}
-        # Start of the last window evaluated (t_1, or the end of the hold after an opening)
-        self._start: int | None = None
-        # Windows (start, end, which cache) prepared or found in the caches
+        # Whether an evaluation restarted its window at the end of the hold (an opening)
+        self._restarted = False
+        # Windows (start, end, which cache) prepared, and the plan of those to prepare
         self._prepared: set[tuple[int, int, int]] = set()
+        self._planned: tuple[object, list[tuple[int, int, int]]] = (None, [])
 
     @property
     def name(self) -> str:
@@ -80,7 +84,7 @@ class FastSession:
             second_mode_chooser(evidence),
             with_early_statics=final,
         )
-        self._start = window.start_index
+        self._restarted |= window.start_index != inputs.rest_index
         self._asked[end] = window_key(
             inputs.channels,
             inputs.rest_index,
@@ -100,65 +104,72 @@ class FastSession:
         inputs = scan_inputs(evidence, self.method.config)
         return self._evaluate(inputs, evidence, evidence.end_index, final=False).sure
 
-    def _to_prepare(
-        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
+    def _plan(
+        self, rest_index: int, hold_end: int, sample_period: float
     ) -> list[tuple[int, int, int]]:
-        """The windows (start, end, cache: 0 from t_1, 1 from the hold's end) the evaluation at
-        the next grid instant after ``last_index`` reads besides its own, whose samples have
-        all arrived and which are not prepared yet: the drift check's reference of its window
-        from t_1 and, when the last evaluation restarted at the hold's end, of that window;
-        then the slip check's reference of the window the last evaluation kept."""
+        """The shorter windows the evaluations from ``hold_end`` on read besides their own, as
+        (start, end, cache: 0 from t_1, 1 from the hold's end), by end: for every grid instant
+        at or after ``hold_end``, the drift check's reference (2/3) and the slip check's (1/2)
+        of its window from t_1 and, once an evaluation restarted at the hold's end, of its
+        window from there."""
+        key = (rest_index, hold_end, sample_period, self._restarted)
+        if self._planned[0] == key:
+            return self._planned[1]
         config = self.method.config
-        offsets = rest_index + evaluation_offsets(sample_period, config)
-        following = offsets[(offsets > last_index) & (offsets >= hold_end)]
-        if following.size == 0:
-            return []
-        j = int(following[0])
-        start = rest_index if self._start is None else self._start
-        starts = [(rest_index, 0)] + ([(start, 1)] if start != rest_index else [])
-        wanted = [
-            (begin, reference_index(begin, j, 2.0 / 3.0, sample_period, config), cache)
+        instants = rest_index + evaluation_offsets(sample_period, config)
+        starts = [(rest_index, 0)] + ([(hold_end, 1)] if self._restarted else [])
+        wanted = {
+            (begin, reference_index(begin, int(j), fraction, sample_period, config), cache)
+            for j in instants[instants >= hold_end]
             for begin, cache in starts
-        ]
-        kept = starts[-1]
-        wanted.append((kept[0], reference_index(kept[0], j, 0.5, sample_period, config), kept[1]))
-        return [
-            (begin, end, cache)
-            for begin, end, cache in wanted
-            if end is not None and end <= last_index and (begin, end, cache) not in self._prepared
-        ]
+            for fraction in (2.0 / 3.0, 0.5)
+        }
+        plan = sorted(
+            ((begin, end, cache) for begin, end, cache in wanted if end is not None),
+            key=lambda item: (item[1], item[2]),
+        )
+        self._planned = (key, plan)
+        return plan
+
+    def _next_to_prepare(
+        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
+    ) -> tuple[int, int, int] | None:
+        """The first window of :meth:`_plan` not prepared yet, if its samples (up to
+        ``last_index``) have all arrived."""
+        for item in self._plan(rest_index, hold_end, sample_period):
+            if item[1] > last_index:
+                return None
+            if item not in self._prepared:
+                return item
+        return None
 
     def wants_to_prepare(
         self, last_index: int, rest_index: int, hold_end: int, sample_period: float
     ) -> bool:
         """Whether :meth:`prepare` has a window to fit once the samples up to ``last_index`` have
-        arrived (t_1 at ``rest_index``, the hold ending at ``hold_end``, T_s in s); cheap."""
-        return bool(self._to_prepare(last_index, rest_index, hold_end, sample_period))
+        arrived (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s); cheap."""
+        return self._next_to_prepare(last_index, rest_index, hold_end, sample_period) is not None
 
-    def prepare(self, evidence: Evidence) -> bool:
-        """Fit one window the next evaluation after ``evidence.end_index`` reads (the class
-        docstring), into this session's caches; False when there was none to fit.
+    def prepare(self, samples: FrontTrace, antenna: Antenna, hold_end: int) -> bool:
+        """Fit one window a coming evaluation reads (the class docstring), from the samples the
+        front end was fed so far (``samples``, of the manoeuvre ``antenna`` measured;
+        evaluations from ``hold_end`` on), into this session's caches; False when there is
+        none to fit.
 
         The fit is that of the evaluation itself (the same function of the same samples), so
         preparing changes no answer, only when its time is spent.
         """
-        pending = self._to_prepare(
-            evidence.end_index, evidence.rest_index, evidence.hold_end, evidence.sample_period
-        )
-        if not pending:
+        rest, ts = samples.rest_index, samples.sample_period
+        if rest is None:
             return False
-        begin, end, cache = pending[0]
-        inputs = scan_inputs(evidence, self.method.config)
-        fit_window(
-            inputs.channels,
-            begin,
-            end,
-            inputs.sample_period,
-            inputs.band,
-            inputs.config,
-            self._caches[cache],
-        )
-        self._prepared.add((begin, end, cache))
+        item = self._next_to_prepare(samples.t.shape[0] - 1, rest, hold_end, ts)
+        if item is None:
+            return False
+        begin, end, cache = item
+        channels = contact_channels(samples.theta, samples.force, samples.torque, antenna)
+        config = self.method.config
+        fit_window(channels, begin, end, ts, samples.band, config, self._caches[cache])
+        self._prepared.add(item)
         return True
 
     def _asked_here(self, inputs: ScanInputs) -> set[int]:
