@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING
 
 from sensing_antenna.antenna import Antenna
@@ -19,6 +20,7 @@ from sensing_antenna.estimation.methods.fast.window import (
     ScanInputs,
     WindowEstimate,
     evaluate_from_t1_or_hold,
+    with_early_statics_of,
 )
 from sensing_antenna.estimation.methods.fast.window_fit import FitCache, fit_window, window_key
 from sensing_antenna.estimation.result import ContactEstimate
@@ -58,6 +60,8 @@ class FastSession:
         # Windows (start, end, which cache) prepared, and the plan of those to prepare
         self._prepared: set[tuple[int, int, int]] = set()
         self._planned: tuple[object, list[tuple[int, int, int]]] = (None, [])
+        # The evidence :meth:`ready` was last asked on and the window it evaluated
+        self._last: tuple[Evidence, WindowEstimate] | None = None
 
     @property
     def name(self) -> str:
@@ -102,7 +106,25 @@ class FastSession:
         if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
             return True
         inputs = scan_inputs(evidence, self.method.config)
-        return self._evaluate(inputs, evidence, evidence.end_index, final=False).sure
+        window = self._evaluate(inputs, evidence, evidence.end_index, final=False)
+        self._last = (evidence, window)
+        return window.sure
+
+    def _kept(self, evidence: Evidence, inputs: ScanInputs, end: int) -> WindowEstimate | None:
+        """The window :meth:`ready` evaluated last, with the slip check's early statics, when it
+        ends at ``end`` and was asked on this very evidence (the same objects: the samples and
+        every other field but the trace); else None."""
+        if self._last is None:
+            return None
+        asked, window = self._last
+        same = all(
+            getattr(asked, name.name) is getattr(evidence, name.name)
+            for name in dataclasses.fields(Evidence)
+            if name.name != "trace"
+        )
+        if window.end_index != end or not same:
+            return None
+        return with_early_statics_of(inputs, window, self._caches)
 
     def _plan(
         self, rest_index: int, hold_end: int, sample_period: float
@@ -198,6 +220,8 @@ class FastSession:
         status, evaluation count (windows asked) and cap as :meth:`FastMethod.conclude` gives
         them when every earlier instant was unsure, so the same estimate when asked at every
         instant. When it was not (offline, or other samples), as :meth:`FastMethod.conclude`.
+        The window :meth:`ready` has just evaluated on the same evidence is taken as it is,
+        with its slip reference added, rather than evaluated again.
         """
         method = self.method
         inputs = scan_inputs(evidence, method.config)
@@ -207,7 +231,10 @@ class FastSession:
         instants = instants[(instants >= evidence.hold_end) & (instants <= evidence.end_index)]
         if not asked or instants.size == 0:
             return method.conclude(evidence, self._caches)
-        window = self._evaluate(inputs, evidence, int(instants[-1]), final=True)
+        end = int(instants[-1])
+        window = self._kept(evidence, inputs, end) or self._evaluate(
+            inputs, evidence, end, final=True
+        )
         count = len(asked | {window.end_index})
         reached_cap = inputs.rest_index + int(offsets[-1]) <= evidence.end_index
         result = ScanResult(window, count, reached_cap and not window.sure)
