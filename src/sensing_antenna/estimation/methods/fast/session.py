@@ -61,7 +61,7 @@ class FastSession:
         self._prepared: set[tuple[int, int, int]] = set()
         self._planned: tuple[object, list[tuple[int, int, int]]] = (None, [])
         # The evidence :meth:`ready` was last asked on and the window it evaluated
-        self._last: tuple[Evidence, WindowEstimate] | None = None
+        self._last: tuple[Evidence, ScanInputs, WindowEstimate] | None = None
 
     @property
     def name(self) -> str:
@@ -107,24 +107,22 @@ class FastSession:
             return True
         inputs = scan_inputs(evidence, self.method.config)
         window = self._evaluate(inputs, evidence, evidence.end_index, final=False)
-        self._last = (evidence, window)
+        self._last = (evidence, inputs, window)
         return window.sure
 
-    def _kept(self, evidence: Evidence, inputs: ScanInputs, end: int) -> WindowEstimate | None:
-        """The window :meth:`ready` evaluated last, with the slip check's early statics, when it
-        ends at ``end`` and was asked on this very evidence (the same objects: the samples and
-        every other field but the trace); else None."""
+    def _kept(self, evidence: Evidence) -> tuple[ScanInputs, WindowEstimate] | None:
+        """The inputs and the window :meth:`ready` evaluated last, when it was asked on this very
+        evidence (the same objects: the samples and every other field but the trace); else
+        None."""
         if self._last is None:
             return None
-        asked, window = self._last
+        asked, inputs, window = self._last
         same = all(
             getattr(asked, name.name) is getattr(evidence, name.name)
             for name in dataclasses.fields(Evidence)
             if name.name != "trace"
         )
-        if window.end_index != end or not same:
-            return None
-        return with_early_statics_of(inputs, window, self._caches)
+        return (inputs, window) if same else None
 
     def _plan(
         self, rest_index: int, hold_end: int, sample_period: float
@@ -224,7 +222,8 @@ class FastSession:
         with its slip reference added, rather than evaluated again.
         """
         method = self.method
-        inputs = scan_inputs(evidence, method.config)
+        kept = self._kept(evidence)
+        inputs = kept[0] if kept is not None else scan_inputs(evidence, method.config)
         asked = self._asked_here(inputs)
         offsets = evaluation_offsets(evidence.sample_period, method.config)
         instants = inputs.rest_index + offsets
@@ -232,9 +231,10 @@ class FastSession:
         if not asked or instants.size == 0:
             return method.conclude(evidence, self._caches)
         end = int(instants[-1])
-        window = self._kept(evidence, inputs, end) or self._evaluate(
-            inputs, evidence, end, final=True
-        )
+        if kept is not None and kept[1].end_index == end:
+            window = with_early_statics_of(inputs, kept[1], self._caches)
+        else:
+            window = self._evaluate(inputs, evidence, end, final=True)
         count = len(asked | {window.end_index})
         reached_cap = inputs.rest_index + int(offsets[-1]) <= evidence.end_index
         result = ScanResult(window, count, reached_cap and not window.sure)
