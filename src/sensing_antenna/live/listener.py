@@ -140,6 +140,7 @@ class Listener:
         self.lags: list[float] = []
         self._said: set[str] = set()
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self._step_time = 0.0  # wall time of the estimator's last preparing step (s)
         self.error: BaseException | None = None
         self._thread = threading.Thread(target=self._work, name="antenna-listen", daemon=True)
         self._thread.start()
@@ -179,8 +180,12 @@ class Listener:
                 try:
                     first = self._queue.get_nowait()
                 except queue.Empty:
-                    # idle: a step of the next evaluation's work (one window fit), then look again
-                    if self._estimator.prepare():
+                    # idle: a step of the coming evaluations' work (one window fit), then look
+                    # again; work for later evaluations waits when the next is due within the
+                    # time the last step took
+                    started = self._clock()
+                    if self._estimator.prepare(self._step_time):
+                        self._step_time = self._clock() - started
                         continue
                     first = self._queue.get()
                 items = [first]

@@ -86,13 +86,21 @@ class Preparing(EstimationMethod, Protocol):
     from the samples already fed, without changing any answer."""
 
     def wants_to_prepare(
-        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
+        self,
+        last_index: int,
+        rest_index: int,
+        hold_end: int,
+        sample_period: float,
+        step_time: float = 0.0,
     ) -> bool:
         """Whether :meth:`prepare` has work once the samples up to ``last_index`` have arrived
-        (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s); cheap."""
+        (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s; ``step_time``: how
+        long a step is expected to take, in s); cheap."""
         ...
 
-    def prepare(self, samples: FrontTrace, antenna: Antenna, hold_end: int) -> bool:
+    def prepare(
+        self, samples: FrontTrace, antenna: Antenna, hold_end: int, step_time: float = 0.0
+    ) -> bool:
         """One step of that work on the samples fed so far; False when there is none."""
         ...
 

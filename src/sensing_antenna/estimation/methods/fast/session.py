@@ -59,7 +59,7 @@ class FastSession:
         self._restarted = False
         # Windows (start, end, which cache) prepared, and the plan of those to prepare
         self._prepared: set[tuple[int, int, int]] = set()
-        self._planned: tuple[object, list[tuple[int, int, int]]] = (None, [])
+        self._planned: tuple[object, list[tuple[int, int, int, int]]] = (None, [])
         # The evidence :meth:`ready` was last asked on and the window it evaluated
         self._last: tuple[Evidence, ScanInputs, WindowEstimate] | None = None
 
@@ -126,55 +126,75 @@ class FastSession:
 
     def _plan(
         self, rest_index: int, hold_end: int, sample_period: float
-    ) -> list[tuple[int, int, int]]:
+    ) -> list[tuple[int, int, int, int]]:
         """The shorter windows the evaluations from ``hold_end`` on read besides their own, as
-        (start, end, cache: 0 from t_1, 1 from the hold's end), by end: for every grid instant
-        at or after ``hold_end``, the drift check's reference (2/3) and the slip check's (1/2)
-        of its window from t_1 and, once an evaluation restarted at the hold's end, of its
-        window from there."""
+        (start, end, cache: 0 from t_1, 1 from the hold's end, the first grid instant that reads
+        it), by end: for every grid instant at or after ``hold_end``, the drift check's
+        reference (2/3) and the slip check's (1/2) of its window from t_1 and, once an
+        evaluation restarted at the hold's end, of its window from there."""
         key = (rest_index, hold_end, sample_period, self._restarted)
         if self._planned[0] == key:
             return self._planned[1]
         config = self.method.config
         instants = rest_index + evaluation_offsets(sample_period, config)
         starts = [(rest_index, 0)] + ([(hold_end, 1)] if self._restarted else [])
-        wanted = {
-            (begin, reference_index(begin, int(j), fraction, sample_period, config), cache)
-            for j in instants[instants >= hold_end]
-            for begin, cache in starts
-            for fraction in (2.0 / 3.0, 0.5)
-        }
+        first_reader: dict[tuple[int, int, int], int] = {}
+        for j in instants[instants >= hold_end][::-1]:
+            for begin, cache in starts:
+                for fraction in (2.0 / 3.0, 0.5):
+                    end = reference_index(begin, int(j), fraction, sample_period, config)
+                    if end is not None:
+                        first_reader[(begin, end, cache)] = int(j)
         plan = sorted(
-            ((begin, end, cache) for begin, end, cache in wanted if end is not None),
-            key=lambda item: (item[1], item[2]),
+            ((*item, j) for item, j in first_reader.items()), key=lambda item: (item[1], item[2])
         )
         self._planned = (key, plan)
         return plan
 
     def _next_to_prepare(
-        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
-    ) -> tuple[int, int, int] | None:
-        """The first window of :meth:`_plan` not prepared yet, if its samples (up to
-        ``last_index``) have all arrived."""
+        self,
+        last_index: int,
+        rest_index: int,
+        hold_end: int,
+        sample_period: float,
+        step_time: float,
+    ) -> tuple[int, int, int, int] | None:
+        """The first window of :meth:`_plan` not prepared yet whose samples (up to
+        ``last_index``) have all arrived, and that the next evaluation reads or, when that
+        evaluation's sample is more than ``step_time`` (s) of samples away, any later one."""
+        instants = rest_index + evaluation_offsets(sample_period, self.method.config)
+        coming = instants[(instants > last_index) & (instants >= hold_end)]
+        following = int(coming[0]) if coming.size else None
+        ahead = following is None or (following - last_index) * sample_period > step_time
         for item in self._plan(rest_index, hold_end, sample_period):
             if item[1] > last_index:
                 return None
-            if item not in self._prepared:
+            if item[:3] not in self._prepared and (ahead or item[3] <= (following or 0)):
                 return item
         return None
 
     def wants_to_prepare(
-        self, last_index: int, rest_index: int, hold_end: int, sample_period: float
+        self,
+        last_index: int,
+        rest_index: int,
+        hold_end: int,
+        sample_period: float,
+        step_time: float = 0.0,
     ) -> bool:
         """Whether :meth:`prepare` has a window to fit once the samples up to ``last_index`` have
-        arrived (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s); cheap."""
-        return self._next_to_prepare(last_index, rest_index, hold_end, sample_period) is not None
+        arrived (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s; a window
+        only a later evaluation than the next reads waits while the next one's sample is less
+        than ``step_time`` s away, so that a fit started now does not delay it); cheap."""
+        item = self._next_to_prepare(last_index, rest_index, hold_end, sample_period, step_time)
+        return item is not None
 
-    def prepare(self, samples: FrontTrace, antenna: Antenna, hold_end: int) -> bool:
+    def prepare(
+        self, samples: FrontTrace, antenna: Antenna, hold_end: int, step_time: float = 0.0
+    ) -> bool:
         """Fit one window a coming evaluation reads (the class docstring), from the samples the
         front end was fed so far (``samples``, of the manoeuvre ``antenna`` measured;
-        evaluations from ``hold_end`` on), into this session's caches; False when there is
-        none to fit.
+        evaluations from ``hold_end`` on; ``step_time`` as for :meth:`wants_to_prepare`), into
+        this session's caches; False when there is none to fit.
 
         The fit is that of the evaluation itself (the same function of the same samples), so
         preparing changes no answer, only when its time is spent.
@@ -182,14 +202,14 @@ class FastSession:
         rest, ts = samples.rest_index, samples.sample_period
         if rest is None:
             return False
-        item = self._next_to_prepare(samples.t.shape[0] - 1, rest, hold_end, ts)
+        item = self._next_to_prepare(samples.t.shape[0] - 1, rest, hold_end, ts, step_time)
         if item is None:
             return False
-        begin, end, cache = item
+        begin, end, cache, _ = item
         channels = contact_channels(samples.theta, samples.force, samples.torque, antenna)
         config = self.method.config
         fit_window(channels, begin, end, ts, samples.band, config, self._caches[cache])
-        self._prepared.add(item)
+        self._prepared.add((begin, end, cache))
         return True
 
     def _asked_here(self, inputs: ScanInputs) -> set[int]:
