@@ -181,10 +181,10 @@ class Listener:
                     first = self._queue.get_nowait()
                 except queue.Empty:
                     # idle: a step of the coming evaluations' work (one window fit), then look
-                    # again; work for later evaluations waits when the next is due within the
-                    # time the last step took
+                    # again; work for later evaluations than the next waits when the next is
+                    # due within 1.5 times the last step's time (a loaded machine stretches it)
                     started = self._clock()
-                    if self._estimator.prepare(self._step_time):
+                    if self._estimator.prepare(1.5 * self._step_time):
                         self._step_time = self._clock() - started
                         continue
                     first = self._queue.get()
