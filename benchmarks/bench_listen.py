@@ -4,9 +4,9 @@ A sender process replays two simulated recordings of the paper antenna (the azim
 x_c = 0.6 m and the vertical case at x_c = 0.7 m, 3 s each) one after the other over UDP on
 localhost, at their own pace (1 kHz, one datagram a sample), for ``--duration`` seconds; this
 process listens (the reader of :func:`sensing_antenna.live.inputs.listen_udp`, a listener and
-its worker thread per recording), as ``antenna listen --udp`` does. Each method's kernels are
-loaded by one offline estimate first, as a lab would start its listener before its first
-manoeuvre.
+its worker thread per recording), as ``antenna listen --udp`` does, warmed up as it is by
+default (:func:`sensing_antenna.live.warm_up.warm_up`: one simulated manoeuvre through the
+method, then the heap frozen), as a lab would start its listener before its first manoeuvre.
 
 Reported per method: recordings and samples received, samples dropped (sent but not received),
 whether every recording's estimate equals the offline ``estimate`` of the same recording, the
@@ -14,12 +14,15 @@ latency of the events (wall time from the receipt of the sample an event is at t
 emission: p50, p99, max over all events but the ends, over the estimates alone, and over the
 instants: contact, push, contact lost) and the worker's lag
 (for each block it took, from the receipt of its first sample to the end of its processing).
-The target: no sample dropped, p99 latency under 20 ms.
+The target: no sample dropped, p99 latency under 20 ms. Each method's row also holds when it
+ran, for how long and the load average of the machine before and after (the listener shares the
+cores with the sender and whatever else runs). The results file keeps the rows of the methods
+not run this time.
 
 Usage::
 
     python benchmarks/bench_listen.py                      # 10 minutes per method
-    python benchmarks/bench_listen.py --duration 60 --methods fast,paper
+    python benchmarks/bench_listen.py --duration 60 --methods fast
 """
 
 from __future__ import annotations
@@ -55,6 +58,7 @@ from sensing_antenna.live.events import (  # noqa: E402
 )
 from sensing_antenna.live.inputs import listen_udp  # noqa: E402
 from sensing_antenna.live.listener import Listener  # noqa: E402
+from sensing_antenna.live.warm_up import warm_up  # noqa: E402
 from sensing_antenna.live.wire import StreamHeader  # noqa: E402
 from sensing_antenna.recording import read_recording, write_recording  # noqa: E402
 from sensing_antenna.simulator import Scenario, simulate  # noqa: E402
@@ -95,7 +99,10 @@ def run_method(method: str, files: list[Path], duration: float) -> dict[str, Any
     # the estimators' model: the simulated device's own T as a calibration gives it (0.1 %)
     antenna = paper_antenna().self_calibrated()
     recordings = [read_recording(path) for path in files]
-    offline = [estimate(r, antenna, method).to_dict() for r in recordings]  # also loads kernels
+    offline = [estimate(r, antenna, method).to_dict() for r in recordings]
+    warm_up(antenna, method)  # as antenna listen does before listening
+    load_before = os.getloadavg()
+    started = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     per_recording = recordings[0].duration + recordings[0].sample_period
     count = max(1, math.ceil(duration / per_recording))
     events: list[Event] = []
@@ -130,6 +137,10 @@ def run_method(method: str, files: list[Path], duration: float) -> dict[str, Any
     latencies = [e.latency for e in events if not isinstance(e, EndEvent)]
     return {
         "method": method,
+        "date": started,
+        "duration_s": duration,
+        "load_average_before": [round(x, 2) for x in load_before],
+        "load_average_after": [round(x, 2) for x in os.getloadavg()],
         "recordings_sent": count,
         "recordings_ended": ended,
         "samples_sent": sent,
@@ -174,7 +185,9 @@ def main() -> None:
             rows.append(run_method(method, files, args.duration))
             row = rows[-1]
             print(
-                f"{method:14s} recordings {row['recordings_ended']:4d} samples"
+                f"{method:14s} load {row['load_average_before'][0]:.2f}->"
+                f"{row['load_average_after'][0]:.2f} recordings {row['recordings_ended']:4d}"
+                " samples"
                 f" {row['samples_received']:7d} dropped {row['dropped']:4d} identical"
                 f" {row['estimates_identical_to_offline']}/{row['estimates']}"
                 "  latency ms p50/p99/max "
@@ -187,13 +200,24 @@ def main() -> None:
                 + "/".join(_ms(row["worker_lag_s"][k]) for k in ("p50", "p99", "max")),
                 flush=True,
             )
+    run = {row["method"] for row in rows}
+    kept = []
+    if args.out.exists():
+        earlier = json.loads(args.out.read_text())
+        for row in earlier["methods"]:
+            if row["method"] not in run:
+                # rows of files written before the rows held their own date and duration
+                row.setdefault("date", earlier.get("date"))
+                row.setdefault("duration_s", earlier.get("duration_s"))
+                kept.append(row)
     data = {
-        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count()},
-        "duration_s": args.duration,
         "rate_hz": 1000,
         "target_p99_s": TARGET_P99_S,
-        "methods": rows,
+        "methods": sorted(
+            kept + rows,
+            key=lambda row: METHODS.index(row["method"]) if row["method"] in METHODS else 99,
+        ),
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(data, indent=2) + "\n")

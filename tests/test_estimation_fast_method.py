@@ -763,6 +763,46 @@ def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
         )
 
 
+@pytest.mark.parametrize(
+    ("config", "step_time"),
+    [(FastConfig(), 0.0), (FastConfig(), 10.0), (FastConfig(max_opening=1e-9, cap=0.6), 0.0)],
+    ids=["default", "next evaluation's windows only", "windows restarted at the hold's end"],
+)
+def test_preparing_between_samples_changes_no_estimate(
+    azimuthal: Recording, config: FastConfig, step_time: float
+) -> None:
+    # OnlineEstimator.prepare (a listener's idle time) fits ahead the shorter windows the next
+    # evaluation reads; every fit is a function of its window's samples, so an online estimator
+    # that prepares whenever it can between samples gives the offline estimate, field by field
+    # (evaluation count included); with max_opening = 1e-9 every window is restarted at the
+    # hold's end, whose windows are prepared too; with a step time of 10 s only the windows the
+    # next evaluation reads are. Preparing starts once the first window the evaluations read
+    # has arrived, before the hold's end (the first evaluation), and there is nothing to prepare
+    # once the estimate is given.
+    antenna, recording = calibrated(), azimuthal.without_ground_truth()
+    offline = estimate(recording, antenna, FastMethod(config)).to_dict()
+    online = OnlineEstimator(antenna, recording.sample_period, FastMethod(config))
+    t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
+    steps: list[int] = []
+    out = None
+    for k in range(t.shape[0]):
+        while online.prepare(step_time):
+            steps.append(k)
+        out = online.update(t[k], theta[k], force[k], torque[k])
+        if out is not None:
+            break
+    assert out is not None
+    assert not online.prepare()
+    streamed = out.to_dict()
+    for key in offline:
+        if key != "diagnostics":
+            assert streamed[key] == offline[key], key
+    assert streamed["diagnostics"]["evaluations"] == offline["diagnostics"]["evaluations"]
+    rest = int(np.searchsorted(t, out.t_1))
+    hold_end = rest + round(EstimatorConfig().frame_window / recording.sample_period)
+    assert steps and rest < min(steps) < hold_end
+
+
 def _turned(recording: Recording, t_1: float, rate: float) -> Recording:
     """``recording`` with its contact loads turning about X^m at ``rate`` (rad/s) for 1 s from
     t_1, as a contact sliding round the obstacle turns them: the force and the torque minus

@@ -6,6 +6,7 @@ The recordings are made by ``antenna simulate`` (paper antenna, both cases)."""
 
 from __future__ import annotations
 
+import gc
 import io
 import json
 import os
@@ -34,6 +35,7 @@ from sensing_antenna.live.events import (
 from sensing_antenna.live.inputs import listen_lines, listen_udp
 from sensing_antenna.live.listener import CONTACT_LOST_TIME, Listener
 from sensing_antenna.live.replay import replay_datagrams, replay_lines, stream_of
+from sensing_antenna.live.warm_up import warm_up
 from sensing_antenna.live.wire import (
     Datagram,
     StreamHeader,
@@ -260,7 +262,7 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
     ]
     for lines, message in cases:
         done = subprocess.run(
-            _cli("listen"),
+            _cli("listen", "--no-warm-up"),
             input="".join(lines),
             capture_output=True,
             text=True,
@@ -358,3 +360,16 @@ def test_replay_keeps_the_recordings_pace(recordings: dict[str, Path]) -> None:
     # never early, and never later than the next sample's turn
     assert np.all(sent_at >= due) and np.all(sent_at[:-1] <= due[1:])
     assert now[0] == pytest.approx(recording.duration / speed)
+
+
+def test_warm_up_runs_a_manoeuvre_and_freezes_the_heap() -> None:
+    # antenna listen warms up by default: one simulated manoeuvre through the method (its
+    # kernels loaded, the antenna's curves built), then the objects alive are left out of the
+    # garbage collector's passes (test_replay_piped_to_listen_and_recorded: the estimate after
+    # it is the offline one)
+    gc.unfreeze()
+    try:
+        assert warm_up(paper_antenna(), "fast") > 0.0
+        assert gc.get_freeze_count() > 0
+    finally:
+        gc.unfreeze()

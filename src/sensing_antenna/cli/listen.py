@@ -47,6 +47,14 @@ def register(subparsers: Any) -> None:
         metavar="N",
         help="stop after N recordings ended (default: when the input ends; over UDP, on Ctrl-C)",
     )
+    parser.add_argument(
+        "--warm-up",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="before listening, run one simulated manoeuvre of the antenna through the method, "
+        "so that the first recording's events do not wait for the method's kernels to load "
+        "(about a second; default: on)",
+    )
     parser.set_defaults(func=_run)
 
 
@@ -56,11 +64,13 @@ def _run(args: argparse.Namespace) -> int:
 
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.cli.arguments import ArgumentError
+    from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.live.events import Event
     from sensing_antenna.live.inputs import listen_lines, listen_udp, parse_address
     from sensing_antenna.live.listener import Listener
     from sensing_antenna.live.record import RecordWriter, numbered_path
+    from sensing_antenna.live.warm_up import freeze_heap, warm_up
     from sensing_antenna.live.wire import StreamHeader, WireError
 
     antenna = load_antenna(args.antenna)
@@ -79,7 +89,18 @@ def _run(args: argparse.Namespace) -> int:
             record = RecordWriter(numbered_path(args.record, number), header)
         return Listener(header, antenna, emit, args.method, config, record, number)
 
+    def ready() -> None:
+        if not args.warm_up:
+            freeze_heap()
+            return
+        try:
+            warm_up(antenna, args.method, config)
+        except SensingAntennaError as exc:  # a model the simulator refuses: listen anyway
+            freeze_heap()
+            print(f"antenna listen: warm-up skipped: {exc}", file=sys.stderr, flush=True)
+
     if args.udp is None:
+        ready()
         listen_lines(sys.stdin.buffer, make, "<stdin>", args.count)
         return 0
     try:
@@ -96,6 +117,7 @@ def _run(args: argparse.Namespace) -> int:
             raise ArgumentError(
                 "--udp", f"cannot listen on {args.udp}: {exc.strerror or exc}"
             ) from None
+        ready()
         host, port = sock.getsockname()[:2]
         print(f"antenna listen: listening on udp {host}:{port}", file=sys.stderr, flush=True)
         listen_udp(sock, make, emit, args.count)

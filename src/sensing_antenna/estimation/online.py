@@ -17,9 +17,11 @@ from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.front.frontend import FrontEnd, one_sample
+from sensing_antenna.estimation.front.steps import samples
 from sensing_antenna.estimation.methods import (
     EarlyStopping,
     EstimationMethod,
+    Preparing,
     Sessioned,
     resolve_method,
 )
@@ -77,6 +79,7 @@ class OnlineEstimator:
         # session of its own; the others are used as they are
         self._run = self.method.session() if isinstance(self.method, Sessioned) else self.method
         self._early = self._run if isinstance(self._run, EarlyStopping) else None
+        self._preparing = self._run if isinstance(self._run, Preparing) else None
 
     @property
     def n_samples(self) -> int:
@@ -159,6 +162,31 @@ class OnlineEstimator:
                 if not every_instant:
                     break
         return None if outcome is None else self._emit(conclude(outcome, self._run))
+
+    def prepare(self, step_time: float = 0.0) -> bool:
+        """Use a moment the caller has nothing to feed: let a method that can
+        (:class:`~.methods.Preparing`, ``fast``) do one step of the work its coming evaluations
+        will need from the samples already fed (from t_1 on). Returns whether there was such a
+        step (call again while idle), False when there is nothing to do (cheap). Changes no
+        estimate.
+
+        ``step_time`` (s): how long a step is expected to take (the caller's last one, say).
+        Work that only a later evaluation than the next needs waits while the next one's
+        sample, the samples arriving at their own pace, is due sooner than that.
+        """
+        front, preparing = self._front, self._preparing
+        rest = front.rest_index
+        if self.result is not None or preparing is None or rest is None:
+            return False
+        hold_end = front.first_evaluation_index
+        if hold_end is None:
+            # the end of the hold after t_1 the configuration gives, until the front end judges it
+            config, ts = self.config, self.sample_period
+            hold_end = rest + max(samples(config.frame_window, ts), samples(config.rest_window, ts))
+        last, ts = front.n_samples - 1, self.sample_period
+        if not preparing.wants_to_prepare(last, rest, hold_end, ts, step_time):
+            return False
+        return preparing.prepare(front.trace(), self.antenna, hold_end, step_time)
 
     def _emit(self, result: ContactEstimate) -> ContactEstimate:
         self.result = result

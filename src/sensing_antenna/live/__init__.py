@@ -7,5 +7,6 @@
   queues samples, a worker thread feeds them to the online estimator;
 - :mod:`.inputs`: the readers of standard input and of a UDP socket;
 - :mod:`.record`: what was received, written as a recording while it arrives;
-- :mod:`.replay`: a recording sent at its own pace, to a text stream or over UDP.
+- :mod:`.replay`: a recording sent at its own pace, to a text stream or over UDP;
+- :mod:`.warm_up`: a listener's process made ready before the first sample arrives.
 """

@@ -7,7 +7,11 @@ takes everything queued since its last turn and feeds it as one block to the
 of the block, so the estimate is that of ``antenna estimate`` on the same samples however they
 were cut into blocks), writes it to the recording file if any, and gives the events
 (:mod:`.events`) to a callback. The reader therefore never waits for an estimate: a slow
-evaluation makes the next block longer, not the reader slower.
+evaluation makes the next block longer, not the reader slower. When nothing is queued the worker
+lets the estimator prepare its next evaluation
+(:meth:`~sensing_antenna.estimation.online.OnlineEstimator.prepare`: ``fast`` fits the shorter
+windows that evaluation reads), one step at a time, so the evaluation at the instant that becomes
+sure does little more than its own window's fit.
 """
 
 from __future__ import annotations
@@ -136,6 +140,7 @@ class Listener:
         self.lags: list[float] = []
         self._said: set[str] = set()
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self._step_time = 0.0  # wall time of the estimator's last preparing step (s)
         self.error: BaseException | None = None
         self._thread = threading.Thread(target=self._work, name="antenna-listen", daemon=True)
         self._thread.start()
@@ -172,7 +177,18 @@ class Listener:
     def _work(self) -> None:
         try:
             while True:
-                items = [self._queue.get()]
+                try:
+                    first = self._queue.get_nowait()
+                except queue.Empty:
+                    # idle: a step of the coming evaluations' work (one window fit), then look
+                    # again; work for later evaluations than the next waits when the next is
+                    # due within 1.5 times the last step's time (a loaded machine stretches it)
+                    started = self._clock()
+                    if self._estimator.prepare(1.5 * self._step_time):
+                        self._step_time = self._clock() - started
+                        continue
+                    first = self._queue.get()
+                items = [first]
                 while True:
                     try:
                         items.append(self._queue.get_nowait())

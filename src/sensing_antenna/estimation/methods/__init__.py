@@ -9,6 +9,9 @@ Two optional abilities, each a protocol the online estimator checks once per man
   scans the same instants, so both forms stay identical.
 - :class:`Sessioned` (``fast``): ``session()`` gives a fresh method that keeps state over one
   manoeuvre (its window fits); the online estimator takes one at every reset.
+- :class:`Preparing` (``fast``'s session): ``wants_to_prepare(...)`` (cheap) and
+  ``prepare(samples, antenna, hold_end)``, one step of the work its coming evaluations will
+  need, done while the online estimator's caller has nothing to feed; it changes no answer.
 
 A new method is added to ``_BUILTIN_METHODS``; the command line lists whatever :data:`METHODS`
 holds.
@@ -20,8 +23,10 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Protocol, runtime_checkable
 
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.front.outcome import FrontTrace
 from sensing_antenna.estimation.methods.baselines import RatioMethod, TwoFrequencyMethod
 from sensing_antenna.estimation.methods.fast.method import FastMethod
 from sensing_antenna.estimation.methods.paper.fusion import PaperMethod
@@ -31,6 +36,7 @@ __all__ = [
     "METHODS",
     "EarlyStopping",
     "EstimationMethod",
+    "Preparing",
     "Sessioned",
     "UnknownMethodError",
     "resolve_method",
@@ -71,6 +77,31 @@ class Sessioned(EstimationMethod, Protocol):
 
     def session(self) -> EstimationMethod:
         """A fresh method for one manoeuvre (the online estimator takes one at every reset)."""
+        ...
+
+
+@runtime_checkable
+class Preparing(EstimationMethod, Protocol):
+    """A method (online: a session) that can do part of its next evaluation's work ahead of time,
+    from the samples already fed, without changing any answer."""
+
+    def wants_to_prepare(
+        self,
+        last_index: int,
+        rest_index: int,
+        hold_end: int,
+        sample_period: float,
+        step_time: float = 0.0,
+    ) -> bool:
+        """Whether :meth:`prepare` has work once the samples up to ``last_index`` have arrived
+        (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s; ``step_time``: how
+        long a step is expected to take, in s); cheap."""
+        ...
+
+    def prepare(
+        self, samples: FrontTrace, antenna: Antenna, hold_end: int, step_time: float = 0.0
+    ) -> bool:
+        """One step of that work on the samples fed so far; False when there is none."""
         ...
 
 

@@ -2,19 +2,27 @@
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING
 
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.front.outcome import FrontTrace
 from sensing_antenna.estimation.methods.fast.conclude import conclude_fast
-from sensing_antenna.estimation.methods.fast.evaluation_grid import evaluation_offsets
+from sensing_antenna.estimation.methods.fast.evaluation_grid import (
+    evaluation_offsets,
+    reference_index,
+)
 from sensing_antenna.estimation.methods.fast.search import ScanResult, scan_inputs
 from sensing_antenna.estimation.methods.fast.second_mode import second_mode_chooser
+from sensing_antenna.estimation.methods.fast.static_fit import contact_channels
 from sensing_antenna.estimation.methods.fast.window import (
     ScanInputs,
     WindowEstimate,
     evaluate_from_t1_or_hold,
+    with_early_statics_of,
 )
-from sensing_antenna.estimation.methods.fast.window_fit import FitCache, window_key
+from sensing_antenna.estimation.methods.fast.window_fit import FitCache, fit_window, window_key
 from sensing_antenna.estimation.result import ContactEstimate
 
 if TYPE_CHECKING:
@@ -34,6 +42,12 @@ class FastSession:
     the last before the samples ended). Asked at every grid instant, it gives the answers of
     the method without a session; asked at fewer (``OnlineEstimator.update_block``), the
     windows it skipped are never fitted.
+
+    Between evaluations, :meth:`prepare` fits ahead of time, as soon as their samples have
+    arrived, the shorter windows the coming evaluations read (their drift check's reference and,
+    should one be declared, its slip check's), so that the evaluation at the instant that
+    becomes sure fits little more than its own window. Every fit is a function of its window's
+    samples alone, so the answers are the same whether or not it was prepared.
     """
 
     def __init__(self, method: FastMethod) -> None:
@@ -41,6 +55,13 @@ class FastSession:
         self._caches: tuple[FitCache, FitCache] = ({}, {})
         # Digest of each window asked, by its last index (for the evaluation count)
         self._asked: dict[int, bytes] = {}
+        # Whether an evaluation restarted its window at the end of the hold (an opening)
+        self._restarted = False
+        # Windows (start, end, which cache) prepared, and the plan of those to prepare
+        self._prepared: set[tuple[int, int, int]] = set()
+        self._planned: tuple[object, list[tuple[int, int, int, int]]] = (None, [])
+        # The evidence :meth:`ready` was last asked on and the window it evaluated
+        self._last: tuple[Evidence, ScanInputs, WindowEstimate] | None = None
 
     @property
     def name(self) -> str:
@@ -67,6 +88,7 @@ class FastSession:
             second_mode_chooser(evidence),
             with_early_statics=final,
         )
+        self._restarted |= window.start_index != inputs.rest_index
         self._asked[end] = window_key(
             inputs.channels,
             inputs.rest_index,
@@ -84,7 +106,111 @@ class FastSession:
         if evidence.end_index >= evidence.rest_index + int(offsets[-1]):
             return True
         inputs = scan_inputs(evidence, self.method.config)
-        return self._evaluate(inputs, evidence, evidence.end_index, final=False).sure
+        window = self._evaluate(inputs, evidence, evidence.end_index, final=False)
+        self._last = (evidence, inputs, window)
+        return window.sure
+
+    def _kept(self, evidence: Evidence) -> tuple[ScanInputs, WindowEstimate] | None:
+        """The inputs and the window :meth:`ready` evaluated last, when it was asked on this very
+        evidence (the same objects: the samples and every other field but the trace); else
+        None."""
+        if self._last is None:
+            return None
+        asked, inputs, window = self._last
+        same = all(
+            getattr(asked, name.name) is getattr(evidence, name.name)
+            for name in dataclasses.fields(Evidence)
+            if name.name != "trace"
+        )
+        return (inputs, window) if same else None
+
+    def _plan(
+        self, rest_index: int, hold_end: int, sample_period: float
+    ) -> list[tuple[int, int, int, int]]:
+        """The shorter windows the evaluations from ``hold_end`` on read besides their own, as
+        (start, end, cache: 0 from t_1, 1 from the hold's end, the first grid instant that reads
+        it), by end: for every grid instant at or after ``hold_end``, the drift check's
+        reference (2/3) and the slip check's (1/2) of its window from t_1 and, once an
+        evaluation restarted at the hold's end, of its window from there."""
+        key = (rest_index, hold_end, sample_period, self._restarted)
+        if self._planned[0] == key:
+            return self._planned[1]
+        config = self.method.config
+        instants = rest_index + evaluation_offsets(sample_period, config)
+        starts = [(rest_index, 0)] + ([(hold_end, 1)] if self._restarted else [])
+        first_reader: dict[tuple[int, int, int], int] = {}
+        for j in instants[instants >= hold_end][::-1]:
+            for begin, cache in starts:
+                for fraction in (2.0 / 3.0, 0.5):
+                    end = reference_index(begin, int(j), fraction, sample_period, config)
+                    if end is not None:
+                        first_reader[(begin, end, cache)] = int(j)
+        plan = sorted(
+            ((*item, j) for item, j in first_reader.items()), key=lambda item: (item[1], item[2])
+        )
+        self._planned = (key, plan)
+        return plan
+
+    def _next_to_prepare(
+        self,
+        last_index: int,
+        rest_index: int,
+        hold_end: int,
+        sample_period: float,
+        step_time: float,
+    ) -> tuple[int, int, int, int] | None:
+        """The first window of :meth:`_plan` not prepared yet whose samples (up to
+        ``last_index``) have all arrived, and that the next evaluation reads or, when that
+        evaluation's sample is more than ``step_time`` (s) of samples away, any later one."""
+        instants = rest_index + evaluation_offsets(sample_period, self.method.config)
+        coming = instants[(instants > last_index) & (instants >= hold_end)]
+        following = int(coming[0]) if coming.size else None
+        ahead = following is None or (following - last_index) * sample_period > step_time
+        for item in self._plan(rest_index, hold_end, sample_period):
+            if item[1] > last_index:
+                return None
+            if item[:3] not in self._prepared and (ahead or item[3] <= (following or 0)):
+                return item
+        return None
+
+    def wants_to_prepare(
+        self,
+        last_index: int,
+        rest_index: int,
+        hold_end: int,
+        sample_period: float,
+        step_time: float = 0.0,
+    ) -> bool:
+        """Whether :meth:`prepare` has a window to fit once the samples up to ``last_index`` have
+        arrived (t_1 at ``rest_index``, evaluations from ``hold_end`` on, T_s in s; a window
+        only a later evaluation than the next reads waits while the next one's sample is less
+        than ``step_time`` s away, so that a fit started now does not delay it); cheap."""
+        item = self._next_to_prepare(last_index, rest_index, hold_end, sample_period, step_time)
+        return item is not None
+
+    def prepare(
+        self, samples: FrontTrace, antenna: Antenna, hold_end: int, step_time: float = 0.0
+    ) -> bool:
+        """Fit one window a coming evaluation reads (the class docstring), from the samples the
+        front end was fed so far (``samples``, of the manoeuvre ``antenna`` measured;
+        evaluations from ``hold_end`` on; ``step_time`` as for :meth:`wants_to_prepare`), into
+        this session's caches; False when there is none to fit.
+
+        The fit is that of the evaluation itself (the same function of the same samples), so
+        preparing changes no answer, only when its time is spent.
+        """
+        rest, ts = samples.rest_index, samples.sample_period
+        if rest is None:
+            return False
+        item = self._next_to_prepare(samples.t.shape[0] - 1, rest, hold_end, ts, step_time)
+        if item is None:
+            return False
+        begin, end, cache, _ = item
+        channels = contact_channels(samples.theta, samples.force, samples.torque, antenna)
+        config = self.method.config
+        fit_window(channels, begin, end, ts, samples.band, config, self._caches[cache])
+        self._prepared.add((begin, end, cache))
+        return True
 
     def _asked_here(self, inputs: ScanInputs) -> set[int]:
         """Last indices of the windows asked on these very samples."""
@@ -112,16 +238,23 @@ class FastSession:
         status, evaluation count (windows asked) and cap as :meth:`FastMethod.conclude` gives
         them when every earlier instant was unsure, so the same estimate when asked at every
         instant. When it was not (offline, or other samples), as :meth:`FastMethod.conclude`.
+        The window :meth:`ready` has just evaluated on the same evidence is taken as it is,
+        with its slip reference added, rather than evaluated again.
         """
         method = self.method
-        inputs = scan_inputs(evidence, method.config)
+        kept = self._kept(evidence)
+        inputs = kept[0] if kept is not None else scan_inputs(evidence, method.config)
         asked = self._asked_here(inputs)
         offsets = evaluation_offsets(evidence.sample_period, method.config)
         instants = inputs.rest_index + offsets
         instants = instants[(instants >= evidence.hold_end) & (instants <= evidence.end_index)]
         if not asked or instants.size == 0:
             return method.conclude(evidence, self._caches)
-        window = self._evaluate(inputs, evidence, int(instants[-1]), final=True)
+        end = int(instants[-1])
+        if kept is not None and kept[1].end_index == end:
+            window = with_early_statics_of(inputs, kept[1], self._caches)
+        else:
+            window = self._evaluate(inputs, evidence, end, final=True)
         count = len(asked | {window.end_index})
         reached_cap = inputs.rest_index + int(offsets[-1]) <= evidence.end_index
         result = ScanResult(window, count, reached_cap and not window.sure)
