@@ -30,7 +30,13 @@ from sensing_antenna.mapping.pose import base_pose_from_metadata
 from sensing_antenna.mapping.recognition import Recognition, recognise
 from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
 
-__all__ = ["MIN_RECOGNITION_POINTS", "ContactMap", "build_map", "points_from_recordings"]
+__all__ = [
+    "MIN_RECOGNITION_POINTS",
+    "ContactMap",
+    "build_map",
+    "fit_surface",
+    "points_from_recordings",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -141,11 +147,10 @@ def build_map(
     p = np.array([c.point for c in used]).reshape(-1, 3)
     cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
     bases = np.array([c.base_position for c in used]).reshape(-1, 3)
-    fitted = None
+    fitted = fit_surface(used, True, surface)
     mesh = None
     std = np.zeros(0)
-    if len(used) >= MIN_SURFACE_POINTS:
-        fitted = (surface if surface is not None else ImplicitSurface()).fit(p, cov, bases)
+    if fitted is not None:
         mesh, std = fitted.mesh()
     recognition = None
     if len(used) >= MIN_RECOGNITION_POINTS:
@@ -160,6 +165,22 @@ def build_map(
         recognition=recognition,
         include_uncertain=include_uncertain,
     )
+
+
+def fit_surface(
+    points: Sequence[ContactPoint],
+    include_uncertain: bool = False,
+    surface: ImplicitSurface | None = None,
+) -> ImplicitSurface | None:
+    """The implicit surface through the points a map uses (None with fewer than
+    :data:`MIN_SURFACE_POINTS`), each point's base the outer side."""
+    used = select_points(list(points), include_uncertain)
+    if len(used) < MIN_SURFACE_POINTS:
+        return None
+    p = np.array([c.point for c in used]).reshape(-1, 3)
+    cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
+    bases = np.array([c.base_position for c in used]).reshape(-1, 3)
+    return (surface if surface is not None else ImplicitSurface()).fit(p, cov, bases)
 
 
 def _true_point(text: str | None) -> FloatArray | None:

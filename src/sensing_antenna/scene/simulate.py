@@ -20,9 +20,13 @@ along the turned frame's -Z, so the sag across the link is g where the scene's i
 g cos(theta2) (4.5 % of the sag at 0.3 rad), and a sweep at elevation theta2 is simulated in
 the plane tangent to its cone at the touch.
 
-A touch the simulator cannot represent is reported instead of simulated: the surface's normal
-turned more than the scenario's 0.5 rad out of the sweep's direction (``glancing``: the link
-would slide over it), or x_c below the simulator's smallest contact point (``near_head``).
+The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
+friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated
+with the obstacle turned by :data:`MAX_TILT`: the same touched point, the push held as if the
+surface faced the sweep more (a real link may slide there). A touch the simulator cannot
+represent is reported instead of simulated: the normal turned more than
+:data:`GLANCING_ANGLE` (``glancing``: the link would slide over it), or x_c below the
+simulator's smallest contact point (``near_head``).
 """
 
 from __future__ import annotations
@@ -44,11 +48,23 @@ from sensing_antenna.simulator import Scenario, simulate
 from sensing_antenna.simulator.contact import motor_frame
 from sensing_antenna.simulator.run import device_link, minimum_contact_point
 
-__all__ = ["MAX_TILT", "OUTCOMES", "SweepOutcome", "simulate_sweep", "touch_scenario"]
+__all__ = [
+    "GLANCING_ANGLE",
+    "MAX_TILT",
+    "OUTCOMES",
+    "SweepOutcome",
+    "simulate_sweep",
+    "touch_scenario",
+]
 
 #: Largest angle of the surface's normal out of the sweep's direction (rad) the simulator's
-#: obstacles take (``Scenario.obstacle_tilt`` must stay below 0.5 rad in magnitude).
-MAX_TILT = 0.5
+#: obstacles are turned by: just inside the scenario's limit (``Scenario.obstacle_tilt`` must
+#: stay below 0.5 rad in magnitude, about the friction cone of mu = 0.6).
+MAX_TILT = 0.49
+
+#: A surface turned further than this (rad) out of the sweep's direction is ``glancing``: the
+#: link would slide over it rather than be held by it (57 degrees).
+GLANCING_ANGLE = 1.0
 
 #: What a sweep can end in.
 OUTCOMES = ("touch", "free", "glancing", "near_head", "inside")
@@ -124,11 +140,14 @@ def touch_scenario(
     if touch.tip:
         kind = "plane"
         tilt = 0.0
-    elif abs(tilt) >= MAX_TILT:
+    elif abs(tilt) >= GLANCING_ANGLE:
         raise ValueError(
             f"the surface's normal is {abs(tilt):.2f} rad out of the sweep's direction, more than"
-            f" the simulator's {MAX_TILT} rad (the link would slide over it)"
+            f" {GLANCING_ANGLE} rad (the link would slide over it)"
         )
+    # beyond the simulator's largest tilt the obstacle is turned by that much: the same
+    # touched point, a push held as if the surface faced the sweep more
+    tilt = max(-MAX_TILT, min(MAX_TILT, tilt))
     description = (
         f"scene {scene.name}: {sweep.case} sweep touching {touch.object_name}"
         f" at x_c = {touch.x_c:.4f} m"

@@ -1,0 +1,215 @@
+"""Which sweep next: a fixed grid, or the sweep expected to reduce the surface's uncertainty most.
+
+The grid (:func:`grid_sweeps`) runs, from each base, azimuthal sweeps across the scene's azimuth
+range at evenly spaced elevations and vertical sweeps up its elevation range at evenly spaced
+azimuths, in an order that spreads them out first (each count's van der Corput order), so that
+a budget cut short still covers the region.
+
+The next-best strategy (:class:`NextBestPlanner`) chooses among the candidates of a grid
+:data:`CANDIDATE_DENSITY` times finer. Until the surface can be fitted (fewer than
+``MIN_SURFACE_POINTS`` usable contacts) it takes the coarse grid's sweeps in their spread-out
+order. Then, for every candidate not yet run, it follows the candidate's link through the
+fitted implicit surface f (negative inside) in steps of :data:`PREDICTION_STEP`: the predicted
+touch is the first link sample where f < 0, or, when the candidate is predicted to miss, the
+sample where f is smallest (where the sweep passes closest to the estimated surface). The
+candidate's score is the surface's predictive standard deviation there: the sweep whose
+expected touch lands where the surface is least known, which is what a contact there reduces
+most. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count only if nothing
+else is left, and each score is divided by one plus the number of earlier sweeps within
+:data:`NEIGHBOUR_ANGLE` of it (its held angle) from the same base and of the same case, which
+keeps a sweep that came back free from being retried next to itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.mapping.surface import ImplicitSurface
+from sensing_antenna.scene.file import Scene
+from sensing_antenna.scene.sweep import LinkShape, Sweep
+
+__all__ = [
+    "CANDIDATE_DENSITY",
+    "MISS_MARGIN",
+    "NEIGHBOUR_ANGLE",
+    "PREDICTION_STEP",
+    "STRATEGIES",
+    "NextBestPlanner",
+    "candidate_sweeps",
+    "grid_sweeps",
+    "spread_order",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: The strategies ``antenna explore --strategy`` offers.
+STRATEGIES = ("grid", "next-best")
+
+#: The next-best candidates are a grid this many times finer than the scene's.
+CANDIDATE_DENSITY = 3
+
+#: Angle step (rad) at which a candidate's link is followed through the fitted surface: 1 cm
+#: at 1 m, about the surface's finest length scale.
+PREDICTION_STEP = 0.01
+
+#: A candidate whose link stays this far outside the fitted surface (m of f) is predicted to
+#: miss it: 2 cm, several times the points' standard deviation.
+MISS_MARGIN = 0.02
+
+#: Sweeps whose held angles are closer than this (rad) count as neighbours: half the coarse
+#: grid's spacing for the built-in scenes.
+NEIGHBOUR_ANGLE = 0.05
+
+#: Samples along the link used for the predictions (every 1 cm for a 1 m link).
+_PREDICTION_SAMPLES = 100
+
+
+def spread_order(n: int) -> list[int]:
+    """0..n-1 in van der Corput order (0, n/2, n/4, 3n/4, ...), so that any prefix spreads."""
+    keys = []
+    for i in range(n):
+        x, f, k = 0.0, 0.5, i
+        while k:
+            x += f * (k & 1)
+            k >>= 1
+            f /= 2
+        keys.append(x)
+    # ranks of the evenly spaced positions, visited by their van der Corput key
+    positions = np.linspace(0.0, 1.0, n) if n > 1 else np.zeros(1)
+    order: list[int] = []
+    for key in keys:
+        remaining = [j for j in range(n) if j not in order]
+        order.append(min(remaining, key=lambda j: abs(positions[j] - key)))
+    return order
+
+
+def _sweeps(scene: Scene, azimuthal: int, vertical: int) -> list[Sweep]:
+    region = scene.region
+    elevations: FloatArray = np.linspace(*region.elevation, azimuthal + 2)[1:-1]
+    azimuths: FloatArray = np.linspace(*region.azimuth, vertical + 2)[1:-1]
+    sweeps: list[Sweep] = []
+    a_order = spread_order(len(elevations))
+    v_order = spread_order(len(azimuths))
+    for base in range(len(scene.bases)):
+        a = [Sweep(base, "azimuthal", float(elevations[i]), *region.azimuth) for i in a_order]
+        v = [Sweep(base, "vertical", float(azimuths[i]), *region.elevation) for i in v_order]
+        # alternate the two cases so that a prefix holds both
+        for k in range(max(len(a), len(v))):
+            sweeps.extend(a[k : k + 1] + v[k : k + 1])
+    if len(scene.bases) > 1:
+        # alternate the bases too
+        per_base = len(sweeps) // len(scene.bases)
+        sweeps = [
+            sweeps[b * per_base + k] for k in range(per_base) for b in range(len(scene.bases))
+        ]
+    return sweeps
+
+
+def grid_sweeps(scene: Scene) -> list[Sweep]:
+    """The scene's grid (module docstring): its held angles evenly inside the region's ranges
+    (the ends left out: a sweep along the region's edge), spread-out order."""
+    return _sweeps(scene, scene.region.azimuthal_sweeps, scene.region.vertical_sweeps)
+
+
+def candidate_sweeps(scene: Scene) -> list[Sweep]:
+    """The next-best strategy's candidates: the grid :data:`CANDIDATE_DENSITY` times finer."""
+    return _sweeps(
+        scene,
+        CANDIDATE_DENSITY * scene.region.azimuthal_sweeps,
+        CANDIDATE_DENSITY * scene.region.vertical_sweeps,
+    )
+
+
+@dataclass(frozen=True)
+class Choice:
+    """A planner's answer: the sweep and why.
+
+    Attributes
+    ----------
+    sweep : Sweep
+    score : float
+        The predictive standard deviation at the predicted touch (m), NaN for a grid choice.
+    predicted : array, shape (3,)
+        Where the sweep is expected to touch (m, world), NaN for a grid choice.
+    """
+
+    sweep: Sweep
+    score: float
+    predicted: FloatArray
+
+
+class NextBestPlanner:
+    """Chooses the next sweep from the contacts so far (module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+        Its bases and region (the objects are not looked at).
+    shape : LinkShape
+        The link's sagged shape.
+    """
+
+    def __init__(self, scene: Scene, shape: LinkShape) -> None:
+        self.scene = scene
+        self.shape = shape
+        self.candidates = candidate_sweeps(scene)
+        self.opening = grid_sweeps(scene)
+        x = shape.abscissae
+        self._samples = np.unique(np.linspace(0, len(x) - 1, _PREDICTION_SAMPLES).astype(int))
+
+    def choose(self, done: Sequence[Sweep], surface: ImplicitSurface | None) -> Choice | None:
+        """The next sweep given the sweeps run so far and the surface fitted to their contacts
+        (None until there is one); None when every candidate has been run."""
+        nan3 = np.full(3, np.nan)
+        if surface is None:
+            for sweep in self.opening:
+                if sweep not in done:
+                    return Choice(sweep, float("nan"), nan3)
+            surface_free = [c for c in self.candidates if c not in done]
+            return Choice(surface_free[0], float("nan"), nan3) if surface_free else None
+        left = [c for c in self.candidates if c not in done]
+        if not left:
+            return None
+        best: tuple[float, Sweep, FloatArray] | None = None
+        fallback: tuple[float, Sweep, FloatArray] | None = None
+        for sweep in left:
+            point, closest = self._predicted_touch(sweep, surface)
+            _, std = surface.predict(point[None, :], return_std=True)
+            crowd = sum(
+                1
+                for d in done
+                if d.base == sweep.base
+                and d.case == sweep.case
+                and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
+            )
+            score = float(std[0]) / (1.0 + crowd)
+            entry = (score, sweep, point)
+            if closest > MISS_MARGIN:
+                if fallback is None or score > fallback[0]:
+                    fallback = entry
+            elif best is None or score > best[0]:
+                best = entry
+        chosen = best if best is not None else fallback
+        assert chosen is not None
+        return Choice(chosen[1], chosen[0], chosen[2])
+
+    def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:
+        """The predicted touch point (m) and the smallest f met (m; <= 0 when it touches)."""
+        base = self.scene.bases[sweep.base]
+        angles = np.arange(sweep.start, sweep.end + 1e-12, PREDICTION_STEP)
+        points = np.concatenate(
+            [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
+        )
+        values = np.asarray(surface.predict(points)).reshape(len(angles), -1)
+        inside = np.nonzero((values < 0).any(axis=1))[0]
+        if inside.size:
+            row = int(inside[0])
+            column = int(np.argmin(values[row]))
+            return points.reshape(len(angles), -1, 3)[row, column], float(values[row, column])
+        flat = int(np.argmin(values))
+        row, column = divmod(flat, values.shape[1])
+        return points.reshape(len(angles), -1, 3)[row, column], float(values[row, column])
