@@ -52,6 +52,7 @@ COMMAND_MODULES = (
     "calibrate",
     "campaign",
     "map",
+    "explore",
     "plot",
 )
 

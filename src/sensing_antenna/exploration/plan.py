@@ -2,7 +2,7 @@
 
 The grid (:func:`grid_sweeps`) runs, from each base, azimuthal sweeps across the scene's azimuth
 range at evenly spaced elevations and vertical sweeps up its elevation range at evenly spaced
-azimuths, in an order that spreads them out first (each count's van der Corput order), so that
+azimuths, in an order that spreads them out first (:func:`spread_order`), so that
 a budget cut short still covers the region.
 
 The next-best strategy (:class:`NextBestPlanner`) chooses among the candidates of a grid
@@ -14,7 +14,11 @@ touch is the first link sample where f < 0, or, when the candidate is predicted 
 sample where f is smallest (where the sweep passes closest to the estimated surface). The
 candidate's score is the surface's predictive standard deviation there: the sweep whose
 expected touch lands where the surface is least known, which is what a contact there reduces
-most. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count only if nothing
+most. Free space counts against a prediction: a sweep that came back free swept its link
+through space the object does not occupy, so a candidate whose predicted touch lies within
+about :data:`FREE_RADIUS` of a free sweep's link is unlikely to touch there, and its score is
+multiplied by 1 - exp(-d^2 / (2 FREE_RADIUS^2)), d the distance to the nearest free link
+sample. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count only if nothing
 else is left, and each score is divided by one plus the number of earlier sweeps within
 :data:`NEIGHBOUR_ANGLE` of it (its held angle) from the same base and of the same case, which
 keeps a sweep that came back free from being retried next to itself.
@@ -22,11 +26,13 @@ keeps a sweep that came back free from being retried next to itself.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from sensing_antenna.mapping.surface import ImplicitSurface
 from sensing_antenna.scene.file import Scene
@@ -34,6 +40,7 @@ from sensing_antenna.scene.sweep import LinkShape, Sweep
 
 __all__ = [
     "CANDIDATE_DENSITY",
+    "FREE_RADIUS",
     "MISS_MARGIN",
     "NEIGHBOUR_ANGLE",
     "PREDICTION_STEP",
@@ -64,26 +71,29 @@ MISS_MARGIN = 0.02
 #: grid's spacing for the built-in scenes.
 NEIGHBOUR_ANGLE = 0.05
 
+#: How near a free sweep's link a predicted touch is contradicted (m): the free sweeps are
+#: followed every :data:`PREDICTION_STEP` (6 mm apart at 0.6 m) with samples 1 cm apart.
+FREE_RADIUS = 0.01
+
 #: Samples along the link used for the predictions (every 1 cm for a 1 m link).
 _PREDICTION_SAMPLES = 100
 
 
 def spread_order(n: int) -> list[int]:
-    """0..n-1 in van der Corput order (0, n/2, n/4, 3n/4, ...), so that any prefix spreads."""
-    keys = []
-    for i in range(n):
-        x, f, k = 0.0, 0.5, i
-        while k:
-            x += f * (k & 1)
-            k >>= 1
-            f /= 2
-        keys.append(x)
-    # ranks of the evenly spaced positions, visited by their van der Corput key
-    positions = np.linspace(0.0, 1.0, n) if n > 1 else np.zeros(1)
+    """0..n-1 middle first, then the middles of the halves, and so on (breadth first), so that
+    any prefix of the order spreads over the range: 8 gives 3, 1, 5, 0, 2, 4, 6, 7."""
     order: list[int] = []
-    for key in keys:
-        remaining = [j for j in range(n) if j not in order]
-        order.append(min(remaining, key=lambda j: abs(positions[j] - key)))
+    intervals = [(0, n - 1)] if n > 0 else []
+    while intervals:
+        following = []
+        for low, high in intervals:
+            middle = (low + high) // 2
+            order.append(middle)
+            if low <= middle - 1:
+                following.append((low, middle - 1))
+            if middle + 1 <= high:
+                following.append((middle + 1, high))
+        intervals = following
     return order
 
 
@@ -161,9 +171,15 @@ class NextBestPlanner:
         x = shape.abscissae
         self._samples = np.unique(np.linspace(0, len(x) - 1, _PREDICTION_SAMPLES).astype(int))
 
-    def choose(self, done: Sequence[Sweep], surface: ImplicitSurface | None) -> Choice | None:
-        """The next sweep given the sweeps run so far and the surface fitted to their contacts
-        (None until there is one); None when every candidate has been run."""
+    def choose(
+        self,
+        done: Sequence[Sweep],
+        surface: ImplicitSurface | None,
+        free: Sequence[Sweep] = (),
+    ) -> Choice | None:
+        """The next sweep given the sweeps run so far, the surface fitted to their contacts
+        (None until there is one) and those of them that touched nothing; None when every
+        candidate has been run."""
         nan3 = np.full(3, np.nan)
         if surface is None:
             for sweep in self.opening:
@@ -174,6 +190,9 @@ class NextBestPlanner:
         left = [c for c in self.candidates if c not in done]
         if not left:
             return None
+        free_cloud = None
+        if free:
+            free_cloud = cKDTree(np.concatenate([self._swept(sweep) for sweep in free]))
         best: tuple[float, Sweep, FloatArray] | None = None
         fallback: tuple[float, Sweep, FloatArray] | None = None
         for sweep in left:
@@ -187,6 +206,9 @@ class NextBestPlanner:
                 and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
             )
             score = float(std[0]) / (1.0 + crowd)
+            if free_cloud is not None:
+                distance = float(free_cloud.query(point)[0])
+                score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
             entry = (score, sweep, point)
             if closest > MISS_MARGIN:
                 if fallback is None or score > fallback[0]:
@@ -197,13 +219,18 @@ class NextBestPlanner:
         assert chosen is not None
         return Choice(chosen[1], chosen[0], chosen[2])
 
-    def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:
-        """The predicted touch point (m) and the smallest f met (m; <= 0 when it touches)."""
+    def _swept(self, sweep: Sweep) -> FloatArray:
+        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3)."""
         base = self.scene.bases[sweep.base]
         angles = np.arange(sweep.start, sweep.end + 1e-12, PREDICTION_STEP)
-        points = np.concatenate(
+        return np.concatenate(
             [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
         )
+
+    def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:
+        """The predicted touch point (m) and the smallest f met (m; <= 0 when it touches)."""
+        angles = np.arange(sweep.start, sweep.end + 1e-12, PREDICTION_STEP)
+        points = self._swept(sweep)
         values = np.asarray(surface.predict(points)).reshape(len(angles), -1)
         inside = np.nonzero((values < 0).any(axis=1))[0]
         if inside.size:

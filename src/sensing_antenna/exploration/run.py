@@ -16,7 +16,8 @@ retract, re-plan), on the simulator:
 
 Manoeuvre i is simulated with the seed ``seed + i``. Everything is stored as it is made
 (``exploration.store``); a second start with the same settings resumes after the last stored
-manoeuvre, and the next-best planner, fed the same stored points, makes the same choices.
+manoeuvre (with a larger budget it goes on), and the next-best planner, fed the same stored
+points, makes the same choices.
 """
 
 from __future__ import annotations
@@ -24,12 +25,13 @@ from __future__ import annotations
 import hashlib
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import trimesh
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.campaign.store import atomic_write_text
@@ -209,6 +211,7 @@ def explore(
     out: Path,
     settings: ExploreSettings | None = None,
     progress: Callable[[Manoeuvre, int], None] | None = None,
+    meshes: Mapping[str, trimesh.Trimesh] | None = None,
 ) -> Exploration:
     """Explore ``scene`` with the simulated ``device``, storing everything in ``out``.
 
@@ -222,6 +225,8 @@ def explore(
     settings : ExploreSettings, optional
     progress : callable, optional
         Called with each new manoeuvre and the budget.
+    meshes : mapping of str to trimesh.Trimesh, optional
+        User meshes recognition registers beside the shape classes (``antenna map --objects``).
 
     Raises
     ------
@@ -242,7 +247,6 @@ def explore(
                 "device": antenna_to_toml(device),
                 "method": settings.method,
                 "strategy": settings.strategy,
-                "budget": budget,
                 "seed": settings.seed,
                 "include_uncertain": settings.include_uncertain,
             },
@@ -264,7 +268,11 @@ def explore(
                         [m.point for m in manoeuvres if m.point is not None],
                         settings.include_uncertain,
                     )
-                    choice = planner.choose([m.sweep for m in manoeuvres], surface)
+                    choice = planner.choose(
+                        [m.sweep for m in manoeuvres],
+                        surface,
+                        [m.sweep for m in manoeuvres if m.outcome == "free"],
+                    )
                 if choice is None:
                     break
                 manoeuvre = _run_one(scene, device, antenna, shape, choice, index, settings, out)
@@ -279,7 +287,7 @@ def explore(
             raise ExplorationInterrupted(number, len(manoeuvres), out) from None
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
-    contact_map = build_map(points, settings.include_uncertain)
+    contact_map = build_map(points, settings.include_uncertain, meshes=meshes)
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 
 

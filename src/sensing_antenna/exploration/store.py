@@ -3,7 +3,8 @@
 ::
 
     OUT/
-      explore.json          the settings and the scene's text (a resume must use the same)
+      settings.json         the settings and the scene's fingerprint (a resume must use the
+                            same; the budget may grow)
       calibration/          the calibration manoeuvres (posts at known x_c), when simulated
       calibrated.toml       the antenna the estimators use, written once the calibration is done
       recordings/NNN.csv    each touching manoeuvre's recording (with its base_pose)
@@ -11,6 +12,7 @@
       manoeuvres.csv        every manoeuvre in one table, rebuilt from manoeuvres/
       scene.ply             the scene's objects (the true surface, for viewing)
       points.csv ... map.png  the map (``antenna map``'s files, docs/mapping.md)
+      exploration.json      the summary ``antenna explore`` writes at the end
       .lock                 held while an exploration runs here
 
 A manoeuvre's recording is written before its JSON file, each atomically (a temp file renamed),
@@ -54,7 +56,7 @@ __all__ = [
     "write_settings",
 ]
 
-SETTINGS_FILE = "explore.json"
+SETTINGS_FILE = "settings.json"
 CALIBRATED_FILE = "calibrated.toml"
 RECORDINGS_DIR = "recordings"
 MANOEUVRES_DIR = "manoeuvres"
