@@ -20,7 +20,7 @@ from sensing_antenna.exploration import (
     grid_sweeps,
 )
 from sensing_antenna.exploration.plan import spread_order
-from sensing_antenna.mapping import ImplicitSurface
+from sensing_antenna.mapping import ClassFit, ImplicitSurface
 from sensing_antenna.scene import LinkShape, load_scene
 
 DEVICE = paper_antenna()
@@ -66,6 +66,25 @@ def test_next_best_aims_where_the_surface_is_unknown() -> None:
     assert nearest > 0.02
     again = planner.choose([], surface, free=[choice.sweep])
     assert again is not None and again.sweep != choice.sweep
+    # two leading classes that disagree: the true ball and one 2 cm larger about the same
+    # centre differ by 2 cm everywhere, so every score becomes sqrt(std^2 + 0.02^2)
+    leaders = [
+        ClassFit("sphere", {}, {}, 0.0, 0.0, 0.0, 4, len(points), vector=ball.parameters),
+        ClassFit(
+            "sphere",
+            {},
+            {},
+            0.0,
+            0.0,
+            0.0,
+            4,
+            len(points),
+            vector=ball.parameters + np.array([0, 0, 0, 0.02]),
+        ),
+    ]
+    aimed = planner.choose([], surface, leaders=leaders)
+    assert aimed is not None
+    assert aimed.score == pytest.approx(np.hypot(choice.score, 0.02), rel=1e-6)
 
 
 @pytest.fixture(scope="module")

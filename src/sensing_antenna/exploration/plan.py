@@ -22,6 +22,12 @@ sample. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count
 else is left, and each score is divided by one plus the number of earlier sweeps within
 :data:`NEIGHBOUR_ANGLE` of it (its held angle) from the same base and of the same case, which
 keeps a sweep that came back free from being retried next to itself.
+
+When recognition abstains between two leading shape classes, the planner also aims at telling
+them apart: at a candidate's predicted touch p the two fitted shapes disagree about where the
+surface is by |d_a(p) - d_b(p)| (their signed distances, m), and the score becomes
+sqrt(std^2 + (d_a - d_b)^2): a contact where the leaders differ separates them, one where they
+agree does not.
 """
 
 from __future__ import annotations
@@ -34,6 +40,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
+from sensing_antenna.mapping.primitives import PRIMITIVES
+from sensing_antenna.mapping.recognition import ClassFit
 from sensing_antenna.mapping.surface import ImplicitSurface
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.sweep import LinkShape, Sweep
@@ -176,10 +184,12 @@ class NextBestPlanner:
         done: Sequence[Sweep],
         surface: ImplicitSurface | None,
         free: Sequence[Sweep] = (),
+        leaders: Sequence[ClassFit] = (),
     ) -> Choice | None:
         """The next sweep given the sweeps run so far, the surface fitted to their contacts
-        (None until there is one) and those of them that touched nothing; None when every
-        candidate has been run."""
+        (None until there is one), those of them that touched nothing, and the two leading
+        shape classes' fits when recognition abstains between them (module docstring); None
+        when every candidate has been run."""
         nan3 = np.full(3, np.nan)
         if surface is None:
             for sweep in self.opening:
@@ -205,7 +215,15 @@ class NextBestPlanner:
                 and d.case == sweep.case
                 and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
             )
-            score = float(std[0]) / (1.0 + crowd)
+            spread = float(std[0])
+            if len(leaders) == 2:
+                # where the two leading shapes disagree about the surface
+                d_a, d_b = (
+                    float(PRIMITIVES[f.name].signed_distance(f.vector, point[None, :])[0])
+                    for f in leaders
+                )
+                spread = math.hypot(spread, d_a - d_b)
+            score = spread / (1.0 + crowd)
             if free_cloud is not None:
                 distance = float(free_cloud.query(point)[0])
                 score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)

@@ -14,6 +14,10 @@ retract, re-plan), on the simulator:
    with its covariance and status; a sweep that touches nothing is stored as free space.
 3. **The map**: ``mapping.build_map`` on every point, as ``antenna map`` builds it.
 
+The next-best strategy refits the surface before each manoeuvre and recognises the points before
+every :data:`RECOGNITION_EVERY`-th, aiming at the two leading classes while recognition abstains
+(``exploration.plan``).
+
 Manoeuvre i is simulated with the seed ``seed + i``. Everything is stored as it is made
 (``exploration.store``); a second start with the same settings resumes after the last stored
 manoeuvre (with a larger budget it goes on), and the next-best planner, fed the same stored
@@ -47,8 +51,15 @@ from sensing_antenna.exploration.store import (
     write_manoeuvre_table,
     write_settings,
 )
-from sensing_antenna.mapping.contact_map import ContactMap, build_map, fit_surface
+from sensing_antenna.mapping.contact_map import (
+    ContactMap,
+    build_map,
+    fit_surface,
+    recognise_points,
+)
 from sensing_antenna.mapping.points import ContactPoint
+from sensing_antenna.mapping.primitives import PRIMITIVES
+from sensing_antenna.mapping.recognition import ClassFit
 from sensing_antenna.recording import write_recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.simulate import simulate_sweep
@@ -68,6 +79,10 @@ CALIBRATION_POINTS = (0.3, 0.45, 0.6, 0.75, 0.9)
 
 #: The calibration manoeuvres' seeds start here (the README's).
 CALIBRATION_SEED = 10
+
+#: The next-best strategy recognises the points so far before every this many manoeuvres, to
+#: aim at the two leading classes when recognition abstains (a recognition takes seconds).
+RECOGNITION_EVERY = 4
 
 #: Methods the exploration offers (those that give an interval or a default sigma_x).
 EXPLORE_METHODS = ("paper", "fast")
@@ -257,6 +272,7 @@ def explore(
             antenna = _prepared(device, out)
             shape = LinkShape(device.link)
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
+            leaders: tuple[ClassFit, ...] = ()
             while len(manoeuvres) < budget:
                 index = len(manoeuvres)
                 if planner is None:
@@ -264,14 +280,15 @@ def explore(
                         break
                     choice: Choice | None = Choice(grid[index], math.nan, np.full(3, np.nan))
                 else:
-                    surface = fit_surface(
-                        [m.point for m in manoeuvres if m.point is not None],
-                        settings.include_uncertain,
-                    )
+                    points = [m.point for m in manoeuvres if m.point is not None]
+                    surface = fit_surface(points, settings.include_uncertain)
+                    if index % RECOGNITION_EVERY == 0:
+                        leaders = _undecided_leaders(points, settings.include_uncertain)
                     choice = planner.choose(
                         [m.sweep for m in manoeuvres],
                         surface,
                         [m.sweep for m in manoeuvres if m.outcome == "free"],
+                        leaders,
                     )
                 if choice is None:
                     break
@@ -289,6 +306,15 @@ def explore(
     points = [m.point for m in manoeuvres if m.point is not None]
     contact_map = build_map(points, settings.include_uncertain, meshes=meshes)
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
+
+
+def _undecided_leaders(points: list[ContactPoint], include_uncertain: bool) -> tuple[ClassFit, ...]:
+    """The two leading primitive fits when recognition abstains between them, else none."""
+    recognition = recognise_points(points, include_uncertain)
+    if recognition is None or not recognition.undecided:
+        return ()
+    leaders = tuple(recognition.fits[:2])
+    return leaders if all(f.name in PRIMITIVES for f in leaders) else ()
 
 
 def _run_one(

@@ -36,6 +36,7 @@ __all__ = [
     "build_map",
     "fit_surface",
     "points_from_recordings",
+    "recognise_points",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -144,18 +145,12 @@ def build_map(
 ) -> ContactMap:
     """The map from points (module docstring); the surface and recognition when possible."""
     used = select_points(list(points), include_uncertain)
-    p = np.array([c.point for c in used]).reshape(-1, 3)
-    cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
-    bases = np.array([c.base_position for c in used]).reshape(-1, 3)
     fitted = fit_surface(used, True, surface)
     mesh = None
     std = np.zeros(0)
     if fitted is not None:
         mesh, std = fitted.mesh()
-    recognition = None
-    if len(used) >= MIN_RECOGNITION_POINTS:
-        outward = (bases - p).mean(axis=0)
-        recognition = recognise(p, cov, meshes=meshes, outward=outward, rng=rng)
+    recognition = recognise_points(used, True, meshes, rng)
     return ContactMap(
         points=tuple(points),
         used=tuple(used),
@@ -181,6 +176,24 @@ def fit_surface(
     cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
     bases = np.array([c.base_position for c in used]).reshape(-1, 3)
     return (surface if surface is not None else ImplicitSurface()).fit(p, cov, bases)
+
+
+def recognise_points(
+    points: Sequence[ContactPoint],
+    include_uncertain: bool = False,
+    meshes: Mapping[str, trimesh.Trimesh] | None = None,
+    rng: np.random.Generator | None = None,
+) -> Recognition | None:
+    """The recognition of the points a map uses (None with fewer than
+    :data:`MIN_RECOGNITION_POINTS`), the mean direction to their bases the outer side."""
+    used = select_points(list(points), include_uncertain)
+    if len(used) < MIN_RECOGNITION_POINTS:
+        return None
+    p = np.array([c.point for c in used]).reshape(-1, 3)
+    cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
+    bases = np.array([c.base_position for c in used]).reshape(-1, 3)
+    outward = (bases - p).mean(axis=0)
+    return recognise(p, cov, meshes=meshes, outward=outward, rng=rng)
 
 
 def _true_point(text: str | None) -> FloatArray | None:
