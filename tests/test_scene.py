@@ -224,3 +224,22 @@ def test_an_open_mesh_is_refused(tmp_path: Path) -> None:
 def test_unknown_scene_names_the_builtins() -> None:
     with pytest.raises(SceneError, match="built-in scenes: post, sphere"):
         load_scene("nowhere-scene.toml")
+
+
+def test_outcomes_the_simulator_cannot_represent_are_named() -> None:
+    shape = LinkShape(DEVICE.link)
+    sweep = Sweep(0, "azimuthal", 0.0, -0.3, 0.3)
+    # a ball cut by the link at the start angle
+    inside = _scene(primitive_object("ball", "sphere", [0.05], [0.5, -0.15, -0.02]))
+    assert simulate_sweep(DEVICE, inside, sweep, shape=shape).outcome == "inside"
+    # a post 4 cm from the head: below the simulator's smallest contact point (6.5 cm)
+    near = _scene(primitive_object("post", "cylinder", [0.005, 0.3], [0.045, 0.01, 0.0]))
+    outcome = simulate_sweep(DEVICE, near, sweep, shape=shape)
+    assert outcome.outcome == "near_head" and outcome.recording is None
+    assert outcome.reason is not None and "smallest" in outcome.reason
+    # a ball met 1.2 rad off its equator: a straight link (no gravity) 5 sin(1.2) cm above a
+    # 5 cm ball's centre
+    top = _scene(primitive_object("ball", "sphere", [0.05], [0.6, 0.1, -0.05 * math.sin(1.2)]))
+    straight = LinkShape(DEVICE.link, gravity=0.0)
+    glancing = simulate_sweep(DEVICE, top, sweep, shape=straight)
+    assert glancing.outcome == "glancing" and glancing.touch is not None
