@@ -156,6 +156,15 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert summary["manoeuvres"] == 2 and summary["method"] == "fast"
 
 
+def test_the_command_offers_the_librarys_strategies_and_scenes() -> None:
+    from sensing_antenna.cli import explore as command
+    from sensing_antenna.exploration import STRATEGIES
+    from sensing_antenna.scene import BUILTIN_SCENES
+
+    assert command.STRATEGIES == STRATEGIES
+    assert command.BUILTIN_SCENES == BUILTIN_SCENES
+
+
 def test_antenna_explore_bad_scene_is_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

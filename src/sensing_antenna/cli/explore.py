@@ -8,12 +8,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
+#: ``exploration.plan.STRATEGIES`` and ``scene.file.BUILTIN_SCENES``, written out: importing
+#: them would load trimesh and scikit-learn for every command's start.
+STRATEGIES = ("grid", "next-best")
+BUILTIN_SCENES = ("post", "sphere", "box", "cylinder")
+
 
 def register(subparsers: Any) -> None:
     """Add ``antenna explore``."""
-    from sensing_antenna.exploration.plan import STRATEGIES
-    from sensing_antenna.scene.file import BUILTIN_SCENES
-
     parser = subparsers.add_parser(
         "explore",
         help="explore a scene with the simulated device: sweeps, contacts, surface, object",
