@@ -83,8 +83,9 @@ def test_next_best_aims_where_the_surface_is_unknown() -> None:
         ),
     ]
     aimed = planner.choose([], surface, leaders=leaders)
-    assert aimed is not None
-    assert aimed.score == pytest.approx(np.hypot(choice.score, 0.02), rel=1e-6)
+    assert aimed is not None and 0 < aimed.probability <= 1
+    assert aimed.score == pytest.approx(np.hypot(aimed.std, 0.02) * aimed.probability, rel=1e-9)
+    assert aimed.score >= choice.score
 
 
 @pytest.fixture(scope="module")

@@ -12,11 +12,13 @@ order. Then, for every candidate not yet run, it follows the candidate's link th
 fitted implicit surface f (negative inside) in steps of :data:`PREDICTION_STEP`: the predicted
 touch is the first link sample where f < 0, or, when the candidate is predicted to miss, the
 sample where f is smallest (where the sweep passes closest to the estimated surface). The
-candidate's score is the surface's predictive standard deviation there: the sweep whose
-expected touch lands where the surface is least known, which is what a contact there reduces
-most. Free space counts against a prediction: a sweep that came back free swept its link
-through space the object does not occupy, so a candidate whose predicted touch lies within
-about :data:`FREE_RADIUS` of a free sweep's link is unlikely to touch there, and its score is
+candidate's score is the surface's predictive standard deviation sigma there, weighted by the
+chance that the sweep touches at all, P(f < 0) = Phi(-f / sigma) at that sample under the
+surface's Gaussian prediction: the sweep whose expected touch lands where the surface is least
+known, which is what a contact there reduces most, unless it is likely to miss. Free space
+counts against a prediction: a sweep that came back free swept its link through space the
+object does not occupy, so a candidate whose predicted touch lies within about
+:data:`FREE_RADIUS` of a free sweep's link is unlikely to touch there, and its score is
 multiplied by 1 - exp(-d^2 / (2 FREE_RADIUS^2)), d the distance to the nearest free link
 sample. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count only if nothing
 else is left, and each score is divided by one plus the number of earlier sweeps within
@@ -25,8 +27,8 @@ keeps a sweep that came back free from being retried next to itself.
 
 When recognition abstains between two leading shape classes, the planner also aims at telling
 them apart: at a candidate's predicted touch p the two fitted shapes disagree about where the
-surface is by |d_a(p) - d_b(p)| (their signed distances, m), and the score becomes
-sqrt(std^2 + (d_a - d_b)^2): a contact where the leaders differ separates them, one where they
+surface is by |d_a(p) - d_b(p)| (their signed distances, m), and sigma becomes
+sqrt(sigma^2 + (d_a - d_b)^2): a contact where the leaders differ separates them, one where they
 agree does not.
 """
 
@@ -153,11 +155,17 @@ class Choice:
         The predictive standard deviation at the predicted touch (m), NaN for a grid choice.
     predicted : array, shape (3,)
         Where the sweep is expected to touch (m, world), NaN for a grid choice.
+    std : float
+        The surface's predictive std there (m), NaN for a grid choice.
+    probability : float
+        The chance that the sweep touches, NaN for a grid choice.
     """
 
     sweep: Sweep
     score: float
     predicted: FloatArray
+    std: float = math.nan
+    probability: float = math.nan
 
 
 class NextBestPlanner:
@@ -203,11 +211,14 @@ class NextBestPlanner:
         free_cloud = None
         if free:
             free_cloud = cKDTree(np.concatenate([self._swept(sweep) for sweep in free]))
-        best: tuple[float, Sweep, FloatArray] | None = None
-        fallback: tuple[float, Sweep, FloatArray] | None = None
+        best: tuple[float, Choice] | None = None
+        fallback: tuple[float, Choice] | None = None
         for sweep in left:
             point, closest = self._predicted_touch(sweep, surface)
-            _, std = surface.predict(point[None, :], return_std=True)
+            _, std_at = surface.predict(point[None, :], return_std=True)
+            std = float(std_at[0])
+            # P(f < 0 there) under the surface's Gaussian prediction: the chance to touch
+            probability = 0.5 * math.erfc(closest / (math.sqrt(2.0) * max(std, 1e-12)))
             crowd = sum(
                 1
                 for d in done
@@ -215,7 +226,7 @@ class NextBestPlanner:
                 and d.case == sweep.case
                 and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
             )
-            spread = float(std[0])
+            spread = std
             if len(leaders) == 2:
                 # where the two leading shapes disagree about the surface
                 d_a, d_b = (
@@ -223,11 +234,11 @@ class NextBestPlanner:
                     for f in leaders
                 )
                 spread = math.hypot(spread, d_a - d_b)
-            score = spread / (1.0 + crowd)
+            score = probability * spread / (1.0 + crowd)
             if free_cloud is not None:
                 distance = float(free_cloud.query(point)[0])
                 score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
-            entry = (score, sweep, point)
+            entry = (score, Choice(sweep, score, point, std, probability))
             if closest > MISS_MARGIN:
                 if fallback is None or score > fallback[0]:
                     fallback = entry
@@ -235,7 +246,7 @@ class NextBestPlanner:
                 best = entry
         chosen = best if best is not None else fallback
         assert chosen is not None
-        return Choice(chosen[1], chosen[0], chosen[2])
+        return chosen[1]
 
     def _swept(self, sweep: Sweep) -> FloatArray:
         """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3)."""
