@@ -177,3 +177,15 @@ def test_antenna_explore_bad_scene_is_one_line(
         err
         == f"antenna explore: error: {bad}: objects[0].radius: must be a finite number, got 'big'"
     )
+
+
+def test_a_larger_budget_goes_on_from_the_stored_manoeuvres(tmp_path: Path) -> None:
+    out = tmp_path / "grow"
+    first = explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
+    stored = (out / "manoeuvres" / "000.json").read_text()
+    grown = explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=2))
+    assert len(first.manoeuvres) == 1 and len(grown.manoeuvres) == 2
+    # the first manoeuvre is the stored one, not run again
+    assert (out / "manoeuvres" / "000.json").read_text() == stored
+    assert grown.manoeuvres[0].to_dict() == first.manoeuvres[0].to_dict()
+    assert grown.manoeuvres[1].sweep != grown.manoeuvres[0].sweep
