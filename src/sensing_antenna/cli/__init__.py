@@ -53,6 +53,7 @@ COMMAND_MODULES = (
     "calibrate",
     "campaign",
     "map",
+    "explore",
     "plot",
 )
 
