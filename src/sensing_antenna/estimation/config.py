@@ -127,9 +127,9 @@ class EstimatorConfig:
         neglected moments are the axial force times the link's slope (1.5 y_c / x_c, Eq. 9,
         times R_x / R_perp up to the friction coefficient 0.6) and the weight of the bent link;
         1.0 bounds 1.5 x 0.6 = 0.9. For the elastica's statics (the front end's ratio) only the
-        bent link's weight remains, in a bending plane that holds it: the term is scaled by the
-        push direction's vertical share (0.7 of it measured on the linear simulator at 0.9 m,
-        vertical).
+        bent link's weight remains, whose moment is derived
+        (:func:`~sensing_antenna.estimation.front.evidence.bent_weight_moment`): 1.0 takes it
+        whole.
     ratio_model_floor : float
         Relative floor of the elastica statics' model term of the ratio uncertainty
         (``Evidence.ratio_uncertainty``): what no statics here holds, the contact's own size
