@@ -18,7 +18,8 @@ other evidence can say which (docs/estimation.md, "The two bending planes"):
 
 A frequency read in the push plane alone (the free plane silent) carries the bent link's
 uncertainty (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`)
-into the status; one corroborated by the free plane does not.
+into the status; one corroborated by a peak at the same frequency in the free plane, clear or
+at least half as clear as a peak must be on its own, does not.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ def bending_planes(
         The torque/force ratio's estimate and standard uncertainty (m).
     config : EstimatorConfig
     diagnostics : dict
-        Receives ``frequency_plane`` ("free", "push", "both" or "sum") and, when the planes
+        Receives ``frequency_plane`` ("free", "push" or "both") and, when the planes
         disagree, ``plane_candidates`` and ``plane_chosen_by``.
 
     Returns
@@ -86,15 +87,34 @@ def bending_planes(
     agree = measurement.components_agree(config.component_agreement)
     if not measurement.clear:
         return measurement, None
-    if not (clear["free"] and clear["push"]):
-        plane = "free" if measurement.component == PLANES["free"] else "push"
-        if measurement.component == "sum" and clear["free"]:
-            plane = "free"
-        diagnostics["frequency_plane"] = plane
-        return measurement, None
-    if agree:
+    if clear["free"] and clear["push"] and not agree:
+        return _disagreeing(
+            measurement, peaks, locate, ratio_estimate, sigma_ratio, config, diagnostics
+        )
+    # a peak at the same frequency in the other plane corroborates at half the clarity a peak
+    # must have on its own (a noise bin reaches 10 times the median with probability 1e-3,
+    # and must also fall within the agreement)
+    weakest = min((peak.quality if peak is not None else 0.0) for peak in peaks.values())
+    if agree and weakest >= 0.5 * config.min_peak_quality:
         diagnostics["frequency_plane"] = "both"
         return measurement, None
+    plane = "free" if measurement.component == PLANES["free"] else "push"
+    if measurement.component == "sum" and clear["free"]:
+        plane = "free"
+    diagnostics["frequency_plane"] = plane
+    return measurement, None
+
+
+def _disagreeing(
+    measurement: FrequencyMeasurement,
+    peaks: dict[str, SpectralPeak | None],
+    locate: Callable[[float], tuple[float, ...]],
+    ratio_estimate: float,
+    sigma_ratio: float,
+    config: EstimatorConfig,
+    diagnostics: dict[str, Any],
+) -> tuple[FrequencyMeasurement, tuple[Status, str] | None]:
+    """Both planes ring clearly and apart: the plane the ratio tells, or ``uncertain``."""
     free, push = peaks["free"], peaks["push"]
     assert free is not None and push is not None
     nearest = {
