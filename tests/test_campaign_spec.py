@@ -611,3 +611,16 @@ def test_runs_a_second_device_adds_over_the_limit_are_refused_naming_it(tmp_path
         CampaignSpecError, match=re.escape(f"{path}: second_device: ") + ".*" + re.escape(message)
     ):
         load_campaign_spec(path)
+
+
+def test_a_plane_campaign_off_the_tip_is_refused_naming_the_point(tmp_path: Path) -> None:
+    text = GOOD.replace("contact_points = [0.3, 0.5]", "contact_points = [0.98, 0.5]")
+    spec = load_campaign_spec(write(tmp_path, text + 'obstacle = "plane"\n'))
+    with pytest.raises(CampaignSpecError) as info:
+        spec.load_device()
+    message = str(info.value)
+    assert "contact_points[1]" in message and "link length 0.98 m" in message
+    at_tip = load_campaign_spec(
+        write(tmp_path, text.replace("[0.98, 0.5]", "[0.98]") + 'obstacle = "plane"\n')
+    )
+    assert at_tip.load_device().link.length == 0.98
