@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.mapping.contact_map import ContactMap
 
-__all__ = ["POINT_COLUMNS", "write_map"]
+__all__ = ["POINT_COLUMNS", "std_colours", "write_map"]
 
 #: The columns of points.csv, in order.
 POINT_COLUMNS = (
@@ -47,7 +47,7 @@ POINT_COLUMNS = (
 )
 
 
-def _colours(values: NDArray[np.float64]) -> NDArray[np.uint8]:
+def std_colours(values: NDArray[np.float64]) -> NDArray[np.uint8]:
     """RGBA rows from blue (smallest) to red (largest) of ``values``."""
     v = np.asarray(values, dtype=float)
     span = float(np.ptp(v)) if v.size else 0.0
@@ -92,7 +92,7 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
     if contact_map.used:
         cloud = trimesh.PointCloud(
             np.array([p.point for p in contact_map.used]),
-            colors=_colours(np.array([p.std for p in contact_map.used])),
+            colors=std_colours(np.array([p.std for p in contact_map.used])),
         )
         path = out / "points.ply"
         cloud.export(path)
@@ -102,7 +102,7 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
         mesh = trimesh.Trimesh(
             vertices=mesh.vertices,
             faces=mesh.faces,
-            vertex_colors=_colours(contact_map.surface_std),
+            vertex_colors=std_colours(contact_map.surface_std),
             process=False,
         )
         path = out / "surface.ply"
