@@ -25,7 +25,7 @@ from sensing_antenna.mapping.points import (
 from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
 from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive
 from sensing_antenna.mapping.recognition import (
-    ABSTAIN_DELTA_BIC,
+    ABSTAIN_DELTA,
     UNDECIDED,
     ClassFit,
     Recognition,
@@ -37,7 +37,7 @@ from sensing_antenna.mapping.store import write_map
 from sensing_antenna.mapping.surface import ImplicitSurface
 
 __all__ = [
-    "ABSTAIN_DELTA_BIC",
+    "ABSTAIN_DELTA",
     "PRIMITIVES",
     "UNDECIDED",
     "BasePose",

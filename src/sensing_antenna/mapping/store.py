@@ -156,16 +156,22 @@ def report(contact_map: ContactMap) -> str:
                 if recognition.undecided
                 else f" (confidence {recognition.confidence:.3f})"
             )
-            + f"; BIC gap to the runner-up {recognition.delta_bic:.1f}"
-            f" (abstains below {recognition.threshold:g}).",
+            + f"; score gap to the runner-up {recognition.delta_score:.1f}"
+            f" (abstains below {recognition.threshold:g})"
+            + (
+                f"; {recognition.rival} explains the points as well and is another shape"
+                if recognition.rival is not None
+                else ""
+            )
+            + ".",
             "",
-            "| class | RMS (mm) | BIC | weight | sizes (mm) |",
-            "|---|---|---|---|---|",
+            "| class | RMS (mm) | chi^2 | score | weight | sizes (mm) |",
+            "|---|---|---|---|---|---|",
         ]
         for fit in recognition.fits:
             sizes = ", ".join(f"{k} {1000 * v:.1f}" for k, v in fit.sizes.items()) or "-"
             lines.append(
-                f"| {fit.name} | {1000 * fit.rms:.2f} | {fit.bic:.1f} | {fit.weight:.3f} | "
-                f"{sizes} |"
+                f"| {fit.name} | {1000 * fit.rms:.2f} | {fit.chi2:.1f} | {fit.score:.1f} | "
+                f"{fit.weight:.3f} | {sizes} |"
             )
     return "\n".join(lines) + "\n"
