@@ -6,9 +6,11 @@ Above ``estimation/`` (it turns estimates into world points), below ``cli/``:
 - :mod:`.points`: :class:`ContactPoint`, a touched point with its covariance;
 - :mod:`.surface`: :class:`ImplicitSurface`, a Gaussian-process implicit surface;
 - :mod:`.primitives`: the shape classes, their exact signed distances and meshes;
-- :mod:`.recognition`: every class fitted, scored by BIC, a decision that may abstain;
+- :mod:`.recognition`: every class fitted, scored by BIC, a decision that abstains when a
+  class the points do not rule out is another shape;
 - :mod:`.contact_map`: :func:`build_map` and :func:`points_from_recordings`;
-- :mod:`.store`: the map's directory.
+- :mod:`.store`: the map's directory;
+- :mod:`.view`: the interactive HTML view (map.html).
 """
 
 from sensing_antenna.mapping.contact_map import (
