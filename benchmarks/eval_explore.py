@@ -223,6 +223,8 @@ def run(
             abstained=recognition.decision == UNDECIDED,
             confident_wrong=recognition.decision not in (name, UNDECIDED),
             confidence=recognition.confidence,
+            candidates=list(recognition.candidates),
+            rival=recognition.rival,
             size_error=size_error(name, dict(fit.sizes), info["truth"]),
         )
     return row
@@ -252,6 +254,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         if any(r["right"] for r in rows)
         else None,
         "mean_sweep_time_s": mean("sweep_time_s"),
+        "mean_run_s": mean("run_s"),
     }
 
 

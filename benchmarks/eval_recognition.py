@@ -170,7 +170,7 @@ def run_scene(
         "n_contacts": len(points),
         "decision": result.decision,
         "candidates": list(result.candidates),
-        "delta_bic": result.delta_bic,
+        "delta_score": result.delta_score,
         "confidence": result.confidence,
         "right": result.decision == name,
         "abstained": result.decision == UNDECIDED,
@@ -218,7 +218,7 @@ def main() -> None:
         r = rows[-1]
         print(
             f"{index:3d} {r['class']:9s} {100 * r['size_m']:5.1f} cm -> {r['decision']:9s}"
-            f" dBIC {r['delta_bic']:7.1f} size err {100 * r['size_error']:5.1f} %"
+            f" dscore {r['delta_score']:7.1f} size err {100 * r['size_error']:5.1f} %"
             f" points {1000 * r['point_rms_m']:.2f} mm surface {1000 * r['surface_rms_m']:.2f} mm",
             flush=True,
         )

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _map_html import html_scene
 from _models import calibrated
 from sensing_antenna.antenna import save_antenna
 from sensing_antenna.cli import main
@@ -67,6 +68,13 @@ def test_map_writes_points_within_their_covariance_of_the_truth(
     assert np.allclose(points[2][2], POSE.covariance_to_world(points[0][2]))
     summary = json.loads((out / "recognition.json").read_text())
     assert summary["n_used"] == 3 and summary["recognition"] is None  # too few to recognise
+    # the interactive view holds the same points, self-contained (no script fetched)
+    html = (out / "map.html").read_text()
+    assert "<script src" not in html and 'src="http' not in html
+    view = html_scene(out / "map.html")
+    cloud = view.geometry["points"]
+    assert np.allclose(np.sort(cloud.vertices, axis=0), np.sort([p[0] for p in points], axis=0))
+    assert "truth" not in view.geometry  # antenna map knows no true surface
 
 
 @pytest.mark.parametrize(

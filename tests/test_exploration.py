@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from _map_html import html_scene
 from sensing_antenna import paper_antenna
 from sensing_antenna.cli import main
 from sensing_antenna.exploration import (
@@ -155,6 +157,17 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
         assert (out / name).is_file()
     summary = json.loads((out / "exploration.json").read_text())
     assert summary["manoeuvres"] == 2 and summary["method"] == "fast"
+    # the interactive view: the points used and the scene's true surface
+    view = html_scene(out / "map.html")
+    with (out / "points.csv").open() as handle:
+        used = [r for r in csv.DictReader(handle) if r["used"] == "true"]
+    expected = np.array([[float(r[k]) for k in ("x", "y", "z")] for r in used]).reshape(-1, 3)
+    if len(expected):
+        assert np.allclose(
+            np.sort(view.geometry["points"].vertices, axis=0), np.sort(expected, axis=0)
+        )
+    truth = view.geometry["truth"]
+    assert np.allclose(truth.bounds, load_scene("post").mesh.bounds)
 
 
 def test_the_command_offers_the_librarys_strategies_and_scenes() -> None:

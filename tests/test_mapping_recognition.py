@@ -9,7 +9,8 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from sensing_antenna.mapping import UNDECIDED, fit_mesh, recognise
+from sensing_antenna.mapping import UNDECIDED, fit_mesh, fit_primitive, recognise
+from sensing_antenna.mapping.recognition import shape_gap
 
 #: Noise of the synthetic points (m, isotropic 1 sigma): about the points' sigma across the link.
 NOISE = 0.001
@@ -70,7 +71,7 @@ def test_each_class_is_recognised_with_its_size(name: str) -> None:
     mesh.apply_transform(_pose(rng))
     points, covariances = _sample(mesh, 35, rng)
     result = recognise(points, covariances, rng=np.random.default_rng(0))
-    assert result.decision == name, (result.decision, result.candidates, result.delta_bic)
+    assert result.decision == name, (result.decision, result.candidates, result.delta_score)
     assert result.confidence > 0.9
     fitted = result.best.sizes
     if name == "box":
@@ -99,7 +100,7 @@ def test_a_few_points_on_a_patch_of_a_large_sphere_abstain_between_plane_and_sph
     result = recognise(points, covariances, rng=np.random.default_rng(0))
     assert result.decision == UNDECIDED
     assert set(result.candidates) == {"plane", "sphere"}
-    assert result.delta_bic < result.threshold
+    assert result.delta_score < result.threshold
 
 
 def test_a_user_mesh_is_registered_at_its_pose() -> None:
@@ -120,3 +121,37 @@ def test_a_user_mesh_is_registered_at_its_pose() -> None:
     assert fit.mesh is not None
     _, distance, _ = trimesh.proximity.closest_point(placed, fit.mesh.vertices)
     assert distance.max() < 0.005
+
+
+def test_points_along_one_outline_of_a_torus_name_no_class_confidently() -> None:
+    # contacts along the outer equator of a torus (axis Z), the half facing the base: its
+    # outline seen along the axis, a band that a cylinder of radius R + r fits about as well;
+    # a score that charges the torus's free axis and ring as if the points fixed them names
+    # the cylinder
+    rng = np.random.default_rng(2)
+    major, minor, n = 0.05, 0.02, 24
+    azimuth = rng.uniform(math.pi / 2, 3 * math.pi / 2, n)
+    elevation = rng.uniform(-0.15, 0.15, n)  # a band of the tube around the equator
+    rho = major + minor * np.cos(elevation)
+    points = np.stack(
+        [rho * np.cos(azimuth), rho * np.sin(azimuth), minor * np.sin(elevation)], axis=1
+    )
+    points += np.array([0.5, 0.0, 0.0]) + rng.normal(0.0, NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+    result = recognise(points, covariances, outward=[-1.0, 0.0, 0.0], rng=np.random.default_rng(0))
+    assert result.decision == UNDECIDED, (result.decision, result.candidates)
+    # below the weight a decision needs, 1 / (1 + exp(-ABSTAIN_DELTA / 2))
+    assert result.confidence < 1.0 / (1.0 + math.exp(-result.threshold / 2))
+
+
+def test_a_capsule_shrunk_to_a_sphere_is_the_same_shape() -> None:
+    rng = np.random.default_rng(4)
+    mesh = trimesh.creation.icosphere(subdivisions=3, radius=0.04)
+    mesh.apply_translation([0.5, 0.1, 0.0])
+    points, covariances = _sample(mesh, 30, rng)
+    sphere = fit_primitive("sphere", points, covariances)
+    cylinder = fit_primitive("cylinder", points, covariances)
+    # a sphere against itself: nothing apart; against a cylinder: the cylinder's rims stand
+    # out of the ball by about r (sqrt(2) - 1) for a cylinder as high as wide
+    assert shape_gap(sphere, sphere) < 1e-3
+    assert shape_gap(sphere, cylinder) > 5e-3

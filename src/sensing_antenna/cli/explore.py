@@ -130,6 +130,6 @@ def _run(args: argparse.Namespace) -> int:
         f"{summary['manoeuvres']} manoeuvres ({outcomes}), {summary['sweep_time_s']:.0f} s of"
         " sweeping"
     )
-    report_map(result.contact_map, args.out)
+    report_map(result.contact_map, args.out, scene.mesh)
     print(f"  {args.out / 'manoeuvres.csv'}\n  {args.out / 'scene.ply'}")
     return 0

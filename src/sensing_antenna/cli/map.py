@@ -20,8 +20,9 @@ def register(subparsers: Any) -> None:
             "fits a Gaussian-process implicit surface through the points with status ok, and "
             "fits every shape class (sphere, cylinder, box, cone, capsule, torus, plane) and "
             "any --objects meshes, naming the best or abstaining when two explain the points "
-            "equally. Writes points.csv, points.ply, surface.ply, recognition.json, report.md "
-            "and map.png into --out (docs/mapping.md)."
+            "equally. Writes points.csv, points.ply, surface.ply, recognition.json, report.md, "
+            "map.png and map.html (an interactive 3D view, self-contained) into --out "
+            "(docs/mapping.md)."
         ),
     )
     parser.add_argument("recordings", nargs="+", type=Path, help="recordings (CSV)")
@@ -67,14 +68,19 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def report_map(contact_map: Any, out: Path) -> None:
-    """Write a map's files and figure into ``out`` and print its summary (``antenna map`` and
-    ``antenna explore`` share it)."""
+def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
+    """Write a map's files, figure and interactive view into ``out`` and print its summary
+    (``antenna map`` and ``antenna explore`` share it); ``truth``, the true surface's mesh when
+    known, is drawn in the view."""
     from sensing_antenna.mapping import write_map
+    from sensing_antenna.mapping.view import write_map_html
     from sensing_antenna.plotting.mapping import plot_map
 
     written = write_map(contact_map, out)
     written.append(plot_map(contact_map, out / "map.png"))
+    html = write_map_html(contact_map, out / "map.html", truth)
+    if html is not None:
+        written.append(html)
     summary = contact_map.summary()
     decision = (
         "not recognised (fewer than 10 points)"

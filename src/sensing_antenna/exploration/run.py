@@ -309,11 +309,13 @@ def explore(
 
 
 def _undecided_leaders(points: list[ContactPoint], include_uncertain: bool) -> tuple[ClassFit, ...]:
-    """The two leading primitive fits when recognition abstains between them, else none."""
+    """The two fits recognition abstains between (the best and its rival, or the two leading
+    scores) when it abstains and both are primitives, else none."""
     recognition = recognise_points(points, include_uncertain)
     if recognition is None or not recognition.undecided:
         return ()
-    leaders = tuple(recognition.fits[:2])
+    by_name = {f.name: f for f in recognition.fits}
+    leaders = tuple(by_name[name] for name in recognition.candidates)
     return leaders if all(f.name in PRIMITIVES for f in leaders) else ()
 
 

@@ -6,9 +6,11 @@ Above ``estimation/`` (it turns estimates into world points), below ``cli/``:
 - :mod:`.points`: :class:`ContactPoint`, a touched point with its covariance;
 - :mod:`.surface`: :class:`ImplicitSurface`, a Gaussian-process implicit surface;
 - :mod:`.primitives`: the shape classes, their exact signed distances and meshes;
-- :mod:`.recognition`: every class fitted, scored by BIC, a decision that may abstain;
+- :mod:`.recognition`: every class fitted, scored by BIC, a decision that abstains when a
+  class the points do not rule out is another shape;
 - :mod:`.contact_map`: :func:`build_map` and :func:`points_from_recordings`;
-- :mod:`.store`: the map's directory.
+- :mod:`.store`: the map's directory;
+- :mod:`.view`: the interactive HTML view (map.html).
 """
 
 from sensing_antenna.mapping.contact_map import (
@@ -25,7 +27,7 @@ from sensing_antenna.mapping.points import (
 from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
 from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive
 from sensing_antenna.mapping.recognition import (
-    ABSTAIN_DELTA_BIC,
+    ABSTAIN_DELTA,
     UNDECIDED,
     ClassFit,
     Recognition,
@@ -37,7 +39,7 @@ from sensing_antenna.mapping.store import write_map
 from sensing_antenna.mapping.surface import ImplicitSurface
 
 __all__ = [
-    "ABSTAIN_DELTA_BIC",
+    "ABSTAIN_DELTA",
     "PRIMITIVES",
     "UNDECIDED",
     "BasePose",

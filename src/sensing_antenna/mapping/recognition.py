@@ -8,12 +8,30 @@ principal axes and an algebraic sphere, keeping the lowest cost). A user mesh is
 the points by iterative closest point (trimesh.registration.icp, from several starting
 rotations) and scored the same way with its six pose parameters.
 
-Score: the Bayesian information criterion BIC = chi^2 + k ln n, with chi^2 = sum (d_i / sigma_i)^2
-(-2 log-likelihood of Gaussian distances up to a constant) and k the class's independent
-parameters; the lowest wins. Confidence: the BIC weight exp(-BIC / 2) normalised over the
-classes, an approximation of the posterior probability of each class under equal priors. The
-decision abstains (``undecided``, naming the two leaders) when the runner-up's BIC is within
-:data:`ABSTAIN_DELTA_BIC` of the best.
+Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with chi^2 =
+sum (d_i / sigma_i)^2 (-2 log-likelihood of Gaussian distances up to a constant), k the class's
+independent parameters and c >= 1 the overdispersion (Burnham and Anderson, "Model Selection and
+Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of the best-fitting class when
+above 1, so that points farther from every class than their covariances say, an estimator's
+systematic error, weigh less); c = 1 is BIC. The lowest score wins.
+
+The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
+points pin the richer class's extra parameters to the simpler shape (a torus fitted to a sphere
+shrinks its ring to nothing) and wrong when they leave them free: points along one outline of a
+torus seen face-on fit a sphere and a whole family of tori alike, and k ln n would name the
+sphere with a weight the points never gave it. So the decision also asks whether the points
+rule the runner-ups out: a class is a **rival** of the best when its own fit is not worse by
+:data:`ABSTAIN_DELTA` in chi^2 / c (the likelihood alone, no penalty: the points do not reject
+it) and its fitted shape is a different object, some part of its surface (the 95th percentile
+of the distances between the two fitted surfaces, both ways) farther from the best's than
+:data:`SAME_SHAPE_SIGMAS` times the points' median standard deviation along the normal. The
+decision abstains (``undecided``, naming the best and its rival) when there is a rival, or
+when the runner-up's score is within :data:`ABSTAIN_DELTA` of the best's.
+
+Confidence: the best class's weight exp(-score / 2) normalised over the classes (the posterior
+probability under equal priors in BIC's approximation), and, when there is a rival, the best's
+weight against the rival on the likelihood alone, 1 / (1 + exp(-delta chi^2 / (2 c))): below
+1 / (1 + exp(-3)) = 0.95 whenever the decision abstains.
 """
 
 from __future__ import annotations
@@ -33,21 +51,30 @@ from scipy.spatial.transform import Rotation
 from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive
 
 __all__ = [
-    "ABSTAIN_DELTA_BIC",
+    "ABSTAIN_DELTA",
     "UNDECIDED",
     "ClassFit",
     "Recognition",
     "fit_mesh",
     "fit_primitive",
     "recognise",
+    "shape_gap",
 ]
 
 FloatArray = NDArray[np.float64]
 
-#: A BIC difference below which two classes explain the points equally: 6, where Kass and
-#: Raftery (J. Am. Stat. Assoc. 90, 1995, Section 3.2) put "strong" evidence (a Bayes factor of
-#: 20, a posterior of about 95 % for the better of two under equal priors).
-ABSTAIN_DELTA_BIC = 6.0
+#: A score or chi^2 difference (twice the log Bayes factor or likelihood ratio) below which two
+#: classes explain the points equally: 6, where Kass and Raftery (J. Am. Stat. Assoc. 90, 1995,
+#: Section 3.2) put "strong" evidence (a factor of 20, a posterior of about 95 % for the better
+#: of two under equal priors).
+ABSTAIN_DELTA = 6.0
+
+#: Two fitted shapes farther apart than this many of the points' median standard deviations
+#: (along the normal) somewhere are different objects: points there would have told them apart.
+SAME_SHAPE_SIGMAS = 3.0
+
+#: Points sampled on each fitted surface to compare two shapes.
+SHAPE_SAMPLES = 2000
 
 #: The decision's name when the leading two classes are not told apart.
 UNDECIDED = "undecided"
@@ -91,13 +118,15 @@ class ClassFit:
     chi2 : float
         sum (d_i / sigma_i)^2 (dimensionless).
     bic : float
-        chi2 + dof ln n.
+        chi2 + dof ln n (the score when c = 1).
     dof : int
         Independent parameters.
     n_points : int
         Points fitted.
     weight : float
-        BIC weight among the classes compared (0 to 1); NaN until compared.
+        Weight exp(-score / 2) among the classes compared (0 to 1); NaN until compared.
+    score : float
+        chi2 / c + dof ln n (module docstring); NaN until compared.
     """
 
     name: str
@@ -109,6 +138,7 @@ class ClassFit:
     dof: int
     n_points: int
     weight: float = math.nan
+    score: float = math.nan
     vector: FloatArray = field(default_factory=lambda: np.zeros(0), compare=False, repr=False)
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
 
@@ -121,6 +151,7 @@ class ClassFit:
             "rms_m": float(self.rms),
             "chi2": float(self.chi2),
             "bic": float(self.bic),
+            "score": None if math.isnan(self.score) else float(self.score),
             "dof": self.dof,
             "n_points": self.n_points,
             "weight": None if math.isnan(self.weight) else float(self.weight),
@@ -136,27 +167,33 @@ class Recognition:
     decision : str
         The best class, or ``undecided``.
     fits : tuple of ClassFit
-        Every class, best (lowest BIC) first, with weights.
+        Every class, best (lowest score) first, with weights.
     candidates : tuple of str
         The two leading classes.
-    delta_bic : float
-        BIC of the runner-up minus the best's (inf with one class).
+    delta_score : float
+        Score of the runner-up minus the best's (inf with one class).
     confidence : float
-        The best class's BIC weight (0 to 1).
+        The best class's weight (0 to 1; against its rival when there is one).
     threshold : float
-        The abstention threshold on delta_bic used.
+        The abstention threshold used.
+    overdispersion : float
+        c, the reduced chi^2 of the best-fitting class when above 1 (else 1).
+    rival : str or None
+        A class the points do not rule out that is a different shape from the best's.
     """
 
     decision: str
     fits: tuple[ClassFit, ...]
     candidates: tuple[str, ...]
-    delta_bic: float
+    delta_score: float
     confidence: float
     threshold: float
+    overdispersion: float = 1.0
+    rival: str | None = None
 
     @property
     def best(self) -> ClassFit:
-        """The lowest-BIC fit (even when the decision abstains)."""
+        """The lowest-score fit (even when the decision abstains)."""
         return self.fits[0]
 
     @property
@@ -169,9 +206,11 @@ class Recognition:
         return {
             "decision": self.decision,
             "candidates": list(self.candidates),
-            "delta_bic": None if math.isinf(self.delta_bic) else float(self.delta_bic),
+            "delta_score": None if math.isinf(self.delta_score) else float(self.delta_score),
             "confidence": float(self.confidence),
-            "abstain_delta_bic": float(self.threshold),
+            "abstain_delta": float(self.threshold),
+            "overdispersion": float(self.overdispersion),
+            "rival": self.rival,
             "fits": [f.to_dict() for f in self.fits],
         }
 
@@ -428,7 +467,14 @@ def fit_mesh(
     extents = mesh.bounding_box.extents
     sizes = {f"extent_{a}": float(e) for a, e in zip("xyz", extents, strict=True)}
     return _scored(
-        f"mesh:{name}", parameters, sizes, np.asarray(distance), sigma, 6, pose.ravel(), placed
+        f"mesh:{name}",
+        parameters,
+        sizes,
+        np.asarray(distance),
+        sigma,
+        6,
+        pose.ravel(),
+        placed,
     )
 
 
@@ -459,6 +505,39 @@ def _scored(
     )
 
 
+def _surface_distance(fit: ClassFit, samples: FloatArray) -> FloatArray:
+    """Unsigned distance (m) of ``samples`` to ``fit``'s surface: the class's exact distance, or
+    the closest point on a registered mesh."""
+    if fit.name in PRIMITIVES:
+        return np.abs(PRIMITIVES[fit.name].signed_distance(fit.vector, samples))
+    assert fit.mesh is not None
+    _, distance, _ = trimesh.proximity.closest_point(fit.mesh, samples)
+    return np.asarray(distance)
+
+
+def shape_gap(a: ClassFit, b: ClassFit, seed: int = 0) -> float:
+    """How far two fitted shapes are apart (m): the 95th percentile of the distances from
+    :data:`SHAPE_SAMPLES` points on each surface to the other surface; inf when either is
+    unbounded (a plane) or has no mesh."""
+    if a.mesh is None or b.mesh is None:
+        return math.inf
+    gaps = []
+    for one, other in ((a, b), (b, a)):
+        assert one.mesh is not None
+        samples, _ = trimesh.sample.sample_surface(one.mesh, SHAPE_SAMPLES, seed=seed)
+        gaps.append(_surface_distance(other, np.asarray(samples)))
+    return float(np.percentile(np.concatenate(gaps), 95.0))
+
+
+def _fit_normals(fit: ClassFit, points: FloatArray) -> FloatArray:
+    """The fitted surface's unit normals at ``points`` (a mesh's: of its closest faces)."""
+    if fit.name in PRIMITIVES:
+        return PRIMITIVES[fit.name].normals(fit.vector, points)
+    assert fit.mesh is not None
+    _, _, faces = trimesh.proximity.closest_point(fit.mesh, points)
+    return np.asarray(fit.mesh.face_normals[faces])
+
+
 def _outward(points: FloatArray, outward: ArrayLike | None) -> FloatArray:
     if outward is not None:
         direction = np.asarray(outward, dtype=float).reshape(3)
@@ -474,7 +553,7 @@ def recognise(
     classes: Sequence[str] | None = None,
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
     outward: ArrayLike | None = None,
-    threshold: float = ABSTAIN_DELTA_BIC,
+    threshold: float = ABSTAIN_DELTA,
     rng: np.random.Generator | None = None,
 ) -> Recognition:
     """Fit every class (and mesh) to the points and decide (module docstring).
@@ -492,7 +571,7 @@ def recognise(
     outward : array, shape (3,), optional
         Direction from the object towards the antenna (see :func:`fit_primitive`).
     threshold : float
-        Abstain when the runner-up's BIC is within this of the best's.
+        Abstain when the runner-up's score is within this of the best's.
     rng : numpy.random.Generator, optional
         Seeded default when None.
     """
@@ -505,18 +584,40 @@ def recognise(
     fits = [fit_primitive(name, p, cov, outward, generator) for name in names]
     for name, mesh in (meshes or {}).items():
         fits.append(fit_mesh(name, mesh, p, cov, generator))
-    fits.sort(key=lambda f: f.bic)
-    # BIC weights: exp(-(BIC_j - BIC_min) / 2), normalised
-    raw = np.exp(-0.5 * (np.array([f.bic for f in fits]) - fits[0].bic))
+    # overdispersion: the best-fitting class's reduced chi^2 when above 1
+    tightest = min(fits, key=lambda f: f.chi2)
+    c = max(1.0, tightest.chi2 / max(len(p) - tightest.dof, 1))
+    n_log = math.log(len(p))
+    fits = [dataclasses.replace(f, score=f.chi2 / c + f.dof * n_log) for f in fits]
+    fits.sort(key=lambda f: f.score)
+    raw = np.exp(-0.5 * (np.array([f.score for f in fits]) - fits[0].score))
     weights = raw / raw.sum()
     fits = [dataclasses.replace(f, weight=float(w)) for f, w in zip(fits, weights, strict=True)]
-    delta = fits[1].bic - fits[0].bic if len(fits) > 1 else math.inf
-    decision = fits[0].name if delta >= threshold else UNDECIDED
+    best = fits[0]
+    delta = fits[1].score - best.score if len(fits) > 1 else math.inf
+    # a rival: not ruled out by the likelihood, and a different object
+    sigma = float(np.median(_normal_sigma(cov, _fit_normals(best, p))))
+    rival = next(
+        (
+            f
+            for f in fits[1:]
+            if (f.chi2 - best.chi2) / c < threshold
+            and shape_gap(best, f) > SAME_SHAPE_SIGMAS * sigma
+        ),
+        None,
+    )
+    confidence = float(weights[0])
+    if rival is not None:
+        confidence = 1.0 / (1.0 + math.exp(-0.5 * (rival.chi2 - best.chi2) / c))
+    decision = best.name if delta >= threshold and rival is None else UNDECIDED
+    leaders = (best, rival) if rival is not None else tuple(fits[:2])
     return Recognition(
         decision=decision,
         fits=tuple(fits),
-        candidates=tuple(f.name for f in fits[:2]),
-        delta_bic=float(delta),
-        confidence=float(weights[0]),
+        candidates=tuple(f.name for f in leaders),
+        delta_score=float(delta),
+        confidence=confidence,
         threshold=threshold,
+        overdispersion=float(c),
+        rival=None if rival is None else rival.name,
     )

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.mapping.contact_map import ContactMap
 
-__all__ = ["POINT_COLUMNS", "write_map"]
+__all__ = ["POINT_COLUMNS", "std_colours", "write_map"]
 
 #: The columns of points.csv, in order.
 POINT_COLUMNS = (
@@ -47,7 +47,7 @@ POINT_COLUMNS = (
 )
 
 
-def _colours(values: NDArray[np.float64]) -> NDArray[np.uint8]:
+def std_colours(values: NDArray[np.float64]) -> NDArray[np.uint8]:
     """RGBA rows from blue (smallest) to red (largest) of ``values``."""
     v = np.asarray(values, dtype=float)
     span = float(np.ptp(v)) if v.size else 0.0
@@ -92,7 +92,7 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
     if contact_map.used:
         cloud = trimesh.PointCloud(
             np.array([p.point for p in contact_map.used]),
-            colors=_colours(np.array([p.std for p in contact_map.used])),
+            colors=std_colours(np.array([p.std for p in contact_map.used])),
         )
         path = out / "points.ply"
         cloud.export(path)
@@ -102,7 +102,7 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
         mesh = trimesh.Trimesh(
             vertices=mesh.vertices,
             faces=mesh.faces,
-            vertex_colors=_colours(contact_map.surface_std),
+            vertex_colors=std_colours(contact_map.surface_std),
             process=False,
         )
         path = out / "surface.ply"
@@ -156,16 +156,22 @@ def report(contact_map: ContactMap) -> str:
                 if recognition.undecided
                 else f" (confidence {recognition.confidence:.3f})"
             )
-            + f"; BIC gap to the runner-up {recognition.delta_bic:.1f}"
-            f" (abstains below {recognition.threshold:g}).",
+            + f"; score gap to the runner-up {recognition.delta_score:.1f}"
+            f" (abstains below {recognition.threshold:g})"
+            + (
+                f"; {recognition.rival} explains the points as well and is another shape"
+                if recognition.rival is not None
+                else ""
+            )
+            + ".",
             "",
-            "| class | RMS (mm) | BIC | weight | sizes (mm) |",
-            "|---|---|---|---|---|",
+            "| class | RMS (mm) | chi^2 | score | weight | sizes (mm) |",
+            "|---|---|---|---|---|---|",
         ]
         for fit in recognition.fits:
             sizes = ", ".join(f"{k} {1000 * v:.1f}" for k, v in fit.sizes.items()) or "-"
             lines.append(
-                f"| {fit.name} | {1000 * fit.rms:.2f} | {fit.bic:.1f} | {fit.weight:.3f} | "
-                f"{sizes} |"
+                f"| {fit.name} | {1000 * fit.rms:.2f} | {fit.chi2:.1f} | {fit.score:.1f} | "
+                f"{fit.weight:.3f} | {sizes} |"
             )
     return "\n".join(lines) + "\n"
