@@ -382,7 +382,7 @@ def _higher_mode(
 
 
 def _early_statics(
-    span: WindowSpan, omega1: float, bias: SensorBias, axial: float, link: Link
+    span: WindowSpan, omega1: float, bias: SensorBias, model: StaticsModel, link: Link
 ) -> StaticRatio | None:
     """Statics of the window's first half from t_1, the slip check's reference; None when that
     half is not on the grid or is no reference (:func:`.checks.is_slip_reference`: too few
@@ -392,7 +392,8 @@ def _early_statics(
     half_fit = None if half is None else fit_window(*span._replace(end_index=half))
     if half_fit is None or not is_slip_reference(half_fit, omega1, span.band, config):
         return None
-    return static_ratio(half_fit, bias, axial, 1.0 / link.bending_compliance)
+    assert half is not None
+    return static_ratio(half_fit, bias, model.axial_at(half), 1.0 / link.bending_compliance)
 
 
 def evaluate_from_t1_or_hold(
@@ -455,9 +456,7 @@ def with_early_statics_of(
             span,
             from_t1.omega1,
             inputs.bias,
-            inputs.statics_model.axial_at(span.end_index)
-            if inputs.statics_model is not None
-            else 0.0,
+            inputs.statics_model if inputs.statics_model is not None else StaticsModel(),
             inputs.link,
         )
     )
