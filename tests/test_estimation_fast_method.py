@@ -109,13 +109,13 @@ def azimuthal_evidence(azimuthal: Recording) -> Evidence:
 
 @pytest.fixture(scope="module")
 def azimuthal_estimate(azimuthal: Recording) -> ContactEstimate:
-    return estimate(azimuthal, calibrated(), FastMethod(DECLARING))
+    return estimate(azimuthal, calibrated(), FastMethod())
 
 
 @pytest.fixture(scope="module")
 def azimuthal_history(azimuthal_evidence: Evidence) -> tuple[WindowEstimate, ...]:
     """Every window from the end of the hold to the cap, with the default settings."""
-    return FastMethod(DECLARING).history(azimuthal_evidence)
+    return FastMethod().history(azimuthal_evidence)
 
 
 @pytest.fixture(scope="module")
@@ -233,10 +233,6 @@ def _channels(
 
 
 NO_BIAS = SensorBias(np.zeros(5), np.zeros((5, 5)), 0)
-#: A tolerance the simulated recordings' windows reach: the default push bends the link by
-#: 7.8 % of x_c at 0.6 m, whose bent-link term on omega_1 (Evidence.bent_link_uncertainty,
-#: 2.2 mm there) makes the 95 % interval about 8.6 mm wide at best
-DECLARING = FastConfig(tolerance=0.01)
 BAND = search_band(LINK, EstimatorConfig())
 
 
@@ -552,7 +548,7 @@ def test_offline_and_online_agree_on_a_simulated_recording(
     # With the push phase, on a recording whose declared window is the one through the push.
     antenna = calibrated()
     recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=seed))
-    method = FastMethod(FastConfig(push_phase=push_phase, tolerance=DECLARING.tolerance))
+    method = FastMethod(FastConfig(push_phase=push_phase))
     offline = estimate(recording, antenna, method)
     assert offline.diagnostics["fit_through_push"] is push_phase
     streamed = _online(recording, method)
@@ -575,7 +571,7 @@ def test_history_holds_the_declared_window_and_runs_to_the_cap(
     # end of the hold is the one conclude() declares (same sample, same x_c, the windows up to
     # it counted as its evaluations); from_t1 starts first_window after t_1; the last window
     # is the cap (the recording runs past it).
-    evidence, history, config = azimuthal_evidence, azimuthal_history, DECLARING
+    evidence, history, config = azimuthal_evidence, azimuthal_history, FastConfig()
     declared = next(w for w in history if w.sure)
     assert history[0].end_index >= evidence.hold_end
     assert evidence.t[declared.end_index] == azimuthal_estimate.t_e
@@ -591,7 +587,7 @@ def test_history_holds_the_declared_window_and_runs_to_the_cap(
     # From t_1: the windows before the hold's end too, the same ones after it; the first fails
     # a check (too short for the fundamental) and is not sure at any tolerance
     declared_at = (declared.end_index - evidence.rest_index) * TS
-    since_t1 = FastMethod(replace(DECLARING, cap=declared_at)).history(evidence, from_t1=True)
+    since_t1 = FastMethod(FastConfig(cap=declared_at)).history(evidence, from_t1=True)
     assert since_t1[0].end_index - evidence.rest_index == round(config.first_window / TS)
     assert since_t1[0].end_index < evidence.hold_end
     same_end = {w.end_index: w for w in history}
@@ -652,9 +648,7 @@ def test_second_mode_chooses_the_branch_near_the_peak() -> None:
     truth = float(recording.metadata["true_xc"])
     blind = recording.without_ground_truth()
     at_cap = estimate(blind, antenna, FastMethod(FastConfig(branch_by_second_mode=False)))
-    # (near the curve's top the push's bent-link term on omega_1 spreads the interval over
-    # 14 mm: a tolerance of 15 mm)
-    early = estimate(blind, antenna, FastMethod(FastConfig(tolerance=0.015)))
+    early = estimate(blind, antenna, FastMethod())
     assert at_cap.status is Status.UNCERTAIN
     assert "second contact mode" in (at_cap.reason or "")
     assert early.status is Status.OK
@@ -753,9 +747,9 @@ def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
     # window's. Blocks of one sample are update(), and one block holding every sample asks
     # nothing before the pipeline's own end, so both give the offline estimate.
     antenna, offline, recording = calibrated(), azimuthal_estimate, azimuthal
-    single = _online(recording, FastMethod(DECLARING), 1)
+    single = _online(recording, FastMethod(), 1)
     assert (single.x_c, single.t_e) == (offline.x_c, offline.t_e)
-    whole = _online(recording, FastMethod(DECLARING), recording.t.shape[0])
+    whole = _online(recording, FastMethod(), recording.t.shape[0])
     assert (whole.x_c, whole.t_e) == (offline.x_c, offline.t_e)
     # The samples from t_1 + 0.2 s (the hold's end: nothing asked before) to t_1 + 0.3 s
     # arrive together: one window asked, the last grid instant in the block
@@ -764,7 +758,7 @@ def test_a_block_of_samples_asks_the_method_once_at_its_last_evaluation_instant(
     first, last = t_1_index + 200, t_1_index + 300
     grid = t_1_index + evaluation_offsets(TS, FastConfig())
     asked = int(grid[(grid >= first) & (grid < last)].max())
-    blocked = OnlineEstimator(antenna, recording.sample_period, FastMethod(DECLARING))
+    blocked = OnlineEstimator(antenna, recording.sample_period, FastMethod())
     for k in range(first):
         assert blocked.update(t[k], theta[k], force[k], torque[k]) is None
     out = blocked.update_block(
@@ -906,11 +900,7 @@ def test_windows_started_warm_declare_what_windows_started_from_the_pencil_decla
     # reach nearly the same optimum: omega_1 differs (another start) by a fraction of its
     # standard error, and both declarations are ok, each x_c inside the other's interval and
     # both intervals holding the simulator's contact point.
-    cold = estimate(
-        azimuthal,
-        calibrated(),
-        FastMethod(FastConfig(warm_start_after=0.0, tolerance=DECLARING.tolerance)),
-    )
+    cold = estimate(azimuthal, calibrated(), FastMethod(FastConfig(warm_start_after=0.0)))
     warm = azimuthal_estimate
     truth = float(azimuthal.metadata["true_xc"])
     assert warm.omega1 != cold.omega1
@@ -932,9 +922,9 @@ def test_a_session_never_serves_the_fits_of_other_samples(
     after = first.t > azimuthal_estimate.t_1 + 0.2
     torque[after, 1] *= 1.03
     second = replace(first, torque=torque)
-    fresh = [azimuthal_estimate, estimate(second, antenna, FastMethod(DECLARING))]
+    fresh = [azimuthal_estimate, estimate(second, antenna, FastMethod())]
     assert fresh[0].ratio_estimate != fresh[1].ratio_estimate
-    session = FastMethod(DECLARING).session()
+    session = FastMethod().session()
     for recording, expected in zip((first, second), fresh, strict=True):
         offline = estimate(recording, antenna, session)
         assert (offline.x_c, offline.t_e, offline.interval, offline.ratio_estimate) == (
@@ -965,9 +955,9 @@ def test_a_fit_cache_never_serves_fits_of_other_settings(
     # modes at most, they give the default method (three) the estimate of a fresh cache, not
     # one from the two-mode fits (which read omega_1 differently).
     caches: Any = ({}, {})
-    two_modes = FastMethod(replace(DECLARING, max_modes=2)).conclude(azimuthal_evidence, caches)
+    two_modes = FastMethod(FastConfig(max_modes=2)).conclude(azimuthal_evidence, caches)
     assert two_modes.omega1 != azimuthal_estimate.omega1
-    shared = FastMethod(DECLARING).conclude(azimuthal_evidence, caches)
+    shared = FastMethod().conclude(azimuthal_evidence, caches)
     keys = ("x_c", "t_e", "omega1", "ratio_estimate", "interval")
     assert [getattr(shared, key) for key in keys] == [
         getattr(azimuthal_estimate, key) for key in keys

@@ -15,9 +15,7 @@ Two measurements, each with a standard error:
 Model-error floors are added in quadrature to the statistical standard errors:
 
 - frequency: a relative error ``frequency_floor`` of omega_1 (T or T_e known to that relative
-  precision; the model frequency is proportional to 1 / T) and, at each grid point, the bent
-  link's shift of the straight link's curve (``omega1_model``), sigma_w^2 = se^2 +
-  (eps omega_hat)^2 + model^2;
+  precision; the model frequency is proportional to 1 / T), sigma_w^2 = se^2 + (eps omega_hat)^2;
 - ratio: what the elastica's statics do not hold, the front end's model term at each grid point
   (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.ratio_model_uncertainty`: the
   stiffness's uncertainty on the statics' corrections, the bent link's weight, a floor),
@@ -136,7 +134,6 @@ def contact_posterior(
     omega_higher: float = math.nan,
     omega_higher_se: float = math.nan,
     higher_mode_floor: float = 0.0,
-    omega1_model: float | FloatArray = 0.0,
 ) -> ContactPosterior:
     """Posterior over x_c on ``grid`` from omega_1 and the torque/force ratio.
 
@@ -164,9 +161,6 @@ def contact_posterior(
         Measured higher mode and its statistical standard error (rad/s); NaN: not measured.
     higher_mode_floor : float
         Relative model error of the higher modes (dimensionless).
-    omega1_model : float or array, shape (G,)
-        A further model error of omega_1(x_c) at each grid point (rad/s), in quadrature (the
-        bent link's); 0: none.
 
     Returns
     -------
@@ -175,17 +169,8 @@ def contact_posterior(
     log_like = np.zeros(grid.shape)
     if math.isfinite(omega1) and math.isfinite(omega1_se):
         # Gaussian likelihood of omega_1 through the forward sensing curve, floor in quadrature
-        if np.ndim(omega1_model):
-            # a model error that varies along the grid: each point's likelihood normalised
-            sigma_x = np.sqrt(
-                omega1_se**2 + (frequency_floor * omega1) ** 2 + np.square(omega1_model)
-            )
-            log_like += -0.5 * ((omega1 - omega1_of_x) / sigma_x) ** 2 - np.log(sigma_x)
-        else:
-            sigma_w = math.sqrt(
-                omega1_se**2 + (frequency_floor * omega1) ** 2 + float(omega1_model) ** 2
-            )
-            log_like += -0.5 * ((omega1 - omega1_of_x) / sigma_w) ** 2
+        sigma_w = math.sqrt(omega1_se**2 + (frequency_floor * omega1) ** 2)
+        log_like += -0.5 * ((omega1 - omega1_of_x) / sigma_w) ** 2
     if math.isfinite(ratio) and math.isfinite(ratio_se):
         sigma_r = np.sqrt(ratio_se**2 + np.square(ratio_model)) * np.ones(grid.shape)
         log_like += -0.5 * ((ratio - grid) / sigma_r) ** 2 - np.log(sigma_r)

@@ -191,7 +191,9 @@ class StaticsModel:
         point: the sensing curves are the straight link's, and the bent link's preload shifts
         its frequencies; the front end's uncertainty of a contact point read from the vibration
         (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`),
-        times the curve's slope there; in the posterior and the frequency's check. None: none.
+        times the curve's slope there. As for the paper method's candidate, it enters the
+        frequency's consistency with the answer (:func:`.checks.frequency_check`), not the
+        posterior: an upper bound of a shift measured at one point. None: none.
     """
 
     axial: FloatArray | None = None

@@ -257,12 +257,6 @@ def evaluate_window(
         omega_higher=omega_h,
         omega_higher_se=omega_h_se,
         higher_mode_floor=config.higher_mode_floor,
-        omega1_model=(
-            statics_model.omega1_sd
-            if statics_model.omega1_sd is not None
-            and statics_model.omega1_sd.shape == table.grid.shape
-            else 0.0
-        ),
     )
     chosen = False
     second_mode: dict[str, Any] = {}
@@ -348,8 +342,9 @@ def _omega1_sigma(
     statics_model: StaticsModel,
     x_c: float,
 ) -> float:
-    """The standard deviation of omega_1 (rad/s) the posterior gives it at ``x_c`` (m): the
-    fit's error, the relative ``frequency_floor`` and the bent link's term, in quadrature."""
+    """The standard deviation of omega_1 (rad/s) its check against the sensing curve at ``x_c``
+    (m) allows: the fit's error and the relative ``frequency_floor`` as in the posterior, and
+    the bent link's term, in quadrature."""
     return math.sqrt(
         omega1_se**2 + (frequency_floor * omega1) ** 2 + statics_model.omega1_sd_at(x_c) ** 2
     )
