@@ -4,7 +4,8 @@ Two fixed sets of simulated recordings, generated here from fixed seeds:
 
 - ``paper``: the built-in paper antenna for the simulator and the estimators, both cases,
   x_c = 0.30, 0.45, 0.60, 0.70, 0.78, 0.90, 0.98 m, noise scales 0.5, 1 and 2 (42 recordings);
-- ``device``: the default campaign's calibrated device (its preparation runs first: observer
+- ``device``: the default campaign's calibrated nominal device (its second device, without
+  the realistic profile's imperfections; its preparation runs first: observer
   identification and T_e calibration on the simulated device), the first repeat of every main
   run (both cases, 15 contact points: 30 recordings), each estimated with the run's model.
 
@@ -89,6 +90,8 @@ def device_set() -> list[Item]:
     from sensing_antenna.campaign.simulated import make_scenario, prepare_campaign
 
     spec = load_campaign_spec(None)
+    if spec.second_device.enabled:  # its nominal device: the one these figures are of
+        spec = spec.second_device_spec()
     preparation = prepare_campaign(spec)
     items = []
     for run in expand_runs(spec, preparation.model, preparation.device):

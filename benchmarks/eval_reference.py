@@ -50,6 +50,14 @@ def _number(text: str | None) -> float:
         return math.nan
 
 
+def _case(text: str | None) -> str:
+    """The manoeuvre (``azimuthal`` or ``vertical``) from the recording's simulation record."""
+    try:
+        return str(json.loads(text or "{}").get("scenario", {}).get("case", "unknown"))
+    except (ValueError, AttributeError):
+        return "unknown"
+
+
 def _point(text: str | None) -> np.ndarray:
     try:
         return np.asarray(json.loads(text), dtype=float) if text else np.full(3, np.nan)
@@ -79,6 +87,7 @@ def run() -> dict[str, Any]:
             truth = _number(recording.metadata.get("true_xc"))
             ratio = _number(recording.metadata.get("true_deflection_ratio"))
             true_point = _point(recording.metadata.get("true_contact_point"))
+            case = _case(recording.metadata.get("simulation"))
             blind = recording.without_ground_truth()
             for method in sorted(METHODS):
                 result = estimate(blind, model, method=method)
@@ -86,6 +95,7 @@ def run() -> dict[str, Any]:
                     {
                         "model": model_name,
                         "recording": name,
+                        "case": case,
                         "true_xc": truth,
                         "deflection_ratio": ratio,
                         "method": method,
@@ -121,27 +131,35 @@ def run() -> dict[str, Any]:
 def _summary(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     out = []
     for model in sorted({r["model"] for r in rows}):
-        for method in sorted({r["method"] for r in rows}):
-            mine = [r for r in rows if r["model"] == model and r["method"] == method]
-            ok = [r for r in mine if r["status"] == "ok"]
-            errors = [abs(r["error"]) for r in ok if math.isfinite(r["error"])]
-            held = [r["interval_holds"] for r in mine if r["interval_holds"] is not None]
-            out.append(
-                {
-                    "model": model,
-                    "method": method,
-                    "runs": len(mine),
-                    "ok": len(ok),
-                    "ok_wrong_over_2cm": sum(e > WRONG_OK for e in errors),
-                    "ok_mean_abs_error": sum(errors) / len(errors) if errors else None,
-                    "ok_max_abs_error": max(errors) if errors else None,
-                    "interval_holds": f"{sum(held)}/{len(held)}" if held else None,
-                    "statuses": {
-                        s: sum(r["status"] == s for r in mine)
-                        for s in sorted({r["status"] for r in mine})
-                    },
-                }
-            )
+        for case in sorted({r["case"] for r in rows}):
+            for method in sorted({r["method"] for r in rows}):
+                mine = [
+                    r
+                    for r in rows
+                    if r["model"] == model and r["case"] == case and r["method"] == method
+                ]
+                if not mine:
+                    continue
+                ok = [r for r in mine if r["status"] == "ok"]
+                errors = [abs(r["error"]) for r in ok if math.isfinite(r["error"])]
+                held = [r["interval_holds"] for r in mine if r["interval_holds"] is not None]
+                out.append(
+                    {
+                        "model": model,
+                        "case": case,
+                        "method": method,
+                        "runs": len(mine),
+                        "ok": len(ok),
+                        "ok_wrong_over_2cm": sum(e > WRONG_OK for e in errors),
+                        "ok_mean_abs_error": sum(errors) / len(errors) if errors else None,
+                        "ok_max_abs_error": max(errors) if errors else None,
+                        "interval_holds": f"{sum(held)}/{len(held)}" if held else None,
+                        "statuses": {
+                            s: sum(r["status"] == s for r in mine)
+                            for s in sorted({r["status"] for r in mine})
+                        },
+                    }
+                )
     return out
 
 
@@ -159,7 +177,7 @@ def print_table(result: dict[str, Any]) -> None:
     for model in ("calibrated", "self"):
         print(f"\nmodel: {model}")
         print(
-            f"{'recording':15} {'true cm':>7} {'y/x':>5} {'method':13} {'status':16}"
+            f"{'recording':22} {'true cm':>7} {'y/x':>5} {'method':13} {'status':16}"
             f" {'x_c cm':>7} {'err cm':>7}  interval cm"
         )
         for r in result["rows"]:
@@ -171,16 +189,17 @@ def print_table(result: dict[str, Any]) -> None:
                 else ""
             )
             print(
-                f"{r['recording']:15} {_cm(r['true_xc'])} {r['deflection_ratio']:5.3f}"
+                f"{r['recording']:22} {_cm(r['true_xc'])} {r['deflection_ratio']:5.3f}"
                 f" {r['method']:13} {r['status']:16} {_cm(r['x_c'])} {_cm(r['error'])}  {interval}"
             )
     print()
     for s in result["summary"]:
-        mean = s["ok_mean_abs_error"]
+        mean, worst = s["ok_mean_abs_error"], s["ok_max_abs_error"]
         print(
-            f"{s['model']:10} {s['method']:13} ok {s['ok']}/{s['runs']},"
+            f"{s['model']:10} {s['case']:9} {s['method']:13} ok {s['ok']}/{s['runs']},"
             f" ok over 2 cm {s['ok_wrong_over_2cm']},"
             f" mean |err| of ok {'-' if mean is None else f'{100 * mean:.2f} cm'},"
+            f" max {'-' if worst is None else f'{100 * worst:.2f} cm'},"
             f" intervals hold {s['interval_holds']}, {s['statuses']}"
         )
 

@@ -44,8 +44,10 @@ def test_default_campaign_is_the_paper_section_5_6() -> None:
     # Section 5.6: x_c = 0.30 to 0.95 m every 5 cm plus 0.98 m, 5 experiments per point, 2 cases
     spec = default_campaign_spec()
     assert spec.n_main_runs == 150
-    # plus the noise sweep: 4 levels x 8 points x 2 cases x 1 repeat
-    assert spec.n_sweep_runs == 64 and spec.n_runs == 214
+    # plus the noise sweep: 4 levels x 8 points x 2 cases x 1 repeat, and the main runs again
+    # on the second device
+    assert spec.n_sweep_runs == 64 and spec.n_second_device_runs == 150
+    assert spec.n_runs == 364
     assert spec.cases == ("azimuthal", "vertical")
     expected = [*np.round(np.arange(0.30, 0.951, 0.05), 2), 0.98]
     np.testing.assert_allclose(spec.contact_points, expected, atol=1e-12)
@@ -65,7 +67,9 @@ def test_runs_are_ordered_named_and_seeded_deterministically() -> None:
     assert len({r.seed for r in runs}) == 150
     again = expand_runs(spec, paper_antenna())
     assert [r.seed for r in again] == [r.seed for r in every]
-    assert len({r.seed for r in every}) == len(every) == 214
+    # the second device's runs repeat the main runs' seeds; no other seed repeats
+    assert len(every) == 364 and len({r.seed for r in every}) == 214
+    assert [r.seed for r in every[214:]] == [r.seed for r in runs]
     assert runs[7].seed == derive_seed(spec.base_seed, 7)
     # the free-motion step draws from another stream of the same base seed
     assert derive_seed(spec.base_seed, 0, stream=1) not in {r.seed for r in runs}
@@ -185,6 +189,12 @@ def test_default_campaign_simulates_a_device_with_the_paper_t_e() -> None:
     np.testing.assert_allclose(spec.calibration.contact_points, spec.contact_points)
     assert spec.calibration.repeats == 1
     assert spec.free_motion.identify
+    # the main runs on the realistic profile, the nominal device (the same hardware) as the
+    # second device
+    assert spec.device.profile == "realistic" and not spec.device.imperfections
+    nominal = spec.second_device_spec()
+    assert nominal.device.profile == "nominal" and not nominal.device.has_imperfections
+    assert nominal.load_device() == device
 
 
 def test_device_and_calibration_sections_load(tmp_path: Path) -> None:
@@ -601,3 +611,16 @@ def test_runs_a_second_device_adds_over_the_limit_are_refused_naming_it(tmp_path
         CampaignSpecError, match=re.escape(f"{path}: second_device: ") + ".*" + re.escape(message)
     ):
         load_campaign_spec(path)
+
+
+def test_a_plane_campaign_off_the_tip_is_refused_naming_the_point(tmp_path: Path) -> None:
+    text = GOOD.replace("contact_points = [0.3, 0.5]", "contact_points = [0.98, 0.5]")
+    spec = load_campaign_spec(write(tmp_path, text + 'obstacle = "plane"\n'))
+    with pytest.raises(CampaignSpecError) as info:
+        spec.load_device()
+    message = str(info.value)
+    assert "contact_points[1]" in message and "link length 0.98 m" in message
+    at_tip = load_campaign_spec(
+        write(tmp_path, text.replace("[0.98, 0.5]", "[0.98]") + 'obstacle = "plane"\n')
+    )
+    assert at_tip.load_device().link.length == 0.98

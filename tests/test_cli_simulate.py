@@ -138,3 +138,34 @@ def test_simulate_bad_device_file_is_one_line(
     assert code != 0
     err = capsys.readouterr().err.strip()
     assert expected in err and err.count("\n") == 0
+
+
+def test_a_deeper_push_bends_the_link_more_and_names_the_nonlinear_link(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    common = ["simulate", "--case", "azimuthal", "--xc", "0.5", "--duration", "3.5"]
+    gentle, deep = tmp_path / "gentle.csv", tmp_path / "deep.csv"
+    assert main([*common, "--out", str(gentle)]) == 0
+    capsys.readouterr()
+    assert main([*common, "--push", "0.15", "--commands", "--out", str(deep)]) == 0
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--link nonlinear" in err
+    gentle_ratio = float(read_recording(gentle).metadata["true_deflection_ratio"])
+    recording = read_recording(deep)
+    # the head turns 0.15 rad past the first touch instead of 0.03: the tip of the link at
+    # x_c is pushed about 0.15 x_c across, several times the default's bend
+    assert float(recording.metadata["true_deflection_ratio"]) > 2.5 * gentle_ratio
+    assert {"u1", "u2"} <= set(recording.extra)
+
+
+def test_the_nonlinear_link_is_chosen_by_flag_without_the_linear_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "deep.csv"
+    argv = ["simulate", "--case", "vertical", "--xc", "0.5", "--push", "0.15", "--link"]
+    assert main([*argv, "nonlinear", "--duration", "3.5", "--out", str(out)]) == 0
+    assert capsys.readouterr().err == ""
+    assert '"link_model": "nonlinear"' in read_recording(out).metadata["simulation"]
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, "curved", "--out", str(out)])
+    assert exc.value.code == 2

@@ -150,21 +150,28 @@ def test_an_unknown_method_is_named_with_the_known_ones(
 
 
 @pytest.mark.parametrize(
-    ("argv", "suggestion"),
+    ("argv", "prog", "suggestion"),
     [
-        (["estimate", "rec.csv", "--metod", "fast"], "--method"),
-        (["--verison"], "--version"),
-        (["simulate", "--case", "free", "--out", "x.csv", "--sed", "1"], "--seed"),
+        (["estimate", "rec.csv", "--metod", "fast"], "antenna estimate", "--method"),
+        (["--verison"], "antenna", "--version"),
+        (
+            ["simulate", "--case", "free", "--out", "x.csv", "--sed", "1"],
+            "antenna simulate",
+            "--seed",
+        ),
+        (["campaign", "run", "--out", "x", "--workrs", "2"], "antenna campaign run", "--workers"),
     ],
 )
 def test_a_mistyped_option_is_answered_with_the_close_one(
-    argv: list[str], suggestion: str, capsys: pytest.CaptureFixture[str]
+    argv: list[str], prog: str, suggestion: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
     with pytest.raises(SystemExit) as exc:
         main(argv)
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and f"(did you mean {suggestion}?)" in err
+    # one line, from the (sub)command that owns the options, nested ones included
+    assert "\n" not in err and err.startswith(f"{prog}: error: unrecognized arguments")
+    assert f"(did you mean {suggestion}?)" in err
 
 
 def test_an_unexpected_argument_is_named_without_a_guess(

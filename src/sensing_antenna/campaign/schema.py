@@ -657,15 +657,33 @@ class CampaignSpec:
         if not self.device.is_model:
             antenna = replace(antenna, name=f"{antenna.name} (device)")
         self._check_points(antenna, "device: ")
+        if self.scenario.get("obstacle") == "plane":
+            self._check_tip_points(antenna.link.length)
         return antenna
 
-    def _check_points(self, antenna: Antenna, what: str) -> None:
-        checks = [("contact_points", self.contact_points)]
+    def _check_tip_points(self, length: float) -> None:
+        """A plane is touched by the link's tip: every contact point must be the device's l."""
+        for key, points in self._point_lists():
+            for i, x in enumerate(points):
+                if not math.isclose(x, length, rel_tol=1e-9):
+                    raise CampaignSpecError(
+                        f"{key}[{i}]",
+                        f"{x!r} m: scenario.obstacle = 'plane' is touched by the link tip, so "
+                        f"every contact point must be the device's link length {length:g} m",
+                        self.source or None,
+                    )
+
+    def _point_lists(self) -> list[tuple[str, Sequence[float]]]:
+        """Every list of contact points the spec simulates, under its field name."""
+        checks: list[tuple[str, Sequence[float]]] = [("contact_points", self.contact_points)]
         if self.noise_sweep.enabled and self.noise_sweep.contact_points is not None:
             checks.append(("noise_sweep.contact_points", self.noise_sweep.contact_points))
         if self.calibration.enabled:
             checks.append(("calibration.contact_points", self.calibration.contact_points))
-        for key, points in checks:
+        return checks
+
+    def _check_points(self, antenna: Antenna, what: str) -> None:
+        for key, points in self._point_lists():
             for i, x in enumerate(points):
                 if x > antenna.link.length:
                     raise CampaignSpecError(

@@ -53,6 +53,7 @@ COMMAND_MODULES = (
     "calibrate",
     "campaign",
     "map",
+    "explore",
     "plot",
 )
 
@@ -98,6 +99,21 @@ class OneLineParser(argparse.ArgumentParser):
         self.option_names: list[str] = []
         self.commands: dict[str, OneLineParser] = {}
         super().__init__(*args, **kwargs)
+
+    def add_subparsers(self, **kwargs: Any) -> Any:
+        """``ArgumentParser.add_subparsers``, remembering the commands for :meth:`leaf`."""
+        action = super().add_subparsers(**kwargs)
+        self.commands = action.choices
+        return action
+
+    def leaf(self, argv: Sequence[str]) -> OneLineParser:
+        """The (sub)command parser that ``argv`` reaches, following its command names."""
+        parser = self
+        for token in argv:
+            child = parser.commands.get(token)
+            if isinstance(child, OneLineParser):
+                parser = child
+        return parser
 
     def add_argument(self, *args: Any, **kwargs: Any) -> argparse.Action:
         """``ArgumentParser.add_argument``, remembering the option's names for suggestions."""
@@ -156,7 +172,6 @@ def build_parser() -> OneLineParser:
     )
     for name in COMMAND_MODULES:
         importlib.import_module(f"sensing_antenna.cli.{name}").register(subparsers)
-    parser.commands = dict(subparsers.choices)
     return parser
 
 
@@ -178,7 +193,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 parser.print_help()
                 return EXIT_BAD_INPUT
             if extras:
-                parser.commands[args.command].reject_unknown(extras)
+                parser.leaf(sys.argv[1:] if argv is None else argv).reject_unknown(extras)
             prog = f"{parser.prog} {args.command}"
             try:
                 code = int(args.func(args))

@@ -55,17 +55,26 @@ def register(subparsers: Any) -> None:
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.mapping import build_map, points_from_recordings, write_map
-    from sensing_antenna.plotting.mapping import plot_map
+    from sensing_antenna.mapping import build_map, points_from_recordings
 
-    meshes = {path.stem: _load_mesh(path) for path in args.objects}
+    meshes = {path.stem: load_mesh(path) for path in args.objects}
     antenna = load_antenna(args.antenna)
     points = points_from_recordings(
         args.recordings, antenna, args.method, config=EstimatorConfig(t1_source=args.t1)
     )
     contact_map = build_map(points, args.include_uncertain, meshes=meshes)
-    written = write_map(contact_map, args.out)
-    written.append(plot_map(contact_map, args.out / "map.png"))
+    report_map(contact_map, args.out)
+    return 0
+
+
+def report_map(contact_map: Any, out: Path) -> None:
+    """Write a map's files and figure into ``out`` and print its summary (``antenna map`` and
+    ``antenna explore`` share it)."""
+    from sensing_antenna.mapping import write_map
+    from sensing_antenna.plotting.mapping import plot_map
+
+    written = write_map(contact_map, out)
+    written.append(plot_map(contact_map, out / "map.png"))
     summary = contact_map.summary()
     decision = (
         "not recognised (fewer than 10 points)"
@@ -85,10 +94,9 @@ def _run(args: argparse.Namespace) -> int:
         )
     for path in written:
         print(f"  {path}")
-    return 0
 
 
-def _load_mesh(path: Path) -> Any:
+def load_mesh(path: Path) -> Any:
     import trimesh
 
     from sensing_antenna.errors import SensingAntennaError

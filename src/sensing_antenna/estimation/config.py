@@ -127,9 +127,9 @@ class EstimatorConfig:
         neglected moments are the axial force times the link's slope (1.5 y_c / x_c, Eq. 9,
         times R_x / R_perp up to the friction coefficient 0.6) and the weight of the bent link;
         1.0 bounds 1.5 x 0.6 = 0.9. For the elastica's statics (the front end's ratio) only the
-        bent link's weight remains, in a bending plane that holds it: the term is scaled by the
-        push direction's vertical share (0.7 of it measured on the linear simulator at 0.9 m,
-        vertical).
+        bent link's weight remains, whose moment is derived
+        (:func:`~sensing_antenna.estimation.front.evidence.bent_weight_moment`): 1.0 takes it
+        whole.
     ratio_model_floor : float
         Relative floor of the elastica statics' model term of the ratio uncertainty
         (``Evidence.ratio_uncertainty``): what no statics here holds, the contact's own size
@@ -143,7 +143,10 @@ class EstimatorConfig:
         sensing curves are the straight link's, and the preload of the bent link shifts the
         frequencies at second order. 0.6 bounds what the rod recordings show (0.8 cm at
         22 % deflection, x_c = 0.3 m, against 1.0 cm) and adds 0.5 mm at the default gentle
-        push.
+        push. The paper method also charges it, at two standard deviations, to the status of
+        a frequency read in the push plane alone (``max_model_spread``); a push plane that
+        rings apart from the free one is judged by the ratio instead
+        (:mod:`~sensing_antenna.estimation.methods.paper.planes`).
     omega2_window : float
         Relative half-width of the search window around each candidate's predicted omega_2;
         0.05 is a quarter of the 20 % gap between the candidates' omega_2 at the curve's top.

@@ -30,7 +30,14 @@ from sensing_antenna.mapping.pose import base_pose_from_metadata
 from sensing_antenna.mapping.recognition import Recognition, recognise
 from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
 
-__all__ = ["MIN_RECOGNITION_POINTS", "ContactMap", "build_map", "points_from_recordings"]
+__all__ = [
+    "MIN_RECOGNITION_POINTS",
+    "ContactMap",
+    "build_map",
+    "fit_surface",
+    "points_from_recordings",
+    "recognise_points",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -138,19 +145,12 @@ def build_map(
 ) -> ContactMap:
     """The map from points (module docstring); the surface and recognition when possible."""
     used = select_points(list(points), include_uncertain)
-    p = np.array([c.point for c in used]).reshape(-1, 3)
-    cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
-    bases = np.array([c.base_position for c in used]).reshape(-1, 3)
-    fitted = None
+    fitted = fit_surface(used, True, surface)
     mesh = None
     std = np.zeros(0)
-    if len(used) >= MIN_SURFACE_POINTS:
-        fitted = (surface if surface is not None else ImplicitSurface()).fit(p, cov, bases)
+    if fitted is not None:
         mesh, std = fitted.mesh()
-    recognition = None
-    if len(used) >= MIN_RECOGNITION_POINTS:
-        outward = (bases - p).mean(axis=0)
-        recognition = recognise(p, cov, meshes=meshes, outward=outward, rng=rng)
+    recognition = recognise_points(used, True, meshes, rng)
     return ContactMap(
         points=tuple(points),
         used=tuple(used),
@@ -160,6 +160,40 @@ def build_map(
         recognition=recognition,
         include_uncertain=include_uncertain,
     )
+
+
+def fit_surface(
+    points: Sequence[ContactPoint],
+    include_uncertain: bool = False,
+    surface: ImplicitSurface | None = None,
+) -> ImplicitSurface | None:
+    """The implicit surface through the points a map uses (None with fewer than
+    :data:`MIN_SURFACE_POINTS`), each point's base the outer side."""
+    used = select_points(list(points), include_uncertain)
+    if len(used) < MIN_SURFACE_POINTS:
+        return None
+    p = np.array([c.point for c in used]).reshape(-1, 3)
+    cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
+    bases = np.array([c.base_position for c in used]).reshape(-1, 3)
+    return (surface if surface is not None else ImplicitSurface()).fit(p, cov, bases)
+
+
+def recognise_points(
+    points: Sequence[ContactPoint],
+    include_uncertain: bool = False,
+    meshes: Mapping[str, trimesh.Trimesh] | None = None,
+    rng: np.random.Generator | None = None,
+) -> Recognition | None:
+    """The recognition of the points a map uses (None with fewer than
+    :data:`MIN_RECOGNITION_POINTS`), the mean direction to their bases the outer side."""
+    used = select_points(list(points), include_uncertain)
+    if len(used) < MIN_RECOGNITION_POINTS:
+        return None
+    p = np.array([c.point for c in used]).reshape(-1, 3)
+    cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
+    bases = np.array([c.base_position for c in used]).reshape(-1, 3)
+    outward = (bases - p).mean(axis=0)
+    return recognise(p, cov, meshes=meshes, outward=outward, rng=rng)
 
 
 def _true_point(text: str | None) -> FloatArray | None:

@@ -38,6 +38,11 @@ NO_OBSTACLE = 0
 CYLINDER = 1
 PLANE = 2
 
+#: Angle (rad) between a plane's normal and the sweep direction, in the sweep plane: the link
+#: meets the plane at 90 degrees minus this, so the plane clears the rest of the link by
+#: (l - x) sin(PLANE_INCIDENCE) at the touch.
+PLANE_INCIDENCE = 0.3
+
 
 def motor_frame(theta1: float, theta2: float) -> NDArray[np.float64]:
     """Rows X^m, Y^m, Z^m in absolute coordinates (recording format), shape (3, 3)."""
@@ -146,9 +151,15 @@ def place_obstacle(
             raise ScenarioError(
                 "contact_point", f"a plane is touched by the link tip: needs x_c = l = {length:g} m"
             )
-        # Normal against the sweep, turned by 0.3 rad towards the tip so that the tip touches
-        # first, and by ``tilt`` out of the sweep plane.
-        normal = _unit(-ahead * math.cos(0.3) + tangent * math.sin(0.3) + aside * math.tan(tilt))
+        # Normal against the sweep, turned by PLANE_INCIDENCE back towards the head (n . e < 0),
+        # and by ``tilt`` out of the sweep plane: the head lies outside the plane, and along the
+        # link the gap (l - x) sin(PLANE_INCIDENCE) is smallest at the tip, so the tip touches
+        # first and the rest of the link stays clear.
+        normal = _unit(
+            -ahead * math.cos(PLANE_INCIDENCE)
+            - tangent * math.sin(PLANE_INCIDENCE)
+            + aside * math.tan(tilt)
+        )
         return Obstacle("plane", tuple(p_touch), tuple(normal), 0.0)
     if kind == "post":
         axis = _unit(np.array([0.0, 0.0, 1.0]) * math.cos(tilt) + ym * math.sin(tilt))

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import Antenna, Link
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 
@@ -25,6 +25,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Evidence",
+    "bent_weight_moment",
     "search_band",
     "sensing_curve",
     "two_frequency_curve",
@@ -79,6 +80,58 @@ def search_band(link: Link, config: EstimatorConfig) -> tuple[float, float]:
         config.contact_range[0] * link.length, config.contact_range[1] * link.length
     )
     return float(low) / (1.0 + config.band_margin), float(high) * (1.0 + config.band_margin)
+
+
+def bent_weight_moment(
+    link: Link, x_c: float, push: float, link_vertical: float, push_vertical: float
+) -> float:
+    """Bound (N m) of the moment the push's bending adds to the link's weight, about the axis
+    the ratio reads (v = X^m x u, u the push's direction).
+
+    The gravity model removes the weight of the free link; the pushed link's points have moved
+    by w(s) along u (the deflection) and by -a(s) along X^m (the shortening of the bent
+    link's projection, a(s) = 1/2 of the integral of theta^2 up to s). A weight -g dm moved by
+    dr adds the moment dr x (-g dm z); along v = X^m x u that is g dm (w (X^m . z) - a (u . z)),
+    since (u x z) . (X^m x u) = -X^m . z and (X^m x z) . (X^m x u) = u . z. So
+
+        |dM| <= g (|X^m . z| integral of w dm + |u . z| integral of a dm),
+
+    the first term linear in the push (so its share of the ratio, dM / |R_perp|, does not
+    depend on the push: 0.6 cm at x_c = 0.5 m for a link 14 deg above the horizontal), the
+    second quadratic. A push in a horizontal bending plane by a horizontal link adds neither.
+    Linear shape of the link loaded at x_c by |R_perp| (Eq. 13), a = x_c, b = l - x_c, on the
+    uniform link and its tip mass:
+
+        integral of w ds = |R_perp| (a^4 / 8 + a^3 b / 3 + a^2 b^2 / 4) / (E I),
+        integral of a ds = |R_perp|^2 (8 l a^5 / 15 - 11 a^6 / 30 + a^4 b^2 / 2) / (8 (E I)^2),
+        w(l) = |R_perp| a^2 (3 l - a) / (6 E I),
+        a(l) = |R_perp|^2 (8 a^5 / 15 + a^4 b) / (8 (E I)^2).
+
+    Parameters
+    ----------
+    link : Link
+    x_c : float
+        Contact point (m), on the link.
+    push : float
+        |R_perp| (N).
+    link_vertical, push_vertical : float
+        |X^m . z| and |u . z|: the link's and the push's vertical shares.
+    """
+    a = x_c
+    b = link.length - x_c
+    compliance = link.bending_compliance
+    sweep = push * compliance * (a**4 / 8.0 + a**3 * b / 3.0 + a**2 * b**2 / 4.0)
+    shortening = (
+        push**2
+        * compliance**2
+        * (8.0 * link.length * a**5 / 15.0 - 11.0 * a**6 / 30.0 + a**4 * b**2 / 2.0)
+        / 8.0
+    )
+    tip_sweep = push * compliance * a**2 * (3.0 * link.length - a) / 6.0
+    tip_shortening = push**2 * compliance**2 * (8.0 * a**5 / 15.0 + a**4 * b) / 8.0
+    distributed = link.linear_density * (link_vertical * sweep + push_vertical * shortening)
+    tip = link.tip_mass * (link_vertical * tip_sweep + push_vertical * tip_shortening)
+    return STANDARD_GRAVITY * (distributed + tip)
 
 
 @dataclass(frozen=True)
@@ -190,13 +243,11 @@ class Evidence:
             the elastica holds the axial force's moment at any deflection; what it does not
             hold is the stiffness's own uncertainty, 2 u of E I (u the frequency model's
             relative uncertainty: E I = rho / T^2), on its corrections |R_x / R_perp| d x_c
-            and 0.6 d^2 x_c (first and second order), and, in a bending plane that holds the
-            weight, the weight of the bent link, which is not the free link's the gravity
-            model removes: ``ratio_model_factor`` d x_c times the share of the push's
-            direction along the vertical (0.7 d x_c measured on the linear simulator at 0.9 m,
-            vertical; nil for a horizontal push, whose bending plane the weight crosses); and
-            a floor, ``ratio_model_floor`` x_c, for what no statics here holds (the contact's
-            own size and compliance, dynamic loads left in the mean);
+            and 0.6 d^2 x_c (first and second order); the weight of the bent link, which is
+            not the free link's the gravity model removes: ``ratio_model_factor`` times
+            :func:`bent_weight_moment` / |R_perp|; and a floor, ``ratio_model_floor`` x_c, for
+            what no statics here holds (the contact's own size and compliance, dynamic loads
+            left in the mean);
           - ``statics="small-deflection"`` (Eq. 21 as printed, the ``ratio`` baseline): the
             neglected moments, the axial force times the link's slope and the weight of the
             bent link, ``ratio_model_factor`` d x_c.
@@ -227,7 +278,7 @@ class Evidence:
     def ratio_model_uncertainty(self, x_c: FloatArray) -> FloatArray:
         """The elastica statics' model term of :meth:`ratio_uncertainty` (m), at contact points
         ``x_c`` (m, any shape, on the link): the stiffness's uncertainty on the statics'
-        corrections, the bent link's weight in a bending plane that holds it, and the floor
+        corrections, the bent link's weight (:func:`bent_weight_moment`), and the floor
         ``ratio_model_floor`` x_c, in quadrature, for the hold's push (``frame``). A method
         with statics of its own that are the elastica's (``fast``) weighs them with it."""
         link = self.antenna.link
@@ -246,8 +297,17 @@ class Evidence:
             * deflection_ratio
             * x_c
         )
-        vertical = abs(float(self.frame.axes_a[1][2]))
-        weight = self.config.ratio_model_factor * deflection_ratio * x_c * vertical
+        weight = (
+            self.config.ratio_model_factor
+            * bent_weight_moment(
+                link,
+                x_c,  # type: ignore[arg-type]
+                push,
+                abs(float(self.frame.motor_axes_a[0][2])),
+                abs(float(self.frame.axes_a[1][2])),
+            )
+            / push
+        )
         floor = self.config.ratio_model_floor * x_c
         return np.asarray(np.hypot(np.hypot(stiffness, weight), floor), dtype=float)
 

@@ -26,6 +26,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_spectrum,
     find_peak,
 )
+from sensing_antenna.estimation.methods.paper.planes import bending_planes
 from sensing_antenna.estimation.methods.touch_point import touched_point
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 
@@ -379,11 +380,34 @@ class PaperMethod:
         }
         agree = measurement.components_agree(cfg.component_agreement)
         diag["components_agree"] = agree
+        x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
+        # Tolerances from the ratio's own uncertainty (noise, tare, statics model)
+        sigma_ratio = evidence.ratio_uncertainty(ratio_estimate)
+        # the candidate's own uncertainty from the bent link (its deflection's preload)
+        sigma_bent = evidence.bent_link_uncertainty(ratio_estimate)
+        tolerance = cfg.disagreement_sigmas * math.hypot(sigma_ratio, sigma_bent)
+        diag["ratio_uncertainty"] = sigma_ratio
+        diag["bent_link_uncertainty"] = sigma_bent
+        measurement, plane_problem = bending_planes(
+            measurement,
+            lambda omega: candidates_from_omega1(
+                link, omega, x_range, cfg.disagreement_sigmas * link.frequency_uncertainty * omega
+            )[0],
+            ratio_estimate,
+            sigma_ratio,
+            cfg,
+            diag,
+        )
+        if plane_problem is not None:
+            problems.append(plane_problem)
         candidates: tuple[float, ...] = ()
         if math.isfinite(measurement.omega1):
-            x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
-            tolerance = cfg.disagreement_sigmas * link.frequency_uncertainty * measurement.omega1
-            candidates, notes = candidates_from_omega1(link, measurement.omega1, x_range, tolerance)
+            omega_tolerance = (
+                cfg.disagreement_sigmas * link.frequency_uncertainty * measurement.omega1
+            )
+            candidates, notes = candidates_from_omega1(
+                link, measurement.omega1, x_range, omega_tolerance
+            )
             diag.update(notes)
         if not measurement.clear:
             problems.append(
@@ -397,13 +421,6 @@ class PaperMethod:
             candidates_used: tuple[float, ...] = ()
         else:
             candidates_used = candidates
-        # Tolerances from the ratio's own uncertainty (noise, tare, small-deflection model)
-        sigma_ratio = evidence.ratio_uncertainty(ratio_estimate)
-        # the candidate's own uncertainty from the bent link (its deflection's preload)
-        sigma_bent = evidence.bent_link_uncertainty(ratio_estimate)
-        tolerance = cfg.disagreement_sigmas * math.hypot(sigma_ratio, sigma_bent)
-        diag["ratio_uncertainty"] = sigma_ratio
-        diag["bent_link_uncertainty"] = sigma_bent
         fusion = fuse(candidates_used, ratio_estimate, tolerance)
         diag["discriminated_by"] = "ratio" if len(candidates_used) > 1 else None
         if len(candidates_used) == 2 and math.isfinite(ratio_estimate):
@@ -455,6 +472,21 @@ class PaperMethod:
         if candidates_used and math.isfinite(fusion.x_c):
             spread = model_spread(link, fusion.x_c, 2.0 * link.frequency_uncertainty)
             diag["model_spread"] = spread
+            if diag.get("frequency_plane") == "push":
+                # a frequency of the push plane alone carries the bent link's preload
+                preload = 2.0 * evidence.bent_link_uncertainty(fusion.x_c)
+                diag["preload_spread"] = preload
+                if math.hypot(spread, preload) > cfg.max_model_spread:
+                    problems.append(
+                        (
+                            Status.UNCERTAIN,
+                            f"omega_1 was read in the push plane alone, where the bent link's "
+                            f"preload shifts it: with the frequency model's own uncertainty "
+                            f"the candidate may be {100 * math.hypot(spread, preload):.1f} cm "
+                            f"off at two standard deviations, more than "
+                            f"{100 * cfg.max_model_spread:g} cm",
+                        )
+                    )
             if spread > cfg.max_model_spread:
                 problems.append(
                     (

@@ -1,0 +1,325 @@
+"""Exploration on simulated scenes: grid against next-best, on the simulator's own contacts.
+
+Each scene holds one primitive (sphere, cylinder, capsule, cone, torus or box, in turn), its
+largest dimension drawn in 4 to 20 cm, a random orientation, its centre 0.3 to 0.95 m from the
+head at an azimuth within +-60 degrees and a height within +-10 cm of the head's. The head sits
+at two base poses, the origin and the mirror point beyond the object, each facing it (a head on
+a robot that moves round the object). The explored region is the object's angular extent seen
+from a base, widened by 0.05 rad, with the elevations shifted by the link's sag there; the grid
+has ``--sweeps`` azimuthal and as many vertical sweeps per base.
+
+Each scene is explored twice with ``exploration.explore`` (every sweep simulated: first touch,
+contact physics, recording, estimate with ``--method``), once per strategy with the grid's size
+as the budget, on the calibrated antenna of one calibration (the README's five posts, made once
+and copied into each run's directory). Per scene and strategy: the contacts (sweeps that
+touched), the points used (status ok), the RMS and largest distance of the points to the true
+surface, the RMS of the fitted surface to the true one near the points (mesh vertices within
+1 cm of a contact) after a quarter, half, three quarters and all of the sweeps, a Chamfer
+distance between that surface and the true surface's patch near the points, the recognition
+(right, abstained, confidently wrong) and the size error of the true class's fit, and the
+simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.json``.
+
+Run: ``python benchmarks/eval_explore.py [--scenes 12] [--sweeps 8] [--method fast] [--seed 0]``.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")  # one core, set before numpy loads
+
+import argparse  # noqa: E402
+import datetime  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import shutil  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+import numpy as np  # noqa: E402
+import trimesh  # noqa: E402
+from scipy.spatial import cKDTree  # noqa: E402
+from scipy.spatial.transform import Rotation  # noqa: E402
+
+from sensing_antenna import paper_antenna  # noqa: E402
+from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
+from sensing_antenna.exploration import ExploreSettings, calibrate_device, explore  # noqa: E402
+from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
+from sensing_antenna.mapping import UNDECIDED, BasePose  # noqa: E402
+from sensing_antenna.mapping.contact_map import fit_surface  # noqa: E402
+from sensing_antenna.scene import ExploreRegion, LinkShape, Scene, primitive_object  # noqa: E402
+
+RESULTS = Path(__file__).resolve().parent / "results" / "explore.json"
+CLASSES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
+STRATEGIES = ("grid", "next-best")
+#: The surface is scored where the points are: mesh vertices within this of a contact (m).
+NEAR = 0.01
+#: Widening of the explored region beyond the object's angular extent (rad).
+MARGIN = 0.05
+
+
+def make_object(
+    name: str, size: float, rng: np.random.Generator
+) -> tuple[list[float], dict[str, Any]]:
+    """The class's sizes in ``mapping.primitives`` order, largest dimension ``size`` (m), and
+    the true sizes by name (box extents sorted)."""
+    if name == "sphere":
+        return [size / 2], {"radius": size / 2}
+    if name == "cylinder":
+        radius = size * rng.uniform(0.2, 0.45)
+        return [radius, size], {"radius": radius, "height": size}
+    if name == "capsule":
+        radius = size * rng.uniform(0.15, 0.3)
+        return [radius, size - 2 * radius], {"radius": radius, "length": size - 2 * radius}
+    if name == "cone":
+        radius = size * rng.uniform(0.25, 0.5)
+        return [radius, size], {"radius": radius, "height": size}
+    if name == "torus":
+        major = size / 2 * rng.uniform(0.55, 0.75)
+        minor = size / 2 - major
+        return [major, minor], {"major_radius": major, "minor_radius": minor}
+    extents = [size, size * rng.uniform(0.4, 1.0), size * rng.uniform(0.4, 1.0)]
+    return extents, {"extents": sorted(extents)}
+
+
+def make_scene(
+    index: int, seed: int, sweeps: int, shape: LinkShape
+) -> tuple[Scene, dict[str, Any]]:
+    rng = np.random.default_rng([seed, index])
+    name = CLASSES[index % len(CLASSES)]
+    size = rng.uniform(0.04, 0.20)
+    sizes, truth = make_object(name, size, rng)
+    azimuth = rng.uniform(-math.pi / 3, math.pi / 3)
+    distance = rng.uniform(0.3, 0.95)
+    height = rng.uniform(-0.1, 0.1)
+    centre = np.array([distance * math.cos(azimuth), distance * math.sin(azimuth), height])
+    rotation = Rotation.random(random_state=rng).as_rotvec()
+    obj = primitive_object(name, name, sizes, centre, rotation)
+    if name == "cone":
+        # a cone's origin is its base centre: put its bounding box's centre where drawn
+        shift = centre - obj.mesh.bounds.mean(axis=0)
+        obj = primitive_object(name, name, sizes, centre + shift, rotation)
+    radius = float(np.max(np.linalg.norm(obj.mesh.vertices - centre, axis=1)))
+    yaw = [azimuth, azimuth + math.pi]
+    positions = [np.zeros(3), np.array([2 * centre[0], 2 * centre[1], 0.0])]
+    bases = tuple(
+        BasePose(
+            np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]]),
+            p,
+        )
+        for a, p in zip(yaw, positions, strict=True)
+    )
+    horizontal = math.hypot(centre[0], centre[1])
+    spread = math.asin(min(radius / horizontal, 1.0)) + MARGIN
+    sag = float(np.interp(horizontal, shape.abscissae, shape.sag(0.0)))
+    low = math.atan2(height - radius - sag, horizontal) - MARGIN
+    high = math.atan2(height + radius - sag, horizontal) + MARGIN
+    region = ExploreRegion((-spread, spread), (max(low, -1.2), min(high, 1.2)), sweeps, sweeps)
+    scene = Scene(f"scene{index}", (obj,), bases, region)
+    info = {"class": name, "size_m": size, "distance_m": distance, "truth": truth}
+    return scene, info
+
+
+def size_error(name: str, fitted: dict[str, float], truth: dict[str, Any]) -> float:
+    """Largest relative error over the class's sizes (box extents sorted)."""
+    if name == "box":
+        got = sorted(fitted.values())
+        return max(abs(a / b - 1) for a, b in zip(got, truth["extents"], strict=True))
+    return max(abs(fitted[k] / v - 1) for k, v in truth.items())
+
+
+def surface_scores(points: list[Any], mesh: trimesh.Trimesh) -> dict[str, float]:
+    """RMS of the fitted surface near the points to the true one, and a Chamfer distance."""
+    surface = fit_surface(points)
+    nan = {"surface_rms_m": math.nan, "chamfer_m": math.nan}
+    if surface is None:
+        return nan
+    zero_level, _ = surface.mesh()
+    used = np.array([p.point for p in points if p.status.value == "ok" and p.usable])
+    if not len(zero_level.vertices):
+        return nan
+    near = zero_level.vertices[cKDTree(used).query(zero_level.vertices)[0] < NEAR]
+    if not len(near):
+        return nan
+    _, distance, _ = trimesh.proximity.closest_point(mesh, near)
+    # Chamfer: the mean of the two one-sided mean distances between the fitted patch and the
+    # true surface's patch near the points
+    samples, _ = trimesh.sample.sample_surface(mesh, 20000, seed=0)
+    true_patch = samples[cKDTree(used).query(samples)[0] < NEAR]
+    chamfer = math.nan
+    if len(true_patch):
+        there = cKDTree(near).query(true_patch)[0]
+        chamfer = 0.5 * (float(np.mean(distance)) + float(np.mean(there)))
+    return {"surface_rms_m": float(np.sqrt(np.mean(distance**2))), "chamfer_m": chamfer}
+
+
+def run(
+    scene: Scene,
+    info: dict[str, Any],
+    strategy: str,
+    method: str,
+    calibrated: Path,
+    seed: int,
+    workdir: Path,
+) -> dict[str, Any]:
+    out = workdir / f"{scene.name}-{strategy}"
+    out.mkdir(parents=True)
+    shutil.copy(calibrated, out / CALIBRATED_FILE)
+    start = time.perf_counter()
+    result = explore(scene, paper_antenna(), out, ExploreSettings(method, strategy, seed=seed))
+    elapsed = time.perf_counter() - start
+    manoeuvres = result.manoeuvres
+    mesh = scene.objects[0].mesh
+    used = [p for p in result.contact_map.used]
+    row: dict[str, Any] = {
+        "strategy": strategy,
+        "sweeps": len(manoeuvres),
+        "contacts": sum(m.outcome == "touch" for m in manoeuvres),
+        "used": len(used),
+        "outcomes": result.summary()["outcomes"],
+        "sweep_time_s": result.summary()["sweep_time_s"],
+        "run_s": elapsed,
+    }
+    if used:
+        _, distance, _ = trimesh.proximity.closest_point(mesh, np.array([p.point for p in used]))
+        row["point_rms_m"] = float(np.sqrt(np.mean(distance**2)))
+        row["point_max_m"] = float(np.max(distance))
+    else:
+        row["point_rms_m"] = row["point_max_m"] = math.nan
+    progress = []
+    for fraction in (0.25, 0.5, 0.75, 1.0):
+        k = max(1, round(fraction * len(manoeuvres)))
+        points = [m.point for m in manoeuvres[:k] if m.point is not None]
+        scores = surface_scores(points, mesh)
+        progress.append(
+            {
+                "sweeps": k,
+                "contacts": sum(m.outcome == "touch" for m in manoeuvres[:k]),
+                "used": sum(p.status.value == "ok" for p in points),
+                **scores,
+            }
+        )
+    row["progress"] = progress
+    row.update({k: v for k, v in progress[-1].items() if k.endswith("_m")})
+    recognition = result.contact_map.recognition
+    if recognition is None:
+        row.update(
+            decision=None,
+            right=False,
+            abstained=False,
+            confident_wrong=False,
+            confidence=math.nan,
+            size_error=math.nan,
+        )
+    else:
+        name = info["class"]
+        fit = next(f for f in recognition.fits if f.name == name)
+        row.update(
+            decision=recognition.decision,
+            right=recognition.decision == name,
+            abstained=recognition.decision == UNDECIDED,
+            confident_wrong=recognition.decision not in (name, UNDECIDED),
+            confidence=recognition.confidence,
+            size_error=size_error(name, dict(fit.sizes), info["truth"]),
+        )
+    return row
+
+
+def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    def mean(key: str) -> float | None:
+        values = [r[key] for r in rows if isinstance(r[key], float) and math.isfinite(r[key])]
+        return float(np.mean(values)) if values else None
+
+    recognised = [r for r in rows if r["decision"] is not None]
+    return {
+        "scenes": len(rows),
+        "mean_contacts": float(np.mean([r["contacts"] for r in rows])),
+        "mean_used": float(np.mean([r["used"] for r in rows])),
+        "mean_point_rms_m": mean("point_rms_m"),
+        "mean_point_max_m": mean("point_max_m"),
+        "mean_surface_rms_m": mean("surface_rms_m"),
+        "mean_chamfer_m": mean("chamfer_m"),
+        "recognised": len(recognised),
+        "right": sum(r["right"] for r in rows),
+        "abstained": sum(r["abstained"] for r in rows),
+        "confident_wrong": sum(r["confident_wrong"] for r in rows),
+        "median_size_error_when_right": float(
+            np.median([r["size_error"] for r in rows if r["right"]])
+        )
+        if any(r["right"] for r in rows)
+        else None,
+        "mean_sweep_time_s": mean("sweep_time_s"),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--scenes", type=int, default=12)
+    parser.add_argument("--sweeps", type=int, default=8, help="grid sweeps per case and base")
+    parser.add_argument("--method", choices=("paper", "fast"), default="fast")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=RESULTS)
+    args = parser.parse_args()
+    device = paper_antenna()
+    shape = LinkShape(device.link)
+    rows: list[dict[str, Any]] = []
+    with tempfile.TemporaryDirectory(prefix="eval-explore-") as folder:
+        workdir = Path(folder)
+        calibrated = workdir / "calibrated.toml"
+        calibrated.write_text(antenna_to_toml(calibrate_device(device)))
+        for index in range(args.scenes):
+            scene, info = make_scene(index, args.seed, args.sweeps, shape)
+            for strategy in STRATEGIES:
+                row = {
+                    "scene": index,
+                    **info,
+                    **run(scene, info, strategy, args.method, calibrated, args.seed, workdir),
+                }
+                rows.append(row)
+                print(
+                    f"{index:3d} {info['class']:9s} {100 * info['size_m']:5.1f} cm"
+                    f" {info['distance_m']:.2f} m {strategy:9s}: {row['contacts']:2d} contacts"
+                    f" ({row['used']:2d} ok), points {1000 * row['point_rms_m']:.1f} mm,"
+                    f" surface {1000 * row['surface_rms_m']:.1f} mm -> {row['decision']}"
+                    f" ({row['run_s']:.0f} s)",
+                    flush=True,
+                )
+    totals = {s: summarise([r for r in rows if r["strategy"] == s]) for s in STRATEGIES}
+    print()
+    print(
+        f"{'strategy':9s} {'contacts':>8s} {'ok':>5s} {'points RMS':>10s} {'surface RMS':>11s}"
+        f" {'Chamfer':>8s} {'right':>5s} {'abst.':>5s} {'wrong':>5s}"
+    )
+    for strategy, s in totals.items():
+
+        def mm(value: float | None) -> str:
+            return "-" if value is None else f"{1000 * value:.2f}"
+
+        print(
+            f"{strategy:9s} {s['mean_contacts']:8.1f} {s['mean_used']:5.1f}"
+            f" {mm(s['mean_point_rms_m']):>7s} mm {mm(s['mean_surface_rms_m']):>8s} mm"
+            f" {mm(s['mean_chamfer_m']):>5s} mm {s['right']:5d} {s['abstained']:5d}"
+            f" {s['confident_wrong']:5d}"
+        )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(
+        json.dumps(
+            {
+                "date": datetime.date.today().isoformat(),
+                "settings": vars(args) | {"out": str(args.out)},
+                "total": totals,
+                "scenes": rows,
+            },
+            indent=1,
+            default=float,
+        )
+        + "\n"
+    )
+    print(f"\nwrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()

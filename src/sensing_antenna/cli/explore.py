@@ -1,0 +1,135 @@
+"""``antenna explore``: sweeps of the simulated device in a scene, mapped and recognised."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+#: ``exploration.plan.STRATEGIES`` and ``scene.file.BUILTIN_SCENES``, written out: importing
+#: them would load trimesh and scikit-learn for every command's start.
+STRATEGIES = ("grid", "next-best")
+BUILTIN_SCENES = ("post", "sphere", "box", "cylinder")
+
+
+def register(subparsers: Any) -> None:
+    """Add ``antenna explore``."""
+    parser = subparsers.add_parser(
+        "explore",
+        help="explore a scene with the simulated device: sweeps, contacts, surface, object",
+        description=(
+            "Calibrates the simulated device (five posts at known points, as the README does), "
+            "then runs sweeps of the head in SCENE (a built-in scene or a scene file): each "
+            "sweep's first touch is simulated with the simulator's contact physics, written as "
+            "a recording with its base_pose, estimated and placed in the world with its "
+            "covariance; a sweep that touches nothing is free space. The strategy chooses the "
+            "sweeps: a fixed grid, or next-best (where the surface fitted so far is least "
+            "known). Then the map of antenna map (points, surface, recognised object) is "
+            "written into --out. Interrupted, the same command resumes (docs/explore.md)."
+        ),
+    )
+    parser.add_argument(
+        "scene", help=f"scene file (TOML) or built-in scene ({', '.join(BUILTIN_SCENES)})"
+    )
+    parser.add_argument("--out", type=Path, required=True, help="output directory")
+    parser.add_argument(
+        "--method", choices=("paper", "fast"), default="paper", help="the estimation method"
+    )
+    parser.add_argument(
+        "--strategy", choices=STRATEGIES, default="grid", help="how the sweeps are chosen"
+    )
+    parser.add_argument(
+        "--budget",
+        type=_positive_int,
+        default=None,
+        help="most manoeuvres (sweeps); default: the scene's grid size",
+    )
+    parser.add_argument(
+        "--antenna", default="paper-2021", help="the simulated device: built-in name or TOML file"
+    )
+    parser.add_argument("--seed", type=_seed, default=0, help="seed of the first manoeuvre")
+    parser.add_argument(
+        "--objects",
+        nargs="+",
+        type=Path,
+        default=(),
+        metavar="MESH",
+        help="meshes (STL, OBJ, PLY; m) to register to the points beside the shape classes",
+    )
+    parser.add_argument(
+        "--include-uncertain",
+        action="store_true",
+        help="let points with status uncertain into the map and the planner's surface",
+    )
+    parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre")
+    parser.set_defaults(func=_run)
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 0 <= value < 2**31:
+        raise argparse.ArgumentTypeError(f"must be from 0 to 2^31 - 1, got {value}")
+    return value
+
+
+def _run(args: argparse.Namespace) -> int:
+    from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.cli.map import load_mesh, report_map
+    from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
+    from sensing_antenna.scene import load_scene
+
+    scene = load_scene(args.scene)
+    device = load_antenna(args.antenna)
+    meshes = {path.stem: load_mesh(path) for path in args.objects}
+    settings = ExploreSettings(
+        method=args.method,
+        strategy=args.strategy,
+        budget=args.budget,
+        seed=args.seed,
+        include_uncertain=args.include_uncertain,
+    )
+
+    def show(manoeuvre: Manoeuvre, budget: int) -> None:
+        point = manoeuvre.point
+        what = manoeuvre.outcome
+        if point is not None:
+            what += f", {point.status.value}"
+            if point.usable:
+                x, y, z = point.point
+                what += f" at ({x:.3f}, {y:.3f}, {z:.3f}) m, std {1000 * point.std:.1f} mm"
+        elif manoeuvre.reason:
+            what += f" ({manoeuvre.reason})"
+        print(f"[{manoeuvre.index + 1}/{budget}] {manoeuvre.sweep.label}: {what}", flush=True)
+
+    print(
+        f"exploring scene {scene.name} ({len(scene.objects)} objects, {len(scene.bases)} base"
+        f" poses) with the {args.method} method, {args.strategy} strategy; the first start"
+        " calibrates the simulated device",
+        file=sys.stderr,
+    )
+    result = explore(scene, device, args.out, settings, None if args.quiet else show, meshes)
+    summary = result.summary()
+    (args.out / "exploration.json").write_text(json.dumps(summary, indent=2) + "\n")
+    outcomes = ", ".join(f"{k} {v}" for k, v in sorted(summary["outcomes"].items()))
+    print(
+        f"{summary['manoeuvres']} manoeuvres ({outcomes}), {summary['sweep_time_s']:.0f} s of"
+        " sweeping"
+    )
+    report_map(result.contact_map, args.out)
+    print(f"  {args.out / 'manoeuvres.csv'}\n  {args.out / 'scene.ply'}")
+    return 0

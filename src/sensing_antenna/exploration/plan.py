@@ -1,0 +1,271 @@
+"""Which sweep next: a fixed grid, or the sweep expected to reduce the surface's uncertainty most.
+
+The grid (:func:`grid_sweeps`) runs, from each base, azimuthal sweeps across the scene's azimuth
+range at evenly spaced elevations and vertical sweeps up its elevation range at evenly spaced
+azimuths, in an order that spreads them out first (:func:`spread_order`), so that
+a budget cut short still covers the region.
+
+The next-best strategy (:class:`NextBestPlanner`) chooses among the candidates of a grid
+:data:`CANDIDATE_DENSITY` times finer. Until the surface can be fitted (fewer than
+``MIN_SURFACE_POINTS`` usable contacts) it takes the coarse grid's sweeps in their spread-out
+order. Then, for every candidate not yet run, it follows the candidate's link through the
+fitted implicit surface f (negative inside) in steps of :data:`PREDICTION_STEP`: the predicted
+touch is the first link sample where f < 0, or, when the candidate is predicted to miss, the
+sample where f is smallest (where the sweep passes closest to the estimated surface). The
+candidate's score is the surface's predictive standard deviation sigma there, weighted by the
+chance that the sweep touches at all, P(f < 0) = Phi(-f / sigma) at that sample under the
+surface's Gaussian prediction: the sweep whose expected touch lands where the surface is least
+known, which is what a contact there reduces most, unless it is likely to miss. Free space
+counts against a prediction: a sweep that came back free swept its link through space the
+object does not occupy, so a candidate whose predicted touch lies within about
+:data:`FREE_RADIUS` of a free sweep's link is unlikely to touch there, and its score is
+multiplied by 1 - exp(-d^2 / (2 FREE_RADIUS^2)), d the distance to the nearest free link
+sample. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count only if nothing
+else is left, and each score is divided by one plus the number of earlier sweeps within
+:data:`NEIGHBOUR_ANGLE` of it (its held angle) from the same base and of the same case, which
+keeps a sweep that came back free from being retried next to itself.
+
+When recognition abstains between two leading shape classes, the planner also aims at telling
+them apart: at a candidate's predicted touch p the two fitted shapes disagree about where the
+surface is by |d_a(p) - d_b(p)| (their signed distances, m), and sigma becomes
+sqrt(sigma^2 + (d_a - d_b)^2): a contact where the leaders differ separates them, one where they
+agree does not.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from sensing_antenna.mapping.primitives import PRIMITIVES
+from sensing_antenna.mapping.recognition import ClassFit
+from sensing_antenna.mapping.surface import ImplicitSurface
+from sensing_antenna.scene.file import Scene
+from sensing_antenna.scene.sweep import LinkShape, Sweep
+
+__all__ = [
+    "CANDIDATE_DENSITY",
+    "FREE_RADIUS",
+    "MISS_MARGIN",
+    "NEIGHBOUR_ANGLE",
+    "PREDICTION_STEP",
+    "STRATEGIES",
+    "NextBestPlanner",
+    "candidate_sweeps",
+    "grid_sweeps",
+    "spread_order",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: The strategies ``antenna explore --strategy`` offers.
+STRATEGIES = ("grid", "next-best")
+
+#: The next-best candidates are a grid this many times finer than the scene's.
+CANDIDATE_DENSITY = 3
+
+#: Angle step (rad) at which a candidate's link is followed through the fitted surface: 1 cm
+#: at 1 m, about the surface's finest length scale.
+PREDICTION_STEP = 0.01
+
+#: A candidate whose link stays this far outside the fitted surface (m of f) is predicted to
+#: miss it: 2 cm, several times the points' standard deviation.
+MISS_MARGIN = 0.02
+
+#: Sweeps whose held angles are closer than this (rad) count as neighbours: half the coarse
+#: grid's spacing for the built-in scenes.
+NEIGHBOUR_ANGLE = 0.05
+
+#: How near a free sweep's link a predicted touch is contradicted (m): the free sweeps are
+#: followed every :data:`PREDICTION_STEP` (6 mm apart at 0.6 m) with samples 1 cm apart.
+FREE_RADIUS = 0.01
+
+#: Samples along the link used for the predictions (every 1 cm for a 1 m link).
+_PREDICTION_SAMPLES = 100
+
+
+def spread_order(n: int) -> list[int]:
+    """0..n-1 middle first, then the middles of the halves, and so on (breadth first), so that
+    any prefix of the order spreads over the range: 8 gives 3, 1, 5, 0, 2, 4, 6, 7."""
+    order: list[int] = []
+    intervals = [(0, n - 1)] if n > 0 else []
+    while intervals:
+        following = []
+        for low, high in intervals:
+            middle = (low + high) // 2
+            order.append(middle)
+            if low <= middle - 1:
+                following.append((low, middle - 1))
+            if middle + 1 <= high:
+                following.append((middle + 1, high))
+        intervals = following
+    return order
+
+
+def _sweeps(scene: Scene, azimuthal: int, vertical: int) -> list[Sweep]:
+    region = scene.region
+    elevations: FloatArray = np.linspace(*region.elevation, azimuthal + 2)[1:-1]
+    azimuths: FloatArray = np.linspace(*region.azimuth, vertical + 2)[1:-1]
+    sweeps: list[Sweep] = []
+    a_order = spread_order(len(elevations))
+    v_order = spread_order(len(azimuths))
+    for base in range(len(scene.bases)):
+        a = [Sweep(base, "azimuthal", float(elevations[i]), *region.azimuth) for i in a_order]
+        v = [Sweep(base, "vertical", float(azimuths[i]), *region.elevation) for i in v_order]
+        # alternate the two cases so that a prefix holds both
+        for k in range(max(len(a), len(v))):
+            sweeps.extend(a[k : k + 1] + v[k : k + 1])
+    if len(scene.bases) > 1:
+        # alternate the bases too
+        per_base = len(sweeps) // len(scene.bases)
+        sweeps = [
+            sweeps[b * per_base + k] for k in range(per_base) for b in range(len(scene.bases))
+        ]
+    return sweeps
+
+
+def grid_sweeps(scene: Scene) -> list[Sweep]:
+    """The scene's grid (module docstring): its held angles evenly inside the region's ranges
+    (the ends left out: a sweep along the region's edge), spread-out order."""
+    return _sweeps(scene, scene.region.azimuthal_sweeps, scene.region.vertical_sweeps)
+
+
+def candidate_sweeps(scene: Scene) -> list[Sweep]:
+    """The next-best strategy's candidates: the grid :data:`CANDIDATE_DENSITY` times finer."""
+    return _sweeps(
+        scene,
+        CANDIDATE_DENSITY * scene.region.azimuthal_sweeps,
+        CANDIDATE_DENSITY * scene.region.vertical_sweeps,
+    )
+
+
+@dataclass(frozen=True)
+class Choice:
+    """A planner's answer: the sweep and why.
+
+    Attributes
+    ----------
+    sweep : Sweep
+    score : float
+        The predictive standard deviation at the predicted touch (m), NaN for a grid choice.
+    predicted : array, shape (3,)
+        Where the sweep is expected to touch (m, world), NaN for a grid choice.
+    std : float
+        The surface's predictive std there (m), NaN for a grid choice.
+    probability : float
+        The chance that the sweep touches, NaN for a grid choice.
+    """
+
+    sweep: Sweep
+    score: float
+    predicted: FloatArray
+    std: float = math.nan
+    probability: float = math.nan
+
+
+class NextBestPlanner:
+    """Chooses the next sweep from the contacts so far (module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+        Its bases and region (the objects are not looked at).
+    shape : LinkShape
+        The link's sagged shape.
+    """
+
+    def __init__(self, scene: Scene, shape: LinkShape) -> None:
+        self.scene = scene
+        self.shape = shape
+        self.candidates = candidate_sweeps(scene)
+        self.opening = grid_sweeps(scene)
+        x = shape.abscissae
+        self._samples = np.unique(np.linspace(0, len(x) - 1, _PREDICTION_SAMPLES).astype(int))
+
+    def choose(
+        self,
+        done: Sequence[Sweep],
+        surface: ImplicitSurface | None,
+        free: Sequence[Sweep] = (),
+        leaders: Sequence[ClassFit] = (),
+    ) -> Choice | None:
+        """The next sweep given the sweeps run so far, the surface fitted to their contacts
+        (None until there is one), those of them that touched nothing, and the two leading
+        shape classes' fits when recognition abstains between them (module docstring); None
+        when every candidate has been run."""
+        nan3 = np.full(3, np.nan)
+        if surface is None:
+            for sweep in self.opening:
+                if sweep not in done:
+                    return Choice(sweep, float("nan"), nan3)
+            surface_free = [c for c in self.candidates if c not in done]
+            return Choice(surface_free[0], float("nan"), nan3) if surface_free else None
+        left = [c for c in self.candidates if c not in done]
+        if not left:
+            return None
+        free_cloud = None
+        if free:
+            free_cloud = cKDTree(np.concatenate([self._swept(sweep) for sweep in free]))
+        best: tuple[float, Choice] | None = None
+        fallback: tuple[float, Choice] | None = None
+        for sweep in left:
+            point, closest = self._predicted_touch(sweep, surface)
+            _, std_at = surface.predict(point[None, :], return_std=True)
+            std = float(std_at[0])
+            # P(f < 0 there) under the surface's Gaussian prediction: the chance to touch
+            probability = 0.5 * math.erfc(closest / (math.sqrt(2.0) * max(std, 1e-12)))
+            crowd = sum(
+                1
+                for d in done
+                if d.base == sweep.base
+                and d.case == sweep.case
+                and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
+            )
+            spread = std
+            if len(leaders) == 2:
+                # where the two leading shapes disagree about the surface
+                d_a, d_b = (
+                    float(PRIMITIVES[f.name].signed_distance(f.vector, point[None, :])[0])
+                    for f in leaders
+                )
+                spread = math.hypot(spread, d_a - d_b)
+            score = probability * spread / (1.0 + crowd)
+            if free_cloud is not None:
+                distance = float(free_cloud.query(point)[0])
+                score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
+            entry = (score, Choice(sweep, score, point, std, probability))
+            if closest > MISS_MARGIN:
+                if fallback is None or score > fallback[0]:
+                    fallback = entry
+            elif best is None or score > best[0]:
+                best = entry
+        chosen = best if best is not None else fallback
+        assert chosen is not None
+        return chosen[1]
+
+    def _swept(self, sweep: Sweep) -> FloatArray:
+        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3)."""
+        base = self.scene.bases[sweep.base]
+        angles = np.arange(sweep.start, sweep.end + 1e-12, PREDICTION_STEP)
+        return np.concatenate(
+            [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
+        )
+
+    def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:
+        """The predicted touch point (m) and the smallest f met (m; <= 0 when it touches)."""
+        angles = np.arange(sweep.start, sweep.end + 1e-12, PREDICTION_STEP)
+        points = self._swept(sweep)
+        values = np.asarray(surface.predict(points)).reshape(len(angles), -1)
+        inside = np.nonzero((values < 0).any(axis=1))[0]
+        if inside.size:
+            row = int(inside[0])
+            column = int(np.argmin(values[row]))
+            return points.reshape(len(angles), -1, 3)[row, column], float(values[row, column])
+        flat = int(np.argmin(values))
+        row, column = divmod(flat, values.shape[1])
+        return points.reshape(len(angles), -1, 3)[row, column], float(values[row, column])

@@ -1,0 +1,357 @@
+"""``explore``: sweeps of the simulated device in a scene, each contact estimated and mapped.
+
+The device's job as the paper's algorithm states it (Section 4: sweep, contact, push, estimate,
+retract, re-plan), on the simulator:
+
+1. **Calibrate** (once per output directory), as the README does for a real device before it
+   measures: five sweeps into posts at known x_c (0.3 to 0.9 m), ``calibrate_from_recordings``,
+   the calibrated antenna written to ``calibrated.toml``; the estimators use it, the simulator
+   the device.
+2. **Each manoeuvre**: the planner (``exploration.plan``: ``grid`` or ``next-best``) picks a
+   sweep; ``scene.simulate_sweep`` finds its first touch and simulates it; the recording is
+   written (its ``base_pose`` says where it was taken) and estimated by the map's own code path
+   (``mapping.points_from_recordings``), giving a :class:`~sensing_antenna.mapping.ContactPoint`
+   with its covariance and status; a sweep that touches nothing is stored as free space.
+3. **The map**: ``mapping.build_map`` on every point, as ``antenna map`` builds it.
+
+The next-best strategy refits the surface before each manoeuvre and recognises the points before
+every :data:`RECOGNITION_EVERY`-th, aiming at the two leading classes while recognition abstains
+(``exploration.plan``).
+
+Manoeuvre i is simulated with the seed ``seed + i``. Everything is stored as it is made
+(``exploration.store``); a second start with the same settings resumes after the last stored
+manoeuvre (with a larger budget it goes on), and the next-best planner, fed the same stored
+points, makes the same choices.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+
+from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
+from sensing_antenna.campaign.store import atomic_write_text
+from sensing_antenna.errors import raise_if_signalled
+from sensing_antenna.exploration.plan import STRATEGIES, Choice, NextBestPlanner, grid_sweeps
+from sensing_antenna.exploration.store import (
+    CALIBRATED_FILE,
+    RECORDINGS_DIR,
+    Manoeuvre,
+    exploration_lock,
+    load_manoeuvres,
+    write_manoeuvre,
+    write_manoeuvre_table,
+    write_settings,
+)
+from sensing_antenna.mapping.contact_map import (
+    ContactMap,
+    build_map,
+    fit_surface,
+    recognise_points,
+)
+from sensing_antenna.mapping.points import ContactPoint
+from sensing_antenna.mapping.primitives import PRIMITIVES
+from sensing_antenna.mapping.recognition import ClassFit
+from sensing_antenna.recording import write_recording
+from sensing_antenna.scene.file import Scene
+from sensing_antenna.scene.simulate import simulate_sweep
+from sensing_antenna.scene.sweep import LinkShape
+
+__all__ = [
+    "CALIBRATION_POINTS",
+    "Exploration",
+    "ExplorationInterrupted",
+    "ExploreSettings",
+    "calibrate_device",
+    "explore",
+]
+
+#: Where the calibration's posts are touched (m): the README's five points.
+CALIBRATION_POINTS = (0.3, 0.45, 0.6, 0.75, 0.9)
+
+#: The calibration manoeuvres' seeds start here (the README's).
+CALIBRATION_SEED = 10
+
+#: The next-best strategy recognises the points so far before every this many manoeuvres, to
+#: aim at the two leading classes when recognition abstains (a recognition takes seconds).
+RECOGNITION_EVERY = 4
+
+#: Methods the exploration offers (those that give an interval or a default sigma_x).
+EXPLORE_METHODS = ("paper", "fast")
+
+
+@dataclass(frozen=True)
+class ExploreSettings:
+    """What an exploration does; a resume must have the same.
+
+    Attributes
+    ----------
+    method : {"paper", "fast"}
+    strategy : {"grid", "next-best"}
+    budget : int or None
+        Most manoeuvres (None: the scene's grid size).
+    seed : int
+        Seed of the first manoeuvre.
+    include_uncertain : bool
+        Let ``uncertain`` points into the map and the planner's surface.
+    """
+
+    method: str = "fast"
+    strategy: str = "grid"
+    budget: int | None = None
+    seed: int = 0
+    include_uncertain: bool = False
+
+    def __post_init__(self) -> None:
+        if self.method not in EXPLORE_METHODS:
+            raise ValueError(f"method must be one of {', '.join(EXPLORE_METHODS)}")
+        if self.strategy not in STRATEGIES:
+            raise ValueError(f"strategy must be one of {', '.join(STRATEGIES)}")
+        if self.budget is not None and self.budget < 1:
+            raise ValueError("budget must be at least 1")
+
+
+class ExplorationInterrupted(KeyboardInterrupt):
+    """Stopped by Ctrl-C or a stop signal; every finished manoeuvre is stored."""
+
+    def __init__(self, signal_number: int, n_stored: int, out: Path) -> None:
+        self.signal_number = signal_number
+        self.n_stored = n_stored
+        self.out = out
+        super().__init__(self.message)
+
+    @property
+    def message(self) -> str:
+        """One line for the command line."""
+        return (
+            f"interrupted: {self.n_stored} manoeuvres are stored in {self.out}; the same command"
+            " resumes from them"
+        )
+
+
+@dataclass(frozen=True)
+class Exploration:
+    """An exploration's result.
+
+    Attributes
+    ----------
+    scene : Scene
+    settings : ExploreSettings
+    manoeuvres : tuple of Manoeuvre
+    contact_map : ContactMap
+        The map of every estimated point.
+    antenna : Antenna
+        The calibrated antenna the estimators used.
+    """
+
+    scene: Scene
+    settings: ExploreSettings
+    manoeuvres: tuple[Manoeuvre, ...]
+    contact_map: ContactMap
+    antenna: Antenna
+
+    @property
+    def points(self) -> list[ContactPoint]:
+        """Every estimated point (any status)."""
+        return [m.point for m in self.manoeuvres if m.point is not None]
+
+    def summary(self) -> dict[str, Any]:
+        """Counts by outcome, the contacts used, the simulated sweeping time (s), and the map's
+        own summary."""
+        outcomes: dict[str, int] = {}
+        for m in self.manoeuvres:
+            outcomes[m.outcome] = outcomes.get(m.outcome, 0) + 1
+        return {
+            "scene": self.scene.name,
+            "method": self.settings.method,
+            "strategy": self.settings.strategy,
+            "manoeuvres": len(self.manoeuvres),
+            "outcomes": outcomes,
+            "sweep_time_s": float(sum(m.sweep_time for m in self.manoeuvres)),
+            "map": self.contact_map.summary(),
+        }
+
+
+def calibrate_device(device: Antenna, folder: Path | None = None) -> Antenna:
+    """The README's calibration on the simulated device: posts at :data:`CALIBRATION_POINTS`
+    (seeds from :data:`CALIBRATION_SEED`), T_e fitted by ``calibrate_from_recordings``; the
+    recordings are written into ``folder`` when given."""
+    from sensing_antenna.calibration.frequency import calibrate_from_recordings
+    from sensing_antenna.simulator import Scenario, simulate
+
+    runs = [
+        simulate(device, Scenario(case="azimuthal", contact_point=x, seed=seed))
+        for seed, x in enumerate(CALIBRATION_POINTS, start=CALIBRATION_SEED)
+    ]
+    if folder is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+        for x, run in zip(CALIBRATION_POINTS, runs, strict=True):
+            write_recording(run, folder / f"post-{x:.2f}.csv")
+    points = [float(run.metadata["true_xc"]) for run in runs]
+    return calibrate_from_recordings(runs, device, points).apply(device)
+
+
+def _prepared(device: Antenna, out: Path) -> Antenna:
+    path = out / CALIBRATED_FILE
+    if path.is_file():
+        return load_antenna(path)
+    calibrated = calibrate_device(device, out / "calibration")
+    atomic_write_text(path, antenna_to_toml(calibrated))
+    return load_antenna(path)
+
+
+def _scene_fingerprint(scene: Scene) -> str:
+    digest = hashlib.sha256()
+    for obj in scene.objects:
+        digest.update(obj.name.encode())
+        digest.update(obj.shape.encode())
+        digest.update(np.round(np.asarray(obj.mesh.vertices), 9).tobytes())
+    for base in scene.bases:
+        digest.update(np.round(base.matrix, 12).tobytes())
+    digest.update(repr(scene.region).encode())
+    return digest.hexdigest()[:16]
+
+
+def explore(
+    scene: Scene,
+    device: Antenna,
+    out: Path,
+    settings: ExploreSettings | None = None,
+    progress: Callable[[Manoeuvre, int], None] | None = None,
+    meshes: Mapping[str, trimesh.Trimesh] | None = None,
+) -> Exploration:
+    """Explore ``scene`` with the simulated ``device``, storing everything in ``out``.
+
+    Parameters
+    ----------
+    scene : Scene
+    device : Antenna
+        The simulated device (the estimators use its calibration, step 1).
+    out : Path
+        Output directory (created; resumed when it holds the same exploration).
+    settings : ExploreSettings, optional
+    progress : callable, optional
+        Called with each new manoeuvre and the budget.
+    meshes : mapping of str to trimesh.Trimesh, optional
+        User meshes recognition registers beside the shape classes (``antenna map --objects``).
+
+    Raises
+    ------
+    ExplorationInterrupted
+        On Ctrl-C or a stop signal, with every finished manoeuvre stored.
+    ExplorationStoreError
+        ``out`` holds another exploration or is in use.
+    """
+    settings = settings if settings is not None else ExploreSettings()
+    grid = grid_sweeps(scene)
+    budget = settings.budget if settings.budget is not None else len(grid)
+    with exploration_lock(out):
+        write_settings(
+            out,
+            {
+                "scene": scene.name,
+                "scene_fingerprint": _scene_fingerprint(scene),
+                "device": antenna_to_toml(device),
+                "method": settings.method,
+                "strategy": settings.strategy,
+                "seed": settings.seed,
+                "include_uncertain": settings.include_uncertain,
+            },
+        )
+        scene.mesh.export(out / "scene.ply")
+        manoeuvres = load_manoeuvres(out)
+        try:
+            antenna = _prepared(device, out)
+            shape = LinkShape(device.link)
+            planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
+            leaders: tuple[ClassFit, ...] = ()
+            while len(manoeuvres) < budget:
+                index = len(manoeuvres)
+                if planner is None:
+                    if index >= len(grid):
+                        break
+                    choice: Choice | None = Choice(grid[index], math.nan, np.full(3, np.nan))
+                else:
+                    points = [m.point for m in manoeuvres if m.point is not None]
+                    surface = fit_surface(points, settings.include_uncertain)
+                    if index % RECOGNITION_EVERY == 0:
+                        leaders = _undecided_leaders(points, settings.include_uncertain)
+                    choice = planner.choose(
+                        [m.sweep for m in manoeuvres],
+                        surface,
+                        [m.sweep for m in manoeuvres if m.outcome == "free"],
+                        leaders,
+                    )
+                if choice is None:
+                    break
+                manoeuvre = _run_one(scene, device, antenna, shape, choice, index, settings, out)
+                write_manoeuvre(out, manoeuvre)
+                manoeuvres.append(manoeuvre)
+                if progress is not None:
+                    progress(manoeuvre, budget)
+                raise_if_signalled()
+        except KeyboardInterrupt as exc:
+            write_manoeuvre_table(out, manoeuvres)
+            number = int(getattr(exc, "signal_number", 2))
+            raise ExplorationInterrupted(number, len(manoeuvres), out) from None
+        write_manoeuvre_table(out, manoeuvres)
+    points = [m.point for m in manoeuvres if m.point is not None]
+    contact_map = build_map(points, settings.include_uncertain, meshes=meshes)
+    return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
+
+
+def _undecided_leaders(points: list[ContactPoint], include_uncertain: bool) -> tuple[ClassFit, ...]:
+    """The two leading primitive fits when recognition abstains between them, else none."""
+    recognition = recognise_points(points, include_uncertain)
+    if recognition is None or not recognition.undecided:
+        return ()
+    leaders = tuple(recognition.fits[:2])
+    return leaders if all(f.name in PRIMITIVES for f in leaders) else ()
+
+
+def _run_one(
+    scene: Scene,
+    device: Antenna,
+    antenna: Antenna,
+    shape: LinkShape,
+    choice: Choice,
+    index: int,
+    settings: ExploreSettings,
+    out: Path,
+) -> Manoeuvre:
+    from sensing_antenna.mapping.contact_map import points_from_recordings
+
+    seed = settings.seed + index
+    outcome = simulate_sweep(device, scene, choice.sweep, seed=seed, shape=shape)
+    recording_name = None
+    point = None
+    if outcome.recording is not None:
+        folder = out / RECORDINGS_DIR
+        folder.mkdir(exist_ok=True)
+        path = folder / f"{index:03d}.csv"
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+        write_recording(outcome.recording, tmp)
+        tmp.replace(path)
+        recording_name = f"{RECORDINGS_DIR}/{path.name}"
+        # the map's own code path: the recording as a file, its base pose from its metadata
+        point = points_from_recordings([path], antenna, settings.method)[0]
+    return Manoeuvre(
+        index=index,
+        sweep=choice.sweep,
+        outcome=outcome.outcome,
+        reason=outcome.reason,
+        touch=None if outcome.touch is None else outcome.touch.to_dict(),
+        sweep_time=outcome.sweep_time,
+        seed=seed,
+        recording=recording_name,
+        point=point,
+        score=choice.score,
+    )

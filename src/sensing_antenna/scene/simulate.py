@@ -1,0 +1,235 @@
+"""A sweep of the simulated device in a scene: the geometric touch, then the contact physics.
+
+:func:`~sensing_antenna.scene.touch.first_touch` finds where the link first meets the scene.
+The simulator's own manoeuvre (``simulator.simulate``) is then run against a local obstacle
+equivalent to the surface there, placed by the simulator from x_c as for any of its runs:
+
+- a contact along the link: a cylinder tangent to the link at x_c whose axis is perpendicular
+  to the link and to the surface's normal, of the surface's local radius along the link (a post
+  for an azimuthal sweep, a bar for a vertical one), turned by the normal's angle out of the
+  sweep's plane (the scenario's ``obstacle_tilt``);
+- a contact at the tip: the simulator's plane, touched by the tip (its normal is the
+  simulator's, not the face's: the touched point is the same).
+
+The simulator's manoeuvre touches at the angles (0, 0) of its absolute frame, so the recording's
+frame is the base's turned to the touch angles: R = R_base M(theta)^T, with M(theta) the motor
+frame's rows (``simulator.contact.motor_frame``), written as the recording's ``base_pose``; the
+recording's angles are relative to that frame. The physics is exact for an azimuthal sweep at
+elevation 0 under a level base (a turn about the vertical); otherwise the simulated gravity acts
+along the turned frame's -Z, so the sag across the link is g where the scene's is
+g cos(theta2) (4.5 % of the sag at 0.3 rad), and a sweep at elevation theta2 is simulated in
+the plane tangent to its cone at the touch.
+
+The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
+friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated
+with the obstacle turned by :data:`MAX_TILT`: the same touched point, the push held as if the
+surface faced the sweep more (a real link may slide there). A touch the simulator cannot
+represent is reported instead of simulated: the normal turned more than
+:data:`GLANCING_ANGLE` (``glancing``: the link would slide over it), or x_c below the
+simulator's smallest contact point (``near_head``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from sensing_antenna.antenna import Antenna
+from sensing_antenna.mapping.pose import BasePose
+from sensing_antenna.recording import Recording
+from sensing_antenna.scene.file import Scene
+from sensing_antenna.scene.sweep import LinkShape, Sweep
+from sensing_antenna.scene.touch import SweepGeometry, Touch, first_touch
+from sensing_antenna.simulator import Scenario, simulate
+from sensing_antenna.simulator.contact import motor_frame
+from sensing_antenna.simulator.run import device_link, minimum_contact_point
+
+__all__ = [
+    "GLANCING_ANGLE",
+    "MAX_TILT",
+    "OUTCOMES",
+    "SweepOutcome",
+    "simulate_sweep",
+    "touch_scenario",
+]
+
+#: Largest angle of the surface's normal out of the sweep's direction (rad) the simulator's
+#: obstacles are turned by: just inside the scenario's limit (``Scenario.obstacle_tilt`` must
+#: stay below 0.5 rad in magnitude, about the friction cone of mu = 0.6).
+MAX_TILT = 0.49
+
+#: A surface turned further than this (rad) out of the sweep's direction is ``glancing``: the
+#: link would slide over it rather than be held by it (57 degrees).
+GLANCING_ANGLE = 1.0
+
+#: What a sweep can end in.
+OUTCOMES = ("touch", "free", "glancing", "near_head", "inside")
+
+_DEFAULTS = Scenario(case="free")
+_DEFAULT_SPEED = _DEFAULTS.sweep_speed
+_DEFAULT_STIFFNESS = _DEFAULTS.contact_stiffness
+
+
+@dataclass(frozen=True)
+class SweepOutcome:
+    """A sweep's result.
+
+    Attributes
+    ----------
+    sweep : Sweep
+    outcome : str
+        ``touch`` (simulated: ``recording`` holds it), ``free`` (nothing within the reach: the
+        swept region is free space), ``glancing``, ``near_head`` or ``inside`` (module
+        docstring; nothing simulated).
+    touch : Touch or None
+        The geometric first touch.
+    scenario : Scenario or None
+        The simulated manoeuvre.
+    recording : Recording or None
+        Its recording, with ``base_pose`` metadata (the turned frame).
+    frame : BasePose or None
+        The recording's absolute frame in the world.
+    reason : str or None
+        Why nothing was simulated.
+    sweep_time : float
+        How long the head swept (s): from the start angle to the touch (or the end) at the
+        scenario's cruise speed, plus the recording after the touch; a free sweep's whole
+        travel.
+    """
+
+    sweep: Sweep
+    outcome: str
+    touch: Touch | None = None
+    scenario: Scenario | None = None
+    recording: Recording | None = None
+    frame: BasePose | None = None
+    reason: str | None = None
+    sweep_time: float = 0.0
+
+
+def touch_scenario(
+    touch: Touch, sweep: Sweep, scene: Scene, seed: int = 0, **scenario_fields: Any
+) -> tuple[Scenario, BasePose]:
+    """The simulator's scenario for a touch and the recording's frame in the world.
+
+    Raises ValueError with the reason when the touch is ``glancing``.
+    """
+    base = scene.bases[sweep.base]
+    rotation = base.rotation @ motor_frame(*touch.angles).T
+    frame = BasePose(rotation, base.position)
+    normal = rotation.T @ touch.normal  # in the recording's frame: X, Y, Z = X^m, Y^m, Z^m
+    if sweep.case == "azimuthal":
+        # the post's normal is -Y cos(t) + Z sin(t), its axis Z cos(t) + Y sin(t)
+        # (simulator.contact.place_obstacle)
+        tilt = math.atan2(normal[2], -normal[1])
+        axis = np.array([0.0, math.sin(tilt), math.cos(tilt)])
+        kind = "post"
+    else:
+        # the bar's normal is -Z cos(t) + Y sin(t), its axis Y cos(t) + Z sin(t)
+        tilt = math.atan2(normal[1], -normal[2])
+        axis = np.array([0.0, math.cos(tilt), math.sin(tilt)])
+        kind = "bar"
+    # the sagged link crosses that axis at an angle phi off the perpendicular; a cylinder of
+    # radius R curves by cos(phi)^2 / R along it (Euler), so R = R_along cos(phi)^2
+    along_axis = float(axis @ (rotation.T @ touch.tangent))
+    radius = touch.radius * (1.0 - along_axis**2)
+    if touch.tip:
+        kind = "plane"
+        tilt = 0.0
+    elif abs(tilt) >= GLANCING_ANGLE:
+        raise ValueError(
+            f"the surface's normal is {abs(tilt):.2f} rad out of the sweep's direction, more than"
+            f" {GLANCING_ANGLE} rad (the link would slide over it)"
+        )
+    # beyond the simulator's largest tilt the obstacle is turned by that much: the same
+    # touched point, a push held as if the surface faced the sweep more
+    tilt = max(-MAX_TILT, min(MAX_TILT, tilt))
+    description = (
+        f"scene {scene.name}: {sweep.case} sweep touching {touch.object_name}"
+        f" at x_c = {touch.x_c:.4f} m"
+    )
+    scenario = Scenario(
+        case=sweep.case,
+        contact_point=touch.x_c,
+        seed=seed,
+        obstacle=kind,  # type: ignore[arg-type]
+        obstacle_radius=radius,
+        obstacle_tilt=tilt,
+        description=description,
+        **scenario_fields,
+    )
+    return scenario, frame
+
+
+def simulate_sweep(
+    device: Antenna,
+    scene: Scene,
+    sweep: Sweep,
+    seed: int = 0,
+    shape: LinkShape | None = None,
+    **scenario_fields: Any,
+) -> SweepOutcome:
+    """Run ``sweep`` of ``device`` in ``scene`` (module docstring).
+
+    Parameters
+    ----------
+    device : Antenna
+        The simulated device (its link and motors).
+    scene : Scene
+    sweep : Sweep
+    seed : int
+        The scenario's seed (sensor noise).
+    shape : LinkShape, optional
+        The link's sagged shape (built from ``device`` when None; pass one to reuse it).
+    **scenario_fields
+        Further :class:`~sensing_antenna.simulator.Scenario` fields (noise_scale, ...).
+    """
+    shape = shape if shape is not None else LinkShape(device.link)
+    speed = float(scenario_fields.get("sweep_speed", _DEFAULT_SPEED))
+    geometry: SweepGeometry = first_touch(scene, sweep, shape)
+    if geometry.inside_at_start:
+        return SweepOutcome(
+            sweep, "inside", reason="the link cuts an object at the sweep's start angle"
+        )
+    touch = geometry.touch
+    if touch is None:
+        return SweepOutcome(sweep, "free", sweep_time=(sweep.end - sweep.start) / speed)
+    approach = (touch.angle - sweep.start) / speed
+    link = device_link(device.link)
+    smallest = minimum_contact_point(
+        link, float(scenario_fields.get("contact_stiffness", _DEFAULT_STIFFNESS))
+    )
+    if touch.x_c < smallest:
+        return SweepOutcome(
+            sweep,
+            "near_head",
+            touch,
+            reason=f"x_c = {touch.x_c:.3f} m is below the simulator's smallest {smallest:.3f} m",
+            sweep_time=approach,
+        )
+    try:
+        scenario, frame = touch_scenario(touch, sweep, scene, seed, **scenario_fields)
+    except ValueError as exc:
+        return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
+    recording = simulate(device, scenario)
+    metadata = dict(recording.metadata)
+    metadata["base_pose"] = frame.to_json()
+    metadata["true_object"] = touch.object_name
+    metadata["true_surface_point"] = json.dumps([float(v) for v in touch.surface_point])
+    recording = replace(recording, metadata=metadata)
+    # the recording starts approach_time before the touch (the simulator's own approach)
+    touch_time = float(recording.metadata.get("true_t_contact", "nan"))
+    after = recording.t[-1] - (touch_time if math.isfinite(touch_time) else 0.0)
+    return SweepOutcome(
+        sweep,
+        "touch",
+        touch,
+        scenario,
+        recording,
+        frame,
+        sweep_time=approach + float(after),
+    )

@@ -1,0 +1,160 @@
+"""A sweep of the head and where its gravity-sagged link lies at each angle.
+
+A sweep turns one joint from ``start`` to ``end`` with the other held at ``fixed``: azimuthal,
+theta1 across with theta2 = ``fixed`` (the link moves towards +Y^m); vertical, theta2 up with
+theta1 = ``fixed`` (towards +Z^m), the two cases of the simulator, from one of the scene's base
+poses. The link at angles (theta1, theta2) is the straight line x X^m sagged by its own weight,
+p(x) = x X^m + g cos(theta2) w_1(x) Z^m in the absolute frame (recording format), w_1 the static
+deflection of the simulator's finite-element link under a unit transverse acceleration (m per
+m/s^2, negative: the load is along -Z^m), the sag the simulator starts its manoeuvres from.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.antenna import STANDARD_GRAVITY, Link
+from sensing_antenna.mapping.pose import BasePose
+from sensing_antenna.simulator.contact import motor_frame
+from sensing_antenna.simulator.link import build_link_model
+from sensing_antenna.simulator.run import device_link
+
+__all__ = ["SWEEP_CASES", "LinkShape", "Sweep"]
+
+FloatArray = NDArray[np.float64]
+
+SWEEP_CASES = ("azimuthal", "vertical")
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """One sweep of the head.
+
+    Attributes
+    ----------
+    base : int
+        Index of the scene's base pose the head sits at.
+    case : {"azimuthal", "vertical"}
+    fixed : float
+        The held joint's angle (rad): theta2 of an azimuthal sweep, theta1 of a vertical one.
+    start, end : float
+        The swept joint from, to (rad), start < end.
+    """
+
+    base: int
+    case: Literal["azimuthal", "vertical"]
+    fixed: float
+    start: float
+    end: float
+
+    def __post_init__(self) -> None:
+        if self.case not in SWEEP_CASES:
+            raise ValueError(f"case must be one of {', '.join(SWEEP_CASES)}, got {self.case!r}")
+        if not self.start < self.end:
+            raise ValueError("a sweep runs from start to a larger end")
+
+    def angles(self, swept: float) -> tuple[float, float]:
+        """(theta1, theta2) (rad) when the swept joint is at ``swept``."""
+        if self.case == "azimuthal":
+            return (swept, self.fixed)
+        return (self.fixed, swept)
+
+    @property
+    def label(self) -> str:
+        """Short text for progress lines."""
+        held = "elevation" if self.case == "azimuthal" else "azimuth"
+        return f"base {self.base} {self.case} at {held} {self.fixed:+.3f} rad"
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-able fields."""
+        return {
+            "base": self.base,
+            "case": self.case,
+            "fixed": self.fixed,
+            "start": self.start,
+            "end": self.end,
+        }
+
+
+@dataclass(frozen=True)
+class LinkShape:
+    """The link's static sagged shape, sampled along its length.
+
+    Parameters
+    ----------
+    link : Link
+        The device's link (a calibrated one is built with the E I its T_e gives, as the
+        simulator builds it).
+    n_elements : int
+        Finite elements (the simulator's default, 16).
+    spacing : float
+        Distance between the samples along the link (m).
+    start_fraction : float
+        The first sample's abscissa as a fraction of l (the simulator's contact search starts
+        at 2 % of l).
+    gravity : float
+        g (m/s^2).
+    """
+
+    link: Link
+    n_elements: int = 16
+    spacing: float = 0.002
+    start_fraction: float = 0.02
+    gravity: float = STANDARD_GRAVITY
+
+    @cached_property
+    def abscissae(self) -> FloatArray:
+        """x of the samples (m), shape (n,), the tip last."""
+        length = self.link.length
+        n = max(2, math.ceil(length * (1.0 - self.start_fraction) / self.spacing) + 1)
+        return np.linspace(self.start_fraction * length, length, n)
+
+    @cached_property
+    def _unit_sag(self) -> tuple[FloatArray, FloatArray]:
+        model = build_link_model(device_link(self.link), self.n_elements)
+        # K q = -1 * m_t: the deflection under a unit acceleration along -Z^m
+        q = np.linalg.solve(model.stiffness, -model.translation_load)
+        x = self.abscissae
+        w = np.array([float(model.shape_at(float(xi)) @ q) for xi in x])
+        slope = np.array([float(model.slope_at(float(xi)) @ q) for xi in x])
+        return w, slope
+
+    def sag(self, theta2: float) -> FloatArray:
+        """w(x) along Z^m (m), shape (n,), at elevation theta2 (rad)."""
+        return self.gravity * math.cos(theta2) * self._unit_sag[0]
+
+    def points(self, theta: tuple[float, float], base: BasePose) -> FloatArray:
+        """The samples in the world (m), shape (n, 3)."""
+        x_m, _, z_m = motor_frame(*theta)
+        local = np.outer(self.abscissae, x_m) + np.outer(self.sag(theta[1]), z_m)
+        return base.point_to_world(local)
+
+    def point_at(self, x: float, theta: tuple[float, float], base: BasePose) -> FloatArray:
+        """p(x) in the world (m), shape (3,), the sag interpolated between samples."""
+        x_m, _, z_m = motor_frame(*theta)
+        w = float(np.interp(x, self.abscissae, self.sag(theta[1])))
+        return base.point_to_world(x * x_m + w * z_m)
+
+    def tangent_at(self, x: float, theta: tuple[float, float], base: BasePose) -> FloatArray:
+        """Unit tangent dp/dx in the world, shape (3,)."""
+        x_m, _, z_m = motor_frame(*theta)
+        slope = (
+            self.gravity
+            * math.cos(theta[1])
+            * float(np.interp(x, self.abscissae, self._unit_sag[1]))
+        )
+        t = x_m + slope * z_m
+        return np.asarray(base.rotation @ (t / np.linalg.norm(t)))
+
+    @property
+    def reach(self) -> float:
+        """Largest distance (m) of a sample from the head's base point, at any elevation: a
+        bound on how fast a link point moves per radian of either joint."""
+        sag = np.abs(self.gravity * self._unit_sag[0])
+        return float(np.max(np.hypot(self.abscissae, sag)) + sag.max())

@@ -1,0 +1,230 @@
+"""Where a sweep's link first touches a scene: the angle, x_c, the surface point and normal.
+
+The link is sampled along its length (:class:`~sensing_antenna.scene.sweep.LinkShape`) and
+g(theta) = min over the samples of the scene's signed distance is followed from the sweep's start.
+No point of the link moves faster than its reach r (m per rad of either joint), so the link
+cannot meet a surface before the joint has turned g / r further: the search advances by that
+much (conservative advancement, the sphere tracing of signed-distance rendering), at least
+:data:`MIN_STEP`, until g <= 0, then bisects the last step to :data:`ANGLE_TOLERANCE`. x_c is the
+sample nearest the surface refined by a bounded scalar minimisation between its neighbours; at
+the tip's sample the contact is the tip's.
+
+The local radius R of the surface along the link, which the simulator's equivalent cylinder
+takes, comes from the distance d(+-h) of the points h = :data:`CURVATURE_PROBE` to either side
+of the touched point along the link's direction in the tangent plane: a circle of radius R
+curves away by d = sqrt(R^2 + h^2) - R, so R = (h^2 - d^2) / (2 d) with d the mean of the two;
+exact on a circular section, small at an edge, and capped to [:data:`MIN_RADIUS`,
+:data:`MAX_RADIUS`].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import minimize_scalar
+
+from sensing_antenna.mapping.pose import BasePose
+from sensing_antenna.scene.file import Scene
+from sensing_antenna.scene.sweep import LinkShape, Sweep
+
+__all__ = [
+    "ANGLE_TOLERANCE",
+    "CURVATURE_PROBE",
+    "MAX_RADIUS",
+    "MIN_RADIUS",
+    "MIN_STEP",
+    "SweepGeometry",
+    "Touch",
+    "first_touch",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: Smallest advance of the search (rad): 0.1 mm at 1 m; it only binds within that of a surface.
+MIN_STEP = 1e-4
+
+#: The touch angle's bisection stops within this (rad): 1 nm at 1 m.
+ANGLE_TOLERANCE = 1e-9
+
+#: Distance to either side of the touched point at which the surface's bend is measured (m):
+#: 2 mm, small against the objects (radii of centimetres) and large against the face size of
+#: a fine mesh's facets (a 256-gon of 1 cm radius has 0.25 mm facets).
+CURVATURE_PROBE = 0.002
+
+#: Smallest local radius (m): an edge's; the simulator needs a positive one.
+MIN_RADIUS = 0.001
+
+#: Largest local radius (m): a flat face's, the simulator's largest obstacle radius.
+MAX_RADIUS = 10.0
+
+
+@dataclass(frozen=True)
+class Touch:
+    """The first contact of a sweep with a scene.
+
+    Attributes
+    ----------
+    angle : float
+        The swept joint's angle at the touch (rad).
+    angles : (float, float)
+        (theta1, theta2) at the touch (rad).
+    x_c : float
+        Where along the link it touches (m); the link's length at the tip.
+    link_point : array, shape (3,)
+        The link's point there, world frame (m).
+    surface_point : array, shape (3,)
+        The nearest point of the surface, world frame (m).
+    normal : array, shape (3,)
+        The surface's outward unit normal there (world frame).
+    tangent : array, shape (3,)
+        The link's unit tangent there (world frame).
+    radius : float
+        The surface's local radius of curvature along the link (m), capped.
+    tip : bool
+        True when the link's tip touches (the surface is not tangent to the link).
+    object_name : str
+        The touched object's name.
+    """
+
+    angle: float
+    angles: tuple[float, float]
+    x_c: float
+    link_point: FloatArray
+    surface_point: FloatArray
+    normal: FloatArray
+    tangent: FloatArray
+    radius: float
+    tip: bool
+    object_name: str
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-able fields (SI units)."""
+        return {
+            "angle": self.angle,
+            "angles": list(self.angles),
+            "x_c": self.x_c,
+            "link_point": self.link_point.tolist(),
+            "surface_point": self.surface_point.tolist(),
+            "normal": self.normal.tolist(),
+            "tangent": self.tangent.tolist(),
+            "radius": self.radius,
+            "tip": self.tip,
+            "object": self.object_name,
+        }
+
+
+@dataclass(frozen=True)
+class SweepGeometry:
+    """What a sweep meets: a touch, nothing (free), or the link inside an object at the start.
+
+    Attributes
+    ----------
+    touch : Touch or None
+    inside_at_start : bool
+        The link already cuts an object at the sweep's start angle (no sweep is possible).
+    """
+
+    touch: Touch | None
+    inside_at_start: bool = False
+
+
+def _gap(scene: Scene, shape: LinkShape, sweep: Sweep, base: BasePose, angle: float) -> float:
+    return float(scene.signed_distance(shape.points(sweep.angles(angle), base)).min())
+
+
+def first_touch(scene: Scene, sweep: Sweep, shape: LinkShape) -> SweepGeometry:
+    """Where the link of ``shape`` first touches ``scene`` during ``sweep`` (module docstring)."""
+    base = scene.bases[sweep.base]
+    reach = shape.reach
+    angle = sweep.start
+    gap = _gap(scene, shape, sweep, base, angle)
+    if gap <= 0:
+        return SweepGeometry(None, inside_at_start=True)
+    while True:
+        step = max(gap / reach, MIN_STEP)
+        if angle >= sweep.end:
+            return SweepGeometry(None)
+        next_angle = min(angle + step, sweep.end)
+        next_gap = _gap(scene, shape, sweep, base, next_angle)
+        if next_gap <= 0:
+            break
+        angle, gap = next_angle, next_gap
+    low, high = angle, next_angle
+    # bisection on the samples: the link is clear at low, cuts the surface at high
+    while high - low > ANGLE_TOLERANCE:
+        middle = 0.5 * (low + high)
+        if _gap(scene, shape, sweep, base, middle) > 0:
+            low = middle
+        else:
+            high = middle
+    # between samples the link may already cut the surface: bisect again on the gap between
+    # the samples, stepping back until the link is clear
+    if _nearest(scene, shape, sweep, base, low)[1] <= 0:
+        high = low
+        low = high - MIN_STEP
+        while _nearest(scene, shape, sweep, base, low)[1] <= 0:
+            low -= MIN_STEP
+        while high - low > ANGLE_TOLERANCE:
+            middle = 0.5 * (low + high)
+            if _nearest(scene, shape, sweep, base, middle)[1] > 0:
+                low = middle
+            else:
+                high = middle
+    return SweepGeometry(_touch_at(scene, sweep, shape, base, low))
+
+
+def _nearest(
+    scene: Scene, shape: LinkShape, sweep: Sweep, base: BasePose, angle: float
+) -> tuple[float, float, bool]:
+    """(x, gap, tip): the link's point nearest the scene at ``angle``, between samples."""
+    theta = sweep.angles(angle)
+    x = shape.abscissae
+    k = int(np.argmin(scene.signed_distance(shape.points(theta, base))))
+    length = float(x[-1])
+
+    def gap_at(s: float) -> float:
+        return float(scene.signed_distance(shape.point_at(s, theta, base)[None, :])[0])
+
+    if k == len(x) - 1 and gap_at(length) <= gap_at(length - 0.1 * shape.spacing):
+        return length, gap_at(length), True
+    low, high = float(x[max(k - 1, 0)]), float(x[min(k + 1, len(x) - 1)])
+    found = minimize_scalar(gap_at, bounds=(low, high), method="bounded", options={"xatol": 1e-9})
+    return float(found.x), float(found.fun), False
+
+
+def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angle: float) -> Touch:
+    theta = sweep.angles(angle)
+    x_c, _, tip = _nearest(scene, shape, sweep, base, angle)
+    link_point = shape.point_at(x_c, theta, base)
+    per_object = [float(obj.signed_distance(link_point[None, :])[0]) for obj in scene.objects]
+    touched = scene.objects[int(np.argmin(per_object))]
+    normal = touched.normal(link_point)
+    distance = min(per_object)
+    surface_point = link_point - distance * normal
+    radius = MAX_RADIUS
+    tangent = shape.tangent_at(x_c, theta, base)
+    if not tip:
+        along = tangent - (tangent @ normal) * normal
+        along /= np.linalg.norm(along)
+        h = CURVATURE_PROBE
+        probes = surface_point + np.outer([h, -h], along)
+        bend = float(np.mean(touched.signed_distance(probes)))
+        if bend > 0:
+            # a circle of radius R curves away by d = sqrt(R^2 + h^2) - R
+            radius = (h * h - bend * bend) / (2.0 * bend)
+        radius = min(max(radius, MIN_RADIUS), MAX_RADIUS)
+    return Touch(
+        angle=angle,
+        angles=theta,
+        x_c=x_c,
+        link_point=link_point,
+        surface_point=surface_point,
+        normal=normal,
+        tangent=tangent,
+        radius=float(radius) if math.isfinite(radius) else MAX_RADIUS,
+        tip=tip,
+        object_name=touched.name,
+    )

@@ -1,0 +1,191 @@
+"""Exploration: the planners, the stored and resumable run, and ``antenna explore``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna import paper_antenna
+from sensing_antenna.cli import main
+from sensing_antenna.exploration import (
+    ExplorationInterrupted,
+    ExplorationStoreError,
+    ExploreSettings,
+    Manoeuvre,
+    NextBestPlanner,
+    explore,
+    grid_sweeps,
+)
+from sensing_antenna.exploration.plan import spread_order
+from sensing_antenna.mapping import ClassFit, ImplicitSurface
+from sensing_antenna.scene import LinkShape, load_scene
+
+DEVICE = paper_antenna()
+
+
+def test_spread_order_visits_every_index_once_middle_first() -> None:
+    for n in (1, 2, 5, 8):
+        order = spread_order(n)
+        assert sorted(order) == list(range(n))
+    assert spread_order(8) == [3, 1, 5, 0, 2, 4, 6, 7]
+    assert spread_order(3) == [1, 0, 2]
+
+
+def test_grid_alternates_bases_and_cases() -> None:
+    scene = load_scene("sphere")
+    grid = grid_sweeps(scene)
+    assert len(grid) == 2 * (8 + 8)
+    assert [s.base for s in grid[:4]] == [0, 1, 0, 1]
+    assert [s.case for s in grid[:4]] == ["azimuthal", "azimuthal", "vertical", "vertical"]
+    assert len(set(grid)) == len(grid)
+    elevation = scene.region.elevation
+    assert all(elevation[0] < s.fixed < elevation[1] for s in grid if s.case == "azimuthal")
+
+
+def test_next_best_aims_where_the_surface_is_unknown() -> None:
+    # contacts on the left half of the ball as seen from base 0: the next sweep's predicted
+    # touch should lie where no contact is, and a free sweep through it turns the choice away
+    scene = load_scene("sphere")
+    ball = scene.objects[0]
+    centre, radius = ball.parameters[:3], ball.parameters[3]
+    rng = np.random.default_rng(0)
+    directions = rng.normal(size=(40, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    left = directions[(directions[:, 0] < -0.2) & (directions[:, 1] < 0.0)]
+    points = centre + radius * left
+    surface = ImplicitSurface().fit(
+        points, np.tile(np.eye(3) * 1e-6, (len(points), 1, 1)), np.zeros(3)
+    )
+    planner = NextBestPlanner(scene, LinkShape(DEVICE.link))
+    choice = planner.choose([], surface)
+    assert choice is not None and np.isfinite(choice.score)
+    nearest = np.min(np.linalg.norm(points - choice.predicted, axis=1))
+    assert nearest > 0.02
+    again = planner.choose([], surface, free=[choice.sweep])
+    assert again is not None and again.sweep != choice.sweep
+    # two leading classes that disagree: the true ball and one 2 cm larger about the same
+    # centre differ by 2 cm everywhere, so every score becomes sqrt(std^2 + 0.02^2)
+    leaders = [
+        ClassFit("sphere", {}, {}, 0.0, 0.0, 0.0, 4, len(points), vector=ball.parameters),
+        ClassFit(
+            "sphere",
+            {},
+            {},
+            0.0,
+            0.0,
+            0.0,
+            4,
+            len(points),
+            vector=ball.parameters + np.array([0, 0, 0, 0.02]),
+        ),
+    ]
+    aimed = planner.choose([], surface, leaders=leaders)
+    assert aimed is not None and 0 < aimed.probability <= 1
+    assert aimed.score == pytest.approx(np.hypot(aimed.std, 0.02) * aimed.probability, rel=1e-9)
+    assert aimed.score >= choice.score
+
+
+@pytest.fixture(scope="module")
+def explored(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Manoeuvre]]:
+    out = tmp_path_factory.mktemp("explore") / "post"
+    stop_after = 2
+
+    def interrupt(manoeuvre: Manoeuvre, budget: int) -> None:
+        if manoeuvre.index + 1 == stop_after:
+            raise KeyboardInterrupt
+
+    settings = ExploreSettings(method="paper", budget=3)
+    with pytest.raises(ExplorationInterrupted) as caught:
+        explore(load_scene("post"), DEVICE, out, settings, interrupt)
+    assert caught.value.n_stored == stop_after
+    assert "2 manoeuvres are stored" in caught.value.message
+    resumed = explore(load_scene("post"), DEVICE, out, settings)
+    return out, list(resumed.manoeuvres)
+
+
+def test_an_interrupted_exploration_resumes_to_the_same_result(
+    explored: tuple[Path, list[Manoeuvre]], tmp_path: Path
+) -> None:
+    out, manoeuvres = explored
+    assert [m.index for m in manoeuvres] == [0, 1, 2]
+    straight = explore(
+        load_scene("post"), DEVICE, tmp_path / "once", ExploreSettings(method="paper", budget=3)
+    )
+    for a, b in zip(manoeuvres, straight.manoeuvres, strict=True):
+        assert a.sweep == b.sweep and a.outcome == b.outcome
+        if a.point is not None:
+            assert b.point is not None
+            np.testing.assert_array_equal(a.point.point, b.point.point)
+    assert sorted(p.name for p in (out / "recordings").iterdir()) == [
+        f"{m.index:03d}.csv" for m in manoeuvres if m.outcome == "touch"
+    ]
+
+
+def test_the_post_scene_is_touched_where_the_post_is(
+    explored: tuple[Path, list[Manoeuvre]],
+) -> None:
+    _, manoeuvres = explored
+    touched = [m for m in manoeuvres if m.outcome == "touch"]
+    assert touched
+    for m in touched:
+        assert m.point is not None and m.touch is not None
+        assert m.point.status.value == "ok"
+        # the point within 3 standard deviations of the surface point the link met
+        error = np.linalg.norm(m.point.point - np.array(m.touch["surface_point"]))
+        assert error < 3.0 * m.point.std
+
+
+def test_other_settings_in_the_same_directory_are_refused(
+    explored: tuple[Path, list[Manoeuvre]],
+) -> None:
+    out, _ = explored
+    with pytest.raises(ExplorationStoreError, match=r"settings.json: method: "):
+        explore(load_scene("post"), DEVICE, out, ExploreSettings(method="fast", budget=3))
+
+
+def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "cli"
+    assert main(["explore", "post", "--out", str(out), "--budget", "2", "--method", "fast"]) == 0
+    text = capsys.readouterr().out
+    assert "[1/2] base 0 azimuthal" in text and "2 manoeuvres" in text
+    for name in ("manoeuvres.csv", "points.csv", "map.png", "scene.ply", "calibrated.toml"):
+        assert (out / name).is_file()
+    summary = json.loads((out / "exploration.json").read_text())
+    assert summary["manoeuvres"] == 2 and summary["method"] == "fast"
+
+
+def test_the_command_offers_the_librarys_strategies_and_scenes() -> None:
+    from sensing_antenna.cli import explore as command
+    from sensing_antenna.exploration import STRATEGIES
+    from sensing_antenna.scene import BUILTIN_SCENES
+
+    assert command.STRATEGIES == STRATEGIES
+    assert command.BUILTIN_SCENES == BUILTIN_SCENES
+
+
+def test_antenna_explore_bad_scene_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[objects]]\nshape = "sphere"\nradius = "big"\nposition = [1, 0, 0]\n')
+    assert main(["explore", str(bad), "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert (
+        err
+        == f"antenna explore: error: {bad}: objects[0].radius: must be a finite number, got 'big'"
+    )
+
+
+def test_a_larger_budget_goes_on_from_the_stored_manoeuvres(tmp_path: Path) -> None:
+    out = tmp_path / "grow"
+    first = explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
+    stored = (out / "manoeuvres" / "000.json").read_text()
+    grown = explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=2))
+    assert len(first.manoeuvres) == 1 and len(grown.manoeuvres) == 2
+    # the first manoeuvre is the stored one, not run again
+    assert (out / "manoeuvres" / "000.json").read_text() == stored
+    assert grown.manoeuvres[0].to_dict() == first.manoeuvres[0].to_dict()
+    assert grown.manoeuvres[1].sweep != grown.manoeuvres[0].sweep

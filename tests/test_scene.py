@@ -1,0 +1,245 @@
+"""Scenes: objects at poses, scene files, the first touch of a sweep, and its simulation."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from sensing_antenna import paper_antenna
+from sensing_antenna.estimation import estimate
+from sensing_antenna.mapping import base_pose_from_metadata
+from sensing_antenna.mapping.pose import BasePose
+from sensing_antenna.scene import (
+    LinkShape,
+    Scene,
+    SceneError,
+    Sweep,
+    first_touch,
+    load_scene,
+    primitive_object,
+    simulate_sweep,
+)
+from sensing_antenna.scene.file import ExploreRegion
+from sensing_antenna.simulator import Scenario, simulate_detailed
+
+DEVICE = paper_antenna()
+BALL = '[[objects]]\nshape = "sphere"\nradius = 0.1\nposition = [0, 0, 0]\n'
+
+
+def _scene(*objects: object, bases: tuple[BasePose, ...] = (BasePose.identity(),)) -> Scene:
+    return Scene("test", tuple(objects), bases, ExploreRegion())  # type: ignore[arg-type]
+
+
+def test_a_post_scene_reproduces_the_simulators_post_run() -> None:
+    # the post Scenario(azimuthal, x_c = 0.55) places, built as a scene object from its own
+    # true_obstacle: the scene's sweep must derive the same scenario and the same recording
+    reference = simulate_detailed(DEVICE, Scenario(case="azimuthal", contact_point=0.55, seed=4))
+    post = reference.obstacle
+    assert post is not None
+    axis = np.array(post.direction)
+    # a cylinder's rotation vector taking Z onto the axis (about X: axis = (0, sin t, cos t))
+    tilt = math.atan2(axis[1], axis[2])
+    centre = np.array(post.point) - axis * post.point[2] / axis[2]  # the axis point at z = 0
+    scene = _scene(primitive_object("post", "cylinder", [post.radius, 0.6], centre, [-tilt, 0, 0]))
+    outcome = simulate_sweep(DEVICE, scene, Sweep(0, "azimuthal", 0.0, -0.3, 0.3), seed=4)
+    assert outcome.outcome == "touch" and outcome.scenario is not None
+    # x_c to the touch search's tolerance (its bisection and scalar minimisation, 1e-9, and the
+    # sag interpolated linearly between the 2 mm samples, below a micrometre)
+    assert outcome.scenario.contact_point == pytest.approx(0.55, abs=1e-6)
+    assert outcome.scenario.obstacle_tilt == pytest.approx(0.02, abs=1e-8)
+    # the radius from the bend over +-2 mm: exact on a circle up to the sag's interpolation
+    assert outcome.scenario.obstacle_radius == pytest.approx(0.01, rel=1e-4)
+    recording = outcome.recording
+    assert recording is not None
+    # the same manoeuvre: the loads differ by the micrometres of placement only (the sensor's
+    # noise is 6 mN per sample)
+    assert np.abs(recording.force - reference.recording.force).max() < 1e-4
+    np.testing.assert_array_equal(recording.theta, reference.recording.theta)
+    antenna = DEVICE.self_calibrated()
+    mine = estimate(recording.without_ground_truth(), antenna, "paper")
+    theirs = estimate(reference.recording.without_ground_truth(), antenna, "paper")
+    assert mine.status == theirs.status
+    assert mine.x_c == pytest.approx(theirs.x_c, abs=1e-5)
+    # the recording's frame: turned by the touch angle (1e-7 rad) about Z
+    pose = base_pose_from_metadata(recording.metadata)
+    np.testing.assert_allclose(pose.rotation, np.eye(3), atol=1e-6)
+
+
+def test_builtin_post_scene_is_the_same_post() -> None:
+    outcome = simulate_sweep(DEVICE, load_scene("post"), Sweep(0, "azimuthal", 0.0, -0.3, 0.3))
+    assert outcome.scenario is not None
+    assert outcome.scenario.contact_point == pytest.approx(0.55, abs=1e-5)
+
+
+def test_sphere_touch_matches_the_tangent_line() -> None:
+    # without gravity the link is the straight segment [0, l] X^m: sweeping in the plane z = 0,
+    # it first touches a sphere (centre c at height h, radius R) where the line is tangent to
+    # the circle of radius r = sqrt(R^2 - h^2) that the plane cuts, at distance D from the
+    # head: theta = alpha - asin(r / D), x_c = sqrt(D^2 - r^2)
+    centre = np.array([0.6, 0.2, 0.03])
+    radius = 0.07
+    scene = _scene(primitive_object("ball", "sphere", [radius], centre))
+    shape = LinkShape(DEVICE.link, gravity=0.0)
+    touch = first_touch(scene, Sweep(0, "azimuthal", 0.0, -0.5, 0.8), shape).touch
+    assert touch is not None and not touch.tip
+    r = math.sqrt(radius**2 - centre[2] ** 2)
+    distance = math.hypot(centre[0], centre[1])
+    assert touch.angle == pytest.approx(
+        math.atan2(centre[1], centre[0]) - math.asin(r / distance), abs=1e-8
+    )
+    assert touch.x_c == pytest.approx(math.sqrt(distance**2 - r**2), abs=1e-7)
+    np.testing.assert_allclose(touch.normal, (touch.surface_point - centre) / radius, atol=1e-6)
+    # the radius along the link: the sphere's normal curvature is 1 / R in every direction
+    assert touch.radius == pytest.approx(radius, rel=1e-4)
+
+
+def test_tip_touches_a_far_box_and_a_sweep_may_be_free() -> None:
+    # a box whose near face is at 0.9 m: the tip (l = 0.98 m) meets its side first
+    box = primitive_object("box", "box", [0.2, 0.2, 0.3], [1.0, 0.3, 0.0])
+    scene = _scene(box)
+    shape = LinkShape(DEVICE.link)
+    touch = first_touch(scene, Sweep(0, "azimuthal", 0.0, -0.3, 0.6), shape).touch
+    assert touch is not None and touch.tip and touch.x_c == DEVICE.link.length
+    assert abs(box.signed_distance(touch.link_point[None, :])[0]) < 1e-8
+    # the same box out of reach: nothing touched, free space
+    far = _scene(primitive_object("box", "box", [0.2, 0.2, 0.3], [1.5, 0.3, 0.0]))
+    outcome = simulate_sweep(DEVICE, far, Sweep(0, "azimuthal", 0.0, -0.3, 0.6))
+    assert outcome.outcome == "free" and outcome.recording is None
+    assert outcome.sweep_time == pytest.approx(0.9 / 0.3)
+
+
+def test_a_mesh_file_touches_like_the_primitive(tmp_path: Path) -> None:
+    # the same box as an STL file in millimetres, moved by the scene: the same first touch
+    box = trimesh.creation.box(extents=[100.0, 150.0, 200.0])
+    box.export(tmp_path / "box.stl")
+    (tmp_path / "scene.toml").write_text(
+        '[[objects]]\nshape = "mesh"\nfile = "box.stl"\nscale = 0.001\n'
+        "position = [0.5, 0.2, 0.0]\nrotation = [0.0, 0.0, 0.3]\n"
+        '[[objects]]\nname = "ball"\nshape = "sphere"\nradius = 0.05\nposition = [0.4, -0.6, 0]\n'
+    )
+    scene = load_scene(tmp_path / "scene.toml")
+    assert [o.shape for o in scene.objects] == ["mesh", "sphere"]
+    primitive = _scene(
+        primitive_object("box", "box", [0.1, 0.15, 0.2], [0.5, 0.2, 0.0], [0, 0, 0.3])
+    )
+    shape = LinkShape(DEVICE.link)
+    sweep = Sweep(0, "azimuthal", 0.0, -0.2, 0.8)
+    from_mesh = first_touch(scene, sweep, shape).touch
+    exact = first_touch(primitive, sweep, shape).touch
+    assert from_mesh is not None and exact is not None
+    assert from_mesh.object_name == "object1"
+    assert from_mesh.angle == pytest.approx(exact.angle, abs=1e-7)
+    np.testing.assert_allclose(from_mesh.surface_point, exact.surface_point, atol=1e-6)
+
+
+def test_a_turned_base_turns_the_touch() -> None:
+    # a level base turned by 0.4 rad and moved: the touch is the unmoved one, carried along,
+    # (the ball 2 cm low, where the link sagging 2.5 cm at 0.6 m meets it near its equator)
+    # and the simulated recording's frame places its true point on the sphere
+    base = BasePose(
+        np.array(
+            [[math.cos(0.4), -math.sin(0.4), 0], [math.sin(0.4), math.cos(0.4), 0], [0, 0, 1]]
+        ),
+        [0.3, -0.2, 0.1],
+    )
+    ball = primitive_object("ball", "sphere", [0.05], [0.6, 0.1, -0.02])
+    moved = primitive_object("ball", "sphere", [0.05], base.point_to_world([0.6, 0.1, -0.02]))
+    shape = LinkShape(DEVICE.link)
+    sweep = Sweep(0, "azimuthal", 0.0, -0.3, 0.6)
+    here = first_touch(_scene(ball), sweep, shape).touch
+    there = first_touch(_scene(moved, bases=(base,)), sweep, shape).touch
+    assert here is not None and there is not None
+    assert there.angle == pytest.approx(here.angle, abs=1e-8)
+    np.testing.assert_allclose(
+        there.surface_point, base.point_to_world(here.surface_point), atol=1e-7
+    )
+    outcome = simulate_sweep(DEVICE, _scene(moved, bases=(base,)), sweep)
+    assert outcome.recording is not None and outcome.frame is not None
+    truth = np.array(eval(outcome.recording.metadata["true_contact_point"]))
+    on_world = outcome.frame.point_to_world(truth)
+    # the simulated link's contact lies on the ball within its push (a few mm into the
+    # penalty contact and the sag's approximation)
+    assert abs(moved.signed_distance(on_world[None, :])[0]) < 3e-3
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ('[[objects]]\nshape = "blob"\nposition = [0, 0, 0]\n', "objects[0].shape"),
+        ('[[objects]]\nshape = "sphere"\nposition = [0, 0, 0]\n', "objects[0].radius"),
+        ('[[objects]]\nshape = "sphere"\nradius = -1\nposition = [0, 0, 0]\n', "objects[0].radius"),
+        ('[[objects]]\nshape = "sphere"\nradius = 0.1\n', "objects[0].position"),
+        (
+            '[[objects]]\nshape = "box"\nextents = [1, 2]\nposition = [0, 0, 0]\n',
+            "objects[0].extents",
+        ),
+        (
+            '[[objects]]\nshape = "sphere"\nradius = 0.1\ncolour = 1\nposition = [0, 0, 0]\n',
+            "objects[0].colour",
+        ),
+        (
+            '[[objects]]\nshape = "mesh"\nfile = "nowhere.stl"\nposition = [0, 0, 0]\n',
+            "objects[0].file",
+        ),
+        (
+            '[[objects]]\nshape = "sphere"\nradius = 0.1\nposition = [0, 0, 500]\n',
+            "objects[0].position",
+        ),
+        ('name = "x"\n', "objects"),
+        (
+            BALL + "[[bases]]\nquaternion = [2, 0, 0, 0]\n",
+            "bases[0].quaternion",
+        ),
+        (
+            BALL + "[explore]\nazimuth = [1, 0]\n",
+            "explore.azimuth",
+        ),
+        ("[[objects]\n", "file"),
+    ],
+)
+def test_bad_scene_files_name_file_and_field(tmp_path: Path, text: str, field: str) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(SceneError) as caught:
+        load_scene(path)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: {field}: ") and "\n" not in message
+
+
+def test_an_open_mesh_is_refused(tmp_path: Path) -> None:
+    open_mesh = trimesh.creation.box(extents=[1, 1, 1])
+    open_mesh.update_faces(np.arange(len(open_mesh.faces)) != 0)
+    open_mesh.export(tmp_path / "open.stl")
+    (tmp_path / "s.toml").write_text(
+        '[[objects]]\nshape = "mesh"\nfile = "open.stl"\nposition = [1, 0, 0]\n'
+    )
+    with pytest.raises(SceneError, match=r"objects\[0\]\.file: .*not closed"):
+        load_scene(tmp_path / "s.toml")
+
+
+def test_unknown_scene_names_the_builtins() -> None:
+    with pytest.raises(SceneError, match="built-in scenes: post, sphere"):
+        load_scene("nowhere-scene.toml")
+
+
+def test_outcomes_the_simulator_cannot_represent_are_named() -> None:
+    shape = LinkShape(DEVICE.link)
+    sweep = Sweep(0, "azimuthal", 0.0, -0.3, 0.3)
+    # a ball cut by the link at the start angle
+    inside = _scene(primitive_object("ball", "sphere", [0.05], [0.5, -0.15, -0.02]))
+    assert simulate_sweep(DEVICE, inside, sweep, shape=shape).outcome == "inside"
+    # a post 4 cm from the head: below the simulator's smallest contact point (6.5 cm)
+    near = _scene(primitive_object("post", "cylinder", [0.005, 0.3], [0.045, 0.01, 0.0]))
+    outcome = simulate_sweep(DEVICE, near, sweep, shape=shape)
+    assert outcome.outcome == "near_head" and outcome.recording is None
+    assert outcome.reason is not None and "smallest" in outcome.reason
+    # a ball met 1.2 rad off its equator: a straight link (no gravity) 5 sin(1.2) cm above a
+    # 5 cm ball's centre
+    top = _scene(primitive_object("ball", "sphere", [0.05], [0.6, 0.1, -0.05 * math.sin(1.2)]))
+    straight = LinkShape(DEVICE.link, gravity=0.0)
+    glancing = simulate_sweep(DEVICE, top, sweep, shape=straight)
+    assert glancing.outcome == "glancing" and glancing.touch is not None
