@@ -101,10 +101,8 @@ def bound_width(window: WindowEstimate, link: Link, config: FastConfig) -> float
         window.omega1_crb,
         statics.ratio,
         statics.standard_error,
-        statics.perpendicular_force,
-        link.flexural_rigidity,
+        0.0,
         frequency_floor=0.0,
-        ratio_geometry_factor=0.0,
     )
     if window.branch_chosen_by_second_mode:
         # The same branch the method's own posterior was conditioned on

@@ -46,8 +46,6 @@ def _posterior(
         omega1_se,
         math.nan,
         math.nan,
-        0.05,
-        0.09,
         0.0,
         0.0,
         higher_modes_of_x=HIGHER_GRID,

@@ -270,30 +270,46 @@ class Evidence:
         if model and statics == "small-deflection":
             model_term = self.config.ratio_model_factor * deflection_ratio * x_c
         elif model:
-            axial = abs(float(reaction[0])) / push
-            stiffness = (
-                2.0
-                * link.frequency_uncertainty
-                * (axial + 1.2 * deflection_ratio)
-                * deflection_ratio
-                * x_c
-            )
-            weight = (
-                self.config.ratio_model_factor
-                * bent_weight_moment(
-                    link,
-                    x_c,
-                    push,
-                    abs(float(self.frame.motor_axes_a[0][2])),
-                    abs(float(self.frame.axes_a[1][2])),
-                )
-                / push
-            )
-            floor = self.config.ratio_model_floor * x_c
-            model_term = math.hypot(stiffness, weight, floor)
+            model_term = float(self.ratio_model_uncertainty(np.array(x_c)))
         noise_term = self.ratio_noise * x_c / link.length
         # in quadrature without squaring (a torque noise of 1e297 N m must not overflow)
         return math.hypot(noise_term, offset_term, model_term)
+
+    def ratio_model_uncertainty(self, x_c: FloatArray) -> FloatArray:
+        """The elastica statics' model term of :meth:`ratio_uncertainty` (m), at contact points
+        ``x_c`` (m, any shape, on the link): the stiffness's uncertainty on the statics'
+        corrections, the bent link's weight (:func:`bent_weight_moment`), and the floor
+        ``ratio_model_floor`` x_c, in quadrature, for the hold's push (``frame``). A method
+        with statics of its own that are the elastica's (``fast``) weighs them with it."""
+        link = self.antenna.link
+        x_c = np.asarray(x_c, dtype=float)
+        reaction = self.frame.reaction_m
+        push = math.hypot(reaction[1], reaction[2])
+        if push <= 0.0:
+            return np.full(x_c.shape, np.inf)
+        # Eq. 13: y_c / x_c = |R_perp| x_c^2 / (3 E I)
+        deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
+        axial = abs(float(reaction[0])) / push
+        stiffness = (
+            2.0
+            * link.frequency_uncertainty
+            * (axial + 1.2 * deflection_ratio)
+            * deflection_ratio
+            * x_c
+        )
+        weight = (
+            self.config.ratio_model_factor
+            * bent_weight_moment(
+                link,
+                x_c,  # type: ignore[arg-type]
+                push,
+                abs(float(self.frame.motor_axes_a[0][2])),
+                abs(float(self.frame.axes_a[1][2])),
+            )
+            / push
+        )
+        floor = self.config.ratio_model_floor * x_c
+        return np.asarray(np.hypot(np.hypot(stiffness, weight), floor), dtype=float)
 
     def bent_link_uncertainty(self, x_c: float) -> float:
         """Standard uncertainty (m) of a contact point read from the vibration, from the push's
@@ -308,9 +324,13 @@ class Evidence:
         """
         if not math.isfinite(x_c):
             return math.inf
+        return float(self.bent_link_uncertainties(np.array(x_c)))
+
+    def bent_link_uncertainties(self, x_c: FloatArray) -> FloatArray:
+        """:meth:`bent_link_uncertainty` at contact points ``x_c`` (m, any shape, finite)."""
         link = self.antenna.link
-        x_c = min(max(x_c, 0.0), link.length)
+        x_c = np.clip(np.asarray(x_c, dtype=float), 0.0, link.length)
         reaction = self.frame.reaction_m
         push = math.hypot(reaction[1], reaction[2])
         deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
-        return self.config.bent_link_factor * deflection_ratio**2 * x_c
+        return np.asarray(self.config.bent_link_factor * deflection_ratio**2 * x_c, dtype=float)

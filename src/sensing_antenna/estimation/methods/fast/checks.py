@@ -6,9 +6,10 @@ grid window of 2/3 the length) whose change widens the standard error; a fit thr
 stands only when it passes the same checks, is more precise and agrees. On the posterior
 (:mod:`.window`): the torque/force ratio agrees with the maximum a posteriori x_c; the contact
 stays closed (the predicted vibration of the contact force below the static push); omega_1 is
-away from the top of the sensing curve; no higher mode of the fit points to another branch. On
-the estimate (:func:`problems`): the static force does not turn between the window's first half
-and t_e (slip).
+away from the top of the sensing curve; no higher mode of the fit points to another branch; the
+measured omega_1 agrees with the sensing curve at the MAP x_c. On the estimate
+(:func:`problems`): the static force does not turn between the window's first half and t_e
+(slip).
 
 Each check returns a note (empty when it passes) or a value with its note, so the window can
 say why it is not sure.
@@ -39,6 +40,7 @@ __all__ = [
     "branch_contradiction",
     "direction_change",
     "drift_check",
+    "frequency_check",
     "is_slip_reference",
     "opening_check",
     "peak_check",
@@ -151,22 +153,48 @@ def is_slip_reference(
 
 
 def ratio_check(
-    statics: StaticRatio, x_map: float, link: Link, config: FastConfig
+    statics: StaticRatio, x_map: float, model_sd: float, config: FastConfig
 ) -> tuple[float, str]:
-    """Distance of the ratio from ``x_map`` (m) in its standard deviations (model floor
-    included), and the note when it exceeds ``max_disagreement`` (else "")."""
+    """Distance of the ratio from ``x_map`` (m) in its standard deviations (the statics model's
+    ``model_sd`` (m) at ``x_map`` included), and the note when it exceeds ``max_disagreement``
+    (else "")."""
     ratio = statics.ratio
     if not math.isfinite(ratio):
         return math.nan, ""
-    # Posterior predictive check of the ratio at the MAP point (its floor included)
-    deflection = statics.perpendicular_force * x_map**2 / (3.0 * link.flexural_rigidity)
-    sigma_r = math.hypot(statics.standard_error, config.ratio_geometry_factor * deflection * x_map)
+    # Posterior predictive check of the ratio at the MAP point (its model term included)
+    sigma_r = math.hypot(statics.standard_error, model_sd)
     ratio_z = abs(ratio - x_map) / sigma_r if sigma_r > 0.0 else math.inf
     if ratio_z <= config.max_disagreement:
         return ratio_z, ""
     return ratio_z, (
         f"the torque/force ratio ({ratio:.3f} m) is {ratio_z:.1f} standard deviations "
         f"from x_c = {x_map:.3f} m"
+    )
+
+
+def frequency_check(
+    omega1: float, sigma: float, omega_at_map: float, x_map: float, top: float, config: FastConfig
+) -> tuple[float, str]:
+    """Distance of the measured ``omega1`` from the sensing curve's ``omega_at_map`` at the MAP
+    ``x_map`` (m), in its standard deviations ``sigma`` (rad/s, floors included), and the note
+    when it exceeds ``max_disagreement`` (else "").
+
+    The posterior predictive check of the frequency, as :func:`ratio_check` is the ratio's:
+    the posterior's maximum sits where the curve gives the measured omega_1 unless the ratio
+    pulls it onto a point the frequency does not allow, which the prior's edge (the tip) makes
+    possible: omega_1 far below the curve's value at l has no point on the falling branch, yet
+    a ratio near l puts the maximum at l. The frequency then says the contact is not there.
+    Above the curve's maximum ``top`` (rad/s) no point has the frequency, on any branch:
+    :func:`peak_check` speaks for that, not this.
+    """
+    if not (math.isfinite(omega1) and sigma > 0.0) or omega1 >= top:
+        return math.nan, ""
+    z = abs(omega1 - omega_at_map) / sigma
+    if z <= config.max_disagreement:
+        return z, ""
+    return z, (
+        f"omega_1 = {omega1:.2f} rad/s is {z:.1f} standard deviations from the sensing curve's "
+        f"{omega_at_map:.2f} rad/s at x_c = {x_map:.3f} m, where the torque/force ratio puts it"
     )
 
 
@@ -301,7 +329,9 @@ def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]
     final = result.final
     if final is None:
         return [(Status.RECORDING_TOO_SHORT, "too few samples after t_1 for a first window")]
-    if not final.sure and final.ratio_z > config.max_disagreement:
+    if not final.sure and (
+        final.ratio_z > config.max_disagreement or final.frequency_z > config.max_disagreement
+    ):
         found.append(
             (
                 Status.ESTIMATORS_DISAGREE,

@@ -12,10 +12,13 @@ import dataclasses
 import math
 from typing import Any
 
+import numpy as np
+
 from sensing_antenna.estimation.front.evidence import Evidence
-from sensing_antenna.estimation.methods.fast.checks import problems, ratio_check
-from sensing_antenna.estimation.methods.fast.config import FastConfig
-from sensing_antenna.estimation.methods.fast.curves import contact_candidates
+from sensing_antenna.estimation.methods.fast.checks import frequency_check, problems, ratio_check
+from sensing_antenna.estimation.methods.fast.config import FastConfig, model_floor
+from sensing_antenna.estimation.methods.fast.curves import contact_candidates, curve_table
+from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
 from sensing_antenna.estimation.methods.fast.search import ScanResult
 from sensing_antenna.estimation.methods.fast.second_mode import branch_at_cap
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
@@ -59,8 +62,13 @@ def conclude_fast(
         diag.update(second_mode)
         if post is not final.posterior and final.statics is not None:
             # The ratio's agreement is judged again at the chosen branch's maximum
-            ratio_z, _ = ratio_check(final.statics, post.x_c, evidence.antenna.link, config)
-            final = dataclasses.replace(final, posterior=post, ratio_z=ratio_z)
+            model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c)))
+            ratio_z, _ = ratio_check(final.statics, post.x_c, model_sd, config)
+            # and the frequency's
+            frequency_z = _frequency_z(evidence, final.omega1, final.omega1_se, post, config)
+            final = dataclasses.replace(
+                final, posterior=post, ratio_z=ratio_z, frequency_z=frequency_z
+            )
             result = dataclasses.replace(result, final=final)
     statics = final.statics
     push = statics.perpendicular_force if statics is not None else math.nan
@@ -94,6 +102,7 @@ def conclude_fast(
             "omega1_crb": final.omega1_crb,
             "omega1_drift": final.omega1_drift,
             "ratio_z": final.ratio_z,
+            "frequency_z": final.frequency_z,
             "ratio_se": statics.standard_error if statics is not None else math.nan,
             "model_order": final.fit.n_modes if final.fit is not None else 0,
             "fit_through_push": final.fit is not None and final.fit.restart is not None,
@@ -120,3 +129,29 @@ def conclude_fast(
         interval=post.interval,
         branch_probability=tuple(post.branch_probability[b] for b in branch_of),
     )
+
+
+def _frequency_z(
+    evidence: Evidence,
+    omega1: float,
+    omega1_se: float,
+    post: ContactPosterior,
+    config: FastConfig,
+) -> float:
+    """The frequency's distance from the sensing curve at ``post``'s maximum, in its standard
+    deviations (:func:`.checks.frequency_check`), the bent link's term included as the windows
+    have it (:func:`.search.scan_inputs`)."""
+    link = evidence.antenna.link
+    table = curve_table(link, post.branch_edges[0], post.branch_edges[-1], config.grid_step)
+    slope = float(np.interp(post.x_c, table.grid, table.slope))
+    bent = slope * evidence.bent_link_uncertainty(post.x_c)
+    sigma = math.sqrt(omega1_se**2 + (model_floor(link, config) * omega1) ** 2 + bent**2)
+    z, _ = frequency_check(
+        omega1,
+        sigma,
+        float(np.interp(post.x_c, table.grid, table.omega1)),
+        post.x_c,
+        float(table.omega1.max()),
+        config,
+    )
+    return z

@@ -83,11 +83,6 @@ class FastConfig:
         contact. A link whose own frequency uncertainty is larger (``Link.frequency_uncertainty``:
         its calibration's scatter, or the spread of a nominal T when not calibrated) uses that
         instead (:func:`model_floor`).
-    ratio_geometry_factor : float
-        kappa of the ratio's model floor kappa (y_c / x_c) x_c (dimensionless). 0.5: the
-        neglected torque of the axial force on the deflection is (y_c / x_c)(R_x / R_perp) x_c,
-        with R_x / R_perp up to the friction coefficient (0.6), and the shortening of the bent
-        link is of the same order.
     grid_step : float
         Spacing of the x_c grid of the posterior (m). 0.25 mm, a twentieth of the tolerance.
     bias_min_samples : int
@@ -202,7 +197,6 @@ class FastConfig:
     min_mode_fraction: float = 0.6
     polynomial_degree: int = 4
     frequency_floor: float = 0.001
-    ratio_geometry_factor: float = 0.5
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
     bias_guard: float = 0.05
@@ -241,7 +235,6 @@ class FastConfig:
             may_be_zero = (
                 "warm_start_after",
                 "frequency_floor",
-                "ratio_geometry_factor",
                 "bias_guard",
             )
             if value == 0.0 and f.name not in may_be_zero:

@@ -33,12 +33,15 @@ class CurveTable:
         Range limits and the extrema of omega_1 inside (m), ascending: the branch edges.
     higher : array, shape (G, 2)
         Contact modes 2 and 3 at each (rad/s).
+    slope : array, shape (G,)
+        |d omega_1 / d x_c| at each (rad/s per m), by differences on the grid.
     """
 
     grid: FloatArray
     omega1: FloatArray
     edges: tuple[float, ...]
     higher: FloatArray
+    slope: FloatArray
 
 
 @functools.lru_cache(maxsize=16)
@@ -50,9 +53,9 @@ def curve_table(link: Link, low: float, high: float, step: float) -> CurveTable:
     inner = tuple(x for x in curve.extrema if low < x < high)
     # Contact modes 2 and 3 (Eq. 3 with the boundary conditions of Eq. 4), shape (G, 2)
     higher = np.asarray(natural_frequencies(link, grid, 3), dtype=float)[:, 1:]
-    return CurveTable(
-        grid, np.asarray(curve.omega1(grid), dtype=float), (low, *inner, high), higher
-    )
+    omega1 = np.asarray(curve.omega1(grid), dtype=float)
+    slope = np.abs(np.gradient(omega1, grid))
+    return CurveTable(grid, omega1, (low, *inner, high), higher, slope)
 
 
 def contact_candidates(link: Link, omega1: float, posterior: ContactPosterior) -> tuple[float, ...]:

@@ -16,10 +16,10 @@ Model-error floors are added in quadrature to the statistical standard errors:
 
 - frequency: a relative error ``frequency_floor`` of omega_1 (T or T_e known to that relative
   precision; the model frequency is proportional to 1 / T), sigma_w^2 = se^2 + (eps omega_hat)^2;
-- ratio: a bias of the small-deflection statics, proportional to the deflection ratio y_c / x_c
-  = |R_perp| x_c^2 / (3 E I) at each grid point (the torque of the axial force on the deflection,
-  the shortening and rotation of the link, all first order in y_c / x_c), sigma_r^2 = se^2 +
-  (kappa x_c y_c / x_c)^2 with kappa = ``ratio_geometry_factor``.
+- ratio: what the elastica's statics do not hold, the front end's model term at each grid point
+  (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.ratio_model_uncertainty`: the
+  stiffness's uncertainty on the statics' corrections, the bent link's weight, a floor),
+  sigma_r^2 = se^2 + model^2.
 
 Prior: flat on the contact range. The posterior is normalised on the grid; the point estimate is
 its maximum (MAP); the 95 % interval is the highest-density region, reported as [lowest, highest]
@@ -127,10 +127,8 @@ def contact_posterior(
     omega1_se: float,
     ratio: float,
     ratio_se: float,
-    perpendicular_force: float,
-    flexural_rigidity: float,
+    ratio_model: float | FloatArray,
     frequency_floor: float,
-    ratio_geometry_factor: float,
     level: float = 0.95,
     higher_modes_of_x: FloatArray | None = None,
     omega_higher: float = math.nan,
@@ -151,14 +149,10 @@ def contact_posterior(
         Measured fundamental and its statistical standard error (rad/s); NaN: not measured.
     ratio, ratio_se : float
         Torque/force ratio and its statistical standard error (m); NaN: not measured.
-    perpendicular_force : float
-        |R_perp| (N), for the deflection ratio of the geometry floor.
-    flexural_rigidity : float
-        E I (N m^2).
+    ratio_model : float or array, shape (G,)
+        The statics model's standard uncertainty of the ratio at each grid point (m); 0: none.
     frequency_floor : float
         Relative model error of omega_1 (dimensionless).
-    ratio_geometry_factor : float
-        kappa of the ratio floor (dimensionless).
     level : float
         Mass of the highest-density interval.
     higher_modes_of_x : array, shape (G, J), optional
@@ -178,9 +172,7 @@ def contact_posterior(
         sigma_w = math.sqrt(omega1_se**2 + (frequency_floor * omega1) ** 2)
         log_like += -0.5 * ((omega1 - omega1_of_x) / sigma_w) ** 2
     if math.isfinite(ratio) and math.isfinite(ratio_se):
-        # Deflection ratio y_c / x_c = |R_perp| x_c^2 / (3 E I) (cantilever tip load, Eq. 7-13)
-        deflection_ratio = perpendicular_force * grid**2 / (3.0 * flexural_rigidity)
-        sigma_r = np.sqrt(ratio_se**2 + (ratio_geometry_factor * deflection_ratio * grid) ** 2)
+        sigma_r = np.sqrt(ratio_se**2 + np.square(ratio_model)) * np.ones(grid.shape)
         log_like += -0.5 * ((ratio - grid) / sigma_r) ** 2 - np.log(sigma_r)
     if (
         higher_modes_of_x is not None

@@ -14,9 +14,14 @@ from dataclasses import dataclass
 
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.config import FastConfig
+from sensing_antenna.estimation.methods.fast.curves import curve_table
 from sensing_antenna.estimation.methods.fast.evaluation_grid import evaluation_offsets
 from sensing_antenna.estimation.methods.fast.second_mode import BranchChooser
-from sensing_antenna.estimation.methods.fast.static_fit import contact_channels, sensor_bias
+from sensing_antenna.estimation.methods.fast.static_fit import (
+    StaticsModel,
+    contact_channels,
+    sensor_bias,
+)
 from sensing_antenna.estimation.methods.fast.window import (
     ScanInputs,
     WindowEstimate,
@@ -33,7 +38,11 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
 
     The contact-load channels, the sensor bias from the initial rest (``bias_min_samples``,
     ``bias_guard``), t_1 and the last sample, T_s, the omega_1 band, the link, the prior range
-    of x_c (``EstimatorConfig.contact_range``) and, with ``push_phase``, the push from t_c.
+    of x_c (``EstimatorConfig.contact_range``), with ``push_phase`` the push from t_c, and what
+    every window reads from the front end: its filtered axial reaction, the model term of the
+    elastica's statics and the bent link's uncertainty of omega_1 on the posterior's grid
+    (fixed once the hold has built the contact frame, so the same for every window, offline
+    and online).
     """
     link = evidence.antenna.link
     channels = contact_channels(evidence.theta, evidence.force, evidence.torque, evidence.antenna)
@@ -55,6 +64,13 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         if config.push_phase
         else None
     )
+    table = curve_table(link, x_range[0], x_range[1], config.grid_step)
+    statics = StaticsModel(
+        evidence.reaction_f[:, 0],
+        table.grid,
+        evidence.ratio_model_uncertainty(table.grid),
+        table.slope * evidence.bent_link_uncertainties(table.grid),
+    )
     return ScanInputs(
         channels,
         bias,
@@ -66,6 +82,7 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         x_range,
         config,
         push,
+        statics,
     )
 
 

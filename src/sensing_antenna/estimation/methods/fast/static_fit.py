@@ -8,14 +8,17 @@ covariance, and there is no filter lag.
 
 Channels (motor frame, gravity removed sample by sample as in Eq. 21, see :mod:`.ratio`):
 R_y, R_z (the reaction perpendicular to the link) and the three components of Gamma - Gamma_g^m.
-Statics: Gamma - Gamma_g^m = r_c x R with r_c = x_c X^m + d (d the deflection, parallel to R), so
-|Gamma - Gamma_g^m| = x_c |R_perp| and
-
-    x_c = |c_Gamma| / |c_R_perp|
-
-(the variant of Eq. 21 with the perpendicular force; exact for axial friction, see :mod:`.ratio`).
-Its standard error propagates the offsets' covariance through the gradient of this ratio (first
-order delta method; the relative error of |c_R_perp| is small once the push is measurable).
+The statics are those of the paper method's Estimator 2, called, not repeated: the planar
+elastica loaded at the contact
+(:func:`~sensing_antenna.estimation.front.ratio.perpendicular_ratio`,
+:mod:`sensing_antenna.beam.elastica`) inverted from M_0 = Gamma' . v (v = X^m x R_perp /
+|R_perp|), the axial R_x and |R_perp|, with the one stiffness of every statics,
+1 / :attr:`~sensing_antenna.antenna.Link.bending_compliance`. The axial force is not fitted
+(the five channels hold the vibration's information; R_x enters the statics at first order in
+the deflection only): it is the front end's filtered reaction along the link at the window's
+last sample. Without deflection this is x_c = |M_0| / |R_perp| (Eq. 21 with the perpendicular
+force). Its standard error propagates the offsets' covariance through the gradient of that
+inversion, by differences of the same function (first-order delta method).
 
 Sensor bias. An F/T sensor keeps a small offset after taring (the simulator draws two resolution
 counts, 12.5 mN and 6e-5 N m, per run). Against pushes of 20 to 200 mN a force offset of 10 mN
@@ -35,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.estimation.front.ratio import contact_loads
+from sensing_antenna.estimation.front.ratio import contact_loads, perpendicular_ratio
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 
 __all__ = [
@@ -43,6 +46,7 @@ __all__ = [
     "TORQUE_CHANNELS",
     "SensorBias",
     "StaticRatio",
+    "StaticsModel",
     "contact_channels",
     "sensor_bias",
     "static_ratio",
@@ -63,7 +67,8 @@ class StaticRatio:
     Attributes
     ----------
     ratio : float
-        |Gamma - Gamma_g^m| / |R_perp| at the window centre (m); NaN when R_perp is zero.
+        The contact's arc length x_c by the elastica's statics of the loads at the window
+        centre (m); NaN when R_perp is zero.
     standard_error : float
         Its standard error from the offsets' covariance (m).
     reaction_perp : array, shape (2,)
@@ -109,15 +114,24 @@ def contact_channels(
     return np.column_stack([reaction[:, 1:], moment])
 
 
-def static_ratio(fit: DampedSinusoidFit, bias: SensorBias | None = None) -> StaticRatio:
-    """The torque/force ratio of the fitted offsets, with its standard error.
+def static_ratio(
+    fit: DampedSinusoidFit,
+    bias: SensorBias | None,
+    axial: float,
+    flexural_rigidity: float,
+) -> StaticRatio:
+    """The contact's arc length from the fitted offsets, with its standard error.
 
     Parameters
     ----------
     fit : DampedSinusoidFit
         A fit of the five :func:`contact_channels`.
-    bias : SensorBias, optional
+    bias : SensorBias or None
         Subtracted from the offsets, its covariance added.
+    axial : float
+        R_x, the reaction along the link (N).
+    flexural_rigidity : float
+        E I (N m^2): 1 / ``Link.bending_compliance``, the stiffness of every statics.
 
     Returns
     -------
@@ -131,20 +145,79 @@ def static_ratio(fit: DampedSinusoidFit, bias: SensorBias | None = None) -> Stat
     force = c[list(FORCE_CHANNELS)]
     torque = c[list(TORQUE_CHANNELS)]
     f_norm = float(np.linalg.norm(force))
-    g_norm = float(np.linalg.norm(torque))
     reaction = np.array(force, dtype=float)
     force_cov = cov[np.ix_(FORCE_CHANNELS, FORCE_CHANNELS)]
     if f_norm == 0.0:
         return StaticRatio(math.nan, math.nan, reaction, torque, force_cov)
-    # Eq. 21 with the perpendicular force: x_c = |Gamma - Gamma_g| / |R_perp|
-    ratio = g_norm / f_norm
-    gradient = np.zeros(c.size)
-    gradient[list(FORCE_CHANNELS)] = -ratio * force / f_norm**2
-    if g_norm > 0.0:
-        gradient[list(TORQUE_CHANNELS)] = torque / (g_norm * f_norm)
+    # The offsets and, for the delta method, each channel moved by a small step: one call of the
+    # front end's statics on the six rows (a few rows go through its scalar path)
+    steps = _STEP * np.array([f_norm, f_norm, *(3 * [max(float(np.linalg.norm(torque)), 1e-300)])])
+    rows = np.vstack([c, c + np.diag(steps)])
+    loads = np.zeros((rows.shape[0], 3))
+    loads[:, 0] = axial
+    loads[:, 1:] = rows[:, list(FORCE_CHANNELS)]
+    arcs = perpendicular_ratio(loads, rows[:, list(TORQUE_CHANNELS)], flexural_rigidity)
+    ratio = float(arcs[0])
+    gradient = (arcs[1:] - ratio) / steps
     variance = float(gradient @ cov @ gradient)
     se = math.sqrt(variance) if variance >= 0.0 and math.isfinite(variance) else math.nan
     return StaticRatio(ratio, se, reaction, torque, force_cov)
+
+
+#: Relative step of the differences that give the statics' gradient: far below the loads'
+#: statistical errors (1e-3 to 1e-2 relative), far above rounding.
+_STEP = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class StaticsModel:
+    """What the hold's push tells every window of a manoeuvre beside its own fit: the axial
+    reaction the statics read, and what the model leaves out at that push.
+
+    Attributes
+    ----------
+    axial : array, shape (n,)
+        R_x, the reaction along the link (N), at every sample: the front end's filtered contact
+        load (Eq. 20, causal), read at each window's last sample.
+    grid : array, shape (G,), optional
+        Contact points (m) at which ``model_sd`` is given: the posterior's grid.
+    model_sd : array, shape (G,), optional
+        Standard uncertainty (m) of the statics' answer from what the elastica does not hold,
+        at each grid point: the front end's own
+        (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.ratio_model_uncertainty`).
+        None: no model term (the statistical error alone).
+    omega1_sd : array, shape (G,), optional
+        Standard uncertainty (rad/s) of omega_1(x_c) from the push's deflection at each grid
+        point: the sensing curves are the straight link's, and the bent link's preload shifts
+        its frequencies; the front end's uncertainty of a contact point read from the vibration
+        (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`),
+        times the curve's slope there. As for the paper method's candidate, it enters the
+        frequency's consistency with the answer (:func:`.checks.frequency_check`), not the
+        posterior: an upper bound of a shift measured at one point. None: none.
+    """
+
+    axial: FloatArray | None = None
+    grid: FloatArray | None = None
+    model_sd: FloatArray | None = None
+    omega1_sd: FloatArray | None = None
+
+    def axial_at(self, index: int) -> float:
+        """R_x (N) at sample ``index``; 0 without it."""
+        if self.axial is None or not 0 <= index < self.axial.shape[0]:
+            return 0.0
+        return float(self.axial[index])
+
+    def sd_at(self, x_c: float) -> float:
+        """``model_sd`` at ``x_c`` (m), linearly between grid points; 0 without a model term."""
+        if self.grid is None or self.model_sd is None:
+            return 0.0
+        return float(np.interp(x_c, self.grid, self.model_sd))
+
+    def omega1_sd_at(self, x_c: float) -> float:
+        """``omega1_sd`` at ``x_c`` (m), linearly between grid points; 0 without it."""
+        if self.grid is None or self.omega1_sd is None:
+            return 0.0
+        return float(np.interp(x_c, self.grid, self.omega1_sd))
 
 
 @dataclass(frozen=True)

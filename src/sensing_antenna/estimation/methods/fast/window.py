@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Link
 from sensing_antenna.estimation.methods.fast.checks import (
     branch_contradiction,
+    frequency_check,
     is_slip_reference,
     opening_check,
     peak_check,
@@ -38,6 +39,7 @@ from sensing_antenna.estimation.methods.fast.second_mode import BranchChooser, o
 from sensing_antenna.estimation.methods.fast.static_fit import (
     SensorBias,
     StaticRatio,
+    StaticsModel,
     static_ratio,
 )
 from sensing_antenna.estimation.methods.fast.window_fit import (
@@ -76,6 +78,7 @@ class ScanInputs(NamedTuple):
     x_range: tuple[float, float]
     config: FastConfig
     push: PushPhase | None = None
+    statics_model: StaticsModel | None = None
 
 
 @dataclass(frozen=True)
@@ -119,6 +122,9 @@ class WindowEstimate:
         when not added (:func:`evaluate_window` leaves them to :func:`with_early_statics_of`).
     ratio_z : float
         Distance of the ratio from the MAP x_c in its standard deviations.
+    frequency_z : float
+        Distance of omega_1 from the sensing curve at the MAP x_c in its standard deviations
+        (NaN when omega_1 is not usable or above the curve's maximum).
     opening : float
         Predicted vibration amplitude of the contact force over the static push at the window
         start (> 1: the contact opens); NaN when not computed.
@@ -145,6 +151,7 @@ class WindowEstimate:
     omega1_drift: float = math.nan
     early_statics: StaticRatio | None = None
     ratio_z: float = math.nan
+    frequency_z: float = math.nan
     opening: float = math.nan
     branch_contradicted: bool = False
     branch_chosen_by_second_mode: bool = False
@@ -162,6 +169,7 @@ def evaluate_window(
     x_range: tuple[float, float],
     config: FastConfig,
     push: PushPhase | None = None,
+    statics_model: StaticsModel | None = None,
     cache: FitCache | None = None,
     choose_branch: BranchChooser | None = None,
 ) -> WindowEstimate:
@@ -189,6 +197,9 @@ def evaluate_window(
     push : PushPhase, optional
         With it, every window fitted here reaches back to the push's start
         (``FastConfig.push_phase``); None: windows start at ``rest_index``.
+    statics_model : StaticsModel, optional
+        The front end's filtered axial reaction, the statics' model term on the posterior's grid
+        (:func:`.search.scan_inputs`); None: neither (no axial force, no model term).
     cache : dict, optional
         Window fits keyed by the windows' own samples (:data:`FitCache`); the drift check's
         shorter windows are taken from it (and added to it). The scan and an online session
@@ -216,7 +227,13 @@ def evaluate_window(
     # The statics from the window from t_1 always: a fit through the push has its static part
     # at the centre of [t_c, t], inside the push for short windows, while the opening check
     # compares it with the vibration at t_1
-    statics = static_ratio(from_t1.fit, bias) if from_t1.fit is not None else None
+    statics_model = statics_model if statics_model is not None else StaticsModel()
+    rigidity = 1.0 / link.bending_compliance
+    statics = (
+        static_ratio(from_t1.fit, bias, statics_model.axial_at(end_index), rigidity)
+        if from_t1.fit is not None
+        else None
+    )
     table = curve_table(link, x_range[0], x_range[1], config.grid_step)
     frequency_floor = model_floor(link, config)
     omega_h = omega_h_se = math.nan
@@ -225,6 +242,7 @@ def evaluate_window(
     ratio = statics.ratio if statics is not None else math.nan
     ratio_se = statics.standard_error if statics is not None else math.nan
     push_force = statics.perpendicular_force if statics is not None else 0.0
+    model_sd = statics_model.model_sd
     posterior = contact_posterior(
         table.omega1,
         table.grid,
@@ -233,10 +251,8 @@ def evaluate_window(
         omega1_se,
         ratio,
         ratio_se,
-        push_force,
-        link.flexural_rigidity,
+        model_sd if model_sd is not None and model_sd.shape == table.grid.shape else 0.0,
         frequency_floor,
-        config.ratio_geometry_factor,
         higher_modes_of_x=table.higher,
         omega_higher=omega_h,
         omega_higher_se=omega_h_se,
@@ -257,9 +273,23 @@ def evaluate_window(
             posterior = conditioned or posterior
     ratio_z = math.nan
     if statics is not None and math.isfinite(omega1):
-        ratio_z, disagreement = ratio_check(statics, posterior.x_c, link, config)
+        ratio_z, disagreement = ratio_check(
+            statics, posterior.x_c, statics_model.sd_at(posterior.x_c), config
+        )
         if disagreement:
             notes.append(disagreement)
+    frequency_z = math.nan
+    if math.isfinite(omega1):
+        frequency_z, note = frequency_check(
+            omega1,
+            _omega1_sigma(omega1, omega1_se, frequency_floor, statics_model, posterior.x_c),
+            float(np.interp(posterior.x_c, table.grid, table.omega1)),
+            posterior.x_c,
+            float(table.omega1.max()),
+            config,
+        )
+        if note:
+            notes.append(note)
     opening = math.nan
     if fit is not None and k is not None and push_force > 0.0:
         opening, note = opening_check(fit, k, push_force, link, posterior.x_c, config)
@@ -297,10 +327,26 @@ def evaluate_window(
         omega1_drift=drift,
         early_statics=None,
         ratio_z=ratio_z,
+        frequency_z=frequency_z,
         opening=opening,
         branch_contradicted=bool(contradiction),
         branch_chosen_by_second_mode=chosen,
         second_mode=second_mode,
+    )
+
+
+def _omega1_sigma(
+    omega1: float,
+    omega1_se: float,
+    frequency_floor: float,
+    statics_model: StaticsModel,
+    x_c: float,
+) -> float:
+    """The standard deviation of omega_1 (rad/s) its check against the sensing curve at ``x_c``
+    (m) allows: the fit's error and the relative ``frequency_floor`` as in the posterior, and
+    the bent link's term, in quadrature."""
+    return math.sqrt(
+        omega1_se**2 + (frequency_floor * omega1) ** 2 + statics_model.omega1_sd_at(x_c) ** 2
     )
 
 
@@ -330,7 +376,9 @@ def _higher_mode(
     return float(fit.omega[k]), float(fit.omega_se[k])
 
 
-def _early_statics(span: WindowSpan, omega1: float, bias: SensorBias) -> StaticRatio | None:
+def _early_statics(
+    span: WindowSpan, omega1: float, bias: SensorBias, model: StaticsModel, link: Link
+) -> StaticRatio | None:
     """Statics of the window's first half from t_1, the slip check's reference; None when that
     half is not on the grid or is no reference (:func:`.checks.is_slip_reference`: too few
     periods of ``omega1`` (rad/s), or another mode in the fundamental's place)."""
@@ -339,7 +387,8 @@ def _early_statics(span: WindowSpan, omega1: float, bias: SensorBias) -> StaticR
     half_fit = None if half is None else fit_window(*span._replace(end_index=half))
     if half_fit is None or not is_slip_reference(half_fit, omega1, span.band, config):
         return None
-    return static_ratio(half_fit, bias)
+    assert half is not None
+    return static_ratio(half_fit, bias, model.axial_at(half), 1.0 / link.bending_compliance)
 
 
 def evaluate_from_t1_or_hold(
@@ -395,5 +444,15 @@ def with_early_statics_of(
         cache,
     )
     from_t1 = measure_fundamental(span, None)
-    early = None if from_t1.mode is None else _early_statics(span, from_t1.omega1, inputs.bias)
+    early = (
+        None
+        if from_t1.mode is None
+        else _early_statics(
+            span,
+            from_t1.omega1,
+            inputs.bias,
+            inputs.statics_model if inputs.statics_model is not None else StaticsModel(),
+            inputs.link,
+        )
+    )
     return dataclasses.replace(estimate, early_statics=early)
