@@ -217,6 +217,28 @@ def test_a_command_of_the_wrong_sign_is_named() -> None:
         identify_motors(wrong, PAPER)
 
 
+def test_commands_in_millivolts_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """u1, u2 in mV fit a J a thousand times the motor's (Eq. 1 is linear in u): far beyond the
+    factor 5 around the antenna file's motor J plus the rigid link's inertia (Table 1: 6.2e-3
+    kg m^2, the link's m_b l^2 / 3 + m_t l^2 about 1.5e-3), while a head whose motor J is 30 %
+    off the file's (TRUE, tested above) is fitted."""
+    recording = simulate(PAPER, Scenario(case="free"), record_commands=True)
+    millivolts = dict(recording.extra)
+    for name in COMMAND_COLUMNS:
+        millivolts[name] = 1e3 * millivolts[name]
+    path = tmp_path / "mv.csv"
+    write_recording(dataclasses.replace(recording, extra=millivolts), path)
+    out = tmp_path / "mv.toml"
+    assert main(["identify", str(path), "--out", str(out), "--servo"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert "mv.csv: column 'u1'" in err
+    assert "in V (not mV)" in err
+    assert not out.exists()
+
+
 def test_simulator_writes_commands_only_when_asked() -> None:
     scenario = Scenario(case="azimuthal", contact_point=0.6)
     plain = simulate(PAPER, scenario)
