@@ -170,7 +170,8 @@ def test_cli_writes_the_fitted_motors_and_prints_their_gains(
     path = tmp_path / "free.csv"
     write_recording(simulate(TRUE, Scenario(case="free"), record_commands=True), path)
     out = tmp_path / "lab.toml"
-    assert main(["identify", str(path), "--out", str(out), "--servo", "--servo-pole", "-40"]) == 0
+    # the form the help gives for a pole in exponent form
+    assert main(["identify", str(path), "--out", str(out), "--servo", "--servo-pole=-4e1"]) == 0
     text = capsys.readouterr().out
     written = load_antenna(out)
     fit = identify_motors(read_recording(path), PAPER)
@@ -191,6 +192,22 @@ def test_servo_pole_needs_servo(tmp_path: Path, capsys: pytest.CaptureFixture[st
         main(["identify", str(path), "--out", str(tmp_path / "x.toml"), "--servo-pole", "-40"]) == 2
     )
     assert "--servo-pole" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("pole", ["5", "0", "-0", "nan", "-inf"])
+def test_servo_pole_has_one_bound_and_one_message(
+    pole: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Eq. 14's closed loop is stable for p < 0 only: every other value gets the same line."""
+    out = tmp_path / "x.toml"
+    argv = ["identify", "free.csv", "--out", str(out), "--servo", f"--servo-pole={pole}"]
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("antenna identify: error: --servo-pole: must be a finite number < 0 ")
+    assert "rad/s (a stable pole), got " in err[-1]
+    assert not out.exists()
 
 
 def test_a_still_recording_fits_no_joint() -> None:
