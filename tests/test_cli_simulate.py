@@ -22,7 +22,7 @@ def test_simulate_writes_a_readable_recording(
             "--xc",
             "0.55",
             "--duration",
-            "1.5",
+            "2.5",
             "--seed",
             "3",
             "--out",
@@ -36,7 +36,7 @@ def test_simulate_writes_a_readable_recording(
     assert captured.err == ""
     rec = read_recording(out)
     assert 0.0 < float(rec.metadata["true_deflection_ratio"]) < 0.1
-    assert rec.n_samples == 1500
+    assert rec.n_samples == 2500
     assert rec.metadata["seed"] == "3"
     assert "theta1_ref" in rec.extra
 
@@ -65,13 +65,45 @@ def test_simulate_warns_when_the_push_exceeds_the_small_deflection_limit(
         encoding="utf-8",
     )
     out = tmp_path / "rec.csv"
-    args = ["simulate", "--case", "azimuthal", "--xc", "0.98", "--duration", "2"]
+    args = ["simulate", "--case", "azimuthal", "--xc", "0.98", "--duration", "2.5"]
     assert main([*args, "--antenna", str(antenna), "--out", str(out)]) == 0
     captured = capsys.readouterr()
     assert float(read_recording(out).metadata["true_deflection_ratio"]) > 0.1
     err = captured.err.strip()
     assert err.startswith("warning:") and err.count("\n") == 0
     assert "Assumption 1" in err and "antenna identify" in err
+
+
+def test_simulate_warns_when_the_stop_leaves_no_spectrum_window(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The estimators need EstimatorConfig.spectrum_window (1 s) after t_1: a stop at about 1 s
+    (the default push at x_c = 0.5 m) in 1.5 s of recording leaves half of it; the duration
+    suggested gives antenna estimate its window."""
+    short, long = tmp_path / "short.csv", tmp_path / "long.csv"
+    common = ["simulate", "--case", "azimuthal", "--xc", "0.5"]
+    assert main([*common, "--duration", "1.5", "--out", str(short)]) == 0
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("warning: the motors stop at ") and err.count("\n") == 0
+    assert "spectrum window" in err
+    suggested = err.rsplit("--duration ", 1)[1].split()[0]
+    assert main(["estimate", str(short)]) != 0 or "recording_too_short" in capsys.readouterr().out
+    capsys.readouterr()
+    assert main([*common, "--duration", suggested, "--out", str(long)]) == 0
+    assert capsys.readouterr().err == ""
+    main(["estimate", str(long)])
+    assert "recording_too_short" not in capsys.readouterr().out
+
+
+def test_simulate_says_when_the_push_is_not_reached(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "far.csv"
+    argv = ["simulate", "--case", "azimuthal", "--xc", "0.5", "--push", "3", "--duration", "1.5"]
+    assert main([*argv, "--out", str(out)]) == 0
+    line = capsys.readouterr().out
+    assert "the push was not reached within --duration 1.5 s" in line
+    assert "nan" not in line
 
 
 def test_plot_recording_writes_pngs(tmp_path: Path) -> None:

@@ -170,7 +170,8 @@ def test_cli_writes_the_fitted_motors_and_prints_their_gains(
     path = tmp_path / "free.csv"
     write_recording(simulate(TRUE, Scenario(case="free"), record_commands=True), path)
     out = tmp_path / "lab.toml"
-    assert main(["identify", str(path), "--out", str(out), "--servo", "--servo-pole", "-40"]) == 0
+    # the form the help gives for a pole in exponent form
+    assert main(["identify", str(path), "--out", str(out), "--servo", "--servo-pole=-4e1"]) == 0
     text = capsys.readouterr().out
     written = load_antenna(out)
     fit = identify_motors(read_recording(path), PAPER)
@@ -191,6 +192,22 @@ def test_servo_pole_needs_servo(tmp_path: Path, capsys: pytest.CaptureFixture[st
         main(["identify", str(path), "--out", str(tmp_path / "x.toml"), "--servo-pole", "-40"]) == 2
     )
     assert "--servo-pole" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("pole", ["5", "0", "-0", "nan", "-inf"])
+def test_servo_pole_has_one_bound_and_one_message(
+    pole: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Eq. 14's closed loop is stable for p < 0 only: every other value gets the same line."""
+    out = tmp_path / "x.toml"
+    argv = ["identify", "free.csv", "--out", str(out), "--servo", f"--servo-pole={pole}"]
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("antenna identify: error: --servo-pole: must be a finite number < 0 ")
+    assert "rad/s (a stable pole), got " in err[-1]
+    assert not out.exists()
 
 
 def test_a_still_recording_fits_no_joint() -> None:
@@ -215,6 +232,28 @@ def test_a_command_of_the_wrong_sign_is_named() -> None:
     wrong = dataclasses.replace(recording, extra=flipped, source="flipped.csv")
     with pytest.raises(IdentificationError, match="not a positive inertia: does column 'u1'"):
         identify_motors(wrong, PAPER)
+
+
+def test_commands_in_millivolts_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """u1, u2 in mV fit a J a thousand times the motor's (Eq. 1 is linear in u): far beyond the
+    factor 5 around the antenna file's motor J plus the rigid link's inertia (Table 1: 6.2e-3
+    kg m^2, the link's m_b l^2 / 3 + m_t l^2 about 1.5e-3), while a head whose motor J is 30 %
+    off the file's (TRUE, tested above) is fitted."""
+    recording = simulate(PAPER, Scenario(case="free"), record_commands=True)
+    millivolts = dict(recording.extra)
+    for name in COMMAND_COLUMNS:
+        millivolts[name] = 1e3 * millivolts[name]
+    path = tmp_path / "mv.csv"
+    write_recording(dataclasses.replace(recording, extra=millivolts), path)
+    out = tmp_path / "mv.toml"
+    assert main(["identify", str(path), "--out", str(out), "--servo"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert "mv.csv: column 'u1'" in err
+    assert "in V (not mV)" in err
+    assert not out.exists()
 
 
 def test_simulator_writes_commands_only_when_asked() -> None:

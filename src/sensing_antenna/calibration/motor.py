@@ -23,7 +23,9 @@ friction is static, which the regularised model does not describe. Least squares
 (J, v, Gamma_nlc) per joint, with standard errors from the residual
 (allowing for the filter's correlation of neighbouring residuals). A joint is fitted when it
 moved by more than ``MIN_MOTION`` and the fit determines J to ``MAX_RELATIVE_ERROR``; the
-others keep the antenna file's motor and are listed with the reason.
+others keep the antenna file's motor and are listed with the reason. A fitted J more than
+``MAX_INERTIA_FACTOR`` from the antenna file's motor J plus the rigid link's inertia refuses the
+recording: its commands are not in V (mV give a thousand times the J).
 
 The servo's gains then follow from the fitted J and v by the pole placement of Section 4.1
 (:func:`~sensing_antenna.control.servo.design_servo`).
@@ -39,7 +41,13 @@ from numpy.typing import NDArray
 from scipy import signal
 
 from sensing_antenna.antenna import Antenna, Motor
-from sensing_antenna.calibration.observer import MIN_MOTION, IdentificationError, units_problem
+from sensing_antenna.calibration.observer import (
+    MAX_INERTIA_FACTOR,
+    MIN_MOTION,
+    IdentificationError,
+    initial_guess,
+    units_problem,
+)
 from sensing_antenna.control.servo import (
     DEFAULT_SERVO_POLE,
     FRICTION_SPEED,
@@ -242,6 +250,24 @@ def _fit_joint(
     return fit, ""
 
 
+def _check_inertia(inertia: float, expected: float, joint: int, where: str) -> None:
+    """IdentificationError unless the fitted J (kg m^2) of ``joint`` lies within
+    ``MAX_INERTIA_FACTOR`` of ``expected``, the motor's J plus the rigid link's inertia (kg m^2).
+
+    The coupling torque is measured, so the fit's J is the motor's alone; the link's inertia
+    widens the band for a head whose sensor misses part of it. Commands in mV give a thousand
+    times the J, a datasheet J off by a few tens of percent stays far inside the band (the same
+    factor as the observer's inertia check)."""
+    if 1.0 / MAX_INERTIA_FACTOR <= inertia / expected <= MAX_INERTIA_FACTOR:
+        return
+    raise IdentificationError(
+        f"{where}: column 'u{joint}': the fit gives J = {inertia:.3g} kg m^2, "
+        f"{inertia / expected:.3g} times the antenna file's motor J plus the rigid link's inertia "
+        f"({expected:.3g} kg m^2, more than a factor {MAX_INERTIA_FACTOR:g}): is 'u{joint}' in V "
+        "(not mV), and its motor's gear_ratio and torque_constant the head's?"
+    )
+
+
 def identify_motors(
     recording: Recording,
     antenna: Antenna,
@@ -268,7 +294,8 @@ def identify_motors(
     Raises
     ------
     IdentificationError
-        When the recording lacks the command columns, is not in the format's units, or no joint
+        When the recording lacks the command columns, is not in the format's units, a fitted J
+        is more than ``MAX_INERTIA_FACTOR`` from the motor's plus the rigid link's, or no joint
         could be fitted (none moved by more than ``MIN_MOTION``, or the motion did not determine
         J); the message names the file and the columns.
     """
@@ -292,6 +319,8 @@ def identify_motors(
     if problem is not None:
         raise IdentificationError(f"{where}: {problem}")
     coupling = coupling_torques(uniform.theta, uniform.torque)
+    gain, omega, _ = initial_guess(antenna)
+    link_inertia = gain / omega**2
     fits: list[JointFit] = []
     skipped: list[tuple[int, str]] = []
     for j, motor in enumerate(antenna.motors):
@@ -314,6 +343,7 @@ def identify_motors(
         if fit is None:
             skipped.append((j + 1, reason))
         else:
+            _check_inertia(fit.inertia, motor.inertia + link_inertia, j + 1, where)
             fits.append(fit)
     if not fits:
         reasons = "; ".join(f"joint {j}: {reason}" for j, reason in skipped)

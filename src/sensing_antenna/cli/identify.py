@@ -9,6 +9,20 @@ from pathlib import Path
 from typing import Any
 
 from sensing_antenna.cli.arguments import antenna_name, number, printable
+from sensing_antenna.errors import format_value
+
+_POLE_REQUIREMENT = "must be a finite number < 0 rad/s (a stable pole)"
+
+
+def _servo_pole(text: str) -> float:
+    """An argparse ``type``: a finite float below 0 (rad/s), the closed-loop pole of Eq. 14."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{_POLE_REQUIREMENT}, got {text!r}") from None
+    if not (math.isfinite(value) and value < 0):
+        raise argparse.ArgumentTypeError(f"{_POLE_REQUIREMENT}, got {format_value(value)}")
+    return value
 
 
 def register(subparsers: Any) -> None:
@@ -49,9 +63,12 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--servo-pole",
-        type=number(high=0.0, unit="rad/s", what="negative number"),
+        type=_servo_pole,
         default=None,
-        help="closed-loop pole p of the gains printed with --servo (rad/s, < 0; default -60)",
+        metavar="P",
+        help="closed-loop pole p of the gains printed with --servo (rad/s, < 0; default -60); "
+        "a value in exponent form goes after '=', --servo-pole=-6e1 (argparse reads a separate "
+        "'-6e1' as an option)",
     )
     parser.set_defaults(func=_run)
 
@@ -70,8 +87,6 @@ def _run(args: argparse.Namespace) -> int:
     if args.servo_pole is not None and not args.servo:
         raise ControlConfigError("--servo-pole: the gains are designed with --servo only")
     pole = DEFAULT_SERVO_POLE if args.servo_pole is None else args.servo_pole
-    if not pole < 0:
-        raise ControlConfigError(f"--servo-pole: must be < 0 rad/s (stable), got {pole!r}")
     antenna = load_antenna(args.antenna)
     recording = read_recording(args.recording)
     motor_fit = identify_motors(recording, antenna) if args.servo else None

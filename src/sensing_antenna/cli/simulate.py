@@ -55,7 +55,13 @@ def register(subparsers: Any) -> None:
         default=0,
         help="seed of every random quantity, such as the sensor noise",
     )
-    parser.add_argument("--duration", type=float, default=3.0, help="total time (s)")
+    parser.add_argument(
+        "--duration",
+        type=float,
+        default=3.0,
+        help="total time (s); a deeper --push stops later, and the estimators need 1 s "
+        "(EstimatorConfig.spectrum_window) after the stop: the command warns when it is short",
+    )
     parser.add_argument("--noise", type=float, default=1.0, help="sensor noise scale (0: none)")
     parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument(
@@ -121,6 +127,9 @@ def _run(args: argparse.Namespace) -> int:
     recording = simulate(antenna, scenario, record_commands=args.commands)
     write_recording(recording, args.out)
     print(summary(str(args.out), scenario, recording.n_samples, recording.metadata))
+    short = window_warning(scenario, recording.metadata)
+    if short is not None:
+        print(short, file=sys.stderr)
     warning = None if args.link == "nonlinear" else deflection_warning(recording)
     if warning is not None and args.push is not None:
         # the deep push was asked for: what is wrong is the linear link, not the detection
@@ -198,9 +207,48 @@ def summary(out: str, scenario: Any, n_samples: int, meta: Any) -> str:
             f"{text}, no contact: the link did not reach the obstacle (--xc {x_c:g} m) within "
             f"the {scenario.duration:g} s simulated; a longer --duration lets it"
         )
+    stop = float(meta.get("true_t_stop", "nan"))
+    if math.isfinite(stop):
+        when = f"stop {stop:.4g} s"
+    else:
+        when = (
+            f"the push was not reached within --duration {scenario.duration:g} s (the motors "
+            "never stopped; a longer --duration or a shallower --push lets them)"
+        )
     return (
         f"{text}, the link touched at x_c = {touched:.4f} m (--xc {x_c:g} m is where the "
         f"undeflected link meets the obstacle; it bends as it pushes), first touch "
-        f"{float(meta['true_t_contact']):.4g} s, stop {float(meta['true_t_stop']):.4g} s, "
+        f"{float(meta['true_t_contact']):.4g} s, {when}, "
         f"y_c / x_c = {100 * float(meta['true_deflection_ratio']):.1f} %"
+    )
+
+
+#: Time constants of the servo (-1 / servo_pole) after the stop within which the head is at rest
+#: (e^-5 < 1 %): t_1, where the estimators' spectrum window starts, follows the stop by that much
+#: at most.
+SETTLING_TIME_CONSTANTS = 5.0
+
+
+def window_warning(scenario: Any, meta: Any) -> str | None:
+    """One line when the recording ends less than the estimators' spectrum window
+    (``EstimatorConfig.spectrum_window``) after the head comes to rest, or None.
+
+    The head comes to rest ``SETTLING_TIME_CONSTANTS`` servo time constants after the stop
+    (``true_t_stop`` of the metadata ``meta``, s); the line suggests the ``--duration`` (rounded
+    up to 0.1 s) that leaves the whole window. No line without a stop (the summary says so).
+    """
+    from sensing_antenna.estimation import EstimatorConfig
+
+    stop = float(meta.get("true_t_stop", "nan"))
+    if not math.isfinite(stop):
+        return None
+    window = EstimatorConfig().spectrum_window
+    needed = stop + SETTLING_TIME_CONSTANTS / -scenario.servo_pole + window
+    if scenario.duration >= needed:
+        return None
+    return (
+        f"warning: the motors stop at {stop:.4g} s, less than the estimators' {window:g} s "
+        f"spectrum window (EstimatorConfig.spectrum_window) before the end of --duration "
+        f"{scenario.duration:g} s: antenna estimate will report recording_too_short; "
+        f"--duration {math.ceil(10 * needed) / 10:g} leaves the whole window"
     )
