@@ -8,6 +8,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.map import add_map_options
+
 #: ``exploration.plan.STRATEGIES`` and ``scene.file.BUILTIN_SCENES``, written out: importing
 #: them would load trimesh and scikit-learn for every command's start.
 STRATEGIES = ("grid", "next-best")
@@ -50,19 +52,7 @@ def register(subparsers: Any) -> None:
         "--antenna", default="paper-2021", help="the simulated device: built-in name or TOML file"
     )
     parser.add_argument("--seed", type=_seed, default=0, help="seed of the first manoeuvre")
-    parser.add_argument(
-        "--objects",
-        nargs="+",
-        type=Path,
-        default=(),
-        metavar="MESH",
-        help="meshes (STL, OBJ, PLY; m) to register to the points beside the shape classes",
-    )
-    parser.add_argument(
-        "--include-uncertain",
-        action="store_true",
-        help="let points with status uncertain into the map and the planner's surface",
-    )
+    add_map_options(parser, "the map and the planner's surface")
     parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre")
     parser.set_defaults(func=_run)
 

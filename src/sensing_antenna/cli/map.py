@@ -31,6 +31,18 @@ def register(subparsers: Any) -> None:
         "--method", choices=METHOD_NAMES, default="paper", help="the estimation method"
     )
     parser.add_argument("--out", type=Path, required=True, help="output directory")
+    add_map_options(parser, "the map (ok only without it)")
+    parser.add_argument(
+        "--t1",
+        choices=("rest", "push"),
+        default="rest",
+        help="t_1 from the head coming to rest or from the push criterion (as antenna estimate)",
+    )
+    parser.set_defaults(func=_run)
+
+
+def add_map_options(parser: Any, uncertain_into: str) -> None:
+    """``--objects`` and ``--include-uncertain``, shared with ``antenna explore``."""
     parser.add_argument(
         "--objects",
         nargs="+",
@@ -42,15 +54,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--include-uncertain",
         action="store_true",
-        help="let points with status uncertain into the map (ok only without it)",
+        help=f"let points with status uncertain into {uncertain_into}",
     )
-    parser.add_argument(
-        "--t1",
-        choices=("rest", "push"),
-        default="rest",
-        help="t_1 from the head coming to rest or from the push criterion (as antenna estimate)",
-    )
-    parser.set_defaults(func=_run)
 
 
 def _run(args: argparse.Namespace) -> int:
