@@ -557,7 +557,9 @@ def test_a_second_device_with_its_own_imperfections_draws_them(tmp_path: Path) -
     assert all("device" not in r.scenario for r in runs[:4])
     drawn = [r.scenario["device"] for r in runs[4:]]
     assert all(d.tip_mass == 2e-5 for d in drawn)
-    assert len({d.clamp_stiffness for d in drawn}) == 4  # one draw per manoeuvre, by its seed
+    # one device built, its set-up drawn per manoeuvre by its seed
+    assert len({d.clamp_stiffness for d in drawn}) == 1
+    assert len({d.encoder_offset for d in drawn}) == 4
 
 
 def test_the_second_device_is_in_the_fingerprint_only_when_present(tmp_path: Path) -> None:

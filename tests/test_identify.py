@@ -39,7 +39,9 @@ def _moves(t: np.ndarray, times: list[float], targets: list[float], duration: fl
     return out
 
 
-def _free_motion(seed: int, joints: tuple[bool, bool] = (True, True)) -> Recording:
+def _free_motion(
+    seed: int, joints: tuple[bool, bool] = (True, True), noise: float = NOISE
+) -> Recording:
     """Free-motion recording from the continuous Eq. 15 (scipy.signal.lsim at TS / 10, independent
     of the discrete observer under test) with the torque signs of contact.py, plus noise."""
     n = 6000
@@ -62,7 +64,7 @@ def _free_motion(seed: int, joints: tuple[bool, bool] = (True, True)) -> Recordi
             gamma2[::10] + 0.5 * weight * ANTENNA.link.length * np.cos(theta[:, 1]),
             -gamma1[::10],
         ]
-    ) + rng.normal(scale=NOISE, size=(n, 3))
+    ) + rng.normal(scale=noise, size=(n, 3))
     force = np.column_stack(
         [-weight * np.sin(theta[:, 1]), np.zeros(n), -weight * np.cos(theta[:, 1])]
     )
@@ -273,3 +275,52 @@ def test_an_angle_at_the_float_limit_is_named_before_the_rest_is_judged(
         identify_free_motion(glitched, ANTENNA)
     with pytest.raises(CalibrationError, match=f"column '{name}'"):
         calibrate_from_recordings([glitched, glitched], ANTENNA, [0.4, 0.6])
+
+
+def _with_payload(recording: Recording, mass: float) -> Recording:
+    """The recording with ``mass`` (kg) more at the tip: its weight's moment added to ty."""
+    moment = mass * STANDARD_GRAVITY * ANTENNA.link.length * np.cos(recording.theta[:, 1])
+    torque = recording.torque.copy()
+    torque[:, 1] += moment
+    return dataclasses.replace(recording, torque=torque)
+
+
+def test_payload_is_read_from_the_moment_at_rest() -> None:
+    # 0.2 g at the tip adds m g l cos(theta2) = 1.9e-3 N m to ty at rest, against a noise of
+    # 1e-4 N m per sample: the standard deviation (the rest's mean and a tare's offset of two
+    # noise deviations) is 0.02 g, the reading within four of it
+    noise = 1e-4
+    fit = identify_free_motion(_with_payload(_free_motion(3, noise=noise), 2e-4), ANTENNA)
+    assert fit.payload is not None and fit.payload.samples > 100
+    assert fit.payload.std == pytest.approx(2 * noise / (STANDARD_GRAVITY * 0.98), rel=0.1)
+    assert fit.payload.significant
+    assert abs(fit.payload.mass - 2e-4) < 4 * fit.payload.std
+    assert fit.payload.apply(ANTENNA).link.tip_mass == pytest.approx(fit.payload.mass)
+    plain = identify_free_motion(_free_motion(3, noise=noise), ANTENNA).payload
+    assert plain is not None and not plain.significant
+
+
+def test_payload_of_a_simulated_tip_mass(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The simulator's finite-element link with 0.1 g glued at its tip, which the antenna file
+    # does not carry: the rest reads it
+    from sensing_antenna.simulator import DeviceImperfections
+
+    scenario = Scenario(
+        case="free", duration=3.0, seed=2, device=DeviceImperfections(tip_mass=1e-4)
+    )
+    rec_path = tmp_path / "free.csv"
+    write_recording(simulate(ANTENNA, scenario).without_ground_truth(), rec_path)
+    out = tmp_path / "fitted.toml"
+    assert main(["identify", str(rec_path), "--out", str(out)]) == 0
+    assert "payload: the moment at rest reads +0.1" in capsys.readouterr().out
+    # within 0.02 g: the tare's offset (two counts of the simulated sensor, 3 micrograms at the
+    # tip each) three times over, and the sagged link's lever
+    assert load_antenna(out).link.tip_mass == pytest.approx(1e-4, abs=2e-5)
+
+
+def test_a_lighter_reading_never_gives_a_negative_tip_mass() -> None:
+    fit = identify_free_motion(_with_payload(_free_motion(4, noise=1e-4), -2e-4), ANTENNA)
+    assert fit.payload is not None and fit.payload.significant and fit.payload.mass < 0
+    assert fit.payload.apply(ANTENNA).link.tip_mass == 0.0

@@ -314,8 +314,8 @@ def test_realistic_profile_is_reproducible_and_differs_between_seeds() -> None:
         assert not device.is_nominal
 
 
-def test_campaign_realistic_profile_gives_each_run_its_own_device() -> None:
-    spec = parse_campaign_spec(
+def _realistic_spec(device: dict[str, object]) -> object:
+    return parse_campaign_spec(
         {
             "name": "t",
             "antenna": "paper-2021",
@@ -323,15 +323,38 @@ def test_campaign_realistic_profile_gives_each_run_its_own_device() -> None:
             "contact_points": [0.5],
             "repeats": 3,
             "base_seed": 1,
-            "device": {"profile": "realistic", "imperfections": {"tip_mass": 1e-4}},
+            "device": device,
         },
         "test",
     )
+
+
+def test_campaign_realistic_profile_is_one_device_whose_set_up_differs_per_run() -> None:
+    spec = _realistic_spec({"profile": "realistic", "imperfections": {"tip_mass": 1e-4}})
     runs = expand_runs(spec, spec.load_antenna())
     devices = [run.scenario["device"] for run in runs]
-    assert len({d.clamp_stiffness for d in devices}) == 3
+    # built once: the link, the clamp and the sensor's calibration are the same in every run
+    assert len({(d.clamp_stiffness, d.joint_start, d.sensor_coupling) for d in devices}) == 1
+    # set up anew: the encoders' zero and the sensor's drift differ between runs
+    assert len({d.encoder_offset for d in devices}) == 3
+    assert len({d.sensor_drift_rate for d in devices}) == 3
     assert all(d.tip_mass == 1e-4 for d in devices)
     assert expand_runs(spec, spec.load_antenna())[0].scenario["device"] == devices[0]
+    other = _realistic_spec({"profile": "realistic", "build": 7})
+    built = expand_runs(other, other.load_antenna())[0].scenario["device"]
+    assert built.clamp_stiffness != devices[0].clamp_stiffness
+
+
+def test_realistic_device_of_one_build_differs_only_in_set_up() -> None:
+    first, second = realistic_device(1, build=5), realistic_device(2, build=5)
+    assert first.tip_mass == second.tip_mass and first.sensor_gain == second.sensor_gain
+    assert first.encoder_offset != second.encoder_offset
+    assert realistic_device(3).tip_mass != realistic_device(4).tip_mass
+
+
+def test_campaign_device_build_must_be_a_seed() -> None:
+    with pytest.raises(CampaignSpecError, match=r"device\.build"):
+        _realistic_spec({"profile": "realistic", "build": -1})
 
 
 def test_campaign_without_device_profile_has_nominal_runs() -> None:

@@ -18,6 +18,15 @@ loads at rest at the start against the link's weight (a wrench in mN and N mm, o
 1e-300, reads no weight); after it, the fitted effective inertia K / omega^2 against the rigid
 link's (angles in degrees give 1/57 of it).
 
+Payload: the head rests before it moves, and the moment about Y^m at rest is the link's weight
+m_b g (l / 2) cos(theta_2) plus m_t g l cos(theta_2) for whatever the link carries at its tip
+(glue, a marker) that the antenna file does not. Its excess over the model's weight, when more
+than three standard deviations of the rest's mean and the tare's offset, is read as such a tip
+mass (a payload; the
+estimators' plausibility check reads the same moment, docs/estimation.md): the identified
+antenna carries it in ``link.tip_mass``, so the frequency model and the calibration of T_e know
+the weight that lowers omega_1.
+
 Threshold (Section 5.2): the maximum of the filtered residual norm of Eq. 16 over the free-motion
 recording, computed with the fitted observer and the detector's residual filter, times a safety
 margin of 1.5 ("the maximum residual obtained during free movements plus a security margin of
@@ -33,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from sensing_antenna.antenna import Antenna, FreeMotionObserver
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, FreeMotionObserver
 from sensing_antenna.detection.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
     OBSERVER_TORQUE_SIGNS,
@@ -42,16 +51,24 @@ from sensing_antenna.detection.contact import (
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
-from sensing_antenna.units_check import angle_problem, recording_problem
+from sensing_antenna.units_check import (
+    angle_problem,
+    initial_rest,
+    recording_problem,
+    rest_reading,
+)
 
 __all__ = [
     "CLAMPED_FREE_BETA_L",
     "DEFAULT_MARGIN",
     "MAX_INERTIA_FACTOR",
+    "PAYLOAD_SIGMAS",
     "IdentificationError",
     "ObserverFit",
+    "Payload",
     "identify_free_motion",
     "initial_guess",
+    "rest_payload",
     "units_problem",
 ]
 
@@ -68,8 +85,51 @@ MIN_MOTION = 1e-3
 _ZETA_GRID = (0.002, 0.01, 0.03, 0.1, 0.3)
 
 
+#: Standard errors an excess of the moment at rest over the model's weight needs to be read as
+#: a payload.
+PAYLOAD_SIGMAS = 3.0
+
+#: The offset a tare leaves on a channel, in standard deviations of its noise per sample (about
+#: one resolution count each): the standard deviation of the payload's moment beside the rest's
+#: mean. Two counts, the order an F/T sensor's tare leaves.
+TARE_NOISES = 2.0
+
+
 class IdentificationError(SensingAntennaError, ValueError):
     """The recording cannot identify the observer (e.g. no joint moved)."""
+
+
+@dataclass(frozen=True)
+class Payload:
+    """Weight at the tip that the model does not carry, read from the moment at rest.
+
+    Parameters
+    ----------
+    mass : float
+        The tip mass the moment's excess over the model's weight gives (kg); negative when the
+        link reads lighter than its model.
+    std : float
+        Its standard deviation (kg): the rest's mean and the tare's offset, both from the
+        torque's scatter over the rest (:data:`TARE_NOISES`); NaN without a rest.
+    samples : int
+        Samples at rest at the start (0: the recording starts moving, nothing is read).
+    """
+
+    mass: float
+    std: float
+    samples: int
+
+    @property
+    def significant(self) -> bool:
+        """True when the mass is more than :data:`PAYLOAD_SIGMAS` standard errors from zero."""
+        return bool(self.samples > 1 and abs(self.mass) > PAYLOAD_SIGMAS * self.std)
+
+    def apply(self, antenna: Antenna) -> Antenna:
+        """``antenna`` with the payload in ``link.tip_mass`` when significant (never below 0)."""
+        if not self.significant:
+            return antenna
+        tip = max(0.0, antenna.link.tip_mass + self.mass)
+        return replace(antenna, link=replace(antenna.link, tip_mass=tip))
 
 
 @dataclass(frozen=True)
@@ -100,6 +160,8 @@ class ObserverFit:
         The physics-based starting point (same units).
     source : str or None
         Recording file.
+    payload : Payload or None
+        Weight at the tip beyond the model's, read at rest (None: not read).
     """
 
     gain: float
@@ -115,6 +177,7 @@ class ObserverFit:
     initial_natural_frequency: float
     initial_damping: float
     source: str | None = None
+    payload: Payload | None = None
 
     @property
     def observer(self) -> FreeMotionObserver:
@@ -269,6 +332,30 @@ def units_problem(recording: Recording, antenna: Antenna) -> str | None:
     )
 
 
+def rest_payload(recording: Recording, antenna: Antenna) -> Payload:
+    """The tip mass (kg) the moment about Y^m at rest at the start reads beyond ``antenna``'s
+    weight (module docstring), with its standard error; zero samples without a rest of at least
+    the estimators' rest window."""
+    from sensing_antenna.estimation.config import EstimatorConfig
+    from sensing_antenna.estimation.front.contact_frame import rest_tolerance
+
+    config = EstimatorConfig()
+    rest = initial_rest(recording.theta, rest_tolerance(recording.theta, config))
+    if rest < max(2, round(config.rest_window / recording.sample_period) + 1):
+        return Payload(0.0, math.nan, 0)
+    window = slice(0, rest)
+    theta = recording.theta[window]
+    reading = rest_reading(theta, recording.force[window], recording.torque[window], antenna)
+    lever = float(np.mean(antenna.link.length * STANDARD_GRAVITY * np.cos(theta[:, 1])))
+    if not lever > 0.0:
+        return Payload(0.0, math.nan, 0)
+    excess = float(reading.torque[1] - reading.expected_torque[1])
+    noise = float(np.std(recording.torque[window, 1], ddof=1))
+    # the rest's mean, and the offset a tare leaves (TARE_NOISES deviations of the noise)
+    error = noise * math.hypot(1.0 / math.sqrt(rest), TARE_NOISES)
+    return Payload(excess / lever, error / lever, rest)
+
+
 def identify_free_motion(
     recording: Recording,
     antenna: Antenna,
@@ -348,4 +435,5 @@ def identify_free_motion(
         initial_natural_frequency=w0,
         initial_damping=d0,
         source=recording.source,
+        payload=rest_payload(uniform, antenna),
     )

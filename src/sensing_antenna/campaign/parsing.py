@@ -320,13 +320,18 @@ def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
             "must be a table of fields (e.g. imperfections.tip_mass = 1e-4)",
             source,
         )
+    build = data.get("build")
+    if build is not None and (isinstance(build, bool) or not isinstance(build, int) or build < 0):
+        raise CampaignSpecError(
+            "device.build", f"must be an integer >= 0 (a seed), got {build!r}", source
+        )
     for key, values in data.items():
-        if key in ("antenna", "profile", "imperfections"):
+        if key in ("antenna", "profile", "imperfections", "build"):
             continue
         if key not in DEVICE_SECTIONS:
             raise CampaignSpecError(
                 f"device.{key}",
-                "unknown key; known: antenna, profile, imperfections,"
+                "unknown key; known: antenna, profile, imperfections, build,"
                 f" {', '.join(DEVICE_SECTIONS)}",
                 source,
             )
@@ -343,6 +348,7 @@ def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
             overrides=overrides,
             profile=profile,
             imperfections=dict(imperfections),
+            build=build,
         )
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc

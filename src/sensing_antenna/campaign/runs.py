@@ -301,11 +301,13 @@ def with_device(
     spec: CampaignSpec, scenario: Mapping[str, Any], seed: int, length: float
 ) -> dict[str, Any]:
     """``scenario`` with the ``device`` imperfections of the manoeuvre of seed ``seed`` (the
-    spec's ``[device]`` profile and table, ``simulator.DeviceImperfections``), unchanged when the
-    spec sets none; ``length`` (m) is the simulated link's, to place a joint."""
+    spec's ``[device]`` profile and table, ``simulator.DeviceImperfections``; every manoeuvre
+    of the campaign on one realistic device, built from the base seed unless the spec names its
+    ``build``), unchanged when the spec sets none; ``length`` (m) is the simulated link's, to
+    place a joint."""
     extra = dict(scenario)
     if spec.device.has_imperfections:
-        extra["device"] = spec.device.imperfections_for(seed, length)
+        extra["device"] = spec.device.imperfections_for(seed, length, spec.base_seed)
     return extra
 
 

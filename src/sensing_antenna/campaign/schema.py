@@ -159,17 +159,22 @@ class DeviceSpec:
         Field values replacing the base antenna's, by section (:data:`DEVICE_SECTIONS`), SI.
     profile : {"nominal", "realistic"}
         Imperfections of the device the model does not know: "nominal" none (besides
-        ``imperfections``), "realistic" one set drawn per simulated manoeuvre from its seed
+        ``imperfections``), "realistic" one device built from the manufacturing spread, whose
+        set-up (drift, encoder zero) is drawn anew for every simulated manoeuvre from its seed
         (``simulator.realistic_device``).
     imperfections : mapping of str to value
         Fields of ``simulator.DeviceImperfections`` set on every manoeuvre (over the profile's
         draw), e.g. ``tip_mass = 1e-4``.
+    build : int or None
+        Which realistic device is built (the seed of its manufacturing draw); None: the
+        campaign's ``base_seed``.
     """
 
     antenna: str | None = None
     overrides: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     profile: str = "nominal"
     imperfections: Mapping[str, Any] = field(default_factory=dict)
+    build: int | None = None
 
     def __post_init__(self) -> None:
         if self.profile not in DEVICE_PROFILES:
@@ -217,10 +222,13 @@ class DeviceSpec:
         """True when some manoeuvre's device departs from the nominal one (profile or table)."""
         return self.profile != "nominal" or bool(self.imperfections)
 
-    def imperfections_for(self, seed: int, length: float) -> DeviceImperfections:
+    def imperfections_for(self, seed: int, length: float, build: int) -> DeviceImperfections:
         """The imperfections of the manoeuvre of seed ``seed`` on a link of ``length`` (m): the
-        profile's draw with the ``imperfections`` table set over it."""
-        drawn = device_profile(self.profile, seed, length)
+        profile's draw for the device of ``build`` (``self.build`` when set) with the
+        ``imperfections`` table set over it."""
+        drawn = device_profile(
+            self.profile, seed, length, build if self.build is None else self.build
+        )
         if not self.imperfections:
             return drawn
         fixed = device_from_mapping(self.imperfections, "device.imperfections")
@@ -238,6 +246,8 @@ class DeviceSpec:
                 data[section] = {k: float(v) for k, v in values.items()}
         if self.profile != "nominal":
             data["profile"] = self.profile
+        if self.build is not None:
+            data["build"] = self.build
         if self.imperfections:
             data["imperfections"] = dict(self.imperfections)
         return data

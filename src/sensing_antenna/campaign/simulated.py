@@ -19,8 +19,9 @@ import time
 from collections.abc import Mapping
 from typing import Any
 
-from sensing_antenna.antenna import Antenna, FreeMotionObserver
+from sensing_antenna.antenna import Antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
+from sensing_antenna.calibration.observer import ObserverFit
 from sensing_antenna.campaign.progress import Progress
 from sensing_antenna.campaign.records import CampaignRow, RunResult, float_or_nan
 from sensing_antenna.campaign.runs import (
@@ -145,8 +146,9 @@ def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:
 
 def identify_observer(
     device: Antenna, spec: CampaignSpec, model: Antenna | None = None
-) -> FreeMotionObserver:
-    """Simulate a free motion on ``device`` and identify the observer of Eq. 15 from it.
+) -> ObserverFit:
+    """Simulate a free motion on ``device`` and identify the observer of Eq. 15 from it, and
+    the payload its rest reads.
 
     The free motion uses the spec's scenario settings and its own seed (stream 1 of the base
     seed). The identification starts from what the engineer knows, ``model`` (default: the
@@ -160,8 +162,7 @@ def identify_observer(
     extra["duration"] = spec.free_motion.duration
     scenario = make_scenario(spec.free_motion.case, None, seed, extra)
     recording = simulate(device, scenario)
-    fit = identify_free_motion(recording.without_ground_truth(), model or device)
-    return fit.observer
+    return identify_free_motion(recording.without_ground_truth(), model or device)
 
 
 def calibrate_on_device(
@@ -248,7 +249,8 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
 
     Order (the paper's): free-motion identification on the device (if asked), then calibration
     on the device (if asked). The identified observer goes to both antennas (the device's
-    controller and the estimators use the same detector); T_e goes to the model only.
+    controller and the estimators use the same detector); the payload its rest reads (a tip mass
+    the model lacks) and T_e go to the model only.
     Checks the spec's scenario section first, so a bad value stops the campaign with one clear
     error instead of failing every run. ``progress`` gets a line per step and the calibration's
     bar.
@@ -262,9 +264,11 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
             f"preparation: identifying the free-motion observer (Eq. 15) on a "
             f"{spec.free_motion.duration:g} s free motion of the device"
         )
-        observer = identify_observer(device, spec, model)
-        device = dataclasses.replace(device, observer=observer)
-        model = dataclasses.replace(model, observer=observer)
+        fit = identify_observer(device, spec, model)
+        device = dataclasses.replace(device, observer=fit.observer)
+        model = dataclasses.replace(model, observer=fit.observer)
+        if fit.payload is not None:
+            model = fit.payload.apply(model)
     calibration = None
     if spec.calibration.enabled:
         progress.line(

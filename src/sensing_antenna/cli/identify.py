@@ -101,6 +101,8 @@ def _run(args: argparse.Namespace) -> int:
     )
     start = antenna if motor_fit is None else motor_fit.antenna(antenna)
     identified = replace(start, name=name, description=description, observer=fit.observer)
+    if fit.payload is not None:
+        identified = fit.payload.apply(identified)
     save_antenna(identified, args.out)
     joints = ", ".join(f"theta{j}" for j in fit.joints)
     print(
@@ -114,10 +116,26 @@ def _run(args: argparse.Namespace) -> int:
         f"{fit.max_filtered_residual:.4g} N m), rms of the unfiltered fit residual "
         f"{fit.residual_rms:.3g} N m, joints used: {joints}"
     )
+    _print_payload(fit.payload, antenna.link.tip_mass, identified.link.tip_mass)
     if motor_fit is not None:
         _print_servo(motor_fit, antenna, pole)
     print(args.out)
     return 0
+
+
+def _print_payload(payload: Any, before: float, after: float) -> None:
+    """What the moment at rest said of weight at the tip, and the tip mass written."""
+    if payload is None or payload.samples == 0:
+        print("payload: not read (the recording does not start at rest)")
+        return
+    read = (
+        f"payload: the moment at rest reads {1e3 * payload.mass:+.4g} g +- "
+        f"{1e3 * payload.std:.2g} g at the tip beyond the antenna's weight"
+    )
+    if payload.significant:
+        print(f"{read}: link.tip_mass = {after:.4g} kg (was {before:.4g} kg)")
+    else:
+        print(f"{read}: not significant, link.tip_mass kept at {before:.4g} kg")
 
 
 def _print_servo(motor_fit: Any, antenna: Any, pole: float) -> None:

@@ -70,7 +70,8 @@ def register(subparsers: Any) -> None:
         metavar="PROFILE|FILE",
         help="imperfections of the simulated device that the antenna does not know: nominal "
         "(none), realistic (one set drawn from --seed, docs/simulator.md) or a TOML file of "
-        'DeviceImperfections fields (optionally with profile = "realistic" under them)',
+        'DeviceImperfections fields (optionally with profile = "realistic" under them, and '
+        "build = N: the realistic device N, whose manoeuvres differ only in set-up)",
     )
     parser.add_argument(
         "--push",
@@ -146,7 +147,8 @@ def load_device(value: str, seed: int, length: float) -> Any:
     """The ``DeviceImperfections`` of ``--device``: a profile name or a TOML file.
 
     A file holds ``DeviceImperfections`` fields at its top level or in a ``[device]`` table,
-    and may name a ``profile`` whose draw (from ``seed``) its fields are set over.
+    and may name a ``profile`` whose draw (from ``seed``) its fields are set over, and the
+    ``build`` of that profile's device (manoeuvres with one build share one device).
     """
     from dataclasses import replace
 
@@ -175,9 +177,14 @@ def load_device(value: str, seed: int, length: float) -> Any:
             "--device",
             f"{value}: profile must be one of {', '.join(DEVICE_PROFILES)}, got {profile!r}",
         )
+    build = table.pop("build", None)
+    if build is not None and (isinstance(build, bool) or not isinstance(build, int) or build < 0):
+        raise ArgumentError(
+            "--device", f"{value}: build must be an integer >= 0 (a seed), got {build!r}"
+        )
     fixed = device_from_mapping(table, value)
     given = {key: getattr(fixed, key) for key in table}
-    return replace(device_profile(profile, seed, length), **given)
+    return replace(device_profile(profile, seed, length, build), **given)
 
 
 def _check_contact_point(case: str, x_c: float | None, link: Any) -> None:

@@ -308,16 +308,26 @@ REALISTIC_WALK_COUNTS = 0.1
 REALISTIC_ENCODER_OFFSET = 0.005
 
 
-def realistic_device(seed: int, length: float = 0.98) -> DeviceImperfections:
+def realistic_device(
+    seed: int, length: float = 0.98, build: int | None = None
+) -> DeviceImperfections:
     """One device drawn from the realistic manufacturing and set-up spread.
+
+    What a device is built with (tip mass, clamp, taper, joint, the sensor's gains and
+    coupling) is drawn from its ``build``; what changes between manoeuvres of one device (the
+    sensor's drift, the encoders' zero after homing) from the manoeuvre's ``seed``. A lab's
+    manoeuvres on its one antenna share a build and differ in set-up.
 
     Parameters
     ----------
     seed : int
-        The run's seed; the draw uses ``numpy.random.default_rng([seed, DEVICE_STREAM])``, so
-        repeats with different seeds get different devices and one seed always the same.
+        The manoeuvre's seed: the set-up draws use
+        ``numpy.random.default_rng([seed, DEVICE_STREAM, 1])``.
     length : float
         Link length l (m), to place the joint.
+    build : int, optional
+        The device's build: its draws use ``numpy.random.default_rng([build, DEVICE_STREAM])``.
+        None: ``seed`` (every manoeuvre on a device of its own).
 
     Returns
     -------
@@ -325,7 +335,7 @@ def realistic_device(seed: int, length: float = 0.98) -> DeviceImperfections:
     """
     from sensing_antenna.simulator.scenario import ATI_NANO17_RESOLUTION
 
-    rng = np.random.default_rng([seed, DEVICE_STREAM])
+    rng = np.random.default_rng([seed if build is None else build, DEVICE_STREAM])
     low, high = REALISTIC_CLAMP_STIFFNESS
     clamp = float(math.exp(rng.uniform(math.log(low), math.log(high))))
     taper = float(rng.uniform(*REALISTIC_STIFFNESS_TAPER))
@@ -333,10 +343,8 @@ def realistic_device(seed: int, length: float = 0.98) -> DeviceImperfections:
     eps = rng.uniform(-REALISTIC_COUPLING, REALISTIC_COUPLING, size=(6, 6))
     np.fill_diagonal(eps, 0.0)
     coupling = eps * full_scale[:, np.newaxis] / full_scale[np.newaxis, :]
-    resolution = np.asarray(ATI_NANO17_RESOLUTION)
     gain = 1.0 + rng.uniform(-REALISTIC_GAIN_ERROR, REALISTIC_GAIN_ERROR, size=6)
-    rate = rng.uniform(-1.0, 1.0, size=6) * REALISTIC_DRIFT_COUNTS_PER_S * resolution
-    drawn: dict[str, Any] = {
+    built: dict[str, Any] = {
         "tip_mass": float(rng.uniform(*REALISTIC_TIP_MASS)),
         "clamp_stiffness": clamp,
         "stiffness_taper": taper,
@@ -347,21 +355,26 @@ def realistic_device(seed: int, length: float = 0.98) -> DeviceImperfections:
         "joint_density_factor": float(rng.uniform(*REALISTIC_JOINT_FACTOR)),
         "sensor_gain": tuple(float(g) for g in gain),
         "sensor_coupling": tuple(tuple(float(c) for c in row) for row in coupling),
-        "sensor_drift_rate": tuple(float(r) for r in rate),
-        "sensor_drift_walk": tuple(float(r) for r in REALISTIC_WALK_COUNTS * resolution),
-        "encoder_offset": tuple(
-            float(v) for v in rng.uniform(-1.0, 1.0, size=2) * REALISTIC_ENCODER_OFFSET
-        ),
     }
-    return DeviceImperfections(**drawn)
+    setup = np.random.default_rng([seed, DEVICE_STREAM, 1])
+    resolution = np.asarray(ATI_NANO17_RESOLUTION)
+    rate = setup.uniform(-1.0, 1.0, size=6) * REALISTIC_DRIFT_COUNTS_PER_S * resolution
+    offsets = setup.uniform(-1.0, 1.0, size=2) * REALISTIC_ENCODER_OFFSET
+    built["sensor_drift_rate"] = tuple(float(r) for r in rate)
+    built["sensor_drift_walk"] = tuple(float(r) for r in REALISTIC_WALK_COUNTS * resolution)
+    built["encoder_offset"] = tuple(float(v) for v in offsets)
+    return DeviceImperfections(**built)
 
 
-def device_profile(name: str, seed: int, length: float = 0.98) -> DeviceImperfections:
-    """The device of profile ``name`` (:data:`DEVICE_PROFILES`) for a run of seed ``seed``."""
+def device_profile(
+    name: str, seed: int, length: float = 0.98, build: int | None = None
+) -> DeviceImperfections:
+    """The device of profile ``name`` (:data:`DEVICE_PROFILES`) for a run of seed ``seed`` on
+    the device of ``build`` (:func:`realistic_device`)."""
     if name == "nominal":
         return DeviceImperfections()
     if name == "realistic":
-        return realistic_device(seed, length)
+        return realistic_device(seed, length, build)
     raise DeviceError(
         "profile", f"must be one of {', '.join(DEVICE_PROFILES)}, got {format_value(name)}"
     )
