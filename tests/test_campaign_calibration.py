@@ -174,7 +174,7 @@ def test_calibration_seeds_have_their_own_stream() -> None:
     from sensing_antenna.campaign.runs import calibration_runs
 
     spec = device_spec(True)
-    seeds = [seed for _, _, seed in calibration_runs(spec)]
+    seeds = [seed for _, _, _, seed in calibration_runs(spec)]
     assert seeds == [derive_seed(17, i, CALIBRATION_STREAM) for i in range(len(seeds))]
     run_seeds = {r.seed for r in expand_runs(spec, paper_antenna())}
     assert len(set(seeds)) == len(seeds) and not set(seeds) & run_seeds

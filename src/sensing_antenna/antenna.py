@@ -41,6 +41,8 @@ from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 __all__ = [
     "BUILTIN_ANTENNAS",
     "CALIBRATED_T_UNCERTAINTY",
+    "MAX_SENSOR_COUPLING",
+    "MAX_SENSOR_GAIN_ERROR",
     "MIN_SLENDERNESS",
     "MODEL_FREQUENCY_FLOOR",
     "NOMINAL_T_UNCERTAINTY",
@@ -51,6 +53,7 @@ __all__ = [
     "Link",
     "Motor",
     "ParameterRange",
+    "SensorCorrection",
     "antenna_to_toml",
     "load_antenna",
     "paper_antenna",
@@ -474,9 +477,92 @@ class FreeMotionObserver:
         return self.damping / (2.0 * self.natural_frequency)
 
 
+#: Largest accepted departure of a sensor correction's gains from 1: beyond it (a factor of 2
+#: in the push force) it is no sensor's calibration but a wrong file.
+MAX_SENSOR_GAIN_ERROR = 1.0
+
+#: Largest accepted force-per-moment term of a sensor correction (1/m): 100 % of a force
+#: channel's full scale per full-scale moment on a sensor whose force range is 100 times its
+#: torque range in N and N m (an ATI Nano17's 25 N and 0.25 N m); cross-talk is a few per cent.
+MAX_SENSOR_COUPLING = 100.0
+
+
+@dataclass(frozen=True)
+class SensorCorrection:
+    """Linear correction of the lateral contact forces the F/T sensor reads (its cross-talk).
+
+    An F/T sensor's channels leak into each other; on an antenna the moments are large and the
+    lateral forces small (a 1 % of full-scale coupling of a 0.25 N m torque channel into a
+    25 N force channel adds 1 N per N m, as much as the push itself), so what matters is the
+    lateral forces read from the moments. With R and Gamma the contact's reaction (N) and its
+    moment about O (N m) in the motor frame, the corrected lateral forces are
+
+        R_y' = fy_gain R_y + fy_per_ty Gamma_y + fy_per_tz Gamma_z
+        R_z' = fz_gain R_z + fz_per_ty Gamma_y + fz_per_tz Gamma_z
+
+    ``antenna calibrate`` fits them to contacts at known points (``calibration.sensor``); the
+    default is no correction.
+
+    Parameters
+    ----------
+    fy_gain, fz_gain : float
+        Gains of the lateral force channels relative to the moments' (dimensionless).
+    fy_per_ty, fy_per_tz, fz_per_ty, fz_per_tz : float
+        Force read per unit moment (N per N m = 1/m).
+    """
+
+    fy_gain: float = 1.0
+    fz_gain: float = 1.0
+    fy_per_ty: float = 0.0
+    fy_per_tz: float = 0.0
+    fz_per_ty: float = 0.0
+    fz_per_tz: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise AntennaConfigError(f"sensor.{f.name}", f"must be a number, got {value!r}")
+            if not math.isfinite(value):
+                raise AntennaConfigError(f"sensor.{f.name}", f"must be finite, got {value!r}")
+        for name in ("fy_gain", "fz_gain"):
+            if not abs(getattr(self, name) - 1.0) < MAX_SENSOR_GAIN_ERROR:
+                raise AntennaConfigError(
+                    f"sensor.{name}",
+                    f"must lie within {MAX_SENSOR_GAIN_ERROR:g} of 1, got {getattr(self, name)!r}",
+                )
+        for name in ("fy_per_ty", "fy_per_tz", "fz_per_ty", "fz_per_tz"):
+            if not abs(getattr(self, name)) <= MAX_SENSOR_COUPLING:
+                raise AntennaConfigError(
+                    f"sensor.{name}",
+                    f"must lie within +-{MAX_SENSOR_COUPLING:g} 1/m (N per N m), got "
+                    f"{getattr(self, name)!r}",
+                )
+
+    @property
+    def is_identity(self) -> bool:
+        """True when the correction changes nothing."""
+        return self == SensorCorrection()
+
+    def correct(
+        self, reaction: NDArray[np.float64], moment: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """The corrected reaction (N), shape (..., 3), from ``reaction`` (N) and ``moment``
+        (N m) of the same shape (contact loads, motor frame)."""
+        if self.is_identity:
+            return reaction
+        out = np.array(reaction, dtype=float)
+        r_y, r_z = reaction[..., 1], reaction[..., 2]
+        g_y, g_z = moment[..., 1], moment[..., 2]
+        out[..., 1] = self.fy_gain * r_y + self.fy_per_ty * g_y + self.fy_per_tz * g_z
+        out[..., 2] = self.fz_gain * r_z + self.fz_per_ty * g_y + self.fz_per_tz * g_z
+        return out
+
+
 @dataclass(frozen=True)
 class Antenna:
-    """A complete sensing antenna: link, azimuth motor (1), elevation motor (2), observer."""
+    """A complete sensing antenna: link, azimuth motor (1), elevation motor (2), observer, and
+    the F/T sensor's correction (none by default)."""
 
     name: str
     link: Link
@@ -485,6 +571,7 @@ class Antenna:
     observer: FreeMotionObserver
     description: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    sensor: SensorCorrection = field(default_factory=SensorCorrection)
 
     def __post_init__(self) -> None:
         name = self.name
@@ -551,7 +638,7 @@ _SECTIONS: dict[str, type] = {
     "elevation_motor": Motor,
     "observer": FreeMotionObserver,
 }
-_TOP_LEVEL_KEYS = {"name", "base", "description", *_SECTIONS}
+_TOP_LEVEL_KEYS = {"name", "base", "description", "sensor", *_SECTIONS}
 
 #: Names of the antenna sets shipped with the package.
 BUILTIN_ANTENNAS = ("paper-2021", "paper-2021-calibrated")
@@ -613,6 +700,17 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
             _, dot, name = exc.field_name.partition(".")
             field_name = f"{section}.{name}" if dot else section
             raise AntennaConfigError(field_name, exc.problem, source) from exc
+    sensor = data.get("sensor", {})
+    if not isinstance(sensor, Mapping):
+        raise AntennaConfigError("sensor", "must be a table", source)
+    allowed = {f.name for f in fields(SensorCorrection)}
+    for key in sensor:
+        if key not in allowed:
+            raise AntennaConfigError(f"sensor.{key}", "unknown key", source)
+    try:
+        parts["sensor"] = SensorCorrection(**sensor)
+    except AntennaConfigError as exc:
+        raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
     name = data.get("name", "unnamed")
     if not isinstance(name, str) or not name:
         raise AntennaConfigError("name", "must be a non-empty string", source)
@@ -624,6 +722,7 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
             azimuth_motor=parts["azimuth_motor"],
             elevation_motor=parts["elevation_motor"],
             observer=parts["observer"],
+            sensor=parts["sensor"],
         )
     except AntennaConfigError as exc:
         raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
@@ -682,6 +781,12 @@ def antenna_to_toml(antenna: Antenna) -> str:
             value = getattr(obj, f.name)
             if value is not None:
                 lines.append(f"{f.name} = {float(value)!r}")
+    if not antenna.sensor.is_identity:
+        lines += ["", "[sensor]"]
+        lines += [
+            f"{f.name} = {float(getattr(antenna.sensor, f.name))!r}"
+            for f in fields(SensorCorrection)
+        ]
     return "\n".join(lines) + "\n"
 
 

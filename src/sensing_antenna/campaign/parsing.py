@@ -21,7 +21,8 @@ A spec file looks like::
     [device]                        # optional: the simulated hardware, when it is not the model
     antenna = "paper-2021"          # default: the top-level antenna
     link.youngs_modulus = 132.65e9  # field overrides, SI
-    profile = "realistic"           # imperfections drawn per run ("nominal": none)
+    profile = "realistic"           # one device built, its set-up drawn per run ("nominal": none)
+    build = 7                       # which realistic device (default: the base seed)
     imperfections.tip_mass = 1e-4   # simulator.DeviceImperfections fields, set on every run
 
     [calibration]                   # optional: fit T_e on the device first (Section 5.1)
@@ -30,6 +31,7 @@ A spec file looks like::
     contact_points = [0.30, 0.35, 0.40]  # m
     repeats = 1
     loss = "soft_l1"
+    sensor = true                   # also the sensor's cross-talk, from both sweep directions
 
     [noise_sweep]                   # optional: extra runs at other sensor noise levels
     noise_scales = [0.5, 2.0]       # multiples of the simulator's nominal noise; [] for none
@@ -357,15 +359,17 @@ def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
 def _parse_calibration(data: Any, source: str) -> CalibrationStep:
     if not isinstance(data, Mapping):
         raise CampaignSpecError("calibration", "must be a table", source)
-    known = ("enabled", "case", "contact_points", "repeats", "loss")
+    known = ("enabled", "case", "contact_points", "repeats", "loss", "sensor")
     for key in data:
         if key not in known:
             raise CampaignSpecError(
                 f"calibration.{key}", f"unknown key; known: {', '.join(known)}", source
             )
     enabled = data.get("enabled", False)
-    if not isinstance(enabled, bool):
-        raise CampaignSpecError("calibration.enabled", "must be true or false", source)
+    sensor = data.get("sensor", False)
+    for key, flag in (("enabled", enabled), ("sensor", sensor)):
+        if not isinstance(flag, bool):
+            raise CampaignSpecError(f"calibration.{key}", "must be true or false", source)
     case = data.get("case", "azimuthal")
     loss = data.get("loss", "soft_l1")
     for key, value in (("case", case), ("loss", loss)):
@@ -382,7 +386,12 @@ def _parse_calibration(data: Any, source: str) -> CalibrationStep:
     points = _numbers(raw, "calibration.contact_points", "m", source)
     try:
         return CalibrationStep(
-            enabled=enabled, case=case, contact_points=points, repeats=repeats, loss=loss
+            enabled=enabled,
+            case=case,
+            contact_points=points,
+            repeats=repeats,
+            loss=loss,
+            sensor=sensor,
         )
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc

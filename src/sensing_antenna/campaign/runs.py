@@ -311,17 +311,19 @@ def with_device(
     return extra
 
 
-def calibration_runs(spec: CampaignSpec) -> list[tuple[str, float, int]]:
-    """(name, contact point in m, seed) of each calibration recording, in a fixed order.
+def calibration_runs(spec: CampaignSpec) -> list[tuple[str, str, float, int]]:
+    """(name, case, contact point in m, seed) of each calibration recording, in a fixed order
+    (the step's case first: a spec without ``sensor`` keeps its seeds).
 
     Seeds come from :data:`CALIBRATION_STREAM` of the base seed, so they never coincide with the
     runs' or the free motion's.
     """
     step = spec.calibration
-    runs: list[tuple[str, float, int]] = []
-    for x_c in step.contact_points:
-        for repeat in range(1, step.repeats + 1):
-            name = f"calibration-{step.case}-{contact_point_label(x_c)}-r{repeat}"
-            seed = derive_seed(spec.base_seed, len(runs), CALIBRATION_STREAM)
-            runs.append((name, float(x_c), seed))
+    runs: list[tuple[str, str, float, int]] = []
+    for case in step.cases:
+        for x_c in step.contact_points:
+            for repeat in range(1, step.repeats + 1):
+                name = f"calibration-{case}-{contact_point_label(x_c)}-r{repeat}"
+                seed = derive_seed(spec.base_seed, len(runs), CALIBRATION_STREAM)
+                runs.append((name, case, float(x_c), seed))
     return runs

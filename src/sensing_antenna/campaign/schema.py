@@ -269,6 +269,10 @@ class CalibrationStep:
         Recordings per contact point.
     loss : str
         Loss of the T_e fit (``calibration.frequency.fit_inverse_t``).
+    sensor : bool
+        Also calibrate the F/T sensor's cross-talk (``calibration.sensor``) on the step's
+        recordings and as many of the other sweep direction at the same points; T_e is fitted
+        on the step's ``case`` alone.
     """
 
     enabled: bool = False
@@ -276,6 +280,7 @@ class CalibrationStep:
     contact_points: tuple[float, ...] = DEFAULT_CALIBRATION_POINTS
     repeats: int = 1
     loss: str = "soft_l1"
+    sensor: bool = False
 
     def __post_init__(self) -> None:
         if self.case not in CASES:
@@ -304,19 +309,31 @@ class CalibrationStep:
             )
 
     @property
+    def cases(self) -> tuple[str, ...]:
+        """The sweep directions recorded: ``case``, and the other with ``sensor``."""
+        if not self.sensor:
+            return (self.case,)
+        other = "vertical" if self.case == "azimuthal" else "azimuthal"
+        return (self.case, other)
+
+    @property
     def n_recordings(self) -> int:
-        """Calibration recordings (contact points x repeats)."""
-        return len(self.contact_points) * self.repeats
+        """Calibration recordings (cases x contact points x repeats)."""
+        return len(self.cases) * len(self.contact_points) * self.repeats
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data in the layout of the TOML section."""
-        return {
+        """Plain data in the layout of the TOML section (``sensor`` only when set, so a spec
+        without it keeps its fingerprint)."""
+        data: dict[str, Any] = {
             "enabled": self.enabled,
             "case": self.case,
             "contact_points": list(self.contact_points),
             "repeats": self.repeats,
             "loss": self.loss,
         }
+        if self.sensor:
+            data["sensor"] = True
+        return data
 
 
 @dataclass(frozen=True)

@@ -167,36 +167,68 @@ def identify_observer(
 
 def calibrate_on_device(
     spec: CampaignSpec, device: Antenna, model: Antenna, progress: Progress | None = None
-) -> FrequencyCalibration:
-    """Section 5.1 on the simulated device: T_e of the frequency model from known contact points.
+) -> tuple[FrequencyCalibration, Antenna]:
+    """Section 5.1 on the simulated device: T_e of the frequency model from known contact points,
+    and, with ``calibration.sensor``, the sensor's cross-talk from the same points swept both
+    ways.
 
     Each calibration manoeuvre is simulated on ``device``; omega_1 is measured with the wide band
     ``calibration.frequency.CALIBRATION_BAND`` by Estimator 1's frequency measurement, using
-    ``model`` (the observer for t_c and t_1); T_e is fitted to the model's beta_1(x_c)^2. The
-    contact points are known by construction (a calibration), so they come from the spec, and the
-    estimators never see the device's T. ``progress`` shows a bar of the recordings.
+    ``model`` (the observer for t_c and t_1); T_e is fitted to the model's beta_1(x_c)^2 on the
+    step's case. The contact points are known by construction (a calibration), so they come from
+    the spec, and the estimators never see the device's T. ``progress`` shows a bar of the
+    recordings and a line for the sensor's fit.
+
+    Returns
+    -------
+    (FrequencyCalibration, Antenna)
+        The T_e fit, and ``model`` with T_e (and the sensor's correction) applied.
     """
     from sensing_antenna.calibration.frequency import CalibrationError, calibrate_from_recordings
+    from sensing_antenna.calibration.sensor import SensorCalibrationError, calibrate_sensor
     from sensing_antenna.simulator import simulate
 
     step = spec.calibration
-    names, points, recordings = [], [], []
+    names, cases, points, recordings = [], [], [], []
     planned = calibration_runs(spec)
-    bar = (progress or Progress(enabled=False)).bar(len(planned), "calibration", "recording")
+    progress = progress or Progress(enabled=False)
+    bar = progress.bar(len(planned), "calibration", "recording")
     with bar:
-        for name, x_c, seed in planned:
+        for name, case, x_c, seed in planned:
             extra = with_device(spec, spec.scenario, seed, device.link.length)
-            scenario = make_scenario(step.case, x_c, seed, extra)
+            scenario = make_scenario(case, x_c, seed, extra)
             recordings.append(simulate(device, scenario).without_ground_truth())
             names.append(name)
+            cases.append(case)
             points.append(x_c)
             bar.update(1)
+    own = [i for i, case in enumerate(cases) if case == step.case]
     try:
-        return calibrate_from_recordings(recordings, model, points, sources=names, loss=step.loss)
+        calibration = calibrate_from_recordings(
+            [recordings[i] for i in own],
+            model,
+            [points[i] for i in own],
+            sources=[names[i] for i in own],
+            loss=step.loss,
+        )
     except CalibrationError as exc:
         raise CampaignSpecError(
             "calibration", f"the calibration step failed: {exc}", spec.source or None
         ) from exc
+    calibrated = calibration.apply(model)
+    if step.sensor:
+        try:
+            sensor = calibrate_sensor(recordings, calibrated, points, sources=names)
+        except SensorCalibrationError as exc:
+            progress.line(f"preparation: the sensor is not calibrated ({exc})")
+        else:
+            calibrated = sensor.apply(calibrated)
+            progress.line(
+                f"preparation: sensor cross-talk fitted ({', '.join(sensor.sweeps)} sweeps); "
+                f"torque/force ratio against the known points {100 * sensor.ratio_rms_before:.1f}"
+                f" % rms before, {100 * sensor.ratio_rms_after:.1f} % after"
+            )
+    return calibration, calibrated
 
 
 def check_scenario(spec: CampaignSpec) -> None:
@@ -240,8 +272,8 @@ def check_scenario(spec: CampaignSpec) -> None:
         extra = {**spec.scenario, "duration": spec.free_motion.duration}
         check(spec.free_motion.case, None, extra, "the free motion: ")
     if spec.calibration.enabled:
-        for _, x_c, _ in calibration_runs(spec):
-            check(spec.calibration.case, x_c, spec.scenario, "")
+        for _, case, x_c, _ in calibration_runs(spec):
+            check(case, x_c, spec.scenario, "")
 
 
 def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Preparation:
@@ -272,11 +304,10 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
     calibration = None
     if spec.calibration.enabled:
         progress.line(
-            f"preparation: calibrating T_e on {spec.calibration.n_recordings} contact "
-            "recordings of the device (Section 5.1)"
+            f"preparation: calibrating T_e{' and the sensor' if spec.calibration.sensor else ''} "
+            f"on {spec.calibration.n_recordings} contact recordings of the device (Section 5.1)"
         )
-        calibration = calibrate_on_device(spec, device, model, progress)
-        model = calibration.apply(model)
+        calibration, model = calibrate_on_device(spec, device, model, progress)
     return Preparation(model=model, device=device, calibration=calibration)
 
 

@@ -24,7 +24,9 @@ def register(subparsers: Any) -> None:
             "omega_1(x_c) matches them, and writes the antenna with T_e. Contact points come from "
             "--points (CSV with columns file,x_c in m) or from each recording's true_xc metadata. "
             "The new antenna is named after --out (or --name), its description saying which "
-            "recordings calibrated it."
+            "recordings calibrated it. With four recordings or more of one sweep direction, the "
+            "same contacts also calibrate the F/T sensor's cross-talk into the lateral forces "
+            "(written as [sensor]; --no-sensor leaves the antenna's)."
         ),
     )
     parser.add_argument("recordings", nargs="+", type=Path, help="recording CSV files")
@@ -51,6 +53,11 @@ def register(subparsers: Any) -> None:
         help="fit loss (scipy.optimize.least_squares); a robust one keeps a wrong spectral peak "
         "from pulling T_e",
     )
+    parser.add_argument(
+        "--no-sensor",
+        action="store_true",
+        help="do not calibrate the sensor's cross-talk (keep the antenna's [sensor])",
+    )
     parser.set_defaults(func=_run)
 
 
@@ -62,6 +69,26 @@ def _description(start: str, recordings: list[Path]) -> str:
         f"antenna {printable(start)} with T_e calibrated by antenna calibrate from "
         f"{len(files)} recording(s): {shown}"
     )
+
+
+def _calibrate_sensor(
+    antenna: Any, recordings: list[Any], points: list[float], paths: list[Path]
+) -> tuple[Any, list[str]]:
+    """``antenna`` with the sensor's cross-talk fitted to the recordings, and what to print."""
+    from sensing_antenna.calibration.sensor import SensorCalibrationError, calibrate_sensor
+
+    try:
+        fit = calibrate_sensor(recordings, antenna, points, sources=[str(p) for p in paths])
+    except SensorCalibrationError as exc:
+        return antenna, [f"sensor: not calibrated, {exc}; the antenna's [sensor] is kept"]
+    terms = ", ".join(f"{k} = {v:.4g}" for k, v in vars(fit.correction).items())
+    lines = [
+        f"sensor: cross-talk fitted on {len(fit.sources)} recordings ({', '.join(fit.sweeps)} "
+        f"sweeps): {terms}; torque/force ratio against the known points "
+        f"{100 * fit.ratio_rms_before:.1f} % rms before, {100 * fit.ratio_rms_after:.1f} % after"
+    ]
+    lines += [f"  sensor, left out: {note}" for note in fit.notes]
+    return fit.apply(antenna), lines
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -96,6 +123,9 @@ def _run(args: argparse.Namespace) -> int:
     fitted = [path for path, used in zip(paths, calibration.used, strict=True) if used]
     description = _description(antenna.name, fitted)
     calibrated = replace(calibration.apply(antenna), name=name, description=description)
+    sensor_lines: list[str] = []
+    if not args.no_sensor:
+        calibrated, sensor_lines = _calibrate_sensor(calibrated, recordings, points, paths)
     save_antenna(calibrated, args.out)
     print(
         f"T_e = {calibration.t_e:.5f} +- {calibration.t_e_std_error:.5f} s/m^2 "
@@ -118,6 +148,8 @@ def _run(args: argparse.Namespace) -> int:
         )
     for note in (*unread, *calibration.notes):
         print(f"  left out: {note}")
+    for line in sensor_lines:
+        print(line)
     if args.plot is not None:
         from sensing_antenna.plotting.calibration import plot_calibration
 

@@ -55,7 +55,8 @@ _FIXED_POINT_STEPS = 4
 def contact_loads(
     theta: FloatArray, force_m: FloatArray, torque_m: FloatArray, antenna: Antenna
 ) -> tuple[FloatArray, FloatArray]:
-    """Loads of the contact alone: R = F - F_g^m and Gamma - Gamma_g^m (Section 4.2).
+    """Loads of the contact alone: R = F - F_g^m and Gamma - Gamma_g^m (Section 4.2), the
+    lateral forces corrected for the sensor's cross-talk (``antenna.sensor``).
 
     Parameters
     ----------
@@ -76,7 +77,8 @@ def contact_loads(
     # Section 4.2 / Eq. 19: remove the gravity force and torque of the link
     reaction = np.asarray(force_m, dtype=float) - antenna.gravity_force(theta2)
     moment = np.asarray(torque_m, dtype=float) - antenna.gravity_torque(theta2)
-    return reaction, moment
+    # the sensor's cross-talk into the lateral forces, as calibrated (none by default)
+    return antenna.sensor.correct(reaction, moment), moment
 
 
 def filtered_contact_loads(
@@ -207,7 +209,8 @@ def paper_ratio(
     """Eq. 21 exactly as printed: filter F and Gamma, then subtract the gravity terms (m), (n,).
 
     This is the estimator of the paper's reference [17], used by the ``ratio`` baseline; the
-    sensor ``offset`` (6,), when given, is removed as for the paper method.
+    sensor ``offset`` (6,), when given, is removed as for the paper method, and the forces are
+    corrected for the sensor's cross-talk (``antenna.sensor``) as everywhere.
     """
     theta2 = np.asarray(theta, dtype=float)[:, 1]
     # Eq. 20: filter the measured force and torque
@@ -216,11 +219,15 @@ def paper_ratio(
         cutoff,
         sample_period,
     )
+    # Eq. 21: x_c(t) = |Gamma_f - Gamma_g| / |F_f - F_g|, the force read through the sensor's
+    # calibrated cross-talk correction (none by default), then tared as the contact loads are
+    moment = filtered[:, 3:] - antenna.gravity_torque(theta2)
+    reaction = antenna.sensor.correct(filtered[:, :3] - antenna.gravity_force(theta2), moment)
     if offset is not None:
-        filtered = filtered - np.asarray(offset, dtype=float)
-    # Eq. 21: x_c(t) = |Gamma_f - Gamma_g| / |F_f - F_g|
-    numerator = np.linalg.norm(filtered[:, 3:] - antenna.gravity_torque(theta2), axis=-1)
-    denominator = np.linalg.norm(filtered[:, :3] - antenna.gravity_force(theta2), axis=-1)
+        reaction = reaction - np.asarray(offset, dtype=float)[:3]
+        moment = moment - np.asarray(offset, dtype=float)[3:]
+    numerator = np.linalg.norm(moment, axis=-1)
+    denominator = np.linalg.norm(reaction, axis=-1)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = numerator / denominator
     return np.where(denominator > 0.0, ratio, np.nan)

@@ -1,0 +1,239 @@
+"""Calibration of the F/T sensor's cross-talk into the lateral forces, from known contacts.
+
+The torque/force ratio reads the contact point from the push's moment over its force. On an
+antenna the moments are large and the lateral forces small, so a sensor's cross-talk from its
+torque channels into its force channels (a per cent of full scale, as much as the push) scales
+the ratio as r = g x / (1 + k x), g and k fixed for the sensor. Contacts at known points x_i
+(the recordings of the frequency calibration) pin that down: the lateral force corrected by
+:class:`~sensing_antenna.antenna.SensorCorrection`,
+
+    R_y' = fy_gain R_y + fy_per_ty Gamma_y + fy_per_tz Gamma_z   (and R_z' alike),
+
+is fitted so that (1) the elastica statics of the corrected push give x_i
+(:func:`~sensing_antenna.estimation.front.ratio.perpendicular_ratio`, relative residual), and
+(2) the push lies in the plane the head swept in (an azimuthal sweep pushes along Y^m: the
+corrected R_z' / R_y' is zero; a vertical sweep the other way round), by
+``scipy.optimize.least_squares`` with a soft-L1 loss (a recording whose push was disturbed does
+not pull the fit). The loads are the hold's mean (the window the contact frame uses, tared by
+the contact-free offset). A sweep about the azimuth fixes fy_gain, fy_per_tz and fz_per_tz;
+one about the elevation fz_gain, fz_per_ty and fy_per_ty; terms no recording fixes stay at no
+correction. The antenna's frequency model (T_e) should be calibrated first: the statics use its
+stiffness.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from sensing_antenna.antenna import Antenna, SensorCorrection
+from sensing_antenna.errors import SensingAntennaError
+
+__all__ = [
+    "MIN_SENSOR_RECORDINGS",
+    "SensorCalibration",
+    "SensorCalibrationError",
+    "calibrate_sensor",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: Recordings of one sweep direction needed to fit its three terms.
+MIN_SENSOR_RECORDINGS = 4
+
+#: The fitted terms of each sweep: azimuthal sweeps push along Y^m, vertical along Z^m.
+_PLANE_TERMS = {
+    "azimuthal": ("fy_gain", "fy_per_tz", "fz_per_tz"),
+    "vertical": ("fz_gain", "fz_per_ty", "fy_per_ty"),
+}
+
+#: Scale of the soft-L1 loss on the residuals (relative ratio error and the push's out-of-plane
+#: slope, both dimensionless): beyond 10 % a residual counts linearly.
+_LOSS_SCALE = 0.1
+
+
+class SensorCalibrationError(SensingAntennaError, ValueError):
+    """The recordings cannot calibrate the sensor (too few usable ones)."""
+
+
+@dataclass(frozen=True)
+class SensorCalibration:
+    """The fitted sensor correction and what it did.
+
+    Attributes
+    ----------
+    correction : SensorCorrection
+    sweeps : tuple of str
+        The sweep directions fitted ("azimuthal", "vertical").
+    sources : tuple of str
+        The recordings used.
+    notes : tuple of str
+        Recordings left out and why.
+    ratio_rms_before, ratio_rms_after : float
+        RMS relative error of the hold's torque/force ratio against the known points, without
+        and with the correction (dimensionless).
+    """
+
+    correction: SensorCorrection
+    sweeps: tuple[str, ...]
+    sources: tuple[str, ...]
+    notes: tuple[str, ...]
+    ratio_rms_before: float
+    ratio_rms_after: float
+
+    def apply(self, antenna: Antenna) -> Antenna:
+        """``antenna`` with this correction."""
+        return replace(antenna, sensor=self.correction)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able summary."""
+        return {
+            "correction": {k: float(v) for k, v in vars(self.correction).items()},
+            "sweeps": list(self.sweeps),
+            "sources": list(self.sources),
+            "notes": list(self.notes),
+            "ratio_rms_before": self.ratio_rms_before,
+            "ratio_rms_after": self.ratio_rms_after,
+        }
+
+
+@dataclass(frozen=True)
+class _Hold:
+    sweep: str
+    x_c: float
+    reaction: FloatArray  # (3,) N, uncorrected
+    moment: FloatArray  # (3,) N m
+
+
+def calibrate_sensor(
+    recordings: Sequence[Any],
+    antenna: Antenna,
+    contact_points: Sequence[float],
+    *,
+    sources: Sequence[str] = (),
+) -> SensorCalibration:
+    """Fit the sensor's cross-talk correction to contacts at known points (module docstring).
+
+    Parameters
+    ----------
+    recordings : sequence of Recording
+        Contact manoeuvres (azimuthal or vertical sweeps), ground truth not read.
+    antenna : Antenna
+        The model, its frequency model calibrated; its own ``sensor`` is replaced.
+    contact_points : sequence of float
+        Known x_c (m) of each recording.
+
+    Raises
+    ------
+    SensorCalibrationError
+        When no sweep direction has :data:`MIN_SENSOR_RECORDINGS` usable recordings.
+    """
+    from sensing_antenna.estimation.front.ratio import perpendicular_ratio
+
+    if len(recordings) != len(contact_points):
+        raise SensorCalibrationError(
+            f"contact points: {len(contact_points)} given for {len(recordings)} recordings"
+        )
+    plain = replace(antenna, sensor=SensorCorrection())
+    names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
+    holds: list[_Hold] = []
+    used: list[str] = []
+    notes: list[str] = []
+    for name, recording, x_c in zip(names, recordings, contact_points, strict=True):
+        hold = _hold(recording, plain, float(x_c))
+        if isinstance(hold, str):
+            notes.append(f"{name}: {hold}")
+        else:
+            holds.append(hold)
+            used.append(name)
+    sweeps = tuple(
+        s for s in _PLANE_TERMS if sum(h.sweep == s for h in holds) >= MIN_SENSOR_RECORDINGS
+    )
+    if not sweeps:
+        raise SensorCalibrationError(
+            f"{len(holds)} usable recording(s): each sweep direction needs "
+            f"{MIN_SENSOR_RECORDINGS} to fit the sensor"
+            + (f" ({'; '.join(notes)})" if notes else "")
+        )
+    kept = [(h, n) for h, n in zip(holds, used, strict=True) if h.sweep in sweeps]
+    holds = [h for h, _ in kept]
+    terms = [t for s in sweeps for t in _PLANE_TERMS[s]]
+    rigidity = 1.0 / antenna.link.bending_compliance
+    reaction = np.array([h.reaction for h in holds])
+    moment = np.array([h.moment for h in holds])
+    points = np.array([h.x_c for h in holds])
+    lateral = np.array([1 if h.sweep == "azimuthal" else 2 for h in holds])
+    rows = np.arange(len(holds))
+
+    def correction(params: FloatArray) -> SensorCorrection:
+        return SensorCorrection(**dict(zip(terms, (float(p) for p in params), strict=True)))
+
+    def residuals(params: FloatArray) -> FloatArray:
+        corrected = correction(params).correct(reaction, moment)
+        ratio = perpendicular_ratio(corrected, moment, rigidity)
+        along = corrected[rows, lateral]
+        across = corrected[rows, 3 - lateral]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = np.where(np.abs(along) > 0, across / np.abs(along), 1.0)
+        return np.concatenate([ratio / points - 1.0, slope])
+
+    start = np.array([getattr(SensorCorrection(), t) for t in terms], dtype=float)
+    before = residuals(start)[: len(holds)]
+    fit = least_squares(residuals, start, loss="soft_l1", f_scale=_LOSS_SCALE)
+    after = residuals(fit.x)[: len(holds)]
+    return SensorCalibration(
+        correction=correction(fit.x),
+        sweeps=sweeps,
+        sources=tuple(n for _, n in kept),
+        notes=tuple(notes),
+        ratio_rms_before=_rms(before),
+        ratio_rms_after=_rms(after),
+    )
+
+
+def _rms(values: FloatArray) -> float:
+    finite = values[np.isfinite(values)]
+    return float(np.sqrt(np.mean(finite**2))) if finite.size else math.nan
+
+
+def _hold(recording: Any, antenna: Antenna, x_c: float) -> _Hold | str:
+    """The hold's mean tared loads of one contact manoeuvre, or why it cannot be used."""
+    from sensing_antenna.calibration.observer import units_problem
+    from sensing_antenna.estimation import gather
+    from sensing_antenna.estimation.front.evidence import Evidence
+    from sensing_antenna.estimation.front.ratio import contact_loads
+    from sensing_antenna.estimation.front.steps import samples
+
+    if not (math.isfinite(x_c) and 0.0 < x_c <= antenna.link.length * (1.0 + 1e-9)):
+        return f"no known contact point on the link (x_c = {x_c!r} m)"
+    problem = units_problem(recording, antenna)
+    if problem is not None:
+        return problem
+    evidence = gather(recording, antenna)
+    if not isinstance(evidence, Evidence):
+        return f"no contact to read ({evidence.status.value}: {evidence.reason})"
+    start = evidence.rest_index
+    stop = min(
+        start + samples(evidence.config.frame_window, evidence.sample_period) + 1,
+        evidence.theta.shape[0],
+    )
+    hold = slice(start, stop)
+    reaction, moment = contact_loads(
+        evidence.theta[hold], evidence.force[hold], evidence.torque[hold], antenna
+    )
+    offset = evidence.load_offset
+    before = evidence.theta[: evidence.contact_index + 1]
+    span = np.ptp(before, axis=0) if before.shape[0] else np.zeros(2)
+    sweep = "azimuthal" if span[0] >= span[1] else "vertical"
+    return _Hold(
+        sweep=sweep,
+        x_c=min(x_c, antenna.link.length),
+        reaction=(reaction - offset[:3]).mean(axis=0),
+        moment=(moment - offset[3:]).mean(axis=0),
+    )

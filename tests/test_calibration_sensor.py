@@ -1,0 +1,152 @@
+"""The F/T sensor's cross-talk correction: its algebra, its file section, and its calibration
+from contacts at known points on a simulated device whose sensor leaks its torques into its
+forces."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna.antenna import (
+    AntennaConfigError,
+    SensorCorrection,
+    load_antenna,
+    paper_antenna,
+    save_antenna,
+)
+from sensing_antenna.calibration.sensor import SensorCalibrationError, calibrate_sensor
+from sensing_antenna.cli import main
+from sensing_antenna.estimation import estimate
+from sensing_antenna.recording import write_recording
+from sensing_antenna.simulator import DeviceImperfections, Scenario, simulate
+
+ANTENNA = paper_antenna().self_calibrated()
+
+#: A sensor whose torque channels leak into its lateral forces: 0.6 N per N m from tz into fy
+#: and -0.8 from ty into fz (0.6 % and 0.6 % of full scale on an ATI Nano17, whose force
+#: ranges are 100 and 140 times its torque range), and 0.5 across the planes.
+_COUPLING = np.zeros((6, 6))
+_COUPLING[1, 5], _COUPLING[2, 4] = 0.6, -0.8
+_COUPLING[1, 4], _COUPLING[2, 5] = 0.5, -0.5
+LEAKY = DeviceImperfections(
+    sensor_coupling=tuple(tuple(float(c) for c in row) for row in _COUPLING)
+)
+
+POINTS = (0.3, 0.45, 0.6, 0.75, 0.9, 0.98)
+
+
+def _recordings(points: tuple[float, ...], seed: int) -> tuple[list, list[float]]:  # type: ignore[type-arg]
+    recordings, truth = [], []
+    for k, case in enumerate(("azimuthal", "vertical")):
+        for i, x in enumerate(points):
+            scenario = Scenario(case=case, contact_point=x, seed=seed + 10 * k + i, device=LEAKY)
+            recording = simulate(ANTENNA, scenario)
+            truth.append(float(recording.metadata["true_xc"]))
+            recordings.append(recording.without_ground_truth())
+    return recordings, truth
+
+
+@pytest.fixture(scope="module")
+def calibration_set() -> tuple[list, list[float]]:  # type: ignore[type-arg]
+    return _recordings(POINTS, 100)
+
+
+def test_correction_is_the_documented_linear_map() -> None:
+    correction = SensorCorrection(
+        fy_gain=1.1, fz_gain=0.9, fy_per_ty=0.2, fy_per_tz=-0.3, fz_per_ty=0.4, fz_per_tz=0.5
+    )
+    reaction = np.array([[0.01, -0.05, 0.02]])
+    moment = np.array([[0.001, 0.02, -0.03]])
+    out = correction.correct(reaction, moment)
+    assert out[0, 0] == reaction[0, 0]  # the axial force is not touched
+    assert out[0, 1] == pytest.approx(1.1 * -0.05 + 0.2 * 0.02 - 0.3 * -0.03)
+    assert out[0, 2] == pytest.approx(0.9 * 0.02 + 0.4 * 0.02 + 0.5 * -0.03)
+    assert SensorCorrection().correct(reaction, moment) is reaction
+
+
+def test_sensor_section_round_trips_and_bad_values_name_the_field(tmp_path: Path) -> None:
+    antenna = dataclasses.replace(ANTENNA, sensor=SensorCorrection(fy_per_tz=-0.6))
+    path = tmp_path / "a.toml"
+    save_antenna(antenna, path)
+    assert "[sensor]" in path.read_text()
+    assert load_antenna(path).sensor == antenna.sensor
+    save_antenna(ANTENNA, path)
+    assert "[sensor]" not in path.read_text()  # no correction, no section
+    for text, field in (
+        ("[sensor]\nfy_gain = 3.0\n", "sensor.fy_gain"),
+        ("[sensor]\nfz_per_ty = 1e4\n", "sensor.fz_per_ty"),
+        ("[sensor]\nfx_gain = 1.0\n", "sensor.fx_gain"),
+    ):
+        path.write_text('base = "paper-2021"\n' + text)
+        with pytest.raises(AntennaConfigError, match=field):
+            load_antenna(path)
+
+
+def test_calibration_undoes_the_cross_talk_on_new_contacts(
+    calibration_set: tuple[list, list[float]],  # type: ignore[type-arg]
+) -> None:
+    recordings, truth = calibration_set
+    fit = calibrate_sensor(recordings, ANTENNA, truth)
+    assert fit.sweeps == ("azimuthal", "vertical")
+    # the coupling shrinks the ratio by tens of per cent; corrected, what is left is the
+    # ratio's own noise at the default gentle push (a few per cent)
+    assert fit.ratio_rms_before > 0.15
+    assert fit.ratio_rms_after < 0.05
+    # the cross-plane terms are read directly from the push's direction: within 20 % of the
+    # leak they undo
+    assert fit.correction.fz_per_tz == pytest.approx(0.5, rel=0.2)
+    assert fit.correction.fy_per_ty == pytest.approx(-0.5, rel=0.2)
+    corrected = fit.apply(ANTENNA)
+    new, new_truth = _recordings((0.4, 0.7), 500)
+    for recording, x_c in zip(new, new_truth, strict=True):
+        before = estimate(recording, ANTENNA, "ratio").ratio_estimate
+        after = estimate(recording, corrected, "ratio").ratio_estimate
+        assert abs(before / x_c - 1) > 0.1
+        # 8 %: three times the ratio's scatter left on the calibration set
+        assert abs(after / x_c - 1) < 0.08
+        assert estimate(recording, corrected, "paper").status.value == "ok"
+
+
+def test_one_sweep_direction_fits_its_own_terms_only(
+    calibration_set: tuple[list, list[float]],  # type: ignore[type-arg]
+) -> None:
+    recordings, truth = calibration_set
+    half = len(POINTS)
+    fit = calibrate_sensor(recordings[:half], ANTENNA, truth[:half])
+    assert fit.sweeps == ("azimuthal",)
+    assert (fit.correction.fz_gain, fit.correction.fz_per_ty, fit.correction.fy_per_ty) == (
+        1.0,
+        0.0,
+        0.0,
+    )
+    with pytest.raises(SensorCalibrationError, match="needs 4"):
+        calibrate_sensor(recordings[:3], ANTENNA, truth[:3])
+
+
+def test_cli_calibrate_writes_the_sensor_and_no_sensor_keeps_it(
+    tmp_path: Path,
+    calibration_set: tuple[list, list[float]],  # type: ignore[type-arg]
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    recordings, truth = calibration_set
+    paths = []
+    for i, recording in enumerate(recordings):
+        path = tmp_path / f"cal{i}.csv"
+        write_recording(recording, path)
+        paths.append(path)
+    table = tmp_path / "points.csv"
+    table.write_text(
+        "file,x_c\n" + "".join(f"{p.name},{x}\n" for p, x in zip(paths, truth, strict=True))
+    )
+    start = tmp_path / "start.toml"
+    save_antenna(ANTENNA, start)
+    out = tmp_path / "cal.toml"
+    args = ["calibrate", *map(str, paths), "--antenna", str(start), "--points", str(table)]
+    assert main([*args, "--out", str(out)]) == 0
+    assert "sensor: cross-talk fitted on 12 recordings" in capsys.readouterr().out
+    assert not load_antenna(out).sensor.is_identity
+    assert main([*args, "--out", str(out), "--no-sensor"]) == 0
+    assert load_antenna(out).sensor.is_identity
