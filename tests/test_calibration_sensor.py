@@ -68,7 +68,9 @@ def test_correction_is_the_documented_linear_map() -> None:
 
 
 def test_sensor_section_round_trips_and_bad_values_name_the_field(tmp_path: Path) -> None:
-    antenna = dataclasses.replace(ANTENNA, sensor=SensorCorrection(fy_per_tz=-0.6))
+    antenna = dataclasses.replace(
+        ANTENNA, sensor=SensorCorrection(fy_per_tz=-0.6, ratio_scatter=0.03)
+    )
     path = tmp_path / "a.toml"
     save_antenna(antenna, path)
     assert "[sensor]" in path.read_text()
@@ -79,6 +81,7 @@ def test_sensor_section_round_trips_and_bad_values_name_the_field(tmp_path: Path
         ("[sensor]\nfy_gain = 3.0\n", "sensor.fy_gain"),
         ("[sensor]\nfz_per_ty = 1e4\n", "sensor.fz_per_ty"),
         ("[sensor]\nfx_gain = 1.0\n", "sensor.fx_gain"),
+        ("[sensor]\nratio_scatter = -0.1\n", "sensor.ratio_scatter"),
     ):
         path.write_text('base = "paper-2021"\n' + text)
         with pytest.raises(AntennaConfigError, match=field):
@@ -95,6 +98,10 @@ def test_calibration_undoes_the_cross_talk_on_new_contacts(
     # ratio's own noise at the default gentle push (a few per cent)
     assert fit.ratio_rms_before > 0.15
     assert fit.ratio_rms_after < 0.05
+    # the scatter left is kept as the ratio's model floor: its rms over the degrees of freedom
+    n = len(truth)
+    expected = fit.ratio_rms_after * (n / (n - 4)) ** 0.5
+    assert fit.correction.ratio_scatter == pytest.approx(expected, rel=1e-6)
     # the cross-plane terms are read directly from the push's direction: within 20 % of the
     # leak they undo
     assert fit.correction.fz_per_tz == pytest.approx(0.5, rel=0.2)

@@ -324,3 +324,16 @@ def test_a_lighter_reading_never_gives_a_negative_tip_mass() -> None:
     fit = identify_free_motion(_with_payload(_free_motion(4, noise=1e-4), -2e-4), ANTENNA)
     assert fit.payload is not None and fit.payload.significant and fit.payload.mass < 0
     assert fit.payload.apply(ANTENNA).link.tip_mass == 0.0
+
+
+def test_payload_of_a_calibrated_link_goes_to_its_weight_alone() -> None:
+    # A link whose tip mass a calibration fitted to the frequencies keeps the weight read at
+    # rest apart (weight_tip_mass): a payload read later adds to that weight, not to the
+    # frequency model's effective mass
+    noise = 1e-4
+    fit = identify_free_motion(_with_payload(_free_motion(3, noise=noise), 2e-4), ANTENNA)
+    assert fit.payload is not None and fit.payload.significant
+    link = dataclasses.replace(ANTENNA.link, tip_mass=5e-5, weight_tip_mass=0.0)
+    applied = fit.payload.apply(dataclasses.replace(ANTENNA, link=link)).link
+    assert applied.tip_mass == 5e-5
+    assert applied.weight_tip_mass == pytest.approx(fit.payload.mass)

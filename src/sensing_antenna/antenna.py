@@ -221,6 +221,12 @@ class Link:
         Relative error of omega_1(x_c) with that T_e, from the calibration's residuals
         (dimensionless, e.g. 0.001 for 0.1 %); the fast method's model floor on omega_1 is at
         least this. None: not measured.
+    weight_tip_mass : float or None
+        The tip mass the link's weight shows at rest (kg), where it differs from the
+        ``tip_mass`` the vibration shows: a calibration that fits the tip mass to the contact
+        frequencies (it also takes up a taper or a joint, so it is an effective mass) keeps the
+        weight the sensor read here. The weight, its moment and the sag use it; None:
+        ``tip_mass``.
     """
 
     length: float
@@ -231,11 +237,15 @@ class Link:
     second_moment: float | None = None
     calibrated_t: float | None = None
     calibration_scatter: float | None = None
+    weight_tip_mass: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("length", "radius", "youngs_modulus", "linear_density"):
             _require_positive("link", name, getattr(self, name))
         _require_non_negative("link", "tip_mass", self.tip_mass)
+        if self.weight_tip_mass is not None:
+            _require_non_negative("link", "weight_tip_mass", self.weight_tip_mass)
+            PARAMETER_RANGES["link.tip_mass"].check("link.weight_tip_mass", self.weight_tip_mass)
         if self.second_moment is not None:
             _require_positive("link", "second_moment", self.second_moment)
         if self.calibrated_t is not None:
@@ -288,7 +298,7 @@ class Link:
         """Tip deflection (m) of the link held horizontal under its weight and the tip mass,
         in linear beam theory: g (rho l^4 / 8 + m_t l^3 / 3) / (E I), from the material data
         (a calibrated T_e does not enter). Paper link: 5.9 cm."""
-        rho, m_t, length = self.linear_density, self.tip_mass, self.length
+        rho, m_t, length = self.linear_density, self.weighed_tip_mass, self.length
         load = rho * length**4 / 8.0 + m_t * length**3 / 3.0
         return STANDARD_GRAVITY * load / self.flexural_rigidity
 
@@ -302,16 +312,21 @@ class Link:
         """Link mass m_b = rho l (kg)."""
         return self.linear_density * self.length
 
+    @property
+    def weighed_tip_mass(self) -> float:
+        """The tip mass the weight shows (kg): ``weight_tip_mass``, else ``tip_mass``."""
+        return self.tip_mass if self.weight_tip_mass is None else self.weight_tip_mass
+
     @functools.cached_property
     def weight(self) -> float:
         """Weight of the link and its tip mass, (m_b + m_t) g (N)."""
-        return (self.mass + self.tip_mass) * STANDARD_GRAVITY
+        return (self.mass + self.weighed_tip_mass) * STANDARD_GRAVITY
 
     @functools.cached_property
     def weight_moment(self) -> float:
         """Moment of that weight about the joint, straight link held horizontal,
         (m_b l / 2 + m_t l) g (N m)."""
-        return (0.5 * self.mass + self.tip_mass) * self.length * STANDARD_GRAVITY
+        return (0.5 * self.mass + self.weighed_tip_mass) * self.length * STANDARD_GRAVITY
 
     @property
     def bending_compliance(self) -> float:
@@ -329,7 +344,7 @@ class Link:
         x = np.asarray(x, dtype=float)
         length = self.length
         link = self.linear_density * x**2 * (6 * length**2 - 4 * length * x + x**2) / 24.0
-        tip = self.tip_mass * x**2 * (3 * length - x) / 6.0
+        tip = self.weighed_tip_mass * x**2 * (3 * length - x) / 6.0
         return np.asarray((link + tip) * self.bending_compliance)
 
     @functools.cached_property
@@ -343,7 +358,7 @@ class Link:
         m_t^2 l^3 / 3) / (E I). Paper link: 1.06e-3 N m (a 5.9 cm tip sag), so 1.1e-4 N m
         between theta2 = -0.10 and +0.03 rad.
         """
-        rho, m_t, length = self.linear_density, self.tip_mass, self.length
+        rho, m_t, length = self.linear_density, self.weighed_tip_mass, self.length
         integral = (
             rho**2 * length**5 / 20.0 + rho * m_t * length**4 / 4.0 + m_t**2 * length**3 / 3.0
         ) * self.bending_compliance
@@ -509,6 +524,10 @@ class SensorCorrection:
         Gains of the lateral force channels relative to the moments' (dimensionless).
     fy_per_ty, fy_per_tz, fz_per_ty, fz_per_tz : float
         Force read per unit moment (N per N m = 1/m).
+    ratio_scatter : float
+        Relative scatter of the torque/force ratio about the known points with the correction,
+        as its calibration measured it (dimensionless): the ratio's model uncertainty is at
+        least this fraction of x_c. 0: not measured.
     """
 
     fy_gain: float = 1.0
@@ -517,6 +536,7 @@ class SensorCorrection:
     fy_per_tz: float = 0.0
     fz_per_ty: float = 0.0
     fz_per_tz: float = 0.0
+    ratio_scatter: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -538,11 +558,15 @@ class SensorCorrection:
                     f"must lie within +-{MAX_SENSOR_COUPLING:g} 1/m (N per N m), got "
                     f"{getattr(self, name)!r}",
                 )
+        if not 0.0 <= self.ratio_scatter <= 1.0:
+            raise AntennaConfigError(
+                "sensor.ratio_scatter", f"must lie in [0, 1], got {self.ratio_scatter!r}"
+            )
 
     @property
     def is_identity(self) -> bool:
-        """True when the correction changes nothing."""
-        return self == SensorCorrection()
+        """True when the correction changes no force (its scatter aside)."""
+        return replace(self, ratio_scatter=0.0) == SensorCorrection()
 
     def correct(
         self, reaction: NDArray[np.float64], moment: NDArray[np.float64]
@@ -781,7 +805,7 @@ def antenna_to_toml(antenna: Antenna) -> str:
             value = getattr(obj, f.name)
             if value is not None:
                 lines.append(f"{f.name} = {float(value)!r}")
-    if not antenna.sensor.is_identity:
+    if antenna.sensor != SensorCorrection():
         lines += ["", "[sensor]"]
         lines += [
             f"{f.name} = {float(getattr(antenna.sensor, f.name))!r}"

@@ -33,6 +33,8 @@ from sensing_antenna.errors import SensingAntennaError
 __all__ = [
     "CALIBRATION_BAND",
     "LOSSES",
+    "MIN_TIP_MASS_POINTS",
+    "TIP_MASS_LOSS_SCALE",
     "WRONG_PEAK",
     "CalibrationError",
     "FrequencyCalibration",
@@ -97,6 +99,9 @@ class FrequencyCalibration:
         Where each point came from (file names), same order as ``contact_points``.
     notes : tuple of str
         Why points were left out, one note per excluded point.
+    tip_mass : float or None
+        The tip mass fitted with T_e (kg; :func:`calibrate_t_e` with ``fit_tip_mass``), None
+        when T_e alone was fitted.
     """
 
     t_e: float
@@ -109,6 +114,7 @@ class FrequencyCalibration:
     loss: str = "soft_l1"
     sources: tuple[str, ...] = ()
     notes: tuple[str, ...] = field(default=())
+    tip_mass: float | None = None
 
     def __post_init__(self) -> None:
         n = self.contact_points.shape
@@ -134,17 +140,19 @@ class FrequencyCalibration:
         """Relative error of the calibrated model omega_1(x_c), dimensionless; NaN if unknown.
 
         The root-mean-square relative residual (measured / fitted - 1) over the points used,
-        with n - 1 degrees of freedom (T_e is fitted). It measures how far the device departs
-        from the one-parameter model along the link (a compliant contact, a base that is not a
-        clamp, contacts away from the given points), which T_e cannot absorb. A point more than
+        with n - 1 degrees of freedom (T_e is fitted; n - 2 with the tip mass). It measures
+        how far the device departs from the fitted model along the link (a compliant contact, a
+        base that is not a clamp, contacts away from the given points), which the fit cannot
+        absorb. A point more than
         :data:`WRONG_PEAK` from the median is a wrong spectral peak, not model error, and is
         left out (:attr:`wrong_peaks`); NaN with fewer than 3 points left.
         """
         kept = self._relative_residuals()
         kept = kept[~self._wrong_peak_mask(kept)]
-        if kept.size < 3:
+        fitted = 1 if self.tip_mass is None else 2
+        if kept.size < 2 + fitted:
             return math.nan
-        return math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
+        return math.sqrt(float(np.sum(kept**2)) / (kept.size - fitted))
 
     @property
     def wrong_peaks(self) -> int:
@@ -167,9 +175,15 @@ class FrequencyCalibration:
         return (self.t_e - self.t_theoretical) / self.t_theoretical
 
     def apply(self, antenna: Antenna) -> Antenna:
-        """The antenna with this T_e as its calibrated T and :attr:`relative_scatter` as its
-        calibration scatter (none when unknown)."""
+        """The antenna with this T_e as its calibrated T, :attr:`relative_scatter` as its
+        calibration scatter (none when unknown) and the fitted tip mass, when fitted (the
+        weight keeps the antenna's tip mass, ``Link.weight_tip_mass``)."""
         scatter = self.relative_scatter
+        if self.tip_mass is not None:
+            # the weight the sensor reads at rest stays the antenna's (weight_tip_mass)
+            link = antenna.link
+            link = replace(link, tip_mass=self.tip_mass, weight_tip_mass=link.weighed_tip_mass)
+            antenna = replace(antenna, link=link)
         return antenna.with_calibrated_t(self.t_e, scatter if math.isfinite(scatter) else None)
 
     def to_dict(self) -> dict[str, Any]:
@@ -183,6 +197,7 @@ class FrequencyCalibration:
             "wrong_peaks": self.wrong_peaks,
             "rms_residual": _json_float(self.rms_residual),
             "loss": self.loss,
+            "tip_mass": self.tip_mass,
             "points": [
                 {
                     "source": self.sources[i] if i < len(self.sources) else "",
@@ -222,6 +237,7 @@ class FrequencyCalibration:
             loss=str(data.get("loss", "soft_l1")),
             sources=tuple(str(p.get("source", "")) for p in points),
             notes=tuple(str(n) for n in data.get("notes", [])),
+            tip_mass=None if data.get("tip_mass") is None else float(data["tip_mass"]),
         )
 
 
@@ -319,8 +335,18 @@ def calibrate_t_e(
     loss: str = "soft_l1",
     sources: Sequence[str] = (),
     notes: Sequence[str] = (),
+    fit_tip_mass: bool = False,
 ) -> FrequencyCalibration:
     """Fit T_e of Section 5.1 to measured fundamental frequencies at known contact points.
+
+    With ``fit_tip_mass``, the link's tip mass is fitted with it (from
+    :data:`MIN_TIP_MASS_POINTS` points on): T_e scales the whole sensing curve, a tip mass
+    reshapes it (it weighs on the overhang beyond x_c, so it lowers omega_1 most for contacts
+    near the root and least at the tip), and the two together absorb the smooth departures of a
+    real link from the uniform one (a payload, a taper, a joint, a compliant clamp) that T_e
+    alone leaves as a scatter along the link. The fit is ``scipy.optimize.least_squares`` on
+    the relative residuals, with ``loss`` at a scale of :data:`TIP_MASS_LOSS_SCALE`, from T_e
+    alone and the link's tip mass, the mass kept within [0, the link's own mass].
 
     Parameters
     ----------
@@ -355,6 +381,10 @@ def calibrate_t_e(
     k = np.full(x_c.shape, math.nan)
     k[on_link] = model_beta1_squared(link, x_c[on_link])
     t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
+    tip_mass = None
+    if fit_tip_mass and int(used.sum()) >= MIN_TIP_MASS_POINTS:
+        t_e, std_error, tip_mass = _fit_with_tip_mass(link, x_c[used], w[used], t_e, loss)
+        k[on_link] = model_beta1_squared(replace(link, tip_mass=tip_mass), x_c[on_link])
     return FrequencyCalibration(
         t_e=t_e,
         t_e_std_error=std_error,
@@ -367,7 +397,50 @@ def calibrate_t_e(
         loss=loss,
         sources=tuple(sources),
         notes=(*left_out, *notes),
+        tip_mass=tip_mass,
     )
+
+
+#: Points a fit of the tip mass with T_e needs (two parameters, and two degrees of freedom
+#: left for the scatter).
+MIN_TIP_MASS_POINTS = 4
+
+#: Scale of the robust loss of that fit, on relative residuals: 1 %, beyond which a point counts
+#: linearly (model departures left by the two parameters are tenths of a per cent, a wrong
+#: spectral peak tens of per cent).
+TIP_MASS_LOSS_SCALE = 0.01
+
+
+def _fit_with_tip_mass(
+    link: Link, x_c: NDArray[np.float64], omega: NDArray[np.float64], t_e: float, loss: str
+) -> tuple[float, float, float]:
+    """(T_e in s/m^2, its standard error, tip mass in kg) fitted to omega_1 at ``x_c``."""
+
+    def residuals(params: NDArray[np.float64]) -> NDArray[np.float64]:
+        inverse_t, mass = params
+        k = model_beta1_squared(replace(link, tip_mass=float(mass)), x_c)
+        return np.asarray(k * inverse_t / omega - 1.0, dtype=float)
+
+    start = np.array([1.0 / t_e, min(max(link.tip_mass, 0.0), link.mass)])
+    fit = least_squares(
+        residuals,
+        start,
+        bounds=([0.0, 0.0], [np.inf, link.mass]),
+        x_scale=[start[0], 0.01 * link.mass],
+        loss=loss,
+        f_scale=TIP_MASS_LOSS_SCALE,
+    )
+    inverse_t, mass = (float(v) for v in fit.x)
+    dof = x_c.size - 2
+    std_error = math.nan
+    if dof > 0:
+        variance = float(np.sum(fit.fun**2)) / dof
+        try:
+            covariance = np.linalg.inv(fit.jac.T @ fit.jac) * variance
+            std_error = math.sqrt(max(float(covariance[0, 0]), 0.0)) / inverse_t**2
+        except np.linalg.LinAlgError:
+            pass
+    return 1.0 / inverse_t, std_error, mass
 
 
 #: Contact points this many ulp of l past the link's end are at the end: a point written as
@@ -403,8 +476,10 @@ def calibrate_from_recordings(
     sources: Sequence[str] = (),
     band: tuple[float, float] = CALIBRATION_BAND,
     loss: str = "soft_l1",
+    fit_tip_mass: bool = False,
 ) -> FrequencyCalibration:
-    """Measure omega_1 in each recording and fit T_e (Section 5.1).
+    """Measure omega_1 in each recording and fit T_e (Section 5.1), and the tip mass with
+    ``fit_tip_mass`` (:func:`calibrate_t_e`).
 
     Parameters
     ----------
@@ -454,7 +529,15 @@ def calibrate_from_recordings(
             )
         else:
             omega[i] = value
-    return calibrate_t_e(contact_points, omega, antenna.link, loss=loss, sources=names, notes=notes)
+    return calibrate_t_e(
+        contact_points,
+        omega,
+        antenna.link,
+        loss=loss,
+        sources=names,
+        notes=notes,
+        fit_tip_mass=fit_tip_mass,
+    )
 
 
 def read_contact_points(

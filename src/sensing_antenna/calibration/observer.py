@@ -125,11 +125,16 @@ class Payload:
         return bool(self.samples > 1 and abs(self.mass) > PAYLOAD_SIGMAS * self.std)
 
     def apply(self, antenna: Antenna) -> Antenna:
-        """``antenna`` with the payload in ``link.tip_mass`` when significant (never below 0)."""
+        """``antenna`` with the payload in ``link.tip_mass`` when significant (never below 0);
+        in ``link.weight_tip_mass`` alone when the link has one (its ``tip_mass`` is what a
+        calibration fitted to the frequencies)."""
         if not self.significant:
             return antenna
-        tip = max(0.0, antenna.link.tip_mass + self.mass)
-        return replace(antenna, link=replace(antenna.link, tip_mass=tip))
+        link = antenna.link
+        tip = max(0.0, link.weighed_tip_mass + self.mass)
+        if link.weight_tip_mass is not None:
+            return replace(antenna, link=replace(link, weight_tip_mass=tip))
+        return replace(antenna, link=replace(link, tip_mass=tip))
 
 
 @dataclass(frozen=True)

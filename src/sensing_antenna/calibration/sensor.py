@@ -18,7 +18,8 @@ not pull the fit). The loads are the hold's mean (the window the contact frame u
 the contact-free offset). A sweep about the azimuth fixes fy_gain, fy_per_tz and fz_per_tz;
 one about the elevation fz_gain, fz_per_ty and fy_per_ty; terms no recording fixes stay at no
 correction. The antenna's frequency model (T_e) should be calibrated first: the statics use its
-stiffness.
+stiffness. The ratio's relative scatter about the known points left with the correction is
+kept as ``ratio_scatter``, a floor of the ratio's model uncertainty.
 """
 
 from __future__ import annotations
@@ -187,8 +188,13 @@ def calibrate_sensor(
     before = residuals(start)[: len(holds)]
     fit = least_squares(residuals, start, loss="soft_l1", f_scale=_LOSS_SCALE)
     after = residuals(fit.x)[: len(holds)]
+    # the ratio's scatter with the correction, over the degrees of freedom its in-plane terms
+    # leave (two per sweep direction)
+    finite = after[np.isfinite(after)]
+    dof = max(finite.size - 2 * len(sweeps), 1)
+    scatter = min(math.sqrt(float(np.sum(finite**2)) / dof), 1.0)
     return SensorCalibration(
-        correction=correction(fit.x),
+        correction=replace(correction(fit.x), ratio_scatter=scatter),
         sweeps=sweeps,
         sources=tuple(n for _, n in kept),
         notes=tuple(notes),

@@ -32,6 +32,7 @@ A spec file looks like::
     repeats = 1
     loss = "soft_l1"
     sensor = true                   # also the sensor's cross-talk, from both sweep directions
+    tip_mass = true                 # fit the tip mass with T_e
 
     [noise_sweep]                   # optional: extra runs at other sensor noise levels
     noise_scales = [0.5, 2.0]       # multiples of the simulator's nominal noise; [] for none
@@ -359,7 +360,7 @@ def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
 def _parse_calibration(data: Any, source: str) -> CalibrationStep:
     if not isinstance(data, Mapping):
         raise CampaignSpecError("calibration", "must be a table", source)
-    known = ("enabled", "case", "contact_points", "repeats", "loss", "sensor")
+    known = ("enabled", "case", "contact_points", "repeats", "loss", "sensor", "tip_mass")
     for key in data:
         if key not in known:
             raise CampaignSpecError(
@@ -367,7 +368,8 @@ def _parse_calibration(data: Any, source: str) -> CalibrationStep:
             )
     enabled = data.get("enabled", False)
     sensor = data.get("sensor", False)
-    for key, flag in (("enabled", enabled), ("sensor", sensor)):
+    tip_mass = data.get("tip_mass", False)
+    for key, flag in (("enabled", enabled), ("sensor", sensor), ("tip_mass", tip_mass)):
         if not isinstance(flag, bool):
             raise CampaignSpecError(f"calibration.{key}", "must be true or false", source)
     case = data.get("case", "azimuthal")
@@ -392,6 +394,7 @@ def _parse_calibration(data: Any, source: str) -> CalibrationStep:
             repeats=repeats,
             loss=loss,
             sensor=sensor,
+            tip_mass=tip_mass,
         )
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc

@@ -273,6 +273,8 @@ class CalibrationStep:
         Also calibrate the F/T sensor's cross-talk (``calibration.sensor``) on the step's
         recordings and as many of the other sweep direction at the same points; T_e is fitted
         on the step's ``case`` alone.
+    tip_mass : bool
+        Fit the link's tip mass with T_e (``calibration.frequency.calibrate_t_e``).
     """
 
     enabled: bool = False
@@ -281,6 +283,7 @@ class CalibrationStep:
     repeats: int = 1
     loss: str = "soft_l1"
     sensor: bool = False
+    tip_mass: bool = False
 
     def __post_init__(self) -> None:
         if self.case not in CASES:
@@ -322,8 +325,8 @@ class CalibrationStep:
         return len(self.cases) * len(self.contact_points) * self.repeats
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data in the layout of the TOML section (``sensor`` only when set, so a spec
-        without it keeps its fingerprint)."""
+        """Plain data in the layout of the TOML section (``sensor`` and ``tip_mass`` only when
+        set, so a spec without them keeps its fingerprint)."""
         data: dict[str, Any] = {
             "enabled": self.enabled,
             "case": self.case,
@@ -333,6 +336,8 @@ class CalibrationStep:
         }
         if self.sensor:
             data["sensor"] = True
+        if self.tip_mass:
+            data["tip_mass"] = True
         return data
 
 

@@ -210,6 +210,7 @@ def calibrate_on_device(
             [points[i] for i in own],
             sources=[names[i] for i in own],
             loss=step.loss,
+            fit_tip_mass=step.tip_mass,
         )
     except CalibrationError as exc:
         raise CampaignSpecError(

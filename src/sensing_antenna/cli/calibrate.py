@@ -54,6 +54,12 @@ def register(subparsers: Any) -> None:
         "from pulling T_e",
     )
     parser.add_argument(
+        "--tip-mass",
+        action="store_true",
+        help="fit the link's tip mass with T_e (4 points or more, spread along the link): the "
+        "two together take up a payload, a taper or a joint that T_e alone leaves as scatter",
+    )
+    parser.add_argument(
         "--no-sensor",
         action="store_true",
         help="do not calibrate the sensor's cross-talk (keep the antenna's [sensor])",
@@ -118,7 +124,12 @@ def _run(args: argparse.Namespace) -> int:
         raise CalibrationError(f"{unread[0]} (and fewer than 2 readable recordings left)")
     points = read_contact_points(paths, recordings, args.points)
     calibration = calibrate_from_recordings(
-        recordings, antenna, points, sources=[str(p) for p in paths], loss=args.loss
+        recordings,
+        antenna,
+        points,
+        sources=[str(p) for p in paths],
+        loss=args.loss,
+        fit_tip_mass=args.tip_mass,
     )
     fitted = [path for path, used in zip(paths, calibration.used, strict=True) if used]
     description = _description(antenna.name, fitted)
@@ -134,6 +145,10 @@ def _run(args: argparse.Namespace) -> int:
         f"rms residual {calibration.rms_residual:.3g} rad/s over {int(calibration.used.sum())} "
         "points"
     )
+    if calibration.tip_mass is not None:
+        print(f"tip mass = {1e3 * calibration.tip_mass:.4g} g (fitted with T_e; link.tip_mass)")
+    elif args.tip_mass:
+        print("tip mass: not fitted (fewer than 4 points), link.tip_mass kept")
     scatter = calibration.relative_scatter
     print(
         f"model scatter {100.0 * scatter:.3f} % (rms relative residual; written as "

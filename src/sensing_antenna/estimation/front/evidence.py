@@ -245,7 +245,8 @@ class Evidence:
             relative uncertainty: E I = rho / T^2), on its corrections |R_x / R_perp| d x_c
             and 0.6 d^2 x_c (first and second order); the weight of the bent link, which is
             not the free link's the gravity model removes: ``ratio_model_factor`` times
-            :func:`bent_weight_moment` / |R_perp|; and a floor, ``ratio_model_floor`` x_c, for
+            :func:`bent_weight_moment` / |R_perp|; and a floor, ``ratio_model_floor`` x_c (or
+            the sensor calibration's ``ratio_scatter`` x_c when larger), for
             what no statics here holds (the contact's own size and compliance, dynamic loads
             left in the mean);
           - ``statics="small-deflection"`` (Eq. 21 as printed, the ``ratio`` baseline): the
@@ -279,7 +280,8 @@ class Evidence:
         """The elastica statics' model term of :meth:`ratio_uncertainty` (m), at contact points
         ``x_c`` (m, any shape, on the link): the stiffness's uncertainty on the statics'
         corrections, the bent link's weight (:func:`bent_weight_moment`), and the floor
-        ``ratio_model_floor`` x_c, in quadrature, for the hold's push (``frame``). A method
+        ``ratio_model_floor`` x_c (the sensor calibration's ``ratio_scatter`` x_c when larger),
+        in quadrature, for the hold's push (``frame``). A method
         with statics of its own that are the elastica's (``fast``) weighs them with it."""
         link = self.antenna.link
         x_c = np.asarray(x_c, dtype=float)
@@ -308,7 +310,8 @@ class Evidence:
             )
             / push
         )
-        floor = self.config.ratio_model_floor * x_c
+        # the floor, or the scatter the sensor's calibration left on the ratio if larger
+        floor = max(self.config.ratio_model_floor, self.antenna.sensor.ratio_scatter) * x_c
         return np.asarray(np.hypot(np.hypot(stiffness, weight), floor), dtype=float)
 
     def bent_link_uncertainty(self, x_c: float) -> float:
