@@ -148,6 +148,14 @@ def test_simulate_device_profile_and_file(tmp_path: Path) -> None:
     nominal = tmp_path / "n.csv"
     assert main([*base, "--out", str(nominal)]) == 0
     assert _device_of(nominal)["clamp_stiffness"] is None
+    # one build, two seeds: the same device, set up anew (the encoders' zero)
+    built = tmp_path / "built.toml"
+    built.write_text('profile = "realistic"\nbuild = 11\n', encoding="utf-8")
+    one, two = tmp_path / "b1.csv", tmp_path / "b2.csv"
+    assert main([*base, "--device", str(built), "--seed", "4", "--out", str(one)]) == 0
+    assert main([*base, "--device", str(built), "--seed", "5", "--out", str(two)]) == 0
+    assert _device_of(one)["clamp_stiffness"] == _device_of(two)["clamp_stiffness"]
+    assert _device_of(one)["encoder_offset"] != _device_of(two)["encoder_offset"]
 
 
 @pytest.mark.parametrize(
@@ -157,6 +165,7 @@ def test_simulate_device_profile_and_file(tmp_path: Path) -> None:
         ("tip_mass = -1.0\n", "device.tip_mass"),
         ('profile = "perfect"\n', "profile"),
         ("tip_mass = [\n", "not a TOML file"),
+        ('profile = "realistic"\nbuild = -2\n', "build must be an integer >= 0"),
     ],
 )
 def test_simulate_bad_device_file_is_one_line(

@@ -140,10 +140,9 @@ def _spread_text(spec: CampaignSpec) -> str:
     if spec.device.profile != "realistic" or not spec.calibration.enabled:
         return ""
     return (
-        " The realistic profile draws one device per manoeuvre, so each calibration recording "
-        "of the main device is a draw of its own (its seed on the calibration's stream): its "
-        "T_e is fitted over the spread, taking up its mean effect on omega_1, and its scatter "
-        "measures the spread (docs/campaigns.md, Second device)."
+        " The realistic profile builds one device for the campaign, and its calibration "
+        "recordings are manoeuvres of that device, each with a set-up of its own: the "
+        "calibration learns the build, not the set-up (docs/campaigns.md, Second device)."
     )
 
 
