@@ -4,7 +4,11 @@
   subtract the gravity terms; divide by the full |F_f - F_g|), the estimator of the paper's
   reference [17], read at the same t_e as the paper method.
 - ``two-frequency``: reference [22]: omega_1 and omega_2 from the spectrum, located on the
-  (omega_1, omega_2) sensing curve by the nearest point in relative distance.
+  (omega_1, omega_2) sensing curve by the nearest point in relative distance; a pair too far
+  from the curve (``EstimatorConfig.max_curve_distance``) is a ``model_mismatch``, and an
+  answer whose bent link (the curves are the straight link's,
+  ``Evidence.bent_link_uncertainty``) may move it by more than ``max_model_spread`` at two
+  standard deviations is ``uncertain``, as the paper method's candidate.
 """
 
 from __future__ import annotations
@@ -107,6 +111,7 @@ class TwoFrequencyMethod:
                 k = int(np.argmin(distance))
                 x_c = float(grid[k])
                 diag["curve_distance"] = float(distance[k])
+                problems.extend(_curve_problems(evidence, x_c, float(distance[k])))
             else:
                 problems.append(
                     (
@@ -127,3 +132,31 @@ class TwoFrequencyMethod:
             problems=problems,
             diagnostics=diag,
         )
+
+
+def _curve_problems(evidence: Evidence, x_c: float, distance: float) -> list[tuple[Status, str]]:
+    """Why the two-frequency answer ``x_c`` (m), whose measured pair lies ``distance`` (relative)
+    from the curve, is not to be trusted: off the curve, or moved by the bent link."""
+    cfg = evidence.config
+    problems: list[tuple[Status, str]] = []
+    if distance > cfg.max_curve_distance:
+        problems.append(
+            (
+                Status.MODEL_MISMATCH,
+                f"the measured omega_1 and omega_2 lie {100 * distance:.0f} % from the nearest "
+                f"point of the sensing curves (at x_c = {x_c:.3f} m), more than "
+                f"{100 * cfg.max_curve_distance:g} %: no contact point of the straight link "
+                "rings so (a push that bent the link, or a device the model does not describe)",
+            )
+        )
+    bent = 2.0 * evidence.bent_link_uncertainty(x_c)
+    if bent > cfg.max_model_spread:
+        problems.append(
+            (
+                Status.UNCERTAIN,
+                f"the push bent the link, whose frequencies the straight link's curves do not "
+                f"hold: this answer may be {100 * bent:.1f} cm off at two standard deviations, "
+                f"more than {100 * cfg.max_model_spread:g} cm",
+            )
+        )
+    return problems
