@@ -10,7 +10,8 @@ Subpackages and modules, one concept each:
 - :mod:`sensing_antenna.simulator`: the 2-DOF device simulator that writes recordings.
 - :mod:`sensing_antenna.estimation`: the front end (t_c, t_1, contact frame, Estimator 2's ratio)
   and the methods (the paper's fusion, baselines, ``fast``).
-- :mod:`sensing_antenna.calibration`: fitting T_e and the free-motion observer.
+- :mod:`sensing_antenna.calibration`: fitting T_e, the free-motion observer and the sensor's
+  cross-talk.
 - :mod:`sensing_antenna.campaign`: declarative experiment campaigns and their reports.
 - :mod:`sensing_antenna.plotting`: every figure, kept apart from computation.
 - :mod:`sensing_antenna.cli`: the ``antenna`` command; parses arguments and calls the library.

@@ -200,6 +200,11 @@ class EstimatorConfig:
         model rings so. 5 %: the pair lies within 2 % of the curve on gentle pushes of the
         calibrated realistic simulated device (median 0.2 %), and 37 to 40 % off it when a
         push bends the link by a third of x_c.
+    max_deflection_ratio : float
+        An answer at which the measured push would bend the link by more than this fraction of
+        x_c (y_c / x_c) is ``uncertain``: the statics and the frequencies of a link bent so far
+        were checked against no independent reference (the rod engine's recordings reach 33 %),
+        and a wrong answer far out on the link reads a push as such a bend. 0.4.
     """
 
     t1_source: Literal["rest", "push"] = "rest"
@@ -237,6 +242,7 @@ class EstimatorConfig:
     max_model_spread: float = 0.01
     free_motion_gain_factor: float = 5.0
     max_curve_distance: float = 0.05
+    max_deflection_ratio: float = 0.4
 
     def __post_init__(self) -> None:
         if self.t1_source not in ("rest", "push"):

@@ -116,6 +116,17 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if statics is not None:
         found.append((Status.ESTIMATORS_DISAGREE, statics))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
+    bend = float(estimate.diagnostics.get("deflection_ratio", math.nan))
+    if on_link and bend > evidence.config.max_deflection_ratio:
+        found.append(
+            (
+                Status.UNCERTAIN,
+                f"the measured push would bend the link by {100 * bend:.0f} % of x_c at "
+                f"x_c = {x_c:.3f} m, beyond the "
+                f"{100 * evidence.config.max_deflection_ratio:g} % the statics and the sensing "
+                "curves were checked to",
+            )
+        )
     payload = _payload_problem(evidence, estimate, notes)
     if payload is not None:
         found.append((Status.MODEL_MISMATCH, payload))

@@ -5,9 +5,10 @@
   reference [17], read at the same t_e as the paper method.
 - ``two-frequency``: reference [22]: omega_1 and omega_2 from the spectrum, located on the
   (omega_1, omega_2) sensing curve by the nearest point in relative distance; a pair too far
-  from the curve (``EstimatorConfig.max_curve_distance``) is a ``model_mismatch``, and an
-  answer whose bent link (the curves are the straight link's,
-  ``Evidence.bent_link_uncertainty``) may move it by more than ``max_model_spread`` at two
+  from the curve (``EstimatorConfig.max_curve_distance``, or three times what the frequency
+  model's own uncertainty allows) is a ``model_mismatch``, and an answer that the model's
+  uncertainty (and, read in the push plane alone, the bent link's,
+  ``Evidence.bent_link_uncertainty``) may move by more than ``max_model_spread`` at two
   standard deviations is ``uncertain``, as the paper method's candidate.
 """
 
@@ -111,7 +112,18 @@ class TwoFrequencyMethod:
                 k = int(np.argmin(distance))
                 x_c = float(grid[k])
                 diag["curve_distance"] = float(distance[k])
-                problems.extend(_curve_problems(evidence, x_c, float(distance[k])))
+                # read in the push plane alone: the free plane's peak does not corroborate it
+                # (the paper method's rule, methods/paper/planes.py)
+                free = measurement.peaks.get("y_c")
+                corroborated = (
+                    free is not None
+                    and free.quality >= 0.5 * cfg.min_peak_quality
+                    and measurement.components_agree(cfg.component_agreement)
+                )
+                push_plane = measurement.component == "z_c" and not corroborated
+                problems.extend(
+                    _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane)
+                )
             else:
                 problems.append(
                     (
@@ -134,29 +146,48 @@ class TwoFrequencyMethod:
         )
 
 
-def _curve_problems(evidence: Evidence, x_c: float, distance: float) -> list[tuple[Status, str]]:
-    """Why the two-frequency answer ``x_c`` (m), whose measured pair lies ``distance`` (relative)
-    from the curve, is not to be trusted: off the curve, or moved by the bent link."""
+def _curve_problems(
+    evidence: Evidence,
+    grid: NDArray[np.float64],
+    omegas: NDArray[np.float64],
+    k: int,
+    distance: float,
+    push_plane: bool,
+) -> list[tuple[Status, str]]:
+    """Why the two-frequency answer ``grid[k]`` (m), whose measured pair lies ``distance``
+    (relative) from the curve ``omegas`` (rad/s, (n, 2)), is not to be trusted: off the curve
+    by more than the model allows, or moved by the model's own uncertainty and, for frequencies
+    read in the push plane alone (``push_plane``), by the bent link, as the paper method's
+    candidate."""
     cfg = evidence.config
+    x_c = float(grid[k])
+    u = evidence.antenna.link.frequency_uncertainty
     problems: list[tuple[Status, str]] = []
-    if distance > cfg.max_curve_distance:
+    # the model's own error may put the pair off the curve by u in each frequency
+    allowed = max(cfg.max_curve_distance, cfg.disagreement_sigmas * math.sqrt(2.0) * u)
+    if distance > allowed:
         problems.append(
             (
                 Status.MODEL_MISMATCH,
                 f"the measured omega_1 and omega_2 lie {100 * distance:.0f} % from the nearest "
                 f"point of the sensing curves (at x_c = {x_c:.3f} m), more than "
-                f"{100 * cfg.max_curve_distance:g} %: no contact point of the straight link "
-                "rings so (a push that bent the link, or a device the model does not describe)",
+                f"{100 * allowed:.2g} %: no contact point of the straight link rings so (a "
+                "push that bent the link, or a device the model does not describe)",
             )
         )
-    bent = 2.0 * evidence.bent_link_uncertainty(x_c)
-    if bent > cfg.max_model_spread:
+    # every point of the curve whose two frequencies lie within 2 u of the answer's could be
+    # the contact, for a model known to u (that of another branch too)
+    near = np.all(np.abs(omegas / omegas[k] - 1.0) <= 2.0 * u, axis=1)
+    spread = float(np.max(np.abs(grid[near] - x_c))) if np.any(near) else 0.0
+    bent = 2.0 * evidence.bent_link_uncertainty(x_c) if push_plane else 0.0
+    if math.hypot(spread, bent) > cfg.max_model_spread:
         problems.append(
             (
                 Status.UNCERTAIN,
-                f"the push bent the link, whose frequencies the straight link's curves do not "
-                f"hold: this answer may be {100 * bent:.1f} cm off at two standard deviations, "
-                f"more than {100 * cfg.max_model_spread:g} cm",
+                f"the frequency model's own uncertainty ({100 * u:.2g} % of each frequency) and "
+                f"the bent link (the curves are the straight link's) may move this answer by "
+                f"{100 * math.hypot(spread, bent):.1f} cm at two standard deviations, more "
+                f"than {100 * cfg.max_model_spread:g} cm",
             )
         )
     return problems
