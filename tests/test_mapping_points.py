@@ -10,6 +10,7 @@ import pytest
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, load_antenna
 from sensing_antenna.errors import FieldError
+from sensing_antenna.estimation import estimate
 from sensing_antenna.estimation.result import ContactEstimate, Status
 from sensing_antenna.mapping import (
     BasePose,
@@ -18,6 +19,7 @@ from sensing_antenna.mapping import (
     contact_point_from_estimate,
     select_points,
 )
+from sensing_antenna.simulator import Scenario, simulate
 
 ANTENNA = load_antenna("paper-2021")
 
@@ -191,3 +193,25 @@ def test_a_quaternion_printed_to_three_decimals_is_normalised() -> None:
     assert math.degrees(math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])) == pytest.approx(
         30.0, abs=0.02
     )
+
+
+def test_a_fast_point_is_uncertain_along_its_measured_push_not_across_the_bending_plane() -> None:
+    # fast places its point with the contact frame (the push's direction the sensor measures)
+    # and reports it, so the deflection model's rho y_c lies along the push only; across the
+    # bending plane remain the sag's rho s, the encoders and the link's radius
+    antenna = ANTENNA.self_calibrated()
+    recording = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=0.5))
+    result = estimate(recording.without_ground_truth(), antenna, method="fast")
+    assert result.status is Status.OK
+    axes = np.asarray(result.diagnostics["axes_c_absolute"])
+    theta = np.asarray(result.diagnostics["theta_at_t1"])
+    x_m = _axes(*theta)[0]
+    push = axes[1] - (axes[1] @ x_m) * x_m
+    push /= np.linalg.norm(push)
+    across = np.cross(x_m, push)
+    point = contact_point_from_estimate(result, antenna)
+    rho_y_c = 0.1 * result.diagnostics["deflection"]
+    assert push @ point.covariance @ push >= rho_y_c**2
+    # the sag's part: 0.1 x 2.1 cm at 0.5 m (docs/explore.md), well below rho y_c (3.7 mm at a
+    # push of 7.5 %); with the push's direction unknown this would exceed rho y_c^2
+    assert across @ point.covariance @ across < rho_y_c**2
