@@ -3,10 +3,17 @@
 Each scene holds one primitive (sphere, cylinder, capsule, cone, torus or box, in turn), its
 largest dimension drawn in 4 to 20 cm, a random orientation, its centre 0.3 to 0.95 m from the
 head at an azimuth within +-60 degrees and a height within +-10 cm of the head's. The head sits
-at two base poses, the origin and the mirror point beyond the object, each facing it (a head on
-a robot that moves round the object). The explored region is the object's angular extent seen
-from a base, widened by 0.05 rad, with the elevations shifted by the link's sag there; the grid
-has ``--sweeps`` azimuthal and as many vertical sweeps per base.
+at ``--bases`` level base poses around the object (a head on a robot that moves round it): the
+origin and the origin turned about the vertical through the object's centre by 120 and 240
+degrees, each facing the object from the same distance, within the reach. A sweeping line first
+touches a convex object where it is tangent to it, on the object's outline seen from the base;
+two bases facing each other across the object see nearly one outline (one great circle of a
+sphere, which a cylinder along the line between them or a flat cone also passes through),
+while outlines seen from three directions 120 degrees apart lie in three planes. The explored
+region is the object's angular extent seen from a base (the same from each), widened by 0.05
+rad, with the elevations shifted by the link's sag there; the grid has ``--sweeps`` azimuthal
+and as many vertical sweeps per base: 36 sweeps by default, about the 32 of two bases with 8
+each, so that the contacts stay near 20 per object.
 
 Each scene is explored twice with ``exploration.explore`` (every sweep simulated: first touch,
 contact physics, recording, estimate with ``--method``), once per strategy with the grid's size
@@ -16,10 +23,13 @@ touched), the points used (status ok), the RMS and largest distance of the point
 surface, the RMS of the fitted surface to the true one near the points (mesh vertices within
 1 cm of a contact) after a quarter, half, three quarters and all of the sweeps, a Chamfer
 distance between that surface and the true surface's patch near the points, the recognition
-(right, abstained, confidently wrong) and the size error of the true class's fit, and the
-simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.json``.
+(right, abstained, confidently wrong) and the size error of the true class's fit, the
+Mahalanobis distance of each ``ok`` point's true contact point under its covariance, and the
+simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.json`` after
+every exploration (a run stopped early keeps the scenes it finished).
 
-Run: ``python benchmarks/eval_explore.py [--scenes 12] [--sweeps 8] [--method fast] [--seed 0]``.
+Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 6] [--bases 3]
+[--strategies grid next-best] [--method fast] [--seed 0] [--out FILE]``.
 """
 
 from __future__ import annotations
@@ -85,8 +95,34 @@ def make_object(
     return extents, {"extents": sorted(extents)}
 
 
+def base_poses(centre: np.ndarray, n_bases: int) -> tuple[BasePose, ...]:
+    """``n_bases`` level base poses around the object, the first at the origin, the others
+    turned about the vertical through ``centre`` (m, shape (3,)) by 2 pi k / n_bases, each
+    facing the object at the first's horizontal distance (two: the origin and the mirror point
+    beyond the object)."""
+    azimuth = math.atan2(centre[1], centre[0])
+    poses = []
+    for k in range(n_bases):
+        turn = 2 * math.pi * k / n_bases
+        c, s = math.cos(turn), math.sin(turn)
+        # O_k = c + R_z(turn) (0 - c), horizontally; level with the first base
+        position = np.array(
+            [
+                centre[0] - (c * centre[0] - s * centre[1]),
+                centre[1] - (s * centre[0] + c * centre[1]),
+                0.0,
+            ]
+        )
+        yaw = azimuth + turn
+        rotation = np.array(
+            [[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]]
+        )
+        poses.append(BasePose(rotation, position))
+    return tuple(poses)
+
+
 def make_scene(
-    index: int, seed: int, sweeps: int, shape: LinkShape
+    index: int, seed: int, sweeps: int, shape: LinkShape, n_bases: int = 3
 ) -> tuple[Scene, dict[str, Any]]:
     rng = np.random.default_rng([seed, index])
     name = CLASSES[index % len(CLASSES)]
@@ -103,15 +139,7 @@ def make_scene(
         shift = centre - obj.mesh.bounds.mean(axis=0)
         obj = primitive_object(name, name, sizes, centre + shift, rotation)
     radius = float(np.max(np.linalg.norm(obj.mesh.vertices - centre, axis=1)))
-    yaw = [azimuth, azimuth + math.pi]
-    positions = [np.zeros(3), np.array([2 * centre[0], 2 * centre[1], 0.0])]
-    bases = tuple(
-        BasePose(
-            np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]]),
-            p,
-        )
-        for a, p in zip(yaw, positions, strict=True)
-    )
+    bases = base_poses(centre, n_bases)
     horizontal = math.hypot(centre[0], centre[1])
     spread = math.asin(min(radius / horizontal, 1.0)) + MARGIN
     sag = float(np.interp(horizontal, shape.abscissae, shape.sag(0.0)))
@@ -156,6 +184,18 @@ def surface_scores(points: list[Any], mesh: trimesh.Trimesh) -> dict[str, float]
     return {"surface_rms_m": float(np.sqrt(np.mean(distance**2))), "chamfer_m": chamfer}
 
 
+def mahalanobis(points: list[Any]) -> list[float]:
+    """Each point's Mahalanobis distance to the simulator's true contact point under its own
+    covariance (points without a truth left out); a calibrated 3-D covariance gives a median
+    of 1.54, the chi distribution's with 3 degrees of freedom."""
+    distances = []
+    for p in points:
+        if np.all(np.isfinite(p.true_point)):
+            error = p.point - p.true_point
+            distances.append(float(math.sqrt(error @ np.linalg.solve(p.covariance, error))))
+    return distances
+
+
 def run(
     scene: Scene,
     info: dict[str, Any],
@@ -189,6 +229,7 @@ def run(
         row["point_max_m"] = float(np.max(distance))
     else:
         row["point_rms_m"] = row["point_max_m"] = math.nan
+    row["mahalanobis"] = mahalanobis(used)
     progress = []
     for fraction in (0.25, 0.5, 0.75, 1.0):
         k = max(1, round(fraction * len(manoeuvres)))
@@ -236,6 +277,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         return float(np.mean(values)) if values else None
 
     recognised = [r for r in rows if r["decision"] is not None]
+    distances = [d for r in rows for d in r["mahalanobis"]]
     return {
         "scenes": len(rows),
         "mean_contacts": float(np.mean([r["contacts"] for r in rows])),
@@ -253,60 +295,29 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         )
         if any(r["right"] for r in rows)
         else None,
+        "median_mahalanobis": float(np.median(distances)) if distances else None,
+        "mahalanobis_quantiles": {
+            str(q): float(np.quantile(distances, q)) for q in (0.1, 0.5, 0.9, 0.99)
+        }
+        if distances
+        else None,
         "mean_sweep_time_s": mean("sweep_time_s"),
         "mean_run_s": mean("run_s"),
     }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scenes", type=int, default=12)
-    parser.add_argument("--sweeps", type=int, default=8, help="grid sweeps per case and base")
-    parser.add_argument("--method", choices=("paper", "fast"), default="fast")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, default=RESULTS)
-    args = parser.parse_args()
-    device = paper_antenna()
-    shape = LinkShape(device.link)
-    rows: list[dict[str, Any]] = []
-    with tempfile.TemporaryDirectory(prefix="eval-explore-") as folder:
-        workdir = Path(folder)
-        calibrated = workdir / "calibrated.toml"
-        calibrated.write_text(antenna_to_toml(calibrate_device(device)))
-        for index in range(args.scenes):
-            scene, info = make_scene(index, args.seed, args.sweeps, shape)
-            for strategy in STRATEGIES:
-                row = {
-                    "scene": index,
-                    **info,
-                    **run(scene, info, strategy, args.method, calibrated, args.seed, workdir),
-                }
-                rows.append(row)
-                print(
-                    f"{index:3d} {info['class']:9s} {100 * info['size_m']:5.1f} cm"
-                    f" {info['distance_m']:.2f} m {strategy:9s}: {row['contacts']:2d} contacts"
-                    f" ({row['used']:2d} ok), points {1000 * row['point_rms_m']:.1f} mm,"
-                    f" surface {1000 * row['surface_rms_m']:.1f} mm -> {row['decision']}"
-                    f" ({row['run_s']:.0f} s)",
-                    flush=True,
-                )
-    totals = {s: summarise([r for r in rows if r["strategy"] == s]) for s in STRATEGIES}
-    print()
-    print(
-        f"{'strategy':9s} {'contacts':>8s} {'ok':>5s} {'points RMS':>10s} {'surface RMS':>11s}"
-        f" {'Chamfer':>8s} {'right':>5s} {'abst.':>5s} {'wrong':>5s}"
-    )
-    for strategy, s in totals.items():
-
-        def mm(value: float | None) -> str:
-            return "-" if value is None else f"{1000 * value:.2f}"
-
-        print(
-            f"{strategy:9s} {s['mean_contacts']:8.1f} {s['mean_used']:5.1f}"
-            f" {mm(s['mean_point_rms_m']):>7s} mm {mm(s['mean_surface_rms_m']):>8s} mm"
-            f" {mm(s['mean_chamfer_m']):>5s} mm {s['right']:5d} {s['abstained']:5d}"
-            f" {s['confident_wrong']:5d}"
-        )
+def write_results(
+    args: argparse.Namespace,
+    rows: list[dict[str, Any]],
+    totals: dict[str, Any] | None = None,
+) -> None:
+    """The settings, the totals per strategy and every row, as JSON in ``args.out``."""
+    if totals is None:
+        totals = {
+            s: summarise([r for r in rows if r["strategy"] == s])
+            for s in args.strategies
+            if any(r["strategy"] == s for r in rows)
+        }
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(
         json.dumps(
@@ -321,6 +332,63 @@ def main() -> None:
         )
         + "\n"
     )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--scenes", type=int, default=12)
+    parser.add_argument("--first", type=int, default=0, help="index of the first scene")
+    parser.add_argument("--sweeps", type=int, default=6, help="grid sweeps per case and base")
+    parser.add_argument("--bases", type=int, default=3, help="base poses around the object")
+    parser.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
+    parser.add_argument("--method", choices=("paper", "fast"), default="fast")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=RESULTS)
+    args = parser.parse_args()
+    device = paper_antenna()
+    shape = LinkShape(device.link)
+    rows: list[dict[str, Any]] = []
+    with tempfile.TemporaryDirectory(prefix="eval-explore-") as folder:
+        workdir = Path(folder)
+        calibrated = workdir / "calibrated.toml"
+        calibrated.write_text(antenna_to_toml(calibrate_device(device)))
+        for index in range(args.first, args.first + args.scenes):
+            scene, info = make_scene(index, args.seed, args.sweeps, shape, args.bases)
+            for strategy in args.strategies:
+                row = {
+                    "scene": index,
+                    **info,
+                    **run(scene, info, strategy, args.method, calibrated, args.seed, workdir),
+                }
+                rows.append(row)
+                # written after every exploration: a run stopped early keeps its scenes
+                write_results(args, rows)
+                print(
+                    f"{index:3d} {info['class']:9s} {100 * info['size_m']:5.1f} cm"
+                    f" {info['distance_m']:.2f} m {strategy:9s}: {row['contacts']:2d} contacts"
+                    f" ({row['used']:2d} ok), points {1000 * row['point_rms_m']:.1f} mm,"
+                    f" surface {1000 * row['surface_rms_m']:.1f} mm -> {row['decision']}"
+                    f" ({row['run_s']:.0f} s)",
+                    flush=True,
+                )
+    totals = {s: summarise([r for r in rows if r["strategy"] == s]) for s in args.strategies}
+    print()
+    print(
+        f"{'strategy':9s} {'contacts':>8s} {'ok':>5s} {'points RMS':>10s} {'surface RMS':>11s}"
+        f" {'Chamfer':>8s} {'right':>5s} {'abst.':>5s} {'wrong':>5s} {'Mahal.':>6s}"
+    )
+    for strategy, s in totals.items():
+
+        def mm(value: float | None) -> str:
+            return "-" if value is None else f"{1000 * value:.2f}"
+
+        print(
+            f"{strategy:9s} {s['mean_contacts']:8.1f} {s['mean_used']:5.1f}"
+            f" {mm(s['mean_point_rms_m']):>7s} mm {mm(s['mean_surface_rms_m']):>8s} mm"
+            f" {mm(s['mean_chamfer_m']):>5s} mm {s['right']:5d} {s['abstained']:5d}"
+            f" {s['confident_wrong']:5d} {s['median_mahalanobis'] or math.nan:6.2f}"
+        )
+    write_results(args, rows, totals)
     print(f"\nwrote {args.out}")
 
 

@@ -10,6 +10,7 @@ import pytest
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, load_antenna
 from sensing_antenna.errors import FieldError
+from sensing_antenna.estimation import estimate
 from sensing_antenna.estimation.result import ContactEstimate, Status
 from sensing_antenna.mapping import (
     BasePose,
@@ -18,6 +19,7 @@ from sensing_antenna.mapping import (
     contact_point_from_estimate,
     select_points,
 )
+from sensing_antenna.simulator import Scenario, simulate
 
 ANTENNA = load_antenna("paper-2021")
 
@@ -38,13 +40,23 @@ def _sag(x: float) -> float:
     return link.linear_density * x**2 * (6 * length**2 - 4 * length * x + x**2) / (24 * ei)
 
 
+def _shortening(x: float, y: float) -> float:
+    """How much nearer the base a cantilever's end under an end load lies than its length x
+    when it deflects by y: 3 y^2 / (5 x), the integral of w'^2 / 2 over the cubic deflection
+    curve (small deflections)."""
+    return 3 * y**2 / (5 * x)
+
+
 def _geometry(x_c: float, theta: np.ndarray, y_c: float, y_axis: np.ndarray) -> np.ndarray:
-    """The touched point: x_c X^m + y_c Y^c + sag along -Z^a's part across the link."""
+    """The touched point: the loaded end of the bent link, (x_c - delta) X^m + y_c Y^c, plus the
+    sag along -Z^a's part across the link."""
     x_m = _axes(*theta)[0]
     down = np.array([0.0, 0.0, -1.0])
     across = down - (down @ x_m) * x_m
     sag = STANDARD_GRAVITY * np.linalg.norm(across) * _sag(x_c)
-    return x_c * x_m + y_c * y_axis + sag * across / np.linalg.norm(across)
+    return (
+        (x_c - _shortening(x_c, y_c)) * x_m + y_c * y_axis + sag * across / np.linalg.norm(across)
+    )
 
 
 def test_quaternion_and_matrix_metadata_give_one_pose() -> None:
@@ -86,12 +98,15 @@ def test_bad_base_pose_is_one_line_naming_file_and_key(value: str, words: str) -
     assert "\n" not in message
 
 
-def test_covariance_matches_a_monte_carlo_of_the_geometry() -> None:
+# y_c / x_c of 3 % (the shortening 0.1 mm, below sigma_x) and 25 % (the shortening 2.3 cm: its
+# share of the stiffness's uncertainty, 2 rho delta = 4.5 mm along the link, exceeds sigma_x)
+@pytest.mark.parametrize("y_c", [0.02, 0.15])
+def test_covariance_matches_a_monte_carlo_of_the_geometry(y_c: float) -> None:
     rng = np.random.default_rng(7)
     theta = np.array([0.3, 0.2])
     x_m, y_m, z_m = _axes(*theta)
     y_axis = -(math.cos(0.1) * y_m + math.sin(0.1) * z_m)  # the load's direction, across X^m
-    x_c, y_c, half_width = 0.6, 0.02, 0.004
+    x_c, half_width = 0.6, 0.004
     point_a = _geometry(x_c, theta, y_c, y_axis)
     estimate = ContactEstimate(
         status=Status.OK,
@@ -120,10 +135,8 @@ def test_covariance_matches_a_monte_carlo_of_the_geometry() -> None:
         x = x_c + sigma_x * rng.standard_normal()
         th = theta + rng.uniform(-quantum / 2, quantum / 2, 2)
         xm_i, ym_i, zm_i = _axes(*th)
+        # the compliance 10 % uncertain: the deflection, and the shortening with its square
         deflection = y_c * (x / x_c) ** 3 * (1 + 0.1 * rng.standard_normal())
-        tilt = 0.1 * rng.standard_normal()  # the deflection's direction, in the bending plane
-        in_plane = x_m - (x_m @ y_axis) * y_axis
-        direction = y_axis + tilt * in_plane / np.linalg.norm(in_plane)
         down = np.array([0.0, 0.0, -1.0])
         across = down - (down @ xm_i) * xm_i
         sag = (
@@ -131,7 +144,12 @@ def test_covariance_matches_a_monte_carlo_of_the_geometry() -> None:
         )
         phi = rng.uniform(0, 2 * math.pi)  # the link's surface, not its axis, touched
         radial = ANTENNA.link.radius * (math.cos(phi) * ym_i + math.sin(phi) * zm_i)
-        p = x * xm_i + deflection * direction + sag * across / np.linalg.norm(across) + radial
+        p = (
+            (x - _shortening(x, deflection)) * xm_i
+            + deflection * y_axis
+            + sag * across / np.linalg.norm(across)
+            + radial
+        )
         samples[i] = pose.point_to_world(p)
     empirical = np.cov(samples.T)
     # variance along many directions within 5 % (the sampling error of 40000 draws is 0.7 %;
@@ -175,3 +193,25 @@ def test_a_quaternion_printed_to_three_decimals_is_normalised() -> None:
     assert math.degrees(math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])) == pytest.approx(
         30.0, abs=0.02
     )
+
+
+def test_a_fast_point_is_uncertain_along_its_measured_push_not_across_the_bending_plane() -> None:
+    # fast places its point with the contact frame (the push's direction the sensor measures)
+    # and reports it, so the deflection model's rho y_c lies along the push only; across the
+    # bending plane remain the sag's rho s, the encoders and the link's radius
+    antenna = ANTENNA.self_calibrated()
+    recording = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=0.5))
+    result = estimate(recording.without_ground_truth(), antenna, method="fast")
+    assert result.status is Status.OK
+    axes = np.asarray(result.diagnostics["axes_c_absolute"])
+    theta = np.asarray(result.diagnostics["theta_at_t1"])
+    x_m = _axes(*theta)[0]
+    push = axes[1] - (axes[1] @ x_m) * x_m
+    push /= np.linalg.norm(push)
+    across = np.cross(x_m, push)
+    point = contact_point_from_estimate(result, antenna)
+    rho_y_c = 0.1 * result.diagnostics["deflection"]
+    assert push @ point.covariance @ push >= rho_y_c**2
+    # the sag's part: 0.1 x 2.1 cm at 0.5 m (docs/explore.md), well below rho y_c (3.7 mm at a
+    # push of 7.5 %); with the push's direction unknown this would exceed rho y_c^2
+    assert across @ point.covariance @ across < rho_y_c**2

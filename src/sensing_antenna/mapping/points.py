@@ -9,7 +9,8 @@ order from three independent sources (docs/mapping.md derives each term):
 along the link
     x_c has a standard deviation sigma_x: from the method's 95 % interval, (high - low) / (2 *
     1.96), or a documented default per method when it gives none (:data:`DEFAULT_ALONG_STD`).
-    dp/dx_c = X^m + (3 y_c / x_c) Y^c + (ds/dx_c) A (y_c grows as x_c^3).
+    dp/dx_c = (1 - 5 delta / x_c) X^m + (3 y_c / x_c) Y^c + (ds/dx_c) A: at a given load y_c
+    grows as x_c^3 and the bent link's shortening delta (below) as y_c^2 / x_c, i.e. x_c^5.
 the encoders
     each angle is known to one count, q_i = 2 pi / (counts n_i) (n_i the gear ratio), a uniform
     rounding error of variance q_i^2 / 12. dX^m/dtheta1 = cos(theta2) Y^m and dX^m/dtheta2 = Z^m,
@@ -17,21 +18,23 @@ the encoders
 the deflection model
     y_c and s both scale with the link's compliance 1 / (E I), but they are different load
     cases of the model (a pinned contact; a uniform weight) and err differently: a relative
-    uncertainty rho moves the point by rho y_c along Y^c and, independently, by rho s along A.
-    The push deflection's
-    direction is as uncertain, by rho radians within the bending plane: rho y_c along the part
-    of X^m across Y^c (a bent link also shortens along its line). Without the contact frame
-    (a method that does not report it) the deflection's direction is unknown: rho y_c in every
-    direction, and y_c = (y_c / x_c) x_c from the reported ratio.
+    uncertainty rho of the push's deflection moves the contact along the elastica the
+    estimators place it on (estimation/methods/touch_point.py): by rho y_c along Y^c (across
+    the link, the measured reaction's direction) and by 2 rho delta back along X^m, delta =
+    x_c - p_a . X^m the bent link's shortening (second order in y_c: delta grows as the
+    square of the compliance); independently, rho s along A. The deflection's direction is
+    the reaction's, which the sensor measures: a round link bends along the load it carries.
+    Without the contact frame (an estimate that does not report it) that direction is
+    unknown: rho y_c in every direction, and y_c = (y_c / x_c) x_c from the reported ratio.
 
 the link's thickness
     the estimate is a point of the link's axis, the object is touched by the link's surface: an
     offset of the link's radius r in an unknown direction across the link, variance r^2 / 2 in
     each of the two directions across it.
 
-Sigma_a = sigma_x^2 J_x J_x^T + sum_i q_i^2 / 12 J_i J_i^T + rho^2 (y_c^2 Y^c Y^cT + s^2 A A^T
-+ J_d J_d^T) + r^2 / 2 (I - X^m X^mT), and in the world Sigma_w = R Sigma_a R^T with the base
-pose's rotation R.
+Sigma_a = sigma_x^2 J_x J_x^T + sum_i q_i^2 / 12 J_i J_i^T + rho^2 (J_d J_d^T + s^2 A A^T)
++ r^2 / 2 (I - X^m X^mT), J_d = y_c Y^c - 2 delta X^m, and in the world Sigma_w = R Sigma_a R^T
+with the base pose's rotation R.
 """
 
 from __future__ import annotations
@@ -254,8 +257,11 @@ def point_covariance(
         * float(link.unit_sag(min(x_in + step, link.length)) - link.unit_sag(x_in - step))
         / (min(x_in + step, link.length) - (x_in - step))
     )
-    # along: dp/dx_c = X^m + (3 y_c / x_c) Y^c + (ds/dx_c) A
-    j_along = x_m + slope * sag_axis
+    # the bent link's shortening delta = x_c - p_a . X^m (the deflection and the sag lie
+    # across X^m); known only with the deflection's direction
+    shortening = max(x_c - float(point_a @ x_m), 0.0) if y_c_axis is not None else 0.0
+    # along: dp/dx_c = (1 - 5 delta / x_c) X^m + (3 y_c / x_c) Y^c + (ds/dx_c) A
+    j_along = (1.0 - 5.0 * shortening / x_c) * x_m + slope * sag_axis
     if y_c_axis is not None:
         j_along = j_along + (3.0 * deflection / x_c) * y_c_axis
     sigma_x = uncertainty.sigma_along(estimate)
@@ -269,15 +275,11 @@ def point_covariance(
             covariance += quantum**2 / 12.0 * np.outer(j_angle, j_angle)
     rho2 = uncertainty.deflection_relative_std**2
     if y_c_axis is not None:
-        # deflection model: rho y_c along Y^c, and rho s along A
-        covariance += rho2 * deflection**2 * np.outer(y_c_axis, y_c_axis)
+        # deflection model along the elastica: J_d = y_c Y^c - 2 delta X^m
+        j_deflection = deflection * y_c_axis - 2.0 * shortening * x_m
+        covariance += rho2 * np.outer(j_deflection, j_deflection)
+        # and, independently, rho s along A
         covariance += rho2 * sag**2 * np.outer(sag_axis, sag_axis)
-        # the deflection's direction: rho y_c along X^m's part across Y^c
-        in_plane = x_m - (x_m @ y_c_axis) * y_c_axis
-        norm = float(np.linalg.norm(in_plane))
-        if norm > 0:
-            j_direction = deflection * in_plane / norm
-            covariance += rho2 * np.outer(j_direction, j_direction)
     else:
         # direction unknown: rho y_c in every direction, plus the sag's rho s
         covariance += rho2 * deflection**2 * np.eye(3)

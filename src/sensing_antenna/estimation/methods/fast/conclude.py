@@ -108,7 +108,11 @@ def conclude_fast(
             "fit_through_push": final.fit is not None and final.fit.restart is not None,
             "modes": final.fit.omega if final.fit is not None else (),
             "push_force": push,
+            "deflection": touch.deflection,
             "deflection_ratio": touch.deflection_ratio,
+            # the frame the point was placed in (the map's covariance reads it)
+            "axes_c_absolute": evidence.frame.axes_a,
+            "theta_at_t1": evidence.frame.theta,
             "note": final.note,
             "other_reasons": [text for _, text in found[1:]],
         }
