@@ -42,6 +42,7 @@ __all__ = [
     "calibrate_t_e",
     "fit_inverse_t",
     "model_beta1_squared",
+    "points_on_link",
     "read_contact_points",
 ]
 
@@ -367,7 +368,7 @@ def calibrate_t_e(
     w = np.asarray(omega1, dtype=float).ravel()
     if x_c.shape != w.shape:
         raise CalibrationError(f"omega1: {w.size} frequencies for {x_c.size} contact points")
-    x_c, on_link, left_out = _points_on_link(x_c, link.length, sources)
+    x_c, on_link, left_out = points_on_link(x_c, link.length, sources)
     used = on_link & np.isfinite(w) & (w > 0)
     if int(used.sum()) < 2:
         reasons = [*left_out, *notes]
@@ -382,31 +383,18 @@ def calibrate_t_e(
     k[on_link] = model_beta1_squared(link, x_c[on_link])
     t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
     tip_mass = None
-    if fit_tip_mass and int(used.sum()) >= MIN_TIP_MASS_POINTS:
-        # wrong spectral peaks out first: gross ones against T_e alone, then those more than
-        # WRONG_PEAK from the median of the two-parameter fit (they are left out of the fit,
-        # as relative_scatter leaves them out of the scatter)
-        kept = used & _near_median(k * (1.0 / t_e) / w - 1.0, used, GROSS_WRONG_PEAK)
-        if int(kept.sum()) >= MIN_TIP_MASS_POINTS:
-            fitted = _fit_with_tip_mass(link, x_c[kept], w[kept], t_e, loss)
-            k_fit = np.full(x_c.shape, math.nan)
-            k_fit[on_link] = model_beta1_squared(replace(link, tip_mass=fitted[2]), x_c[on_link])
-            refined = used & _near_median(k_fit / fitted[0] / w - 1.0, kept, WRONG_PEAK)
-            if int(refined.sum()) >= MIN_TIP_MASS_POINTS:
-                if not np.array_equal(refined, kept):
-                    fitted = _fit_with_tip_mass(link, x_c[refined], w[refined], fitted[0], loss)
-                    k_fit[on_link] = model_beta1_squared(
-                        replace(link, tip_mass=fitted[2]), x_c[on_link]
-                    )
-                t_e, std_error, tip_mass = fitted
-                for i in map(int, np.flatnonzero(used & ~refined)):
-                    label = sources[i] if i < len(sources) else f"point {i}"
-                    off = float(w[i] / (k_fit[i] / t_e) - 1.0)
-                    left_out.append(
-                        f"{label}: omega_1 = {float(w[i]):.2f} rad/s lies {100 * off:+.0f} % "
-                        "from the fit, a wrong spectral peak (left out of the fit)"
-                    )
-                k, used = k_fit, refined
+    if fit_tip_mass:
+        joint = _with_tip_mass(link, x_c, on_link, w, used, k, t_e, loss)
+        if joint is not None:
+            t_e, std_error, tip_mass, k, kept = joint
+            for i in map(int, np.flatnonzero(used & ~kept)):
+                label = sources[i] if i < len(sources) else f"point {i}"
+                off = float(w[i] / (k[i] / t_e) - 1.0)
+                left_out.append(
+                    f"{label}: omega_1 = {float(w[i]):.2f} rad/s lies {100 * off:+.0f} % "
+                    "from the fit, a wrong spectral peak (left out of the fit)"
+                )
+            used = kept
     return FrequencyCalibration(
         t_e=t_e,
         t_e_std_error=std_error,
@@ -451,6 +439,42 @@ MIN_TIP_MASS_POINTS = 4
 TIP_MASS_LOSS_SCALE = 0.01
 
 
+def _with_tip_mass(
+    link: Link,
+    x_c: NDArray[np.float64],
+    on_link: NDArray[np.bool_],
+    omega: NDArray[np.float64],
+    used: NDArray[np.bool_],
+    k_alone: NDArray[np.float64],
+    t_e: float,
+    loss: str,
+) -> tuple[float, float, float, NDArray[np.float64], NDArray[np.bool_]] | None:
+    """T_e and the tip mass fitted together from T_e alone (``t_e`` with beta_1^2 ``k_alone``
+    of the link's own tip mass at every point), wrong spectral peaks out
+    first: gross ones against T_e alone (:data:`GROSS_WRONG_PEAK`), then those more than
+    :data:`WRONG_PEAK` from the median of the two-parameter fit (as ``relative_scatter`` leaves
+    them out of the scatter). Returns (T_e, its standard error, the mass, beta_1^2 of every
+    point with it, the points fitted), or None with fewer than :data:`MIN_TIP_MASS_POINTS`."""
+
+    def beta1_squared(mass: float) -> NDArray[np.float64]:
+        k = np.full(x_c.shape, math.nan)
+        k[on_link] = model_beta1_squared(replace(link, tip_mass=mass), x_c[on_link])
+        return k
+
+    kept = used & _near_median(k_alone / t_e / omega - 1.0, used, GROSS_WRONG_PEAK)
+    if int(kept.sum()) < MIN_TIP_MASS_POINTS:
+        return None
+    fitted = _fit_with_tip_mass(link, x_c[kept], omega[kept], t_e, loss)
+    k = beta1_squared(fitted[2])
+    refined = used & _near_median(k / fitted[0] / omega - 1.0, kept, WRONG_PEAK)
+    if int(refined.sum()) < MIN_TIP_MASS_POINTS:
+        return None
+    if not np.array_equal(refined, kept):
+        fitted = _fit_with_tip_mass(link, x_c[refined], omega[refined], fitted[0], loss)
+        k = beta1_squared(fitted[2])
+    return (*fitted, k, refined)
+
+
 def _fit_with_tip_mass(
     link: Link, x_c: NDArray[np.float64], omega: NDArray[np.float64], t_e: float, loss: str
 ) -> tuple[float, float, float]:
@@ -488,7 +512,7 @@ def _fit_with_tip_mass(
 END_ULPS = 4
 
 
-def _points_on_link(
+def points_on_link(
     x_c: NDArray[np.float64], length: float, sources: Sequence[str]
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], list[str]]:
     """Points (m) with those a few ulp past the end set to l, which lie on (0, l], and a note

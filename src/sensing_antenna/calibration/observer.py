@@ -85,8 +85,8 @@ MIN_MOTION = 1e-3
 _ZETA_GRID = (0.002, 0.01, 0.03, 0.1, 0.3)
 
 
-#: Standard errors an excess of the moment at rest over the model's weight needs to be read as
-#: a payload.
+#: Standard deviations an excess of the moment at rest over the model's weight needs to be read
+#: as a payload.
 PAYLOAD_SIGMAS = 3.0
 
 #: The offset a tare leaves on a channel, in standard deviations of its noise per sample (about
@@ -121,7 +121,8 @@ class Payload:
 
     @property
     def significant(self) -> bool:
-        """True when the mass is more than :data:`PAYLOAD_SIGMAS` standard errors from zero."""
+        """True when the mass is more than :data:`PAYLOAD_SIGMAS` standard deviations from
+        zero."""
         return bool(self.samples > 1 and abs(self.mass) > PAYLOAD_SIGMAS * self.std)
 
     def apply(self, antenna: Antenna) -> Antenna:
@@ -319,19 +320,22 @@ def units_problem(recording: Recording, antenna: Antenna) -> str | None:
     the start (:func:`~sensing_antenna.units_check.recording_problem`), at rest as the
     estimators judge it (the rest tolerance and window of ``EstimatorConfig``). Identification
     and calibration both ask it."""
-    from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.estimation.front.contact_frame import rest_tolerance
-
     problem = angle_problem(recording.theta)
     if problem is not None:
         # before the rest tolerance, whose angle differences a glitch of 1e308 rad overflows
         return problem
-    config = EstimatorConfig()
     return recording_problem(
-        recording.theta,
-        recording.force,
-        recording.torque,
-        antenna,
+        recording.theta, recording.force, recording.torque, antenna, *_rest_rule(recording)
+    )
+
+
+def _rest_rule(recording: Recording) -> tuple[float, int]:
+    """The estimators' rest: the angle tolerance (rad) and the fewest samples a rest has."""
+    from sensing_antenna.estimation.config import EstimatorConfig
+    from sensing_antenna.estimation.front.contact_frame import rest_tolerance
+
+    config = EstimatorConfig()
+    return (
         rest_tolerance(recording.theta, config),
         round(config.rest_window / recording.sample_period) + 1,
     )
@@ -339,14 +343,11 @@ def units_problem(recording: Recording, antenna: Antenna) -> str | None:
 
 def rest_payload(recording: Recording, antenna: Antenna) -> Payload:
     """The tip mass (kg) the moment about Y^m at rest at the start reads beyond ``antenna``'s
-    weight (module docstring), with its standard error; zero samples without a rest of at least
-    the estimators' rest window."""
-    from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.estimation.front.contact_frame import rest_tolerance
-
-    config = EstimatorConfig()
-    rest = initial_rest(recording.theta, rest_tolerance(recording.theta, config))
-    if rest < max(2, round(config.rest_window / recording.sample_period) + 1):
+    weight (module docstring), with its standard deviation; zero samples without a rest of at
+    least the estimators' rest window."""
+    tolerance, fewest = _rest_rule(recording)
+    rest = initial_rest(recording.theta, tolerance)
+    if rest < max(2, fewest):
         return Payload(0.0, math.nan, 0)
     window = slice(0, rest)
     theta = recording.theta[window]

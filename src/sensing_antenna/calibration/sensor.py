@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from sensing_antenna.antenna import Antenna, SensorCorrection
+from sensing_antenna.calibration.frequency import points_on_link
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [
@@ -92,16 +93,13 @@ class SensorCalibration:
         """``antenna`` with this correction."""
         return replace(antenna, sensor=self.correction)
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-able summary."""
-        return {
-            "correction": {k: float(v) for k, v in vars(self.correction).items()},
-            "sweeps": list(self.sweeps),
-            "sources": list(self.sources),
-            "notes": list(self.notes),
-            "ratio_rms_before": self.ratio_rms_before,
-            "ratio_rms_after": self.ratio_rms_after,
-        }
+    @property
+    def ratio_summary(self) -> str:
+        """The ratio's error against the known points without and with the correction."""
+        return (
+            f"torque/force ratio against the known points {100 * self.ratio_rms_before:.1f} % "
+            f"rms before, {100 * self.ratio_rms_after:.1f} % after"
+        )
 
 
 @dataclass(frozen=True)
@@ -143,10 +141,14 @@ def calibrate_sensor(
         )
     plain = replace(antenna, sensor=SensorCorrection())
     names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
+    points_in, on_link, notes = points_on_link(
+        np.asarray(contact_points, dtype=float), antenna.link.length, names
+    )
     holds: list[_Hold] = []
     used: list[str] = []
-    notes: list[str] = []
-    for name, recording, x_c in zip(names, recordings, contact_points, strict=True):
+    for name, recording, x_c, on in zip(names, recordings, points_in, on_link, strict=True):
+        if not on:
+            continue  # named in the notes
         hold = _hold(recording, plain, float(x_c))
         if isinstance(hold, str):
             notes.append(f"{name}: {hold}")
@@ -214,22 +216,17 @@ def _hold(recording: Any, antenna: Antenna, x_c: float) -> _Hold | str:
     from sensing_antenna.estimation import gather
     from sensing_antenna.estimation.front.evidence import Evidence
     from sensing_antenna.estimation.front.ratio import contact_loads
-    from sensing_antenna.estimation.front.steps import samples
+    from sensing_antenna.estimation.front.steps import hold_window
 
-    if not (math.isfinite(x_c) and 0.0 < x_c <= antenna.link.length * (1.0 + 1e-9)):
-        return f"no known contact point on the link (x_c = {x_c!r} m)"
     problem = units_problem(recording, antenna)
     if problem is not None:
         return problem
     evidence = gather(recording, antenna)
     if not isinstance(evidence, Evidence):
         return f"no contact to read ({evidence.status.value}: {evidence.reason})"
-    start = evidence.rest_index
-    stop = min(
-        start + samples(evidence.config.frame_window, evidence.sample_period) + 1,
-        evidence.theta.shape[0],
+    hold = hold_window(
+        evidence.rest_index, evidence.theta.shape[0], evidence.config, evidence.sample_period
     )
-    hold = slice(start, stop)
     reaction, moment = contact_loads(
         evidence.theta[hold], evidence.force[hold], evidence.torque[hold], antenna
     )
@@ -239,7 +236,7 @@ def _hold(recording: Any, antenna: Antenna, x_c: float) -> _Hold | str:
     sweep = "azimuthal" if span[0] >= span[1] else "vertical"
     return _Hold(
         sweep=sweep,
-        x_c=min(x_c, antenna.link.length),
+        x_c=x_c,
         reaction=(reaction - offset[:3]).mean(axis=0),
         moment=(moment - offset[3:]).mean(axis=0),
     )

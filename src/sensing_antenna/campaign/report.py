@@ -91,9 +91,9 @@ def _imperfection_lines(spec: CampaignSpec) -> list[str]:
     if not spec.device.has_imperfections:
         return []
     fixed = ", ".join(f"{k} = {v}" for k, v in sorted(spec.device.imperfections.items()))
-    build = spec.base_seed if spec.device.build is None else spec.device.build
     profile = (
-        f"realistic (device build {build}; its set-up drawn per manoeuvre from its seed)"
+        f"realistic (device build {spec.device.build_of(spec.base_seed)}; its set-up drawn per "
+        "manoeuvre from its seed)"
         if spec.device.profile == "realistic"
         else spec.device.profile
     )

@@ -222,13 +222,15 @@ class DeviceSpec:
         """True when some manoeuvre's device departs from the nominal one (profile or table)."""
         return self.profile != "nominal" or bool(self.imperfections)
 
-    def imperfections_for(self, seed: int, length: float, build: int) -> DeviceImperfections:
-        """The imperfections of the manoeuvre of seed ``seed`` on a link of ``length`` (m): the
-        profile's draw for the device of ``build`` (``self.build`` when set) with the
-        ``imperfections`` table set over it."""
-        drawn = device_profile(
-            self.profile, seed, length, build if self.build is None else self.build
-        )
+    def build_of(self, base_seed: int) -> int:
+        """The realistic device's build: ``build`` when set, else the campaign's ``base_seed``."""
+        return base_seed if self.build is None else self.build
+
+    def imperfections_for(self, seed: int, length: float, base_seed: int) -> DeviceImperfections:
+        """The imperfections of the manoeuvre of seed ``seed`` on a link of ``length`` (m) in a
+        campaign of ``base_seed``: the profile's draw for the device of :meth:`build_of` with
+        the ``imperfections`` table set over it."""
+        drawn = device_profile(self.profile, seed, length, self.build_of(base_seed))
         if not self.imperfections:
             return drawn
         fixed = device_from_mapping(self.imperfections, "device.imperfections")

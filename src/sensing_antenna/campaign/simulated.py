@@ -226,8 +226,7 @@ def calibrate_on_device(
             calibrated = sensor.apply(calibrated)
             progress.line(
                 f"preparation: sensor cross-talk fitted ({', '.join(sensor.sweeps)} sweeps); "
-                f"torque/force ratio against the known points {100 * sensor.ratio_rms_before:.1f}"
-                f" % rms before, {100 * sensor.ratio_rms_after:.1f} % after"
+                f"{sensor.ratio_summary}"
             )
     return calibration, calibrated
 

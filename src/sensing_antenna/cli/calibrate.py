@@ -90,8 +90,7 @@ def _calibrate_sensor(
     terms = ", ".join(f"{k} = {v:.4g}" for k, v in vars(fit.correction).items())
     lines = [
         f"sensor: cross-talk fitted on {len(fit.sources)} recordings ({', '.join(fit.sweeps)} "
-        f"sweeps): {terms}; torque/force ratio against the known points "
-        f"{100 * fit.ratio_rms_before:.1f} % rms before, {100 * fit.ratio_rms_after:.1f} % after"
+        f"sweeps): {terms}; {fit.ratio_summary}"
     ]
     lines += [f"  sensor, left out: {note}" for note in fit.notes]
     return fit.apply(antenna), lines

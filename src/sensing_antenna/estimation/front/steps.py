@@ -45,6 +45,7 @@ __all__ = [
     "free_motion_gain",
     "gap_problem",
     "hold_push",
+    "hold_window",
     "planned_end",
     "ratio_tolerance",
     "samples",
@@ -58,6 +59,12 @@ FloatArray = NDArray[np.float64]
 def samples(duration: float, sample_period: float) -> int:
     """Number of sample intervals in ``duration`` (at least one)."""
     return max(1, round(duration / sample_period))
+
+
+def hold_window(rest_index: int, n: int, cfg: EstimatorConfig, ts: float) -> slice:
+    """The samples whose mean reaction is the push: [t_1, t_1 + frame_window] within the ``n``
+    samples (``ts`` the sample period, s)."""
+    return slice(rest_index, min(rest_index + samples(cfg.frame_window, ts) + 1, n))
 
 
 def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig) -> str | None:
@@ -288,7 +295,7 @@ def hold_push(
     n = theta.shape[0]
     stop = min(rest_index + max(samples(cfg.frame_window, ts), samples(cfg.rest_window, ts)), n - 1)
     stop += 1
-    hold = slice(rest_index, min(rest_index + samples(cfg.frame_window, ts) + 1, stop))
+    hold = hold_window(rest_index, stop, cfg, ts)
     reaction, _ = contact_loads(theta[hold], force[hold], torque[hold], antenna)
     reaction = reaction - np.asarray(offset, dtype=float)[:3]
     noise = signal_noise(force[:stop])[0]

@@ -29,6 +29,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     find_peak,
 )
 from sensing_antenna.estimation.methods.paper.fusion import conclude
+from sensing_antenna.estimation.methods.paper.planes import planes_agree
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = ["RatioMethod", "TwoFrequencyMethod"]
@@ -112,15 +113,8 @@ class TwoFrequencyMethod:
                 k = int(np.argmin(distance))
                 x_c = float(grid[k])
                 diag["curve_distance"] = float(distance[k])
-                # read in the push plane alone: the free plane's peak does not corroborate it
-                # (the paper method's rule, methods/paper/planes.py)
-                free = measurement.peaks.get("y_c")
-                corroborated = (
-                    free is not None
-                    and free.quality >= 0.5 * cfg.min_peak_quality
-                    and measurement.components_agree(cfg.component_agreement)
-                )
-                push_plane = measurement.component == "z_c" and not corroborated
+                # read in the push plane alone: the free plane does not ring with it
+                push_plane = measurement.component == "z_c" and not planes_agree(measurement, cfg)
                 problems.extend(
                     _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane)
                 )

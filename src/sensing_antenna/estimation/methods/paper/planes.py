@@ -33,7 +33,7 @@ from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement, SpectralPeak
 from sensing_antenna.estimation.result import Status
 
-__all__ = ["PLANES", "bending_planes"]
+__all__ = ["PLANES", "bending_planes", "planes_agree"]
 
 #: Torque component of each bending plane: about Y^c the vibration out of the push plane
 #: ("free"), about Z^c the vibration in it ("push").
@@ -91,11 +91,7 @@ def bending_planes(
         return _disagreeing(
             measurement, peaks, locate, ratio_estimate, sigma_ratio, config, diagnostics
         )
-    # a peak at the same frequency in the other plane corroborates at half the clarity a peak
-    # must have on its own (a noise bin reaches 10 times the median with probability 1e-3,
-    # and must also fall within the agreement)
-    weakest = min((peak.quality if peak is not None else 0.0) for peak in peaks.values())
-    if agree and weakest >= 0.5 * config.min_peak_quality:
+    if planes_agree(measurement, config):
         diagnostics["frequency_plane"] = "both"
         return measurement, None
     plane = "free" if measurement.component == PLANES["free"] else "push"
@@ -103,6 +99,20 @@ def bending_planes(
         plane = "free"
     diagnostics["frequency_plane"] = plane
     return measurement, None
+
+
+def planes_agree(measurement: FrequencyMeasurement, config: EstimatorConfig) -> bool:
+    """True when both bending planes ring at the same omega_1: within ``component_agreement``,
+    each peak at least half as clear as a peak must be on its own (a noise bin reaches 10 times
+    the median with probability 1e-3, and must also fall within the agreement)."""
+    weakest = min(
+        (peak.quality if peak is not None else 0.0)
+        for peak in (measurement.peaks.get(component) for component in PLANES.values())
+    )
+    return bool(
+        measurement.components_agree(config.component_agreement)
+        and weakest >= 0.5 * config.min_peak_quality
+    )
 
 
 def _disagreeing(
