@@ -10,8 +10,6 @@ know. Contacts before and beyond the sensing curve's top (0.45 and 0.85 m), in b
 
 from __future__ import annotations
 
-import dataclasses
-
 import pytest
 
 from sensing_antenna import paper_antenna
@@ -78,10 +76,3 @@ def test_an_imperfection_the_model_does_not_know_is_right_or_said(name: str) -> 
                 if result.status.value == "ok" and abs(result.x_c - touched) > OK_TOLERANCE:
                     wrong.append(f"{case} {x_c} {method}: {result.x_c:.3f} m for {touched:.3f}")
     assert not wrong, f"{name}: ok but wrong: {'; '.join(wrong)}"
-
-
-def test_the_imperfections_are_each_what_they_say() -> None:
-    # each entry sets fields that exist and departs from the nominal device
-    for device, scenario in IMPERFECTIONS.values():
-        assert DeviceImperfections(**device) != DeviceImperfections() or scenario
-        assert not set(scenario) - {f.name for f in dataclasses.fields(Scenario)}
