@@ -9,7 +9,8 @@ stays closed (the predicted vibration of the contact force below the static push
 away from the top of the sensing curve; no higher mode of the fit points to another branch; the
 measured omega_1 agrees with the sensing curve at the MAP x_c. On the estimate
 (:func:`problems`): the static force does not turn between the window's first half and t_e
-(slip).
+(slip); a window at the cap that is not sure answers ``ok`` only when every check but the
+interval's width passed and the interval is within ``cap_tolerance`` (:func:`accepted_at_cap`).
 
 Each check returns a note (empty when it passes) or a value with its note, so the window can
 say why it is not sure.
@@ -34,9 +35,11 @@ from sensing_antenna.estimation.result import Status
 
 if TYPE_CHECKING:
     from sensing_antenna.estimation.methods.fast.search import ScanResult
+    from sensing_antenna.estimation.methods.fast.window import WindowEstimate
     from sensing_antenna.estimation.methods.fast.window_fit import Fundamental
 
 __all__ = [
+    "accepted_at_cap",
     "branch_contradiction",
     "direction_change",
     "drift_check",
@@ -318,6 +321,12 @@ def direction_change(early: StaticRatio, late: StaticRatio) -> tuple[float, floa
     return angle, math.sqrt(max(variance, 0.0))
 
 
+def accepted_at_cap(final: WindowEstimate, config: FastConfig) -> bool:
+    """Whether the window at the cap, not sure at ``tolerance``, still answers ``ok``: every
+    check but the interval's width passed and the interval is within ``cap_tolerance``."""
+    return final.checks_passed and final.posterior.width <= config.cap_tolerance
+
+
 def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]:
     """What is wrong with the scan's final window, as (status, reason) pairs; empty when nothing.
 
@@ -339,7 +348,7 @@ def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]
                 f"({final.note})",
             )
         )
-    elif not final.sure:
+    elif not final.sure and not (result.reached_cap and accepted_at_cap(final, config)):
         if result.reached_cap:
             found.append(
                 (

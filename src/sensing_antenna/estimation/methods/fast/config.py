@@ -27,6 +27,13 @@ class FastConfig:
     tolerance : float
         Declare when the 95 % interval of x_c is narrower than this (m). 5 mm, half the paper's
         typical 1 cm error.
+    cap_tolerance : float
+        At the cap, the final window's answer is ``ok`` when its 95 % interval is narrower than
+        this (m) and every other check passes; wider, or any check failing, ``uncertain``. The
+        tolerance above decides how early to stop; at the cap the method has the record the
+        paper method answers from, and an interval that holds the truth bounds the error by its
+        width. 1 cm, the paper's typical error and the fast method's largest allowed error.
+        Never below ``tolerance``.
     cadence : float
         Shortest time between evaluations of the growing window (s). 10 ms: on short windows
         the declaration comes at most this late after the first instant that would be sure.
@@ -186,6 +193,7 @@ class FastConfig:
     """
 
     tolerance: float = 0.005
+    cap_tolerance: float = 0.01
     cadence: float = 0.01
     growth: float = 1.1
     first_window: float = 0.05
@@ -241,6 +249,11 @@ class FastConfig:
                 raise FastConfigError(f"{f.name}: must be > 0, got {value!r}")
         if self.first_window > self.cap:
             raise FastConfigError("first_window: must not exceed cap")
+        if self.cap_tolerance < self.tolerance:
+            raise FastConfigError(
+                f"cap_tolerance: must not be below tolerance ({self.tolerance!r}), "
+                f"got {self.cap_tolerance!r}"
+            )
         if self.growth <= 1.0:
             raise FastConfigError(f"growth: must be > 1, got {self.growth!r}")
 
