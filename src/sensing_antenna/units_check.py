@@ -9,6 +9,7 @@ head cannot turn by half a revolution or more (the angle would be aliased); angl
 glitch of 1e300 break them.
 
 :func:`rest_reading` compares the mean loads over a window at rest with the weight;
+:func:`is_payload` says when the moment at rest exceeds the weight by more than a tare leaves;
 :func:`initial_rest` finds the samples at rest at the start of a recording; :func:`angle_problem`
 checks the angles; :func:`recording_problem` is the angles and the rest at the start together.
 The estimation front end (at t_c, on the window its tare averages), ``antenna identify`` and
@@ -28,12 +29,16 @@ from sensing_antenna.antenna import Antenna
 __all__ = [
     "MAX_ANGLE_STEP",
     "MAX_ELEVATION",
+    "PAYLOAD_SIGMAS",
     "REST_FORCE_FRACTION",
     "REST_TORQUE_FRACTION",
+    "TARE_NOISES",
     "RestReading",
     "angle_problem",
     "initial_rest",
+    "is_payload",
     "recording_problem",
+    "rest_moment_std",
     "rest_reading",
 ]
 
@@ -64,6 +69,14 @@ MAX_ELEVATION = 0.5 * math.pi
 #: Largest turn of either angle between two consecutive samples (rad): half a revolution, beyond
 #: which a turn cannot be told from one the other way round (the angle is aliased).
 MAX_ANGLE_STEP = math.pi
+
+#: Standard deviations (:func:`rest_moment_std`) by which the moment at rest must exceed the
+#: model's weight to be read as weight the model does not carry (a payload at the tip).
+PAYLOAD_SIGMAS = 3.0
+
+#: The offset a tare leaves on a channel, in standard deviations of its noise per sample (about
+#: one resolution count each): two counts, the order an F/T sensor's tare leaves.
+TARE_NOISES = 2.0
 
 _FORCE_COLUMNS = "'fx', 'fy', 'fz'"
 _TORQUE_COLUMNS = "'tx', 'ty', 'tz'"
@@ -289,3 +302,17 @@ def recording_problem(
         theta[window], force[window], torque[window], antenna, "at rest at the start"
     )
     return reading.problem
+
+
+def rest_moment_std(noise: float, mean_error: float) -> float:
+    """Standard deviation (N m) of a moment at rest beyond the model's weight when the link
+    carries none: the rest mean's ``mean_error`` and the offset a tare leaves,
+    :data:`TARE_NOISES` times the channel's ``noise`` per sample (N m), in quadrature."""
+    return math.hypot(mean_error, TARE_NOISES * noise)
+
+
+def is_payload(excess: float, std: float) -> bool:
+    """Whether a moment at rest ``excess`` (N m) beyond the model's weight is weight the model
+    does not carry: more than :data:`PAYLOAD_SIGMAS` times its ``std`` (:func:`rest_moment_std`)
+    from zero, either sign (a lighter reading is a link lighter than its model)."""
+    return bool(std >= 0.0 and abs(excess) > PAYLOAD_SIGMAS * std)

@@ -54,7 +54,9 @@ from sensing_antenna.recording import Recording, resample_uniform
 from sensing_antenna.units_check import (
     angle_problem,
     initial_rest,
+    is_payload,
     recording_problem,
+    rest_moment_std,
     rest_reading,
 )
 
@@ -62,7 +64,6 @@ __all__ = [
     "CLAMPED_FREE_BETA_L",
     "DEFAULT_MARGIN",
     "MAX_INERTIA_FACTOR",
-    "PAYLOAD_SIGMAS",
     "IdentificationError",
     "ObserverFit",
     "Payload",
@@ -85,16 +86,6 @@ MIN_MOTION = 1e-3
 _ZETA_GRID = (0.002, 0.01, 0.03, 0.1, 0.3)
 
 
-#: Standard deviations an excess of the moment at rest over the model's weight needs to be read
-#: as a payload.
-PAYLOAD_SIGMAS = 3.0
-
-#: The offset a tare leaves on a channel, in standard deviations of its noise per sample (about
-#: one resolution count each): the standard deviation of the payload's moment beside the rest's
-#: mean. Two counts, the order an F/T sensor's tare leaves.
-TARE_NOISES = 2.0
-
-
 class IdentificationError(SensingAntennaError, ValueError):
     """The recording cannot identify the observer (e.g. no joint moved)."""
 
@@ -110,7 +101,8 @@ class Payload:
         link reads lighter than its model.
     std : float
         Its standard deviation (kg): the rest's mean and the tare's offset, both from the
-        torque's scatter over the rest (:data:`TARE_NOISES`); NaN without a rest.
+        torque's scatter over the rest (:func:`~sensing_antenna.units_check.rest_moment_std`);
+        NaN without a rest.
     samples : int
         Samples at rest at the start (0: the recording starts moving, nothing is read).
     """
@@ -121,9 +113,9 @@ class Payload:
 
     @property
     def significant(self) -> bool:
-        """True when the mass is more than :data:`PAYLOAD_SIGMAS` standard deviations from
-        zero."""
-        return bool(self.samples > 1 and abs(self.mass) > PAYLOAD_SIGMAS * self.std)
+        """True when the mass is more than its standard deviations from zero than a payload
+        needs (:func:`~sensing_antenna.units_check.is_payload`)."""
+        return self.samples > 1 and is_payload(self.mass, self.std)
 
     def apply(self, antenna: Antenna) -> Antenna:
         """``antenna`` with the payload in ``link.tip_mass`` when significant (never below 0);
@@ -357,8 +349,7 @@ def rest_payload(recording: Recording, antenna: Antenna) -> Payload:
         return Payload(0.0, math.nan, 0)
     excess = float(reading.torque[1] - reading.expected_torque[1])
     noise = float(np.std(recording.torque[window, 1], ddof=1))
-    # the rest's mean, and the offset a tare leaves (TARE_NOISES deviations of the noise)
-    error = noise * math.hypot(1.0 / math.sqrt(rest), TARE_NOISES)
+    error = rest_moment_std(noise, noise / math.sqrt(rest))
     return Payload(excess / lever, error / lever, rest)
 
 

@@ -61,7 +61,7 @@ from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import touched_point
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
-from sensing_antenna.units_check import angle_problem
+from sensing_antenna.units_check import angle_problem, is_payload, rest_moment_std
 
 __all__ = ["review"]
 
@@ -290,15 +290,6 @@ def _friction_problem(
     )
 
 
-#: Significance (standard errors of the tare's mean) an unexplained moment at rest needs to be
-#: read as weight the model does not know of.
-_PAYLOAD_SIGMAS = 3.0
-
-#: The offset a tare leaves on the torque, in deviations of its noise per sample (about one
-#: resolution count each): a few counts, five at most. A payload of 0.05 g at the tip of the
-#: paper's link reads 15 counts.
-_TARE_COUNTS = 5.0
-
 #: Fraction of ``max_model_spread`` beyond which the payload's effect is computed on the heavier
 #: link's own sensing curve (a table of its eigenvalues, tens of ms) rather than scaled.
 _EXACT_FROM = 0.25
@@ -329,11 +320,10 @@ def _payload_problem(
         return None
     lever = STANDARD_GRAVITY * link.length * math.cos(float(evidence.theta[0, 1]))
     excess = float(evidence.load_offset[4])
-    # What a tare leaves: the mean's standard error, and an offset of a few counts, counted as
-    # up to _TARE_COUNTS deviations of the torque's noise per sample
+    # What a tare leaves: the mean's standard error and an offset of a few counts
     noise = float(evidence.diagnostics.get("torque_noise", 0.0))
-    allowed = _PAYLOAD_SIGMAS * evidence.torque_offset_error + _TARE_COUNTS * noise
-    if not (lever > 0.0 and excess > allowed):
+    std = rest_moment_std(noise, evidence.torque_offset_error)
+    if not (lever > 0.0 and excess > 0.0 and is_payload(excess, std)):
         return None  # a lighter reading is no payload: a sensor offset, which weighs nothing
     mass = excess / lever
     try:
