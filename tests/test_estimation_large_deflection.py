@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from sensing_antenna import paper_antenna
-from sensing_antenna.estimation import EstimatorConfig, Status, estimate
+from sensing_antenna.estimation import ContactEstimate, EstimatorConfig, Status, estimate
 from sensing_antenna.estimation.front.evidence import bent_weight_moment
 from sensing_antenna.recording import Recording, read_recording
 from sensing_antenna.simulator import Scenario, simulate
@@ -33,14 +33,17 @@ def rod(name: str) -> tuple[Recording, float, np.ndarray]:
 
 
 @pytest.mark.parametrize("name", ["xc050-push028", "xc090-push028"])
-def test_a_push_of_a_third_of_x_c_is_ok_and_right(name: str) -> None:
+def test_a_push_of_a_third_of_x_c_is_right_and_says_the_bent_link_is_unknown(name: str) -> None:
     # 31 % and 33 % deflection (true_deflection_ratio): the elastica's statics put the ratio
-    # within 1 cm of where the rod touched, the answer comes back ok within 1 cm and the
-    # touched point within 1 cm of the rod's in 3D (the small-deflection statics put the
-    # contact 5 % of x_c too far out along X^m at this deflection)
+    # within 1 cm of where the rod touched, the answer lies within 1 cm and the touched point
+    # within 1 cm of the rod's in 3D (the small-deflection statics put the contact 5 % of x_c
+    # too far out along X^m at this deflection). The answer is not ok: at that bend the
+    # straight link's sensing curves are not known to 1 cm (this rod's free plane rings at
+    # them, the project's exact link's does not), and the reason says so.
     recording, truth, point = rod(name)
     result = estimate(recording, paper_antenna().self_calibrated())
-    assert result.status is Status.OK, result.reason
+    assert result.status is Status.UNCERTAIN
+    assert "bends the link" in (result.reason or "")
     assert abs(result.x_c - truth) < 0.01
     assert abs(result.ratio_estimate - truth) < 0.01
     assert np.linalg.norm(result.contact_point - point) < 0.01
@@ -71,7 +74,7 @@ def test_planes_ringing_apart_are_told_apart_by_the_ratio_in_a_vertical_plane(na
     # derived, 1.0 and 1.3 cm) tells the free plane's candidate, 3 cm from the other
     recording, truth, _ = rod(name)
     result = estimate(recording, paper_antenna().self_calibrated(), method="paper")
-    assert result.status is Status.OK, result.reason
+    _uncertain_only_for_the_bend(result)
     assert result.diagnostics["frequency_plane"] == "free"
     assert result.diagnostics["plane_chosen_by"] == "ratio"
     assert abs(result.x_c - truth) < 0.01
@@ -92,7 +95,7 @@ def test_planes_ringing_apart_are_told_apart_by_a_precise_ratio() -> None:
     # tells the free plane's candidate from the push plane's (3 cm apart)
     recording, truth, _ = rod("xc050-push020")
     result = estimate(recording, paper_antenna().self_calibrated(), method="paper")
-    assert result.status is Status.OK, result.reason
+    _uncertain_only_for_the_bend(result)
     assert result.diagnostics["frequency_plane"] == "free"
     assert result.diagnostics["plane_chosen_by"] == "ratio"
     assert abs(result.x_c - truth) < 0.01
@@ -121,15 +124,22 @@ def test_bent_weight_moment_is_the_weight_moved_by_the_bending(x_c: float, push:
     assert got == pytest.approx(float(expected), rel=1e-6)
 
 
-def test_a_push_plane_frequency_corroborated_by_a_weaker_free_plane_is_ok() -> None:
+def test_a_push_plane_frequency_corroborated_by_a_weaker_free_plane() -> None:
     # The simulated device near the tip (x_c = 0.95 m, the default push bends it by 10 %): the
     # push plane rings clearly, the free plane at the same frequency 15 to 18 times its band's
-    # median, under the 20 a peak needs alone; the two agree, so the bent link's term (2 sigma
-    # 1.1 to 1.4 cm there) is not charged and the right answer stays ok
+    # median, under the 20 a peak needs alone; the two agree and the answer is right. The bent
+    # link's term (2 sigma 1.1 to 1.4 cm there) keeps it from ok
     antenna = paper_antenna()
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.95, seed=957))
     truth = float(recording.metadata["true_xc"])
     result = estimate(recording.without_ground_truth(), antenna.self_calibrated())
-    assert result.status is Status.OK, result.reason
+    _uncertain_only_for_the_bend(result)
     assert result.diagnostics["frequency_plane"] == "both"
     assert abs(result.x_c - truth) < 0.005
+
+
+def _uncertain_only_for_the_bend(result: ContactEstimate) -> None:
+    """The estimate is uncertain for the bent link's term alone."""
+    assert result.status is Status.UNCERTAIN, result.reason
+    assert "bends the link" in (result.reason or "")
+    assert not result.diagnostics.get("other_reasons"), result.diagnostics["other_reasons"]

@@ -33,6 +33,11 @@ forms agree.
    grow with the loads' scale) cover the difference. The frequency does
    not depend on the scale of the loads, the ratio does: forces doubled halve the ratio, a
    synthetic sine in the wrench matches no contact point with both.
+5. A straight enough link (``uncertain``): the sensing curves are the straight link's, and a
+   push that bends the link shifts its frequencies (:func:`_bent_link_problem`); a method that
+   read omega_1 is not ``ok`` where that shift, at two standard deviations, may move the
+   vibration's point by more than ``max_model_spread``; nor any method beyond
+   ``max_deflection_ratio``, where the statics were not checked.
 
 The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the method's own included;
 the rest go to ``diagnostics["other_reasons"]``. Whatever the status, a best guess outside
@@ -116,6 +121,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if statics is not None:
         found.append((Status.ESTIMATORS_DISAGREE, statics))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
+    bent = _bent_link_problem(evidence, estimate) if on_link else None
+    if bent is not None:
+        found.append((Status.UNCERTAIN, bent))
     bend = float(estimate.diagnostics.get("deflection_ratio", math.nan))
     if on_link and bend > evidence.config.max_deflection_ratio:
         found.append(
@@ -454,6 +462,26 @@ def _index_at(evidence: Evidence, t_e: float) -> int:
         return evidence.end_index
     index = int(np.searchsorted(evidence.t, t_e))
     return min(max(index, evidence.rest_index), evidence.end_index)
+
+
+def _bent_link_problem(evidence: Evidence, estimate: ContactEstimate) -> str | None:
+    """Why the point the vibration gives may be more than ``max_model_spread`` off on a link
+    the push bends, or None: the sensing curves are the straight link's, and the bent link's
+    preload shifts its frequencies (``Evidence.bent_link_uncertainty``, at two standard
+    deviations). Only for methods that read omega_1."""
+    if not math.isfinite(estimate.omega1):
+        return None
+    preload = 2.0 * evidence.bent_link_uncertainty(estimate.x_c)
+    limit = evidence.config.max_model_spread
+    if not preload > limit:
+        return None
+    bend = float(evidence.push_deflection_ratio(estimate.x_c))
+    return (
+        f"the push bends the link by {100 * bend:.0f} % of x_c at x_c = {estimate.x_c:.3f} m: "
+        f"the sensing curves are the straight link's, and the bent link's preload may move the "
+        f"point the vibration gives by {100 * preload:.1f} cm at two standard deviations, more "
+        f"than {100 * limit:g} cm"
+    )
 
 
 def _vibration_problems(

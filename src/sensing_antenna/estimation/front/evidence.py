@@ -331,9 +331,15 @@ class Evidence:
 
     def bent_link_uncertainties(self, x_c: FloatArray) -> FloatArray:
         """:meth:`bent_link_uncertainty` at contact points ``x_c`` (m, any shape, finite)."""
-        link = self.antenna.link
-        x_c = np.clip(np.asarray(x_c, dtype=float), 0.0, link.length)
+        x_c = np.clip(np.asarray(x_c, dtype=float), 0.0, self.antenna.link.length)
+        deflection_ratio = self.push_deflection_ratio(x_c)
+        return np.asarray(self.config.bent_link_factor * deflection_ratio**2 * x_c, dtype=float)
+
+    def push_deflection_ratio(self, x_c: FloatArray | float) -> FloatArray:
+        """d = |R_perp| x_c^2 / (3 E I) (dimensionless, the shape of ``x_c``): the hold's push
+        deflection over x_c (m) by the linear statics, as :meth:`bent_link_uncertainty` reads
+        it."""
         reaction = self.frame.reaction_m
         push = math.hypot(reaction[1], reaction[2])
-        deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
-        return np.asarray(self.config.bent_link_factor * deflection_ratio**2 * x_c, dtype=float)
+        x_c = np.asarray(x_c, dtype=float)
+        return np.asarray(push * x_c**2 * self.antenna.link.bending_compliance / 3.0)
