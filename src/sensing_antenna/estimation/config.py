@@ -143,10 +143,11 @@ class EstimatorConfig:
         sensing curves are the straight link's, and the preload of the bent link shifts the
         frequencies at second order. 0.6 bounds what the rod recordings show (0.8 cm at
         22 % deflection, x_c = 0.3 m, against 1.0 cm) and adds 0.5 mm at the default gentle
-        push. At two standard deviations beyond ``max_model_spread`` it makes every answer read
-        from the vibration ``uncertain`` (the plausibility layer); a push plane that rings apart
-        from the free one is judged by the ratio
-        (:mod:`~sensing_antenna.estimation.methods.paper.planes`).
+        push. The paper method charges it, at two standard deviations, to the status of a
+        frequency read in the push plane alone (``max_model_spread``); beyond
+        ``max_model_spread`` itself it makes every answer read from the vibration ``uncertain``,
+        in whichever plane (the plausibility layer); a push plane that rings apart from the free
+        one is judged by the ratio (:mod:`~sensing_antenna.estimation.methods.paper.planes`).
     omega2_window : float
         Relative half-width of the search window around each candidate's predicted omega_2;
         0.05 is a quarter of the 20 % gap between the candidates' omega_2 at the curve's top.

@@ -35,8 +35,8 @@ forms agree.
    synthetic sine in the wrench matches no contact point with both.
 5. A straight enough link (``uncertain``): the sensing curves are the straight link's, and a
    push that bends the link shifts its frequencies (:func:`_bent_link_problem`); a method that
-   read omega_1 is not ``ok`` where that shift, at two standard deviations, may move the
-   vibration's point by more than ``max_model_spread``; nor any method beyond
+   read omega_1 is not ``ok`` where that shift, in whichever plane, may move the vibration's
+   point by more than ``max_model_spread``; nor any method beyond
    ``max_deflection_ratio``, where the statics were not checked.
 
 The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the method's own included;
@@ -467,20 +467,20 @@ def _index_at(evidence: Evidence, t_e: float) -> int:
 def _bent_link_problem(evidence: Evidence, estimate: ContactEstimate) -> str | None:
     """Why the point the vibration gives may be more than ``max_model_spread`` off on a link
     the push bends, or None: the sensing curves are the straight link's, and the bent link's
-    preload shifts its frequencies (``Evidence.bent_link_uncertainty``, at two standard
-    deviations). Only for methods that read omega_1."""
+    preload shifts its frequencies by up to ``Evidence.bent_link_uncertainty`` (a bound of the
+    shift the rod showed), in whichever plane it was read. Only for methods that read omega_1.
+    """
     if not math.isfinite(estimate.omega1):
         return None
-    preload = 2.0 * evidence.bent_link_uncertainty(estimate.x_c)
+    shift = evidence.bent_link_uncertainty(estimate.x_c)
     limit = evidence.config.max_model_spread
-    if not preload > limit:
+    if not shift > limit:
         return None
     bend = float(evidence.push_deflection_ratio(estimate.x_c))
     return (
         f"the push bends the link by {100 * bend:.0f} % of x_c at x_c = {estimate.x_c:.3f} m: "
         f"the sensing curves are the straight link's, and the bent link's preload may move the "
-        f"point the vibration gives by {100 * preload:.1f} cm at two standard deviations, more "
-        f"than {100 * limit:g} cm"
+        f"point the vibration gives by up to {100 * shift:.1f} cm, more than {100 * limit:g} cm"
     )
 
 

@@ -472,6 +472,21 @@ class PaperMethod:
         if candidates_used and math.isfinite(fusion.x_c):
             spread = model_spread(link, fusion.x_c, 2.0 * link.frequency_uncertainty)
             diag["model_spread"] = spread
+            if diag.get("frequency_plane") == "push":
+                # a frequency of the push plane alone carries the bent link's preload
+                preload = 2.0 * evidence.bent_link_uncertainty(fusion.x_c)
+                diag["preload_spread"] = preload
+                if math.hypot(spread, preload) > cfg.max_model_spread:
+                    problems.append(
+                        (
+                            Status.UNCERTAIN,
+                            f"omega_1 was read in the push plane alone, where the bent link's "
+                            f"preload shifts it: with the frequency model's own uncertainty "
+                            f"the candidate may be {100 * math.hypot(spread, preload):.1f} cm "
+                            f"off at two standard deviations, more than "
+                            f"{100 * cfg.max_model_spread:g} cm",
+                        )
+                    )
             if spread > cfg.max_model_spread:
                 problems.append(
                     (

@@ -16,12 +16,12 @@ other evidence can say which (docs/estimation.md, "The two bending planes"):
   (``ratio_resolution_sigmas`` of its uncertainty), chooses the plane;
 - otherwise the answer is ``uncertain``.
 
-Two planes agree when the free plane has a peak at the same frequency, clear or at least half
-as clear as a peak must be on its own. Agreeing or not, a frequency read on a bent link carries
-the bent link's uncertainty
-(:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`) into the
-status (the plausibility layer): the project's exact link and the rod engine disagree on the free
-plane of a hard push.
+A frequency read in the push plane alone (the free plane silent) carries the bent link's
+uncertainty (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`)
+into the status at two standard deviations; one corroborated by a peak at the same frequency in
+the free plane, clear or at least half as clear as a peak must be on its own, carries it as the
+bound of a shift (the plausibility layer): the project's exact link and the rod engine disagree
+on the free plane of a hard push.
 """
 
 from __future__ import annotations
