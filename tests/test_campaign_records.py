@@ -34,7 +34,7 @@ DOCUMENTED_COLUMNS = (
     "x_c_estimate_m, error_m, abs_error_m, omega1_rad_s, peak_quality, ratio_estimate_m, "
     "candidates_m, t_c_s, t_1_s, t_e_s, interval_low_m, interval_high_m, simulate_s, "
     "estimate_s, noise_scale, x_c_contact_m, error_contact_m, abs_error_contact_m, "
-    "omega1_se_rad_s, omega1_crb_rad_s, front_end_s, point_error_m"
+    "omega1_se_rad_s, omega1_crb_rad_s, front_end_s, point_error_m, bound_delay_s"
 ).split(", ")
 
 RUN = RunSpec(3, "vertical-x0500mm-r2", "vertical", 0.5, 2, 1327166134, paper_antenna(), ())
@@ -73,9 +73,15 @@ def estimates() -> list[ContactEstimate]:
 
 def result() -> RunResult:
     timing = {"simulate_s": 0.089, "front_end_s": 0.01}
+    bounds = {"paper": math.nan, "fast": 0.28700000000000003}
     rows = tuple(
         CampaignRow.of_estimate(
-            RUN, e, contact_abscissa=0.49905517596364546, estimate_s=0.02, **timing
+            RUN,
+            e,
+            contact_abscissa=0.49905517596364546,
+            estimate_s=0.02,
+            bound_delay_s=bounds[e.method],
+            **timing,
         )
         for e in estimates()
     )
@@ -111,6 +117,10 @@ def test_a_row_copies_the_estimate_and_computes_the_errors() -> None:
     assert (fast.omega1_se_rad_s, fast.omega1_crb_rad_s) == (0.12101681329110635, 0.11)
     assert math.isnan(fast.peak_quality) and math.isnan(paper.interval_low_m)
     assert paper.noise_scale == 1.0  # the run's level (no noise_scale in its scenario)
+    # the information bound of the fast method's delay; a run file without it reads NaN
+    assert fast.bound_delay_s == 0.28700000000000003 and math.isnan(paper.bound_delay_s)
+    older = {k: v for k, v in fast.to_dict().items() if k != "bound_delay_s"}
+    assert math.isnan(CampaignRow.from_dict(older).bound_delay_s)
 
 
 def test_rows_read_back_from_the_run_file_are_the_same_rows(tmp_path: Path) -> None:

@@ -30,7 +30,8 @@ def one_point_spec(**changes: object) -> CampaignSpec:
 
 def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> None:
     from sensing_antenna.campaign.simulated import make_scenario, simulate_and_estimate
-    from sensing_antenna.estimation import estimate
+    from sensing_antenna.estimation import Evidence, estimate, gather
+    from sensing_antenna.estimation.methods.fast import bound_delay
     from sensing_antenna.simulator import simulate
 
     antenna = paper_antenna()
@@ -67,10 +68,21 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
             front_end_s=row.front_end_s,
             estimate_s=row.estimate_s,
             contact_point=json.loads(recording.metadata["true_contact_point"]),
+            bound_delay_s=row.bound_delay_s,
         )
         # the touched point in 3D: within a few mm of where the link touched (the 3D point of
         # an estimate within 1 cm along the link, bent and sagged by the model's statics)
         assert 0.0 <= row.point_error_m < 0.01
+    # the fast row also holds the information bound of its delay, as the package computes it on
+    # the same evidence, and no later than the method's own declaration; the others hold none
+    fast, evidence = result.rows[-1], gather(blind, antenna)
+    assert isinstance(evidence, Evidence)
+    assert fast.bound_delay_s == bound_delay(evidence)
+    assert 0.0 < fast.bound_delay_s <= fast.delay_s
+    assert all(math.isnan(row.bound_delay_s) for row in result.rows[:-1])
+    # a spec without the bound leaves it out
+    off = expand_runs(one_point_spec(methods=("fast",), fast_bound=False), antenna)[0]
+    assert math.isnan(simulate_and_estimate(off).rows[0].bound_delay_s)
 
 
 def test_a_run_the_front_end_stops_early_and_a_method_that_raises_are_recorded() -> None:

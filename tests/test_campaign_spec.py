@@ -110,6 +110,23 @@ def test_fingerprint_ignores_name_but_not_seeds(tmp_path: Path) -> None:
     assert a.fingerprint() == b.fingerprint() != c.fingerprint()
 
 
+def test_the_fast_bound_is_on_unless_the_spec_turns_it_off(tmp_path: Path) -> None:
+    # On by default (the built-in spec too), with the fingerprint of a spec that never mentions
+    # it; off, another fingerprint (its fast rows differ), carried to every run
+    default = load_campaign_spec(write(tmp_path, GOOD))
+    on = load_campaign_spec(
+        write(tmp_path, GOOD.replace("base_seed = 3", "base_seed = 3\nfast_bound = true"))
+    )
+    assert default.fast_bound and default_campaign_spec().fast_bound
+    assert on == replace(default, source=on.source)
+    assert on.fingerprint() == default.fingerprint()
+    text = GOOD.replace("base_seed = 3", "base_seed = 3\nfast_bound = false")
+    off = load_campaign_spec(write(tmp_path, text))
+    assert not off.fast_bound and off.fingerprint() != default.fingerprint()
+    assert not any(run.fast_bound for run in expand_runs(off, paper_antenna()))
+    assert all(run.fast_bound for run in expand_runs(default, paper_antenna()))
+
+
 @pytest.mark.parametrize(
     ("old", "new", "field"),
     [
@@ -124,6 +141,7 @@ def test_fingerprint_ignores_name_but_not_seeds(tmp_path: Path) -> None:
         ('methods = ["paper", "ratio"]', 'methods = ["magic"]', "methods[0]"),
         ("noise_scale = 0.5", "seed = 4", "scenario.seed"),
         ('name = "small"', 'name = "small"\ncolour = "red"', "colour"),
+        ("base_seed = 3", 'base_seed = 3\nfast_bound = "yes"', "fast_bound"),
     ],
 )
 def test_bad_fields_are_named_with_the_file(tmp_path: Path, old: str, new: str, field: str) -> None:

@@ -9,6 +9,7 @@ A spec file looks like::
     repeats = 2
     base_seed = 7
     methods = ["paper", "ratio", "two-frequency"]
+    fast_bound = true               # the fast method's information bound on its rows (default)
 
     [scenario]                      # keyword arguments of simulator.Scenario, SI units
     noise_scale = 1.0
@@ -109,6 +110,7 @@ _TOP_LEVEL_KEYS = (
     "calibration",
     "noise_sweep",
     "second_device",
+    "fast_bound",
 )
 
 _NOISE_SWEEP_KEYS = ("noise_scales", "contact_points", "repeats", "cases")
@@ -266,6 +268,9 @@ def _build(data: Mapping[str, Any], source: str, base_dir: Path | None) -> Campa
     calibration = _parse_calibration(data.get("calibration", {}), source)
     noise_sweep = _parse_noise_sweep(data.get("noise_sweep", {}), source)
     second_device = _parse_second_device(data.get("second_device"), source)
+    fast_bound = data.get("fast_bound", True)
+    if not isinstance(fast_bound, bool):
+        raise CampaignSpecError("fast_bound", "must be true or false", source)
     try:
         free_step = FreeMotionStep(
             identify=identify, duration=float(duration), case=str(free.get("case", "free"))
@@ -285,6 +290,7 @@ def _build(data: Mapping[str, Any], source: str, base_dir: Path | None) -> Campa
             calibration=calibration,
             noise_sweep=noise_sweep,
             second_device=second_device,
+            fast_bound=fast_bound,
             source=source,
         )
     except CampaignSpecError as exc:

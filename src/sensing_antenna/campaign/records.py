@@ -114,6 +114,11 @@ class CampaignRow:
     point_error_m : float
         Distance (m) from the estimate's touched point in 3D (``ContactEstimate.contact_point``,
         absolute frame) to where the link touched (the simulator's ``true_contact_point``).
+    bound_delay_s : float
+        ``fast`` only: the information bound of t_e - t_1 (s), the first window from t_1 whose
+        95 % interval would be within the tolerance with omega_1 at its Cramer-Rao bound and no
+        floors (``estimation.methods.fast.bound_delay``); NaN when no window qualifies before
+        the cap, when not computed (``CampaignSpec.fast_bound``) and for other methods.
     """
 
     run_id: str
@@ -148,6 +153,7 @@ class CampaignRow:
     omega1_crb_rad_s: float = math.nan
     front_end_s: float = math.nan
     point_error_m: float = math.nan
+    bound_delay_s: float = math.nan
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -190,12 +196,14 @@ class CampaignRow:
         front_end_s: float = math.nan,
         estimate_s: float = math.nan,
         contact_point: Sequence[float] | None = None,
+        bound_delay_s: float = math.nan,
     ) -> CampaignRow:
         """The row of one method's estimate on ``run`` (the method named by the estimate).
 
         The standard error and Cramer-Rao bound of omega_1 come from the estimate's
         ``diagnostics["omega1_se"]`` and ``diagnostics["omega1_crb"]`` (``fast``);
-        ``contact_point`` is where the link touched (absolute frame, m, shape (3,)), if known.
+        ``contact_point`` is where the link touched (absolute frame, m, shape (3,)), if known;
+        ``bound_delay_s`` the information bound of the delay (s, ``fast``).
         """
         low, high = estimate.interval if estimate.interval is not None else (math.nan, math.nan)
         diagnostics = estimate.diagnostics
@@ -218,6 +226,7 @@ class CampaignRow:
             omega1_se_rad_s=float_or_nan(diagnostics.get("omega1_se")),
             omega1_crb_rad_s=float_or_nan(diagnostics.get("omega1_crb")),
             point_error_m=_distance(estimate.contact_point, contact_point),
+            bound_delay_s=bound_delay_s,
         )
 
     @classmethod

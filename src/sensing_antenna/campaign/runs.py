@@ -78,6 +78,9 @@ class RunSpec:
         ``noise_scale``).
     device : Antenna or None
         The simulated hardware (with the observer its controller uses); None: ``antenna``.
+    fast_bound : bool
+        Whether the ``fast`` row also gets the information bound of its delay
+        (``CampaignSpec.fast_bound``).
     """
 
     index: int
@@ -90,6 +93,7 @@ class RunSpec:
     methods: tuple[str, ...]
     scenario: Mapping[str, Any] = field(default_factory=dict)
     device: Antenna | None = None
+    fast_bound: bool = True
 
     @property
     def noise_scale(self) -> float:
@@ -292,6 +296,7 @@ def expand_runs(
                 methods=spec.methods,
                 scenario=with_device(own, run.scenario, seed, length),
                 device=hardware,
+                fast_bound=spec.fast_bound,
             )
         )
     return runs

@@ -520,6 +520,10 @@ class CampaignSpec:
         Optional extra runs at other sensor noise levels; by default none.
     second_device : SecondDevice
         Optional: the main runs again on a second device; by default none.
+    fast_bound : bool
+        Whether each run's ``fast`` row also gets the information bound of its delay
+        (``estimation.methods.fast.bound_delay``, docs/fast.md): the windows from t_1 up to the
+        first that qualifies, those before the pipeline's hold fitted for it alone. Default on.
     description : str
         Free text for the report.
     source : str
@@ -539,6 +543,7 @@ class CampaignSpec:
     calibration: CalibrationStep = field(default_factory=CalibrationStep)
     noise_sweep: NoiseSweep = field(default_factory=NoiseSweep)
     second_device: SecondDevice = field(default_factory=SecondDevice)
+    fast_bound: bool = True
     description: str = ""
     source: str = ""
 
@@ -553,6 +558,8 @@ class CampaignSpec:
             raise CampaignSpecError("repeats", f"must be >= 1, got {self.repeats!r}", src)
         if self.base_seed < 0:
             raise CampaignSpecError("base_seed", f"must be >= 0, got {self.base_seed!r}", src)
+        if not isinstance(self.fast_bound, bool):
+            raise CampaignSpecError("fast_bound", "must be true or false", src)
         if problem := limits.runs_problem(
             self.n_main_runs, self.n_sweep_runs, self.n_second_device_runs
         ):
@@ -729,8 +736,8 @@ class CampaignSpec:
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON/TOML-ready) that :func:`parse_campaign_spec` reads back.
 
-        ``noise_sweep`` and ``second_device`` appear only when enabled, so a spec without them
-        has the fingerprint of one that never mentions them.
+        ``noise_sweep`` and ``second_device`` appear only when enabled, and ``fast_bound`` only
+        when off, so a spec without them has the fingerprint of one that never mentions them.
         """
         data = {
             "name": self.name,
@@ -754,6 +761,8 @@ class CampaignSpec:
             data["noise_sweep"] = self.noise_sweep.to_dict()
         if self.second_device.enabled:
             data["second_device"] = self.second_device.to_dict()
+        if not self.fast_bound:
+            data["fast_bound"] = False
         return data
 
     def preparation_fingerprint(self) -> str:

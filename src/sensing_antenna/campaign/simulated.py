@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import time
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
@@ -34,6 +35,11 @@ from sensing_antenna.campaign.runs import (
 )
 from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
+
+if TYPE_CHECKING:
+    from sensing_antenna.estimation import ContactEstimate, Evidence
+    from sensing_antenna.estimation.methods.fast import FastMethod
+    from sensing_antenna.estimation.methods.fast.window_fit import FitCache
 
 __all__ = [
     "calibrate_on_device",
@@ -68,11 +74,14 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     The estimation front end runs once on the recording (``estimation.gather``) and every
     method concludes from its evidence, which gives each method the estimate ``estimate``
     gives. Timing (wall clock): ``front_end_s`` is the front end's, ``estimate_s`` of a method
-    is that plus its own conclusion. An estimator that raises is recorded for that method
-    (status ``"error"``) and the other methods still run; an exception from the simulator
-    propagates (the runner records the run as failed).
+    is that plus its own conclusion. With ``run.fast_bound`` the ``fast`` row also gets the
+    information bound of its delay (``estimation.methods.fast.bound_delay``, reading the
+    method's window fits), outside its ``estimate_s``. An estimator that raises is recorded for
+    that method (status ``"error"``) and the other methods still run; an exception from the
+    simulator or the bound propagates (the runner records the run as failed).
     """
-    from sensing_antenna.estimation import conclude, gather
+    from sensing_antenna.estimation import METHODS, Evidence, conclude, gather
+    from sensing_antenna.estimation.methods.fast import FastMethod, bound_delay
     from sensing_antenna.simulator import simulate
 
     start = time.perf_counter()
@@ -100,11 +109,17 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
     front_end_s = time.perf_counter() - begin
     rows = []
     for method in run.methods:
+        impl = METHODS.get(method)
+        bounded = (
+            _KeepingFits(impl, ({}, {}))
+            if run.fast_bound and isinstance(impl, FastMethod) and isinstance(evidence, Evidence)
+            else None
+        )
         begin = time.perf_counter()
         try:
             # an early outcome of the front end (no contact, no push, bad input) is every
             # method's result, under its own name
-            estimate = conclude(evidence, method)
+            estimate = conclude(evidence, bounded or method)
         except Exception as exc:  # recorded per method: one broken estimator must not hide others
             elapsed = front_end_s + time.perf_counter() - begin
             reason = f"{type(exc).__name__}: {exc}"
@@ -115,6 +130,10 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
             )
             continue
         elapsed = front_end_s + time.perf_counter() - begin
+        bound = math.nan
+        if bounded is not None:
+            assert isinstance(evidence, Evidence)
+            bound = bound_delay(evidence, bounded.method.config, caches=bounded.caches)
         rows.append(
             CampaignRow.of_estimate(
                 run,
@@ -123,9 +142,29 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
                 front_end_s=front_end_s,
                 estimate_s=elapsed,
                 contact_point=touched,
+                bound_delay_s=bound,
             )
         )
     return RunResult(rows=tuple(rows))
+
+
+@dataclasses.dataclass(frozen=True)
+class _KeepingFits:
+    """The fast method concluding with ``caches``, which it fills with its window fits, so that
+    the information bound computed after it reads them instead of fitting those windows again
+    (a window's fit is a function of its own samples: neither answer changes)."""
+
+    method: FastMethod
+    caches: tuple[FitCache, FitCache]
+
+    @property
+    def name(self) -> str:
+        """The method's name."""
+        return self.method.name
+
+    def conclude(self, evidence: Evidence) -> ContactEstimate:
+        """The method's estimate (:meth:`FastMethod.conclude`)."""
+        return self.method.conclude(evidence, self.caches)
 
 
 def _true_contact_point(metadata: Mapping[str, str]) -> tuple[float, ...] | None:

@@ -12,6 +12,8 @@ Where things live (each module one idea):
 - :mod:`.window_fit`: one window's fit and fundamental (fit cache, push phase, drift term);
 - :mod:`.checks`: what keeps a window from being declared, and the problems of an estimate;
 - :mod:`.second_mode`: the second contact mode chooses between two branches;
+- :mod:`.bound`: the information bound of the delay (:func:`bound_delay`), what the method's
+  own model could do;
 - :mod:`.conclude`: from the final window to the :class:`~.result.ContactEstimate`;
 - :mod:`.curves`: the sensing curves on the posterior's grid;
 - :mod:`.likelihood`: the posterior over x_c;
@@ -31,6 +33,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from sensing_antenna.estimation.methods.fast.bound import bound_delay, bound_width
     from sensing_antenna.estimation.methods.fast.config import (
         FastConfig,
         FastConfigError,
@@ -64,6 +67,8 @@ __all__ = [
     "ScanInputs",
     "ScanResult",
     "WindowEstimate",
+    "bound_delay",
+    "bound_width",
     "curve_table",
     "evaluate_window",
     "evaluation_offsets",
@@ -85,6 +90,8 @@ _WHERE = {
     "ScanInputs": "window",
     "ScanResult": "search",
     "WindowEstimate": "window",
+    "bound_delay": "bound",
+    "bound_width": "bound",
     "curve_table": "curves",
     "evaluate_window": "window",
     "evaluation_offsets": "evaluation_grid",
