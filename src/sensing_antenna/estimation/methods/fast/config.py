@@ -121,8 +121,9 @@ class FastConfig:
         x_c) exceeds the static push, the link bounces on the obstacle and is not pinned over
         the window, so its frequency is not omega_1(x_c) (windows over the bouncing read it
         low). The window then starts at the end of the pipeline's hold (``frame_window`` after
-        t_1, sized for the rebounds near the tip) and is only declared if the contact stays
-        closed there. 1, the physical limit.
+        t_1, sized for the rebounds near the tip), and a hold's length later again while the
+        contact still opens there; it is only declared from a start where the contact stays
+        closed. 1, the physical limit.
     higher_modes : bool
         Whether a fitted contact mode 2 or 3 enters the posterior. Off by default: a fitted
         higher mode may be one the pinned-contact model does not describe (a compliant contact

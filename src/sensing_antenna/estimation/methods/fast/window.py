@@ -404,22 +404,25 @@ def evaluate_from_t1_or_hold(
     When the window from t_1 shows the contact opening (``max_opening``), the link was bouncing
     on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
     once it is at least ``first_window`` long (before that the one from t_1 is returned, not
-    sure). ``caches`` holds the fits of the two kinds of window; None refits.
+    sure), and while that one still opens, the window from a hold's length later, and so on.
+    ``caches`` holds the fits of the windows from t_1 and of those restarted; None refits.
     ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
     gets the slip check's early statics (:func:`with_early_statics_of`).
     """
     early, late = caches if caches is not None else (None, None)
     window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
     first = round(inputs.config.first_window / inputs.sample_period)
-    if (
+    start, step = hold_end, hold_end - inputs.rest_index
+    while (
         window.opening > inputs.config.max_opening
-        and inputs.rest_index < hold_end <= inputs.end_index - first
+        and inputs.rest_index < start <= inputs.end_index - first
     ):
         window = evaluate_window(
-            *inputs._replace(rest_index=hold_end, push=None),
+            *inputs._replace(rest_index=start, push=None),
             cache=late,
             choose_branch=choose_branch,
         )
+        start += step
     return with_early_statics_of(inputs, window, caches) if with_early_statics else window
 
 
