@@ -1,0 +1,46 @@
+"""The free-plane model of the pushed link (benchmarks/bent_link_free_plane.py): its limits."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensing_antenna import paper_antenna
+from sensing_antenna.beam import natural_frequencies
+
+SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "bent_link_free_plane.py"
+
+
+@pytest.fixture(scope="module")
+def model():
+    spec = importlib.util.spec_from_file_location("bent_link_free_plane", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bent_link_free_plane"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_barely_bent_link_rings_at_the_straight_links_omega_1(model) -> None:
+    omega_1 = float(np.ravel(natural_frequencies(paper_antenna().link, np.array([0.5]), 1))[0])
+    got = model.free_plane_fundamental(model.paper_rod(), 0.5, 1e-4)
+    assert got == pytest.approx(omega_1, rel=1e-4)
+
+
+def test_rigid_turn_costs_exactly_the_reactions_work(model) -> None:
+    rod = model.paper_rod()
+    energy, exact = model.rigid_turn_energy(rod, 0.5, 0.3, (1.0, 0.0))
+    assert energy == pytest.approx(exact, rel=1e-6)
+    energy, _ = model.rigid_turn_energy(rod, 0.5, 0.3, None)
+    assert abs(energy) < 1e-6 * exact
+
+
+def test_free_plane_of_a_hard_push_stays_within_half_a_percent(model) -> None:
+    omega_1 = float(np.ravel(natural_frequencies(paper_antenna().link, np.array([0.5]), 1))[0])
+    for poisson in (0.2, 0.4):
+        got = model.free_plane_fundamental(model.paper_rod(poisson), 0.5, 0.3)
+        assert 0.0 < got / omega_1 - 1 < 0.005
