@@ -37,9 +37,9 @@ def test_a_push_of_a_third_of_x_c_is_right_and_says_the_bent_link_is_unknown(nam
     # 31 % and 33 % deflection (true_deflection_ratio): the elastica's statics put the ratio
     # within 1 cm of where the rod touched, the answer lies within 1 cm and the touched point
     # within 1 cm of the rod's in 3D (the small-deflection statics put the contact 5 % of x_c
-    # too far out along X^m at this deflection). The answer is not ok: at that bend the
-    # straight link's sensing curves are not known to 1 cm (this rod's free plane rings at
-    # them, the project's exact link's does not), and the reason says so.
+    # too far out along X^m at this deflection). The answer is not ok: at that bend the push
+    # plane rings off the straight link's sensing curves by more than 1 cm's worth, and its
+    # mode can pass for the free plane's in the torque about Y^c; the reason says so.
     recording, truth, point = rod(name)
     result = estimate(recording, paper_antenna().self_calibrated())
     assert result.status is Status.UNCERTAIN

@@ -20,8 +20,9 @@ A frequency read in the push plane alone (the free plane silent) carries the ben
 uncertainty (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`)
 into the status at two standard deviations; one corroborated by a peak at the same frequency in
 the free plane, clear or at least half as clear as a peak must be on its own, carries it as the
-bound of a shift (the plausibility layer): the project's exact link and the rod engine disagree
-on the free plane of a hard push.
+bound of a shift (the plausibility layer): on a bent link the push plane's mode leaks into the
+free plane's component (the sag tilts the planes), so the two can agree on the push plane's
+frequency.
 """
 
 from __future__ import annotations
