@@ -4,9 +4,10 @@ Each scene holds one primitive (sphere, cylinder, capsule, cone, torus or box, i
 largest dimension drawn in 4 to 20 cm, a random orientation, its centre 0.3 to 0.95 m from the
 head at an azimuth within +-60 degrees and a height within +-10 cm of the head's. The head sits
 at ``--bases`` level base poses around the object (a head on a robot that moves round it): the
-origin, and the origin turned about the vertical through the object's centre by 120 and 240
-degrees, each facing the object from the origin's distance, the second seeing it from above
-(its line of sight 0.5 rad below the horizontal) and the third from below (0.5 rad above). A
+origin, and two poses turned about the vertical through the object's centre by 120 and 240
+degrees from it, each facing the object from 0.55 m (``--distance``: where the robot puts the
+head, inside the link's best range), the second seeing it from above (its line of sight 0.5
+rad below the horizontal) and the third from below (0.5 rad above; ``--sight``). A
 sweeping line first touches a convex object where it is tangent to it, on the object's outline
 seen from the base; bases at one height see outlines in level-sighted planes, which a sphere,
 a cylinder or a torus may all pass through, while the outlines seen from above and below lie in
@@ -80,6 +81,11 @@ MARGIN = 0.05
 #: above: minus this) and from the third (from below: plus this); ``--sight 0`` puts every base
 #: at the first's height.
 SIGHT = 0.5
+#: Distance (m) from the object's centre at which the robot places the second and third bases:
+#: away from the sensing curve's top (x_c near 0.77 m for the paper's link), where omega_1
+#: hardly changes with x_c and the frequency-based estimates come back uncertain, and from the
+#: far end, where the points err most; ``--distance 0`` keeps the first base's distance.
+WORKING_DISTANCE = 0.55
 
 
 def make_object(
@@ -106,18 +112,20 @@ def make_object(
     return extents, {"extents": sorted(extents)}
 
 
-def base_poses(centre: np.ndarray, n_bases: int, sight: float = SIGHT) -> tuple[BasePose, ...]:
+def base_poses(
+    centre: np.ndarray, n_bases: int, sight: float = SIGHT, working: float = WORKING_DISTANCE
+) -> tuple[BasePose, ...]:
     """``n_bases`` level base poses around the object (centre ``centre``, m, shape (3,)), the
     first at the origin, base k turned about the vertical through the centre by 2 pi k /
-    n_bases and facing it at the first's distance, its line of sight to the centre at the
-    elevation 0, -sight, +sight (rad) by k mod 3 (the first keeps its own; ``sight`` 0: every
-    base at the first's height)."""
+    n_bases and facing it from ``working`` (m; 0: the first's distance), its line of sight to
+    the centre at the elevation 0, -sight, +sight (rad) by k mod 3 (the first keeps its own;
+    ``sight`` 0: every base at the first's height)."""
     azimuth = math.atan2(centre[1], centre[0])
-    distance = float(np.linalg.norm(centre))
+    first = float(np.linalg.norm(centre))
     poses = []
     for k in range(n_bases):
         yaw = azimuth + 2 * math.pi * k / n_bases
-        level = math.asin(centre[2] / distance)
+        level = math.asin(centre[2] / first)
         elevation = (level, level - sight, level + sight)[k % 3] if sight else level
         direction = np.array(
             [
@@ -126,6 +134,7 @@ def base_poses(centre: np.ndarray, n_bases: int, sight: float = SIGHT) -> tuple[
                 math.sin(elevation),
             ]
         )
+        distance = working if working > 0 else first
         position = np.zeros(3) if k == 0 else centre - distance * direction
         rotation = np.array(
             [[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]]
@@ -135,7 +144,13 @@ def base_poses(centre: np.ndarray, n_bases: int, sight: float = SIGHT) -> tuple[
 
 
 def make_scene(
-    index: int, seed: int, sweeps: int, shape: LinkShape, n_bases: int = 3, sight: float = SIGHT
+    index: int,
+    seed: int,
+    sweeps: int,
+    shape: LinkShape,
+    n_bases: int = 3,
+    sight: float = SIGHT,
+    working: float = WORKING_DISTANCE,
 ) -> tuple[Scene, dict[str, Any]]:
     rng = np.random.default_rng([seed, index])
     name = CLASSES[index % len(CLASSES)]
@@ -151,7 +166,7 @@ def make_scene(
         # a cone's origin is its base centre: put its bounding box's centre where drawn
         shift = centre - obj.mesh.bounds.mean(axis=0)
         obj = primitive_object(name, name, sizes, centre + shift, rotation)
-    bases = base_poses(centre, n_bases, sight)
+    bases = base_poses(centre, n_bases, sight, working)
     regions = tuple(
         ExploreRegion(*facing_region(obj.mesh.vertices, base, shape, MARGIN), sweeps, sweeps)
         for base in bases
@@ -360,6 +375,12 @@ def main() -> None:
     parser.add_argument(
         "--sight", type=float, default=SIGHT, help="the raised and lowered bases' sight (rad)"
     )
+    parser.add_argument(
+        "--distance",
+        type=float,
+        default=WORKING_DISTANCE,
+        help="the other bases' distance from the object (m; 0: the first base's)",
+    )
     parser.add_argument("--out", type=Path, default=RESULTS)
     args = parser.parse_args()
     device = paper_antenna()
@@ -370,7 +391,9 @@ def main() -> None:
         calibrated = workdir / "calibrated.toml"
         calibrated.write_text(antenna_to_toml(calibrate_device(device, link=args.link)))
         for index in range(args.first, args.first + args.scenes):
-            scene, info = make_scene(index, args.seed, args.sweeps, shape, args.bases, args.sight)
+            scene, info = make_scene(
+                index, args.seed, args.sweeps, shape, args.bases, args.sight, args.distance
+            )
             for strategy in args.strategies:
                 row = {
                     "scene": index,

@@ -39,7 +39,11 @@ from eval_explore import make_scene  # noqa: E402
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
 from sensing_antenna.exploration import calibrate_device, grid_sweeps  # noqa: E402
-from sensing_antenna.mapping import BasePose, contact_point_from_estimate  # noqa: E402
+from sensing_antenna.mapping import (  # noqa: E402
+    BasePose,
+    PointUncertainty,
+    contact_point_from_estimate,
+)
 from sensing_antenna.scene import LinkShape, simulate_sweep  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "point_covariance.json"
@@ -47,6 +51,9 @@ LINKS = ("linear", "nonlinear")
 #: The error's parts: along the link, along the push, across the bending plane, and along the
 #: touched surface's normal (the only part recognition and the surface weigh).
 PARTS = ("along", "push", "binormal", "normal")
+#: Other deflection uncertainties rho the points' covariances are also computed with (the
+#: default is ``PointUncertainty``'s).
+RHOS = (0.05, 0.02)
 
 
 def measure(outcome: Any, antenna: Any, method: str) -> dict[str, float] | None:
@@ -71,6 +78,19 @@ def measure(outcome: Any, antenna: Any, method: str) -> dict[str, float] | None:
     for name, axis in axes:
         row[f"error_{name}_m"] = float(error @ axis)
         row[f"std_{name}_m"] = float(math.sqrt(axis @ point.covariance @ axis))
+    # the same point under other deflection uncertainties rho: the normal's std and the
+    # Mahalanobis distance
+    for rho in RHOS:
+        other = contact_point_from_estimate(
+            result,
+            antenna,
+            BasePose.identity(),
+            uncertainty=PointUncertainty(deflection_relative_std=rho),
+        )
+        row[f"std_normal_rho{rho:g}_m"] = float(math.sqrt(normal @ other.covariance @ normal))
+        row[f"mahalanobis_rho{rho:g}"] = float(
+            math.sqrt(error @ np.linalg.solve(other.covariance, error))
+        )
     return row
 
 
@@ -90,6 +110,15 @@ def summarise(rows: list[dict[str, float]]) -> dict[str, Any]:
             "error_rms_m": float(np.sqrt(np.mean(error**2))),
             "std_median_m": float(np.median(std)),
             "z_rms": float(np.sqrt(np.mean((error / std) ** 2))),
+        }
+    error = np.array([r["error_normal_m"] for r in rows])
+    for rho in RHOS:
+        std = np.array([r[f"std_normal_rho{rho:g}_m"] for r in rows])
+        others = np.array([r[f"mahalanobis_rho{rho:g}"] for r in rows])
+        summary[f"rho{rho:g}"] = {
+            "normal_std_median_m": float(np.median(std)),
+            "normal_z_rms": float(np.sqrt(np.mean((error / std) ** 2))),
+            "mahalanobis_median": float(np.median(others)),
         }
     return summary
 
@@ -130,6 +159,13 @@ def main() -> None:
         )
         quantiles = f"{q['0.1']:8.2f} {q['0.5']:6.2f} {q['0.9']:6.2f}"
         print(f"{link:9s} {s['points']:6d} {quantiles}   {parts}")
+        for rho in RHOS:
+            r = s[f"rho{rho:g}"]
+            print(
+                f"{'':9s} rho {rho:g}: normal std {1000 * r['normal_std_median_m']:.2f} mm,"
+                f" error / std RMS {r['normal_z_rms']:.2f}, Mahalanobis median"
+                f" {r['mahalanobis_median']:.2f}"
+            )
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(
         json.dumps(

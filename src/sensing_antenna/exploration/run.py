@@ -6,7 +6,8 @@ retract, re-plan), on the simulator:
 1. **Calibrate** (once per output directory), as the README does for a real device before it
    measures: five sweeps into posts at known x_c (0.3 to 0.9 m), ``calibrate_from_recordings``,
    the calibrated antenna written to ``calibrated.toml``; the estimators use it, the simulator
-   the device.
+   the device. The simulated link is the settings' ``link``, the geometrically exact one by
+   default, for the calibration and every sweep alike.
 2. **Each manoeuvre**: the planner (``exploration.plan``: ``grid`` or ``next-best``) picks a
    sweep; ``scene.simulate_sweep`` finds its first touch and simulates it; the recording is
    written (its ``base_pose`` says where it was taken) and estimated by the map's own code path
