@@ -165,13 +165,14 @@ def facing_region(
 ) -> tuple[tuple[float, float], tuple[float, float]]:
     """The angles under which ``base`` sees ``points`` (m, world, shape (n, 3); e.g. an object's
     mesh vertices): theta1 and theta2 from, to (rad), widened by ``margin`` (rad), the elevations
-    raised by the link's sag at each point's distance (the link at theta2 passes w(r) < 0
-    below its straight line) and kept within +-1.2 rad."""
+    raised by the link's sag at each point's distance r (the link at theta2 passes w(r) < 0
+    across itself, along Z^m: its point at r lies w(r) / r rad below theta2) and kept within
+    +-1.2 rad."""
     local = (np.asarray(points, dtype=float) - base.position) @ base.rotation  # R^T (p - O)
-    horizontal = np.hypot(local[:, 0], local[:, 1])
-    sag = np.interp(np.linalg.norm(local, axis=1), shape.abscissae, shape.sag())
+    reach = np.linalg.norm(local, axis=1)
+    sag = np.interp(reach, shape.abscissae, shape.sag())
     azimuths = np.arctan2(local[:, 1], local[:, 0])
-    elevations = np.arctan2(local[:, 2] - sag, horizontal)
+    elevations = np.arctan2(local[:, 2], np.hypot(local[:, 0], local[:, 1])) - sag / reach
     return (
         (float(azimuths.min()) - margin, float(azimuths.max()) + margin),
         (max(float(elevations.min()) - margin, -1.2), min(float(elevations.max()) + margin, 1.2)),
