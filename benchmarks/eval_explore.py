@@ -4,21 +4,23 @@ Each scene holds one primitive (sphere, cylinder, capsule, cone, torus or box, i
 largest dimension drawn in 4 to 20 cm, a random orientation, its centre 0.3 to 0.95 m from the
 head at an azimuth within +-60 degrees and a height within +-10 cm of the head's. The head sits
 at ``--bases`` level base poses around the object (a head on a robot that moves round it): the
-origin and the origin turned about the vertical through the object's centre by 120 and 240
-degrees, each facing the object from the same distance, within the reach. A sweeping line first
-touches a convex object where it is tangent to it, on the object's outline seen from the base;
-two bases facing each other across the object see nearly one outline (one great circle of a
-sphere, which a cylinder along the line between them or a flat cone also passes through),
-while outlines seen from three directions 120 degrees apart lie in three planes. The explored
-region is the object's angular extent seen from a base (the same from each), widened by 0.05
-rad, with the elevations shifted by the link's sag there; the grid has ``--sweeps`` azimuthal
-and as many vertical sweeps per base: 36 sweeps by default, about the 32 of two bases with 8
-each, so that the contacts stay near 20 per object.
+origin, and two poses turned about the vertical through the object's centre by 120 and 240
+degrees from it, each facing the object from 0.55 m (``--distance``: where the robot puts the
+head, inside the link's best range), the second seeing it from above (its line of sight 0.5
+rad below the horizontal) and the third from below (0.5 rad above; ``--sight``). A
+sweeping line first touches a convex object where it is tangent to it, on the object's outline
+seen from the base; bases at one height see outlines in level-sighted planes, which a sphere,
+a cylinder or a torus may all pass through, while the outlines seen from above and below lie in
+planes tilted by 0.5 rad the other ways. Each base explores its own region, the object's
+angular extent seen from it, widened by 0.05 rad, the elevations shifted by the link's sag at
+each point's distance; the grid has ``--sweeps`` azimuthal and as many vertical sweeps per
+base: 36 sweeps by default, so that the contacts stay near 20 per object.
 
 Each scene is explored twice with ``exploration.explore`` (every sweep simulated: first touch,
 contact physics, recording, estimate with ``--method``), once per strategy with the grid's size
 as the budget, on the calibrated antenna of one calibration (the README's five posts, made once
-and copied into each run's directory). Per scene and strategy: the contacts (sweeps that
+and copied into each run's directory), with the simulator's geometrically exact link
+(``--link linear``: the small-deflection one). Per scene and strategy: the contacts (sweeps that
 touched), the points used (status ok), the RMS and largest distance of the points to the true
 surface, the RMS of the fitted surface to the true one near the points (mesh vertices within
 1 cm of a contact) after a quarter, half, three quarters and all of the sweeps, a Chamfer
@@ -29,7 +31,7 @@ simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.
 every exploration (a run stopped early keeps the scenes it finished).
 
 Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 6] [--bases 3]
-[--strategies grid next-best] [--method fast] [--seed 0] [--out FILE]``.
+[--strategies grid next-best] [--method fast] [--link nonlinear] [--seed 0] [--out FILE]``.
 """
 
 from __future__ import annotations
@@ -60,7 +62,13 @@ from sensing_antenna.exploration import ExploreSettings, calibrate_device, explo
 from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
 from sensing_antenna.mapping import UNDECIDED, BasePose  # noqa: E402
 from sensing_antenna.mapping.contact_map import fit_surface  # noqa: E402
-from sensing_antenna.scene import ExploreRegion, LinkShape, Scene, primitive_object  # noqa: E402
+from sensing_antenna.scene import (  # noqa: E402
+    ExploreRegion,
+    LinkShape,
+    Scene,
+    facing_region,
+    primitive_object,
+)
 
 RESULTS = Path(__file__).resolve().parent / "results" / "explore.json"
 CLASSES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
@@ -69,6 +77,15 @@ STRATEGIES = ("grid", "next-best")
 NEAR = 0.01
 #: Widening of the explored region beyond the object's angular extent (rad).
 MARGIN = 0.05
+#: Elevation (rad) of the line of sight from the second base to the object's centre (from
+#: above: minus this) and from the third (from below: plus this); ``--sight 0`` puts every base
+#: at the first's height.
+SIGHT = 0.5
+#: Distance (m) from the object's centre at which the robot places the second and third bases:
+#: away from the sensing curve's top (x_c near 0.77 m for the paper's link), where omega_1
+#: hardly changes with x_c and the frequency-based estimates come back uncertain, and from the
+#: far end, where the points err most; ``--distance 0`` keeps the first base's distance.
+WORKING_DISTANCE = 0.55
 
 
 def make_object(
@@ -95,25 +112,30 @@ def make_object(
     return extents, {"extents": sorted(extents)}
 
 
-def base_poses(centre: np.ndarray, n_bases: int) -> tuple[BasePose, ...]:
-    """``n_bases`` level base poses around the object, the first at the origin, the others
-    turned about the vertical through ``centre`` (m, shape (3,)) by 2 pi k / n_bases, each
-    facing the object at the first's horizontal distance (two: the origin and the mirror point
-    beyond the object)."""
+def base_poses(
+    centre: np.ndarray, n_bases: int, sight: float = SIGHT, working: float = WORKING_DISTANCE
+) -> tuple[BasePose, ...]:
+    """``n_bases`` level base poses around the object (centre ``centre``, m, shape (3,)), the
+    first at the origin, base k turned about the vertical through the centre by 2 pi k /
+    n_bases and facing it from ``working`` (m; 0: the first's distance), its line of sight to
+    the centre at the elevation 0, -sight, +sight (rad) by k mod 3 (the first keeps its own;
+    ``sight`` 0: every base at the first's height)."""
     azimuth = math.atan2(centre[1], centre[0])
+    first = float(np.linalg.norm(centre))
     poses = []
     for k in range(n_bases):
-        turn = 2 * math.pi * k / n_bases
-        c, s = math.cos(turn), math.sin(turn)
-        # O_k = c + R_z(turn) (0 - c), horizontally; level with the first base
-        position = np.array(
+        yaw = azimuth + 2 * math.pi * k / n_bases
+        level = math.asin(centre[2] / first)
+        elevation = (level, level - sight, level + sight)[k % 3] if sight else level
+        direction = np.array(
             [
-                centre[0] - (c * centre[0] - s * centre[1]),
-                centre[1] - (s * centre[0] + c * centre[1]),
-                0.0,
+                math.cos(elevation) * math.cos(yaw),
+                math.cos(elevation) * math.sin(yaw),
+                math.sin(elevation),
             ]
         )
-        yaw = azimuth + turn
+        distance = working if working > 0 else first
+        position = np.zeros(3) if k == 0 else centre - distance * direction
         rotation = np.array(
             [[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]]
         )
@@ -122,7 +144,13 @@ def base_poses(centre: np.ndarray, n_bases: int) -> tuple[BasePose, ...]:
 
 
 def make_scene(
-    index: int, seed: int, sweeps: int, shape: LinkShape, n_bases: int = 3
+    index: int,
+    seed: int,
+    sweeps: int,
+    shape: LinkShape,
+    n_bases: int = 3,
+    sight: float = SIGHT,
+    working: float = WORKING_DISTANCE,
 ) -> tuple[Scene, dict[str, Any]]:
     rng = np.random.default_rng([seed, index])
     name = CLASSES[index % len(CLASSES)]
@@ -138,15 +166,12 @@ def make_scene(
         # a cone's origin is its base centre: put its bounding box's centre where drawn
         shift = centre - obj.mesh.bounds.mean(axis=0)
         obj = primitive_object(name, name, sizes, centre + shift, rotation)
-    radius = float(np.max(np.linalg.norm(obj.mesh.vertices - centre, axis=1)))
-    bases = base_poses(centre, n_bases)
-    horizontal = math.hypot(centre[0], centre[1])
-    spread = math.asin(min(radius / horizontal, 1.0)) + MARGIN
-    sag = float(np.interp(horizontal, shape.abscissae, shape.sag(0.0)))
-    low = math.atan2(height - radius - sag, horizontal) - MARGIN
-    high = math.atan2(height + radius - sag, horizontal) + MARGIN
-    region = ExploreRegion((-spread, spread), (max(low, -1.2), min(high, 1.2)), sweeps, sweeps)
-    scene = Scene(f"scene{index}", (obj,), bases, region)
+    bases = base_poses(centre, n_bases, sight, working)
+    regions = tuple(
+        ExploreRegion(*facing_region(obj.mesh.vertices, base, shape, MARGIN), sweeps, sweeps)
+        for base in bases
+    )
+    scene = Scene(f"scene{index}", (obj,), bases, regions[0], base_regions=regions)
     info = {"class": name, "size_m": size, "distance_m": distance, "truth": truth}
     return scene, info
 
@@ -204,12 +229,15 @@ def run(
     calibrated: Path,
     seed: int,
     workdir: Path,
+    link: str = "nonlinear",
 ) -> dict[str, Any]:
     out = workdir / f"{scene.name}-{strategy}"
     out.mkdir(parents=True)
     shutil.copy(calibrated, out / CALIBRATED_FILE)
     start = time.perf_counter()
-    result = explore(scene, paper_antenna(), out, ExploreSettings(method, strategy, seed=seed))
+    result = explore(
+        scene, paper_antenna(), out, ExploreSettings(method, strategy, seed=seed, link=link)
+    )
     elapsed = time.perf_counter() - start
     manoeuvres = result.manoeuvres
     mesh = scene.objects[0].mesh
@@ -343,6 +371,16 @@ def main() -> None:
     parser.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
     parser.add_argument("--method", choices=("paper", "fast"), default="fast")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--link", choices=("nonlinear", "linear"), default="nonlinear")
+    parser.add_argument(
+        "--sight", type=float, default=SIGHT, help="the raised and lowered bases' sight (rad)"
+    )
+    parser.add_argument(
+        "--distance",
+        type=float,
+        default=WORKING_DISTANCE,
+        help="the other bases' distance from the object (m; 0: the first base's)",
+    )
     parser.add_argument("--out", type=Path, default=RESULTS)
     args = parser.parse_args()
     device = paper_antenna()
@@ -351,14 +389,25 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="eval-explore-") as folder:
         workdir = Path(folder)
         calibrated = workdir / "calibrated.toml"
-        calibrated.write_text(antenna_to_toml(calibrate_device(device)))
+        calibrated.write_text(antenna_to_toml(calibrate_device(device, link=args.link)))
         for index in range(args.first, args.first + args.scenes):
-            scene, info = make_scene(index, args.seed, args.sweeps, shape, args.bases)
+            scene, info = make_scene(
+                index, args.seed, args.sweeps, shape, args.bases, args.sight, args.distance
+            )
             for strategy in args.strategies:
                 row = {
                     "scene": index,
                     **info,
-                    **run(scene, info, strategy, args.method, calibrated, args.seed, workdir),
+                    **run(
+                        scene,
+                        info,
+                        strategy,
+                        args.method,
+                        calibrated,
+                        args.seed,
+                        workdir,
+                        args.link,
+                    ),
                 }
                 rows.append(row)
                 # written after every exploration: a run stopped early keeps its scenes

@@ -7,8 +7,9 @@ estimated with ``--method`` after the README's calibration. For every ``ok`` est
 Mahalanobis distance of the simulator's true contact point under the point's covariance
 (``mapping.contact_point_from_estimate``; a calibrated 3-D covariance gives a median of 1.54 and
 a 90th percentile of 2.50, the chi distribution's with 3 degrees of freedom), and the error's
-parts along the link X^m, along the push across it and across the bending plane, each with the
-covariance's standard deviation in that direction.
+parts along the link X^m, along the push across it, across the bending plane and along the
+touched surface's normal, each with the covariance's standard deviation in that direction.
+Each link is calibrated on itself (the README's five posts).
 
 The linear link is linear in its deflection: its points do not move along X^m (docs/simulator.md),
 while a real link, inextensible, shortens by delta = x_c - p . X^m as it bends, about 3 y_c^2 /
@@ -38,15 +39,26 @@ from eval_explore import make_scene  # noqa: E402
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
 from sensing_antenna.exploration import calibrate_device, grid_sweeps  # noqa: E402
-from sensing_antenna.mapping import BasePose, contact_point_from_estimate  # noqa: E402
+from sensing_antenna.mapping import (  # noqa: E402
+    BasePose,
+    PointUncertainty,
+    contact_point_from_estimate,
+)
 from sensing_antenna.scene import LinkShape, simulate_sweep  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "point_covariance.json"
 LINKS = ("linear", "nonlinear")
+#: The error's parts: along the link, along the push, across the bending plane, and along the
+#: touched surface's normal (the only part recognition and the surface weigh).
+PARTS = ("along", "push", "binormal", "normal")
+#: Other deflection uncertainties rho the points' covariances are also computed with (the
+#: default is ``PointUncertainty``'s).
+RHOS = (0.05, 0.02)
 
 
-def measure(recording: Any, antenna: Any, method: str) -> dict[str, float] | None:
-    """The Mahalanobis distance and the error's parts of one recording's estimate (m)."""
+def measure(outcome: Any, antenna: Any, method: str) -> dict[str, float] | None:
+    """The Mahalanobis distance and the error's parts of one sweep's estimate (m)."""
+    recording = outcome.recording
     result = estimate(recording.without_ground_truth(), antenna, method=method)
     if result.status.value != "ok" or result.trace is None or result.trace.frame is None:
         return None
@@ -58,11 +70,27 @@ def measure(recording: Any, antenna: Any, method: str) -> dict[str, float] | Non
     push = frame.axes_a[1] - (frame.axes_a[1] @ x_m) * x_m
     push /= np.linalg.norm(push)
     binormal = np.cross(x_m, push)
+    # the touched surface's outward normal in the recording's frame: what recognition weighs
+    normal = outcome.frame.rotation.T @ outcome.touch.normal
     row = {"x_c": float(result.x_c)}
     row["mahalanobis"] = float(math.sqrt(error @ np.linalg.solve(point.covariance, error)))
-    for name, axis in (("along", x_m), ("push", push), ("binormal", binormal)):
+    axes = (("along", x_m), ("push", push), ("binormal", binormal), ("normal", normal))
+    for name, axis in axes:
         row[f"error_{name}_m"] = float(error @ axis)
         row[f"std_{name}_m"] = float(math.sqrt(axis @ point.covariance @ axis))
+    # the same point under other deflection uncertainties rho: the normal's std and the
+    # Mahalanobis distance
+    for rho in RHOS:
+        other = contact_point_from_estimate(
+            result,
+            antenna,
+            BasePose.identity(),
+            uncertainty=PointUncertainty(deflection_relative_std=rho),
+        )
+        row[f"std_normal_rho{rho:g}_m"] = float(math.sqrt(normal @ other.covariance @ normal))
+        row[f"mahalanobis_rho{rho:g}"] = float(
+            math.sqrt(error @ np.linalg.solve(other.covariance, error))
+        )
     return row
 
 
@@ -74,7 +102,7 @@ def summarise(rows: list[dict[str, float]]) -> dict[str, Any]:
             str(q): float(np.quantile(distances, q)) for q in (0.1, 0.5, 0.9, 0.99)
         },
     }
-    for name in ("along", "push", "binormal"):
+    for name in PARTS:
         error = np.array([r[f"error_{name}_m"] for r in rows])
         std = np.array([r[f"std_{name}_m"] for r in rows])
         summary[name] = {
@@ -82,6 +110,15 @@ def summarise(rows: list[dict[str, float]]) -> dict[str, Any]:
             "error_rms_m": float(np.sqrt(np.mean(error**2))),
             "std_median_m": float(np.median(std)),
             "z_rms": float(np.sqrt(np.mean((error / std) ** 2))),
+        }
+    error = np.array([r["error_normal_m"] for r in rows])
+    for rho in RHOS:
+        std = np.array([r[f"std_normal_rho{rho:g}_m"] for r in rows])
+        others = np.array([r[f"mahalanobis_rho{rho:g}"] for r in rows])
+        summary[f"rho{rho:g}"] = {
+            "normal_std_median_m": float(np.median(std)),
+            "normal_z_rms": float(np.sqrt(np.mean((error / std) ** 2))),
+            "mahalanobis_median": float(np.median(others)),
         }
     return summary
 
@@ -95,7 +132,8 @@ def main() -> None:
     args = parser.parse_args()
     device = paper_antenna()
     shape = LinkShape(device.link)
-    antenna = calibrate_device(device)
+    # each link calibrated on itself, as a device is calibrated before it measures
+    antennas = {link: calibrate_device(device, link=link) for link in LINKS}
     rows: dict[str, list[dict[str, float]]] = {link: [] for link in LINKS}
     for index in range(args.scenes):
         scene, _ = make_scene(index, args.seed, 6, shape, 3)
@@ -106,7 +144,7 @@ def main() -> None:
                 )
                 if outcome.recording is None:
                     continue
-                row = measure(outcome.recording, antenna, args.method)
+                row = measure(outcome, antennas[link], args.method)
                 if row is not None:
                     rows[link].append(row | {"scene": index, "sweep": k})
         counts = " and ".join(str(len(rows[link])) for link in LINKS)
@@ -117,10 +155,17 @@ def main() -> None:
         q = s["mahalanobis_quantiles"]
         parts = "  ".join(
             f"{name} {1000 * s[name]['error_rms_m']:.2f} / {1000 * s[name]['std_median_m']:.2f}"
-            for name in ("along", "push", "binormal")
+            for name in PARTS
         )
         quantiles = f"{q['0.1']:8.2f} {q['0.5']:6.2f} {q['0.9']:6.2f}"
         print(f"{link:9s} {s['points']:6d} {quantiles}   {parts}")
+        for rho in RHOS:
+            r = s[f"rho{rho:g}"]
+            print(
+                f"{'':9s} rho {rho:g}: normal std {1000 * r['normal_std_median_m']:.2f} mm,"
+                f" error / std RMS {r['normal_z_rms']:.2f}, Mahalanobis median"
+                f" {r['mahalanobis_median']:.2f}"
+            )
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(
         json.dumps(

@@ -147,6 +147,25 @@ def test_other_settings_in_the_same_directory_are_refused(
     out, _ = explored
     with pytest.raises(ExplorationStoreError, match=r"settings.json: method: "):
         explore(load_scene("post"), DEVICE, out, ExploreSettings(method="fast", budget=3))
+    linear = ExploreSettings(method="paper", budget=3, link="linear")
+    with pytest.raises(ExplorationStoreError, match=r"settings.json: link: "):
+        explore(load_scene("post"), DEVICE, out, linear)
+
+
+def test_the_exploration_simulates_the_exact_link(explored: tuple[Path, list[Manoeuvre]]) -> None:
+    out, manoeuvres = explored
+    from sensing_antenna.recording import read_recording
+
+    for m in manoeuvres:
+        if m.recording is not None:
+            simulation = json.loads(read_recording(out / m.recording).metadata["simulation"])
+            assert simulation["scenario"]["link_model"] == "nonlinear"
+    calibration = json.loads(
+        read_recording(out / "calibration" / "post-0.30.csv").metadata["simulation"]
+    )
+    assert calibration["scenario"]["link_model"] == "nonlinear"
+    with pytest.raises(ValueError, match="link must be one of"):
+        ExploreSettings(link="bent")
 
 
 def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -18,6 +18,7 @@ from sensing_antenna.scene import (
     Scene,
     SceneError,
     Sweep,
+    facing_region,
     first_touch,
     load_scene,
     primitive_object,
@@ -198,6 +199,10 @@ def test_a_turned_base_turns_the_touch() -> None:
             BALL + "[explore]\nazimuth = [1, 0]\n",
             "explore.azimuth",
         ),
+        (
+            BALL + "[[bases]]\n[[bases]]\nelevation = [0.5, 0.2]\n",
+            "bases[1].elevation",
+        ),
         ("[[objects]\n", "file"),
     ],
 )
@@ -243,3 +248,49 @@ def test_outcomes_the_simulator_cannot_represent_are_named() -> None:
     straight = LinkShape(DEVICE.link, gravity=0.0)
     glancing = simulate_sweep(DEVICE, top, sweep, shape=straight)
     assert glancing.outcome == "glancing" and glancing.touch is not None
+
+
+def test_a_base_may_explore_its_own_angles(tmp_path: Path) -> None:
+    from sensing_antenna.exploration import grid_sweeps
+
+    path = tmp_path / "two.toml"
+    path.write_text(
+        BALL.replace("[0, 0, 0]", "[0.6, 0, 0]")
+        + "[[bases]]\n"
+        + "[[bases]]\nposition = [0.6, -0.5, 0.4]\nyaw = 1.5708\nelevation = [-0.9, -0.5]\n"
+        + "[explore]\nazimuth = [-0.2, 0.2]\nelevation = [-0.1, 0.1]\nazimuthal_sweeps = 3\n"
+    )
+    scene = load_scene(path)
+    assert scene.region_of(0) == scene.region
+    own = scene.region_of(1)
+    # its own elevations, the scene's azimuths and grid counts
+    assert own.elevation == (-0.9, -0.5) and own.azimuth == (-0.2, 0.2)
+    assert own.azimuthal_sweeps == 3
+    for sweep in grid_sweeps(scene):
+        elevation = scene.region_of(sweep.base).elevation
+        if sweep.case == "azimuthal":
+            assert elevation[0] < sweep.fixed < elevation[1]
+        else:
+            assert (sweep.start, sweep.end) == elevation
+
+
+def test_facing_region_is_the_angles_a_ball_subtends() -> None:
+    # a ball of radius r at distance d on a base's line of sight, seen 0.5 rad from above: the
+    # straight link's tangent lines are asin(r / d) to either side (the mesh's vertices lie on
+    # the ball, within its facets' 0.1 mm of it: 2e-4 rad at 0.6 m)
+    radius, distance, sight = 0.06, 0.6, -0.5
+    ball = primitive_object("ball", "sphere", [radius], [0.3, 0.2, 0.1])
+    direction = np.array([math.cos(sight), 0.0, math.sin(sight)])
+    base = BasePose(np.eye(3), ball.parameters[:3] - distance * direction)
+    half = math.asin(radius / distance)
+    straight = LinkShape(DEVICE.link, gravity=0.0)
+    azimuth, elevation = facing_region(ball.mesh.vertices, base, straight, margin=0.0)
+    assert elevation == pytest.approx((sight - half, sight + half), abs=2e-3)
+    # across the sight line the angle narrows as the vertical circle leans: asin(r / d) / cos
+    assert azimuth[1] == pytest.approx(-azimuth[0], abs=1e-9)
+    assert 0.9 * half < azimuth[1] < 1.1 * half / math.cos(sight)
+    # the sagged link passes below its line: the region rises by about -w(d) / d
+    sagged = LinkShape(DEVICE.link)
+    _, raised = facing_region(ball.mesh.vertices, base, sagged, margin=0.0)
+    rise = -float(np.interp(distance, sagged.abscissae, sagged.sag())) / distance
+    assert raised[0] - elevation[0] == pytest.approx(rise, rel=0.15)

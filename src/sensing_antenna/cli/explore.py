@@ -52,6 +52,12 @@ def register(subparsers: Any) -> None:
         "--antenna", default="paper-2021", help="the simulated device: built-in name or TOML file"
     )
     parser.add_argument("--seed", type=_seed, default=0, help="seed of the first manoeuvre")
+    parser.add_argument(
+        "--link",
+        choices=("nonlinear", "linear"),
+        default="nonlinear",
+        help="the simulated link: geometrically exact (default) or small-deflection",
+    )
     add_map_options(parser, "the map and the planner's surface")
     parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre")
     parser.set_defaults(func=_run)
@@ -92,6 +98,7 @@ def _run(args: argparse.Namespace) -> int:
         budget=args.budget,
         seed=args.seed,
         include_uncertain=args.include_uncertain,
+        link=args.link,
     )
 
     def show(manoeuvre: Manoeuvre, budget: int) -> None:

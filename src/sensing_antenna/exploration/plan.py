@@ -1,9 +1,9 @@
 """Which sweep next: a fixed grid, or the sweep expected to reduce the surface's uncertainty most.
 
-The grid (:func:`grid_sweeps`) runs, from each base, azimuthal sweeps across the scene's azimuth
-range at evenly spaced elevations and vertical sweeps up its elevation range at evenly spaced
-azimuths, in an order that spreads them out first (:func:`spread_order`), so that
-a budget cut short still covers the region.
+The grid (:func:`grid_sweeps`) runs, from each base, azimuthal sweeps across the base's azimuth
+range (``Scene.region_of``) at evenly spaced elevations and vertical sweeps up its elevation
+range at evenly spaced azimuths, in an order that spreads them out first
+(:func:`spread_order`), so that a budget cut short still covers the region.
 
 The next-best strategy (:class:`NextBestPlanner`) chooses among the candidates of a grid
 :data:`CANDIDATE_DENSITY` times finer. Until the surface can be fitted (fewer than
@@ -108,13 +108,13 @@ def spread_order(n: int) -> list[int]:
 
 
 def _sweeps(scene: Scene, azimuthal: int, vertical: int) -> list[Sweep]:
-    region = scene.region
-    elevations: FloatArray = np.linspace(*region.elevation, azimuthal + 2)[1:-1]
-    azimuths: FloatArray = np.linspace(*region.azimuth, vertical + 2)[1:-1]
     sweeps: list[Sweep] = []
-    a_order = spread_order(len(elevations))
-    v_order = spread_order(len(azimuths))
+    a_order = spread_order(azimuthal)
+    v_order = spread_order(vertical)
     for base in range(len(scene.bases)):
+        region = scene.region_of(base)
+        elevations: FloatArray = np.linspace(*region.elevation, azimuthal + 2)[1:-1]
+        azimuths: FloatArray = np.linspace(*region.azimuth, vertical + 2)[1:-1]
         a = [Sweep(base, "azimuthal", float(elevations[i]), *region.azimuth) for i in a_order]
         v = [Sweep(base, "vertical", float(azimuths[i]), *region.elevation) for i in v_order]
         # alternate the two cases so that a prefix holds both

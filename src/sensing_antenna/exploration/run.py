@@ -6,7 +6,8 @@ retract, re-plan), on the simulator:
 1. **Calibrate** (once per output directory), as the README does for a real device before it
    measures: five sweeps into posts at known x_c (0.3 to 0.9 m), ``calibrate_from_recordings``,
    the calibrated antenna written to ``calibrated.toml``; the estimators use it, the simulator
-   the device.
+   the device. The simulated link is the settings' ``link``, the geometrically exact one by
+   default, for the calibration and every sweep alike.
 2. **Each manoeuvre**: the planner (``exploration.plan``: ``grid`` or ``next-best``) picks a
    sweep; ``scene.simulate_sweep`` finds its first touch and simulates it; the recording is
    written (its ``base_pose`` says where it was taken) and estimated by the map's own code path
@@ -64,6 +65,7 @@ from sensing_antenna.recording import write_recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.simulate import simulate_sweep
 from sensing_antenna.scene.sweep import LinkShape
+from sensing_antenna.simulator.scenario import LINK_MODELS
 
 __all__ = [
     "CALIBRATION_POINTS",
@@ -102,6 +104,10 @@ class ExploreSettings:
         Seed of the first manoeuvre.
     include_uncertain : bool
         Let ``uncertain`` points into the map and the planner's surface.
+    link : {"nonlinear", "linear"}
+        The simulated link (``Scenario.link_model``), of the calibration and of every sweep:
+        the geometrically exact link (the default: a physical link shortens as it bends), or
+        the small-deflection one.
     """
 
     method: str = "fast"
@@ -109,6 +115,7 @@ class ExploreSettings:
     budget: int | None = None
     seed: int = 0
     include_uncertain: bool = False
+    link: str = "nonlinear"
 
     def __post_init__(self) -> None:
         if self.method not in EXPLORE_METHODS:
@@ -117,6 +124,8 @@ class ExploreSettings:
             raise ValueError(f"strategy must be one of {', '.join(STRATEGIES)}")
         if self.budget is not None and self.budget < 1:
             raise ValueError("budget must be at least 1")
+        if self.link not in LINK_MODELS:
+            raise ValueError(f"link must be one of {', '.join(LINK_MODELS)}")
 
 
 class ExplorationInterrupted(KeyboardInterrupt):
@@ -180,15 +189,20 @@ class Exploration:
         }
 
 
-def calibrate_device(device: Antenna, folder: Path | None = None) -> Antenna:
+def calibrate_device(
+    device: Antenna, folder: Path | None = None, link: str = "nonlinear"
+) -> Antenna:
     """The README's calibration on the simulated device: posts at :data:`CALIBRATION_POINTS`
-    (seeds from :data:`CALIBRATION_SEED`), T_e fitted by ``calibrate_from_recordings``; the
-    recordings are written into ``folder`` when given."""
+    (seeds from :data:`CALIBRATION_SEED`) with the simulator's ``link`` model, T_e fitted by
+    ``calibrate_from_recordings``; the recordings are written into ``folder`` when given."""
     from sensing_antenna.calibration.frequency import calibrate_from_recordings
     from sensing_antenna.simulator import Scenario, simulate
 
     runs = [
-        simulate(device, Scenario(case="azimuthal", contact_point=x, seed=seed))
+        simulate(
+            device,
+            Scenario(case="azimuthal", contact_point=x, seed=seed, link_model=link),  # type: ignore[arg-type]
+        )
         for seed, x in enumerate(CALIBRATION_POINTS, start=CALIBRATION_SEED)
     ]
     if folder is not None:
@@ -199,11 +213,11 @@ def calibrate_device(device: Antenna, folder: Path | None = None) -> Antenna:
     return calibrate_from_recordings(runs, device, points).apply(device)
 
 
-def _prepared(device: Antenna, out: Path) -> Antenna:
+def _prepared(device: Antenna, out: Path, link: str) -> Antenna:
     path = out / CALIBRATED_FILE
     if path.is_file():
         return load_antenna(path)
-    calibrated = calibrate_device(device, out / "calibration")
+    calibrated = calibrate_device(device, out / "calibration", link)
     atomic_write_text(path, antenna_to_toml(calibrated))
     return load_antenna(path)
 
@@ -217,6 +231,7 @@ def _scene_fingerprint(scene: Scene) -> str:
     for base in scene.bases:
         digest.update(np.round(base.matrix, 12).tobytes())
     digest.update(repr(scene.region).encode())
+    digest.update(repr(scene.base_regions).encode())
     return digest.hexdigest()[:16]
 
 
@@ -264,12 +279,13 @@ def explore(
                 "strategy": settings.strategy,
                 "seed": settings.seed,
                 "include_uncertain": settings.include_uncertain,
+                "link": settings.link,
             },
         )
         scene.mesh.export(out / "scene.ply")
         manoeuvres = load_manoeuvres(out)
         try:
-            antenna = _prepared(device, out)
+            antenna = _prepared(device, out, settings.link)
             shape = LinkShape(device.link)
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
             leaders: tuple[ClassFit, ...] = ()
@@ -332,7 +348,9 @@ def _run_one(
     from sensing_antenna.mapping.contact_map import points_from_recordings
 
     seed = settings.seed + index
-    outcome = simulate_sweep(device, scene, choice.sweep, seed=seed, shape=shape)
+    outcome = simulate_sweep(
+        device, scene, choice.sweep, seed=seed, shape=shape, link_model=settings.link
+    )
     recording_name = None
     point = None
     if outcome.recording is not None:

@@ -5,7 +5,8 @@ Above ``simulator/`` (it calls ``simulate``) and ``mapping/`` (poses, shape clas
 
 - :mod:`.objects`: :class:`SceneObject`, a primitive or a user's mesh at a pose;
 - :mod:`.file`: :class:`Scene` and its TOML file (:func:`load_scene`);
-- :mod:`.sweep`: :class:`Sweep` and the link's sagged shape (:class:`LinkShape`);
+- :mod:`.sweep`: :class:`Sweep`, the link's sagged shape (:class:`LinkShape`) and the angles
+  under which a base sees an object (:func:`facing_region`);
 - :mod:`.touch`: :func:`first_touch`, where a sweep's link meets the scene;
 - :mod:`.simulate`: :func:`simulate_sweep`, the touch run through the simulator's physics.
 """
@@ -13,7 +14,7 @@ Above ``simulator/`` (it calls ``simulate``) and ``mapping/`` (poses, shape clas
 from sensing_antenna.scene.file import BUILTIN_SCENES, ExploreRegion, Scene, SceneError, load_scene
 from sensing_antenna.scene.objects import OBJECT_SHAPES, SceneObject, mesh_object, primitive_object
 from sensing_antenna.scene.simulate import OUTCOMES, SweepOutcome, simulate_sweep, touch_scenario
-from sensing_antenna.scene.sweep import LinkShape, Sweep
+from sensing_antenna.scene.sweep import LinkShape, Sweep, facing_region
 from sensing_antenna.scene.touch import SweepGeometry, Touch, first_touch
 
 __all__ = [
@@ -29,6 +30,7 @@ __all__ = [
     "SweepGeometry",
     "SweepOutcome",
     "Touch",
+    "facing_region",
     "first_touch",
     "load_scene",
     "mesh_object",

@@ -21,6 +21,8 @@
     [[bases]]                             # the antenna's base poses; default: one, the origin
     position = [0.0, 0.0, 0.0]            # the head's base point O (m)
     yaw = 0.0                             # rad about the world's Z; or quaternion = [w, x, y, z]
+    azimuth = [-0.3, 0.3]                 # optional: this base's own explored angles (rad),
+    elevation = [-0.8, -0.4]              # each defaulting to [explore]'s
 
     [explore]                             # the region swept (defaults below)
     azimuth = [-0.6, 0.6]                 # theta1 range (rad): azimuthal sweeps run across it
@@ -118,6 +120,9 @@ class Scene:
     region : ExploreRegion
     source : str
         The file it came from (or the built-in's name).
+    base_regions : tuple of (ExploreRegion or None)
+        A base's own explored angles (its grid counts are ``region``'s), by base index; a base
+        without one (None, or beyond the tuple) explores ``region``.
     """
 
     name: str
@@ -125,6 +130,12 @@ class Scene:
     bases: tuple[BasePose, ...]
     region: ExploreRegion
     source: str = ""
+    base_regions: tuple[ExploreRegion | None, ...] = ()
+
+    def region_of(self, base: int) -> ExploreRegion:
+        """The region base ``base`` (index) explores."""
+        own = self.base_regions[base] if base < len(self.base_regions) else None
+        return self.region if own is None else own
 
     def signed_distance(self, points: Any) -> np.ndarray:
         """Distance (m) of points (n, 3) to the nearest object, negative inside one."""
@@ -188,9 +199,11 @@ def _build(data: Mapping[str, Any], source: str, folder: Path | None) -> Scene:
     base_tables = data.get("bases", [{}])
     if not isinstance(base_tables, list) or not base_tables or len(base_tables) > _MAX_COUNT:
         raise fail("bases", f"must be 1 to {_MAX_COUNT} [[bases]] tables")
-    bases = tuple(_base(table, f"bases[{i}]", fail) for i, table in enumerate(base_tables))
     region = _region(data.get("explore", {}), fail)
-    return Scene(name, objects, bases, region, source)
+    parsed = [_base(table, f"bases[{i}]", region, fail) for i, table in enumerate(base_tables)]
+    bases = tuple(pose for pose, _ in parsed)
+    base_regions = tuple(own for _, own in parsed)
+    return Scene(name, objects, bases, region, source, base_regions)
 
 
 def _table(value: object, where: str, fail: Any) -> Mapping[str, Any]:
@@ -295,13 +308,23 @@ def _mesh_file(value: object, where: str, folder: Path | None, fail: Any) -> tri
     return mesh
 
 
-def _base(value: object, where: str, fail: Any) -> BasePose:
+def _base(
+    value: object, where: str, region: ExploreRegion, fail: Any
+) -> tuple[BasePose, ExploreRegion | None]:
+    """The base's pose, and its own region when it gives angles (None: the scene's)."""
     table = _table(value, where, fail)
-    unknown = set(table) - {"position", "yaw", "quaternion"}
+    known = ("position", "yaw", "quaternion", "azimuth", "elevation")
+    unknown = set(table) - set(known)
     if unknown:
-        raise fail(
-            f"{where}.{sorted(unknown)[0]}", "unknown key (known: position, yaw, quaternion)"
-        )
+        raise fail(f"{where}.{sorted(unknown)[0]}", f"unknown key (known: {', '.join(known)})")
+    own = None
+    if "azimuth" in table or "elevation" in table:
+        azimuth, elevation = _ranges(table, where, region, fail)
+        own = ExploreRegion(azimuth, elevation, region.azimuthal_sweeps, region.vertical_sweeps)
+    return _base_pose(table, where, fail), own
+
+
+def _base_pose(table: Mapping[str, Any], where: str, fail: Any) -> BasePose:
     if "yaw" in table and "quaternion" in table:
         raise fail(f"{where}.quaternion", "give yaw or quaternion, not both")
     position = _vector(
@@ -318,6 +341,23 @@ def _base(value: object, where: str, fail: Any) -> BasePose:
     return BasePose(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), position)
 
 
+def _ranges(
+    table: Mapping[str, Any], where: str, defaults: ExploreRegion, fail: Any
+) -> list[tuple[float, float]]:
+    """The azimuth and elevation ranges (rad) of ``table``, each defaulting to ``defaults``'."""
+    ranges = []
+    for key, limit in (("azimuth", math.pi), ("elevation", 1.2)):
+        low, high = _vector(table.get(key, list(getattr(defaults, key))), 2, f"{where}.{key}", fail)
+        if not -limit <= low < high <= limit:
+            raise fail(
+                f"{where}.{key}",
+                f"must be [from, to] with -{limit:.3g} <= from < to <= {limit:.3g} rad, got"
+                f" [{low:g}, {high:g}]",
+            )
+        ranges.append((float(low), float(high)))
+    return ranges
+
+
 def _region(value: object, fail: Any) -> ExploreRegion:
     table = _table(value, "explore", fail)
     defaults = ExploreRegion()
@@ -327,16 +367,7 @@ def _region(value: object, fail: Any) -> ExploreRegion:
             f"explore.{sorted(unknown)[0]}",
             "unknown key (known: azimuth, elevation, azimuthal_sweeps, vertical_sweeps)",
         )
-    ranges = []
-    for key, limit in (("azimuth", math.pi), ("elevation", 1.2)):
-        low, high = _vector(table.get(key, list(getattr(defaults, key))), 2, f"explore.{key}", fail)
-        if not -limit <= low < high <= limit:
-            raise fail(
-                f"explore.{key}",
-                f"must be [from, to] with -{limit:.3g} <= from < to <= {limit:.3g} rad, got"
-                f" [{low:g}, {high:g}]",
-            )
-        ranges.append((float(low), float(high)))
+    ranges = _ranges(table, "explore", defaults, fail)
     counts = []
     for key in ("azimuthal_sweeps", "vertical_sweeps"):
         count = table.get(key, getattr(defaults, key))

@@ -16,9 +16,10 @@ frame is the base's turned to the touch angles: R = R_base M(theta)^T, with M(th
 frame's rows (``simulator.contact.motor_frame``), written as the recording's ``base_pose``; the
 recording's angles are relative to that frame. The physics is exact for an azimuthal sweep at
 elevation 0 under a level base (a turn about the vertical); otherwise the simulated gravity acts
-along the turned frame's -Z, so the sag across the link is g where the scene's is
-g cos(theta2) (4.5 % of the sag at 0.3 rad), and a sweep at elevation theta2 is simulated in
-the plane tangent to its cone at the touch.
+along the turned frame's -Z, so the sag across the link is g where a physical link's is
+g cos(theta2) (the scene's link shape, ``scene.sweep.LinkShape``, sags as the simulated one, so
+that the simulated contact lies on the touched surface), and a sweep at elevation theta2 is
+simulated in the plane tangent to its cone at the touch.
 
 The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
 friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated

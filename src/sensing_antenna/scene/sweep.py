@@ -4,9 +4,13 @@ A sweep turns one joint from ``start`` to ``end`` with the other held at ``fixed
 theta1 across with theta2 = ``fixed`` (the link moves towards +Y^m); vertical, theta2 up with
 theta1 = ``fixed`` (towards +Z^m), the two cases of the simulator, from one of the scene's base
 poses. The link at angles (theta1, theta2) is the straight line x X^m sagged by its own weight,
-p(x) = x X^m + g cos(theta2) w_1(x) Z^m in the absolute frame (recording format), w_1 the static
-deflection of the simulator's finite-element link under a unit transverse acceleration (m per
-m/s^2, negative: the load is along -Z^m), the sag the simulator starts its manoeuvres from.
+p(x) = x X^m + g w_1(x) Z^m in the absolute frame (recording format), w_1 the static deflection
+of the simulator's finite-element link under a unit transverse acceleration (m per m/s^2,
+negative: the load is along -Z^m): the sag the simulator starts its manoeuvres from. The
+simulator touches in a frame turned to the touch's angles (``scene.simulate``), where the whole
+of g acts across the link, so the sag is g w_1 at every elevation (a level link's; a physical
+link's is g cos(theta2) w_1): the geometric touch and the simulated one then meet the surface at
+the same point.
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ from sensing_antenna.simulator.contact import motor_frame
 from sensing_antenna.simulator.link import build_link_model
 from sensing_antenna.simulator.run import device_link
 
-__all__ = ["SWEEP_CASES", "LinkShape", "Sweep"]
+__all__ = ["SWEEP_CASES", "LinkShape", "Sweep", "facing_region"]
 
 FloatArray = NDArray[np.float64]
 
@@ -125,30 +129,26 @@ class LinkShape:
         slope = np.array([float(model.slope_at(float(xi)) @ q) for xi in x])
         return w, slope
 
-    def sag(self, theta2: float) -> FloatArray:
-        """w(x) along Z^m (m), shape (n,), at elevation theta2 (rad)."""
-        return self.gravity * math.cos(theta2) * self._unit_sag[0]
+    def sag(self) -> FloatArray:
+        """w(x) along Z^m (m), shape (n,), the same at every elevation (module docstring)."""
+        return self.gravity * self._unit_sag[0]
 
     def points(self, theta: tuple[float, float], base: BasePose) -> FloatArray:
         """The samples in the world (m), shape (n, 3)."""
         x_m, _, z_m = motor_frame(*theta)
-        local = np.outer(self.abscissae, x_m) + np.outer(self.sag(theta[1]), z_m)
+        local = np.outer(self.abscissae, x_m) + np.outer(self.sag(), z_m)
         return base.point_to_world(local)
 
     def point_at(self, x: float, theta: tuple[float, float], base: BasePose) -> FloatArray:
         """p(x) in the world (m), shape (3,), the sag interpolated between samples."""
         x_m, _, z_m = motor_frame(*theta)
-        w = float(np.interp(x, self.abscissae, self.sag(theta[1])))
+        w = float(np.interp(x, self.abscissae, self.sag()))
         return base.point_to_world(x * x_m + w * z_m)
 
     def tangent_at(self, x: float, theta: tuple[float, float], base: BasePose) -> FloatArray:
         """Unit tangent dp/dx in the world, shape (3,)."""
         x_m, _, z_m = motor_frame(*theta)
-        slope = (
-            self.gravity
-            * math.cos(theta[1])
-            * float(np.interp(x, self.abscissae, self._unit_sag[1]))
-        )
+        slope = self.gravity * float(np.interp(x, self.abscissae, self._unit_sag[1]))
         t = x_m + slope * z_m
         return np.asarray(base.rotation @ (t / np.linalg.norm(t)))
 
@@ -158,3 +158,22 @@ class LinkShape:
         bound on how fast a link point moves per radian of either joint."""
         sag = np.abs(self.gravity * self._unit_sag[0])
         return float(np.max(np.hypot(self.abscissae, sag)) + sag.max())
+
+
+def facing_region(
+    points: NDArray[np.floating], base: BasePose, shape: LinkShape, margin: float = 0.05
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The angles under which ``base`` sees ``points`` (m, world, shape (n, 3); e.g. an object's
+    mesh vertices): theta1 and theta2 from, to (rad), widened by ``margin`` (rad), the elevations
+    raised by the link's sag at each point's distance r (the link at theta2 passes w(r) < 0
+    across itself, along Z^m: its point at r lies w(r) / r rad below theta2) and kept within
+    +-1.2 rad."""
+    local = (np.asarray(points, dtype=float) - base.position) @ base.rotation  # R^T (p - O)
+    reach = np.linalg.norm(local, axis=1)
+    sag = np.interp(reach, shape.abscissae, shape.sag())
+    azimuths = np.arctan2(local[:, 1], local[:, 0])
+    elevations = np.arctan2(local[:, 2], np.hypot(local[:, 0], local[:, 1])) - sag / reach
+    return (
+        (float(azimuths.min()) - margin, float(azimuths.max()) + margin),
+        (max(float(elevations.min()) - margin, -1.2), min(float(elevations.max()) + margin, 1.2)),
+    )
