@@ -37,12 +37,12 @@ def bound_width(window: WindowEstimate, link: Link, config: FastConfig) -> float
     bound and no floors (on the branch the second contact mode chose, when it chose one).
 
     The window's statics (ratio and its statistical standard error) enter as in its own
-    posterior, without the statics' model term; NaN when the window has no statics or no finite
-    bound of omega_1.
+    posterior, without the statics' model term; NaN when the window has no statics or no finite,
+    positive bound of omega_1.
     """
     statics = window.statics
-    if statics is None or not math.isfinite(window.omega1_crb):
-        return math.nan
+    if statics is None or not (math.isfinite(window.omega1_crb) and window.omega1_crb > 0.0):
+        return math.nan  # no statics, or no bound of omega_1 to weigh the frequency by
     grid = window.posterior.grid
     table = curve_table(link, float(grid[0]), float(grid[-1]), config.grid_step)
     posterior = contact_posterior(
