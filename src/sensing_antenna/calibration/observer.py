@@ -113,8 +113,8 @@ class Payload:
 
     @property
     def significant(self) -> bool:
-        """True when the mass is more than its standard deviations from zero than a payload
-        needs (:func:`~sensing_antenna.units_check.is_payload`)."""
+        """True when the mass lies far enough from zero, in its standard deviations, to be a
+        payload (:func:`~sensing_antenna.units_check.is_payload`)."""
         return self.samples > 1 and is_payload(self.mass, self.std)
 
     def apply(self, antenna: Antenna) -> Antenna:

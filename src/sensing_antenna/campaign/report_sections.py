@@ -326,6 +326,13 @@ def _bound(t: TargetSummary) -> str:
     return _seconds(t.median_bound) + (f" ({t.n_bound_at_cap} at cap)" if t.n_bound_at_cap else "")
 
 
+def _bound_judged(t: TargetSummary) -> str:
+    """Whether the bound target is met ("met", "missed"; "-" without a bound)."""
+    if not math.isfinite(t.bound_ratio):
+        return "-"
+    return "met" if t.bound_ratio <= BOUND_RATIO_TARGET else "missed"
+
+
 def bound_sentence(t: TargetSummary) -> str:
     """The method's median t_e - t_1 against its median information bound, and the target."""
     if not math.isfinite(t.bound_ratio):
@@ -333,24 +340,20 @@ def bound_sentence(t: TargetSummary) -> str:
             "no bound: not computed on these runs (`fast_bound = false`), or no window of any "
             f"run qualified before the cap; the target ({BOUND_RATIO_TARGET:g}) is not judged."
         )
-    met = "met" if t.bound_ratio <= BOUND_RATIO_TARGET else "missed"
     at_cap = (
         f", {t.n_bound_at_cap} of {t.n_runs} runs counted at the cap" if t.n_bound_at_cap else ""
     )
     return (
         f"median t_e - t_1 {_seconds(t.median_delay)} s against a median information bound of "
         f"{_seconds(t.median_bound)} s{at_cap}: {t.bound_ratio:.2f} times it, target at most "
-        f"{BOUND_RATIO_TARGET:g}: **{met}**."
+        f"{BOUND_RATIO_TARGET:g}: **{_bound_judged(t)}**."
     )
 
 
 def bound_cells(t: TargetSummary) -> list[str]:
     """The method's median t_e - t_1 (s), its median information bound (s), their ratio and
     whether the target is met ("-" without a bound)."""
-    judged = "-"
-    if math.isfinite(t.bound_ratio):
-        judged = "met" if t.bound_ratio <= BOUND_RATIO_TARGET else "missed"
-    return [_seconds(t.median_delay), _bound(t), _ratio(t.bound_ratio), judged]
+    return [_seconds(t.median_delay), _bound(t), _ratio(t.bound_ratio), _bound_judged(t)]
 
 
 def _target_row(t: TargetSummary) -> list[str]:
