@@ -124,6 +124,10 @@ class CampaignSpecError(FieldError):
     """A campaign spec field is missing, unknown or invalid; the message names file and field."""
 
 
+#: The free sweep of the joint each manoeuvre sweeps (``simulator.Scenario`` cases).
+FREE_SWEEP = {"azimuthal": "free", "vertical": "free-vertical"}
+
+
 @dataclass(frozen=True)
 class FreeMotionStep:
     """Optional first step: simulate a free motion and identify the Eq. 15 observer from it.
@@ -134,13 +138,21 @@ class FreeMotionStep:
         Whether to run the step.
     duration : float
         Length of the simulated free motion (s).
-    case : str
-        Manoeuvre of the free motion (``"free"``).
+    case : str or None
+        Manoeuvre of the one free motion (``"free"``, ``"free-vertical"``); None: a free sweep
+        of each joint the campaign's cases sweep (Section 5.2's "free movements").
     """
 
     identify: bool = False
     duration: float = 4.0
-    case: str = "free"
+    case: str | None = None
+
+    def free_cases(self, cases: Sequence[str]) -> tuple[str, ...]:
+        """The simulator cases of the free motions for a campaign sweeping ``cases``."""
+        if self.case is not None:
+            return (self.case,)
+        swept = [FREE_SWEEP[case] for case in FREE_SWEEP if case in cases]
+        return tuple(swept) or ("free",)
 
     def __post_init__(self) -> None:
         if problem := duration_problem(self.duration):

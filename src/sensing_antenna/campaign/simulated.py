@@ -186,22 +186,38 @@ def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:
 def identify_observer(
     device: Antenna, spec: CampaignSpec, model: Antenna | None = None
 ) -> ObserverFit:
-    """Simulate a free motion on ``device`` and identify the observer of Eq. 15 from it, and
-    the payload its rest reads.
+    """Simulate free motions on ``device`` and identify the observer of Eq. 15 from them, and
+    the payload their rests read.
 
-    The free motion uses the spec's scenario settings and its own seed (stream 1 of the base
-    seed). The identification starts from what the engineer knows, ``model`` (default: the
-    device itself), and sees only the recording.
+    The free motions (``FreeMotionStep.free_cases``: by default a free sweep of each swept
+    joint) use the spec's scenario settings and their own seeds (stream 1 of the base seed).
+    The identification starts from what the engineer knows, ``model`` (default: the device
+    itself), and sees only the recordings.
     """
     from sensing_antenna.calibration.observer import identify_free_motion
     from sensing_antenna.simulator import simulate
 
-    seed = derive_seed(spec.base_seed, 0, FREE_MOTION_STREAM)
-    extra = with_device(spec, spec.scenario, seed, device.link.length)
-    extra["duration"] = spec.free_motion.duration
-    scenario = make_scenario(spec.free_motion.case, None, seed, extra)
-    recording = simulate(device, scenario)
-    return identify_free_motion(recording.without_ground_truth(), model or device)
+    recordings = []
+    for k, case in enumerate(spec.free_motion.free_cases(spec.cases)):
+        seed = derive_seed(spec.base_seed, k, FREE_MOTION_STREAM)
+        extra = with_device(spec, spec.scenario, seed, device.link.length)
+        extra["duration"] = spec.free_motion.duration
+        scenario = make_scenario(case, None, seed, extra)
+        recordings.append(simulate(device, scenario).without_ground_truth())
+    return identify_free_motion(recordings, model or device)
+
+
+def knowing_weight(device: Antenna, fit: ObserverFit) -> Antenna:
+    """The simulated device whose controller uses ``fit``: its observer and threshold, and the
+    weight its rests read (the payload as ``link.weight_tip_mass``, which the detector and the
+    push monitor remove and the simulator's physics does not read)."""
+    device = dataclasses.replace(device, observer=fit.observer)
+    payload = fit.payload
+    if payload is None or not payload.significant:
+        return device
+    link = device.link
+    weight = max(0.0, link.weighed_tip_mass + payload.mass)
+    return dataclasses.replace(device, link=dataclasses.replace(link, weight_tip_mass=weight))
 
 
 def calibrate_on_device(
@@ -309,7 +325,8 @@ def check_scenario(spec: CampaignSpec) -> None:
         check(run.case, run.contact_point, run.scenario, "")
     if spec.free_motion.identify:
         extra = {**spec.scenario, "duration": spec.free_motion.duration}
-        check(spec.free_motion.case, None, extra, "the free motion: ")
+        for case in spec.free_motion.free_cases(spec.cases):
+            check(case, None, extra, "the free motion: ")
     if spec.calibration.enabled:
         for _, case, x_c, _ in calibration_runs(spec):
             check(case, x_c, spec.scenario, "")
@@ -336,7 +353,7 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
             f"{spec.free_motion.duration:g} s free motion of the device"
         )
         fit = identify_observer(device, spec, model)
-        device = dataclasses.replace(device, observer=fit.observer)
+        device = knowing_weight(device, fit)
         model = dataclasses.replace(model, observer=fit.observer)
         if fit.payload is not None:
             model = fit.payload.apply(model)

@@ -16,6 +16,7 @@ from sensing_antenna.simulator.device import DeviceImperfections
 __all__ = [
     "ATI_NANO17_RESOLUTION",
     "CASES",
+    "FREE_CASES",
     "LINK_MODELS",
     "MAX_DURATION",
     "MAX_ELEMENTS",
@@ -28,7 +29,10 @@ __all__ = [
     "duration_problem",
 ]
 
-CASES = ("azimuthal", "vertical", "free")
+CASES = ("azimuthal", "vertical", "free", "free-vertical")
+#: The cases with nothing to touch: the azimuthal sweep and the vertical one, each run past its
+#: nominal touch and brought to rest.
+FREE_CASES = ("free", "free-vertical")
 OBSTACLE_KINDS = ("post", "bar", "plane")
 #: The link's mechanics: "linear" (Euler-Bernoulli about the undeformed line, Assumption 1) or
 #: "nonlinear" (geometrically exact inextensible rod, ``simulator.nonlinear_link``).
@@ -169,12 +173,13 @@ class Scenario:
 
     Parameters
     ----------
-    case : {"azimuthal", "vertical", "free"}
+    case : {"azimuthal", "vertical", "free", "free-vertical"}
         Azimuthal: theta1 sweeps (theta2 = 0) into a vertical post. Vertical: theta2 sweeps up,
-        against gravity, into a horizontal bar. Free: the azimuthal sweep with no obstacle.
+        against gravity, into a horizontal bar. Free: the azimuthal sweep with no obstacle;
+        free-vertical: the vertical one.
     contact_point : float or None
         x_c (m) at which the gravity-sagged, otherwise undeflected link would touch the obstacle.
-        Required unless ``case == "free"``.
+        Required unless the case is free (:data:`FREE_CASES`).
     seed : int
         Seed of the one ``numpy.random.Generator`` that draws every random quantity.
     duration : float
@@ -240,7 +245,7 @@ class Scenario:
         Free text copied into the recording.
     """
 
-    case: Literal["azimuthal", "vertical", "free"] = "azimuthal"
+    case: Literal["azimuthal", "vertical", "free", "free-vertical"] = "azimuthal"
     contact_point: float | None = None
     seed: int = 0
     duration: float = 3.5
@@ -271,9 +276,9 @@ class Scenario:
             raise ScenarioError(
                 "case", f"must be one of {', '.join(CASES)}, got {format_value(self.case)}"
             )
-        if self.case == "free":
+        if self.case in FREE_CASES:
             if self.contact_point is not None:
-                raise ScenarioError("contact_point", "must be None for the free case")
+                raise ScenarioError("contact_point", f"must be None for the {self.case} case")
         else:
             if self.contact_point is None:
                 raise ScenarioError("contact_point", f"is required for the {self.case} case")
@@ -383,8 +388,8 @@ class Scenario:
 
     @property
     def obstacle_kind(self) -> str | None:
-        """The obstacle actually used: None for the free case."""
-        if self.case == "free":
+        """The obstacle actually used: None for the free cases."""
+        if self.case in FREE_CASES:
             return None
         if self.obstacle is not None:
             return self.obstacle
