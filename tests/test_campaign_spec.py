@@ -644,3 +644,23 @@ def test_a_plane_campaign_off_the_tip_is_refused_naming_the_point(tmp_path: Path
         write(tmp_path, text.replace("[0.98, 0.5]", "[0.98]") + 'obstacle = "plane"\n')
     )
     assert at_tip.load_device().link.length == 0.98
+
+
+def test_the_free_motions_are_a_free_sweep_of_each_swept_joint(tmp_path: Path) -> None:
+    # Section 5.2: the threshold comes from the free movements; by default one free sweep per
+    # joint the cases sweep, or the one free_motion.case names
+    from sensing_antenna.campaign.simulated import check_scenario
+
+    assert default_campaign_spec().free_motion.free_cases(["azimuthal", "vertical"]) == (
+        "free",
+        "free-vertical",
+    )
+    spec = load_campaign_spec(write(tmp_path, GOOD + "\n[free_motion]\nidentify = true\n"))
+    assert spec.free_motion.free_cases(spec.cases) == ("free",)
+    one = GOOD + '\n[free_motion]\nidentify = true\ncase = "free-vertical"\n'
+    assert load_campaign_spec(write(tmp_path, one)).free_motion.free_cases(spec.cases) == (
+        "free-vertical",
+    )
+    bad = load_campaign_spec(write(tmp_path, one.replace('"free-vertical"', '"sideways"')))
+    with pytest.raises(CampaignSpecError, match=r"free_motion\.case: the free motion: must be"):
+        check_scenario(bad)

@@ -312,7 +312,8 @@ def check_scenario(spec: CampaignSpec) -> None:
             make_scenario(case, x_c, 0, dict(extra))
         except ScenarioError as exc:
             field = exc.field_name
-            name = "free_motion.duration" if prefix and field == "duration" else f"scenario.{field}"
+            free = prefix and field in ("duration", "case")
+            name = f"free_motion.{field}" if free else f"scenario.{field}"
             raise CampaignSpecError(
                 name, prefix + str(exc).split(": ", 1)[-1], spec.source or None
             ) from exc
