@@ -388,7 +388,8 @@ def test_cli_identifies_from_several_recordings(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     paths = []
-    for k, rec in enumerate((_free_motion(7, joints=(True, False)), _free_motion(8, (False, True)))):
+    moves = (_free_motion(7, joints=(True, False)), _free_motion(8, joints=(False, True)))
+    for k, rec in enumerate(moves):
         path = tmp_path / f"free{k}.csv"
         write_recording(rec, path)
         paths.append(str(path))

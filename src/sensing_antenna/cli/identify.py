@@ -34,11 +34,12 @@ def register(subparsers: Any) -> None:
             "Fits gain, natural frequency and damping of the free-motion observer to recordings "
             "of free motion (no contact; give one of each joint the head sweeps, e.g. a free "
             "azimuthal and a free vertical sweep), sets the contact threshold to the largest "
-            "filtered residual over them times the margin (Section 5.2), and writes the starting antenna with that "
-            "observer as a new antenna: named after --out (or --name), its description saying "
-            "which recordings it was identified from. With --servo it also fits each moving "
-            "joint's Eq. 1 (inertia J, viscous friction v, Coulomb torque) to the motor commands "
-            "the recording carries (columns u1, u2, V), writes them into the motors, and prints "
+            "filtered residual over them times the margin (Section 5.2), and writes the "
+            "starting antenna with that observer as a new antenna: named after --out (or "
+            "--name), its description saying which recordings it was identified from. With "
+            "--servo (one recording) it also fits each moving joint's Eq. 1 (inertia J, viscous "
+            "friction v, Coulomb torque) to the motor commands the recording carries (columns "
+            "u1, u2, V), writes them into the motors, and prints "
             "the servo's gains designed from them (Section 4.1, Eq. 14)."
         ),
     )
