@@ -18,7 +18,7 @@ from sensing_antenna.calibration.observer import (
 )
 from sensing_antenna.cli import main
 from sensing_antenna.detection.contact import detect_contact
-from sensing_antenna.recording import Recording, write_recording
+from sensing_antenna.recording import Recording, resample_uniform, write_recording
 from sensing_antenna.simulator import Scenario, simulate
 
 TS = 1e-3  # s
@@ -350,14 +350,24 @@ def test_joints_identified_from_separate_recordings_match_one_recording_of_both(
     assert fit.gain == pytest.approx(TRUE_GAIN, rel=0.05)
     assert fit.natural_frequency == pytest.approx(TRUE_OMEGA, rel=0.05)
     assert fit.source == "free.csv, free2.csv"
-    # the threshold covers the larger of the two recordings' residuals
-    alone = [identify_free_motion(r, ANTENNA).max_filtered_residual for r in (azimuth, elevation)]
-    assert fit.max_filtered_residual >= 0.5 * max(alone)
+    # the threshold's residual is the larger of the two recordings' with the fitted observer
+    identified = dataclasses.replace(ANTENNA, observer=fit.observer)
+    peaks = [
+        np.max(detect_contact(r, identified).filtered_residual_norm) for r in (azimuth, elevation)
+    ]
+    assert fit.max_filtered_residual == pytest.approx(max(peaks), rel=1e-12)
+    assert fit.contact_threshold == pytest.approx(1.5 * max(peaks), rel=1e-12)
+    # a recording sampled at another period (2 ms) is fitted on the first one's grid: the
+    # same system within the same 5 %
+    coarse = resample_uniform(elevation, 2 * TS)
+    mixed = identify_free_motion([azimuth, coarse], ANTENNA)
+    assert mixed.joints == (1, 2)
+    assert mixed.natural_frequency == pytest.approx(TRUE_OMEGA, rel=0.05)
     with pytest.raises(IdentificationError, match="none given"):
         identify_free_motion([], ANTENNA)
 
 
-def test_a_vertical_free_sweep_with_an_unknown_tip_mass_identifies(tmp_path: Path) -> None:
+def test_a_vertical_free_sweep_with_an_unknown_tip_mass_identifies() -> None:
     # A device carrying 0.1 g at its tip that the antenna file lacks. In a vertical sweep the
     # torque about Y^m holds that mass's weight moment, about 1e-3 N m, ten times the link's
     # vibration: a fit that removed only the file's weight would find no Eq. 15 that explains

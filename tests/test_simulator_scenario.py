@@ -96,8 +96,9 @@ def test_the_free_vertical_sweep_moves_theta2_alone_and_touches_nothing() -> Non
     theta1, theta2 = recording.theta.T
     assert np.ptp(theta1) < 1e-9
     assert np.ptp(theta2) > 0.1
-    # at rest at the end: within one encoder count (2 pi / 10000 rad) over the last 0.1 s
-    assert abs(theta2[-1] - theta2[-100]) < 1e-3
+    # brought to rest: over the last 0.1 s it moves at under 3 % of the 0.3 rad/s sweep speed
+    # (the servo's last creep under the weight's moment)
+    assert abs(theta2[-1] - theta2[-100]) < 0.03 * 0.3 * 0.1
     assert "true_xc" not in recording.metadata  # no obstacle to touch
     with pytest.raises(ScenarioError, match="contact_point: must be None"):
         Scenario(case="free-vertical", contact_point=0.5)

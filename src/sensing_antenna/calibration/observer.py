@@ -150,7 +150,8 @@ class ObserverFit:
     contact_threshold : float
         ``margin`` times ``max_filtered_residual`` (N m).
     max_filtered_residual : float
-        Largest filtered residual norm of Eq. 16 over the recording with the fitted observer (N m).
+        Largest filtered residual norm of Eq. 16 over the recordings with the fitted observer
+        (N m).
     residual_rms : float
         RMS of measured minus fitted dynamic torque over the joints used (N m).
     joints : tuple of int
@@ -162,7 +163,7 @@ class ObserverFit:
     initial_gain, initial_natural_frequency, initial_damping : float
         The physics-based starting point (same units).
     source : str or None
-        Recording file.
+        The recordings' files, comma-separated.
     payload : Payload or None
         Weight at the tip beyond the model's, read at rest (None: not read).
     """
@@ -406,7 +407,10 @@ def identify_free_motion(
         raise IdentificationError("recordings: none given; a free-motion recording is needed")
     if not (math.isfinite(margin) and margin >= 1.0):
         raise IdentificationError(f"margin: must be a number >= 1, got {margin!r}")
-    where = ", ".join(r.source or "<recording>" for r in given)
+    named = [r.source for r in given if r.source]
+    where = ", ".join(named) if named else "<recording>"
+    if len(given) > 1 and len(named) < len(given):
+        where = ", ".join(r.source or f"<recording {k + 1}>" for k, r in enumerate(given))
     moves = [_free_motion(recording, antenna) for recording in given]
     payload = combined_payload([move.payload for move in moves])
     weighed = payload.apply(antenna)
@@ -416,18 +420,16 @@ def identify_free_motion(
             f"{where}: columns 'theta1', 'theta2': no joint moved by more than {MIN_MOTION:g} rad;"
             " a free-motion recording is needed"
         )
+    period = moved[0].recording.sample_period
+    for k, move in enumerate(moves):
+        if move.recording.sample_period != period:
+            # the observer runs at one period: every recording on its grid
+            moves[k] = replace(move, recording=resample_uniform(move.recording, period))
+    moved = [move for move in moves if move.joints]
     data = [
         (move.recording.theta[:, move.joints], _targets(move.recording, weighed)[:, move.joints])
         for move in moved
     ]
-    period = moved[0].recording.sample_period
-    for move in moved[1:]:
-        if not math.isclose(move.recording.sample_period, period, rel_tol=1e-6):
-            raise IdentificationError(
-                f"{move.recording.source or '<recording>'}: column 't': sampled every "
-                f"{move.recording.sample_period:g} s, the first recording every {period:g} s; "
-                "the observer is fitted at one sampling period"
-            )
     k0, w0, d0 = initial_guess(antenna)
     try:
         # Arithmetic that overflows means values no link gives (a wrench of 1e300 N m)
@@ -465,7 +467,7 @@ def identify_free_motion(
         initial_gain=k0,
         initial_natural_frequency=w0,
         initial_damping=d0,
-        source=where if any(r.source for r in given) else None,
+        source=where if named else None,
         payload=payload,
     )
 
@@ -492,11 +494,13 @@ def _free_motion(recording: Recording, antenna: Antenna) -> _FreeMotion:
 
 
 def combined_payload(payloads: Sequence[Payload]) -> Payload:
-    """The inverse-variance mean of the payloads that read a rest (a mass with its standard
-    deviation, kg, and the samples summed); no samples when none did."""
+    """The payloads of several rests as one: their inverse-variance mean mass (kg), with the
+    smallest of their standard deviations (not the mean's, which would fall as more rests are
+    added: most of each is the tare's offset, which rests after one tare share), and the
+    samples summed; no samples when none read a rest."""
     read = [p for p in payloads if p.samples > 1 and math.isfinite(p.std) and p.std > 0]
     if not read:
         return Payload(0.0, math.nan, 0)
     weights = np.array([1.0 / p.std**2 for p in read])
     mass = float(np.sum(weights * np.array([p.mass for p in read])) / np.sum(weights))
-    return Payload(mass, float(1.0 / math.sqrt(np.sum(weights))), sum(p.samples for p in read))
+    return Payload(mass, min(p.std for p in read), sum(p.samples for p in read))

@@ -268,7 +268,7 @@ def _settings_lines(
         f"{obs.contact_threshold:.4g} N m"
         + (
             " (identified on simulated free sweeps of the device, "
-            + ", ".join(spec.free_motion.free_cases(spec.cases))
+            + ", ".join(spec.free_motion_cases())
             + "; used by the device's controller and by the estimators)"
             if spec.free_motion.identify
             else ""

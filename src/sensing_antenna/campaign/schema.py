@@ -30,7 +30,7 @@ from sensing_antenna.simulator.device import (
     device_from_mapping,
     device_profile,
 )
-from sensing_antenna.simulator.scenario import duration_problem
+from sensing_antenna.simulator.scenario import FREE_CASES, duration_problem
 
 __all__ = [
     "CASES",
@@ -157,6 +157,12 @@ class FreeMotionStep:
     def __post_init__(self) -> None:
         if problem := duration_problem(self.duration):
             raise CampaignSpecError("free_motion.duration", problem)
+        if self.case is not None and self.case not in FREE_CASES:
+            raise CampaignSpecError(
+                "free_motion.case",
+                f"must be one of {', '.join(FREE_CASES)} (a sweep with nothing to touch), "
+                f"got {self.case!r}",
+            )
 
 
 @dataclass(frozen=True)
@@ -679,6 +685,14 @@ class CampaignSpec:
         """Every case of the campaign, main runs first, then any only the sweep has."""
         return self.cases + tuple(c for c in self.sweep_cases if c not in self.cases)
 
+    def free_motion_cases(self) -> tuple[str, ...]:
+        """The simulator cases of the free-motion step: ``free_motion.case``, else a free sweep
+        of each joint the campaign sweeps (its runs, the noise sweep's, the calibration's)."""
+        swept = self.all_cases
+        if self.calibration.enabled and self.calibration.case not in swept:
+            swept = (*swept, self.calibration.case)
+        return self.free_motion.free_cases(swept)
+
     def load_antenna(self) -> Antenna:
         """The campaign's nominal model; checks every contact point lies on its link."""
         antenna = load_antenna(self.antenna)
@@ -780,12 +794,16 @@ class CampaignSpec:
     def preparation_fingerprint(self) -> str:
         """Short hash of what the preparation steps (identification, calibration) depend on.
 
-        The antennas, the scenario, the base seed and the two steps' sections; not the runs'
-        contact points, repeats or methods.
+        The antennas, the scenario, the base seed, the two steps' sections and, when the
+        observer is identified, the free motions' cases; not the runs' contact points, repeats
+        or methods.
         """
         data = self.to_dict()
         keys = ("antenna", "scenario", "base_seed", "free_motion", "device", "calibration")
-        text = json.dumps({k: data[k] for k in keys}, sort_keys=True)
+        hashed = {k: data[k] for k in keys}
+        if self.free_motion.identify:
+            hashed["free_motion_cases"] = list(self.free_motion_cases())
+        text = json.dumps(hashed, sort_keys=True)
         return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
     def fingerprint(self) -> str:

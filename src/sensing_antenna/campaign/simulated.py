@@ -20,7 +20,7 @@ import time
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
-from sensing_antenna.antenna import Antenna
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.calibration.observer import ObserverFit
 from sensing_antenna.campaign.progress import Progress
@@ -189,8 +189,8 @@ def identify_observer(
     """Simulate free motions on ``device`` and identify the observer of Eq. 15 from them, and
     the payload their rests read.
 
-    The free motions (``FreeMotionStep.free_cases``: by default a free sweep of each swept
-    joint) use the spec's scenario settings and their own seeds (stream 1 of the base seed).
+    The free motions (``CampaignSpec.free_motion_cases``: by default a free sweep of each
+    swept joint) use the spec's scenario settings and their own seeds (stream 1 of the base seed).
     The identification starts from what the engineer knows, ``model`` (default: the device
     itself), and sees only the recordings.
     """
@@ -198,7 +198,7 @@ def identify_observer(
     from sensing_antenna.simulator import simulate
 
     recordings = []
-    for k, case in enumerate(spec.free_motion.free_cases(spec.cases)):
+    for k, case in enumerate(spec.free_motion_cases()):
         seed = derive_seed(spec.base_seed, k, FREE_MOTION_STREAM)
         extra = with_device(spec, spec.scenario, seed, device.link.length)
         extra["duration"] = spec.free_motion.duration
@@ -207,17 +207,17 @@ def identify_observer(
     return identify_free_motion(recordings, model or device)
 
 
-def knowing_weight(device: Antenna, fit: ObserverFit) -> Antenna:
-    """The simulated device whose controller uses ``fit``: its observer and threshold, and the
-    weight its rests read (the payload as ``link.weight_tip_mass``, which the detector and the
-    push monitor remove and the simulator's physics does not read)."""
-    device = dataclasses.replace(device, observer=fit.observer)
-    payload = fit.payload
-    if payload is None or not payload.significant:
-        return device
+def knowing_weight(device: Antenna, identified: Antenna) -> Antenna:
+    """The simulated device whose controller knows what identification found: the observer and
+    threshold of ``identified`` (the model after identification, its payload applied), and the
+    weight's moment about the head that model gives, carried as the device's
+    ``link.weight_tip_mass`` (which the detector and the push monitor remove and the
+    simulator's physics does not read)."""
     link = device.link
-    weight = max(0.0, link.weighed_tip_mass + payload.mass)
-    return dataclasses.replace(device, link=dataclasses.replace(link, weight_tip_mass=weight))
+    # (m_b / 2 + m_t) l g of the device's link equal to the identified model's moment
+    tip = identified.link.weight_moment / (STANDARD_GRAVITY * link.length) - 0.5 * link.mass
+    weighed = dataclasses.replace(link, weight_tip_mass=max(0.0, tip))
+    return dataclasses.replace(device, observer=identified.observer, link=weighed)
 
 
 def calibrate_on_device(
@@ -296,8 +296,8 @@ def check_scenario(spec: CampaignSpec) -> None:
     Raises
     ------
     CampaignSpecError
-        Naming the spec file and ``scenario.<field>`` (``free_motion.duration`` for the free
-        motion's length), on the first scenario that is not valid.
+        Naming the spec file and ``scenario.<field>`` (``free_motion.duration`` and
+        ``free_motion.case`` for the free motions'), on the first scenario that is not valid.
     """
     from sensing_antenna.simulator.scenario import ScenarioError
 
@@ -326,7 +326,7 @@ def check_scenario(spec: CampaignSpec) -> None:
         check(run.case, run.contact_point, run.scenario, "")
     if spec.free_motion.identify:
         extra = {**spec.scenario, "duration": spec.free_motion.duration}
-        for case in spec.free_motion.free_cases(spec.cases):
+        for case in spec.free_motion_cases():
             check(case, None, extra, "the free motion: ")
     if spec.calibration.enabled:
         for _, case, x_c, _ in calibration_runs(spec):
@@ -349,15 +349,17 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
     model = spec.load_antenna()
     device = spec.load_device()
     if spec.free_motion.identify:
+        cases = spec.free_motion_cases()
         progress.line(
-            f"preparation: identifying the free-motion observer (Eq. 15) on a "
-            f"{spec.free_motion.duration:g} s free motion of the device"
+            f"preparation: identifying the free-motion observer (Eq. 15) on {len(cases)} "
+            f"free sweep{'s' if len(cases) > 1 else ''} of {spec.free_motion.duration:g} s of "
+            "the device"
         )
         fit = identify_observer(device, spec, model)
-        device = knowing_weight(device, fit)
         model = dataclasses.replace(model, observer=fit.observer)
         if fit.payload is not None:
             model = fit.payload.apply(model)
+        device = knowing_weight(device, model)
     calibration = None
     if spec.calibration.enabled:
         progress.line(

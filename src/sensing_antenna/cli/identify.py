@@ -122,26 +122,32 @@ def _run(args: argparse.Namespace) -> int:
         f"{fit.max_filtered_residual:.4g} N m), rms of the unfiltered fit residual "
         f"{fit.residual_rms:.3g} N m, joints used: {joints}"
     )
-    _print_payload(fit.payload, antenna.link.tip_mass, identified.link.tip_mass)
+    _print_payload(fit.payload, antenna.link, identified.link)
     if motor_fit is not None:
         _print_servo(motor_fit, antenna, pole)
     print(args.out)
     return 0
 
 
-def _print_payload(payload: Any, before: float, after: float) -> None:
-    """What the moment at rest said of weight at the tip, and the tip mass written."""
+def _print_payload(payload: Any, before: Any, after: Any) -> None:
+    """What the moments at rest said of weight at the tip, and the field written: the links
+    ``before`` and ``after`` identification (``link.weight_tip_mass`` where the link has one,
+    ``Payload.apply``)."""
     if payload is None or payload.samples == 0:
-        print("payload: not read (the recording does not start at rest)")
+        print("payload: not read (no recording starts at rest)")
         return
     read = (
         f"payload: the moment at rest reads {1e3 * payload.mass:+.4g} g +- "
         f"{1e3 * payload.std:.2g} g at the tip beyond the antenna's weight"
     )
+    field = "weight_tip_mass" if before.weight_tip_mass is not None else "tip_mass"
     if payload.significant:
-        print(f"{read}: link.tip_mass = {after:.4g} kg (was {before:.4g} kg)")
+        print(
+            f"{read}: link.{field} = {after.weighed_tip_mass:.4g} kg "
+            f"(was {before.weighed_tip_mass:.4g} kg)"
+        )
     else:
-        print(f"{read}: not significant, link.tip_mass kept at {before:.4g} kg")
+        print(f"{read}: not significant, link.{field} kept at {before.weighed_tip_mass:.4g} kg")
 
 
 def _print_servo(motor_fit: Any, antenna: Any, pole: float) -> None:
