@@ -216,6 +216,8 @@ def _gap(
     px = x * frame[0, 0] + v * frame[1, 0] + w * frame[2, 0] - obst[1]
     py = x * frame[0, 1] + v * frame[1, 1] + w * frame[2, 1] - obst[2]
     pz = x * frame[0, 2] + v * frame[1, 2] + w * frame[2, 2] - obst[3]
+    if obst[0] == 3.0:
+        return math.sqrt(px * px + py * py + pz * pz) - obst[7]
     dpar = px * obst[4] + py * obst[5] + pz * obst[6]
     if obst[0] == 2.0:
         return dpar
@@ -857,6 +859,8 @@ def run_samples(
                     d = pc - obst[1:4]
                     if obst[0] == 2.0:
                         nvec[:] = obst[4:7]
+                    elif obst[0] == 3.0:
+                        nvec[:] = d / math.sqrt(d @ d)
                     else:
                         dpar = d @ obst[4:7]
                         nvec[:] = d - dpar * obst[4:7]

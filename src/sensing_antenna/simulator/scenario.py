@@ -33,7 +33,7 @@ CASES = ("azimuthal", "vertical", "free", "free-vertical")
 #: The cases with nothing to touch: the azimuthal sweep and the vertical one, each run past its
 #: nominal touch and brought to rest.
 FREE_CASES = ("free", "free-vertical")
-OBSTACLE_KINDS = ("post", "bar", "plane")
+OBSTACLE_KINDS = ("post", "bar", "ball", "plane")
 #: The link's mechanics: "linear" (Euler-Bernoulli about the undeformed line, Assumption 1) or
 #: "nonlinear" (geometrically exact inextensible rod, ``simulator.nonlinear_link``).
 LINK_MODELS = ("linear", "nonlinear")
@@ -193,14 +193,15 @@ class Scenario:
         Coulomb friction coefficient mu between link and obstacle.
     push : object or None
         The push criterion (``detection.push.PushCriterion``); None uses its default.
-    obstacle : {"post", "bar", "plane"} or None
+    obstacle : {"post", "bar", "ball", "plane"} or None
         Obstacle kind; None: post for the azimuthal case, bar for the vertical case.
     obstacle_radius : float
-        Radius of the post or bar (m).
+        Radius of the post, bar or ball (m).
     obstacle_tilt : float
         Misalignment of the obstacle (rad): the post leans along the sweep, the bar rolls about
-        the link, the plane turns its normal out of the sweep plane. Gives the contact normal a
-        component out of the sweep plane.
+        the link, the plane turns its normal out of the sweep plane, the ball's normal at the
+        touch turns as the post's (azimuthal) or the bar's (vertical). Gives the contact normal
+        a component out of the sweep plane.
     contact_stiffness : float
         Normal penalty stiffness (N/m); also the tangential stick stiffness.
     contact_damping : float
@@ -253,7 +254,7 @@ class Scenario:
     damping_ratio: float = 0.005
     friction_coefficient: float = 0.6
     push: Any = None
-    obstacle: Literal["post", "bar", "plane"] | None = None
+    obstacle: Literal["post", "bar", "ball", "plane"] | None = None
     obstacle_radius: float = 0.01
     obstacle_tilt: float = 0.02
     contact_stiffness: float = 1.0e4
