@@ -65,6 +65,13 @@ def register(subparsers: Any) -> None:
         "(EstimatorConfig.spectrum_window) after the stop: the command warns when it is short",
     )
     parser.add_argument("--noise", type=float, default=1.0, help="sensor noise scale (0: none)")
+    parser.add_argument(
+        "--direction",
+        choices=("up", "down"),
+        default="up",
+        help="the swept joint turns up (towards +Y^m, or lifting the link towards +Z^m) or "
+        "down (towards -Y^m, or lowering the link onto a bar below it)",
+    )
     parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument(
         "--device",
@@ -126,6 +133,7 @@ def _run(args: argparse.Namespace) -> int:
         device=device,
         link_model=args.link,
         push=push,
+        sweep_direction=1 if args.direction == "up" else -1,
     )
     recording = simulate(antenna, scenario, record_commands=args.commands)
     write_recording(recording, args.out)

@@ -122,6 +122,7 @@ def place_obstacle(
     radius: float,
     tilt: float,
     sweep_joint: int,
+    direction: int = 1,
 ) -> Obstacle:
     """Place an obstacle that the sagged link touches at ``contact_point`` at ``theta_touch``.
 
@@ -145,6 +146,8 @@ def place_obstacle(
         sweep) or the bar's (vertical sweep) does.
     sweep_joint : int
         0 when theta1 sweeps (towards +Y^m), 1 when theta2 sweeps (towards +Z^m).
+    direction : {1, -1}
+        The sweep's sense: -1 turns the joint down, towards -Y^m or -Z^m.
 
     Returns
     -------
@@ -152,7 +155,7 @@ def place_obstacle(
     """
     frame = motor_frame(*theta_touch)
     xm, ym, zm = frame
-    ahead = ym if sweep_joint == 0 else zm
+    ahead = direction * (ym if sweep_joint == 0 else zm)
     aside = zm if sweep_joint == 0 else ym
     p_touch = contact_point * xm + sag * zm
     tangent = _unit(xm + sag_slope * zm)
@@ -172,10 +175,12 @@ def place_obstacle(
         )
         return Obstacle("plane", tuple(p_touch), tuple(normal), 0.0)
     post = kind == "post" or (kind == "ball" and sweep_joint == 0)
+    # the post leans along the sweep, the bar rolls so that the normal turns towards +Y^m:
+    # either way the normal's part out of the sweep's plane is +sin(tilt) whatever the sense
     if post:
-        axis = _unit(np.array([0.0, 0.0, 1.0]) * math.cos(tilt) + ym * math.sin(tilt))
+        axis = _unit(np.array([0.0, 0.0, 1.0]) * math.cos(tilt) + direction * ym * math.sin(tilt))
     else:
-        axis = _unit(ym * math.cos(tilt) + zm * math.sin(tilt))
+        axis = _unit(ym * math.cos(tilt) + direction * zm * math.sin(tilt))
     normal = _unit(np.cross(tangent, axis))
     if normal @ ahead > 0:
         normal = -normal

@@ -344,12 +344,10 @@ def simulate_detailed(
     # --- reference trajectory (Section 4 step 1) -----------------------------------------------
     sweep_joint = 1 if scenario.case in ("vertical", "free-vertical") else 0
     servo = [design_servo(m, scenario.servo_pole, ts) for m in antenna.motors]
-    lag = 2.0 * servo[sweep_joint].time_constant * scenario.sweep_speed
-    travel = float(
-        ramp_displacement(
-            np.array(scenario.approach_time), scenario.sweep_speed, scenario.accel_time
-        )
-    )
+    # the swept joint's signed speed: up (+1) or down (-1)
+    speed = scenario.sweep_direction * scenario.sweep_speed
+    lag = 2.0 * servo[sweep_joint].time_constant * speed
+    travel = float(ramp_displacement(np.array(scenario.approach_time), speed, scenario.accel_time))
     theta_touch = (0.0, 0.0)
     start = [0.0, 0.0]
     start[sweep_joint] = theta_touch[sweep_joint] - travel + lag
@@ -359,7 +357,7 @@ def simulate_detailed(
     reference[:, sweep_joint] = sweep_reference(
         t,
         start[sweep_joint],
-        scenario.sweep_speed,
+        speed,
         scenario.accel_time,
         scenario.start_time,
         stop_after,
@@ -416,6 +414,7 @@ def simulate_detailed(
             scenario.obstacle_radius,
             scenario.obstacle_tilt,
             sweep_joint,
+            scenario.sweep_direction,
         )
         obst_array = obstacle.as_array()
 

@@ -208,6 +208,10 @@ class Scenario:
         Normal and tangential contact damping (N s/m).
     sweep_speed : float
         Cruise speed of the swept joint (rad/s).
+    sweep_direction : {1, -1}
+        1: the swept joint turns up, the link moving towards +Y^m (azimuthal) or +Z^m (vertical:
+        lifted against its weight); -1: down, towards -Y^m or -Z^m (vertical: lowered with its
+        weight onto a bar below it). The obstacle lies ahead of the sweep either way.
     accel_time : float or None
         Duration of the raised-cosine speed ramp from rest to cruise (s). None: the vibration-free
         ramp, 1.5 periods of the link's first free mode (3 pi / omega_1,free; 0.59 s for the paper
@@ -260,6 +264,7 @@ class Scenario:
     contact_stiffness: float = 1.0e4
     contact_damping: float = 0.5
     sweep_speed: float = 0.3
+    sweep_direction: int = 1
     accel_time: float | None = None
     start_time: float = 0.1
     approach_time: float | None = None
@@ -305,6 +310,11 @@ class Scenario:
             raise ScenarioError("damping_ratio", "must be < 1 (light structural damping)")
         for name in ("obstacle_radius", "contact_stiffness", "sweep_speed"):
             _finite(name, getattr(self, name), 0.0, strict=True)
+        if isinstance(self.sweep_direction, bool) or self.sweep_direction not in (1, -1):
+            raise ScenarioError(
+                "sweep_direction",
+                f"must be 1 (up) or -1 (down), got {format_value(self.sweep_direction)}",
+            )
         if self.accel_time is not None:
             _finite("accel_time", self.accel_time, 0.0, strict=True)
         _finite("start_time", self.start_time, 0.0)
