@@ -37,12 +37,20 @@ def test_spread_order_visits_every_index_once_middle_first() -> None:
     assert spread_order(3) == [1, 0, 2]
 
 
-def test_grid_alternates_bases_and_cases() -> None:
+def test_grid_alternates_bases_cases_and_directions() -> None:
     scene = load_scene("sphere")
     grid = grid_sweeps(scene)
-    assert len(grid) == 3 * (6 + 6)
-    assert [s.base for s in grid[:6]] == [0, 1, 2, 0, 1, 2]
-    assert [s.case for s in grid[:6]] == 3 * ["azimuthal"] + 3 * ["vertical"]
+    # 4 elevations swept both ways and 4 azimuths swept up, from each of the 3 bases
+    assert len(grid) == 3 * (2 * 4 + 4)
+    assert [s.base for s in grid[:9]] == 3 * [0, 1, 2]
+    assert [s.case for s in grid[:9]] == 6 * ["azimuthal"] + 3 * ["vertical"]
+    assert [s.direction for s in grid[:9]] == 3 * [1] + 3 * [-1] + 3 * [1]
+    # an elevation's two sweeps cover the same range
+    assert (grid[0].fixed, grid[0].start, grid[0].end) == (
+        grid[3].fixed,
+        grid[3].start,
+        grid[3].end,
+    )
     assert len(set(grid)) == len(grid)
     elevation = scene.region.elevation
     assert all(elevation[0] < s.fixed < elevation[1] for s in grid if s.case == "azimuthal")
