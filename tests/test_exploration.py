@@ -149,6 +149,33 @@ def test_the_post_scene_is_touched_where_the_post_is(
         assert error < 3.0 * m.point.std
 
 
+def test_the_post_is_swept_both_ways_and_touched_on_both_sides(
+    explored: tuple[Path, list[Manoeuvre]],
+) -> None:
+    out, manoeuvres = explored
+    # the grid's first elevation towards +Y, then back towards -Y, stored and resumed as such
+    assert [m.sweep.direction for m in manoeuvres] == [1, -1, 1]
+    ahead, back = manoeuvres[0], manoeuvres[1]
+    assert ahead.touch is not None and back.touch is not None
+    # the post's axis is nearly vertical at the one base (the world frame): sweeping towards
+    # +Y the link meets its -Y face, sweeping back its +Y face
+    assert ahead.touch["normal"][1] < -0.9 and back.touch["normal"][1] > 0.9
+    with open(out / "manoeuvres.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [row["direction"] for row in rows] == ["+1", "-1", "+1"]
+
+
+def test_a_stored_sweep_with_a_bad_direction_names_file_and_field(tmp_path: Path) -> None:
+    out = tmp_path / "post"
+    explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
+    path = out / "manoeuvres" / "000.json"
+    data = json.loads(path.read_text())
+    data["sweep"]["direction"] = 2
+    path.write_text(json.dumps(data))
+    with pytest.raises(ExplorationStoreError, match=r"000\.json: .*direction must be \+1 or -1"):
+        explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
+
+
 def test_other_settings_in_the_same_directory_are_refused(
     explored: tuple[Path, list[Manoeuvre]],
 ) -> None:

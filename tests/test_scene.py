@@ -195,6 +195,20 @@ def test_a_sweep_towards_minus_y_records_the_mirror_image() -> None:
     assert abs(mirrored.signed_distance(point[None, :])[0]) < 5e-3
 
 
+def test_a_sweep_keeps_its_direction_and_refuses_a_downward_vertical_one() -> None:
+    back = Sweep(1, "azimuthal", 0.1, -0.4, 0.5, direction=-1)
+    assert (back.origin, back.finish) == (0.5, -0.4)
+    assert Sweep.from_dict(back.to_dict()) == back
+    # a sweep stored before directions existed runs towards +Y
+    legacy = {k: v for k, v in back.to_dict().items() if k != "direction"}
+    assert Sweep.from_dict(legacy).direction == 1
+    assert "-Y" in back.label and "+Y" in Sweep(1, "azimuthal", 0.1, -0.4, 0.5).label
+    with pytest.raises(ValueError, match="upwards only"):
+        Sweep(0, "vertical", 0.0, -0.2, 0.2, direction=-1)
+    with pytest.raises(ValueError, match="direction must be"):
+        Sweep(0, "azimuthal", 0.0, -0.2, 0.2, direction=0)
+
+
 def test_a_turned_base_turns_the_touch() -> None:
     # a level base turned by 0.4 rad and moved: the touch is the unmoved one, carried along,
     # (the ball 2 cm low, where the link sagging 2.5 cm at 0.6 m meets it near its equator)
