@@ -25,8 +25,7 @@ multiplied by 1 - exp(-d^2 / (2 FREE_RADIUS^2)), d the distance to the nearest f
 sample. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count only if nothing
 else is left, and each score is divided by one plus the number of earlier sweeps within
 :data:`NEIGHBOUR_ANGLE` of it (its held angle) from the same base, of the same case and
-direction, which
-keeps a sweep that came back free from being retried next to itself.
+direction, which keeps a sweep that came back free from being retried next to itself.
 
 When recognition abstains between two leading shape classes, the planner also aims at telling
 them apart: at a candidate's predicted touch p the two fitted shapes disagree about where the
