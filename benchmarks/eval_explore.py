@@ -13,8 +13,11 @@ seen from the base; bases at one height see outlines in level-sighted planes, wh
 a cylinder or a torus may all pass through, while the outlines seen from above and below lie in
 planes tilted by 0.5 rad the other ways. Each base explores its own region, the object's
 angular extent seen from it, widened by 0.05 rad, the elevations shifted by the link's sag at
-each point's distance; the grid has ``--sweeps`` azimuthal and as many vertical sweeps per
-base: 36 sweeps by default, so that the contacts stay near 20 per object.
+each point's distance; the grid has, per base, ``--sweeps`` elevations each swept both ways
+(azimuthal sweeps towards +Y^m and back towards -Y^m, which touch opposite sides of the
+outline) and as many vertical sweeps (upwards): 3 (2 x 4 + 4) = 36 sweeps by default, as many
+as the one-way grid of 6 azimuthal and 6 vertical sweeps per base, so that the contacts stay
+below 40 per object.
 
 Each scene is explored twice with ``exploration.explore`` (every sweep simulated: first touch,
 contact physics, recording, estimate with ``--method``), once per strategy with the grid's size
@@ -30,7 +33,7 @@ Mahalanobis distance of each ``ok`` point's true contact point under its covaria
 simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.json`` after
 every exploration (a run stopped early keeps the scenes it finished).
 
-Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 6] [--bases 3]
+Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 4] [--bases 3]
 [--strategies grid next-best] [--method fast] [--link nonlinear] [--seed 0] [--out FILE]``.
 """
 
@@ -366,7 +369,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scenes", type=int, default=12)
     parser.add_argument("--first", type=int, default=0, help="index of the first scene")
-    parser.add_argument("--sweeps", type=int, default=6, help="grid sweeps per case and base")
+    parser.add_argument(
+        "--sweeps",
+        type=int,
+        default=4,
+        help="grid elevations (each swept both ways) and vertical sweeps per base",
+    )
     parser.add_argument("--bases", type=int, default=3, help="base poses around the object")
     parser.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
     parser.add_argument("--method", choices=("paper", "fast"), default="fast")

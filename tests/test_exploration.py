@@ -37,12 +37,20 @@ def test_spread_order_visits_every_index_once_middle_first() -> None:
     assert spread_order(3) == [1, 0, 2]
 
 
-def test_grid_alternates_bases_and_cases() -> None:
+def test_grid_alternates_bases_cases_and_directions() -> None:
     scene = load_scene("sphere")
     grid = grid_sweeps(scene)
-    assert len(grid) == 3 * (6 + 6)
-    assert [s.base for s in grid[:6]] == [0, 1, 2, 0, 1, 2]
-    assert [s.case for s in grid[:6]] == 3 * ["azimuthal"] + 3 * ["vertical"]
+    # 4 elevations swept both ways and 4 azimuths swept up, from each of the 3 bases
+    assert len(grid) == 3 * (2 * 4 + 4)
+    assert [s.base for s in grid[:9]] == 3 * [0, 1, 2]
+    assert [s.case for s in grid[:9]] == 6 * ["azimuthal"] + 3 * ["vertical"]
+    assert [s.direction for s in grid[:9]] == 3 * [1] + 3 * [-1] + 3 * [1]
+    # an elevation's two sweeps cover the same range
+    assert (grid[0].fixed, grid[0].start, grid[0].end) == (
+        grid[3].fixed,
+        grid[3].start,
+        grid[3].end,
+    )
     assert len(set(grid)) == len(grid)
     elevation = scene.region.elevation
     assert all(elevation[0] < s.fixed < elevation[1] for s in grid if s.case == "azimuthal")
@@ -139,6 +147,33 @@ def test_the_post_scene_is_touched_where_the_post_is(
         # the point within 3 standard deviations of the surface point the link met
         error = np.linalg.norm(m.point.point - np.array(m.touch["surface_point"]))
         assert error < 3.0 * m.point.std
+
+
+def test_the_post_is_swept_both_ways_and_touched_on_both_sides(
+    explored: tuple[Path, list[Manoeuvre]],
+) -> None:
+    out, manoeuvres = explored
+    # the grid's first elevation towards +Y, then back towards -Y, stored and resumed as such
+    assert [m.sweep.direction for m in manoeuvres] == [1, -1, 1]
+    ahead, back = manoeuvres[0], manoeuvres[1]
+    assert ahead.touch is not None and back.touch is not None
+    # the post's axis is nearly vertical at the one base (the world frame): sweeping towards
+    # +Y the link meets its -Y face, sweeping back its +Y face
+    assert ahead.touch["normal"][1] < -0.9 and back.touch["normal"][1] > 0.9
+    with open(out / "manoeuvres.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [row["direction"] for row in rows] == ["+1", "-1", "+1"]
+
+
+def test_a_stored_sweep_with_a_bad_direction_names_file_and_field(tmp_path: Path) -> None:
+    out = tmp_path / "post"
+    explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
+    path = out / "manoeuvres" / "000.json"
+    data = json.loads(path.read_text())
+    data["sweep"]["direction"] = 2
+    path.write_text(json.dumps(data))
+    with pytest.raises(ExplorationStoreError, match=r"000\.json: .*direction must be \+1 or -1"):
+        explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
 
 
 def test_other_settings_in_the_same_directory_are_refused(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -135,6 +136,77 @@ def test_a_mesh_file_touches_like_the_primitive(tmp_path: Path) -> None:
     assert from_mesh.object_name == "object1"
     assert from_mesh.angle == pytest.approx(exact.angle, abs=1e-7)
     np.testing.assert_allclose(from_mesh.surface_point, exact.surface_point, atol=1e-6)
+
+
+def test_a_sweep_towards_minus_y_touches_the_other_tangent_line() -> None:
+    # the gravity-free link of the test above swept the other way, from the range's end down:
+    # it first meets the circle on the tangent line on the other side of the centre's bearing,
+    # theta = alpha + asin(r / D), at the same x_c = sqrt(D^2 - r^2), the normal facing back
+    # along +Y^m: its component there is r / R (the rest is the centre's height, along -Z)
+    centre = np.array([0.6, 0.2, 0.03])
+    radius = 0.07
+    scene = _scene(primitive_object("ball", "sphere", [radius], centre))
+    shape = LinkShape(DEVICE.link, gravity=0.0)
+    touch = first_touch(scene, Sweep(0, "azimuthal", 0.0, -0.5, 0.8, direction=-1), shape).touch
+    assert touch is not None and not touch.tip
+    r = math.sqrt(radius**2 - centre[2] ** 2)
+    distance = math.hypot(centre[0], centre[1])
+    alpha = math.atan2(centre[1], centre[0])
+    assert touch.angle == pytest.approx(alpha + math.asin(r / distance), abs=1e-8)
+    assert touch.x_c == pytest.approx(math.sqrt(distance**2 - r**2), abs=1e-7)
+    y_m = np.array([-math.sin(touch.angle), math.cos(touch.angle), 0.0])
+    assert touch.normal @ y_m == pytest.approx(r / radius, abs=1e-6)
+
+
+def test_a_sweep_towards_minus_y_records_the_mirror_image() -> None:
+    # the ball reflected in the head's X-Z plane and swept towards -Y^m: the same physics
+    # reflected (gravity along Z is unchanged), so the recording is the +Y sweep's with theta1,
+    # fy, tx, tz negated, in a proper frame that places its true point on the ball, and the
+    # estimate's point lies on the ball as the +Y sweep's does on its own
+    ball = primitive_object("ball", "sphere", [0.05], [0.6, 0.1, -0.02])
+    mirrored = primitive_object("ball", "sphere", [0.05], [0.6, -0.1, -0.02])
+    forward = simulate_sweep(DEVICE, _scene(ball), Sweep(0, "azimuthal", 0.0, -0.6, 0.6), seed=2)
+    backward = simulate_sweep(
+        DEVICE, _scene(mirrored), Sweep(0, "azimuthal", 0.0, -0.6, 0.6, direction=-1), seed=2
+    )
+    assert forward.recording is not None and backward.recording is not None
+    assert backward.frame is not None and forward.touch is not None
+    assert backward.touch is not None
+    assert backward.touch.angle == pytest.approx(-forward.touch.angle, abs=1e-7)
+    rotation = backward.frame.rotation
+    np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(rotation) == pytest.approx(1.0, abs=1e-12)
+    a, b = forward.recording, backward.recording
+    # the swept joint turns the other way: theta1 falls through the touch
+    assert b.theta[-1, 0] < b.theta[0, 0]
+    np.testing.assert_allclose(b.theta * [-1, 1], a.theta, atol=1e-9)
+    np.testing.assert_allclose(b.force * [1, -1, 1], a.force, atol=1e-9)
+    np.testing.assert_allclose(b.torque * [-1, 1, -1], a.torque, atol=1e-9)
+    truth = np.array(json.loads(b.metadata["true_contact_point"]))
+    on_world = backward.frame.point_to_world(truth)
+    assert abs(mirrored.signed_distance(on_world[None, :])[0]) < 3e-3
+    ahead = estimate(a.without_ground_truth(), DEVICE, "paper")
+    back = estimate(b.without_ground_truth(), DEVICE, "paper")
+    assert back.status is ahead.status
+    np.testing.assert_allclose(back.contact_point * [1, -1, 1], ahead.contact_point, atol=1e-6)
+    # the link lies tangent to the ball there: a point 1 cm along it (the paper's typical
+    # error) is 1 cm^2 / 2R = 1 mm off the ball, the push's deflection a few mm more
+    point = backward.frame.point_to_world(back.contact_point)
+    assert abs(mirrored.signed_distance(point[None, :])[0]) < 5e-3
+
+
+def test_a_sweep_keeps_its_direction_and_refuses_a_downward_vertical_one() -> None:
+    back = Sweep(1, "azimuthal", 0.1, -0.4, 0.5, direction=-1)
+    assert (back.origin, back.finish) == (0.5, -0.4)
+    assert Sweep.from_dict(back.to_dict()) == back
+    # a sweep stored before directions existed runs towards +Y
+    legacy = {k: v for k, v in back.to_dict().items() if k != "direction"}
+    assert Sweep.from_dict(legacy).direction == 1
+    assert "-Y" in back.label and "+Y" in Sweep(1, "azimuthal", 0.1, -0.4, 0.5).label
+    with pytest.raises(ValueError, match="upwards only"):
+        Sweep(0, "vertical", 0.0, -0.2, 0.2, direction=-1)
+    with pytest.raises(ValueError, match="direction must be"):
+        Sweep(0, "azimuthal", 0.0, -0.2, 0.2, direction=0)
 
 
 def test_a_turned_base_turns_the_touch() -> None:

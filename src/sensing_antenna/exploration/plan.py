@@ -1,9 +1,11 @@
 """Which sweep next: a fixed grid, or the sweep expected to reduce the surface's uncertainty most.
 
 The grid (:func:`grid_sweeps`) runs, from each base, azimuthal sweeps across the base's azimuth
-range (``Scene.region_of``) at evenly spaced elevations and vertical sweeps up its elevation
-range at evenly spaced azimuths, in an order that spreads them out first
-(:func:`spread_order`), so that a budget cut short still covers the region.
+range (``Scene.region_of``) at evenly spaced elevations, each elevation both ways (towards +Y^m
+and -Y^m: a sweeping line touches a convex object on the side it comes from, so the two see
+opposite sides), and vertical sweeps up its elevation range at evenly spaced azimuths, in an
+order that spreads them out first (:func:`spread_order`), so that a budget cut short still
+covers the region.
 
 The next-best strategy (:class:`NextBestPlanner`) chooses among the candidates of a grid
 :data:`CANDIDATE_DENSITY` times finer. Until the surface can be fitted (fewer than
@@ -22,8 +24,8 @@ object does not occupy, so a candidate whose predicted touch lies within about
 multiplied by 1 - exp(-d^2 / (2 FREE_RADIUS^2)), d the distance to the nearest free link
 sample. Candidates predicted to miss by more than :data:`MISS_MARGIN` of f count only if nothing
 else is left, and each score is divided by one plus the number of earlier sweeps within
-:data:`NEIGHBOUR_ANGLE` of it (its held angle) from the same base and of the same case, which
-keeps a sweep that came back free from being retried next to itself.
+:data:`NEIGHBOUR_ANGLE` of it (its held angle) from the same base, of the same case and
+direction, which keeps a sweep that came back free from being retried next to itself.
 
 When recognition abstains between two leading shape classes, the planner also aims at telling
 them apart: at a candidate's predicted touch p the two fitted shapes disagree about where the
@@ -115,11 +117,20 @@ def _sweeps(scene: Scene, azimuthal: int, vertical: int) -> list[Sweep]:
         region = scene.region_of(base)
         elevations: FloatArray = np.linspace(*region.elevation, azimuthal + 2)[1:-1]
         azimuths: FloatArray = np.linspace(*region.azimuth, vertical + 2)[1:-1]
-        a = [Sweep(base, "azimuthal", float(elevations[i]), *region.azimuth) for i in a_order]
+        # each elevation swept both ways: the two directions touch opposite sides
+        pairs = [
+            [
+                Sweep(base, "azimuthal", float(elevations[i]), *region.azimuth, direction)
+                for direction in (1, -1)
+            ]
+            for i in a_order
+        ]
         v = [Sweep(base, "vertical", float(azimuths[i]), *region.elevation) for i in v_order]
-        # alternate the two cases so that a prefix holds both
-        for k in range(max(len(a), len(v))):
-            sweeps.extend(a[k : k + 1] + v[k : k + 1])
+        # alternate the cases (an elevation's two directions, then an azimuth) so that a prefix
+        # holds both
+        for k in range(max(len(pairs), len(v))):
+            sweeps.extend(pairs[k] if k < len(pairs) else [])
+            sweeps.extend(v[k : k + 1])
     if len(scene.bases) > 1:
         # alternate the bases too
         per_base = len(sweeps) // len(scene.bases)
@@ -224,6 +235,7 @@ class NextBestPlanner:
                 for d in done
                 if d.base == sweep.base
                 and d.case == sweep.case
+                and d.direction == sweep.direction
                 and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
             )
             spread = std
@@ -251,14 +263,14 @@ class NextBestPlanner:
     def _swept(self, sweep: Sweep) -> FloatArray:
         """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3)."""
         base = self.scene.bases[sweep.base]
-        angles = np.arange(sweep.start, sweep.end + 1e-12, PREDICTION_STEP)
+        angles = sweep.swept_angles(PREDICTION_STEP)
         return np.concatenate(
             [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
         )
 
     def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:
         """The predicted touch point (m) and the smallest f met (m; <= 0 when it touches)."""
-        angles = np.arange(sweep.start, sweep.end + 1e-12, PREDICTION_STEP)
+        angles = sweep.swept_angles(PREDICTION_STEP)
         points = self._swept(sweep)
         values = np.asarray(surface.predict(points)).reshape(len(angles), -1)
         inside = np.nonzero((values < 0).any(axis=1))[0]

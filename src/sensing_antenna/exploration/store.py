@@ -125,13 +125,7 @@ class Manoeuvre:
         sweep = data["sweep"]
         return cls(
             index=int(data["index"]),
-            sweep=Sweep(
-                int(sweep["base"]),
-                sweep["case"],
-                float(sweep["fixed"]),
-                float(sweep["start"]),
-                float(sweep["end"]),
-            ),
+            sweep=Sweep.from_dict(sweep),
             outcome=str(data["outcome"]),
             reason=data.get("reason"),
             touch=data.get("touch"),
@@ -248,6 +242,7 @@ _TABLE_COLUMNS = (
     "base",
     "case",
     "fixed",
+    "direction",
     "outcome",
     "touch_angle",
     "true_x_c",
@@ -283,6 +278,7 @@ def write_manoeuvre_table(out: Path, manoeuvres: Sequence[Manoeuvre]) -> Path:
                 m.sweep.base,
                 m.sweep.case,
                 f"{m.sweep.fixed:.6g}",
+                f"{m.sweep.direction:+d}",
                 m.outcome,
                 "" if "angle" not in touch else f"{touch['angle']:.6g}",
                 "" if "x_c" not in touch else f"{touch['x_c']:.6g}",

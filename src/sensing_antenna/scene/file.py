@@ -27,8 +27,8 @@
     [explore]                             # the region swept (defaults below)
     azimuth = [-0.6, 0.6]                 # theta1 range (rad): azimuthal sweeps run across it
     elevation = [-0.35, 0.35]             # theta2 range (rad): vertical sweeps run up it
-    azimuthal_sweeps = 5                  # the grid's elevations per base
-    vertical_sweeps = 5                   # the grid's azimuths per base
+    azimuthal_sweeps = 5                  # the grid's elevations per base, each swept both ways
+    vertical_sweeps = 5                   # the grid's azimuths per base, each swept up
 
 Sizes: sphere ``radius``; cylinder ``radius``, ``height``; capsule ``radius``, ``length`` (of
 the axis segment); cone ``radius`` (base), ``height``; torus ``major_radius``,
@@ -93,11 +93,12 @@ class ExploreRegion:
     Attributes
     ----------
     azimuth : (float, float)
-        theta1 from, to (rad): an azimuthal sweep runs from the first to the second.
+        theta1 range (rad): an azimuthal sweep runs across it, either way.
     elevation : (float, float)
         theta2 from, to (rad): a vertical sweep runs up from the first to the second.
     azimuthal_sweeps, vertical_sweeps : int
-        The grid's elevations (azimuthal sweeps) and azimuths (vertical sweeps) per base.
+        The grid's elevations (each swept both ways by azimuthal sweeps) and azimuths (vertical
+        sweeps) per base.
     """
 
     azimuth: tuple[float, float] = (-0.6, 0.6)

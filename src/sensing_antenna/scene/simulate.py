@@ -21,6 +21,11 @@ g cos(theta2) (the scene's link shape, ``scene.sweep.LinkShape``, sags as the si
 that the simulated contact lies on the touched surface), and a sweep at elevation theta2 is
 simulated in the plane tangent to its cone at the touch.
 
+A sweep towards -Y^m is simulated as its mirror image (the reflection y -> -y of the
+recording's frame, gravity unchanged: the same physics): the simulator runs the +Y^m sweep into
+the reflected obstacle, and the recording written is the reflection of that one
+(``simulator.mirror``), what a device sweeping towards -Y^m records, in the same proper frame R.
+
 The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
 friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated
 with the obstacle turned by :data:`MAX_TILT`: the same touched point, the push held as if the
@@ -47,6 +52,7 @@ from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.scene.touch import SweepGeometry, Touch, first_touch
 from sensing_antenna.simulator import Scenario, simulate
 from sensing_antenna.simulator.contact import motor_frame
+from sensing_antenna.simulator.mirror import mirror_recording
 from sensing_antenna.simulator.run import device_link, minimum_contact_point
 
 __all__ = [
@@ -115,14 +121,18 @@ class SweepOutcome:
 def touch_scenario(
     touch: Touch, sweep: Sweep, scene: Scene, seed: int = 0, **scenario_fields: Any
 ) -> tuple[Scenario, BasePose]:
-    """The simulator's scenario for a touch and the recording's frame in the world.
+    """The simulator's scenario for a touch and the recording's frame in the world; for a sweep
+    towards -Y^m the scenario of its mirror image (module docstring).
 
     Raises ValueError with the reason when the touch is ``glancing``.
     """
     base = scene.bases[sweep.base]
     rotation = base.rotation @ motor_frame(*touch.angles).T
     frame = BasePose(rotation, base.position)
-    normal = rotation.T @ touch.normal  # in the recording's frame: X, Y, Z = X^m, Y^m, Z^m
+    # in the recording's frame (X, Y, Z = X^m, Y^m, Z^m), reflected for a sweep towards -Y^m
+    reflect = np.diag([1.0, float(sweep.direction), 1.0])
+    normal = reflect @ rotation.T @ touch.normal
+    tangent = reflect @ rotation.T @ touch.tangent
     if sweep.case == "azimuthal":
         # the post's normal is -Y cos(t) + Z sin(t), its axis Z cos(t) + Y sin(t)
         # (simulator.contact.place_obstacle)
@@ -136,7 +146,7 @@ def touch_scenario(
         kind = "bar"
     # the sagged link crosses that axis at an angle phi off the perpendicular; a cylinder of
     # radius R curves by cos(phi)^2 / R along it (Euler), so R = R_along cos(phi)^2
-    along_axis = float(axis @ (rotation.T @ touch.tangent))
+    along_axis = float(axis @ tangent)
     radius = touch.radius * (1.0 - along_axis**2)
     if touch.tip:
         kind = "plane"
@@ -149,8 +159,9 @@ def touch_scenario(
     # beyond the simulator's largest tilt the obstacle is turned by that much: the same
     # touched point, a push held as if the surface faced the sweep more
     tilt = max(-MAX_TILT, min(MAX_TILT, tilt))
+    towards = "" if sweep.direction == 1 else " towards -Y"
     description = (
-        f"scene {scene.name}: {sweep.case} sweep touching {touch.object_name}"
+        f"scene {scene.name}: {sweep.case} sweep{towards} touching {touch.object_name}"
         f" at x_c = {touch.x_c:.4f} m"
     )
     scenario = Scenario(
@@ -199,7 +210,7 @@ def simulate_sweep(
     touch = geometry.touch
     if touch is None:
         return SweepOutcome(sweep, "free", sweep_time=(sweep.end - sweep.start) / speed)
-    approach = (touch.angle - sweep.start) / speed
+    approach = abs(touch.angle - sweep.origin) / speed
     link = device_link(device.link)
     smallest = minimum_contact_point(
         link, float(scenario_fields.get("contact_stiffness", _DEFAULT_STIFFNESS))
@@ -217,6 +228,8 @@ def simulate_sweep(
     except ValueError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     recording = simulate(device, scenario)
+    if sweep.direction == -1:
+        recording = mirror_recording(recording)
     metadata = dict(recording.metadata)
     metadata["base_pose"] = frame.to_json()
     metadata["true_object"] = touch.object_name

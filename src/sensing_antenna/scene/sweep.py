@@ -1,9 +1,14 @@
 """A sweep of the head and where its gravity-sagged link lies at each angle.
 
-A sweep turns one joint from ``start`` to ``end`` with the other held at ``fixed``: azimuthal,
-theta1 across with theta2 = ``fixed`` (the link moves towards +Y^m); vertical, theta2 up with
-theta1 = ``fixed`` (towards +Z^m), the two cases of the simulator, from one of the scene's base
-poses. The link at angles (theta1, theta2) is the straight line x X^m sagged by its own weight,
+A sweep turns one joint across its range [``start``, ``end``] with the other held at ``fixed``,
+from one of the scene's base poses: azimuthal, theta1 across with theta2 = ``fixed``, from
+``start`` up to ``end`` (``direction`` +1: the link moves towards +Y^m) or from ``end`` down to
+``start`` (-1: towards -Y^m); vertical, theta2 up from ``start`` with theta1 = ``fixed`` (towards
++Z^m; +1 only: a downward sweep, gravity helping the push, is not a case of the simulator). A
+sweeping line first touches a convex object on the side it comes from, so the two directions of
+an azimuthal sweep see opposite sides of it.
+
+The link at angles (theta1, theta2) is the straight line x X^m sagged by its own weight,
 p(x) = x X^m + g w_1(x) Z^m in the absolute frame (recording format), w_1 the static deflection
 of the simulator's finite-element link under a unit transverse acceleration (m per m/s^2,
 negative: the load is along -Z^m): the sag the simulator starts its manoeuvres from. The
@@ -16,9 +21,10 @@ the same point.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,11 +35,14 @@ from sensing_antenna.simulator.contact import motor_frame
 from sensing_antenna.simulator.link import build_link_model
 from sensing_antenna.simulator.run import device_link
 
-__all__ = ["SWEEP_CASES", "LinkShape", "Sweep", "facing_region"]
+__all__ = ["SWEEP_CASES", "SWEEP_DIRECTIONS", "LinkShape", "Sweep", "facing_region"]
 
 FloatArray = NDArray[np.float64]
 
 SWEEP_CASES = ("azimuthal", "vertical")
+
+#: The directions a sweep may run in: +1 from ``start`` to ``end``, -1 from ``end`` to ``start``.
+SWEEP_DIRECTIONS = (1, -1)
 
 
 @dataclass(frozen=True)
@@ -48,7 +57,10 @@ class Sweep:
     fixed : float
         The held joint's angle (rad): theta2 of an azimuthal sweep, theta1 of a vertical one.
     start, end : float
-        The swept joint from, to (rad), start < end.
+        The swept joint's range (rad), start < end.
+    direction : {1, -1}
+        +1: from ``start`` to ``end`` (towards +Y^m, or +Z^m for a vertical sweep); -1: from
+        ``end`` to ``start`` (towards -Y^m; azimuthal sweeps only).
     """
 
     base: int
@@ -56,12 +68,48 @@ class Sweep:
     fixed: float
     start: float
     end: float
+    direction: int = 1
 
     def __post_init__(self) -> None:
         if self.case not in SWEEP_CASES:
             raise ValueError(f"case must be one of {', '.join(SWEEP_CASES)}, got {self.case!r}")
         if not self.start < self.end:
-            raise ValueError("a sweep runs from start to a larger end")
+            raise ValueError("a sweep's range runs from start to a larger end")
+        if self.direction not in SWEEP_DIRECTIONS:
+            raise ValueError(f"direction must be +1 or -1, got {self.direction!r}")
+        if self.case == "vertical" and self.direction != 1:
+            raise ValueError("a vertical sweep runs upwards only (direction +1)")
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Sweep:
+        """The sweep of :meth:`to_dict`'s fields (``direction`` +1 when absent)."""
+        direction = data.get("direction", 1)
+        if isinstance(direction, bool) or direction not in SWEEP_DIRECTIONS:
+            raise ValueError(f"direction must be +1 or -1, got {direction!r}")
+        return cls(
+            int(data["base"]),
+            data["case"],
+            float(data["fixed"]),
+            float(data["start"]),
+            float(data["end"]),
+            int(direction),
+        )
+
+    @property
+    def origin(self) -> float:
+        """The swept joint's angle where the sweep begins (rad)."""
+        return self.start if self.direction == 1 else self.end
+
+    @property
+    def finish(self) -> float:
+        """The swept joint's angle where the sweep ends when it touches nothing (rad)."""
+        return self.end if self.direction == 1 else self.start
+
+    def swept_angles(self, step: float) -> NDArray[np.float64]:
+        """The swept joint's angles every ``step`` (rad) in the order the sweep passes them."""
+        if self.direction == 1:
+            return np.arange(self.start, self.end + 1e-12, step)
+        return np.arange(self.end, self.start - 1e-12, -step)
 
     def angles(self, swept: float) -> tuple[float, float]:
         """(theta1, theta2) (rad) when the swept joint is at ``swept``."""
@@ -73,7 +121,11 @@ class Sweep:
     def label(self) -> str:
         """Short text for progress lines."""
         held = "elevation" if self.case == "azimuthal" else "azimuth"
-        return f"base {self.base} {self.case} at {held} {self.fixed:+.3f} rad"
+        towards = {("azimuthal", 1): "+Y", ("azimuthal", -1): "-Y", ("vertical", 1): "+Z"}
+        return (
+            f"base {self.base} {self.case} towards {towards[(self.case, self.direction)]}"
+            f" at {held} {self.fixed:+.3f} rad"
+        )
 
     def to_dict(self) -> dict[str, object]:
         """JSON-able fields."""
@@ -83,6 +135,7 @@ class Sweep:
             "fixed": self.fixed,
             "start": self.start,
             "end": self.end,
+            "direction": self.direction,
         }
 
 

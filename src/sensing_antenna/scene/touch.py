@@ -1,13 +1,13 @@
 """Where a sweep's link first touches a scene: the angle, x_c, the surface point and normal.
 
 The link is sampled along its length (:class:`~sensing_antenna.scene.sweep.LinkShape`) and
-g(theta) = min over the samples of the scene's signed distance is followed from the sweep's start.
-No point of the link moves faster than its reach r (m per rad of either joint), so the link
-cannot meet a surface before the joint has turned g / r further: the search advances by that
-much (conservative advancement, the sphere tracing of signed-distance rendering), at least
-:data:`MIN_STEP`, until g <= 0, then bisects the last step to :data:`ANGLE_TOLERANCE`. x_c is the
-sample nearest the surface refined by a bounded scalar minimisation between its neighbours; at
-the tip's sample the contact is the tip's.
+g(theta) = min over the samples of the scene's signed distance is followed from the sweep's first
+angle in its direction. No point of the link moves faster than its reach r (m per rad of either
+joint), so the link cannot meet a surface before the joint has turned g / r further: the search
+advances by that much (conservative advancement, the sphere tracing of signed-distance
+rendering), at least :data:`MIN_STEP`, until g <= 0, then bisects the last step to
+:data:`ANGLE_TOLERANCE`. x_c is the sample nearest the surface refined by a bounded scalar
+minimisation between its neighbours; at the tip's sample the contact is the tip's.
 
 The local radius R of the surface along the link, which the simulator's equivalent cylinder
 takes, comes from the distance d(+-h) of the points h = :data:`CURVATURE_PROBE` to either side
@@ -136,44 +136,48 @@ def _gap(scene: Scene, shape: LinkShape, sweep: Sweep, base: BasePose, angle: fl
 
 
 def first_touch(scene: Scene, sweep: Sweep, shape: LinkShape) -> SweepGeometry:
-    """Where the link of ``shape`` first touches ``scene`` during ``sweep`` (module docstring)."""
+    """Where the link of ``shape`` first touches ``scene`` during ``sweep``, followed from the
+    sweep's first angle in its direction (module docstring)."""
     base = scene.bases[sweep.base]
     reach = shape.reach
-    angle = sweep.start
+    sign = float(sweep.direction)
+    angle = sweep.origin
     gap = _gap(scene, shape, sweep, base, angle)
     if gap <= 0:
         return SweepGeometry(None, inside_at_start=True)
     while True:
         step = max(gap / reach, MIN_STEP)
-        if angle >= sweep.end:
+        remaining = sign * (sweep.finish - angle)
+        if remaining <= 0:
             return SweepGeometry(None)
-        next_angle = min(angle + step, sweep.end)
+        next_angle = angle + sign * min(step, remaining)
         next_gap = _gap(scene, shape, sweep, base, next_angle)
         if next_gap <= 0:
             break
         angle, gap = next_angle, next_gap
-    low, high = angle, next_angle
-    # bisection on the samples: the link is clear at low, cuts the surface at high
-    while high - low > ANGLE_TOLERANCE:
-        middle = 0.5 * (low + high)
+    # clear at ``clear``, cutting the surface at ``cut``; the sweep goes from the one to the other
+    clear, cut = angle, next_angle
+    # bisection on the samples
+    while abs(cut - clear) > ANGLE_TOLERANCE:
+        middle = 0.5 * (clear + cut)
         if _gap(scene, shape, sweep, base, middle) > 0:
-            low = middle
+            clear = middle
         else:
-            high = middle
+            cut = middle
     # between samples the link may already cut the surface: bisect again on the gap between
     # the samples, stepping back until the link is clear
-    if _nearest(scene, shape, sweep, base, low)[1] <= 0:
-        high = low
-        low = high - MIN_STEP
-        while _nearest(scene, shape, sweep, base, low)[1] <= 0:
-            low -= MIN_STEP
-        while high - low > ANGLE_TOLERANCE:
-            middle = 0.5 * (low + high)
+    if _nearest(scene, shape, sweep, base, clear)[1] <= 0:
+        cut = clear
+        clear = cut - sign * MIN_STEP
+        while _nearest(scene, shape, sweep, base, clear)[1] <= 0:
+            clear -= sign * MIN_STEP
+        while abs(cut - clear) > ANGLE_TOLERANCE:
+            middle = 0.5 * (clear + cut)
             if _nearest(scene, shape, sweep, base, middle)[1] > 0:
-                low = middle
+                clear = middle
             else:
-                high = middle
-    return SweepGeometry(_touch_at(scene, sweep, shape, base, low))
+                cut = middle
+    return SweepGeometry(_touch_at(scene, sweep, shape, base, clear))
 
 
 def _nearest(
