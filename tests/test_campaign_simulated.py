@@ -179,7 +179,7 @@ def test_a_campaign_says_what_it_does_from_its_first_moment(
     # a line before any work, one per preparation step, the calibration's bar, then the runs'
     expected = [
         f"campaign one: 1 runs (1 main) x 1 method(s) (ratio), in {tmp_path}",
-        "preparation: identifying the free-motion observer (Eq. 15) on a 2 s free motion",
+        "preparation: identifying the free-motion observer (Eq. 15) on 1 free sweep of 2 s",
         "preparation: calibrating T_e on 2 contact recordings of the device (Section 5.1)",
         "calibration: 100%",
         "runs: 0 of 1 stored already, 1 to run in this process",

@@ -644,3 +644,38 @@ def test_a_plane_campaign_off_the_tip_is_refused_naming_the_point(tmp_path: Path
         write(tmp_path, text.replace("[0.98, 0.5]", "[0.98]") + 'obstacle = "plane"\n')
     )
     assert at_tip.load_device().link.length == 0.98
+
+
+def test_the_free_motions_are_a_free_sweep_of_each_swept_joint(tmp_path: Path) -> None:
+    # Section 5.2: the threshold comes from the free movements; by default one free sweep per
+    # joint the campaign sweeps (its runs, the noise sweep's, the calibration's), or the one
+    # free_motion.case names
+    assert default_campaign_spec().free_motion_cases() == ("free", "free-vertical")
+    spec = load_campaign_spec(write(tmp_path, GOOD + "\n[free_motion]\nidentify = true\n"))
+    assert spec.free_motion_cases() == ("free",)
+    calibrated = GOOD + "\n[free_motion]\nidentify = true\n[calibration]\nenabled = true\n"
+    calibrated += 'case = "vertical"\ncontact_points = [0.4, 0.6]\n'
+    both = load_campaign_spec(write(tmp_path, calibrated))
+    assert both.free_motion_cases() == ("free", "free-vertical")
+    assert both.preparation_fingerprint() != spec.preparation_fingerprint()
+    one = GOOD + '\n[free_motion]\nidentify = true\ncase = "free-vertical"\n'
+    assert load_campaign_spec(write(tmp_path, one)).free_motion_cases() == ("free-vertical",)
+    for case in ("sideways", "azimuthal"):
+        with pytest.raises(CampaignSpecError, match=r"free_motion\.case: must be one of free, "):
+            load_campaign_spec(write(tmp_path, one.replace('"free-vertical"', f'"{case}"')))
+
+
+def test_the_simulated_controller_knows_the_weight_identification_found() -> None:
+    # The device's link carries 0.1 g at its tip that the model lacks; identification read it
+    # as a payload, so the identified model weighs it. The controller's weight moment is the
+    # identified model's, once (not the device's own tip mass plus the payload again), and the
+    # device's physics (its tip_mass) is untouched.
+    from sensing_antenna.campaign.simulated import knowing_weight
+
+    model = paper_antenna()
+    device = replace(model, link=replace(model.link, tip_mass=1e-4, youngs_modulus=132.65e9))
+    identified = replace(model, link=replace(model.link, tip_mass=1e-4))
+    known = knowing_weight(device, identified)
+    assert known.link.weight_moment == pytest.approx(identified.link.weight_moment, rel=1e-12)
+    assert known.link.tip_mass == device.link.tip_mass
+    assert known.observer == identified.observer

@@ -126,11 +126,13 @@ def test_bent_weight_moment_is_the_weight_moved_by_the_bending(x_c: float, push:
 
 def test_a_push_plane_frequency_corroborated_by_a_weaker_free_plane_is_ok() -> None:
     # The simulated device near the tip (x_c = 0.95 m, the default push bends it by 10 %): the
-    # push plane rings clearly, the free plane at the same frequency 15 to 18 times its band's
+    # push plane rings clearly, the free plane within 1.2 % of its frequency 11 times its band's
     # median, under the 20 a peak needs alone; the two agree and the answer is right. The bent
-    # link's bound there (0.6 d^2 x_c, 0.6 cm) is within 1 cm: ok
+    # link's bound there (0.6 d^2 x_c, 0.6 cm) is within 1 cm: ok. How clearly the free plane
+    # rings varies with the run (3 to 470 times the median over seeds 1 to 6 and 957); this
+    # seed is one where it rings between the corroboration's 10 and a peak's own 20.
     antenna = paper_antenna()
-    recording = simulate(antenna, Scenario(case="vertical", contact_point=0.95, seed=957))
+    recording = simulate(antenna, Scenario(case="vertical", contact_point=0.95, seed=1))
     truth = float(recording.metadata["true_xc"])
     result = estimate(recording.without_ground_truth(), antenna.self_calibrated())
     assert result.status is Status.OK, result.reason

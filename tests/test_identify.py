@@ -18,7 +18,7 @@ from sensing_antenna.calibration.observer import (
 )
 from sensing_antenna.cli import main
 from sensing_antenna.detection.contact import detect_contact
-from sensing_antenna.recording import Recording, write_recording
+from sensing_antenna.recording import Recording, resample_uniform, write_recording
 from sensing_antenna.simulator import Scenario, simulate
 
 TS = 1e-3  # s
@@ -337,3 +337,76 @@ def test_payload_of_a_calibrated_link_goes_to_its_weight_alone() -> None:
     applied = fit.payload.apply(dataclasses.replace(ANTENNA, link=link)).link
     assert applied.tip_mass == 5e-5
     assert applied.weight_tip_mass == pytest.approx(fit.payload.mass)
+
+
+def test_joints_identified_from_separate_recordings_match_one_recording_of_both() -> None:
+    # Each joint moving in a recording of its own, fitted together, recovers the system as a
+    # recording in which both move does: within 5 % (the noise's share over 6 s of moves, as in
+    # the single-recording test above)
+    azimuth = _free_motion(5, joints=(True, False))
+    elevation = dataclasses.replace(_free_motion(6, joints=(False, True)), source="free2.csv")
+    fit = identify_free_motion([azimuth, elevation], ANTENNA)
+    assert fit.joints == (1, 2)
+    assert fit.gain == pytest.approx(TRUE_GAIN, rel=0.05)
+    assert fit.natural_frequency == pytest.approx(TRUE_OMEGA, rel=0.05)
+    assert fit.source == "free.csv, free2.csv"
+    # the threshold's residual is the larger of the two recordings' with the fitted observer
+    identified = dataclasses.replace(ANTENNA, observer=fit.observer)
+    peaks = [
+        np.max(detect_contact(r, identified).filtered_residual_norm) for r in (azimuth, elevation)
+    ]
+    assert fit.max_filtered_residual == pytest.approx(max(peaks), rel=1e-12)
+    assert fit.contact_threshold == pytest.approx(1.5 * max(peaks), rel=1e-12)
+    # a recording sampled at another period (2 ms) is fitted on the first one's grid: the
+    # same system within the same 5 %
+    coarse = resample_uniform(elevation, 2 * TS)
+    mixed = identify_free_motion([azimuth, coarse], ANTENNA)
+    assert mixed.joints == (1, 2)
+    assert mixed.natural_frequency == pytest.approx(TRUE_OMEGA, rel=0.05)
+    with pytest.raises(IdentificationError, match="none given"):
+        identify_free_motion([], ANTENNA)
+
+
+def test_a_vertical_free_sweep_with_an_unknown_tip_mass_identifies() -> None:
+    # A device carrying 0.1 g at its tip that the antenna file lacks. In a vertical sweep the
+    # torque about Y^m holds that mass's weight moment, about 1e-3 N m, ten times the link's
+    # vibration: a fit that removed only the file's weight would find no Eq. 15 that explains
+    # it. The rest reads the payload, the fit removes its weight, and the detector of the
+    # identified antenna sees no contact in another vertical free sweep.
+    from sensing_antenna.simulator import DeviceImperfections
+
+    device = DeviceImperfections(tip_mass=1e-4)
+
+    def free(case: str, seed: int) -> Recording:
+        scenario = Scenario(case=case, duration=3.0, seed=seed, device=device)  # type: ignore[arg-type]
+        return simulate(ANTENNA, scenario).without_ground_truth()
+
+    fit = identify_free_motion([free("free", 1), free("free-vertical", 2)], ANTENNA)
+    assert fit.joints == (1, 2)
+    assert fit.payload is not None and fit.payload.significant
+    assert fit.payload.mass == pytest.approx(1e-4, abs=2e-5)  # as the single-recording test
+    vertical = identify_free_motion(free("free-vertical", 2), ANTENNA)
+    assert vertical.joints == (2,)
+    # the rigid link's inertia about the head, m_b l^2 / 3 + m_t l^2, within 10 %
+    inertia = ANTENNA.link.mass * 0.98**2 / 3 + 1e-4 * 0.98**2
+    assert vertical.gain / vertical.natural_frequency**2 == pytest.approx(inertia, rel=0.1)
+    identified = fit.payload.apply(dataclasses.replace(ANTENNA, observer=fit.observer))
+    assert detect_contact(free("free-vertical", 3), identified).index is None
+
+
+def test_cli_identifies_from_several_recordings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    paths = []
+    moves = (_free_motion(7, joints=(True, False)), _free_motion(8, joints=(False, True)))
+    for k, rec in enumerate(moves):
+        path = tmp_path / f"free{k}.csv"
+        write_recording(rec, path)
+        paths.append(str(path))
+    out = tmp_path / "fitted.toml"
+    assert main(["identify", *paths, "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "joints used: theta1, theta2" in printed
+    assert "free0.csv, " in load_antenna(out).description
+    assert main(["identify", *paths, "--out", str(out), "--servo"]) == 2
+    assert "--servo" in capsys.readouterr().err

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.recording import MAX_FILE_BYTES, MAX_SAMPLES
 from sensing_antenna.simulator import Scenario, ScenarioError
 from sensing_antenna.simulator.run import SAMPLE_PERIOD
@@ -82,3 +83,22 @@ def test_each_limit_names_its_field_in_one_line(field: str, value: object, words
     assert message.startswith(f"scenario.{field}: ")
     assert words in message
     assert "\n" not in message and "np." not in message
+
+
+def test_the_free_vertical_sweep_moves_theta2_alone_and_touches_nothing() -> None:
+    # The vertical sweep with no bar: theta2 ramps up to the sweep speed and is brought to
+    # rest after the approach time, theta1 stays put, and nothing touches the link.
+    from sensing_antenna.simulator import simulate
+
+    scenario = Scenario(case="free-vertical", duration=2.0, noise_scale=0.0)
+    assert scenario.obstacle_kind is None
+    recording = simulate(paper_antenna(), scenario)
+    theta1, theta2 = recording.theta.T
+    assert np.ptp(theta1) < 1e-9
+    assert np.ptp(theta2) > 0.1
+    # brought to rest: over the last 0.1 s it moves at under 3 % of the 0.3 rad/s sweep speed
+    # (the servo's last creep under the weight's moment)
+    assert abs(theta2[-1] - theta2[-100]) < 0.03 * 0.3 * 0.1
+    assert "true_xc" not in recording.metadata  # no obstacle to touch
+    with pytest.raises(ScenarioError, match="contact_point: must be None"):
+        Scenario(case="free-vertical", contact_point=0.5)

@@ -25,17 +25,21 @@ than three standard deviations of the rest's mean and the tare's offset, is read
 mass (a payload; the
 estimators' plausibility check reads the same moment, docs/estimation.md): the identified
 antenna carries it in ``link.tip_mass``, so the frequency model and the calibration of T_e know
-the weight that lowers omega_1.
+the weight that lowers omega_1. The observer is fitted, and its threshold read, with that payload's
+weight removed, as the detector of the identified antenna removes it.
 
 Threshold (Section 5.2): the maximum of the filtered residual norm of Eq. 16 over the free-motion
-recording, computed with the fitted observer and the detector's residual filter, times a safety
+recordings, computed with the fitted observer and the detector's residual filter, times a safety
 margin of 1.5 ("the maximum residual obtained during free movements plus a security margin of
-50 %").
+50 %"). The free movements should be those the head makes when it sweeps, both joints: a
+threshold read from azimuthal motion alone does not cover what a vertical sweep's residual
+holds (the weight's moment changing with theta_2, joint 2's own dynamics).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -67,6 +71,7 @@ __all__ = [
     "IdentificationError",
     "ObserverFit",
     "Payload",
+    "combined_payload",
     "identify_free_motion",
     "initial_guess",
     "rest_payload",
@@ -145,7 +150,8 @@ class ObserverFit:
     contact_threshold : float
         ``margin`` times ``max_filtered_residual`` (N m).
     max_filtered_residual : float
-        Largest filtered residual norm of Eq. 16 over the recording with the fitted observer (N m).
+        Largest filtered residual norm of Eq. 16 over the recordings with the fitted observer
+        (N m).
     residual_rms : float
         RMS of measured minus fitted dynamic torque over the joints used (N m).
     joints : tuple of int
@@ -157,7 +163,7 @@ class ObserverFit:
     initial_gain, initial_natural_frequency, initial_damping : float
         The physics-based starting point (same units).
     source : str or None
-        Recording file.
+        The recordings' files, comma-separated.
     payload : Payload or None
         Weight at the tip beyond the model's, read at rest (None: not read).
     """
@@ -238,22 +244,26 @@ def _targets(recording: Recording, antenna: Antenna) -> NDArray[np.float64]:
 
 
 def _fit(
-    angles: NDArray[np.float64],
-    measured: NDArray[np.float64],
+    data: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
     period: float,
     guess: tuple[float, float, float],
     where: str,
 ) -> tuple[float, float, float, float]:
     """(K, omega, d) of Eq. 15 fitted to the measured coupling torques, and the residual rms
-    (N m): a grid over omega and zeta with K solved linearly, then least squares. Raises
-    IdentificationError when Eq. 15 explains the torque poorly (not free motion)."""
+    (N m): a grid over omega and zeta with K solved linearly, then least squares. ``data``
+    holds, per recording, the moved joints' angles (rad) and measured torques (N m), each of
+    shape (n, joints). Raises IdentificationError when Eq. 15 explains the torque poorly (not
+    free motion)."""
     nyquist = math.pi / period
     k0, w0, d0 = guess
+    measured = np.concatenate([torques.ravel() for _, torques in data])
 
     def unit_response(omega: float, damping: float) -> NDArray[np.float64]:
         observer = FreeMotionObserver(1.0, omega, damping, 1.0)
-        # Eq. 15 with K = 1, discretised as online
-        return observe_free_motion(angles, observer, period)
+        # Eq. 15 with K = 1, discretised as online, each recording from its own rest
+        return np.concatenate(
+            [observe_free_motion(angles, observer, period).ravel() for angles, _ in data]
+        )
 
     best = (math.inf, k0, min(w0, 0.5 * nyquist), d0)
     for omega in w0 * np.geomspace(0.4, 2.5, 49):
@@ -268,7 +278,7 @@ def _fit(
 
     def residuals(params: NDArray[np.float64]) -> NDArray[np.float64]:
         gain, omega, damping = params
-        return (measured - gain * unit_response(omega, damping)).ravel()
+        return measured - gain * unit_response(omega, damping)
 
     rigid = k0 / w0**2
     if best[1] < _MIN_GAIN:
@@ -354,17 +364,19 @@ def rest_payload(recording: Recording, antenna: Antenna) -> Payload:
 
 
 def identify_free_motion(
-    recording: Recording,
+    recordings: Recording | Sequence[Recording],
     antenna: Antenna,
     margin: float = DEFAULT_MARGIN,
     residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
 ) -> ObserverFit:
-    """Fit the Eq. 15 observer and the contact threshold to a free-motion recording.
+    """Fit the Eq. 15 observer and the contact threshold to free-motion recordings.
 
     Parameters
     ----------
-    recording : Recording
-        Free motion, no contact; irregular sampling is resampled linearly first.
+    recordings : Recording or sequence of Recording
+        Free motion, no contact: one recording, or several (the head's free movements, e.g. an
+        azimuthal and a vertical sweep) fitted together, each joint from the recordings in which
+        it moved; irregular sampling is resampled linearly first.
     antenna : Antenna
         Link (weight, physics-based start); its current observer is not used.
     margin : float
@@ -375,39 +387,54 @@ def identify_free_motion(
     Returns
     -------
     ObserverFit
+        The threshold is ``margin`` times the largest filtered residual over all recordings; the
+        payload is the rests' inverse-variance mean (:func:`combined_payload`). The observer's
+        torques and the threshold's residuals are those of the link with that payload: the
+        weight the sensor read, which a detector using the identified antenna removes.
 
     Raises
     ------
     IdentificationError
-        When no joint moved by more than ``MIN_MOTION``, ``margin`` is not a number >= 1, the
+        When no joint moved by more than ``MIN_MOTION``, ``margin`` is not a number >= 1, a
         recording is not in the format's units (its angles, or its loads at rest against the
         link's weight, :func:`~sensing_antenna.units_check.recording_problem`), the fitted
         observer leaves more than ``MAX_RELATIVE_RESIDUAL`` of the torque unexplained (not a
         free motion), or its effective inertia is more than ``MAX_INERTIA_FACTOR`` from the
         rigid link's.
     """
-    where = recording.source or "<recording>"
+    given = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    if not given:
+        raise IdentificationError("recordings: none given; a free-motion recording is needed")
     if not (math.isfinite(margin) and margin >= 1.0):
         raise IdentificationError(f"margin: must be a number >= 1, got {margin!r}")
-    uniform = resample_uniform(recording) if recording.sampling.irregular else recording
-    period = uniform.sample_period
-    problem = units_problem(uniform, antenna)
-    if problem is not None:
-        raise IdentificationError(f"{where}: {problem}")
-    span = np.ptp(uniform.theta, axis=0)
-    joints = tuple(j for j in (0, 1) if span[j] > MIN_MOTION)
-    if not joints:
+    named = [r.source for r in given if r.source]
+    where = ", ".join(named) if named else "<recording>"
+    if len(given) > 1 and len(named) < len(given):
+        where = ", ".join(r.source or f"<recording {k + 1}>" for k, r in enumerate(given))
+    moves = [_free_motion(recording, antenna) for recording in given]
+    payload = combined_payload([move.payload for move in moves])
+    weighed = payload.apply(antenna)
+    moved = [move for move in moves if move.joints]
+    if not moved:
         raise IdentificationError(
             f"{where}: columns 'theta1', 'theta2': no joint moved by more than {MIN_MOTION:g} rad;"
             " a free-motion recording is needed"
         )
-    angles = uniform.theta[:, joints]
-    measured = _targets(uniform, antenna)[:, joints]
+    period = moved[0].recording.sample_period
+    for k, move in enumerate(moves):
+        if move.recording.sample_period != period:
+            # the observer runs at one period: every recording on its grid
+            moves[k] = replace(move, recording=resample_uniform(move.recording, period))
+    moved = [move for move in moves if move.joints]
+    data = [
+        (move.recording.theta[:, move.joints], _targets(move.recording, weighed)[:, move.joints])
+        for move in moved
+    ]
     k0, w0, d0 = initial_guess(antenna)
     try:
         # Arithmetic that overflows means values no link gives (a wrench of 1e300 N m)
         with np.errstate(over="raise"):
-            gain, omega, damping, rms = _fit(angles, measured, period, (k0, w0, d0), where)
+            gain, omega, damping, rms = _fit(data, period, (k0, w0, d0), where)
     except FloatingPointError:
         raise IdentificationError(
             f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the fit of Eq. 15 overflows: "
@@ -415,9 +442,18 @@ def identify_free_motion(
         ) from None
     _check_inertia(gain / omega**2, k0 / w0**2, where)
     provisional = FreeMotionObserver(gain, omega, damping, contact_threshold=1.0)
-    provisional_antenna = replace(antenna, observer=provisional)
-    detection = detect_contact(uniform, provisional_antenna, residual_cutoff=residual_cutoff)
-    peak = float(np.max(detection.filtered_residual_norm))
+    provisional_antenna = replace(weighed, observer=provisional)
+    peak = max(
+        float(
+            np.max(
+                detect_contact(
+                    move.recording, provisional_antenna, residual_cutoff=residual_cutoff
+                ).filtered_residual_norm
+            )
+        )
+        for move in moves
+    )
+    joints = sorted({j + 1 for move in moved for j in move.joints})
     return ObserverFit(
         gain=gain,
         natural_frequency=omega,
@@ -425,12 +461,46 @@ def identify_free_motion(
         contact_threshold=margin * peak,
         max_filtered_residual=peak,
         residual_rms=rms,
-        joints=tuple(j + 1 for j in joints),
+        joints=tuple(joints),
         margin=float(margin),
         residual_cutoff=float(residual_cutoff),
         initial_gain=k0,
         initial_natural_frequency=w0,
         initial_damping=d0,
-        source=recording.source,
-        payload=rest_payload(uniform, antenna),
+        source=where if named else None,
+        payload=payload,
     )
+
+
+@dataclass(frozen=True)
+class _FreeMotion:
+    """One free-motion recording, checked and uniformly sampled, with its moved joints (0-based)
+    and the payload its rest reads."""
+
+    recording: Recording
+    joints: list[int]
+    payload: Payload
+
+
+def _free_motion(recording: Recording, antenna: Antenna) -> _FreeMotion:
+    where = recording.source or "<recording>"
+    uniform = resample_uniform(recording) if recording.sampling.irregular else recording
+    problem = units_problem(uniform, antenna)
+    if problem is not None:
+        raise IdentificationError(f"{where}: {problem}")
+    span = np.ptp(uniform.theta, axis=0)
+    joints = [j for j in (0, 1) if span[j] > MIN_MOTION]
+    return _FreeMotion(uniform, joints, rest_payload(uniform, antenna))
+
+
+def combined_payload(payloads: Sequence[Payload]) -> Payload:
+    """The payloads of several rests as one: their inverse-variance mean mass (kg), with the
+    smallest of their standard deviations (not the mean's, which would fall as more rests are
+    added: most of each is the tare's offset, which rests after one tare share), and the
+    samples summed; no samples when none read a rest."""
+    read = [p for p in payloads if p.samples > 1 and math.isfinite(p.std) and p.std > 0]
+    if not read:
+        return Payload(0.0, math.nan, 0)
+    weights = np.array([1.0 / p.std**2 for p in read])
+    mass = float(np.sum(weights * np.array([p.mass for p in read])) / np.sum(weights))
+    return Payload(mass, min(p.std for p in read), sum(p.samples for p in read))

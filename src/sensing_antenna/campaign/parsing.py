@@ -273,7 +273,9 @@ def _build(data: Mapping[str, Any], source: str, base_dir: Path | None) -> Campa
         raise CampaignSpecError("fast_bound", "must be true or false", source)
     try:
         free_step = FreeMotionStep(
-            identify=identify, duration=float(duration), case=str(free.get("case", "free"))
+            identify=identify,
+            duration=float(duration),
+            case=None if free.get("case") is None else str(free["case"]),
         )
         return CampaignSpec(
             name=name,

@@ -267,8 +267,9 @@ def _settings_lines(
         f"{obs.natural_frequency:.4g} rad/s, damping {obs.damping:.4g} 1/s, contact threshold "
         f"{obs.contact_threshold:.4g} N m"
         + (
-            " (identified on a simulated free motion of the device; used by the device's "
-            "controller and by the estimators)"
+            " (identified on simulated free sweeps of the device, "
+            + ", ".join(spec.free_motion_cases())
+            + "; used by the device's controller and by the estimators)"
             if spec.free_motion.identify
             else ""
         ),

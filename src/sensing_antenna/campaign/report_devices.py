@@ -196,7 +196,7 @@ def devices_section(
         return []
     first, second = both.labels[0], both.labels[1]
     identify = (
-        "its free-motion observer identified on a free motion of it, "
+        "its free-motion observer identified on free sweeps of it, "
         if spec.free_motion.identify
         else ""
     )

@@ -30,7 +30,7 @@ from sensing_antenna.simulator.device import (
     device_from_mapping,
     device_profile,
 )
-from sensing_antenna.simulator.scenario import duration_problem
+from sensing_antenna.simulator.scenario import FREE_CASES, duration_problem
 
 __all__ = [
     "CASES",
@@ -124,6 +124,10 @@ class CampaignSpecError(FieldError):
     """A campaign spec field is missing, unknown or invalid; the message names file and field."""
 
 
+#: The free sweep of the joint each manoeuvre sweeps (``simulator.Scenario`` cases).
+FREE_SWEEP = {"azimuthal": "free", "vertical": "free-vertical"}
+
+
 @dataclass(frozen=True)
 class FreeMotionStep:
     """Optional first step: simulate a free motion and identify the Eq. 15 observer from it.
@@ -134,17 +138,31 @@ class FreeMotionStep:
         Whether to run the step.
     duration : float
         Length of the simulated free motion (s).
-    case : str
-        Manoeuvre of the free motion (``"free"``).
+    case : str or None
+        Manoeuvre of the one free motion (``"free"``, ``"free-vertical"``); None: a free sweep
+        of each joint the campaign's cases sweep (Section 5.2's "free movements").
     """
 
     identify: bool = False
     duration: float = 4.0
-    case: str = "free"
+    case: str | None = None
+
+    def free_cases(self, cases: Sequence[str]) -> tuple[str, ...]:
+        """The simulator cases of the free motions for a campaign sweeping ``cases``."""
+        if self.case is not None:
+            return (self.case,)
+        swept = [FREE_SWEEP[case] for case in FREE_SWEEP if case in cases]
+        return tuple(swept) or ("free",)
 
     def __post_init__(self) -> None:
         if problem := duration_problem(self.duration):
             raise CampaignSpecError("free_motion.duration", problem)
+        if self.case is not None and self.case not in FREE_CASES:
+            raise CampaignSpecError(
+                "free_motion.case",
+                f"must be one of {', '.join(FREE_CASES)} (a sweep with nothing to touch), "
+                f"got {self.case!r}",
+            )
 
 
 @dataclass(frozen=True)
@@ -667,6 +685,14 @@ class CampaignSpec:
         """Every case of the campaign, main runs first, then any only the sweep has."""
         return self.cases + tuple(c for c in self.sweep_cases if c not in self.cases)
 
+    def free_motion_cases(self) -> tuple[str, ...]:
+        """The simulator cases of the free-motion step: ``free_motion.case``, else a free sweep
+        of each joint the campaign sweeps (its runs, the noise sweep's, the calibration's)."""
+        swept = self.all_cases
+        if self.calibration.enabled and self.calibration.case not in swept:
+            swept = (*swept, self.calibration.case)
+        return self.free_motion.free_cases(swept)
+
     def load_antenna(self) -> Antenna:
         """The campaign's nominal model; checks every contact point lies on its link."""
         antenna = load_antenna(self.antenna)
@@ -768,12 +794,16 @@ class CampaignSpec:
     def preparation_fingerprint(self) -> str:
         """Short hash of what the preparation steps (identification, calibration) depend on.
 
-        The antennas, the scenario, the base seed and the two steps' sections; not the runs'
-        contact points, repeats or methods.
+        The antennas, the scenario, the base seed, the two steps' sections and, when the
+        observer is identified, the free motions' cases; not the runs' contact points, repeats
+        or methods.
         """
         data = self.to_dict()
         keys = ("antenna", "scenario", "base_seed", "free_motion", "device", "calibration")
-        text = json.dumps({k: data[k] for k in keys}, sort_keys=True)
+        hashed = {k: data[k] for k in keys}
+        if self.free_motion.identify:
+            hashed["free_motion_cases"] = list(self.free_motion_cases())
+        text = json.dumps(hashed, sort_keys=True)
         return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
     def fingerprint(self) -> str:

@@ -20,7 +20,7 @@ import time
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
-from sensing_antenna.antenna import Antenna
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
 from sensing_antenna.calibration.observer import ObserverFit
 from sensing_antenna.campaign.progress import Progress
@@ -186,22 +186,38 @@ def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:
 def identify_observer(
     device: Antenna, spec: CampaignSpec, model: Antenna | None = None
 ) -> ObserverFit:
-    """Simulate a free motion on ``device`` and identify the observer of Eq. 15 from it, and
-    the payload its rest reads.
+    """Simulate free motions on ``device`` and identify the observer of Eq. 15 from them, and
+    the payload their rests read.
 
-    The free motion uses the spec's scenario settings and its own seed (stream 1 of the base
-    seed). The identification starts from what the engineer knows, ``model`` (default: the
-    device itself), and sees only the recording.
+    The free motions (``CampaignSpec.free_motion_cases``: by default a free sweep of each
+    swept joint) use the spec's scenario settings and their own seeds (stream 1 of the base seed).
+    The identification starts from what the engineer knows, ``model`` (default: the device
+    itself), and sees only the recordings.
     """
     from sensing_antenna.calibration.observer import identify_free_motion
     from sensing_antenna.simulator import simulate
 
-    seed = derive_seed(spec.base_seed, 0, FREE_MOTION_STREAM)
-    extra = with_device(spec, spec.scenario, seed, device.link.length)
-    extra["duration"] = spec.free_motion.duration
-    scenario = make_scenario(spec.free_motion.case, None, seed, extra)
-    recording = simulate(device, scenario)
-    return identify_free_motion(recording.without_ground_truth(), model or device)
+    recordings = []
+    for k, case in enumerate(spec.free_motion_cases()):
+        seed = derive_seed(spec.base_seed, k, FREE_MOTION_STREAM)
+        extra = with_device(spec, spec.scenario, seed, device.link.length)
+        extra["duration"] = spec.free_motion.duration
+        scenario = make_scenario(case, None, seed, extra)
+        recordings.append(simulate(device, scenario).without_ground_truth())
+    return identify_free_motion(recordings, model or device)
+
+
+def knowing_weight(device: Antenna, identified: Antenna) -> Antenna:
+    """The simulated device whose controller knows what identification found: the observer and
+    threshold of ``identified`` (the model after identification, its payload applied), and the
+    weight's moment about the head that model gives, carried as the device's
+    ``link.weight_tip_mass`` (which the detector and the push monitor remove and the
+    simulator's physics does not read)."""
+    link = device.link
+    # (m_b / 2 + m_t) l g of the device's link equal to the identified model's moment
+    tip = identified.link.weight_moment / (STANDARD_GRAVITY * link.length) - 0.5 * link.mass
+    weighed = dataclasses.replace(link, weight_tip_mass=max(0.0, tip))
+    return dataclasses.replace(device, observer=identified.observer, link=weighed)
 
 
 def calibrate_on_device(
@@ -280,8 +296,8 @@ def check_scenario(spec: CampaignSpec) -> None:
     Raises
     ------
     CampaignSpecError
-        Naming the spec file and ``scenario.<field>`` (``free_motion.duration`` for the free
-        motion's length), on the first scenario that is not valid.
+        Naming the spec file and ``scenario.<field>`` (``free_motion.duration`` and
+        ``free_motion.case`` for the free motions'), on the first scenario that is not valid.
     """
     from sensing_antenna.simulator.scenario import ScenarioError
 
@@ -296,7 +312,8 @@ def check_scenario(spec: CampaignSpec) -> None:
             make_scenario(case, x_c, 0, dict(extra))
         except ScenarioError as exc:
             field = exc.field_name
-            name = "free_motion.duration" if prefix and field == "duration" else f"scenario.{field}"
+            free = prefix and field in ("duration", "case")
+            name = f"free_motion.{field}" if free else f"scenario.{field}"
             raise CampaignSpecError(
                 name, prefix + str(exc).split(": ", 1)[-1], spec.source or None
             ) from exc
@@ -309,7 +326,8 @@ def check_scenario(spec: CampaignSpec) -> None:
         check(run.case, run.contact_point, run.scenario, "")
     if spec.free_motion.identify:
         extra = {**spec.scenario, "duration": spec.free_motion.duration}
-        check(spec.free_motion.case, None, extra, "the free motion: ")
+        for case in spec.free_motion_cases():
+            check(case, None, extra, "the free motion: ")
     if spec.calibration.enabled:
         for _, case, x_c, _ in calibration_runs(spec):
             check(case, x_c, spec.scenario, "")
@@ -331,15 +349,17 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
     model = spec.load_antenna()
     device = spec.load_device()
     if spec.free_motion.identify:
+        cases = spec.free_motion_cases()
         progress.line(
-            f"preparation: identifying the free-motion observer (Eq. 15) on a "
-            f"{spec.free_motion.duration:g} s free motion of the device"
+            f"preparation: identifying the free-motion observer (Eq. 15) on {len(cases)} "
+            f"free sweep{'s' if len(cases) > 1 else ''} of {spec.free_motion.duration:g} s of "
+            "the device"
         )
         fit = identify_observer(device, spec, model)
-        device = dataclasses.replace(device, observer=fit.observer)
         model = dataclasses.replace(model, observer=fit.observer)
         if fit.payload is not None:
             model = fit.payload.apply(model)
+        device = knowing_weight(device, model)
     calibration = None
     if spec.calibration.enabled:
         progress.line(

@@ -29,19 +29,23 @@ def register(subparsers: Any) -> None:
     """Add ``antenna identify``."""
     parser = subparsers.add_parser(
         "identify",
-        help="fit the free-motion observer (Eq. 15) and contact threshold to a free motion",
+        help="fit the free-motion observer (Eq. 15) and contact threshold to free motions",
         description=(
-            "Fits gain, natural frequency and damping of the free-motion observer to a recording "
-            "of free motion (no contact), sets the contact threshold to the largest filtered "
-            "residual times the margin (Section 5.2), and writes the starting antenna with that "
-            "observer as a new antenna: named after --out (or --name), its description saying "
-            "which recording it was identified from. With --servo it also fits each moving "
-            "joint's Eq. 1 (inertia J, viscous friction v, Coulomb torque) to the motor commands "
-            "the recording carries (columns u1, u2, V), writes them into the motors, and prints "
+            "Fits gain, natural frequency and damping of the free-motion observer to recordings "
+            "of free motion (no contact; give one of each joint the head sweeps, e.g. a free "
+            "azimuthal and a free vertical sweep), sets the contact threshold to the largest "
+            "filtered residual over them times the margin (Section 5.2), and writes the "
+            "starting antenna with that observer as a new antenna: named after --out (or "
+            "--name), its description saying which recordings it was identified from. With "
+            "--servo (one recording) it also fits each moving joint's Eq. 1 (inertia J, viscous "
+            "friction v, Coulomb torque) to the motor commands the recording carries (columns "
+            "u1, u2, V), writes them into the motors, and prints "
             "the servo's gains designed from them (Section 4.1, Eq. 14)."
         ),
     )
-    parser.add_argument("recording", type=Path, help="free-motion recording CSV")
+    parser.add_argument(
+        "recordings", type=Path, nargs="+", metavar="recording", help="free-motion recording CSV"
+    )
     parser.add_argument("--out", type=Path, required=True, help="antenna TOML to write")
     parser.add_argument(
         "--name", default=None, help="name of the new antenna (default: the stem of --out)"
@@ -87,17 +91,19 @@ def _run(args: argparse.Namespace) -> int:
     if args.servo_pole is not None and not args.servo:
         raise ControlConfigError("--servo-pole: the gains are designed with --servo only")
     pole = DEFAULT_SERVO_POLE if args.servo_pole is None else args.servo_pole
+    if args.servo and len(args.recordings) > 1:
+        raise ControlConfigError("--servo: the motors are fitted to one recording; give one")
     antenna = load_antenna(args.antenna)
-    recording = read_recording(args.recording)
-    motor_fit = identify_motors(recording, antenna) if args.servo else None
-    fit = identify_free_motion(recording, antenna, margin=args.margin)
+    recordings = [read_recording(path) for path in args.recordings]
+    motor_fit = identify_motors(recordings[0], antenna) if args.servo else None
+    fit = identify_free_motion(recordings, antenna, margin=args.margin)
     what = "the free-motion observer and contact threshold"
     if motor_fit is not None:
         fitted = " and ".join(str(j.joint) for j in motor_fit.joints)
         what += f" and the motors of joint{'s' if len(motor_fit.joints) > 1 else ''} {fitted}"
     description = (
         f"antenna {printable(antenna.name)} with {what} identified by antenna identify from "
-        f"{printable(str(args.recording))}"
+        f"{printable(', '.join(str(path) for path in args.recordings))}"
     )
     start = antenna if motor_fit is None else motor_fit.antenna(antenna)
     identified = replace(start, name=name, description=description, observer=fit.observer)
@@ -116,26 +122,32 @@ def _run(args: argparse.Namespace) -> int:
         f"{fit.max_filtered_residual:.4g} N m), rms of the unfiltered fit residual "
         f"{fit.residual_rms:.3g} N m, joints used: {joints}"
     )
-    _print_payload(fit.payload, antenna.link.tip_mass, identified.link.tip_mass)
+    _print_payload(fit.payload, antenna.link, identified.link)
     if motor_fit is not None:
         _print_servo(motor_fit, antenna, pole)
     print(args.out)
     return 0
 
 
-def _print_payload(payload: Any, before: float, after: float) -> None:
-    """What the moment at rest said of weight at the tip, and the tip mass written."""
+def _print_payload(payload: Any, before: Any, after: Any) -> None:
+    """What the moments at rest said of weight at the tip, and the field written: the links
+    ``before`` and ``after`` identification (``link.weight_tip_mass`` where the link has one,
+    ``Payload.apply``)."""
     if payload is None or payload.samples == 0:
-        print("payload: not read (the recording does not start at rest)")
+        print("payload: not read (no recording starts at rest)")
         return
     read = (
         f"payload: the moment at rest reads {1e3 * payload.mass:+.4g} g +- "
         f"{1e3 * payload.std:.2g} g at the tip beyond the antenna's weight"
     )
+    field = "weight_tip_mass" if before.weight_tip_mass is not None else "tip_mass"
     if payload.significant:
-        print(f"{read}: link.tip_mass = {after:.4g} kg (was {before:.4g} kg)")
+        print(
+            f"{read}: link.{field} = {after.weighed_tip_mass:.4g} kg "
+            f"(was {before.weighed_tip_mass:.4g} kg)"
+        )
     else:
-        print(f"{read}: not significant, link.tip_mass kept at {before:.4g} kg")
+        print(f"{read}: not significant, link.{field} kept at {before.weighed_tip_mass:.4g} kg")
 
 
 def _print_servo(motor_fit: Any, antenna: Any, pole: float) -> None:

@@ -10,7 +10,8 @@ from typing import Any
 from sensing_antenna.cli.arguments import ArgumentError, check_contact_points, number
 
 #: The cases of :class:`sensing_antenna.simulator.Scenario`, in the order ``--help`` lists them.
-CASES = ("azimuthal", "vertical", "free")
+CASES = ("azimuthal", "vertical", "free", "free-vertical")
+_FREE = ("free", "free-vertical")
 
 #: The scenario's fields the command fills from its flags: an error about one names the flag.
 FLAGS = {
@@ -32,8 +33,9 @@ def register(subparsers: Any) -> None:
         help="simulate one contact manoeuvre and write a recording (CSV)",
         description=(
             "Simulates the 2-DOF head of the antenna sweeping its flexible link (azimuthal: "
-            "theta1 into a vertical post; vertical: theta2 up into a horizontal bar; free: the "
-            "azimuthal sweep with nothing to touch, a recording for antenna identify), with "
+            "theta1 into a vertical post; vertical: theta2 up into a horizontal bar; free and "
+            "free-vertical: those sweeps with nothing to touch, recordings for antenna "
+            "identify), with "
             "sensor noise, the motors stopped by the push criterion, and writes the recording "
             "with its ground truth as metadata. --xc is the nominal contact point, where the "
             "undeflected link meets the obstacle; the link bends as it pushes, and the line "
@@ -47,7 +49,7 @@ def register(subparsers: Any) -> None:
         default=None,
         metavar="M",
         help="nominal contact point x_c, in (0, l] (m): required for the azimuthal and vertical "
-        "cases, not given for free",
+        "cases, not given for the free ones",
     )
     parser.add_argument(
         "--seed",
@@ -63,6 +65,13 @@ def register(subparsers: Any) -> None:
         "(EstimatorConfig.spectrum_window) after the stop: the command warns when it is short",
     )
     parser.add_argument("--noise", type=float, default=1.0, help="sensor noise scale (0: none)")
+    parser.add_argument(
+        "--direction",
+        choices=("up", "down"),
+        default="up",
+        help="the swept joint turns up (towards +Y^m, or lifting the link towards +Z^m) or "
+        "down (towards -Y^m, or lowering the link onto a bar below it)",
+    )
     parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument(
         "--device",
@@ -124,6 +133,7 @@ def _run(args: argparse.Namespace) -> int:
         device=device,
         link_model=args.link,
         push=push,
+        sweep_direction=1 if args.direction == "up" else -1,
     )
     recording = simulate(antenna, scenario, record_commands=args.commands)
     write_recording(recording, args.out)
@@ -190,9 +200,9 @@ def load_device(value: str, seed: int, length: float) -> Any:
 def _check_contact_point(case: str, x_c: float | None, link: Any) -> None:
     """--xc against --case and the link: every message names --xc and the range (0, l] m."""
     allowed = f"a contact point in (0, {link.length:g}] m"
-    if case == "free" and x_c is not None:
-        raise ArgumentError("--xc", "not used with --case free (the link touches nothing)")
-    if case != "free" and x_c is None:
+    if case in _FREE and x_c is not None:
+        raise ArgumentError("--xc", f"not used with --case {case} (the link touches nothing)")
+    if case not in _FREE and x_c is None:
         raise ArgumentError("--xc", f"required with --case {case}: {allowed}")
     if x_c is not None:
         check_contact_points(link, [x_c])

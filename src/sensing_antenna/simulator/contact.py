@@ -1,8 +1,12 @@
 """Rigid obstacles in the absolute frame, their placement from x_c, and the contact geometry.
 
-An obstacle is a cylinder (post: near-vertical axis; bar: near-horizontal axis) or a plane. The
-gap between a point p and the obstacle is ``distance(p, axis) - R`` for a cylinder and
-``(p - P0) . n`` for a plane; the outward normal points from the obstacle towards p. The contact
+An obstacle is a cylinder (post: near-vertical axis; bar: near-horizontal axis), a ball or a
+plane. The gap between a point p and the obstacle is ``distance(p, axis) - R`` for a cylinder,
+``|p - C| - R`` for a ball of centre C and ``(p - P0) . n`` for a plane; the outward normal
+points from the obstacle towards p. A cylinder is curved across the link only: a link pushed
+along its axis (a post leaning out of the sweep's plane beyond the friction cone) slides along
+it as along a straight edge. A ball is curved both ways, as a rounded object is: sliding, the
+contact stays on its surface. The contact
 law itself (penalty normal force with damping, tangential stick spring, Coulomb slip) lives in the
 time loop of :mod:`sensing_antenna.simulator.integrator`; the functions here are shared with it.
 
@@ -26,6 +30,7 @@ from numpy.typing import NDArray
 from sensing_antenna.simulator.scenario import ScenarioError
 
 __all__ = [
+    "BALL",
     "CYLINDER",
     "NO_OBSTACLE",
     "PLANE",
@@ -37,6 +42,7 @@ __all__ = [
 NO_OBSTACLE = 0
 CYLINDER = 1
 PLANE = 2
+BALL = 3
 
 #: Angle (rad) between a plane's normal and the sweep direction, in the sweep plane: the link
 #: meets the plane at 90 degrees minus this, so the plane clears the rest of the link by
@@ -58,13 +64,14 @@ class Obstacle:
     Attributes
     ----------
     kind : str
-        "post", "bar" or "plane".
+        "post", "bar", "ball" or "plane".
     point : tuple of 3 float
-        A point of the cylinder axis, or of the plane (m).
+        A point of the cylinder axis, the ball's centre, or a point of the plane (m).
     direction : tuple of 3 float
-        Unit axis of the cylinder, or unit outward normal of the plane.
+        Unit axis of the cylinder, unit outward normal of the plane, or of the ball at the
+        nominal touch.
     radius : float
-        Cylinder radius (m); 0 for a plane.
+        Cylinder or ball radius (m); 0 for a plane.
     """
 
     kind: str
@@ -74,7 +81,7 @@ class Obstacle:
 
     def as_array(self) -> NDArray[np.float64]:
         """Packed form for the compiled loop: [kind, point(3), direction(3), radius]."""
-        code = PLANE if self.kind == "plane" else CYLINDER
+        code = {"plane": PLANE, "ball": BALL}.get(self.kind, CYLINDER)
         return np.array([code, *self.point, *self.direction, self.radius], dtype=np.float64)
 
     def gap(self, point: NDArray[np.float64]) -> float:
@@ -84,6 +91,8 @@ class Obstacle:
         d = np.asarray(point, dtype=float) - p0
         if self.kind == "plane":
             return float(d @ a)
+        if self.kind == "ball":
+            return float(np.linalg.norm(d) - self.radius)
         perp = d - (d @ a) * a
         return float(np.linalg.norm(perp) - self.radius)
 
@@ -113,13 +122,14 @@ def place_obstacle(
     radius: float,
     tilt: float,
     sweep_joint: int,
+    direction: int = 1,
 ) -> Obstacle:
     """Place an obstacle that the sagged link touches at ``contact_point`` at ``theta_touch``.
 
     Parameters
     ----------
     kind : str
-        "post", "bar" or "plane".
+        "post", "bar", "ball" or "plane".
     contact_point : float
         x_c (m).
     length : float
@@ -129,12 +139,15 @@ def place_obstacle(
     sag, sag_slope : float
         Static gravity deflection w(x_c) (m) and slope w'(x_c) along Z^m at the touch angles.
     radius : float
-        Cylinder radius (m).
+        Cylinder or ball radius (m).
     tilt : float
         Misalignment (rad): post leans along the sweep; bar rolls about X^m; plane normal turns
-        out of the sweep plane.
+        out of the sweep plane; a ball's normal at the touch turns as the post's (azimuthal
+        sweep) or the bar's (vertical sweep) does.
     sweep_joint : int
         0 when theta1 sweeps (towards +Y^m), 1 when theta2 sweeps (towards +Z^m).
+    direction : {1, -1}
+        The sweep's sense: -1 turns the joint down, towards -Y^m or -Z^m.
 
     Returns
     -------
@@ -142,7 +155,7 @@ def place_obstacle(
     """
     frame = motor_frame(*theta_touch)
     xm, ym, zm = frame
-    ahead = ym if sweep_joint == 0 else zm
+    ahead = direction * (ym if sweep_joint == 0 else zm)
     aside = zm if sweep_joint == 0 else ym
     p_touch = contact_point * xm + sag * zm
     tangent = _unit(xm + sag_slope * zm)
@@ -161,12 +174,18 @@ def place_obstacle(
             + aside * math.tan(tilt)
         )
         return Obstacle("plane", tuple(p_touch), tuple(normal), 0.0)
-    if kind == "post":
-        axis = _unit(np.array([0.0, 0.0, 1.0]) * math.cos(tilt) + ym * math.sin(tilt))
+    post = kind == "post" or (kind == "ball" and sweep_joint == 0)
+    # the post leans along the sweep, the bar rolls so that the normal turns towards +Y^m:
+    # either way the normal's part out of the sweep's plane is +sin(tilt) whatever the sense
+    if post:
+        axis = _unit(np.array([0.0, 0.0, 1.0]) * math.cos(tilt) + direction * ym * math.sin(tilt))
     else:
-        axis = _unit(ym * math.cos(tilt) + zm * math.sin(tilt))
+        axis = _unit(ym * math.cos(tilt) + direction * zm * math.sin(tilt))
     normal = _unit(np.cross(tangent, axis))
     if normal @ ahead > 0:
         normal = -normal
     centre = p_touch - radius * normal
+    if kind == "ball":
+        # the cylinder's normal at the touch: the ball of that radius tangent to the link there
+        return Obstacle(kind, tuple(centre), tuple(normal), radius)
     return Obstacle(kind, tuple(centre), tuple(axis), radius)

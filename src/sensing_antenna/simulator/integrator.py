@@ -119,6 +119,10 @@ _NORMAL_FORCE = 13
 _ANCHOR_ARC = 14  # nonlinear link: the abscissa of the material point stuck at the contact
 CONTACT_STATE_SIZE = 15
 
+#: Half-bandwidth of the link's mass matrix: a Hermite element couples the 4 consecutive
+#: coordinates of its two nodes (``link.build_link_model``).
+_MASS_BAND = 3
+
 #: Columns of the ground-truth array written by :func:`run_samples`: true angles (2), contact
 #: flag, x_c, contact point in the absolute frame (3), normal force, motor voltages (2), contact
 #: force on the link in the motor frame (3), stick flag.
@@ -212,6 +216,8 @@ def _gap(
     px = x * frame[0, 0] + v * frame[1, 0] + w * frame[2, 0] - obst[1]
     py = x * frame[0, 1] + v * frame[1, 1] + w * frame[2, 1] - obst[2]
     pz = x * frame[0, 2] + v * frame[1, 2] + w * frame[2, 2] - obst[3]
+    if obst[0] == 3.0:
+        return math.sqrt(px * px + py * py + pz * pz) - obst[7]
     dpar = px * obst[4] + py * obst[5] + pz * obst[6]
     if obst[0] == 2.0:
         return dpar
@@ -549,6 +555,7 @@ def sensor_wrench(
     X: NDArray[np.float64],
     A: NDArray[np.float64],
     n: int,
+    mass_m: NDArray[np.float64],
     mq: NDArray[np.float64],
     sq: NDArray[np.float64],
     par: NDArray[np.float64],
@@ -564,6 +571,19 @@ def sensor_wrench(
 
     From the momentum balance of the link: the head exerts ``F_h = int rho a dx - W - F_c`` and
     ``tau_h = int rho p x a dx - int p x rho g dx - p_c x F_c``; the sensor reads -F_h, -tau_h.
+
+    About X^m, with the deflected points p = (x, v, w) and the accelerations of the equations
+    of motion, ``a_y = v'' + cos(theta2) x theta1''`` and ``a_z = w'' + x theta2''``, the link's
+    inertial moment is ``int rho (v a_z - w a_y) dx = q_v.M q_w'' - q_w.M q_v''
+    + theta2'' s.q_v - cos(theta2) theta1'' s.q_w``: exact with the consistent mass matrix
+    ``mass_m`` (M, banded, tip mass included) and ``s = int rho x N dx`` (``sq``), since v and w
+    lie in the Hermite space. Gravity's moment is ``g_z int rho v dx`` (g_y = 0 in the motor
+    frame). The elastic forces of either link model have no moment about X^m (the bending
+    energy and the shortening do not change when the deflection turns about X^m), so the
+    balance gives what a link that does not twist transmits: no torque about X^m, bar the
+    Rayleigh damping's moment. The nonlinear link's arc length s stands for x in the rigid
+    accelerations, as in its equations of motion; its axial shortening moves mass along X^m
+    only and leaves the moment about X^m unchanged.
     """
     g = par[_P_GRAVITY]
     s1 = par[_P_S1] - axial_sums[0]
@@ -582,6 +602,16 @@ def sensor_wrench(
     saw = sq @ A[n : 2 * n]
     mv = mq @ X[0:n]
     mw = mq @ X[n : 2 * n]
+    # int rho (v a_z - w a_y) dx about X^m: q_v.M q_w'' - q_w.M q_v'' over M's band (no
+    # temporaries), plus the rigid accelerations' part
+    spin = 0.0
+    for i in range(n):
+        row_w = acc2 * sq[i]
+        row_v = c2 * acc1 * sq[i]
+        for j in range(max(i - _MASS_BAND, 0), min(i + _MASS_BAND + 1, n)):
+            row_w += mass_m[i, j] * A[n + j]
+            row_v += mass_m[i, j] * A[j]
+        spin += X[i] * row_w - X[n + i] * row_v
     fcx = cs[_FORCE_M]
     fcy = cs[_FORCE_M + 1]
     fcz = cs[_FORCE_M + 2]
@@ -591,7 +621,7 @@ def sensor_wrench(
     fhx = -mass * gx - fcx - axial_sums[1]
     fhy = c2 * acc1 * s1 + mav - fcy
     fhz = acc2 * s1 + maw - mass * gz - fcz
-    thx = -(gz * mv) - (py * fcz - pz * fcy)
+    thx = spin - (gz * mv) - (py * fcz - pz * fcy)
     thy = -(acc2 * s2m + saw) - (gx * mw - gz * s1) - (pz * fcx - px * fcz)
     thz = c2 * acc1 * s2m + sav - (-gx * mv) - (px * fcy - py * fcx)
     out[0] = -fhx
@@ -695,7 +725,7 @@ def run_samples(
             for i in range(n_el + 1):
                 axial_sums[0] += node_mass[i] * axial1[i, 0]
                 axial_sums[1] += node_mass[i] * axial1[i, 1]
-        sensor_wrench(X, A, n, mq, sq, par, cs, wrench, axial_sums)
+        sensor_wrench(X, A, n, mass_m, mq, sq, par, cs, wrench, axial_sums)
         for i in range(6):
             meas_wrench[k, i] = wrench[i] + bias[i] + noise[k, i]
         quantum = par[_P_ENCODER]
@@ -829,6 +859,8 @@ def run_samples(
                     d = pc - obst[1:4]
                     if obst[0] == 2.0:
                         nvec[:] = obst[4:7]
+                    elif obst[0] == 3.0:
+                        nvec[:] = d / math.sqrt(d @ d)
                     else:
                         dpar = d @ obst[4:7]
                         nvec[:] = d - dpar * obst[4:7]

@@ -32,7 +32,7 @@ from sensing_antenna.simulator.integrator import (
 from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
 from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
 from sensing_antenna.simulator.nonlinear_link import node_masses, static_equilibrium
-from sensing_antenna.simulator.scenario import Scenario, ScenarioError
+from sensing_antenna.simulator.scenario import FREE_CASES, Scenario, ScenarioError
 
 __all__ = [
     "FINAL_AVERAGE_TIME",
@@ -342,24 +342,22 @@ def simulate_detailed(
     n = model.n_dof
 
     # --- reference trajectory (Section 4 step 1) -----------------------------------------------
-    sweep_joint = 1 if scenario.case == "vertical" else 0
+    sweep_joint = 1 if scenario.case in ("vertical", "free-vertical") else 0
     servo = [design_servo(m, scenario.servo_pole, ts) for m in antenna.motors]
-    lag = 2.0 * servo[sweep_joint].time_constant * scenario.sweep_speed
-    travel = float(
-        ramp_displacement(
-            np.array(scenario.approach_time), scenario.sweep_speed, scenario.accel_time
-        )
-    )
+    # the swept joint's signed speed: up (+1) or down (-1)
+    speed = scenario.sweep_direction * scenario.sweep_speed
+    lag = 2.0 * servo[sweep_joint].time_constant * speed
+    travel = float(ramp_displacement(np.array(scenario.approach_time), speed, scenario.accel_time))
     theta_touch = (0.0, 0.0)
     start = [0.0, 0.0]
     start[sweep_joint] = theta_touch[sweep_joint] - travel + lag
     reference = np.empty((n_samples, 2))
     reference[:, 1 - sweep_joint] = start[1 - sweep_joint]
-    stop_after = scenario.approach_time if scenario.case == "free" else None
+    stop_after = scenario.approach_time if scenario.case in FREE_CASES else None
     reference[:, sweep_joint] = sweep_reference(
         t,
         start[sweep_joint],
-        scenario.sweep_speed,
+        speed,
         scenario.accel_time,
         scenario.start_time,
         stop_after,
@@ -416,6 +414,7 @@ def simulate_detailed(
             scenario.obstacle_radius,
             scenario.obstacle_tilt,
             sweep_joint,
+            scenario.sweep_direction,
         )
         obst_array = obstacle.as_array()
 
@@ -500,7 +499,7 @@ def simulate_detailed(
             record(k0, k1)
 
     stop_index: int | None = None
-    if scenario.case != "free":
+    if scenario.case not in FREE_CASES:
         rule = _default_stop_rule(antenna, scenario.push) if stop_rule is None else stop_rule
         rule.reset()
         for k in range(n_samples):

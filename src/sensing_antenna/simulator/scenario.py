@@ -16,6 +16,7 @@ from sensing_antenna.simulator.device import DeviceImperfections
 __all__ = [
     "ATI_NANO17_RESOLUTION",
     "CASES",
+    "FREE_CASES",
     "LINK_MODELS",
     "MAX_DURATION",
     "MAX_ELEMENTS",
@@ -28,8 +29,11 @@ __all__ = [
     "duration_problem",
 ]
 
-CASES = ("azimuthal", "vertical", "free")
-OBSTACLE_KINDS = ("post", "bar", "plane")
+CASES = ("azimuthal", "vertical", "free", "free-vertical")
+#: The cases with nothing to touch: the azimuthal sweep and the vertical one, each run past its
+#: nominal touch and brought to rest.
+FREE_CASES = ("free", "free-vertical")
+OBSTACLE_KINDS = ("post", "bar", "ball", "plane")
 #: The link's mechanics: "linear" (Euler-Bernoulli about the undeformed line, Assumption 1) or
 #: "nonlinear" (geometrically exact inextensible rod, ``simulator.nonlinear_link``).
 LINK_MODELS = ("linear", "nonlinear")
@@ -169,12 +173,13 @@ class Scenario:
 
     Parameters
     ----------
-    case : {"azimuthal", "vertical", "free"}
+    case : {"azimuthal", "vertical", "free", "free-vertical"}
         Azimuthal: theta1 sweeps (theta2 = 0) into a vertical post. Vertical: theta2 sweeps up,
-        against gravity, into a horizontal bar. Free: the azimuthal sweep with no obstacle.
+        against gravity, into a horizontal bar. Free: the azimuthal sweep with no obstacle;
+        free-vertical: the vertical one.
     contact_point : float or None
         x_c (m) at which the gravity-sagged, otherwise undeflected link would touch the obstacle.
-        Required unless ``case == "free"``.
+        Required unless the case is free (:data:`FREE_CASES`).
     seed : int
         Seed of the one ``numpy.random.Generator`` that draws every random quantity.
     duration : float
@@ -188,20 +193,25 @@ class Scenario:
         Coulomb friction coefficient mu between link and obstacle.
     push : object or None
         The push criterion (``detection.push.PushCriterion``); None uses its default.
-    obstacle : {"post", "bar", "plane"} or None
+    obstacle : {"post", "bar", "ball", "plane"} or None
         Obstacle kind; None: post for the azimuthal case, bar for the vertical case.
     obstacle_radius : float
-        Radius of the post or bar (m).
+        Radius of the post, bar or ball (m).
     obstacle_tilt : float
         Misalignment of the obstacle (rad): the post leans along the sweep, the bar rolls about
-        the link, the plane turns its normal out of the sweep plane. Gives the contact normal a
-        component out of the sweep plane.
+        the link, the plane turns its normal out of the sweep plane, the ball's normal at the
+        touch turns as the post's (azimuthal) or the bar's (vertical). Gives the contact normal
+        a component out of the sweep plane.
     contact_stiffness : float
         Normal penalty stiffness (N/m); also the tangential stick stiffness.
     contact_damping : float
         Normal and tangential contact damping (N s/m).
     sweep_speed : float
         Cruise speed of the swept joint (rad/s).
+    sweep_direction : {1, -1}
+        1: the swept joint turns up, the link moving towards +Y^m (azimuthal) or +Z^m (vertical:
+        lifted against its weight); -1: down, towards -Y^m or -Z^m (vertical: lowered with its
+        weight onto a bar below it). The obstacle lies ahead of the sweep either way.
     accel_time : float or None
         Duration of the raised-cosine speed ramp from rest to cruise (s). None: the vibration-free
         ramp, 1.5 periods of the link's first free mode (3 pi / omega_1,free; 0.59 s for the paper
@@ -240,7 +250,7 @@ class Scenario:
         Free text copied into the recording.
     """
 
-    case: Literal["azimuthal", "vertical", "free"] = "azimuthal"
+    case: Literal["azimuthal", "vertical", "free", "free-vertical"] = "azimuthal"
     contact_point: float | None = None
     seed: int = 0
     duration: float = 3.5
@@ -248,12 +258,13 @@ class Scenario:
     damping_ratio: float = 0.005
     friction_coefficient: float = 0.6
     push: Any = None
-    obstacle: Literal["post", "bar", "plane"] | None = None
+    obstacle: Literal["post", "bar", "ball", "plane"] | None = None
     obstacle_radius: float = 0.01
     obstacle_tilt: float = 0.02
     contact_stiffness: float = 1.0e4
     contact_damping: float = 0.5
     sweep_speed: float = 0.3
+    sweep_direction: int = 1
     accel_time: float | None = None
     start_time: float = 0.1
     approach_time: float | None = None
@@ -271,9 +282,9 @@ class Scenario:
             raise ScenarioError(
                 "case", f"must be one of {', '.join(CASES)}, got {format_value(self.case)}"
             )
-        if self.case == "free":
+        if self.case in FREE_CASES:
             if self.contact_point is not None:
-                raise ScenarioError("contact_point", "must be None for the free case")
+                raise ScenarioError("contact_point", f"must be None for the {self.case} case")
         else:
             if self.contact_point is None:
                 raise ScenarioError("contact_point", f"is required for the {self.case} case")
@@ -299,6 +310,11 @@ class Scenario:
             raise ScenarioError("damping_ratio", "must be < 1 (light structural damping)")
         for name in ("obstacle_radius", "contact_stiffness", "sweep_speed"):
             _finite(name, getattr(self, name), 0.0, strict=True)
+        if isinstance(self.sweep_direction, bool) or self.sweep_direction not in (1, -1):
+            raise ScenarioError(
+                "sweep_direction",
+                f"must be 1 (up) or -1 (down), got {format_value(self.sweep_direction)}",
+            )
         if self.accel_time is not None:
             _finite("accel_time", self.accel_time, 0.0, strict=True)
         _finite("start_time", self.start_time, 0.0)
@@ -383,8 +399,8 @@ class Scenario:
 
     @property
     def obstacle_kind(self) -> str | None:
-        """The obstacle actually used: None for the free case."""
-        if self.case == "free":
+        """The obstacle actually used: None for the free cases."""
+        if self.case in FREE_CASES:
             return None
         if self.obstacle is not None:
             return self.obstacle
