@@ -195,7 +195,7 @@ def test_a_sweep_towards_minus_y_records_the_mirror_image() -> None:
     assert abs(mirrored.signed_distance(point[None, :])[0]) < 5e-3
 
 
-def test_a_sweep_keeps_its_direction_and_refuses_a_downward_vertical_one() -> None:
+def test_a_sweep_keeps_its_direction() -> None:
     back = Sweep(1, "azimuthal", 0.1, -0.4, 0.5, direction=-1)
     assert (back.origin, back.finish) == (0.5, -0.4)
     assert Sweep.from_dict(back.to_dict()) == back
@@ -203,10 +203,33 @@ def test_a_sweep_keeps_its_direction_and_refuses_a_downward_vertical_one() -> No
     legacy = {k: v for k, v in back.to_dict().items() if k != "direction"}
     assert Sweep.from_dict(legacy).direction == 1
     assert "-Y" in back.label and "+Y" in Sweep(1, "azimuthal", 0.1, -0.4, 0.5).label
-    with pytest.raises(ValueError, match="upwards only"):
-        Sweep(0, "vertical", 0.0, -0.2, 0.2, direction=-1)
+    assert "-Z" in Sweep(0, "vertical", 0.0, -0.2, 0.2, direction=-1).label
     with pytest.raises(ValueError, match="direction must be"):
         Sweep(0, "azimuthal", 0.0, -0.2, 0.2, direction=0)
+
+
+def test_a_vertical_sweep_down_touches_the_top_of_a_ball() -> None:
+    # The link lowered onto a ball below it, its weight helping the push: no mirror image of a
+    # sweep up, simulated as such. It touches the ball's top (the normal along +Z^m), the
+    # recording's theta2 falls through the touch, its true contact point lies on the ball, and
+    # the estimate's point too, within the 5 mm of the mirrored sweep's test above
+    ball = primitive_object("ball", "sphere", [0.05], [0.6, 0.0, -0.12])
+    sweep = Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1)
+    outcome = simulate_sweep(DEVICE, _scene(ball), sweep, seed=4)
+    assert outcome.outcome == "touch", outcome.reason
+    assert outcome.touch is not None and outcome.recording is not None
+    assert outcome.frame is not None
+    z_m = outcome.frame.rotation[:, 2]
+    assert outcome.touch.normal @ z_m > 0.99
+    recording = outcome.recording
+    assert recording.theta[-1, 1] < recording.theta[0, 1] - 0.1
+    truth = np.array(json.loads(recording.metadata["true_contact_point"]))
+    assert abs(ball.signed_distance(outcome.frame.point_to_world(truth)[None, :])[0]) < 3e-3
+    # the estimators with the device's own T as a calibration would give it
+    result = estimate(recording.without_ground_truth(), DEVICE.self_calibrated(), "paper")
+    assert result.status.value == "ok", result.reason
+    point = outcome.frame.point_to_world(result.contact_point)
+    assert abs(ball.signed_distance(point[None, :])[0]) < 5e-3
 
 
 def test_a_turned_base_turns_the_touch() -> None:

@@ -25,6 +25,8 @@ A sweep towards -Y^m is simulated as its mirror image (the reflection y -> -y of
 recording's frame, gravity unchanged: the same physics): the simulator runs the +Y^m sweep into
 the reflected obstacle, and the recording written is the reflection of that one
 (``simulator.mirror``), what a device sweeping towards -Y^m records, in the same proper frame R.
+A vertical sweep down (towards -Z^m) has no such image, its weight helping the push: the
+simulator runs it as such (``Scenario.sweep_direction = -1``), into a bar below the link.
 
 The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
 friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated
@@ -130,7 +132,8 @@ def touch_scenario(
     rotation = base.rotation @ motor_frame(*touch.angles).T
     frame = BasePose(rotation, base.position)
     # in the recording's frame (X, Y, Z = X^m, Y^m, Z^m), reflected for a sweep towards -Y^m
-    reflect = np.diag([1.0, float(sweep.direction), 1.0])
+    mirrored = sweep.case == "azimuthal" and sweep.direction == -1
+    reflect = np.diag([1.0, -1.0 if mirrored else 1.0, 1.0])
     normal = reflect @ rotation.T @ touch.normal
     tangent = reflect @ rotation.T @ touch.tangent
     if sweep.case == "azimuthal":
@@ -140,9 +143,11 @@ def touch_scenario(
         axis = np.array([0.0, math.sin(tilt), math.cos(tilt)])
         kind = "post"
     else:
-        # the bar's normal is -Z cos(t) + Y sin(t), its axis Y cos(t) + Z sin(t)
-        tilt = math.atan2(normal[1], -normal[2])
-        axis = np.array([0.0, math.cos(tilt), math.sin(tilt)])
+        # the bar's normal is -d Z cos(t) + Y sin(t), its axis Y cos(t) + d Z sin(t), d the
+        # sweep's direction (simulator.contact.place_obstacle)
+        d = float(sweep.direction)
+        tilt = math.atan2(normal[1], -d * normal[2])
+        axis = np.array([0.0, math.cos(tilt), d * math.sin(tilt)])
         kind = "bar"
     # the sagged link crosses that axis at an angle phi off the perpendicular; a cylinder of
     # radius R curves by cos(phi)^2 / R along it (Euler), so R = R_along cos(phi)^2
@@ -159,13 +164,16 @@ def touch_scenario(
     # beyond the simulator's largest tilt the obstacle is turned by that much: the same
     # touched point, a push held as if the surface faced the sweep more
     tilt = max(-MAX_TILT, min(MAX_TILT, tilt))
-    towards = "" if sweep.direction == 1 else " towards -Y"
+    towards = ""
+    if sweep.direction == -1:
+        towards = " towards -Y" if sweep.case == "azimuthal" else " down"
     description = (
         f"scene {scene.name}: {sweep.case} sweep{towards} touching {touch.object_name}"
         f" at x_c = {touch.x_c:.4f} m"
     )
     scenario = Scenario(
         case=sweep.case,
+        sweep_direction=-1 if sweep.case == "vertical" and sweep.direction == -1 else 1,
         contact_point=touch.x_c,
         seed=seed,
         obstacle=kind,  # type: ignore[arg-type]
@@ -228,7 +236,7 @@ def simulate_sweep(
     except ValueError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     recording = simulate(device, scenario)
-    if sweep.direction == -1:
+    if sweep.case == "azimuthal" and sweep.direction == -1:
         recording = mirror_recording(recording)
     metadata = dict(recording.metadata)
     metadata["base_pose"] = frame.to_json()

@@ -3,10 +3,10 @@
 A sweep turns one joint across its range [``start``, ``end``] with the other held at ``fixed``,
 from one of the scene's base poses: azimuthal, theta1 across with theta2 = ``fixed``, from
 ``start`` up to ``end`` (``direction`` +1: the link moves towards +Y^m) or from ``end`` down to
-``start`` (-1: towards -Y^m); vertical, theta2 up from ``start`` with theta1 = ``fixed`` (towards
-+Z^m; +1 only: a downward sweep, gravity helping the push, is not a case of the simulator). A
-sweeping line first touches a convex object on the side it comes from, so the two directions of
-an azimuthal sweep see opposite sides of it.
+``start`` (-1: towards -Y^m); vertical, theta2 with theta1 = ``fixed``, up from ``start``
+(+1: towards +Z^m, lifting the link) or down from ``end`` (-1: towards -Z^m, lowering it onto
+what lies below, its weight helping the push). A sweeping line first touches a convex object on
+the side it comes from, so the two directions of a sweep see opposite sides of it.
 
 The link at angles (theta1, theta2) is the straight line x X^m sagged by its own weight,
 p(x) = x X^m + g w_1(x) Z^m in the absolute frame (recording format), w_1 the static deflection
@@ -60,7 +60,7 @@ class Sweep:
         The swept joint's range (rad), start < end.
     direction : {1, -1}
         +1: from ``start`` to ``end`` (towards +Y^m, or +Z^m for a vertical sweep); -1: from
-        ``end`` to ``start`` (towards -Y^m; azimuthal sweeps only).
+        ``end`` to ``start`` (towards -Y^m, or -Z^m).
     """
 
     base: int
@@ -77,8 +77,6 @@ class Sweep:
             raise ValueError("a sweep's range runs from start to a larger end")
         if self.direction not in SWEEP_DIRECTIONS:
             raise ValueError(f"direction must be +1 or -1, got {self.direction!r}")
-        if self.case == "vertical" and self.direction != 1:
-            raise ValueError("a vertical sweep runs upwards only (direction +1)")
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Sweep:
@@ -121,9 +119,9 @@ class Sweep:
     def label(self) -> str:
         """Short text for progress lines."""
         held = "elevation" if self.case == "azimuthal" else "azimuth"
-        towards = {("azimuthal", 1): "+Y", ("azimuthal", -1): "-Y", ("vertical", 1): "+Z"}
+        axis = "Y" if self.case == "azimuthal" else "Z"
         return (
-            f"base {self.base} {self.case} towards {towards[(self.case, self.direction)]}"
+            f"base {self.base} {self.case} towards {'+' if self.direction == 1 else '-'}{axis}"
             f" at {held} {self.fixed:+.3f} rad"
         )
 
