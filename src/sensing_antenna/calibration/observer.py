@@ -71,7 +71,6 @@ __all__ = [
     "IdentificationError",
     "ObserverFit",
     "Payload",
-    "combined_payload",
     "identify_free_motion",
     "initial_guess",
     "rest_payload",
@@ -388,8 +387,9 @@ def identify_free_motion(
     -------
     ObserverFit
         The threshold is ``margin`` times the largest filtered residual over all recordings; the
-        payload is the rests' inverse-variance mean (:func:`combined_payload`). The observer's
-        torques and the threshold's residuals are those of the link with that payload: the
+        payload is the rests' inverse-variance mean, with the smallest of their standard
+        deviations (a shared tare does not average out). The observer's torques and the
+        threshold's residuals are those of the link with that payload: the
         weight the sensor read, which a detector using the identified antenna removes.
 
     Raises
@@ -407,24 +407,27 @@ def identify_free_motion(
         raise IdentificationError("recordings: none given; a free-motion recording is needed")
     if not (math.isfinite(margin) and margin >= 1.0):
         raise IdentificationError(f"margin: must be a number >= 1, got {margin!r}")
-    named = [r.source for r in given if r.source]
-    where = ", ".join(named) if named else "<recording>"
-    if len(given) > 1 and len(named) < len(given):
-        where = ", ".join(r.source or f"<recording {k + 1}>" for k, r in enumerate(given))
+    named = any(r.source for r in given)
+    where = ", ".join(r.source or f"<recording {k + 1}>" for k, r in enumerate(given))
+    if len(given) == 1:
+        where = given[0].source or "<recording>"
     moves = [_free_motion(recording, antenna) for recording in given]
-    payload = combined_payload([move.payload for move in moves])
+    payload = _combined_payload([move.payload for move in moves])
     weighed = payload.apply(antenna)
-    moved = [move for move in moves if move.joints]
-    if not moved:
+    first = next((move for move in moves if move.joints), None)
+    if first is None:
         raise IdentificationError(
             f"{where}: columns 'theta1', 'theta2': no joint moved by more than {MIN_MOTION:g} rad;"
             " a free-motion recording is needed"
         )
-    period = moved[0].recording.sample_period
-    for k, move in enumerate(moves):
-        if move.recording.sample_period != period:
-            # the observer runs at one period: every recording on its grid
-            moves[k] = replace(move, recording=resample_uniform(move.recording, period))
+    # the observer runs at one period: every recording on the first moving one's grid
+    period = first.recording.sample_period
+    moves = [
+        move
+        if move.recording.sample_period == period
+        else replace(move, recording=resample_uniform(move.recording, period))
+        for move in moves
+    ]
     moved = [move for move in moves if move.joints]
     data = [
         (move.recording.theta[:, move.joints], _targets(move.recording, weighed)[:, move.joints])
@@ -493,7 +496,7 @@ def _free_motion(recording: Recording, antenna: Antenna) -> _FreeMotion:
     return _FreeMotion(uniform, joints, rest_payload(uniform, antenna))
 
 
-def combined_payload(payloads: Sequence[Payload]) -> Payload:
+def _combined_payload(payloads: Sequence[Payload]) -> Payload:
     """The payloads of several rests as one: their inverse-variance mean mass (kg), with the
     smallest of their standard deviations (not the mean's, which would fall as more rests are
     added: most of each is the tare's offset, which rests after one tare share), and the

@@ -30,7 +30,7 @@ from sensing_antenna.simulator.device import (
     device_from_mapping,
     device_profile,
 )
-from sensing_antenna.simulator.scenario import FREE_CASES, duration_problem
+from sensing_antenna.simulator.scenario import FREE_CASE_OF, FREE_CASES, duration_problem
 
 __all__ = [
     "CASES",
@@ -124,10 +124,6 @@ class CampaignSpecError(FieldError):
     """A campaign spec field is missing, unknown or invalid; the message names file and field."""
 
 
-#: The free sweep of the joint each manoeuvre sweeps (``simulator.Scenario`` cases).
-FREE_SWEEP = {"azimuthal": "free", "vertical": "free-vertical"}
-
-
 @dataclass(frozen=True)
 class FreeMotionStep:
     """Optional first step: simulate a free motion and identify the Eq. 15 observer from it.
@@ -151,7 +147,7 @@ class FreeMotionStep:
         """The simulator cases of the free motions for a campaign sweeping ``cases``."""
         if self.case is not None:
             return (self.case,)
-        swept = [FREE_SWEEP[case] for case in FREE_SWEEP if case in cases]
+        swept = [free for case, free in FREE_CASE_OF.items() if case in cases]
         return tuple(swept) or ("free",)
 
     def __post_init__(self) -> None:

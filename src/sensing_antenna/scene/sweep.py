@@ -75,22 +75,19 @@ class Sweep:
             raise ValueError(f"case must be one of {', '.join(SWEEP_CASES)}, got {self.case!r}")
         if not self.start < self.end:
             raise ValueError("a sweep's range runs from start to a larger end")
-        if self.direction not in SWEEP_DIRECTIONS:
+        if isinstance(self.direction, bool) or self.direction not in SWEEP_DIRECTIONS:
             raise ValueError(f"direction must be +1 or -1, got {self.direction!r}")
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Sweep:
         """The sweep of :meth:`to_dict`'s fields (``direction`` +1 when absent)."""
-        direction = data.get("direction", 1)
-        if isinstance(direction, bool) or direction not in SWEEP_DIRECTIONS:
-            raise ValueError(f"direction must be +1 or -1, got {direction!r}")
         return cls(
             int(data["base"]),
             data["case"],
             float(data["fixed"]),
             float(data["start"]),
             float(data["end"]),
-            int(direction),
+            data.get("direction", 1),
         )
 
     @property

@@ -342,7 +342,7 @@ def simulate_detailed(
     n = model.n_dof
 
     # --- reference trajectory (Section 4 step 1) -----------------------------------------------
-    sweep_joint = 1 if scenario.case in ("vertical", "free-vertical") else 0
+    sweep_joint = scenario.swept_joint
     servo = [design_servo(m, scenario.servo_pole, ts) for m in antenna.motors]
     # the swept joint's signed speed: up (+1) or down (-1)
     speed = scenario.sweep_direction * scenario.sweep_speed

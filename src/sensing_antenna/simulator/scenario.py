@@ -17,6 +17,7 @@ __all__ = [
     "ATI_NANO17_RESOLUTION",
     "CASES",
     "FREE_CASES",
+    "FREE_CASE_OF",
     "LINK_MODELS",
     "MAX_DURATION",
     "MAX_ELEMENTS",
@@ -30,9 +31,10 @@ __all__ = [
 ]
 
 CASES = ("azimuthal", "vertical", "free", "free-vertical")
-#: The cases with nothing to touch: the azimuthal sweep and the vertical one, each run past its
-#: nominal touch and brought to rest.
-FREE_CASES = ("free", "free-vertical")
+#: The case with nothing to touch that sweeps the joint of each contact case: the azimuthal sweep
+#: and the vertical one, each run past its nominal touch and brought to rest.
+FREE_CASE_OF = {"azimuthal": "free", "vertical": "free-vertical"}
+FREE_CASES = tuple(FREE_CASE_OF.values())
 OBSTACLE_KINDS = ("post", "bar", "ball", "plane")
 #: The link's mechanics: "linear" (Euler-Bernoulli about the undeformed line, Assumption 1) or
 #: "nonlinear" (geometrically exact inextensible rod, ``simulator.nonlinear_link``).
@@ -396,6 +398,11 @@ class Scenario:
                 f"must be >= accel_time ({accel:.3g} s), got {format_value(approach)}",
             )
         return replace(self, accel_time=accel, approach_time=approach)
+
+    @property
+    def swept_joint(self) -> int:
+        """Index of the joint the manoeuvre sweeps: 0 (theta1) or 1 (theta2)."""
+        return 1 if self.case in ("vertical", FREE_CASE_OF["vertical"]) else 0
 
     @property
     def obstacle_kind(self) -> str | None:
