@@ -391,3 +391,25 @@ def test_facing_region_is_the_angles_a_ball_subtends() -> None:
     _, raised = facing_region(ball.mesh.vertices, base, sagged, margin=0.0)
     rise = -float(np.interp(distance, sagged.abscissae, sagged.sag())) / distance
     assert raised[0] - elevation[0] == pytest.approx(rise, rel=0.15)
+
+
+def test_a_rounded_surface_is_simulated_as_a_ball_a_straight_one_as_a_cylinder() -> None:
+    # A sphere curves by 1 / R both along the link and across it: its equivalent obstacle is a
+    # ball of its radius, on which a link sliding across stays on the surface. A vertical
+    # cylinder met by a level azimuthal sweep curves along the link only: a post.
+    from sensing_antenna.scene.simulate import touch_scenario
+
+    shape = LinkShape(DEVICE.link, gravity=0.0)
+    sweep = Sweep(0, "azimuthal", 0.0, -0.5, 0.8)
+    ball = _scene(primitive_object("ball", "sphere", [0.07], [0.6, 0.2, 0.03]))
+    touch = first_touch(ball, sweep, shape).touch
+    assert touch is not None
+    assert touch.across_radius == pytest.approx(0.07, rel=1e-3)
+    scenario, _ = touch_scenario(touch, sweep, ball)
+    assert scenario.obstacle == "ball"
+    assert scenario.obstacle_radius == pytest.approx(0.07, rel=1e-3)
+    post = _scene(primitive_object("post", "cylinder", [0.03, 0.5], [0.6, 0.2, 0.0]))
+    touch = first_touch(post, sweep, shape).touch
+    assert touch is not None and touch.across_radius > 1.0
+    scenario, _ = touch_scenario(touch, sweep, post)
+    assert scenario.obstacle == "post"

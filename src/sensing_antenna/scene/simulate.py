@@ -58,6 +58,7 @@ from sensing_antenna.simulator.mirror import mirror_recording
 from sensing_antenna.simulator.run import device_link, minimum_contact_point
 
 __all__ = [
+    "BALL_RATIO",
     "GLANCING_ANGLE",
     "MAX_TILT",
     "OUTCOMES",
@@ -65,6 +66,11 @@ __all__ = [
     "simulate_sweep",
     "touch_scenario",
 ]
+
+#: A surface whose radius across the link is at most this many times its radius along it is
+#: curved both ways, and its equivalent obstacle a ball (a sphere, a capsule's caps); beyond,
+#: a cylinder, straight across (a cylinder's side, a box's edge).
+BALL_RATIO = 2.0
 
 #: Largest angle of the surface's normal out of the sweep's direction (rad) the simulator's
 #: obstacles are turned by: just inside the scenario's limit (``Scenario.obstacle_tilt`` must
@@ -153,6 +159,11 @@ def touch_scenario(
     # radius R curves by cos(phi)^2 / R along it (Euler), so R = R_along cos(phi)^2
     along_axis = float(axis @ tangent)
     radius = touch.radius * (1.0 - along_axis**2)
+    if touch.across_radius <= BALL_RATIO * touch.radius:
+        # curved across the link too: a ball of the radius along it, on which a link sliding
+        # across stays on the surface (a cylinder is straight that way)
+        kind = "ball"
+        radius = touch.radius
     if touch.tip:
         kind = "plane"
         tilt = 0.0

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -83,6 +84,8 @@ class Touch:
         The link's unit tangent there (world frame).
     radius : float
         The surface's local radius of curvature along the link (m), capped.
+    across_radius : float
+        Its radius of curvature across the link, in the tangent plane (m), capped.
     tip : bool
         True when the link's tip touches (the surface is not tangent to the link).
     object_name : str
@@ -97,6 +100,7 @@ class Touch:
     normal: FloatArray
     tangent: FloatArray
     radius: float
+    across_radius: float
     tip: bool
     object_name: str
 
@@ -111,6 +115,7 @@ class Touch:
             "normal": self.normal.tolist(),
             "tangent": self.tangent.tolist(),
             "radius": self.radius,
+            "across_radius": self.across_radius,
             "tip": self.tip,
             "object": self.object_name,
         }
@@ -199,6 +204,17 @@ def _nearest(
     return float(found.x), float(found.fun), False
 
 
+def _bend_radius(touched: Any, point: FloatArray, direction: FloatArray) -> float:
+    """The surface's radius of curvature (m) at ``point`` along the unit tangent ``direction``:
+    a circle of radius R curves away by d = sqrt(R^2 + h^2) - R at h = CURVATURE_PROBE to
+    either side, capped to [MIN_RADIUS, MAX_RADIUS]."""
+    h = CURVATURE_PROBE
+    probes = point + np.outer([h, -h], direction)
+    bend = float(np.mean(touched.signed_distance(probes)))
+    radius = (h * h - bend * bend) / (2.0 * bend) if bend > 0 else MAX_RADIUS
+    return min(max(radius, MIN_RADIUS), MAX_RADIUS)
+
+
 def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angle: float) -> Touch:
     theta = sweep.angles(angle)
     x_c, _, tip = _nearest(scene, shape, sweep, base, angle)
@@ -208,18 +224,13 @@ def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angl
     normal = touched.normal(link_point)
     distance = min(per_object)
     surface_point = link_point - distance * normal
-    radius = MAX_RADIUS
+    radius = across_radius = MAX_RADIUS
     tangent = shape.tangent_at(x_c, theta, base)
     if not tip:
         along = tangent - (tangent @ normal) * normal
         along /= np.linalg.norm(along)
-        h = CURVATURE_PROBE
-        probes = surface_point + np.outer([h, -h], along)
-        bend = float(np.mean(touched.signed_distance(probes)))
-        if bend > 0:
-            # a circle of radius R curves away by d = sqrt(R^2 + h^2) - R
-            radius = (h * h - bend * bend) / (2.0 * bend)
-        radius = min(max(radius, MIN_RADIUS), MAX_RADIUS)
+        radius = _bend_radius(touched, surface_point, along)
+        across_radius = _bend_radius(touched, surface_point, np.cross(normal, along))
     return Touch(
         angle=angle,
         angles=theta,
@@ -229,6 +240,7 @@ def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angl
         normal=normal,
         tangent=tangent,
         radius=float(radius) if math.isfinite(radius) else MAX_RADIUS,
+        across_radius=float(across_radius) if math.isfinite(across_radius) else MAX_RADIUS,
         tip=tip,
         object_name=touched.name,
     )
