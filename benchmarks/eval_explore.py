@@ -26,15 +26,20 @@ and copied into each run's directory), with the simulator's geometrically exact 
 (``--link linear``: the small-deflection one). Per scene and strategy: the contacts (sweeps that
 touched), the points used (status ok), the RMS and largest distance of the points to the true
 surface, the RMS of the fitted surface to the true one near the points (mesh vertices within
-1 cm of a contact) after a quarter, half, three quarters and all of the sweeps, a Chamfer
-distance between that surface and the true surface's patch near the points, the recognition
+1 cm of a contact), a Chamfer distance between that surface and the true surface's patch near
+the points, and the whole object's RMS distance to the fitted surface with the fraction of its
+area within 5 mm of it (a map that never touched a side is far from it there), after every 3
+sweeps and at the end; the contacts each strategy needs to bring the whole object's RMS to 5 mm
+(the two strategies compared scene by scene on it); the recognition
 (right, abstained, confidently wrong) and the size error of the true class's fit, the
 Mahalanobis distance of each ``ok`` point's true contact point under its covariance, and the
 simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.json`` after
-every exploration (a run stopped early keeps the scenes it finished).
+every exploration (a run stopped early keeps the scenes it finished). ``--keep DIR`` keeps each
+exploration's directory there (its recordings and points, for ``antenna map``).
 
 Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 4] [--bases 3]
-[--strategies grid next-best] [--method fast] [--link nonlinear] [--seed 0] [--out FILE]``.
+[--strategies grid next-best] [--method fast] [--link nonlinear] [--seed 0] [--out FILE]
+[--keep DIR]``.
 """
 
 from __future__ import annotations
@@ -78,6 +83,14 @@ CLASSES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
 STRATEGIES = ("grid", "next-best")
 #: The surface is scored where the points are: mesh vertices within this of a contact (m).
 NEAR = 0.01
+#: The whole object is scored on every this-many-th of the 20,000 samples of its surface.
+OBJECT_STRIDE = 5
+#: A part of the true surface within this of the fitted one is covered by the map (m).
+COVERED = 0.005
+#: The whole-object RMS the strategies are compared at: the contacts each needs to reach it (m).
+TARGET_RMS = 0.005
+#: Checkpoints along each exploration: after every this-many sweeps, and at the end.
+CHECK_EVERY = 3
 #: Widening of the explored region beyond the object's angular extent (rad).
 MARGIN = 0.05
 #: Elevation (rad) of the line of sight from the second base to the object's centre (from
@@ -188,9 +201,12 @@ def size_error(name: str, fitted: dict[str, float], truth: dict[str, Any]) -> fl
 
 
 def surface_scores(points: list[Any], mesh: trimesh.Trimesh) -> dict[str, float]:
-    """RMS of the fitted surface near the points to the true one, and a Chamfer distance."""
+    """RMS of the fitted surface near the points to the true one, a Chamfer distance, and the
+    whole object's RMS distance to the fitted surface and the fraction of its area within
+    :data:`COVERED` of it (the parts never touched count by how far the map is from them)."""
     surface = fit_surface(points)
-    nan = {"surface_rms_m": math.nan, "chamfer_m": math.nan}
+    nan = {"surface_rms_m": math.nan, "chamfer_m": math.nan, "object_rms_m": math.nan}
+    nan["covered"] = 0.0
     if surface is None:
         return nan
     zero_level, _ = surface.mesh()
@@ -209,7 +225,14 @@ def surface_scores(points: list[Any], mesh: trimesh.Trimesh) -> dict[str, float]
     if len(true_patch):
         there = cKDTree(near).query(true_patch)[0]
         chamfer = 0.5 * (float(np.mean(distance)) + float(np.mean(there)))
-    return {"surface_rms_m": float(np.sqrt(np.mean(distance**2))), "chamfer_m": chamfer}
+    # the whole true surface, sampled uniformly by area, to the fitted zero level
+    _, whole, _ = trimesh.proximity.closest_point(zero_level, samples[::OBJECT_STRIDE])
+    return {
+        "surface_rms_m": float(np.sqrt(np.mean(distance**2))),
+        "chamfer_m": chamfer,
+        "object_rms_m": float(np.sqrt(np.mean(whole**2))),
+        "covered": float(np.mean(whole <= COVERED)),
+    }
 
 
 def mahalanobis(points: list[Any]) -> list[float]:
@@ -262,8 +285,8 @@ def run(
         row["point_rms_m"] = row["point_max_m"] = math.nan
     row["mahalanobis"] = mahalanobis(used)
     progress = []
-    for fraction in (0.25, 0.5, 0.75, 1.0):
-        k = max(1, round(fraction * len(manoeuvres)))
+    checkpoints = sorted({*range(CHECK_EVERY, len(manoeuvres), CHECK_EVERY), len(manoeuvres)})
+    for k in checkpoints:
         points = [m.point for m in manoeuvres[:k] if m.point is not None]
         scores = surface_scores(points, mesh)
         progress.append(
@@ -275,7 +298,9 @@ def run(
             }
         )
     row["progress"] = progress
-    row.update({k: v for k, v in progress[-1].items() if k.endswith("_m")})
+    row.update({k: v for k, v in progress[-1].items() if k.endswith("_m") or k == "covered"})
+    reached = [c["contacts"] for c in progress if c["object_rms_m"] <= TARGET_RMS]
+    row["contacts_to_target"] = reached[0] if reached else None
     recognition = result.contact_map.recognition
     if recognition is None:
         row.update(
@@ -317,6 +342,14 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "mean_point_max_m": mean("point_max_m"),
         "mean_surface_rms_m": mean("surface_rms_m"),
         "mean_chamfer_m": mean("chamfer_m"),
+        "mean_object_rms_m": mean("object_rms_m"),
+        "mean_covered": mean("covered"),
+        "reached_target": sum(r["contacts_to_target"] is not None for r in rows),
+        "mean_contacts_to_target": float(
+            np.mean([r["contacts_to_target"] for r in rows if r["contacts_to_target"] is not None])
+        )
+        if any(r["contacts_to_target"] is not None for r in rows)
+        else None,
         "recognised": len(recognised),
         "right": sum(r["right"] for r in rows),
         "abstained": sum(r["abstained"] for r in rows),
@@ -337,6 +370,30 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def print_target(rows: list[dict[str, Any]]) -> None:
+    """The contacts each strategy needs for a whole-object RMS of 5 mm, scene by scene."""
+    need: dict[int, dict[str, int | None]] = {}
+    for r in rows:
+        need.setdefault(r["scene"], {})[r["strategy"]] = r["contacts_to_target"]
+    pairs = [
+        (n["grid"], n["next-best"])
+        for n in need.values()
+        if n.get("grid") is not None and n.get("next-best") is not None
+    ]
+    print(f"\nwhole-object RMS <= {1000 * TARGET_RMS:.0f} mm:")
+    for strategy in STRATEGIES:
+        got = [n[strategy] for n in need.values() if strategy in n]
+        reached = [c for c in got if c is not None]
+        print(f"  {strategy:9s} reached in {len(reached)} of {len(got)} scenes")
+    if pairs:
+        ratio = [b / a for a, b in pairs if a]
+        print(
+            f"  both reached it in {len(pairs)} scenes: next-best / grid contacts,"
+            f" median {np.median(ratio):.2f}, at most half in"
+            f" {sum(x <= 0.5 for x in ratio)}"
+        )
+
+
 def write_results(
     args: argparse.Namespace,
     rows: list[dict[str, Any]],
@@ -354,7 +411,8 @@ def write_results(
         json.dumps(
             {
                 "date": datetime.date.today().isoformat(),
-                "settings": vars(args) | {"out": str(args.out)},
+                "settings": vars(args)
+                | {"out": str(args.out), "keep": args.keep and str(args.keep)},
                 "total": totals,
                 "scenes": rows,
             },
@@ -390,12 +448,16 @@ def main() -> None:
         help="the other bases' distance from the object (m; 0: the first base's)",
     )
     parser.add_argument("--out", type=Path, default=RESULTS)
+    parser.add_argument(
+        "--keep", type=Path, default=None, help="keep each exploration's directory in this one"
+    )
     args = parser.parse_args()
     device = paper_antenna()
     shape = LinkShape(device.link)
     rows: list[dict[str, Any]] = []
     with tempfile.TemporaryDirectory(prefix="eval-explore-") as folder:
-        workdir = Path(folder)
+        workdir = Path(folder) if args.keep is None else args.keep
+        workdir.mkdir(parents=True, exist_ok=True)
         calibrated = workdir / "calibrated.toml"
         calibrated.write_text(antenna_to_toml(calibrate_device(device, link=args.link)))
         for index in range(args.first, args.first + args.scenes):
@@ -445,6 +507,7 @@ def main() -> None:
             f" {mm(s['mean_chamfer_m']):>5s} mm {s['right']:5d} {s['abstained']:5d}"
             f" {s['confident_wrong']:5d} {s['median_mahalanobis'] or math.nan:6.2f}"
         )
+    print_target(rows)
     write_results(args, rows, totals)
     print(f"\nwrote {args.out}")
 

@@ -160,14 +160,19 @@ def test_a_sweep_towards_minus_y_touches_the_other_tangent_line() -> None:
 
 def test_a_sweep_towards_minus_y_records_the_mirror_image() -> None:
     # the ball reflected in the head's X-Z plane and swept towards -Y^m: the same physics
-    # reflected (gravity along Z is unchanged), so the recording is the +Y sweep's with theta1,
-    # fy, tx, tz negated, in a proper frame that places its true point on the ball, and the
-    # estimate's point lies on the ball as the +Y sweep's does on its own
+    # reflected (gravity along Z is unchanged), so without noise the recording is the +Y
+    # sweep's with theta1, fy, tx, tz negated, in a proper frame that places its true point on
+    # the ball, and the estimate's point lies on the ball as the +Y sweep's does on its own
     ball = primitive_object("ball", "sphere", [0.05], [0.6, 0.1, -0.02])
     mirrored = primitive_object("ball", "sphere", [0.05], [0.6, -0.1, -0.02])
-    forward = simulate_sweep(DEVICE, _scene(ball), Sweep(0, "azimuthal", 0.0, -0.6, 0.6), seed=2)
+    forward = simulate_sweep(
+        DEVICE, _scene(ball), Sweep(0, "azimuthal", 0.0, -0.6, 0.6), noise_scale=0.0
+    )
     backward = simulate_sweep(
-        DEVICE, _scene(mirrored), Sweep(0, "azimuthal", 0.0, -0.6, 0.6, direction=-1), seed=2
+        DEVICE,
+        _scene(mirrored),
+        Sweep(0, "azimuthal", 0.0, -0.6, 0.6, direction=-1),
+        noise_scale=0.0,
     )
     assert forward.recording is not None and backward.recording is not None
     assert backward.frame is not None and forward.touch is not None
@@ -177,21 +182,28 @@ def test_a_sweep_towards_minus_y_records_the_mirror_image() -> None:
     np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
     assert np.linalg.det(rotation) == pytest.approx(1.0, abs=1e-12)
     a, b = forward.recording, backward.recording
-    # the swept joint turns the other way: theta1 falls through the touch
+    # the swept joint turns the other way: theta1 falls through the touch; the two touches'
+    # geometry agrees to the first touch's tolerance, hence not to the bit
     assert b.theta[-1, 0] < b.theta[0, 0]
-    np.testing.assert_allclose(b.theta * [-1, 1], a.theta, atol=1e-9)
-    np.testing.assert_allclose(b.force * [1, -1, 1], a.force, atol=1e-9)
-    np.testing.assert_allclose(b.torque * [-1, 1, -1], a.torque, atol=1e-9)
+    np.testing.assert_allclose(b.theta * [-1, 1], a.theta, atol=1e-7)
+    np.testing.assert_allclose(b.force * [1, -1, 1], a.force, atol=1e-6)
+    np.testing.assert_allclose(b.torque * [-1, 1, -1], a.torque, atol=1e-6)
     truth = np.array(json.loads(b.metadata["true_contact_point"]))
     on_world = backward.frame.point_to_world(truth)
     assert abs(mirrored.signed_distance(on_world[None, :])[0]) < 3e-3
     ahead = estimate(a.without_ground_truth(), DEVICE, "paper")
     back = estimate(b.without_ground_truth(), DEVICE, "paper")
     assert back.status is ahead.status
-    np.testing.assert_allclose(back.contact_point * [1, -1, 1], ahead.contact_point, atol=1e-6)
-    # the link lies tangent to the ball there: a point 1 cm along it (the paper's typical
-    # error) is 1 cm^2 / 2R = 1 mm off the ball, the push's deflection a few mm more
-    point = backward.frame.point_to_world(back.contact_point)
+    np.testing.assert_allclose(back.contact_point * [1, -1, 1], ahead.contact_point, atol=1e-4)
+    # with the sensor's noise: the link lies tangent to the ball there, a point 1 cm along it
+    # (the paper's typical error) is 1 cm^2 / 2R = 1 mm off the ball, the push's deflection a
+    # few mm more
+    noisy = simulate_sweep(
+        DEVICE, _scene(mirrored), Sweep(0, "azimuthal", 0.0, -0.6, 0.6, direction=-1), seed=2
+    )
+    assert noisy.recording is not None and noisy.frame is not None
+    result = estimate(noisy.recording.without_ground_truth(), DEVICE, "paper")
+    point = noisy.frame.point_to_world(result.contact_point)
     assert abs(mirrored.signed_distance(point[None, :])[0]) < 5e-3
 
 

@@ -7,7 +7,10 @@ equivalent to the surface there, placed by the simulator from x_c as for any of 
 - a contact along the link: a cylinder tangent to the link at x_c whose axis is perpendicular
   to the link and to the surface's normal, of the surface's local radius along the link (a post
   for an azimuthal sweep, a bar for a vertical one), turned by the normal's angle out of the
-  sweep's plane (the scenario's ``obstacle_tilt``);
+  sweep's plane (the scenario's ``obstacle_tilt``); where the surface is curved both ways (its
+  radius across the link at most :data:`BALL_RATIO` times the one along it: a sphere, a
+  capsule's caps) a ball of the radius along the link instead, on which a link sliding across
+  stays on the surface;
 - a contact at the tip: the simulator's plane, touched by the tip (its normal is the
   simulator's, not the face's: the touched point is the same).
 
@@ -21,12 +24,9 @@ g cos(theta2) (the scene's link shape, ``scene.sweep.LinkShape``, sags as the si
 that the simulated contact lies on the touched surface), and a sweep at elevation theta2 is
 simulated in the plane tangent to its cone at the touch.
 
-A sweep towards -Y^m is simulated as its mirror image (the reflection y -> -y of the
-recording's frame, gravity unchanged: the same physics): the simulator runs the +Y^m sweep into
-the reflected obstacle, and the recording written is the reflection of that one
-(``simulator.mirror``), what a device sweeping towards -Y^m records, in the same proper frame R.
-A vertical sweep down (towards -Z^m) has no such image, its weight helping the push: the
-simulator runs it as such (``Scenario.sweep_direction = -1``), into a bar below the link.
+A sweep the other way (towards -Y^m, or a vertical sweep down) is simulated as such
+(``Scenario.sweep_direction = -1``): the obstacle lies on the other side of the link, and a
+vertical sweep down has the link's weight helping the push onto a bar below it.
 
 The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
 friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated
@@ -54,7 +54,6 @@ from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.scene.touch import SweepGeometry, Touch, first_touch
 from sensing_antenna.simulator import Scenario, simulate
 from sensing_antenna.simulator.contact import motor_frame
-from sensing_antenna.simulator.mirror import mirror_recording
 from sensing_antenna.simulator.run import device_link, minimum_contact_point
 
 __all__ = [
@@ -129,29 +128,26 @@ class SweepOutcome:
 def touch_scenario(
     touch: Touch, sweep: Sweep, scene: Scene, seed: int = 0, **scenario_fields: Any
 ) -> tuple[Scenario, BasePose]:
-    """The simulator's scenario for a touch and the recording's frame in the world; for a sweep
-    towards -Y^m the scenario of its mirror image (module docstring).
+    """The simulator's scenario for a touch and the recording's frame in the world (module
+    docstring).
 
     Raises ValueError with the reason when the touch is ``glancing``.
     """
     base = scene.bases[sweep.base]
     rotation = base.rotation @ motor_frame(*touch.angles).T
     frame = BasePose(rotation, base.position)
-    # in the recording's frame (X, Y, Z = X^m, Y^m, Z^m), reflected for a sweep towards -Y^m
-    mirrored = sweep.case == "azimuthal" and sweep.direction == -1
-    reflect = np.diag([1.0, -1.0 if mirrored else 1.0, 1.0])
-    normal = reflect @ rotation.T @ touch.normal
-    tangent = reflect @ rotation.T @ touch.tangent
+    # in the recording's frame (X, Y, Z = X^m, Y^m, Z^m); d the sweep's direction
+    normal = rotation.T @ touch.normal
+    tangent = rotation.T @ touch.tangent
+    d = float(sweep.direction)
     if sweep.case == "azimuthal":
-        # the post's normal is -Y cos(t) + Z sin(t), its axis Z cos(t) + Y sin(t)
+        # the post's normal is -d Y cos(t) + Z sin(t), its axis Z cos(t) + d Y sin(t)
         # (simulator.contact.place_obstacle)
-        tilt = math.atan2(normal[2], -normal[1])
-        axis = np.array([0.0, math.sin(tilt), math.cos(tilt)])
+        tilt = math.atan2(normal[2], -d * normal[1])
+        axis = np.array([0.0, d * math.sin(tilt), math.cos(tilt)])
         kind = "post"
     else:
-        # the bar's normal is -d Z cos(t) + Y sin(t), its axis Y cos(t) + d Z sin(t), d the
-        # sweep's direction (simulator.contact.place_obstacle)
-        d = float(sweep.direction)
+        # the bar's normal is -d Z cos(t) + Y sin(t), its axis Y cos(t) + d Z sin(t)
         tilt = math.atan2(normal[1], -d * normal[2])
         axis = np.array([0.0, math.cos(tilt), d * math.sin(tilt)])
         kind = "bar"
@@ -184,7 +180,7 @@ def touch_scenario(
     )
     scenario = Scenario(
         case=sweep.case,
-        sweep_direction=-1 if sweep.case == "vertical" and sweep.direction == -1 else 1,
+        sweep_direction=sweep.direction,
         contact_point=touch.x_c,
         seed=seed,
         obstacle=kind,  # type: ignore[arg-type]
@@ -247,8 +243,6 @@ def simulate_sweep(
     except ValueError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     recording = simulate(device, scenario)
-    if sweep.case == "azimuthal" and sweep.direction == -1:
-        recording = mirror_recording(recording)
     metadata = dict(recording.metadata)
     metadata["base_pose"] = frame.to_json()
     metadata["true_object"] = touch.object_name
