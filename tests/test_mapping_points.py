@@ -215,3 +215,32 @@ def test_a_fast_point_is_uncertain_along_its_measured_push_not_across_the_bendin
     # the sag's part: 0.1 x 2.1 cm at 0.5 m (docs/explore.md), well below rho y_c (3.7 mm at a
     # push of 7.5 %); with the push's direction unknown this would exceed rho y_c^2
     assert across @ point.covariance @ across < rho_y_c**2
+
+
+@pytest.mark.parametrize(
+    ("case", "centre"), [("azimuthal", [0.6, 0.09, 0.0]), ("vertical", [0.6, 0.0, 0.09])]
+)
+def test_the_link_is_tangent_to_the_ball_it_pushes(case: str, centre: list[float]) -> None:
+    # a round link pushed against a ball touches it where their surfaces are tangent: the
+    # point's link tangent is perpendicular to the ball's normal at the simulator's true
+    # contact, within three of its standard deviations, whereas the unbent link (the motor
+    # angles' X^m alone) is turned from it by the push's slope
+    from sensing_antenna.scene import Scene, Sweep, primitive_object, simulate_sweep
+    from sensing_antenna.scene.file import ExploreRegion
+
+    radius = 0.05
+    ball = primitive_object("ball", "sphere", [radius], centre)
+    scene = Scene("ball", (ball,), (BasePose.identity(),), ExploreRegion())
+    outcome = simulate_sweep(ANTENNA, scene, Sweep(0, case, 0.0, -0.5, 0.5), seed=1)
+    assert outcome.recording is not None and outcome.frame is not None
+    result = estimate(outcome.recording.without_ground_truth(), ANTENNA, "paper")
+    truth = np.array(json.loads(outcome.recording.metadata["true_contact_point"]))
+    point = contact_point_from_estimate(result, ANTENNA, outcome.frame, true_point_a=truth)
+    normal = point.true_point - np.array(centre)
+    normal /= np.linalg.norm(normal)
+    assert abs(point.tangent @ normal) < 3 * math.sin(point.tangent_std)
+    assert np.linalg.norm(point.tangent) == pytest.approx(1.0, abs=1e-12)
+    assert point.link_beyond == pytest.approx(ANTENNA.link.length - result.x_c, abs=1e-12)
+    theta = np.asarray(result.diagnostics["theta_at_t1"], dtype=float)
+    unbent = outcome.frame.rotation @ _axes(*theta)[0]
+    assert abs(unbent @ normal) > abs(point.tangent @ normal)

@@ -10,7 +10,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from sensing_antenna.mapping import UNDECIDED, fit_mesh, fit_primitive, recognise
-from sensing_antenna.mapping.recognition import shape_gap
+from sensing_antenna.mapping.recognition import LINE_STRETCH, LinkLines, shape_gap
 
 #: Noise of the synthetic points (m, isotropic 1 sigma): about the points' sigma across the link.
 NOISE = 0.001
@@ -155,3 +155,97 @@ def test_a_capsule_shrunk_to_a_sphere_is_the_same_shape() -> None:
     # out of the ball by about r (sqrt(2) - 1) for a cylinder as high as wide
     assert shape_gap(sphere, sphere) < 1e-3
     assert shape_gap(sphere, cylinder) > 5e-3
+
+
+def test_a_line_cutting_into_a_sphere_costs_its_depth() -> None:
+    # a line through a point of a sphere at an angle beta into it reaches R (1 - cos beta)
+    # deep at s = R sin beta along it (|p + s t - c| is least there); with beta chosen so that
+    # this is one of the sampled stretches (R sin beta = LINE_STRETCH / 2) the residual is that
+    # depth over the spread there; a tangent line costs nothing
+    radius, sigma, std = 0.05, 0.002, 0.02
+    beta = math.asin(0.5 * LINE_STRETCH / radius)
+    centre = np.array([0.6, 0.0, 0.0])
+    point = centre + radius * np.array([-1.0, 0.0, 0.0])
+    cutting = np.array([math.sin(beta), math.cos(beta), 0.0])
+    tangent = np.array([0.0, 1.0, 0.0])
+    lines = LinkLines(np.array([cutting, tangent]), [std, std], [0.6, 0.6], [0.3, 0.3])
+
+    def distance(q: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(q - centre, axis=1) - radius
+
+    got = lines.residuals(distance, np.array([point, point]), np.array([sigma, sigma]))
+    depth = radius * (1 - math.cos(beta))
+    spread = math.hypot(sigma, 0.5 * LINE_STRETCH * std)
+    assert got[0] == pytest.approx(-depth / spread, rel=1e-9)
+    assert got[1] == 0.0
+
+
+def _first_touch(
+    mesh: trimesh.Trimesh, pivot: np.ndarray, ahead: np.ndarray, across: np.ndarray
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Where a ray from ``pivot`` turning from ahead - across towards ``ahead`` (unit vectors)
+    first meets ``mesh`` (bisection on trimesh's ray test, to 1e-12 rad), and its direction."""
+
+    def ray(angle: float) -> np.ndarray:
+        d = math.cos(angle) * ahead - math.sin(angle) * across
+        return np.asarray(d / np.linalg.norm(d))
+
+    def hits(angle: float) -> bool:
+        return bool(mesh.ray.intersects_any([pivot], [ray(angle)])[0])
+
+    low, high = 0.5, 0.0
+    if hits(low) or not hits(high):
+        return None
+    for _ in range(40):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if not hits(middle) else (low, middle)
+    location, _, _ = mesh.ray.intersects_location([pivot], [ray(high)])
+    return location[np.argmin(np.linalg.norm(location - pivot, axis=1))], ray(high)
+
+
+def _first_touches(
+    mesh: trimesh.Trimesh, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
+    """First touches of lines swept about three pivots around ``mesh`` (trimesh's rays,
+    independent of the scene module) and the lines' directions: each pivot 0.5 m from the
+    mesh's centre, sweeping both ways in four planes through it turned at random about the
+    line of sight."""
+    centre = mesh.bounding_box.centroid
+    points, tangents = [], []
+    for heading in (0.0, 2.1, 4.2):
+        pivot = centre + 0.5 * np.array([-math.cos(heading), -math.sin(heading), 0.0])
+        ahead = (centre - pivot) / 0.5
+        side = np.cross([0.0, 0.0, 1.0], ahead)
+        for tilt in rng.uniform(-0.6, 0.6, 4):
+            across = math.cos(tilt) * side + math.sin(tilt) * np.array([0.0, 0.0, 1.0])
+            for sense in (1.0, -1.0):
+                touch = _first_touch(mesh, pivot, ahead, sense * across)
+                if touch is not None:
+                    points.append(touch[0])
+                    tangents.append(touch[1])
+    return np.array(points), np.array(tangents)
+
+
+@pytest.mark.parametrize("name", ["box", "cylinder"])
+def test_the_lines_that_touched_tell_a_box_from_a_cylinder(name: str) -> None:
+    # a line swept towards a box first meets it on an edge, and a cylinder fits points on a
+    # box's edges nearly as well as the box: the lines tell them apart, as a cylinder through
+    # those points is not tangent to the lines that touched them; on a cylinder, the lines
+    # cost the cylinder nothing
+    rng = np.random.default_rng(3)
+    mesh = SHAPES[name][0]()
+    mesh.apply_transform(_pose(rng))
+    mesh.apply_translation([0.6, 0.0, 0.0] - mesh.bounding_box.centroid)
+    points, tangents = _first_touches(mesh, rng)
+    n = len(points)
+    assert n >= 20
+    points = points + rng.normal(0.0, NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+    pivots_far = np.full(n, 0.4)
+    lines = LinkLines(tangents, np.full(n, 0.01), pivots_far, np.full(n, 0.3))
+    result = recognise(points, covariances, rng=np.random.default_rng(0), lines=lines)
+    assert result.decision == name, (result.decision, result.candidates)
+    fits = {f.name: f for f in result.fits}
+    assert fits[name].line_chi2 < 0.5 * n  # the true shape: tangent within the noise
+    other = "cylinder" if name == "box" else "box"
+    assert fits[other].line_chi2 > fits[name].line_chi2 + result.threshold

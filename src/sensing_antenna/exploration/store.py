@@ -158,6 +158,9 @@ def point_to_dict(point: ContactPoint) -> dict[str, Any]:
         "base_position": _finite_list(point.base_position),
         "reason": point.reason,
         "true_point": _finite_list(point.true_point),
+        "tangent": _finite_list(point.tangent),
+        "tangent_std": None if not np.isfinite(point.tangent_std) else point.tangent_std,
+        "link_beyond": None if not np.isfinite(point.link_beyond) else point.link_beyond,
     }
 
 
@@ -173,7 +176,14 @@ def point_from_dict(data: dict[str, Any]) -> ContactPoint:
         base_position=_array(data["base_position"], (3,)),
         reason=data.get("reason"),
         true_point=_array(data["true_point"], (3,)),
+        tangent=_array(data.get("tangent", [None] * 3), (3,)),
+        tangent_std=_number(data.get("tangent_std")),
+        link_beyond=_number(data.get("link_beyond")),
     )
+
+
+def _number(value: Any) -> float:
+    return float("nan") if value is None else float(value)
 
 
 @contextlib.contextmanager

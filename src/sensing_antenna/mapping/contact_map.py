@@ -27,7 +27,7 @@ from sensing_antenna.mapping.points import (
     select_points,
 )
 from sensing_antenna.mapping.pose import base_pose_from_metadata
-from sensing_antenna.mapping.recognition import Recognition, recognise
+from sensing_antenna.mapping.recognition import LinkLines, Recognition, recognise
 from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
 
 __all__ = [
@@ -35,6 +35,7 @@ __all__ = [
     "ContactMap",
     "build_map",
     "fit_surface",
+    "link_lines",
     "points_from_recordings",
     "recognise_points",
 ]
@@ -193,7 +194,17 @@ def recognise_points(
     cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
     bases = np.array([c.base_position for c in used]).reshape(-1, 3)
     outward = (bases - p).mean(axis=0)
-    return recognise(p, cov, meshes=meshes, outward=outward, rng=rng)
+    return recognise(p, cov, meshes=meshes, outward=outward, rng=rng, lines=link_lines(used))
+
+
+def link_lines(points: Sequence[ContactPoint]) -> LinkLines:
+    """The link's line at each point, for the recognition's tangency residual."""
+    return LinkLines(
+        tangents=np.array([c.tangent for c in points]).reshape(-1, 3),
+        std=np.array([c.tangent_std for c in points]),
+        behind=np.array([c.x_c for c in points]),
+        beyond=np.array([c.link_beyond for c in points]),
+    )
 
 
 def _true_point(text: str | None) -> FloatArray | None:

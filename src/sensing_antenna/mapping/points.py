@@ -35,6 +35,12 @@ the link's thickness
 Sigma_a = sigma_x^2 J_x J_x^T + sum_i q_i^2 / 12 J_i J_i^T + rho^2 (J_d J_d^T + s^2 A A^T)
 + r^2 / 2 (I - X^m X^mT), J_d = y_c Y^c - 2 delta X^m, and in the world Sigma_w = R Sigma_a R^T
 with the base pose's rotation R.
+
+The link's tangent at the contact, t ~ X^m + (3 y_c / (2 x_c)) Y^c + (ds/dx_c) A (the end slope
+of a cantilever of length x_c loaded at its end, y' = 3 y_c / (2 x_c), and the sag's slope),
+with the standard deviation in angle sqrt((rho y')^2 + (rho ds/dx_c)^2 + tau^2), tau =
+:data:`TANGENT_FLOOR` the head's pointing: a round link touching an object is tangent to it
+there, which the recognition checks (mapping.recognition, "The link's line").
 """
 
 from __future__ import annotations
@@ -53,10 +59,12 @@ from sensing_antenna.mapping.pose import BasePose
 
 __all__ = [
     "DEFAULT_ALONG_STD",
+    "TANGENT_FLOOR",
     "Z_95",
     "ContactPoint",
     "PointUncertainty",
     "contact_point_from_estimate",
+    "link_tangent",
     "select_points",
 ]
 
@@ -75,6 +83,12 @@ DEFAULT_ALONG_STD: Mapping[str, float] = {
     "ratio": 0.03,
     "unknown": 0.01,
 }
+
+
+#: Standard deviation (rad) of the link's direction at a contact beside the deflection model's:
+#: the head's pointing, its encoders' zero (set by hand or an index pulse, a few mrad) and a
+#: clamp that lets the rod rock in its bore under the push (a few mrad at the paper's loads).
+TANGENT_FLOOR = 0.01
 
 
 @dataclass(frozen=True)
@@ -139,6 +153,13 @@ class ContactPoint:
     true_point : array, shape (3,)
         The simulator's ground truth (``true_contact_point``) in the world frame when known,
         else NaN; never used to build the map.
+    tangent : array, shape (3,)
+        The link's unit tangent at the contact, from the base towards the tip (world); NaN when
+        not known.
+    tangent_std : float
+        Its standard deviation in angle (rad); NaN when not known.
+    link_beyond : float
+        Link length (m) between the contact and the tip; NaN when not known.
     """
 
     point: FloatArray
@@ -150,6 +171,9 @@ class ContactPoint:
     base_position: FloatArray
     reason: str | None = None
     true_point: FloatArray = field(default_factory=lambda: np.full(3, np.nan))
+    tangent: FloatArray = field(default_factory=lambda: np.full(3, np.nan))
+    tangent_std: float = math.nan
+    link_beyond: float = math.nan
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "status", Status(self.status))
@@ -158,6 +182,7 @@ class ContactPoint:
             ("covariance", (3, 3)),
             ("base_position", (3,)),
             ("true_point", (3,)),
+            ("tangent", (3,)),
         ):
             array = np.array(getattr(self, name), dtype=float).reshape(shape)
             array.setflags(write=False)
@@ -210,6 +235,9 @@ def contact_point_from_estimate(
     point_a = np.asarray(estimate.contact_point, dtype=float)
     x_c = float(estimate.x_c)
     usable = bool(np.all(np.isfinite(point_a)) and math.isfinite(x_c) and x_c > 0)
+    tangent, tangent_std = (
+        link_tangent(estimate, antenna, spec) if usable else (np.full(3, np.nan), math.nan)
+    )
     return ContactPoint(
         point=pose.point_to_world(point_a) if usable else np.full(3, np.nan),
         covariance=(
@@ -224,31 +252,43 @@ def contact_point_from_estimate(
         base_position=pose.position,
         reason=estimate.reason,
         true_point=truth,
+        tangent=pose.rotation @ tangent,
+        tangent_std=tangent_std,
+        link_beyond=max(antenna.link.length - x_c, 0.0) if usable else math.nan,
     )
 
 
-def point_covariance(
-    estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
-) -> FloatArray:
-    """Sigma_a (m^2), shape (3, 3), in the recording's absolute frame (module docstring)."""
+@dataclass(frozen=True)
+class _Geometry:
+    """The estimate's link at the contact, in the absolute frame (module docstring)."""
+
+    theta: FloatArray  # motor angles at t_1 (rad)
+    x_m: FloatArray
+    y_m: FloatArray
+    z_m: FloatArray
+    deflection: float  # y_c (m)
+    y_c_axis: FloatArray | None  # the deflection's direction, when reported
+    sag: float  # s (m)
+    sag_axis: FloatArray  # A, unit
+    sag_slope: float  # ds/dx_c
+
+
+def _geometry(estimate: ContactEstimate, antenna: Antenna) -> _Geometry:
     x_c = float(estimate.x_c)
     point_a = np.asarray(estimate.contact_point, dtype=float)
     diagnostics = estimate.diagnostics
     theta = _angles(diagnostics.get("theta_at_t1"), point_a)
     axes_m = motor_axes(theta)  # rows X^m, Y^m, Z^m in the absolute frame
-    x_m, y_m, z_m = axes_m[0], axes_m[1], axes_m[2]
+    x_m = axes_m[0]
     deflection = _finite(
         diagnostics.get("deflection"), _finite(diagnostics.get("deflection_ratio"), 0.0) * x_c
     )
-    y_c_axis = _contact_y_axis(diagnostics.get("axes_c_absolute"))
     # the sag's direction A: -Z^a without its part along X^m; s = g |A| u(x_c)
     down = np.array([0.0, 0.0, -1.0])
     across = down - (down @ x_m) * x_m
     across_norm = float(np.linalg.norm(across))
     link = antenna.link
     x_in = min(x_c, link.length)
-    sag = STANDARD_GRAVITY * across_norm * float(link.unit_sag(x_in))
-    sag_axis = across / across_norm if across_norm > 0 else np.zeros(3)
     # ds/dx_c by a central difference of the handbook sag curve (1 mm steps inside the link)
     step = min(1e-3, 0.5 * x_in)
     slope = (
@@ -257,6 +297,48 @@ def point_covariance(
         * float(link.unit_sag(min(x_in + step, link.length)) - link.unit_sag(x_in - step))
         / (min(x_in + step, link.length) - (x_in - step))
     )
+    return _Geometry(
+        theta=theta,
+        x_m=x_m,
+        y_m=axes_m[1],
+        z_m=axes_m[2],
+        deflection=deflection,
+        y_c_axis=_contact_y_axis(diagnostics.get("axes_c_absolute")),
+        sag=STANDARD_GRAVITY * across_norm * float(link.unit_sag(x_in)),
+        sag_axis=across / across_norm if across_norm > 0 else np.zeros(3),
+        sag_slope=slope,
+    )
+
+
+def link_tangent(
+    estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
+) -> tuple[FloatArray, float]:
+    """The link's unit tangent at the contact (absolute frame, shape (3,)) and its standard
+    deviation in angle (rad) (module docstring); without the deflection's direction the push's
+    slope is unknown and enters only the standard deviation."""
+    g = _geometry(estimate, antenna)
+    x_c = float(estimate.x_c)
+    push_slope = 1.5 * g.deflection / x_c
+    tangent = g.x_m + g.sag_slope * g.sag_axis
+    if g.y_c_axis is not None:
+        tangent = tangent + push_slope * g.y_c_axis
+    rho = uncertainty.deflection_relative_std
+    push_std = rho * push_slope if g.y_c_axis is not None else push_slope
+    std = math.sqrt(push_std**2 + (rho * g.sag_slope) ** 2 + TANGENT_FLOOR**2)
+    return np.asarray(tangent / np.linalg.norm(tangent)), std
+
+
+def point_covariance(
+    estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
+) -> FloatArray:
+    """Sigma_a (m^2), shape (3, 3), in the recording's absolute frame (module docstring)."""
+    x_c = float(estimate.x_c)
+    point_a = np.asarray(estimate.contact_point, dtype=float)
+    g = _geometry(estimate, antenna)
+    theta, x_m, y_m, z_m = g.theta, g.x_m, g.y_m, g.z_m
+    deflection, y_c_axis = g.deflection, g.y_c_axis
+    sag, sag_axis, slope = g.sag, g.sag_axis, g.sag_slope
+    link = antenna.link
     # the bent link's shortening delta = x_c - p_a . X^m (the deflection and the sag lie
     # across X^m); known only with the deflection's direction
     shortening = max(x_c - float(point_a @ x_m), 0.0) if y_c_axis is not None else 0.0

@@ -8,12 +8,24 @@ principal axes and an algebraic sphere, keeping the lowest cost). A user mesh is
 the points by iterative closest point (trimesh.registration.icp, from several starting
 rotations) and scored the same way with its six pose parameters.
 
-Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with chi^2 =
-sum (d_i / sigma_i)^2 (-2 log-likelihood of Gaussian distances up to a constant), k the class's
-independent parameters and c >= 1 the overdispersion (Burnham and Anderson, "Model Selection and
-Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of the best-fitting class when
-above 1, so that points farther from every class than their covariances say, an estimator's
-systematic error, weigh less); c = 1 is BIC. The lowest score wins.
+The link's line. A link sweeping towards an object first touches it where the link is tangent
+to it: just before, the whole link was outside, and a round link never cuts into what it
+pushes. Each contact whose link direction is known (:class:`LinkLines`: the link's unit tangent
+at the contact, its standard deviation in angle, and how much link lies behind and beyond the
+contact) adds one residual: along the link's stretch around the contact (up to
+:data:`LINE_STRETCH` each way, within the link), the steepest descent of the fitted surface's
+signed distance below its value at the point, per metre along the link, in units of the
+tangent's angular standard deviation: r = min(0, min_k (d(p + s_k t) - d(p)) / |s_k|) / sigma_t.
+It is 0 for a convex surface tangent to the link and for an edge the link passes over, and
+about the angle the link would make into the surface otherwise: a cylinder through the points a
+sweeping line left on a box's edges is not tangent to the lines that touched them.
+
+Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with
+chi^2 = sum (d_i / sigma_i)^2 + sum r_i^2 (-2 log-likelihood of Gaussian residuals up to a
+constant), k the class's independent parameters and c >= 1 the overdispersion (Burnham and
+Anderson, "Model Selection and Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of
+the best-fitting class when above 1, so that points farther from every class than their
+covariances say, an estimator's systematic error, weigh less); c = 1 is BIC. The lowest score wins.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
 points pin the richer class's extra parameters to the simpler shape (a torus fitted to a sphere
@@ -38,7 +50,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -52,8 +64,10 @@ from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive
 
 __all__ = [
     "ABSTAIN_DELTA",
+    "LINE_STRETCH",
     "UNDECIDED",
     "ClassFit",
+    "LinkLines",
     "Recognition",
     "fit_mesh",
     "fit_primitive",
@@ -100,6 +114,69 @@ EXTENT_PRIOR = 0.005
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
 MIN_SIZE = 1e-4
 
+#: How far along the link each way from a contact its line is checked against a fit (m).
+LINE_STRETCH = 0.04
+
+#: Where along that stretch, as fractions of it.
+_LINE_FRACTIONS = (0.125, 0.25, 0.5, 1.0)
+
+
+@dataclass(frozen=True)
+class LinkLines:
+    """The link's line at each contact, for the tangency residual (module docstring).
+
+    Attributes
+    ----------
+    tangents : array, shape (n, 3)
+        The link's unit tangent at each contact, from the base towards the tip (world); a row
+        of NaN where it is not known (no residual for that contact).
+    std : array, shape (n,)
+        The tangent's standard deviation in angle (rad).
+    behind, beyond : array, shape (n,)
+        Link length (m) between the base and the contact, and between the contact and the tip.
+    """
+
+    tangents: FloatArray
+    std: FloatArray
+    behind: FloatArray
+    beyond: FloatArray
+
+    def __post_init__(self) -> None:
+        n = len(np.asarray(self.tangents).reshape(-1, 3))
+        object.__setattr__(self, "tangents", np.asarray(self.tangents, float).reshape(n, 3))
+        for name in ("std", "behind", "beyond"):
+            value = np.asarray(getattr(self, name), dtype=float).reshape(-1)
+            if len(value) != n:
+                raise ValueError(f"LinkLines.{name}: {len(value)} values for {n} tangents")
+            object.__setattr__(self, name, value)
+
+    def samples(self, points: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Points along each line (m), shape (n, k, 3), and their signed arc lengths s (m),
+        shape (n, k); s is NaN where the link does not reach or the tangent is unknown."""
+        steps = LINE_STRETCH * np.array([*(-f for f in _LINE_FRACTIONS), *_LINE_FRACTIONS])
+        arc = np.broadcast_to(steps, (len(points), len(steps))).copy()
+        arc[(arc < 0) & (-arc > self.behind[:, None])] = np.nan
+        arc[(arc > 0) & (arc > self.beyond[:, None])] = np.nan
+        known = np.all(np.isfinite(self.tangents), axis=1) & np.isfinite(self.std)
+        arc[~known] = np.nan
+        along = np.nan_to_num(arc)[:, :, None] * np.nan_to_num(self.tangents)[:, None, :]
+        return np.asarray(points[:, None, :] + along), arc
+
+    def residuals(
+        self, distance: Callable[[FloatArray], FloatArray], points: FloatArray, sigma: FloatArray
+    ) -> FloatArray:
+        """r_i (module docstring), shape (n,), for a signed distance function of (m, 3) points
+        and the points' standard deviations along the surface's normal (m, shape (n,))."""
+        samples, arc = self.samples(points)
+        n, k = arc.shape
+        if n == 0:
+            return np.zeros(0)
+        at_line = distance(samples.reshape(-1, 3)).reshape(n, k)
+        own = np.minimum(distance(points), 0.0)
+        spread = np.sqrt(sigma[:, None] ** 2 + (np.nan_to_num(arc) * self.std[:, None]) ** 2)
+        deeper = np.where(np.isfinite(arc), (at_line - own[:, None]) / spread, np.inf)
+        return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
+
 
 @dataclass(frozen=True)
 class ClassFit:
@@ -116,13 +193,15 @@ class ClassFit:
     rms : float
         RMS of the point-to-surface distances (m).
     chi2 : float
-        sum (d_i / sigma_i)^2 (dimensionless).
+        sum (d_i / sigma_i)^2 + sum r_i^2 (dimensionless).
     bic : float
         chi2 + dof ln n (the score when c = 1).
     dof : int
         Independent parameters.
     n_points : int
         Points fitted.
+    line_chi2 : float
+        The link lines' part of chi2, sum r_i^2 (0 without lines).
     weight : float
         Weight exp(-score / 2) among the classes compared (0 to 1); NaN until compared.
     score : float
@@ -137,6 +216,7 @@ class ClassFit:
     bic: float
     dof: int
     n_points: int
+    line_chi2: float = 0.0
     weight: float = math.nan
     score: float = math.nan
     vector: FloatArray = field(default_factory=lambda: np.zeros(0), compare=False, repr=False)
@@ -150,6 +230,7 @@ class ClassFit:
             "sizes": {k: float(v) for k, v in self.sizes.items()},
             "rms_m": float(self.rms),
             "chi2": float(self.chi2),
+            "line_chi2": float(self.line_chi2),
             "bic": float(self.bic),
             "score": None if math.isnan(self.score) else float(self.score),
             "dof": self.dof,
@@ -324,6 +405,7 @@ def fit_primitive(
     covariances: ArrayLike,
     outward: ArrayLike | None = None,
     rng: np.random.Generator | None = None,
+    lines: LinkLines | None = None,
 ) -> ClassFit:
     """Fit one class to the points (module docstring).
 
@@ -340,6 +422,8 @@ def fit_primitive(
         fits on the right side; the mean direction to the centroid's opposite when None.
     rng : numpy.random.Generator, optional
         For the extra starting rotations of the box (seeded default).
+    lines : LinkLines, optional
+        The link's line at each contact: a tangency residual per contact (module docstring).
     """
     model = PRIMITIVES[shape] if isinstance(shape, str) else shape
     p = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -349,9 +433,16 @@ def fit_primitive(
     low, high = _bounds(model, p)
     sigma = _isotropic_sigma(cov)
 
+    def line_residuals(x: FloatArray, s: FloatArray) -> FloatArray:
+        if lines is None:
+            return np.zeros(0)
+        return lines.residuals(lambda q: model.signed_distance(x, q), p, s)
+
     def residuals(x: FloatArray, s: FloatArray) -> FloatArray:
         distance = model.signed_distance(x, p) / s
-        return np.concatenate([distance, _extent_excess(model.name, x, p) / EXTENT_PRIOR])
+        return np.concatenate(
+            [distance, line_residuals(x, s), _extent_excess(model.name, x, p) / EXTENT_PRIOR]
+        )
 
     best = None
     for start in _starts(model, p, direction, generator):
@@ -394,6 +485,7 @@ def fit_primitive(
         model.dof,
         vector=x,
         mesh=model.mesh(x),
+        line=line_residuals(x, sigma),
     )
 
 
@@ -404,13 +496,15 @@ def fit_mesh(
     covariances: ArrayLike,
     rng: np.random.Generator | None = None,
     n_starts: int = 24,
+    lines: LinkLines | None = None,
 ) -> ClassFit:
     """Register a user mesh (its own size, any pose) to the points by ICP and score it.
 
     The points are moved onto the mesh (trimesh.registration.icp, the closest point on the
     mesh for each point: right for points covering only part of the object) from ``n_starts``
     rotations about the points' centroid placed on the mesh's centre and from the alignment of
-    principal axes (trimesh.registration.mesh_other); the lowest cost wins.
+    principal axes (trimesh.registration.mesh_other); the lowest cost wins. ``lines`` adds
+    the tangency residuals of the registered mesh (not used to register it).
     """
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
@@ -466,6 +560,10 @@ def fit_mesh(
     parameters = {f"m{i}{j}": float(pose[i, j]) for i in range(3) for j in range(4)}
     extents = mesh.bounding_box.extents
     sizes = {f"extent_{a}": float(e) for a, e in zip("xyz", extents, strict=True)}
+    line = np.zeros(0)
+    if lines is not None:
+        # trimesh's signed distance is positive inside
+        line = lines.residuals(lambda q: -trimesh.proximity.signed_distance(placed, q), p, sigma)
     return _scored(
         f"mesh:{name}",
         parameters,
@@ -475,6 +573,7 @@ def fit_mesh(
         6,
         pose.ravel(),
         placed,
+        line,
     )
 
 
@@ -487,16 +586,20 @@ def _scored(
     dof: int,
     vector: FloatArray,
     mesh: trimesh.Trimesh | None,
+    line: FloatArray | None = None,
 ) -> ClassFit:
     n = len(distance)
-    # chi^2 = sum (d_i / sigma_i)^2; BIC = chi^2 + k ln n
+    # chi^2 = sum (d_i / sigma_i)^2 + sum r_i^2; BIC = chi^2 + k ln n
     chi2 = float(np.sum((distance / sigma) ** 2))
+    line_chi2 = float(np.sum(line**2)) if line is not None else 0.0
+    chi2 += line_chi2
     return ClassFit(
         name=name,
         parameters=parameters,
         sizes=sizes,
         rms=float(np.sqrt(np.mean(distance**2))),
         chi2=chi2,
+        line_chi2=line_chi2,
         bic=chi2 + dof * math.log(n),
         dof=dof,
         n_points=n,
@@ -555,6 +658,7 @@ def recognise(
     outward: ArrayLike | None = None,
     threshold: float = ABSTAIN_DELTA,
     rng: np.random.Generator | None = None,
+    lines: LinkLines | None = None,
 ) -> Recognition:
     """Fit every class (and mesh) to the points and decide (module docstring).
 
@@ -574,6 +678,8 @@ def recognise(
         Abstain when the runner-up's score is within this of the best's.
     rng : numpy.random.Generator, optional
         Seeded default when None.
+    lines : LinkLines, optional
+        The link's line at each contact (module docstring).
     """
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
@@ -581,9 +687,11 @@ def recognise(
         raise ValueError(f"recognition needs at least 10 points, got {len(p)}")
     generator = rng if rng is not None else np.random.default_rng(0)
     names = list(classes) if classes is not None else list(PRIMITIVES)
-    fits = [fit_primitive(name, p, cov, outward, generator) for name in names]
+    if lines is not None and len(lines.tangents) != len(p):
+        raise ValueError(f"{len(lines.tangents)} link lines for {len(p)} points")
+    fits = [fit_primitive(name, p, cov, outward, generator, lines) for name in names]
     for name, mesh in (meshes or {}).items():
-        fits.append(fit_mesh(name, mesh, p, cov, generator))
+        fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines))
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
     tightest = min(fits, key=lambda f: f.chi2)
     c = max(1.0, tightest.chi2 / max(len(p) - tightest.dof, 1))
