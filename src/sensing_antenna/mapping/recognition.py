@@ -114,6 +114,10 @@ EXTENT_PRIOR = 0.005
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
 MIN_SIZE = 1e-4
 
+#: Fits on the points alone refined with the link's lines, the best first: the lines make the
+#: problem rougher, and a pose the points alone rank second may suit them best.
+REFINED_STARTS = 3
+
 #: How far along the link each way from a contact its line is checked against a fit (m).
 LINE_STRETCH = 0.04
 
@@ -438,20 +442,21 @@ def fit_primitive(
             return np.zeros(0)
         return lines.residuals(lambda q: model.signed_distance(x, q), p, s)
 
-    def residuals(x: FloatArray, s: FloatArray) -> FloatArray:
+    def residuals(x: FloatArray, s: FloatArray, with_lines: bool) -> FloatArray:
         distance = model.signed_distance(x, p) / s
-        return np.concatenate(
-            [distance, line_residuals(x, s), _extent_excess(model.name, x, p) / EXTENT_PRIOR]
-        )
+        line = line_residuals(x, s) if with_lines else np.zeros(0)
+        return np.concatenate([distance, line, _extent_excess(model.name, x, p) / EXTENT_PRIOR])
 
-    best = None
+    # the starts on the points alone (a smooth problem), the best few then refined with each
+    # point's sigma along the fitted surface's normal and the link's lines
+    solutions = []
     for start in _starts(model, p, direction, generator):
         start = np.clip(start, low, high)
         try:
             solution = least_squares(
                 residuals,
                 start,
-                args=(sigma,),
+                args=(sigma, False),
                 bounds=(low, high),
                 loss="soft_l1",
                 f_scale=ROBUST_SCALE,
@@ -459,20 +464,24 @@ def fit_primitive(
             )
         except ValueError:  # a start outside the model's domain
             continue
-        if best is None or solution.cost < best.cost:
-            best = solution
-    assert best is not None
-    # second pass: each point's sigma along the fitted surface's normal
-    sigma = _normal_sigma(cov, model.normals(best.x, p))
-    refined = least_squares(
-        residuals,
-        best.x,
-        args=(sigma,),
-        bounds=(low, high),
-        loss="soft_l1",
-        f_scale=ROBUST_SCALE,
-        max_nfev=2 * MAX_EVALUATIONS * len(best.x),
-    )
+        solutions.append(solution)
+    assert solutions
+    solutions.sort(key=lambda solution: solution.cost)
+    refined = None
+    for solution in solutions[: REFINED_STARTS if lines is not None else 1]:
+        normal_sigma = _normal_sigma(cov, model.normals(solution.x, p))
+        candidate = least_squares(
+            residuals,
+            solution.x,
+            args=(normal_sigma, lines is not None),
+            bounds=(low, high),
+            loss="soft_l1",
+            f_scale=ROBUST_SCALE,
+            max_nfev=2 * MAX_EVALUATIONS * len(solution.x),
+        )
+        if refined is None or candidate.cost < refined.cost:
+            refined = candidate
+    assert refined is not None
     x = refined.x
     distance = model.signed_distance(x, p)
     sigma = _normal_sigma(cov, model.normals(x, p))
