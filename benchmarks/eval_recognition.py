@@ -9,7 +9,8 @@ noise of the covariance :mod:`sensing_antenna.mapping.points` gives a ``fast`` e
 its median 95 % interval (0.4 cm on the default campaign), 2000-count encoders, a push
 deflection of ``--deflection-ratio`` times x_c in an unknown direction, the link's radius.
 The contacts are not simulated (no sweeps, no estimator): this measures the map and the
-recognition given points with the estimates' uncertainty.
+recognition given points with the estimates' uncertainty, without the links' lines (points
+drawn on a side carry no sweep; ``eval_explore.py`` has them).
 
 Per scene: the decision, whether it is right, abstained or confidently wrong; the size error of
 the true class's fit (largest relative error over its sizes; box extents compared sorted); the
