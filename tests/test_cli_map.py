@@ -58,6 +58,10 @@ def test_map_writes_points_within_their_covariance_of_the_truth(
         covariance = np.array(
             [[c["xx"], c["xy"], c["xz"]], [c["xy"], c["yy"], c["yz"]], [c["xz"], c["yz"], c["zz"]]]
         )
+        tangent = np.array([float(row[f"tangent_{k}"]) for k in "xyz"])
+        # the link's tangent at the contact: a unit vector, with its angular deviation
+        assert np.linalg.norm(tangent) == pytest.approx(1.0, abs=1e-6)
+        assert 0.0 < float(row["tangent_std"]) < 0.1
         error = point - truth
         # Mahalanobis distance of the truth: below 3.37, the 99 % point of chi with 3 dof
         assert float(np.sqrt(error @ np.linalg.solve(covariance, error))) < 3.37, row["source"]
@@ -66,6 +70,10 @@ def test_map_writes_points_within_their_covariance_of_the_truth(
     assert np.allclose(points[2][0], POSE.point_to_world(points[0][0]))
     assert np.allclose(points[2][1], POSE.point_to_world(points[0][1]))
     assert np.allclose(points[2][2], POSE.covariance_to_world(points[0][2]))
+    tangents = [np.array([float(row[f"tangent_{k}"]) for k in "xyz"]) for row in rows]
+    assert np.allclose(tangents[2], POSE.rotation @ tangents[0], atol=1e-6)
+    # from the base (the origin here) towards the point, within the link's bend and sag
+    assert tangents[0] @ points[0][0] / np.linalg.norm(points[0][0]) > 0.99
     summary = json.loads((out / "recognition.json").read_text())
     assert summary["n_used"] == 3 and summary["recognition"] is None  # too few to recognise
     # the interactive view holds the same points, self-contained (no script fetched)

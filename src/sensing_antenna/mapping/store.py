@@ -2,7 +2,9 @@
 
 points.csv has one row per recording: ``source, method, status, x, y, z`` (m, world frame), the
 covariance's six entries ``cov_xx, cov_xy, cov_xz, cov_yy, cov_yz, cov_zz`` (m^2), ``std``
-(the worst-direction sigma, m), ``x_c`` (m), ``used`` (whether it entered the map),
+(the worst-direction sigma, m), ``x_c`` (m), the link's unit tangent at the contact
+``tangent_x, tangent_y, tangent_z`` (world frame) and its angular ``tangent_std`` (rad),
+``used`` (whether it entered the map),
 ``true_x, true_y, true_z`` (ground truth when the recording had it) and ``reason``. The PLY
 files colour points and surface vertices by their standard deviation, blue (smallest) to red
 (largest).
@@ -39,6 +41,10 @@ POINT_COLUMNS = (
     "cov_zz",
     "std",
     "x_c",
+    "tangent_x",
+    "tangent_y",
+    "tangent_z",
+    "tangent_std",
     "used",
     "true_x",
     "true_y",
@@ -83,6 +89,8 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
                     ),
                     _number(p.std),
                     _number(p.x_c),
+                    *(_number(v) for v in p.tangent),
+                    _number(p.tangent_std),
                     "true" if id(p) in used else "false",
                     *(_number(v) for v in p.true_point),
                     p.reason or "",
