@@ -449,7 +449,10 @@ def main() -> None:
     )
     parser.add_argument("--out", type=Path, default=RESULTS)
     parser.add_argument(
-        "--keep", type=Path, default=None, help="keep each exploration's directory in this one"
+        "--keep",
+        type=Path,
+        default=None,
+        help="keep each exploration's directory in this one (a scene's must not exist yet)",
     )
     args = parser.parse_args()
     device = paper_antenna()

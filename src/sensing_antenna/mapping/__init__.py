@@ -6,8 +6,8 @@ Above ``estimation/`` (it turns estimates into world points), below ``cli/``:
 - :mod:`.points`: :class:`ContactPoint`, a touched point with its covariance;
 - :mod:`.surface`: :class:`ImplicitSurface`, a Gaussian-process implicit surface;
 - :mod:`.primitives`: the shape classes, their exact signed distances and meshes;
-- :mod:`.recognition`: every class fitted, scored by BIC, a decision that abstains when a
-  class the points do not rule out is another shape;
+- :mod:`.recognition`: every class fitted to the points and the links' lines, scored by BIC,
+  a decision that abstains when a class the points do not rule out is another shape;
 - :mod:`.contact_map`: :func:`build_map` and :func:`points_from_recordings`;
 - :mod:`.store`: the map's directory;
 - :mod:`.view`: the interactive HTML view (map.html).
@@ -30,6 +30,7 @@ from sensing_antenna.mapping.recognition import (
     ABSTAIN_DELTA,
     UNDECIDED,
     ClassFit,
+    LinkLines,
     Recognition,
     fit_mesh,
     fit_primitive,
@@ -47,6 +48,7 @@ __all__ = [
     "ContactMap",
     "ContactPoint",
     "ImplicitSurface",
+    "LinkLines",
     "PointUncertainty",
     "Primitive",
     "Recognition",

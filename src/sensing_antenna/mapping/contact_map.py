@@ -197,8 +197,11 @@ def recognise_points(
     return recognise(p, cov, meshes=meshes, outward=outward, rng=rng, lines=link_lines(used))
 
 
-def link_lines(points: Sequence[ContactPoint]) -> LinkLines:
-    """The link's line at each point, for the recognition's tangency residual."""
+def link_lines(points: Sequence[ContactPoint]) -> LinkLines | None:
+    """The link's line at each point, for the recognition's tangency residual; None when no
+    point knows its tangent (points stored before they carried one)."""
+    if not any(np.all(np.isfinite(c.tangent)) and math.isfinite(c.tangent_std) for c in points):
+        return None
     return LinkLines(
         tangents=np.array([c.tangent for c in points]).reshape(-1, 3),
         std=np.array([c.tangent_std for c in points]),

@@ -12,12 +12,13 @@ The link's line. A link sweeping towards an object first touches it where the li
 to it: just before, the whole link was outside, and a round link never cuts into what it
 pushes. Each contact whose link direction is known (:class:`LinkLines`: the link's unit tangent
 at the contact, its standard deviation in angle, and how much link lies behind and beyond the
-contact) adds one residual: along the link's stretch around the contact (up to
-:data:`LINE_STRETCH` each way, within the link), the steepest descent of the fitted surface's
-signed distance below its value at the point, per metre along the link, in units of the
-tangent's angular standard deviation: r = min(0, min_k (d(p + s_k t) - d(p)) / |s_k|) / sigma_t.
-It is 0 for a convex surface tangent to the link and for an edge the link passes over, and
-about the angle the link would make into the surface otherwise: a cylinder through the points a
+contact) adds one residual: how far the link's line cuts into the fitted shape beyond the
+point's own depth, over its spread, at samples q_k = p + s_k t along the link's stretch around
+the contact (up to :data:`LINE_STRETCH` each way, within the link):
+r = min(0, min_k (d(q_k) - min(0, d(p))) / sqrt(sigma^2 + (s_k sigma_t)^2)), sigma the point's
+standard deviation along the normal and sigma_t the tangent's in angle. It is 0 for a convex
+surface tangent to the link and for an edge the link passes over, and a line crossing a surface
+of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through the points a
 sweeping line left on a box's edges is not tangent to the lines that touched them.
 
 Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with
@@ -171,6 +172,8 @@ class LinkLines:
     ) -> FloatArray:
         """r_i (module docstring), shape (n,), for a signed distance function of (m, 3) points
         and the points' standard deviations along the surface's normal (m, shape (n,))."""
+        if len(points) != len(self.tangents):
+            raise ValueError(f"{len(self.tangents)} link lines for {len(points)} points")
         samples, arc = self.samples(points)
         n, k = arc.shape
         if n == 0:
@@ -513,7 +516,8 @@ def fit_mesh(
     mesh for each point: right for points covering only part of the object) from ``n_starts``
     rotations about the points' centroid placed on the mesh's centre and from the alignment of
     principal axes (trimesh.registration.mesh_other); the lowest cost wins. ``lines`` adds
-    the tangency residuals of the registered mesh (not used to register it).
+    the tangency residuals of the registered mesh (not used to register it), for a closed
+    (watertight) mesh only: an open one has no inside.
     """
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
@@ -570,8 +574,8 @@ def fit_mesh(
     extents = mesh.bounding_box.extents
     sizes = {f"extent_{a}": float(e) for a, e in zip("xyz", extents, strict=True)}
     line = np.zeros(0)
-    if lines is not None:
-        # trimesh's signed distance is positive inside
+    if lines is not None and placed.is_watertight:
+        # trimesh's signed distance is positive inside (and meaningful for a closed mesh only)
         line = lines.residuals(lambda q: -trimesh.proximity.signed_distance(placed, q), p, sigma)
     return _scored(
         f"mesh:{name}",

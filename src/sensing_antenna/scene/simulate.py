@@ -26,7 +26,7 @@ simulated in the plane tangent to its cone at the touch.
 
 A sweep the other way (towards -Y^m, or a vertical sweep down) is simulated as such
 (``Scenario.sweep_direction = -1``): the obstacle lies on the other side of the link, and a
-vertical sweep down has the link's weight helping the push onto a bar below it.
+vertical sweep down has the link's weight helping the push onto the obstacle below it.
 
 The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
 friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated
@@ -67,8 +67,9 @@ __all__ = [
 ]
 
 #: A surface whose radius across the link is at most this many times its radius along it is
-#: curved both ways, and its equivalent obstacle a ball (a sphere, a capsule's caps); beyond,
-#: a cylinder, straight across (a cylinder's side, a box's edge).
+#: curved across at least half as much as along, and its equivalent obstacle a ball of the
+#: radius along (a sphere, a capsule's caps); beyond, a cylinder, straight across (a cylinder's
+#: side, a box's edge). Radii are capped at 10 m: a flat face gives a 10 m ball or cylinder.
 BALL_RATIO = 2.0
 
 #: Largest angle of the surface's normal out of the sweep's direction (rad) the simulator's
