@@ -35,7 +35,10 @@ sweeps and at the end; the contacts each strategy needs to bring the whole objec
 Mahalanobis distance of each ``ok`` point's true contact point under its covariance, and the
 simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.json`` after
 every exploration (a run stopped early keeps the scenes it finished). ``--keep DIR`` keeps each
-exploration's directory there (its recordings and points, for ``antenna map``).
+exploration's directory there (its recordings and points, for ``antenna map``); an exploration
+already there is resumed, and a finished one re-scored: its map rebuilt with the current code
+from its stored points (exact for the grid, whose sweeps do not depend on the map; next-best's
+were chosen by the code that ran them), ``resumed`` in its row, ``run_s`` the re-score's time.
 
 Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 4] [--bases 3]
 [--strategies grid next-best] [--method fast] [--link nonlinear] [--seed 0] [--out FILE]
@@ -258,8 +261,10 @@ def run(
     link: str = "nonlinear",
 ) -> dict[str, Any]:
     out = workdir / f"{scene.name}-{strategy}"
-    out.mkdir(parents=True)
-    shutil.copy(calibrated, out / CALIBRATED_FILE)
+    resumed = out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    if not (out / CALIBRATED_FILE).exists():
+        shutil.copy(calibrated, out / CALIBRATED_FILE)
     start = time.perf_counter()
     result = explore(
         scene, paper_antenna(), out, ExploreSettings(method, strategy, seed=seed, link=link)
@@ -276,6 +281,7 @@ def run(
         "outcomes": result.summary()["outcomes"],
         "sweep_time_s": result.summary()["sweep_time_s"],
         "run_s": elapsed,
+        "resumed": resumed,
     }
     if used:
         _, distance, _ = trimesh.proximity.closest_point(mesh, np.array([p.point for p in used]))
@@ -452,7 +458,7 @@ def main() -> None:
         "--keep",
         type=Path,
         default=None,
-        help="keep each exploration's directory in this one (a scene's must not exist yet)",
+        help="keep each exploration's directory in this one (one already there is resumed)",
     )
     args = parser.parse_args()
     device = paper_antenna()

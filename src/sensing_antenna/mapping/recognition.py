@@ -115,8 +115,9 @@ EXTENT_PRIOR = 0.005
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
 MIN_SIZE = 1e-4
 
-#: Fits on the points alone refined with the link's lines, the best first: the lines make the
-#: problem rougher, and a pose the points alone rank second may suit them best.
+#: Fits on the points alone refined with the link's lines, the best first (beside the fits
+#: started with the lines): the lines make the problem rougher, and a pose the points alone
+#: rank second may suit them best.
 REFINED_STARTS = 3
 
 #: How far along the link each way from a contact its line is checked against a fit (m).
@@ -450,42 +451,44 @@ def fit_primitive(
         line = line_residuals(x, s) if with_lines else np.zeros(0)
         return np.concatenate([distance, line, _extent_excess(model.name, x, p) / EXTENT_PRIOR])
 
-    # the starts on the points alone (a smooth problem), the best few then refined with each
-    # point's sigma along the fitted surface's normal and the link's lines
-    solutions = []
-    for start in _starts(model, p, direction, generator):
-        start = np.clip(start, low, high)
-        try:
-            solution = least_squares(
-                residuals,
-                start,
-                args=(sigma, False),
-                bounds=(low, high),
-                loss="soft_l1",
-                f_scale=ROBUST_SCALE,
-                max_nfev=MAX_EVALUATIONS * len(start),
-            )
-        except ValueError:  # a start outside the model's domain
-            continue
-        solutions.append(solution)
-    assert solutions
-    solutions.sort(key=lambda solution: solution.cost)
-    refined = None
-    for solution in solutions[: REFINED_STARTS if lines is not None else 1]:
-        normal_sigma = _normal_sigma(cov, model.normals(solution.x, p))
-        candidate = least_squares(
+    def fit(start: FloatArray, s: FloatArray, with_lines: bool, evaluations: int) -> Any:
+        return least_squares(
             residuals,
-            solution.x,
-            args=(normal_sigma, lines is not None),
+            start,
+            args=(s, with_lines),
             bounds=(low, high),
             loss="soft_l1",
             f_scale=ROBUST_SCALE,
-            max_nfev=2 * MAX_EVALUATIONS * len(solution.x),
+            max_nfev=evaluations * len(start),
         )
-        if refined is None or candidate.cost < refined.cost:
-            refined = candidate
-    assert refined is not None
-    x = refined.x
+
+    def refine(x: FloatArray) -> FloatArray:
+        # each point's sigma along the fitted surface's normal, and the link's lines
+        normal_sigma = _normal_sigma(cov, model.normals(x, p))
+        return np.asarray(fit(x, normal_sigma, lines is not None, 2 * MAX_EVALUATIONS).x)
+
+    def total(x: FloatArray) -> float:
+        # the scored chi^2 (plus the extent prior) with the sigma at x: one scale for all
+        normal_sigma = _normal_sigma(cov, model.normals(x, p))
+        return float(np.sum(residuals(x, normal_sigma, True) ** 2))
+
+    # each start fitted on the points alone (a smooth problem); with lines, also from each
+    # start with them, and the best few of the points-alone fits refined: the lines make the
+    # problem rough, and either path may be the one that finds the shape
+    alone, direct = [], []
+    for start in _starts(model, p, direction, generator):
+        start = np.clip(start, low, high)
+        try:
+            alone.append(fit(start, sigma, False, MAX_EVALUATIONS))
+            if lines is not None:
+                direct.append(fit(start, sigma, True, MAX_EVALUATIONS).x)
+        except ValueError:  # a start outside the model's domain
+            continue
+    assert alone
+    alone.sort(key=lambda solution: solution.cost)
+    chosen = alone[: REFINED_STARTS if lines is not None else 1]
+    candidates = [refine(solution.x) for solution in chosen] + [refine(x) for x in direct]
+    x = min(candidates, key=total) if len(candidates) > 1 else candidates[0]
     distance = model.signed_distance(x, p)
     sigma = _normal_sigma(cov, model.normals(x, p))
     return _scored(
