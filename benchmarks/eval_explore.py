@@ -203,13 +203,20 @@ def size_error(name: str, fitted: dict[str, float], truth: dict[str, Any]) -> fl
     return max(abs(fitted[k] / v - 1) for k, v in truth.items())
 
 
-def surface_scores(points: list[Any], mesh: trimesh.Trimesh) -> dict[str, float]:
+def surface_scores(
+    points: list[Any], mesh: trimesh.Trimesh, samples: np.ndarray
+) -> dict[str, float]:
     """RMS of the fitted surface near the points to the true one, a Chamfer distance, and the
     whole object's RMS distance to the fitted surface and the fraction of its area within
-    :data:`COVERED` of it (the parts never touched count by how far the map is from them)."""
+    :data:`COVERED` of it (the parts never touched count by how far the map is from them);
+    ``samples`` are points on the true surface, uniform by area (m, shape (n, 3))."""
     surface = fit_surface(points)
-    nan = {"surface_rms_m": math.nan, "chamfer_m": math.nan, "object_rms_m": math.nan}
-    nan["covered"] = 0.0
+    nan = {
+        "surface_rms_m": math.nan,
+        "chamfer_m": math.nan,
+        "object_rms_m": math.nan,
+        "covered": 0.0,
+    }
     if surface is None:
         return nan
     zero_level, _ = surface.mesh()
@@ -222,7 +229,6 @@ def surface_scores(points: list[Any], mesh: trimesh.Trimesh) -> dict[str, float]
     _, distance, _ = trimesh.proximity.closest_point(mesh, near)
     # Chamfer: the mean of the two one-sided mean distances between the fitted patch and the
     # true surface's patch near the points
-    samples, _ = trimesh.sample.sample_surface(mesh, 20000, seed=0)
     true_patch = samples[cKDTree(used).query(samples)[0] < NEAR]
     chamfer = math.nan
     if len(true_patch):
@@ -291,10 +297,11 @@ def run(
         row["point_rms_m"] = row["point_max_m"] = math.nan
     row["mahalanobis"] = mahalanobis(used)
     progress = []
+    samples, _ = trimesh.sample.sample_surface(mesh, 20000, seed=0)
     checkpoints = sorted({*range(CHECK_EVERY, len(manoeuvres), CHECK_EVERY), len(manoeuvres)})
     for k in checkpoints:
         points = [m.point for m in manoeuvres[:k] if m.point is not None]
-        scores = surface_scores(points, mesh)
+        scores = surface_scores(points, mesh, samples)
         progress.append(
             {
                 "sweeps": k,

@@ -15,6 +15,7 @@ from _models import calibrated
 from sensing_antenna.antenna import save_antenna
 from sensing_antenna.cli import main
 from sensing_antenna.mapping import BasePose
+from sensing_antenna.mapping.points import TANGENT_FLOOR
 from sensing_antenna.recording import read_recording, write_recording
 
 #: A base pose for the third recording: turned 30 degrees about Z and lifted onto a robot.
@@ -61,7 +62,9 @@ def test_map_writes_points_within_their_covariance_of_the_truth(
         tangent = np.array([float(row[f"tangent_{k}"]) for k in "xyz"])
         # the link's tangent at the contact: a unit vector, with its angular deviation
         assert np.linalg.norm(tangent) == pytest.approx(1.0, abs=1e-6)
-        assert 0.0 < float(row["tangent_std"]) < 0.1
+        # at least the pointing floor; with the push's direction reported, rho = 10 % of its
+        # slope (0.15 rad at a 10 % push) adds little, far below 0.1 rad
+        assert TANGENT_FLOOR <= float(row["tangent_std"]) < 0.1
         error = point - truth
         # Mahalanobis distance of the truth: below 3.37, the 99 % point of chi with 3 dof
         assert float(np.sqrt(error @ np.linalg.solve(covariance, error))) < 3.37, row["source"]

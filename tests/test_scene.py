@@ -182,19 +182,20 @@ def test_a_sweep_towards_minus_y_records_the_mirror_image() -> None:
     np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
     assert np.linalg.det(rotation) == pytest.approx(1.0, abs=1e-12)
     a, b = forward.recording, backward.recording
-    # the swept joint turns the other way: theta1 falls through the touch; the two touches'
-    # geometry agrees to the first touch's tolerance, hence not to the bit
+    # the swept joint turns the other way: theta1 falls through the touch; to the bit, as the
+    # simulator's own sweep down (tests/test_simulator_direction.py): the touch search on the
+    # reflected ball runs the same numbers with y negated
     assert b.theta[-1, 0] < b.theta[0, 0]
-    np.testing.assert_allclose(b.theta * [-1, 1], a.theta, atol=1e-7)
-    np.testing.assert_allclose(b.force * [1, -1, 1], a.force, atol=1e-6)
-    np.testing.assert_allclose(b.torque * [-1, 1, -1], a.torque, atol=1e-6)
+    np.testing.assert_array_equal(b.theta * [-1, 1], a.theta)
+    np.testing.assert_array_equal(b.force * [1, -1, 1], a.force)
+    np.testing.assert_array_equal(b.torque * [-1, 1, -1], a.torque)
     truth = np.array(json.loads(b.metadata["true_contact_point"]))
     on_world = backward.frame.point_to_world(truth)
     assert abs(mirrored.signed_distance(on_world[None, :])[0]) < 3e-3
     ahead = estimate(a.without_ground_truth(), DEVICE, "paper")
     back = estimate(b.without_ground_truth(), DEVICE, "paper")
     assert back.status is ahead.status
-    np.testing.assert_allclose(back.contact_point * [1, -1, 1], ahead.contact_point, atol=1e-4)
+    np.testing.assert_array_equal(back.contact_point * [1, -1, 1], ahead.contact_point)
     # with the sensor's noise: the link lies tangent to the ball there, a point 1 cm along it
     # (the paper's typical error) is 1 cm^2 / 2R = 1 mm off the ball, the push's deflection a
     # few mm more

@@ -154,13 +154,13 @@ def point_to_dict(point: ContactPoint) -> dict[str, Any]:
         "status": point.status.value,
         "source": point.source,
         "method": point.method,
-        "x_c": None if not np.isfinite(point.x_c) else point.x_c,
+        "x_c": _finite_number(point.x_c),
         "base_position": _finite_list(point.base_position),
         "reason": point.reason,
         "true_point": _finite_list(point.true_point),
         "tangent": _finite_list(point.tangent),
-        "tangent_std": None if not np.isfinite(point.tangent_std) else point.tangent_std,
-        "link_beyond": None if not np.isfinite(point.link_beyond) else point.link_beyond,
+        "tangent_std": _finite_number(point.tangent_std),
+        "link_beyond": _finite_number(point.link_beyond),
     }
 
 
@@ -172,7 +172,7 @@ def point_from_dict(data: dict[str, Any]) -> ContactPoint:
         status=data["status"],
         source=data["source"],
         method=data["method"],
-        x_c=float("nan") if data["x_c"] is None else float(data["x_c"]),
+        x_c=_number(data["x_c"]),
         base_position=_array(data["base_position"], (3,)),
         reason=data.get("reason"),
         true_point=_array(data["true_point"], (3,)),
@@ -184,6 +184,10 @@ def point_from_dict(data: dict[str, Any]) -> ContactPoint:
 
 def _number(value: Any) -> float:
     return float("nan") if value is None else float(value)
+
+
+def _finite_number(value: float) -> float | None:
+    return float(value) if np.isfinite(value) else None
 
 
 @contextlib.contextmanager

@@ -115,8 +115,8 @@ EXTENT_PRIOR = 0.005
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
 MIN_SIZE = 1e-4
 
-#: Fits on the points alone refined with the link's lines, the best first (beside the fits
-#: started with the lines): the lines make the problem rougher, and a pose the points alone
+#: How many of the best fits on the points alone are refined with the link's lines, beside
+#: the fits started with them: the lines make the problem rough, and a pose the points alone
 #: rank second may suit them best.
 REFINED_STARTS = 3
 
@@ -703,8 +703,6 @@ def recognise(
         raise ValueError(f"recognition needs at least 10 points, got {len(p)}")
     generator = rng if rng is not None else np.random.default_rng(0)
     names = list(classes) if classes is not None else list(PRIMITIVES)
-    if lines is not None and len(lines.tangents) != len(p):
-        raise ValueError(f"{len(lines.tangents)} link lines for {len(p)} points")
     fits = [fit_primitive(name, p, cov, outward, generator, lines) for name in names]
     for name, mesh in (meshes or {}).items():
         fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines))
