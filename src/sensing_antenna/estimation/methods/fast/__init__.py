@@ -10,6 +10,7 @@ Where things live (each module one idea):
 - :mod:`.evaluation_grid`: the instants at which windows are evaluated;
 - :mod:`.window`: one evaluation (:class:`WindowEstimate`, :func:`evaluate_window`);
 - :mod:`.window_fit`: one window's fit and fundamental (fit cache, push phase, drift term);
+- :mod:`.planes`: which bending plane each fitted mode vibrates in;
 - :mod:`.checks`: what keeps a window from being declared, and the problems of an estimate;
 - :mod:`.second_mode`: the second contact mode chooses between two branches;
 - :mod:`.bound`: the information bound of the delay (:func:`bound_delay`), what the method's

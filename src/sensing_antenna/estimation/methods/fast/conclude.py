@@ -13,15 +13,18 @@ import math
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.checks import frequency_check, problems, ratio_check
 from sensing_antenna.estimation.methods.fast.config import FastConfig, model_floor
 from sensing_antenna.estimation.methods.fast.curves import contact_candidates, curve_table
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
+from sensing_antenna.estimation.methods.fast.planes import free_plane_share
 from sensing_antenna.estimation.methods.fast.search import ScanResult
 from sensing_antenna.estimation.methods.fast.second_mode import branch_at_cap
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
+from sensing_antenna.estimation.methods.fast.window import WindowEstimate
 from sensing_antenna.estimation.methods.touch_point import touched_point
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 
@@ -107,6 +110,7 @@ def conclude_fast(
             "model_order": final.fit.n_modes if final.fit is not None else 0,
             "fit_through_push": final.fit is not None and final.fit.restart is not None,
             "modes": final.fit.omega if final.fit is not None else (),
+            "free_plane_share": _free_plane_share(final, evidence.frame.reaction_m[1:]),
             "push_force": push,
             "deflection": touch.deflection,
             "deflection_ratio": touch.deflection_ratio,
@@ -133,6 +137,14 @@ def conclude_fast(
         interval=post.interval,
         branch_probability=tuple(post.branch_probability[b] for b in branch_of),
     )
+
+
+def _free_plane_share(final: WindowEstimate, push_direction: NDArray[np.float64]) -> float:
+    """Share of the fundamental's signal in the free plane (:mod:`.planes`); NaN without one."""
+    if final.fit is None or not math.isfinite(final.omega1):
+        return math.nan
+    k = int(np.argmin(np.abs(final.fit.omega - final.omega1)))
+    return float(free_plane_share(final.fit, push_direction)[k])
 
 
 def _frequency_z(

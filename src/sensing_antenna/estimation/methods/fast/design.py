@@ -98,9 +98,12 @@ class ModelDesign:
         )
         return np.asarray(derivatives, dtype=float)
 
-    def free_amplitudes(self, params: FloatArray, coef: NDArray[np.floating]) -> FloatArray:
-        """Amplitude at t_ref of each mode's vibration after the restart (or of the only one),
-        shape (K, M): the restarted pair carried to the origin tau = 0 and added."""
+    def free_phasors(
+        self, params: FloatArray, coef: NDArray[np.floating]
+    ) -> NDArray[np.complex128]:
+        """Complex amplitude a - i b at t_ref of each mode's vibration after the restart (or of
+        the only one), shape (K, M): the restarted pair carried to the origin tau = 0 and
+        added."""
         m = params.size // 2
         first = self.n_fixed
         a, b = coef[first : first + 2 * m : 2], coef[first + 1 : first + 2 * m : 2]
@@ -113,4 +116,4 @@ class ModelDesign:
             cos_lag, sin_lag = np.cos(omega * lag), np.sin(omega * lag)
             a = a + gain * (a2 * cos_lag - b2 * sin_lag)
             b = b + gain * (a2 * sin_lag + b2 * cos_lag)
-        return np.asarray(np.hypot(a, b).T, dtype=float)
+        return np.asarray((a - 1j * b).T, dtype=complex)

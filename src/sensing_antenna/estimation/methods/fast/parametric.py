@@ -118,6 +118,10 @@ class DampedSinusoidFit:
     restart : int or None
         Sample of the window from which the modes' amplitudes hold (``amplitudes`` are those
         of the vibration after it); None: the whole window.
+    phasors : complex array, shape (K, M), or None
+        Complex amplitude a - i b of each mode in each channel at ``t_ref`` for the term
+        e^(-s tau) (a cos w tau + b sin w tau) (channel units; ``amplitudes`` is its modulus):
+        the channels of a standing vibration share its phase. None when not kept.
     """
 
     omega: FloatArray
@@ -135,6 +139,7 @@ class DampedSinusoidFit:
     bic: float
     converged: bool
     restart: int | None = None
+    phasors: ComplexArray | None = None
 
     @property
     def n_modes(self) -> int:
@@ -425,7 +430,7 @@ class FitCandidate:
         diag = np.sqrt(np.clip(np.diag(cov)[: 2 * m], 0.0, None))
         offset_idx = 2 * m + np.arange(k) * n_linear
         order = np.argsort(params[0::2])
-        amplitudes = design.free_amplitudes(params, coef)
+        phasors = design.free_phasors(params, coef)
         drifts = coef[1] if design.degree >= 1 else np.zeros(k)
         sample_period = design.sample_period
         return DampedSinusoidFit(
@@ -436,7 +441,7 @@ class FitCandidate:
             offsets=np.asarray(coef[0], dtype=float),
             offset_cov=cov[np.ix_(offset_idx, offset_idx)],
             drifts=np.asarray(drifts, dtype=float),
-            amplitudes=np.asarray(amplitudes[:, order], dtype=float),
+            amplitudes=np.asarray(np.abs(phasors[:, order]), dtype=float),
             noise_std=np.asarray(noise, dtype=float),
             t_ref=self.t_start + 0.5 * (n - 1) * sample_period,
             n_samples=n,
@@ -444,6 +449,7 @@ class FitCandidate:
             bic=self.bic,
             converged=ok,
             restart=design.restart,
+            phasors=np.asarray(phasors[:, order], dtype=complex),
         )
 
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass
 
+import numpy as np
+
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.curves import curve_table
@@ -41,8 +43,8 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
     of x_c (``EstimatorConfig.contact_range``), with ``push_phase`` the push from t_c, and what
     every window reads from the front end: its filtered axial reaction, the model term of the
     elastica's statics and the bent link's uncertainty of omega_1 on the posterior's grid
-    (fixed once the hold has built the contact frame, so the same for every window, offline
-    and online).
+    and the push's direction across the link (fixed once the hold has built the contact frame, so
+    the same for every window, offline and online).
     """
     link = evidence.antenna.link
     channels = contact_channels(evidence.theta, evidence.force, evidence.torque, evidence.antenna)
@@ -70,6 +72,7 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         table.grid,
         evidence.ratio_model_uncertainty(table.grid),
         table.slope * evidence.bent_link_uncertainties(table.grid),
+        np.array(evidence.frame.reaction_m[1:], dtype=float),
     )
     return ScanInputs(
         channels,

@@ -194,12 +194,17 @@ class StaticsModel:
         times the curve's slope there. As for the paper method's candidate, it enters the
         frequency's consistency with the answer (:func:`.checks.frequency_check`), not the
         posterior: an upper bound of a shift measured at one point. None: none.
+    push_direction : array, shape (2,), optional
+        The hold's reaction across the link, (R_y, R_z) in the motor frame (N): which plane is
+        the push's, so that the fundamental is read in the free plane when it rings
+        (:mod:`.planes`). None: the strongest mode, whatever its plane.
     """
 
     axial: FloatArray | None = None
     grid: FloatArray | None = None
     model_sd: FloatArray | None = None
     omega1_sd: FloatArray | None = None
+    push_direction: FloatArray | None = None
 
     def axial_at(self, index: int) -> float:
         """R_x (N) at sample ``index``; 0 without it."""

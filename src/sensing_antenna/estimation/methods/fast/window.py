@@ -213,11 +213,13 @@ def evaluate_window(
     -------
     WindowEstimate
     """
+    statics_model = statics_model if statics_model is not None else StaticsModel()
+    direction = statics_model.push_direction
     span = WindowSpan(channels, rest_index, end_index, sample_period, band, config, cache)
-    from_t1 = measure_fundamental(span, None)
+    from_t1 = measure_fundamental(span, None, direction)
     frequency = from_t1
     if push is not None:
-        through = measure_fundamental(span, push)
+        through = measure_fundamental(span, push, direction)
         if push_agrees(through, from_t1, config):
             frequency = through
     fit, k = frequency.fit, frequency.mode
@@ -227,7 +229,6 @@ def evaluate_window(
     # The statics from the window from t_1 always: a fit through the push has its static part
     # at the centre of [t_c, t], inside the push for short windows, while the opening check
     # compares it with the vibration at t_1
-    statics_model = statics_model if statics_model is not None else StaticsModel()
     rigidity = 1.0 / link.bending_compliance
     statics = (
         static_ratio(from_t1.fit, bias, statics_model.axial_at(end_index), rigidity)
@@ -446,16 +447,11 @@ def with_early_statics_of(
         inputs.config,
         cache,
     )
-    from_t1 = measure_fundamental(span, None)
+    statics_model = inputs.statics_model if inputs.statics_model is not None else StaticsModel()
+    from_t1 = measure_fundamental(span, None, statics_model.push_direction)
     early = (
         None
         if from_t1.mode is None
-        else _early_statics(
-            span,
-            from_t1.omega1,
-            inputs.bias,
-            inputs.statics_model if inputs.statics_model is not None else StaticsModel(),
-            inputs.link,
-        )
+        else _early_statics(span, from_t1.omega1, inputs.bias, statics_model, inputs.link)
     )
     return dataclasses.replace(estimate, early_statics=early)

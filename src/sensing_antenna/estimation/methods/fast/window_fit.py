@@ -28,6 +28,7 @@ from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_in
 from sensing_antenna.estimation.methods.fast.model_order import select_model_solutions
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 from sensing_antenna.estimation.methods.fast.pencil import first_poles
+from sensing_antenna.estimation.methods.fast.planes import free_plane_share
 from sensing_antenna.estimation.methods.fast.warm_start import (
     Solutions,
     fewest_modes,
@@ -203,17 +204,37 @@ def _blas_libraries() -> ThreadpoolController:
 
 
 def find_fundamental(
-    fit: DampedSinusoidFit | None, band: tuple[float, float], config: FastConfig
+    fit: DampedSinusoidFit | None,
+    band: tuple[float, float],
+    config: FastConfig,
+    push_direction: FloatArray | None = None,
 ) -> tuple[int | None, str]:
-    """Index of the fundamental in ``fit`` and, when it cannot be used, why."""
+    """Index of the fundamental in ``fit`` and, when it cannot be used, why.
+
+    The strongest mode in the omega_1 band; with ``push_direction`` (the hold's reaction
+    across the link, (R_y, R_z) in the motor frame), the strongest of those that vibrate
+    mostly in the free plane when one is detected (:mod:`.planes`): out of its bending plane
+    the bent link keeps the straight link's omega_1, in it the held contact raises it.
+    """
     if fit is None:
         return None, "window too short for the model"
     k = fit.strongest_in_band(band)
     if k is None:
         return None, "no vibration mode in the omega_1 band"
-    detection = fit.snr()[k] * math.sqrt(0.5 * fit.n_samples)
-    if detection < config.min_detection:
-        return None, f"the fundamental's detection statistic is only {detection:.1f}"
+    detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)
+    if push_direction is not None:
+        share = free_plane_share(fit, push_direction)
+        free = np.flatnonzero(
+            (fit.omega >= band[0])
+            & (fit.omega <= band[1])
+            & (share > 0.5)
+            & (detection >= config.min_detection)
+            & np.isfinite(fit.omega_se)
+        )
+        if free.size and not share[k] > 0.5:
+            k = int(free[np.argmax(detection[free])])
+    if detection[k] < config.min_detection:
+        return None, f"the fundamental's detection statistic is only {detection[k]:.1f}"
     if not (fit.converged and math.isfinite(fit.omega_se[k])):
         return None, "the fit did not converge"
     return k, ""
@@ -263,13 +284,16 @@ class WindowSpan(NamedTuple):
     cache: FitCache | None
 
 
-def measure_fundamental(span: WindowSpan, push: PushPhase | None) -> Fundamental:
+def measure_fundamental(
+    span: WindowSpan, push: PushPhase | None, push_direction: FloatArray | None = None
+) -> Fundamental:
     """Fit the window (through the push when given) and measure its fundamental: its standard
-    error with the drift check's term, and the period checks."""
+    error with the drift check's term, and the period checks. ``push_direction`` as in
+    :func:`find_fundamental`."""
     config, band = span.config, span.band
     fit = fit_window(*span, push)
     omega1 = omega1_se = omega1_crb = drift = math.nan
-    k, note = find_fundamental(fit, band, config)
+    k, note = find_fundamental(fit, band, config, push_direction)
     notes = [note] if note else []
     failed = {"fundamental"} if note else set()
     if fit is not None and k is not None:
@@ -286,7 +310,7 @@ def measure_fundamental(span: WindowSpan, push: PushPhase | None) -> Fundamental
             span.rest_index, span.end_index, 2.0 / 3.0, span.sample_period, config
         )
         ref_fit = None if ref is None else fit_window(*span._replace(end_index=ref), push)
-        k_ref, _ = find_fundamental(ref_fit, band, config)
+        k_ref, _ = find_fundamental(ref_fit, band, config, push_direction)
         drift, note = drift_check(ref_fit, k_ref, omega1, omega1_crb, config)
         if note:
             notes.append(note)
