@@ -252,3 +252,34 @@ def test_the_lines_that_touched_tell_a_box_from_a_cylinder(name: str) -> None:
     assert fits[name].line_chi2 < 0.5 * n
     other = "cylinder" if name == "box" else "box"
     assert fits[other].line_chi2 > fits[name].line_chi2 + result.threshold
+
+
+def test_a_decision_needs_the_weight_the_threshold_stands_for() -> None:
+    # points on a 5 cm ball without noise, and user meshes of the ball and of the same ball dr
+    # larger (fine enough that their facets stand at most 8 um inside the sphere): the points
+    # lie about dr inside each larger one, chi^2 = n (dr / NOISE)^2 = 7.5 less the facets'
+    # share, past the gap of 6. One such runner-up leaves the best about e^3.5 / (1 + e^3.5)
+    # = 0.97 and a decision; four take about 4 / (e^3.5 + 4) = 11 % between them, and the
+    # decision abstains
+    n = 300
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    azimuth = math.pi * (3.0 - math.sqrt(5.0)) * k
+    rho = np.sqrt(1.0 - z**2)
+    points = 0.05 * np.stack([rho * np.cos(azimuth), rho * np.sin(azimuth), z], axis=1)
+    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+    dr = NOISE * math.sqrt(7.5 / n)
+    ball = trimesh.creation.icosphere(subdivisions=5, radius=0.05)
+    larger = trimesh.creation.icosphere(subdivisions=5, radius=0.05 + dr)
+    one = recognise(points, covariances, classes=[], meshes={"ball": ball, "larger": larger})
+    four = recognise(
+        points,
+        covariances,
+        classes=[],
+        meshes={"ball": ball} | {f"larger{i}": larger for i in range(4)},
+    )
+    floor = 1.0 / (1.0 + math.exp(-one.threshold / 2))
+    assert one.threshold < one.delta_score < 7.5
+    assert four.threshold < four.delta_score < 7.5
+    assert one.decision == "mesh:ball" and one.confidence >= floor
+    assert four.decision == UNDECIDED and four.confidence < floor

@@ -43,8 +43,11 @@ when the runner-up's score is within :data:`ABSTAIN_DELTA` of the best's.
 
 Confidence: the best class's weight exp(-score / 2) normalised over the classes (the posterior
 probability under equal priors in BIC's approximation), and, when there is a rival, the best's
-weight against the rival on the likelihood alone, 1 / (1 + exp(-delta chi^2 / (2 c))): below
-1 / (1 + exp(-3)) = 0.95 whenever the decision abstains.
+weight against the rival on the likelihood alone, 1 / (1 + exp(-delta chi^2 / (2 c))). A
+decision needs the weight a runner-up :data:`ABSTAIN_DELTA` behind leaves the best,
+1 / (1 + exp(-3)) = 0.95: several classes each that far behind share more than 5 % between
+them, and the decision abstains. So a named class always carries a confidence of at least
+0.95, and an abstention one below it.
 """
 
 from __future__ import annotations
@@ -691,7 +694,8 @@ def recognise(
     outward : array, shape (3,), optional
         Direction from the object towards the antenna (see :func:`fit_primitive`).
     threshold : float
-        Abstain when the runner-up's score is within this of the best's.
+        Abstain when the runner-up's score is within this of the best's, or the best's weight
+        is below 1 / (1 + exp(-threshold / 2)).
     rng : numpy.random.Generator, optional
         Seeded default when None.
     lines : LinkLines, optional
@@ -731,7 +735,8 @@ def recognise(
     confidence = float(weights[0])
     if rival is not None:
         confidence = 1.0 / (1.0 + math.exp(-0.5 * (rival.chi2 - best.chi2) / c))
-    decision = best.name if delta >= threshold and rival is None else UNDECIDED
+    sure = confidence >= 1.0 / (1.0 + math.exp(-0.5 * threshold))
+    decision = best.name if delta >= threshold and rival is None and sure else UNDECIDED
     leaders = (best, rival) if rival is not None else tuple(fits[:2])
     return Recognition(
         decision=decision,
