@@ -123,6 +123,26 @@ def test_a_bad_scenario_field_stops_the_campaign_with_one_error(tmp_path: Path) 
         run_campaign(spec, tmp_path / "b", workers=1, progress=False)
 
 
+def test_a_spec_push_is_the_head_rotation_or_the_criterion_fields(tmp_path: Path) -> None:
+    from sensing_antenna.campaign.runner import run_campaign
+    from sensing_antenna.campaign.simulated import make_scenario
+    from sensing_antenna.detection.push import PushCriterion
+
+    # a number: the head's rotation past the first touch (rad), as antenna simulate --push
+    scenario = make_scenario("azimuthal", 0.5, 0, {"push": 0.1})
+    assert scenario.push == PushCriterion(kind="rotation", threshold=0.1)
+    table = {"kind": "force", "threshold": 0.5}
+    assert make_scenario("azimuthal", 0.5, 0, {"push": table}).push == PushCriterion(**table)
+    for bad, problem in [
+        ("deep", "must be the head's rotation past the first touch"),
+        (-1.0, "must be a finite number > 0"),
+        ({"kind": "speed"}, "must be one of"),
+    ]:
+        spec = one_point_spec(scenario={"push": bad}, source="bad.toml")
+        with pytest.raises(CampaignSpecError, match=rf"bad\.toml: scenario\.push: {problem}"):
+            run_campaign(spec, tmp_path / str(bad), workers=1, progress=False)
+
+
 def test_every_run_scenario_is_checked_before_anything_is_written(tmp_path: Path) -> None:
     from sensing_antenna.campaign.runner import run_campaign
 

@@ -102,3 +102,9 @@ def test_the_free_vertical_sweep_moves_theta2_alone_and_touches_nothing() -> Non
     assert "true_xc" not in recording.metadata  # no obstacle to touch
     with pytest.raises(ScenarioError, match="contact_point: must be None"):
         Scenario(case="free-vertical", contact_point=0.5)
+
+
+def test_a_push_that_is_not_a_criterion_is_refused() -> None:
+    # a bare angle would reach the push monitor and fail there; the scenario names the field
+    with pytest.raises(ScenarioError, match=r"push: must be a push criterion"):
+        Scenario(case="azimuthal", contact_point=0.5, push=0.1)

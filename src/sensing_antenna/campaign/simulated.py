@@ -63,9 +63,36 @@ def make_scenario(case: str, contact_point: float | None, seed: int, extra: dict
                 f"scenario.{key}", f"not a Scenario field; known: {', '.join(sorted(known))}"
             )
     kwargs: dict[str, Any] = {"case": case, "seed": seed, **extra}
+    if "push" in kwargs:
+        kwargs["push"] = push_criterion(kwargs["push"])
     if contact_point is not None:
         kwargs["contact_point"] = contact_point
     return Scenario(**kwargs)
+
+
+def push_criterion(value: Any) -> Any:
+    """``scenario.push`` of a spec as the simulator's push criterion: a number is the head's
+    rotation past the first touch (rad), as ``antenna simulate --push``; a table gives the
+    fields of ``detection.push.PushCriterion`` (kind, threshold, cutoff). Raises
+    CampaignSpecError naming the field."""
+    from sensing_antenna.detection.push import PushConfigError, PushCriterion
+
+    if value is None or isinstance(value, PushCriterion):
+        return value
+    try:
+        if isinstance(value, Mapping):
+            return PushCriterion(**value)
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return PushCriterion(kind="rotation", threshold=float(value))
+    except PushConfigError as exc:
+        raise CampaignSpecError("scenario.push", str(exc).split(": ", 1)[-1]) from exc
+    except TypeError as exc:
+        raise CampaignSpecError("scenario.push", str(exc)) from exc
+    raise CampaignSpecError(
+        "scenario.push",
+        "must be the head's rotation past the first touch (rad) or a table of the push "
+        f"criterion's kind, threshold and cutoff, got {value!r}",
+    )
 
 
 def simulate_and_estimate(run: RunSpec) -> RunResult:

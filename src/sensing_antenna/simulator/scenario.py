@@ -291,6 +291,15 @@ class Scenario:
             if self.contact_point is None:
                 raise ScenarioError("contact_point", f"is required for the {self.case} case")
             _finite("contact_point", self.contact_point, 0.0, strict=True)
+        if self.push is not None:
+            from sensing_antenna.detection.push import PushCriterion
+
+            if not isinstance(self.push, PushCriterion):
+                raise ScenarioError(
+                    "push",
+                    "must be a push criterion (detection.push.PushCriterion) or None, "
+                    f"got {format_value(self.push)}",
+                )
         if self.link_model not in LINK_MODELS:
             raise ScenarioError(
                 "link_model",
