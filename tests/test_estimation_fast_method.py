@@ -1167,3 +1167,31 @@ def test_fundamental_is_read_in_the_free_plane_when_the_push_plane_rings_high() 
     # within the method's 5 mm tolerance of where the link touched, at the free plane's mode
     assert result.omega1 == pytest.approx(low)
     assert result.x_c == pytest.approx(truth, abs=0.005)
+
+
+def test_a_free_plane_mode_far_above_the_fundamental_is_another_vibration() -> None:
+    """A vertical push onto a ball at 0.51 m (exact link): the link rings at its contact
+    fundamental in the push plane, and a weak mode near the free link's second (about twice
+    as high) in the free plane. Read as omega_1 that one would put x_c near 0.7 m; the free
+    plane's mode is read only within ``free_plane_margin`` above the strongest."""
+    antenna = paper_antenna().self_calibrated()
+    scenario = Scenario(
+        case="vertical",
+        contact_point=0.51,
+        obstacle="ball",
+        obstacle_radius=0.048,
+        obstacle_tilt=-0.49,
+        link_model="nonlinear",
+        seed=8,
+        duration=3.5,
+    )
+    simulated = simulate(antenna, scenario)
+    truth = float(simulated.metadata["true_xc"])
+    recording = simulated.without_ground_truth()
+    result = estimate(recording, antenna, "fast")
+    assert result.diagnostics["free_plane_share"] < 0.5
+    assert result.x_c == pytest.approx(truth, abs=0.005)
+    # any free-plane mode of the band, however far above: the other vibration's contact point
+    anywhere = estimate(recording, antenna, FastMethod(FastConfig(free_plane_margin=10.0)))
+    assert anywhere.diagnostics["free_plane_share"] > 0.5
+    assert abs(anywhere.x_c - truth) > 0.1

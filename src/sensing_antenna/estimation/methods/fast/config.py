@@ -66,6 +66,15 @@ class FastConfig:
         start over the noise (combined over channels) times sqrt(n / 2), reaches this value. For
         white noise the largest of ~n / 2 independent periodogram ordinates reaches about
         sqrt(2 ln n) ~ 3.7 standard deviations; 10 leaves no room for a noise peak.
+    free_plane_margin : float
+        A mode detected in the omega_1 band that vibrates mostly in the free plane is read as
+        the fundamental instead of the strongest mode (in the push plane) only when its
+        frequency is at most this fraction above the strongest's (:mod:`.planes`). The push
+        plane rings above the straight link's omega_1 where friction holds the contact along
+        the obstacle and at most 4 % below it where it slides, the free plane within -0.9 to
+        +2.3 % of it (pushes up to 31 % deflection, docs/estimation.md, "The two bending
+        planes"): 0.07. A free-plane mode further above is another vibration, such as the
+        free plane's own where friction does not hold the contact.
     max_modes : int
         Largest number of damped modes tried (BIC chooses 1 .. max_modes). 3: the fundamental
         and the two strongest modes above it. The touch and the stop excite contact modes 2
@@ -202,6 +211,7 @@ class FastConfig:
     drift_factor: float = 2.0
     min_periods: float = 1.5
     min_detection: float = 10.0
+    free_plane_margin: float = 0.07
     max_modes: int = 3
     min_mode_fraction: float = 0.6
     polynomial_degree: int = 4
@@ -243,6 +253,7 @@ class FastConfig:
                 raise FastConfigError(f"{f.name}: must be a finite number >= 0, got {value!r}")
             may_be_zero = (
                 "warm_start_after",
+                "free_plane_margin",
                 "frequency_floor",
                 "bias_guard",
             )

@@ -212,9 +212,10 @@ def find_fundamental(
     """Index of the fundamental in ``fit`` and, when it cannot be used, why.
 
     The strongest mode in the omega_1 band; with ``push_direction`` (the hold's reaction
-    across the link, (R_y, R_z) in the motor frame), the strongest of those that vibrate
-    mostly in the free plane when one is detected (:mod:`.planes`): out of its bending plane
-    the bent link keeps the straight link's omega_1, in it the held contact raises it.
+    across the link, (R_y, R_z) in the motor frame), when that mode vibrates mostly in the
+    push plane, the strongest detected mode of the band that vibrates mostly in the free
+    plane at most ``free_plane_margin`` above it (:mod:`.planes`): out of its bending plane
+    the bent link keeps the straight link's omega_1, in it a held contact raises it.
     """
     if fit is None:
         return None, "window too short for the model"
@@ -228,6 +229,7 @@ def find_fundamental(
             (fit.omega >= band[0])
             & (fit.omega <= band[1])
             & (share > 0.5)
+            & (fit.omega <= (1.0 + config.free_plane_margin) * fit.omega[k])
             & (detection >= config.min_detection)
             & np.isfinite(fit.omega_se)
         )
