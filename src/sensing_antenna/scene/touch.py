@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,6 +28,7 @@ from scipy.optimize import minimize_scalar
 
 from sensing_antenna.mapping.pose import BasePose
 from sensing_antenna.scene.file import Scene
+from sensing_antenna.scene.objects import SceneObject
 from sensing_antenna.scene.sweep import LinkShape, Sweep
 
 __all__ = [
@@ -204,7 +204,7 @@ def _nearest(
     return float(found.x), float(found.fun), False
 
 
-def _bend_radius(touched: Any, point: FloatArray, direction: FloatArray) -> float:
+def _bend_radius(touched: SceneObject, point: FloatArray, direction: FloatArray) -> float:
     """The surface's radius of curvature (m) at ``point`` along the unit tangent ``direction``:
     a circle of radius R curves away by d = sqrt(R^2 + h^2) - R at h = CURVATURE_PROBE to
     either side, capped to [MIN_RADIUS, MAX_RADIUS]."""
