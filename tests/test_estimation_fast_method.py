@@ -1195,3 +1195,35 @@ def test_a_free_plane_mode_far_above_the_fundamental_is_another_vibration() -> N
     anywhere = estimate(recording, antenna, FastMethod(FastConfig(free_plane_margin=10.0)))
     assert anywhere.diagnostics["free_plane_share"] > 0.5
     assert abs(anywhere.x_c - truth) > 0.1
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.6, math.pi / 2])
+def test_a_mode_is_placed_in_its_bending_plane_by_its_loads(angle: float) -> None:
+    """Statics of a standing vibration pushed along u = (0, cos a, sin a) in the motor frame: in
+    the push plane the contact moves along u, so the reaction is along u and its moment
+    x_c X^m x R along X^m x u; in the free plane the reaction is along X^m x u and the moment
+    along X^m x (X^m x u) = -u. Each with one phase in every channel."""
+    from sensing_antenna.estimation.methods.fast.planes import free_plane_share
+
+    u = np.array([0.0, math.cos(angle), math.sin(angle)])
+    x = np.array([1.0, 0.0, 0.0])
+    x_c, force = 0.6, 0.01  # m, N
+    loads = []
+    for direction in (u, np.cross(x, u)):
+        reaction = force * direction
+        moment = np.cross(x_c * x, reaction)
+        loads.append(np.concatenate([reaction[1:], moment]))
+    phase = np.exp(0.7j)
+    fit = dataclasses.replace(
+        _fit([50.0, 52.0]),
+        offsets=np.zeros(5),
+        offset_cov=np.eye(5),
+        drifts=np.zeros(5),
+        amplitudes=np.abs(np.column_stack(loads)),
+        noise_std=np.array([6e-3, 6e-3, 4e-5, 4e-5, 4e-5]),
+        phasors=np.column_stack(loads) * phase,
+    )
+    share = free_plane_share(fit, 0.03 * u[1:])
+    assert share == pytest.approx([0.0, 1.0], abs=1e-12)
+    # the push direction's sign and size do not matter
+    assert free_plane_share(fit, -2.0 * u[1:]) == pytest.approx(share, abs=1e-12)

@@ -1,10 +1,11 @@
 """Which bending plane each fitted mode vibrates in: the push plane or the free plane.
 
 The sensing curves are the straight link's, pinned at the contact in both planes. A link the
-push has bent keeps that model out of its bending plane (the free plane: within 0.4 % of omega_1
-up to 30 % deflection, docs/estimation.md, "The two bending planes"), while in the push plane a
-contact that friction holds along the obstacle raises the frequency by an amount no function of
-the deflection bounds (up to +173 % at x_c = 0.9 m held outright). When both planes ring in the
+push has bent keeps that model out of its bending plane (the free plane: within a few per cent
+of omega_1 up to 30 % deflection, friction along the link included, docs/estimation.md, "The two
+bending planes"), while in the push plane a contact that friction holds along the obstacle
+raises the frequency by an amount no function of the deflection bounds (up to +173 % at
+x_c = 0.9 m held outright). When both planes ring in the
 omega_1 band as separate modes, the free plane's is the one to read.
 
 The five contact-load channels (:func:`.static_fit.contact_channels`) are R_y, R_z, Gamma_x,
