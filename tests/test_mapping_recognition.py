@@ -279,7 +279,10 @@ def test_a_decision_needs_the_weight_the_threshold_stands_for() -> None:
         meshes={"ball": ball} | {f"larger{i}": larger for i in range(4)},
     )
     floor = 1.0 / (1.0 + math.exp(-one.threshold / 2))
+    assert one.confidence_floor == pytest.approx(floor)
     assert one.threshold < one.delta_score < 7.5
     assert four.threshold < four.delta_score < 7.5
     assert one.decision == "mesh:ball" and one.confidence >= floor
+    # abstaining for the weight alone: past the gap, no rival
+    assert four.rival is None
     assert four.decision == UNDECIDED and four.confidence < floor

@@ -73,6 +73,7 @@ __all__ = [
     "ClassFit",
     "LinkLines",
     "Recognition",
+    "confidence_floor",
     "fit_mesh",
     "fit_primitive",
     "recognise",
@@ -292,6 +293,11 @@ class Recognition:
     def undecided(self) -> bool:
         """True when the decision abstains."""
         return self.decision == UNDECIDED
+
+    @property
+    def confidence_floor(self) -> float:
+        """The confidence a decision needs, 1 / (1 + exp(-threshold / 2)) (0.95 at 6)."""
+        return confidence_floor(self.threshold)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able (SI units)."""
@@ -669,6 +675,12 @@ def _outward(points: FloatArray, outward: ArrayLike | None) -> FloatArray:
     return direction / norm if norm > 0 else np.array([0.0, 0.0, 1.0])
 
 
+def confidence_floor(threshold: float) -> float:
+    """The best class's weight a runner-up ``threshold`` behind in score leaves it,
+    1 / (1 + exp(-threshold / 2)): the confidence a decision needs (module docstring)."""
+    return 1.0 / (1.0 + math.exp(-0.5 * threshold))
+
+
 def recognise(
     points: ArrayLike,
     covariances: ArrayLike,
@@ -735,7 +747,7 @@ def recognise(
     confidence = float(weights[0])
     if rival is not None:
         confidence = 1.0 / (1.0 + math.exp(-0.5 * (rival.chi2 - best.chi2) / c))
-    sure = confidence >= 1.0 / (1.0 + math.exp(-0.5 * threshold))
+    sure = confidence >= confidence_floor(threshold)
     decision = best.name if delta >= threshold and rival is None and sure else UNDECIDED
     leaders = (best, rival) if rival is not None else tuple(fits[:2])
     return Recognition(

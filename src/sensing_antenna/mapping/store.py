@@ -167,6 +167,14 @@ def report(contact_map: ContactMap) -> str:
             + f"; score gap to the runner-up {recognition.delta_score:.1f}"
             f" (abstains below {recognition.threshold:g})"
             + (
+                f"; the best's weight {recognition.confidence:.3f} is below the"
+                f" {recognition.confidence_floor:.3f} a decision needs"
+                if recognition.undecided
+                and recognition.rival is None
+                and recognition.confidence < recognition.confidence_floor
+                else ""
+            )
+            + (
                 f"; {recognition.rival} explains the points as well and is another shape"
                 if recognition.rival is not None
                 else ""
