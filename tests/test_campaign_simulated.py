@@ -134,12 +134,14 @@ def test_a_spec_push_is_the_head_rotation_or_the_criterion_fields(tmp_path: Path
     table = {"kind": "force", "threshold": 0.5}
     assert make_scenario("azimuthal", 0.5, 0, {"push": table}).push == PushCriterion(**table)
     for bad, problem in [
-        ("deep", "must be the head's rotation past the first touch"),
-        (-1.0, "must be a finite number > 0"),
-        ({"kind": "speed"}, "must be one of"),
+        ("deep", r"push: must be the head's rotation past the first touch"),
+        (-1.0, r"push: must be a finite number > 0"),
+        ({"kind": "speed"}, r"push\.kind: must be one of"),
+        ({"cutoff": 0.0}, r"push\.cutoff: must be a finite number > 0"),
+        ({"treshold": 0.1}, r"push\.treshold: not a push criterion field; known: cutoff, kind"),
     ]:
         spec = one_point_spec(scenario={"push": bad}, source="bad.toml")
-        with pytest.raises(CampaignSpecError, match=rf"bad\.toml: scenario\.push: {problem}"):
+        with pytest.raises(CampaignSpecError, match=rf"bad\.toml: scenario\.{problem}"):
             run_campaign(spec, tmp_path / str(bad), workers=1, progress=False)
 
 

@@ -79,15 +79,24 @@ def push_criterion(value: Any) -> Any:
 
     if value is None or isinstance(value, PushCriterion):
         return value
+    known = {f.name for f in dataclasses.fields(PushCriterion)}
+    if isinstance(value, Mapping):
+        for key in value:
+            if key not in known:
+                raise CampaignSpecError(
+                    f"scenario.push.{key}",
+                    f"not a push criterion field; known: {', '.join(sorted(known))}",
+                )
     try:
         if isinstance(value, Mapping):
             return PushCriterion(**value)
         if isinstance(value, (int, float)) and not isinstance(value, bool):
             return PushCriterion(kind="rotation", threshold=float(value))
     except PushConfigError as exc:
-        raise CampaignSpecError("scenario.push", str(exc).split(": ", 1)[-1]) from exc
-    except TypeError as exc:
-        raise CampaignSpecError("scenario.push", str(exc)) from exc
+        # "push.<field>: <problem>"; a bare number is the threshold
+        field, _, problem = str(exc).partition(": ")
+        name = f"scenario.{field}" if isinstance(value, Mapping) else "scenario.push"
+        raise CampaignSpecError(name, problem) from exc
     raise CampaignSpecError(
         "scenario.push",
         "must be the head's rotation past the first touch (rad) or a table of the push "
