@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_campaign.py [--workers N] [--spec FILE] [--keep DIR]
+    python benchmarks/bench_campaign.py [--workers N] [--spec FILE] [--keep DIR] [--note TEXT]
 
 Prints a table and writes ``benchmarks/results/campaign.json``. The campaign runs into a fresh
 temporary directory (or ``--keep DIR``, which must not hold a finished campaign), so every run is
@@ -55,6 +55,9 @@ def main() -> int:
     parser.add_argument("--workers", type=int, default=None, help="default: all cores")
     parser.add_argument("--spec", default=None, help="campaign TOML (default: paper-2021)")
     parser.add_argument("--keep", type=Path, default=None, help="campaign directory to keep")
+    parser.add_argument(
+        "--note", default="", help="what else ran on the machine meanwhile, kept in the results"
+    )
     args = parser.parse_args()
 
     spec = load_campaign_spec(args.spec)
@@ -117,7 +120,8 @@ def main() -> int:
         "simulate": _stats(simulate),
         "front_end": _stats(front_end),
         "conclude": {method: _stats(values) for method, values in per_method.items()},
-        "note": "machine shared with other work while measured; times are under load",
+        # what else ran on the machine, as the one who measured says (--note)
+        "note": args.note,
     }
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
     RESULTS.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
