@@ -143,7 +143,8 @@ def is_slip_reference(
     """Whether the fit of a window's first half may serve as the slip check's reference.
 
     It must hold ``min_periods`` periods of the whole window's fundamental ``omega1`` (rad/s)
-    and have its strongest mode in ``band`` within :data:`_SAME_MODE` of it.
+    and a mode of ``band``, detected, within :data:`_SAME_MODE` of it: the fundamental, which
+    need not be the strongest (the free plane's, :mod:`.planes`).
     """
     if half is None or half.duration * omega1 < 2.0 * math.pi * config.min_periods:
         # Statics of a window too short for the model are not a reference (mode and offset
@@ -151,8 +152,10 @@ def is_slip_reference(
         return False
     # A half that read another fundamental has put part of the vibration in its static part
     # (a slow, fast-decaying mode in its place): its statics are no reference either
-    k = half.strongest_in_band(band)
-    return k is not None and abs(float(half.omega[k]) - omega1) <= _SAME_MODE * omega1
+    detected = half.snr() * math.sqrt(0.5 * half.n_samples) >= config.min_detection
+    in_band = (half.omega >= band[0]) & (half.omega <= band[1])
+    near = np.abs(half.omega - omega1) <= _SAME_MODE * omega1
+    return bool(np.any(detected & in_band & near))
 
 
 def ratio_check(
