@@ -247,6 +247,26 @@ def test_antenna_explore_bad_scene_is_one_line(
     )
 
 
+def test_stored_sweeps_this_grid_would_not_make_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # an exploration kept from a grid of another version (one that swept the other way first):
+    # going on would repeat or skip this grid's sweeps
+    out = tmp_path / "old"
+    explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
+    path = out / "manoeuvres" / "000.json"
+    stored = json.loads(path.read_text())
+    stored["sweep"]["direction"] = -stored["sweep"]["direction"]
+    path.write_text(json.dumps(stored))
+    with pytest.raises(ExplorationStoreError, match=r"000\.json: sweep: base 0, azimuthal at"):
+        explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=2))
+    assert main(["explore", "post", "--method", "paper", "--budget", "2", "--out", str(out)]) == 2
+    # after the line saying what it explores, one line of error
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith(f"antenna explore: error: {path}: sweep: base 0")
+    assert err[-1].endswith("explore into another output directory")
+
+
 def test_a_larger_budget_goes_on_from_the_stored_manoeuvres(tmp_path: Path) -> None:
     out = tmp_path / "grow"
     first = explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))

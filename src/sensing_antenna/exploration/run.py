@@ -41,10 +41,18 @@ import trimesh
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.campaign.store import atomic_write_text
 from sensing_antenna.errors import raise_if_signalled
-from sensing_antenna.exploration.plan import STRATEGIES, Choice, NextBestPlanner, grid_sweeps
+from sensing_antenna.exploration.plan import (
+    STRATEGIES,
+    Choice,
+    NextBestPlanner,
+    candidate_sweeps,
+    grid_sweeps,
+)
 from sensing_antenna.exploration.store import (
     CALIBRATED_FILE,
+    MANOEUVRES_DIR,
     RECORDINGS_DIR,
+    ExplorationStoreError,
     Manoeuvre,
     exploration_lock,
     load_manoeuvres,
@@ -64,7 +72,7 @@ from sensing_antenna.mapping.recognition import ClassFit
 from sensing_antenna.recording import write_recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.simulate import simulate_sweep
-from sensing_antenna.scene.sweep import LinkShape
+from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.simulator.scenario import LINK_MODELS
 
 __all__ = [
@@ -222,6 +230,30 @@ def _prepared(device: Antenna, out: Path, link: str) -> Antenna:
     return load_antenna(path)
 
 
+def _check_stored_sweeps(
+    out: Path, manoeuvres: list[Manoeuvre], scene: Scene, grid: list[Sweep], strategy: str
+) -> None:
+    """Refuse stored manoeuvres that this strategy would not have swept: an exploration made
+    by another version of the planner (a grid that swept one way only, say) would go on with
+    sweeps that repeat or skip its own. The grid's must be its first sweeps in order;
+    next-best's, sweeps of its grid or of its candidates."""
+    allowed = None if strategy == "grid" else {*grid, *candidate_sweeps(scene)}
+    for index, manoeuvre in enumerate(manoeuvres):
+        sweep = manoeuvre.sweep
+        if allowed is None:
+            fits = index < len(grid) and sweep == grid[index]
+        else:
+            fits = sweep in allowed
+        if not fits:
+            path = out / MANOEUVRES_DIR / f"{index:03d}.json"
+            raise ExplorationStoreError(
+                f"{path}: sweep: base {sweep.base}, {sweep.case} at {sweep.fixed:+.4f} rad, "
+                f"direction {sweep.direction:+d} is not one this version's {strategy} strategy "
+                "sweeps there (an exploration made by another version); explore into another "
+                "output directory"
+            )
+
+
 def _scene_fingerprint(scene: Scene) -> str:
     digest = hashlib.sha256()
     for obj in scene.objects:
@@ -284,6 +316,7 @@ def explore(
         )
         scene.mesh.export(out / "scene.ply")
         manoeuvres = load_manoeuvres(out)
+        _check_stored_sweeps(out, manoeuvres, scene, grid, settings.strategy)
         try:
             antenna = _prepared(device, out, settings.link)
             shape = LinkShape(device.link)
