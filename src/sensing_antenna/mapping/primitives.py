@@ -17,10 +17,14 @@ capsule   centre (3), rotation (3), radius,     radius, length of the axis segme
           segment length
 cone      base centre (3), rotation (3), base   base radius, height (apex on +Z)
           radius, height
-torus     centre (3), rotation (3), major R,    major radius, minor radius
-          minor r
+torus     centre (3), rotation (3), hole        major radius, minor radius
+          R - r >= 0, minor r
 box       centre (3), rotation (3), extents (3) the three edge lengths
 ========  ====================================  ==========================================
+
+The torus is a ring (R >= r, as scene files require): its major radius is parametrised as the
+minor radius plus the hole's half-width, bounded below by 0, so that the fit cannot shrink the
+ring to a sphere with dimples at its poles.
 
 ``dof`` is the number of independent parameters (a rotation about a symmetry axis is not one),
 the k of a model-selection score.
@@ -169,7 +173,8 @@ def _cone(parameters: FloatArray, points: FloatArray) -> FloatArray:
 def _torus(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # d = sqrt((rho - R)^2 + z^2) - r
     local = _local(parameters, points)
-    major, minor = parameters[6], parameters[7]
+    minor = parameters[7]
+    major = parameters[6] + minor
     rho = np.hypot(local[:, 0], local[:, 1])
     return np.asarray(np.hypot(rho - major, local[:, 2]) - minor)
 
@@ -248,14 +253,17 @@ PRIMITIVES: dict[str, Primitive] = {
         ),
         Primitive(
             "torus",
-            (*_POSE, "major_radius", "minor_radius"),
+            (*_POSE, "hole", "minor_radius"),
             8,
             ("major_radius", "minor_radius"),
             _torus,
-            lambda p: p[6:8],
+            lambda p: np.array([p[6] + p[7], p[7]]),
             _with_pose(
                 lambda p: trimesh.creation.torus(
-                    major_radius=p[6], minor_radius=p[7], major_sections=64, minor_sections=32
+                    major_radius=p[6] + p[7],
+                    minor_radius=p[7],
+                    major_sections=64,
+                    minor_sections=32,
                 )
             ),
         ),

@@ -29,17 +29,17 @@ the best-fitting class when above 1, so that points farther from every class tha
 covariances say, an estimator's systematic error, weigh less); c = 1 is BIC. The lowest score wins.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
-points pin the richer class's extra parameters to the simpler shape (a torus fitted to a sphere
-shrinks its ring to nothing) and wrong when they leave them free: points along one outline of a
-torus seen face-on fit a sphere and a whole family of tori alike, and k ln n would name the
-sphere with a weight the points never gave it. So the decision also asks whether the points
-rule the runner-ups out: a class is a **rival** of the best when its own fit is not worse by
-:data:`ABSTAIN_DELTA` in chi^2 / c (the likelihood alone, no penalty: the points do not reject
-it) and its fitted shape is a different object, some part of its surface (the 95th percentile
-of the distances between the two fitted surfaces, both ways) farther from the best's than
-:data:`SAME_SHAPE_SIGMAS` times the points' median standard deviation along the normal. The
-decision abstains (``undecided``, naming the best and its rival) when there is a rival, or
-when the runner-up's score is within :data:`ABSTAIN_DELTA` of the best's.
+points pin the richer class's extra parameters to the simpler shape (a capsule fitted to a
+sphere shrinks its segment to nothing) and wrong when they leave them free: points along one
+outline of a torus seen face-on fit a sphere and a whole family of tori alike, and k ln n would
+name the sphere with a weight the points never gave it. So the decision also asks whether the
+points rule the runner-ups out: a class is a **rival** of the best when its own fit is not
+worse by :data:`ABSTAIN_DELTA` in chi^2 / c (the likelihood alone, no penalty: the points do
+not reject it) and its fitted shape is a different object, some part of its surface (the
+95th percentile of the distances between the two fitted surfaces, both ways) farther from the
+best's than :data:`SAME_SHAPE_SIGMAS` times the points' median standard deviation along the
+normal. The decision abstains (``undecided``, naming the best and its rival) when there is a
+rival, or when the runner-up's score is within :data:`ABSTAIN_DELTA` of the best's.
 
 Confidence: the best class's weight exp(-score / 2) normalised over the classes (the posterior
 probability under equal priors in BIC's approximation), and, when there is a rival, the best's
@@ -377,7 +377,8 @@ def _starts(
         elif shape.name == "cone":
             starts.append(np.array([*(centre - 0.5 * size * z_axis), *rotvec, size, 2 * size]))
         elif shape.name == "torus":
-            starts.append(np.array([*centre, *rotvec, 0.7 * size, 0.3 * size]))
+            # major 0.7, minor 0.3 of the size: a hole of 0.4
+            starts.append(np.array([*centre, *rotvec, 0.4 * size, 0.3 * size]))
         else:  # box
             starts.append(np.array([*centre, *rotvec, 1.5 * size, 1.5 * size, 1.5 * size]))
     return starts
@@ -400,7 +401,7 @@ def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
 
 def _bounds(shape: Primitive, points: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Sizes from :data:`MIN_SIZE` to :data:`MAX_SIZE_SPREADS` times the points' spread (the
-    torus's major radius to one spread)."""
+    torus's hole, R - r, to one spread)."""
     n = len(shape.parameter_names)
     low = np.full(n, -np.inf)
     high = np.full(n, np.inf)
@@ -410,8 +411,8 @@ def _bounds(shape: Primitive, points: FloatArray) -> tuple[FloatArray, FloatArra
         low[n - n_sizes :] = MIN_SIZE
         high[n - n_sizes :] = max(MAX_SIZE_SPREADS * spread, 10 * MIN_SIZE)
     if shape.name == "torus":
-        # a ring larger than all the touches is a bent cylinder, one parameter dearer: the
-        # torus is the class of rings the points go around
+        # a ring whose hole is wider than all the touches is a bent cylinder, one parameter
+        # dearer: the torus is the class of rings the points go around
         high[6] = max(spread, 10 * MIN_SIZE)
     return low, high
 
