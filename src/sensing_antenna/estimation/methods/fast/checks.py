@@ -152,8 +152,8 @@ def is_slip_reference(
         return False
     # A half that read another fundamental has put part of the vibration in its static part
     # (a slow, fast-decaying mode in its place): its statics are no reference either
-    detected = half.snr() * math.sqrt(0.5 * half.n_samples) >= config.min_detection
-    in_band = (half.omega >= band[0]) & (half.omega <= band[1])
+    detected = half.detection() >= config.min_detection
+    in_band = half.in_band(band)
     near = np.abs(half.omega - omega1) <= _SAME_MODE * omega1
     return bool(np.any(detected & in_band & near))
 
@@ -278,7 +278,7 @@ def branch_contradiction(
     others = [c for c in candidates if posterior.branch_of(c) != chosen]
     if not own or not others:
         return ""
-    detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)
+    detection = fit.detection()
 
     def mismatch(omega: float, x_c: float) -> tuple[float, int]:
         # Relative distance to the nearer of the candidate's modes 2 and 3, and which one

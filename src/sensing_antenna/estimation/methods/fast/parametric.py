@@ -168,9 +168,18 @@ class DampedSinusoidFit:
         ratio = self.start_amplitudes() / self.noise_std[:, None]
         return np.asarray(np.sqrt(np.sum(ratio**2, axis=0)), dtype=float)
 
+    def detection(self) -> FloatArray:
+        """Each mode's detection statistic, shape (M,): :meth:`snr` times sqrt(n / 2), the
+        amplitude at the window start over the noise of one periodogram ordinate."""
+        return np.asarray(self.snr() * math.sqrt(0.5 * self.n_samples), dtype=float)
+
+    def in_band(self, band: tuple[float, float]) -> NDArray[np.bool_]:
+        """Which modes lie inside ``band`` (rad/s, inclusive), shape (M,)."""
+        return np.asarray((self.omega >= band[0]) & (self.omega <= band[1]))
+
     def strongest_in_band(self, band: tuple[float, float]) -> int | None:
         """Index of the mode inside ``band`` (rad/s) with the largest combined SNR, or None."""
-        inside = np.flatnonzero((self.omega >= band[0]) & (self.omega <= band[1]))
+        inside = np.flatnonzero(self.in_band(band))
         if inside.size == 0:
             return None
         return int(inside[np.argmax(self.snr()[inside])])

@@ -360,7 +360,7 @@ def _higher_mode(
     (or the fit did not converge).
     """
     low, high = float(higher.min()), float(higher.max())
-    detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)
+    detection = fit.detection()
     usable = [
         k
         for k in range(fit.n_modes)

@@ -222,12 +222,11 @@ def find_fundamental(
     k = fit.strongest_in_band(band)
     if k is None:
         return None, "no vibration mode in the omega_1 band"
-    detection = fit.snr() * math.sqrt(0.5 * fit.n_samples)
+    detection = fit.detection()
     if push_direction is not None:
         share = free_plane_share(fit, push_direction)
         free = np.flatnonzero(
-            (fit.omega >= band[0])
-            & (fit.omega <= band[1])
+            fit.in_band(band)
             & (share > 0.5)
             & (fit.omega <= (1.0 + config.free_plane_margin) * fit.omega[k])
             & (detection >= config.min_detection)
