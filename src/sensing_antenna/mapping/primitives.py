@@ -23,8 +23,8 @@ box       centre (3), rotation (3), extents (3) the three edge lengths
 ========  ====================================  ==========================================
 
 The torus is a ring (R >= r, as scene files require): its major radius is parametrised as the
-minor radius plus the hole's half-width, bounded below by 0, so that the fit cannot shrink the
-ring to a sphere with dimples at its poles.
+minor radius plus the hole's radius R - r, bounded below (``recognition.MIN_SIZE`` in the fit),
+so that the fit cannot shrink the ring to a sphere with dimples at its poles.
 
 ``dof`` is the number of independent parameters (a rotation about a symmetry axis is not one),
 the k of a model-selection score.

@@ -677,8 +677,9 @@ def _outward(points: FloatArray, outward: ArrayLike | None) -> FloatArray:
 
 
 def confidence_floor(threshold: float) -> float:
-    """The best class's weight a runner-up ``threshold`` behind in score leaves it,
-    1 / (1 + exp(-threshold / 2)): the confidence a decision needs (module docstring)."""
+    """The best class's weight against one runner-up ``threshold`` behind in score,
+    1 / (1 + exp(-threshold / 2)): at the abstention threshold, the confidence a decision needs
+    (module docstring)."""
     return 1.0 / (1.0 + math.exp(-0.5 * threshold))
 
 
@@ -747,7 +748,8 @@ def recognise(
     )
     confidence = float(weights[0])
     if rival is not None:
-        confidence = 1.0 / (1.0 + math.exp(-0.5 * (rival.chi2 - best.chi2) / c))
+        # the best's weight against the rival on the likelihood alone
+        confidence = confidence_floor((rival.chi2 - best.chi2) / c)
     sure = confidence >= confidence_floor(threshold)
     decision = best.name if delta >= threshold and rival is None and sure else UNDECIDED
     leaders = (best, rival) if rival is not None else tuple(fits[:2])

@@ -171,7 +171,7 @@ def report(contact_map: ContactMap) -> str:
                 f" {recognition.confidence_floor:.3f} a decision needs"
                 if recognition.undecided
                 and recognition.rival is None
-                and recognition.confidence < recognition.confidence_floor
+                and recognition.delta_score >= recognition.threshold
                 else ""
             )
             + (
