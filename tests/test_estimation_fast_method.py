@@ -1158,6 +1158,8 @@ def test_fundamental_is_read_in_the_free_plane_when_the_push_plane_rings_high() 
     recording = simulate(antenna, scenario)
     truth = float(recording.metadata["true_xc"])
     result = estimate(recording.without_ground_truth(), antenna, "fast")
+    # around omega_1 at x_c = 0.9 m (83 rad/s; the curve's top is 101 rad/s), below mode 2
+    # (267 rad/s there)
     in_band = [w for w in result.diagnostics["modes"] if 60.0 < w < 110.0]
     # two modes of the omega_1 band, their contact points more than 1 cm apart
     low, high = min(in_band), max(in_band)

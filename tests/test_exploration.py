@@ -24,7 +24,7 @@ from sensing_antenna.exploration import (
 )
 from sensing_antenna.exploration.plan import spread_order
 from sensing_antenna.mapping import UNDECIDED, BasePose, ClassFit, ImplicitSurface, recognise
-from sensing_antenna.scene import LinkShape, Scene, first_touch, load_scene
+from sensing_antenna.scene import LinkShape, Scene, Sweep, first_touch, load_scene
 
 DEVICE = paper_antenna()
 
@@ -279,11 +279,14 @@ def test_a_larger_budget_goes_on_from_the_stored_manoeuvres(tmp_path: Path) -> N
     assert grown.manoeuvres[1].sweep != grown.manoeuvres[0].sweep
 
 
-def _outline_contacts(scene: Scene, rng: np.random.Generator, sigma: float) -> np.ndarray:
-    """The surface points the scene's grid sweeps first touch, moved by Gaussian noise of
-    ``sigma`` (m) in every direction, shape (n, 3)."""
+def _outline_contacts(
+    scene: Scene, rng: np.random.Generator, sigma: float, sweeps: list[Sweep] | None = None
+) -> np.ndarray:
+    """The surface points the sweeps (the scene's grid when None) first touch, moved by
+    Gaussian noise of ``sigma`` (m) in every direction, shape (n, 3)."""
     shape = LinkShape(DEVICE.link)
-    touched = [first_touch(scene, sweep, shape).touch for sweep in grid_sweeps(scene)]
+    sweeps = grid_sweeps(scene) if sweeps is None else sweeps
+    touched = [first_touch(scene, sweep, shape).touch for sweep in sweeps]
     points = np.array([t.surface_point for t in touched if t is not None])
     return points + sigma * rng.standard_normal(points.shape)
 
@@ -311,3 +314,20 @@ def test_outlines_seen_from_three_sides_tell_a_sphere_that_two_opposite_bases_ca
     # the radius within 2 %: 1 mm of noise on a 6 cm ball, about 30 points
     assert three.best.sizes["radius"] == pytest.approx(ball.parameters[3], rel=0.02)
     assert decisions["opposite"].decision == UNDECIDED
+
+
+def test_a_ball_touched_from_above_and_below_is_not_a_torus_shrunk_round_it() -> None:
+    # The grid's outlines and the same vertical sweeps run down as well, so the points ring
+    # the ball from above and below and leave its poles untouched: a torus of major radius
+    # near zero (a sphere with dimples at the poles) fitted them better than the sphere and,
+    # another shape, made the decision abstain. The torus class is a ring (R >= r).
+    scene = load_scene("sphere")
+    grid = grid_sweeps(scene)
+    down = [dataclasses.replace(s, direction=-1) for s in grid if s.case == "vertical"]
+    sigma = 0.001
+    points = _outline_contacts(scene, np.random.default_rng(3), sigma, grid + down)
+    covariances = np.tile(sigma**2 * np.eye(3), (len(points), 1, 1))
+    result = recognise(points, covariances, rng=np.random.default_rng(0))
+    torus = next(f for f in result.fits if f.name == "torus")
+    assert torus.sizes["major_radius"] >= torus.sizes["minor_radius"]
+    assert result.decision == "sphere" and result.rival is None
