@@ -417,12 +417,37 @@ def test_a_rounded_surface_is_simulated_as_a_ball_a_straight_one_as_a_cylinder()
     ball = _scene(primitive_object("ball", "sphere", [0.07], [0.6, 0.2, 0.03]))
     touch = first_touch(ball, sweep, shape).touch
     assert touch is not None
-    assert touch.across_radius == pytest.approx(0.07, rel=1e-3)
+    assert touch.principal_radii == pytest.approx((0.07, 0.07), rel=1e-3)
     scenario, _ = touch_scenario(touch, sweep, ball)
     assert scenario.obstacle == "ball"
     assert scenario.obstacle_radius == pytest.approx(0.07, rel=1e-3)
     post = _scene(primitive_object("post", "cylinder", [0.03, 0.5], [0.6, 0.2, 0.0]))
     touch = first_touch(post, sweep, shape).touch
-    assert touch is not None and touch.across_radius > 1.0
+    assert touch is not None and touch.principal_radii[1] > 1.0
     scenario, _ = touch_scenario(touch, sweep, post)
+    assert scenario.obstacle == "post"
+
+
+@pytest.mark.parametrize("lean", [0.0, 40.0, 60.0])
+def test_an_edge_is_simulated_as_a_cylinder_whichever_way_the_link_crosses_it(lean: float) -> None:
+    # A box turned to meet the level sweep with a vertical edge, then leant by ``lean`` degrees
+    # about Y: the link crosses the edge that far off the perpendicular, and the surface bends
+    # both along the link and across it. It is still curved one way only (straight along the
+    # edge), so its obstacle is a post, on which a link sliding across stays on the edge, not a
+    # ball, off which it would slide.
+    from scipy.spatial.transform import Rotation
+
+    from sensing_antenna.scene.simulate import touch_scenario
+
+    turn = Rotation.from_euler("y", lean, degrees=True) * Rotation.from_euler("z", 45, degrees=True)
+    box = primitive_object("box", "box", [0.1, 0.1, 0.3], [0.6, 0.2, 0.0], turn.as_rotvec())
+    scene = _scene(box)
+    sweep = Sweep(0, "azimuthal", 0.0, -0.5, 0.8)
+    touch = first_touch(scene, sweep, LinkShape(DEVICE.link, gravity=0.0)).touch
+    assert touch is not None and not touch.tip
+    # the edge, 0.1 / sqrt(2) m in front of the box's centre
+    assert touch.surface_point[1] == pytest.approx(0.2 - 0.1 / math.sqrt(2), abs=1e-4)
+    smallest, largest = touch.principal_radii
+    assert smallest < 2e-3 and largest > 5 * smallest
+    scenario, _ = touch_scenario(touch, sweep, scene)
     assert scenario.obstacle == "post"

@@ -8,9 +8,10 @@ equivalent to the surface there, placed by the simulator from x_c as for any of 
   to the link and to the surface's normal, of the surface's local radius along the link (a post
   for an azimuthal sweep, a bar for a vertical one), turned by the normal's angle out of the
   sweep's plane (the scenario's ``obstacle_tilt``); where the surface is curved both ways (its
-  radius across the link at most :data:`BALL_RATIO` times the one along it: a sphere, a
-  capsule's caps) a ball of the radius along the link instead, on which a link sliding across
-  stays on the surface;
+  largest principal radius at most :data:`BALL_RATIO` times its smallest: a sphere, a capsule's
+  caps, a corner) a ball of the radius along the link instead, on which a link sliding across
+  stays on the surface. An edge is curved one way only, whichever way the link crosses it:
+  a cylinder, along which a link sliding across stays on the edge, as it does on a real one;
 - a contact at the tip: the simulator's plane, touched by the tip (its normal is the
   simulator's, not the face's: the touched point is the same).
 
@@ -66,10 +67,11 @@ __all__ = [
     "touch_scenario",
 ]
 
-#: A surface whose radius across the link is at most this many times its radius along it is
-#: curved across at least half as much as along, and its equivalent obstacle a ball of the
-#: radius along (a sphere, a capsule's caps); beyond, a cylinder, straight across (a cylinder's
-#: side, a box's edge). Radii are capped at 10 m: a flat face gives a 10 m ball or cylinder.
+#: A surface whose largest principal radius is at most this many times its smallest is curved
+#: every way at least half as much as the most, and its equivalent obstacle a ball of the radius
+#: along the link (a sphere, a capsule's caps, a box's corner); beyond, a cylinder, straight
+#: across (a cylinder's side, a box's edge met at any angle). Radii are capped at 10 m: a flat
+#: face gives a 10 m ball.
 BALL_RATIO = 2.0
 
 #: Largest angle of the surface's normal out of the sweep's direction (rad) the simulator's
@@ -156,9 +158,10 @@ def touch_scenario(
     # radius R curves by cos(phi)^2 / R along it (Euler), so R = R_along cos(phi)^2
     along_axis = float(axis @ tangent)
     radius = touch.radius * (1.0 - along_axis**2)
-    if touch.across_radius <= BALL_RATIO * touch.radius:
-        # curved across the link too: a ball of the radius along it, on which a link sliding
-        # across stays on the surface (a cylinder is straight that way)
+    smallest, largest = touch.principal_radii
+    if largest <= BALL_RATIO * smallest:
+        # curved every way: a ball of the radius along the link, on which a link sliding
+        # across stays on the surface (a cylinder is straight along its axis)
         kind = "ball"
         radius = touch.radius
     if touch.tip:

@@ -14,7 +14,11 @@ takes, comes from the distance d(+-h) of the points h = :data:`CURVATURE_PROBE` 
 of the touched point along the link's direction in the tangent plane: a circle of radius R
 curves away by d = sqrt(R^2 + h^2) - R, so R = (h^2 - d^2) / (2 d) with d the mean of the two;
 exact on a circular section, small at an edge, and capped to [:data:`MIN_RADIUS`,
-:data:`MAX_RADIUS`].
+:data:`MAX_RADIUS`]. The same probe in :data:`BEND_DIRECTIONS` directions of the tangent plane
+gives the surface's principal radii, its smallest and largest radius over the directions: equal
+on a sphere; on a cylinder's side, or at an edge, the radius across the axis and one many times
+larger (the direction nearest the axis is at most half a step off it), whichever way the link
+crosses.
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ from sensing_antenna.scene.sweep import LinkShape, Sweep
 
 __all__ = [
     "ANGLE_TOLERANCE",
+    "BEND_DIRECTIONS",
     "CURVATURE_PROBE",
     "MAX_RADIUS",
     "MIN_RADIUS",
@@ -61,6 +66,12 @@ MIN_RADIUS = 0.001
 #: Largest local radius (m): a flat face's, the simulator's largest obstacle radius.
 MAX_RADIUS = 10.0
 
+#: Directions of the tangent plane, evenly over half a turn, in which the principal radii are
+#: looked for: 22.5 degrees apart, so an edge's straight direction is met within 11.25 degrees,
+#: where its bend is at most sin(11.25 deg) = 0.2 of the largest (a wedge's bend grows as the
+#: sine of the angle off its edge).
+BEND_DIRECTIONS = 8
+
 
 @dataclass(frozen=True)
 class Touch:
@@ -84,8 +95,10 @@ class Touch:
         The link's unit tangent there (world frame).
     radius : float
         The surface's local radius of curvature along the link (m), capped.
-    across_radius : float
-        Its radius of curvature across the link, in the tangent plane (m), capped.
+    principal_radii : (float, float)
+        Its smallest and largest radius of curvature over the directions of the tangent plane
+        (m), capped: equal on a sphere, the largest many times the smallest on a cylinder or an
+        edge.
     tip : bool
         True when the link's tip touches (the surface is not tangent to the link).
     object_name : str
@@ -100,7 +113,7 @@ class Touch:
     normal: FloatArray
     tangent: FloatArray
     radius: float
-    across_radius: float
+    principal_radii: tuple[float, float]
     tip: bool
     object_name: str
 
@@ -115,7 +128,7 @@ class Touch:
             "normal": self.normal.tolist(),
             "tangent": self.tangent.tolist(),
             "radius": self.radius,
-            "across_radius": self.across_radius,
+            "principal_radii": list(self.principal_radii),
             "tip": self.tip,
             "object": self.object_name,
         }
@@ -224,13 +237,20 @@ def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angl
     normal = touched.normal(link_point)
     distance = min(per_object)
     surface_point = link_point - distance * normal
-    radius = across_radius = MAX_RADIUS
+    radius = MAX_RADIUS
+    principal = (MAX_RADIUS, MAX_RADIUS)
     tangent = shape.tangent_at(x_c, theta, base)
     if not tip:
         along = tangent - (tangent @ normal) * normal
         along /= np.linalg.norm(along)
+        across = np.cross(normal, along)
         radius = _bend_radius(touched, surface_point, along)
-        across_radius = _bend_radius(touched, surface_point, np.cross(normal, along))
+        turns = np.pi * np.arange(BEND_DIRECTIONS) / BEND_DIRECTIONS
+        radii = [
+            _bend_radius(touched, surface_point, math.cos(t) * along + math.sin(t) * across)
+            for t in turns
+        ]
+        principal = (min(radii), max(radii))
     return Touch(
         angle=angle,
         angles=theta,
@@ -240,7 +260,7 @@ def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angl
         normal=normal,
         tangent=tangent,
         radius=float(radius) if math.isfinite(radius) else MAX_RADIUS,
-        across_radius=float(across_radius) if math.isfinite(across_radius) else MAX_RADIUS,
+        principal_radii=(float(principal[0]), float(principal[1])),
         tip=tip,
         object_name=touched.name,
     )
