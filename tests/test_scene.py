@@ -138,6 +138,26 @@ def test_a_mesh_file_touches_like_the_primitive(tmp_path: Path) -> None:
     np.testing.assert_allclose(from_mesh.surface_point, exact.surface_point, atol=1e-6)
 
 
+@pytest.mark.parametrize(
+    ("shape", "sizes"),
+    [
+        ("cylinder", [0.03, 0.1]),
+        ("capsule", [0.02, 0.06]),
+        ("cone", [0.04, 0.09]),
+        ("torus", [0.05, 0.02]),
+        ("box", [0.08, 0.05, 0.03]),
+    ],
+)
+def test_a_primitive_objects_surface_is_its_mesh(shape: str, sizes: list[float]) -> None:
+    # What the link touches (the signed distance) and what the figures and scores use (the
+    # mesh) are one surface, and the object reports the sizes it was made with: the torus's
+    # parameters hold its hole, R - r, not R.
+    obj = primitive_object("it", shape, sizes, [0.6, 0.1, -0.02], [0.3, -0.5, 0.2])
+    vertices = np.asarray(obj.mesh.vertices)
+    assert np.max(np.abs(obj.signed_distance(vertices))) < 2e-4
+    assert list(obj.sizes.values()) == pytest.approx(sizes, abs=1e-12)
+
+
 def test_a_sweep_towards_minus_y_touches_the_other_tangent_line() -> None:
     # the gravity-free link of the test above swept the other way, from the range's end down:
     # it first meets the circle on the tangent line on the other side of the centre's bearing,

@@ -69,6 +69,7 @@ class Primitive:
     _distance: Callable[[FloatArray, FloatArray], FloatArray]
     _sizes: Callable[[FloatArray], FloatArray]
     _mesh: Callable[[FloatArray], trimesh.Trimesh] | None
+    _size_entries: Callable[[FloatArray], FloatArray] = lambda sizes: sizes
 
     def signed_distance(self, parameters: FloatArray, points: FloatArray) -> FloatArray:
         """d(p) (m), shape (n,), for points of shape (n, 3) (m)."""
@@ -77,6 +78,11 @@ class Primitive:
     def sizes(self, parameters: FloatArray) -> FloatArray:
         """The class's sizes (m), in the order of ``size_names``."""
         return self._sizes(np.asarray(parameters, dtype=float))
+
+    def size_parameters(self, sizes: FloatArray) -> FloatArray:
+        """The parameter vector's entries after the pose for sizes (m) in the order of
+        ``size_names``: the inverse of :meth:`sizes` (a torus's hole is major - minor)."""
+        return np.asarray(self._size_entries(np.asarray(sizes, dtype=float)), dtype=float)
 
     def mesh(self, parameters: FloatArray) -> trimesh.Trimesh | None:
         """The shape as a trimesh mesh (None for the unbounded plane)."""
@@ -266,6 +272,7 @@ PRIMITIVES: dict[str, Primitive] = {
                     minor_sections=32,
                 )
             ),
+            lambda sizes: np.array([sizes[0] - sizes[1], sizes[1]]),
         ),
         Primitive(
             "box",

@@ -88,7 +88,7 @@ def _rotation(rotation: ArrayLike) -> FloatArray:
 
 
 def _fine_mesh(shape: str, parameters: FloatArray) -> trimesh.Trimesh:
-    sizes = parameters[6:]
+    sizes = PRIMITIVES[shape].sizes(parameters)
     if shape == "sphere":
         return trimesh.creation.icosphere(subdivisions=5, radius=parameters[3]).apply_translation(
             parameters[0:3]
@@ -136,7 +136,7 @@ def primitive_object(
     """
     if shape not in OBJECT_SHAPES:
         raise ValueError(f"unknown shape {shape!r} (known: {', '.join(OBJECT_SHAPES)})")
-    s = np.asarray(sizes, dtype=float).reshape(-1)
+    s = PRIMITIVES[shape].size_parameters(np.asarray(sizes, dtype=float).reshape(-1))
     if shape == "sphere":
         parameters = np.concatenate([np.asarray(position, dtype=float), s])
     else:
