@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -124,7 +125,10 @@ def test_covariance_matches_a_monte_carlo_of_the_geometry(y_c: float) -> None:
     pose = BasePose.from_quaternion([0.5, -0.2, 0.1], [math.cos(0.4), 0.0, math.sin(0.4), 0.0])
     spec = PointUncertainty(deflection_relative_std=0.1, encoder_counts=2000)
     point = contact_point_from_estimate(estimate, ANTENNA, pose, "synthetic", spec)
-    assert np.allclose(point.point, pose.point_to_world(point_a))
+    # the map's point is on the link's surface: the axis point moved by the radius against the
+    # load's direction (the link bends away from the object)
+    on_surface = point_a - ANTENNA.link.radius * y_axis
+    assert np.allclose(point.point, pose.point_to_world(on_surface), rtol=0, atol=1e-12)
 
     # Monte Carlo: every source drawn as the docs describe it, the point recomputed
     n = 40000
@@ -193,6 +197,32 @@ def test_a_quaternion_printed_to_three_decimals_is_normalised() -> None:
     assert math.degrees(math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])) == pytest.approx(
         30.0, abs=0.02
     )
+
+
+def test_the_point_is_where_the_links_surface_meets_the_object() -> None:
+    # A link along X pressed against a wall at y = 0.1 m from -Y: it bends back along -Y (the
+    # load's direction Y^c), its axis at x_c lies one link radius short of the wall, and the
+    # map's point lies on the wall. Without the contact frame the side is unknown: the axis.
+    radius = ANTENNA.link.radius
+    axis_point = np.array([0.6, 0.1 - radius, 0.0])
+    estimate = ContactEstimate(
+        status=Status.OK,
+        reason=None,
+        method="paper",
+        x_c=0.6,
+        contact_point=axis_point,
+        diagnostics={
+            "theta_at_t1": np.array([0.0, 0.0]),
+            "deflection": 0.02,
+            "axes_c_absolute": np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]]),
+        },
+    )
+    point = contact_point_from_estimate(estimate, ANTENNA)
+    assert point.point[1] == pytest.approx(0.1, abs=1e-12)
+    assert point.point[[0, 2]] == pytest.approx(axis_point[[0, 2]], abs=1e-12)
+    diagnostics = {k: v for k, v in estimate.diagnostics.items() if k != "axes_c_absolute"}
+    bare = dataclasses.replace(estimate, diagnostics=diagnostics)
+    assert contact_point_from_estimate(bare, ANTENNA).point == pytest.approx(axis_point, abs=1e-12)
 
 
 def test_a_fast_point_is_uncertain_along_its_measured_push_not_across_the_bending_plane() -> None:

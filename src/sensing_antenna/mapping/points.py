@@ -3,8 +3,10 @@
 An estimate gives the touched point in the recording's absolute frame (``contact_point``),
 p_a = x_c X^m + y_c Y^c + s A, the abscissa x_c along the link's rigid line X^m (at t_1's motor
 angles), bent by the push deflection y_c along Y^c and by the weight's sag s along A (the part of
--Z^a across the link; estimation/methods/touch_point.py). Its covariance is propagated to first
-order from three independent sources (docs/mapping.md derives each term):
+-Z^a across the link; estimation/methods/touch_point.py): a point of the link's axis. The map's
+point is on the link's surface, where the object touches it (the link's thickness, below). Its
+covariance is propagated to first order from independent sources (docs/mapping.md derives each
+term):
 
 along the link
     x_c has a standard deviation sigma_x: from the method's 95 % interval, (high - low) / (2 *
@@ -28,9 +30,13 @@ the deflection model
     unknown: rho y_c in every direction, and y_c = (y_c / x_c) x_c from the reported ratio.
 
 the link's thickness
-    the estimate is a point of the link's axis, the object is touched by the link's surface: an
-    offset of the link's radius r in an unknown direction across the link, variance r^2 / 2 in
-    each of the two directions across it.
+    the estimate is a point of the link's axis, the object is touched by the link's surface,
+    on the side the object pushes from: the link bends away from the object, along Y^c, so the
+    surface point is the axis point moved by r against Y^c (its part across the link,
+    :func:`surface_offset`). The normal's direction around the link is the reaction's only to
+    within the friction cone, and unknown without the contact frame (no move then): the
+    variance r^2 / 2 in each of the two directions across the link, as for an offset in an
+    unknown direction, covers both.
 
 Sigma_a = sigma_x^2 J_x J_x^T + sum_i q_i^2 / 12 J_i J_i^T + rho^2 (J_d J_d^T + s^2 A A^T)
 + r^2 / 2 (I - X^m X^mT), J_d = y_c Y^c - 2 delta X^m, and in the world Sigma_w = R Sigma_a R^T
@@ -66,6 +72,7 @@ __all__ = [
     "contact_point_from_estimate",
     "link_tangent",
     "select_points",
+    "surface_offset",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -134,7 +141,8 @@ class ContactPoint:
     Attributes
     ----------
     point : array, shape (3,)
-        The touched point (m), world frame; NaN without an estimate.
+        The touched point (m), world frame, on the link's surface where the object touches it;
+        NaN without an estimate.
     covariance : array, shape (3, 3)
         Its covariance (m^2), world frame; NaN without an estimate.
     status : Status
@@ -238,6 +246,8 @@ def contact_point_from_estimate(
     tangent, tangent_std = (
         link_tangent(estimate, antenna, spec) if usable else (np.full(3, np.nan), math.nan)
     )
+    if usable:
+        point_a = point_a + surface_offset(estimate, antenna)
     return ContactPoint(
         point=pose.point_to_world(point_a) if usable else np.full(3, np.nan),
         covariance=(
@@ -308,6 +318,20 @@ def _geometry(estimate: ContactEstimate, antenna: Antenna) -> _Geometry:
         sag_axis=across / across_norm if across_norm > 0 else np.zeros(3),
         sag_slope=slope,
     )
+
+
+def surface_offset(estimate: ContactEstimate, antenna: Antenna) -> FloatArray:
+    """From the link's axis to its surface where the object touches it (m, absolute frame,
+    shape (3,)): the link's radius against the deflection's direction Y^c, across the link
+    (module docstring); zero without the contact frame."""
+    g = _geometry(estimate, antenna)
+    if g.y_c_axis is None:
+        return np.zeros(3)
+    across = g.y_c_axis - (g.y_c_axis @ g.x_m) * g.x_m
+    norm = float(np.linalg.norm(across))
+    if not norm > 0:
+        return np.zeros(3)
+    return np.asarray(-antenna.link.radius * across / norm)
 
 
 def link_tangent(
