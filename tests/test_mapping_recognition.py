@@ -84,6 +84,32 @@ def test_each_class_is_recognised_with_its_size(name: str) -> None:
     assert result.best.rms < 2 * NOISE
 
 
+@pytest.mark.parametrize("name", ["box", "capsule"])
+def test_two_wrong_points_do_not_decide_the_class(name: str) -> None:
+    # Two of 37 points 3 cm off the surface with the covariance of right ones (estimates
+    # reported ok that are wrong): the class and its sizes are still the points' own, whereas
+    # under a plain Gaussian chi^2 those two points alone leave both undecided.
+    rng = np.random.default_rng(sorted(SHAPES).index(name))
+    make, sizes = SHAPES[name]
+    mesh = make()
+    mesh.apply_transform(_pose(rng))
+    points, covariances = _sample(mesh, 35, rng)
+    wrong, _ = _sample(mesh, 2, rng)
+    wrong += 0.03 * (wrong - mesh.centroid) / np.linalg.norm(wrong - mesh.centroid, axis=1)[:, None]
+    points = np.vstack([points, wrong])
+    covariances = np.vstack([covariances, covariances[:2]])
+    result = recognise(points, covariances, rng=np.random.default_rng(0))
+    assert result.decision == name, (result.decision, result.candidates, result.delta_score)
+    fitted = result.best.sizes
+    if name == "box":
+        errors = [
+            abs(a / b - 1) for a, b in zip(sorted(fitted.values()), sizes["extent"], strict=True)
+        ]
+    else:
+        errors = [abs(fitted[k] / v - 1) for k, v in sizes.items()]
+    assert max(errors) < SIZE_TOLERANCE, (fitted, sizes)
+
+
 def test_a_few_points_on_a_patch_of_a_large_sphere_abstain_between_plane_and_sphere() -> None:
     # a 3 cm patch of a 50 cm sphere bulges a / 2R = 0.9 mm at its centre, as much as the noise
     rng = np.random.default_rng(11)
