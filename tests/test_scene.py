@@ -46,7 +46,10 @@ def test_a_post_scene_reproduces_the_simulators_post_run() -> None:
     # a cylinder's rotation vector taking Z onto the axis (about X: axis = (0, sin t, cos t))
     tilt = math.atan2(axis[1], axis[2])
     centre = np.array(post.point) - axis * post.point[2] / axis[2]  # the axis point at z = 0
-    scene = _scene(primitive_object("post", "cylinder", [post.radius, 0.6], centre, [-tilt, 0, 0]))
+    # the simulator's link touches with its axis, the scene's with its surface: the same post
+    # is thinner by the link's radius in the scene
+    thinner = post.radius - DEVICE.link.radius
+    scene = _scene(primitive_object("post", "cylinder", [thinner, 0.6], centre, [-tilt, 0, 0]))
     outcome = simulate_sweep(DEVICE, scene, Sweep(0, "azimuthal", 0.0, -0.3, 0.3), seed=4)
     assert outcome.outcome == "touch" and outcome.scenario is not None
     # x_c to the touch search's tolerance (its bisection and scalar minimisation, 1e-9, and the
@@ -79,16 +82,18 @@ def test_builtin_post_scene_is_the_same_post() -> None:
 
 def test_sphere_touch_matches_the_tangent_line() -> None:
     # without gravity the link is the straight segment [0, l] X^m: sweeping in the plane z = 0,
-    # it first touches a sphere (centre c at height h, radius R) where the line is tangent to
-    # the circle of radius r = sqrt(R^2 - h^2) that the plane cuts, at distance D from the
-    # head: theta = alpha - asin(r / D), x_c = sqrt(D^2 - r^2)
+    # its surface (radius a) first touches a sphere (centre c at height h, radius R) where its
+    # axis is tangent to the circle of radius r = sqrt((R + a)^2 - h^2) that the plane cuts of
+    # the sphere grown by a, at distance D from the head: theta = alpha - asin(r / D),
+    # x_c = sqrt(D^2 - r^2)
     centre = np.array([0.6, 0.2, 0.03])
     radius = 0.07
     scene = _scene(primitive_object("ball", "sphere", [radius], centre))
     shape = LinkShape(DEVICE.link, gravity=0.0)
     touch = first_touch(scene, Sweep(0, "azimuthal", 0.0, -0.5, 0.8), shape).touch
     assert touch is not None and not touch.tip
-    r = math.sqrt(radius**2 - centre[2] ** 2)
+    grown = radius + DEVICE.link.radius
+    r = math.sqrt(grown**2 - centre[2] ** 2)
     distance = math.hypot(centre[0], centre[1])
     assert touch.angle == pytest.approx(
         math.atan2(centre[1], centre[0]) - math.asin(r / distance), abs=1e-8
@@ -106,7 +111,9 @@ def test_tip_touches_a_far_box_and_a_sweep_may_be_free() -> None:
     shape = LinkShape(DEVICE.link)
     touch = first_touch(scene, Sweep(0, "azimuthal", 0.0, -0.3, 0.6), shape).touch
     assert touch is not None and touch.tip and touch.x_c == DEVICE.link.length
-    assert abs(box.signed_distance(touch.link_point[None, :])[0]) < 1e-8
+    # the tip's axis one link radius from the face its surface touches
+    gap = box.signed_distance(touch.link_point[None, :])[0]
+    assert gap == pytest.approx(DEVICE.link.radius, abs=1e-8)
     # the same box out of reach: nothing touched, free space
     far = _scene(primitive_object("box", "box", [0.2, 0.2, 0.3], [1.5, 0.3, 0.0]))
     outcome = simulate_sweep(DEVICE, far, Sweep(0, "azimuthal", 0.0, -0.3, 0.6))
@@ -162,20 +169,21 @@ def test_a_sweep_towards_minus_y_touches_the_other_tangent_line() -> None:
     # the gravity-free link of the test above swept the other way, from the range's end down:
     # it first meets the circle on the tangent line on the other side of the centre's bearing,
     # theta = alpha + asin(r / D), at the same x_c = sqrt(D^2 - r^2), the normal facing back
-    # along +Y^m: its component there is r / R (the rest is the centre's height, along -Z)
+    # along +Y^m: its component there is r / (R + a) (the rest is the centre's height, along -Z)
     centre = np.array([0.6, 0.2, 0.03])
     radius = 0.07
     scene = _scene(primitive_object("ball", "sphere", [radius], centre))
     shape = LinkShape(DEVICE.link, gravity=0.0)
     touch = first_touch(scene, Sweep(0, "azimuthal", 0.0, -0.5, 0.8, direction=-1), shape).touch
     assert touch is not None and not touch.tip
-    r = math.sqrt(radius**2 - centre[2] ** 2)
+    grown = radius + DEVICE.link.radius
+    r = math.sqrt(grown**2 - centre[2] ** 2)
     distance = math.hypot(centre[0], centre[1])
     alpha = math.atan2(centre[1], centre[0])
     assert touch.angle == pytest.approx(alpha + math.asin(r / distance), abs=1e-8)
     assert touch.x_c == pytest.approx(math.sqrt(distance**2 - r**2), abs=1e-7)
     y_m = np.array([-math.sin(touch.angle), math.cos(touch.angle), 0.0])
-    assert touch.normal @ y_m == pytest.approx(r / radius, abs=1e-6)
+    assert touch.normal @ y_m == pytest.approx(r / grown, abs=1e-6)
 
 
 def test_a_sweep_towards_minus_y_records_the_mirror_image() -> None:
@@ -438,13 +446,13 @@ def test_a_rounded_surface_is_simulated_as_a_ball_a_straight_one_as_a_cylinder()
     touch = first_touch(ball, sweep, shape).touch
     assert touch is not None
     assert touch.principal_radii == pytest.approx((0.07, 0.07), rel=1e-3)
-    scenario, _ = touch_scenario(touch, sweep, ball)
+    scenario, _ = touch_scenario(touch, sweep, ball, link_radius=0.0)
     assert scenario.obstacle == "ball"
     assert scenario.obstacle_radius == pytest.approx(0.07, rel=1e-3)
     post = _scene(primitive_object("post", "cylinder", [0.03, 0.5], [0.6, 0.2, 0.0]))
     touch = first_touch(post, sweep, shape).touch
     assert touch is not None and touch.principal_radii[1] > 1.0
-    scenario, _ = touch_scenario(touch, sweep, post)
+    scenario, _ = touch_scenario(touch, sweep, post, link_radius=0.0)
     assert scenario.obstacle == "post"
 
 
@@ -469,5 +477,5 @@ def test_an_edge_is_simulated_as_a_cylinder_whichever_way_the_link_crosses_it(le
     assert touch.surface_point[1] == pytest.approx(0.2 - 0.1 / math.sqrt(2), abs=1e-4)
     smallest, largest = touch.principal_radii
     assert smallest < 2e-3 and largest > 5 * smallest
-    scenario, _ = touch_scenario(touch, sweep, scene)
+    scenario, _ = touch_scenario(touch, sweep, scene, link_radius=0.0)
     assert scenario.obstacle == "post"

@@ -15,6 +15,11 @@ equivalent to the surface there, placed by the simulator from x_c as for any of 
 - a contact at the tip: the simulator's plane, touched by the tip (its normal is the
   simulator's, not the face's: the touched point is the same).
 
+A round link touches with its surface, its radius a off its axis (``scene.touch``), while the
+simulator's link touches with its axis: each obstacle is the surface grown by a (a cylinder or
+a ball of radius R + a about the same axis or centre; the tip's plane through the tip's axis,
+a from the face), which the axis meets where the link's surface meets the surface.
+
 The simulator's manoeuvre touches at the angles (0, 0) of its absolute frame, so the recording's
 frame is the base's turned to the touch angles: R = R_base M(theta)^T, with M(theta) the motor
 frame's rows (``simulator.contact.motor_frame``), written as the recording's ``base_pose``; the
@@ -129,10 +134,17 @@ class SweepOutcome:
 
 
 def touch_scenario(
-    touch: Touch, sweep: Sweep, scene: Scene, seed: int = 0, **scenario_fields: Any
+    touch: Touch,
+    sweep: Sweep,
+    scene: Scene,
+    seed: int = 0,
+    *,
+    link_radius: float,
+    **scenario_fields: Any,
 ) -> tuple[Scenario, BasePose]:
     """The simulator's scenario for a touch and the recording's frame in the world (module
-    docstring).
+    docstring); ``link_radius`` (m) grows the obstacle, as the simulated link touches with its
+    axis.
 
     Raises ValueError with the reason when the touch is ``glancing``.
     """
@@ -164,6 +176,9 @@ def touch_scenario(
         # across stays on the surface (a cylinder is straight along its axis)
         kind = "ball"
         radius = touch.radius
+    # the simulator's link touches with its axis: its obstacle is the surface grown by the
+    # link's radius, which the axis meets where the link's surface meets the surface
+    radius += link_radius
     if touch.tip:
         kind = "plane"
         tilt = 0.0
@@ -243,7 +258,9 @@ def simulate_sweep(
             sweep_time=approach,
         )
     try:
-        scenario, frame = touch_scenario(touch, sweep, scene, seed, **scenario_fields)
+        scenario, frame = touch_scenario(
+            touch, sweep, scene, seed, link_radius=device.link.radius, **scenario_fields
+        )
     except ValueError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     recording = simulate(device, scenario)

@@ -1,8 +1,9 @@
 """Where a sweep's link first touches a scene: the angle, x_c, the surface point and normal.
 
 The link is sampled along its length (:class:`~sensing_antenna.scene.sweep.LinkShape`) and
-g(theta) = min over the samples of the scene's signed distance is followed from the sweep's first
-angle in its direction. No point of the link moves faster than its reach r (m per rad of either
+g(theta) = min over the samples of the scene's signed distance, less the link's radius a (a round
+link touches with its surface, a off its axis), is followed from the sweep's first angle in its
+direction. No point of the link moves faster than its reach r (m per rad of either
 joint), so the link cannot meet a surface before the joint has turned g / r further: the search
 advances by that much (conservative advancement, the sphere tracing of signed-distance
 rendering), at least :data:`MIN_STEP`, until g <= 0, then bisects the last step to
@@ -86,7 +87,7 @@ class Touch:
     x_c : float
         Where along the link it touches (m); the link's length at the tip.
     link_point : array, shape (3,)
-        The link's point there, world frame (m).
+        The link's axis there, world frame (m): the link's radius off the surface.
     surface_point : array, shape (3,)
         The nearest point of the surface, world frame (m).
     normal : array, shape (3,)
@@ -150,7 +151,9 @@ class SweepGeometry:
 
 
 def _gap(scene: Scene, shape: LinkShape, sweep: Sweep, base: BasePose, angle: float) -> float:
-    return float(scene.signed_distance(shape.points(sweep.angles(angle), base)).min())
+    """The link's surface's smallest distance to the scene (m): its axis's less its radius."""
+    distance = scene.signed_distance(shape.points(sweep.angles(angle), base)).min()
+    return float(distance) - shape.link.radius
 
 
 def first_touch(scene: Scene, sweep: Sweep, shape: LinkShape) -> SweepGeometry:
@@ -201,14 +204,17 @@ def first_touch(scene: Scene, sweep: Sweep, shape: LinkShape) -> SweepGeometry:
 def _nearest(
     scene: Scene, shape: LinkShape, sweep: Sweep, base: BasePose, angle: float
 ) -> tuple[float, float, bool]:
-    """(x, gap, tip): the link's point nearest the scene at ``angle``, between samples."""
+    """(x, gap, tip): the link's point nearest the scene at ``angle``, between samples, and
+    the gap from its surface (m)."""
     theta = sweep.angles(angle)
     x = shape.abscissae
     k = int(np.argmin(scene.signed_distance(shape.points(theta, base))))
     length = float(x[-1])
+    thickness = shape.link.radius
 
     def gap_at(s: float) -> float:
-        return float(scene.signed_distance(shape.point_at(s, theta, base)[None, :])[0])
+        distance = scene.signed_distance(shape.point_at(s, theta, base)[None, :])[0]
+        return float(distance) - thickness
 
     if k == len(x) - 1 and gap_at(length) <= gap_at(length - 0.1 * shape.spacing):
         return length, gap_at(length), True
