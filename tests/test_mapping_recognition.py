@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 import pytest
@@ -63,6 +64,15 @@ def _sample(
     return noisy, np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
 
 
+def _size_error(name: str, fitted: Mapping[str, float]) -> float:
+    """The largest relative error of the fitted sizes against ``SHAPES``' (box extents sorted)."""
+    sizes = SHAPES[name][1]
+    if name == "box":
+        pairs = zip(sorted(fitted.values()), sizes["extent"], strict=True)
+        return max(abs(a / b - 1) for a, b in pairs)
+    return max(abs(fitted[k] / v - 1) for k, v in sizes.items())
+
+
 @pytest.mark.parametrize("name", list(SHAPES))
 def test_each_class_is_recognised_with_its_size(name: str) -> None:
     rng = np.random.default_rng(sorted(SHAPES).index(name))
@@ -73,13 +83,7 @@ def test_each_class_is_recognised_with_its_size(name: str) -> None:
     result = recognise(points, covariances, rng=np.random.default_rng(0))
     assert result.decision == name, (result.decision, result.candidates, result.delta_score)
     assert result.confidence > 0.9
-    fitted = result.best.sizes
-    if name == "box":
-        extents = sorted(fitted.values())
-        errors = [abs(a / b - 1) for a, b in zip(extents, sizes["extent"], strict=True)]
-    else:
-        errors = [abs(fitted[k] / v - 1) for k, v in sizes.items()]
-    assert max(errors) < SIZE_TOLERANCE, (fitted, sizes)
+    assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, (result.best.sizes, sizes)
     # the residual is the noise: the RMS distance of points with 1 mm noise along the normal
     assert result.best.rms < 2 * NOISE
 
@@ -100,14 +104,7 @@ def test_two_wrong_points_do_not_decide_the_class(name: str) -> None:
     covariances = np.vstack([covariances, covariances[:2]])
     result = recognise(points, covariances, rng=np.random.default_rng(0))
     assert result.decision == name, (result.decision, result.candidates, result.delta_score)
-    fitted = result.best.sizes
-    if name == "box":
-        errors = [
-            abs(a / b - 1) for a, b in zip(sorted(fitted.values()), sizes["extent"], strict=True)
-        ]
-    else:
-        errors = [abs(fitted[k] / v - 1) for k, v in sizes.items()]
-    assert max(errors) < SIZE_TOLERANCE, (fitted, sizes)
+    assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, (result.best.sizes, sizes)
 
 
 def test_a_few_points_on_a_patch_of_a_large_sphere_abstain_between_plane_and_sphere() -> None:
