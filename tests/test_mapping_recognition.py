@@ -64,6 +64,14 @@ def _sample(
     return noisy, np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
 
 
+def _placed(name: str) -> tuple[trimesh.Trimesh, np.random.Generator]:
+    """The class's mesh at a random pose, and the generator that drew it (seeded by the name)."""
+    rng = np.random.default_rng(sorted(SHAPES).index(name))
+    mesh = SHAPES[name][0]()
+    mesh.apply_transform(_pose(rng))
+    return mesh, rng
+
+
 def _size_error(name: str, fitted: Mapping[str, float]) -> float:
     """The largest relative error of the fitted sizes against ``SHAPES``' (box extents sorted)."""
     sizes = SHAPES[name][1]
@@ -75,15 +83,12 @@ def _size_error(name: str, fitted: Mapping[str, float]) -> float:
 
 @pytest.mark.parametrize("name", list(SHAPES))
 def test_each_class_is_recognised_with_its_size(name: str) -> None:
-    rng = np.random.default_rng(sorted(SHAPES).index(name))
-    make, sizes = SHAPES[name]
-    mesh = make()
-    mesh.apply_transform(_pose(rng))
+    mesh, rng = _placed(name)
     points, covariances = _sample(mesh, 35, rng)
     result = recognise(points, covariances, rng=np.random.default_rng(0))
     assert result.decision == name, (result.decision, result.candidates, result.delta_score)
     assert result.confidence > 0.9
-    assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, (result.best.sizes, sizes)
+    assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, result.best.sizes
     # the residual is the noise: the RMS distance of points with 1 mm noise along the normal
     assert result.best.rms < 2 * NOISE
 
@@ -93,10 +98,7 @@ def test_two_wrong_points_do_not_decide_the_class(name: str) -> None:
     # Two of 37 points 3 cm off the surface with the covariance of right ones (estimates
     # reported ok that are wrong): the class and its sizes are still the points' own, whereas
     # under a plain Gaussian chi^2 those two points alone leave both undecided.
-    rng = np.random.default_rng(sorted(SHAPES).index(name))
-    make, sizes = SHAPES[name]
-    mesh = make()
-    mesh.apply_transform(_pose(rng))
+    mesh, rng = _placed(name)
     points, covariances = _sample(mesh, 35, rng)
     wrong, _ = _sample(mesh, 2, rng)
     wrong += 0.03 * (wrong - mesh.centroid) / np.linalg.norm(wrong - mesh.centroid, axis=1)[:, None]
@@ -104,7 +106,7 @@ def test_two_wrong_points_do_not_decide_the_class(name: str) -> None:
     covariances = np.vstack([covariances, covariances[:2]])
     result = recognise(points, covariances, rng=np.random.default_rng(0))
     assert result.decision == name, (result.decision, result.candidates, result.delta_score)
-    assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, (result.best.sizes, sizes)
+    assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, result.best.sizes
 
 
 def test_a_few_points_on_a_patch_of_a_large_sphere_abstain_between_plane_and_sphere() -> None:
