@@ -563,7 +563,7 @@ def fit_primitive(
         model.dof,
         vector=x,
         mesh=model.mesh(x),
-        spread=_spread(p),
+        spread=spread,
         line=line_residuals(x, sigma),
     )
 

@@ -250,12 +250,13 @@ def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angl
         along = tangent - (tangent @ normal) * normal
         along /= np.linalg.norm(along)
         across = np.cross(normal, along)
-        radius = _bend_radius(touched, surface_point, along)
+        # the first direction is along the link
         turns = np.pi * np.arange(BEND_DIRECTIONS) / BEND_DIRECTIONS
         radii = [
             _bend_radius(touched, surface_point, math.cos(t) * along + math.sin(t) * across)
             for t in turns
         ]
+        radius = radii[0]
         principal = (min(radii), max(radii))
     return Touch(
         angle=angle,
