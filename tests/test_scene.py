@@ -448,13 +448,15 @@ def test_a_rounded_surface_is_simulated_as_a_ball_a_straight_one_as_a_cylinder()
     touch = first_touch(ball, sweep, shape).touch
     assert touch is not None
     assert touch.principal_radii == pytest.approx((0.07, 0.07), rel=1e-3)
-    scenario, _ = touch_scenario(touch, sweep, ball, link_radius=0.0)
+    scenario, _ = touch_scenario(touch, sweep, ball)
     assert scenario.obstacle == "ball"
-    assert scenario.obstacle_radius == pytest.approx(0.07, rel=1e-3)
+    # grown by the link's radius: the simulated link touches with its axis
+    assert touch.link_radius == DEVICE.link.radius
+    assert scenario.obstacle_radius == pytest.approx(0.07 + DEVICE.link.radius, rel=1e-3)
     post = _scene(primitive_object("post", "cylinder", [0.03, 0.5], [0.6, 0.2, 0.0]))
     touch = first_touch(post, sweep, shape).touch
     assert touch is not None and touch.principal_radii[1] > 1.0
-    scenario, _ = touch_scenario(touch, sweep, post, link_radius=0.0)
+    scenario, _ = touch_scenario(touch, sweep, post)
     assert scenario.obstacle == "post"
 
 
@@ -479,5 +481,5 @@ def test_an_edge_is_simulated_as_a_cylinder_whichever_way_the_link_crosses_it(le
     assert touch.surface_point[1] == pytest.approx(0.2 - 0.1 / math.sqrt(2), abs=1e-4)
     smallest, largest = touch.principal_radii
     assert smallest < 2e-3 and largest > 5 * smallest
-    scenario, _ = touch_scenario(touch, sweep, scene, link_radius=0.0)
+    scenario, _ = touch_scenario(touch, sweep, scene)
     assert scenario.obstacle == "post"

@@ -243,18 +243,17 @@ def contact_point_from_estimate(
     point_a = np.asarray(estimate.contact_point, dtype=float)
     x_c = float(estimate.x_c)
     usable = bool(np.all(np.isfinite(point_a)) and math.isfinite(x_c) and x_c > 0)
-    tangent, tangent_std = (
-        link_tangent(estimate, antenna, spec) if usable else (np.full(3, np.nan), math.nan)
-    )
     if usable:
-        point_a = point_a + surface_offset(estimate, antenna)
+        g = _geometry(estimate, antenna)
+        tangent, tangent_std = _tangent(g, x_c, spec)
+        point_w = pose.point_to_world(point_a + _surface_offset(g, antenna.link.radius))
+        covariance = pose.covariance_to_world(_covariance(g, estimate, antenna, spec))
+    else:
+        tangent, tangent_std = np.full(3, np.nan), math.nan
+        point_w, covariance = np.full(3, np.nan), np.full((3, 3), np.nan)
     return ContactPoint(
-        point=pose.point_to_world(point_a) if usable else np.full(3, np.nan),
-        covariance=(
-            pose.covariance_to_world(point_covariance(estimate, antenna, spec))
-            if usable
-            else np.full((3, 3), np.nan)
-        ),
+        point=point_w,
+        covariance=covariance,
         status=estimate.status,
         source=source,
         method=estimate.method,
@@ -324,14 +323,17 @@ def surface_offset(estimate: ContactEstimate, antenna: Antenna) -> FloatArray:
     """From the link's axis to its surface where the object touches it (m, absolute frame,
     shape (3,)): the link's radius against the deflection's direction Y^c, across the link
     (module docstring); zero without the contact frame."""
-    g = _geometry(estimate, antenna)
+    return _surface_offset(_geometry(estimate, antenna), antenna.link.radius)
+
+
+def _surface_offset(g: _Geometry, radius: float) -> FloatArray:
     if g.y_c_axis is None:
         return np.zeros(3)
     across = g.y_c_axis - (g.y_c_axis @ g.x_m) * g.x_m
     norm = float(np.linalg.norm(across))
     if not norm > 0:
         return np.zeros(3)
-    return np.asarray(-antenna.link.radius * across / norm)
+    return np.asarray(-radius * across / norm)
 
 
 def link_tangent(
@@ -340,8 +342,10 @@ def link_tangent(
     """The link's unit tangent at the contact (absolute frame, shape (3,)) and its standard
     deviation in angle (rad) (module docstring); without the deflection's direction the push's
     slope is unknown and enters only the standard deviation."""
-    g = _geometry(estimate, antenna)
-    x_c = float(estimate.x_c)
+    return _tangent(_geometry(estimate, antenna), float(estimate.x_c), uncertainty)
+
+
+def _tangent(g: _Geometry, x_c: float, uncertainty: PointUncertainty) -> tuple[FloatArray, float]:
     push_slope = 1.5 * g.deflection / x_c
     tangent = g.x_m + g.sag_slope * g.sag_axis
     if g.y_c_axis is not None:
@@ -356,9 +360,14 @@ def point_covariance(
     estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
 ) -> FloatArray:
     """Sigma_a (m^2), shape (3, 3), in the recording's absolute frame (module docstring)."""
+    return _covariance(_geometry(estimate, antenna), estimate, antenna, uncertainty)
+
+
+def _covariance(
+    g: _Geometry, estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
+) -> FloatArray:
     x_c = float(estimate.x_c)
     point_a = np.asarray(estimate.contact_point, dtype=float)
-    g = _geometry(estimate, antenna)
     theta, x_m, y_m, z_m = g.theta, g.x_m, g.y_m, g.z_m
     deflection, y_c_axis = g.deflection, g.y_c_axis
     sag, sag_axis, slope = g.sag, g.sag_axis, g.sag_slope

@@ -441,6 +441,13 @@ def point_chi2(z2: FloatArray, sigma: FloatArray, spread: float) -> FloatArray:
     return np.asarray(-2.0 * (inlier - np.logaddexp(0.0, -0.5 * cap)))
 
 
+def _z2(distance: FloatArray, sigma: FloatArray, line: FloatArray) -> FloatArray:
+    """z^2 = (d / sigma)^2 + r^2 per point (module docstring), shape (n,): the distance d (m)
+    in its standard deviations sigma (m) and the link's line residual r (none: empty)."""
+    z2 = (np.asarray(distance, dtype=float) / sigma) ** 2
+    return np.asarray(z2 + np.asarray(line, dtype=float) ** 2 if len(line) else z2)
+
+
 def _bounds(shape: Primitive, points: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Sizes from :data:`MIN_SIZE` to :data:`MAX_SIZE_SPREADS` times the points' spread (the
     torus's hole, R - r, to one spread)."""
@@ -516,9 +523,8 @@ def fit_primitive(
         )
 
     def point_z2(x: FloatArray, normal_sigma: FloatArray) -> FloatArray:
-        distance = model.signed_distance(x, p) / normal_sigma
-        line = line_residuals(x, normal_sigma)
-        return np.asarray(distance**2 + (line**2 if len(line) else 0.0))
+        distance = model.signed_distance(x, p)
+        return _z2(distance, normal_sigma, line_residuals(x, normal_sigma))
 
     def refine(x: FloatArray) -> FloatArray:
         # each point's sigma along the fitted surface's normal, and the link's lines; a point
@@ -672,8 +678,8 @@ def _scored(
 ) -> ClassFit:
     n = len(distance)
     lines = line if line is not None and len(line) == n else np.zeros(n)
-    # each point's part of chi^2 from z^2 = (d / sigma)^2 + r^2; BIC = chi^2 + k ln n
-    parts = point_chi2((distance / sigma) ** 2 + lines**2, sigma, spread)
+    # each point's part of chi^2; BIC = chi^2 + k ln n
+    parts = point_chi2(_z2(distance, sigma, lines), sigma, spread)
     chi2 = float(np.sum(parts))
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(

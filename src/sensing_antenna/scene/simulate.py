@@ -138,13 +138,11 @@ def touch_scenario(
     sweep: Sweep,
     scene: Scene,
     seed: int = 0,
-    *,
-    link_radius: float,
     **scenario_fields: Any,
 ) -> tuple[Scenario, BasePose]:
     """The simulator's scenario for a touch and the recording's frame in the world (module
-    docstring); ``link_radius`` (m) grows the obstacle, as the simulated link touches with its
-    axis.
+    docstring); the touch's ``link_radius`` (m) grows the obstacle, as the simulated link
+    touches with its axis.
 
     Raises ValueError with the reason when the touch is ``glancing``.
     """
@@ -178,7 +176,7 @@ def touch_scenario(
         radius = touch.radius
     # the simulator's link touches with its axis: its obstacle is the surface grown by the
     # link's radius, which the axis meets where the link's surface meets the surface
-    radius += link_radius
+    radius += touch.link_radius
     if touch.tip:
         kind = "plane"
         tilt = 0.0
@@ -258,9 +256,7 @@ def simulate_sweep(
             sweep_time=approach,
         )
     try:
-        scenario, frame = touch_scenario(
-            touch, sweep, scene, seed, link_radius=device.link.radius, **scenario_fields
-        )
+        scenario, frame = touch_scenario(touch, sweep, scene, seed, **scenario_fields)
     except ValueError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     recording = simulate(device, scenario)

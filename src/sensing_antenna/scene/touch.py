@@ -104,6 +104,8 @@ class Touch:
         True when the link's tip touches (the surface is not tangent to the link).
     object_name : str
         The touched object's name.
+    link_radius : float
+        The link's radius the touch was found with (m): its axis is that far off the surface.
     """
 
     angle: float
@@ -117,6 +119,7 @@ class Touch:
     principal_radii: tuple[float, float]
     tip: bool
     object_name: str
+    link_radius: float
 
     def to_dict(self) -> dict[str, object]:
         """JSON-able fields (SI units)."""
@@ -132,6 +135,7 @@ class Touch:
             "principal_radii": list(self.principal_radii),
             "tip": self.tip,
             "object": self.object_name,
+            "link_radius": self.link_radius,
         }
 
 
@@ -270,4 +274,5 @@ def _touch_at(scene: Scene, sweep: Sweep, shape: LinkShape, base: BasePose, angl
         principal_radii=(float(principal[0]), float(principal[1])),
         tip=tip,
         object_name=touched.name,
+        link_radius=shape.link.radius,
     )
