@@ -32,6 +32,7 @@ the k of a model-selection score.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -41,7 +42,7 @@ import trimesh
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-__all__ = ["PRIMITIVES", "Primitive", "primitive"]
+__all__ = ["PRIMITIVES", "Primitive", "local_coordinates", "primitive"]
 
 FloatArray = NDArray[np.float64]
 
@@ -103,15 +104,25 @@ class Primitive:
         return np.asarray(gradient / np.where(norm > 0, norm, 1.0))
 
 
-def _local(parameters: FloatArray, points: FloatArray) -> FloatArray:
-    """Points in the shape's frame: R^T (p - c), with c = parameters[0:3], w = parameters[3:6]."""
-    rotation = Rotation.from_rotvec(parameters[3:6]).as_matrix()
+def local_coordinates(parameters: FloatArray, points: FloatArray) -> FloatArray:
+    """Points (m, shape (n, 3)) in a posed shape's own frame: R^T (p - c), with the centre c =
+    parameters[0:3] and R the rotation of the rotation vector w = parameters[3:6] (rad)."""
+    rotation = _rotation(np.ascontiguousarray(parameters[3:6], dtype=float).tobytes())
     return np.asarray((points - parameters[0:3]) @ rotation)
+
+
+@functools.lru_cache(maxsize=32)
+def _rotation(rotation_vector: bytes) -> FloatArray:
+    # a fit evaluates one pose many times over (each distance, the normals' six differences,
+    # the finite-difference Jacobian's columns that leave w alone): built once per pose
+    matrix = Rotation.from_rotvec(np.frombuffer(rotation_vector, dtype=float).copy()).as_matrix()
+    matrix.setflags(write=False)
+    return np.asarray(matrix)
 
 
 def _transform(parameters: FloatArray) -> FloatArray:
     matrix = np.eye(4)
-    matrix[:3, :3] = Rotation.from_rotvec(parameters[3:6]).as_matrix()
+    matrix[:3, :3] = _rotation(np.ascontiguousarray(parameters[3:6], dtype=float).tobytes())
     matrix[:3, 3] = parameters[0:3]
     return matrix
 
@@ -147,7 +158,7 @@ def _segments_distance(rho: FloatArray, z: FloatArray, profile: FloatArray) -> F
 
 def _cylinder(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the exact distance to a capped cylinder: q = (rho - r, |z| - h / 2)
-    local = _local(parameters, points)
+    local = local_coordinates(parameters, points)
     radius, height = parameters[6], parameters[7]
     q_rho = np.hypot(local[:, 0], local[:, 1]) - radius
     q_z = np.abs(local[:, 2]) - 0.5 * height
@@ -157,7 +168,7 @@ def _cylinder(parameters: FloatArray, points: FloatArray) -> FloatArray:
 
 def _capsule(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # distance to the axis segment [-L/2, L/2] along Z, minus r
-    local = _local(parameters, points)
+    local = local_coordinates(parameters, points)
     radius, length = parameters[6], parameters[7]
     z = np.clip(local[:, 2], -0.5 * length, 0.5 * length)
     return np.asarray(np.linalg.norm(local - np.stack([0 * z, 0 * z, z], axis=1), axis=1) - radius)
@@ -166,7 +177,7 @@ def _capsule(parameters: FloatArray, points: FloatArray) -> FloatArray:
 def _cone(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the cross-section is the triangle (0, 0), (R, 0), (0, h) in (rho, z): distance to its
     # base and slant edges, negative inside the triangle
-    local = _local(parameters, points)
+    local = local_coordinates(parameters, points)
     radius, height = parameters[6], parameters[7]
     rho = np.hypot(local[:, 0], local[:, 1])
     z = local[:, 2]
@@ -178,7 +189,7 @@ def _cone(parameters: FloatArray, points: FloatArray) -> FloatArray:
 
 def _torus(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # d = sqrt((rho - R)^2 + z^2) - r
-    local = _local(parameters, points)
+    local = local_coordinates(parameters, points)
     minor = parameters[7]
     major = parameters[6] + minor
     rho = np.hypot(local[:, 0], local[:, 1])
@@ -187,7 +198,7 @@ def _torus(parameters: FloatArray, points: FloatArray) -> FloatArray:
 
 def _box(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the exact box distance: q = |p| - e / 2; |max(q, 0)| + min(max_i q_i, 0)
-    local = _local(parameters, points)
+    local = local_coordinates(parameters, points)
     q = np.abs(local) - 0.5 * parameters[6:9]
     outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
     return np.asarray(outside + np.minimum(q.max(axis=1), 0.0))

@@ -73,7 +73,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive
+from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive, local_coordinates
 
 __all__ = [
     "ABSTAIN_DELTA",
@@ -167,6 +167,9 @@ class LinkLines:
     std: FloatArray
     behind: FloatArray
     beyond: FloatArray
+    _placed: dict[bytes, tuple[FloatArray, FloatArray, FloatArray]] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         n = len(np.asarray(self.tangents).reshape(-1, 3))
@@ -196,15 +199,26 @@ class LinkLines:
         and the points' standard deviations along the surface's normal (m, shape (n,))."""
         if len(points) != len(self.tangents):
             raise ValueError(f"{len(self.tangents)} link lines for {len(points)} points")
-        samples, arc = self.samples(points)
+        flat, arc, slope_part = self._placed_at(points)
         n, k = arc.shape
         if n == 0:
             return np.zeros(0)
-        at_line = distance(samples.reshape(-1, 3)).reshape(n, k)
+        at_line = distance(flat).reshape(n, k)
         own = np.minimum(distance(points), 0.0)
-        spread = np.sqrt(sigma[:, None] ** 2 + (np.nan_to_num(arc) * self.std[:, None]) ** 2)
+        spread = np.sqrt(sigma[:, None] ** 2 + slope_part)
         deeper = np.where(np.isfinite(arc), (at_line - own[:, None]) / spread, np.inf)
         return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
+
+    def _placed_at(self, points: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        # the samples depend on the points alone, which a fit keeps: placed once per point set
+        points = np.ascontiguousarray(points, dtype=float)
+        key = points.tobytes()
+        if key not in self._placed:
+            samples, arc = self.samples(points)
+            slope_part = (np.nan_to_num(arc) * self.std[:, None]) ** 2
+            self._placed.clear()
+            self._placed[key] = (samples.reshape(-1, 3), arc, slope_part)
+        return self._placed[key]
 
 
 @dataclass(frozen=True)
@@ -406,7 +420,7 @@ def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
     """How far the shape's extents along its own axes exceed the points' span there (m)."""
     if name in ("plane", "sphere", "torus"):
         return np.zeros(0)
-    local = (points - x[0:3]) @ Rotation.from_rotvec(x[3:6]).as_matrix()
+    local = local_coordinates(x, points)
     span = local.max(axis=0) - local.min(axis=0)
     if name == "box":
         return np.asarray(np.maximum(x[6:9] - span, 0.0))

@@ -1,0 +1,120 @@
+"""Does a method's 95 % interval hold the contact, on the exploration benchmark's recordings?
+
+The recordings kept by ``eval_explore.py --keep DIR`` are touches the campaigns do not make:
+posts, bars and balls tilted across the sweep, the simulator's geometrically exact link, pushes
+of 6 to 10 % deflection. Each is estimated again with the exploration's calibrated antenna
+(``DIR/calibrated.toml``) and, for every ``ok`` answer with an interval, scored against the
+recording's ``true_xc``: the error (m), whether the interval holds it, and by the simulated
+obstacle's kind. ``--every N`` takes every N-th recording (in name order).
+
+Run: ``python benchmarks/eval_explore_intervals.py DIR [--every 4] [--method fast]``.
+Prints a table and writes ``benchmarks/results/explore_intervals.json``.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")  # one core, set before numpy loads
+
+import argparse  # noqa: E402
+import datetime  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from sensing_antenna import load_antenna  # noqa: E402
+from sensing_antenna.estimation import estimate  # noqa: E402
+from sensing_antenna.recording import read_recording  # noqa: E402
+
+RESULTS = Path(__file__).resolve().parent / "results" / "explore_intervals.json"
+
+#: The 95 % interval's half-width in standard deviations.
+Z_95 = 1.959963984540054
+
+
+def score(path: Path, antenna: Any, method: str) -> dict[str, Any]:
+    """One recording's answer and its error against the simulator's contact."""
+    recording = read_recording(path)
+    truth = float(recording.metadata["true_xc"])
+    kind = json.loads(recording.metadata.get("true_obstacle", "{}")).get("kind", "")
+    answer = estimate(recording.without_ground_truth(), antenna, method)
+    low, high = answer.interval if answer.interval is not None else (math.nan, math.nan)
+    return {
+        "recording": str(path),
+        "obstacle": kind,
+        "status": str(answer.status.value),
+        "true_xc": truth,
+        "x_c": float(answer.x_c),
+        "error_m": float(answer.x_c) - truth,
+        "interval": [low, high],
+        "holds": bool(low <= truth <= high),
+        "deflection_ratio": float(answer.diagnostics.get("deflection_ratio", math.nan)),
+    }
+
+
+def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """Coverage and errors of the ``ok`` answers with an interval."""
+    scored = [r for r in rows if r["status"] == "ok" and math.isfinite(r["interval"][0])]
+    if not scored:
+        return {"ok": 0}
+    error = np.array([r["error_m"] for r in scored])
+    sigma = np.array([(r["interval"][1] - r["interval"][0]) / (2 * Z_95) for r in scored])
+    centred = error - np.median(error)
+    return {
+        "ok": len(scored),
+        "holds": int(sum(r["holds"] for r in scored)),
+        "coverage": float(np.mean([r["holds"] for r in scored])),
+        "error_median_m": float(np.median(error)),
+        "error_robust_std_m": float(1.4826 * np.median(np.abs(centred))),
+        "interval_std_median_m": float(np.median(sigma)),
+        "over_1cm": int(np.sum(np.abs(error) > 0.01)),
+        "max_abs_error_m": float(np.max(np.abs(error))),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("kept", type=Path, help="a directory of eval_explore.py --keep")
+    parser.add_argument("--every", type=int, default=4)
+    parser.add_argument("--method", choices=("paper", "fast"), default="fast")
+    parser.add_argument("--out", type=Path, default=RESULTS)
+    args = parser.parse_args()
+    antenna = load_antenna(args.kept / "calibrated.toml")
+    paths = sorted(args.kept.glob("scene*/recordings/*.csv"))[:: args.every]
+    rows = []
+    for i, path in enumerate(paths):
+        rows.append(score(path, antenna, args.method))
+        print(f"\r{i + 1}/{len(paths)} recordings", end="", flush=True)
+    print()
+    kinds = sorted({r["obstacle"] for r in rows})
+    total = {"all": summarise(rows)}
+    total |= {k: summarise([r for r in rows if r["obstacle"] == k]) for k in kinds}
+    print(
+        f"{'obstacle':10s} {'ok':>5s} {'holds':>6s} {'median err':>11s} {'robust std':>11s} "
+        f"{'interval sd':>12s} {'>1 cm':>6s} {'max':>8s}"
+    )
+    for name, t in total.items():
+        if t["ok"]:
+            print(
+                f"{name:10s} {t['ok']:5d} {100 * t['coverage']:5.0f}% "
+                f"{1e3 * t['error_median_m']:8.2f} mm {1e3 * t['error_robust_std_m']:8.2f} mm "
+                f"{1e3 * t['interval_std_median_m']:9.2f} mm {t['over_1cm']:6d} "
+                f"{1e3 * t['max_abs_error_m']:5.1f} mm"
+            )
+    result = {
+        "date": datetime.date.today().isoformat(),
+        "settings": {"kept": str(args.kept), "every": args.every, "method": args.method},
+        "total": total,
+        "rows": rows,
+    }
+    args.out.write_text(json.dumps(result, indent=1) + "\n")
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
