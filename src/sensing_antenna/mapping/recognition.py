@@ -82,6 +82,7 @@ __all__ = [
     "UNDECIDED",
     "ClassFit",
     "LinkLines",
+    "PlacedLines",
     "Recognition",
     "confidence_floor",
     "fit_mesh",
@@ -167,9 +168,6 @@ class LinkLines:
     std: FloatArray
     behind: FloatArray
     beyond: FloatArray
-    _placed: dict[bytes, tuple[FloatArray, FloatArray, FloatArray]] = field(
-        default_factory=dict, init=False, repr=False, compare=False
-    )
 
     def __post_init__(self) -> None:
         n = len(np.asarray(self.tangents).reshape(-1, 3))
@@ -197,28 +195,52 @@ class LinkLines:
     ) -> FloatArray:
         """r_i (module docstring), shape (n,), for a signed distance function of (m, 3) points
         and the points' standard deviations along the surface's normal (m, shape (n,))."""
+        return self.placed(points).residuals(distance, sigma)
+
+    def placed(self, points: FloatArray) -> PlacedLines:
+        """The lines at these contacts (m, shape (n, 3)), sampled once: a fit evaluates its
+        residuals many times over the same points."""
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
         if len(points) != len(self.tangents):
             raise ValueError(f"{len(self.tangents)} link lines for {len(points)} points")
-        flat, arc, slope_part = self._placed_at(points)
-        n, k = arc.shape
+        samples, arc = self.samples(points)
+        slope_variance = (np.nan_to_num(arc) * self.std[:, None]) ** 2
+        return PlacedLines(points, samples.reshape(-1, 3), arc, slope_variance)
+
+
+@dataclass(frozen=True)
+class PlacedLines:
+    """:class:`LinkLines` sampled at a set of contacts (:meth:`LinkLines.placed`).
+
+    Attributes
+    ----------
+    points : array, shape (n, 3)
+        The contacts (m).
+    samples : array, shape (n * k, 3)
+        Points along each line (m), k per contact.
+    arc : array, shape (n, k)
+        Their signed arc lengths (m); NaN where the link does not reach.
+    slope_variance : array, shape (n, k)
+        (s sigma_t)^2 (m^2): how far the line's angle error moves each sample across it.
+    """
+
+    points: FloatArray
+    samples: FloatArray
+    arc: FloatArray
+    slope_variance: FloatArray
+
+    def residuals(
+        self, distance: Callable[[FloatArray], FloatArray], sigma: FloatArray
+    ) -> FloatArray:
+        """r_i (module docstring), shape (n,): :meth:`LinkLines.residuals` at these contacts."""
+        n, k = self.arc.shape
         if n == 0:
             return np.zeros(0)
-        at_line = distance(flat).reshape(n, k)
-        own = np.minimum(distance(points), 0.0)
-        spread = np.sqrt(sigma[:, None] ** 2 + slope_part)
-        deeper = np.where(np.isfinite(arc), (at_line - own[:, None]) / spread, np.inf)
+        at_line = distance(self.samples).reshape(n, k)
+        own = np.minimum(distance(self.points), 0.0)
+        spread = np.sqrt(sigma[:, None] ** 2 + self.slope_variance)
+        deeper = np.where(np.isfinite(self.arc), (at_line - own[:, None]) / spread, np.inf)
         return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
-
-    def _placed_at(self, points: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        # the samples depend on the points alone, which a fit keeps: placed once per point set
-        points = np.ascontiguousarray(points, dtype=float)
-        key = points.tobytes()
-        if key not in self._placed:
-            samples, arc = self.samples(points)
-            slope_part = (np.nan_to_num(arc) * self.std[:, None]) ** 2
-            self._placed.clear()
-            self._placed[key] = (samples.reshape(-1, 3), arc, slope_part)
-        return self._placed[key]
 
 
 @dataclass(frozen=True)
@@ -515,10 +537,12 @@ def fit_primitive(
     sigma = _isotropic_sigma(cov)
     spread = _spread(p)
 
+    placed = lines.placed(p) if lines is not None else None
+
     def line_residuals(x: FloatArray, s: FloatArray) -> FloatArray:
-        if lines is None:
+        if placed is None:
             return np.zeros(0)
-        return lines.residuals(lambda q: model.signed_distance(x, q), p, s)
+        return placed.residuals(lambda q: model.signed_distance(x, q), s)
 
     def residuals(x: FloatArray, s: FloatArray, with_lines: bool) -> FloatArray:
         distance = model.signed_distance(x, p) / s
