@@ -109,6 +109,47 @@ def test_sigterm_ends_with_one_line_and_143(tmp_path: Path) -> None:
     assert not (tmp_path / "rec.csv").exists()
 
 
+#: ``antenna`` whose simulation first drops an object with a slow finalizer: Python runs the
+#: finalizer in the main thread, and an exception raised there (the signal's) is printed and
+#: dropped, the program going on.
+_ANTENNA_SLOW_FINALIZER = (
+    "import signal, sys, time\n"
+    "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+    "import sensing_antenna.simulator as simulator\n"
+    "class Slow:\n"
+    "    def __del__(self):\n"
+    "        time.sleep(4.0)\n"
+    "original = simulator.simulate\n"
+    "def slowed(*args, **kwargs):\n"
+    "    Slow()\n"
+    "    return original(*args, **kwargs)\n"
+    "simulator.simulate = slowed\n"
+    "from sensing_antenna.cli import main\n"
+    "sys.exit(main())\n"
+)
+
+
+def test_sigterm_inside_a_finalizer_still_stops_the_command(tmp_path: Path) -> None:
+    # the signal lands while the finalizer sleeps (it starts within the first second or so and
+    # lasts 4 s); Python drops the exception raised there, and the command delivers the
+    # signal again where it can unwind: one line, 143, no recording
+    out = tmp_path / "rec.csv"
+    process = subprocess.Popen(
+        [sys.executable, "-c", _ANTENNA_SLOW_FINALIZER, *_LONG_COMMAND, "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_environment(),
+    )
+    time.sleep(_STARTED)
+    assert process.poll() is None, "the command ended before it could be stopped"
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 143, stderr
+    assert stderr.strip() == "antenna simulate: stopped by SIGTERM"
+    assert not out.exists()
+
+
 def test_an_interrupted_campaign_says_what_it_keeps(tmp_path: Path) -> None:
     # the default campaign runs for a minute or more: it is interrupted while it sets up or runs
     command = ["campaign", "run", "--workers", "1", "--no-progress"]

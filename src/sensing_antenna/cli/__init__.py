@@ -21,7 +21,9 @@ How a command ends, whichever it is:
   command stops as well (bash goes on when a program exits normally after Ctrl-C);
 - 143 (128 + SIGTERM) when asked to stop, one line on stderr; SIGTERM raises
   :class:`~sensing_antenna.errors.Terminated` where the command is, so clean-ups run as for
-  Ctrl-C (any interruption that carries another ``signal_number`` ends with 128 + it);
+  Ctrl-C (any interruption that carries another ``signal_number`` ends with 128 + it); one that
+  lands in a finalizer, where Python drops exceptions, is raised again a moment later, and one
+  dropped anywhere else still ends the command when it returns;
 - quietly with 141 (128 + SIGPIPE) when whatever reads the output closes it
   (``antenna beam ... | head -2``), what a shell reports for a program stopped by a closed pipe.
 """
@@ -39,7 +41,13 @@ from collections.abc import Iterator, Mapping, Sequence
 from types import FrameType
 from typing import Any, NoReturn
 
-from sensing_antenna.errors import SensingAntennaError, Terminated, note_signal
+from sensing_antenna.errors import (
+    SensingAntennaError,
+    Terminated,
+    forget_signals,
+    note_signal,
+    raise_if_signalled,
+)
 
 #: Command modules, in the order ``antenna --help`` lists them.
 COMMAND_MODULES = (
@@ -195,8 +203,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             if extras:
                 parser.leaf(sys.argv[1:] if argv is None else argv).reject_unknown(extras)
             prog = f"{parser.prog} {args.command}"
+            forget_signals()
             try:
                 code = int(args.func(args))
+                # a stop the command's code dropped on its way up still stops it here
+                raise_if_signalled()
             except SensingAntennaError as exc:
                 _say(f"{prog}: error: {_named_by_flag(exc, getattr(args, 'flags', {}))}")
                 return EXIT_BAD_INPUT
@@ -258,9 +269,16 @@ def _say(line: str) -> None:
     print(line, file=sys.stderr)
 
 
+#: Delay (s) after which an interruption Python dropped in a finalizer is raised again: long
+#: enough for the finalizer to have returned (the dropped exception ended it), short against
+#: any command.
+REDELIVERY = 0.01
+
+
 @contextlib.contextmanager
 def _terminate_raises() -> Iterator[None]:
-    """Within: SIGTERM raises :class:`Terminated` in this process (the main thread).
+    """Within: SIGTERM raises :class:`Terminated` in this process (the main thread), and an
+    interruption Python drops in a finalizer is delivered again.
 
     Left alone when SIGTERM is already handled or ignored (by whoever started us), or when not
     in the main thread. A process forked inside (a worker of a pool) inherits the handler; there
@@ -276,6 +294,28 @@ def _terminate_raises() -> Iterator[None]:
         note_signal(number)
         raise Terminated(number)
 
+    pending: list[int] = []
+
+    def redeliver(number: int, frame: FrameType | None) -> None:
+        stop = pending.pop() if pending else signal.SIGTERM
+        pending.clear()
+        raise KeyboardInterrupt if stop == signal.SIGINT else Terminated(stop)
+
+    def unraisable(event: Any) -> None:
+        # an interruption raised inside a finalizer (a __del__, a weakref callback, the garbage
+        # collector) is dropped by Python, which prints it and goes on: raise it again a moment
+        # later (REDELIVERY s), back where the command can unwind, without the dropped traceback
+        if (
+            isinstance(event.exc_value, KeyboardInterrupt)
+            and os.getpid() == owner
+            and hasattr(signal, "setitimer")  # POSIX
+        ):
+            pending.append(int(getattr(event.exc_value, "signal_number", signal.SIGINT)))
+            signal.signal(signal.SIGALRM, redeliver)
+            signal.setitimer(signal.ITIMER_REAL, REDELIVERY)
+            return
+        dropped_hook(event)
+
     try:
         if signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:
             yield
@@ -284,9 +324,16 @@ def _terminate_raises() -> Iterator[None]:
     except ValueError:  # not the main thread: signals are not ours to handle
         yield
         return
+    dropped_hook = sys.unraisablehook
+    sys.unraisablehook = unraisable
+    alarm = signal.getsignal(signal.SIGALRM) if hasattr(signal, "SIGALRM") else None
     try:
         yield
     finally:
+        sys.unraisablehook = dropped_hook
+        if alarm is not None and signal.getsignal(signal.SIGALRM) is redeliver:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            signal.signal(signal.SIGALRM, alarm)
         signal.signal(signal.SIGTERM, previous)
 
 
