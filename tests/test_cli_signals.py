@@ -51,12 +51,16 @@ def _environment() -> dict[str, str]:
 
 
 def _interrupt(
-    signal_number: int, out: Path, command: list[str] = _LONG_COMMAND, started: float = _STARTED
+    signal_number: int,
+    out: Path,
+    command: list[str] = _LONG_COMMAND,
+    started: float = _STARTED,
+    program: str = _ANTENNA,
 ) -> subprocess.CompletedProcess[str]:
-    """Start ``command``, send ``signal_number`` to its process alone ``started`` seconds after
-    (once it runs); its ending."""
+    """Start ``command`` (run by ``program``), send ``signal_number`` to its process alone
+    ``started`` seconds after (once it runs); its ending."""
     process = subprocess.Popen(
-        [sys.executable, "-c", _ANTENNA, *command, "--out", str(out)],
+        [sys.executable, "-c", program, *command, "--out", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -134,19 +138,9 @@ def test_sigterm_inside_a_finalizer_still_stops_the_command(tmp_path: Path) -> N
     # lasts 4 s); Python drops the exception raised there, and the command delivers the
     # signal again where it can unwind: one line, 143, no recording
     out = tmp_path / "rec.csv"
-    process = subprocess.Popen(
-        [sys.executable, "-c", _ANTENNA_SLOW_FINALIZER, *_LONG_COMMAND, "--out", str(out)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=_environment(),
-    )
-    time.sleep(_STARTED)
-    assert process.poll() is None, "the command ended before it could be stopped"
-    process.send_signal(signal.SIGTERM)
-    _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 143, stderr
-    assert stderr.strip() == "antenna simulate: stopped by SIGTERM"
+    done = _interrupt(signal.SIGTERM, out, program=_ANTENNA_SLOW_FINALIZER)
+    assert done.returncode == 143, done.stderr
+    assert done.stderr.strip() == "antenna simulate: stopped by SIGTERM"
     assert not out.exists()
 
 
