@@ -294,23 +294,20 @@ def _terminate_raises() -> Iterator[None]:
         note_signal(number)
         raise Terminated(number)
 
-    pending: list[int] = []
-
     def redeliver(number: int, frame: FrameType | None) -> None:
-        stop = pending.pop() if pending else signal.SIGTERM
-        pending.clear()
-        raise KeyboardInterrupt if stop == signal.SIGINT else Terminated(stop)
+        raise_if_signalled()
 
     def unraisable(event: Any) -> None:
         # an interruption raised inside a finalizer (a __del__, a weakref callback, the garbage
-        # collector) is dropped by Python, which prints it and goes on: raise it again a moment
-        # later (REDELIVERY s), back where the command can unwind, without the dropped traceback
+        # collector) is dropped by Python, which prints it and goes on: recorded as a stop
+        # signal, it is raised again a moment later (REDELIVERY s), back where the command can
+        # unwind, without the dropped traceback
         if (
             isinstance(event.exc_value, KeyboardInterrupt)
             and os.getpid() == owner
-            and hasattr(signal, "setitimer")  # POSIX
+            and alarm is not None
         ):
-            pending.append(int(getattr(event.exc_value, "signal_number", signal.SIGINT)))
+            note_signal(int(getattr(event.exc_value, "signal_number", signal.SIGINT)))
             signal.signal(signal.SIGALRM, redeliver)
             signal.setitimer(signal.ITIMER_REAL, REDELIVERY)
             return
@@ -326,7 +323,8 @@ def _terminate_raises() -> Iterator[None]:
         return
     dropped_hook = sys.unraisablehook
     sys.unraisablehook = unraisable
-    alarm = signal.getsignal(signal.SIGALRM) if hasattr(signal, "SIGALRM") else None
+    # the alarm's handler before ours; None where there are no timers (not POSIX)
+    alarm = signal.getsignal(signal.SIGALRM) if hasattr(signal, "setitimer") else None
     try:
         yield
     finally:

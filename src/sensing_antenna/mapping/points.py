@@ -356,16 +356,10 @@ def _tangent(g: _Geometry, x_c: float, uncertainty: PointUncertainty) -> tuple[F
     return np.asarray(tangent / np.linalg.norm(tangent)), std
 
 
-def point_covariance(
-    estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
-) -> FloatArray:
-    """Sigma_a (m^2), shape (3, 3), in the recording's absolute frame (module docstring)."""
-    return _covariance(_geometry(estimate, antenna), estimate, antenna, uncertainty)
-
-
 def _covariance(
     g: _Geometry, estimate: ContactEstimate, antenna: Antenna, uncertainty: PointUncertainty
 ) -> FloatArray:
+    """Sigma_a (m^2), shape (3, 3), in the recording's absolute frame (module docstring)."""
     x_c = float(estimate.x_c)
     point_a = np.asarray(estimate.contact_point, dtype=float)
     theta, x_m, y_m, z_m = g.theta, g.x_m, g.y_m, g.z_m

@@ -107,22 +107,26 @@ class Primitive:
 def local_coordinates(parameters: FloatArray, points: FloatArray) -> FloatArray:
     """Points (m, shape (n, 3)) in a posed shape's own frame: R^T (p - c), with the centre c =
     parameters[0:3] and R the rotation of the rotation vector w = parameters[3:6] (rad)."""
-    rotation = _rotation(np.ascontiguousarray(parameters[3:6], dtype=float).tobytes())
-    return np.asarray((points - parameters[0:3]) @ rotation)
+    return np.asarray((points - parameters[0:3]) @ _rotation(parameters))
+
+
+def _rotation(parameters: FloatArray) -> FloatArray:
+    """R (read-only, shape (3, 3)) of the rotation vector parameters[3:6] (rad)."""
+    return _rotation_of(np.ascontiguousarray(parameters[3:6], dtype=float).tobytes())
 
 
 @functools.lru_cache(maxsize=32)
-def _rotation(rotation_vector: bytes) -> FloatArray:
+def _rotation_of(rotation_vector: bytes) -> FloatArray:
     # a fit evaluates one pose many times over (each distance, the normals' six differences,
     # the finite-difference Jacobian's columns that leave w alone): built once per pose
     matrix = Rotation.from_rotvec(np.frombuffer(rotation_vector, dtype=float).copy()).as_matrix()
     matrix.setflags(write=False)
-    return np.asarray(matrix)
+    return matrix
 
 
 def _transform(parameters: FloatArray) -> FloatArray:
     matrix = np.eye(4)
-    matrix[:3, :3] = _rotation(np.ascontiguousarray(parameters[3:6], dtype=float).tobytes())
+    matrix[:3, :3] = _rotation(parameters)
     matrix[:3, 3] = parameters[0:3]
     return matrix
 
