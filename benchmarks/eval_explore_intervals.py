@@ -31,12 +31,10 @@ import numpy as np  # noqa: E402
 
 from sensing_antenna import load_antenna  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
+from sensing_antenna.mapping.points import Z_95  # noqa: E402
 from sensing_antenna.recording import read_recording  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "explore_intervals.json"
-
-#: The 95 % interval's half-width in standard deviations.
-Z_95 = 1.959963984540054
 
 
 def score(path: Path, kept: Path, antenna: Any) -> dict[str, Any]:
