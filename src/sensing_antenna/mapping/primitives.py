@@ -33,7 +33,6 @@ the k of a model-selection score.
 from __future__ import annotations
 
 import functools
-import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -148,18 +147,6 @@ def _sphere(parameters: FloatArray, points: FloatArray) -> FloatArray:
     return np.asarray(np.linalg.norm(points - parameters[0:3], axis=1) - parameters[3])
 
 
-def _segments_distance(rho: FloatArray, z: FloatArray, profile: FloatArray) -> FloatArray:
-    """Unsigned distance from (rho, z) points to a polyline profile's segments, shape (n,)."""
-    best = np.full(rho.shape, np.inf)
-    query = np.stack([rho, z], axis=1)
-    for start, end in itertools.pairwise(profile):
-        edge = end - start
-        t = np.clip(((query - start) @ edge) / float(edge @ edge), 0.0, 1.0)
-        nearest = start + t[:, None] * edge
-        best = np.minimum(best, np.linalg.norm(query - nearest, axis=1))
-    return best
-
-
 def _cylinder(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the exact distance to a capped cylinder: q = (rho - r, |z| - h / 2)
     local = local_coordinates(parameters, points)
@@ -180,13 +167,16 @@ def _capsule(parameters: FloatArray, points: FloatArray) -> FloatArray:
 
 def _cone(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the cross-section is the triangle (0, 0), (R, 0), (0, h) in (rho, z): distance to its
-    # base and slant edges, negative inside the triangle
+    # base (0, 0)-(R, 0) and its slant edge (R, 0)-(0, h), negative inside the triangle
     local = local_coordinates(parameters, points)
     radius, height = parameters[6], parameters[7]
     rho = np.hypot(local[:, 0], local[:, 1])
     z = local[:, 2]
-    profile = np.array([[0.0, 0.0], [radius, 0.0], [0.0, height]])
-    distance = _segments_distance(rho, z, profile)
+    base = np.hypot(rho - np.clip(rho, 0.0, radius), z)
+    # the slant from (R, 0) along (-R, h): t the nearest point's fraction of it
+    t = np.clip(((radius - rho) * radius + z * height) / (radius**2 + height**2), 0.0, 1.0)
+    slant = np.hypot(rho - radius * (1.0 - t), z - height * t)
+    distance = np.minimum(base, slant)
     inside = (z >= 0.0) & (rho * height + z * radius <= radius * height)
     return np.asarray(np.where(inside, -distance, distance))
 
