@@ -32,9 +32,12 @@ area within 5 mm of it (a map that never touched a side is far from it there), a
 sweeps and at the end; the contacts each strategy needs to bring the whole object's RMS to 5 mm
 (the two strategies compared scene by scene on it); the recognition
 (right, abstained, confidently wrong) and the size error of the true class's fit, the
-Mahalanobis distance of each ``ok`` point's true contact point under its covariance, and the
-simulated sweeping time. Prints a table and writes ``benchmarks/results/explore.json`` after
-every exploration (a run stopped early keeps the scenes it finished). ``--keep DIR`` keeps each
+Mahalanobis distance of each ``ok`` point's true contact point under its covariance, how far
+the true object disagrees with the swept links recognition weighs (its residual per free sweep
+and per touching link, the worst and the count beyond 2: swept links the truth contradicts
+would refute the right class), and the simulated sweeping time. Prints a table and writes
+``benchmarks/results/explore.json`` after every exploration (a run stopped early keeps the
+scenes it finished). ``--keep DIR`` keeps each
 exploration's directory there (its recordings and points, for ``antenna map``); an exploration
 already there is resumed, and a finished one re-scored: its map rebuilt with the current code
 from its stored points (exact for the grid, whose sweeps do not depend on the map; next-best's
@@ -70,8 +73,9 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
 from sensing_antenna.exploration import ExploreSettings, calibrate_device, explore  # noqa: E402
+from sensing_antenna.exploration.run import swept_links  # noqa: E402
 from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
-from sensing_antenna.mapping import UNDECIDED, BasePose  # noqa: E402
+from sensing_antenna.mapping import PRIMITIVES, UNDECIDED, BasePose  # noqa: E402
 from sensing_antenna.mapping.contact_map import fit_surface  # noqa: E402
 from sensing_antenna.scene import (  # noqa: E402
     ExploreRegion,
@@ -256,6 +260,26 @@ def mahalanobis(points: list[Any]) -> list[float]:
     return distances
 
 
+def swept_truth(scene: Scene, result: Any, out: Path) -> dict[str, Any]:
+    """How far the true object disagrees with the swept links recognition weighs: its residual
+    r_j per free sweep and per touching link (``mapping.free_space``), the worst of each, and
+    how many sweeps it is below -2 in and how many touches above 2 (each about 2 % of them if
+    the samples' sigma is right and Gaussian, fewer when it is generous)."""
+    free, touched = swept_links(result.manoeuvres, scene, result.antenna, out)
+    obj = scene.objects[0]
+    shape = PRIMITIVES[obj.shape]
+    r_free = free.residuals(shape.signed_distance(obj.parameters, free.samples))
+    r_touch = touched.residuals(shape.signed_distance(obj.parameters, touched.samples))
+    return {
+        "free_sweeps": int(free.n_sweeps),
+        "free_truth_min_r": float(r_free.min()) if len(r_free) else math.nan,
+        "free_truth_below_2": int(np.sum(r_free < -2.0)),
+        "touch_links": int(touched.n_sweeps),
+        "touch_truth_max_r": float(r_touch.max()) if len(r_touch) else math.nan,
+        "touch_truth_above_2": int(np.sum(r_touch > 2.0)),
+    }
+
+
 def run(
     scene: Scene,
     info: dict[str, Any],
@@ -296,6 +320,7 @@ def run(
     else:
         row["point_rms_m"] = row["point_max_m"] = math.nan
     row["mahalanobis"] = mahalanobis(used)
+    row.update(swept_truth(scene, result, out))
     progress = []
     samples, _ = trimesh.sample.sample_surface(mesh, 20000, seed=0)
     checkpoints = sorted({*range(CHECK_EVERY, len(manoeuvres), CHECK_EVERY), len(manoeuvres)})
@@ -378,6 +403,10 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         }
         if distances
         else None,
+        "free_sweeps": sum(r.get("free_sweeps", 0) for r in rows),
+        "free_truth_below_2": sum(r.get("free_truth_below_2", 0) for r in rows),
+        "touch_links": sum(r.get("touch_links", 0) for r in rows),
+        "touch_truth_above_2": sum(r.get("touch_truth_above_2", 0) for r in rows),
         "mean_sweep_time_s": mean("sweep_time_s"),
         "mean_run_s": mean("run_s"),
     }

@@ -61,14 +61,19 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.mapping import build_map, points_from_recordings
+    from sensing_antenna.mapping import (
+        build_map,
+        points_from_recordings,
+        swept_from_recordings,
+    )
 
     meshes = {path.stem: load_mesh(path) for path in args.objects}
     antenna = load_antenna(args.antenna)
     points = points_from_recordings(
         args.recordings, antenna, args.method, config=EstimatorConfig(t1_source=args.t1)
     )
-    contact_map = build_map(points, args.include_uncertain, meshes=meshes)
+    swept = swept_from_recordings(args.recordings, antenna, points)
+    contact_map = build_map(points, args.include_uncertain, meshes=meshes, swept=swept)
     report_map(contact_map, args.out)
     return 0
 

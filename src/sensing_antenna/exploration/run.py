@@ -13,7 +13,9 @@ retract, re-plan), on the simulator:
    written (its ``base_pose`` says where it was taken) and estimated by the map's own code path
    (``mapping.points_from_recordings``), giving a :class:`~sensing_antenna.mapping.ContactPoint`
    with its covariance and status; a sweep that touches nothing is stored as free space.
-3. **The map**: ``mapping.build_map`` on every point, as ``antenna map`` builds it.
+3. **The map**: ``mapping.build_map`` on every point, as ``antenna map`` builds it, with the
+   free space every sweep's link passed through before its touch and the links that touched
+   where no ``ok`` point says so (:func:`swept_links`).
 
 The next-best strategy refits the surface before each manoeuvre and recognises the points before
 every :data:`RECOGNITION_EVERY`-th, aiming at the two leading classes while recognition abstains
@@ -30,18 +32,21 @@ from __future__ import annotations
 import hashlib
 import math
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import trimesh
+from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.campaign.store import atomic_write_text
 from sensing_antenna.errors import raise_if_signalled
+from sensing_antenna.estimation.result import Status
 from sensing_antenna.exploration.plan import (
+    PREDICTION_STEP,
     STRATEGIES,
     Choice,
     NextBestPlanner,
@@ -66,6 +71,15 @@ from sensing_antenna.mapping.contact_map import (
     fit_surface,
     recognise_points,
 )
+from sensing_antenna.mapping.free_space import (
+    FreeSpace,
+    Piece,
+    Touches,
+    free_space,
+    onset_turn,
+    recording_links,
+    touches,
+)
 from sensing_antenna.mapping.points import ContactPoint
 from sensing_antenna.mapping.primitives import PRIMITIVES
 from sensing_antenna.mapping.recognition import ClassFit
@@ -75,6 +89,8 @@ from sensing_antenna.scene.simulate import simulate_sweep
 from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.simulator.scenario import LINK_MODELS
 
+FloatArray = NDArray[np.float64]
+
 __all__ = [
     "CALIBRATION_POINTS",
     "Exploration",
@@ -82,6 +98,7 @@ __all__ = [
     "ExploreSettings",
     "calibrate_device",
     "explore",
+    "swept_links",
 ]
 
 #: Where the calibration's posts are touched (m): the README's five points.
@@ -332,7 +349,8 @@ def explore(
                     points = [m.point for m in manoeuvres if m.point is not None]
                     surface = fit_surface(points, settings.include_uncertain)
                     if index % RECOGNITION_EVERY == 0:
-                        leaders = _undecided_leaders(points, settings.include_uncertain)
+                        swept = swept_links(manoeuvres, scene, antenna, out)
+                        leaders = _undecided_leaders(points, settings.include_uncertain, swept)
                     choice = planner.choose(
                         [m.sweep for m in manoeuvres],
                         surface,
@@ -353,14 +371,62 @@ def explore(
             raise ExplorationInterrupted(number, len(manoeuvres), out) from None
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
-    contact_map = build_map(points, settings.include_uncertain, meshes=meshes)
+    swept = swept_links(manoeuvres, scene, antenna, out)
+    contact_map = build_map(points, settings.include_uncertain, meshes=meshes, swept=swept)
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 
 
-def _undecided_leaders(points: list[ContactPoint], include_uncertain: bool) -> tuple[ClassFit, ...]:
+def swept_links(
+    manoeuvres: Sequence[Manoeuvre], scene: Scene, antenna: Antenna, out: Path
+) -> tuple[FreeSpace, Touches]:
+    """Where the manoeuvres' links were free and where they touched (``mapping.free_space``).
+
+    Free: the whole sweep when it touched nothing; up to the touch otherwise, the recording's
+    own angles before its detected contact's onset when it has one (in its own frame,
+    ``base_pose``) after the unrecorded approach as planned, else (a glancing touch, not
+    simulated) the planned angles short of the geometric touch by the onset turn of a contact at
+    the tip. Touched: the link at the onset of each detected contact whose point is not ``ok``
+    (an ``ok`` point says more), and at each glancing touch.
+    """
+    from sensing_antenna.recording import read_recording
+
+    free: list[list[Piece]] = []
+    touched: list[list[Piece]] = []
+    for m in manoeuvres:
+        sweep = m.sweep
+        planned = sweep.swept_angles(PREDICTION_STEP)
+        base = scene.bases[sweep.base]
+        pieces: list[Piece] = []
+        if m.outcome == "free":
+            end = math.inf * sweep.direction
+        elif m.outcome not in ("touch", "glancing") or m.touch is None:
+            continue
+        elif m.recording is not None and (out / m.recording).exists():
+            recording = read_recording(out / m.recording)
+            x_c = m.point.x_c if m.point is not None else math.nan
+            recorded, onset = recording_links(recording, antenna, x_c)
+            pieces.append(recorded)
+            if onset is not None and (m.point is None or m.point.status is not Status.OK):
+                touched.append([onset])
+            # the recording's frame is turned to the touch's angles, where it starts at theta_0
+            swept = 0 if sweep.case == "azimuthal" else 1
+            end = float(m.touch["angle"]) + float(recording.theta[0, swept])
+        else:
+            touch = float(m.touch["angle"])
+            touched.append([(base, np.array([sweep.angles(touch)]))])
+            end = touch - sweep.direction * onset_turn(antenna, math.nan)
+        before = planned[(planned - end) * sweep.direction < 0]
+        theta = np.array([sweep.angles(float(a)) for a in before]).reshape(-1, 2)
+        free.append([(base, theta), *pieces])
+    return free_space(free, antenna), touches(touched, antenna)
+
+
+def _undecided_leaders(
+    points: list[ContactPoint], include_uncertain: bool, swept: Sequence[FreeSpace]
+) -> tuple[ClassFit, ...]:
     """The two fits recognition abstains between (the best and its rival, or the two leading
     scores) when it abstains and both are primitives, else none."""
-    recognition = recognise_points(points, include_uncertain)
+    recognition = recognise_points(points, include_uncertain, swept=swept)
     if recognition is None or not recognition.undecided:
         return ()
     by_name = {f.name: f for f in recognition.fits}

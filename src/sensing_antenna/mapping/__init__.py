@@ -5,10 +5,14 @@ Above ``estimation/`` (it turns estimates into world points), below ``cli/``:
 - :mod:`.pose`: the antenna base's pose in the world (``base_pose`` metadata);
 - :mod:`.points`: :class:`ContactPoint`, a touched point with its covariance;
 - :mod:`.surface`: :class:`ImplicitSurface`, a Gaussian-process implicit surface;
+- :mod:`.free_space`: :class:`FreeSpace` and :class:`Touches`, where the links swept without
+  touching and where they touched;
 - :mod:`.primitives`: the shape classes, their exact signed distances and meshes;
-- :mod:`.recognition`: every class fitted to the points and the links' lines, scored by BIC,
+- :mod:`.recognition`: every class fitted to the points, the links' lines and the swept links,
+  scored by BIC,
   a decision that abstains when a class the points do not rule out is another shape;
-- :mod:`.contact_map`: :func:`build_map` and :func:`points_from_recordings`;
+- :mod:`.contact_map`: :func:`build_map`, :func:`points_from_recordings` and
+  :func:`swept_from_recordings`;
 - :mod:`.store`: the map's directory;
 - :mod:`.view`: the interactive HTML view (map.html).
 """
@@ -17,7 +21,9 @@ from sensing_antenna.mapping.contact_map import (
     ContactMap,
     build_map,
     points_from_recordings,
+    swept_from_recordings,
 )
+from sensing_antenna.mapping.free_space import FreeSpace, Touches, free_space, touches
 from sensing_antenna.mapping.points import (
     ContactPoint,
     PointUncertainty,
@@ -47,18 +53,23 @@ __all__ = [
     "ClassFit",
     "ContactMap",
     "ContactPoint",
+    "FreeSpace",
     "ImplicitSurface",
     "LinkLines",
     "PointUncertainty",
     "Primitive",
     "Recognition",
+    "Touches",
     "base_pose_from_metadata",
     "build_map",
     "contact_point_from_estimate",
     "fit_mesh",
     "fit_primitive",
+    "free_space",
     "points_from_recordings",
     "recognise",
     "select_points",
+    "swept_from_recordings",
+    "touches",
     "write_map",
 ]

@@ -1,9 +1,11 @@
 """A map: contact points from recordings, the surface through them, and what object they are.
 
 :func:`points_from_recordings` estimates each recording and places its point in the world
-(the recording's ``base_pose``); :func:`build_map` keeps the points that may enter a map (status
-``ok``, and ``uncertain`` when asked), fits the implicit surface when there are enough of them
-and recognises the object when there are enough for every class.
+(the recording's ``base_pose``); :func:`swept_from_recordings` finds where each recording's link
+swept untouched and where it touched (``mapping.free_space``); :func:`build_map` keeps the
+points that may enter a map (status ``ok``, and ``uncertain`` when asked), fits the implicit
+surface when there are enough of them and recognises the object when there are enough for every
+class.
 """
 
 from __future__ import annotations
@@ -20,6 +22,15 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.estimation.result import Status
+from sensing_antenna.mapping.free_space import (
+    FreeSpace,
+    Piece,
+    Touches,
+    free_space,
+    recording_links,
+    touches,
+)
 from sensing_antenna.mapping.points import (
     ContactPoint,
     PointUncertainty,
@@ -38,6 +49,7 @@ __all__ = [
     "link_lines",
     "points_from_recordings",
     "recognise_points",
+    "swept_from_recordings",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -137,21 +149,53 @@ def points_from_recordings(
     return points
 
 
+def swept_from_recordings(
+    paths: Sequence[Path],
+    antenna: Antenna,
+    points: Sequence[ContactPoint] | None = None,
+) -> tuple[FreeSpace, Touches]:
+    """Where the recordings' links swept untouched, and where they touched when their points
+    (``points``, in the same order) are not ``ok`` (``mapping.free_space.recording_links``:
+    the angles before the onset of the detected contact, short of it by the onset turn of a
+    contact at the point's x_c, and the link at that onset).
+
+    Raises
+    ------
+    RecordingError, FieldError
+        One line naming the file when a recording or its base pose is malformed.
+    """
+    from sensing_antenna.recording import read_recording
+
+    free: list[list[Piece]] = []
+    touched: list[list[Piece]] = []
+    for k, path in enumerate(paths):
+        point = points[k] if points is not None and k < len(points) else None
+        recorded, onset = recording_links(
+            read_recording(path), antenna, point.x_c if point is not None else math.nan
+        )
+        free.append([recorded])
+        if onset is not None and (point is None or point.status is not Status.OK):
+            touched.append([onset])
+    return free_space(free, antenna), touches(touched, antenna)
+
+
 def build_map(
     points: Sequence[ContactPoint],
     include_uncertain: bool = False,
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
     surface: ImplicitSurface | None = None,
     rng: np.random.Generator | None = None,
+    swept: Sequence[FreeSpace] = (),
 ) -> ContactMap:
-    """The map from points (module docstring); the surface and recognition when possible."""
+    """The map from points (module docstring); the surface and recognition when possible,
+    recognition also weighing ``swept``, where links swept untouched and where they touched."""
     used = select_points(list(points), include_uncertain)
     fitted = fit_surface(used, True, surface)
     mesh = None
     std = np.zeros(0)
     if fitted is not None:
         mesh, std = fitted.mesh()
-    recognition = recognise_points(used, True, meshes, rng)
+    recognition = recognise_points(used, True, meshes, rng, swept)
     return ContactMap(
         points=tuple(points),
         used=tuple(used),
@@ -184,6 +228,7 @@ def recognise_points(
     include_uncertain: bool = False,
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
     rng: np.random.Generator | None = None,
+    swept: Sequence[FreeSpace] = (),
 ) -> Recognition | None:
     """The recognition of the points a map uses (None with fewer than
     :data:`MIN_RECOGNITION_POINTS`), the mean direction to their bases the outer side."""
@@ -194,7 +239,9 @@ def recognise_points(
     cov = np.array([c.covariance for c in used]).reshape(-1, 3, 3)
     bases = np.array([c.base_position for c in used]).reshape(-1, 3)
     outward = (bases - p).mean(axis=0)
-    return recognise(p, cov, meshes=meshes, outward=outward, rng=rng, lines=link_lines(used))
+    return recognise(
+        p, cov, meshes=meshes, outward=outward, rng=rng, lines=link_lines(used), swept=swept
+    )
 
 
 def link_lines(points: Sequence[ContactPoint]) -> LinkLines | None:

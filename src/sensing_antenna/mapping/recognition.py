@@ -73,6 +73,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from sensing_antenna.mapping.free_space import FreeSpace
 from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive, local_coordinates
 
 __all__ = [
@@ -144,6 +145,14 @@ LINE_STRETCH = 0.04
 #: allows (the mixture's outlier weight, module docstring): about the share of ``ok`` estimates
 #: over 1 cm off in the simulated campaigns and explorations, which stays below it.
 OUTLIER_FRACTION = 0.01
+
+#: How far beyond the points' bounding box (m, plus half their spread) free space is checked
+#: against a fit: a fitted shape reaches beyond its points by its hidden side at most.
+FREE_MARGIN = 0.02
+
+#: A free-space sample farther outside a fit than this (m) at the start of a refinement stays
+#: out of it while the refinement moves the shape (the score checks every sample).
+FREE_ACTIVE = 0.01
 
 #: Where along that stretch, as fractions of it.
 _LINE_FRACTIONS = (0.125, 0.25, 0.5, 1.0)
@@ -268,6 +277,9 @@ class ClassFit:
         Points fitted.
     line_chi2 : float
         sum r_i^2, the link lines' residuals before the mixture (0 without lines).
+    swept_chi2 : float
+        sum r_j^2, the swept links' residuals (free space and touches) before the mixture
+        (0 without them).
     weight : float
         Weight exp(-score / 2) among the classes compared (0 to 1); NaN until compared.
     score : float
@@ -283,6 +295,7 @@ class ClassFit:
     dof: int
     n_points: int
     line_chi2: float = 0.0
+    swept_chi2: float = 0.0
     weight: float = math.nan
     score: float = math.nan
     vector: FloatArray = field(default_factory=lambda: np.zeros(0), compare=False, repr=False)
@@ -297,6 +310,7 @@ class ClassFit:
             "rms_m": float(self.rms),
             "chi2": float(self.chi2),
             "line_chi2": float(self.line_chi2),
+            "swept_chi2": float(self.swept_chi2),
             "bic": float(self.bic),
             "score": None if math.isnan(self.score) else float(self.score),
             "dof": self.dof,
@@ -509,6 +523,7 @@ def fit_primitive(
     outward: ArrayLike | None = None,
     rng: np.random.Generator | None = None,
     lines: LinkLines | None = None,
+    swept: Sequence[FreeSpace] = (),
 ) -> ClassFit:
     """Fit one class to the points (module docstring).
 
@@ -527,6 +542,10 @@ def fit_primitive(
         For the extra starting rotations of the box (seeded default).
     lines : LinkLines, optional
         The link's line at each contact: a tangency residual per contact (module docstring).
+    swept : sequence of FreeSpace
+        Where links swept untouched (:class:`FreeSpace`) and where they touched
+        (:class:`~sensing_antenna.mapping.free_space.Touches`): a residual per sweep or contact
+        (module docstring).
     """
     model = PRIMITIVES[shape] if isinstance(shape, str) else shape
     p = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -538,22 +557,39 @@ def fit_primitive(
     spread = _spread(p)
 
     placed = lines.placed(p) if lines is not None else None
+    spaces = [space.near(p, FREE_MARGIN + 0.5 * spread) for space in swept]
+    link_evidence = lines is not None or bool(spaces)
 
     def line_residuals(x: FloatArray, s: FloatArray) -> FloatArray:
         if placed is None:
             return np.zeros(0)
         return placed.residuals(lambda q: model.signed_distance(x, q), s)
 
-    def residuals(x: FloatArray, s: FloatArray, with_lines: bool) -> FloatArray:
+    def swept_residuals(x: FloatArray, regions: Sequence[FreeSpace]) -> FloatArray:
+        return np.concatenate(
+            [np.zeros(0)]
+            + [region.residuals(model.signed_distance(x, region.samples)) for region in regions]
+        )
+
+    def residuals(
+        x: FloatArray, s: FloatArray, with_lines: bool, regions: Sequence[FreeSpace]
+    ) -> FloatArray:
         distance = model.signed_distance(x, p) / s
         line = line_residuals(x, s) if with_lines else np.zeros(0)
-        return np.concatenate([distance, line, _extent_excess(model.name, x, p) / EXTENT_PRIOR])
+        prior = _extent_excess(model.name, x, p) / EXTENT_PRIOR
+        return np.concatenate([distance, line, swept_residuals(x, regions), prior])
 
-    def fit(start: FloatArray, s: FloatArray, with_lines: bool, evaluations: int) -> Any:
+    def fit(
+        start: FloatArray,
+        s: FloatArray,
+        with_lines: bool,
+        evaluations: int,
+        regions: Sequence[FreeSpace] = (),
+    ) -> Any:
         return least_squares(
             residuals,
             start,
-            args=(s, with_lines),
+            args=(s, with_lines, regions),
             bounds=(low, high),
             loss="soft_l1",
             f_scale=ROBUST_SCALE,
@@ -566,18 +602,24 @@ def fit_primitive(
 
     def refine(x: FloatArray) -> FloatArray:
         # each point's sigma along the fitted surface's normal, and the link's lines; a point
-        # the mixture counts as wrong at x (its z^2 beyond its cap) leaves the refinement
+        # the mixture counts as wrong at x (its z^2 beyond its cap) leaves the refinement, and
+        # so do free-space samples far outside the shape at x
         normal_sigma = _normal_sigma(cov, model.normals(x, p))
         wrong = point_z2(x, normal_sigma) > outlier_cap(normal_sigma, spread)
         normal_sigma = np.where(wrong, np.inf, normal_sigma)
-        return np.asarray(fit(x, normal_sigma, lines is not None, 2 * MAX_EVALUATIONS).x)
+        regions = [
+            space.within(model.signed_distance(x, space.samples), FREE_ACTIVE) for space in spaces
+        ]
+        solution = fit(x, normal_sigma, lines is not None, 2 * MAX_EVALUATIONS, regions)
+        return np.asarray(solution.x)
 
     def total(x: FloatArray) -> float:
         # the scored chi^2 (plus the extent prior) with the sigma at x: one scale for all
         normal_sigma = _normal_sigma(cov, model.normals(x, p))
         parts = point_chi2(point_z2(x, normal_sigma), normal_sigma, spread)
+        free_parts = _swept_chi2(swept_residuals(x, spaces), spaces, spread)
         prior = _extent_excess(model.name, x, p) / EXTENT_PRIOR
-        return float(np.sum(parts) + np.sum(prior**2))
+        return float(np.sum(parts) + np.sum(free_parts) + np.sum(prior**2))
 
     # each start fitted on the points alone (a smooth problem); with lines, also from each
     # start with them, and the best few of the points-alone fits refined: the lines make the
@@ -593,7 +635,7 @@ def fit_primitive(
             continue
     assert alone
     alone.sort(key=lambda solution: solution.cost)
-    chosen = alone[: REFINED_STARTS if lines is not None else 1]
+    chosen = alone[: REFINED_STARTS if link_evidence else 1]
     candidates = [refine(solution.x) for solution in chosen] + [refine(x) for x in direct]
     x = min(candidates, key=total) if len(candidates) > 1 else candidates[0]
     distance = model.signed_distance(x, p)
@@ -609,6 +651,8 @@ def fit_primitive(
         mesh=model.mesh(x),
         spread=spread,
         line=line_residuals(x, sigma),
+        swept=swept_residuals(x, spaces),
+        spaces=spaces,
     )
 
 
@@ -620,6 +664,7 @@ def fit_mesh(
     rng: np.random.Generator | None = None,
     n_starts: int = 24,
     lines: LinkLines | None = None,
+    swept: Sequence[FreeSpace] = (),
 ) -> ClassFit:
     """Register a user mesh (its own size, any pose) to the points by ICP and score it.
 
@@ -627,8 +672,8 @@ def fit_mesh(
     mesh for each point: right for points covering only part of the object) from ``n_starts``
     rotations about the points' centroid placed on the mesh's centre and from the alignment of
     principal axes (trimesh.registration.mesh_other); the lowest cost wins. ``lines`` adds
-    the tangency residuals of the registered mesh (not used to register it), for a closed
-    (watertight) mesh only: an open one has no inside.
+    the tangency residuals of the registered mesh and ``swept`` its swept links' residuals (not
+    used to register it), for a closed (watertight) mesh only: an open one has no inside.
     """
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
@@ -685,9 +730,24 @@ def fit_mesh(
     extents = mesh.bounding_box.extents
     sizes = {f"extent_{a}": float(e) for a, e in zip("xyz", extents, strict=True)}
     line = np.zeros(0)
-    if lines is not None and placed.is_watertight:
+    sweeps, spaces = np.zeros(0), []
+    if placed.is_watertight:
         # trimesh's signed distance is positive inside (and meaningful for a closed mesh only)
-        line = lines.residuals(lambda q: -trimesh.proximity.signed_distance(placed, q), p, sigma)
+        def signed(q: FloatArray) -> FloatArray:
+            return -np.asarray(trimesh.proximity.signed_distance(placed, q))
+
+        if lines is not None:
+            line = lines.residuals(signed, p, sigma)
+        # only samples within the placed mesh's box grown by this can come near it
+        reach = FREE_MARGIN + 0.5 * _spread(p)
+        spaces = [space.near(placed.bounds, reach) for space in swept]
+        sweeps = np.concatenate(
+            [np.zeros(0)]
+            + [
+                space.residuals(signed(space.samples) if len(space.samples) else np.zeros(0))
+                for space in spaces
+            ]
+        )
     return _scored(
         f"mesh:{name}",
         parameters,
@@ -699,6 +759,8 @@ def fit_mesh(
         placed,
         _spread(p),
         line,
+        sweeps,
+        spaces,
     )
 
 
@@ -713,12 +775,15 @@ def _scored(
     mesh: trimesh.Trimesh | None,
     spread: float,
     line: FloatArray | None = None,
+    swept: FloatArray | None = None,
+    spaces: Sequence[FreeSpace] = (),
 ) -> ClassFit:
     n = len(distance)
     lines = line if line is not None and len(line) == n else np.zeros(n)
-    # each point's part of chi^2; BIC = chi^2 + k ln n
+    sweeps = swept if swept is not None else np.zeros(0)
+    # each point's and each sweep's part of chi^2; BIC = chi^2 + k ln n
     parts = point_chi2(_z2(distance, sigma, lines), sigma, spread)
-    chi2 = float(np.sum(parts))
+    chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(
         name=name,
@@ -727,12 +792,25 @@ def _scored(
         rms=float(np.sqrt(np.mean(distance**2))),
         chi2=chi2,
         line_chi2=line_chi2,
+        swept_chi2=float(np.sum(sweeps**2)),
         bic=chi2 + dof * math.log(n),
         dof=dof,
         n_points=n,
         vector=vector,
         mesh=mesh,
     )
+
+
+def _swept_chi2(r: FloatArray, spaces: Sequence[FreeSpace], spread: float) -> FloatArray:
+    """Each sweep's or contact's part of chi^2 (:func:`point_chi2` of r_j^2, the cap at its
+    evidence's median sample standard deviation), shape (n,) for the residuals of ``spaces``
+    in order; empty without them."""
+    if not len(r):
+        return np.zeros(0)
+    sigma = np.concatenate(
+        [np.full(s.n_sweeps, float(np.median(s.std)) if len(s.std) else 1.0) for s in spaces]
+    )
+    return point_chi2(np.asarray(r, dtype=float) ** 2, sigma, spread)
 
 
 def _surface_distance(fit: ClassFit, samples: FloatArray) -> FloatArray:
@@ -793,6 +871,7 @@ def recognise(
     threshold: float = ABSTAIN_DELTA,
     rng: np.random.Generator | None = None,
     lines: LinkLines | None = None,
+    swept: Sequence[FreeSpace] = (),
 ) -> Recognition:
     """Fit every class (and mesh) to the points and decide (module docstring).
 
@@ -815,6 +894,8 @@ def recognise(
         Seeded default when None.
     lines : LinkLines, optional
         The link's line at each contact (module docstring).
+    swept : sequence of FreeSpace
+        Where links swept untouched and where they touched (module docstring).
     """
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
@@ -822,9 +903,9 @@ def recognise(
         raise ValueError(f"recognition needs at least 10 points, got {len(p)}")
     generator = rng if rng is not None else np.random.default_rng(0)
     names = list(classes) if classes is not None else list(PRIMITIVES)
-    fits = [fit_primitive(name, p, cov, outward, generator, lines) for name in names]
+    fits = [fit_primitive(name, p, cov, outward, generator, lines, swept) for name in names]
     for name, mesh in (meshes or {}).items():
-        fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines))
+        fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines, swept=swept))
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
     tightest = min(fits, key=lambda f: f.chi2)
     c = max(1.0, tightest.chi2 / max(len(p) - tightest.dof, 1))

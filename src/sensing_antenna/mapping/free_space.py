@@ -1,0 +1,311 @@
+"""Where the link swept without touching: space no object occupies.
+
+A sweeping head moves its link through free space until the touch: at every angle before it,
+the link crossed no object. That is evidence about the object's shape beside the touched points
+themselves: a shape that reaches into space a link swept through untouched is refuted, whatever
+its fit to the points (a cylinder's flat end where a sweep passed beyond a capsule's round cap).
+
+The link at motor angles theta is the straight line x X^m bent by its weight, the same model
+the contact points use (``mapping.points``): p(x) = x X^m + g |A| u(x) A, A the part of -Z^a
+across the link and u the cantilever's unit sag (``Link.unit_sag``), in the world through the
+base pose. Each sample of the link is known to within its standard deviation across the link,
+sigma(x)^2 = (x tau)^2 + (rho s(x))^2: tau = :data:`FREE_POINTING`, rho the deflection model's
+relative uncertainty (``PointUncertainty``) and s(x) the sag. The head's zero offset, part of
+the points' pointing (``points.TANGENT_FLOOR``), moves a base's points and its free space alike
+and does not separate them; what does is the link's swing while it sweeps: the head's angular
+acceleration alpha loads it with rho_l alpha x per length, a tip deflection of
+11 rho_l alpha l^5 / (120 E I) while it lasts (2.2 mm for the paper's link at 0.5 rad/s^2, a
+sweep reaching 0.3 rad/s in 0.6 s), which its first mode, barely damped, keeps ringing at up to
+twice that once the acceleration stops.
+
+When a contact is detected at t_c the link has been pressing the object for a while: the
+contact detector (``detection.contact``, Section 4.2 of the paper) waits for the external
+torque to cross its threshold tau_th, which a contact at x reaches once the head has turned on
+by tau_th x / (3 E I) (a cantilever loaded at x: its base torque F x = 3 E I delta / x^2 for the
+deflection delta = x dtheta), some centimetres of link. The contact's onset is found looking
+back from t_c: the last sample where the detector's filtered residual was at most
+:data:`ONSET_FRACTION` of the threshold, a level a contact reaches after a twentieth of that
+turn plus the residual filter's lag (:func:`contact_onset`). The free part of a sweep ends
+:data:`ONSET_FACTOR` times that twentieth before the onset (:func:`onset_turn`; x the
+estimate's abscissa, or the link's length when the estimate has none: the most compliant
+contact turns the head furthest). A recording without a detected contact adds no free space: a
+contact too light to detect, sliding over an edge, bends the link as far as one just below the
+threshold, so its angles do not say where the link was.
+
+For recognition (``mapping.recognition``) a :class:`FreeSpace` gives one residual per sweep:
+how far its link reaches into a shape, beyond the link's own radius, over its standard
+deviation, at the deepest of its samples: r_j = min(0, min_k (d(q_k) - a) / sigma_k), d the
+shape's signed distance (negative inside) and a the link's radius.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
+from sensing_antenna.detection.contact import ContactDetection, detect_contact
+from sensing_antenna.estimation.front.contact_frame import motor_axes
+from sensing_antenna.mapping.points import PointUncertainty
+from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
+from sensing_antenna.recording import Recording
+
+__all__ = [
+    "FREE_POINTING",
+    "FREE_STEP",
+    "ONSET_FACTOR",
+    "ONSET_FRACTION",
+    "FreeSpace",
+    "Piece",
+    "Touches",
+    "contact_onset",
+    "free_before",
+    "free_space",
+    "onset_turn",
+    "recording_links",
+    "touches",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: A contact's onset is the last sample before t_c where the detector's filtered residual was
+#: at most this fraction of its threshold: twenty times the free motion's residual at the
+#: paper's threshold, so that noise does not end the look back early.
+ONSET_FRACTION = 0.05
+
+#: How many times the static turn to the onset level (module docstring) a sweep's free part
+#: ends before the onset: the residual filter's lag (10 ms, 3 mrad at 0.3 rad/s) and the
+#: contact's build-up add to the static turn.
+ONSET_FACTOR = 5.0
+
+#: Standard deviation (rad) of the free link's direction, from the base, beside the sag model:
+#: its swing while sweeping, twice the quasi-static tip deflection of the module docstring
+#: over the paper link's length (4.4 mm at 0.98 m), and the encoders' counts.
+FREE_POINTING = 0.0045
+
+#: Largest distance (m) between neighbouring samples of the swept link, along it and from one
+#: angle to the next: about the standard deviation of the samples 0.5 m out.
+FREE_STEP = 0.005
+
+
+@dataclass(frozen=True)
+class FreeSpace:
+    """Samples of links that swept through free space, grouped by sweep.
+
+    Attributes
+    ----------
+    samples : array, shape (m, 3)
+        Points of the links' axes (m, world).
+    std : array, shape (m,)
+        Their standard deviations across the link (m).
+    sweep : array of int, shape (m,)
+        Which sweep each sample belongs to (0 .. n_sweeps - 1).
+    n_sweeps : int
+        Sweeps, including any whose samples were all left out by :meth:`near`.
+    radius : float
+        The link's radius (m): a shape's surface may come this close to a sample's axis point.
+    """
+
+    samples: FloatArray
+    std: FloatArray
+    sweep: NDArray[np.int64]
+    n_sweeps: int
+    radius: float
+
+    def __post_init__(self) -> None:
+        samples = np.asarray(self.samples, dtype=float).reshape(-1, 3)
+        n = len(samples)
+        std = np.asarray(self.std, dtype=float).reshape(-1)
+        sweep = np.asarray(self.sweep, dtype=np.int64).reshape(-1)
+        if len(std) != n or len(sweep) != n:
+            raise ValueError(f"FreeSpace: {n} samples, {len(std)} std, {len(sweep)} sweep indices")
+        if n and (sweep.min() < 0 or sweep.max() >= self.n_sweeps):
+            raise ValueError(f"FreeSpace.sweep: indices outside 0 .. {self.n_sweeps - 1}")
+        object.__setattr__(self, "samples", samples)
+        object.__setattr__(self, "std", std)
+        object.__setattr__(self, "sweep", sweep)
+
+    def near(self, points: ArrayLike, margin: float) -> FreeSpace:
+        """The samples inside the points' bounding box grown by ``margin`` (m) each way: the
+        part of free space a shape fitted to the points can reach."""
+        p = np.asarray(points, dtype=float).reshape(-1, 3)
+        low = p.min(axis=0) - margin
+        high = p.max(axis=0) + margin
+        keep = np.all((self.samples >= low) & (self.samples <= high), axis=1)
+        return self._subset(keep)
+
+    def within(self, signed_distance: FloatArray, distance: float) -> FreeSpace:
+        """The samples whose signed distance to a shape (m, shape (m,)) is below ``distance``
+        (m) beyond the link's radius: those a shape moving a little may reach."""
+        keep = np.asarray(signed_distance) - self.radius < distance
+        return self._subset(keep)
+
+    def _subset(self, keep: NDArray[np.bool_]) -> Any:
+        return dataclasses.replace(
+            self, samples=self.samples[keep], std=self.std[keep], sweep=self.sweep[keep]
+        )
+
+    def residuals(self, signed_distance: FloatArray) -> FloatArray:
+        """r_j (module docstring), shape (n_sweeps,), from a shape's signed distance (m) at
+        every sample, shape (m,); 0 for a sweep no shape reaches."""
+        depth = (np.asarray(signed_distance, dtype=float) - self.radius) / self.std
+        r = np.zeros(self.n_sweeps)
+        np.minimum.at(r, self.sweep, depth)
+        return r
+
+
+@dataclass(frozen=True)
+class Touches(FreeSpace):
+    """The link at each contact's onset, where it touched the object somewhere along its length
+    (the attributes of :class:`FreeSpace`, one group per contact): a shape that comes nowhere
+    near such a link is refuted, r_j = max(0, min_k (d(q_k) - a) / sigma_k)."""
+
+    def residuals(self, signed_distance: FloatArray) -> FloatArray:
+        """r_j, shape (n_sweeps,), from a shape's signed distance (m) at every sample, shape
+        (m,); 0 for a contact whose link the shape reaches, and for one with no samples."""
+        depth = (np.asarray(signed_distance, dtype=float) - self.radius) / self.std
+        r = np.full(self.n_sweeps, np.inf)
+        np.minimum.at(r, self.sweep, depth)
+        return np.where(np.isfinite(r), np.maximum(r, 0.0), 0.0)
+
+    def within(self, signed_distance: FloatArray, distance: float) -> FreeSpace:
+        """All the samples: the one nearest a shape decides, however far it is."""
+        return self
+
+
+def onset_turn(antenna: Antenna, x_c: float) -> float:
+    """How far before the contact's onset (rad) a sweep's free part ends, for a contact at
+    ``x_c`` (m; the link's length when not finite): :data:`ONSET_FACTOR` times
+    :data:`ONSET_FRACTION` tau_th x / (3 E I), E I from the antenna's (calibrated) frequency
+    model."""
+    link = antenna.link
+    x = x_c if math.isfinite(x_c) and 0.0 < x_c <= link.length else link.length
+    rigidity = 1.0 / link.bending_compliance
+    static = antenna.observer.contact_threshold * x / (3.0 * rigidity)
+    return ONSET_FACTOR * ONSET_FRACTION * static
+
+
+def contact_onset(detection: ContactDetection) -> float:
+    """The contact's onset (s): the last sample at or before t_c where the detector's filtered
+    residual was at most :data:`ONSET_FRACTION` of its threshold (the recording's first sample
+    when it never was); NaN when no contact was detected."""
+    if detection.index is None:
+        return math.nan
+    level = detection.filtered_residual_norm[: detection.index + 1]
+    quiet = np.nonzero(level <= ONSET_FRACTION * detection.threshold)[0]
+    return float(detection.t[quiet[-1] if quiet.size else 0])
+
+
+def free_before(theta: ArrayLike, t: ArrayLike, onset: float, turn: float) -> FloatArray:
+    """The angles (rad, shape (k, 2)) of a recording's head while its link was free: those
+    before the contact's ``onset`` (s) at least ``turn`` (rad) from the angles there; none
+    when the onset is not known (NaN: no contact detected, module docstring)."""
+    angles = np.asarray(theta, dtype=float).reshape(-1, 2)
+    times = np.asarray(t, dtype=float).reshape(-1)
+    if not math.isfinite(onset):
+        return angles[:0]
+    at_onset = int(np.clip(np.searchsorted(times, onset), 0, len(angles) - 1))
+    before = angles[: at_onset + 1]
+    far = np.linalg.norm(before - angles[at_onset], axis=1) >= turn
+    last = np.nonzero(far)[0]
+    return before[: last[-1] + 1] if last.size else before[:0]
+
+
+#: One stretch of a sweep: the base pose its angles are in and the head's angles (rad, shape
+#: (k, 2)) while the link was free (or, for :class:`Touches`, when it touched).
+Piece = tuple[BasePose, ArrayLike]
+
+
+def recording_links(
+    recording: Recording, antenna: Antenna, x_c: float = math.nan
+) -> tuple[Piece, Piece | None]:
+    """What a recording says of its link: the free part of its sweep (:func:`free_before` the
+    onset of its detected contact, by the :func:`onset_turn` of a contact at ``x_c``, m), and
+    the link at that onset (None without a detected contact), both in its ``base_pose``.
+
+    Raises
+    ------
+    FieldError
+        One line naming the recording when its base pose is malformed.
+    """
+    pose = base_pose_from_metadata(recording.metadata, recording.source)
+    onset = contact_onset(detect_contact(recording, antenna))
+    free = free_before(recording.theta, recording.t, onset, onset_turn(antenna, x_c))
+    if not math.isfinite(onset):
+        return (pose, free), None
+    at = int(np.clip(np.searchsorted(recording.t, onset), 0, len(recording.t) - 1))
+    return (pose, free), (pose, recording.theta[at : at + 1])
+
+
+def free_space(
+    sweeps: Sequence[Sequence[Piece]],
+    antenna: Antenna,
+    uncertainty: PointUncertainty | None = None,
+) -> FreeSpace:
+    """The links of ``sweeps`` (each one or more :data:`Piece`), sampled every
+    :data:`FREE_STEP` along the link and between angles (module docstring)."""
+    return FreeSpace(*_sampled(sweeps, antenna, uncertainty))
+
+
+def touches(
+    contacts: Sequence[Sequence[Piece]],
+    antenna: Antenna,
+    uncertainty: PointUncertainty | None = None,
+) -> Touches:
+    """The links at the onsets of ``contacts`` (each one or more :data:`Piece`, usually one
+    angle), sampled as :func:`free_space` samples them."""
+    return Touches(*_sampled(contacts, antenna, uncertainty))
+
+
+def _sampled(
+    sweeps: Sequence[Sequence[Piece]], antenna: Antenna, uncertainty: PointUncertainty | None
+) -> tuple[FloatArray, FloatArray, NDArray[np.int64], int, float]:
+    uncertainty = uncertainty if uncertainty is not None else PointUncertainty()
+    link = antenna.link
+    x = np.linspace(0.0, link.length, max(2, math.ceil(link.length / FREE_STEP) + 1))[1:]
+    unit_sag = STANDARD_GRAVITY * np.asarray(link.unit_sag(x), dtype=float)
+    rho = uncertainty.deflection_relative_std
+    samples, std, index = [], [], []
+    for j, pieces in enumerate(sweeps):
+        for pose, theta in pieces:
+            angles = np.asarray(theta, dtype=float).reshape(-1, 2)
+            angles = _resampled(angles, FREE_STEP / link.length)
+            if not len(angles):
+                continue
+            x_m = np.array([motor_axes(a)[0] for a in angles])  # X^m per angle, shape (k, 3)
+            # the sag along A, the part of -Z^a across the link: g u(x) (-Z^a - (-Z^a . X^m) X^m)
+            across = -np.eye(3)[2][None, :] + x_m[:, 2:3] * x_m
+            along = x[None, :, None] * x_m[:, None, :]
+            local = along + unit_sag[None, :, None] * across[:, None, :]
+            sag = unit_sag[None, :] * np.linalg.norm(across, axis=1)[:, None]
+            sigma = np.hypot(x[None, :] * FREE_POINTING, rho * sag)
+            samples.append(pose.point_to_world(local.reshape(-1, 3)))
+            std.append(sigma.reshape(-1))
+            index.append(np.full(sigma.size, j))
+    if not samples:
+        return np.zeros((0, 3)), np.zeros(0), np.zeros(0, np.int64), len(sweeps), link.radius
+    return (
+        np.concatenate(samples),
+        np.concatenate(std),
+        np.concatenate(index).astype(np.int64),
+        len(sweeps),
+        link.radius,
+    )
+
+
+def _resampled(angles: FloatArray, step: float) -> FloatArray:
+    """The head's path through ``angles`` (rad, shape (k, 2)) every ``step`` (rad) of turn,
+    its ends kept: a recording's 1 kHz samples are far denser than the link needs."""
+    if len(angles) < 2:
+        return angles
+    turn = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(angles, axis=0), axis=1))])
+    if turn[-1] <= step:
+        return angles[[0, -1]]
+    at = np.linspace(0.0, turn[-1], math.ceil(turn[-1] / step) + 1)
+    return np.column_stack([np.interp(at, turn, angles[:, i]) for i in range(2)])

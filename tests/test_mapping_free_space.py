@@ -1,0 +1,181 @@
+"""Swept links: where the links swept untouched and where they touched, and what recognition
+makes of it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensing_antenna import paper_antenna
+from sensing_antenna.antenna import STANDARD_GRAVITY
+from sensing_antenna.mapping import (
+    BasePose,
+    FreeSpace,
+    Touches,
+    fit_primitive,
+    free_space,
+    recognise,
+)
+from sensing_antenna.mapping.free_space import FREE_STEP, free_before, onset_turn, recording_links
+from sensing_antenna.simulator import Scenario, simulate
+
+#: Noise of the synthetic points (m, isotropic 1 sigma).
+NOISE = 0.001
+
+
+def test_a_level_link_lies_along_x_sagged_by_its_weight() -> None:
+    # the handbook cantilever under its own weight: tip deflection rho g l^4 / (8 E I)
+    antenna = paper_antenna()
+    link = antenna.link
+    space = free_space([[(BasePose.identity(), np.zeros((1, 2)))]], antenna)
+    tip = space.samples[np.argmax(space.samples[:, 0])]
+    sag = link.linear_density * STANDARD_GRAVITY * link.length**4 / (8 * link.flexural_rigidity)
+    assert tip == pytest.approx([link.length, 0.0, -sag], rel=1e-9, abs=1e-12)
+    assert space.radius == link.radius
+
+
+def test_a_link_held_upright_does_not_sag() -> None:
+    antenna = paper_antenna()
+    space = free_space([[(BasePose.identity(), np.array([[0.0, math.pi / 2]]))]], antenna)
+    assert np.abs(space.samples[:, :2]).max() < 1e-12
+    assert space.samples[:, 2].max() == pytest.approx(antenna.link.length, rel=1e-12)
+
+
+def test_the_base_pose_places_the_link_in_the_world() -> None:
+    antenna = paper_antenna()
+    pose = BasePose(np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]), [1.0, 2.0, 3.0])
+    local = free_space([[(BasePose.identity(), np.zeros((1, 2)))]], antenna).samples
+    world = free_space([[(pose, np.zeros((1, 2)))]], antenna).samples
+    assert world == pytest.approx(local @ pose.rotation.T + pose.position, abs=1e-12)
+
+
+def test_a_sweep_is_sampled_between_its_angles() -> None:
+    # two angles 0.1 rad apart: the link's positions in between are free too
+    antenna = paper_antenna()
+    space = free_space([[(BasePose.identity(), np.array([[0.0, 0.0], [0.1, 0.0]]))]], antenna)
+    tips = space.samples[np.isclose(np.linalg.norm(space.samples[:, :2], axis=1), 0.98, atol=1e-3)]
+    azimuths = np.arctan2(tips[:, 1], tips[:, 0])
+    assert azimuths.min() == pytest.approx(0.0, abs=1e-9)
+    assert azimuths.max() == pytest.approx(0.1, abs=1e-9)
+    assert np.diff(np.sort(azimuths)).max() * antenna.link.length <= FREE_STEP + 1e-12
+
+
+def test_the_free_part_ends_the_onset_turn_before_the_onset() -> None:
+    t = np.arange(0.0, 2.0, 0.001)
+    theta = np.column_stack([0.3 * t, np.zeros_like(t)])
+    free = free_before(theta, t, 1.5, 0.06)
+    # the last sample at least 0.06 rad before 0.45 rad (samples 0.3 mrad apart)
+    assert 0.39 - 0.0003 - 1e-12 <= free[-1, 0] <= 0.39 + 1e-12
+    assert free[0, 0] == 0.0
+    # no detected contact: a light contact may have bent the link anywhere
+    assert len(free_before(theta, t, math.nan, 0.06)) == 0
+
+
+def test_the_onset_turn_is_a_quarter_of_the_static_turn_to_the_threshold() -> None:
+    # a contact at x turns the head by tau x / (3 E I) before its torque reaches tau; the
+    # onset is at a twentieth of tau, and the free part ends five times that turn before it
+    antenna = paper_antenna()
+    link = antenna.link
+    static = antenna.observer.contact_threshold * 0.5 / (3 * link.flexural_rigidity)
+    assert onset_turn(antenna, 0.5) == pytest.approx(0.25 * static, rel=1e-9)
+    # unknown x_c: the tip, the most compliant
+    assert onset_turn(antenna, math.nan) == pytest.approx(0.25 * static / 0.5 * link.length)
+
+
+@pytest.mark.parametrize(("case", "x_c"), [("azimuthal", 0.3), ("vertical", 0.9)])
+def test_a_simulated_sweep_is_free_until_before_its_contact(case: str, x_c: float) -> None:
+    # the simulator's own contact instant, which the recording's angles do not show: the free
+    # part ends before it, and the link taken as touching is at or past it
+    antenna = paper_antenna()
+    recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=4, duration=2.0))
+    true_contact = float(recording.metadata["true_t_contact"])
+    (_, free), touch = recording_links(recording, antenna, x_c)
+    assert touch is not None
+    n_free = len(np.asarray(free))
+    assert n_free > 0
+    assert recording.t[n_free - 1] < true_contact
+    touching = np.nonzero(np.all(recording.theta == np.asarray(touch[1])[0], axis=1))[0]
+    assert recording.t[touching[-1]] >= true_contact
+
+
+def test_a_free_line_through_a_sphere_costs_its_depth_over_its_sigma() -> None:
+    radius, link_radius, sigma = 0.05, 0.001, 0.002
+    centre = np.array([0.6, 0.0, 0.0])
+    offset = 0.04  # the line passes 1 cm inside the sphere
+    line = np.column_stack([np.full(201, 0.6), np.linspace(-0.1, 0.1, 201), np.full(201, offset)])
+    beside = line + np.array([0.0, 0.0, 0.02])  # 1 cm outside
+    space = FreeSpace(
+        np.vstack([line, beside]),
+        np.full(402, sigma),
+        np.repeat([0, 1], 201),
+        2,
+        link_radius,
+    )
+    got = space.residuals(np.linalg.norm(space.samples - centre, axis=1) - radius)
+    assert got[0] == pytest.approx((offset - radius - link_radius) / sigma, rel=1e-9)
+    assert got[1] == 0.0
+    # the same lines as links that touched: the one inside reaches the sphere, the one 1 cm
+    # beside it misses it by that much
+    touched = Touches(space.samples, space.std, space.sweep, 2, link_radius)
+    got = touched.residuals(np.linalg.norm(space.samples - centre, axis=1) - radius)
+    assert got[0] == 0.0
+    assert got[1] == pytest.approx((offset + 0.02 - radius - link_radius) / sigma, rel=1e-9)
+
+
+def _patch(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """12 points on a 3 cm patch of a 50 cm sphere around its top (0, 0, 0.6)."""
+    radius, n = 0.5, 12
+    polar = np.arccos(1 - rng.uniform(0, 1, n) * (1 - math.cos(0.03 / radius)))
+    azimuth = rng.uniform(0, 2 * math.pi, n)
+    unit = np.stack(
+        [np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)], axis=1
+    )
+    points = np.array([0.0, 0.0, -radius + 0.6]) + radius * unit
+    points += rng.normal(0.0, NOISE, points.shape)
+    return points, np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+
+
+def test_links_that_swept_past_a_patch_rule_out_the_plane_through_it() -> None:
+    # The points alone leave a plane and a sphere undecided (the patch bulges as much as the
+    # noise). Four links swept past the patch's edges untouched, 6 cm from its top and 2.5 mm
+    # below its tangent plane, where the sphere has curved away by 3.6 mm: they cut the plane.
+    rng = np.random.default_rng(11)
+    points, covariances = _patch(rng)
+    along = np.linspace(-0.04, 0.04, 81)
+    sweeps = []
+    for angle in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi):
+        out = np.array([math.cos(angle), math.sin(angle), 0.0])
+        side = np.array([-math.sin(angle), math.cos(angle), 0.0])
+        sweeps.append(0.06 * out + along[:, None] * side + [0.0, 0.0, 0.6 - 0.0025])
+    samples = np.vstack(sweeps)
+    space = FreeSpace(samples, np.full(len(samples), 0.0005), np.repeat(range(4), 81), 4, 0.0005)
+    up = np.array([0.0, 0.0, 1.0])  # the antenna is above the patch
+    alone = recognise(points, covariances, outward=up, rng=np.random.default_rng(0))
+    assert alone.undecided and set(alone.candidates) == {"plane", "sphere"}
+    result = recognise(points, covariances, outward=up, rng=np.random.default_rng(0), swept=[space])
+    fits = {f.name: f for f in result.fits}
+    # the plane gives way between the points and the links, and pays for both
+    assert fits["plane"].swept_chi2 > result.threshold
+    assert fits["sphere"].swept_chi2 < 1.0
+    assert fits["sphere"].score < fits["plane"].score - result.threshold
+
+
+def test_free_space_the_true_shape_stays_out_of_costs_its_fit_nothing() -> None:
+    # a sphere's points and links that passed 2 mm outside it: the fit stays where it was
+    rng = np.random.default_rng(5)
+    centre, radius = np.array([0.6, 0.1, 0.0]), 0.05
+    unit = rng.normal(size=(30, 3))
+    unit /= np.linalg.norm(unit, axis=1)[:, None]
+    points = centre + radius * unit + rng.normal(0.0, NOISE, (30, 3))
+    covariances = np.tile(np.eye(3) * NOISE**2, (30, 1, 1))
+    ring = np.linspace(0, 2 * math.pi, 400)
+    passing = centre + (radius + 0.003) * np.column_stack(
+        [np.cos(ring), np.sin(ring), np.zeros_like(ring)]
+    )
+    space = FreeSpace(passing, np.full(400, 0.002), np.zeros(400, int), 1, 0.001)
+    plain = fit_primitive("sphere", points, covariances)
+    with_free = fit_primitive("sphere", points, covariances, swept=[space])
+    assert with_free.swept_chi2 < 0.1
+    assert with_free.sizes["radius"] == pytest.approx(plain.sizes["radius"], abs=2e-4)
