@@ -10,7 +10,7 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from sensing_antenna.mapping import UNDECIDED, fit_mesh, fit_primitive, recognise
+from sensing_antenna.mapping import UNDECIDED, FreeSpace, fit_mesh, fit_primitive, recognise
 from sensing_antenna.mapping.recognition import LINE_STRETCH, LinkLines, shape_gap
 
 #: Noise of the synthetic points (m, isotropic 1 sigma): about the points' sigma across the link.
@@ -109,11 +109,9 @@ def test_two_wrong_points_do_not_decide_the_class(name: str) -> None:
     assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, result.best.sizes
 
 
-def test_a_few_points_on_a_patch_of_a_large_sphere_abstain_between_plane_and_sphere() -> None:
-    # a 3 cm patch of a 50 cm sphere bulges a / 2R = 0.9 mm at its centre, as much as the noise
-    rng = np.random.default_rng(11)
-    radius = 0.5
-    n = 12
+def _sphere_patch(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """12 points with noise on a 3 cm patch of a 50 cm sphere around its top (0, 0, 0.6)."""
+    radius, n = 0.5, 12
     polar = np.arccos(1 - rng.uniform(0, 1, n) * (1 - math.cos(0.03 / radius)))
     azimuth = rng.uniform(0, 2 * math.pi, n)
     unit = np.stack(
@@ -121,11 +119,40 @@ def test_a_few_points_on_a_patch_of_a_large_sphere_abstain_between_plane_and_sph
     )
     points = np.array([0.0, 0.0, -radius + 0.6]) + radius * unit
     points += rng.normal(0.0, NOISE, points.shape)
-    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+    return points, np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+
+
+def test_a_few_points_on_a_patch_of_a_large_sphere_abstain_between_plane_and_sphere() -> None:
+    # a 3 cm patch of a 50 cm sphere bulges a / 2R = 0.9 mm at its centre, as much as the noise
+    points, covariances = _sphere_patch(np.random.default_rng(11))
     result = recognise(points, covariances, rng=np.random.default_rng(0))
     assert result.decision == UNDECIDED
     assert set(result.candidates) == {"plane", "sphere"}
     assert result.delta_score < result.threshold
+
+
+def test_links_that_swept_past_a_patch_rule_out_the_plane_through_it() -> None:
+    # The points alone leave a plane and a sphere undecided. Four links swept past the patch's
+    # edges untouched, 6 cm from its top and 2.5 mm below its tangent plane, where the sphere
+    # has curved away by 3.6 mm: they cut the plane.
+    points, covariances = _sphere_patch(np.random.default_rng(11))
+    along = np.linspace(-0.04, 0.04, 81)
+    sweeps = []
+    for angle in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi):
+        out = np.array([math.cos(angle), math.sin(angle), 0.0])
+        side = np.array([-math.sin(angle), math.cos(angle), 0.0])
+        sweeps.append(0.06 * out + along[:, None] * side + [0.0, 0.0, 0.6 - 0.0025])
+    samples = np.vstack(sweeps)
+    space = FreeSpace(samples, np.full(len(samples), 0.0005), np.repeat(range(4), 81), 4, 0.0005)
+    up = np.array([0.0, 0.0, 1.0])  # the antenna is above the patch
+    alone = recognise(points, covariances, outward=up, rng=np.random.default_rng(0))
+    assert alone.undecided and set(alone.candidates) == {"plane", "sphere"}
+    result = recognise(points, covariances, outward=up, rng=np.random.default_rng(0), swept=[space])
+    fits = {f.name: f for f in result.fits}
+    # the plane gives way between the points and the links, and pays for both
+    assert fits["plane"].swept_chi2 > result.threshold
+    assert fits["sphere"].swept_chi2 < 1.0
+    assert fits["sphere"].score < fits["plane"].score - result.threshold
 
 
 def test_a_user_mesh_is_registered_at_its_pose() -> None:
