@@ -39,6 +39,9 @@ _ANTENNA = (
 #: and writes nothing before it is done.
 _LONG_COMMAND = ["simulate", "--case", "azimuthal", "--xc", "0.5", "--duration", "120"]
 
+#: A command that is done in about a second.
+_SHORT_COMMAND = ["simulate", "--case", "azimuthal", "--xc", "0.5", "--duration", "2.5"]
+
 #: Time given to the process to start and enter the command (s): parsing takes 50 ms on an idle
 #: machine, over a second on a loaded one (the suite beside other jobs on two cores); the 120 s
 #: simulation runs for several seconds more.
@@ -142,6 +145,46 @@ def test_sigterm_inside_a_finalizer_still_stops_the_command(tmp_path: Path) -> N
     assert done.returncode == 143, done.stderr
     assert done.stderr.strip() == "antenna simulate: stopped by SIGTERM"
     assert not out.exists()
+
+
+#: ``antenna`` whose simulator swallows a SIGTERM it receives (a library catching everything).
+_ANTENNA_SWALLOWING = (
+    "import os, signal, sys, time\n"
+    "import sensing_antenna.simulator as simulator\n"
+    "original = simulator.simulate\n"
+    "def swallowing(*args, **kwargs):\n"
+    "    try:\n"
+    "        os.kill(os.getpid(), signal.SIGTERM)\n"
+    "        time.sleep(2.0)\n"
+    "    except BaseException:\n"
+    "        pass\n"
+    "    return original(*args, **kwargs)\n"
+    "simulator.simulate = swallowing\n"
+    "from sensing_antenna.cli import main\n"
+    "sys.exit(main())\n"
+)
+
+
+def test_a_stop_the_command_swallowed_still_stops_it_when_it_returns(tmp_path: Path) -> None:
+    # the command's own code caught the SIGTERM and went on to finish; the command line still
+    # reports the stop and ends by it when the command returns
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            _ANTENNA_SWALLOWING,
+            *_SHORT_COMMAND,
+            "--out",
+            str(tmp_path / "r.csv"),
+        ],
+        capture_output=True,
+        text=True,
+        env=_environment(),
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 143, done.stderr
+    assert done.stderr.strip() == "antenna simulate: stopped by SIGTERM"
 
 
 def test_an_interrupted_campaign_says_what_it_keeps(tmp_path: Path) -> None:
