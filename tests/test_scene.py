@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -78,6 +79,13 @@ def test_builtin_post_scene_is_the_same_post() -> None:
     outcome = simulate_sweep(DEVICE, load_scene("post"), Sweep(0, "azimuthal", 0.0, -0.3, 0.3))
     assert outcome.scenario is not None
     assert outcome.scenario.contact_point == pytest.approx(0.55, abs=1e-5)
+
+
+def test_a_sweep_with_another_links_shape_is_refused() -> None:
+    thicker = LinkShape(dataclasses.replace(DEVICE.link, radius=2 * DEVICE.link.radius))
+    sweep = Sweep(0, "azimuthal", 0.0, -0.3, 0.3)
+    with pytest.raises(ValueError, match="radius"):
+        simulate_sweep(DEVICE, load_scene("post"), sweep, shape=thicker)
 
 
 def test_sphere_touch_matches_the_tangent_line() -> None:

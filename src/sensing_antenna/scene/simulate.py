@@ -231,8 +231,20 @@ def simulate_sweep(
         The link's sagged shape (built from ``device`` when None; pass one to reuse it).
     **scenario_fields
         Further :class:`~sensing_antenna.simulator.Scenario` fields (noise_scale, ...).
+
+    Raises
+    ------
+    ValueError
+        ``shape`` is another link's (its radius or length not the device's): the geometric
+        touch and the simulated one would not meet.
     """
     shape = shape if shape is not None else LinkShape(device.link)
+    for name in ("radius", "length"):
+        if getattr(shape.link, name) != getattr(device.link, name):
+            raise ValueError(
+                f"simulate_sweep: the shape's link {name} {getattr(shape.link, name)} m is not"
+                f" the device's {getattr(device.link, name)} m"
+            )
     speed = float(scenario_fields.get("sweep_speed", _DEFAULT_SPEED))
     geometry: SweepGeometry = first_touch(scene, sweep, shape)
     if geometry.inside_at_start:
