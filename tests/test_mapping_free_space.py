@@ -72,6 +72,15 @@ def test_the_free_part_ends_the_onset_turn_before_the_onset() -> None:
     assert len(free_before(theta, t, math.nan, 0.06)) == 0
 
 
+def test_the_turn_is_the_links_not_the_motor_angles() -> None:
+    # an azimuth step at the elevation theta2 turns the link by cos(theta2) of it
+    t = np.arange(0.0, 2.0, 0.001)
+    theta = np.column_stack([0.3 * t, np.full_like(t, 1.0)])
+    free = free_before(theta, t, 1.5, 0.06)
+    chord = 2 * math.asin(math.sin(0.03) / math.cos(1.0))  # the azimuth step turning it 0.06
+    assert 0.45 - chord - 0.0003 - 1e-12 <= free[-1, 0] <= 0.45 - chord + 1e-12
+
+
 def test_the_onset_turn_is_a_quarter_of_the_static_turn_to_the_threshold() -> None:
     # a contact at x turns the head by tau x / (3 E I) before its torque reaches tau; the
     # onset is at a twentieth of tau, and the free part ends five times that turn before it
@@ -140,3 +149,31 @@ def test_free_space_the_true_shape_stays_out_of_costs_its_fit_nothing() -> None:
     with_free = fit_primitive("sphere", points, covariances, swept=[space])
     assert with_free.swept_chi2 < 0.1
     assert with_free.sizes["radius"] == pytest.approx(plain.sizes["radius"], abs=2e-4)
+    # the same ring 3 mm inside the sphere: the points hold the fit, which pays for the ring
+    inside = FreeSpace(
+        passing - 0.006 * (passing - centre) / (radius + 0.003), space.std, space.sweep, 1, 0.001
+    )
+    cut = fit_primitive("sphere", points, covariances, swept=[inside])
+    assert cut.swept_chi2 > 1.0
+
+
+def test_a_link_that_touched_beyond_the_points_costs_the_true_shape_nothing() -> None:
+    # points on a cap of the sphere facing the base; a link touched it 150 degrees round,
+    # tangent there, its stretch near the touch well beyond the points' box: the sphere through
+    # the points reaches it (within the fit's own millimetre)
+    rng = np.random.default_rng(6)
+    centre, radius, link_radius = np.array([0.6, 0.0, 0.0]), 0.05, 0.001
+    unit = rng.normal(size=(30, 3))
+    unit[:, 0] = -np.abs(unit[:, 0]) - 3.0
+    unit /= np.linalg.norm(unit, axis=1)[:, None]
+    points = centre + radius * unit + rng.normal(0.0, NOISE, (30, 3))
+    covariances = np.tile(np.eye(3) * NOISE**2, (30, 1, 1))
+    normal = np.array([math.cos(math.pi / 6), math.sin(math.pi / 6), 0.0])
+    direction = np.array([-normal[1], normal[0], 0.0])
+    along = np.linspace(-0.2, 0.2, 401)
+    link = centre + (radius + link_radius) * normal + along[:, None] * direction
+    assert link[200, 0] > points[:, 0].max() + 0.5 * np.ptp(points, axis=0).max() + 0.04
+    touched = Touches(link, np.full(401, 0.002), np.zeros(401, int), 1, link_radius)
+    fit = fit_primitive("sphere", points, covariances, swept=[touched])
+    assert fit.swept_chi2 < 1.0
+    assert fit.sizes["radius"] == pytest.approx(radius, abs=2e-3)

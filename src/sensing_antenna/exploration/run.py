@@ -403,13 +403,17 @@ def swept_links(
             continue
         elif m.recording is not None and (out / m.recording).exists():
             recording = read_recording(out / m.recording)
-            x_c = m.point.x_c if m.point is not None else math.nan
-            recorded, onset = recording_links(recording, antenna, x_c)
-            pieces.append(recorded)
-            if onset is not None and (m.point is None or m.point.status is not Status.OK):
+            ok = m.point is not None and m.point.status is Status.OK
+            x_c = m.point.x_c if m.point is not None and ok else math.nan
+            (pose, recorded), onset = recording_links(recording, antenna, x_c)
+            if onset is not None and not ok:
                 touched.append([onset])
-            # the recording's frame is turned to the touch's angles, where it starts at theta_0
+            # the recording's frame is turned to the touch's angles: its swept angle plus the
+            # touch's is the sweep's, and the simulated approach may begin before the sweep did
             swept = 0 if sweep.case == "azimuthal" else 1
+            angle = float(m.touch["angle"]) + np.asarray(recorded)[:, swept]
+            inside = (angle >= sweep.start) & (angle <= sweep.end)
+            pieces.append((pose, np.asarray(recorded)[inside]))
             end = float(m.touch["angle"]) + float(recording.theta[0, swept])
         else:
             touch = float(m.touch["angle"])

@@ -157,7 +157,7 @@ def swept_from_recordings(
     """Where the recordings' links swept untouched, and where they touched when their points
     (``points``, in the same order) are not ``ok`` (``mapping.free_space.recording_links``:
     the angles before the onset of the detected contact, short of it by the onset turn of a
-    contact at the point's x_c, and the link at that onset).
+    contact at an ``ok`` point's x_c, and the link at that onset).
 
     Raises
     ------
@@ -170,11 +170,11 @@ def swept_from_recordings(
     touched: list[list[Piece]] = []
     for k, path in enumerate(paths):
         point = points[k] if points is not None and k < len(points) else None
-        recorded, onset = recording_links(
-            read_recording(path), antenna, point.x_c if point is not None else math.nan
-        )
+        ok = point is not None and point.status is Status.OK
+        x_c = point.x_c if point is not None and ok else math.nan
+        recorded, onset = recording_links(read_recording(path), antenna, x_c)
         free.append([recorded])
-        if onset is not None and (point is None or point.status is not Status.OK):
+        if onset is not None and not ok:
             touched.append([onset])
     return free_space(free, antenna), touches(touched, antenna)
 

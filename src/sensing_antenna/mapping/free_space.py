@@ -12,11 +12,10 @@ base pose. Each sample of the link is known to within its standard deviation acr
 sigma(x)^2 = (x tau)^2 + (rho s(x))^2: tau = :data:`FREE_POINTING`, rho the deflection model's
 relative uncertainty (``PointUncertainty``) and s(x) the sag. The head's zero offset, part of
 the points' pointing (``points.TANGENT_FLOOR``), moves a base's points and its free space alike
-and does not separate them; what does is the link's swing while it sweeps: the head's angular
-acceleration alpha loads it with rho_l alpha x per length, a tip deflection of
-11 rho_l alpha l^5 / (120 E I) while it lasts (2.2 mm for the paper's link at 0.5 rad/s^2, a
-sweep reaching 0.3 rad/s in 0.6 s), which its first mode, barely damped, keeps ringing at up to
-twice that once the acceleration stops.
+and does not separate them; what does is the link's swing while the head speeds up: its angular
+acceleration alpha loads the link with rho_l alpha x per length, a quasi-static tip deflection
+of 11 rho_l alpha l^5 / (120 E I), 3.5 mm for the paper's link at 0.8 rad/s^2 (the peak of a
+smooth ramp to 0.3 rad/s in 0.6 s), which the first mode overshoots by about half.
 
 When a contact is detected at t_c the link has been pressing the object for a while: the
 contact detector (``detection.contact``, Section 4.2 of the paper) waits for the external
@@ -26,9 +25,11 @@ deflection delta = x dtheta), some centimetres of link. The contact's onset is f
 back from t_c: the last sample where the detector's filtered residual was at most
 :data:`ONSET_FRACTION` of the threshold, a level a contact reaches after a twentieth of that
 turn plus the residual filter's lag (:func:`contact_onset`). The free part of a sweep ends
-:data:`ONSET_FACTOR` times that twentieth before the onset (:func:`onset_turn`; x the
-estimate's abscissa, or the link's length when the estimate has none: the most compliant
-contact turns the head furthest). A recording without a detected contact adds no free space: a
+before the onset by :data:`ONSET_FACTOR` times that twentieth (:func:`onset_turn`; x an ``ok``
+estimate's abscissa, else the link's length: the most compliant contact turns the head
+furthest) and by the filter's lag at the head's speed there. Turns are the angle the link's
+direction X^m turns through, not a difference of motor angles (an azimuth step turns the link by
+cos(theta2) of it). A recording without a detected contact adds no free space: a
 contact too light to detect, sliding over an edge, bends the link as far as one just below the
 threshold, so its angles do not say where the link was.
 
@@ -44,7 +45,7 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -74,37 +75,41 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
+#: A :class:`FreeSpace` or a subclass (:class:`Touches`), for methods that keep the kind.
+_Space = TypeVar("_Space", bound="FreeSpace")
+
 #: A contact's onset is the last sample before t_c where the detector's filtered residual was
 #: at most this fraction of its threshold: twenty times the free motion's residual at the
 #: paper's threshold, so that noise does not end the look back early.
 ONSET_FRACTION = 0.05
 
 #: How many times the static turn to the onset level (module docstring) a sweep's free part
-#: ends before the onset: the residual filter's lag (10 ms, 3 mrad at 0.3 rad/s) and the
-#: contact's build-up add to the static turn.
+#: ends before the onset, beside the residual filter's lag: the contact's build-up (its impact,
+#: the link's own response) adds to the static turn.
 ONSET_FACTOR = 5.0
 
 #: Standard deviation (rad) of the free link's direction, from the base, beside the sag model:
-#: its swing while sweeping, twice the quasi-static tip deflection of the module docstring
-#: over the paper link's length (4.4 mm at 0.98 m), and the encoders' counts.
-FREE_POINTING = 0.0045
+#: its swing while the head speeds up, one and a half times the quasi-static tip deflection of
+#: the module docstring over the paper link's length (5.2 mm at 0.98 m), and the encoders'
+#: counts.
+FREE_POINTING = 0.0053
 
 #: Largest distance (m) between neighbouring samples of the swept link, along it and from one
 #: angle to the next: about the standard deviation of the samples 0.5 m out.
 FREE_STEP = 0.005
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FreeSpace:
     """Samples of links that swept through free space, grouped by sweep.
 
     Attributes
     ----------
-    samples : array, shape (m, 3)
+    samples : array, shape (k, 3)
         Points of the links' axes (m, world).
-    std : array, shape (m,)
-        Their standard deviations across the link (m).
-    sweep : array of int, shape (m,)
+    std : array, shape (k,)
+        Their standard deviations across the link (m, > 0).
+    sweep : array of int, shape (k,)
         Which sweep each sample belongs to (0 .. n_sweeps - 1).
     n_sweeps : int
         Sweeps, including any whose samples were all left out by :meth:`near`.
@@ -125,13 +130,18 @@ class FreeSpace:
         sweep = np.asarray(self.sweep, dtype=np.int64).reshape(-1)
         if len(std) != n or len(sweep) != n:
             raise ValueError(f"FreeSpace: {n} samples, {len(std)} std, {len(sweep)} sweep indices")
+        if not np.all(std > 0.0) or not np.all(np.isfinite(std)):
+            raise ValueError("FreeSpace.std: every standard deviation must be finite and > 0")
+        if self.n_sweeps < 0 or not self.radius >= 0.0:
+            raise ValueError("FreeSpace: n_sweeps and radius must be >= 0")
         if n and (sweep.min() < 0 or sweep.max() >= self.n_sweeps):
             raise ValueError(f"FreeSpace.sweep: indices outside 0 .. {self.n_sweeps - 1}")
-        object.__setattr__(self, "samples", samples)
-        object.__setattr__(self, "std", std)
-        object.__setattr__(self, "sweep", sweep)
+        for name, value in (("samples", samples), ("std", std), ("sweep", sweep)):
+            value = value.copy()
+            value.flags.writeable = False
+            object.__setattr__(self, name, value)
 
-    def near(self, points: ArrayLike, margin: float) -> FreeSpace:
+    def near(self: _Space, points: ArrayLike, margin: float) -> _Space:
         """The samples inside the points' bounding box grown by ``margin`` (m) each way: the
         part of free space a shape fitted to the points can reach."""
         p = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -140,27 +150,28 @@ class FreeSpace:
         keep = np.all((self.samples >= low) & (self.samples <= high), axis=1)
         return self._subset(keep)
 
-    def within(self, signed_distance: FloatArray, distance: float) -> FreeSpace:
-        """The samples whose signed distance to a shape (m, shape (m,)) is below ``distance``
+    def within(self: _Space, signed_distance: FloatArray, distance: float) -> _Space:
+        """The samples whose signed distance to a shape (m, shape (k,)) is below ``distance``
         (m) beyond the link's radius: those a shape moving a little may reach."""
         keep = np.asarray(signed_distance) - self.radius < distance
         return self._subset(keep)
 
-    def _subset(self, keep: NDArray[np.bool_]) -> Any:
+    def _subset(self: _Space, keep: NDArray[np.bool_]) -> _Space:
         return dataclasses.replace(
             self, samples=self.samples[keep], std=self.std[keep], sweep=self.sweep[keep]
         )
 
     def residuals(self, signed_distance: FloatArray) -> FloatArray:
         """r_j (module docstring), shape (n_sweeps,), from a shape's signed distance (m) at
-        every sample, shape (m,); 0 for a sweep no shape reaches."""
+        every sample, shape (k,); 0 for a sweep no shape reaches (a NaN distance is none)."""
         depth = (np.asarray(signed_distance, dtype=float) - self.radius) / self.std
+        depth = np.where(np.isnan(depth), np.inf, depth)
         r = np.zeros(self.n_sweeps)
         np.minimum.at(r, self.sweep, depth)
         return r
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Touches(FreeSpace):
     """The link at each contact's onset, where it touched the object somewhere along its length
     (the attributes of :class:`FreeSpace`, one group per contact): a shape that comes nowhere
@@ -168,13 +179,20 @@ class Touches(FreeSpace):
 
     def residuals(self, signed_distance: FloatArray) -> FloatArray:
         """r_j, shape (n_sweeps,), from a shape's signed distance (m) at every sample, shape
-        (m,); 0 for a contact whose link the shape reaches, and for one with no samples."""
+        (k,); 0 for a contact whose link the shape reaches, and for one with no samples (a NaN
+        distance is none)."""
         depth = (np.asarray(signed_distance, dtype=float) - self.radius) / self.std
+        depth = np.where(np.isnan(depth), np.inf, depth)
         r = np.full(self.n_sweeps, np.inf)
         np.minimum.at(r, self.sweep, depth)
         return np.where(np.isfinite(r), np.maximum(r, 0.0), 0.0)
 
-    def within(self, signed_distance: FloatArray, distance: float) -> FreeSpace:
+    def near(self: _Space, points: ArrayLike, margin: float) -> _Space:
+        """All the samples: a link that touched beyond the points still says the object
+        reaches it (a few hundred samples per contact)."""
+        return self
+
+    def within(self: _Space, signed_distance: FloatArray, distance: float) -> _Space:
         """All the samples: the one nearest a shape decides, however far it is."""
         return self
 
@@ -212,9 +230,24 @@ def free_before(theta: ArrayLike, t: ArrayLike, onset: float, turn: float) -> Fl
         return angles[:0]
     at_onset = int(np.clip(np.searchsorted(times, onset), 0, len(angles) - 1))
     before = angles[: at_onset + 1]
-    far = np.linalg.norm(before - angles[at_onset], axis=1) >= turn
+    far = _turn(before, angles[at_onset]) >= turn
     last = np.nonzero(far)[0]
     return before[: last[-1] + 1] if last.size else before[:0]
+
+
+def _direction(theta: FloatArray) -> FloatArray:
+    """X^m (unit) at motor angles ``theta`` (rad, shape (k, 2)), shape (k, 3)."""
+    c1, s1 = np.cos(theta[:, 0]), np.sin(theta[:, 0])
+    c2, s2 = np.cos(theta[:, 1]), np.sin(theta[:, 1])
+    return np.column_stack([c2 * c1, c2 * s1, s2])
+
+
+def _turn(theta: FloatArray, to: FloatArray) -> FloatArray:
+    """The angle (rad, shape (k,)) the link's direction turns through from each of ``theta``
+    (rad, shape (k, 2)) to ``to`` (rad, shape (2,))."""
+    a = _direction(theta)
+    b = _direction(np.asarray(to, dtype=float).reshape(1, 2))
+    return np.asarray(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), a @ b[0]))
 
 
 #: One stretch of a sweep: the base pose its angles are in and the head's angles (rad, shape
@@ -226,8 +259,10 @@ def recording_links(
     recording: Recording, antenna: Antenna, x_c: float = math.nan
 ) -> tuple[Piece, Piece | None]:
     """What a recording says of its link: the free part of its sweep (:func:`free_before` the
-    onset of its detected contact, by the :func:`onset_turn` of a contact at ``x_c``, m), and
-    the link at that onset (None without a detected contact), both in its ``base_pose``.
+    onset of its detected contact, by the :func:`onset_turn` of a contact at ``x_c`` (m; the
+    abscissa of an ``ok`` estimate, NaN otherwise) and the residual filter's lag at the head's
+    speed), and the link at that onset (None without a detected contact), both in its
+    ``base_pose``.
 
     Raises
     ------
@@ -235,11 +270,22 @@ def recording_links(
         One line naming the recording when its base pose is malformed.
     """
     pose = base_pose_from_metadata(recording.metadata, recording.source)
-    onset = contact_onset(detect_contact(recording, antenna))
-    free = free_before(recording.theta, recording.t, onset, onset_turn(antenna, x_c))
+    detection = detect_contact(recording, antenna)
+    onset = contact_onset(detection)
     if not math.isfinite(onset):
-        return (pose, free), None
-    at = int(np.clip(np.searchsorted(recording.t, onset), 0, len(recording.t) - 1))
+        return (pose, recording.theta[:0]), None
+    t = recording.t
+    at = int(np.clip(np.searchsorted(t, onset), 0, len(t) - 1))
+    # the head's turn rate over the filter's time constant before the onset
+    lag = 1.0 / detection.residual_cutoff
+    earlier = int(np.clip(np.searchsorted(t, onset - lag), 0, at))
+    span = float(t[at] - t[earlier])
+    rate = (
+        float(_turn(recording.theta[earlier : earlier + 1], recording.theta[at])[0]) / span
+        if span > 0
+        else 0.0
+    )
+    free = free_before(recording.theta, t, onset, onset_turn(antenna, x_c) + rate * lag)
     return (pose, free), (pose, recording.theta[at : at + 1])
 
 

@@ -21,12 +21,20 @@ surface tangent to the link and for an edge the link passes over, and a line cro
 of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through the points a
 sweeping line left on a box's edges is not tangent to the lines that touched them.
 
+The swept links (``mapping.free_space``): each sweep's link where it passed untouched, and the
+link of each contact with no ``ok`` point where it touched, add one residual per sweep or
+contact, r_j = min(0, min_k (d(q_k) - a) / sigma_k) over the free samples (a shape reaching
+into free space) and max(0, min_k (d(q_k) - a) / sigma_k) over a touching link's (a shape
+nowhere near it), a the link's radius.
+
 Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with chi^2 the sum over
 the points of -2 log-likelihood of their residuals z_i^2 = (d_i / sigma_i)^2 + r_i^2 up to a
-constant, k the class's independent parameters and c >= 1 the overdispersion (Burnham and
-Anderson, "Model Selection and Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of
-the best-fitting class when above 1, so that points farther from every class than their
-covariances say, an estimator's systematic error, weigh less); c = 1 is BIC. The lowest score wins.
+constant, and over the swept links of their r_j^2 in the same mixture (below), k the class's
+independent parameters, n the points, and c >= 1 the overdispersion (Burnham and Anderson,
+"Model Selection and Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of the
+best-fitting class, over n - k, when above 1, so that points farther from every class than their
+covariances say, an estimator's systematic error, weigh less); c = 1 is BIC. The lowest score
+wins.
 The residuals' distribution is a mixture: a point is right, Gaussian about the surface with its
 sigma_i, except with the chance :data:`OUTLIER_FRACTION` that an estimate reported ``ok`` is
 wrong and lies anywhere across the points' spread L. Relative to a point on the surface its
