@@ -3,6 +3,7 @@ makes of it."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -10,10 +11,13 @@ import pytest
 
 from sensing_antenna import paper_antenna
 from sensing_antenna.antenna import STANDARD_GRAVITY
+from sensing_antenna.estimation import estimate
+from sensing_antenna.estimation.result import Status
 from sensing_antenna.mapping import (
     BasePose,
     FreeSpace,
     Touches,
+    contact_point_from_estimate,
     fit_primitive,
     free_space,
 )
@@ -54,6 +58,7 @@ def test_a_sweep_is_sampled_between_its_angles() -> None:
     # two angles 0.1 rad apart: the link's positions in between are free too
     antenna = paper_antenna()
     space = free_space([[(BasePose.identity(), np.array([[0.0, 0.0], [0.1, 0.0]]))]], antenna)
+    # the tips: at l from the base in the horizontal plane (the sag is vertical), to a millimetre
     tips = space.samples[np.isclose(np.linalg.norm(space.samples[:, :2], axis=1), 0.98, atol=1e-3)]
     azimuths = np.arctan2(tips[:, 1], tips[:, 0])
     assert azimuths.min() == pytest.approx(0.0, abs=1e-9)
@@ -95,15 +100,24 @@ def test_the_onset_turn_is_a_quarter_of_the_static_turn_to_the_threshold() -> No
 @pytest.mark.parametrize(("case", "x_c"), [("azimuthal", 0.3), ("vertical", 0.9)])
 def test_a_simulated_sweep_is_free_until_before_its_contact(case: str, x_c: float) -> None:
     # the simulator's own contact instant, which the recording's angles do not show: the free
-    # part ends before it, and the link taken as touching is at or past it
+    # part ends before it, with the margin of an ok estimate's x_c (the tighter) and with the
+    # tip's when there is no estimate, and the link taken as touching is at or past it
     antenna = paper_antenna()
     recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=4, duration=2.0))
     true_contact = float(recording.metadata["true_t_contact"])
-    (_, free), touch = recording_links(recording, antenna, x_c)
-    assert touch is not None
+    # an ok estimate at the contact's x_c (the uncalibrated estimators say uncertain here)
+    result = estimate(recording.without_ground_truth(), antenna, method="fast")
+    point = dataclasses.replace(
+        contact_point_from_estimate(result, antenna), status=Status.OK, x_c=x_c
+    )
+    (_, free), touch = recording_links(recording, antenna, point)
+    assert touch is None  # an ok point says more
     n_free = len(np.asarray(free))
     assert n_free > 0
     assert recording.t[n_free - 1] < true_contact
+    (_, free_tip), touch = recording_links(recording, antenna)
+    assert 0 < len(np.asarray(free_tip)) < n_free
+    assert touch is not None
     touching = np.nonzero(np.all(recording.theta == np.asarray(touch[1])[0], axis=1))[0]
     assert recording.t[touching[-1]] >= true_contact
 
@@ -148,6 +162,7 @@ def test_free_space_the_true_shape_stays_out_of_costs_its_fit_nothing() -> None:
     plain = fit_primitive("sphere", points, covariances)
     with_free = fit_primitive("sphere", points, covariances, swept=[space])
     assert with_free.swept_chi2 < 0.1
+    # a fifth of the points' noise: the ring outside leaves the fit where the points put it
     assert with_free.sizes["radius"] == pytest.approx(plain.sizes["radius"], abs=2e-4)
     # the same ring 3 mm inside the sphere: the points hold the fit, which pays for the ring
     inside = FreeSpace(
@@ -176,4 +191,7 @@ def test_a_link_that_touched_beyond_the_points_costs_the_true_shape_nothing() ->
     touched = Touches(link, np.full(401, 0.002), np.zeros(401, int), 1, link_radius)
     fit = fit_primitive("sphere", points, covariances, swept=[touched])
     assert fit.swept_chi2 < 1.0
+    # within twice the points' noise, where the shallow cap alone leaves the radius further off
     assert fit.sizes["radius"] == pytest.approx(radius, abs=2e-3)
+    plain = fit_primitive("sphere", points, covariances)
+    assert abs(plain.sizes["radius"] - radius) > 2e-3

@@ -44,7 +44,6 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.campaign.store import atomic_write_text
 from sensing_antenna.errors import raise_if_signalled
-from sensing_antenna.estimation.result import Status
 from sensing_antenna.exploration.plan import (
     PREDICTION_STEP,
     STRATEGIES,
@@ -403,18 +402,16 @@ def swept_links(
             continue
         elif m.recording is not None and (out / m.recording).exists():
             recording = read_recording(out / m.recording)
-            ok = m.point is not None and m.point.status is Status.OK
-            x_c = m.point.x_c if m.point is not None and ok else math.nan
-            (pose, recorded), onset = recording_links(recording, antenna, x_c)
-            if onset is not None and not ok:
+            (pose, recorded), onset = recording_links(recording, antenna, m.point)
+            if onset is not None:
                 touched.append([onset])
             # the recording's frame is turned to the touch's angles: its swept angle plus the
             # touch's is the sweep's, and the simulated approach may begin before the sweep did
-            swept = 0 if sweep.case == "azimuthal" else 1
-            angle = float(m.touch["angle"]) + np.asarray(recorded)[:, swept]
+            joint = 0 if sweep.case == "azimuthal" else 1
+            angle = float(m.touch["angle"]) + np.asarray(recorded)[:, joint]
             inside = (angle >= sweep.start) & (angle <= sweep.end)
             pieces.append((pose, np.asarray(recorded)[inside]))
-            end = float(m.touch["angle"]) + float(recording.theta[0, swept])
+            end = float(m.touch["angle"]) + float(recording.theta[0, joint])
         else:
             touch = float(m.touch["angle"])
             touched.append([(base, np.array([sweep.angles(touch)]))])

@@ -22,7 +22,6 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.estimation.result import Status
 from sensing_antenna.mapping.free_space import (
     FreeSpace,
     Piece,
@@ -170,11 +169,9 @@ def swept_from_recordings(
     touched: list[list[Piece]] = []
     for k, path in enumerate(paths):
         point = points[k] if points is not None and k < len(points) else None
-        ok = point is not None and point.status is Status.OK
-        x_c = point.x_c if point is not None and ok else math.nan
-        recorded, onset = recording_links(read_recording(path), antenna, x_c)
+        recorded, onset = recording_links(read_recording(path), antenna, point)
         free.append([recorded])
-        if onset is not None and not ok:
+        if onset is not None:
             touched.append([onset])
     return free_space(free, antenna), touches(touched, antenna)
 

@@ -52,8 +52,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.detection.contact import ContactDetection, detect_contact
-from sensing_antenna.estimation.front.contact_frame import motor_axes
-from sensing_antenna.mapping.points import PointUncertainty
+from sensing_antenna.estimation.result import Status
+from sensing_antenna.mapping.points import ContactPoint, PointUncertainty
 from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
 from sensing_antenna.recording import Recording
 
@@ -90,8 +90,8 @@ ONSET_FACTOR = 5.0
 
 #: Standard deviation (rad) of the free link's direction, from the base, beside the sag model:
 #: its swing while the head speeds up, one and a half times the quasi-static tip deflection of
-#: the module docstring over the paper link's length (5.2 mm at 0.98 m), and the encoders'
-#: counts.
+#: the module docstring over the paper link's length (5.2 mm at 0.98 m); the encoders' counts
+#: (3e-5 rad at the joint) are negligible beside it.
 FREE_POINTING = 0.0053
 
 #: Largest distance (m) between neighbouring samples of the swept link, along it and from one
@@ -256,12 +256,13 @@ Piece = tuple[BasePose, ArrayLike]
 
 
 def recording_links(
-    recording: Recording, antenna: Antenna, x_c: float = math.nan
+    recording: Recording, antenna: Antenna, point: ContactPoint | None = None
 ) -> tuple[Piece, Piece | None]:
     """What a recording says of its link: the free part of its sweep (:func:`free_before` the
-    onset of its detected contact, by the :func:`onset_turn` of a contact at ``x_c`` (m; the
-    abscissa of an ``ok`` estimate, NaN otherwise) and the residual filter's lag at the head's
-    speed), and the link at that onset (None without a detected contact), both in its
+    onset of its detected contact, by the :func:`onset_turn` of a contact at ``point``'s x_c
+    when it is ``ok``, else at the tip, and by the residual filter's lag at the head's speed),
+    and the link at that onset when ``point`` (the recording's estimate) is not ``ok``: an
+    ``ok`` point says more (None then, and without a detected contact); both in the recording's
     ``base_pose``.
 
     Raises
@@ -285,8 +286,10 @@ def recording_links(
         if span > 0
         else 0.0
     )
+    ok = point is not None and point.status is Status.OK
+    x_c = point.x_c if point is not None and ok else math.nan
     free = free_before(recording.theta, t, onset, onset_turn(antenna, x_c) + rate * lag)
-    return (pose, free), (pose, recording.theta[at : at + 1])
+    return (pose, free), None if ok else (pose, recording.theta[at : at + 1])
 
 
 def free_space(
@@ -324,7 +327,7 @@ def _sampled(
             angles = _resampled(angles, FREE_STEP / link.length)
             if not len(angles):
                 continue
-            x_m = np.array([motor_axes(a)[0] for a in angles])  # X^m per angle, shape (k, 3)
+            x_m = _direction(angles)
             # the sag along A, the part of -Z^a across the link: g u(x) (-Z^a - (-Z^a . X^m) X^m)
             across = -np.eye(3)[2][None, :] + x_m[:, 2:3] * x_m
             along = x[None, :, None] * x_m[:, None, :]
@@ -346,8 +349,9 @@ def _sampled(
 
 
 def _resampled(angles: FloatArray, step: float) -> FloatArray:
-    """The head's path through ``angles`` (rad, shape (k, 2)) every ``step`` (rad) of turn,
-    its ends kept: a recording's 1 kHz samples are far denser than the link needs."""
+    """The head's path through ``angles`` (rad, shape (k, 2)) every ``step`` (rad) of the motor
+    angles' path (the link turns by as much or less), its ends kept: a recording's 1 kHz
+    samples are far denser than the link needs."""
     if len(angles) < 2:
         return angles
     turn = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(angles, axis=0), axis=1))])
