@@ -574,10 +574,7 @@ def fit_primitive(
         return placed.residuals(lambda q: model.signed_distance(x, q), s)
 
     def swept_residuals(x: FloatArray, regions: Sequence[FreeSpace]) -> FloatArray:
-        return np.concatenate(
-            [np.zeros(0)]
-            + [region.residuals(model.signed_distance(x, region.samples)) for region in regions]
-        )
+        return _swept_residuals(regions, lambda q: model.signed_distance(x, q))
 
     def residuals(
         x: FloatArray, s: FloatArray, with_lines: bool, regions: Sequence[FreeSpace]
@@ -749,13 +746,7 @@ def fit_mesh(
         # only samples within the placed mesh's box grown by this can come near it
         reach = FREE_MARGIN + 0.5 * _spread(p)
         spaces = [space.near(placed.bounds, reach) for space in swept]
-        sweeps = np.concatenate(
-            [np.zeros(0)]
-            + [
-                space.residuals(signed(space.samples) if len(space.samples) else np.zeros(0))
-                for space in spaces
-            ]
-        )
+        sweeps = _swept_residuals(spaces, signed)
     return _scored(
         f"mesh:{name}",
         parameters,
@@ -806,6 +797,20 @@ def _scored(
         n_points=n,
         vector=vector,
         mesh=mesh,
+    )
+
+
+def _swept_residuals(
+    spaces: Sequence[FreeSpace], distance: Callable[[FloatArray], FloatArray]
+) -> FloatArray:
+    """r_j of every sweep or contact of ``spaces`` in order, shape (n,), for a signed distance
+    function of (k, 3) points (m); empty without them."""
+    return np.concatenate(
+        [np.zeros(0)]
+        + [
+            space.residuals(distance(space.samples) if len(space.samples) else np.zeros(0))
+            for space in spaces
+        ]
     )
 
 
