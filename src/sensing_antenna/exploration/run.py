@@ -90,6 +90,10 @@ from sensing_antenna.simulator.scenario import LINK_MODELS
 
 FloatArray = NDArray[np.float64]
 
+#: A stored recording's links (``mapping.free_space.recording_links``) and its first motor
+#: angles (rad, shape (2,)).
+RecordedLinks = tuple[tuple[Piece, Piece | None], FloatArray]
+
 __all__ = [
     "CALIBRATION_POINTS",
     "Exploration",
@@ -314,6 +318,7 @@ def explore(
         ``out`` holds another exploration or is in use.
     """
     settings = settings if settings is not None else ExploreSettings()
+    recorded: dict[int, RecordedLinks] = {}  # each stored recording's links, read once
     grid = grid_sweeps(scene)
     budget = settings.budget if settings.budget is not None else len(grid)
     with exploration_lock(out):
@@ -348,7 +353,7 @@ def explore(
                     points = [m.point for m in manoeuvres if m.point is not None]
                     surface = fit_surface(points, settings.include_uncertain)
                     if index % RECOGNITION_EVERY == 0:
-                        swept = swept_links(manoeuvres, scene, antenna, out)
+                        swept = swept_links(manoeuvres, scene, antenna, out, recorded)
                         leaders = _undecided_leaders(points, settings.include_uncertain, swept)
                     choice = planner.choose(
                         [m.sweep for m in manoeuvres],
@@ -370,13 +375,17 @@ def explore(
             raise ExplorationInterrupted(number, len(manoeuvres), out) from None
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
-    swept = swept_links(manoeuvres, scene, antenna, out)
+    swept = swept_links(manoeuvres, scene, antenna, out, recorded)
     contact_map = build_map(points, settings.include_uncertain, meshes=meshes, swept=swept)
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 
 
 def swept_links(
-    manoeuvres: Sequence[Manoeuvre], scene: Scene, antenna: Antenna, out: Path
+    manoeuvres: Sequence[Manoeuvre],
+    scene: Scene,
+    antenna: Antenna,
+    out: Path,
+    recorded: dict[int, RecordedLinks] | None = None,
 ) -> tuple[FreeSpace, Touches]:
     """Where the manoeuvres' links were free and where they touched (``mapping.free_space``).
 
@@ -385,10 +394,14 @@ def swept_links(
     ``base_pose``) after the unrecorded approach as planned, else (a glancing touch, not
     simulated) the planned angles short of the geometric touch by the onset turn of a contact at
     the tip. Touched: the link at the onset of each detected contact whose point is not ``ok``
-    (an ``ok`` point says more), and at each glancing touch.
+    (an ``ok`` point says more), and at each glancing touch. ``recorded`` keeps each
+    manoeuvre's recording's :func:`~sensing_antenna.mapping.free_space.recording_links` and
+    first angles by its index between calls (a stored recording does not change), so that each
+    is read once.
     """
     from sensing_antenna.recording import read_recording
 
+    links = recorded if recorded is not None else {}
     free: list[list[Piece]] = []
     touched: list[list[Piece]] = []
     for m in manoeuvres:
@@ -401,17 +414,22 @@ def swept_links(
         elif m.outcome not in ("touch", "glancing") or m.touch is None:
             continue
         elif m.recording is not None and (out / m.recording).exists():
-            recording = read_recording(out / m.recording)
-            (pose, recorded), onset = recording_links(recording, antenna, m.point)
+            if m.index not in links:
+                recording = read_recording(out / m.recording)
+                links[m.index] = (
+                    recording_links(recording, antenna, m.point),
+                    recording.theta[0],
+                )
+            ((pose, free_angles), onset), first = links[m.index]
             if onset is not None:
                 touched.append([onset])
             # the recording's frame is turned to the touch's angles: its swept angle plus the
             # touch's is the sweep's, and the simulated approach may begin before the sweep did
             joint = 0 if sweep.case == "azimuthal" else 1
-            angle = float(m.touch["angle"]) + np.asarray(recorded)[:, joint]
+            angle = float(m.touch["angle"]) + np.asarray(free_angles)[:, joint]
             inside = (angle >= sweep.start) & (angle <= sweep.end)
-            pieces.append((pose, np.asarray(recorded)[inside]))
-            end = float(m.touch["angle"]) + float(recording.theta[0, joint])
+            pieces.append((pose, np.asarray(free_angles)[inside]))
+            end = float(m.touch["angle"]) + float(first[joint])
         else:
             touch = float(m.touch["angle"])
             touched.append([(base, np.array([sweep.angles(touch)]))])
