@@ -22,7 +22,7 @@ from sensing_antenna.exploration import (
     explore,
     grid_sweeps,
 )
-from sensing_antenna.exploration.plan import spread_order
+from sensing_antenna.exploration.plan import candidate_sweeps, spread_order
 from sensing_antenna.mapping import UNDECIDED, BasePose, ClassFit, ImplicitSurface, recognise
 from sensing_antenna.scene import LinkShape, Scene, Sweep, first_touch, load_scene
 
@@ -40,11 +40,18 @@ def test_spread_order_visits_every_index_once_middle_first() -> None:
 def test_grid_alternates_bases_cases_and_directions() -> None:
     scene = load_scene("sphere")
     grid = grid_sweeps(scene)
-    # 4 elevations swept both ways and 4 azimuths swept up, from each of the 3 bases
+    # 4 elevations swept both ways and 4 azimuths swept once, from each of the 3 bases
     assert len(grid) == 3 * (2 * 4 + 4)
     assert [s.base for s in grid[:9]] == 3 * [0, 1, 2]
     assert [s.case for s in grid[:9]] == 6 * ["azimuthal"] + 3 * ["vertical"]
-    assert [s.direction for s in grid[:9]] == 3 * [1] + 3 * [-1] + 3 * [1]
+    # the first vertical sweep is the middle azimuth's, the second of four: down
+    assert [s.direction for s in grid[:9]] == 3 * [1] + 3 * [-1] + 3 * [-1]
+    # from each base, up at the 1st and 3rd azimuths and down at the 2nd and 4th
+    for base in range(3):
+        vertical = sorted(
+            (s.fixed, s.direction) for s in grid if s.base == base and s.case == "vertical"
+        )
+        assert [direction for _, direction in vertical] == [1, -1, 1, -1]
     # an elevation's two sweeps cover the same range
     assert (grid[0].fixed, grid[0].start, grid[0].end) == (
         grid[3].fixed,
@@ -54,6 +61,15 @@ def test_grid_alternates_bases_cases_and_directions() -> None:
     assert len(set(grid)) == len(grid)
     elevation = scene.region.elevation
     assert all(elevation[0] < s.fixed < elevation[1] for s in grid if s.case == "azimuthal")
+
+
+def test_next_best_candidates_run_every_sweep_both_ways() -> None:
+    scene = load_scene("sphere")
+    candidates = candidate_sweeps(scene)
+    # 12 elevations and 12 azimuths per base, each both ways
+    assert len(candidates) == 3 * 2 * (12 + 12)
+    assert len(set(candidates)) == len(candidates)
+    assert set(candidates) == {dataclasses.replace(s, direction=-s.direction) for s in candidates}
 
 
 def test_next_best_aims_where_the_surface_is_unknown() -> None:

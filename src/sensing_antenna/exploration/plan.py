@@ -3,9 +3,10 @@
 The grid (:func:`grid_sweeps`) runs, from each base, azimuthal sweeps across the base's azimuth
 range (``Scene.region_of``) at evenly spaced elevations, each elevation both ways (towards +Y^m
 and -Y^m: a sweeping line touches a convex object on the side it comes from, so the two see
-opposite sides), and vertical sweeps up its elevation range at evenly spaced azimuths, in an
-order that spreads them out first (:func:`spread_order`), so that a budget cut short still
-covers the region.
+opposite sides), and vertical sweeps across its elevation range at evenly spaced azimuths,
+up at the even ones and down at the odd (an upward sweep touches the outline's underside, a
+downward one its top), in an order that spreads them out first (:func:`spread_order`), so
+that a budget cut short still covers the region.
 
 The next-best strategy (:class:`NextBestPlanner`) chooses among the candidates of a grid
 :data:`CANDIDATE_DENSITY` times finer. Until the surface can be fitted (fewer than
@@ -109,7 +110,15 @@ def spread_order(n: int) -> list[int]:
     return order
 
 
-def _sweeps(scene: Scene, azimuthal: int, vertical: int) -> list[Sweep]:
+def _vertical_directions(index: int, both: bool) -> tuple[int, ...]:
+    """The directions of the vertical sweep at the ``index``-th azimuth: up and down when
+    ``both``, else up at the even azimuths and down at the odd."""
+    if both:
+        return (1, -1)
+    return (1,) if index % 2 == 0 else (-1,)
+
+
+def _sweeps(scene: Scene, azimuthal: int, vertical: int, vertical_both: bool) -> list[Sweep]:
     sweeps: list[Sweep] = []
     a_order = spread_order(azimuthal)
     v_order = spread_order(vertical)
@@ -125,7 +134,12 @@ def _sweeps(scene: Scene, azimuthal: int, vertical: int) -> list[Sweep]:
             ]
             for i in a_order
         ]
-        v = [Sweep(base, "vertical", float(azimuths[i]), *region.elevation) for i in v_order]
+        # a vertical sweep up touches the outline's underside, one down its top
+        v = [
+            Sweep(base, "vertical", float(azimuths[i]), *region.elevation, direction)
+            for i in v_order
+            for direction in _vertical_directions(i, vertical_both)
+        ]
         # alternate the cases (an elevation's two directions, then an azimuth) so that a prefix
         # holds both
         for k in range(max(len(pairs), len(v))):
@@ -143,15 +157,17 @@ def _sweeps(scene: Scene, azimuthal: int, vertical: int) -> list[Sweep]:
 def grid_sweeps(scene: Scene) -> list[Sweep]:
     """The scene's grid (module docstring): its held angles evenly inside the region's ranges
     (the ends left out: a sweep along the region's edge), spread-out order."""
-    return _sweeps(scene, scene.region.azimuthal_sweeps, scene.region.vertical_sweeps)
+    return _sweeps(scene, scene.region.azimuthal_sweeps, scene.region.vertical_sweeps, False)
 
 
 def candidate_sweeps(scene: Scene) -> list[Sweep]:
-    """The next-best strategy's candidates: the grid :data:`CANDIDATE_DENSITY` times finer."""
+    """The next-best strategy's candidates: the grid :data:`CANDIDATE_DENSITY` times finer,
+    every sweep in both directions."""
     return _sweeps(
         scene,
         CANDIDATE_DENSITY * scene.region.azimuthal_sweeps,
         CANDIDATE_DENSITY * scene.region.vertical_sweeps,
+        True,
     )
 
 

@@ -26,9 +26,9 @@
 
     [explore]                             # the region swept (defaults below)
     azimuth = [-0.6, 0.6]                 # theta1 range (rad): azimuthal sweeps run across it
-    elevation = [-0.35, 0.35]             # theta2 range (rad): vertical sweeps run up it
+    elevation = [-0.35, 0.35]             # theta2 range (rad): vertical sweeps run across it
     azimuthal_sweeps = 5                  # the grid's elevations per base, each swept both ways
-    vertical_sweeps = 5                   # the grid's azimuths per base, each swept up
+    vertical_sweeps = 5                   # the grid's azimuths per base, swept up and down in turn
 
 Sizes: sphere ``radius``; cylinder ``radius``, ``height``; capsule ``radius``, ``length`` (of
 the axis segment); cone ``radius`` (base), ``height``; torus ``major_radius``,
