@@ -224,6 +224,7 @@ def test_a_capsule_shrunk_onto_a_ball_is_not_its_runner_up() -> None:
     assert fits["capsule"].sizes["length"] < 0.005
     assert result.decision == "sphere"
     assert "capsule" not in result.candidates
+    assert result.same_shape == ("capsule",)
     assert result.delta_score > 20.0
     assert result.confidence >= result.confidence_floor
 

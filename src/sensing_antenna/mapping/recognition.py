@@ -443,6 +443,8 @@ class Recognition:
         c, the reduced chi^2 of the best-fitting class when above 1 (else 1).
     rival : str or None
         A class the points do not rule out that is a different shape from the best's.
+    same_shape : tuple of str
+        Runner-ups whose fitted shape is the best's: their weight counts with the best's.
     """
 
     decision: str
@@ -453,6 +455,7 @@ class Recognition:
     threshold: float
     overdispersion: float = 1.0
     rival: str | None = None
+    same_shape: tuple[str, ...] = ()
 
     @property
     def best(self) -> ClassFit:
@@ -479,6 +482,7 @@ class Recognition:
             "abstain_delta": float(self.threshold),
             "overdispersion": float(self.overdispersion),
             "rival": self.rival,
+            "same_shape": list(self.same_shape),
             "fits": [f.to_dict() for f in self.fits],
         }
 
@@ -1083,4 +1087,5 @@ def recognise(
         threshold=threshold,
         overdispersion=float(c),
         rival=None if rival is None else rival.name,
+        same_shape=tuple(f.name for f in fits[1:] if id(f) in same),
     )

@@ -179,6 +179,12 @@ def report(contact_map: ContactMap) -> str:
                 if recognition.rival is not None
                 else ""
             )
+            + (
+                f"; {', '.join(recognition.same_shape)} fitted the same shape and"
+                f" {'counts' if len(recognition.same_shape) == 1 else 'count'} with it"
+                if recognition.same_shape
+                else ""
+            )
             + ".",
             "",
             "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md);"
