@@ -15,7 +15,8 @@ planes tilted by 0.5 rad the other ways. Each base explores its own region, the 
 angular extent seen from it, widened by 0.05 rad, the elevations shifted by the link's sag at
 each point's distance; the grid has, per base, ``--sweeps`` elevations each swept both ways
 (azimuthal sweeps towards +Y^m and back towards -Y^m, which touch opposite sides of the
-outline) and as many vertical sweeps (upwards): 3 (2 x 4 + 4) = 36 sweeps by default, as many
+outline) and as many vertical sweeps (up and down in turn): 3 (2 x 4 + 4) = 36 sweeps by
+default, as many
 as the one-way grid of 6 azimuthal and 6 vertical sweeps per base, so that the contacts stay
 below 40 per object.
 

@@ -211,9 +211,10 @@ def test_a_capsule_shrunk_to_a_sphere_is_the_same_shape() -> None:
 
 def test_a_capsule_shrunk_onto_a_ball_is_not_its_runner_up() -> None:
     # the capsule's segment shrinks to a few mm on a ball's points and trails the sphere by
-    # its extra parameters' penalty (4 ln 30 = 13.6 less what it gains): under a threshold of
-    # 20 it would make the decision abstain between two names of one ball. It is the same
-    # shape: the decision is the sphere against the next shape, with the capsule's weight
+    # its extra parameters' penalty (3 ln 30 = 10.2 less the 2.3 it gains): under a
+    # threshold of 20 it would make the decision abstain between two names of one ball. It
+    # is the same shape, and the points do not favour it: the decision is the sphere against
+    # the next shape, with the capsule's weight
     rng = np.random.default_rng(4)
     mesh = trimesh.creation.icosphere(subdivisions=3, radius=0.04)
     mesh.apply_translation([0.5, 0.1, 0.0])
@@ -227,6 +228,30 @@ def test_a_capsule_shrunk_onto_a_ball_is_not_its_runner_up() -> None:
     assert result.same_shape == ("capsule",)
     assert result.delta_score > 20.0
     assert result.confidence >= result.confidence_floor
+
+
+def test_a_capsule_the_points_favour_is_not_a_name_of_the_ball() -> None:
+    # a capsule of 3 cm radius and a 3 mm segment: its fit is within a millimetre of the
+    # sphere's, about the noise, but its chi^2 is 7 better than the sphere's, which the
+    # penalty of its three extra parameters (10.2) outweighs: the points tell the two apart
+    # without deciding, and the decision abstains between them
+    mesh = trimesh.creation.capsule(height=0.003, radius=0.03, count=[32, 32])
+    mesh.apply_translation([0.5, 0.1, 0.0])
+    points, _ = trimesh.sample.sample_surface(mesh, 30, seed=2)
+    points = points + np.random.default_rng(2).normal(0.0, NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * NOISE**2, (30, 1, 1))
+    result = recognise(
+        points,
+        covariances,
+        classes=["sphere", "capsule", "cylinder", "plane"],
+        rng=np.random.default_rng(0),
+    )
+    fits = {f.name: f for f in result.fits}
+    assert fits["sphere"].chi2 - fits["capsule"].chi2 > result.threshold
+    assert shape_gap(fits["sphere"], fits["capsule"]) < 3 * NOISE
+    assert result.decision == UNDECIDED
+    assert set(result.candidates) == {"sphere", "capsule"}
+    assert result.same_shape == ()
 
 
 def test_a_line_cutting_into_a_sphere_costs_its_depth() -> None:
@@ -250,53 +275,6 @@ def test_a_line_cutting_into_a_sphere_costs_its_depth() -> None:
     spread = math.hypot(sigma, 0.5 * LINE_STRETCH * std)
     assert got[0] == pytest.approx(-depth / spread, rel=1e-9)
     assert got[1] == 0.0
-
-
-def test_points_off_a_ball_only_along_their_links_do_not_grow_it() -> None:
-    # each point on a line tangent to a 3 cm ball, moved 2 of its 3 mm deviations along the
-    # line: s^2 / (2 R) = 0.6 mm outside the ball, two of its 0.3 mm deviations across the
-    # link. On the points alone the ball grows by that; sought along their links, the points
-    # balance u^2 against the distance left (about half the shift: 0.15 mm out) and the ball
-    # stays within half the growth
-    rng = np.random.default_rng(1)
-    radius, centre, n = 0.03, np.array([0.6, 0.1, 0.0]), 30
-    normals = rng.normal(size=(n, 3))
-    normals /= np.linalg.norm(normals, axis=1)[:, None]
-    tangents = np.cross(normals, rng.normal(size=(n, 3)))
-    tangents /= np.linalg.norm(tangents, axis=1)[:, None]
-    along, across = 0.003, 0.0003
-    shifts = 2 * along * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
-    points = centre + radius * normals + shifts[:, None] * tangents
-    outer = np.einsum("ni,nj->nij", tangents, tangents)
-    covariances = along**2 * outer + across**2 * (np.eye(3) - outer)
-    lines = LinkLines(tangents, np.full(n, 0.01), np.full(n, 0.5), np.full(n, 0.3))
-    alone = fit_primitive("sphere", points, covariances).sizes["radius"] - radius
-    sought = fit_primitive("sphere", points, covariances, lines=lines).sizes["radius"] - radius
-    grown = math.hypot(radius, 2 * along) - radius
-    assert alone == pytest.approx(grown, rel=0.01)
-    assert abs(sought) < 0.5 * grown
-
-
-def test_a_contact_is_not_sought_past_the_tip() -> None:
-    # a half-plane's edge 3 mm from a point along its link, the link's tip pointing that way:
-    # with 0.5 m of link beyond the point the contact moves onto the edge (one of its 3 mm
-    # deviations, 1 mm above the plane there); with the tip at the point it cannot, and the
-    # point costs its whole distance to the edge
-    towards_edge = np.array([-1.0, 0.0, 0.0])
-    lines = LinkLines(np.array([towards_edge] * 2), [0.01] * 2, [0.5, 0.5], [0.5, 0.0])
-    points = np.array([[0.003, 0.0, 0.001]] * 2)
-    covariances = np.tile(np.diag([0.003**2, 0.001**2, 0.001**2]), (2, 1, 1))
-
-    def distance(q: np.ndarray) -> np.ndarray:
-        # the half-plane z = 0, x <= 0, from above
-        return np.where(q[:, 0] <= 0.0, q[:, 2], np.hypot(q[:, 0], q[:, 2]))
-
-    sigma = np.array([0.001, 0.001])
-    shift, at = lines.placed(points, covariances).along(distance, sigma)
-    assert shift[0] == pytest.approx(1.0, abs=0.05)
-    assert at[0] == pytest.approx(0.001, rel=0.05)
-    assert shift[1] == 0.0
-    assert at[1] == pytest.approx(math.hypot(0.003, 0.001))
 
 
 def _first_touch(

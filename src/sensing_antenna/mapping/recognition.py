@@ -21,16 +21,6 @@ surface tangent to the link and for an edge the link passes over, and a line cro
 of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through the points a
 sweeping line left on a box's edges is not tangent to the lines that touched them.
 
-Along the link. An estimate errs mostly along its link (x_c), and a point moved along a line
-tangent to a shape leaves the shape: by s^2 / (2 R) beside a surface of radius R across the
-link, by s sin(beta) beside an edge the link crosses at beta, always outwards, which fits read
-as a larger shape. So a contact whose link is known is sought along it: the point's part of
-the fit is min over s of u^2 + (d(p + s t) / sigma)^2, u = s / sigma_s, sigma_s the point's
-standard deviation along the link (sqrt(t^T Sigma t)), the profile of the Gaussian likelihood
-of where the link touched over the unknown shift (over :data:`ALONG_STEPS` standard deviations,
-refined by a parabola, never past the base or the tip). A point off a shape across the link
-costs as before; one off it only along the link costs its shift in its own deviations.
-
 The swept links (``mapping.free_space``): each sweep's link where it passed untouched, and the
 link of each contact with no ``ok`` point where it touched, add one residual per sweep or
 contact, r_j = min(0, min_k (d(q_k) - a) / sigma_k) over the free samples (a shape reaching
@@ -38,13 +28,13 @@ into free space) and max(0, min_k (d(q_k) - a) / sigma_k) over a touching link's
 nowhere near it), a the link's radius.
 
 Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with chi^2 the sum over
-the points of -2 log-likelihood of their residuals z_i^2 = u_i^2 + (d_i / sigma_i)^2 + r_i^2
-(d_i at the shift u_i along the link, u_i = 0 without one) up to a constant, and over the
-swept links of their r_j^2 in the same mixture (below), k the class's independent parameters,
-n the points, and c >= 1 the overdispersion (Burnham and Anderson, "Model Selection and
-Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of the best-fitting class, over
-n - k, when above 1, so that points farther from every class than their covariances say, an
-estimator's systematic error, weigh less); c = 1 is BIC. The lowest score wins.
+the points of -2 log-likelihood of their residuals z_i^2 = (d_i / sigma_i)^2 + r_i^2 up to a
+constant, and over the swept links of their r_j^2 in the same mixture (below), k the class's
+independent parameters, n the points, and c >= 1 the overdispersion (Burnham and Anderson,
+"Model Selection and Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of the
+best-fitting class, over n - k, when above 1, so that points farther from every class than their
+covariances say, an estimator's systematic error, weigh less); c = 1 is BIC. The lowest score
+wins.
 The residuals' distribution is a mixture: a point is right, Gaussian about the surface with its
 sigma_i, except with the chance :data:`OUTLIER_FRACTION` that an estimate reported ``ok`` is
 wrong and lies anywhere across the points' spread L. Relative to a point on the surface its
@@ -65,20 +55,20 @@ worse by :data:`ABSTAIN_DELTA` in chi^2 / c (the likelihood alone, no penalty: t
 not reject it) and its fitted shape is a different object, some part of its surface (the
 95th percentile of the distances between the two fitted surfaces, both ways) farther from the
 best's than :data:`SAME_SHAPE_SIGMAS` times the points' median standard deviation along the
-normal. A runner-up whose fitted shape is the best's (within that distance) is the same
-object under another class's name, a richer one the penalty rightly put behind: it is not a
-runner-up of the decision, and its weight adds to the best's. The decision abstains
-(``undecided``, naming the best and its rival) when there is a rival, or when the best runner-up
-of another shape scores within :data:`ABSTAIN_DELTA` of the best.
+normal. A runner-up whose fitted shape is the best's (within that distance), and whose chi^2 /
+c is within :data:`ABSTAIN_DELTA` of the best's (the points do not tell the two apart), is the
+same object under another class's name: the two score as one class, the best's score less
+2 ln of their weights over the best's. The decision abstains (``undecided``, naming the best
+and its rival) when there is a rival, or when the best runner-up of another shape scores
+within :data:`ABSTAIN_DELTA` of that.
 
 Confidence: the best class's weight exp(-score / 2) normalised over the classes (the posterior
-probability under equal priors in BIC's approximation), with the weights of the classes whose
-fit is the same shape, and, when there is a rival, the best's
-weight against the rival on the likelihood alone, 1 / (1 + exp(-delta chi^2 / (2 c))). A
-decision needs the weight a runner-up :data:`ABSTAIN_DELTA` behind leaves the best,
-1 / (1 + exp(-3)) = 0.95: several classes each that far behind share more than 5 % between
-them, and the decision abstains. So a named class always carries a confidence of at least
-0.95, and an abstention one below it.
+probability under equal priors in BIC's approximation) with the weights of the classes of its
+shape, and, when there is a rival, the best's weight against the rival on the likelihood alone,
+1 / (1 + exp(-delta chi^2 / (2 c))). A decision needs the weight a runner-up
+:data:`ABSTAIN_DELTA` behind leaves the best, 1 / (1 + exp(-3)) = 0.95: several classes each
+that far behind share more than 5 % between them, and the decision abstains. So a named class
+always carries a confidence of at least 0.95, and an abstention one below it.
 """
 
 from __future__ import annotations
@@ -183,11 +173,6 @@ FREE_ACTIVE = 0.01
 #: Where along that stretch, as fractions of it.
 _LINE_FRACTIONS = (0.125, 0.25, 0.5, 1.0)
 
-#: Where along the link a contact is sought about its estimate, in the point's standard
-#: deviations along the link (module docstring, "Along the link"): farther costs more than
-#: the mixture's cap on a wrong point for any sigma the explorations give.
-ALONG_STEPS = (-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0)
-
 
 @dataclass(frozen=True)
 class LinkLines:
@@ -237,34 +222,15 @@ class LinkLines:
         and the points' standard deviations along the surface's normal (m, shape (n,))."""
         return self.placed(points).residuals(distance, sigma)
 
-    def placed(self, points: FloatArray, covariances: FloatArray | None = None) -> PlacedLines:
+    def placed(self, points: FloatArray) -> PlacedLines:
         """The lines at these contacts (m, shape (n, 3)), sampled once: a fit evaluates its
-        residuals many times over the same points. With the points' covariances (m^2, shape
-        (n, 3, 3)) each contact is also sought along its link (:meth:`PlacedLines.along`)."""
+        residuals many times over the same points."""
         points = np.asarray(points, dtype=float).reshape(-1, 3)
         if len(points) != len(self.tangents):
             raise ValueError(f"{len(self.tangents)} link lines for {len(points)} points")
         samples, arc = self.samples(points)
         slope_variance = (np.nan_to_num(arc) * self.std[:, None]) ** 2
-        known = np.all(np.isfinite(self.tangents), axis=1)
-        tangents = np.where(known[:, None], np.nan_to_num(self.tangents), 0.0)
-        along_std = np.zeros(len(points))
-        if covariances is not None:
-            cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
-            variance = np.einsum("ni,nij,nj->n", tangents, cov, tangents)
-            along_std = np.sqrt(np.maximum(variance, 0.0))
-        shift = np.asarray(ALONG_STEPS)[None, :] * along_std[:, None]
-        along_samples = points[:, None, :] + shift[:, :, None] * tangents[:, None, :]
-        return PlacedLines(
-            points,
-            samples.reshape(-1, 3),
-            arc,
-            slope_variance,
-            tangents,
-            along_std,
-            along_samples.reshape(-1, 3),
-            np.column_stack([-self.behind, self.beyond]),
-        )
+        return PlacedLines(points, samples.reshape(-1, 3), arc, slope_variance)
 
 
 @dataclass(frozen=True)
@@ -281,25 +247,12 @@ class PlacedLines:
         Their signed arc lengths (m); NaN where the link does not reach.
     slope_variance : array, shape (n, k)
         (s sigma_t)^2 (m^2): how far the line's angle error moves each sample across it.
-    tangents : array, shape (n, 3)
-        The link's unit tangent at each contact; zero where it is not known.
-    along_std : array, shape (n,)
-        Each point's standard deviation along its link (m); zero without covariances or a
-        tangent (the contact is not sought along the link).
-    along_samples : array, shape (n * len(ALONG_STEPS), 3)
-        The points shifted along their links by :data:`ALONG_STEPS` standard deviations (m).
-    along_range : array, shape (n, 2)
-        How far each contact may move along its link (m): back to the base, on to the tip.
     """
 
     points: FloatArray
     samples: FloatArray
     arc: FloatArray
     slope_variance: FloatArray
-    tangents: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
-    along_std: FloatArray = field(default_factory=lambda: np.zeros(0))
-    along_samples: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
-    along_range: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
 
     def residuals(
         self, distance: Callable[[FloatArray], FloatArray], sigma: FloatArray
@@ -313,45 +266,6 @@ class PlacedLines:
         spread = np.sqrt(sigma[:, None] ** 2 + self.slope_variance)
         deeper = np.where(np.isfinite(self.arc), (at_line - own[:, None]) / spread, np.inf)
         return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
-
-    def along(
-        self, distance: Callable[[FloatArray], FloatArray], sigma: FloatArray
-    ) -> tuple[FloatArray, FloatArray]:
-        """Each contact sought along its link (module docstring, "Along the link"): the shift
-        u_i = s_i / sigma_s,i (in the point's standard deviations along the link) that
-        minimises u^2 + (d(p_i + s t_i) / sigma_i)^2, and the distance d there (m); both shape
-        (n,), for a signed distance function of (m, 3) points and the points' standard
-        deviations along the surface's normal ``sigma`` (m, shape (n,)). The minimum is
-        taken over :data:`ALONG_STEPS` and a parabola through the best step and its two
-        neighbours."""
-        n = len(self.points)
-        if n == 0 or len(self.along_std) != n:
-            return np.zeros(n), np.asarray(distance(self.points)) if n else np.zeros(0)
-        steps = np.asarray(ALONG_STEPS)
-        # the shifts that stay on the link, in standard deviations along it
-        with np.errstate(divide="ignore", invalid="ignore"):
-            low, high = (self.along_range / self.along_std[:, None]).T
-        low, high = np.nan_to_num(low, nan=-np.inf), np.nan_to_num(high, nan=np.inf)
-        at = np.asarray(distance(self.along_samples)).reshape(n, len(steps))
-        g = steps**2 + (at / sigma[:, None]) ** 2
-        g[(steps < low[:, None]) | (steps > high[:, None])] = np.inf
-        rows = np.arange(n)
-        best = np.argmin(g, axis=1)
-        middle = np.clip(best, 1, len(steps) - 2)
-        g0, g1, g2 = g[rows, middle - 1], g[rows, middle], g[rows, middle + 1]
-        curvature = g0 - 2.0 * g1 + g2
-        with np.errstate(invalid="ignore", divide="ignore"):
-            offset = np.where(
-                np.isfinite(curvature) & (curvature > 0), 0.5 * (g0 - g2) / curvature, 0.0
-            )
-        vertex = steps[middle] + np.clip(offset, -1.0, 1.0)
-        vertex = np.clip(vertex, steps[0], steps[-1])
-        moved = self.points + (vertex * self.along_std)[:, None] * self.tangents
-        at_vertex = np.asarray(distance(moved))
-        g_vertex = vertex**2 + (at_vertex / sigma) ** 2
-        better = (vertex >= low) & (vertex <= high) & (g_vertex < g[rows, best])
-        shift = np.where(better, vertex, steps[best])
-        return shift, np.where(better, at_vertex, at[rows, best])
 
 
 @dataclass(frozen=True)
@@ -432,11 +346,15 @@ class Recognition:
     fits : tuple of ClassFit
         Every class, best (lowest score) first, with weights.
     candidates : tuple of str
-        The two leading classes.
+        The best class and its rival, or the best runner-up of another shape (one name when
+        there is none).
     delta_score : float
-        Score of the runner-up minus the best's (inf with one class).
+        Score of the best runner-up of another shape minus the best's, that less 2 ln of the
+        weight of the best and its shape's runner-ups (:attr:`same_shape`) over the best's
+        (inf without one).
     confidence : float
-        The best class's weight (0 to 1; against its rival when there is one).
+        The best class's weight with its shape's runner-ups' (0 to 1; against its rival when
+        there is one).
     threshold : float
         The abstention threshold used.
     overdispersion : float
@@ -597,15 +515,10 @@ def point_chi2(z2: FloatArray, sigma: FloatArray, spread: float) -> FloatArray:
     return np.asarray(-2.0 * (inlier - np.logaddexp(0.0, -0.5 * cap)))
 
 
-def _z2(
-    distance: FloatArray, sigma: FloatArray, line: FloatArray, shift: FloatArray | None = None
-) -> FloatArray:
-    """z^2 = u^2 + (d / sigma)^2 + r^2 per point (module docstring), shape (n,): the distance
-    d (m) in its standard deviations sigma (m), the contact's shift along the link u (in its
-    standard deviations; none: 0) and the link's line residual r (none: empty)."""
+def _z2(distance: FloatArray, sigma: FloatArray, line: FloatArray) -> FloatArray:
+    """z^2 = (d / sigma)^2 + r^2 per point (module docstring), shape (n,): the distance d (m)
+    in its standard deviations sigma (m) and the link's line residual r (none: empty)."""
     z2 = (np.asarray(distance, dtype=float) / sigma) ** 2
-    if shift is not None:
-        z2 = z2 + np.asarray(shift, dtype=float) ** 2
     return np.asarray(z2 + np.asarray(line, dtype=float) ** 2 if len(line) else z2)
 
 
@@ -667,7 +580,7 @@ def fit_primitive(
     sigma = _isotropic_sigma(cov)
     spread = _spread(p)
 
-    placed = lines.placed(p, cov) if lines is not None else None
+    placed = lines.placed(p) if lines is not None else None
     spaces = [space.near(p, FREE_MARGIN + 0.5 * spread) for space in swept]
     link_evidence = lines is not None or bool(spaces)
 
@@ -682,15 +595,10 @@ def fit_primitive(
     def residuals(
         x: FloatArray, s: FloatArray, with_lines: bool, regions: Sequence[FreeSpace]
     ) -> FloatArray:
-        if with_lines and placed is not None:
-            # each contact where along its link the shape suits it best
-            shift, distance = placed.along(lambda q: model.signed_distance(x, q), s)
-            points = np.concatenate([shift, distance / s])
-        else:
-            points = model.signed_distance(x, p) / s
+        distance = model.signed_distance(x, p) / s
         line = line_residuals(x, s) if with_lines else np.zeros(0)
         prior = _extent_excess(model.name, x, p) / EXTENT_PRIOR
-        return np.concatenate([points, line, swept_residuals(x, regions), prior])
+        return np.concatenate([distance, line, swept_residuals(x, regions), prior])
 
     def fit(
         start: FloatArray,
@@ -709,17 +617,9 @@ def fit_primitive(
             max_nfev=evaluations * len(start),
         )
 
-    def along(x: FloatArray, normal_sigma: FloatArray) -> tuple[FloatArray, FloatArray] | None:
-        if placed is None:
-            return None
-        return placed.along(lambda q: model.signed_distance(x, q), normal_sigma)
-
     def point_z2(x: FloatArray, normal_sigma: FloatArray) -> FloatArray:
-        sought = along(x, normal_sigma)
-        if sought is None:
-            return _z2(model.signed_distance(x, p), normal_sigma, np.zeros(0))
-        shift, distance = sought
-        return _z2(distance, normal_sigma, line_residuals(x, normal_sigma), shift)
+        distance = model.signed_distance(x, p)
+        return _z2(distance, normal_sigma, line_residuals(x, normal_sigma))
 
     def refine(x: FloatArray) -> FloatArray:
         # each point's sigma along the fitted surface's normal, and the link's lines; a point
@@ -774,7 +674,6 @@ def fit_primitive(
         line=line_residuals(x, sigma),
         swept=swept_residuals(x, spaces),
         spaces=spaces,
-        along=along(x, sigma),
     )
 
 
@@ -852,7 +751,6 @@ def fit_mesh(
     extents = mesh.bounding_box.extents
     sizes = {f"extent_{a}": float(e) for a, e in zip("xyz", extents, strict=True)}
     line = np.zeros(0)
-    along = None
     sweeps, spaces = np.zeros(0), []
     if placed.is_watertight:
         # trimesh's signed distance is positive inside (and meaningful for a closed mesh only)
@@ -860,9 +758,7 @@ def fit_mesh(
             return -np.asarray(trimesh.proximity.signed_distance(placed, q))
 
         if lines is not None:
-            at_contacts = lines.placed(p, cov)
-            line = at_contacts.residuals(signed, sigma)
-            along = at_contacts.along(signed, sigma)
+            line = lines.residuals(signed, p, sigma)
         # only samples within the placed mesh's box grown by this can come near it
         reach = FREE_MARGIN + 0.5 * _spread(p)
         spaces = [space.near(placed.bounds, reach) for space in swept]
@@ -880,7 +776,6 @@ def fit_mesh(
         line,
         sweeps,
         spaces,
-        along,
     )
 
 
@@ -897,15 +792,12 @@ def _scored(
     line: FloatArray | None = None,
     swept: FloatArray | None = None,
     spaces: Sequence[FreeSpace] = (),
-    along: tuple[FloatArray, FloatArray] | None = None,
 ) -> ClassFit:
     n = len(distance)
     lines = line if line is not None and len(line) == n else np.zeros(n)
     sweeps = swept if swept is not None else np.zeros(0)
-    # each point's (sought along its link: shift and distance there) and each sweep's part of
-    # chi^2; BIC = chi^2 + k ln n
-    shift, at = along if along is not None else (None, distance)
-    parts = point_chi2(_z2(at, sigma, lines, shift), sigma, spread)
+    # each point's and each sweep's part of chi^2; BIC = chi^2 + k ln n
+    parts = point_chi2(_z2(distance, sigma, lines), sigma, spread)
     chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(
@@ -1054,12 +946,21 @@ def recognise(
     fits = [dataclasses.replace(f, weight=float(w)) for f, w in zip(fits, weights, strict=True)]
     best = fits[0]
     sigma = float(np.median(_normal_sigma(cov, _fit_normals(best, p))))
-    # a runner-up whose fitted shape is the best's (a capsule shrunk to a ball) is the same
-    # answer under a richer name: its weight is the best's, and the decision is between shapes
+    # a runner-up whose fitted shape is the best's (a capsule shrunk to a ball), and which
+    # the points do not tell from it (chi^2 / c within the threshold), is the same answer
+    # under another class's name: the best and it score as one class, their weights added,
+    # and the decision is between shapes
     near = [f for f in fits[1:] if f.score - best.score < SAME_SHAPE_SCORE * threshold]
-    same = {id(f) for f in near if shape_gap(best, f) <= SAME_SHAPE_SIGMAS * sigma}
+    same = {
+        id(f)
+        for f in near
+        if abs(best.chi2 - f.chi2) / c < threshold
+        and shape_gap(best, f) <= SAME_SHAPE_SIGMAS * sigma
+    }
     others = [f for f in fits[1:] if id(f) not in same]
-    delta = others[0].score - best.score if others else math.inf
+    group = float(weights[0] + sum(w for f, w in zip(fits, weights, strict=True) if id(f) in same))
+    group_score = best.score - 2.0 * math.log(group / weights[0])
+    delta = others[0].score - group_score if others else math.inf
     # a rival: not ruled out by the likelihood, and a different object
     rival = next(
         (
@@ -1070,8 +971,7 @@ def recognise(
         ),
         None,
     )
-    shared = sum(w for f, w in zip(fits, weights, strict=True) if id(f) in same)
-    confidence = min(1.0, float(weights[0] + shared))
+    confidence = min(1.0, group)
     if rival is not None:
         # the best's weight against the rival on the likelihood alone
         confidence = confidence_floor((rival.chi2 - best.chi2) / c)

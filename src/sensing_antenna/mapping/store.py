@@ -164,8 +164,12 @@ def report(contact_map: ContactMap) -> str:
                 if recognition.undecided
                 else f" (confidence {recognition.confidence:.3f})"
             )
-            + f"; score gap to the runner-up {recognition.delta_score:.1f}"
-            f" (abstains below {recognition.threshold:g})"
+            + (
+                f"; score gap to the runner-up {recognition.delta_score:.1f}"
+                f" (abstains below {recognition.threshold:g})"
+                if math.isfinite(recognition.delta_score)
+                else "; no runner-up of another shape"
+            )
             + (
                 f"; the best's weight {recognition.confidence:.3f} is below the"
                 f" {recognition.confidence_floor:.3f} a decision needs"

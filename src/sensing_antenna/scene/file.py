@@ -95,7 +95,7 @@ class ExploreRegion:
     azimuth : (float, float)
         theta1 range (rad): an azimuthal sweep runs across it, either way.
     elevation : (float, float)
-        theta2 from, to (rad): a vertical sweep runs up from the first to the second.
+        theta2 from, to (rad): a vertical sweep runs across it, up or down.
     azimuthal_sweeps, vertical_sweeps : int
         The grid's elevations (each swept both ways by azimuthal sweeps) and azimuths (vertical
         sweeps) per base.
