@@ -254,6 +254,28 @@ def test_a_capsule_the_points_favour_is_not_a_name_of_the_ball() -> None:
     assert result.same_shape == ()
 
 
+def test_fits_apart_by_more_than_the_points_scatter_are_not_one_shape() -> None:
+    # points on a 2.4 cm thick, 5 cm long cylinder with 1 mm of noise and covariances that say
+    # 4 mm (as the explorations' do along the normal): a capsule's and a box's fits lie about
+    # 3 mm from the cylinder's, within 3 of the covariances' sigma but three times the points'
+    # scatter about the cylinder (0.7 mm RMS): other shapes, which a contact there would tell
+    # apart. The decision abstains between the cylinder and the capsule
+    rng = np.random.default_rng(0)
+    mesh = trimesh.creation.cylinder(radius=0.012, height=0.05, sections=128)
+    mesh.apply_translation([0.5, 0.1, 0.0])
+    points, _ = trimesh.sample.sample_surface(mesh, 30, seed=0)
+    points = points + rng.normal(0.0, NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * (4 * NOISE) ** 2, (30, 1, 1))
+    result = recognise(points, covariances, rng=np.random.default_rng(0))
+    fits = {f.name: f for f in result.fits}
+    assert result.best.name == "cylinder"
+    for other in ("capsule", "box"):
+        assert result.best.rms < shape_gap(result.best, fits[other]) < 3 * 4 * NOISE
+    assert result.same_shape == ()
+    assert result.decision == UNDECIDED
+    assert result.candidates == ("cylinder", "capsule")
+
+
 def test_a_line_cutting_into_a_sphere_costs_its_depth() -> None:
     # a line through a point of a sphere at an angle beta into it reaches R (1 - cos beta)
     # deep at s = R sin beta along it (|p + s t - c| is least there); with beta chosen so that

@@ -55,12 +55,13 @@ worse by :data:`ABSTAIN_DELTA` in chi^2 / c (the likelihood alone, no penalty: t
 not reject it) and its fitted shape is a different object, some part of its surface (the
 95th percentile of the distances between the two fitted surfaces, both ways) farther from the
 best's than :data:`SAME_SHAPE_SIGMAS` times the points' median standard deviation along the
-normal. A runner-up whose fitted shape is the best's (within that distance), and whose chi^2 /
-c is within :data:`ABSTAIN_DELTA` of the best's (the points do not tell the two apart), is the
-same object under another class's name: the two score as one class, the best's score less
-2 ln of their weights over the best's. The decision abstains (``undecided``, naming the best
-and its rival) when there is a rival, or when the best runner-up of another shape scores
-within :data:`ABSTAIN_DELTA` of that.
+normal. A runner-up whose fitted shape is the best's (the same percentile of their distances
+at most the best fit's RMS distance to the points: apart by less than the points scatter),
+and whose chi^2 / c is within :data:`ABSTAIN_DELTA` of the best's (the points do not tell the
+two apart), is the same object under another class's name: the two score as one class, the
+best's score less 2 ln of their weights over the best's. The decision abstains
+(``undecided``, naming the best and its rival) when there is a rival, or when the best runner-up
+of another shape scores within :data:`ABSTAIN_DELTA` of that.
 
 Confidence: the best class's weight exp(-score / 2) normalised over the classes (the posterior
 probability under equal priors in BIC's approximation) with the weights of the classes of its
@@ -946,16 +947,15 @@ def recognise(
     fits = [dataclasses.replace(f, weight=float(w)) for f, w in zip(fits, weights, strict=True)]
     best = fits[0]
     sigma = float(np.median(_normal_sigma(cov, _fit_normals(best, p))))
-    # a runner-up whose fitted shape is the best's (a capsule shrunk to a ball), and which
-    # the points do not tell from it (chi^2 / c within the threshold), is the same answer
-    # under another class's name: the best and it score as one class, their weights added,
-    # and the decision is between shapes
+    # a runner-up whose fitted shape is the best's (a capsule shrunk to a ball: apart by no
+    # more than the points scatter about the best) and which the points do not tell from it
+    # (chi^2 / c within the threshold) is the same answer under another class's name: the
+    # best and it score as one class, their weights added, and the decision is between shapes
     near = [f for f in fits[1:] if f.score - best.score < SAME_SHAPE_SCORE * threshold]
     same = {
         id(f)
         for f in near
-        if abs(best.chi2 - f.chi2) / c < threshold
-        and shape_gap(best, f) <= SAME_SHAPE_SIGMAS * sigma
+        if abs(best.chi2 - f.chi2) / c < threshold and shape_gap(best, f) <= best.rms
     }
     others = [f for f in fits[1:] if id(f) not in same]
     group = float(weights[0] + sum(w for f, w in zip(fits, weights, strict=True) if id(f) in same))
