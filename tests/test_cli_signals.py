@@ -59,17 +59,27 @@ def _interrupt(
     command: list[str] = _LONG_COMMAND,
     started: float = _STARTED,
     program: str = _ANTENNA,
+    ready: Path | None = None,
 ) -> subprocess.CompletedProcess[str]:
     """Start ``command`` (run by ``program``), send ``signal_number`` to its process alone
-    ``started`` seconds after (once it runs); its ending."""
+    ``started`` seconds after (once it runs), or once the file ``ready`` exists (the program
+    is given its path in ``ANTENNA_TEST_READY``); its ending."""
+    environment = _environment()
+    if ready is not None:
+        environment["ANTENNA_TEST_READY"] = str(ready)
     process = subprocess.Popen(
         [sys.executable, "-c", program, *command, "--out", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=_environment(),
+        env=environment,
     )
-    time.sleep(started)
+    if ready is None:
+        time.sleep(started)
+    else:
+        deadline = time.monotonic() + 60.0
+        while not ready.exists() and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
     assert process.poll() is None, "the command ended before it could be interrupted"
     process.send_signal(signal_number)
     stdout, stderr = process.communicate(timeout=60)
@@ -120,11 +130,12 @@ def test_sigterm_ends_with_one_line_and_143(tmp_path: Path) -> None:
 #: finalizer in the main thread, and an exception raised there (the signal's) is printed and
 #: dropped, the program going on.
 _ANTENNA_SLOW_FINALIZER = (
-    "import signal, sys, time\n"
+    "import os, pathlib, signal, sys, time\n"
     "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
     "import sensing_antenna.simulator as simulator\n"
     "class Slow:\n"
     "    def __del__(self):\n"
+    "        pathlib.Path(os.environ['ANTENNA_TEST_READY']).touch()\n"
     "        time.sleep(4.0)\n"
     "original = simulator.simulate\n"
     "def slowed(*args, **kwargs):\n"
@@ -137,11 +148,13 @@ _ANTENNA_SLOW_FINALIZER = (
 
 
 def test_sigterm_inside_a_finalizer_still_stops_the_command(tmp_path: Path) -> None:
-    # the signal lands while the finalizer sleeps (it starts within the first second or so and
-    # lasts 4 s); Python drops the exception raised there, and the command delivers the
-    # signal again where it can unwind: one line, 143, no recording
+    # the signal lands while the finalizer sleeps (sent once the finalizer says it has begun:
+    # the imports alone take 2.5 to 3.3 s here); Python drops the exception raised there, and
+    # the command delivers the signal again where it can unwind: one line, 143, no recording
     out = tmp_path / "rec.csv"
-    done = _interrupt(signal.SIGTERM, out, program=_ANTENNA_SLOW_FINALIZER)
+    done = _interrupt(
+        signal.SIGTERM, out, program=_ANTENNA_SLOW_FINALIZER, ready=tmp_path / "finalizing"
+    )
     assert done.returncode == 143, done.stderr
     assert done.stderr.strip() == "antenna simulate: stopped by SIGTERM"
     assert not out.exists()
