@@ -118,6 +118,12 @@ def test_motor_axes_match_recording_format() -> None:
     np.testing.assert_allclose(axes[1], [-s1, c1, 0.0], atol=1e-15)
     np.testing.assert_allclose(axes[2], np.cross(axes[0], axes[1]), atol=1e-15)
     np.testing.assert_allclose(axes @ axes.T, np.eye(3), atol=1e-15)
+    # many angles at once: each frame as for its angles alone (the same arithmetic, exactly)
+    many = np.array([[0.7, -0.4], [-1.2, 0.9], [0.0, 0.0]])
+    frames = motor_axes(many)
+    assert frames.shape == (3, 3, 3)
+    for angles, frame in zip(many, frames, strict=True):
+        np.testing.assert_array_equal(frame, motor_axes(angles))
 
 
 def test_gravity_terms_match_spec_sign_check() -> None:

@@ -52,6 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.detection.contact import ContactDetection, detect_contact
+from sensing_antenna.estimation.front.contact_frame import motor_axes
 from sensing_antenna.estimation.result import Status
 from sensing_antenna.mapping.points import ContactPoint, PointUncertainty
 from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
@@ -235,18 +236,11 @@ def free_before(theta: ArrayLike, t: ArrayLike, onset: float, turn: float) -> Fl
     return before[: last[-1] + 1] if last.size else before[:0]
 
 
-def _direction(theta: FloatArray) -> FloatArray:
-    """X^m (unit) at motor angles ``theta`` (rad, shape (k, 2)), shape (k, 3)."""
-    c1, s1 = np.cos(theta[:, 0]), np.sin(theta[:, 0])
-    c2, s2 = np.cos(theta[:, 1]), np.sin(theta[:, 1])
-    return np.column_stack([c2 * c1, c2 * s1, s2])
-
-
 def _turn(theta: FloatArray, to: FloatArray) -> FloatArray:
     """The angle (rad, shape (k,)) the link's direction turns through from each of ``theta``
     (rad, shape (k, 2)) to ``to`` (rad, shape (2,))."""
-    a = _direction(theta)
-    b = _direction(np.asarray(to, dtype=float).reshape(1, 2))
+    a = motor_axes(theta)[:, 0]
+    b = motor_axes(np.asarray(to, dtype=float).reshape(1, 2))[:, 0]
     return np.asarray(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), a @ b[0]))
 
 
@@ -327,7 +321,7 @@ def _sampled(
             angles = _resampled(angles, FREE_STEP / link.length)
             if not len(angles):
                 continue
-            x_m = _direction(angles)
+            x_m = motor_axes(angles)[:, 0]  # X^m per angle, shape (k, 3)
             # the sag along A, the part of -Z^a across the link: g u(x) (-Z^a - (-Z^a . X^m) X^m)
             across = -np.eye(3)[2][None, :] + x_m[:, 2:3] * x_m
             along = x[None, :, None] * x_m[:, None, :]

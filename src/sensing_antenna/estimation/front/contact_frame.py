@@ -47,22 +47,22 @@ def motor_axes(theta: FloatArray) -> FloatArray:
 
     Parameters
     ----------
-    theta : array, shape (2,)
+    theta : array, shape (2,) or (k, 2)
         Motor angles theta1 (azimuth), theta2 (elevation) (rad).
 
     Returns
     -------
-    array, shape (3, 3)
+    array, shape (3, 3) or (k, 3, 3)
     """
-    c1, s1 = np.cos(theta[0]), np.sin(theta[0])
-    c2, s2 = np.cos(theta[1]), np.sin(theta[1])
-    return np.array(
-        [
-            [c2 * c1, c2 * s1, s2],
-            [-s1, c1, 0.0],
-            [-s2 * c1, -s2 * s1, c2],
-        ]
+    theta = np.asarray(theta, dtype=float)
+    c1, s1 = np.cos(theta[..., 0]), np.sin(theta[..., 0])
+    c2, s2 = np.cos(theta[..., 1]), np.sin(theta[..., 1])
+    rows = (
+        (c2 * c1, c2 * s1, s2),
+        (-s1, c1, np.zeros_like(c1)),
+        (-s2 * c1, -s2 * s1, c2),
     )
+    return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
 
 
 def to_absolute(vector_m: FloatArray, theta: FloatArray) -> FloatArray:
