@@ -951,23 +951,32 @@ def recognise(
     # more than the points scatter about the best) and which the points do not tell from it
     # (chi^2 / c within the threshold) is the same answer under another class's name: the
     # best and it score as one class, their weights added, and the decision is between shapes
-    near = [f for f in fits[1:] if f.score - best.score < SAME_SHAPE_SCORE * threshold]
-    same = {
-        id(f)
-        for f in near
-        if abs(best.chi2 - f.chi2) / c < threshold and shape_gap(best, f) <= best.rms
-    }
-    others = [f for f in fits[1:] if id(f) not in same]
-    group = float(weights[0] + sum(w for f, w in zip(fits, weights, strict=True) if id(f) in same))
-    group_score = best.score - 2.0 * math.log(group / weights[0])
+    gaps: dict[str, float] = {}
+
+    def gap(f: ClassFit) -> float:
+        # each runner-up's shape compared with the best's once (2000 samples each way)
+        if f.name not in gaps:
+            gaps[f.name] = shape_gap(best, f)
+        return gaps[f.name]
+
+    same = [
+        f
+        for f in fits[1:]
+        if f.score - best.score < SAME_SHAPE_SCORE * threshold
+        and abs(best.chi2 - f.chi2) / c < threshold
+        and gap(f) <= best.rms
+    ]
+    merged = {f.name for f in same}
+    others = [f for f in fits[1:] if f.name not in merged]
+    group = best.weight + sum(f.weight for f in same)
+    group_score = best.score - 2.0 * math.log(group / best.weight)
     delta = others[0].score - group_score if others else math.inf
     # a rival: not ruled out by the likelihood, and a different object
     rival = next(
         (
             f
             for f in others
-            if (f.chi2 - best.chi2) / c < threshold
-            and shape_gap(best, f) > SAME_SHAPE_SIGMAS * sigma
+            if (f.chi2 - best.chi2) / c < threshold and gap(f) > SAME_SHAPE_SIGMAS * sigma
         ),
         None,
     )
@@ -987,5 +996,5 @@ def recognise(
         threshold=threshold,
         overdispersion=float(c),
         rival=None if rival is None else rival.name,
-        same_shape=tuple(f.name for f in fits[1:] if id(f) in same),
+        same_shape=tuple(f.name for f in same),
     )
