@@ -212,6 +212,30 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
         assert "does not oppose the head's turn" in (result.reason or "")
 
 
+def test_a_link_that_slid_past_a_ball_is_slip_not_a_flipped_sign(antenna: Antenna) -> None:
+    # A sweep down onto a small ball hit 0.49 rad off its top: the exact link pushes it until
+    # t_1, then slides over it and springs back against its underside, so the hold's reaction
+    # points along the turn. The signs are right (the push at t_1 opposed the turn), and the
+    # answer says the link slid off rather than that a column is flipped.
+    scenario = Scenario(
+        case="vertical",
+        sweep_direction=-1,
+        contact_point=0.54,
+        obstacle="ball",
+        obstacle_radius=0.0121,
+        obstacle_tilt=-0.49,
+        link_model="nonlinear",
+        seed=2,
+        duration=4.0,
+    )
+    recording = simulate(antenna, scenario)
+    assert recording.metadata["true_in_contact_at_end"] == "false"
+    for name, result in all_methods(recording.without_ground_truth(), antenna).items():
+        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
+        assert result.status is Status.SLIP_SUSPECTED, (name, result.reason)
+        assert any("the link slid off the object or past it" in text for text in reasons), name
+
+
 def test_a_torque_column_of_1e300_gives_a_status_not_a_traceback(
     azimuthal: Recording, antenna: Antenna
 ) -> None:

@@ -10,7 +10,8 @@ forms agree.
    against the link's weight and the free motion against the observer (found by the front end
    at t_c, ``Evidence.input_problem``), the angles up to t_e
    (:func:`~sensing_antenna.units_check.angle_problem`), and the push against the head's turn
-   into the contact (an obstacle only pushes back).
+   into the contact (an obstacle only pushes back; a push that opposed the turn up to t_1 and
+   not over the hold after it is a link that slid off the object, ``slip_suspected``).
 2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``). An answer past the tip by
    no more than ``disagreement_sigmas`` statistical uncertainties of the ratio at the tip (noise
    and tare, :meth:`~.evidence.Evidence.ratio_uncertainty` without its model term, which grows
@@ -103,7 +104,7 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
         found.append((Status.IMPLAUSIBLE_INPUT, angles))
     push = _push_direction_problem(evidence)
     if push is not None:
-        found.append((Status.IMPLAUSIBLE_INPUT, push))
+        found.append(push)
     estimate = _at_tip_when_just_past(evidence, estimate)
     x_c = estimate.x_c
     on_link = math.isfinite(x_c) and 0.0 < x_c <= link.length
@@ -384,15 +385,19 @@ def _on_branch(curve: Any, x_c: float, candidates: Any) -> list[float]:
     return [c.x_c for c in candidates if branch(c.x_c) == branch(x_c)]
 
 
-def _push_direction_problem(evidence: Evidence) -> str | None:
+def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     """Why the push does not oppose the head's motion into the contact, or None.
 
     An obstacle can only push back: from t_c to t_1 the head turns into it by dtheta, which moves
     the link along d = (0, dtheta_1 cos theta_2, dtheta_2) in the motor frame (the azimuth about
     Z^a moves X^m along cos theta_2 Y^m, the elevation along Z^m), and the mean reaction over the
     hold must have R . d < 0 (Y^c = -Y^m for an azimuthal push, Section 5.4). A sign flipped in
-    one angle or in the forces turns it. Not judged when the head turned by less than the rest
-    tolerance.
+    one angle or in the forces turns it, during the push as over the hold
+    (``implausible_input``). When the push's filtered reaction at t_1 did oppose the turn, by
+    more than three of its standard errors (the low-passed noise and the tare's), and the
+    hold's does not, the signs are right and the contact moved: the link slid off the object or
+    past it, and touches it from the other side if at all (``slip_suspected``). Not judged when
+    the head turned by less than the rest tolerance.
     """
     theta = evidence.theta
     turn = theta[evidence.rest_index] - theta[evidence.contact_index]
@@ -403,7 +408,19 @@ def _push_direction_problem(evidence: Evidence) -> str | None:
     reaction = evidence.frame.reaction_m
     if float(reaction @ direction) < 0.0:
         return None
-    return (
+    pushed = np.asarray(evidence.reaction_f[evidence.rest_index], dtype=float)
+    noise = float(evidence.diagnostics.get("force_noise", 0.0)) * math.sqrt(
+        0.5 * evidence.config.lowpass_cutoff * evidence.sample_period
+    )
+    error = math.hypot(noise, evidence.offset_error)
+    along = float(pushed @ direction) / float(np.linalg.norm(direction))
+    if along < -3.0 * error:
+        return Status.SLIP_SUSPECTED, (
+            f"the contact force opposed the head's turn into the contact while it pushed "
+            f"({_vector(pushed)} N at t_1, filtered) but not over the hold after t_1 "
+            f"({_vector(reaction)} N): the link slid off the object or past it"
+        )
+    return Status.IMPLAUSIBLE_INPUT, (
         f"columns 'theta1', 'theta2', 'fx', 'fy', 'fz': the mean contact force over the hold "
         f"{_vector(reaction)} N does not oppose the head's turn into the contact "
         f"({_vector(turn)} rad from t_c to t_1); an obstacle can only push back: a sign "
