@@ -22,7 +22,7 @@ from sensing_antenna.exploration import (
     explore,
     grid_sweeps,
 )
-from sensing_antenna.exploration.plan import candidate_sweeps, spread_order
+from sensing_antenna.exploration.plan import PREDICTION_STEP, candidate_sweeps, spread_order
 from sensing_antenna.mapping import UNDECIDED, BasePose, ClassFit, ImplicitSurface, recognise
 from sensing_antenna.scene import LinkShape, Scene, Sweep, first_touch, load_scene
 
@@ -94,25 +94,51 @@ def test_next_best_aims_where_the_surface_is_unknown() -> None:
     again = planner.choose([], surface, free=[choice.sweep])
     assert again is not None and again.sweep != choice.sweep
     # two leading classes that disagree: the true ball and one 2 cm larger about the same
-    # centre differ by 2 cm everywhere, so every score becomes sqrt(std^2 + 0.02^2)
-    leaders = [
-        ClassFit("sphere", {}, {}, 0.0, 0.0, 0.0, 4, len(points), vector=ball.parameters),
-        ClassFit(
-            "sphere",
-            {},
-            {},
-            0.0,
-            0.0,
-            0.0,
-            4,
-            len(points),
-            vector=ball.parameters + np.array([0, 0, 0, 0.02]),
-        ),
-    ]
+    # centre; the aimed sweep is one whose outcome tells them apart, and scores no less
+    leaders = two_balls(ball.parameters, 0.02, len(points))
     aimed = planner.choose([], surface, leaders=leaders)
     assert aimed is not None and 0 < aimed.probability <= 1
-    assert aimed.score == pytest.approx(np.hypot(aimed.std, 0.02) * aimed.probability, rel=1e-9)
+    assert planner.separation(aimed.sweep, leaders) > 0.0
     assert aimed.score >= choice.score
+
+
+def two_balls(parameters: np.ndarray, larger: float, n_points: int) -> list[ClassFit]:
+    """Two sphere fits about one centre, the second ``larger`` (m) in radius."""
+    return [
+        ClassFit("sphere", {}, {}, 0.0, 0.0, 0.0, 4, n_points, vector=parameters + grow)
+        for grow in (np.zeros(4), np.array([0.0, 0.0, 0.0, larger]))
+    ]
+
+
+def test_the_leaders_separation_is_what_the_sweep_would_find() -> None:
+    # Two concentric balls, 2 cm apart in radius. A sweep whose link passes the centre at
+    # m > r + 2 cm finds neither (0); at r < m < r + 2 cm it touches the larger only, and the
+    # smaller stays m - r from the swept link; nearer, it touches both, at two points.
+    scene = load_scene("sphere")
+    ball = scene.objects[0]
+    centre, radius = ball.parameters[:3], ball.parameters[3]
+    leaders = two_balls(ball.parameters, 0.02, 10)
+    shape = LinkShape(DEVICE.link)
+    planner = NextBestPlanner(scene, shape)
+    seen = set()
+    for sweep in planner.candidates:
+        base = scene.bases[sweep.base]
+        # the link's nearest approach to the centre, from every sample of the link
+        nearest = min(
+            float(np.min(np.linalg.norm(shape.points(sweep.angles(a), base) - centre, axis=1)))
+            for a in sweep.swept_angles(PREDICTION_STEP)
+        )
+        separation = planner.separation(sweep, leaders)
+        if nearest > radius + 0.021:
+            assert separation == 0.0
+            seen.add("neither")
+        elif radius + 0.001 < nearest < radius + 0.019:
+            assert separation == pytest.approx(nearest - radius, abs=1e-3)
+            seen.add("one")
+        elif nearest < radius - 0.001:
+            assert separation > 0.0
+            seen.add("both")
+    assert seen == {"neither", "one", "both"}
 
 
 @pytest.fixture(scope="module")

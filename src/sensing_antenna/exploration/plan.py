@@ -29,10 +29,14 @@ else is left, and each score is divided by one plus the number of earlier sweeps
 direction, which keeps a sweep that came back free from being retried next to itself.
 
 When recognition abstains between two leading shape classes, the planner also aims at telling
-them apart: at a candidate's predicted touch p the two fitted shapes disagree about where the
-surface is by |d_a(p) - d_b(p)| (their signed distances, m), and sigma becomes
-sqrt(sigma^2 + (d_a - d_b)^2): a contact where the leaders differ separates them, one where they
-agree does not.
+them apart by what each predicts the candidate will find (:meth:`NextBestPlanner.separation`):
+each fitted shape is followed along the candidate's link as the surface is, and the two
+outcomes are s m apart: the distance between the two predicted touches when both touch; when
+only one does, how far the other's surface stays from the swept link (the sweep's coming back
+free, or touching, refutes one of them); 0 when both miss. The score is then
+sqrt(score^2 + (s / (1 + crowd))^2), and a candidate the leaders disagree about is never
+relegated as a predicted miss: a contact, or free space, where the leaders differ separates
+them; one where they agree does not.
 """
 
 from __future__ import annotations
@@ -213,6 +217,7 @@ class NextBestPlanner:
         self.opening = grid_sweeps(scene)
         x = shape.abscissae
         self._samples = np.unique(np.linspace(0, len(x) - 1, _PREDICTION_SAMPLES).astype(int))
+        self._swept_cache: dict[Sweep, FloatArray] = {}
 
     def choose(
         self,
@@ -241,6 +246,7 @@ class NextBestPlanner:
         best: tuple[float, Choice] | None = None
         fallback: tuple[float, Choice] | None = None
         for sweep in left:
+            separation = self.separation(sweep, leaders) if len(leaders) == 2 else 0.0
             point, closest = self._predicted_touch(sweep, surface)
             _, std_at = surface.predict(point[None, :], return_std=True)
             std = float(std_at[0])
@@ -254,20 +260,13 @@ class NextBestPlanner:
                 and d.direction == sweep.direction
                 and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
             )
-            spread = std
-            if len(leaders) == 2:
-                # where the two leading shapes disagree about the surface
-                d_a, d_b = (
-                    float(PRIMITIVES[f.name].signed_distance(f.vector, point[None, :])[0])
-                    for f in leaders
-                )
-                spread = math.hypot(spread, d_a - d_b)
-            score = probability * spread / (1.0 + crowd)
+            score = probability * std / (1.0 + crowd)
             if free_cloud is not None:
                 distance = float(free_cloud.query(point)[0])
                 score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
+            score = math.hypot(score, separation / (1.0 + crowd))
             entry = (score, Choice(sweep, score, point, std, probability))
-            if closest > MISS_MARGIN:
+            if closest > MISS_MARGIN and separation == 0.0:
                 if fallback is None or score > fallback[0]:
                     fallback = entry
             elif best is None or score > best[0]:
@@ -276,13 +275,43 @@ class NextBestPlanner:
         assert chosen is not None
         return chosen[1]
 
+    def separation(self, sweep: Sweep, leaders: Sequence[ClassFit]) -> float:
+        """How far apart two fitted shapes put the outcome of ``sweep`` (m; module docstring):
+        the distance between their predicted touches, or how far the missed one stays from the
+        swept link when only one is touched, or 0 when neither is."""
+        points = self._swept(sweep)
+        rows = len(sweep.swept_angles(PREDICTION_STEP))
+        touches: list[FloatArray] = []
+        misses: list[float] = []
+        for fit in leaders:
+            distance = np.asarray(
+                PRIMITIVES[fit.name].signed_distance(fit.vector, points), dtype=float
+            ).reshape(rows, -1)
+            hit = np.nonzero((distance < 0).any(axis=1))[0]
+            if hit.size:
+                row = int(hit[0])
+                column = int(np.argmin(distance[row]))
+                touches.append(points.reshape(rows, -1, 3)[row, column])
+            else:
+                misses.append(float(distance.min()))
+        if len(touches) == 2:
+            return float(np.linalg.norm(touches[0] - touches[1]))
+        if len(touches) == 1:
+            return misses[0]
+        return 0.0
+
     def _swept(self, sweep: Sweep) -> FloatArray:
-        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3)."""
-        base = self.scene.bases[sweep.base]
-        angles = sweep.swept_angles(PREDICTION_STEP)
-        return np.concatenate(
-            [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
-        )
+        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3); kept
+        per sweep (a candidate is followed at every choice)."""
+        kept = self._swept_cache.get(sweep)
+        if kept is None:
+            base = self.scene.bases[sweep.base]
+            angles = sweep.swept_angles(PREDICTION_STEP)
+            kept = np.concatenate(
+                [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
+            )
+            self._swept_cache[sweep] = kept
+        return kept
 
     def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:
         """The predicted touch point (m) and the smallest f met (m; <= 0 when it touches)."""
