@@ -38,6 +38,7 @@ def register(subparsers: Any) -> None:
         default="rest",
         help="t_1 from the head coming to rest or from the push criterion (as antenna estimate)",
     )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     parser.set_defaults(func=_run)
 
 
@@ -60,19 +61,22 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.campaign.progress import Progress
     from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.mapping import (
-        build_map,
-        points_from_recordings,
-        swept_from_recordings,
-    )
+    from sensing_antenna.mapping import build_map, map_inputs_from_recordings
 
     meshes = {path.stem: load_mesh(path) for path in args.objects}
     antenna = load_antenna(args.antenna)
-    points = points_from_recordings(
-        args.recordings, antenna, args.method, config=EstimatorConfig(t1_source=args.t1)
-    )
-    swept = swept_from_recordings(args.recordings, antenna, points)
+    with Progress(not args.no_progress).bar(
+        len(args.recordings), f"estimating ({args.method})", unit="recording"
+    ) as bar:
+        points, swept = map_inputs_from_recordings(
+            args.recordings,
+            antenna,
+            args.method,
+            config=EstimatorConfig(t1_source=args.t1),
+            progress=lambda _: bar.update(1),
+        )
     contact_map = build_map(points, args.include_uncertain, meshes=meshes, swept=swept)
     report_map(contact_map, args.out)
     return 0

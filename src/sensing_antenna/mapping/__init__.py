@@ -11,8 +11,9 @@ Above ``estimation/`` (it turns estimates into world points), below ``cli/``:
 - :mod:`.recognition`: every class fitted to the points, the links' lines and the swept links,
   scored by BIC,
   a decision that abstains when a class the points do not rule out is another shape;
-- :mod:`.contact_map`: :func:`build_map`, :func:`points_from_recordings` and
-  :func:`swept_from_recordings`;
+- :mod:`.contact_map`: :func:`build_map`, :func:`points_from_recordings`,
+  :func:`swept_from_recordings` and :func:`map_inputs_from_recordings` (both, each recording
+  read once);
 - :mod:`.store`: the map's directory;
 - :mod:`.view`: the interactive HTML view (map.html).
 """
@@ -20,6 +21,7 @@ Above ``estimation/`` (it turns estimates into world points), below ``cli/``:
 from sensing_antenna.mapping.contact_map import (
     ContactMap,
     build_map,
+    map_inputs_from_recordings,
     points_from_recordings,
     swept_from_recordings,
 )
@@ -66,6 +68,7 @@ __all__ = [
     "fit_mesh",
     "fit_primitive",
     "free_space",
+    "map_inputs_from_recordings",
     "points_from_recordings",
     "recognise",
     "select_points",

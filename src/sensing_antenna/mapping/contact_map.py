@@ -2,20 +2,21 @@
 
 :func:`points_from_recordings` estimates each recording and places its point in the world
 (the recording's ``base_pose``); :func:`swept_from_recordings` finds where each recording's link
-swept untouched and where it touched (``mapping.free_space``); :func:`build_map` keeps the
-points that may enter a map (status ``ok``, and ``uncertain`` when asked), fits the implicit
-surface when there are enough of them and recognises the object when there are enough for every
-class.
+swept untouched and where it touched (``mapping.free_space``);
+:func:`map_inputs_from_recordings` does both, reading each recording once. :func:`build_map`
+keeps the points that may enter a map (status ``ok``, and ``uncertain`` when asked), fits the
+implicit surface when there are enough of them and recognises the object when there are enough
+for every class.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import trimesh
@@ -40,12 +41,16 @@ from sensing_antenna.mapping.pose import base_pose_from_metadata
 from sensing_antenna.mapping.recognition import LinkLines, Recognition, recognise
 from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
 
+if TYPE_CHECKING:
+    from sensing_antenna.recording import Recording
+
 __all__ = [
     "MIN_RECOGNITION_POINTS",
     "ContactMap",
     "build_map",
     "fit_surface",
     "link_lines",
+    "map_inputs_from_recordings",
     "points_from_recordings",
     "recognise_points",
     "swept_from_recordings",
@@ -133,19 +138,11 @@ def points_from_recordings(
     RecordingError, FieldError
         One line naming the file when a recording or its base pose is malformed.
     """
-    from sensing_antenna.estimation.pipeline import estimate
     from sensing_antenna.recording import read_recording
 
-    points = []
-    for path in paths:
-        recording = read_recording(path)
-        pose = base_pose_from_metadata(recording.metadata, str(path))
-        truth = _true_point(recording.metadata.get("true_contact_point"))
-        result = estimate(recording.without_ground_truth(), antenna, method=method, config=config)
-        points.append(
-            contact_point_from_estimate(result, antenna, pose, str(path), uncertainty, truth)
-        )
-    return points
+    return [
+        _point(read_recording(path), path, antenna, method, uncertainty, config) for path in paths
+    ]
 
 
 def swept_from_recordings(
@@ -165,14 +162,70 @@ def swept_from_recordings(
     """
     from sensing_antenna.recording import read_recording
 
-    free: list[list[Piece]] = []
-    touched: list[list[Piece]] = []
-    for k, path in enumerate(paths):
-        point = points[k] if points is not None and k < len(points) else None
-        recorded, onset = recording_links(read_recording(path), antenna, point)
-        free.append([recorded])
-        if onset is not None:
-            touched.append([onset])
+    links = [
+        recording_links(
+            read_recording(path),
+            antenna,
+            points[k] if points is not None and k < len(points) else None,
+        )
+        for k, path in enumerate(paths)
+    ]
+    return _swept(links, antenna)
+
+
+def map_inputs_from_recordings(
+    paths: Sequence[Path],
+    antenna: Antenna,
+    method: Any = "paper",
+    uncertainty: PointUncertainty | None = None,
+    config: Any = None,
+    progress: Callable[[Path], None] | None = None,
+) -> tuple[list[ContactPoint], tuple[FreeSpace, Touches]]:
+    """:func:`points_from_recordings` and :func:`swept_from_recordings` of the same recordings,
+    each read once; ``progress`` is called with each path when it is done.
+
+    Raises
+    ------
+    RecordingError, FieldError
+        One line naming the file when a recording or its base pose is malformed.
+    """
+    from sensing_antenna.recording import read_recording
+
+    points: list[ContactPoint] = []
+    links = []
+    for path in paths:
+        recording = read_recording(path)
+        point = _point(recording, path, antenna, method, uncertainty, config)
+        points.append(point)
+        links.append(recording_links(recording, antenna, point))
+        if progress is not None:
+            progress(path)
+    return points, _swept(links, antenna)
+
+
+def _point(
+    recording: Recording,
+    path: Path,
+    antenna: Antenna,
+    method: Any,
+    uncertainty: PointUncertainty | None,
+    config: Any,
+) -> ContactPoint:
+    """The recording's touched point in the world (:func:`points_from_recordings`)."""
+    from sensing_antenna.estimation.pipeline import estimate
+
+    pose = base_pose_from_metadata(recording.metadata, str(path))
+    truth = _true_point(recording.metadata.get("true_contact_point"))
+    result = estimate(recording.without_ground_truth(), antenna, method=method, config=config)
+    return contact_point_from_estimate(result, antenna, pose, str(path), uncertainty, truth)
+
+
+def _swept(
+    links: Sequence[tuple[Piece, Piece | None]], antenna: Antenna
+) -> tuple[FreeSpace, Touches]:
+    """The free space of every recording's links and the touches of those with an onset."""
+    free = [[recorded] for recorded, _ in links]
+    touched = [[onset] for _, onset in links if onset is not None]
     return free_space(free, antenna), touches(touched, antenna)
 
 
