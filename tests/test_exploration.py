@@ -24,7 +24,14 @@ from sensing_antenna.exploration import (
 )
 from sensing_antenna.exploration.plan import PREDICTION_STEP, candidate_sweeps, spread_order
 from sensing_antenna.mapping import UNDECIDED, BasePose, ClassFit, ImplicitSurface, recognise
-from sensing_antenna.scene import LinkShape, Scene, Sweep, first_touch, load_scene
+from sensing_antenna.scene import (
+    LinkShape,
+    Scene,
+    Sweep,
+    first_touch,
+    load_scene,
+    primitive_object,
+)
 
 DEVICE = paper_antenna()
 
@@ -93,13 +100,6 @@ def test_next_best_aims_where_the_surface_is_unknown() -> None:
     assert nearest > 0.02
     again = planner.choose([], surface, free=[choice.sweep])
     assert again is not None and again.sweep != choice.sweep
-    # two leading classes that disagree: the true ball and one 2 cm larger about the same
-    # centre; the aimed sweep is one whose outcome tells them apart, and scores no less
-    leaders = two_balls(ball.parameters, 0.02, len(points))
-    aimed = planner.choose([], surface, leaders=leaders)
-    assert aimed is not None and 0 < aimed.probability <= 1
-    assert planner.separation(aimed.sweep, leaders) > 0.0
-    assert aimed.score >= choice.score
 
 
 def two_balls(parameters: np.ndarray, larger: float, n_points: int) -> list[ClassFit]:
@@ -110,35 +110,69 @@ def two_balls(parameters: np.ndarray, larger: float, n_points: int) -> list[Clas
     ]
 
 
-def test_the_leaders_separation_is_what_the_sweep_would_find() -> None:
-    # Two concentric balls, 2 cm apart in radius. A sweep whose link passes the centre at
-    # m > r + 2 cm finds neither (0); at r < m < r + 2 cm it touches the larger only, and the
-    # smaller stays m - r from the swept link; nearer, it touches both, at two points.
+def test_next_best_aims_at_a_sweep_whose_outcome_tells_two_leaders_apart() -> None:
+    # Points all over the ball: the surface is known everywhere, and without leaders no
+    # candidate scores much. With two leading fits, the ball and one 2 cm larger about its
+    # centre, the planner takes a sweep that touches the larger ball before the smaller one,
+    # as the scene's own geometry (first_touch) finds with each ball in turn.
     scene = load_scene("sphere")
     ball = scene.objects[0]
     centre, radius = ball.parameters[:3], ball.parameters[3]
-    leaders = two_balls(ball.parameters, 0.02, 10)
+    directions = np.random.default_rng(1).normal(size=(60, 3))
+    points = centre + radius * directions / np.linalg.norm(directions, axis=1, keepdims=True)
+    surface = ImplicitSurface().fit(
+        points, np.tile(np.eye(3) * 1e-6, (len(points), 1, 1)), np.zeros(3)
+    )
+    shape = LinkShape(DEVICE.link)
+    planner = NextBestPlanner(scene, shape)
+    plain = planner.choose([], surface)
+    aimed = planner.choose([], surface, leaders=two_balls(ball.parameters, 0.02, len(points)))
+    assert plain is not None and aimed is not None
+    assert plain.score < 0.01 <= 0.019 < aimed.score
+    larger = dataclasses.replace(
+        scene,
+        objects=(primitive_object("ball", "sphere", [radius + 0.02], centre, (0.0, 0.0, 0.0)),),
+    )
+    big, small = first_touch(larger, aimed.sweep, shape), first_touch(scene, aimed.sweep, shape)
+    assert big.touch is not None
+    assert small.touch is None or abs(small.touch.angle - big.touch.angle) > 0.01
+
+
+def test_the_leaders_separation_is_what_the_sweep_would_find() -> None:
+    # Two concentric balls, 1.5 cm apart in radius (below the cap of 2 cm): where the link
+    # first touches the larger, the smaller is 1.5 cm from it, whether the sweep goes on to
+    # touch it or not; a sweep that passes farther than r + 1.5 cm from the centre touches
+    # neither (0), and one that starts inside a ball has no outcome to predict (0), as with a
+    # ball about the base that holds the whole link.
+    scene = load_scene("sphere")
+    ball = scene.objects[0]
+    centre, radius = ball.parameters[:3], ball.parameters[3]
+    gap = 0.015
+    leaders = two_balls(ball.parameters, gap, 10)
+    enclosing = two_balls(np.array([0.0, 0.0, 0.0, 2.0]), 0.0, 10)[:1] + leaders[:1]
     shape = LinkShape(DEVICE.link)
     planner = NextBestPlanner(scene, shape)
     seen = set()
     for sweep in planner.candidates:
         base = scene.bases[sweep.base]
-        # the link's nearest approach to the centre, from every sample of the link
-        nearest = min(
+        # the link's distance to the centre at each angle, from every sample of the link
+        distance = [
             float(np.min(np.linalg.norm(shape.points(sweep.angles(a), base) - centre, axis=1)))
             for a in sweep.swept_angles(PREDICTION_STEP)
-        )
+        ]
+        start, nearest = distance[0], min(distance)
         separation = planner.separation(sweep, leaders)
-        if nearest > radius + 0.021:
+        if start < radius + gap - 0.001:
+            assert separation == 0.0
+            seen.add("inside")
+        elif nearest > radius + gap + 0.001:
             assert separation == 0.0
             seen.add("neither")
-        elif radius + 0.001 < nearest < radius + 0.019:
-            assert separation == pytest.approx(nearest - radius, abs=1e-3)
-            seen.add("one")
-        elif nearest < radius - 0.001:
-            assert separation > 0.0
-            seen.add("both")
-    assert seen == {"neither", "one", "both"}
+        elif start > radius + gap + 0.001 and nearest < radius + gap - 0.001:
+            assert separation == pytest.approx(gap, abs=1e-3), (sweep, nearest - radius)
+            seen.add("touched")
+        assert planner.separation(sweep, enclosing) == 0.0
+    assert {"neither", "touched"} <= seen
 
 
 @pytest.fixture(scope="module")

@@ -30,13 +30,14 @@ direction, which keeps a sweep that came back free from being retried next to it
 
 When recognition abstains between two leading shape classes, the planner also aims at telling
 them apart by what each predicts the candidate will find (:meth:`NextBestPlanner.separation`):
-each fitted shape is followed along the candidate's link as the surface is, and the two
-outcomes are s m apart: the distance between the two predicted touches when both touch; when
-only one does, how far the other's surface stays from the swept link (the sweep's coming back
-free, or touching, refutes one of them); 0 when both miss. The score is then
-sqrt(score^2 + (s / (1 + crowd))^2), and a candidate the leaders disagree about is never
-relegated as a predicted miss: a contact, or free space, where the leaders differ separates
-them; one where they agree does not.
+each fitted shape is followed through the candidate's sweep as the surface is, and where one
+predicts the touch, the other's surface is s from the link: 0 when they agree, the gap the
+link has still to close (or has passed) when one is touched later, how far the other passes
+when it is not touched at all, the larger of the two ways round, at most :data:`MISS_MARGIN`
+(a gap of a few cm is decisive already); 0 when neither is touched or the link starts inside
+one. The score is then sqrt(score^2 + (s / (1 + crowd))^2), and a candidate the leaders
+disagree about is never relegated as a predicted miss: a contact, or free space, where the
+leaders differ separates them; one where they agree does not.
 """
 
 from __future__ import annotations
@@ -183,7 +184,9 @@ class Choice:
     ----------
     sweep : Sweep
     score : float
-        The predictive standard deviation at the predicted touch (m), NaN for a grid choice.
+        The predictive standard deviation at the predicted touch, weighted by the chance to
+        touch, and the leading fits' separation when there are two (m; module docstring), NaN
+        for a grid choice.
     predicted : array, shape (3,)
         Where the sweep is expected to touch (m, world), NaN for a grid choice.
     std : float
@@ -217,7 +220,7 @@ class NextBestPlanner:
         self.opening = grid_sweeps(scene)
         x = shape.abscissae
         self._samples = np.unique(np.linspace(0, len(x) - 1, _PREDICTION_SAMPLES).astype(int))
-        self._swept_cache: dict[Sweep, FloatArray] = {}
+        self._swept_cache: dict[Sweep, tuple[FloatArray, int]] = {}
 
     def choose(
         self,
@@ -276,40 +279,49 @@ class NextBestPlanner:
         return chosen[1]
 
     def separation(self, sweep: Sweep, leaders: Sequence[ClassFit]) -> float:
-        """How far apart two fitted shapes put the outcome of ``sweep`` (m; module docstring):
-        the distance between their predicted touches, or how far the missed one stays from the
-        swept link when only one is touched, or 0 when neither is."""
-        points = self._swept(sweep)
-        rows = len(sweep.swept_angles(PREDICTION_STEP))
-        touches: list[FloatArray] = []
-        misses: list[float] = []
-        for fit in leaders:
-            distance = np.asarray(
-                PRIMITIVES[fit.name].signed_distance(fit.vector, points), dtype=float
-            ).reshape(rows, -1)
-            hit = np.nonzero((distance < 0).any(axis=1))[0]
-            if hit.size:
-                row = int(hit[0])
-                column = int(np.argmin(distance[row]))
-                touches.append(points.reshape(rows, -1, 3)[row, column])
-            else:
-                misses.append(float(distance.min()))
-        if len(touches) == 2:
-            return float(np.linalg.norm(touches[0] - touches[1]))
-        if len(touches) == 1:
-            return misses[0]
-        return 0.0
+        """How far apart two primitive fits put the outcome of ``sweep`` (m; module docstring).
+
+        Each fit's signed distance to the swept link (the smallest over the link's samples) is
+        followed through the sweep; where it first crosses zero (interpolated between angle
+        steps) that fit predicts the touch, and the separation is the other fit's distance to
+        the link there, the larger of the two when both are touched, at most
+        :data:`MISS_MARGIN`; 0 when neither is touched, when the link starts inside either fit
+        (no outcome to predict) or when a distance is not finite.
+        """
+        points, rows = self._swept_rows(sweep)
+        nearest = [
+            np.asarray(PRIMITIVES[fit.name].signed_distance(fit.vector, points), dtype=float)
+            .reshape(rows, -1)
+            .min(axis=1)
+            for fit in leaders
+        ]
+        if not all(np.all(np.isfinite(d)) and d[0] >= 0.0 for d in nearest):
+            return 0.0
+        steps = np.arange(rows, dtype=float)
+        gap = 0.0
+        for own, other in ((nearest[0], nearest[1]), (nearest[1], nearest[0])):
+            inside = np.nonzero(own < 0.0)[0]
+            if inside.size:
+                k = int(inside[0])
+                touch = k - 1 + own[k - 1] / (own[k - 1] - own[k])
+                gap = max(gap, abs(float(np.interp(touch, steps, other))))
+        return min(gap, MISS_MARGIN)
 
     def _swept(self, sweep: Sweep) -> FloatArray:
-        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3); kept
-        per sweep (a candidate is followed at every choice)."""
+        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3)."""
+        return self._swept_rows(sweep)[0]
+
+    def _swept_rows(self, sweep: Sweep) -> tuple[FloatArray, int]:
+        """:meth:`_swept` and its number of angles, kept per sweep (a candidate is followed at
+        every choice)."""
         kept = self._swept_cache.get(sweep)
         if kept is None:
             base = self.scene.bases[sweep.base]
             angles = sweep.swept_angles(PREDICTION_STEP)
-            kept = np.concatenate(
+            points = np.concatenate(
                 [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
             )
+            kept = (points, len(angles))
             self._swept_cache[sweep] = kept
         return kept
 
