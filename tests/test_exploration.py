@@ -22,7 +22,12 @@ from sensing_antenna.exploration import (
     explore,
     grid_sweeps,
 )
-from sensing_antenna.exploration.plan import PREDICTION_STEP, candidate_sweeps, spread_order
+from sensing_antenna.exploration.plan import (
+    MISS_MARGIN,
+    PREDICTION_STEP,
+    candidate_sweeps,
+    spread_order,
+)
 from sensing_antenna.mapping import UNDECIDED, BasePose, ClassFit, ImplicitSurface, recognise
 from sensing_antenna.scene import (
     LinkShape,
@@ -173,6 +178,26 @@ def test_the_leaders_separation_is_what_the_sweep_would_find() -> None:
             seen.add("touched")
         assert planner.separation(sweep, enclosing) == 0.0
     assert {"neither", "touched"} <= seen
+
+
+def test_the_leaders_separation_is_bounded_by_how_far_apart_they_are() -> None:
+    # Two balls of one radius, centres 1 cm apart: no point's distances to them differ by more
+    # than 1 cm, so neither does any outcome, whichever fit comes first; balls 3 cm apart in
+    # radius are told apart by every sweep that touches them, up to the cap
+    scene = load_scene("sphere")
+    ball = scene.objects[0]
+    planner = NextBestPlanner(scene, LinkShape(DEVICE.link))
+    shifted = two_balls(ball.parameters, 0.0, 10)
+    shifted[1] = dataclasses.replace(
+        shifted[1], vector=ball.parameters + np.array([0.006, -0.008, 0.0, 0.0])
+    )
+    apart = [planner.separation(sweep, shifted) for sweep in planner.candidates]
+    assert apart == [planner.separation(sweep, shifted[::-1]) for sweep in planner.candidates]
+    assert max(apart) <= 0.01 + 1e-12
+    assert sum(0.002 < s for s in apart) > 10
+    far = two_balls(ball.parameters, 0.03, 10)
+    capped = {planner.separation(sweep, far) for sweep in planner.candidates}
+    assert capped == {0.0, MISS_MARGIN}
 
 
 @pytest.fixture(scope="module")

@@ -32,12 +32,13 @@ When recognition abstains between two leading shape classes, the planner also ai
 them apart by what each predicts the candidate will find (:meth:`NextBestPlanner.separation`):
 each fitted shape is followed through the candidate's sweep as the surface is, and where one
 predicts the touch, the other's surface is s from the link: 0 when they agree, the gap the
-link has still to close (or has passed) when one is touched later, how far the other passes
+link has still to close (or has passed) when one is touched later, the other's distance there
 when it is not touched at all, the larger of the two ways round, at most :data:`MISS_MARGIN`
-(a gap of a few cm is decisive already); 0 when neither is touched or the link starts inside
-one. The score is then sqrt(score^2 + (s / (1 + crowd))^2), and a candidate the leaders
-disagree about is never relegated as a predicted miss: a contact, or free space, where the
-leaders differ separates them; one where they agree does not.
+(a gap of a few cm is decisive already); 0 when neither is touched, when the link starts
+inside one, or when a distance is not finite. The score is then
+sqrt(score^2 + (s / (1 + crowd))^2), and a candidate the leaders disagree about is never
+relegated as a predicted miss: a contact, or free space, where the leaders differ separates
+them; one where they agree does not.
 """
 
 from __future__ import annotations
