@@ -63,6 +63,7 @@ from sensing_antenna.beam import SensingCurve, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.front.ratio import lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import touched_point
@@ -409,8 +410,8 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     if float(reaction @ direction) < 0.0:
         return None
     pushed = np.asarray(evidence.reaction_f[evidence.rest_index], dtype=float)
-    noise = float(evidence.diagnostics.get("force_noise", 0.0)) * math.sqrt(
-        0.5 * evidence.config.lowpass_cutoff * evidence.sample_period
+    noise = float(evidence.diagnostics.get("force_noise", 0.0)) * lowpass_noise_gain(
+        evidence.config.lowpass_cutoff, evidence.sample_period
     )
     error = math.hypot(noise, evidence.offset_error)
     along = float(pushed @ direction) / float(np.linalg.norm(direction))

@@ -39,6 +39,7 @@ __all__ = [
     "contact_loads",
     "converged_index",
     "filtered_contact_loads",
+    "lowpass_noise_gain",
     "paper_ratio",
     "perpendicular_ratio",
     "ratio_noise",
@@ -292,15 +293,21 @@ def converged_index(
     return start + window_samples + int(hits[0]) if hits.size else None
 
 
+def lowpass_noise_gain(cutoff: float, sample_period: float) -> float:
+    """sqrt(omega_c T_s / 2) (dimensionless): the first-order low-pass filter of Eq. 20 passes
+    white noise of standard deviation s with standard deviation s sqrt(omega_c T_s / 2) (its
+    noise bandwidth is omega_c / 4 in Hz, of the 1 / (2 T_s) Hz of the samples); omega_c in
+    rad/s, T_s in s."""
+    return float(np.sqrt(0.5 * cutoff * sample_period))
+
+
 def ratio_noise(
     force_noise: float, push_force: float, length: float, cutoff: float, sample_period: float
 ) -> float:
     """Standard deviation of the filtered ratio caused by white force noise (m).
 
-    A first-order low-pass filter (Eq. 20) passes white noise of standard deviation s with
-    standard deviation s sqrt(omega_c T_s / 2) (its noise bandwidth is omega_c / 4 in Hz, of the
-    1 / (2 T_s) Hz of the samples); the ratio x = |Gamma| / |R| then varies by x s_f / |R|, taken
-    at x = l as an upper bound.
+    The filter passes white force noise s as s :func:`lowpass_noise_gain`; the ratio
+    x = |Gamma| / |R| then varies by x s_f / |R|, taken at x = l as an upper bound.
 
     Parameters
     ----------
@@ -315,4 +322,4 @@ def ratio_noise(
     """
     if push_force <= 0.0:
         return float("inf")
-    return length * force_noise * float(np.sqrt(0.5 * cutoff * sample_period)) / push_force
+    return length * force_noise * lowpass_noise_gain(cutoff, sample_period) / push_force
