@@ -221,7 +221,7 @@ class NextBestPlanner:
         self.opening = grid_sweeps(scene)
         x = shape.abscissae
         self._samples = np.unique(np.linspace(0, len(x) - 1, _PREDICTION_SAMPLES).astype(int))
-        self._swept_cache: dict[Sweep, tuple[FloatArray, int]] = {}
+        self._swept_cache: dict[Sweep, FloatArray] = {}
 
     def choose(
         self,
@@ -246,7 +246,9 @@ class NextBestPlanner:
             return None
         free_cloud = None
         if free:
-            free_cloud = cKDTree(np.concatenate([self._swept(sweep) for sweep in free]))
+            free_cloud = cKDTree(
+                np.concatenate([self._swept(sweep).reshape(-1, 3) for sweep in free])
+            )
         best: tuple[float, Choice] | None = None
         fallback: tuple[float, Choice] | None = None
         for sweep in left:
@@ -289,9 +291,13 @@ class NextBestPlanner:
         :data:`MISS_MARGIN`; 0 when neither is touched, when the link starts inside either fit
         (no outcome to predict) or when a distance is not finite.
         """
-        points, rows = self._swept_rows(sweep)
+        points = self._swept(sweep)
+        rows = len(points)
         nearest = [
-            np.asarray(PRIMITIVES[fit.name].signed_distance(fit.vector, points), dtype=float)
+            np.asarray(
+                PRIMITIVES[fit.name].signed_distance(fit.vector, points.reshape(-1, 3)),
+                dtype=float,
+            )
             .reshape(rows, -1)
             .min(axis=1)
             for fit in leaders
@@ -309,33 +315,28 @@ class NextBestPlanner:
         return min(gap, MISS_MARGIN)
 
     def _swept(self, sweep: Sweep) -> FloatArray:
-        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (m, 3)."""
-        return self._swept_rows(sweep)[0]
-
-    def _swept_rows(self, sweep: Sweep) -> tuple[FloatArray, int]:
-        """:meth:`_swept` and its number of angles, kept per sweep (a candidate is followed at
-        every choice)."""
+        """The link's samples over the sweep, every :data:`PREDICTION_STEP`, shape (angles,
+        samples, 3) (m); kept per sweep, as a candidate is followed at every choice."""
         kept = self._swept_cache.get(sweep)
         if kept is None:
             base = self.scene.bases[sweep.base]
-            angles = sweep.swept_angles(PREDICTION_STEP)
-            points = np.concatenate(
-                [self.shape.points(sweep.angles(float(a)), base)[self._samples] for a in angles]
+            kept = np.stack(
+                [
+                    self.shape.points(sweep.angles(float(a)), base)[self._samples]
+                    for a in sweep.swept_angles(PREDICTION_STEP)
+                ]
             )
-            kept = (points, len(angles))
             self._swept_cache[sweep] = kept
         return kept
 
     def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:
         """The predicted touch point (m) and the smallest f met (m; <= 0 when it touches)."""
-        angles = sweep.swept_angles(PREDICTION_STEP)
         points = self._swept(sweep)
-        values = np.asarray(surface.predict(points)).reshape(len(angles), -1)
+        values = np.asarray(surface.predict(points.reshape(-1, 3))).reshape(points.shape[:2])
         inside = np.nonzero((values < 0).any(axis=1))[0]
         if inside.size:
             row = int(inside[0])
             column = int(np.argmin(values[row]))
-            return points.reshape(len(angles), -1, 3)[row, column], float(values[row, column])
-        flat = int(np.argmin(values))
-        row, column = divmod(flat, values.shape[1])
-        return points.reshape(len(angles), -1, 3)[row, column], float(values[row, column])
+        else:
+            row, column = divmod(int(np.argmin(values)), points.shape[1])
+        return points[row, column], float(values[row, column])
