@@ -16,9 +16,8 @@ angular extent seen from it, widened by 0.05 rad, the elevations shifted by the 
 each point's distance; the grid has, per base, ``--sweeps`` elevations each swept both ways
 (azimuthal sweeps towards +Y^m and back towards -Y^m, which touch opposite sides of the
 outline) and as many vertical sweeps (up and down in turn): 3 (2 x 4 + 4) = 36 sweeps by
-default, as many
-as the one-way grid of 6 azimuthal and 6 vertical sweeps per base, so that the contacts stay
-below 40 per object.
+default, as many as the one-way grid of 6 azimuthal and 6 vertical sweeps per base, so that the
+contacts stay below 40 per object.
 
 Each scene is explored twice with ``exploration.explore`` (every sweep simulated: first touch,
 contact physics, recording, estimate with ``--method``), once per strategy with the grid's size
