@@ -141,13 +141,17 @@ class EstimatorConfig:
         Coefficient of the uncertainty a push's deflection adds to a contact point read from
         the vibration, factor (y_c / x_c)^2 x_c (``Evidence.bent_link_uncertainty``): the
         sensing curves are the straight link's, and the preload of the bent link shifts the
-        frequencies at second order. 0.6 bounds what the rod recordings show (0.8 cm at
-        22 % deflection, x_c = 0.3 m, against 1.0 cm) and adds 0.5 mm at the default gentle
-        push. The paper method charges it, at two standard deviations, to the status of a
-        frequency read in the push plane alone (``max_model_spread``); beyond
-        ``max_model_spread`` itself it makes every answer read from the vibration ``uncertain``,
-        in whichever plane (the plausibility layer); a push plane that rings apart from the free
-        one is judged by the ratio (:mod:`~sensing_antenna.estimation.methods.paper.planes`).
+        frequencies at second order (and, where friction holds the contact along the bent
+        link, at first order in the push). 0.6 bounds what the rod recordings show at a hard
+        push (0.8 cm at 22 % deflection, x_c = 0.3 m, against 1.0 cm); at their default push
+        (8 to 10 %) the rod's contacts at 0.6 to 0.9 m lie 1.3 of it away (rms). The fast
+        method's posterior carries it as the frequency's standard uncertainty at every x_c. The
+        paper method charges it, at two standard deviations, to the status of a frequency read
+        in the push plane alone (``max_model_spread``); beyond ``max_model_spread`` itself it
+        makes every answer read from the vibration ``uncertain``, in whichever plane (the
+        plausibility layer); a push plane that rings apart from the free one is judged by the
+        ratio (:mod:`~sensing_antenna.estimation.methods.paper.planes`). 0: a link whose
+        frequencies do not move with the push (the simulator's linear link).
     omega2_window : float
         Relative half-width of the search window around each candidate's predicted omega_2;
         0.05 is a quarter of the 20 % gap between the candidates' omega_2 at the curve's top.
@@ -263,6 +267,12 @@ class EstimatorConfig:
                 if not (0.0 <= low < high <= 1.0):
                     raise EstimatorConfigError(
                         f"contact_range: must satisfy 0 <= min < max <= 1, got {value!r}"
+                    )
+                continue
+            if f.name == "bent_link_factor":
+                if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                    raise EstimatorConfigError(
+                        f"{f.name}: must be a finite number >= 0, got {value!r}"
                     )
                 continue
             if f.name in ("zero_padding", "max_gap"):

@@ -322,8 +322,8 @@ class Evidence:
         loads it along its bent axis (the reaction tilts with the link's slope), which shifts
         its contact frequencies at second order in the deflection: on the rod recordings a
         push deflecting the contact by 22 % of x_c = 0.30 m put the frequency's candidate
-        0.8 cm from the contact (d = 0.24: 0.6 d^2 x_c = 1.0 cm). Negligible at gentle pushes
-        (0.5 mm at d = 0.03, x_c = 1 m).
+        0.8 cm from the contact (d = 0.24: 0.6 d^2 x_c = 1.0 cm). Small at gentle pushes
+        (0.5 mm at d = 0.03, x_c = 1 m); 2 mm at the default push at 0.6 m (d = 0.075).
         """
         if not math.isfinite(x_c):
             return math.inf

@@ -134,6 +134,7 @@ def contact_posterior(
     omega_higher: float = math.nan,
     omega_higher_se: float = math.nan,
     higher_mode_floor: float = 0.0,
+    frequency_model: float | FloatArray = 0.0,
 ) -> ContactPosterior:
     """Posterior over x_c on ``grid`` from omega_1 and the torque/force ratio.
 
@@ -161,6 +162,10 @@ def contact_posterior(
         Measured higher mode and its statistical standard error (rad/s); NaN: not measured.
     higher_mode_floor : float
         Relative model error of the higher modes (dimensionless).
+    frequency_model : float or array, shape (G,)
+        The sensing curve's own standard uncertainty of omega_1 at each grid point (rad/s), in
+        quadrature with the floor: what the straight link's curve leaves out at the hold's push
+        (the bent link's shift); 0: none.
 
     Returns
     -------
@@ -168,9 +173,14 @@ def contact_posterior(
     """
     log_like = np.zeros(grid.shape)
     if math.isfinite(omega1) and math.isfinite(omega1_se):
-        # Gaussian likelihood of omega_1 through the forward sensing curve, floor in quadrature
-        sigma_w = math.sqrt(omega1_se**2 + (frequency_floor * omega1) ** 2)
+        # Gaussian likelihood of omega_1 through the forward sensing curve, the floor and the
+        # curve's own term in quadrature; a sigma that varies along the grid brings its norm
+        sigma_w = np.sqrt(
+            omega1_se**2 + (frequency_floor * omega1) ** 2 + np.square(frequency_model)
+        )
         log_like += -0.5 * ((omega1 - omega1_of_x) / sigma_w) ** 2
+        if np.ndim(sigma_w):
+            log_like -= np.log(sigma_w)
     if math.isfinite(ratio) and math.isfinite(ratio_se):
         sigma_r = np.sqrt(ratio_se**2 + np.square(ratio_model)) * np.ones(grid.shape)
         log_like += -0.5 * ((ratio - grid) / sigma_r) ** 2 - np.log(sigma_r)

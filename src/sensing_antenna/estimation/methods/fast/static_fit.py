@@ -191,9 +191,9 @@ class StaticsModel:
         point: the sensing curves are the straight link's, and the bent link's preload shifts
         its frequencies; the front end's uncertainty of a contact point read from the vibration
         (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`),
-        times the curve's slope there. As for the paper method's candidate, it enters the
-        frequency's consistency with the answer (:func:`.checks.frequency_check`), not the
-        posterior: an upper bound of a shift measured at one point. None: none.
+        times the curve's slope there. It enters the posterior's likelihood of omega_1 and
+        the frequency's consistency with the answer (:func:`.checks.frequency_check`), as
+        the paper method's candidate carries it. None: none.
     push_direction : array, shape (2,), optional
         The hold's reaction across the link, (R_y, R_z) in the motor frame (N): which plane is
         the push's, so that the fundamental is read in the free plane when it rings

@@ -243,7 +243,6 @@ def evaluate_window(
     ratio = statics.ratio if statics is not None else math.nan
     ratio_se = statics.standard_error if statics is not None else math.nan
     push_force = statics.perpendicular_force if statics is not None else 0.0
-    model_sd = statics_model.model_sd
     posterior = contact_posterior(
         table.omega1,
         table.grid,
@@ -252,12 +251,13 @@ def evaluate_window(
         omega1_se,
         ratio,
         ratio_se,
-        model_sd if model_sd is not None and model_sd.shape == table.grid.shape else 0.0,
+        _on_grid(statics_model.model_sd, table.grid),
         frequency_floor,
         higher_modes_of_x=table.higher,
         omega_higher=omega_h,
         omega_higher_se=omega_h_se,
         higher_mode_floor=config.higher_mode_floor,
+        frequency_model=_on_grid(statics_model.omega1_sd, table.grid),
     )
     chosen = False
     second_mode: dict[str, Any] = {}
@@ -334,6 +334,11 @@ def evaluate_window(
         branch_chosen_by_second_mode=chosen,
         second_mode=second_mode,
     )
+
+
+def _on_grid(values: FloatArray | None, grid: FloatArray) -> float | FloatArray:
+    """``values`` given at every point of ``grid``, else 0 (no term)."""
+    return values if values is not None and values.shape == grid.shape else 0.0
 
 
 def _omega1_sigma(
