@@ -683,9 +683,7 @@ def test_second_mode_chooses_the_branch_near_the_peak() -> None:
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.75, seed=3))
     truth = float(recording.metadata["true_xc"])
     blind = recording.without_ground_truth()
-    at_cap = estimate(
-        blind, antenna, FastMethod(FastConfig(branch_by_second_mode=False)), STRAIGHT
-    )
+    at_cap = estimate(blind, antenna, FastMethod(FastConfig(branch_by_second_mode=False)), STRAIGHT)
     early = estimate(blind, antenna, FastMethod(), STRAIGHT)
     assert at_cap.status is Status.OK and early.status is Status.OK
     assert early.t_e - early.t_1 < 0.5 * (at_cap.t_e - at_cap.t_1)
@@ -939,9 +937,7 @@ def test_windows_started_warm_declare_what_windows_started_from_the_pencil_decla
     # the two starts may settle on different model orders, here 3 modes warm and 2 from the
     # pencil (the third mode's evidence is marginal, the torque about X^m carrying no ringing),
     # and differ by 0.47 of it.
-    cold = estimate(
-        azimuthal, calibrated(), FastMethod(FastConfig(warm_start_after=0.0)), STRAIGHT
-    )
+    cold = estimate(azimuthal, calibrated(), FastMethod(FastConfig(warm_start_after=0.0)), STRAIGHT)
     warm = azimuthal_estimate
     truth = float(azimuthal.metadata["true_xc"])
     assert warm.omega1 != cold.omega1

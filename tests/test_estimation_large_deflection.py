@@ -50,7 +50,9 @@ def test_a_push_of_a_third_of_x_c_is_right_and_says_the_bent_link_is_unknown(nam
     assert result.diagnostics["deflection_ratio"] > 0.25
 
 
-@pytest.mark.parametrize("name", ["xc060-push003", "xc070-push003", "xc080-push003", "xc090-push003"])
+@pytest.mark.parametrize(
+    "name", ["xc060-push003", "xc070-push003", "xc080-push003", "xc090-push003"]
+)
 def test_the_fast_interval_holds_the_rods_contact_at_the_default_push(name: str) -> None:
     # The default push bends the rod by 8 to 10 % of x_c, and at 0.6 to 0.9 m its contact rings
     # 0.4 to 1.7 % off the straight link's sensing curve (friction holds the contact along the
