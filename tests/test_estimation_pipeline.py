@@ -393,6 +393,14 @@ def test_t1_source_is_validated() -> None:
         EstimatorConfig(t1_source="later")  # type: ignore[arg-type]
 
 
+def test_the_bent_link_factor_may_be_zero_but_not_negative() -> None:
+    # 0: a link whose frequencies do not move with the push
+    assert EstimatorConfig(bent_link_factor=0.0).bent_link_factor == 0.0
+    for bad in (-0.1, math.nan, math.inf):
+        with pytest.raises(EstimatorConfigError, match=r"bent_link_factor: must be a finite"):
+            EstimatorConfig(bent_link_factor=bad)
+
+
 def _simulated(case: str) -> Recording:
     """A simulated manoeuvre (the project's simulator, an independent source of samples)."""
     x_c, seed = (0.45, 7) if case == "azimuthal" else (0.8, 8)

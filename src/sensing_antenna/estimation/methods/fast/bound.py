@@ -7,8 +7,8 @@ residual noise) and no model floors, every other check ignored (the pipeline's h
 periods in the window, the drift, the ratio's agreement, the peak margin): the earliest instant
 at which the record's fundamental and torque/force ratio could give an interval that narrow to
 an efficient estimator that trusted the linear model completely. The method's own interval
-adds the model floors and the fit's drift to the same windows, and its declaration waits for the
-checks and the hold as well.
+adds the model floors, the bent link's term and the fit's drift to the same windows, and its
+declaration waits for the checks and the hold as well.
 
 :func:`bound_width` is that interval's width for one window, :func:`bound_delay` the bound
 instant of a manoeuvre, as t - t_1.
