@@ -20,28 +20,27 @@ default, as many as the one-way grid of 6 azimuthal and 6 vertical sweeps per ba
 contacts stay below 40 per object.
 
 Each scene is explored twice with ``exploration.explore`` (every sweep simulated: first touch,
-contact physics, recording, estimate with ``--method``), once per strategy with the grid's size
-as the budget, on the calibrated antenna of one calibration (the README's five posts, made once
-and copied into each run's directory), with the simulator's geometrically exact link
-(``--link linear``: the small-deflection one). Per scene and strategy: the contacts (sweeps that
-touched), the points used (status ok), the RMS and largest distance of the points to the true
-surface, the RMS of the fitted surface to the true one near the points (mesh vertices within
-1 cm of a contact), a Chamfer distance between that surface and the true surface's patch near
-the points, and the whole object's RMS distance to the fitted surface with the fraction of its
-area within 5 mm of it (a map that never touched a side is far from it there), after every 3
-sweeps and at the end; the contacts each strategy needs to bring the whole object's RMS to 5 mm
-(the two strategies compared scene by scene on it); the recognition
-(right, abstained, confidently wrong) and the size error of the true class's fit, the
-Mahalanobis distance of each ``ok`` point's true contact point under its covariance, how far
-the true object disagrees with the swept links recognition weighs (its residual per free sweep
-and per touching link, the worst and the count beyond 2: swept links the truth contradicts
-would refute the right class), and the simulated sweeping time. Prints a table and writes
-``benchmarks/results/explore.json`` after every exploration (a run stopped early keeps the
-scenes it finished). ``--keep DIR`` keeps each
-exploration's directory there (its recordings and points, for ``antenna map``); an exploration
-already there is resumed, and a finished one re-scored: its map rebuilt with the current code
-from its stored points (exact for the grid, whose sweeps do not depend on the map; next-best's
-were chosen by the code that ran them), ``resumed`` in its row, ``run_s`` the re-score's time.
+contact physics, recording, estimate with ``--method``), once per strategy with the grid's size as
+the budget, on the antenna of one preparation (the observer identified on free sweeps, then the
+README's five posts; made once and copied into each run's directory), with the simulator's
+geometrically exact link (``--link linear``: the small-deflection one). Per scene and strategy: the
+contacts (sweeps that touched), the points used (status ok), the RMS and largest distance of the
+points to the true surface, the RMS of the fitted surface to the true one near the points (mesh
+vertices within 1 cm of a contact), a Chamfer distance between that surface and the true surface's
+patch near the points, and the whole object's RMS distance to the fitted surface with the fraction
+of its area within 5 mm of it (a map that never touched a side is far from it there), after every 3
+sweeps and at the end; the contacts each strategy needs to bring the whole object's RMS to 5 mm (the
+two strategies compared scene by scene on it); the recognition (right, abstained, confidently wrong)
+and the size error of the true class's fit, the Mahalanobis distance of each ``ok`` point's true
+contact point under its covariance, how far the true object disagrees with the swept links
+recognition weighs (its residual per free sweep and per touching link, the worst and the count
+beyond 2: swept links the truth contradicts would refute the right class), and the simulated
+sweeping time. Prints a table and writes ``benchmarks/results/explore.json`` after every exploration
+(a run stopped early keeps the scenes it finished). ``--keep DIR`` keeps each exploration's
+directory there (its recordings and points, for ``antenna map``); an exploration already there is
+resumed, and a finished one re-scored: its map rebuilt with the current code from its stored points
+(exact for the grid, whose sweeps do not depend on the map; next-best's were chosen by the code that
+ran them), ``resumed`` in its row, ``run_s`` the re-score's time.
 
 Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 4] [--bases 3]
 [--strategies grid next-best] [--method fast] [--link nonlinear] [--seed 0] [--out FILE]
@@ -72,7 +71,7 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
-from sensing_antenna.exploration import ExploreSettings, calibrate_device, explore  # noqa: E402
+from sensing_antenna.exploration import ExploreSettings, explore, prepare_device  # noqa: E402
 from sensing_antenna.exploration.run import swept_links  # noqa: E402
 from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
 from sensing_antenna.mapping import PRIMITIVES, UNDECIDED, BasePose  # noqa: E402
@@ -504,7 +503,7 @@ def main() -> None:
         workdir = Path(folder) if args.keep is None else args.keep
         workdir.mkdir(parents=True, exist_ok=True)
         calibrated = workdir / "calibrated.toml"
-        calibrated.write_text(antenna_to_toml(calibrate_device(device, link=args.link)))
+        calibrated.write_text(antenna_to_toml(prepare_device(device, link=args.link)))
         for index in range(args.first, args.first + args.scenes):
             scene, info = make_scene(
                 index, args.seed, args.sweeps, shape, args.bases, args.sight, args.distance

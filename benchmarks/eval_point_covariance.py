@@ -9,7 +9,8 @@ Mahalanobis distance of the simulator's true contact point under the point's cov
 a 90th percentile of 2.50, the chi distribution's with 3 degrees of freedom), and the error's
 parts along the link X^m, along the push across it, across the bending plane and along the
 touched surface's normal, each with the covariance's standard deviation in that direction.
-Each link is calibrated on itself (the README's five posts).
+Each link is prepared on itself as ``antenna explore`` prepares it (the observer identified on
+free sweeps, then the README's five posts).
 
 The linear link is linear in its deflection: its points do not move along X^m (docs/simulator.md),
 while a real link, inextensible, shortens by delta = x_c - p . X^m as it bends, about 3 y_c^2 /
@@ -38,7 +39,8 @@ import numpy as np  # noqa: E402
 from eval_explore import make_scene  # noqa: E402
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
-from sensing_antenna.exploration import calibrate_device, grid_sweeps  # noqa: E402
+from sensing_antenna.exploration import grid_sweeps, prepare_device  # noqa: E402
+from sensing_antenna.exploration.run import controlled_device  # noqa: E402
 from sensing_antenna.mapping import (  # noqa: E402
     BasePose,
     PointUncertainty,
@@ -132,15 +134,17 @@ def main() -> None:
     args = parser.parse_args()
     device = paper_antenna()
     shape = LinkShape(device.link)
-    # each link calibrated on itself, as a device is calibrated before it measures
-    antennas = {link: calibrate_device(device, link=link) for link in LINKS}
+    # each link prepared on itself (observer identified, T_e calibrated), as a device is
+    # prepared before it measures; the device's controller detects with what was identified
+    antennas = {link: prepare_device(device, link=link) for link in LINKS}
+    devices = {link: controlled_device(device, antennas[link]) for link in LINKS}
     rows: dict[str, list[dict[str, float]]] = {link: [] for link in LINKS}
     for index in range(args.scenes):
         scene, _ = make_scene(index, args.seed, 6, shape, 3)
         for k, sweep in enumerate(grid_sweeps(scene)):
             for link in LINKS:
                 outcome = simulate_sweep(
-                    device, scene, sweep, seed=args.seed + k, shape=shape, link_model=link
+                    devices[link], scene, sweep, seed=args.seed + k, shape=shape, link_model=link
                 )
                 if outcome.recording is None:
                     continue

@@ -17,8 +17,8 @@ from sensing_antenna.exploration.run import (
     Exploration,
     ExplorationInterrupted,
     ExploreSettings,
-    calibrate_device,
     explore,
+    prepare_device,
 )
 from sensing_antenna.exploration.store import ExplorationStoreError, Manoeuvre
 
@@ -30,8 +30,8 @@ __all__ = [
     "ExploreSettings",
     "Manoeuvre",
     "NextBestPlanner",
-    "calibrate_device",
     "candidate_sweeps",
     "explore",
     "grid_sweeps",
+    "prepare_device",
 ]

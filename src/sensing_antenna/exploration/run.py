@@ -3,11 +3,14 @@
 The device's job as the paper's algorithm states it (Section 4: sweep, contact, push, estimate,
 retract, re-plan), on the simulator:
 
-1. **Calibrate** (once per output directory), as the README does for a real device before it
-   measures: five sweeps into posts at known x_c (0.3 to 0.9 m), ``calibrate_from_recordings``,
-   the calibrated antenna written to ``calibrated.toml``; the estimators use it, the simulator
-   the device. The simulated link is the settings' ``link``, the geometrically exact one by
-   default, for the calibration and every sweep alike.
+1. **Prepare** (once per output directory), as the README does for a real device before it
+   measures: the free-motion observer (Eq. 15) and contact threshold identified on a free
+   sweep of each joint (``identify_free_motion``), then five sweeps into posts at known x_c
+   (0.3 to 0.9 m) and ``calibrate_from_recordings``; the identified and calibrated antenna is
+   written to ``calibrated.toml``. The estimators use it; the simulated device keeps its own
+   link and takes the identified observer and threshold for its controller, as a lab's head
+   does (``campaign.simulated.knowing_weight``). The simulated link is the settings' ``link``,
+   the geometrically exact one by default, for the preparation and every sweep alike.
 2. **Each manoeuvre**: the planner (``exploration.plan``: ``grid`` or ``next-best``) picks a
    sweep; ``scene.simulate_sweep`` finds its first touch and simulates it; the recording is
    written (its ``base_pose`` says where it was taken) and estimated by the map's own code path
@@ -33,7 +36,7 @@ import hashlib
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -99,8 +102,8 @@ __all__ = [
     "Exploration",
     "ExplorationInterrupted",
     "ExploreSettings",
-    "calibrate_device",
     "explore",
+    "prepare_device",
     "swept_links",
 ]
 
@@ -109,6 +112,12 @@ CALIBRATION_POINTS = (0.3, 0.45, 0.6, 0.75, 0.9)
 
 #: The calibration manoeuvres' seeds start here (the README's).
 CALIBRATION_SEED = 10
+
+#: The free sweeps the observer is identified on (one of each joint), their length (s) and
+#: their first seed.
+FREE_MOTION_CASES = ("free", "free-vertical")
+FREE_MOTION_DURATION = 4.0
+FREE_MOTION_SEED = 20
 
 #: The next-best strategy recognises the points so far before every this many manoeuvres, to
 #: aim at the two leading classes when recognition abstains (a recognition takes seconds).
@@ -217,36 +226,64 @@ class Exploration:
         }
 
 
-def calibrate_device(
-    device: Antenna, folder: Path | None = None, link: str = "nonlinear"
-) -> Antenna:
-    """The README's calibration on the simulated device: posts at :data:`CALIBRATION_POINTS`
-    (seeds from :data:`CALIBRATION_SEED`) with the simulator's ``link`` model, T_e fitted by
-    ``calibrate_from_recordings``; the recordings are written into ``folder`` when given."""
+def prepare_device(device: Antenna, folder: Path | None = None, link: str = "nonlinear") -> Antenna:
+    """The README's preparation of the simulated ``device``, with the simulator's ``link``
+    model: the observer and contact threshold identified on :data:`FREE_MOTION_CASES` (seeds
+    from :data:`FREE_MOTION_SEED`), then T_e calibrated on posts at
+    :data:`CALIBRATION_POINTS` (seeds from :data:`CALIBRATION_SEED`) touched by the device with
+    that observer; every recording is written into ``folder`` when given.
+
+    Returns
+    -------
+    Antenna
+        ``device`` as the estimators know it: identified observer and payload, calibrated T_e.
+    """
     from sensing_antenna.calibration.frequency import calibrate_from_recordings
+    from sensing_antenna.calibration.observer import identify_free_motion
     from sensing_antenna.simulator import Scenario, simulate
 
-    runs = [
+    free = [
         simulate(
             device,
+            Scenario(case=case, seed=seed, duration=FREE_MOTION_DURATION, link_model=link),  # type: ignore[arg-type]
+        )
+        for seed, case in enumerate(FREE_MOTION_CASES, start=FREE_MOTION_SEED)
+    ]
+    fit = identify_free_motion([run.without_ground_truth() for run in free], device)
+    model = replace(device, observer=fit.observer)
+    if fit.payload is not None:
+        model = fit.payload.apply(model)
+    runs = [
+        simulate(
+            controlled_device(device, model),
             Scenario(case="azimuthal", contact_point=x, seed=seed, link_model=link),  # type: ignore[arg-type]
         )
         for seed, x in enumerate(CALIBRATION_POINTS, start=CALIBRATION_SEED)
     ]
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
+        for case, run in zip(FREE_MOTION_CASES, free, strict=True):
+            write_recording(run, folder / f"{case}.csv")
         for x, run in zip(CALIBRATION_POINTS, runs, strict=True):
             write_recording(run, folder / f"post-{x:.2f}.csv")
     points = [float(run.metadata["true_xc"]) for run in runs]
-    return calibrate_from_recordings(runs, device, points).apply(device)
+    return calibrate_from_recordings(runs, model, points).apply(model)
+
+
+def controlled_device(device: Antenna, model: Antenna) -> Antenna:
+    """The simulated ``device`` whose controller detects and pushes with what the preparation
+    found (``model``'s observer, threshold and weight); its physics stays the device's."""
+    from sensing_antenna.campaign.simulated import knowing_weight
+
+    return knowing_weight(device, model)
 
 
 def _prepared(device: Antenna, out: Path, link: str) -> Antenna:
     path = out / CALIBRATED_FILE
     if path.is_file():
         return load_antenna(path)
-    calibrated = calibrate_device(device, out / "calibration", link)
-    atomic_write_text(path, antenna_to_toml(calibrated))
+    prepared = prepare_device(device, out / "calibration", link)
+    atomic_write_text(path, antenna_to_toml(prepared))
     return load_antenna(path)
 
 
@@ -341,6 +378,7 @@ def explore(
         try:
             antenna = _prepared(device, out, settings.link)
             shape = LinkShape(device.link)
+            controlled = controlled_device(device, antenna)
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
             leaders: tuple[ClassFit, ...] = ()
             while len(manoeuvres) < budget:
@@ -363,7 +401,9 @@ def explore(
                     )
                 if choice is None:
                     break
-                manoeuvre = _run_one(scene, device, antenna, shape, choice, index, settings, out)
+                manoeuvre = _run_one(
+                    scene, controlled, antenna, shape, choice, index, settings, out
+                )
                 write_manoeuvre(out, manoeuvre)
                 manoeuvres.append(manoeuvre)
                 if progress is not None:
