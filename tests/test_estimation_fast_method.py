@@ -83,6 +83,10 @@ EDGES = (X_RANGE[0], *CURVE.extrema, X_RANGE[1])
 #: pushed; the tests of the search's mechanics estimate its recordings without the bent link's
 #: term (``bent_link_factor``), which would otherwise hold most of them to the cap.
 STRAIGHT = EstimatorConfig(bent_link_factor=0.0)
+#: That link's contact is a pinned spring with no load along the link, and it rings on the
+#: sensing curve to 0.1 %, as the synthetic rings do exactly: the tests of the search's branch
+#: logic use that floor, not the default's allowance for how a physical contact holds the link.
+ON_CURVE = FastConfig(frequency_floor=0.001)
 
 
 def _posterior(omega: float, omega_se: float, ratio: float, ratio_se: float) -> Any:
@@ -332,9 +336,11 @@ def test_a_higher_mode_of_the_other_branch_stops_a_declaration() -> None:
     clean = np.column_stack([r_y, zeros, zeros, zeros, 0.854 * r_y])
     noise = np.array([6e-3, 6e-3, 3e-5, 3e-5, 3e-5]) * rng.standard_normal((n, 5))
     inputs = ScanInputs(
-        clean + noise, NO_BIAS, 0, n - 1, TS, BAND, LINK, X_RANGE, FastConfig(cadence=0.02)
+        clean + noise, NO_BIAS, 0, n - 1, TS, BAND, LINK, X_RANGE, replace(ON_CURVE, cadence=0.02)
     )
-    unchecked = scan(inputs._replace(config=FastConfig(cadence=0.02, branch_mode_tolerance=1e3)))
+    unchecked = scan(
+        inputs._replace(config=replace(ON_CURVE, cadence=0.02, branch_mode_tolerance=1e3))
+    )
     assert unchecked.final is not None and unchecked.final.sure
     assert unchecked.final.posterior.x_c == pytest.approx(0.854, abs=0.005)
     checked = scan(inputs)
@@ -353,7 +359,7 @@ def test_a_fundamental_read_above_the_top_of_the_curve_is_not_declared() -> None
     top = float(CURVE.omega1(CURVE.extrema[0]))
     rng = np.random.default_rng(3)
     channels = _channels(0.80, 301, rng, 0.2, omega=1.005 * top)
-    config = FastConfig(tolerance=0.01)
+    config = replace(ON_CURVE, tolerance=0.01)
     grid = curve_table(LINK, X_RANGE[0], X_RANGE[1], config.grid_step).grid
     model = StaticsModel(None, grid, np.full(grid.shape, 0.05))
     args = (channels, NO_BIAS, 0, 300, TS, BAND, LINK, X_RANGE, config)
@@ -526,7 +532,7 @@ def test_a_window_whose_posterior_holds_two_branches_asks_the_second_mode() -> N
     x = 0.9
     channels = _channels(x, 600, rng, 0.2)
     loose = SensorBias(np.zeros(5), np.diag([0.0, 0.0, 6.4e-5, 6.4e-5, 6.4e-5]), 1000)
-    cfg = FastConfig()
+    cfg = ON_CURVE
     asked: list[tuple[int, int, tuple[float, ...]]] = []
 
     def right(
@@ -704,8 +710,8 @@ def test_at_the_cap_an_interval_within_cap_tolerance_answers() -> None:
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.8, seed=2))
     truth = float(recording.metadata["true_xc"])
     blind = recording.without_ground_truth()
-    answered = estimate(blind, antenna, FastMethod(), STRAIGHT)
-    held = estimate(blind, antenna, FastMethod(FastConfig(cap_tolerance=0.005)), STRAIGHT)
+    answered = estimate(blind, antenna, FastMethod(ON_CURVE), STRAIGHT)
+    held = estimate(blind, antenna, FastMethod(replace(ON_CURVE, cap_tolerance=0.005)), STRAIGHT)
     assert held.status is Status.UNCERTAIN and "interval" in (held.reason or "")
     assert answered.status is Status.OK and answered.reason is None
     assert answered.t_e - answered.t_1 == pytest.approx(FastConfig().cap, abs=0.01)
@@ -729,8 +735,10 @@ def test_second_mode_chooses_the_branch_near_the_peak() -> None:
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.75, seed=3))
     truth = float(recording.metadata["true_xc"])
     blind = recording.without_ground_truth()
-    at_cap = estimate(blind, antenna, FastMethod(FastConfig(branch_by_second_mode=False)), STRAIGHT)
-    early = estimate(blind, antenna, FastMethod(), STRAIGHT)
+    at_cap = estimate(
+        blind, antenna, FastMethod(replace(ON_CURVE, branch_by_second_mode=False)), STRAIGHT
+    )
+    early = estimate(blind, antenna, FastMethod(ON_CURVE), STRAIGHT)
     assert at_cap.status is Status.OK and early.status is Status.OK
     assert early.t_e - early.t_1 < 0.5 * (at_cap.t_e - at_cap.t_1)
     for result in (at_cap, early):
@@ -770,21 +778,21 @@ def test_the_second_mode_declares_a_noisy_far_contact_online_as_offline(
     # gives the same estimate, since the chooser reads only the samples up to the window's end.
     evidence = _evidence(noisy_far)
     caches: Any = ({}, {})  # the two settings differ in their checks only: one set of fits
-    at_cap = FastMethod(FastConfig(branch_by_second_mode=False)).conclude(evidence, caches)
+    at_cap = FastMethod(replace(ON_CURVE, branch_by_second_mode=False)).conclude(evidence, caches)
     assert at_cap.status is Status.UNCERTAIN and at_cap.t_e - at_cap.t_1 >= 0.99
-    offline = FastMethod().conclude(evidence, caches)
+    offline = FastMethod(ON_CURVE).conclude(evidence, caches)
     assert offline.status is Status.OK
     assert offline.diagnostics["branch_chosen_by"] == "omega2"
     assert offline.t_e - offline.t_1 < 0.4
     assert offline.x_c == pytest.approx(0.9, abs=FastConfig().tolerance / 2)
-    streamed = _online(noisy_far, FastMethod())
+    streamed = _online(noisy_far, FastMethod(ON_CURVE))
     assert (streamed.status, streamed.x_c, streamed.t_e) == (
         offline.status,
         offline.x_c,
         offline.t_e,
     )
     # The study form holds the declared window, chosen there by the second mode
-    history = FastMethod(FastConfig(cap=offline.t_e - offline.t_1)).history(evidence)
+    history = FastMethod(replace(ON_CURVE, cap=offline.t_e - offline.t_1)).history(evidence)
     declared = next(w for w in history if w.sure)
     assert declared.branch_chosen_by_second_mode
     assert evidence.t[declared.end_index] == offline.t_e

@@ -215,7 +215,7 @@ class FastConfig:
     max_modes: int = 3
     min_mode_fraction: float = 0.6
     polynomial_degree: int = 4
-    frequency_floor: float = 0.001
+    frequency_floor: float = 0.003
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
     bias_guard: float = 0.05
