@@ -94,11 +94,12 @@ class FastConfig:
         chooses a lower degree.
     frequency_floor : float
         Relative model error of omega_1 added in quadrature (dimensionless): how well T (or
-        T_e) and the sensing curve predict the frequency. 0.001: the agreement of the link's
-        sensing curve with the frequencies of the finite-element simulator with a compliant
-        contact. A link whose own frequency uncertainty is larger (``Link.frequency_uncertainty``:
-        its calibration's scatter, or the spread of a nominal T when not calibrated) uses that
-        instead (:func:`model_floor`).
+        T_e) and the sensing curve predict the frequency. 0.003: how far a physical contact
+        lets a gently pushed link ring off the pinned sensing curve (friction, the reaction's
+        tilt, the post's radius), which a calibration on one kind of post does not see
+        (docs/fast.md, "Posterior and floors"). A link whose own frequency uncertainty is larger
+        (``Link.frequency_uncertainty``: its calibration's scatter, or the spread of a nominal
+        T when not calibrated) uses that instead (:func:`model_floor`).
     grid_step : float
         Spacing of the x_c grid of the posterior (m). 0.25 mm, a twentieth of the tolerance.
     bias_min_samples : int
