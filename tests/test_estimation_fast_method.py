@@ -224,6 +224,45 @@ def test_a_model_term_the_same_everywhere_adds_to_the_standard_error_in_quadratu
     assert with_term.interval == pytest.approx(pooled.interval, abs=step)
 
 
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("frequency_model", math.nan),
+        ("frequency_model", math.inf),
+        ("frequency_model", -0.1),
+        ("ratio_model", math.nan),
+        ("ratio_model", -0.1),
+    ],
+)
+def test_a_model_term_that_is_not_a_standard_deviation_is_refused(name: str, value: float) -> None:
+    # A NaN term would make the density NaN and the answer the grid's first point, silently
+    term = np.full(GRID.shape, 0.4)
+    term[100] = value
+    terms = {"ratio_model": 0.0, "frequency_model": 0.0, name: term}
+    with pytest.raises(ValueError, match=name):
+        contact_posterior(
+            OMEGA_GRID,
+            GRID,
+            EDGES,
+            float(CURVE.omega1(0.55)),
+            0.3,
+            0.56,
+            0.02,
+            frequency_floor=0.0,
+            **terms,
+        )
+
+
+def test_an_infinite_ratio_term_leaves_the_ratio_out() -> None:
+    # No push to read the ratio by: the frequency alone, both branches of omega_1 open
+    omega = float(CURVE.omega1(0.9))
+    args = (OMEGA_GRID, GRID, EDGES, omega, 0.3, 0.9, 0.02)
+    blind = contact_posterior(*args, np.full(GRID.shape, np.inf), 0.0)
+    alone = contact_posterior(*args[:5], math.nan, math.nan, 0.0, 0.0)
+    np.testing.assert_array_equal(blind.density, alone.density)
+    assert min(blind.branch_probability[:2]) > 0.05 or min(blind.branch_probability[1:]) > 0.05
+
+
 def test_interval_coverage_when_the_device_rings_off_the_curve() -> None:
     # Each draw's device rings off the sensing curve by a model error of standard deviation
     # 0.6 % of omega_1 (what a pushed link shows, docs/fast.md "Limits"), which varies along

@@ -119,6 +119,14 @@ def _hpd_bounds(density: FloatArray, grid: FloatArray, level: float) -> tuple[fl
     return float(grid[chosen].min() - 0.5 * step), float(grid[chosen].max() + 0.5 * step)
 
 
+def _check_model_term(name: str, term: float | FloatArray, infinite: bool) -> None:
+    values = np.asarray(term, dtype=float)
+    valid = values >= 0.0 if infinite else np.isfinite(values) & (values >= 0.0)
+    if not np.all(valid):
+        what = ">= 0" if infinite else "finite and >= 0"
+        raise ValueError(f"{name}: must be {what} at every grid point")
+
+
 def contact_posterior(
     omega1_of_x: FloatArray,
     grid: FloatArray,
@@ -170,7 +178,16 @@ def contact_posterior(
     Returns
     -------
     ContactPosterior
+
+    Raises
+    ------
+    ValueError
+        A model term that is NaN or negative, or a ``frequency_model`` that is infinite, at
+        some grid point: the density would be NaN and the answer the grid's start. An infinite
+        ``ratio_model`` (no push to read the ratio by) leaves the ratio out.
     """
+    _check_model_term("ratio_model", ratio_model, infinite=True)
+    _check_model_term("frequency_model", frequency_model, infinite=False)
     log_like = np.zeros(grid.shape)
     if math.isfinite(omega1) and math.isfinite(omega1_se):
         # Gaussian likelihood of omega_1 through the forward sensing curve, the floor and the
@@ -181,7 +198,7 @@ def contact_posterior(
         log_like += -0.5 * ((omega1 - omega1_of_x) / sigma_w) ** 2
         if np.ndim(sigma_w):
             log_like -= np.log(sigma_w)
-    if math.isfinite(ratio) and math.isfinite(ratio_se):
+    if math.isfinite(ratio) and math.isfinite(ratio_se) and np.all(np.isfinite(ratio_model)):
         sigma_r = np.sqrt(ratio_se**2 + np.square(ratio_model)) * np.ones(grid.shape)
         log_like += -0.5 * ((ratio - grid) / sigma_r) ** 2 - np.log(sigma_r)
     if (
