@@ -44,6 +44,7 @@ __all__ = [
     "direction_change",
     "drift_check",
     "frequency_check",
+    "frequency_sigma",
     "is_slip_reference",
     "opening_check",
     "peak_check",
@@ -176,6 +177,16 @@ def ratio_check(
         f"the torque/force ratio ({ratio:.3f} m) is {ratio_z:.1f} standard deviations "
         f"from x_c = {x_map:.3f} m"
     )
+
+
+def frequency_sigma(
+    omega1: float, omega1_se: float, frequency_floor: float, model_sd: float
+) -> float:
+    """The standard deviation of omega_1 (rad/s) its check against the sensing curve allows,
+    as the posterior has it: the fit's error ``omega1_se`` (rad/s), the relative
+    ``frequency_floor`` and the curve's own term ``model_sd`` (rad/s, the bent link's), in
+    quadrature."""
+    return math.sqrt(omega1_se**2 + (frequency_floor * omega1) ** 2 + model_sd**2)
 
 
 def frequency_check(

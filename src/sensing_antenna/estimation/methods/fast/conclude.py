@@ -16,7 +16,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.estimation.front.evidence import Evidence
-from sensing_antenna.estimation.methods.fast.checks import frequency_check, problems, ratio_check
+from sensing_antenna.estimation.methods.fast.checks import (
+    frequency_check,
+    frequency_sigma,
+    problems,
+    ratio_check,
+)
 from sensing_antenna.estimation.methods.fast.config import FastConfig, model_floor
 from sensing_antenna.estimation.methods.fast.curves import contact_candidates, curve_table
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
@@ -161,10 +166,9 @@ def _frequency_z(
     table = curve_table(link, post.branch_edges[0], post.branch_edges[-1], config.grid_step)
     slope = float(np.interp(post.x_c, table.grid, table.slope))
     bent = slope * evidence.bent_link_uncertainty(post.x_c)
-    sigma = math.sqrt(omega1_se**2 + (model_floor(link, config) * omega1) ** 2 + bent**2)
     z, _ = frequency_check(
         omega1,
-        sigma,
+        frequency_sigma(omega1, omega1_se, model_floor(link, config), bent),
         float(np.interp(post.x_c, table.grid, table.omega1)),
         post.x_c,
         float(table.omega1.max()),

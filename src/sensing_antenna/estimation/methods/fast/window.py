@@ -24,6 +24,7 @@ from sensing_antenna.antenna import Link
 from sensing_antenna.estimation.methods.fast.checks import (
     branch_contradiction,
     frequency_check,
+    frequency_sigma,
     is_slip_reference,
     opening_check,
     peak_check,
@@ -283,7 +284,9 @@ def evaluate_window(
     if math.isfinite(omega1):
         frequency_z, note = frequency_check(
             omega1,
-            _omega1_sigma(omega1, omega1_se, frequency_floor, statics_model, posterior.x_c),
+            frequency_sigma(
+                omega1, omega1_se, frequency_floor, statics_model.omega1_sd_at(posterior.x_c)
+            ),
             float(np.interp(posterior.x_c, table.grid, table.omega1)),
             posterior.x_c,
             float(table.omega1.max()),
@@ -339,21 +342,6 @@ def evaluate_window(
 def _on_grid(values: FloatArray | None, grid: FloatArray) -> float | FloatArray:
     """``values`` given at every point of ``grid``, else 0 (no term)."""
     return values if values is not None and values.shape == grid.shape else 0.0
-
-
-def _omega1_sigma(
-    omega1: float,
-    omega1_se: float,
-    frequency_floor: float,
-    statics_model: StaticsModel,
-    x_c: float,
-) -> float:
-    """The standard deviation of omega_1 (rad/s) its check against the sensing curve at ``x_c``
-    (m) allows: the fit's error and the relative ``frequency_floor`` as in the posterior, and
-    the bent link's term, in quadrature."""
-    return math.sqrt(
-        omega1_se**2 + (frequency_floor * omega1) ** 2 + statics_model.omega1_sd_at(x_c) ** 2
-    )
 
 
 def _higher_mode(
