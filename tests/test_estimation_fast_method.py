@@ -600,6 +600,34 @@ def test_a_window_whose_posterior_holds_two_branches_asks_the_second_mode() -> N
     assert len(asked) == 1
 
 
+def test_the_second_mode_pointing_to_the_other_branch_stops_a_declaration() -> None:
+    # A ring at omega_1(0.86 m), whose other candidate is near 0.70 m, and a torque/force ratio
+    # at 0.70 m (a tilted post can bias it so): the posterior is sure of the near branch. The
+    # second contact mode is the other evidence: answering for 0.86 m it stops the declaration
+    # (and marks the branch contradicted, which the cap asks again); answering for the
+    # posterior's branch, or not at all, it lets it stand.
+    rng = np.random.default_rng(6)
+    channels = _channels(0.70, 600, rng, 0.2, omega=float(CURVE.omega1(0.86)))
+    args = (channels, NO_BIAS, 0, 560, TS, BAND, LINK, X_RANGE, ON_CURVE)
+
+    def chooser(far: bool | None) -> Any:
+        def choose(start: int, end: int, omega1: float, candidates: tuple[float, ...]) -> Any:
+            assert len(candidates) == 2
+            return (None if far is None else int(far)), {"asked": True}
+
+        return choose
+
+    plain = evaluate_window(*args, cache={})
+    assert plain.sure and plain.posterior.x_c == pytest.approx(0.70, abs=0.01)
+    objected = evaluate_window(*args, cache={}, choose_branch=chooser(True))
+    assert not objected.sure and objected.branch_contradicted
+    assert "second contact mode points to x_c = 0.86" in objected.note
+    for answer in (False, None):
+        agreed = evaluate_window(*args, cache={}, choose_branch=chooser(answer))
+        assert agreed.sure and not agreed.branch_contradicted
+        assert agreed.second_mode == {"asked": True}
+
+
 # On simulated recordings: the batch and online forms, the study form, the second mode
 
 

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.checks import (
+    accepted_at_cap,
     frequency_check,
     frequency_sigma,
     problems,
@@ -66,7 +67,8 @@ def conclude_fast(
         diag["branch_chosen_by"] = "omega2"
     if result.reached_cap and not final.sure:
         # The final window's samples only (up to the cap), online and offline alike
-        post, second_mode = branch_at_cap(evidence, final, candidates)
+        answers = accepted_at_cap(final, config)
+        post, second_mode = branch_at_cap(evidence, final, candidates, answers)
         diag.update(second_mode)
         if post is not final.posterior and final.statics is not None:
             # The ratio's agreement is judged again at the chosen branch's maximum

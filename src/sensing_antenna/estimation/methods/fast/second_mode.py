@@ -21,7 +21,13 @@ from sensing_antenna.estimation.methods.paper.fusion import predicted_omega2, se
 if TYPE_CHECKING:
     from sensing_antenna.estimation.methods.fast.window import WindowEstimate
 
-__all__ = ["BranchChooser", "branch_at_cap", "on_chosen_branch", "second_mode_chooser"]
+__all__ = [
+    "BranchChooser",
+    "branch_at_cap",
+    "on_chosen_branch",
+    "second_mode_chooser",
+    "second_mode_objection",
+]
 
 #: Which of two candidate contact points (m) the window [start, end] (sample indices) with
 #: fundamental omega_1 (rad/s) supports: 0, 1 or None when it does not say, and the test's
@@ -82,21 +88,51 @@ def on_chosen_branch(
     return posterior.given_branch(branch)
 
 
+def second_mode_objection(
+    posterior: ContactPosterior,
+    candidates: tuple[float, ...],
+    omega1: float,
+    start: int,
+    end: int,
+    choose_branch: BranchChooser,
+) -> tuple[str, dict[str, Any]]:
+    """Why the second contact mode says the posterior's branch is wrong ("" if it does not),
+    and the chooser's notes ({} when not asked).
+
+    With two candidates of omega_1 (rad/s) on different branches, the chooser is asked on the
+    window [start, end]; an answer on the other branch than the posterior's maximum objects.
+    """
+    if len(candidates) != 2:
+        return "", {}
+    choice, answer = choose_branch(start, end, omega1, candidates)
+    if choice is None:
+        return "", answer
+    if posterior.branch_of(candidates[choice]) == posterior.branch_of(posterior.x_c):
+        return "", answer
+    return (
+        f"the second contact mode points to x_c = {candidates[choice]:.3f} m, on the other "
+        f"branch of omega_1 than the posterior's x_c = {posterior.x_c:.3f} m"
+    ), answer
+
+
 def branch_at_cap(
     evidence: Evidence,
     window: WindowEstimate,
     candidates: tuple[float, ...],
+    answers: bool = False,
 ) -> tuple[ContactPosterior, dict[str, Any]]:
     """At the cap, let the second contact mode choose between two branches the ratio cannot.
 
     Asked (:func:`second_mode_chooser`, on the final window) when the posterior still holds
-    both branches, or when the window's higher mode contradicted the branch it holds; with
+    both branches, when the window's higher mode contradicted the branch it holds, or when the
+    window ``answers`` at the cap on one branch (its interval within ``cap_tolerance``, which
+    no window before it reached at ``tolerance``, where the windows ask); with
     ``branch_by_second_mode`` on, the first case has been asked at the window already. When
     decisive the posterior is conditioned on that branch; otherwise it is unchanged.
     """
     posterior = window.posterior
     split = max(posterior.branch_probability) < posterior.level
-    if len(candidates) != 2 or not (split or window.branch_contradicted):
+    if len(candidates) != 2 or not (split or window.branch_contradicted or answers):
         return posterior, {}
     if window.branch_chosen_by_second_mode or (split and window.second_mode):
         return posterior, {}

@@ -36,7 +36,11 @@ from sensing_antenna.estimation.methods.fast.curves import contact_candidates, c
 from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
-from sensing_antenna.estimation.methods.fast.second_mode import BranchChooser, on_chosen_branch
+from sensing_antenna.estimation.methods.fast.second_mode import (
+    BranchChooser,
+    on_chosen_branch,
+    second_mode_objection,
+)
 from sensing_antenna.estimation.methods.fast.static_fit import (
     SensorBias,
     StaticRatio,
@@ -310,6 +314,29 @@ def evaluate_window(
         note = peak_check(omega1, omega1_se, frequency_floor, float(table.omega1.max()), config)
         if note:
             notes.append(note)
+    if (
+        not notes
+        and not chosen
+        and posterior.width <= config.tolerance
+        and choose_branch is not None
+        and config.branch_by_second_mode
+        and math.isfinite(omega1)
+    ):
+        # About to declare one branch of two: the second contact mode, evidence independent of
+        # the ratio that chose the branch, must not point to the other one
+        objection, answer = second_mode_objection(
+            posterior,
+            contact_candidates(link, omega1, posterior),
+            omega1,
+            rest_index,
+            end_index,
+            choose_branch,
+        )
+        if answer:
+            second_mode = answer
+        if objection:
+            notes.append(objection)
+            contradiction = objection
     checks_passed = not notes
     if not notes and posterior.width > config.tolerance:
         notes.append(
