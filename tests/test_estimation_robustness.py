@@ -159,6 +159,27 @@ def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
         assert math.isnan(result.x_c) or 0.0 < result.x_c <= 0.98
 
 
+@pytest.mark.parametrize("column", [1, 4])
+@pytest.mark.parametrize("value", [1e100, 1e155])
+def test_a_glitch_whose_square_overflows_gives_an_answer_not_a_traceback(
+    column: int, value: float
+) -> None:
+    # Smaller glitches than the one above still overflow a square (the frequency's standard
+    # deviation) or the statics' model term (NaN): the estimate comes back, never `ok` off the
+    # contact, and without warnings.
+    recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
+    clean = estimate(recording, calibrated())
+    k = int(np.searchsorted(recording.t, clean.t_1 + 0.05))
+    loads = np.hstack([recording.force, recording.torque])
+    loads[k, column] = value
+    glitched = Recording(
+        t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:]
+    )
+    for method in ("paper", "ratio", "two-frequency", "fast"):
+        result = estimate(glitched, calibrated(), method)
+        assert result.status is not Status.OK or abs(result.x_c - 0.5) < 0.005, method
+
+
 def test_a_ratio_that_overflows_is_no_reading() -> None:
     # Torques scaled far beyond any device (1e300, 8e5: 1.8e4 N m for the link's weight)
     # overflow Eq. 21 and its fixed point to inf; ContactEstimate.ratio_estimate is a length or

@@ -186,7 +186,7 @@ def frequency_sigma(
     as the posterior has it: the fit's error ``omega1_se`` (rad/s), the relative
     ``frequency_floor`` and the curve's own term ``model_sd`` (rad/s, the bent link's), in
     quadrature."""
-    return math.sqrt(omega1_se**2 + (frequency_floor * omega1) ** 2 + model_sd**2)
+    return math.hypot(omega1_se, frequency_floor * omega1, model_sd)
 
 
 def frequency_check(

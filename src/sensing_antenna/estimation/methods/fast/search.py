@@ -67,11 +67,15 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         else None
     )
     table = curve_table(link, x_range[0], x_range[1], config.grid_step)
+    # Loads beyond any sensor (a glitch of 1e155 N) overflow the model terms: a term that is
+    # not a number says nothing, and the ratio it belongs to is left out (an infinite term)
+    ratio_model = evidence.ratio_model_uncertainty(table.grid)
+    bent = table.slope * evidence.bent_link_uncertainties(table.grid)
     statics = StaticsModel(
         evidence.reaction_f[:, 0],
         table.grid,
-        evidence.ratio_model_uncertainty(table.grid),
-        table.slope * evidence.bent_link_uncertainties(table.grid),
+        np.where(np.isnan(ratio_model), np.inf, ratio_model),
+        np.where(np.isfinite(bent), bent, 0.0),
         np.array(evidence.frame.reaction_m[1:], dtype=float),
     )
     return ScanInputs(
