@@ -86,6 +86,8 @@ def conclude_fast(
     axial = float(evidence.frame.reaction_m[0])
     touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link, axial)
     found = problems(result, config)
+    if "second_mode_objection" in diag:
+        found.append((Status.ESTIMATORS_DISAGREE, diag["second_mode_objection"]))
     if evidence.gap is not None:
         found.append((Status.BAD_INPUT, evidence.gap))
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}

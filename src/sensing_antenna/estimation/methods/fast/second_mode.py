@@ -128,7 +128,10 @@ def branch_at_cap(
     window ``answers`` at the cap on one branch (its interval within ``cap_tolerance``, which
     no window before it reached at ``tolerance``, where the windows ask); with
     ``branch_by_second_mode`` on, the first case has been asked at the window already. When
-    decisive the posterior is conditioned on that branch; otherwise it is unchanged.
+    decisive the posterior is conditioned on that branch. When the window answers and the mode
+    points to a branch the posterior gives no probability, the notes carry why
+    (``second_mode_objection``, a disagreement for the conclusion); otherwise the posterior
+    is unchanged.
     """
     posterior = window.posterior
     split = max(posterior.branch_probability) < posterior.level
@@ -140,5 +143,15 @@ def branch_at_cap(
     choice, notes = choose(window.start_index, window.end_index, window.omega1, candidates)
     conditioned = on_chosen_branch(posterior, candidates, choice)
     if conditioned is None:
+        other = choice is not None and posterior.branch_of(candidates[choice]) != (
+            posterior.branch_of(posterior.x_c)
+        )
+        if answers and other:
+            assert choice is not None
+            objection = (
+                f"the second contact mode points to x_c = {candidates[choice]:.3f} m, on a "
+                "branch of omega_1 the torque/force ratio gives no probability"
+            )
+            return posterior, {"second_mode": notes, "second_mode_objection": objection}
         return posterior, {"second_mode": notes}
     return conditioned, {"second_mode": notes, "branch_chosen_by": "omega2"}
