@@ -291,6 +291,45 @@ def test_other_settings_in_the_same_directory_are_refused(
         explore(load_scene("post"), DEVICE, out, linear)
 
 
+def test_the_device_is_identified_before_it_explores(
+    explored: tuple[Path, list[Manoeuvre]],
+) -> None:
+    # As a lab prepares its head: the observer and contact threshold fitted to two free sweeps
+    # (kept with the calibration's posts), the estimators' antenna carrying them, and the
+    # simulated controller detecting with them, so that the touch is seen within milliseconds
+    # and the push past it bends the link about 3 % of x_c (the paper's own 0.02 N m threshold
+    # sees it late: 5 to 10 %)
+    from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.recording import read_recording
+
+    out, manoeuvres = explored
+    for name in ("free.csv", "free-vertical.csv"):
+        assert (out / "calibration" / name).is_file()
+    prepared = load_antenna(out / "calibrated.toml")
+    assert prepared.link.calibrated_t is not None
+    assert prepared.observer.contact_threshold < 0.1 * DEVICE.observer.contact_threshold
+    bends = [
+        float(read_recording(out / m.recording).metadata["true_deflection_ratio"])
+        for m in manoeuvres
+        if m.recording is not None
+    ]
+    assert bends and all(0.02 < bend < 0.045 for bend in bends), bends
+
+
+def test_a_directory_prepared_otherwise_is_not_resumed(
+    explored: tuple[Path, list[Manoeuvre]], tmp_path: Path
+) -> None:
+    # An older exploration's directory: its settings say nothing of the preparation
+    out, _ = explored
+    older = tmp_path / "older"
+    older.mkdir()
+    settings = json.loads((out / "settings.json").read_text())
+    del settings["preparation"]
+    (older / "settings.json").write_text(json.dumps(settings))
+    with pytest.raises(ExplorationStoreError, match=r"settings.json: preparation: "):
+        explore(load_scene("post"), DEVICE, older, ExploreSettings(method="paper", budget=3))
+
+
 def test_the_exploration_simulates_the_exact_link(explored: tuple[Path, list[Manoeuvre]]) -> None:
     out, manoeuvres = explored
     from sensing_antenna.recording import read_recording

@@ -113,6 +113,10 @@ CALIBRATION_POINTS = (0.3, 0.45, 0.6, 0.75, 0.9)
 #: The calibration manoeuvres' seeds start here (the README's).
 CALIBRATION_SEED = 10
 
+#: What the preparation does (stored with the settings: a directory prepared otherwise is not
+#: resumed).
+PREPARATION = "observer identified on free sweeps, then T_e calibrated on posts"
+
 #: The free sweeps the observer is identified on (one of each joint), their length (s) and
 #: their first seed.
 FREE_MOTION_CASES = ("free", "free-vertical")
@@ -370,6 +374,9 @@ def explore(
                 "seed": settings.seed,
                 "include_uncertain": settings.include_uncertain,
                 "link": settings.link,
+                # what step 1 makes of the device: an older directory's antenna was calibrated
+                # only, its sweeps detected with the nominal observer
+                "preparation": PREPARATION,
             },
         )
         scene.mesh.export(out / "scene.ply")
