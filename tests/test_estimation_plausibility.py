@@ -336,7 +336,7 @@ def test_an_unmodelled_tip_mass_is_a_model_mismatch_for_the_vibration_methods() 
         result = estimate(recording, device, method)
         assert result.status is Status.MODEL_MISMATCH, (method, result.reason)
         assert "link.tip_mass" in (result.reason or "")
-        # 4 to 5 cm, by where each method's answer sits (0.30 to 0.31 m)
+        # about 4 to 5 cm, by where each method's answer sits (0.30 to 0.31 m)
         assert 0.035 < result.diagnostics["payload_spread"] < 0.06
     assert "payload_spread" not in estimate(recording, device, "ratio").diagnostics
     # without the payload: the tare's offset alone moves it by a millimetre or two at most

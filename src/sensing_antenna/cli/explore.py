@@ -22,9 +22,10 @@ def register(subparsers: Any) -> None:
         "explore",
         help="explore a scene with the simulated device: sweeps, contacts, surface, object",
         description=(
-            "Calibrates the simulated device (five posts at known points, as the README does), "
-            "then runs sweeps of the head in SCENE (a built-in scene or a scene file): each "
-            "sweep's first touch is simulated with the simulator's contact physics, written as "
+            "Prepares the simulated device as the README's session does (its observer and "
+            "contact threshold identified on two free sweeps, T_e calibrated on five posts at "
+            "known points), then runs sweeps of the head in SCENE (a built-in scene or a scene "
+            "file): each sweep's first touch is simulated with the simulator's contact physics, written as "
             "a recording with its base_pose, estimated and placed in the world with its "
             "covariance; a sweep that touches nothing is free space. The strategy chooses the "
             "sweeps: a fixed grid, or next-best (where the surface fitted so far is least "
@@ -116,7 +117,7 @@ def _run(args: argparse.Namespace) -> int:
     print(
         f"exploring scene {scene.name} ({len(scene.objects)} objects, {len(scene.bases)} base"
         f" poses) with the {args.method} method, {args.strategy} strategy; the first start"
-        " calibrates the simulated device",
+        " prepares the simulated device (identifies its observer, calibrates T_e)",
         file=sys.stderr,
     )
     result = explore(scene, device, args.out, settings, None if args.quiet else show, meshes)
