@@ -22,15 +22,15 @@ def register(subparsers: Any) -> None:
         "explore",
         help="explore a scene with the simulated device: sweeps, contacts, surface, object",
         description=(
-            "Prepares the simulated device as the README's session does (its observer and "
-            "contact threshold identified on two free sweeps, T_e calibrated on five posts at "
-            "known points), then runs sweeps of the head in SCENE (a built-in scene or a scene "
-            "file): each sweep's first touch is simulated with the simulator's contact "
-            "physics, written as a recording with its base_pose, estimated and placed in the "
-            "world with its covariance; a sweep that touches nothing is free space. The "
-            "strategy chooses the sweeps: a fixed grid, or next-best (where the surface fitted so far is least "
-            "known). Then the map of antenna map (points, surface, recognised object) is "
-            "written into --out. Interrupted, the same command resumes (docs/explore.md)."
+            "Prepares the simulated device as the README's session does (its observer and contact "
+            "threshold identified on two free sweeps, T_e calibrated on five posts at known "
+            "points), then runs sweeps of the head in SCENE (a built-in scene or a scene file): "
+            "each sweep's first touch is simulated with the simulator's contact physics, written "
+            "as a recording with its base_pose, estimated and placed in the world with its "
+            "covariance; a sweep that touches nothing is free space. The strategy chooses the "
+            "sweeps: a fixed grid, or next-best (where the surface fitted so far is least known). "
+            "Then the map of antenna map (points, surface, recognised object) is written into "
+            "--out. Interrupted, the same command resumes (docs/explore.md)."
         ),
     )
     parser.add_argument(
