@@ -136,6 +136,17 @@ def test_human_output_says_best_guess_for_doubtful_estimates() -> None:
     assert wrong.to_dict()["x_c"] == wrong.x_c  # JSON keeps the best guess
 
 
+def _glitched(column: int, value: float) -> Recording:
+    """A clean synthetic push at 0.5 m with one load sample 50 ms after t_1 set to ``value``."""
+    recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
+    clean = estimate(recording, calibrated())
+    assert clean.status is Status.OK, clean.reason
+    k = int(np.searchsorted(recording.t, clean.t_1 + 0.05))
+    loads = np.hstack([recording.force, recording.torque])
+    loads[k, column] = value
+    return Recording(t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:])
+
+
 @pytest.mark.parametrize("column", [1, 4])  # fy, ty: the push's force and its moment
 @pytest.mark.parametrize("value", [1e300, -1.7976931348623157e308])
 def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
@@ -144,15 +155,7 @@ def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
     # One sample of 1e300 N (or N m) after t_1, where the hold, the ratio and the spectrum read:
     # sums, norms, the ratio's fixed point overflow. The suite runs with warnings as errors, so
     # a NumPy warning here (lines on a user's terminal) fails the test. Found by the fuzz suite.
-    recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
-    clean = estimate(recording, calibrated())
-    assert clean.status is Status.OK, clean.reason
-    k = int(np.searchsorted(recording.t, clean.t_1 + 0.05))
-    loads = np.hstack([recording.force, recording.torque])
-    loads[k, column] = value
-    glitched = Recording(
-        t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:]
-    )
+    glitched = _glitched(column, value)
     for method in ("paper", "ratio", "two-frequency", "fast"):
         result = estimate(glitched, calibrated(), method)
         assert result.status is not Status.OK, (method, result.x_c)
@@ -167,14 +170,7 @@ def test_a_glitch_whose_square_overflows_gives_an_answer_not_a_traceback(
     # Smaller glitches than the one above still overflow a square (the frequency's standard
     # deviation) or the statics' model term (NaN): the estimate comes back, never `ok` off the
     # contact, and without warnings.
-    recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
-    clean = estimate(recording, calibrated())
-    k = int(np.searchsorted(recording.t, clean.t_1 + 0.05))
-    loads = np.hstack([recording.force, recording.torque])
-    loads[k, column] = value
-    glitched = Recording(
-        t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:]
-    )
+    glitched = _glitched(column, value)
     for method in ("paper", "ratio", "two-frequency", "fast"):
         result = estimate(glitched, calibrated(), method)
         assert result.status is not Status.OK or abs(result.x_c - 0.5) < 0.005, method
