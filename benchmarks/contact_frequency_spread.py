@@ -7,7 +7,7 @@ simulator's geometrically exact link against posts and balls of 3 mm to 3 cm rad
 friction coefficients 0, 0.3 and 0.6, at x_c = 0.35, 0.5, 0.6 and 0.9 m (one seed each). For
 every contact that held to the end, against the sensing curve at the recording's ``true_xc``,
 in per cent: omega_1 as the fast method reads it on the window it would answer from with the
-sensing curve trusted to 0.1 % (``frequency_floor`` 0.001: windows 0.2 to 0.5 s after t_1,
+sensing curve trusted to 0.1 % (``frequency_floor`` 0.001: windows 0.2 to 1 s after t_1,
 while the contact settles), and as Estimator 1 reads it over the whole hold (the paper
 method's spectrum). A reading more than 2 % off is another vibration (the link slid off the
 obstacle or bounced on it) and is counted apart. A calibration absorbs its own posts' offset,
