@@ -25,7 +25,6 @@ Prints a line per contact and the summary; writes
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import datetime
 import json
 import math
@@ -37,9 +36,9 @@ import numpy as np
 from sensing_antenna import paper_antenna
 from sensing_antenna.beam.sensing import SensingCurve
 from sensing_antenna.calibration.observer import identify_free_motion
+from sensing_antenna.campaign.simulated import knowing_weight
 from sensing_antenna.estimation import estimate, measure_omega1
 from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
-from sensing_antenna.exploration.run import controlled_device
 from sensing_antenna.simulator import Scenario, simulate
 
 RESULTS = Path(__file__).resolve().parent / "results" / "contact_frequency_spread.json"
@@ -65,8 +64,8 @@ def main() -> None:
         for k, case in enumerate(("free", "free-vertical"))
     ]
     fit = identify_free_motion([run.without_ground_truth() for run in free], device)
-    model = dataclasses.replace(device.self_calibrated(), observer=fit.observer)
-    pushing = controlled_device(device, model)
+    model = fit.apply(device.self_calibrated())
+    pushing = knowing_weight(device, model)
     curve = SensingCurve.from_link(device.link)
     rows: list[dict[str, Any]] = []
     for x_c in CONTACTS:

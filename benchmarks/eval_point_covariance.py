@@ -38,9 +38,9 @@ import numpy as np  # noqa: E402
 
 from eval_explore import make_scene  # noqa: E402
 from sensing_antenna import paper_antenna  # noqa: E402
+from sensing_antenna.campaign.simulated import knowing_weight  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
 from sensing_antenna.exploration import grid_sweeps, prepare_device  # noqa: E402
-from sensing_antenna.exploration.run import controlled_device  # noqa: E402
 from sensing_antenna.mapping import (  # noqa: E402
     BasePose,
     PointUncertainty,
@@ -137,7 +137,7 @@ def main() -> None:
     # each link prepared on itself (observer identified, T_e calibrated), as a device is
     # prepared before it measures; the device's controller detects with what was identified
     antennas = {link: prepare_device(device, link=link) for link in LINKS}
-    devices = {link: controlled_device(device, antennas[link]) for link in LINKS}
+    devices = {link: knowing_weight(device, antennas[link]) for link in LINKS}
     rows: dict[str, list[dict[str, float]]] = {link: [] for link in LINKS}
     for index in range(args.scenes):
         scene, _ = make_scene(index, args.seed, 6, shape, 3)

@@ -197,6 +197,12 @@ class ObserverFit:
         """zeta = d / (2 omega) (dimensionless)."""
         return self.damping / (2.0 * self.natural_frequency)
 
+    def apply(self, antenna: Antenna) -> Antenna:
+        """``antenna`` with this observer and threshold, and the payload the rests read when
+        it is significant (:meth:`Payload.apply`)."""
+        identified = replace(antenna, observer=self.observer)
+        return self.payload.apply(identified) if self.payload is not None else identified
+
 
 #: Largest factor between the fitted effective inertia K / omega^2 and the rigid link's
 #: m_b l^2 / 3 + m_t l^2 (Eq. 15 tends to K / omega^2 theta'' at low frequency, the rigid link's

@@ -392,9 +392,7 @@ def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Pr
             "the device"
         )
         fit = identify_observer(device, spec, model)
-        model = dataclasses.replace(model, observer=fit.observer)
-        if fit.payload is not None:
-            model = fit.payload.apply(model)
+        model = fit.apply(model)
         device = knowing_weight(device, model)
     calibration = None
     if spec.calibration.enabled:

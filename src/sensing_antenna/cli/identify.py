@@ -106,9 +106,7 @@ def _run(args: argparse.Namespace) -> int:
         f"{printable(', '.join(str(path) for path in args.recordings))}"
     )
     start = antenna if motor_fit is None else motor_fit.antenna(antenna)
-    identified = replace(start, name=name, description=description, observer=fit.observer)
-    if fit.payload is not None:
-        identified = fit.payload.apply(identified)
+    identified = fit.apply(replace(start, name=name, description=description))
     save_antenna(identified, args.out)
     joints = ", ".join(f"theta{j}" for j in fit.joints)
     print(

@@ -36,7 +36,7 @@ import hashlib
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +45,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
+from sensing_antenna.campaign.simulated import knowing_weight
 from sensing_antenna.campaign.store import atomic_write_text
 from sensing_antenna.errors import raise_if_signalled
 from sensing_antenna.exploration.plan import (
@@ -253,13 +254,11 @@ def prepare_device(device: Antenna, folder: Path | None = None, link: str = "non
         )
         for seed, case in enumerate(FREE_MOTION_CASES, start=FREE_MOTION_SEED)
     ]
-    fit = identify_free_motion([run.without_ground_truth() for run in free], device)
-    model = replace(device, observer=fit.observer)
-    if fit.payload is not None:
-        model = fit.payload.apply(model)
+    model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
+    controlled = knowing_weight(device, model)
     runs = [
         simulate(
-            controlled_device(device, model),
+            controlled,
             Scenario(case="azimuthal", contact_point=x, seed=seed, link_model=link),  # type: ignore[arg-type]
         )
         for seed, x in enumerate(CALIBRATION_POINTS, start=CALIBRATION_SEED)
@@ -272,14 +271,6 @@ def prepare_device(device: Antenna, folder: Path | None = None, link: str = "non
             write_recording(run, folder / f"post-{x:.2f}.csv")
     points = [float(run.metadata["true_xc"]) for run in runs]
     return calibrate_from_recordings(runs, model, points).apply(model)
-
-
-def controlled_device(device: Antenna, model: Antenna) -> Antenna:
-    """The simulated ``device`` whose controller detects and pushes with what the preparation
-    found (``model``'s observer, threshold and weight); its physics stays the device's."""
-    from sensing_antenna.campaign.simulated import knowing_weight
-
-    return knowing_weight(device, model)
 
 
 def _prepared(device: Antenna, out: Path, link: str) -> Antenna:
@@ -385,7 +376,7 @@ def explore(
         try:
             antenna = _prepared(device, out, settings.link)
             shape = LinkShape(device.link)
-            controlled = controlled_device(device, antenna)
+            controlled = knowing_weight(device, antenna)
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
             leaders: tuple[ClassFit, ...] = ()
             while len(manoeuvres) < budget:
