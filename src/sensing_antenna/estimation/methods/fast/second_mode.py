@@ -105,14 +105,21 @@ def second_mode_objection(
     if len(candidates) != 2:
         return "", {}
     choice, answer = choose_branch(start, end, omega1, candidates)
-    if choice is None:
-        return "", answer
-    if posterior.branch_of(candidates[choice]) == posterior.branch_of(posterior.x_c):
-        return "", answer
+    return _objection(posterior, candidates, choice), answer
+
+
+def _objection(
+    posterior: ContactPosterior, candidates: tuple[float, ...], choice: int | None
+) -> str:
+    """Why the chooser's ``choice`` contradicts the branch of ``posterior``'s maximum; ""."""
+    if choice is None or posterior.branch_of(candidates[choice]) == posterior.branch_of(
+        posterior.x_c
+    ):
+        return ""
     return (
         f"the second contact mode points to x_c = {candidates[choice]:.3f} m, on the other "
         f"branch of omega_1 than the posterior's x_c = {posterior.x_c:.3f} m"
-    ), answer
+    )
 
 
 def branch_at_cap(
@@ -143,15 +150,10 @@ def branch_at_cap(
     choice, notes = choose(window.start_index, window.end_index, window.omega1, candidates)
     conditioned = on_chosen_branch(posterior, candidates, choice)
     if conditioned is None:
-        other = choice is not None and posterior.branch_of(candidates[choice]) != (
-            posterior.branch_of(posterior.x_c)
-        )
-        if answers and other:
-            assert choice is not None
-            objection = (
-                f"the second contact mode points to x_c = {candidates[choice]:.3f} m, on a "
-                "branch of omega_1 the torque/force ratio gives no probability"
-            )
+        # a branch the posterior gives no probability: no conditioning, but an answer there
+        # would rest on the branch the second mode contradicts
+        objection = _objection(posterior, candidates, choice) if answers else ""
+        if objection:
             return posterior, {"second_mode": notes, "second_mode_objection": objection}
         return posterior, {"second_mode": notes}
     return conditioned, {"second_mode": notes, "branch_chosen_by": "omega2"}
