@@ -260,7 +260,11 @@ def test_an_infinite_ratio_term_leaves_the_ratio_out() -> None:
     blind = contact_posterior(*args, np.full(GRID.shape, np.inf), 0.0)
     alone = contact_posterior(*args[:5], math.nan, math.nan, 0.0, 0.0)
     np.testing.assert_array_equal(blind.density, alone.density)
-    assert min(blind.branch_probability[:2]) > 0.05 or min(blind.branch_probability[1:]) > 0.05
+    # omega_1(0.9 m) has a candidate on each side of the curve's top: both keep mass, where the
+    # ratio at 0.9 m with a finite term would leave the near one none
+    assert sorted(blind.branch_probability)[-2] > 0.05
+    informed = contact_posterior(*args, np.full(GRID.shape, 0.01), 0.0)
+    assert sorted(informed.branch_probability)[-2] < 1e-6
 
 
 def test_interval_coverage_when_the_device_rings_off_the_curve() -> None:
