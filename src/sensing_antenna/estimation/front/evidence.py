@@ -282,7 +282,9 @@ class Evidence:
         corrections, the bent link's weight (:func:`bent_weight_moment`), and the floor
         ``ratio_model_floor`` x_c (the sensor calibration's ``ratio_scatter`` x_c when larger),
         in quadrature, for the hold's push (``frame``). A method
-        with statics of its own that are the elastica's (``fast``) weighs them with it."""
+        with statics of its own that are the elastica's (``fast``) weighs them with it. Infinite
+        where there is no push to read the ratio by, or where loads beyond any sensor overflow
+        the term: the ratio says nothing there."""
         link = self.antenna.link
         x_c = np.asarray(x_c, dtype=float)
         reaction = self.frame.reaction_m
@@ -312,7 +314,8 @@ class Evidence:
         )
         # the floor, or the scatter the sensor's calibration left on the ratio if larger
         floor = max(self.config.ratio_model_floor, self.antenna.sensor.ratio_scatter) * x_c
-        return np.asarray(np.hypot(np.hypot(stiffness, weight), floor), dtype=float)
+        term = np.asarray(np.hypot(np.hypot(stiffness, weight), floor), dtype=float)
+        return np.where(np.isnan(term), np.inf, term)
 
     def bent_link_uncertainty(self, x_c: float) -> float:
         """Standard uncertainty (m) of a contact point read from the vibration, from the push's

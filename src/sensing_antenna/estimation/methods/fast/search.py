@@ -67,14 +67,13 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         else None
     )
     table = curve_table(link, x_range[0], x_range[1], config.grid_step)
-    # Loads beyond any sensor (a glitch of 1e155 N) overflow the model terms: a term that is
-    # not a number says nothing, and the ratio it belongs to is left out (an infinite term)
-    ratio_model = evidence.ratio_model_uncertainty(table.grid)
+    # Loads beyond any sensor (a glitch of 1e155 N) overflow the bent link's term too (the
+    # ratio's comes back infinite, which leaves the ratio out): not a number, no term
     bent = table.slope * evidence.bent_link_uncertainties(table.grid)
     statics = StaticsModel(
         evidence.reaction_f[:, 0],
         table.grid,
-        np.where(np.isnan(ratio_model), np.inf, ratio_model),
+        evidence.ratio_model_uncertainty(table.grid),
         np.where(np.isfinite(bent), bent, 0.0),
         np.array(evidence.frame.reaction_m[1:], dtype=float),
     )
