@@ -95,8 +95,9 @@ class FastConfig:
     frequency_floor : float
         Relative model error of omega_1 added in quadrature (dimensionless): how well T (or
         T_e) and the sensing curve predict the frequency. 0.003: how far a physical contact
-        lets a gently pushed link ring off the pinned sensing curve (friction, the reaction's
-        tilt, the post's radius), which a calibration on one kind of post does not see
+        lets a gently pushed link ring off its calibrated sensing curve in the windows the
+        method answers from (friction, the reaction's tilt, the post's radius, the contact
+        settling after the stop), which a calibration on one kind of post does not see
         (docs/fast.md, "Posterior and floors"). A link whose own frequency uncertainty is larger
         (``Link.frequency_uncertainty``: its calibration's scatter, or the spread of a nominal
         T when not calibrated) uses that instead (:func:`model_floor`).
