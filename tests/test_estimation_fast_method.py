@@ -777,12 +777,14 @@ def test_at_the_cap_an_interval_within_cap_tolerance_answers() -> None:
     # moves little with x_c; no window is sure at 5 mm by the cap, whose interval is a little
     # wider. Within cap_tolerance (1 cm) the cap's answer is ok; held to 5 mm it is uncertain,
     # the same estimate with the same interval, which holds the contact abscissa.
+    # (Waiting for the cap: no window is declared for being near the floors' width.)
     antenna = calibrated()
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.8, seed=2))
     truth = float(recording.metadata["true_xc"])
     blind = recording.without_ground_truth()
-    answered = estimate(blind, antenna, FastMethod(ON_CURVE), STRAIGHT)
-    held = estimate(blind, antenna, FastMethod(replace(ON_CURVE, cap_tolerance=0.005)), STRAIGHT)
+    waiting = replace(ON_CURVE, settled_margin=0.0)
+    answered = estimate(blind, antenna, FastMethod(waiting), STRAIGHT)
+    held = estimate(blind, antenna, FastMethod(replace(waiting, cap_tolerance=0.005)), STRAIGHT)
     assert held.status is Status.UNCERTAIN and "interval" in (held.reason or "")
     assert answered.status is Status.OK and answered.reason is None
     assert answered.t_e - answered.t_1 == pytest.approx(FastConfig().cap, abs=0.01)
@@ -791,6 +793,34 @@ def test_at_the_cap_an_interval_within_cap_tolerance_answers() -> None:
     low, high = answered.interval
     assert FastConfig().tolerance < high - low <= FastConfig().cap_tolerance
     assert low <= truth <= high
+
+
+def test_an_interval_the_floors_hold_above_the_tolerance_is_declared_without_waiting() -> None:
+    # Vertical, 0.85 m, seed 4 on the calibrated antenna: past the curve's top the 0.3 %
+    # frequency floor alone keeps the interval above 5 mm, so no window is ever sure at the
+    # tolerance. Made to wait, the method answers at the cap (1 s); by default it answers as
+    # soon as the interval is within cap_tolerance and within settled_margin of the width the
+    # floors leave, 0.2 s after t_1: the same status, an interval a little wider than the
+    # cap's at most, and both hold the contact abscissa.
+    antenna = calibrated()
+    recording = simulate(antenna, Scenario(case="vertical", contact_point=0.85, seed=4))
+    truth = float(recording.metadata["true_xc"])
+    blind = recording.without_ground_truth()
+    config = FastConfig()
+    waiting = estimate(blind, antenna, FastMethod(replace(config, settled_margin=0.0)), STRAIGHT)
+    settled = estimate(blind, antenna, FastMethod(config), STRAIGHT)
+    assert waiting.status is Status.OK and settled.status is Status.OK
+    assert waiting.t_e - waiting.t_1 == pytest.approx(config.cap, abs=0.01)
+    assert settled.t_e - settled.t_1 < 0.3
+    assert settled.interval is not None and waiting.interval is not None
+    widths = [high - low for low, high in (settled.interval, waiting.interval)]
+    assert config.tolerance < widths[1] <= widths[0] <= config.cap_tolerance
+    assert widths[0] <= (1.0 + config.settled_margin) * widths[1] + config.grid_step
+    for result in (settled, waiting):
+        assert result.interval is not None
+        assert result.interval[0] <= truth <= result.interval[1]
+    declared = next(w for w in FastMethod(config).history(_evidence(blind)) if w.sure)
+    assert declared.settled and declared.checks_passed
 
 
 def test_second_mode_chooses_the_branch_near_the_peak() -> None:
@@ -995,12 +1025,13 @@ def test_a_contact_force_that_turns_is_reported_as_slip_online_as_offline(
     # The slip check compares the static contact force fitted on the window's first half with
     # that of the whole window. Turned at 1.2 rad/s from t_1, the force at the centres of
     # [t_1, t_1 + 0.5 s] and [t_1, t_1 + 1 s] differs by 0.3 rad (17.2 deg), twice
-    # max_direction_drift. With a tolerance no window meets the estimate is the cap's: slip
+    # max_direction_drift. With a tolerance no window meets (and no declaration for being near
+    # the floors' width) the estimate is the cap's: slip
     # suspected, by that angle within 3 of its standard errors. Fed online in blocks of 100
     # samples the method asks one window per block from the hold's end and the cap's, not the
     # instants skipped (a real-time loop would otherwise spend seconds at the cap), and
     # concludes on the cap's window with the same slip reference: the same estimate.
-    method = FastMethod(FastConfig(tolerance=1e-6))
+    method = FastMethod(FastConfig(tolerance=1e-6, settled_margin=0.0))
     turned = _turned(azimuthal, azimuthal_estimate.t_1, 1.2)
     offline = estimate(turned, calibrated(), method, STRAIGHT)
     assert offline.status is Status.SLIP_SUSPECTED
@@ -1027,7 +1058,7 @@ def test_the_scan_concludes_on_the_first_sure_window_with_its_slip_reference(
     # the scan's cached fits: the same as a computation from scratch. The window declared at
     # 0.237 s is too short for one (its half holds 1.2 periods); the cap's 1 s window has one.
     evidence = azimuthal_evidence
-    config = FastConfig(tolerance=tolerance)
+    config = FastConfig(tolerance=tolerance, settled_margin=0.0)
     expected = next(
         (w for w in azimuthal_history if w.checks_passed and w.posterior.width <= tolerance),
         azimuthal_history[-1],

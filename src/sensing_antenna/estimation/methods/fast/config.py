@@ -34,6 +34,13 @@ class FastConfig:
         paper method answers from, and an interval that holds the truth bounds the error by its
         width. 1 cm, the paper's typical error and the fast method's largest allowed error.
         Never below ``tolerance``.
+    settled_margin : float
+        A window whose interval is wider than ``tolerance`` is declared all the same when every
+        check passes, the interval is within ``cap_tolerance`` and it is at most this fraction
+        wider than the interval unlimited data would leave (omega_1's and the ratio's
+        statistical errors gone, the model floors kept): the floors hold it above the
+        tolerance, and the cap could narrow it by this fraction at most, so waiting for the cap
+        would cost time for nothing the answer could use. 0.1; 0 waits for the cap.
     cadence : float
         Shortest time between evaluations of the growing window (s). 10 ms: on short windows
         the declaration comes at most this late after the first instant that would be sure.
@@ -206,6 +213,7 @@ class FastConfig:
 
     tolerance: float = 0.005
     cap_tolerance: float = 0.01
+    settled_margin: float = 0.1
     cadence: float = 0.01
     growth: float = 1.1
     first_window: float = 0.05
@@ -258,6 +266,7 @@ class FastConfig:
                 "free_plane_margin",
                 "frequency_floor",
                 "bias_guard",
+                "settled_margin",
             )
             if value == 0.0 and f.name not in may_be_zero:
                 raise FastConfigError(f"{f.name}: must be > 0, got {value!r}")

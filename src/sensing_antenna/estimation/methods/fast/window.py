@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
@@ -112,7 +113,7 @@ class WindowEstimate:
         The static torque/force ratio.
     posterior : ContactPosterior
     sure : bool
-        ``checks_passed`` and the interval no wider than the tolerance.
+        ``checks_passed`` and the interval no wider than the tolerance, or ``settled``.
     checks_passed : bool
         True when every check but the interval's width passes (usable frequency, periods in
         the window, drift, ratio agreement, contact closed, away from the top of the curve):
@@ -140,6 +141,10 @@ class WindowEstimate:
         (``FastConfig.branch_by_second_mode``); ``posterior`` is then conditioned on it.
     second_mode : dict
         What the second contact mode's test reported when it was asked (empty otherwise).
+    settled : bool
+        True when the window is sure although its interval is wider than the tolerance: within
+        ``cap_tolerance`` and within ``settled_margin`` of the width unlimited data would
+        leave (the model floors'), so waiting for the cap could not narrow it much.
     """
 
     start_index: int
@@ -161,6 +166,7 @@ class WindowEstimate:
     branch_contradicted: bool = False
     branch_chosen_by_second_mode: bool = False
     second_mode: dict[str, Any] = field(default_factory=dict)
+    settled: bool = False
 
 
 def evaluate_window(
@@ -248,22 +254,26 @@ def evaluate_window(
     ratio = statics.ratio if statics is not None else math.nan
     ratio_se = statics.standard_error if statics is not None else math.nan
     push_force = statics.perpendicular_force if statics is not None else 0.0
-    posterior = contact_posterior(
-        table.omega1,
-        table.grid,
-        table.edges,
-        omega1,
-        omega1_se,
-        ratio,
-        ratio_se,
-        _on_grid(statics_model.model_sd, table.grid),
-        frequency_floor,
-        higher_modes_of_x=table.higher,
-        omega_higher=omega_h,
-        omega_higher_se=omega_h_se,
-        higher_mode_floor=config.higher_mode_floor,
-        frequency_model=_on_grid(statics_model.omega1_sd, table.grid),
-    )
+
+    def posterior_with(frequency_se: float, ratio_se: float) -> ContactPosterior:
+        return contact_posterior(
+            table.omega1,
+            table.grid,
+            table.edges,
+            omega1,
+            frequency_se,
+            ratio,
+            ratio_se,
+            _on_grid(statics_model.model_sd, table.grid),
+            frequency_floor,
+            higher_modes_of_x=table.higher,
+            omega_higher=omega_h,
+            omega_higher_se=omega_h_se,
+            higher_mode_floor=config.higher_mode_floor,
+            frequency_model=_on_grid(statics_model.omega1_sd, table.grid),
+        )
+
+    posterior = posterior_with(omega1_se, ratio_se)
     chosen = False
     second_mode: dict[str, Any] = {}
     if (
@@ -314,10 +324,21 @@ def evaluate_window(
         note = peak_check(omega1, omega1_se, frequency_floor, float(table.omega1.max()), config)
         if note:
             notes.append(note)
+    # The ratio's statistical error goes with unlimited data where its model term is positive
+    ratio_model = _on_grid(statics_model.model_sd, table.grid)
+    ratio_limit = 0.0 if np.all(np.asarray(ratio_model) > 0.0) else ratio_se
+    settled = (
+        not notes
+        and config.settled_margin > 0.0
+        and config.tolerance < posterior.width <= config.cap_tolerance
+        and posterior.width
+        <= (1.0 + config.settled_margin)
+        * _floors_width(posterior, posterior_with, ratio_limit, chosen)
+    )
     if (
         not notes
         and not chosen
-        and posterior.width <= config.tolerance
+        and (posterior.width <= config.tolerance or settled)
         and choose_branch is not None
         and config.branch_by_second_mode
         and math.isfinite(omega1)
@@ -338,7 +359,7 @@ def evaluate_window(
             notes.append(objection)
             contradiction = objection
     checks_passed = not notes
-    if not notes and posterior.width > config.tolerance:
+    if not notes and posterior.width > config.tolerance and not settled:
         notes.append(
             f"the 95 % interval is {1000 * posterior.width:.1f} mm wide "
             f"(tolerance {1000 * config.tolerance:g} mm)"
@@ -363,7 +384,24 @@ def evaluate_window(
         branch_contradicted=bool(contradiction),
         branch_chosen_by_second_mode=chosen,
         second_mode=second_mode,
+        settled=settled and not notes,
     )
+
+
+def _floors_width(
+    posterior: ContactPosterior,
+    posterior_with: Callable[[float, float], ContactPosterior],
+    ratio_limit: float,
+    chosen: bool,
+) -> float:
+    """Width (m) of the 95 % interval that unlimited data would leave: omega_1's standard error
+    gone (the drift term with it: a longer window outgrows a transient) and the ratio's at
+    ``ratio_limit``, the model floors kept; on the same branch when the second mode chose
+    one."""
+    limit = posterior_with(0.0, ratio_limit)
+    if chosen:
+        limit = limit.given_branch(posterior.branch_of(posterior.x_c))
+    return limit.width
 
 
 def _on_grid(values: FloatArray | None, grid: FloatArray) -> float | FloatArray:
