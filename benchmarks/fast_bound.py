@@ -161,6 +161,7 @@ def run_one(setup: Setup, case: str, x_c: float, seed: int) -> dict[str, Any]:
         )
     if any(
         w.sure != (w.checks_passed and (w.posterior.width <= config.tolerance or w.settled))
+        or (w.settled and not config.tolerance < w.posterior.width <= config.cap_tolerance)
         for w in history
     ):
         raise RuntimeError("a window's sure flag is not its checks and its width (or settled)")

@@ -47,7 +47,8 @@ def register(subparsers: Any) -> None:
         default=None,
         metavar="M",
         help="fast method: declare when the 95 %% interval of x_c is narrower than this (m; "
-        "default: the fast method's, 0.005)",
+        "default: the fast method's, 0.005), or earlier within 1 cm when the model's floors "
+        "hold it wider",
     )
     parser.add_argument(
         "--t1",

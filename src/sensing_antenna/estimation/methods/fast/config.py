@@ -36,11 +36,12 @@ class FastConfig:
         Never below ``tolerance``.
     settled_margin : float
         A window whose interval is wider than ``tolerance`` is declared all the same when every
-        check passes, the interval is within ``cap_tolerance`` and it is at most this fraction
-        wider than the interval unlimited data would leave (omega_1's and the ratio's
-        statistical errors gone, the model floors kept): the floors hold it above the
-        tolerance, and the cap could narrow it by this fraction at most, so waiting for the cap
-        would cost time for nothing the answer could use. 0.1; 0 waits for the cap.
+        check passes, the interval is within ``cap_tolerance``, the window is long enough for
+        the slip check's reference, and the interval is at most this fraction wider than the
+        narrowest one unlimited data could leave (every statistical error gone, the model
+        floors kept, omega_1 anywhere within two of its standard errors): the floors hold it
+        above the tolerance, and waiting for the cap would narrow it little. 0.1; 0 waits for
+        the cap.
     cadence : float
         Shortest time between evaluations of the growing window (s). 10 ms: on short windows
         the declaration comes at most this late after the first instant that would be sure.

@@ -13,7 +13,9 @@ from t_1:
 2. the torque/force ratio of the static loads gives x_c with its standard error;
 3. both become a posterior over x_c on a 0.25 mm grid (:mod:`.likelihood`, :mod:`.window`);
 4. the estimate is declared at the first evaluation whose 95 % interval is narrower than
-   ``tolerance`` and that passes every check (:mod:`.checks`). Evaluations run on a geometric
+   ``tolerance`` and that passes every check (:mod:`.checks`), or whose interval the model
+   floors hold above it but within ``cap_tolerance`` and within ``settled_margin`` of what
+   unlimited data could leave (:mod:`.window`). Evaluations run on a geometric
    grid (:mod:`.evaluation_grid`) from ``first_window`` (50 ms) after t_1, so t_e adapts to
    how easy the case is (:mod:`.search`); at ``cap`` (1 s) after t_1 the best estimate is given
    with status ``uncertain`` (:mod:`.conclude`). Whenever the posterior is split between two

@@ -143,8 +143,9 @@ class WindowEstimate:
         What the second contact mode's test reported when it was asked (empty otherwise).
     settled : bool
         True when the window is sure although its interval is wider than the tolerance: within
-        ``cap_tolerance`` and within ``settled_margin`` of the width unlimited data would
-        leave (the model floors'), so waiting for the cap could not narrow it much.
+        ``cap_tolerance``, long enough for the slip check's reference, and within
+        ``settled_margin`` of the narrowest width unlimited data could leave (the model
+        floors'), so waiting for the cap would narrow it little.
     """
 
     start_index: int
@@ -255,12 +256,14 @@ def evaluate_window(
     ratio_se = statics.standard_error if statics is not None else math.nan
     push_force = statics.perpendicular_force if statics is not None else 0.0
 
-    def posterior_with(frequency_se: float, ratio_se: float) -> ContactPosterior:
+    def posterior_with(
+        omega: float, frequency_se: float, ratio_se: float, higher_se: float
+    ) -> ContactPosterior:
         return contact_posterior(
             table.omega1,
             table.grid,
             table.edges,
-            omega1,
+            omega,
             frequency_se,
             ratio,
             ratio_se,
@@ -268,12 +271,12 @@ def evaluate_window(
             frequency_floor,
             higher_modes_of_x=table.higher,
             omega_higher=omega_h,
-            omega_higher_se=omega_h_se,
+            omega_higher_se=higher_se,
             higher_mode_floor=config.higher_mode_floor,
             frequency_model=_on_grid(statics_model.omega1_sd, table.grid),
         )
 
-    posterior = posterior_with(omega1_se, ratio_se)
+    posterior = posterior_with(omega1, omega1_se, ratio_se, omega_h_se)
     chosen = False
     second_mode: dict[str, Any] = {}
     if (
@@ -324,23 +327,30 @@ def evaluate_window(
         note = peak_check(omega1, omega1_se, frequency_floor, float(table.omega1.max()), config)
         if note:
             notes.append(note)
-    # The ratio's statistical error goes with unlimited data where its model term is positive
-    ratio_model = _on_grid(statics_model.model_sd, table.grid)
-    ratio_limit = 0.0 if np.all(np.asarray(ratio_model) > 0.0) else ratio_se
     settled = (
         not notes
         and config.settled_margin > 0.0
         and config.tolerance < posterior.width <= config.cap_tolerance
+        # the ratio's model term must bound it where its statistical error goes
+        and (
+            not math.isfinite(ratio)
+            or bool(np.all(np.asarray(_on_grid(statics_model.model_sd, table.grid)) > 0.0))
+        )
+        # long enough for the slip check's reference (its first half holds min_periods), which
+        # the cap's window would have had
+        and fit is not None
+        and fit.duration * omega1 >= 4.0 * math.pi * config.min_periods
         and posterior.width
         <= (1.0 + config.settled_margin)
-        * _floors_width(posterior, posterior_with, ratio_limit, chosen)
+        * _floors_width(posterior, posterior_with, omega1, omega1_crb, chosen)
     )
     if (
         not notes
         and not chosen
         and (posterior.width <= config.tolerance or settled)
         and choose_branch is not None
-        and config.branch_by_second_mode
+        # a settled window skips the cap, which would have asked
+        and (config.branch_by_second_mode or settled)
         and math.isfinite(omega1)
     ):
         # About to declare one branch of two: the second contact mode, evidence independent of
@@ -388,20 +398,31 @@ def evaluate_window(
     )
 
 
+#: The floors' width is taken as its smallest over omega_1 within this many of its statistical
+#: standard errors: where the width moves with omega_1 (near the top of the sensing curve),
+#: the omega_1 unlimited data would read may leave a narrower interval than the current one.
+_FLOORS_SPAN = 2.0
+
+
 def _floors_width(
     posterior: ContactPosterior,
-    posterior_with: Callable[[float, float], ContactPosterior],
-    ratio_limit: float,
+    posterior_with: Callable[[float, float, float, float], ContactPosterior],
+    omega1: float,
+    omega1_crb: float,
     chosen: bool,
 ) -> float:
-    """Width (m) of the 95 % interval that unlimited data would leave: omega_1's standard error
-    gone (the drift term with it: a longer window outgrows a transient) and the ratio's at
-    ``ratio_limit``, the model floors kept; on the same branch when the second mode chose
-    one."""
-    limit = posterior_with(0.0, ratio_limit)
-    if chosen:
-        limit = limit.given_branch(posterior.branch_of(posterior.x_c))
-    return limit.width
+    """Width (m) of the 95 % interval that unlimited data could leave: every statistical error
+    gone (omega_1's with its drift term, since a longer window outgrows a transient; the
+    ratio's; a higher mode's), the model floors kept, at the narrowest over omega_1 within
+    :data:`_FLOORS_SPAN` of its Cramer-Rao standard errors; on the same branch when the second
+    mode chose one."""
+    widths = []
+    for k in (-_FLOORS_SPAN, 0.0, _FLOORS_SPAN):
+        limit = posterior_with(omega1 + k * omega1_crb, 0.0, 0.0, 0.0)
+        if chosen:
+            limit = limit.given_branch(limit.branch_of(posterior.x_c))
+        widths.append(limit.width)
+    return min(widths)
 
 
 def _on_grid(values: FloatArray | None, grid: FloatArray) -> float | FloatArray:
