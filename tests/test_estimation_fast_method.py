@@ -825,6 +825,10 @@ def test_an_interval_the_floors_hold_above_the_tolerance_is_declared_without_wai
     # long enough that its first half can be the slip check's reference, as the cap's is
     periods = (declared.end_index - declared.start_index) * TS * declared.omega1 / (2 * math.pi)
     assert periods >= 2 * config.min_periods
+    # and the online form, fed sample by sample, settles on the same window with the same answer
+    online = _online(blind, FastMethod(config))
+    keys = ("status", "x_c", "t_e", "interval")
+    assert [getattr(online, key) for key in keys] == [getattr(settled, key) for key in keys]
 
 
 def test_second_mode_chooses_the_branch_near_the_peak() -> None:
