@@ -10,7 +10,7 @@ loop is simulated on a model clock: sample k arrives at k T_s, the loop feeds wh
 arrived (``update_block``) and the clock advances by the measured processing (CPU) time.
 Reported per recording: t_e - t_1 (data time), the answer's arrival - t_1 (the delay a robot
 sees), and the mean and largest time of one evaluation; the paper method's arrival beside it.
-One run with a tolerance no window meets shows the answer at the cap.
+One run with a tolerance no window meets, and no settled declaration, shows the answer at the cap.
 Prints tables and writes ``benchmarks/results/estimation.json`` and, for the real-time loop,
 ``estimation_realtime.png``.
 Run: ``python benchmarks/bench_estimation.py`` (about 20 s once the kernels are compiled);
