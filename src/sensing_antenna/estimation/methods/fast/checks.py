@@ -50,6 +50,7 @@ __all__ = [
     "opening_check",
     "peak_check",
     "periods_check",
+    "periods_held",
     "problems",
     "push_agrees",
     "ratio_check",
@@ -63,10 +64,15 @@ __all__ = [
 _SAME_MODE = 0.1
 
 
+def periods_held(fit: DampedSinusoidFit, omega1: float) -> float:
+    """How many periods of ``omega1`` (rad/s) the window of ``fit`` holds."""
+    return fit.duration * omega1 / (2.0 * math.pi)
+
+
 def periods_check(fit: DampedSinusoidFit, omega1: float, config: FastConfig) -> str:
     """Why the window is too short for a frequency: it holds fewer than ``min_periods`` periods
     of ``omega1`` (rad/s); "" when it holds enough."""
-    periods = fit.duration * omega1 / (2.0 * math.pi)
+    periods = periods_held(fit, omega1)
     if periods < config.min_periods:
         return f"the window holds {periods:.2f} periods of omega_1"
     return ""
@@ -101,7 +107,7 @@ def drift_check(
     """
     if reference is None or reference_mode is None:
         return math.nan, "no fundamental on the shorter window to check its drift"
-    ref_periods = reference.duration * omega1 / (2.0 * math.pi)
+    ref_periods = periods_held(reference, omega1)
     if ref_periods < config.min_periods:
         # Below min_periods the shorter window's own fundamental is too loose to see a
         # drift of the size that matters here: "no change seen" would mean nothing
@@ -148,7 +154,7 @@ def is_slip_reference(
     and a mode of ``band``, detected, within :data:`_SAME_MODE` of it: the fundamental, which
     need not be the strongest (the free plane's, :mod:`.planes`).
     """
-    if half is None or half.duration * omega1 < 2.0 * math.pi * config.min_periods:
+    if half is None or periods_held(half, omega1) < config.min_periods:
         # Statics of a window too short for the model are not a reference (mode and offset
         # are confounded below a period or so)
         return False

@@ -29,6 +29,7 @@ from sensing_antenna.estimation.methods.fast.checks import (
     is_slip_reference,
     opening_check,
     peak_check,
+    periods_held,
     push_agrees,
     ratio_check,
 )
@@ -255,6 +256,8 @@ def evaluate_window(
     ratio = statics.ratio if statics is not None else math.nan
     ratio_se = statics.standard_error if statics is not None else math.nan
     push_force = statics.perpendicular_force if statics is not None else 0.0
+    ratio_model = _on_grid(statics_model.model_sd, table.grid)
+    frequency_model = _on_grid(statics_model.omega1_sd, table.grid)
 
     def posterior_with(
         omega: float, frequency_se: float, ratio_se: float, higher_se: float
@@ -267,13 +270,13 @@ def evaluate_window(
             frequency_se,
             ratio,
             ratio_se,
-            _on_grid(statics_model.model_sd, table.grid),
+            ratio_model,
             frequency_floor,
             higher_modes_of_x=table.higher,
             omega_higher=omega_h,
             omega_higher_se=higher_se,
             higher_mode_floor=config.higher_mode_floor,
-            frequency_model=_on_grid(statics_model.omega1_sd, table.grid),
+            frequency_model=frequency_model,
         )
 
     posterior = posterior_with(omega1, omega1_se, ratio_se, omega_h_se)
@@ -332,14 +335,11 @@ def evaluate_window(
         and config.settled_margin > 0.0
         and config.tolerance < posterior.width <= config.cap_tolerance
         # the ratio's model term must bound it where its statistical error goes
-        and (
-            not math.isfinite(ratio)
-            or bool(np.all(np.asarray(_on_grid(statics_model.model_sd, table.grid)) > 0.0))
-        )
+        and (not math.isfinite(ratio) or bool(np.all(np.asarray(ratio_model) > 0.0)))
         # long enough for the slip check's reference (its first half holds min_periods), which
         # the cap's window would have had
         and fit is not None
-        and fit.duration * omega1 >= 4.0 * math.pi * config.min_periods
+        and periods_held(fit, omega1) >= 2.0 * config.min_periods
         and posterior.width
         <= (1.0 + config.settled_margin)
         * _floors_width(posterior, posterior_with, omega1, omega1_crb, chosen)
