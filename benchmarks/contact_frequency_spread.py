@@ -61,6 +61,22 @@ BANDS = ((0.30, 0.45), (0.50, 0.65), (0.70, 0.90))
 WINDOWS = ((0.0, 0.35), (0.35, 0.5), (0.5, 0.7), (0.7, 1.01))
 
 
+def on_curve(row: dict[str, Any], key: str) -> bool:
+    """Whether the contact held and its reading ``key`` is the fundamental (not another
+    vibration, not missing)."""
+    value = row[key]
+    return bool(row["held"]) and value is not None and abs(value) < OTHER_VIBRATION
+
+
+def rms_summary(values: list[float]) -> dict[str, Any]:
+    """Count and root mean square (per cent; None for no value) of ``values``."""
+    read = np.array(values, dtype=float)
+    return {
+        "n": int(read.size),
+        "rms_percent": float(np.sqrt(np.mean(read**2))) if read.size else None,
+    }
+
+
 def settling(rows: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
     """Root mean square (per cent) of the early window's offset from the same contact's
     whole-hold offset, by the window's length (s): the part of the spread the settling
@@ -68,26 +84,20 @@ def settling(rows: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
     both = [
         r
         for r in rows
-        if r["held"]
-        and r["fast_status"] == "ok"
-        and r["fast_offset_percent"] is not None
-        and r["offset_percent"] is not None
-        and max(abs(r["fast_offset_percent"]), abs(r["offset_percent"])) < OTHER_VIBRATION
+        if r["fast_status"] == "ok"
+        and on_curve(r, "fast_offset_percent")
+        and on_curve(r, "offset_percent")
     ]
-    out = {}
-    for low, high in WINDOWS:
-        inside = np.array(
+    return {
+        f"{low:.2f}-{high:.2f}": rms_summary(
             [
                 r["fast_offset_percent"] - r["offset_percent"]
                 for r in both
                 if low <= r["fast_window_s"] < high
             ]
         )
-        out[f"{low:.2f}-{high:.2f}"] = {
-            "n": int(inside.size),
-            "rms_percent": float(np.sqrt(np.mean(inside**2))) if inside.size else None,
-        }
-    return out
+        for low, high in WINDOWS
+    }
 
 
 def main() -> None:
@@ -151,13 +161,10 @@ def main() -> None:
         kept = [r for r in read_at if abs(r[key]) < OTHER_VIBRATION]
         read = np.array([r[key] for r in kept])
         rms = float(np.sqrt(np.mean(read**2)))
-        bands = {}
-        for low, high in BANDS:
-            inside = np.array([r[key] for r in kept if low <= r["x_c"] <= high])
-            bands[f"{low:.2f}-{high:.2f}"] = {
-                "n": int(inside.size),
-                "rms_percent": float(np.sqrt(np.mean(inside**2))) if inside.size else None,
-            }
+        bands = {
+            f"{low:.2f}-{high:.2f}": rms_summary([r[key] for r in kept if low <= r["x_c"] <= high])
+            for low, high in BANDS
+        }
         summary[name] = {
             "held": len(read_at),
             "other_vibration": len(read_at) - len(kept),
@@ -187,10 +194,7 @@ def main() -> None:
                 [
                     r["offset_percent"]
                     for r in rows
-                    if r["held"]
-                    and r["friction"] == mu
-                    and r["offset_percent"] is not None
-                    and abs(r["offset_percent"]) < OTHER_VIBRATION
+                    if r["friction"] == mu and on_curve(r, "offset_percent")
                 ]
             )
         )
