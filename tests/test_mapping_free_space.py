@@ -122,6 +122,36 @@ def test_a_simulated_sweep_is_free_until_before_its_contact(case: str, x_c: floa
     assert recording.t[touching[-1]] >= true_contact
 
 
+def test_the_touching_link_presses_the_object_on_an_identified_head() -> None:
+    # the head as a lab prepares it: its observer identified on free sweeps, which leaves the
+    # residual of a vertical sweep near the onset's level for a while before a contact, so the
+    # onset can come centimetres before the touch; the link taken as touching must not: it is
+    # at or just past the simulator's contact instant (a few mrad of head turn at most)
+    from sensing_antenna.calibration.observer import identify_free_motion
+    from sensing_antenna.campaign.simulated import knowing_weight
+    from sensing_antenna.estimation.front.contact_frame import motor_axes
+
+    device = paper_antenna()
+    free = [
+        simulate(device, Scenario(case=case, seed=seed, duration=4.0))
+        for seed, case in ((20, "free"), (21, "free-vertical"))
+    ]
+    model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
+    recording = simulate(
+        knowing_weight(device, model), Scenario(case="vertical", contact_point=0.5, seed=12)
+    )
+    true_contact = float(recording.metadata["true_t_contact"])
+    _, touch = recording_links(recording, model)
+    assert touch is not None
+    at_contact = recording.theta[np.searchsorted(recording.t, true_contact)]
+    touching = np.asarray(touch[1])[0]
+    ahead = motor_axes(np.array([at_contact, touching]))[:, 0]
+    turn = math.acos(min(1.0, float(ahead[0] @ ahead[1])))
+    direction = np.sign(recording.theta[-1, 1] - recording.theta[0, 1])
+    assert (touching[1] - at_contact[1]) * direction >= 0.0
+    assert turn < 0.005
+
+
 def test_a_free_line_through_a_sphere_costs_its_depth_over_its_sigma() -> None:
     radius, link_radius, sigma = 0.05, 0.001, 0.002
     centre = np.array([0.6, 0.0, 0.0])

@@ -153,7 +153,7 @@ def swept_from_recordings(
     """Where the recordings' links swept untouched, and where they touched when their points
     (``points``, in the same order) are not ``ok`` (``mapping.free_space.recording_links``:
     the angles before the onset of the detected contact, short of it by the onset turn of a
-    contact at an ``ok`` point's x_c, and the link at that onset).
+    contact at an ``ok`` point's x_c, and the link when the contact was detected).
 
     Raises
     ------

@@ -29,9 +29,11 @@ before the onset by :data:`ONSET_FACTOR` times that twentieth (:func:`onset_turn
 estimate's abscissa, else the link's length: the most compliant contact turns the head
 furthest) and by the filter's lag at the head's speed there. Turns are the angle the link's
 direction X^m turns through, not a difference of motor angles (an azimuth step turns the link by
-cos(theta2) of it). A recording without a detected contact adds no free space: a
-contact too light to detect, sliding over an edge, bends the link as far as one just below the
-threshold, so its angles do not say where the link was.
+cos(theta2) of it). The onset can come well before the touch, where the free motion's residual
+stays near its level for a while (it only shortens the free part); the link that touched is
+taken at t_c, when it is pressing the object. A recording without a detected contact adds no
+free space: a contact too light to detect, sliding over an edge, bends the link as far as one
+just below the threshold, so its angles do not say where the link was.
 
 For recognition (``mapping.recognition``) a :class:`FreeSpace` gives one residual per sweep:
 how far its link reaches into a shape, beyond the link's own radius, over its standard
@@ -174,9 +176,9 @@ class FreeSpace:
 
 @dataclass(frozen=True, eq=False)
 class Touches(FreeSpace):
-    """The link at each contact's onset, where it touched the object somewhere along its length
-    (the attributes of :class:`FreeSpace`, one group per contact): a shape that comes nowhere
-    near such a link is refuted, r_j = max(0, min_k (d(q_k) - a) / sigma_k)."""
+    """The link of each contact when it was detected, touching the object somewhere along its
+    length (the attributes of :class:`FreeSpace`, one group per contact): a shape that comes
+    nowhere near such a link is refuted, r_j = max(0, min_k (d(q_k) - a) / sigma_k)."""
 
     def residuals(self, signed_distance: FloatArray) -> FloatArray:
         """r_j, shape (n_sweeps,), from a shape's signed distance (m) at every sample, shape
@@ -255,9 +257,10 @@ def recording_links(
     """What a recording says of its link: the free part of its sweep (:func:`free_before` the
     onset of its detected contact, by the :func:`onset_turn` of a contact at ``point``'s x_c
     when it is ``ok``, else at the tip, and by the residual filter's lag at the head's speed),
-    and the link at that onset when ``point`` (the recording's estimate) is not ``ok``: an
-    ``ok`` point says more (None then, and without a detected contact); both in the recording's
-    ``base_pose``.
+    and the link when the contact was detected (t_c) when ``point`` (the recording's estimate)
+    is not ``ok``: an ``ok`` point says more (None then, and without a detected contact); both
+    in the recording's ``base_pose``. The onset, looked back for, can come well before the
+    touch (where the free motion's residual is large); the link at t_c is pressing the object.
 
     Raises
     ------
@@ -283,7 +286,8 @@ def recording_links(
     ok = point is not None and point.status is Status.OK
     x_c = point.x_c if point is not None and ok else math.nan
     free = free_before(recording.theta, t, onset, onset_turn(antenna, x_c) + rate * lag)
-    return (pose, free), None if ok else (pose, recording.theta[at : at + 1])
+    detected = int(detection.index) if detection.index is not None else at
+    return (pose, free), None if ok else (pose, recording.theta[detected : detected + 1])
 
 
 def free_space(
