@@ -288,6 +288,7 @@ def run(
     seed: int,
     workdir: Path,
     link: str = "nonlinear",
+    until_recognised: int = 0,
 ) -> dict[str, Any]:
     out = workdir / f"{scene.name}-{strategy}"
     resumed = out.exists()
@@ -296,7 +297,10 @@ def run(
         shutil.copy(calibrated, out / CALIBRATED_FILE)
     start = time.perf_counter()
     result = explore(
-        scene, paper_antenna(), out, ExploreSettings(method, strategy, seed=seed, link=link)
+        scene,
+        paper_antenna(),
+        out,
+        ExploreSettings(method, strategy, seed=seed, link=link, until_recognised=until_recognised),
     )
     elapsed = time.perf_counter() - start
     manoeuvres = result.manoeuvres
@@ -488,6 +492,13 @@ def main() -> None:
         default=WORKING_DISTANCE,
         help="the other bases' distance from the object (m; 0: the first base's)",
     )
+    parser.add_argument(
+        "--until-recognised",
+        type=int,
+        default=0,
+        metavar="N",
+        help="after the budget, up to N more sweeps while recognition abstains",
+    )
     parser.add_argument("--out", type=Path, default=RESULTS)
     parser.add_argument(
         "--keep",
@@ -521,6 +532,7 @@ def main() -> None:
                         args.seed,
                         workdir,
                         args.link,
+                        args.until_recognised,
                     ),
                 }
                 rows.append(row)

@@ -422,6 +422,33 @@ def test_a_larger_budget_goes_on_from_the_stored_manoeuvres(tmp_path: Path) -> N
     assert grown.manoeuvres[1].sweep != grown.manoeuvres[0].sweep
 
 
+def test_an_unrecognised_object_is_swept_on_where_the_leaders_disagree(
+    explored: tuple[Path, list[Manoeuvre]], tmp_path: Path
+) -> None:
+    # four sweeps' points are too few to recognise anything by (but enough for a surface):
+    # after the budget, the two sweeps until_recognised allows are run, both next-best
+    # candidates the planner scored; a second start with the same settings runs nothing, and a
+    # larger budget goes on with the grid's next sweep
+    scene = load_scene("post")
+    out = tmp_path / "more"
+    out.mkdir()
+    (out / "calibrated.toml").write_text((explored[0] / "calibrated.toml").read_text())
+    settings = ExploreSettings(method="paper", budget=4, until_recognised=2)
+    most: list[int] = []
+    first = explore(scene, DEVICE, out, settings, lambda m, n: most.append(n))
+    assert most == [6] * 6
+    assert first.contact_map.recognition is None
+    grid = grid_sweeps(scene)
+    sweeps = [m.sweep for m in first.manoeuvres]
+    assert sweeps[:4] == grid[:4] and len(set(sweeps)) == 6
+    assert set(sweeps[4:]) <= set(candidate_sweeps(scene))
+    assert all(np.isfinite(m.score) for m in first.manoeuvres[4:])
+    again = explore(scene, DEVICE, out, settings)
+    assert [m.to_dict() for m in again.manoeuvres] == [m.to_dict() for m in first.manoeuvres]
+    grown = explore(scene, DEVICE, out, ExploreSettings(method="paper", budget=7))
+    assert [m.sweep for m in grown.manoeuvres[6:]] == [grid[4]]
+
+
 def _outline_contacts(
     scene: Scene, rng: np.random.Generator, sigma: float, sweeps: list[Sweep] | None = None
 ) -> np.ndarray:

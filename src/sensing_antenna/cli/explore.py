@@ -50,6 +50,16 @@ def register(subparsers: Any) -> None:
         help="most manoeuvres (sweeps); default: the scene's grid size",
     )
     parser.add_argument(
+        "--until-recognised",
+        type=_count,
+        default=0,
+        metavar="N",
+        help=(
+            "after the budget, while the object is not recognised, up to N more sweeps, each "
+            "where the two leading shapes disagree most (default 0)"
+        ),
+    )
+    parser.add_argument(
         "--antenna", default="paper-2021", help="the simulated device: built-in name or TOML file"
     )
     parser.add_argument("--seed", type=_seed, default=0, help="seed of the first manoeuvre")
@@ -71,6 +81,16 @@ def _positive_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be at least 0, got {value}")
     return value
 
 
@@ -100,9 +120,10 @@ def _run(args: argparse.Namespace) -> int:
         seed=args.seed,
         include_uncertain=args.include_uncertain,
         link=args.link,
+        until_recognised=args.until_recognised,
     )
 
-    def show(manoeuvre: Manoeuvre, budget: int) -> None:
+    def show(manoeuvre: Manoeuvre, most: int) -> None:
         point = manoeuvre.point
         what = manoeuvre.outcome
         if point is not None:
@@ -112,7 +133,7 @@ def _run(args: argparse.Namespace) -> int:
                 what += f" at ({x:.3f}, {y:.3f}, {z:.3f}) m, std {1000 * point.std:.1f} mm"
         elif manoeuvre.reason:
             what += f" ({manoeuvre.reason})"
-        print(f"[{manoeuvre.index + 1}/{budget}] {manoeuvre.sweep.label}: {what}", flush=True)
+        print(f"[{manoeuvre.index + 1}/{most}] {manoeuvre.sweep.label}: {what}", flush=True)
 
     print(
         f"exploring scene {scene.name} ({len(scene.objects)} objects, {len(scene.bases)} base"

@@ -22,7 +22,9 @@ retract, re-plan), on the simulator:
 
 The next-best strategy refits the surface before each manoeuvre and recognises the points before
 every :data:`RECOGNITION_EVERY`-th, aiming at the two leading classes while recognition abstains
-(``exploration.plan``).
+(``exploration.plan``). After the budget, either strategy may go on while recognition abstains
+(``ExploreSettings.until_recognised``): it recognises the points before each further manoeuvre,
+stops once a class is named, and otherwise sweeps where the two leading fits disagree most.
 
 Manoeuvre i is simulated with the seed ``seed + i``. Everything is stored as it is made
 (``exploration.store``); a second start with the same settings resumes after the last stored
@@ -32,6 +34,7 @@ points, makes the same choices.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 import os
@@ -150,6 +153,11 @@ class ExploreSettings:
         The simulated link (``Scenario.link_model``), of the calibration and of every sweep:
         the geometrically exact link (the default: a physical link shortens as it bends), or
         the small-deflection one.
+    until_recognised : int
+        After the budget, while recognition abstains (or has too few points to answer), up to
+        this many more manoeuvres, each the sweep that best tells the two leading classes apart
+        (``NextBestPlanner.choose(separate=True)``), recognising again after each; 0 stops at
+        the budget.
     """
 
     method: str = "fast"
@@ -158,6 +166,7 @@ class ExploreSettings:
     seed: int = 0
     include_uncertain: bool = False
     link: str = "nonlinear"
+    until_recognised: int = 0
 
     def __post_init__(self) -> None:
         if self.method not in EXPLORE_METHODS:
@@ -166,6 +175,8 @@ class ExploreSettings:
             raise ValueError(f"strategy must be one of {', '.join(STRATEGIES)}")
         if self.budget is not None and self.budget < 1:
             raise ValueError("budget must be at least 1")
+        if self.until_recognised < 0:
+            raise ValueError("until_recognised must be at least 0")
         if self.link not in LINK_MODELS:
             raise ValueError(f"link must be one of {', '.join(LINK_MODELS)}")
 
@@ -287,13 +298,20 @@ def _check_stored_sweeps(
 ) -> None:
     """Refuse stored manoeuvres that this strategy would not have swept: an exploration made
     by another version of the planner (a grid that swept one way only, say) would go on with
-    sweeps that repeat or skip its own. The grid's must be its first sweeps in order;
-    next-best's, sweeps of its grid or of its candidates."""
-    allowed = None if strategy == "grid" else {*grid, *candidate_sweeps(scene)}
+    sweeps that repeat or skip its own. The grid's own sweeps must come in its order, and any
+    other must be a next-best candidate the planner chose (a sweep after the budget, aimed at
+    recognition, with its score); next-best's, sweeps of its grid or of its candidates."""
+    candidates = set(candidate_sweeps(scene))
+    allowed = {*grid, *candidates}
+    seen: set[Sweep] = set()
     for index, manoeuvre in enumerate(manoeuvres):
         sweep = manoeuvre.sweep
-        if allowed is None:
-            fits = index < len(grid) and sweep == grid[index]
+        following = next((g for g in grid if g not in seen), None)
+        seen.add(sweep)
+        if strategy == "grid" and sweep == following:
+            continue
+        if strategy == "grid":
+            fits = sweep in candidates and not math.isnan(manoeuvre.score)
         else:
             fits = sweep in allowed
         if not fits:
@@ -304,6 +322,17 @@ def _check_stored_sweeps(
                 "sweeps there (an exploration made by another version); explore into another "
                 "output directory"
             )
+
+
+def _grid_end(done: Sequence[Sweep], grid: Sequence[Sweep], budget: int) -> int:
+    """How many manoeuvres the grid's own plan takes: the budget, or, once every grid sweep
+    is among ``done``, the manoeuvres up to the one that completed it, if fewer."""
+    left = set(grid)
+    for index, sweep in enumerate(done):
+        left.discard(sweep)
+        if not left:
+            return min(budget, index + 1)
+    return budget
 
 
 def _scene_fingerprint(scene: Scene) -> str:
@@ -338,7 +367,8 @@ def explore(
         Output directory (created; resumed when it holds the same exploration).
     settings : ExploreSettings, optional
     progress : callable, optional
-        Called with each new manoeuvre and the budget.
+        Called with each new manoeuvre and the most manoeuvres the exploration may make (the
+        budget and ``until_recognised``).
     meshes : mapping of str to trimesh.Trimesh, optional
         User meshes recognition registers beside the shape classes (``antenna map --objects``).
 
@@ -378,25 +408,36 @@ def explore(
             shape = LinkShape(device.link)
             controlled = knowing_weight(device, antenna)
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
+            aim = planner
             leaders: tuple[ClassFit, ...] = ()
-            while len(manoeuvres) < budget:
+            while True:
                 index = len(manoeuvres)
-                if planner is None:
-                    if index >= len(grid):
-                        break
-                    choice: Choice | None = Choice(grid[index], math.nan, np.full(3, np.nan))
-                else:
-                    points = [m.point for m in manoeuvres if m.point is not None]
+                done = [m.sweep for m in manoeuvres]
+                free = [m.sweep for m in manoeuvres if m.outcome == "free"]
+                points = [m.point for m in manoeuvres if m.point is not None]
+                end = budget if planner is not None else _grid_end(done, grid, budget)
+                choice: Choice | None = None
+                if index < end and planner is None:
+                    # the grid's next sweep (one is left until the grid ends)
+                    following = next(sweep for sweep in grid if sweep not in done)
+                    choice = Choice(following, math.nan, np.full(3, np.nan))
+                elif index < end and planner is not None:
                     surface = fit_surface(points, settings.include_uncertain)
                     if index % RECOGNITION_EVERY == 0:
                         swept = swept_links(manoeuvres, scene, antenna, out, recorded)
-                        leaders = _undecided_leaders(points, settings.include_uncertain, swept)
-                    choice = planner.choose(
-                        [m.sweep for m in manoeuvres],
-                        surface,
-                        [m.sweep for m in manoeuvres if m.outcome == "free"],
-                        leaders,
-                    )
+                        _, leaders = _recognition_state(points, settings.include_uncertain, swept)
+                    choice = planner.choose(done, surface, free, leaders)
+                elif index < end + settings.until_recognised:
+                    swept = swept_links(manoeuvres, scene, antenna, out, recorded)
+                    decided, leaders = _recognition_state(points, settings.include_uncertain, swept)
+                    if decided:
+                        break
+                    aim = aim if aim is not None else NextBestPlanner(scene, shape)
+                    surface = fit_surface(points, settings.include_uncertain)
+                    choice = aim.choose(done, surface, free, leaders, separate=True)
+                    if choice is not None and math.isnan(choice.score):
+                        # chosen before a surface could be fitted: still the planner's choice
+                        choice = dataclasses.replace(choice, score=0.0)
                 if choice is None:
                     break
                 manoeuvre = _run_one(
@@ -405,7 +446,7 @@ def explore(
                 write_manoeuvre(out, manoeuvre)
                 manoeuvres.append(manoeuvre)
                 if progress is not None:
-                    progress(manoeuvre, budget)
+                    progress(manoeuvre, end + settings.until_recognised)
                 raise_if_signalled()
         except KeyboardInterrupt as exc:
             write_manoeuvre_table(out, manoeuvres)
@@ -431,7 +472,7 @@ def swept_links(
     own angles before its detected contact's onset when it has one (in its own frame,
     ``base_pose``) after the unrecorded approach as planned, else (a glancing touch, not
     simulated) the planned angles short of the geometric touch by the onset turn of a contact at
-    the tip. Touched: the link at the onset of each detected contact whose point is not ``ok``
+    the tip. Touched: the link at the detection of each contact whose point is not ``ok``
     (an ``ok`` point says more), and at each glancing touch. ``recorded`` keeps each
     manoeuvre's recording's :func:`~sensing_antenna.mapping.free_space.recording_links` and
     first angles by its index between calls (a stored recording does not change), so that each
@@ -458,9 +499,9 @@ def swept_links(
                     recording_links(recording, antenna, m.point),
                     recording.theta[0],
                 )
-            ((pose, free_angles), onset), first = links[m.index]
-            if onset is not None:
-                touched.append([onset])
+            ((pose, free_angles), touching), first = links[m.index]
+            if touching is not None:
+                touched.append([touching])
             # the recording's frame is turned to the touch's angles: its swept angle plus the
             # touch's is the sweep's, and the simulated approach may begin before the sweep did
             joint = 0 if sweep.case == "azimuthal" else 1
@@ -478,17 +519,20 @@ def swept_links(
     return free_space(free, antenna), touches(touched, antenna)
 
 
-def _undecided_leaders(
+def _recognition_state(
     points: list[ContactPoint], include_uncertain: bool, swept: Sequence[FreeSpace]
-) -> tuple[ClassFit, ...]:
-    """The two fits recognition abstains between (the best and its rival, or the two leading
-    scores) when it abstains and both are primitives, else none."""
+) -> tuple[bool, tuple[ClassFit, ...]]:
+    """Whether recognition names a class from the points so far, and, when it abstains, the
+    two fits it abstains between (the best and its rival, or the two leading scores) if both
+    are primitives (else none)."""
     recognition = recognise_points(points, include_uncertain, swept=swept)
-    if recognition is None or not recognition.undecided:
-        return ()
+    if recognition is None:
+        return False, ()
+    if not recognition.undecided:
+        return True, ()
     by_name = {f.name: f for f in recognition.fits}
     leaders = tuple(by_name[name] for name in recognition.candidates)
-    return leaders if all(f.name in PRIMITIVES for f in leaders) else ()
+    return False, leaders if all(f.name in PRIMITIVES for f in leaders) else ()
 
 
 def _run_one(
