@@ -468,6 +468,13 @@ def write_results(
     )
 
 
+def _count(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be at least 0, got {value}")
+    return value
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scenes", type=int, default=12)
@@ -494,7 +501,7 @@ def main() -> None:
     )
     parser.add_argument(
         "--until-recognised",
-        type=int,
+        type=_count,
         default=0,
         metavar="N",
         help="after the budget, up to N more sweeps while recognition abstains",

@@ -390,6 +390,16 @@ def test_antenna_explore_bad_scene_is_one_line(
     )
 
 
+def test_antenna_explore_negative_until_recognised_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as caught:
+        main(["explore", "post", "--out", str(tmp_path / "x"), "--until-recognised", "-1"])
+    assert caught.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "antenna explore: error: --until-recognised: must be at least 0, got -1"
+
+
 def test_stored_sweeps_this_grid_would_not_make_are_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -422,13 +432,13 @@ def test_a_larger_budget_goes_on_from_the_stored_manoeuvres(tmp_path: Path) -> N
     assert grown.manoeuvres[1].sweep != grown.manoeuvres[0].sweep
 
 
-def test_an_unrecognised_object_is_swept_on_where_the_leaders_disagree(
+def test_an_unrecognised_object_is_swept_on_after_the_budget(
     explored: tuple[Path, list[Manoeuvre]], tmp_path: Path
 ) -> None:
     # four sweeps' points are too few to recognise anything by (but enough for a surface):
     # after the budget, the two sweeps until_recognised allows are run, both next-best
-    # candidates the planner scored; a second start with the same settings runs nothing, and a
-    # larger budget goes on with the grid's next sweep
+    # candidates the planner scored, stored as aimed at recognition; a second start with the
+    # same settings runs nothing, and a larger budget goes on with the grid's next sweep
     scene = load_scene("post")
     out = tmp_path / "more"
     out.mkdir()
@@ -443,10 +453,31 @@ def test_an_unrecognised_object_is_swept_on_where_the_leaders_disagree(
     assert sweeps[:4] == grid[:4] and len(set(sweeps)) == 6
     assert set(sweeps[4:]) <= set(candidate_sweeps(scene))
     assert all(np.isfinite(m.score) for m in first.manoeuvres[4:])
+    assert [m.aim for m in first.manoeuvres] == ["plan"] * 4 + ["recognition"] * 2
     again = explore(scene, DEVICE, out, settings)
     assert [m.to_dict() for m in again.manoeuvres] == [m.to_dict() for m in first.manoeuvres]
     grown = explore(scene, DEVICE, out, ExploreSettings(method="paper", budget=7))
     assert [m.sweep for m in grown.manoeuvres[6:]] == [grid[4]]
+
+
+def test_an_object_recognised_at_the_budget_ends_the_exploration(
+    explored: tuple[Path, list[Manoeuvre]], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # recognition that names an object (here a stand-in that always does) leaves nothing to
+    # sweep for after the budget
+    import types
+
+    import sensing_antenna.exploration.run as run
+
+    monkeypatch.setattr(
+        run, "recognise_points", lambda *args, **kwargs: types.SimpleNamespace(undecided=False)
+    )
+    out = tmp_path / "named"
+    out.mkdir()
+    (out / "calibrated.toml").write_text((explored[0] / "calibrated.toml").read_text())
+    settings = ExploreSettings(method="paper", budget=2, until_recognised=3)
+    result = explore(load_scene("post"), DEVICE, out, settings)
+    assert [m.aim for m in result.manoeuvres] == ["plan", "plan"]
 
 
 def _outline_contacts(

@@ -55,8 +55,8 @@ def register(subparsers: Any) -> None:
         default=0,
         metavar="N",
         help=(
-            "after the budget, while the object is not recognised, up to N more sweeps, each "
-            "where the two leading shapes disagree most (default 0)"
+            "after the budget, while the object is not recognised, up to N more sweeps, aimed "
+            "at telling the two leading shapes apart (default 0)"
         ),
     )
     parser.add_argument(

@@ -38,9 +38,7 @@ when it is not touched at all, the larger of the two ways round, at most :data:`
 inside one, or when a distance is not finite. The score is then
 sqrt(score^2 + (s / (1 + crowd))^2), and a candidate the leaders disagree about is never
 relegated as a predicted miss: a contact, or free space, where the leaders differ separates
-them; one where they agree does not. After its budget, an exploration that has not yet
-recognised its object asks for the sweep that separates the leaders most (``separate``), the
-score above only choosing between sweeps that separate them equally, or when none does.
+them; one where they agree does not.
 """
 
 from __future__ import annotations
@@ -231,14 +229,11 @@ class NextBestPlanner:
         surface: ImplicitSurface | None,
         free: Sequence[Sweep] = (),
         leaders: Sequence[ClassFit] = (),
-        separate: bool = False,
     ) -> Choice | None:
         """The next sweep given the sweeps run so far, the surface fitted to their contacts
         (None until there is one), those of them that touched nothing, and the two leading
         shape classes' fits when recognition abstains between them (module docstring); None
-        when every candidate has been run. With ``separate``, the sweep that separates the
-        leaders most (over one plus its crowd) comes first, the usual score deciding between
-        equals and when no sweep separates them."""
+        when every candidate has been run."""
         nan3 = np.full(3, np.nan)
         if surface is None:
             for sweep in self.opening:
@@ -254,8 +249,8 @@ class NextBestPlanner:
             free_cloud = cKDTree(
                 np.concatenate([self._swept(sweep).reshape(-1, 3) for sweep in free])
             )
-        best: tuple[tuple[float, float], Choice] | None = None
-        fallback: tuple[tuple[float, float], Choice] | None = None
+        best: tuple[float, Choice] | None = None
+        fallback: tuple[float, Choice] | None = None
         for sweep in left:
             separation = self.separation(sweep, leaders) if len(leaders) == 2 else 0.0
             point, closest = self._predicted_touch(sweep, surface)
@@ -276,12 +271,11 @@ class NextBestPlanner:
                 distance = float(free_cloud.query(point)[0])
                 score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
             score = math.hypot(score, separation / (1.0 + crowd))
-            rank = (separation / (1.0 + crowd) if separate else 0.0, score)
-            entry = (rank, Choice(sweep, score, point, std, probability))
+            entry = (score, Choice(sweep, score, point, std, probability))
             if closest > MISS_MARGIN and separation == 0.0:
-                if fallback is None or rank > fallback[0]:
+                if fallback is None or score > fallback[0]:
                     fallback = entry
-            elif best is None or rank > best[0]:
+            elif best is None or score > best[0]:
                 best = entry
         chosen = best if best is not None else fallback
         assert chosen is not None

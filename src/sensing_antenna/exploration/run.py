@@ -24,7 +24,8 @@ The next-best strategy refits the surface before each manoeuvre and recognises t
 every :data:`RECOGNITION_EVERY`-th, aiming at the two leading classes while recognition abstains
 (``exploration.plan``). After the budget, either strategy may go on while recognition abstains
 (``ExploreSettings.until_recognised``): it recognises the points before each further manoeuvre,
-stops once a class is named, and otherwise sweeps where the two leading fits disagree most.
+stops once a class is named, and otherwise takes next-best's choice with the two leading
+fits, which aims at telling them apart.
 
 Manoeuvre i is simulated with the seed ``seed + i``. Everything is stored as it is made
 (``exploration.store``); a second start with the same settings resumes after the last stored
@@ -34,7 +35,6 @@ points, makes the same choices.
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import math
 import os
@@ -154,10 +154,11 @@ class ExploreSettings:
         the geometrically exact link (the default: a physical link shortens as it bends), or
         the small-deflection one.
     until_recognised : int
-        After the budget, while recognition abstains (or has too few points to answer), up to
-        this many more manoeuvres, each the sweep that best tells the two leading classes apart
-        (``NextBestPlanner.choose(separate=True)``), recognising again after each; 0 stops at
-        the budget.
+        After the budget (or the grid's last sweep, if sooner), while recognition abstains (or
+        has too few points to answer), up to this many more manoeuvres, recognising before
+        each: next-best's choice with the two leading classes (``NextBestPlanner.choose``,
+        which aims at telling them apart; its usual choice when there are no two leading
+        primitives); 0 stops at the budget.
     """
 
     method: str = "fast"
@@ -298,20 +299,18 @@ def _check_stored_sweeps(
 ) -> None:
     """Refuse stored manoeuvres that this strategy would not have swept: an exploration made
     by another version of the planner (a grid that swept one way only, say) would go on with
-    sweeps that repeat or skip its own. The grid's own sweeps must come in its order, and any
-    other must be a next-best candidate the planner chose (a sweep after the budget, aimed at
-    recognition, with its score); next-best's, sweeps of its grid or of its candidates."""
-    candidates = set(candidate_sweeps(scene))
-    allowed = {*grid, *candidates}
+    sweeps that repeat or skip its own. The grid's planned sweeps must come in its order;
+    next-best's, and any sweep aimed at recognition, must be sweeps of the grid or of the
+    next-best candidates (where the budget ended is not stored: an aimed sweep may stand
+    anywhere)."""
+    allowed = {*grid, *candidate_sweeps(scene)}
     seen: set[Sweep] = set()
     for index, manoeuvre in enumerate(manoeuvres):
         sweep = manoeuvre.sweep
         following = next((g for g in grid if g not in seen), None)
         seen.add(sweep)
-        if strategy == "grid" and sweep == following:
-            continue
-        if strategy == "grid":
-            fits = sweep in candidates and not math.isnan(manoeuvre.score)
+        if strategy == "grid" and manoeuvre.aim == "plan":
+            fits = sweep == following
         else:
             fits = sweep in allowed
         if not fits:
@@ -410,6 +409,16 @@ def explore(
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
             aim = planner
             leaders: tuple[ClassFit, ...] = ()
+            last = len(manoeuvres) - len(manoeuvres) % RECOGNITION_EVERY
+            if planner is not None and last < len(manoeuvres) < budget:
+                # resumed between recognitions: the leaders the last one found
+                earlier = manoeuvres[:last]
+                _, leaders = _recognition_state(
+                    [m.point for m in earlier if m.point is not None],
+                    settings.include_uncertain,
+                    swept_links(earlier, scene, antenna, out, recorded),
+                    meshes,
+                )
             while True:
                 index = len(manoeuvres)
                 done = [m.sweep for m in manoeuvres]
@@ -417,6 +426,7 @@ def explore(
                 points = [m.point for m in manoeuvres if m.point is not None]
                 end = budget if planner is not None else _grid_end(done, grid, budget)
                 choice: Choice | None = None
+                purpose = "plan"
                 if index < end and planner is None:
                     # the grid's next sweep (one is left until the grid ends)
                     following = next(sweep for sweep in grid if sweep not in done)
@@ -425,23 +435,25 @@ def explore(
                     surface = fit_surface(points, settings.include_uncertain)
                     if index % RECOGNITION_EVERY == 0:
                         swept = swept_links(manoeuvres, scene, antenna, out, recorded)
-                        _, leaders = _recognition_state(points, settings.include_uncertain, swept)
+                        _, leaders = _recognition_state(
+                            points, settings.include_uncertain, swept, meshes
+                        )
                     choice = planner.choose(done, surface, free, leaders)
                 elif index < end + settings.until_recognised:
                     swept = swept_links(manoeuvres, scene, antenna, out, recorded)
-                    decided, leaders = _recognition_state(points, settings.include_uncertain, swept)
+                    decided, leaders = _recognition_state(
+                        points, settings.include_uncertain, swept, meshes
+                    )
                     if decided:
                         break
                     aim = aim if aim is not None else NextBestPlanner(scene, shape)
                     surface = fit_surface(points, settings.include_uncertain)
-                    choice = aim.choose(done, surface, free, leaders, separate=True)
-                    if choice is not None and math.isnan(choice.score):
-                        # chosen before a surface could be fitted: still the planner's choice
-                        choice = dataclasses.replace(choice, score=0.0)
+                    choice = aim.choose(done, surface, free, leaders)
+                    purpose = "recognition"
                 if choice is None:
                     break
                 manoeuvre = _run_one(
-                    scene, controlled, antenna, shape, choice, index, settings, out
+                    scene, controlled, antenna, shape, choice, index, settings, out, purpose
                 )
                 write_manoeuvre(out, manoeuvre)
                 manoeuvres.append(manoeuvre)
@@ -520,12 +532,15 @@ def swept_links(
 
 
 def _recognition_state(
-    points: list[ContactPoint], include_uncertain: bool, swept: Sequence[FreeSpace]
+    points: list[ContactPoint],
+    include_uncertain: bool,
+    swept: Sequence[FreeSpace],
+    meshes: Mapping[str, trimesh.Trimesh] | None = None,
 ) -> tuple[bool, tuple[ClassFit, ...]]:
-    """Whether recognition names a class from the points so far, and, when it abstains, the
-    two fits it abstains between (the best and its rival, or the two leading scores) if both
-    are primitives (else none)."""
-    recognition = recognise_points(points, include_uncertain, swept=swept)
+    """Whether recognition (the map's, with the user's ``meshes``) names an object from the
+    points so far, and, when it abstains, the two fits it abstains between (the best and its
+    rival, or the two leading scores) if both are primitives (else none)."""
+    recognition = recognise_points(points, include_uncertain, meshes, swept=swept)
     if recognition is None:
         return False, ()
     if not recognition.undecided:
@@ -544,6 +559,7 @@ def _run_one(
     index: int,
     settings: ExploreSettings,
     out: Path,
+    aim: str,
 ) -> Manoeuvre:
     from sensing_antenna.mapping.contact_map import points_from_recordings
 
@@ -574,4 +590,5 @@ def _run_one(
         recording=recording_name,
         point=point,
         score=choice.score,
+        aim=aim,
     )

@@ -44,6 +44,7 @@ from sensing_antenna.mapping.points import ContactPoint
 from sensing_antenna.scene.sweep import Sweep
 
 __all__ = [
+    "AIMS",
     "CALIBRATED_FILE",
     "ExplorationStoreError",
     "Manoeuvre",
@@ -61,6 +62,9 @@ CALIBRATED_FILE = "calibrated.toml"
 RECORDINGS_DIR = "recordings"
 MANOEUVRES_DIR = "manoeuvres"
 TABLE_FILE = "manoeuvres.csv"
+
+#: What may choose a manoeuvre's sweep (``Manoeuvre.aim``).
+AIMS = ("plan", "recognition")
 
 
 class ExplorationStoreError(SensingAntennaError):
@@ -90,7 +94,11 @@ class Manoeuvre:
     point : ContactPoint or None
         The estimated touched point (any status), for a touch.
     score : float
-        The planner's score of the sweep (m; NaN for a grid sweep).
+        The planner's score of the sweep (m; NaN for a grid sweep, and for one chosen before
+        a surface could be fitted).
+    aim : {"plan", "recognition"}
+        What chose the sweep: the strategy's plan (within the budget), or the sweeps after it
+        while recognition abstains (``ExploreSettings.until_recognised``).
     """
 
     index: int
@@ -103,6 +111,11 @@ class Manoeuvre:
     recording: str | None
     point: ContactPoint | None
     score: float
+    aim: str = "plan"
+
+    def __post_init__(self) -> None:
+        if self.aim not in AIMS:
+            raise ValueError(f"aim: {self.aim!r} is not one of {', '.join(AIMS)}")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able fields."""
@@ -117,6 +130,7 @@ class Manoeuvre:
             "recording": self.recording,
             "point": None if self.point is None else point_to_dict(self.point),
             "score": None if not np.isfinite(self.score) else self.score,
+            "aim": self.aim,
         }
 
     @classmethod
@@ -134,6 +148,7 @@ class Manoeuvre:
             recording=data.get("recording"),
             point=None if data.get("point") is None else point_from_dict(data["point"]),
             score=float("nan") if data.get("score") is None else float(data["score"]),
+            aim=str(data.get("aim", "plan")),
         )
 
 
@@ -269,6 +284,7 @@ _TABLE_COLUMNS = (
     "error",
     "sweep_time",
     "score",
+    "aim",
     "recording",
     "reason",
 )
@@ -303,6 +319,7 @@ def write_manoeuvre_table(out: Path, manoeuvres: Sequence[Manoeuvre]) -> Path:
                 "" if not np.isfinite(error) else f"{error:.6g}",
                 f"{m.sweep_time:.4g}",
                 "" if not np.isfinite(m.score) else f"{m.score:.6g}",
+                m.aim,
                 m.recording or "",
                 m.reason or (point.reason if point is not None and point.reason else ""),
             ]

@@ -223,9 +223,10 @@ def _point(
 def _swept(
     links: Sequence[tuple[Piece, Piece | None]], antenna: Antenna
 ) -> tuple[FreeSpace, Touches]:
-    """The free space of every recording's links and the touches of those with an onset."""
+    """The free space of every recording's links and the touches of those with a touching
+    link."""
     free = [[recorded] for recorded, _ in links]
-    touched = [[onset] for _, onset in links if onset is not None]
+    touched = [[touching] for _, touching in links if touching is not None]
     return free_space(free, antenna), touches(touched, antenna)
 
 

@@ -17,11 +17,13 @@ acceleration alpha loads the link with rho_l alpha x per length, a quasi-static 
 of 11 rho_l alpha l^5 / (120 E I), 3.5 mm for the paper's link at 0.8 rad/s^2 (the peak of a
 smooth ramp to 0.3 rad/s in 0.6 s), which the first mode overshoots by about half.
 
-When a contact is detected at t_c the link has been pressing the object for a while: the
-contact detector (``detection.contact``, Section 4.2 of the paper) waits for the external
-torque to cross its threshold tau_th, which a contact at x reaches once the head has turned on
-by tau_th x / (3 E I) (a cantilever loaded at x: its base torque F x = 3 E I delta / x^2 for the
-deflection delta = x dtheta), some centimetres of link. The contact's onset is found looking
+When a contact is detected at t_c the link is pressing the object: the contact detector
+(``detection.contact``, Section 4.2 of the paper) waits for the external torque to cross its
+threshold tau_th, which a contact at x reaches once the head has turned on by tau_th x / (3 E I)
+(a cantilever loaded at x: its base torque F x = 3 E I delta / x^2 for the deflection
+delta = x dtheta), some centimetres of link at the paper's threshold (0.02 N m), well under a
+millimetre at one identified on free sweeps (about 1e-4 N m), where the residual filter's lag
+sets t_c. The contact's onset is found looking
 back from t_c: the last sample where the detector's filtered residual was at most
 :data:`ONSET_FRACTION` of the threshold, a level a contact reaches after a twentieth of that
 turn plus the residual filter's lag (:func:`contact_onset`). The free part of a sweep ends
@@ -286,7 +288,10 @@ def recording_links(
     ok = point is not None and point.status is Status.OK
     x_c = point.x_c if point is not None and ok else math.nan
     free = free_before(recording.theta, t, onset, onset_turn(antenna, x_c) + rate * lag)
-    detected = int(detection.index) if detection.index is not None else at
+    # t_c on the recording's own samples (the detector may have resampled them); a finite
+    # onset means a detected contact
+    t_c = float(detection.t_c) if detection.t_c is not None else onset
+    detected = int(np.clip(np.searchsorted(t, t_c), 0, len(t) - 1))
     return (pose, free), None if ok else (pose, recording.theta[detected : detected + 1])
 
 
@@ -305,8 +310,8 @@ def touches(
     antenna: Antenna,
     uncertainty: PointUncertainty | None = None,
 ) -> Touches:
-    """The links at the onsets of ``contacts`` (each one or more :data:`Piece`, usually one
-    angle), sampled as :func:`free_space` samples them."""
+    """The links of ``contacts`` when each was detected (each one or more :data:`Piece`,
+    usually one angle), sampled as :func:`free_space` samples them."""
     return Touches(*_sampled(contacts, antenna, uncertainty))
 
 
