@@ -71,6 +71,7 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
+from sensing_antenna.cli.arguments import integer  # noqa: E402
 from sensing_antenna.exploration import ExploreSettings, explore, prepare_device  # noqa: E402
 from sensing_antenna.exploration.run import swept_links  # noqa: E402
 from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
@@ -468,13 +469,6 @@ def write_results(
     )
 
 
-def _count(text: str) -> int:
-    value = int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be at least 0, got {value}")
-    return value
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scenes", type=int, default=12)
@@ -501,7 +495,7 @@ def main() -> None:
     )
     parser.add_argument(
         "--until-recognised",
-        type=_count,
+        type=integer(0),
         default=0,
         metavar="N",
         help="after the budget, up to N more sweeps while recognition abstains",

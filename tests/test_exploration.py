@@ -397,7 +397,7 @@ def test_antenna_explore_negative_until_recognised_is_one_line(
         main(["explore", "post", "--out", str(tmp_path / "x"), "--until-recognised", "-1"])
     assert caught.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert err == "antenna explore: error: --until-recognised: must be at least 0, got -1"
+    assert err == "antenna explore: error: --until-recognised: must be an integer >= 0, got -1"
 
 
 def test_stored_sweeps_this_grid_would_not_make_are_refused(

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.arguments import integer
 from sensing_antenna.cli.map import add_map_options
 
 #: ``exploration.plan.STRATEGIES`` and ``scene.file.BUILTIN_SCENES``, written out: importing
@@ -51,7 +52,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--until-recognised",
-        type=_count,
+        type=integer(0),
         default=0,
         metavar="N",
         help=(
@@ -81,16 +82,6 @@ def _positive_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
-    return value
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be at least 0, got {value}")
     return value
 
 
