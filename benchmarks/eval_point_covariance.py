@@ -1,8 +1,8 @@
 """A contact point's covariance against its error, on the linear and the geometrically exact link.
 
 The touches are the first touches of ``eval_explore.py``'s scenes (its grid sweeps from every
-base), each simulated twice, with the simulator's linear link (the default, which ``antenna
-explore`` uses) and with its geometrically exact link (``link_model = "nonlinear"``), and
+base), each simulated twice, with the simulator's linear link (``link_model = "linear"``) and
+with its geometrically exact link (the one ``antenna explore`` simulates by default), and
 estimated with ``--method`` after the README's calibration. For every ``ok`` estimate: the
 Mahalanobis distance of the simulator's true contact point under the point's covariance
 (``mapping.contact_point_from_estimate``; a calibrated 3-D covariance gives a median of 1.54 and
