@@ -39,9 +39,9 @@ class FastConfig:
         check passes, the interval is within ``cap_tolerance``, the window is long enough for
         the slip check's reference, and the interval is at most this fraction wider than the
         narrowest one unlimited data could leave (every statistical error gone, the model
-        floors kept, omega_1 anywhere within two of its standard errors): the floors hold it
-        above the tolerance, and waiting for the cap would narrow it little. 0.1; 0 waits for
-        the cap.
+        floors kept, the narrowest of omega_1 and two of its standard errors either side):
+        the floors hold it above the tolerance, and waiting for the cap would narrow it
+        little. 0.1; 0 waits for the cap.
     cadence : float
         Shortest time between evaluations of the growing window (s). 10 ms: on short windows
         the declaration comes at most this late after the first instant that would be sure.

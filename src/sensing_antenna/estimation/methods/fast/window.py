@@ -398,9 +398,10 @@ def evaluate_window(
     )
 
 
-#: The floors' width is taken as its smallest over omega_1 within this many of its statistical
-#: standard errors: where the width moves with omega_1 (near the top of the sensing curve),
-#: the omega_1 unlimited data would read may leave a narrower interval than the current one.
+#: The floors' width is taken as its smallest at omega_1 and this many of its Cramer-Rao
+#: standard errors either side: where the width moves with omega_1 (near the top of the sensing
+#: curve), the omega_1 unlimited data would read may leave a narrower interval than the current
+#: one.
 _FLOORS_SPAN = 2.0
 
 
@@ -413,9 +414,9 @@ def _floors_width(
 ) -> float:
     """Width (m) of the 95 % interval that unlimited data could leave: every statistical error
     gone (omega_1's with its drift term, since a longer window outgrows a transient; the
-    ratio's; a higher mode's), the model floors kept, at the narrowest over omega_1 within
-    :data:`_FLOORS_SPAN` of its Cramer-Rao standard errors; on the same branch when the second
-    mode chose one."""
+    ratio's; a higher mode's), the model floors kept, the narrowest at omega_1 and
+    :data:`_FLOORS_SPAN` of its Cramer-Rao standard errors either side; on the same branch
+    when the second mode chose one."""
     widths = []
     for k in (-_FLOORS_SPAN, 0.0, _FLOORS_SPAN):
         limit = posterior_with(omega1 + k * omega1_crb, 0.0, 0.0, 0.0)
