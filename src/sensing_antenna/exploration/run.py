@@ -304,13 +304,10 @@ def _check_stored_sweeps(
     next-best candidates (where the budget ended is not stored: an aimed sweep may stand
     anywhere)."""
     allowed = {*grid, *candidate_sweeps(scene)}
-    seen: set[Sweep] = set()
     for index, manoeuvre in enumerate(manoeuvres):
         sweep = manoeuvre.sweep
-        following = next((g for g in grid if g not in seen), None)
-        seen.add(sweep)
         if strategy == "grid" and manoeuvre.aim == "plan":
-            fits = sweep == following
+            fits = sweep == _next_grid_sweep(grid, [m.sweep for m in manoeuvres[:index]])
         else:
             fits = sweep in allowed
         if not fits:
@@ -321,6 +318,12 @@ def _check_stored_sweeps(
                 "sweeps there (an exploration made by another version); explore into another "
                 "output directory"
             )
+
+
+def _next_grid_sweep(grid: Sequence[Sweep], done: Sequence[Sweep]) -> Sweep | None:
+    """The grid's first sweep not among ``done`` (None once every one is)."""
+    swept = set(done)
+    return next((sweep for sweep in grid if sweep not in swept), None)
 
 
 def _grid_end(done: Sequence[Sweep], grid: Sequence[Sweep], budget: int) -> int:
@@ -407,18 +410,22 @@ def explore(
             shape = LinkShape(device.link)
             controlled = knowing_weight(device, antenna)
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
-            aim = planner
+            # the planner of the sweeps after the budget (next-best's own, or one made then)
+            chooser = planner
             leaders: tuple[ClassFit, ...] = ()
+
+            def recognised(upto: list[Manoeuvre]) -> tuple[bool, tuple[ClassFit, ...]]:
+                return _recognition_state(
+                    [m.point for m in upto if m.point is not None],
+                    settings.include_uncertain,
+                    swept_links(upto, scene, antenna, out, recorded),
+                    meshes,
+                )
+
             last = len(manoeuvres) - len(manoeuvres) % RECOGNITION_EVERY
             if planner is not None and last < len(manoeuvres) < budget:
                 # resumed between recognitions: the leaders the last one found
-                earlier = manoeuvres[:last]
-                _, leaders = _recognition_state(
-                    [m.point for m in earlier if m.point is not None],
-                    settings.include_uncertain,
-                    swept_links(earlier, scene, antenna, out, recorded),
-                    meshes,
-                )
+                _, leaders = recognised(manoeuvres[:last])
             while True:
                 index = len(manoeuvres)
                 done = [m.sweep for m in manoeuvres]
@@ -426,34 +433,28 @@ def explore(
                 points = [m.point for m in manoeuvres if m.point is not None]
                 end = budget if planner is not None else _grid_end(done, grid, budget)
                 choice: Choice | None = None
-                purpose = "plan"
+                aim = "plan"
                 if index < end and planner is None:
-                    # the grid's next sweep (one is left until the grid ends)
-                    following = next(sweep for sweep in grid if sweep not in done)
+                    following = _next_grid_sweep(grid, done)  # one is left until the grid ends
+                    assert following is not None
                     choice = Choice(following, math.nan, np.full(3, np.nan))
                 elif index < end and planner is not None:
                     surface = fit_surface(points, settings.include_uncertain)
                     if index % RECOGNITION_EVERY == 0:
-                        swept = swept_links(manoeuvres, scene, antenna, out, recorded)
-                        _, leaders = _recognition_state(
-                            points, settings.include_uncertain, swept, meshes
-                        )
+                        _, leaders = recognised(manoeuvres)
                     choice = planner.choose(done, surface, free, leaders)
                 elif index < end + settings.until_recognised:
-                    swept = swept_links(manoeuvres, scene, antenna, out, recorded)
-                    decided, leaders = _recognition_state(
-                        points, settings.include_uncertain, swept, meshes
-                    )
+                    decided, leaders = recognised(manoeuvres)
                     if decided:
                         break
-                    aim = aim if aim is not None else NextBestPlanner(scene, shape)
+                    chooser = chooser if chooser is not None else NextBestPlanner(scene, shape)
                     surface = fit_surface(points, settings.include_uncertain)
-                    choice = aim.choose(done, surface, free, leaders)
-                    purpose = "recognition"
+                    choice = chooser.choose(done, surface, free, leaders)
+                    aim = "recognition"
                 if choice is None:
                     break
                 manoeuvre = _run_one(
-                    scene, controlled, antenna, shape, choice, index, settings, out, purpose
+                    scene, controlled, antenna, shape, choice, index, settings, out, aim
                 )
                 write_manoeuvre(out, manoeuvre)
                 manoeuvres.append(manoeuvre)
