@@ -800,9 +800,9 @@ def test_an_interval_the_floors_hold_above_the_tolerance_is_declared_without_wai
     # frequency floor alone keeps the interval above 5 mm, so no window is ever sure at the
     # tolerance. Made to wait, the method answers at the cap (1 s); by default it answers as
     # soon as the interval is within cap_tolerance and within settled_margin of the width the
-    # floors could leave, 0.2 to 0.3 s after t_1: the same status, an interval a little wider
-    # than the cap's at most (the cap's is no narrower than its own floors' width), and both
-    # hold the contact abscissa.
+    # floors could leave, 0.2 to 0.3 s after t_1: the same status, an interval no narrower than
+    # the cap's (here equal, 7 mm on the 0.25 mm grid) and at most
+    # settled_margin wider, and both hold the contact abscissa.
     antenna = calibrated()
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.85, seed=4))
     truth = float(recording.metadata["true_xc"])
