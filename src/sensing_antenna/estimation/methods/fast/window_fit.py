@@ -215,7 +215,11 @@ def find_fundamental(
     across the link, (R_y, R_z) in the motor frame), when that mode vibrates mostly in the
     push plane, the strongest detected mode of the band that vibrates mostly in the free
     plane at most ``free_plane_margin`` above it (:mod:`.planes`): out of its bending plane
-    the bent link keeps the straight link's omega_1, in it a held contact raises it.
+    the bent link keeps the straight link's omega_1, in it a held contact raises it, or lowers
+    it by at most a few per cent where the contact slides. So a free-plane mode more than the
+    margin above a detected push-plane mode is another vibration (the free plane's own where
+    the contact does not hold it), even when it is the strongest: the strongest such
+    push-plane mode is read instead.
     """
     if fit is None:
         return None, "window too short for the model"
@@ -225,13 +229,12 @@ def find_fundamental(
     detection = fit.detection()
     if push_direction is not None:
         share = free_plane_share(fit, push_direction)
-        free = np.flatnonzero(
-            fit.in_band(band)
-            & (share > 0.5)
-            & (fit.omega <= (1.0 + config.free_plane_margin) * fit.omega[k])
-            & (detection >= config.min_detection)
-            & np.isfinite(fit.omega_se)
-        )
+        usable = fit.in_band(band) & (detection >= config.min_detection) & np.isfinite(fit.omega_se)
+        ceiling = 1.0 + config.free_plane_margin
+        held_below = np.flatnonzero(usable & (share < 0.5) & (ceiling * fit.omega < fit.omega[k]))
+        if share[k] > 0.5 and held_below.size:
+            k = int(held_below[np.argmax(detection[held_below])])
+        free = np.flatnonzero(usable & (share > 0.5) & (fit.omega <= ceiling * fit.omega[k]))
         if free.size and not share[k] > 0.5:
             k = int(free[np.argmax(detection[free])])
     if detection[k] < config.min_detection:
