@@ -390,14 +390,23 @@ def test_antenna_explore_bad_scene_is_one_line(
     )
 
 
-def test_antenna_explore_negative_until_recognised_is_one_line(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize(
+    ("option", "value", "problem"),
+    [
+        ("--until-recognised", "-1", "must be an integer >= 0, got -1"),
+        ("--budget", "0", "must be an integer >= 1, got 0"),
+        ("--seed", "-1", "must be an integer from 0 to 2147483647, got -1"),
+        ("--seed", "1.5", "must be an integer from 0 to 2147483647, got '1.5'"),
+    ],
+)
+def test_antenna_explore_bad_counts_are_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str, problem: str
 ) -> None:
     with pytest.raises(SystemExit) as caught:
-        main(["explore", "post", "--out", str(tmp_path / "x"), "--until-recognised", "-1"])
+        main(["explore", "post", "--out", str(tmp_path / "x"), option, value])
     assert caught.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert err == "antenna explore: error: --until-recognised: must be an integer >= 0, got -1"
+    assert err == f"antenna explore: error: {option}: {problem}"
 
 
 def test_stored_sweeps_this_grid_would_not_make_are_refused(

@@ -46,7 +46,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--budget",
-        type=_positive_int,
+        type=integer(1),
         default=None,
         help="most manoeuvres (sweeps); default: the scene's grid size",
     )
@@ -63,7 +63,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--antenna", default="paper-2021", help="the simulated device: built-in name or TOML file"
     )
-    parser.add_argument("--seed", type=_seed, default=0, help="seed of the first manoeuvre")
+    parser.add_argument(
+        "--seed", type=integer(0, 2**31 - 1), default=0, help="seed of the first manoeuvre"
+    )
     parser.add_argument(
         "--link",
         choices=("nonlinear", "linear"),
@@ -73,26 +75,6 @@ def register(subparsers: Any) -> None:
     add_map_options(parser, "the map and the planner's surface")
     parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre")
     parser.set_defaults(func=_run)
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
-    return value
-
-
-def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
-    if not 0 <= value < 2**31:
-        raise argparse.ArgumentTypeError(f"must be from 0 to 2^31 - 1, got {value}")
-    return value
 
 
 def _run(args: argparse.Namespace) -> int:
