@@ -216,10 +216,11 @@ def find_fundamental(
     push plane, the strongest detected mode of the band that vibrates mostly in the free
     plane at most ``free_plane_margin`` above it (:mod:`.planes`): out of its bending plane
     the bent link keeps the straight link's omega_1, in it a held contact raises it, or lowers
-    it by at most a few per cent where the contact slides. So a free-plane mode more than the
-    margin above a detected push-plane mode is another vibration (the free plane's own where
-    the contact does not hold it), even when it is the strongest: the strongest such
-    push-plane mode is read instead.
+    it by at most a few per cent where the contact slides. So when the strongest mode lies in
+    the free plane more than the margin above a detected push-plane mode, and no push-plane
+    mode lies within the margin below it, it is another vibration (the free plane's own where
+    the contact does not hold it): the fundamental is chosen as above from the strongest of
+    those push-plane modes.
     """
     if fit is None:
         return None, "window too short for the model"
@@ -229,11 +230,16 @@ def find_fundamental(
     detection = fit.detection()
     if push_direction is not None:
         share = free_plane_share(fit, push_direction)
-        usable = fit.in_band(band) & (detection >= config.min_detection) & np.isfinite(fit.omega_se)
+        detected = fit.in_band(band) & (detection >= config.min_detection)
         ceiling = 1.0 + config.free_plane_margin
-        held_below = np.flatnonzero(usable & (share < 0.5) & (ceiling * fit.omega < fit.omega[k]))
-        if share[k] > 0.5 and held_below.size:
-            k = int(held_below[np.argmax(detection[held_below])])
+        pushed = detected & (share < 0.5) & (fit.omega <= fit.omega[k])
+        far_below = pushed & (ceiling * fit.omega < fit.omega[k])
+        if share[k] > 0.5 and far_below.any() and not (pushed & ~far_below).any():
+            # no push-plane mode corroborates the free plane's: the push plane's is read (a
+            # fit that cannot bound its frequency gives no fundamental, below)
+            below = np.flatnonzero(far_below)
+            k = int(below[np.argmax(detection[below])])
+        usable = detected & np.isfinite(fit.omega_se)
         free = np.flatnonzero(usable & (share > 0.5) & (fit.omega <= ceiling * fit.omega[k]))
         if free.size and not share[k] > 0.5:
             k = int(free[np.argmax(detection[free])])
