@@ -52,7 +52,7 @@ from sensing_antenna.mapping import (  # noqa: E402
 RESULTS = Path(__file__).resolve().parent / "results" / "recognition.json"
 CLASSES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
 #: Median width of the fast method's 95 % interval on the default campaign (m).
-FAST_INTERVAL_WIDTH = 0.004
+FAST_INTERVAL_WIDTH = 0.00525
 #: The surface is scored where the points are: mesh vertices within this of a contact (m).
 NEAR = 0.01
 
