@@ -263,10 +263,13 @@ def mahalanobis(points: list[Any]) -> list[float]:
 
 def surface_z(points: list[Any], mesh: trimesh.Trimesh) -> list[float]:
     """Each point's signed distance to the true surface over its own standard deviation along
-    the surface's normal there (n^T Sigma n)^(1/2): what the covariance claims where the map and
-    recognition read it. The simulator's contact can slide along the surface during and after
-    the estimate's window, which moves the true contact point but not the surface; a calibrated
-    normal sigma gives a median |z| of 0.674 (the half-normal's)."""
+    the surface's normal there (n^T Sigma n)^(1/2), positive outside: what the covariance claims
+    where the map and recognition read it. The simulator's contact can slide along the surface
+    during and after the estimate's window, which moves the true contact point but not the
+    surface; a calibrated normal sigma gives a median |z| of 0.674 (the half-normal's) where the
+    surface is flat on the scale of the errors (an error e along a surface of radius R adds
+    about e^2 / (2 R) outward; near a box's edge the nearest face's normal need not be the
+    error's direction)."""
     if not points:
         return []
     located = np.array([p.point for p in points])

@@ -1371,7 +1371,7 @@ def test_a_free_plane_mode_far_above_is_not_read_even_when_strongest() -> None:
     """A link lowered at 0.63 m onto a bar whose top slopes 0.3 rad across it (the side of a
     capsule 14 cm in radius, exact link): it slides along the bar while it rings. The push plane
     rings at the contact's fundamental (70.6 rad/s on the curve), the free plane more strongly
-    near the free link's second mode (100 rad/s; about 93 here, with the contact's friction).
+    near the free link's second mode (about 100 rad/s; 93 to 94 here).
     Read as omega_1 that one puts x_c 9 cm out with a 1 cm interval, ``ok``; the push plane's
     is read. The head's observer is the one the README's preparation identifies on this device
     (``exploration.prepare_device``), whose contact detection ends the push."""

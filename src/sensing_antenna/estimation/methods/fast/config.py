@@ -81,9 +81,9 @@ class FastConfig:
         plane rings above the straight link's omega_1 where friction holds the contact along
         the obstacle and at most 4 % below it where it slides, the free plane within -0.9 to
         +2.3 % of it (pushes up to 31 % deflection, docs/estimation.md, "The two bending
-        planes"): 0.07. A free-plane mode further above a detected push-plane mode, with none
-        within the margin below it, is another vibration, such as the free plane's own where
-        friction does not hold the contact, and is not read even when it is the strongest.
+        planes"): 0.07. A free-plane mode further above every detected push-plane mode of the
+        band is another vibration, such as the free plane's own where friction does not hold
+        the contact, and is not read even when it is the strongest.
     max_modes : int
         Largest number of damped modes tried (BIC chooses 1 .. max_modes). 3: the fundamental
         and the two strongest modes above it. The touch and the stop excite contact modes 2

@@ -217,10 +217,9 @@ def find_fundamental(
     plane at most ``free_plane_margin`` above it (:mod:`.planes`): out of its bending plane
     the bent link keeps the straight link's omega_1, in it a held contact raises it, or lowers
     it by at most a few per cent where the contact slides. So when the strongest mode lies in
-    the free plane more than the margin above a detected push-plane mode, and no push-plane
-    mode lies within the margin below it, it is another vibration (the free plane's own where
-    the contact does not hold it): the fundamental is chosen as above from the strongest of
-    those push-plane modes.
+    the free plane more than the margin above every detected push-plane mode of the band, it
+    is another vibration (the free plane's own where the contact does not hold it): the
+    fundamental is chosen as above from the strongest of those push-plane modes.
     """
     if fit is None:
         return None, "window too short for the model"
@@ -232,12 +231,11 @@ def find_fundamental(
         share = free_plane_share(fit, push_direction)
         detected = fit.in_band(band) & (detection >= config.min_detection)
         ceiling = 1.0 + config.free_plane_margin
-        pushed = detected & (share < 0.5) & (fit.omega <= fit.omega[k])
-        far_below = pushed & (ceiling * fit.omega < fit.omega[k])
-        if share[k] > 0.5 and far_below.any() and not (pushed & ~far_below).any():
-            # no push-plane mode corroborates the free plane's: the push plane's is read (a
-            # fit that cannot bound its frequency gives no fundamental, below)
-            below = np.flatnonzero(far_below)
+        pushed = detected & (share < 0.5)
+        if share[k] > 0.5 and pushed.any() and np.all(ceiling * fit.omega[pushed] < fit.omega[k]):
+            # every push-plane mode far below the free plane's: the push plane's is read (a fit
+            # that cannot bound its frequency gives no fundamental, below)
+            below = np.flatnonzero(pushed)
             k = int(below[np.argmax(detection[below])])
         usable = detected & np.isfinite(fit.omega_se)
         free = np.flatnonzero(usable & (share > 0.5) & (fit.omega <= ceiling * fit.omega[k]))
