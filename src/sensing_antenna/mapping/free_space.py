@@ -233,11 +233,17 @@ def free_before(theta: ArrayLike, t: ArrayLike, onset: float, turn: float) -> Fl
     times = np.asarray(t, dtype=float).reshape(-1)
     if not math.isfinite(onset):
         return angles[:0]
-    at_onset = int(np.clip(np.searchsorted(times, onset), 0, len(angles) - 1))
+    at_onset = _sample_at(times, onset)
     before = angles[: at_onset + 1]
     far = _turn(before, angles[at_onset]) >= turn
     last = np.nonzero(far)[0]
     return before[: last[-1] + 1] if last.size else before[:0]
+
+
+def _sample_at(times: FloatArray, instant: float) -> int:
+    """The first sample at or after ``instant`` (s) of ``times`` (s, increasing), the last
+    one past the end."""
+    return int(np.clip(np.searchsorted(times, instant), 0, len(times) - 1))
 
 
 def _turn(theta: FloatArray, to: FloatArray) -> FloatArray:
@@ -275,7 +281,7 @@ def recording_links(
     if not math.isfinite(onset):
         return (pose, recording.theta[:0]), None
     t = recording.t
-    at = int(np.clip(np.searchsorted(t, onset), 0, len(t) - 1))
+    at = _sample_at(t, onset)
     # the head's turn rate over the filter's time constant before the onset
     lag = 1.0 / detection.residual_cutoff
     earlier = int(np.clip(np.searchsorted(t, onset - lag), 0, at))
@@ -289,9 +295,9 @@ def recording_links(
     x_c = point.x_c if point is not None and ok else math.nan
     free = free_before(recording.theta, t, onset, onset_turn(antenna, x_c) + rate * lag)
     # t_c on the recording's own samples (the detector may have resampled them); a finite
-    # onset means a detected contact
-    t_c = float(detection.t_c) if detection.t_c is not None else onset
-    detected = int(np.clip(np.searchsorted(t, t_c), 0, len(t) - 1))
+    # onset means a detected contact, which has its t_c
+    assert detection.t_c is not None
+    detected = _sample_at(t, detection.t_c)
     return (pose, free), None if ok else (pose, recording.theta[detected : detected + 1])
 
 
