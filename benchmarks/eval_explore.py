@@ -273,13 +273,12 @@ def surface_z(points: list[Any], mesh: trimesh.Trimesh) -> list[float]:
     if not points:
         return []
     located = np.array([p.point for p in points])
+    covariances = np.array([p.covariance for p in points])
     closest, _, faces = trimesh.proximity.closest_point(mesh, located)
     normals = mesh.face_normals[faces]
-    values = []
-    for p, c, n in zip(points, closest, normals, strict=True):
-        sigma = math.sqrt(float(n @ p.covariance @ n))
-        values.append(float((p.point - c) @ n) / sigma)
-    return values
+    signed = np.einsum("ni,ni->n", located - closest, normals)
+    sigma = np.sqrt(np.einsum("ni,nij,nj->n", normals, covariances, normals))
+    return [float(z) for z in signed / sigma]
 
 
 def swept_truth(scene: Scene, result: Any, out: Path) -> dict[str, Any]:
