@@ -40,6 +40,7 @@ import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 
+from eval_explore import CLASSES, make_object, size_error  # noqa: E402
 from sensing_antenna.antenna import load_antenna  # noqa: E402
 from sensing_antenna.estimation.result import ContactEstimate, Status  # noqa: E402
 from sensing_antenna.mapping import (  # noqa: E402
@@ -48,40 +49,13 @@ from sensing_antenna.mapping import (  # noqa: E402
     contact_point_from_estimate,
     recognise,
 )
+from sensing_antenna.scene import primitive_object  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "recognition.json"
-CLASSES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
 #: Median width of the fast method's 95 % interval on the default campaign (m).
 FAST_INTERVAL_WIDTH = 0.00525
 #: The surface is scored where the points are: mesh vertices within this of a contact (m).
 NEAR = 0.01
-
-
-def make_object(name: str, size: float, rng: np.random.Generator) -> tuple[Any, dict[str, Any]]:
-    """A trimesh of the class with largest dimension ``size`` (m), and its true sizes."""
-    if name == "sphere":
-        return trimesh.creation.icosphere(subdivisions=4, radius=size / 2), {"radius": size / 2}
-    if name == "cylinder":
-        radius = size * rng.uniform(0.2, 0.45)
-        mesh = trimesh.creation.cylinder(radius=radius, height=size, sections=96)
-        return mesh, {"radius": radius, "height": size}
-    if name == "capsule":
-        radius = size * rng.uniform(0.15, 0.3)
-        mesh = trimesh.creation.capsule(height=size - 2 * radius, radius=radius, count=[48, 48])
-        return mesh, {"radius": radius, "length": size - 2 * radius}
-    if name == "cone":
-        radius = size * rng.uniform(0.25, 0.5)
-        mesh = trimesh.creation.cone(radius=radius, height=size, sections=96)
-        return mesh, {"radius": radius, "height": size}
-    if name == "torus":
-        major = size / 2 * rng.uniform(0.55, 0.75)
-        minor = size / 2 - major
-        mesh = trimesh.creation.torus(
-            major_radius=major, minor_radius=minor, major_sections=96, minor_sections=48
-        )
-        return mesh, {"major_radius": major, "minor_radius": minor}
-    extents = np.array([size, size * rng.uniform(0.4, 1.0), size * rng.uniform(0.4, 1.0)])
-    return trimesh.creation.box(extents=extents), {"extents": sorted(extents.tolist())}
 
 
 def place(mesh: Any, rng: np.random.Generator) -> np.ndarray:
@@ -130,21 +104,14 @@ def contacts(
     return points, covariances, chosen
 
 
-def size_error(name: str, fitted: dict[str, float], truth: dict[str, Any]) -> float:
-    """Largest relative error over the class's sizes (box extents sorted)."""
-    if name == "box":
-        got = sorted(fitted.values())
-        return max(abs(a / b - 1) for a, b in zip(got, truth["extents"], strict=True))
-    return max(abs(fitted[k] / v - 1) for k, v in truth.items())
-
-
 def run_scene(
     index: int, n_contacts: int, deflection_ratio: float, antenna: Any, seed: int
 ) -> dict[str, Any]:
     rng = np.random.default_rng([seed, index])
     name = CLASSES[index % len(CLASSES)]
     size = rng.uniform(0.04, 0.20)
-    mesh, truth = make_object(name, size, rng)
+    sizes, truth = make_object(name, size, rng)
+    mesh = primitive_object(name, name, sizes).mesh
     place(mesh, rng)
     points, covariances, _ = contacts(mesh, n_contacts, antenna, deflection_ratio, rng)
     start = time.perf_counter()
