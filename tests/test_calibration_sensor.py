@@ -98,6 +98,8 @@ def test_calibration_undoes_the_cross_talk_on_new_contacts(
     # ratio's own noise at the default gentle push (a few per cent)
     assert fit.ratio_rms_before > 0.15
     assert fit.ratio_rms_after < 0.05
+    # and it predicts each contact left out of the fit: adopted
+    assert fit.adopted and fit.ratio_rms_held_out < 0.05
     # the scatter left is kept as the ratio's model floor: its rms over the degrees of freedom
     n = len(truth)
     expected = fit.ratio_rms_after * (n / (n - 4)) ** 0.5
@@ -115,6 +117,25 @@ def test_calibration_undoes_the_cross_talk_on_new_contacts(
         # 8 %: three times the ratio's scatter left on the calibration set
         assert abs(after / x_c - 1) < 0.08
         assert estimate(recording, corrected, "paper").status.value == "ok"
+
+
+def test_a_sensor_without_cross_talk_gets_no_correction() -> None:
+    # Six contacts of one sweep direction on a sensor that does not leak, each with its own
+    # noise: the ratio is 2 % off them (its noise at the default gentle push), and terms fitted
+    # to that take a little of it off those contacts but add to it on each left out of the fit
+    # (by a third to a half on three such sets): nothing is written, and the ratio's scatter is
+    # the uncorrected one.
+    recordings, truth = [], []
+    for i, x in enumerate(POINTS):
+        recording = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=x, seed=300 + i))
+        truth.append(float(recording.metadata["true_xc"]))
+        recordings.append(recording.without_ground_truth())
+    fit = calibrate_sensor(recordings, ANTENNA, truth)
+    assert fit.ratio_rms_after < fit.ratio_rms_before < fit.ratio_rms_held_out
+    assert not fit.adopted
+    assert dataclasses.replace(fit.correction, ratio_scatter=0.0) == SensorCorrection()
+    assert fit.correction.ratio_scatter == pytest.approx(fit.ratio_rms_before, rel=1e-6)
+    assert "not adopted" in fit.ratio_summary
 
 
 def test_one_sweep_direction_fits_its_own_terms_only(

@@ -18,8 +18,17 @@ not pull the fit). The loads are the hold's mean (the window the contact frame u
 the contact-free offset). A sweep about the azimuth fixes fy_gain, fy_per_tz and fz_per_tz;
 one about the elevation fz_gain, fz_per_ty and fy_per_ty; terms no recording fixes stay at no
 correction. The antenna's frequency model (T_e) should be calibrated first: the statics use its
-stiffness. The ratio's relative scatter about the known points left with the correction is
-kept as ``ratio_scatter``, a floor of the ratio's model uncertainty.
+stiffness.
+
+The correction is adopted only when it predicts contacts it was not fitted to: each recording is
+left out in turn, the terms fitted to the others, and the left-out ratio's error with that fit
+compared with its error uncorrected. Five contacts of one sweep direction on a sensor without
+cross-talk leave the ratio a few per cent off for other reasons (the sensor's noise at a gentle
+push, the statics' model); two terms fitted to that fit it on those contacts and lengthen the
+ratio elsewhere. When the held-out error with the correction is not below the error without it,
+no correction is written. The ratio's relative scatter about the known points left with the
+correction adopted (or without it) is kept as ``ratio_scatter``, a floor of the ratio's model
+uncertainty.
 """
 
 from __future__ import annotations
@@ -79,7 +88,12 @@ class SensorCalibration:
         Recordings left out and why.
     ratio_rms_before, ratio_rms_after : float
         RMS relative error of the hold's torque/force ratio against the known points, without
-        and with the correction (dimensionless).
+        and with the fitted correction (dimensionless).
+    ratio_rms_held_out : float
+        The same with each recording corrected by the terms fitted to the others.
+    adopted : bool
+        Whether the held-out error is below ``ratio_rms_before``; if not, ``correction`` is no
+        correction (its ``ratio_scatter`` the uncorrected ratio's).
     """
 
     correction: SensorCorrection
@@ -88,6 +102,8 @@ class SensorCalibration:
     notes: tuple[str, ...]
     ratio_rms_before: float
     ratio_rms_after: float
+    ratio_rms_held_out: float
+    adopted: bool
 
     def apply(self, antenna: Antenna) -> Antenna:
         """``antenna`` with this correction."""
@@ -95,10 +111,18 @@ class SensorCalibration:
 
     @property
     def ratio_summary(self) -> str:
-        """The ratio's error against the known points without and with the correction."""
-        return (
+        """The ratio's error against the known points without and with the correction, and
+        whether it was adopted."""
+        summary = (
             f"torque/force ratio against the known points {100 * self.ratio_rms_before:.1f} % "
-            f"rms before, {100 * self.ratio_rms_after:.1f} % after"
+            f"rms before, {100 * self.ratio_rms_after:.1f} % after, "
+            f"{100 * self.ratio_rms_held_out:.1f} % on each left out of the fit"
+        )
+        if self.adopted:
+            return summary
+        return (
+            f"{summary}: not adopted, the fit does not predict the contacts it was not fitted "
+            "to better than no correction (no cross-talk these recordings can tell)"
         )
 
 
@@ -177,31 +201,49 @@ def calibrate_sensor(
     def correction(params: FloatArray) -> SensorCorrection:
         return SensorCorrection(**dict(zip(terms, (float(p) for p in params), strict=True)))
 
-    def residuals(params: FloatArray) -> FloatArray:
-        corrected = correction(params).correct(reaction, moment)
-        ratio = perpendicular_ratio(corrected, moment, rigidity)
-        along = corrected[rows, lateral]
-        across = corrected[rows, 3 - lateral]
+    def residuals(params: FloatArray, keep: NDArray[np.bool_] | None = None) -> FloatArray:
+        """The ratio's relative errors, then the pushes' out-of-plane slopes, of the holds in
+        ``keep`` (all when None)."""
+        chosen = rows if keep is None else rows[keep]
+        corrected = correction(params).correct(reaction[chosen], moment[chosen])
+        ratio = perpendicular_ratio(corrected, moment[chosen], rigidity)
+        along = corrected[np.arange(chosen.size), lateral[chosen]]
+        across = corrected[np.arange(chosen.size), 3 - lateral[chosen]]
         with np.errstate(divide="ignore", invalid="ignore"):
             slope = np.where(np.abs(along) > 0, across / np.abs(along), 1.0)
-        return np.concatenate([ratio / points - 1.0, slope])
+        return np.concatenate([ratio / points[chosen] - 1.0, slope])
+
+    def fitted(keep: NDArray[np.bool_] | None = None) -> FloatArray:
+        found = least_squares(
+            lambda params: residuals(params, keep), start, loss="soft_l1", f_scale=_LOSS_SCALE
+        )
+        return np.asarray(found.x, dtype=float)
 
     start = np.array([getattr(SensorCorrection(), t) for t in terms], dtype=float)
     before = residuals(start)[: len(holds)]
-    fit = least_squares(residuals, start, loss="soft_l1", f_scale=_LOSS_SCALE)
-    after = residuals(fit.x)[: len(holds)]
-    # the ratio's scatter with the correction, over the degrees of freedom its in-plane terms
-    # leave (two per sweep direction)
-    finite = after[np.isfinite(after)]
-    dof = max(finite.size - 2 * len(sweeps), 1)
+    params = fitted()
+    after = residuals(params)[: len(holds)]
+    held_out = np.array(
+        [residuals(fitted(rows != i), rows == i)[0] for i in range(len(holds))], dtype=float
+    )
+    adopted = bool(_rms(held_out) < _rms(before))
+    # the ratio's scatter left, over the degrees of freedom the in-plane terms leave (two per
+    # sweep direction) when the correction is adopted
+    left = after if adopted else before
+    finite = left[np.isfinite(left)]
+    dof = max(finite.size - (2 * len(sweeps) if adopted else 0), 1)
     scatter = min(math.sqrt(float(np.sum(finite**2)) / dof), 1.0)
     return SensorCalibration(
-        correction=replace(correction(fit.x), ratio_scatter=scatter),
+        correction=replace(
+            correction(params) if adopted else SensorCorrection(), ratio_scatter=scatter
+        ),
         sweeps=sweeps,
         sources=tuple(n for _, n in kept),
         notes=tuple(notes),
         ratio_rms_before=_rms(before),
         ratio_rms_after=_rms(after),
+        ratio_rms_held_out=_rms(held_out),
+        adopted=adopted,
     )
 
 

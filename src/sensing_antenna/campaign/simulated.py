@@ -316,8 +316,8 @@ def calibrate_on_device(
         else:
             calibrated = sensor.apply(calibrated)
             progress.line(
-                f"preparation: sensor cross-talk fitted ({', '.join(sensor.sweeps)} sweeps); "
-                f"{sensor.ratio_summary}"
+                f"preparation: sensor cross-talk {'fitted' if sensor.adopted else 'tried'} "
+                f"({', '.join(sensor.sweeps)} sweeps); {sensor.ratio_summary}"
             )
     return calibration, calibrated
 

@@ -88,9 +88,12 @@ def _calibrate_sensor(
     except SensorCalibrationError as exc:
         return antenna, [f"sensor: not calibrated, {exc}; the antenna's [sensor] is kept"]
     terms = ", ".join(f"{k} = {v:.4g}" for k, v in vars(fit.correction).items())
+    fitted = f"on {len(fit.sources)} recordings ({', '.join(fit.sweeps)} sweeps)"
     lines = [
-        f"sensor: cross-talk fitted on {len(fit.sources)} recordings ({', '.join(fit.sweeps)} "
-        f"sweeps): {terms}; {fit.ratio_summary}"
+        f"sensor: cross-talk fitted {fitted}: {terms}; {fit.ratio_summary}"
+        if fit.adopted
+        else f"sensor: no cross-talk correction written ({fitted}; {fit.ratio_summary}); "
+        f"ratio_scatter = {fit.correction.ratio_scatter:.4g}"
     ]
     lines += [f"  sensor, left out: {note}" for note in fit.notes]
     return fit.apply(antenna), lines
