@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -97,3 +98,33 @@ def test_plot_sensing_curves(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     assert [p.name for p in paths] == ["figure8.png", "figure9.png"]
     for path in paths:
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_figure8_shows_the_papers_measurements_on_the_papers_link_only() -> None:
+    import dataclasses
+
+    import matplotlib.pyplot as plt
+
+    from sensing_antenna.antenna import paper_antenna
+    from sensing_antenna.plotting.sensing_curves import figure8
+
+    def labels(antenna: Any) -> list[str]:
+        fig = figure8(antenna)
+        found = [text.get_text() for text in fig.axes[0].get_legend().get_texts()]
+        plt.close(fig)
+        return found
+
+    paper = paper_antenna()
+    assert labels(paper) == [
+        "f1 (T = 0.2281 s/m$^2$)",
+        "f2 (T = 0.2281 s/m$^2$)",
+        "f3 (T = 0.2281 s/m$^2$)",
+        "f1 with the paper's T_e = 0.2124",
+        "the paper's measured f1 band",
+    ]
+    # the paper's link calibrated: its own T_e, named so, beside the paper's
+    assert labels(paper.with_calibrated_t(0.23))[0] == "f1 (T_e = 0.2300 s/m$^2$)"
+    assert labels(paper.with_calibrated_t(0.2124))[3:] == ["the paper's measured f1 band"]
+    # another link: its own curves only
+    other = dataclasses.replace(paper, link=dataclasses.replace(paper.link, length=0.75))
+    assert [label[:3] for label in labels(other)] == ["f1 ", "f2 ", "f3 "]
