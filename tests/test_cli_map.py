@@ -149,3 +149,25 @@ def test_one_pass_over_the_recordings_gives_what_two_do(recordings: list[Path]) 
     for one, two in ((free, free_apart), (touched, touched_apart)):
         assert one.n_sweeps == two.n_sweeps
         np.testing.assert_array_equal(one.samples, two.samples)
+
+
+def test_recordings_of_another_antenna_mapped_with_the_default_are_warned_of(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A lab's recordings name their antenna's file; mapped without it, every estimate uses the
+    # default's observer and stiffness, which can look like bad data: one warning line per
+    # antenna named, none when the antenna is given
+    lab = [tmp_path / f"lab-{i}.csv" for i in range(2)]
+    for source, path in zip(recordings, lab, strict=False):
+        write_recording(read_recording(source).with_metadata(antenna="lab-antenna"), path)
+    paths = [*map(str, lab), str(recordings[2])]
+    model = tmp_path / "model.toml"
+    save_antenna(calibrated(), model)
+    assert main(["map", *paths, "--out", str(tmp_path / "a"), "--no-progress"]) == 0
+    warnings = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warnings) == 1
+    assert "2 recording(s)" in warnings[0] and "'lab-antenna'" in warnings[0]
+    assert f"{lab[0]} and 1 more" in warnings[0] and "--antenna" in warnings[0]
+    args = ["map", *paths, "--out", str(tmp_path / "b"), "--antenna", str(model), "--no-progress"]
+    assert main(args) == 0
+    assert "warning" not in capsys.readouterr().err

@@ -332,12 +332,16 @@ def test_a_directory_prepared_otherwise_is_not_resumed(
 
 def test_the_exploration_simulates_the_exact_link(explored: tuple[Path, list[Manoeuvre]]) -> None:
     out, manoeuvres = explored
+    from sensing_antenna.antenna import load_antenna
     from sensing_antenna.recording import read_recording
 
+    calibrated = load_antenna(out / "calibrated.toml")
     for m in manoeuvres:
         if m.recording is not None:
-            simulation = json.loads(read_recording(out / m.recording).metadata["simulation"])
-            assert simulation["scenario"]["link_model"] == "nonlinear"
+            metadata = read_recording(out / m.recording).metadata
+            assert json.loads(metadata["simulation"])["scenario"]["link_model"] == "nonlinear"
+            # named after the model their estimates need, not the built-in one
+            assert metadata["antenna"] == calibrated.name != "paper-2021"
     calibration = json.loads(
         read_recording(out / "calibration" / "post-0.30.csv").metadata["simulation"]
     )

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import itertools
+import sys
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.cli.estimate import METHOD_NAMES
+from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, METHOD_NAMES
 
 
 def register(subparsers: Any) -> None:
@@ -26,7 +28,7 @@ def register(subparsers: Any) -> None:
         ),
     )
     parser.add_argument("recordings", nargs="+", type=Path, help="recordings (CSV)")
-    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
+    parser.add_argument("--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file")
     parser.add_argument(
         "--method", choices=METHOD_NAMES, default="paper", help="the estimation method"
     )
@@ -40,6 +42,35 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     parser.set_defaults(func=_run)
+
+
+def warn_of_other_antennas(paths: list[Path], model: str) -> None:
+    """One line on stderr for each antenna other than the default ``model`` that the
+    recordings' ``antenna`` metadata names (as ``antenna estimate`` warns of one recording); a
+    file that cannot be read is left to the map, which says why."""
+    from sensing_antenna.cli.arguments import printable
+    from sensing_antenna.errors import SensingAntennaError
+    from sensing_antenna.recording import parse_metadata
+
+    named: dict[str, list[Path]] = {}
+    for path in paths:
+        try:
+            with open(path, encoding="utf-8-sig", errors="replace") as stream:
+                lines = list(itertools.takewhile(lambda line: line.startswith("#"), stream))
+            metadata, _ = parse_metadata([line.rstrip("\r\n") for line in lines], str(path))
+        except (OSError, SensingAntennaError):
+            continue
+        named.setdefault(metadata.get("antenna", ""), []).append(path)
+    for recorded, files in named.items():
+        if not recorded or recorded == model:
+            continue
+        which = f"{files[0]}" + (f" and {len(files) - 1} more" if len(files) > 1 else "")
+        print(
+            f"antenna: warning: {len(files)} recording(s) ({which}) name antenna "
+            f"{printable(recorded)!r} in their metadata and are estimated with the default "
+            f"{printable(model)!r}: give that antenna's file with --antenna",
+            file=sys.stderr,
+        )
 
 
 def add_map_options(parser: Any, uncertain_into: str) -> None:
@@ -67,6 +98,8 @@ def _run(args: argparse.Namespace) -> int:
 
     meshes = {path.stem: load_mesh(path) for path in args.objects}
     antenna = load_antenna(args.antenna)
+    if args.antenna == DEFAULT_ANTENNA:
+        warn_of_other_antennas(args.recordings, antenna.name)
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"
     ) as bar:

@@ -39,7 +39,7 @@ import hashlib
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -110,6 +110,10 @@ __all__ = [
     "prepare_device",
     "swept_links",
 ]
+
+#: The name of the antenna the estimators use (``calibrated.toml``), which the recordings
+#: name as theirs.
+CALIBRATED_NAME = "explore-calibrated"
 
 #: Where the calibration's posts are touched (m): the README's five points.
 CALIBRATION_POINTS = (0.3, 0.45, 0.6, 0.75, 0.9)
@@ -289,7 +293,7 @@ def _prepared(device: Antenna, out: Path, link: str) -> Antenna:
     path = out / CALIBRATED_FILE
     if path.is_file():
         return load_antenna(path)
-    prepared = prepare_device(device, out / "calibration", link)
+    prepared = replace(prepare_device(device, out / "calibration", link), name=CALIBRATED_NAME)
     atomic_write_text(path, antenna_to_toml(prepared))
     return load_antenna(path)
 
@@ -575,7 +579,9 @@ def _run_one(
         folder.mkdir(exist_ok=True)
         path = folder / f"{index:03d}.csv"
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-        write_recording(outcome.recording, tmp)
+        # named after the model its estimates need (calibrated.toml), as a lab's recordings
+        # name their antenna's file: another model is warned of where they are read again
+        write_recording(outcome.recording.with_metadata(antenna=antenna.name), tmp)
         tmp.replace(path)
         recording_name = f"{RECORDINGS_DIR}/{path.name}"
         # the map's own code path: the recording as a file, its base pose from its metadata
