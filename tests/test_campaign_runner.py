@@ -25,7 +25,13 @@ from sensing_antenna.campaign.report import build_report
 from sensing_antenna.campaign.runner import CampaignOutcome, execute_safely, run_campaign
 from sensing_antenna.campaign.runs import RunSpec, expand_runs
 from sensing_antenna.campaign.schema import CampaignSpec, SecondDevice
-from sensing_antenna.campaign.store import CampaignStoreError, campaign_lock, load_run_results
+from sensing_antenna.campaign.store import (
+    CampaignStoreError,
+    campaign_lock,
+    load_run_results,
+    read_manifest,
+    write_manifest,
+)
 from sensing_antenna.estimation import ContactEstimate
 
 #: Columns that depend on wall-clock time and may differ between identical campaigns.
@@ -244,8 +250,18 @@ def test_a_result_without_a_row_per_method_is_a_failed_run() -> None:
 
 def test_a_directory_of_another_spec_is_refused(tmp_path: Path) -> None:
     run_inline(small_spec(), tmp_path)
-    with pytest.raises(CampaignStoreError, match=r"campaign\.json: fingerprint"):
+    with pytest.raises(
+        CampaignStoreError, match=r"campaign\.json: fingerprint.*differs in repeats"
+    ):
         run_inline(small_spec(repeats=3), tmp_path)
+
+
+def test_a_manifest_left_alone_by_a_stopped_campaign_is_replaced(tmp_path: Path) -> None:
+    # a campaign stopped after writing its manifest (before its preparation): nothing of it is
+    # kept, so the next spec may use the directory
+    write_manifest(tmp_path, small_spec(repeats=3))
+    run_inline(small_spec(), tmp_path)
+    assert read_manifest(tmp_path).fingerprint() == small_spec().fingerprint()
 
 
 def test_a_damaged_run_file_is_reported_with_its_path(tmp_path: Path) -> None:

@@ -157,6 +157,11 @@ def test_every_run_scenario_is_checked_before_anything_is_written(tmp_path: Path
             spec, out, prepare_antenna=lambda _: paper_antenna(), workers=1, progress=False
         )
     assert not out.exists()
+    # and a contact point beyond the link, which only the antenna's file can tell
+    spec = one_point_spec(contact_points=(1.2,), source="bad.toml")
+    with pytest.raises(CampaignSpecError, match=r"contact_points\[0\]: 1\.2 m is beyond the link"):
+        run_campaign(spec, out, workers=1, progress=False)
+    assert not out.exists()
 
 
 def test_the_free_motion_duration_is_checked_when_the_spec_is_made() -> None:

@@ -337,6 +337,11 @@ def check_scenario(spec: CampaignSpec) -> None:
     """
     from sensing_antenna.simulator.scenario import ScenarioError
 
+    # the model's and the devices' files, and every contact point against their links
+    spec.load_antenna()
+    spec.load_device()
+    if spec.second_device.enabled:
+        spec.second_device_spec().load_device()
     checked: set[tuple[str, float | None, tuple[tuple[str, str], ...]]] = set()
 
     def check(case: str, x_c: float | None, extra: Mapping[str, Any], prefix: str) -> None:

@@ -176,18 +176,31 @@ def atomic_write_text(path: Path, text: str) -> None:
 
 
 def write_manifest(out_dir: Path, spec: CampaignSpec) -> None:
-    """Record the spec in ``out_dir``; refuse a directory holding results of a different spec."""
+    """Record the spec in ``out_dir``; refuse a directory holding a preparation or runs of a
+    different spec (a manifest alone, left by a campaign stopped before its preparation, is
+    replaced)."""
     path = out_dir / MANIFEST_FILE
     if path.is_file():
         stored = read_manifest(out_dir)
-        if stored.fingerprint() != spec.fingerprint():
+        if stored.fingerprint() == spec.fingerprint():
+            return
+        if _holds_work(out_dir):
+            old, new = stored.to_dict(), spec.to_dict()
+            fields = sorted(k for k in {*old, *new} if old.get(k) != new.get(k))
+            differs = f"; it differs in {', '.join(fields)}" if fields else ""
             raise CampaignStoreError(
-                f"{path}: fingerprint: the runs stored here come from a different campaign spec "
-                f"({stored.name!r}); use another output directory"
+                f"{path}: fingerprint: the preparation and runs stored here come from a "
+                f"different campaign spec ({stored.name!r}{differs}); use another output "
+                "directory"
             )
-        return
     data = {"fingerprint": spec.fingerprint(), "spec": spec.to_dict(), "source": spec.source}
     atomic_write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
+
+
+def _holds_work(out_dir: Path) -> bool:
+    """Whether ``out_dir`` holds anything a campaign made besides its manifest."""
+    made = (ANTENNA_FILE, DEVICE_FILE, CALIBRATION_FILE, RUNS_DIR, SECOND_DEVICE_DIR, CSV_FILE)
+    return any((out_dir / name).exists() for name in made)
 
 
 def read_manifest(out_dir: Path) -> CampaignSpec:
