@@ -15,6 +15,7 @@ from sensing_antenna.recording import (
     MAX_FILE_BYTES,
     MAX_PERIODS_PER_SAMPLE,
     MAX_SAMPLES,
+    MIN_SAMPLE_PERIOD,
     Recording,
     RecordingError,
     check_sampling,
@@ -146,8 +147,9 @@ _value = st.text(
 def _recordings(draw: st.DrawFn) -> Recording:
     n = draw(st.integers(min_value=2, max_value=12))
     # Irregular steps (jitter, drops) around any period: a quarter to four periods each, so the
-    # span stays within MAX_PERIODS_PER_SAMPLE of the median step, as the format requires.
-    period = draw(st.floats(min_value=1e-6, max_value=1.0))
+    # span stays within MAX_PERIODS_PER_SAMPLE of the median step, and the median step is at
+    # least MIN_SAMPLE_PERIOD, as the format requires.
+    period = draw(st.floats(min_value=4 * MIN_SAMPLE_PERIOD, max_value=1.0))
     multiples = draw(
         st.lists(st.floats(min_value=0.25, max_value=4.0), min_size=n - 1, max_size=n - 1)
     )
@@ -352,6 +354,28 @@ def test_a_mostly_empty_span_is_refused_at_its_gap(tmp_path: Path) -> None:
     _write_rows(path, t)
     with pytest.raises(RecordingError, match="2100 periods"):
         read_recording(path)
+
+
+def test_a_sample_period_no_sensor_has_is_refused_as_a_unit_error(tmp_path: Path) -> None:
+    # Time stamps in ns read as s (a 1 kHz file: steps of 1e-12 s) or 1e-17 s apart: the
+    # detectors' filters would have poles of 1 in floating point. Refused at the second sample,
+    # in a file and in memory; 1 us (a 1 MHz logger) is still read.
+    path = tmp_path / "ns.csv"
+    for step in (1e-12, 1e-17):
+        _write_rows(path, step * np.arange(100), period=step)
+        with pytest.raises(RecordingError) as info:
+            read_recording(path)
+        assert (info.value.line, info.value.field) == (4, "t")
+        assert "another unit than seconds" in info.value.problem
+        with pytest.raises(RecordingError, match="shorter than 1e-06 s"):
+            Recording(
+                t=step * np.arange(100),
+                theta=np.zeros((100, 2)),
+                force=np.zeros((100, 3)),
+                torque=np.zeros((100, 3)),
+            )
+    _write_rows(path, MIN_SAMPLE_PERIOD * np.arange(100), period=MIN_SAMPLE_PERIOD)
+    assert read_recording(path).sample_period == MIN_SAMPLE_PERIOD
 
 
 def test_recordings_in_memory_and_the_resampler_refuse_the_same_spans() -> None:

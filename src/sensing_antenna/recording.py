@@ -43,6 +43,7 @@ __all__ = [
     "MAX_FILE_BYTES",
     "MAX_PERIODS_PER_SAMPLE",
     "MAX_SAMPLES",
+    "MIN_SAMPLE_PERIOD",
     "REQUIRED_COLUMNS",
     "Recording",
     "RecordingError",
@@ -101,6 +102,12 @@ MAX_SAMPLES = 10_000_000
 #: diagnostics, the estimators' gap check), but a file whose span is mostly empty has an outlier
 #: time stamp or a gap its resampling would fill with straight lines.
 MAX_PERIODS_PER_SAMPLE = 100
+
+#: Shortest sample period accepted (s): 1 us. No force/torque sensor samples that fast (the
+#: fastest read at tens of kHz), and the detectors' filters lose their precision far below it
+#: (a 5 rad/s low-pass at 1e-17 s has a pole of 1 in floating point); a shorter period is time
+#: stamps in another unit than seconds.
+MIN_SAMPLE_PERIOD = 1e-6
 
 #: Bytes read at a time: a NUL byte, invalid UTF-8 or a size above the limit is found within one
 #: chunk of where it starts.
@@ -214,12 +221,18 @@ def check_sampling(
 
 def _time_span_problem(t: NDArray[np.float64], period: float) -> tuple[int, str] | None:
     """Why strictly increasing time stamps ``t`` (s) cannot be put on a grid of step ``period``
-    (s) within :data:`MAX_SAMPLES` and :data:`MAX_PERIODS_PER_SAMPLE`, or None when they can.
+    (s) of at least :data:`MIN_SAMPLE_PERIOD` within :data:`MAX_SAMPLES` and
+    :data:`MAX_PERIODS_PER_SAMPLE`, or None when they can.
 
     Returns the index of the sample at fault (the one after the largest step, or the first sample
     when the largest step is the first) and the problem.
     """
     n = t.shape[0]
+    if period < MIN_SAMPLE_PERIOD:
+        return 1, (
+            f"a sample period of {format_value(period)} s, shorter than {MIN_SAMPLE_PERIOD:g} s, "
+            "faster than any force/torque sensor: time stamps in another unit than seconds?"
+        )
     span = float(t[-1]) - float(t[0])
     periods = span / period
     if n <= MAX_SAMPLES and periods < min(MAX_SAMPLES, MAX_PERIODS_PER_SAMPLE * n):
