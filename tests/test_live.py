@@ -281,6 +281,8 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
     with pytest.raises(SystemExit) as exc:
         main(["replay", str(recordings["azimuthal"]), "--speed", "-1"])
     assert exc.value.code == 2
+    # a pace that would take longer than a day to replay the recording
+    assert main(["replay", str(recordings["azimuthal"]), "--speed", "1e-300"]) == 2
 
 
 def test_udp_address_errors_name_the_flag(

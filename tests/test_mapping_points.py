@@ -89,6 +89,13 @@ def test_quaternion_and_matrix_metadata_give_one_pose() -> None:
         ('{"position": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, -1]]}', "orthonormal"),
         ('{"position": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0]]}', "3 x 3"),
         ('{"position": [0, 0, 0], "scale": 2}', "unknown"),
+        # JSON that is no pose: booleans and strings for numbers, a key twice, deep nesting,
+        # a coordinate whose square overflows
+        ('{"position": [true, false, 0], "quaternion": [1, 0, 0, 0]}', "three numbers"),
+        ('{"position": [0, 0, 0], "quaternion": ["1", 0, 0, 0]}', "four numbers"),
+        ('{"position": [0, 0, 0], "position": [1, 0, 0], "quaternion": [1, 0, 0, 0]}', "twice"),
+        ('{"position": ' + "[" * 5000 + "]" * 5000 + "}", "nested too deep"),
+        ('{"position": [1e300, 0, 0], "quaternion": [1, 0, 0, 0]}', "1e+300 m"),
     ],
 )
 def test_bad_base_pose_is_one_line_naming_file_and_key(value: str, words: str) -> None:

@@ -39,6 +39,10 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(func=_run)
 
 
+#: The longest paced replay (s): a day; a slower --speed is a typing error.
+MAX_REPLAY_S = 86400.0
+
+
 def _run(args: argparse.Namespace) -> int:
     import socket
 
@@ -55,6 +59,13 @@ def _run(args: argparse.Namespace) -> int:
         except WireError as exc:
             raise ArgumentError("--udp", str(exc)) from None
     recording = read_recording(args.recording)
+    span = float(recording.t[-1] - recording.t[0])
+    if args.speed > 0 and not span / args.speed <= MAX_REPLAY_S:
+        raise ArgumentError(
+            "--speed",
+            f"{args.speed:g} would take {span / args.speed:.3g} s to replay the recording's "
+            f"{span:.3g} s, more than a day ({MAX_REPLAY_S:g} s); 0 sends it unpaced",
+        )
     if address is None:
         replay_lines(recording, sys.stdout.write, sys.stdout.flush, args.speed)
         return 0

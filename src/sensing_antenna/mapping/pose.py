@@ -65,7 +65,9 @@ class BasePose:
         position = np.array(self.position, dtype=float).reshape(3)
         if not (np.all(np.isfinite(rotation)) and np.all(np.isfinite(position))):
             raise FieldError(BASE_POSE_KEY, "rotation and position must be finite numbers")
-        distance = float(np.linalg.norm(position))
+        # scaled by the largest coordinate, as hypot does: the plain norm of 1e300 overflows
+        scale = float(np.abs(position).max())
+        distance = scale * float(np.linalg.norm(position / scale)) if scale > 0 else 0.0
         if distance > MAX_BASE_DISTANCE:
             raise FieldError(
                 BASE_POSE_KEY,
@@ -150,9 +152,13 @@ def base_pose_from_metadata(metadata: Mapping[str, str], source: str | None = No
     if text is None:
         return BasePose.identity()
     try:
-        data: Any = json.loads(text)
+        data: Any = json.loads(text, object_pairs_hook=_unique_keys)
     except json.JSONDecodeError as exc:
         raise FieldError(BASE_POSE_KEY, f"not JSON ({exc.msg})", source) from None
+    except RecursionError:
+        raise FieldError(BASE_POSE_KEY, "not a pose (JSON nested too deep)", source) from None
+    except ValueError as exc:  # a key given twice
+        raise FieldError(BASE_POSE_KEY, str(exc), source) from None
     try:
         return _pose_from_json(data)
     except FieldError as exc:
@@ -175,7 +181,25 @@ def _pose_from_json(data: Any) -> BasePose:
     return BasePose(rotation, position)
 
 
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object's fields, refusing a key given twice (JSON would keep the last)."""
+    data: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in data:
+            raise ValueError(f"{key}: given twice")
+        data[key] = value
+    return data
+
+
 def _numbers(value: Any, shape: tuple[int, ...], what: str) -> FloatArray:
+    # JSON numbers only, nested as the shape says: true, false and "0" are not coordinates
+    rows = value if len(shape) == 2 and isinstance(value, list) else [value]
+    if not all(
+        isinstance(row, list)
+        and all(isinstance(v, int | float) and not isinstance(v, bool) for v in row)
+        for row in rows
+    ):
+        raise FieldError(BASE_POSE_KEY, f"{what} expected")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError):
