@@ -259,6 +259,15 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
             "metadata key 'sample_period': missing",
         ),
         (text[:2], "no header after the metadata"),
+        # a declared period 10 % off the time stamps' (1 ms): a file read whole would use the
+        # steps, a stream's estimator was built for the declared one
+        (
+            [
+                "# sample_period: 0.0011\n" if line.startswith("# sample_period") else line
+                for line in text[: header_at + 40]
+            ],
+            "sample_period: the stream declares 0.0011 s, but its time stamps step by 0.001 s",
+        ),
     ]
     for lines, message in cases:
         done = subprocess.run(

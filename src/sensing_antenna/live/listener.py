@@ -41,7 +41,8 @@ from sensing_antenna.live.events import (
     PushEvent,
 )
 from sensing_antenna.live.record import RecordWriter
-from sensing_antenna.live.wire import StreamHeader
+from sensing_antenna.live.wire import StreamHeader, WireError
+from sensing_antenna.recording import PERIOD_CONSISTENCY
 
 __all__ = ["CONTACT_LOST_TIME", "Listener"]
 
@@ -51,6 +52,9 @@ __all__ = ["CONTACT_LOST_TIME", "Listener"]
 #: nearer the base), so that the residual swinging through the threshold while the link rings
 #: does not count as a loss.
 CONTACT_LOST_TIME = 0.1
+
+#: The time steps whose median is compared with the stream's declared ``sample_period``.
+PERIOD_CHECK_STEPS = 20
 
 _END = "end"
 _ABORT = "abort"
@@ -137,6 +141,7 @@ class Listener:
         self._t = _Growing()
         self._received = _Growing()
         self.dropped = 0
+        self._period_checked = False
         self.lags: list[float] = []
         self._said: set[str] = set()
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
@@ -223,6 +228,7 @@ class Listener:
         self._received.extend(received)
         steps = np.diff(t) if previous is None else np.diff(t, prepend=previous)
         ts = self.header.sample_period
+        self._check_period()
         self.dropped += int(np.sum(np.maximum(np.rint(steps / ts) - 1.0, 0.0)))
         theta, force, torque = (rows[:, columns] for columns in self._columns[1:])
         estimator = self._estimator
@@ -235,6 +241,23 @@ class Listener:
             self._say_estimate(result, first)
         self._watch_contact(first)
         self.lags.append(self._latency(first))
+
+    def _check_period(self) -> None:
+        """Refuse a stream whose time stamps do not step by its declared ``sample_period``: the
+        estimator was built for T_s before the samples came, and a file read whole would use
+        the steps instead (:data:`~sensing_antenna.recording.PERIOD_CONSISTENCY`)."""
+        if self._period_checked or self._t.size <= PERIOD_CHECK_STEPS:
+            return
+        self._period_checked = True
+        ts = self.header.sample_period
+        median = float(np.median(np.diff(self._t.values[: PERIOD_CHECK_STEPS + 1])))
+        if abs(median - ts) > PERIOD_CONSISTENCY * ts:
+            raise WireError(
+                f"sample_period: the stream declares {ts!r} s, but its time stamps step by "
+                f"{median:.6g} s (the median of its first {PERIOD_CHECK_STEPS} steps), more "
+                f"than {100 * PERIOD_CONSISTENCY:g} % apart: the estimates need the period the "
+                "samples have"
+            )
 
     def _latency(self, index: int) -> float:
         return self._clock() - float(self._received.values[index])
