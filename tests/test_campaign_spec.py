@@ -142,6 +142,7 @@ def test_the_fast_bound_is_on_unless_the_spec_turns_it_off(tmp_path: Path) -> No
         ("noise_scale = 0.5", "seed = 4", "scenario.seed"),
         ('name = "small"', 'name = "small"\ncolour = "red"', "colour"),
         ("base_seed = 3", 'base_seed = 3\nfast_bound = "yes"', "fast_bound"),
+        ('name = "small"', 'name = "ti\\nny"', "name"),
     ],
 )
 def test_bad_fields_are_named_with_the_file(tmp_path: Path, old: str, new: str, field: str) -> None:

@@ -339,6 +339,8 @@ def test_a_turned_base_turns_the_touch() -> None:
             "objects[0].position",
         ),
         ('name = "x"\n', "objects"),
+        # a scene's name goes into every recording's one-line description
+        ('name = "a\\nb"\n' + BALL, "name"),
         (
             BALL + "[[bases]]\nquaternion = [2, 0, 0, 0]\n",
             "bases[0].quaternion",

@@ -563,8 +563,9 @@ class CampaignSpec:
 
     def __post_init__(self) -> None:
         src = self.source or None
-        if not self.name:
-            raise CampaignSpecError("name", "must be a non-empty string", src)
+        if not (isinstance(self.name, str) and self.name and self.name.isprintable()):
+            # one line: it titles the report
+            raise CampaignSpecError("name", f"must be a line of text, got {self.name!r}", src)
         _check_choices("cases", self.cases, CASES, src)
         _check_choices("methods", self.methods, known_methods(), src)
         _check_contact_points("contact_points", self.contact_points, src)

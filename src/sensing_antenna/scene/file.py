@@ -187,8 +187,9 @@ def _build(data: Mapping[str, Any], source: str, folder: Path | None) -> Scene:
             sorted(unknown)[0], "unknown key (known: name, description, objects, bases, explore)"
         )
     name = data.get("name", Path(source).stem)
-    if not isinstance(name, str):
-        raise fail("name", f"must be text, got {format_value(name)}")
+    if not isinstance(name, str) or not name.isprintable() or not name:
+        # one line: it goes into every recording's description
+        raise fail("name", f"must be a line of text, got {format_value(name)}")
     tables = data.get("objects")
     if not isinstance(tables, list) or not tables:
         raise fail("objects", "missing: a scene needs at least one [[objects]] table")
