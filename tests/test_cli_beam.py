@@ -55,6 +55,22 @@ def test_the_tip_frequency_as_printed_finds_the_tip(capsys: pytest.CaptureFixtur
     assert len(json.loads(capsys.readouterr().out)["candidates"]) == 1
 
 
+def test_a_frequency_just_above_the_top_finds_the_top_within_its_tolerance(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # the paper link's curve tops at 100.5763 rad/s (x_c = 0.768 m): 100.58 measured a little
+    # high there is the top within 0.1 rad/s, and off the curve within 0.001, the range printed
+    # to enough digits to show it
+    assert main(["beam", "--omega1", "100.58", "--tolerance", "0.1", "--json"]) == 0
+    (found,) = json.loads(capsys.readouterr().out)["candidates"]
+    assert found["x_c"] == pytest.approx(0.7678, abs=1e-4) and found["slope"] == 0.0
+    assert main(["beam", "--omega1", "100.58", "--tolerance", "0.001"]) == 1
+    assert "(16.04884, 100.5763] rad/s" in capsys.readouterr().err
+    # the tolerance is --omega1's: with --xc it is refused, not ignored
+    assert main(["beam", "--xc", "0.5", "--tolerance", "1"]) == 2
+    assert "--tolerance: the uncertainty of --omega1" in capsys.readouterr().err
+
+
 def test_out_of_range_frequency_exits_1_with_empty_list(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

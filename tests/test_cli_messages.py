@@ -95,6 +95,7 @@ def test_the_simulator_s_limits_are_named_by_the_flag(
         (["beam", "--omega1", "-3"], "--omega1: must be a finite frequency > 0 rad/s, got -3.0"),
         (["identify", "r.csv", "--out", "a.toml", "--margin", "0.5"], "--margin: must be a"),
         (["estimate", "r.csv", "--method", "fast", "--tolerance", "nan"], "--tolerance: must be"),
+        (["estimate", "r.csv", "--method", "fast", "--tolerance", "0"], "--tolerance: must be"),
         (["campaign", "run", "--out", "c", "--workers", "0"], "--workers: must be an integer >= 1"),
     ],
 )

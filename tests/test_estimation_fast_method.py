@@ -517,6 +517,10 @@ def test_cli_json_has_interval_and_branch_probability(
     paper = json.loads(capsys.readouterr().out)
     assert paper["interval"] is None and paper["branch_probability"] is None
     assert main(["estimate", str(path), "--tolerance", "0.01"]) == 2
+    # a tolerance looser than the cap's 1 cm loosens the cap's too (no internal field named)
+    capsys.readouterr()
+    assert main(["estimate", str(path), "--method", "fast", "--tolerance", "0.02"]) == 0
+    assert "cap_tolerance" not in capsys.readouterr().err
 
 
 def test_drift_check_widens_the_frequency_error_only_when_the_record_disagrees() -> None:

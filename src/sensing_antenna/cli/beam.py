@@ -18,7 +18,7 @@ import math
 import sys
 from typing import Any
 
-from sensing_antenna.cli.arguments import check_contact_points, integer, number
+from sensing_antenna.cli.arguments import ArgumentError, check_contact_points, integer, number
 
 #: Exit code when the frequency has no consistent contact point.
 EXIT_OUT_OF_RANGE = 1
@@ -87,6 +87,8 @@ def run(args: argparse.Namespace) -> int:
 
     antenna = load_antenna(args.antenna)
     if args.xc is not None:
+        if args.tolerance is not None:
+            raise ArgumentError("--tolerance", "the uncertainty of --omega1, not used with --xc")
         check_contact_points(antenna.link, args.xc)
         return _frequencies(antenna.name, antenna.link, args.xc, args.modes, args.json)
     tolerance = DEFAULT_TOLERANCE * args.omega1 if args.tolerance is None else args.tolerance
@@ -119,6 +121,9 @@ def _contact_points(link: Any, omega1: float, tolerance: float, as_json: bool) -
     curve = SensingCurve.from_link(link)
     candidates = curve.contact_points(omega1, tolerance)
     low, high = curve.omega1_range()
+    if not candidates and high < omega1 <= high + tolerance:
+        # measured a little high at the top of the curve: the top is the candidate
+        candidates = curve.contact_points(high)
     if as_json:
         payload = {
             "omega1": omega1,
@@ -138,7 +143,8 @@ def _contact_points(link: Any, omega1: float, tolerance: float, as_json: bool) -
     if not candidates:
         print(
             f"antenna beam: omega1 = {omega1:g} rad/s is outside the model's range "
-            f"({low:.4g}, {high:.4g}] rad/s for contact points in (0, {link.length:g}] m",
+            f"({low:.7g}, {high:.7g}] rad/s for contact points in (0, {link.length:g}] m, "
+            f"beyond the tolerance {tolerance:.3g} rad/s",
             file=sys.stderr,
         )
         return EXIT_OUT_OF_RANGE

@@ -43,12 +43,12 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--tolerance",
-        type=number(low=0.0, unit="m"),
+        type=number(low=0.0, low_open=True, unit="m"),
         default=None,
         metavar="M",
         help="fast method: declare when the 95 %% interval of x_c is narrower than this (m; "
         "default: the fast method's, 0.005), or earlier within 1 cm when the model's floors "
-        "hold it wider",
+        "hold it wider; at the cap the answer is ok within 1 cm or this, if larger",
     )
     parser.add_argument(
         "--t1",
@@ -105,7 +105,11 @@ def _fast_with_tolerance(method: str, tolerance: float) -> Any:
 
     if method != "fast":
         raise SensingAntennaError(f"--tolerance: only used by --method fast, not {method!r}")
-    return FastMethod(FastConfig(tolerance=tolerance))
+    default = FastConfig()
+    # a tolerance looser than the cap's makes the cap's as loose
+    return FastMethod(
+        FastConfig(tolerance=tolerance, cap_tolerance=max(default.cap_tolerance, tolerance))
+    )
 
 
 def _cm(value: Any) -> str:

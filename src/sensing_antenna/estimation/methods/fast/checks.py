@@ -390,7 +390,7 @@ def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]
             found.append(
                 (
                     Status.UNCERTAIN,
-                    f"uncertain: not sure within {config.cap:g} s after t_1 ({final.note})",
+                    f"not sure within {config.cap:g} s after t_1 ({final.note})",
                 )
             )
         else:
