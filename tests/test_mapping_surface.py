@@ -52,3 +52,25 @@ def test_zero_level_lies_on_the_true_surface_within_the_noise(mesh: trimesh.Trim
 def test_too_few_points_are_refused() -> None:
     with pytest.raises(ValueError, match="at least 4"):
         ImplicitSurface().fit(np.zeros((3, 3)), np.tile(np.eye(3), (3, 1, 1)), np.ones(3))
+
+
+def test_the_mesh_kept_does_not_hang_on_the_length_scale_fitted() -> None:
+    # The marginal likelihood has an optimum near each bound of the length scale, and the fit
+    # may land on either as contacts are added. Held at 1 cm or at 1 m, the mesh covers the same
+    # part of the ball: the side the points sample, a quarter of their spread beyond them.
+    ball = trimesh.creation.icosphere(subdivisions=4, radius=0.08).apply_translation([0.6, 0, 0])
+    rng = np.random.default_rng(5)
+    points = _facing(ball, 30, seed=6)
+    noisy = points + rng.normal(0.0, NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * NOISE**2, (len(points), 1, 1))
+    samples, _ = trimesh.sample.sample_surface(ball, 4000, seed=7)
+    covered = []
+    for scale in (0.01, 1.0):
+        surface = ImplicitSurface(length_scale_bounds=(scale, scale))
+        surface.fit(noisy, covariances, np.zeros(3))
+        assert surface.length_scale_ == pytest.approx(scale)
+        zero_level, _ = surface.mesh()
+        _, gap, _ = trimesh.proximity.closest_point(zero_level, samples)
+        covered.append(float(np.mean(gap < 0.005)))
+    # the facing half of the ball and a band beyond its rim
+    assert 0.45 < covered[0] < 0.9 and covered[1] == pytest.approx(covered[0], abs=0.05)

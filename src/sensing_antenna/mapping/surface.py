@@ -18,7 +18,7 @@ than twice the points' spread. The kernel is
 a constant times a squared exponential, its length scale and amplitude fitted by maximum
 marginal likelihood within :attr:`length_scale_bounds`. The predictive standard deviation of f
 (m, near the surface) is the surface's uncertainty; the mesh is the zero level by marching
-cubes (scikit-image), kept where a contact lies within one length scale.
+cubes (scikit-image), kept where a contact lies within a quarter of the points' spread.
 """
 
 from __future__ import annotations
@@ -43,9 +43,11 @@ FloatArray = NDArray[np.float64]
 #: Fewest points a surface is fitted to: the normals need neighbours (3 besides the point).
 MIN_SURFACE_POINTS = 4
 
-#: The mesh is kept within this many length scales of a contact (and a quarter of the points'
-#: spread): beyond, the prior speaks, not the points.
-REACH_LENGTH_SCALES = 1.0
+#: The mesh is kept within this fraction of the points' spread of a contact: beyond, the prior
+#: speaks, not the points. Not the kernel's length scale: its marginal likelihood has an optimum
+#: near each bound, and the fit moves between them as contacts are added (on the explorations'
+#: spheres, from 1 m to 1 cm with one sweep more, which kept a tenth of the surface).
+REACH_SPREAD = 0.25
 
 
 @dataclass
@@ -147,12 +149,12 @@ class ImplicitSurface:
         """The zero level as a mesh and the predictive std at its vertices (m).
 
         Marching cubes on a ``resolution``^3 grid over the points' bounding box padded by a
-        quarter of their spread (and the offset), kept where a contact lies within the reach:
-        :data:`REACH_LENGTH_SCALES` length scales, at most a quarter of the spread. The mesh may
-        be empty when the zero level does not cross the grid.
+        quarter of their spread (and the offset), kept where a contact lies within
+        :data:`REACH_SPREAD` of the points' spread. The mesh may be empty when the zero level
+        does not cross the grid.
         """
         spread = float(np.linalg.norm(self.points_.max(axis=0) - self.points_.min(axis=0)))
-        reach = min(REACH_LENGTH_SCALES * self.length_scale_, 0.25 * spread)
+        reach = REACH_SPREAD * spread
         pad = 0.25 * spread + self.offset_
         low = self.points_.min(axis=0) - pad
         high = self.points_.max(axis=0) + pad
