@@ -97,6 +97,10 @@ def test_the_simulator_s_limits_are_named_by_the_flag(
         (["estimate", "r.csv", "--method", "fast", "--tolerance", "nan"], "--tolerance: must be"),
         (["estimate", "r.csv", "--method", "fast", "--tolerance", "0"], "--tolerance: must be"),
         (["campaign", "run", "--out", "c", "--workers", "0"], "--workers: must be an integer >= 1"),
+        # one file given twice would count twice, whatever its spelling
+        (["map", "r.csv", "./r.csv", "--out", "m"], "recordings: r.csv given twice"),
+        (["calibrate", "r.csv", "r.csv", "--out", "a.toml"], "recordings: r.csv given twice"),
+        (["identify", "r.csv", "r.csv", "--out", "a.toml"], "recordings: r.csv given twice"),
     ],
 )
 def test_other_bad_arguments_name_their_flag(

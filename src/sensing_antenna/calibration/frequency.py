@@ -374,7 +374,7 @@ def calibrate_t_e(
         reasons = [*left_out, *notes]
         why = ""
         if reasons:
-            more = f"; and {len(reasons) - 1} more" if len(reasons) > 1 else ""
+            more = f"; and {len(reasons) - 1} more recording(s)" if len(reasons) > 1 else ""
             why = f" (left out: {reasons[0]}{more})"
         raise CalibrationError(
             f"omega1: need at least 2 measured frequencies to fit T_e, got {int(used.sum())}{why}"
@@ -595,7 +595,12 @@ def calibrate_from_recordings(
     names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
     omega = np.full(len(recordings), math.nan)
     notes: list[str] = []
+    _, on_link, _ = points_on_link(
+        np.asarray(contact_points, dtype=float), antenna.link.length, names
+    )
     for i, recording in enumerate(recordings):
+        if not on_link[i]:
+            continue  # left out for its point, one note (calibrate_t_e's)
         problem = units_problem(recording, antenna)
         if problem is not None:
             notes.append(f"{names[i]}: {problem}")

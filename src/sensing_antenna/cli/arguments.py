@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -135,3 +136,19 @@ def antenna_name(name: str | None, out: Path) -> str:
 def printable(text: str) -> str:
     """``text`` on one line: characters that are not printable shown as escapes (``\\n``)."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def distinct_files(paths: Iterable[Path], what: str = "recordings") -> list[Path]:
+    """``paths`` as given, refusing one file given twice (the same file by two spellings
+    included): it would count twice."""
+    given = list(paths)
+    seen: dict[Path, Path] = {}
+    for path in given:
+        key = Path(os.path.realpath(path))
+        if key in seen:
+            same = "" if str(seen[key]) == str(path) else f" (as {printable(str(seen[key]))})"
+            raise ArgumentError(
+                what, f"{printable(str(path))} given twice{same}: it would count twice"
+            )
+        seen[key] = path
+    return given

@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.cli.arguments import antenna_name, printable
+from sensing_antenna.cli.arguments import antenna_name, distinct_files, printable
 
 #: The fit losses of :data:`sensing_antenna.calibration.frequency.LOSSES`, written out so that
 #: parsing arguments does not import the calibration (``tests/test_cli_help.py`` checks them).
@@ -115,7 +115,7 @@ def _run(args: argparse.Namespace) -> int:
 
     antenna = load_antenna(args.antenna)
     paths, recordings, unread = [], [], []
-    for path in args.recordings:
+    for path in distinct_files(args.recordings):
         try:
             recordings.append(read_recording(path))
         except SensingAntennaError as exc:

@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.cli.arguments import antenna_name, number, printable
+from sensing_antenna.cli.arguments import antenna_name, distinct_files, number, printable
 from sensing_antenna.errors import format_value
 
 _POLE_REQUIREMENT = "must be a finite number < 0 rad/s (a stable pole)"
@@ -94,7 +94,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.servo and len(args.recordings) > 1:
         raise ControlConfigError("--servo: the motors are fitted to one recording; give one")
     antenna = load_antenna(args.antenna)
-    recordings = [read_recording(path) for path in args.recordings]
+    recordings = [read_recording(path) for path in distinct_files(args.recordings)]
     motor_fit = identify_motors(recordings[0], antenna) if args.servo else None
     fit = identify_free_motion(recordings, antenna, margin=args.margin)
     what = "the free-motion observer and contact threshold"

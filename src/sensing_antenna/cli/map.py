@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli.arguments import distinct_files
 from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, METHOD_NAMES
 
 
@@ -96,6 +97,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.mapping import build_map, map_inputs_from_recordings
 
+    distinct_files(args.recordings)
     meshes = {path.stem: load_mesh(path) for path in args.objects}
     antenna = load_antenna(args.antenna)
     if args.antenna == DEFAULT_ANTENNA:
