@@ -365,6 +365,28 @@ def test_bad_scene_files_name_file_and_field(tmp_path: Path, text: str, field: s
     assert message.startswith(f"{path}: {field}: ") and "\n" not in message
 
 
+def test_a_mesh_in_millimetres_or_a_directory_is_refused_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a 10 cm cube written in mm reads as a 100 m one; the same file for recognition
+    trimesh.creation.box(extents=[100, 100, 100]).export(tmp_path / "cube_mm.stl")
+    (tmp_path / "s.toml").write_text(
+        '[[objects]]\nshape = "mesh"\nfile = "cube_mm.stl"\nposition = [1, 0, 0]\n'
+    )
+    with pytest.raises(SceneError, match=r"objects\[0\]\.file: .*100 m.*in metres\?"):
+        load_scene(tmp_path / "s.toml")
+    (tmp_path / "d.toml").write_text(
+        '[[objects]]\nshape = "mesh"\nfile = "."\nposition = [1, 0, 0]\n'
+    )
+    with pytest.raises(SceneError, match=r"objects\[0\]\.file: .*: a directory"):
+        load_scene(tmp_path / "d.toml")
+    from sensing_antenna.cli import main
+
+    args = ["map", "r.csv", "--objects", str(tmp_path / "cube_mm.stl"), "--out", "m"]
+    assert main(args) == 2
+    assert "cube_mm.stl: its largest extent is 100 m" in capsys.readouterr().err
+
+
 def test_an_open_mesh_is_refused(tmp_path: Path) -> None:
     open_mesh = trimesh.creation.box(extents=[1, 1, 1])
     open_mesh.update_faces(np.arange(len(open_mesh.faces)) != 0)

@@ -155,13 +155,19 @@ def load_mesh(path: Path) -> Any:
     import trimesh
 
     from sensing_antenna.errors import SensingAntennaError
+    from sensing_antenna.scene.objects import mesh_problem
 
     if not path.is_file():
-        raise SensingAntennaError(f"{path}: no such mesh file")
+        raise SensingAntennaError(
+            f"{path}: {'a directory, not a mesh file' if path.is_dir() else 'no such mesh file'}"
+        )
     try:
         mesh = trimesh.load_mesh(path, force="mesh")
     except Exception as exc:  # trimesh raises many kinds on a malformed file
         raise SensingAntennaError(f"{path}: not a readable mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise SensingAntennaError(f"{path}: the file holds no triangles")
+    problem = mesh_problem(mesh)
+    if problem is not None:
+        raise SensingAntennaError(f"{path}: {problem}")
     return mesh

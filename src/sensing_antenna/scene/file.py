@@ -50,7 +50,7 @@ import trimesh
 
 from sensing_antenna.errors import FieldError, format_value
 from sensing_antenna.mapping.pose import MAX_BASE_DISTANCE, BasePose
-from sensing_antenna.scene.objects import SceneObject, mesh_object, primitive_object
+from sensing_antenna.scene.objects import SceneObject, mesh_object, mesh_problem, primitive_object
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
@@ -296,13 +296,16 @@ def _mesh_file(value: object, where: str, folder: Path | None, fail: Any) -> tri
     if not path.is_absolute() and folder is not None:
         path = folder / path
     if not path.is_file():
-        raise fail(where, f"{path}: no such file")
+        raise fail(where, f"{path}: {'a directory' if path.is_dir() else 'no such file'}")
     try:
         mesh = trimesh.load_mesh(path, force="mesh")
     except Exception as exc:  # trimesh raises many kinds on a malformed file
         raise fail(where, f"{path}: not a readable mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise fail(where, f"{path}: the file holds no triangles")
+    problem = mesh_problem(mesh)
+    if problem is not None:
+        raise fail(where, f"{path}: {problem}")
     if not mesh.is_watertight:
         raise fail(
             where, f"{path}: the mesh is not closed (watertight), so its inside is undefined"

@@ -22,12 +22,39 @@ from scipy.spatial.transform import Rotation
 
 from sensing_antenna.mapping.primitives import PRIMITIVES
 
-__all__ = ["OBJECT_SHAPES", "SceneObject", "mesh_object", "primitive_object"]
+__all__ = [
+    "MAX_MESH_EXTENT",
+    "OBJECT_SHAPES",
+    "SceneObject",
+    "mesh_object",
+    "mesh_problem",
+    "primitive_object",
+]
 
 FloatArray = NDArray[np.float64]
 
 #: The primitive shapes a scene may hold (``mesh`` is a user's file).
 OBJECT_SHAPES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
+
+#: Largest extent (m) of a user's mesh: 10 m, ten times an antenna's reach. A mesh written in
+#: millimetres and read as metres is a thousand times too large.
+MAX_MESH_EXTENT = 10.0
+
+
+def mesh_problem(mesh: trimesh.Trimesh) -> str | None:
+    """Why a user's mesh (m) cannot be an object, or None: vertices that are not finite, or an
+    extent beyond :data:`MAX_MESH_EXTENT`."""
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    if not np.all(np.isfinite(vertices)):
+        return "vertices that are not finite numbers"
+    extent = float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
+    if extent > MAX_MESH_EXTENT:
+        return (
+            f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
+            "(a mesh in millimetres reads a thousand times too large)"
+        )
+    return None
+
 
 #: Subdivision of the primitives' meshes used for figures and surface scores: finer than
 #: recognition's so that a faceted mesh is within 0.1 mm of the exact surface for the
