@@ -70,7 +70,8 @@ def _add_rosbag(formats: Any) -> None:
         default="x,y,z",
         metavar="AXES",
         help="the sensor's axes along the motor axes X^m, Y^m, Z^m, each with its sign, a "
-        "right-handed set such as -x,-y,z (turned half a turn about Z^m) or z,x,y",
+        "right-handed set such as --frame=-x,-y,z (turned half a turn about Z^m; the equals "
+        "sign when it begins with a minus) or z,x,y",
     )
     parser.add_argument(
         "--reaction",
