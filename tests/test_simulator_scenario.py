@@ -72,6 +72,7 @@ def test_the_budget_fits_the_simulator_and_the_recording_reader() -> None:
         ("description", "two\nlines", "one line"),
         ("description", " padded", "one line"),
         ("noise_scale", np.float64("nan"), "must be a finite number, got nan"),
+        ("noise_scale", 1e300, "must be at most 1000 (times the sensor's noise), got 1e+300"),
     ],
 )
 def test_each_limit_names_its_field_in_one_line(field: str, value: object, words: str) -> None:

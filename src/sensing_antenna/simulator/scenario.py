@@ -21,6 +21,7 @@ __all__ = [
     "LINK_MODELS",
     "MAX_DURATION",
     "MAX_ELEMENTS",
+    "MAX_NOISE_SCALE",
     "MAX_SIMULATED_SAMPLES",
     "MAX_SUBSTEPS",
     "OBSTACLE_KINDS",
@@ -73,6 +74,10 @@ MAX_DURATION = MAX_SIMULATED_SAMPLES * 1e-3
 #: elements already give 1e-6 (docs/simulator.md), so 128 give about 2e-10; each time step costs
 #: the square of the element count, 64 times the default's at 128.
 MAX_ELEMENTS = 128
+
+#: Largest ``noise_scale``: 1000 times the sensor's noise buries any contact (the campaign's
+#: noise sweep stops at 4); beyond it a typing error, and the samples could overflow.
+MAX_NOISE_SCALE = 1000.0
 
 #: Most internal Newmark steps per 1 ms sample: 100 (a 10 us step). The integrator is
 #: unconditionally stable, so more steps only refine the step error; the cost grows with them.
@@ -187,7 +192,8 @@ class Scenario:
     duration : float
         Total recorded time (s).
     noise_scale : float
-        Multiplies the sensor noise and bias (0: noiseless, exact encoders).
+        Multiplies the sensor noise and bias (0: noiseless, exact encoders); at most
+        :data:`MAX_NOISE_SCALE`.
     damping_ratio : float
         Structural damping ratio of the link at its first free mode and at the highest first
         contact-mode frequency (Rayleigh damping, dimensionless).
@@ -319,6 +325,12 @@ class Scenario:
             _finite(name, getattr(self, name), 0.0)
         if self.damping_ratio >= 1.0:
             raise ScenarioError("damping_ratio", "must be < 1 (light structural damping)")
+        if self.noise_scale > MAX_NOISE_SCALE:
+            raise ScenarioError(
+                "noise_scale",
+                f"must be at most {MAX_NOISE_SCALE:g} (times the sensor's noise), got "
+                f"{format_value(self.noise_scale)}",
+            )
         for name in ("obstacle_radius", "contact_stiffness", "sweep_speed"):
             _finite(name, getattr(self, name), 0.0, strict=True)
         if isinstance(self.sweep_direction, bool) or self.sweep_direction not in (1, -1):
