@@ -125,16 +125,25 @@ def test_bad_input_is_one_line_exit_2(
     assert "\n" not in err
 
 
-def test_a_bad_recording_after_good_ones_is_one_line_after_the_bar(
+def test_a_bad_recording_among_good_ones_is_left_out_in_one_line(
     recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # the bar counts the recordings estimated; the error that stops it is a line of its own
-    argv = ["map", str(recordings[0]), str(tmp_path / "absent.csv"), "--out", str(tmp_path)]
-    assert main(argv) == 2
-    lines = capsys.readouterr().err.strip().splitlines()
-    assert lines[-1].startswith("antenna map: error: ") and "absent.csv" in lines[-1], lines
-    assert all(line.startswith("estimating (paper):") for line in lines[:-1]), lines
-    assert "1/2" in lines[-2], lines
+    # a lab's set with one truncated or missing file: the map is made of the others, and the
+    # file left out is named in a line of its own after the bar, which counts every file
+    bad = tmp_path / "bad.csv"
+    write_recording(read_recording(recordings[0]).with_metadata(base_pose="{"), bad)
+    argv = ["map", str(recordings[0]), str(tmp_path / "absent.csv"), str(bad), str(recordings[1])]
+    assert main([*argv, "--out", str(tmp_path / "out")]) == 0
+    captured = capsys.readouterr()
+    assert " of 2 points used" in captured.out
+    lines = captured.err.strip().splitlines()
+    warnings = [line for line in lines if line.startswith("antenna map: warning: left out ")]
+    assert len(warnings) == 2, lines
+    assert "absent.csv: cannot read file" in warnings[0]
+    assert "bad.csv: base_pose: not JSON" in warnings[1]
+    assert any("4/4" in line for line in lines if line.startswith("estimating")), lines
+    rows = _rows(tmp_path / "out" / "points.csv")
+    assert [Path(row["source"]).name for row in rows] == ["post.csv", "bar.csv"]
 
 
 def test_one_pass_over_the_recordings_gives_what_two_do(recordings: list[Path]) -> None:

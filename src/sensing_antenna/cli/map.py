@@ -94,6 +94,7 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.campaign.progress import Progress
+    from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.mapping import build_map, map_inputs_from_recordings
 
@@ -105,13 +106,20 @@ def _run(args: argparse.Namespace) -> int:
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"
     ) as bar:
+        left_out: list[str] = []
         points, swept = map_inputs_from_recordings(
             args.recordings,
             antenna,
             args.method,
             config=EstimatorConfig(t1_source=args.t1),
             progress=lambda _: bar.update(1),
+            unreadable=lambda _, exc: left_out.append(str(exc)),
         )
+    if not points:
+        more = f" (and {len(left_out) - 1} more unreadable)" if len(left_out) > 1 else ""
+        raise SensingAntennaError(f"{left_out[0]}{more}")
+    for problem in left_out:  # one line each; the map is made of the others
+        print(f"antenna map: warning: left out {problem}", file=sys.stderr)
     contact_map = build_map(points, args.include_uncertain, meshes=meshes, swept=swept)
     report_map(contact_map, args.out)
     return 0

@@ -23,6 +23,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.errors import FieldError, SensingAntennaError
 from sensing_antenna.mapping.free_space import (
     FreeSpace,
     Piece,
@@ -180,21 +181,34 @@ def map_inputs_from_recordings(
     uncertainty: PointUncertainty | None = None,
     config: Any = None,
     progress: Callable[[Path], None] | None = None,
+    unreadable: Callable[[Path, SensingAntennaError], None] | None = None,
 ) -> tuple[list[ContactPoint], tuple[FreeSpace, Touches]]:
     """:func:`points_from_recordings` and :func:`swept_from_recordings` of the same recordings,
-    each read once; ``progress`` is called with each path when it is done.
+    each read once; ``progress`` is called with each path when it is done. With
+    ``unreadable``, a recording that cannot be read or whose base pose is malformed is handed
+    to it with the error (one line naming the file) and left out; without, the error is raised.
 
     Raises
     ------
     RecordingError, FieldError
-        One line naming the file when a recording or its base pose is malformed.
+        Without ``unreadable``: one line naming the file when a recording or its base pose is
+        malformed.
     """
-    from sensing_antenna.recording import read_recording
+    from sensing_antenna.recording import RecordingError, read_recording
 
     points: list[ContactPoint] = []
     links = []
     for path in paths:
-        recording = read_recording(path)
+        try:
+            recording = read_recording(path)
+            base_pose_from_metadata(recording.metadata, str(path))
+        except (RecordingError, FieldError) as exc:
+            if unreadable is None:
+                raise
+            unreadable(path, exc)
+            if progress is not None:
+                progress(path)
+            continue
         point = _point(recording, path, antenna, method, uncertainty, config)
         points.append(point)
         links.append(recording_links(recording, antenna, point))
