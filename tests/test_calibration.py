@@ -236,6 +236,9 @@ def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
     table.write_text("file,x_c\na.csv,0.4\nb.csv,far\n", encoding="utf-8")
     with pytest.raises(CalibrationError, match=r"points\.csv: line 3: x_c: not a number"):
         read_contact_points(paths, recordings, table)
+    table.write_text("file,x_c\na.csv\nb.csv,0.8\n", encoding="utf-8")
+    with pytest.raises(CalibrationError, match=r"points\.csv: line 2: x_c: missing"):
+        read_contact_points(paths, recordings, table)
     table.write_text("name,x_c\n", encoding="utf-8")
     with pytest.raises(CalibrationError, match="missing column 'file'"):
         read_contact_points(paths, recordings, table)

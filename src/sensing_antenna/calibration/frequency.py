@@ -694,6 +694,8 @@ def _read_points_table(table: Path) -> list[_PointRow]:
 
 def _point_row(table: Path, line: int, row: dict[str | Any, Any]) -> _PointRow:
     text: Any = row.get("x_c")
+    if text is None:
+        raise CalibrationError(f"{table}: line {line}: x_c: missing (the row is short of cells)")
     try:
         value = float(text)
     except (TypeError, ValueError):
