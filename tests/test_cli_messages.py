@@ -153,3 +153,21 @@ def test_the_range_is_the_antenna_s(capsys: pytest.CaptureFixture[str]) -> None:
     assert paper_antenna().link.length == 0.98
     err = _error(["beam", "--xc", "0.99"], capsys)
     assert err == f"antenna beam: error: --xc: contact point must lie in {XC_RANGE}, got 0.99"
+
+
+def test_an_output_directory_that_is_a_file_is_named_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    recording = tmp_path / "r.csv"
+    assert main(["simulate", "--case", "free", "--duration", "0.5", "--out", str(recording)]) == 0
+    taken = tmp_path / "taken"
+    taken.write_text("")
+    capsys.readouterr()
+    for out in (taken, taken / "sub"):
+        assert main(["map", str(recording), "--out", str(out), "--no-progress"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"{out}: " in err
+        assert "(a file where a directory is to be made?)" in err
+    # and a UDP destination of port 0, which the system refuses as an invalid argument
+    assert main(["replay", str(recording), "--udp", "127.0.0.1:0"]) == 2
+    assert "--udp: port 0 is no destination" in capsys.readouterr().err

@@ -235,7 +235,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_CLOSED_PIPE
     except OSError as exc:  # unwritable output, missing directory, disk full, ...
         where = f"{exc.filename}: " if exc.filename else ""
-        _say(f"{prog}: error: {where}{exc.strerror or exc}")
+        why = exc.strerror or str(exc)
+        if isinstance(exc, FileExistsError | NotADirectoryError) and exc.filename is not None:
+            # mkdir met a file: the output directory named, or one on its path, is a file
+            why = f"{why} (a file where a directory is to be made?)"
+        _say(f"{prog}: error: {where}{why}")
         return EXIT_BAD_INPUT
     except MemoryError as exc:
         _say(f"{prog}: error: not enough memory" + (f" ({exc})" if str(exc) else ""))

@@ -58,6 +58,10 @@ def _run(args: argparse.Namespace) -> int:
             address = parse_address(args.udp)
         except WireError as exc:
             raise ArgumentError("--udp", str(exc)) from None
+        if address[1] == 0:
+            raise ArgumentError(
+                "--udp", "port 0 is no destination: give the port antenna listen prints"
+            )
     recording = read_recording(args.recording)
     span = float(recording.t[-1] - recording.t[0])
     if args.speed > 0 and not span / args.speed <= MAX_REPLAY_S:
