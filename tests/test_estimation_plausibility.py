@@ -138,6 +138,18 @@ def test_a_whole_wrench_in_mn_and_n_mm_gives_no_absurd_best_guess(
         assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
 
 
+def test_a_whole_wrench_in_kn_and_kn_m_is_implausible_not_no_contact(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # Loads a thousand times too small never reach the contact detector's threshold: the
+    # units check of the whole record names the torques, the missing contact comes second
+    for name, result in all_methods(scaled(azimuthal, 1e-3, 1e-3), antenna).items():
+        assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        assert "columns 'tx', 'ty', 'tz'" in (result.reason or "")
+        assert any("filtered residual" in r for r in result.diagnostics["other_reasons"])
+        assert math.isnan(result.x_c)
+
+
 @pytest.mark.parametrize("case", ["azimuthal", "vertical"])
 def test_angles_in_degrees_are_implausible_input(
     request: pytest.FixtureRequest, antenna: Antenna, case: str

@@ -546,7 +546,27 @@ class FrontEnd:
         if self._contact is None:
             assert self._detector is not None
             reason = f"filtered residual stays at or below {self._detector.threshold:g} N m"
-            return self._stop(self._early(Status.NO_CONTACT, reason))
+            outcome = self._early(Status.NO_CONTACT, reason)
+            # loads in kN or torques in kN m never reach the threshold: the units check of
+            # the whole record, as at a contact, says so before "no contact"
+            problem = at_contact(
+                self._theta[:n],
+                self._force[:n],
+                self._torque[:n],
+                self.antenna,
+                n - 1,
+                self.config,
+                self.sample_period,
+            ).input_problem
+            if problem is not None:
+                diagnostics = {**outcome.diagnostics, "other_reasons": [reason]}
+                outcome = dataclasses.replace(
+                    outcome,
+                    status=Status.IMPLAUSIBLE_INPUT,
+                    reason=problem,
+                    diagnostics=diagnostics,
+                )
+            return self._stop(outcome)
         assert self._start is not None
         if self._rest is None:
             reason = no_t1_reason(self.config, self._start.rest_tolerance)
