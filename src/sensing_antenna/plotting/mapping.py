@@ -16,12 +16,12 @@ from sensing_antenna.mapping.contact_map import ContactMap
 
 __all__ = ["VIEWS", "plot_map"]
 
-#: (title, elevation, azimuth) of each view, degrees.
+#: (title, elevation, azimuth, the axis seen end-on or None) of each view, degrees.
 VIEWS = (
-    ("front (along +X)", 0.0, 180.0),
-    ("side (along +Y)", 0.0, -90.0),
-    ("above", 90.0, -90.0),
-    ("oblique", 25.0, -135.0),
+    ("front (along +X)", 0.0, 180.0, "x"),
+    ("side (along +Y)", 0.0, -90.0, "y"),
+    ("above", 90.0, -90.0, "z"),
+    ("oblique", 25.0, -135.0, None),
 )
 
 
@@ -36,7 +36,7 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
     if contact_map.recognition is not None:
         shape = contact_map.recognition.best.mesh
     scatter = None
-    for index, (title, elevation, azimuth) in enumerate(VIEWS, start=1):
+    for index, (title, elevation, azimuth, end_on) in enumerate(VIEWS, start=1):
         ax = fig.add_subplot(2, 2, index, projection="3d")
         if mesh is not None and len(mesh.faces):
             ax.plot_trisurf(
@@ -55,9 +55,13 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
         ax.view_init(elev=elevation, azim=azimuth)
         ax.set_aspect("equal")
         ax.set_title(title)
-        ax.set_xlabel("x (cm)")
-        ax.set_ylabel("y (cm)")
-        ax.set_zlabel("z (cm)")
+        for name in "xyz":
+            axis = getattr(ax, f"{name}axis")
+            if name == end_on:  # seen end-on, its ticks fall on one spot
+                axis.set_ticklabels([])
+                axis.set_label_text("")
+            else:
+                axis.set_label_text(f"{name} (cm)")
     if scatter is not None:
         fig.colorbar(
             scatter,
