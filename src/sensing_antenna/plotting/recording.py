@@ -102,7 +102,8 @@ def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
         for i, axis_name in enumerate("xyz"):
             axes[i].plot(t, data[:, i], lw=0.8)
             _finish(axes[i], f"{name[0].upper()}_{axis_name}^m ({unit})", None, stop)
-        axes[0].set_title(f"{name} by the link on the head (motor frame): {title}", fontsize=9)
+        # on two lines: a long description would run past the figure's edge
+        axes[0].set_title(f"{name} by the link on the head (motor frame)\n{title}", fontsize=9)
         axes[-1].set_xlabel("t (s)")
         paths.append(save_figure(fig, out / f"{name}.png", dpi=110))
 
