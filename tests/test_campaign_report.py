@@ -511,7 +511,7 @@ def test_a_zero_error_is_drawn_at_zero_not_on_a_log_floor(
     # ratio's mean |error| at 0.3 m is exactly 0 (the toy lands on the truth); at 0.6 m 1 cm
     ydata = ratio.get_ydata()
     assert ydata[0] == 0.0 and ydata[1] == pytest.approx(1.0, abs=ROUND_OFF * 100)
-    assert "linear below 0.001 cm, log above" in drawn.texts("errors-by-method.png")
+    assert "error axes: linear below 0.001 cm, log above" in drawn.texts("errors-by-method.png")
 
 
 def test_the_frequency_figure_promises_a_bound_only_when_it_draws_one(

@@ -63,16 +63,11 @@ def _error_axis(ax: Any) -> None:
     """Absolute errors in cm: symmetric-log, linear below 10 um so that 0 is drawn at 0."""
     ax.set_yscale("symlog", linthresh=_ERROR_LINEAR_BELOW_CM, linscale=0.5)
     ax.set_ylim(bottom=0.0)
-    ax.text(
-        0.99,
-        0.01,
-        f"linear below {_ERROR_LINEAR_BELOW_CM:g} cm, log above",
-        transform=ax.transAxes,
-        ha="right",
-        va="bottom",
-        fontsize="x-small",
-        color="0.4",
-    )
+    # once per figure, in its bottom right corner: inside the axes a legend may cover it
+    note = f"error axes: linear below {_ERROR_LINEAR_BELOW_CM:g} cm, log above"
+    figure = ax.get_figure()
+    if figure is not None and not any(text.get_text() == note for text in figure.texts):
+        figure.text(0.995, 0.005, note, ha="right", va="bottom", fontsize="x-small", color="0.4")
 
 
 def plot_case_estimates(points: RunPoints, paper: PointTable | None, out_dir: str | Path) -> Path:
