@@ -170,25 +170,18 @@ def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     assert calibrate_t_e(PAPER_POINTS, omega, link).relative_scatter == pytest.approx(
         0.002, rel=0.1
     )
-    # One wrong peak at half the frequency (or a wrong known point): 50 % from the others'
-    # fit, left out of the fit and named, so T_e is the 14 others' (their uneven pattern moves
-    # it by under 0.1 %; the robust loss alone let the wrong one pull it by 0.4 %) and the
-    # scatter is theirs
+    # One wrong peak at half the frequency: left out of the scatter (not 50 %), but it pulls the
+    # robust T_e by offset (0.4 %), and every residual of the calibrated model carries that
     omega[9] *= 0.5
-    names = [f"post{i}.csv" for i in range(PAPER_POINTS.size)]
-    result = calibrate_t_e(PAPER_POINTS, omega, link, sources=names)
+    result = calibrate_t_e(PAPER_POINTS, omega, link)
     offset = result.t_e / PAPER_T_E - 1.0
-    assert abs(offset) < 1e-3
-    assert not result.used[9] and int(result.used.sum()) == PAPER_POINTS.size - 1
-    assert result.notes[0].startswith("post9.csv: omega_1 = ")
-    assert "-50 % from the others' fit" in result.notes[0]
-    assert "left out of the fit" in result.notes[0]
+    assert 0.001 < abs(offset) < 0.01
     # measured / fitted - 1 = (1 + pattern) T_e / T_e,true - 1 at the 14 other points, rms with
     # 13 degrees of freedom
     kept = np.delete((1.0 + 0.002 * signs) * (1.0 + offset) - 1.0, 9)
     expected = math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
     assert result.relative_scatter == pytest.approx(expected, rel=1e-6)
-    assert result.wrong_peaks == 0
+    assert result.wrong_peaks == 1
     # A departure of about 1 % on three points near the tip (a soft contact) is model error,
     # not wrong peaks: it stays in the scatter
     tip = k / PAPER_T_E * np.where(PAPER_POINTS >= 0.9, 0.99, 1.0)

@@ -382,24 +382,6 @@ def calibrate_t_e(
     k = np.full(x_c.shape, math.nan)
     k[on_link] = model_beta1_squared(link, x_c[on_link])
     t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
-    if int(used.sum()) >= 3:
-        # a point GROSS_WRONG_PEAK from the others' median is a wrong peak or a wrong known
-        # point, not a shape the model misses: out of the fit, named (the robust loss only
-        # bounds its pull on T_e)
-        relative = w / (k / t_e) - 1.0
-        median = float(np.median(relative[used]))
-        wrong = used & (np.abs(relative - median) > GROSS_WRONG_PEAK)
-        if np.any(wrong) and int((used & ~wrong).sum()) >= 2:
-            for i in map(int, np.flatnonzero(wrong)):
-                label = sources[i] if i < len(sources) else f"point {i}"
-                left_out.append(
-                    f"{label}: omega_1 = {float(w[i]):.2f} rad/s lies "
-                    f"{100 * (relative[i] - median):+.0f} % from the others' fit at its known "
-                    f"point x_c = {float(x_c[i]):.4f} m: a wrong spectral peak or a wrong known "
-                    "point (left out of the fit)"
-                )
-            used = used & ~wrong
-            t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
     tip_mass = None
     if fit_tip_mass:
         joint = _with_tip_mass(link, x_c, on_link, w, used, k, t_e, loss)
