@@ -181,7 +181,7 @@ def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     kept = np.delete((1.0 + 0.002 * signs) * (1.0 + offset) - 1.0, 9)
     expected = math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
     assert result.relative_scatter == pytest.approx(expected, rel=1e-6)
-    assert result.wrong_peaks == 1
+    assert result.wrong_peaks == 1 and np.flatnonzero(result.wrong_peak_points).tolist() == [9]
     # A departure of about 1 % on three points near the tip (a soft contact) is model error,
     # not wrong peaks: it stays in the scatter
     tip = k / PAPER_T_E * np.where(PAPER_POINTS >= 0.9, 0.99, 1.0)

@@ -148,8 +148,8 @@ class FrequencyCalibration:
         :data:`WRONG_PEAK` from the median is a wrong spectral peak, not model error, and is
         left out (:attr:`wrong_peaks`); NaN with fewer than 3 points left.
         """
-        kept = self._relative_residuals()
-        kept = kept[~self._wrong_peak_mask(kept)]
+        relative = self._relative_residuals()
+        kept = relative[self.used & np.isfinite(relative) & ~self.wrong_peak_points]
         fitted = 1 if self.tip_mass is None else 2
         if kept.size < 2 + fitted:
             return math.nan
@@ -158,17 +158,24 @@ class FrequencyCalibration:
     @property
     def wrong_peaks(self) -> int:
         """Points used by the fit but left out of :attr:`relative_scatter` as wrong peaks."""
-        return int(self._wrong_peak_mask(self._relative_residuals()).sum())
+        return int(self.wrong_peak_points.sum())
+
+    @property
+    def wrong_peak_points(self) -> NDArray[np.bool_]:
+        """Which points, shape (n,), are used by the fit but more than :data:`WRONG_PEAK` from
+        the median relative residual: left out of :attr:`relative_scatter` as wrong peaks (or
+        wrong known points)."""
+        relative = self._relative_residuals()
+        usable = self.used & np.isfinite(relative)
+        if not np.any(usable):
+            return np.zeros(relative.shape, dtype=bool)
+        median = float(np.median(relative[usable]))
+        return np.asarray(usable & (np.abs(relative - median) > WRONG_PEAK), dtype=bool)
 
     def _relative_residuals(self) -> NDArray[np.float64]:
-        relative = (self.omega1_measured / self.omega1_fitted - 1.0)[self.used]
-        return np.asarray(relative[np.isfinite(relative)], dtype=float)
-
-    @staticmethod
-    def _wrong_peak_mask(relative: NDArray[np.float64]) -> NDArray[np.bool_]:
-        if relative.size == 0:
-            return np.zeros(0, dtype=bool)
-        return np.asarray(np.abs(relative - np.median(relative)) > WRONG_PEAK, dtype=bool)
+        """measured / fitted - 1 at every point, shape (n,)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.asarray(self.omega1_measured / self.omega1_fitted - 1.0, dtype=float)
 
     @property
     def relative_difference(self) -> float:

@@ -106,6 +106,7 @@ def _run(args: argparse.Namespace) -> int:
 
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.frequency import (
+        WRONG_PEAK,
         CalibrationError,
         calibrate_from_recordings,
         read_contact_points,
@@ -158,10 +159,17 @@ def _run(args: argparse.Namespace) -> int:
         if math.isfinite(scatter)
         else "model scatter: not measured (fewer than 3 points)"
     )
+    wrong = calibration.wrong_peak_points
     for i, x_c in enumerate(calibration.contact_points):
         print(
             f"  {calibration.sources[i]}: x_c = {x_c:.4f} m, omega_1 measured "
             f"{calibration.omega1_measured[i]:.3f}, fitted {calibration.omega1_fitted[i]:.3f} rad/s"
+            + (
+                f"; more than {100 * WRONG_PEAK:g} % off the others, left out of the scatter: "
+                "a wrong spectral peak or a wrong known point?"
+                if wrong[i]
+                else ""
+            )
         )
     for note in (*unread, *calibration.notes):
         print(f"  left out: {note}")
