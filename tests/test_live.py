@@ -266,7 +266,24 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
                 "# sample_period: 0.0011\n" if line.startswith("# sample_period") else line
                 for line in text[: header_at + 40]
             ],
-            "sample_period: the stream declares 0.0011 s, but its time stamps step by 0.001 s",
+            "<stdin>: sample_period: the stream declares 0.0011 s, but its time stamps step by "
+            "0.001 s (the median of its first 20 steps)",
+        ),
+        # the same in a stream of 11 samples: judged at its end on the 10 steps it has
+        (
+            [
+                "# sample_period: 0.0011\n" if line.startswith("# sample_period") else line
+                for line in text[: header_at + 12]
+            ],
+            "time stamps step by 0.001 s (the median of its first 10 steps)",
+        ),
+        # a period no sensor has (time in another unit), refused with the header
+        (
+            [
+                "# sample_period: 1e-17\n" if line.startswith("# sample_period") else line
+                for line in text[: header_at + 3]
+            ],
+            "metadata key 'sample_period': 1e-17 s, shorter than 1e-06 s",
         ),
     ]
     for lines, message in cases:

@@ -242,21 +242,24 @@ class Listener:
         self._watch_contact(first)
         self.lags.append(self._latency(first))
 
-    def _check_period(self) -> None:
+    def _check_period(self, final: bool = False) -> None:
         """Refuse a stream whose time stamps do not step by its declared ``sample_period``: the
         estimator was built for T_s before the samples came, and a file read whole would use
-        the steps instead (:data:`~sensing_antenna.recording.PERIOD_CONSISTENCY`)."""
-        if self._period_checked or self._t.size <= PERIOD_CHECK_STEPS:
+        the steps instead (:data:`~sensing_antenna.recording.PERIOD_CONSISTENCY`). Judged on
+        the first :data:`PERIOD_CHECK_STEPS` steps, or at the end (``final``) on those a
+        shorter stream has."""
+        steps = min(self._t.size - 1, PERIOD_CHECK_STEPS)
+        if self._period_checked or steps < (1 if final else PERIOD_CHECK_STEPS):
             return
         self._period_checked = True
         ts = self.header.sample_period
-        median = float(np.median(np.diff(self._t.values[: PERIOD_CHECK_STEPS + 1])))
+        median = float(np.median(np.diff(self._t.values[: steps + 1])))
         if abs(median - ts) > PERIOD_CONSISTENCY * ts:
             raise WireError(
-                f"sample_period: the stream declares {ts!r} s, but its time stamps step by "
-                f"{median:.6g} s (the median of its first {PERIOD_CHECK_STEPS} steps), more "
-                f"than {100 * PERIOD_CONSISTENCY:g} % apart: the estimates need the period the "
-                "samples have"
+                f"{self.header.source}: sample_period: the stream declares {ts!r} s, but its "
+                f"time stamps step by {median:.6g} s (the median of its first {steps} steps), "
+                f"more than {100 * PERIOD_CONSISTENCY:g} % apart: the estimates need the period "
+                "the samples have"
             )
 
     def _latency(self, index: int) -> float:
@@ -305,6 +308,7 @@ class Listener:
                 return
 
     def _finish(self, reason: str) -> None:
+        self._check_period(final=True)
         estimator = self._estimator
         last = self._t.size - 1
         if estimator.result is None:

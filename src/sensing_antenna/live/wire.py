@@ -24,6 +24,7 @@ from types import MappingProxyType
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import (
     FORMAT_NAME,
+    MIN_SAMPLE_PERIOD,
     RecordingError,
     parse_header,
     parse_metadata,
@@ -135,6 +136,15 @@ def read_header(lines: Sequence[str], source: str, first_line: int = 1) -> Strea
             first_line + index,
             "sample_period",
             "missing: a live stream gives its sample period before its samples",
+            metadata=True,
+        )
+    if float(metadata["sample_period"]) < MIN_SAMPLE_PERIOD:
+        raise RecordingError(
+            source,
+            first_line + index,
+            "sample_period",
+            f"{metadata['sample_period']} s, shorter than {MIN_SAMPLE_PERIOD:g} s, faster than "
+            "any force/torque sensor: in another unit than seconds?",
             metadata=True,
         )
     return StreamHeader(metadata, tuple(columns), source)
