@@ -253,13 +253,15 @@ class Listener:
             return
         self._period_checked = True
         ts = self.header.sample_period
-        median = float(np.median(np.diff(self._t.values[: steps + 1])))
-        if abs(median - ts) > PERIOD_CONSISTENCY * ts:
+        step = np.diff(self._t.values[: steps + 1])
+        # a dropped sample is a step of whole periods: each step against its nearest multiple
+        periods = np.maximum(np.rint(step / ts), 1.0)
+        if float(np.median(np.abs(step / periods - ts))) > PERIOD_CONSISTENCY * ts:
             raise WireError(
                 f"{self.header.source}: sample_period: the stream declares {ts!r} s, but its "
-                f"time stamps step by {median:.6g} s (the median of its first {steps} steps), "
-                f"more than {100 * PERIOD_CONSISTENCY:g} % apart: the estimates need the period "
-                "the samples have"
+                f"time stamps step by {float(np.median(step / periods)):.6g} s (the median of "
+                f"its first {steps} steps), more than {100 * PERIOD_CONSISTENCY:g} % apart: the "
+                "estimates need the period the samples have"
             )
 
     def _latency(self, index: int) -> float:
