@@ -95,7 +95,10 @@ def test_quaternion_and_matrix_metadata_give_one_pose() -> None:
         ('{"position": [0, 0, 0], "quaternion": ["1", 0, 0, 0]}', "four numbers"),
         ('{"position": [0, 0, 0], "position": [1, 0, 0], "quaternion": [1, 0, 0, 0]}', "twice"),
         ('{"position": ' + "[" * 5000 + "]" * 5000 + "}", "nested too deep"),
-        ('{"position": [1e300, 0, 0], "quaternion": [1, 0, 0, 0]}', "1e+300 m"),
+        ('{"position": [1e300, 0, 0], "quaternion": [1, 0, 0, 0]}', "within +-1e+06"),
+        ('{"position": [0, 0, 0], "quaternion": [1e300, 0, 0, 0]}', "within +-1e+06"),
+        ('{"position": [1' + "0" * 400 + ', 0, 0], "quaternion": [1, 0, 0, 0]}', "three"),
+        ('{"position": [1' + "0" * 5000 + ', 0, 0], "quaternion": [1, 0, 0, 0]}', "too long"),
     ],
 )
 def test_bad_base_pose_is_one_line_naming_file_and_key(value: str, words: str) -> None:

@@ -32,6 +32,11 @@ BASE_POSE_KEY = "base_pose"
 #: significant digits, well below any real mounting error.
 ORTHONORMAL_TOLERANCE = 1e-4
 
+#: Largest magnitude of any number of a pose: a rotation's entries and a unit quaternion's are
+#: at most 1, a position beyond 100 m is refused with its own message; beyond this, a number's
+#: square overflows.
+MAX_POSE_NUMBER = 1e6
+
 #: Farthest a base may sit from the world's origin (m): 100 m holds a robot's workspace in any
 #: lab or field frame a map of centimetre-sized contacts would use, and refuses a position in
 #: millimetres (a base 0.2 m away written as 200).
@@ -157,8 +162,10 @@ def base_pose_from_metadata(metadata: Mapping[str, str], source: str | None = No
         raise FieldError(BASE_POSE_KEY, f"not JSON ({exc.msg})", source) from None
     except RecursionError:
         raise FieldError(BASE_POSE_KEY, "not a pose (JSON nested too deep)", source) from None
-    except ValueError as exc:  # a key given twice
+    except _DuplicateKey as exc:
         raise FieldError(BASE_POSE_KEY, str(exc), source) from None
+    except ValueError:  # an integer of thousands of digits
+        raise FieldError(BASE_POSE_KEY, "not a pose (a number too long)", source) from None
     try:
         return _pose_from_json(data)
     except FieldError as exc:
@@ -181,12 +188,16 @@ def _pose_from_json(data: Any) -> BasePose:
     return BasePose(rotation, position)
 
 
+class _DuplicateKey(ValueError):
+    """A JSON object gives a key twice."""
+
+
 def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     """A JSON object's fields, refusing a key given twice (JSON would keep the last)."""
     data: dict[str, Any] = {}
     for key, value in pairs:
         if key in data:
-            raise ValueError(f"{key}: given twice")
+            raise _DuplicateKey(f"{key}: given twice")
         data[key] = value
     return data
 
@@ -202,8 +213,10 @@ def _numbers(value: Any, shape: tuple[int, ...], what: str) -> FloatArray:
         raise FieldError(BASE_POSE_KEY, f"{what} expected")
     try:
         array = np.array(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise FieldError(BASE_POSE_KEY, f"{what} expected") from None
+    if array.size and not float(np.abs(array).max()) <= MAX_POSE_NUMBER:
+        raise FieldError(BASE_POSE_KEY, f"{what} expected, each within +-{MAX_POSE_NUMBER:g}")
     if array.shape != shape or not all(math.isfinite(v) for v in array.ravel()):
         raise FieldError(BASE_POSE_KEY, f"{what} expected")
     return array
