@@ -99,7 +99,7 @@ def test_calibration_undoes_the_cross_talk_on_new_contacts(
     assert fit.ratio_rms_before > 0.15
     assert fit.ratio_rms_after < 0.05
     # and it predicts each contact left out of the fit: adopted
-    assert fit.adopted and fit.ratio_rms_held_out < 0.05
+    assert fit.adopted == ("azimuthal", "vertical") and fit.ratio_rms_held_out < 0.05
     # the scatter left is kept as the ratio's model floor: its rms over the degrees of freedom
     n = len(truth)
     expected = fit.ratio_rms_after * (n / (n - 4)) ** 0.5
@@ -132,10 +132,35 @@ def test_a_sensor_without_cross_talk_gets_no_correction() -> None:
         recordings.append(recording.without_ground_truth())
     fit = calibrate_sensor(recordings, ANTENNA, truth)
     assert fit.ratio_rms_after < fit.ratio_rms_before < fit.ratio_rms_held_out
-    assert not fit.adopted
+    assert fit.adopted == ()
     assert dataclasses.replace(fit.correction, ratio_scatter=0.0) == SensorCorrection()
     assert fit.correction.ratio_scatter == pytest.approx(fit.ratio_rms_before, rel=1e-6)
     assert "not adopted" in fit.ratio_summary
+
+
+def test_a_leak_in_one_plane_is_corrected_there_and_nowhere_else() -> None:
+    # tz leaks into fy only (0.6 N per N m): the azimuthal sweeps' terms undo it and predict
+    # their contacts left out of the fit; on this set the vertical sweeps' terms, fitted to
+    # their noise alone, do not, and are left at no correction (the fit stays within the
+    # limits a correction may take, where an unbounded one stepped to a negative gain)
+    coupling = np.zeros((6, 6))
+    coupling[1, 5] = 0.6
+    device = DeviceImperfections(
+        sensor_coupling=tuple(tuple(float(c) for c in row) for row in coupling)
+    )
+    recordings, truth = [], []
+    for k, case in enumerate(("azimuthal", "vertical")):
+        for i, x in enumerate(POINTS):
+            scenario = Scenario(case=case, contact_point=x, seed=100 + 10 * k + i, device=device)
+            recording = simulate(ANTENNA, scenario)
+            truth.append(float(recording.metadata["true_xc"]))
+            recordings.append(recording.without_ground_truth())
+    fit = calibrate_sensor(recordings, ANTENNA, truth)
+    assert fit.sweeps == ("azimuthal", "vertical") and fit.adopted == ("azimuthal",)
+    assert fit.correction.fy_per_tz == pytest.approx(-0.6, rel=0.15)
+    untouched = (fit.correction.fz_gain, fit.correction.fz_per_ty, fit.correction.fy_per_ty)
+    assert untouched == (1.0, 0.0, 0.0)
+    assert "not adopted for the vertical sweeps" in fit.ratio_summary
 
 
 def test_one_sweep_direction_fits_its_own_terms_only(

@@ -20,15 +20,17 @@ one about the elevation fz_gain, fz_per_ty and fy_per_ty; terms no recording fix
 correction. The antenna's frequency model (T_e) should be calibrated first: the statics use its
 stiffness.
 
-The correction is adopted only when it predicts contacts it was not fitted to: each recording is
-left out in turn, the terms fitted to the others, and the left-out ratio's error with that fit
-compared with its error uncorrected. Five contacts of one sweep direction on a sensor without
-cross-talk leave the ratio a few per cent off for other reasons (the sensor's noise at a gentle
-push, the statics' model); two terms fitted to that fit it on those contacts and lengthen the
-ratio elsewhere. When the held-out error with the correction is not below the error without it,
-no correction is written. The ratio's relative scatter about the known points left with the
-correction adopted (or without it) is kept as ``ratio_scatter``, a floor of the ratio's model
-uncertainty.
+A sweep direction's terms are adopted only when they predict contacts they were not fitted to:
+each recording is left out in turn, the terms fitted to the others, and the left-out ratio's
+error with that fit compared with its error uncorrected, over the direction's recordings. Five
+contacts of one sweep direction on a sensor without cross-talk leave the ratio several per cent
+off for other reasons (the sensor's noise at a gentle push, the statics' model); two terms
+fitted to that fit it on those contacts and lengthen the ratio elsewhere. A direction whose
+held-out error with the terms is not below its error without them keeps no correction (the
+others are fitted again without its terms). With :data:`MIN_SENSOR_RECORDINGS` recordings of a
+direction, each held-out fit has one fewer than a fit needs, which leans towards refusing. The
+ratio's relative scatter about the known points left with the terms adopted is kept as
+``ratio_scatter``, a floor of the ratio's model uncertainty.
 """
 
 from __future__ import annotations
@@ -42,7 +44,12 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from sensing_antenna.antenna import Antenna, SensorCorrection
+from sensing_antenna.antenna import (
+    MAX_SENSOR_COUPLING,
+    MAX_SENSOR_GAIN_ERROR,
+    Antenna,
+    SensorCorrection,
+)
 from sensing_antenna.calibration.frequency import points_on_link
 from sensing_antenna.errors import SensingAntennaError
 
@@ -91,9 +98,10 @@ class SensorCalibration:
         and with the fitted correction (dimensionless).
     ratio_rms_held_out : float
         The same with each recording corrected by the terms fitted to the others.
-    adopted : bool
-        Whether the held-out error is below ``ratio_rms_before``; if not, ``correction`` is no
-        correction (its ``ratio_scatter`` the uncorrected ratio's).
+    adopted : tuple of str
+        The sweep directions whose terms are kept: those whose recordings' held-out error is
+        below their error without correction. The others' terms are no correction; with none
+        adopted, ``correction`` is no correction, its ``ratio_scatter`` the uncorrected ratio's.
     """
 
     correction: SensorCorrection
@@ -103,7 +111,7 @@ class SensorCalibration:
     ratio_rms_before: float
     ratio_rms_after: float
     ratio_rms_held_out: float
-    adopted: bool
+    adopted: tuple[str, ...]
 
     def apply(self, antenna: Antenna) -> Antenna:
         """``antenna`` with this correction."""
@@ -118,11 +126,14 @@ class SensorCalibration:
             f"rms before, {100 * self.ratio_rms_after:.1f} % after, "
             f"{100 * self.ratio_rms_held_out:.1f} % on each left out of the fit"
         )
-        if self.adopted:
+        if self.adopted == self.sweeps:
             return summary
+        refused = ", ".join(s for s in self.sweeps if s not in self.adopted)
+        kept = f"adopted for the {', '.join(self.adopted)} sweeps; " if self.adopted else ""
         return (
-            f"{summary}: not adopted, the fit does not predict the contacts it was not fitted "
-            "to better than no correction (no cross-talk these recordings can tell)"
+            f"{summary}: {kept}not adopted for the {refused} sweeps, whose contacts left out of "
+            "the fit it does not predict better than no correction (no cross-talk they can "
+            "tell)"
         )
 
 
@@ -198,14 +209,16 @@ def calibrate_sensor(
     lateral = np.array([1 if h.sweep == "azimuthal" else 2 for h in holds])
     rows = np.arange(len(holds))
 
-    def correction(params: FloatArray) -> SensorCorrection:
-        return SensorCorrection(**dict(zip(terms, (float(p) for p in params), strict=True)))
+    def correction(params: FloatArray, names: Sequence[str]) -> SensorCorrection:
+        return SensorCorrection(**dict(zip(names, (float(p) for p in params), strict=True)))
 
-    def residuals(params: FloatArray, keep: NDArray[np.bool_] | None = None) -> FloatArray:
+    def residuals(
+        params: FloatArray, names: Sequence[str], keep: NDArray[np.bool_] | None = None
+    ) -> FloatArray:
         """The ratio's relative errors, then the pushes' out-of-plane slopes, of the holds in
-        ``keep`` (all when None)."""
+        ``keep`` (all when None), with the terms ``names`` at ``params``."""
         chosen = rows if keep is None else rows[keep]
-        corrected = correction(params).correct(reaction[chosen], moment[chosen])
+        corrected = correction(params, names).correct(reaction[chosen], moment[chosen])
         ratio = perpendicular_ratio(corrected, moment[chosen], rigidity)
         along = corrected[np.arange(chosen.size), lateral[chosen]]
         across = corrected[np.arange(chosen.size), 3 - lateral[chosen]]
@@ -213,29 +226,47 @@ def calibrate_sensor(
             slope = np.where(np.abs(along) > 0, across / np.abs(along), 1.0)
         return np.concatenate([ratio / points[chosen] - 1.0, slope])
 
-    def fitted(keep: NDArray[np.bool_] | None = None) -> FloatArray:
+    def fitted(names: Sequence[str], keep: NDArray[np.bool_] | None = None) -> FloatArray:
+        start = np.array([getattr(SensorCorrection(), t) for t in names], dtype=float)
+        # within the limits a SensorCorrection accepts (gains in (0, 2), couplings to +-100)
+        gain = [t.endswith("_gain") for t in names]
+        low = np.where(gain, 1.0 - 0.99 * MAX_SENSOR_GAIN_ERROR, -MAX_SENSOR_COUPLING)
+        high = np.where(gain, 1.0 + 0.99 * MAX_SENSOR_GAIN_ERROR, MAX_SENSOR_COUPLING)
         found = least_squares(
-            lambda params: residuals(params, keep), start, loss="soft_l1", f_scale=_LOSS_SCALE
+            lambda params: residuals(params, names, keep),
+            start,
+            bounds=(low, high),
+            loss="soft_l1",
+            f_scale=_LOSS_SCALE,
         )
         return np.asarray(found.x, dtype=float)
 
-    start = np.array([getattr(SensorCorrection(), t) for t in terms], dtype=float)
-    before = residuals(start)[: len(holds)]
-    params = fitted()
-    after = residuals(params)[: len(holds)]
+    before = residuals(np.array([getattr(SensorCorrection(), t) for t in terms]), terms)
+    before = before[: len(holds)]
+    params = fitted(terms)
+    after = residuals(params, terms)[: len(holds)]
     held_out = np.array(
-        [residuals(fitted(rows != i), rows == i)[0] for i in range(len(holds))], dtype=float
+        [residuals(fitted(terms, rows != i), terms, rows == i)[0] for i in range(len(holds))],
+        dtype=float,
     )
-    adopted = bool(_rms(held_out) < _rms(before))
-    # the ratio's scatter left, over the degrees of freedom the in-plane terms leave (two per
-    # sweep direction) when the correction is adopted
-    left = after if adopted else before
+    # each sweep direction's terms are kept when they predict its holds left out of the fit
+    # better than no correction
+    direction = np.array([h.sweep for h in holds])
+    adopted = tuple(
+        s for s in sweeps if _rms(held_out[direction == s]) < _rms(before[direction == s])
+    )
+    names = [t for s in adopted for t in _PLANE_TERMS[s]]
+    if adopted != sweeps and names:
+        params = fitted(names)
+    left = residuals(params, names)[: len(holds)] if names else before
+    # the ratio's scatter left, over the degrees of freedom the fitted in-plane terms leave
+    # (two per sweep direction adopted)
     finite = left[np.isfinite(left)]
-    dof = max(finite.size - (2 * len(sweeps) if adopted else 0), 1)
+    dof = max(finite.size - 2 * len(adopted), 1)
     scatter = min(math.sqrt(float(np.sum(finite**2)) / dof), 1.0)
     return SensorCalibration(
         correction=replace(
-            correction(params) if adopted else SensorCorrection(), ratio_scatter=scatter
+            correction(params, names) if names else SensorCorrection(), ratio_scatter=scatter
         ),
         sweeps=sweeps,
         sources=tuple(n for _, n in kept),
