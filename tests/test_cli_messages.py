@@ -171,3 +171,17 @@ def test_an_output_directory_that_is_a_file_is_named_so(
     # and a UDP destination of port 0, which the system refuses as an invalid argument
     assert main(["replay", str(recording), "--udp", "127.0.0.1:0"]) == 2
     assert "--udp: port 0 is no destination" in capsys.readouterr().err
+
+
+def test_one_file_by_two_names_is_given_twice(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a hard link and a symbolic one lead to the same file, which would count twice
+    first = tmp_path / "a.csv"
+    first.write_text("")
+    (tmp_path / "hard.csv").hardlink_to(first)
+    (tmp_path / "soft.csv").symlink_to(first)
+    for other in ("hard.csv", "soft.csv"):
+        assert main(["map", str(first), str(tmp_path / other), "--out", str(tmp_path / "m")]) == 2
+        err = capsys.readouterr().err
+        assert f"recordings: {tmp_path / other} given twice (as {first})" in err

@@ -142,9 +142,13 @@ def distinct_files(paths: Iterable[Path], what: str = "recordings") -> list[Path
     """``paths`` as given, refusing one file given twice (the same file by two spellings
     included): it would count twice."""
     given = list(paths)
-    seen: dict[Path, Path] = {}
+    seen: dict[object, Path] = {}
     for path in given:
-        key = Path(os.path.realpath(path))
+        try:  # the file itself, whatever links lead to it
+            status = os.stat(path)
+            key: object = (status.st_dev, status.st_ino)
+        except OSError:  # not there: its reader names it
+            key = os.path.realpath(path)
         if key in seen:
             same = "" if str(seen[key]) == str(path) else f" (as {printable(str(seen[key]))})"
             raise ArgumentError(

@@ -45,6 +45,10 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(func=_run)
 
 
+#: Bytes of a recording read for its metadata before the map reads it whole.
+HEADER_BYTES = 1 << 16
+
+
 def warn_of_other_antennas(paths: list[Path], model: str) -> None:
     """One line on stderr for each antenna other than the default ``model`` that the
     recordings' ``antenna`` metadata names (as ``antenna estimate`` warns of one recording); a
@@ -56,9 +60,11 @@ def warn_of_other_antennas(paths: list[Path], model: str) -> None:
     named: dict[str, list[Path]] = {}
     for path in paths:
         try:
-            with open(path, encoding="utf-8-sig", errors="replace") as stream:
-                lines = list(itertools.takewhile(lambda line: line.startswith("#"), stream))
-            metadata, _ = parse_metadata([line.rstrip("\r\n") for line in lines], str(path))
+            # the head of the file only: the map's own reader refuses what is not a recording
+            with open(path, "rb") as stream:
+                head = stream.read(HEADER_BYTES).decode("utf-8-sig", errors="replace")
+            lines = list(itertools.takewhile(lambda line: line.startswith("#"), head.splitlines()))
+            metadata, _ = parse_metadata(lines, str(path))
         except (OSError, SensingAntennaError):
             continue
         named.setdefault(metadata.get("antenna", ""), []).append(path)

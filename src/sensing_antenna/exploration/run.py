@@ -292,7 +292,8 @@ def prepare_device(device: Antenna, folder: Path | None = None, link: str = "non
 def _prepared(device: Antenna, out: Path, link: str) -> Antenna:
     path = out / CALIBRATED_FILE
     if path.is_file():
-        return load_antenna(path)
+        # a directory prepared before the model had its own name: its recordings name it too
+        return replace(load_antenna(path), name=CALIBRATED_NAME)
     prepared = replace(prepare_device(device, out / "calibration", link), name=CALIBRATED_NAME)
     atomic_write_text(path, antenna_to_toml(prepared))
     return load_antenna(path)

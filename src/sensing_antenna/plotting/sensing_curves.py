@@ -35,7 +35,7 @@ def _is_papers_link(link: Link) -> bool:
     """Whether ``link`` is the paper's (Table 2), whatever its T_e: the paper's measurements
     belong on its figure only then."""
     paper = paper_antenna().link
-    return all(
+    return link.second_moment == paper.second_moment and all(
         math.isclose(getattr(link, name), getattr(paper, name), rel_tol=1e-9)
         for name in ("length", "radius", "youngs_modulus", "linear_density", "tip_mass")
     )
