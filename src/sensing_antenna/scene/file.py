@@ -260,13 +260,12 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
     position = _vector(table["position"], 3, f"{where}.position", fail, MAX_BASE_DISTANCE)
     rotation = _vector(table.get("rotation", [0.0, 0.0, 0.0]), 3, f"{where}.rotation", fail)
     if shape == "mesh":
-        return mesh_object(
-            name,
-            _mesh_file(table.get("file"), f"{where}.file", folder, fail),
-            position,
-            rotation,
-            _number(table.get("scale", 1.0), f"{where}.scale", fail, 0.0, 1.0),
-        )
+        mesh = _mesh_file(table.get("file"), f"{where}.file", folder, fail)
+        scale = _number(table.get("scale", 1.0), f"{where}.scale", fail, 0.0, 1.0)
+        problem = mesh_problem(mesh.copy().apply_scale(scale))
+        if problem is not None:
+            raise fail(f"{where}.file", f"{table.get('file')} at scale {scale:g}: {problem}")
+        return mesh_object(name, mesh, position, rotation, scale)
     sizes: list[float] = []
     for key in _SIZE_KEYS[str(shape)]:
         if key not in table:
@@ -303,9 +302,8 @@ def _mesh_file(value: object, where: str, folder: Path | None, fail: Any) -> tri
         raise fail(where, f"{path}: not a readable mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise fail(where, f"{path}: the file holds no triangles")
-    problem = mesh_problem(mesh)
-    if problem is not None:
-        raise fail(where, f"{path}: {problem}")
+    if not np.all(np.isfinite(mesh.vertices)):
+        raise fail(where, f"{path}: vertices that are not finite numbers")
     if not mesh.is_watertight:
         raise fail(
             where, f"{path}: the mesh is not closed (watertight), so its inside is undefined"

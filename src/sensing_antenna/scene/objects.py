@@ -51,7 +51,8 @@ def mesh_problem(mesh: trimesh.Trimesh) -> str | None:
     if extent > MAX_MESH_EXTENT:
         return (
             f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
-            "(a mesh in millimetres reads a thousand times too large)"
+            "(a mesh in millimetres reads a thousand times too large; a scene's scale = 0.001 "
+            "reads it in millimetres)"
         )
     return None
 

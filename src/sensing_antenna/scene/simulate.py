@@ -57,7 +57,7 @@ from sensing_antenna.mapping.pose import BasePose
 from sensing_antenna.recording import Recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.sweep import LinkShape, Sweep
-from sensing_antenna.scene.touch import SweepGeometry, Touch, first_touch
+from sensing_antenna.scene.touch import MAX_RADIUS, SweepGeometry, Touch, first_touch
 from sensing_antenna.simulator import Scenario, simulate
 from sensing_antenna.simulator.contact import motor_frame
 from sensing_antenna.simulator.run import device_link, minimum_contact_point
@@ -67,6 +67,7 @@ __all__ = [
     "GLANCING_ANGLE",
     "MAX_TILT",
     "OUTCOMES",
+    "GlancingTouchError",
     "SweepOutcome",
     "simulate_sweep",
     "touch_scenario",
@@ -133,6 +134,10 @@ class SweepOutcome:
     sweep_time: float = 0.0
 
 
+class GlancingTouchError(ValueError):
+    """The touched surface turns too far out of the sweep's direction to be simulated."""
+
+
 def touch_scenario(
     touch: Touch,
     sweep: Sweep,
@@ -144,7 +149,7 @@ def touch_scenario(
     docstring); the touch's ``link_radius`` (m) grows the obstacle, as the simulated link
     touches with its axis.
 
-    Raises ValueError with the reason when the touch is ``glancing``.
+    Raises :class:`GlancingTouchError` with the reason when the touch is ``glancing``.
     """
     base = scene.bases[sweep.base]
     rotation = base.rotation @ motor_frame(*touch.angles).T
@@ -176,12 +181,12 @@ def touch_scenario(
         radius = touch.radius
     # the simulator's link touches with its axis: its obstacle is the surface grown by the
     # link's radius, which the axis meets where the link's surface meets the surface
-    radius += touch.link_radius
+    radius = min(radius + touch.link_radius, MAX_RADIUS)
     if touch.tip:
         kind = "plane"
         tilt = 0.0
     elif abs(tilt) >= GLANCING_ANGLE:
-        raise ValueError(
+        raise GlancingTouchError(
             f"the surface's normal is {abs(tilt):.2f} rad out of the sweep's direction, more than"
             f" {GLANCING_ANGLE} rad (the link would slide over it)"
         )
@@ -269,7 +274,7 @@ def simulate_sweep(
         )
     try:
         scenario, frame = touch_scenario(touch, sweep, scene, seed, **scenario_fields)
-    except ValueError as exc:
+    except GlancingTouchError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     recording = simulate(device, scenario)
     metadata = dict(recording.metadata)
