@@ -16,6 +16,7 @@ import pytest
 from scipy.optimize import brentq
 
 from sensing_antenna.antenna import load_antenna, paper_antenna, save_antenna
+from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.calibration.frequency import (
     CalibrationError,
     FrequencyCalibration,
@@ -182,6 +183,15 @@ def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     expected = math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
     assert result.relative_scatter == pytest.approx(expected, rel=1e-6)
     assert result.wrong_peaks == 1 and np.flatnonzero(result.wrong_peak_points).tolist() == [9]
+    # A payload of 0.5 g the model lacks bends the whole curve: 8 of 15 points lie more than
+    # 5 % from the median, model error, not wrong peaks: all stay in the scatter
+    payload = natural_frequencies(replace(link, tip_mass=5e-4), PAPER_POINTS, 1)
+    bent = calibrate_t_e(PAPER_POINTS, payload[:, 0], link)
+    relative = payload[:, 0] / bent.omega1_fitted - 1.0
+    assert bent.wrong_peaks == 0
+    assert bent.relative_scatter == pytest.approx(
+        math.sqrt(float(np.sum(relative**2)) / (relative.size - 1)), rel=1e-9
+    )
     # A departure of about 1 % on three points near the tip (a soft contact) is model error,
     # not wrong peaks: it stays in the scatter
     tip = k / PAPER_T_E * np.where(PAPER_POINTS >= 0.9, 0.99, 1.0)

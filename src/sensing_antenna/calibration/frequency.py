@@ -144,9 +144,9 @@ class FrequencyCalibration:
         with n - 1 degrees of freedom (T_e is fitted; n - 2 with the tip mass). It measures
         how far the device departs from the fitted model along the link (a compliant contact, a
         base that is not a clamp, contacts away from the given points), which the fit cannot
-        absorb. A point more than
-        :data:`WRONG_PEAK` from the median is a wrong spectral peak, not model error, and is
-        left out (:attr:`wrong_peaks`); NaN with fewer than 3 points left.
+        absorb. A point more than :data:`WRONG_PEAK` from the median, one of few
+        (:attr:`wrong_peak_points`), is a wrong spectral peak, not model error, and is left out
+        (:attr:`wrong_peaks`); NaN with fewer than 3 points left.
         """
         relative = self._relative_residuals()
         kept = relative[self.used & np.isfinite(relative) & ~self.wrong_peak_points]
@@ -163,14 +163,18 @@ class FrequencyCalibration:
     @property
     def wrong_peak_points(self) -> NDArray[np.bool_]:
         """Which points, shape (n,), are used by the fit but more than :data:`WRONG_PEAK` from
-        the median relative residual: left out of :attr:`relative_scatter` as wrong peaks (or
-        wrong known points)."""
+        the median relative residual, when they are few (one, or a tenth of the points): left
+        out of :attr:`relative_scatter` as wrong peaks (or wrong known points). More are the
+        model's error (a payload bends the whole curve: 0.2 g puts 4 of 15 points beyond), and
+        stay in the scatter."""
         relative = self._relative_residuals()
         usable = self.used & np.isfinite(relative)
+        none = np.zeros(relative.shape, dtype=bool)
         if not np.any(usable):
-            return np.zeros(relative.shape, dtype=bool)
+            return none
         median = float(np.median(relative[usable]))
-        return np.asarray(usable & (np.abs(relative - median) > WRONG_PEAK), dtype=bool)
+        beyond = np.asarray(usable & (np.abs(relative - median) > WRONG_PEAK), dtype=bool)
+        return beyond if int(beyond.sum()) <= max(1, int(usable.sum()) // 10) else none
 
     def _relative_residuals(self) -> NDArray[np.float64]:
         """measured / fitted - 1 at every point, shape (n,)."""
