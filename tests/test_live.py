@@ -229,6 +229,42 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
 
 
+def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
+    recordings: dict[str, Path],
+) -> None:
+    # a stream whose declared period is 10 % off its time stamps is left out with a skipped
+    # event naming it; the listener goes on and estimates the next stream
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    wrong = [
+        "# sample_period: 0.0011" if line.startswith("# sample_period") else line
+        for line in header.lines()
+    ]
+    rows = [f"{0.001 * k!r},0,0,0,0,-0.0451,0,0.0221,0,0,0" for k in range(30)]
+    events: list[Event] = []
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, paper_antenna(), events.append, "ratio", number=number)
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        address = sock.getsockname()
+        reader = threading.Thread(target=listen_udp, args=(sock, make, events.append, 2))
+        reader.start()
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+            sender.sendto(Datagram("header", "w", 0, tuple(wrong)).encode(), address)
+            sender.sendto(Datagram("samples", "w", 0, tuple(rows)).encode(), address)
+            sender.sendto(Datagram("end", "w", 1).encode(), address)
+            replay_datagrams(recording, sender, address, speed=4, stream="s")
+        reader.join(timeout=120)
+    assert not reader.is_alive()
+    skipped = [e.to_dict()["reason"] for e in events if e.to_dict()["event"] == "skipped"]
+    assert any("stream w: sample_period: the stream declares 0.0011 s" in r for r in skipped)
+    assert any("the stream is left out" in r for r in skipped)
+    found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
+    _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
+
+
 def test_datagrams() -> None:
     lines = [f"{k},1.5" for k in range(400)]
     packed = pack_samples(lines, "s", 7, max_bytes=200)

@@ -170,13 +170,21 @@ def listen_udp(
     def skip(reason: str) -> None:
         on_event(SkippedEvent(ended + 1, reason))
 
+    def finish(stream: _UdpStream, reason: str) -> None:
+        """End ``stream``; one the listener refused (its period, say) is skipped, not fatal:
+        other streams may follow."""
+        try:
+            stream.close(reason)
+        except WireError as exc:
+            skip(f"{exc}: the stream is left out")
+
     try:
         while count is None or ended < count:
             try:
                 data = sock.recv(MAX_DATAGRAM_BYTES + 1)
             except TimeoutError:
                 if current is not None and clock() - current.heard > idle:
-                    current.close(f"no datagram for {idle:g} s")
+                    finish(current, f"no datagram for {idle:g} s")
                     current, ended = None, ended + 1
                 continue
             received = clock()
@@ -196,7 +204,7 @@ def listen_udp(
                     skip(str(exc))
                     continue
                 if current is not None:
-                    current.close("another stream began")
+                    finish(current, "another stream began")
                     current, ended = None, ended + 1
                     if count is not None and ended >= count:
                         break
@@ -207,11 +215,16 @@ def listen_udp(
             elif datagram.kind == "end":
                 assert current is not None
                 current.lost += max(0, datagram.seq - current.expected)
-                current.close("end of stream")
+                finish(current, "end of stream")
                 current, ended = None, ended + 1
             else:
                 assert current is not None
-                _receive_samples(current, datagram, received, skip)
+                try:
+                    _receive_samples(current, datagram, received, skip)
+                except WireError as exc:
+                    skip(f"{exc}: the stream is left out")
+                    _close_quietly(current.listener)
+                    current, ended = None, ended + 1
         return ended
     finally:
         _close_quietly(None if current is None else current.listener)
