@@ -254,13 +254,16 @@ def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
             sender.sendto(Datagram("header", "w", 0, tuple(wrong)).encode(), address)
             sender.sendto(Datagram("samples", "w", 0, tuple(rows)).encode(), address)
-            sender.sendto(Datagram("end", "w", 1).encode(), address)
+            # its header repeated, as a sender repeats it each second: not joined again
+            sender.sendto(Datagram("header", "w", 1, tuple(wrong)).encode(), address)
+            sender.sendto(Datagram("samples", "w", 1, tuple(rows)).encode(), address)
+            sender.sendto(Datagram("end", "w", 2).encode(), address)
             replay_datagrams(recording, sender, address, speed=4, stream="s")
         reader.join(timeout=120)
     assert not reader.is_alive()
     skipped = [e.to_dict()["reason"] for e in events if e.to_dict()["event"] == "skipped"]
     assert any("stream w: sample_period: the stream declares 0.0011 s" in r for r in skipped)
-    assert any("the stream is left out" in r for r in skipped)
+    assert sum("the stream is left out" in r for r in skipped) == 1
     found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
     _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
 
@@ -304,6 +307,14 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
             ],
             "<stdin>: sample_period: the stream declares 0.0011 s, but its time stamps step by "
             "0.001 s (the median of its first 20 steps)",
+        ),
+        # a period declared ten times too short: its steps are not ten dropped samples each
+        (
+            [
+                "# sample_period: 0.0001\n" if line.startswith("# sample_period") else line
+                for line in text[: header_at + 40]
+            ],
+            "sample_period: the stream declares 0.0001 s, but its time stamps step by 0.001 s",
         ),
         # the same in a stream of 11 samples: judged at its end on the 10 steps it has
         (

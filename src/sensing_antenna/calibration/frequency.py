@@ -163,15 +163,16 @@ class FrequencyCalibration:
     @property
     def wrong_peak_points(self) -> NDArray[np.bool_]:
         """Which points, shape (n,), are used by the fit but more than :data:`WRONG_PEAK` from
-        the median relative residual, when they are few (one, or a tenth of the points): left
+        the median relative residual, when they are few (one, or a tenth of the points, of
+        :data:`MIN_WRONG_PEAK_POINTS` or more): left
         out of :attr:`relative_scatter` as wrong peaks (or wrong known points). More are the
         model's error (a payload bends the whole curve: 0.2 g puts 4 of 15 points beyond), and
         stay in the scatter."""
         relative = self._relative_residuals()
         usable = self.used & np.isfinite(relative)
         none = np.zeros(relative.shape, dtype=bool)
-        if not np.any(usable):
-            return none
+        if int(usable.sum()) < MIN_WRONG_PEAK_POINTS:
+            return none  # a median of fewer cannot tell a wrong peak from the model's error
         median = float(np.median(relative[usable]))
         beyond = np.asarray(usable & (np.abs(relative - median) > WRONG_PEAK), dtype=bool)
         return beyond if int(beyond.sum()) <= max(1, int(usable.sum()) // 10) else none
@@ -421,6 +422,9 @@ def calibrate_t_e(
         tip_mass=tip_mass,
     )
 
+
+#: Fewest points used whose median residual can single out a wrong peak.
+MIN_WRONG_PEAK_POINTS = 5
 
 #: A point whose omega_1 lies farther than this (relative) from the median of T_e alone's fit is
 #: left out of the tip mass's fit before it starts: a peak of another mode, a harmonic or the

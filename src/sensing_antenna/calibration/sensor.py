@@ -95,9 +95,10 @@ class SensorCalibration:
         Recordings left out and why.
     ratio_rms_before, ratio_rms_after : float
         RMS relative error of the hold's torque/force ratio against the known points, without
-        and with the fitted correction (dimensionless).
+        and with the correction written (dimensionless).
     ratio_rms_held_out : float
-        The same with each recording corrected by the terms fitted to the others.
+        The same with each recording corrected by every direction's terms fitted to the others
+        (the test that adopts them).
     adopted : tuple of str
         The sweep directions whose terms are kept: those whose recordings' held-out error is
         below their error without correction. The others' terms are no correction; with none
@@ -244,7 +245,6 @@ def calibrate_sensor(
     before = residuals(np.array([getattr(SensorCorrection(), t) for t in terms]), terms)
     before = before[: len(holds)]
     params = fitted(terms)
-    after = residuals(params, terms)[: len(holds)]
     held_out = np.array(
         [residuals(fitted(terms, rows != i), terms, rows == i)[0] for i in range(len(holds))],
         dtype=float,
@@ -272,7 +272,7 @@ def calibrate_sensor(
         sources=tuple(n for _, n in kept),
         notes=tuple(notes),
         ratio_rms_before=_rms(before),
-        ratio_rms_after=_rms(after),
+        ratio_rms_after=_rms(left),
         ratio_rms_held_out=_rms(held_out),
         adopted=adopted,
     )

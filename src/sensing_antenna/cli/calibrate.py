@@ -157,7 +157,7 @@ def _run(args: argparse.Namespace) -> int:
         f"model scatter {100.0 * scatter:.3f} % (rms relative residual; written as "
         "link.calibration_scatter)"
         if math.isfinite(scatter)
-        else "model scatter: not measured (fewer than 3 points)"
+        else "model scatter: not measured (too few points: 3 needed, 4 with the tip mass)"
     )
     wrong = calibration.wrong_peak_points
     for i, x_c in enumerate(calibration.contact_points):

@@ -63,7 +63,11 @@ def warn_of_other_antennas(paths: list[Path], model: str) -> None:
             # the head of the file only: the map's own reader refuses what is not a recording
             with open(path, "rb") as stream:
                 head = stream.read(HEADER_BYTES).decode("utf-8-sig", errors="replace")
-            lines = list(itertools.takewhile(lambda line: line.startswith("#"), head.splitlines()))
+            rows = head.split("\n")
+            if len(head) >= HEADER_BYTES:
+                rows = rows[:-1]  # the last may be cut off
+            rows = [row.rstrip("\r") for row in rows]
+            lines = list(itertools.takewhile(lambda line: line.startswith("#"), rows))
             metadata, _ = parse_metadata(lines, str(path))
         except (OSError, SensingAntennaError):
             continue

@@ -165,6 +165,7 @@ def listen_udp(
     source = f"udp:{host}:{port}"
     current: _UdpStream | None = None
     ended = 0
+    refused: set[str] = set()  # streams left out, ignored until their end
     sock.settimeout(min(idle, 0.2))
 
     def skip(reason: str) -> None:
@@ -177,6 +178,7 @@ def listen_udp(
             stream.close(reason)
         except WireError as exc:
             skip(f"{exc}: the stream is left out")
+            refused.add(stream.name)
 
     try:
         while count is None or ended < count:
@@ -193,6 +195,10 @@ def listen_udp(
             except WireError as exc:
                 skip(str(exc))
                 continue
+            if datagram.stream in refused:
+                if datagram.kind == "end":
+                    refused.discard(datagram.stream)
+                continue  # a stream left out: its repeated headers do not join it again
             ours = current is not None and datagram.stream == current.name
             if ours:
                 assert current is not None
@@ -223,6 +229,7 @@ def listen_udp(
                     _receive_samples(current, datagram, received, skip)
                 except WireError as exc:
                     skip(f"{exc}: the stream is left out")
+                    refused.add(current.name)
                     _close_quietly(current.listener)
                     current, ended = None, ended + 1
         return ended

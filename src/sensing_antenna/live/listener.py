@@ -56,6 +56,10 @@ CONTACT_LOST_TIME = 0.1
 #: The time steps whose median is compared with the stream's declared ``sample_period``.
 PERIOD_CHECK_STEPS = 20
 
+#: Fewest steps whose median number of periods must be one (more are dropped samples or a
+#: period declared too short); fewer cannot tell.
+MIN_STEPS_FOR_DROPS = 5
+
 _END = "end"
 _ABORT = "abort"
 
@@ -254,12 +258,17 @@ class Listener:
         self._period_checked = True
         ts = self.header.sample_period
         step = np.diff(self._t.values[: steps + 1])
-        # a dropped sample is a step of whole periods: each step against its nearest multiple
+        # a dropped sample is a step of whole periods, each step read against its nearest
+        # multiple; but most steps are one period (a stream stepping by ten declared periods
+        # declares a tenth of its period), and their median is the period, as a file's is. A
+        # few steps cannot tell drops from a wrong period: only their multiples are judged
         periods = np.maximum(np.rint(step / ts), 1.0)
-        if float(np.median(np.abs(step / periods - ts))) > PERIOD_CONSISTENCY * ts:
+        median = float(np.median(step / periods))
+        mostly_single = steps < MIN_STEPS_FOR_DROPS or float(np.median(periods)) == 1.0
+        if not mostly_single or abs(median - ts) > PERIOD_CONSISTENCY * ts:
             raise WireError(
                 f"{self.header.source}: sample_period: the stream declares {ts!r} s, but its "
-                f"time stamps step by {float(np.median(step / periods)):.6g} s (the median of "
+                f"time stamps step by {float(np.median(step)):.6g} s (the median of "
                 f"its first {steps} steps), more than {100 * PERIOD_CONSISTENCY:g} % apart: the "
                 "estimates need the period the samples have"
             )

@@ -215,6 +215,8 @@ def _numbers(value: Any, shape: tuple[int, ...], what: str) -> FloatArray:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise FieldError(BASE_POSE_KEY, f"{what} expected") from None
+    if array.shape == shape and not np.all(np.isfinite(array)):
+        raise FieldError(BASE_POSE_KEY, f"{what} expected, finite")
     if array.size and not float(np.abs(array).max()) <= MAX_POSE_NUMBER:
         raise FieldError(BASE_POSE_KEY, f"{what} expected, each within +-{MAX_POSE_NUMBER:g}")
     if array.shape != shape or not all(math.isfinite(v) for v in array.ravel()):

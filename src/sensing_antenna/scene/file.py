@@ -302,8 +302,8 @@ def _mesh_file(value: object, where: str, folder: Path | None, fail: Any) -> tri
         raise fail(where, f"{path}: not a readable mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise fail(where, f"{path}: the file holds no triangles")
-    if not np.all(np.isfinite(mesh.vertices)):
-        raise fail(where, f"{path}: vertices that are not finite numbers")
+    if not np.all(np.isfinite(mesh.vertices)):  # before watertightness, which they break
+        raise fail(where, f"{path}: {mesh_problem(mesh)}")
     if not mesh.is_watertight:
         raise fail(
             where, f"{path}: the mesh is not closed (watertight), so its inside is undefined"
