@@ -187,10 +187,9 @@ def test_udp_on_localhost(recordings: dict[str, Path], tmp_path: Path) -> None:
     assert read_recording(kept) == recording
 
 
-def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) -> None:
-    recording = read_recording(recordings["azimuthal"])
-    header, _ = stream_of(recording)
-    row = "0.0,0,0,0,0,-0.0451,0,0.0221,0,0,0"
+def _heard_over_udp(datagrams: list[bytes], then: Recording) -> list[Event]:
+    """The events of a UDP listener (``ratio`` method, two recordings) sent ``datagrams`` and
+    then ``then`` replayed as stream ``s``."""
     events: list[Event] = []
 
     def make(header: StreamHeader, number: int) -> Listener:
@@ -202,19 +201,34 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
         reader = threading.Thread(target=listen_udp, args=(sock, make, events.append, 2))
         reader.start()
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
-            for datagram in [
-                b"hello",
-                b"sensing-antenna-udp/1 samples b 0\n\xff",
-                Datagram("samples", "b", 0, (row,)).encode(),  # before its header: waits
-                Datagram("header", "b", 0, tuple(header.lines())).encode(),
-                Datagram("samples", "b", 0, (row, "0.001,x")).encode(),
-                Datagram("samples", "b", 2, (row.replace("0.0,", "0.002,", 1),)).encode(),
-                Datagram("samples", "b", 1, (row,)).encode(),  # late
-                Datagram("end", "b", 3).encode(),
-            ]:
+            for datagram in datagrams:
                 sender.sendto(datagram, address)
-            replay_datagrams(recording, sender, address, speed=4, stream="s")
+            replay_datagrams(then, sender, address, speed=4, stream="s")
         reader.join(timeout=120)
+    assert not reader.is_alive()
+    # the second recording is heard whatever became of the first
+    found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
+    _same_estimate(found.to_dict(), estimate(then, paper_antenna(), "ratio").to_dict())
+    return events
+
+
+def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) -> None:
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    row = "0.0,0,0,0,0,-0.0451,0,0.0221,0,0,0"
+    events = _heard_over_udp(
+        [
+            b"hello",
+            b"sensing-antenna-udp/1 samples b 0\n\xff",
+            Datagram("samples", "b", 0, (row,)).encode(),  # before its header: waits
+            Datagram("header", "b", 0, tuple(header.lines())).encode(),
+            Datagram("samples", "b", 0, (row, "0.001,x")).encode(),
+            Datagram("samples", "b", 2, (row.replace("0.0,", "0.002,", 1),)).encode(),
+            Datagram("samples", "b", 1, (row,)).encode(),  # late
+            Datagram("end", "b", 3).encode(),
+        ],
+        recording,
+    )
     first = [e.to_dict() for e in events if e.to_dict()["recording"] == 1]
     reasons = " | ".join(e["reason"] for e in first if e["event"] == "skipped")
     assert "does not begin with 'sensing-antenna-udp/1 KIND STREAM SEQ'" in reasons
@@ -225,47 +239,34 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     assert end["event"] == "end" and end["samples"] == 2
     assert end["reason"] == "end of stream; 1 samples datagrams lost"
     assert [e["status"] for e in first if e["event"] == "estimate"] == ["bad_input"]
-    found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
-    _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
 
 
 def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
     recordings: dict[str, Path],
 ) -> None:
     # a stream whose declared period is 10 % off its time stamps is left out with a skipped
-    # event naming it; the listener goes on and estimates the next stream
+    # event naming it, its repeated header (a sender repeats it each second) not joined again;
+    # the listener goes on and estimates the next stream
     recording = read_recording(recordings["azimuthal"])
     header, _ = stream_of(recording)
-    wrong = [
+    wrong = tuple(
         "# sample_period: 0.0011" if line.startswith("# sample_period") else line
         for line in header.lines()
-    ]
-    rows = [f"{0.001 * k!r},0,0,0,0,-0.0451,0,0.0221,0,0,0" for k in range(30)]
-    events: list[Event] = []
-
-    def make(header: StreamHeader, number: int) -> Listener:
-        return Listener(header, paper_antenna(), events.append, "ratio", number=number)
-
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind(("127.0.0.1", 0))
-        address = sock.getsockname()
-        reader = threading.Thread(target=listen_udp, args=(sock, make, events.append, 2))
-        reader.start()
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
-            sender.sendto(Datagram("header", "w", 0, tuple(wrong)).encode(), address)
-            sender.sendto(Datagram("samples", "w", 0, tuple(rows)).encode(), address)
-            # its header repeated, as a sender repeats it each second: not joined again
-            sender.sendto(Datagram("header", "w", 1, tuple(wrong)).encode(), address)
-            sender.sendto(Datagram("samples", "w", 1, tuple(rows)).encode(), address)
-            sender.sendto(Datagram("end", "w", 2).encode(), address)
-            replay_datagrams(recording, sender, address, speed=4, stream="s")
-        reader.join(timeout=120)
-    assert not reader.is_alive()
+    )
+    rows = tuple(f"{0.001 * k!r},0,0,0,0,-0.0451,0,0.0221,0,0,0" for k in range(30))
+    events = _heard_over_udp(
+        [
+            Datagram("header", "w", 0, wrong).encode(),
+            Datagram("samples", "w", 0, rows).encode(),
+            Datagram("header", "w", 1, wrong).encode(),
+            Datagram("samples", "w", 1, rows).encode(),
+            Datagram("end", "w", 2).encode(),
+        ],
+        recording,
+    )
     skipped = [e.to_dict()["reason"] for e in events if e.to_dict()["event"] == "skipped"]
     assert any("stream w: sample_period: the stream declares 0.0011 s" in r for r in skipped)
     assert sum("the stream is left out" in r for r in skipped) == 1
-    found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
-    _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
 
 
 def test_datagrams() -> None:
