@@ -228,7 +228,8 @@ def _time_span_problem(t: NDArray[np.float64], period: float) -> tuple[int, str]
     when the largest step is the first) and the problem.
     """
     n = t.shape[0]
-    if period < MIN_SAMPLE_PERIOD:
+    # with the period's own 2 % slack: time stamps far from zero step by a period rounded
+    if period < (1.0 - PERIOD_CONSISTENCY) * MIN_SAMPLE_PERIOD:
         return 1, (
             f"a sample period of {format_value(period)} s, shorter than {MIN_SAMPLE_PERIOD:g} s, "
             "faster than any force/torque sensor: time stamps in another unit than seconds?"

@@ -25,6 +25,7 @@ from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import (
     FORMAT_NAME,
     MIN_SAMPLE_PERIOD,
+    PERIOD_CONSISTENCY,
     RecordingError,
     parse_header,
     parse_metadata,
@@ -138,7 +139,7 @@ def read_header(lines: Sequence[str], source: str, first_line: int = 1) -> Strea
             "missing: a live stream gives its sample period before its samples",
             metadata=True,
         )
-    if float(metadata["sample_period"]) < MIN_SAMPLE_PERIOD:
+    if float(metadata["sample_period"]) < (1.0 - PERIOD_CONSISTENCY) * MIN_SAMPLE_PERIOD:
         raise RecordingError(
             source,
             first_line + index,
