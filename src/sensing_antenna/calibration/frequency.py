@@ -539,7 +539,8 @@ def points_on_link(
     for i in map(int, np.flatnonzero(~on_link)):
         label = sources[i] if i < len(sources) else f"point {i}"
         where = (
-            "no known contact point (no true_xc metadata and no --points row)"
+            "no known contact point (no --points row, and no true_xc metadata or one that is "
+            "not a number)"
             if math.isnan(x_c[i])
             else f"x_c = {float(x_c[i])!r} m is not on the link (0, {length:g}] m"
         )
