@@ -381,6 +381,14 @@ def test_angles_in_degrees_are_caught_with_an_identified_observer() -> None:
         result = estimate(degrees, model, method)
         assert result.status is Status.IMPLAUSIBLE_INPUT, (method, result.reason)
         assert "angles not in radians" in (result.reason or "")
+    # the same when the recording is right and the antenna file's observer is another
+    # device's (its gain a hundred times too large): the reason names both causes
+    other = dataclasses.replace(
+        model, observer=dataclasses.replace(model.observer, gain=100.0 * model.observer.gain)
+    )
+    result = estimate(recording, other, "paper")
+    assert result.status is Status.IMPLAUSIBLE_INPUT, result.reason
+    assert "observer is not this device's" in (result.reason or "")
 
 
 def test_torques_a_hundred_times_too_large_are_implausible_not_a_payload(

@@ -240,7 +240,8 @@ def free_motion_gain(
     return gain, (
         f"columns 'theta1', 'theta2', 'ty', 'tz': the torque of the free motion before the "
         f"contact is {gain:.3g} times what the observer predicts from the angles (at least "
-        f"1/{factor:g}): angles not in radians (degrees give 1/57)?"
+        f"1/{factor:g}): angles not in radians (degrees give 1/57), or an antenna file whose "
+        "observer is not this device's (antenna identify)?"
     )
 
 
