@@ -6,6 +6,7 @@ import argparse
 import json
 import math
 import sys
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -74,7 +75,9 @@ def _run(args: argparse.Namespace) -> int:
     antenna = load_antenna(args.antenna)
     recording = read_recording(args.recording)
     if args.antenna == DEFAULT_ANTENNA:
-        warn_if_other_antenna(str(args.recording), recording.metadata, antenna.name)
+        warn_of_other_antennas(
+            {recording.metadata.get("antenna", ""): [str(args.recording)]}, antenna.name
+        )
     result = estimate(recording, antenna, method=method, config=EstimatorConfig(t1_source=args.t1))
     if args.json:
         data = {"recording": str(args.recording), **result.to_dict()}
@@ -84,16 +87,21 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def warn_if_other_antenna(source: str, metadata: Any, model: str) -> None:
-    """One line on stderr when the recording's ``antenna`` metadata names another antenna than
-    the built-in one the estimate falls back on: the device's observer, threshold and stiffness
-    are in its own file, and estimates with another's can go wrong in ways that look like bad
-    data (a contact missed, a push that seems to turn the wrong way)."""
-    recorded = metadata.get("antenna")
-    if recorded and recorded != model:
+def warn_of_other_antennas(named: Mapping[str, Sequence[str]], model: str) -> None:
+    """One line on stderr for each antenna that recordings' ``antenna`` metadata names
+    (``named``: that name, "" when absent, to the recordings' sources) other than the built-in
+    ``model`` the estimates fall back on: the device's observer, threshold and stiffness are
+    in its own file, and estimates with another's can go wrong in ways that look like bad data
+    (a contact missed, a push that seems to turn the wrong way)."""
+    for recorded, sources in named.items():
+        if not recorded or recorded == model or not sources:
+            continue
+        which = sources[0]
+        if len(sources) > 1:
+            which = f"{len(sources)} recording(s) ({sources[0]} and {len(sources) - 1} more)"
         print(
-            f"antenna: warning: {source} was recorded with antenna {printable(recorded)!r} (its "
-            f"metadata) and is estimated with the default {printable(model)!r}: give that "
+            f"antenna: warning: {which} recorded with antenna {printable(recorded)!r} (its "
+            f"metadata) and estimated with the default {printable(model)!r}: give that "
             "antenna's file with --antenna",
             file=sys.stderr,
         )

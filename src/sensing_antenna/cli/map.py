@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import argparse
-import itertools
 import sys
 from pathlib import Path
 from typing import Any
 
 from sensing_antenna.cli.arguments import distinct_files
-from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, METHOD_NAMES
+from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, METHOD_NAMES, warn_of_other_antennas
 
 
 def register(subparsers: Any) -> None:
@@ -45,45 +44,6 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(func=_run)
 
 
-#: Bytes of a recording read for its metadata before the map reads it whole.
-HEADER_BYTES = 1 << 16
-
-
-def warn_of_other_antennas(paths: list[Path], model: str) -> None:
-    """One line on stderr for each antenna other than the default ``model`` that the
-    recordings' ``antenna`` metadata names (as ``antenna estimate`` warns of one recording); a
-    file that cannot be read is left to the map, which says why."""
-    from sensing_antenna.cli.arguments import printable
-    from sensing_antenna.errors import SensingAntennaError
-    from sensing_antenna.recording import parse_metadata
-
-    named: dict[str, list[Path]] = {}
-    for path in paths:
-        try:
-            # the head of the file only: the map's own reader refuses what is not a recording
-            with open(path, "rb") as stream:
-                head = stream.read(HEADER_BYTES).decode("utf-8-sig", errors="replace")
-            rows = head.split("\n")
-            if len(head) >= HEADER_BYTES:
-                rows = rows[:-1]  # the last may be cut off
-            rows = [row.rstrip("\r") for row in rows]
-            lines = list(itertools.takewhile(lambda line: line.startswith("#"), rows))
-            metadata, _ = parse_metadata(lines, str(path))
-        except (OSError, SensingAntennaError):
-            continue
-        named.setdefault(metadata.get("antenna", ""), []).append(path)
-    for recorded, files in named.items():
-        if not recorded or recorded == model:
-            continue
-        which = f"{files[0]}" + (f" and {len(files) - 1} more" if len(files) > 1 else "")
-        print(
-            f"antenna: warning: {len(files)} recording(s) ({which}) name antenna "
-            f"{printable(recorded)!r} in their metadata and are estimated with the default "
-            f"{printable(model)!r}: give that antenna's file with --antenna",
-            file=sys.stderr,
-        )
-
-
 def add_map_options(parser: Any, uncertain_into: str) -> None:
     """``--objects`` and ``--include-uncertain``, shared with ``antenna explore``."""
     parser.add_argument(
@@ -111,8 +71,7 @@ def _run(args: argparse.Namespace) -> int:
     distinct_files(args.recordings)
     meshes = {path.stem: load_mesh(path) for path in args.objects}
     antenna = load_antenna(args.antenna)
-    if args.antenna == DEFAULT_ANTENNA:
-        warn_of_other_antennas(args.recordings, antenna.name)
+    named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"
     ) as bar:
@@ -124,7 +83,12 @@ def _run(args: argparse.Namespace) -> int:
             config=EstimatorConfig(t1_source=args.t1),
             progress=lambda _: bar.update(1),
             unreadable=lambda _, exc: left_out.append(str(exc)),
+            read=lambda path, metadata: named.setdefault(metadata.get("antenna", ""), []).append(
+                str(path)
+            ),
         )
+    if args.antenna == DEFAULT_ANTENNA:
+        warn_of_other_antennas(named, antenna.name)
     if not points:
         more = f" (and {len(left_out) - 1} more unreadable)" if len(left_out) > 1 else ""
         raise SensingAntennaError(f"{left_out[0]}{more}")

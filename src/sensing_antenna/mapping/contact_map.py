@@ -38,7 +38,7 @@ from sensing_antenna.mapping.points import (
     contact_point_from_estimate,
     select_points,
 )
-from sensing_antenna.mapping.pose import base_pose_from_metadata
+from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
 from sensing_antenna.mapping.recognition import LinkLines, Recognition, recognise
 from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
 
@@ -141,9 +141,12 @@ def points_from_recordings(
     """
     from sensing_antenna.recording import read_recording
 
-    return [
-        _point(read_recording(path), path, antenna, method, uncertainty, config) for path in paths
-    ]
+    points = []
+    for path in paths:
+        recording = read_recording(path)
+        pose = base_pose_from_metadata(recording.metadata, str(path))
+        points.append(_point(recording, path, pose, antenna, method, uncertainty, config))
+    return points
 
 
 def swept_from_recordings(
@@ -182,11 +185,13 @@ def map_inputs_from_recordings(
     config: Any = None,
     progress: Callable[[Path], None] | None = None,
     unreadable: Callable[[Path, SensingAntennaError], None] | None = None,
+    read: Callable[[Path, Mapping[str, str]], None] | None = None,
 ) -> tuple[list[ContactPoint], tuple[FreeSpace, Touches]]:
     """:func:`points_from_recordings` and :func:`swept_from_recordings` of the same recordings,
-    each read once; ``progress`` is called with each path when it is done. With
-    ``unreadable``, a recording that cannot be read or whose base pose is malformed is handed
-    to it with the error (one line naming the file) and left out; without, the error is raised.
+    each read once; ``progress`` is called with each path when it is done, ``read`` with each
+    recording's path and metadata once it is read. With ``unreadable``, a recording that cannot
+    be read or whose base pose is malformed is handed to it with the error (one line naming the
+    file) and left out; without, the error is raised.
 
     Raises
     ------
@@ -201,7 +206,7 @@ def map_inputs_from_recordings(
     for path in paths:
         try:
             recording = read_recording(path)
-            base_pose_from_metadata(recording.metadata, str(path))
+            pose = base_pose_from_metadata(recording.metadata, str(path))
         except (RecordingError, FieldError) as exc:
             if unreadable is None:
                 raise
@@ -209,7 +214,9 @@ def map_inputs_from_recordings(
             if progress is not None:
                 progress(path)
             continue
-        point = _point(recording, path, antenna, method, uncertainty, config)
+        if read is not None:
+            read(path, recording.metadata)
+        point = _point(recording, path, pose, antenna, method, uncertainty, config)
         points.append(point)
         links.append(recording_links(recording, antenna, point))
         if progress is not None:
@@ -220,15 +227,16 @@ def map_inputs_from_recordings(
 def _point(
     recording: Recording,
     path: Path,
+    pose: BasePose,
     antenna: Antenna,
     method: Any,
     uncertainty: PointUncertainty | None,
     config: Any,
 ) -> ContactPoint:
-    """The recording's touched point in the world (:func:`points_from_recordings`)."""
+    """The recording's touched point in the world at its base ``pose``
+    (:func:`points_from_recordings`)."""
     from sensing_antenna.estimation.pipeline import estimate
 
-    pose = base_pose_from_metadata(recording.metadata, str(path))
     truth = _true_point(recording.metadata.get("true_contact_point"))
     result = estimate(recording.without_ground_truth(), antenna, method=method, config=config)
     return contact_point_from_estimate(result, antenna, pose, str(path), uncertainty, truth)
