@@ -13,7 +13,6 @@ A world point is p_w = R p_a + t.
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -215,10 +214,10 @@ def _numbers(value: Any, shape: tuple[int, ...], what: str) -> FloatArray:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise FieldError(BASE_POSE_KEY, f"{what} expected") from None
-    if array.shape == shape and not np.all(np.isfinite(array)):
-        raise FieldError(BASE_POSE_KEY, f"{what} expected, finite")
-    if array.size and not float(np.abs(array).max()) <= MAX_POSE_NUMBER:
-        raise FieldError(BASE_POSE_KEY, f"{what} expected, each within +-{MAX_POSE_NUMBER:g}")
-    if array.shape != shape or not all(math.isfinite(v) for v in array.ravel()):
+    if array.shape != shape:
         raise FieldError(BASE_POSE_KEY, f"{what} expected")
+    if not np.all(np.isfinite(array)):
+        raise FieldError(BASE_POSE_KEY, f"{what} expected, finite")
+    if not float(np.abs(array).max()) <= MAX_POSE_NUMBER:
+        raise FieldError(BASE_POSE_KEY, f"{what} expected, each within +-{MAX_POSE_NUMBER:g}")
     return array
