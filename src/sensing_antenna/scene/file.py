@@ -260,11 +260,8 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
     position = _vector(table["position"], 3, f"{where}.position", fail, MAX_BASE_DISTANCE)
     rotation = _vector(table.get("rotation", [0.0, 0.0, 0.0]), 3, f"{where}.rotation", fail)
     if shape == "mesh":
-        mesh = _mesh_file(table.get("file"), f"{where}.file", folder, fail)
         scale = _number(table.get("scale", 1.0), f"{where}.scale", fail, 0.0, 1.0)
-        problem = mesh_problem(mesh.copy().apply_scale(scale))
-        if problem is not None:
-            raise fail(f"{where}.file", f"{table.get('file')} at scale {scale:g}: {problem}")
+        mesh = _mesh_file(table.get("file"), f"{where}.file", folder, fail, scale)
         return mesh_object(name, mesh, position, rotation, scale)
     sizes: list[float] = []
     for key in _SIZE_KEYS[str(shape)]:
@@ -288,7 +285,9 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
     return primitive_object(name, str(shape), sizes, position, rotation)
 
 
-def _mesh_file(value: object, where: str, folder: Path | None, fail: Any) -> trimesh.Trimesh:
+def _mesh_file(
+    value: object, where: str, folder: Path | None, fail: Any, scale: float
+) -> trimesh.Trimesh:
     if not isinstance(value, str) or not value:
         raise fail(where, f"must name a mesh file (STL, OBJ, PLY), got {format_value(value)}")
     path = Path(value)
@@ -302,8 +301,9 @@ def _mesh_file(value: object, where: str, folder: Path | None, fail: Any) -> tri
         raise fail(where, f"{path}: not a readable mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise fail(where, f"{path}: the file holds no triangles")
-    if not np.all(np.isfinite(mesh.vertices)):  # before watertightness, which they break
-        raise fail(where, f"{path}: {mesh_problem(mesh)}")
+    problem = mesh_problem(mesh, scale)  # before watertightness, which NaN vertices break
+    if problem is not None:
+        raise fail(where, f"{path} at scale {scale:g}: {problem}")
     if not mesh.is_watertight:
         raise fail(
             where, f"{path}: the mesh is not closed (watertight), so its inside is undefined"

@@ -41,13 +41,13 @@ OBJECT_SHAPES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
 MAX_MESH_EXTENT = 10.0
 
 
-def mesh_problem(mesh: trimesh.Trimesh) -> str | None:
-    """Why a user's mesh (m) cannot be an object, or None: vertices that are not finite, or an
-    extent beyond :data:`MAX_MESH_EXTENT`."""
+def mesh_problem(mesh: trimesh.Trimesh, scale: float = 1.0) -> str | None:
+    """Why a user's mesh, its coordinates times ``scale`` in m, cannot be an object, or None:
+    vertices that are not finite, or an extent beyond :data:`MAX_MESH_EXTENT`."""
     vertices = np.asarray(mesh.vertices, dtype=float)
     if not np.all(np.isfinite(vertices)):
         return "vertices that are not finite numbers"
-    extent = float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
+    extent = scale * float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
     if extent > MAX_MESH_EXTENT:
         return (
             f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
