@@ -227,8 +227,12 @@ def calibrate_sensor(
             slope = np.where(np.abs(along) > 0, across / np.abs(along), 1.0)
         return np.concatenate([ratio / points[chosen] - 1.0, slope])
 
+    def identity(names: Sequence[str]) -> FloatArray:
+        """The terms ``names`` at no correction."""
+        return np.array([getattr(SensorCorrection(), t) for t in names], dtype=float)
+
     def fitted(names: Sequence[str], keep: NDArray[np.bool_] | None = None) -> FloatArray:
-        start = np.array([getattr(SensorCorrection(), t) for t in names], dtype=float)
+        start = identity(names)
         # within the limits a SensorCorrection accepts (gains in (0, 2), couplings to +-100)
         gain = [t.endswith("_gain") for t in names]
         low = np.where(gain, 1.0 - 0.99 * MAX_SENSOR_GAIN_ERROR, -MAX_SENSOR_COUPLING)
@@ -242,8 +246,7 @@ def calibrate_sensor(
         )
         return np.asarray(found.x, dtype=float)
 
-    before = residuals(np.array([getattr(SensorCorrection(), t) for t in terms]), terms)
-    before = before[: len(holds)]
+    before = residuals(identity(terms), terms)[: len(holds)]
     params = fitted(terms)
     held_out = np.array(
         [residuals(fitted(terms, rows != i), terms, rows == i)[0] for i in range(len(holds))],

@@ -803,12 +803,16 @@ class CampaignSpec:
         text = json.dumps(hashed, sort_keys=True)
         return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
-    def fingerprint(self) -> str:
-        """Short hash of everything that determines the results (not name or description)."""
+    def determining(self) -> dict[str, Any]:
+        """:meth:`to_dict` less what does not determine the results (name and description)."""
         data = self.to_dict()
         data.pop("name")
         data.pop("description")
-        text = json.dumps(data, sort_keys=True)
+        return data
+
+    def fingerprint(self) -> str:
+        """Short hash of everything that determines the results (:meth:`determining`)."""
+        text = json.dumps(self.determining(), sort_keys=True)
         return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
 

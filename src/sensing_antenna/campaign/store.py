@@ -185,9 +185,8 @@ def write_manifest(out_dir: Path, spec: CampaignSpec) -> None:
         if stored.fingerprint() == spec.fingerprint():
             return
         if _holds_work(out_dir):
-            old, new = stored.to_dict(), spec.to_dict()
-            named = {"name", "description"}  # not the runs': not in the fingerprint
-            fields = sorted(k for k in {*old, *new} - named if old.get(k) != new.get(k))
+            old, new = stored.determining(), spec.determining()
+            fields = sorted(k for k in {*old, *new} if old.get(k) != new.get(k))
             differs = f"; it differs in {', '.join(fields)}" if fields else ""
             raise CampaignStoreError(
                 f"{path}: fingerprint: the preparation and runs stored here come from a "
