@@ -158,6 +158,7 @@ def test_a_leak_in_one_plane_is_corrected_there_and_nowhere_else() -> None:
             recordings.append(recording.without_ground_truth())
     fit = calibrate_sensor(recordings, ANTENNA, truth)
     assert fit.sweeps == ("azimuthal", "vertical") and fit.adopted == ("azimuthal",)
+    # within 15 %: the ratio's 2 % noise at the default push is fitted too (-0.63 on this set)
     assert fit.correction.fy_per_tz == pytest.approx(-0.6, rel=0.15)
     untouched = (fit.correction.fz_gain, fit.correction.fz_per_ty, fit.correction.fy_per_ty)
     assert untouched == (1.0, 0.0, 0.0)

@@ -72,5 +72,7 @@ def test_the_mesh_kept_does_not_hang_on_the_length_scale_fitted() -> None:
         zero_level, _ = surface.mesh()
         _, gap, _ = trimesh.proximity.closest_point(zero_level, samples)
         covered.append(float(np.mean(gap < 0.005)))
-    # the facing half of the ball and a band beyond its rim
+    # the facing half of the ball and a band beyond its rim (kept within the length scale, the
+    # 1 cm fit covered 0.14); the two zero levels lie under a millimetre apart over the mesh kept,
+    # against the 5 mm that counts as covered, so the two fractions agree within 0.05
     assert 0.45 < covered[0] < 0.9 and covered[1] == pytest.approx(covered[0], abs=0.05)
