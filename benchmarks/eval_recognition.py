@@ -6,7 +6,7 @@ the origin (the antenna's base) within the head's reach (azimuth within +-90 deg
 within +-30 degrees). The contacts are points of the object's side facing the origin (faces
 whose outward normal points towards it), drawn uniformly on that side, each moved by Gaussian
 noise of the covariance :mod:`sensing_antenna.mapping.points` gives a ``fast`` estimate there:
-its median 95 % interval (0.4 cm on the default campaign), 2000-count encoders, a push
+its median 95 % interval on the default campaign (FAST_INTERVAL_WIDTH), 2000-count encoders, a push
 deflection of ``--deflection-ratio`` times x_c in an unknown direction, the link's radius.
 The contacts are not simulated (no sweeps, no estimator): this measures the map and the
 recognition given points with the estimates' uncertainty, without the links' lines (points

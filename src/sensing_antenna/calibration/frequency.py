@@ -164,10 +164,9 @@ class FrequencyCalibration:
     def wrong_peak_points(self) -> NDArray[np.bool_]:
         """Which points, shape (n,), are used by the fit but more than :data:`WRONG_PEAK` from
         the median relative residual, when they are few (one, or a tenth of the points, of
-        :data:`MIN_WRONG_PEAK_POINTS` or more): left
-        out of :attr:`relative_scatter` as wrong peaks (or wrong known points). More are the
-        model's error (a payload bends the whole curve: 0.2 g puts 4 of 15 points beyond), and
-        stay in the scatter."""
+        :data:`MIN_WRONG_PEAK_POINTS` or more): left out of :attr:`relative_scatter` as wrong
+        peaks (or wrong known points). More are the model's error (a payload bends the whole
+        curve: 0.2 g puts 4 of 15 points beyond), and stay in the scatter."""
         relative = self._relative_residuals()
         usable = self.used & np.isfinite(relative)
         none = np.zeros(relative.shape, dtype=bool)
