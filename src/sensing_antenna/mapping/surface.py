@@ -45,8 +45,8 @@ MIN_SURFACE_POINTS = 4
 
 #: The mesh is kept within this fraction of the points' spread of a contact: beyond, the prior
 #: speaks, not the points. Not the kernel's length scale: its marginal likelihood has an optimum
-#: near each bound, and the fit moves between them as contacts are added (on the explorations'
-#: spheres, from 1 m to 1 cm with one sweep more, which kept a tenth of the surface).
+#: near each bound, and the fit moves between them as contacts are added (docs/design-notes.md,
+#: "The surface's reach").
 REACH_SPREAD = 0.25
 
 
