@@ -296,6 +296,10 @@ def test_calibration_leaves_out_a_recording_not_in_the_format_units() -> None:
     (note,) = result.notes
     assert note.startswith("b.csv: columns 'tx', 'ty', 'tz': ")
     assert result.t_e == alone.t_e  # the same fit as without it
+    # two points are too few for the second mode's scatter: the antenna carries none
+    assert np.isfinite(result.omega2_measured[result.used]).all()
+    assert math.isnan(result.mode2_scatter)
+    assert result.apply(antenna).link.mode2_scatter is None
     # with too few left, the error names why the others were left out
     with pytest.raises(CalibrationError, match=r"got 1 \(left out: b\.csv: columns 'tx'"):
         calibrate_from_recordings(recordings[:2], antenna, points[:2], sources=["a.csv", "b.csv"])

@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
-from sensing_antenna.calibration.frequency import FrequencyCalibration
+from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.calibration.frequency import MIN_MODE2_POINTS, FrequencyCalibration
 from sensing_antenna.campaign.records import CampaignRow
 from sensing_antenna.campaign.runner import run_campaign
 from sensing_antenna.campaign.runs import CALIBRATION_STREAM, derive_seed, expand_runs
@@ -141,6 +142,32 @@ def test_estimators_get_the_model_with_t_e_and_the_simulator_the_device(calibrat
     assert device.observer == model.observer != paper_antenna().observer
     runs = expand_runs(device_spec(True), model, device)
     assert runs[0].antenna is model and runs[0].simulated_antenna is device
+
+
+def test_the_calibration_measures_the_second_mode_and_the_model_carries_its_scatter(
+    calibrated: Path,
+) -> None:
+    stored = read_calibration(calibrated)
+    model = read_stored_antenna(calibrated)
+    assert stored is not None and model is not None
+    calibration = stored[1]
+    assert calibration.omega2_measured is not None and calibration.omega2_fitted is not None
+    measured = np.isfinite(calibration.omega2_measured)
+    assert measured.sum() >= MIN_MODE2_POINTS
+    # each peak is the device's second contact mode at its point (an independent reference:
+    # the beam model of the device's own link; the simulator's compliant contact and finite
+    # elements differ from it by well under 1 %)
+    device = load_antenna(calibrated / DEVICE_FILE)
+    points = calibration.contact_points[measured]
+    reference = np.asarray(natural_frequencies(device.link, points, 2), dtype=float)[:, 1]
+    np.testing.assert_allclose(calibration.omega2_measured[measured], reference, rtol=0.01)
+    # its scatter about the calibrated model is written into the model, and survives the JSON
+    assert 0.0 < calibration.mode2_scatter < 0.01
+    assert model.link.mode2_scatter == pytest.approx(calibration.mode2_scatter)
+    data = json.loads((calibrated / CALIBRATION_FILE).read_text("utf-8"))["calibration"]
+    assert data["mode2_scatter"] == pytest.approx(calibration.mode2_scatter)
+    again = FrequencyCalibration.from_dict(data)
+    assert again.mode2_scatter == pytest.approx(calibration.mode2_scatter)
 
 
 def test_resume_reuses_the_calibration(calibrated: Path) -> None:

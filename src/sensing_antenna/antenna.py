@@ -156,6 +156,9 @@ PARAMETER_RANGES: Mapping[str, ParameterRange] = MappingProxyType(
         "link.calibration_scatter": ParameterRange(
             0.0, 1.0, "", "a relative scatter: above 1 (100 %) the calibration says nothing"
         ),
+        "link.mode2_scatter": ParameterRange(
+            0.0, 1.0, "", "a relative scatter: above 1 (100 %) the calibration says nothing"
+        ),
         "motor.torque_constant": ParameterRange(
             1e-6, 10.0, "N m/V", "from a micromotor to a large servomotor, before its gear"
         ),
@@ -221,6 +224,11 @@ class Link:
         Relative error of omega_1(x_c) with that T_e, from the calibration's residuals
         (dimensionless, e.g. 0.001 for 0.1 %); the fast method's model floor on omega_1 is at
         least this. None: not measured.
+    mode2_scatter : float or None
+        Relative error of the second contact mode omega_2(x_c) with that T_e, from the
+        calibration's measured omega_2 (dimensionless; its bias along the link included): the
+        fast method lets omega_2 narrow an answer at its cap only when this is known. None: not
+        measured.
     weight_tip_mass : float or None
         The tip mass the link's weight shows at rest (kg), where it differs from the
         ``tip_mass`` the vibration shows: a calibration that fits the tip mass to the contact
@@ -237,6 +245,7 @@ class Link:
     second_moment: float | None = None
     calibrated_t: float | None = None
     calibration_scatter: float | None = None
+    mode2_scatter: float | None = None
     weight_tip_mass: float | None = None
 
     def __post_init__(self) -> None:
@@ -250,8 +259,9 @@ class Link:
             _require_positive("link", "second_moment", self.second_moment)
         if self.calibrated_t is not None:
             _require_positive("link", "calibrated_t", self.calibrated_t)
-        if self.calibration_scatter is not None:
-            _require_non_negative("link", "calibration_scatter", self.calibration_scatter)
+        for name in ("calibration_scatter", "mode2_scatter"):
+            if getattr(self, name) is not None:
+                _require_non_negative("link", name, getattr(self, name))
         for name in ("length", "radius", "youngs_modulus", "tip_mass", "second_moment"):
             value = getattr(self, name)
             if value is not None:
@@ -265,7 +275,7 @@ class Link:
                 f" {format_value(self.radius)} m is a bulk density of {bulk:.4g} kg/m^3, outside"
                 f" {bulk_range.low:g} to {bulk_range.high:g} kg/m^3 ({bulk_range.reason})",
             )
-        for name in ("calibrated_t", "calibration_scatter"):
+        for name in ("calibrated_t", "calibration_scatter", "mode2_scatter"):
             value = getattr(self, name)
             if value is not None:
                 PARAMETER_RANGES[f"link.{name}"].check(f"link.{name}", value)
@@ -639,13 +649,19 @@ class Antenna:
         out[..., 1] = self.link.gravity_moment(theta2)
         return out
 
-    def with_calibrated_t(self, t_e: float, scatter: float | None = None) -> Antenna:
-        """A copy whose frequency model uses the calibrated T_e and its relative scatter.
+    def with_calibrated_t(
+        self, t_e: float, scatter: float | None = None, mode2_scatter: float | None = None
+    ) -> Antenna:
+        """A copy whose frequency model uses the calibrated T_e and its relative scatters (of
+        omega_1 and of omega_2).
 
-        A new T_e replaces the whole calibration: without ``scatter`` the copy has none (the
-        old one described the old T_e).
+        A new T_e replaces the whole calibration: without a scatter the copy has none (the old
+        one described the old T_e).
         """
-        return replace(self, link=replace(self.link, calibrated_t=t_e, calibration_scatter=scatter))
+        link = replace(
+            self.link, calibrated_t=t_e, calibration_scatter=scatter, mode2_scatter=mode2_scatter
+        )
+        return replace(self, link=link)
 
     def self_calibrated(self, scatter: float = MODEL_FREQUENCY_FLOOR) -> Antenna:
         """This antenna with its own T as a calibrated T_e and a relative ``scatter``: the model a

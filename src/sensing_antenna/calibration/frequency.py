@@ -33,6 +33,7 @@ from sensing_antenna.errors import SensingAntennaError
 __all__ = [
     "CALIBRATION_BAND",
     "LOSSES",
+    "MIN_MODE2_POINTS",
     "MIN_TIP_MASS_POINTS",
     "TIP_MASS_LOSS_SCALE",
     "WRONG_PEAK",
@@ -103,6 +104,11 @@ class FrequencyCalibration:
     tip_mass : float or None
         The tip mass fitted with T_e (kg; :func:`calibrate_t_e` with ``fit_tip_mass``), None
         when T_e alone was fitted.
+    omega2_measured : ndarray, shape (n,), or None
+        The second contact mode measured at each point (rad/s; NaN where no clear peak lay
+        near the calibrated model's), None when not looked for.
+    omega2_fitted : ndarray, shape (n,), or None
+        The calibrated model's omega_2 at each point (rad/s), None when not looked for.
     """
 
     t_e: float
@@ -116,12 +122,21 @@ class FrequencyCalibration:
     sources: tuple[str, ...] = ()
     notes: tuple[str, ...] = field(default=())
     tip_mass: float | None = None
+    omega2_measured: NDArray[np.float64] | None = None
+    omega2_fitted: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         n = self.contact_points.shape
-        for name in ("omega1_measured", "omega1_fitted", "used"):
-            if getattr(self, name).shape != n:
-                raise CalibrationError(f"{name}: shape {getattr(self, name).shape} != {n}")
+        for name in (
+            "omega1_measured",
+            "omega1_fitted",
+            "used",
+            "omega2_measured",
+            "omega2_fitted",
+        ):
+            value = getattr(self, name)
+            if value is not None and value.shape != n:
+                raise CalibrationError(f"{name}: shape {value.shape} != {n}")
         if not (math.isfinite(self.t_e) and self.t_e > 0):
             raise CalibrationError(f"t_e: must be finite and > 0, got {self.t_e!r}")
 
@@ -156,6 +171,25 @@ class FrequencyCalibration:
         return math.sqrt(float(np.sum(kept**2)) / (kept.size - fitted))
 
     @property
+    def mode2_scatter(self) -> float:
+        """Relative error of the calibrated model's omega_2(x_c), dimensionless; NaN if unknown.
+
+        The root-mean-square relative residual (measured / model - 1) of the second contact
+        mode over the points where it was measured, its mean included: nothing is fitted to
+        omega_2, so a link whose second mode sits off the model's (a taper, a joint, a clamp
+        that is not rigid, which T_e fitted to omega_1 does not take up) shows it here whole.
+        NaN with fewer than :data:`MIN_MODE2_POINTS` points measured.
+        """
+        if self.omega2_measured is None or self.omega2_fitted is None:
+            return math.nan
+        with np.errstate(divide="ignore", invalid="ignore"):
+            relative = self.omega2_measured / self.omega2_fitted - 1.0
+        kept = relative[self.used & np.isfinite(relative)]
+        if kept.size < MIN_MODE2_POINTS:
+            return math.nan
+        return math.sqrt(float(np.mean(kept**2)))
+
+    @property
     def wrong_peaks(self) -> int:
         """Points used by the fit but left out of :attr:`relative_scatter` as wrong peaks."""
         return int(self.wrong_peak_points.sum())
@@ -187,16 +221,20 @@ class FrequencyCalibration:
         return (self.t_e - self.t_theoretical) / self.t_theoretical
 
     def apply(self, antenna: Antenna) -> Antenna:
-        """The antenna with this T_e as its calibrated T, :attr:`relative_scatter` as its
-        calibration scatter (none when unknown) and the fitted tip mass, when fitted (the
-        weight keeps the antenna's tip mass, ``Link.weight_tip_mass``)."""
-        scatter = self.relative_scatter
+        """The antenna with this T_e as its calibrated T, :attr:`relative_scatter` and
+        :attr:`mode2_scatter` as its scatters (none when unknown) and the fitted tip mass, when
+        fitted (the weight keeps the antenna's tip mass, ``Link.weight_tip_mass``)."""
+        scatter, mode2 = self.relative_scatter, self.mode2_scatter
         if self.tip_mass is not None:
             # the weight the sensor reads at rest stays the antenna's (weight_tip_mass)
             link = antenna.link
             link = replace(link, tip_mass=self.tip_mass, weight_tip_mass=link.weighed_tip_mass)
             antenna = replace(antenna, link=link)
-        return antenna.with_calibrated_t(self.t_e, scatter if math.isfinite(scatter) else None)
+        return antenna.with_calibrated_t(
+            self.t_e,
+            scatter if math.isfinite(scatter) else None,
+            mode2 if math.isfinite(mode2) else None,
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready summary (SI units); NaN (no measurement) is stored as None."""
@@ -210,6 +248,7 @@ class FrequencyCalibration:
             "rms_residual": _json_float(self.rms_residual),
             "loss": self.loss,
             "tip_mass": self.tip_mass,
+            "mode2_scatter": _json_float(self.mode2_scatter),
             "points": [
                 {
                     "source": self.sources[i] if i < len(self.sources) else "",
@@ -217,10 +256,20 @@ class FrequencyCalibration:
                     "omega1_measured": _json_float(float(self.omega1_measured[i])),
                     "omega1_fitted": float(self.omega1_fitted[i]),
                     "used": bool(self.used[i]),
+                    **self._omega2_at(i),
                 }
                 for i in range(self.contact_points.size)
             ],
             "notes": list(self.notes),
+        }
+
+    def _omega2_at(self, i: int) -> dict[str, float | None]:
+        """Point ``i``'s omega_2 entries of :meth:`to_dict`; none when not looked for."""
+        if self.omega2_measured is None or self.omega2_fitted is None:
+            return {}
+        return {
+            "omega2_measured": _json_float(float(self.omega2_measured[i])),
+            "omega2_fitted": float(self.omega2_fitted[i]),
         }
 
     @classmethod
@@ -238,6 +287,7 @@ class FrequencyCalibration:
             values = [math.nan if p[name] is None else float(p[name]) for p in points]
             return np.array(values, dtype=float)
 
+        with_omega2 = bool(points) and all("omega2_fitted" in p for p in points)
         return cls(
             t_e=float(data["t_e"]),
             t_e_std_error=_float_or_nan(data.get("t_e_std_error")),
@@ -250,6 +300,8 @@ class FrequencyCalibration:
             sources=tuple(str(p.get("source", "")) for p in points),
             notes=tuple(str(n) for n in data.get("notes", [])),
             tip_mass=None if data.get("tip_mass") is None else float(data["tip_mass"]),
+            omega2_measured=column("omega2_measured") if with_omega2 else None,
+            omega2_fitted=column("omega2_fitted") if with_omega2 else None,
         )
 
 
@@ -591,6 +643,7 @@ def calibrate_from_recordings(
         )
     names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
     omega = np.full(len(recordings), math.nan)
+    components = ["none"] * len(recordings)
     notes: list[str] = []
     _, on_link, _ = points_on_link(
         np.asarray(contact_points, dtype=float), antenna.link.length, names
@@ -613,7 +666,8 @@ def calibrate_from_recordings(
             )
         else:
             omega[i] = value
-    return calibrate_t_e(
+            components[i] = measurement.component
+    calibration = calibrate_t_e(
         contact_points,
         omega,
         antenna.link,
@@ -622,6 +676,43 @@ def calibrate_from_recordings(
         notes=notes,
         fit_tip_mass=fit_tip_mass,
     )
+    return _with_second_mode(calibration, recordings, antenna, components)
+
+
+#: Fewest points with a measured second contact mode for its scatter
+#: (:attr:`FrequencyCalibration.mode2_scatter`): with fewer, one rms says little of the link.
+MIN_MODE2_POINTS = 5
+
+
+def _with_second_mode(
+    calibration: FrequencyCalibration,
+    recordings: Sequence[Any],
+    antenna: Antenna,
+    components: Sequence[str],
+) -> FrequencyCalibration:
+    """``calibration`` with omega_2 measured at each point used, near the calibrated model's
+    (:func:`~sensing_antenna.estimation.methods.paper.frequency.second_mode_peak`, on the
+    spectrum omega_1 was read from)."""
+    from sensing_antenna.beam import natural_frequencies
+    from sensing_antenna.estimation import EarlyOutcome, gather
+    from sensing_antenna.estimation.methods.paper.frequency import second_mode_peak
+
+    link = calibration.apply(antenna).link
+    x_c = calibration.contact_points
+    fitted = np.full(x_c.shape, math.nan)
+    inside = (x_c > 0.0) & (x_c <= link.length)
+    if np.any(inside):
+        fitted[inside] = np.asarray(natural_frequencies(link, x_c[inside], 2), dtype=float)[:, 1]
+    measured = np.full(x_c.shape, math.nan)
+    for i in map(int, np.flatnonzero(calibration.used & np.isfinite(fitted))):
+        evidence = gather(recordings[i], antenna)
+        if isinstance(evidence, EarlyOutcome):
+            continue
+        omega1 = float(calibration.omega1_measured[i])
+        peak = second_mode_peak(evidence, components[i], float(fitted[i]), omega1)
+        if peak is not None:
+            measured[i] = peak.omega
+    return replace(calibration, omega2_measured=measured, omega2_fitted=fitted)
 
 
 def read_contact_points(

@@ -73,7 +73,7 @@ SECOND_DEVICE_SUFFIX = "-d2"
 CONTACT_POINT_RESOLUTION = 1e-6
 
 #: Antenna sections a ``[device]`` section may override, with the fields allowed in each. The
-#: link's ``calibrated_t`` and ``calibration_scatter`` are model parameters, not hardware, so a
+#: link's ``calibrated_t`` and its scatters are model parameters, not hardware, so a
 #: device cannot set them.
 DEVICE_SECTIONS: dict[str, tuple[str, ...]] = {
     "link": ("length", "radius", "youngs_modulus", "linear_density", "tip_mass", "second_moment"),
@@ -213,7 +213,7 @@ class DeviceSpec:
                 if key not in allowed:
                     hint = (
                         " (a model value found by the calibration step, not set on the device)"
-                        if key in ("calibrated_t", "calibration_scatter")
+                        if key in ("calibrated_t", "calibration_scatter", "mode2_scatter")
                         else f"; known: {', '.join(allowed)}"
                     )
                     raise CampaignSpecError(f"device.{section}.{key}", f"unknown field{hint}")

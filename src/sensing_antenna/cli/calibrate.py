@@ -5,9 +5,12 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sensing_antenna.cli.arguments import antenna_name, distinct_files, printable
+
+if TYPE_CHECKING:
+    from sensing_antenna.calibration.frequency import FrequencyCalibration
 
 #: The fit losses of :data:`sensing_antenna.calibration.frequency.LOSSES`, written out so that
 #: parsing arguments does not import the calibration (``tests/test_cli_help.py`` checks them).
@@ -159,11 +162,13 @@ def _run(args: argparse.Namespace) -> int:
         if math.isfinite(scatter)
         else "model scatter: not measured (too few points: 3 needed, 4 with the tip mass)"
     )
+    print(_mode2_line(calibration))
     wrong = calibration.wrong_peak_points
     for i, x_c in enumerate(calibration.contact_points):
         print(
             f"  {calibration.sources[i]}: x_c = {x_c:.4f} m, omega_1 measured "
             f"{calibration.omega1_measured[i]:.3f}, fitted {calibration.omega1_fitted[i]:.3f} rad/s"
+            + _omega2_text(calibration, i)
             + (
                 f"; more than {100 * WRONG_PEAK:g} % off the others, left out of the scatter: "
                 "a wrong spectral peak or a wrong known point?"
@@ -181,3 +186,31 @@ def _run(args: argparse.Namespace) -> int:
         print(plot_calibration(calibration, antenna.link, args.plot))
     print(args.out)
     return 0
+
+
+def _mode2_line(calibration: FrequencyCalibration) -> str:
+    """What the calibration measured of the second contact mode, in one line."""
+    import numpy as np
+
+    from sensing_antenna.calibration.frequency import MIN_MODE2_POINTS
+
+    measured = calibration.omega2_measured
+    count = int(np.isfinite(measured[calibration.used]).sum()) if measured is not None else 0
+    scatter = calibration.mode2_scatter
+    if math.isfinite(scatter):
+        return (
+            f"second contact mode: scatter {100.0 * scatter:.3f} % about the model over {count} "
+            "points (written as link.mode2_scatter; the fast method's omega_2 at its cap)"
+        )
+    return (
+        f"second contact mode: measured at {count} points, {MIN_MODE2_POINTS} needed for its "
+        "scatter (link.mode2_scatter not written)"
+    )
+
+
+def _omega2_text(calibration: FrequencyCalibration, i: int) -> str:
+    """ ", omega_2 measured ... model ... rad/s" for point ``i``, "" when not measured."""
+    measured, fitted = calibration.omega2_measured, calibration.omega2_fitted
+    if measured is None or fitted is None or not math.isfinite(float(measured[i])):
+        return ""
+    return f"; omega_2 measured {float(measured[i]):.2f}, model {float(fitted[i]):.2f} rad/s"

@@ -83,7 +83,9 @@ def device_link(link: Link) -> Link:
         return link
     # T_e = sqrt(rho / (E I)) solved for E with rho and I kept
     youngs = link.linear_density / (link.calibrated_t**2 * link.area_moment)
-    return replace(link, youngs_modulus=youngs, calibrated_t=None, calibration_scatter=None)
+    return replace(
+        link, youngs_modulus=youngs, calibrated_t=None, calibration_scatter=None, mode2_scatter=None
+    )
 
 
 class StopRule(Protocol):

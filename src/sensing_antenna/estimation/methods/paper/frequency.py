@@ -42,6 +42,7 @@ __all__ = [
     "find_peak",
     "measure_frequency",
     "power_spectrum",
+    "second_mode_peak",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -305,3 +306,34 @@ def evidence_spectrum(evidence: Evidence, component: str) -> tuple[FloatArray, F
     omega, power = power_spectrum(projected, evidence.sample_period, evidence.config.zero_padding)
     spectra = {"y_c": power[:, 0], "z_c": power[:, 1]}
     return omega, spectra.get(component, power.sum(axis=1))
+
+
+def second_mode_peak(
+    evidence: Evidence, component: str, expected: float, omega1: float
+) -> SpectralPeak | None:
+    """The second contact mode's spectral peak near ``expected`` (rad/s), or None.
+
+    Searched, in the spectrum of ``component`` over the evidence's Delta t_e1 window, within
+    ``omega2_window`` of ``expected`` (the model's omega_2 where the contact is thought to be);
+    its quality is over the median power within four times that (the search band itself lies
+    on the peak's main lobe). None when that band holds no peak of at least
+    ``min_peak_quality``, or when the peak lies nearer 2 or 3 omega_1 than ``expected``: a
+    clipping contact's harmonic may be what it is (at the top of the paper link's sensing
+    curve, 2 omega_1 is 3 % below omega_2).
+    """
+    cfg = evidence.config
+    if not (math.isfinite(expected) and expected > 0.0):
+        return None
+    omega, spectrum = evidence_spectrum(evidence, component)
+    band = (expected / (1.0 + cfg.omega2_window), expected * (1.0 + cfg.omega2_window))
+    peak = find_peak(omega, spectrum, band)
+    wide = (omega >= expected / (1.0 + 4.0 * cfg.omega2_window)) & (
+        omega <= expected * (1.0 + 4.0 * cfg.omega2_window)
+    )
+    floor = float(np.median(spectrum[wide])) if np.any(wide) else 0.0
+    if peak is None or not peak.power >= cfg.min_peak_quality * floor:
+        return None
+    for harmonic in (2.0 * omega1, 3.0 * omega1):
+        if abs(peak.omega - harmonic) < abs(peak.omega - expected):
+            return None
+    return SpectralPeak(peak.omega, peak.power, peak.power / floor if floor > 0 else math.inf)
