@@ -2,7 +2,9 @@
 
 The status and reason come from the checks' problems (:func:`.checks.problems`, in the order of
 :data:`~.result.STATUS_PRECEDENCE`); at the cap, when the posterior still holds two branches,
-the second contact mode may choose one (:func:`.second_mode.branch_at_cap`); the touched point
+the second contact mode may choose one (:func:`.second_mode.branch_at_cap`) and, on a link whose
+calibration measured it, narrow an interval still too wide
+(:func:`.second_mode.narrowed_by_second_mode`); the touched point
 in 3D follows from the maximum a posteriori x_c and the contact frame.
 """
 
@@ -28,7 +30,10 @@ from sensing_antenna.estimation.methods.fast.curves import contact_candidates, c
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
 from sensing_antenna.estimation.methods.fast.planes import free_plane_share
 from sensing_antenna.estimation.methods.fast.search import ScanResult
-from sensing_antenna.estimation.methods.fast.second_mode import branch_at_cap
+from sensing_antenna.estimation.methods.fast.second_mode import (
+    branch_at_cap,
+    narrowed_by_second_mode,
+)
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
 from sensing_antenna.estimation.methods.fast.window import WindowEstimate
 from sensing_antenna.estimation.methods.touch_point import touched_point
@@ -80,6 +85,11 @@ def conclude_fast(
                 final, posterior=post, ratio_z=ratio_z, frequency_z=frequency_z
             )
             result = dataclasses.replace(result, final=final)
+        if (final.checks_passed or final.near_top) and not accepted_at_cap(final, config):
+            final, narrowing = _narrowed(evidence, final, config)
+            diag["second_mode_narrowing"] = narrowing
+            result = dataclasses.replace(result, final=final)
+            post = final.posterior
     statics = final.statics
     push = statics.perpendicular_force if statics is not None else math.nan
     # the axial part of the push is not fitted: the hold's, from the front end
@@ -93,6 +103,9 @@ def conclude_fast(
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)
+    disagreement = diag.get("second_mode_narrowing", {}).get("disagrees")
+    if reason is not None and disagreement:
+        reason += f"; {disagreement}"
     if reason is not None and "branch_chosen_by" in diag:
         reason += (
             f"; the second contact mode then chose the branch of x_c = {post.x_c:.3f} m, and "
@@ -146,6 +159,41 @@ def conclude_fast(
         interval=post.interval,
         branch_probability=tuple(post.branch_probability[b] for b in branch_of),
     )
+
+
+def _narrowed(
+    evidence: Evidence, final: WindowEstimate, config: FastConfig
+) -> tuple[WindowEstimate, dict[str, Any]]:
+    """The window at the cap with the second contact mode in its posterior
+    (:func:`.second_mode.narrowed_by_second_mode`), its checks judged again at the new
+    maximum; unchanged when the mode is not used. omega_2 places the contact where omega_1 is
+    flat, so the peak margin no longer holds the answer back."""
+    post, notes = narrowed_by_second_mode(evidence, final, final.posterior, config)
+    if post is None:
+        return final, notes
+    ratio_z = final.ratio_z
+    passed = True
+    note = ""
+    if final.statics is not None:
+        model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c)))
+        ratio_z, note = ratio_check(final.statics, post.x_c, model_sd, config)
+        passed = not note
+    frequency_z = _frequency_z(evidence, final.omega1, final.omega1_se, post, config)
+    if passed and post.width > config.cap_tolerance:
+        note = (
+            f"the 95 % interval is {1000 * post.width:.1f} mm wide with the second contact "
+            f"mode (cap tolerance {1000 * config.cap_tolerance:g} mm)"
+        )
+    narrowed = dataclasses.replace(
+        final,
+        posterior=post,
+        ratio_z=ratio_z,
+        frequency_z=frequency_z,
+        checks_passed=passed,
+        near_top=False,
+        note=note,
+    )
+    return narrowed, {**notes, "interval_before": final.posterior.interval}
 
 
 def _free_plane_share(final: WindowEstimate, push_direction: NDArray[np.float64]) -> float:

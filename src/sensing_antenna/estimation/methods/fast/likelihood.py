@@ -102,6 +102,28 @@ class ContactPosterior:
             branch_probability=probability,
         )
 
+    def times(self, likelihood: FloatArray) -> ContactPosterior | None:
+        """The posterior updated by another measurement's ``likelihood`` on the grid (shape
+        (G,), any positive scale): x_c, the interval and the branch probabilities follow. None
+        when the product holds no mass (the measurement excludes every x_c this posterior
+        allows)."""
+        product = self.density * np.asarray(likelihood, dtype=float)
+        mass = float(product.sum())
+        if not (math.isfinite(mass) and mass > 0.0):
+            return None
+        density = product / mass
+        branches = _branch_indices(self.branch_edges, self.grid)
+        probability = tuple(
+            float(density[branches == b].sum()) for b in range(len(self.branch_probability))
+        )
+        return replace(
+            self,
+            density=density,
+            x_c=float(self.grid[int(np.argmax(density))]),
+            interval=_hpd_bounds(density, self.grid, self.level),
+            branch_probability=probability,
+        )
+
 
 def _branch_indices(branch_edges: tuple[float, ...], grid: FloatArray) -> NDArray[np.int_]:
     """Index of the monotone branch holding each grid point."""

@@ -13,9 +13,14 @@ import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
+from sensing_antenna.antenna import MODEL_FREQUENCY_FLOOR
 from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.methods.fast.config import FastConfig
+from sensing_antenna.estimation.methods.fast.curves import curve_table
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
-from sensing_antenna.estimation.methods.paper.frequency import evidence_frequency
+from sensing_antenna.estimation.methods.paper.frequency import evidence_frequency, second_mode_peak
 from sensing_antenna.estimation.methods.paper.fusion import predicted_omega2, second_mode_choice
 
 if TYPE_CHECKING:
@@ -24,6 +29,7 @@ if TYPE_CHECKING:
 __all__ = [
     "BranchChooser",
     "branch_at_cap",
+    "narrowed_by_second_mode",
     "on_chosen_branch",
     "second_mode_chooser",
     "second_mode_objection",
@@ -157,3 +163,56 @@ def branch_at_cap(
             return posterior, {"second_mode": notes, "second_mode_objection": objection}
         return posterior, {"second_mode": notes}
     return conditioned, {"second_mode": notes, "branch_chosen_by": "omega2"}
+
+
+def narrowed_by_second_mode(
+    evidence: Evidence, window: WindowEstimate, posterior: ContactPosterior, config: FastConfig
+) -> tuple[ContactPosterior | None, dict[str, Any]]:
+    """At the cap: ``posterior`` times the likelihood of the window's second contact mode.
+
+    Near the top of omega_1(x_c) the fundamental hardly moves with x_c while omega_2 changes by
+    several rad/s per cm, so omega_2 places the contact there. It is used only on a link whose
+    calibration measured omega_2 (``Link.mode2_scatter``): the measured peak
+    (:func:`~.paper.frequency.second_mode_peak` on the window's own samples, near the model's
+    omega_2 at the posterior's x_c) enters as N(omega_2; omega_2(x_c), sigma^2), sigma the
+    calibration's scatter (at least ``MODEL_FREQUENCY_FLOOR``) times omega_2.
+
+    Returns the narrowed posterior (None when not used) and notes: why not, or the peak, its
+    sigma and how far it lies from the model over the posterior's interval. A peak farther
+    than ``max_disagreement`` sigmas from omega_2 at every x_c of the interval is not used and
+    is said (``"disagrees"``): the device departs from the model more than its calibration.
+    """
+    link = evidence.antenna.link
+    if link.mode2_scatter is None:
+        return None, {"not_used": "the calibration did not measure omega_2"}
+    table = curve_table(
+        link, posterior.branch_edges[0], posterior.branch_edges[-1], config.grid_step
+    )
+    omega2_of_x = np.interp(posterior.grid, table.grid, table.higher[:, 0])
+    expected = float(np.interp(posterior.x_c, posterior.grid, omega2_of_x))
+    samples = dataclasses.replace(
+        evidence, rest_index=window.start_index, end_index=window.end_index
+    )
+    component = evidence_frequency(samples).component
+    peak = second_mode_peak(samples, component, expected, window.omega1)
+    if peak is None:
+        return None, {"not_used": f"no clear peak of omega_2 near {expected:.1f} rad/s"}
+    sigma = max(link.mode2_scatter, MODEL_FREQUENCY_FLOOR) * peak.omega
+    z = (peak.omega - omega2_of_x) / sigma
+    low, high = posterior.interval
+    inside = (posterior.grid >= low) & (posterior.grid <= high)
+    nearest = float(np.min(np.abs(z[inside]))) if np.any(inside) else math.inf
+    notes: dict[str, Any] = {
+        "omega2": peak.omega,
+        "omega2_sigma": sigma,
+        "omega2_quality": peak.quality,
+        "omega2_z_in_interval": nearest,
+    }
+    if nearest > config.max_disagreement:
+        notes["disagrees"] = (
+            f"the second contact mode at {peak.omega:.1f} rad/s lies {nearest:.1f} standard "
+            f"deviations or more from the model's omega_2 at every x_c of the interval: the "
+            "device departs from the model more than its calibration measured"
+        )
+        return None, notes
+    return posterior.times(np.exp(-0.5 * z**2)), notes

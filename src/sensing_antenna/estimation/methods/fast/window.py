@@ -147,6 +147,9 @@ class WindowEstimate:
         ``cap_tolerance``, long enough for the slip check's reference, and within
         ``settled_margin`` of the narrowest width unlimited data could leave (the model
         floors'), so waiting for the cap would narrow it little.
+    near_top : bool
+        True when every check passed but the peak margin: omega_1 is within ``peak_margin``
+        standard deviations of the top of the sensing curve, where it does not place x_c.
     """
 
     start_index: int
@@ -169,6 +172,7 @@ class WindowEstimate:
     branch_chosen_by_second_mode: bool = False
     second_mode: dict[str, Any] = field(default_factory=dict)
     settled: bool = False
+    near_top: bool = False
 
 
 def evaluate_window(
@@ -324,12 +328,14 @@ def evaluate_window(
         contradiction = branch_contradiction(fit, k, posterior, table, link, config)
         if contradiction:
             notes.append(contradiction)
+    near_top = False
     if not notes and math.isfinite(omega1) and not math.isfinite(omega_h):
         # No declaration near the top of omega_1(x_c), unless a higher contact mode (whose
         # curves do not peak there) enters the posterior
         note = peak_check(omega1, omega1_se, frequency_floor, float(table.omega1.max()), config)
         if note:
             notes.append(note)
+            near_top = True
     settled = (
         not notes
         and config.settled_margin > 0.0
@@ -395,6 +401,7 @@ def evaluate_window(
         branch_chosen_by_second_mode=chosen,
         second_mode=second_mode,
         settled=settled and not notes,
+        near_top=near_top,
     )
 
 
