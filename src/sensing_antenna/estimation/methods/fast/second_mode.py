@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from sensing_antenna.antenna import MODEL_FREQUENCY_FLOOR
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.curves import curve_table
@@ -175,7 +174,8 @@ def narrowed_by_second_mode(
     calibration measured omega_2 (``Link.mode2_scatter``): the measured peak
     (:func:`~.paper.frequency.second_mode_peak` on the window's own samples, near the model's
     omega_2 at the posterior's x_c) enters as N(omega_2; omega_2(x_c), sigma^2), sigma the
-    calibration's scatter (at least ``MODEL_FREQUENCY_FLOOR``) times omega_2.
+    calibration's scatter or ``higher_mode_floor``, the larger, times omega_2 (as omega_1's
+    floor is the larger of its calibration's scatter and ``frequency_floor``).
 
     Returns the narrowed posterior (None when not used) and notes: why not, or the peak, its
     sigma and how far it lies from the model over the posterior's interval. A peak farther
@@ -197,7 +197,7 @@ def narrowed_by_second_mode(
     peak = second_mode_peak(samples, component, expected, window.omega1)
     if peak is None:
         return None, {"not_used": f"no clear peak of omega_2 near {expected:.1f} rad/s"}
-    sigma = max(link.mode2_scatter, MODEL_FREQUENCY_FLOOR) * peak.omega
+    sigma = max(link.mode2_scatter, config.higher_mode_floor) * peak.omega
     z = (peak.omega - omega2_of_x) / sigma
     low, high = posterior.interval
     inside = (posterior.grid >= low) & (posterior.grid <= high)
