@@ -97,6 +97,9 @@ def test_toml_override_with_base(tmp_path: Path) -> None:
         ("[link]\ncalibrated_t = nan\n", "link.calibrated_t"),
         ("[link]\ncalibration_scatter = -0.001\n", "link.calibration_scatter"),
         ("[link]\ncalibration_scatter = nan\n", "link.calibration_scatter"),
+        ("[link]\nmode2_scatter = -0.001\n", "link.mode2_scatter"),
+        ('[link]\nmode2_scatter = "x"\n', "link.mode2_scatter"),
+        ("[link]\nmode2_scatter = 2.0\n", "link.mode2_scatter"),
         ("[link]\ncolour = 3.0\n", "link.colour"),
         ("[motor]\ninertia = 1.0\n", "motor"),
         ("[azimuth_motor]\ninertia = -1.0\n", "azimuth_motor.inertia"),
@@ -232,6 +235,7 @@ _FIELDS = {
         "second_moment",
         "calibrated_t",
         "calibration_scatter",
+        "mode2_scatter",
     ),
     "azimuth_motor": (
         "torque_constant",

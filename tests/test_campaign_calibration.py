@@ -168,6 +168,12 @@ def test_the_calibration_measures_the_second_mode_and_the_model_carries_its_scat
     assert data["mode2_scatter"] == pytest.approx(calibration.mode2_scatter)
     again = FrequencyCalibration.from_dict(data)
     assert again.mode2_scatter == pytest.approx(calibration.mode2_scatter)
+    # a calibration written before omega_2 was measured still loads, without it
+    for point in data["points"]:
+        del point["omega2_measured"], point["omega2_fitted"]
+    older = FrequencyCalibration.from_dict(data)
+    assert older.omega2_measured is None and math.isnan(older.mode2_scatter)
+    assert older.apply(model).link.mode2_scatter is None
 
 
 def test_resume_reuses_the_calibration(calibrated: Path) -> None:

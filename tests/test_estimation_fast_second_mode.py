@@ -9,6 +9,7 @@ use); the reference is where the simulated link touched (``true_xc``).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -65,9 +66,10 @@ def test_a_calibrated_omega2_narrows_the_answer_and_holds_the_contact(
     # with its compliant contact against the pinned-contact model: within 1 %)
     expected = float(natural_frequencies(DEVICE.link, np.array([true_xc]), 2)[0][1])
     assert narrowing["omega2"] == pytest.approx(expected, rel=0.01)
-    # its standard deviation: the larger of the calibration's scatter and the method's floor
-    floor = max(0.003, FastConfig().higher_mode_floor)
-    assert narrowing["omega2_sigma"] == pytest.approx(floor * narrowing["omega2"])
+    # its standard deviation: the larger of the calibration's scatter and the method's floor,
+    # with the peak's own error, which for a peak this clear is small beside it
+    model = max(0.003, FastConfig().higher_mode_floor) * narrowing["omega2"]
+    assert model <= narrowing["omega2_sigma"] <= 1.05 * model
 
 
 def test_an_omega2_no_contact_of_the_posterior_explains_is_not_used(
@@ -113,3 +115,24 @@ def test_the_product_of_a_posterior_and_a_likelihood_that_excludes_it_is_none() 
     # the 95 % highest-density region of a Gaussian: +-1.96 sigma
     assert narrow.width == pytest.approx(2 * 1.96 * 0.002, abs=0.0015)
     assert math.isclose(sum(narrow.branch_probability), 1.0)
+
+
+def test_omega1_above_the_curves_top_is_not_made_ok_by_omega2() -> None:
+    # A model whose T_e is 2 % too high puts the curve's top 2 % low: the link's omega_1 at
+    # 0.7565 m lies several standard deviations above it, at no contact point of the model.
+    # omega_2 scales with the same T, so it alone would fit a point a few mm off.
+    model = DEVICE.with_calibrated_t(1.02 * DEVICE.link.t_param, MODEL_FREQUENCY_FLOOR, 0.003)
+    recording = simulate(DEVICE, Scenario(case="azimuthal", contact_point=0.7565, seed=3))
+    result = estimate(recording.without_ground_truth(), model, FastMethod())
+    assert result.status is not Status.OK
+    assert "above the top of the sensing curve" in (result.reason or "")
+
+
+def test_omega2_is_not_used_without_a_calibrated_t(near_top: tuple[Recording, float]) -> None:
+    recording, _ = near_top
+    uncalibrated = dataclasses.replace(
+        DEVICE, link=dataclasses.replace(DEVICE.link, mode2_scatter=0.003)
+    )
+    result = estimate(recording, uncalibrated, FastMethod())
+    assert result.status is not Status.OK
+    assert "not_used" in result.diagnostics["second_mode_narrowing"]

@@ -227,8 +227,8 @@ class Link:
     mode2_scatter : float or None
         Relative error of the second contact mode omega_2(x_c) with that T_e, from the
         calibration's measured omega_2 (dimensionless; its bias along the link included): the
-        fast method lets omega_2 narrow an answer at its cap only when this is known. None: not
-        measured.
+        fast method lets omega_2 narrow an answer at its cap only when this and
+        ``calibrated_t`` are known. None: not measured.
     weight_tip_mass : float or None
         The tip mass the link's weight shows at rest (kg), where it differs from the
         ``tip_mass`` the vibration shows: a calibration that fits the tip mass to the contact

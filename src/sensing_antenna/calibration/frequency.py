@@ -175,17 +175,21 @@ class FrequencyCalibration:
         """Relative error of the calibrated model's omega_2(x_c), dimensionless; NaN if unknown.
 
         The root-mean-square relative residual (measured / model - 1) of the second contact
-        mode over the points where it was measured, its mean included: nothing is fitted to
-        omega_2, so a link whose second mode sits off the model's (a taper, a joint, a clamp
-        that is not rigid, which T_e fitted to omega_1 does not take up) shows it here whole.
-        NaN with fewer than :data:`MIN_MODE2_POINTS` points measured.
+        mode over the points used where it was measured (the wrong peaks of omega_1 left out,
+        as in :attr:`relative_scatter`), its mean included: nothing is fitted to omega_2, so a
+        link whose second mode sits off the model's (a taper, a joint, a clamp that is not
+        rigid, which T_e fitted to omega_1 does not take up) shows it here whole. NaN with
+        fewer than :data:`MIN_MODE2_POINTS` such points, or when omega_2 was found at fewer
+        than two thirds of them: it is searched within 5 % of the model's, so a link far off
+        the model would leave only its nearest points, and a scatter that says too little.
         """
         if self.omega2_measured is None or self.omega2_fitted is None:
             return math.nan
         with np.errstate(divide="ignore", invalid="ignore"):
             relative = self.omega2_measured / self.omega2_fitted - 1.0
-        kept = relative[self.used & np.isfinite(relative)]
-        if kept.size < MIN_MODE2_POINTS:
+        points = self.used & np.isfinite(self.omega2_fitted) & ~self.wrong_peak_points
+        kept = relative[points & np.isfinite(relative)]
+        if kept.size < MIN_MODE2_POINTS or 3 * kept.size < 2 * int(points.sum()):
             return math.nan
         return math.sqrt(float(np.mean(kept**2)))
 
@@ -254,7 +258,7 @@ class FrequencyCalibration:
                     "source": self.sources[i] if i < len(self.sources) else "",
                     "x_c": float(self.contact_points[i]),
                     "omega1_measured": _json_float(float(self.omega1_measured[i])),
-                    "omega1_fitted": float(self.omega1_fitted[i]),
+                    "omega1_fitted": _json_float(float(self.omega1_fitted[i])),
                     "used": bool(self.used[i]),
                     **self._omega2_at(i),
                 }
@@ -269,7 +273,7 @@ class FrequencyCalibration:
             return {}
         return {
             "omega2_measured": _json_float(float(self.omega2_measured[i])),
-            "omega2_fitted": float(self.omega2_fitted[i]),
+            "omega2_fitted": _json_float(float(self.omega2_fitted[i])),
         }
 
     @classmethod

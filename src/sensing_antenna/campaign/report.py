@@ -12,6 +12,8 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.figures import ReportFigures, draw_figures
 from sensing_antenna.campaign.report_devices import devices_section
@@ -158,7 +160,30 @@ def _scatter_lines(check: CalibrationCheck) -> list[str]:
             f"The model carries it as `calibration_scatter` ({100 * check.applied_scatter:.3f} "
             "%), and the fast method's model floor on omega_1 is at least this."
         )
-    return [text, ""]
+    return [text, "", *_mode2_lines(check), ""]
+
+
+def _mode2_lines(check: CalibrationCheck) -> list[str]:
+    """What the calibration measured of the second contact mode, in one paragraph."""
+    calibration = check.calibration
+    measured = calibration.omega2_measured
+    if measured is None:
+        return ["The calibration did not look for the second contact mode."]
+    count = int(np.isfinite(measured[calibration.used]).sum())
+    scatter = calibration.mode2_scatter
+    if not math.isfinite(scatter) or check.applied_mode2_scatter is None:
+        return [
+            f"The second contact mode was found near the model's at {count} of "
+            f"{check.n_used} points used: too few for its scatter, so the fast method does not "
+            "use omega_2 at its cap."
+        ]
+    return [
+        f"The measured omega_2 scatter by {100 * scatter:.3f} % (rms, relative, {count} "
+        "points, its mean included) about the calibrated model. The model carries it as "
+        f"`mode2_scatter` ({100 * check.applied_mode2_scatter:.3f} %): at its cap the fast "
+        "method may narrow an interval the fundamental leaves too wide with omega_2, within "
+        'this (docs/fast.md, "The second mode at the cap").'
+    ]
 
 
 def _calibration_section(

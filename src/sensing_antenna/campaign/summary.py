@@ -107,6 +107,8 @@ class CalibrationCheck:
         (T_e - T) / T of the paper (Section 5.1: :data:`PAPER_T_E` against :data:`PAPER_T`).
     applied_scatter : float or None
         The relative scatter the model carries (``link.calibration_scatter``), None if none.
+    applied_mode2_scatter : float or None
+        The second contact mode's (``link.mode2_scatter``), None if none.
     """
 
     calibration: FrequencyCalibration
@@ -116,6 +118,7 @@ class CalibrationCheck:
     t_e_vs_device: float
     paper_relative_difference: float
     applied_scatter: float | None
+    applied_mode2_scatter: float | None = None
 
 
 @dataclass(frozen=True)
@@ -229,6 +232,7 @@ def check_calibration(
         t_e_vs_device=(calibration.t_e - device_t) / device_t,
         paper_relative_difference=(PAPER_T_E - PAPER_T) / PAPER_T,
         applied_scatter=model.link.calibration_scatter,
+        applied_mode2_scatter=model.link.mode2_scatter,
     )
 
 

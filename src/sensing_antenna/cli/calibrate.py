@@ -203,8 +203,9 @@ def _mode2_line(calibration: FrequencyCalibration) -> str:
             "points (written as link.mode2_scatter; the fast method's omega_2 at its cap)"
         )
     return (
-        f"second contact mode: measured at {count} points, {MIN_MODE2_POINTS} needed for its "
-        "scatter (link.mode2_scatter not written)"
+        f"second contact mode: found near the model's at {count} of "
+        f"{int(calibration.used.sum())} points; its scatter needs {MIN_MODE2_POINTS} and two "
+        "thirds of the points (link.mode2_scatter not written)"
     )
 
 

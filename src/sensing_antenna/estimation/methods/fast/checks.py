@@ -278,6 +278,12 @@ def peak_check(
     the relative ``frequency_floor`` in quadrature) of the maximum.
     """
     sigma = math.hypot(omega1_se, frequency_floor * omega1)
+    if omega1 > top:
+        by = f", by {(omega1 - top) / sigma:.1f} standard deviations" if sigma > 0.0 else ""
+        return (
+            f"omega_1 = {omega1:.2f} rad/s is above the top of the sensing curve "
+            f"({top:.2f} rad/s){by}"
+        )
     if top - omega1 < config.peak_margin * sigma:
         return (
             f"omega_1 = {omega1:.2f} rad/s is within {config.peak_margin:g} standard "

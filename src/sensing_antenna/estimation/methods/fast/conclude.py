@@ -33,6 +33,8 @@ from sensing_antenna.estimation.methods.fast.search import ScanResult
 from sensing_antenna.estimation.methods.fast.second_mode import (
     branch_at_cap,
     narrowed_by_second_mode,
+    second_mode_chooser,
+    second_mode_objection,
 )
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
 from sensing_antenna.estimation.methods.fast.window import WindowEstimate
@@ -165,21 +167,35 @@ def _narrowed(
     evidence: Evidence, final: WindowEstimate, config: FastConfig
 ) -> tuple[WindowEstimate, dict[str, Any]]:
     """The window at the cap with the second contact mode in its posterior
-    (:func:`.second_mode.narrowed_by_second_mode`), its checks judged again at the new
-    maximum; unchanged when the mode is not used. omega_2 places the contact where omega_1 is
-    flat, so the peak margin no longer holds the answer back."""
+    (:func:`.second_mode.narrowed_by_second_mode`), unchanged when the mode is not used.
+
+    omega_2 places the contact where omega_1 is flat, so the peak margin no longer holds the
+    answer back; every other check is judged again at the new maximum: the ratio, the
+    frequency (omega_1 more than ``max_disagreement`` standard deviations above the curve's
+    top is at no contact point), and the second-mode test of the other branch."""
     post, notes = narrowed_by_second_mode(evidence, final, final.posterior, config)
     if post is None:
         return final, notes
+    found: list[str] = []
     ratio_z = final.ratio_z
-    passed = True
-    note = ""
     if final.statics is not None:
         model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c)))
         ratio_z, note = ratio_check(final.statics, post.x_c, model_sd, config)
-        passed = not note
-    frequency_z = _frequency_z(evidence, final.omega1, final.omega1_se, post, config)
-    if passed and post.width > config.cap_tolerance:
+        found.append(note)
+    frequency_z, note = _frequency_judged(evidence, final.omega1, final.omega1_se, post, config)
+    found.append(note)
+    objection, answer = second_mode_objection(
+        post,
+        contact_candidates(evidence.antenna.link, final.omega1, post),
+        final.omega1,
+        final.start_index,
+        final.end_index,
+        second_mode_chooser(evidence),
+    )
+    found.append(objection)
+    found = [text for text in found if text]
+    note = "; ".join(found)
+    if not found and post.width > config.cap_tolerance:
         note = (
             f"the 95 % interval is {1000 * post.width:.1f} mm wide with the second contact "
             f"mode (cap tolerance {1000 * config.cap_tolerance:g} mm)"
@@ -189,11 +205,14 @@ def _narrowed(
         posterior=post,
         ratio_z=ratio_z,
         frequency_z=frequency_z,
-        checks_passed=passed,
+        checks_passed=not found,
         near_top=False,
         note=note,
     )
-    return narrowed, {**notes, "interval_before": final.posterior.interval}
+    info = {**notes, "interval_before": final.posterior.interval}
+    if answer:
+        info["second_mode_test"] = answer
+    return narrowed, info
 
 
 def _free_plane_share(final: WindowEstimate, push_direction: NDArray[np.float64]) -> float:
@@ -214,16 +233,31 @@ def _frequency_z(
     """The frequency's distance from the sensing curve at ``post``'s maximum, in its standard
     deviations (:func:`.checks.frequency_check`), the bent link's term included as the windows
     have it (:func:`.search.scan_inputs`)."""
+    return _frequency_judged(evidence, omega1, omega1_se, post, config)[0]
+
+
+def _frequency_judged(
+    evidence: Evidence,
+    omega1: float,
+    omega1_se: float,
+    post: ContactPosterior,
+    config: FastConfig,
+) -> tuple[float, str]:
+    """:func:`_frequency_z` and why the frequency does not allow ``post``'s maximum ("" when
+    it does): farther from the curve there than ``max_disagreement`` standard deviations, or
+    as far above the curve's top, where no contact point rings."""
     link = evidence.antenna.link
     table = curve_table(link, post.branch_edges[0], post.branch_edges[-1], config.grid_step)
     slope = float(np.interp(post.x_c, table.grid, table.slope))
     bent = slope * evidence.bent_link_uncertainty(post.x_c)
-    z, _ = frequency_check(
-        omega1,
-        frequency_sigma(omega1, omega1_se, model_floor(link, config), bent),
-        float(np.interp(post.x_c, table.grid, table.omega1)),
-        post.x_c,
-        float(table.omega1.max()),
-        config,
+    sigma = frequency_sigma(omega1, omega1_se, model_floor(link, config), bent)
+    top = float(table.omega1.max())
+    z, note = frequency_check(
+        omega1, sigma, float(np.interp(post.x_c, table.grid, table.omega1)), post.x_c, top, config
     )
-    return z
+    if not note and math.isfinite(omega1) and omega1 - top > config.max_disagreement * sigma:
+        note = (
+            f"omega_1 = {omega1:.2f} rad/s is {(omega1 - top) / sigma:.1f} standard deviations "
+            f"above the top of the sensing curve ({top:.2f} rad/s): no contact point rings so"
+        )
+    return z, note

@@ -24,7 +24,8 @@ Model-error floors are added in quadrature to the statistical standard errors:
 Prior: flat on the contact range. The posterior is normalised on the grid; the point estimate is
 its maximum (MAP); the 95 % interval is the highest-density region, reported as [lowest, highest]
 point of that region (conservative when the region has two parts, one on each branch); the branch
-probabilities are the posterior mass on each monotone branch of omega_1(x_c).
+probabilities are the posterior mass on each monotone branch of omega_1(x_c). Another
+measurement's likelihood on the grid updates it (:meth:`ContactPosterior.times`).
 """
 
 from __future__ import annotations

@@ -173,9 +173,12 @@ def narrowed_by_second_mode(
     several rad/s per cm, so omega_2 places the contact there. It is used only on a link whose
     calibration measured omega_2 (``Link.mode2_scatter``): the measured peak
     (:func:`~.paper.frequency.second_mode_peak` on the window's own samples, near the model's
-    omega_2 at the posterior's x_c) enters as N(omega_2; omega_2(x_c), sigma^2), sigma the
+    omega_2 at the posterior's x_c) enters as N(omega_2; omega_2(x_c), sigma^2): sigma is the
     calibration's scatter or ``higher_mode_floor``, the larger, times omega_2 (as omega_1's
-    floor is the larger of its calibration's scatter and ``frequency_floor``).
+    floor is the larger of its calibration's scatter and ``frequency_floor``), and the peak's
+    statistical error, sqrt(6 / Q) / T_w for a peak of quality Q over a window of T_w seconds,
+    in quadrature. Not used without a calibrated T_e, or when ``higher_modes`` has put a
+    fitted higher mode in the posterior already.
 
     Returns the narrowed posterior (None when not used) and notes: why not, or the peak, its
     sigma and how far it lies from the model over the posterior's interval. A peak farther
@@ -183,8 +186,10 @@ def narrowed_by_second_mode(
     is said (``"disagrees"``): the device departs from the model more than its calibration.
     """
     link = evidence.antenna.link
-    if link.mode2_scatter is None:
-        return None, {"not_used": "the calibration did not measure omega_2"}
+    if link.mode2_scatter is None or link.calibrated_t is None:
+        return None, {"not_used": "no calibration measured omega_2 (link.mode2_scatter)"}
+    if config.higher_modes:
+        return None, {"not_used": "a fitted higher mode is already in the posterior"}
     table = curve_table(
         link, posterior.branch_edges[0], posterior.branch_edges[-1], config.grid_step
     )
@@ -197,7 +202,13 @@ def narrowed_by_second_mode(
     peak = second_mode_peak(samples, component, expected, window.omega1)
     if peak is None:
         return None, {"not_used": f"no clear peak of omega_2 near {expected:.1f} rad/s"}
-    sigma = max(link.mode2_scatter, config.higher_mode_floor) * peak.omega
+    # the model's error, and the peak's own: the Cramer-Rao bound of a sinusoid's frequency in
+    # white noise over T_w, 3 / (Q T_w^2) with Q the spectrum's signal to noise, doubled for
+    # the windowed peak's estimator and the median the quality is taken over
+    span = samples.spectrum_slice
+    duration = (span.stop - span.start) * evidence.sample_period
+    statistical = math.sqrt(6.0 / peak.quality) / duration
+    sigma = math.hypot(max(link.mode2_scatter, config.higher_mode_floor) * peak.omega, statistical)
     z = (peak.omega - omega2_of_x) / sigma
     low, high = posterior.interval
     inside = (posterior.grid >= low) & (posterior.grid <= high)
@@ -205,6 +216,7 @@ def narrowed_by_second_mode(
     notes: dict[str, Any] = {
         "omega2": peak.omega,
         "omega2_sigma": sigma,
+        "omega2_statistical": statistical,
         "omega2_quality": peak.quality,
         "omega2_z_in_interval": nearest,
     }

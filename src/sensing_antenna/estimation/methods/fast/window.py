@@ -149,7 +149,8 @@ class WindowEstimate:
         floors'), so waiting for the cap would narrow it little.
     near_top : bool
         True when every check passed but the peak margin: omega_1 is within ``peak_margin``
-        standard deviations of the top of the sensing curve, where it does not place x_c.
+        standard deviations of the top of the sensing curve, or above it, where it does not
+        place x_c.
     """
 
     start_index: int

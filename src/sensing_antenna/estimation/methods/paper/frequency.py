@@ -315,14 +315,15 @@ def second_mode_peak(
 
     Searched, in the spectrum of ``component`` over the evidence's Delta t_e1 window, within
     ``omega2_window`` of ``expected`` (the model's omega_2 where the contact is thought to be);
-    its quality is over the median power within four times that (the search band itself lies
-    on the peak's main lobe). None when that band holds no peak of at least
-    ``min_peak_quality``, or when the peak lies nearer 2 or 3 omega_1 than ``expected``: a
-    clipping contact's harmonic may be what it is (at the top of the paper link's sensing
-    curve, 2 omega_1 is 3 % below omega_2).
+    its quality is over the median power within a factor 1 + 4 ``omega2_window`` of it (the
+    search band itself lies on the peak's main lobe). None when that band holds no peak of at
+    least ``min_peak_quality``, when the peak lies nearer 2 or 3 omega_1 than ``expected`` (a
+    clipping contact's harmonic may be what it is: on the paper link 2 omega_1 comes within 4 %
+    of omega_2 near 0.73 m, and 3 omega_1 meets it near 0.63 and 0.84 m), or when omega_1 is
+    not known.
     """
     cfg = evidence.config
-    if not (math.isfinite(expected) and expected > 0.0):
+    if not (math.isfinite(expected) and expected > 0.0 and math.isfinite(omega1)):
         return None
     omega, spectrum = evidence_spectrum(evidence, component)
     band = (expected / (1.0 + cfg.omega2_window), expected * (1.0 + cfg.omega2_window))
