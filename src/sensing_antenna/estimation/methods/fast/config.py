@@ -151,10 +151,11 @@ class FastConfig:
         interval could rest on a wrong match.
     higher_mode_floor : float
         Relative model error of the higher contact modes (2 and 3) against their pinned-contact
-        sensing curves (dimensionless), added in quadrature. 0.005: covers the lowering of
-        those modes by the finite-element simulator's compliant contact with a margin (a
-        stiffer contact lowers them less). On a real device use the scatter of a calibration of
-        the higher modes.
+        sensing curves (dimensionless), added in quadrature: to omega_2 when it narrows an
+        answer at the cap (a calibration's larger ``Link.mode2_scatter`` replaces it) and to
+        the fitted modes with ``higher_modes``. 0.005: covers the lowering of those modes by
+        the finite-element simulator's compliant contact with a margin (a stiffer contact lowers
+        them less; one three times softer than the calibration's, by 0.5 to 1 %).
     branch_mode_tolerance : float
         Relative distance (dimensionless) within which a fitted higher mode is taken as contact
         mode 2 or 3 of a candidate x_c. When omega_1 fits candidates on two branches, the window

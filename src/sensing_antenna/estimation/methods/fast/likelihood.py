@@ -89,19 +89,12 @@ class ContactPosterior:
         branch probabilities (1 on ``branch``) follow. Unchanged when the branch holds no mass.
         """
         on_branch = _branch_indices(self.branch_edges, self.grid) == branch
-        mass = float(self.density[on_branch].sum())
-        if mass <= 0.0:
+        conditioned = self.times(on_branch.astype(float))
+        if conditioned is None:
             return self
-        density = np.where(on_branch, self.density, 0.0) / mass
         count = len(self.branch_probability)
         probability = tuple(1.0 if b == branch else 0.0 for b in range(count))
-        return replace(
-            self,
-            density=density,
-            x_c=float(self.grid[int(np.argmax(density))]),
-            interval=_hpd_bounds(density, self.grid, self.level),
-            branch_probability=probability,
-        )
+        return replace(conditioned, branch_probability=probability)
 
     def times(self, likelihood: FloatArray) -> ContactPosterior | None:
         """The posterior updated by another measurement's ``likelihood`` on the grid (shape
