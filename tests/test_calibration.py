@@ -171,18 +171,18 @@ def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     assert calibrate_t_e(PAPER_POINTS, omega, link).relative_scatter == pytest.approx(
         0.002, rel=0.1
     )
-    # One wrong peak at half the frequency: left out of the scatter (not 50 %), but it pulls the
-    # robust T_e by offset (0.4 %), and every residual of the calibrated model carries that
+    # One wrong peak at half the frequency: left out of the fit and of the scatter, with a note
+    # naming it; T_e and the scatter are those of the 14 other points
     omega[9] *= 0.5
-    result = calibrate_t_e(PAPER_POINTS, omega, link)
-    offset = result.t_e / PAPER_T_E - 1.0
-    assert 0.001 < abs(offset) < 0.01
-    # measured / fitted - 1 = (1 + pattern) T_e / T_e,true - 1 at the 14 other points, rms with
-    # 13 degrees of freedom
-    kept = np.delete((1.0 + 0.002 * signs) * (1.0 + offset) - 1.0, 9)
-    expected = math.sqrt(float(np.sum(kept**2)) / (kept.size - 1))
-    assert result.relative_scatter == pytest.approx(expected, rel=1e-6)
-    assert result.wrong_peaks == 1 and np.flatnonzero(result.wrong_peak_points).tolist() == [9]
+    names = [f"p{i}" for i in range(PAPER_POINTS.size)]
+    result = calibrate_t_e(PAPER_POINTS, omega, link, sources=names)
+    alone = calibrate_t_e(np.delete(PAPER_POINTS, 9), np.delete(omega, 9), link)
+    assert result.t_e == pytest.approx(alone.t_e, rel=1e-12)
+    assert result.relative_scatter == pytest.approx(alone.relative_scatter, rel=1e-9)
+    assert not result.used[9] and int(result.used.sum()) == 14
+    (note,) = result.notes
+    # 0.5 x (1 - 0.2 %) of the model's: -50.1 %
+    assert note.startswith("p9: omega_1 = ") and "-50.1 % from the others' fit" in note
     # A payload of 0.5 g the model lacks bends the whole curve: 8 of 15 points lie more than
     # 5 % from the median, model error, not wrong peaks: all stay in the scatter
     payload = natural_frequencies(replace(link, tip_mass=5e-4), PAPER_POINTS, 1)

@@ -206,13 +206,7 @@ class FrequencyCalibration:
         peaks (or wrong known points). More are the model's error (a payload bends the whole
         curve: 0.2 g puts 4 of 15 points beyond), and stay in the scatter."""
         relative = self._relative_residuals()
-        usable = self.used & np.isfinite(relative)
-        none = np.zeros(relative.shape, dtype=bool)
-        if int(usable.sum()) < MIN_WRONG_PEAK_POINTS:
-            return none  # a median of fewer cannot tell a wrong peak from the model's error
-        median = float(np.median(relative[usable]))
-        beyond = np.asarray(usable & (np.abs(relative - median) > WRONG_PEAK), dtype=bool)
-        return beyond if int(beyond.sum()) <= max(1, int(usable.sum()) // 10) else none
+        return _wrong_peaks(relative, self.used & np.isfinite(relative))
 
     def _relative_residuals(self) -> NDArray[np.float64]:
         """measured / fitted - 1 at every point, shape (n,)."""
@@ -449,6 +443,18 @@ def calibrate_t_e(
     k = np.full(x_c.shape, math.nan)
     k[on_link] = model_beta1_squared(link, x_c[on_link])
     t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
+    wrong = _wrong_peaks(w / (k / t_e) - 1.0, used)
+    if np.any(wrong) and not fit_tip_mass:
+        # a wrong peak or a wrong known point: the robust loss only tempers its pull
+        used = used & ~wrong
+        t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
+        for i in map(int, np.flatnonzero(wrong)):
+            label = sources[i] if i < len(sources) else f"point {i}"
+            off = float(w[i] / (k[i] / t_e) - 1.0)
+            left_out.append(
+                f"{label}: omega_1 = {float(w[i]):.2f} rad/s lies {100 * off:+.1f} % from the "
+                "others' fit, a wrong spectral peak or a wrong known point (left out of the fit)"
+            )
     tip_mass = None
     if fit_tip_mass:
         joint = _with_tip_mass(link, x_c, on_link, w, used, k, t_e, loss)
@@ -480,6 +486,20 @@ def calibrate_t_e(
 
 #: Fewest points used whose median residual can single out a wrong peak.
 MIN_WRONG_PEAK_POINTS = 5
+
+
+def _wrong_peaks(relative: NDArray[np.float64], usable: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Which points of ``usable`` lie more than :data:`WRONG_PEAK` from the median of the
+    ``relative`` residuals, when they are few (one, or a tenth of the points, of
+    :data:`MIN_WRONG_PEAK_POINTS` or more): wrong peaks or wrong known points. More are the
+    model's error (a payload bends the whole curve), and none is returned."""
+    none = np.zeros(relative.shape, dtype=bool)
+    if int(usable.sum()) < MIN_WRONG_PEAK_POINTS:
+        return none  # a median of fewer cannot tell a wrong peak from the model's error
+    median = float(np.median(relative[usable]))
+    with np.errstate(invalid="ignore"):
+        beyond = np.asarray(usable & (np.abs(relative - median) > WRONG_PEAK), dtype=bool)
+    return beyond if int(beyond.sum()) <= max(1, int(usable.sum()) // 10) else none
 
 #: A point whose omega_1 lies farther than this (relative) from the median of T_e alone's fit is
 #: left out of the tip mass's fit before it starts: a peak of another mode, a harmonic or the
