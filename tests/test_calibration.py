@@ -245,6 +245,10 @@ def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
     table.write_text("name,x_c\n", encoding="utf-8")
     with pytest.raises(CalibrationError, match="missing column 'file'"):
         read_contact_points(paths, recordings, table)
+    # a recording the table has no row for has no known point: left out, as without metadata
+    table.write_text("file,x_c\na.csv,0.4\n", encoding="utf-8")
+    first, second = read_contact_points(paths, recordings, table)
+    assert first == 0.4 and math.isnan(second)
 
 
 def test_points_table_that_is_not_utf8_is_one_line(tmp_path: Path) -> None:

@@ -99,3 +99,6 @@ def test_a_recording_of_another_antenna_estimated_with_the_default_is_warned_of(
     save_antenna(calibrated(), model)
     assert main(["estimate", str(other), "--antenna", str(model)]) == 0
     assert capsys.readouterr().err == ""  # the user chose the model
+    # the default named on the command line is chosen too
+    assert main(["estimate", str(other), "--antenna", "paper-2021"]) == 0
+    assert capsys.readouterr().err == ""

@@ -9,14 +9,20 @@ use); the reference is where the simulated link touched (``true_xc``).
 
 from __future__ import annotations
 
-import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from sensing_antenna.antenna import MODEL_FREQUENCY_FLOOR, paper_antenna
+from sensing_antenna.antenna import (
+    MODEL_FREQUENCY_FLOOR,
+    AntennaConfigError,
+    load_antenna,
+    paper_antenna,
+)
 from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.cli.estimate import summary
 from sensing_antenna.estimation import Evidence, estimate, gather
 from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
@@ -48,6 +54,8 @@ def test_without_omega2_the_top_of_the_curve_stays_uncertain(
     assert result.status is Status.UNCERTAIN
     assert result.interval[1] - result.interval[0] > CAP_TOLERANCE
     assert "not_used" in result.diagnostics["second_mode_narrowing"]
+    # the reason names what would help
+    assert "link.mode2_scatter" in (result.reason or "")
 
 
 def test_a_calibrated_omega2_narrows_the_answer_and_holds_the_contact(
@@ -62,6 +70,8 @@ def test_a_calibrated_omega2_narrows_the_answer_and_holds_the_contact(
     assert low <= true_xc <= high
     before = narrowing["interval_before"]
     assert before[1] - before[0] > high - low
+    # the command line's summary says so
+    assert "narrowed at the cap by omega_2 from" in summary("rec.csv", result.to_dict())
     # the peak used is the device's second contact mode at the touch (the finite-element link
     # with its compliant contact against the pinned-contact model: within 1 %)
     expected = float(natural_frequencies(DEVICE.link, np.array([true_xc]), 2)[0][1])
@@ -128,11 +138,10 @@ def test_omega1_above_the_curves_top_is_not_made_ok_by_omega2() -> None:
     assert "above the top of the sensing curve" in (result.reason or "")
 
 
-def test_omega2_is_not_used_without_a_calibrated_t(near_top: tuple[Recording, float]) -> None:
-    recording, _ = near_top
-    uncalibrated = dataclasses.replace(
-        DEVICE, link=dataclasses.replace(DEVICE.link, mode2_scatter=0.003)
-    )
-    result = estimate(recording, uncalibrated, FastMethod())
-    assert result.status is not Status.OK
-    assert "not_used" in result.diagnostics["second_mode_narrowing"]
+def test_a_mode2_scatter_without_a_calibrated_t_is_refused_in_one_line(tmp_path: Path) -> None:
+    path = tmp_path / "hand.toml"
+    path.write_text('base = "paper-2021"\n[link]\nmode2_scatter = 0.003\n', encoding="utf-8")
+    with pytest.raises(
+        AntennaConfigError, match=r"link\.mode2_scatter: .*needs link\.calibrated_t"
+    ):
+        load_antenna(path)

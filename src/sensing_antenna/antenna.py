@@ -227,8 +227,8 @@ class Link:
     mode2_scatter : float or None
         Relative error of the second contact mode omega_2(x_c) with that T_e, from the
         calibration's measured omega_2 (dimensionless; its bias along the link included): the
-        fast method lets omega_2 narrow an answer at its cap only when this and
-        ``calibrated_t`` are known. None: not measured.
+        fast method lets omega_2 narrow an answer at its cap. Only with ``calibrated_t``.
+        None: not measured.
     weight_tip_mass : float or None
         The tip mass the link's weight shows at rest (kg), where it differs from the
         ``tip_mass`` the vibration shows: a calibration that fits the tip mass to the contact
@@ -279,6 +279,12 @@ class Link:
             value = getattr(self, name)
             if value is not None:
                 PARAMETER_RANGES[f"link.{name}"].check(f"link.{name}", value)
+        if self.mode2_scatter is not None and self.calibrated_t is None:
+            raise AntennaConfigError(
+                "link.mode2_scatter",
+                "is the scatter of a calibration's omega_2 about the model with its T_e: it "
+                "needs link.calibrated_t (antenna calibrate writes both)",
+            )
         if self.length < MIN_SLENDERNESS * self.radius:
             raise AntennaConfigError(
                 "link.radius",

@@ -501,6 +501,7 @@ def _wrong_peaks(relative: NDArray[np.float64], usable: NDArray[np.bool_]) -> ND
         beyond = np.asarray(usable & (np.abs(relative - median) > WRONG_PEAK), dtype=bool)
     return beyond if int(beyond.sum()) <= max(1, int(usable.sum()) // 10) else none
 
+
 #: A point whose omega_1 lies farther than this (relative) from the median of T_e alone's fit is
 #: left out of the tip mass's fit before it starts: a peak of another mode, a harmonic or the
 #: free motion's, not a shape a tip mass makes (0.2 g at the tip moves the points by 13 % at
@@ -614,8 +615,8 @@ def points_on_link(
     for i in map(int, np.flatnonzero(~on_link)):
         label = sources[i] if i < len(sources) else f"point {i}"
         where = (
-            "no known contact point (no --points row, and no true_xc metadata or one that is "
-            "not a number)"
+            "no known contact point (no row in the --points table or, without one, no "
+            "true_xc metadata; or one that is not a number)"
             if math.isnan(x_c[i])
             else f"x_c = {float(x_c[i])!r} m is not on the link (0, {length:g}] m"
         )
@@ -745,8 +746,10 @@ def read_contact_points(
     """Known contact points (m) of calibration recordings, from a table or their metadata.
 
     With ``table``, a CSV file (UTF-8) with columns ``file`` and ``x_c`` (m); a row matches a
-    recording by its path as given or by its file name. Two rows for one ``file``, or a file name
-    two rows match, are refused (naming the lines): which would win is not the user's intent.
+    recording by its path as given or by its file name, and a recording without a row has no
+    known point (NaN: the calibration leaves it out with a note). Two rows for one ``file``, or
+    a file name two rows match, are refused (naming the lines): which would win is not the
+    user's intent.
     Without it, each recording's ground-truth metadata ``true_xc`` is used (NaN where it is
     absent or not a number; the calibration leaves that recording out with a note): calibration
     is the one place where ground truth is an input, since the contact points of a calibration
@@ -828,7 +831,7 @@ def _point_of(table: Path, rows: Sequence[_PointRow], path: Path) -> float:
         return exact[0].x_c
     named = [row for row in rows if Path(row.file).name == path.name]
     if not named:
-        raise CalibrationError(f"{table}: file: no row for recording {path}")
+        return math.nan  # no known point: left out with a note, as a recording without metadata
     if len(named) > 1:
         lines = " and ".join(str(row.line) for row in named)
         raise CalibrationError(

@@ -93,7 +93,8 @@ def _calibrate_sensor(
     terms = ", ".join(f"{k} = {v:.4g}" for k, v in vars(fit.correction).items())
     fitted = f"on {len(fit.sources)} recordings ({', '.join(fit.sweeps)} sweeps)"
     lines = [
-        f"sensor: cross-talk fitted {fitted}: {terms}; {fit.ratio_summary}"
+        f"sensor: lateral-force correction (a sensor's cross-talk, or the statics' bias at "
+        f"the push) fitted {fitted}: {terms}; {fit.ratio_summary}"
         if fit.adopted
         else f"sensor: no cross-talk correction written ({fitted}; {fit.ratio_summary}); "
         f"ratio_scatter = {fit.correction.ratio_scatter:.4g}"
@@ -165,6 +166,8 @@ def _run(args: argparse.Namespace) -> int:
     print(_mode2_line(calibration))
     wrong = calibration.wrong_peak_points
     for i, x_c in enumerate(calibration.contact_points):
+        if not math.isfinite(float(x_c)):
+            continue  # no known point: its note below says so
         print(
             f"  {calibration.sources[i]}: x_c = {x_c:.4f} m, omega_1 measured "
             f"{calibration.omega1_measured[i]:.3f}, fitted {calibration.omega1_fitted[i]:.3f} rad/s"
@@ -183,8 +186,8 @@ def _run(args: argparse.Namespace) -> int:
     if args.plot is not None:
         from sensing_antenna.plotting.calibration import plot_calibration
 
-        print(plot_calibration(calibration, antenna.link, args.plot))
-    print(args.out)
+        print(f"figure {plot_calibration(calibration, antenna.link, args.plot)}")
+    print(f"wrote {args.out}")
     return 0
 
 

@@ -58,7 +58,9 @@ def register(subparsers: Any) -> None:
         help="t_1 from the head coming to rest (any device) or from the default push "
         "criterion's decision (a device that stops with it, such as our simulator)",
     )
-    parser.add_argument("--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file")
+    parser.add_argument(
+        "--antenna", default=None, help=f"built-in name or TOML file (default {DEFAULT_ANTENNA})"
+    )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)
 
@@ -72,9 +74,9 @@ def _run(args: argparse.Namespace) -> int:
     method: Any = args.method
     if args.tolerance is not None:
         method = _fast_with_tolerance(args.method, args.tolerance)
-    antenna = load_antenna(args.antenna)
+    antenna = load_antenna(args.antenna or DEFAULT_ANTENNA)
     recording = read_recording(args.recording)
-    if args.antenna == DEFAULT_ANTENNA:
+    if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(
             {recording.metadata.get("antenna", ""): [str(args.recording)]}, antenna.name
         )
@@ -138,7 +140,7 @@ def summary(name: str, data: dict[str, Any]) -> str:
     )
     x_c_text = _cm(data["x_c"])
     if data["status"] != "ok" and data["x_c"] is not None:
-        x_c_text += f" (best guess, not confirmed: {data['reason']})"
+        x_c_text += " (best guess, not confirmed: see the status)"
     lines = [
         f"{name}: method {data['method']}",
         f"  status          {data['status']}" + (f" ({data['reason']})" if data["reason"] else ""),
@@ -152,6 +154,12 @@ def summary(name: str, data: dict[str, Any]) -> str:
     interval = data.get("interval")
     if interval is not None:
         lines.append(f"  95 % interval   {_cm(interval[0])} to {_cm(interval[1])}")
+    before = data.get("diagnostics", {}).get("second_mode_narrowing", {}).get("interval_before")
+    if before is not None:
+        lines.append(
+            f"                  narrowed at the cap by omega_2 from {_cm(before[0])} to "
+            f"{_cm(before[1])}"
+        )
     probability = data.get("branch_probability")
     if probability:
         lines.append("  branch prob.    " + ", ".join(f"{p:.3f}" for p in probability))

@@ -28,7 +28,9 @@ def register(subparsers: Any) -> None:
         ),
     )
     parser.add_argument("recordings", nargs="+", type=Path, help="recordings (CSV)")
-    parser.add_argument("--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file")
+    parser.add_argument(
+        "--antenna", default=None, help=f"built-in name or TOML file (default {DEFAULT_ANTENNA})"
+    )
     parser.add_argument(
         "--method", choices=METHOD_NAMES, default="paper", help="the estimation method"
     )
@@ -70,7 +72,7 @@ def _run(args: argparse.Namespace) -> int:
 
     distinct_files(args.recordings)
     meshes = {path.stem: load_mesh(path) for path in args.objects}
-    antenna = load_antenna(args.antenna)
+    antenna = load_antenna(args.antenna or DEFAULT_ANTENNA)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"
@@ -87,7 +89,7 @@ def _run(args: argparse.Namespace) -> int:
                 str(path)
             ),
         )
-    if args.antenna == DEFAULT_ANTENNA:
+    if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(named, antenna.name)
     if not points:
         more = f" (and {len(left_out) - 1} more unreadable)" if len(left_out) > 1 else ""

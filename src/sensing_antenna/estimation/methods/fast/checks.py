@@ -393,12 +393,13 @@ def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]
         )
     elif not final.sure and not (result.reached_cap and accepted_at_cap(final, config)):
         if result.reached_cap:
-            found.append(
-                (
-                    Status.UNCERTAIN,
-                    f"not sure within {config.cap:g} s after t_1 ({final.note})",
+            why = final.note
+            if final.checks_passed:  # only the width held it back, and the cap's is wider
+                why = (
+                    f"the 95 % interval is {1000 * final.posterior.width:.1f} mm wide, more than "
+                    f"the {1000 * config.cap_tolerance:g} mm allowed at the cap"
                 )
-            )
+            found.append((Status.UNCERTAIN, f"not sure within {config.cap:g} s after t_1 ({why})"))
         else:
             found.append(
                 (

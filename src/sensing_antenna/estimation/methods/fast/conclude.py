@@ -105,15 +105,26 @@ def conclude_fast(
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)
-    disagreement = diag.get("second_mode_narrowing", {}).get("disagrees")
-    if reason is not None and disagreement:
-        reason += f"; {disagreement}"
+    narrowing = diag.get("second_mode_narrowing", {})
+    if reason is not None and narrowing.get("disagrees"):
+        reason += f"; {narrowing['disagrees']}"
+    link = evidence.antenna.link
+    if (
+        status is Status.UNCERTAIN
+        and reason is not None
+        and link.calibrated_t is not None
+        and link.mode2_scatter is None
+        and (final.near_top or (final.checks_passed and post.width > config.cap_tolerance))
+    ):
+        reason += (
+            "; a calibration that measures the second contact mode (link.mode2_scatter, five "
+            "contacts or more) could let omega_2 narrow it"
+        )
     if reason is not None and "branch_chosen_by" in diag:
         reason += (
             f"; the second contact mode then chose the branch of x_c = {post.x_c:.3f} m, and "
             "the interval is given on that branch"
         )
-    link = evidence.antenna.link
     if status is Status.UNCERTAIN and reason is not None and link.calibrated_t is None:
         reason += (
             f"; the antenna is not calibrated: its omega_1 is known to "

@@ -339,6 +339,11 @@ def _uncertainty_source(link: Link) -> str:
         return "a nominal T"
     if link.calibration_scatter is None:
         return "assumed: the calibration measured no scatter"
+    if link.calibration_scatter < link.frequency_uncertainty:
+        return (
+            f"the model's floor, above the calibration's scatter of "
+            f"{100 * link.calibration_scatter:.2g} %"
+        )
     return "the calibration's scatter"
 
 
