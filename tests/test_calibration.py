@@ -183,12 +183,18 @@ def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     (note,) = result.notes
     # 0.5 x (1 - 0.2 %) of the model's: -50.1 %
     assert note.startswith("p9: omega_1 = ") and "-50.1 % from the others' fit" in note
+    # it is known as such, in the calibration's JSON too
+    assert result.wrong_peaks == 1 and result.wrong_peak_points.tolist() == [
+        i == 9 for i in range(15)
+    ]
+    again = FrequencyCalibration.from_dict(result.to_dict())
+    assert again.wrong_peak_points.tolist() == result.wrong_peak_points.tolist()
     # A payload of 0.5 g the model lacks bends the whole curve: 8 of 15 points lie more than
     # 5 % from the median, model error, not wrong peaks: all stay in the scatter
     payload = natural_frequencies(replace(link, tip_mass=5e-4), PAPER_POINTS, 1)
     bent = calibrate_t_e(PAPER_POINTS, payload[:, 0], link)
     relative = payload[:, 0] / bent.omega1_fitted - 1.0
-    assert bent.wrong_peaks == 0
+    assert bent.wrong_peaks == 0 and bent.used.all() and not bent.notes
     assert bent.relative_scatter == pytest.approx(
         math.sqrt(float(np.sum(relative**2)) / (relative.size - 1)), rel=1e-9
     )
@@ -196,7 +202,7 @@ def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     # not wrong peaks: it stays in the scatter
     tip = k / PAPER_T_E * np.where(PAPER_POINTS >= 0.9, 0.99, 1.0)
     soft = calibrate_t_e(PAPER_POINTS, tip, link)
-    assert soft.wrong_peaks == 0 and soft.relative_scatter > 0.004
+    assert soft.wrong_peaks == 0 and soft.used.all() and soft.relative_scatter > 0.004
     calibrated = result.apply(paper_antenna())
     assert calibrated.link.calibration_scatter == result.relative_scatter
     # written and read back with the antenna, as the campaign's antenna.toml is
@@ -249,6 +255,10 @@ def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
     table.write_text("file,x_c\na.csv,0.4\n", encoding="utf-8")
     first, second = read_contact_points(paths, recordings, table)
     assert first == 0.4 and math.isnan(second)
+    # a table that names none of them is another set's: refused
+    table.write_text("file,x_c\nc.csv,0.4\n", encoding="utf-8")
+    with pytest.raises(CalibrationError, match=r"points\.csv: file: no row names any of the 2"):
+        read_contact_points(paths, recordings, table)
 
 
 def test_points_table_that_is_not_utf8_is_one_line(tmp_path: Path) -> None:

@@ -109,6 +109,9 @@ class FrequencyCalibration:
         near the calibrated model's), None when not looked for.
     omega2_fitted : ndarray, shape (n,), or None
         The calibrated model's omega_2 at each point (rad/s), None when not looked for.
+    left_out_as_wrong : ndarray of bool, shape (n,), or None
+        Points the fit left out as wrong spectral peaks or wrong known points (more than
+        :data:`WRONG_PEAK` from the others, and few); None when not recorded (older files).
     """
 
     t_e: float
@@ -124,6 +127,7 @@ class FrequencyCalibration:
     tip_mass: float | None = None
     omega2_measured: NDArray[np.float64] | None = None
     omega2_fitted: NDArray[np.float64] | None = None
+    left_out_as_wrong: NDArray[np.bool_] | None = None
 
     def __post_init__(self) -> None:
         n = self.contact_points.shape
@@ -133,6 +137,7 @@ class FrequencyCalibration:
             "used",
             "omega2_measured",
             "omega2_fitted",
+            "left_out_as_wrong",
         ):
             value = getattr(self, name)
             if value is not None and value.shape != n:
@@ -160,8 +165,9 @@ class FrequencyCalibration:
         how far the device departs from the fitted model along the link (a compliant contact, a
         base that is not a clamp, contacts away from the given points), which the fit cannot
         absorb. A point more than :data:`WRONG_PEAK` from the median, one of few
-        (:attr:`wrong_peak_points`), is a wrong spectral peak, not model error, and is left out
-        (:attr:`wrong_peaks`); NaN with fewer than 3 points left.
+        (:attr:`wrong_peak_points`), is a wrong spectral peak or a wrong known point, not model
+        error: left out of the fit and of this (:attr:`wrong_peaks`); NaN with fewer than 3
+        points left.
         """
         relative = self._relative_residuals()
         kept = relative[self.used & np.isfinite(relative) & ~self.wrong_peak_points]
@@ -195,18 +201,21 @@ class FrequencyCalibration:
 
     @property
     def wrong_peaks(self) -> int:
-        """Points used by the fit but left out of :attr:`relative_scatter` as wrong peaks."""
+        """Points left out of the fit and of :attr:`relative_scatter` as wrong peaks."""
         return int(self.wrong_peak_points.sum())
 
     @property
     def wrong_peak_points(self) -> NDArray[np.bool_]:
-        """Which points, shape (n,), are used by the fit but more than :data:`WRONG_PEAK` from
-        the median relative residual, when they are few (one, or a tenth of the points, of
-        :data:`MIN_WRONG_PEAK_POINTS` or more): left out of :attr:`relative_scatter` as wrong
-        peaks (or wrong known points). More are the model's error (a payload bends the whole
-        curve: 0.2 g puts 4 of 15 points beyond), and stay in the scatter."""
+        """Which points, shape (n,), are wrong spectral peaks or wrong known points: those the
+        fit left out as such (:attr:`left_out_as_wrong`), and any point it used that lies more
+        than :data:`WRONG_PEAK` from the median relative residual when such points are few
+        (one, or a tenth of the points, of :data:`MIN_WRONG_PEAK_POINTS` or more). More are the
+        model's error (a payload bends the whole curve: 0.2 g puts 4 of 15 points beyond)."""
         relative = self._relative_residuals()
-        return _wrong_peaks(relative, self.used & np.isfinite(relative))
+        found = _wrong_peaks(relative, self.used & np.isfinite(relative))
+        if self.left_out_as_wrong is not None:
+            found = found | self.left_out_as_wrong
+        return found
 
     def _relative_residuals(self) -> NDArray[np.float64]:
         """measured / fitted - 1 at every point, shape (n,)."""
@@ -254,6 +263,7 @@ class FrequencyCalibration:
                     "omega1_measured": _json_float(float(self.omega1_measured[i])),
                     "omega1_fitted": _json_float(float(self.omega1_fitted[i])),
                     "used": bool(self.used[i]),
+                    "wrong": bool(self.wrong_peak_points[i]),
                     **self._omega2_at(i),
                 }
                 for i in range(self.contact_points.size)
@@ -300,6 +310,11 @@ class FrequencyCalibration:
             tip_mass=None if data.get("tip_mass") is None else float(data["tip_mass"]),
             omega2_measured=column("omega2_measured") if with_omega2 else None,
             omega2_fitted=column("omega2_fitted") if with_omega2 else None,
+            left_out_as_wrong=(
+                np.array([bool(p["wrong"]) for p in points], dtype=bool)
+                if points and all("wrong" in p for p in points)
+                else None
+            ),
         )
 
 
@@ -443,31 +458,24 @@ def calibrate_t_e(
     k = np.full(x_c.shape, math.nan)
     k[on_link] = model_beta1_squared(link, x_c[on_link])
     t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
-    wrong = _wrong_peaks(w / (k / t_e) - 1.0, used)
-    if np.any(wrong) and not fit_tip_mass:
-        # a wrong peak or a wrong known point: the robust loss only tempers its pull
-        used = used & ~wrong
-        t_e, std_error = fit_inverse_t(k[used], w[used], loss=loss)
-        for i in map(int, np.flatnonzero(wrong)):
-            label = sources[i] if i < len(sources) else f"point {i}"
-            off = float(w[i] / (k[i] / t_e) - 1.0)
-            left_out.append(
-                f"{label}: omega_1 = {float(w[i]):.2f} rad/s lies {100 * off:+.1f} % from the "
-                "others' fit, a wrong spectral peak or a wrong known point (left out of the fit)"
-            )
     tip_mass = None
-    if fit_tip_mass:
-        joint = _with_tip_mass(link, x_c, on_link, w, used, k, t_e, loss)
-        if joint is not None:
-            t_e, std_error, tip_mass, k, kept = joint
-            for i in map(int, np.flatnonzero(used & ~kept)):
-                label = sources[i] if i < len(sources) else f"point {i}"
-                off = float(w[i] / (k[i] / t_e) - 1.0)
-                left_out.append(
-                    f"{label}: omega_1 = {float(w[i]):.2f} rad/s lies {100 * off:+.0f} % "
-                    "from the fit, a wrong spectral peak (left out of the fit)"
-                )
-            used = kept
+    joint = _with_tip_mass(link, x_c, on_link, w, used, k, t_e, loss) if fit_tip_mass else None
+    if joint is not None:
+        t_e, std_error, tip_mass, k, kept = joint
+        wrong = used & ~kept
+    else:
+        # a wrong peak or a wrong known point: the robust loss only tempers its pull
+        wrong = _wrong_peaks(w / (k / t_e) - 1.0, used)
+        if np.any(wrong):
+            t_e, std_error = fit_inverse_t(k[used & ~wrong], w[used & ~wrong], loss=loss)
+    for i in map(int, np.flatnonzero(wrong)):
+        label = sources[i] if i < len(sources) else f"point {i}"
+        off = float(w[i] / (k[i] / t_e) - 1.0)
+        left_out.append(
+            f"{label}: omega_1 = {float(w[i]):.2f} rad/s lies {100 * off:+.1f} % from the "
+            "others' fit, a wrong spectral peak or a wrong known point (left out of the fit)"
+        )
+    used = used & ~wrong
     return FrequencyCalibration(
         t_e=t_e,
         t_e_std_error=std_error,
@@ -481,6 +489,7 @@ def calibrate_t_e(
         sources=tuple(sources),
         notes=(*left_out, *notes),
         tip_mass=tip_mass,
+        left_out_as_wrong=wrong,
     )
 
 
@@ -758,11 +767,18 @@ def read_contact_points(
     Raises
     ------
     CalibrationError
-        Naming the file, line or recording and what is missing or wrong.
+        Naming the file, line or recording and what is missing or wrong; a table that names
+        none of the recordings.
     """
     if table is not None:
         rows = _read_points_table(table)
-        return [_point_of(table, rows, path) for path in paths]
+        points = [_point_of(table, rows, path) for path in paths]
+        if paths and all(math.isnan(x) for x in points):
+            raise CalibrationError(
+                f"{table}: file: no row names any of the {len(paths)} recording(s) given "
+                f"(by path as given or by file name; the first is {paths[0]})"
+            )
+        return points
     return [_metadata_point(recording.metadata.get("true_xc")) for recording in recordings]
 
 

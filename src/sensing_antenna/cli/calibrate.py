@@ -53,8 +53,9 @@ def register(subparsers: Any) -> None:
         "--loss",
         choices=LOSS_NAMES,
         default="soft_l1",
-        help="fit loss (scipy.optimize.least_squares); a robust one keeps a wrong spectral peak "
-        "from pulling T_e",
+        help="fit loss (scipy.optimize.least_squares); a robust one tempers points off the "
+        "others (one clearly off, a wrong peak or a wrong known point, is left out and T_e "
+        "fitted again whatever the loss)",
     )
     parser.add_argument(
         "--tip-mass",
@@ -110,6 +111,7 @@ def _run(args: argparse.Namespace) -> int:
 
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.frequency import (
+        MIN_TIP_MASS_POINTS,
         WRONG_PEAK,
         CalibrationError,
         calibrate_from_recordings,
@@ -143,7 +145,12 @@ def _run(args: argparse.Namespace) -> int:
     calibrated = replace(calibration.apply(antenna), name=name, description=description)
     sensor_lines: list[str] = []
     if not args.no_sensor:
-        calibrated, sensor_lines = _calibrate_sensor(calibrated, recordings, points, paths)
+        # a point the frequency fit found wrong may be a wrong known point: not for the sensor
+        known = [
+            math.nan if wrong else x_c
+            for x_c, wrong in zip(points, calibration.wrong_peak_points, strict=True)
+        ]
+        calibrated, sensor_lines = _calibrate_sensor(calibrated, recordings, known, paths)
     save_antenna(calibrated, args.out)
     print(
         f"T_e = {calibration.t_e:.5f} +- {calibration.t_e_std_error:.5f} s/m^2 "
@@ -155,7 +162,10 @@ def _run(args: argparse.Namespace) -> int:
     if calibration.tip_mass is not None:
         print(f"tip mass = {1e3 * calibration.tip_mass:.4g} g (fitted with T_e; link.tip_mass)")
     elif args.tip_mass:
-        print("tip mass: not fitted (fewer than 4 points), link.tip_mass kept")
+        print(
+            f"tip mass: not fitted (fewer than {MIN_TIP_MASS_POINTS} points that agree with one "
+            "another), link.tip_mass kept"
+        )
     scatter = calibration.relative_scatter
     print(
         f"model scatter {100.0 * scatter:.3f} % (rms relative residual; written as "
@@ -166,15 +176,15 @@ def _run(args: argparse.Namespace) -> int:
     print(_mode2_line(calibration))
     wrong = calibration.wrong_peak_points
     for i, x_c in enumerate(calibration.contact_points):
-        if not math.isfinite(float(x_c)):
-            continue  # no known point: its note below says so
+        if not 0.0 < float(x_c) <= antenna.link.length:
+            continue  # no known point on the link: its note below says so
         print(
             f"  {calibration.sources[i]}: x_c = {x_c:.4f} m, omega_1 measured "
             f"{calibration.omega1_measured[i]:.3f}, fitted {calibration.omega1_fitted[i]:.3f} rad/s"
             + _omega2_text(calibration, i)
             + (
-                f"; more than {100 * WRONG_PEAK:g} % off the others, left out of the scatter: "
-                "a wrong spectral peak or a wrong known point?"
+                f"; more than {100 * WRONG_PEAK:g} % off the others, left out of the fit: a "
+                "wrong spectral peak or a wrong known point?"
                 if wrong[i]
                 else ""
             )

@@ -74,7 +74,7 @@ def _run(args: argparse.Namespace) -> int:
     method: Any = args.method
     if args.tolerance is not None:
         method = _fast_with_tolerance(args.method, args.tolerance)
-    antenna = load_antenna(args.antenna or DEFAULT_ANTENNA)
+    antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     recording = read_recording(args.recording)
     if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(

@@ -72,7 +72,7 @@ def _run(args: argparse.Namespace) -> int:
 
     distinct_files(args.recordings)
     meshes = {path.stem: load_mesh(path) for path in args.objects}
-    antenna = load_antenna(args.antenna or DEFAULT_ANTENNA)
+    antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"

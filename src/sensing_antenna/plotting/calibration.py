@@ -44,10 +44,19 @@ def plot_calibration(calibration: FrequencyCalibration, link: Link, out_dir: str
         label=f"theoretical, T = {calibration.t_theoretical:.4f}",
     )
     used = calibration.used
+    wrong = calibration.wrong_peak_points & ~used
+    missing = ~used & ~wrong
     x = calibration.contact_points * _CM
     ax.plot(x[used], calibration.omega1_measured[used], "o", mfc="none", label="measured")
-    if np.any(~used):
-        ax.plot(x[~used], np.zeros(int(np.sum(~used))), "rx", label="no frequency found")
+    if np.any(wrong):
+        ax.plot(
+            x[wrong],
+            calibration.omega1_measured[wrong],
+            "r^",
+            label="left out: a wrong peak or a wrong known point",
+        )
+    if np.any(missing):
+        ax.plot(x[missing], np.zeros(int(np.sum(missing))), "rx", label="no frequency found")
     ax.set_ylabel("omega_1 (rad/s)")
     ax.set_title("Figure 10: calibration of the frequency-contact point function")
     ax.legend()

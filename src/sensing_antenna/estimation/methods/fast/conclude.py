@@ -114,6 +114,7 @@ def conclude_fast(
         and reason is not None
         and link.calibrated_t is not None
         and link.mode2_scatter is None
+        and not config.higher_modes
         and (final.near_top or (final.checks_passed and post.width > config.cap_tolerance))
     ):
         reason += (
