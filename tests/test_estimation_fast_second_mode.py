@@ -23,7 +23,7 @@ from sensing_antenna.antenna import (
 )
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.cli.estimate import summary
-from sensing_antenna.estimation import Evidence, estimate, gather
+from sensing_antenna.estimation import Evidence, OnlineEstimator, estimate, gather
 from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
 from sensing_antenna.estimation.methods.fast.second_mode import narrowed_by_second_mode
@@ -149,3 +149,18 @@ def test_a_mode2_scatter_without_a_calibrated_t_is_refused_in_one_line(tmp_path:
         AntennaConfigError, match=r"link\.mode2_scatter: .*needs link\.calibrated_t"
     ):
         load_antenna(path)
+
+
+def test_online_the_narrowed_answer_is_the_offline_one(near_top: tuple[Recording, float]) -> None:
+    recording, _ = near_top
+    offline = estimate(recording, WITH_MODE2, FastMethod())
+    online = OnlineEstimator(WITH_MODE2, recording.sample_period, FastMethod())
+    streamed = None
+    for k in range(recording.n_samples):
+        out = online.update(
+            recording.t[k], recording.theta[k], recording.force[k], recording.torque[k]
+        )
+        streamed = out if out is not None else streamed
+    streamed = streamed or online.finalize()
+    assert streamed.status is offline.status is Status.OK
+    assert streamed.x_c == offline.x_c and streamed.interval == offline.interval
