@@ -17,7 +17,7 @@ the area's ``run_*`` function, reproduces it.
 from __future__ import annotations
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 
 import fuzz_inputs as fz
 from sensing_antenna.estimation import ContactEstimate, Status
@@ -63,6 +63,27 @@ def test_estimators_ok_only_on_the_link_from_plausible_input(
 
 @FEWER
 @given(case=fz.identify_inputs())
+# the long run's finding (seed 45): one load sample at -1e300 late in the sweep, a margin of
+# 1e300, and an infinite contact threshold returned as a fit
+@example(
+    case=(
+        fz.Perturbation(
+            base=0,
+            force_scale=1.0,
+            torque_scale=1.0,
+            angle_scale=1.0,
+            flips=(True, False, False, False, True, True, False, True),
+            noise=0.0,
+            noise_seed=31498,
+            keep_from=0.0,
+            keep_to=1.0,
+            glitch=(0.9032152826140614, 6, -1e300),
+            sine_hz=None,
+            time_scale=1.0,
+        ),
+        1e300,
+    )
+)
 def test_identify_fits_a_usable_observer_or_names_the_problem(
     bases: fz.Bases, case: tuple[fz.Perturbation, float]
 ) -> None:

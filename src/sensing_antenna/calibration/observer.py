@@ -462,6 +462,11 @@ def identify_free_motion(
         )
         for move in moves
     )
+    if not math.isfinite(margin * peak):
+        raise IdentificationError(
+            f"contact threshold: {margin!r} x the largest filtered residual ({peak!r} N m) is not "
+            "finite: a load sample of the free motion is far out of range"
+        )
     joints = sorted({j + 1 for move in moved for j in move.joints})
     return ObserverFit(
         gain=gain,
