@@ -161,7 +161,10 @@ def test_the_calibration_measures_the_second_mode_and_the_model_carries_its_scat
     points = calibration.contact_points[measured]
     reference = np.asarray(natural_frequencies(device.link, points, 2), dtype=float)[:, 1]
     np.testing.assert_allclose(calibration.omega2_measured[measured], reference, rtol=0.01)
-    # its scatter about the calibrated model is written into the model, and survives the JSON
+    # its scatter about the calibrated model is written into the model, and survives the JSON;
+    # under 1 %: this device differs from the model in E alone, which T_e takes up, and the
+    # simulator's compliant contact lowers omega_2 by 0.2 to 0.35 % (docs/design-notes.md,
+    # "Higher contact modes"), which keeps it above zero
     assert 0.0 < calibration.mode2_scatter < 0.01
     assert model.link.mode2_scatter == pytest.approx(calibration.mode2_scatter)
     data = json.loads((calibrated / CALIBRATION_FILE).read_text("utf-8"))["calibration"]

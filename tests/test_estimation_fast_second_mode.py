@@ -9,7 +9,6 @@ use); the reference is where the simulated link touched (``true_xc``).
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -119,16 +118,20 @@ def test_an_omega2_no_contact_of_the_posterior_explains_is_not_used(
 
 
 def test_the_product_of_a_posterior_and_a_likelihood_that_excludes_it_is_none() -> None:
+    # a flat posterior on a 1 mm grid over two branches split at 0.77 m
     grid = np.linspace(0.3, 0.9, 601)
     density = np.full(grid.size, 1.0 / grid.size)
-    posterior = ContactPosterior(grid, density, 0.6, (0.315, 0.885), 0.95, (0.3, 0.9), (1.0,))
+    posterior = ContactPosterior(
+        grid, density, 0.6, (0.315, 0.885), 0.95, (0.3, 0.77, 0.9), (0.78, 0.22)
+    )
     assert posterior.times(np.zeros(grid.size)) is None
     narrow = posterior.times(np.exp(-0.5 * ((grid - 0.7) / 0.002) ** 2))
     assert narrow is not None
-    assert narrow.x_c == pytest.approx(0.7, abs=0.001)
-    # the 95 % highest-density region of a Gaussian: +-1.96 sigma
+    assert narrow.x_c == pytest.approx(0.7, abs=0.001)  # within a grid cell
+    # the 95 % highest-density region of a Gaussian: +-1.96 sigma, each end on the 1 mm grid
     assert narrow.width == pytest.approx(2 * 1.96 * 0.002, abs=0.0015)
-    assert math.isclose(sum(narrow.branch_probability), 1.0)
+    # all its mass on the first branch: 0.77 m lies 35 sigma from the likelihood's centre
+    assert narrow.branch_probability == pytest.approx((1.0, 0.0), abs=1e-12)
 
 
 def test_omega1_above_the_curves_top_is_not_made_ok_by_omega2() -> None:

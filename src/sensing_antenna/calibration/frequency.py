@@ -189,15 +189,26 @@ class FrequencyCalibration:
         than two thirds of them: it is searched within 5 % of the model's, so a link far off
         the model would leave only its nearest points, and a scatter that says too little.
         """
-        if self.omega2_measured is None or self.omega2_fitted is None:
+        kept, looked = self._mode2_residuals()
+        if kept.size < MIN_MODE2_POINTS or 3 * kept.size < 2 * looked:
             return math.nan
+        return math.sqrt(float(np.mean(kept**2)))
+
+    @property
+    def mode2_points(self) -> int:
+        """Points whose second contact mode was found near the model's (those
+        :attr:`mode2_scatter` is taken over); 0 when it was not looked for."""
+        return int(self._mode2_residuals()[0].size)
+
+    def _mode2_residuals(self) -> tuple[NDArray[np.float64], int]:
+        """omega_2's relative residuals where it was found, and at how many points it was
+        looked for (the points used, wrong peaks left out)."""
+        if self.omega2_measured is None or self.omega2_fitted is None:
+            return np.zeros(0), 0
         with np.errstate(divide="ignore", invalid="ignore"):
             relative = self.omega2_measured / self.omega2_fitted - 1.0
         points = self.used & np.isfinite(self.omega2_fitted) & ~self.wrong_peak_points
-        kept = relative[points & np.isfinite(relative)]
-        if kept.size < MIN_MODE2_POINTS or 3 * kept.size < 2 * int(points.sum()):
-            return math.nan
-        return math.sqrt(float(np.mean(kept**2)))
+        return relative[points & np.isfinite(relative)], int(points.sum())
 
     @property
     def wrong_peaks(self) -> int:
@@ -669,7 +680,7 @@ def calibrate_from_recordings(
         When fewer than two recordings are left to fit.
     """
     from sensing_antenna.calibration.observer import units_problem
-    from sensing_antenna.estimation import measure_omega1
+    from sensing_antenna.estimation import Evidence, gather, omega1_of
 
     if len(recordings) != len(contact_points):
         raise CalibrationError(
@@ -678,6 +689,7 @@ def calibrate_from_recordings(
     names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
     omega = np.full(len(recordings), math.nan)
     components = ["none"] * len(recordings)
+    evidences: list[Evidence | None] = [None] * len(recordings)
     notes: list[str] = []
     _, on_link, _ = points_on_link(
         np.asarray(contact_points, dtype=float), antenna.link.length, names
@@ -689,7 +701,8 @@ def calibrate_from_recordings(
         if problem is not None:
             notes.append(f"{names[i]}: {problem}")
             continue
-        measurement = measure_omega1(recording, antenna, band=band)
+        gathered = gather(recording, antenna)
+        measurement = omega1_of(gathered, band)
         value = float(measurement.omega1)
         if not (math.isfinite(value) and value > 0):
             notes.append(f"{names[i]}: no fundamental frequency found ({_describe(measurement)})")
@@ -701,6 +714,7 @@ def calibrate_from_recordings(
         else:
             omega[i] = value
             components[i] = measurement.component
+            evidences[i] = gathered if isinstance(gathered, Evidence) else None
     calibration = calibrate_t_e(
         contact_points,
         omega,
@@ -710,7 +724,7 @@ def calibrate_from_recordings(
         notes=notes,
         fit_tip_mass=fit_tip_mass,
     )
-    return _with_second_mode(calibration, recordings, antenna, components)
+    return _with_second_mode(calibration, evidences, antenna, components)
 
 
 #: Fewest points with a measured second contact mode for its scatter
@@ -720,15 +734,14 @@ MIN_MODE2_POINTS = 5
 
 def _with_second_mode(
     calibration: FrequencyCalibration,
-    recordings: Sequence[Any],
+    evidences: Sequence[Any],
     antenna: Antenna,
     components: Sequence[str],
 ) -> FrequencyCalibration:
     """``calibration`` with omega_2 measured at each point used, near the calibrated model's
     (:func:`~sensing_antenna.estimation.methods.paper.frequency.second_mode_peak`, on the
-    spectrum omega_1 was read from)."""
+    evidence and spectrum omega_1 was read from; None: no evidence)."""
     from sensing_antenna.beam import natural_frequencies
-    from sensing_antenna.estimation import EarlyOutcome, gather
     from sensing_antenna.estimation.methods.paper.frequency import second_mode_peak
 
     link = calibration.apply(antenna).link
@@ -739,8 +752,8 @@ def _with_second_mode(
         fitted[inside] = np.asarray(natural_frequencies(link, x_c[inside], 2), dtype=float)[:, 1]
     measured = np.full(x_c.shape, math.nan)
     for i in map(int, np.flatnonzero(calibration.used & np.isfinite(fitted))):
-        evidence = gather(recordings[i], antenna)
-        if isinstance(evidence, EarlyOutcome):
+        evidence = evidences[i]
+        if evidence is None:
             continue
         omega1 = float(calibration.omega1_measured[i])
         peak = second_mode_peak(evidence, components[i], float(fitted[i]), omega1)

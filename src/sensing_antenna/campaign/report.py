@@ -12,8 +12,6 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.campaign.figures import ReportFigures, draw_figures
 from sensing_antenna.campaign.report_devices import devices_section
@@ -166,10 +164,9 @@ def _scatter_lines(check: CalibrationCheck) -> list[str]:
 def _mode2_lines(check: CalibrationCheck) -> list[str]:
     """What the calibration measured of the second contact mode, in one paragraph."""
     calibration = check.calibration
-    measured = calibration.omega2_measured
-    if measured is None:
+    if calibration.omega2_measured is None:
         return ["The calibration did not look for the second contact mode."]
-    count = int(np.isfinite(measured[calibration.used]).sum())
+    count = calibration.mode2_points
     scatter = calibration.mode2_scatter
     if not math.isfinite(scatter) or check.applied_mode2_scatter is None:
         return [

@@ -203,12 +203,9 @@ def _run(args: argparse.Namespace) -> int:
 
 def _mode2_line(calibration: FrequencyCalibration) -> str:
     """What the calibration measured of the second contact mode, in one line."""
-    import numpy as np
-
     from sensing_antenna.calibration.frequency import MIN_MODE2_POINTS
 
-    measured = calibration.omega2_measured
-    count = int(np.isfinite(measured[calibration.used]).sum()) if measured is not None else 0
+    count = calibration.mode2_points
     scatter = calibration.mode2_scatter
     if math.isfinite(scatter):
         return (

@@ -8,7 +8,8 @@ pipeline):
 - the two steps of ``estimate``: :func:`gather` (the front end on a recording: an
   :class:`Evidence` or an :class:`EarlyOutcome`) and :func:`conclude` (a method's estimate from
   it); :class:`FrontEnd`, the front end as a streaming object; :class:`FrontTrace`, what it saw;
-- :func:`measure_omega1`, Estimator 1's frequency measurement alone;
+- :func:`measure_omega1`, Estimator 1's frequency measurement alone (:func:`omega1_of` on
+  evidence already gathered);
 - :class:`ContactEstimate`, :class:`Status`, :class:`EstimatorConfig`;
 - what a method is: :class:`EstimationMethod`, :class:`EarlyStopping`, :class:`Sessioned`;
 - :class:`FastMethod` and :class:`FastConfig`, the fast method and its settings.
@@ -33,7 +34,13 @@ if TYPE_CHECKING:
     from sensing_antenna.estimation.methods.fast import FastConfig, FastMethod
     from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement
     from sensing_antenna.estimation.online import OnlineEstimator
-    from sensing_antenna.estimation.pipeline import conclude, estimate, gather, measure_omega1
+    from sensing_antenna.estimation.pipeline import (
+        conclude,
+        estimate,
+        gather,
+        measure_omega1,
+        omega1_of,
+    )
     from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = [
@@ -56,6 +63,7 @@ __all__ = [
     "estimate",
     "gather",
     "measure_omega1",
+    "omega1_of",
 ]
 
 _WHERE = {
@@ -67,6 +75,7 @@ _WHERE = {
     "conclude": "pipeline",
     "estimate": "pipeline",
     "measure_omega1": "pipeline",
+    "omega1_of": "pipeline",
     "gather": "pipeline",
     "FrontEnd": "front.frontend",
     "EarlyOutcome": "front.outcome",

@@ -42,6 +42,7 @@ __all__ = [
     "estimate",
     "gather",
     "measure_omega1",
+    "omega1_of",
     "search_band",
 ]
 
@@ -169,7 +170,12 @@ def measure_omega1(
     """
     cfg = config if config is not None else EstimatorConfig()
     search = band if band is not None else search_band(antenna.link, cfg)
-    gathered = gather(recording, antenna, cfg)
+    return omega1_of(gather(recording, antenna, cfg), search)
+
+
+def omega1_of(gathered: Gathered, band: tuple[float, float]) -> FrequencyMeasurement:
+    """:func:`measure_omega1` on what :func:`gather` returned, searched in ``band`` (rad/s):
+    for a caller that reads more of the same evidence (a calibration's omega_2)."""
     if isinstance(gathered, EarlyOutcome):
         return FrequencyMeasurement(
             omega1=math.nan,
@@ -177,12 +183,12 @@ def measure_omega1(
             component="none",
             t_start=math.nan,
             t_end=math.nan,
-            band=search,
+            band=band,
             clear=False,
             reason=gathered.reason,
         )
     # Estimator 1 on the evidence at t_e
-    measurement = evidence_frequency(gathered, search)
+    measurement = evidence_frequency(gathered, band)
     if gathered.gap is not None:
         return dataclasses.replace(measurement, reason=gathered.gap)
     if not gathered.complete:

@@ -78,11 +78,8 @@ def conclude_fast(
         post, second_mode = branch_at_cap(evidence, final, candidates, answers)
         diag.update(second_mode)
         if post is not final.posterior and final.statics is not None:
-            # The ratio's agreement is judged again at the chosen branch's maximum
-            model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c)))
-            ratio_z, _ = ratio_check(final.statics, post.x_c, model_sd, config)
-            # and the frequency's
-            frequency_z = _frequency_z(evidence, final.omega1, final.omega1_se, post, config)
+            # The ratio's and the frequency's agreement judged again at the branch's maximum
+            ratio_z, _, frequency_z, _ = _judged_at(evidence, final, post, config)
             final = dataclasses.replace(
                 final, posterior=post, ratio_z=ratio_z, frequency_z=frequency_z
             )
@@ -188,14 +185,7 @@ def _narrowed(
     post, notes = narrowed_by_second_mode(evidence, final, final.posterior, config)
     if post is None:
         return final, notes
-    found: list[str] = []
-    ratio_z = final.ratio_z
-    if final.statics is not None:
-        model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c)))
-        ratio_z, note = ratio_check(final.statics, post.x_c, model_sd, config)
-        found.append(note)
-    frequency_z, note = _frequency_judged(evidence, final.omega1, final.omega1_se, post, config)
-    found.append(note)
+    ratio_z, ratio_note, frequency_z, frequency_note = _judged_at(evidence, final, post, config)
     objection, answer = second_mode_objection(
         post,
         contact_candidates(evidence.antenna.link, final.omega1, post),
@@ -204,8 +194,7 @@ def _narrowed(
         final.end_index,
         second_mode_chooser(evidence),
     )
-    found.append(objection)
-    found = [text for text in found if text]
+    found = [text for text in (ratio_note, frequency_note, objection) if text]
     note = "; ".join(found)
     if not found and post.width > config.cap_tolerance:
         note = (
@@ -235,17 +224,18 @@ def _free_plane_share(final: WindowEstimate, push_direction: NDArray[np.float64]
     return float(free_plane_share(final.fit, push_direction)[k])
 
 
-def _frequency_z(
-    evidence: Evidence,
-    omega1: float,
-    omega1_se: float,
-    post: ContactPosterior,
-    config: FastConfig,
-) -> float:
-    """The frequency's distance from the sensing curve at ``post``'s maximum, in its standard
-    deviations (:func:`.checks.frequency_check`), the bent link's term included as the windows
-    have it (:func:`.search.scan_inputs`)."""
-    return _frequency_judged(evidence, omega1, omega1_se, post, config)[0]
+def _judged_at(
+    evidence: Evidence, final: WindowEstimate, post: ContactPosterior, config: FastConfig
+) -> tuple[float, str, float, str]:
+    """The window's ratio and frequency judged again at ``post``'s maximum: the ratio's
+    distance in its standard deviations (:func:`.checks.ratio_check`, the window's own when it
+    has no statics) and why it disagrees, then the frequency's (:func:`_frequency_judged`)."""
+    ratio_z, ratio_note = final.ratio_z, ""
+    if final.statics is not None:
+        model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c)))
+        ratio_z, ratio_note = ratio_check(final.statics, post.x_c, model_sd, config)
+    frequency_z, note = _frequency_judged(evidence, final.omega1, final.omega1_se, post, config)
+    return ratio_z, ratio_note, frequency_z, note
 
 
 def _frequency_judged(
@@ -255,9 +245,11 @@ def _frequency_judged(
     post: ContactPosterior,
     config: FastConfig,
 ) -> tuple[float, str]:
-    """:func:`_frequency_z` and why the frequency does not allow ``post``'s maximum ("" when
-    it does): farther from the curve there than ``max_disagreement`` standard deviations, or
-    as far above the curve's top, where no contact point rings."""
+    """The frequency's distance from the sensing curve at ``post``'s maximum, in its standard
+    deviations (:func:`.checks.frequency_check`, the bent link's term included as the windows
+    have it, :func:`.search.scan_inputs`), and why it does not allow that maximum ("" when it
+    does): farther from the curve there than ``max_disagreement`` standard deviations, or as
+    far above the curve's top, where no contact point rings."""
     link = evidence.antenna.link
     table = curve_table(link, post.branch_edges[0], post.branch_edges[-1], config.grid_step)
     slope = float(np.interp(post.x_c, table.grid, table.slope))
