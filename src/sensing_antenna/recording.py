@@ -54,6 +54,7 @@ __all__ = [
     "parse_metadata",
     "read_recording",
     "resample_uniform",
+    "sample_period_problem",
     "write_recording",
 ]
 
@@ -219,6 +220,18 @@ def check_sampling(
     )
 
 
+def sample_period_problem(period: float) -> str | None:
+    """Why ``period`` (s) is no sensor's sample period ("<period> s, shorter than ..."), or
+    None. With the period's own 2 % slack (:data:`PERIOD_CONSISTENCY`): time stamps far from
+    zero step by a period rounded."""
+    if period < (1.0 - PERIOD_CONSISTENCY) * MIN_SAMPLE_PERIOD:
+        return (
+            f"{format_value(period)} s, shorter than {MIN_SAMPLE_PERIOD:g} s, faster than any "
+            "force/torque sensor"
+        )
+    return None
+
+
 def _time_span_problem(t: NDArray[np.float64], period: float) -> tuple[int, str] | None:
     """Why strictly increasing time stamps ``t`` (s) cannot be put on a grid of step ``period``
     (s) of at least :data:`MIN_SAMPLE_PERIOD` within :data:`MAX_SAMPLES` and
@@ -228,12 +241,9 @@ def _time_span_problem(t: NDArray[np.float64], period: float) -> tuple[int, str]
     when the largest step is the first) and the problem.
     """
     n = t.shape[0]
-    # with the period's own 2 % slack: time stamps far from zero step by a period rounded
-    if period < (1.0 - PERIOD_CONSISTENCY) * MIN_SAMPLE_PERIOD:
-        return 1, (
-            f"a sample period of {format_value(period)} s, shorter than {MIN_SAMPLE_PERIOD:g} s, "
-            "faster than any force/torque sensor: time stamps in another unit than seconds?"
-        )
+    too_short = sample_period_problem(period)
+    if too_short is not None:
+        return 1, f"a sample period of {too_short}: time stamps in another unit than seconds?"
     span = float(t[-1]) - float(t[0])
     periods = span / period
     if n <= MAX_SAMPLES and periods < min(MAX_SAMPLES, MAX_PERIODS_PER_SAMPLE * n):

@@ -202,7 +202,7 @@ def calibrate_sensor(
         )
     kept = [(h, n) for h, n in zip(holds, used, strict=True) if h.sweep in sweeps]
     holds = [h for h, _ in kept]
-    terms = [t for s in sweeps for t in _PLANE_TERMS[s]]
+    terms = _terms(sweeps)
     rigidity = 1.0 / antenna.link.bending_compliance
     reaction = np.array([h.reaction for h in holds])
     moment = np.array([h.moment for h in holds])
@@ -258,19 +258,17 @@ def calibrate_sensor(
     adopted = tuple(
         s for s in sweeps if _rms(held_out[direction == s]) < _rms(before[direction == s])
     )
-    names = [t for s in adopted for t in _PLANE_TERMS[s]]
-    if adopted != sweeps and names:
-        params = fitted(names)
-    left = residuals(params, names)[: len(holds)] if names else before
+    names = _terms(adopted)
+    if adopted != sweeps:  # none adopted: no terms, no correction
+        params = fitted(names) if names else identity(names)
+    left = residuals(params, names)[: len(holds)]
     # the ratio's scatter left, over the degrees of freedom the fitted in-plane terms leave
     # (two per sweep direction adopted)
     finite = left[np.isfinite(left)]
     dof = max(finite.size - 2 * len(adopted), 1)
     scatter = min(math.sqrt(float(np.sum(finite**2)) / dof), 1.0)
     return SensorCalibration(
-        correction=replace(
-            correction(params, names) if names else SensorCorrection(), ratio_scatter=scatter
-        ),
+        correction=replace(correction(params, names), ratio_scatter=scatter),
         sweeps=sweeps,
         sources=tuple(n for _, n in kept),
         notes=tuple(notes),
@@ -279,6 +277,11 @@ def calibrate_sensor(
         ratio_rms_held_out=_rms(held_out),
         adopted=adopted,
     )
+
+
+def _terms(sweeps: Sequence[str]) -> list[str]:
+    """The correction's terms the sweep directions ``sweeps`` fix, in order."""
+    return [t for s in sweeps for t in _PLANE_TERMS[s]]
 
 
 def _rms(values: FloatArray) -> float:

@@ -24,11 +24,10 @@ from types import MappingProxyType
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import (
     FORMAT_NAME,
-    MIN_SAMPLE_PERIOD,
-    PERIOD_CONSISTENCY,
     RecordingError,
     parse_header,
     parse_metadata,
+    sample_period_problem,
 )
 
 __all__ = [
@@ -139,13 +138,13 @@ def read_header(lines: Sequence[str], source: str, first_line: int = 1) -> Strea
             "missing: a live stream gives its sample period before its samples",
             metadata=True,
         )
-    if float(metadata["sample_period"]) < (1.0 - PERIOD_CONSISTENCY) * MIN_SAMPLE_PERIOD:
+    too_short = sample_period_problem(float(metadata["sample_period"]))
+    if too_short is not None:
         raise RecordingError(
             source,
             first_line + index,
             "sample_period",
-            f"{metadata['sample_period']} s, shorter than {MIN_SAMPLE_PERIOD:g} s, faster than "
-            "any force/torque sensor: in another unit than seconds?",
+            f"{too_short}: in another unit than seconds?",
             metadata=True,
         )
     return StreamHeader(metadata, tuple(columns), source)
