@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -74,9 +75,18 @@ def test_a_frequency_just_above_the_top_finds_the_top_within_its_tolerance(
     assert -top.fun == pytest.approx(100.5763, abs=1e-4)
     assert main(["beam", "--omega1", "100.58", "--tolerance", "0.1", "--json"]) == 0
     (found,) = json.loads(capsys.readouterr().out)["candidates"]
+    # the answer is the curve's extremum itself, where its slope is zero
     assert found["x_c"] == pytest.approx(top.x, abs=1e-4) and found["slope"] == 0.0
     assert main(["beam", "--omega1", "100.58", "--tolerance", "0.001"]) == 1
-    assert "(16.04884, 100.5763] rad/s" in capsys.readouterr().err
+    printed = re.search(r"\(([0-9.]+), ([0-9.]+)\] rad/s", capsys.readouterr().err)
+    assert printed is not None
+    low, high = float(printed.group(1)), float(printed.group(2))
+    # the range's low end is the limit x_c -> 0, the clamped-free cantilever's fundamental
+    # (beta_1 l = 1.87510407, Euler-Bernoulli), and both ends are printed to 7 digits: enough
+    # to show the top below 100.58 by more than the tolerance
+    cantilever = 1.875104068711961**2 / (link.theoretical_t * link.length**2)
+    assert low == pytest.approx(cantilever, rel=1e-6)
+    assert high == pytest.approx(-top.fun, abs=1e-4) and high < 100.58 - 0.001
     # the tolerance is --omega1's: with --xc it is refused, not ignored
     assert main(["beam", "--xc", "0.5", "--tolerance", "1"]) == 2
     assert "--tolerance: the uncertainty of --omega1" in capsys.readouterr().err

@@ -13,6 +13,7 @@ A world point is p_w = R p_a + t.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -32,8 +33,9 @@ BASE_POSE_KEY = "base_pose"
 ORTHONORMAL_TOLERANCE = 1e-4
 
 #: Largest magnitude of any number of a pose: a rotation's entries and a unit quaternion's are
-#: at most 1, a position beyond 100 m is refused with its own message; beyond this, a number's
-#: square overflows.
+#: at most 1, a position beyond 100 m is refused with its own message; this bound keeps every
+#: product the checks form (a determinant cubes the entries) far from overflow, and a number
+#: beyond it is no pose's.
 MAX_POSE_NUMBER = 1e6
 
 #: Farthest a base may sit from the world's origin (m): 100 m holds a robot's workspace in any
@@ -69,9 +71,8 @@ class BasePose:
         position = np.array(self.position, dtype=float).reshape(3)
         if not (np.all(np.isfinite(rotation)) and np.all(np.isfinite(position))):
             raise FieldError(BASE_POSE_KEY, "rotation and position must be finite numbers")
-        # scaled by the largest coordinate, as hypot does: the plain norm of 1e300 overflows
-        scale = float(np.abs(position).max())
-        distance = scale * float(np.linalg.norm(position / scale)) if scale > 0 else 0.0
+        # hypot scales by the largest coordinate: the plain norm of 1e300 overflows
+        distance = math.hypot(*(float(x) for x in position))
         if distance > MAX_BASE_DISTANCE:
             raise FieldError(
                 BASE_POSE_KEY,
