@@ -115,11 +115,13 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
     if html is not None:
         written.append(html)
     summary = contact_map.summary()
-    decision = (
-        "not recognised (fewer than 10 points)"
-        if contact_map.recognition is None
-        else contact_map.recognition.decision
-    )
+    recognition = contact_map.recognition
+    if recognition is None:
+        decision = "not recognised (fewer than 10 points)"
+    elif recognition.undecided:
+        decision = f"undecided ({' or '.join(recognition.candidates)})"
+    else:
+        decision = f"{recognition.decision} ({recognition.best.sizes_text()})"
     statuses = ", ".join(f"{k} {v}" for k, v in sorted(summary["statuses"].items()))
     print(
         f"{summary['n_used']} of {summary['n_recordings']} points used ({statuses}); "

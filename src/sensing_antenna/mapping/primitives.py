@@ -41,9 +41,13 @@ import trimesh
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-__all__ = ["PRIMITIVES", "Primitive", "local_coordinates", "primitive"]
+__all__ = ["PRIMITIVES", "Growth", "Primitive", "local_coordinates", "primitive"]
 
 FloatArray = NDArray[np.float64]
+
+#: One way a shape grows (:meth:`Primitive.growths`): the sizes it changes (indices into
+#: ``size_names``) and the parameter vector's change per metre of growth.
+Growth = tuple[tuple[int, ...], FloatArray]
 
 
 @dataclass(frozen=True)
@@ -70,6 +74,7 @@ class Primitive:
     _sizes: Callable[[FloatArray], FloatArray]
     _mesh: Callable[[FloatArray], trimesh.Trimesh] | None
     _size_entries: Callable[[FloatArray], FloatArray] = lambda sizes: sizes
+    _growths: Callable[[FloatArray], tuple[Growth, ...]] = lambda parameters: ()
 
     def signed_distance(self, parameters: FloatArray, points: FloatArray) -> FloatArray:
         """d(p) (m), shape (n,), for points of shape (n, 3) (m)."""
@@ -83,6 +88,14 @@ class Primitive:
         """The parameter vector's entries after the pose for sizes (m) in the order of
         ``size_names``: the inverse of :meth:`sizes` (a torus's hole is major - minor)."""
         return np.asarray(self._size_entries(np.asarray(sizes, dtype=float)), dtype=float)
+
+    def growths(self, parameters: FloatArray) -> tuple[Growth, ...]:
+        """Each way the shape can grow at one end of a size while the rest of it stays: the
+        sizes it changes (indices into ``size_names``) and the parameter vector's change per
+        metre the end moves outward. A box's extent grows at either face, a cylinder's height
+        or a capsule's length at either end, a cone at its base along its slant (its radius
+        and height together); a sphere's or a torus's sizes have no ends."""
+        return self._growths(np.asarray(parameters, dtype=float))
 
     def mesh(self, parameters: FloatArray) -> trimesh.Trimesh | None:
         """The shape as a trimesh mesh (None for the unbounded plane)."""
@@ -198,6 +211,37 @@ def _box(parameters: FloatArray, points: FloatArray) -> FloatArray:
     return np.asarray(outside + np.minimum(q.max(axis=1), 0.0))
 
 
+def _axis_ends(size: int, axis: int) -> Callable[[FloatArray], tuple[Growth, ...]]:
+    """The growths of a size measured along the shape's own ``axis`` between two ends, the
+    centre halfway: the parameter at 6 + ``size`` grows and the centre follows the moving end
+    by half."""
+
+    def growths(parameters: FloatArray) -> tuple[Growth, ...]:
+        direction = _rotation(parameters)[:, axis]
+        ends = []
+        for sense in (1.0, -1.0):
+            change = np.zeros(len(parameters))
+            change[0:3] = 0.5 * sense * direction
+            change[6 + size] = 1.0
+            ends.append(((size,), change))
+        return tuple(ends)
+
+    return growths
+
+
+def _box_growths(parameters: FloatArray) -> tuple[Growth, ...]:
+    return tuple(g for axis in range(3) for g in _axis_ends(axis, axis)(parameters))
+
+
+def _cone_growth(parameters: FloatArray) -> tuple[Growth, ...]:
+    # the base moves out along -Z by one metre and the slant goes on: the radius grows by R / h
+    change = np.zeros(len(parameters))
+    change[0:3] = -_rotation(parameters)[:, 2]
+    change[6] = parameters[6] / parameters[7]
+    change[7] = 1.0
+    return (((0, 1), change),)
+
+
 def _cone_mesh(parameters: FloatArray) -> trimesh.Trimesh:
     mesh = trimesh.creation.cone(radius=parameters[6], height=parameters[7], sections=64)
     mesh.apply_transform(_transform(parameters))
@@ -241,6 +285,7 @@ PRIMITIVES: dict[str, Primitive] = {
             _cylinder,
             lambda p: p[6:8],
             _with_pose(lambda p: trimesh.creation.cylinder(radius=p[6], height=p[7], sections=64)),
+            _growths=_axis_ends(1, 2),
         ),
         Primitive(
             "capsule",
@@ -252,6 +297,7 @@ PRIMITIVES: dict[str, Primitive] = {
             _with_pose(
                 lambda p: trimesh.creation.capsule(height=p[7], radius=p[6], count=[32, 32])
             ),
+            _growths=_axis_ends(1, 2),
         ),
         Primitive(
             "cone",
@@ -261,6 +307,7 @@ PRIMITIVES: dict[str, Primitive] = {
             _cone,
             lambda p: p[6:8],
             _cone_mesh,
+            _growths=_cone_growth,
         ),
         Primitive(
             "torus",
@@ -287,6 +334,7 @@ PRIMITIVES: dict[str, Primitive] = {
             _box,
             lambda p: p[6:9],
             _with_pose(lambda p: trimesh.creation.box(extents=p[6:9])),
+            _growths=_box_growths,
         ),
     )
 }

@@ -45,6 +45,17 @@ costs a class no more than its being wrong costs, and cannot on its own decide b
 shapes (the truncated residual of Torr's robust model selection, "Geometric motion segmentation
 and model selection", Phil. Trans. R. Soc. A 356, 1998).
 
+Sizes. Each size of a class's fit carries a standard deviation: the Gauss-Newton covariance
+(J^T J)^-1 of the fit's parameters, J the Jacobian of the evidence's normalised residuals at the
+fit (the points' d_i / sigma_i, the lines' and the swept links' residuals; not the extent prior,
+and not the points counted wrong), carried to the sizes, times the square root of the
+overdispersion c. A size the evidence leaves free (a box's extent along an axis where one face
+only was touched: the face holds, the far one may be anywhere behind it) has no standard
+deviation: it is reported as the smallest the points allow, the extent prior's, and only that
+lower bound is measured. The points' errors are not independent (a face touched at its edges
+reads outward at each), so the spread of sizes about the truth is wider than these standard
+deviations alone; ``benchmarks/eval_explore.py`` measures it.
+
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
 points pin the richer class's extra parameters to the simpler shape (a capsule fitted to a
 sphere shrinks its segment to nothing) and wrong when they leave them free: points along one
@@ -105,6 +116,7 @@ __all__ = [
     "point_chi2",
     "recognise",
     "shape_gap",
+    "size_std",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -170,6 +182,14 @@ FREE_MARGIN = 0.02
 #: A free-space sample farther outside a fit than this (m) at the start of a refinement stays
 #: out of it while the refinement moves the shape (the score checks every sample).
 FREE_ACTIVE = 0.01
+
+#: Step (m or rad) of the central differences of a fit's Jacobian for its sizes' standard
+#: deviations: a micrometre, far below the points' scatter and far above rounding.
+JACOBIAN_STEP = 1e-6
+
+#: Eigenvalues of J^T J below this fraction of the largest are directions the points do not
+#: hold (a box's hidden extent with its centre): sizes moving along them are free.
+EIGEN_FLOOR = 1e-12
 
 #: Where along that stretch, as fractions of it.
 _LINE_FRACTIONS = (0.125, 0.25, 0.5, 1.0)
@@ -281,6 +301,10 @@ class ClassFit:
         Fitted parameters (m, rad; a mesh: its 4 x 4 pose as ``m00`` ... ``m23``).
     sizes : Mapping[str, float]
         The class's sizes (m).
+    size_std : Mapping[str, float]
+        Each size's standard deviation (m; module docstring, "Sizes."), inf for a size the
+        points leave free (a box's hidden extent: only its lower bound, the size itself, is
+        measured); empty for a user mesh, whose size is its own.
     rms : float
         RMS of the point-to-surface distances (m).
     chi2 : float
@@ -315,8 +339,23 @@ class ClassFit:
     swept_chi2: float = 0.0
     weight: float = math.nan
     score: float = math.nan
+    size_std: Mapping[str, float] = field(default_factory=dict)
     vector: FloatArray = field(default_factory=lambda: np.zeros(0), compare=False, repr=False)
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
+
+    def sizes_text(self) -> str:
+        """The sizes in mm for reading: ``radius 18.7 +- 1.0 mm``, a size the points leave free
+        as ``height at least 20.5 mm``, a user mesh's as its own; ``-`` without sizes."""
+        parts = []
+        for name, value in self.sizes.items():
+            std = self.size_std.get(name)
+            if std is None:
+                parts.append(f"{name} {1000 * value:.1f} mm")
+            elif math.isfinite(std):
+                parts.append(f"{name} {1000 * value:.1f} +- {1000 * std:.1f} mm")
+            else:
+                parts.append(f"{name} at least {1000 * value:.1f} mm")
+        return ", ".join(parts) or "-"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able (SI units)."""
@@ -324,6 +363,10 @@ class ClassFit:
             "class": self.name,
             "parameters": {k: float(v) for k, v in self.parameters.items()},
             "sizes": {k: float(v) for k, v in self.sizes.items()},
+            # null: a size the points leave free (only its lower bound is measured)
+            "size_std": {
+                k: float(v) if math.isfinite(v) else None for k, v in self.size_std.items()
+            },
             "rms_m": float(self.rms),
             "chi2": float(self.chi2),
             "line_chi2": float(self.line_chi2),
@@ -662,7 +705,19 @@ def fit_primitive(
     x = min(candidates, key=total) if len(candidates) > 1 else candidates[0]
     distance = model.signed_distance(x, p)
     sigma = _normal_sigma(cov, model.normals(x, p))
-    return _scored(
+    # the evidence alone, without the extent prior, the points counted wrong left out
+    kept = np.where(point_z2(x, sigma) > outlier_cap(sigma, spread), np.inf, sigma)
+
+    def evidence(v: FloatArray) -> FloatArray:
+        return np.concatenate(
+            [
+                model.signed_distance(v, p) / kept,
+                line_residuals(v, kept),
+                swept_residuals(v, spaces),
+            ]
+        )
+
+    fitted = _scored(
         model.name,
         dict(zip(model.parameter_names, x.tolist(), strict=True)),
         dict(zip(model.size_names, model.sizes(x).tolist(), strict=True)),
@@ -676,6 +731,57 @@ def fit_primitive(
         swept=swept_residuals(x, spaces),
         spaces=spaces,
     )
+    std = size_std(model, x, evidence, spread, float(np.median(sigma)))
+    return dataclasses.replace(
+        fitted, size_std=dict(zip(model.size_names, std.tolist(), strict=True))
+    )
+
+
+def size_std(
+    shape: Primitive,
+    x: FloatArray,
+    residuals: Callable[[FloatArray], FloatArray],
+    spread: float,
+    point_std: float,
+) -> FloatArray:
+    """Standard deviation (m) of each of ``shape``'s sizes at the fit ``x``, shape (n_sizes,):
+    the Gauss-Newton covariance (J^T J)^-1 of the normalised ``residuals`` (a function of the
+    parameter vector; J by central differences of :data:`JACOBIAN_STEP`) carried to the sizes.
+
+    A size is left free by the points (inf) when it moves along a direction J^T J does not hold
+    (its eigenvalue below :data:`EIGEN_FLOOR` of the largest), when its standard deviation
+    exceeds the points' spread ``spread`` (m), or when the shape, grown at one of its ends
+    (:meth:`Primitive.growths`) by D, raises the residuals' sum of squares by less than 1 as it
+    grows on to 2 D, D = max(2 std, 3 ``point_std``) with ``point_std`` the points' typical
+    standard deviation (m). A fit held at the smallest size the points allow has its far end at
+    the outermost points, where the distance's derivative differs on either side; growing it
+    first releases the points within their noise of that end, and then meets nothing when
+    nothing is there, while an end that points hold resists the more the farther it moves.
+    """
+    n = len(x)
+    at_x = residuals(x)
+    jacobian = np.empty((len(at_x), n))
+    gradient = np.empty((len(shape.size_names), n))
+    for j in range(n):
+        shift = np.zeros(n)
+        shift[j] = JACOBIAN_STEP
+        jacobian[:, j] = (residuals(x + shift) - residuals(x - shift)) / (2 * JACOBIAN_STEP)
+        gradient[:, j] = (shape.sizes(x + shift) - shape.sizes(x - shift)) / (2 * JACOBIAN_STEP)
+    information = jacobian.T @ jacobian
+    if not np.all(np.isfinite(information)):
+        return np.full(len(shape.size_names), np.inf)
+    eigenvalues, eigenvectors = np.linalg.eigh(information)
+    floor = EIGEN_FLOOR * max(float(eigenvalues[-1]), np.finfo(float).tiny)
+    variance = np.sum((gradient @ eigenvectors) ** 2 / np.maximum(eigenvalues, floor), axis=1)
+    std = np.where(np.sqrt(variance) <= spread, np.sqrt(variance), np.inf)
+    for sizes, change in shape.growths(x):
+        step = max(2.0 * float(np.max(std[list(sizes)])), 3.0 * point_std)
+        if not math.isfinite(step):
+            continue
+        near, far = (float(np.sum(residuals(x + k * step * change) ** 2)) for k in (1.0, 2.0))
+        if not far >= near + 1.0:
+            std[list(sizes)] = np.inf
+    return np.asarray(std)
 
 
 def fit_mesh(
@@ -940,7 +1046,15 @@ def recognise(
     tightest = min(fits, key=lambda f: f.chi2)
     c = max(1.0, tightest.chi2 / max(len(p) - tightest.dof, 1))
     n_log = math.log(len(p))
-    fits = [dataclasses.replace(f, score=f.chi2 / c + f.dof * n_log) for f in fits]
+    # the sizes' standard deviations widened by the same overdispersion
+    fits = [
+        dataclasses.replace(
+            f,
+            score=f.chi2 / c + f.dof * n_log,
+            size_std={k: v * math.sqrt(c) for k, v in f.size_std.items()},
+        )
+        for f in fits
+    ]
     fits.sort(key=lambda f: f.score)
     raw = np.exp(-0.5 * (np.array([f.score for f in fits]) - fits[0].score))
     weights = raw / raw.sum()

@@ -194,13 +194,16 @@ def report(contact_map: ContactMap) -> str:
             "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md);"
             " the lines' and the swept links' own sums of squares are beside it.",
             "",
-            "| class | RMS (mm) | chi^2 | lines | swept | score | weight | sizes (mm) |",
+            "A size is given with its standard deviation; one the points leave free (a side"
+            " never touched) as at least the size the points show.",
+            "",
+            "| class | RMS (mm) | chi^2 | lines | swept | score | weight | sizes |",
             "|---|---|---|---|---|---|---|---|",
         ]
         for fit in recognition.fits:
-            sizes = ", ".join(f"{k} {1000 * v:.1f}" for k, v in fit.sizes.items()) or "-"
             lines.append(
                 f"| {fit.name} | {1000 * fit.rms:.2f} | {fit.chi2:.1f} | {fit.line_chi2:.1f} | "
-                f"{fit.swept_chi2:.1f} | {fit.score:.1f} | {fit.weight:.3f} | {sizes} |"
+                f"{fit.swept_chi2:.1f} | {fit.score:.1f} | {fit.weight:.3f} | "
+                f"{fit.sizes_text()} |"
             )
     return "\n".join(lines) + "\n"
