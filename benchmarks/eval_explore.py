@@ -31,7 +31,9 @@ patch near the points, and the whole object's RMS distance to the fitted surface
 of its area within 5 mm of it (a map that never touched a side is far from it there), after every 3
 sweeps and at the end; the contacts each strategy needs to bring the whole object's RMS to 5 mm (the
 two strategies compared scene by scene on it); the recognition (right, abstained, confidently wrong)
-and the size error of the true class's fit, the Mahalanobis distance of each ``ok`` point's true
+and the size error of the true class's fit (each size's error also over the standard deviation
+the fit reports, and whether the fit claims every size to 5 %, twice its standard deviation
+within 5 % of it, while being off by more), the Mahalanobis distance of each ``ok`` point's true
 contact point under its covariance and its distance to the true surface over its sigma along the
 normal, how far the true object disagrees with the swept links
 recognition weighs (its residual per free sweep and per touching link, the worst and the count
@@ -97,6 +99,8 @@ OBJECT_STRIDE = 5
 COVERED = 0.005
 #: The whole-object RMS the strategies are compared at: the contacts each needs to reach it (m).
 TARGET_RMS = 0.005
+#: The issue's size target: every size of a right answer within this of the truth (relative).
+SIZE_TOLERANCE = 0.05
 #: Checkpoints along each exploration: after every this-many sweeps, and at the end.
 CHECK_EVERY = 3
 #: Widening of the explored region beyond the object's angular extent (rad).
@@ -202,10 +206,43 @@ def make_scene(
 
 def size_error(name: str, fitted: dict[str, float], truth: dict[str, Any]) -> float:
     """Largest relative error over the class's sizes (box extents sorted)."""
+    got, _, true = matched_sizes(name, fitted, dict.fromkeys(fitted, math.nan), truth)
+    return float(np.max(np.abs(got / true - 1)))
+
+
+def matched_sizes(
+    name: str, fitted: dict[str, float], std: dict[str, float], truth: dict[str, Any]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fitted sizes, their standard deviations and the true sizes, matched (m): a box's
+    extents sorted by size (its axes are its own), the others by name."""
     if name == "box":
-        got = sorted(fitted.values())
-        return max(abs(a / b - 1) for a, b in zip(got, truth["extents"], strict=True))
-    return max(abs(fitted[k] / v - 1) for k, v in truth.items())
+        order = np.argsort(list(fitted.values()))
+        return (
+            np.array(list(fitted.values()))[order],
+            np.array(list(std.values()))[order],
+            np.sort(truth["extents"]),
+        )
+    keys = list(truth)
+    return (
+        np.array([fitted[k] for k in keys]),
+        np.array([std.get(k, math.nan) for k in keys]),
+        np.array([truth[k] for k in keys]),
+    )
+
+
+def size_scores(
+    name: str, fitted: dict[str, float], std: dict[str, float], truth: dict[str, Any]
+) -> tuple[float, list[float | None], bool]:
+    """The size error (:func:`size_error`), each size's error over its standard deviation (None
+    where the fit left it free), and whether the fit claims every size to 5 % (twice its
+    standard deviation within 5 % of it: the sizes a user may trust to 5 %)."""
+    got, sd, true = matched_sizes(name, fitted, std, truth)
+    z = [
+        float((g - t) / s) if math.isfinite(s) and s > 0 else None
+        for g, s, t in zip(got, sd, true, strict=True)
+    ]
+    claimed = bool(np.all(np.isfinite(sd) & (2 * sd <= SIZE_TOLERANCE * got)))
+    return float(np.max(np.abs(got / true - 1))), z, claimed
 
 
 def surface_scores(
@@ -374,6 +411,8 @@ def run(
             confident_wrong=False,
             confidence=math.nan,
             size_error=math.nan,
+            size_z=[],
+            size_claimed=False,
         )
     else:
         name = info["class"]
@@ -386,7 +425,14 @@ def run(
             confidence=recognition.confidence,
             candidates=list(recognition.candidates),
             rival=recognition.rival,
-            size_error=size_error(name, dict(fit.sizes), info["truth"]),
+        )
+        error, z, claimed = size_scores(name, dict(fit.sizes), dict(fit.size_std), info["truth"])
+        row.update(
+            size_error=error,
+            sizes=dict(fit.sizes),
+            size_std={k: v if math.isfinite(v) else None for k, v in fit.size_std.items()},
+            size_z=z,
+            size_claimed=claimed,
         )
     return row
 
@@ -419,6 +465,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "right": sum(r["right"] for r in rows),
         "abstained": sum(r["abstained"] for r in rows),
         "confident_wrong": sum(r["confident_wrong"] for r in rows),
+        **size_summary([r for r in rows if r["right"]]),
         "median_size_error_when_right": float(
             np.median([r["size_error"] for r in rows if r["right"]])
         )
@@ -438,6 +485,22 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "touch_truth_above_2": sum(r.get("touch_truth_above_2", 0) for r in rows),
         "mean_sweep_time_s": mean("sweep_time_s"),
         "mean_run_s": mean("run_s"),
+    }
+
+
+def size_summary(right: list[dict[str, Any]]) -> dict[str, Any]:
+    """Over the right answers: sizes within 5 %, the sizes' errors over their standard
+    deviations, and the answers that claim every size to 5 % (twice its standard deviation)
+    against those of them that are off by more."""
+    z = np.abs([v for r in right for v in r.get("size_z", []) if v is not None])
+    claimed = [r for r in right if r.get("size_claimed")]
+    return {
+        "size_within_5": sum(r["size_error"] <= SIZE_TOLERANCE for r in right),
+        "size_z_median_abs": float(np.median(z)) if z.size else None,
+        "size_z_within_2": float(np.mean(z <= 2)) if z.size else None,
+        "size_free": sum(v is None for r in right for v in r.get("size_z", [])),
+        "size_claimed": len(claimed),
+        "size_claimed_but_off": sum(r["size_error"] > SIZE_TOLERANCE for r in claimed),
     }
 
 
@@ -590,6 +653,15 @@ def main() -> None:
             f" {mm(s['mean_chamfer_m']):>5s} mm {s['right']:5d} {s['abstained']:5d}"
             f" {s['confident_wrong']:5d} {s['median_mahalanobis'] or math.nan:6.2f}"
             f" {s['median_abs_surface_z'] or math.nan:6.2f}"
+        )
+    print("\nsizes of the right answers:")
+    for strategy, s in totals.items():
+        print(
+            f"  {strategy:9s} within 5 % {s['size_within_5']} of {s['right']};"
+            f" error over std: median |z| {s['size_z_median_abs'] or math.nan:.2f},"
+            f" within 2 {s['size_z_within_2'] or math.nan:.2f}, free {s['size_free']};"
+            f" claimed to 5 % {s['size_claimed']}, of which off by more"
+            f" {s['size_claimed_but_off']}"
         )
     print_target(rows)
     write_results(args, rows, totals)

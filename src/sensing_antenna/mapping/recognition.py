@@ -52,9 +52,10 @@ and not the points counted wrong), carried to the sizes, times the square root o
 overdispersion c. A size the evidence leaves free (a box's extent along an axis where one face
 only was touched: the face holds, the far one may be anywhere behind it) has no standard
 deviation: it is reported as the smallest the points allow, the extent prior's, and only that
-lower bound is measured. The points' errors are not independent (a face touched at its edges
-reads outward at each), so the spread of sizes about the truth is wider than these standard
-deviations alone; ``benchmarks/eval_explore.py`` measures it.
+lower bound is measured (an end is free when growing the shape there is not resisted:
+:func:`size_std`). The points' errors are not independent (a face touched at its edges reads
+outward at each), so a size can be off by more than its standard deviation says;
+``benchmarks/eval_explore.py`` measures how often.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
 points pin the richer class's extra parameters to the simpler shape (a capsule fitted to a
