@@ -79,13 +79,14 @@ def register(subparsers: Any) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
-    from sensing_antenna.cli.map import load_mesh, report_map
+    from sensing_antenna.cli.map import report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
     from sensing_antenna.scene import load_scene
+    from sensing_antenna.scene.objects import read_mesh
 
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)
-    meshes = {path.stem: load_mesh(path) for path in args.objects}
+    meshes = {path.stem: read_mesh(path) for path in args.objects}
     settings = ExploreSettings(
         method=args.method,
         strategy=args.strategy,

@@ -69,9 +69,10 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.mapping import build_map, map_inputs_from_recordings
+    from sensing_antenna.scene.objects import read_mesh
 
     distinct_files(args.recordings)
-    meshes = {path.stem: load_mesh(path) for path in args.objects}
+    meshes = {path.stem: read_mesh(path) for path in args.objects}
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     with Progress(not args.no_progress).bar(
@@ -135,25 +136,3 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
         )
     for path in written:
         print(f"  {path}")
-
-
-def load_mesh(path: Path) -> Any:
-    import trimesh
-
-    from sensing_antenna.errors import SensingAntennaError
-    from sensing_antenna.scene.objects import mesh_problem
-
-    if not path.is_file():
-        raise SensingAntennaError(
-            f"{path}: {'a directory, not a mesh file' if path.is_dir() else 'no such mesh file'}"
-        )
-    try:
-        mesh = trimesh.load_mesh(path, force="mesh")
-    except Exception as exc:  # trimesh raises many kinds on a malformed file
-        raise SensingAntennaError(f"{path}: not a readable mesh ({exc})") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise SensingAntennaError(f"{path}: the file holds no triangles")
-    problem = mesh_problem(mesh)
-    if problem is not None:
-        raise SensingAntennaError(f"{path}: {problem}")
-    return mesh

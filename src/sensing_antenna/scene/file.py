@@ -48,9 +48,9 @@ from typing import Any
 import numpy as np
 import trimesh
 
-from sensing_antenna.errors import FieldError, format_value
+from sensing_antenna.errors import FieldError, SensingAntennaError, format_value
 from sensing_antenna.mapping.pose import MAX_BASE_DISTANCE, BasePose
-from sensing_antenna.scene.objects import SceneObject, mesh_object, mesh_problem, primitive_object
+from sensing_antenna.scene.objects import SceneObject, mesh_object, primitive_object, read_mesh
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
@@ -293,17 +293,10 @@ def _mesh_file(
     path = Path(value)
     if not path.is_absolute() and folder is not None:
         path = folder / path
-    if not path.is_file():
-        raise fail(where, f"{path}: {'a directory' if path.is_dir() else 'no such file'}")
     try:
-        mesh = trimesh.load_mesh(path, force="mesh")
-    except Exception as exc:  # trimesh raises many kinds on a malformed file
-        raise fail(where, f"{path}: not a readable mesh ({exc})") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise fail(where, f"{path}: the file holds no triangles")
-    problem = mesh_problem(mesh, scale)  # before watertightness, which NaN vertices break
-    if problem is not None:
-        raise fail(where, f"{path} at scale {scale:g}: {problem}")
+        mesh = read_mesh(path, scale)  # before watertightness, which NaN vertices break
+    except SensingAntennaError as exc:
+        raise fail(where, str(exc)) from None
     if not mesh.is_watertight:
         raise fail(
             where, f"{path}: the mesh is not closed (watertight), so its inside is undefined"

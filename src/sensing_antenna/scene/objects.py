@@ -14,12 +14,14 @@ faces for a mesh, which must therefore be closed (watertight) for its inside to 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.mapping.primitives import PRIMITIVES
 
 __all__ = [
@@ -29,6 +31,7 @@ __all__ = [
     "mesh_object",
     "mesh_problem",
     "primitive_object",
+    "read_mesh",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -55,6 +58,27 @@ def mesh_problem(mesh: trimesh.Trimesh, scale: float = 1.0) -> str | None:
             "reads it in millimetres)"
         )
     return None
+
+
+def read_mesh(path: Path, scale: float = 1.0) -> trimesh.Trimesh:
+    """The triangles of a user's mesh file (STL, OBJ, PLY; coordinates times ``scale`` in m),
+    as trimesh reads them (not scaled); SensingAntennaError naming the file and the problem
+    when it is missing, unreadable, empty or fails :func:`mesh_problem`."""
+    if not path.is_file():
+        raise SensingAntennaError(
+            f"{path}: {'a directory, not a mesh file' if path.is_dir() else 'no such mesh file'}"
+        )
+    try:
+        mesh = trimesh.load_mesh(path, force="mesh")
+    except Exception as exc:  # trimesh raises many kinds on a malformed file
+        raise SensingAntennaError(f"{path}: not a readable mesh ({exc})") from None
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise SensingAntennaError(f"{path}: the file holds no triangles")
+    problem = mesh_problem(mesh, scale)
+    if problem is not None:
+        at = "" if scale == 1.0 else f" at scale {scale:g}"
+        raise SensingAntennaError(f"{path}{at}: {problem}")
+    return mesh
 
 
 #: Subdivision of the primitives' meshes used for figures and surface scores: finer than
