@@ -517,3 +517,23 @@ def test_an_edge_is_simulated_as_a_cylinder_whichever_way_the_link_crosses_it(le
     assert smallest < 2e-3 and largest > 5 * smallest
     scenario, _ = touch_scenario(touch, sweep, scene)
     assert scenario.obstacle == "post"
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("[[bases]]\nposition = [0.0, 0.0, 0.0]\nyaw = 90\n", r"bases\[0\]\.yaw: .*in radians\?"),
+        ("[[bases]]\nposition = [0.0, 0.0, 0.0]\nyaw = 1e300\n", r"bases\[0\]\.yaw: "),
+        (
+            BALL.replace("position", "rotation = [0, 0, 90]\nposition"),
+            r"objects\[0\]\.rotation: turns by 90 rad.*in radians\?",
+        ),
+    ],
+)
+def test_an_angle_in_degrees_is_refused(text: str, words: str, tmp_path: Path) -> None:
+    # a scene's angles are in radians: a yaw of 90 (a quarter turn written in degrees) turns
+    # 14 times round, which no one means
+    path = tmp_path / "scene.toml"
+    path.write_text(text if text.startswith("[[objects]]") else BALL + text)
+    with pytest.raises(SceneError, match=words):
+        load_scene(path)

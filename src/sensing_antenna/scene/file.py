@@ -10,7 +10,7 @@
     shape = "sphere"                      # sphere, cylinder, capsule, cone, torus, box or mesh
     radius = 0.06                         # the shape's sizes (m), below
     position = [0.6, 0.1, 0.0]            # m, world frame (a cone: its base centre)
-    rotation = [0.0, 0.0, 0.0]            # optional rotation vector (rad)
+    rotation = [0.0, 0.0, 0.0]            # optional rotation vector (rad, at most a turn)
 
     [[objects]]
     shape = "mesh"
@@ -20,7 +20,7 @@
 
     [[bases]]                             # the antenna's base poses; default: one, the origin
     position = [0.0, 0.0, 0.0]            # the head's base point O (m)
-    yaw = 0.0                             # rad about the world's Z; or quaternion = [w, x, y, z]
+    yaw = 0.0                             # rad about Z, within a turn; or quaternion [w, x, y, z]
     azimuth = [-0.3, 0.3]                 # optional: this base's own explored angles (rad),
     elevation = [-0.8, -0.4]              # each defaulting to [explore]'s
 
@@ -67,6 +67,10 @@ BUILTIN_SCENES = ("post", "sphere", "box", "cylinder")
 
 #: Largest size of a primitive (m): an object the antenna (1 m or so) can explore.
 MAX_OBJECT_SIZE = 10.0
+
+#: Largest angle (rad) of a yaw or an object's rotation vector: one turn reaches every
+#: orientation, and a larger number is most likely in degrees (90 for a quarter turn).
+ANGLE_LIMIT = 2.0 * math.pi
 
 #: Most objects, bases and grid sweeps a scene may ask for (a scene is hand-written).
 _MAX_COUNT = 100
@@ -226,6 +230,18 @@ def _number(
     return float(value)
 
 
+def _angle(value: object, where: str, fail: Any) -> float:
+    """An angle (rad) within one turn either way: beyond it, most likely degrees."""
+    angle = _number(value, where, fail)
+    if abs(angle) > ANGLE_LIMIT:
+        raise fail(
+            where,
+            f"must be within +-{ANGLE_LIMIT:.4f} rad (one turn), got {format_value(value)}: "
+            "in radians?",
+        )
+    return angle
+
+
 def _vector(value: object, n: int, where: str, fail: Any, limit: float | None = None) -> np.ndarray:
     if not isinstance(value, list) or len(value) != n:
         raise fail(where, f"must be a list of {n} numbers, got {format_value(value)}")
@@ -259,6 +275,12 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
         raise fail(f"{where}.position", "missing")
     position = _vector(table["position"], 3, f"{where}.position", fail, MAX_BASE_DISTANCE)
     rotation = _vector(table.get("rotation", [0.0, 0.0, 0.0]), 3, f"{where}.rotation", fail)
+    if np.linalg.norm(rotation) > ANGLE_LIMIT:
+        raise fail(
+            f"{where}.rotation",
+            f"turns by {np.linalg.norm(rotation):.4g} rad, more than one turn "
+            f"({ANGLE_LIMIT:.4f}): in radians?",
+        )
     if shape == "mesh":
         scale = _number(table.get("scale", 1.0), f"{where}.scale", fail, 0.0, 1.0)
         mesh = _mesh_file(table.get("file"), f"{where}.file", folder, fail, scale)
@@ -332,7 +354,7 @@ def _base_pose(table: Mapping[str, Any], where: str, fail: Any) -> BasePose:
             return BasePose.from_quaternion(position, list(quaternion))
     except FieldError as exc:
         raise fail(f"{where}.quaternion", exc.problem) from None
-    yaw = _number(table.get("yaw", 0.0), f"{where}.yaw", fail)
+    yaw = _angle(table.get("yaw", 0.0), f"{where}.yaw", fail)
     c, s = math.cos(yaw), math.sin(yaw)
     return BasePose(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), position)
 
