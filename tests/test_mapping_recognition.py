@@ -11,6 +11,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from sensing_antenna.mapping import UNDECIDED, FreeSpace, fit_mesh, fit_primitive, recognise
+from sensing_antenna.mapping.primitives import PRIMITIVES
 from sensing_antenna.mapping.recognition import LINE_STRETCH, LinkLines, shape_gap
 
 #: Noise of the synthetic points (m, isotropic 1 sigma): about the points' sigma across the link.
@@ -484,3 +485,26 @@ def test_a_box_touched_on_three_faces_gives_its_extents_as_lower_bounds() -> Non
     order = np.argsort(got)
     assert np.all(np.abs(got[order] - extents) < 3 * std[order]), (got, std)
     assert "+-" in fit.sizes_text()
+
+
+@pytest.mark.parametrize("name", ["box", "cylinder", "cone", "torus"])
+def test_a_fit_reads_one_way_whatever_its_start(name: str) -> None:
+    # The canonical form is the same shape (the same signed distance everywhere), with a
+    # rotation vector of at most pi and a box's extents in increasing order
+    shape = PRIMITIVES[name]
+    rng = np.random.default_rng(7)
+    x = np.concatenate([[0.5, 0.1, -0.1], [2.0, -2.5, 1.5], rng.uniform(0.02, 0.08, 3)])
+    x = x[: len(shape.parameter_names)]
+    probes = x[:3] + rng.normal(0.0, 0.1, (500, 3))
+    canonical = shape.canonical(x)
+    assert np.allclose(shape.signed_distance(canonical, probes), shape.signed_distance(x, probes))
+    assert np.linalg.norm(canonical[3:6]) <= math.pi + 1e-12
+    if name == "box":
+        assert list(canonical[6:9]) == sorted(x[6:9])
+    # and a fit reports it so: the box touched on all sides, its extents smallest first
+    mesh, rng = _placed(name)
+    points, covariances = _sample(mesh, 60, rng)
+    fit = fit_primitive(name, points, covariances, rng=np.random.default_rng(0))
+    assert np.linalg.norm(fit.vector[3:6]) <= math.pi + 1e-12
+    if name == "box":
+        assert list(fit.sizes.values()) == sorted(fit.sizes.values())

@@ -75,6 +75,7 @@ class Primitive:
     _mesh: Callable[[FloatArray], trimesh.Trimesh] | None
     _size_entries: Callable[[FloatArray], FloatArray] = lambda sizes: sizes
     _growths: Callable[[FloatArray], tuple[Growth, ...]] = lambda parameters: ()
+    _canonical: Callable[[FloatArray], FloatArray] | None = None
 
     def signed_distance(self, parameters: FloatArray, points: FloatArray) -> FloatArray:
         """d(p) (m), shape (n,), for points of shape (n, 3) (m)."""
@@ -88,6 +89,15 @@ class Primitive:
         """The parameter vector's entries after the pose for sizes (m) in the order of
         ``size_names``: the inverse of :meth:`sizes` (a torus's hole is major - minor)."""
         return np.asarray(self._size_entries(np.asarray(sizes, dtype=float)), dtype=float)
+
+    def canonical(self, parameters: FloatArray) -> FloatArray:
+        """The same shape's parameter vector in one form: a rotation vector of at most pi
+        rad, and a box's extents in increasing order (its axes permuted to match), so that
+        one shape reads one way whatever the fit started from."""
+        parameters = np.array(parameters, dtype=float)
+        if self._canonical is not None:
+            return np.asarray(self._canonical(parameters))
+        return parameters
 
     def growths(self, parameters: FloatArray) -> tuple[Growth, ...]:
         """Each way the shape can grow at one end of a size while the rest of it stays: the
@@ -242,6 +252,24 @@ def _cone_growth(parameters: FloatArray) -> tuple[Growth, ...]:
     return (((0, 1), change),)
 
 
+def _canonical_pose(parameters: FloatArray) -> FloatArray:
+    """The rotation vector as scipy writes it back (norm at most pi)."""
+    parameters[3:6] = Rotation.from_rotvec(parameters[3:6]).as_rotvec()
+    return parameters
+
+
+def _canonical_box(parameters: FloatArray) -> FloatArray:
+    """Extents in increasing order, the box's axes permuted with them (one axis reversed when
+    the permutation would mirror the frame: a box is the same either way along an axis)."""
+    order = np.argsort(parameters[6:9], kind="stable")
+    axes = _rotation(parameters)[:, order].copy()
+    if np.linalg.det(axes) < 0:
+        axes[:, 0] *= -1.0
+    parameters[3:6] = Rotation.from_matrix(axes).as_rotvec()
+    parameters[6:9] = parameters[6:9][order]
+    return parameters
+
+
 def _cone_mesh(parameters: FloatArray) -> trimesh.Trimesh:
     mesh = trimesh.creation.cone(radius=parameters[6], height=parameters[7], sections=64)
     mesh.apply_transform(_transform(parameters))
@@ -286,6 +314,7 @@ PRIMITIVES: dict[str, Primitive] = {
             lambda p: p[6:8],
             _with_pose(lambda p: trimesh.creation.cylinder(radius=p[6], height=p[7], sections=64)),
             _growths=_axis_ends(1, 2),
+            _canonical=_canonical_pose,
         ),
         Primitive(
             "capsule",
@@ -298,6 +327,7 @@ PRIMITIVES: dict[str, Primitive] = {
                 lambda p: trimesh.creation.capsule(height=p[7], radius=p[6], count=[32, 32])
             ),
             _growths=_axis_ends(1, 2),
+            _canonical=_canonical_pose,
         ),
         Primitive(
             "cone",
@@ -308,6 +338,7 @@ PRIMITIVES: dict[str, Primitive] = {
             lambda p: p[6:8],
             _cone_mesh,
             _growths=_cone_growth,
+            _canonical=_canonical_pose,
         ),
         Primitive(
             "torus",
@@ -325,6 +356,7 @@ PRIMITIVES: dict[str, Primitive] = {
                 )
             ),
             lambda sizes: np.array([sizes[0] - sizes[1], sizes[1]]),
+            _canonical=_canonical_pose,
         ),
         Primitive(
             "box",
@@ -335,6 +367,7 @@ PRIMITIVES: dict[str, Primitive] = {
             lambda p: p[6:9],
             _with_pose(lambda p: trimesh.creation.box(extents=p[6:9])),
             _growths=_box_growths,
+            _canonical=_canonical_box,
         ),
     )
 }

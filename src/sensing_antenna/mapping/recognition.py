@@ -703,7 +703,7 @@ def fit_primitive(
     alone.sort(key=lambda solution: solution.cost)
     chosen = alone[: REFINED_STARTS if link_evidence else 1]
     candidates = [refine(solution.x) for solution in chosen] + [refine(x) for x in direct]
-    x = min(candidates, key=total) if len(candidates) > 1 else candidates[0]
+    x = model.canonical(min(candidates, key=total) if len(candidates) > 1 else candidates[0])
     distance = model.signed_distance(x, p)
     sigma = _normal_sigma(cov, model.normals(x, p))
     # the evidence alone, without the extent prior, the points counted wrong left out

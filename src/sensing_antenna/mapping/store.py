@@ -157,6 +157,12 @@ def report(contact_map: ContactMap) -> str:
     if recognition is None:
         lines.append("Recognition: not attempted (fewer than 10 points).")
     else:
+        # without a rival the second candidate is the best of another shape
+        runner_up = (
+            f" ({recognition.candidates[1]})"
+            if recognition.rival is None and len(recognition.candidates) > 1
+            else ""
+        )
         lines += [
             f"Recognition: **{recognition.decision}**"
             + (
@@ -165,8 +171,8 @@ def report(contact_map: ContactMap) -> str:
                 else f" (confidence {recognition.confidence:.3f})"
             )
             + (
-                f"; score gap to the runner-up {recognition.delta_score:.1f}"
-                f" (abstains below {recognition.threshold:g})"
+                f"; score gap to the best of another shape{runner_up}"
+                f" {recognition.delta_score:.1f} (abstains below {recognition.threshold:g})"
                 if math.isfinite(recognition.delta_score)
                 else "; no runner-up of another shape"
             )
@@ -191,8 +197,9 @@ def report(contact_map: ContactMap) -> str:
             )
             + ".",
             "",
-            "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md);"
-            " the lines' and the swept links' own sums of squares are beside it.",
+            "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md),"
+            " each at most its outlier cap; the lines' and the swept links' own sums of squares,"
+            " uncapped, are beside it.",
             "",
             "A size is given with its standard deviation; one the points leave free (a side"
             " never touched) as at least the size the points show.",
