@@ -99,7 +99,7 @@ OBJECT_STRIDE = 5
 COVERED = 0.005
 #: The whole-object RMS the strategies are compared at: the contacts each needs to reach it (m).
 TARGET_RMS = 0.005
-#: The issue's size target: every size of a right answer within this of the truth (relative).
+#: The size target: every size of a right answer within this of the truth (relative).
 SIZE_TOLERANCE = 0.05
 #: Checkpoints along each exploration: after every this-many sweeps, and at the end.
 CHECK_EVERY = 3
@@ -431,6 +431,7 @@ def run(
             size_error=error,
             sizes=dict(fit.sizes),
             size_std={k: v if math.isfinite(v) else None for k, v in fit.size_std.items()},
+            size_at_least=dict(fit.size_at_least),
             size_z=z,
             size_claimed=claimed,
         )
@@ -498,7 +499,9 @@ def size_summary(right: list[dict[str, Any]]) -> dict[str, Any]:
         "size_within_5": sum(r["size_error"] <= SIZE_TOLERANCE for r in right),
         "size_z_median_abs": float(np.median(z)) if z.size else None,
         "size_z_within_2": float(np.mean(z <= 2)) if z.size else None,
+        # sizes with no deviation: not measured, or only a lower bound (``size_at_least``)
         "size_free": sum(v is None for r in right for v in r.get("size_z", [])),
+        "size_at_least": sum(len(r.get("size_at_least", {})) for r in right),
         "size_claimed": len(claimed),
         "size_claimed_but_off": sum(r["size_error"] > SIZE_TOLERANCE for r in claimed),
     }

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import pytest
@@ -470,6 +470,8 @@ def test_a_box_touched_on_three_faces_gives_its_extents_as_lower_bounds() -> Non
     assert all(math.isinf(v) for v in fit.size_std.values()), fit.size_std
     assert fit.sizes_text().count("at least") == 3
     assert all(v is None for v in fit.to_dict()["size_std"].values())
+    # the bounds lie below the truth (the box's axes are its own: compare sorted)
+    assert np.all(np.sort(list(fit.size_at_least.values())) < extents), fit.size_at_least
     # the same box touched on all six faces: every extent measured, within 3 sigma
     faces = []
     for axis in range(3):
@@ -508,3 +510,75 @@ def test_a_fit_reads_one_way_whatever_its_start(name: str) -> None:
     assert np.linalg.norm(fit.vector[3:6]) <= math.pi + 1e-12
     if name == "box":
         assert list(fit.sizes.values()) == sorted(fit.sizes.values())
+
+
+def _cylinder_points(
+    keep: Callable[[np.ndarray], np.ndarray], n: int, rng: np.random.Generator, noise: float = NOISE
+) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` noisy points of SHAPES' cylinder (radius 4 cm, height 15 cm, axis on Z) where
+    ``keep`` (a function of the exact points) is true."""
+    mesh = SHAPES["cylinder"][0]()
+    exact, _ = trimesh.sample.sample_surface(mesh, 200 * n, seed=int(rng.integers(2**31)))
+    exact = exact[keep(exact)][:n]
+    return exact + rng.normal(0.0, noise, exact.shape), np.tile(np.eye(3) * noise**2, (n, 1, 1))
+
+
+def test_what_the_points_do_not_show_has_no_deviation() -> None:
+    rng = np.random.default_rng(4)
+    # one cap untouched: the height could be anything beyond the points, a lower bound below
+    # the true 15 cm; the radius is measured
+    points, covariances = _cylinder_points(lambda q: q[:, 2] > -0.074, 60, rng)
+    fit = fit_primitive("cylinder", points, covariances)
+    assert math.isinf(fit.size_std["height"]) and fit.size_at_least["height"] < 0.15
+    assert abs(fit.sizes["radius"] - 0.04) < 3 * fit.size_std["radius"]
+    assert "height at least" in fit.sizes_text()
+    # both caps and no side: the radius is not measured (not a bound: any radius above the
+    # caps' points fits), the height is
+    points, covariances = _cylinder_points(lambda q: np.abs(q[:, 2]) > 0.0749, 60, rng)
+    fit = fit_primitive("cylinder", points, covariances)
+    assert math.isinf(fit.size_std["radius"]) and "radius" not in fit.size_at_least
+    assert "(not measured)" in fit.sizes_text()
+    assert abs(fit.sizes["height"] - 0.15) < 3 * fit.size_std["height"]
+    # a 0.15 rad cap of a 6 cm sphere: its radius is not measured
+    unit = rng.normal(size=(400, 3))
+    unit /= np.linalg.norm(unit, axis=1)[:, None]
+    cap = 0.06 * unit[unit[:, 2] > math.cos(0.15)][:25]
+    cap += rng.normal(0.0, NOISE, cap.shape)
+    fit = fit_primitive("sphere", cap, np.tile(np.eye(3) * NOISE**2, (len(cap), 1, 1)))
+    assert math.isinf(fit.size_std["radius"]) and not fit.size_at_least
+
+
+def test_an_end_a_few_wide_points_touch_is_held_loosely() -> None:
+    # The side at 0.3 mm, each cap touched by three points of 4 mm: the height is measured,
+    # with a deviation of the caps' order (4 mm / sqrt(3) each end), not the side's
+    rng = np.random.default_rng(6)
+    side, side_cov = _cylinder_points(lambda q: np.abs(q[:, 2]) < 0.07, 50, rng, 0.0003)
+    top, top_cov = _cylinder_points(lambda q: q[:, 2] > 0.0749, 3, rng, 0.004)
+    bottom, bottom_cov = _cylinder_points(lambda q: q[:, 2] < -0.0749, 3, rng, 0.004)
+    fit = fit_primitive(
+        "cylinder",
+        np.vstack([side, top, bottom]),
+        np.concatenate([side_cov, top_cov, bottom_cov]),
+    )
+    assert not fit.size_at_least
+    assert 0.001 < fit.size_std["height"] < 0.01
+    assert abs(fit.sizes["height"] - 0.15) < 3 * fit.size_std["height"]
+
+
+def test_points_noisier_than_their_covariance_widen_the_deviations() -> None:
+    # 2 mm of noise where the covariances say 1 mm: the overdispersion c (about 4) widens the
+    # radius's deviation to the spread's, 2 mm / sqrt(n), as it widens the scores
+    n = 200
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    azimuth = math.pi * (3.0 - math.sqrt(5.0)) * k
+    rho = np.sqrt(1.0 - z**2)
+    unit = np.stack([rho * np.cos(azimuth), rho * np.sin(azimuth), z], axis=1)
+    rng = np.random.default_rng(8)
+    points = 0.06 * unit + rng.normal(0.0, 2 * NOISE, (n, 3))
+    result = recognise(
+        points, np.tile(np.eye(3) * NOISE**2, (n, 1, 1)), classes=["sphere"], rng=rng
+    )
+    assert result.overdispersion == pytest.approx(4.0, rel=0.25)
+    # c's own sampling error (about 10 % on 200 points) and the normals' spread (5 %)
+    assert result.best.size_std["radius"] == pytest.approx(2 * NOISE / math.sqrt(n), rel=0.15)

@@ -104,7 +104,8 @@ def warn_of_other_antennas(named: Mapping[str, Sequence[str]], model: str) -> No
         print(
             f"antenna: warning: {which} recorded with antenna {printable(recorded)!r} (its "
             f"metadata) and estimated with the default {printable(model)!r}: give that "
-            "antenna's file with --antenna",
+            "antenna's file with --antenna (with another's observer and stiffness a good "
+            "recording can come back implausible_input or no_contact)",
             file=sys.stderr,
         )
 

@@ -102,9 +102,10 @@ class Primitive:
     def growths(self, parameters: FloatArray) -> tuple[Growth, ...]:
         """Each way the shape can grow at one end of a size while the rest of it stays: the
         sizes it changes (indices into ``size_names``) and the parameter vector's change per
-        metre the end moves outward. A box's extent grows at either face, a cylinder's height
-        or a capsule's length at either end, a cone at its base along its slant (its radius
-        and height together); a sphere's or a torus's sizes have no ends."""
+        metre the end moves outward along the shape's axis. A box's extent grows at either
+        face, a cylinder's height or a capsule's length at either end, a cone at its base
+        along its slant (its radius and height together; the base's rim moves sqrt(1 + (R /
+        h)^2) m per metre); a sphere's or a torus's sizes have no ends."""
         return self._growths(np.asarray(parameters, dtype=float))
 
     def mesh(self, parameters: FloatArray) -> trimesh.Trimesh | None:

@@ -49,12 +49,12 @@ Sizes. Each size of a class's fit carries a standard deviation: the Gauss-Newton
 (J^T J)^-1 of the fit's parameters, J the Jacobian of the evidence's normalised residuals at the
 fit (the points' d_i / sigma_i, the lines' and the swept links' residuals; not the extent prior,
 and not the points counted wrong), carried to the sizes, times the square root of the
-overdispersion c. A size the evidence leaves free (a box's extent along an axis where one face
-only was touched: the face holds, the far one may be anywhere behind it) has no standard
-deviation: it is reported as the smallest the points allow, the extent prior's, and only that
-lower bound is measured (an end is free when growing the shape there is not resisted:
-:func:`size_std`). The points' errors are not independent (a face touched at its edges reads
-outward at each), so a size can be off by more than its standard deviation says;
+overdispersion c. A size the evidence does not hold (a sphere's radius from a small cap) is not
+measured: no deviation. A size whose end no touch reaches (a box's extent where one face only
+was touched) is held by the extent prior at the outermost points: it is reported as a lower
+bound, three of the points' deviations below the fitted size (:func:`size_std` finds such ends
+by growing the shape there). The points' errors are not independent (a face touched at its
+edges reads outward at each), so a size can be off by more than its standard deviation says;
 ``benchmarks/eval_explore.py`` measures how often.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
@@ -304,8 +304,13 @@ class ClassFit:
         The class's sizes (m).
     size_std : Mapping[str, float]
         Each size's standard deviation (m; module docstring, "Sizes."), inf for a size the
-        points leave free (a box's hidden extent: only its lower bound, the size itself, is
-        measured); empty for a user mesh, whose size is its own.
+        points do not measure; empty for a user mesh, whose size is its own.
+        :func:`fit_primitive` gives it for the points' own covariances, :func:`recognise`
+        widened by the overdispersion.
+    size_at_least : Mapping[str, float]
+        For each size of the shape that could grow at an end nothing holds (a box's hidden
+        face), the lower bound the points give it (m): the fitted size less three of the
+        points' median deviations, since the end was left at the outermost, noisy, points.
     rms : float
         RMS of the point-to-surface distances (m).
     chi2 : float
@@ -341,21 +346,26 @@ class ClassFit:
     weight: float = math.nan
     score: float = math.nan
     size_std: Mapping[str, float] = field(default_factory=dict)
+    size_at_least: Mapping[str, float] = field(default_factory=dict)
     vector: FloatArray = field(default_factory=lambda: np.zeros(0), compare=False, repr=False)
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
 
     def sizes_text(self) -> str:
-        """The sizes in mm for reading: ``radius 18.7 +- 1.0 mm``, a size the points leave free
-        as ``height at least 20.5 mm``, a user mesh's as its own; ``-`` without sizes."""
+        """The sizes in mm for reading: ``radius 18.7 +- 1.0 mm``, a size that is only a lower
+        bound as ``height at least 147.2 mm``, one the points do not measure as ``radius 251.2
+        mm (not measured)``, a user mesh's as its own; ``-`` without sizes."""
         parts = []
         for name, value in self.sizes.items():
             std = self.size_std.get(name)
-            if std is None:
+            if name in self.size_at_least:
+                parts.append(f"{name} at least {1000 * self.size_at_least[name]:.1f} mm")
+            elif std is None:
                 parts.append(f"{name} {1000 * value:.1f} mm")
             elif math.isfinite(std):
-                parts.append(f"{name} {1000 * value:.1f} +- {1000 * std:.1f} mm")
+                digits = 1 if std >= 5e-5 else 2
+                parts.append(f"{name} {1000 * value:.{digits}f} +- {1000 * std:.{digits}f} mm")
             else:
-                parts.append(f"{name} at least {1000 * value:.1f} mm")
+                parts.append(f"{name} {1000 * value:.1f} mm (not measured)")
         return ", ".join(parts) or "-"
 
     def to_dict(self) -> dict[str, Any]:
@@ -364,10 +374,11 @@ class ClassFit:
             "class": self.name,
             "parameters": {k: float(v) for k, v in self.parameters.items()},
             "sizes": {k: float(v) for k, v in self.sizes.items()},
-            # null: a size the points leave free (only its lower bound is measured)
+            # null: a size the points do not measure
             "size_std": {
                 k: float(v) if math.isfinite(v) else None for k, v in self.size_std.items()
             },
+            "size_at_least": {k: float(v) for k, v in self.size_at_least.items()},
             "rms_m": float(self.rms),
             "chi2": float(self.chi2),
             "line_chi2": float(self.line_chi2),
@@ -732,9 +743,12 @@ def fit_primitive(
         swept=swept_residuals(x, spaces),
         spaces=spaces,
     )
-    std = size_std(model, x, evidence, spread, float(np.median(sigma)))
+    std, free = size_std(model, x, evidence, spread, kept[np.isfinite(kept)])
+    at_least = np.maximum(model.sizes(x) - 3.0 * float(np.median(sigma)), 0.0)
     return dataclasses.replace(
-        fitted, size_std=dict(zip(model.size_names, std.tolist(), strict=True))
+        fitted,
+        size_std=dict(zip(model.size_names, std.tolist(), strict=True)),
+        size_at_least={n: float(at_least[i]) for i, n in enumerate(model.size_names) if free[i]},
     )
 
 
@@ -743,46 +757,57 @@ def size_std(
     x: FloatArray,
     residuals: Callable[[FloatArray], FloatArray],
     spread: float,
-    point_std: float,
-) -> FloatArray:
-    """Standard deviation (m) of each of ``shape``'s sizes at the fit ``x``, shape (n_sizes,):
-    the Gauss-Newton covariance (J^T J)^-1 of the normalised ``residuals`` (a function of the
-    parameter vector; J by central differences of :data:`JACOBIAN_STEP`) carried to the sizes.
+    point_std: FloatArray,
+) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """Standard deviation (m) of each of ``shape``'s sizes at the fit ``x``, shape (n_sizes,),
+    and whether each is only a lower bound (an end nothing holds).
 
-    A size is left free by the points (inf) when it moves along a direction J^T J does not hold
-    (its eigenvalue below :data:`EIGEN_FLOOR` of the largest), when its standard deviation
-    exceeds the points' spread ``spread`` (m), or when the shape, grown at one of its ends
-    (:meth:`Primitive.growths`) by D, raises the residuals' sum of squares by less than 1 as it
-    grows on to 2 D, D = max(2 std, 3 ``point_std``) with ``point_std`` the points' typical
-    standard deviation (m). A fit held at the smallest size the points allow has its far end at
-    the outermost points, where the distance's derivative differs on either side; growing it
-    first releases the points within their noise of that end, and then meets nothing when
-    nothing is there, while an end that points hold resists the more the farther it moves.
+    The Gauss-Newton covariance (J^T J)^-1 of the normalised ``residuals`` (a function of the
+    parameter vector; J by central differences of :data:`JACOBIAN_STEP`) carried to the sizes;
+    inf (not measured) where a size moves along a direction J^T J does not hold (its eigenvalue
+    below :data:`EIGEN_FLOOR` of the largest) or its deviation exceeds the points' spread
+    ``spread`` (m). Then each end (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max
+    (2 sigma, 3 times the 90th percentile of ``point_std``, the points' deviations along the
+    normal, m), sigma the largest finite deviation of the sizes it moves: a fit held at the
+    smallest size the points allow has an untouched end at the outermost points, where the
+    distance's derivative differs on either side, and growing it first releases the points
+    within their noise of it, after which only what holds the end resists, as the square of the
+    distance. The rise of the residuals' sum of squares between D and 2 D, 3 D^2 / s^2, gives
+    that end's deviation s; with no rise, or s beyond the spread, the end is free and its sizes
+    are lower bounds (inf, True); otherwise a size's deviation is at least s.
     """
     n = len(x)
-    at_x = residuals(x)
-    jacobian = np.empty((len(at_x), n))
+    jacobian = np.empty((len(residuals(x)), n))
     gradient = np.empty((len(shape.size_names), n))
     for j in range(n):
         shift = np.zeros(n)
         shift[j] = JACOBIAN_STEP
         jacobian[:, j] = (residuals(x + shift) - residuals(x - shift)) / (2 * JACOBIAN_STEP)
         gradient[:, j] = (shape.sizes(x + shift) - shape.sizes(x - shift)) / (2 * JACOBIAN_STEP)
+    free = np.zeros(len(shape.size_names), dtype=bool)
     information = jacobian.T @ jacobian
     if not np.all(np.isfinite(information)):
-        return np.full(len(shape.size_names), np.inf)
+        return np.full(len(shape.size_names), np.inf), free
     eigenvalues, eigenvectors = np.linalg.eigh(information)
     floor = EIGEN_FLOOR * max(float(eigenvalues[-1]), np.finfo(float).tiny)
     variance = np.sum((gradient @ eigenvectors) ** 2 / np.maximum(eigenvalues, floor), axis=1)
     std = np.where(np.sqrt(variance) <= spread, np.sqrt(variance), np.inf)
+    noise = float(np.percentile(point_std, 90.0)) if len(point_std) else 0.0
     for sizes, change in shape.growths(x):
-        step = max(2.0 * float(np.max(std[list(sizes)])), 3.0 * point_std)
-        if not math.isfinite(step):
+        moved = std[list(sizes)]
+        finite = moved[np.isfinite(moved)]
+        step = max(2.0 * float(finite.max()) if finite.size else 0.0, 3.0 * noise)
+        if not step > 0.0:
             continue
         near, far = (float(np.sum(residuals(x + k * step * change) ** 2)) for k in (1.0, 2.0))
-        if not far >= near + 1.0:
+        rise = far - near
+        end = step * math.sqrt(3.0 / rise) if rise > 0.0 else math.inf
+        if end > spread:
+            free[list(sizes)] = True
             std[list(sizes)] = np.inf
-    return np.asarray(std)
+        else:
+            std[list(sizes)] = np.maximum(std[list(sizes)], end)
+    return np.asarray(std), free
 
 
 def fit_mesh(
