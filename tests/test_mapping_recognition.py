@@ -73,6 +73,16 @@ def _placed(name: str) -> tuple[trimesh.Trimesh, np.random.Generator]:
     return mesh, rng
 
 
+def _lattice(n: int, band: float = 1.0) -> np.ndarray:
+    """``n`` unit vectors spread evenly (a Fibonacci lattice) over the unit sphere's band
+    |z| <= ``band``, shape (n, 3)."""
+    k = np.arange(n) + 0.5
+    z = band * (1.0 - 2.0 * k / n)
+    azimuth = math.pi * (3.0 - math.sqrt(5.0)) * k
+    rho = np.sqrt(1.0 - z**2)
+    return np.stack([rho * np.cos(azimuth), rho * np.sin(azimuth), z], axis=1)
+
+
 def _size_error(name: str, fitted: Mapping[str, float]) -> float:
     """The largest relative error of the fitted sizes against ``SHAPES``' (box extents sorted)."""
     sizes = SHAPES[name][1]
@@ -385,11 +395,7 @@ def test_a_decision_needs_the_weight_the_threshold_stands_for() -> None:
     # leaves the best about e^3.5 / (1 + e^3.5) = 0.97 and a decision; four take about
     # 4 / (e^3.5 + 4) = 11 % between them, and the decision abstains
     n = 300
-    k = np.arange(n) + 0.5
-    z = 0.3 * (1.0 - 2.0 * k / n)
-    azimuth = math.pi * (3.0 - math.sqrt(5.0)) * k
-    rho = np.sqrt(1.0 - z**2)
-    points = 0.05 * np.stack([rho * np.cos(azimuth), rho * np.sin(azimuth), z], axis=1)
+    points = 0.05 * _lattice(n, band=0.3)
     covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
     dr = NOISE * math.sqrt(7.5 / n)
     ball = trimesh.creation.icosphere(subdivisions=5, radius=0.05)
@@ -419,13 +425,8 @@ def test_a_sphere_radius_standard_deviation_is_the_noise_over_root_n() -> None:
     # out, the centre and the radius decouple, and least squares gives var(r) = sigma^2 / n
     # (the mean of n independent radial residuals); 200 points on a Fibonacci lattice
     n, radius = 200, 0.06
-    k = np.arange(n) + 0.5
-    z = 1.0 - 2.0 * k / n
-    azimuth = math.pi * (3.0 - math.sqrt(5.0)) * k
-    rho = np.sqrt(1.0 - z**2)
-    unit = np.stack([rho * np.cos(azimuth), rho * np.sin(azimuth), z], axis=1)
     rng = np.random.default_rng(5)
-    points = np.array([0.4, 0.1, -0.05]) + radius * unit + rng.normal(0.0, NOISE, (n, 3))
+    points = np.array([0.4, 0.1, -0.05]) + radius * _lattice(n) + rng.normal(0.0, NOISE, (n, 3))
     fit = fit_primitive("sphere", points, np.tile(np.eye(3) * NOISE**2, (n, 1, 1)))
     # the lattice's normals sum to zero within a few per cent of n, and the normalised
     # residuals of points off the surface by 1 mm change the normals by 1 / 60: 5 %
@@ -569,13 +570,8 @@ def test_points_noisier_than_their_covariance_widen_the_deviations() -> None:
     # 2 mm of noise where the covariances say 1 mm: the overdispersion c (about 4) widens the
     # radius's deviation to the spread's, 2 mm / sqrt(n), as it widens the scores
     n = 200
-    k = np.arange(n) + 0.5
-    z = 1.0 - 2.0 * k / n
-    azimuth = math.pi * (3.0 - math.sqrt(5.0)) * k
-    rho = np.sqrt(1.0 - z**2)
-    unit = np.stack([rho * np.cos(azimuth), rho * np.sin(azimuth), z], axis=1)
     rng = np.random.default_rng(8)
-    points = 0.06 * unit + rng.normal(0.0, 2 * NOISE, (n, 3))
+    points = 0.06 * _lattice(n) + rng.normal(0.0, 2 * NOISE, (n, 3))
     result = recognise(
         points, np.tile(np.eye(3) * NOISE**2, (n, 1, 1)), classes=["sphere"], rng=rng
     )
