@@ -52,10 +52,10 @@ and not the points counted wrong), carried to the sizes, times the square root o
 overdispersion c. A size the evidence does not hold (a sphere's radius from a small cap) is not
 measured: no deviation. A size whose end no touch reaches (a box's extent where one face only
 was touched) is held by the extent prior at the outermost points: it is reported as a lower
-bound, three of the points' deviations below the fitted size (:func:`size_std` finds such ends
-by growing the shape there). The points' errors are not independent (a face touched at its
-edges reads outward at each), so a size can be off by more than its standard deviation says;
-``benchmarks/eval_explore.py`` measures how often.
+bound, three times the deviation of the points there below the fitted size (:func:`size_std`
+finds such ends by growing the shape there). The points' errors are not independent (a face
+touched at its edges reads outward at each), so a size can be off by more than its standard
+deviation says; ``benchmarks/eval_explore.py`` measures how often.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
 points pin the richer class's extra parameters to the simpler shape (a capsule fitted to a
@@ -304,13 +304,15 @@ class ClassFit:
         The class's sizes (m).
     size_std : Mapping[str, float]
         Each size's standard deviation (m; module docstring, "Sizes."), inf for a size the
-        points do not measure; empty for a user mesh, whose size is its own.
+        points do not measure or only bound from below (:attr:`size_at_least`); empty for a
+        user mesh, whose size is its own.
         :func:`fit_primitive` gives it for the points' own covariances, :func:`recognise`
         widened by the overdispersion.
     size_at_least : Mapping[str, float]
-        For each size of the shape that could grow at an end nothing holds (a box's hidden
-        face), the lower bound the points give it (m): the fitted size less three of the
-        points' median deviations, since the end was left at the outermost, noisy, points.
+        For each size the extent prior holds whose end nothing holds (a box's hidden face), the
+        lower bound the points give it (m): the fitted size less three times the largest
+        deviation of the points at that end, since the end was left at the outermost, noisy,
+        points (widened by the overdispersion in :func:`recognise`).
     rms : float
         RMS of the point-to-surface distances (m).
     chi2 : float
@@ -532,6 +534,16 @@ def _starts(
     return starts
 
 
+#: The sizes the extent prior holds at the points' span, by class: the only sizes an untouched
+#: end can leave as lower bounds (a free radius drifts, and is not measured).
+_PRIOR_HELD = {
+    "box": ("extent_x", "extent_y", "extent_z"),
+    "cylinder": ("height",),
+    "capsule": ("length",),
+    "cone": ("height",),
+}
+
+
 def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
     """How far the shape's extents along its own axes exceed the points' span there (m)."""
     if name in ("plane", "sphere", "torus"):
@@ -743,12 +755,14 @@ def fit_primitive(
         swept=swept_residuals(x, spaces),
         spaces=spaces,
     )
-    std, free = size_std(model, x, evidence, spread, kept[np.isfinite(kept)])
-    at_least = np.maximum(model.sizes(x) - 3.0 * float(np.median(sigma)), 0.0)
+    std, margin = size_std(model, x, evidence, spread, kept)
+    at_least = np.maximum(model.sizes(x) - margin, 0.0)
     return dataclasses.replace(
         fitted,
         size_std=dict(zip(model.size_names, std.tolist(), strict=True)),
-        size_at_least={n: float(at_least[i]) for i, n in enumerate(model.size_names) if free[i]},
+        size_at_least={
+            n: float(at_least[i]) for i, n in enumerate(model.size_names) if np.isfinite(margin[i])
+        },
     )
 
 
@@ -758,23 +772,31 @@ def size_std(
     residuals: Callable[[FloatArray], FloatArray],
     spread: float,
     point_std: FloatArray,
-) -> tuple[FloatArray, NDArray[np.bool_]]:
+) -> tuple[FloatArray, FloatArray]:
     """Standard deviation (m) of each of ``shape``'s sizes at the fit ``x``, shape (n_sizes,),
-    and whether each is only a lower bound (an end nothing holds).
+    and for a size that is only a lower bound how far below the fitted size the bound lies (m;
+    NaN for the others).
 
     The Gauss-Newton covariance (J^T J)^-1 of the normalised ``residuals`` (a function of the
-    parameter vector; J by central differences of :data:`JACOBIAN_STEP`) carried to the sizes;
-    inf (not measured) where a size moves along a direction J^T J does not hold (its eigenvalue
-    below :data:`EIGEN_FLOOR` of the largest) or its deviation exceeds the points' spread
-    ``spread`` (m). Then each end (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max
-    (2 sigma, 3 times the 90th percentile of ``point_std``, the points' deviations along the
-    normal, m), sigma the largest finite deviation of the sizes it moves: a fit held at the
-    smallest size the points allow has an untouched end at the outermost points, where the
-    distance's derivative differs on either side, and growing it first releases the points
-    within their noise of it, after which only what holds the end resists, as the square of the
-    distance. The rise of the residuals' sum of squares between D and 2 D, 3 D^2 / s^2, gives
-    that end's deviation s; with no rise, or s beyond the spread, the end is free and its sizes
-    are lower bounds (inf, True); otherwise a size's deviation is at least s.
+    parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i;
+    J by central differences of :data:`JACOBIAN_STEP`) carried to the sizes; inf (not
+    measured) where a size moves along a direction J^T J does not hold (its eigenvalue below
+    :data:`EIGEN_FLOOR` of the largest) or its deviation exceeds the points' spread ``spread``
+    (m). ``point_std`` are the points' deviations along the normal (m, inf for a point left
+    out). Then each end (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max(2 sigma,
+    3 times a deviation of the points whose distance moves with that end), sigma the
+    largest finite deviation of the sizes it moves: a fit held at the smallest size the points
+    allow has an untouched end at the outermost points, where the distance's derivative
+    differs on either side, and growing it first releases the points within their noise of it,
+    after which only what holds the end resists, as the square of the distance. A rise of the
+    residuals' sum of squares below 1 from D to 2 D leaves the end free: the sizes it moves
+    have no deviation, and those the extent prior holds (a box's extents, a cylinder's height,
+    a capsule's length, a cone's height) are lower bounds, three times the largest deviation of
+    the points at that end (at least the median point's) below the fitted size. Each end is
+    grown at two scales, D from the median and from the largest deviation of its points (a few
+    wide points may be all that hold it), and is held when either resists. Otherwise the rise,
+    3 D^2 / s^2, gives the end's own deviation s, and each measured size it moves has a
+    deviation of at least s times the rate it moves at.
     """
     n = len(x)
     jacobian = np.empty((len(residuals(x)), n))
@@ -784,30 +806,53 @@ def size_std(
         shift[j] = JACOBIAN_STEP
         jacobian[:, j] = (residuals(x + shift) - residuals(x - shift)) / (2 * JACOBIAN_STEP)
         gradient[:, j] = (shape.sizes(x + shift) - shape.sizes(x - shift)) / (2 * JACOBIAN_STEP)
-    free = np.zeros(len(shape.size_names), dtype=bool)
     information = jacobian.T @ jacobian
     if not np.all(np.isfinite(information)):
-        return np.full(len(shape.size_names), np.inf), free
+        return np.full(len(shape.size_names), np.inf), np.full(len(shape.size_names), np.nan)
     eigenvalues, eigenvectors = np.linalg.eigh(information)
     floor = EIGEN_FLOOR * max(float(eigenvalues[-1]), np.finfo(float).tiny)
     variance = np.sum((gradient @ eigenvectors) ** 2 / np.maximum(eigenvalues, floor), axis=1)
     std = np.where(np.sqrt(variance) <= spread, np.sqrt(variance), np.inf)
-    noise = float(np.percentile(point_std, 90.0)) if len(point_std) else 0.0
+    at_x = residuals(x)
+    typical = float(np.median(point_std[np.isfinite(point_std)])) if len(point_std) else 0.0
+    held_by_prior = [name in _PRIOR_HELD.get(shape.name, ()) for name in shape.size_names]
+    margin = np.full(len(shape.size_names), np.nan)
     for sizes, change in shape.growths(x):
-        moved = std[list(sizes)]
-        finite = moved[np.isfinite(moved)]
-        step = max(2.0 * float(finite.max()) if finite.size else 0.0, 3.0 * noise)
+        # the points whose distance moves with this end (at least half as fast), and the step
+        # from their deviations: near the end, before any of them meets another face
+        moved = residuals(x + JACOBIAN_STEP * change)[: len(point_std)] - at_x[: len(point_std)]
+        finite_std = np.isfinite(point_std)
+        attached = finite_std & (
+            np.abs(moved) * np.where(finite_std, point_std, 0.0) > 0.5 * JACOBIAN_STEP
+        )
+        widths = point_std[attached] if np.any(attached) else np.array([typical])
+        finite = std[list(sizes)][np.isfinite(std[list(sizes)])]
+        least = 2.0 * float(finite.max()) if finite.size else 0.0
+        # at two scales: the typical attached point's, and the widest's (a few wide points may
+        # be all that hold an end); held when either resists
+        rise, step = 0.0, 0.0
+        for width in sorted({float(np.median(widths)), float(np.max(widths))}):
+            d = max(least, 3.0 * width)
+            if not d > 0.0:
+                continue
+            near, far = (float(np.sum(residuals(x + k * d * change) ** 2)) for k in (1.0, 2.0))
+            if far - near >= max(rise, 1.0) or not step:
+                rise, step = far - near, d
         if not step > 0.0:
             continue
-        near, far = (float(np.sum(residuals(x + k * step * change) ** 2)) for k in (1.0, 2.0))
-        rise = far - near
-        end = step * math.sqrt(3.0 / rise) if rise > 0.0 else math.inf
-        if end > spread:
-            free[list(sizes)] = True
-            std[list(sizes)] = np.inf
-        else:
-            std[list(sizes)] = np.maximum(std[list(sizes)], end)
-    return np.asarray(std), free
+        noise = float(np.max(widths))
+        for index in sizes:
+            if rise < 1.0:
+                # a free end: a size the prior held at the outermost points is a lower bound,
+                # three of their largest deviation below it; any other is not measured
+                std[index] = np.inf
+                if held_by_prior[index]:
+                    margin[index] = max(np.nan_to_num(margin[index]), 3.0 * max(noise, typical))
+            elif math.isfinite(std[index]):
+                # the end's own deviation, carried to this size (a cone's radius moves by R / h)
+                rate = abs(float(shape.sizes(x + change)[index] - shape.sizes(x)[index]))
+                std[index] = max(std[index], rate * step * math.sqrt(3.0 / rise))
+    return np.asarray(std), margin
 
 
 def fit_mesh(
@@ -1078,6 +1123,10 @@ def recognise(
             f,
             score=f.chi2 / c + f.dof * n_log,
             size_std={k: v * math.sqrt(c) for k, v in f.size_std.items()},
+            size_at_least={
+                k: max(f.sizes[k] - (f.sizes[k] - v) * math.sqrt(c), 0.0)
+                for k, v in f.size_at_least.items()
+            },
         )
         for f in fits
     ]

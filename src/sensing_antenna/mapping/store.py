@@ -201,8 +201,8 @@ def report(contact_map: ContactMap) -> str:
             " each at most its outlier cap; the lines' and the swept links' own sums of squares,"
             " uncapped, are beside it.",
             "",
-            "A size is given with its standard deviation; one the points leave free (a side"
-            " never touched) as at least the size the points show.",
+            "A size is given with its standard deviation; one with an end never touched as a"
+            " lower bound (at least), one the points do not hold as not measured.",
             "",
             "| class | RMS (mm) | chi^2 | lines | swept | score | weight | sizes |",
             "|---|---|---|---|---|---|---|---|",
