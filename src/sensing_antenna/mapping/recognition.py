@@ -814,7 +814,8 @@ def size_std(
     variance = np.sum((gradient @ eigenvectors) ** 2 / np.maximum(eigenvalues, floor), axis=1)
     std = np.where(np.sqrt(variance) <= spread, np.sqrt(variance), np.inf)
     at_x = residuals(x)
-    typical = float(np.median(point_std[np.isfinite(point_std)])) if len(point_std) else 0.0
+    kept = point_std[np.isfinite(point_std)]  # every point counted wrong: none
+    typical = float(np.median(kept)) if kept.size else 0.0
     held_by_prior = [name in _PRIOR_HELD.get(shape.name, ()) for name in shape.size_names]
     margin = np.full(len(shape.size_names), np.nan)
     for sizes, change in shape.growths(x):
