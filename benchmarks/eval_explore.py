@@ -206,20 +206,20 @@ def make_scene(
 
 def size_error(name: str, fitted: dict[str, float], truth: dict[str, Any]) -> float:
     """Largest relative error over the class's sizes (box extents sorted)."""
-    got, _, true = matched_sizes(name, fitted, dict.fromkeys(fitted, math.nan), truth)
-    return float(np.max(np.abs(got / true - 1)))
+    return size_scores(name, fitted, {}, truth)[0]
 
 
 def matched_sizes(
     name: str, fitted: dict[str, float], std: dict[str, float], truth: dict[str, Any]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The fitted sizes, their standard deviations and the true sizes, matched (m): a box's
-    extents sorted by size (its axes are its own), the others by name."""
+    """The fitted sizes, their standard deviations (NaN where ``std`` has none) and the true
+    sizes, matched (m): a box's extents sorted by size (its axes are its own), the others by
+    name."""
     if name == "box":
         order = np.argsort(list(fitted.values()))
         return (
             np.array(list(fitted.values()))[order],
-            np.array(list(std.values()))[order],
+            np.array([std.get(k, math.nan) for k in fitted])[order],
             np.sort(truth["extents"]),
         )
     keys = list(truth)

@@ -689,13 +689,16 @@ def fit_primitive(
         distance = model.signed_distance(x, p)
         return _z2(distance, normal_sigma, line_residuals(x, normal_sigma))
 
-    def refine(x: FloatArray) -> FloatArray:
-        # each point's sigma along the fitted surface's normal, and the link's lines; a point
-        # the mixture counts as wrong at x (its z^2 beyond its cap) leaves the refinement, and
-        # so do free-space samples far outside the shape at x
-        normal_sigma = _normal_sigma(cov, model.normals(x, p))
+    def inlier_sigma(x: FloatArray, normal_sigma: FloatArray) -> FloatArray:
+        # a point the mixture counts as wrong at x (its z^2 beyond its cap) weighs nothing
         wrong = point_z2(x, normal_sigma) > outlier_cap(normal_sigma, spread)
-        normal_sigma = np.where(wrong, np.inf, normal_sigma)
+        return np.where(wrong, np.inf, normal_sigma)
+
+    def refine(x: FloatArray) -> FloatArray:
+        # each point's sigma along the fitted surface's normal, and the link's lines; the
+        # points counted wrong leave the refinement, and so do free-space samples far outside
+        # the shape at x
+        normal_sigma = inlier_sigma(x, _normal_sigma(cov, model.normals(x, p)))
         regions = [
             space.within(model.signed_distance(x, space.samples), FREE_ACTIVE) for space in spaces
         ]
@@ -730,7 +733,7 @@ def fit_primitive(
     distance = model.signed_distance(x, p)
     sigma = _normal_sigma(cov, model.normals(x, p))
     # the evidence alone, without the extent prior, the points counted wrong left out
-    kept = np.where(point_z2(x, sigma) > outlier_cap(sigma, spread), np.inf, sigma)
+    kept = inlier_sigma(x, sigma)
 
     def evidence(v: FloatArray) -> FloatArray:
         return np.concatenate(
@@ -799,7 +802,8 @@ def size_std(
     deviation of at least s times the rate it moves at.
     """
     n = len(x)
-    jacobian = np.empty((len(residuals(x)), n))
+    at_x = residuals(x)
+    jacobian = np.empty((len(at_x), n))
     gradient = np.empty((len(shape.size_names), n))
     for j in range(n):
         shift = np.zeros(n)
@@ -813,19 +817,15 @@ def size_std(
     floor = EIGEN_FLOOR * max(float(eigenvalues[-1]), np.finfo(float).tiny)
     variance = np.sum((gradient @ eigenvectors) ** 2 / np.maximum(eigenvalues, floor), axis=1)
     std = np.where(np.sqrt(variance) <= spread, np.sqrt(variance), np.inf)
-    at_x = residuals(x)
-    kept = point_std[np.isfinite(point_std)]  # every point counted wrong: none
-    typical = float(np.median(kept)) if kept.size else 0.0
+    kept = np.isfinite(point_std)  # every point counted wrong: none
+    typical = float(np.median(point_std[kept])) if np.any(kept) else 0.0
     held_by_prior = [name in _PRIOR_HELD.get(shape.name, ()) for name in shape.size_names]
     margin = np.full(len(shape.size_names), np.nan)
     for sizes, change in shape.growths(x):
         # the points whose distance moves with this end (at least half as fast), and the step
         # from their deviations: near the end, before any of them meets another face
         moved = residuals(x + JACOBIAN_STEP * change)[: len(point_std)] - at_x[: len(point_std)]
-        finite_std = np.isfinite(point_std)
-        attached = finite_std & (
-            np.abs(moved) * np.where(finite_std, point_std, 0.0) > 0.5 * JACOBIAN_STEP
-        )
+        attached = kept & (np.abs(moved) * np.where(kept, point_std, 0.0) > 0.5 * JACOBIAN_STEP)
         widths = point_std[attached] if np.any(attached) else np.array([typical])
         finite = std[list(sizes)][np.isfinite(std[list(sizes)])]
         least = 2.0 * float(finite.max()) if finite.size else 0.0
@@ -842,6 +842,7 @@ def size_std(
         if not step > 0.0:
             continue
         noise = float(np.max(widths))
+        rates = np.abs(shape.sizes(x + change) - shape.sizes(x))  # per metre of growth
         for index in sizes:
             if rise < 1.0:
                 # a free end: a size the prior held at the outermost points is a lower bound,
@@ -851,8 +852,7 @@ def size_std(
                     margin[index] = max(np.nan_to_num(margin[index]), 3.0 * max(noise, typical))
             elif math.isfinite(std[index]):
                 # the end's own deviation, carried to this size (a cone's radius moves by R / h)
-                rate = abs(float(shape.sizes(x + change)[index] - shape.sizes(x)[index]))
-                std[index] = max(std[index], rate * step * math.sqrt(3.0 / rise))
+                std[index] = max(std[index], rates[index] * step * math.sqrt(3.0 / rise))
     return np.asarray(std), margin
 
 
