@@ -316,6 +316,23 @@ def test_the_device_is_identified_before_it_explores(
     assert bends and all(0.02 < bend < 0.045 for bend in bends), bends
 
 
+def test_the_preparation_calibrates_the_links_own_stiffness(
+    explored: tuple[Path, list[Manoeuvre]],
+) -> None:
+    # T_e from the five smooth posts against T = sqrt(rho / (E I)) of the simulated link, in
+    # closed form: the exact link pinned by a smooth post rings on the model's curve within its
+    # contact's compliance and the spectral estimate's resolution, 0.1 %. A post that grips the
+    # link (mu 0.6) rings lower by about twice that, which T_e would carry into every estimate.
+    from sensing_antenna.antenna import load_antenna
+
+    out, _ = explored
+    radius = DEVICE.link.radius
+    second_moment = np.pi * radius**4 / 4
+    t_link = np.sqrt(DEVICE.link.linear_density / (DEVICE.link.youngs_modulus * second_moment))
+    prepared = load_antenna(out / "calibrated.toml")
+    assert prepared.link.calibrated_t == pytest.approx(t_link, rel=1e-3)
+
+
 def test_a_directory_prepared_otherwise_is_not_resumed(
     explored: tuple[Path, list[Manoeuvre]], tmp_path: Path
 ) -> None:
