@@ -499,15 +499,16 @@ def test_an_object_recognised_at_the_budget_ends_the_exploration(
 
     import sensing_antenna.exploration.run as run
 
-    monkeypatch.setattr(
-        run, "recognise_points", lambda *args, **kwargs: types.SimpleNamespace(undecided=False)
-    )
+    named = types.SimpleNamespace(undecided=False)
+    monkeypatch.setattr(run, "recognise_points", lambda *args, **kwargs: named)
     out = tmp_path / "named"
     out.mkdir()
     (out / "calibrated.toml").write_text((explored[0] / "calibrated.toml").read_text())
     settings = ExploreSettings(method="paper", budget=2, until_recognised=3)
     result = explore(load_scene("post"), DEVICE, out, settings)
     assert [m.aim for m in result.manoeuvres] == ["plan", "plan"]
+    # the map keeps the recognition that ended the sweeps, made of the same points
+    assert result.contact_map.recognition is named
 
 
 def _outline_contacts(

@@ -88,7 +88,7 @@ from sensing_antenna.mapping.free_space import (
 )
 from sensing_antenna.mapping.points import ContactPoint
 from sensing_antenna.mapping.primitives import PRIMITIVES
-from sensing_antenna.mapping.recognition import ClassFit
+from sensing_antenna.mapping.recognition import ClassFit, Recognition
 from sensing_antenna.recording import write_recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.simulate import simulate_sweep
@@ -96,6 +96,9 @@ from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.simulator.scenario import LINK_MODELS
 
 FloatArray = NDArray[np.float64]
+
+#: A recognition that names an object (else None), and the two fits it abstains between.
+RecognitionState = tuple[Recognition | None, tuple[ClassFit, ...]]
 
 #: A stored recording's links (``mapping.free_space.recording_links``) and its first motor
 #: angles (rad, shape (2,)).
@@ -432,8 +435,9 @@ def explore(
             # the planner of the sweeps after the budget (next-best's own, or one made then)
             chooser = planner
             leaders: tuple[ClassFit, ...] = ()
+            final: Recognition | None = None  # the last recognition, when it ended the sweeps
 
-            def recognised(upto: list[Manoeuvre]) -> tuple[bool, tuple[ClassFit, ...]]:
+            def recognised(upto: list[Manoeuvre]) -> RecognitionState:
                 return _recognition_state(
                     [m.point for m in upto if m.point is not None],
                     settings.include_uncertain,
@@ -463,8 +467,9 @@ def explore(
                         _, leaders = recognised(manoeuvres)
                     choice = planner.choose(done, surface, free, leaders)
                 elif index < end + settings.until_recognised:
-                    decided, leaders = recognised(manoeuvres)
-                    if decided:
+                    named, leaders = recognised(manoeuvres)
+                    if named is not None:
+                        final = named  # of every point and swept link: the map's own
                         break
                     chooser = chooser if chooser is not None else NextBestPlanner(scene, shape)
                     surface = fit_surface(points, settings.include_uncertain)
@@ -487,7 +492,9 @@ def explore(
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
     swept = swept_links(manoeuvres, scene, antenna, out, recorded)
-    contact_map = build_map(points, settings.include_uncertain, meshes=meshes, swept=swept)
+    contact_map = build_map(
+        points, settings.include_uncertain, meshes=meshes, swept=swept, recognition=final
+    )
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 
 
@@ -556,18 +563,18 @@ def _recognition_state(
     include_uncertain: bool,
     swept: Sequence[FreeSpace],
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
-) -> tuple[bool, tuple[ClassFit, ...]]:
-    """Whether recognition (the map's, with the user's ``meshes``) names an object from the
-    points so far, and, when it abstains, the two fits it abstains between (the best and its
-    rival, or the two leading scores) if both are primitives (else none)."""
+) -> RecognitionState:
+    """The recognition (the map's, with the user's ``meshes``) of the points so far when it
+    names an object (else None), and, when it abstains, the two fits it abstains between (the
+    best and its rival, or the two leading scores) if both are primitives (else none)."""
     recognition = recognise_points(points, include_uncertain, meshes, swept=swept)
     if recognition is None:
-        return False, ()
+        return None, ()
     if not recognition.undecided:
-        return True, ()
+        return recognition, ()
     by_name = {f.name: f for f in recognition.fits}
     leaders = tuple(by_name[name] for name in recognition.candidates)
-    return False, leaders if all(f.name in PRIMITIVES for f in leaders) else ()
+    return None, leaders if all(f.name in PRIMITIVES for f in leaders) else ()
 
 
 def _run_one(

@@ -259,16 +259,20 @@ def build_map(
     surface: ImplicitSurface | None = None,
     rng: np.random.Generator | None = None,
     swept: Sequence[FreeSpace] = (),
+    recognition: Recognition | None = None,
 ) -> ContactMap:
     """The map from points (module docstring); the surface and recognition when possible,
-    recognition also weighing ``swept``, where links swept untouched and where they touched."""
+    recognition also weighing ``swept``, where links swept untouched and where they touched.
+    ``surface`` and ``recognition``, when given, are those already made of the same points
+    (and swept links), and are kept."""
     used = select_points(list(points), include_uncertain)
     fitted = fit_surface(used, True, surface)
     mesh = None
     std = np.zeros(0)
     if fitted is not None:
         mesh, std = fitted.mesh()
-    recognition = recognise_points(used, True, meshes, rng, swept)
+    if recognition is None:
+        recognition = recognise_points(used, True, meshes, rng, swept)
     return ContactMap(
         points=tuple(points),
         used=tuple(used),
