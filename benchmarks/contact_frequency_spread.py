@@ -3,7 +3,7 @@
 The evidence for the fast method's ``frequency_floor`` (docs/fast.md, "Posterior and floors"):
 the paper antenna prepared as ``antenna explore`` prepares it (``prepare_device``: the observer
 identified on two free sweeps, so that the push past the touch bends the link about 3 % of
-x_c, then T_e calibrated on five posts), pushed with the simulator's geometrically exact link
+x_c, then T_e calibrated on five smooth posts), pushed with the simulator's geometrically exact link
 against posts and balls of 3 mm and 3 cm radius with friction coefficients 0, 0.3 and 0.6, at
 x_c = 0.30 to 0.90 m every 5 cm (one seed each). For every contact that held to the end,
 against the calibrated sensing curve at the recording's ``true_xc``, in per cent: omega_1 as

@@ -22,7 +22,7 @@ contacts stay below 40 per object.
 Each scene is explored twice with ``exploration.explore`` (every sweep simulated: first touch,
 contact physics, recording, estimate with ``--method``), once per strategy with the grid's size as
 the budget, on the antenna of one preparation (the observer identified on free sweeps, then the
-README's five posts; made once and copied into each run's directory), with the simulator's
+five smooth posts; made once and copied into each run's directory), with the simulator's
 geometrically exact link (``--link linear``: the small-deflection one). Per scene and strategy: the
 contacts (sweeps that touched), the points used (status ok), the RMS and largest distance of the
 points to the true surface, the RMS of the fitted surface to the true one near the points (mesh

@@ -10,7 +10,7 @@ a 90th percentile of 2.50, the chi distribution's with 3 degrees of freedom), an
 parts along the link X^m, along the push across it, across the bending plane and along the
 touched surface's normal, each with the covariance's standard deviation in that direction.
 Each link is prepared on itself as ``antenna explore`` prepares it (the observer identified on
-free sweeps, then the README's five posts).
+free sweeps, then five smooth posts).
 
 The linear link is linear in its deflection: its points do not move along X^m (docs/simulator.md),
 while a real link, inextensible, shortens by delta = x_c - p . X^m as it bends, about 3 y_c^2 /

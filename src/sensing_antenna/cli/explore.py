@@ -23,8 +23,8 @@ def register(subparsers: Any) -> None:
         "explore",
         help="explore a scene with the simulated device: sweeps, contacts, surface, object",
         description=(
-            "Prepares the simulated device as the README's session does (its observer and contact "
-            "threshold identified on two free sweeps, T_e calibrated on five posts at known "
+            "Prepares the simulated device as a lab prepares its own (its observer and contact "
+            "threshold identified on two free sweeps, T_e calibrated on five smooth posts at known "
             "points), then runs sweeps of the head in SCENE (a built-in scene or a scene file): "
             "each sweep's first touch is simulated with the simulator's contact physics, written "
             "as a recording with its base_pose, estimated and placed in the world with its "

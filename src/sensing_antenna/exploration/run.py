@@ -3,14 +3,15 @@
 The device's job as the paper's algorithm states it (Section 4: sweep, contact, push, estimate,
 retract, re-plan), on the simulator:
 
-1. **Prepare** (once per output directory), as the README does for a real device before it
-   measures: the free-motion observer (Eq. 15) and contact threshold identified on a free
-   sweep of each joint (``identify_free_motion``), then five sweeps into posts at known x_c
-   (0.3 to 0.9 m) and ``calibrate_from_recordings``; the identified and calibrated antenna is
-   written to ``calibrated.toml``. The estimators use it; the simulated device keeps its own
-   link and takes the identified observer and threshold for its controller, as a lab's head
-   does (``campaign.simulated.knowing_weight``). The simulated link is the settings' ``link``,
-   the geometrically exact one by default, for the preparation and every sweep alike.
+1. **Prepare** (once per output directory), as a lab prepares its device before it measures
+   (docs/real-antenna.md): the free-motion observer (Eq. 15) and contact threshold identified
+   on a free sweep of each joint (``identify_free_motion``), then five sweeps into smooth posts
+   at known x_c (0.3 to 0.9 m) and ``calibrate_from_recordings``; the identified and
+   calibrated antenna is written to ``calibrated.toml``. The estimators use it; the simulated
+   device keeps its own link and takes the identified observer and threshold for its
+   controller, as a lab's head does (``campaign.simulated.knowing_weight``). The simulated
+   link is the settings' ``link``, the geometrically exact one by default, for the
+   preparation and every sweep alike.
 2. **Each manoeuvre**: the planner (``exploration.plan``: ``grid`` or ``next-best``) picks a
    sweep; ``scene.simulate_sweep`` finds its first touch and simulates it; the recording is
    written (its ``base_pose`` says where it was taken) and estimated by the map's own code path
@@ -125,16 +126,13 @@ CALIBRATION_POINTS = (0.3, 0.45, 0.6, 0.75, 0.9)
 #: The calibration manoeuvres' seeds start here (the README's).
 CALIBRATION_SEED = 10
 
-#: The calibration's posts are smooth pins (Coulomb coefficient between link and post): a post
-#: that grips the link holds the pushed, bent link along its length, and the link then rings
-#: below the pinned contact of the frequency model by an amount that depends on the grip, which
-#: T_e would carry into every estimate as a bias along the link. A smooth pin comes nearest the
-#: model, as a polished pin or a roller does in a lab (docs/real-antenna.md).
+#: Coulomb coefficient between the link and the calibration's posts: smooth posts, so that T_e
+#: is the link's own stiffness and not a contact's (docs/real-antenna.md, step 4).
 CALIBRATION_FRICTION = 0.0
 
 #: What the preparation does (stored with the settings: a directory prepared otherwise is not
 #: resumed).
-PREPARATION = "observer identified on free sweeps, then T_e calibrated on posts"
+PREPARATION = "observer identified on free sweeps, then T_e calibrated on smooth posts"
 
 #: The free sweeps the observer is identified on (one of each joint), their length (s) and
 #: their first seed.
@@ -259,11 +257,12 @@ class Exploration:
 
 
 def prepare_device(device: Antenna, folder: Path | None = None, link: str = "nonlinear") -> Antenna:
-    """The README's preparation of the simulated ``device``, with the simulator's ``link``
-    model: the observer and contact threshold identified on :data:`FREE_MOTION_CASES` (seeds
-    from :data:`FREE_MOTION_SEED`), then T_e calibrated on posts at
-    :data:`CALIBRATION_POINTS` (seeds from :data:`CALIBRATION_SEED`) touched by the device with
-    that observer; every recording is written into ``folder`` when given.
+    """The preparation of the simulated ``device`` (module docstring), with the simulator's
+    ``link`` model: the observer and contact threshold identified on :data:`FREE_MOTION_CASES`
+    (seeds from :data:`FREE_MOTION_SEED`), then T_e calibrated on smooth posts
+    (:data:`CALIBRATION_FRICTION`) at :data:`CALIBRATION_POINTS` (seeds from
+    :data:`CALIBRATION_SEED`) touched by the device with that observer; every recording is
+    written into ``folder`` when given.
 
     Returns
     -------

@@ -263,8 +263,9 @@ def build_map(
 ) -> ContactMap:
     """The map from points (module docstring); the surface and recognition when possible,
     recognition also weighing ``swept``, where links swept untouched and where they touched.
-    ``surface`` and ``recognition``, when given, are those already made of the same points
-    (and swept links), and are kept."""
+    ``surface`` (its settings) is fitted to the points as :func:`fit_surface` fits it;
+    ``recognition``, when given, is one already made of the same points, swept links and
+    meshes, and is kept (``rng`` then unused)."""
     used = select_points(list(points), include_uncertain)
     fitted = fit_surface(used, True, surface)
     mesh = None
