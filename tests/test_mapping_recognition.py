@@ -237,6 +237,8 @@ def test_a_capsule_shrunk_onto_a_ball_is_not_its_runner_up() -> None:
     assert result.decision == "sphere"
     assert "capsule" not in result.candidates
     assert result.same_shape == ("capsule",)
+    # the score gap is to the next shape, which the report names
+    assert result.runner_up == result.candidates[1] != "capsule"
     assert result.delta_score > 20.0
     assert result.confidence >= result.confidence_floor
 

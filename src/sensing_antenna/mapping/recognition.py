@@ -421,6 +421,9 @@ class Recognition:
         A class the points do not rule out that is a different shape from the best's.
     same_shape : tuple of str
         Runner-ups whose fitted shape is the best's: their weight counts with the best's.
+    runner_up : str or None
+        The best runner-up of another shape, the one :attr:`delta_score` is to (None without
+        one).
     """
 
     decision: str
@@ -432,6 +435,7 @@ class Recognition:
     overdispersion: float = 1.0
     rival: str | None = None
     same_shape: tuple[str, ...] = ()
+    runner_up: str | None = None
 
     @property
     def best(self) -> ClassFit:
@@ -459,6 +463,7 @@ class Recognition:
             "overdispersion": float(self.overdispersion),
             "rival": self.rival,
             "same_shape": list(self.same_shape),
+            "runner_up": self.runner_up,
             "fits": [f.to_dict() for f in self.fits],
         }
 
@@ -1187,4 +1192,5 @@ def recognise(
         overdispersion=float(c),
         rival=None if rival is None else rival.name,
         same_shape=tuple(f.name for f in same),
+        runner_up=others[0].name if others else None,
     )

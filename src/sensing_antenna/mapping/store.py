@@ -157,12 +157,7 @@ def report(contact_map: ContactMap) -> str:
     if recognition is None:
         lines.append("Recognition: not attempted (fewer than 10 points).")
     else:
-        # without a rival the second candidate is the best of another shape
-        runner_up = (
-            f" ({recognition.candidates[1]})"
-            if recognition.rival is None and len(recognition.candidates) > 1
-            else ""
-        )
+        runner_up = "" if recognition.runner_up is None else f" ({recognition.runner_up})"
         lines += [
             f"Recognition: **{recognition.decision}**"
             + (
