@@ -550,8 +550,9 @@ _PRIOR_HELD = {
 
 
 def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
-    """How far the shape's extents along its own axes exceed the points' span there (m)."""
-    if name in ("plane", "sphere", "torus"):
+    """How far the shape's extents along its own axes exceed the points' span there (m), for
+    the classes of :data:`_PRIOR_HELD`."""
+    if name not in _PRIOR_HELD:
         return np.zeros(0)
     local = local_coordinates(x, points)
     span = local.max(axis=0) - local.min(axis=0)
