@@ -490,7 +490,9 @@ def explore(
             raise ExplorationInterrupted(number, len(manoeuvres), out) from None
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
-    swept = swept_links(manoeuvres, scene, antenna, out, recorded)
+    # the swept links are recognition's evidence only: the recognition that ended the sweeps
+    # has weighed them already
+    swept = () if final is not None else swept_links(manoeuvres, scene, antenna, out, recorded)
     contact_map = build_map(
         points, settings.include_uncertain, meshes=meshes, swept=swept, recognition=final
     )
