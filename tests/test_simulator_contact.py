@@ -15,7 +15,7 @@ from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.calibration.observer import identify_free_motion
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, ScenarioError, simulate, simulate_detailed
-from sensing_antenna.simulator.contact import motor_frame
+from sensing_antenna.simulator.contact import Obstacle, motor_frame
 from sensing_antenna.simulator.run import (
     SMALL_DEFLECTION_LIMIT,
     deflection_warning,
@@ -356,3 +356,18 @@ def test_a_ball_keeps_the_contact_on_its_surface_where_a_post_lets_it_slide() ->
 
     assert abs(off_sphere("ball")) < 2e-5
     assert off_sphere("post") > 1e-3
+
+
+@pytest.mark.parametrize("kind", ["post", "ball", "plane"])
+def test_an_obstacles_outward_normal_is_the_gradient_of_its_gap(kind: str) -> None:
+    # central differences of the signed distance, 1e-6 m steps: the gradient to about 1e-9
+    obstacle = Obstacle(kind, (0.5, 0.1, -0.2), (0.0, 0.6, 0.8), 0.0 if kind == "plane" else 0.03)
+    rng = np.random.default_rng(3)
+    points = np.asarray(obstacle.point) + rng.normal(0.0, 0.05, (20, 3))
+    normals = obstacle.outward_normals(points)
+    for point, normal in zip(points, normals, strict=True):
+        gradient = [
+            (obstacle.gap(point + 1e-6 * e) - obstacle.gap(point - 1e-6 * e)) / 2e-6
+            for e in np.eye(3)
+        ]
+        assert normal == pytest.approx(gradient, abs=1e-6)

@@ -37,6 +37,7 @@ from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
     "COMMAND_COLUMNS",
+    "CONTACT_TRACK_COLUMNS",
     "FORMAT_NAME",
     "GROUND_TRUTH_KEYS",
     "GROUND_TRUTH_PREFIX",
@@ -69,6 +70,11 @@ REQUIRED_COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
 #: its sample's time until the next sample's. Read by ``antenna identify --servo``; a recording
 #: without them is read as before.
 COMMAND_COLUMNS = ("u1", "u2")
+
+#: Optional ground-truth columns of a simulated contact's track (a scene's sweeps write them):
+#: the contact point in the absolute frame (m) at every sample, and 1 while in contact (0 before
+#: the touch and after a release, where the point's columns hold 0).
+CONTACT_TRACK_COLUMNS = ("true_contact_x", "true_contact_y", "true_contact_z", "true_in_contact")
 
 #: Metadata keys that hold ground truth besides those starting with :data:`GROUND_TRUTH_PREFIX`.
 GROUND_TRUTH_KEYS = frozenset({"seed", "simulation"})

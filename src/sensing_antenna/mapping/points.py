@@ -2,7 +2,8 @@
 
 An estimate gives the touched point in the recording's absolute frame (``contact_point``),
 p_a = x_c X^m + y_c Y^c + s A, the abscissa x_c along the link's rigid line X^m (at t_1's motor
-angles), bent by the push deflection y_c along Y^c and by the weight's sag s along A (the part of
+angles), bent by the push deflection y_c along Y^c (the reaction's direction at the instant the
+point describes, the diagnostics' ``t_point``) and by the weight's sag s along A (the part of
 -Z^a across the link; estimation/methods/touch_point.py): a point of the link's axis. The map's
 point is on the link's surface, where the object touches it (the link's thickness, below). Its
 covariance is propagated to first order from independent sources (docs/mapping.md derives each
@@ -159,8 +160,9 @@ class ContactPoint:
     reason : str or None
         Why the status is not ``ok``.
     true_point : array, shape (3,)
-        The simulator's ground truth (``true_contact_point``) in the world frame when known,
-        else NaN; never used to build the map.
+        The simulator's ground truth in the world frame when known (where the contact was at
+        the estimate's ``t_point`` from the recording's contact track, else where it ended,
+        ``true_contact_point``), else NaN; never used to build the map.
     tangent : array, shape (3,)
         The link's unit tangent at the contact, from the base towards the tip (world); NaN when
         not known.

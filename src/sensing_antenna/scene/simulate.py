@@ -54,13 +54,18 @@ import numpy as np
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.mapping.pose import BasePose
-from sensing_antenna.recording import Recording
+from sensing_antenna.recording import CONTACT_TRACK_COLUMNS, Recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.scene.touch import MAX_RADIUS, SweepGeometry, Touch, first_touch
-from sensing_antenna.simulator import Scenario, simulate
+from sensing_antenna.simulator import Scenario
 from sensing_antenna.simulator.contact import motor_frame
-from sensing_antenna.simulator.run import device_link, minimum_contact_point
+from sensing_antenna.simulator.run import (
+    SimulationDetail,
+    device_link,
+    minimum_contact_point,
+    simulate_detailed,
+)
 
 __all__ = [
     "BALL_RATIO",
@@ -276,12 +281,14 @@ def simulate_sweep(
         scenario, frame = touch_scenario(touch, sweep, scene, seed, **scenario_fields)
     except GlancingTouchError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
-    recording = simulate(device, scenario)
+    detail = simulate_detailed(device, scenario)
+    recording = detail.recording
     metadata = dict(recording.metadata)
     metadata["base_pose"] = frame.to_json()
     metadata["true_object"] = touch.object_name
     metadata["true_surface_point"] = json.dumps([float(v) for v in touch.surface_point])
-    recording = replace(recording, metadata=metadata)
+    track = _contact_track(detail, device.link.radius)
+    recording = replace(recording, metadata=metadata, extra={**recording.extra, **track})
     # the recording starts approach_time before the touch (the simulator's own approach)
     touch_time = float(recording.metadata.get("true_t_contact", "nan"))
     after = recording.t[-1] - (touch_time if math.isfinite(touch_time) else 0.0)
@@ -294,3 +301,24 @@ def simulate_sweep(
         frame,
         sweep_time=approach + float(after),
     )
+
+
+def _contact_track(detail: SimulationDetail, radius: float) -> dict[str, np.ndarray]:
+    """Where the object touched the link at every sample, as
+    ``recording.CONTACT_TRACK_COLUMNS``: a contact that slides along the surface after the
+    touch is known where it was at the instant an estimate describes (its ``t_point``), not
+    only where it ended. The simulated contact is on the link's axis, against the obstacle grown
+    by the link's ``radius`` (m; module docstring); the object is touched that far from it,
+    against the obstacle's outward normal, where a map places its points."""
+    touching = np.asarray(detail.in_contact, dtype=bool)
+    axis = np.nan_to_num(detail.contact_point)
+    point = np.zeros_like(axis)
+    if detail.obstacle is not None and touching.any():
+        normals = detail.obstacle.outward_normals(axis[touching])
+        point[touching] = axis[touching] - radius * np.nan_to_num(normals)
+    return {
+        CONTACT_TRACK_COLUMNS[0]: point[:, 0].copy(),
+        CONTACT_TRACK_COLUMNS[1]: point[:, 1].copy(),
+        CONTACT_TRACK_COLUMNS[2]: point[:, 2].copy(),
+        CONTACT_TRACK_COLUMNS[3]: touching.astype(float),
+    }

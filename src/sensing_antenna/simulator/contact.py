@@ -96,6 +96,18 @@ class Obstacle:
         perp = d - (d @ a) * a
         return float(np.linalg.norm(perp) - self.radius)
 
+    def outward_normals(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Unit outward normals (n, 3) at the obstacle's surface points nearest ``points``
+        (n, 3) (m): the gradient of :meth:`gap` (NaN on a cylinder's axis or a ball's centre)."""
+        d = np.asarray(points, dtype=float).reshape(-1, 3) - np.asarray(self.point)
+        a = np.asarray(self.direction)
+        if self.kind == "plane":
+            return np.tile(a, (len(d), 1))
+        if self.kind != "ball":
+            d = d - np.outer(d @ a, a)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.asarray(d / np.linalg.norm(d, axis=1, keepdims=True))
+
     def to_json(self) -> str:
         """JSON text for the recording's ``true_obstacle`` metadata."""
         return json.dumps(

@@ -190,6 +190,20 @@ class ContactFrame:
         norm = self.push_force
         return float(abs(self.reaction_m[0]) / norm) if norm > 0 else float("nan")
 
+    def turned_to(self, reaction_m: FloatArray) -> ContactFrame | None:
+        """The frame at the same motor angles with Y^c along another reaction (motor frame, N,
+        shape (3,)): where the contact is when the reaction has turned, as a contact that
+        slides along the surface turns it. None where Y^c or Z^c is undefined."""
+        axes = _contact_axes(np.asarray(reaction_m, dtype=float), 1.0)
+        if axes is None:
+            return None
+        return ContactFrame(
+            axes_m=axes,
+            motor_axes_a=self.motor_axes_a,
+            theta=self.theta,
+            reaction_m=np.asarray(reaction_m, dtype=float),
+        )
+
 
 def contact_frame(
     theta: FloatArray, reaction_m: FloatArray, link_length: float
@@ -214,21 +228,30 @@ def contact_frame(
     theta_mean = np.mean(np.asarray(theta, dtype=float), axis=0)
     # Section 5.3: Y^c along the reaction of the object on the antenna, averaged over the window
     reaction = np.mean(np.asarray(reaction_m, dtype=float), axis=0)
+    axes = _contact_axes(reaction, link_length)
+    if axes is None:
+        return None
+    return ContactFrame(
+        axes_m=axes,
+        motor_axes_a=motor_axes(theta_mean),
+        theta=theta_mean,
+        reaction_m=reaction,
+    )
+
+
+def _contact_axes(reaction: FloatArray, length: float) -> FloatArray | None:
+    """Rows X^c, Y^c, Z^c in motor coordinates for a reaction (motor frame) and a link of
+    ``length`` (m; it scales OP_r only), or None."""
     norm = float(np.linalg.norm(reaction))
     if norm == 0.0:
         return None
     y_c = reaction / norm
     # Section 5.3: Z^c along OP_r x Y^c, OP_r = l X^m = (l, 0, 0) in motor coordinates
-    z_raw = np.cross(np.array([link_length, 0.0, 0.0]), y_c)
+    z_raw = np.cross(np.array([length, 0.0, 0.0]), y_c)
     z_norm = float(np.linalg.norm(z_raw))
-    if z_norm < 1e-6 * link_length:
+    if z_norm < 1e-6 * length:
         return None
     z_c = z_raw / z_norm
     # Section 5.3: X^c = Y^c x Z^c
     x_c = np.cross(y_c, z_c)
-    return ContactFrame(
-        axes_m=np.vstack([x_c, y_c, z_c]),
-        motor_axes_a=motor_axes(theta_mean),
-        theta=theta_mean,
-        reaction_m=reaction,
-    )
+    return np.vstack([x_c, y_c, z_c])

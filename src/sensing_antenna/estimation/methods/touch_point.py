@@ -72,8 +72,9 @@ def touched_point(
     x_c : float
         Contact point along the link, arc length (m).
     frame : ContactFrame
-        Contact frame at t_1 (axes and motor angles); the push's direction across the link is
-        Y^c without its part along X^m.
+        The motor angles at t_1 and Y^c along the reaction at the instant the point describes
+        (``ContactFrame.turned_to``); the push's direction across the link is Y^c without its
+        part along X^m.
     push_force : float
         |R_perp|, the reaction perpendicular to the link (N), e.g. filtered at t_e.
     link : Link

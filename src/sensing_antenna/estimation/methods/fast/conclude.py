@@ -93,7 +93,13 @@ def conclude_fast(
     push = statics.perpendicular_force if statics is not None else math.nan
     # the axial part of the push is not fitted: the hold's, from the front end
     axial = float(evidence.frame.reaction_m[0])
-    touch = touched_point(post.x_c, evidence.frame, push, evidence.antenna.link, axial)
+    # the point where the contact was at the window's centre, where the fitted statics hold:
+    # the link bends along the reaction it carries then, which has turned from the hold's
+    # when the contact slid along the surface meanwhile
+    frame = evidence.frame
+    if statics is not None:
+        frame = frame.turned_to(np.array([axial, *statics.reaction_perp])) or frame
+    touch = touched_point(post.x_c, frame, push, evidence.antenna.link, axial)
     found = problems(result, config)
     if "second_mode_objection" in diag:
         found.append((Status.ESTIMATORS_DISAGREE, diag["second_mode_objection"]))
@@ -147,9 +153,10 @@ def conclude_fast(
             "push_force": push,
             "deflection": touch.deflection,
             "deflection_ratio": touch.deflection_ratio,
-            # the frame the point was placed in (the map's covariance reads it)
-            "axes_c_absolute": evidence.frame.axes_a,
-            "theta_at_t1": evidence.frame.theta,
+            # the frame the point was placed in and when (the map's covariance reads it)
+            "axes_c_absolute": frame.axes_a,
+            "theta_at_t1": frame.theta,
+            "t_point": 0.5 * float(t[final.start_index] + t[final.end_index]),
             "note": final.note,
             "other_reasons": [text for _, text in found[1:]],
         }

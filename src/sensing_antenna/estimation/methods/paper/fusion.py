@@ -237,9 +237,10 @@ def conclude(
                 )
             )
     push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
-    touch = touched_point(
-        x_c, evidence.frame, push_force, evidence.antenna.link, float(reaction_now[0])
-    )
+    # the point where the contact was at t_e: the link bends along the reaction it carries
+    # then, which has turned from t_1's when the contact slid along the surface meanwhile
+    frame = evidence.frame.turned_to(reaction_now) or evidence.frame
+    touch = touched_point(x_c, frame, push_force, evidence.antenna.link, float(reaction_now[0]))
     if not math.isfinite(x_c):
         found.append((Status.NO_CLEAR_PEAK, "no estimate of x_c could be formed"))
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
@@ -254,8 +255,9 @@ def conclude(
             "direction_drift": drift,
             "deflection": touch.deflection,
             "deflection_ratio": touch.deflection_ratio,
-            "axes_c_absolute": evidence.frame.axes_a,
-            "theta_at_t1": evidence.frame.theta,
+            "axes_c_absolute": frame.axes_a,
+            "theta_at_t1": frame.theta,
+            "t_point": float(evidence.t[e]),
             "delta_t_e2": (
                 float(evidence.t[evidence.converged_index] - evidence.t[evidence.rest_index])
                 if evidence.converged_index is not None
