@@ -6,7 +6,10 @@ with its geometrically exact link (the one ``antenna explore`` simulates by defa
 estimated with ``--method`` after the README's calibration. For every ``ok`` estimate: the
 Mahalanobis distance of the simulator's true contact point under the point's covariance
 (``mapping.contact_point_from_estimate``; a calibrated 3-D covariance gives a median of 1.54 and
-a 90th percentile of 2.50, the chi distribution's with 3 degrees of freedom), and the error's
+a 90th percentile of 2.50, the chi distribution's with 3 degrees of freedom), the true point
+taken where the simulated contact was at the instant the point describes (the estimate's
+``t_point``, read from the recording's contact track), and, beside it, the same distance to
+where the contact ended and how far it slid from the one to the other; and the error's
 parts along the link X^m, along the push across it, across the bending plane and along the
 touched surface's normal, each with the covariance's standard deviation in that direction.
 Each link is prepared on itself as ``antenna explore`` prepares it (the observer identified on
@@ -46,6 +49,7 @@ from sensing_antenna.mapping import (  # noqa: E402
     PointUncertainty,
     contact_point_from_estimate,
 )
+from sensing_antenna.recording import CONTACT_TRACK_COLUMNS  # noqa: E402
 from sensing_antenna.scene import LinkShape, simulate_sweep  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "point_covariance.json"
@@ -64,7 +68,13 @@ def measure(outcome: Any, antenna: Any, method: str) -> dict[str, float] | None:
     result = estimate(recording.without_ground_truth(), antenna, method=method)
     if result.status.value != "ok" or result.trace is None or result.trace.frame is None:
         return None
-    truth = np.asarray(json.loads(recording.metadata["true_contact_point"]), dtype=float)
+    # where the simulated contact was at the instant the point describes (the recording's
+    # contact track), and where it ended
+    # (the nearest sample in contact: a contact may open and close again after t_1)
+    touching = np.flatnonzero(recording.extra[CONTACT_TRACK_COLUMNS[3]] > 0.5)
+    k = int(touching[np.argmin(np.abs(recording.t[touching] - result.diagnostics["t_point"]))])
+    track = np.column_stack([recording.extra[name] for name in CONTACT_TRACK_COLUMNS[:3]])
+    truth, ended = track[k], track[touching[-1]]
     point = contact_point_from_estimate(result, antenna, BasePose.identity())
     error = point.point - truth
     frame = result.trace.frame
@@ -76,6 +86,9 @@ def measure(outcome: Any, antenna: Any, method: str) -> dict[str, float] | None:
     normal = outcome.frame.rotation.T @ outcome.touch.normal
     row = {"x_c": float(result.x_c)}
     row["mahalanobis"] = float(math.sqrt(error @ np.linalg.solve(point.covariance, error)))
+    row["slide_after_m"] = float(np.linalg.norm(ended - truth))
+    late = point.point - ended
+    row["mahalanobis_ended"] = float(math.sqrt(late @ np.linalg.solve(point.covariance, late)))
     axes = (("along", x_m), ("push", push), ("binormal", binormal), ("normal", normal))
     for name, axis in axes:
         row[f"error_{name}_m"] = float(error @ axis)
@@ -98,10 +111,19 @@ def measure(outcome: Any, antenna: Any, method: str) -> dict[str, float] | None:
 
 def summarise(rows: list[dict[str, float]]) -> dict[str, Any]:
     distances = np.array([r["mahalanobis"] for r in rows])
+    ended = np.array([r["mahalanobis_ended"] for r in rows])
+    slide = np.array([r["slide_after_m"] for r in rows])
     summary: dict[str, Any] = {
         "points": len(rows),
         "mahalanobis_quantiles": {
             str(q): float(np.quantile(distances, q)) for q in (0.1, 0.5, 0.9, 0.99)
+        },
+        "ended": {
+            "mahalanobis_quantiles": {
+                str(q): float(np.quantile(ended, q)) for q in (0.1, 0.5, 0.9, 0.99)
+            },
+            "slide_median_m": float(np.median(slide)),
+            "slide_p90_m": float(np.quantile(slide, 0.9)),
         },
     }
     for name in PARTS:
@@ -163,6 +185,13 @@ def main() -> None:
         )
         quantiles = f"{q['0.1']:8.2f} {q['0.5']:6.2f} {q['0.9']:6.2f}"
         print(f"{link:9s} {s['points']:6d} {quantiles}   {parts}")
+        e = s["ended"]
+        q = e["mahalanobis_quantiles"]
+        print(
+            f"{'':9s} to where the contact ended: Mahalanobis {q['0.1']:.2f} {q['0.5']:.2f}"
+            f" {q['0.9']:.2f}; slid {1000 * e['slide_median_m']:.2f} mm (median),"
+            f" {1000 * e['slide_p90_m']:.2f} mm (90 %) after the point's instant"
+        )
         for rho in RHOS:
             r = s[f"rho{rho:g}"]
             print(
