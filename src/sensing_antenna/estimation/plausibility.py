@@ -182,7 +182,8 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
 def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     """``estimate`` with x_c = l when it lies past the tip by no more than
     ``disagreement_sigmas`` statistical uncertainties of the ratio at l (otherwise unchanged),
-    the touched point recomputed there."""
+    the touched point recomputed there, where the contact was at the estimate's t_e (the
+    filtered reaction then, as the paper method places its point)."""
     link = evidence.antenna.link
     excess = estimate.x_c - link.length
     if not (math.isfinite(excess) and excess > 0.0):
@@ -191,14 +192,20 @@ def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> Con
     allowed = evidence.config.disagreement_sigmas * sigma
     if not excess <= allowed:
         return estimate
-    push = math.hypot(evidence.frame.reaction_m[1], evidence.frame.reaction_m[2])
-    touch = touched_point(
-        link.length, evidence.frame, push, link, float(evidence.frame.reaction_m[0])
-    )
+    end = evidence.end_index
+    if math.isfinite(estimate.t_e):
+        end = min(int(np.searchsorted(evidence.t, estimate.t_e)), evidence.end_index)
+    reaction = evidence.reaction_f[end]
+    frame = evidence.frame.turned_to(reaction) or evidence.frame
+    push = math.hypot(reaction[1], reaction[2])
+    touch = touched_point(link.length, frame, push, link, float(reaction[0]))
     diagnostics = {
         **estimate.diagnostics,
         "x_c_past_tip": estimate.x_c,
+        "deflection": touch.deflection,
         "deflection_ratio": touch.deflection_ratio,
+        "axes_c_absolute": frame.axes_a,
+        "t_point": float(evidence.t[end]),
     }
     return dataclasses.replace(
         estimate, x_c=link.length, contact_point=touch.point_a, diagnostics=diagnostics
