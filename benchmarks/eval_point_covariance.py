@@ -49,7 +49,7 @@ from sensing_antenna.mapping import (  # noqa: E402
     PointUncertainty,
     contact_point_from_estimate,
 )
-from sensing_antenna.recording import CONTACT_TRACK_COLUMNS  # noqa: E402
+from sensing_antenna.recording import tracked_contact  # noqa: E402
 from sensing_antenna.scene import LinkShape, simulate_sweep  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "point_covariance.json"
@@ -68,18 +68,17 @@ def measure(outcome: Any, antenna: Any, method: str) -> dict[str, float] | None:
     result = estimate(recording.without_ground_truth(), antenna, method=method)
     if result.status.value != "ok" or result.trace is None or result.trace.frame is None:
         return None
-    # where the simulated contact was at the instant the point describes (the recording's
-    # contact track), and where it ended
-    # (the nearest sample in contact: a contact may open and close again after t_1)
-    touching = np.flatnonzero(recording.extra[CONTACT_TRACK_COLUMNS[3]] > 0.5)
-    k = int(touching[np.argmin(np.abs(recording.t[touching] - result.diagnostics["t_point"]))])
-    track = np.column_stack([recording.extra[name] for name in CONTACT_TRACK_COLUMNS[:3]])
-    truth, ended = track[k], track[touching[-1]]
+    # where the link touched at the instant the point describes (the recording's contact
+    # track), and where it ended
+    truth = tracked_contact(recording, result.diagnostics["t_point"])
+    ended = tracked_contact(recording, recording.t[-1])
+    assert truth is not None and ended is not None
     point = contact_point_from_estimate(result, antenna, BasePose.identity())
     error = point.point - truth
-    frame = result.trace.frame
-    x_m = frame.motor_axes_a[0]
-    push = frame.axes_a[1] - (frame.axes_a[1] @ x_m) * x_m
+    # the push and the bending plane as the point was placed: Y^c along the answer's reaction
+    x_m = result.trace.frame.motor_axes_a[0]
+    y_c = np.asarray(result.diagnostics["axes_c_absolute"])[1]
+    push = y_c - (y_c @ x_m) * x_m
     push /= np.linalg.norm(push)
     binormal = np.cross(x_m, push)
     # the touched surface's outward normal in the recording's frame: what recognition weighs

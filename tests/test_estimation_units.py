@@ -169,6 +169,22 @@ def test_axial_reaction_gives_no_frame() -> None:
     assert contact_frame(np.zeros((1, 2)), np.array([[0.1, 0.0, 0.0]]), 0.98) is None
 
 
+def test_a_frame_turned_to_another_reaction_keeps_the_heads_pose() -> None:
+    # the same frame as a fresh one built from the new reaction at the same angles; a reaction
+    # along the link leaves it undefined
+    theta = np.array([[0.2, -0.1]])
+    frame = contact_frame(theta, np.array([[0.0, -0.05, 0.0]]), 0.98)
+    assert frame is not None
+    reaction = np.array([0.01, -0.04, 0.02])
+    turned = frame.turned_to(reaction)
+    fresh = contact_frame(theta, reaction[None, :], 0.98)
+    assert turned is not None and fresh is not None
+    np.testing.assert_allclose(turned.axes_m, fresh.axes_m, atol=1e-14)
+    np.testing.assert_array_equal(turned.motor_axes_a, frame.motor_axes_a)
+    np.testing.assert_array_equal(turned.theta, frame.theta)
+    assert frame.turned_to(np.array([0.1, 0.0, 0.0])) is None
+
+
 def test_rest_found_after_ramp_stops() -> None:
     # The angle ramps until sample 600 then holds with noise 1e-6 rad: rest starts at 600.
     rng = np.random.default_rng(5)

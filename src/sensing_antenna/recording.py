@@ -37,10 +37,12 @@ from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
     "COMMAND_COLUMNS",
+    "CONTACT_POINT_COLUMNS",
     "CONTACT_TRACK_COLUMNS",
     "FORMAT_NAME",
     "GROUND_TRUTH_KEYS",
     "GROUND_TRUTH_PREFIX",
+    "IN_CONTACT_COLUMN",
     "MAX_FILE_BYTES",
     "MAX_PERIODS_PER_SAMPLE",
     "MAX_SAMPLES",
@@ -56,6 +58,7 @@ __all__ = [
     "read_recording",
     "resample_uniform",
     "sample_period_problem",
+    "tracked_contact",
     "write_recording",
 ]
 
@@ -72,9 +75,12 @@ REQUIRED_COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
 COMMAND_COLUMNS = ("u1", "u2")
 
 #: Optional ground-truth columns of a simulated contact's track (a scene's sweeps write them):
-#: the contact point in the absolute frame (m) at every sample, and 1 while in contact (0 before
-#: the touch and after a release, where the point's columns hold 0).
-CONTACT_TRACK_COLUMNS = ("true_contact_x", "true_contact_y", "true_contact_z", "true_in_contact")
+#: where the link touched at every sample (m, absolute frame; docs/recording-format.md) ...
+CONTACT_POINT_COLUMNS = ("true_contact_x", "true_contact_y", "true_contact_z")
+#: ... and 1 while in contact (0 before the touch and after a release, where the point's
+#: columns hold 0).
+IN_CONTACT_COLUMN = "true_in_contact"
+CONTACT_TRACK_COLUMNS = (*CONTACT_POINT_COLUMNS, IN_CONTACT_COLUMN)
 
 #: Metadata keys that hold ground truth besides those starting with :data:`GROUND_TRUTH_PREFIX`.
 GROUND_TRUTH_KEYS = frozenset({"seed", "simulation"})
@@ -809,3 +815,16 @@ def resample_uniform(recording: Recording, period: float | None = None) -> Recor
         extra={k: interp(v) for k, v in recording.extra.items()},
         source=recording.source,
     )
+
+
+def tracked_contact(recording: Recording, t: float) -> NDArray[np.float64] | None:
+    """Where the link touched at the in-contact sample nearest ``t`` (s) by the recording's
+    contact track (:data:`CONTACT_TRACK_COLUMNS`; a contact may open and close again), shape
+    (3,) (m, absolute frame); None without a track, a finite ``t`` or any contact."""
+    if not all(name in recording.extra for name in CONTACT_TRACK_COLUMNS):
+        return None
+    touching = np.flatnonzero(recording.extra[IN_CONTACT_COLUMN] > 0.5)
+    if not (touching.size and math.isfinite(t)):
+        return None
+    k = int(touching[np.argmin(np.abs(recording.t[touching] - t))])
+    return np.array([float(recording.extra[name][k]) for name in CONTACT_POINT_COLUMNS])

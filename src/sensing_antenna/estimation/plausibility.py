@@ -182,8 +182,8 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
 def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     """``estimate`` with x_c = l when it lies past the tip by no more than
     ``disagreement_sigmas`` statistical uncertainties of the ratio at l (otherwise unchanged),
-    the touched point recomputed there, where the contact was at the estimate's t_e (the
-    filtered reaction then, as the paper method places its point)."""
+    the touched point recomputed there with the filtered reaction at the estimate's t_e, as the
+    paper method places its point (the instant it describes lies 1 / omega_c before t_e)."""
     link = evidence.antenna.link
     excess = estimate.x_c - link.length
     if not (math.isfinite(excess) and excess > 0.0):
@@ -205,7 +205,7 @@ def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> Con
         "deflection": touch.deflection,
         "deflection_ratio": touch.deflection_ratio,
         "axes_c_absolute": frame.axes_a,
-        "t_point": float(evidence.t[end]),
+        "t_point": float(evidence.t[end]) - 1.0 / evidence.config.lowpass_cutoff,
     }
     return dataclasses.replace(
         estimate, x_c=link.length, contact_point=touch.point_a, diagnostics=diagnostics

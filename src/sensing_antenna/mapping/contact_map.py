@@ -236,9 +236,13 @@ def _point(
     """The recording's touched point in the world at its base ``pose``
     (:func:`points_from_recordings`)."""
     from sensing_antenna.estimation.pipeline import estimate
+    from sensing_antenna.recording import tracked_contact
 
     result = estimate(recording.without_ground_truth(), antenna, method=method, config=config)
-    truth = _tracked_point(recording, result.diagnostics.get("t_point"))
+    t_point = result.diagnostics.get("t_point")
+    truth = None
+    if isinstance(t_point, (int, float)):
+        truth = tracked_contact(recording, float(t_point))
     if truth is None:
         truth = _true_point(recording.metadata.get("true_contact_point"))
     return contact_point_from_estimate(result, antenna, pose, str(path), uncertainty, truth)
@@ -335,23 +339,6 @@ def link_lines(points: Sequence[ContactPoint]) -> LinkLines | None:
         behind=np.array([c.x_c for c in points]),
         beyond=np.array([c.link_beyond for c in points]),
     )
-
-
-def _tracked_point(recording: Recording, t_point: object) -> FloatArray | None:
-    """The simulated contact at the sample nearest ``t_point`` (s) among those in contact (a
-    contact may open and close again after t_1), when the recording carries its track
-    (``recording.CONTACT_TRACK_COLUMNS``) and touched at all; else None."""
-    from sensing_antenna.recording import CONTACT_TRACK_COLUMNS
-
-    if not all(name in recording.extra for name in CONTACT_TRACK_COLUMNS):
-        return None
-    if not isinstance(t_point, (int, float)) or not math.isfinite(t_point):
-        return None
-    touching = np.flatnonzero(recording.extra[CONTACT_TRACK_COLUMNS[3]] > 0.5)
-    if not touching.size:
-        return None
-    k = int(touching[np.argmin(np.abs(recording.t[touching] - float(t_point)))])
-    return np.array([float(recording.extra[name][k]) for name in CONTACT_TRACK_COLUMNS[:3]])
 
 
 def _true_point(text: str | None) -> FloatArray | None:

@@ -54,7 +54,7 @@ import numpy as np
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.mapping.pose import BasePose
-from sensing_antenna.recording import CONTACT_TRACK_COLUMNS, Recording
+from sensing_antenna.recording import CONTACT_POINT_COLUMNS, IN_CONTACT_COLUMN, Recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.scene.touch import MAX_RADIUS, SweepGeometry, Touch, first_touch
@@ -304,21 +304,19 @@ def simulate_sweep(
 
 
 def _contact_track(detail: SimulationDetail, radius: float) -> dict[str, np.ndarray]:
-    """Where the object touched the link at every sample, as
-    ``recording.CONTACT_TRACK_COLUMNS``: a contact that slides along the surface after the
-    touch is known where it was at the instant an estimate describes (its ``t_point``), not
-    only where it ended. The simulated contact is on the link's axis, against the obstacle grown
-    by the link's ``radius`` (m; module docstring); the object is touched that far from it,
-    against the obstacle's outward normal, where a map places its points."""
+    """Where the link touched at every sample, as ``recording.CONTACT_TRACK_COLUMNS``: a
+    contact that slides after the touch is known where it was at the instant an estimate
+    describes (its ``t_point``), not only where it ended. The simulated contact is on the
+    link's axis, against the local obstacle grown by the link's ``radius`` (m; module
+    docstring); the track is that far from it against the obstacle's outward normal, on the
+    local obstacle's surface, where a map places its points. The local obstacle is the
+    object's surface near the touch (turned by at most :data:`MAX_TILT`), so a contact that
+    slides far leaves the object's own surface."""
     touching = np.asarray(detail.in_contact, dtype=bool)
     axis = np.nan_to_num(detail.contact_point)
     point = np.zeros_like(axis)
     if detail.obstacle is not None and touching.any():
         normals = detail.obstacle.outward_normals(axis[touching])
         point[touching] = axis[touching] - radius * np.nan_to_num(normals)
-    return {
-        CONTACT_TRACK_COLUMNS[0]: point[:, 0].copy(),
-        CONTACT_TRACK_COLUMNS[1]: point[:, 1].copy(),
-        CONTACT_TRACK_COLUMNS[2]: point[:, 2].copy(),
-        CONTACT_TRACK_COLUMNS[3]: touching.astype(float),
-    }
+    track = {name: point[:, k].copy() for k, name in enumerate(CONTACT_POINT_COLUMNS)}
+    return {**track, IN_CONTACT_COLUMN: touching.astype(float)}

@@ -28,8 +28,9 @@ from sensing_antenna.recording import Recording
 
 __all__ = ["mirror_recording"]
 
-#: Extra columns whose sign flips under the reflection (joint 1's angle and command).
-_ODD_COLUMNS = ("theta1_ref", "u1")
+#: Extra columns whose sign flips under the reflection (joint 1's angle and command, the
+#: contact track's y).
+_ODD_COLUMNS = ("theta1_ref", "u1", "true_contact_y")
 
 
 def _reflect(values: object) -> object:

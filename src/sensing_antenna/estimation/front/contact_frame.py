@@ -155,7 +155,8 @@ def first_rest_index(
 
 @dataclass(frozen=True)
 class ContactFrame:
-    """The frame attached to the contact at t_1 (Section 5.3).
+    """The frame attached to the contact at t_1 (Section 5.3); turned (:meth:`turned_to`), the
+    same motor angles with Y^c along a later reaction, where a point of that instant is placed.
 
     Attributes
     ----------

@@ -237,8 +237,9 @@ def conclude(
                 )
             )
     push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
-    # the point where the contact was at t_e: the link bends along the reaction it carries
-    # then, which has turned from t_1's when the contact slid along the surface meanwhile
+    # the point where the contact was when the filtered reaction at t_e was carried (its mean
+    # age behind t_e is the first-order filter's 1 / omega_c): the link bends along the
+    # reaction it carries, which turns from t_1's as the contact slides along the surface
     frame = evidence.frame.turned_to(reaction_now) or evidence.frame
     touch = touched_point(x_c, frame, push_force, evidence.antenna.link, float(reaction_now[0]))
     if not math.isfinite(x_c):
@@ -257,7 +258,7 @@ def conclude(
             "deflection_ratio": touch.deflection_ratio,
             "axes_c_absolute": frame.axes_a,
             "theta_at_t1": frame.theta,
-            "t_point": float(evidence.t[e]),
+            "t_point": float(evidence.t[e]) - 1.0 / cfg.lowpass_cutoff,
             "delta_t_e2": (
                 float(evidence.t[evidence.converged_index] - evidence.t[evidence.rest_index])
                 if evidence.converged_index is not None
