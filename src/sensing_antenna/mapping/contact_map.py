@@ -132,7 +132,8 @@ def points_from_recordings(
     """Estimate each recording and place its touched point in the world.
 
     Each recording's ``base_pose`` metadata (docs/recording-format.md) places its absolute frame;
-    a ``true_contact_point`` it carries is kept as ground truth (never used by the map).
+    its ground truth is kept (never used by the map): the contact track at the estimate's
+    ``t_point`` when it has one, else its ``true_contact_point``.
 
     Raises
     ------
