@@ -66,7 +66,7 @@ from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.front.ratio import lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
-from sensing_antenna.estimation.methods.touch_point import touched_point
+from sensing_antenna.estimation.methods.touch_point import touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.units_check import angle_problem, is_payload, rest_moment_std
 
@@ -195,17 +195,14 @@ def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> Con
     end = evidence.end_index
     if math.isfinite(estimate.t_e):
         end = min(int(np.searchsorted(evidence.t, estimate.t_e)), evidence.end_index)
-    reaction = evidence.reaction_f[end]
-    frame = evidence.frame.turned_to(reaction) or evidence.frame
-    push = math.hypot(reaction[1], reaction[2])
-    touch = touched_point(link.length, frame, push, link, float(reaction[0]))
+    touch, frame, t_point = touched_point_filtered(evidence, link.length, end)
     diagnostics = {
         **estimate.diagnostics,
         "x_c_past_tip": estimate.x_c,
         "deflection": touch.deflection,
         "deflection_ratio": touch.deflection_ratio,
         "axes_c_absolute": frame.axes_a,
-        "t_point": float(evidence.t[end]) - 1.0 / evidence.config.lowpass_cutoff,
+        "t_point": t_point,
     }
     return dataclasses.replace(
         estimate, x_c=link.length, contact_point=touch.point_a, diagnostics=diagnostics

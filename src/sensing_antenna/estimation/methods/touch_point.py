@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +35,10 @@ from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 
-__all__ = ["TouchPoint", "touched_point"]
+if TYPE_CHECKING:
+    from sensing_antenna.estimation.front.evidence import Evidence
+
+__all__ = ["TouchPoint", "touched_point", "touched_point_filtered"]
 
 FloatArray = NDArray[np.float64]
 
@@ -113,3 +117,17 @@ def touched_point(
         sag = STANDARD_GRAVITY * across_norm * float(link.unit_sag(x_c))
         point_a = point_a + sag * across / across_norm
     return TouchPoint(point_a=point_a, deflection=end.y, deflection_ratio=end.y / x_c, sag=sag)
+
+
+def touched_point_filtered(
+    evidence: Evidence, x_c: float, index: int
+) -> tuple[TouchPoint, ContactFrame, float]:
+    """The touched point at ``x_c`` (m) placed with the front end's filtered reaction at sample
+    ``index``, the frame it was placed in (Y^c turned to that reaction) and the instant it
+    describes (s): the first-order low-pass's output lags its input by 1 / omega_c on average,
+    and a contact that slides along the surface turns the reaction the link bends along."""
+    reaction = evidence.reaction_f[index]
+    frame = evidence.frame.turned_to(reaction) or evidence.frame
+    push = math.hypot(reaction[1], reaction[2])
+    touch = touched_point(x_c, frame, push, evidence.antenna.link, float(reaction[0]))
+    return touch, frame, float(evidence.t[index]) - 1.0 / evidence.config.lowpass_cutoff

@@ -27,7 +27,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     find_peak,
 )
 from sensing_antenna.estimation.methods.paper.planes import bending_planes
-from sensing_antenna.estimation.methods.touch_point import touched_point
+from sensing_antenna.estimation.methods.touch_point import touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 
 __all__ = [
@@ -237,11 +237,7 @@ def conclude(
                 )
             )
     push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
-    # the point where the contact was when the filtered reaction at t_e was carried (its mean
-    # age behind t_e is the first-order filter's 1 / omega_c): the link bends along the
-    # reaction it carries, which turns from t_1's as the contact slides along the surface
-    frame = evidence.frame.turned_to(reaction_now) or evidence.frame
-    touch = touched_point(x_c, frame, push_force, evidence.antenna.link, float(reaction_now[0]))
+    touch, frame, t_point = touched_point_filtered(evidence, x_c, e)
     if not math.isfinite(x_c):
         found.append((Status.NO_CLEAR_PEAK, "no estimate of x_c could be formed"))
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
@@ -258,7 +254,7 @@ def conclude(
             "deflection_ratio": touch.deflection_ratio,
             "axes_c_absolute": frame.axes_a,
             "theta_at_t1": frame.theta,
-            "t_point": float(evidence.t[e]) - 1.0 / cfg.lowpass_cutoff,
+            "t_point": t_point,
             "delta_t_e2": (
                 float(evidence.t[evidence.converged_index] - evidence.t[evidence.rest_index])
                 if evidence.converged_index is not None
