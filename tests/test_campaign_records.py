@@ -92,16 +92,40 @@ def test_the_csv_columns_are_the_row_fields_in_the_documented_order() -> None:
     assert list(CSV_COLUMNS) == DOCUMENTED_COLUMNS
 
 
-def test_a_row_scores_the_touched_point_in_3d() -> None:
-    paper = dataclasses.replace(estimates()[0], contact_point=np.array([0.3, 0.4, 0.1]))
-    # a 3-4-5 triangle: 5 mm from the estimate to where the link touched
-    row = CampaignRow.of_estimate(RUN, paper, contact_point=(0.3, 0.403, 0.104))
-    assert row.point_error_m == pytest.approx(0.005, rel=1e-12)
-    assert CampaignRow.from_csv(row.to_csv()).point_error_m == row.point_error_m
-    assert math.isnan(CampaignRow.of_estimate(RUN, paper).point_error_m)  # truth unknown
-    assert math.isnan(
-        CampaignRow.of_estimate(RUN, estimates()[0], contact_point=(0, 0, 0)).point_error_m
+def test_a_row_scores_the_touched_point_where_the_contact_was_at_its_instant() -> None:
+    """The truth is the contact's track at the estimate's t_point, not where it ended."""
+    from sensing_antenna.campaign.simulated import point_error
+    from sensing_antenna.recording import CONTACT_POINT_COLUMNS, IN_CONTACT_COLUMN, Recording
+
+    t = np.arange(0.0, 1.0, 0.001)
+    track = np.zeros((t.size, 3))
+    touching = t >= 0.1
+    # the contact slides 1 cm along y from t = 0.1 s to the end
+    track[touching] = [0.3, 0.4, 0.1]
+    track[touching, 1] += 0.01 * (t[touching] - 0.1) / 0.9
+    zeros = np.zeros((t.size, 3))
+    extra = {name: track[:, k] for k, name in enumerate(CONTACT_POINT_COLUMNS)}
+    recording = Recording(
+        t, zeros[:, :2], zeros, zeros, {}, {**extra, IN_CONTACT_COLUMN: touching * 1.0}
     )
+    # without the contact frame the point is the axis point itself; the track at 0.55 s is at
+    # (0.3, 0.405, 0.1): 3 mm along y and 4 mm along z from the estimate, 5 mm
+    paper = dataclasses.replace(
+        estimates()[0],
+        contact_point=np.array([0.3, 0.408, 0.104]),
+        diagnostics={"t_point": 0.55},
+    )
+    assert point_error(paper, recording, paper_antenna()) == pytest.approx(0.005, abs=2e-5)
+    # an instant before the touch reads the first sample in contact, at (0.3, 0.4, 0.1)
+    early = dataclasses.replace(paper, diagnostics={"t_point": 0.0})
+    expected = math.hypot(0.008, 0.004)
+    assert point_error(early, recording, paper_antenna()) == pytest.approx(expected, rel=1e-9)
+    # unknown without an instant or a track
+    assert math.isnan(point_error(estimates()[0], recording, paper_antenna()))
+    assert math.isnan(point_error(paper, dataclasses.replace(recording, extra={}), paper_antenna()))
+    row = CampaignRow.of_estimate(RUN, paper, point_error_m=0.005)
+    assert CampaignRow.from_csv(row.to_csv()).point_error_m == 0.005
+    assert math.isnan(CampaignRow.of_estimate(RUN, paper).point_error_m)  # truth unknown
 
 
 def test_a_row_copies_the_estimate_and_computes_the_errors() -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -29,7 +28,11 @@ def one_point_spec(**changes: object) -> CampaignSpec:
 
 
 def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> None:
-    from sensing_antenna.campaign.simulated import make_scenario, simulate_and_estimate
+    from sensing_antenna.campaign.simulated import (
+        make_scenario,
+        point_error,
+        simulate_and_estimate,
+    )
     from sensing_antenna.estimation import Evidence, estimate, gather
     from sensing_antenna.estimation.methods.fast import bound_delay
     from sensing_antenna.simulator import simulate
@@ -60,14 +63,15 @@ def test_run_function_copies_each_method_estimate_of_the_seeded_recording() -> N
     for row in result.rows:
         assert row.noise_scale == 1.0 and row.x_c_contact_m == contact
         assert 0 < row.front_end_s <= row.estimate_s
+        estimated = estimate(blind, antenna, method=row.method)
         assert row == CampaignRow.of_estimate(
             run,
-            estimate(blind, antenna, method=row.method),
+            estimated,
             contact_abscissa=contact,
             simulate_s=row.simulate_s,
             front_end_s=row.front_end_s,
             estimate_s=row.estimate_s,
-            contact_point=json.loads(recording.metadata["true_contact_point"]),
+            point_error_m=point_error(estimated, recording, antenna),
             bound_delay_s=row.bound_delay_s,
         )
         # the touched point in 3D: within a few mm of where the link touched (the 3D point of

@@ -16,7 +16,13 @@ from sensing_antenna.calibration.observer import IdentificationError
 from sensing_antenna.cli import main
 from sensing_antenna.control import HeadController, coupling_torques
 from sensing_antenna.control.servo import design_servo
-from sensing_antenna.recording import COMMAND_COLUMNS, Recording, read_recording, write_recording
+from sensing_antenna.recording import (
+    COMMAND_COLUMNS,
+    CONTACT_TRACK_COLUMNS,
+    Recording,
+    read_recording,
+    write_recording,
+)
 from sensing_antenna.simulator import Scenario, simulate, simulate_detailed
 
 TS = 1e-3  # s
@@ -260,8 +266,14 @@ def test_simulator_writes_commands_only_when_asked() -> None:
     scenario = Scenario(case="azimuthal", contact_point=0.6)
     plain = simulate(PAPER, scenario)
     detail = simulate_detailed(PAPER, scenario, record_commands=True)
-    assert list(plain.extra) == ["theta1_ref", "theta2_ref"]
-    assert list(detail.recording.extra) == ["theta1_ref", "theta2_ref", "u1", "u2"]
+    assert list(plain.extra) == ["theta1_ref", "theta2_ref", *CONTACT_TRACK_COLUMNS]
+    assert list(detail.recording.extra) == [
+        "theta1_ref",
+        "theta2_ref",
+        *CONTACT_TRACK_COLUMNS,
+        "u1",
+        "u2",
+    ]
     np.testing.assert_array_equal(detail.recording.extra["u1"], detail.voltage[:, 0])
     np.testing.assert_array_equal(detail.recording.extra["u2"], detail.voltage[:, 1])
     # everything else is the default recording's, to the bit

@@ -60,6 +60,17 @@ def recordings(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     return paths
 
 
+def _resting_row(recording: Recording, t: float) -> str:
+    """A sample at rest (the link's weight on the sensor) at ``t`` (s), with a cell for each of
+    the recording's columns (its extra columns zero)."""
+    return ",".join([repr(t), "0,0,0,0,-0.0451,0,0.0221,0", *("0" * len(recording.extra))])
+
+
+def _cells(recording: Recording) -> int:
+    """Cells in a row of ``recording``: the nine required columns and its extra ones."""
+    return 9 + len(recording.extra)
+
+
 def _lines(recording: Recording) -> list[bytes]:
     """What ``antenna replay --speed 0`` writes, as the lines a reader of stdin gets."""
     out = io.StringIO()
@@ -215,7 +226,7 @@ def _heard_over_udp(datagrams: list[bytes], then: Recording) -> list[Event]:
 def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) -> None:
     recording = read_recording(recordings["azimuthal"])
     header, _ = stream_of(recording)
-    row = "0.0,0,0,0,0,-0.0451,0,0.0221,0,0,0"
+    row = _resting_row(recording, 0.0)
     events = _heard_over_udp(
         [
             b"hello",
@@ -233,7 +244,7 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     reasons = " | ".join(e["reason"] for e in first if e["event"] == "skipped")
     assert "does not begin with 'sensing-antenna-udp/1 KIND STREAM SEQ'" in reasons
     assert "not UTF-8" in reasons
-    assert "stream b: datagram 0: expected 11 cells, found 2" in reasons
+    assert f"stream b: datagram 0: expected {_cells(recording)} cells, found 2" in reasons
     assert "stream b: datagram 1 arrived after 2: left out" in reasons
     end = first[-1]
     assert end["event"] == "end" and end["samples"] == 2
@@ -253,7 +264,7 @@ def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
         "# sample_period: 0.0011" if line.startswith("# sample_period") else line
         for line in header.lines()
     )
-    rows = tuple(f"{0.001 * k!r},0,0,0,0,-0.0451,0,0.0221,0,0,0" for k in range(30))
+    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(30))
     events = _heard_over_udp(
         [
             Datagram("header", "w", 0, wrong).encode(),
@@ -288,8 +299,12 @@ def test_datagrams() -> None:
 def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
     text = recordings["azimuthal"].read_text().splitlines(keepends=True)
     header_at = next(k for k, line in enumerate(text) if not line.startswith("#"))
+    cells = _cells(read_recording(recordings["azimuthal"]))
     cases = [
-        ([*text[: header_at + 5], "0.1,x\n"], f"<stdin>:{header_at + 6}: expected 11 cells"),
+        (
+            [*text[: header_at + 5], "0.1,x\n"],
+            f"<stdin>:{header_at + 6}: expected {cells} cells",
+        ),
         (
             [*text[: header_at + 3], text[header_at + 1]],
             f"<stdin>:{header_at + 4}: column 't': time 0.0 s does not increase",

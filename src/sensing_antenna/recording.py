@@ -74,7 +74,7 @@ REQUIRED_COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
 #: without them is read as before.
 COMMAND_COLUMNS = ("u1", "u2")
 
-#: Optional ground-truth columns of a simulated contact's track (a scene's sweeps write them):
+#: Optional ground-truth columns of a simulated contact's track (the simulator writes them):
 #: where the link touched at every sample (m, absolute frame; docs/recording-format.md) ...
 CONTACT_POINT_COLUMNS = ("true_contact_x", "true_contact_y", "true_contact_z")
 #: ... and 1 while in contact (0 before the touch and after a release, where the point's

@@ -112,8 +112,10 @@ class CampaignRow:
         Wall-clock time of the estimation front end on the recording (s), run once per run and
         shared by its methods; ``estimate_s - front_end_s`` is the method's own time.
     point_error_m : float
-        Distance (m) from the estimate's touched point in 3D (``ContactEstimate.contact_point``,
-        absolute frame) to where the link touched (the simulator's ``true_contact_point``).
+        Distance (m) from the estimate's touched point in 3D, on the link's surface (its
+        ``contact_point``, absolute frame, moved by ``mapping.points.surface_offset``), to where
+        the link touched at the instant the point describes (the recording's contact track at
+        the estimate's ``diagnostics["t_point"]``, ``recording.tracked_contact``).
     bound_delay_s : float
         ``fast`` only: the information bound of t_e - t_1 (s), the first window from t_1 whose
         95 % interval would be within the tolerance with omega_1 at its Cramer-Rao bound and no
@@ -195,14 +197,14 @@ class CampaignRow:
         simulate_s: float = math.nan,
         front_end_s: float = math.nan,
         estimate_s: float = math.nan,
-        contact_point: Sequence[float] | None = None,
+        point_error_m: float = math.nan,
         bound_delay_s: float = math.nan,
     ) -> CampaignRow:
         """The row of one method's estimate on ``run`` (the method named by the estimate).
 
         The standard error and Cramer-Rao bound of omega_1 come from the estimate's
         ``diagnostics["omega1_se"]`` and ``diagnostics["omega1_crb"]`` (``fast``);
-        ``contact_point`` is where the link touched (absolute frame, m, shape (3,)), if known;
+        ``point_error_m`` the touched point's error in 3D (m), if known;
         ``bound_delay_s`` the information bound of the delay (s, ``fast``).
         """
         low, high = estimate.interval if estimate.interval is not None else (math.nan, math.nan)
@@ -225,7 +227,7 @@ class CampaignRow:
             estimate_s=estimate_s,
             omega1_se_rad_s=float_or_nan(diagnostics.get("omega1_se")),
             omega1_crb_rad_s=float_or_nan(diagnostics.get("omega1_crb")),
-            point_error_m=_distance(estimate.contact_point, contact_point),
+            point_error_m=point_error_m,
             bound_delay_s=bound_delay_s,
         )
 
@@ -298,13 +300,6 @@ class CampaignRow:
             else:
                 values[f.name] = text
         return cls(**values)
-
-
-def _distance(point: Any, truth: Sequence[float] | None) -> float:
-    """|point - truth| (m); NaN when either is unknown."""
-    if truth is None:
-        return math.nan
-    return float_or_nan(math.dist(tuple(point), tuple(truth)))
 
 
 #: Columns of runs.csv, in order: the fields of :class:`CampaignRow`.

@@ -14,11 +14,12 @@ Also the steps before the runs, in the paper's order:
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import time
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.calibration.frequency import FrequencyCalibration
@@ -35,6 +36,7 @@ from sensing_antenna.campaign.runs import (
 )
 from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
+from sensing_antenna.recording import Recording, tracked_contact
 
 if TYPE_CHECKING:
     from sensing_antenna.estimation import ContactEstimate, Evidence
@@ -46,6 +48,7 @@ __all__ = [
     "check_scenario",
     "identify_observer",
     "make_scenario",
+    "point_error",
     "prepare_antenna",
     "prepare_campaign",
     "simulate_and_estimate",
@@ -131,7 +134,6 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
         "contact_abscissa": _true_contact_abscissa(recording.metadata),
         "simulate_s": simulate_s,
     }
-    touched = _true_contact_point(recording.metadata)
     blind = recording.without_ground_truth()
     begin = time.perf_counter()
     try:
@@ -177,7 +179,7 @@ def simulate_and_estimate(run: RunSpec) -> RunResult:
                 **truth,
                 front_end_s=front_end_s,
                 estimate_s=elapsed,
-                contact_point=touched,
+                point_error_m=point_error(estimate, recording, run.antenna),
                 bound_delay_s=bound,
             )
         )
@@ -203,15 +205,19 @@ class _KeepingFits:
         return self.method.conclude(evidence, self.caches)
 
 
-def _true_contact_point(metadata: Mapping[str, str]) -> tuple[float, ...] | None:
-    """The recording's ground-truth ``true_contact_point`` (m, absolute frame), None when
-    absent or not three numbers."""
-    try:
-        point = json.loads(metadata.get("true_contact_point", "null"))
-        values = tuple(float(v) for v in point)
-    except (TypeError, ValueError):
-        return None
-    return values if len(values) == 3 else None
+def point_error(estimate: ContactEstimate, recording: Recording, antenna: Antenna) -> float:
+    """Distance (m) from the estimate's touched point, on the link's surface
+    (``contact_point`` plus ``mapping.points.surface_offset``), to where the link touched at
+    the instant the point describes (its ``diagnostics["t_point"]``) by the recording's contact
+    track (``recording.tracked_contact``); NaN without either."""
+    from sensing_antenna.mapping.points import surface_offset
+
+    t_point = float_or_nan(estimate.diagnostics.get("t_point"))
+    truth = tracked_contact(recording, t_point)
+    point = np.asarray(estimate.contact_point, dtype=float)
+    if truth is None or point.shape != (3,):
+        return math.nan
+    return float_or_nan(np.linalg.norm(point + surface_offset(estimate, antenna) - truth))
 
 
 def _true_contact_abscissa(metadata: Mapping[str, str]) -> float:

@@ -54,14 +54,13 @@ import numpy as np
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.mapping.pose import BasePose
-from sensing_antenna.recording import CONTACT_POINT_COLUMNS, IN_CONTACT_COLUMN, Recording
+from sensing_antenna.recording import Recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.scene.touch import MAX_RADIUS, SweepGeometry, Touch, first_touch
 from sensing_antenna.simulator import Scenario
 from sensing_antenna.simulator.contact import motor_frame
 from sensing_antenna.simulator.run import (
-    SimulationDetail,
     device_link,
     minimum_contact_point,
     simulate_detailed,
@@ -287,8 +286,7 @@ def simulate_sweep(
     metadata["base_pose"] = frame.to_json()
     metadata["true_object"] = touch.object_name
     metadata["true_surface_point"] = json.dumps([float(v) for v in touch.surface_point])
-    track = _contact_track(detail, device.link.radius)
-    recording = replace(recording, metadata=metadata, extra={**recording.extra, **track})
+    recording = replace(recording, metadata=metadata)
     # the recording starts approach_time before the touch (the simulator's own approach)
     touch_time = float(recording.metadata.get("true_t_contact", "nan"))
     after = recording.t[-1] - (touch_time if math.isfinite(touch_time) else 0.0)
@@ -301,22 +299,3 @@ def simulate_sweep(
         frame,
         sweep_time=approach + float(after),
     )
-
-
-def _contact_track(detail: SimulationDetail, radius: float) -> dict[str, np.ndarray]:
-    """Where the link touched at every sample, as ``recording.CONTACT_TRACK_COLUMNS``: a
-    contact that slides after the touch is known where it was at the instant an estimate
-    describes (its ``t_point``), not only where it ended. The simulated contact is on the
-    link's axis, against the local obstacle grown by the link's ``radius`` (m; module
-    docstring); the track is that far from it against the obstacle's outward normal, on the
-    local obstacle's surface, where a map places its points. The local obstacle is the
-    object's surface near the touch (turned by at most :data:`MAX_TILT`), so a contact that
-    slides far leaves the object's own surface."""
-    touching = np.asarray(detail.in_contact, dtype=bool)
-    axis = np.nan_to_num(detail.contact_point)
-    point = np.zeros_like(axis)
-    if detail.obstacle is not None and touching.any():
-        normals = detail.obstacle.outward_normals(axis[touching])
-        point[touching] = axis[touching] - radius * np.nan_to_num(normals)
-    track = {name: point[:, k].copy() for k, name in enumerate(CONTACT_POINT_COLUMNS)}
-    return {**track, IN_CONTACT_COLUMN: touching.astype(float)}

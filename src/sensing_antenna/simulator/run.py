@@ -20,7 +20,13 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link, antenna_to_toml
 from sensing_antenna.control.servo import FRICTION_SPEED, design_servo, initial_servo_state
-from sensing_antenna.recording import COMMAND_COLUMNS, FORMAT_NAME, Recording
+from sensing_antenna.recording import (
+    COMMAND_COLUMNS,
+    CONTACT_POINT_COLUMNS,
+    FORMAT_NAME,
+    IN_CONTACT_COLUMN,
+    Recording,
+)
 from sensing_antenna.simulator.contact import Obstacle, place_obstacle
 from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.integrator import (
@@ -568,6 +574,8 @@ def simulate_detailed(
         sort_keys=True,
     )
     extra = {"theta1_ref": reference[:, 0].copy(), "theta2_ref": reference[:, 1].copy()}
+    if obstacle is not None:
+        extra.update(_contact_track(in_contact, truth[:, 4:7], obstacle, antenna.link.radius))
     if record_commands:
         extra.update({name: truth[:, 8 + j].copy() for j, name in enumerate(COMMAND_COLUMNS)})
     recording = Recording(
@@ -643,3 +651,28 @@ def _describe(scenario: Scenario, kind: str | None) -> str:
     if kind is None:
         return f"simulated {scenario.case} sweep, no obstacle"
     return f"simulated {scenario.case} sweep into a {kind} at x_c = {scenario.contact_point:g} m"
+
+
+def _contact_track(
+    in_contact: NDArray[np.bool_],
+    axis_point: NDArray[np.float64],
+    obstacle: Obstacle,
+    radius: float,
+) -> dict[str, NDArray[np.float64]]:
+    """Where the link touched at every sample, as ``recording.CONTACT_TRACK_COLUMNS``: a
+    contact that slides after the touch is known where it was at the instant an estimate
+    describes (its ``t_point``), not only where it ended.
+
+    ``axis_point`` (n, 3) is the simulated contact on the link's axis (m, absolute frame),
+    ``in_contact`` (n,) where it touches; the link's surface touches ``radius`` (m) from its
+    axis against the obstacle's outward normal, on the obstacle's surface, where a map places
+    its points. The columns hold 0 while not in contact.
+    """
+    touching = np.asarray(in_contact, dtype=bool)
+    axis = np.nan_to_num(np.asarray(axis_point, dtype=float))
+    point = np.zeros_like(axis)
+    if touching.any():
+        normals = obstacle.outward_normals(axis[touching])
+        point[touching] = axis[touching] - radius * np.nan_to_num(normals)
+    track = {name: point[:, k].copy() for k, name in enumerate(CONTACT_POINT_COLUMNS)}
+    return {**track, IN_CONTACT_COLUMN: touching.astype(float)}
