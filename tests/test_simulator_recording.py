@@ -79,6 +79,15 @@ def test_metadata_and_ground_truth(tmp_path: Path) -> None:
         ({"case": "azimuthal", "contact_point": 0.5, "duration": -1.0}, "duration"),
         ({"case": "azimuthal", "contact_point": 0.5, "servo_pole": 5.0}, "servo_pole"),
         ({"case": "azimuthal", "contact_point": 0.5, "damping_ratio": 1.5}, "damping_ratio"),
+        ({"case": "azimuthal", "contact_point": 0.5, "obstacle_placement": (0, 0, 0)}, "obstacle_"),
+        (
+            {"case": "azimuthal", "contact_point": 0.5, "obstacle_placement": (0.5, 0, 0, 0, 0, 0)},
+            "obstacle_placement",
+        ),
+        (
+            {"case": "vertical", "contact_point": 0.5, "obstacle_placement": (math.nan,) * 6},
+            "obstacle_placement",
+        ),
     ],
 )
 def test_scenario_validation_names_the_field(changes: dict[str, object], field: str) -> None:

@@ -1,8 +1,13 @@
 """A sweep of the simulated device in a scene: the geometric touch, then the contact physics.
 
 :func:`~sensing_antenna.scene.touch.first_touch` finds where the link first meets the scene.
-The simulator's own manoeuvre (``simulator.simulate``) is then run against a local obstacle
-equivalent to the surface there, placed by the simulator from x_c as for any of its runs:
+The simulator's own manoeuvre (``simulator.simulate``) is then run against an obstacle of the
+shapes it has (a cylinder, a ball, a plane). Where the touched object is one of them there, it
+is the object itself, placed in the recording's frame (``Scenario.obstacle_placement``): a
+sphere (a ball), a cylinder's or a capsule's side (a cylinder of its axis), a capsule's cap (a
+ball of its centre), so that a contact sliding along it stays on the object. Elsewhere (a box, a
+cone, a torus, a user's mesh, a cylinder's cap or rim) it is a local obstacle equivalent to the
+surface at the touch, placed by the simulator from x_c as for any of its runs:
 
 - a contact along the link: a cylinder tangent to the link at x_c whose axis is perpendicular
   to the link and to the surface's normal, of the surface's local radius along the link (a post
@@ -16,9 +21,10 @@ equivalent to the surface there, placed by the simulator from x_c as for any of 
   simulator's, not the face's: the touched point is the same).
 
 A round link touches with its surface, its radius a off its axis (``scene.touch``), while the
-simulator's link touches with its axis: each obstacle is the surface grown by a (a cylinder or
-a ball of radius R + a about the same axis or centre; the tip's plane through the tip's axis,
-a from the face), which the axis meets where the link's surface meets the surface.
+simulator's link touches with its axis: each obstacle, the object itself or a local one, is
+the surface grown by a (a cylinder or a ball of radius R + a about the same axis or centre;
+the tip's plane through the tip's axis, a from the face), which the axis meets where the
+link's surface meets the surface.
 
 The simulator's manoeuvre touches at the angles (0, 0) of its absolute frame, so the recording's
 frame is the base's turned to the touch angles: R = R_base M(theta)^T, with M(theta) the motor
@@ -34,10 +40,12 @@ A sweep the other way (towards -Y^m, or a vertical sweep down) is simulated as s
 (``Scenario.sweep_direction = -1``): the obstacle lies on the other side of the link, and a
 vertical sweep down has the link's weight helping the push onto the obstacle below it.
 
-The simulator's obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about the
-friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is simulated
-with the obstacle turned by :data:`MAX_TILT`: the same touched point, the push held as if the
-surface faced the sweep more (a real link may slide there). A touch the simulator cannot
+The simulator's local obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about
+the friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is
+simulated with the local obstacle turned by :data:`MAX_TILT`: the same touched point, the push
+held as if the surface faced the sweep more (a real link may slide there). The touched object
+itself is not turned: beyond the friction cone the link slides along it, as on a real object.
+A touch the simulator cannot
 represent is reported instead of simulated: the normal turned more than
 :data:`GLANCING_ANGLE` (``glancing``: the link would slide over it), or x_c below the
 simulator's smallest contact point (``near_head``).
@@ -51,6 +59,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.mapping.pose import BasePose
@@ -71,6 +80,7 @@ __all__ = [
     "GLANCING_ANGLE",
     "MAX_TILT",
     "OUTCOMES",
+    "SIDE_NORMAL",
     "GlancingTouchError",
     "SweepOutcome",
     "simulate_sweep",
@@ -92,6 +102,10 @@ MAX_TILT = 0.49
 #: A surface turned further than this (rad) out of the sweep's direction is ``glancing``: the
 #: link would slide over it rather than be held by it (57 degrees).
 GLANCING_ANGLE = 1.0
+
+#: A cylinder's or a capsule's side is where its outward normal lies within this of
+#: perpendicular to its axis (|n . axis|, the cosine); elsewhere a cylinder's cap or rim.
+SIDE_NORMAL = 1e-3
 
 #: What a sweep can end in.
 OUTCOMES = ("touch", "free", "glancing", "near_head", "inside")
@@ -186,6 +200,7 @@ def touch_scenario(
     # the simulator's link touches with its axis: its obstacle is the surface grown by the
     # link's radius, which the axis meets where the link's surface meets the surface
     radius = min(radius + touch.link_radius, MAX_RADIUS)
+    placement: tuple[float, ...] | None = None
     if touch.tip:
         kind = "plane"
         tilt = 0.0
@@ -194,8 +209,15 @@ def touch_scenario(
             f"the surface's normal is {abs(tilt):.2f} rad out of the sweep's direction, more than"
             f" {GLANCING_ANGLE} rad (the link would slide over it)"
         )
-    # beyond the simulator's largest tilt the obstacle is turned by that much: the same
-    # touched point, a push held as if the surface faced the sweep more
+    else:
+        exact = _touched_shape(touch, scene, frame)
+        if exact is not None:
+            kind, radius, placement = exact
+            if kind == "cylinder":
+                kind = "post" if sweep.case == "azimuthal" else "bar"
+    # beyond the simulator's largest tilt a local obstacle is turned by that much: the same
+    # touched point, a push held as if the surface faced the sweep more (the touched shape
+    # itself, placed, is not turned: the link slides where friction cannot hold it)
     tilt = max(-MAX_TILT, min(MAX_TILT, tilt))
     towards = ""
     if sweep.direction == -1:
@@ -212,10 +234,42 @@ def touch_scenario(
         obstacle=kind,  # type: ignore[arg-type]
         obstacle_radius=radius,
         obstacle_tilt=tilt,
+        obstacle_placement=placement,
         description=description,
         **scenario_fields,
     )
     return scenario, frame
+
+
+def _touched_shape(
+    touch: Touch, scene: Scene, frame: BasePose
+) -> tuple[str, float, tuple[float, ...]] | None:
+    """The touched object itself as the simulator's obstacle where the simulator has its shape
+    (module docstring): ``(kind, radius, placement)`` with kind ``ball`` or ``cylinder``, the
+    radius grown by the link's (m), the placement in the recording's frame (``frame``) as
+    ``Scenario.obstacle_placement`` takes it; None for another shape or part of one."""
+    named = [obj for obj in scene.objects if obj.name == touch.object_name]
+    touched = min(named, key=lambda obj: abs(float(obj.signed_distance(touch.surface_point)[0])))
+    p = touched.parameters
+    # a ball's direction is only its outward normal at the touch, a cylinder's its axis
+    direction = touch.normal
+    if touched.shape == "sphere":
+        kind, centre, radius = "ball", p[:3], float(p[3])
+    elif touched.shape in ("cylinder", "capsule"):
+        axis = Rotation.from_rotvec(p[3:6]).as_matrix()[:, 2]
+        radius, half = float(p[6]), 0.5 * float(p[7])
+        along = float((touch.surface_point - p[:3]) @ axis)
+        if abs(along) < half and abs(float(touch.normal @ axis)) < SIDE_NORMAL:
+            kind, centre, direction = "cylinder", p[:3], axis
+        elif touched.shape == "capsule":
+            kind, centre = "ball", p[:3] + math.copysign(half, along) * axis
+        else:
+            return None  # a cylinder's cap or rim: the local obstacle
+    else:
+        return None
+    to_frame = frame.rotation.T
+    point = to_frame @ (centre - frame.position)
+    return kind, radius + touch.link_radius, (*point, *(to_frame @ direction))
 
 
 def simulate_sweep(

@@ -412,18 +412,24 @@ def simulate_detailed(
         )
         sag = float(model.shape_at(scenario.contact_point) @ q_sag)
         sag_slope = float(model.slope_at(scenario.contact_point) @ q_sag)
-        obstacle = place_obstacle(
-            kind,
-            scenario.contact_point,
-            link.length,
-            theta_touch,
-            sag,
-            sag_slope,
-            scenario.obstacle_radius,
-            scenario.obstacle_tilt,
-            sweep_joint,
-            scenario.sweep_direction,
-        )
+        if scenario.obstacle_placement is not None:
+            placement = np.asarray(scenario.obstacle_placement)
+            direction = placement[3:] / np.linalg.norm(placement[3:])
+            radius = 0.0 if kind == "plane" else scenario.obstacle_radius
+            obstacle = Obstacle(kind, tuple(placement[:3]), tuple(direction), radius)
+        else:
+            obstacle = place_obstacle(
+                kind,
+                scenario.contact_point,
+                link.length,
+                theta_touch,
+                sag,
+                sag_slope,
+                scenario.obstacle_radius,
+                scenario.obstacle_tilt,
+                sweep_joint,
+                scenario.sweep_direction,
+            )
         obst_array = obstacle.as_array()
 
     # --- parameters of the compiled loop -------------------------------------------------------

@@ -210,6 +210,13 @@ class Scenario:
         the link, the plane turns its normal out of the sweep plane, the ball's normal at the
         touch turns as the post's (azimuthal) or the bar's (vertical). Gives the contact normal
         a component out of the sweep plane.
+    obstacle_placement : tuple of 6 float or None
+        The obstacle placed explicitly in the absolute frame instead of from ``contact_point``
+        and ``obstacle_tilt``: a point (m; a point of the cylinder's axis, the ball's centre, a
+        point of the plane) and a direction (the cylinder's axis, the plane's outward normal,
+        the ball's outward normal at the touch; normalised). The sweep must then meet it near
+        ``contact_point``, which still names the touch (a scene's sweeps place the touched
+        object itself: ``scene.simulate``). None: placed from ``contact_point``.
     contact_stiffness : float
         Normal penalty stiffness (N/m); also the tangential stick stiffness.
     contact_damping : float
@@ -269,6 +276,7 @@ class Scenario:
     obstacle: Literal["post", "bar", "ball", "plane"] | None = None
     obstacle_radius: float = 0.01
     obstacle_tilt: float = 0.02
+    obstacle_placement: tuple[float, ...] | None = None
     contact_stiffness: float = 1.0e4
     contact_damping: float = 0.5
     sweep_speed: float = 0.3
@@ -344,6 +352,19 @@ class Scenario:
         _finite("obstacle_tilt", self.obstacle_tilt)
         if abs(self.obstacle_tilt) >= 0.5:
             raise ScenarioError("obstacle_tilt", "must be below 0.5 rad in magnitude")
+        if self.obstacle_placement is not None:
+            placement = self.obstacle_placement
+            if not isinstance(placement, (tuple, list)) or len(placement) != 6:
+                raise ScenarioError(
+                    "obstacle_placement",
+                    f"must be six numbers (a point, m, and a direction), got "
+                    f"{format_value(placement)}",
+                )
+            for value in placement:
+                _finite("obstacle_placement", value)
+            if not math.hypot(*placement[3:]) > 0.0:
+                raise ScenarioError("obstacle_placement", "the direction must not be zero")
+            object.__setattr__(self, "obstacle_placement", tuple(float(v) for v in placement))
         if self.approach_time is not None:
             _finite("approach_time", self.approach_time, self.accel_time or 0.0)
         for name, (high, unit, reason) in _UPPER_LIMITS.items():
