@@ -25,6 +25,7 @@ from sensing_antenna.scene import (
     facing_region,
     first_touch,
     load_scene,
+    mesh_object,
     primitive_object,
     simulate_sweep,
 )
@@ -58,9 +59,14 @@ def test_a_post_scene_reproduces_the_simulators_post_run() -> None:
     # x_c to the touch search's tolerance (its bisection and scalar minimisation, 1e-9, and the
     # sag interpolated linearly between the 2 mm samples, below a micrometre)
     assert outcome.scenario.contact_point == pytest.approx(0.55, abs=1e-6)
-    assert outcome.scenario.obstacle_tilt == pytest.approx(0.02, abs=1e-8)
-    # the radius from the bend over +-2 mm: exact on a circle up to the sag's interpolation
-    assert outcome.scenario.obstacle_radius == pytest.approx(0.01, rel=1e-4)
+    # the post itself, grown back by the link's radius, placed where the simulator put its own
+    assert outcome.scenario.obstacle == "cylinder"
+    assert outcome.scenario.obstacle_radius == pytest.approx(0.01, rel=1e-12)
+    assert outcome.scenario.obstacle_placement is not None
+    placed = np.array(outcome.scenario.obstacle_placement)
+    np.testing.assert_allclose(placed[3:], axis, atol=1e-6)  # the recording's frame turns 1e-7
+    offset = placed[:3] - np.array(post.point)
+    np.testing.assert_allclose(offset - (offset @ axis) * axis, 0.0, atol=1e-7)
     recording = outcome.recording
     assert recording is not None
     # the same manoeuvre: the loads differ by the micrometres of placement only (the sensor's
@@ -323,38 +329,43 @@ def test_a_point_is_where_the_contact_was_at_its_instant_when_the_contact_slides
     assert np.linalg.norm(ended - points["fast"].true_point) > 0.01
 
 
+_DOWN = Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1)
+
+
 @pytest.mark.parametrize(
-    ("touched", "sweep", "kind"),
+    ("touched", "kind"),
     [
         # a ball touched off its top: the link slides down it
-        (
-            primitive_object("ball", "sphere", [0.05], [0.6, 0.02, -0.12]),
-            Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1),
-            "ball",
-        ),
+        (primitive_object("ball", "sphere", [0.05], [0.6, 0.02, -0.12]), "ball"),
         # a bar sloping 0.9 rad across the sweep, beyond the friction cone: the link slides
         # along it
         (
             primitive_object("bar", "cylinder", [0.03, 0.3], [0.6, 0.0, -0.1], [0.9, 0.0, 0.0]),
-            Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1),
-            "bar",
+            "cylinder",
         ),
-        # a capsule standing below the link, touched on its cap off its top
+        # the same, 3 cm long: the link slides along it and over its rim
         (
-            primitive_object("capsule", "capsule", [0.04, 0.1], [0.6, 0.01, -0.14]),
-            Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1),
-            "ball",
+            primitive_object("disc", "cylinder", [0.03, 0.03], [0.6, 0.0, -0.1], [0.9, 0, 0]),
+            "cylinder",
         ),
+        # a capsule as short, touched on its side: the link slides past the segment's end
+        # onto a cap
+        (
+            primitive_object("pill", "capsule", [0.03, 0.03], [0.6, 0.0, -0.1], [0.9, 0, 0]),
+            "capsule",
+        ),
+        # a capsule standing below the link, touched on its cap off its top: the link slides
+        # down the cap and onto the side
+        (primitive_object("capsule", "capsule", [0.03, 0.02], [0.6, 0.01, -0.14]), "capsule"),
     ],
 )
-def test_a_sliding_contact_stays_on_the_touched_object(
-    touched: SceneObject, sweep: Sweep, kind: str
-) -> None:
-    # The exact link pushed onto a sphere, a cylinder's side or a capsule's cap slides along
-    # it by centimetres; the simulator's obstacle is the object itself, grown by the link's
-    # radius, so the contact's track stays on the object throughout: within the penalty
-    # contact's penetration F_n / k (a push under 1 N into 1e4 N/m: 0.1 mm)
-    outcome = simulate_sweep(DEVICE, _scene(touched), sweep, seed=4, link_model="nonlinear")
+def test_a_sliding_contact_stays_on_the_touched_object(touched: SceneObject, kind: str) -> None:
+    # The exact link pushed onto a sphere, a cylinder or a capsule slides along it by
+    # centimetres, over a rim or from one part onto another; the simulator's obstacle is the
+    # object itself, grown by the link's radius, so the contact's track stays on the object
+    # throughout: within the penalty contact's penetration F_n / k (a push under 1 N into
+    # 1e4 N/m: 0.1 mm)
+    outcome = simulate_sweep(DEVICE, _scene(touched), _DOWN, seed=4, link_model="nonlinear")
     assert outcome.recording is not None and outcome.frame is not None, outcome.reason
     assert outcome.scenario is not None and outcome.scenario.obstacle == kind
     recording = outcome.recording
@@ -550,10 +561,15 @@ def test_facing_region_is_the_angles_a_ball_subtends() -> None:
 
 
 def test_a_rounded_surface_is_simulated_as_a_ball_a_straight_one_as_a_cylinder() -> None:
-    # A sphere curves by 1 / R both along the link and across it: its equivalent obstacle is a
-    # ball of its radius, on which a link sliding across stays on the surface. A vertical
-    # cylinder met by a level azimuthal sweep curves along the link only: a post.
+    # A sphere curves by 1 / R both along the link and across it; a vertical cylinder met by a
+    # level azimuthal sweep along the link only. Either primitive is placed itself, grown by
+    # the link's radius (the simulated link touches with its axis). A surface the simulator
+    # has no shape for gets the equivalent local obstacle: where it curves every way a ball,
+    # on which a link sliding across stays on the surface.
+    from scipy.spatial.transform import Rotation
+
     from sensing_antenna.scene.simulate import touch_scenario
+    from sensing_antenna.scene.touch import MIN_RADIUS
 
     shape = LinkShape(DEVICE.link, gravity=0.0)
     sweep = Sweep(0, "azimuthal", 0.0, -0.5, 0.8)
@@ -563,16 +579,33 @@ def test_a_rounded_surface_is_simulated_as_a_ball_a_straight_one_as_a_cylinder()
     # the bend probe is exact on a circle; its chord depth h^2 / (2 R) = 29 um read from
     # distances rounded to about 1e-16 m puts R within about 1e-11 of itself
     assert touch.principal_radii == pytest.approx((0.07, 0.07), rel=1e-9)
-    scenario, _ = touch_scenario(touch, sweep, ball)
-    assert scenario.obstacle == "ball"
-    # grown by the link's radius: the simulated link touches with its axis
+    scenario, frame = touch_scenario(touch, sweep, ball)
+    assert scenario.obstacle == "ball" and scenario.obstacle_placement is not None
     assert touch.link_radius == DEVICE.link.radius
-    assert scenario.obstacle_radius == pytest.approx(0.07 + DEVICE.link.radius, rel=1e-9)
+    assert scenario.obstacle_radius == pytest.approx(0.07 + DEVICE.link.radius, rel=1e-12)
+    centre = frame.point_to_world(np.array(scenario.obstacle_placement[:3]))
+    np.testing.assert_allclose(centre, [0.6, 0.2, 0.03], atol=1e-12)
     post = _scene(primitive_object("post", "cylinder", [0.03, 0.5], [0.6, 0.2, 0.0]))
     touch = first_touch(post, sweep, shape).touch
     assert touch is not None and touch.principal_radii[1] > 1.0
     scenario, _ = touch_scenario(touch, sweep, post)
-    assert scenario.obstacle == "post"
+    assert scenario.obstacle == "cylinder"
+    assert scenario.obstacle_length == pytest.approx(0.5 + 2 * DEVICE.link.radius, rel=1e-12)
+    # a corner, curved every way: a ball (of the smallest radius, grown by the link's), met
+    # by the link sweeping at a cube turned to point a corner at it; a user's mesh of the same
+    # cube (its own distance, not a primitive's) meets the same local obstacle
+    corner = Rotation.align_vectors([[0.0, -1.0, 0.0]], [[1.0, 1.0, 1.0]])[0].as_rotvec()
+    cubes = [
+        primitive_object("cube", "box", [0.1, 0.1, 0.1], [0.6, 0.2, 0.0], corner),
+        mesh_object("cube", trimesh.creation.box(extents=[0.1] * 3), [0.6, 0.2, 0.0], corner),
+    ]
+    for cube in cubes:
+        scene = _scene(cube)
+        touch = first_touch(scene, sweep, shape).touch
+        assert touch is not None and not touch.tip
+        scenario, _ = touch_scenario(touch, sweep, scene)
+        assert scenario.obstacle == "ball" and scenario.obstacle_placement is None
+        assert scenario.obstacle_radius == pytest.approx(MIN_RADIUS + DEVICE.link.radius)
 
 
 @pytest.mark.parametrize("lean", [0.0, 40.0, 60.0])

@@ -8,11 +8,13 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from _simulator_helpers import RotationAfterForceStop, dominant_frequency
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.calibration.observer import identify_free_motion
+from sensing_antenna.mapping.primitives import PRIMITIVES
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, ScenarioError, simulate, simulate_detailed
 from sensing_antenna.simulator.contact import Obstacle, motor_frame
@@ -358,11 +360,19 @@ def test_a_ball_keeps_the_contact_on_its_surface_where_a_post_lets_it_slide() ->
     assert off_sphere("post") > 1e-3
 
 
-@pytest.mark.parametrize("kind", ["post", "ball", "plane"])
+@pytest.mark.parametrize("kind", ["post", "ball", "plane", "capsule", "cylinder"])
 def test_an_obstacles_outward_normal_is_the_gradient_of_its_gap(kind: str) -> None:
     # central differences of the signed distance, 1e-6 m steps: their error is the step's
-    # curvature term, h^2 / R ~ 3e-11 on the 3 cm radius, and rounding, eps |gap| / h ~ 1e-11
-    obstacle = Obstacle(kind, (0.5, 0.1, -0.2), (0.0, 0.6, 0.8), 0.0 if kind == "plane" else 0.03)
+    # curvature term, h^2 / R ~ 3e-11 on the 3 cm radius (the capped cylinder's rim, rounded
+    # by 5 mm, 2e-10), and rounding, eps |gap| / h ~ 1e-11
+    obstacle = Obstacle(
+        kind,
+        (0.5, 0.1, -0.2),
+        (0.0, 0.6, 0.8),
+        0.0 if kind == "plane" else 0.03,
+        half_length=0.04 if kind in ("capsule", "cylinder") else 0.0,
+        rounding=0.005 if kind == "cylinder" else 0.0,
+    )
     rng = np.random.default_rng(3)
     points = np.asarray(obstacle.point) + rng.normal(0.0, 0.05, (20, 3))
     normals = obstacle.outward_normals(points)
@@ -372,3 +382,33 @@ def test_an_obstacles_outward_normal_is_the_gradient_of_its_gap(kind: str) -> No
             for e in np.eye(3)
         ]
         assert normal == pytest.approx(gradient, abs=1e-9)
+
+
+@pytest.mark.parametrize("shape", ["capsule", "cylinder"])
+def test_a_capsule_or_capped_cylinder_obstacle_is_the_object_grown_by_the_links_radius(
+    shape: str,
+) -> None:
+    # The obstacle a link of radius a meets with its axis is the object grown by a: its gap is
+    # the object's own signed distance less a, everywhere (inside, beside the side, beyond the
+    # ends and the rim), against the primitive's independent distance (mapping.primitives);
+    # a capped cylinder's radius and height grow by a and its rim is rounded by a
+    a, radius, length = 0.001, 0.03, 0.05
+    rotation = np.array([0.4, -0.3, 0.2])
+    centre = np.array([0.6, 0.02, -0.1])
+    axis = Rotation.from_rotvec(rotation).as_matrix()[:, 2]
+    grow = 2.0 * a if shape == "cylinder" else 0.0
+    obstacle = Obstacle(
+        shape,
+        tuple(centre),
+        tuple(axis),
+        radius + a,
+        half_length=0.5 * (length + grow),
+        rounding=a if shape == "cylinder" else 0.0,
+    )
+    points = centre + np.random.default_rng(5).normal(0.0, 0.04, (400, 3))
+    expected = PRIMITIVES[shape].signed_distance(
+        np.array([*centre, *rotation, radius, length]), points
+    )
+    gaps = np.array([obstacle.gap(p) for p in points])
+    np.testing.assert_allclose(gaps, expected - a, atol=1e-12)
+    assert (gaps < 0).any() and (gaps > 0.02).any()

@@ -79,7 +79,21 @@ def test_metadata_and_ground_truth(tmp_path: Path) -> None:
         ({"case": "azimuthal", "contact_point": 0.5, "duration": -1.0}, "duration"),
         ({"case": "azimuthal", "contact_point": 0.5, "servo_pole": 5.0}, "servo_pole"),
         ({"case": "azimuthal", "contact_point": 0.5, "damping_ratio": 1.5}, "damping_ratio"),
-        ({"case": "azimuthal", "contact_point": 0.5, "obstacle_placement": (0, 0, 0)}, "obstacle_"),
+        (
+            {"case": "azimuthal", "contact_point": 0.5, "obstacle_placement": (0, 0, 0)},
+            "obstacle_placement",
+        ),
+        ({"case": "azimuthal", "contact_point": 0.5, "obstacle": "capsule"}, "obstacle_placement"),
+        (
+            {
+                "case": "azimuthal",
+                "contact_point": 0.5,
+                "obstacle": "cylinder",
+                "obstacle_placement": (0.5, 0, 0, 0, 0, 1),
+            },
+            "obstacle_length",
+        ),
+        ({"case": "azimuthal", "contact_point": 0.5, "obstacle_length": 0.1}, "obstacle_length"),
         (
             {"case": "azimuthal", "contact_point": 0.5, "obstacle_placement": (0.5, 0, 0, 0, 0, 0)},
             "obstacle_placement",

@@ -10,7 +10,7 @@ import pytest
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.recording import MAX_FILE_BYTES, MAX_SAMPLES
 from sensing_antenna.simulator import Scenario, ScenarioError
-from sensing_antenna.simulator.run import SAMPLE_PERIOD
+from sensing_antenna.simulator.run import SAMPLE_PERIOD, simulate_detailed
 from sensing_antenna.simulator.scenario import (
     MAX_DURATION,
     MAX_ELEMENTS,
@@ -18,10 +18,6 @@ from sensing_antenna.simulator.scenario import (
     MAX_SUBSTEPS,
     duration_problem,
 )
-
-#: Longest row write_recording can give the simulator's eleven columns: 24 characters per
-#: number (repr of a double, e.g. -2.2250738585072014e-308), ten commas and a line feed.
-LONGEST_ROW = 11 * 24 + 11
 
 
 @pytest.mark.parametrize("case", ["azimuthal", "free"])
@@ -51,9 +47,17 @@ def test_duration_problem_is_the_check_a_campaign_runs_on_its_own_fields() -> No
 def test_the_budget_fits_the_simulator_and_the_recording_reader() -> None:
     # The longest simulation records MAX_SIMULATED_SAMPLES at the simulator's period, a recording
     # the reader accepts both by sample count and by file size (with 64 KiB for the metadata).
+    # Its longest row: every column the simulator writes (its motor commands and the contact's
+    # track included) at 24 characters per number (repr of a double, e.g.
+    # -2.2250738585072014e-308), a comma between two and a line feed.
+    scenario = Scenario(case="azimuthal", contact_point=0.5, duration=1.0)
+    recording = simulate_detailed(paper_antenna(), scenario, record_commands=True).recording
+    columns = 9 + len(recording.extra)
+    assert columns == 17
+    longest_row = columns * 24 + columns
     assert round(MAX_DURATION / SAMPLE_PERIOD) == MAX_SIMULATED_SAMPLES
     assert MAX_SIMULATED_SAMPLES <= MAX_SAMPLES
-    assert MAX_SIMULATED_SAMPLES * LONGEST_ROW + 2**16 <= MAX_FILE_BYTES
+    assert MAX_SIMULATED_SAMPLES * longest_row + 2**16 <= MAX_FILE_BYTES
 
 
 @pytest.mark.parametrize(

@@ -2,12 +2,11 @@
 
 :func:`~sensing_antenna.scene.touch.first_touch` finds where the link first meets the scene.
 The simulator's own manoeuvre (``simulator.simulate``) is then run against an obstacle of the
-shapes it has (a cylinder, a ball, a plane). Where the touched object is one of them there, it
-is the object itself, placed in the recording's frame (``Scenario.obstacle_placement``): a
-sphere (a ball), a cylinder's or a capsule's side (a cylinder of its axis), a capsule's cap (a
-ball of its centre), so that a contact sliding along it stays on the object. Elsewhere (a box, a
-cone, a torus, a user's mesh, a cylinder's cap or rim) it is a local obstacle equivalent to the
-surface at the touch, placed by the simulator from x_c as for any of its runs:
+shapes it has. A sphere, a cylinder or a capsule is the obstacle itself, placed in the
+recording's frame (``Scenario.obstacle_placement``: a ball, a capped cylinder, a capsule), so
+that a contact sliding along it, over a rim or from a cap onto a side, stays on the object. A
+box, a cone, a torus or a user's mesh is met by a local obstacle equivalent to the surface at
+the touch, placed by the simulator from x_c as for any of its runs:
 
 - a contact along the link: a cylinder tangent to the link at x_c whose axis is perpendicular
   to the link and to the surface's normal, of the surface's local radius along the link (a post
@@ -22,9 +21,10 @@ surface at the touch, placed by the simulator from x_c as for any of its runs:
 
 A round link touches with its surface, its radius a off its axis (``scene.touch``), while the
 simulator's link touches with its axis: each obstacle, the object itself or a local one, is
-the surface grown by a (a cylinder or a ball of radius R + a about the same axis or centre;
-the tip's plane through the tip's axis, a from the face), which the axis meets where the
-link's surface meets the surface.
+the surface grown by a (a cylinder, a capsule or a ball of radius R + a about the same axis or
+centre, a capped cylinder also a longer at each end with its rim rounded by a; the tip's
+plane through the tip's axis, a from the face), which the axis meets where the link's surface
+meets the surface.
 
 The simulator's manoeuvre touches at the angles (0, 0) of its absolute frame, so the recording's
 frame is the base's turned to the touch angles: R = R_base M(theta)^T, with M(theta) the motor
@@ -43,8 +43,8 @@ vertical sweep down has the link's weight helping the push onto the obstacle bel
 The simulator's local obstacles turn at most :data:`MAX_TILT` out of the sweep's plane (about
 the friction cone of mu = 0.6); a surface turned further, up to :data:`GLANCING_ANGLE`, is
 simulated with the local obstacle turned by :data:`MAX_TILT`: the same touched point, the push
-held as if the surface faced the sweep more (a real link may slide there). The touched object
-itself is not turned: beyond the friction cone the link slides along it, as on a real object.
+held as if the surface faced the sweep more (a real link may slide there). An object placed
+itself is as it is: beyond the friction cone the link slides along it, as on a real object.
 A touch the simulator cannot
 represent is reported instead of simulated: the normal turned more than
 :data:`GLANCING_ANGLE` (``glancing``: the link would slide over it), or x_c below the
@@ -80,7 +80,6 @@ __all__ = [
     "GLANCING_ANGLE",
     "MAX_TILT",
     "OUTCOMES",
-    "SIDE_NORMAL",
     "GlancingTouchError",
     "SweepOutcome",
     "simulate_sweep",
@@ -102,10 +101,6 @@ MAX_TILT = 0.49
 #: A surface turned further than this (rad) out of the sweep's direction is ``glancing``: the
 #: link would slide over it rather than be held by it (57 degrees).
 GLANCING_ANGLE = 1.0
-
-#: A cylinder's or a capsule's side is where its outward normal lies within this of
-#: perpendicular to its axis (|n . axis|, the cosine); elsewhere a cylinder's cap or rim.
-SIDE_NORMAL = 1e-3
 
 #: What a sweep can end in.
 OUTCOMES = ("touch", "free", "glancing", "near_head", "inside")
@@ -201,6 +196,7 @@ def touch_scenario(
     # link's radius, which the axis meets where the link's surface meets the surface
     radius = min(radius + touch.link_radius, MAX_RADIUS)
     placement: tuple[float, ...] | None = None
+    length = 0.0
     if touch.tip:
         kind = "plane"
         tilt = 0.0
@@ -212,9 +208,8 @@ def touch_scenario(
     else:
         exact = _touched_shape(touch, scene, frame)
         if exact is not None:
-            kind, radius, placement = exact
-            if kind == "cylinder":
-                kind = "post" if sweep.case == "azimuthal" else "bar"
+            kind, radius, length, placement = exact
+            tilt = 0.0  # a placed obstacle is not turned
     # beyond the simulator's largest tilt a local obstacle is turned by that much: the same
     # touched point, a push held as if the surface faced the sweep more (the touched shape
     # itself, placed, is not turned: the link slides where friction cannot hold it)
@@ -235,6 +230,7 @@ def touch_scenario(
         obstacle_radius=radius,
         obstacle_tilt=tilt,
         obstacle_placement=placement,
+        obstacle_length=length,
         description=description,
         **scenario_fields,
     )
@@ -243,33 +239,29 @@ def touch_scenario(
 
 def _touched_shape(
     touch: Touch, scene: Scene, frame: BasePose
-) -> tuple[str, float, tuple[float, ...]] | None:
+) -> tuple[str, float, float, tuple[float, ...]] | None:
     """The touched object itself as the simulator's obstacle where the simulator has its shape
-    (module docstring): ``(kind, radius, placement)`` with kind ``ball`` or ``cylinder``, the
-    radius grown by the link's (m), the placement in the recording's frame (``frame``) as
-    ``Scenario.obstacle_placement`` takes it; None for another shape or part of one."""
+    (module docstring): ``(kind, radius, length, placement)`` with kind ``ball``, ``capsule``
+    or ``cylinder`` (capped), the radius grown by the link's (m), the length of the capsule's
+    segment or the cylinder's height grown by twice the link's radius (m), and the placement
+    in the recording's frame (``frame``) as ``Scenario.obstacle_placement`` takes it; None for
+    another shape."""
     named = [obj for obj in scene.objects if obj.name == touch.object_name]
     touched = min(named, key=lambda obj: abs(float(obj.signed_distance(touch.surface_point)[0])))
-    p = touched.parameters
-    # a ball's direction is only its outward normal at the touch, a cylinder's its axis
-    direction = touch.normal
-    if touched.shape == "sphere":
-        kind, centre, radius = "ball", p[:3], float(p[3])
-    elif touched.shape in ("cylinder", "capsule"):
-        axis = Rotation.from_rotvec(p[3:6]).as_matrix()[:, 2]
-        radius, half = float(p[6]), 0.5 * float(p[7])
-        along = float((touch.surface_point - p[:3]) @ axis)
-        if abs(along) < half and abs(float(touch.normal @ axis)) < SIDE_NORMAL:
-            kind, centre, direction = "cylinder", p[:3], axis
-        elif touched.shape == "capsule":
-            kind, centre = "ball", p[:3] + math.copysign(half, along) * axis
-        else:
-            return None  # a cylinder's cap or rim: the local obstacle
-    else:
+    if touched.shape not in ("sphere", "cylinder", "capsule"):
         return None
+    p = touched.parameters
+    grown = touch.link_radius
     to_frame = frame.rotation.T
-    point = to_frame @ (centre - frame.position)
-    return kind, radius + touch.link_radius, (*point, *(to_frame @ direction))
+    centre = to_frame @ (p[:3] - frame.position)
+    if touched.shape == "sphere":
+        # a ball's direction is only its outward normal at the touch
+        return "ball", float(p[3]) + grown, 0.0, (*centre, *(to_frame @ touch.normal))
+    axis = to_frame @ Rotation.from_rotvec(p[3:6]).as_matrix()[:, 2]
+    # a capsule grown by a is a capsule of the same segment; a capped cylinder grown by a is
+    # one of radius and height grown by a with its rim rounded by a, as the simulator makes it
+    length = float(p[7]) + (2.0 * grown if touched.shape == "cylinder" else 0.0)
+    return touched.shape, float(p[6]) + grown, length, (*centre, *axis)
 
 
 def simulate_sweep(

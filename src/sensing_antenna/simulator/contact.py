@@ -1,12 +1,15 @@
 """Rigid obstacles in the absolute frame, their placement from x_c, and the contact geometry.
 
-An obstacle is a cylinder (post: near-vertical axis; bar: near-horizontal axis), a ball or a
-plane. The gap between a point p and the obstacle is ``distance(p, axis) - R`` for a cylinder,
-``|p - C| - R`` for a ball of centre C and ``(p - P0) . n`` for a plane; the outward normal
-points from the obstacle towards p. A cylinder is curved across the link only: a link pushed
-along its axis (a post leaning out of the sweep's plane beyond the friction cone) slides along
-it as along a straight edge. A ball is curved both ways, as a rounded object is: sliding, the
-contact stays on its surface. The contact
+An obstacle is an endless cylinder (post: near-vertical axis; bar: near-horizontal axis), a
+ball, a plane, or, placed explicitly (``Scenario.obstacle_placement``), a capsule or a capped
+cylinder. The gap between a point p and the obstacle is its signed distance:
+``distance(p, axis) - R`` for an endless cylinder, ``|p - C| - R`` for a ball of centre C,
+``(p - P0) . n`` for a plane, the distance to the axis's segment less R for a capsule, and the
+exact distance to a capped cylinder (its side, its end discs, or its rim beyond both); the
+outward normal is the distance's gradient, pointing from the obstacle towards p. A cylinder is
+curved across the link only: a link pushed along its axis (a post leaning out of the sweep's
+plane beyond the friction cone) slides along it as along a straight edge. A ball is curved both
+ways, as a rounded object is: sliding, the contact stays on its surface. The contact
 law itself (penalty normal force with damping, tangential stick spring, Coulomb slip) lives in the
 time loop of :mod:`sensing_antenna.simulator.integrator`; the functions here are shared with it.
 
@@ -31,6 +34,8 @@ from sensing_antenna.simulator.scenario import ScenarioError
 
 __all__ = [
     "BALL",
+    "CAPPED_CYLINDER",
+    "CAPSULE",
     "CYLINDER",
     "NO_OBSTACLE",
     "PLANE",
@@ -43,6 +48,11 @@ NO_OBSTACLE = 0
 CYLINDER = 1
 PLANE = 2
 BALL = 3
+CAPSULE = 4
+CAPPED_CYLINDER = 5
+
+#: The codes of the compiled loop by obstacle kind (an endless cylinder otherwise).
+_CODES = {"plane": PLANE, "ball": BALL, "capsule": CAPSULE, "cylinder": CAPPED_CYLINDER}
 
 #: Angle (rad) between a plane's normal and the sweep direction, in the sweep plane: the link
 #: meets the plane at 90 degrees minus this, so the plane clears the rest of the link by
@@ -64,60 +74,89 @@ class Obstacle:
     Attributes
     ----------
     kind : str
-        "post", "bar", "ball" or "plane".
+        "post", "bar" (endless cylinders), "ball", "plane", "capsule" or "cylinder" (capped).
     point : tuple of 3 float
-        A point of the cylinder axis, the ball's centre, or a point of the plane (m).
+        A point of the endless cylinder's axis, the ball's centre, a point of the plane, or the
+        capsule's or the capped cylinder's centre (m).
     direction : tuple of 3 float
-        Unit axis of the cylinder, unit outward normal of the plane, or of the ball at the
-        nominal touch.
+        Unit axis of a cylinder or a capsule, unit outward normal of the plane, or of the ball
+        at the nominal touch.
     radius : float
-        Cylinder or ball radius (m); 0 for a plane.
+        Radius of a cylinder, a ball or a capsule (m); 0 for a plane.
+    half_length : float
+        Half the capsule's axis segment, half the capped cylinder's height (m); 0 otherwise.
+    rounding : float
+        Radius (m) the capped cylinder's rim is rounded by: it is its core, ``rounding``
+        thinner and shorter at each end, grown by ``rounding`` (a cylinder grown by the link's
+        radius); 0 otherwise.
     """
 
     kind: str
     point: tuple[float, float, float]
     direction: tuple[float, float, float]
     radius: float
+    half_length: float = 0.0
+    rounding: float = 0.0
 
     def as_array(self) -> NDArray[np.float64]:
-        """Packed form for the compiled loop: [kind, point(3), direction(3), radius]."""
-        code = {"plane": PLANE, "ball": BALL}.get(self.kind, CYLINDER)
-        return np.array([code, *self.point, *self.direction, self.radius], dtype=np.float64)
+        """Packed form for the compiled loop: [code, point(3), direction(3), radius, half
+        length, rounding]."""
+        code = _CODES.get(self.kind, CYLINDER)
+        values = [code, *self.point, *self.direction, self.radius]
+        return np.array([*values, self.half_length, self.rounding], dtype=np.float64)
 
     def gap(self, point: NDArray[np.float64]) -> float:
         """Signed distance of ``point`` (3,) (m) outside the obstacle (negative inside)."""
-        p0 = np.asarray(self.point)
-        a = np.asarray(self.direction)
-        d = np.asarray(point, dtype=float) - p0
-        if self.kind == "plane":
-            return float(d @ a)
-        if self.kind == "ball":
-            return float(np.linalg.norm(d) - self.radius)
-        perp = d - (d @ a) * a
-        return float(np.linalg.norm(perp) - self.radius)
+        return float(self._distances(np.asarray(point, dtype=float).reshape(1, 3))[0][0])
 
     def outward_normals(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         """Unit outward normals (n, 3) at the obstacle's surface points nearest ``points``
-        (n, 3) (m): the gradient of :meth:`gap` (NaN on a cylinder's axis or a ball's centre)."""
-        d = np.asarray(points, dtype=float).reshape(-1, 3) - np.asarray(self.point)
+        (n, 3) (m): the gradient of :meth:`gap` (NaN on a cylinder's or a capsule's axis or
+        a ball's centre)."""
+        return self._distances(np.asarray(points, dtype=float).reshape(-1, 3))[1]
+
+    def _distances(self, points: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+        """Signed distances (n,) and outward unit normals (n, 3) of ``points`` (n, 3)."""
+        d = points - np.asarray(self.point)
         a = np.asarray(self.direction)
+        along = d @ a
         if self.kind == "plane":
-            return np.tile(a, (len(d), 1))
-        if self.kind != "ball":
-            d = d - np.outer(d @ a, a)
+            return along, np.tile(a, (len(d), 1))
+        if self.kind == "ball":
+            along = np.zeros(len(d))
+        elif self.kind == "capsule":
+            along = np.clip(along, -self.half_length, self.half_length)
+        q = d - np.outer(along, a)
+        rho = np.linalg.norm(q, axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
-            return np.asarray(d / np.linalg.norm(d, axis=1, keepdims=True))
+            radial = q / rho[:, None]
+        if self.kind != "cylinder":
+            return rho - self.radius, radial
+        # capped: its core's side and nearer end are dr and da away, its core's rim both
+        core = self.rounding
+        dr = rho - (self.radius - core)
+        da = np.abs(along) - (self.half_length - core)
+        axial = np.outer(np.where(along >= 0.0, 1.0, -1.0), a)
+        rim = (dr > 0.0) & (da > 0.0)
+        from_core = np.where(rim, np.hypot(dr, da), np.maximum(dr, da))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            normal = np.where((dr > da)[:, None], radial, axial)
+            beyond = (dr[:, None] * radial + da[:, None] * axial) / from_core[:, None]
+        return from_core - core, np.where(rim[:, None], beyond, normal)
 
     def to_json(self) -> str:
         """JSON text for the recording's ``true_obstacle`` metadata."""
-        return json.dumps(
-            {
-                "kind": self.kind,
-                "point": [round(v, 12) for v in self.point],
-                "direction": [round(v, 12) for v in self.direction],
-                "radius": self.radius,
-            }
-        )
+        data: dict[str, object] = {
+            "kind": self.kind,
+            "point": [round(v, 12) for v in self.point],
+            "direction": [round(v, 12) for v in self.direction],
+            "radius": self.radius,
+        }
+        if self.half_length:
+            data["half_length"] = self.half_length
+        if self.rounding:
+            data["rounding"] = self.rounding
+        return json.dumps(data)
 
 
 def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -393,7 +393,7 @@ def simulate_detailed(
 
     # --- obstacle (placed from x_c on the sagged link at the touch angles) ---------------------
     obstacle: Obstacle | None = None
-    obst_array = np.zeros(8)
+    obst_array = np.zeros(10)
     kind = scenario.obstacle_kind
     if kind is not None:
         assert scenario.contact_point is not None
@@ -416,7 +416,13 @@ def simulate_detailed(
             placement = np.asarray(scenario.obstacle_placement)
             direction = placement[3:] / np.linalg.norm(placement[3:])
             radius = 0.0 if kind == "plane" else scenario.obstacle_radius
-            obstacle = Obstacle(kind, tuple(placement[:3]), tuple(direction), radius)
+            half = 0.5 * scenario.obstacle_length
+            # a capped cylinder as the link's axis meets it: its rim rounded by the link's
+            # radius (its radius and height given grown by it)
+            rounding = min(antenna.link.radius, radius, half) if kind == "cylinder" else 0.0
+            obstacle = Obstacle(
+                kind, tuple(placement[:3]), tuple(direction), radius, half, rounding
+            )
         else:
             obstacle = place_obstacle(
                 kind,

@@ -25,6 +25,7 @@ __all__ = [
     "MAX_SIMULATED_SAMPLES",
     "MAX_SUBSTEPS",
     "OBSTACLE_KINDS",
+    "PLACED_KINDS",
     "Scenario",
     "ScenarioError",
     "SensorNoise",
@@ -36,7 +37,9 @@ CASES = ("azimuthal", "vertical", "free", "free-vertical")
 #: and the vertical one, each run past its nominal touch and brought to rest.
 FREE_CASE_OF = {"azimuthal": "free", "vertical": "free-vertical"}
 FREE_CASES = tuple(FREE_CASE_OF.values())
-OBSTACLE_KINDS = ("post", "bar", "ball", "plane")
+OBSTACLE_KINDS = ("post", "bar", "ball", "plane", "capsule", "cylinder")
+#: The kinds placed only explicitly (``Scenario.obstacle_placement``), with a length.
+PLACED_KINDS = ("capsule", "cylinder")
 #: The link's mechanics: "linear" (Euler-Bernoulli about the undeformed line, Assumption 1) or
 #: "nonlinear" (geometrically exact inextensible rod, ``simulator.nonlinear_link``).
 LINK_MODELS = ("linear", "nonlinear")
@@ -62,8 +65,9 @@ ATI_NANO17_RESOLUTION = (
 #: simulator's 1 kHz, where a manoeuvre lasts seconds (3.5 s by default). Memory grows with the
 #: samples (references, measurements, ground truth, the recording and its text), so this keeps
 #: ``antenna simulate`` under a gigabyte (docs/simulator.md, "Scenario limits"), and the recording
-#: it writes, at most 275 bytes per sample (eleven columns of at most 24 characters), within the
-#: reader's ``recording.MAX_FILE_BYTES``.
+#: it writes, at most 425 bytes per sample (seventeen columns of at most 24 characters: the
+#: commands and the contact's track included), within the reader's
+#: ``recording.MAX_FILE_BYTES``.
 MAX_SIMULATED_SAMPLES = 600_000
 
 #: Longest ``duration`` (s): :data:`MAX_SIMULATED_SAMPLES` at the simulator's 1 kHz
@@ -201,10 +205,16 @@ class Scenario:
         Coulomb friction coefficient mu between link and obstacle.
     push : object or None
         The push criterion (``detection.push.PushCriterion``); None uses its default.
-    obstacle : {"post", "bar", "ball", "plane"} or None
-        Obstacle kind; None: post for the azimuthal case, bar for the vertical case.
+    obstacle : {"post", "bar", "ball", "plane", "capsule", "cylinder"} or None
+        Obstacle kind; None: post for the azimuthal case, bar for the vertical case. A post or
+        a bar is an endless cylinder; a capsule and a capped cylinder need
+        ``obstacle_placement`` and ``obstacle_length``.
     obstacle_radius : float
-        Radius of the post, bar or ball (m).
+        Radius of the post, bar, ball, capsule or cylinder (m).
+    obstacle_length : float
+        The capsule's axis segment or the capped cylinder's height (m); 0 for the other kinds.
+        Like ``obstacle_radius`` it is the obstacle the link's axis meets: an object grown by
+        the link's radius, so a capped cylinder's rim is rounded by the link's radius.
     obstacle_tilt : float
         Misalignment of the obstacle (rad): the post leans along the sweep, the bar rolls about
         the link, the plane turns its normal out of the sweep plane, the ball's normal at the
@@ -214,9 +224,10 @@ class Scenario:
         The obstacle placed explicitly in the absolute frame instead of from ``contact_point``
         and ``obstacle_tilt``: a point (m; a point of the cylinder's axis, the ball's centre, a
         point of the plane) and a direction (the cylinder's axis, the plane's outward normal,
-        the ball's outward normal at the touch; normalised). The sweep must then meet it near
-        ``contact_point``, which still names the touch (a scene's sweeps place the touched
-        object itself: ``scene.simulate``). None: placed from ``contact_point``.
+        the ball's outward normal at the touch; normalised; a capsule's or a capped cylinder's
+        centre and axis). The sweep must then meet it near ``contact_point``, which still names
+        the touch (a scene's sweeps place the touched object itself: ``scene.simulate``), and
+        ``obstacle_tilt`` is not used. None: placed from ``contact_point``.
     contact_stiffness : float
         Normal penalty stiffness (N/m); also the tangential stick stiffness.
     contact_damping : float
@@ -273,8 +284,9 @@ class Scenario:
     damping_ratio: float = 0.005
     friction_coefficient: float = 0.6
     push: Any = None
-    obstacle: Literal["post", "bar", "ball", "plane"] | None = None
+    obstacle: Literal["post", "bar", "ball", "plane", "capsule", "cylinder"] | None = None
     obstacle_radius: float = 0.01
+    obstacle_length: float = 0.0
     obstacle_tilt: float = 0.02
     obstacle_placement: tuple[float, ...] | None = None
     contact_stiffness: float = 1.0e4
@@ -365,6 +377,20 @@ class Scenario:
             if not math.hypot(*placement[3:]) > 0.0:
                 raise ScenarioError("obstacle_placement", "the direction must not be zero")
             object.__setattr__(self, "obstacle_placement", tuple(float(v) for v in placement))
+        _finite("obstacle_length", self.obstacle_length, 0.0)
+        if self.obstacle in PLACED_KINDS:
+            if self.obstacle_placement is None:
+                raise ScenarioError(
+                    "obstacle_placement", f"a {self.obstacle} is placed only explicitly: needed"
+                )
+            if self.obstacle == "cylinder" and not self.obstacle_length > 0.0:
+                raise ScenarioError("obstacle_length", "a capped cylinder's height must be > 0")
+        elif self.obstacle_length != 0.0:
+            raise ScenarioError(
+                "obstacle_length",
+                f"only a capsule or a capped cylinder has a length, not a"
+                f" {self.obstacle or 'default obstacle'}",
+            )
         if self.approach_time is not None:
             _finite("approach_time", self.approach_time, self.accel_time or 0.0)
         for name, (high, unit, reason) in _UPPER_LIMITS.items():
