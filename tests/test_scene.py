@@ -329,6 +329,25 @@ def test_a_point_is_where_the_contact_was_at_its_instant_when_the_contact_slides
     assert np.linalg.norm(ended - points["fast"].true_point) > 0.01
 
 
+def test_a_link_sliding_off_a_ball_beyond_the_friction_cone_is_not_reported_ok() -> None:
+    # The ball further off the link's line (the touched normal 44 degrees across the sweep,
+    # beyond mu = 0.6's 31): friction cannot hold the pushed link, which slides centimetres
+    # down the ball; neither method answers ok
+    ball = primitive_object("ball", "sphere", [0.05], [0.6, 0.035, -0.12])
+    sweep = Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1)
+    outcome = simulate_sweep(DEVICE, _scene(ball), sweep, seed=4, link_model="nonlinear")
+    assert outcome.recording is not None and outcome.touch is not None
+    assert math.acos(outcome.touch.normal[2]) > math.atan(0.6) + 0.2
+    # the ball itself was the obstacle, as the recording's metadata says
+    simulation = json.loads(outcome.recording.metadata["simulation"])
+    assert simulation["scenario"]["obstacle"] == "ball"
+    assert len(simulation["scenario"]["obstacle_placement"]) == 6
+    blind = outcome.recording.without_ground_truth()
+    for method in ("fast", "paper"):
+        result = estimate(blind, DEVICE.self_calibrated(), method)
+        assert result.status.value != "ok", (method, result.x_c)
+
+
 _DOWN = Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1)
 
 
