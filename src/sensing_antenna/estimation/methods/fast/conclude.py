@@ -97,8 +97,15 @@ def conclude_fast(
     # the link bends along the reaction it carries then, which has turned from the hold's
     # when the contact slid along the surface meanwhile
     frame = evidence.frame
+    t_point = 0.5 * float(t[final.start_index] + t[final.end_index])
+    turned = None
     if statics is not None:
-        frame = frame.turned_to(np.array([axial, *statics.reaction_perp])) or frame
+        turned = frame.turned_to(np.array([axial, *statics.reaction_perp]))
+    if turned is not None:
+        frame = turned
+    else:
+        # the hold's frame: its mean reaction over [t_1, t_1 + frame_window]
+        t_point = float(t[evidence.rest_index]) + 0.5 * evidence.config.frame_window
     touch = touched_point(post.x_c, frame, push, evidence.antenna.link, axial)
     found = problems(result, config)
     if "second_mode_objection" in diag:
@@ -156,7 +163,7 @@ def conclude_fast(
             # the frame the point was placed in and when (the map's covariance reads it)
             "axes_c_absolute": frame.axes_a,
             "theta_at_t1": frame.theta,
-            "t_point": 0.5 * float(t[final.start_index] + t[final.end_index]),
+            "t_point": t_point,
             "note": final.note,
             "other_reasons": [text for _, text in found[1:]],
         }
