@@ -412,3 +412,14 @@ def test_a_capsule_or_capped_cylinder_obstacle_is_the_object_grown_by_the_links_
     gaps = np.array([obstacle.gap(p) for p in points])
     np.testing.assert_allclose(gaps, expected - a, atol=1e-12)
     assert (gaps < 0).any() and (gaps > 0.02).any()
+
+
+def test_an_obstacle_rounded_beyond_its_radius_or_length_is_refused() -> None:
+    with pytest.raises(ValueError, match="rounding"):
+        Obstacle(
+            "cylinder", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), 0.01, half_length=0.05, rounding=0.02
+        )
+    with pytest.raises(ValueError, match="rounding"):
+        Obstacle(
+            "cylinder", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), 0.05, half_length=0.01, rounding=0.02
+        )

@@ -98,7 +98,7 @@ JITTER_TOLERANCE = 0.01
 PERIOD_CONSISTENCY = 0.02
 
 #: Largest file :func:`read_recording` reads (bytes): 256 MiB. One sample of the simulator's
-#: fifteen columns at full precision takes about 230 bytes, so this holds more than 15 minutes at
+#: fifteen columns at full precision takes about 250 bytes, so this holds more than 15 minutes at
 #: 1 kHz, where one manoeuvre lasts seconds; reading takes about four times the file's size in
 #: memory (text, lines, arrays), so the limit keeps that near a gigabyte and stops a stream that
 #: never ends (a device such as ``/dev/zero``, a pipe) before it exhausts memory.

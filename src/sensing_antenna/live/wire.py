@@ -53,7 +53,7 @@ DATAGRAM_KINDS = ("header", "samples", "end")
 MAX_DATAGRAM_BYTES = 65507
 #: Size (bytes) up to which a sender packs sample lines into one datagram: one Ethernet frame's
 #: payload less the IP and UDP headers and a margin, so that a datagram is never fragmented
-#: (five to seven lines of the simulator's columns at full precision).
+#: (four to five lines of the simulator's fifteen columns at full precision).
 SAMPLE_DATAGRAM_BYTES = 1400
 
 

@@ -12,8 +12,8 @@ the touch, placed by the simulator from x_c as for any of its runs:
   to the link and to the surface's normal, of the surface's local radius along the link (a post
   for an azimuthal sweep, a bar for a vertical one), turned by the normal's angle out of the
   sweep's plane (the scenario's ``obstacle_tilt``); where the surface is curved both ways (its
-  largest principal radius at most :data:`BALL_RATIO` times its smallest: a sphere, a capsule's
-  caps, a corner) a ball of the radius along the link instead, on which a link sliding across
+  largest principal radius at most :data:`BALL_RATIO` times its smallest: a box's corner, a
+  mesh's rounded part) a ball of the radius along the link instead, on which a link sliding across
   stays on the surface. An edge is curved one way only, whichever way the link crosses it:
   a cylinder, along which a link sliding across stays on the edge, as it does on a real one;
 - a contact at the tip: the simulator's plane, touched by the tip (its normal is the
@@ -88,9 +88,9 @@ __all__ = [
 
 #: A surface whose largest principal radius is at most this many times its smallest is curved
 #: every way at least half as much as the most, and its equivalent obstacle a ball of the radius
-#: along the link (a sphere, a capsule's caps, a box's corner); beyond, a cylinder, straight
-#: across (a cylinder's side, a box's edge met at any angle). Radii are capped at 10 m: a flat
-#: face gives a 10 m ball.
+#: along the link (a box's corner, a mesh's rounded part); beyond, a cylinder, straight
+#: across (a box's edge met at any angle, a mesh's cylindrical part). Radii are capped at 10 m:
+#: a flat face gives a 10 m ball.
 BALL_RATIO = 2.0
 
 #: Largest angle of the surface's normal out of the sweep's direction (rad) the simulator's

@@ -98,6 +98,15 @@ class Obstacle:
     half_length: float = 0.0
     rounding: float = 0.0
 
+    def __post_init__(self) -> None:
+        # a rim rounded by more than the radius or the half length has no core cylinder
+        largest = min(self.radius, self.half_length)
+        if self.rounding != 0.0 and not 0.0 < self.rounding <= largest:
+            raise ValueError(
+                f"Obstacle: rounding {self.rounding!r} m must lie in [0, {largest!r}] m (the"
+                " radius and the half length)"
+            )
+
     def as_array(self) -> NDArray[np.float64]:
         """Packed form for the compiled loop: [code, point(3), direction(3), radius, half
         length, rounding]."""
