@@ -28,6 +28,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from sensing_antenna.simulator.scenario import ScenarioError
@@ -40,6 +41,8 @@ __all__ = [
     "NO_OBSTACLE",
     "PLANE",
     "Obstacle",
+    "distance_and_normal",
+    "distances_and_normals",
     "motor_frame",
     "place_obstacle",
 ]
@@ -120,38 +123,14 @@ class Obstacle:
 
     def outward_normals(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         """Unit outward normals (n, 3) at the obstacle's surface points nearest ``points``
-        (n, 3) (m): the gradient of :meth:`gap` (NaN on a cylinder's or a capsule's axis or
-        a ball's centre)."""
+        (n, 3) (m): the gradient of :meth:`gap` (zero on a cylinder's or a capsule's axis or
+        at a ball's centre)."""
         return self._distances(np.asarray(points, dtype=float).reshape(-1, 3))[1]
 
     def _distances(self, points: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
-        """Signed distances (n,) and outward unit normals (n, 3) of ``points`` (n, 3)."""
-        d = points - np.asarray(self.point)
-        a = np.asarray(self.direction)
-        along = d @ a
-        if self.kind == "plane":
-            return along, np.tile(a, (len(d), 1))
-        if self.kind == "ball":
-            along = np.zeros(len(d))
-        elif self.kind == "capsule":
-            along = np.clip(along, -self.half_length, self.half_length)
-        q = d - np.outer(along, a)
-        rho = np.linalg.norm(q, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            radial = q / rho[:, None]
-        if self.kind != "cylinder":
-            return rho - self.radius, radial
-        # capped: its core's side and nearer end are dr and da away, its core's rim both
-        core = self.rounding
-        dr = rho - (self.radius - core)
-        da = np.abs(along) - (self.half_length - core)
-        axial = np.outer(np.where(along >= 0.0, 1.0, -1.0), a)
-        rim = (dr > 0.0) & (da > 0.0)
-        from_core = np.where(rim, np.hypot(dr, da), np.maximum(dr, da))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            normal = np.where((dr > da)[:, None], radial, axial)
-            beyond = (dr[:, None] * radial + da[:, None] * axial) / from_core[:, None]
-        return from_core - core, np.where(rim[:, None], beyond, normal)
+        """Signed distances (n,) and outward unit normals (n, 3) of ``points`` (n, 3), as the
+        compiled loop computes them (:func:`distance_and_normal`)."""
+        return distances_and_normals(np.ascontiguousarray(points), self.as_array())
 
     def to_json(self) -> str:
         """JSON text for the recording's ``true_obstacle`` metadata."""
@@ -166,6 +145,64 @@ class Obstacle:
         if self.rounding:
             data["rounding"] = self.rounding
         return json.dumps(data)
+
+
+@njit(cache=True)
+def distance_and_normal(
+    px: float, py: float, pz: float, obst: NDArray[np.float64]
+) -> tuple[float, float, float, float]:
+    """Signed distance (m) from the obstacle's surface of the point (px, py, pz) taken from
+    the obstacle's point, and the outward unit normal there, (distance, nx, ny, nz): the
+    distance's gradient, zero where it is undefined (a ball's centre, a cylinder's or a
+    capsule's axis). ``obst`` is ``Obstacle.as_array()``: [code, point (3), direction (3),
+    radius, half length, rounding]: a capped cylinder's rim is rounded by the rounding
+    radius (its side and ends as the radius and half length say)."""
+    ax, ay, az = obst[4], obst[5], obst[6]
+    along = px * ax + py * ay + pz * az
+    if obst[0] == 2.0:  # plane
+        return along, ax, ay, az
+    if obst[0] == 3.0:  # ball
+        along = 0.0
+    elif obst[0] == 4.0:  # capsule: the nearest point of its segment
+        along = min(max(along, -obst[8]), obst[8])
+    qx, qy, qz = px - along * ax, py - along * ay, pz - along * az
+    rho = math.sqrt(qx * qx + qy * qy + qz * qz)
+    scale = 1.0 / rho if rho > 0.0 else 0.0
+    if obst[0] != 5.0:  # ball, endless cylinder, capsule
+        return rho - obst[7], qx * scale, qy * scale, qz * scale
+    # capped cylinder: how far beyond the side (dr) and beyond the nearer end (da) of its
+    # core, the cylinder the rounding grows to it
+    dr = rho - (obst[7] - obst[9])
+    da = abs(along) - (obst[8] - obst[9])
+    end = 1.0 if along >= 0.0 else -1.0
+    if dr > 0.0 and da > 0.0:  # beyond the rim
+        distance = math.sqrt(dr * dr + da * da)
+        side, cap = dr / distance * scale, da / distance * end
+        normal_x, normal_y, normal_z = (
+            side * qx + cap * ax,
+            side * qy + cap * ay,
+            side * qz + cap * az,
+        )
+        return distance - obst[9], normal_x, normal_y, normal_z
+    if dr > da:
+        return dr - obst[9], qx * scale, qy * scale, qz * scale
+    return da - obst[9], end * ax, end * ay, end * az
+
+
+@njit(cache=True)
+def distances_and_normals(
+    points: NDArray[np.float64], obst: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`distance_and_normal` of each of ``points`` (n, 3) (m, absolute frame): the
+    signed distances (n,) and the outward unit normals (n, 3)."""
+    n = points.shape[0]
+    distances = np.empty(n)
+    normals = np.empty((n, 3))
+    for i in range(n):
+        distances[i], normals[i, 0], normals[i, 1], normals[i, 2] = distance_and_normal(
+            points[i, 0] - obst[1], points[i, 1] - obst[2], points[i, 2] - obst[3], obst
+        )
+    return distances, normals
 
 
 def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -32,6 +32,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from sensing_antenna.control.servo import joint_coupling_torques, joint_servo_step
+from sensing_antenna.simulator.contact import distance_and_normal
 from sensing_antenna.simulator.nonlinear_link import (
     add_shortening_gradient,
     link_forces,
@@ -216,49 +217,7 @@ def _gap(
     px = x * frame[0, 0] + v * frame[1, 0] + w * frame[2, 0] - obst[1]
     py = x * frame[0, 1] + v * frame[1, 1] + w * frame[2, 1] - obst[2]
     pz = x * frame[0, 2] + v * frame[1, 2] + w * frame[2, 2] - obst[3]
-    return _distance_and_normal(px, py, pz, obst)[0]
-
-
-@njit(cache=True)
-def _distance_and_normal(
-    px: float, py: float, pz: float, obst: NDArray[np.float64]
-) -> tuple[float, float, float, float]:
-    """Signed distance (m) from the obstacle's surface of the point (px, py, pz) taken from
-    the obstacle's point, and the outward unit normal there, (distance, nx, ny, nz): the
-    distance's gradient, zero where it is undefined (a ball's centre, a cylinder's or a
-    capsule's axis). ``obst`` is ``Obstacle.as_array()``: [code, point (3), direction (3),
-    radius, half length, rounding]: a capped cylinder's rim is rounded by the rounding
-    radius (its side and ends as the radius and half length say)."""
-    ax, ay, az = obst[4], obst[5], obst[6]
-    along = px * ax + py * ay + pz * az
-    if obst[0] == 2.0:  # plane
-        return along, ax, ay, az
-    if obst[0] == 3.0:  # ball
-        along = 0.0
-    elif obst[0] == 4.0:  # capsule: the nearest point of its segment
-        along = min(max(along, -obst[8]), obst[8])
-    qx, qy, qz = px - along * ax, py - along * ay, pz - along * az
-    rho = math.sqrt(qx * qx + qy * qy + qz * qz)
-    scale = 1.0 / rho if rho > 0.0 else 0.0
-    if obst[0] != 5.0:  # ball, endless cylinder, capsule
-        return rho - obst[7], qx * scale, qy * scale, qz * scale
-    # capped cylinder: how far beyond the side (dr) and beyond the nearer end (da) of its
-    # core, the cylinder the rounding grows to it
-    dr = rho - (obst[7] - obst[9])
-    da = abs(along) - (obst[8] - obst[9])
-    end = 1.0 if along >= 0.0 else -1.0
-    if dr > 0.0 and da > 0.0:  # beyond the rim
-        distance = math.sqrt(dr * dr + da * da)
-        side, cap = dr / distance * scale, da / distance * end
-        normal_x, normal_y, normal_z = (
-            side * qx + cap * ax,
-            side * qy + cap * ay,
-            side * qz + cap * az,
-        )
-        return distance - obst[9], normal_x, normal_y, normal_z
-    if dr > da:
-        return dr - obst[9], qx * scale, qy * scale, qz * scale
-    return da - obst[9], end * ax, end * ay, end * az
+    return distance_and_normal(px, py, pz, obst)[0]
 
 
 @njit(cache=True)
@@ -890,7 +849,7 @@ def run_samples(
                 if g0 < 0.02:
                     geometry = True
                     # outward normal at the contact point
-                    _, nx, ny, nz = _distance_and_normal(
+                    _, nx, ny, nz = distance_and_normal(
                         pc[0] - obst[1], pc[1] - obst[2], pc[2] - obst[3], obst
                     )
                     nvec[0], nvec[1], nvec[2] = nx, ny, nz
