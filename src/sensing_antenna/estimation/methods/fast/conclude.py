@@ -96,15 +96,14 @@ def conclude_fast(
     # the point where the contact was at the window's centre, where the fitted statics hold:
     # the link bends along the reaction it carries then, which has turned from the hold's
     # when the contact slid along the surface meanwhile
-    frame = evidence.frame
-    t_point = 0.5 * float(t[final.start_index] + t[final.end_index])
     turned = None
     if statics is not None:
-        turned = frame.turned_to(np.array([axial, *statics.reaction_perp]))
+        turned = evidence.frame.turned_to(np.array([axial, *statics.reaction_perp]))
     if turned is not None:
-        frame = turned
+        frame, t_point = turned, 0.5 * float(t[final.start_index] + t[final.end_index])
     else:
         # the hold's frame: its mean reaction over [t_1, t_1 + frame_window]
+        frame = evidence.frame
         t_point = float(t[evidence.rest_index]) + 0.5 * evidence.config.frame_window
     touch = touched_point(post.x_c, frame, push, evidence.antenna.link, axial)
     found = problems(result, config)
