@@ -817,14 +817,15 @@ def resample_uniform(recording: Recording, period: float | None = None) -> Recor
     )
 
 
-def tracked_contact(recording: Recording, t: float) -> NDArray[np.float64] | None:
+def tracked_contact(recording: Recording, t: float | None) -> NDArray[np.float64] | None:
     """Where the link touched at the in-contact sample nearest ``t`` (s) by the recording's
     contact track (:data:`CONTACT_TRACK_COLUMNS`; a contact may open and close again), shape
-    (3,) (m, absolute frame); None without a track, a finite ``t`` or any contact."""
+    (3,) (m, absolute frame); None without a track, a finite ``t`` (an estimate's
+    ``t_point`` may be missing) or any contact."""
     if not all(name in recording.extra for name in CONTACT_TRACK_COLUMNS):
         return None
     touching = np.flatnonzero(recording.extra[IN_CONTACT_COLUMN] > 0.5)
-    if not (touching.size and math.isfinite(t)):
+    if t is None or not (touching.size and math.isfinite(t)):
         return None
     k = int(touching[np.argmin(np.abs(recording.t[touching] - t))])
     return np.array([float(recording.extra[name][k]) for name in CONTACT_POINT_COLUMNS])

@@ -212,8 +212,7 @@ def point_error(estimate: ContactEstimate, recording: Recording, antenna: Antenn
     track (``recording.tracked_contact``); NaN without either."""
     from sensing_antenna.mapping.points import surface_offset
 
-    t_point = float_or_nan(estimate.diagnostics.get("t_point"))
-    truth = tracked_contact(recording, t_point)
+    truth = tracked_contact(recording, estimate.diagnostics.get("t_point"))
     point = np.asarray(estimate.contact_point, dtype=float)
     if truth is None or point.shape != (3,):
         return math.nan

@@ -240,10 +240,7 @@ def _point(
     from sensing_antenna.recording import tracked_contact
 
     result = estimate(recording.without_ground_truth(), antenna, method=method, config=config)
-    t_point = result.diagnostics.get("t_point")
-    truth = None
-    if isinstance(t_point, (int, float)):
-        truth = tracked_contact(recording, float(t_point))
+    truth = tracked_contact(recording, result.diagnostics.get("t_point"))
     if truth is None:
         truth = _true_point(recording.metadata.get("true_contact_point"))
     return contact_point_from_estimate(result, antenna, pose, str(path), uncertainty, truth)
