@@ -24,13 +24,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from sensing_antenna.recording import Recording
+from sensing_antenna.recording import CONTACT_POINT_COLUMNS, Recording
 
 __all__ = ["mirror_recording"]
 
 #: Extra columns whose sign flips under the reflection (joint 1's angle and command, the
 #: contact track's y).
-_ODD_COLUMNS = ("theta1_ref", "u1", "true_contact_y")
+_ODD_COLUMNS = ("theta1_ref", "u1", CONTACT_POINT_COLUMNS[1])
 
 
 def _reflect(values: object) -> object:
