@@ -381,14 +381,24 @@ _DOWN = Sweep(0, "vertical", 0.0, -0.6, 0.3, direction=-1)
         # a capsule standing below the link, touched on its cap off its top: the link slides
         # down the cap and onto the side
         (primitive_object("capsule", "capsule", [0.03, 0.02], [0.6, 0.01, -0.14]), "capsule"),
+        # a cube turned on a corner: the link slides along an edge and over faces
+        (primitive_object("cube", "box", [0.04] * 3, [0.6, 0.0, -0.1], [0.6, 0.6, 0.3]), "box"),
+        # a cone standing below the link, touched off its apex: the link slides down its slant
+        (primitive_object("cone", "cone", [0.04, 0.06], [0.6, 0.015, -0.16]), "cone"),
+        # a ring standing across the sweep, touched on its tube: the link slides round it
+        (
+            primitive_object("ring", "torus", [0.05, 0.015], [0.6, 0.0, -0.12], [0.9, 0, 0]),
+            "torus",
+        ),
     ],
 )
 def test_a_sliding_contact_stays_on_the_touched_object(touched: SceneObject, kind: str) -> None:
-    # The exact link pushed onto a sphere, a cylinder or a capsule slides along it by
-    # centimetres, over a rim or from one part onto another; the simulator's obstacle is the
-    # object itself, grown by the link's radius, so the contact's track stays on the object
-    # throughout: within the penalty contact's penetration F_n / k (a push under 1 N into
-    # 1e4 N/m: 0.1 mm)
+    # The exact link pushed onto a primitive object slides along it by centimetres, over a rim,
+    # an edge or from one part onto another; the simulator's obstacle is the object itself,
+    # grown by the link's radius, so the contact's track stays on the object throughout:
+    # within the penalty contact's penetration F_n / k (a push under 1 N into 1e4 N/m:
+    # 0.1 mm). A local stand-in for the surface at the touch let the cone's and the ring's
+    # contacts leave them by 8 mm.
     outcome = simulate_sweep(DEVICE, _scene(touched), _DOWN, seed=4, link_model="nonlinear")
     assert outcome.recording is not None and outcome.frame is not None, outcome.reason
     assert outcome.scenario is not None and outcome.scenario.obstacle == kind
@@ -615,37 +625,45 @@ def test_a_rounded_surface_is_simulated_as_a_ball_a_straight_one_as_a_cylinder()
     scenario, _ = touch_scenario(touch, sweep, post)
     assert scenario.obstacle == "cylinder"
     assert scenario.obstacle_length == pytest.approx(0.5 + 2 * DEVICE.link.radius, rel=1e-12)
-    # a corner, curved every way: a ball (of the smallest radius, grown by the link's), met
-    # by the link sweeping at a cube turned to point a corner at it; a user's mesh of the same
-    # cube (its own distance, not a primitive's) meets the same local obstacle
+    # a corner, curved every way: a user's mesh of a cube turned to point a corner at the
+    # sweeping link meets a ball (of the smallest radius, grown by the link's); the primitive
+    # cube is placed itself, in its own frame, its sizes its own
     corner = Rotation.align_vectors([[0.0, -1.0, 0.0]], [[1.0, 1.0, 1.0]])[0].as_rotvec()
-    cubes = [
-        primitive_object("cube", "box", [0.1, 0.1, 0.1], [0.6, 0.2, 0.0], corner),
-        mesh_object("cube", trimesh.creation.box(extents=[0.1] * 3), [0.6, 0.2, 0.0], corner),
-    ]
-    for cube in cubes:
-        scene = _scene(cube)
-        touch = first_touch(scene, sweep, shape).touch
-        assert touch is not None and not touch.tip
-        scenario, _ = touch_scenario(touch, sweep, scene)
-        assert scenario.obstacle == "ball" and scenario.obstacle_placement is None
-        assert scenario.obstacle_radius == pytest.approx(MIN_RADIUS + DEVICE.link.radius)
+    mesh = _scene(
+        mesh_object("cube", trimesh.creation.box(extents=[0.1] * 3), [0.6, 0.2, 0.0], corner)
+    )
+    touch = first_touch(mesh, sweep, shape).touch
+    assert touch is not None and not touch.tip
+    scenario, _ = touch_scenario(touch, sweep, mesh)
+    assert scenario.obstacle == "ball" and scenario.obstacle_placement is None
+    assert scenario.obstacle_radius == pytest.approx(MIN_RADIUS + DEVICE.link.radius)
+    cube = _scene(primitive_object("cube", "box", [0.1, 0.1, 0.1], [0.6, 0.2, 0.0], corner))
+    touch = first_touch(cube, sweep, shape).touch
+    assert touch is not None and not touch.tip
+    scenario, frame = touch_scenario(touch, sweep, cube)
+    assert scenario.obstacle == "box" and scenario.obstacle_sizes == (0.1, 0.1, 0.1)
+    assert scenario.obstacle_placement is not None
+    placed = np.array(scenario.obstacle_placement)
+    np.testing.assert_allclose(frame.point_to_world(placed[:3]), [0.6, 0.2, 0.0], atol=1e-12)
+    axes = Rotation.from_rotvec(corner).as_matrix()
+    np.testing.assert_allclose(frame.rotation @ placed[3:6], axes[:, 2], atol=1e-12)
+    np.testing.assert_allclose(frame.rotation @ placed[6:9], axes[:, 0], atol=1e-12)
 
 
 @pytest.mark.parametrize("lean", [0.0, 40.0, 60.0])
 def test_an_edge_is_simulated_as_a_cylinder_whichever_way_the_link_crosses_it(lean: float) -> None:
-    # A box turned to meet the level sweep with a vertical edge, then leant by ``lean`` degrees
-    # about Y: the link crosses the edge that far off the perpendicular, and the surface bends
-    # both along the link and across it. It is still curved one way only (straight along the
-    # edge), so its obstacle is a post, on which a link sliding across stays on the edge, not a
-    # ball, off which it would slide.
+    # A user's mesh of a box turned to meet the level sweep with a vertical edge, then leant by
+    # ``lean`` degrees about Y: the link crosses the edge that far off the perpendicular, and
+    # the surface bends both along the link and across it. It is still curved one way only
+    # (straight along the edge), so its local obstacle is a post, on which a link sliding
+    # across stays on the edge, not a ball, off which it would slide.
     from scipy.spatial.transform import Rotation
 
     from sensing_antenna.scene.simulate import touch_scenario
 
     turn = Rotation.from_euler("y", lean, degrees=True) * Rotation.from_euler("z", 45, degrees=True)
-    box = primitive_object("box", "box", [0.1, 0.1, 0.3], [0.6, 0.2, 0.0], turn.as_rotvec())
-    scene = _scene(box)
+    box = trimesh.creation.box(extents=[0.1, 0.1, 0.3])
+    scene = _scene(mesh_object("box", box, [0.6, 0.2, 0.0], turn.as_rotvec()))
     sweep = Sweep(0, "azimuthal", 0.0, -0.5, 0.8)
     touch = first_touch(scene, sweep, LinkShape(DEVICE.link, gravity=0.0)).touch
     assert touch is not None and not touch.tip

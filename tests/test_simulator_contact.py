@@ -360,18 +360,29 @@ def test_a_ball_keeps_the_contact_on_its_surface_where_a_post_lets_it_slide() ->
     assert off_sphere("post") > 1e-3
 
 
-@pytest.mark.parametrize("kind", ["post", "ball", "plane", "capsule", "cylinder"])
+_SOLID_AXES = (0.0, -0.8, 0.6, 1.0, 0.0, 0.0, 0.0, 0.6, 0.8)  # rows X, Y, Z = X x Y
+_SOLID_SIZES = {"box": (0.04, 0.06, 0.1), "cone": (0.04, 0.08), "torus": (0.05, 0.02)}
+
+
+@pytest.mark.parametrize(
+    "kind", ["post", "ball", "plane", "capsule", "cylinder", "box", "cone", "torus"]
+)
 def test_an_obstacles_outward_normal_is_the_gradient_of_its_gap(kind: str) -> None:
     # central differences of the signed distance, 1e-6 m steps: their error is the step's
     # curvature term, h^2 / R ~ 3e-11 on the 3 cm radius (the capped cylinder's rim, rounded
-    # by 5 mm, 2e-10), and rounding, eps |gap| / h ~ 1e-11
+    # by 5 mm, 2e-10; a box's edges, a cone's rim and apex, rounded by 5 mm; (h / t)^2 / 6 =
+    # 6e-9 at a point t = 5 mm from the torus's core circle), and rounding, eps |gap| / h ~
+    # 1e-11
+    solid = kind in _SOLID_SIZES
     obstacle = Obstacle(
         kind,
         (0.5, 0.1, -0.2),
         (0.0, 0.6, 0.8),
-        0.0 if kind == "plane" else 0.03,
+        0.0 if kind == "plane" or solid else 0.03,
         half_length=0.04 if kind in ("capsule", "cylinder") else 0.0,
-        rounding=0.005 if kind == "cylinder" else 0.0,
+        rounding=0.005 if kind == "cylinder" or solid else 0.0,
+        axes=_SOLID_AXES if solid else (),
+        sizes=_SOLID_SIZES.get(kind, ()),
     )
     rng = np.random.default_rng(3)
     points = np.asarray(obstacle.point) + rng.normal(0.0, 0.05, (20, 3))
@@ -381,7 +392,7 @@ def test_an_obstacles_outward_normal_is_the_gradient_of_its_gap(kind: str) -> No
             (obstacle.gap(point + 1e-6 * e) - obstacle.gap(point - 1e-6 * e)) / 2e-6
             for e in np.eye(3)
         ]
-        assert normal == pytest.approx(gradient, abs=1e-9)
+        assert normal == pytest.approx(gradient, abs=1e-8 if kind == "torus" else 1e-9)
 
 
 @pytest.mark.parametrize("shape", ["capsule", "cylinder"])
@@ -409,6 +420,29 @@ def test_a_capsule_or_capped_cylinder_obstacle_is_the_object_grown_by_the_links_
     expected = PRIMITIVES[shape].signed_distance(
         np.array([*centre, *rotation, radius, length]), points
     )
+    gaps = np.array([obstacle.gap(p) for p in points])
+    np.testing.assert_allclose(gaps, expected - a, atol=1e-12)
+    assert (gaps < 0).any() and (gaps > 0.02).any()
+
+
+@pytest.mark.parametrize("shape", ["box", "cone", "torus"])
+def test_a_box_cone_or_torus_obstacle_is_the_object_grown_by_the_links_radius(shape: str) -> None:
+    # the same for the solids with a frame of their own: the gap is the primitive's exact
+    # signed distance less a, the solid grown by a (its edges, rim and apex rounded by a),
+    # inside, beside faces and beyond edges and corners
+    a = 0.001
+    rotation = np.array([0.4, -0.3, 0.2])
+    centre = np.array([0.6, 0.02, -0.1])
+    axes = Rotation.from_rotvec(rotation).as_matrix()
+    sizes = _SOLID_SIZES[shape]
+    obstacle = Obstacle(
+        shape, tuple(centre), tuple(axes[:, 2]), 0.0, rounding=a, axes=tuple(axes.T.flat),
+        sizes=sizes,
+    )  # fmt: skip
+    # the torus's parameters name its hole, R - r
+    own = (sizes[0] - sizes[1], sizes[1]) if shape == "torus" else sizes
+    points = centre + np.random.default_rng(5).normal(0.0, 0.05, (400, 3))
+    expected = PRIMITIVES[shape].signed_distance(np.array([*centre, *rotation, *own]), points)
     gaps = np.array([obstacle.gap(p) for p in points])
     np.testing.assert_allclose(gaps, expected - a, atol=1e-12)
     assert (gaps < 0).any() and (gaps > 0.02).any()

@@ -70,6 +70,15 @@ def test_metadata_and_ground_truth(tmp_path: Path) -> None:
     assert read_recording(tmp_path / "v.csv").metadata["true_xc"] == meta["true_xc"]
 
 
+_BOX: dict[str, object] = {
+    "case": "azimuthal",
+    "contact_point": 0.5,
+    "obstacle": "box",
+    "obstacle_placement": (0.5, 0.05, 0, 0, 0, 1, 1, 1, 0),
+    "obstacle_sizes": (0.05, 0.05, 0.1),
+}
+
+
 @pytest.mark.parametrize(
     ("changes", "field"),
     [
@@ -102,6 +111,23 @@ def test_metadata_and_ground_truth(tmp_path: Path) -> None:
             {"case": "vertical", "contact_point": 0.5, "obstacle_placement": (math.nan,) * 6},
             "obstacle_placement",
         ),
+        # a box needs its X axis too, not along its Z; a cone two sizes; a torus's tube no
+        # wider than its ring; sizes only for the solids
+        (_BOX | {"obstacle_placement": (0.5, 0, 0, 0, 0, 1)}, "obstacle_placement"),
+        (_BOX | {"obstacle_placement": (0.5, 0, 0, 0, 0, 1, 0, 0, 2)}, "obstacle_placement"),
+        (_BOX | {"obstacle_sizes": (0.1, 0.1)}, "obstacle_sizes"),
+        (_BOX | {"obstacle_sizes": (0.1, -0.1, 0.1)}, "obstacle_sizes"),
+        (_BOX | {"obstacle_length": 0.1}, "obstacle_length"),
+        (
+            _BOX
+            | {
+                "obstacle": "torus",
+                "obstacle_placement": _BOX["obstacle_placement"][:6],
+                "obstacle_sizes": (0.02, 0.03),
+            },
+            "obstacle_sizes",
+        ),
+        ({"case": "azimuthal", "contact_point": 0.5, "obstacle_sizes": (0.1,)}, "obstacle_sizes"),
     ],
 )
 def test_scenario_validation_names_the_field(changes: dict[str, object], field: str) -> None:

@@ -2,11 +2,11 @@
 
 :func:`~sensing_antenna.scene.touch.first_touch` finds where the link first meets the scene.
 The simulator's own manoeuvre (``simulator.simulate``) is then run against an obstacle of the
-shapes it has. A sphere, a cylinder or a capsule is the obstacle itself, placed in the
-recording's frame (``Scenario.obstacle_placement``: a ball, a capped cylinder, a capsule), so
-that a contact sliding along it, over a rim or from a cap onto a side, stays on the object. A
-box, a cone, a torus or a user's mesh is met by a local obstacle equivalent to the surface at
-the touch, placed by the simulator from x_c as for any of its runs:
+shapes it has. A primitive object is the obstacle itself, placed in the recording's frame
+(``Scenario.obstacle_placement``: a ball, a capped cylinder, a capsule, a box, a cone, a
+torus), so that a contact sliding along it, over an edge or a rim, from a cap onto a side,
+stays on the object. A user's mesh is met by a local obstacle equivalent to the surface at the
+touch, placed by the simulator from x_c as for any of its runs:
 
 - a contact along the link: a cylinder tangent to the link at x_c whose axis is perpendicular
   to the link and to the surface's normal, of the surface's local radius along the link (a post
@@ -22,9 +22,9 @@ the touch, placed by the simulator from x_c as for any of its runs:
 A round link touches with its surface, its radius a off its axis (``scene.touch``), while the
 simulator's link touches with its axis: each obstacle, the object itself or a local one, is
 the surface grown by a (a cylinder, a capsule or a ball of radius R + a about the same axis or
-centre, a capped cylinder also a longer at each end with its rim rounded by a; the tip's
-plane through the tip's axis, a from the face), which the axis meets where the link's surface
-meets the surface.
+centre, a capped cylinder also a longer at each end with its rim rounded by a; a box, a cone
+or a torus grown by a, its edges, rim and apex rounded by it; the tip's plane through the
+tip's axis, a from the face), which the axis meets where the link's surface meets the surface.
 
 The simulator's manoeuvre touches at the angles (0, 0) of its absolute frame, so the recording's
 frame is the base's turned to the touch angles: R = R_base M(theta)^T, with M(theta) the motor
@@ -63,6 +63,7 @@ from scipy.spatial.transform import Rotation
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.mapping.pose import BasePose
+from sensing_antenna.mapping.primitives import PRIMITIVES
 from sensing_antenna.recording import Recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.sweep import LinkShape, Sweep
@@ -195,8 +196,7 @@ def touch_scenario(
     # the simulator's link touches with its axis: its obstacle is the surface grown by the
     # link's radius, which the axis meets where the link's surface meets the surface
     radius = min(radius + touch.link_radius, MAX_RADIUS)
-    placement: tuple[float, ...] | None = None
-    length = 0.0
+    placed: dict[str, Any] = {}
     if touch.tip:
         kind = "plane"
         tilt = 0.0
@@ -206,9 +206,10 @@ def touch_scenario(
             f" {GLANCING_ANGLE} rad (the link would slide over it)"
         )
     else:
-        exact = _touched_shape(touch, scene, frame)
-        if exact is not None:
-            kind, radius, length, placement = exact
+        placed = _touched_shape(touch, scene, frame) or {}
+        if placed:
+            kind = placed.pop("obstacle")
+            radius = placed.pop("obstacle_radius", radius)
             tilt = 0.0  # a placed obstacle is not turned
     # beyond the simulator's largest tilt a local obstacle is turned by that much: the same
     # touched point, a push held as if the surface faced the sweep more (the touched shape
@@ -229,39 +230,51 @@ def touch_scenario(
         obstacle=kind,  # type: ignore[arg-type]
         obstacle_radius=radius,
         obstacle_tilt=tilt,
-        obstacle_placement=placement,
-        obstacle_length=length,
         description=description,
+        **placed,
         **scenario_fields,
     )
     return scenario, frame
 
 
-def _touched_shape(
-    touch: Touch, scene: Scene, frame: BasePose
-) -> tuple[str, float, float, tuple[float, ...]] | None:
-    """The touched object itself as the simulator's obstacle where the simulator has its shape
-    (module docstring): ``(kind, radius, length, placement)`` with kind ``ball``, ``capsule``
-    or ``cylinder`` (capped), the radius grown by the link's (m), the length of the capsule's
-    segment or the cylinder's height grown by twice the link's radius (m), and the placement
-    in the recording's frame (``frame``) as ``Scenario.obstacle_placement`` takes it; None for
-    another shape."""
+def _touched_shape(touch: Touch, scene: Scene, frame: BasePose) -> dict[str, Any] | None:
+    """The touched object itself as the simulator's obstacle (module docstring): the
+    scenario's fields ``obstacle`` (``ball``, ``capsule``, ``cylinder``, ``box``, ``cone`` or
+    ``torus``), ``obstacle_placement`` in the recording's frame (``frame``), and its sizes: a
+    ball's, a capsule's or a capped cylinder's ``obstacle_radius`` grown by the link's radius
+    (m), the capsule's segment or the cylinder's height grown by twice the link's radius as
+    ``obstacle_length`` (m), or a box's, a cone's or a torus's own ``obstacle_sizes`` (the
+    simulator grows it); None for a user's mesh."""
     named = [obj for obj in scene.objects if obj.name == touch.object_name]
     touched = min(named, key=lambda obj: abs(float(obj.signed_distance(touch.surface_point)[0])))
-    if touched.shape not in ("sphere", "cylinder", "capsule"):
+    if touched.shape == "mesh":
         return None
     p = touched.parameters
     grown = touch.link_radius
     to_frame = frame.rotation.T
-    centre = to_frame @ (p[:3] - frame.position)
+    centre = tuple(to_frame @ (p[:3] - frame.position))
     if touched.shape == "sphere":
         # a ball's direction is only its outward normal at the touch
-        return "ball", float(p[3]) + grown, 0.0, (*centre, *(to_frame @ touch.normal))
-    axis = to_frame @ Rotation.from_rotvec(p[3:6]).as_matrix()[:, 2]
-    # a capsule grown by a is a capsule of the same segment; a capped cylinder grown by a is
-    # one of radius and height grown by a with its rim rounded by a, as the simulator makes it
-    length = float(p[7]) + (2.0 * grown if touched.shape == "cylinder" else 0.0)
-    return touched.shape, float(p[6]) + grown, length, (*centre, *axis)
+        placement = (*centre, *(to_frame @ touch.normal))
+        return {"obstacle": "ball", "obstacle_radius": float(p[3]) + grown,
+                "obstacle_placement": placement}  # fmt: skip
+    axes = to_frame @ Rotation.from_rotvec(p[3:6]).as_matrix()
+    placement = (*centre, *axes[:, 2])
+    if touched.shape in ("capsule", "cylinder"):
+        # a capsule grown by a is a capsule of the same segment; a capped cylinder grown by a
+        # is one of radius and height grown by a with its rim rounded by a, as the simulator
+        # makes it
+        length = float(p[7]) + (2.0 * grown if touched.shape == "cylinder" else 0.0)
+        return {
+            "obstacle": touched.shape,
+            "obstacle_radius": float(p[6]) + grown,
+            "obstacle_length": length,
+            "obstacle_placement": placement,
+        }
+    if touched.shape == "box":
+        placement = (*placement, *axes[:, 0])
+    sizes = tuple(float(v) for v in PRIMITIVES[touched.shape].sizes(p))
+    return {"obstacle": touched.shape, "obstacle_sizes": sizes, "obstacle_placement": placement}
 
 
 def simulate_sweep(

@@ -1,12 +1,15 @@
 """Rigid obstacles in the absolute frame, their placement from x_c, and the contact geometry.
 
 An obstacle is an endless cylinder (post: near-vertical axis; bar: near-horizontal axis), a
-ball, a plane, or, placed explicitly (``Scenario.obstacle_placement``), a capsule or a capped
-cylinder. The gap between a point p and the obstacle is its signed distance:
-``distance(p, axis) - R`` for an endless cylinder, ``|p - C| - R`` for a ball of centre C,
-``(p - P0) . n`` for a plane, the distance to the axis's segment less R for a capsule, and the
-exact distance to a capped cylinder (its side, its end discs, or its rim beyond both); the
-outward normal is the distance's gradient, pointing from the obstacle towards p. A cylinder is
+ball, a plane, or, placed explicitly (``Scenario.obstacle_placement``), a capsule, a capped
+cylinder, a box, a cone or a torus. The gap between a point p and the obstacle is its signed
+distance: ``distance(p, axis) - R`` for an endless cylinder, ``|p - C| - R`` for a ball of
+centre C, ``(p - P0) . n`` for a plane, the distance to the axis's segment less R for a
+capsule, the exact distance to a capped cylinder (its side, its end discs, or its rim beyond
+both), and for a box, a cone or a torus the exact distance to the solid (in its own frame, as
+``mapping.primitives`` has it) less a rounding radius: the solid grown by the link's radius,
+its edges, rim and apex rounded by it. The outward normal is the distance's gradient, pointing
+from the obstacle towards p. A cylinder is
 curved across the link only: a link pushed along its axis (a post leaning out of the sweep's
 plane beyond the friction cone) slides along it as along a straight edge. A ball is curved both
 ways, as a rounded object is: sliding, the contact stays on its surface. The contact
@@ -35,11 +38,14 @@ from sensing_antenna.simulator.scenario import ScenarioError
 
 __all__ = [
     "BALL",
+    "BOX",
     "CAPPED_CYLINDER",
     "CAPSULE",
+    "CONE",
     "CYLINDER",
     "NO_OBSTACLE",
     "PLANE",
+    "TORUS",
     "Obstacle",
     "distance_and_normal",
     "distances_and_normals",
@@ -53,9 +59,22 @@ PLANE = 2
 BALL = 3
 CAPSULE = 4
 CAPPED_CYLINDER = 5
+BOX = 6
+CONE = 7
+TORUS = 8
 
 #: The codes of the compiled loop by obstacle kind (an endless cylinder otherwise).
-_CODES = {"plane": PLANE, "ball": BALL, "capsule": CAPSULE, "cylinder": CAPPED_CYLINDER}
+_CODES = {
+    "plane": PLANE,
+    "ball": BALL,
+    "capsule": CAPSULE,
+    "cylinder": CAPPED_CYLINDER,
+    "box": BOX,
+    "cone": CONE,
+    "torus": TORUS,
+}
+#: The kinds with a frame of their own and sizes (``Obstacle.axes``, ``Obstacle.sizes``).
+SOLID_KINDS = ("box", "cone", "torus")
 
 #: Angle (rad) between a plane's normal and the sweep direction, in the sweep plane: the link
 #: meets the plane at 90 degrees minus this, so the plane clears the rest of the link by
@@ -77,13 +96,15 @@ class Obstacle:
     Attributes
     ----------
     kind : str
-        "post", "bar" (endless cylinders), "ball", "plane", "capsule" or "cylinder" (capped).
+        "post", "bar" (endless cylinders), "ball", "plane", "capsule", "cylinder" (capped),
+        "box", "cone" or "torus".
     point : tuple of 3 float
-        A point of the endless cylinder's axis, the ball's centre, a point of the plane, or the
-        capsule's or the capped cylinder's centre (m).
+        A point of the endless cylinder's axis, the ball's centre, a point of the plane, the
+        capsule's, the capped cylinder's, the box's or the torus's centre, or the centre of the
+        cone's base (m).
     direction : tuple of 3 float
-        Unit axis of a cylinder or a capsule, unit outward normal of the plane, or of the ball
-        at the nominal touch.
+        Unit axis of a cylinder, a capsule, a cone (towards its apex) or a torus, the box's
+        local Z, unit outward normal of the plane, or of the ball at the nominal touch.
     radius : float
         Radius of a cylinder, a ball or a capsule (m); 0 for a plane.
     half_length : float
@@ -91,7 +112,14 @@ class Obstacle:
     rounding : float
         Radius (m) the capped cylinder's rim is rounded by: it is its core, ``rounding``
         thinner and shorter at each end, grown by ``rounding`` (a cylinder grown by the link's
-        radius); 0 otherwise.
+        radius); what a box, a cone or a torus is grown by (m); 0 otherwise.
+    axes : tuple of 9 float
+        A box's, a cone's or a torus's own X, Y and Z axes (rows, unit, absolute frame; Z the
+        ``direction``); empty otherwise.
+    sizes : tuple of float
+        The solid's own sizes before ``rounding`` (m): a box's three edge lengths along its
+        axes, a cone's base radius and height, a torus's major and minor radii; empty
+        otherwise.
     """
 
     kind: str
@@ -100,8 +128,22 @@ class Obstacle:
     radius: float
     half_length: float = 0.0
     rounding: float = 0.0
+    axes: tuple[float, ...] = ()
+    sizes: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
+        if self.kind in SOLID_KINDS:
+            frame = np.asarray(self.axes, dtype=float)
+            if frame.shape != (9,) or not np.allclose(
+                frame.reshape(3, 3) @ frame.reshape(3, 3).T, np.eye(3), atol=1e-9
+            ):
+                raise ValueError(f"Obstacle: a {self.kind} needs orthonormal axes, 9 numbers")
+            count = 3 if self.kind == "box" else 2
+            if len(self.sizes) != count or not all(v > 0.0 for v in self.sizes):
+                raise ValueError(f"Obstacle: a {self.kind} needs {count} sizes > 0 m")
+            if not self.rounding >= 0.0:
+                raise ValueError(f"Obstacle: rounding {self.rounding!r} m must be >= 0")
+            return
         # a rim rounded by more than the radius or the half length has no core cylinder
         largest = min(self.radius, self.half_length)
         if self.rounding != 0.0 and not 0.0 < self.rounding <= largest:
@@ -112,10 +154,14 @@ class Obstacle:
 
     def as_array(self) -> NDArray[np.float64]:
         """Packed form for the compiled loop: [code, point(3), direction(3), radius, half
-        length, rounding]."""
+        length, rounding, axes (9, rows), sizes (3, a box's halved; zeros when unused)]."""
         code = _CODES.get(self.kind, CYLINDER)
         values = [code, *self.point, *self.direction, self.radius]
-        return np.array([*values, self.half_length, self.rounding], dtype=np.float64)
+        axes = list(self.axes) if self.axes else [0.0] * 9
+        sizes = list(self.sizes) + [0.0] * (3 - len(self.sizes))
+        if self.kind == "box":
+            sizes = [0.5 * v for v in sizes]
+        return np.array([*values, self.half_length, self.rounding, *axes, *sizes], dtype=np.float64)
 
     def gap(self, point: NDArray[np.float64]) -> float:
         """Signed distance of ``point`` (3,) (m) outside the obstacle (negative inside)."""
@@ -144,6 +190,9 @@ class Obstacle:
             data["half_length"] = self.half_length
         if self.rounding:
             data["rounding"] = self.rounding
+        if self.axes:
+            data["axes"] = [round(v, 12) for v in self.axes]
+            data["sizes"] = list(self.sizes)
         return json.dumps(data)
 
 
@@ -155,8 +204,11 @@ def distance_and_normal(
     the obstacle's point, and the outward unit normal there, (distance, nx, ny, nz): the
     distance's gradient, zero where it is undefined (a ball's centre, a cylinder's or a
     capsule's axis). ``obst`` is ``Obstacle.as_array()``: [code, point (3), direction (3),
-    radius, half length, rounding]: a capped cylinder's rim is rounded by the rounding
-    radius (its side and ends as the radius and half length say)."""
+    radius, half length, rounding, axes (9), sizes (3)]: a capped cylinder's rim is rounded
+    by the rounding radius (its side and ends as the radius and half length say); a box, a
+    cone or a torus is its solid grown by the rounding radius."""
+    if obst[0] >= 6.0:
+        return _solid_distance_and_normal(px, py, pz, obst)
     ax, ay, az = obst[4], obst[5], obst[6]
     along = px * ax + py * ay + pz * az
     if obst[0] == 2.0:  # plane
@@ -187,6 +239,63 @@ def distance_and_normal(
     if dr > da:
         return dr - obst[9], qx * scale, qy * scale, qz * scale
     return da - obst[9], end * ax, end * ay, end * az
+
+
+@njit(cache=True)
+def _solid_distance_and_normal(
+    px: float, py: float, pz: float, obst: NDArray[np.float64]
+) -> tuple[float, float, float, float]:
+    """:func:`distance_and_normal` of a box, a cone or a torus: in the solid's own frame
+    (local = axes @ p), the exact distance to it and its gradient, less the rounding."""
+    lx = obst[10] * px + obst[11] * py + obst[12] * pz
+    ly = obst[13] * px + obst[14] * py + obst[15] * pz
+    lz = obst[16] * px + obst[17] * py + obst[18] * pz
+    if obst[0] == 6.0:  # box of half extents sizes: how far beyond each pair of faces
+        qx, qy, qz = abs(lx) - obst[19], abs(ly) - obst[20], abs(lz) - obst[21]
+        sx = 1.0 if lx >= 0.0 else -1.0
+        sy = 1.0 if ly >= 0.0 else -1.0
+        sz = 1.0 if lz >= 0.0 else -1.0
+        if qx > 0.0 or qy > 0.0 or qz > 0.0:
+            mx, my, mz = max(qx, 0.0), max(qy, 0.0), max(qz, 0.0)
+            core = math.sqrt(mx * mx + my * my + mz * mz)
+            nx, ny, nz = sx * mx / core, sy * my / core, sz * mz / core
+        elif qx >= qy and qx >= qz:
+            core, nx, ny, nz = qx, sx, 0.0, 0.0
+        elif qy >= qz:
+            core, nx, ny, nz = qy, 0.0, sy, 0.0
+        else:
+            core, nx, ny, nz = qz, 0.0, 0.0, sz
+    else:
+        rho = math.sqrt(lx * lx + ly * ly)
+        cx, cy = (lx / rho, ly / rho) if rho > 0.0 else (0.0, 0.0)
+        if obst[0] == 7.0:  # cone: its half-section is the triangle (0, 0), (R, 0), (0, h)
+            radius, height = obst[19], obst[20]
+            # nearest points of the base (0, 0)-(R, 0) and of the slant (R, 0)-(0, h)
+            br, bz = rho - min(rho, radius), lz
+            t = ((radius - rho) * radius + lz * height) / (radius * radius + height * height)
+            t = min(max(t, 0.0), 1.0)
+            sr, sz_ = rho - radius * (1.0 - t), lz - height * t
+            base, slant = math.hypot(br, bz), math.hypot(sr, sz_)
+            dr, dz, nearest = (br, bz, base) if base <= slant else (sr, sz_, slant)
+            if nearest == 0.0:  # on the surface itself: that face's own normal
+                scale = 1.0 / math.hypot(height, radius)
+                gr, gz = (0.0, -1.0) if base <= slant else (height * scale, radius * scale)
+                core = 0.0
+            elif lz >= 0.0 and rho * height + lz * radius <= radius * height:  # inside
+                core, gr, gz = -nearest, -dr / nearest, -dz / nearest
+            else:
+                core, gr, gz = nearest, dr / nearest, dz / nearest
+        else:  # torus of major radius sizes[0], minor sizes[1]
+            dr, dz = rho - obst[19], lz
+            tube = math.sqrt(dr * dr + dz * dz)
+            core = tube - obst[20]
+            gr, gz = (dr / tube, dz / tube) if tube > 0.0 else (0.0, 0.0)
+        nx, ny, nz = gr * cx, gr * cy, gz
+    # back to the absolute frame: the axes are the rows
+    normal_x = nx * obst[10] + ny * obst[13] + nz * obst[16]
+    normal_y = nx * obst[11] + ny * obst[14] + nz * obst[17]
+    normal_z = nx * obst[12] + ny * obst[15] + nz * obst[18]
+    return core - obst[9], normal_x, normal_y, normal_z
 
 
 @njit(cache=True)

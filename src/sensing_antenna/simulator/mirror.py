@@ -33,7 +33,7 @@ __all__ = ["mirror_recording"]
 _ODD_COLUMNS = ("theta1_ref", "u1", CONTACT_POINT_COLUMNS[1])
 
 
-def _reflect(values: object) -> object:
+def _reflect(values: object) -> list[float] | None:
     if values is None:
         return None
     x, y, z = (float(v) for v in values)  # type: ignore[attr-defined]
@@ -60,6 +60,10 @@ def mirror_recording(recording: Recording) -> Recording:
         obstacle = json.loads(metadata["true_obstacle"])
         obstacle["point"] = _reflect(obstacle["point"])
         obstacle["direction"] = _reflect(obstacle["direction"])
+        if "axes" in obstacle:  # a solid's own axes, each reflected (its shape is symmetric)
+            rows = obstacle["axes"]
+            axes = rows[0:3], rows[3:6], rows[6:9]
+            obstacle["axes"] = [v for axis in axes for v in _reflect(axis) or ()]
         metadata["true_obstacle"] = json.dumps(obstacle)
     if "simulation" in metadata:
         simulation = json.loads(metadata["simulation"])

@@ -38,7 +38,7 @@ from sensing_antenna.simulator.integrator import (
 from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
 from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
 from sensing_antenna.simulator.nonlinear_link import node_masses, static_equilibrium
-from sensing_antenna.simulator.scenario import FREE_CASES, Scenario, ScenarioError
+from sensing_antenna.simulator.scenario import FREE_CASES, SIZED_KINDS, Scenario, ScenarioError
 
 __all__ = [
     "FINAL_AVERAGE_TIME",
@@ -420,9 +420,12 @@ def simulate_detailed(
             # a capped cylinder as the link's axis meets it: its rim rounded by the link's
             # radius (its radius and height given grown by it)
             rounding = min(antenna.link.radius, radius, half) if kind == "cylinder" else 0.0
-            obstacle = Obstacle(
-                kind, tuple(placement[:3]), tuple(direction), radius, half, rounding
-            )
+            if kind in SIZED_KINDS:
+                obstacle = _solid_obstacle(kind, placement, scenario.obstacle_sizes, antenna)
+            else:
+                obstacle = Obstacle(
+                    kind, tuple(placement[:3]), tuple(direction), radius, half, rounding
+                )
         else:
             obstacle = place_obstacle(
                 kind,
@@ -614,6 +617,30 @@ def simulate_detailed(
         obstacle=obstacle,
         link_model=model,
         rayleigh=(alpha, beta),
+    )
+
+
+def _solid_obstacle(
+    kind: str, placement: NDArray[np.float64], sizes: tuple[float, ...], antenna: Antenna
+) -> Obstacle:
+    """A box, a cone or a torus placed by ``placement`` (the scenario's: its centre, or the
+    cone's base centre, its Z axis, and a box's X axis), of its own ``sizes`` (m), grown by
+    the link's radius, as the link's axis meets it."""
+    z_axis = placement[3:6] / np.linalg.norm(placement[3:6])
+    if kind == "box":
+        x_axis = placement[6:9] - (placement[6:9] @ z_axis) * z_axis
+    else:  # symmetric about Z: any X across it
+        x_axis = np.cross(z_axis, np.eye(3)[int(np.argmin(np.abs(z_axis)))])
+    x_axis = x_axis / np.linalg.norm(x_axis)
+    axes = np.vstack([x_axis, np.cross(z_axis, x_axis), z_axis])
+    return Obstacle(
+        kind,
+        tuple(placement[:3]),
+        tuple(z_axis),
+        0.0,
+        rounding=antenna.link.radius,
+        axes=tuple(axes.reshape(-1)),
+        sizes=tuple(sizes),
     )
 
 

@@ -9,6 +9,8 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
+import numpy as np
+
 from sensing_antenna.control.servo import DEFAULT_SERVO_POLE
 from sensing_antenna.errors import SensingAntennaError, format_value
 from sensing_antenna.simulator.device import DeviceImperfections
@@ -37,9 +39,11 @@ CASES = ("azimuthal", "vertical", "free", "free-vertical")
 #: and the vertical one, each run past its nominal touch and brought to rest.
 FREE_CASE_OF = {"azimuthal": "free", "vertical": "free-vertical"}
 FREE_CASES = tuple(FREE_CASE_OF.values())
-OBSTACLE_KINDS = ("post", "bar", "ball", "plane", "capsule", "cylinder")
-#: The kinds placed only explicitly (``Scenario.obstacle_placement``), with a length.
-PLACED_KINDS = ("capsule", "cylinder")
+OBSTACLE_KINDS = ("post", "bar", "ball", "plane", "capsule", "cylinder", "box", "cone", "torus")
+#: The kinds placed only explicitly (``Scenario.obstacle_placement``).
+PLACED_KINDS = ("capsule", "cylinder", "box", "cone", "torus")
+#: The placed kinds given by their own sizes (``Scenario.obstacle_sizes``), and how many.
+SIZED_KINDS = {"box": 3, "cone": 2, "torus": 2}
 #: The link's mechanics: "linear" (Euler-Bernoulli about the undeformed line, Assumption 1) or
 #: "nonlinear" (geometrically exact inextensible rod, ``simulator.nonlinear_link``).
 LINK_MODELS = ("linear", "nonlinear")
@@ -205,16 +209,23 @@ class Scenario:
         Coulomb friction coefficient mu between link and obstacle.
     push : object or None
         The push criterion (``detection.push.PushCriterion``); None uses its default.
-    obstacle : {"post", "bar", "ball", "plane", "capsule", "cylinder"} or None
+    obstacle : {"post", "bar", "ball", "plane", "capsule", "cylinder", "box", "cone", \
+"torus"} or None
         Obstacle kind; None: post for the azimuthal case, bar for the vertical case. A post or
         a bar is an endless cylinder; a capsule and a capped cylinder need
-        ``obstacle_placement`` and ``obstacle_length``.
+        ``obstacle_placement`` and ``obstacle_length``, a box, a cone and a torus
+        ``obstacle_placement`` and ``obstacle_sizes``.
     obstacle_radius : float
         Radius of the post, bar, ball, capsule or cylinder (m).
     obstacle_length : float
         The capsule's axis segment or the capped cylinder's height (m); 0 for the other kinds.
         Like ``obstacle_radius`` it is the obstacle the link's axis meets: an object grown by
         the link's radius, so a capped cylinder's rim is rounded by the link's radius.
+    obstacle_sizes : tuple of float
+        A box's three edge lengths (along its own X, Y, Z), a cone's base radius and height,
+        a torus's major and minor radii (minor at most major): the object's own sizes (m),
+        which the simulator grows by the link's radius (edges, rim and apex rounded by it),
+        as the link's axis meets it. Empty for the other kinds.
     obstacle_tilt : float
         Misalignment of the obstacle (rad): the post leans along the sweep, the bar rolls about
         the link, the plane turns its normal out of the sweep plane, the ball's normal at the
@@ -224,8 +235,10 @@ class Scenario:
         The obstacle placed explicitly in the absolute frame instead of from ``contact_point``
         and ``obstacle_tilt``: a point (m; a point of the cylinder's axis, the ball's centre, a
         point of the plane) and a direction (the cylinder's axis, the plane's outward normal,
-        the ball's outward normal at the touch; normalised; a capsule's or a capped cylinder's
-        centre and axis). The sweep must then meet it near ``contact_point``, which still names
+        the ball's outward normal at the touch; normalised; a capsule's, a capped cylinder's
+        or a torus's centre and axis, a cone's base centre and axis towards its apex). A box
+        takes nine: its centre, its own Z axis, and its own X axis (made perpendicular to Z).
+        The sweep must then meet it near ``contact_point``, which still names
         the touch (a scene's sweeps place the touched object itself: ``scene.simulate``), and
         ``obstacle_tilt`` is not used. None: placed from ``contact_point``.
     contact_stiffness : float
@@ -284,9 +297,13 @@ class Scenario:
     damping_ratio: float = 0.005
     friction_coefficient: float = 0.6
     push: Any = None
-    obstacle: Literal["post", "bar", "ball", "plane", "capsule", "cylinder"] | None = None
+    obstacle: (
+        Literal["post", "bar", "ball", "plane", "capsule", "cylinder", "box", "cone", "torus"]
+        | None
+    ) = None
     obstacle_radius: float = 0.01
     obstacle_length: float = 0.0
+    obstacle_sizes: tuple[float, ...] = ()
     obstacle_tilt: float = 0.02
     obstacle_placement: tuple[float, ...] | None = None
     contact_stiffness: float = 1.0e4
@@ -365,18 +382,8 @@ class Scenario:
         if abs(self.obstacle_tilt) >= 0.5:
             raise ScenarioError("obstacle_tilt", "must be below 0.5 rad in magnitude")
         if self.obstacle_placement is not None:
-            placement = self.obstacle_placement
-            if not isinstance(placement, (tuple, list)) or len(placement) != 6:
-                raise ScenarioError(
-                    "obstacle_placement",
-                    f"must be six numbers (a point, m, and a direction), got "
-                    f"{format_value(placement)}",
-                )
-            for value in placement:
-                _finite("obstacle_placement", value)
-            if not math.hypot(*placement[3:]) > 0.0:
-                raise ScenarioError("obstacle_placement", "the direction must not be zero")
-            object.__setattr__(self, "obstacle_placement", tuple(float(v) for v in placement))
+            self._check_placement(self.obstacle_placement)
+        self._check_sizes()
         _finite("obstacle_length", self.obstacle_length, 0.0)
         if self.obstacle in PLACED_KINDS:
             if self.obstacle_placement is None:
@@ -385,7 +392,7 @@ class Scenario:
                 )
             if self.obstacle == "cylinder" and not self.obstacle_length > 0.0:
                 raise ScenarioError("obstacle_length", "a capped cylinder's height must be > 0")
-        elif self.obstacle_length != 0.0:
+        if self.obstacle not in ("capsule", "cylinder") and self.obstacle_length != 0.0:
             raise ScenarioError(
                 "obstacle_length",
                 f"only a capsule or a capped cylinder has a length, not a"
@@ -393,6 +400,7 @@ class Scenario:
             )
         if self.approach_time is not None:
             _finite("approach_time", self.approach_time, self.accel_time or 0.0)
+
         for name, (high, unit, reason) in _UPPER_LIMITS.items():
             value = getattr(self, name)
             if value is not None and value > high:
@@ -447,6 +455,49 @@ class Scenario:
                 "must be one line of text without edge spaces (it is written into the"
                 f" recording's metadata), got {format_value(description)}",
             )
+
+    def _check_placement(self, placement: object) -> None:
+        count = 9 if self.obstacle == "box" else 6
+        what = "a centre, its Z and its X axes" if count == 9 else "a point, m, and a direction"
+        if not isinstance(placement, (tuple, list)) or len(placement) != count:
+            raise ScenarioError(
+                "obstacle_placement",
+                f"must be {count} numbers ({what}), got {format_value(placement)}",
+            )
+        for value in placement:
+            _finite("obstacle_placement", value)
+        values = np.asarray(placement, dtype=float)
+        if not np.linalg.norm(values[3:6]) > 0.0:
+            raise ScenarioError("obstacle_placement", "the direction must not be zero")
+        if count == 9 and not np.linalg.norm(np.cross(values[3:6], values[6:9])) > 1e-9 * (
+            np.linalg.norm(values[3:6]) * np.linalg.norm(values[6:9])
+        ):
+            raise ScenarioError(
+                "obstacle_placement", "the box's X axis must not be zero or along its Z axis"
+            )
+        object.__setattr__(self, "obstacle_placement", tuple(float(v) for v in placement))
+
+    def _check_sizes(self) -> None:
+        sizes = self.obstacle_sizes
+        count = SIZED_KINDS.get(self.obstacle or "", 0)
+        if not isinstance(sizes, (tuple, list)) or len(sizes) != count:
+            needed = f"{count} numbers" if count else "empty"
+            raise ScenarioError(
+                "obstacle_sizes",
+                f"must be {needed} for a {self.obstacle or 'default obstacle'},"
+                f" got {format_value(sizes)}",
+            )
+        for value in sizes:
+            _finite("obstacle_sizes", value, 0.0, strict=True)
+            if value > _UPPER_LIMITS["obstacle_radius"][0]:
+                raise ScenarioError(
+                    "obstacle_sizes", f"{format_value(value)} m is more than 10 m (a wall)"
+                )
+        if self.obstacle == "torus" and sizes[1] > sizes[0]:
+            raise ScenarioError(
+                "obstacle_sizes", "a torus's minor radius must not exceed its major radius"
+            )
+        object.__setattr__(self, "obstacle_sizes", tuple(float(v) for v in sizes))
 
     def resolved(self, omega_free: float) -> Scenario:
         """This scenario with the default ramp times made explicit.
