@@ -273,6 +273,21 @@ def test_a_failed_run_of_the_first_layout_and_one_without_the_later_fields(
     assert all(math.isnan(r.x_c_contact_m) and math.isnan(r.noise_scale) for r in ok.rows)
 
 
+def test_a_format_2_run_file_reads_with_its_point_error_unknown(tmp_path: Path) -> None:
+    # format 2 measured the 3D point against the end of the record, not the contact at the
+    # estimate's instant: a campaign resumed across versions must not average the two
+    stored = result()
+    rows = [dataclasses.replace(row, point_error_m=0.002) for row in stored.rows]
+    write_run_result(tmp_path, dataclasses.replace(stored, rows=tuple(rows)))
+    path = tmp_path / "runs" / f"{RUN.run_id}.json"
+    data = json.loads(path.read_text("utf-8"))
+    assert load_run_results(tmp_path, METHODS)[RUN.run_id].rows[0].point_error_m == 0.002
+    path.write_text(json.dumps({**data, "format": 2}), encoding="utf-8")
+    (loaded,) = load_run_results(tmp_path, METHODS).values()
+    assert all(math.isnan(row.point_error_m) for row in loaded.rows)
+    assert [row.x_c_estimate_m for row in loaded.rows] == [row.x_c_estimate_m for row in rows]
+
+
 def test_a_run_file_of_an_unknown_format_is_one_clear_error(tmp_path: Path) -> None:
     write_run_result(tmp_path, result())
     path = tmp_path / "runs" / f"{RUN.run_id}.json"

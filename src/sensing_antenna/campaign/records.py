@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import TYPE_CHECKING, Any
 
 from sensing_antenna.campaign.runs import RunSpec
@@ -38,8 +38,10 @@ RUN_FAILED = "failed"
 METHOD_RUN_FAILED = "run-failed"
 #: Method status recorded when an estimator raised instead of returning a status.
 METHOD_ERROR = "error"
-#: Layout of the run files this code writes (see :meth:`RunResult.to_dict`).
-RUN_FILE_FORMAT = 2
+#: Layout of the run files this code writes (see :meth:`RunResult.to_dict`): 3 measures
+#: ``point_error_m`` against the contact at the estimate's instant (2 did against the end of
+#: the record; the rows otherwise alike).
+RUN_FILE_FORMAT = 3
 
 
 def float_or_nan(value: Any) -> float:
@@ -416,7 +418,11 @@ class RunResult:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], methods: Sequence[str]) -> RunResult:
-        """Inverse of :meth:`to_dict`; also reads run files of format 1.
+        """Inverse of :meth:`to_dict`; also reads run files of formats 1 and 2.
+
+        Format 2 measured ``point_error_m`` against where the link rested at the record's end,
+        not where it touched at the estimate's instant: it reads NaN, so that a campaign
+        resumed across versions does not summarise two measures as one.
 
         Format 1 stored the run's fields once and one entry per method under ``methods`` (a
         failed run none); its rows are rebuilt for ``methods``, the campaign's methods, as
@@ -430,9 +436,11 @@ class RunResult:
         """
         if data.get("format", 1) == 1:
             return _from_format_1(data, methods)
-        if data["format"] != RUN_FILE_FORMAT:
+        if data["format"] not in (2, RUN_FILE_FORMAT):
             raise ValueError(f"unknown run file format {data['format']!r}")
         rows = tuple(CampaignRow.from_dict(row) for row in data["rows"])
+        if data["format"] == 2:
+            rows = tuple(replace(row, point_error_m=math.nan) for row in rows)
         return cls(rows=rows, detail=str(data.get("detail", "")))
 
 

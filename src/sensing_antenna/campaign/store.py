@@ -327,7 +327,7 @@ def load_run_results(out_dir: Path, methods: Sequence[str]) -> dict[str, RunResu
     for path in sorted(runs.glob("*.json")):
         try:
             data = json.loads(path.read_text("utf-8"))
-            if isinstance(data, dict) and data.get("format", 1) not in (1, RUN_FILE_FORMAT):
+            if isinstance(data, dict) and data.get("format", 1) not in (1, 2, RUN_FILE_FORMAT):
                 raise CampaignStoreError(
                     f"{path}: format: {data['format']!r} is not one this version reads (1 to "
                     f"{RUN_FILE_FORMAT}); use the version of sensing-antenna that wrote it"
