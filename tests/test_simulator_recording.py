@@ -128,6 +128,16 @@ _BOX: dict[str, object] = {
             "obstacle_sizes",
         ),
         ({"case": "azimuthal", "contact_point": 0.5, "obstacle_sizes": (0.1,)}, "obstacle_sizes"),
+        (
+            {
+                "case": "azimuthal",
+                "contact_point": 0.5,
+                "obstacle": "capsule",
+                "obstacle_placement": (0.5, 0, 0, 0, 0, 1),
+                "obstacle_length": 1e3,
+            },
+            "obstacle_length",
+        ),
     ],
 )
 def test_scenario_validation_names_the_field(changes: dict[str, object], field: str) -> None:

@@ -97,6 +97,7 @@ MAX_SUBSTEPS = 100
 #: anything; within them it has been run (docs/simulator.md, "Scenario limits").
 _UPPER_LIMITS: dict[str, tuple[float, str, str]] = {
     "obstacle_radius": (10.0, "m", "a post or bar thicker than that is a wall: the plane"),
+    "obstacle_length": (100.0, "m", "a cylinder longer than that is endless: a post or a bar"),
     "contact_stiffness": (
         1e10,
         "N/m",
