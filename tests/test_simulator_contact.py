@@ -371,8 +371,8 @@ def test_an_obstacles_outward_normal_is_the_gradient_of_its_gap(kind: str) -> No
     # central differences of the signed distance, 1e-6 m steps: their error is the step's
     # curvature term, h^2 / R ~ 3e-11 on the 3 cm radius (the capped cylinder's rim, rounded
     # by 5 mm, 2e-10; a box's edges, a cone's rim and apex, rounded by 5 mm; (h / t)^2 / 6 =
-    # 6e-9 at a point t = 5 mm from the torus's core circle), and rounding, eps |gap| / h ~
-    # 1e-11
+    # 6e-9 at a point t = 5 mm from the torus's core circle or the cone's apex, where the
+    # gradient turns at 1 / t), and rounding, eps |gap| / h ~ 1e-11
     solid = kind in _SOLID_SIZES
     obstacle = Obstacle(
         kind,
@@ -386,13 +386,16 @@ def test_an_obstacles_outward_normal_is_the_gradient_of_its_gap(kind: str) -> No
     )
     rng = np.random.default_rng(3)
     points = np.asarray(obstacle.point) + rng.normal(0.0, 0.05, (20, 3))
+    if solid:  # and about the cone's apex, the box's top face, the torus's hole
+        top = np.asarray(obstacle.point) + 0.08 * np.asarray(_SOLID_AXES[6:])
+        points = np.vstack([points, top + rng.normal(0.0, 0.01, (20, 3))])
     normals = obstacle.outward_normals(points)
     for point, normal in zip(points, normals, strict=True):
         gradient = [
             (obstacle.gap(point + 1e-6 * e) - obstacle.gap(point - 1e-6 * e)) / 2e-6
             for e in np.eye(3)
         ]
-        assert normal == pytest.approx(gradient, abs=1e-8 if kind == "torus" else 1e-9)
+        assert normal == pytest.approx(gradient, abs=1e-8 if kind in ("torus", "cone") else 1e-9)
 
 
 @pytest.mark.parametrize("shape", ["capsule", "cylinder"])

@@ -3,6 +3,8 @@ below it, with its weight), simulated natively (``Scenario.sweep_direction = -1`
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -70,3 +72,48 @@ def test_every_method_places_a_contact_from_above(x_c: float) -> None:
 def test_the_direction_is_up_or_down(value: object) -> None:
     with pytest.raises(ScenarioError, match=r"sweep_direction: must be 1 \(up\) or -1 \(down\)"):
         Scenario(case="vertical", contact_point=0.5, sweep_direction=value)  # type: ignore[arg-type]
+
+
+def test_a_box_met_sweeping_down_is_the_mirror_image_of_its_reflection_met_sweeping_up() -> None:
+    # A box turned every way (so that the contact's normal has all three components), met by
+    # an azimuthal sweep towards +Y^m, and its reflection in the X-Z plane met by the sweep
+    # towards -Y^m: the second recording is the first's mirror image
+    # (``simulator.mirror.mirror_recording``), its obstacle the reflected box, which the
+    # mirror's own reflection of the first's ``true_obstacle`` describes (the same gap
+    # everywhere).
+    from scipy.spatial.transform import Rotation
+
+    from sensing_antenna.simulator.contact import Obstacle
+    from sensing_antenna.simulator.mirror import mirror_recording
+
+    axes = Rotation.from_rotvec([0.3, -0.5, 0.7]).as_matrix()
+    centre = np.array([0.6, 0.045, -0.03])
+    flip = np.array([1.0, -1.0, 1.0])
+
+    def run(direction: int, reflect: np.ndarray) -> object:
+        placement = np.concatenate([centre, axes[:, 2], axes[:, 0]]) * np.tile(reflect, 3)
+        scenario = Scenario(
+            case="azimuthal",
+            contact_point=0.6,
+            noise_scale=0.0,
+            sweep_direction=direction,
+            obstacle="box",
+            obstacle_sizes=(0.04, 0.05, 0.08),
+            obstacle_placement=tuple(placement),
+        )
+        return simulate(paper_antenna(), scenario)
+
+    up, down = run(1, np.ones(3)), run(-1, flip)
+    mirrored = mirror_recording(up)  # type: ignore[arg-type]
+    assert up.metadata["true_t_contact"] != "nan"  # type: ignore[attr-defined]
+    np.testing.assert_allclose(down.theta, mirrored.theta, rtol=0, atol=1e-12)  # type: ignore[attr-defined]
+    np.testing.assert_allclose(down.force, mirrored.force, rtol=0, atol=1e-9)  # type: ignore[attr-defined]
+    np.testing.assert_allclose(down.torque, mirrored.torque, rtol=0, atol=1e-9)  # type: ignore[attr-defined]
+    boxes = [
+        Obstacle(**json.loads(recording.metadata["true_obstacle"]))  # type: ignore[attr-defined]
+        for recording in (down, mirrored)
+    ]
+    points = centre * flip + np.random.default_rng(2).normal(0.0, 0.05, (200, 3))
+    np.testing.assert_allclose(
+        [boxes[0].gap(p) for p in points], [boxes[1].gap(p) for p in points], atol=1e-11
+    )

@@ -39,8 +39,8 @@ METHOD_RUN_FAILED = "run-failed"
 #: Method status recorded when an estimator raised instead of returning a status.
 METHOD_ERROR = "error"
 #: Layout of the run files this code writes (see :meth:`RunResult.to_dict`): 3 measures
-#: ``point_error_m`` against the contact at the estimate's instant (2 did against the end of
-#: the record; the rows otherwise alike).
+#: ``point_error_m`` against the contact at the estimate's instant (the versions writing 2
+#: mostly did against the end of the record; the rows otherwise alike).
 RUN_FILE_FORMAT = 3
 
 
@@ -420,9 +420,10 @@ class RunResult:
     def from_dict(cls, data: Mapping[str, Any], methods: Sequence[str]) -> RunResult:
         """Inverse of :meth:`to_dict`; also reads run files of formats 1 and 2.
 
-        Format 2 measured ``point_error_m`` against where the link rested at the record's end,
-        not where it touched at the estimate's instant: it reads NaN, so that a campaign
-        resumed across versions does not summarise two measures as one.
+        Format 2 may hold a ``point_error_m`` measured against where the link rested at the
+        record's end, not where it touched at the estimate's instant (a file does not say
+        which): it reads NaN, so that a campaign resumed across versions does not summarise
+        two measures as one.
 
         Format 1 stored the run's fields once and one entry per method under ``methods`` (a
         failed run none); its rows are rebuilt for ``methods``, the campaign's methods, as

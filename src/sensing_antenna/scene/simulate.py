@@ -209,8 +209,9 @@ def touch_scenario(
         placed = _touched_shape(touch, scene, frame) or {}
         if placed:
             kind = placed.pop("obstacle")
-            radius = placed.pop("obstacle_radius", radius)
             tilt = 0.0  # a placed obstacle is not turned
+            # a box, a cone or a torus has sizes, not a radius: the scenario's default stays
+            radius = placed.pop("obstacle_radius", Scenario.obstacle_radius)
     # beyond the simulator's largest tilt a local obstacle is turned by that much: the same
     # touched point, a push held as if the surface faced the sweep more (the touched shape
     # itself, placed, is not turned: the link slides where friction cannot hold it)

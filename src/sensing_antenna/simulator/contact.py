@@ -267,7 +267,8 @@ def _solid_distance_and_normal(
             core, nx, ny, nz = qz, 0.0, 0.0, sz
     else:
         rho = math.sqrt(lx * lx + ly * ly)
-        cx, cy = (lx / rho, ly / rho) if rho > 0.0 else (0.0, 0.0)
+        # the radial direction; on the axis any (the distance's gradient is undefined there)
+        cx, cy = (lx / rho, ly / rho) if rho > 0.0 else (1.0, 0.0)
         if obst[0] == 7.0:  # cone: its half-section is the triangle (0, 0), (R, 0), (0, h)
             radius, height = obst[19], obst[20]
             # nearest points of the base (0, 0)-(R, 0) and of the slant (R, 0)-(0, h)
@@ -289,7 +290,7 @@ def _solid_distance_and_normal(
             dr, dz = rho - obst[19], lz
             tube = math.sqrt(dr * dr + dz * dz)
             core = tube - obst[20]
-            gr, gz = (dr / tube, dz / tube) if tube > 0.0 else (0.0, 0.0)
+            gr, gz = (dr / tube, dz / tube) if tube > 0.0 else (1.0, 0.0)
         nx, ny, nz = gr * cx, gr * cy, gz
     # back to the absolute frame: the axes are the rows
     normal_x = nx * obst[10] + ny * obst[13] + nz * obst[16]

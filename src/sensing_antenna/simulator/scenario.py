@@ -232,7 +232,7 @@ class Scenario:
         the link, the plane turns its normal out of the sweep plane, the ball's normal at the
         touch turns as the post's (azimuthal) or the bar's (vertical). Gives the contact normal
         a component out of the sweep plane.
-    obstacle_placement : tuple of 6 float or None
+    obstacle_placement : tuple of 6 (a box: 9) float or None
         The obstacle placed explicitly in the absolute frame instead of from ``contact_point``
         and ``obstacle_tilt``: a point (m; a point of the cylinder's axis, the ball's centre, a
         point of the plane) and a direction (the cylinder's axis, the plane's outward normal,
@@ -470,7 +470,7 @@ class Scenario:
         values = np.asarray(placement, dtype=float)
         if not np.linalg.norm(values[3:6]) > 0.0:
             raise ScenarioError("obstacle_placement", "the direction must not be zero")
-        if count == 9 and not np.linalg.norm(np.cross(values[3:6], values[6:9])) > 1e-9 * (
+        if count == 9 and not np.linalg.norm(np.cross(values[3:6], values[6:9])) > 1e-6 * (
             np.linalg.norm(values[3:6]) * np.linalg.norm(values[6:9])
         ):
             raise ScenarioError(
