@@ -1,8 +1,8 @@
 """Does the fast method's 95 % interval hold the contact, on the exploration's recordings?
 
 The recordings kept by ``eval_explore.py --keep DIR`` are touches the campaigns do not make:
-posts, bars and balls tilted across the sweep, the simulator's geometrically exact link, pushes
-of 6 to 10 % deflection. Each is estimated again with the exploration's calibrated antenna
+spheres, cylinders, capsules, boxes, cones and tori met at any angle across the sweep, the
+simulator's geometrically exact link, pushes of 6 to 10 % deflection. Each is estimated again with the exploration's calibrated antenna
 (``DIR/calibrated.toml``) by the ``fast`` method (the one with an interval) and, for every
 ``ok`` answer, scored against the recording's ``true_xc``: the error (m), whether the interval
 holds it, and by the simulated obstacle's kind. ``--every N`` takes every N-th recording (in
