@@ -12,12 +12,12 @@ touch, placed by the simulator from x_c as for any of its runs:
   to the link and to the surface's normal, of the surface's local radius along the link (a post
   for an azimuthal sweep, a bar for a vertical one), turned by the normal's angle out of the
   sweep's plane (the scenario's ``obstacle_tilt``); where the surface is curved both ways (its
-  largest principal radius at most :data:`BALL_RATIO` times its smallest: a box's corner, a
-  mesh's rounded part) a ball of the radius along the link instead, on which a link sliding across
+  largest principal radius at most :data:`BALL_RATIO` times its smallest: a mesh's corner or
+  rounded part) a ball of the radius along the link instead, on which a link sliding across
   stays on the surface. An edge is curved one way only, whichever way the link crosses it:
   a cylinder, along which a link sliding across stays on the edge, as it does on a real one;
-- a contact at the tip: the simulator's plane, touched by the tip (its normal is the
-  simulator's, not the face's: the touched point is the same).
+- a contact at the tip (on any object): the simulator's plane, touched by the tip (its normal
+  is the simulator's, not the face's: the touched point is the same).
 
 A round link touches with its surface, its radius a off its axis (``scene.touch``), while the
 simulator's link touches with its axis: each obstacle, the object itself or a local one, is
@@ -89,8 +89,8 @@ __all__ = [
 
 #: A surface whose largest principal radius is at most this many times its smallest is curved
 #: every way at least half as much as the most, and its equivalent obstacle a ball of the radius
-#: along the link (a box's corner, a mesh's rounded part); beyond, a cylinder, straight
-#: across (a box's edge met at any angle, a mesh's cylindrical part). Radii are capped at 10 m:
+#: along the link (a mesh's corner or rounded part); beyond, a cylinder, straight across (a
+#: mesh's edge met at any angle, its cylindrical part). Radii are capped at 10 m:
 #: a flat face gives a 10 m ball.
 BALL_RATIO = 2.0
 
