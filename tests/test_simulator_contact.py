@@ -438,10 +438,8 @@ def test_a_box_cone_or_torus_obstacle_is_the_object_grown_by_the_links_radius(sh
     centre = np.array([0.6, 0.02, -0.1])
     axes = Rotation.from_rotvec(rotation).as_matrix()
     sizes = _SOLID_SIZES[shape]
-    obstacle = Obstacle(
-        shape, tuple(centre), tuple(axes[:, 2]), 0.0, rounding=a, axes=tuple(axes.T.flat),
-        sizes=sizes,
-    )  # fmt: skip
+    rows = tuple(axes.T.flat)  # the solid's own X, Y, Z
+    obstacle = Obstacle(shape, tuple(centre), rows[6:], 0.0, rounding=a, axes=rows, sizes=sizes)
     # the torus's parameters name its hole, R - r
     own = (sizes[0] - sizes[1], sizes[1]) if shape == "torus" else sizes
     points = centre + np.random.default_rng(5).normal(0.0, 0.05, (400, 3))

@@ -196,26 +196,20 @@ def touch_scenario(
     # the simulator's link touches with its axis: its obstacle is the surface grown by the
     # link's radius, which the axis meets where the link's surface meets the surface
     radius = min(radius + touch.link_radius, MAX_RADIUS)
-    placed: dict[str, Any] = {}
-    if touch.tip:
-        kind = "plane"
-        tilt = 0.0
-    elif abs(tilt) >= GLANCING_ANGLE:
+    if abs(tilt) >= GLANCING_ANGLE and not touch.tip:
         raise GlancingTouchError(
             f"the surface's normal is {abs(tilt):.2f} rad out of the sweep's direction, more than"
             f" {GLANCING_ANGLE} rad (the link would slide over it)"
         )
-    else:
-        placed = _touched_shape(touch, scene, frame) or {}
-        if placed:
-            kind = placed.pop("obstacle")
-            tilt = 0.0  # a placed obstacle is not turned
-            # a box, a cone or a torus has sizes, not a radius: the scenario's default stays
-            radius = placed.pop("obstacle_radius", Scenario.obstacle_radius)
     # beyond the simulator's largest tilt a local obstacle is turned by that much: the same
-    # touched point, a push held as if the surface faced the sweep more (the touched shape
-    # itself, placed, is not turned: the link slides where friction cannot hold it)
+    # touched point, a push held as if the surface faced the sweep more
     tilt = max(-MAX_TILT, min(MAX_TILT, tilt))
+    obstacle: dict[str, Any] = {"obstacle": kind, "obstacle_radius": radius, "obstacle_tilt": tilt}
+    if touch.tip:
+        obstacle = {"obstacle": "plane", "obstacle_radius": radius, "obstacle_tilt": 0.0}
+    elif (placed := _touched_shape(touch, scene, frame)) is not None:
+        # the object itself is not turned: the link slides where friction cannot hold it
+        obstacle = placed | {"obstacle_tilt": 0.0}
     towards = ""
     if sweep.direction == -1:
         towards = " towards -Y" if sweep.case == "azimuthal" else " down"
@@ -228,11 +222,8 @@ def touch_scenario(
         sweep_direction=sweep.direction,
         contact_point=touch.x_c,
         seed=seed,
-        obstacle=kind,  # type: ignore[arg-type]
-        obstacle_radius=radius,
-        obstacle_tilt=tilt,
         description=description,
-        **placed,
+        **obstacle,
         **scenario_fields,
     )
     return scenario, frame
@@ -256,9 +247,11 @@ def _touched_shape(touch: Touch, scene: Scene, frame: BasePose) -> dict[str, Any
     centre = tuple(to_frame @ (p[:3] - frame.position))
     if touched.shape == "sphere":
         # a ball's direction is only its outward normal at the touch
-        placement = (*centre, *(to_frame @ touch.normal))
-        return {"obstacle": "ball", "obstacle_radius": float(p[3]) + grown,
-                "obstacle_placement": placement}  # fmt: skip
+        return {
+            "obstacle": "ball",
+            "obstacle_radius": float(p[3]) + grown,
+            "obstacle_placement": (*centre, *(to_frame @ touch.normal)),
+        }
     axes = to_frame @ Rotation.from_rotvec(p[3:6]).as_matrix()
     placement = (*centre, *axes[:, 2])
     if touched.shape in ("capsule", "cylinder"):
@@ -274,6 +267,7 @@ def _touched_shape(touch: Touch, scene: Scene, frame: BasePose) -> dict[str, Any
         }
     if touched.shape == "box":
         placement = (*placement, *axes[:, 0])
+    # a box, a cone or a torus: its own sizes, no radius (the scenario's default stays)
     sizes = tuple(float(v) for v in PRIMITIVES[touched.shape].sizes(p))
     return {"obstacle": touched.shape, "obstacle_sizes": sizes, "obstacle_placement": placement}
 

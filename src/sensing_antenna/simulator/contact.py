@@ -34,7 +34,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from sensing_antenna.simulator.scenario import ScenarioError
+from sensing_antenna.simulator.scenario import SIZED_KINDS, ScenarioError
 
 __all__ = [
     "BALL",
@@ -51,6 +51,7 @@ __all__ = [
     "distances_and_normals",
     "motor_frame",
     "place_obstacle",
+    "place_solid",
 ]
 
 NO_OBSTACLE = 0
@@ -73,8 +74,6 @@ _CODES = {
     "cone": CONE,
     "torus": TORUS,
 }
-#: The kinds with a frame of their own and sizes (``Obstacle.axes``, ``Obstacle.sizes``).
-SOLID_KINDS = ("box", "cone", "torus")
 
 #: Angle (rad) between a plane's normal and the sweep direction, in the sweep plane: the link
 #: meets the plane at 90 degrees minus this, so the plane clears the rest of the link by
@@ -132,13 +131,13 @@ class Obstacle:
     sizes: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        if self.kind in SOLID_KINDS:
+        if self.kind in SIZED_KINDS:  # a box, a cone, a torus: a frame of its own and sizes
             frame = np.asarray(self.axes, dtype=float)
             if frame.shape != (9,) or not np.allclose(
                 frame.reshape(3, 3) @ frame.reshape(3, 3).T, np.eye(3), atol=1e-9
             ):
                 raise ValueError(f"Obstacle: a {self.kind} needs orthonormal axes, 9 numbers")
-            count = 3 if self.kind == "box" else 2
+            count = SIZED_KINDS[self.kind]
             if len(self.sizes) != count or not all(v > 0.0 for v in self.sizes):
                 raise ValueError(f"Obstacle: a {self.kind} needs {count} sizes > 0 m")
             if not self.rounding >= 0.0:
@@ -317,6 +316,30 @@ def distances_and_normals(
 
 def _unit(v: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.asarray(v / np.linalg.norm(v))
+
+
+def place_solid(
+    kind: str, placement: NDArray[np.float64], sizes: tuple[float, ...], rounding: float
+) -> Obstacle:
+    """A box, a cone or a torus placed as ``Scenario.obstacle_placement`` says (its centre, or
+    the cone's base centre, its Z axis, and a box's X axis, made perpendicular to Z), of its
+    own ``sizes`` (m), grown by ``rounding`` (m)."""
+    z_axis = placement[3:6] / np.linalg.norm(placement[3:6])
+    if kind == "box":
+        x_axis = placement[6:9] - (placement[6:9] @ z_axis) * z_axis
+    else:  # symmetric about Z: any X across it
+        x_axis = np.cross(z_axis, np.eye(3)[int(np.argmin(np.abs(z_axis)))])
+    x_axis = x_axis / np.linalg.norm(x_axis)
+    axes = np.vstack([x_axis, np.cross(z_axis, x_axis), z_axis])
+    return Obstacle(
+        kind,
+        tuple(placement[:3]),
+        tuple(z_axis),
+        0.0,
+        rounding=rounding,
+        axes=tuple(axes.reshape(-1)),
+        sizes=tuple(sizes),
+    )
 
 
 def place_obstacle(

@@ -27,7 +27,7 @@ from sensing_antenna.recording import (
     IN_CONTACT_COLUMN,
     Recording,
 )
-from sensing_antenna.simulator.contact import Obstacle, place_obstacle
+from sensing_antenna.simulator.contact import Obstacle, place_obstacle, place_solid
 from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.integrator import (
     CONTACT_STATE_SIZE,
@@ -412,7 +412,11 @@ def simulate_detailed(
         )
         sag = float(model.shape_at(scenario.contact_point) @ q_sag)
         sag_slope = float(model.slope_at(scenario.contact_point) @ q_sag)
-        if scenario.obstacle_placement is not None:
+        if scenario.obstacle_placement is not None and kind in SIZED_KINDS:
+            # its own sizes, grown by the link's radius as the link's axis meets it
+            placement = np.asarray(scenario.obstacle_placement)
+            obstacle = place_solid(kind, placement, scenario.obstacle_sizes, antenna.link.radius)
+        elif scenario.obstacle_placement is not None:
             placement = np.asarray(scenario.obstacle_placement)
             direction = placement[3:] / np.linalg.norm(placement[3:])
             radius = 0.0 if kind == "plane" else scenario.obstacle_radius
@@ -420,12 +424,9 @@ def simulate_detailed(
             # a capped cylinder as the link's axis meets it: its rim rounded by the link's
             # radius (its radius and height given grown by it)
             rounding = min(antenna.link.radius, radius, half) if kind == "cylinder" else 0.0
-            if kind in SIZED_KINDS:
-                obstacle = _solid_obstacle(kind, placement, scenario.obstacle_sizes, antenna)
-            else:
-                obstacle = Obstacle(
-                    kind, tuple(placement[:3]), tuple(direction), radius, half, rounding
-                )
+            obstacle = Obstacle(
+                kind, tuple(placement[:3]), tuple(direction), radius, half, rounding
+            )
         else:
             obstacle = place_obstacle(
                 kind,
@@ -617,30 +618,6 @@ def simulate_detailed(
         obstacle=obstacle,
         link_model=model,
         rayleigh=(alpha, beta),
-    )
-
-
-def _solid_obstacle(
-    kind: str, placement: NDArray[np.float64], sizes: tuple[float, ...], antenna: Antenna
-) -> Obstacle:
-    """A box, a cone or a torus placed by ``placement`` (the scenario's: its centre, or the
-    cone's base centre, its Z axis, and a box's X axis), of its own ``sizes`` (m), grown by
-    the link's radius, as the link's axis meets it."""
-    z_axis = placement[3:6] / np.linalg.norm(placement[3:6])
-    if kind == "box":
-        x_axis = placement[6:9] - (placement[6:9] @ z_axis) * z_axis
-    else:  # symmetric about Z: any X across it
-        x_axis = np.cross(z_axis, np.eye(3)[int(np.argmin(np.abs(z_axis)))])
-    x_axis = x_axis / np.linalg.norm(x_axis)
-    axes = np.vstack([x_axis, np.cross(z_axis, x_axis), z_axis])
-    return Obstacle(
-        kind,
-        tuple(placement[:3]),
-        tuple(z_axis),
-        0.0,
-        rounding=antenna.link.radius,
-        axes=tuple(axes.reshape(-1)),
-        sizes=tuple(sizes),
     )
 
 

@@ -401,7 +401,6 @@ class Scenario:
             )
         if self.approach_time is not None:
             _finite("approach_time", self.approach_time, self.accel_time or 0.0)
-
         for name, (high, unit, reason) in _UPPER_LIMITS.items():
             value = getattr(self, name)
             if value is not None and value > high:
@@ -488,11 +487,12 @@ class Scenario:
                 f"must be {needed} for a {self.obstacle or 'default obstacle'},"
                 f" got {format_value(sizes)}",
             )
+        high = _UPPER_LIMITS["obstacle_radius"][0]
         for value in sizes:
             _finite("obstacle_sizes", value, 0.0, strict=True)
-            if value > _UPPER_LIMITS["obstacle_radius"][0]:
+            if value > high:
                 raise ScenarioError(
-                    "obstacle_sizes", f"{format_value(value)} m is more than 10 m (a wall)"
+                    "obstacle_sizes", f"{format_value(value)} m is more than {high:g} m (a wall)"
                 )
         if self.obstacle == "torus" and sizes[1] > sizes[0]:
             raise ScenarioError(
