@@ -15,9 +15,10 @@ across the link, 1 mm for 2 cm at 3 degrees). A recording
 without the track is scored against ``true_xc``. ``--every N`` takes every N-th recording (in
 name order).
 
-Run: ``python benchmarks/eval_explore_intervals.py DIR [--every 4] [--out FILE]``.
-Prints a table and writes ``benchmarks/results/explore_intervals.json`` (recordings named
-relative to DIR).
+Run: ``python benchmarks/eval_explore_intervals.py DIR [DIR ...] [--every 4] [--strategies grid
+next-best] [--out FILE]`` (the stored results: the two halves of ``explore.json``'s explorations,
+``--strategies grid``). Prints a table and writes ``benchmarks/results/explore_intervals.json``
+(recordings named by their DIR's name and their path in it).
 """
 
 from __future__ import annotations
@@ -114,18 +115,30 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("kept", type=Path, help="a directory of eval_explore.py --keep")
+    parser.add_argument("kept", type=Path, nargs="+", help="directories of eval_explore.py --keep")
     parser.add_argument("--every", type=int, default=4, help="every N-th recording (N >= 1)")
+    parser.add_argument(
+        "--strategies", nargs="+", default=["grid", "next-best"], help="explorations to read"
+    )
     parser.add_argument("--out", type=Path, default=RESULTS)
     args = parser.parse_args()
     if args.every < 1:
         parser.error("--every must be at least 1")
-    antenna = load_antenna(args.kept / "calibrated.toml")
-    paths = sorted(args.kept.glob("scene*/recordings/*.csv"))[:: args.every]
+    # each directory's own preparation; every N-th of its recordings, in name order
+    jobs = []
+    for kept in args.kept:
+        antenna = load_antenna(kept / "calibrated.toml")
+        paths = sorted(
+            path
+            for strategy in args.strategies
+            for path in kept.glob(f"scene*-{strategy}/recordings/*.csv")
+        )
+        jobs += [(path, kept, antenna) for path in paths[:: args.every]]
     rows = []
-    for i, path in enumerate(paths):
-        rows.append(score(path, args.kept, antenna))
-        print(f"\r{i + 1}/{len(paths)} recordings", end="", flush=True)
+    for i, (path, kept, antenna) in enumerate(jobs):
+        row = score(path, kept, antenna)
+        rows.append(row | {"recording": f"{kept.name}/{row['recording']}"})
+        print(f"\r{i + 1}/{len(jobs)} recordings", end="", flush=True)
     print()
     kinds = sorted({r["obstacle"] for r in rows})
     total = {"all": summarise(rows)}
@@ -144,7 +157,12 @@ def main() -> None:
             )
     result = {
         "date": datetime.date.today().isoformat(),
-        "settings": {"kept": args.kept.name, "every": args.every, "method": "fast"},
+        "settings": {
+            "kept": [kept.name for kept in args.kept],
+            "strategies": args.strategies,
+            "every": args.every,
+            "method": "fast",
+        },
         "total": total,
         "rows": rows,
     }
