@@ -208,8 +208,9 @@ def _gap(
     nonlinear: bool,
 ) -> float:
     """Signed distance (m) of the link's axis point at abscissa ``x`` from the obstacle
-    (``contact.distance_and_normal``, compiled into this file's kernels: numba's cache does
-    not see a change there, so a change to the obstacles changes this file too)."""
+    (``contact.distance_and_normal``, inlined, so that the normal it does not use is not
+    computed on this hot path; compiled into this file's kernels: numba's cache does not see
+    a change there, so a change to the obstacles changes this file too)."""
     e = _shape(x, n_el, h_el, wn, wd)
     drop = 2 * n_el + 2 - n
     v, _ = _interp(X[0:n], e, wn, wd, drop)
