@@ -49,13 +49,15 @@ Sizes. Each size of a class's fit carries a standard deviation: the Gauss-Newton
 (J^T J)^-1 of the fit's parameters, J the Jacobian of the evidence's normalised residuals at the
 fit (the points' d_i / sigma_i, the lines' and the swept links' residuals; not the extent prior,
 and not the points counted wrong), carried to the sizes, times the square root of the
-overdispersion c. A size the evidence does not hold (a sphere's radius from a small cap) is not
-measured: no deviation. A size whose end no touch reaches (a box's extent where one face only
-was touched) is held by the extent prior at the outermost points: it is reported as a lower
-bound, three times the deviation of the points there below the fitted size (:func:`size_std`
-finds such ends by growing the shape there). The points' errors are not independent (a face
-touched at its edges reads outward at each), so a size can be off by more than its standard
-deviation says; ``benchmarks/eval_explore.py`` measures how often.
+overdispersion c (the covariance times c is kept with the fit, :attr:`ClassFit.covariance`,
+and :meth:`ClassFit.distance_std` carries it to the fitted surface). A size the evidence does
+not hold (a sphere's radius from a small cap) is not measured: no deviation. A size whose end no
+touch reaches (a box's extent where one face only was touched) is held by the extent prior at
+the outermost points: it is reported as a lower bound, three times the deviation of the points
+there below the fitted size (:func:`size_std` finds such ends by growing the shape there). The
+points' errors are not independent (a face touched at its edges reads outward at each), so a
+size can be off by more than its standard deviation says; ``benchmarks/eval_explore.py``
+measures how often.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
 points pin the richer class's extra parameters to the simpler shape (a capsule fitted to a
@@ -114,6 +116,7 @@ __all__ = [
     "fit_mesh",
     "fit_primitive",
     "outlier_cap",
+    "parameter_covariance",
     "point_chi2",
     "recognise",
     "shape_gap",
@@ -156,8 +159,15 @@ MAX_SIZE_SPREADS = 10.0
 
 #: Scale of the extent prior (m): a shape's extent along its own axes beyond the points' span
 #: there costs (excess / this)^2, as a residual of this many metres would. Points say nothing
-#: of a shape beyond them (a cylinder's far end, a box's hidden faces): without the prior those
-#: sizes drift freely; with it they stay at the smallest the points allow.
+#: of a shape beyond them (a cylinder's far end, a box's hidden faces, a cone's base): without
+#: the prior those sizes drift freely; with it they stay at the smallest the points allow. A
+#: cone's apex is no such end: its slant places it, however far short of it the points stop,
+#: and a prior this stiff would pull it in by a large part of the gap (the cone read short by
+#: several of its deviations); its excess costs (excess / the points' spread)^2, which keeps a
+#: cone from stretching its apex far beyond them (as a narrow cone mimics a cylinder's side)
+#: and leaves one its slant places where it is. That part is a belief about objects (not
+#: much larger than what was touched of them), not a convention, so it counts in the cone's
+#: chi^2: a cone that explains a cylinder's side by an apex far beyond the points pays for it.
 EXTENT_PRIOR = 0.005
 
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
@@ -308,6 +318,11 @@ class ClassFit:
         user mesh, whose size is its own.
         :func:`fit_primitive` gives it for the points' own covariances, :func:`recognise`
         widened by the overdispersion.
+    covariance : array, shape (dof, dof)
+        The Gauss-Newton covariance of :attr:`vector` (module docstring, "Sizes."; units of the
+        parameters squared), with a direction the evidence does not hold at the variance of
+        :data:`EIGEN_FLOOR`; shape (0, 0) for a user mesh. Widened by the overdispersion in
+        :func:`recognise`, as the sizes' deviations are.
     size_at_least : Mapping[str, float]
         For each size the extent prior holds whose end nothing holds (a box's hidden face), the
         lower bound the points give it (m): the fitted size less three times the largest
@@ -317,7 +332,8 @@ class ClassFit:
         RMS of the point-to-surface distances (m).
     chi2 : float
         sum over the points of their part of chi^2 (:func:`point_chi2`, of z_i^2 = (d_i /
-        sigma_i)^2 + r_i^2; dimensionless).
+        sigma_i)^2 + r_i^2; dimensionless), the swept links' parts, and a cone's apex prior
+        (:data:`EXTENT_PRIOR`).
     bic : float
         chi2 + dof ln n (the score when c = 1).
     dof : int
@@ -350,7 +366,33 @@ class ClassFit:
     size_std: Mapping[str, float] = field(default_factory=dict)
     size_at_least: Mapping[str, float] = field(default_factory=dict)
     vector: FloatArray = field(default_factory=lambda: np.zeros(0), compare=False, repr=False)
+    covariance: FloatArray = field(
+        default_factory=lambda: np.zeros((0, 0)), compare=False, repr=False
+    )
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
+
+    def distance_std(self, points: ArrayLike) -> FloatArray:
+        """Standard deviation (m) of the fitted shape's signed distance at each of ``points``
+        (m, shape (n, 3)), from :attr:`covariance`: how far the fitted surface may lie from
+        where it is drawn there, shape (n,); NaN for a user mesh or a covariance that is not
+        finite."""
+        q = np.asarray(points, dtype=float).reshape(-1, 3)
+        model = PRIMITIVES.get(self.name)
+        n = len(self.vector)
+        if model is None or self.covariance.shape != (n, n):
+            return np.full(len(q), np.nan)
+        if not np.all(np.isfinite(self.covariance)):
+            return np.full(len(q), np.nan)
+        gradient = np.empty((len(q), n))
+        for j in range(n):
+            shift = np.zeros(n)
+            shift[j] = JACOBIAN_STEP
+            gradient[:, j] = (
+                model.signed_distance(self.vector + shift, q)
+                - model.signed_distance(self.vector - shift, q)
+            ) / (2 * JACOBIAN_STEP)
+        variance = np.einsum("ij,jk,ik->i", gradient, self.covariance, gradient)
+        return np.asarray(np.sqrt(np.maximum(variance, 0.0)))
 
     def sizes_text(self) -> str:
         """The sizes in mm for reading: ``radius 18.7 +- 1.0 mm``, a size that is only a lower
@@ -549,20 +591,36 @@ _PRIOR_HELD = {
 }
 
 
-def _extent_excess(name: str, x: FloatArray, points: FloatArray) -> FloatArray:
-    """How far the shape's extents along its own axes exceed the points' span there (m), for
-    the classes of :data:`_PRIOR_HELD`."""
+def _extent_prior(name: str, x: FloatArray, points: FloatArray, spread: float) -> FloatArray:
+    """The extent prior's residuals (dimensionless; :data:`EXTENT_PRIOR`): how far the shape's
+    extents along its own axes exceed the points' span there over that scale, for the classes
+    of :data:`_PRIOR_HELD`; a cone's apex beyond the points over their ``spread`` (m)."""
     if name not in _PRIOR_HELD:
         return np.zeros(0)
     local = local_coordinates(x, points)
+    if name == "cone":
+        # the base's side is a free end; the apex is where the slant meets the axis, which the
+        # slant's points place wherever they stop along it: held only on the object's scale
+        base = max(float(local[:, 2].min()), 0.0)
+        return np.array([base / EXTENT_PRIOR, math.sqrt(_apex_chi2(name, x, points, spread))])
     span = local.max(axis=0) - local.min(axis=0)
     if name == "box":
-        return np.asarray(np.maximum(x[6:9] - span, 0.0))
+        return np.asarray(np.maximum(x[6:9] - span, 0.0)) / EXTENT_PRIOR
     if name == "capsule":
         extent = x[7] + 2 * x[6]
-    else:  # cylinder, cone: the height
+    else:  # cylinder: the height
         extent = x[7]
-    return np.asarray([max(extent - span[2], 0.0)])
+    return np.asarray([max(extent - span[2], 0.0) / EXTENT_PRIOR])
+
+
+def _apex_chi2(name: str, x: FloatArray, points: FloatArray, spread: float) -> float:
+    """A cone's apex beyond the points, over their ``spread`` (m), squared: the part of its
+    chi^2 that says objects are not much larger than what was touched of them (module
+    docstring, :data:`EXTENT_PRIOR`); 0 for the other classes."""
+    if name != "cone":
+        return 0.0
+    reach = float(local_coordinates(x, points)[:, 2].max())
+    return (max(x[7] - reach, 0.0) / spread) ** 2
 
 
 def _spread(points: FloatArray) -> float:
@@ -671,7 +729,7 @@ def fit_primitive(
     ) -> FloatArray:
         distance = model.signed_distance(x, p) / s
         line = line_residuals(x, s) if with_lines else np.zeros(0)
-        prior = _extent_excess(model.name, x, p) / EXTENT_PRIOR
+        prior = _extent_prior(model.name, x, p, spread)
         return np.concatenate([distance, line, swept_residuals(x, regions), prior])
 
     def fit(
@@ -716,7 +774,7 @@ def fit_primitive(
         normal_sigma = _normal_sigma(cov, model.normals(x, p))
         parts = point_chi2(point_z2(x, normal_sigma), normal_sigma, spread)
         free_parts = _swept_chi2(swept_residuals(x, spaces), spaces, spread)
-        prior = _extent_excess(model.name, x, p) / EXTENT_PRIOR
+        prior = _extent_prior(model.name, x, p, spread)
         return float(np.sum(parts) + np.sum(free_parts) + np.sum(prior**2))
 
     # each start fitted on the points alone (a smooth problem); with lines, also from each
@@ -763,11 +821,14 @@ def fit_primitive(
         line=line_residuals(x, sigma),
         swept=swept_residuals(x, spaces),
         spaces=spaces,
+        belief=_apex_chi2(model.name, x, p, spread),
     )
-    std, margin = size_std(model, x, evidence, spread, kept)
+    covariance = parameter_covariance(x, evidence)
+    std, margin = size_std(model, x, covariance, evidence, spread, kept)
     at_least = np.maximum(model.sizes(x) - margin, 0.0)
     return dataclasses.replace(
         fitted,
+        covariance=covariance,
         size_std=dict(zip(model.size_names, std.tolist(), strict=True)),
         size_at_least={
             n: float(at_least[i]) for i, n in enumerate(model.size_names) if np.isfinite(margin[i])
@@ -775,9 +836,36 @@ def fit_primitive(
     )
 
 
+def parameter_covariance(
+    x: FloatArray, residuals: Callable[[FloatArray], FloatArray]
+) -> FloatArray:
+    """The Gauss-Newton covariance (J^T J)^-1 of the parameters at ``x``, shape (n, n) (units of
+    the parameters squared): J the Jacobian of the normalised ``residuals`` by central
+    differences of :data:`JACOBIAN_STEP`, each eigenvalue of J^T J floored at
+    :data:`EIGEN_FLOOR` of the largest (a direction the residuals do not hold gets a variance
+    far beyond any size); inf throughout when they hold none, NaN when J^T J is not
+    finite."""
+    n = len(x)
+    at_x = residuals(x)
+    jacobian = np.empty((len(at_x), n))
+    for j in range(n):
+        shift = np.zeros(n)
+        shift[j] = JACOBIAN_STEP
+        jacobian[:, j] = (residuals(x + shift) - residuals(x - shift)) / (2 * JACOBIAN_STEP)
+    information = jacobian.T @ jacobian
+    if not np.all(np.isfinite(information)):
+        return np.full((n, n), np.nan)
+    eigenvalues, eigenvectors = np.linalg.eigh(information)
+    floor = EIGEN_FLOOR * float(eigenvalues[-1])
+    if not floor > 1.0 / np.finfo(float).max:
+        return np.full((n, n), np.inf)  # the residuals hold no direction
+    return np.asarray((eigenvectors / np.maximum(eigenvalues, floor)) @ eigenvectors.T)
+
+
 def size_std(
     shape: Primitive,
     x: FloatArray,
+    covariance: FloatArray,
     residuals: Callable[[FloatArray], FloatArray],
     spread: float,
     point_std: FloatArray,
@@ -786,43 +874,40 @@ def size_std(
     and for a size that is only a lower bound how far below the fitted size the bound lies (m;
     NaN for the others).
 
-    The Gauss-Newton covariance (J^T J)^-1 of the normalised ``residuals`` (a function of the
-    parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i;
-    J by central differences of :data:`JACOBIAN_STEP`) carried to the sizes; inf (not
-    measured) where a size moves along a direction J^T J does not hold (its eigenvalue below
-    :data:`EIGEN_FLOOR` of the largest) or its deviation exceeds the points' spread ``spread``
-    (m). ``point_std`` are the points' deviations along the normal (m, inf for a point left
-    out). Then each end (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max(2 sigma,
-    3 times a deviation of the points whose distance moves with that end), sigma the
-    largest finite deviation of the sizes it moves: a fit held at the smallest size the points
-    allow has an untouched end at the outermost points, where the distance's derivative
-    differs on either side, and growing it first releases the points within their noise of it,
-    after which only what holds the end resists, as the square of the distance. A rise of the
-    residuals' sum of squares below 1 from D to 2 D leaves the end free: the sizes it moves
-    have no deviation, and those the extent prior holds (a box's extents, a cylinder's height,
-    a capsule's length, a cone's height) are lower bounds, three times the largest deviation of
-    the points at that end (at least the median point's) below the fitted size. Each end is
-    grown at two scales, D from the median and from the largest deviation of its points (a few
-    wide points may be all that hold it), and is held when either resists. Otherwise the rise,
-    3 D^2 / s^2, gives the end's own deviation s, and each measured size it moves has a
-    deviation of at least s times the rate it moves at.
+    The parameters' ``covariance`` (:func:`parameter_covariance` of ``residuals``, a function of the
+    parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i) carried
+    to the sizes; inf (not measured) where a size moves along a direction the residuals do not hold
+    (its deviation then exceeds the points' spread ``spread``, m) or where the covariance is not
+    finite. ``point_std`` are the points' deviations along the normal (m, inf for a point left out).
+    Then each end (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max(2 sigma, 3 times a
+    deviation of the points whose distance moves with that end), sigma the largest finite deviation
+    of the sizes it moves: a fit held at the smallest size the points allow has an untouched end at
+    the outermost points, where the distance's derivative differs on either side, and growing it
+    first releases the points within their noise of it, after which only what holds the end resists,
+    as the square of the distance. A rise of the residuals' sum of squares below 1 from D to 2 D
+    leaves the end free: the sizes it moves have no deviation, and those the extent prior holds (a
+    box's extents, a cylinder's height, a capsule's length, a cone's height) are lower bounds, three
+    times the largest deviation of the points at that end (at least the median point's) below the
+    fitted size. Each end is grown at two scales, D from the median and from the largest deviation
+    of its points (a few wide points may be all that hold it), and is held when either resists.
+    Otherwise the rise, 3 D^2 / s^2, gives the end's own deviation s, and each measured size it
+    moves has a deviation of at least s times the rate it moves at.
+
     """
     n = len(x)
+    if np.all(np.isnan(covariance)):
+        return np.full(len(shape.size_names), np.inf), np.full(len(shape.size_names), np.nan)
     at_x = residuals(x)
-    jacobian = np.empty((len(at_x), n))
     gradient = np.empty((len(shape.size_names), n))
     for j in range(n):
         shift = np.zeros(n)
         shift[j] = JACOBIAN_STEP
-        jacobian[:, j] = (residuals(x + shift) - residuals(x - shift)) / (2 * JACOBIAN_STEP)
         gradient[:, j] = (shape.sizes(x + shift) - shape.sizes(x - shift)) / (2 * JACOBIAN_STEP)
-    information = jacobian.T @ jacobian
-    if not np.all(np.isfinite(information)):
-        return np.full(len(shape.size_names), np.inf), np.full(len(shape.size_names), np.nan)
-    eigenvalues, eigenvectors = np.linalg.eigh(information)
-    floor = EIGEN_FLOOR * max(float(eigenvalues[-1]), np.finfo(float).tiny)
-    variance = np.sum((gradient @ eigenvectors) ** 2 / np.maximum(eigenvalues, floor), axis=1)
-    std = np.where(np.sqrt(variance) <= spread, np.sqrt(variance), np.inf)
+    std = np.full(len(shape.size_names), np.inf)
+    if np.all(np.isfinite(covariance)):
+        variance = np.einsum("ij,jk,ik->i", gradient, covariance, gradient)
+        deviation = np.sqrt(np.maximum(variance, 0.0))
+        std = np.where(deviation <= spread, deviation, np.inf)
     kept = np.isfinite(point_std)  # every point counted wrong: none
     typical = float(np.median(point_std[kept])) if np.any(kept) else 0.0
     held_by_prior = [name in _PRIOR_HELD.get(shape.name, ()) for name in shape.size_names]
@@ -977,13 +1062,15 @@ def _scored(
     line: FloatArray | None = None,
     swept: FloatArray | None = None,
     spaces: Sequence[FreeSpace] = (),
+    belief: float = 0.0,
 ) -> ClassFit:
     n = len(distance)
     lines = line if line is not None and len(line) == n else np.zeros(n)
     sweeps = swept if swept is not None else np.zeros(0)
-    # each point's and each sweep's part of chi^2; BIC = chi^2 + k ln n
+    # each point's and each sweep's part of chi^2, and the class's prior belief (a cone's
+    # apex); BIC = chi^2 + k ln n
     parts = point_chi2(_z2(distance, sigma, lines), sigma, spread)
-    chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
+    chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)) + belief)
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(
         name=name,
@@ -1130,6 +1217,7 @@ def recognise(
             f,
             score=f.chi2 / c + f.dof * n_log,
             size_std={k: v * math.sqrt(c) for k, v in f.size_std.items()},
+            covariance=f.covariance * c,
             size_at_least={
                 k: max(f.sizes[k] - (f.sizes[k] - v) * math.sqrt(c), 0.0)
                 for k, v in f.size_at_least.items()
