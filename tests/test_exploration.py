@@ -203,6 +203,51 @@ def test_the_leaders_separation_is_bounded_by_how_far_apart_they_are() -> None:
     assert capped == {0.0, MISS_MARGIN}
 
 
+def test_next_best_aims_where_the_recognised_fit_is_least_sure() -> None:
+    # Points all over the ball: the surface is known everywhere. A recognised fit whose centre
+    # is uncertain along one axis only (1.5 cm) is unsure of its surface where the surface
+    # faces along that axis, by the centre's deviation times the normal's component (a
+    # sphere's distance moves with its centre as -n): the planner aims at a touch there, for
+    # either axis, and no candidate carries more than the cap
+    scene = load_scene("sphere")
+    ball = scene.objects[0]
+    centre, radius = ball.parameters[:3], ball.parameters[3]
+    directions = np.random.default_rng(1).normal(size=(60, 3))
+    points = centre + radius * directions / np.linalg.norm(directions, axis=1, keepdims=True)
+    surface = ImplicitSurface().fit(
+        points, np.tile(np.eye(3) * 1e-6, (len(points), 1, 1)), np.zeros(3)
+    )
+    planner = NextBestPlanner(scene, LinkShape(DEVICE.link))
+    plain = planner.choose([], surface)
+    assert plain is not None and plain.score < 0.01
+    for axis in (0, 2):
+        covariance = np.zeros((4, 4))
+        covariance[axis, axis] = 0.015**2
+        fit = ClassFit(
+            "sphere", {}, {}, 0.0, 0.0, 0.0, 4, 60, vector=ball.parameters, covariance=covariance
+        )
+        aimed = planner.choose([], surface, leaders=[fit])
+        assert aimed is not None and aimed.score > 0.01
+        normal = (aimed.predicted - centre) / np.linalg.norm(aimed.predicted - centre)
+        assert abs(normal[axis]) > 0.8, (axis, normal)
+        own = [planner.fit_uncertainty(sweep, fit)[0] for sweep in planner.candidates]
+        assert 0.0 <= min(own) and max(own) <= MISS_MARGIN
+    # a fit that holds the base inside it predicts no outcome
+    enclosing = ClassFit(
+        "sphere",
+        {},
+        {},
+        0.0,
+        0.0,
+        0.0,
+        4,
+        60,
+        vector=np.array([0.0, 0.0, 0.0, 2.0]),
+        covariance=np.eye(4) * 1e-4,
+    )
+    assert all(planner.fit_uncertainty(s, enclosing)[0] == 0.0 for s in planner.candidates)
+
+
 @pytest.fixture(scope="module")
 def explored(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Manoeuvre]]:
     out = tmp_path_factory.mktemp("explore") / "post"
@@ -499,7 +544,7 @@ def test_an_object_recognised_at_the_budget_ends_the_exploration(
 
     import sensing_antenna.exploration.run as run
 
-    named = types.SimpleNamespace(undecided=False)
+    named = types.SimpleNamespace(undecided=False, best=types.SimpleNamespace(name="stand-in"))
     monkeypatch.setattr(run, "recognise_points", lambda *args, **kwargs: named)
     out = tmp_path / "named"
     out.mkdir()

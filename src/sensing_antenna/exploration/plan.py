@@ -39,6 +39,18 @@ inside one, or when a distance is not finite. The score is then
 sqrt(score^2 + (s / (1 + crowd))^2), and a candidate the leaders disagree about is never
 relegated as a predicted miss: a contact, or free space, where the leaders differ separates
 them; one where they agree does not.
+
+The leading fit (the named object's, or the better of the two) is a second model of the same
+surface, held by its few parameters: where its points do not reach (a cone's apex, a
+cylinder's end) it extrapolates, and the sizes it reads there are as good as that
+extrapolation. So each candidate is also followed through that fit, as through the surface:
+the standard deviation s of the fit's signed distance at its predicted touch (or closest pass),
+from the fit's parameter covariance (``ClassFit.distance_std``, at most :data:`MISS_MARGIN`),
+and the chance Phi(-d / s) that the sweep touches the fit at all, d the fit's smallest distance
+to the link over the sweep, give the fit's own term u = Phi(-d / s) s, which a contact there
+would reduce. With both, the score is
+sqrt(score^2 + (separation / (1 + crowd))^2 + (u / (1 + crowd))^2), and a candidate whose
+touch the fit predicts within :data:`MISS_MARGIN` is not relegated as a predicted miss.
 """
 
 from __future__ import annotations
@@ -186,8 +198,8 @@ class Choice:
     sweep : Sweep
     score : float
         The predictive standard deviation at the predicted touch, weighted by the chance to
-        touch, and the leading fits' separation when there are two (m; module docstring), NaN
-        for a grid choice.
+        touch, with the leading fit's own term and the leading fits' separation when there
+        are two (m; module docstring), NaN for a grid choice.
     predicted : array, shape (3,)
         Where the sweep is expected to touch (m, world), NaN for a grid choice.
     std : float
@@ -222,6 +234,7 @@ class NextBestPlanner:
         x = shape.abscissae
         self._samples = np.unique(np.linspace(0, len(x) - 1, _PREDICTION_SAMPLES).astype(int))
         self._swept_cache: dict[Sweep, FloatArray] = {}
+        self._fit_cache: dict[int, tuple[ClassFit, dict[Sweep, FloatArray]]] = {}
 
     def choose(
         self,
@@ -231,9 +244,9 @@ class NextBestPlanner:
         leaders: Sequence[ClassFit] = (),
     ) -> Choice | None:
         """The next sweep given the sweeps run so far, the surface fitted to their contacts
-        (None until there is one), those of them that touched nothing, and the two leading
-        shape classes' fits when recognition abstains between them (module docstring); None
-        when every candidate has been run."""
+        (None until there is one), those of them that touched nothing, and the recognised
+        object's fit, or the two leading shape classes' fits when recognition abstains between
+        them (module docstring); None when every candidate has been run."""
         nan3 = np.full(3, np.nan)
         if surface is None:
             for sweep in self.opening:
@@ -244,6 +257,8 @@ class NextBestPlanner:
         left = [c for c in self.candidates if c not in done]
         if not left:
             return None
+        # the fits' distances are kept for these leaders only
+        self._fit_cache = {id(f): self._fit_cache.get(id(f), (f, {})) for f in leaders}
         free_cloud = None
         if free:
             free_cloud = cKDTree(
@@ -253,6 +268,9 @@ class NextBestPlanner:
         fallback: tuple[float, Choice] | None = None
         for sweep in left:
             separation = self.separation(sweep, leaders) if len(leaders) == 2 else 0.0
+            own, fit_closest = (
+                self.fit_uncertainty(sweep, leaders[0]) if leaders else (0.0, math.nan)
+            )
             point, closest = self._predicted_touch(sweep, surface)
             _, std_at = surface.predict(point[None, :], return_std=True)
             std = float(std_at[0])
@@ -270,9 +288,9 @@ class NextBestPlanner:
             if free_cloud is not None:
                 distance = float(free_cloud.query(point)[0])
                 score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
-            score = math.hypot(score, separation / (1.0 + crowd))
+            score = math.hypot(score, separation / (1.0 + crowd), own / (1.0 + crowd))
             entry = (score, Choice(sweep, score, point, std, probability))
-            if closest > MISS_MARGIN and separation == 0.0:
+            if closest > MISS_MARGIN and separation == 0.0 and not fit_closest <= MISS_MARGIN:
                 if fallback is None or score > fallback[0]:
                     fallback = entry
             elif best is None or score > best[0]:
@@ -280,6 +298,30 @@ class NextBestPlanner:
         chosen = best if best is not None else fallback
         assert chosen is not None
         return chosen[1]
+
+    def fit_uncertainty(self, sweep: Sweep, fit: ClassFit) -> tuple[float, float]:
+        """How little the leading fit knows where ``sweep`` would touch it (m; module
+        docstring), and the smallest signed distance of the fit to the link over the sweep (m;
+        < 0 when it predicts a touch); (0, NaN) when the link starts inside the fit or a
+        distance is not finite.
+
+        The deviation s of the fit's distance (at most :data:`MISS_MARGIN`) is taken at the
+        predicted touch (the link's sample nearest the fit where the sweep first enters it) or,
+        when the fit predicts a miss, at its closest pass; the chance of a touch at all,
+        Phi(-d / s), from the smallest distance d over the sweep (a sweep that passes deep
+        through the fit touches it whatever s)."""
+        points = self._swept(sweep)
+        distance = self._fit_distances(sweep, fit)
+        if not np.all(np.isfinite(distance)) or distance[0].min() < 0.0:
+            return 0.0, math.nan
+        rows = np.nonzero((distance < 0.0).any(axis=1))[0]
+        row = int(rows[0]) if rows.size else int(np.argmin(distance.min(axis=1)))
+        column = int(np.argmin(distance[row]))
+        deepest = float(distance.min())
+        std = min(float(fit.distance_std(points[row, column][None, :])[0]), MISS_MARGIN)
+        if not std > 0.0:  # NaN or nothing uncertain
+            return 0.0, deepest
+        return 0.5 * math.erfc(deepest / (math.sqrt(2.0) * std)) * std, deepest
 
     def separation(self, sweep: Sweep, leaders: Sequence[ClassFit]) -> float:
         """How far apart two primitive fits put the outcome of ``sweep`` (m; module docstring).
@@ -291,17 +333,8 @@ class NextBestPlanner:
         :data:`MISS_MARGIN`; 0 when neither is touched, when the link starts inside either fit
         (no outcome to predict) or when a distance is not finite.
         """
-        points = self._swept(sweep)
-        rows = len(points)
-        nearest = [
-            np.asarray(
-                PRIMITIVES[fit.name].signed_distance(fit.vector, points.reshape(-1, 3)),
-                dtype=float,
-            )
-            .reshape(rows, -1)
-            .min(axis=1)
-            for fit in leaders
-        ]
+        nearest = [self._fit_distances(sweep, fit).min(axis=1) for fit in leaders]
+        rows = len(nearest[0])
         if not all(np.all(np.isfinite(d)) and d[0] >= 0.0 for d in nearest):
             return 0.0
         steps = np.arange(rows, dtype=float)
@@ -327,6 +360,23 @@ class NextBestPlanner:
                 ]
             )
             self._swept_cache[sweep] = kept
+        return kept
+
+    def _fit_distances(self, sweep: Sweep, fit: ClassFit) -> FloatArray:
+        """The fit's signed distance (m) at the link's samples over the sweep, shape (angles,
+        samples); kept for the fits of the planner's last choice."""
+        held, per_sweep = self._fit_cache.get(id(fit), (None, {}))
+        if held is not fit:
+            per_sweep = {}
+            self._fit_cache[id(fit)] = (fit, per_sweep)
+        kept = per_sweep.get(sweep)
+        if kept is None:
+            points = self._swept(sweep)
+            kept = np.asarray(
+                PRIMITIVES[fit.name].signed_distance(fit.vector, points.reshape(-1, 3)),
+                dtype=float,
+            ).reshape(points.shape[:2])
+            per_sweep[sweep] = kept
         return kept
 
     def _predicted_touch(self, sweep: Sweep, surface: ImplicitSurface) -> tuple[FloatArray, float]:

@@ -22,11 +22,11 @@ retract, re-plan), on the simulator:
    where no ``ok`` point says so (:func:`swept_links`).
 
 The next-best strategy refits the surface before each manoeuvre and recognises the points before
-every :data:`RECOGNITION_EVERY`-th, aiming at the two leading classes while recognition abstains
-(``exploration.plan``). After the budget, either strategy may go on while recognition abstains
-(``ExploreSettings.until_recognised``): it recognises the points before each further manoeuvre,
-stops once a class is named, and otherwise takes next-best's choice with the two leading
-fits, which aims at telling them apart.
+every :data:`RECOGNITION_EVERY`-th, aiming where the named object's fit is least sure of its
+surface, and at the two leading classes while recognition abstains (``exploration.plan``). After the
+budget, either strategy may go on while recognition abstains (``ExploreSettings.until_recognised``):
+it recognises the points before each further manoeuvre, stops once a class is named, and otherwise
+takes next-best's choice with the two leading fits, which aims at telling them apart.
 
 Manoeuvre i is simulated with the seed ``seed + i``. Everything is stored as it is made
 (``exploration.store``); a second start with the same settings resumes after the last stored
@@ -566,13 +566,15 @@ def _recognition_state(
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
 ) -> RecognitionState:
     """The recognition (the map's, with the user's ``meshes``) of the points so far when it
-    names an object (else None), and, when it abstains, the two fits it abstains between (the
-    best and its rival, or the two leading scores) if both are primitives (else none)."""
+    names an object (else None), and the fits the planner aims with: the named object's fit,
+    or, when recognition abstains, the two fits it abstains between (the best and its rival,
+    or the two leading scores); none when they are not all primitives."""
     recognition = recognise_points(points, include_uncertain, meshes, swept=swept)
     if recognition is None:
         return None, ()
     if not recognition.undecided:
-        return recognition, ()
+        best = recognition.best
+        return recognition, (best,) if best.name in PRIMITIVES else ()
     by_name = {f.name: f for f in recognition.fits}
     leaders = tuple(by_name[name] for name in recognition.candidates)
     return None, leaders if all(f.name in PRIMITIVES for f in leaders) else ()
