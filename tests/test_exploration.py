@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -203,17 +204,36 @@ def test_the_leaders_separation_is_bounded_by_how_far_apart_they_are() -> None:
     assert capped == {0.0, MISS_MARGIN}
 
 
+def _ball_fit(vector: np.ndarray, covariance: np.ndarray) -> ClassFit:
+    """A sphere fit of ``vector`` (centre and radius, m) with that parameter covariance."""
+    return ClassFit(
+        name="sphere",
+        parameters={},
+        sizes={},
+        rms=0.0,
+        chi2=0.0,
+        bic=0.0,
+        dof=4,
+        n_points=60,
+        vector=vector,
+        covariance=covariance,
+    )
+
+
 def test_next_best_aims_where_the_recognised_fit_is_least_sure() -> None:
     # Points all over the ball: the surface is known everywhere. A recognised fit whose centre
     # is uncertain along one axis only (1.5 cm) is unsure of its surface where the surface
     # faces along that axis, by the centre's deviation times the normal's component (a
     # sphere's distance moves with its centre as -n): the planner aims at a touch there, for
-    # either axis, and no candidate carries more than the cap
+    # either axis. A deviation of 5 cm is capped at 2 cm, and a fit that holds the base
+    # inside it predicts no outcome
     scene = load_scene("sphere")
     ball = scene.objects[0]
-    centre, radius = ball.parameters[:3], ball.parameters[3]
+    centre = ball.parameters[:3]
     directions = np.random.default_rng(1).normal(size=(60, 3))
-    points = centre + radius * directions / np.linalg.norm(directions, axis=1, keepdims=True)
+    points = centre + ball.parameters[3] * directions / np.linalg.norm(
+        directions, axis=1, keepdims=True
+    )
     surface = ImplicitSurface().fit(
         points, np.tile(np.eye(3) * 1e-6, (len(points), 1, 1)), np.zeros(3)
     )
@@ -223,29 +243,18 @@ def test_next_best_aims_where_the_recognised_fit_is_least_sure() -> None:
     for axis in (0, 2):
         covariance = np.zeros((4, 4))
         covariance[axis, axis] = 0.015**2
-        fit = ClassFit(
-            "sphere", {}, {}, 0.0, 0.0, 0.0, 4, 60, vector=ball.parameters, covariance=covariance
-        )
-        aimed = planner.choose([], surface, leaders=[fit])
+        aimed = planner.choose([], surface, leaders=[_ball_fit(ball.parameters, covariance)])
         assert aimed is not None and aimed.score > 0.01
         normal = (aimed.predicted - centre) / np.linalg.norm(aimed.predicted - centre)
         assert abs(normal[axis]) > 0.8, (axis, normal)
-        own = [planner.fit_uncertainty(sweep, fit)[0] for sweep in planner.candidates]
-        assert 0.0 <= min(own) and max(own) <= MISS_MARGIN
-    # a fit that holds the base inside it predicts no outcome
-    enclosing = ClassFit(
-        "sphere",
-        {},
-        {},
-        0.0,
-        0.0,
-        0.0,
-        4,
-        60,
-        vector=np.array([0.0, 0.0, 0.0, 2.0]),
-        covariance=np.eye(4) * 1e-4,
-    )
-    assert all(planner.fit_uncertainty(s, enclosing)[0] == 0.0 for s in planner.candidates)
+    wide = _ball_fit(ball.parameters, np.eye(4) * 0.05**2)
+    outcomes = [planner.fit_outcome(sweep, wide) for sweep in planner.candidates]
+    touched = [std for _, std, deepest in outcomes if deepest < 0.0]
+    assert touched and set(touched) == {MISS_MARGIN}
+    enclosing = _ball_fit(np.array([0.0, 0.0, 0.0, 2.0]), np.eye(4) * 1e-4)
+    for sweep in planner.candidates:
+        at, std, deepest = planner.fit_outcome(sweep, enclosing)
+        assert np.all(np.isnan(at)) and std == 0.0 and math.isnan(deepest)
 
 
 @pytest.fixture(scope="module")

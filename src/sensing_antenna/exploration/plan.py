@@ -41,16 +41,18 @@ relegated as a predicted miss: a contact, or free space, where the leaders diffe
 them; one where they agree does not.
 
 The leading fit (the named object's, or the better of the two) is a second model of the same
-surface, held by its few parameters: where its points do not reach (a cone's apex, a
-cylinder's end) it extrapolates, and the sizes it reads there are as good as that
-extrapolation. So each candidate is also followed through that fit, as through the surface:
-the standard deviation s of the fit's signed distance at its predicted touch (or closest pass),
-from the fit's parameter covariance (``ClassFit.distance_std``, at most :data:`MISS_MARGIN`),
-and the chance Phi(-d / s) that the sweep touches the fit at all, d the fit's smallest distance
-to the link over the sweep, give the fit's own term u = Phi(-d / s) s, which a contact there
-would reduce. With both, the score is
-sqrt(score^2 + (separation / (1 + crowd))^2 + (u / (1 + crowd))^2), and a candidate whose
-touch the fit predicts within :data:`MISS_MARGIN` is not relegated as a predicted miss.
+surface, held by its few parameters: where its points do not reach (a cone's apex, a cylinder's
+end) it extrapolates, and the sizes it reads there are as good as that extrapolation. So each
+candidate is also followed through that fit, as through the surface: the standard deviation u of
+the fit's signed distance at its predicted touch (or closest pass), from the fit's parameter
+covariance (``ClassFit.distance_std``, at most :data:`MISS_MARGIN`), and the chance Phi(-d / u)
+that the sweep touches the fit at all, d the fit's smallest distance to the link over the sweep,
+give the fit's term Phi(-d / u) u, which a contact there would reduce; a free sweep near the
+fit's touch discounts it as it discounts the surface's (the fit may not have seen that sweep:
+recognition runs every few manoeuvres). With both, the score is
+sqrt(score^2 + (separation / (1 + crowd))^2 + (Phi(-d / u) u / (1 + crowd))^2), and a candidate
+whose touch the fit gives a fair chance (d at most 2 u and :data:`MISS_MARGIN`) is not relegated
+as a predicted miss.
 """
 
 from __future__ import annotations
@@ -245,8 +247,9 @@ class NextBestPlanner:
     ) -> Choice | None:
         """The next sweep given the sweeps run so far, the surface fitted to their contacts
         (None until there is one), those of them that touched nothing, and the recognised
-        object's fit, or the two leading shape classes' fits when recognition abstains between
-        them (module docstring); None when every candidate has been run."""
+        object's primitive fit, or the two leading shape classes' primitive fits when
+        recognition abstains between them (module docstring); None when every candidate has
+        been run."""
         nan3 = np.full(3, np.nan)
         if surface is None:
             for sweep in self.opening:
@@ -268,9 +271,17 @@ class NextBestPlanner:
         fallback: tuple[float, Choice] | None = None
         for sweep in left:
             separation = self.separation(sweep, leaders) if len(leaders) == 2 else 0.0
-            own, fit_closest = (
-                self.fit_uncertainty(sweep, leaders[0]) if leaders else (0.0, math.nan)
-            )
+            fit_term, fit_touches = 0.0, False
+            if leaders:
+                at, fit_std, deepest = self.fit_outcome(sweep, leaders[0])
+                if fit_std > 0.0 and math.isfinite(deepest):
+                    # the chance of touching the fit at all, and a free sweep near the fit's
+                    # touch (since its recognition, perhaps) against it
+                    fit_term = 0.5 * math.erfc(deepest / (math.sqrt(2.0) * fit_std)) * fit_std
+                    if free_cloud is not None:
+                        near = float(free_cloud.query(at)[0])
+                        fit_term *= 1.0 - math.exp(-0.5 * (near / FREE_RADIUS) ** 2)
+                    fit_touches = deepest <= min(MISS_MARGIN, 2.0 * fit_std)
             point, closest = self._predicted_touch(sweep, surface)
             _, std_at = surface.predict(point[None, :], return_std=True)
             std = float(std_at[0])
@@ -288,9 +299,9 @@ class NextBestPlanner:
             if free_cloud is not None:
                 distance = float(free_cloud.query(point)[0])
                 score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
-            score = math.hypot(score, separation / (1.0 + crowd), own / (1.0 + crowd))
+            score = math.hypot(score, separation / (1.0 + crowd), fit_term / (1.0 + crowd))
             entry = (score, Choice(sweep, score, point, std, probability))
-            if closest > MISS_MARGIN and separation == 0.0 and not fit_closest <= MISS_MARGIN:
+            if closest > MISS_MARGIN and separation == 0.0 and not fit_touches:
                 if fallback is None or score > fallback[0]:
                     fallback = entry
             elif best is None or score > best[0]:
@@ -299,29 +310,24 @@ class NextBestPlanner:
         assert chosen is not None
         return chosen[1]
 
-    def fit_uncertainty(self, sweep: Sweep, fit: ClassFit) -> tuple[float, float]:
-        """How little the leading fit knows where ``sweep`` would touch it (m; module
-        docstring), and the smallest signed distance of the fit to the link over the sweep (m;
-        < 0 when it predicts a touch); (0, NaN) when the link starts inside the fit or a
-        distance is not finite.
-
-        The deviation s of the fit's distance (at most :data:`MISS_MARGIN`) is taken at the
-        predicted touch (the link's sample nearest the fit where the sweep first enters it) or,
-        when the fit predicts a miss, at its closest pass; the chance of a touch at all,
-        Phi(-d / s), from the smallest distance d over the sweep (a sweep that passes deep
-        through the fit touches it whatever s)."""
+    def fit_outcome(self, sweep: Sweep, fit: ClassFit) -> tuple[FloatArray, float, float]:
+        """What the leading fit predicts of ``sweep`` (module docstring): the link's sample
+        nearest the fit where the sweep first enters it, or where it passes closest when it
+        does not (m, world, shape (3,)); the standard deviation of the fit's distance there (m,
+        at most :data:`MISS_MARGIN`; 0 when not finite); and the fit's smallest signed distance
+        to the link over the sweep (m, < 0 when it predicts a touch). NaN point and distance
+        when the link starts inside the fit or a distance is not finite."""
         points = self._swept(sweep)
         distance = self._fit_distances(sweep, fit)
         if not np.all(np.isfinite(distance)) or distance[0].min() < 0.0:
-            return 0.0, math.nan
+            return np.full(3, np.nan), 0.0, math.nan
         rows = np.nonzero((distance < 0.0).any(axis=1))[0]
         row = int(rows[0]) if rows.size else int(np.argmin(distance.min(axis=1)))
         column = int(np.argmin(distance[row]))
-        deepest = float(distance.min())
-        std = min(float(fit.distance_std(points[row, column][None, :])[0]), MISS_MARGIN)
-        if not std > 0.0:  # NaN or nothing uncertain
-            return 0.0, deepest
-        return 0.5 * math.erfc(deepest / (math.sqrt(2.0) * std)) * std, deepest
+        point = points[row, column]
+        std = float(fit.distance_std(point[None, :])[0])
+        std = min(std, MISS_MARGIN) if math.isfinite(std) else 0.0
+        return point, std, float(distance.min())
 
     def separation(self, sweep: Sweep, leaders: Sequence[ClassFit]) -> float:
         """How far apart two primitive fits put the outcome of ``sweep`` (m; module docstring).

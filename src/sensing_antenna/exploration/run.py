@@ -98,7 +98,8 @@ from sensing_antenna.simulator.scenario import LINK_MODELS
 
 FloatArray = NDArray[np.float64]
 
-#: A recognition that names an object (else None), and the two fits it abstains between.
+#: A recognition that names an object (else None), and the fits the planner aims with: the
+#: named object's, or the two it abstains between.
 RecognitionState = tuple[Recognition | None, tuple[ClassFit, ...]]
 
 #: A stored recording's links (``mapping.free_space.recording_links``) and its first motor

@@ -54,10 +54,16 @@ and :meth:`ClassFit.distance_std` carries it to the fitted surface). A size the 
 not hold (a sphere's radius from a small cap) is not measured: no deviation. A size whose end no
 touch reaches (a box's extent where one face only was touched) is held by the extent prior at
 the outermost points: it is reported as a lower bound, three times the deviation of the points
-there below the fitted size (:func:`size_std` finds such ends by growing the shape there). The
-points' errors are not independent (a face touched at its edges reads outward at each), so a
-size can be off by more than its standard deviation says; ``benchmarks/eval_explore.py``
-measures how often.
+there below the fitted size (:func:`size_std` finds such ends by growing the shape there). A
+cone's apex is no such end: the slant places it however far short of it the points stop, and
+the prior, which holds it at the points' reach while the class is fitted and scored, would pull
+it in by a large part of the gap. So a cone's shape, sizes and covariance are those of its fit
+refined with only its base held by the prior, when the evidence measures every size of that
+shape or bounds it from below (a size it does not measure says the slant does not place the
+apex, and the fit as scored, the smallest the points allow, stands); its chi^2 and RMS stay
+those of the fit it was scored by. The points' errors
+are not independent (a face touched at its edges reads outward at each), so a size can be off
+by more than its standard deviation says; ``benchmarks/eval_explore.py`` measures how often.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
 points pin the richer class's extra parameters to the simpler shape (a capsule fitted to a
@@ -159,15 +165,11 @@ MAX_SIZE_SPREADS = 10.0
 
 #: Scale of the extent prior (m): a shape's extent along its own axes beyond the points' span
 #: there costs (excess / this)^2, as a residual of this many metres would. Points say nothing
-#: of a shape beyond them (a cylinder's far end, a box's hidden faces, a cone's base): without
-#: the prior those sizes drift freely; with it they stay at the smallest the points allow. A
-#: cone's apex is no such end: its slant places it, however far short of it the points stop,
-#: and a prior this stiff would pull it in by a large part of the gap (the cone read short by
-#: several of its deviations); its excess costs (excess / the points' spread)^2, which keeps a
-#: cone from stretching its apex far beyond them (as a narrow cone mimics a cylinder's side)
-#: and leaves one its slant places where it is. That part is a belief about objects (not
-#: much larger than what was touched of them), not a convention, so it counts in the cone's
-#: chi^2: a cone that explains a cylinder's side by an apex far beyond the points pays for it.
+#: of a shape beyond them (a cylinder's far end, a box's hidden faces): without the prior those
+#: sizes drift freely; with it they stay at the smallest the points allow. A cone's apex is held
+#: so too while the class is fitted and scored (a cone free to put its apex far beyond the
+#: points mimics other shapes' sides), but its slant places the apex wherever the points stop,
+#: so its sizes are read from the fit refined with only its base held (module docstring).
 EXTENT_PRIOR = 0.005
 
 #: Smallest size a fit may take (m): a tenth of a millimetre, below any touchable feature.
@@ -318,11 +320,11 @@ class ClassFit:
         user mesh, whose size is its own.
         :func:`fit_primitive` gives it for the points' own covariances, :func:`recognise`
         widened by the overdispersion.
-    covariance : array, shape (dof, dof)
+    covariance : array, shape (len(vector), len(vector))
         The Gauss-Newton covariance of :attr:`vector` (module docstring, "Sizes."; units of the
-        parameters squared), with a direction the evidence does not hold at the variance of
-        :data:`EIGEN_FLOOR`; shape (0, 0) for a user mesh. Widened by the overdispersion in
-        :func:`recognise`, as the sizes' deviations are.
+        parameters squared; :func:`parameter_covariance`), a direction the evidence does not
+        hold at a variance far beyond any size; shape (0, 0) for a user mesh. Widened by the
+        overdispersion in :func:`recognise`, as the sizes' deviations are.
     size_at_least : Mapping[str, float]
         For each size the extent prior holds whose end nothing holds (a box's hidden face), the
         lower bound the points give it (m): the fitted size less three times the largest
@@ -332,8 +334,7 @@ class ClassFit:
         RMS of the point-to-surface distances (m).
     chi2 : float
         sum over the points of their part of chi^2 (:func:`point_chi2`, of z_i^2 = (d_i /
-        sigma_i)^2 + r_i^2; dimensionless), the swept links' parts, and a cone's apex prior
-        (:data:`EXTENT_PRIOR`).
+        sigma_i)^2 + r_i^2; dimensionless) and the swept links' parts.
     bic : float
         chi2 + dof ln n (the score when c = 1).
     dof : int
@@ -374,8 +375,9 @@ class ClassFit:
     def distance_std(self, points: ArrayLike) -> FloatArray:
         """Standard deviation (m) of the fitted shape's signed distance at each of ``points``
         (m, shape (n, 3)), from :attr:`covariance`: how far the fitted surface may lie from
-        where it is drawn there, shape (n,); NaN for a user mesh or a covariance that is not
-        finite."""
+        where it is drawn there, shape (n,). Where the surface moves with a direction the
+        evidence does not hold (a cylinder's untouched end) it is far beyond any size; NaN for
+        a user mesh or a covariance that is not finite (the evidence holds no direction)."""
         q = np.asarray(points, dtype=float).reshape(-1, 3)
         model = PRIMITIVES.get(self.name)
         n = len(self.vector)
@@ -383,14 +385,7 @@ class ClassFit:
             return np.full(len(q), np.nan)
         if not np.all(np.isfinite(self.covariance)):
             return np.full(len(q), np.nan)
-        gradient = np.empty((len(q), n))
-        for j in range(n):
-            shift = np.zeros(n)
-            shift[j] = JACOBIAN_STEP
-            gradient[:, j] = (
-                model.signed_distance(self.vector + shift, q)
-                - model.signed_distance(self.vector - shift, q)
-            ) / (2 * JACOBIAN_STEP)
+        gradient = _gradient(lambda v: model.signed_distance(v, q), self.vector)
         variance = np.einsum("ij,jk,ik->i", gradient, self.covariance, gradient)
         return np.asarray(np.sqrt(np.maximum(variance, 0.0)))
 
@@ -591,36 +586,25 @@ _PRIOR_HELD = {
 }
 
 
-def _extent_prior(name: str, x: FloatArray, points: FloatArray, spread: float) -> FloatArray:
+def _extent_prior(
+    name: str, x: FloatArray, points: FloatArray, free_apex: bool = False
+) -> FloatArray:
     """The extent prior's residuals (dimensionless; :data:`EXTENT_PRIOR`): how far the shape's
     extents along its own axes exceed the points' span there over that scale, for the classes
-    of :data:`_PRIOR_HELD`; a cone's apex beyond the points over their ``spread`` (m)."""
+    of :data:`_PRIOR_HELD`; with ``free_apex`` a cone's base side only."""
     if name not in _PRIOR_HELD:
         return np.zeros(0)
     local = local_coordinates(x, points)
-    if name == "cone":
-        # the base's side is a free end; the apex is where the slant meets the axis, which the
-        # slant's points place wherever they stop along it: held only on the object's scale
-        base = max(float(local[:, 2].min()), 0.0)
-        return np.array([base / EXTENT_PRIOR, math.sqrt(_apex_chi2(name, x, points, spread))])
+    if name == "cone" and free_apex:
+        return np.array([max(float(local[:, 2].min()), 0.0) / EXTENT_PRIOR])
     span = local.max(axis=0) - local.min(axis=0)
     if name == "box":
         return np.asarray(np.maximum(x[6:9] - span, 0.0)) / EXTENT_PRIOR
     if name == "capsule":
         extent = x[7] + 2 * x[6]
-    else:  # cylinder: the height
+    else:  # cylinder, cone: the height
         extent = x[7]
     return np.asarray([max(extent - span[2], 0.0) / EXTENT_PRIOR])
-
-
-def _apex_chi2(name: str, x: FloatArray, points: FloatArray, spread: float) -> float:
-    """A cone's apex beyond the points, over their ``spread`` (m), squared: the part of its
-    chi^2 that says objects are not much larger than what was touched of them (module
-    docstring, :data:`EXTENT_PRIOR`); 0 for the other classes."""
-    if name != "cone":
-        return 0.0
-    reach = float(local_coordinates(x, points)[:, 2].max())
-    return (max(x[7] - reach, 0.0) / spread) ** 2
 
 
 def _spread(points: FloatArray) -> float:
@@ -725,11 +709,15 @@ def fit_primitive(
         return _swept_residuals(regions, lambda q: model.signed_distance(x, q))
 
     def residuals(
-        x: FloatArray, s: FloatArray, with_lines: bool, regions: Sequence[FreeSpace]
+        x: FloatArray,
+        s: FloatArray,
+        with_lines: bool,
+        regions: Sequence[FreeSpace],
+        free_apex: bool = False,
     ) -> FloatArray:
         distance = model.signed_distance(x, p) / s
         line = line_residuals(x, s) if with_lines else np.zeros(0)
-        prior = _extent_prior(model.name, x, p, spread)
+        prior = _extent_prior(model.name, x, p, free_apex)
         return np.concatenate([distance, line, swept_residuals(x, regions), prior])
 
     def fit(
@@ -738,11 +726,12 @@ def fit_primitive(
         with_lines: bool,
         evaluations: int,
         regions: Sequence[FreeSpace] = (),
+        free_apex: bool = False,
     ) -> Any:
         return least_squares(
             residuals,
             start,
-            args=(s, with_lines, regions),
+            args=(s, with_lines, regions, free_apex),
             bounds=(low, high),
             loss="soft_l1",
             f_scale=ROBUST_SCALE,
@@ -758,7 +747,7 @@ def fit_primitive(
         wrong = point_z2(x, normal_sigma) > outlier_cap(normal_sigma, spread)
         return np.where(wrong, np.inf, normal_sigma)
 
-    def refine(x: FloatArray) -> FloatArray:
+    def refine(x: FloatArray, free_apex: bool = False) -> FloatArray:
         # each point's sigma along the fitted surface's normal, and the link's lines; the
         # points counted wrong leave the refinement, and so do free-space samples far outside
         # the shape at x
@@ -766,7 +755,8 @@ def fit_primitive(
         regions = [
             space.within(model.signed_distance(x, space.samples), FREE_ACTIVE) for space in spaces
         ]
-        solution = fit(x, normal_sigma, lines is not None, 2 * MAX_EVALUATIONS, regions)
+        evaluations = 2 * MAX_EVALUATIONS
+        solution = fit(x, normal_sigma, lines is not None, evaluations, regions, free_apex)
         return np.asarray(solution.x)
 
     def total(x: FloatArray) -> float:
@@ -774,7 +764,7 @@ def fit_primitive(
         normal_sigma = _normal_sigma(cov, model.normals(x, p))
         parts = point_chi2(point_z2(x, normal_sigma), normal_sigma, spread)
         free_parts = _swept_chi2(swept_residuals(x, spaces), spaces, spread)
-        prior = _extent_prior(model.name, x, p, spread)
+        prior = _extent_prior(model.name, x, p)
         return float(np.sum(parts) + np.sum(free_parts) + np.sum(prior**2))
 
     # each start fitted on the points alone (a smooth problem); with lines, also from each
@@ -796,17 +786,34 @@ def fit_primitive(
     x = model.canonical(min(candidates, key=total) if len(candidates) > 1 else candidates[0])
     distance = model.signed_distance(x, p)
     sigma = _normal_sigma(cov, model.normals(x, p))
-    # the evidence alone, without the extent prior, the points counted wrong left out
-    kept = inlier_sigma(x, sigma)
 
-    def evidence(v: FloatArray) -> FloatArray:
-        return np.concatenate(
-            [
-                model.signed_distance(v, p) / kept,
-                line_residuals(v, kept),
-                swept_residuals(v, spaces),
-            ]
-        )
+    def uncertainty(v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        # the covariance, the sizes' deviations and lower-bound margins at v (size_std), from
+        # the evidence alone: without the extent prior, the points counted wrong at v left out
+        kept = inlier_sigma(v, _normal_sigma(cov, model.normals(v, p)))
+
+        def evidence(u: FloatArray) -> FloatArray:
+            return np.concatenate(
+                [
+                    model.signed_distance(u, p) / kept,
+                    line_residuals(u, kept),
+                    swept_residuals(u, spaces),
+                ]
+            )
+
+        covariance = parameter_covariance(v, evidence)
+        return (covariance, *size_std(model, v, covariance, evidence, spread, kept))
+
+    shaped = x
+    covariance, std, margin = uncertainty(x)
+    if model.name == "cone":
+        # a cone's apex let go from the points' reach to where its slant places it, kept when
+        # the evidence measures every size of that shape, or bounds it from below (module
+        # docstring, "Sizes.")
+        refit = model.canonical(refine(x, free_apex=True))
+        held = uncertainty(refit)
+        if not np.any(np.isinf(held[1]) & np.isnan(held[2])):
+            shaped, (covariance, std, margin) = refit, held
 
     fitted = _scored(
         model.name,
@@ -821,19 +828,31 @@ def fit_primitive(
         line=line_residuals(x, sigma),
         swept=swept_residuals(x, spaces),
         spaces=spaces,
-        belief=_apex_chi2(model.name, x, p, spread),
     )
-    covariance = parameter_covariance(x, evidence)
-    std, margin = size_std(model, x, covariance, evidence, spread, kept)
-    at_least = np.maximum(model.sizes(x) - margin, 0.0)
+    at_least = np.maximum(model.sizes(shaped) - margin, 0.0)
     return dataclasses.replace(
         fitted,
+        parameters=dict(zip(model.parameter_names, shaped.tolist(), strict=True)),
+        sizes=dict(zip(model.size_names, model.sizes(shaped).tolist(), strict=True)),
+        vector=shaped,
+        mesh=model.mesh(shaped),
         covariance=covariance,
         size_std=dict(zip(model.size_names, std.tolist(), strict=True)),
         size_at_least={
             n: float(at_least[i]) for i, n in enumerate(model.size_names) if np.isfinite(margin[i])
         },
     )
+
+
+def _gradient(function: Callable[[FloatArray], FloatArray], x: FloatArray) -> FloatArray:
+    """d function / d x at ``x`` by central differences of :data:`JACOBIAN_STEP`, shape
+    (len(function(x)), len(x))."""
+    columns = []
+    for j in range(len(x)):
+        shift = np.zeros(len(x))
+        shift[j] = JACOBIAN_STEP
+        columns.append((function(x + shift) - function(x - shift)) / (2 * JACOBIAN_STEP))
+    return np.stack(columns, axis=1)
 
 
 def parameter_covariance(
@@ -846,12 +865,7 @@ def parameter_covariance(
     far beyond any size); inf throughout when they hold none, NaN when J^T J is not
     finite."""
     n = len(x)
-    at_x = residuals(x)
-    jacobian = np.empty((len(at_x), n))
-    for j in range(n):
-        shift = np.zeros(n)
-        shift[j] = JACOBIAN_STEP
-        jacobian[:, j] = (residuals(x + shift) - residuals(x - shift)) / (2 * JACOBIAN_STEP)
+    jacobian = _gradient(residuals, x)
     information = jacobian.T @ jacobian
     if not np.all(np.isfinite(information)):
         return np.full((n, n), np.nan)
@@ -874,35 +888,31 @@ def size_std(
     and for a size that is only a lower bound how far below the fitted size the bound lies (m;
     NaN for the others).
 
-    The parameters' ``covariance`` (:func:`parameter_covariance` of ``residuals``, a function of the
-    parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i) carried
-    to the sizes; inf (not measured) where a size moves along a direction the residuals do not hold
-    (its deviation then exceeds the points' spread ``spread``, m) or where the covariance is not
-    finite. ``point_std`` are the points' deviations along the normal (m, inf for a point left out).
-    Then each end (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max(2 sigma, 3 times a
-    deviation of the points whose distance moves with that end), sigma the largest finite deviation
-    of the sizes it moves: a fit held at the smallest size the points allow has an untouched end at
-    the outermost points, where the distance's derivative differs on either side, and growing it
-    first releases the points within their noise of it, after which only what holds the end resists,
-    as the square of the distance. A rise of the residuals' sum of squares below 1 from D to 2 D
-    leaves the end free: the sizes it moves have no deviation, and those the extent prior holds (a
-    box's extents, a cylinder's height, a capsule's length, a cone's height) are lower bounds, three
-    times the largest deviation of the points at that end (at least the median point's) below the
-    fitted size. Each end is grown at two scales, D from the median and from the largest deviation
-    of its points (a few wide points may be all that hold it), and is held when either resists.
-    Otherwise the rise, 3 D^2 / s^2, gives the end's own deviation s, and each measured size it
-    moves has a deviation of at least s times the rate it moves at.
-
+    The parameters' ``covariance`` (:func:`parameter_covariance` of ``residuals``, a function of
+    the parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i)
+    carried to the sizes; inf (not measured) where a size moves along a direction the residuals
+    do not hold (its deviation then exceeds the points' spread ``spread``, m) or the covariance
+    is not finite (NaN throughout: nothing else is judged). ``point_std`` are the points'
+    deviations along the normal (m, inf for a point left out). Then each end
+    (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max(2 sigma, 3 times a deviation
+    of the points whose distance moves with that end), sigma the largest finite deviation of the
+    sizes it moves: a fit held at the smallest size the points allow has an untouched end at the
+    outermost points, where the distance's derivative differs on either side, and growing it
+    first releases the points within their noise of it, after which only what holds the end
+    resists, as the square of the distance. A rise of the residuals' sum of squares below 1 from
+    D to 2 D leaves the end free: the sizes it moves have no deviation, and those the extent
+    prior holds (a box's extents, a cylinder's height, a capsule's length, a cone's height) are
+    lower bounds, three times the largest deviation of the points at that end (at least the
+    median point's) below the fitted size. Each end is grown at two scales, D from the median
+    and from the largest deviation of its points (a few wide points may be all that hold it),
+    and is held when either resists. Otherwise the rise, 3 D^2 / s^2, gives the end's own
+    deviation s, and each measured size it moves has a deviation of at least s times the rate it
+    moves at.
     """
-    n = len(x)
     if np.all(np.isnan(covariance)):
         return np.full(len(shape.size_names), np.inf), np.full(len(shape.size_names), np.nan)
     at_x = residuals(x)
-    gradient = np.empty((len(shape.size_names), n))
-    for j in range(n):
-        shift = np.zeros(n)
-        shift[j] = JACOBIAN_STEP
-        gradient[:, j] = (shape.sizes(x + shift) - shape.sizes(x - shift)) / (2 * JACOBIAN_STEP)
+    gradient = _gradient(shape.sizes, x)
     std = np.full(len(shape.size_names), np.inf)
     if np.all(np.isfinite(covariance)):
         variance = np.einsum("ij,jk,ik->i", gradient, covariance, gradient)
@@ -1062,15 +1072,13 @@ def _scored(
     line: FloatArray | None = None,
     swept: FloatArray | None = None,
     spaces: Sequence[FreeSpace] = (),
-    belief: float = 0.0,
 ) -> ClassFit:
     n = len(distance)
     lines = line if line is not None and len(line) == n else np.zeros(n)
     sweeps = swept if swept is not None else np.zeros(0)
-    # each point's and each sweep's part of chi^2, and the class's prior belief (a cone's
-    # apex); BIC = chi^2 + k ln n
+    # each point's and each sweep's part of chi^2; BIC = chi^2 + k ln n
     parts = point_chi2(_z2(distance, sigma, lines), sigma, spread)
-    chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)) + belief)
+    chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(
         name=name,
