@@ -640,5 +640,7 @@ def test_a_cone_touched_below_its_apex_keeps_its_height_and_says_how_sure_its_su
     assert abs(np.mean(heights) - height) < 3.0 * standard_error, np.mean(heights)
     ratio = np.mean(reported, axis=0) / np.std(distances, axis=0, ddof=1)
     assert np.all((ratio > 0.7) & (ratio < 1.35)), ratio
-    # beyond the points the surface is less sure than among them
+    # beyond the points the surface is less sure than among them: the 30 fits' own spread is
+    # about four times wider at 85 % of the height than on the slant among the points (0.78
+    # against 0.18 mm), so twice is a margin the ratios above leave it
     assert np.mean(reported, axis=0)[1] > 2.0 * np.mean(reported, axis=0)[0]

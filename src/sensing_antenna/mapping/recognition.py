@@ -61,9 +61,9 @@ it in by a large part of the gap. So a cone's shape, sizes and covariance are th
 refined with only its base held by the prior, when the evidence measures every size of that
 shape or bounds it from below (a size it does not measure says the slant does not place the
 apex, and the fit as scored, the smallest the points allow, stands); its chi^2 and RMS stay
-those of the fit it was scored by. The points' errors
-are not independent (a face touched at its edges reads outward at each), so a size can be off
-by more than its standard deviation says; ``benchmarks/eval_explore.py`` measures how often.
+those of the fit it was scored by. The points' errors are not independent (a face touched at
+its edges reads outward at each), so a size can be off by more than its standard deviation
+says; ``benchmarks/eval_explore.py`` measures how often.
 
 The penalty k ln n prefers the simpler of two classes that fit equally, which is right when the
 points pin the richer class's extra parameters to the simpler shape (a capsule fitted to a
@@ -385,9 +385,7 @@ class ClassFit:
             return np.full(len(q), np.nan)
         if not np.all(np.isfinite(self.covariance)):
             return np.full(len(q), np.nan)
-        gradient = _gradient(lambda v: model.signed_distance(v, q), self.vector)
-        variance = np.einsum("ij,jk,ik->i", gradient, self.covariance, gradient)
-        return np.asarray(np.sqrt(np.maximum(variance, 0.0)))
+        return _carried(lambda v: model.signed_distance(v, q), self.vector, self.covariance)
 
     def sizes_text(self) -> str:
         """The sizes in mm for reading: ``radius 18.7 +- 1.0 mm``, a size that is only a lower
@@ -804,16 +802,18 @@ def fit_primitive(
         covariance = parameter_covariance(v, evidence)
         return (covariance, *size_std(model, v, covariance, evidence, spread, kept))
 
-    shaped = x
-    covariance, std, margin = uncertainty(x)
+    shaped, measured = x, None
     if model.name == "cone":
         # a cone's apex let go from the points' reach to where its slant places it, kept when
         # the evidence measures every size of that shape, or bounds it from below (module
         # docstring, "Sizes.")
         refit = model.canonical(refine(x, free_apex=True))
-        held = uncertainty(refit)
-        if not np.any(np.isinf(held[1]) & np.isnan(held[2])):
-            shaped, (covariance, std, margin) = refit, held
+        measured = uncertainty(refit)
+        if np.any(np.isinf(measured[1]) & np.isnan(measured[2])):
+            measured = None
+        else:
+            shaped = refit
+    covariance, std, margin = measured if measured is not None else uncertainty(x)
 
     fitted = _scored(
         model.name,
@@ -853,6 +853,17 @@ def _gradient(function: Callable[[FloatArray], FloatArray], x: FloatArray) -> Fl
         shift[j] = JACOBIAN_STEP
         columns.append((function(x + shift) - function(x - shift)) / (2 * JACOBIAN_STEP))
     return np.stack(columns, axis=1)
+
+
+def _carried(
+    function: Callable[[FloatArray], FloatArray], x: FloatArray, covariance: FloatArray
+) -> FloatArray:
+    """Standard deviation of each of ``function``'s values at ``x`` under the parameters'
+    ``covariance``, to first order (g^T C g, g its :func:`_gradient`), shape
+    (len(function(x)),)."""
+    gradient = _gradient(function, x)
+    variance = np.einsum("ij,jk,ik->i", gradient, covariance, gradient)
+    return np.asarray(np.sqrt(np.maximum(variance, 0.0)))
 
 
 def parameter_covariance(
@@ -912,11 +923,9 @@ def size_std(
     if np.all(np.isnan(covariance)):
         return np.full(len(shape.size_names), np.inf), np.full(len(shape.size_names), np.nan)
     at_x = residuals(x)
-    gradient = _gradient(shape.sizes, x)
     std = np.full(len(shape.size_names), np.inf)
     if np.all(np.isfinite(covariance)):
-        variance = np.einsum("ij,jk,ik->i", gradient, covariance, gradient)
-        deviation = np.sqrt(np.maximum(variance, 0.0))
+        deviation = _carried(shape.sizes, x, covariance)
         std = np.where(deviation <= spread, deviation, np.inf)
     kept = np.isfinite(point_std)  # every point counted wrong: none
     typical = float(np.median(point_std[kept])) if np.any(kept) else 0.0
