@@ -112,6 +112,15 @@ FREE_RADIUS = 0.01
 _PREDICTION_SAMPLES = 100
 
 
+def _unswept(free_cloud: cKDTree | None, point: FloatArray) -> float:
+    """1 - exp(-d^2 / (2 FREE_RADIUS^2)), d the distance (m) from ``point`` to the nearest
+    free sweep's link sample (module docstring); 1 without free sweeps."""
+    if free_cloud is None:
+        return 1.0
+    distance = float(free_cloud.query(point)[0])
+    return 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
+
+
 def spread_order(n: int) -> list[int]:
     """0..n-1 middle first, then the middles of the halves, and so on (breadth first), so that
     any prefix of the order spreads over the range: 8 gives 3, 1, 5, 0, 2, 4, 6, 7."""
@@ -278,9 +287,7 @@ class NextBestPlanner:
                     # the chance of touching the fit at all, and a free sweep near the fit's
                     # touch (since its recognition, perhaps) against it
                     fit_term = 0.5 * math.erfc(deepest / (math.sqrt(2.0) * fit_std)) * fit_std
-                    if free_cloud is not None:
-                        near = float(free_cloud.query(at)[0])
-                        fit_term *= 1.0 - math.exp(-0.5 * (near / FREE_RADIUS) ** 2)
+                    fit_term *= _unswept(free_cloud, at)
                     fit_touches = deepest <= min(MISS_MARGIN, 2.0 * fit_std)
             point, closest = self._predicted_touch(sweep, surface)
             _, std_at = surface.predict(point[None, :], return_std=True)
@@ -295,10 +302,7 @@ class NextBestPlanner:
                 and d.direction == sweep.direction
                 and abs(d.fixed - sweep.fixed) < NEIGHBOUR_ANGLE
             )
-            score = probability * std / (1.0 + crowd)
-            if free_cloud is not None:
-                distance = float(free_cloud.query(point)[0])
-                score *= 1.0 - math.exp(-0.5 * (distance / FREE_RADIUS) ** 2)
+            score = probability * std / (1.0 + crowd) * _unswept(free_cloud, point)
             score = math.hypot(score, separation / (1.0 + crowd), fit_term / (1.0 + crowd))
             entry = (score, Choice(sweep, score, point, std, probability))
             if closest > MISS_MARGIN and separation == 0.0 and not fit_touches:
@@ -371,10 +375,8 @@ class NextBestPlanner:
     def _fit_distances(self, sweep: Sweep, fit: ClassFit) -> FloatArray:
         """The fit's signed distance (m) at the link's samples over the sweep, shape (angles,
         samples); kept for the fits of the planner's last choice."""
-        held, per_sweep = self._fit_cache.get(id(fit), (None, {}))
-        if held is not fit:
-            per_sweep = {}
-            self._fit_cache[id(fit)] = (fit, per_sweep)
+        # keyed by identity: the cache holds the fit, so no other object can take its id
+        per_sweep = self._fit_cache.setdefault(id(fit), (fit, {}))[1]
         kept = per_sweep.get(sweep)
         if kept is None:
             points = self._swept(sweep)
