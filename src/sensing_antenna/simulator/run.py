@@ -412,12 +412,13 @@ def simulate_detailed(
         )
         sag = float(model.shape_at(scenario.contact_point) @ q_sag)
         sag_slope = float(model.slope_at(scenario.contact_point) @ q_sag)
-        if scenario.obstacle_placement is not None and kind in SIZED_KINDS:
+        placement = (
+            None if scenario.obstacle_placement is None else np.asarray(scenario.obstacle_placement)
+        )
+        if placement is not None and kind in SIZED_KINDS:
             # its own sizes, grown by the link's radius as the link's axis meets it
-            placement = np.asarray(scenario.obstacle_placement)
             obstacle = place_solid(kind, placement, scenario.obstacle_sizes, antenna.link.radius)
-        elif scenario.obstacle_placement is not None:
-            placement = np.asarray(scenario.obstacle_placement)
+        elif placement is not None:
             direction = placement[3:] / np.linalg.norm(placement[3:])
             radius = 0.0 if kind == "plane" else scenario.obstacle_radius
             half = 0.5 * scenario.obstacle_length
