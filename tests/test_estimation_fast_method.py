@@ -733,6 +733,59 @@ def test_history_holds_the_declared_window_and_runs_to_the_cap(
     assert not since_t1[0].checks_passed and since_t1[0].note
 
 
+def _ringing(
+    recording: Recording, t_1: float, omega: float, amplitude: float, tau: float
+) -> Recording:
+    """``recording`` with a decaying ring at ``omega`` (rad/s) from ``t_1`` (s) on, along the
+    hold's own static contact load (so wholly in the push plane): ``amplitude`` times that load
+    at t_1, decaying with time constant ``tau`` (s). A stand-in for a link that bounces on the
+    obstacle, or touches it elsewhere, after the push."""
+    loads = np.hstack([recording.force, recording.torque])
+    rest = recording.t < 0.25
+    hold = (recording.t > t_1) & (recording.t < t_1 + 0.2)
+    static = loads[hold].mean(axis=0) - loads[rest].mean(axis=0)
+    s = np.clip(recording.t - t_1, 0.0, None)
+    ring = np.where(s > 0.0, amplitude * np.exp(-s / tau) * np.sin(omega * s), 0.0)
+    loads = loads + ring[:, None] * static
+    return replace(recording, force=loads[:, :3], torque=loads[:, 3:])
+
+
+@pytest.mark.parametrize(
+    ("other", "amplitude", "tau", "seed"),
+    [(0.74, 1.5, 0.15, 0), (0.70, 1.5, 0.15, 1), (0.70, 1.0, 2.0, 0), (0.70, 1.0, 2.0, 3)],
+    ids=["dies out, far", "dies out, near", "persists, seed 0", "persists, seed 3"],
+)
+def test_a_second_fundamental_in_the_push_plane_is_never_answered_ok(
+    other: float, amplitude: float, tau: float, seed: int
+) -> None:
+    # A contact at 0.65 m, gently pushed (2.5 % deflection: the ratio's error is about 1.4 cm),
+    # with a ring at omega_1 of another contact point (0.70 or 0.74 m) on top from t_1 on,
+    # along the push: two fundamentals in the push plane, which one held contact cannot make.
+    # Where the ring dies out (0.15 s), the window restarts past it and answers at the
+    # contact; where it persists, no answer is ok. Without the check, the ring near the
+    # contact's frequency (0.70 m) was answered ok at 0.70 m, dying out or not.
+    x_c = 0.65
+    plain = synthetic_recording(
+        Synthetic(x_c=x_c, deflection_ratio=0.025, seed=seed, case="vertical")
+    )
+    plain = plain.without_ground_truth()
+    first = estimate(plain, calibrated(), "fast")
+    assert first.status is Status.OK and abs(first.x_c - x_c) < 1e-3
+    assert all(math.isnan(w.second_fundamental) for w in FastMethod().history(_evidence(plain)))
+    omega = float(CURVE.omega1(other))
+    ringing = _ringing(plain, first.t_1, omega, amplitude, tau)
+    history = FastMethod().history(_evidence(ringing))
+    seconds = [w.second_fundamental for w in history if math.isfinite(w.second_fundamental)]
+    assert seconds
+    result = estimate(ringing, calibrated(), "fast")
+    if tau < 0.5:
+        assert result.status is Status.OK
+        assert abs(result.x_c - x_c) < 2.5e-3
+        assert result.interval[0] <= x_c <= result.interval[1]
+    else:
+        assert result.status is not Status.OK
+
+
 def test_an_opening_contact_moves_the_window_start_to_the_end_of_the_hold(
     azimuthal_evidence: Evidence, azimuthal_history: tuple[WindowEstimate, ...]
 ) -> None:

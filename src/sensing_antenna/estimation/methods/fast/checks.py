@@ -5,7 +5,8 @@ On the fundamental of a window (:mod:`.window_fit`): enough periods, and a drift
 grid window of 2/3 the length) whose change widens the standard error; a fit through the push
 stands only when it passes the same checks, is more precise and agrees. On the posterior
 (:mod:`.window`): the torque/force ratio agrees with the maximum a posteriori x_c; the contact
-stays closed (the predicted vibration of the contact force below the static push); omega_1 is
+stays closed (the predicted vibration of the contact force below the static push) and the push
+plane rings at one fundamental (the link held at one point); omega_1 is
 away from the top of the sensing curve; no higher mode of the fit points to another branch; the
 measured omega_1 agrees with the sensing curve at the MAP x_c. On the estimate
 (:func:`problems`): the static force does not turn between the window's first half and t_e
@@ -23,6 +24,7 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from sensing_antenna.antenna import Link
@@ -31,6 +33,7 @@ from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.curves import CurveTable, contact_candidates
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
+from sensing_antenna.estimation.methods.fast.planes import free_plane_share
 from sensing_antenna.estimation.methods.fast.static_fit import StaticRatio
 from sensing_antenna.estimation.result import Status
 
@@ -48,6 +51,7 @@ __all__ = [
     "frequency_sigma",
     "is_slip_reference",
     "opening_check",
+    "other_fundamental",
     "peak_check",
     "periods_check",
     "periods_held",
@@ -265,6 +269,45 @@ def opening_check(
             f"{opening:.2f} times the static push at the window start"
         )
     return opening, ""
+
+
+def other_fundamental(
+    fit: DampedSinusoidFit,
+    k: int,
+    band: tuple[float, float],
+    push_direction: NDArray[np.float64] | None,
+    config: FastConfig,
+) -> tuple[float, str]:
+    """A second fundamental of the push plane in ``fit`` (rad/s) and the note; NaN and "" when
+    there is none.
+
+    Held at one point, the link has one mode in the omega_1 band in the plane it is pushed in.
+    Another detected mode of that plane (:mod:`.planes`), in the band and farther from the
+    fundamental ``k`` than ``free_plane_margin`` (within which the two planes of one held
+    contact ring, and a mode between them may be counted in either), says the window holds
+    more than one contact state: a contact that bounces, or one that moved along the link.
+    Which of the two is the contact's cannot be told from the window.
+    """
+    if push_direction is None:
+        return math.nan, ""
+    share = free_plane_share(fit, push_direction)
+    omega = fit.omega
+    gap = config.free_plane_margin * float(omega[k])
+    other = (
+        fit.in_band(band)
+        & (fit.detection() >= config.min_detection)
+        & np.isfinite(fit.omega_se)
+        & (share < 0.5)
+        & (np.abs(omega - omega[k]) > gap)
+    )
+    if not other.any():
+        return math.nan, ""
+    strongest = int(np.flatnonzero(other)[np.argmax(fit.detection()[other])])
+    second = float(omega[strongest])
+    return second, (
+        f"the push plane rings at {float(omega[k]):.2f} and {second:.2f} rad/s, two "
+        f"fundamentals: the link was not held at one point over the window"
+    )
 
 
 def peak_check(

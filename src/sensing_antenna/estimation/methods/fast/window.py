@@ -28,6 +28,7 @@ from sensing_antenna.estimation.methods.fast.checks import (
     frequency_sigma,
     is_slip_reference,
     opening_check,
+    other_fundamental,
     peak_check,
     periods_held,
     push_agrees,
@@ -169,6 +170,7 @@ class WindowEstimate:
     ratio_z: float = math.nan
     frequency_z: float = math.nan
     opening: float = math.nan
+    second_fundamental: float = math.nan
     branch_contradicted: bool = False
     branch_chosen_by_second_mode: bool = False
     second_mode: dict[str, Any] = field(default_factory=dict)
@@ -244,6 +246,11 @@ def evaluate_window(
     omega1, omega1_se, omega1_crb = frequency.omega1, frequency.omega1_se, frequency.omega1_crb
     drift = frequency.drift
     notes = list(frequency.notes)
+    second_fundamental = math.nan
+    if fit is not None and k is not None:
+        second_fundamental, note = other_fundamental(fit, k, band, direction, config)
+        if note:
+            notes.append(note)
     # The statics from the window from t_1 always: a fit through the push has its static part
     # at the centre of [t_c, t], inside the push for short windows, while the opening check
     # compares it with the vibration at t_1
@@ -398,6 +405,7 @@ def evaluate_window(
         ratio_z=ratio_z,
         frequency_z=frequency_z,
         opening=opening,
+        second_fundamental=second_fundamental,
         branch_contradicted=bool(contradiction),
         branch_chosen_by_second_mode=chosen,
         second_mode=second_mode,
@@ -480,6 +488,12 @@ def _early_statics(
     return static_ratio(half_fit, bias, model.axial_at(half), 1.0 / link.bending_compliance)
 
 
+def _held(window: WindowEstimate, config: FastConfig) -> bool:
+    """Whether nothing in ``window`` says the link bounced on the obstacle: the contact force
+    stays closed (``max_opening``) and the push plane has one fundamental."""
+    return not (window.opening > config.max_opening or math.isfinite(window.second_fundamental))
+
+
 def evaluate_from_t1_or_hold(
     inputs: ScanInputs,
     hold_end: int,
@@ -490,10 +504,11 @@ def evaluate_from_t1_or_hold(
     """:func:`evaluate_window` on [t_1, ``inputs.end_index``]; from the end of the hold when the
     contact opened.
 
-    When the window from t_1 shows the contact opening (``max_opening``), the link was bouncing
-    on the obstacle early in the window; the window [hold_end, end_index] is evaluated instead
-    once it is at least ``first_window`` long (before that the one from t_1 is returned, not
-    sure), and while that one still opens, the window from a hold's length later, and so on.
+    When the window from t_1 shows the contact opening (``max_opening``) or two fundamentals
+    (``WindowEstimate.second_fundamental``), the link was bouncing on the obstacle early in the
+    window; the window [hold_end, end_index] is evaluated instead once it is at least
+    ``first_window`` long (before that the one from t_1 is returned, not sure), and while that
+    one still shows it, the window from a hold's length later, and so on.
     ``caches`` holds the fits of the windows from t_1 and of those restarted; None refits.
     ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
     gets the slip check's early statics (:func:`with_early_statics_of`).
@@ -503,8 +518,7 @@ def evaluate_from_t1_or_hold(
     first = round(inputs.config.first_window / inputs.sample_period)
     start, step = hold_end, hold_end - inputs.rest_index
     while (
-        window.opening > inputs.config.max_opening
-        and inputs.rest_index < start <= inputs.end_index - first
+        not _held(window, inputs.config) and inputs.rest_index < start <= inputs.end_index - first
     ):
         window = evaluate_window(
             *inputs._replace(rest_index=start, push=None),
