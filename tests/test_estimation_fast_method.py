@@ -25,6 +25,7 @@ from _models import calibrated
 from sensing_antenna.antenna import FreeMotionObserver, paper_antenna
 from sensing_antenna.beam import frequency_scale, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
+from sensing_antenna.cli.estimate import summary
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation import (
     ContactEstimate,
@@ -782,6 +783,9 @@ def test_a_second_fundamental_in_the_push_plane_is_never_answered_ok(
         assert result.status is Status.OK
         assert abs(result.x_c - x_c) < 2.5e-3
         assert result.interval[0] <= x_c <= result.interval[1]
+        # the window it answers from starts past the ring, and the summary says so
+        assert result.diagnostics["window_start"] > result.t_1
+        assert "window from" in summary("ring.csv", result.to_dict())
     else:
         assert result.status is not Status.OK
 

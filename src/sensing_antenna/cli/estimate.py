@@ -152,6 +152,9 @@ def summary(name: str, data: dict[str, Any]) -> str:
         f"  t_c, t_1, t_e   {_s(data['t_c'])}, {_s(data['t_1'])}, {_s(data['t_e'])}",
         f"  contact point   {point_text} (absolute frame)",
     ]
+    start = data.get("diagnostics", {}).get("window_start")
+    if start is not None and data["t_1"] is not None and start > data["t_1"]:
+        lines.append(f"  window from     {_s(start)} (the contact bounced after t_1)")
     interval = data.get("interval")
     if interval is not None:
         lines.append(f"  95 % interval   {_cm(interval[0])} to {_cm(interval[1])}")
