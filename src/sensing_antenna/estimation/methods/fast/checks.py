@@ -277,36 +277,43 @@ def other_fundamental(
     band: tuple[float, float],
     push_direction: NDArray[np.float64] | None,
     config: FastConfig,
-) -> tuple[float, str]:
-    """A second fundamental of the push plane in ``fit`` (rad/s) and the note; NaN and "" when
-    there is none.
+) -> tuple[float, float, str]:
+    """Two fundamentals of the push plane in ``fit``: the one the fundamental ``k`` is, or the
+    strongest, and the strongest other (rad/s), with the note; NaN, NaN and "" when the push
+    plane has one.
 
-    Held at one point, the link has one mode in the omega_1 band in the plane it is pushed in.
-    Another detected mode of that plane (:mod:`.planes`), in the band and farther from the
-    fundamental ``k`` than ``free_plane_margin`` (within which the two planes of one held
-    contact ring, and a mode between them may be counted in either), says the window holds
-    more than one contact state: a contact that bounces, or one that moved along the link.
-    Which of the two is the contact's cannot be told from the window.
+    Held at one point, the link has one mode in the omega_1 band in the plane it is pushed in
+    (its free plane's may ring apart from it, and ``k`` may be that one, :mod:`.planes`). Two
+    detected modes of the band that vibrate mostly in the push plane, farther apart than
+    ``push_plane_gap``, say the window holds more than one contact state: a contact that
+    bounces, or one that moved along the link. Which of them is the contact's cannot be told
+    from the window.
     """
     if push_direction is None:
-        return math.nan, ""
+        return math.nan, math.nan, ""
     share = free_plane_share(fit, push_direction)
-    omega = fit.omega
-    gap = config.free_plane_margin * float(omega[k])
-    other = (
+    detection = fit.detection()
+    pushed = np.flatnonzero(
         fit.in_band(band)
-        & (fit.detection() >= config.min_detection)
+        & (detection >= config.min_detection)
         & np.isfinite(fit.omega_se)
         & (share < 0.5)
-        & (np.abs(omega - omega[k]) > gap)
     )
-    if not other.any():
-        return math.nan, ""
-    strongest = int(np.flatnonzero(other)[np.argmax(fit.detection()[other])])
-    second = float(omega[strongest])
-    return second, (
-        f"the push plane rings at {float(omega[k]):.2f} and {second:.2f} rad/s, two "
-        f"fundamentals: the link was not held at one point over the window"
+    if pushed.size < 2:
+        return math.nan, math.nan, ""
+    reference = k if k in pushed else int(pushed[np.argmax(detection[pushed])])
+    omega = float(fit.omega[reference])
+    others = pushed[np.abs(fit.omega[pushed] - omega) > config.push_plane_gap * omega]
+    if others.size == 0:
+        return math.nan, math.nan, ""
+    second = float(fit.omega[others[np.argmax(detection[others])]])
+    return (
+        omega,
+        second,
+        (
+            f"the push plane rings at {omega:.2f} and {second:.2f} rad/s, two fundamentals: the "
+            f"link was not held at one point over the window"
+        ),
     )
 
 

@@ -84,6 +84,13 @@ class FastConfig:
         planes"): 0.07. A free-plane mode further above every detected push-plane mode of the
         band is another vibration, such as the free plane's own where friction does not hold
         the contact, and is not read even when it is the strongest.
+    push_plane_gap : float
+        Relative distance (dimensionless) beyond which two detected modes of the omega_1 band
+        that vibrate mostly in the push plane are two fundamentals: a link held at one point
+        has one such mode, so the window holds a contact that bounced or moved
+        (:func:`~.checks.other_fundamental`). 0.07, as ``free_plane_margin``: one held
+        contact's free and push planes ring within that of each other where it slides, and a
+        mode mixing them may be counted in the push plane.
     max_modes : int
         Largest number of damped modes tried (BIC chooses 1 .. max_modes). 3: the fundamental
         and the two strongest modes above it. The touch and the stop excite contact modes 2
@@ -225,6 +232,7 @@ class FastConfig:
     min_periods: float = 1.5
     min_detection: float = 10.0
     free_plane_margin: float = 0.07
+    push_plane_gap: float = 0.07
     max_modes: int = 3
     min_mode_fraction: float = 0.6
     polynomial_degree: int = 4

@@ -124,7 +124,7 @@ def evaluations(
 
     The grid is t_1 + :func:`~.evaluation_grid.evaluation_offsets`; evaluation starts at the
     first grid point at or after ``earliest`` and ends at the cap or at ``inputs.end_index``,
-    whichever comes first. Each window starts at t_1, or at ``hold_end`` when the contact opened
+    whichever comes first. Each window starts at t_1, or at ``hold_end`` when the link bounced
     (:func:`.window.evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are
     cached, so the drift check's shorter windows are fitted once; ``caches`` (windows from t_1,
     windows from the hold's end) are used and filled when given, else new ones (a cache never

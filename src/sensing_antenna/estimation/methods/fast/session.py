@@ -55,7 +55,7 @@ class FastSession:
         self._caches: tuple[FitCache, FitCache] = ({}, {})
         # Digest of each window asked, by its last index (for the evaluation count)
         self._asked: dict[int, bytes] = {}
-        # Whether an evaluation restarted its window at the end of the hold (an opening)
+        # Whether an evaluation restarted its window at the end of the hold (the link bounced)
         self._restarted = False
         # Windows (start, end, which cache) prepared, and the plan of those to prepare
         self._prepared: set[tuple[int, int, int]] = set()

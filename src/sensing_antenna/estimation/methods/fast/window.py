@@ -6,8 +6,9 @@ push when that fit stands, :func:`.checks.push_agrees`) and its static torque/fo
 (:mod:`.static_fit`), forms the posterior over x_c (:mod:`.likelihood`), lets the second
 contact mode choose between two branches (:mod:`.second_mode`) and runs the checks
 (:mod:`.checks`). :func:`evaluate_from_t1_or_hold` restarts the window at the end of the
-pipeline's hold when the contact opened; :func:`with_early_statics_of` adds the slip check's
-reference, the statics of the window's first half.
+pipeline's hold when the link bounced (the contact opened, or the push plane rang at two
+fundamentals); :func:`with_early_statics_of` adds the slip check's reference, the statics of
+the window's first half.
 """
 
 from __future__ import annotations
@@ -118,7 +119,8 @@ class WindowEstimate:
         ``checks_passed`` and the interval no wider than the tolerance, or ``settled``.
     checks_passed : bool
         True when every check but the interval's width passes (usable frequency, periods in
-        the window, drift, ratio agreement, contact closed, away from the top of the curve):
+        the window, drift, ratio agreement, contact closed, one fundamental in the push plane,
+        away from the top of the curve):
         ``sure`` at any tolerance at least the interval's width.
     note : str
         Why the frequency was not used or why it is not sure (empty when sure).
@@ -136,6 +138,10 @@ class WindowEstimate:
     opening : float
         Predicted vibration amplitude of the contact force over the static push at the window
         start (> 1: the contact opens); NaN when not computed.
+    fundamentals : tuple of float
+        The push plane's two fundamentals when the window rang at two (rad/s,
+        :func:`~.checks.other_fundamental`): the link was not held at one point over it. NaN,
+        NaN when it rang at one.
     branch_contradicted : bool
         True when a higher mode of the fit points to another branch than the posterior's.
     branch_chosen_by_second_mode : bool
@@ -170,7 +176,7 @@ class WindowEstimate:
     ratio_z: float = math.nan
     frequency_z: float = math.nan
     opening: float = math.nan
-    second_fundamental: float = math.nan
+    fundamentals: tuple[float, float] = (math.nan, math.nan)
     branch_contradicted: bool = False
     branch_chosen_by_second_mode: bool = False
     second_mode: dict[str, Any] = field(default_factory=dict)
@@ -246,9 +252,10 @@ def evaluate_window(
     omega1, omega1_se, omega1_crb = frequency.omega1, frequency.omega1_se, frequency.omega1_crb
     drift = frequency.drift
     notes = list(frequency.notes)
-    second_fundamental = math.nan
+    fundamentals = (math.nan, math.nan)
     if fit is not None and k is not None:
-        second_fundamental, note = other_fundamental(fit, k, band, direction, config)
+        first, second, note = other_fundamental(fit, k, band, direction, config)
+        fundamentals = (first, second)
         if note:
             notes.append(note)
     # The statics from the window from t_1 always: a fit through the push has its static part
@@ -405,7 +412,7 @@ def evaluate_window(
         ratio_z=ratio_z,
         frequency_z=frequency_z,
         opening=opening,
-        second_fundamental=second_fundamental,
+        fundamentals=fundamentals,
         branch_contradicted=bool(contradiction),
         branch_chosen_by_second_mode=chosen,
         second_mode=second_mode,
@@ -491,7 +498,32 @@ def _early_statics(
 def _held(window: WindowEstimate, config: FastConfig) -> bool:
     """Whether nothing in ``window`` says the link bounced on the obstacle: the contact force
     stays closed (``max_opening``) and the push plane has one fundamental."""
-    return not (window.opening > config.max_opening or math.isfinite(window.second_fundamental))
+    return not (window.opening > config.max_opening or math.isfinite(window.fundamentals[1]))
+
+
+def _resolving(
+    window: WindowEstimate, pair: tuple[float, float], sample_period: float
+) -> WindowEstimate:
+    """``window``, not sure when it is shorter than 2 pi / |omega_a - omega_b| (s), the time
+    that tells apart the two fundamentals ``pair`` (rad/s) of a window before it: in a shorter
+    one a single fitted mode may be the two read as one."""
+    needed = 2.0 * math.pi / abs(pair[0] - pair[1])
+    length = (window.end_index - window.start_index) * sample_period
+    if length >= needed or not (window.checks_passed or window.near_top):
+        return window
+    note = (
+        f"the window ({length:.2f} s) is too short to tell apart the push plane's two "
+        f"fundamentals of an earlier one, {pair[0]:.2f} and {pair[1]:.2f} rad/s "
+        f"({needed:.2f} s)"
+    )
+    return dataclasses.replace(
+        window,
+        sure=False,
+        checks_passed=False,
+        settled=False,
+        near_top=False,
+        note="; ".join(text for text in (window.note, note) if text),
+    )
 
 
 def evaluate_from_t1_or_hold(
@@ -502,19 +534,22 @@ def evaluate_from_t1_or_hold(
     with_early_statics: bool = True,
 ) -> WindowEstimate:
     """:func:`evaluate_window` on [t_1, ``inputs.end_index``]; from the end of the hold when the
-    contact opened.
+    link bounced.
 
     When the window from t_1 shows the contact opening (``max_opening``) or two fundamentals
     (``WindowEstimate.second_fundamental``), the link was bouncing on the obstacle early in the
     window; the window [hold_end, end_index] is evaluated instead once it is at least
     ``first_window`` long (before that the one from t_1 is returned, not sure), and while that
-    one still shows it, the window from a hold's length later, and so on.
+    one still shows it, the window from a hold's length later, and so on. A restarted window
+    after two fundamentals is sure only when it is long enough to tell them apart
+    (2 pi / their distance): one mode in a shorter one may be both.
     ``caches`` holds the fits of the windows from t_1 and of those restarted; None refits.
     ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
     gets the slip check's early statics (:func:`with_early_statics_of`).
     """
     early, late = caches if caches is not None else (None, None)
     window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
+    pair = window.fundamentals
     first = round(inputs.config.first_window / inputs.sample_period)
     start, step = hold_end, hold_end - inputs.rest_index
     while (
@@ -525,7 +560,10 @@ def evaluate_from_t1_or_hold(
             cache=late,
             choose_branch=choose_branch,
         )
+        pair = window.fundamentals if math.isfinite(window.fundamentals[1]) else pair
         start += step
+    if window.start_index != inputs.rest_index and math.isfinite(pair[1]):
+        window = _resolving(window, pair, inputs.sample_period)
     return with_early_statics_of(inputs, window, caches) if with_early_statics else window
 
 
