@@ -753,18 +753,27 @@ def _ringing(
 
 @pytest.mark.parametrize(
     ("other", "amplitude", "tau", "seed"),
-    [(0.74, 1.5, 0.15, 0), (0.70, 1.5, 0.15, 0), (0.70, 1.0, 2.0, 0), (0.70, 1.0, 2.0, 3)],
-    ids=["dies out, far", "dies out, near", "persists, seed 0", "persists, seed 3"],
+    [
+        (0.74, 1.5, 0.15, 0),
+        (0.68, 1.5, 0.15, 0),
+        (0.70, 1.5, 0.15, 1),
+        (0.70, 1.0, 2.0, 0),
+        (0.70, 1.0, 2.0, 3),
+    ],
+    ids=["dies out, 0.74 m", "dies out, 0.68 m", "dies out, 0.70 m", "persists, 0", "persists, 3"],
 )
 def test_two_fundamentals_in_the_push_plane_are_waited_out_or_not_answered(
     other: float, amplitude: float, tau: float, seed: int
 ) -> None:
     # A contact at 0.65 m, gently pushed (2.5 % deflection: the ratio's error is about 1.4 cm),
-    # with a ring at omega_1 of another contact point (0.70 or 0.74 m) on top from t_1 on,
-    # along the push, as a link bouncing on the obstacle rings: two fundamentals in the push
-    # plane, which one held contact cannot make. No window is declared at the ring's point.
-    # Where the ring dies out (0.15 s), the window restarts past it, long enough to have told
-    # the two apart, and answers at the contact; where it persists, the answer is not ok.
+    # with a ring at omega_1 of another contact point on top from t_1 on, along the push, as
+    # a link bouncing on the obstacle rings: two fundamentals in the push plane, which one
+    # held contact cannot make. Without the check, the rings at 0.68 m (seed 0), 0.70 m
+    # (seed 1) and the persisting ones were answered ok at the ring's point. No window is
+    # declared anywhere but at the contact (1 mm: four steps of the posterior's grid; the
+    # synthetic rings exactly on the sensing curve). A ring that dies out (0.15 s) is waited
+    # out: the answer is ok at the contact from a window started past it, or, where it rings
+    # until the cap, uncertain with the contact in its interval; a persisting one is never ok.
     x_c = 0.65
     plain = synthetic_recording(
         Synthetic(x_c=x_c, deflection_ratio=0.025, seed=seed, case="vertical")
@@ -777,18 +786,18 @@ def test_two_fundamentals_in_the_push_plane_are_waited_out_or_not_answered(
     ringing = _ringing(plain, first.t_1, float(CURVE.omega1(other)), amplitude, tau)
     history = FastMethod().history(_evidence(ringing))
     assert any(math.isfinite(w.fundamentals[1]) for w in history)
-    # 1 cm: half the distance between the two points, four times the answer's tolerance
-    assert not any(w.sure and abs(w.posterior.x_c - other) < 0.01 for w in history)
+    assert all(abs(w.posterior.x_c - x_c) < 1e-3 for w in history if w.sure)
     result = estimate(ringing, calibrated(), "fast")
-    if tau < 0.5:
-        assert result.status is Status.OK
-        assert abs(result.x_c - x_c) < 2.5e-3
-        assert result.interval[0] <= x_c <= result.interval[1]
+    if tau > 0.5:
+        assert result.status is not Status.OK
+    elif result.status is Status.OK:
+        assert abs(result.x_c - x_c) < 1e-3
         # the window it answers from starts past the ring, and the summary says so
         assert result.diagnostics["window_start"] > result.t_1
         assert "window from" in summary("ring.csv", result.to_dict())
     else:
-        assert result.status is not Status.OK
+        assert result.status is Status.UNCERTAIN
+        assert result.interval[0] <= x_c <= result.interval[1]
 
 
 def test_a_push_plane_ringing_apart_from_the_free_plane_is_one_held_contact() -> None:

@@ -279,15 +279,15 @@ def other_fundamental(
     config: FastConfig,
 ) -> tuple[float, float, str]:
     """Two fundamentals of the push plane in ``fit``: the one the fundamental ``k`` is, or the
-    strongest, and the strongest other (rad/s), with the note; NaN, NaN and "" when the push
+    strongest, and the nearest other (rad/s), with the note; NaN, NaN and "" when the push
     plane has one.
 
     Held at one point, the link has one mode in the omega_1 band in the plane it is pushed in
     (its free plane's may ring apart from it, and ``k`` may be that one, :mod:`.planes`). Two
-    detected modes of the band that vibrate mostly in the push plane, farther apart than
-    ``push_plane_gap``, say the window holds more than one contact state: a contact that
-    bounces, or one that moved along the link. Which of them is the contact's cannot be told
-    from the window.
+    detected modes of the band that vibrate mostly in the push plane, the other farther than
+    ``push_plane_gap`` from that one, say the window holds more than one contact state: a
+    contact that bounces, or one that moved along the link. Which of them is the contact's
+    cannot be told from the window.
     """
     if push_direction is None:
         return math.nan, math.nan, ""
@@ -306,7 +306,7 @@ def other_fundamental(
     others = pushed[np.abs(fit.omega[pushed] - omega) > config.push_plane_gap * omega]
     if others.size == 0:
         return math.nan, math.nan, ""
-    second = float(fit.omega[others[np.argmax(detection[others])]])
+    second = float(fit.omega[others[np.argmin(np.abs(fit.omega[others] - omega))]])
     return (
         omega,
         second,

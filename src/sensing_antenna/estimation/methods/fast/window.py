@@ -92,12 +92,13 @@ class ScanInputs(NamedTuple):
 
 @dataclass(frozen=True)
 class WindowEstimate:
-    """One evaluation of the growing window [t_s, t_j] (t_s: t_1, or the end of the hold).
+    """One evaluation of the growing window [t_s, t_j] (t_s: t_1, or later when the link bounced).
 
     Attributes
     ----------
     start_index : int
-        First sample of the window: t_1, or the end of the hold after an opening. A fit
+        First sample of the window: t_1, or, when the link bounced (the contact opened or the
+        push plane rang at two fundamentals), the end of the hold or a hold's length later. A fit
         through the push (``FastConfig.push_phase``) reaches back to t_c; its ``restart`` is
         then t_1's place in it.
     end_index : int
@@ -119,8 +120,9 @@ class WindowEstimate:
         ``checks_passed`` and the interval no wider than the tolerance, or ``settled``.
     checks_passed : bool
         True when every check but the interval's width passes (usable frequency, periods in
-        the window, drift, ratio agreement, contact closed, one fundamental in the push plane,
-        away from the top of the curve):
+        the window, drift, ratio agreement, contact closed, one fundamental in the push plane
+        and, started again after two, long enough to tell them apart, away from the top of the
+        curve):
         ``sure`` at any tolerance at least the interval's width.
     note : str
         Why the frequency was not used or why it is not sure (empty when sure).
@@ -501,6 +503,16 @@ def _held(window: WindowEstimate, config: FastConfig) -> bool:
     return not (window.opening > config.max_opening or math.isfinite(window.fundamentals[1]))
 
 
+def _closer(pair: tuple[float, float], other: tuple[float, float]) -> tuple[float, float]:
+    """Of two pairs of fundamentals (rad/s; NaN, NaN for none), the closer one: the one that
+    takes the longer window to tell apart."""
+    if not math.isfinite(other[1]):
+        return pair
+    if not math.isfinite(pair[1]):
+        return other
+    return pair if abs(pair[0] - pair[1]) <= abs(other[0] - other[1]) else other
+
+
 def _resolving(
     window: WindowEstimate, pair: tuple[float, float], sample_period: float
 ) -> WindowEstimate:
@@ -537,7 +549,7 @@ def evaluate_from_t1_or_hold(
     link bounced.
 
     When the window from t_1 shows the contact opening (``max_opening``) or two fundamentals
-    (``WindowEstimate.second_fundamental``), the link was bouncing on the obstacle early in the
+    (``WindowEstimate.fundamentals``), the link was bouncing on the obstacle early in the
     window; the window [hold_end, end_index] is evaluated instead once it is at least
     ``first_window`` long (before that the one from t_1 is returned, not sure), and while that
     one still shows it, the window from a hold's length later, and so on. A restarted window
@@ -560,7 +572,7 @@ def evaluate_from_t1_or_hold(
             cache=late,
             choose_branch=choose_branch,
         )
-        pair = window.fundamentals if math.isfinite(window.fundamentals[1]) else pair
+        pair = _closer(window.fundamentals, pair)
         start += step
     if window.start_index != inputs.rest_index and math.isfinite(pair[1]):
         window = _resolving(window, pair, inputs.sample_period)
