@@ -815,6 +815,7 @@ def test_a_push_plane_ringing_apart_from_the_free_plane_is_one_held_contact() ->
     ringing = _ringing(plain, first.t_1, 1.2 * float(CURVE.omega1(x_c)), 0.25, 1.3)
     assert all(math.isnan(w.fundamentals[1]) for w in FastMethod().history(_evidence(ringing)))
     result = estimate(ringing, calibrated(), "fast")
+    # 1 mm: four steps of the posterior's grid; the synthetic free plane rings on the curve
     assert result.status is Status.OK and abs(result.x_c - x_c) < 1e-3
     assert result.diagnostics["free_plane_share"] > 0.5
 

@@ -163,7 +163,7 @@ def conclude_fast(
             "axes_c_absolute": frame.axes_a,
             "theta_at_t1": frame.theta,
             "t_point": t_point,
-            # the window's first sample: t_1, or later where the contact bounced there
+            # the window's first sample: t_1, or later when the link bounced after t_1
             "window_start": float(t[final.start_index]),
             "note": final.note,
             "other_reasons": [text for _, text in found[1:]],
