@@ -76,7 +76,7 @@ from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
 from sensing_antenna.cli.arguments import integer  # noqa: E402
 from sensing_antenna.exploration import ExploreSettings, explore, prepare_device  # noqa: E402
-from sensing_antenna.exploration.run import swept_links  # noqa: E402
+from sensing_antenna.exploration.run import DEFAULT_BUILD, swept_links  # noqa: E402
 from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
 from sensing_antenna.mapping import PRIMITIVES, UNDECIDED, BasePose  # noqa: E402
 from sensing_antenna.mapping.contact_map import fit_surface  # noqa: E402
@@ -348,6 +348,8 @@ def run(
     workdir: Path,
     link: str = "nonlinear",
     until_recognised: int = 0,
+    device_profile: str = "nominal",
+    device_build: int = DEFAULT_BUILD,
 ) -> dict[str, Any]:
     out = workdir / f"{scene.name}-{strategy}"
     resumed = out.exists()
@@ -359,7 +361,15 @@ def run(
         scene,
         paper_antenna(),
         out,
-        ExploreSettings(method, strategy, seed=seed, link=link, until_recognised=until_recognised),
+        ExploreSettings(
+            method,
+            strategy,
+            seed=seed,
+            link=link,
+            until_recognised=until_recognised,
+            device_profile=device_profile,
+            device_build=device_build,
+        ),
     )
     elapsed = time.perf_counter() - start
     manoeuvres = result.manoeuvres
@@ -576,6 +586,15 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--link", choices=("nonlinear", "linear"), default="nonlinear")
     parser.add_argument(
+        "--device-profile",
+        choices=("nominal", "realistic"),
+        default="nominal",
+        help="the simulated device's imperfections (ExploreSettings.device_profile)",
+    )
+    parser.add_argument(
+        "--device-build", type=integer(0), default=DEFAULT_BUILD, help="its build seed"
+    )
+    parser.add_argument(
         "--sight", type=float, default=SIGHT, help="the raised and lowered bases' sight (rad)"
     )
     parser.add_argument(
@@ -606,7 +625,13 @@ def main() -> None:
         workdir = Path(folder) if args.keep is None else args.keep
         workdir.mkdir(parents=True, exist_ok=True)
         calibrated = workdir / "calibrated.toml"
-        calibrated.write_text(antenna_to_toml(prepare_device(device, link=args.link)))
+        prepared = prepare_device(
+            device,
+            link=args.link,
+            device_profile=args.device_profile,
+            device_build=args.device_build,
+        )
+        calibrated.write_text(antenna_to_toml(prepared))
         for index in range(args.first, args.first + args.scenes):
             scene, info = make_scene(
                 index, args.seed, args.sweeps, shape, args.bases, args.sight, args.distance
@@ -625,6 +650,8 @@ def main() -> None:
                         workdir,
                         args.link,
                         args.until_recognised,
+                        args.device_profile,
+                        args.device_build,
                     ),
                 }
                 rows.append(row)

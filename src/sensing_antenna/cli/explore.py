@@ -72,6 +72,23 @@ def register(subparsers: Any) -> None:
         default="nonlinear",
         help="the simulated link: geometrically exact (default) or small-deflection",
     )
+    parser.add_argument(
+        "--device-profile",
+        choices=("nominal", "realistic"),
+        default="nominal",
+        help=(
+            "the simulated device's imperfections, which the estimators are not told of: none "
+            "(default), or a realistic build (tip mass, clamp, taper, joint, sensor cross-talk, "
+            "drift, encoder zero; docs/simulator.md), calibrated first as a lab would"
+        ),
+    )
+    parser.add_argument(
+        "--device-build",
+        type=integer(0, 2**31 - 1),
+        default=2021,
+        metavar="N",
+        help="which realistic device (the seed of its build; default 2021, the default campaign's)",
+    )
     add_map_options(parser, "the map and the planner's surface")
     parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre")
     parser.set_defaults(func=_run)
@@ -95,6 +112,8 @@ def _run(args: argparse.Namespace) -> int:
         include_uncertain=args.include_uncertain,
         link=args.link,
         until_recognised=args.until_recognised,
+        device_profile=args.device_profile,
+        device_build=args.device_build,
     )
 
     def show(manoeuvre: Manoeuvre, most: int) -> None:

@@ -42,7 +42,7 @@ import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import trimesh
@@ -94,6 +94,7 @@ from sensing_antenna.recording import write_recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.simulate import simulate_sweep
 from sensing_antenna.scene.sweep import LinkShape, Sweep
+from sensing_antenna.simulator.device import DeviceImperfections, realistic_device
 from sensing_antenna.simulator.scenario import LINK_MODELS
 
 FloatArray = NDArray[np.float64]
@@ -148,6 +149,29 @@ RECOGNITION_EVERY = 4
 #: Methods the exploration offers (those that give an interval or a default sigma_x).
 EXPLORE_METHODS = ("paper", "fast")
 
+#: The sweeps of the calibration's posts.
+AZIMUTHAL: Literal["azimuthal"] = "azimuthal"
+VERTICAL: Literal["vertical"] = "vertical"
+
+#: The simulated devices an exploration offers (:class:`ExploreSettings`).
+DEVICE_PROFILES = ("nominal", "realistic")
+
+#: The realistic device explored by default: the default campaign's (its base seed), whose
+#: preparation the campaign's report shows.
+DEFAULT_BUILD = 2021
+
+#: Where a realistic device's calibration touches (m): the campaigns' points, each swept both
+#: ways (azimuthal and vertical), for T_e with the tip mass and the sensor's cross-talk.
+REALISTIC_CALIBRATION_POINTS = (
+    0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80, 0.85, 0.90, 0.95, 0.98
+)  # fmt: skip
+
+#: What the preparation of a realistic device does (stored with the settings).
+REALISTIC_PREPARATION = (
+    "observer identified on free sweeps, then T_e with the tip mass and the sensor's cross-talk"
+    " calibrated on smooth posts swept both ways"
+)
+
 
 @dataclass(frozen=True)
 class ExploreSettings:
@@ -167,6 +191,16 @@ class ExploreSettings:
         The simulated link (``Scenario.link_model``), of the calibration and of every sweep:
         the geometrically exact link (the default: a physical link shortens as it bends), or
         the small-deflection one.
+    device_profile : {"nominal", "realistic"}
+        The simulated device's imperfections, which the estimators are not told of: none (the
+        device file's own antenna), or one device of the realistic profile
+        (``simulator.realistic_device``: its build, tip mass, clamp, taper, joint, sensor gains
+        and coupling, drawn from ``device_build``; its set-up, the sensor's drift and the
+        encoders' zero, drawn anew for every simulated manoeuvre, the preparation's included).
+        A realistic device is prepared as the campaigns prepare theirs (:func:`prepare_device`).
+    device_build : int
+        The realistic device's build seed (which device of the profile): by default
+        :data:`DEFAULT_BUILD`.
     until_recognised : int
         After the budget (or the grid's last sweep, if sooner), while recognition abstains (or
         has too few points to answer), up to this many more manoeuvres, recognising before
@@ -182,6 +216,8 @@ class ExploreSettings:
     include_uncertain: bool = False
     link: str = "nonlinear"
     until_recognised: int = 0
+    device_profile: str = "nominal"
+    device_build: int = DEFAULT_BUILD
 
     def __post_init__(self) -> None:
         if self.method not in EXPLORE_METHODS:
@@ -194,6 +230,15 @@ class ExploreSettings:
             raise ValueError("until_recognised must be at least 0")
         if self.link not in LINK_MODELS:
             raise ValueError(f"link must be one of {', '.join(LINK_MODELS)}")
+        if self.device_profile not in DEVICE_PROFILES:
+            raise ValueError(f"device_profile must be one of {', '.join(DEVICE_PROFILES)}")
+
+    def imperfections(self, seed: int, length: float) -> DeviceImperfections:
+        """The simulated device's imperfections in the manoeuvre of seed ``seed`` (none on the
+        nominal device); ``length`` (m) is the link's, to place its joint."""
+        if self.device_profile == "nominal":
+            return DeviceImperfections()
+        return realistic_device(seed, length, build=self.device_build)
 
 
 class ExplorationInterrupted(KeyboardInterrupt):
@@ -257,7 +302,14 @@ class Exploration:
         }
 
 
-def prepare_device(device: Antenna, folder: Path | None = None, link: str = "nonlinear") -> Antenna:
+def prepare_device(
+    device: Antenna,
+    folder: Path | None = None,
+    link: str = "nonlinear",
+    *,
+    device_profile: str = "nominal",
+    device_build: int = DEFAULT_BUILD,
+) -> Antenna:
     """The preparation of the simulated ``device`` (module docstring), with the simulator's
     ``link`` model: the observer and contact threshold identified on :data:`FREE_MOTION_CASES`
     (seeds from :data:`FREE_MOTION_SEED`), then T_e calibrated on smooth posts
@@ -265,53 +317,109 @@ def prepare_device(device: Antenna, folder: Path | None = None, link: str = "non
     :data:`CALIBRATION_SEED`) touched by the device with that observer; every recording is
     written into ``folder`` when given.
 
+    A realistic device (``device_profile``, ``device_build`` as in :class:`ExploreSettings`)
+    is prepared as a campaign prepares its own: each recording simulated with the device's
+    imperfections of its seed, the posts at :data:`REALISTIC_CALIBRATION_POINTS` touched by an
+    azimuthal and by a vertical sweep, T_e fitted with the tip mass on the azimuthal ones
+    (``soft_l1`` loss) and the sensor's cross-talk on all (``calibration.sensor``; kept only
+    when it predicts recordings left out of its fit, else the model keeps no correction).
+
     Returns
     -------
     Antenna
-        ``device`` as the estimators know it: identified observer and payload, calibrated T_e.
+        ``device`` as the estimators know it: identified observer and payload, calibrated T_e
+        (and tip mass and sensor correction, for a realistic device).
     """
     from sensing_antenna.calibration.frequency import calibrate_from_recordings
     from sensing_antenna.calibration.observer import identify_free_motion
+    from sensing_antenna.calibration.sensor import SensorCalibrationError, calibrate_sensor
     from sensing_antenna.simulator import Scenario, simulate
 
+    profile = ExploreSettings(link=link, device_profile=device_profile, device_build=device_build)
+    length = device.link.length
     free = [
         simulate(
             device,
-            Scenario(case=case, seed=seed, duration=FREE_MOTION_DURATION, link_model=link),  # type: ignore[arg-type]
+            Scenario(
+                case=case,  # type: ignore[arg-type]
+                seed=seed,
+                duration=FREE_MOTION_DURATION,
+                link_model=link,  # type: ignore[arg-type]
+                device=profile.imperfections(seed, length),
+            ),
         )
         for seed, case in enumerate(FREE_MOTION_CASES, start=FREE_MOTION_SEED)
     ]
     model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
     controlled = knowing_weight(device, model)
+    realistic = device_profile != "nominal"
+    posts: list[tuple[Literal["azimuthal", "vertical"], float]] = (
+        [(AZIMUTHAL, x) for x in REALISTIC_CALIBRATION_POINTS]
+        + [(VERTICAL, x) for x in REALISTIC_CALIBRATION_POINTS]
+        if realistic
+        else [(AZIMUTHAL, x) for x in CALIBRATION_POINTS]
+    )
     runs = [
         simulate(
             controlled,
             Scenario(
-                case="azimuthal",
+                case=case,
                 contact_point=x,
                 seed=seed,
                 link_model=link,  # type: ignore[arg-type]
                 friction_coefficient=CALIBRATION_FRICTION,
+                device=profile.imperfections(seed, length),
             ),
         )
-        for seed, x in enumerate(CALIBRATION_POINTS, start=CALIBRATION_SEED)
+        for seed, (case, x) in enumerate(posts, start=CALIBRATION_SEED)
     ]
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
         for case, run in zip(FREE_MOTION_CASES, free, strict=True):
             write_recording(run, folder / f"{case}.csv")
-        for x, run in zip(CALIBRATION_POINTS, runs, strict=True):
-            write_recording(run, folder / f"post-{x:.2f}.csv")
+        for (case, x), run in zip(posts, runs, strict=True):
+            name = f"post-{x:.2f}.csv" if case == AZIMUTHAL else f"post-{x:.2f}-{case}.csv"
+            write_recording(run, folder / name)
     points = [float(run.metadata["true_xc"]) for run in runs]
-    return calibrate_from_recordings(runs, model, points).apply(model)
+    blind = [run.without_ground_truth() for run in runs]
+    if not realistic:
+        return calibrate_from_recordings(runs, model, points).apply(model)
+    own = [i for i, (case, _) in enumerate(posts) if case == AZIMUTHAL]
+    calibrated = calibrate_from_recordings(
+        [blind[i] for i in own], model, [points[i] for i in own], loss="soft_l1", fit_tip_mass=True
+    ).apply(model)
+    try:
+        sensor = calibrate_sensor(blind, calibrated, points)
+    except SensorCalibrationError:
+        return calibrated  # no direction with enough usable posts: no correction
+    return sensor.apply(calibrated)
 
 
-def _prepared(device: Antenna, out: Path, link: str) -> Antenna:
+def _device_settings(settings: ExploreSettings) -> dict[str, Any]:
+    """The stored settings of a realistic device (none for the nominal one, whose directories
+    predate the choice)."""
+    if settings.device_profile == "nominal":
+        return {}
+    return {
+        "device_profile": settings.device_profile,
+        "device_build": settings.device_build,
+        "preparation": REALISTIC_PREPARATION,
+    }
+
+
+def _prepared(device: Antenna, out: Path, settings: ExploreSettings) -> Antenna:
     path = out / CALIBRATED_FILE
     if path.is_file():
         # a directory prepared before the model had its own name: its recordings name it too
         return replace(load_antenna(path), name=CALIBRATED_NAME)
-    prepared = replace(prepare_device(device, out / "calibration", link), name=CALIBRATED_NAME)
+    prepared = prepare_device(
+        device,
+        out / "calibration",
+        settings.link,
+        device_profile=settings.device_profile,
+        device_build=settings.device_build,
+    )
+    prepared = replace(prepared, name=CALIBRATED_NAME)
     atomic_write_text(path, antenna_to_toml(prepared))
     return load_antenna(path)
 
@@ -422,14 +530,18 @@ def explore(
                 # what step 1 makes of the device: an older directory's antenna was calibrated
                 # only, its sweeps detected with the nominal observer
                 "preparation": PREPARATION,
+                **_device_settings(settings),
             },
         )
         scene.mesh.export(out / "scene.ply")
         manoeuvres = load_manoeuvres(out)
         _check_stored_sweeps(out, manoeuvres, scene, grid, settings.strategy)
         try:
-            antenna = _prepared(device, out, settings.link)
+            antenna = _prepared(device, out, settings)
+            # the planner knows the device file's link; the simulated link sags as built
             shape = LinkShape(device.link)
+            build = settings.imperfections(settings.seed, device.link.length)
+            built = LinkShape(device.link, device=build)
             controlled = knowing_weight(device, antenna)
             planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
             # the planner of the sweeps after the budget (next-best's own, or one made then)
@@ -478,7 +590,7 @@ def explore(
                 if choice is None:
                     break
                 manoeuvre = _run_one(
-                    scene, controlled, antenna, shape, choice, index, settings, out, aim
+                    scene, controlled, antenna, built, choice, index, settings, out, aim
                 )
                 write_manoeuvre(out, manoeuvre)
                 manoeuvres.append(manoeuvre)
@@ -596,7 +708,13 @@ def _run_one(
 
     seed = settings.seed + index
     outcome = simulate_sweep(
-        device, scene, choice.sweep, seed=seed, shape=shape, link_model=settings.link
+        device,
+        scene,
+        choice.sweep,
+        seed=seed,
+        shape=shape,
+        link_model=settings.link,
+        imperfections=settings.imperfections(seed, device.link.length),
     )
     recording_name = None
     point = None

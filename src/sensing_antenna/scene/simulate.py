@@ -70,6 +70,7 @@ from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.scene.touch import MAX_RADIUS, SweepGeometry, Touch, first_touch
 from sensing_antenna.simulator import Scenario
 from sensing_antenna.simulator.contact import motor_frame
+from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.run import (
     device_link,
     minimum_contact_point,
@@ -278,6 +279,7 @@ def simulate_sweep(
     sweep: Sweep,
     seed: int = 0,
     shape: LinkShape | None = None,
+    imperfections: DeviceImperfections | None = None,
     **scenario_fields: Any,
 ) -> SweepOutcome:
     """Run ``sweep`` of ``device`` in ``scene`` (module docstring).
@@ -291,7 +293,11 @@ def simulate_sweep(
     seed : int
         The scenario's seed (sensor noise).
     shape : LinkShape, optional
-        The link's sagged shape (built from ``device`` when None; pass one to reuse it).
+        The link's sagged shape (built from ``device`` and ``imperfections`` when None; pass
+        one to reuse it, built with the same imperfections' link).
+    imperfections : DeviceImperfections, optional
+        The simulated device's departures from ``device`` in this manoeuvre (the scenario's
+        ``device``); None: the nominal device.
     **scenario_fields
         Further :class:`~sensing_antenna.simulator.Scenario` fields (noise_scale, ...).
 
@@ -301,7 +307,9 @@ def simulate_sweep(
         ``shape`` is another link's (its radius or length not the device's): the geometric
         touch and the simulated one would not meet.
     """
-    shape = shape if shape is not None else LinkShape(device.link)
+    shape = shape if shape is not None else LinkShape(device.link, device=imperfections)
+    if imperfections is not None:
+        scenario_fields["device"] = imperfections
     for name in ("radius", "length"):
         if getattr(shape.link, name) != getattr(device.link, name):
             raise ValueError(

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.mapping.pose import BasePose
 from sensing_antenna.simulator.contact import motor_frame
+from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.link import build_link_model
 from sensing_antenna.simulator.run import device_link
 
@@ -152,6 +153,10 @@ class LinkShape:
         at 2 % of l).
     gravity : float
         g (m/s^2).
+    device : DeviceImperfections, optional
+        The simulated device's departures from ``link`` (``simulator.DeviceImperfections``):
+        its build (tip mass, clamp, taper, joint) sags the link as the simulator's does; its
+        sensor and encoders do not move it. None: the uniform, rigidly clamped link.
     """
 
     link: Link
@@ -159,6 +164,7 @@ class LinkShape:
     spacing: float = 0.002
     start_fraction: float = 0.02
     gravity: float = STANDARD_GRAVITY
+    device: DeviceImperfections | None = None
 
     @cached_property
     def abscissae(self) -> FloatArray:
@@ -169,7 +175,7 @@ class LinkShape:
 
     @cached_property
     def _unit_sag(self) -> tuple[FloatArray, FloatArray]:
-        model = build_link_model(device_link(self.link), self.n_elements)
+        model = build_link_model(device_link(self.link), self.n_elements, self.device)
         # K q = -1 * m_t: the deflection under a unit acceleration along -Z^m
         q = np.linalg.solve(model.stiffness, -model.translation_load)
         x = self.abscissae
