@@ -445,13 +445,15 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert np.allclose(truth.bounds, load_scene("post").mesh.bounds)
 
 
-def test_the_command_offers_the_librarys_strategies_and_scenes() -> None:
+def test_the_command_offers_the_librarys_strategies_scenes_and_devices() -> None:
     from sensing_antenna.cli import explore as command
     from sensing_antenna.exploration import STRATEGIES
     from sensing_antenna.scene import BUILTIN_SCENES
+    from sensing_antenna.simulator import DEVICE_PROFILES
 
     assert command.STRATEGIES == STRATEGIES
     assert command.BUILTIN_SCENES == BUILTIN_SCENES
+    assert command.DEVICE_PROFILES == DEVICE_PROFILES
 
 
 def test_antenna_explore_bad_scene_is_one_line(
@@ -474,6 +476,7 @@ def test_antenna_explore_bad_scene_is_one_line(
         ("--budget", "0", "must be an integer >= 1, got 0"),
         ("--seed", "-1", "must be an integer from 0 to 2147483647, got -1"),
         ("--seed", "1.5", "must be an integer from 0 to 2147483647, got '1.5'"),
+        ("--device-build", "-1", "must be an integer from 0 to 2147483647, got -1"),
     ],
 )
 def test_antenna_explore_bad_counts_are_one_line(
@@ -619,3 +622,77 @@ def test_a_ball_touched_from_above_and_below_is_not_a_torus_shrunk_round_it() ->
     torus = next(f for f in result.fits if f.name == "torus")
     assert torus.sizes["major_radius"] >= torus.sizes["minor_radius"]
     assert result.decision == "sphere" and result.rival is None
+
+
+@pytest.fixture(scope="module")
+def realistic(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[Manoeuvre]]:
+    out = tmp_path_factory.mktemp("explore") / "realistic"
+    settings = ExploreSettings(method="fast", budget=3, link="linear", device_profile="realistic")
+    return out, list(explore(load_scene("post"), DEVICE, out, settings).manoeuvres)
+
+
+def test_a_realistic_device_is_built_once_and_set_up_anew_for_every_manoeuvre(
+    realistic: tuple[Path, list[Manoeuvre]],
+) -> None:
+    # One device of the profile (its build: the default campaign's), whose sensor drift and
+    # encoder zero are drawn again for every manoeuvre, as a lab homes its head each time
+    from sensing_antenna.recording import read_recording
+    from sensing_antenna.simulator import realistic_device
+
+    out, manoeuvres = realistic
+    settings = json.loads((out / "settings.json").read_text())
+    assert (settings["device_profile"], settings["device_build"]) == ("realistic", 2021)
+    built = realistic_device(0, DEVICE.link.length, build=2021)
+    offsets = []
+    for m in manoeuvres:
+        assert m.recording is not None
+        meta = read_recording(out / m.recording).metadata
+        device = json.loads(meta["simulation"])["scenario"]["device"]
+        assert device["tip_mass"] == pytest.approx(built.tip_mass)
+        assert device["clamp_stiffness"] == pytest.approx(built.clamp_stiffness)
+        offsets.append(tuple(device["encoder_offset"]))
+    assert len(set(offsets)) == len(manoeuvres)
+
+
+def test_a_realistic_device_is_calibrated_with_its_payload_and_sensor(
+    realistic: tuple[Path, list[Manoeuvre]],
+) -> None:
+    # As the campaigns calibrate theirs: posts at 15 points swept both ways, T_e fitted with
+    # the tip mass the build carries (0.07 g; the fit's error on 15 points is a few percent)
+    # and the sensor's cross-talk, which leaks the torque into the force channels
+    from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.simulator import realistic_device
+
+    out, _ = realistic
+    posts = sorted(p.name for p in (out / "calibration").glob("post-*.csv"))
+    assert len(posts) == 30 and sum(name.endswith("-vertical.csv") for name in posts) == 15
+    prepared = load_antenna(out / "calibrated.toml")
+    built = realistic_device(0, DEVICE.link.length, build=2021)
+    assert prepared.link.tip_mass == pytest.approx(built.tip_mass, rel=0.25)
+    assert not prepared.sensor.is_identity
+
+
+def test_on_a_realistic_device_an_ok_point_is_where_the_link_touched(
+    realistic: tuple[Path, list[Manoeuvre]],
+) -> None:
+    # The estimators are not told of the imperfections: a point they call ok must still lie
+    # within three standard deviations of the surface point the link met
+    _, manoeuvres = realistic
+    touched = [m for m in manoeuvres if m.outcome == "touch"]
+    assert touched
+    for m in touched:
+        assert m.point is not None and m.touch is not None
+        if m.point.status.value == "ok":
+            error = np.linalg.norm(m.point.point - np.array(m.touch["surface_point"]))
+            assert error < 3.0 * m.point.std
+
+
+def test_another_device_in_the_same_directory_is_refused(
+    realistic: tuple[Path, list[Manoeuvre]],
+) -> None:
+    out, _ = realistic
+    nominal = ExploreSettings(method="fast", budget=3, link="linear")
+    with pytest.raises(ExplorationStoreError, match=r"settings.json: device_build, device_profile"):
+        explore(load_scene("post"), DEVICE, out, nominal)
+    with pytest.raises(ValueError, match="device_profile must be one of nominal, realistic"):
+        ExploreSettings(device_profile="worn")

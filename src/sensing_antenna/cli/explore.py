@@ -11,10 +11,12 @@ from typing import Any
 from sensing_antenna.cli.arguments import integer
 from sensing_antenna.cli.map import add_map_options
 
-#: ``exploration.plan.STRATEGIES`` and ``scene.file.BUILTIN_SCENES``, written out: importing
-#: them would load trimesh and scikit-learn for every command's start.
+#: ``exploration.plan.STRATEGIES``, ``scene.file.BUILTIN_SCENES`` and
+#: ``simulator.DEVICE_PROFILES``, written out: importing them would load trimesh and
+#: scikit-learn for every command's start.
 STRATEGIES = ("grid", "next-best")
 BUILTIN_SCENES = ("post", "sphere", "box", "cylinder")
+DEVICE_PROFILES = ("nominal", "realistic")
 
 
 def register(subparsers: Any) -> None:
@@ -74,7 +76,7 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--device-profile",
-        choices=("nominal", "realistic"),
+        choices=DEVICE_PROFILES,
         default="nominal",
         help=(
             "the simulated device's imperfections, which the estimators are not told of: none "

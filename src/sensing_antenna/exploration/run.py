@@ -94,7 +94,7 @@ from sensing_antenna.recording import write_recording
 from sensing_antenna.scene.file import Scene
 from sensing_antenna.scene.simulate import simulate_sweep
 from sensing_antenna.scene.sweep import LinkShape, Sweep
-from sensing_antenna.simulator.device import DeviceImperfections, realistic_device
+from sensing_antenna.simulator.device import DEVICE_PROFILES, DeviceImperfections, device_profile
 from sensing_antenna.simulator.scenario import LINK_MODELS
 
 FloatArray = NDArray[np.float64]
@@ -152,9 +152,6 @@ EXPLORE_METHODS = ("paper", "fast")
 #: The sweeps of the calibration's posts.
 AZIMUTHAL: Literal["azimuthal"] = "azimuthal"
 VERTICAL: Literal["vertical"] = "vertical"
-
-#: The simulated devices an exploration offers (:class:`ExploreSettings`).
-DEVICE_PROFILES = ("nominal", "realistic")
 
 #: The realistic device explored by default: the default campaign's (its base seed), whose
 #: preparation the campaign's report shows.
@@ -236,9 +233,7 @@ class ExploreSettings:
     def imperfections(self, seed: int, length: float) -> DeviceImperfections:
         """The simulated device's imperfections in the manoeuvre of seed ``seed`` (none on the
         nominal device); ``length`` (m) is the link's, to place its joint."""
-        if self.device_profile == "nominal":
-            return DeviceImperfections()
-        return realistic_device(seed, length, build=self.device_build)
+        return device_profile(self.device_profile, seed, length, self.device_build)
 
 
 class ExplorationInterrupted(KeyboardInterrupt):
