@@ -232,19 +232,29 @@ def calibrate_sensor(
         return np.array([getattr(SensorCorrection(), t) for t in names], dtype=float)
 
     def fitted(names: Sequence[str], keep: NDArray[np.bool_] | None = None) -> FloatArray:
-        start = identity(names)
         # within the limits a SensorCorrection accepts (gains in (0, 2), couplings to +-100)
         gain = [t.endswith("_gain") for t in names]
         low = np.where(gain, 1.0 - 0.99 * MAX_SENSOR_GAIN_ERROR, -MAX_SENSOR_COUPLING)
         high = np.where(gain, 1.0 + 0.99 * MAX_SENSOR_GAIN_ERROR, MAX_SENSOR_COUPLING)
-        found = least_squares(
-            lambda params: residuals(params, names, keep),
-            start,
-            bounds=(low, high),
-            loss="soft_l1",
-            f_scale=_LOSS_SCALE,
+        chosen = rows if keep is None else rows[keep]
+        linear = _linear_start(
+            names, reaction[chosen], moment[chosen], points[chosen], lateral[chosen]
         )
-        return np.asarray(found.x, dtype=float)
+        # from no correction and from the linear statics' solution: a cross-talk that nearly
+        # cancels the force near the tip puts the ratio several times off there, and from no
+        # correction the loss can fall more by shrinking every ratio than by undoing it
+        best: Any = None
+        for start in (identity(names), np.clip(linear, low, high)):
+            found = least_squares(
+                lambda params: residuals(params, names, keep),
+                start,
+                bounds=(low, high),
+                loss="soft_l1",
+                f_scale=_LOSS_SCALE,
+            )
+            if best is None or found.cost < best.cost:
+                best = found
+        return np.asarray(best.x, dtype=float)
 
     before = residuals(identity(terms), terms)[: len(holds)]
     params = fitted(terms)
@@ -277,6 +287,48 @@ def calibrate_sensor(
         ratio_rms_held_out=_rms(held_out),
         adopted=adopted,
     )
+
+
+def _linear_start(
+    names: Sequence[str],
+    reaction: FloatArray,
+    moment: FloatArray,
+    points: FloatArray,
+    lateral: NDArray[np.int_],
+) -> FloatArray:
+    """The terms ``names`` that the small-deflection statics give in closed form, shape
+    (len(names),): each push's corrected force along its sweep equal to its moment over its
+    known x_c (R_y' = Gamma_z / x_i for an azimuthal sweep, R_z' = -Gamma_y / x_i for a vertical
+    one, the signs of ``perpendicular_ratio``'s moment in the bending plane) and its force
+    across the sweep zero, each a linear least-squares fit of its own terms, twice round (the
+    planes share small cross terms)."""
+    current = dict(zip(names, (getattr(SensorCorrection(), t) for t in names), strict=True))
+
+    def term(name: str) -> float:
+        return current.get(name, getattr(SensorCorrection(), name))
+
+    for _ in range(2):
+        for sweep, (gain, along, across) in _PLANE_TERMS.items():
+            if gain not in current:
+                continue
+            rows = lateral == (1 if sweep == "azimuthal" else 2)
+            a, m = (1, 2) if sweep == "azimuthal" else (2, 1)  # force along, moment's axis
+            r, g = reaction[rows], moment[rows]
+            # along: gain R_a + along Gamma_m + (the other plane's term) Gamma_a = target
+            other = f"f{'yz'[a - 1]}_per_t{'yz'[a - 1]}"
+            target = (1.0 if a == 1 else -1.0) * g[:, m] / points[rows] - term(other) * g[:, a]
+            solution, *_ = np.linalg.lstsq(np.column_stack([r[:, a], g[:, m]]), target)
+            current[gain], current[along] = (float(v) for v in solution)
+            # across: the other force's gain R_b + its other term Gamma_a + across Gamma_m = 0
+            b = 3 - a
+            rest = (
+                term(f"f{'yz'[b - 1]}_gain") * r[:, b]
+                + term(other.replace(f"f{'yz'[a - 1]}", f"f{'yz'[b - 1]}")) * g[:, a]
+            )
+            denominator = float(g[:, m] @ g[:, m])
+            if denominator > 0.0:
+                current[across] = -float(rest @ g[:, m]) / denominator
+    return np.array([current[t] for t in names], dtype=float)
 
 
 def _terms(sweeps: Sequence[str]) -> list[str]:
