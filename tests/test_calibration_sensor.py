@@ -242,3 +242,6 @@ def test_a_leak_that_nearly_cancels_the_push_near_the_tip_is_undone() -> None:
     # within 15 %, as above
     assert fit.correction.fy_per_tz == pytest.approx(0.96, rel=0.15)
     assert fit.correction.fz_per_ty == pytest.approx(-1.31, rel=0.15)
+    # and the cross-plane terms, from the pushes' directions
+    assert fit.correction.fy_per_ty == pytest.approx(0.90, rel=0.15)
+    assert fit.correction.fz_per_tz == pytest.approx(0.28, rel=0.15)

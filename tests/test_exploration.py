@@ -336,6 +336,16 @@ def test_a_stored_sweep_with_a_bad_direction_names_file_and_field(tmp_path: Path
         explore(load_scene("post"), DEVICE, out, ExploreSettings(method="paper", budget=1))
 
 
+def test_a_nominal_explorations_settings_are_those_of_older_directories(
+    explored: tuple[Path, list[Manoeuvre]],
+) -> None:
+    # the device's profile and build are stored for a realistic device only, so that
+    # directories explored before the choice existed resume
+    out, _ = explored
+    settings = json.loads((out / "settings.json").read_text())
+    assert not {"device_profile", "device_build"} & set(settings)
+
+
 def test_other_settings_in_the_same_directory_are_refused(
     explored: tuple[Path, list[Manoeuvre]],
 ) -> None:
@@ -448,12 +458,14 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
 def test_the_command_offers_the_librarys_strategies_scenes_and_devices() -> None:
     from sensing_antenna.cli import explore as command
     from sensing_antenna.exploration import STRATEGIES
+    from sensing_antenna.exploration.run import DEFAULT_BUILD
     from sensing_antenna.scene import BUILTIN_SCENES
     from sensing_antenna.simulator import DEVICE_PROFILES
 
     assert command.STRATEGIES == STRATEGIES
     assert command.BUILTIN_SCENES == BUILTIN_SCENES
     assert command.DEVICE_PROFILES == DEVICE_PROFILES
+    assert command.DEFAULT_BUILD == DEFAULT_BUILD
 
 
 def test_antenna_explore_bad_scene_is_one_line(
@@ -487,6 +499,19 @@ def test_antenna_explore_bad_counts_are_one_line(
     assert caught.value.code == 2
     err = capsys.readouterr().err.strip()
     assert err == f"antenna explore: error: {option}: {problem}"
+
+
+def test_a_build_without_the_realistic_profile_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "x"
+    assert main(["explore", "post", "--out", str(out), "--device-build", "5"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "antenna explore: error: --device-build: a realistic device's build: give"
+        " --device-profile realistic too"
+    )
+    assert not out.exists()
 
 
 def test_stored_sweeps_this_grid_would_not_make_are_refused(
@@ -635,7 +660,8 @@ def test_a_realistic_device_is_built_once_and_set_up_anew_for_every_manoeuvre(
     realistic: tuple[Path, list[Manoeuvre]],
 ) -> None:
     # One device of the profile (its build: the default campaign's), whose sensor drift and
-    # encoder zero are drawn again for every manoeuvre, as a lab homes its head each time
+    # encoder zero are drawn again for every manoeuvre, the preparation's included, as a lab
+    # homes its head each time
     from sensing_antenna.recording import read_recording
     from sensing_antenna.simulator import realistic_device
 
@@ -643,15 +669,19 @@ def test_a_realistic_device_is_built_once_and_set_up_anew_for_every_manoeuvre(
     settings = json.loads((out / "settings.json").read_text())
     assert (settings["device_profile"], settings["device_build"]) == ("realistic", 2021)
     built = realistic_device(0, DEVICE.link.length, build=2021)
-    offsets = []
-    for m in manoeuvres:
-        assert m.recording is not None
-        meta = read_recording(out / m.recording).metadata
-        device = json.loads(meta["simulation"])["scenario"]["device"]
+    paths = [out / m.recording for m in manoeuvres if m.recording is not None]
+    paths += sorted((out / "calibration").glob("*.csv"))
+    assert len(paths) == len(manoeuvres) + 32
+    offsets, seeds = [], []
+    for path in paths:
+        meta = read_recording(path).metadata
+        scenario = json.loads(meta["simulation"])["scenario"]
+        device = scenario["device"]
         assert device["tip_mass"] == pytest.approx(built.tip_mass)
         assert device["clamp_stiffness"] == pytest.approx(built.clamp_stiffness)
         offsets.append(tuple(device["encoder_offset"]))
-    assert len(set(offsets)) == len(manoeuvres)
+        seeds.append(scenario["seed"])
+    assert len(set(offsets)) == len(paths) and len(set(seeds)) == len(paths)
 
 
 def test_a_realistic_device_is_calibrated_with_its_payload_and_sensor(
@@ -670,6 +700,9 @@ def test_a_realistic_device_is_calibrated_with_its_payload_and_sensor(
     built = realistic_device(0, DEVICE.link.length, build=2021)
     assert prepared.link.tip_mass == pytest.approx(built.tip_mass, rel=0.25)
     assert not prepared.sensor.is_identity
+    # what the sensor's fit found is kept beside its posts
+    summary = (out / "calibration" / "sensor.txt").read_text()
+    assert "torque/force ratio against the known points" in summary
 
 
 def test_on_a_realistic_device_an_ok_point_is_where_the_link_touched(
@@ -679,7 +712,7 @@ def test_on_a_realistic_device_an_ok_point_is_where_the_link_touched(
     # within three standard deviations of the surface point the link met
     _, manoeuvres = realistic
     touched = [m for m in manoeuvres if m.outcome == "touch"]
-    assert touched
+    assert any(m.point is not None and m.point.status.value == "ok" for m in touched)
     for m in touched:
         assert m.point is not None and m.touch is not None
         if m.point.status.value == "ok":
@@ -696,3 +729,8 @@ def test_another_device_in_the_same_directory_is_refused(
         explore(load_scene("post"), DEVICE, out, nominal)
     with pytest.raises(ValueError, match="device_profile must be one of nominal, realistic"):
         ExploreSettings(device_profile="worn")
+    for build in (-1, 1.5, True, "7"):
+        with pytest.raises(ValueError, match="device_build must be an integer >= 0"):
+            ExploreSettings(device_profile="realistic", device_build=build)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="not used with the nominal one"):
+        ExploreSettings(device_build=5)

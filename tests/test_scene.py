@@ -719,32 +719,28 @@ def test_a_built_device_touches_where_its_own_sagged_link_meets_the_object(
     link_model: str,
 ) -> None:
     # A device whose tip carries 0.5 g and whose clamp gives (30 N m/rad) sags a centimetre
-    # more at 0.74 m: swept with that shape, the simulated contact starts where the geometric
-    # touch met the ball (within one sample's travel and the penalty contact's penetration,
-    # a few tenths of a millimetre); with the uniform link's shape it starts a centimetre away.
+    # more at 0.74 m: its sweep's simulated contact starts where the geometric touch of its
+    # own sagged link met the ball (within one sample's travel and the penalty contact's
+    # penetration, a few tenths of a millimetre), a centimetre from where the uniform link's
+    # would have met it
     from sensing_antenna.simulator import DeviceImperfections
 
     device = DeviceImperfections(tip_mass=0.5e-3, clamp_stiffness=30.0)
-    ball = primitive_object("ball", "sphere", [0.05], [0.7, 0.25, -0.05])
+    scene = _scene(primitive_object("ball", "sphere", [0.05], [0.7, 0.25, -0.05]))
     sweep = Sweep(0, "azimuthal", 0.0, -0.2, 0.8)
-    gaps = []
-    for shape in (LinkShape(DEVICE.link, device=device), LinkShape(DEVICE.link)):
-        outcome = simulate_sweep(
-            DEVICE,
-            _scene(ball),
-            sweep,
-            seed=3,
-            shape=shape,
-            imperfections=device,
-            link_model=link_model,
-        )
-        recording, frame, touch = outcome.recording, outcome.frame, outcome.touch
-        assert recording is not None and frame is not None and touch is not None
-        assert json.loads(recording.metadata["simulation"])["scenario"]["device"]["tip_mass"] == (
-            pytest.approx(0.5e-3)
-        )
-        touching = np.flatnonzero(recording.extra[IN_CONTACT_COLUMN] > 0.5)
-        track = np.column_stack([recording.extra[name] for name in CONTACT_POINT_COLUMNS])
-        start = frame.point_to_world(track[touching[:1]])[0]
-        gaps.append(float(np.linalg.norm(start - touch.surface_point)))
-    assert gaps[0] < 5e-4 and gaps[1] > 5e-3, gaps
+    outcome = simulate_sweep(
+        DEVICE, scene, sweep, seed=3, imperfections=device, link_model=link_model
+    )
+    recording, frame, touch = outcome.recording, outcome.frame, outcome.touch
+    assert recording is not None and frame is not None and touch is not None
+    simulated = json.loads(recording.metadata["simulation"])["scenario"]["device"]
+    assert simulated["tip_mass"] == pytest.approx(0.5e-3)
+    touching = np.flatnonzero(recording.extra[IN_CONTACT_COLUMN] > 0.5)
+    track = np.column_stack([recording.extra[name] for name in CONTACT_POINT_COLUMNS])
+    start = frame.point_to_world(track[touching[:1]])[0]
+    assert np.linalg.norm(start - touch.surface_point) < 5e-4
+    uniform = first_touch(scene, sweep, LinkShape(DEVICE.link)).touch
+    assert uniform is not None and np.linalg.norm(start - uniform.surface_point) > 5e-3
+    # a shape of another build is refused: the two touches would not meet
+    with pytest.raises(ValueError, match="not the device's as built"):
+        simulate_sweep(DEVICE, scene, sweep, shape=LinkShape(DEVICE.link), imperfections=device)

@@ -301,7 +301,8 @@ def _linear_start(
     known x_c (R_y' = Gamma_z / x_i for an azimuthal sweep, R_z' = -Gamma_y / x_i for a vertical
     one, the signs of ``perpendicular_ratio``'s moment in the bending plane) and its force
     across the sweep zero, each a linear least-squares fit of its own terms, twice round (the
-    planes share small cross terms)."""
+    planes share small cross terms). Each push's along-sweep equation is weighted by x_i over
+    its moment, so that it counts by its relative ratio error, as the fit does."""
     current = dict(zip(names, (getattr(SensorCorrection(), t) for t in names), strict=True))
 
     def term(name: str) -> float:
@@ -317,7 +318,10 @@ def _linear_start(
             # along: gain R_a + along Gamma_m + (the other plane's term) Gamma_a = target
             other = f"f{'yz'[a - 1]}_per_t{'yz'[a - 1]}"
             target = (1.0 if a == 1 else -1.0) * g[:, m] / points[rows] - term(other) * g[:, a]
-            solution, *_ = np.linalg.lstsq(np.column_stack([r[:, a], g[:, m]]), target)
+            with np.errstate(divide="ignore"):
+                weight = np.where(g[:, m] != 0.0, points[rows] / np.abs(g[:, m]), 0.0)
+            design = np.column_stack([r[:, a], g[:, m]]) * weight[:, None]
+            solution, *_ = np.linalg.lstsq(design, target * weight, rcond=None)
             current[gain], current[along] = (float(v) for v in solution)
             # across: the other force's gain R_b + its other term Gamma_a + across Gamma_m = 0
             b = 3 - a

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.cli.arguments import integer
+from sensing_antenna.cli.arguments import ArgumentError, integer
 from sensing_antenna.cli.map import add_map_options
 
 #: ``exploration.plan.STRATEGIES``, ``scene.file.BUILTIN_SCENES`` and
@@ -17,6 +17,8 @@ from sensing_antenna.cli.map import add_map_options
 STRATEGIES = ("grid", "next-best")
 BUILTIN_SCENES = ("post", "sphere", "box", "cylinder")
 DEVICE_PROFILES = ("nominal", "realistic")
+#: ``exploration.run.DEFAULT_BUILD``, written out for the same reason.
+DEFAULT_BUILD = 2021
 
 
 def register(subparsers: Any) -> None:
@@ -87,9 +89,12 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--device-build",
         type=integer(0, 2**31 - 1),
-        default=2021,
+        default=DEFAULT_BUILD,
         metavar="N",
-        help="which realistic device (the seed of its build; default 2021, the default campaign's)",
+        help=(
+            f"which realistic device (the seed of its build; default {DEFAULT_BUILD}, the "
+            "default campaign's)"
+        ),
     )
     add_map_options(parser, "the map and the planner's surface")
     parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre")
@@ -103,6 +108,10 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.scene import load_scene
     from sensing_antenna.scene.objects import read_mesh
 
+    if args.device_profile == "nominal" and args.device_build != DEFAULT_BUILD:
+        raise ArgumentError(
+            "--device-build", "a realistic device's build: give --device-profile realistic too"
+        )
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)
     meshes = {path.stem: read_mesh(path) for path in args.objects}
@@ -133,7 +142,9 @@ def _run(args: argparse.Namespace) -> int:
     print(
         f"exploring scene {scene.name} ({len(scene.objects)} objects, {len(scene.bases)} base"
         f" poses) with the {args.method} method, {args.strategy} strategy; the first start"
-        " prepares the simulated device (identifies its observer, calibrates T_e)",
+        " prepares the simulated device (identifies its observer, calibrates T_e"
+        + (", its tip mass and sensor" if args.device_profile == "realistic" else "")
+        + ")",
         file=sys.stderr,
     )
     result = explore(scene, device, args.out, settings, None if args.quiet else show, meshes)

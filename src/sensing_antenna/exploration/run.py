@@ -6,10 +6,11 @@ retract, re-plan), on the simulator:
 1. **Prepare** (once per output directory), as a lab prepares its device before it measures
    (docs/real-antenna.md): the free-motion observer (Eq. 15) and contact threshold identified
    on a free sweep of each joint (``identify_free_motion``), then five sweeps into smooth posts
-   at known x_c (0.3 to 0.9 m) and ``calibrate_from_recordings``; the identified and
-   calibrated antenna is written to ``calibrated.toml``. The estimators use it; the simulated
-   device keeps its own link and takes the identified observer and threshold for its
-   controller, as a lab's head does (``campaign.simulated.knowing_weight``). The simulated
+   at known x_c (0.3 to 0.9 m) and ``calibrate_from_recordings`` (a realistic device: 15 posts
+   swept both ways, T_e with the tip mass and the sensor's cross-talk, :func:`prepare_device`);
+   the identified and calibrated antenna is written to ``calibrated.toml``. The estimators use
+   it; the simulated device keeps its own link and takes the identified observer and threshold
+   for its controller, as a lab's head does (``campaign.simulated.knowing_weight``). The simulated
    link is the settings' ``link``, the geometrically exact one by default, for the
    preparation and every sweep alike.
 2. **Each manoeuvre**: the planner (``exploration.plan``: ``grid`` or ``next-best``) picks a
@@ -49,6 +50,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
+from sensing_antenna.campaign.runs import CALIBRATION_STREAM, FREE_MOTION_STREAM, derive_seed
 from sensing_antenna.campaign.simulated import knowing_weight
 from sensing_antenna.campaign.store import atomic_write_text
 from sensing_antenna.errors import raise_if_signalled
@@ -153,8 +155,8 @@ EXPLORE_METHODS = ("paper", "fast")
 AZIMUTHAL: Literal["azimuthal"] = "azimuthal"
 VERTICAL: Literal["vertical"] = "vertical"
 
-#: The realistic device explored by default: the default campaign's (its base seed), whose
-#: preparation the campaign's report shows.
+#: The realistic device explored by default: the default campaign's build (its base seed: the
+#: same draw of imperfections, on the device file's link).
 DEFAULT_BUILD = 2021
 
 #: Where a realistic device's calibration touches (m): the campaigns' points, each swept both
@@ -229,6 +231,11 @@ class ExploreSettings:
             raise ValueError(f"link must be one of {', '.join(LINK_MODELS)}")
         if self.device_profile not in DEVICE_PROFILES:
             raise ValueError(f"device_profile must be one of {', '.join(DEVICE_PROFILES)}")
+        build = self.device_build
+        if isinstance(build, bool) or not isinstance(build, int) or build < 0:
+            raise ValueError(f"device_build must be an integer >= 0 (a seed), got {build!r}")
+        if self.device_profile == "nominal" and build != DEFAULT_BUILD:
+            raise ValueError("device_build is a realistic device's: not used with the nominal one")
 
     def imperfections(self, seed: int, length: float) -> DeviceImperfections:
         """The simulated device's imperfections in the manoeuvre of seed ``seed`` (none on the
@@ -313,11 +320,13 @@ def prepare_device(
     written into ``folder`` when given.
 
     A realistic device (``device_profile``, ``device_build`` as in :class:`ExploreSettings`)
-    is prepared as a campaign prepares its own: each recording simulated with the device's
-    imperfections of its seed, the posts at :data:`REALISTIC_CALIBRATION_POINTS` touched by an
-    azimuthal and by a vertical sweep, T_e fitted with the tip mass on the azimuthal ones
-    (``soft_l1`` loss) and the sensor's cross-talk on all (``calibration.sensor``; kept only
-    when it predicts recordings left out of its fit, else the model keeps no correction).
+    is prepared as a campaign prepares its own: each recording with a seed of its own (the
+    campaigns' free-motion and calibration streams of the build, so that no sweep shares its
+    set-up or noise), the posts at :data:`REALISTIC_CALIBRATION_POINTS` touched by an azimuthal
+    and by a vertical sweep, their planned x_c the known points, T_e fitted with the tip mass
+    on the azimuthal ones (``soft_l1`` loss) and the sensor's cross-talk on all
+    (``calibration.sensor``; kept only when it predicts posts left out of its fit), what the
+    sensor's fit found written to ``folder/sensor.txt``.
 
     Returns
     -------
@@ -331,43 +340,43 @@ def prepare_device(
     from sensing_antenna.simulator import Scenario, simulate
 
     profile = ExploreSettings(link=link, device_profile=device_profile, device_build=device_build)
+    realistic = device_profile != "nominal"
     length = device.link.length
-    free = [
-        simulate(
-            device,
-            Scenario(
-                case=case,  # type: ignore[arg-type]
-                seed=seed,
-                duration=FREE_MOTION_DURATION,
-                link_model=link,  # type: ignore[arg-type]
-                device=profile.imperfections(seed, length),
-            ),
+
+    def seed_of(index: int, stream: int, first: int) -> int:
+        return derive_seed(device_build, index, stream) if realistic else first + index
+
+    free = []
+    for k, case in enumerate(FREE_MOTION_CASES):
+        seed = seed_of(k, FREE_MOTION_STREAM, FREE_MOTION_SEED)
+        scenario = Scenario(
+            case=case,  # type: ignore[arg-type]
+            seed=seed,
+            duration=FREE_MOTION_DURATION,
+            link_model=link,  # type: ignore[arg-type]
+            device=profile.imperfections(seed, length),
         )
-        for seed, case in enumerate(FREE_MOTION_CASES, start=FREE_MOTION_SEED)
-    ]
+        free.append(simulate(device, scenario))
     model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
     controlled = knowing_weight(device, model)
-    realistic = device_profile != "nominal"
     posts: list[tuple[Literal["azimuthal", "vertical"], float]] = (
         [(AZIMUTHAL, x) for x in REALISTIC_CALIBRATION_POINTS]
         + [(VERTICAL, x) for x in REALISTIC_CALIBRATION_POINTS]
         if realistic
         else [(AZIMUTHAL, x) for x in CALIBRATION_POINTS]
     )
-    runs = [
-        simulate(
-            controlled,
-            Scenario(
-                case=case,
-                contact_point=x,
-                seed=seed,
-                link_model=link,  # type: ignore[arg-type]
-                friction_coefficient=CALIBRATION_FRICTION,
-                device=profile.imperfections(seed, length),
-            ),
+    runs = []
+    for k, (case, x) in enumerate(posts):
+        seed = seed_of(k, CALIBRATION_STREAM, CALIBRATION_SEED)
+        scenario = Scenario(
+            case=case,
+            contact_point=x,
+            seed=seed,
+            link_model=link,  # type: ignore[arg-type]
+            friction_coefficient=CALIBRATION_FRICTION,
+            device=profile.imperfections(seed, length),
         )
-        for seed, (case, x) in enumerate(posts, start=CALIBRATION_SEED)
-    ]
+        runs.append(simulate(controlled, scenario))
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
         for case, run in zip(FREE_MOTION_CASES, free, strict=True):
@@ -375,19 +384,24 @@ def prepare_device(
         for (case, x), run in zip(posts, runs, strict=True):
             name = f"post-{x:.2f}.csv" if case == AZIMUTHAL else f"post-{x:.2f}-{case}.csv"
             write_recording(run, folder / name)
-    points = [float(run.metadata["true_xc"]) for run in runs]
-    blind = [run.without_ground_truth() for run in runs]
     if not realistic:
+        points = [float(run.metadata["true_xc"]) for run in runs]
         return calibrate_from_recordings(runs, model, points).apply(model)
+    blind = [run.without_ground_truth() for run in runs]
+    planned = [x for _, x in posts]
     own = [i for i, (case, _) in enumerate(posts) if case == AZIMUTHAL]
     calibrated = calibrate_from_recordings(
-        [blind[i] for i in own], model, [points[i] for i in own], loss="soft_l1", fit_tip_mass=True
+        [blind[i] for i in own], model, [planned[i] for i in own], loss="soft_l1", fit_tip_mass=True
     ).apply(model)
     try:
-        sensor = calibrate_sensor(blind, calibrated, points)
-    except SensorCalibrationError:
-        return calibrated  # no direction with enough usable posts: no correction
-    return sensor.apply(calibrated)
+        sensor = calibrate_sensor(blind, calibrated, planned)
+    except SensorCalibrationError as exc:
+        summary, prepared = f"the sensor is not calibrated: {exc}", calibrated
+    else:
+        summary, prepared = sensor.ratio_summary, sensor.apply(calibrated)
+    if folder is not None:
+        atomic_write_text(folder / "sensor.txt", summary + "\n")
+    return prepared
 
 
 def _device_settings(settings: ExploreSettings) -> dict[str, Any]:

@@ -304,12 +304,18 @@ def simulate_sweep(
     Raises
     ------
     ValueError
-        ``shape`` is another link's (its radius or length not the device's): the geometric
-        touch and the simulated one would not meet.
+        ``shape`` is another link's (its radius or length not the device's, or its build not
+        ``imperfections``'): the geometric touch and the simulated one would not meet.
     """
     shape = shape if shape is not None else LinkShape(device.link, device=imperfections)
     if imperfections is not None:
         scenario_fields["device"] = imperfections
+    built = None if shape.device is None else shape.device.link_part
+    if built != (None if imperfections is None else imperfections.link_part):
+        raise ValueError(
+            "simulate_sweep: the shape's link is not the device's as built (its tip mass, clamp,"
+            " taper or joint): the geometric touch and the simulated one would not meet"
+        )
     for name in ("radius", "length"):
         if getattr(shape.link, name) != getattr(device.link, name):
             raise ValueError(

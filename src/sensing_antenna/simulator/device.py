@@ -198,6 +198,23 @@ class DeviceImperfections:
             )
         )
 
+    @property
+    def link_part(self) -> DeviceImperfections | None:
+        """The part the link's model depends on (tip mass, clamp, taper, joint), or None when
+        that is nominal: devices whose sensor and encoders alone differ share it."""
+        if self.link_is_nominal:
+            return None
+        return DeviceImperfections(
+            tip_mass=self.tip_mass,
+            clamp_stiffness=self.clamp_stiffness,
+            stiffness_taper=self.stiffness_taper,
+            density_taper=self.density_taper,
+            joint_start=self.joint_start,
+            joint_length=self.joint_length,
+            joint_stiffness_factor=self.joint_stiffness_factor,
+            joint_density_factor=self.joint_density_factor,
+        )
+
     def sensor_matrix(self) -> NDArray[np.float64] | None:
         """``diag(gain) (I + C)``, shape (6, 6), or None when it is the identity."""
         if self.sensor_gain == _IDENTITY_GAIN and self.sensor_coupling == _NO_COUPLING:

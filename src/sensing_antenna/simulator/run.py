@@ -155,23 +155,6 @@ class SimulationDetail:
     rayleigh: tuple[float, float]
 
 
-def _link_imperfections(device: DeviceImperfections) -> DeviceImperfections | None:
-    """The part of ``device`` the link's model depends on (None: the nominal link), the key of
-    the cached link set-up, so that sensor-only imperfections share the nominal link's."""
-    if device.link_is_nominal:
-        return None
-    return DeviceImperfections(
-        tip_mass=device.tip_mass,
-        clamp_stiffness=device.clamp_stiffness,
-        stiffness_taper=device.stiffness_taper,
-        density_taper=device.density_taper,
-        joint_start=device.joint_start,
-        joint_length=device.joint_length,
-        joint_stiffness_factor=device.joint_stiffness_factor,
-        joint_density_factor=device.joint_density_factor,
-    )
-
-
 @lru_cache(maxsize=16)
 def _link_setup(
     link: Link, n_elements: int, device: DeviceImperfections | None = None
@@ -340,7 +323,7 @@ def simulate_detailed(
     ts = SAMPLE_PERIOD
     n_samples = round(scenario.duration / ts)
     t: NDArray[np.float64] = np.arange(n_samples, dtype=np.float64) * ts
-    imperfect = _link_imperfections(scenario.device)
+    imperfect = scenario.device.link_part  # the key of the cached link set-up
     model, omega_free, omega_contact = _link_setup(link, scenario.n_elements, imperfect)
     scenario = scenario.resolved(omega_free)
     assert scenario.accel_time is not None and scenario.approach_time is not None
