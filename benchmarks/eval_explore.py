@@ -23,7 +23,10 @@ Each scene is explored twice with ``exploration.explore`` (every sweep simulated
 contact physics, recording, estimate with ``--method``), once per strategy with the grid's size as
 the budget, on the antenna of one preparation (the observer identified on free sweeps, then the
 five smooth posts; made once and copied into each run's directory), with the simulator's
-geometrically exact link (``--link linear``: the small-deflection one). Per scene and strategy: the
+geometrically exact link (``--link linear``: the small-deflection one). ``--device-profile
+realistic`` explores with one build of the realistic profile (``--device-build``), prepared as
+``exploration.prepare_device`` prepares it; what the preparation made of it (T_e, tip mass,
+sensor correction and its fit) goes into the results' settings. Per scene and strategy: the
 contacts (sweeps that touched), the points used (status ok), the RMS and largest distance of the
 points to the true surface, the RMS of the fitted surface to the true one near the points (mesh
 vertices within 1 cm of a contact), a Chamfer distance between that surface and the true surface's
@@ -46,8 +49,8 @@ resumed, and a finished one re-scored: its map rebuilt with the current code fro
 ran them), ``resumed`` in its row, ``run_s`` the re-score's time.
 
 Run: ``python benchmarks/eval_explore.py [--scenes 12] [--first 0] [--sweeps 4] [--bases 3]
-[--strategies grid next-best] [--method fast] [--link nonlinear] [--seed 0] [--out FILE]
-[--keep DIR]``.
+[--strategies grid next-best] [--method fast] [--link nonlinear]
+[--device-profile nominal|realistic] [--device-build N] [--seed 0] [--out FILE] [--keep DIR]``.
 """
 
 from __future__ import annotations
@@ -58,6 +61,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")  # one core, set before numpy loads
 
 import argparse  # noqa: E402
+import dataclasses  # noqa: E402
 import datetime  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
@@ -349,7 +353,7 @@ def run(
     link: str = "nonlinear",
     until_recognised: int = 0,
     device_profile: str = "nominal",
-    device_build: int = DEFAULT_BUILD,
+    device_build: int | None = None,
 ) -> dict[str, Any]:
     out = workdir / f"{scene.name}-{strategy}"
     resumed = out.exists()
@@ -592,7 +596,10 @@ def main() -> None:
         help="the simulated device's imperfections (ExploreSettings.device_profile)",
     )
     parser.add_argument(
-        "--device-build", type=integer(0), default=DEFAULT_BUILD, help="its build seed"
+        "--device-build",
+        type=integer(0),
+        default=None,
+        help=f"a realistic device's build seed (default {DEFAULT_BUILD})",
     )
     parser.add_argument(
         "--sight", type=float, default=SIGHT, help="the raised and lowered bases' sight (rad)"
@@ -627,11 +634,21 @@ def main() -> None:
         calibrated = workdir / "calibrated.toml"
         prepared = prepare_device(
             device,
+            workdir / "calibration",
             link=args.link,
             device_profile=args.device_profile,
             device_build=args.device_build,
         )
         calibrated.write_text(antenna_to_toml(prepared))
+        # what the preparation made of the device, kept with the results
+        sensor = workdir / "calibration" / "sensor.txt"
+        args.preparation = {
+            "calibrated_t": prepared.link.calibrated_t,
+            "tip_mass_kg": prepared.link.tip_mass,
+            "calibration_scatter": prepared.link.calibration_scatter,
+            "sensor": dataclasses.asdict(prepared.sensor),
+            "sensor_fit": sensor.read_text().strip() if sensor.is_file() else None,
+        }
         for index in range(args.first, args.first + args.scenes):
             scene, info = make_scene(
                 index, args.seed, args.sweeps, shape, args.bases, args.sight, args.distance

@@ -670,8 +670,10 @@ def test_a_realistic_device_is_built_once_and_set_up_anew_for_every_manoeuvre(
     assert (settings["device_profile"], settings["device_build"]) == ("realistic", 2021)
     built = realistic_device(0, DEVICE.link.length, build=2021)
     paths = [out / m.recording for m in manoeuvres if m.recording is not None]
+    swept = len(paths)
+    assert swept > 0
     paths += sorted((out / "calibration").glob("*.csv"))
-    assert len(paths) == len(manoeuvres) + 32
+    assert len(paths) == swept + 32
     offsets, seeds = [], []
     for path in paths:
         meta = read_recording(path).metadata
@@ -734,3 +736,14 @@ def test_another_device_in_the_same_directory_is_refused(
             ExploreSettings(device_profile="realistic", device_build=build)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="not used with the nominal one"):
         ExploreSettings(device_build=5)
+
+
+def test_a_realistic_devices_posts_reach_its_own_tip() -> None:
+    # the campaigns' points short of the link's tip, then the tip: 15 on the paper's 0.98 m
+    from sensing_antenna.exploration.run import realistic_calibration_points
+
+    assert realistic_calibration_points(0.98) == (
+        0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80, 0.85, 0.90, 0.95, 0.98
+    )  # fmt: skip
+    assert realistic_calibration_points(0.5) == (0.30, 0.35, 0.40, 0.45, 0.5)
+    assert realistic_calibration_points(1.2)[-2:] == (0.98, 1.2)

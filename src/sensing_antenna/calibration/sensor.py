@@ -14,11 +14,14 @@ is fitted so that (1) the elastica statics of the corrected push give x_i
 (2) the push lies in the plane the head swept in (an azimuthal sweep pushes along Y^m: the
 corrected R_z' / R_y' is zero; a vertical sweep the other way round), by
 ``scipy.optimize.least_squares`` with a soft-L1 loss (a recording whose push was disturbed does
-not pull the fit). The loads are the hold's mean (the window the contact frame uses, tared by
-the contact-free offset). A sweep about the azimuth fixes fy_gain, fy_per_tz and fz_per_tz;
-one about the elevation fz_gain, fz_per_ty and fy_per_ty; terms no recording fixes stay at no
-correction. The antenna's frequency model (T_e) should be calibrated first: the statics use its
-stiffness.
+not pull the fit), started from no correction and from the small-deflection statics' solution
+in closed form, the lower loss kept: a cross-talk that nearly cancels the push's force near
+the tip puts the ratio there many times off, and from no correction alone the loss can fall
+more by shrinking every ratio than by undoing the leak. The loads are
+the hold's mean (the window the contact frame uses, tared by the contact-free offset). A sweep
+about the azimuth fixes fy_gain, fy_per_tz and fz_per_tz; one about the elevation fz_gain,
+fz_per_ty and fy_per_ty; terms no recording fixes stay at no correction. The antenna's
+frequency model (T_e) should be calibrated first: the statics use its stiffness.
 
 A sweep direction's terms are adopted only when they predict contacts they were not fitted to:
 each recording is left out in turn, the terms fitted to the others, and the left-out ratio's

@@ -89,7 +89,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--device-build",
         type=integer(0, 2**31 - 1),
-        default=DEFAULT_BUILD,
+        default=None,
         metavar="N",
         help=(
             f"which realistic device (the seed of its build; default {DEFAULT_BUILD}, the "
@@ -108,7 +108,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.scene import load_scene
     from sensing_antenna.scene.objects import read_mesh
 
-    if args.device_profile == "nominal" and args.device_build != DEFAULT_BUILD:
+    if args.device_profile == "nominal" and args.device_build is not None:
         raise ArgumentError(
             "--device-build", "a realistic device's build: give --device-profile realistic too"
         )

@@ -51,6 +51,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
 from sensing_antenna.campaign.runs import CALIBRATION_STREAM, FREE_MOTION_STREAM, derive_seed
+from sensing_antenna.campaign.schema import DEFAULT_CALIBRATION_POINTS
 from sensing_antenna.campaign.simulated import knowing_weight
 from sensing_antenna.campaign.store import atomic_write_text
 from sensing_antenna.errors import raise_if_signalled
@@ -112,11 +113,14 @@ RecordedLinks = tuple[tuple[Piece, Piece | None], FloatArray]
 __all__ = [
     "CALIBRATION_FRICTION",
     "CALIBRATION_POINTS",
+    "DEFAULT_BUILD",
+    "REALISTIC_CALIBRATION_POINTS",
     "Exploration",
     "ExplorationInterrupted",
     "ExploreSettings",
     "explore",
     "prepare_device",
+    "realistic_calibration_points",
     "swept_links",
 ]
 
@@ -159,11 +163,11 @@ VERTICAL: Literal["vertical"] = "vertical"
 #: same draw of imperfections, on the device file's link).
 DEFAULT_BUILD = 2021
 
-#: Where a realistic device's calibration touches (m): the campaigns' points, each swept both
-#: ways (azimuthal and vertical), for T_e with the tip mass and the sensor's cross-talk.
-REALISTIC_CALIBRATION_POINTS = (
-    0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80, 0.85, 0.90, 0.95, 0.98
-)  # fmt: skip
+#: Where a realistic device's calibration touches (m): the campaigns' points
+#: (``campaign.schema.DEFAULT_CALIBRATION_POINTS``) short of the link's tip, and the tip, each
+#: swept both ways (azimuthal and vertical), for T_e with the tip mass and the sensor's
+#: cross-talk (:func:`realistic_calibration_points`).
+REALISTIC_CALIBRATION_POINTS = DEFAULT_CALIBRATION_POINTS
 
 #: What the preparation of a realistic device does (stored with the settings).
 REALISTIC_PREPARATION = (
@@ -197,9 +201,9 @@ class ExploreSettings:
         and coupling, drawn from ``device_build``; its set-up, the sensor's drift and the
         encoders' zero, drawn anew for every simulated manoeuvre, the preparation's included).
         A realistic device is prepared as the campaigns prepare theirs (:func:`prepare_device`).
-    device_build : int
-        The realistic device's build seed (which device of the profile): by default
-        :data:`DEFAULT_BUILD`.
+    device_build : int or None
+        The realistic device's build seed (which device of the profile); None:
+        :data:`DEFAULT_BUILD`. Only with the realistic profile.
     until_recognised : int
         After the budget (or the grid's last sweep, if sooner), while recognition abstains (or
         has too few points to answer), up to this many more manoeuvres, recognising before
@@ -216,7 +220,7 @@ class ExploreSettings:
     link: str = "nonlinear"
     until_recognised: int = 0
     device_profile: str = "nominal"
-    device_build: int = DEFAULT_BUILD
+    device_build: int | None = None
 
     def __post_init__(self) -> None:
         if self.method not in EXPLORE_METHODS:
@@ -232,15 +236,28 @@ class ExploreSettings:
         if self.device_profile not in DEVICE_PROFILES:
             raise ValueError(f"device_profile must be one of {', '.join(DEVICE_PROFILES)}")
         build = self.device_build
+        if build is None:
+            return
         if isinstance(build, bool) or not isinstance(build, int) or build < 0:
             raise ValueError(f"device_build must be an integer >= 0 (a seed), got {build!r}")
-        if self.device_profile == "nominal" and build != DEFAULT_BUILD:
+        if self.device_profile == "nominal":
             raise ValueError("device_build is a realistic device's: not used with the nominal one")
+
+    @property
+    def build(self) -> int:
+        """The realistic device's build seed (``device_build``, or :data:`DEFAULT_BUILD`)."""
+        return DEFAULT_BUILD if self.device_build is None else self.device_build
 
     def imperfections(self, seed: int, length: float) -> DeviceImperfections:
         """The simulated device's imperfections in the manoeuvre of seed ``seed`` (none on the
         nominal device); ``length`` (m) is the link's, to place its joint."""
-        return device_profile(self.device_profile, seed, length, self.device_build)
+        return device_profile(self.device_profile, seed, length, self.build)
+
+
+def realistic_calibration_points(length: float) -> tuple[float, ...]:
+    """A realistic device's calibration posts (m) on a link of ``length`` (m): those of
+    :data:`REALISTIC_CALIBRATION_POINTS` short of the tip, then the tip."""
+    return (*(x for x in REALISTIC_CALIBRATION_POINTS if x < length), length)
 
 
 class ExplorationInterrupted(KeyboardInterrupt):
@@ -310,7 +327,7 @@ def prepare_device(
     link: str = "nonlinear",
     *,
     device_profile: str = "nominal",
-    device_build: int = DEFAULT_BUILD,
+    device_build: int | None = None,
 ) -> Antenna:
     """The preparation of the simulated ``device`` (module docstring), with the simulator's
     ``link`` model: the observer and contact threshold identified on :data:`FREE_MOTION_CASES`
@@ -319,14 +336,25 @@ def prepare_device(
     :data:`CALIBRATION_SEED`) touched by the device with that observer; every recording is
     written into ``folder`` when given.
 
-    A realistic device (``device_profile``, ``device_build`` as in :class:`ExploreSettings`)
-    is prepared as a campaign prepares its own: each recording with a seed of its own (the
-    campaigns' free-motion and calibration streams of the build, so that no sweep shares its
-    set-up or noise), the posts at :data:`REALISTIC_CALIBRATION_POINTS` touched by an azimuthal
-    and by a vertical sweep, their planned x_c the known points, T_e fitted with the tip mass
-    on the azimuthal ones (``soft_l1`` loss) and the sensor's cross-talk on all
+    A realistic device is prepared as a campaign prepares its own: each recording with a seed of
+    its own (the campaigns' free-motion and calibration streams of the build, so that no sweep
+    shares its set-up or noise), the posts at :func:`realistic_calibration_points` touched by an
+    azimuthal and by a vertical sweep, their planned x_c the known points, T_e fitted with the
+    tip mass on the azimuthal ones (``soft_l1`` loss) and the sensor's cross-talk on all
     (``calibration.sensor``; kept only when it predicts posts left out of its fit), what the
     sensor's fit found written to ``folder/sensor.txt``.
+
+    Parameters
+    ----------
+    device : Antenna
+        The simulated device (its link and motors; the estimators' starting model).
+    folder : Path, optional
+        Where the preparation's recordings (and a realistic device's ``sensor.txt``) go.
+    link : {"nonlinear", "linear"}
+        The simulated link, as :attr:`ExploreSettings.link`.
+    device_profile : {"nominal", "realistic"}
+    device_build : int or None
+        As in :class:`ExploreSettings`.
 
     Returns
     -------
@@ -344,7 +372,7 @@ def prepare_device(
     length = device.link.length
 
     def seed_of(index: int, stream: int, first: int) -> int:
-        return derive_seed(device_build, index, stream) if realistic else first + index
+        return derive_seed(profile.build, index, stream) if realistic else first + index
 
     free = []
     for k, case in enumerate(FREE_MOTION_CASES):
@@ -360,8 +388,8 @@ def prepare_device(
     model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
     controlled = knowing_weight(device, model)
     posts: list[tuple[Literal["azimuthal", "vertical"], float]] = (
-        [(AZIMUTHAL, x) for x in REALISTIC_CALIBRATION_POINTS]
-        + [(VERTICAL, x) for x in REALISTIC_CALIBRATION_POINTS]
+        [(AZIMUTHAL, x) for x in realistic_calibration_points(length)]
+        + [(VERTICAL, x) for x in realistic_calibration_points(length)]
         if realistic
         else [(AZIMUTHAL, x) for x in CALIBRATION_POINTS]
     )
@@ -405,13 +433,13 @@ def prepare_device(
 
 
 def _device_settings(settings: ExploreSettings) -> dict[str, Any]:
-    """The stored settings of a realistic device (none for the nominal one, whose directories
-    predate the choice)."""
+    """The stored settings of a realistic device (none for the nominal one, so that a directory
+    without them resumes as nominal)."""
     if settings.device_profile == "nominal":
         return {}
     return {
         "device_profile": settings.device_profile,
-        "device_build": settings.device_build,
+        "device_build": settings.build,
         "preparation": REALISTIC_PREPARATION,
     }
 
