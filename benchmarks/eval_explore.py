@@ -91,6 +91,7 @@ from sensing_antenna.scene import (  # noqa: E402
     facing_region,
     primitive_object,
 )
+from sensing_antenna.simulator import DEVICE_PROFILES  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "explore.json"
 CLASSES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
@@ -591,7 +592,7 @@ def main() -> None:
     parser.add_argument("--link", choices=("nonlinear", "linear"), default="nonlinear")
     parser.add_argument(
         "--device-profile",
-        choices=("nominal", "realistic"),
+        choices=DEVICE_PROFILES,
         default="nominal",
         help="the simulated device's imperfections (ExploreSettings.device_profile)",
     )

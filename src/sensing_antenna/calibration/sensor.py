@@ -308,33 +308,36 @@ def _linear_start(
     its moment, so that it counts by its relative ratio error, as the fit does."""
     current = dict(zip(names, (getattr(SensorCorrection(), t) for t in names), strict=True))
 
-    def term(name: str) -> float:
+    def term(force: str, torque: str | None = None) -> float:
+        """The current value of f{force}_gain, or of f{force}_per_t{torque}."""
+        name = f"f{force}_gain" if torque is None else f"f{force}_per_t{torque}"
         return current.get(name, getattr(SensorCorrection(), name))
 
+    axis = {"y": 1, "z": 2}
     for _ in range(2):
         for sweep, (gain, along, across) in _PLANE_TERMS.items():
             if gain not in current:
                 continue
-            rows = lateral == (1 if sweep == "azimuthal" else 2)
-            a, m = (1, 2) if sweep == "azimuthal" else (2, 1)  # force along, moment's axis
+            # the force along the sweep, and the axis of its moment, which is also the force
+            # across it: an azimuthal sweep pushes along Y^m about Z^m, a vertical one the
+            # other way round
+            f, m = ("y", "z") if sweep == "azimuthal" else ("z", "y")
+            rows = lateral == axis[f]
             r, g = reaction[rows], moment[rows]
-            # along: gain R_a + along Gamma_m + (the other plane's term) Gamma_a = target
-            other = f"f{'yz'[a - 1]}_per_t{'yz'[a - 1]}"
-            target = (1.0 if a == 1 else -1.0) * g[:, m] / points[rows] - term(other) * g[:, a]
+            r_f, r_m, g_f, g_m = r[:, axis[f]], r[:, axis[m]], g[:, axis[f]], g[:, axis[m]]
+            # along: gain R_f + along Gamma_m + f_per_t{f} Gamma_f = +-Gamma_m / x_i
+            sign = 1.0 if f == "y" else -1.0
+            target = sign * g_m / points[rows] - term(f, f) * g_f
             with np.errstate(divide="ignore"):
-                weight = np.where(g[:, m] != 0.0, points[rows] / np.abs(g[:, m]), 0.0)
-            design = np.column_stack([r[:, a], g[:, m]]) * weight[:, None]
+                weight = np.where(g_m != 0.0, points[rows] / np.abs(g_m), 0.0)
+            design = np.column_stack([r_f, g_m]) * weight[:, None]
             solution, *_ = np.linalg.lstsq(design, target * weight, rcond=None)
             current[gain], current[along] = (float(v) for v in solution)
-            # across: the other force's gain R_b + its other term Gamma_a + across Gamma_m = 0
-            b = 3 - a
-            rest = (
-                term(f"f{'yz'[b - 1]}_gain") * r[:, b]
-                + term(other.replace(f"f{'yz'[a - 1]}", f"f{'yz'[b - 1]}")) * g[:, a]
-            )
-            denominator = float(g[:, m] @ g[:, m])
+            # across: m_gain R_m + m_per_t{f} Gamma_f + across Gamma_m = 0
+            rest = term(m) * r_m + term(m, f) * g_f
+            denominator = float(g_m @ g_m)
             if denominator > 0.0:
-                current[across] = -float(rest @ g[:, m]) / denominator
+                current[across] = -float(rest @ g_m) / denominator
     return np.array([current[t] for t in names], dtype=float)
 
 

@@ -387,12 +387,10 @@ def prepare_device(
         free.append(simulate(device, scenario))
     model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
     controlled = knowing_weight(device, model)
-    posts: list[tuple[Literal["azimuthal", "vertical"], float]] = (
-        [(AZIMUTHAL, x) for x in realistic_calibration_points(length)]
-        + [(VERTICAL, x) for x in realistic_calibration_points(length)]
-        if realistic
-        else [(AZIMUTHAL, x) for x in CALIBRATION_POINTS]
-    )
+    at = realistic_calibration_points(length) if realistic else CALIBRATION_POINTS
+    posts: list[tuple[Literal["azimuthal", "vertical"], float]] = [(AZIMUTHAL, x) for x in at]
+    if realistic:
+        posts += [(VERTICAL, x) for x in at]
     runs = []
     for k, (case, x) in enumerate(posts):
         seed = seed_of(k, CALIBRATION_STREAM, CALIBRATION_SEED)
@@ -433,10 +431,12 @@ def prepare_device(
 
 
 def _device_settings(settings: ExploreSettings) -> dict[str, Any]:
-    """The stored settings of a realistic device (none for the nominal one, so that a directory
-    without them resumes as nominal)."""
+    """The stored settings of the device and what step 1 makes of it (the profile and build
+    for a realistic device only, so that a directory without them resumes as nominal)."""
     if settings.device_profile == "nominal":
-        return {}
+        # an older directory's antenna was calibrated only, its sweeps detected with the
+        # nominal observer: another preparation, not resumed
+        return {"preparation": PREPARATION}
     return {
         "device_profile": settings.device_profile,
         "device_build": settings.build,
@@ -564,9 +564,6 @@ def explore(
                 "seed": settings.seed,
                 "include_uncertain": settings.include_uncertain,
                 "link": settings.link,
-                # what step 1 makes of the device: an older directory's antenna was calibrated
-                # only, its sweeps detected with the nominal observer
-                "preparation": PREPARATION,
                 **_device_settings(settings),
             },
         )
