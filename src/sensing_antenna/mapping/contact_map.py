@@ -6,7 +6,8 @@ swept untouched and where it touched (``mapping.free_space``);
 :func:`map_inputs_from_recordings` does both, reading each recording once. :func:`build_map`
 keeps the points that may enter a map (status ``ok``, and ``uncertain`` when asked), fits the
 implicit surface when there are enough of them and recognises the object when there are enough
-for every class.
+for every class. When recognition names the object, its fitted shape is the map's surface of the
+whole object (:meth:`ContactMap.object_surface`), the implicit surface that of the touched parts.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ from sensing_antenna.mapping.points import (
     select_points,
 )
 from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
-from sensing_antenna.mapping.recognition import LinkLines, Recognition, recognise
+from sensing_antenna.mapping.recognition import ClassFit, LinkLines, Recognition, recognise
 from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
 
 if TYPE_CHECKING:
@@ -98,6 +99,22 @@ class ContactMap:
         """Distance of each used point to its ground truth (m), NaN where unknown."""
         return np.array([float(np.linalg.norm(p.point - p.true_point)) for p in self.used])
 
+    @property
+    def named_fit(self) -> ClassFit | None:
+        """The fit of the object recognition names; None when it abstains or was not tried."""
+        recognition = self.recognition
+        return None if recognition is None or recognition.undecided else recognition.best
+
+    def object_surface(self) -> tuple[trimesh.Trimesh, FloatArray] | None:
+        """The named object's fitted surface, the whole object (world frame, m), and the
+        standard deviation of where it lies at each vertex (m, shape (n_vertices,),
+        :meth:`ClassFit.distance_std`: far beyond the object's size where no evidence holds
+        it, NaN for a user mesh); None when no object is named."""
+        fit = self.named_fit
+        if fit is None or fit.mesh is None or not len(fit.mesh.faces):
+            return None
+        return fit.mesh, fit.distance_std(fit.mesh.vertices)
+
     def summary(self) -> dict[str, Any]:
         """JSON-able counts and results (SI units)."""
         errors = self.point_errors
@@ -119,6 +136,20 @@ class ContactMap:
             else float(self.surface.length_scale_),
             "surface_faces": 0 if self.surface_mesh is None else len(self.surface_mesh.faces),
             "recognition": None if self.recognition is None else self.recognition.to_dict(),
+            "object_surface": self._object_summary(),
+        }
+
+    def _object_summary(self) -> dict[str, Any] | None:
+        surface = self.object_surface()
+        if surface is None:
+            return None
+        mesh, std = surface
+        known = std[np.isfinite(std)]
+        return {
+            "class": self.recognition.decision if self.recognition is not None else None,
+            "faces": len(mesh.faces),
+            "std_median_m": float(np.median(known)) if known.size else None,
+            "std_p90_m": float(np.quantile(known, 0.9)) if known.size else None,
         }
 
 

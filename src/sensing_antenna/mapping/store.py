@@ -1,4 +1,5 @@
-"""A map's directory: points.csv, points.ply, surface.ply, recognition.json, report.md.
+"""A map's directory: points.csv, points.ply, surface.ply, object.ply, recognition.json,
+report.md.
 
 points.csv has one row per recording: ``source, method, status, x, y, z`` (m, world frame), the
 covariance's six entries ``cov_xx, cov_xy, cov_xz, cov_yy, cov_yz, cov_zz`` (m^2), ``std``
@@ -7,7 +8,10 @@ covariance's six entries ``cov_xx, cov_xy, cov_xz, cov_yy, cov_yz, cov_zz`` (m^2
 ``used`` (whether it entered the map),
 ``true_x, true_y, true_z`` (ground truth when the recording had it) and ``reason``. The PLY
 files colour points and surface vertices by their standard deviation, blue (smallest) to red
-(largest).
+(largest). object.ply, written when recognition names the object, is the named class's fitted
+shape, the whole object; its vertices are coloured by the standard deviation of where the shape
+lies there (:meth:`ContactMap.object_surface`), red at the object's size and beyond (where no
+evidence holds it), all grey for a user mesh, whose registration carries none.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ import csv
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -51,6 +56,10 @@ POINT_COLUMNS = (
     "true_z",
     "reason",
 )
+
+
+#: Colour (RGBA) of an object surface whose registration carries no deviation (a user mesh).
+GREY = (150, 150, 150, 255)
 
 
 def std_colours(values: NDArray[np.float64]) -> NDArray[np.uint8]:
@@ -116,6 +125,11 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
         path = out / "surface.ply"
         mesh.export(path)
         written.append(path)
+    surface = contact_map.object_surface()
+    if surface is not None:
+        path = out / "object.ply"
+        _object_mesh(*surface).export(path)
+        written.append(path)
     path = out / "recognition.json"
     path.write_text(json.dumps(contact_map.summary(), indent=2, allow_nan=False) + "\n")
     written.append(path)
@@ -123,6 +137,32 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
     path.write_text(report(contact_map))
     written.append(path)
     return written
+
+
+def _object_mesh(mesh: trimesh.Trimesh, std: NDArray[np.float64]) -> trimesh.Trimesh:
+    """The named object's mesh coloured by its standard deviation, capped at its size (m)."""
+    if np.all(np.isfinite(std)):
+        colours = std_colours(np.minimum(std, float(np.max(mesh.extents))))
+    else:
+        colours = np.tile(np.array(GREY, dtype=np.uint8), (len(mesh.vertices), 1))
+    return trimesh.Trimesh(
+        vertices=mesh.vertices, faces=mesh.faces, vertex_colors=colours, process=False
+    )
+
+
+def _object_line(summary: dict[str, Any] | None) -> str:
+    if summary is None:
+        return "Object surface: none (recognition names no object)."
+    line = (
+        f"Object surface: the {summary['class']}'s fitted shape, {summary['faces']} faces"
+        " (object.ply)"
+    )
+    if summary["std_median_m"] is None:
+        return line + "."
+    return (
+        line + f"; where it lies, standard deviation median {1000 * summary['std_median_m']:.1f}"
+        f" mm, 90th percentile {1000 * summary['std_p90_m']:.1f} mm."
+    )
 
 
 def report(contact_map: ContactMap) -> str:
@@ -152,6 +192,7 @@ def report(contact_map: ContactMap) -> str:
         )
     else:
         lines.append("Surface: none (too few points, or no zero level in the grid).")
+    lines.append(_object_line(s["object_surface"]))
     recognition = contact_map.recognition
     lines.append("")
     if recognition is None:
