@@ -33,7 +33,10 @@ vertices within 1 cm of a contact), a Chamfer distance between that surface and 
 patch near the points, and the whole object's RMS distance to the fitted surface with the fraction
 of its area within 5 mm of it (a map that never touched a side is far from it there), after every 3
 sweeps and at the end; the contacts each strategy needs to bring the whole object's RMS to 5 mm (the
-two strategies compared scene by scene on it); the recognition (right, abstained, confidently wrong)
+two strategies compared scene by scene on it), with the implicit surface and with the map's surface
+of the whole object (the named class's fitted shape where recognition names one, recognised with the
+swept links so far at each checkpoint up to the first that reaches the target, the implicit surface
+where not), and the named shape's whole-object RMS at the end; the recognition (right, abstained, confidently wrong)
 and the size error of the true class's fit (each size's error also over the standard deviation
 the fit reports, and whether the fit claims every size to 5 %, twice its standard deviation
 within 5 % of it, while being off by more), the Mahalanobis distance of each ``ok`` point's true
@@ -83,7 +86,7 @@ from sensing_antenna.exploration import ExploreSettings, explore, prepare_device
 from sensing_antenna.exploration.run import DEFAULT_BUILD, swept_links  # noqa: E402
 from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
 from sensing_antenna.mapping import PRIMITIVES, UNDECIDED, BasePose  # noqa: E402
-from sensing_antenna.mapping.contact_map import fit_surface  # noqa: E402
+from sensing_antenna.mapping.contact_map import fit_surface, recognise_points  # noqa: E402
 from sensing_antenna.scene import (  # noqa: E402
     ExploreRegion,
     LinkShape,
@@ -291,6 +294,45 @@ def surface_scores(
     }
 
 
+def whole_rms(mesh: trimesh.Trimesh, samples: np.ndarray) -> float:
+    """RMS distance (m) of the true surface's ``samples`` (m, shape (n, 3)) to ``mesh``."""
+    _, distance, _ = trimesh.proximity.closest_point(mesh, samples)
+    return float(np.sqrt(np.mean(distance**2)))
+
+
+def object_progress(
+    scene: Scene,
+    result: Any,
+    out: Path,
+    progress: list[dict[str, Any]],
+    samples: np.ndarray,
+) -> int | None:
+    """The contacts after which the map's surface of the whole object first lies within
+    :data:`TARGET_RMS` of the true surface (RMS over its ``samples``): the named object's fitted
+    shape (``ContactMap.object_surface``, recognition with the swept links so far, as the map
+    makes it) where recognition names one, the implicit surface where not; None when it never
+    does. Each checkpoint of ``progress`` it reaches gets ``shape_rms_m``, the named shape's RMS
+    (NaN when none is named); recognising is costly, so the checkpoints stop at the first that
+    reaches the target."""
+    manoeuvres = result.manoeuvres
+    recorded: dict[int, Any] = {}
+    for check in progress:
+        k = check["sweeps"]
+        if k == len(manoeuvres):
+            recognition = result.contact_map.recognition
+        else:
+            points = [m.point for m in manoeuvres[:k] if m.point is not None]
+            swept = swept_links(manoeuvres[:k], scene, result.antenna, out, recorded)
+            recognition = recognise_points(points, swept=swept)
+        named = recognition is not None and not recognition.undecided
+        mesh = recognition.best.mesh if named and recognition is not None else None
+        check["shape_rms_m"] = math.nan if mesh is None else whole_rms(mesh, samples)
+        surface_rms = check["shape_rms_m"] if mesh is not None else check["object_rms_m"]
+        if surface_rms <= TARGET_RMS:
+            return int(check["contacts"])
+    return None
+
+
 def mahalanobis(points: list[Any]) -> list[float]:
     """Each point's Mahalanobis distance to the simulator's true contact point under its own
     covariance (points without a truth left out); a calibrated 3-D covariance gives a median
@@ -417,6 +459,13 @@ def run(
     row.update({k: v for k, v in progress[-1].items() if k.endswith("_m") or k == "covered"})
     reached = [c["contacts"] for c in progress if c["object_rms_m"] <= TARGET_RMS]
     row["contacts_to_target"] = reached[0] if reached else None
+    row["contacts_to_object_target"] = object_progress(
+        scene, result, out, progress, samples[::OBJECT_STRIDE]
+    )
+    named = result.contact_map.object_surface()
+    row["shape_rms_m"] = (
+        math.nan if named is None else whole_rms(named[0], samples[::OBJECT_STRIDE])
+    )
     recognition = result.contact_map.recognition
     if recognition is None:
         row.update(
@@ -472,11 +521,10 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "mean_object_rms_m": mean("object_rms_m"),
         "mean_covered": mean("covered"),
         "reached_target": sum(r["contacts_to_target"] is not None for r in rows),
-        "mean_contacts_to_target": float(
-            np.mean([r["contacts_to_target"] for r in rows if r["contacts_to_target"] is not None])
-        )
-        if any(r["contacts_to_target"] is not None for r in rows)
-        else None,
+        "mean_contacts_to_target": mean_reached(rows, "contacts_to_target"),
+        "mean_shape_rms_m": mean("shape_rms_m"),
+        "reached_object_target": sum(r.get("contacts_to_object_target") is not None for r in rows),
+        "mean_contacts_to_object_target": mean_reached(rows, "contacts_to_object_target"),
         "recognised": len(recognised),
         "right": sum(r["right"] for r in rows),
         "abstained": sum(r["abstained"] for r in rows),
@@ -504,6 +552,12 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def mean_reached(rows: list[dict[str, Any]], key: str) -> float | None:
+    """The mean of ``key`` (contacts to a target) over the rows that reached it."""
+    reached = [r[key] for r in rows if r.get(key) is not None]
+    return float(np.mean(reached)) if reached else None
+
+
 def size_summary(right: list[dict[str, Any]]) -> dict[str, Any]:
     """Over the right answers: sizes within 5 %, the sizes' errors over their standard
     deviations, and the answers that claim every size to 5 % (twice its standard deviation)
@@ -523,16 +577,28 @@ def size_summary(right: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def print_target(rows: list[dict[str, Any]]) -> None:
-    """The contacts each strategy needs for a whole-object RMS of 5 mm, scene by scene."""
+    """The contacts each strategy needs for a whole-object RMS of 5 mm, scene by scene: of the
+    implicit surface, and of the map's surface of the whole object (the named shape where
+    recognition names one)."""
+    for key, surface in (
+        ("contacts_to_target", "the implicit surface"),
+        ("contacts_to_object_target", "the named shape, else the implicit surface"),
+    ):
+        print_pairs(rows, key, surface)
+
+
+def print_pairs(rows: list[dict[str, Any]], key: str, surface: str) -> None:
+    """How many scenes each strategy brings to the target with ``surface``, and the ratio of
+    their contacts (``key``) where both do."""
     need: dict[int, dict[str, int | None]] = {}
     for r in rows:
-        need.setdefault(r["scene"], {})[r["strategy"]] = r["contacts_to_target"]
+        need.setdefault(r["scene"], {})[r["strategy"]] = r.get(key)
     pairs = [
         (n["grid"], n["next-best"])
         for n in need.values()
         if n.get("grid") is not None and n.get("next-best") is not None
     ]
-    print(f"\nwhole-object RMS <= {1000 * TARGET_RMS:.0f} mm:")
+    print(f"\nwhole-object RMS <= {1000 * TARGET_RMS:.0f} mm, {surface}:")
     for strategy in STRATEGIES:
         got = [n[strategy] for n in need.values() if strategy in n]
         reached = [c for c in got if c is not None]
