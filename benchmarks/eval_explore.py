@@ -36,12 +36,12 @@ sweeps and at the end; the contacts each strategy needs to bring the whole objec
 two strategies compared scene by scene on it), with the implicit surface and with the map's surface
 of the whole object (the named class's fitted shape where recognition names one, recognised with the
 swept links so far at each checkpoint up to the first that reaches the target, the implicit surface
-where not), and the named shape's whole-object RMS at the end; the recognition (right, abstained, confidently wrong)
-and the size error of the true class's fit (each size's error also over the standard deviation
-the fit reports, and whether the fit claims every size to 5 %, twice its standard deviation
-within 5 % of it, while being off by more), the Mahalanobis distance of each ``ok`` point's true
-contact point under its covariance and its distance to the true surface over its sigma along the
-normal, how far the true object disagrees with the swept links
+where not), and the named shape's whole-object RMS at the end; the recognition (right, abstained,
+confidently wrong) and the size error of the true class's fit (each size's error also over the
+standard deviation the fit reports, and whether the fit claims every size to 5 %, twice its
+standard deviation within 5 % of it, while being off by more), the Mahalanobis distance of each
+``ok`` point's true contact point under its covariance and its distance to the true surface over
+its sigma along the normal, how far the true object disagrees with the swept links
 recognition weighs (its residual per free sweep and per touching link, the worst and the count
 beyond 2: swept links the truth contradicts would refute the right class), and the simulated
 sweeping time. Prints a table and writes ``benchmarks/results/explore.json`` after every exploration
@@ -309,12 +309,13 @@ def object_progress(
 ) -> int | None:
     """The contacts after which the map's surface of the whole object first lies within
     :data:`TARGET_RMS` of the true surface (RMS over its ``samples``): the named object's fitted
-    shape (``ContactMap.object_surface``, recognition with the swept links so far, as the map
-    makes it) where recognition names one, the implicit surface where not; None when it never
+    shape (the map's ``object.ply``, recognised with the swept links so far, as the map
+    recognises) where recognition names one, the implicit surface where not; None when it never
     does. Each checkpoint of ``progress`` it reaches gets ``shape_rms_m``, the named shape's RMS
     (NaN when none is named); recognising is costly, so the checkpoints stop at the first that
     reaches the target."""
     manoeuvres = result.manoeuvres
+    include_uncertain = result.settings.include_uncertain
     recorded: dict[int, Any] = {}
     for check in progress:
         k = check["sweeps"]
@@ -323,9 +324,9 @@ def object_progress(
         else:
             points = [m.point for m in manoeuvres[:k] if m.point is not None]
             swept = swept_links(manoeuvres[:k], scene, result.antenna, out, recorded)
-            recognition = recognise_points(points, swept=swept)
-        named = recognition is not None and not recognition.undecided
-        mesh = recognition.best.mesh if named and recognition is not None else None
+            recognition = recognise_points(points, include_uncertain, swept=swept)
+        named = None if recognition is None else recognition.named
+        mesh = None if named is None else named.mesh
         check["shape_rms_m"] = math.nan if mesh is None else whole_rms(mesh, samples)
         surface_rms = check["shape_rms_m"] if mesh is not None else check["object_rms_m"]
         if surface_rms <= TARGET_RMS:
@@ -464,7 +465,7 @@ def run(
     )
     named = result.contact_map.object_surface()
     row["shape_rms_m"] = (
-        math.nan if named is None else whole_rms(named[0], samples[::OBJECT_STRIDE])
+        math.nan if named is None else whole_rms(named.mesh, samples[::OBJECT_STRIDE])
     )
     recognition = result.contact_map.recognition
     if recognition is None:
@@ -522,6 +523,8 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "mean_covered": mean("covered"),
         "reached_target": sum(r["contacts_to_target"] is not None for r in rows),
         "mean_contacts_to_target": mean_reached(rows, "contacts_to_target"),
+        # over the scenes whose map names a bounded object, ``named`` of them
+        "named": sum(math.isfinite(r["shape_rms_m"]) for r in rows),
         "mean_shape_rms_m": mean("shape_rms_m"),
         "reached_object_target": sum(r.get("contacts_to_object_target") is not None for r in rows),
         "mean_contacts_to_object_target": mean_reached(rows, "contacts_to_object_target"),

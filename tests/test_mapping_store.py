@@ -7,53 +7,101 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from sensing_antenna.estimation.result import Status
-from sensing_antenna.mapping import ContactPoint, build_map, write_map
+from _contacts import NOISE, contacts, half_sphere
+from sensing_antenna.mapping import build_map, recognise, write_map
+from sensing_antenna.mapping.store import GREY
 
 #: The 99 % point of the chi distribution with 4 degrees of freedom (a sphere's parameters).
 CHI4_99 = 3.64
+#: Pure red and pure blue in object.ply's colours (RGB).
+RED, BLUE = (255, 64, 0), (0, 64, 255)
 
 
-def _half_sphere(n: int, centre: np.ndarray, radius: float) -> list[ContactPoint]:
-    """n points with 1 mm noise (their stated sigma) on the half of a sphere facing a base at
-    the origin."""
-    rng = np.random.default_rng(3)
-    directions = rng.normal(size=(n, 3))
-    directions[:, 0] = -np.abs(directions[:, 0])
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    points = centre + radius * directions + rng.normal(scale=1e-3, size=(n, 3))
-    return [
-        ContactPoint(p, 1e-6 * np.eye(3), Status.OK, f"r{i}", "paper", 0.5, np.zeros(3))
-        for i, p in enumerate(points)
-    ]
+def _colours(path: Path) -> np.ndarray:
+    mesh = trimesh.load(path, process=False)
+    return np.asarray(mesh.visual.vertex_colors)[:, :3]
 
 
-def test_the_named_object_is_the_whole_surface_within_its_deviation(tmp_path: Path) -> None:
+def test_a_named_sphere_is_the_whole_object_within_its_deviation(tmp_path: Path) -> None:
     centre, radius = np.array([0.5, 0.0, 0.0]), 0.05
-    contact_map = build_map(_half_sphere(30, centre, radius))
-    assert contact_map.named_fit is not None and contact_map.named_fit.name == "sphere"
-    written = write_map(contact_map, tmp_path)
-    assert tmp_path / "object.ply" in written
-    mesh = trimesh.load(tmp_path / "object.ply", process=False)
-    assert len(mesh.faces) and len(mesh.visual.vertex_colors) == len(mesh.vertices)
+    contact_map = build_map(contacts(half_sphere(30, centre, radius)))
     surface = contact_map.object_surface()
-    assert surface is not None
-    _, std = surface
-    # the back half too, never touched: a sphere is the whole object once its four parameters
-    # are fitted. Each vertex moves with them, so its error over its deviation is at most the
-    # parameters' Mahalanobis error (Cauchy-Schwarz), below chi_4's 99 % point
-    error = np.abs(np.linalg.norm(mesh.vertices - centre, axis=1) - radius)
-    back = mesh.vertices[:, 0] > centre[0] + 0.5 * radius
-    assert back.any() and np.all(error <= CHI4_99 * std)
-    assert 0 < np.median(std) < 1e-3  # 30 points of 1 mm hold the sphere to under a mm
-    report = (tmp_path / "report.md").read_text()
-    assert "Object surface: the sphere's fitted shape" in report
+    assert surface is not None and surface.name == "sphere"
+    assert tmp_path / "object.ply" in write_map(contact_map, tmp_path)
+    vertices, std = surface.mesh.vertices, surface.std
+    # Each vertex moves with the four fitted parameters, so its error over its deviation is at
+    # most their Mahalanobis error (Cauchy-Schwarz), below chi_4's 99 % point; the faces are
+    # flat, so a vertex split off an edge lies inside the sphere by at most edge^2 / (8 r)
+    assert contact_map.recognition is not None
+    fitted = contact_map.recognition.best.mesh
+    edge = float(np.max(fitted.edges_unique_length))
+    error = np.abs(np.linalg.norm(vertices - centre, axis=1) - radius)
+    assert np.all(error <= CHI4_99 * std + edge**2 / (8 * radius))
+    # the back half, never touched, is placed by the fit and less sure than the front
+    back = vertices[:, 0] > centre[0] + 0.5 * radius
+    front = vertices[:, 0] < centre[0] - 0.5 * radius
+    assert np.median(std[back]) > 2 * np.median(std[front])
+    summary = contact_map.summary()["object_surface"]
+    assert summary["class"] == "sphere" and summary["held_share"] == 1.0
+    assert 0 < summary["held_std_median_m"] < summary["held_std_p90_m"] < NOISE
+    # coloured from blue (no deviation) towards red (a tenth of the size): all held, all bluish
+    colours = _colours(tmp_path / "object.ply")
+    assert len(colours) == len(vertices) and np.all(colours[:, 0] < 0.1 * 255)
+    assert np.corrcoef(colours[:, 0].astype(float), std)[0, 1] > 0.99
+    assert "Object surface: the sphere's fitted shape (object.ply); 100 % of its area" in (
+        (tmp_path / "report.md").read_text()
+    )
+
+
+def test_an_end_no_touch_reached_is_not_held(tmp_path: Path) -> None:
+    # a cylinder (radius 3 cm, height 10 cm) touched on the half of its side facing the base
+    # and on its top face; its bottom face never
+    rng = np.random.default_rng(5)
+    centre, r, h = np.array([0.5, 0.0, 0.0]), 0.03, 0.10
+    phi, z = rng.uniform(np.pi / 2, 3 * np.pi / 2, 40), rng.uniform(-h / 2, h / 2, 40)
+    rho, angle = r * np.sqrt(rng.uniform(0, 1, 12)), rng.uniform(0, 2 * np.pi, 12)
+    side = np.c_[r * np.cos(phi), r * np.sin(phi), z]
+    top = np.c_[rho * np.cos(angle), rho * np.sin(angle), np.full(12, h / 2)]
+    points = centre + np.r_[side, top] + rng.normal(scale=NOISE, size=(52, 3))
+    contact_map = build_map(contacts(points))
+    surface = contact_map.object_surface()
+    assert surface is not None and surface.name == "cylinder"
+    write_map(contact_map, tmp_path)
+    z_local = surface.mesh.vertices[:, 2]
+    bottom = z_local < z_local.min() + 1e-4
+    middle = np.abs(z_local - centre[2]) < 0.3 * h
+    assert np.all(surface.std[bottom] >= surface.unheld)  # the extent prior's end, not evidence
+    assert np.all(surface.std[middle] < NOISE)
+    # held: the side and the top, (h + r / 2) / (h + r) of the area (the rim's vertices share
+    # their area with the bottom: a couple of per cent)
+    held = contact_map.summary()["object_surface"]["held_share"]
+    assert abs(held - (h + r / 2) / (h + r)) < 0.03
+    colours = _colours(tmp_path / "object.ply")
+    assert np.all(colours[bottom] == RED)
+    assert np.all(colours[middle][:, 0] < 0.1 * 255)
+
+
+def test_a_registered_mesh_carries_no_deviation(tmp_path: Path) -> None:
+    centre, radius = np.array([0.5, 0.0, 0.0]), 0.05
+    points = half_sphere(30, centre, radius)
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=radius)
+    recognition = recognise(points, NOISE**2 * np.ones((30, 1, 1)) * np.eye(3), [], {"ball": ball})
+    contact_map = build_map(contacts(points), recognition=recognition)
+    surface = contact_map.object_surface()
+    assert surface is not None and surface.name == "mesh:ball"
+    assert np.all(np.isnan(surface.std))
+    assert contact_map.summary()["object_surface"]["held_share"] is None
+    write_map(contact_map, tmp_path)  # recognition.json with nulls, no NaN
+    assert np.all(_colours(tmp_path / "object.ply") == GREY[:3])
+    assert "its registration carries no deviation" in (tmp_path / "report.md").read_text()
 
 
 def test_no_object_surface_without_a_named_object(tmp_path: Path) -> None:
-    contact_map = build_map(_half_sphere(8, np.array([0.5, 0.0, 0.0]), 0.05))
+    contact_map = build_map(contacts(half_sphere(8, np.array([0.5, 0.0, 0.0]), 0.05)))
     assert contact_map.recognition is None and contact_map.object_surface() is None
     assert tmp_path / "object.ply" not in write_map(contact_map, tmp_path)
     assert not (tmp_path / "object.ply").exists()
-    assert "Object surface: none" in (tmp_path / "report.md").read_text()
+    assert "Object surface: none (recognition names no object)" in (
+        (tmp_path / "report.md").read_text()
+    )
     assert contact_map.summary()["object_surface"] is None

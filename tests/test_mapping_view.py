@@ -7,25 +7,17 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from _contacts import contacts, half_sphere
 from _map_html import html_scene
-from sensing_antenna.estimation.result import Status
-from sensing_antenna.mapping import ContactPoint, build_map
+from sensing_antenna.mapping import build_map
 from sensing_antenna.mapping.view import write_map_html
 
 
 def test_the_view_holds_points_surface_recognised_shape_and_truth(tmp_path: Path) -> None:
     # 30 points with 1 mm noise on the half of a 5 cm sphere facing a base at the origin
-    rng = np.random.default_rng(3)
     centre, radius = np.array([0.5, 0.0, 0.0]), 0.05
-    directions = rng.normal(size=(30, 3))
-    directions[:, 0] = -np.abs(directions[:, 0])
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    points = centre + radius * directions + rng.normal(scale=1e-3, size=(30, 3))
-    contacts = [
-        ContactPoint(p, 1e-6 * np.eye(3), Status.OK, f"r{i}", "paper", 0.5, np.zeros(3))
-        for i, p in enumerate(points)
-    ]
-    contact_map = build_map(contacts)
+    points = half_sphere(30, centre, radius)
+    contact_map = build_map(contacts(points))
     truth = trimesh.creation.icosphere(subdivisions=3, radius=radius)
     truth.apply_translation(centre)
     path = write_map_html(contact_map, tmp_path / "map.html", truth)

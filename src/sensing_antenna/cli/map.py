@@ -22,9 +22,9 @@ def register(subparsers: Any) -> None:
             "fits a Gaussian-process implicit surface through the points with status ok, and "
             "fits every shape class (sphere, cylinder, box, cone, capsule, torus, plane) and "
             "any --objects meshes, naming the best or abstaining when two explain the points "
-            "equally. Writes points.csv, points.ply, surface.ply, recognition.json, report.md, "
-            "map.png and map.html (an interactive 3D view, self-contained) into --out "
-            "(docs/mapping.md)."
+            "equally. Writes points.csv, points.ply, surface.ply, object.ply (the named object's "
+            "fitted shape), recognition.json, report.md, map.png and map.html (an interactive "
+            "3D view, self-contained) into --out (docs/mapping.md)."
         ),
     )
     parser.add_argument("recordings", nargs="+", type=Path, help="recordings (CSV)")

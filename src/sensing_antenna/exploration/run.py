@@ -719,9 +719,9 @@ def _recognition_state(
     recognition = recognise_points(points, include_uncertain, meshes, swept=swept)
     if recognition is None:
         return None, ()
-    if not recognition.undecided:
-        best = recognition.best
-        return recognition, (best,) if best.name in PRIMITIVES else ()
+    named = recognition.named
+    if named is not None:
+        return recognition, (named,) if named.name in PRIMITIVES else ()
     by_name = {f.name: f for f in recognition.fits}
     leaders = tuple(by_name[name] for name in recognition.candidates)
     return None, leaders if all(f.name in PRIMITIVES for f in leaders) else ()

@@ -7,7 +7,7 @@ swept untouched and where it touched (``mapping.free_space``);
 keeps the points that may enter a map (status ``ok``, and ``uncertain`` when asked), fits the
 implicit surface when there are enough of them and recognises the object when there are enough
 for every class. When recognition names the object, its fitted shape is the map's surface of the
-whole object (:meth:`ContactMap.object_surface`), the implicit surface that of the touched parts.
+whole object (:class:`ObjectSurface`), the implicit surface that of the touched parts.
 """
 
 from __future__ import annotations
@@ -48,7 +48,9 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MIN_RECOGNITION_POINTS",
+    "UNHELD_FRACTION",
     "ContactMap",
+    "ObjectSurface",
     "build_map",
     "fit_surface",
     "link_lines",
@@ -62,6 +64,85 @@ FloatArray = NDArray[np.float64]
 
 #: Fewest points recognition is tried on: one more than the box's 9 parameters.
 MIN_RECOGNITION_POINTS = 10
+
+
+#: Where the named object's surface deviates by this fraction of its size or more, the
+#: evidence does not hold it (an untouched end, a hidden face).
+UNHELD_FRACTION = 0.1
+
+
+@dataclass(frozen=True)
+class ObjectSurface:
+    """The named object's fitted surface, the whole object, with where it is held.
+
+    Attributes
+    ----------
+    name : str
+        The named class (``mesh:NAME`` for a user mesh).
+    mesh : trimesh.Trimesh
+        The fitted shape (world frame, m), its faces split to edges of at most a twentieth of
+        its size, so that faces, not only edges and corners, carry vertices.
+    std : array, shape (n_vertices,)
+        Standard deviation of where the surface lies at each vertex (m;
+        :meth:`ClassFit.distance_std`): far beyond the object's size where no evidence holds
+        it, NaN throughout for a user mesh (its registration carries none).
+    size : float
+        The object's size, the largest extent of its mesh (m).
+    """
+
+    name: str
+    mesh: trimesh.Trimesh
+    std: FloatArray
+    size: float
+
+    @classmethod
+    def of(cls, fit: ClassFit) -> ObjectSurface:
+        """The surface of ``fit`` (its mesh must have faces)."""
+        assert fit.mesh is not None
+        size = float(np.max(fit.mesh.extents))
+        vertices, faces = trimesh.remesh.subdivide_to_size(
+            fit.mesh.vertices, fit.mesh.faces, max_edge=size / 20
+        )
+        mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+        return cls(fit.name, mesh, fit.distance_std(mesh.vertices), size)
+
+    @property
+    def unheld(self) -> float:
+        """The deviation (m) from which the evidence does not hold the surface:
+        :data:`UNHELD_FRACTION` of its size."""
+        return UNHELD_FRACTION * self.size
+
+    def vertex_areas(self) -> FloatArray:
+        """The area each vertex stands for, a third of its faces' (m^2, shape (n_vertices,))."""
+        areas = np.zeros(len(self.mesh.vertices))
+        np.add.at(areas, self.mesh.faces.ravel(), np.repeat(self.mesh.area_faces / 3.0, 3))
+        return areas
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-able: the class, the faces, and where the surface is held (its deviation below
+        :attr:`unheld`): that share of the area, and the deviation's median and 90th percentile
+        there by area (m); the three null for a user mesh."""
+        summary: dict[str, Any] = {
+            "class": self.name,
+            "faces": len(self.mesh.faces),
+            "size_m": self.size,
+            "held_share": None,
+            "held_std_median_m": None,
+            "held_std_p90_m": None,
+        }
+        if not np.all(np.isfinite(self.std)):
+            return summary
+        areas = self.vertex_areas()
+        held = self.std < self.unheld
+        summary["held_share"] = float(areas[held].sum() / areas.sum())
+        if held.any():
+            order = np.argsort(self.std[held])
+            cumulative = np.cumsum(areas[held][order]) / areas[held].sum()
+            quantile = [
+                float(self.std[held][order][np.searchsorted(cumulative, q)]) for q in (0.5, 0.9)
+            ]
+            summary["held_std_median_m"], summary["held_std_p90_m"] = quantile
+        return summary
 
 
 @dataclass(frozen=True)
@@ -99,21 +180,13 @@ class ContactMap:
         """Distance of each used point to its ground truth (m), NaN where unknown."""
         return np.array([float(np.linalg.norm(p.point - p.true_point)) for p in self.used])
 
-    @property
-    def named_fit(self) -> ClassFit | None:
-        """The fit of the object recognition names; None when it abstains or was not tried."""
-        recognition = self.recognition
-        return None if recognition is None or recognition.undecided else recognition.best
-
-    def object_surface(self) -> tuple[trimesh.Trimesh, FloatArray] | None:
-        """The named object's fitted surface, the whole object (world frame, m), and the
-        standard deviation of where it lies at each vertex (m, shape (n_vertices,),
-        :meth:`ClassFit.distance_std`: far beyond the object's size where no evidence holds
-        it, NaN for a user mesh); None when no object is named."""
-        fit = self.named_fit
+    def object_surface(self) -> ObjectSurface | None:
+        """The named object's fitted surface, the whole object; None when no object is named
+        or the named class is unbounded (the plane)."""
+        fit = None if self.recognition is None else self.recognition.named
         if fit is None or fit.mesh is None or not len(fit.mesh.faces):
             return None
-        return fit.mesh, fit.distance_std(fit.mesh.vertices)
+        return ObjectSurface.of(fit)
 
     def summary(self) -> dict[str, Any]:
         """JSON-able counts and results (SI units)."""
@@ -141,16 +214,7 @@ class ContactMap:
 
     def _object_summary(self) -> dict[str, Any] | None:
         surface = self.object_surface()
-        if surface is None:
-            return None
-        mesh, std = surface
-        known = std[np.isfinite(std)]
-        return {
-            "class": self.recognition.decision if self.recognition is not None else None,
-            "faces": len(mesh.faces),
-            "std_median_m": float(np.median(known)) if known.size else None,
-            "std_p90_m": float(np.quantile(known, 0.9)) if known.size else None,
-        }
+        return None if surface is None else surface.summary()
 
 
 def points_from_recordings(

@@ -478,6 +478,11 @@ class Recognition:
         return self.fits[0]
 
     @property
+    def named(self) -> ClassFit | None:
+        """The fit of the class the decision names; None when it abstains."""
+        return None if self.undecided else self.best
+
+    @property
     def undecided(self) -> bool:
         """True when the decision abstains."""
         return self.decision == UNDECIDED

@@ -8,10 +8,11 @@ covariance's six entries ``cov_xx, cov_xy, cov_xz, cov_yy, cov_yz, cov_zz`` (m^2
 ``used`` (whether it entered the map),
 ``true_x, true_y, true_z`` (ground truth when the recording had it) and ``reason``. The PLY
 files colour points and surface vertices by their standard deviation, blue (smallest) to red
-(largest). object.ply, written when recognition names the object, is the named class's fitted
-shape, the whole object; its vertices are coloured by the standard deviation of where the shape
-lies there (:meth:`ContactMap.object_surface`), red at the object's size and beyond (where no
-evidence holds it), all grey for a user mesh, whose registration carries none.
+(largest). object.ply, written when recognition names a bounded object, is the named class's
+fitted shape, the whole object (:class:`~sensing_antenna.mapping.contact_map.ObjectSurface`);
+its vertices are coloured by the standard deviation of where the shape lies there, from blue at
+0 to red at a tenth of the object's size and beyond (where the evidence does not hold it), grey
+for a user mesh, whose registration carries none.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from sensing_antenna.mapping.contact_map import ContactMap
+from sensing_antenna.mapping.contact_map import UNHELD_FRACTION, ContactMap, ObjectSurface
 
 __all__ = ["POINT_COLUMNS", "std_colours", "write_map"]
 
@@ -58,16 +59,23 @@ POINT_COLUMNS = (
 )
 
 
-#: Colour (RGBA) of an object surface whose registration carries no deviation (a user mesh).
+#: Colour (RGBA) of what carries no deviation: a registered user mesh, the true surface.
 GREY = (150, 150, 150, 255)
 
 
-def std_colours(values: NDArray[np.float64]) -> NDArray[np.uint8]:
-    """RGBA rows from blue (smallest) to red (largest) of ``values``."""
+def std_colours(values: NDArray[np.float64], top: float | None = None) -> NDArray[np.uint8]:
+    """RGBA rows from blue to red of ``values``: from the smallest to the largest, or, with
+    ``top``, from 0 to ``top`` and beyond (inf red); NaN grey."""
     v = np.asarray(values, dtype=float)
-    span = float(np.ptp(v)) if v.size else 0.0
-    t = (v - v.min()) / span if span > 0 else np.zeros_like(v)
+    known = np.isfinite(v) if top is None else ~np.isnan(v)
+    if top is not None:
+        t = np.clip(np.where(known, v, 0.0) / top, 0.0, 1.0)
+    else:
+        low = float(v[known].min()) if known.any() else 0.0
+        span = float(np.ptp(v[known])) if known.any() else 0.0
+        t = (np.where(known, v, low) - low) / span if span > 0 else np.zeros_like(v)
     rgba = np.stack([255 * t, 64 * np.ones_like(t), 255 * (1 - t), 255 * np.ones_like(t)], axis=1)
+    rgba[~known] = GREY
     return np.asarray(rgba.round(), dtype=np.uint8)
 
 
@@ -128,7 +136,7 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
     surface = contact_map.object_surface()
     if surface is not None:
         path = out / "object.ply"
-        _object_mesh(*surface).export(path)
+        _object_mesh(surface).export(path)
         written.append(path)
     path = out / "recognition.json"
     path.write_text(json.dumps(contact_map.summary(), indent=2, allow_nan=False) + "\n")
@@ -139,29 +147,34 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
     return written
 
 
-def _object_mesh(mesh: trimesh.Trimesh, std: NDArray[np.float64]) -> trimesh.Trimesh:
-    """The named object's mesh coloured by its standard deviation, capped at its size (m)."""
-    if np.all(np.isfinite(std)):
-        colours = std_colours(np.minimum(std, float(np.max(mesh.extents))))
-    else:
-        colours = np.tile(np.array(GREY, dtype=np.uint8), (len(mesh.vertices), 1))
+def _object_mesh(surface: ObjectSurface) -> trimesh.Trimesh:
+    """The named object's mesh, coloured by its deviation from 0 (blue) to where the evidence
+    no longer holds it (red)."""
     return trimesh.Trimesh(
-        vertices=mesh.vertices, faces=mesh.faces, vertex_colors=colours, process=False
+        vertices=surface.mesh.vertices,
+        faces=surface.mesh.faces,
+        vertex_colors=std_colours(surface.std, surface.unheld),
+        process=False,
     )
 
 
-def _object_line(summary: dict[str, Any] | None) -> str:
+def _object_line(contact_map: ContactMap, summary: dict[str, Any] | None) -> str:
+    named = None if contact_map.recognition is None else contact_map.recognition.named
     if summary is None:
-        return "Object surface: none (recognition names no object)."
-    line = (
-        f"Object surface: the {summary['class']}'s fitted shape, {summary['faces']} faces"
-        " (object.ply)"
+        why = "recognition names no object" if named is None else f"the {named.name} is unbounded"
+        return f"Object surface: none ({why})."
+    line = f"Object surface: the {summary['class']}'s fitted shape (object.ply)"
+    if summary["held_share"] is None:
+        return line + "; its registration carries no deviation."
+    line += (
+        f"; {100 * summary['held_share']:.0f} % of its area held by the evidence to"
+        f" {100 * UNHELD_FRACTION:.0f} % of its size"
     )
-    if summary["std_median_m"] is None:
+    if summary["held_std_median_m"] is None:
         return line + "."
     return (
-        line + f"; where it lies, standard deviation median {1000 * summary['std_median_m']:.1f}"
-        f" mm, 90th percentile {1000 * summary['std_p90_m']:.1f} mm."
+        line + f", there with a standard deviation of {1000 * summary['held_std_median_m']:.2f}"
+        f" mm (median by area; 90 %: {1000 * summary['held_std_p90_m']:.2f} mm)."
     )
 
 
@@ -192,7 +205,7 @@ def report(contact_map: ContactMap) -> str:
         )
     else:
         lines.append("Surface: none (too few points, or no zero level in the grid).")
-    lines.append(_object_line(s["object_surface"]))
+    lines.append(_object_line(contact_map, s["object_surface"]))
     recognition = contact_map.recognition
     lines.append("")
     if recognition is None:

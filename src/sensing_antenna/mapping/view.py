@@ -22,13 +22,12 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.mapping.contact_map import ContactMap
-from sensing_antenna.mapping.store import std_colours
+from sensing_antenna.mapping.store import GREY, std_colours
 
 __all__ = ["map_scene", "write_map_html"]
 
-#: Colours (RGBA) of the recognised shape and of the true surface.
+#: Colour (RGBA) of the recognised shape (the true surface's is grey).
 RECOGNISED_COLOUR = (40, 160, 60, 255)
-TRUTH_COLOUR = (150, 150, 150, 255)
 
 
 def _markers(points: NDArray[np.float64], colours: NDArray[np.uint8]) -> trimesh.Trimesh:
@@ -81,7 +80,7 @@ def map_scene(contact_map: ContactMap, truth: trimesh.Trimesh | None = None) -> 
         shape = _coloured(recognition.best.mesh, RECOGNISED_COLOUR)
         scene.add_geometry(shape, node_name="recognised", geom_name="recognised")
     if truth is not None and len(truth.faces):
-        scene.add_geometry(_coloured(truth, TRUTH_COLOUR), node_name="truth", geom_name="truth")
+        scene.add_geometry(_coloured(truth, GREY), node_name="truth", geom_name="truth")
     return scene
 
 
