@@ -166,9 +166,10 @@ def _object_line(contact_map: ContactMap, summary: dict[str, Any] | None) -> str
     line = f"Object surface: the {summary['class']}'s fitted shape (object.ply)"
     if summary["held_share"] is None:
         return line + "; its registration carries no deviation."
+    unheld = UNHELD_FRACTION * summary["size_m"]
     line += (
-        f"; {100 * summary['held_share']:.0f} % of its area held by the evidence to"
-        f" {100 * UNHELD_FRACTION:.0f} % of its size"
+        f"; {100 * summary['held_share']:.0f} % of its area held by the evidence (its deviation"
+        f" there below {1000 * unheld:.1f} mm, {UNHELD_FRACTION:g} of its size)"
     )
     if summary["held_std_median_m"] is None:
         return line + "."
