@@ -168,14 +168,14 @@ def _object_line(contact_map: ContactMap, summary: dict[str, Any] | None) -> str
         return line + "; its registration carries no deviation."
     unheld = UNHELD_FRACTION * summary["size_m"]
     line += (
-        f"; {100 * summary['held_share']:.0f} % of its area held by the evidence (its deviation"
-        f" there below {1000 * unheld:.1f} mm, {UNHELD_FRACTION:g} of its size)"
+        f"; {100 * summary['held_share']:.0f} % of its area held by the evidence (deviation"
+        f" below {1000 * unheld:.1f} mm, {UNHELD_FRACTION:g} of its size)"
     )
     if summary["held_std_median_m"] is None:
         return line + "."
     return (
-        line + f", there with a standard deviation of {1000 * summary['held_std_median_m']:.2f}"
-        f" mm (median by area; 90 %: {1000 * summary['held_std_p90_m']:.2f} mm)."
+        line + f", with a standard deviation of {1000 * summary['held_std_median_m']:.2f} mm"
+        f" there (median by area; 90 %: {1000 * summary['held_std_p90_m']:.2f} mm)."
     )
 
 
