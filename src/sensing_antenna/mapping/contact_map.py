@@ -85,9 +85,11 @@ class ObjectSurface:
     std : array, shape (n_vertices,)
         Standard deviation of where the surface lies at each vertex (m;
         :meth:`ClassFit.distance_std`): far beyond the object's size where no evidence holds
-        it, NaN throughout for a user mesh (its registration carries none).
+        it, NaN throughout for a user mesh (its registration carries none) or a fit whose
+        covariance is not finite.
     size : float
-        The object's size, the largest extent of its mesh (m).
+        The object's size, the largest extent of its mesh's oriented bounding box (m), whatever
+        its pose.
     """
 
     name: str
@@ -99,7 +101,7 @@ class ObjectSurface:
     def of(cls, fit: ClassFit) -> ObjectSurface:
         """The surface of ``fit`` (its mesh must have faces)."""
         assert fit.mesh is not None
-        size = float(np.max(fit.mesh.extents))
+        size = float(np.max(trimesh.bounds.oriented_bounds(fit.mesh)[1]))
         vertices, faces = trimesh.remesh.subdivide_to_size(
             fit.mesh.vertices, fit.mesh.faces, max_edge=size / 20
         )
@@ -119,9 +121,10 @@ class ObjectSurface:
         return areas
 
     def summary(self) -> dict[str, Any]:
-        """JSON-able: the class, the faces, and where the surface is held (its deviation below
-        :attr:`unheld`): that share of the area, and the deviation's median and 90th percentile
-        there by area (m); the three null for a user mesh."""
+        """JSON-able: the class, the faces, the size (m), and where the surface is held (its
+        deviation below :attr:`unheld`; a vertex without a finite one is not): that share of the
+        area, and the deviation's median and 90th percentile there by area (m); the three null
+        when no vertex has a deviation (a user mesh), the two quantiles when none is held."""
         summary: dict[str, Any] = {
             "class": self.name,
             "faces": len(self.mesh.faces),
@@ -130,7 +133,7 @@ class ObjectSurface:
             "held_std_median_m": None,
             "held_std_p90_m": None,
         }
-        if not np.all(np.isfinite(self.std)):
+        if np.all(np.isnan(self.std)):
             return summary
         areas = self.vertex_areas()
         held = self.std < self.unheld

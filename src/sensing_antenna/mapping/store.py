@@ -64,8 +64,11 @@ GREY = (150, 150, 150, 255)
 
 
 def std_colours(values: NDArray[np.float64], top: float | None = None) -> NDArray[np.uint8]:
-    """RGBA rows from blue to red of ``values``: from the smallest to the largest, or, with
-    ``top``, from 0 to ``top`` and beyond (inf red); NaN grey."""
+    """RGBA rows from blue to red of ``values``: from the smallest to the largest finite one
+    (the others grey), or, with ``top`` (> 0), from 0 to ``top`` and beyond (inf red, NaN
+    grey)."""
+    if top is not None and not top > 0:
+        raise ValueError(f"top must be > 0, not {top}")
     v = np.asarray(values, dtype=float)
     known = np.isfinite(v) if top is None else ~np.isnan(v)
     if top is not None:
@@ -165,7 +168,7 @@ def _object_line(contact_map: ContactMap, summary: dict[str, Any] | None) -> str
         return f"Object surface: none ({why})."
     line = f"Object surface: the {summary['class']}'s fitted shape (object.ply)"
     if summary["held_share"] is None:
-        return line + "; its registration carries no deviation."
+        return line + "; it carries no deviation (a registered mesh, or a fit not held at all)."
     unheld = UNHELD_FRACTION * summary["size_m"]
     line += (
         f"; {100 * summary['held_share']:.0f} % of its area held by the evidence (deviation"
