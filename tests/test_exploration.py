@@ -583,7 +583,8 @@ def test_an_object_recognised_at_the_budget_ends_the_exploration(
 
     import sensing_antenna.exploration.run as run
 
-    named = types.SimpleNamespace(undecided=False, best=types.SimpleNamespace(name="stand-in"))
+    best = types.SimpleNamespace(name="stand-in", mesh=None)
+    named = types.SimpleNamespace(undecided=False, best=best, named=best)
     monkeypatch.setattr(run, "recognise_points", lambda *args, **kwargs: named)
     out = tmp_path / "named"
     out.mkdir()
