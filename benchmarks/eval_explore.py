@@ -463,11 +463,13 @@ def run(
     row["contacts_to_object_target"] = object_progress(
         scene, result, out, progress, samples[::OBJECT_STRIDE]
     )
-    named = result.contact_map.object_surface()
-    row["shape_rms_m"] = (
-        math.nan if named is None else whole_rms(named.mesh, samples[::OBJECT_STRIDE])
-    )
     recognition = result.contact_map.recognition
+    named = None if recognition is None else recognition.named
+    row["shape_rms_m"] = (
+        math.nan
+        if named is None or named.mesh is None
+        else whole_rms(named.mesh, samples[::OBJECT_STRIDE])
+    )
     if recognition is None:
         row.update(
             decision=None,

@@ -29,7 +29,14 @@ from sensing_antenna.exploration.plan import (
     candidate_sweeps,
     spread_order,
 )
-from sensing_antenna.mapping import UNDECIDED, BasePose, ClassFit, ImplicitSurface, recognise
+from sensing_antenna.mapping import (
+    UNDECIDED,
+    BasePose,
+    ClassFit,
+    ImplicitSurface,
+    Recognition,
+    recognise,
+)
 from sensing_antenna.scene import (
     LinkShape,
     Scene,
@@ -579,12 +586,10 @@ def test_an_object_recognised_at_the_budget_ends_the_exploration(
 ) -> None:
     # recognition that names an object (here a stand-in that always does) leaves nothing to
     # sweep for after the budget
-    import types
-
     import sensing_antenna.exploration.run as run
 
-    best = types.SimpleNamespace(name="stand-in", mesh=None)
-    named = types.SimpleNamespace(undecided=False, best=best, named=best)
+    stand_in = ClassFit("stand-in", {}, {}, rms=0.0, chi2=0.0, bic=0.0, dof=0, n_points=0)
+    named = Recognition("stand-in", (stand_in,), ("stand-in",), math.inf, 1.0, 6.0)
     monkeypatch.setattr(run, "recognise_points", lambda *args, **kwargs: named)
     out = tmp_path / "named"
     out.mkdir()

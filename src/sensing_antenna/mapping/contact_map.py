@@ -16,6 +16,7 @@ import json
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -185,7 +186,11 @@ class ContactMap:
 
     def object_surface(self) -> ObjectSurface | None:
         """The named object's fitted surface, the whole object; None when no object is named
-        or the named class is unbounded (the plane)."""
+        or the named class is unbounded (the plane). Made once per map."""
+        return self._object_surface
+
+    @cached_property
+    def _object_surface(self) -> ObjectSurface | None:
         fit = None if self.recognition is None else self.recognition.named
         if fit is None or fit.mesh is None or not len(fit.mesh.faces):
             return None
@@ -212,12 +217,10 @@ class ContactMap:
             else float(self.surface.length_scale_),
             "surface_faces": 0 if self.surface_mesh is None else len(self.surface_mesh.faces),
             "recognition": None if self.recognition is None else self.recognition.to_dict(),
-            "object_surface": self._object_summary(),
+            "object_surface": None
+            if self._object_surface is None
+            else self._object_surface.summary(),
         }
-
-    def _object_summary(self) -> dict[str, Any] | None:
-        surface = self.object_surface()
-        return None if surface is None else surface.summary()
 
 
 def points_from_recordings(

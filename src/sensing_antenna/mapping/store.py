@@ -162,17 +162,17 @@ def _object_mesh(surface: ObjectSurface) -> trimesh.Trimesh:
 
 
 def _object_line(contact_map: ContactMap, summary: dict[str, Any] | None) -> str:
-    named = None if contact_map.recognition is None else contact_map.recognition.named
-    if summary is None:
+    surface = contact_map.object_surface()
+    if surface is None or summary is None:
+        named = None if contact_map.recognition is None else contact_map.recognition.named
         why = "recognition names no object" if named is None else f"the {named.name} is unbounded"
         return f"Object surface: none ({why})."
-    line = f"Object surface: the {summary['class']}'s fitted shape (object.ply)"
+    line = f"Object surface: the {surface.name}'s fitted shape (object.ply)"
     if summary["held_share"] is None:
         return line + "; it carries no deviation (a registered mesh, or a fit not held at all)."
-    unheld = UNHELD_FRACTION * summary["size_m"]
     line += (
         f"; {100 * summary['held_share']:.0f} % of its area held by the evidence (deviation"
-        f" below {1000 * unheld:.1f} mm, {UNHELD_FRACTION:g} of its size)"
+        f" below {1000 * surface.unheld:.1f} mm, {UNHELD_FRACTION:g} of its size)"
     )
     if summary["held_std_median_m"] is None:
         return line + "."
