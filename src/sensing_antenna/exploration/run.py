@@ -114,7 +114,6 @@ __all__ = [
     "CALIBRATION_FRICTION",
     "CALIBRATION_POINTS",
     "DEFAULT_BUILD",
-    "REALISTIC_CALIBRATION_POINTS",
     "Exploration",
     "ExplorationInterrupted",
     "ExploreSettings",
@@ -163,11 +162,6 @@ VERTICAL: Literal["vertical"] = "vertical"
 #: same draw of imperfections, on the device file's link).
 DEFAULT_BUILD = 2021
 
-#: Where a realistic device's calibration touches (m): the campaigns' points
-#: (``campaign.schema.DEFAULT_CALIBRATION_POINTS``) short of the link's tip, and the tip, each
-#: swept both ways (azimuthal and vertical), for T_e with the tip mass and the sensor's
-#: cross-talk (:func:`realistic_calibration_points`).
-REALISTIC_CALIBRATION_POINTS = DEFAULT_CALIBRATION_POINTS
 
 #: What the preparation of a realistic device does (stored with the settings).
 REALISTIC_PREPARATION = (
@@ -255,9 +249,11 @@ class ExploreSettings:
 
 
 def realistic_calibration_points(length: float) -> tuple[float, ...]:
-    """A realistic device's calibration posts (m) on a link of ``length`` (m): those of
-    :data:`REALISTIC_CALIBRATION_POINTS` short of the tip, then the tip."""
-    return (*(x for x in REALISTIC_CALIBRATION_POINTS if x < length), length)
+    """A realistic device's calibration posts (m) on a link of ``length`` (m), each swept both
+    ways (azimuthal and vertical) for T_e with the tip mass and the sensor's cross-talk: the
+    campaigns' points (``campaign.schema.DEFAULT_CALIBRATION_POINTS``) short of the tip, then
+    the tip."""
+    return (*(x for x in DEFAULT_CALIBRATION_POINTS if x < length), length)
 
 
 class ExplorationInterrupted(KeyboardInterrupt):
