@@ -135,7 +135,8 @@ def branch_at_cap(
 ) -> tuple[ContactPosterior, dict[str, Any]]:
     """At the cap, let the second contact mode choose between two branches the ratio cannot.
 
-    Asked (:func:`second_mode_chooser`, on the final window) when the posterior still holds
+    Asked (:func:`second_mode_chooser`, on the final window, or from t_1 to the cap when that
+    window is too short to resolve the candidates' omega_2) when the posterior still holds
     both branches, when the window's higher mode contradicted the branch it holds, or when the
     window ``answers`` at the cap on one branch (its interval within ``cap_tolerance``, which
     no window before it reached at ``tolerance``, where the windows ask); with
@@ -153,6 +154,11 @@ def branch_at_cap(
         return posterior, {}
     choose = second_mode_chooser(evidence)
     choice, notes = choose(window.start_index, window.end_index, window.omega1, candidates)
+    if "not_asked" in notes and window.start_index > evidence.rest_index:
+        # a window restarted late is too short to resolve the two omega_2: the samples from
+        # t_1 to the cap, the span the paper's own test reads
+        choice, notes = choose(evidence.rest_index, window.end_index, window.omega1, candidates)
+        notes = {**notes, "span": "from t_1"}
     conditioned = on_chosen_branch(posterior, candidates, choice)
     if conditioned is None:
         # a branch the posterior gives no probability: no conditioning, but an answer there
