@@ -523,3 +523,24 @@ def test_candidates_the_ratio_cannot_tell_apart_without_a_second_mode_are_uncert
     chosen = estimate(synthetic_recording(Synthetic(x_c=0.8, seed=3)), calibrated())
     assert chosen.status is Status.OK and chosen.diagnostics["discriminated_by"] == "omega2"
     assert chosen.x_c == pytest.approx(0.8, abs=1e-3)
+
+
+@pytest.mark.parametrize("method", ["fast", "paper"])
+def test_the_point_turns_with_a_head_that_yields_after_t1(method: str) -> None:
+    # A servo holding the head against the push yields a little after t_1. The point is placed
+    # with the head's angles at the instant it describes: the same recording with the azimuth
+    # stepped by 2 mrad from t_1 + 0.1 s on (forces unchanged) gives the same x_c and a point
+    # turned about the azimuth axis by the step's share of those angles.
+    antenna = calibrated()
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.5, seed=4))
+    blind = recording.without_ground_truth()
+    before = estimate(blind, antenna, method=method)
+    step, theta = 2e-3, np.array(blind.theta)
+    theta[blind.t > before.t_1 + 0.1, 0] += step
+    after = estimate(dataclasses.replace(blind, theta=theta), antenna, method=method)
+    assert after.x_c == before.x_c
+    turned = after.diagnostics["theta_at_point"][0] - before.diagnostics["theta_at_point"][0]
+    assert 0.3 * step < turned <= step
+    azimuth = [math.atan2(e.contact_point[1], e.contact_point[0]) for e in (before, after)]
+    assert azimuth[1] - azimuth[0] == pytest.approx(turned, abs=1e-9)
+    assert after.contact_point[2] == pytest.approx(before.contact_point[2], abs=1e-12)

@@ -127,7 +127,7 @@ def test_covariance_matches_a_monte_carlo_of_the_geometry(y_c: float) -> None:
         contact_point=point_a,
         interval=(x_c - half_width, x_c + half_width),
         diagnostics={
-            "theta_at_t1": theta,
+            "theta_at_point": theta,
             "deflection": y_c,
             "axes_c_absolute": np.array([np.cross(y_axis, x_m), y_axis, x_m]),
         },
@@ -222,7 +222,7 @@ def test_the_point_is_where_the_links_surface_meets_the_object() -> None:
         x_c=0.6,
         contact_point=axis_point,
         diagnostics={
-            "theta_at_t1": np.array([0.0, 0.0]),
+            "theta_at_point": np.array([0.0, 0.0]),
             "deflection": 0.02,
             "axes_c_absolute": np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]]),
         },
@@ -244,7 +244,7 @@ def test_a_fast_point_is_uncertain_along_its_measured_push_not_across_the_bendin
     result = estimate(recording.without_ground_truth(), antenna, method="fast")
     assert result.status is Status.OK
     axes = np.asarray(result.diagnostics["axes_c_absolute"])
-    theta = np.asarray(result.diagnostics["theta_at_t1"])
+    theta = np.asarray(result.diagnostics["theta_at_point"])
     x_m = _axes(*theta)[0]
     push = axes[1] - (axes[1] @ x_m) * x_m
     push /= np.linalg.norm(push)
@@ -281,6 +281,6 @@ def test_the_link_is_tangent_to_the_ball_it_pushes(case: str, centre: list[float
     assert abs(point.tangent @ normal) < 3 * math.sin(point.tangent_std)
     assert np.linalg.norm(point.tangent) == pytest.approx(1.0, abs=1e-12)
     assert point.link_beyond == pytest.approx(ANTENNA.link.length - result.x_c, abs=1e-12)
-    theta = np.asarray(result.diagnostics["theta_at_t1"], dtype=float)
+    theta = np.asarray(result.diagnostics["theta_at_point"], dtype=float)
     unbent = outcome.frame.rotation @ _axes(*theta)[0]
     assert abs(unbent @ normal) > abs(point.tangent @ normal)

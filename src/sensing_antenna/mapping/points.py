@@ -1,10 +1,11 @@
 """Contact points in the world with their covariance: what a map is built from.
 
 An estimate gives the touched point in the recording's absolute frame (``contact_point``),
-p_a = x_c X^m + y_c Y^c + s A, the abscissa x_c along the link's rigid line X^m (at t_1's motor
-angles), bent by the push deflection y_c along Y^c (the reaction's direction at the instant the
-point describes, the diagnostics' ``t_point``) and by the weight's sag s along A (the part of
--Z^a across the link; estimation/methods/touch_point.py): a point of the link's axis. The map's
+p_a = x_c X^m + y_c Y^c + s A, the abscissa x_c along the link's rigid line X^m, bent by the
+push deflection y_c along Y^c (the reaction's direction) and by the weight's sag s along A (the
+part of -Z^a across the link; estimation/methods/touch_point.py), all at the instant the point
+describes (the diagnostics' ``t_point``, with the head's motor angles and the reaction then): a
+point of the link's axis. The map's
 point is on the link's surface, where the object touches it (the link's thickness, below). Its
 covariance is propagated to first order from independent sources (docs/mapping.md derives each
 term):
@@ -225,7 +226,7 @@ def contact_point_from_estimate(
     ----------
     estimate : ContactEstimate
         Its ``contact_point`` (absolute frame, m), ``x_c``, ``interval``, ``status`` and the
-        diagnostics ``theta_at_t1`` (rad, shape (2,)), ``deflection`` (m) and
+        diagnostics ``theta_at_point`` (rad, shape (2,)), ``deflection`` (m) and
         ``axes_c_absolute`` (rows X^c, Y^c, Z^c) when present; without the angles the link's
         direction is taken from the point itself.
     antenna : Antenna
@@ -273,7 +274,7 @@ def contact_point_from_estimate(
 class _Geometry:
     """The estimate's link at the contact, in the absolute frame (module docstring)."""
 
-    theta: FloatArray  # motor angles at t_1 (rad)
+    theta: FloatArray  # motor angles the point was placed at (rad)
     x_m: FloatArray
     y_m: FloatArray
     z_m: FloatArray
@@ -288,7 +289,7 @@ def _geometry(estimate: ContactEstimate, antenna: Antenna) -> _Geometry:
     x_c = float(estimate.x_c)
     point_a = np.asarray(estimate.contact_point, dtype=float)
     diagnostics = estimate.diagnostics
-    theta = _angles(diagnostics.get("theta_at_t1"), point_a)
+    theta = _angles(diagnostics.get("theta_at_point"), point_a)
     axes_m = motor_axes(theta)  # rows X^m, Y^m, Z^m in the absolute frame
     x_m = axes_m[0]
     deflection = _finite(

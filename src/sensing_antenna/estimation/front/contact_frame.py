@@ -163,9 +163,10 @@ class ContactFrame:
     axes_m : array, shape (3, 3)
         Rows X^c, Y^c, Z^c in motor coordinates.
     motor_axes_a : array, shape (3, 3)
-        Rows X^m, Y^m, Z^m in absolute coordinates at t_1.
+        Rows X^m, Y^m, Z^m in absolute coordinates at :attr:`theta`.
     theta : array, shape (2,)
-        Motor angles averaged over the frame window (rad).
+        Motor angles averaged over the frame window (rad), or at the instant of a frame
+        :meth:`turned_to` another.
     reaction_m : array, shape (3,)
         Reaction of the object on the antenna R = F - F_g^m, motor frame (N).
     """
@@ -191,17 +192,21 @@ class ContactFrame:
         norm = self.push_force
         return float(abs(self.reaction_m[0]) / norm) if norm > 0 else float("nan")
 
-    def turned_to(self, reaction_m: FloatArray) -> ContactFrame | None:
-        """The frame at the same motor angles with Y^c along another reaction (motor frame, N,
-        shape (3,)): where the contact is when the reaction has turned, as a contact that
-        slides along the surface turns it. None where Y^c or Z^c is undefined."""
+    def turned_to(
+        self, reaction_m: FloatArray, theta: FloatArray | None = None
+    ) -> ContactFrame | None:
+        """The frame of another instant: Y^c along its reaction (motor frame, N, shape (3,)),
+        as a contact that slides along the surface turns it, and the head at its motor angles
+        ``theta`` (rad, shape (2,); default this frame's), as a servo that yields under the
+        push turns it. None where Y^c or Z^c is undefined."""
         axes = _contact_axes(np.asarray(reaction_m, dtype=float), 1.0)
         if axes is None:
             return None
+        angles = self.theta if theta is None else np.asarray(theta, dtype=float).reshape(2)
         return ContactFrame(
             axes_m=axes,
-            motor_axes_a=self.motor_axes_a,
-            theta=self.theta,
+            motor_axes_a=self.motor_axes_a if theta is None else motor_axes(angles),
+            theta=angles,
             reaction_m=np.asarray(reaction_m, dtype=float),
         )
 

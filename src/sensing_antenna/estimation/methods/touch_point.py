@@ -19,7 +19,9 @@ estimators). Near the tip of the paper's link it reaches 5 cm, as large as the p
 the paper's Assumption 5 neglects it. Both use one stiffness, 1 / (E I) =
 :attr:`~sensing_antenna.antenna.Link.bending_compliance` (rho / T^2 with the frequency model's T:
 a calibrated T_e measures it). The point is expressed in the absolute frame with the motor axes
-at t_1 (X^m, Y^m, Z^m of the recording format).
+(X^m, Y^m, Z^m of the recording format) of the frame it is placed in: at the instant the point
+describes, as the reaction it bends along (a servo holding the head yields a little under the
+push, by about a milliradian on the simulated head, half a millimetre at x_c = 0.5 m).
 """
 
 from __future__ import annotations
@@ -123,11 +125,17 @@ def touched_point_filtered(
     evidence: Evidence, x_c: float, index: int
 ) -> tuple[TouchPoint, ContactFrame, float]:
     """The touched point at ``x_c`` (m) placed with the front end's filtered reaction at sample
-    ``index``, the frame it was placed in (Y^c turned to that reaction) and the instant it
-    describes (s): the first-order low-pass's output lags its input by 1 / omega_c on average,
-    and a contact that slides along the surface turns the reaction the link bends along."""
+    ``index``, the frame it was placed in (Y^c turned to that reaction, the head at its motor
+    angles through the same low-pass from t_1) and the instant it describes (s): the first-order
+    low-pass's output lags its input by 1 / omega_c on average, a contact that slides along the
+    surface turns the reaction the link bends along, and a servo that yields under the push
+    turns the head."""
     reaction = evidence.reaction_f[index]
-    frame = evidence.frame.turned_to(reaction) or evidence.frame
+    start = min(evidence.rest_index, index)
+    age = evidence.t[index] - evidence.t[start : index + 1]
+    weights = np.exp(-evidence.config.lowpass_cutoff * age)
+    theta = weights @ evidence.theta[start : index + 1] / np.sum(weights)
+    frame = evidence.frame.turned_to(reaction, theta) or evidence.frame
     push = math.hypot(reaction[1], reaction[2])
     touch = touched_point(x_c, frame, push, evidence.antenna.link, float(reaction[0]))
     return touch, frame, float(evidence.t[index]) - 1.0 / evidence.config.lowpass_cutoff

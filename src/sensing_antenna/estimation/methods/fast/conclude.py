@@ -98,7 +98,9 @@ def conclude_fast(
     # when the contact slid along the surface meanwhile
     turned = None
     if statics is not None:
-        turned = evidence.frame.turned_to(np.array([axial, *statics.reaction_perp]))
+        # and the head where it held over the window: a servo yields a little under the push
+        held = np.mean(evidence.theta[final.start_index : final.end_index + 1], axis=0)
+        turned = evidence.frame.turned_to(np.array([axial, *statics.reaction_perp]), held)
     if turned is not None:
         frame, t_point = turned, 0.5 * float(t[final.start_index] + t[final.end_index])
     else:
@@ -161,7 +163,7 @@ def conclude_fast(
             "deflection_ratio": touch.deflection_ratio,
             # the frame the point was placed in and when (the map's covariance reads it)
             "axes_c_absolute": frame.axes_a,
-            "theta_at_t1": frame.theta,
+            "theta_at_point": frame.theta,
             "t_point": t_point,
             # the window's first sample: t_1, or later when the link bounced after t_1
             "window_start": float(t[final.start_index]),

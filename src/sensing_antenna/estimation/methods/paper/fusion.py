@@ -253,7 +253,7 @@ def conclude(
             "deflection": touch.deflection,
             "deflection_ratio": touch.deflection_ratio,
             "axes_c_absolute": frame.axes_a,
-            "theta_at_t1": frame.theta,
+            "theta_at_point": frame.theta,
             "t_point": t_point,
             "delta_t_e2": (
                 float(evidence.t[evidence.converged_index] - evidence.t[evidence.rest_index])
