@@ -189,9 +189,9 @@ def truth_section(summary: CampaignSummary) -> list[str]:
         "are a claim about where the link touches, so their coverage is judged against the "
         "contact abscissa. Errors against both, in mm, over every run with an estimate; and "
         "the distance from the estimated touched point in 3D (the abscissa along the link at "
-        "t_1's motor angles, bent by the push and sagged by the weight, on the link's surface) "
-        "to where the link touched at the instant the point describes (ground truth: the "
-        "recording's contact track at the estimate's `t_point`):",
+        "the motor angles of the instant the point describes, bent by the push and sagged by "
+        "the weight, on the link's surface) to where the link touched at that instant (ground "
+        "truth: the recording's contact track at the estimate's `t_point`):",
         "",
         *markdown_table(
             [
