@@ -529,18 +529,30 @@ def test_candidates_the_ratio_cannot_tell_apart_without_a_second_mode_are_uncert
 def test_the_point_turns_with_a_head_that_yields_after_t1(method: str) -> None:
     # A servo holding the head against the push yields a little after t_1. The point is placed
     # with the head's angles at the instant it describes: the same recording with the azimuth
-    # stepped by 2 mrad from t_1 + 0.1 s on (forces unchanged) gives the same x_c and a point
-    # turned about the azimuth axis by the step's share of those angles.
+    # stepped by 2 mrad after the hold that sets the contact frame (forces unchanged) gives the
+    # same x_c and a point turned about the azimuth axis by the step's share of those angles:
+    # of the answer's window for `fast`, of the reaction's low-pass weights from t_1 for `paper`.
     antenna = calibrated()
     recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.5, seed=4))
     blind = recording.without_ground_truth()
     before = estimate(blind, antenna, method=method)
-    step, theta = 2e-3, np.array(blind.theta)
-    theta[blind.t > before.t_1 + 0.1, 0] += step
+    config = EstimatorConfig()
+    step, stepped = 2e-3, blind.t > before.t_1 + config.frame_window + 0.05
+    theta = np.array(blind.theta)
+    theta[stepped, 0] += step
     after = estimate(dataclasses.replace(blind, theta=theta), antenna, method=method)
     assert after.x_c == before.x_c
+    t = blind.t
+    if method == "fast":
+        held = (t >= before.diagnostics["window_start"]) & (t <= before.t_e)
+        share = np.count_nonzero(held & stepped) / np.count_nonzero(held)
+    else:
+        held = (t >= before.t_1) & (t <= before.t_e)
+        weights = np.exp(-config.lowpass_cutoff * (before.t_e - t[held]))
+        share = weights[stepped[held]].sum() / weights.sum()
     turned = after.diagnostics["theta_at_point"][0] - before.diagnostics["theta_at_point"][0]
-    assert 0.3 * step < turned <= step
+    assert 0.2 < share < 1.0
+    assert turned == pytest.approx(share * step, rel=0.01)
     azimuth = [math.atan2(e.contact_point[1], e.contact_point[0]) for e in (before, after)]
     assert azimuth[1] - azimuth[0] == pytest.approx(turned, abs=1e-9)
     assert after.contact_point[2] == pytest.approx(before.contact_point[2], abs=1e-12)

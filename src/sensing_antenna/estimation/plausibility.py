@@ -202,6 +202,7 @@ def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> Con
         "deflection": touch.deflection,
         "deflection_ratio": touch.deflection_ratio,
         "axes_c_absolute": frame.axes_a,
+        "theta_at_point": frame.theta,
         "t_point": t_point,
     }
     return dataclasses.replace(

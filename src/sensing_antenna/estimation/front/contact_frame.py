@@ -156,7 +156,8 @@ def first_rest_index(
 @dataclass(frozen=True)
 class ContactFrame:
     """The frame attached to the contact at t_1 (Section 5.3); turned (:meth:`turned_to`), the
-    same motor angles with Y^c along a later reaction, where a point of that instant is placed.
+    frame of a later instant, with Y^c along its reaction and the head at its motor angles,
+    where a point of that instant is placed.
 
     Attributes
     ----------

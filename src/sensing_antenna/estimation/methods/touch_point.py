@@ -78,7 +78,7 @@ def touched_point(
     x_c : float
         Contact point along the link, arc length (m).
     frame : ContactFrame
-        The motor angles at t_1 and Y^c along the reaction at the instant the point describes
+        The motor angles and Y^c along the reaction at the instant the point describes
         (``ContactFrame.turned_to``); the push's direction across the link is Y^c without its
         part along X^m.
     push_force : float
@@ -125,17 +125,25 @@ def touched_point_filtered(
     evidence: Evidence, x_c: float, index: int
 ) -> tuple[TouchPoint, ContactFrame, float]:
     """The touched point at ``x_c`` (m) placed with the front end's filtered reaction at sample
-    ``index``, the frame it was placed in (Y^c turned to that reaction, the head at its motor
-    angles through the same low-pass from t_1) and the instant it describes (s): the first-order
-    low-pass's output lags its input by 1 / omega_c on average, a contact that slides along the
-    surface turns the reaction the link bends along, and a servo that yields under the push
-    turns the head."""
+    ``index``, the frame it was placed in and the instant it describes (s, not before t_1): the
+    first-order low-pass's output lags its input by 1 / omega_c on average, a contact that
+    slides along the surface turns the reaction the link bends along, and a servo that yields
+    under the push turns the head. Y^c is turned to that reaction, and the head is at its motor
+    angles weighted as the low-pass weighs its input, exp(-omega_c age), cut off at t_1: the
+    head still turns into the object before t_1, and the reaction's content from before t_1
+    weighs exp(-omega_c (t - t_1)) of it (under 1 % a second after t_1). A reaction whose
+    direction across the link is undefined leaves the hold's frame and instant."""
     reaction = evidence.reaction_f[index]
     start = min(evidence.rest_index, index)
     age = evidence.t[index] - evidence.t[start : index + 1]
     weights = np.exp(-evidence.config.lowpass_cutoff * age)
     theta = weights @ evidence.theta[start : index + 1] / np.sum(weights)
-    frame = evidence.frame.turned_to(reaction, theta) or evidence.frame
+    frame = evidence.frame.turned_to(reaction, theta)
+    t_1 = float(evidence.t[evidence.rest_index])
+    if frame is None:
+        frame, t_point = evidence.frame, t_1 + 0.5 * evidence.config.frame_window
+    else:
+        t_point = max(float(evidence.t[index]) - 1.0 / evidence.config.lowpass_cutoff, t_1)
     push = math.hypot(reaction[1], reaction[2])
     touch = touched_point(x_c, frame, push, evidence.antenna.link, float(reaction[0]))
-    return touch, frame, float(evidence.t[index]) - 1.0 / evidence.config.lowpass_cutoff
+    return touch, frame, t_point

@@ -73,7 +73,7 @@ def conclude_fast(
     if final.branch_chosen_by_second_mode:
         diag["branch_chosen_by"] = "omega2"
     if result.reached_cap and not final.sure:
-        # The final window's samples only (up to the cap), online and offline alike
+        # The final window's samples (from t_1 when it is too short), online and offline alike
         answers = accepted_at_cap(final, config)
         post, second_mode = branch_at_cap(evidence, final, candidates, answers)
         diag.update(second_mode)

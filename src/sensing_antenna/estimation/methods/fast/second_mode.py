@@ -3,7 +3,10 @@
 Where omega_1 is reached at two contact points and the torque/force ratio cannot tell them
 apart, the paper's second-mode test (:func:`~.fusion.second_mode_choice`) on the spectrum of the
 window's own samples may choose one: at every window whose posterior holds both branches
-(``FastConfig.branch_by_second_mode``), and at the cap.
+(``FastConfig.branch_by_second_mode``), and at the cap, where a window too short for the test
+has it read the samples from t_1. Before an answer is given on one branch, the same spectrum
+may object to it with less than a choice needs (:func:`~.fusion.second_mode_against`, the
+paper method's rule).
 """
 
 from __future__ import annotations
@@ -20,7 +23,11 @@ from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.curves import curve_table
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
 from sensing_antenna.estimation.methods.paper.frequency import evidence_frequency, second_mode_peak
-from sensing_antenna.estimation.methods.paper.fusion import predicted_omega2, second_mode_choice
+from sensing_antenna.estimation.methods.paper.fusion import (
+    predicted_omega2,
+    second_mode_against,
+    second_mode_choice,
+)
 
 if TYPE_CHECKING:
     from sensing_antenna.estimation.methods.fast.window import WindowEstimate
@@ -51,7 +58,9 @@ def second_mode_chooser(evidence: Evidence) -> BranchChooser:
     lobe's slope and hold no peak whatever the truth). An answer whose peak lies nearer 2 or 3
     omega_1 than the chosen candidate's omega_2 is dropped: a clipping contact's harmonic may be
     what it saw (at 0.70 m on the paper link 3 omega_1 is 2.9 % from the other candidate's
-    omega_2).
+    omega_2). The notes' ``"against"`` says, per candidate, whether the spectrum speaks against
+    it by the paper method's rule (:func:`~.fusion.second_mode_against`), a peak that is not
+    nearer such a harmonic.
     """
 
     def choose(
@@ -64,17 +73,31 @@ def second_mode_chooser(evidence: Evidence) -> BranchChooser:
         window = dataclasses.replace(evidence, rest_index=start, end_index=end)
         component = evidence_frequency(window).component
         choice, notes = second_mode_choice(window, component, candidates)
+
+        def harmonic_near(k: int) -> float | None:
+            # the harmonic of omega_1 nearer candidate k's peak than its omega_2, if any
+            peak = notes["peak_omega"][k]
+            for harmonic in (2.0 * omega1, 3.0 * omega1):
+                if abs(peak - harmonic) < abs(peak - omega2[k]):
+                    return harmonic
+            return None
+
+        against = [
+            second_mode_against(notes, k, evidence.config) is not None
+            and harmonic_near(1 - k) is None
+            for k in (0, 1)
+        ]
+        notes = {**notes, "against": against}
         if choice is None:
             return choice, notes
         # The peak the answer rests on, nearer a harmonic than the candidate's omega_2?
-        peak = notes["peak_omega"][choice]
-        for harmonic in (2.0 * omega1, 3.0 * omega1):
-            if abs(peak - harmonic) < abs(peak - omega2[choice]):
-                dropped = (
-                    f"the peak at {peak:.1f} rad/s is nearer {harmonic:.1f} rad/s, a "
-                    "harmonic of omega_1"
-                )
-                return None, {**notes, "dropped": dropped}
+        harmonic = harmonic_near(choice)
+        if harmonic is not None:
+            dropped = (
+                f"the peak at {notes['peak_omega'][choice]:.1f} rad/s is nearer "
+                f"{harmonic:.1f} rad/s, a harmonic of omega_1"
+            )
+            return None, {**notes, "dropped": dropped}
         return choice, notes
 
     return choose
@@ -105,24 +128,36 @@ def second_mode_objection(
     and the chooser's notes ({} when not asked).
 
     With two candidates of omega_1 (rad/s) on different branches, the chooser is asked on the
-    window [start, end]; an answer on the other branch than the posterior's maximum objects.
+    window [start, end]; an answer on the other branch than the posterior's maximum objects, and
+    so does a spectrum that speaks against the candidate on the posterior's branch (the notes'
+    ``"against"``): an answer about to be given needs less evidence against it to wait than a
+    branch needs to be chosen.
     """
     if len(candidates) != 2:
         return "", {}
     choice, answer = choose_branch(start, end, omega1, candidates)
-    return _objection(posterior, candidates, choice), answer
+    return _objection(posterior, candidates, choice, answer), answer
 
 
 def _objection(
-    posterior: ContactPosterior, candidates: tuple[float, ...], choice: int | None
+    posterior: ContactPosterior,
+    candidates: tuple[float, ...],
+    choice: int | None,
+    notes: dict[str, Any],
 ) -> str:
-    """Why the chooser's ``choice`` contradicts the branch of ``posterior``'s maximum; ""."""
-    if choice is None or posterior.branch_of(candidates[choice]) == posterior.branch_of(
-        posterior.x_c
-    ):
+    """Why the chooser's ``choice``, or its notes' ``"against"``, contradicts the branch of
+    ``posterior``'s maximum; ""."""
+    own = posterior.branch_of(posterior.x_c)
+    mine = [k for k in (0, 1) if posterior.branch_of(candidates[k]) == own]
+    if choice is not None:
+        pointed = None if choice in mine else choice
+    else:
+        against = notes.get("against", (False, False))
+        pointed = 1 - mine[0] if len(mine) == 1 and against[mine[0]] else None
+    if pointed is None:
         return ""
     return (
-        f"the second contact mode points to x_c = {candidates[choice]:.3f} m, on the other "
+        f"the second contact mode points to x_c = {candidates[pointed]:.3f} m, on the other "
         f"branch of omega_1 than the posterior's x_c = {posterior.x_c:.3f} m"
     )
 
@@ -150,7 +185,8 @@ def branch_at_cap(
     split = max(posterior.branch_probability) < posterior.level
     if len(candidates) != 2 or not (split or window.branch_contradicted or answers):
         return posterior, {}
-    if window.branch_chosen_by_second_mode or (split and window.second_mode):
+    asked = bool(window.second_mode) and "not_asked" not in window.second_mode
+    if window.branch_chosen_by_second_mode or (split and asked):
         return posterior, {}
     choose = second_mode_chooser(evidence)
     choice, notes = choose(window.start_index, window.end_index, window.omega1, candidates)
@@ -163,7 +199,7 @@ def branch_at_cap(
     if conditioned is None:
         # a branch the posterior gives no probability: no conditioning, but an answer there
         # would rest on the branch the second mode contradicts
-        objection = _objection(posterior, candidates, choice) if answers else ""
+        objection = _objection(posterior, candidates, choice, notes) if answers else ""
         if objection:
             return posterior, {"second_mode": notes, "second_mode_objection": objection}
         return posterior, {"second_mode": notes}

@@ -38,6 +38,7 @@ __all__ = [
     "conclude",
     "fuse",
     "model_spread",
+    "second_mode_against",
     "sensing_curve",
 ]
 
@@ -346,7 +347,7 @@ def _uncertainty_source(link: Link) -> str:
     return "the calibration's scatter"
 
 
-def _second_mode_against(notes: dict[str, Any], chosen: int, cfg: Any) -> int | None:
+def second_mode_against(notes: dict[str, Any], chosen: int, cfg: Any) -> int | None:
     """The other candidate when the second mode speaks against ``chosen``, else None.
 
     A scale error of the loads moves the ratio, not the modes: a peak in the other candidate's
@@ -452,7 +453,7 @@ class PaperMethod:
                         "the second contact mode is not clear",
                     )
                 )
-            contradiction = _second_mode_against(notes, int(fusion.chosen or 0), cfg)
+            contradiction = second_mode_against(notes, int(fusion.chosen or 0), cfg)
             if contradiction is not None:
                 problems.append(
                     (
