@@ -161,17 +161,21 @@ def test_a_mode2_scatter_without_a_calibrated_t_is_refused_in_one_line(tmp_path:
         load_antenna(path)
 
 
-def test_online_the_narrowed_answer_is_the_offline_one(near_top: tuple[Recording, float]) -> None:
-    recording, _ = near_top
-    offline = estimate(recording, WITH_MODE2, FastMethod())
-    online = OnlineEstimator(WITH_MODE2, recording.sample_period, FastMethod())
+def _streamed(recording: Recording, model: Antenna) -> ContactEstimate:
+    online = OnlineEstimator(model, recording.sample_period, FastMethod())
     streamed = None
     for k in range(recording.n_samples):
         out = online.update(
             recording.t[k], recording.theta[k], recording.force[k], recording.torque[k]
         )
         streamed = out if out is not None else streamed
-    streamed = streamed or online.finalize()
+    return streamed or online.finalize()
+
+
+def test_online_the_narrowed_answer_is_the_offline_one(near_top: tuple[Recording, float]) -> None:
+    recording, _ = near_top
+    offline = estimate(recording, WITH_MODE2, FastMethod())
+    streamed = _streamed(recording, WITH_MODE2)
     assert streamed.status is offline.status is Status.OK
     assert streamed.x_c == offline.x_c and streamed.interval == offline.interval
 
@@ -193,17 +197,6 @@ def _realistic_run(case: str, x_c: float, seed: int) -> tuple[Recording, float]:
         device, Scenario(case=case, contact_point=x_c, seed=seed, device=imperfections)
     )
     return recording.without_ground_truth(), float(recording.metadata["true_xc"])
-
-
-def _streamed(recording: Recording, model: Antenna) -> ContactEstimate:
-    online = OnlineEstimator(model, recording.sample_period, FastMethod())
-    streamed = None
-    for k in range(recording.n_samples):
-        out = online.update(
-            recording.t[k], recording.theta[k], recording.force[k], recording.torque[k]
-        )
-        streamed = out if out is not None else streamed
-    return streamed or online.finalize()
 
 
 def test_at_the_tip_a_misleading_ratio_does_not_put_the_answer_on_the_other_branch() -> None:
