@@ -531,13 +531,17 @@ def test_the_point_turns_with_a_head_that_yields_after_t1(method: str) -> None:
     # with the head's angles at the instant it describes: the same recording with the azimuth
     # stepped by 2 mrad after the hold that sets the contact frame (forces unchanged) gives the
     # same x_c and a point turned about the azimuth axis by the step's share of those angles:
-    # of the answer's window for `fast`, of the reaction's low-pass weights from t_1 for `paper`.
+    # of the answer's window for `fast`, of the reaction's low-pass weights from t_1 for `paper`
+    # (stepped where it takes about half of them).
     antenna = calibrated()
     recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.5, seed=4))
     blind = recording.without_ground_truth()
     before = estimate(blind, antenna, method=method)
     config = EstimatorConfig()
-    step, stepped = 2e-3, blind.t > before.t_1 + config.frame_window + 0.05
+    start = before.t_1 + config.frame_window + 0.05
+    if method == "paper":
+        start = max(start, before.t_e - math.log(2.0) / config.lowpass_cutoff)
+    step, stepped = 2e-3, blind.t > start
     theta = np.array(blind.theta)
     theta[stepped, 0] += step
     after = estimate(dataclasses.replace(blind, theta=theta), antenna, method=method)
@@ -551,8 +555,8 @@ def test_the_point_turns_with_a_head_that_yields_after_t1(method: str) -> None:
         weights = np.exp(-config.lowpass_cutoff * (before.t_e - t[held]))
         share = weights[stepped[held]].sum() / weights.sum()
     turned = after.diagnostics["theta_at_point"][0] - before.diagnostics["theta_at_point"][0]
-    assert 0.2 < share < 1.0
-    assert turned == pytest.approx(share * step, rel=0.01)
+    assert 0.2 < share < 0.8
+    assert turned == pytest.approx(share * step, rel=1e-6)
     azimuth = [math.atan2(e.contact_point[1], e.contact_point[0]) for e in (before, after)]
     assert azimuth[1] - azimuth[0] == pytest.approx(turned, abs=1e-9)
     assert after.contact_point[2] == pytest.approx(before.contact_point[2], abs=1e-12)

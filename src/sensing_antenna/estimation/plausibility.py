@@ -183,7 +183,8 @@ def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> Con
     """``estimate`` with x_c = l when it lies past the tip by no more than
     ``disagreement_sigmas`` statistical uncertainties of the ratio at l (otherwise unchanged),
     the touched point recomputed there with the filtered reaction at the estimate's t_e, as the
-    paper method places its point (the instant it describes lies 1 / omega_c before t_e)."""
+    paper method places its point (``touch_point.touched_point_filtered``: the instant it
+    describes lies 1 / omega_c before t_e, not before t_1)."""
     link = evidence.antenna.link
     excess = estimate.x_c - link.length
     if not (math.isfinite(excess) and excess > 0.0):

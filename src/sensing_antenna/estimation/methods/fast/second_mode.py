@@ -150,15 +150,19 @@ def _objection(
     own = posterior.branch_of(posterior.x_c)
     mine = [k for k in (0, 1) if posterior.branch_of(candidates[k]) == own]
     if choice is not None:
-        pointed = None if choice in mine else choice
-    else:
-        against = notes.get("against", (False, False))
-        pointed = 1 - mine[0] if len(mine) == 1 and against[mine[0]] else None
-    if pointed is None:
+        if choice in mine:
+            return ""
+        return (
+            f"the second contact mode points to x_c = {candidates[choice]:.3f} m, on the other "
+            f"branch of omega_1 than the posterior's x_c = {posterior.x_c:.3f} m"
+        )
+    against = notes.get("against", (False, False))
+    if len(mine) != 1 or not against[mine[0]]:
         return ""
     return (
-        f"the second contact mode points to x_c = {candidates[pointed]:.3f} m, on the other "
-        f"branch of omega_1 than the posterior's x_c = {posterior.x_c:.3f} m"
+        f"the spectrum speaks against the posterior's x_c = {posterior.x_c:.3f} m: a peak near "
+        f"the second contact mode of x_c = {candidates[1 - mine[0]]:.3f} m, on the other branch "
+        "of omega_1, ten times stronger than near its own"
     )
 
 
@@ -176,10 +180,11 @@ def branch_at_cap(
     window ``answers`` at the cap on one branch (its interval within ``cap_tolerance``, which
     no window before it reached at ``tolerance``, where the windows ask); with
     ``branch_by_second_mode`` on, the first case has been asked at the window already. When
-    decisive the posterior is conditioned on that branch. When the window answers and the mode
-    points to a branch the posterior gives no probability, the notes carry why
-    (``second_mode_objection``, a disagreement for the conclusion); otherwise the posterior
-    is unchanged.
+    decisive the posterior is conditioned on that branch. When it does not condition (no choice,
+    or a branch the posterior gives no probability) and the window answers, an objection to the
+    answer's branch (:func:`second_mode_objection`'s rule) is in the notes
+    (``second_mode_objection``, a disagreement for the conclusion); otherwise the posterior is
+    unchanged.
     """
     posterior = window.posterior
     split = max(posterior.branch_probability) < posterior.level
@@ -197,8 +202,8 @@ def branch_at_cap(
         notes = {**notes, "span": "from t_1"}
     conditioned = on_chosen_branch(posterior, candidates, choice)
     if conditioned is None:
-        # a branch the posterior gives no probability: no conditioning, but an answer there
-        # would rest on the branch the second mode contradicts
+        # no choice, or a branch the posterior gives no probability: no conditioning, but an
+        # answer would rest on a branch the second mode may speak against
         objection = _objection(posterior, candidates, choice, notes) if answers else ""
         if objection:
             return posterior, {"second_mode": notes, "second_mode_objection": objection}
