@@ -66,7 +66,7 @@ from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.front.ratio import lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
-from sensing_antenna.estimation.methods.touch_point import touched_point_filtered
+from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.units_check import angle_problem, is_payload, rest_moment_std
 
@@ -200,11 +200,7 @@ def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> Con
     diagnostics = {
         **estimate.diagnostics,
         "x_c_past_tip": estimate.x_c,
-        "deflection": touch.deflection,
-        "deflection_ratio": touch.deflection_ratio,
-        "axes_c_absolute": frame.axes_a,
-        "theta_at_point": frame.theta,
-        "t_point": t_point,
+        **placement(touch, frame, t_point),
     }
     return dataclasses.replace(
         estimate, x_c=link.length, contact_point=touch.point_a, diagnostics=diagnostics

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -40,7 +40,7 @@ from sensing_antenna.estimation.front.contact_frame import ContactFrame
 if TYPE_CHECKING:
     from sensing_antenna.estimation.front.evidence import Evidence
 
-__all__ = ["TouchPoint", "touched_point", "touched_point_filtered"]
+__all__ = ["TouchPoint", "placement", "touched_point", "touched_point_filtered"]
 
 FloatArray = NDArray[np.float64]
 
@@ -119,6 +119,20 @@ def touched_point(
         sag = STANDARD_GRAVITY * across_norm * float(link.unit_sag(x_c))
         point_a = point_a + sag * across / across_norm
     return TouchPoint(point_a=point_a, deflection=end.y, deflection_ratio=end.y / x_c, sag=sag)
+
+
+def placement(touch: TouchPoint, frame: ContactFrame, t_point: float) -> dict[str, Any]:
+    """The diagnostics every method reports of where its point was placed: the push deflection
+    ``deflection`` (m) and ``deflection_ratio``, the frame ``axes_c_absolute`` (rows X^c, Y^c,
+    Z^c in the absolute frame) and ``theta_at_point`` (the motor angles, rad) it was placed in,
+    and the instant ``t_point`` (s) it describes; a map's covariance reads them."""
+    return {
+        "deflection": touch.deflection,
+        "deflection_ratio": touch.deflection_ratio,
+        "axes_c_absolute": frame.axes_a,
+        "theta_at_point": frame.theta,
+        "t_point": t_point,
+    }
 
 
 def touched_point_filtered(

@@ -38,7 +38,7 @@ from sensing_antenna.estimation.methods.fast.second_mode import (
 )
 from sensing_antenna.estimation.methods.fast.static_fit import SensorBias
 from sensing_antenna.estimation.methods.fast.window import WindowEstimate
-from sensing_antenna.estimation.methods.touch_point import touched_point
+from sensing_antenna.estimation.methods.touch_point import placement, touched_point
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 
 __all__ = ["conclude_fast"]
@@ -159,12 +159,7 @@ def conclude_fast(
             "modes": final.fit.omega if final.fit is not None else (),
             "free_plane_share": _free_plane_share(final, evidence.frame.reaction_m[1:]),
             "push_force": push,
-            "deflection": touch.deflection,
-            "deflection_ratio": touch.deflection_ratio,
-            # the frame the point was placed in and when (the map's covariance reads it)
-            "axes_c_absolute": frame.axes_a,
-            "theta_at_point": frame.theta,
-            "t_point": t_point,
+            **placement(touch, frame, t_point),
             # the window's first sample: t_1, or later when the link bounced after t_1
             "window_start": float(t[final.start_index]),
             "note": final.note,

@@ -27,7 +27,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     find_peak,
 )
 from sensing_antenna.estimation.methods.paper.planes import bending_planes
-from sensing_antenna.estimation.methods.touch_point import touched_point_filtered
+from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 
 __all__ = [
@@ -251,11 +251,7 @@ def conclude(
             "push_force": push_force,
             "axial_fraction": evidence.frame.axial_fraction,
             "direction_drift": drift,
-            "deflection": touch.deflection,
-            "deflection_ratio": touch.deflection_ratio,
-            "axes_c_absolute": frame.axes_a,
-            "theta_at_point": frame.theta,
-            "t_point": t_point,
+            **placement(touch, frame, t_point),
             "delta_t_e2": (
                 float(evidence.t[evidence.converged_index] - evidence.t[evidence.rest_index])
                 if evidence.converged_index is not None
