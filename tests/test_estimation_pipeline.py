@@ -555,7 +555,8 @@ def test_the_point_turns_with_a_head_that_yields_after_t1(method: str) -> None:
         weights = np.exp(-config.lowpass_cutoff * (before.t_e - t[held]))
         share = weights[stepped[held]].sum() / weights.sum()
     turned = after.diagnostics["theta_at_point"][0] - before.diagnostics["theta_at_point"][0]
-    assert 0.2 < share < 0.8
+    assert 0.2 < share < 0.8  # a share that tells these angles from t_1's (0) and the step's (1)
+    # the same samples' weighted mean: equal but for rounding
     assert turned == pytest.approx(share * step, rel=1e-6)
     azimuth = [math.atan2(e.contact_point[1], e.contact_point[0]) for e in (before, after)]
     assert azimuth[1] - azimuth[0] == pytest.approx(turned, abs=1e-9)
