@@ -644,3 +644,35 @@ def test_a_cone_touched_below_its_apex_keeps_its_height_and_says_how_sure_its_su
     # about four times wider at 85 % of the height than on the slant among the points (0.78
     # against 0.18 mm), so twice is a margin the ratios above leave it
     assert np.mean(reported, axis=0)[1] > 2.0 * np.mean(reported, axis=0)[0]
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_box_touched_on_its_edges_is_not_grown_by_errors_along_the_link(seed: int) -> None:
+    # the lines' first touches of a box are on its edges, and an error along the link moves a
+    # point off the box whichever way it goes: the Euclidean distance reads every such point
+    # outside and a box fitted by it grows by a good part of the errors (by 1.1 to 1.3 mm on
+    # average over the three extents here); at each contact's nearest point along its line the
+    # box stays where the edges are
+    rng = np.random.default_rng(10 + seed)
+    extents = np.array([0.06, 0.1, 0.16])
+    mesh = trimesh.creation.box(extents=extents)
+    mesh.apply_transform(_pose(rng))
+    mesh.apply_translation([0.6, 0.0, 0.0] - mesh.bounding_box.centroid)
+    points, tangents = _first_touches(mesh, rng)
+    n = len(points)
+    along, across = 0.003, 0.0003  # the estimates' deviations along and across the link (m)
+    covariances = np.array(
+        [along**2 * np.outer(t, t) + across**2 * (np.eye(3) - np.outer(t, t)) for t in tangents]
+    )
+    points = points + np.array([rng.multivariate_normal(np.zeros(3), c) for c in covariances])
+    lines = LinkLines(tangents, np.full(n, 0.001), np.full(n, 0.4), np.full(n, 0.3))
+    fit = fit_primitive("box", points, covariances, rng=np.random.default_rng(0), lines=lines)
+    names = sorted(fit.sizes, key=lambda k: fit.sizes[k])
+    error = np.array([fit.sizes[k] for k in names]) - extents
+    # measured sizes within three of their deviations plus 0.1 mm; the mean of the three,
+    # which an outward growth moves one way, within 0.6 mm (half the Euclidean fit's growth)
+    for e, name in zip(error, names, strict=True):
+        std = fit.size_std[name]
+        if math.isfinite(std):
+            assert abs(e) < 3 * std + 1e-4, (error, fit.size_std)
+    assert abs(float(np.mean(error))) < 6e-4, error

@@ -1,22 +1,45 @@
 """Which object was touched: every shape class fitted to the points, scored, and a decision.
 
 Each primitive class (:mod:`~sensing_antenna.mapping.primitives`) is fitted by robust least
-squares of the point-to-surface distance, d_i / sigma_i, where sigma_i^2 = n_i^T Sigma_i n_i is
-the point's variance along the fitted surface's normal n_i (scipy.optimize.least_squares, soft-L1
-loss so that one bad point does not drag the fit; several starts per class from the points'
-principal axes and an algebraic sphere, keeping the lowest cost). A user mesh is registered to
-the points by iterative closest point (trimesh.registration.icp, from several starting
-rotations) and scored the same way with its six pose parameters.
+squares of each contact's distance to the surface in its standard deviations (below,
+"Distance."; scipy.optimize.least_squares, soft-L1 loss so that one bad point does not drag the
+fit; several starts per class from the points' principal axes and an algebraic sphere, fitted
+first by the Euclidean distance d_i / sigma_i, sigma_i^2 = n_i^T Sigma_i n_i the point's
+variance along the surface's normal n_i, then refined, keeping the lowest cost). A user mesh is
+registered to the points by iterative closest point (trimesh.registration.icp, from several
+starting rotations) and scored the same way with its six pose parameters.
+
+Distance. A contact's point lies on its link's line, far better known across the link than
+along it (the abscissa x_c is what the estimate knows least), and the link touched where its
+line meets the surface without entering it: tangent to a smooth surface, or passing over an
+edge. Over an edge an error along the link moves the point off the surface whichever way it
+goes, so the Euclidean distance reads every such point outside, and a box fitted by it grows by
+a good part of those errors. So where the link's tangent t_i is known (:class:`LinkLines`), a
+contact is taken at its nearest point along its line in its own metric: the line p_i + s t_i is
+sampled within :data:`TOUCH_REACH` of the point's standard deviations along t_i, sigma_a
+(:data:`TOUCH_SAMPLES` samples), and s_i minimises d(p_i + s t_i)^2 / sigma_i^2 + s^2 / sigma_a^2
+(the least sample moved to the vertex of the parabola through it and its neighbours), sigma_i the
+covariance across t_i along the normal there. Its residuals are the distance there,
+d_i / sqrt(sigma_i^2 + (s_i sigma_t)^2) (sigma_t the tangent's deviation in angle), its place
+a_i = s_i / sigma_a, and its line's cut c_i = min(0, m_i - min(0, d_i)) / sigma_i: how far the
+line enters the shape within that reach beyond that point's depth, m_i the line's least distance
+(the least sample, refined where the secants on either side of an edge meet). Beside a smooth
+surface tangent to the line d changes along it only at second order: the nearest point stays by
+the point and a_i is about 0, whatever the error along the link. Over an edge the nearest point
+is the edge, and a_i measures that error. A shape grown until the lines cross it pays for the
+cut. Against a plane this is the Mahalanobis distance, d^2 / (n^T Sigma n). A contact without a
+known tangent keeps the Euclidean d_i / sigma_i.
 
 The link's line. A link sweeping towards an object first touches it where the link is tangent
 to it: just before, the whole link was outside, and a round link never cuts into what it
 pushes. Each contact whose link direction is known (:class:`LinkLines`: the link's unit tangent
 at the contact, its standard deviation in angle, and how much link lies behind and beyond the
 contact) adds one residual: how far the link's line cuts into the fitted shape beyond the
-point's own depth, over its spread, at samples q_k = p + s_k t along the link's stretch around
-the contact (up to :data:`LINE_STRETCH` each way, within the link):
-r = min(0, min_k (d(q_k) - min(0, d(p))) / sqrt(sigma^2 + (s_k sigma_t)^2)), sigma the point's
-standard deviation along the normal and sigma_t the tangent's in angle. It is 0 for a convex
+depth of its nearest point, over its spread, at samples q_k = p + s_k t along the link's stretch
+around the contact (up to :data:`LINE_STRETCH` each way, within the link):
+r = min(0, min_k (d(q_k) - min(0, d_i)) / sqrt(sigma^2 + (s_k sigma_t)^2)), d_i the distance at
+the nearest point ("Distance."; at p without a tangent), sigma the point's standard deviation
+along the normal and sigma_t the tangent's in angle. It is 0 for a convex
 surface tangent to the link and for an edge the link passes over, and a line crossing a surface
 of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through the points a
 sweeping line left on a box's edges is not tangent to the lines that touched them.
@@ -28,13 +51,17 @@ into free space) and max(0, min_k (d(q_k) - a) / sigma_k) over a touching link's
 nowhere near it), a the link's radius.
 
 Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with chi^2 the sum over
-the points of -2 log-likelihood of their residuals z_i^2 = (d_i / sigma_i)^2 + r_i^2 up to a
-constant, and over the swept links of their r_j^2 in the same mixture (below), k the class's
-independent parameters, n the points, and c >= 1 the overdispersion (Burnham and Anderson,
-"Model Selection and Multimodel Inference", 2002, Section 6.2: the reduced chi^2 of the
-best-fitting class, over n - k, when above 1, so that points farther from every class than their
-covariances say, an estimator's systematic error, weigh less); c = 1 is BIC. The lowest score
-wins.
+the points of -2 log-likelihood of their residuals z_i^2 = (d_i / sigma_i)^2 + a_i^2 + c_i^2 +
+r_i^2 (the Euclidean d_i / sigma_i alone without a tangent) up to a constant, and over the swept
+links of their r_j^2 in the same mixture (below), k the class's independent parameters, n the
+points, and c >= 1 the overdispersion (Burnham and Anderson, "Model Selection and Multimodel
+Inference", 2002, Section 6.2: the reduced chi^2 of the best-fitting class, over N - k, when
+above 1, so that points farther from every class than their covariances say, an estimator's
+systematic error, weigh less; N counts a distance per point and each a_i by the share of the
+point's deviation along the link that its place measures, g^2 / sigma_i^2 over g^2 / sigma_i^2 +
+1 / sigma_a^2, g^2 the mean square of d's slopes along the line beside the nearest point: 1 over
+an edge, 0 beside a surface tangent to the line, :attr:`ClassFit.measurements`);
+c = 1 is BIC. The lowest score wins.
 The residuals' distribution is a mixture: a point is right, Gaussian about the surface with its
 sigma_i, except with the chance :data:`OUTLIER_FRACTION` that an estimate reported ``ok`` is
 wrong and lies anywhere across the points' spread L. Relative to a point on the surface its
@@ -47,8 +74,8 @@ and model selection", Phil. Trans. R. Soc. A 356, 1998).
 
 Sizes. Each size of a class's fit carries a standard deviation: the Gauss-Newton covariance
 (J^T J)^-1 of the fit's parameters, J the Jacobian of the evidence's normalised residuals at the
-fit (the points' d_i / sigma_i, the lines' and the swept links' residuals; not the extent prior,
-and not the points counted wrong), carried to the sizes, times the square root of the
+fit (the points' d_i / sigma_i, a_i and c_i, the lines' and the swept links' residuals; not the
+extent prior, and not the points counted wrong), carried to the sizes, times the square root of the
 overdispersion c (the covariance times c is kept with the fit, :attr:`ClassFit.covariance`,
 and :meth:`ClassFit.distance_std` carries it to the fitted surface). A size the evidence does
 not hold (a sphere's radius from a small cap) is not measured: no deviation. A size whose end no
@@ -204,6 +231,14 @@ JACOBIAN_STEP = 1e-6
 #: hold (a box's hidden extent with its centre): sizes moving along them are free.
 EIGEN_FLOOR = 1e-12
 
+#: How far along the link from a contact its nearest point is sought, and its line's cut, in the
+#: point's standard deviations along the link: farther, the point is not there by its covariance.
+TOUCH_REACH = 4.0
+
+#: Samples of the line over that reach (odd: one at the point), an eighth of a standard
+#: deviation apart (module docstring, "Distance.").
+TOUCH_SAMPLES = 65
+
 #: Where along that stretch, as fractions of it.
 _LINE_FRACTIONS = (0.125, 0.25, 0.5, 1.0)
 
@@ -250,11 +285,16 @@ class LinkLines:
         return np.asarray(points[:, None, :] + along), arc
 
     def residuals(
-        self, distance: Callable[[FloatArray], FloatArray], points: FloatArray, sigma: FloatArray
+        self,
+        distance: Callable[[FloatArray], FloatArray],
+        points: FloatArray,
+        sigma: FloatArray,
+        touched: FloatArray | None = None,
     ) -> FloatArray:
         """r_i (module docstring), shape (n,), for a signed distance function of (m, 3) points
-        and the points' standard deviations along the surface's normal (m, shape (n,))."""
-        return self.placed(points).residuals(distance, sigma)
+        and the points' standard deviations along the surface's normal (m, shape (n,));
+        ``touched`` as in :meth:`PlacedLines.residuals`."""
+        return self.placed(points).residuals(distance, sigma, touched)
 
     def placed(self, points: FloatArray) -> PlacedLines:
         """The lines at these contacts (m, shape (n, 3)), sampled once: a fit evaluates its
@@ -289,14 +329,19 @@ class PlacedLines:
     slope_variance: FloatArray
 
     def residuals(
-        self, distance: Callable[[FloatArray], FloatArray], sigma: FloatArray
+        self,
+        distance: Callable[[FloatArray], FloatArray],
+        sigma: FloatArray,
+        touched: FloatArray | None = None,
     ) -> FloatArray:
-        """r_i (module docstring), shape (n,): :meth:`LinkLines.residuals` at these contacts."""
+        """r_i (module docstring), shape (n,): :meth:`LinkLines.residuals` at these contacts;
+        the depth each point's own touch allows is d there, ``touched`` (m, shape (n,)) when
+        given (the distance where its line touches the shape), else at the point itself."""
         n, k = self.arc.shape
         if n == 0:
             return np.zeros(0)
         at_line = distance(self.samples).reshape(n, k)
-        own = np.minimum(distance(self.points), 0.0)
+        own = np.minimum(distance(self.points) if touched is None else touched, 0.0)
         spread = np.sqrt(sigma[:, None] ** 2 + self.slope_variance)
         deeper = np.where(np.isfinite(self.arc), (at_line - own[:, None]) / spread, np.inf)
         return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
@@ -341,6 +386,10 @@ class ClassFit:
         Independent parameters.
     n_points : int
         Points fitted.
+    measurements : float
+        The residuals the points' chi^2 sums, counted for the overdispersion: one distance
+        per point, and each touch's place along its line by the share of its deviation that
+        is the point's own (module docstring, "Distance."); n_points when NaN.
     line_chi2 : float
         sum r_i^2, the link lines' residuals before the mixture (0 without lines).
     swept_chi2 : float
@@ -360,6 +409,7 @@ class ClassFit:
     bic: float
     dof: int
     n_points: int
+    measurements: float = math.nan
     line_chi2: float = 0.0
     swept_chi2: float = 0.0
     weight: float = math.nan
@@ -424,6 +474,9 @@ class ClassFit:
             "score": None if math.isnan(self.score) else float(self.score),
             "dof": self.dof,
             "n_points": self.n_points,
+            "measurements": float(self.measurements)
+            if math.isfinite(self.measurements)
+            else float(self.n_points),
             "weight": None if math.isnan(self.weight) else float(self.weight),
         }
 
@@ -516,6 +569,191 @@ def _normal_sigma(covariances: FloatArray, normals: FloatArray) -> FloatArray:
 
 def _isotropic_sigma(covariances: FloatArray) -> FloatArray:
     return np.asarray(np.sqrt(np.trace(covariances, axis1=1, axis2=2) / 3.0))
+
+
+@dataclass(frozen=True)
+class _Touch:
+    """Each contact's line, for its nearest point along it and its cut into a shape (module
+    docstring, "Distance."): the line p_i + s t_i sampled over s within :data:`TOUCH_REACH`
+    standard deviations of the point along the link, and the point's covariance across the
+    link. A contact without a known tangent has one sample, the point itself, and its whole
+    covariance.
+
+    Attributes
+    ----------
+    points : array, shape (n, 3)
+        The contacts (m).
+    tangents : array, shape (n, 3)
+        The link's unit tangent at each (zeros where unknown).
+    along : array, shape (n,)
+        The point's standard deviation along the tangent (m; inf where unknown).
+    slope : array, shape (n,)
+        The tangent's standard deviation in angle (rad; 0 where unknown).
+    arc : array, shape (n, k)
+        The samples' offsets s along the line (m), NaN beyond the link.
+    across : array, shape (n, 3, 3)
+        The covariance across the tangent, (I - t t^T) Sigma (I - t t^T) (m^2; Sigma where the
+        tangent is unknown).
+    """
+
+    points: FloatArray
+    tangents: FloatArray
+    along: FloatArray
+    slope: FloatArray
+    arc: FloatArray
+    across: FloatArray
+    # the samples within the link (m, shape (m, 3)) and where they sit in arc's flat order
+    samples: FloatArray = field(init=False, repr=False)
+    flat: NDArray[np.intp] = field(init=False, repr=False)
+    filled: FloatArray = field(init=False, repr=False)  # arc, 0 beyond the link
+
+    def __post_init__(self) -> None:
+        flat = np.flatnonzero(np.isfinite(self.arc))
+        rows = flat // self.arc.shape[1]
+        object.__setattr__(self, "filled", np.nan_to_num(self.arc))
+        placed = self.points[rows] + self.arc.reshape(-1)[flat, None] * self.tangents[rows]
+        object.__setattr__(self, "flat", flat)
+        object.__setattr__(self, "samples", placed)
+
+    @classmethod
+    def of(cls, points: FloatArray, covariances: FloatArray, lines: LinkLines | None) -> _Touch:
+        n = len(points)
+        if lines is None:
+            known = np.zeros(n, dtype=bool)
+            tangents, slope, behind, beyond = (
+                np.zeros((n, 3)),
+                np.zeros(n),
+                np.zeros(n),
+                np.zeros(n),
+            )
+        else:
+            known = np.all(np.isfinite(lines.tangents), axis=1) & np.isfinite(lines.std)
+            tangents = np.where(known[:, None], np.nan_to_num(lines.tangents), 0.0)
+            slope = np.where(known, np.nan_to_num(lines.std), 0.0)
+            behind, beyond = lines.behind, lines.beyond
+        variance = np.einsum("ni,nij,nj->n", tangents, covariances, tangents)
+        along = np.where(known, np.sqrt(np.maximum(variance, 1e-18)), np.inf)
+        grid = np.linspace(-TOUCH_REACH, TOUCH_REACH, TOUCH_SAMPLES)
+        arc = np.where(known[:, None], np.nan_to_num(along, posinf=0.0)[:, None] * grid, np.nan)
+        arc[~known, TOUCH_SAMPLES // 2] = 0.0  # the point itself
+        arc[(arc < 0) & (-arc > behind[:, None])] = np.nan
+        arc[(arc > 0) & (arc > beyond[:, None])] = np.nan
+        projector = np.eye(3) - np.einsum("ni,nj->nij", tangents, tangents)
+        across = projector @ covariances @ projector
+        return cls(points, tangents, along, slope, arc, across)
+
+    def where(self, shift: FloatArray) -> FloatArray:
+        """The points moved along their lines by ``shift`` (m, shape (n,)), shape (n, 3)."""
+        return np.asarray(self.points + shift[:, None] * self.tangents)
+
+    def across_sigma(self, normals: FloatArray) -> FloatArray:
+        """sqrt(n_i^T Sigma_across n_i) (m), shape (n,), for unit normals (n, 3)."""
+        return _normal_sigma(self.across, normals)
+
+    def sampled(self, distance: Callable[[FloatArray], FloatArray]) -> FloatArray:
+        """d at each line's samples (m), shape (n, k); inf beyond the link."""
+        values = np.full(self.arc.size, np.inf)
+        values[self.flat] = distance(self.samples)
+        return values.reshape(self.arc.shape)
+
+    def nearest(self, values: FloatArray, across: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Where along each line the cost d(p + s t)^2 / across^2 + s^2 / sigma_a^2 is least
+        (m, shape (n,): the least sample's, moved to the vertex of the parabola through it and
+        its neighbours), and the mean square of the distance's slopes along the line on either
+        side of that sample (shape (n,)), from the samples' ``values`` (:meth:`sampled`) and the
+        deviations ``across`` (m; inf: the point itself)."""
+        n, k = values.shape
+        rows = np.arange(n)
+        weight = np.where(np.isfinite(across), 1.0 / np.maximum(across, 1e-12) ** 2, 0.0)
+        along = np.where(np.isfinite(self.along), self.along, 1.0)
+        arc = self.filled
+        finite = np.isfinite(values)
+        cost = np.where(
+            finite,
+            weight[:, None] * np.where(finite, values, 0.0) ** 2 + (arc / along[:, None]) ** 2,
+            np.inf,
+        )
+        j = np.argmin(cost, axis=1)
+        shift = arc[rows, j]
+        left, right = np.maximum(j - 1, 0), np.minimum(j + 1, k - 1)
+        c0, c1, c2 = cost[rows, left], cost[rows, j], cost[rows, right]
+        inner = (left < j) & (j < right) & np.isfinite(c0) & np.isfinite(c2)
+        c0, c1, c2 = (np.where(inner, c, 0.0) for c in (c0, c1, c2))
+        h = np.where(inner, arc[rows, right] - arc[rows, j], 1.0)
+        curve = c0 - 2.0 * c1 + c2
+        step = np.divide(0.5 * h * (c0 - c2), curve, out=np.zeros(n), where=inner & (curve > 0.0))
+        shift = shift + np.clip(step, -h, h)
+        with np.errstate(invalid="ignore"):
+            slopes = [
+                (values[rows, j] - values[rows, left]) / np.where(left < j, h, 1.0),
+                (values[rows, right] - values[rows, j]) / np.where(j < right, h, 1.0),
+            ]
+        known = [(left < j) & np.isfinite(slopes[0]), (j < right) & np.isfinite(slopes[1])]
+        count = known[0].astype(float) + known[1]
+        square = np.where(known[0], slopes[0], 0.0) ** 2 + np.where(known[1], slopes[1], 0.0) ** 2
+        return shift, np.divide(square, count, out=np.zeros(n), where=count > 0)
+
+    @staticmethod
+    def least(values: FloatArray, arc: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Each line's least distance to the shape (m; negative where it cuts in) and where
+        along it (m), both shape (n,), from the samples' ``values`` at offsets ``arc``: the least
+        sample, refined where the line passes over an edge (the secants on either side met)."""
+        n, k = values.shape
+        rows = np.arange(n)[:, None]
+        index = np.argmin(values, axis=1)[:, None] + np.arange(-2, 3)
+        inside = (index >= 0) & (index < k)
+        clipped = np.clip(index, 0, k - 1)
+        v = np.where(inside, values[rows, clipped], np.inf)  # the least sample and 2 each side
+        s = np.where(inside, np.nan_to_num(arc[rows, clipped]), 0.0)
+        least, shift = v[:, 2], s[:, 2]
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+            # the secant through samples i, i + 1 met with that through i + 2, i + 3 (i = 0, 1):
+            # exact where the distance is straight on either side of an edge
+            slope = np.diff(v, axis=1) / np.diff(s, axis=1)  # shape (n, 4)
+            for i in (0, 1):
+                k1, k2 = slope[:, i], slope[:, i + 2]
+                ok = np.all(np.isfinite(v[:, i : i + 4]), axis=1) & (k2 - k1 > 1e-9)
+                cross = (v[:, i + 2] - v[:, i] + k1 * s[:, i] - k2 * s[:, i + 2]) / np.where(
+                    ok, k2 - k1, 1.0
+                )
+                ok &= (cross >= s[:, 1]) & (cross <= s[:, 3])
+                value = v[:, i] + k1 * (cross - s[:, i])
+                better = ok & (value < least)
+                least = np.where(better, value, least)
+                shift = np.where(better, cross, shift)
+        return least, shift
+
+    def shifted(
+        self, distance: Callable[[FloatArray], FloatArray], across: FloatArray
+    ) -> FloatArray:
+        """Where along each line its nearest point lies (m, shape (n,); :meth:`nearest`)."""
+        return self.nearest(self.sampled(distance), across)[0]
+
+    def residuals(
+        self, distance: Callable[[FloatArray], FloatArray], across: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Each contact's distance d at its nearest point along its line (m), its standard
+        deviation (m), and the residuals of its place there and of its line's cut (module
+        docstring, "Distance.", shape (n, 2)), and the share of the point's deviation along the
+        link that the place is measured to (0 to 1), each shape (n,) unless said, for the
+        deviations ``across`` (m) along the normal there (inf for a point that weighs nothing:
+        its residuals are then 0)."""
+        values = self.sampled(distance)
+        shift, slope2 = self.nearest(values, across)
+        at = np.asarray(distance(self.where(shift)), dtype=float)
+        sigma = np.sqrt(across**2 + (shift * self.slope) ** 2)
+        least, least_shift = self.least(values, self.arc)
+        weighed = np.isfinite(across) & np.isfinite(self.along)
+        place = np.divide(shift, self.along, out=np.zeros(len(shift)), where=weighed)
+        cut_sigma = np.sqrt(across**2 + (least_shift * self.slope) ** 2)
+        depth = np.minimum(least - np.minimum(at, 0.0), 0.0)
+        cut = np.divide(depth, cut_sigma, out=np.zeros(len(shift)), where=np.isfinite(across))
+        # the share of the point's variance along the link its place measures (the
+        # information d's slope along the line gives against the point's own)
+        pinned = np.where(weighed, slope2 / np.maximum(across, 1e-12) ** 2, 0.0)
+        own = np.where(weighed, 1.0 / np.maximum(self.along, 1e-12) ** 2, 1.0)
+        share = pinned / (pinned + own)
+        return at, sigma, np.stack([place, cut], axis=1), share
 
 
 def _algebraic_sphere(points: FloatArray) -> tuple[FloatArray, float]:
@@ -634,10 +872,15 @@ def point_chi2(z2: FloatArray, sigma: FloatArray, spread: float) -> FloatArray:
     return np.asarray(-2.0 * (inlier - np.logaddexp(0.0, -0.5 * cap)))
 
 
-def _z2(distance: FloatArray, sigma: FloatArray, line: FloatArray) -> FloatArray:
-    """z^2 = (d / sigma)^2 + r^2 per point (module docstring), shape (n,): the distance d (m)
-    in its standard deviations sigma (m) and the link's line residual r (none: empty)."""
+def _z2(
+    distance: FloatArray, sigma: FloatArray, line: FloatArray, extra: FloatArray | None = None
+) -> FloatArray:
+    """z^2 = (d / sigma)^2 + a^2 + c^2 + r^2 per point (module docstring), shape (n,): the
+    distance d (m) in its standard deviations sigma (m), the place a and cut c along the line
+    (``extra``, shape (n, 2); none: None) and the link's line residual r (none: empty)."""
     z2 = (np.asarray(distance, dtype=float) / sigma) ** 2
+    if extra is not None:
+        z2 = z2 + np.sum(np.asarray(extra, dtype=float).reshape(len(z2), -1) ** 2, axis=1)
     return np.asarray(z2 + np.asarray(line, dtype=float) ** 2 if len(line) else z2)
 
 
@@ -698,18 +941,40 @@ def fit_primitive(
     low, high = _bounds(model, p)
     sigma = _isotropic_sigma(cov)
     spread = _spread(p)
+    touch = _Touch.of(p, cov, lines)
 
     placed = lines.placed(p) if lines is not None else None
     spaces = [space.near(p, FREE_MARGIN + 0.5 * spread) for space in swept]
     link_evidence = lines is not None or bool(spaces)
 
-    def line_residuals(x: FloatArray, s: FloatArray) -> FloatArray:
+    def line_residuals(x: FloatArray, s: FloatArray, touched: FloatArray) -> FloatArray:
         if placed is None:
             return np.zeros(0)
-        return placed.residuals(lambda q: model.signed_distance(x, q), s)
+        return placed.residuals(lambda q: model.signed_distance(x, q), s, touched)
 
     def swept_residuals(x: FloatArray, regions: Sequence[FreeSpace]) -> FloatArray:
         return _swept_residuals(regions, lambda q: model.signed_distance(x, q))
+
+    def touched(
+        x: FloatArray, s: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        # each contact at its nearest point along its line: distance (m), deviation (m), place
+        # and cut (in deviations) and the share of its deviation along the link measured
+        return touch.residuals(lambda q: model.signed_distance(x, q), s)
+
+    def normal_sigma(x: FloatArray) -> FloatArray:
+        # the deviation across the link along the shape's normal at each contact's nearest
+        # point along its line (found with the normal at the point itself)
+        first = touch.across_sigma(model.normals(x, p))
+        shift = touch.shifted(lambda q: model.signed_distance(x, q), first)
+        return touch.across_sigma(model.normals(x, touch.where(shift)))
+
+    def point_residuals(x: FloatArray, s: FloatArray, with_lines: bool) -> FloatArray:
+        # d_i / sigma_i at the nearest points along the lines, their places and cuts, and the
+        # lines' residuals
+        at, sigma_at, extra, _ = touched(x, s)
+        line = line_residuals(x, s, at) if with_lines else np.zeros(0)
+        return np.concatenate([at / sigma_at, extra[:, 0], extra[:, 1], line])
 
     def residuals(
         x: FloatArray,
@@ -717,11 +982,16 @@ def fit_primitive(
         with_lines: bool,
         regions: Sequence[FreeSpace],
         free_apex: bool = False,
+        search: bool = True,
     ) -> FloatArray:
-        distance = model.signed_distance(x, p) / s
-        line = line_residuals(x, s) if with_lines else np.zeros(0)
+        if search:
+            points_part = point_residuals(x, s, with_lines)
+        else:  # the Euclidean d_i / sigma_i
+            distance = model.signed_distance(x, p)
+            line = line_residuals(x, s, distance) if with_lines else np.zeros(0)
+            points_part = np.concatenate([distance / s, line])
         prior = _extent_prior(model.name, x, p, free_apex)
-        return np.concatenate([distance, line, swept_residuals(x, regions), prior])
+        return np.concatenate([points_part, swept_residuals(x, regions), prior])
 
     def fit(
         start: FloatArray,
@@ -730,42 +1000,44 @@ def fit_primitive(
         evaluations: int,
         regions: Sequence[FreeSpace] = (),
         free_apex: bool = False,
+        search: bool = True,
     ) -> Any:
         return least_squares(
             residuals,
             start,
-            args=(s, with_lines, regions, free_apex),
+            args=(s, with_lines, regions, free_apex, search),
             bounds=(low, high),
             loss="soft_l1",
             f_scale=ROBUST_SCALE,
             max_nfev=evaluations * len(start),
         )
 
-    def point_z2(x: FloatArray, normal_sigma: FloatArray) -> FloatArray:
-        distance = model.signed_distance(x, p)
-        return _z2(distance, normal_sigma, line_residuals(x, normal_sigma))
+    def point_z2(x: FloatArray, s: FloatArray) -> FloatArray:
+        at, sigma_at, extra, _ = touched(x, s)
+        return _z2(at, sigma_at, line_residuals(x, s, at), extra)
 
-    def inlier_sigma(x: FloatArray, normal_sigma: FloatArray) -> FloatArray:
+    def inlier_sigma(x: FloatArray, s: FloatArray) -> FloatArray:
         # a point the mixture counts as wrong at x (its z^2 beyond its cap) weighs nothing
-        wrong = point_z2(x, normal_sigma) > outlier_cap(normal_sigma, spread)
-        return np.where(wrong, np.inf, normal_sigma)
+        wrong = point_z2(x, s) > outlier_cap(s, spread)
+        return np.where(wrong, np.inf, s)
 
-    def refine(x: FloatArray, free_apex: bool = False) -> FloatArray:
-        # each point's sigma along the fitted surface's normal, and the link's lines; the
-        # points counted wrong leave the refinement, and so do free-space samples far outside
-        # the shape at x
-        normal_sigma = inlier_sigma(x, _normal_sigma(cov, model.normals(x, p)))
+    def refine(x: FloatArray, free_apex: bool = False, exclude: bool = True) -> FloatArray:
+        # each point's sigma along the fitted surface's normal, and the link's lines; with
+        # ``exclude`` the points counted wrong leave the refinement; free-space samples far
+        # outside the shape at x do
+        sigma_x = normal_sigma(x)
+        kept = inlier_sigma(x, sigma_x) if exclude else sigma_x
         regions = [
             space.within(model.signed_distance(x, space.samples), FREE_ACTIVE) for space in spaces
         ]
         evaluations = 2 * MAX_EVALUATIONS
-        solution = fit(x, normal_sigma, lines is not None, evaluations, regions, free_apex)
+        solution = fit(x, kept, lines is not None, evaluations, regions, free_apex)
         return np.asarray(solution.x)
 
     def total(x: FloatArray) -> float:
         # the scored chi^2 (plus the extent prior) with the sigma at x: one scale for all
-        normal_sigma = _normal_sigma(cov, model.normals(x, p))
-        parts = point_chi2(point_z2(x, normal_sigma), normal_sigma, spread)
+        sigma_x = normal_sigma(x)
+        parts = point_chi2(point_z2(x, sigma_x), sigma_x, spread)
         free_parts = _swept_chi2(swept_residuals(x, spaces), spaces, spread)
         prior = _extent_prior(model.name, x, p)
         return float(np.sum(parts) + np.sum(free_parts) + np.sum(prior**2))
@@ -777,29 +1049,32 @@ def fit_primitive(
     for start in _starts(model, p, direction, generator):
         start = np.clip(start, low, high)
         try:
-            alone.append(fit(start, sigma, False, MAX_EVALUATIONS))
+            alone.append(fit(start, sigma, False, MAX_EVALUATIONS, search=False))
             if lines is not None:
-                direct.append(fit(start, sigma, True, MAX_EVALUATIONS).x)
+                direct.append(fit(start, sigma, True, MAX_EVALUATIONS, search=False).x)
         except ValueError:  # a start outside the model's domain
             continue
     assert alone
     alone.sort(key=lambda solution: solution.cost)
     chosen = alone[: REFINED_STARTS if link_evidence else 1]
-    candidates = [refine(solution.x) for solution in chosen] + [refine(x) for x in direct]
+    # each refined twice: a start the Euclidean distances grew past edges counts the points
+    # there wrong, and the second refinement, from the first's shape, takes them back
+    starts = [solution.x for solution in chosen] + direct
+    candidates = [refine(refine(start, exclude=False)) for start in starts]
     x = model.canonical(min(candidates, key=total) if len(candidates) > 1 else candidates[0])
     distance = model.signed_distance(x, p)
-    sigma = _normal_sigma(cov, model.normals(x, p))
+    sigma = normal_sigma(x)
+    touches = touched(x, sigma)
 
     def uncertainty(v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         # the covariance, the sizes' deviations and lower-bound margins at v (size_std), from
         # the evidence alone: without the extent prior, the points counted wrong at v left out
-        kept = inlier_sigma(v, _normal_sigma(cov, model.normals(v, p)))
+        kept = inlier_sigma(v, normal_sigma(v))
 
         def evidence(u: FloatArray) -> FloatArray:
             return np.concatenate(
                 [
-                    model.signed_distance(u, p) / kept,
-                    line_residuals(u, kept),
+                    point_residuals(u, kept, True),
                     swept_residuals(u, spaces),
                 ]
             )
@@ -830,9 +1105,10 @@ def fit_primitive(
         vector=x,
         mesh=model.mesh(x),
         spread=spread,
-        line=line_residuals(x, sigma),
+        line=line_residuals(x, sigma, touches[0]),
         swept=swept_residuals(x, spaces),
         spaces=spaces,
+        touches=touches,
     )
     at_least = np.maximum(model.sizes(shaped) - margin, 0.0)
     return dataclasses.replace(
@@ -1046,13 +1322,23 @@ def fit_mesh(
     sizes = {f"extent_{a}": float(e) for a, e in zip("xyz", extents, strict=True)}
     line = np.zeros(0)
     sweeps, spaces = np.zeros(0), []
+    touches = None
     if placed.is_watertight:
         # trimesh's signed distance is positive inside (and meaningful for a closed mesh only)
         def signed(q: FloatArray) -> FloatArray:
             return -np.asarray(trimesh.proximity.signed_distance(placed, q))
 
+        def normals_at(q: FloatArray) -> FloatArray:
+            _, _, closest = trimesh.proximity.closest_point(placed, q)
+            return np.asarray(placed.face_normals[closest])
+
+        # each line's touch with the mesh, as for a primitive
+        touch = _Touch.of(p, cov, lines)
+        shift = touch.shifted(signed, touch.across_sigma(normals))
+        sigma = touch.across_sigma(normals_at(touch.where(shift)))
+        touches = touch.residuals(signed, sigma)
         if lines is not None:
-            line = lines.residuals(signed, p, sigma)
+            line = lines.residuals(signed, p, sigma, touches[0])
         # only samples within the placed mesh's box grown by this can come near it
         reach = FREE_MARGIN + 0.5 * _spread(p)
         spaces = [space.near(placed.bounds, reach) for space in swept]
@@ -1070,6 +1356,7 @@ def fit_mesh(
         line,
         sweeps,
         spaces,
+        touches,
     )
 
 
@@ -1086,12 +1373,20 @@ def _scored(
     line: FloatArray | None = None,
     swept: FloatArray | None = None,
     spaces: Sequence[FreeSpace] = (),
+    touches: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None = None,
 ) -> ClassFit:
+    """The fit scored; ``distance`` the points' Euclidean distances (m, for the RMS) and
+    ``touches`` the lines' touches (:meth:`_Touch.residuals`), the Euclidean distances in
+    ``sigma`` alone when None."""
     n = len(distance)
     lines = line if line is not None and len(line) == n else np.zeros(n)
     sweeps = swept if swept is not None else np.zeros(0)
+    if touches is None:
+        at, sigma_at, extra, share = distance, sigma, None, np.zeros(n)
+    else:
+        at, sigma_at, extra, share = touches
     # each point's and each sweep's part of chi^2; BIC = chi^2 + k ln n
-    parts = point_chi2(_z2(distance, sigma, lines), sigma, spread)
+    parts = point_chi2(_z2(at, sigma_at, lines, extra), sigma, spread)
     chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(
@@ -1105,6 +1400,7 @@ def _scored(
         bic=chi2 + dof * math.log(n),
         dof=dof,
         n_points=n,
+        measurements=float(n + np.sum(share)),
         vector=vector,
         mesh=mesh,
     )
@@ -1231,7 +1527,8 @@ def recognise(
         fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines, swept=swept))
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
     tightest = min(fits, key=lambda f: f.chi2)
-    c = max(1.0, tightest.chi2 / max(len(p) - tightest.dof, 1))
+    measured = tightest.measurements if math.isfinite(tightest.measurements) else len(p)
+    c = max(1.0, tightest.chi2 / max(measured - tightest.dof, 1.0))
     n_log = math.log(len(p))
     # the sizes' standard deviations widened by the same overdispersion
     fits = [
