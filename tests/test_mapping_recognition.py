@@ -669,10 +669,11 @@ def test_a_box_touched_on_its_edges_is_not_grown_by_errors_along_the_link(seed: 
     fit = fit_primitive("box", points, covariances, rng=np.random.default_rng(0), lines=lines)
     names = sorted(fit.sizes, key=lambda k: fit.sizes[k])
     error = np.array([fit.sizes[k] for k in names]) - extents
-    # measured sizes within three of their deviations plus 0.1 mm; the mean of the three,
-    # which an outward growth moves one way, within 0.6 mm (half the Euclidean fit's growth)
-    for e, name in zip(error, names, strict=True):
-        std = fit.size_std[name]
-        if math.isfinite(std):
-            assert abs(e) < 3 * std + 1e-4, (error, fit.size_std)
-    assert abs(float(np.mean(error))) < 6e-4, error
+    # the sizes the fit measures (a finite deviation; an extent no touch bounds is held by the
+    # extent prior alone) each within 1.5 mm, half the points' deviation along the link, and
+    # their mean, which an outward growth moves one way, within 0.6 mm (half the Euclidean
+    # fit's growth)
+    measured = np.array([math.isfinite(fit.size_std[k]) for k in names])
+    assert measured.sum() >= 2, fit.size_std
+    assert np.all(np.abs(error[measured]) < 1.5e-3), (error, fit.size_std)
+    assert abs(float(np.mean(error[measured]))) < 6e-4, (error, fit.size_std)

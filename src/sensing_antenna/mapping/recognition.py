@@ -18,17 +18,23 @@ a good part of those errors. So where the link's tangent t_i is known (:class:`L
 contact is taken at its nearest point along its line in its own metric: the line p_i + s t_i is
 sampled within :data:`TOUCH_REACH` of the point's standard deviations along t_i, sigma_a
 (:data:`TOUCH_SAMPLES` samples), and s_i minimises d(p_i + s t_i)^2 / sigma_i^2 + s^2 / sigma_a^2
-(the least sample moved to the vertex of the parabola through it and its neighbours), sigma_i the
-covariance across t_i along the normal there. Its residuals are the distance there,
+(the least sample moved to the vertex of the parabola through it and its neighbours, at most one
+sample away; samples beyond the link's ends are left out), sigma_i the standard deviation across
+t_i along the normal there. Its residuals are the distance there,
 d_i / sqrt(sigma_i^2 + (s_i sigma_t)^2) (sigma_t the tangent's deviation in angle), its place
-a_i = s_i / sigma_a, and its line's cut c_i = min(0, m_i - min(0, d_i)) / sigma_i: how far the
-line enters the shape within that reach beyond that point's depth, m_i the line's least distance
-(the least sample, refined where the secants on either side of an edge meet). Beside a smooth
-surface tangent to the line d changes along it only at second order: the nearest point stays by
-the point and a_i is about 0, whatever the error along the link. Over an edge the nearest point
-is the edge, and a_i measures that error. A shape grown until the lines cross it pays for the
-cut. Against a plane this is the Mahalanobis distance, d^2 / (n^T Sigma n). A contact without a
-known tangent keeps the Euclidean d_i / sigma_i.
+a_i = s_i / sigma_a, and its line's cut c_i = min(0, m_i - min(0, d_i)) / sqrt(sigma_i^2 +
+(s_m sigma_t)^2): how far the line enters the shape within that reach beyond that point's depth,
+m_i the line's least distance, at s_m (the least sample, refined where the secants on either side
+of an edge meet). Beside a smooth surface tangent to the line d changes along it only at second
+order: the nearest point stays by the point and a_i is small, negligible where kappa sigma_a^2 / 2
+is well below sigma_i (kappa the surface's curvature along the line). Over an edge the nearest
+point is the edge, and a_i measures the error along the link. A shape grown until the lines cross
+it pays for the cut. For a plane along the link this is the Mahalanobis distance,
+d^2 / (n^T Sigma n), exactly; a link crossing a plane pays the cut. Limits: t_i is taken as the
+covariance's axis (the terms coupling along and across the link are left out), and the cut is
+divided by sigma_i along one face's normal, which over an edge can be several times smaller than
+the least distance's own spread across the link, and charges a line inside an edge less than
+one as far outside it. A contact without a known tangent keeps the Euclidean d_i / sigma_i.
 
 The link's line. A link sweeping towards an object first touches it where the link is tangent
 to it: just before, the whole link was outside, and a round link never cuts into what it
@@ -39,7 +45,8 @@ depth of its nearest point, over its spread, at samples q_k = p + s_k t along th
 around the contact (up to :data:`LINE_STRETCH` each way, within the link):
 r = min(0, min_k (d(q_k) - min(0, d_i)) / sqrt(sigma^2 + (s_k sigma_t)^2)), d_i the distance at
 the nearest point ("Distance."; at p without a tangent), sigma the point's standard deviation
-along the normal and sigma_t the tangent's in angle. It is 0 for a convex
+across the link along the normal and sigma_t the tangent's in angle (within the nearest point's
+reach its samples charge a cut the cut already charges, twice). It is 0 for a convex
 surface tangent to the link and for an edge the link passes over, and a line crossing a surface
 of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through the points a
 sweeping line left on a box's edges is not tangent to the lines that touched them.
@@ -388,8 +395,9 @@ class ClassFit:
         Points fitted.
     measurements : float
         The residuals the points' chi^2 sums, counted for the overdispersion: one distance
-        per point, and each touch's place along its line by the share of its deviation that
-        is the point's own (module docstring, "Distance."); n_points when NaN.
+        per point, and each place along its line by the share of the point's variance along
+        the link that it measures (module docstring, "Distance." and "Score"); n_points when
+        NaN.
     line_chi2 : float
         sum r_i^2, the link lines' residuals before the mixture (0 without lines).
     swept_chi2 : float
@@ -409,7 +417,6 @@ class ClassFit:
     bic: float
     dof: int
     n_points: int
-    measurements: float = math.nan
     line_chi2: float = 0.0
     swept_chi2: float = 0.0
     weight: float = math.nan
@@ -421,6 +428,7 @@ class ClassFit:
         default_factory=lambda: np.zeros((0, 0)), compare=False, repr=False
     )
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
+    measurements: float = math.nan
 
     def distance_std(self, points: ArrayLike) -> FloatArray:
         """Standard deviation (m) of the fitted shape's signed distance at each of ``points``
@@ -1181,7 +1189,8 @@ def size_std(
     NaN for the others).
 
     The parameters' ``covariance`` (:func:`parameter_covariance` of ``residuals``, a function of
-    the parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i)
+    the parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i, at
+    their nearest points along their lines)
     carried to the sizes; inf (not measured) where a size moves along a direction the residuals
     do not hold (its deviation then exceeds the points' spread ``spread``, m) or the covariance
     is not finite (NaN throughout: nothing else is judged). ``point_std`` are the points'
