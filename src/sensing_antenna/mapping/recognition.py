@@ -283,13 +283,23 @@ class LinkLines:
         """Points along each line (m), shape (n, k, 3), and their signed arc lengths s (m),
         shape (n, k); s is NaN where the link does not reach or the tangent is unknown."""
         steps = LINE_STRETCH * np.array([*(-f for f in _LINE_FRACTIONS), *_LINE_FRACTIONS])
-        arc = np.broadcast_to(steps, (len(points), len(steps))).copy()
-        arc[(arc < 0) & (-arc > self.behind[:, None])] = np.nan
-        arc[(arc > 0) & (arc > self.beyond[:, None])] = np.nan
-        known = np.all(np.isfinite(self.tangents), axis=1) & np.isfinite(self.std)
-        arc[~known] = np.nan
+        arc = self.within(np.broadcast_to(steps, (len(points), len(steps))))
         along = np.nan_to_num(arc)[:, :, None] * np.nan_to_num(self.tangents)[:, None, :]
         return np.asarray(points[:, None, :] + along), arc
+
+    @property
+    def known(self) -> NDArray[np.bool_]:
+        """Whether each contact's tangent and its deviation are known, shape (n,)."""
+        return np.asarray(np.all(np.isfinite(self.tangents), axis=1) & np.isfinite(self.std))
+
+    def within(self, arc: FloatArray) -> FloatArray:
+        """Arc lengths s (m, shape (n, k)) with NaN where the link does not reach (beyond its
+        base or tip) or the tangent is unknown."""
+        arc = np.array(arc, dtype=float)
+        arc[(arc < 0) & (-arc > self.behind[:, None])] = np.nan
+        arc[(arc > 0) & (arc > self.beyond[:, None])] = np.nan
+        arc[~self.known] = np.nan
+        return arc
 
     def residuals(
         self,
@@ -299,8 +309,8 @@ class LinkLines:
         touched: FloatArray | None = None,
     ) -> FloatArray:
         """r_i (module docstring), shape (n,), for a signed distance function of (m, 3) points
-        and the points' standard deviations along the surface's normal (m, shape (n,));
-        ``touched`` as in :meth:`PlacedLines.residuals`."""
+        and the points' standard deviations across the link along the surface's normal (m,
+        shape (n,)); ``touched`` as in :meth:`PlacedLines.residuals`."""
         return self.placed(points).residuals(distance, sigma, touched)
 
     def placed(self, points: FloatArray) -> PlacedLines:
@@ -342,8 +352,8 @@ class PlacedLines:
         touched: FloatArray | None = None,
     ) -> FloatArray:
         """r_i (module docstring), shape (n,): :meth:`LinkLines.residuals` at these contacts;
-        the depth each point's own touch allows is d there, ``touched`` (m, shape (n,)) when
-        given (the distance where its line touches the shape), else at the point itself."""
+        the depth allowed is d at each point's nearest point along its line, ``touched`` (m,
+        shape (n,)), when given, else d at the point itself."""
         n, k = self.arc.shape
         if n == 0:
             return np.zeros(0)
@@ -430,6 +440,11 @@ class ClassFit:
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
     measurements: float = math.nan
 
+    @property
+    def counted(self) -> float:
+        """:attr:`measurements`, n_points where it is not known."""
+        return float(self.measurements if math.isfinite(self.measurements) else self.n_points)
+
     def distance_std(self, points: ArrayLike) -> FloatArray:
         """Standard deviation (m) of the fitted shape's signed distance at each of ``points``
         (m, shape (n, 3)), from :attr:`covariance`: how far the fitted surface may lie from
@@ -482,9 +497,7 @@ class ClassFit:
             "score": None if math.isnan(self.score) else float(self.score),
             "dof": self.dof,
             "n_points": self.n_points,
-            "measurements": float(self.measurements)
-            if math.isfinite(self.measurements)
-            else float(self.n_points),
+            "measurements": self.counted,
             "weight": None if math.isnan(self.weight) else float(self.weight),
         }
 
@@ -626,26 +639,17 @@ class _Touch:
     @classmethod
     def of(cls, points: FloatArray, covariances: FloatArray, lines: LinkLines | None) -> _Touch:
         n = len(points)
-        if lines is None:
-            known = np.zeros(n, dtype=bool)
-            tangents, slope, behind, beyond = (
-                np.zeros((n, 3)),
-                np.zeros(n),
-                np.zeros(n),
-                np.zeros(n),
-            )
-        else:
-            known = np.all(np.isfinite(lines.tangents), axis=1) & np.isfinite(lines.std)
-            tangents = np.where(known[:, None], np.nan_to_num(lines.tangents), 0.0)
-            slope = np.where(known, np.nan_to_num(lines.std), 0.0)
-            behind, beyond = lines.behind, lines.beyond
+        known = lines.known if lines is not None else np.zeros(n, dtype=bool)
+        tangents = np.zeros((n, 3)) if lines is None else np.nan_to_num(lines.tangents)
+        tangents[~known] = 0.0
+        slope = np.where(known, np.nan_to_num(lines.std), 0.0) if lines is not None else np.zeros(n)
         variance = np.einsum("ni,nij,nj->n", tangents, covariances, tangents)
         along = np.where(known, np.sqrt(np.maximum(variance, 1e-18)), np.inf)
         grid = np.linspace(-TOUCH_REACH, TOUCH_REACH, TOUCH_SAMPLES)
         arc = np.where(known[:, None], np.nan_to_num(along, posinf=0.0)[:, None] * grid, np.nan)
+        if lines is not None:
+            arc = lines.within(arc)
         arc[~known, TOUCH_SAMPLES // 2] = 0.0  # the point itself
-        arc[(arc < 0) & (-arc > behind[:, None])] = np.nan
-        arc[(arc > 0) & (arc > beyond[:, None])] = np.nan
         projector = np.eye(3) - np.einsum("ni,nj->nij", tangents, tangents)
         across = projector @ covariances @ projector
         return cls(points, tangents, along, slope, arc, across)
@@ -1030,9 +1034,9 @@ def fit_primitive(
         return np.where(wrong, np.inf, s)
 
     def refine(x: FloatArray, free_apex: bool = False, exclude: bool = True) -> FloatArray:
-        # each point's sigma along the fitted surface's normal, and the link's lines; with
-        # ``exclude`` the points counted wrong leave the refinement; free-space samples far
-        # outside the shape at x do
+        # each point's sigma across the link along the fitted surface's normal at its nearest
+        # point, and the link's lines; with ``exclude`` the points counted wrong leave the
+        # refinement; free-space samples far outside the shape at x do
         sigma_x = normal_sigma(x)
         kept = inlier_sigma(x, sigma_x) if exclude else sigma_x
         regions = [
@@ -1341,12 +1345,12 @@ def fit_mesh(
             _, _, closest = trimesh.proximity.closest_point(placed, q)
             return np.asarray(placed.face_normals[closest])
 
-        # each line's touch with the mesh, as for a primitive
-        touch = _Touch.of(p, cov, lines)
-        shift = touch.shifted(signed, touch.across_sigma(normals))
-        sigma = touch.across_sigma(normals_at(touch.where(shift)))
-        touches = touch.residuals(signed, sigma)
         if lines is not None:
+            # each contact at its nearest point along its line, as for a primitive
+            touch = _Touch.of(p, cov, lines)
+            shift = touch.shifted(signed, touch.across_sigma(normals))
+            sigma = touch.across_sigma(normals_at(touch.where(shift)))
+            touches = touch.residuals(signed, sigma)
             line = lines.residuals(signed, p, sigma, touches[0])
         # only samples within the placed mesh's box grown by this can come near it
         reach = FREE_MARGIN + 0.5 * _spread(p)
@@ -1536,8 +1540,7 @@ def recognise(
         fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines, swept=swept))
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
     tightest = min(fits, key=lambda f: f.chi2)
-    measured = tightest.measurements if math.isfinite(tightest.measurements) else len(p)
-    c = max(1.0, tightest.chi2 / max(measured - tightest.dof, 1.0))
+    c = max(1.0, tightest.chi2 / max(tightest.counted - tightest.dof, 1.0))
     n_log = math.log(len(p))
     # the sizes' standard deviations widened by the same overdispersion
     fits = [
