@@ -15,26 +15,29 @@ line meets the surface without entering it: tangent to a smooth surface, or pass
 edge. Over an edge an error along the link moves the point off the surface whichever way it
 goes, so the Euclidean distance reads every such point outside, and a box fitted by it grows by
 a good part of those errors. So where the link's tangent t_i is known (:class:`LinkLines`), a
-contact is taken at its nearest point along its line in its own metric: the line p_i + s t_i is
+contact is taken where its line touches the shape, in its own metric. The line p_i + s t_i is
 sampled within :data:`TOUCH_REACH` of the point's standard deviations along t_i, sigma_a
-(:data:`TOUCH_SAMPLES` samples), and s_i minimises d(p_i + s t_i)^2 / sigma_i^2 + s^2 / sigma_a^2
-(the least sample moved to the vertex of the parabola through it and its neighbours, at most one
-sample away; samples beyond the link's ends are left out), sigma_i the standard deviation across
-t_i along the normal there. Its residuals are the distance there,
-d_i / sqrt(sigma_i^2 + (s_i sigma_t)^2) (sigma_t the tangent's deviation in angle), its place
-a_i = s_i / sigma_a, and its line's cut c_i = min(0, m_i - min(0, d_i)) / sqrt(sigma_i^2 +
-(s_m sigma_t)^2): how far the line enters the shape within that reach beyond that point's depth,
-m_i the line's least distance, at s_m (the least sample, refined where the secants on either side
-of an edge meet). Beside a smooth surface tangent to the line d changes along it only at second
-order: the nearest point stays by the point and a_i is small, negligible where kappa sigma_a^2 / 2
-is well below sigma_i (kappa the surface's curvature along the line). Over an edge the nearest
-point is the edge, and a_i measures the error along the link. A shape grown until the lines cross
-it pays for the cut. For a plane along the link this is the Mahalanobis distance,
-d^2 / (n^T Sigma n), exactly; a link crossing a plane pays the cut. Limits: t_i is taken as the
-covariance's axis (the terms coupling along and across the link are left out), and the cut is
-divided by sigma_i along one face's normal, which over an edge can be several times smaller than
-the least distance's own spread across the link, and charges a line inside an edge less than
-one as far outside it. A contact without a known tangent keeps the Euclidean d_i / sigma_i.
+(:data:`TOUCH_SAMPLES` samples; none beyond the link's ends), and m_i is its least distance to
+the shape there, at s_m (the least sample, refined where the secants on either side of an edge
+meet); a line that enters the shape (m_i < 0) is taken as moved out by m_i, so that it touches.
+Its nearest point s_i minimises (d(p_i + s t_i) - min(0, m_i))^2 / sigma_i^2 + s^2 / sigma_a^2,
+sigma_i the standard deviation across t_i along the normal there (the least sample, then the
+least between its neighbours on d itself, so that s_i moves smoothly with the shape). Its
+residuals are the distance there beyond the line's depth, (d_i - min(0, m_i)) /
+sqrt(sigma_i^2 + (s_i sigma_t)^2) (sigma_t the tangent's deviation in angle), its place
+a_i = s_i / sigma_a, and its line's cut c_i = min(0, m_i) / sigma_m, sigma_m m_i's own spread as
+the line moves across itself: sigma_m^2 = g^T Sigma_across g + (s_m sigma_t |g|)^2, g m_i's
+gradient; over an edge the faces' normals weighed so that g is across the line,
+g = (k_2 n_1 - k_1 n_2) / (k_2 - k_1), k = n . t (a line a distance inside a right-angled edge
+reaches only that over up to sqrt(2) deep, and its spread is as much smaller); beside a smooth
+surface its normal. Beside a smooth surface tangent to the line d changes along it only at
+second order: the nearest point stays by the point and a_i is small, negligible where
+kappa sigma_a^2 / 2 is well below sigma_i (kappa the surface's curvature along the line). Over an
+edge the nearest point is the edge, and a_i measures the error along the link. A shape grown
+until the lines cross it pays for the cut. For a plane along the link this is the Mahalanobis
+distance, d^2 / (n^T Sigma n), exactly; a link crossing a plane pays the cut. Limit: t_i is
+taken as the covariance's axis (the terms coupling along and across the link are left out). A
+contact without a known tangent keeps the Euclidean d_i / sigma_i.
 
 The link's line. A link sweeping towards an object first touches it where the link is tangent
 to it: just before, the whole link was outside, and a round link never cuts into what it
@@ -42,11 +45,12 @@ pushes. Each contact whose link direction is known (:class:`LinkLines`: the link
 at the contact, its standard deviation in angle, and how much link lies behind and beyond the
 contact) adds one residual: how far the link's line cuts into the fitted shape beyond the
 depth of its nearest point, over its spread, at samples q_k = p + s_k t along the link's stretch
-around the contact (up to :data:`LINE_STRETCH` each way, within the link):
+around the contact (up to :data:`LINE_STRETCH` each way, within the link, beyond the nearest
+point's reach, whose own cut charges the line within it):
 r = min(0, min_k (d(q_k) - min(0, d_i)) / sqrt(sigma^2 + (s_k sigma_t)^2)), d_i the distance at
 the nearest point ("Distance."; at p without a tangent), sigma the point's standard deviation
-across the link along the normal and sigma_t the tangent's in angle (within the nearest point's
-reach its samples charge a cut the cut already charges, twice). It is 0 for a convex
+across the link along d's gradient at the deepest sample and sigma_t the tangent's in angle (the
+Euclidean fits that start a class's search: along the normal at the point). It is 0 for a convex
 surface tangent to the link and for an edge the link passes over, and a line crossing a surface
 of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through the points a
 sweeping line left on a box's edges is not tangent to the lines that touched them.
@@ -79,10 +83,11 @@ costs a class no more than its being wrong costs, and cannot on its own decide b
 shapes (the truncated residual of Torr's robust model selection, "Geometric motion segmentation
 and model selection", Phil. Trans. R. Soc. A 356, 1998).
 
-Sizes. Each size of a class's fit carries a standard deviation: the Gauss-Newton covariance
-(J^T J)^-1 of the fit's parameters, J the Jacobian of the evidence's normalised residuals at the
-fit (the points' d_i / sigma_i, a_i and c_i, the lines' and the swept links' residuals; not the
-extent prior, and not the points counted wrong), carried to the sizes, times the square root of the
+Sizes. Each size of a class's fit carries a standard deviation: the covariance of the fit's
+parameters from the evidence's normalised residuals at the fit (the points' d_i / sigma_i, a_i
+and c_i, the lines' and the swept links' residuals; not the extent prior, and not the points
+counted wrong; :func:`parameter_covariance`: Gauss-Newton's, then the residuals' slopes over one
+standard deviation), carried to the sizes, times the square root of the
 overdispersion c (the covariance times c is kept with the fit, :attr:`ClassFit.covariance`,
 and :meth:`ClassFit.distance_std` carries it to the fitted surface). A size the evidence does
 not hold (a sphere's radius from a small cap) is not measured: no deviation. A size whose end no
@@ -129,6 +134,7 @@ always carries a confidence of at least 0.95, and an abstention one below it.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -234,6 +240,10 @@ FREE_ACTIVE = 0.01
 #: deviations: a micrometre, far below the points' scatter and far above rounding.
 JACOBIAN_STEP = 1e-6
 
+#: Rounds of measuring a fit's information again over the range its parameters are uncertain
+#: by (:func:`parameter_covariance`).
+SECANT_ROUNDS = 2
+
 #: Eigenvalues of J^T J below this fraction of the largest are directions the points do not
 #: hold (a box's hidden extent with its centre): sizes moving along them are free.
 EIGEN_FLOOR = 1e-12
@@ -245,6 +255,14 @@ TOUCH_REACH = 4.0
 #: Samples of the line over that reach (odd: one at the point), an eighth of a standard
 #: deviation apart (module docstring, "Distance.").
 TOUCH_SAMPLES = 65
+
+#: Rounds and points per round of the search for a contact's nearest point along its line
+#: between the samples beside the least: each round narrows it to a quarter.
+_REFINE_ROUNDS = 4
+_REFINE_POINTS = 9
+
+#: Step (m) of the central differences of d's gradient beside a line's least distance.
+_GRADIENT_STEP = 1e-6
 
 #: Where along that stretch, as fractions of it.
 _LINE_FRACTIONS = (0.125, 0.25, 0.5, 1.0)
@@ -307,11 +325,12 @@ class LinkLines:
         points: FloatArray,
         sigma: FloatArray,
         touched: FloatArray | None = None,
+        reach: FloatArray | None = None,
     ) -> FloatArray:
         """r_i (module docstring), shape (n,), for a signed distance function of (m, 3) points
         and the points' standard deviations across the link along the surface's normal (m,
-        shape (n,)); ``touched`` as in :meth:`PlacedLines.residuals`."""
-        return self.placed(points).residuals(distance, sigma, touched)
+        shape (n,)); ``touched`` and ``reach`` as in :meth:`PlacedLines.residuals`."""
+        return self.placed(points).residuals(distance, sigma, touched, reach)
 
     def placed(self, points: FloatArray) -> PlacedLines:
         """The lines at these contacts (m, shape (n, 3)), sampled once: a fit evaluates its
@@ -350,18 +369,42 @@ class PlacedLines:
         distance: Callable[[FloatArray], FloatArray],
         sigma: FloatArray,
         touched: FloatArray | None = None,
+        reach: FloatArray | None = None,
+        across: FloatArray | None = None,
     ) -> FloatArray:
         """r_i (module docstring), shape (n,): :meth:`LinkLines.residuals` at these contacts;
         the depth allowed is d at each point's nearest point along its line, ``touched`` (m,
-        shape (n,)), when given, else d at the point itself."""
+        shape (n,)), when given, else d at the point itself; samples within ``reach`` (m,
+        shape (n,)) of the point are left out (the nearest point's own cut charges them).
+        With the points' covariances across the link, ``across`` (m^2, shape (n, 3, 3)), each
+        sample's depth is over its own deviation, along d's gradient there, instead of
+        ``sigma``."""
         n, k = self.arc.shape
         if n == 0:
             return np.zeros(0)
         at_line = distance(self.samples).reshape(n, k)
         own = np.minimum(distance(self.points) if touched is None else touched, 0.0)
         spread = np.sqrt(sigma[:, None] ** 2 + self.slope_variance)
-        deeper = np.where(np.isfinite(self.arc), (at_line - own[:, None]) / spread, np.inf)
-        return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
+        counted = np.isfinite(self.arc)
+        if reach is not None:
+            counted &= np.abs(np.nan_to_num(self.arc)) > reach[:, None]
+        depth = at_line - own[:, None]
+        deeper = np.where(counted, depth / spread, np.inf)
+        residual = np.minimum(deeper.min(axis=1), 0.0)
+        if across is None:
+            return np.asarray(residual)
+        # each sample that cuts in, over its own deviation along d's gradient there
+        row, col = np.nonzero(counted & (depth < 0.0))
+        if len(row) == 0:
+            return np.asarray(residual)
+        normal = _distance_gradient(distance, self.samples.reshape(n, k, 3)[row, col])
+        variance = np.einsum("ni,nij,nj->n", normal, across[row], normal)
+        variance = variance + self.slope_variance[row, col] * np.sum(normal**2, axis=1)
+        own_deviation = np.full((n, k), np.inf)
+        own_deviation[row, col] = np.sqrt(np.maximum(variance, 1e-18))
+        cuts = np.where(np.isfinite(own_deviation), depth / own_deviation, 0.0)
+        weighed = np.isfinite(sigma)  # a point that weighs nothing keeps 0
+        return np.asarray(np.where(weighed, np.minimum(cuts.min(axis=1), 0.0), 0.0))
 
 
 @dataclass(frozen=True)
@@ -383,7 +426,7 @@ class ClassFit:
         :func:`fit_primitive` gives it for the points' own covariances, :func:`recognise`
         widened by the overdispersion.
     covariance : array, shape (len(vector), len(vector))
-        The Gauss-Newton covariance of :attr:`vector` (module docstring, "Sizes."; units of the
+        The covariance of :attr:`vector` (module docstring, "Sizes."; units of the
         parameters squared; :func:`parameter_covariance`), a direction the evidence does not
         hold at a variance far beyond any size; shape (0, 0) for a user mesh. Widened by the
         overdispersion in :func:`recognise`, as the sizes' deviations are.
@@ -654,6 +697,11 @@ class _Touch:
         across = projector @ covariances @ projector
         return cls(points, tangents, along, slope, arc, across)
 
+    @property
+    def reach(self) -> FloatArray:
+        """How far along each line its samples reach (m, shape (n,); 0 without a tangent)."""
+        return np.asarray(np.where(np.isfinite(self.along), TOUCH_REACH * self.along, 0.0))
+
     def where(self, shift: FloatArray) -> FloatArray:
         """The points moved along their lines by ``shift`` (m, shape (n,)), shape (n, 3)."""
         return np.asarray(self.points + shift[:, None] * self.tangents)
@@ -668,12 +716,20 @@ class _Touch:
         values[self.flat] = distance(self.samples)
         return values.reshape(self.arc.shape)
 
-    def nearest(self, values: FloatArray, across: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Where along each line the cost d(p + s t)^2 / across^2 + s^2 / sigma_a^2 is least
-        (m, shape (n,): the least sample's, moved to the vertex of the parabola through it and
-        its neighbours), and the mean square of the distance's slopes along the line on either
-        side of that sample (shape (n,)), from the samples' ``values`` (:meth:`sampled`) and the
-        deviations ``across`` (m; inf: the point itself)."""
+    def nearest(
+        self,
+        distance: Callable[[FloatArray], FloatArray],
+        values: FloatArray,
+        across: FloatArray,
+        offset: FloatArray,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Where along each line the cost (d(p + s t) - offset)^2 / across^2 + s^2 / sigma_a^2
+        is least (m, shape (n,)), and the mean square of the distance's slopes along the line on
+        either side of the least sample (shape (n,)), from the samples' ``values``
+        (:meth:`sampled`, less ``offset``, m, shape (n,)) and the deviations ``across`` (m;
+        inf: the point itself): the least sample, then the least between its neighbours on d
+        itself (:meth:`refined`), so that the place moves smoothly with the shape (a sampled
+        place moves in steps, and a fit's slopes would follow the steps)."""
         n, k = values.shape
         rows = np.arange(n)
         weight = np.where(np.isfinite(across), 1.0 / np.maximum(across, 1e-12) ** 2, 0.0)
@@ -686,24 +742,58 @@ class _Touch:
             np.inf,
         )
         j = np.argmin(cost, axis=1)
-        shift = arc[rows, j]
         left, right = np.maximum(j - 1, 0), np.minimum(j + 1, k - 1)
-        c0, c1, c2 = cost[rows, left], cost[rows, j], cost[rows, right]
-        inner = (left < j) & (j < right) & np.isfinite(c0) & np.isfinite(c2)
-        c0, c1, c2 = (np.where(inner, c, 0.0) for c in (c0, c1, c2))
-        h = np.where(inner, arc[rows, right] - arc[rows, j], 1.0)
-        curve = c0 - 2.0 * c1 + c2
-        step = np.divide(0.5 * h * (c0 - c2), curve, out=np.zeros(n), where=inner & (curve > 0.0))
-        shift = shift + np.clip(step, -h, h)
+        left = np.where(np.isfinite(cost[rows, left]), left, j)
+        right = np.where(np.isfinite(cost[rows, right]), right, j)
+        shift = self.refined(distance, offset, weight, along, arc[rows, left], arc[rows, right])
+        before = np.where(left < j, arc[rows, j] - arc[rows, left], 1.0)
+        after = np.where(j < right, arc[rows, right] - arc[rows, j], 1.0)
         with np.errstate(invalid="ignore"):
             slopes = [
-                (values[rows, j] - values[rows, left]) / np.where(left < j, h, 1.0),
-                (values[rows, right] - values[rows, j]) / np.where(j < right, h, 1.0),
+                (values[rows, j] - values[rows, left]) / before,
+                (values[rows, right] - values[rows, j]) / after,
             ]
         known = [(left < j) & np.isfinite(slopes[0]), (j < right) & np.isfinite(slopes[1])]
         count = known[0].astype(float) + known[1]
         square = np.where(known[0], slopes[0], 0.0) ** 2 + np.where(known[1], slopes[1], 0.0) ** 2
         return shift, np.divide(square, count, out=np.zeros(n), where=count > 0)
+
+    def refined(
+        self,
+        distance: Callable[[FloatArray], FloatArray],
+        offset: FloatArray,
+        weight: FloatArray,
+        along: FloatArray,
+        low: FloatArray,
+        high: FloatArray,
+    ) -> FloatArray:
+        """The least of (d(p + s t) - offset)^2 weight + (s / along)^2 over s in [low, high]
+        (m, each shape (n,)): :data:`_REFINE_ROUNDS` rounds of :data:`_REFINE_POINTS` evenly spaced
+        points, each round between the least one's neighbours, then the vertex of the parabola
+        through the last round's least and its neighbours."""
+        n = len(low)
+        rows = np.arange(n)
+        grid = np.linspace(0.0, 1.0, _REFINE_POINTS)
+        a, b = low, high
+        for _ in range(_REFINE_ROUNDS):
+            s = a[:, None] + (b - a)[:, None] * grid  # shape (n, m)
+            d = np.asarray(distance(self.where_all(s)), dtype=float).reshape(s.shape)
+            d = d - offset[:, None]
+            cost = weight[:, None] * d**2 + (s / along[:, None]) ** 2
+            i = np.clip(np.argmin(cost, axis=1), 1, _REFINE_POINTS - 2)
+            a, b = s[rows, i - 1], s[rows, i + 1]
+        c0, c1, c2 = cost[rows, i - 1], cost[rows, i], cost[rows, i + 1]
+        middle, spacing = s[rows, i], 0.5 * (b - a)
+        curve = c0 - 2.0 * c1 + c2
+        ok = (spacing > 0.0) & (curve > 0.0)
+        step = np.divide(spacing * (c0 - c2), 2.0 * curve, out=np.zeros(n), where=ok)
+        return np.asarray(middle + np.clip(step, -spacing, spacing))
+
+    def where_all(self, shift: FloatArray) -> FloatArray:
+        """The points moved along their lines by each of ``shift`` (m, shape (n, m)), shape
+        (n * m, 3)."""
+        moved = self.points[:, None, :] + shift[:, :, None] * self.tangents[:, None, :]
+        return np.asarray(moved.reshape(-1, 3))
 
     @staticmethod
     def least(values: FloatArray, arc: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -726,7 +816,7 @@ class _Touch:
                 k1, k2 = slope[:, i], slope[:, i + 2]
                 ok = np.all(np.isfinite(v[:, i : i + 4]), axis=1) & (k2 - k1 > 1e-9)
                 cross = (v[:, i + 2] - v[:, i] + k1 * s[:, i] - k2 * s[:, i + 2]) / np.where(
-                    ok, k2 - k1, 1.0
+                    ok, k1 - k2, 1.0
                 )
                 ok &= (cross >= s[:, 1]) & (cross <= s[:, 3])
                 value = v[:, i] + k1 * (cross - s[:, i])
@@ -735,37 +825,88 @@ class _Touch:
                 shift = np.where(better, cross, shift)
         return least, shift
 
+    def least_sigma(
+        self, distance: Callable[[FloatArray], FloatArray], shift: FloatArray
+    ) -> FloatArray:
+        """The standard deviation (m, shape (n,)) of each line's least distance to the shape,
+        found at ``shift`` along it (m, shape (n,)): sqrt(g^T Sigma_across g + (s_m sigma_t
+        |g|)^2), g the least distance's gradient as the line moves across itself, from d's
+        gradients n_1, n_2 a sample before and after it (central differences):
+        g = (k_2 n_1 - k_1 n_2) / (k_2 - k_1), k = n . t, the weighing of the two that is
+        across the line (over an edge, the faces' normals; beside a smooth surface, its normal
+        there); their mean where they do not bracket a least distance (the reach's end)."""
+        n = len(shift)
+        step = self.along * (2.0 * TOUCH_REACH / (TOUCH_SAMPLES - 1))
+        step = np.where(np.isfinite(step), step, 0.0)
+        ends = np.concatenate([self.where(shift - step), self.where(shift + step)])
+        gradient = _distance_gradient(distance, ends)
+        before, after = gradient[:n], gradient[n:]
+        k1 = np.einsum("ni,ni->n", before, self.tangents)
+        k2 = np.einsum("ni,ni->n", after, self.tangents)
+        bracket = (k1 < 0.0) & (k2 > 0.0)
+        weight = np.divide(k2, k2 - k1, out=np.full(n, 0.5), where=bracket)
+        g = weight[:, None] * before + (1.0 - weight[:, None]) * after
+        g = g - np.einsum("ni,ni->n", g, self.tangents)[:, None] * self.tangents
+        variance = np.einsum("ni,nij,nj->n", g, self.across, g)
+        variance = variance + (shift * self.slope) ** 2 * np.einsum("ni,ni->n", g, g)
+        return np.asarray(np.sqrt(np.maximum(variance, 1e-18)))
+
     def shifted(
         self, distance: Callable[[FloatArray], FloatArray], across: FloatArray
     ) -> FloatArray:
-        """Where along each line its nearest point lies (m, shape (n,); :meth:`nearest`)."""
-        return self.nearest(self.sampled(distance), across)[0]
+        """Where along each line its nearest point lies (m, shape (n,); :meth:`residuals`)."""
+        return self.touching(distance, across)[0]
+
+    def touching(
+        self, distance: Callable[[FloatArray], FloatArray], across: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Where along each line its nearest point lies (m), the mean square of d's slopes
+        beside it, how deep the line reaches into the shape within its reach (m, <= 0; 0
+        without a tangent) and where (m), each shape (n,): the nearest point of the line moved
+        out by that depth, where it touches (:meth:`nearest` of d less the depth)."""
+        values = self.sampled(distance)
+        least, least_shift = self.least(values, self.arc)
+        depth = np.where(np.isfinite(self.along), np.minimum(least, 0.0), 0.0)
+        shift, slope2 = self.nearest(distance, values - depth[:, None], across, depth)
+        return shift, slope2, depth, least_shift
 
     def residuals(
         self, distance: Callable[[FloatArray], FloatArray], across: FloatArray
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """Each contact's distance d at its nearest point along its line (m), its standard
-        deviation (m), and the residuals of its place there and of its line's cut (module
-        docstring, "Distance.", shape (n, 2)), and the share of the point's deviation along the
-        link that the place is measured to (0 to 1), each shape (n,) unless said, for the
-        deviations ``across`` (m) along the normal there (inf for a point that weighs nothing:
-        its residuals are then 0)."""
-        values = self.sampled(distance)
-        shift, slope2 = self.nearest(values, across)
-        at = np.asarray(distance(self.where(shift)), dtype=float)
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Each contact's distance d at its nearest point along its line beyond the line's
+        depth (m), its standard deviation (m), the residuals of its place there and of its
+        line's cut (module docstring, "Distance.", shape (n, 2)), the share of the point's
+        deviation along the link that the place is measured to (0 to 1), and d there where
+        negative (m, the depth the link's line residual allows), each shape (n,) unless said,
+        for the deviations ``across`` (m) along the normal there (inf for a point that weighs
+        nothing: its residuals are then 0)."""
+        shift, slope2, depth, least_shift = self.touching(distance, across)
+        reached = np.asarray(distance(self.where(shift)), dtype=float)
+        at = reached - depth
         sigma = np.sqrt(across**2 + (shift * self.slope) ** 2)
-        least, least_shift = self.least(values, self.arc)
         weighed = np.isfinite(across) & np.isfinite(self.along)
         place = np.divide(shift, self.along, out=np.zeros(len(shift)), where=weighed)
-        cut_sigma = np.sqrt(across**2 + (least_shift * self.slope) ** 2)
-        depth = np.minimum(least - np.minimum(at, 0.0), 0.0)
+        cut_sigma = np.where(
+            np.isfinite(self.along), self.least_sigma(distance, least_shift), across
+        )
         cut = np.divide(depth, cut_sigma, out=np.zeros(len(shift)), where=np.isfinite(across))
         # the share of the point's variance along the link its place measures (the
         # information d's slope along the line gives against the point's own)
         pinned = np.where(weighed, slope2 / np.maximum(across, 1e-12) ** 2, 0.0)
         own = np.where(weighed, 1.0 / np.maximum(self.along, 1e-12) ** 2, 1.0)
         share = pinned / (pinned + own)
-        return at, sigma, np.stack([place, cut], axis=1), share
+        return at, sigma, np.stack([place, cut], axis=1), share, np.minimum(reached, 0.0)
+
+
+def _distance_gradient(
+    distance: Callable[[FloatArray], FloatArray], points: FloatArray
+) -> FloatArray:
+    """d's gradient at the points (central differences of :data:`_GRADIENT_STEP`), shape
+    (n, 3)."""
+    offsets = _GRADIENT_STEP * np.concatenate([np.eye(3), -np.eye(3)])
+    shifted = (np.asarray(points, dtype=float)[:, None, :] + offsets).reshape(-1, 3)
+    values = np.asarray(distance(shifted), dtype=float).reshape(-1, 6)
+    return np.asarray((values[:, :3] - values[:, 3:]) / (2.0 * _GRADIENT_STEP))
 
 
 def _algebraic_sphere(points: FloatArray) -> tuple[FloatArray, float]:
@@ -959,19 +1100,26 @@ def fit_primitive(
     spaces = [space.near(p, FREE_MARGIN + 0.5 * spread) for space in swept]
     link_evidence = lines is not None or bool(spaces)
 
-    def line_residuals(x: FloatArray, s: FloatArray, touched: FloatArray) -> FloatArray:
+    def line_residuals(
+        x: FloatArray, s: FloatArray, touched: FloatArray, search: bool = True
+    ) -> FloatArray:
+        # beyond the nearest point's reach, when it was searched for
         if placed is None:
             return np.zeros(0)
-        return placed.residuals(lambda q: model.signed_distance(x, q), s, touched)
+        distance = functools.partial(model.signed_distance, x)
+        if not search:
+            return placed.residuals(distance, s, touched)
+        return placed.residuals(distance, s, touched, touch.reach, touch.across)
 
     def swept_residuals(x: FloatArray, regions: Sequence[FreeSpace]) -> FloatArray:
         return _swept_residuals(regions, lambda q: model.signed_distance(x, q))
 
     def touched(
         x: FloatArray, s: FloatArray
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        # each contact at its nearest point along its line: distance (m), deviation (m), place
-        # and cut (in deviations) and the share of its deviation along the link measured
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+        # each contact at its nearest point along its line: distance beyond the line's depth
+        # (m), deviation (m), place and cut (in deviations), the share of its deviation along
+        # the link measured, and the depth its link's line residual allows (m)
         return touch.residuals(lambda q: model.signed_distance(x, q), s)
 
     def normal_sigma(x: FloatArray) -> FloatArray:
@@ -984,8 +1132,8 @@ def fit_primitive(
     def point_residuals(x: FloatArray, s: FloatArray, with_lines: bool) -> FloatArray:
         # d_i / sigma_i at the nearest points along the lines, their places and cuts, and the
         # lines' residuals
-        at, sigma_at, extra, _ = touched(x, s)
-        line = line_residuals(x, s, at) if with_lines else np.zeros(0)
+        at, sigma_at, extra, _, reached = touched(x, s)
+        line = line_residuals(x, s, reached) if with_lines else np.zeros(0)
         return np.concatenate([at / sigma_at, extra[:, 0], extra[:, 1], line])
 
     def residuals(
@@ -1000,7 +1148,7 @@ def fit_primitive(
             points_part = point_residuals(x, s, with_lines)
         else:  # the Euclidean d_i / sigma_i
             distance = model.signed_distance(x, p)
-            line = line_residuals(x, s, distance) if with_lines else np.zeros(0)
+            line = line_residuals(x, s, distance, search=False) if with_lines else np.zeros(0)
             points_part = np.concatenate([distance / s, line])
         prior = _extent_prior(model.name, x, p, free_apex)
         return np.concatenate([points_part, swept_residuals(x, regions), prior])
@@ -1025,8 +1173,8 @@ def fit_primitive(
         )
 
     def point_z2(x: FloatArray, s: FloatArray) -> FloatArray:
-        at, sigma_at, extra, _ = touched(x, s)
-        return _z2(at, sigma_at, line_residuals(x, s, at), extra)
+        at, sigma_at, extra, _, reached = touched(x, s)
+        return _z2(at, sigma_at, line_residuals(x, s, reached), extra)
 
     def inlier_sigma(x: FloatArray, s: FloatArray) -> FloatArray:
         # a point the mixture counts as wrong at x (its z^2 beyond its cap) weighs nothing
@@ -1091,7 +1239,7 @@ def fit_primitive(
                 ]
             )
 
-        covariance = parameter_covariance(v, evidence)
+        covariance = parameter_covariance(v, evidence, spread)
         return (covariance, *size_std(model, v, covariance, evidence, spread, kept))
 
     shaped, measured = x, None
@@ -1117,10 +1265,10 @@ def fit_primitive(
         vector=x,
         mesh=model.mesh(x),
         spread=spread,
-        line=line_residuals(x, sigma, touches[0]),
+        line=line_residuals(x, sigma, touches[4]),
         swept=swept_residuals(x, spaces),
         spaces=spaces,
-        touches=touches,
+        touches=touches[:4],
     )
     at_least = np.maximum(model.sizes(shaped) - margin, 0.0)
     return dataclasses.replace(
@@ -1160,14 +1308,20 @@ def _carried(
 
 
 def parameter_covariance(
-    x: FloatArray, residuals: Callable[[FloatArray], FloatArray]
+    x: FloatArray, residuals: Callable[[FloatArray], FloatArray], reach: float = math.inf
 ) -> FloatArray:
-    """The Gauss-Newton covariance (J^T J)^-1 of the parameters at ``x``, shape (n, n) (units of
-    the parameters squared): J the Jacobian of the normalised ``residuals`` by central
-    differences of :data:`JACOBIAN_STEP`, each eigenvalue of J^T J floored at
-    :data:`EIGEN_FLOOR` of the largest (a direction the residuals do not hold gets a variance
-    far beyond any size); inf throughout when they hold none, NaN when J^T J is not
-    finite."""
+    """The covariance of the parameters at ``x``, shape (n, n) (units of the parameters
+    squared), from the normalised ``residuals``: first Gauss-Newton's (J^T J)^-1, J the
+    Jacobian by central differences of :data:`JACOBIAN_STEP`, each eigenvalue of J^T J floored
+    at :data:`EIGEN_FLOOR` of the largest (a direction the residuals do not hold gets a variance
+    far beyond any size; inf throughout when they hold none, NaN when J^T J is not finite).
+    Then the residuals' slopes are measured again along each principal axis whose deviation
+    is within ``reach`` (m or rad; the others are kept), forward and back over one deviation,
+    and the information is their mean square, :data:`SECANT_ROUNDS` times, each round's steps
+    the geometric mean of the last round's and the deviations it gave: the residuals are
+    piecewise smooth (a contact's nearest point moves from one face to the next, a line's cut
+    starts), a fit often stops where their slopes change, and the slopes there can be far
+    steeper than over the range the parameters are uncertain by."""
     n = len(x)
     jacobian = _gradient(residuals, x)
     information = jacobian.T @ jacobian
@@ -1177,7 +1331,37 @@ def parameter_covariance(
     floor = EIGEN_FLOOR * float(eigenvalues[-1])
     if not floor > 1.0 / np.finfo(float).max:
         return np.full((n, n), np.inf)  # the residuals hold no direction
-    return np.asarray((eigenvectors / np.maximum(eigenvalues, floor)) @ eigenvectors.T)
+    held = int(np.sum(eigenvalues > floor))
+    covariance = (eigenvectors / np.maximum(eigenvalues, floor)) @ eigenvectors.T
+    # the held axes within reach (the covariance's smallest), measured again; the others kept
+    variances, axes = np.linalg.eigh(covariance)
+    deviations = np.sqrt(np.maximum(variances, 0.0))
+    measured = int(np.sum(deviations[:held] <= reach))
+    if measured == 0:
+        return np.asarray(covariance)
+    basis, steps = axes[:, :measured], deviations[:measured]
+    at_x = residuals(x)
+    inverse = np.diag(variances[:measured])
+    for _ in range(SECANT_ROUNDS):
+        information = np.zeros((measured, measured))
+        for sign in (1.0, -1.0):
+            slopes = np.stack(
+                [
+                    (residuals(x + sign * h * basis[:, j]) - at_x) / (sign * h)
+                    for j, h in enumerate(steps)
+                ],
+                axis=1,
+            )
+            if not np.all(np.isfinite(slopes)):
+                return np.asarray(covariance)
+            information += 0.5 * slopes.T @ slopes
+        values, vectors = np.linalg.eigh(information)
+        inverse = (vectors / np.maximum(values, floor)) @ vectors.T
+        # the next round's steps: the geometric mean of these and the deviations they gave
+        # (undamped, a residual that curves would swing them between two scales)
+        steps = np.minimum(np.sqrt(steps * np.sqrt(np.diag(inverse))), reach)
+    free = axes[:, measured:]
+    return np.asarray(basis @ inverse @ basis.T + (free * variances[measured:]) @ free.T)
 
 
 def size_std(
@@ -1350,8 +1534,9 @@ def fit_mesh(
             touch = _Touch.of(p, cov, lines)
             shift = touch.shifted(signed, touch.across_sigma(normals))
             sigma = touch.across_sigma(normals_at(touch.where(shift)))
-            touches = touch.residuals(signed, sigma)
-            line = lines.residuals(signed, p, sigma, touches[0])
+            at, sigma_at, extra, share, reached = touch.residuals(signed, sigma)
+            touches = (at, sigma_at, extra, share)
+            line = lines.placed(p).residuals(signed, sigma, reached, touch.reach, touch.across)
         # only samples within the placed mesh's box grown by this can come near it
         reach = FREE_MARGIN + 0.5 * _spread(p)
         spaces = [space.near(placed.bounds, reach) for space in swept]
