@@ -21,9 +21,9 @@ sampled within :data:`TOUCH_REACH` of the point's standard deviations along t_i,
 the shape there, at s_m (the least sample, refined where the secants on either side of an edge
 meet); a line that enters the shape (m_i < 0) is taken as moved out by m_i, so that it touches.
 Its nearest point s_i minimises (d(p_i + s t_i) - min(0, m_i))^2 / sigma_i^2 + s^2 / sigma_a^2,
-sigma_i the standard deviation across t_i along the normal there (the least sample, then the
-least between its neighbours on d itself, so that s_i moves smoothly with the shape). Its
-residuals are the distance there beyond the line's depth, (d_i - min(0, m_i)) /
+sigma_i the standard deviation across t_i along the normal there; s_i is found at the least
+sample, then between its neighbours on d itself, so that it moves smoothly with the shape. Its
+residuals are the distance there beyond the line's depth, e_i = (d_i - min(0, m_i)) /
 sqrt(sigma_i^2 + (s_i sigma_t)^2) (sigma_t the tangent's deviation in angle), its place
 a_i = s_i / sigma_a, and its line's cut c_i = min(0, m_i) / sigma_m, sigma_m m_i's own spread as
 the line moves across itself: sigma_m^2 = g^T Sigma_across g + (s_m sigma_t |g|)^2, g m_i's
@@ -62,8 +62,9 @@ into free space) and max(0, min_k (d(q_k) - a) / sigma_k) over a touching link's
 nowhere near it), a the link's radius.
 
 Score: a Bayesian information criterion, score = chi^2 / c + k ln n, with chi^2 the sum over
-the points of -2 log-likelihood of their residuals z_i^2 = (d_i / sigma_i)^2 + a_i^2 + c_i^2 +
-r_i^2 (the Euclidean d_i / sigma_i alone without a tangent) up to a constant, and over the swept
+the points of -2 log-likelihood of their residuals z_i^2 = e_i^2 + a_i^2 + c_i^2 + r_i^2, e_i
+the distance residual ("Distance."; the Euclidean d_i / sigma_i alone without a tangent) up to a
+constant, and over the swept
 links of their r_j^2 in the same mixture (below), k the class's independent parameters, n the
 points, and c >= 1 the overdispersion (Burnham and Anderson, "Model Selection and Multimodel
 Inference", 2002, Section 6.2: the reduced chi^2 of the best-fitting class, over N - k, when
@@ -84,8 +85,8 @@ shapes (the truncated residual of Torr's robust model selection, "Geometric moti
 and model selection", Phil. Trans. R. Soc. A 356, 1998).
 
 Sizes. Each size of a class's fit carries a standard deviation: the covariance of the fit's
-parameters from the evidence's normalised residuals at the fit (the points' d_i / sigma_i, a_i
-and c_i, the lines' and the swept links' residuals; not the extent prior, and not the points
+parameters from the evidence's normalised residuals at the fit (the points' e_i, a_i and c_i,
+the lines' and the swept links' residuals; not the extent prior, and not the points
 counted wrong; :func:`parameter_covariance`: Gauss-Newton's, then the residuals' slopes over one
 standard deviation), carried to the sizes, times the square root of the
 overdispersion c (the covariance times c is kept with the fit, :attr:`ClassFit.covariance`,
@@ -261,7 +262,8 @@ TOUCH_SAMPLES = 65
 _REFINE_ROUNDS = 4
 _REFINE_POINTS = 9
 
-#: Step (m) of the central differences of d's gradient beside a line's least distance.
+#: Step (m) of the central differences of d's gradient (beside a line's least distance, at the
+#: link line's samples).
 _GRADIENT_STEP = 1e-6
 
 #: Where along that stretch, as fractions of it.
@@ -326,11 +328,13 @@ class LinkLines:
         sigma: FloatArray,
         touched: FloatArray | None = None,
         reach: FloatArray | None = None,
+        across: FloatArray | None = None,
     ) -> FloatArray:
         """r_i (module docstring), shape (n,), for a signed distance function of (m, 3) points
         and the points' standard deviations across the link along the surface's normal (m,
-        shape (n,)); ``touched`` and ``reach`` as in :meth:`PlacedLines.residuals`."""
-        return self.placed(points).residuals(distance, sigma, touched, reach)
+        shape (n,)); ``touched``, ``reach`` and ``across`` as in
+        :meth:`PlacedLines.residuals`."""
+        return self.placed(points).residuals(distance, sigma, touched, reach, across)
 
     def placed(self, points: FloatArray) -> PlacedLines:
         """The lines at these contacts (m, shape (n, 3)), sampled once: a fit evaluates its
@@ -854,7 +858,7 @@ class _Touch:
     def shifted(
         self, distance: Callable[[FloatArray], FloatArray], across: FloatArray
     ) -> FloatArray:
-        """Where along each line its nearest point lies (m, shape (n,); :meth:`residuals`)."""
+        """Where along each line its nearest point lies (m, shape (n,); :meth:`touching`)."""
         return self.touching(distance, across)[0]
 
     def touching(
@@ -1574,8 +1578,8 @@ def _scored(
     touches: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None = None,
 ) -> ClassFit:
     """The fit scored; ``distance`` the points' Euclidean distances (m, for the RMS) and
-    ``touches`` the lines' touches (:meth:`_Touch.residuals`), the Euclidean distances in
-    ``sigma`` alone when None."""
+    ``touches`` the lines' touches (the first four of :meth:`_Touch.residuals`), the
+    Euclidean distances in ``sigma`` alone when None."""
     n = len(distance)
     lines = line if line is not None and len(line) == n else np.zeros(n)
     sweeps = swept if swept is not None else np.zeros(0)
