@@ -47,13 +47,13 @@ contact) adds one residual: how far the link's line cuts into the fitted shape b
 depth of its nearest point, over its spread, at samples q_k = p + s_k t along the link's stretch
 around the contact (up to :data:`LINE_STRETCH` each way, within the link, beyond the nearest
 point's reach, whose own cut charges the line within it):
-r = min(0, min_k (d(q_k) - min(0, d_i)) / sqrt(sigma^2 + (s_k sigma_t)^2)), d_i the distance at
-the nearest point ("Distance."; at p without a tangent), sigma the point's standard deviation
-across the link along d's gradient at the deepest sample and sigma_t the tangent's in angle (the
-Euclidean fits that start a class's search: along the normal at the point). It is 0 for a convex
-surface tangent to the link and for an edge the link passes over, and a line crossing a surface
-of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through the points a
-sweeping line left on a box's edges is not tangent to the lines that touched them.
+r = min(0, min_k (d(q_k) - min(0, d_i)) / sqrt(sigma_k^2 + (s_k sigma_t)^2)), d_i the distance
+at the nearest point ("Distance."; at p without a tangent), sigma_k the point's standard
+deviation across the link along d's gradient at q_k and sigma_t the tangent's in angle (the
+Euclidean fits that start a class's search: sigma_k along the normal at the point). It is 0
+for a convex surface tangent to the link and for an edge the link passes over, and a line
+crossing a surface of radius R at an angle beta cuts R (1 - cos beta) deep: a cylinder through
+the points a sweeping line left on a box's edges is not tangent to the lines that touched them.
 
 The swept links (``mapping.free_space``): each sweep's link where it passed untouched, and the
 link of each contact with no ``ok`` point where it touched, add one residual per sweep or
@@ -262,6 +262,9 @@ TOUCH_SAMPLES = 65
 _REFINE_ROUNDS = 4
 _REFINE_POINTS = 9
 
+#: Distances (m) closer than this to a line's least are as least (rounding).
+_TIE = 1e-12
+
 #: Step (m) of the central differences of d's gradient (beside a line's least distance, at the
 #: link line's samples).
 _GRADIENT_STEP = 1e-6
@@ -401,11 +404,17 @@ class PlacedLines:
         row, col = np.nonzero(counted & (depth < 0.0))
         if len(row) == 0:
             return np.asarray(residual)
-        normal = _distance_gradient(distance, self.samples.reshape(n, k, 3)[row, col])
+        gradient = _distance_gradient(distance, self.samples.reshape(n, k, 3)[row, col])
+        # a distance's gradient is a unit normal but where two sides meet (a medial axis,
+        # deep inside): there the deviation along the nearest point's normal stands
+        size = np.linalg.norm(gradient, axis=1)
+        normal = gradient / np.maximum(size, 1e-6)[:, None]
         variance = np.einsum("ni,nij,nj->n", normal, across[row], normal)
         variance = variance + self.slope_variance[row, col] * np.sum(normal**2, axis=1)
         own_deviation = np.full((n, k), np.inf)
-        own_deviation[row, col] = np.sqrt(np.maximum(variance, 1e-18))
+        own_deviation[row, col] = np.where(
+            size > 0.5, np.sqrt(np.maximum(variance, 1e-18)), spread[row, col]
+        )
         cuts = np.where(np.isfinite(own_deviation), depth / own_deviation, 0.0)
         weighed = np.isfinite(sigma)  # a point that weighs nothing keeps 0
         return np.asarray(np.where(weighed, np.minimum(cuts.min(axis=1), 0.0), 0.0))
@@ -803,10 +812,15 @@ class _Touch:
     def least(values: FloatArray, arc: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Each line's least distance to the shape (m; negative where it cuts in) and where
         along it (m), both shape (n,), from the samples' ``values`` at offsets ``arc``: the least
-        sample, refined where the line passes over an edge (the secants on either side met)."""
+        sample (of samples within :data:`_TIE` of it, the nearest the point: along a line
+        parallel to a plane every sample is least), refined where the line passes over an edge
+        (the secants on either side met)."""
         n, k = values.shape
         rows = np.arange(n)[:, None]
-        index = np.argmin(values, axis=1)[:, None] + np.arange(-2, 3)
+        lowest = np.min(values, axis=1, keepdims=True)
+        tied = values <= lowest + _TIE
+        nearest = np.argmin(np.where(tied, np.abs(np.nan_to_num(arc)), np.inf), axis=1)
+        index = nearest[:, None] + np.arange(-2, 3)
         inside = (index >= 0) & (index < k)
         clipped = np.clip(index, 0, k - 1)
         v = np.where(inside, values[rows, clipped], np.inf)  # the least sample and 2 each side
