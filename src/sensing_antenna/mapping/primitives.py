@@ -41,7 +41,14 @@ import trimesh
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-__all__ = ["PRIMITIVES", "Growth", "Primitive", "local_coordinates", "primitive"]
+__all__ = [
+    "PRIMITIVES",
+    "Growth",
+    "Primitive",
+    "distance_gradient",
+    "local_coordinates",
+    "primitive",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -114,17 +121,22 @@ class Primitive:
 
     def normals(self, parameters: FloatArray, points: FloatArray, step: float = 1e-5) -> FloatArray:
         """Unit gradient of d at the points (central differences of ``step`` m), shape (n, 3)."""
-        points = np.asarray(points, dtype=float)
-        gradient = np.empty_like(points)
-        for axis in range(3):
-            shift = np.zeros(3)
-            shift[axis] = step
-            gradient[:, axis] = (
-                self.signed_distance(parameters, points + shift)
-                - self.signed_distance(parameters, points - shift)
-            ) / (2 * step)
+        gradient = distance_gradient(
+            lambda q: self.signed_distance(parameters, q), np.asarray(points, dtype=float), step
+        )
         norm = np.linalg.norm(gradient, axis=1, keepdims=True)
         return np.asarray(gradient / np.where(norm > 0, norm, 1.0))
+
+
+def distance_gradient(
+    distance: Callable[[FloatArray], FloatArray], points: FloatArray, step: float
+) -> FloatArray:
+    """Gradient of a distance function of (m, 3) points at the points (m), by central
+    differences of ``step`` m, shape (n, 3)."""
+    offsets = step * np.concatenate([np.eye(3), -np.eye(3)])
+    shifted = (np.asarray(points, dtype=float)[:, None, :] + offsets).reshape(-1, 3)
+    values = np.asarray(distance(shifted), dtype=float).reshape(-1, 6)
+    return np.asarray((values[:, :3] - values[:, 3:]) / (2.0 * step))
 
 
 def local_coordinates(parameters: FloatArray, points: FloatArray) -> FloatArray:

@@ -148,7 +148,12 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from sensing_antenna.mapping.free_space import FreeSpace
-from sensing_antenna.mapping.primitives import PRIMITIVES, Primitive, local_coordinates
+from sensing_antenna.mapping.primitives import (
+    PRIMITIVES,
+    Primitive,
+    distance_gradient,
+    local_coordinates,
+)
 
 __all__ = [
     "ABSTAIN_DELTA",
@@ -404,7 +409,9 @@ class PlacedLines:
         row, col = np.nonzero(counted & (depth < 0.0))
         if len(row) == 0:
             return np.asarray(residual)
-        gradient = _distance_gradient(distance, self.samples.reshape(n, k, 3)[row, col])
+        gradient = distance_gradient(
+            distance, self.samples.reshape(n, k, 3)[row, col], _GRADIENT_STEP
+        )
         # a distance's gradient is a unit normal but where two sides meet (a medial axis,
         # deep inside): there the deviation along the nearest point's normal stands
         size = np.linalg.norm(gradient, axis=1)
@@ -717,7 +724,7 @@ class _Touch:
 
     def where(self, shift: FloatArray) -> FloatArray:
         """The points moved along their lines by ``shift`` (m, shape (n,)), shape (n, 3)."""
-        return np.asarray(self.points + shift[:, None] * self.tangents)
+        return self.where_all(shift[:, None])
 
     def across_sigma(self, normals: FloatArray) -> FloatArray:
         """sqrt(n_i^T Sigma_across n_i) (m), shape (n,), for unit normals (n, 3)."""
@@ -857,7 +864,7 @@ class _Touch:
         step = self.along * (2.0 * TOUCH_REACH / (TOUCH_SAMPLES - 1))
         step = np.where(np.isfinite(step), step, 0.0)
         ends = np.concatenate([self.where(shift - step), self.where(shift + step)])
-        gradient = _distance_gradient(distance, ends)
+        gradient = distance_gradient(distance, ends, _GRADIENT_STEP)
         before, after = gradient[:n], gradient[n:]
         k1 = np.einsum("ni,ni->n", before, self.tangents)
         k2 = np.einsum("ni,ni->n", after, self.tangents)
@@ -914,17 +921,6 @@ class _Touch:
         own = np.where(weighed, 1.0 / np.maximum(self.along, 1e-12) ** 2, 1.0)
         share = pinned / (pinned + own)
         return at, sigma, np.stack([place, cut], axis=1), share, np.minimum(reached, 0.0)
-
-
-def _distance_gradient(
-    distance: Callable[[FloatArray], FloatArray], points: FloatArray
-) -> FloatArray:
-    """d's gradient at the points (central differences of :data:`_GRADIENT_STEP`), shape
-    (n, 3)."""
-    offsets = _GRADIENT_STEP * np.concatenate([np.eye(3), -np.eye(3)])
-    shifted = (np.asarray(points, dtype=float)[:, None, :] + offsets).reshape(-1, 3)
-    values = np.asarray(distance(shifted), dtype=float).reshape(-1, 6)
-    return np.asarray((values[:, :3] - values[:, 3:]) / (2.0 * _GRADIENT_STEP))
 
 
 def _algebraic_sphere(points: FloatArray) -> tuple[FloatArray, float]:
