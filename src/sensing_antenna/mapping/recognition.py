@@ -262,6 +262,9 @@ TOUCH_REACH = 4.0
 #: deviation apart (module docstring, "Distance.").
 TOUCH_SAMPLES = 65
 
+#: Each line's samples, in the point's standard deviations along the link.
+_TOUCH_GRID = np.linspace(-TOUCH_REACH, TOUCH_REACH, TOUCH_SAMPLES)
+
 #: Rounds and points per round of the search for a contact's nearest point along its line
 #: between the samples beside the least: each round narrows it to a quarter.
 _REFINE_ROUNDS = 4
@@ -401,14 +404,13 @@ class PlacedLines:
         if reach is not None:
             counted &= np.abs(np.nan_to_num(self.arc)) > reach[:, None]
         depth = at_line - own[:, None]
-        deeper = np.where(counted, depth / spread, np.inf)
-        residual = np.minimum(deeper.min(axis=1), 0.0)
         if across is None:
-            return np.asarray(residual)
+            deeper = np.where(counted, depth / spread, np.inf)
+            return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
         # each sample that cuts in, over its own deviation along d's gradient there
         row, col = np.nonzero(counted & (depth < 0.0))
         if len(row) == 0:
-            return np.asarray(residual)
+            return np.zeros(n)
         gradient = distance_gradient(
             distance, self.samples.reshape(n, k, 3)[row, col], _GRADIENT_STEP
         )
@@ -708,8 +710,9 @@ class _Touch:
         slope = np.where(known, np.nan_to_num(lines.std), 0.0) if lines is not None else np.zeros(n)
         variance = np.einsum("ni,nij,nj->n", tangents, covariances, tangents)
         along = np.where(known, np.sqrt(np.maximum(variance, 1e-18)), np.inf)
-        grid = np.linspace(-TOUCH_REACH, TOUCH_REACH, TOUCH_SAMPLES)
-        arc = np.where(known[:, None], np.nan_to_num(along, posinf=0.0)[:, None] * grid, np.nan)
+        arc = np.where(
+            known[:, None], np.nan_to_num(along, posinf=0.0)[:, None] * _TOUCH_GRID, np.nan
+        )
         if lines is not None:
             arc = lines.within(arc)
         arc[~known, TOUCH_SAMPLES // 2] = 0.0  # the point itself
@@ -721,6 +724,12 @@ class _Touch:
     def reach(self) -> FloatArray:
         """How far along each line its samples reach (m, shape (n,); 0 without a tangent)."""
         return np.asarray(np.where(np.isfinite(self.along), TOUCH_REACH * self.along, 0.0))
+
+    @property
+    def spacing(self) -> FloatArray:
+        """The spacing of each line's samples (m, shape (n,); 0 without a tangent)."""
+        step = _TOUCH_GRID[1] - _TOUCH_GRID[0]
+        return np.asarray(np.where(np.isfinite(self.along), step * self.along, 0.0))
 
     def where(self, shift: FloatArray) -> FloatArray:
         """The points moved along their lines by ``shift`` (m, shape (n,)), shape (n, 3)."""
@@ -861,9 +870,7 @@ class _Touch:
         across the line (over an edge, the faces' normals; beside a smooth surface, its normal
         there); their mean where they do not bracket a least distance (the reach's end)."""
         n = len(shift)
-        step = self.along * (2.0 * TOUCH_REACH / (TOUCH_SAMPLES - 1))
-        step = np.where(np.isfinite(step), step, 0.0)
-        ends = np.concatenate([self.where(shift - step), self.where(shift + step)])
+        ends = np.concatenate([self.where(shift - self.spacing), self.where(shift + self.spacing)])
         gradient = distance_gradient(distance, ends, _GRADIENT_STEP)
         before, after = gradient[:n], gradient[n:]
         k1 = np.einsum("ni,ni->n", before, self.tangents)
