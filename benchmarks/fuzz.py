@@ -1,5 +1,5 @@
 """The long fuzz run: thousands of inputs through the reader, the estimators, identify,
-calibrate, antenna files, campaign specs and the command line.
+calibrate, antenna files, campaign specs, scene files and the command line.
 
 The inputs and the judges are those of the test suite's fuzz tests (``tests/fuzz_inputs.py``):
 hypothesis strategies draw the inputs, and each input's outcome is ``ok``, an estimate's status,
@@ -53,6 +53,7 @@ SHARES = {
     "identify": 0.075,
     "calibrate": 0.075,
     "cli": 0.1,
+    "scene file": 0.1,
 }
 #: Findings of each kind kept per area in the JSON (the first ones met).
 KEPT_FINDINGS = 5
@@ -68,6 +69,7 @@ def areas(bases: fz.Bases, files: fz.CliFiles) -> dict[str, tuple[Any, Callable[
         "identify": (fz.identify_inputs(), lambda c: fz.run_identify(bases, c)),
         "calibrate": (fz.calibrate_inputs(), lambda c: fz.run_calibrate(bases, c)),
         "cli": (fz.cli_arguments(files.paths), lambda argv: fz.run_cli(argv, files.folder)),
+        "scene file": (fz.scene_files(), fz.run_scene_file),
     }
 
 

@@ -990,3 +990,109 @@ def run_cli(argv: Sequence[str], folder: Path) -> list[Outcome]:
             return [Outcome(BAD_ENDING, f"exit 2 with {len(lines)} lines: {text[-300:]}")]
         return [Outcome(ERROR, lines[0])]
     return [Outcome(OK, f"exit {code}")]
+
+
+# --------------------------------------------------------------------------------------------
+# Area 8: scene files
+
+#: One object of each kind as a scene file writes it: the sizes a primitive needs, a mesh file.
+_SCENE_OBJECTS = (
+    {"shape": "sphere", "radius": 0.06, "position": [0.6, 0.1, 0.0]},
+    {"shape": "cylinder", "radius": 0.04, "height": 0.15, "position": [0.5, 0.0, 0.0]},
+    {"shape": "capsule", "radius": 0.03, "length": 0.1, "position": [0.5, 0.0, 0.0]},
+    {"shape": "cone", "radius": 0.05, "height": 0.12, "position": [0.6, 0.0, -0.05]},
+    {"shape": "torus", "major_radius": 0.07, "minor_radius": 0.02, "position": [0.6, 0.0, 0.0]},
+    {"shape": "box", "extents": [0.12, 0.08, 0.16], "position": [0.55, 0.05, 0.0]},
+    {"shape": "mesh", "file": "part.stl", "scale": 0.001, "position": [0.5, -0.2, 0.0]},
+)
+_SCENE_BASES = (
+    {"position": [0.0, 0.0, 0.0]},
+    {"position": [0.87, -0.4, 0.0], "yaw": 2.09},
+    {"position": [0.8, 0.5, 0.1], "quaternion": [0.9, 0.0, 0.0, 0.43]},
+    {"position": [0.0, 0.0, 0.0], "azimuth": [-0.3, 0.3], "elevation": [-0.8, -0.4]},
+)
+_SCENE_EXPLORE = {
+    "azimuth": [-0.6, 0.6],
+    "elevation": [-0.35, 0.35],
+    "azimuthal_sweeps": 3,
+    "vertical_sweeps": 4,
+}
+#: Mesh files beside a scene, by name: a closed box in millimetres, an open surface (one
+#: triangle), text that is no mesh, and an empty file.
+_SCENE_MESH_FILES = ("part.stl", "sheet.obj", "junk.ply", "empty.stl")
+
+
+def write_scene_meshes(folder: Path) -> None:
+    """The files of :data:`_SCENE_MESH_FILES` in ``folder``."""
+    import trimesh
+
+    trimesh.creation.box(extents=(80.0, 60.0, 40.0)).export(folder / "part.stl")
+    (folder / "sheet.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", encoding="utf-8")
+    (folder / "junk.ply").write_text("ply\nformat ascii 1.0\nnonsense\n", encoding="utf-8")
+    (folder / "empty.stl").write_bytes(b"")
+
+
+@st.composite
+def scene_files(draw: st.DrawFn) -> bytes:
+    """A scene file: objects of every kind, bases and the explored region, each with fields
+    changed or not, the top level changed now and then, or junk."""
+    choice = draw(st.integers(0, 9))
+    if choice == 0:
+        return draw(st.binary(max_size=100))
+    if choice == 1:
+        return draw(st.text(max_size=100)).encode("utf-8")
+
+    def maybe_edited(table: Mapping[str, Any]) -> dict[str, Any]:
+        return draw(edited_tables({}, table))[1] if draw(st.booleans()) else dict(table)
+
+    objects = []
+    for _ in range(draw(st.integers(1, 3))):
+        template = dict(draw(st.sampled_from(_SCENE_OBJECTS)))
+        if template["shape"] == "mesh" and draw(st.booleans()):
+            template["file"] = draw(st.sampled_from([*_SCENE_MESH_FILES, "missing.stl", "."]))
+        objects.append(maybe_edited(template))
+    bases = [
+        maybe_edited(draw(st.sampled_from(_SCENE_BASES))) for _ in range(draw(st.integers(0, 3)))
+    ]
+    top: dict[str, Any] = {"name": "fuzzed", "objects": objects}
+    if bases:
+        top["bases"] = bases
+    tables = {"explore": maybe_edited(_SCENE_EXPLORE)} if draw(st.booleans()) else {}
+    if choice == 2:
+        tables, top = draw(edited_tables(tables, top))
+    return toml_document(tables, top).encode("utf-8")
+
+
+def run_scene_file(data: bytes) -> list[Outcome]:
+    """Load a scene file beside the mesh files of :func:`write_scene_meshes`; a scene loaded
+    must have finite, non-empty meshes whose signed distance is finite, finite base poses and
+    an explored region of ordered angles with at least one sweep."""
+
+    def action() -> list[Outcome]:
+        from sensing_antenna.scene import load_scene
+
+        with tempfile.TemporaryDirectory(prefix="fuzz-") as folder:
+            write_scene_meshes(Path(folder))
+            path = Path(folder) / "scene.toml"
+            path.write_bytes(data)
+            scene = load_scene(path)
+        for obj in scene.objects:
+            vertices = np.asarray(obj.mesh.vertices)
+            if len(obj.mesh.faces) == 0 or not np.all(np.isfinite(vertices)):
+                return [Outcome(TRACEBACK, f"object {obj.name}: an empty or non-finite mesh")]
+        probe = np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0]])
+        if not np.all(np.isfinite(scene.signed_distance(probe))):
+            return [Outcome(TRACEBACK, "the scene's signed distance is not finite")]
+        for pose in scene.bases:
+            if not (np.all(np.isfinite(pose.rotation)) and np.all(np.isfinite(pose.position))):
+                return [Outcome(TRACEBACK, "a base pose is not finite")]
+        for index in range(len(scene.bases)):
+            region = scene.region_of(index)
+            low, high = region.azimuth
+            if not (math.isfinite(low) and math.isfinite(high) and low <= high):
+                return [Outcome(TRACEBACK, f"base {index}: azimuth {region.azimuth}")]
+            if region.azimuthal_sweeps < 0 or region.vertical_sweeps < 0:
+                return [Outcome(TRACEBACK, f"base {index}: negative sweep counts")]
+        return [Outcome(OK)]
+
+    return guarded(action)

@@ -6,8 +6,9 @@ and no warning (lines on a user's terminal); an estimate ``ok`` lies on the link
 comes from samples that pass the units check of the plausibility layer, and a best guess under
 any other status is on the link or NaN; an identified observer or a calibrated T_e is finite
 and positive and comes from recordings that pass the same check; an antenna loaded writes back
-to itself; a campaign loaded lists its runs within the limits; ``antenna`` ends with 0 or 2,
-and after 2 with one line on stderr.
+to itself; a campaign loaded lists its runs within the limits; a scene loaded has finite
+meshes, base poses and explored angles; ``antenna`` ends with 0 or 2, and after 2 with one line
+on stderr.
 
 The examples per area are few, so the suite stays fast; under CI the profile of
 ``conftest.py`` derandomizes them (the same examples every run). A finding's example, given to
@@ -144,3 +145,9 @@ def test_the_judges_tell_findings(bases: fz.Bases) -> None:
 def test_the_command_line_judge_tells_an_ending(cli_files: fz.CliFiles) -> None:
     assert fz.run_cli(["beam", "--xc"], cli_files.folder)[0].kind == fz.ERROR
     assert fz.run_cli(["beam", "--xc", "0.5"], cli_files.folder)[0].kind == fz.OK
+
+
+@FEW
+@given(fz.scene_files())
+def test_scene_files_load_or_name_the_problem(data: bytes) -> None:
+    assert_no_finding(fz.run_scene_file(data))
