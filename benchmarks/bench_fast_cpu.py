@@ -35,16 +35,14 @@ import argparse  # noqa: E402
 import datetime  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
-import platform  # noqa: E402
 import statistics  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-from threadpoolctl import threadpool_info  # noqa: E402
-
 from fast_settings import add_fast_arguments, fast_settings  # noqa: E402
+from machine import machine_info  # noqa: E402
 from sensing_antenna.antenna import Antenna, paper_antenna  # noqa: E402
 from sensing_antenna.estimation import estimate  # noqa: E402
 from sensing_antenna.estimation.methods import EstimationMethod  # noqa: E402
@@ -177,14 +175,9 @@ def main() -> None:
             f"{row['set']:7} {row['method']:14} {row['recordings']:4d} {row['mean_ms']:7.1f} "
             f"{row['median_ms']:7.1f} {row['max_ms']:7.1f}"
         )
-    blas = [
-        {"library": lib.get("internal_api"), "threads": lib.get("num_threads")}
-        for lib in threadpool_info()
-        if lib.get("user_api") == "blas"
-    ]
     record = {
         "date": datetime.date.today().isoformat(),
-        "machine": {"cpus": os.cpu_count(), "python": platform.python_version(), "blas": blas},
+        "machine": machine_info(),
         "omp_num_threads": os.environ.get("OMP_NUM_THREADS"),
         "repeat": args.repeat,
         "fast_settings": settings,

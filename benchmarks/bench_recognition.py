@@ -37,16 +37,14 @@ import argparse  # noqa: E402
 import datetime  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
-import platform  # noqa: E402
 import statistics  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-from threadpoolctl import threadpool_info  # noqa: E402
-
 from eval_explore import make_scene  # noqa: E402
+from machine import machine_info  # noqa: E402
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
 from sensing_antenna.cli.arguments import integer  # noqa: E402
@@ -158,14 +156,9 @@ def main() -> None:
     differ = [r["scene"] for r in rows if r["named"] != r["explore_named"]]
     if differ:
         print(f"scenes {differ}: named otherwise than by the exploration's own map")
-    blas = [
-        {"library": lib.get("internal_api"), "threads": lib.get("num_threads")}
-        for lib in threadpool_info()
-        if lib.get("user_api") == "blas"
-    ]
     record = {
         "date": datetime.date.today().isoformat(),
-        "machine": {"cpus": os.cpu_count(), "python": platform.python_version(), "blas": blas},
+        "machine": machine_info(),
         "omp_num_threads": os.environ.get("OMP_NUM_THREADS"),
         "seed": args.seed,
         "repeat": args.repeat,
