@@ -46,14 +46,14 @@ RESULTS = Path(__file__).resolve().parent / "results" / "fuzz.json"
 #: Share of the inputs each area gets: the cheap areas get many, the estimators (every method
 #: on a 3.5 s recording) and the command line fewer.
 SHARES = {
-    "reader": 0.25,
-    "antenna file": 0.15,
-    "campaign spec": 0.15,
+    "reader": 0.225,
+    "antenna file": 0.125,
+    "campaign spec": 0.125,
     "estimators": 0.2,
     "identify": 0.075,
     "calibrate": 0.075,
     "cli": 0.1,
-    "scene file": 0.1,
+    "scene file": 0.075,
 }
 #: Findings of each kind kept per area in the JSON (the first ones met).
 KEPT_FINDINGS = 5

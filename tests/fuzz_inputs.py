@@ -1032,32 +1032,102 @@ def write_scene_meshes(folder: Path) -> None:
     (folder / "empty.stl").write_bytes(b"")
 
 
+#: Values a scene's fields get wrong or put at their limits, by the kind of field: sizes zero,
+#: tiny or huge; positions far or not finite; angles at and past one turn; quaternions off unit
+#: length; ranges reversed, empty or past their limits (a half-turn, 1.2 rad); sweep counts at
+#: and past their bounds.
+_SIZE_EDGES = (0, -0.0, 5e-324, 1e-30, 1e-6, 9.99e-4, 1e-3, 10.0, 10.000001, 1e300, math.nan, -1)
+_SCENE_EDGES: dict[str, tuple[Any, ...]] = {
+    "size": _SIZE_EDGES,
+    "extents": (*([0.1, 0.1, v] for v in _SIZE_EDGES), [0.1, 0.1], [0.1, 0.1, 0.1, 0.1]),
+    "position": ([0.0, 0.0, 0.0], [99.0, 0.0, 0.0], [1e300, 0.0, 0.0], [math.nan, 0.0, 0.0]),
+    "rotation": (
+        [math.pi, 0.0, 0.0],
+        [2.0 * math.pi, 0.0, 0.0],
+        [2.0 * math.pi + 1e-9, 0.0, 0.0],
+        [0.0, 0.0, -90.0],
+        [1e300, 0.0, 0.0],
+    ),
+    "yaw": (math.pi, -2.0 * math.pi, 2.0 * math.pi + 1e-9, 90.0, math.inf),
+    "quaternion": (
+        [1.0, 0.0, 0.0, 0.0],
+        [0.7071, 0.0, 0.0, 0.7071],
+        [0.98, 0.0, 0.0, 0.0],
+        [1.02, 0.0, 0.0, 0.1],
+        [0.0, 0.0, 0.0, 0.0],
+        [1e300, 0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+    ),
+    "range": (
+        [-math.pi, math.pi],
+        [-1.2, 1.2],
+        [-1.2000001, 0.0],
+        [-3.2, 0.0],
+        [0.5, 0.5],
+        [1.0, 0.0],
+        [0.0],
+    ),
+    "count": (0, 1, 100, 101, -1, True, 1.5),
+    "name": ("", "a\nb", "x" * 200),
+    "file": (*_SCENE_MESH_FILES, "missing.stl", ".", ""),
+}
+#: The kind of each field a scene's tables hold or may be given.
+_SCENE_FIELDS = {
+    "radius": "size",
+    "height": "size",
+    "length": "size",
+    "major_radius": "size",
+    "minor_radius": "size",
+    "scale": "size",
+    "extents": "extents",
+    "position": "position",
+    "rotation": "rotation",
+    "yaw": "yaw",
+    "quaternion": "quaternion",
+    "azimuth": "range",
+    "elevation": "range",
+    "azimuthal_sweeps": "count",
+    "vertical_sweeps": "count",
+    "name": "name",
+    "file": "file",
+}
+
+
 @st.composite
 def scene_files(draw: st.DrawFn) -> bytes:
-    """A scene file: objects of every kind, bases and the explored region, each with fields
-    changed or not, the top level changed now and then, or junk."""
+    """A scene file: one to three objects of every kind, bases and the explored region, valid
+    but for one field of one table (mostly one it holds) set to an edge value of its kind
+    (:data:`_SCENE_EDGES`), a TOML value of any kind or dropped; the top level changed now and
+    then; or junk."""
     choice = draw(st.integers(0, 9))
     if choice == 0:
         return draw(st.binary(max_size=100))
     if choice == 1:
         return draw(st.text(max_size=100)).encode("utf-8")
-
-    def maybe_edited(table: Mapping[str, Any]) -> dict[str, Any]:
-        return draw(edited_tables({}, table))[1] if draw(st.booleans()) else dict(table)
-
     objects = []
     for _ in range(draw(st.integers(1, 3))):
         template = dict(draw(st.sampled_from(_SCENE_OBJECTS)))
         if template["shape"] == "mesh" and draw(st.booleans()):
             template["file"] = draw(st.sampled_from([*_SCENE_MESH_FILES, "missing.stl", "."]))
-        objects.append(maybe_edited(template))
-    bases = [
-        maybe_edited(draw(st.sampled_from(_SCENE_BASES))) for _ in range(draw(st.integers(0, 3)))
-    ]
+        objects.append(template)
+    bases = [dict(draw(st.sampled_from(_SCENE_BASES))) for _ in range(draw(st.integers(0, 3)))]
+    explore = dict(_SCENE_EXPLORE) if draw(st.booleans()) else None
+    editable = [*objects, *bases, *([explore] if explore is not None else [])]
+    if choice >= 3 and draw(st.integers(0, 9)) > 0:
+        table = draw(st.sampled_from(editable))
+        own = sorted(k for k in table if k != "shape")
+        key = draw(st.sampled_from(own if draw(st.integers(0, 3)) else sorted(_SCENE_FIELDS)))
+        how = draw(st.integers(0, 9))
+        if how == 0:
+            table.pop(key, None)
+        elif how == 1:
+            table[key] = draw(toml_values)
+        else:
+            table[key] = draw(st.sampled_from(_SCENE_EDGES[_SCENE_FIELDS[key]]))
     top: dict[str, Any] = {"name": "fuzzed", "objects": objects}
     if bases:
         top["bases"] = bases
-    tables = {"explore": maybe_edited(_SCENE_EXPLORE)} if draw(st.booleans()) else {}
+    tables = {"explore": explore} if explore is not None else {}
     if choice == 2:
         tables, top = draw(edited_tables(tables, top))
     return toml_document(tables, top).encode("utf-8")
@@ -1065,8 +1135,9 @@ def scene_files(draw: st.DrawFn) -> bytes:
 
 def run_scene_file(data: bytes) -> list[Outcome]:
     """Load a scene file beside the mesh files of :func:`write_scene_meshes`; a scene loaded
-    must have finite, non-empty meshes whose signed distance is finite, finite base poses and
-    an explored region of ordered angles with at least one sweep."""
+    must have finite, non-empty meshes whose signed distance is finite, finite base poses and,
+    for every base, explored angles in order within their limits (azimuth one half-turn either
+    way, elevation 1.2 rad) and at least one sweep."""
 
     def action() -> list[Outcome]:
         from sensing_antenna.scene import load_scene
@@ -1088,11 +1159,15 @@ def run_scene_file(data: bytes) -> list[Outcome]:
                 return [Outcome(TRACEBACK, "a base pose is not finite")]
         for index in range(len(scene.bases)):
             region = scene.region_of(index)
-            low, high = region.azimuth
-            if not (math.isfinite(low) and math.isfinite(high) and low <= high):
-                return [Outcome(TRACEBACK, f"base {index}: azimuth {region.azimuth}")]
-            if region.azimuthal_sweeps < 0 or region.vertical_sweeps < 0:
-                return [Outcome(TRACEBACK, f"base {index}: negative sweep counts")]
+            for name, (low, high), limit in (
+                ("azimuth", region.azimuth, math.pi),
+                ("elevation", region.elevation, 1.2),
+            ):
+                if not -limit <= low < high <= limit:
+                    return [Outcome(TRACEBACK, f"base {index}: {name} {(low, high)}")]
+            counts = (region.azimuthal_sweeps, region.vertical_sweeps)
+            if min(counts) < 0 or max(counts) == 0:
+                return [Outcome(TRACEBACK, f"base {index}: sweep counts {counts}")]
         return [Outcome(OK)]
 
     return guarded(action)

@@ -448,6 +448,25 @@ def test_a_turned_base_turns_the_touch() -> None:
         ('[[objects]]\nshape = "sphere"\nposition = [0, 0, 0]\n', "objects[0].radius"),
         ('[[objects]]\nshape = "sphere"\nradius = -1\nposition = [0, 0, 0]\n', "objects[0].radius"),
         ('[[objects]]\nshape = "sphere"\nradius = 0.1\n', "objects[0].position"),
+        # sizes below a millimetre: trimesh meshes a few micrometres' section with no faces
+        # and a radius of 1e-30 with non-finite vertices
+        (
+            '[[objects]]\nshape = "sphere"\nradius = 1e-30\nposition = [0, 0, 0]\n',
+            "objects[0].radius",
+        ),
+        (
+            '[[objects]]\nshape = "cylinder"\nradius = 1e-6\nheight = 0.1\nposition = [0, 0, 0]\n',
+            "objects[0].radius",
+        ),
+        (
+            '[[objects]]\nshape = "torus"\nmajor_radius = 0.07\nminor_radius = 1e-5\n'
+            "position = [0, 0, 0]\n",
+            "objects[0].minor_radius",
+        ),
+        (
+            '[[objects]]\nshape = "box"\nextents = [0.1, 0.1, 1e-4]\nposition = [0, 0, 0]\n',
+            "objects[0].extents",
+        ),
         (
             '[[objects]]\nshape = "box"\nextents = [1, 2]\nposition = [0, 0, 0]\n',
             "objects[0].extents",
@@ -511,6 +530,18 @@ def test_a_mesh_in_millimetres_or_a_directory_is_refused_in_one_line(
     args = ["map", "r.csv", "--objects", str(tmp_path / "cube_mm.stl"), "--out", "m"]
     assert main(args) == 2
     assert "cube_mm.stl: its largest extent is 100 m" in capsys.readouterr().err
+
+
+def test_a_mesh_scaled_below_a_millimetre_is_refused_in_one_line(tmp_path: Path) -> None:
+    # a 10 mm cube read at a scale meant for nanometres; tiny scales also made trimesh warn
+    trimesh.creation.box(extents=[10, 10, 10]).export(tmp_path / "cube.stl")
+    for scale in ("1e-6", "1e-100"):
+        (tmp_path / "s.toml").write_text(
+            f'[[objects]]\nshape = "mesh"\nfile = "cube.stl"\nscale = {scale}\n'
+            "position = [1, 0, 0]\n"
+        )
+        with pytest.raises(SceneError, match=r"objects\[0\]\.file: .*less than 0\.001 m"):
+            load_scene(tmp_path / "s.toml")
 
 
 def test_an_open_mesh_is_refused(tmp_path: Path) -> None:

@@ -107,7 +107,7 @@ class BasePose:
         q = np.asarray(quaternion, dtype=float)
         if q.shape != (4,) or not np.all(np.isfinite(q)):
             raise FieldError(BASE_POSE_KEY, "quaternion must be four numbers [w, x, y, z]")
-        norm = float(np.linalg.norm(q))
+        norm = math.hypot(*(float(v) for v in q))  # no overflow on 1e300 entries
         if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
             raise FieldError(
                 BASE_POSE_KEY,

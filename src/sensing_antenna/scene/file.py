@@ -32,8 +32,9 @@
 
 Sizes: sphere ``radius``; cylinder ``radius``, ``height``; capsule ``radius``, ``length`` (of
 the axis segment); cone ``radius`` (base), ``height``; torus ``major_radius``,
-``minor_radius``; box ``extents = [x, y, z]``. Every error names the file, the field and the
-problem in one line (:class:`SceneError`).
+``minor_radius``; box ``extents = [x, y, z]``; each from 1 mm to 10 m (a mesh's largest extent
+too, after ``scale``). Every error names the file, the field and the problem in one line
+(:class:`SceneError`).
 """
 
 from __future__ import annotations
@@ -50,7 +51,13 @@ import trimesh
 
 from sensing_antenna.errors import FieldError, SensingAntennaError, format_value
 from sensing_antenna.mapping.pose import MAX_BASE_DISTANCE, BasePose
-from sensing_antenna.scene.objects import SceneObject, mesh_object, primitive_object, read_mesh
+from sensing_antenna.scene.objects import (
+    MIN_OBJECT_SIZE,
+    SceneObject,
+    mesh_object,
+    primitive_object,
+    read_mesh,
+)
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
@@ -246,7 +253,8 @@ def _vector(value: object, n: int, where: str, fail: Any, limit: float | None = 
     if not isinstance(value, list) or len(value) != n:
         raise fail(where, f"must be a list of {n} numbers, got {format_value(value)}")
     numbers = np.array([_number(v, where, fail) for v in value])
-    if limit is not None and np.linalg.norm(numbers) > limit:
+    # hypot scales by the largest entry: the plain norm of 1e300 overflows (with a warning)
+    if limit is not None and math.hypot(*numbers) > limit:
         raise fail(where, f"more than {limit:g} m from the origin: in metres?")
     return numbers
 
@@ -275,11 +283,11 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
         raise fail(f"{where}.position", "missing")
     position = _vector(table["position"], 3, f"{where}.position", fail, MAX_BASE_DISTANCE)
     rotation = _vector(table.get("rotation", [0.0, 0.0, 0.0]), 3, f"{where}.rotation", fail)
-    if np.linalg.norm(rotation) > ANGLE_LIMIT:
+    turn = math.hypot(*rotation)
+    if turn > ANGLE_LIMIT:
         raise fail(
             f"{where}.rotation",
-            f"turns by {np.linalg.norm(rotation):.4g} rad, more than one turn "
-            f"({ANGLE_LIMIT:.4f}): in radians?",
+            f"turns by {turn:.4g} rad, more than one turn ({ANGLE_LIMIT:.4f}): in radians?",
         )
     if shape == "mesh":
         scale = _number(table.get("scale", 1.0), f"{where}.scale", fail, 0.0, 1.0)
@@ -297,14 +305,22 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
                     f"{where}.extents",
                     f"must be a list of 3 numbers, got {format_value(table[key])}",
                 )
-            sizes.extend(
-                _number(v, f"{where}.extents", fail, 0.0, MAX_OBJECT_SIZE) for v in table[key]
-            )
+            sizes.extend(_size(v, f"{where}.extents", fail) for v in table[key])
         else:
-            sizes.append(_number(table[key], f"{where}.{key}", fail, 0.0, MAX_OBJECT_SIZE))
+            sizes.append(_size(table[key], f"{where}.{key}", fail))
     if shape == "torus" and not sizes[1] < sizes[0]:
         raise fail(f"{where}.minor_radius", "must be smaller than major_radius")
     return primitive_object(name, str(shape), sizes, position, rotation)
+
+
+def _size(value: object, where: str, fail: Any) -> float:
+    """A primitive's size (m), from :data:`~.objects.MIN_OBJECT_SIZE` to :data:`MAX_OBJECT_SIZE`."""
+    size = _number(value, where, fail, 0.0, MAX_OBJECT_SIZE)
+    if size < MIN_OBJECT_SIZE:
+        raise fail(
+            where, f"must be at least {MIN_OBJECT_SIZE:g} m, got {format_value(value)}: in metres?"
+        )
+    return size
 
 
 def _mesh_file(

@@ -26,6 +26,7 @@ from sensing_antenna.mapping.primitives import PRIMITIVES
 
 __all__ = [
     "MAX_MESH_EXTENT",
+    "MIN_OBJECT_SIZE",
     "OBJECT_SHAPES",
     "SceneObject",
     "mesh_object",
@@ -43,14 +44,26 @@ OBJECT_SHAPES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
 #: millimetres and read as metres is a thousand times too large.
 MAX_MESH_EXTENT = 10.0
 
+#: Smallest size (m) of an object: a primitive's every size and a mesh's largest extent. 1 mm,
+#: about the link's own radius, below which a touch says nothing of the shape (a size in
+#: metres read as kilometres lands here); trimesh also meshes a section of a few micrometres
+#: with no faces.
+MIN_OBJECT_SIZE = 1e-3
+
 
 def mesh_problem(mesh: trimesh.Trimesh, scale: float = 1.0) -> str | None:
     """Why a user's mesh, its coordinates times ``scale`` in m, cannot be an object, or None:
-    vertices that are not finite, or an extent beyond :data:`MAX_MESH_EXTENT`."""
+    vertices that are not finite, or a largest extent beyond :data:`MAX_MESH_EXTENT` or below
+    :data:`MIN_OBJECT_SIZE`."""
     vertices = np.asarray(mesh.vertices, dtype=float)
     if not np.all(np.isfinite(vertices)):
         return "vertices that are not finite numbers"
     extent = scale * float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
+    if not extent >= MIN_OBJECT_SIZE:
+        return (
+            f"its largest extent is {extent:.4g} m, less than {MIN_OBJECT_SIZE:g} m: in metres? "
+            "(a scene's scale is the file's unit in m: 0.001 for millimetres)"
+        )
     if extent > MAX_MESH_EXTENT:
         return (
             f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
