@@ -1039,6 +1039,8 @@ def write_scene_meshes(folder: Path) -> None:
 _SIZE_EDGES = (0, -0.0, 5e-324, 1e-30, 1e-6, 9.99e-4, 1e-3, 10.0, 10.000001, 1e300, math.nan, -1)
 _SCENE_EDGES: dict[str, tuple[Any, ...]] = {
     "size": _SIZE_EDGES,
+    # a mesh's scale is within (0, 1]; part.stl's 80 mm read at 0.125 is 10 m, the limit
+    "scale": (0, 1e-300, 1e-6, 0.0125, 0.125, 0.1250001, 1.0, 1.0000001, math.nan),
     "extents": (*([0.1, 0.1, v] for v in _SIZE_EDGES), [0.1, 0.1], [0.1, 0.1, 0.1, 0.1]),
     "position": ([0.0, 0.0, 0.0], [99.0, 0.0, 0.0], [1e300, 0.0, 0.0], [math.nan, 0.0, 0.0]),
     "rotation": (
@@ -1078,7 +1080,7 @@ _SCENE_FIELDS = {
     "length": "size",
     "major_radius": "size",
     "minor_radius": "size",
-    "scale": "size",
+    "scale": "scale",
     "extents": "extents",
     "position": "position",
     "rotation": "rotation",
@@ -1096,9 +1098,9 @@ _SCENE_FIELDS = {
 @st.composite
 def scene_files(draw: st.DrawFn) -> bytes:
     """A scene file: one to three objects of every kind, bases and the explored region, valid
-    but for one field of one table (mostly one it holds) set to an edge value of its kind
-    (:data:`_SCENE_EDGES`), a TOML value of any kind or dropped; the top level changed now and
-    then; or junk."""
+    but for one field (now and then two) of a table (mostly one it holds) set to an edge value
+    of its kind (:data:`_SCENE_EDGES`), a TOML value of any kind or dropped; the top level
+    changed now and then; or junk."""
     choice = draw(st.integers(0, 9))
     if choice == 0:
         return draw(st.binary(max_size=100))
@@ -1113,7 +1115,8 @@ def scene_files(draw: st.DrawFn) -> bytes:
     bases = [dict(draw(st.sampled_from(_SCENE_BASES))) for _ in range(draw(st.integers(0, 3)))]
     explore = dict(_SCENE_EXPLORE) if draw(st.booleans()) else None
     editable = [*objects, *bases, *([explore] if explore is not None else [])]
-    if choice >= 3 and draw(st.integers(0, 9)) > 0:
+    # one field edited, now and then a second (two sizes of one shape at their edges together)
+    for _ in range(draw(st.sampled_from([0, 1, 1, 1, 1, 1, 1, 2, 2, 2])) if choice >= 3 else 0):
         table = draw(st.sampled_from(editable))
         own = sorted(k for k in table if k != "shape")
         key = draw(st.sampled_from(own if draw(st.integers(0, 3)) else sorted(_SCENE_FIELDS)))

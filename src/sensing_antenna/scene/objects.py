@@ -44,10 +44,10 @@ OBJECT_SHAPES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
 #: millimetres and read as metres is a thousand times too large.
 MAX_MESH_EXTENT = 10.0
 
-#: Smallest size (m) of an object: a primitive's every size and a mesh's largest extent. 1 mm,
-#: about the link's own radius, below which a touch says nothing of the shape (a size in
-#: metres read as kilometres lands here); trimesh also meshes a section of a few micrometres
-#: with no faces.
+#: Smallest size (m) of an object: a primitive's every size and a mesh's largest extent. 1 mm:
+#: smaller, a size in a scene file is most likely in the wrong unit; and a primitive's sizes
+#: then stay within 1e-4 of each other (10 m at most), a ratio its mesh keeps non-empty
+#: (trimesh merges vertices closer than 1e-8 of the mesh's own size).
 MIN_OBJECT_SIZE = 1e-3
 
 
@@ -153,11 +153,13 @@ def _rotation(rotation: ArrayLike) -> FloatArray:
 
 
 def _fine_mesh(shape: str, parameters: FloatArray) -> trimesh.Trimesh:
-    sizes = PRIMITIVES[shape].sizes(parameters)
+    # meshed at unit size and scaled: trimesh's tolerances are absolute, and would merge the
+    # vertices of a millimetre's section
+    unit = float(np.max(PRIMITIVES[shape].sizes(parameters)))
+    sizes = PRIMITIVES[shape].sizes(parameters) / unit
     if shape == "sphere":
-        return trimesh.creation.icosphere(subdivisions=5, radius=parameters[3]).apply_translation(
-            parameters[0:3]
-        )
+        mesh = trimesh.creation.icosphere(subdivisions=5, radius=1.0)
+        return mesh.apply_scale(unit).apply_translation(parameters[0:3])
     if shape == "cylinder":
         mesh = trimesh.creation.cylinder(radius=sizes[0], height=sizes[1], sections=_SECTIONS)
     elif shape == "capsule":
@@ -173,7 +175,7 @@ def _fine_mesh(shape: str, parameters: FloatArray) -> trimesh.Trimesh:
     matrix = np.eye(4)
     matrix[:3, :3] = _rotation(parameters[3:6])
     matrix[:3, 3] = parameters[0:3]
-    return mesh.apply_transform(matrix)
+    return mesh.apply_scale(unit).apply_transform(matrix)
 
 
 def primitive_object(
