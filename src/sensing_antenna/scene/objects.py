@@ -60,10 +60,7 @@ def mesh_problem(mesh: trimesh.Trimesh, scale: float = 1.0) -> str | None:
         return "vertices that are not finite numbers"
     extent = scale * float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
     if not extent >= MIN_OBJECT_SIZE:
-        return (
-            f"its largest extent is {extent:.4g} m, less than {MIN_OBJECT_SIZE:g} m: in metres? "
-            "(a scene's scale is the file's unit in m: 0.001 for millimetres)"
-        )
+        return f"its largest extent is {extent:.4g} m, less than {MIN_OBJECT_SIZE:g} m: in metres?"
     if extent > MAX_MESH_EXTENT:
         return (
             f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
