@@ -152,8 +152,9 @@ def _rotation(rotation: ArrayLike) -> FloatArray:
 def _fine_mesh(shape: str, parameters: FloatArray) -> trimesh.Trimesh:
     # meshed at unit size and scaled: trimesh's tolerances are absolute, and would merge the
     # vertices of a millimetre's section
-    unit = float(np.max(PRIMITIVES[shape].sizes(parameters)))
-    sizes = PRIMITIVES[shape].sizes(parameters) / unit
+    sizes = PRIMITIVES[shape].sizes(parameters)
+    unit = float(np.max(sizes))
+    sizes = sizes / unit
     if shape == "sphere":
         mesh = trimesh.creation.icosphere(subdivisions=5, radius=1.0)
         return mesh.apply_scale(unit).apply_translation(parameters[0:3])
