@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import io
 import json
 import math
@@ -1022,14 +1023,24 @@ _SCENE_EXPLORE = {
 _SCENE_MESH_FILES = ("part.stl", "sheet.obj", "junk.ply", "empty.stl")
 
 
-def write_scene_meshes(folder: Path) -> None:
-    """The files of :data:`_SCENE_MESH_FILES` in ``folder``."""
+@functools.cache
+def _scene_mesh_bytes() -> dict[str, bytes]:
+    """The contents of :data:`_SCENE_MESH_FILES`, by name (made once)."""
     import trimesh
 
-    trimesh.creation.box(extents=(80.0, 60.0, 40.0)).export(folder / "part.stl")
-    (folder / "sheet.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", encoding="utf-8")
-    (folder / "junk.ply").write_text("ply\nformat ascii 1.0\nnonsense\n", encoding="utf-8")
-    (folder / "empty.stl").write_bytes(b"")
+    box = trimesh.creation.box(extents=(80.0, 60.0, 40.0)).export(file_type="stl")
+    return {
+        "part.stl": bytes(box),
+        "sheet.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        "junk.ply": b"ply\nformat ascii 1.0\nnonsense\n",
+        "empty.stl": b"",
+    }
+
+
+def write_scene_meshes(folder: Path) -> None:
+    """The files of :data:`_SCENE_MESH_FILES` in ``folder``."""
+    for name in _SCENE_MESH_FILES:
+        (folder / name).write_bytes(_scene_mesh_bytes()[name])
 
 
 #: Values a scene's fields get wrong or put at their limits, by the kind of field: sizes zero,
