@@ -102,7 +102,7 @@ def run_method(method: str, files: list[Path], duration: float) -> dict[str, Any
     offline = [estimate(r, antenna, method).to_dict() for r in recordings]
     warm_up(antenna, method)  # as antenna listen does before listening
     load_before = os.getloadavg()
-    started = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    started = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
     per_recording = recordings[0].duration + recordings[0].sample_period
     count = max(1, math.ceil(duration / per_recording))
     events: list[Event] = []

@@ -199,7 +199,7 @@ def main() -> None:
 
     record = {
         "benchmark": "fuzz: inputs through every area, outcomes by kind",
-        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "machine": {
             "python": platform.python_version(),
             "processor": platform.processor() or platform.machine(),

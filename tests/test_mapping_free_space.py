@@ -188,6 +188,12 @@ def test_a_free_line_through_a_sphere_costs_its_depth_over_its_sigma() -> None:
     got = touched.residuals(np.linalg.norm(space.samples - centre, axis=1) - radius)
     assert got[0] == 0.0
     assert got[1] == pytest.approx((offset + 0.02 - radius - link_radius) / sigma, rel=1e-9)
+    # a batch of shapes (the sphere and one 2 cm larger) reads as each shape alone
+    distances = np.linalg.norm(space.samples - centre, axis=1) - np.array([[radius], [0.07]])
+    for region in (space, touched):
+        batch = region.residuals(distances)
+        assert batch.shape == (2, 2)
+        assert np.array_equal(batch, [region.residuals(d) for d in distances])
 
 
 def test_free_space_the_true_shape_stays_out_of_costs_its_fit_nothing() -> None:

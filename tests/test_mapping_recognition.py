@@ -700,3 +700,20 @@ def test_a_box_touched_on_its_edges_states_deviations_its_errors_keep_to() -> No
     assert len(ratios) >= 8, ratios
     rms = float(np.sqrt(np.mean(np.square(ratios))))
     assert 0.5 < rms < 1.8, ratios
+
+
+@pytest.mark.parametrize("name", list(PRIMITIVES))
+def test_a_batch_of_shapes_gives_each_shapes_own_distances(name: str) -> None:
+    # the batch form (a Jacobian's columns in one call) is the one-vector form, vector by
+    # vector, to the last bit: the fits' steps must not depend on which form evaluated them
+    rng = np.random.default_rng(3)
+    shape = PRIMITIVES[name]
+    vectors = rng.normal(0.0, 0.3, (4, len(shape.parameter_names)))
+    vectors[:, len(vectors[0]) - len(shape.size_names) :] = rng.uniform(0.02, 0.2)
+    probes = rng.normal(0.0, 0.2, (4, 50, 3))
+    batch = shape.signed_distance(vectors, probes)
+    one_by_one = [shape.signed_distance(v, q) for v, q in zip(vectors, probes, strict=True)]
+    assert batch.shape == (4, 50)
+    assert np.array_equal(batch, np.stack(one_by_one))
+    with pytest.raises(ValueError, match="4 parameter vectors"):
+        shape.signed_distance(vectors, probes[0])

@@ -16,15 +16,10 @@ from __future__ import annotations
 import os
 import re
 import stat
-import sys
+import tomllib
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
 
 __all__ = ["MAX_KEY_PARTS", "MAX_TOML_BYTES", "parse_toml_file", "parse_toml_text"]
 

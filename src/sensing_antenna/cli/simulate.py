@@ -160,9 +160,8 @@ def load_device(value: str, seed: int, length: float) -> Any:
     and may name a ``profile`` whose draw (from ``seed``) its fields are set over, and the
     ``build`` of that profile's device (manoeuvres with one build share one device).
     """
-    from dataclasses import replace
-
     import tomllib
+    from dataclasses import replace
 
     from sensing_antenna.simulator import DEVICE_PROFILES, device_from_mapping, device_profile
 

@@ -168,12 +168,21 @@ class FreeSpace:
 
     def residuals(self, signed_distance: FloatArray) -> FloatArray:
         """r_j (module docstring), shape (n_sweeps,), from a shape's signed distance (m) at
-        every sample, shape (k,); 0 for a sweep no shape reaches (a NaN distance is none)."""
+        every sample, shape (k,); 0 for a sweep no shape reaches (a NaN distance is none). For
+        a batch of shapes' distances, shape (B, k): shape (B, n_sweeps)."""
+        return self._least_depth(signed_distance, 0.0)
+
+    def _least_depth(self, signed_distance: FloatArray, empty: float) -> FloatArray:
+        """Each sweep's least (d - a) / sigma over its samples, ``empty`` for one without
+        samples, shape (..., n_sweeps) for distances of shape (..., k)."""
         depth = (np.asarray(signed_distance, dtype=float) - self.radius) / self.std
         depth = np.where(np.isnan(depth), np.inf, depth)
-        r = np.zeros(self.n_sweeps)
-        np.minimum.at(r, self.sweep, depth)
-        return r
+        batch = depth.shape[:-1]
+        rows = int(np.prod(batch, dtype=int))
+        r = np.full(rows * self.n_sweeps, empty)
+        groups = (np.arange(rows)[:, None] * self.n_sweeps + self.sweep).reshape(-1)
+        np.minimum.at(r, groups, depth.reshape(-1))
+        return r.reshape(*batch, self.n_sweeps)
 
 
 @dataclass(frozen=True, eq=False)
@@ -185,11 +194,8 @@ class Touches(FreeSpace):
     def residuals(self, signed_distance: FloatArray) -> FloatArray:
         """r_j, shape (n_sweeps,), from a shape's signed distance (m) at every sample, shape
         (k,); 0 for a contact whose link the shape reaches, and for one with no samples (a NaN
-        distance is none)."""
-        depth = (np.asarray(signed_distance, dtype=float) - self.radius) / self.std
-        depth = np.where(np.isnan(depth), np.inf, depth)
-        r = np.full(self.n_sweeps, np.inf)
-        np.minimum.at(r, self.sweep, depth)
+        distance is none). For a batch of shapes' distances, shape (B, k): shape (B, n_sweeps)."""
+        r = self._least_depth(signed_distance, np.inf)
         return np.where(np.isfinite(r), np.maximum(r, 0.0), 0.0)
 
     def near(self: _Space, points: ArrayLike, margin: float) -> _Space:

@@ -85,8 +85,17 @@ class Primitive:
     _canonical: Callable[[FloatArray], FloatArray] | None = None
 
     def signed_distance(self, parameters: FloatArray, points: FloatArray) -> FloatArray:
-        """d(p) (m), shape (n,), for points of shape (n, 3) (m)."""
-        return self._distance(np.asarray(parameters, dtype=float), np.asarray(points, float))
+        """d(p) (m): shape (n,) for one parameter vector and points of shape (n, 3) (m); for
+        a batch of B parameter vectors, shape (B, p), points of shape (B, n, 3), each vector's
+        distance at its own points, shape (B, n) (one call for the B columns of a Jacobian)."""
+        x = np.asarray(parameters, dtype=float)
+        q = np.asarray(points, dtype=float)
+        if x.ndim == 2:
+            if q.ndim != 3 or len(q) != len(x):
+                shape = f"({len(x)}, n, 3)"
+                raise ValueError(f"{len(x)} parameter vectors need points of shape {shape}")
+            return self._distance(x[:, None, :], q)
+        return self._distance(x, q)
 
     def sizes(self, parameters: FloatArray) -> FloatArray:
         """The class's sizes (m), in the order of ``size_names``."""
@@ -141,20 +150,24 @@ def distance_gradient(
 
 def local_coordinates(parameters: FloatArray, points: FloatArray) -> FloatArray:
     """Points (m, shape (n, 3)) in a posed shape's own frame: R^T (p - c), with the centre c =
-    parameters[0:3] and R the rotation of the rotation vector w = parameters[3:6] (rad)."""
-    return np.asarray((points - parameters[0:3]) @ _rotation(parameters))
+    parameters[0:3] and R the rotation of the rotation vector w = parameters[3:6] (rad). For a
+    batch, parameters of shape (B, 1, p) and points (B, n, 3): shape (B, n, 3)."""
+    return np.asarray((points - parameters[..., 0:3]) @ _rotation(parameters))
 
 
 def _rotation(parameters: FloatArray) -> FloatArray:
-    """R (read-only, shape (3, 3)) of the rotation vector parameters[3:6] (rad)."""
-    return _rotation_of(np.ascontiguousarray(parameters[3:6], dtype=float).tobytes())
+    """R (read-only, shape (3, 3)) of the rotation vector parameters[3:6] (rad); for a batch
+    of shape (B, 1, p), shape (B, 3, 3)."""
+    vectors = np.ascontiguousarray(parameters[..., 3:6], dtype=float)
+    return _rotation_of(vectors.tobytes(), parameters.ndim > 1)
 
 
 @functools.lru_cache(maxsize=32)
-def _rotation_of(rotation_vector: bytes) -> FloatArray:
+def _rotation_of(rotation_vectors: bytes, batch: bool) -> FloatArray:
     # a fit evaluates one pose many times over (each distance, the normals' six differences,
     # the finite-difference Jacobian's columns that leave w alone): built once per pose
-    matrix = Rotation.from_rotvec(np.frombuffer(rotation_vector, dtype=float).copy()).as_matrix()
+    vectors = np.frombuffer(rotation_vectors, dtype=float).copy()
+    matrix = Rotation.from_rotvec(vectors.reshape(-1, 3) if batch else vectors).as_matrix()
     matrix.setflags(write=False)
     return matrix
 
@@ -166,29 +179,38 @@ def _transform(parameters: FloatArray) -> FloatArray:
     return matrix
 
 
+# Each class's distance takes one parameter vector (p,) and points (n, 3), or a batch of them
+# (B, 1, p) and points (B, n, 3): parameters are read as parameters[..., i], points' coordinates
+# along the last axis.
+
+
 def _plane_normal(parameters: FloatArray) -> FloatArray:
-    polar, azimuth = parameters[0], parameters[1]
-    return np.array(
-        [np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)]
+    polar, azimuth = parameters[..., 0], parameters[..., 1]
+    return np.stack(
+        [np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)],
+        axis=-1,
     )
 
 
 def _plane(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # d = n . p - offset
-    return np.asarray(points @ _plane_normal(parameters) - parameters[2])
+    normal = _plane_normal(parameters)
+    if normal.ndim == 1:
+        return np.asarray(points @ normal - parameters[2])
+    return np.asarray((points @ normal.swapaxes(-1, -2))[..., 0] - parameters[..., 2])
 
 
 def _sphere(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # d = |p - c| - r
-    return np.asarray(np.linalg.norm(points - parameters[0:3], axis=1) - parameters[3])
+    return np.asarray(np.linalg.norm(points - parameters[..., 0:3], axis=-1) - parameters[..., 3])
 
 
 def _cylinder(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the exact distance to a capped cylinder: q = (rho - r, |z| - h / 2)
     local = local_coordinates(parameters, points)
-    radius, height = parameters[6], parameters[7]
-    q_rho = np.hypot(local[:, 0], local[:, 1]) - radius
-    q_z = np.abs(local[:, 2]) - 0.5 * height
+    radius, height = parameters[..., 6], parameters[..., 7]
+    q_rho = np.hypot(local[..., 0], local[..., 1]) - radius
+    q_z = np.abs(local[..., 2]) - 0.5 * height
     outside = np.hypot(np.maximum(q_rho, 0.0), np.maximum(q_z, 0.0))
     return np.asarray(outside + np.minimum(np.maximum(q_rho, q_z), 0.0))
 
@@ -196,18 +218,19 @@ def _cylinder(parameters: FloatArray, points: FloatArray) -> FloatArray:
 def _capsule(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # distance to the axis segment [-L/2, L/2] along Z, minus r
     local = local_coordinates(parameters, points)
-    radius, length = parameters[6], parameters[7]
-    z = np.clip(local[:, 2], -0.5 * length, 0.5 * length)
-    return np.asarray(np.linalg.norm(local - np.stack([0 * z, 0 * z, z], axis=1), axis=1) - radius)
+    radius, length = parameters[..., 6], parameters[..., 7]
+    z = np.clip(local[..., 2], -0.5 * length, 0.5 * length)
+    axis = np.stack([0 * z, 0 * z, z], axis=-1)
+    return np.asarray(np.linalg.norm(local - axis, axis=-1) - radius)
 
 
 def _cone(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the cross-section is the triangle (0, 0), (R, 0), (0, h) in (rho, z): distance to its
     # base (0, 0)-(R, 0) and its slant edge (R, 0)-(0, h), negative inside the triangle
     local = local_coordinates(parameters, points)
-    radius, height = parameters[6], parameters[7]
-    rho = np.hypot(local[:, 0], local[:, 1])
-    z = local[:, 2]
+    radius, height = parameters[..., 6], parameters[..., 7]
+    rho = np.hypot(local[..., 0], local[..., 1])
+    z = local[..., 2]
     base = np.hypot(rho - np.clip(rho, 0.0, radius), z)
     # the slant from (R, 0) along (-R, h): t the nearest point's fraction of it
     t = np.clip(((radius - rho) * radius + z * height) / (radius**2 + height**2), 0.0, 1.0)
@@ -220,18 +243,18 @@ def _cone(parameters: FloatArray, points: FloatArray) -> FloatArray:
 def _torus(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # d = sqrt((rho - R)^2 + z^2) - r
     local = local_coordinates(parameters, points)
-    minor = parameters[7]
-    major = parameters[6] + minor
-    rho = np.hypot(local[:, 0], local[:, 1])
-    return np.asarray(np.hypot(rho - major, local[:, 2]) - minor)
+    minor = parameters[..., 7]
+    major = parameters[..., 6] + minor
+    rho = np.hypot(local[..., 0], local[..., 1])
+    return np.asarray(np.hypot(rho - major, local[..., 2]) - minor)
 
 
 def _box(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # the exact box distance: q = |p| - e / 2; |max(q, 0)| + min(max_i q_i, 0)
     local = local_coordinates(parameters, points)
-    q = np.abs(local) - 0.5 * parameters[6:9]
-    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
-    return np.asarray(outside + np.minimum(q.max(axis=1), 0.0))
+    q = np.abs(local) - 0.5 * parameters[..., 6:9]
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=-1)
+    return np.asarray(outside + np.minimum(q.max(axis=-1), 0.0))
 
 
 def _axis_ends(size: int, axis: int) -> Callable[[FloatArray], tuple[Growth, ...]]:

@@ -379,6 +379,14 @@ class PlacedLines:
     arc: FloatArray
     slope_variance: FloatArray
 
+    def tiled(self, copies: int) -> PlacedLines:
+        """The lines ``copies`` times over, one block after another (a batch of shapes whose
+        distance function reads the queries block by block, as :meth:`residuals` builds them)."""
+        if copies == 1:
+            return self
+        fields = (self.points, self.samples, self.arc, self.slope_variance)
+        return PlacedLines(*(np.concatenate([a] * copies) for a in fields))
+
     def residuals(
         self,
         distance: Callable[[FloatArray], FloatArray],
@@ -407,13 +415,16 @@ class PlacedLines:
         if across is None:
             deeper = np.where(counted, depth / spread, np.inf)
             return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
-        # each sample that cuts in, over its own deviation along d's gradient there
-        row, col = np.nonzero(counted & (depth < 0.0))
-        if len(row) == 0:
+        # each sample that cuts in, over its own deviation along d's gradient there (d's
+        # gradient is found at every counted sample: as many per contact whatever the shape)
+        if not np.any(counted & (depth < 0.0)):
             return np.zeros(n)
+        row, col = np.nonzero(counted)
         gradient = distance_gradient(
             distance, self.samples.reshape(n, k, 3)[row, col], _GRADIENT_STEP
         )
+        cut = depth[row, col] < 0.0
+        row, col, gradient = row[cut], col[cut], gradient[cut]
         # a distance's gradient is a unit normal but where two sides meet (a medial axis,
         # deep inside): there the deviation along the nearest point's normal stands
         size = np.linalg.norm(gradient, axis=1)
@@ -720,6 +731,15 @@ class _Touch:
         across = projector @ covariances @ projector
         return cls(points, tangents, along, slope, arc, across)
 
+    def tiled(self, copies: int) -> _Touch:
+        """The contacts ``copies`` times over, one block after another: for a batch of shapes,
+        whose distance function reads the queries block by block (every query array below is
+        built contact by contact, so each block's queries come together and equally many)."""
+        if copies == 1:
+            return self
+        fields = (self.points, self.tangents, self.along, self.slope, self.arc, self.across)
+        return _Touch(*(np.concatenate([a] * copies) for a in fields))
+
     @property
     def reach(self) -> FloatArray:
         """How far along each line its samples reach (m, shape (n,); 0 without a tangent)."""
@@ -870,9 +890,9 @@ class _Touch:
         across the line (over an edge, the faces' normals; beside a smooth surface, its normal
         there); their mean where they do not bracket a least distance (the reach's end)."""
         n = len(shift)
-        ends = np.concatenate([self.where(shift - self.spacing), self.where(shift + self.spacing)])
-        gradient = distance_gradient(distance, ends, _GRADIENT_STEP)
-        before, after = gradient[:n], gradient[n:]
+        ends = self.where_all(np.stack([shift - self.spacing, shift + self.spacing], axis=1))
+        gradient = distance_gradient(distance, ends, _GRADIENT_STEP).reshape(n, 2, 3)
+        before, after = gradient[:, 0], gradient[:, 1]
         k1 = np.einsum("ni,ni->n", before, self.tangents)
         k2 = np.einsum("ni,ni->n", after, self.tangents)
         bracket = (k1 < 0.0) & (k2 > 0.0)
@@ -1121,19 +1141,50 @@ def fit_primitive(
     spaces = [space.near(p, FREE_MARGIN + 0.5 * spread) for space in swept]
     link_evidence = lines is not None or bool(spaces)
 
+    # Each residual below takes one parameter vector x, shape (k,), or a batch of them, shape
+    # (B, k) (a finite-difference Jacobian's columns in one call): the contacts' quantities come
+    # back flat, shape (B * n,), block by block; the residual vectors, shape (B, m).
+    @functools.cache
+    def tiled(copies: int) -> tuple[_Touch, PlacedLines | None]:
+        return touch.tiled(copies), None if placed is None else placed.tiled(copies)
+
+    def distance_of(x: FloatArray) -> Callable[[FloatArray], FloatArray]:
+        # d at query points built contact by contact from the tiled lines: block b is x[b]'s
+        if x.ndim == 1:
+            return functools.partial(model.signed_distance, x)
+        return lambda q: model.signed_distance(x, q.reshape(len(x), -1, 3)).reshape(-1)
+
+    def copies(x: FloatArray) -> int:
+        return 1 if x.ndim == 1 else len(x)
+
+    def rows(x: FloatArray, parts: Sequence[FloatArray]) -> FloatArray:
+        # flat parts, block by block, joined into each vector's residuals
+        joined = np.concatenate([np.reshape(part, (copies(x), -1)) for part in parts], axis=1)
+        return joined[0] if x.ndim == 1 else joined
+
     def line_residuals(
         x: FloatArray, s: FloatArray, touched: FloatArray, search: bool = True
     ) -> FloatArray:
         # beyond the nearest point's reach, when it was searched for
-        if placed is None:
+        lines_x = tiled(copies(x))[1]
+        if lines_x is None:
             return np.zeros(0)
-        distance = functools.partial(model.signed_distance, x)
+        sigma_x = np.tile(s, copies(x))
         if not search:
-            return placed.residuals(distance, s, touched)
-        return placed.residuals(distance, s, touched, touch.reach, touch.across)
+            return lines_x.residuals(distance_of(x), sigma_x, touched)
+        touch_x = tiled(copies(x))[0]
+        return lines_x.residuals(distance_of(x), sigma_x, touched, touch_x.reach, touch_x.across)
 
     def swept_residuals(x: FloatArray, regions: Sequence[FreeSpace]) -> FloatArray:
-        return _swept_residuals(regions, lambda q: model.signed_distance(x, q))
+        parts = [
+            space.residuals(
+                model.signed_distance(
+                    x, np.broadcast_to(space.samples, (*x.shape[:-1], *space.samples.shape))
+                )
+            )
+            for space in regions
+        ]
+        return np.concatenate(parts, axis=-1) if parts else np.zeros((*x.shape[:-1], 0))
 
     def touched(
         x: FloatArray, s: FloatArray
@@ -1141,7 +1192,7 @@ def fit_primitive(
         # each contact at its nearest point along its line: distance beyond the line's depth
         # (m), deviation (m), place and cut (in deviations), the share of its deviation along
         # the link measured, and the depth its link's line residual allows (m)
-        return touch.residuals(lambda q: model.signed_distance(x, q), s)
+        return tiled(copies(x))[0].residuals(distance_of(x), np.tile(s, copies(x)))
 
     def normal_sigma(x: FloatArray) -> FloatArray:
         # the deviation across the link along the shape's normal at each contact's nearest
@@ -1155,7 +1206,7 @@ def fit_primitive(
         # lines' residuals
         at, sigma_at, extra, _, reached = touched(x, s)
         line = line_residuals(x, s, reached) if with_lines else np.zeros(0)
-        return np.concatenate([at / sigma_at, extra[:, 0], extra[:, 1], line])
+        return rows(x, [at / sigma_at, extra[:, 0], extra[:, 1], line])
 
     def residuals(
         x: FloatArray,
@@ -1168,11 +1219,15 @@ def fit_primitive(
         if search:
             points_part = point_residuals(x, s, with_lines)
         else:  # the Euclidean d_i / sigma_i
-            distance = model.signed_distance(x, p)
+            at_points = np.broadcast_to(p, (*x.shape[:-1], *p.shape))
+            distance = model.signed_distance(x, at_points).reshape(-1)
             line = line_residuals(x, s, distance, search=False) if with_lines else np.zeros(0)
-            points_part = np.concatenate([distance / s, line])
-        prior = _extent_prior(model.name, x, p, free_apex)
-        return np.concatenate([points_part, swept_residuals(x, regions), prior])
+            points_part = rows(x, [distance / np.tile(s, copies(x)), line])
+        prior = np.reshape(
+            [_extent_prior(model.name, v, p, free_apex) for v in np.reshape(x, (copies(x), -1))],
+            (copies(x), -1),
+        )
+        return rows(x, [points_part, swept_residuals(x, regions), prior])
 
     def fit(
         start: FloatArray,
@@ -1183,14 +1238,21 @@ def fit_primitive(
         free_apex: bool = False,
         search: bool = True,
     ) -> Any:
+        arguments = (s, with_lines, regions, free_apex, search)
+
+        def columns(_: Any, steps: Any) -> list[FloatArray]:
+            # the finite-difference Jacobian's evaluations (scipy's own steps) in one batch
+            return list(residuals(np.array(list(steps)), *arguments))
+
         return least_squares(
             residuals,
             start,
-            args=(s, with_lines, regions, free_apex, search),
+            args=arguments,
             bounds=(low, high),
             loss="soft_l1",
             f_scale=ROBUST_SCALE,
             max_nfev=evaluations * len(start),
+            workers=columns,
         )
 
     def point_z2(x: FloatArray, s: FloatArray) -> FloatArray:

@@ -204,7 +204,7 @@ def bounded_levenberg_marquardt(
         # The Gauss-Newton model's reduction for the (clipped) step
         predicted = -(gradient @ step + 0.5 * (step @ (normal @ step)))
         actual = cost - trial_cost if np.isfinite(trial_cost) else -1.0
-        ratio = actual / predicted if predicted > 0.0 else -1.0
+        ratio = float(actual / predicted) if predicted > 0.0 else -1.0
         radius = updated_radius(radius, ratio, math.sqrt(np.sum((scale * step) ** 2)))
         small_step = math.sqrt(step @ step) < xtol * (xtol + math.sqrt(params @ params))
         if actual > 0.0 and ratio > _ACCEPT_ABOVE:
