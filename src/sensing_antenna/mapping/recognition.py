@@ -204,6 +204,12 @@ ROBUST_SCALE = 3.0
 #: that has not converged by then is on a class the points do not suit, and its BIC says so.
 MAX_EVALUATIONS = 100
 
+#: Relative tolerances of each fit's steps and cost (least_squares' xtol and ftol): a fit stops
+#: when a step moves its parameters by less than this share of their size (a tenth of a
+#: micrometre on a 10 cm shape, far below any point's scatter) or its cost by less than this
+#: share of itself (a chi^2 of hundreds by a thousandth at most, against the abstention's 6).
+FIT_TOLERANCE = 1e-6
+
 #: Largest size a fit may take, in spreads of the points (the diagonal of their bounding box):
 #: a closed object ten times larger than all the touches is a plane by another name, and the
 #: plane class is there for that.
@@ -1253,6 +1259,8 @@ def fit_primitive(
             f_scale=ROBUST_SCALE,
             max_nfev=evaluations * len(start),
             workers=columns,
+            xtol=FIT_TOLERANCE,
+            ftol=FIT_TOLERANCE,
         )
 
     def point_z2(x: FloatArray, s: FloatArray) -> FloatArray:
