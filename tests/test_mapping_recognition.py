@@ -10,7 +10,15 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from sensing_antenna.mapping import UNDECIDED, FreeSpace, fit_mesh, fit_primitive, recognise
+from sensing_antenna.mapping import (
+    UNDECIDED,
+    FreeSpace,
+    Touches,
+    fit_mesh,
+    fit_primitive,
+    recognise,
+    recognition,
+)
 from sensing_antenna.mapping.primitives import PRIMITIVES
 from sensing_antenna.mapping.recognition import LINE_STRETCH, LinkLines, shape_gap
 
@@ -709,7 +717,8 @@ def test_a_batch_of_shapes_gives_each_shapes_own_distances(name: str) -> None:
     rng = np.random.default_rng(3)
     shape = PRIMITIVES[name]
     vectors = rng.normal(0.0, 0.3, (4, len(shape.parameter_names)))
-    vectors[:, len(vectors[0]) - len(shape.size_names) :] = rng.uniform(0.02, 0.2)
+    sizes = len(shape.size_names)
+    vectors[:, len(vectors[0]) - sizes :] = rng.uniform(0.02, 0.2, (4, sizes))
     probes = rng.normal(0.0, 0.2, (4, 50, 3))
     batch = shape.signed_distance(vectors, probes)
     one_by_one = [shape.signed_distance(v, q) for v, q in zip(vectors, probes, strict=True)]
@@ -717,3 +726,42 @@ def test_a_batch_of_shapes_gives_each_shapes_own_distances(name: str) -> None:
     assert np.array_equal(batch, np.stack(one_by_one))
     with pytest.raises(ValueError, match="4 parameter vectors"):
         shape.signed_distance(vectors, probes[0])
+
+
+def test_a_fit_is_the_same_whether_its_jacobians_are_batched_or_not(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # each Jacobian's columns are evaluated in one batch (least_squares' workers): evaluated one
+    # by one instead, every step, and so the fit and its covariance, are the same to the last
+    # bit; with the links' lines (one tangent unknown), free space and touching links
+    rng = np.random.default_rng(3)
+    mesh = SHAPES["box"][0]()
+    mesh.apply_transform(_pose(rng))
+    mesh.apply_translation([0.6, 0.0, 0.0] - mesh.bounding_box.centroid)
+    points, tangents = _first_touches(mesh, rng)
+    n = len(points)
+    points = points + rng.normal(0.0, NOISE, points.shape)
+    tangents[0] = np.nan
+    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+    lines = LinkLines(tangents, np.full(n, 0.01), np.full(n, 0.4), np.full(n, 0.3))
+    samples, faces = trimesh.sample.sample_surface(mesh, 300, seed=1)
+    outside = samples + 0.004 * mesh.face_normals[faces]
+    swept = [
+        FreeSpace(outside, np.full(300, 0.002), np.arange(300) % 6, 6, 0.001),
+        Touches(outside[:60], np.full(60, 0.002), np.arange(60) % 3, 3, 0.001),
+    ]
+
+    def fitted() -> list[object]:
+        fit = fit_primitive(
+            "cylinder", points, covariances, lines=lines, swept=swept, rng=np.random.default_rng(0)
+        )
+        return [fit.vector, fit.covariance, fit.chi2, fit.line_chi2, fit.swept_chi2]
+
+    batched = fitted()
+    original = recognition.least_squares
+    monkeypatch.setattr(
+        recognition, "least_squares", lambda *a, workers=None, **k: original(*a, **k)
+    )
+    one_by_one = fitted()
+    for got, expected in zip(batched, one_by_one, strict=True):
+        assert np.array_equal(got, expected, equal_nan=True)

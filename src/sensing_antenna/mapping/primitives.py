@@ -164,8 +164,8 @@ def _rotation(parameters: FloatArray) -> FloatArray:
 
 @functools.lru_cache(maxsize=32)
 def _rotation_of(rotation_vectors: bytes, batch: bool) -> FloatArray:
-    # a fit evaluates one pose many times over (each distance, the normals' six differences,
-    # the finite-difference Jacobian's columns that leave w alone): built once per pose
+    # a fit evaluates one pose many times over (each distance of one residual evaluation, the
+    # normals' six differences): built once per pose, or per batch of poses
     vectors = np.frombuffer(rotation_vectors, dtype=float).copy()
     matrix = Rotation.from_rotvec(vectors.reshape(-1, 3) if batch else vectors).as_matrix()
     matrix.setflags(write=False)

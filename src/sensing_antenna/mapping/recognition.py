@@ -204,10 +204,14 @@ ROBUST_SCALE = 3.0
 #: that has not converged by then is on a class the points do not suit, and its BIC says so.
 MAX_EVALUATIONS = 100
 
-#: Relative tolerances of each fit's steps and cost (least_squares' xtol and ftol): a fit stops
-#: when a step moves its parameters by less than this share of their size (a tenth of a
-#: micrometre on a 10 cm shape, far below any point's scatter) or its cost by less than this
-#: share of itself (a chi^2 of hundreds by a thousandth at most, against the abstention's 6).
+#: Tolerances of each fit (least_squares' xtol and ftol): a fit stops when a step is shorter than
+#: this share of the parameter vector's norm (centre in metres, rotation vector in radians and
+#: sizes: micrometres and microradians for a shape within a metre of the head, far below the
+#: points' scatter), or when a step lowers the robust cost by less than this share of it. A fit
+#: on rough residuals (a contact's nearest point moving from face to face) stops where its steps
+#: stall either way; the finer default tolerances (1e-8) cost several times the evaluations there
+#: and move the named class's sizes by micrometres (docs/design-notes.md, "Recognition's cost,
+#: batched and looser").
 FIT_TOLERANCE = 1e-6
 
 #: Largest size a fit may take, in spreads of the points (the diagonal of their bounding box):
@@ -1147,9 +1151,10 @@ def fit_primitive(
     spaces = [space.near(p, FREE_MARGIN + 0.5 * spread) for space in swept]
     link_evidence = lines is not None or bool(spaces)
 
-    # Each residual below takes one parameter vector x, shape (k,), or a batch of them, shape
-    # (B, k) (a finite-difference Jacobian's columns in one call): the contacts' quantities come
-    # back flat, shape (B * n,), block by block; the residual vectors, shape (B, m).
+    # The residuals of the fits (line, swept, touched, point and residuals below) take one
+    # parameter vector x, shape (k,), or a batch of them, shape (B, k) (a finite-difference
+    # Jacobian's columns in one call): the contacts' quantities come back flat, shape (B * n,),
+    # block by block; the residual vectors, shape (B, m). The scores' helpers take one x.
     @functools.cache
     def tiled(copies: int) -> tuple[_Touch, PlacedLines | None]:
         return touch.tiled(copies), None if placed is None else placed.tiled(copies)
@@ -1247,7 +1252,9 @@ def fit_primitive(
         arguments = (s, with_lines, regions, free_apex, search)
 
         def columns(_: Any, steps: Any) -> list[FloatArray]:
-            # the finite-difference Jacobian's evaluations (scipy's own steps) in one batch
+            # the finite-difference Jacobian's evaluations (scipy's own steps) in one batch:
+            # least_squares hands ``workers`` its residual function and those steps, and uses
+            # it for nothing else, so the function handed (that of ``residuals``) is not called
             return list(residuals(np.array(list(steps)), *arguments))
 
         return least_squares(
