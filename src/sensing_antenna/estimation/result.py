@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 __all__ = ["STATUS_PRECEDENCE", "ContactEstimate", "Status"]
 
 
-class Status(str, enum.Enum):  # noqa: UP042 (str() and format() give "Status.OK" as before)
+class Status(str, enum.Enum):  # noqa: UP042 (a StrEnum's str() would read "ok", not "Status.OK")
     """Outcome of an estimation (a ``str`` enum: ``Status.OK == "ok"``)."""
 
     #: Both estimators agree; the contact point is trustworthy.

@@ -158,16 +158,16 @@ def local_coordinates(parameters: FloatArray, points: FloatArray) -> FloatArray:
 def _rotation(parameters: FloatArray) -> FloatArray:
     """R (read-only, shape (3, 3)) of the rotation vector parameters[3:6] (rad); for a batch
     of shape (B, 1, p), shape (B, 3, 3)."""
-    vectors = np.ascontiguousarray(parameters[..., 3:6], dtype=float)
-    return _rotation_of(vectors.tobytes(), parameters.ndim > 1)
+    if parameters.ndim > 1:  # a batch's poses are each met once: not worth keeping
+        return np.asarray(Rotation.from_rotvec(parameters[:, 0, 3:6]).as_matrix())
+    return _rotation_of(np.ascontiguousarray(parameters[3:6], dtype=float).tobytes())
 
 
 @functools.lru_cache(maxsize=32)
-def _rotation_of(rotation_vectors: bytes, batch: bool) -> FloatArray:
+def _rotation_of(rotation_vector: bytes) -> FloatArray:
     # a fit evaluates one pose many times over (each distance of one residual evaluation, the
-    # normals' six differences): built once per pose, or per batch of poses
-    vectors = np.frombuffer(rotation_vectors, dtype=float).copy()
-    matrix = Rotation.from_rotvec(vectors.reshape(-1, 3) if batch else vectors).as_matrix()
+    # normals' six differences): built once per pose
+    matrix = Rotation.from_rotvec(np.frombuffer(rotation_vector, dtype=float).copy()).as_matrix()
     matrix.setflags(write=False)
     return matrix
 
@@ -194,10 +194,8 @@ def _plane_normal(parameters: FloatArray) -> FloatArray:
 
 def _plane(parameters: FloatArray, points: FloatArray) -> FloatArray:
     # d = n . p - offset
-    normal = _plane_normal(parameters)
-    if normal.ndim == 1:
-        return np.asarray(points @ normal - parameters[2])
-    return np.asarray((points @ normal.swapaxes(-1, -2))[..., 0] - parameters[..., 2])
+    column = np.swapaxes(np.atleast_2d(_plane_normal(parameters)), -1, -2)
+    return np.asarray((points @ column)[..., 0] - parameters[..., 2])
 
 
 def _sphere(parameters: FloatArray, points: FloatArray) -> FloatArray:

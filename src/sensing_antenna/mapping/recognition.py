@@ -382,20 +382,27 @@ class PlacedLines:
         Their signed arc lengths (m); NaN where the link does not reach.
     slope_variance : array, shape (n, k)
         (s sigma_t)^2 (m^2): how far the line's angle error moves each sample across it.
+    blocks : int
+        How many copies of the same contacts it holds, one after another (:meth:`tiled`).
     """
 
     points: FloatArray
     samples: FloatArray
     arc: FloatArray
     slope_variance: FloatArray
+    blocks: int = 1
 
     def tiled(self, copies: int) -> PlacedLines:
         """The lines ``copies`` times over, one block after another (a batch of shapes whose
-        distance function reads the queries block by block, as :meth:`residuals` builds them)."""
+        distance function reads the queries block by block, as :meth:`residuals` builds them:
+        each block's together and as many)."""
         if copies == 1:
             return self
-        fields = (self.points, self.samples, self.arc, self.slope_variance)
-        return PlacedLines(*(np.concatenate([a] * copies) for a in fields))
+        points, samples, arc, slope_variance = (
+            np.concatenate([a] * copies)
+            for a in (self.points, self.samples, self.arc, self.slope_variance)
+        )
+        return PlacedLines(points, samples, arc, slope_variance, copies)
 
     def residuals(
         self,
@@ -425,16 +432,18 @@ class PlacedLines:
         if across is None:
             deeper = np.where(counted, depth / spread, np.inf)
             return np.asarray(np.minimum(deeper.min(axis=1), 0.0))
-        # each sample that cuts in, over its own deviation along d's gradient there (d's
-        # gradient is found at every counted sample: as many per contact whatever the shape)
-        if not np.any(counted & (depth < 0.0)):
+        # each sample that cuts in, over its own deviation along d's gradient there (found in
+        # every block at each sample that cuts in in any: as many queries per block)
+        cut = counted & (depth < 0.0)
+        if not np.any(cut):
             return np.zeros(n)
-        row, col = np.nonzero(counted)
+        anywhere = cut.reshape(self.blocks, -1, k).any(axis=0)
+        row, col = np.nonzero(np.tile(anywhere, (self.blocks, 1)))
         gradient = distance_gradient(
             distance, self.samples.reshape(n, k, 3)[row, col], _GRADIENT_STEP
         )
-        cut = depth[row, col] < 0.0
-        row, col, gradient = row[cut], col[cut], gradient[cut]
+        own = cut[row, col]
+        row, col, gradient = row[own], col[own], gradient[own]
         # a distance's gradient is a unit normal but where two sides meet (a medial axis,
         # deep inside): there the deviation along the nearest point's normal stands
         size = np.linalg.norm(gradient, axis=1)
@@ -1165,6 +1174,10 @@ def fit_primitive(
             return functools.partial(model.signed_distance, x)
         return lambda q: model.signed_distance(x, q.reshape(len(x), -1, 3)).reshape(-1)
 
+    def distance_at(x: FloatArray, q: FloatArray) -> FloatArray:
+        # d of each vector of x at the same points q (m, shape (k, 3)): shape (k,) or (B, k)
+        return model.signed_distance(x, np.broadcast_to(q, (*x.shape[:-1], *q.shape)))
+
     def copies(x: FloatArray) -> int:
         return 1 if x.ndim == 1 else len(x)
 
@@ -1177,25 +1190,16 @@ def fit_primitive(
         x: FloatArray, s: FloatArray, touched: FloatArray, search: bool = True
     ) -> FloatArray:
         # beyond the nearest point's reach, when it was searched for
-        lines_x = tiled(copies(x))[1]
+        touch_x, lines_x = tiled(copies(x))
         if lines_x is None:
             return np.zeros(0)
         sigma_x = np.tile(s, copies(x))
         if not search:
             return lines_x.residuals(distance_of(x), sigma_x, touched)
-        touch_x = tiled(copies(x))[0]
         return lines_x.residuals(distance_of(x), sigma_x, touched, touch_x.reach, touch_x.across)
 
     def swept_residuals(x: FloatArray, regions: Sequence[FreeSpace]) -> FloatArray:
-        parts = [
-            space.residuals(
-                model.signed_distance(
-                    x, np.broadcast_to(space.samples, (*x.shape[:-1], *space.samples.shape))
-                )
-            )
-            for space in regions
-        ]
-        return np.concatenate(parts, axis=-1) if parts else np.zeros((*x.shape[:-1], 0))
+        return _swept_residuals(regions, functools.partial(distance_at, x), x.shape[:-1])
 
     def touched(
         x: FloatArray, s: FloatArray
@@ -1230,8 +1234,7 @@ def fit_primitive(
         if search:
             points_part = point_residuals(x, s, with_lines)
         else:  # the Euclidean d_i / sigma_i
-            at_points = np.broadcast_to(p, (*x.shape[:-1], *p.shape))
-            distance = model.signed_distance(x, at_points).reshape(-1)
+            distance = distance_at(x, p).reshape(-1)
             line = line_residuals(x, s, distance, search=False) if with_lines else np.zeros(0)
             points_part = rows(x, [distance / np.tile(s, copies(x)), line])
         prior = np.reshape(
@@ -1703,17 +1706,18 @@ def _scored(
 
 
 def _swept_residuals(
-    spaces: Sequence[FreeSpace], distance: Callable[[FloatArray], FloatArray]
+    spaces: Sequence[FreeSpace],
+    distance: Callable[[FloatArray], FloatArray],
+    batch: tuple[int, ...] = (),
 ) -> FloatArray:
-    """r_j of every sweep or contact of ``spaces`` in order, shape (n,), for a signed distance
-    function of (k, 3) points (m); empty without them."""
-    return np.concatenate(
-        [np.zeros(0)]
-        + [
-            space.residuals(distance(space.samples) if len(space.samples) else np.zeros(0))
-            for space in spaces
-        ]
-    )
+    """r_j of every sweep or contact of ``spaces`` in order, shape (*batch, n), for a signed
+    distance function of (k, 3) points (m) giving shape (*batch, k) (a batch of shapes'
+    distances, or one shape's with ``batch`` empty); empty without them."""
+    parts = [
+        space.residuals(distance(space.samples) if len(space.samples) else np.zeros((*batch, 0)))
+        for space in spaces
+    ]
+    return np.concatenate(parts, axis=-1) if parts else np.zeros((*batch, 0))
 
 
 def _swept_chi2(r: FloatArray, spaces: Sequence[FreeSpace], spread: float) -> FloatArray:
