@@ -1150,11 +1150,12 @@ def scene_files(draw: st.DrawFn) -> bytes:
 def run_scene_file(data: bytes) -> list[Outcome]:
     """Load a scene file beside the mesh files of :func:`write_scene_meshes`; a scene loaded
     must have finite, non-empty meshes whose signed distance is finite, finite base poses and,
-    for every base, explored angles in order within their limits (azimuth one half-turn either
-    way, elevation 1.2 rad) and at least one sweep."""
+    for every base, explored angles in order within their limits (``scene.sweep.MAX_AZIMUTH``
+    and ``MAX_ELEVATION``) and at least one sweep."""
 
     def action() -> list[Outcome]:
         from sensing_antenna.scene import load_scene
+        from sensing_antenna.scene.sweep import MAX_AZIMUTH, MAX_ELEVATION
 
         with tempfile.TemporaryDirectory(prefix="fuzz-") as folder:
             write_scene_meshes(Path(folder))
@@ -1174,8 +1175,8 @@ def run_scene_file(data: bytes) -> list[Outcome]:
         for index in range(len(scene.bases)):
             region = scene.region_of(index)
             for name, (low, high), limit in (
-                ("azimuth", region.azimuth, math.pi),
-                ("elevation", region.elevation, 1.2),
+                ("azimuth", region.azimuth, MAX_AZIMUTH),
+                ("elevation", region.elevation, MAX_ELEVATION),
             ):
                 if not -limit <= low < high <= limit:
                     return [Outcome(TRACEBACK, f"base {index}: {name} {(low, high)}")]

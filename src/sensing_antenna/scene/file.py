@@ -58,6 +58,7 @@ from sensing_antenna.scene.objects import (
     primitive_object,
     read_mesh,
 )
+from sensing_antenna.scene.sweep import MAX_AZIMUTH, MAX_ELEVATION
 from sensing_antenna.toml_files import parse_toml_file, parse_toml_text
 
 __all__ = [
@@ -380,7 +381,7 @@ def _ranges(
 ) -> list[tuple[float, float]]:
     """The azimuth and elevation ranges (rad) of ``table``, each defaulting to ``defaults``'."""
     ranges = []
-    for key, limit in (("azimuth", math.pi), ("elevation", 1.2)):
+    for key, limit in (("azimuth", MAX_AZIMUTH), ("elevation", MAX_ELEVATION)):
         low, high = _vector(table.get(key, list(getattr(defaults, key))), 2, f"{where}.{key}", fail)
         if not -limit <= low < high <= limit:
             raise fail(

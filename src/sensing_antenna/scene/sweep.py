@@ -36,7 +36,15 @@ from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.link import build_link_model
 from sensing_antenna.simulator.run import device_link
 
-__all__ = ["SWEEP_CASES", "SWEEP_DIRECTIONS", "LinkShape", "Sweep", "facing_region"]
+__all__ = [
+    "MAX_AZIMUTH",
+    "MAX_ELEVATION",
+    "SWEEP_CASES",
+    "SWEEP_DIRECTIONS",
+    "LinkShape",
+    "Sweep",
+    "facing_region",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -44,6 +52,12 @@ SWEEP_CASES = ("azimuthal", "vertical")
 
 #: The directions a sweep may run in: +1 from ``start`` to ``end``, -1 from ``end`` to ``start``.
 SWEEP_DIRECTIONS = (1, -1)
+
+#: Limits (rad) of the angles a region is explored over, either way: the azimuth theta1 within
+#: a half-turn (every heading once), the elevation theta2 within 1.2 rad (69 degrees), short of
+#: the vertical, where turning the azimuth no longer moves the link.
+MAX_AZIMUTH = math.pi
+MAX_ELEVATION = 1.2
 
 
 @dataclass(frozen=True)
@@ -221,7 +235,7 @@ def facing_region(
     mesh vertices): theta1 and theta2 from, to (rad), widened by ``margin`` (rad), the elevations
     raised by the link's sag at each point's distance r (the link at theta2 passes w(r) < 0
     across itself, along Z^m: its point at r lies w(r) / r rad below theta2) and kept within
-    +-1.2 rad."""
+    +-:data:`MAX_ELEVATION`."""
     local = (np.asarray(points, dtype=float) - base.position) @ base.rotation  # R^T (p - O)
     reach = np.linalg.norm(local, axis=1)
     sag = np.interp(reach, shape.abscissae, shape.sag())
@@ -229,5 +243,8 @@ def facing_region(
     elevations = np.arctan2(local[:, 2], np.hypot(local[:, 0], local[:, 1])) - sag / reach
     return (
         (float(azimuths.min()) - margin, float(azimuths.max()) + margin),
-        (max(float(elevations.min()) - margin, -1.2), min(float(elevations.max()) + margin, 1.2)),
+        (
+            max(float(elevations.min()) - margin, -MAX_ELEVATION),
+            min(float(elevations.max()) + margin, MAX_ELEVATION),
+        ),
     )
