@@ -84,7 +84,7 @@ from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
 from sensing_antenna.cli.arguments import integer  # noqa: E402
 from sensing_antenna.exploration import ExploreSettings, explore, prepare_device  # noqa: E402
 from sensing_antenna.exploration.run import DEFAULT_BUILD, swept_links  # noqa: E402
-from sensing_antenna.exploration.store import CALIBRATED_FILE  # noqa: E402
+from sensing_antenna.exploration.store import AIMS, CALIBRATED_FILE  # noqa: E402
 from sensing_antenna.mapping import PRIMITIVES, UNDECIDED, BasePose  # noqa: E402
 from sensing_antenna.mapping.contact_map import fit_surface, recognise_points  # noqa: E402
 from sensing_antenna.scene import (  # noqa: E402
@@ -398,6 +398,7 @@ def run(
     until_recognised: int = 0,
     device_profile: str = "nominal",
     device_build: int | None = None,
+    sizes_within: float | None = None,
 ) -> dict[str, Any]:
     out = workdir / f"{scene.name}-{strategy}"
     resumed = out.exists()
@@ -415,6 +416,7 @@ def run(
             seed=seed,
             link=link,
             until_recognised=until_recognised,
+            sizes_within=sizes_within,
             device_profile=device_profile,
             device_build=device_build,
         ),
@@ -431,6 +433,7 @@ def run(
         "outcomes": result.summary()["outcomes"],
         "sweep_time_s": result.summary()["sweep_time_s"],
         "run_s": elapsed,
+        "aims": {aim: sum(m.aim == aim for m in manoeuvres) for aim in AIMS},
         "resumed": resumed,
     }
     if used:
@@ -689,6 +692,13 @@ def main() -> None:
         metavar="N",
         help="after the budget, up to N more sweeps while recognition abstains",
     )
+    parser.add_argument(
+        "--sizes-within",
+        type=float,
+        default=None,
+        metavar="SHARE",
+        help="with --until-recognised: go on also while the named sizes are not known so well",
+    )
     parser.add_argument("--out", type=Path, default=RESULTS)
     parser.add_argument(
         "--keep",
@@ -741,6 +751,7 @@ def main() -> None:
                         args.until_recognised,
                         args.device_profile,
                         args.device_build,
+                        args.sizes_within,
                     ),
                 }
                 rows.append(row)

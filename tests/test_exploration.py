@@ -496,6 +496,7 @@ def test_antenna_explore_bad_scene_is_one_line(
         ("--seed", "-1", "must be an integer from 0 to 2147483647, got -1"),
         ("--seed", "1.5", "must be an integer from 0 to 2147483647, got '1.5'"),
         ("--device-build", "-1", "must be an integer from 0 to 2147483647, got -1"),
+        ("--sizes-within", "0", "must be a finite share in (0, 1], got 0.0"),
     ],
 )
 def test_antenna_explore_bad_counts_are_one_line(
@@ -599,6 +600,58 @@ def test_an_object_recognised_at_the_budget_ends_the_exploration(
     assert [m.aim for m in result.manoeuvres] == ["plan", "plan"]
     # the map keeps the recognition that ended the sweeps, made of the same points
     assert result.contact_map.recognition is named
+
+
+@pytest.mark.parametrize(("size_std", "aims"), [(0.01, ["sizes"] * 2), (0.001, [])])
+def test_a_named_object_is_swept_on_until_its_sizes_are_known(
+    explored: tuple[Path, list[Manoeuvre]],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    size_std: float,
+    aims: list[str],
+) -> None:
+    # a 5 cm radius named with a deviation of 1 cm (2 sigma is 40 % of it) is swept for after
+    # the budget, aimed at its sizes; one of 1 mm (4 %) is known within 5 % at the budget
+    import sensing_antenna.exploration.run as run
+
+    stand_in = ClassFit(
+        "stand-in",
+        {},
+        {"radius": 0.05},
+        rms=0.0,
+        chi2=0.0,
+        bic=0.0,
+        dof=0,
+        n_points=0,
+        size_std={"radius": size_std},
+    )
+    named = Recognition("stand-in", (stand_in,), ("stand-in",), math.inf, 1.0, 6.0)
+    monkeypatch.setattr(run, "recognise_points", lambda *args, **kwargs: named)
+    out = tmp_path / "sizes"
+    out.mkdir()
+    (out / "calibrated.toml").write_text((explored[0] / "calibrated.toml").read_text())
+    settings = ExploreSettings(method="paper", budget=2, until_recognised=2, sizes_within=0.05)
+    result = explore(load_scene("post"), DEVICE, out, settings)
+    assert [m.aim for m in result.manoeuvres] == ["plan", "plan", *aims]
+
+
+@pytest.mark.parametrize("share", [0.0, -0.1, 1.5, math.nan, "0.05"])
+def test_sizes_within_must_be_a_share(share: object) -> None:
+    with pytest.raises(ValueError, match="sizes_within must be a share in"):
+        ExploreSettings(until_recognised=2, sizes_within=share)  # type: ignore[arg-type]
+
+
+def test_sizes_within_without_more_sweeps_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "x"
+    assert main(["explore", "post", "--out", str(out), "--sizes-within", "0.05"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "antenna explore: error: --sizes-within: sizes are known after the budget: give"
+        " --until-recognised N too"
+    )
+    assert not out.exists()
 
 
 def _outline_contacts(

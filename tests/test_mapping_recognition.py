@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 
 from sensing_antenna.mapping import (
     UNDECIDED,
+    ClassFit,
     FreeSpace,
     Touches,
     fit_mesh,
@@ -765,3 +766,18 @@ def test_a_fit_is_the_same_whether_its_jacobians_are_batched_or_not(
     one_by_one = fitted()
     for got, expected in zip(batched, one_by_one, strict=True):
         assert np.array_equal(got, expected, equal_nan=True)
+
+
+def test_sizes_are_known_when_twice_each_deviation_is_within_the_share() -> None:
+    # a 40 mm height with a deviation of 0.9 mm: 2 sigma is 4.5 % of it, within 5 % but not 4 %;
+    # a size only bounded from below (inf) or without a deviation is never known
+    def fit(sizes: dict[str, float], std: dict[str, float]) -> ClassFit:
+        return ClassFit("cylinder", {}, sizes, 0.0, 0.0, 0.0, 5, 20, size_std=std)
+
+    measured = fit({"radius": 0.02, "height": 0.04}, {"radius": 0.0002, "height": 0.0009})
+    assert measured.sizes_known(0.05)
+    assert not measured.sizes_known(0.04)
+    bounded = fit({"radius": 0.02, "height": 0.04}, {"radius": 0.0002, "height": math.inf})
+    assert not bounded.sizes_known(0.5)
+    assert not fit({"radius": 0.02}, {}).sizes_known(0.5)
+    assert fit({}, {}).sizes_known(0.01)  # a user mesh: its size is its own

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.cli.arguments import ArgumentError, integer
+from sensing_antenna.cli.arguments import ArgumentError, integer, number
 from sensing_antenna.cli.map import add_map_options
 
 #: ``exploration.plan.STRATEGIES``, ``scene.file.BUILTIN_SCENES`` and
@@ -65,6 +65,16 @@ def register(subparsers: Any) -> None:
         ),
     )
     parser.add_argument(
+        "--sizes-within",
+        type=number(0.0, 1.0, low_open=True, what="share"),
+        default=None,
+        metavar="SHARE",
+        help=(
+            "with --until-recognised: go on also while the named object's sizes are not each "
+            "known to within this share of themselves (twice the standard deviation; 0.05: 5 %%)"
+        ),
+    )
+    parser.add_argument(
         "--antenna", default="paper-2021", help="the simulated device: built-in name or TOML file"
     )
     parser.add_argument(
@@ -112,6 +122,10 @@ def _run(args: argparse.Namespace) -> int:
         raise ArgumentError(
             "--device-build", "a realistic device's build: give --device-profile realistic too"
         )
+    if args.sizes_within is not None and args.until_recognised == 0:
+        raise ArgumentError(
+            "--sizes-within", "sizes are known after the budget: give --until-recognised N too"
+        )
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)
     meshes = {path.stem: read_mesh(path) for path in args.objects}
@@ -123,6 +137,7 @@ def _run(args: argparse.Namespace) -> int:
         include_uncertain=args.include_uncertain,
         link=args.link,
         until_recognised=args.until_recognised,
+        sizes_within=args.sizes_within,
         device_profile=args.device_profile,
         device_build=args.device_build,
     )

@@ -27,7 +27,9 @@ every :data:`RECOGNITION_EVERY`-th, aiming where the named object's fit is least
 surface, and at the two leading classes while recognition abstains (``exploration.plan``). After the
 budget, either strategy may go on while recognition abstains (``ExploreSettings.until_recognised``):
 it recognises the points before each further manoeuvre, stops once a class is named, and otherwise
-takes next-best's choice with the two leading fits, which aims at telling them apart.
+takes next-best's choice with the two leading fits, which aims at telling them apart. With
+``ExploreSettings.sizes_within`` it also goes on while the named class's sizes are not known that
+well, aiming where that fit is least sure of its surface.
 
 Manoeuvre i is simulated with the seed ``seed + i``. Everything is stored as it is made
 (``exploration.store``); a second start with the same settings resumes after the last stored
@@ -204,6 +206,12 @@ class ExploreSettings:
         each: next-best's choice with the two leading classes (``NextBestPlanner.choose``,
         which aims at telling them apart; its usual choice when there are no two leading
         primitives); 0 stops at the budget.
+    sizes_within : float or None
+        With ``until_recognised``: the manoeuvres after the budget go on also while the named
+        class's sizes are not each known to within this share of themselves
+        (``ClassFit.sizes_known``: twice the standard deviation, widened by the overdispersion,
+        at most this share; 0.05: 5 %), aimed where the named fit is least sure of its surface
+        (``NextBestPlanner.choose`` with that fit); None: naming the object ends them.
     """
 
     method: str = "fast"
@@ -215,6 +223,7 @@ class ExploreSettings:
     until_recognised: int = 0
     device_profile: str = "nominal"
     device_build: int | None = None
+    sizes_within: float | None = None
 
     def __post_init__(self) -> None:
         if self.method not in EXPLORE_METHODS:
@@ -225,6 +234,9 @@ class ExploreSettings:
             raise ValueError("budget must be at least 1")
         if self.until_recognised < 0:
             raise ValueError("until_recognised must be at least 0")
+        within = self.sizes_within
+        if within is not None and not (isinstance(within, float | int) and 0.0 < within <= 1.0):
+            raise ValueError(f"sizes_within must be a share in (0, 1], got {within!r}")
         if self.link not in LINK_MODELS:
             raise ValueError(f"link must be one of {', '.join(LINK_MODELS)}")
         if self.device_profile not in DEVICE_PROFILES:
@@ -610,13 +622,13 @@ def explore(
                     choice = planner.choose(done, surface, free, leaders)
                 elif index < end + settings.until_recognised:
                     named, leaders = recognised(manoeuvres)
-                    if named is not None:
+                    if named is not None and _sizes_known(named, settings.sizes_within):
                         final = named  # of every point and swept link: the map's own
                         break
                     chooser = chooser if chooser is not None else NextBestPlanner(scene, shape)
                     surface = fit_surface(points, settings.include_uncertain)
                     choice = chooser.choose(done, surface, free, leaders)
-                    aim = "recognition"
+                    aim = "recognition" if named is None else "sizes"
                 if choice is None:
                     break
                 manoeuvre = _run_one(
@@ -700,6 +712,14 @@ def swept_links(
         theta = np.array([sweep.angles(float(a)) for a in before]).reshape(-1, 2)
         free.append([(base, theta), *pieces])
     return free_space(free, antenna), touches(touched, antenna)
+
+
+def _sizes_known(recognition: Recognition, within: float | None) -> bool:
+    """Whether the object ``recognition`` names is known well enough to stop sweeping: its
+    sizes each within ``within`` of themselves (``ClassFit.sizes_known``), or always when
+    None."""
+    named = recognition.named
+    return within is None or (named is not None and named.sizes_known(within))
 
 
 def _recognition_state(

@@ -64,7 +64,7 @@ MANOEUVRES_DIR = "manoeuvres"
 TABLE_FILE = "manoeuvres.csv"
 
 #: What may choose a manoeuvre's sweep (``Manoeuvre.aim``).
-AIMS = ("plan", "recognition")
+AIMS = ("plan", "recognition", "sizes")
 
 
 class ExplorationStoreError(SensingAntennaError):
@@ -96,9 +96,10 @@ class Manoeuvre:
     score : float
         The planner's score of the sweep (m; NaN for a grid sweep, and for one chosen before
         a surface could be fitted).
-    aim : {"plan", "recognition"}
+    aim : {"plan", "recognition", "sizes"}
         What chose the sweep: the strategy's plan (within the budget), or the sweeps after it
-        while recognition abstains (``ExploreSettings.until_recognised``).
+        while recognition abstains (``ExploreSettings.until_recognised``), or while the named
+        object's sizes are not known well enough (``ExploreSettings.sizes_within``).
     """
 
     index: int

@@ -555,6 +555,16 @@ class ClassFit:
             return np.full(len(q), np.nan)
         return _carried(lambda v: model.signed_distance(v, q), self.vector, self.covariance)
 
+    def sizes_known(self, within: float) -> bool:
+        """Whether every size is known to within the share ``within`` of itself (0.05: 5 %):
+        twice its standard deviation (about a 95 % interval's half-width) at most that share of
+        it. A size the points do not measure or only bound from below is not known; a fit
+        without sizes (a user mesh) is."""
+        return all(
+            2.0 * self.size_std.get(name, math.inf) <= within * size
+            for name, size in self.sizes.items()
+        )
+
     def sizes_text(self) -> str:
         """The sizes in mm for reading: ``radius 18.7 +- 1.0 mm``, a size that is only a lower
         bound as ``height at least 147.2 mm``, one the points do not measure as ``radius 251.2
