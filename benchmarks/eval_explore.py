@@ -81,7 +81,7 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.antenna import antenna_to_toml  # noqa: E402
-from sensing_antenna.cli.arguments import integer  # noqa: E402
+from sensing_antenna.cli.arguments import integer, number  # noqa: E402
 from sensing_antenna.exploration import ExploreSettings, explore, prepare_device  # noqa: E402
 from sensing_antenna.exploration.run import DEFAULT_BUILD, swept_links  # noqa: E402
 from sensing_antenna.exploration.store import AIMS, CALIBRATED_FILE  # noqa: E402
@@ -694,10 +694,13 @@ def main() -> None:
     )
     parser.add_argument(
         "--sizes-within",
-        type=float,
+        type=number(0.0, 1.0, low_open=True, what="share"),
         default=None,
         metavar="SHARE",
-        help="with --until-recognised: go on also while the named sizes are not known so well",
+        help=(
+            "with --until-recognised: go on also while the named object's sizes are not each "
+            "known to within this share of themselves (twice the standard deviation)"
+        ),
     )
     parser.add_argument("--out", type=Path, default=RESULTS)
     parser.add_argument(
@@ -707,6 +710,10 @@ def main() -> None:
         help="keep each exploration's directory in this one (one already there is resumed)",
     )
     args = parser.parse_args()
+    if args.sizes_within is not None and args.until_recognised == 0:
+        parser.error(
+            "--sizes-within: the sizes are swept for after the budget: give --until-recognised N"
+        )
     device = paper_antenna()
     shape = LinkShape(device.link)
     rows: list[dict[str, Any]] = []

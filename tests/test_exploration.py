@@ -6,6 +6,7 @@ import csv
 import dataclasses
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -602,43 +603,78 @@ def test_an_object_recognised_at_the_budget_ends_the_exploration(
     assert result.contact_map.recognition is named
 
 
-@pytest.mark.parametrize(("size_std", "aims"), [(0.01, ["sizes"] * 2), (0.001, [])])
+@pytest.mark.parametrize(
+    ("deviations", "aims"),
+    [
+        ([0.01, 0.01, 0.01], ["sizes"] * 2),  # never known: every sweep the count allows
+        ([0.01, 0.001], ["sizes"]),  # known after one more sweep
+        ([None, 0.01, 0.001], ["recognition", "sizes"]),  # named after one more sweep
+        ([0.001], []),  # known at the budget
+    ],
+)
 def test_a_named_object_is_swept_on_until_its_sizes_are_known(
     explored: tuple[Path, list[Manoeuvre]],
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
-    size_std: float,
+    deviations: list[float | None],
     aims: list[str],
 ) -> None:
-    # a 5 cm radius named with a deviation of 1 cm (2 sigma is 40 % of it) is swept for after
-    # the budget, aimed at its sizes; one of 1 mm (4 %) is known within 5 % at the budget
+    # a sphere of 5 cm radius, named with a deviation of 1 cm (2 sigma is 40 % of it), is swept
+    # for after the budget, next-best aiming with the named fit; one of 1 mm (4 %) is known
+    # within 5 %, and the recognition that found it so is the map's (None: not yet named)
+    import sensing_antenna.exploration.plan as plan
     import sensing_antenna.exploration.run as run
 
-    stand_in = ClassFit(
-        "stand-in",
-        {},
-        {"radius": 0.05},
-        rms=0.0,
-        chi2=0.0,
-        bic=0.0,
-        dof=0,
-        n_points=0,
-        size_std={"radius": size_std},
-    )
-    named = Recognition("stand-in", (stand_in,), ("stand-in",), math.inf, 1.0, 6.0)
-    monkeypatch.setattr(run, "recognise_points", lambda *args, **kwargs: named)
+    def named(std: float) -> Recognition:
+        fit = ClassFit(
+            "sphere", {}, {"radius": 0.05}, 0.0, 0.0, 0.0, 4, 20, size_std={"radius": std}
+        )
+        return Recognition("sphere", (fit,), ("sphere",), math.inf, 1.0, 6.0)
+
+    answers = [None if std is None else named(std) for std in deviations]
+    asked: list[Recognition | None] = []
+
+    def recognise_points(*args: object, **kwargs: object) -> Recognition | None:
+        asked.append(answers[min(len(asked), len(answers) - 1)])
+        return asked[-1]
+
+    aimed: list[tuple[ClassFit, ...]] = []
+    choose = plan.NextBestPlanner.choose
+
+    def recording(
+        self: plan.NextBestPlanner,
+        done: Sequence[Sweep],
+        surface: object,
+        free: Sequence[Sweep] = (),
+        leaders: Sequence[ClassFit] = (),
+    ) -> plan.Choice | None:
+        aimed.append(tuple(leaders))
+        return choose(self, done, surface, free, leaders)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(run, "recognise_points", recognise_points)
+    monkeypatch.setattr(plan.NextBestPlanner, "choose", recording)
     out = tmp_path / "sizes"
     out.mkdir()
     (out / "calibrated.toml").write_text((explored[0] / "calibrated.toml").read_text())
     settings = ExploreSettings(method="paper", budget=2, until_recognised=2, sizes_within=0.05)
     result = explore(load_scene("post"), DEVICE, out, settings)
     assert [m.aim for m in result.manoeuvres] == ["plan", "plan", *aims]
+    # each sweep for sizes aimed with the named fit
+    sized = [a for a, m in zip(aimed, result.manoeuvres[2:], strict=True) if m.aim == "sizes"]
+    assert [[fit.name for fit in a] for a in sized] == [["sphere"]] * aims.count("sizes")
+    if len(aims) < 2:  # stopped once the sizes were known: that recognition is the map's
+        assert result.contact_map.recognition is asked[-1]
 
 
-@pytest.mark.parametrize("share", [0.0, -0.1, 1.5, math.nan, "0.05"])
+@pytest.mark.parametrize("share", [0.0, -0.1, 1.5, math.nan, "0.05", True])
 def test_sizes_within_must_be_a_share(share: object) -> None:
     with pytest.raises(ValueError, match="sizes_within must be a share in"):
         ExploreSettings(until_recognised=2, sizes_within=share)  # type: ignore[arg-type]
+
+
+def test_sizes_within_needs_sweeps_after_the_budget() -> None:
+    with pytest.raises(ValueError, match="give until_recognised too"):
+        ExploreSettings(sizes_within=0.05)
 
 
 def test_sizes_within_without_more_sweeps_is_one_line(
@@ -648,8 +684,8 @@ def test_sizes_within_without_more_sweeps_is_one_line(
     assert main(["explore", "post", "--out", str(out), "--sizes-within", "0.05"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        "antenna explore: error: --sizes-within: sizes are known after the budget: give"
-        " --until-recognised N too"
+        "antenna explore: error: --sizes-within: the sizes are swept for after the budget only:"
+        " give --until-recognised N too"
     )
     assert not out.exists()
 

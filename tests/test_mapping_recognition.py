@@ -780,4 +780,8 @@ def test_sizes_are_known_when_twice_each_deviation_is_within_the_share() -> None
     bounded = fit({"radius": 0.02, "height": 0.04}, {"radius": 0.0002, "height": math.inf})
     assert not bounded.sizes_known(0.5)
     assert not fit({"radius": 0.02}, {}).sizes_known(0.5)
-    assert fit({}, {}).sizes_known(0.01)  # a user mesh: its size is its own
+    plane = ClassFit("plane", {}, {}, 0.0, 0.0, 0.0, 3, 20)
+    assert plane.sizes_known(0.01)
+    # a user mesh is registered at its own size: its extents have no deviations to know
+    extents = {"extent_x": 0.1, "extent_y": 0.05, "extent_z": 0.02}
+    assert ClassFit("mesh:block", {}, extents, 0.0, 0.0, 0.0, 6, 20).sizes_known(0.01)

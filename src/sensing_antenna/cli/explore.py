@@ -61,7 +61,8 @@ def register(subparsers: Any) -> None:
         metavar="N",
         help=(
             "after the budget, while the object is not recognised, up to N more sweeps, aimed "
-            "at telling the two leading shapes apart (default 0)"
+            "at telling the two leading shapes apart (with --sizes-within, also while its "
+            "sizes are not known; default 0)"
         ),
     )
     parser.add_argument(
@@ -124,7 +125,8 @@ def _run(args: argparse.Namespace) -> int:
         )
     if args.sizes_within is not None and args.until_recognised == 0:
         raise ArgumentError(
-            "--sizes-within", "sizes are known after the budget: give --until-recognised N too"
+            "--sizes-within",
+            "the sizes are swept for after the budget only: give --until-recognised N too",
         )
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)

@@ -207,11 +207,12 @@ class ExploreSettings:
         which aims at telling them apart; its usual choice when there are no two leading
         primitives); 0 stops at the budget.
     sizes_within : float or None
-        With ``until_recognised``: the manoeuvres after the budget go on also while the named
-        class's sizes are not each known to within this share of themselves
-        (``ClassFit.sizes_known``: twice the standard deviation, widened by the overdispersion,
-        at most this share; 0.05: 5 %), aimed where the named fit is least sure of its surface
-        (``NextBestPlanner.choose`` with that fit); None: naming the object ends them.
+        With ``until_recognised`` (and within its count): the manoeuvres after the budget go on
+        also while the named class's sizes are not each known to within this share of
+        themselves (``ClassFit.sizes_known``: twice the standard deviation, widened by the
+        overdispersion, at most this share; 0.05: 5 %), aimed where the named fit is least sure
+        of its surface (``NextBestPlanner.choose`` with that fit; a named user mesh ends them);
+        None: naming the object ends them.
     """
 
     method: str = "fast"
@@ -235,8 +236,15 @@ class ExploreSettings:
         if self.until_recognised < 0:
             raise ValueError("until_recognised must be at least 0")
         within = self.sizes_within
-        if within is not None and not (isinstance(within, float | int) and 0.0 < within <= 1.0):
-            raise ValueError(f"sizes_within must be a share in (0, 1], got {within!r}")
+        if within is not None:
+            if isinstance(within, bool) or not isinstance(within, float | int):
+                raise ValueError(f"sizes_within must be a share in (0, 1], got {within!r}")
+            if not 0.0 < within <= 1.0:
+                raise ValueError(f"sizes_within must be a share in (0, 1], got {within!r}")
+            if self.until_recognised == 0:
+                raise ValueError(
+                    "sizes_within is for the sweeps after the budget: give until_recognised too"
+                )
         if self.link not in LINK_MODELS:
             raise ValueError(f"link must be one of {', '.join(LINK_MODELS)}")
         if self.device_profile not in DEVICE_PROFILES:

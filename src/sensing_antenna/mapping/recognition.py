@@ -558,8 +558,11 @@ class ClassFit:
     def sizes_known(self, within: float) -> bool:
         """Whether every size is known to within the share ``within`` of itself (0.05: 5 %):
         twice its standard deviation (about a 95 % interval's half-width) at most that share of
-        it. A size the points do not measure or only bound from below is not known; a fit
-        without sizes (a user mesh) is."""
+        it, each size on its own (a capsule's short length as its radius). A size the points do
+        not measure or only bound from below is not known; a plane (no sizes) and a user mesh
+        (registered at its own size) are."""
+        if self.name.startswith("mesh:"):
+            return True
         return all(
             2.0 * self.size_std.get(name, math.inf) <= within * size
             for name, size in self.sizes.items()
