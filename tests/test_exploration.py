@@ -461,6 +461,19 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
         )
     truth = view.geometry["truth"]
     assert np.allclose(truth.bounds, load_scene("post").mesh.bounds)
+    # going on after the budget: two points are too few to recognise, so the sweep is aimed at
+    # recognition, and the summary says so
+    more = ["--until-recognised", "1", "--sizes-within", "0.05"]
+    assert (
+        main(["explore", "post", "--out", str(out), "--budget", "2", "--method", "fast", *more])
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert "3 manoeuvres (" in text and "; after the budget, aimed at recognition 1)" in text
+    assert json.loads((out / "exploration.json").read_text())["aims"] == {
+        "plan": 2,
+        "recognition": 1,
+    }
 
 
 def test_the_command_offers_the_librarys_strategies_scenes_and_devices() -> None:
@@ -577,6 +590,7 @@ def test_an_unrecognised_object_is_swept_on_after_the_budget(
     assert set(sweeps[4:]) <= set(candidate_sweeps(scene))
     assert all(np.isfinite(m.score) for m in first.manoeuvres[4:])
     assert [m.aim for m in first.manoeuvres] == ["plan"] * 4 + ["recognition"] * 2
+    assert first.summary()["aims"] == {"plan": 4, "recognition": 2}
     again = explore(scene, DEVICE, out, settings)
     assert [m.to_dict() for m in again.manoeuvres] == [m.to_dict() for m in first.manoeuvres]
     grown = explore(scene, DEVICE, out, ExploreSettings(method="paper", budget=7))

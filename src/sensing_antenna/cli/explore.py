@@ -168,9 +168,11 @@ def _run(args: argparse.Namespace) -> int:
     summary = result.summary()
     (args.out / "exploration.json").write_text(json.dumps(summary, indent=2) + "\n")
     outcomes = ", ".join(f"{k} {v}" for k, v in sorted(summary["outcomes"].items()))
+    after = ", ".join(f"{k} {v}" for k, v in sorted(summary["aims"].items()) if k != "plan")
     print(
-        f"{summary['manoeuvres']} manoeuvres ({outcomes}), {summary['sweep_time_s']:.0f} s of"
-        " sweeping"
+        f"{summary['manoeuvres']} manoeuvres ({outcomes}"
+        + (f"; after the budget, aimed at {after}" if after else "")
+        + f"), {summary['sweep_time_s']:.0f} s of sweeping"
     )
     report_map(result.contact_map, args.out, scene.mesh)
     print(f"  {args.out / 'manoeuvres.csv'}\n  {args.out / 'scene.ply'}")

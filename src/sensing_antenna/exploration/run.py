@@ -321,17 +321,20 @@ class Exploration:
         return [m.point for m in self.manoeuvres if m.point is not None]
 
     def summary(self) -> dict[str, Any]:
-        """Counts by outcome, the contacts used, the simulated sweeping time (s), and the map's
-        own summary."""
+        """Counts by outcome and by aim (``Manoeuvre.aim``), the contacts used, the simulated
+        sweeping time (s), and the map's own summary."""
         outcomes: dict[str, int] = {}
+        aims: dict[str, int] = {}
         for m in self.manoeuvres:
             outcomes[m.outcome] = outcomes.get(m.outcome, 0) + 1
+            aims[m.aim] = aims.get(m.aim, 0) + 1
         return {
             "scene": self.scene.name,
             "method": self.settings.method,
             "strategy": self.settings.strategy,
             "manoeuvres": len(self.manoeuvres),
             "outcomes": outcomes,
+            "aims": aims,
             "sweep_time_s": float(sum(m.sweep_time for m in self.manoeuvres)),
             "map": self.contact_map.summary(),
         }
