@@ -237,9 +237,8 @@ class ExploreSettings:
             raise ValueError("until_recognised must be at least 0")
         within = self.sizes_within
         if within is not None:
-            if isinstance(within, bool) or not isinstance(within, float | int):
-                raise ValueError(f"sizes_within must be a share in (0, 1], got {within!r}")
-            if not 0.0 < within <= 1.0:
+            number = isinstance(within, float | int) and not isinstance(within, bool)
+            if not number or not 0.0 < within <= 1.0:
                 raise ValueError(f"sizes_within must be a share in (0, 1], got {within!r}")
             if self.until_recognised == 0:
                 raise ValueError(
@@ -633,7 +632,9 @@ def explore(
                     choice = planner.choose(done, surface, free, leaders)
                 elif index < end + settings.until_recognised:
                     named, leaders = recognised(manoeuvres)
-                    if named is not None and _sizes_known(named, settings.sizes_within):
+                    within = settings.sizes_within
+                    # a recognition that names the object has it as its best fit
+                    if named is not None and (within is None or named.best.sizes_known(within)):
                         final = named  # of every point and swept link: the map's own
                         break
                     chooser = chooser if chooser is not None else NextBestPlanner(scene, shape)
@@ -723,14 +724,6 @@ def swept_links(
         theta = np.array([sweep.angles(float(a)) for a in before]).reshape(-1, 2)
         free.append([(base, theta), *pieces])
     return free_space(free, antenna), touches(touched, antenna)
-
-
-def _sizes_known(recognition: Recognition, within: float | None) -> bool:
-    """Whether the object ``recognition`` names is known well enough to stop sweeping: its
-    sizes each within ``within`` of themselves (``ClassFit.sizes_known``), or always when
-    None."""
-    named = recognition.named
-    return within is None or (named is not None and named.sizes_known(within))
 
 
 def _recognition_state(
