@@ -560,8 +560,8 @@ class ClassFit:
         twice its standard deviation (about a 95 % interval's half-width) at most that share of
         it, each size on its own (a capsule's short length as its radius). A size the points do
         not measure or only bound from below is not known; a plane (no sizes) and a user mesh
-        (registered at its own size) are."""
-        if self.name.startswith("mesh:"):
+        (no primitive class: registered at its own size) are."""
+        if self.name not in PRIMITIVES:
             return True
         return all(
             2.0 * self.size_std.get(name, math.inf) <= within * size
