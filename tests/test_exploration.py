@@ -676,7 +676,7 @@ def test_a_named_object_is_swept_on_until_its_sizes_are_known(
     # each sweep for sizes aimed with the named fit
     sized = [a for a, m in zip(aimed, result.manoeuvres[2:], strict=True) if m.aim == "sizes"]
     assert [[fit.name for fit in a] for a in sized] == [["sphere"]] * aims.count("sizes")
-    if len(aims) < 2:  # stopped once the sizes were known: that recognition is the map's
+    if len(aims) < settings.until_recognised:  # stopped once known: that recognition is the map's
         assert result.contact_map.recognition is asked[-1]
 
 
