@@ -423,6 +423,7 @@ def run(
     )
     elapsed = time.perf_counter() - start
     manoeuvres = result.manoeuvres
+    summary = result.summary()
     mesh = scene.objects[0].mesh
     used = [p for p in result.contact_map.used]
     row: dict[str, Any] = {
@@ -430,10 +431,10 @@ def run(
         "sweeps": len(manoeuvres),
         "contacts": sum(m.outcome == "touch" for m in manoeuvres),
         "used": len(used),
-        "outcomes": result.summary()["outcomes"],
-        "sweep_time_s": result.summary()["sweep_time_s"],
+        "outcomes": summary["outcomes"],
+        "sweep_time_s": summary["sweep_time_s"],
         "run_s": elapsed,
-        "aims": {aim: sum(m.aim == aim for m in manoeuvres) for aim in AIMS},
+        "aims": {aim: summary["aims"].get(aim, 0) for aim in AIMS},
         "resumed": resumed,
     }
     if used:
