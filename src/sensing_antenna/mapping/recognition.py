@@ -236,6 +236,21 @@ MIN_SIZE = 1e-4
 #: rank second may suit them best.
 REFINED_STARTS = 3
 
+#: The fits a decision weighs are refined again from this many starts drawn around each: the
+#: link's lines and the swept links make the residuals rough, and a fit can stop in one of
+#: several minima a few millimetres apart whose chi^2 differ by more than the points tell
+#: classes apart by; which one it finds must not decide the answer.
+RESTARTS_AROUND = 4
+
+#: Which fits are refined again: those whose chi^2 (over the overdispersion) lies within this
+#: many abstention thresholds of the best's, the classes a decision compares.
+CONTENDER_SPAN = 2.0
+
+#: The starts around a fit are drawn from its parameter covariance, each principal deviation
+#: at most this share of the points' spread (m, and rad for a rotation): a direction the
+#: evidence does not hold would otherwise throw a start beyond the points.
+RESTART_REACH = 0.1
+
 #: How far along the link each way from a contact its line is checked against a fit (m).
 LINE_STRETCH = 0.04
 
@@ -1136,6 +1151,7 @@ def fit_primitive(
     rng: np.random.Generator | None = None,
     lines: LinkLines | None = None,
     swept: Sequence[FreeSpace] = (),
+    around: Sequence[ArrayLike] = (),
 ) -> ClassFit:
     """Fit one class to the points (module docstring).
 
@@ -1158,6 +1174,9 @@ def fit_primitive(
         Where links swept untouched (:class:`FreeSpace`) and where they touched
         (:class:`~sensing_antenna.mapping.free_space.Touches`): a residual per sweep or contact
         (module docstring).
+    around : sequence of arrays, shape (p,) each
+        Parameter vectors near an earlier fit of this class: the fit is refined from these
+        alone, instead of from starts of the points' geometry (:func:`recognise`'s restarts).
     """
     model = PRIMITIVES[shape] if isinstance(shape, str) else shape
     p = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -1320,7 +1339,7 @@ def fit_primitive(
     # start with them, and the best few of the points-alone fits refined: the lines make the
     # problem rough, and either path may be the one that finds the shape
     alone, direct = [], []
-    for start in _starts(model, p, direction, generator):
+    for start in _starts(model, p, direction, generator) if not len(around) else []:
         start = np.clip(start, low, high)
         try:
             alone.append(fit(start, sigma, False, MAX_EVALUATIONS, search=False))
@@ -1328,12 +1347,13 @@ def fit_primitive(
                 direct.append(fit(start, sigma, True, MAX_EVALUATIONS, search=False).x)
         except ValueError:  # a start outside the model's domain
             continue
-    assert alone
+    assert alone or len(around)
     alone.sort(key=lambda solution: solution.cost)
     chosen = alone[: REFINED_STARTS if link_evidence else 1]
     # each refined twice: a start the Euclidean distances grew past edges counts the points
     # there wrong, and the second refinement, from the first's shape, takes them back
     starts = [solution.x for solution in chosen] + direct
+    starts += [np.clip(np.asarray(v, dtype=float), low, high) for v in around]
     candidates = [refine(refine(start, exclude=False)) for start in starts]
     x = model.canonical(min(candidates, key=total) if len(candidates) > 1 else candidates[0])
     distance = model.signed_distance(x, p)
@@ -1787,6 +1807,42 @@ def _outward(points: FloatArray, outward: ArrayLike | None) -> FloatArray:
     return direction / norm if norm > 0 else np.array([0.0, 0.0, 1.0])
 
 
+def _restarted(
+    fits: list[ClassFit],
+    points: FloatArray,
+    covariances: FloatArray,
+    outward: ArrayLike | None,
+    threshold: float,
+    rng: np.random.Generator,
+    lines: LinkLines | None,
+    swept: Sequence[FreeSpace],
+) -> list[ClassFit]:
+    """The primitive ``fits`` with each contender (:data:`CONTENDER_SPAN`) refined again from
+    :data:`RESTARTS_AROUND` starts drawn around it (:data:`RESTART_REACH`), kept where that
+    lowers its chi^2."""
+    tightest = min(fits, key=lambda f: f.chi2)
+    c = max(1.0, tightest.chi2 / max(tightest.counted - tightest.dof, 1.0))
+    reach = RESTART_REACH * _spread(points)
+    kept = []
+    for f in fits:
+        n = len(f.vector)
+        held = f.covariance.shape == (n, n) and bool(np.all(np.isfinite(f.covariance)))
+        if not held or (f.chi2 - tightest.chi2) / c >= CONTENDER_SPAN * threshold:
+            kept.append(f)
+            continue
+        variances, directions = np.linalg.eigh(0.5 * (f.covariance + f.covariance.T))
+        deviation = np.minimum(np.sqrt(np.clip(variances, 0.0, None)), reach)
+        starts = [
+            f.vector + directions @ (deviation * rng.standard_normal(n))
+            for _ in range(RESTARTS_AROUND)
+        ]
+        again = fit_primitive(
+            f.name, points, covariances, outward, rng, lines, swept, around=starts
+        )
+        kept.append(again if again.chi2 < f.chi2 else f)
+    return kept
+
+
 def confidence_floor(threshold: float) -> float:
     """The best class's weight against one runner-up ``threshold`` behind in score,
     1 / (1 + exp(-threshold / 2)): at the abstention threshold, the confidence a decision needs
@@ -1836,6 +1892,7 @@ def recognise(
     generator = rng if rng is not None else np.random.default_rng(0)
     names = list(classes) if classes is not None else list(PRIMITIVES)
     fits = [fit_primitive(name, p, cov, outward, generator, lines, swept) for name in names]
+    fits = _restarted(fits, p, cov, outward, threshold, generator, lines, swept)
     for name, mesh in (meshes or {}).items():
         fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines, swept=swept))
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
