@@ -246,10 +246,26 @@ RESTARTS_AROUND = 4
 #: many abstention thresholds of the best's, the classes a decision compares.
 CONTENDER_SPAN = 2.0
 
-#: The starts around a fit are drawn from its parameter covariance, each principal deviation
-#: at most this share of the points' spread (m, and rad for a rotation): a direction the
+#: The starts around a fit are drawn from its parameter covariance, each length (a centre's
+#: coordinate, a size) moved by at most this share of the points' spread: a direction the
 #: evidence does not hold would otherwise throw a start beyond the points.
 RESTART_REACH = 0.1
+
+#: ... and each angle (a rotation vector's component, a plane's normal) by at most this (rad).
+RESTART_TURN = 0.5
+
+#: The parameters that are angles (rad); every other is a length (m).
+ANGLES = frozenset({"wx", "wy", "wz", "polar", "azimuth"})
+
+#: A posed fit is also refined again with its axis (its frame's Z) turned onto each of the five
+#: other axes of an icosahedron that shares it: atan 2 = 63.4 degrees away, at five azimuths
+#: 72 degrees apart, the most evenly six axes can be spread. Starts along the points' principal
+#: axes can leave a fit's axis across the shape's (a squat cylinder, a ball's rival cylinder),
+#: where no start nearby finds it.
+TURNS = tuple(
+    Rotation.from_rotvec(math.atan(2.0) * np.array([-math.sin(a), math.cos(a), 0.0]))
+    for a in np.arange(5) * 2.0 * math.pi / 5.0
+)
 
 #: How far along the link each way from a contact its line is checked against a fit (m).
 LINE_STRETCH = 0.04
@@ -1818,29 +1834,50 @@ def _restarted(
     swept: Sequence[FreeSpace],
 ) -> list[ClassFit]:
     """The primitive ``fits`` with each contender (:data:`CONTENDER_SPAN`) refined again from
-    :data:`RESTARTS_AROUND` starts drawn around it (:data:`RESTART_REACH`), kept where that
-    lowers its chi^2."""
+    starts around it (:func:`_refit_around`)."""
     tightest = min(fits, key=lambda f: f.chi2)
     c = max(1.0, tightest.chi2 / max(tightest.counted - tightest.dof, 1.0))
     reach = RESTART_REACH * _spread(points)
     kept = []
     for f in fits:
-        n = len(f.vector)
-        held = f.covariance.shape == (n, n) and bool(np.all(np.isfinite(f.covariance)))
-        if not held or (f.chi2 - tightest.chi2) / c >= CONTENDER_SPAN * threshold:
+        if f.name not in PRIMITIVES or (f.chi2 - tightest.chi2) / c >= CONTENDER_SPAN * threshold:
             kept.append(f)
             continue
-        variances, directions = np.linalg.eigh(0.5 * (f.covariance + f.covariance.T))
-        deviation = np.minimum(np.sqrt(np.clip(variances, 0.0, None)), reach)
-        starts = [
-            f.vector + directions @ (deviation * rng.standard_normal(n))
-            for _ in range(RESTARTS_AROUND)
-        ]
-        again = fit_primitive(
-            f.name, points, covariances, outward, rng, lines, swept, around=starts
-        )
-        kept.append(again if again.chi2 < f.chi2 else f)
+        kept.append(_refit_around(f, points, covariances, outward, rng, lines, swept, reach))
     return kept
+
+
+def _refit_around(
+    f: ClassFit,
+    points: FloatArray,
+    covariances: FloatArray,
+    outward: ArrayLike | None,
+    rng: np.random.Generator,
+    lines: LinkLines | None,
+    swept: Sequence[FreeSpace],
+    reach: float,
+) -> ClassFit:
+    """``f`` refined again from :data:`RESTARTS_AROUND` starts drawn from its covariance and,
+    for a posed class, with its axis turned by each of :data:`TURNS`; of the two, the lower
+    chi^2."""
+    n = len(f.vector)
+    names = PRIMITIVES[f.name].parameter_names
+    caps = np.array([RESTART_TURN if name in ANGLES else reach for name in names])
+    if f.covariance.shape == (n, n) and np.all(np.isfinite(f.covariance)):
+        variances, directions = np.linalg.eigh(0.5 * (f.covariance + f.covariance.T))
+        root = directions * np.sqrt(np.clip(variances, 0.0, None))
+    else:  # a direction the points do not hold: as far as the caps let
+        root = np.diag(caps)
+    steps = [root @ rng.standard_normal(n) for _ in range(RESTARTS_AROUND)]
+    starts = [f.vector + np.clip(step, -caps, caps) for step in steps]
+    if names[3:6] == ("wx", "wy", "wz"):
+        pose = Rotation.from_rotvec(f.vector[3:6])
+        for turn in TURNS:
+            turned = f.vector.copy()
+            turned[3:6] = (pose * turn).as_rotvec()
+            starts.append(turned)
+    again = fit_primitive(f.name, points, covariances, outward, rng, lines, swept, around=starts)
+    return again if again.chi2 < f.chi2 else f
 
 
 def confidence_floor(threshold: float) -> float:
