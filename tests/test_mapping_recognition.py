@@ -231,11 +231,11 @@ def test_a_capsule_shrunk_to_a_sphere_is_the_same_shape() -> None:
 
 def test_a_capsule_shrunk_onto_a_ball_is_not_its_runner_up() -> None:
     # the capsule's segment shrinks to a few mm on a ball's points and trails the sphere by
-    # its extra parameters' penalty (3 ln 30 = 10.2 less the 2.3 it gains): under a
+    # its extra parameters' penalty (3 ln 30 = 10.2 less the 2.2 it gains): under a
     # threshold of 20 it would make the decision abstain between two names of one ball. It
     # is the same shape, and the points do not favour it: the decision is the sphere against
     # the next shape, with the capsule's weight
-    rng = np.random.default_rng(4)
+    rng = np.random.default_rng(9)
     mesh = trimesh.creation.icosphere(subdivisions=3, radius=0.04)
     mesh.apply_translation([0.5, 0.1, 0.0])
     points, covariances = _sample(mesh, 30, rng)

@@ -1835,6 +1835,8 @@ def _restarted(
 ) -> list[ClassFit]:
     """The primitive ``fits`` with each contender (:data:`CONTENDER_SPAN`) refined again from
     starts around it (:func:`_refit_around`)."""
+    if not fits:  # user meshes only
+        return fits
     tightest = min(fits, key=lambda f: f.chi2)
     c = max(1.0, tightest.chi2 / max(tightest.counted - tightest.dof, 1.0))
     reach = RESTART_REACH * _spread(points)
