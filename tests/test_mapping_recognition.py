@@ -407,10 +407,12 @@ def test_a_squat_cylinder_is_fitted_along_its_own_axis_whichever_copy_of_its_poi
     rng = np.random.default_rng(3)
     radius, height = rng.uniform(0.015, 0.03), rng.uniform(0.03, 0.06)
     mesh = trimesh.creation.cylinder(radius=radius, height=height, sections=128)
-    mesh.apply_transform(_pose(rng))
+    pose = _pose(rng)
+    mesh.apply_transform(pose)
     mesh.apply_translation([0.6, 0.0, 0.0] - mesh.bounding_box.centroid)
     points, tangents = _first_touches(mesh, rng)
     n = len(points)
+    assert n >= 20
     points = points + rng.normal(0.0, NOISE, points.shape)
     covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
     lines = LinkLines(tangents, np.full(n, 0.01), np.full(n, 0.4), np.full(n, 0.3))
@@ -426,6 +428,25 @@ def test_a_squat_cylinder_is_fitted_along_its_own_axis_whichever_copy_of_its_poi
     for f in fits:
         assert f.sizes["radius"] == pytest.approx(radius, rel=SIZE_TOLERANCE)
         assert f.sizes["height"] == pytest.approx(height, rel=SIZE_TOLERANCE)
+        axis = Rotation.from_rotvec(f.vector[3:6]).as_matrix()[:, 2]
+        assert abs(axis @ pose[:3, 2]) > math.cos(math.radians(5.0))
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="a capsule's short segment the points hardly measure can stand apart from the "
+    "ball by more than the points' rms, and so be a rival (docs/mapping.md)",
+)
+def test_a_ball_is_named_though_its_capsule_finds_a_short_segment() -> None:
+    # 30 points over a whole 4 cm ball, 1 mm noise: the capsule's best fit has a 3.5 mm
+    # segment and 5.7 less chi^2 for its three more degrees of freedom (chance: 1 in 8), its
+    # surface 1.02 mm from the ball's against the points' 0.94 mm rms
+    rng = np.random.default_rng(4)
+    mesh = trimesh.creation.icosphere(subdivisions=3, radius=0.04)
+    mesh.apply_translation([0.5, 0.1, 0.0])
+    points, covariances = _sample(mesh, 30, rng)
+    result = recognise(points, covariances, rng=np.random.default_rng(0))
+    assert result.decision == "sphere", result.candidates
 
 
 def test_a_decision_needs_the_weight_the_threshold_stands_for() -> None:

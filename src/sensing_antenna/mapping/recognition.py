@@ -5,9 +5,10 @@ squares of each contact's distance to the surface in its standard deviations (be
 "Distance."; scipy.optimize.least_squares, soft-L1 loss so that one bad point does not drag the
 fit; several starts per class from the points' principal axes and an algebraic sphere, fitted
 first by the Euclidean distance d_i / sigma_i, sigma_i^2 = n_i^T Sigma_i n_i the point's
-variance along the surface's normal n_i, then refined, keeping the lowest cost). A user mesh is
-registered to the points by iterative closest point (trimesh.registration.icp, from several
-starting rotations) and scored the same way with its six pose parameters.
+variance along the surface's normal n_i, then refined, keeping the lowest cost; the classes a
+decision weighs are refined again from starts around their fits, :data:`CONTENDER_SPAN`). A
+user mesh is registered to the points by iterative closest point (trimesh.registration.icp,
+from several starting rotations) and scored the same way with its six pose parameters.
 
 Distance. A contact's point lies on its link's line, far better known across the link than
 along it (the abscissa x_c is what the estimate knows least), and the link touched where its
@@ -242,16 +243,18 @@ REFINED_STARTS = 3
 #: classes apart by; which one it finds must not decide the answer.
 RESTARTS_AROUND = 4
 
-#: Which fits are refined again: those whose chi^2 (over the overdispersion) lies within this
-#: many abstention thresholds of the best's, the classes a decision compares.
+#: Which fits are refined again: the primitive classes whose chi^2 (over the overdispersion)
+#: lies within this many abstention thresholds of the lowest chi^2 of any class.
 CONTENDER_SPAN = 2.0
 
-#: The starts around a fit are drawn from its parameter covariance, each length (a centre's
-#: coordinate, a size) moved by at most this share of the points' spread: a direction the
-#: evidence does not hold would otherwise throw a start beyond the points.
+#: The starts around a fit are drawn from its parameter covariance, each component clipped: a
+#: length (a centre's coordinate, a size) to this share of the points' spread, as a direction
+#: the evidence does not hold would otherwise throw a start beyond the points...
 RESTART_REACH = 0.1
 
-#: ... and each angle (a rotation vector's component, a plane's normal) by at most this (rad).
+#: ... and an angle (a rotation vector's component, a plane's normal) to this (rad). A class's
+#: free spin about its own axis has a variance far beyond it, so a posed fit's draws tilt its
+#: axis by tens of degrees, at the corners of the clip.
 RESTART_TURN = 0.5
 
 #: The parameters that are angles (rad); every other is a length (m).
@@ -1191,8 +1194,9 @@ def fit_primitive(
         (:class:`~sensing_antenna.mapping.free_space.Touches`): a residual per sweep or contact
         (module docstring).
     around : sequence of arrays, shape (p,) each
-        Parameter vectors near an earlier fit of this class: the fit is refined from these
-        alone, instead of from starts of the points' geometry (:func:`recognise`'s restarts).
+        Parameter vectors (m, and rad for angles) near an earlier fit of this class: the fit is
+        refined from these alone, instead of from starts of the points' geometry
+        (:func:`recognise`'s restarts).
     """
     model = PRIMITIVES[shape] if isinstance(shape, str) else shape
     p = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -1878,7 +1882,12 @@ def _refit_around(
             turned = f.vector.copy()
             turned[3:6] = (pose * turn).as_rotvec()
             starts.append(turned)
-    again = fit_primitive(f.name, points, covariances, outward, rng, lines, swept, around=starts)
+    try:
+        again = fit_primitive(
+            f.name, points, covariances, outward, rng, lines, swept, around=starts
+        )
+    except ValueError:  # a start where the residuals are not finite: the fit stands
+        return f
     return again if again.chi2 < f.chi2 else f
 
 
@@ -1900,7 +1909,8 @@ def recognise(
     lines: LinkLines | None = None,
     swept: Sequence[FreeSpace] = (),
 ) -> Recognition:
-    """Fit every class (and mesh) to the points and decide (module docstring).
+    """Fit every class (and mesh) to the points, refine the contenders again
+    (:data:`CONTENDER_SPAN`) and decide (module docstring).
 
     Parameters
     ----------
