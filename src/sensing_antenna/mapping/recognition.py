@@ -5,10 +5,9 @@ squares of each contact's distance to the surface in its standard deviations (be
 "Distance."; scipy.optimize.least_squares, soft-L1 loss so that one bad point does not drag the
 fit; several starts per class from the points' principal axes and an algebraic sphere, fitted
 first by the Euclidean distance d_i / sigma_i, sigma_i^2 = n_i^T Sigma_i n_i the point's
-variance along the surface's normal n_i, then refined, keeping the lowest cost; the classes a
-decision weighs are refined again from starts around their fits, :data:`CONTENDER_SPAN`). A
-user mesh is registered to the points by iterative closest point (trimesh.registration.icp,
-from several starting rotations) and scored the same way with its six pose parameters.
+variance along the surface's normal n_i, then refined, keeping the lowest cost). A user mesh is
+registered to the points by iterative closest point (trimesh.registration.icp, from several
+starting rotations) and scored the same way with its six pose parameters.
 
 Distance. A contact's point lies on its link's line, far better known across the link than
 along it (the abscissa x_c is what the estimate knows least), and the link touched where its
@@ -236,39 +235,6 @@ MIN_SIZE = 1e-4
 #: the fits started with them: the lines make the problem rough, and a pose the points alone
 #: rank second may suit them best.
 REFINED_STARTS = 3
-
-#: The fits a decision weighs are refined again from this many starts drawn around each: the
-#: link's lines and the swept links make the residuals rough, and a fit can stop in one of
-#: several minima a few millimetres apart whose chi^2 differ by more than the points tell
-#: classes apart by; which one it finds must not decide the answer.
-RESTARTS_AROUND = 4
-
-#: Which fits are refined again: the primitive classes whose chi^2 (over the overdispersion)
-#: lies within this many abstention thresholds of the lowest chi^2 of any class.
-CONTENDER_SPAN = 2.0
-
-#: The starts around a fit are drawn from its parameter covariance, each component clipped: a
-#: length (a centre's coordinate, a size) to this share of the points' spread, as a direction
-#: the evidence does not hold would otherwise throw a start beyond the points...
-RESTART_REACH = 0.1
-
-#: ... and an angle (a rotation vector's component, a plane's normal) to this (rad). A class's
-#: free spin about its own axis has a variance far beyond it, so a posed fit's draws tilt its
-#: axis by tens of degrees, at the corners of the clip.
-RESTART_TURN = 0.5
-
-#: The parameters that are angles (rad); every other is a length (m).
-ANGLES = frozenset({"wx", "wy", "wz", "polar", "azimuth"})
-
-#: A posed fit is also refined again with its axis (its frame's Z) turned onto each of the five
-#: other axes of an icosahedron that shares it: atan 2 = 63.4 degrees away, at five azimuths
-#: 72 degrees apart, the most evenly six axes can be spread. Starts along the points' principal
-#: axes can leave a fit's axis across the shape's (a squat cylinder, a ball's rival cylinder),
-#: where no start nearby finds it.
-TURNS = tuple(
-    Rotation.from_rotvec(math.atan(2.0) * np.array([-math.sin(a), math.cos(a), 0.0]))
-    for a in np.arange(5) * 2.0 * math.pi / 5.0
-)
 
 #: How far along the link each way from a contact its line is checked against a fit (m).
 LINE_STRETCH = 0.04
@@ -1170,7 +1136,6 @@ def fit_primitive(
     rng: np.random.Generator | None = None,
     lines: LinkLines | None = None,
     swept: Sequence[FreeSpace] = (),
-    around: Sequence[ArrayLike] = (),
 ) -> ClassFit:
     """Fit one class to the points (module docstring).
 
@@ -1193,10 +1158,6 @@ def fit_primitive(
         Where links swept untouched (:class:`FreeSpace`) and where they touched
         (:class:`~sensing_antenna.mapping.free_space.Touches`): a residual per sweep or contact
         (module docstring).
-    around : sequence of arrays, shape (p,) each
-        Parameter vectors (m, and rad for angles) near an earlier fit of this class: the fit is
-        refined from these alone, instead of from starts of the points' geometry
-        (:func:`recognise`'s restarts).
     """
     model = PRIMITIVES[shape] if isinstance(shape, str) else shape
     p = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -1359,7 +1320,7 @@ def fit_primitive(
     # start with them, and the best few of the points-alone fits refined: the lines make the
     # problem rough, and either path may be the one that finds the shape
     alone, direct = [], []
-    for start in _starts(model, p, direction, generator) if not len(around) else []:
+    for start in _starts(model, p, direction, generator):
         start = np.clip(start, low, high)
         try:
             alone.append(fit(start, sigma, False, MAX_EVALUATIONS, search=False))
@@ -1367,13 +1328,12 @@ def fit_primitive(
                 direct.append(fit(start, sigma, True, MAX_EVALUATIONS, search=False).x)
         except ValueError:  # a start outside the model's domain
             continue
-    assert alone or len(around)
+    assert alone
     alone.sort(key=lambda solution: solution.cost)
     chosen = alone[: REFINED_STARTS if link_evidence else 1]
     # each refined twice: a start the Euclidean distances grew past edges counts the points
     # there wrong, and the second refinement, from the first's shape, takes them back
     starts = [solution.x for solution in chosen] + direct
-    starts += [np.clip(np.asarray(v, dtype=float), low, high) for v in around]
     candidates = [refine(refine(start, exclude=False)) for start in starts]
     x = model.canonical(min(candidates, key=total) if len(candidates) > 1 else candidates[0])
     distance = model.signed_distance(x, p)
@@ -1827,70 +1787,6 @@ def _outward(points: FloatArray, outward: ArrayLike | None) -> FloatArray:
     return direction / norm if norm > 0 else np.array([0.0, 0.0, 1.0])
 
 
-def _restarted(
-    fits: list[ClassFit],
-    points: FloatArray,
-    covariances: FloatArray,
-    outward: ArrayLike | None,
-    threshold: float,
-    rng: np.random.Generator,
-    lines: LinkLines | None,
-    swept: Sequence[FreeSpace],
-) -> list[ClassFit]:
-    """The primitive ``fits`` with each contender (:data:`CONTENDER_SPAN`) refined again from
-    starts around it (:func:`_refit_around`)."""
-    if not fits:  # user meshes only
-        return fits
-    tightest = min(fits, key=lambda f: f.chi2)
-    c = max(1.0, tightest.chi2 / max(tightest.counted - tightest.dof, 1.0))
-    reach = RESTART_REACH * _spread(points)
-    kept = []
-    for f in fits:
-        if f.name not in PRIMITIVES or (f.chi2 - tightest.chi2) / c >= CONTENDER_SPAN * threshold:
-            kept.append(f)
-            continue
-        kept.append(_refit_around(f, points, covariances, outward, rng, lines, swept, reach))
-    return kept
-
-
-def _refit_around(
-    f: ClassFit,
-    points: FloatArray,
-    covariances: FloatArray,
-    outward: ArrayLike | None,
-    rng: np.random.Generator,
-    lines: LinkLines | None,
-    swept: Sequence[FreeSpace],
-    reach: float,
-) -> ClassFit:
-    """``f`` refined again from :data:`RESTARTS_AROUND` starts drawn from its covariance and,
-    for a posed class, with its axis turned by each of :data:`TURNS`; of the two, the lower
-    chi^2."""
-    n = len(f.vector)
-    names = PRIMITIVES[f.name].parameter_names
-    caps = np.array([RESTART_TURN if name in ANGLES else reach for name in names])
-    if f.covariance.shape == (n, n) and np.all(np.isfinite(f.covariance)):
-        variances, directions = np.linalg.eigh(0.5 * (f.covariance + f.covariance.T))
-        root = directions * np.sqrt(np.clip(variances, 0.0, None))
-    else:  # a direction the points do not hold: as far as the caps let
-        root = np.diag(caps)
-    steps = [root @ rng.standard_normal(n) for _ in range(RESTARTS_AROUND)]
-    starts = [f.vector + np.clip(step, -caps, caps) for step in steps]
-    if names[3:6] == ("wx", "wy", "wz"):
-        pose = Rotation.from_rotvec(f.vector[3:6])
-        for turn in TURNS:
-            turned = f.vector.copy()
-            turned[3:6] = (pose * turn).as_rotvec()
-            starts.append(turned)
-    try:
-        again = fit_primitive(
-            f.name, points, covariances, outward, rng, lines, swept, around=starts
-        )
-    except ValueError:  # a start where the residuals are not finite: the fit stands
-        return f
-    return again if again.chi2 < f.chi2 else f
-
-
 def confidence_floor(threshold: float) -> float:
     """The best class's weight against one runner-up ``threshold`` behind in score,
     1 / (1 + exp(-threshold / 2)): at the abstention threshold, the confidence a decision needs
@@ -1909,8 +1805,7 @@ def recognise(
     lines: LinkLines | None = None,
     swept: Sequence[FreeSpace] = (),
 ) -> Recognition:
-    """Fit every class (and mesh) to the points, refine the contenders again
-    (:data:`CONTENDER_SPAN`) and decide (module docstring).
+    """Fit every class (and mesh) to the points and decide (module docstring).
 
     Parameters
     ----------
@@ -1941,7 +1836,6 @@ def recognise(
     generator = rng if rng is not None else np.random.default_rng(0)
     names = list(classes) if classes is not None else list(PRIMITIVES)
     fits = [fit_primitive(name, p, cov, outward, generator, lines, swept) for name in names]
-    fits = _restarted(fits, p, cov, outward, threshold, generator, lines, swept)
     for name, mesh in (meshes or {}).items():
         fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines, swept=swept))
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
