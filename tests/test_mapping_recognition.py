@@ -434,10 +434,11 @@ def test_a_decision_needs_the_weight_the_threshold_stands_for() -> None:
 
 def test_points_on_one_side_of_a_torus_whose_fit_stays_far_off_name_no_other_class() -> None:
     # 60 points on the side of a torus (major radius 54.0 mm, minor 36.6 mm) facing the base,
-    # each with the covariance of a fast estimate pushed to 5 %, about 3 mm: eval_recognition's
-    # scene 4 (seed 0, 60 contacts), kept as data. The torus's own fit stops far from its
-    # minimum (chi^2 about 200 against 34 at the shape), a flat cone fits best and a box nearly
-    # as well: the decision must not name the cone (or any class but the torus) confidently
+    # each drawn from the covariance of a fast estimate pushed to 5 % (standard deviations of 4
+    # to 6 mm): eval_recognition's scene 4 (seed 0, 60 contacts), kept as data. The torus's own
+    # fit stops far from its minimum (chi^2 about 200; refined from starts around it, 34), a
+    # flat cone fits best and a box nearly as well: the decision must not name the cone (or any
+    # class but the torus) confidently, whichever generator draws the fits' random starts
     table = np.loadtxt(
         Path(__file__).parent / "data" / "torus_side_60_points.csv", delimiter=",", skiprows=1
     )
