@@ -3,7 +3,8 @@
 Each primitive class (:mod:`~sensing_antenna.mapping.primitives`) is fitted by robust least
 squares of each contact's distance to the surface in its standard deviations (below,
 "Distance."; scipy.optimize.least_squares, soft-L1 loss so that one bad point does not drag the
-fit; several starts per class from the points' principal axes and an algebraic sphere, fitted
+fit; several starts per class from the points' principal axes and an algebraic sphere, and
+for the axisymmetric classes from axes turned over an icosahedron's and sizes scaled, fitted
 first by the Euclidean distance d_i / sigma_i, sigma_i^2 = n_i^T Sigma_i n_i the point's
 variance along the surface's normal n_i, then refined, keeping the lowest cost). A user mesh is
 registered to the points by iterative closest point (trimesh.registration.icp, from several
@@ -118,8 +119,11 @@ best's than :data:`SAME_SHAPE_SIGMAS` times the points' median standard deviatio
 normal. A runner-up whose fitted shape is the best's (the same percentile of their distances
 at most the best fit's RMS distance to the points: apart by less than the points scatter),
 and whose chi^2 / c is within :data:`ABSTAIN_DELTA` of the best's (the points do not tell the
-two apart), is the same object under another class's name: the two score as one class, the
-best's score less 2 ln of their weights over the best's. The decision abstains
+two apart), is the same object under another class's name; so is a class that holds the best's
+as its own special case (a capsule of no segment is a ball), no farther from it than
+:data:`SAME_SHAPE_SIGMAS` of that sigma, whose extra parameters narrow the points' own scatter
+no more than they would narrow noise (the F test at :data:`NESTED_LEVEL`). The two score as
+one class, the best's score less 2 ln of their weights over the best's. The decision abstains
 (``undecided``, naming the best and its rival) when there is a rival, or when the best runner-up
 of another shape scores within :data:`ABSTAIN_DELTA` of that.
 
@@ -146,6 +150,7 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
+from scipy.stats import f as f_distribution
 
 from sensing_antenna.mapping.free_space import FreeSpace
 from sensing_antenna.mapping.primitives import (
@@ -186,6 +191,14 @@ ABSTAIN_DELTA = 6.0
 #: Two fitted shapes farther apart than this many of the points' median standard deviations
 #: (along the normal) somewhere are different objects: points there would have told them apart.
 SAME_SHAPE_SIGMAS = 3.0
+
+#: The classes each class holds as a special case of its own parameters: a capsule whose
+#: segment has no length is a sphere.
+_NESTED = {"capsule": ("sphere",)}
+
+#: The level of the F test by which a richer class's narrower scatter is more than noise
+#: (:func:`_scatter_narrowed`).
+NESTED_LEVEL = 0.95
 
 #: Runner-ups within this many abstention thresholds of the best's score are compared with
 #: its shape: beyond, their weight (below exp(-threshold) of the best's) changes nothing.
@@ -235,6 +248,13 @@ MIN_SIZE = 1e-4
 #: the fits started with them: the lines make the problem rough, and a pose the points alone
 #: rank second may suit them best.
 REFINED_STARTS = 3
+
+#: The sizes of an axisymmetric class's further starts, as multiples of its first starts'
+#: (:func:`_starts`): the algebraic sphere of a patch seen from one side can miss the
+#: radius by that much either way.
+RESIZED_STARTS = (0.5, 2.0)
+
+_GOLDEN = (1.0 + math.sqrt(5.0)) / 2.0
 
 #: How far along the link each way from a contact its line is checked against a fit (m).
 LINE_STRETCH = 0.04
@@ -994,8 +1014,15 @@ def _algebraic_sphere(points: FloatArray) -> tuple[FloatArray, float]:
 
 def _starts(
     shape: Primitive, points: FloatArray, outward: FloatArray, rng: np.random.Generator
-) -> list[FloatArray]:
-    """Initial parameter vectors for ``shape`` from the points' geometry."""
+) -> tuple[list[FloatArray], list[FloatArray]]:
+    """Initial parameter vectors for ``shape`` from the points' geometry: the first starts
+    (the algebraic sphere's centre and radius; the axis along each of the points' principal
+    axes, both senses for the cone; the principal frame and random rotations for the box), and
+    for an axisymmetric class the further ones its points-alone fits also start from: the
+    first start's shape with its axis along each of :data:`_ICOSAHEDRON_AXES` (both senses for
+    a cone), and each first start with its sizes :data:`RESIZED_STARTS` times as large. A
+    squat or one-sided patch gives its principal axes no clear order and its algebraic sphere
+    no clear radius, and a fit from those alone can stop far from the class's best."""
     centroid = points.mean(axis=0)
     centred = points - centroid
     _, spread_sq, axes = np.linalg.svd(centred, full_matrices=False)
@@ -1012,36 +1039,70 @@ def _starts(
         normal = axes[2] if axes[2] @ outward >= 0 else -axes[2]
         polar = math.acos(float(np.clip(normal[2], -1, 1)))
         azimuth = math.atan2(normal[1], normal[0])
-        return [np.array([polar, azimuth, float(normal @ centroid)])]
+        return [np.array([polar, azimuth, float(normal @ centroid)])], []
     if shape.name == "sphere":
-        return [np.array([*centre, radius])]
-    rotations: list[FloatArray] = []
-    for axis in axes:
-        # rotation taking Z to the axis (both senses for the cone)
-        for sense in (1.0, -1.0) if shape.name == "cone" else (1.0,):
-            rotation, _ = Rotation.align_vectors([sense * axis], [[0.0, 0.0, 1.0]])
-            rotations.append(rotation.as_rotvec())
+        return [np.array([*centre, radius])], []
+    senses = (1.0, -1.0) if shape.name == "cone" else (1.0,)
+    rotations = _axis_rotations(axes, senses)
+    size = max(radius, 0.5 * spread)
     if shape.name == "box":
         frame = axes.T if np.linalg.det(axes.T) > 0 else axes.T * np.array([1, 1, -1])
         rotations = [Rotation.from_matrix(frame).as_rotvec()]
         rotations += [Rotation.random(random_state=rng).as_rotvec() for _ in range(5)]
-    size = max(radius, 0.5 * spread)
-    starts = []
-    for rotvec in rotations:
-        z_axis = Rotation.from_rotvec(rotvec).as_matrix()[:, 2]
-        if shape.name == "cylinder":
-            starts.append(np.array([*centre, *rotvec, size, 2 * size]))
-        elif shape.name == "capsule":
-            starts.append(np.array([*centre, *rotvec, size, size]))
-        elif shape.name == "cone":
-            starts.append(np.array([*(centre - 0.5 * size * z_axis), *rotvec, size, 2 * size]))
-        elif shape.name == "torus":
-            # major 0.7, minor 0.3 of the size: a hole of 0.4
-            starts.append(np.array([*centre, *rotvec, 0.4 * size, 0.3 * size]))
-        else:  # box
-            starts.append(np.array([*centre, *rotvec, 1.5 * size, 1.5 * size, 1.5 * size]))
-    return starts
+        return [_posed_start(shape.name, centre, rotvec, size) for rotvec in rotations], []
+    first = [_posed_start(shape.name, centre, rotvec, size) for rotvec in rotations]
+    turned = [
+        _posed_start(shape.name, centre, rotvec, size)
+        for rotvec in _axis_rotations(_ICOSAHEDRON_AXES, senses)
+    ]
+    resized = [
+        _posed_start(shape.name, centre, rotvec, factor * size)
+        for factor in RESIZED_STARTS
+        for rotvec in rotations
+    ]
+    return first, turned + resized
 
+
+def _axis_rotations(axes: FloatArray, senses: tuple[float, ...]) -> list[FloatArray]:
+    """Rotation vectors (rad) taking Z onto each of ``axes`` (unit, shape (k, 3)) in each of
+    ``senses``."""
+    rotations = []
+    for axis in axes:
+        for sense in senses:
+            rotation, _ = Rotation.align_vectors([sense * axis], [[0.0, 0.0, 1.0]])
+            rotations.append(rotation.as_rotvec())
+    return rotations
+
+
+def _posed_start(name: str, centre: FloatArray, rotvec: FloatArray, size: float) -> FloatArray:
+    """A posed class's start: about ``centre`` (m), its own Z axis turned by ``rotvec`` (rad),
+    its sizes in proportion to ``size`` (m)."""
+    z_axis = Rotation.from_rotvec(rotvec).as_matrix()[:, 2]
+    if name == "cylinder":
+        return np.array([*centre, *rotvec, size, 2 * size])
+    if name == "capsule":
+        return np.array([*centre, *rotvec, size, size])
+    if name == "cone":
+        return np.array([*(centre - 0.5 * size * z_axis), *rotvec, size, 2 * size])
+    if name == "torus":
+        # major 0.7, minor 0.3 of the size: a hole of 0.4
+        return np.array([*centre, *rotvec, 0.4 * size, 0.3 * size])
+    return np.array([*centre, *rotvec, 1.5 * size, 1.5 * size, 1.5 * size])  # box
+
+
+#: Six axes through opposite vertices of a regular icosahedron (unit vectors): directions
+#: 63.4 deg apart that cover every axis a shape may have to within 37.4 deg, for the further
+#: starts of the axisymmetric classes (:func:`_starts`).
+_ICOSAHEDRON_AXES = np.array(
+    [
+        [0.0, 1.0, _GOLDEN],
+        [0.0, -1.0, _GOLDEN],
+        [1.0, _GOLDEN, 0.0],
+        [-1.0, _GOLDEN, 0.0],
+        [_GOLDEN, 0.0, 1.0],
+        [-_GOLDEN, 0.0, 1.0],
+    ]
+) / math.sqrt(1.0 + _GOLDEN**2)
 
 #: The sizes the extent prior holds at the points' span, by class: the only sizes an untouched
 #: end can leave as lower bounds (a free radius drifts, and is not measured).
@@ -1317,14 +1378,15 @@ def fit_primitive(
         return float(np.sum(parts) + np.sum(free_parts) + np.sum(prior**2))
 
     # each start fitted on the points alone (a smooth problem); with lines, also from each
-    # start with them, and the best few of the points-alone fits refined: the lines make the
+    # first start with them, and the best few of the points-alone fits refined: the lines make the
     # problem rough, and either path may be the one that finds the shape
     alone, direct = [], []
-    for start in _starts(model, p, direction, generator):
+    starts, further = _starts(model, p, direction, generator)
+    for index, start in enumerate(starts + further):
         start = np.clip(start, low, high)
         try:
             alone.append(fit(start, sigma, False, MAX_EVALUATIONS, search=False))
-            if lines is not None:
+            if lines is not None and index < len(starts):
                 direct.append(fit(start, sigma, True, MAX_EVALUATIONS, search=False).x)
         except ValueError:  # a start outside the model's domain
             continue
@@ -1498,19 +1560,19 @@ def size_std(
     is not finite (NaN throughout: nothing else is judged). ``point_std`` are the points'
     deviations along the normal (m, inf for a point left out). Then each end
     (:meth:`Primitive.growths`) is grown by D and by 2 D, D = max(2 sigma, 3 times a deviation
-    of the points whose distance moves with that end), sigma the largest finite deviation of the
-    sizes it moves: a fit held at the smallest size the points allow has an untouched end at the
-    outermost points, where the distance's derivative differs on either side, and growing it
-    first releases the points within their noise of it, after which only what holds the end
-    resists, as the square of the distance. A rise of the residuals' sum of squares below 1 from
-    D to 2 D leaves the end free: the sizes it moves have no deviation, and those the extent
-    prior holds (a box's extents, a cylinder's height, a capsule's length, a cone's height) are
-    lower bounds, three times the largest deviation of the points at that end (at least the
-    median point's) below the fitted size. Each end is grown at two scales, D from the median
-    and from the largest deviation of its points (a few wide points may be all that hold it),
-    and is held when either resists. Otherwise the rise, 3 D^2 / s^2, gives the end's own
-    deviation s, and each measured size it moves has a deviation of at least s times the rate it
-    moves at.
+    of the points whose distance moves with that end), sigma the largest finite deviation the
+    covariance gives the sizes it moves: a fit held at the smallest size the points allow has an
+    untouched end at the outermost points, where the distance's derivative differs on either
+    side, and growing it first releases the points within their noise of it, after which only
+    what holds the end resists, as the square of the distance. A rise of the residuals' sum of
+    squares below 1 from D to 2 D leaves the end free: the sizes it moves have no deviation, and
+    those the extent prior holds (a box's extents, a cylinder's height, a capsule's length, a
+    cone's height) are lower bounds, three times the largest deviation of the points at that end
+    (at least the median point's) below the fitted size. Each end is grown at two scales, D from
+    the median and from the largest deviation of its points (a few wide points may be all that
+    hold it), and is held when either resists. Otherwise the rise, 3 D^2 / s^2, gives the end's
+    own deviation s, and each measured size it moves has a deviation of at least s times the
+    rate it moves at.
     """
     if np.all(np.isnan(covariance)):
         return np.full(len(shape.size_names), np.inf), np.full(len(shape.size_names), np.nan)
@@ -1519,6 +1581,7 @@ def size_std(
     if np.all(np.isfinite(covariance)):
         deviation = _carried(shape.sizes, x, covariance)
         std = np.where(deviation <= spread, deviation, np.inf)
+    carried = std.copy()  # each end's step from the covariance's deviations, not another end's
     kept = np.isfinite(point_std)  # every point counted wrong: none
     typical = float(np.median(point_std[kept])) if np.any(kept) else 0.0
     held_by_prior = [name in _PRIOR_HELD.get(shape.name, ()) for name in shape.size_names]
@@ -1529,7 +1592,7 @@ def size_std(
         moved = residuals(x + JACOBIAN_STEP * change)[: len(point_std)] - at_x[: len(point_std)]
         attached = kept & (np.abs(moved) * np.where(kept, point_std, 0.0) > 0.5 * JACOBIAN_STEP)
         widths = point_std[attached] if np.any(attached) else np.array([typical])
-        finite = std[list(sizes)][np.isfinite(std[list(sizes)])]
+        finite = carried[list(sizes)][np.isfinite(carried[list(sizes)])]
         least = 2.0 * float(finite.max()) if finite.size else 0.0
         # at two scales: the typical attached point's, and the widest's (a few wide points may
         # be all that hold an end); held when either resists
@@ -1755,6 +1818,22 @@ def _surface_distance(fit: ClassFit, samples: FloatArray) -> FloatArray:
     return np.asarray(distance)
 
 
+def _scatter_narrowed(simpler: ClassFit, richer: ClassFit, level: float = NESTED_LEVEL) -> bool:
+    """Whether a class that holds ``simpler``'s shape as its own special case narrows the
+    points' scatter about it by more than its extra parameters would by fitting noise: the F
+    test of nested least squares at ``level``, F = ((RSS_s - RSS_r) / k) / (RSS_r / (n - p_r))
+    with RSS the points' squared distances (n RMS^2), k the extra parameters and p_r the
+    richer's. It reads the points' own scatter, not their covariances, which may be wider than
+    the points' errors. False when the test cannot be made (no extra parameter, no residual
+    degree of freedom, a perfect fit)."""
+    n = simpler.n_points
+    extra, left = richer.dof - simpler.dof, n - richer.dof
+    if extra <= 0 or left <= 0 or not richer.rms > 0.0:
+        return False
+    statistic = (simpler.rms**2 / richer.rms**2 - 1.0) * left / extra
+    return bool(statistic > f_distribution.ppf(level, extra, left))
+
+
 def shape_gap(a: ClassFit, b: ClassFit, seed: int = 0) -> float:
     """How far two fitted shapes are apart (m): the 95th percentile of the distances from
     :data:`SHAPE_SAMPLES` points on each surface to the other surface; inf when either is
@@ -1874,12 +1953,25 @@ def recognise(
             gaps[f.name] = shape_gap(best, f)
         return gaps[f.name]
 
+    def same_shape(f: ClassFit) -> bool:
+        # apart by no more than the points scatter about the best; or a class that holds the
+        # best's shape as its own special case (a capsule of no segment is a ball), not apart
+        # by as much as a rival must be, whose extra parameters narrow the points' own scatter
+        # no more than fitting noise does
+        if gap(f) <= best.rms:
+            return True
+        return (
+            best.name in _NESTED.get(f.name, ())
+            and gap(f) <= SAME_SHAPE_SIGMAS * sigma
+            and not _scatter_narrowed(best, f)
+        )
+
     same = [
         f
         for f in fits[1:]
         if f.score - best.score < SAME_SHAPE_SCORE * threshold
         and abs(best.chi2 - f.chi2) / c < threshold
-        and gap(f) <= best.rms
+        and same_shape(f)
     ]
     merged = {f.name for f in same}
     others = [f for f in fits[1:] if f.name not in merged]
