@@ -400,7 +400,10 @@ def test_the_lines_that_touched_tell_a_box_from_a_cylinder(name: str) -> None:
     # a line swept towards a box first meets it on an edge, and a cylinder fits points on a
     # box's edges nearly as well as the box: the lines tell them apart, as a cylinder through
     # those points is not tangent to the lines that touched them; on a cylinder, the lines
-    # cost the cylinder nothing
+    # cost the cylinder nothing. These 24 points on one side of the cylinder are fitted as
+    # well by a torus whose tube is the cylinder (major radius about 19 cm, chi^2 15.7 against
+    # 20.9, the lines costing neither): the decision may abstain between the two, never name
+    # the box
     rng = np.random.default_rng(3)
     mesh = SHAPES[name][0]()
     mesh.apply_transform(_pose(rng))
@@ -413,7 +416,9 @@ def test_the_lines_that_touched_tell_a_box_from_a_cylinder(name: str) -> None:
     pivots_far = np.full(n, 0.4)
     lines = LinkLines(tangents, np.full(n, 0.01), pivots_far, np.full(n, 0.3))
     result = recognise(points, covariances, rng=np.random.default_rng(0), lines=lines)
-    assert result.decision == name, (result.decision, result.candidates)
+    allowed = (name,) if name == "box" else (name, UNDECIDED)
+    assert result.decision in allowed, (result.decision, result.candidates)
+    assert name in result.candidates, result.candidates
     fits = {f.name: f for f in result.fits}
     # the true shape: tangent within the noise, each one-sided residual at most about one
     # sigma, and zero whenever the noise moves the line outwards (half the time): chi^2 per
