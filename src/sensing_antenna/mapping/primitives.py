@@ -71,6 +71,9 @@ class Primitive:
         Independent parameters (the k of BIC).
     size_names : tuple of str
         The sizes :meth:`sizes` returns.
+    holds : tuple of str
+        The classes whose every shape this class's parameters also give, as a special case (a
+        capsule whose segment has no length is a sphere).
     """
 
     name: str
@@ -83,6 +86,7 @@ class Primitive:
     _size_entries: Callable[[FloatArray], FloatArray] = lambda sizes: sizes
     _growths: Callable[[FloatArray], tuple[Growth, ...]] = lambda parameters: ()
     _canonical: Callable[[FloatArray], FloatArray] | None = None
+    holds: tuple[str, ...] = ()
 
     def signed_distance(self, parameters: FloatArray, points: FloatArray) -> FloatArray:
         """d(p) (m): shape (n,) for one parameter vector and points of shape (n, 3) (m); for
@@ -362,6 +366,7 @@ PRIMITIVES: dict[str, Primitive] = {
             ),
             _growths=_axis_ends(1, 2),
             _canonical=_canonical_pose,
+            holds=("sphere",),
         ),
         Primitive(
             "cone",

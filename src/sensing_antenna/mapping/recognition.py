@@ -120,12 +120,12 @@ normal. A runner-up whose fitted shape is the best's (the same percentile of the
 at most the best fit's RMS distance to the points: apart by less than the points scatter),
 and whose chi^2 / c is within :data:`ABSTAIN_DELTA` of the best's (the points do not tell the
 two apart), is the same object under another class's name; so is a class that holds the best's
-as its own special case (a capsule of no segment is a ball), no farther from it than
-:data:`SAME_SHAPE_SIGMAS` of that sigma, whose extra parameters narrow the points' own scatter
-no more than they would narrow noise (the F test at :data:`NESTED_LEVEL`). The two score as
-one class, the best's score less 2 ln of their weights over the best's. The decision abstains
-(``undecided``, naming the best and its rival) when there is a rival, or when the best runner-up
-of another shape scores within :data:`ABSTAIN_DELTA` of that.
+as its own special case (``Primitive.holds``: a capsule of no segment is a ball), no farther
+from it than :data:`SAME_SHAPE_SIGMAS` of that sigma, whose extra parameters narrow the
+points' own scatter no more than they would narrow noise (the F test at :data:`NESTED_LEVEL`).
+The two score as one class, the best's score less 2 ln of their weights over the best's. The
+decision abstains (``undecided``, naming the best and its rival) when there is a rival, or when
+the best runner-up of another shape scores within :data:`ABSTAIN_DELTA` of that.
 
 Confidence: the best class's weight exp(-score / 2) normalised over the classes (the posterior
 probability under equal priors in BIC's approximation) with the weights of the classes of its
@@ -192,10 +192,6 @@ ABSTAIN_DELTA = 6.0
 #: (along the normal) somewhere are different objects: points there would have told them apart.
 SAME_SHAPE_SIGMAS = 3.0
 
-#: The classes each class holds as a special case of its own parameters: a capsule whose
-#: segment has no length is a sphere.
-_NESTED = {"capsule": ("sphere",)}
-
 #: The level of the F test by which a richer class's narrower scatter is more than noise
 #: (:func:`_scatter_narrowed`).
 NESTED_LEVEL = 0.95
@@ -253,8 +249,6 @@ REFINED_STARTS = 3
 #: (:func:`_starts`): the algebraic sphere of a patch seen from one side can miss the
 #: radius by that much either way.
 RESIZED_STARTS = (0.5, 2.0)
-
-_GOLDEN = (1.0 + math.sqrt(5.0)) / 2.0
 
 #: How far along the link each way from a contact its line is checked against a fit (m).
 LINE_STRETCH = 0.04
@@ -1077,18 +1071,20 @@ def _axis_rotations(axes: FloatArray, senses: tuple[float, ...]) -> list[FloatAr
 def _posed_start(name: str, centre: FloatArray, rotvec: FloatArray, size: float) -> FloatArray:
     """A posed class's start: about ``centre`` (m), its own Z axis turned by ``rotvec`` (rad),
     its sizes in proportion to ``size`` (m)."""
-    z_axis = Rotation.from_rotvec(rotvec).as_matrix()[:, 2]
     if name == "cylinder":
         return np.array([*centre, *rotvec, size, 2 * size])
     if name == "capsule":
         return np.array([*centre, *rotvec, size, size])
-    if name == "cone":
+    if name == "cone":  # its base half a size below the centre along its axis
+        z_axis = Rotation.from_rotvec(rotvec).as_matrix()[:, 2]
         return np.array([*(centre - 0.5 * size * z_axis), *rotvec, size, 2 * size])
     if name == "torus":
         # major 0.7, minor 0.3 of the size: a hole of 0.4
         return np.array([*centre, *rotvec, 0.4 * size, 0.3 * size])
     return np.array([*centre, *rotvec, 1.5 * size, 1.5 * size, 1.5 * size])  # box
 
+
+_GOLDEN = (1.0 + math.sqrt(5.0)) / 2.0
 
 #: Six axes through opposite vertices of a regular icosahedron (unit vectors): directions
 #: 63.4 deg apart that cover every axis a shape may have to within 37.4 deg, for the further
@@ -1381,12 +1377,12 @@ def fit_primitive(
     # first start with them, and the best few of the points-alone fits refined: the lines make the
     # problem rough, and either path may be the one that finds the shape
     alone, direct = [], []
-    starts, further = _starts(model, p, direction, generator)
-    for index, start in enumerate(starts + further):
+    first, further = _starts(model, p, direction, generator)
+    for index, start in enumerate(first + further):
         start = np.clip(start, low, high)
         try:
             alone.append(fit(start, sigma, False, MAX_EVALUATIONS, search=False))
-            if lines is not None and index < len(starts):
+            if lines is not None and index < len(first):
                 direct.append(fit(start, sigma, True, MAX_EVALUATIONS, search=False).x)
         except ValueError:  # a start outside the model's domain
             continue
@@ -1961,7 +1957,8 @@ def recognise(
         if gap(f) <= best.rms:
             return True
         return (
-            best.name in _NESTED.get(f.name, ())
+            f.name in PRIMITIVES
+            and best.name in PRIMITIVES[f.name].holds
             and gap(f) <= SAME_SHAPE_SIGMAS * sigma
             and not _scatter_narrowed(best, f)
         )
