@@ -395,6 +395,22 @@ def _first_touches(
     return np.array(points), np.array(tangents)
 
 
+def _swept_touches(
+    mesh: trimesh.Trimesh, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, LinkLines]:
+    """The posed ``mesh`` moved to 0.6 m ahead, its first touches by swept lines
+    (:func:`_first_touches`, at least 20) with 1 mm noise, their covariances and their lines
+    (tangent within 0.01 rad, 0.4 m of link behind each touch, 0.3 m beyond)."""
+    mesh.apply_translation([0.6, 0.0, 0.0] - mesh.bounding_box.centroid)
+    points, tangents = _first_touches(mesh, rng)
+    n = len(points)
+    assert n >= 20
+    points = points + rng.normal(0.0, NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
+    lines = LinkLines(tangents, np.full(n, 0.01), np.full(n, 0.4), np.full(n, 0.3))
+    return points, covariances, lines
+
+
 @pytest.mark.parametrize("name", ["box", "cylinder"])
 def test_the_lines_that_touched_tell_a_box_from_a_cylinder(name: str) -> None:
     # a line swept towards a box first meets it on an edge, and a cylinder fits points on a
@@ -407,14 +423,8 @@ def test_the_lines_that_touched_tell_a_box_from_a_cylinder(name: str) -> None:
     rng = np.random.default_rng(3)
     mesh = SHAPES[name][0]()
     mesh.apply_transform(_pose(rng))
-    mesh.apply_translation([0.6, 0.0, 0.0] - mesh.bounding_box.centroid)
-    points, tangents = _first_touches(mesh, rng)
+    points, covariances, lines = _swept_touches(mesh, rng)
     n = len(points)
-    assert n >= 20
-    points = points + rng.normal(0.0, NOISE, points.shape)
-    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
-    pivots_far = np.full(n, 0.4)
-    lines = LinkLines(tangents, np.full(n, 0.01), pivots_far, np.full(n, 0.3))
     result = recognise(points, covariances, rng=np.random.default_rng(0), lines=lines)
     allowed = (name,) if name == "box" else (name, UNDECIDED)
     assert result.decision in allowed, (result.decision, result.candidates)
@@ -525,13 +535,7 @@ def test_a_squat_cylinder_is_fitted_along_its_own_axis_whichever_copy_of_its_poi
     mesh = trimesh.creation.cylinder(radius=radius, height=height, sections=128)
     pose = _pose(rng)
     mesh.apply_transform(pose)
-    mesh.apply_translation([0.6, 0.0, 0.0] - mesh.bounding_box.centroid)
-    points, tangents = _first_touches(mesh, rng)
-    n = len(points)
-    assert n >= 20
-    points = points + rng.normal(0.0, NOISE, points.shape)
-    covariances = np.tile(np.eye(3) * NOISE**2, (n, 1, 1))
-    lines = LinkLines(tangents, np.full(n, 0.01), np.full(n, 0.4), np.full(n, 0.3))
+    points, covariances, lines = _swept_touches(mesh, rng)
     fits = []
     for copy in range(6):
         moved = points + np.random.default_rng(copy).normal(0.0, 1e-9, points.shape)
