@@ -34,6 +34,7 @@ from sensing_antenna.estimation.methods.fast.warm_start import (
     fewest_modes,
     warm_reference,
 )
+from sensing_antenna.estimation.methods.paper.frequency import find_peak, power_spectrum
 
 __all__ = [
     "FitCache",
@@ -190,8 +191,47 @@ def _fit_and_solutions(
             warm=warm,
             min_modes=fewest_modes(rest_index, end_index, sample_period, config, push is not None),
         )
+        if warm is not None and _misses_band_peak(signals, result[0], sample_period, band):
+            # Started where a shorter window's fits were, the fit has no mode at the window's
+            # strongest vibration of the band (a short window may merge two close modes into
+            # one, and its starts carry that on): the fits from the pencil too, the better kept
+            cold_result = select_model_solutions(
+                signals,
+                sample_period,
+                max_modes,
+                degrees,
+                start * sample_period,
+                min_omega=config.min_mode_fraction * band[0],
+                target_band=band,
+                poles=first_poles(signals, max_modes),
+                min_modes=fewest_modes(rest_index, end_index, sample_period, config),
+            )
+            if cold_result[0] is not None and (
+                result[0] is None or cold_result[0].bic < result[0].bic
+            ):
+                result = cold_result
     cache[key] = result
     return result
+
+
+def _misses_band_peak(
+    signals: FloatArray,
+    fit: DampedSinusoidFit | None,
+    sample_period: float,
+    band: tuple[float, float],
+) -> bool:
+    """Whether the highest peak in ``band`` (rad/s) of the channels' summed spectrum, each
+    channel weighted by the fit's noise, lies farther than the Hann window's main-lobe half
+    width (4 pi / T_w) from every mode of ``fit``: the fit then misses the strongest vibration
+    the window holds there. False without a fit or without a peak."""
+    if fit is None:
+        return False
+    omega, power = power_spectrum(signals / fit.noise_std, sample_period, zero_padding=2)
+    peak = find_peak(omega, power.sum(axis=1), band)
+    if peak is None:
+        return False
+    lobe = 4.0 * math.pi / (signals.shape[0] * sample_period)
+    return bool(np.all(np.abs(fit.omega - peak.omega) > lobe))
 
 
 @functools.cache
