@@ -226,7 +226,8 @@ def _misses_band_peak(
     the window holds there. False without a fit or without a peak."""
     if fit is None:
         return False
-    omega, power = power_spectrum(signals / fit.noise_std, sample_period, zero_padding=2)
+    noise = np.where(fit.noise_std > 0.0, fit.noise_std, 1.0)
+    omega, power = power_spectrum(signals / noise, sample_period, zero_padding=2)
     peak = find_peak(omega, power.sum(axis=1), band)
     if peak is None:
         return False
