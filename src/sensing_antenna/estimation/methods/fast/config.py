@@ -207,13 +207,16 @@ class FastConfig:
         window restarts there) start every fit, each polynomial degree and number of modes,
         from the solution of the same model on their drift check's reference window (the grid
         window of about 2/3 their length, fitted anyway), with one solve weighted by the noise
-        found there, instead of two solves from the matrix pencil (:mod:`.warm_start`). A rule
-        of the window alone, so a window has the same fit offline and online, whichever windows
-        were fitted before. 0.2 s, the pipeline's hold: every window evaluated after the hold
-        starts warm, from references that themselves start from the pencil while shorter than
-        this. 0: every window from the pencil. Windows through the push (``push_phase``) always
-        start from the pencil: their reference holds relatively more of the touch's ringing,
-        and a start from it can settle in a worse optimum.
+        found there, instead of two solves from the matrix pencil (:mod:`.warm_start`); from
+        the pencil as well, the smaller BIC kept, when no detected mode of that fit reads the
+        window's clear spectral peak in the omega_1 band (a shorter window may have fitted two
+        close modes as one). A rule of the window alone, so a window has the same fit offline
+        and online, whichever windows were fitted before. 0.2 s, the pipeline's hold: every
+        window evaluated after the hold starts warm, from references that themselves start
+        from the pencil while shorter than this. 0: every window from the pencil. Windows
+        through the push (``push_phase``) always start from the pencil: their reference holds
+        relatively more of the touch's ringing, and a start from it can settle in a worse
+        optimum.
     long_window_min_modes : int
         Fewest damped modes tried on the windows that start warm (``warm_start_after``);
         shorter windows try from one. 2: the touch and the stop excite contact modes 2 and 3

@@ -6,7 +6,10 @@ twice (weights from first differences, then from its own residuals). A window of
 scan at least ``FastConfig.warm_start_after`` long instead starts every (degree, order) from the
 solution of the same model on its drift check's reference window, about 2/3 of it on the
 evaluation grid (:func:`.evaluation_grid.reference_index`), which the drift check fits anyway:
-one solve, weighted by the noise found there. The reference is a function of the window alone
+one solve, weighted by the noise found there; when no detected mode of that fit lies at the
+window's clear spectral peak in the omega_1 band (a shorter window may have fitted two close
+modes as one, and its solutions carry that on), the fits from the pencil run too and the
+smaller BIC wins (:mod:`.window_fit`). The reference is a function of the window alone
 (:func:`warm_reference`), so a window has the same fit whichever windows were fitted before it,
 offline and online. Windows through the push always start from the pencil (``FastConfig``).
 Windows that start warm try two modes or more (``FastConfig.long_window_min_modes``), shorter

@@ -27,7 +27,7 @@ from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
 from sensing_antenna.estimation.methods.fast.model_order import select_model_solutions
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
-from sensing_antenna.estimation.methods.fast.pencil import first_poles
+from sensing_antenna.estimation.methods.fast.pencil import difference_scale, first_poles
 from sensing_antenna.estimation.methods.fast.planes import free_plane_share
 from sensing_antenna.estimation.methods.fast.warm_start import (
     Solutions,
@@ -137,7 +137,8 @@ def fit_window(
     A window from its start (t_1, or the end of the hold) at least ``warm_start_after`` long
     starts every candidate from the solutions of its drift check's reference window
     (:mod:`.warm_start`), fitted first (and cached) when not at hand, and tries
-    ``long_window_min_modes`` modes or more.
+    ``long_window_min_modes`` modes or more; from the matrix pencil as well, the smaller BIC
+    kept, when that fit misses the band's clear spectral peak (:func:`_misses_band_peak`).
     """
     span = WindowSpan(
         channels, rest_index, end_index, sample_period, band, config, {} if cache is None else cache
@@ -175,43 +176,40 @@ def _fit_and_solutions(
     # One BLAS thread for the fit's small matrices (a few hundred rows by ten to twenty
     # columns): more threads only contend for the cores and spin, the more so when the
     # process or the machine already runs one thread per core
+    select = functools.partial(
+        select_model_solutions,
+        signals,
+        sample_period,
+        max_modes,
+        degrees,
+        start * sample_period,
+        min_omega=config.min_mode_fraction * band[0],
+        target_band=band,
+        regressors=None if push is None else push.angle[start : end_index + 1],
+        restart=None if push is None else rest_index - start,
+        min_modes=fewest_modes(rest_index, end_index, sample_period, config, push is not None),
+    )
     with _blas_libraries().limit(limits=1, user_api="blas"):
         poles = first_poles(signals, max_modes) if fits_at_all and cold else None
-        result = select_model_solutions(
-            signals,
-            sample_period,
-            max_modes,
-            degrees,
-            start * sample_period,
-            min_omega=config.min_mode_fraction * band[0],
-            target_band=band,
-            poles=poles,
-            regressors=None if push is None else push.angle[start : end_index + 1],
-            restart=None if push is None else rest_index - start,
-            warm=warm,
-            min_modes=fewest_modes(rest_index, end_index, sample_period, config, push is not None),
-        )
-        if warm is not None and _misses_band_peak(signals, result[0], sample_period, band):
-            # Started where a shorter window's fits were, the fit has no mode at the window's
-            # strongest vibration of the band (a short window may merge two close modes into
-            # one, and its starts carry that on): the fits from the pencil too, the better kept
-            cold_result = select_model_solutions(
-                signals,
-                sample_period,
-                max_modes,
-                degrees,
-                start * sample_period,
-                min_omega=config.min_mode_fraction * band[0],
-                target_band=band,
-                poles=first_poles(signals, max_modes),
-                min_modes=fewest_modes(rest_index, end_index, sample_period, config),
-            )
-            if cold_result[0] is not None and (
-                result[0] is None or cold_result[0].bic < result[0].bic
+        result = select(poles=poles, warm=warm)
+        if warm is not None and _misses_band_peak(signals, result[0], sample_period, band, config):
+            # Started where a shorter window's fits were, the fit does not read the window's
+            # strongest vibration of the band (a window too short to part two close modes
+            # fits them as one, and its solutions carry that on): the fits are started from
+            # the pencil too, and the smaller BIC of the two kept
+            from_pencil = select(poles=first_poles(signals, max_modes) if fits_at_all else None)
+            if from_pencil[0] is not None and (
+                result[0] is None or from_pencil[0].bic < result[0].bic
             ):
-                result = cold_result
+                result = from_pencil
     cache[key] = result
     return result
+
+
+#: Power over the band's median a spectral peak needs before a fit is asked to read it
+#: (:func:`_misses_band_peak`): the paper method's clear peak (``EstimatorConfig``'s
+#: ``min_peak_quality`` default), which a noise ordinate reaches with probability 2^-20.
+CLEAR_PEAK = 20.0
 
 
 def _misses_band_peak(
@@ -219,20 +217,28 @@ def _misses_band_peak(
     fit: DampedSinusoidFit | None,
     sample_period: float,
     band: tuple[float, float],
+    config: FastConfig,
 ) -> bool:
-    """Whether the highest peak in ``band`` (rad/s) of the channels' summed spectrum, each
-    channel weighted by the fit's noise, lies farther than the Hann window's main-lobe half
-    width (4 pi / T_w) from every mode of ``fit``: the fit then misses the strongest vibration
-    the window holds there. False without a fit or without a peak."""
-    if fit is None:
-        return False
-    noise = np.where(fit.noise_std > 0.0, fit.noise_std, 1.0)
-    omega, power = power_spectrum(signals / noise, sample_period, zero_padding=2)
+    """Whether ``fit`` (of ``signals``, shape (n, K)) misses the highest clear peak
+    (:data:`CLEAR_PEAK`) in ``band`` (rad/s) of the channels' summed spectrum: none of its
+    modes detected at ``config.min_detection`` lies within the half width of the Hann
+    window's main lobe, 4 pi / T_w, of the peak (True without a fit). Each channel is divided
+    by its noise (:func:`.pencil.difference_scale`, which no fit changes) and rid of a
+    polynomial of ``config.polynomial_degree`` in time, as the fit's static part; False when
+    the band holds no clear peak."""
+    n = signals.shape[0]
+    scaled = signals / difference_scale(signals)
+    x = np.linspace(-1.0, 1.0, n)
+    vandermonde = np.polynomial.legendre.legvander(x, config.polynomial_degree)
+    coef, *_ = np.linalg.lstsq(vandermonde, scaled, rcond=None)
+    omega, power = power_spectrum(scaled - vandermonde @ coef, sample_period, zero_padding=2)
     peak = find_peak(omega, power.sum(axis=1), band)
-    if peak is None:
+    if peak is None or peak.quality < CLEAR_PEAK:
         return False
-    lobe = 4.0 * math.pi / (signals.shape[0] * sample_period)
-    return bool(np.all(np.abs(fit.omega - peak.omega) > lobe))
+    if fit is None:
+        return True
+    near = np.abs(fit.omega - peak.omega) <= 4.0 * math.pi / (n * sample_period)
+    return not bool(np.any(near & (fit.detection() >= config.min_detection)))
 
 
 @functools.cache
