@@ -173,9 +173,6 @@ def _fit_and_solutions(
     # degree's largest order does not start warm
     fits_at_all = signals.shape[0] >= 3 * (lowest + 1 + 4 * max_modes)
     cold = warm is None or any((degree, max_modes) not in warm for degree in degrees)
-    # One BLAS thread for the fit's small matrices (a few hundred rows by ten to twenty
-    # columns): more threads only contend for the cores and spin, the more so when the
-    # process or the machine already runs one thread per core
     select = functools.partial(
         select_model_solutions,
         signals,
@@ -189,12 +186,15 @@ def _fit_and_solutions(
         restart=None if push is None else rest_index - start,
         min_modes=fewest_modes(rest_index, end_index, sample_period, config, push is not None),
     )
+    # One BLAS thread for the fit's small matrices (a few hundred rows by ten to twenty
+    # columns): more threads only contend for the cores and spin, the more so when the
+    # process or the machine already runs one thread per core
     with _blas_libraries().limit(limits=1, user_api="blas"):
         poles = first_poles(signals, max_modes) if fits_at_all and cold else None
         result = select(poles=poles, warm=warm)
         if warm is not None and _misses_band_peak(signals, result[0], sample_period, band, config):
             # Started where a shorter window's fits were, the fit does not read the window's
-            # strongest vibration of the band (a window too short to part two close modes
+            # clear vibration in the band (a window too short to part two close modes
             # fits them as one, and its solutions carry that on): the fits are started from
             # the pencil too, and the smaller BIC of the two kept
             from_pencil = select(poles=first_poles(signals, max_modes) if fits_at_all else None)
@@ -208,8 +208,9 @@ def _fit_and_solutions(
 
 #: Power over the band's median a spectral peak needs before a fit is asked to read it
 #: (:func:`_misses_band_peak`): the paper method's clear peak (``EstimatorConfig``'s
-#: ``min_peak_quality`` default), which a noise ordinate reaches with probability 2^-20.
-CLEAR_PEAK = 20.0
+#: ``min_peak_quality`` default), which one channel's noise ordinate reaches with probability
+#: 2^-20.
+_CLEAR_PEAK = 20.0
 
 
 def _misses_band_peak(
@@ -220,7 +221,7 @@ def _misses_band_peak(
     config: FastConfig,
 ) -> bool:
     """Whether ``fit`` (of ``signals``, shape (n, K)) misses the highest clear peak
-    (:data:`CLEAR_PEAK`) in ``band`` (rad/s) of the channels' summed spectrum: none of its
+    (:data:`_CLEAR_PEAK`) in ``band`` (rad/s) of the channels' summed spectrum: none of its
     modes detected at ``config.min_detection`` lies within the half width of the Hann
     window's main lobe, 4 pi / T_w, of the peak (True without a fit). Each channel is divided
     by its noise (:func:`.pencil.difference_scale`, which no fit changes) and rid of a
@@ -233,7 +234,7 @@ def _misses_band_peak(
     coef, *_ = np.linalg.lstsq(vandermonde, scaled, rcond=None)
     omega, power = power_spectrum(scaled - vandermonde @ coef, sample_period, zero_padding=2)
     peak = find_peak(omega, power.sum(axis=1), band)
-    if peak is None or peak.quality < CLEAR_PEAK:
+    if peak is None or peak.quality < _CLEAR_PEAK:
         return False
     if fit is None:
         return True
