@@ -738,12 +738,13 @@ def test_history_holds_the_declared_window_and_runs_to_the_cap(
 def test_a_longer_window_does_not_carry_on_a_mode_a_shorter_one_merged() -> None:
     # An exploration's vertical sweep onto a box edge (tests/data, cut at 2 s; the model is
     # that exploration's calibrated antenna). Its first windows, 0.2 to 0.56 s long, cannot
-    # part the contact's 78 rad/s from a short-lived ring near 100 rad/s (their Hann main
-    # lobes are +-22 to +-63 rad/s wide) and fit one damped mode near 100; the longer windows
-    # start from those fits. The record's own spectrum over the second after t_1 peaks at the
-    # contact's omega_1 (numpy's FFT here, independent of the fit; fx, fz and tz peak there
-    # too), and the fast method must read that one: started only from the short windows it
-    # read 100 rad/s, the top of the sensing curve, and answered ok at 0.742 m, 9 cm off.
+    # part the contact's 78 rad/s from a short-lived ring near 100 rad/s in their spectra
+    # (Hann main lobes +-22 to +-63 rad/s wide), and their fits take one damped mode near
+    # 100; the longer windows start from those fits. The record's own spectrum over the
+    # second after t_1 peaks at the contact's omega_1 (numpy's FFT here, independent of the
+    # fit; fx, fz and tz peak there too), and the fast method must read that one: a fit
+    # started only from the short windows' reads 100 rad/s, the top of the sensing curve,
+    # and answers ok at 0.742 m.
     recording = read_recording(DATA / "box_edge_vertical_0.65.csv")
     antenna = load_antenna(DATA / "explore-calibrated.toml")
     result = estimate(recording, antenna, "fast")
@@ -753,8 +754,8 @@ def test_a_longer_window_does_not_carry_on_a_mode_a_shorter_one_merged() -> None
     power = np.abs(np.fft.rfft(torque * np.hanning(torque.size), n_fft)) ** 2
     omega = 2.0 * np.pi * np.fft.rfftfreq(n_fft, TS)
     ringing = float(omega[np.argmax(np.where(omega > 20.0, power, 0.0))])
-    # The grid step is 0.4 rad/s; the peak's width over 1 s is 2 pi rad/s, a third of what
-    # parts 78 from 100 rad/s: the fit and the spectrum read the same mode within it
+    # The grid step is 0.4 rad/s; over 1 s the main lobe's half width is 4 pi rad/s, well
+    # within the 22 rad/s between 78 and 100: the fit and the spectrum read one mode to 2 pi
     assert ringing == pytest.approx(78.3, abs=1.0)
     assert result.omega1 == pytest.approx(ringing, abs=2.0 * math.pi)
     true_xc = float(recording.metadata["true_xc"])

@@ -113,6 +113,7 @@ def window_key(
         config.push_polynomial_degree,
         config.warm_start_after,
         config.long_window_min_modes,
+        config.min_detection,
     )
     digest.update(np.array(settings, dtype=float).tobytes())
     if push is not None:
@@ -192,12 +193,18 @@ def _fit_and_solutions(
     with _blas_libraries().limit(limits=1, user_api="blas"):
         poles = first_poles(signals, max_modes) if fits_at_all and cold else None
         result = select(poles=poles, warm=warm)
-        if warm is not None and _misses_band_peak(signals, result[0], sample_period, band, config):
+        if (
+            warm is not None
+            and fits_at_all
+            and _misses_band_peak(signals, result[0], sample_period, band, config)
+        ):
             # Started where a shorter window's fits were, the fit does not read the window's
             # clear vibration in the band (a window too short to part two close modes
             # fits them as one, and its solutions carry that on): the fits are started from
             # the pencil too, and the smaller BIC of the two kept
-            from_pencil = select(poles=first_poles(signals, max_modes) if fits_at_all else None)
+            from_pencil = select(
+                poles=poles if poles is not None else first_poles(signals, max_modes)
+            )
             if from_pencil[0] is not None and (
                 result[0] is None or from_pencil[0].bic < result[0].bic
             ):
@@ -208,8 +215,7 @@ def _fit_and_solutions(
 
 #: Power over the band's median a spectral peak needs before a fit is asked to read it
 #: (:func:`_misses_band_peak`): the paper method's clear peak (``EstimatorConfig``'s
-#: ``min_peak_quality`` default), which one channel's noise ordinate reaches with probability
-#: 2^-20.
+#: ``min_peak_quality`` default). A false alarm costs one more set of fits, nothing else.
 _CLEAR_PEAK = 20.0
 
 
@@ -223,7 +229,8 @@ def _misses_band_peak(
     """Whether ``fit`` (of ``signals``, shape (n, K)) misses the highest clear peak
     (:data:`_CLEAR_PEAK`) in ``band`` (rad/s) of the channels' summed spectrum: none of its
     modes detected at ``config.min_detection`` lies within the half width of the Hann
-    window's main lobe, 4 pi / T_w, of the peak (True without a fit). Each channel is divided
+    window's main lobe, 4 pi / T_w, of the peak (True without a fit, when the band holds a clear
+    peak). Each channel is divided
     by its noise (:func:`.pencil.difference_scale`, which no fit changes) and rid of a
     polynomial of ``config.polynomial_degree`` in time, as the fit's static part; False when
     the band holds no clear peak."""
