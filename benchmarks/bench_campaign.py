@@ -3,15 +3,15 @@
 Usage::
 
     python benchmarks/bench_campaign.py [--workers N] [--spec FILE] [--keep DIR] [--note TEXT]
+        [--out FILE]
 
-Prints a table and writes ``benchmarks/results/campaign.json``. The campaign runs into a fresh
-temporary directory (or ``--keep DIR``, which must not hold a finished campaign), so every run is
-simulated and estimated; the time is split into preparation (observer identification on the
-device, then the T_e calibration of Section 5.1: 15 simulated recordings, inline), the runs (wall
-clock, with the per-run times summed over workers: simulation, the estimation front end (once
-per recording) and each method's conclusion) and the report. With a second device its
-preparation (made the same way) is counted in the preparation and its calibration recorded
-apart.
+Prints a table and writes ``benchmarks/results/campaign.json`` (or ``--out FILE``). The campaign
+runs into a fresh temporary directory (or ``--keep DIR``, which must not hold a finished campaign),
+so every run is simulated and estimated; the time is split into preparation (observer identification
+on the device, then the T_e calibration of Section 5.1: 15 simulated recordings, inline), the runs
+(wall clock, with the per-run times summed over workers: simulation, the estimation front end (once
+per recording) and each method's conclusion) and the report. With a second device its preparation
+(made the same way) is counted in the preparation and its calibration recorded apart.
 """
 
 from __future__ import annotations
@@ -58,6 +58,7 @@ def main() -> int:
     parser.add_argument(
         "--note", default="", help="what else ran on the machine meanwhile, kept in the results"
     )
+    parser.add_argument("--out", type=Path, default=RESULTS, help="results file (JSON)")
     args = parser.parse_args()
 
     spec = load_campaign_spec(args.spec)
@@ -123,8 +124,8 @@ def main() -> int:
         # what else ran on the machine, as the one who measured says (--note)
         "note": args.note,
     }
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
 
     print(f"campaign {spec.name}: {outcome.n_runs} runs on {workers} workers")
     print(f"{'part':<28}{'seconds':>10}")
@@ -142,7 +143,7 @@ def main() -> int:
         print(f"T_e = {prepared['t_e']:.5f} (device T = {prepared['device_t']:.5f})")
     if "t_e" in second:
         print(f"second device: T_e = {second['t_e']:.5f} (device T = {second['device_t']:.5f})")
-    print(RESULTS)
+    print(args.out)
     return 0
 
 
