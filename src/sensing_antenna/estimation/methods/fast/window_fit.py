@@ -22,8 +22,10 @@ import numpy as np
 from numpy.typing import NDArray
 from threadpoolctl import ThreadpoolController
 
+from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.methods.fast.checks import drift_check, periods_check
 from sensing_antenna.estimation.methods.fast.config import FastConfig
+from sensing_antenna.estimation.methods.fast.design import ModelDesign
 from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
 from sensing_antenna.estimation.methods.fast.model_order import select_model_solutions
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
@@ -214,9 +216,9 @@ def _fit_and_solutions(
 
 
 #: Power over the band's median a spectral peak needs before a fit is asked to read it
-#: (:func:`_misses_band_peak`): the paper method's clear peak (``EstimatorConfig``'s
-#: ``min_peak_quality`` default). A false alarm costs one more set of fits, nothing else.
-_CLEAR_PEAK = 20.0
+#: (:func:`_misses_band_peak`): the paper method's clear peak, its default
+#: ``min_peak_quality``. A false alarm costs one more set of fits, nothing else.
+_CLEAR_PEAK = EstimatorConfig.min_peak_quality
 
 
 def _misses_band_peak(
@@ -228,18 +230,17 @@ def _misses_band_peak(
 ) -> bool:
     """Whether ``fit`` (of ``signals``, shape (n, K)) misses the highest clear peak
     (:data:`_CLEAR_PEAK`) in ``band`` (rad/s) of the channels' summed spectrum: none of its
-    modes detected at ``config.min_detection`` lies within the half width of the Hann
-    window's main lobe, 4 pi / T_w, of the peak (True without a fit, when the band holds a clear
-    peak). Each channel is divided
-    by its noise (:func:`.pencil.difference_scale`, which no fit changes) and rid of a
-    polynomial of ``config.polynomial_degree`` in time, as the fit's static part; False when
-    the band holds no clear peak."""
+    modes detected at ``config.min_detection`` lies within the half width of the Hann window's
+    main lobe, 4 pi / T_w, of the peak (True without a fit, when the band holds a clear peak).
+    Each channel is divided by its noise (:func:`.pencil.difference_scale`, which no fit
+    changes) and rid of the fit's static part at ``config.polynomial_degree``
+    (:class:`.design.ModelDesign`'s polynomial columns); False when the band holds no clear
+    peak."""
     n = signals.shape[0]
     scaled = signals / difference_scale(signals)
-    x = np.linspace(-1.0, 1.0, n)
-    vandermonde = np.polynomial.legendre.legvander(x, config.polynomial_degree)
-    coef, *_ = np.linalg.lstsq(vandermonde, scaled, rcond=None)
-    omega, power = power_spectrum(scaled - vandermonde @ coef, sample_period, zero_padding=2)
+    static = ModelDesign(n, sample_period, config.polynomial_degree).fixed
+    coef, *_ = np.linalg.lstsq(static, scaled, rcond=None)
+    omega, power = power_spectrum(scaled - static @ coef, sample_period, zero_padding=2)
     peak = find_peak(omega, power.sum(axis=1), band)
     if peak is None or peak.quality < _CLEAR_PEAK:
         return False
