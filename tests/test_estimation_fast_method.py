@@ -754,7 +754,8 @@ def test_a_longer_window_does_not_carry_on_a_mode_a_shorter_one_merged() -> None
     power = np.abs(np.fft.rfft(torque * np.hanning(torque.size), n_fft)) ** 2
     omega = 2.0 * np.pi * np.fft.rfftfreq(n_fft, TS)
     ringing = float(omega[np.argmax(np.where(omega > 20.0, power, 0.0))])
-    # The grid step is 0.4 rad/s; over 1 s the main lobe's half width is 4 pi rad/s, well
+    # 78.3: the paper method's peak on this recording (78.29 rad/s, its own 1 s spectrum). The
+    # grid step is 0.4 rad/s; over 1 s the main lobe's half width is 4 pi rad/s, well
     # within the 22 rad/s between 78 and 100: the fit and the spectrum read one mode to 2 pi
     assert ringing == pytest.approx(78.3, abs=1.0)
     assert result.omega1 == pytest.approx(ringing, abs=2.0 * math.pi)
