@@ -510,6 +510,32 @@ def test_front_end_names_a_misshapen_block() -> None:
         front.update_block(np.zeros(2), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)))
 
 
+def test_online_samples_skipped_are_put_back_and_a_time_jump_is_bad_input() -> None:
+    # Fed sample by sample without every 25th: the estimate of the file those samples make
+    # (which reading resamples); a stamp a day late cannot be filled and ends the run
+    recording = synthetic_recording(Synthetic(x_c=0.6, seed=5))
+    kept = np.arange(recording.n_samples) % 25 != 24
+    lossy = dataclasses.replace(
+        recording,
+        t=recording.t[kept],
+        theta=recording.theta[kept],
+        force=recording.force[kept],
+        torque=recording.torque[kept],
+        extra={},
+    )
+    _, online = run_online(lossy)
+    offline = estimate(lossy, calibrated())
+    assert online.status is offline.status is Status.OK
+    assert online.x_c == pytest.approx(offline.x_c, abs=1e-9)
+    assert online.x_c == pytest.approx(estimate(recording, calibrated()).x_c, abs=1e-3)
+    jumped = OnlineEstimator(calibrated(), TS)
+    jumped.update(0.0, np.zeros(2), np.zeros(3), np.zeros(3))
+    jumped.update(86400.0, np.zeros(2), np.zeros(3), np.zeros(3))
+    result = jumped.finalize()
+    assert result.status is Status.BAD_INPUT
+    assert (result.reason or "").startswith("t: time jumps from 0.0 to 86400.0 s")
+
+
 def test_candidates_the_ratio_cannot_tell_apart_without_a_second_mode_are_uncertain() -> None:
     # Near the top of the sensing curve (x_c = 0.8 m; its maximum near 0.768 l) the two
     # candidates of omega_1 (0.739 and 0.800 m) lie 6 cm apart, within two of the ratio's

@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
 from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.front.steps import fill_missing
 from sensing_antenna.estimation.methods import EstimationMethod
 from sensing_antenna.estimation.online import OnlineEstimator
 from sensing_antenna.estimation.result import ContactEstimate
@@ -53,7 +54,8 @@ __all__ = ["CONTACT_LOST_TIME", "Listener"]
 #: does not count as a loss.
 CONTACT_LOST_TIME = 0.1
 
-#: The time steps whose median is compared with the stream's declared ``sample_period``.
+#: The time steps from which the stream's period is read and compared with its declared
+#: ``sample_period``.
 PERIOD_CHECK_STEPS = 20
 
 #: Fewest steps whose median number of periods must be one (more are dropped samples or a
@@ -142,8 +144,10 @@ class Listener:
             [header.required(name) for name in names]
             for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
         ]
-        self._t = _Growing()
+        self._t = _Growing()  # with the samples missing put back
         self._received = _Growing()
+        self._stamps = _Growing()  # the first time stamps received, for the period's check
+        self._last: tuple[float, NDArray[np.float64]] | None = None
         self.dropped = 0
         self._period_checked = False
         self.lags: list[float] = []
@@ -156,8 +160,8 @@ class Listener:
 
     @property
     def samples(self) -> int:
-        """Samples the worker has taken so far."""
-        return self._t.size
+        """Samples the worker has taken so far (as received: without those put back)."""
+        return self._t.size - self.dropped
 
     @property
     def result(self) -> ContactEstimate | None:
@@ -225,21 +229,30 @@ class Listener:
         received = np.repeat([when for _, when in blocks], [a.shape[0] for a in arrays])
         if self._record is not None:
             self._record.write(rows)
-        first = self._t.size
         t = rows[:, self._columns[0][0]]
-        previous = self._t.values[first - 1] if first else None
-        self._t.extend(t)
-        self._received.extend(received)
-        steps = np.diff(t) if previous is None else np.diff(t, prepend=previous)
-        ts = self.header.sample_period
+        self._stamps.extend(t[: PERIOD_CHECK_STEPS + 1 - self._stamps.size])
         self._check_period()
-        self.dropped += int(np.sum(np.maximum(np.rint(steps / ts) - 1.0, 0.0)))
+        # the samples as the estimator holds them, missing ones put back: the instants it
+        # reports are indices into these
+        try:
+            filled = fill_missing(
+                t, rows, self.header.sample_period, self._estimator.config.max_gap, self._last
+            )
+        except ValueError as exc:
+            raise WireError(f"{self.header.source}: t: {exc}") from None
+        self._last = (float(t[-1]), rows[-1])
+        first = self._t.size
+        self._t.extend(filled.t)
+        self._received.extend(received[filled.origin])
+        self.dropped += filled.t.shape[0] - t.shape[0]
         theta, force, torque = (rows[:, columns] for columns in self._columns[1:])
         estimator = self._estimator
         result = None
         if estimator.result is None:
             result = estimator.update_block(t, theta, force, torque, every_instant=True)
-        self._residual.update_block(t, theta, force, torque)
+        self._residual.update_block(
+            filled.t, *(filled.values[:, columns] for columns in self._columns[1:])
+        )
         self._say_instants(first)
         if result is not None:
             self._say_estimate(result, first)
@@ -252,26 +265,35 @@ class Listener:
         the steps instead (:data:`~sensing_antenna.recording.PERIOD_CONSISTENCY`). Judged on
         the first :data:`PERIOD_CHECK_STEPS` steps, or at the end (``final``) on those a
         shorter stream has."""
-        steps = min(self._t.size - 1, PERIOD_CHECK_STEPS)
+        steps = min(self._stamps.size - 1, PERIOD_CHECK_STEPS)
         if self._period_checked or steps < (1 if final else PERIOD_CHECK_STEPS):
             return
         self._period_checked = True
         ts = self.header.sample_period
-        step = np.diff(self._t.values[: steps + 1])
+        stamps = self._stamps.values[: steps + 1]
+        step = np.diff(stamps)
         # a dropped sample is a step of whole periods, each step read against its nearest
         # multiple; but most steps are one period (a stream stepping by ten declared periods
-        # declares a tenth of its period), and their median is the period, as a file's is. A
-        # few steps cannot tell drops from a wrong period: only their multiples are judged
+        # declares a tenth of its period). A few steps cannot tell drops from a wrong period:
+        # only their multiples are judged
         periods = np.maximum(np.rint(step / ts), 1.0)
-        median = float(np.median(step / periods))
-        mostly_single = steps < MIN_STEPS_FOR_DROPS or float(np.median(periods)) == 1.0
-        if not mostly_single or abs(median - ts) > PERIOD_CONSISTENCY * ts:
-            raise WireError(
-                f"{self.header.source}: sample_period: the stream declares {ts!r} s, but its "
-                f"time stamps step by {float(np.median(step)):.6g} s (the median of "
-                f"its first {steps} steps), more than {100 * PERIOD_CONSISTENCY:g} % apart: the "
-                "estimates need the period the samples have"
-            )
+        if steps >= MIN_STEPS_FOR_DROPS and float(np.median(periods)) != 1.0:
+            period, how = float(np.median(step)), f"the median of its first {steps} steps"
+        else:
+            # the period is the slope of the time stamps against their sample numbers (drops
+            # counted): each stamp's jitter averages out over the line, where it stays in a
+            # median of steps (a tenth of a period of jitter moves that by a few per cent)
+            number = np.concatenate([[0.0], np.cumsum(periods)])
+            number -= number.mean()
+            period = float(number @ (stamps - stamps[0]) / (number @ number))
+            how = f"a line through its first {steps + 1} time stamps"
+            if abs(period - ts) <= PERIOD_CONSISTENCY * ts:
+                return
+        raise WireError(
+            f"{self.header.source}: sample_period: the stream declares {ts!r} s, but its "
+            f"time stamps step by {period:.6g} s ({how}), more than "
+            f"{100 * PERIOD_CONSISTENCY:g} % apart: the estimates need the period the samples have"
+        )
 
     def _latency(self, index: int) -> float:
         return self._clock() - float(self._received.values[index])
@@ -329,4 +351,4 @@ class Listener:
             self._emit(EstimateEvent(self.number, result, latency))
         t_last = float(self._t.values[last]) if last >= 0 else math.nan
         latency = self._latency(last) if last >= 0 else 0.0
-        self._emit(EndEvent(self.number, self._t.size, self.dropped, t_last, reason, latency))
+        self._emit(EndEvent(self.number, self.samples, self.dropped, t_last, reason, latency))

@@ -51,6 +51,7 @@ from sensing_antenna.estimation.front.steps import (
     HoldPush,
     at_contact,
     dead_channel,
+    fill_missing,
     gap_problem,
     hold_push,
     planned_end,
@@ -117,7 +118,8 @@ class FrontEnd:
     antenna : Antenna
         Link, observer and contact threshold.
     sample_period : float
-        T_s (s) of the uniform samples that will be fed.
+        T_s (s) of the samples that will be fed (those missing are put back:
+        :meth:`update_block`).
     config : EstimatorConfig, optional
         Defaults to ``EstimatorConfig()``.
     diagnostics : Mapping, optional
@@ -183,6 +185,8 @@ class FrontEnd:
         self._n = 0
         self._loads_done = self._ratio_done = self._mean_done = 0
         self._filled: list[tuple[int, tuple[float, float]]] = []  # (known at sample, interval)
+        self._put_back_at: list[NDArray[np.intp]] = []  # samples put back where stamps skip
+        self._jump: str | None = None  # a step of the time stamps too long to fill
         self._contact: int | None = None
         self._start: ContactStart | None = None
         self._rest: int | None = None
@@ -194,7 +198,8 @@ class FrontEnd:
 
     @property
     def n_samples(self) -> int:
-        """Samples fed since :meth:`reset`."""
+        """Samples held since :meth:`reset`: those fed, and those put back where the time stamps
+        skipped some (:meth:`update_block`)."""
         return self._n
 
     @property
@@ -240,7 +245,11 @@ class FrontEnd:
         Parameters
         ----------
         t : array_like, shape (n,)
-            Sample times (s); steps of more than ``config.max_gap`` missing samples are gaps.
+            Sample times (s). Where they step by k sample periods (k >= 2, rounded), the k - 1
+            samples missing are put back by linear interpolation (:func:`.steps.fill_missing`,
+            as a whole recording is resampled) and counted in the diagnostics
+            (``filled_samples``); steps of more than ``config.max_gap`` missing samples are also
+            gaps, and one beyond :data:`.steps.MAX_FILLED` makes the outcome ``bad_input``.
         theta : array_like, shape (n, 2)
             Motor angles (rad).
         force, torque : array_like, shape (n, 3)
@@ -266,6 +275,9 @@ class FrontEnd:
         )
         if self._outcome is not None or count == 0:
             return None
+        if self._refused is None:
+            times, angles, forces, moments = self._put_back(times, angles, forces, moments)
+            count = times.shape[0]
         first, stop = self._n, self._n + count
         self._reserve(stop)
         # the detectors read the samples where they now lie (writable, C-ordered: no copy)
@@ -279,8 +291,9 @@ class FrontEnd:
         self._n = stop
         if filled_gaps:
             self._filled.extend((first, (float(a), float(b))) for a, b in filled_gaps)
-        if self._refused is not None:
-            return self._stop(self._early(Status.BAD_INPUT, self._refused))
+        problem = self._refused if self._refused is not None else self._jump
+        if problem is not None:
+            return self._stop(self._early(Status.BAD_INPUT, problem))
         if self._monitor is not None:
             self._monitor.update_block(*fed)
         else:
@@ -288,6 +301,36 @@ class FrontEnd:
             self._detector.update_block(*fed)
         with _samples_arithmetic():
             return self._advance(first, stop)
+
+    def _put_back(
+        self, t: FloatArray, theta: FloatArray, force: FloatArray, torque: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """The block with the samples its time stamps skip put back (:func:`fill_missing`); the
+        long steps remembered as gaps from the sample after each, a step beyond any filling
+        refused (the next outcome is ``bad_input``)."""
+        n = self._n
+        previous = None
+        if n:
+            before = np.concatenate([self._theta[n - 1], self._force[n - 1], self._torque[n - 1]])
+            previous = (float(self._t[n - 1]), before)
+        try:
+            filled = fill_missing(
+                t,
+                np.hstack([theta, force, torque]),
+                self.sample_period,
+                self.config.max_gap,
+                previous,
+            )
+        except ValueError as exc:
+            self._jump = f"t: {exc}"
+            return t, theta, force, torque
+        if filled.t is t:
+            return t, theta, force, torque
+        self._put_back_at.append(n + np.flatnonzero(filled.filled))
+        ends = np.searchsorted(filled.t, [end for _, end in filled.gaps])
+        self._filled.extend((n + int(k), gap) for k, gap in zip(ends, filled.gaps, strict=True))
+        v = filled.values
+        return filled.t, v[:, 0:2], v[:, 2:5], v[:, 5:8]
 
     def _reserve(self, stop: int) -> None:
         size = self._t.shape[0]
@@ -453,7 +496,7 @@ class FrontEnd:
         torque_noise = signal_noise(self._torque[: hold.stop])[0]
         root = math.sqrt(start.count) if start.count else 1.0
         converged = self._converged
-        diagnostics = self._diagnostics()
+        diagnostics = self._diagnostics(end)
         diagnostics.update(
             {
                 "rebounds": hold.rebounds,
@@ -493,8 +536,18 @@ class FrontEnd:
             diagnostics=diagnostics,
         )
 
-    def _diagnostics(self) -> dict[str, Any]:
-        diagnostics = dict(self._notes)
+    def _notes_now(self, end: int | None = None) -> dict[str, Any]:
+        """What the caller said of the samples, and how many missing ones were put back up to
+        sample ``end`` (all held when None)."""
+        notes = dict(self._notes)
+        last = self._n - 1 if end is None else end
+        filled = sum(int(np.count_nonzero(at <= last)) for at in self._put_back_at)
+        if filled:
+            notes["filled_samples"] = filled
+        return notes
+
+    def _diagnostics(self, end: int | None = None) -> dict[str, Any]:
+        diagnostics = self._notes_now(end)
         if self._start is not None:
             diagnostics.update(
                 {
@@ -511,7 +564,7 @@ class FrontEnd:
         not in the format's units (found at t_c) says so first: the push or its absence was
         judged on loads of the wrong scale."""
         t = self._t
-        diagnostics = dict(self._notes) if status is Status.BAD_INPUT else self._diagnostics()
+        diagnostics = self._notes_now() if status is Status.BAD_INPUT else self._diagnostics()
         problem = None if self._start is None else self._start.input_problem
         if problem is not None and status is not Status.BAD_INPUT:
             diagnostics["other_reasons"] = [reason]

@@ -11,7 +11,8 @@
    against the impact. The push counts when its mean is ``min_push_significance`` standard
    errors above zero; the frame of Section 5.3 is built from that mean.
 4. Estimator 2's convergence tolerance (:func:`ratio_tolerance`) and t_e (:func:`planned_end`).
-5. Gaps of missing samples (:func:`time_gaps`, :func:`gap_problem`).
+5. Gaps of missing samples: filled in as they arrive (:func:`fill_missing`), remembered when long
+   (:func:`time_gaps`), judged over the estimation window (:func:`gap_problem`).
 
 :class:`~.frontend.FrontEnd` calls them in this order as the samples arrive.
 """
@@ -38,10 +39,13 @@ from sensing_antenna.estimation.front.ratio import contact_loads, load_offset, r
 from sensing_antenna.units_check import initial_rest, rest_reading
 
 __all__ = [
+    "MAX_FILLED",
     "ContactStart",
+    "FilledSamples",
     "HoldPush",
     "at_contact",
     "dead_channel",
+    "fill_missing",
     "free_motion_gain",
     "gap_problem",
     "hold_push",
@@ -90,6 +94,128 @@ def dead_channel(force: FloatArray, torque: FloatArray) -> str | None:
         if values.shape[0] > 1 and np.all(np.ptp(values, axis=0) == 0.0):
             return f"{name}: every component is constant over the recording (sensor not working)"
     return None
+
+
+#: Most samples :func:`fill_missing` puts back in one step of the time stamps: 100,000 (100 s at
+#: 1 kHz, far longer than a manoeuvre). A longer step is an outlier time stamp, whose filling
+#: would take memory without bound.
+MAX_FILLED = 100_000
+
+
+@dataclass(frozen=True)
+class FilledSamples:
+    """A block of samples with the missing ones put back (:func:`fill_missing`).
+
+    Attributes
+    ----------
+    t : array, shape (N,)
+        Time stamps (s): the block's own, and between two that step by k sample periods
+        (rounded, k >= 2), k - 1 more at equal steps.
+    values : array, shape (N, m)
+        The block's values, and the filled samples' by linear interpolation between the
+        samples on either side (the previous block's last for the first step).
+    origin : array of int, shape (N,)
+        For each sample, the block's sample it came with: its own index, or for a filled one
+        the index of the sample after its gap (which revealed it).
+    filled : array of bool, shape (N,)
+        True for the samples put back.
+    gaps : tuple of (float, float)
+        The steps (s, s) that missed more than ``max_gap`` samples: filled, but too long to be
+        read as the signal (:func:`gap_problem`).
+    """
+
+    t: FloatArray
+    values: FloatArray
+    origin: NDArray[np.intp]
+    filled: NDArray[np.bool_]
+    gaps: tuple[tuple[float, float], ...]
+
+
+def fill_missing(
+    t: FloatArray,
+    values: FloatArray,
+    sample_period: float,
+    max_gap: int,
+    previous: tuple[float, FloatArray] | None = None,
+) -> FilledSamples:
+    """The samples of a stream with those it missed put back on its grid, as they arrive.
+
+    Where consecutive time stamps step by k sample periods (rounded, k >= 2), the k - 1 samples
+    between are filled in by linear interpolation, at equal steps, as reading a whole recording
+    resamples it onto its grid (:func:`~sensing_antenna.recording.resample_uniform`): every
+    step of the front end reads the samples as uniform, so a missing one left out would shift
+    every instant after it by a period (a stream missing one sample in 20 reads its vibration
+    5 % fast). Steps shorter than 1.5 periods (jitter) are left as they are.
+
+    Parameters
+    ----------
+    t : array, shape (n,)
+        Time stamps (s), increasing.
+    values : array, shape (n, m)
+        The samples' values (any units).
+    sample_period : float
+        Nominal T_s (s).
+    max_gap : int
+        Steps missing more than this many samples are also reported as gaps.
+    previous : (float, array of shape (m,)), optional
+        The sample before the block (its time stamp and values); None at a stream's start.
+
+    Returns
+    -------
+    FilledSamples
+        The block itself (the same arrays) when no sample is missing.
+
+    Raises
+    ------
+    ValueError
+        When one step misses more than :data:`MAX_FILLED` samples (an outlier time stamp).
+    """
+    t = np.asarray(t, dtype=np.float64)
+    values = np.asarray(values, dtype=np.float64)
+    n = t.shape[0]
+    own = np.arange(n, dtype=np.intp)
+    if n == 0:
+        return FilledSamples(t, values, own, np.zeros(0, dtype=bool), ())
+    if previous is None:
+        left_t, left_values, right = t[:-1], values[:-1], slice(1, None)
+    else:
+        left_t = np.concatenate([[previous[0]], t[:-1]])
+        left_values = np.vstack([np.asarray(previous[1], dtype=np.float64), values[:-1]])
+        right = slice(0, None)
+    right_t = t[right]
+    with np.errstate(invalid="ignore", over="ignore"):
+        missing = np.rint((right_t - left_t) / sample_period) - 1.0
+    missing = np.where(np.isfinite(missing), missing, 0.0)
+    if not np.any(missing > 0.0):
+        return FilledSamples(t, values, own, np.zeros(n, dtype=bool), ())
+    k = int(np.argmax(missing))
+    if missing[k] > MAX_FILLED:
+        raise ValueError(
+            f"time jumps from {float(left_t[k])!r} to {float(right_t[k])!r} s, "
+            f"{missing[k] + 1:.4g} sample "
+            f"periods of {sample_period!r} s in one step: an outlier time stamp (at most "
+            f"{MAX_FILLED} missing samples are filled)"
+        )
+    counts = np.maximum(missing, 0.0).astype(np.intp) + 1
+    if previous is None:
+        counts = np.concatenate([[1], counts])
+        left_t = np.concatenate([[t[0]], left_t])
+        left_values = np.vstack([values[:1], left_values])
+    origin = np.repeat(own, counts)
+    # position of each output sample within its step: 1 .. counts, the block's own at counts
+    within = np.arange(origin.shape[0]) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    fraction = within / np.repeat(counts, counts)
+    is_own = within == np.repeat(counts, counts)
+    start_t, start_values = left_t[origin], left_values[origin]
+    filled_t = np.where(is_own, t[origin], start_t + fraction * (t[origin] - start_t))
+    filled_values = np.where(
+        is_own[:, None],
+        values[origin],
+        start_values + fraction[:, None] * (values[origin] - start_values),
+    )
+    long_steps = np.flatnonzero(missing > max_gap)
+    gaps = tuple((float(left_t[s + (previous is None)]), float(right_t[s])) for s in long_steps)
+    return FilledSamples(filled_t, filled_values, origin, ~is_own, gaps)
 
 
 def time_gaps(t: FloatArray, sample_period: float, max_gap: int) -> tuple[tuple[float, float], ...]:
