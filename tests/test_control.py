@@ -172,3 +172,35 @@ def test_bad_controller_input_is_one_clear_error() -> None:
         controller.step((0.0, 0.0, 0.0), (0.0, 0.0), (0.0, 0.0))
     with pytest.raises(ValueError, match="measured"):
         CouplingTorqueObserver(antenna.observer).step((0.0,))
+
+
+def test_a_glitch_is_refused_and_leaves_the_loop_as_it_was() -> None:
+    # One NaN angle stepped into the servo's or the observer's state would hold that joint's
+    # output at NaN until reset; it is refused before anything moves, so a loop that skips the
+    # sample goes on exactly as if it had never come
+    antenna = paper_antenna()
+    reference = np.column_stack([np.linspace(0.0, 0.02, 50), np.zeros(50)])
+    measured = 0.9 * reference
+    coupling = np.full((50, 2), 1e-3)
+    clean, glitched = HeadController(antenna), HeadController(antenna)
+    observed, observed_glitched = (CouplingTorqueObserver(antenna.observer) for _ in range(2))
+    for controller in (clean, glitched):
+        controller.reset(origin=np.zeros(2))
+    for k in range(50):
+        if k == 20:
+            with pytest.raises(ValueError, match=r"measured: \[0.0, nan\] is not finite"):
+                glitched.step(reference[k], (0.0, math.nan), coupling[k])
+            with pytest.raises(ValueError, match="coupling"):
+                glitched.step(reference[k], measured[k], (math.inf, 0.0))
+            with pytest.raises(ValueError, match="measured"):
+                observed_glitched.step((math.nan, 0.0))
+        expected = clean.step(reference[k], measured[k], coupling[k])
+        assert np.array_equal(glitched.step(reference[k], measured[k], coupling[k]), expected)
+        expected_torque = observed.step(measured[k])
+        assert np.array_equal(observed_glitched.step(measured[k]), expected_torque)
+    bad = measured.copy()
+    bad[7, 1] = math.nan
+    with pytest.raises(ValueError, match=r"measured: .* at row 7"):
+        HeadController(antenna).step_block(reference, bad, coupling)
+    with pytest.raises(ValueError, match="at row 7"):
+        CouplingTorqueObserver(antenna.observer).step_block(bad)

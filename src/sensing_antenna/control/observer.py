@@ -18,6 +18,8 @@ angles relative to the first ones stepped after a reset.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -65,12 +67,19 @@ class CouplingTorqueObserver:
         -------
         ndarray, shape (2,)
             Gamma_e,1 and Gamma_e,2 (N m).
+
+        Raises
+        ------
+        ValueError
+            For angles that are NaN or infinite (an encoder glitch): the observer's state is
+            untouched; a NaN stepped in would hold every later output at NaN.
         """
         angles = np.asarray(measured, dtype=np.float64)
         if angles.shape != (2,):
             raise ValueError(
                 f"measured: expected two angles (joints 1 and 2), got shape {angles.shape}"
             )
+        _finite(angles[None, :])
         return self._filter.update_block(angles[None, :])[0]
 
     def step_block(self, measured: ArrayLike) -> NDArray[np.float64]:
@@ -85,13 +94,32 @@ class CouplingTorqueObserver:
         -------
         ndarray, shape (n, 2)
             Gamma_e,1 and Gamma_e,2 (N m).
+
+        Raises
+        ------
+        ValueError
+            For misshapen angles or a NaN or infinite one (naming its row), the state untouched.
         """
         angles = np.asarray(measured, dtype=np.float64)
         if angles.ndim != 2 or angles.shape[1] != 2:
             raise ValueError(
                 f"measured: expected shape (n, 2) (joints 1 and 2), got shape {angles.shape}"
             )
+        _finite(angles)
         return self._filter.update_block(angles)
+
+
+def _finite(angles: NDArray[np.float64]) -> None:
+    """Refuse NaN or infinite angles (shape (n, 2))."""
+    if angles.shape[0] == 1 and math.isfinite(angles[0, 0]) and math.isfinite(angles[0, 1]):
+        return  # one sample, the loop's case: cheaper in Python than NumPy calls
+    bad = np.flatnonzero(~np.all(np.isfinite(angles), axis=1))
+    if bad.size:
+        where = f" at row {bad[0]}" if angles.shape[0] > 1 else ""
+        raise ValueError(
+            f"measured: {angles[bad[0]].tolist()}{where} is not finite (an encoder glitch?): "
+            "the torques were not computed, the state is unchanged"
+        )
 
 
 def observe_coupling_torques(

@@ -503,6 +503,13 @@ class HeadController:
         -------
         ndarray, shape (2,)
             Joint torques n K_m u (N m).
+
+        Raises
+        ------
+        ValueError
+            For a value that is NaN or infinite (an encoder or sensor glitch), naming it. The
+            controller's state is untouched: the loop may keep its last command for the sample
+            and step on with the next; a NaN stepped in would hold every later command at NaN.
         """
         rows = [
             _pair(v, name)[None, :]
@@ -512,6 +519,7 @@ class HeadController:
                 (coupling, "coupling"),
             )
         ]
+        _finite(rows)
         return self._block(*rows)[0]
 
     def step_block(
@@ -528,6 +536,12 @@ class HeadController:
         -------
         ndarray, shape (n, 2)
             Joint torques (N m); the command of row k uses the rows up to k only.
+
+        Raises
+        ------
+        ValueError
+            For misshapen inputs, or a NaN or infinite value (naming its row), the state
+            untouched, as :meth:`step`.
         """
         rows = [
             np.ascontiguousarray(np.asarray(v, dtype=np.float64).reshape(-1, 2))
@@ -538,6 +552,7 @@ class HeadController:
                 "reference, measured, coupling: shapes "
                 f"{', '.join(str(r.shape) for r in rows)} differ"
             )
+        _finite(rows)
         return self._block(*rows)
 
     def _block(
@@ -579,6 +594,22 @@ def _limits(
         unit = "N m" if name == "torque_limit" else "V"
         raise ControlConfigError(f"{name}: must be > 0 {unit}, got {values.tolist()}")
     return values if name == "torque_limit" else values * torque_gains
+
+
+def _finite(rows: list[NDArray[np.float64]]) -> None:
+    """Refuse NaN or infinite inputs (reference, measured, coupling: rows of shape (n, 2))."""
+    if rows[0].shape[0] == 1:
+        (a, b), (c, d), (e, f) = (r[0].tolist() for r in rows)
+        if math.isfinite(a + b + c + d + e + f):  # one sample, the loop's case: cheap
+            return
+    for name, values in zip(("reference", "measured", "coupling"), rows, strict=True):
+        bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+        if bad.size:
+            where = f" at row {bad[0]}" if values.shape[0] > 1 else ""
+            raise ValueError(
+                f"{name}: {values[bad[0]].tolist()}{where} is not finite (a glitch of the "
+                "encoders or the sensor?): the command was not computed, the state is unchanged"
+            )
 
 
 def _pair(values: ArrayLike, name: str) -> NDArray[np.float64]:
