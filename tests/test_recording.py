@@ -448,3 +448,32 @@ def test_a_header_with_another_separator_says_which(
     )
     with pytest.raises(RecordingError, match=f"one column separated by {called}"):
         read_recording(path)
+
+
+def test_a_loggers_text_columns_and_footer_are_left_out(tmp_path: Path) -> None:
+    # A lab's logger writes a state column, a sensor temperature it did not always read and a
+    # footer; the samples read as without them. A '#' line among the samples is refused
+    rows = [
+        "t,phase,theta1,theta2,fx,fy,fz,tx,ty,tz,temp_C",
+        "0.0,REST,0.0,0.0,0,0,-0.04,0,0.02,0,25.1",
+        "0.001,SWEEP,0.001,0.0,0,0,-0.04,0,0.02,0,",
+        "0.002,SWEEP,0.002,0.0,0,0,-0.04,0,0.02,0,nan",
+    ]
+    path = tmp_path / "lab.csv"
+    path.write_text("\n".join([*rows, "# end: 3 samples", ""]))
+    rec = read_recording(path)
+    assert dict(rec.extra) == {}
+    np.testing.assert_array_equal(rec.theta[:, 0], [0.0, 0.001, 0.002])
+    np.testing.assert_array_equal(rec.torque[:, 1], [0.02] * 3)
+    middle = tmp_path / "two.csv"
+    middle.write_text("\n".join([*rows[:2], "# another recording", *rows[2:], ""]))
+    with pytest.raises(RecordingError) as info:
+        read_recording(middle)
+    assert info.value.line == 3 and "a '#' line among the samples" in info.value.problem
+    text_required = tmp_path / "text.csv"
+    text_required.write_text(
+        "\n".join([*rows[:2], rows[2].replace("0.001,SWEEP,0.001", "0.001,SWEEP,x")])
+    )
+    with pytest.raises(RecordingError) as info:
+        read_recording(text_required)
+    assert (info.value.line, info.value.field) == (3, "theta1")

@@ -568,27 +568,48 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
     return names
 
 
-def _locate_bad_cell(
+def _numeric_columns(
     rows: list[str], first_line: int, names: list[str], source: str
-) -> RecordingError:
-    """Find the first malformed row or cell (slow path, only after the fast parse failed)."""
+) -> tuple[NDArray[np.float64], list[str]]:
+    """The table and its column names (slow path, only after the fast parse failed): every
+    column but the extra ones with a cell that is not a number. A row of the wrong length, a
+    '#' line among the samples or a required column's cell that is not a number is refused,
+    naming its line."""
+    required = [name in REQUIRED_COLUMNS for name in names]
+    text_columns: set[int] = set()
+    table = np.empty((len(rows), len(names)))
     for offset, row in enumerate(rows):
         cells = row.split(",")
         number = first_line + offset
+        if row.lstrip().startswith("#"):
+            raise RecordingError(
+                source,
+                number,
+                None,
+                "a '#' line among the samples: metadata go before the header, and a file "
+                "holds one recording",
+            )
         if len(cells) != len(names):
-            return RecordingError(
+            raise RecordingError(
                 source,
                 number,
                 None,
                 f"expected {len(names)} cells, found {len(cells)}"
                 + (" (truncated last row)" if offset == len(rows) - 1 else ""),
             )
-        for name, cell in zip(names, cells, strict=True):
+        for k, (name, cell) in enumerate(zip(names, cells, strict=True)):
+            if k in text_columns:
+                continue
             try:
-                float(cell)
+                table[offset, k] = float(cell)
             except ValueError:
-                return RecordingError(source, number, name, f"not a number ({cell.strip()!r})")
-    return RecordingError(source, None, None, "could not be parsed as numbers")  # pragma: no cover
+                if required[k]:
+                    raise RecordingError(
+                        source, number, name, f"not a number ({cell.strip()!r})"
+                    ) from None
+                text_columns.add(k)
+    kept = [k for k in range(len(names)) if k not in text_columns]
+    return table[:, kept], [names[k] for k in kept]
 
 
 def _read_text(path: str | Path, source: str) -> str:
@@ -676,15 +697,30 @@ def read_recording(path: str | Path) -> Recording:
         raise RecordingError(source, None, None, "no header row after the metadata")
     names = parse_header(lines[header_index], header_index + 1, source)
     rows = lines[header_index + 1 :]
+    # a logger's footer: '#' lines after the last sample say nothing the samples need
+    while rows and rows[-1].lstrip().startswith("#"):
+        rows.pop()
+        while rows and not rows[-1].strip():
+            rows.pop()
     first_line = header_index + 2
     if not rows:
         raise RecordingError(source, header_index + 1, None, "header but no data rows")
     try:
         data = np.loadtxt(rows, delimiter=",", dtype=np.float64, comments=None, ndmin=2)
-    except ValueError as exc:
-        raise _locate_bad_cell(rows, first_line, names, source) from exc
-    if data.shape[1] != len(names):
-        raise _locate_bad_cell(rows, first_line, names, source)
+    except ValueError:
+        data = None
+    if data is None or data.shape[1] != len(names):
+        # a row of the wrong length or a cell not a number: named, unless it lies in a column
+        # no reader needs (a logger's state or text column), which is left out whole
+        data, names = _numeric_columns(rows, first_line, names, source)
+    extra_bad = [
+        k
+        for k, name in enumerate(names)
+        if name not in REQUIRED_COLUMNS and not np.all(np.isfinite(data[:, k]))
+    ]
+    if extra_bad:  # NaN or infinite in a column no reader needs: left out whole
+        kept = [k for k in range(len(names)) if k not in extra_bad]
+        data, names = data[:, kept], [names[k] for k in kept]
     finite = np.isfinite(data)
     if not np.all(finite):
         row, col = np.argwhere(~finite)[0]
