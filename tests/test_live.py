@@ -521,3 +521,15 @@ def test_warm_up_runs_a_manoeuvre_and_freezes_the_heap() -> None:
         assert gc.get_freeze_count() > 0
     finally:
         gc.unfreeze()
+
+
+def test_a_stream_with_a_loggers_text_column_is_heard(recordings: dict[str, Path]) -> None:
+    # A column beyond the nine that holds text (a logger's state) is no reason to refuse the
+    # stream: the estimate is the one without it, as a file's reading leaves such a column out
+    recording = read_recording(recordings["azimuthal"])
+    lines = _lines(recording)
+    header_at = next(k for k, line in enumerate(lines) if not line.startswith(b"#"))
+    tagged = [*lines[:header_at], lines[header_at].rstrip(b"\r\n") + b",state\n"]
+    tagged += [line.rstrip(b"\r\n") + b",SWEEP\n" for line in lines[header_at + 1 :]]
+    found = next(e for e in _listen(tagged, "paper") if isinstance(e, EstimateEvent))
+    _same_estimate(found.to_dict(), estimate(recording, paper_antenna()).to_dict())
