@@ -142,3 +142,20 @@ def test_calibrate_goes_on_without_a_file_it_cannot_use(
     assert str(broken) in left_out[0] and f"{unknown}: no known contact point" in left_out[1]
     assert "np.float64" not in printed
     assert "3 recording(s)" in load_antenna(out).description
+
+
+def test_calibrate_points_out_a_point_too_few_others_can_judge(
+    contacts: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Three known points, the middle one written 5 cm short: below five points the fit cannot
+    # leave it out as a wrong point, but the line says it lies far off the others
+    points = tmp_path / "points.csv"
+    rows = [f"{path.name},{x}" for path, x in zip(contacts, (0.4, 0.55, 0.8), strict=True)]
+    points.write_text("file,x_c\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    out = tmp_path / "set.toml"
+    args = ["calibrate", *map(str, contacts), "--points", str(points), "--out", str(out)]
+    assert main(args) == 0
+    lines = capsys.readouterr().out.splitlines()
+    flagged = [line for line in lines if "check it" in line]
+    assert len(flagged) == 1 and f"{contacts[1]}: x_c = 0.5500 m" in flagged[0]
+    assert "no known contact point" not in "\n".join(lines)

@@ -112,6 +112,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.frequency import (
         MIN_TIP_MASS_POINTS,
+        MIN_WRONG_PEAK_POINTS,
         WRONG_PEAK,
         CalibrationError,
         calibrate_from_recordings,
@@ -146,11 +147,18 @@ def _run(args: argparse.Namespace) -> int:
     sensor_lines: list[str] = []
     if not args.no_sensor:
         # a point the frequency fit found wrong may be a wrong known point: not for the sensor
-        known = [
-            math.nan if wrong else x_c
-            for x_c, wrong in zip(points, calibration.wrong_peak_points, strict=True)
+        right = [not wrong for wrong in calibration.wrong_peak_points]
+        calibrated, sensor_lines = _calibrate_sensor(
+            calibrated,
+            [r for r, keep in zip(recordings, right, strict=True) if keep],
+            [x for x, keep in zip(points, right, strict=True) if keep],
+            [p for p, keep in zip(paths, right, strict=True) if keep],
+        )
+        sensor_lines += [
+            f"  sensor, left out: {path}: a wrong spectral peak or known point to the T_e fit"
+            for path, keep in zip(paths, right, strict=True)
+            if not keep
         ]
-        calibrated, sensor_lines = _calibrate_sensor(calibrated, recordings, known, paths)
     save_antenna(calibrated, args.out)
     print(
         f"T_e = {calibration.t_e:.5f} +- {calibration.t_e_std_error:.5f} s/m^2 "
@@ -175,6 +183,7 @@ def _run(args: argparse.Namespace) -> int:
     )
     print(_mode2_line(calibration))
     wrong = calibration.wrong_peak_points
+    doubtful = _doubtful_points(calibration, MIN_WRONG_PEAK_POINTS, WRONG_PEAK)
     for i, x_c in enumerate(calibration.contact_points):
         if not 0.0 < float(x_c) <= antenna.link.length:
             continue  # no known point on the link: its note below says so
@@ -186,6 +195,10 @@ def _run(args: argparse.Namespace) -> int:
                 f"; more than {100 * WRONG_PEAK:g} % off the others, left out of the fit: a "
                 "wrong spectral peak or a wrong known point?"
                 if wrong[i]
+                else f"; more than {100 * WRONG_PEAK:g} % off the others: with fewer than "
+                f"{MIN_WRONG_PEAK_POINTS} points the fit cannot tell a wrong spectral peak or "
+                "known point from the model's error, and kept it: check it"
+                if doubtful[i]
                 else ""
             )
         )
@@ -199,6 +212,22 @@ def _run(args: argparse.Namespace) -> int:
         print(f"figure {plot_calibration(calibration, antenna.link, args.plot)}")
     print(f"wrote {args.out}")
     return 0
+
+
+def _doubtful_points(calibration: FrequencyCalibration, fewest: int, share: float) -> list[bool]:
+    """Points used by a fit of fewer than ``fewest`` points whose omega_1 lies more than
+    ``share`` from the others' (the median relative residual): what the fit would leave out as
+    a wrong peak or point with more points beside it."""
+    import numpy as np
+
+    used = calibration.used & ~calibration.wrong_peak_points
+    with np.errstate(divide="ignore", invalid="ignore"):
+        relative = calibration.omega1_measured / calibration.omega1_fitted - 1.0
+    usable = used & np.isfinite(relative)
+    if usable.sum() >= fewest or usable.sum() < 3:
+        return [False] * len(used)
+    median = float(np.median(relative[usable]))
+    return [bool(u and abs(r - median) > share) for u, r in zip(usable, relative, strict=True)]
 
 
 def _mode2_line(calibration: FrequencyCalibration) -> str:
