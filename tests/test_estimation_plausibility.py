@@ -415,3 +415,26 @@ def test_a_stiffer_calibration_bends_the_touched_point_less(azimuthal: Recording
     assert b.diagnostics["deflection"] / a.diagnostics["deflection"] == pytest.approx(
         0.81 * (b.x_c / a.x_c) ** 3, rel=1e-3
     )
+
+
+def test_a_recording_that_starts_in_motion_is_told_to_start_at_rest() -> None:
+    # A vertical sweep logged from 0.2 s on, the head already lifting the link: the moment
+    # before the contact is read over the approach, where the motion adds to the weight. Read
+    # as a payload it would move the answer; the reason says to start the recording at rest
+    # rather than to give a payload the link does not carry
+    antenna = paper_antenna().self_calibrated()
+    recording = simulate(antenna, Scenario(case="vertical", contact_point=0.7, seed=3))
+    keep = slice(200, None)
+    late = dataclasses.replace(
+        recording.without_ground_truth(),
+        t=recording.t[keep] - recording.t[200],
+        theta=recording.theta[keep],
+        force=recording.force[keep],
+        torque=recording.torque[keep],
+        extra={},
+    )
+    result = estimate(late, antenna)
+    assert result.diagnostics["tare"] == "approach"
+    assert result.status is not Status.OK
+    assert "start the recording with half a second at rest" in (result.reason or "")
+    assert "link.tip_mass" not in (result.reason or "")

@@ -76,6 +76,17 @@ def test_scales_and_signs_that_are_not_the_weight(
     assert f"columns {columns}: over the {N} samples at rest" in reading.problem
 
 
+def test_a_sensor_tared_with_the_link_on_is_named_as_such() -> None:
+    # Tared with the link mounted, the sensor reads no weight: the reason says so, where a
+    # torque in N mm or with a sign flipped gets the reason of a wrong scale
+    theta, force, torque = at_rest()
+    tared = rest_reading(theta, force - force.mean(axis=0), torque - torque.mean(axis=0), ANTENNA)
+    assert "a sensor tared with the link on it" in (tared.problem or "")
+    flipped = rest_reading(theta, force, -torque, ANTENNA)
+    assert "a sign flipped?" in (flipped.problem or "")
+    assert "tared" not in (flipped.problem or "")
+
+
 def test_tolerances_are_fractions_of_the_weight() -> None:
     reading = rest_reading(*at_rest(), ANTENNA)
     assert reading.torque_tolerance == pytest.approx(

@@ -212,11 +212,19 @@ def rest_reading(
             "beyond 1e300?)"
         )
     elif torque_off > torque_tolerance:
+        # a moment near zero at rest: the weight taken out by a tare with the link mounted
+        tared = float(np.linalg.norm(mean_torque)) <= torque_tolerance
+        causes = (
+            "a sensor tared with the link on it (tare it without the link: the format's "
+            "loads hold its weight)?"
+            if tared
+            else "torques in N mm, scaled, or a sign flipped?"
+        )
         problems.append(
             f"columns {_TORQUE_COLUMNS}: over {duration} the torque reads "
             f"{_vector(mean_torque)} N m, {_times(reading.torque_scale)} the moment of the "
             f"link's weight {_vector(expected_torque)} N m that the antenna predicts (more "
-            f"than {torque_tolerance:.3g} N m away): torques in N mm, scaled, or a sign flipped?"
+            f"than {torque_tolerance:.3g} N m away): {causes}"
         )
     if not math.isfinite(force_off):
         problems.append(

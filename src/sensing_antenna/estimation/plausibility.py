@@ -370,6 +370,16 @@ def _payload_problem(
     notes["payload_spread"] = spread
     if not spread > limit:
         return None
+    if evidence.diagnostics.get("tare") == "approach":
+        # no rest at the start: the moment was read while the head moved towards the contact
+        return (
+            f"before the contact the link's moment ty reads {excess:.3g} N m more than the "
+            "model's weight, over the approach (the recording does not start at rest, so the "
+            "head's motion is in that reading): as a payload at the tip, "
+            f"{1e3 * mass:.2g} g, it would move the contact point the vibration gives by "
+            f"{100 * spread:.1f} cm, more than {100 * limit:g} cm; start the recording with "
+            "half a second at rest to read the weight"
+        )
     return (
         f"at rest the link's moment ty is {excess:.3g} N m more than the model's weight (the "
         f"offset a tare leaves is a few sensor counts): {1e3 * mass:.2g} g at the tip that the "
