@@ -455,7 +455,8 @@ def test_a_stream_missing_samples_is_estimated_as_the_file_is(
 def test_a_stream_whose_time_stamps_jitter_is_read(recordings: dict[str, Path]) -> None:
     # Time stamps taken on a computer jitter by a fraction of a period; the declared period is
     # read from a line through the first stamps, which a median of steps is not steady enough
-    # for (0.2 ms of jitter at 1 kHz moved it beyond 2 % in about 4 streams in 10)
+    # for (0.2 ms of jitter at 1 kHz moved it beyond 2 % in about 4 streams in 10), and a
+    # step of 1.6 periods, a late stamp after an early one, is no sample lost
     whole = read_recording(recordings["azimuthal"])
     lines = _lines(whole)
     header_at = next(k for k, line in enumerate(lines) if not line.startswith(b"#"))
@@ -463,10 +464,11 @@ def test_a_stream_whose_time_stamps_jitter_is_read(recordings: dict[str, Path]) 
     shaken = lines[: header_at + 1]
     for line in lines[header_at + 1 :]:
         cells = line.decode().split(",")
-        cells[0] = repr(round(float(cells[0]) + rng.uniform(-2e-4, 2e-4), 7))
+        cells[0] = repr(round(float(cells[0]) + rng.uniform(-3e-4, 3e-4), 7))
         shaken.append(",".join(cells).encode())
     events = _listen(shaken, "paper")
     found = next(e for e in events if isinstance(e, EstimateEvent))
+    assert "filled_samples" not in found.estimate.diagnostics
     assert found.estimate.status == estimate(whole, paper_antenna()).status
     assert abs(found.x_c - estimate(whole, paper_antenna()).x_c) < 1e-4
 

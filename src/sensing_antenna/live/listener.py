@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.front.steps import fill_missing
+from sensing_antenna.estimation.front.steps import fill_missing, samples_missing
 from sensing_antenna.estimation.methods import EstimationMethod
 from sensing_antenna.estimation.online import OnlineEstimator
 from sensing_antenna.estimation.result import ContactEstimate
@@ -272,11 +272,11 @@ class Listener:
         ts = self.header.sample_period
         stamps = self._stamps.values[: steps + 1]
         step = np.diff(stamps)
-        # a dropped sample is a step of whole periods, each step read against its nearest
-        # multiple; but most steps are one period (a stream stepping by ten declared periods
-        # declares a tenth of its period). A few steps cannot tell drops from a wrong period:
-        # only their multiples are judged
-        periods = np.maximum(np.rint(step / ts), 1.0)
+        # a dropped sample is a step of whole periods (:func:`samples_missing`); but most
+        # steps are one period (a stream stepping by ten declared periods declares a tenth of
+        # its period). A few steps cannot tell drops from a wrong period: only their
+        # multiples are judged
+        periods = 1.0 + samples_missing(step, ts)
         if steps >= MIN_STEPS_FOR_DROPS and float(np.median(periods)) != 1.0:
             period, how = float(np.median(step)), f"the median of its first {steps} steps"
         else:

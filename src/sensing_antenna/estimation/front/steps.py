@@ -40,6 +40,7 @@ from sensing_antenna.units_check import initial_rest, rest_reading
 
 __all__ = [
     "MAX_FILLED",
+    "STEP_JITTER",
     "ContactStart",
     "FilledSamples",
     "HoldPush",
@@ -53,6 +54,7 @@ __all__ = [
     "planned_end",
     "ratio_tolerance",
     "samples",
+    "samples_missing",
     "sampling_problem",
     "time_gaps",
 ]
@@ -102,6 +104,23 @@ def dead_channel(force: FloatArray, torque: FloatArray) -> str | None:
 MAX_FILLED = 100_000
 
 
+#: Jitter allowed to a step that lost samples (periods): a step of at least k - 0.25 periods
+#: counts as k (k - 1 samples missing). A sample lost with the stamps' jitter steps by 2 +- 0.25
+#: periods, while a stamp taken late after one taken early (a stream whose stamps jitter by a
+#: third of a period) steps by up to 1.67: filled, it would add a sample that never was and put
+#: every later instant a period late. Long steps are counted the same way.
+STEP_JITTER = 0.25
+
+
+def samples_missing(steps: FloatArray, sample_period: float) -> FloatArray:
+    """Samples missing in each time step (s, any shape) of a stream sampled at
+    ``sample_period`` (s): k - 1 for a step of at least k - :data:`STEP_JITTER` periods
+    (k >= 2), else 0 (also for a step that is not finite)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        missing = np.floor(np.asarray(steps, dtype=np.float64) / sample_period + STEP_JITTER)
+    return np.where(np.isfinite(missing) & (missing > 1.0), missing - 1.0, 0.0)
+
+
 @dataclass(frozen=True)
 class FilledSamples:
     """A block of samples with the missing ones put back (:func:`fill_missing`).
@@ -110,7 +129,7 @@ class FilledSamples:
     ----------
     t : array, shape (N,)
         Time stamps (s): the block's own, and between two that step by k sample periods
-        (rounded, k >= 2), k - 1 more at equal steps.
+        (:func:`samples_missing`), k - 1 more at equal steps.
     values : array, shape (N, m)
         The block's values, and the filled samples' by linear interpolation between the
         samples on either side (the previous block's last for the first step).
@@ -140,12 +159,13 @@ def fill_missing(
 ) -> FilledSamples:
     """The samples of a stream with those it missed put back on its grid, as they arrive.
 
-    Where consecutive time stamps step by k sample periods (rounded, k >= 2), the k - 1 samples
+    Where consecutive time stamps step by k sample periods (k >= 2, less
+    :data:`STEP_JITTER` at most: :func:`samples_missing`), the k - 1 samples
     between are filled in by linear interpolation, at equal steps, as reading a whole recording
     resamples it onto its grid (:func:`~sensing_antenna.recording.resample_uniform`): every
     step of the front end reads the samples as uniform, so a missing one left out would shift
     every instant after it by a period (a stream missing one sample in 20 reads its vibration
-    5 % fast). Steps shorter than 1.5 periods (jitter) are left as they are.
+    5 % fast). Other steps (jitter) are left as they are.
 
     Parameters
     ----------
@@ -183,9 +203,7 @@ def fill_missing(
         left_values = np.vstack([np.asarray(previous[1], dtype=np.float64), values[:-1]])
         right = slice(0, None)
     right_t = t[right]
-    with np.errstate(invalid="ignore", over="ignore"):
-        missing = np.rint((right_t - left_t) / sample_period) - 1.0
-    missing = np.where(np.isfinite(missing), missing, 0.0)
+    missing = samples_missing(right_t - left_t, sample_period)
     if not np.any(missing > 0.0):
         return FilledSamples(t, values, own, np.zeros(n, dtype=bool), ())
     k = int(np.argmax(missing))
@@ -230,8 +248,7 @@ def time_gaps(t: FloatArray, sample_period: float, max_gap: int) -> tuple[tuple[
     max_gap : int
         Largest number of missing samples in a row that linear interpolation may fill.
     """
-    steps = np.diff(np.asarray(t, dtype=float))
-    missing = np.rint(steps / sample_period) - 1.0
+    missing = samples_missing(np.diff(np.asarray(t, dtype=float)), sample_period)
     where = np.flatnonzero(missing > max_gap)
     return tuple((float(t[k]), float(t[k + 1])) for k in where)
 
