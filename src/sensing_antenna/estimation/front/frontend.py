@@ -245,10 +245,10 @@ class FrontEnd:
         Parameters
         ----------
         t : array_like, shape (n,)
-            Sample times (s). Where they step by k sample periods (k >= 2, less a quarter at most:
-            :func:`.steps.samples_missing`), the k - 1
-            samples missing are put back by linear interpolation (:func:`.steps.fill_missing`,
-            as a whole recording is resampled) and counted in the diagnostics
+            Sample times (s). Where they step by k sample periods (k >= 2, less a quarter at
+            most: :func:`.steps.samples_missing`), the k - 1 samples missing are put back by
+            linear interpolation (:func:`.steps.fill_missing`, as a whole recording is
+            resampled) and counted in the diagnostics
             (``filled_samples``); steps of more than ``config.max_gap`` missing samples are also
             gaps, and one beyond :data:`.steps.MAX_FILLED` makes the outcome ``bad_input``.
         theta : array_like, shape (n, 2)
