@@ -87,6 +87,14 @@ def test_a_sensor_tared_with_the_link_on_is_named_as_such() -> None:
     assert "tared" not in (flipped.problem or "")
 
 
+def test_the_one_column_in_a_wrong_unit_is_named() -> None:
+    # tz alone written in N mm: the reason says where the reading is off
+    theta, force, torque = at_rest()
+    torque[:, 2] = 1000 * (torque[:, 2] + 0.0218 / 1000)
+    reading = rest_reading(theta, force, torque, ANTENNA)
+    assert "most of it in 'tz'" in (reading.problem or "")
+
+
 def test_tolerances_are_fractions_of_the_weight() -> None:
     reading = rest_reading(*at_rest(), ANTENNA)
     assert reading.torque_tolerance == pytest.approx(

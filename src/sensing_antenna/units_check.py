@@ -224,7 +224,8 @@ def rest_reading(
             f"columns {_TORQUE_COLUMNS}: over {duration} the torque reads "
             f"{_vector(mean_torque)} N m, {_times(reading.torque_scale)} the moment of the "
             f"link's weight {_vector(expected_torque)} N m that the antenna predicts (more "
-            f"than {torque_tolerance:.3g} N m away): {causes}"
+            f"than {torque_tolerance:.3g} N m away{_worst(mean_torque, expected_torque, 'txyz')})"
+            f": {causes}"
         )
     if not math.isfinite(force_off):
         problems.append(
@@ -235,12 +236,23 @@ def rest_reading(
         problems.append(
             f"columns {_FORCE_COLUMNS}: over {duration} the force reads {_vector(mean_force)} N, "
             f"{_times(reading.force_scale)} the link's weight {_vector(expected_force)} N that "
-            f"the antenna predicts (more than {force_tolerance:.3g} N away): forces in mN, "
-            "scaled, or a sign flipped?"
+            f"the antenna predicts (more than {force_tolerance:.3g} N away"
+            f"{_worst(mean_force, expected_force, 'fxyz')}): forces in mN, scaled, or a sign "
+            "flipped?"
         )
     if not problems:
         return reading
     return RestReading(**{**reading.__dict__, "problem": "; ".join(problems)})
+
+
+def _worst(read: FloatArray, expected: FloatArray, names: str) -> str:
+    """Which column (``names``: the letter, then x, y, z) lies farthest from its expected value,
+    when it holds most of the distance: a single column in the wrong unit or sign."""
+    off = np.abs(read - expected)
+    k = int(np.argmax(off))
+    if not (math.isfinite(off[k]) and off[k] ** 2 > 0.8 * float(off @ off)):
+        return ""
+    return f", most of it in '{names[0]}{names[1 + k]}'"
 
 
 def _vector(values: FloatArray) -> str:
