@@ -158,4 +158,27 @@ def test_calibrate_points_out_a_point_too_few_others_can_judge(
     lines = capsys.readouterr().out.splitlines()
     flagged = [line for line in lines if "check it" in line]
     assert len(flagged) == 1 and f"{contacts[1]}: x_c = 0.5500 m" in flagged[0]
-    assert "no known contact point" not in "\n".join(lines)
+
+
+def test_calibrate_keeps_a_point_it_left_out_out_of_the_sensor_fit(
+    contacts: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Five known points, one written 5 cm short: the T_e fit leaves it out as a wrong point,
+    # and the sensor's fit leaves it out by name, not as a point without a known contact
+    more = []
+    for i, x_c in enumerate((0.5, 0.7)):
+        scenario = Scenario(case="azimuthal", contact_point=x_c, duration=2.0, seed=20 + i)
+        more.append(tmp_path / f"more-{i}.csv")
+        write_recording(simulate(paper_antenna(), scenario), more[-1])
+    files = [*contacts, *more]
+    points = tmp_path / "points.csv"
+    known = (0.4, 0.55, 0.8, 0.5, 0.7)
+    rows = [f"{path.name},{x}" for path, x in zip(files, known, strict=True)]
+    points.write_text("file,x_c\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    out = tmp_path / "set.toml"
+    args = ["calibrate", *map(str, files), "--points", str(points), "--out", str(out)]
+    assert main(args) == 0
+    printed = capsys.readouterr().out
+    assert f"{contacts[1]}: x_c = 0.5500 m" in printed and "left out of the fit" in printed
+    assert f"sensor, left out: {contacts[1]}: a wrong spectral peak or known point" in printed
+    assert "no known contact point" not in printed

@@ -470,6 +470,14 @@ def test_a_loggers_text_columns_and_footer_are_left_out(tmp_path: Path) -> None:
     with pytest.raises(RecordingError) as info:
         read_recording(middle)
     assert info.value.line == 3 and "a '#' line among the samples" in info.value.problem
+    # a column the format names (the motor commands) is judged as the nine are
+    commands = tmp_path / "commands.csv"
+    commands.write_text(
+        "t,theta1,theta2,fx,fy,fz,tx,ty,tz,u1,u2\n0,0,0,0,0,0,0,0,0,0.1,0.2\n0.001,0,0,0,0,0,0,0,0,,0.2\n"
+    )
+    with pytest.raises(RecordingError) as info:
+        read_recording(commands)
+    assert (info.value.line, info.value.field) == (3, "u1")
     text_required = tmp_path / "text.csv"
     text_required.write_text(
         "\n".join([*rows[:2], rows[2].replace("0.001,SWEEP,0.001", "0.001,SWEEP,x")])

@@ -47,6 +47,8 @@ __all__ = [
     "MAX_PERIODS_PER_SAMPLE",
     "MAX_SAMPLES",
     "MIN_SAMPLE_PERIOD",
+    "NAMED_COLUMNS",
+    "REFERENCE_COLUMNS",
     "REQUIRED_COLUMNS",
     "Recording",
     "RecordingError",
@@ -81,6 +83,17 @@ CONTACT_POINT_COLUMNS = ("true_contact_x", "true_contact_y", "true_contact_z")
 #: columns hold 0).
 IN_CONTACT_COLUMN = "true_in_contact"
 CONTACT_TRACK_COLUMNS = (*CONTACT_POINT_COLUMNS, IN_CONTACT_COLUMN)
+
+#: Optional columns of the commanded angles theta*_1, theta*_2 (rad; the simulator writes them,
+#: ``antenna plot recording`` draws them).
+REFERENCE_COLUMNS = ("theta1_ref", "theta2_ref")
+
+#: Columns this format names: a cell of one that is not a finite number is an error, where a
+#: column the format does not name with such a cell (a logger's state, a reading it did not
+#: always take) is left out whole.
+NAMED_COLUMNS = frozenset(
+    (*REQUIRED_COLUMNS, *COMMAND_COLUMNS, *CONTACT_TRACK_COLUMNS, *REFERENCE_COLUMNS)
+)
 
 #: Metadata keys that hold ground truth besides those starting with :data:`GROUND_TRUTH_PREFIX`.
 GROUND_TRUTH_KEYS = frozenset({"seed", "simulation"})
@@ -572,10 +585,10 @@ def _numeric_columns(
     rows: list[str], first_line: int, names: list[str], source: str
 ) -> tuple[NDArray[np.float64], list[str]]:
     """The table and its column names (slow path, only after the fast parse failed): every
-    column but the extra ones with a cell that is not a number. A row of the wrong length, a
-    '#' line among the samples or a required column's cell that is not a number is refused,
-    naming its line."""
-    required = [name in REQUIRED_COLUMNS for name in names]
+    column but those the format does not name (:data:`NAMED_COLUMNS`) with a cell that is not a
+    number. A row of the wrong length, a '#' line among the samples or a named column's cell
+    that is not a number is refused, naming its line."""
+    required = [name in NAMED_COLUMNS for name in names]
     text_columns: set[int] = set()
     table = np.empty((len(rows), len(names)))
     for offset, row in enumerate(rows):
@@ -716,9 +729,9 @@ def read_recording(path: str | Path) -> Recording:
     extra_bad = [
         k
         for k, name in enumerate(names)
-        if name not in REQUIRED_COLUMNS and not np.all(np.isfinite(data[:, k]))
+        if name not in NAMED_COLUMNS and not np.all(np.isfinite(data[:, k]))
     ]
-    if extra_bad:  # NaN or infinite in a column no reader needs: left out whole
+    if extra_bad:  # NaN or infinite in a column the format does not name: left out whole
         kept = [k for k in range(len(names)) if k not in extra_bad]
         data, names = data[:, kept], [names[k] for k in kept]
     finite = np.isfinite(data)

@@ -216,7 +216,7 @@ def rest_reading(
         tared = float(np.linalg.norm(mean_torque)) <= torque_tolerance
         causes = (
             "a sensor tared with the link on it (tare it without the link: the format's "
-            "loads hold its weight)?"
+            "loads hold its weight), or torques scaled far down?"
             if tared
             else "torques in N mm, scaled, or a sign flipped?"
         )

@@ -183,7 +183,7 @@ def _run(args: argparse.Namespace) -> int:
     )
     print(_mode2_line(calibration))
     wrong = calibration.wrong_peak_points
-    doubtful = _doubtful_points(calibration, MIN_WRONG_PEAK_POINTS, WRONG_PEAK)
+    doubtful = _doubtful_points(calibration, WRONG_PEAK)
     for i, x_c in enumerate(calibration.contact_points):
         if not 0.0 < float(x_c) <= antenna.link.length:
             continue  # no known point on the link: its note below says so
@@ -195,9 +195,10 @@ def _run(args: argparse.Namespace) -> int:
                 f"; more than {100 * WRONG_PEAK:g} % off the others, left out of the fit: a "
                 "wrong spectral peak or a wrong known point?"
                 if wrong[i]
-                else f"; more than {100 * WRONG_PEAK:g} % off the others: with fewer than "
-                f"{MIN_WRONG_PEAK_POINTS} points the fit cannot tell a wrong spectral peak or "
-                "known point from the model's error, and kept it: check it"
+                else f"; more than {100 * WRONG_PEAK:g} % off the others, kept in the fit (it "
+                f"leaves such a point out from {MIN_WRONG_PEAK_POINTS} points on, one or a tenth "
+                "of them: more are the model's error): a wrong spectral peak or known point? "
+                "check it"
                 if doubtful[i]
                 else ""
             )
@@ -214,20 +215,19 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _doubtful_points(calibration: FrequencyCalibration, fewest: int, share: float) -> list[bool]:
-    """Points used by a fit of fewer than ``fewest`` points whose omega_1 lies more than
-    ``share`` from the others' (the median relative residual): what the fit would leave out as
-    a wrong peak or point with more points beside it."""
+def _doubtful_points(calibration: FrequencyCalibration, share: float) -> list[bool]:
+    """Points the fit kept whose omega_1 lies more than ``share`` from the others' (the median
+    relative residual of the points it used, three at least): a wrong peak or known point the
+    fit could not leave out (below five points, or beyond the one or a tenth it leaves out)."""
     import numpy as np
 
-    used = calibration.used & ~calibration.wrong_peak_points
     with np.errstate(divide="ignore", invalid="ignore"):
         relative = calibration.omega1_measured / calibration.omega1_fitted - 1.0
-    usable = used & np.isfinite(relative)
-    if usable.sum() >= fewest or usable.sum() < 3:
-        return [False] * len(used)
-    median = float(np.median(relative[usable]))
-    return [bool(u and abs(r - median) > share) for u, r in zip(usable, relative, strict=True)]
+    usable = calibration.used & np.isfinite(relative)
+    if usable.sum() < 3:
+        return [False] * len(usable)
+    far = np.abs(relative - float(np.median(relative[usable]))) > share
+    return [bool(k) for k in usable & far & ~calibration.wrong_peak_points]
 
 
 def _mode2_line(calibration: FrequencyCalibration) -> str:

@@ -38,7 +38,7 @@ class OnlineEstimator:
     ----------
     antenna : Antenna
     sample_period : float
-        T_s (s) of the uniform samples that will be fed.
+        T_s (s) of the samples that will be fed (those their time stamps skip are put back).
     method : str or EstimationMethod
         As for ``estimate``.
     config : EstimatorConfig, optional
@@ -53,8 +53,10 @@ class OnlineEstimator:
     :meth:`update` returns the estimate exactly once, at the sample it is given (t_e, or the
     earlier instant a method that stops early is ready at), and None otherwise (also after the
     estimate). :meth:`finalize` closes a run that ended first (no contact, no push, too short)
-    and returns the estimate ``estimate`` gives on the same samples. Time stamps that skip more
-    than ``config.max_gap`` samples are remembered as gaps.
+    and returns the estimate ``estimate`` gives on the same samples. Samples the time stamps
+    skip are put back by linear interpolation as they become known
+    (:meth:`~.front.frontend.FrontEnd.update_block`), and more than ``config.max_gap`` in a row
+    are remembered as gaps; the indices below count them.
     """
 
     def __init__(
@@ -83,17 +85,19 @@ class OnlineEstimator:
 
     @property
     def n_samples(self) -> int:
-        """Samples fed since :meth:`reset`."""
+        """Samples held since :meth:`reset`: those fed and those put back where the time stamps
+        skipped some."""
         return self._front.n_samples
 
     @property
     def contact_index(self) -> int | None:
-        """Sample of t_c (counted from the first after :meth:`reset`), once found."""
+        """Sample of t_c (counted from the first after :meth:`reset`, the samples put back
+        included), once found."""
         return self._front.contact_index
 
     @property
     def rest_index(self) -> int | None:
-        """Sample of t_1 (counted from the first after :meth:`reset`), once found."""
+        """Sample of t_1 (counted as :attr:`contact_index`), once found."""
         return self._front.rest_index
 
     def update(

@@ -83,6 +83,21 @@ class _Growing:
         self.size = stop
 
 
+def _period_of_line(stamps: NDArray[np.float64], countings: list[NDArray[np.float64]]) -> float:
+    """The slope (s) of the least-squares line through ``stamps`` (shape (n,)) against their
+    sample numbers, those numbered by the one of ``countings`` (periods of each step, shape
+    (n - 1,)) the line fits best."""
+    best = (math.inf, math.nan)
+    relative = stamps - stamps[0]
+    for periods in countings:
+        number = np.concatenate([[0.0], np.cumsum(periods)])
+        number -= number.mean()
+        slope = float(number @ relative / (number @ number))
+        misfit = relative - relative.mean() - slope * number
+        best = min(best, (float(misfit @ misfit), slope))
+    return best[1]
+
+
 class Listener:
     """One recording received live (module docstring).
 
@@ -233,25 +248,27 @@ class Listener:
         self._stamps.extend(t[: PERIOD_CHECK_STEPS + 1 - self._stamps.size])
         self._check_period()
         # the samples as the estimator holds them, missing ones put back: the instants it
-        # reports are indices into these
-        try:
-            filled = fill_missing(
-                t, rows, self.header.sample_period, self._estimator.config.max_gap, self._last
-            )
-        except ValueError as exc:
-            raise WireError(f"{self.header.source}: t: {exc}") from None
+        # reports are indices into these (after an outlier time stamp, which ends its run, the
+        # rest as they came, for the contact's loss)
+        filled = fill_missing(
+            t, rows, self.header.sample_period, self._estimator.config.max_gap, self._last
+        )
         self._last = (float(t[-1]), rows[-1])
         first = self._t.size
         self._t.extend(filled.t)
+        self._t.extend(t[filled.taken :])
         self._received.extend(received[filled.origin])
-        self.dropped += filled.t.shape[0] - t.shape[0]
+        self._received.extend(received[filled.taken :])
+        self.dropped += int(filled.filled.sum())
+        residual_rows = np.vstack([filled.values, rows[filled.taken :]])
         theta, force, torque = (rows[:, columns] for columns in self._columns[1:])
         estimator = self._estimator
         result = None
         if estimator.result is None:
             result = estimator.update_block(t, theta, force, torque, every_instant=True)
         self._residual.update_block(
-            filled.t, *(filled.values[:, columns] for columns in self._columns[1:])
+            residual_rows[:, self._columns[0][0]],
+            *(residual_rows[:, columns] for columns in self._columns[1:]),
         )
         self._say_instants(first)
         if result is not None:
@@ -280,12 +297,12 @@ class Listener:
         if steps >= MIN_STEPS_FOR_DROPS and float(np.median(periods)) != 1.0:
             period, how = float(np.median(step)), f"the median of its first {steps} steps"
         else:
-            # the period is the slope of the time stamps against their sample numbers (drops
-            # counted): each stamp's jitter averages out over the line, where it stays in a
-            # median of steps (a tenth of a period of jitter moves that by a few per cent)
-            number = np.concatenate([[0.0], np.cumsum(periods)])
-            number -= number.mean()
-            period = float(number @ (stamps - stamps[0]) / (number @ number))
+            # the period is the slope of the time stamps against their sample numbers: each
+            # stamp's jitter averages out over the line, where it stays in a median of steps (a
+            # tenth of a period of jitter moves that by a few per cent). The drops are counted
+            # as the line fits the stamps best: a step of 1.6 periods is a late stamp after an
+            # early one, or a lost sample with jitter, and only the others tell which
+            period = _period_of_line(stamps, [periods, np.maximum(np.rint(step / ts), 1.0)])
             how = f"a line through its first {steps + 1} time stamps"
             if abs(period - ts) <= PERIOD_CONSISTENCY * ts:
                 return

@@ -24,7 +24,7 @@ from types import MappingProxyType
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import (
     FORMAT_NAME,
-    REQUIRED_COLUMNS,
+    NAMED_COLUMNS,
     RecordingError,
     parse_header,
     parse_metadata,
@@ -152,15 +152,16 @@ def read_header(lines: Sequence[str], source: str, first_line: int = 1) -> Strea
 
 
 def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> list[float]:
-    """The numbers of one sample line, in the header's column order. A cell of a column beyond
-    the nine required that is not a finite number (a logger's state name, a reading not taken)
-    is NaN: no reader needs it, and a file read back leaves that column out.
+    """The numbers of one sample line, in the header's column order. A cell that is not a finite
+    number in a column the format does not name (a logger's state name, a reading not taken;
+    :data:`~sensing_antenna.recording.NAMED_COLUMNS`) is NaN: a file read back leaves that
+    column out.
 
     Raises
     ------
     RecordingError
         Naming the stream, the line ``number`` and the column: a wrong number of cells, a cell
-        of a required column that is not a number, NaN or infinite.
+        of a named column that is not a number, NaN or infinite.
     """
     cells = line.split(",")
     if len(cells) != len(header.columns):
@@ -171,13 +172,13 @@ def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> 
         try:
             value = float(cell)
         except ValueError:
-            if name not in REQUIRED_COLUMNS:
+            if name not in NAMED_COLUMNS:
                 values.append(math.nan)
                 continue
             raise RecordingError(
                 header.source, number, name, f"not a number ({cell.strip()!r})"
             ) from None
-        if not math.isfinite(value) and name not in REQUIRED_COLUMNS:
+        if not math.isfinite(value) and name not in NAMED_COLUMNS:
             values.append(math.nan)
             continue
         if not math.isfinite(value):

@@ -47,6 +47,7 @@ from sensing_antenna.estimation.front.ratio import (
     window_mean,
 )
 from sensing_antenna.estimation.front.steps import (
+    STEP_JITTER,
     ContactStart,
     HoldPush,
     at_contact,
@@ -292,44 +293,50 @@ class FrontEnd:
         self._n = stop
         if filled_gaps:
             self._filled.extend((first, (float(a), float(b))) for a, b in filled_gaps)
-        problem = self._refused if self._refused is not None else self._jump
-        if problem is not None:
-            return self._stop(self._early(Status.BAD_INPUT, problem))
-        if self._monitor is not None:
-            self._monitor.update_block(*fed)
-        else:
-            assert self._detector is not None
-            self._detector.update_block(*fed)
-        with _samples_arithmetic():
-            return self._advance(first, stop)
+        if self._refused is not None:
+            return self._stop(self._early(Status.BAD_INPUT, self._refused))
+        outcome = None
+        if stop > first:
+            if self._monitor is not None:
+                self._monitor.update_block(*fed)
+            else:
+                assert self._detector is not None
+                self._detector.update_block(*fed)
+            with _samples_arithmetic():
+                outcome = self._advance(first, stop)
+        if outcome is None and self._jump is not None:
+            # the samples before an outlier time stamp said what they could; it ends the run
+            return self._stop(self._early(Status.BAD_INPUT, self._jump))
+        return outcome
 
     def _put_back(
         self, t: FloatArray, theta: FloatArray, force: FloatArray, torque: FloatArray
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """The block with the samples its time stamps skip put back (:func:`fill_missing`); the
-        long steps remembered as gaps from the sample after each, a step beyond any filling
-        refused (the next outcome is ``bad_input``)."""
-        n = self._n
+        """The block with the samples its time stamps skip put back (:func:`fill_missing`), the
+        long steps remembered as gaps from their first sample put back; cut before a step
+        beyond any filling, which ends the run (``bad_input``) after the samples before it."""
+        n, ts = self._n, self.sample_period
+        if (
+            n
+            and t.shape[0] == 1
+            and (float(t[0]) - float(self._t[n - 1])) < (2.0 - STEP_JITTER) * ts
+        ):
+            return t, theta, force, torque  # the loop's case: the next sample, nothing skipped
         previous = None
         if n:
             before = np.concatenate([self._theta[n - 1], self._force[n - 1], self._torque[n - 1]])
             previous = (float(self._t[n - 1]), before)
-        try:
-            filled = fill_missing(
-                t,
-                np.hstack([theta, force, torque]),
-                self.sample_period,
-                self.config.max_gap,
-                previous,
-            )
-        except ValueError as exc:
-            self._jump = f"t: {exc}"
-            return t, theta, force, torque
+        filled = fill_missing(
+            t, np.hstack([theta, force, torque]), ts, self.config.max_gap, previous
+        )
+        if filled.jump is not None:
+            self._jump = f"t: {filled.jump}"
         if filled.t is t:
             return t, theta, force, torque
         self._put_back_at.append(n + np.flatnonzero(filled.filled))
-        ends = np.searchsorted(filled.t, [end for _, end in filled.gaps])
-        self._filled.extend((n + int(k), gap) for k, gap in zip(ends, filled.gaps, strict=True))
+        self._filled.extend(
+            (n + int(k), gap) for k, gap in zip(filled.gap_starts, filled.gaps, strict=True)
+        )
         v = filled.values
         return filled.t, v[:, 0:2], v[:, 2:5], v[:, 5:8]
 
@@ -388,7 +395,7 @@ class FrontEnd:
                 return None
             hold = self._judge_hold(judged)
             if hold.frame is None:
-                return self._stop(self._early(Status.PUSH_NOT_REACHED, hold.problem or ""))
+                return self._stop(self._early(Status.PUSH_NOT_REACHED, hold.problem or "", judged))
             self._hold = hold
             _, self._ratio_tolerance = ratio_tolerance(hold, self.antenna, cfg, ts)
         if self._planned is None:
@@ -484,10 +491,10 @@ class FrontEnd:
         stop = end + 1
         problem = dead_channel(self._force[:stop], self._torque[:stop])
         if problem is not None:
-            return self._early(Status.BAD_INPUT, problem)
+            return self._early(Status.BAD_INPUT, problem, end)
         hold = self._hold if self._hold is not None else self._judge_hold(end)
         if hold.frame is None:
-            return self._early(Status.PUSH_NOT_REACHED, hold.problem or "")
+            return self._early(Status.PUSH_NOT_REACHED, hold.problem or "", end)
         self._fill(stop)
         cfg, ts, start, rest = self.config, self.sample_period, self._start, self._rest
         offset = start.offset
@@ -560,12 +567,12 @@ class FrontEnd:
             )
         return diagnostics
 
-    def _early(self, status: Status, reason: str) -> EarlyOutcome:
+    def _early(self, status: Status, reason: str, end: int | None = None) -> EarlyOutcome:
         """An outcome without evidence; bad input keeps only what the caller said. A recording
         not in the format's units (found at t_c) says so first: the push or its absence was
         judged on loads of the wrong scale."""
         t = self._t
-        diagnostics = self._notes_now() if status is Status.BAD_INPUT else self._diagnostics()
+        diagnostics = self._notes_now(end) if status is Status.BAD_INPUT else self._diagnostics(end)
         problem = None if self._start is None else self._start.input_problem
         if problem is not None and status is not Status.BAD_INPUT:
             diagnostics["other_reasons"] = [reason]

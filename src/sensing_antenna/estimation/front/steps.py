@@ -141,13 +141,23 @@ class FilledSamples:
     gaps : tuple of (float, float)
         The steps (s, s) that missed more than ``max_gap`` samples: filled, but too long to be
         read as the signal (:func:`gap_problem`).
+    gap_starts : array of int, shape (len(gaps),)
+        Where each of ``gaps`` begins among the N samples: its first sample put back.
+    taken : int
+        The block's samples these hold: all of them, or those before a ``jump``.
+    jump : str or None
+        Why the samples from ``taken`` on cannot be put on the grid: a step missing more than
+        :data:`MAX_FILLED` samples, or one beyond any number (an outlier time stamp).
     """
 
     t: FloatArray
     values: FloatArray
     origin: NDArray[np.intp]
     filled: NDArray[np.bool_]
-    gaps: tuple[tuple[float, float], ...]
+    gaps: tuple[tuple[float, float], ...] = ()
+    gap_starts: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
+    taken: int = 0
+    jump: str | None = None
 
 
 def fill_missing(
@@ -160,12 +170,13 @@ def fill_missing(
     """The samples of a stream with those it missed put back on its grid, as they arrive.
 
     Where consecutive time stamps step by k sample periods (k >= 2, less
-    :data:`STEP_JITTER` at most: :func:`samples_missing`), the k - 1 samples
-    between are filled in by linear interpolation, at equal steps, as reading a whole recording
-    resamples it onto its grid (:func:`~sensing_antenna.recording.resample_uniform`): every
-    step of the front end reads the samples as uniform, so a missing one left out would shift
-    every instant after it by a period (a stream missing one sample in 20 reads its vibration
-    5 % fast). Other steps (jitter) are left as they are.
+    :data:`STEP_JITTER` at most: :func:`samples_missing`), the k - 1 samples between are
+    filled in by linear interpolation, at equal steps, as reading a whole recording resamples
+    it onto its grid (:func:`~sensing_antenna.recording.resample_uniform`): every step of the
+    front end reads the samples as uniform, so a missing one left out would shift every instant
+    after it by a period (a stream missing one sample in 20 reads its vibration 5 % fast).
+    Other steps (jitter) are left as they are. A filled sample depends on the sample after its
+    gap: it is known when that one arrives.
 
     Parameters
     ----------
@@ -183,45 +194,45 @@ def fill_missing(
     Returns
     -------
     FilledSamples
-        The block itself (the same arrays) when no sample is missing.
-
-    Raises
-    ------
-    ValueError
-        When one step misses more than :data:`MAX_FILLED` samples (an outlier time stamp).
+        The block itself (the same arrays) when no sample is missing; up to the first outlier
+        step (``jump``) when there is one.
     """
     t = np.asarray(t, dtype=np.float64)
     values = np.asarray(values, dtype=np.float64)
     n = t.shape[0]
-    own = np.arange(n, dtype=np.intp)
     if n == 0:
-        return FilledSamples(t, values, own, np.zeros(0, dtype=bool), ())
+        return FilledSamples(t, values, np.zeros(0, dtype=np.intp), np.zeros(0, dtype=bool))
     if previous is None:
-        left_t, left_values, right = t[:-1], values[:-1], slice(1, None)
+        left_t, left_values = np.concatenate([[t[0]], t[:-1]]), np.vstack([values[:1], values[:-1]])
     else:
         left_t = np.concatenate([[previous[0]], t[:-1]])
         left_values = np.vstack([np.asarray(previous[1], dtype=np.float64), values[:-1]])
-        right = slice(0, None)
-    right_t = t[right]
-    missing = samples_missing(right_t - left_t, sample_period)
-    if not np.any(missing > 0.0):
-        return FilledSamples(t, values, own, np.zeros(n, dtype=bool), ())
-    k = int(np.argmax(missing))
-    if missing[k] > MAX_FILLED:
-        raise ValueError(
-            f"time jumps from {float(left_t[k])!r} to {float(right_t[k])!r} s, "
-            f"{missing[k] + 1:.4g} sample "
-            f"periods of {sample_period!r} s in one step: an outlier time stamp (at most "
-            f"{MAX_FILLED} missing samples are filled)"
+    # one step per sample of the block: into it from the one before (none for a stream's first)
+    with np.errstate(over="ignore", invalid="ignore"):
+        steps = t - left_t
+        periods = steps / sample_period
+    missing = samples_missing(steps, sample_period)
+    # beyond any filling, or beyond any number (finite stamps whose step overflows)
+    outlier = (periods > MAX_FILLED + 1 - STEP_JITTER) & np.isfinite(t) & np.isfinite(left_t)
+    jump = None
+    taken = n
+    if np.any(outlier):
+        taken = int(np.argmax(outlier))
+        jump = (
+            f"time jumps from {float(left_t[taken])!r} to {float(t[taken])!r} s, "
+            f"{periods[taken]:.4g} sample periods of {sample_period!r} s in one "
+            f"step: an outlier time stamp (at most {MAX_FILLED} missing samples are filled)"
         )
-    counts = np.maximum(missing, 0.0).astype(np.intp) + 1
-    if previous is None:
-        counts = np.concatenate([[1], counts])
-        left_t = np.concatenate([[t[0]], left_t])
-        left_values = np.vstack([values[:1], left_values])
+        t, values, missing = t[:taken], values[:taken], missing[:taken]
+        left_t, left_values = left_t[:taken], left_values[:taken]
+    own = np.arange(taken, dtype=np.intp)
+    if not np.any(missing > 0.0):
+        return FilledSamples(t, values, own, np.zeros(taken, dtype=bool), taken=taken, jump=jump)
+    counts = missing.astype(np.intp) + 1
     origin = np.repeat(own, counts)
+    ends = np.cumsum(counts)  # one past each own sample's place among the output
     # position of each output sample within its step: 1 .. counts, the block's own at counts
-    within = np.arange(origin.shape[0]) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    within = np.arange(origin.shape[0]) - np.repeat(ends - counts, counts) + 1
     fraction = within / np.repeat(counts, counts)
     is_own = within == np.repeat(counts, counts)
     start_t, start_values = left_t[origin], left_values[origin]
@@ -232,8 +243,16 @@ def fill_missing(
         start_values + fraction[:, None] * (values[origin] - start_values),
     )
     long_steps = np.flatnonzero(missing > max_gap)
-    gaps = tuple((float(left_t[s + (previous is None)]), float(right_t[s])) for s in long_steps)
-    return FilledSamples(filled_t, filled_values, origin, ~is_own, gaps)
+    return FilledSamples(
+        filled_t,
+        filled_values,
+        origin,
+        ~is_own,
+        tuple((float(left_t[k]), float(t[k])) for k in long_steps),
+        (ends[long_steps] - counts[long_steps]).astype(np.intp),
+        taken,
+        jump,
+    )
 
 
 def time_gaps(t: FloatArray, sample_period: float, max_gap: int) -> tuple[tuple[float, float], ...]:
