@@ -236,7 +236,10 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
             Datagram("samples", "b", 0, (row, "0.001,x")).encode(),
             Datagram("samples", "b", 2, (row.replace("0.0,", "0.002,", 1),)).encode(),
             Datagram("samples", "b", 1, (row,)).encode(),  # late
-            Datagram("end", "b", 3).encode(),
+            # a stamp a day ahead: left out, not kept to leave the good ones after it behind
+            Datagram("samples", "b", 3, (row.replace("0.0,", "86400.0,", 1),)).encode(),
+            Datagram("samples", "b", 4, (row.replace("0.0,", "0.003,", 1),)).encode(),
+            Datagram("end", "b", 5).encode(),
         ],
         recording,
     )
@@ -246,8 +249,9 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     assert "not UTF-8" in reasons
     assert f"stream b: datagram 0: expected {_cells(recording)} cells, found 2" in reasons
     assert "stream b: datagram 1 arrived after 2: left out" in reasons
+    assert "datagram 3: time 86400.0 s jumps from 0.002 s by more than" in reasons
     end = first[-1]
-    assert end["event"] == "end" and end["samples"] == 2
+    assert end["event"] == "end" and end["samples"] == 3
     assert end["reason"] == "end of stream; 1 samples datagrams lost"
     assert [e["status"] for e in first if e["event"] == "estimate"] == ["bad_input"]
 
@@ -483,6 +487,9 @@ def test_two_recordings_in_one_stream(recordings: dict[str, Path]) -> None:
     for event, case in zip(estimates, ("azimuthal", "vertical"), strict=True):
         reference = estimate(read_recording(recordings[case]), paper_antenna(), "ratio")
         assert event.x_c == reference.x_c
+    # an acquisition program's footer after the last recording is no recording of its own
+    footed = _listen([*first, b"# end: 3000 samples\n"], "ratio")
+    assert [type(e) for e in footed].count(EstimateEvent) == 1
 
 
 def test_replay_keeps_the_recordings_pace(recordings: dict[str, Path]) -> None:

@@ -557,8 +557,17 @@ def _vibration_problems(
         notes.setdefault("vibration_contact_point", nearest)
         problem = _scale_problem(evidence, value, nearest, omega1)
         if problem is not None:
-            found.append((Status.MODEL_MISMATCH, f"{what} {problem}"))
+            quotient = value / nearest
+            units = not 1.0 / _UNITS_FACTOR < quotient < _UNITS_FACTOR
+            status = Status.IMPLAUSIBLE_INPUT if units else Status.MODEL_MISMATCH
+            found.append((status, f"{what} {problem}"))
     return found
+
+
+#: A torque/force ratio this many times the vibration's contact point, or this fraction of it,
+#: is loads in another unit (mN, N mm, kN: a factor 1000), not a model or a push gone wrong
+#: (within a factor of a few): the status is ``implausible_input``, before the others.
+_UNITS_FACTOR = 30.0
 
 
 def _vibration_points(evidence: Evidence, omega1: float) -> tuple[float, ...]:

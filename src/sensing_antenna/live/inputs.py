@@ -8,7 +8,8 @@ estimates run in each listener's worker thread.
 Standard input is trusted as a file is: a malformed line or a time that does not increase
 stops the reader with a :class:`~sensing_antenna.recording.RecordingError` naming the line. A
 UDP port receives whatever anyone sends it: a datagram not in the format, a malformed line, a
-late datagram or a time that does not increase is left out with a
+late datagram, a time that does not increase or one that jumps ahead beyond any filling (an
+outlier stamp, which would leave every good sample after it behind) is left out with a
 :class:`~.events.SkippedEvent` saying why, and listening goes on.
 """
 
@@ -19,6 +20,7 @@ import socket
 import time
 from collections.abc import Callable, Iterable
 
+from sensing_antenna.estimation.front.steps import MAX_FILLED
 from sensing_antenna.live.events import Event, SkippedEvent
 from sensing_antenna.live.listener import Listener
 from sensing_antenna.live.wire import (
@@ -37,6 +39,10 @@ __all__ = ["IDLE_END", "MakeListener", "listen_lines", "listen_udp", "parse_addr
 #: A UDP recording whose sender fell silent for this long (s) is closed as if it had ended: a
 #: sender that stopped without its ``end`` datagram (the datagram lost, the program killed).
 IDLE_END = 2.0
+
+#: A step of the time stamps beyond this many sample periods is an outlier stamp: more samples
+#: than the front end puts back (:data:`~sensing_antenna.estimation.front.steps.MAX_FILLED`).
+_OUTLIER_STEP = MAX_FILLED + 1
 
 #: How a reader starts the listener of a recording: ``make(header, number)``, number from 1.
 MakeListener = Callable[[StreamHeader, int], Listener]
@@ -99,7 +105,8 @@ def listen_lines(
                 )
             last_t = t
             current.put([values], received)
-        if current is None and pending:
+        if current is None and pending and not ended:
+            # after a recording, '#' lines the input ends with are a footer, as in a file
             raise RecordingError(
                 source, pending_first + len(pending), None, "no header after the metadata"
             )
@@ -251,6 +258,7 @@ def _receive_samples(
     current.expected = datagram.seq + 1
     header = current.listener.header
     position = header.required("t")
+    period = header.sample_period
     rows = []
     for line in datagram.lines:
         try:
@@ -266,6 +274,13 @@ def _receive_samples(
             skip(
                 f"stream {current.name}: datagram {datagram.seq}: time {t!r} s does not"
                 f" increase (previous {current.last_t!r} s)"
+            )
+            continue
+        if current.last_t is not None and (t - current.last_t) > _OUTLIER_STEP * period:
+            skip(
+                f"stream {current.name}: datagram {datagram.seq}: time {t!r} s jumps from"
+                f" {current.last_t!r} s by more than {MAX_FILLED} samples: an outlier time"
+                " stamp, left out"
             )
             continue
         current.last_t = t

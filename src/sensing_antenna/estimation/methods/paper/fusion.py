@@ -463,10 +463,10 @@ class PaperMethod:
             problems.append(
                 (
                     Status.ESTIMATORS_DISAGREE,
-                    f"the frequency candidate {fusion.x_c:.3f} m is {fusion.distance:.3f} m from "
-                    f"the ratio estimate {ratio_estimate:.3f} m, more than "
+                    f"the frequency candidate {fusion.x_c:.3f} m is {_metres(fusion.distance)} "
+                    f"m from the ratio estimate {_metres(ratio_estimate)} m, more than "
                     f"{cfg.disagreement_sigmas:g} times their uncertainty "
-                    f"({math.hypot(sigma_ratio, sigma_bent):.3f} m: noise, tare, statics "
+                    f"({_metres(math.hypot(sigma_ratio, sigma_bent))} m: noise, tare, statics "
                     "model, bent link)",
                 )
             )
@@ -519,3 +519,9 @@ class PaperMethod:
             problems=problems,
             diagnostics=diag,
         )
+
+
+def _metres(value: float) -> str:
+    """A length (m) to the millimetre, or to four digits when it is no link's (loads in another
+    unit make ratios of 10^3 to 10^70 m)."""
+    return f"{value:.3f}" if abs(value) < 1e3 else f"{value:.4g}"
