@@ -284,6 +284,30 @@ def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
     assert sum("the stream is left out" in r for r in skipped) == 1
 
 
+def test_a_udp_recording_first_heard_after_its_start_is_left_out(
+    recordings: dict[str, Path],
+) -> None:
+    # The first header lost: the stream is first heard at its repetition, 40 samples in. Read
+    # from there the recording has no rest and no contact; it is left out with a skipped
+    # event, and the next recording is heard whole
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(40))
+    events = _heard_over_udp(
+        [
+            Datagram("samples", "m", 0, rows[:20]).encode(),
+            Datagram("header", "m", 1, tuple(header.lines())).encode(),
+            Datagram("samples", "m", 1, rows[20:]).encode(),
+            Datagram("end", "m", 2).encode(),
+        ],
+        recording,
+    )
+    said = [e.to_dict() for e in events]
+    assert next(e["event"] for e in said if e["recording"] == 1) == "skipped"
+    assert "stream m: first heard after 1 samples datagrams" in said[0]["reason"]
+    assert not any(e["event"] == "estimate" and e["recording"] == 1 for e in said)
+
+
 def test_datagrams() -> None:
     lines = [f"{k},1.5" for k in range(400)]
     packed = pack_samples(lines, "s", 7, max_bytes=200)

@@ -9,7 +9,8 @@ Standard input is trusted as a file is: a malformed line or a time that does not
 stops the reader with a :class:`~sensing_antenna.recording.RecordingError` naming the line. A
 UDP port receives whatever anyone sends it: a datagram not in the format, a malformed line, a
 late datagram, a time that does not increase or one that jumps ahead beyond any filling (an
-outlier stamp, which would leave every good sample after it behind) is left out with a
+outlier stamp, which would leave every good sample after it behind), a recording first heard
+after its start is left out with a
 :class:`~.events.SkippedEvent` saying why, and listening goes on.
 """
 
@@ -215,6 +216,17 @@ def listen_udp(
                     header = read_header(list(datagram.lines), f"{source} stream {datagram.stream}")
                 except RecordingError as exc:
                     skip(str(exc))
+                    continue
+                if datagram.seq > 0:
+                    # heard first after samples were sent (listening began late, or the first
+                    # header was lost): the recording's start, its rest and its contact, is gone
+                    skip(
+                        f"stream {datagram.stream}: first heard after {datagram.seq} samples "
+                        "datagrams: its start (the rest, the contact) was missed; left out, "
+                        "the next recording is heard"
+                    )
+                    refused.add(datagram.stream)
+                    ended += 1  # as a stream refused for its period: a recording, left out
                     continue
                 if current is not None:
                     finish(current, "another stream began")
