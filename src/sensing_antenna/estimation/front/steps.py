@@ -330,6 +330,14 @@ def at_contact(
             theta[before], torque[before], predicted_torque[before], antenna, cfg
         )
         checks["free_motion_gain"] = gain
+        if problem is not None and quiet < w_rest + 1:
+            # the observer starts from rest: a record that starts in motion gives it a start
+            # it never had, which the first free motion then misreads
+            problem = problem.replace(
+                "?",
+                ", or a recording that does not start at rest (start it with the head still "
+                "for half a second)?",
+            )
         if problem is not None:
             problems.append(problem)
     if quiet >= w_rest + 1:
