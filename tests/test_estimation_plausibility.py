@@ -454,3 +454,19 @@ def test_forces_in_kilonewtons_are_implausible_input_first(
             continue
         assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
         assert "times the contact point" in (result.reason or ""), name
+
+
+def test_loads_beyond_any_device_warn_no_more_online_than_offline(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # Torques of 1e150 N m overflow the fast method's arithmetic; offline its conclusion keeps
+    # NumPy quiet and the status judges the result. The online form's early evaluations do too
+    # (the test suite turns any RuntimeWarning into an error)
+    recording = scaled(azimuthal, 1.0, 1e150)
+    offline = estimate(recording, antenna, "fast")
+    online = OnlineEstimator(antenna, recording.sample_period, "fast")
+    given = online.update_block(
+        recording.t, recording.theta, recording.force, recording.torque, every_instant=True
+    )
+    result = given if given is not None else online.finalize()
+    assert not result.ok and result.status is offline.status

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from sensing_antenna.antenna import Antenna
@@ -160,7 +161,12 @@ class OnlineEstimator:
         for index in indices:
             if self._early.due(index - rest, self.sample_period):
                 evidence = front.evidence_at(index)
-                if isinstance(evidence, Evidence) and self._early.ready(evidence):
+                # loads far beyond any device's overflow the method's arithmetic, as in
+                # conclude: the statuses judge what follows, warnings would only print
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+                    is_ready = isinstance(evidence, Evidence) and self._early.ready(evidence)
+                if is_ready:
+                    assert isinstance(evidence, Evidence)
                     traced = dataclasses.replace(evidence, trace=front.trace(evidence))
                     return self._emit(conclude(traced, self._run))
                 if not every_instant:
@@ -190,7 +196,8 @@ class OnlineEstimator:
         last, ts = front.n_samples - 1, self.sample_period
         if not preparing.wants_to_prepare(last, rest, hold_end, ts, step_time):
             return False
-        return preparing.prepare(front.trace(), self.antenna, hold_end, step_time)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+            return preparing.prepare(front.trace(), self.antenna, hold_end, step_time)
 
     def _emit(self, result: ContactEstimate) -> ContactEstimate:
         self.result = result
