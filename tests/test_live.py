@@ -207,6 +207,7 @@ def _heard_over_udp(datagrams: list[bytes], then: Recording) -> list[Event]:
         return Listener(header, paper_antenna(), events.append, "ratio", number=number)
 
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)  # as antenna listen does
         sock.bind(("127.0.0.1", 0))
         address = sock.getsockname()
         reader = threading.Thread(target=listen_udp, args=(sock, make, events.append, 2))
@@ -284,28 +285,69 @@ def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
     assert sum("the stream is left out" in r for r in skipped) == 1
 
 
-def test_a_udp_recording_first_heard_after_its_start_is_left_out(
+def test_a_udp_stream_whose_clock_steps_is_left_out_after_a_few_samples(
     recordings: dict[str, Path],
 ) -> None:
-    # The first header lost: the stream is first heard at its repetition, 40 samples in. Read
-    # from there the recording has no rest and no contact; it is left out with a skipped
-    # event, and the next recording is heard whole
+    # The sender's clock steps 1000 s ahead and stays there: each sample after it would be an
+    # outlier stamp left out with an event of its own; after 50 in a row the stream is left
+    # out, and the next one is heard
     recording = read_recording(recordings["azimuthal"])
     header, _ = stream_of(recording)
-    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(40))
+    rows = [_resting_row(recording, 0.001 * k) for k in range(5)]
+    rows += [_resting_row(recording, 1000.0 + 0.001 * k) for k in range(60)]
     events = _heard_over_udp(
         [
-            Datagram("samples", "m", 0, rows[:20]).encode(),
-            Datagram("header", "m", 1, tuple(header.lines())).encode(),
-            Datagram("samples", "m", 1, rows[20:]).encode(),
-            Datagram("end", "m", 2).encode(),
+            Datagram("header", "c", 0, tuple(header.lines())).encode(),
+            *(
+                Datagram("samples", "c", k, tuple(rows[5 * k : 5 * k + 5])).encode()
+                for k in range(13)
+            ),
+            Datagram("end", "c", 13).encode(),
         ],
         recording,
     )
+    skipped = [e.to_dict()["reason"] for e in events if e.to_dict()["event"] == "skipped"]
+    assert sum("an outlier time stamp, left out" in r for r in skipped) == 50
+    assert any("50 time stamps in a row left out" in r for r in skipped)
+
+
+def test_a_udp_recording_first_heard_after_its_start_is_left_out(
+    recordings: dict[str, Path],
+) -> None:
+    # The first header lost: the stream is first heard at its repetition, 20 samples in. Read
+    # from there the recording has no rest and no contact; it is left out with a skipped event
+    # that names no recording (0) and counts for no --count, and the next one is heard whole
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(40))
+    events: list[Event] = []
+
+    def make(stream: StreamHeader, number: int) -> Listener:
+        return Listener(stream, paper_antenna(), events.append, "ratio", number=number)
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        address = sock.getsockname()
+        reader = threading.Thread(target=listen_udp, args=(sock, make, events.append, 1))
+        reader.start()
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sender:
+            for datagram in [
+                Datagram("samples", "m", 0, rows[:20]),
+                Datagram("header", "m", 1, tuple(header.lines())),
+                Datagram("samples", "m", 1, rows[20:]),
+                Datagram("end", "m", 2),
+            ]:
+                sender.sendto(datagram.encode(), address)
+            replay_datagrams(recording, sender, address, speed=4, stream="s")
+        reader.join(timeout=120)
+    assert not reader.is_alive()
     said = [e.to_dict() for e in events]
-    assert next(e["event"] for e in said if e["recording"] == 1) == "skipped"
-    assert "stream m: first heard after 1 samples datagrams" in said[0]["reason"]
-    assert not any(e["event"] == "estimate" and e["recording"] == 1 for e in said)
+    skipped = [e for e in said if e["event"] == "skipped"]
+    assert len(skipped) == 1 and skipped[0]["recording"] == 0
+    assert "stream m: first heard after 1 samples datagrams" in skipped[0]["reason"]
+    found = next(e for e in events if isinstance(e, EstimateEvent))
+    assert found.recording == 1
+    _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
 
 
 def test_datagrams() -> None:

@@ -27,7 +27,8 @@ forms agree.
 3. A real vibration: the fundamental omega_1 that the method measured, or, for a method that
    measures none (``ratio``), Estimator 1 on the samples from t_1 to t_e, must be a clear peak
    (``no_clear_peak``).
-4. One scale (``model_mismatch``): the vibration puts the contact at the point of the sensing
+4. One scale (``model_mismatch``; ``implausible_input`` beyond a factor 30, a unit's 1000): the
+   vibration puts the contact at the point of the sensing
    curve with that omega_1 (the nearest of its candidates); the front end's torque/force ratio at
    t_e and the answer must lie within ``max_scale_mismatch`` of it, unless
    ``disagreement_sigmas`` statistical uncertainties of the ratio (noise and tare, which do not

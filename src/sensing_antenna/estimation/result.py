@@ -42,11 +42,12 @@ class Status(str, enum.Enum):  # noqa: UP042 (a StrEnum's str() would read "ok",
     BAD_INPUT = "bad_input"
     #: The recording is not in the format's units and signs by its own physics: the loads at
     #: rest are not the link's weight (mN, N mm, scaled, a sign flipped), the angles are not
-    #: those of a head in radians, or the free motion's torque is not what the angles predict.
+    #: those of a head in radians, the free motion's torque is not what the angles predict, or
+    #: the torque/force ratio is more than 30 times from where the vibration puts the contact.
     IMPLAUSIBLE_INPUT = "implausible_input"
     #: The evidence does not fit the physics of a contact: the answer lies outside the link
-    #: (0, l], or the torque/force ratio or the answer is a factor away from where the measured
-    #: vibration puts the contact.
+    #: (0, l], or the torque/force ratio or the answer is a factor (1.5 to 30) away from where
+    #: the measured vibration puts the contact.
     MODEL_MISMATCH = "model_mismatch"
     #: The method's interval never became narrower than the requested tolerance before its cap
     #: (``fast`` method); x_c is the best estimate at the cap.

@@ -21,7 +21,7 @@ import socket
 import time
 from collections.abc import Callable, Iterable
 
-from sensing_antenna.estimation.front.steps import MAX_FILLED
+from sensing_antenna.estimation.front.steps import MAX_FILLED, STEP_JITTER
 from sensing_antenna.live.events import Event, SkippedEvent
 from sensing_antenna.live.listener import Listener
 from sensing_antenna.live.wire import (
@@ -43,7 +43,11 @@ IDLE_END = 2.0
 
 #: A step of the time stamps beyond this many sample periods is an outlier stamp: more samples
 #: than the front end puts back (:data:`~sensing_antenna.estimation.front.steps.MAX_FILLED`).
-_OUTLIER_STEP = MAX_FILLED + 1
+_OUTLIER_STEP = MAX_FILLED + 1 - STEP_JITTER
+
+#: Samples left out in a row for their time stamps after which the stream is left out: its
+#: samples no longer follow one time line (the sender's clock stepped, or an outlier came first).
+_MAX_REJECTED = 50
 
 #: How a reader starts the listener of a recording: ``make(header, number)``, number from 1.
 MakeListener = Callable[[StreamHeader, int], Listener]
@@ -150,6 +154,7 @@ class _UdpStream:
         self.last_t: float | None = None
         self.lost = 0
         self.heard = 0.0
+        self.rejected = 0  # samples left out in a row for their time stamps
 
     def close(self, reason: str) -> None:
         if self.lost:
@@ -174,6 +179,7 @@ def listen_udp(
     current: _UdpStream | None = None
     ended = 0
     refused: set[str] = set()  # streams left out, ignored until their end
+    joined: set[str] = set()  # streams heard (one that resumes after the idle end is known)
     sock.settimeout(min(idle, 0.2))
 
     def skip(reason: str) -> None:
@@ -217,16 +223,19 @@ def listen_udp(
                 except RecordingError as exc:
                     skip(str(exc))
                     continue
-                if datagram.seq > 0:
+                if datagram.seq > 0 and datagram.stream not in joined:
                     # heard first after samples were sent (listening began late, or the first
-                    # header was lost): the recording's start, its rest and its contact, is gone
-                    skip(
-                        f"stream {datagram.stream}: first heard after {datagram.seq} samples "
-                        "datagrams: its start (the rest, the contact) was missed; left out, "
-                        "the next recording is heard"
+                    # header was lost): the recording's start, its rest and its contact, is
+                    # gone. Never joined, it takes no recording's number (0) nor a --count
+                    on_event(
+                        SkippedEvent(
+                            0,
+                            f"stream {datagram.stream}: first heard after {datagram.seq} "
+                            "samples datagrams: its start (the rest, the contact) was missed; "
+                            "left out, the next recording is heard",
+                        )
                     )
                     refused.add(datagram.stream)
-                    ended += 1  # as a stream refused for its period: a recording, left out
                     continue
                 if current is not None:
                     finish(current, "another stream began")
@@ -235,6 +244,7 @@ def listen_udp(
                         break
                 current = _UdpStream(make(header, ended + 1), datagram)
                 current.heard = received
+                joined.add(datagram.stream)
             elif not ours or datagram.kind == "header":
                 continue  # a repeated header, or samples of a stream not joined
             elif datagram.kind == "end":
@@ -282,19 +292,26 @@ def _receive_samples(
             )
             continue
         t = values[position]
+        problem = None
         if current.last_t is not None and not t > current.last_t:
-            skip(
-                f"stream {current.name}: datagram {datagram.seq}: time {t!r} s does not"
-                f" increase (previous {current.last_t!r} s)"
+            problem = f"time {t!r} s does not increase (previous {current.last_t!r} s)"
+        elif current.last_t is not None and (t - current.last_t) > _OUTLIER_STEP * period:
+            problem = (
+                f"time {t!r} s jumps from {current.last_t!r} s by more than {MAX_FILLED}"
+                " samples: an outlier time stamp, left out"
             )
+        if problem is not None:
+            current.rejected += 1
+            if current.rejected > _MAX_REJECTED:
+                # not a stamp gone astray but a time line the samples no longer follow (the
+                # sender's clock stepped, or the first stamp was the outlier)
+                raise WireError(
+                    f"stream {current.name}: datagram {datagram.seq}: {_MAX_REJECTED} time "
+                    f"stamps in a row left out, the last {t!r} s after {current.last_t!r} s"
+                )
+            skip(f"stream {current.name}: datagram {datagram.seq}: {problem}")
             continue
-        if current.last_t is not None and (t - current.last_t) > _OUTLIER_STEP * period:
-            skip(
-                f"stream {current.name}: datagram {datagram.seq}: time {t!r} s jumps from"
-                f" {current.last_t!r} s by more than {MAX_FILLED} samples: an outlier time"
-                " stamp, left out"
-            )
-            continue
+        current.rejected = 0
         current.last_t = t
         rows.append(values)
     if rows:
