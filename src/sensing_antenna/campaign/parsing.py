@@ -200,7 +200,8 @@ def _on_base(
         if not file.is_file():
             raise CampaignSpecError(
                 "base",
-                f"unknown {value!r}: not a built-in campaign ({names}) and no such file ({file})",
+                f"unknown {value!r}: not a built-in campaign ({names}) and no such file "
+                f"({str(file)!r})",
                 source,
             )
         if file.resolve() in chain:
