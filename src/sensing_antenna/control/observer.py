@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import FreeMotionObserver
+from sensing_antenna.control.servo import refuse_non_finite
 from sensing_antenna.detection.filters import FreeMotionObserverFilter
 
 __all__ = ["CouplingTorqueObserver", "observe_coupling_torques"]
@@ -113,13 +114,7 @@ def _finite(angles: NDArray[np.float64]) -> None:
     """Refuse NaN or infinite angles (shape (n, 2))."""
     if angles.shape[0] == 1 and math.isfinite(angles[0, 0]) and math.isfinite(angles[0, 1]):
         return  # one sample, the loop's case: cheaper in Python than NumPy calls
-    bad = np.flatnonzero(~np.all(np.isfinite(angles), axis=1))
-    if bad.size:
-        where = f" at row {bad[0]}" if angles.shape[0] > 1 else ""
-        raise ValueError(
-            f"measured: {angles[bad[0]].tolist()}{where} is not finite (an encoder glitch?): "
-            "the torques were not computed, the state is unchanged"
-        )
+    refuse_non_finite([("measured", angles)], "coupling torque")
 
 
 def observe_coupling_torques(
