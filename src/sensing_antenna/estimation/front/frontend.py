@@ -23,6 +23,7 @@ samples are cut into blocks.
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import math
 from collections.abc import Mapping, Sequence
@@ -186,7 +187,7 @@ class FrontEnd:
         self._n = 0
         self._loads_done = self._ratio_done = self._mean_done = 0
         self._filled: list[tuple[int, tuple[float, float]]] = []  # (known at sample, interval)
-        self._put_back_at: list[NDArray[np.intp]] = []  # samples put back where stamps skip
+        self._put_back_at: list[int] = []  # samples put back where stamps skip (ascending)
         self._jump: str | None = None  # a step of the time stamps too long to fill
         self._contact: int | None = None
         self._start: ContactStart | None = None
@@ -333,7 +334,7 @@ class FrontEnd:
             self._jump = f"t: {filled.jump}"
         if filled.t is t:
             return t, theta, force, torque
-        self._put_back_at.append(n + np.flatnonzero(filled.filled))
+        self._put_back_at.extend((n + np.flatnonzero(filled.filled)).tolist())
         self._filled.extend(
             (n + int(k), gap) for k, gap in zip(filled.gap_starts, filled.gaps, strict=True)
         )
@@ -549,7 +550,7 @@ class FrontEnd:
         sample ``end`` (all held when None)."""
         notes = dict(self._notes)
         last = self._n - 1 if end is None else end
-        filled = sum(int(np.count_nonzero(at <= last)) for at in self._put_back_at)
+        filled = bisect.bisect_right(self._put_back_at, last)
         if filled:
             notes["filled_samples"] = filled
         return notes
