@@ -21,7 +21,7 @@ import socket
 import time
 from collections.abc import Callable, Iterable
 
-from sensing_antenna.estimation.front.steps import MAX_FILLED, STEP_JITTER
+from sensing_antenna.estimation.front.steps import MAX_FILLED, OUTLIER_PERIODS
 from sensing_antenna.live.events import Event, SkippedEvent
 from sensing_antenna.live.listener import Listener
 from sensing_antenna.live.wire import (
@@ -40,10 +40,6 @@ __all__ = ["IDLE_END", "MakeListener", "listen_lines", "listen_udp", "parse_addr
 #: A UDP recording whose sender fell silent for this long (s) is closed as if it had ended: a
 #: sender that stopped without its ``end`` datagram (the datagram lost, the program killed).
 IDLE_END = 2.0
-
-#: A step of the time stamps beyond this many sample periods is an outlier stamp: more samples
-#: than the front end puts back (:data:`~sensing_antenna.estimation.front.steps.MAX_FILLED`).
-_OUTLIER_STEP = MAX_FILLED + 1 - STEP_JITTER
 
 #: Samples left out in a row for their time stamps after which the stream is left out: its
 #: samples no longer follow one time line (the sender's clock stepped, or an outlier came first).
@@ -295,7 +291,8 @@ def _receive_samples(
         problem = None
         if current.last_t is not None and not t > current.last_t:
             problem = f"time {t!r} s does not increase (previous {current.last_t!r} s)"
-        elif current.last_t is not None and (t - current.last_t) > _OUTLIER_STEP * period:
+        elif current.last_t is not None and (t - current.last_t) > OUTLIER_PERIODS * period:
+            # more than the front end would put back: the stamp, not the samples after it
             problem = (
                 f"time {t!r} s jumps from {current.last_t!r} s by more than {MAX_FILLED}"
                 " samples: an outlier time stamp, left out"

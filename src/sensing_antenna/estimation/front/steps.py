@@ -40,6 +40,7 @@ from sensing_antenna.units_check import initial_rest, rest_reading
 
 __all__ = [
     "MAX_FILLED",
+    "OUTLIER_PERIODS",
     "STEP_JITTER",
     "ContactStart",
     "FilledSamples",
@@ -110,6 +111,11 @@ MAX_FILLED = 100_000
 #: third of a period) steps by up to 1.67: filled, it would add a sample that never was and put
 #: every later instant a period late. Long steps are counted the same way.
 STEP_JITTER = 0.25
+
+
+#: A step of the time stamps longer than this many sample periods is an outlier stamp: it would
+#: miss more than :data:`MAX_FILLED` samples (:func:`samples_missing`).
+OUTLIER_PERIODS = MAX_FILLED + 1 - STEP_JITTER
 
 
 def samples_missing(steps: FloatArray, sample_period: float) -> FloatArray:
@@ -213,7 +219,7 @@ def fill_missing(
         periods = steps / sample_period
     missing = samples_missing(steps, sample_period)
     # beyond any filling, or beyond any number (finite stamps whose step overflows)
-    outlier = (periods > MAX_FILLED + 1 - STEP_JITTER) & np.isfinite(t) & np.isfinite(left_t)
+    outlier = (periods > OUTLIER_PERIODS) & np.isfinite(t) & np.isfinite(left_t)
     jump = None
     taken = n
     if np.any(outlier):
