@@ -333,17 +333,14 @@ def at_contact(
     checks: dict[str, Any] = {}
     if predicted_torque is not None:
         gain, problem = free_motion_gain(
-            theta[before], torque[before], predicted_torque[before], antenna, cfg
+            theta[before],
+            torque[before],
+            predicted_torque[before],
+            antenna,
+            cfg,
+            starts_at_rest=quiet >= w_rest + 1,
         )
         checks["free_motion_gain"] = gain
-        if problem is not None and quiet < w_rest + 1:
-            # the observer starts from rest: a record that starts in motion gives it a start
-            # it never had, which the first free motion then misreads
-            problem = problem.replace(
-                "?",
-                ", or a recording that does not start at rest (start it with the head still "
-                "for half a second)?",
-            )
         if problem is not None:
             problems.append(problem)
     if quiet >= w_rest + 1:
@@ -373,6 +370,7 @@ def free_motion_gain(
     predicted_torque: FloatArray,
     antenna: Antenna,
     cfg: EstimatorConfig,
+    starts_at_rest: bool = True,
 ) -> tuple[float, str | None]:
     """How large the measured coupling torque before t_c is against the observer's prediction.
 
@@ -393,6 +391,10 @@ def free_motion_gain(
         Measured torque and the detector's Gamma_e^m + Gamma_g^m up to t_c (N m).
     antenna : Antenna
     cfg : EstimatorConfig
+    starts_at_rest : bool
+        Whether the samples begin with the head at rest. The observer starts from rest: a
+        record that starts in motion gives it a start it never had, which the first free motion
+        then misreads, and the problem names that cause too.
 
     Returns
     -------
@@ -417,7 +419,13 @@ def free_motion_gain(
         f"columns 'theta1', 'theta2', 'ty', 'tz': the torque of the free motion before the "
         f"contact is {gain:.3g} times what the observer predicts from the angles (at least "
         f"1/{factor:g}): angles not in radians (degrees give 1/57), or an antenna file whose "
-        "observer is not this device's (antenna identify)?"
+        "observer is not this device's (antenna identify)"
+        + (
+            "?"
+            if starts_at_rest
+            else ", or a recording that does not start at rest (start it with the head still "
+            "for half a second)?"
+        )
     )
 
 
