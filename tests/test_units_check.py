@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, paper_antenna
+from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.front.steps import free_motion_gain
 from sensing_antenna.units_check import (
     REST_FORCE_FRACTION,
     REST_TORQUE_FRACTION,
@@ -127,3 +129,21 @@ def test_initial_rest_and_the_whole_recording() -> None:
     assert recording_problem(theta, force, 2 * torque, ANTENNA, 1e-4, 51) is not None
     # too short a rest to judge: not judged
     assert recording_problem(theta, force, 2 * torque, ANTENNA, 1e-4, 200) is None
+
+
+def test_a_free_motion_misread_names_a_start_in_motion_only_when_there_was_one() -> None:
+    # The observer predicts a swinging torque the sensor does not read (a gain near 0, below
+    # the 1/5 allowed): degrees or a wrong observer, and, where the record has no rest at its
+    # start, the observer's own start, which assumed one
+    theta = np.zeros((200, 2))
+    gravity = ANTENNA.gravity_torque(theta[:, 1])
+    swing = np.zeros((200, 3))
+    swing[:, 2] = 0.01 * np.sin(np.linspace(0.0, 6.0, 200))
+    at_rest_first = free_motion_gain(theta, gravity, gravity + swing, ANTENNA, EstimatorConfig())
+    in_motion = free_motion_gain(
+        theta, gravity, gravity + swing, ANTENNA, EstimatorConfig(), starts_at_rest=False
+    )
+    assert at_rest_first[0] == in_motion[0] == 0.0
+    assert "angles not in radians" in (at_rest_first[1] or "")
+    assert "does not start at rest" not in (at_rest_first[1] or "")
+    assert "a recording that does not start at rest" in (in_motion[1] or "")
