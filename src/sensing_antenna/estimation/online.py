@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 from numpy.typing import ArrayLike
 
 from sensing_antenna.antenna import Antenna
@@ -26,7 +25,7 @@ from sensing_antenna.estimation.methods import (
     Sessioned,
     resolve_method,
 )
-from sensing_antenna.estimation.pipeline import conclude
+from sensing_antenna.estimation.pipeline import conclude, method_arithmetic
 from sensing_antenna.estimation.result import ContactEstimate
 
 __all__ = ["OnlineEstimator"]
@@ -161,9 +160,7 @@ class OnlineEstimator:
         for index in indices:
             if self._early.due(index - rest, self.sample_period):
                 evidence = front.evidence_at(index)
-                # loads far beyond any device's overflow the method's arithmetic, as in
-                # conclude: the statuses judge what follows, warnings would only print
-                with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+                with method_arithmetic():
                     is_ready = isinstance(evidence, Evidence) and self._early.ready(evidence)
                 if is_ready:
                     assert isinstance(evidence, Evidence)
@@ -196,7 +193,7 @@ class OnlineEstimator:
         last, ts = front.n_samples - 1, self.sample_period
         if not preparing.wants_to_prepare(last, rest, hold_end, ts, step_time):
             return False
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+        with method_arithmetic():
             return preparing.prepare(front.trace(), self.antenna, hold_end, step_time)
 
     def _emit(self, result: ContactEstimate) -> ContactEstimate:

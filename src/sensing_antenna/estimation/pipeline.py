@@ -134,12 +134,17 @@ def conclude(gathered: Gathered, method: str | EstimationMethod = "paper") -> Co
     impl = resolve_method(method)
     if isinstance(gathered, EarlyOutcome):
         return gathered.estimate(impl.name)
-    # Samples far beyond any device's (loads in wrong units, a glitch of 1e300 N in the hold)
-    # overflow the arithmetic of the method and the review; the statuses judge the non-finite
-    # values that follow, so NumPy's warnings would only put lines on a user's terminal
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+    with method_arithmetic():
         reviewed = review(gathered, impl.conclude(gathered))
     return dataclasses.replace(reviewed, trace=gathered.trace)
+
+
+def method_arithmetic() -> np.errstate:
+    """A method's arithmetic on the evidence, its conclusion or an early evaluation: samples far
+    beyond any device's (loads in wrong units, a glitch of 1e300 N in the hold) overflow it and
+    the review; the statuses judge the non-finite values that follow, so NumPy's warnings would
+    only put lines on a user's terminal."""
+    return np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore")
 
 
 def measure_omega1(
