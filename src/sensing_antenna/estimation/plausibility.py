@@ -558,10 +558,7 @@ def _vibration_problems(
         notes.setdefault("vibration_contact_point", nearest)
         problem = _scale_problem(evidence, value, nearest, omega1)
         if problem is not None:
-            quotient = value / nearest
-            units = not 1.0 / _UNITS_FACTOR < quotient < _UNITS_FACTOR
-            status = Status.IMPLAUSIBLE_INPUT if units else Status.MODEL_MISMATCH
-            found.append((status, f"{what} {problem}"))
+            found.append((problem[0], f"{what} {problem[1]}"))
     return found
 
 
@@ -593,8 +590,11 @@ def _tip(link: Link) -> tuple[float, bool]:
     return float(curve.omega1(link.length)), float(curve.omega1_slope(link.length)) < 0.0
 
 
-def _scale_problem(evidence: Evidence, value: float, nearest: float, omega1: float) -> str | None:
-    """Why ``value`` (m) is not the contact point ``nearest`` (m) the vibration gives, or None."""
+def _scale_problem(
+    evidence: Evidence, value: float, nearest: float, omega1: float
+) -> tuple[Status, str] | None:
+    """Why ``value`` (m) is not the contact point ``nearest`` (m) the vibration gives, with its
+    status (``implausible_input`` beyond :data:`_UNITS_FACTOR`), or None."""
     cfg = evidence.config
     factor = cfg.max_scale_mismatch
     quotient = value / nearest
@@ -604,7 +604,8 @@ def _scale_problem(evidence: Evidence, value: float, nearest: float, omega1: flo
     sigma = evidence.ratio_uncertainty(nearest, model=False)
     if abs(value - nearest) <= cfg.disagreement_sigmas * sigma:
         return None
-    return (
+    units = not 1.0 / _UNITS_FACTOR < quotient < _UNITS_FACTOR
+    return Status.IMPLAUSIBLE_INPUT if units else Status.MODEL_MISMATCH, (
         f"{value:.4g} m is {quotient:.3g} times the contact point {nearest:.3f} m where the "
         f"vibration (omega_1 = {omega1:.1f} rad/s) puts it (more than a factor {factor:g}, and "
         f"{cfg.disagreement_sigmas:g} statistical uncertainties of the ratio, {sigma:.3f} m, "
