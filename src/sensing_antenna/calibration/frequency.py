@@ -228,6 +228,19 @@ class FrequencyCalibration:
             found = found | self.left_out_as_wrong
         return found
 
+    @property
+    def kept_far_points(self) -> NDArray[np.bool_]:
+        """Which points, shape (n,), the fit used and kept although they lie more than
+        :data:`WRONG_PEAK` from the median relative residual of the points it used (three at
+        least): wrong peaks or known points it could not leave out (below
+        :data:`MIN_WRONG_PEAK_POINTS` points, or beyond the one or a tenth it leaves out)."""
+        relative = self._relative_residuals()
+        usable = self.used & np.isfinite(relative)
+        if int(usable.sum()) < 3:
+            return np.zeros(usable.shape, dtype=bool)
+        far = usable & ~_near_median(relative, usable, WRONG_PEAK)
+        return np.asarray(far & ~self.wrong_peak_points, dtype=bool)
+
     def _relative_residuals(self) -> NDArray[np.float64]:
         """measured / fitted - 1 at every point, shape (n,)."""
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from itertools import compress
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -150,14 +151,13 @@ def _run(args: argparse.Namespace) -> int:
         right = [not wrong for wrong in calibration.wrong_peak_points]
         calibrated, sensor_lines = _calibrate_sensor(
             calibrated,
-            [r for r, keep in zip(recordings, right, strict=True) if keep],
-            [x for x, keep in zip(points, right, strict=True) if keep],
-            [p for p, keep in zip(paths, right, strict=True) if keep],
+            list(compress(recordings, right)),
+            list(compress(points, right)),
+            list(compress(paths, right)),
         )
         sensor_lines += [
             f"  sensor, left out: {path}: a wrong spectral peak or known point to the T_e fit"
-            for path, keep in zip(paths, right, strict=True)
-            if not keep
+            for path in compress(paths, calibration.wrong_peak_points)
         ]
     save_antenna(calibrated, args.out)
     print(
@@ -183,7 +183,7 @@ def _run(args: argparse.Namespace) -> int:
     )
     print(_mode2_line(calibration))
     wrong = calibration.wrong_peak_points
-    doubtful = _doubtful_points(calibration, WRONG_PEAK)
+    doubtful = calibration.kept_far_points
     for i, x_c in enumerate(calibration.contact_points):
         if not 0.0 < float(x_c) <= antenna.link.length:
             continue  # no known point on the link: its note below says so
@@ -213,21 +213,6 @@ def _run(args: argparse.Namespace) -> int:
         print(f"figure {plot_calibration(calibration, antenna.link, args.plot)}")
     print(f"wrote {args.out}")
     return 0
-
-
-def _doubtful_points(calibration: FrequencyCalibration, share: float) -> list[bool]:
-    """Points the fit kept whose omega_1 lies more than ``share`` from the others' (the median
-    relative residual of the points it used, three at least): a wrong peak or known point the
-    fit could not leave out (below five points, or beyond the one or a tenth it leaves out)."""
-    import numpy as np
-
-    with np.errstate(divide="ignore", invalid="ignore"):
-        relative = calibration.omega1_measured / calibration.omega1_fitted - 1.0
-    usable = calibration.used & np.isfinite(relative)
-    if usable.sum() < 3:
-        return [False] * len(usable)
-    far = np.abs(relative - float(np.median(relative[usable]))) > share
-    return [bool(k) for k in usable & far & ~calibration.wrong_peak_points]
 
 
 def _mode2_line(calibration: FrequencyCalibration) -> str:
