@@ -588,7 +588,7 @@ def _numeric_columns(
     column but those the format does not name (:data:`NAMED_COLUMNS`) with a cell that is not a
     number. A row of the wrong length, a '#' line among the samples or a named column's cell
     that is not a number is refused, naming its line."""
-    required = [name in NAMED_COLUMNS for name in names]
+    named = [name in NAMED_COLUMNS for name in names]
     text_columns: set[int] = set()
     table = np.empty((len(rows), len(names)))
     for offset, row in enumerate(rows):
@@ -616,7 +616,7 @@ def _numeric_columns(
             try:
                 table[offset, k] = float(cell)
             except ValueError:
-                if required[k]:
+                if named[k]:
                     raise RecordingError(
                         source, number, name, f"not a number ({cell.strip()!r})"
                     ) from None

@@ -250,6 +250,10 @@ def _worst(read: FloatArray, expected: FloatArray, names: str) -> str:
     when it holds most of the distance: a single column in the wrong unit or sign."""
     off = np.abs(read - expected)
     k = int(np.argmax(off))
+    # "most": 80 % of the squared distance. One column in the wrong unit or sign holds nearly
+    # all of it (a tz in N mm: 0.0218 N m against the others' offsets of 1e-4), a scale of
+    # the whole wrench spreads it as the weight's moment does (ty alone at theta2 = 0, yet
+    # then that is the column to look at too)
     if not (math.isfinite(off[k]) and off[k] ** 2 > 0.8 * float(off @ off)):
         return ""
     return f", most of it in '{names[0]}{names[1 + k]}'"

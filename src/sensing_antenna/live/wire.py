@@ -172,17 +172,15 @@ def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> 
         try:
             value = float(cell)
         except ValueError:
+            value = None
+        if value is None or not math.isfinite(value):
             if name not in NAMED_COLUMNS:
                 values.append(math.nan)
                 continue
-            raise RecordingError(
-                header.source, number, name, f"not a number ({cell.strip()!r})"
-            ) from None
-        if not math.isfinite(value) and name not in NAMED_COLUMNS:
-            values.append(math.nan)
-            continue
-        if not math.isfinite(value):
-            raise RecordingError(header.source, number, name, "NaN or infinite value")
+            problem = (
+                f"not a number ({cell.strip()!r})" if value is None else "NaN or infinite value"
+            )
+            raise RecordingError(header.source, number, name, problem)
         values.append(value)
     return values
 
