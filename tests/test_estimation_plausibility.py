@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from _models import calibrated
+from _recordings import samples_kept
 from sensing_antenna.antenna import Antenna, paper_antenna
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.estimation import (
@@ -425,15 +426,8 @@ def test_a_recording_that_starts_in_motion_is_told_to_start_at_rest() -> None:
     # rather than to give a payload the link does not carry
     antenna = paper_antenna().self_calibrated()
     recording = simulate(antenna, Scenario(case="vertical", contact_point=0.7, seed=3))
-    keep = slice(200, None)
-    late = dataclasses.replace(
-        recording.without_ground_truth(),
-        t=recording.t[keep] - recording.t[200],
-        theta=recording.theta[keep],
-        force=recording.force[keep],
-        torque=recording.torque[keep],
-        extra={},
-    )
+    late = samples_kept(recording.without_ground_truth(), slice(200, None))
+    late = dataclasses.replace(late, t=late.t - late.t[0])
     result = estimate(late, antenna)
     assert result.diagnostics["tare"] == "approach"
     assert result.status is not Status.OK

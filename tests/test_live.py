@@ -519,6 +519,8 @@ def test_a_stream_missing_samples_is_estimated_as_the_file_is(
     assert live.diagnostics["filled_samples"] == round(
         (held[-1] - held[0]) / lossy.sample_period + 1 - held.size
     )
+    # and the 5 % put back by straight lines keep the whole record's answer within 2 mm, the
+    # millimetres fast's 95 % interval spans here (read as uniform, 1.5 cm off)
     assert abs(live.x_c - estimate(whole, paper_antenna(), method).x_c) < 2e-3
 
 
@@ -539,8 +541,9 @@ def test_a_stream_whose_time_stamps_jitter_is_read(recordings: dict[str, Path]) 
     events = _listen(shaken, "paper")
     found = next(e for e in events if isinstance(e, EstimateEvent))
     assert "filled_samples" not in found.estimate.diagnostics
-    assert found.estimate.status == estimate(whole, paper_antenna()).status
-    assert abs(found.x_c - estimate(whole, paper_antenna()).x_c) < 1e-4
+    # read as uniform samples, the stream gives the answer of the file without the jitter
+    reference = estimate(whole, paper_antenna())
+    assert (found.estimate.status, found.x_c) == (reference.status, reference.x_c)
 
 
 def test_two_recordings_in_one_stream(recordings: dict[str, Path]) -> None:

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 
+from _recordings import samples_kept
 from sensing_antenna import paper_antenna
 from sensing_antenna.antenna import STANDARD_GRAVITY
 from sensing_antenna.estimation import estimate
@@ -146,14 +147,7 @@ def test_the_touching_link_presses_the_object_on_an_identified_head() -> None:
     true_contact = float(recording.metadata["true_t_contact"])
     # the same with every 7th sample before the contact lost (the detector resamples it)
     keep = (np.arange(recording.n_samples) % 7 != 3) | (recording.t > true_contact)
-    gappy = dataclasses.replace(
-        recording,
-        t=recording.t[keep],
-        theta=recording.theta[keep],
-        force=recording.force[keep],
-        torque=recording.torque[keep],
-        extra={k: v[keep] for k, v in recording.extra.items()},
-    )
+    gappy = samples_kept(recording, keep)
     for run in (recording, gappy):
         _, touch = recording_links(run, model)
         assert touch is not None

@@ -90,9 +90,11 @@ def test_a_sensor_tared_with_the_link_on_is_named_as_such() -> None:
 
 
 def test_the_one_column_in_a_wrong_unit_is_named() -> None:
-    # tz alone written in N mm: the reason says where the reading is off
+    # tz alone written in N mm, with a sensor offset of 22 uN m there after taring (two
+    # counts of the simulated sensor are 60 uN m): it reads 0.022 "N m" where 0 is expected,
+    # and the reason says which column is off
     theta, force, torque = at_rest()
-    torque[:, 2] = 1000 * (torque[:, 2] + 0.0218 / 1000)
+    torque[:, 2] = 1000 * (torque[:, 2] + 22e-6)
     reading = rest_reading(theta, force, torque, ANTENNA)
     assert "most of it in 'tz'" in (reading.problem or "")
 
