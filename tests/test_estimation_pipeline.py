@@ -534,6 +534,31 @@ def test_online_samples_skipped_are_put_back_and_a_time_jump_is_bad_input() -> N
     assert (result.reason or "").startswith("t: time jumps from 0.0 to 86400.0 s")
 
 
+@pytest.mark.parametrize("clock", [1.008, 0.995])
+def test_stamps_off_the_declared_period_are_resampled_offline_and_refused_online(
+    clock: float,
+) -> None:
+    # Stamps one period apart under a sample_period declared 0.8 % long or 0.5 % short (under
+    # the 1 % of jitter that alone makes sampling irregular). Read as samples one declared
+    # period apart, the vibration rings that much off and x_c moves by millimetres, still `ok`;
+    # a file is resampled by its stamps and answers as if declared right; a stream, which
+    # cannot be resampled whole, is refused as soon as the stamps' span tells
+    recording = synthetic_recording(Synthetic(x_c=0.6, seed=5))
+    declared = recording.with_metadata(sample_period=repr(TS * clock))
+    right = estimate(recording, calibrated())
+    offline = estimate(declared, calibrated())
+    assert offline.status is right.status is Status.OK
+    assert offline.diagnostics["resampled"]
+    # interpolation between samples 10+ per period of the vibration: micrometres at most
+    assert offline.x_c == pytest.approx(right.x_c, abs=1e-5)
+    as_declared = dataclasses.replace(declared, t=TS * clock * np.arange(recording.n_samples))
+    assert abs(estimate(as_declared, calibrated()).x_c - right.x_c) > 1e-3
+    _, online = run_online(declared)
+    assert online.status is Status.BAD_INPUT
+    assert (online.reason or "").startswith("t: the time stamps step 0.001 s on average")
+    assert "sample_period" in (online.reason or "")
+
+
 def test_candidates_the_ratio_cannot_tell_apart_without_a_second_mode_are_uncertain() -> None:
     # Near the top of the sensing curve (x_c = 0.8 m; its maximum near 0.768 l) the two
     # candidates of omega_1 (0.739 and 0.800 m) lie 6 cm apart, within two of the ratio's

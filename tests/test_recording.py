@@ -262,6 +262,19 @@ def test_check_sampling_regular_jitter_and_drops() -> None:
     assert diag.max_jitter < 1e-15
 
 
+def test_stamps_whose_clock_runs_off_the_period_make_sampling_irregular() -> None:
+    # 2,000 stamps one period apart: 0.2 % off the nominal period spans 4 periods more than
+    # the nominal, beyond 0.1 % and half a period; 0.05 % is within
+    t = 1e-3 * np.arange(2000)
+    off = check_sampling(t, nominal=1e-3 / 1.002)
+    assert off.irregular and off.n_dropped == 0
+    assert off.mean_period == pytest.approx(1e-3, rel=1e-12)
+    assert off.max_jitter < 0.01 * off.nominal_period  # not the jitter: the clock
+    assert not check_sampling(t, nominal=1e-3 / 1.0005).irregular
+    # a short record may not tell: half a period over 100 steps is 0.5 %
+    assert not check_sampling(t[:100], nominal=1e-3 / 1.004).irregular
+
+
 def test_sample_period_falls_back_to_median_when_metadata_inconsistent() -> None:
     rec = _recording(metadata={"sample_period": "0.002"})
     assert rec.sample_period == pytest.approx(1e-3, rel=1e-12)

@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from sensing_antenna.errors import SensingAntennaError, format_value
 
 __all__ = [
+    "CLOCK_TOLERANCE",
     "COMMAND_COLUMNS",
     "CONTACT_POINT_COLUMNS",
     "CONTACT_TRACK_COLUMNS",
@@ -54,6 +55,7 @@ __all__ = [
     "RecordingError",
     "SamplingDiagnostics",
     "check_sampling",
+    "clock_disagrees",
     "is_ground_truth_key",
     "parse_header",
     "parse_metadata",
@@ -105,6 +107,11 @@ GROUND_TRUTH_PREFIX = "true_"
 #: samples are missing. Decimal time stamps written with 6 or more significant digits stay far
 #: below it.
 JITTER_TOLERANCE = 0.01
+
+#: The time stamps' clock may run off the sample period by this fraction (0.1 %) before the stamps
+#: are trusted over the period: a frequency read on samples taken as one period apart is off by as
+#: much as the two clocks disagree, and the fast method's frequency floor is 0.3 %.
+CLOCK_TOLERANCE = 1e-3
 
 #: ``sample_period`` metadata counts as consistent with the data when the median time step is
 #: within this fraction of it (2 %).
@@ -197,7 +204,10 @@ class SamplingDiagnostics:
     n_dropped : int
         Number of missing samples (a step of k periods counts k - 1).
     irregular : bool
-        True when samples are missing or the jitter exceeds ``JITTER_TOLERANCE`` of the period.
+        True when samples are missing, the jitter exceeds ``JITTER_TOLERANCE`` of the period,
+        or the stamps' clock runs off the period (:func:`clock_disagrees`).
+    mean_period : float
+        The stamps' span over the periods it holds, dropped samples counted (s).
     """
 
     nominal_period: float
@@ -205,6 +215,15 @@ class SamplingDiagnostics:
     max_jitter: float
     n_dropped: int
     irregular: bool
+    mean_period: float
+
+
+def clock_disagrees(span: float, intervals: int, period: float) -> bool:
+    """True when ``intervals`` sample periods of ``period`` (s) cannot be the ``span`` (s) their
+    time stamps cover: beyond :data:`CLOCK_TOLERANCE` of them and half a period more (the
+    span's two stamps may each be a quarter period early or late)."""
+    expected = intervals * period
+    return abs(span - expected) > CLOCK_TOLERANCE * expected + 0.5 * period
 
 
 def check_sampling(
@@ -236,12 +255,17 @@ def check_sampling(
     multiples = np.maximum(np.rint(steps / period), 1.0)
     jitter = float(np.max(np.abs(steps - multiples * period)))
     dropped = int(np.sum(multiples - 1.0))
+    intervals = steps.shape[0] + dropped
+    span = float(times[-1] - times[0])
     return SamplingDiagnostics(
         nominal_period=period,
         median_period=median,
         max_jitter=jitter,
         n_dropped=dropped,
-        irregular=dropped > 0 or jitter > tolerance * period,
+        irregular=(
+            dropped > 0 or jitter > tolerance * period or clock_disagrees(span, intervals, period)
+        ),
+        mean_period=span / intervals,
     )
 
 
