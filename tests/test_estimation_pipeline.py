@@ -274,6 +274,23 @@ def test_no_contact() -> None:
     assert early.reason == result.reason
 
 
+@pytest.mark.parametrize("count", [2, 50, 300])
+def test_too_few_samples_for_any_manoeuvre_are_too_short_not_a_free_sweep(count: int) -> None:
+    # The first samples of a free sweep: no contact in them, but too few to hold one the front
+    # end could use (two rests of 50 ms and the 0.2 s hold: 0.3 s), so they say nothing of free
+    # space; 302 samples span 0.301 s, a free sweep's record however short
+    recording = synthetic_recording(Synthetic(contact_time=50.0, stops=False, duration=2.0))
+    head = samples_kept(recording, np.arange(recording.n_samples) < count)
+    result = estimate(head, calibrated())
+    assert result.status is Status.RECORDING_TOO_SHORT
+    assert result.reason.startswith(f"{count} samples (")
+    assert "no contact" in result.reason
+    _, final = run_online(head)
+    assert comparable(final) == comparable(result)
+    longer = samples_kept(recording, np.arange(recording.n_samples) < 302)
+    assert estimate(longer, calibrated()).status is Status.NO_CONTACT
+
+
 def test_push_too_gentle_is_not_a_push() -> None:
     # 0.2 % deflection at 0.9 m: |R| = 3 E I y / x^3 = 0.7 mN... below the 5 mN push threshold,
     # but the vibration still triggers the contact detector.

@@ -90,7 +90,8 @@ class EarlyOutcome:
     Attributes
     ----------
     status : Status
-        ``bad_input``, ``no_contact`` or ``push_not_reached``.
+        ``bad_input``, ``implausible_input``, ``no_contact``, ``recording_too_short`` (too few
+        samples to hold a contact at all) or ``push_not_reached``.
     reason : str
         Why, in one sentence.
     t_c, t_1 : float
