@@ -86,6 +86,25 @@ def test_plot_estimate_writes_four_figures(recording_file: Path, tmp_path: Path)
     assert all((out / n).stat().st_size > 10_000 for n in names)
 
 
+def test_plot_estimate_says_why_figures_13_and_14_are_missing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    free = tmp_path / "free.csv"
+    write_recording(
+        synthetic_recording(Synthetic(contact_time=50.0, stops=False, duration=2.0)), free
+    )
+    out = tmp_path / "figs"
+    assert main(["plot", "estimate", str(free), "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert sorted(p.name for p in out.glob("*.png")) == [
+        "figure11-contact.png",
+        "figure12-push.png",
+    ]
+    err = captured.err.strip()
+    assert "\n" not in err and "figures 13 and 14 not drawn" in err and "no_contact" in err
+    assert "figure13" not in captured.out
+
+
 def test_a_recording_of_another_antenna_estimated_with_the_default_is_warned_of(
     recording_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

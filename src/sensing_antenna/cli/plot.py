@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -94,10 +95,20 @@ def _add_estimate(kinds: Any) -> None:
 
 def _run_estimate(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
-    from sensing_antenna.plotting.estimate import plot_estimate
+    from sensing_antenna.estimation import EstimatorConfig, estimate
+    from sensing_antenna.plotting.estimate import plot_contact_estimate
     from sensing_antenna.recording import read_recording
 
     recording = read_recording(args.recording)
-    for path in plot_estimate(recording, load_antenna(args.antenna), args.out):
+    antenna = load_antenna(args.antenna)
+    result = estimate(recording, antenna)
+    paths = plot_contact_estimate(result, antenna, args.out, EstimatorConfig().zero_padding)
+    for path in paths:
         print(path)
+    if not any(path.name.startswith("figure13") for path in paths):
+        print(
+            f"antenna plot estimate: figures 13 and 14 not drawn: the estimate stopped before "
+            f"its spectrum and ratio windows ({result.status.value}: {result.reason})",
+            file=sys.stderr,
+        )
     return 0
