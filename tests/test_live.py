@@ -551,7 +551,10 @@ def test_two_recordings_in_one_stream(recordings: dict[str, Path]) -> None:
     second = _lines(read_recording(recordings["vertical"]))
     events = _listen(first + second, "ratio")
     ends = [e for e in events if isinstance(e, EndEvent)]
-    assert [(e.recording, e.reason) for e in ends] == [(1, "next recording"), (2, "end of input")]
+    assert [(e.recording, e.reason) for e in ends] == [
+        (1, "a '#' line after the samples"),
+        (2, "end of input"),
+    ]
     estimates = [e for e in events if isinstance(e, EstimateEvent)]
     for event, case in zip(estimates, ("azimuthal", "vertical"), strict=True):
         reference = estimate(read_recording(recordings[case]), paper_antenna(), "ratio")

@@ -84,7 +84,7 @@ def listen_lines(
                 continue
             if line.startswith("#"):
                 if current is not None:
-                    current.close("next recording")
+                    current.close("a '#' line after the samples")
                     current, ended = None, ended + 1
                     if count is not None and ended >= count:
                         return ended
