@@ -167,28 +167,31 @@ def listen_udp(
     clock: Callable[[], float] = time.perf_counter,
 ) -> int:
     """Receive datagrams on a bound socket until ``count`` recordings ended (forever when
-    None); returns the number ended. ``on_event`` receives the reader's own
-    :class:`~.events.SkippedEvent`s (from this thread: the listeners' events come from
-    theirs)."""
+    None; streams left out are not counted, though they keep their numbers); returns the
+    number ended. ``on_event`` receives the reader's own :class:`~.events.SkippedEvent`s (from
+    this thread: the listeners' events come from theirs)."""
     host, port = sock.getsockname()[:2]
     source = f"udp:{host}:{port}"
     current: _UdpStream | None = None
-    ended = 0
+    numbered = 0  # streams joined, each with its recording's number
+    ended = 0  # recordings ended, not counting streams left out (what ``count`` counts)
     refused: set[str] = set()  # streams left out, ignored until their end
     joined: set[str] = set()  # streams heard (one that resumes after the idle end is known)
     sock.settimeout(min(idle, 0.2))
 
     def skip(reason: str) -> None:
-        on_event(SkippedEvent(ended + 1, reason))
+        on_event(SkippedEvent(numbered if current is not None else numbered + 1, reason))
 
-    def finish(stream: _UdpStream, reason: str) -> None:
-        """End ``stream``; one the listener refused (its period, say) is skipped, not fatal:
-        other streams may follow."""
+    def finish(stream: _UdpStream, reason: str) -> int:
+        """End ``stream``: 1, or 0 when the listener refused it (its period, say): skipped,
+        not fatal (other streams may follow) and not counted."""
         try:
             stream.close(reason)
         except WireError as exc:
             skip(f"{exc}: the stream is left out")
             refused.add(stream.name)
+            return 0
+        return 1
 
     try:
         while count is None or ended < count:
@@ -196,8 +199,8 @@ def listen_udp(
                 data = sock.recv(MAX_DATAGRAM_BYTES + 1)
             except TimeoutError:
                 if current is not None and clock() - current.heard > idle:
-                    finish(current, f"no datagram for {idle:g} s")
-                    current, ended = None, ended + 1
+                    ended += finish(current, f"no datagram for {idle:g} s")
+                    current = None
                 continue
             received = clock()
             try:
@@ -234,11 +237,12 @@ def listen_udp(
                     refused.add(datagram.stream)
                     continue
                 if current is not None:
-                    finish(current, "another stream began")
-                    current, ended = None, ended + 1
+                    ended += finish(current, "another stream began")
+                    current = None
                     if count is not None and ended >= count:
                         break
-                current = _UdpStream(make(header, ended + 1), datagram)
+                numbered += 1
+                current = _UdpStream(make(header, numbered), datagram)
                 current.heard = received
                 joined.add(datagram.stream)
             elif not ours or datagram.kind == "header":
@@ -246,8 +250,8 @@ def listen_udp(
             elif datagram.kind == "end":
                 assert current is not None
                 current.lost += max(0, datagram.seq - current.expected)
-                finish(current, "end of stream")
-                current, ended = None, ended + 1
+                ended += finish(current, "end of stream")
+                current = None
             else:
                 assert current is not None
                 try:
@@ -256,7 +260,7 @@ def listen_udp(
                     skip(f"{exc}: the stream is left out")
                     refused.add(current.name)
                     _close_quietly(current.listener)
-                    current, ended = None, ended + 1
+                    current = None
         return ended
     finally:
         _close_quietly(None if current is None else current.listener)
