@@ -42,7 +42,7 @@ def test_slower_joints_are_interpolated_linearly_and_the_wrench_kept_as_sampled(
     clocked = put_on_clock(wrench, joints, source="log")
     report = clocked.report
     assert report.period == 0.001 and report.n_samples == 1001
-    assert report.joints.median_rate == 200.0 and report.wrench.median_rate == 1000.0
+    assert report.joints.rate == 200.0 and report.wrench.rate == 1000.0
     np.testing.assert_array_equal(clocked.t, np.arange(1001) * 0.001)
     np.testing.assert_array_equal(clocked.wrench, wrench.values)
     expected = np.column_stack([0.3 * clocked.t, 0.1 - 0.2 * clocked.t])
@@ -88,3 +88,71 @@ def test_streams_that_do_not_overlap_or_repeat_a_stamp_are_refused() -> None:
     repeated = _ramp_joints(EPOCH_NS + np.array([0, MS, MS, 2 * MS], dtype=np.int64))
     with pytest.raises(ImporterError, match=r"'/joints': messages 1 and 2 .* same stamp"):
         put_on_clock(wrench, repeated, source="log")
+
+
+def _jittered(wrench: Stream, stamps: np.ndarray) -> Stream:
+    return Stream(name=wrench.name, kind=wrench.kind, stamps=stamps, values=wrench.values)
+
+
+@pytest.mark.parametrize(
+    "how",
+    ["stamps jittered by up to half a period", "a recorder's latency of 0 to 5 periods", "bursts"],
+)
+def test_every_message_keeps_its_own_sample_whatever_its_stamp_s_jitter(how: str) -> None:
+    # 3,000 samples at 1 kHz, none dropped, stamped three ways a lab meets: a logger's jitter
+    # of up to +-0.5 ms; a recorder's arrival time, 0 to 5 ms late and in order; arrivals four
+    # at a time, 10 us apart, every 4 ms. Counting each step as its nearest whole number of
+    # median steps read 1127 Hz, 2570 Hz and 100 kHz from them, inventing or leaving out
+    # hundreds of samples; the stamps' line against the messages' count reads the sensor's
+    # 1 kHz, and each message is its own sample
+    rng = np.random.default_rng(5)
+    n = 3000
+    wrench = _wrench(n)
+    k = np.arange(n, dtype=np.int64)
+    if how.startswith("stamps"):
+        stamps = wrench.stamps + rng.integers(-MS // 2 + 1, MS // 2, size=n)
+    elif how.startswith("a recorder"):
+        arrival = wrench.stamps + rng.integers(0, 5 * MS, size=n)
+        stamps = np.maximum.accumulate(arrival) + k  # in order, one nanosecond apart at least
+    else:
+        stamps = EPOCH_NS + (k // 4 * 4 + 3) * MS + (k % 4) * 10_000
+    # the joints cover the whole stream, 5 ms late included
+    joints = _ramp_joints(EPOCH_NS + np.arange(-10, n + 20, 10, dtype=np.int64) * MS)
+    clocked = put_on_clock(_jittered(wrench, stamps), joints, source="log")
+    report = clocked.report
+    assert report.period == pytest.approx(0.001, rel=2e-4)  # the clock tolerance is 1e-3
+    assert report.wrench.n_missing == report.wrench.n_gaps == 0
+    assert report.n_samples == n and report.n_interpolated == report.n_left_out == 0
+    np.testing.assert_array_equal(clocked.wrench, wrench.values)
+
+
+def test_dropped_messages_are_counted_under_jitter_and_bridged_or_left_out() -> None:
+    # stamps jittered by up to +-0.4 ms; two messages dropped (bridged: the estimators take up
+    # to three in a row) and later ten (a gap, left out)
+    rng = np.random.default_rng(6)
+    n = 2000
+    wrench = _wrench(n)
+    kept = np.setdiff1d(np.arange(n), [700, 701, *range(1300, 1310)])
+    stamps = wrench.stamps + rng.integers(-400_000, 400_001, size=n)
+    lossy = Stream("/wrench", "wrench", stamps[kept], wrench.values[kept])
+    joints = _ramp_joints(EPOCH_NS + np.arange(-10, n + 10, 10, dtype=np.int64) * MS)
+    clocked = put_on_clock(lossy, joints, source="log")
+    report = clocked.report
+    assert report.wrench.n_missing == 12 and report.wrench.n_gaps == 1
+    assert report.n_interpolated == 2 and report.n_left_out == 10
+    slots = np.rint(clocked.t / report.period).astype(int)
+    assert set(range(n)) - set(slots) == set(range(1300, 1310))
+    own = np.isin(slots, kept)
+    np.testing.assert_array_equal(clocked.wrench[own], wrench.values[slots[own]])
+
+
+def test_the_report_says_what_the_clock_leaves_out_or_makes_up() -> None:
+    wrench = _wrench(1000)
+    joints = _ramp_joints(EPOCH_NS + np.arange(300, 1000, 10, dtype=np.int64) * MS)
+    lines = put_on_clock(wrench, joints, source="log").report.lines()
+    assert lines[-1].startswith("the wrench's first 0.3 s and last 0.009 s left out:")
+    faster = put_on_clock(wrench, _ramp_joints(wrench.stamps), source="log", period=1 / 3000)
+    assert faster.report.lines()[-1] == (
+        "the clock's 3000 Hz is above the wrench's own 1000 Hz: the samples between its "
+        "messages are interpolated"
+    )

@@ -10,7 +10,7 @@ from typing import Any
 
 from sensing_antenna.cli.arguments import add_actions, number
 
-#: Default gap threshold, in median steps of a topic (the value of
+#: Default gap threshold, in samples of a topic missing in a row (the value of
 #: ``sensing_antenna.importers.clock.DEFAULT_MAX_GAP``, written out so that parsing arguments
 #: does not import NumPy; ``tests/test_import_rosbag.py`` checks that they agree).
 DEFAULT_MAX_GAP = 3.0
@@ -87,10 +87,10 @@ def _add_rosbag(formats: Any) -> None:
     )
     parser.add_argument(
         "--max-gap",
-        type=number(low=1.0, low_open=True),
+        type=number(low=0.0),
         default=DEFAULT_MAX_GAP,
-        metavar="STEPS",
-        help="a step longer than this many median steps of its topic is a gap, whose samples "
+        metavar="SAMPLES",
+        help="more than this many samples of a topic missing in a row is a gap, whose samples "
         "are left out",
     )
     parser.add_argument(

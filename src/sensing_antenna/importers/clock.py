@@ -1,20 +1,31 @@
 """Timed streams from a log put onto a recording's one uniform clock, with rates and gaps.
 
 A lab's log holds the force/torque sensor and the joint angles as separate streams, each with its
-own time stamps, rate, jitter and dropped messages. A recording has one clock. :func:`put_on_clock`
-lays a grid of step T_s (by default the wrench stream's span over the number of sample periods it
-holds, which stamp jitter barely moves) over the time both streams cover, starting at the first
-wrench message in it, and fills each slot k (time k T_s):
+own time stamps, rate, jitter and dropped messages. A recording has one clock.
 
-- the wrench with the sensor's own sample: the message whose stamp is nearest to the slot, when
-  it lies within T_s / 2 (stamp jitter moves no value; nothing is interpolated). A slot with
+Each stream's own clock is read from its stamps first (:func:`sample_clock`): the sensor samples
+at a steady rate, message i is its sample n_i (n_i - i the messages dropped before it), and its
+stamp is that sample's instant plus jitter (a logger's, or a recorder's latency, which may be
+several periods and come in bursts). The period is the median of the steps over 64 messages,
+divided by 64 (jitter divided as much, and a rare drop spoils few of them); a drop is a lasting
+shift of the stamps against the messages' count, where a running median of the stamps'
+lead over that count rises by at least a period beyond its noise; then the line through the stamps
+against their sample numbers gives the period and each message's instant without its jitter.
+A drop shorter than the jitter cannot be told and is not counted.
+
+:func:`put_on_clock` lays a grid of step T_s (by default the wrench stream's period) over the time
+both streams cover, starting at the first wrench message in it, and fills each slot k (time
+k T_s):
+
+- the wrench with the sensor's own sample: the message whose instant is nearest to the slot,
+  when it lies within T_s / 2 (stamp jitter moves no value; nothing is interpolated). A slot with
   none (a dropped message) takes the straight line between the messages either side;
-- the joint angles by linear interpolation between the messages either side (joint states
-  usually come slower than the sensor, and the angles move smoothly);
-- a slot inside a gap of either stream, a step between two messages longer than ``max_gap``
-  times that stream's median step, is left out: the recording then shows the missing samples
-  and the estimators treat them as dropped (docs/recording-format.md), instead of estimating
-  from straight lines drawn across the gap.
+- the joint angles by linear interpolation between the messages either side, at their stamps
+  (joint states usually come slower than the sensor, and the angles move smoothly);
+- a slot inside a gap of either stream, more than ``max_gap`` of its samples missing in a row,
+  is left out: the recording then shows the missing samples and the estimators treat them as
+  dropped (docs/recording-format.md), instead of estimating from straight lines drawn across the
+  gap.
 
 Time stamps are integer nanoseconds throughout, so a stream written at the grid's own instants
 comes out with its values unchanged, to the bit.
@@ -27,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.ndimage import median_filter
 
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import MAX_SAMPLES
@@ -36,15 +48,29 @@ __all__ = [
     "ClockReport",
     "ClockedStreams",
     "ImporterError",
+    "SampleClock",
     "Stream",
     "StreamReport",
     "put_on_clock",
+    "sample_clock",
 ]
 
-#: A step longer than this many median steps of its stream is a gap whose slots are left out
+#: More than this many samples of a stream missing in a row is a gap whose slots are left out
 #: (3: the estimators give ``bad_input`` for more than three samples missing in a row after the
 #: push, so a shorter hole is bridged and a longer one shown).
 DEFAULT_MAX_GAP = 3.0
+
+#: The report says how much of the wrench the joints leave out beyond this many periods.
+_TRIM_NOTED = 10
+
+#: Messages over which a stream's period is read: steps over this many messages, divided by it,
+#: carry the stamps' jitter divided as much.
+_PERIOD_LAG = 64
+#: Messages in the running median that follows a stream's stamps against its sample count.
+_LEVEL_WINDOW = 31
+#: A drop is counted where that running median rises by half a period and this many of its own
+#: standard deviations: stamps' jitter does not count drops.
+_LEVEL_SIGMAS = 4.0
 
 _NS = 1e9  # nanoseconds per second
 
@@ -77,7 +103,7 @@ class Stream:
 
 @dataclass(frozen=True)
 class StreamReport:
-    """Rates and gaps of one stream.
+    """Rate, drops and gaps of one stream.
 
     Parameters
     ----------
@@ -85,33 +111,39 @@ class StreamReport:
         As in :class:`Stream`.
     n_messages : int
         Messages in the stream.
-    median_period : float
-        Median step between consecutive stamps (s).
+    period : float
+        The stream's sample period read from its stamps (s, :func:`sample_clock`).
+    n_missing : int
+        Samples its stamps show missing between its first and last message.
     largest_step : float
         Largest step between consecutive stamps (s).
     n_gaps : int
-        Steps longer than ``max_gap`` median steps.
+        Runs of more than ``max_gap`` samples missing.
+    jitter : float
+        Largest distance of a stamp from its sample's instant on the stream's own clock (s).
     """
 
     name: str
     kind: str
     n_messages: int
-    median_period: float
+    period: float
+    n_missing: int
     largest_step: float
     n_gaps: int
+    jitter: float
 
     @property
-    def median_rate(self) -> float:
-        """1 / median_period (Hz)."""
-        return 1.0 / self.median_period
+    def rate(self) -> float:
+        """1 / period (Hz)."""
+        return 1.0 / self.period
 
     def line(self) -> str:
-        """One line for a person: count, rate, largest gap."""
-        periods = self.largest_step / self.median_period
+        """One line for a person: count, rate, missing samples, largest step, gaps, jitter."""
         return (
-            f"{self.name} ({self.kind}): {self.n_messages} messages, median rate"
-            f" {self.median_rate:.6g} Hz, largest step {self.largest_step:.6g} s"
-            f" ({periods:.3g} median steps), {self.n_gaps} gap(s)"
+            f"{self.name} ({self.kind}): {self.n_messages} messages, rate {self.rate:.6g} Hz"
+            f" (its stamps' line), {self.n_missing} missing, largest step"
+            f" {self.largest_step:.6g} s, {self.n_gaps} gap(s), stamps within"
+            f" {self.jitter:.3g} s of its clock"
         )
 
 
@@ -136,10 +168,13 @@ class ClockReport:
     n_left_out : int
         Slots left out, inside a gap of either stream.
     largest_offset : float
-        Largest distance between a wrench message used as it is and its slot (s): the stamps'
-        jitter against the clock.
+        Largest distance between the instant of a wrench message used as it is and its slot
+        (s): 0 on the wrench's own clock.
     max_gap : float
-        The gap threshold used (median steps).
+        The gap threshold used (samples missing in a row).
+    trimmed : tuple of float
+        Time (s) of the wrench stream before the grid's first slot and after its last: where
+        the joints do not cover it.
     """
 
     wrench: StreamReport
@@ -152,19 +187,31 @@ class ClockReport:
     n_left_out: int
     largest_offset: float
     max_gap: float
+    trimmed: tuple[float, float] = (0.0, 0.0)
 
     def lines(self) -> list[str]:
         """Lines for a person: each stream, the clock, the samples filled and left out."""
         span = (self.n_slots - 1) * self.period
-        return [
+        lines = [
             f"wrench {self.wrench.line()}",
             f"joints {self.joints.line()}",
             f"clock: {self.n_samples} samples every {self.period:.6g} s"
-            f" ({1.0 / self.period:.6g} Hz) over {span:.6g} s; wrench stamps within"
-            f" {self.largest_offset:.3g} s of it",
+            f" ({1.0 / self.period:.6g} Hz) over {span:.6g} s",
             f"{self.n_interpolated} sample(s) without their own wrench message, interpolated;"
-            f" {self.n_left_out} left out in gaps longer than {self.max_gap:g} median steps",
+            f" {self.n_left_out} left out in gaps of more than {self.max_gap:g} samples missing",
         ]
+        before, after = self.trimmed
+        if max(before, after) > _TRIM_NOTED * self.period:
+            lines.append(
+                f"the wrench's first {before:.3g} s and last {after:.3g} s left out: the joints"
+                " do not cover them (a recording needs the rest before the sweep)"
+            )
+        if self.period < 0.99 * self.wrench.period:
+            lines.append(
+                f"the clock's {1.0 / self.period:.6g} Hz is above the wrench's own"
+                f" {self.wrench.rate:.6g} Hz: the samples between its messages are interpolated"
+            )
+        return lines
 
 
 @dataclass(frozen=True)
@@ -203,29 +250,108 @@ def _check_stream(stream: Stream, source: str) -> None:
         )
 
 
-def _report(stream: Stream, max_gap: float) -> StreamReport:
-    steps = np.diff(stream.stamps)
-    median = float(np.median(steps))
+@dataclass(frozen=True)
+class SampleClock:
+    """A stream's own clock, read from its stamps (:func:`sample_clock`).
+
+    Parameters
+    ----------
+    period : float
+        Sample period (ns).
+    numbers : ndarray of int64, shape (n,)
+        Each message's sample number, the first's 0: increasing, by more than one after a drop.
+    instants : ndarray, shape (n,)
+        Each message's sample instant (ns from the first stamp), on the line through the
+        stamps against their numbers: the stamps without their jitter.
+    """
+
+    period: float
+    numbers: NDArray[np.int64]
+    instants: NDArray[np.float64]
+
+
+def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
+    """The clock of a stream whose messages are a sensor's samples at a steady rate, some
+    dropped, each stamped with jitter (module docstring).
+
+    Parameters
+    ----------
+    stamps : ndarray of int64, shape (n,)
+        Time stamps (ns), strictly increasing, n >= 2.
+
+    Returns
+    -------
+    SampleClock
+    """
+    s = (stamps - stamps[0]).astype(np.float64)
+    n = s.shape[0]
+    lag = min(_PERIOD_LAG, n - 1)
+    period = float(np.median((s[lag:] - s[:-lag]) / lag))
+    count = np.arange(n, dtype=np.int64)
+    numbers = count
+    for _ in range(2):  # the drops on a first period, then on the line's
+        numbers = count + _drops(s, s / period - count)
+        slope, intercept = np.polyfit(numbers.astype(np.float64), s, 1)
+        period = float(slope)
+    instants = intercept + period * numbers.astype(np.float64)
+    if np.max(np.abs(s - instants)) <= 1.0:  # stamps on their grid: kept to the nanosecond
+        period = float(s[-1]) / float(numbers[-1])
+        instants = period * numbers.astype(np.float64)
+    return SampleClock(period, numbers, instants)
+
+
+def _drops(s: NDArray[np.float64], lead: NDArray[np.float64]) -> NDArray[np.int64]:
+    """Samples dropped before each message (nondecreasing): where the running median of the
+    stamps' ``lead`` over their count (in periods) rises, from one side of a window to the
+    other, by half a period and its noise; at the longest step there, by the whole rise."""
+    n = lead.shape[0]
+    width = min(_LEVEL_WINDOW, n)
+    level = median_filter(lead, size=width, mode="nearest")
+    spread = 1.4826 * float(np.median(np.abs(lead - level)))
+    noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
+    half = width // 2
+    index = np.arange(n)
+    # the rise across message k: the level half a window after it against half a window before
+    # (local, so a period slightly off does not add up along the stream)
+    rise = level[np.minimum(index + half, n - 1)] - level[np.maximum(index - half - 1, 0)]
+    count = np.floor(rise + 0.5 - noise)
+    drops = np.zeros(n, dtype=np.int64)
+    steps = np.diff(s)
+    rising = count > 0
+    edges = np.flatnonzero(np.diff(np.concatenate([[False], rising, [False]]).astype(np.int8)))
+    for low, high in zip(edges[::2], edges[1::2], strict=True):
+        # one run of messages across which the level rose: the drop is before the message
+        # the longest step of the run leads to (steps[k - 1] leads to message k)
+        first = max(low, 1)
+        at = first + int(np.argmax(steps[first - 1 : max(high, first + 1) - 1]))
+        drops[at:] += int(np.max(count[low:high]))
+    return drops
+
+
+def _report(stream: Stream, clock: SampleClock, max_gap: float) -> StreamReport:
     return StreamReport(
         name=stream.name,
         kind=stream.kind,
         n_messages=int(stream.stamps.shape[0]),
-        median_period=median / _NS,
-        largest_step=float(np.max(steps)) / _NS,
-        n_gaps=int(np.sum(steps > max_gap * median)),
+        period=clock.period / _NS,
+        n_missing=int(clock.numbers[-1]) - (int(stream.stamps.shape[0]) - 1),
+        largest_step=float(np.max(np.diff(stream.stamps))) / _NS,
+        n_gaps=int(np.sum(np.diff(clock.numbers) > max_gap + 1)),
+        jitter=float(np.max(np.abs((stream.stamps - stream.stamps[0]) - clock.instants))) / _NS,
     )
 
 
 def _in_gap(
-    stamps: NDArray[np.float64], slots: NDArray[np.float64], limit: float
+    times: NDArray[np.float64], numbers: NDArray[np.int64], slots: NDArray[np.float64], most: float
 ) -> NDArray[np.bool_]:
-    """For each slot time, whether it lies strictly between two stamps more than ``limit``
-    apart (all in ns relative to the origin)."""
-    after = np.searchsorted(stamps, slots, side="right")
-    inside = (after > 0) & (after < stamps.shape[0])
-    before = np.clip(after - 1, 0, stamps.shape[0] - 1)
-    following = np.clip(after, 0, stamps.shape[0] - 1)
-    return inside & (stamps[following] - stamps[before] > limit) & (slots > stamps[before])
+    """For each slot time, whether it lies strictly between two messages (at ``times``, all in
+    ns relative to the origin) between which more than ``most`` samples are missing."""
+    after = np.searchsorted(times, slots, side="right")
+    inside = (after > 0) & (after < times.shape[0])
+    before = np.clip(after - 1, 0, times.shape[0] - 1)
+    following = np.clip(after, 0, times.shape[0] - 1)
+    missing = numbers[following] - numbers[before] - 1
+    return inside & (missing > most) & (slots > times[before])
 
 
 def put_on_clock(
@@ -245,10 +371,9 @@ def put_on_clock(
     source : str
         The log's name, for messages.
     period : float, optional
-        T_s (s); when None, the wrench stream's span over the number of periods it holds
-        (each step counted as the whole number of median steps nearest to it).
+        T_s (s); when None, the wrench stream's own period (:func:`sample_clock`).
     max_gap : float
-        Steps longer than this many median steps of their stream are gaps (> 1).
+        More than this many samples of a stream missing in a row is a gap (>= 0).
 
     Returns
     -------
@@ -263,31 +388,33 @@ def put_on_clock(
     """
     for stream in (wrench, joints):
         _check_stream(stream, source)
-    if not (math.isfinite(max_gap) and max_gap > 1.0):
-        raise ValueError(f"max_gap must be a finite number > 1, got {max_gap!r}")
-    wrench_report, joints_report = _report(wrench, max_gap), _report(joints, max_gap)
-    start = max(int(wrench.stamps[0]), int(joints.stamps[0]))
-    end = min(int(wrench.stamps[-1]), int(joints.stamps[-1]))
+    if not (math.isfinite(max_gap) and max_gap >= 0.0):
+        raise ValueError(f"max_gap must be a finite number >= 0, got {max_gap!r}")
+    wrench_clock, joints_clock = sample_clock(wrench.stamps), sample_clock(joints.stamps)
+    # the wrench messages at their samples' instants (their stamps without the jitter), ns
+    instants = int(wrench.stamps[0]) + np.rint(wrench_clock.instants).astype(np.int64)
+    start = max(int(instants[0]), int(joints.stamps[0]))
+    end = min(int(instants[-1]), int(joints.stamps[-1]))
     if start >= end:
         raise ImporterError(
             f"{source}: {wrench.name!r} ({_span(wrench)}) and {joints.name!r} ({_span(joints)})"
             " do not overlap in time"
         )
-    step = _mean_period(wrench.stamps) if period is None else float(period)
+    step = wrench_clock.period / _NS if period is None else float(period)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"period must be finite and > 0, got {step!r}")
     step_ns = step * _NS
-    first = int(np.searchsorted(wrench.stamps, start, side="left"))
-    origin = int(wrench.stamps[first])
+    first = int(np.searchsorted(instants, start, side="left"))
+    origin = int(instants[first])
     periods = (end - origin) / step_ns
     if periods >= MAX_SAMPLES:
         raise ImporterError(
             f"{source}: {(end - origin) / _NS:.6g} s of overlap at {step:.6g} s per sample"
             f" is {periods:.4g} samples, more than the limit of {MAX_SAMPLES}"
         )
-    n_slots = math.floor(periods + 1e-9) + 1
+    n_slots = math.floor(periods + 1e-6) + 1  # the instants are whole nanoseconds
     slot_ns = np.arange(n_slots, dtype=np.float64) * step_ns
-    wrench_ns = (wrench.stamps - origin).astype(np.float64)
+    wrench_ns = (instants - origin).astype(np.float64)
     joints_ns = (joints.stamps - origin).astype(np.float64)
 
     # the wrench message nearest each slot, when within T_s / 2 (the first of a tie)
@@ -309,10 +436,8 @@ def put_on_clock(
     joint_values = np.column_stack(
         [np.interp(slot_ns, joints_ns, column) for column in joints.values.T]
     )
-    wrench_limit = max_gap * wrench_report.median_period * _NS
-    joints_limit = max_gap * joints_report.median_period * _NS
-    left_out = (~has_own & _in_gap(wrench_ns, slot_ns, wrench_limit)) | _in_gap(
-        joints_ns, slot_ns, joints_limit
+    left_out = (~has_own & _in_gap(wrench_ns, wrench_clock.numbers, slot_ns, max_gap)) | _in_gap(
+        joints_ns, joints_clock.numbers, slot_ns, max_gap
     )
     kept = np.flatnonzero(~left_out)
     if kept.shape[0] < 2:
@@ -321,9 +446,10 @@ def put_on_clock(
         )
     used = own_message[has_own]
     largest_offset = float(np.max(offset[used])) / _NS if used.size else 0.0
+    last_slot = origin + (n_slots - 1) * step_ns
     report = ClockReport(
-        wrench=wrench_report,
-        joints=joints_report,
+        wrench=_report(wrench, wrench_clock, max_gap),
+        joints=_report(joints, joints_clock, max_gap),
         period=step,
         origin_ns=origin,
         n_slots=n_slots,
@@ -332,6 +458,10 @@ def put_on_clock(
         n_left_out=int(np.sum(left_out)),
         largest_offset=largest_offset,
         max_gap=max_gap,
+        trimmed=(
+            max(origin - int(instants[0]), 0) / _NS,
+            max(int(instants[-1]) - last_slot, 0.0) / _NS,
+        ),
     )
     return ClockedStreams(
         t=kept.astype(np.float64) * step,
@@ -339,18 +469,6 @@ def put_on_clock(
         joints=joint_values[kept],
         report=report,
     )
-
-
-def _mean_period(stamps: NDArray[np.int64]) -> float:
-    """A stream's sample period (s): its span over the number of periods it holds, each step
-    counted as the whole number of median steps nearest to it (a dropped message makes a step
-    of two). Stamp jitter enters only through the first and last stamps, so the error is at most
-    twice the jitter over the span; the median of jittered steps can be off by far more, and a
-    clock that runs fast or slow slips past the sensor's samples over a long log."""
-    steps = np.diff(stamps)
-    median = float(np.median(steps))
-    periods = np.maximum(np.rint(steps / median), 1.0)
-    return float(stamps[-1] - stamps[0]) / float(np.sum(periods)) / _NS
 
 
 def _span(stream: Stream) -> str:

@@ -288,10 +288,11 @@ def read_rosbag(
     axes : SensorAxes, optional
         The sensor's axes on the motor frame; the identity when None.
     sample_period : float, optional
-        The recording's T_s (s); the wrench topic's median step when None.
+        The recording's T_s (s); the wrench topic's own period when None
+        (:func:`.clock.sample_clock`).
     max_gap : float
-        Steps longer than this many median steps of their topic are gaps, whose samples are
-        left out (> 1).
+        More than this many samples of a topic missing in a row is a gap, whose samples are
+        left out (>= 0).
     stamps : {"header", "bag"}
         Time of a message: its header stamp, or the time the bag recorded it.
     metadata : Mapping[str, str], optional
