@@ -54,6 +54,7 @@ def _write_bag(
     wrench_type: str = "geometry_msgs/msg/WrenchStamped",
     headers_unset: bool = False,
     other_publisher_every: int = 0,
+    nan_at: Sequence[int] = (),
 ) -> Path:
     """Write the recording as a bag: one WrenchStamped and one JointState message per sample.
 
@@ -63,7 +64,8 @@ def _write_bag(
     other name 0; ``sensor`` R with v_sensor = R @ v_motor (default the identity);
     ``headers_unset`` writes every header stamp as 0, the stamps only as the bag's record times;
     ``other_publisher_every`` > 0 adds, every so many samples, a JointState message of another
-    publisher on the same topic, 1 ns before the head's, naming only a ``gripper`` joint.
+    publisher on the same topic, 1 ns before the head's, naming only a ``gripper`` joint;
+    ``nan_at`` the samples whose wrench message reads NaN.
     """
     store = get_typestore(Stores.ROS2_HUMBLE if ros == 2 else Stores.ROS1_NOETIC)
     types = store.types
@@ -74,6 +76,7 @@ def _write_bag(
     kept = range(recording.n_samples) if wrench_kept is None else wrench_kept
     matrix = np.eye(3) if sensor is None else sensor
     force, torque = recording.force @ matrix.T, recording.torque @ matrix.T
+    force[list(nan_at)] = np.nan
     vector = types["geometry_msgs/msg/Vector3"]
 
     def header(k: int, stamp: int) -> object:
@@ -194,23 +197,29 @@ def test_messages_of_another_publisher_on_the_joint_topic_are_left_aside(
     assert "; 350 without both joints left aside" in "\n".join(result.report.lines())
 
 
-def test_a_nan_in_a_message_is_refused_naming_the_topic_and_the_message(
+def test_messages_with_a_nan_or_a_repeated_stamp_are_left_out_and_counted(
     recording: Recording, tmp_path: Path
 ) -> None:
+    # a message the sensor could not read (NaN) and a driver's repeat of the message before:
+    # each left out, its sample bridged as a dropped one, the rest as they were
+    short = _first(recording, 40)
+    stamps = EPOCH_NS + np.arange(40, dtype=np.int64) * 1_000_000
+    stamps[17] = stamps[16]
+    bag = _write_bag(_bag_path(tmp_path, 2), short, 2, wrench_ns=stamps, nan_at=[5])
+    result = read_rosbag(bag, WRENCH, JOINTS)
+    assert (
+        "; messages left out: 1 with a NaN or infinite value and 1 at the stamp of the one"
+        in (result.report.lines()[1])
+    )
+    assert result.report.clock.n_interpolated == 2 and result.report.clock.wrench.n_missing == 2
+    own = np.setdiff1d(np.arange(40), [5, 17])
+    np.testing.assert_array_equal(result.recording.force[own], short.force[own])
+    np.testing.assert_array_equal(result.recording.t, short.t)
     unreadable = np.full((3, 3), np.nan)  # the sensor reads NaN on every axis
-    bag = _write_bag(_bag_path(tmp_path, 2), _first(recording, 20), 2, sensor=unreadable)
-    with pytest.raises(ImporterError, match=f"{WRENCH!r}: message 0 holds a NaN or infinite"):
-        read_rosbag(bag, WRENCH, JOINTS)
-
-
-def test_two_messages_of_a_topic_at_one_stamp_are_refused(
-    recording: Recording, tmp_path: Path
-) -> None:
-    short = _first(recording, 20)
-    stamps = EPOCH_NS + np.arange(20, dtype=np.int64) * 1_000_000
-    stamps[7] = stamps[6]
-    bag = _write_bag(_bag_path(tmp_path, 2), short, 2, wrench_ns=stamps)
-    with pytest.raises(ImporterError, match=f"{WRENCH!r}: messages 6 and 7 .* the same stamp"):
+    bag = _write_bag(tmp_path / "nan_ros2", _first(recording, 20), 2, sensor=unreadable)
+    with pytest.raises(
+        ImporterError, match=f"{WRENCH!r}: 0 message.s. kept of 20, at least 2 needed; messages"
+    ):
         read_rosbag(bag, WRENCH, JOINTS)
 
 

@@ -68,6 +68,8 @@ _TRIM_NOTED = 10
 _PERIOD_LAG = 64
 #: Messages in the running median that follows a stream's stamps against its sample count.
 _LEVEL_WINDOW = 31
+#: Most passes of drops counted and the line fitted again (they settle in two or three).
+_PASSES = 5
 #: A drop is counted where that running median rises by half a period and this many of its own
 #: standard deviations: stamps' jitter does not count drops.
 _LEVEL_SIGMAS = 4.0
@@ -285,14 +287,18 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
     """
     s = (stamps - stamps[0]).astype(np.float64)
     n = s.shape[0]
-    lag = min(_PERIOD_LAG, n - 1)
+    # a short stream's steps over fewer messages, so that most of them hold no drop
+    lag = min(_PERIOD_LAG, max(1, n // 8))
     period = float(np.median((s[lag:] - s[:-lag]) / lag))
     count = np.arange(n, dtype=np.int64)
     numbers = count
-    for _ in range(2):  # the drops on a first period, then on the line's
-        numbers = count + _drops(s, s / period - count)
-        slope, intercept = np.polyfit(numbers.astype(np.float64), s, 1)
+    for _ in range(_PASSES):  # the drops on a first period, then on the line's, until they hold
+        found = count + _drops(s, s / period - count)
+        slope, intercept = np.polyfit(found.astype(np.float64), s, 1)
         period = float(slope)
+        if np.array_equal(found, numbers):
+            break
+        numbers = found
     instants = intercept + period * numbers.astype(np.float64)
     if np.max(np.abs(s - instants)) <= 1.0:  # stamps on their grid: kept to the nanosecond
         period = float(s[-1]) / float(numbers[-1])
@@ -305,7 +311,7 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64]) -> NDArray[np.int6
     stamps' ``lead`` over their count (in periods) rises, from one side of a window to the
     other, by half a period and its noise; at the longest step there, by the whole rise."""
     n = lead.shape[0]
-    width = min(_LEVEL_WINDOW, n)
+    width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))  # odd; a short stream's a quarter of it
     level = median_filter(lead, size=width, mode="nearest")
     spread = 1.4826 * float(np.median(np.abs(lead - level)))
     noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)

@@ -51,6 +51,24 @@ _ROS1_MAGIC = b"#ROSBAG V2.0"
 
 
 @dataclass(frozen=True)
+class LeftOut:
+    """Messages of a topic left out: with a NaN or infinite value, and at the stamp of the
+    message before them."""
+
+    non_finite: int = 0
+    repeated: int = 0
+
+    def describe(self) -> str:
+        """ "" when none, else what was left out, for a person."""
+        parts = []
+        if self.non_finite:
+            parts.append(f"{self.non_finite} with a NaN or infinite value")
+        if self.repeated:
+            parts.append(f"{self.repeated} at the stamp of the one before")
+        return f"; messages left out: {' and '.join(parts)}" if parts else ""
+
+
+@dataclass(frozen=True)
 class ImportReport:
     """What the import found and did: the two topics' rates and gaps, the clock, the mapping.
 
@@ -69,6 +87,8 @@ class ImportReport:
         left out.
     axes : SensorAxes
         The sensor's axes on the motor frame.
+    left_out : (LeftOut, LeftOut)
+        The wrench's and the joints' messages left out (a NaN, a repeated stamp).
     """
 
     source: str
@@ -77,6 +97,7 @@ class ImportReport:
     n_skipped_joint_messages: int
     clock: ClockReport
     axes: SensorAxes
+    left_out: tuple[LeftOut, LeftOut] = (LeftOut(), LeftOut())
 
     def lines(self) -> list[str]:
         """A few lines for a person: each topic, the joints, the frame, the clock, the gaps."""
@@ -84,8 +105,9 @@ class ImportReport:
         wrench, joints, *clock = self.clock.lines()
         return [
             f"{self.source}: ROS {self.ros_version} bag",
-            f"  {wrench}",
-            f"  {joints}" + (f"; {skipped} without both joints left aside" if skipped else ""),
+            f"  {wrench}{self.left_out[0].describe()}",
+            f"  {joints}{self.left_out[1].describe()}"
+            + (f"; {skipped} without both joints left aside" if skipped else ""),
             f"  theta1 <- joint {self.joint_names[0]!r}, theta2 <- joint"
             f" {self.joint_names[1]!r}; sensor axes on X^m, Y^m, Z^m: {self.axes.describe()}",
             *(f"  {line}" for line in clock),
@@ -140,7 +162,7 @@ def _check_topic(topics: Mapping[str, Any], topic: str, expected: str, source: s
 
 def _sorted(
     source: str, topic: str, kind: str, stamps: list[int], values: list[Any], stamp_kind: str
-) -> Stream:
+) -> tuple[Stream, LeftOut]:
     stamp_array = np.array(stamps, dtype=np.int64)
     if stamp_kind == "header" and np.any(stamp_array == 0):
         k = int(np.argmax(stamp_array == 0))
@@ -149,12 +171,22 @@ def _sorted(
             " record times (--stamps bag)"
         )
     value_array = np.array(values, dtype=np.float64).reshape(len(values), -1)
-    finite = np.all(np.isfinite(value_array), axis=1)
-    if not np.all(finite):
-        k = int(np.argmin(finite))
-        raise ImporterError(f"{source}: topic {topic!r}: message {k} holds a NaN or infinite value")
     order = np.argsort(stamp_array, kind="stable")
-    return Stream(name=topic, kind=kind, stamps=stamp_array[order], values=value_array[order])
+    stamp_array, value_array = stamp_array[order], value_array[order]
+    # a message with a NaN or infinite value, or at the stamp of the one before it (a driver's
+    # repeat), is left out: the clock then sees that sample as dropped, and bridges it
+    finite = np.all(np.isfinite(value_array), axis=1)
+    stamp_array, value_array = stamp_array[finite], value_array[finite]
+    new = np.ones(stamp_array.shape[0], dtype=bool)
+    new[1:] = np.diff(stamp_array) > 0
+    stream = Stream(name=topic, kind=kind, stamps=stamp_array[new], values=value_array[new])
+    left_out = LeftOut(int(np.sum(~finite)), int(np.sum(~new)))
+    if stream.stamps.shape[0] < 2:
+        raise ImporterError(
+            f"{source}: topic {topic!r}: {stream.stamps.shape[0]} message(s) kept of"
+            f" {len(values)}, at least 2 needed{left_out.describe()}"
+        )
+    return stream, left_out
 
 
 def _read_streams(
@@ -164,7 +196,7 @@ def _read_streams(
     joints_topic: str,
     joint_names: tuple[str | None, str | None],
     stamps: str,
-) -> tuple[Stream, Stream, tuple[str, str], int]:
+) -> tuple[tuple[Stream, LeftOut], tuple[Stream, LeftOut], tuple[str, str], int]:
     topics = reader.topics
     wrench_info = _check_topic(topics, wrench_topic, WRENCH_TYPE, source)
     joints_info = _check_topic(topics, joints_topic, JOINTS_TYPE, source)
@@ -308,9 +340,8 @@ def read_rosbag(
     ------
     ImporterError
         rosbags missing; the bag unreadable; a topic missing, of another type or with fewer
-        than two messages; fewer than two messages naming both joints; a NaN or infinite value;
-        two messages of a topic at one stamp; a header
-        stamp of zero; topics that do not overlap in time.
+        than two messages; fewer than two messages naming both joints (or with finite values
+        at stamps of their own); a header stamp of zero; topics that do not overlap in time.
     """
     source = str(path)
     highlevel = _load_rosbags()
@@ -319,7 +350,7 @@ def read_rosbag(
     try:
         reader = highlevel.AnyReader([bag])
         with reader:
-            wrench, joints, names, skipped = _read_streams(
+            read, joint_read, names, skipped = _read_streams(
                 reader, source, wrench_topic, joints_topic, (joint1, joint2), stamps
             )
             ros_version = 2 if reader.is2 else 1
@@ -330,6 +361,7 @@ def read_rosbag(
             f"{source}: not a readable ROS 1 .bag file or ROS 2 bag directory"
             f" ({type(exc).__name__}: {exc})".replace("\n", " ")
         ) from None
+    (wrench, wrench_left_out), (joints, joints_left_out) = read, joint_read
     clocked = put_on_clock(wrench, joints, source=source, period=sample_period, max_gap=max_gap)
     clock = clocked.report
     force, torque = axes.to_motor(clocked.wrench[:, :3], clocked.wrench[:, 3:])
@@ -357,5 +389,6 @@ def read_rosbag(
         n_skipped_joint_messages=skipped,
         clock=clock,
         axes=axes,
+        left_out=(wrench_left_out, joints_left_out),
     )
     return RosbagImport(recording=recording, report=report)
