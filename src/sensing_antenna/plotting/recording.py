@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from sensing_antenna.plotting import save_figure
-from sensing_antenna.recording import REQUIRED_COLUMNS, Recording, RecordingError
+from sensing_antenna.recording import REQUIRED_COLUMNS, Recording, RecordingError, resample_uniform
 
 __all__ = ["PLOT_LIMIT", "plot_recording"]
 
@@ -107,12 +107,16 @@ def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
         axes[-1].set_xlabel("t (s)")
         paths.append(save_figure(fig, out / f"{name}.png", dpi=110))
 
-    start = int(np.searchsorted(t, stop)) + 100 if stop is not None else t.size // 2
-    if t.size - start >= 64:
-        period = float(np.median(np.diff(t)))
+    # the spectrum on the uniform grid, as the estimators read an irregular recording
+    uniform = resample_uniform(recording) if recording.sampling.irregular else recording
+    start = (
+        int(np.searchsorted(uniform.t, stop)) + 100 if stop is not None else uniform.n_samples // 2
+    )
+    if uniform.n_samples - start >= 64:
+        period = uniform.sample_period
         fig, ax = plt.subplots(figsize=(7, 3.5))
         for i, axis_name in enumerate("xyz"):
-            x = recording.torque[start:, i] - recording.torque[start:, i].mean()
+            x = uniform.torque[start:, i] - uniform.torque[start:, i].mean()
             spectrum = np.abs(np.fft.rfft(x * np.hanning(x.size), 8 * x.size))
             omega = 2 * math.pi * np.fft.rfftfreq(8 * x.size, period)
             keep = omega < 300.0
