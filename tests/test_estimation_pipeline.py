@@ -278,7 +278,7 @@ def test_no_contact() -> None:
 def test_too_few_samples_for_any_manoeuvre_are_too_short_not_a_free_sweep(count: int) -> None:
     # The first samples of a free sweep: no contact in them, but too few to hold one the front
     # end could use (two rests of 50 ms and the 0.2 s hold: 0.3 s), so they say nothing of free
-    # space; 302 samples span 0.301 s, a free sweep's record however short
+    # space; 301 samples span 0.3 s, a free sweep's record however short
     recording = synthetic_recording(Synthetic(contact_time=50.0, stops=False, duration=2.0))
     head = samples_kept(recording, np.arange(recording.n_samples) < count)
     result = estimate(head, calibrated())
@@ -287,7 +287,7 @@ def test_too_few_samples_for_any_manoeuvre_are_too_short_not_a_free_sweep(count:
     assert "no contact" in result.reason
     _, final = run_online(head)
     assert comparable(final) == comparable(result)
-    longer = samples_kept(recording, np.arange(recording.n_samples) < 302)
+    longer = samples_kept(recording, np.arange(recording.n_samples) < 301)
     assert estimate(longer, calibrated()).status is Status.NO_CONTACT
 
 
@@ -552,14 +552,11 @@ def test_online_samples_skipped_are_put_back_and_a_time_jump_is_bad_input() -> N
 
 
 @pytest.mark.parametrize("clock", [1.008, 0.995])
-def test_stamps_off_the_declared_period_are_resampled_offline_and_refused_online(
-    clock: float,
-) -> None:
+def test_stamps_off_the_declared_period_are_resampled_by_them(clock: float) -> None:
     # Stamps one period apart under a sample_period declared 0.8 % long or 0.5 % short (under
     # the 1 % of jitter that alone makes sampling irregular). Read as samples one declared
     # period apart, the vibration rings that much off and x_c moves by millimetres, still `ok`;
-    # a file is resampled by its stamps and answers as if declared right; a stream, which
-    # cannot be resampled whole, is refused as soon as the stamps' span tells
+    # the file is resampled by its stamps and answers as if declared right
     recording = synthetic_recording(Synthetic(x_c=0.6, seed=5))
     declared = recording.with_metadata(sample_period=repr(TS * clock))
     right = estimate(recording, calibrated())
@@ -570,10 +567,6 @@ def test_stamps_off_the_declared_period_are_resampled_offline_and_refused_online
     assert offline.x_c == pytest.approx(right.x_c, abs=1e-5)
     as_declared = dataclasses.replace(declared, t=TS * clock * np.arange(recording.n_samples))
     assert abs(estimate(as_declared, calibrated()).x_c - right.x_c) > 1e-3
-    _, online = run_online(declared)
-    assert online.status is Status.BAD_INPUT
-    assert (online.reason or "").startswith("t: the time stamps step 0.001 s on average")
-    assert "sample_period" in (online.reason or "")
 
 
 def test_candidates_the_ratio_cannot_tell_apart_without_a_second_mode_are_uncertain() -> None:

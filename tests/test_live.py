@@ -398,6 +398,17 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
             "<stdin>: sample_period: the stream declares 0.0011 s, but its time stamps step by "
             "0.001 s (a line through its first 21 time stamps)",
         ),
+        # 0.5 % off stamps that lie on their line to the microsecond: read on the declared
+        # period the vibration would ring 0.5 % off; a line this sure holds it to 0.1 %, the
+        # tolerance by which a file's stamps are trusted over its period
+        (
+            [
+                "# sample_period: 0.001005\n" if line.startswith("# sample_period") else line
+                for line in text[: header_at + 40]
+            ],
+            "the stream declares 0.001005 s, but its time stamps step by 0.001 s (a line through"
+            " its first 21 time stamps), more than 0.1 % apart",
+        ),
         # a period declared ten times too short: its steps are not ten dropped samples each
         (
             [

@@ -105,7 +105,8 @@ def _run_estimate(args: argparse.Namespace) -> int:
     paths = plot_contact_estimate(result, antenna, args.out, EstimatorConfig().zero_padding)
     for path in paths:
         print(path)
-    if not any(path.name.startswith("figure13") for path in paths):
+    trace = result.trace
+    if trace is None or trace.frame is None or trace.spectrum is None:
         print(
             f"antenna plot estimate: figures 13 and 14 not drawn: the estimate stopped before "
             f"its spectrum and ratio windows ({result.status.value}: {result.reason})",

@@ -43,7 +43,7 @@ from sensing_antenna.live.events import (
 )
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.wire import StreamHeader, WireError
-from sensing_antenna.recording import PERIOD_CONSISTENCY
+from sensing_antenna.recording import CLOCK_TOLERANCE, PERIOD_CONSISTENCY
 
 __all__ = ["CONTACT_LOST_TIME", "Listener"]
 
@@ -57,6 +57,10 @@ CONTACT_LOST_TIME = 0.1
 #: The time steps from which the stream's period is read and compared with its declared
 #: ``sample_period``.
 PERIOD_CHECK_STEPS = 20
+
+#: The stream's period may differ from its declared one by this many standard errors of the
+#: line through its first stamps (between ``CLOCK_TOLERANCE`` and ``PERIOD_CONSISTENCY``).
+_PERIOD_SIGMAS = 8.0
 
 #: Fewest steps whose median number of periods must be one (more are dropped samples or a
 #: period declared too short); fewer cannot tell.
@@ -83,19 +87,24 @@ class _Growing:
         self.size = stop
 
 
-def _period_of_line(stamps: NDArray[np.float64], countings: list[NDArray[np.float64]]) -> float:
-    """The slope (s) of the least-squares line through ``stamps`` (shape (n,)) against their
-    sample numbers, those numbered by the one of ``countings`` (periods of each step, shape
-    (n - 1,)) the line fits best."""
-    best = (math.inf, math.nan)
+def _period_of_line(
+    stamps: NDArray[np.float64], countings: list[NDArray[np.float64]]
+) -> tuple[float, float]:
+    """The slope (s) of the least-squares line through ``stamps`` (shape (n,), n >= 2) against
+    their sample numbers, those numbered by the one of ``countings`` (periods of each step,
+    shape (n - 1,)) the line fits best, and its standard error (s; 0 for two stamps)."""
+    best = (math.inf, math.nan, 0.0)
     relative = stamps - stamps[0]
     for periods in countings:
         number = np.concatenate([[0.0], np.cumsum(periods)])
         number -= number.mean()
-        slope = float(number @ relative / (number @ number))
+        spread = float(number @ number)
+        slope = float(number @ relative / spread)
         misfit = relative - relative.mean() - slope * number
-        best = min(best, (float(misfit @ misfit), slope))
-    return best[1]
+        residual = float(misfit @ misfit)
+        error = math.sqrt(residual / (stamps.shape[0] - 2) / spread) if stamps.shape[0] > 2 else 0.0
+        best = min(best, (residual, slope, error))
+    return best[1], best[2]
 
 
 class Listener:
@@ -279,7 +288,9 @@ class Listener:
     def _check_period(self, final: bool = False) -> None:
         """Refuse a stream whose time stamps do not step by its declared ``sample_period``: the
         estimator was built for T_s before the samples came, and a file read whole would use
-        the steps instead (:data:`~sensing_antenna.recording.PERIOD_CONSISTENCY`). Judged on
+        the steps instead (:data:`~sensing_antenna.recording.CLOCK_TOLERANCE`, or as much more
+        as the stamps' jitter leaves the line uncertain, up to
+        :data:`~sensing_antenna.recording.PERIOD_CONSISTENCY`). Judged on
         the first :data:`PERIOD_CHECK_STEPS` steps, or at the end (``final``) on those a
         shorter stream has."""
         steps = min(self._stamps.size - 1, PERIOD_CHECK_STEPS)
@@ -296,20 +307,24 @@ class Listener:
         periods = 1.0 + samples_missing(step, ts)
         if steps >= MIN_STEPS_FOR_DROPS and float(np.median(periods)) != 1.0:
             period, how = float(np.median(step)), f"the median of its first {steps} steps"
+            tolerance = PERIOD_CONSISTENCY
         else:
             # the period is the slope of the time stamps against their sample numbers: each
             # stamp's jitter averages out over the line, where it stays in a median of steps (a
             # tenth of a period of jitter moves that by a few per cent). The drops are counted
             # as the line fits the stamps best: a step of 1.6 periods is a late stamp after an
             # early one, or a lost sample with jitter, and only the others tell which
-            period = _period_of_line(stamps, [periods, np.maximum(np.rint(step / ts), 1.0)])
+            period, error = _period_of_line(stamps, [periods, np.maximum(np.rint(step / ts), 1.0)])
             how = f"a line through its first {steps + 1} time stamps"
-            if abs(period - ts) <= PERIOD_CONSISTENCY * ts:
+            # as close as the stamps' jitter lets the line tell, down to the clock tolerance
+            # by which a file's stamps are trusted over its period
+            tolerance = min(PERIOD_CONSISTENCY, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
+            if abs(period - ts) <= tolerance * ts:
                 return
         raise WireError(
             f"{self.header.source}: sample_period: the stream declares {ts!r} s, but its "
-            f"time stamps step by {period:.6g} s ({how}), more than "
-            f"{100 * PERIOD_CONSISTENCY:g} % apart: the estimates need the period the samples have"
+            f"time stamps step by {period:.6g} s ({how}), more than {100 * tolerance:.2g} %"
+            " apart: the estimates need the period the samples have"
         )
 
     def _latency(self, index: int) -> float:

@@ -52,7 +52,6 @@ from sensing_antenna.estimation.front.steps import (
     ContactStart,
     HoldPush,
     at_contact,
-    clock_problem,
     dead_channel,
     fill_missing,
     gap_problem,
@@ -253,8 +252,7 @@ class FrontEnd:
             linear interpolation (:func:`.steps.fill_missing`, as a whole recording is
             resampled) and counted in the diagnostics
             (``filled_samples``); steps of more than ``config.max_gap`` missing samples are also
-            gaps, and one beyond :data:`.steps.MAX_FILLED` makes the outcome ``bad_input``, as
-            do stamps whose span runs off the sample period (:func:`.steps.clock_problem`).
+            gaps, and one beyond :data:`.steps.MAX_FILLED` makes the outcome ``bad_input``.
         theta : array_like, shape (n, 2)
             Motor angles (rad).
         force, torque : array_like, shape (n, 3)
@@ -298,12 +296,6 @@ class FrontEnd:
             self._filled.extend((first, (float(a), float(b))) for a, b in filled_gaps)
         if self._refused is not None:
             return self._stop(self._early(Status.BAD_INPUT, self._refused))
-        if stop > 1:
-            off_clock = clock_problem(
-                float(self._t[stop - 1]) - float(self._t[0]), stop - 1, self.sample_period
-            )
-            if off_clock is not None:
-                return self._stop(self._early(Status.BAD_INPUT, off_clock))
         outcome = None
         if stop > first:
             if self._monitor is not None:
@@ -618,7 +610,7 @@ class FrontEnd:
             reason = f"filtered residual stays at or below {self._detector.threshold:g} N m"
             outcome = self._early(Status.NO_CONTACT, reason)
             shortest = 2.0 * self.config.rest_window + self.config.frame_window
-            if (n - 1) * self.sample_period < shortest:
+            if n - 1 < samples(shortest, self.sample_period):
                 # too few samples to hold a contact the front end could use: not a free sweep
                 outcome = self._early(
                     Status.RECORDING_TOO_SHORT,

@@ -1,7 +1,6 @@
 """The causal steps of the front end, each a function of the samples up to the instant it needs.
 
-1. Sampling and sensor checks (:func:`sampling_problem`, :func:`clock_problem`,
-   :func:`dead_channel`).
+1. Sampling and sensor checks (:func:`sampling_problem`, :func:`dead_channel`).
 2. Sensor offset (tare) and rest tolerance from the samples up to t_c (:func:`at_contact`), and
    the recording's own units check there: the loads the tare averages against the link's weight
    (:func:`sensing_antenna.units_check.rest_reading`), the free motion before t_c against the
@@ -37,7 +36,6 @@ from sensing_antenna.estimation.front.contact_frame import (
     signal_noise,
 )
 from sensing_antenna.estimation.front.ratio import contact_loads, load_offset, ratio_noise
-from sensing_antenna.recording import CLOCK_TOLERANCE, clock_disagrees
 from sensing_antenna.units_check import initial_rest, rest_reading
 
 __all__ = [
@@ -48,7 +46,6 @@ __all__ = [
     "FilledSamples",
     "HoldPush",
     "at_contact",
-    "clock_problem",
     "dead_channel",
     "fill_missing",
     "free_motion_gain",
@@ -91,26 +88,6 @@ def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig
             f"({band_top:.0f} rad/s)"
         )
     return None
-
-
-def clock_problem(span: float, intervals: int, sample_period: float) -> str | None:
-    """Why time stamps that cover ``span`` (s) over ``intervals`` sample periods, filled samples
-    counted, cannot be samples ``sample_period`` (s) apart (bad input), or None.
-
-    A stream's stamps running off its declared period by more than
-    :data:`~sensing_antenna.recording.CLOCK_TOLERANCE` would put every frequency as far off;
-    a file is resampled by its stamps instead (:attr:`~sensing_antenna.recording.Recording.
-    sampling`), a stream is not.
-    """
-    if not clock_disagrees(span, intervals, sample_period):
-        return None
-    mean = span / intervals
-    return (
-        f"t: the time stamps step {mean:.6g} s on average over {span:.4g} s, "
-        f"{(mean / sample_period - 1.0) * 100.0:+.2f} % off sample_period {sample_period:.6g} s "
-        f"(at most {CLOCK_TOLERANCE * 100.0:g} %): frequencies read on that period would be as "
-        "far off; declare the period the stamps step (a file is resampled by its stamps)"
-    )
 
 
 def dead_channel(force: FloatArray, torque: FloatArray) -> str | None:
