@@ -7,11 +7,13 @@ Each stream's own clock is read from its stamps first (:func:`sample_clock`): th
 at a steady rate, message i is its sample n_i (n_i - i the messages dropped before it), and its
 stamp is that sample's instant plus jitter (a logger's, or a recorder's latency, which may be
 several periods and come in bursts). The period is the median of the steps over 64 messages,
-divided by 64 (jitter divided as much, and a rare drop spoils few of them); a drop is a lasting
-shift of the stamps against the messages' count, where a running median of the stamps'
-lead over that count rises by at least a period beyond its noise; then the line through the stamps
-against their sample numbers gives the period and each message's instant without its jitter.
-A drop shorter than the jitter cannot be told and is not counted.
+divided by the samples they span; a drop is a lasting rise of the stamps against the messages'
+count, where a running median of the stamps' lead over that count rises by half a period beyond
+its noise and stays up (a recorder that stalls and catches up does not drop); the two are
+read in turn until they agree. The line through the stamps against their sample numbers then
+gives the period and each message's instant without its jitter. A drop shorter than the jitter
+cannot be told and is not counted; stamps that fall back for good (a clock set back while
+recording) cannot be put in order and are refused.
 
 :func:`put_on_clock` lays a grid of step T_s (by default the wrench stream's period) over the time
 both streams cover, starting at the first wrench message in it, and fills each slot k (time
@@ -45,6 +47,7 @@ from sensing_antenna.recording import MAX_SAMPLES
 
 __all__ = [
     "DEFAULT_MAX_GAP",
+    "STEADY_PERIODS",
     "ClockReport",
     "ClockedStreams",
     "ImporterError",
@@ -68,8 +71,19 @@ _TRIM_NOTED = 10
 _PERIOD_LAG = 64
 #: Messages in the running median that follows a stream's stamps against its sample count.
 _LEVEL_WINDOW = 31
-#: Most passes of drops counted and the line fitted again (they settle in two or three).
-_PASSES = 5
+#: Below this noise of the lead's running median (periods) the stamps have no jitter to speak
+#: of, and a step's own length tells the drops in it.
+_CLEAN_NOISE = 0.05
+#: A stream whose stamps lie farther than this many periods from their line is not a
+#: sensor's samples at a steady rate (a recorder's latency and bursts stay within a few).
+STEADY_PERIODS = 8.0
+#: Joint angles that change by no more than this across a silence stood still (rad): the
+#: estimators' floor of the head's rest tolerance.
+_STILL = 1.0e-4
+#: Most passes of the steps' period and the drops counted on it (they settle in two or three).
+_PASSES = 4
+#: Messages a stream is split after, evenly spread, to look for stamps lower for good.
+_FALL_SPLITS = 100
 #: A drop is counted where that running median rises by half a period and this many of its own
 #: standard deviations: stamps' jitter does not count drops.
 _LEVEL_SIGMAS = 4.0
@@ -120,9 +134,11 @@ class StreamReport:
     largest_step : float
         Largest step between consecutive stamps (s).
     n_gaps : int
-        Runs of more than ``max_gap`` samples missing.
+        Runs of more than ``max_gap`` samples missing (none judged when not ``steady``).
     jitter : float
         Largest distance of a stamp from its sample's instant on the stream's own clock (s).
+    steady : bool
+        Whether the stamps lie within :data:`STEADY_PERIODS` periods of that clock.
     """
 
     name: str
@@ -133,6 +149,7 @@ class StreamReport:
     largest_step: float
     n_gaps: int
     jitter: float
+    steady: bool = True
 
     @property
     def rate(self) -> float:
@@ -141,6 +158,12 @@ class StreamReport:
 
     def line(self) -> str:
         """One line for a person: count, rate, missing samples, largest step, gaps, jitter."""
+        if not self.steady:
+            return (
+                f"{self.name} ({self.kind}): {self.n_messages} messages, not at a steady rate"
+                f" (about {self.rate:.6g} Hz, stamps up to {self.jitter:.3g} s off its line),"
+                f" largest step {self.largest_step:.6g} s; no gaps judged"
+            )
         return (
             f"{self.name} ({self.kind}): {self.n_messages} messages, rate {self.rate:.6g} Hz"
             f" (its stamps' line), {self.n_missing} missing, largest step"
@@ -265,11 +288,30 @@ class SampleClock:
     instants : ndarray, shape (n,)
         Each message's sample instant (ns from the first stamp), on the line through the
         stamps against their numbers: the stamps without their jitter.
+    offsets : ndarray, shape (n,)
+        Each stamp less its instant (ns).
+    fall : float
+        The largest lasting fall of the stamps below their instants' line (ns): 0 on a steady
+        clock (jitter, a drop, a stall and its catching up never lower the stamps for good); a
+        clock set back while recording does.
     """
 
     period: float
     numbers: NDArray[np.int64]
     instants: NDArray[np.float64]
+    offsets: NDArray[np.float64]
+    fall: float
+
+    @property
+    def jitter(self) -> float:
+        """The largest distance of a stamp from its instant (ns)."""
+        return float(np.max(np.abs(self.offsets)))
+
+    def steady(self) -> bool:
+        """Whether the stamps lie within :data:`STEADY_PERIODS` periods of their instants: the
+        messages are a sensor's samples at a steady rate (a publisher that sends on change, or
+        at a changing rate, is not)."""
+        return self.jitter <= STEADY_PERIODS * self.period
 
 
 def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
@@ -289,52 +331,115 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
     n = s.shape[0]
     # a short stream's steps over fewer messages, so that most of them hold no drop
     lag = min(_PERIOD_LAG, max(1, n // 8))
-    period = float(np.median((s[lag:] - s[:-lag]) / lag))
     count = np.arange(n, dtype=np.int64)
     numbers = count
-    for _ in range(_PASSES):  # the drops on a first period, then on the line's, until they hold
-        found = count + _drops(s, s / period - count)
-        slope, intercept = np.polyfit(found.astype(np.float64), s, 1)
-        period = float(slope)
+    for _ in range(_PASSES):
+        # the median step over ``lag`` messages, of the spans without a drop counted: drops
+        # once counted do not move it (a line through stamps miscounted would take the
+        # miscount up as a slope, and keep it)
+        spans = numbers[lag:] - numbers[:-lag]
+        clean = spans == lag
+        steps = (s[lag:] - s[:-lag])[clean] / lag if clean.any() else (s[lag:] - s[:-lag]) / spans
+        steps_period = float(np.median(steps))
+        found = count + _drops(s, s / steps_period - count, steps_period)
         if np.array_equal(found, numbers):
             break
         numbers = found
+    slope, intercept = np.polyfit(numbers.astype(np.float64), s, 1)
+    period = float(slope)
     instants = intercept + period * numbers.astype(np.float64)
     if np.max(np.abs(s - instants)) <= 1.0:  # stamps on their grid: kept to the nanosecond
         period = float(s[-1]) / float(numbers[-1])
         instants = period * numbers.astype(np.float64)
-    return SampleClock(period, numbers, instants)
+    offsets = s - instants
+    # a clock set back is judged against the steps' period, which one step back hardly moves
+    # (the line takes it up as a slope)
+    fall = _fall(s / steps_period - numbers) * steps_period
+    return SampleClock(period, numbers, instants, offsets, fall)
 
 
-def _drops(s: NDArray[np.float64], lead: NDArray[np.float64]) -> NDArray[np.int64]:
-    """Samples dropped before each message (nondecreasing): where the running median of the
-    stamps' ``lead`` over their count (in periods) rises, from one side of a window to the
-    other, by half a period and its noise; at the longest step there, by the whole rise."""
+def _fall(offsets: NDArray[np.float64]) -> float:
+    """How far (periods) the stamps' ``offsets`` (periods, from a steady clock of their sample
+    numbers) lie lower after some message than before it, medians either side, at the split
+    where they lie lowest: 0 unless beyond 2 periods and the offsets' noise. A clock set back
+    while recording leaves its stamps lower for good; a drop is in the sample numbers, and a
+    stall and its catching up are a bump that leaves the medians where they were."""
+    n = offsets.shape[0]
+    width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))
+    if n < 2 * width:
+        return 0.0
+    level = median_filter(offsets, size=width, mode="nearest")
+    spread = 1.4826 * float(np.median(np.abs(offsets - level)))
+    noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
+    splits = np.unique(np.linspace(width, n - width, _FALL_SPLITS).astype(np.int64))
+    fall = max(float(np.median(offsets[:k]) - np.median(offsets[k:])) for k in splits)
+    return fall if fall > max(2.0, 1.0 + 2.0 * noise) else 0.0
+
+
+def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> NDArray[np.int64]:
+    """Samples dropped before each message (nondecreasing), from the stamps ``s`` (ns from the
+    first), their ``lead`` over their count (in periods) and the ``period`` (ns).
+
+    A drop raises the lead for good: the running median of the lead, half a window after a
+    message against half a window before, rises by half a period and its noise across it; runs
+    of such messages less than a window apart are one rise, counted if the level stays up a
+    window longer (a recorder that stalls and catches up does not drop) and sized by the whole
+    rise. Within a run the drops go where the steps' own lengths put them, when those add up
+    to the rise, else at its longest step. Near the stream's ends, which the windows do not
+    cover, stamps without jitter tell drops by their steps alone.
+    """
     n = lead.shape[0]
     width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))  # odd; a short stream's a quarter of it
+    half = width // 2
     level = median_filter(lead, size=width, mode="nearest")
     spread = 1.4826 * float(np.median(np.abs(lead - level)))
     noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
-    half = width // 2
-    index = np.arange(n)
-    # the rise across message k: the level half a window after it against half a window before
-    # (local, so a period slightly off does not add up along the stream)
-    rise = level[np.minimum(index + half, n - 1)] - level[np.maximum(index - half - 1, 0)]
-    count = np.floor(rise + 0.5 - noise)
-    drops = np.zeros(n, dtype=np.int64)
     steps = np.diff(s)
-    rising = count > 0
-    edges = np.flatnonzero(np.diff(np.concatenate([[False], rising, [False]]).astype(np.int8)))
-    for low, high in zip(edges[::2], edges[1::2], strict=True):
-        # one run of messages across which the level rose: the drop is before the message
-        # the longest step of the run leads to (steps[k - 1] leads to message k)
+    each = np.maximum(np.rint(steps / period) - 1.0, 0.0).astype(np.int64)  # into message k + 1
+    drops = np.zeros(n, dtype=np.int64)
+    index = np.arange(n)
+    before, after = index - half - 1, index + half
+    covered = (before >= 0) & (after <= n - 1)
+    if noise < _CLEAN_NOISE:
+        # near the ends, steps without jitter: their own lengths, taken out of the lead
+        for k in np.flatnonzero(~covered[1:] & (each > 0)):
+            drops[k + 1 :] += each[k]
+        level = median_filter(lead - drops, size=width, mode="nearest")
+    rise = np.zeros(n)
+    rise[covered] = level[after[covered]] - level[before[covered]]
+    rising = np.flatnonzero(rise >= 0.5 + noise)
+    runs: list[list[int]] = []
+    for message in rising.tolist():
+        if runs and message - runs[-1][1] <= width:
+            runs[-1][1] = message
+        else:
+            runs.append([message, message])
+    for number, (low, high) in enumerate(runs):
+        base = level[low - half - 1]
+        kept = level[high + half : min(high + half + width, n)]
+        lasting = float(np.min(kept)) - base
+        if lasting < 0.5 + noise:
+            continue
+        # sized by the lead's medians either side, as far as the neighbouring runs
+        start = runs[number - 1][1] + half if number else 0
+        stop = runs[number + 1][0] - half if number + 1 < len(runs) else n
+        before_lead = lead[start : low - half] - drops[start : low - half]
+        after_lead = lead[high + half : stop] - drops[high + half : stop]
+        total = round(float(np.median(after_lead) - np.median(before_lead)))
+        if total < 1:
+            continue
         first = max(low, 1)
-        at = first + int(np.argmax(steps[first - 1 : max(high, first + 1) - 1]))
-        drops[at:] += int(np.max(count[low:high]))
+        own = each[first - 1 : high]  # the steps into messages first .. high
+        if int(own.sum()) == total:
+            for k in np.flatnonzero(own):
+                drops[first + k :] += own[k]
+        else:
+            drops[first + int(np.argmax(steps[first - 1 : high])) :] += total
     return drops
 
 
-def _report(stream: Stream, clock: SampleClock, max_gap: float) -> StreamReport:
+def _report(stream: Stream, clock: SampleClock, gaps: NDArray[np.bool_]) -> StreamReport:
+    steady = clock.steady()
     return StreamReport(
         name=stream.name,
         kind=stream.kind,
@@ -342,22 +447,26 @@ def _report(stream: Stream, clock: SampleClock, max_gap: float) -> StreamReport:
         period=clock.period / _NS,
         n_missing=int(clock.numbers[-1]) - (int(stream.stamps.shape[0]) - 1),
         largest_step=float(np.max(np.diff(stream.stamps))) / _NS,
-        n_gaps=int(np.sum(np.diff(clock.numbers) > max_gap + 1)),
-        jitter=float(np.max(np.abs((stream.stamps - stream.stamps[0]) - clock.instants))) / _NS,
+        n_gaps=int(np.sum(gaps)) if steady else 0,
+        jitter=clock.jitter / _NS,
+        steady=steady,
     )
 
 
 def _in_gap(
-    times: NDArray[np.float64], numbers: NDArray[np.int64], slots: NDArray[np.float64], most: float
+    times: NDArray[np.float64], gaps: NDArray[np.bool_], slots: NDArray[np.float64]
 ) -> NDArray[np.bool_]:
     """For each slot time, whether it lies strictly between two messages (at ``times``, all in
-    ns relative to the origin) between which more than ``most`` samples are missing."""
+    ns relative to the origin) whose step is a gap (``gaps``, one per step)."""
     after = np.searchsorted(times, slots, side="right")
     inside = (after > 0) & (after < times.shape[0])
-    before = np.clip(after - 1, 0, times.shape[0] - 1)
-    following = np.clip(after, 0, times.shape[0] - 1)
-    missing = numbers[following] - numbers[before] - 1
-    return inside & (missing > most) & (slots > times[before])
+    before = np.clip(after - 1, 0, times.shape[0] - 2)
+    return inside & gaps[before] & (slots > times[np.clip(after - 1, 0, times.shape[0] - 1)])
+
+
+def _gaps(clock: SampleClock, most: float) -> NDArray[np.bool_]:
+    """Each step of a stream: whether more than ``most`` samples are missing in it."""
+    return np.diff(clock.numbers) - 1 > most
 
 
 def put_on_clock(
@@ -397,6 +506,13 @@ def put_on_clock(
     if not (math.isfinite(max_gap) and max_gap >= 0.0):
         raise ValueError(f"max_gap must be a finite number >= 0, got {max_gap!r}")
     wrench_clock, joints_clock = sample_clock(wrench.stamps), sample_clock(joints.stamps)
+    if wrench_clock.fall > 0.0:
+        at = int(np.argmin(wrench_clock.offsets))
+        raise ImporterError(
+            f"{source}: {wrench.name!r}: its stamps fall back by about"
+            f" {wrench_clock.fall / _NS:.3g} s for good near message {at}: a clock set back while"
+            " recording; its samples cannot be put in order (try the other stamps, --stamps)"
+        )
     # the wrench messages at their samples' instants (their stamps without the jitter), ns
     instants = int(wrench.stamps[0]) + np.rint(wrench_clock.instants).astype(np.int64)
     start = max(int(instants[0]), int(joints.stamps[0]))
@@ -442,9 +558,14 @@ def put_on_clock(
     joint_values = np.column_stack(
         [np.interp(slot_ns, joints_ns, column) for column in joints.values.T]
     )
-    left_out = (~has_own & _in_gap(wrench_ns, wrench_clock.numbers, slot_ns, max_gap)) | _in_gap(
-        joints_ns, joints_clock.numbers, slot_ns, max_gap
-    )
+    wrench_gaps = _gaps(wrench_clock, max_gap)
+    left_out = ~has_own & _in_gap(wrench_ns, wrench_gaps, slot_ns)
+    # where the angles did not move across it, a silence of the joints (a publisher that sends
+    # on change) is no gap: the straight line between its ends is the path
+    moved = np.max(np.abs(np.diff(joints.values, axis=0)), axis=1) > _STILL
+    joints_gaps = _gaps(joints_clock, max_gap) & moved
+    if joints_clock.steady():
+        left_out |= _in_gap(joints_ns, joints_gaps, slot_ns)
     kept = np.flatnonzero(~left_out)
     if kept.shape[0] < 2:
         raise ImporterError(
@@ -454,8 +575,8 @@ def put_on_clock(
     largest_offset = float(np.max(offset[used])) / _NS if used.size else 0.0
     last_slot = origin + (n_slots - 1) * step_ns
     report = ClockReport(
-        wrench=_report(wrench, wrench_clock, max_gap),
-        joints=_report(joints, joints_clock, max_gap),
+        wrench=_report(wrench, wrench_clock, wrench_gaps),
+        joints=_report(joints, joints_clock, joints_gaps),
         period=step,
         origin_ns=origin,
         n_slots=n_slots,
