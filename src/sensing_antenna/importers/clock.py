@@ -134,7 +134,8 @@ class StreamReport:
     largest_step : float
         Largest step between consecutive stamps (s).
     n_gaps : int
-        Runs of more than ``max_gap`` samples missing (none judged when not ``steady``).
+        Runs of more than ``max_gap`` samples missing (for the joints, across which the angles
+        moved; none for joints not ``steady``).
     jitter : float
         Largest distance of a stamp from its sample's instant on the stream's own clock (s).
     steady : bool
@@ -162,7 +163,7 @@ class StreamReport:
             return (
                 f"{self.name} ({self.kind}): {self.n_messages} messages, not at a steady rate"
                 f" (about {self.rate:.6g} Hz, stamps up to {self.jitter:.3g} s off its line),"
-                f" largest step {self.largest_step:.6g} s; no gaps judged"
+                f" largest step {self.largest_step:.6g} s, {self.n_gaps} gap(s)"
             )
         return (
             f"{self.name} ({self.kind}): {self.n_messages} messages, rate {self.rate:.6g} Hz"
@@ -447,7 +448,7 @@ def _report(stream: Stream, clock: SampleClock, gaps: NDArray[np.bool_]) -> Stre
         period=clock.period / _NS,
         n_missing=int(clock.numbers[-1]) - (int(stream.stamps.shape[0]) - 1),
         largest_step=float(np.max(np.diff(stream.stamps))) / _NS,
-        n_gaps=int(np.sum(gaps)) if steady else 0,
+        n_gaps=int(np.sum(gaps)),
         jitter=clock.jitter / _NS,
         steady=steady,
     )
@@ -563,9 +564,9 @@ def put_on_clock(
     # where the angles did not move across it, a silence of the joints (a publisher that sends
     # on change) is no gap: the straight line between its ends is the path
     moved = np.max(np.abs(np.diff(joints.values, axis=0)), axis=1) > _STILL
-    joints_gaps = _gaps(joints_clock, max_gap) & moved
-    if joints_clock.steady():
-        left_out |= _in_gap(joints_ns, joints_gaps, slot_ns)
+    # a joint topic not at a steady rate has no samples to count missing: no gaps
+    joints_gaps = _gaps(joints_clock, max_gap) & moved & joints_clock.steady()
+    left_out |= _in_gap(joints_ns, joints_gaps, slot_ns)
     kept = np.flatnonzero(~left_out)
     if kept.shape[0] < 2:
         raise ImporterError(
