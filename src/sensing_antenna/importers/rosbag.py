@@ -59,7 +59,7 @@ class LeftOut:
     repeated: int = 0
 
     def describe(self) -> str:
-        """ "" when none, else what was left out, for a person."""
+        """What was left out, for a person; empty when nothing was."""
         parts = []
         if self.non_finite:
             parts.append(f"{self.non_finite} with a NaN or infinite value")
