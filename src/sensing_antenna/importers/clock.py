@@ -230,7 +230,12 @@ class ClockReport:
         if max(before, after) > _TRIM_NOTED * self.period:
             lines.append(
                 f"the wrench's first {before:.3g} s and last {after:.3g} s left out: the joints"
-                " do not cover them (a recording needs the rest before the sweep)"
+                " do not cover them"
+                + (
+                    " (a recording needs the rest before the sweep)"
+                    if before > _TRIM_NOTED * self.period
+                    else ""
+                )
             )
         if self.period < 0.99 * self.wrench.period:
             lines.append(
@@ -508,11 +513,12 @@ def put_on_clock(
         raise ValueError(f"max_gap must be a finite number >= 0, got {max_gap!r}")
     wrench_clock, joints_clock = sample_clock(wrench.stamps), sample_clock(joints.stamps)
     if wrench_clock.fall > 0.0:
-        at = int(np.argmin(wrench_clock.offsets))
+        at = int(wrench.stamps[int(np.argmin(wrench_clock.offsets))] - wrench.stamps[0]) / _NS
         raise ImporterError(
             f"{source}: {wrench.name!r}: its stamps fall back by about"
-            f" {wrench_clock.fall / _NS:.3g} s for good near message {at}: a clock set back while"
-            " recording; its samples cannot be put in order (try the other stamps, --stamps)"
+            f" {wrench_clock.fall / _NS:.3g} s for good near {at:.4g} s after its first: a clock"
+            " set back while recording; its samples cannot be put in order (if only one of the"
+            " sensor's and the recorder's clocks stepped, the other's stamps may hold: --stamps)"
         )
     # the wrench messages at their samples' instants (their stamps without the jitter), ns
     instants = int(wrench.stamps[0]) + np.rint(wrench_clock.instants).astype(np.int64)
