@@ -94,19 +94,18 @@ def _jittered(wrench: Stream, stamps: np.ndarray) -> Stream:
     return Stream(name=wrench.name, kind=wrench.kind, stamps=stamps, values=wrench.values)
 
 
+@pytest.mark.parametrize("n", [3000, 2001, 2003])
 @pytest.mark.parametrize(
     "how",
     ["stamps jittered by up to half a period", "a recorder's latency of 0 to 2 periods", "bursts"],
 )
-def test_every_message_keeps_its_own_sample_whatever_its_stamp_s_jitter(how: str) -> None:
-    # 3,000 samples at 1 kHz, none dropped, stamped three ways a lab meets: a logger's jitter
-    # of up to +-0.5 ms; a recorder's arrival time, 0 to 2 ms late and in order; arrivals four
-    # at a time, 10 us apart, every 4 ms (a step rounded to its nearest whole number of median
-    # steps reads them as 1127 Hz, 1320 Hz and 100 kHz, and invents or leaves out hundreds of
-    # samples). The stamps' line against the messages' count reads the sensor's 1 kHz, and each
-    # message is its own sample
+def test_every_message_keeps_its_own_sample_whatever_its_stamp_s_jitter(how: str, n: int) -> None:
+    # samples at 1 kHz, none dropped, stamped three ways a lab meets: a logger's jitter of up
+    # to +-0.5 ms; a recorder's arrival time, 0 to 2 ms late and in order; arrivals four at a
+    # time, 10 us apart, every 4 ms (a step rounded to its nearest whole number of median steps
+    # reads them as 1127 Hz, 1320 Hz and 100 kHz). The sensor's 1 kHz, and each message its
+    # own sample, whatever the stream's length against the bursts
     rng = np.random.default_rng(5)
-    n = 3000
     wrench = _wrench(n)
     k = np.arange(n, dtype=np.int64)
     if how.startswith("stamps"):
@@ -193,8 +192,7 @@ def test_a_drop_under_a_recorder_s_latency_is_counted_whole(seed: int) -> None:
 
 def test_a_clock_set_back_while_recording_is_refused() -> None:
     # the stamps' clock set back by 20 ms half-way (an NTP step): sorted, two stretches of
-    # samples interleave and no steady clock holds them; read anyway, the line through them
-    # put the sensor at 1.01 kHz
+    # samples interleave, and a line through them would put the sensor at 1.01 kHz
     rng = np.random.default_rng(2)
     n = 3000
     wrench = _wrench(n)
@@ -226,3 +224,26 @@ def test_joints_sent_on_change_are_not_gaps_while_they_stand_still() -> None:
     np.testing.assert_allclose(
         clocked.joints[:, 0], np.delete(theta1, range(2000, 2010)), atol=1e-12
     )
+
+
+@pytest.mark.parametrize("lost", ["1 % at random", "5 % at random", "every 50th"])
+def test_many_drops_on_stamps_without_jitter_are_each_counted(lost: str) -> None:
+    # so many drops that nearly every 64 messages hold one: stamps on their grid count each
+    # step's own drops, at the sensor's own rate
+    rng = np.random.default_rng(8)
+    n = 3000
+    wrench = _wrench(n)
+    if lost == "every 50th":
+        dropped = np.arange(49, n - 1, 50)
+    else:
+        share = 0.01 if lost.startswith("1") else 0.05
+        dropped = rng.choice(np.arange(1, n - 1), int(share * n), replace=False)
+    kept = np.setdiff1d(np.arange(n), dropped)
+    lossy = Stream("/wrench", "wrench", wrench.stamps[kept], wrench.values[kept])
+    joints = _ramp_joints(EPOCH_NS + np.arange(0, n + 10, 10, dtype=np.int64) * MS)
+    clocked = put_on_clock(lossy, joints, source="log")
+    assert clocked.report.period == 0.001
+    assert clocked.report.wrench.n_missing == dropped.size
+    slots = np.rint(clocked.t / 0.001).astype(int)
+    own = np.isin(slots, kept)
+    np.testing.assert_array_equal(clocked.wrench[own], wrench.values[slots[own]])

@@ -370,6 +370,25 @@ def test_datagrams() -> None:
             decode_datagram(data)
 
 
+def test_a_stream_too_short_to_tell_its_jitter_keeps_the_period_s_2_percent(
+    recordings: dict[str, Path],
+) -> None:
+    # two stamps 1.01 ms apart under a declared 1 ms: a line through two stamps has no
+    # jitter to judge by, so the stream's end is judged within 2 %, and the estimate says the
+    # recording is too short (three stamps 1 % apart, the same)
+    text = [line.decode() for line in _lines(read_recording(recordings["azimuthal"]))]
+    header_at = next(k for k, line in enumerate(text) if not line.startswith("#"))
+    rows = [text[header_at + 1 + k].split(",", 1)[1] for k in range(3)]
+    for stamps in (["0.0", "0.00101"], ["0.0", "0.00101", "0.00202"]):
+        lines = [
+            *text[: header_at + 1],
+            *(f"{t},{row}" for t, row in zip(stamps, rows[: len(stamps)], strict=True)),
+        ]
+        events = _listen([line.encode() for line in lines])
+        found = [e for e in events if isinstance(e, EstimateEvent)]
+        assert [e.to_dict()["status"] for e in found] == ["recording_too_short"]
+
+
 def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
     text = recordings["azimuthal"].read_text().splitlines(keepends=True)
     header_at = next(k for k, line in enumerate(text) if not line.startswith("#"))

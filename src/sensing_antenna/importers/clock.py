@@ -80,6 +80,9 @@ STEADY_PERIODS = 8.0
 #: Joint angles that change by no more than this across a silence stood still (rad): the
 #: estimators' floor of the head's rest tolerance.
 _STILL = 1.0e-4
+#: Stamps whose every step lies within this fraction of a period of a whole number of periods
+#: have their drops counted step by step.
+_CLEAN_STEP = 0.25
 #: Most passes of the steps' period and the drops counted on it (they settle in two or three).
 _PASSES = 4
 #: Messages a stream is split after, evenly spread, to look for stamps lower for good.
@@ -338,19 +341,22 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
     # a short stream's steps over fewer messages, so that most of them hold no drop
     lag = min(_PERIOD_LAG, max(1, n // 8))
     count = np.arange(n, dtype=np.int64)
-    numbers = count
-    for _ in range(_PASSES):
-        # the median step over ``lag`` messages, of the spans without a drop counted: drops
-        # once counted do not move it (a line through stamps miscounted would take the
-        # miscount up as a slope, and keep it)
-        spans = numbers[lag:] - numbers[:-lag]
-        clean = spans == lag
-        steps = (s[lag:] - s[:-lag])[clean] / lag if clean.any() else (s[lag:] - s[:-lag]) / spans
-        steps_period = float(np.median(steps))
-        found = count + _drops(s, s / steps_period - count, steps_period)
-        if np.array_equal(found, numbers):
-            break
-        numbers = found
+    steps = np.diff(s)
+    single = float(np.median(steps))
+    mean = float(s[-1]) / (n - 1)
+    ratio = steps / single if single > 0.0 else steps
+    if (
+        2.0 * single > mean  # not bursts: fewer drops than messages
+        and np.all(ratio > 1.0 - _CLEAN_STEP)
+        and np.all(np.abs(ratio - np.rint(ratio)) < _CLEAN_STEP)
+    ):
+        # every step within a quarter period of a whole number of them: each step's own
+        # rounding counts its drops, however many (the running medians need most messages
+        # without one)
+        numbers = np.concatenate([[0], np.cumsum(np.maximum(np.rint(steps / single), 1.0))])
+        numbers = numbers.astype(np.int64)
+    else:
+        numbers = _counted(s, count, lag)
     slope, intercept = np.polyfit(numbers.astype(np.float64), s, 1)
     period = float(slope)
     instants = intercept + period * numbers.astype(np.float64)
@@ -360,8 +366,35 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
     offsets = s - instants
     # a clock set back is judged against the steps' period, which one step back hardly moves
     # (the line takes it up as a slope)
+    steps_period = _steps_period(s, numbers, lag)
     fall = _fall(s / steps_period - numbers) * steps_period
     return SampleClock(period, numbers, instants, offsets, fall)
+
+
+def _steps_period(s: NDArray[np.float64], numbers: NDArray[np.int64], lag: int) -> float:
+    """The median step (ns) over ``lag`` messages of the spans without a drop in ``numbers``."""
+    spans = numbers[lag:] - numbers[:-lag]
+    clean = spans == lag
+    if clean.any():
+        return float(np.median((s[lag:] - s[:-lag])[clean] / lag))
+    return float(np.median((s[lag:] - s[:-lag]) / spans))
+
+
+def _counted(s: NDArray[np.float64], count: NDArray[np.int64], lag: int) -> NDArray[np.int64]:
+    """Sample numbers of jittered stamps ``s`` (ns from the first): the drops counted on the
+    steps' period, and the period read again without the spans they fall in, until the two
+    agree."""
+    numbers = count
+    for _ in range(_PASSES):
+        # the median step over ``lag`` messages, of the spans without a drop counted: drops
+        # once counted do not move it (a line through stamps miscounted would take the
+        # miscount up as a slope, and keep it)
+        steps_period = _steps_period(s, numbers, lag)
+        found = count + _drops(s, s / steps_period - count, steps_period)
+        if np.array_equal(found, numbers):
+            break
+        numbers = found
+    return numbers
 
 
 def _fall(offsets: NDArray[np.float64]) -> float:
@@ -374,7 +407,7 @@ def _fall(offsets: NDArray[np.float64]) -> float:
     width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))
     if n < 2 * width:
         return 0.0
-    level = median_filter(offsets, size=width, mode="nearest")
+    level = median_filter(offsets, size=width, mode="mirror")
     spread = 1.4826 * float(np.median(np.abs(offsets - level)))
     noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
     splits = np.unique(np.linspace(width, n - width, _FALL_SPLITS).astype(np.int64))
@@ -397,7 +430,7 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> 
     n = lead.shape[0]
     width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))  # odd; a short stream's a quarter of it
     half = width // 2
-    level = median_filter(lead, size=width, mode="nearest")
+    level = median_filter(lead, size=width, mode="mirror")
     spread = 1.4826 * float(np.median(np.abs(lead - level)))
     noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
     steps = np.diff(s)
@@ -410,7 +443,7 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> 
         # near the ends, steps without jitter: their own lengths, taken out of the lead
         for k in np.flatnonzero(~covered[1:] & (each > 0)):
             drops[k + 1 :] += each[k]
-        level = median_filter(lead - drops, size=width, mode="nearest")
+        level = median_filter(lead - drops, size=width, mode="mirror")
     rise = np.zeros(n)
     rise[covered] = level[after[covered]] - level[before[covered]]
     rising = np.flatnonzero(rise >= 0.5 + noise)
@@ -435,12 +468,16 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> 
         if total < 1:
             continue
         first = max(low, 1)
-        own = each[first - 1 : high]  # the steps into messages first .. high
-        if int(own.sum()) == total:
-            for k in np.flatnonzero(own):
-                drops[first + k :] += own[k]
-        else:
-            drops[first + int(np.argmax(steps[first - 1 : high])) :] += total
+        # the drops each step of the run holds by its own length; what they leave of the rise
+        # at its longest step, what they hold beyond it taken from its shortest ones
+        excess = steps[first - 1 : high] / period - 1.0
+        own = np.maximum(np.rint(excess), 0.0).astype(np.int64)
+        while int(own.sum()) > total:
+            held = np.flatnonzero(own)
+            own[held[int(np.argmin(excess[held]))]] -= 1
+        own[int(np.argmax(excess))] += total - int(own.sum())
+        for k in np.flatnonzero(own):
+            drops[first + k :] += own[k]
     return drops
 
 

@@ -316,9 +316,12 @@ class Listener:
             # early one, or a lost sample with jitter, and only the others tell which
             period, error = _period_of_line(stamps, [periods, np.maximum(np.rint(step / ts), 1.0)])
             how = f"a line through its first {steps + 1} time stamps"
-            # as close as the stamps' jitter lets the line tell, down to the clock tolerance
-            # by which a file's stamps are trusted over its period
-            tolerance = min(PERIOD_CONSISTENCY, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
+            # on its full first stamps, as close as their jitter lets the line tell, down to the
+            # clock tolerance by which a file's stamps are trusted over its period (fewer, at
+            # a shorter stream's end, cannot tell their jitter)
+            tolerance = PERIOD_CONSISTENCY
+            if steps == PERIOD_CHECK_STEPS:
+                tolerance = min(tolerance, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
             if abs(period - ts) <= tolerance * ts:
                 return
         raise WireError(
