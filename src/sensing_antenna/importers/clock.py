@@ -422,10 +422,11 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> 
     A drop raises the lead for good: the running median of the lead, half a window after a
     message against half a window before, rises by half a period and its noise across it; runs
     of such messages less than a window apart are one rise, counted if the level stays up a
-    window longer (a recorder that stalls and catches up does not drop) and sized by the whole
-    rise. Within a run the drops go where the steps' own lengths put them, when those add up
-    to the rise, else at its longest step. Near the stream's ends, which the windows do not
-    cover, stamps without jitter tell drops by their steps alone.
+    window longer (a recorder that stalls and catches up does not drop) and sized by the lead's
+    medians either side. Within a run each step holds the drops its own length says, the rest
+    of the rise at the run's longest step (a surplus taken from its shortest). Near the
+    stream's ends, which the windows do not cover, stamps without jitter tell drops by their
+    steps alone.
     """
     n = lead.shape[0]
     width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))  # odd; a short stream's a quarter of it
