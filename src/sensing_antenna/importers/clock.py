@@ -22,8 +22,9 @@ k T_s):
 - the wrench with the sensor's own sample: the message whose instant is nearest to the slot,
   when it lies within T_s / 2 (stamp jitter moves no value; nothing is interpolated). A slot with
   none (a dropped message) takes the straight line between the messages either side;
-- the joint angles by linear interpolation between the messages either side, at their stamps
-  (joint states usually come slower than the sensor, and the angles move smoothly);
+- the joint angles by linear interpolation between the messages either side, at their samples'
+  instants (at their stamps when they do not come at a steady rate; joint states usually come
+  slower than the sensor, and the angles move smoothly);
 - a slot inside a gap of either stream, more than ``max_gap`` of its samples missing in a row,
   is left out: the recording then shows the missing samples and the estimators treat them as
   dropped (docs/recording-format.md), instead of estimating from straight lines drawn across the
@@ -582,7 +583,11 @@ def put_on_clock(
     n_slots = math.floor(periods + 1e-6) + 1  # the instants are whole nanoseconds
     slot_ns = np.arange(n_slots, dtype=np.float64) * step_ns
     wrench_ns = (instants - origin).astype(np.float64)
+    # the joints at their samples' instants too when they come at a steady rate (else at their
+    # stamps: a publisher on change has no samples to place)
     joints_ns = (joints.stamps - origin).astype(np.float64)
+    if joints_clock.steady():
+        joints_ns = joints_clock.instants + float(int(joints.stamps[0]) - origin)
 
     # the wrench message nearest each slot, when within T_s / 2 (the first of a tie)
     nearest = np.rint(wrench_ns / step_ns)
