@@ -398,6 +398,21 @@ def _counted(s: NDArray[np.float64], count: NDArray[np.int64], lag: int) -> NDAr
     return numbers
 
 
+def _window(n: int) -> int:
+    """Messages in the running median of a stream of ``n``: odd, and a short stream's a quarter
+    of it."""
+    return min(_LEVEL_WINDOW, max(3, (n // 4) | 1))
+
+
+def _level(values: NDArray[np.float64], width: int) -> tuple[NDArray[np.float64], float]:
+    """The running median of ``values`` (periods) over ``width`` messages, and the noise a rise
+    of it must exceed: :data:`_LEVEL_SIGMAS` standard deviations of a median of ``width``
+    values of their robust spread about it."""
+    level = median_filter(values, size=width, mode="mirror")
+    spread = 1.4826 * float(np.median(np.abs(values - level)))
+    return level, _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
+
+
 def _fall(offsets: NDArray[np.float64]) -> float:
     """How far (periods) the stamps' ``offsets`` (periods, from a steady clock of their sample
     numbers) lie lower after some message than before it, medians either side, at the split
@@ -405,12 +420,10 @@ def _fall(offsets: NDArray[np.float64]) -> float:
     while recording leaves its stamps lower for good; a drop is in the sample numbers, and a
     stall and its catching up are a bump that leaves the medians where they were."""
     n = offsets.shape[0]
-    width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))
+    width = _window(n)
     if n < 2 * width:
         return 0.0
-    level = median_filter(offsets, size=width, mode="mirror")
-    spread = 1.4826 * float(np.median(np.abs(offsets - level)))
-    noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
+    _, noise = _level(offsets, width)
     splits = np.unique(np.linspace(width, n - width, _FALL_SPLITS).astype(np.int64))
     fall = max(float(np.median(offsets[:k]) - np.median(offsets[k:])) for k in splits)
     return fall if fall > max(2.0, 1.0 + 2.0 * noise) else 0.0
@@ -430,11 +443,9 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> 
     steps alone.
     """
     n = lead.shape[0]
-    width = min(_LEVEL_WINDOW, max(3, (n // 4) | 1))  # odd; a short stream's a quarter of it
+    width = _window(n)
     half = width // 2
-    level = median_filter(lead, size=width, mode="mirror")
-    spread = 1.4826 * float(np.median(np.abs(lead - level)))
-    noise = _LEVEL_SIGMAS * 1.2533 * spread / math.sqrt(width)
+    level, noise = _level(lead, width)
     steps = np.diff(s)
     each = np.maximum(np.rint(steps / period) - 1.0, 0.0).astype(np.int64)  # into message k + 1
     drops = np.zeros(n, dtype=np.int64)
@@ -445,7 +456,7 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> 
         # near the ends, steps without jitter: their own lengths, taken out of the lead
         for k in np.flatnonzero(~covered[1:] & (each > 0)):
             drops[k + 1 :] += each[k]
-        level = median_filter(lead - drops, size=width, mode="mirror")
+        level = _level(lead - drops, width)[0]
     rise = np.zeros(n)
     rise[covered] = level[after[covered]] - level[before[covered]]
     rising = np.flatnonzero(rise >= 0.5 + noise)
