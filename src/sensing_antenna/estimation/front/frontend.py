@@ -607,18 +607,19 @@ class FrontEnd:
             return self._stop(self._early(Status.BAD_INPUT, problem))
         if self._contact is None:
             assert self._detector is not None
+            status = Status.NO_CONTACT
             reason = f"filtered residual stays at or below {self._detector.threshold:g} N m"
-            outcome = self._early(Status.NO_CONTACT, reason)
             shortest = 2.0 * self.config.rest_window + self.config.frame_window
             if n - 1 < samples(shortest, self.sample_period):
                 # too few samples to hold a contact the front end could use: not a free sweep
-                outcome = self._early(
-                    Status.RECORDING_TOO_SHORT,
+                status = Status.RECORDING_TOO_SHORT
+                reason = (
                     f"{n} samples ({(n - 1) * self.sample_period:.4g} s) and no contact in "
                     f"them: too few for any manoeuvre, which needs {shortest:g} s at the least "
                     "(a rest before the sweep and one at the push, rest_window each, and the "
-                    "push's hold, frame_window)",
+                    "push's hold, frame_window)"
                 )
+            outcome = self._early(status, reason)
             # loads in kN or torques in kN m never reach the threshold: the units check of
             # the whole record, as at a contact, says so before "no contact"
             problem = at_contact(
@@ -631,7 +632,7 @@ class FrontEnd:
                 self.sample_period,
             ).input_problem
             if problem is not None:
-                diagnostics = {**outcome.diagnostics, "other_reasons": [outcome.reason]}
+                diagnostics = {**outcome.diagnostics, "other_reasons": [reason]}
                 outcome = dataclasses.replace(
                     outcome,
                     status=Status.IMPLAUSIBLE_INPUT,
