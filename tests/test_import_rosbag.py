@@ -48,6 +48,7 @@ def _write_bag(
     *,
     wrench_ns: NDArray[np.int64] | None = None,
     joints_ns: NDArray[np.int64] | None = None,
+    joints_header_ns: NDArray[np.int64] | None = None,
     wrench_kept: Sequence[int] | None = None,
     names: Sequence[str] = ("pan", "tilt"),
     sensor: NDArray[np.float64] | None = None,
@@ -58,7 +59,8 @@ def _write_bag(
 ) -> Path:
     """Write the recording as a bag: one WrenchStamped and one JointState message per sample.
 
-    ``wrench_ns``/``joints_ns`` are the header stamps (default: EPOCH_NS + t in ns);
+    ``wrench_ns``/``joints_ns`` are the header stamps and the bag's record times (default:
+    EPOCH_NS + t in ns); ``joints_header_ns``, when given, the joints' header stamps instead;
     ``wrench_kept`` the samples whose wrench message is written (default all); ``names`` the
     joints of each JointState message, where ``pan`` carries theta1 and ``tilt`` theta2 and any
     other name 0; ``sensor`` R with v_sensor = R @ v_motor (default the identity);
@@ -73,6 +75,7 @@ def _write_bag(
     stamps_ns = EPOCH_NS + np.rint(recording.t * 1e9).astype(np.int64)
     wrench_ns = stamps_ns if wrench_ns is None else wrench_ns
     joints_ns = stamps_ns if joints_ns is None else joints_ns
+    joints_header = joints_ns if joints_header_ns is None else joints_header_ns
     kept = range(recording.n_samples) if wrench_kept is None else wrench_kept
     matrix = np.eye(3) if sensor is None else sensor
     force, torque = recording.force @ matrix.T, recording.torque @ matrix.T
@@ -106,7 +109,7 @@ def _write_bag(
         angle = {"pan": recording.theta[:, 0], "tilt": recording.theta[:, 1]}
         for k in range(recording.n_samples):
             message = types["sensor_msgs/msg/JointState"](
-                header=header(k, int(joints_ns[k])),
+                header=header(k, int(joints_header[k])),
                 name=list(names),
                 position=np.array([angle[n][k] if n in angle else 0.0 for n in names]),
                 velocity=np.zeros(0),
@@ -313,6 +316,46 @@ def test_unset_header_stamps_are_refused_unless_the_bag_s_times_are_asked_for(
     with pytest.raises(ImporterError, match=r"message 0 has no header stamp \(0\); use the bag's"):
         read_rosbag(bag, WRENCH, JOINTS)
     _assert_same_samples(read_rosbag(bag, WRENCH, JOINTS, stamps="bag").recording, recording)
+
+
+@pytest.mark.parametrize("back_ms", [6, 20])
+def test_a_joint_clock_set_back_while_recording_is_refused_and_the_bag_s_times_hold(
+    back_ms: int, recording: Recording, tmp_path: Path
+) -> None:
+    # the joints' publisher's clock set back half-way (an NTP step) while the recorder's holds:
+    # sorted by header stamp, the angles after the step would sit back_ms early (the step times
+    # the head's speed), every answer still `ok`; the first stamp after the step
+    # lies a period less than back_ms below the one received before it
+    received = EPOCH_NS + np.rint(recording.t * 1e9).astype(np.int64)
+    stamped = received.copy()
+    half = recording.n_samples // 2
+    stamped[half:] -= back_ms * 1_000_000
+    bag = _write_bag(
+        _bag_path(tmp_path, 2), recording, 2, joints_ns=received, joints_header_ns=stamped
+    )
+    with pytest.raises(
+        ImporterError,
+        match=rf"topic '{JOINTS}': message {half}'s header stamp is {(back_ms - 1) / 1000:g} s"
+        r" before one the bag received earlier \(.* s after the topic's first\): its publisher's"
+        r" clock was set back while recording; the bag's record times may hold \(--stamps bag\)$",
+    ):
+        read_rosbag(bag, WRENCH, JOINTS)
+    _assert_same_samples(read_rosbag(bag, WRENCH, JOINTS, stamps="bag").recording, recording)
+
+
+def test_header_stamps_jittered_out_of_the_order_received_are_no_clock_set_back(
+    recording: Recording, tmp_path: Path
+) -> None:
+    # a driver stamping each message within +-2 ms of its instant, received in order: stamps
+    # up to 4 ms out of the order received are jitter, not a clock set back
+    received = EPOCH_NS + np.rint(recording.t * 1e9).astype(np.int64)
+    rng = np.random.default_rng(5)
+    stamped = received + rng.integers(-2_000_000, 2_000_001, size=received.shape[0])
+    bag = _write_bag(
+        _bag_path(tmp_path, 2), recording, 2, joints_ns=received, joints_header_ns=stamped
+    )
+    report = read_rosbag(bag, WRENCH, JOINTS).report.clock
+    assert report.joints.n_messages == recording.n_samples and report.n_left_out == 0
 
 
 def test_a_ros2_bag_may_be_named_by_its_metadata_file_and_a_ros1_bag_needs_its_suffix(

@@ -33,6 +33,7 @@ from sensing_antenna.recording import Recording
 __all__ = [
     "INSTALL_HINT",
     "JOINTS_TYPE",
+    "STEP_BACK_NS",
     "WRENCH_TYPE",
     "ImportReport",
     "RosbagImport",
@@ -47,6 +48,8 @@ JOINTS_TYPE = "sensor_msgs/msg/JointState"
 INSTALL_HINT = "pip install 'sensing-antenna[ros]'"
 
 _NS = 10**9
+#: A header stamp this far (ns) below one the bag received before it is a clock set back.
+STEP_BACK_NS = 5_000_000
 _ROS1_MAGIC = b"#ROSBAG V2.0"
 
 
@@ -170,6 +173,7 @@ def _sorted(
             f"{source}: topic {topic!r}: message {k} has no header stamp (0); use the bag's"
             " record times (--stamps bag)"
         )
+    _check_received_in_order(source, topic, stamp_array, stamp_kind)
     value_array = np.array(values, dtype=np.float64).reshape(len(values), -1)
     order = np.argsort(stamp_array, kind="stable")
     stamp_array, value_array = stamp_array[order], value_array[order]
@@ -187,6 +191,25 @@ def _sorted(
             f" {len(values)}, at least 2 needed{left_out.describe()}"
         )
     return stream, left_out
+
+
+def _check_received_in_order(source: str, topic: str, stamps: np.ndarray, stamp_kind: str) -> None:
+    """Refuse a topic whose header stamps, in the order the bag received the messages, fall
+    :data:`STEP_BACK_NS` or more below an earlier message's: one publisher's messages arrive in
+    the order it sent them, so that is its clock set back while recording (sorted, the
+    stretches before and after would interleave, each sample up to the step off its instant)."""
+    if stamp_kind != "header" or stamps.shape[0] < 2:
+        return
+    behind = np.maximum.accumulate(stamps)[:-1] - stamps[1:]
+    k = int(np.argmax(behind))
+    if behind[k] >= STEP_BACK_NS:
+        after = int(stamps[k + 1] - stamps[0]) / _NS
+        raise ImporterError(
+            f"{source}: topic {topic!r}: message {k + 1}'s header stamp is"
+            f" {behind[k] / _NS:.3g} s before one the bag received earlier ({after:.4g} s after"
+            " the topic's first): its publisher's clock was set back while recording; the bag's"
+            " record times may hold (--stamps bag)"
+        )
 
 
 def _read_streams(
