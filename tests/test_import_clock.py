@@ -221,6 +221,11 @@ def test_joints_sent_on_change_are_not_gaps_while_they_stand_still() -> None:
     joints = Stream("/joints", "joints", stamps, np.column_stack([theta1[sent], 0.0 * t[sent]]))
     clocked = put_on_clock(wrench, joints, source="log")
     assert clocked.report.n_left_out == 10 and clocked.report.joints.n_gaps == 1
+    joints_report = clocked.report.joints
+    assert (joints_report.n_missing, joints_report.n_still) == (509, 499)
+    assert "509 missing (499 of them while the angles stood still: sent on change)" in (
+        joints_report.line()
+    )
     np.testing.assert_allclose(
         clocked.joints[:, 0], np.delete(theta1, range(2000, 2010)), atol=1e-12
     )

@@ -144,6 +144,9 @@ class StreamReport:
         Largest distance of a stamp from its sample's instant on the stream's own clock (s).
     steady : bool
         Whether the stamps lie within :data:`STEADY_PERIODS` periods of that clock.
+    n_still : int
+        Of ``n_missing``, those in silences across which the angles stood still (a joint
+        publisher that sends on change): no gaps.
     """
 
     name: str
@@ -155,6 +158,7 @@ class StreamReport:
     n_gaps: int
     jitter: float
     steady: bool = True
+    n_still: int = 0
 
     @property
     def rate(self) -> float:
@@ -171,7 +175,13 @@ class StreamReport:
             )
         return (
             f"{self.name} ({self.kind}): {self.n_messages} messages, rate {self.rate:.6g} Hz"
-            f" (its stamps' line), {self.n_missing} missing, largest step"
+            f" (its stamps' line), {self.n_missing} missing"
+            + (
+                f" ({self.n_still} of them while the angles stood still: sent on change)"
+                if self.n_still
+                else ""
+            )
+            + ", largest step"
             f" {self.largest_step:.6g} s, {self.n_gaps} gap(s), stamps within"
             f" {self.jitter:.3g} s of its clock"
         )
@@ -494,7 +504,9 @@ def _drops(s: NDArray[np.float64], lead: NDArray[np.float64], period: float) -> 
     return drops
 
 
-def _report(stream: Stream, clock: SampleClock, gaps: NDArray[np.bool_]) -> StreamReport:
+def _report(
+    stream: Stream, clock: SampleClock, gaps: NDArray[np.bool_], still: int = 0
+) -> StreamReport:
     steady = clock.steady()
     return StreamReport(
         name=stream.name,
@@ -506,6 +518,7 @@ def _report(stream: Stream, clock: SampleClock, gaps: NDArray[np.bool_]) -> Stre
         n_gaps=int(np.sum(gaps)),
         jitter=clock.jitter / _NS,
         steady=steady,
+        n_still=still,
     )
 
 
@@ -637,7 +650,14 @@ def put_on_clock(
     last_slot = origin + (n_slots - 1) * step_ns
     report = ClockReport(
         wrench=_report(wrench, wrench_clock, wrench_gaps),
-        joints=_report(joints, joints_clock, joints_gaps),
+        joints=_report(
+            joints,
+            joints_clock,
+            joints_gaps,
+            int(np.sum((np.diff(joints_clock.numbers) - 1)[~moved]))
+            if joints_clock.steady()
+            else 0,
+        ),
         period=step,
         origin_ns=origin,
         n_slots=n_slots,
