@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +49,15 @@ def test_a_push_of_a_third_of_x_c_is_right_and_says_the_bent_link_is_unknown(nam
     assert abs(result.ratio_estimate - truth) < 0.01
     assert np.linalg.norm(result.contact_point - point) < 0.01
     assert result.diagnostics["deflection_ratio"] > 0.25
+    # the push it names as gentle enough bends the link so that the term is 1 cm there (Eq. 13:
+    # y_c / x_c = |R_perp| x_c^2 / (3 E I); the term bent_link_factor d^2 x_c); read to its two
+    # digits, within 6 %
+    gentle = re.search(r"a push of ([0-9.e-]+) N or less", result.reason or "")
+    assert gentle is not None, result.reason
+    link, config = paper_antenna().link, EstimatorConfig()
+    bend = float(gentle.group(1)) * result.x_c**2 * link.bending_compliance / 3.0
+    term = config.bent_link_factor * bend**2 * result.x_c
+    assert term == pytest.approx(config.max_model_spread, rel=0.06)
 
 
 @pytest.mark.parametrize(

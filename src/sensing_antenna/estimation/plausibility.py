@@ -508,10 +508,15 @@ def _bent_link_problem(evidence: Evidence, estimate: ContactEstimate) -> str | N
     if not shift > limit:
         return None
     bend = float(evidence.push_deflection_ratio(estimate.x_c))
+    # the term grows as the deflection squared, the deflection as the push
+    gentler = math.sqrt(limit / shift)
+    push = math.hypot(evidence.frame.reaction_m[1], evidence.frame.reaction_m[2])
     return (
         f"the push bends the link by {100 * bend:.0f} % of x_c at x_c = {estimate.x_c:.3f} m: "
         f"the sensing curves are the straight link's, and the bent link's preload may move the "
-        f"point the vibration gives by up to {100 * shift:.1f} cm, more than {100 * limit:g} cm"
+        f"point the vibration gives by up to {100 * shift:.1f} cm, more than {100 * limit:g} cm "
+        f"(a push of {gentler * push:.2g} N or less, {100 * gentler * bend:.0f} % of x_c, "
+        "keeps it within that here)"
     )
 
 
