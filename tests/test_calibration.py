@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from _recordings import samples_kept
 from sensing_antenna.antenna import load_antenna, paper_antenna, save_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.calibration.frequency import (
@@ -317,6 +318,41 @@ def test_calibration_leaves_out_a_recording_not_in_the_format_units() -> None:
     # with too few left, the error names why the others were left out
     with pytest.raises(CalibrationError, match=r"got 1 \(left out: b\.csv: columns 'tx'"):
         calibrate_from_recordings(recordings[:2], antenna, points[:2], sources=["a.csv", "b.csv"])
+
+
+def test_a_recording_an_estimate_would_refuse_calibrates_nothing() -> None:
+    # the estimators' checks of their input, asked of every recording: 10 samples missing in
+    # the hold (bad_input), a record cut 0.25 s after the stop (recording_too_short: its
+    # omega_1 0.3 % off) and the lateral force's sign flipped (implausible_input: an obstacle
+    # that pulls) leave each one out of the T_e fit and of the sensor's, named with the status
+    from sensing_antenna.calibration.frequency import calibrate_from_recordings
+    from sensing_antenna.calibration.sensor import calibrate_sensor
+    from sensing_antenna.estimation import estimate
+    from sensing_antenna.simulator import Scenario, simulate
+
+    antenna = paper_antenna().self_calibrated()
+    points = [0.3, 0.45, 0.6, 0.75, 0.9]
+    clean = [
+        simulate(antenna, Scenario(case="azimuthal", contact_point=x, seed=20 + i))
+        for i, x in enumerate(points)
+    ]
+    t_1 = estimate(clean[2], antenna).t_1
+    holed = samples_kept(clean[2], np.abs(clean[2].t - (t_1 + 0.45)) > 0.005)
+    cut = samples_kept(clean[2], clean[2].t < t_1 + 0.25)
+    flipped = replace(clean[2], force=clean[2].force * np.array([1.0, -1.0, 1.0]))
+    reference = calibrate_from_recordings(clean[:2] + clean[3:], antenna, points[:2] + points[3:])
+    faults = ((holed, "bad_input"), (cut, "recording_too_short"), (flipped, "implausible_input"))
+    for bad, status in faults:
+        recordings = [*clean[:2], bad, *clean[3:]]
+        names = [f"{x}.csv" for x in points]
+        result = calibrate_from_recordings(recordings, antenna, points, sources=names)
+        assert result.used.tolist() == [True, True, False, True, True]
+        (note,) = result.notes
+        assert note.startswith(f"0.6.csv: an estimate would be {status} (")
+        assert result.t_e == reference.t_e
+        sensor = calibrate_sensor(recordings, antenna, points, sources=names)
+        assert sensor.sources == ("0.3.csv", "0.45.csv", "0.75.csv", "0.9.csv")
+        assert any(n.startswith(f"0.6.csv: an estimate would be {status} (") for n in sensor.notes)
 
 
 def test_contact_points_a_few_ulp_past_the_tip_are_the_tip() -> None:

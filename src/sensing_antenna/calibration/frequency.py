@@ -682,18 +682,18 @@ def calibrate_from_recordings(
         Search band for the fundamental frequency (rad/s); wide by default so that the measured
         frequencies do not presuppose the model being fitted.
 
-    A recording that cannot be used is left out with a note naming it and why (not in the
-    format's units: its angles, or its loads at rest against the link's weight,
-    :func:`~.observer.units_problem`; no clear fundamental; no known contact point), and the fit
-    goes on with the others.
+    A recording that cannot be used is left out with a note naming it and why (the estimators'
+    checks of their input, :func:`~.usable.contact_evidence`: not in the format's units,
+    samples missing in the hold, loads on another scale than the vibration, a record too short;
+    no clear fundamental; no known contact point), and the fit goes on with the others.
 
     Raises
     ------
     CalibrationError
         When fewer than two recordings are left to fit.
     """
-    from sensing_antenna.calibration.observer import units_problem
-    from sensing_antenna.estimation import Evidence, gather, omega1_of
+    from sensing_antenna.calibration.usable import contact_evidence
+    from sensing_antenna.estimation import omega1_of
 
     if len(recordings) != len(contact_points):
         raise CalibrationError(
@@ -702,7 +702,7 @@ def calibrate_from_recordings(
     names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
     omega = np.full(len(recordings), math.nan)
     components = ["none"] * len(recordings)
-    evidences: list[Evidence | None] = [None] * len(recordings)
+    evidences: list[Any] = [None] * len(recordings)
     notes: list[str] = []
     _, on_link, _ = points_on_link(
         np.asarray(contact_points, dtype=float), antenna.link.length, names
@@ -710,11 +710,10 @@ def calibrate_from_recordings(
     for i, recording in enumerate(recordings):
         if not on_link[i]:
             continue  # left out for its point, one note (calibrate_t_e's)
-        problem = units_problem(recording, antenna)
-        if problem is not None:
-            notes.append(f"{names[i]}: {problem}")
+        gathered = contact_evidence(recording, antenna)
+        if isinstance(gathered, str):
+            notes.append(f"{names[i]}: {gathered}")
             continue
-        gathered = gather(recording, antenna)
         measurement = omega1_of(gathered, band)
         value = float(measurement.omega1)
         if not (math.isfinite(value) and value > 0):
@@ -727,7 +726,7 @@ def calibrate_from_recordings(
         else:
             omega[i] = value
             components[i] = measurement.component
-            evidences[i] = gathered if isinstance(gathered, Evidence) else None
+            evidences[i] = gathered
     calibration = calibrate_t_e(
         contact_points,
         omega,

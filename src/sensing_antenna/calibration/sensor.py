@@ -353,18 +353,13 @@ def _rms(values: FloatArray) -> float:
 
 def _hold(recording: Any, antenna: Antenna, x_c: float) -> _Hold | str:
     """The hold's mean tared loads of one contact manoeuvre, or why it cannot be used."""
-    from sensing_antenna.calibration.observer import units_problem
-    from sensing_antenna.estimation import gather
-    from sensing_antenna.estimation.front.evidence import Evidence
+    from sensing_antenna.calibration.usable import contact_evidence
     from sensing_antenna.estimation.front.ratio import contact_loads
     from sensing_antenna.estimation.front.steps import hold_window
 
-    problem = units_problem(recording, antenna)
-    if problem is not None:
-        return problem
-    evidence = gather(recording, antenna)
-    if not isinstance(evidence, Evidence):
-        return f"no contact to read ({evidence.status.value}: {evidence.reason})"
+    evidence = contact_evidence(recording, antenna)
+    if isinstance(evidence, str):
+        return evidence
     hold = hold_window(
         evidence.rest_index, evidence.theta.shape[0], evidence.config, evidence.sample_period
     )

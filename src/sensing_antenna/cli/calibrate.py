@@ -185,8 +185,11 @@ def _run(args: argparse.Namespace) -> int:
     wrong = calibration.wrong_peak_points
     doubtful = calibration.kept_far_points
     for i, x_c in enumerate(calibration.contact_points):
-        if not 0.0 < float(x_c) <= antenna.link.length:
-            continue  # no known point on the link: its note below says so
+        if not (
+            0.0 < float(x_c) <= antenna.link.length
+            and math.isfinite(float(calibration.omega1_measured[i]))
+        ):
+            continue  # no known point on the link or no omega_1 read: its note below says why
         print(
             f"  {calibration.sources[i]}: x_c = {x_c:.4f} m, omega_1 measured "
             f"{calibration.omega1_measured[i]:.3f}, fitted {calibration.omega1_fitted[i]:.3f} rad/s"
