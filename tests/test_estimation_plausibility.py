@@ -120,6 +120,20 @@ def test_scaled_forces_are_never_ok(
     assert evidence in text
 
 
+@pytest.mark.parametrize("force", [1.0 / 9.81, 1.0 / 4.448], ids=["kgf", "lbf"])
+def test_forces_in_kgf_or_lbf_are_no_record_too_short(
+    azimuthal: Recording, antenna: Antenna, force: float
+) -> None:
+    # the ratio reads 4.4 to 10 times the contact, off the link, and its mean wanders there
+    # beyond the convergence tolerance: the vibration methods name the ratio, not a record
+    # to take longer or a slip
+    for name, result in all_methods(scaled(azimuthal, force=force), antenna).items():
+        assert result.status is not Status.OK, (name, result.x_c)
+        if name != "ratio":
+            assert result.status is Status.MODEL_MISMATCH, (name, result.reason)
+            assert "torque/force ratio" in (result.reason or ""), (name, result.reason)
+
+
 def test_torques_in_newton_millimetres_give_a_status_not_a_traceback(
     azimuthal: Recording, antenna: Antenna
 ) -> None:

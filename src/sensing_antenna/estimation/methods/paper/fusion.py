@@ -153,6 +153,10 @@ def model_spread(link: Link, x_c: float, relative: float) -> float:
     return spread
 
 
+#: A ratio beyond this many link lengths (or below zero) is off the link: no contact's.
+_OFF_LINK = 1.5
+
+
 def conclude(
     evidence: Evidence,
     method: str,
@@ -191,7 +195,20 @@ def conclude(
     found: list[tuple[Status, str]] = list(problems)
     if evidence.gap is not None:
         found.append((Status.BAD_INPUT, evidence.gap))
-    if not evidence.complete:
+    length = evidence.antenna.link.length
+    ratio_end = float(evidence.ratio_mean[e])
+    if evidence.converged_index is None and not 0.0 <= ratio_end <= _OFF_LINK * length:
+        # a ratio that reads off the link is not settling because it is no contact's: not a
+        # record too short or a slip
+        found.append(
+            (
+                Status.MODEL_MISMATCH,
+                f"the torque/force ratio reads {_metres(ratio_end)} m, off the {length:g} m "
+                f"link, and did not settle: loads in other units than N and N m, or a sensor "
+                "axis turned?",
+            )
+        )
+    elif not evidence.complete:
         have = evidence.t[e] - evidence.t[evidence.rest_index]
         if evidence.converged_index is None:
             need = "the torque/force ratio had not settled yet"
