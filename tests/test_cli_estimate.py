@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -55,6 +56,20 @@ def test_every_method_and_summary(
     assert main(["estimate", str(recording_file), "--method", method]) == 0
     out = capsys.readouterr().out
     assert f"method {method}" in out and "status" in out and "x_c" in out
+
+
+def test_a_ratio_no_link_has_prints_to_four_digits(
+    recording_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the torque about Z^m in N cm: the ratio reads 10^19 m, which printed to the millimetre
+    # filled a line with digits of noise
+    recording = read_recording(recording_file)
+    scaled = tmp_path / "scaled.csv"
+    torque = recording.torque * [1.0, 1.0, 100.0]
+    write_recording(dataclasses.replace(recording, torque=torque), scaled)
+    assert main(["estimate", str(scaled)]) == 0
+    (line,) = [text for text in capsys.readouterr().out.splitlines() if "ratio estimate" in text]
+    assert "e+" in line and len(line.split()[-2]) <= 10, line
 
 
 def test_malformed_file_is_one_line_exit_2(

@@ -124,7 +124,11 @@ def _fast_with_tolerance(method: str, tolerance: float) -> Any:
 
 
 def _cm(value: Any) -> str:
-    return "-" if value is None else f"{100 * value:.1f} cm"
+    """A length (m) in cm to the millimetre, or to four digits when it is no link's (loads in
+    other units make ratios of 10^3 to 10^70 m)."""
+    if value is None:
+        return "-"
+    return f"{100 * value:.1f} cm" if abs(value) < 1e3 else f"{100 * value:.4g} cm"
 
 
 def _s(value: Any) -> str:
