@@ -178,6 +178,44 @@ _ANTENNA_SWALLOWING = (
 )
 
 
+#: ``antenna`` whose simulator stands for a compiled function (numba's) interrupted inside: the
+#: KeyboardInterrupt comes back as the cause of a SystemError.
+_ANTENNA_COMPILED = (
+    "import signal, sys\n"
+    "import sensing_antenna.simulator as simulator\n"
+    "def compiled(*args, **kwargs):\n"
+    "    try:\n"
+    "        raise KeyboardInterrupt\n"
+    "    except KeyboardInterrupt as exc:\n"
+    "        raise SystemError('CPUDispatcher(<function solve>) returned a result with an'\n"
+    "                          ' exception set') from exc\n"
+    "simulator.simulate = compiled\n"
+    "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+    "from sensing_antenna.cli import main\n"
+    "sys.exit(main())\n"
+)
+
+
+def test_ctrl_c_inside_a_compiled_function_is_an_interruption(tmp_path: Path) -> None:
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            _ANTENNA_COMPILED,
+            *_SHORT_COMMAND,
+            "--out",
+            str(tmp_path / "r.csv"),
+        ],
+        capture_output=True,
+        text=True,
+        env=_environment(),
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == -signal.SIGINT, done.stderr
+    assert done.stderr.strip() == "antenna simulate: interrupted"
+
+
 def test_a_stop_the_command_swallowed_still_stops_it_when_it_returns(tmp_path: Path) -> None:
     # the command's own code caught the SIGTERM and went on to finish; the command line still
     # reports the stop and ends by it when the command returns
