@@ -93,6 +93,25 @@ def test_map_writes_points_within_their_covariance_of_the_truth(
     assert "truth" not in view.geometry  # antenna map knows no true surface
 
 
+def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a previous map named an object and drew a surface; this one, with the datasheet's
+    # antenna, uses no point: a file of the old map beside the new report would contradict it
+    out = tmp_path / "map"
+    out.mkdir()
+    for name in ("points.ply", "surface.ply", "object.ply", "map.html"):
+        (out / name).write_text("a previous map's\n")
+    assert main(["map", *map(str, recordings), "--out", str(out), "--no-progress"]) == 0
+    assert "0 of 3 points used" in capsys.readouterr().out
+    assert sorted(p.name for p in out.iterdir()) == [
+        "map.png",
+        "points.csv",
+        "recognition.json",
+        "report.md",
+    ]
+
+
 @pytest.mark.parametrize(
     ("problem", "words"),
     [
