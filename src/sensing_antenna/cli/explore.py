@@ -114,7 +114,7 @@ def register(subparsers: Any) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
-    from sensing_antenna.cli.map import report_map
+    from sensing_antenna.cli.map import OBJECTS_UNIT_HINT, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
     from sensing_antenna.scene import load_scene
     from sensing_antenna.scene.objects import read_mesh
@@ -130,7 +130,7 @@ def _run(args: argparse.Namespace) -> int:
         )
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)
-    meshes = {path.stem: read_mesh(path) for path in args.objects}
+    meshes = {path.stem: read_mesh(path, unit_hint=OBJECTS_UNIT_HINT) for path in args.objects}
     settings = ExploreSettings(
         method=args.method,
         strategy=args.strategy,

@@ -46,6 +46,10 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(func=_run)
 
 
+#: How ``--objects`` meshes in other units are to be read, for the size check's message.
+OBJECTS_UNIT_HINT = "--objects reads metres: write the file in metres"
+
+
 def add_map_options(parser: Any, uncertain_into: str) -> None:
     """``--objects`` and ``--include-uncertain``, shared with ``antenna explore``."""
     parser.add_argument(
@@ -54,7 +58,7 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
         type=Path,
         default=(),
         metavar="MESH",
-        help="meshes (STL, OBJ, PLY; m) to register to the points beside the shape classes",
+        help="closed meshes (STL, OBJ, PLY; m) to register to the points beside the shape classes",
     )
     parser.add_argument(
         "--include-uncertain",
@@ -72,7 +76,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.scene.objects import read_mesh
 
     distinct_files(args.recordings)
-    meshes = {path.stem: read_mesh(path) for path in args.objects}
+    meshes = {path.stem: read_mesh(path, unit_hint=OBJECTS_UNIT_HINT) for path in args.objects}
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     with Progress(not args.no_progress).bar(

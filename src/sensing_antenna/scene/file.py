@@ -333,14 +333,9 @@ def _mesh_file(
     if not path.is_absolute() and folder is not None:
         path = folder / path
     try:
-        mesh = read_mesh(path, scale)  # before watertightness, which NaN vertices break
+        return read_mesh(path, scale)
     except SensingAntennaError as exc:
         raise fail(where, str(exc)) from None
-    if not mesh.is_watertight:
-        raise fail(
-            where, f"{path}: the mesh is not closed (watertight), so its inside is undefined"
-        )
-    return mesh
 
 
 def _base(

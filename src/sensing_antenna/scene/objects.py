@@ -51,10 +51,17 @@ MAX_MESH_EXTENT = 10.0
 MIN_OBJECT_SIZE = 1e-3
 
 
-def mesh_problem(mesh: trimesh.Trimesh, scale: float = 1.0) -> str | None:
+#: How a scene reads a mesh in other units, for :func:`mesh_problem`'s messages.
+SCENE_SCALE_HINT = "a scene's scale = 0.001 reads it in millimetres"
+
+
+def mesh_problem(
+    mesh: trimesh.Trimesh, scale: float = 1.0, unit_hint: str = SCENE_SCALE_HINT
+) -> str | None:
     """Why a user's mesh, its coordinates times ``scale`` in m, cannot be an object, or None:
-    vertices that are not finite, or a largest extent beyond :data:`MAX_MESH_EXTENT` or below
-    :data:`MIN_OBJECT_SIZE`."""
+    vertices that are not finite, a largest extent beyond :data:`MAX_MESH_EXTENT` or below
+    :data:`MIN_OBJECT_SIZE` (the message ends with ``unit_hint``, how to read it in other
+    units), or a surface that is not closed."""
     vertices = np.asarray(mesh.vertices, dtype=float)
     if not np.all(np.isfinite(vertices)):
         return "vertices that are not finite numbers"
@@ -64,16 +71,20 @@ def mesh_problem(mesh: trimesh.Trimesh, scale: float = 1.0) -> str | None:
     if extent > MAX_MESH_EXTENT:
         return (
             f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
-            "(a mesh in millimetres reads a thousand times too large; a scene's scale = 0.001 "
-            "reads it in millimetres)"
+            f"(a mesh in millimetres reads a thousand times too large; {unit_hint})"
+        )
+    if not mesh.is_watertight:
+        return (
+            "the mesh is not closed (watertight), so its inside is undefined (trimesh's "
+            "fill_holes may close it)"
         )
     return None
 
 
-def read_mesh(path: Path, scale: float = 1.0) -> trimesh.Trimesh:
+def read_mesh(path: Path, scale: float = 1.0, unit_hint: str = SCENE_SCALE_HINT) -> trimesh.Trimesh:
     """The triangles of a user's mesh file (STL, OBJ, PLY; coordinates times ``scale`` in m),
     as trimesh reads them (not scaled); SensingAntennaError naming the file and the problem
-    when it is missing, unreadable, empty or fails :func:`mesh_problem`."""
+    when it is missing, unreadable, empty or fails :func:`mesh_problem` (``unit_hint``)."""
     if not path.is_file():
         raise SensingAntennaError(
             f"{path}: {'a directory, not a mesh file' if path.is_dir() else 'no such mesh file'}"
@@ -84,7 +95,7 @@ def read_mesh(path: Path, scale: float = 1.0) -> trimesh.Trimesh:
         raise SensingAntennaError(f"{path}: not a readable mesh ({exc})") from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise SensingAntennaError(f"{path}: the file holds no triangles")
-    problem = mesh_problem(mesh, scale)
+    problem = mesh_problem(mesh, scale, unit_hint)
     if problem is not None:
         at = "" if scale == 1.0 else f" at scale {scale:g}"
         raise SensingAntennaError(f"{path}{at}: {problem}")
