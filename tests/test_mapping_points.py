@@ -209,6 +209,26 @@ def test_a_quaternion_printed_to_three_decimals_is_normalised() -> None:
     )
 
 
+def test_a_rotation_printed_to_three_decimals_is_made_orthonormal() -> None:
+    # the same turn as a matrix printed to three decimals, as a robot's log prints it: R R^T is
+    # off the identity by 5e-4 (refused before, at 1e-4); the nearest rotation is taken
+    rows = [[0.866, -0.5, 0.0], [0.5, 0.866, 0.0], [0.0, 0.0, 1.0]]
+    pose = base_pose_from_metadata(
+        {"base_pose": json.dumps({"position": [0, 0, 0], "rotation": rows})}
+    )
+    assert np.allclose(pose.rotation @ pose.rotation.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(pose.rotation) == pytest.approx(1.0, abs=1e-12)
+    assert math.degrees(math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])) == pytest.approx(
+        30.0, abs=0.01
+    )
+    # a matrix scaled by 5 % is no rotation: refused, with how far off it is
+    scaled = [[1.05 * v for v in row] for row in rows]
+    with pytest.raises(FieldError, match=r"R R\^T is up to 0\.10\d* off the identity"):
+        base_pose_from_metadata(
+            {"base_pose": json.dumps({"position": [0, 0, 0], "rotation": scaled})}
+        )
+
+
 def test_the_point_is_where_the_links_surface_meets_the_object() -> None:
     # A link along X pressed against a wall at y = 0.1 m from -Y: it bends back along -Y (the
     # load's direction Y^c), its axis at x_c lies one link radius short of the wall, and the

@@ -28,9 +28,11 @@ __all__ = ["BASE_POSE_KEY", "BasePose", "base_pose_from_metadata"]
 #: The recording metadata key holding the base pose.
 BASE_POSE_KEY = "base_pose"
 
-#: How far from orthonormal a given rotation may be: rounding of values written with 6 or more
-#: significant digits, well below any real mounting error.
-ORTHONORMAL_TOLERANCE = 1e-4
+#: How far from orthonormal a given rotation may be (largest entry of R R^T - I); it is then
+#: made orthonormal (the nearest rotation). 1 %: a rotation printed with three decimals, as a
+#: robot's log often does, is off by up to about 0.2 %, while one that is not a rotation (a
+#: reflection, a typo, a scaled matrix) is off by far more.
+ORTHONORMAL_TOLERANCE = 0.01
 
 #: Largest magnitude of any number of a pose: a rotation's entries and a unit quaternion's are
 #: at most 1, a position beyond 100 m is refused with its own message; this bound keeps every
@@ -58,7 +60,8 @@ class BasePose:
     Attributes
     ----------
     rotation : array, shape (3, 3)
-        R, world coordinates of the absolute frame's axes as columns (orthonormal, det +1).
+        R, world coordinates of the absolute frame's axes as columns (orthonormal, det +1;
+        one within :data:`ORTHONORMAL_TOLERANCE` is made so).
     position : array, shape (3,)
         t, the base point O in the world frame (m).
     """
@@ -80,8 +83,16 @@ class BasePose:
                 f"{MAX_BASE_DISTANCE:g} m: in metres? (millimetres read as metres land here)",
             )
         error = float(np.abs(rotation @ rotation.T - np.eye(3)).max())
-        if error > ORTHONORMAL_TOLERANCE or np.linalg.det(rotation) < 0:
-            raise FieldError(BASE_POSE_KEY, "rotation must be orthonormal with determinant +1")
+        determinant = float(np.linalg.det(rotation))
+        if error > ORTHONORMAL_TOLERANCE or determinant < 0:
+            raise FieldError(
+                BASE_POSE_KEY,
+                "rotation must be orthonormal with determinant +1 (within 1 %, then made so):"
+                f" R R^T is up to {error:.3g} off the identity, determinant {determinant:.4g}",
+            )
+        # the nearest rotation (polar decomposition): a printed matrix's rounding taken off
+        left, _, right = np.linalg.svd(rotation)
+        rotation = left @ right
         rotation.setflags(write=False)
         position.setflags(write=False)
         object.__setattr__(self, "rotation", rotation)
