@@ -124,6 +124,7 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
         ("open mesh", "open.stl: the mesh is not closed (watertight)"),
         # a mesh in mm: --objects has no scale to give, unlike a scene
         ("mesh in mm", "a thousand times too large; --objects reads metres"),
+        ("out is a file", "out: a file, where --out names the map's directory"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(
@@ -140,6 +141,8 @@ def test_bad_input_is_one_line_exit_2(
         bad = tmp_path / "bad.csv"
         write_recording(read_recording(recordings[0]).with_metadata(base_pose="{"), bad)
         argv[1] = str(bad)
+    elif problem == "out is a file":
+        (tmp_path / "out").write_text("")
     elif problem == "mesh":
         mesh = tmp_path / "junk.stl"
         mesh.write_text("solid nothing here\nthis is not an stl\n")
