@@ -468,12 +468,30 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
         main(["explore", "post", "--out", str(out), "--budget", "2", "--method", "fast", *more])
         == 0
     )
-    text = capsys.readouterr().out
+    captured = capsys.readouterr()
+    assert f"{out} holds 2 stored manoeuvres: resuming after them" in captured.err
+    text = captured.out
     assert "3 manoeuvres (" in text and "; after the budget, aimed at recognition 1)" in text
     assert json.loads((out / "exploration.json").read_text())["aims"] == {
         "plan": 2,
         "recognition": 1,
     }
+
+
+def test_a_scene_out_of_the_link_s_reach_is_warned_of(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a ball 2 m from the base, beyond the 0.98 m link: every sweep is free, and said so first
+    scene = tmp_path / "far.toml"
+    scene.write_text('[[objects]]\nshape = "sphere"\nradius = 0.05\nposition = [2.0, 0, 0]\n')
+    out = tmp_path / "far"
+    assert main(["explore", str(scene), "--out", str(out), "--budget", "1", "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert (
+        "antenna explore: warning: no object lies within the link's reach (0.98 m) of a base"
+        " (the nearest 1.95 m away): every sweep will be free" in captured.err
+    )
+    assert "1 manoeuvres (free 1)" in captured.out
 
 
 def test_the_command_offers_the_librarys_strategies_scenes_and_devices() -> None:

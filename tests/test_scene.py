@@ -555,6 +555,23 @@ def test_an_open_mesh_is_refused(tmp_path: Path) -> None:
         load_scene(tmp_path / "s.toml")
 
 
+def test_a_base_inside_an_object_is_refused(tmp_path: Path) -> None:
+    # a ball's radius in cm (6 for 0.06 m) swallows the antenna: every sweep starts inside it
+    ball = '[[objects]]\nshape = "sphere"\nradius = 6\nposition = [0.6, 0.05, 0.04]\n'
+    (tmp_path / "s.toml").write_text(ball)
+    with pytest.raises(
+        SceneError,
+        match=r"objects\[0\]: the base point \[0\.0, 0\.0, 0\.0\] of bases\[0\] lies inside"
+        r" objects\[0\] \('object1'\): a size or position in another unit than m\?$",
+    ):
+        load_scene(tmp_path / "s.toml")
+    # a base of its own, 2 cm inside a box's face: named by the base
+    box = '[[objects]]\nshape = "box"\nextents = [0.2, 0.2, 0.2]\nposition = [0.6, 0, 0]\n'
+    (tmp_path / "s.toml").write_text(box + "[[bases]]\nposition = [0.52, 0, 0]\n")
+    with pytest.raises(SceneError, match=r"bases\[0\]\.position: the base point \[0\.52, "):
+        load_scene(tmp_path / "s.toml")
+
+
 def test_unknown_scene_names_the_builtins() -> None:
     with pytest.raises(SceneError, match="built-in scenes: post, sphere"):
         load_scene("nowhere-scene.toml")

@@ -116,6 +116,8 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.cli.map import OBJECTS_UNIT_HINT, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
+    from sensing_antenna.exploration.run import ExplorationInterrupted
+    from sensing_antenna.exploration.store import MANOEUVRES_DIR
     from sensing_antenna.scene import load_scene
     from sensing_antenna.scene.objects import read_mesh
 
@@ -164,6 +166,21 @@ def _run(args: argparse.Namespace) -> int:
         + ")",
         file=sys.stderr,
     )
+    nearest = min(float(scene.signed_distance(base.position)[0]) for base in scene.bases)
+    if nearest > device.link.length:
+        print(
+            f"antenna explore: warning: no object lies within the link's reach"
+            f" ({device.link.length:g} m) of a base (the nearest {nearest:.3g} m away): every"
+            " sweep will be free",
+            file=sys.stderr,
+        )
+    stored = len(list((args.out / MANOEUVRES_DIR).glob("*.json")))
+    if stored:
+        print(
+            f"{args.out} holds {stored} stored manoeuvres: resuming after them (a directory of"
+            " another exploration is refused)",
+            file=sys.stderr,
+        )
     result = explore(scene, device, args.out, settings, None if args.quiet else show, meshes)
     summary = result.summary()
     (args.out / "exploration.json").write_text(json.dumps(summary, indent=2) + "\n")
@@ -174,6 +191,10 @@ def _run(args: argparse.Namespace) -> int:
         + (f"; after the budget, aimed at {after}" if after else "")
         + f"), {summary['sweep_time_s']:.0f} s of sweeping"
     )
-    report_map(result.contact_map, args.out, scene.mesh)
+    try:
+        report_map(result.contact_map, args.out, scene.mesh)
+    except KeyboardInterrupt as exc:
+        number = int(getattr(exc, "signal_number", 2))
+        raise ExplorationInterrupted(number, len(result.manoeuvres), args.out) from None
     print(f"  {args.out / 'manoeuvres.csv'}\n  {args.out / 'scene.ply'}")
     return 0

@@ -657,12 +657,16 @@ def explore(
             raise ExplorationInterrupted(number, len(manoeuvres), out) from None
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
-    # the swept links are recognition's evidence only: the recognition that ended the sweeps
-    # has weighed them already
-    swept = () if final is not None else swept_links(manoeuvres, scene, antenna, out, recorded)
-    contact_map = build_map(
-        points, settings.include_uncertain, meshes=meshes, swept=swept, recognition=final
-    )
+    try:
+        # the swept links are recognition's evidence only: the recognition that ended the
+        # sweeps has weighed them already
+        swept = () if final is not None else swept_links(manoeuvres, scene, antenna, out, recorded)
+        contact_map = build_map(
+            points, settings.include_uncertain, meshes=meshes, swept=swept, recognition=final
+        )
+    except KeyboardInterrupt as exc:
+        number = int(getattr(exc, "signal_number", 2))
+        raise ExplorationInterrupted(number, len(manoeuvres), out) from None
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 
 

@@ -217,6 +217,17 @@ def _build(data: Mapping[str, Any], source: str, folder: Path | None) -> Scene:
     parsed = [_base(table, f"bases[{i}]", region, fail) for i, table in enumerate(base_tables)]
     bases = tuple(pose for pose, _ in parsed)
     base_regions = tuple(own for _, own in parsed)
+    for i, base in enumerate(bases):
+        for k, obj in enumerate(objects):
+            if float(obj.signed_distance(base.position.reshape(1, 3))[0]) < 0.0:
+                where = f"bases[{i}].position" if "bases" in data else f"objects[{k}]"
+                raise fail(
+                    where,
+                    f"the base point {format_value([float(x) for x in base.position])} of"
+                    f" bases[{i}] lies"
+                    f" inside objects[{k}] ({obj.name!r}): a size or position in another unit"
+                    " than m?",
+                )
     return Scene(name, objects, bases, region, source, base_regions)
 
 
