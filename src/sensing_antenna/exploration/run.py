@@ -474,7 +474,14 @@ def _prepared(device: Antenna, out: Path, settings: ExploreSettings) -> Antenna:
         device_profile=settings.device_profile,
         device_build=settings.device_build,
     )
-    prepared = replace(prepared, name=CALIBRATED_NAME)
+    prepared = replace(
+        prepared,
+        name=CALIBRATED_NAME,
+        description=(
+            f"{device.name} as the exploration's preparation identified and calibrated it on"
+            " the simulated device (its recordings in calibration/ beside this file)"
+        ),
+    )
     atomic_write_text(path, antenna_to_toml(prepared))
     return load_antenna(path)
 
