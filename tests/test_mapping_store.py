@@ -9,7 +9,7 @@ import trimesh
 
 from _contacts import NOISE, contacts, half_sphere
 from sensing_antenna.mapping import build_map, recognise, write_map
-from sensing_antenna.mapping.store import GREY
+from sensing_antenna.mapping.store import GREY, OVERDISPERSED, overdispersed
 
 #: The 99 % point of the chi distribution with 4 degrees of freedom (a sphere's parameters).
 CHI4_99 = 3.64
@@ -105,3 +105,21 @@ def test_no_object_surface_without_a_named_object(tmp_path: Path) -> None:
         (tmp_path / "report.md").read_text()
     )
     assert contact_map.summary()["object_surface"] is None
+
+
+def test_points_far_from_every_class_are_said_to_be(tmp_path: Path) -> None:
+    # a ball's points, a third of them shifted by 3 cm (a base pose wrong by that much): no class
+    # fits them within their deviations, and the report says so with how far off they lie
+    points = half_sphere(30, np.array([0.5, 0.0, 0.0]), 0.05)
+    points[::3] += [0.0, 0.03, 0.0]
+    contact_map = build_map(contacts(points))
+    assert contact_map.recognition is not None
+    c = contact_map.recognition.overdispersion
+    assert c > OVERDISPERSED
+    said = overdispersed(contact_map.recognition)
+    assert said.startswith(f"the points lie {np.sqrt(c):.1f} times farther from the best")
+    write_map(contact_map, tmp_path)
+    assert f"{said[:1].upper()}{said[1:]}." in (tmp_path / "report.md").read_text()
+    # the unshifted ball: nothing said
+    clean = build_map(contacts(half_sphere(30, np.array([0.5, 0.0, 0.0]), 0.05)))
+    assert clean.recognition is not None and overdispersed(clean.recognition) == ""

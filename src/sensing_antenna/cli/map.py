@@ -113,6 +113,7 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
     (``antenna map`` and ``antenna explore`` share it); ``truth``, the true surface's mesh when
     known, is drawn in the view."""
     from sensing_antenna.mapping import write_map
+    from sensing_antenna.mapping.store import overdispersed
     from sensing_antenna.mapping.view import write_map_html
     from sensing_antenna.plotting.mapping import plot_map
 
@@ -134,6 +135,8 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
         f"{summary['n_used']} of {summary['n_recordings']} points used ({statuses}); "
         f"surface faces {summary['surface_faces']}; object {decision}"
     )
+    if recognition is not None and overdispersed(recognition):
+        print(f"  {overdispersed(recognition)}")
     if summary["n_used"] == 0 and summary["statuses"].get("uncertain"):
         print(
             "  no estimate is ok: an antenna that is not calibrated answers uncertain (give "

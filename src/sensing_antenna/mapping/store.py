@@ -158,6 +158,24 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
     return written
 
 
+#: Overdispersion (the best class's reduced chi^2) beyond which the points are said to lie
+#: farther from every class than their covariances allow: 4, residuals twice their deviations
+#: (docs/mapping.md has what it was on right and on misplaced points).
+OVERDISPERSED = 4.0
+
+
+def overdispersed(recognition: Any) -> str:
+    """What an overdispersion beyond :data:`OVERDISPERSED` says, or ""."""
+    c = float(recognition.overdispersion)
+    if not c > OVERDISPERSED:
+        return ""
+    return (
+        f"the points lie {math.sqrt(c):.1f} times farther from the best-fitting class than"
+        " their deviations say: the object is none of the classes, or points are misplaced"
+        " (a base pose, a calibration)"
+    )
+
+
 def _object_mesh(surface: ObjectSurface) -> trimesh.Trimesh:
     """The named object's mesh, coloured by its deviation from 0 (blue) to where the evidence
     no longer holds it (red)."""
@@ -257,7 +275,11 @@ def report(contact_map: ContactMap) -> str:
                 else ""
             )
             + ".",
-            "",
+            *(
+                [f"{overdispersed(recognition)[:1].upper()}{overdispersed(recognition)[1:]}.", ""]
+                if overdispersed(recognition)
+                else [""]
+            ),
             "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md),"
             " each at most its outlier cap; the lines' and the swept links' own sums of squares,"
             " uncapped, are beside it.",
