@@ -121,6 +121,25 @@ def test_calibration_undoes_the_cross_talk_on_new_contacts(
         assert estimate(recording, corrected, "paper").status.value == "ok"
 
 
+def test_one_recording_with_its_torque_in_another_unit_is_left_out(
+    calibration_set: tuple[list, list[float]],  # type: ignore[type-arg]
+) -> None:
+    # tz in N dm among N m (ten times): no leak explains one contact's ratio ten times off while
+    # the others' fit within per cents; left out, named, the correction is the others'
+    recordings, truth = calibration_set
+    names = [f"c{i}.csv" for i in range(len(recordings))]
+    bad = list(recordings)
+    bad[2] = dataclasses.replace(recordings[2], torque=recordings[2].torque * [1.0, 1.0, 10.0])
+    fit = calibrate_sensor(bad, ANTENNA, truth, sources=names)
+    assert "c2.csv" not in fit.sources and len(fit.sources) == len(names) - 1
+    (note,) = [n for n in fit.notes if n.startswith("c2.csv: ")]
+    assert "times its known point with the correction fitted to the others" in note
+    assert fit.adopted == ("azimuthal", "vertical") and fit.ratio_rms_after < 0.05
+    others = [k for k in range(len(names)) if k != 2]
+    alone = calibrate_sensor([recordings[k] for k in others], ANTENNA, [truth[k] for k in others])
+    assert fit.correction == alone.correction
+
+
 def test_a_sensor_without_cross_talk_gets_no_correction() -> None:
     # Six contacts of one sweep direction on a sensor that does not leak, each with its own
     # noise: the ratio is 2 % off them (its noise at the default gentle push), and terms fitted

@@ -265,6 +265,27 @@ def calibrate_sensor(
         [residuals(fitted(terms, rows != i), terms, rows == i)[0] for i in range(len(holds))],
         dtype=float,
     )
+    worst = _gross_outlier(held_out)
+    if worst is not None:
+        # one recording no correction of the others' predicts: its loads, not the sensor's leak
+        name = kept[worst][1]
+        note = (
+            f"{name}: its torque/force ratio is {1.0 + held_out[worst]:.3g} times its known point"
+            " with the correction fitted to the others, which put theirs within"
+            f" {100 * float(np.nanmedian(np.abs(np.delete(held_out, worst)))):.2g} % (median):"
+            " loads on another scale than the others'?"
+        )
+        rest = [k for k, n in enumerate(names) if n != name]
+        try:
+            fit = calibrate_sensor(
+                [recordings[k] for k in rest],
+                antenna,
+                [contact_points[k] for k in rest],
+                sources=[names[k] for k in rest],
+            )
+        except SensorCalibrationError as exc:
+            raise SensorCalibrationError(f"{exc}; {note}") from None
+        return replace(fit, notes=(*notes, note, *fit.notes[len(notes) :]))
     # each sweep direction's terms are kept when they predict its holds left out of the fit
     # better than no correction
     direction = np.array([h.sweep for h in holds])
@@ -290,6 +311,24 @@ def calibrate_sensor(
         ratio_rms_held_out=_rms(held_out),
         adopted=adopted,
     )
+
+
+#: A recording whose held-out ratio error is beyond this (relative: its ratio twice its known
+#: point, or on the wrong side of the base) and ten times the others' median is one no leak
+#: explains (:func:`_gross_outlier`).
+GROSS_RATIO_ERROR = 1.0
+
+
+def _gross_outlier(held_out: FloatArray) -> int | None:
+    """The hold whose held-out relative ratio error is beyond :data:`GROSS_RATIO_ERROR` and ten
+    times the others' median, or None: a file whose loads are on another scale (a torque in
+    N cm among N m), which would otherwise pull the correction and its scatter."""
+    errors = np.abs(held_out)
+    if errors.size < 3 or not np.any(np.isfinite(errors)):
+        return None
+    worst = int(np.nanargmax(np.where(np.isfinite(errors), errors, -np.inf)))
+    others = float(np.nanmedian(np.delete(errors, worst)))
+    return worst if errors[worst] > max(GROSS_RATIO_ERROR, 10.0 * others) else None
 
 
 def _linear_start(
