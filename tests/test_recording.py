@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import gzip
+import re
 from pathlib import Path
 
 import numpy as np
@@ -460,6 +462,35 @@ def test_a_header_with_another_separator_says_which(
         + "\n"
     )
     with pytest.raises(RecordingError, match=f"one column separated by {called}"):
+        read_recording(path)
+
+
+def test_a_compressed_recording_is_named_as_such(tmp_path: Path) -> None:
+    # a lab's archive of logs, given as is: not "binary content" but what it is
+    path = tmp_path / "rec.csv"
+    write_recording(_recording(), path)
+    packed = tmp_path / "rec.csv.gz"
+    packed.write_bytes(gzip.compress(path.read_bytes()))
+    with pytest.raises(RecordingError, match=r"rec\.csv\.gz: a gzip-compressed file: not read"):
+        read_recording(packed)
+
+
+@pytest.mark.parametrize("written", ['"tz"', "TZ", "tz [N m]", "tz (Nm)"])
+def test_a_required_name_written_otherwise_is_named_with_what_was_found(
+    written: str, tmp_path: Path
+) -> None:
+    # a spreadsheet's quotes, a logger's capitals, a unit in the header: the column is there,
+    # written otherwise, and the error shows how
+    path = tmp_path / "header.csv"
+    write_recording(_recording(), path)
+    text = path.read_text().replace(",tz\n", f",{written}\n", 1)
+    path.write_text(text)
+    with pytest.raises(
+        RecordingError,
+        match=r"column 'tz': required column missing from header \(found "
+        + re.escape(repr(written))
+        + ": names are written bare and in lower case",
+    ):
         read_recording(path)
 
 

@@ -601,8 +601,23 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
         seen.add(name)
     for name in REQUIRED_COLUMNS:
         if name not in seen:
-            raise RecordingError(source, number, name, "required column missing from header")
+            raise RecordingError(
+                source, number, name, f"required column missing from header{_near(name, names)}"
+            )
     return names
+
+
+def _near(name: str, names: list[str]) -> str:
+    """ " (found 'T', ...: ...)" when a header name is ``name`` written otherwise (quoted, in
+    another case, with a unit), else "" """
+    for found in names:
+        bare = found.strip("\"' ").split("[")[0].split("(")[0].strip().lower()
+        if bare == name and found != name:
+            return (
+                f" (found {found!r}: names are written bare and in lower case, without quotes"
+                " or units; the units are the format's, docs/recording-format.md)"
+            )
+    return ""
 
 
 def _numeric_columns(
@@ -649,6 +664,14 @@ def _numeric_columns(
     return table[:, kept], [names[k] for k in kept]
 
 
+#: The first bytes of compressed files a lab might give for a recording, and what they are.
+_COMPRESSED = (
+    (b"\x1f\x8b", "a gzip-compressed file"),
+    (b"PK\x03\x04", "a zip archive"),
+    (b"\xfd7zXZ\x00", "an xz-compressed file"),
+)
+
+
 def _read_text(path: str | Path, source: str) -> str:
     """The file's text, read in chunks: refused at the first NUL byte, invalid UTF-8 or byte
     beyond :data:`MAX_FILE_BYTES` (a regular file above it before reading anything)."""
@@ -678,6 +701,12 @@ def _read_text(path: str | Path, source: str) -> str:
                         f" ({MAX_FILE_BYTES // 2**20} MiB) and not a regular file"
                         " (a stream or device that does not end?)",
                     )
+                if size == len(chunk):
+                    for magic, what in _COMPRESSED:
+                        if chunk.startswith(magic):
+                            raise RecordingError(
+                                source, None, None, f"{what}: not read, extract it first"
+                            )
                 nul = chunk.find(b"\0")
                 if nul >= 0:
                     line = newlines + chunk.count(b"\n", 0, nul) + 1
