@@ -34,7 +34,8 @@ def contact_evidence(recording: Recording, antenna: Antenna) -> Evidence | str:
     format's units (:func:`~.observer.units_problem`), or an estimate by the paper method that
     ends on one of :data:`INPUT_FAULTS` (samples missing in the hold, loads on another scale
     than the vibration, a record too short for the spectrum, no contact or push), named with
-    its reason."""
+    its reason. A record too short for an estimate still calibrates when it holds half the
+    spectrum window after t_1."""
     from sensing_antenna.calibration.observer import units_problem
     from sensing_antenna.estimation import conclude, gather
     from sensing_antenna.estimation.front.evidence import Evidence
@@ -44,6 +45,18 @@ def contact_evidence(recording: Recording, antenna: Antenna) -> Evidence | str:
         return problem
     gathered = gather(recording, antenna)
     estimate = conclude(gathered, "paper")
-    if estimate.status in INPUT_FAULTS or not isinstance(gathered, Evidence):
+    if not isinstance(gathered, Evidence) or (
+        estimate.status in INPUT_FAULTS and not _long_enough(gathered, estimate.status)
+    ):
         return f"an estimate would be {estimate.status.value} ({estimate.reason})"
     return gathered
+
+
+def _long_enough(evidence: Evidence, status: Status) -> bool:
+    """Whether a record an estimate calls too short still holds half the spectrum window after
+    t_1: omega_1 read over it is at most twice as coarse (a set recorded a few ms short of the
+    window calibrates as well)."""
+    if status is not Status.RECORDING_TOO_SHORT:
+        return False
+    have = float(evidence.t[evidence.end_index] - evidence.t[evidence.rest_index])
+    return have >= 0.5 * evidence.config.spectrum_window
