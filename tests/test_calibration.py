@@ -23,6 +23,7 @@ from sensing_antenna.calibration.frequency import (
     FrequencyCalibration,
     calibrate_t_e,
     fit_inverse_t,
+    points_on_link,
     read_contact_points,
 )
 
@@ -260,6 +261,24 @@ def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
     table.write_text("file,x_c\nc.csv,0.4\n", encoding="utf-8")
     with pytest.raises(CalibrationError, match=r"points\.csv: file: no row names any of the 2"):
         read_contact_points(paths, recordings, table)
+
+
+def test_points_table_as_a_spreadsheet_writes_it(tmp_path: Path) -> None:
+    # a space after each comma reads as without; semicolons (a European spreadsheet's) are
+    # named; points in cm are left out with the unit they are likely in
+    paths = [tmp_path / "a.csv", tmp_path / "b.csv"]
+    recordings = [_FakeRecording({}), _FakeRecording({})]
+    table = tmp_path / "points.csv"
+    table.write_text("file, x_c\na.csv, 0.4\nb.csv, 0.8\n", encoding="utf-8")
+    assert read_contact_points(paths, recordings, table) == [0.4, 0.8]
+    table.write_text("file;x_c\na.csv;0.4\nb.csv;0.8\n", encoding="utf-8")
+    with pytest.raises(CalibrationError, match=r"one column separated by semicolons"):
+        read_contact_points(paths, recordings, table)
+    link = paper_antenna().link
+    _, on_link, notes = points_on_link(np.array([40.0, 800.0]), link.length, ["a", "b"])
+    assert not on_link.any()
+    assert notes[0].endswith("is not on the link (0, 0.98] m (in cm?)")
+    assert notes[1].endswith("(in mm?)")
 
 
 def test_points_table_that_is_not_utf8_is_one_line(tmp_path: Path) -> None:

@@ -124,7 +124,7 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
         ("open mesh", "open.stl: the mesh is not closed (watertight)"),
         # a mesh in mm: --objects has no scale to give, unlike a scene
         ("mesh in mm", "a thousand times too large; --objects reads metres"),
-        ("out is a file", "out: a file, where --out names the map's directory"),
+        ("out is a file", "out: File exists (a file where a directory is to be made?)"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(

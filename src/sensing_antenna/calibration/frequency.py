@@ -652,9 +652,18 @@ def points_on_link(
             "true_xc metadata; or one that is not a number)"
             if math.isnan(x_c[i])
             else f"x_c = {float(x_c[i])!r} m is not on the link (0, {length:g}] m"
+            + _unit_hint(float(x_c[i]), length)
         )
         notes.append(f"{label}: {where}")
     return x_c, np.asarray(on_link, dtype=bool), notes
+
+
+def _unit_hint(x_c: float, length: float) -> str:
+    """ " (in cm?)" or " (in mm?)" when ``x_c`` (m) read in that unit lies on the link."""
+    for factor, unit in ((100.0, "cm"), (1000.0, "mm")):
+        if 0.0 < x_c / factor <= length:
+            return f" (in {unit}?)"
+    return ""
 
 
 def calibrate_from_recordings(
@@ -823,11 +832,21 @@ def _read_points_table(table: Path) -> list[_PointRow]:
     rows: list[_PointRow] = []
     try:
         with open(table, encoding="utf-8-sig", newline="") as handle:
-            reader = csv.DictReader(handle)
-            columns = reader.fieldnames or []
+            reader = csv.DictReader(handle, skipinitialspace=True)
+            columns = [name.strip() for name in reader.fieldnames or []]
+            reader.fieldnames = columns
             for column in ("file", "x_c"):
                 if column not in columns:
-                    raise CalibrationError(f"{table}: line 1: missing column {column!r}")
+                    separated = next(
+                        (
+                            f" (its header {columns[0]!r} is one column separated by {called};"
+                            " columns are separated by commas)"
+                            for separator, called in ((";", "semicolons"), ("\t", "tabs"))
+                            if len(columns) == 1 and separator in columns[0]
+                        ),
+                        "",
+                    )
+                    raise CalibrationError(f"{table}: line 1: missing column {column!r}{separated}")
             for record in reader:
                 rows.append(_point_row(table, reader.line_num, record))
     except UnicodeDecodeError as exc:

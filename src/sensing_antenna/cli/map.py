@@ -76,8 +76,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.scene.objects import read_mesh
 
     distinct_files(args.recordings)
-    if args.out.exists() and not args.out.is_dir():  # before every recording is estimated
-        raise SensingAntennaError(f"{args.out}: a file, where --out names the map's directory")
+    args.out.mkdir(parents=True, exist_ok=True)  # a file in its way: said before estimating
     meshes = {path.stem: read_mesh(path, unit_hint=OBJECTS_UNIT_HINT) for path in args.objects}
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources

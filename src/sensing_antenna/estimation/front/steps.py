@@ -82,10 +82,13 @@ def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig
     """
     nyquist = math.pi / sample_period
     if nyquist < cfg.min_nyquist_factor * band_top:
+        # stamps in ms read as s: a thousand times the period, which in s would do
+        in_ms = 1000.0 * nyquist >= cfg.min_nyquist_factor * band_top and sample_period >= 0.5
         return (
             f"sample period {sample_period:g} s: the Nyquist frequency {nyquist:.0f} rad/s is "
             f"below {cfg.min_nyquist_factor:g} times the top of the omega_1 band "
             f"({band_top:.0f} rad/s)"
+            + (" (time stamps in ms? the format's are in s)" if in_ms else "")
         )
     return None
 
