@@ -134,6 +134,20 @@ def test_forces_in_kgf_or_lbf_are_no_record_too_short(
             assert "torque/force ratio" in (result.reason or ""), (name, result.reason)
 
 
+def test_a_record_cut_before_the_ratio_s_first_mean_is_too_short(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # 0.1 s after t_1 the ratio's moving mean (0.2 s) has no value yet: a record too short,
+    # not a ratio off the link
+    t_1 = estimate(azimuthal, antenna).t_1
+    cut = samples_kept(azimuthal, azimuthal.t < t_1 + 0.1)
+    for name, result in all_methods(cut, antenna).items():
+        if name != "fast":
+            assert result.status is Status.RECORDING_TOO_SHORT, (name, result.reason)
+        reasons = " ".join([result.reason or "", *result.diagnostics.get("other_reasons", [])])
+        assert "off the" not in reasons, (name, reasons)
+
+
 def test_torques_in_newton_millimetres_give_a_status_not_a_traceback(
     azimuthal: Recording, antenna: Antenna
 ) -> None:

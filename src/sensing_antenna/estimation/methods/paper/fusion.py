@@ -197,7 +197,8 @@ def conclude(
         found.append((Status.BAD_INPUT, evidence.gap))
     length = evidence.antenna.link.length
     ratio_end = float(evidence.ratio_mean[e])
-    if evidence.converged_index is None and not 0.0 <= ratio_end <= _OFF_LINK * length:
+    off_link = math.isfinite(ratio_end) and not 0.0 <= ratio_end <= _OFF_LINK * length
+    if evidence.converged_index is None and off_link:
         # a ratio that reads off the link is not settling because it is no contact's: not a
         # record too short or a slip
         found.append(
