@@ -237,11 +237,19 @@ def write_settings(out: Path, settings: dict[str, Any]) -> None:
                 k for k in set(stored) | set(settings) if stored.get(k) != settings.get(k)
             )
             raise ExplorationStoreError(
-                f"{path}: {', '.join(changed)}: the manoeuvres stored here come from other"
-                " settings; run with the same ones to resume, or use another output directory"
+                f"{path}: {', '.join(_change(k, stored.get(k), settings.get(k)) for k in changed)}:"
+                " the manoeuvres stored here come from other settings; run with the same ones to"
+                " resume, or use another output directory"
             )
         return
     atomic_write_text(path, json.dumps(settings, indent=2, sort_keys=True) + "\n")
+
+
+def _change(key: str, stored: Any, given: Any) -> str:
+    """A setting that differs, with both values when they are short (a device file is not)."""
+    if max(len(json.dumps(stored)), len(json.dumps(given))) > 40:
+        return key
+    return f"{key} {json.dumps(stored)} stored, {json.dumps(given)} given"
 
 
 def write_manoeuvre(out: Path, manoeuvre: Manoeuvre) -> Path:
