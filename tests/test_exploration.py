@@ -358,10 +358,12 @@ def test_other_settings_in_the_same_directory_are_refused(
     explored: tuple[Path, list[Manoeuvre]],
 ) -> None:
     out, _ = explored
-    with pytest.raises(ExplorationStoreError, match=r'settings.json: method "paper" stored, "fast" given: '):
+    stored_paper = r'settings.json: method "paper" stored, "fast" given: '
+    with pytest.raises(ExplorationStoreError, match=stored_paper):
         explore(load_scene("post"), DEVICE, out, ExploreSettings(method="fast", budget=3))
     linear = ExploreSettings(method="paper", budget=3, link="linear")
-    with pytest.raises(ExplorationStoreError, match=r'settings.json: link "nonlinear" stored, "linear" given: '):
+    stored_nonlinear = r'settings.json: link "nonlinear" stored, "linear" given: '
+    with pytest.raises(ExplorationStoreError, match=stored_nonlinear):
         explore(load_scene("post"), DEVICE, out, linear)
 
 
@@ -856,7 +858,8 @@ def test_another_device_in_the_same_directory_is_refused(
 ) -> None:
     out, _ = realistic
     nominal = ExploreSettings(method="fast", budget=3, link="linear")
-    with pytest.raises(ExplorationStoreError, match=r'settings.json: device_build 2021 stored, null given, device_profile'):
+    stored_build = r"settings.json: device_build 2021 stored, null given, device_profile"
+    with pytest.raises(ExplorationStoreError, match=stored_build):
         explore(load_scene("post"), DEVICE, out, nominal)
     with pytest.raises(ValueError, match="device_profile must be one of nominal, realistic"):
         ExploreSettings(device_profile="worn")

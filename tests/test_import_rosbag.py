@@ -318,36 +318,54 @@ def test_unset_header_stamps_are_refused_unless_the_bag_s_times_are_asked_for(
     _assert_same_samples(read_rosbag(bag, WRENCH, JOINTS, stamps="bag").recording, recording)
 
 
+@pytest.mark.parametrize("ros", [1, 2])
 @pytest.mark.parametrize("back_ms", [6, 20])
 def test_a_joint_clock_set_back_while_recording_is_refused_and_the_bag_s_times_hold(
-    back_ms: int, recording: Recording, tmp_path: Path
+    back_ms: int, ros: int, recording: Recording, tmp_path: Path
 ) -> None:
     # the joints' publisher's clock set back half-way (an NTP step) while the recorder's holds:
     # sorted by header stamp, the angles after the step would sit back_ms early (the step times
-    # the head's speed), every answer still `ok`; the first stamp after the step
-    # lies a period less than back_ms below the one received before it
-    received = EPOCH_NS + np.rint(recording.t * 1e9).astype(np.int64)
-    stamped = received.copy()
+    # the head's speed); the first stamp after the step lies a period less than back_ms below
+    # the one recorded before it, and the latency after it is back_ms longer
+    recorded = EPOCH_NS + np.rint(recording.t * 1e9).astype(np.int64)
+    stamped = recorded.copy()
     half = recording.n_samples // 2
     stamped[half:] -= back_ms * 1_000_000
     bag = _write_bag(
-        _bag_path(tmp_path, 2), recording, 2, joints_ns=received, joints_header_ns=stamped
+        _bag_path(tmp_path, ros), recording, ros, joints_ns=recorded, joints_header_ns=stamped
     )
     with pytest.raises(
         ImporterError,
         match=rf"topic '{JOINTS}': message {half}'s header stamp is {(back_ms - 1) / 1000:g} s"
-        r" before one the bag received earlier \(.* s after the topic's first\): its publisher's"
-        r" clock was set back while recording; the bag's record times may hold \(--stamps bag\)$",
+        r" before one recorded before it \(.* s after the topic's first\), and the latency after"
+        rf" it {back_ms / 1000:g} s longer: its publisher's clock was set back while recording;"
+        r" the bag's record times may hold \(--stamps bag\)$",
     ):
         read_rosbag(bag, WRENCH, JOINTS)
     _assert_same_samples(read_rosbag(bag, WRENCH, JOINTS, stamps="bag").recording, recording)
 
 
+@pytest.mark.parametrize("ros", [1, 2])
+def test_a_recorder_clock_set_back_leaves_good_header_stamps_alone(
+    ros: int, recording: Recording, tmp_path: Path
+) -> None:
+    # the recorder's clock steps back 20 ms half-way while the driver's stamps hold: the bag
+    # gives the joints in the order of its stepped record times, so a header stamp comes after
+    # a later one, but the latency falls instead of rising, and the header stamps are right
+    stamped = EPOCH_NS + np.rint(recording.t * 1e9).astype(np.int64)
+    recorded = stamped.copy()
+    recorded[recording.n_samples // 2 :] -= 20_000_000
+    bag = _write_bag(
+        _bag_path(tmp_path, ros), recording, ros, joints_ns=recorded, joints_header_ns=stamped
+    )
+    _assert_same_samples(read_rosbag(bag, WRENCH, JOINTS).recording, recording)
+
+
 def test_header_stamps_jittered_out_of_the_order_received_are_no_clock_set_back(
     recording: Recording, tmp_path: Path
 ) -> None:
-    # a driver stamping each message within +-2 ms of its instant, received in order: stamps
-    # up to 4 ms out of the order received are jitter, not a clock set back
+    # a driver stamping each message within +-2 ms of its instant, recorded in order: stamps
+    # up to 4 ms out of the order recorded are jitter, not a clock set back
     received = EPOCH_NS + np.rint(recording.t * 1e9).astype(np.int64)
     rng = np.random.default_rng(5)
     stamped = received + rng.integers(-2_000_000, 2_000_001, size=received.shape[0])

@@ -48,8 +48,10 @@ JOINTS_TYPE = "sensor_msgs/msg/JointState"
 INSTALL_HINT = "pip install 'sensing-antenna[ros]'"
 
 _NS = 10**9
-#: A header stamp this far (ns) below one the bag received before it is a clock set back.
+#: A header stamp this far (ns) below one recorded before it is a clock stepped back.
 STEP_BACK_NS = 5_000_000
+#: Messages either side of such a stamp whose median latencies say which clock stepped.
+_LATENCY_WINDOW = 31
 _ROS1_MAGIC = b"#ROSBAG V2.0"
 
 
@@ -164,7 +166,13 @@ def _check_topic(topics: Mapping[str, Any], topic: str, expected: str, source: s
 
 
 def _sorted(
-    source: str, topic: str, kind: str, stamps: list[int], values: list[Any], stamp_kind: str
+    source: str,
+    topic: str,
+    kind: str,
+    stamps: list[int],
+    values: list[Any],
+    stamp_kind: str,
+    received: list[int],
 ) -> tuple[Stream, LeftOut]:
     stamp_array = np.array(stamps, dtype=np.int64)
     if stamp_kind == "header" and np.any(stamp_array == 0):
@@ -173,7 +181,9 @@ def _sorted(
             f"{source}: topic {topic!r}: message {k} has no header stamp (0); use the bag's"
             " record times (--stamps bag)"
         )
-    _check_received_in_order(source, topic, stamp_array, stamp_kind)
+    _check_publisher_clock(
+        source, topic, stamp_array, np.array(received, dtype=np.int64), stamp_kind
+    )
     value_array = np.array(values, dtype=np.float64).reshape(len(values), -1)
     order = np.argsort(stamp_array, kind="stable")
     stamp_array, value_array = stamp_array[order], value_array[order]
@@ -193,22 +203,36 @@ def _sorted(
     return stream, left_out
 
 
-def _check_received_in_order(source: str, topic: str, stamps: np.ndarray, stamp_kind: str) -> None:
-    """Refuse a topic whose header stamps, in the order the bag received the messages, fall
-    :data:`STEP_BACK_NS` or more below an earlier message's: one publisher's messages arrive in
-    the order it sent them, so that is its clock set back while recording (sorted, the
-    stretches before and after would interleave, each sample up to the step off its instant)."""
+def _check_publisher_clock(
+    source: str, topic: str, stamps: np.ndarray, received: np.ndarray, stamp_kind: str
+) -> None:
+    """Refuse a topic whose publisher's clock was set back while recording.
+
+    The reader gives a topic's messages in the order of the bag's record times. A header stamp
+    :data:`STEP_BACK_NS` or more below an earlier message's is a clock stepped back, the
+    publisher's or the recorder's; the latency, record time less header stamp, tells which: it
+    rises for good by the step when the publisher's clock went back (its stamps, sorted, would
+    interleave two stretches, each sample up to the step off its instant), and falls when the
+    recorder's did (the header stamps hold, only the order was the recorder's)."""
     if stamp_kind != "header" or stamps.shape[0] < 2:
         return
     behind = np.maximum.accumulate(stamps)[:-1] - stamps[1:]
-    k = int(np.argmax(behind))
-    if behind[k] >= STEP_BACK_NS:
-        after = int(stamps[k + 1] - stamps[0]) / _NS
+    k = int(np.argmax(behind >= STEP_BACK_NS))
+    if not behind[k] >= STEP_BACK_NS:
+        return
+    latency = received - stamps
+    step = k + 1
+    width = _LATENCY_WINDOW
+    before = float(np.median(latency[max(0, step - width) : step]))
+    after = float(np.median(latency[step : step + width]))
+    if after - before >= 0.5 * float(behind[k]):
+        since = int(stamps[step] - stamps[0]) / _NS
         raise ImporterError(
-            f"{source}: topic {topic!r}: message {k + 1}'s header stamp is"
-            f" {behind[k] / _NS:.3g} s before one the bag received earlier ({after:.4g} s after"
-            " the topic's first): its publisher's clock was set back while recording; the bag's"
-            " record times may hold (--stamps bag)"
+            f"{source}: topic {topic!r}: message {step}'s header stamp is"
+            f" {behind[k] / _NS:.3g} s before one recorded before it ({since:.4g} s after the"
+            f" topic's first), and the latency after it {(after - before) / _NS:.3g} s longer:"
+            " its publisher's clock was set back while recording; the bag's record times may"
+            " hold (--stamps bag)"
         )
 
 
@@ -224,15 +248,18 @@ def _read_streams(
     wrench_info = _check_topic(topics, wrench_topic, WRENCH_TYPE, source)
     joints_info = _check_topic(topics, joints_topic, JOINTS_TYPE, source)
     wrench_stamps: list[int] = []
+    wrench_received: list[int] = []
     wrench_values: list[tuple[float, ...]] = []
     for connection, bag_time, raw in reader.messages(connections=wrench_info.connections):
         message = reader.deserialize(raw, connection.msgtype)
         force, torque = message.wrench.force, message.wrench.torque
         wrench_stamps.append(_stamp(message, bag_time, stamps))
+        wrench_received.append(int(bag_time))
         wrench_values.append((force.x, force.y, force.z, torque.x, torque.y, torque.z))
     names: tuple[str, str] | None = None
     indices: dict[tuple[str, ...], tuple[int, int] | None] = {}
     joint_stamps: list[int] = []
+    joint_received: list[int] = []
     joint_values: list[tuple[float, float]] = []
     for number, (connection, bag_time, raw) in enumerate(
         reader.messages(connections=joints_info.connections)
@@ -257,6 +284,7 @@ def _read_streams(
                 f" names and {len(position)} positions"
             )
         joint_stamps.append(_stamp(message, bag_time, stamps))
+        joint_received.append(int(bag_time))
         joint_values.append((float(position[pair[0]]), float(position[pair[1]])))
     assert names is not None  # the topic has at least two messages
     if len(joint_stamps) < 2:
@@ -267,8 +295,12 @@ def _read_streams(
             f" {names[0]!r} and {names[1]!r}, at least 2 needed (the topic's joints: {listed})"
         )
     skipped = joints_info.msgcount - len(joint_stamps)
-    wrench = _sorted(source, wrench_topic, WRENCH_TYPE, wrench_stamps, wrench_values, stamps)
-    joints = _sorted(source, joints_topic, JOINTS_TYPE, joint_stamps, joint_values, stamps)
+    wrench = _sorted(
+        source, wrench_topic, WRENCH_TYPE, wrench_stamps, wrench_values, stamps, wrench_received
+    )
+    joints = _sorted(
+        source, joints_topic, JOINTS_TYPE, joint_stamps, joint_values, stamps, joint_received
+    )
     return wrench, joints, names, skipped
 
 
