@@ -237,6 +237,21 @@ def test_execute_safely_turns_an_exception_into_a_failed_result() -> None:
     assert result.methods == spec_run.methods
 
 
+def test_ctrl_c_inside_compiled_code_is_an_interruption_not_a_failed_run() -> None:
+    # numba raises a SystemError from the KeyboardInterrupt that stopped it: the campaign
+    # stops as on any Ctrl-C, the run not recorded as failed
+    spec_run = expand_runs(small_spec(), paper_antenna())[0]
+
+    def interrupted(run: RunSpec) -> RunResult:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise SystemError("CPUDispatcher returned a result with an exception set") from exc
+
+    with pytest.raises(KeyboardInterrupt):
+        execute_safely(interrupted, spec_run)
+
+
 def test_a_result_without_a_row_per_method_is_a_failed_run() -> None:
     spec_run = expand_runs(small_spec(), paper_antenna())[0]
 

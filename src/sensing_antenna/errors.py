@@ -41,6 +41,21 @@ def raise_if_signalled() -> None:
         raise Terminated(number)
 
 
+def interruption_of(exc: BaseException) -> KeyboardInterrupt | None:
+    """The interruption (Ctrl-C, or a stop signal's :class:`Terminated`) ``exc`` is or was
+    raised from or while handling, or None. A compiled function (numba's) interrupted inside
+    raises a ``SystemError`` from the ``KeyboardInterrupt``: callers that catch errors by kind
+    ask here before they take it for a failure."""
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen:
+        if isinstance(cause, KeyboardInterrupt):
+            return cause
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    return None
+
+
 class SensingAntennaError(Exception):
     """Base class for errors caused by input: files, fields, arguments."""
 

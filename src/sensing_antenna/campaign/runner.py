@@ -48,6 +48,7 @@ from sensing_antenna.campaign.worker_threads import limit_to_one_blas_thread
 from sensing_antenna.errors import (
     SensingAntennaError,
     forget_signals,
+    interruption_of,
     note_signal,
     raise_if_signalled,
 )
@@ -197,6 +198,9 @@ def execute_safely(run_one: RunFunction, run: RunSpec) -> RunResult:
     try:
         result = run_one(run)
     except Exception as exc:  # a failing run is recorded and must not stop the others
+        interrupt = interruption_of(exc)  # Ctrl-C inside compiled code: no failure of the run
+        if interrupt is not None:
+            raise interrupt from None
         return RunResult.failed(run, f"{type(exc).__name__}: {exc}", traceback.format_exc())
     if result.run_id != run.run_id:
         return RunResult.failed(

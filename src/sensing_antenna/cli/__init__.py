@@ -45,6 +45,7 @@ from sensing_antenna.errors import (
     SensingAntennaError,
     Terminated,
     forget_signals,
+    interruption_of,
     note_signal,
     raise_if_signalled,
 )
@@ -213,7 +214,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return EXIT_BAD_INPUT
             except SystemError as exc:
                 # a compiled function (numba's) turns an interruption inside it into this
-                interrupt = _interruption(exc)
+                interrupt = interruption_of(exc)
                 if interrupt is None:
                     raise
                 raise interrupt from None
@@ -250,19 +251,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError as exc:
         _say(f"{prog}: error: not enough memory" + (f" ({exc})" if str(exc) else ""))
         return EXIT_BAD_INPUT
-
-
-def _interruption(exc: BaseException) -> KeyboardInterrupt | None:
-    """The interruption (Ctrl-C, or a stop signal's :class:`Terminated`) that ``exc`` was
-    raised from or while handling, or None."""
-    seen: set[int] = set()
-    cause: BaseException | None = exc
-    while cause is not None and id(cause) not in seen:
-        if isinstance(cause, KeyboardInterrupt):
-            return cause
-        seen.add(id(cause))
-        cause = cause.__cause__ or cause.__context__
-    return None
 
 
 def _named_by_flag(exc: SensingAntennaError, flags: Mapping[str, str]) -> str:

@@ -56,7 +56,7 @@ from sensing_antenna.campaign.runs import CALIBRATION_STREAM, FREE_MOTION_STREAM
 from sensing_antenna.campaign.schema import DEFAULT_CALIBRATION_POINTS
 from sensing_antenna.campaign.simulated import knowing_weight
 from sensing_antenna.campaign.store import atomic_write_text
-from sensing_antenna.errors import raise_if_signalled
+from sensing_antenna.errors import interruption_of, raise_if_signalled
 from sensing_antenna.exploration.plan import (
     PREDICTION_STEP,
     STRATEGIES,
@@ -658,9 +658,12 @@ def explore(
                 if progress is not None:
                     progress(manoeuvre, end + settings.until_recognised)
                 raise_if_signalled()
-        except KeyboardInterrupt as exc:
+        except (KeyboardInterrupt, SystemError) as exc:
+            interrupt = interruption_of(exc)  # a SystemError from compiled code interrupted
+            if interrupt is None:
+                raise
             write_manoeuvre_table(out, manoeuvres)
-            number = int(getattr(exc, "signal_number", 2))
+            number = int(getattr(interrupt, "signal_number", 2))
             raise ExplorationInterrupted(number, len(manoeuvres), out) from None
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
@@ -671,8 +674,11 @@ def explore(
         contact_map = build_map(
             points, settings.include_uncertain, meshes=meshes, swept=swept, recognition=final
         )
-    except KeyboardInterrupt as exc:
-        number = int(getattr(exc, "signal_number", 2))
+    except (KeyboardInterrupt, SystemError) as exc:
+        interrupt = interruption_of(exc)
+        if interrupt is None:
+            raise
+        number = int(getattr(interrupt, "signal_number", 2))
         raise ExplorationInterrupted(number, len(manoeuvres), out) from None
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 
