@@ -101,7 +101,7 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
     # antenna, uses no point: a file of the old map beside the new report would contradict it
     out = tmp_path / "map"
     out.mkdir()
-    for name in ("points.ply", "surface.ply", "object.ply", "map.html"):
+    for name in ("points.ply", "surface.ply", "object.ply", "map.html", "recognition.json"):
         (out / name).write_text("a previous map's\n")
     assert main(["map", *map(str, recordings), "--out", str(out), "--no-progress"]) == 0
     assert "0 of 3 points used" in capsys.readouterr().out
@@ -111,6 +111,12 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
         "recognition.json",
         "report.md",
     ]
+    # a directory of the user's own, holding no map: their files are theirs
+    own = tmp_path / "scans"
+    own.mkdir()
+    (own / "object.ply").write_text("a scan of the object\n")
+    assert main(["map", *map(str, recordings), "--out", str(own), "--no-progress"]) == 0
+    assert (own / "object.ply").read_text() == "a scan of the object\n"
 
 
 @pytest.mark.parametrize(
@@ -119,9 +125,6 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
         ("missing", "absent.csv: cannot read file"),
         ("pose", "base_pose: not JSON"),
         ("mesh", "junk.stl: "),
-        # a box without its lid, registered, fits its points worse than the closed box and
-        # was ruled out without a word; a scene refuses it
-        ("open mesh", "open.stl: the mesh is not closed (watertight)"),
         # a mesh in mm: --objects has no scale to give, unlike a scene
         ("mesh in mm", "a thousand times too large; --objects reads metres"),
         ("out is a file", "out: File exists (a file where a directory is to be made?)"),
@@ -149,18 +152,29 @@ def test_bad_input_is_one_line_exit_2(
         argv += ["--objects", str(mesh)]
     else:
         box = trimesh.creation.box(extents=[0.06, 0.1, 0.14])
-        if problem == "open mesh":
-            lid = box.face_normals[:, 2] > 0.5
-            box = trimesh.Trimesh(box.vertices, box.faces[~lid])
-        else:
-            box.apply_scale(1000.0)
-        mesh = tmp_path / "open.stl"
+        box.apply_scale(1000.0)
+        mesh = tmp_path / "box_mm.stl"
         box.export(mesh)
         argv += ["--objects", str(mesh)]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("antenna map: error: ") and words in err, err
     assert "\n" not in err
+
+
+def test_an_open_mesh_is_registered_with_a_warning(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a box without its lid (a scan open where it stood): registered, but points on the missing
+    # face count against it, which the user is told
+    box = trimesh.creation.box(extents=[0.06, 0.1, 0.14])
+    lid = box.face_normals[:, 2] > 0.5
+    mesh = tmp_path / "open.stl"
+    trimesh.Trimesh(box.vertices, box.faces[~lid]).export(mesh)
+    argv = ["map", str(recordings[0]), "--out", str(tmp_path / "out"), "--no-progress"]
+    assert main([*argv, "--objects", str(mesh)]) == 0
+    err = capsys.readouterr().err
+    assert f"antenna map: warning: {mesh}: the mesh is not closed (watertight): points on" in err
 
 
 def test_a_bad_recording_among_good_ones_is_left_out_in_one_line(

@@ -114,12 +114,11 @@ def register(subparsers: Any) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
-    from sensing_antenna.cli.map import OBJECTS_UNIT_HINT, report_map
+    from sensing_antenna.cli.map import read_objects, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
     from sensing_antenna.exploration.run import ExplorationInterrupted
     from sensing_antenna.exploration.store import MANOEUVRES_DIR
     from sensing_antenna.scene import load_scene
-    from sensing_antenna.scene.objects import read_mesh
 
     if args.device_profile == "nominal" and args.device_build is not None:
         raise ArgumentError(
@@ -132,7 +131,7 @@ def _run(args: argparse.Namespace) -> int:
         )
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)
-    meshes = {path.stem: read_mesh(path, unit_hint=OBJECTS_UNIT_HINT) for path in args.objects}
+    meshes = read_objects(args.objects, "antenna explore")
     settings = ExploreSettings(
         method=args.method,
         strategy=args.strategy,

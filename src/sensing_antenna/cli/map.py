@@ -50,6 +50,24 @@ def register(subparsers: Any) -> None:
 OBJECTS_UNIT_HINT = "--objects reads metres: write the file in metres"
 
 
+def read_objects(paths: Any, command: str) -> dict[str, Any]:
+    """The ``--objects`` meshes by file stem; one that is not closed is read with a warning on
+    stderr (a scan open where it stood: points on its missing faces count against it)."""
+    from sensing_antenna.scene.objects import read_mesh
+
+    meshes = {}
+    for path in paths:
+        mesh = read_mesh(path, unit_hint=OBJECTS_UNIT_HINT, closed=False)
+        if not mesh.is_watertight:
+            print(
+                f"{command}: warning: {path}: the mesh is not closed (watertight): points on"
+                " its missing faces count against it (trimesh's fill_holes may close it)",
+                file=sys.stderr,
+            )
+        meshes[path.stem] = mesh
+    return meshes
+
+
 def add_map_options(parser: Any, uncertain_into: str) -> None:
     """``--objects`` and ``--include-uncertain``, shared with ``antenna explore``."""
     parser.add_argument(
@@ -58,7 +76,8 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
         type=Path,
         default=(),
         metavar="MESH",
-        help="closed meshes (STL, OBJ, PLY; m) to register to the points beside the shape classes",
+        help="meshes (STL, OBJ, PLY; m; closed, else a warning) to register to the points "
+        "beside the shape classes",
     )
     parser.add_argument(
         "--include-uncertain",
@@ -73,11 +92,10 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.mapping import build_map, map_inputs_from_recordings
-    from sensing_antenna.scene.objects import read_mesh
 
     distinct_files(args.recordings)
     args.out.mkdir(parents=True, exist_ok=True)  # a file in its way: said before estimating
-    meshes = {path.stem: read_mesh(path, unit_hint=OBJECTS_UNIT_HINT) for path in args.objects}
+    meshes = read_objects(args.objects, "antenna map")
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     with Progress(not args.no_progress).bar(

@@ -86,8 +86,9 @@ def _number(value: float) -> str:
     return "" if not math.isfinite(value) else f"{value:.9g}"
 
 
-#: A map's files written only when it holds what they show: a previous map's in the same
-#: directory are removed first, so that none contradicts the new report.
+#: A map's files written only when it holds what they show: in a previous map's directory
+#: (one with its recognition.json) they are removed first, so that none contradicts the new
+#: report.
 SOMETIMES_WRITTEN = ("points.ply", "surface.ply", "object.ply", "map.html")
 
 
@@ -95,8 +96,9 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
     """Write the map's files into ``out`` (created), after removing those of
     :data:`SOMETIMES_WRITTEN` a previous map left there; returns the paths written."""
     out.mkdir(parents=True, exist_ok=True)
-    for name in SOMETIMES_WRITTEN:
-        (out / name).unlink(missing_ok=True)
+    if (out / "recognition.json").is_file():
+        for name in SOMETIMES_WRITTEN:
+            (out / name).unlink(missing_ok=True)
     written = []
     used = {id(p) for p in contact_map.used}
     path = out / "points.csv"

@@ -61,7 +61,7 @@ def mesh_problem(
     """Why a user's mesh, its coordinates times ``scale`` in m, cannot be an object, or None:
     vertices that are not finite, a largest extent beyond :data:`MAX_MESH_EXTENT` or below
     :data:`MIN_OBJECT_SIZE` (the message ends with ``unit_hint``, how to read it in other
-    units), or a surface that is not closed."""
+    units)."""
     vertices = np.asarray(mesh.vertices, dtype=float)
     if not np.all(np.isfinite(vertices)):
         return "vertices that are not finite numbers"
@@ -73,18 +73,23 @@ def mesh_problem(
             f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
             f"(a mesh in millimetres reads a thousand times too large; {unit_hint})"
         )
-    if not mesh.is_watertight:
-        return (
-            "the mesh is not closed (watertight), so its inside is undefined (trimesh's "
-            "fill_holes may close it)"
-        )
     return None
 
 
-def read_mesh(path: Path, scale: float = 1.0, unit_hint: str = SCENE_SCALE_HINT) -> trimesh.Trimesh:
+#: Why a mesh that is not closed cannot be a scene's object.
+NOT_CLOSED = (
+    "the mesh is not closed (watertight), so its inside is undefined (trimesh's fill_holes may"
+    " close it)"
+)
+
+
+def read_mesh(
+    path: Path, scale: float = 1.0, unit_hint: str = SCENE_SCALE_HINT, closed: bool = True
+) -> trimesh.Trimesh:
     """The triangles of a user's mesh file (STL, OBJ, PLY; coordinates times ``scale`` in m),
     as trimesh reads them (not scaled); SensingAntennaError naming the file and the problem
-    when it is missing, unreadable, empty or fails :func:`mesh_problem` (``unit_hint``)."""
+    when it is missing, unreadable, empty, fails :func:`mesh_problem` (``unit_hint``) or, with
+    ``closed``, is not closed (:data:`NOT_CLOSED`)."""
     if not path.is_file():
         raise SensingAntennaError(
             f"{path}: {'a directory, not a mesh file' if path.is_dir() else 'no such mesh file'}"
@@ -96,6 +101,8 @@ def read_mesh(path: Path, scale: float = 1.0, unit_hint: str = SCENE_SCALE_HINT)
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise SensingAntennaError(f"{path}: the file holds no triangles")
     problem = mesh_problem(mesh, scale, unit_hint)
+    if problem is None and closed and not mesh.is_watertight:
+        problem = NOT_CLOSED
     if problem is not None:
         at = "" if scale == 1.0 else f" at scale {scale:g}"
         raise SensingAntennaError(f"{path}{at}: {problem}")
