@@ -61,8 +61,8 @@ def test_every_method_and_summary(
 def test_a_ratio_no_link_has_prints_to_four_digits(
     recording_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # the torque about Z^m in N cm: the ratio reads 10^19 m, which printed to the millimetre
-    # filled a line with digits of noise
+    # the torque about Z^m in N cm: the ratio reads 10^19 m, printed to four digits (to the
+    # millimetre it would fill a line with digits of noise)
     recording = read_recording(recording_file)
     scaled = tmp_path / "scaled.csv"
     torque = recording.torque * [1.0, 1.0, 100.0]

@@ -211,7 +211,7 @@ def test_a_quaternion_printed_to_three_decimals_is_normalised() -> None:
 
 def test_a_rotation_printed_to_three_decimals_is_made_orthonormal() -> None:
     # the same turn as a matrix printed to three decimals, as a robot's log prints it: R R^T is
-    # off the identity by 5e-4 (refused before, at 1e-4); the nearest rotation is taken
+    # off the identity by 5e-4; the nearest rotation is taken
     rows = [[0.866, -0.5, 0.0], [0.5, 0.866, 0.0], [0.0, 0.0, 1.0]]
     pose = base_pose_from_metadata(
         {"base_pose": json.dumps({"position": [0, 0, 0], "rotation": rows})}

@@ -667,7 +667,7 @@ def _numeric_columns(
 #: The first bytes of compressed files a lab might give for a recording, and what they are.
 _COMPRESSED = (
     (b"\x1f\x8b", "a gzip-compressed file"),
-    (b"PK\x03\x04", "a zip archive"),
+    (b"PK\x03\x04", "a zip archive (a spreadsheet's .xlsx is one: save it as CSV)"),
     (b"\xfd7zXZ\x00", "an xz-compressed file"),
 )
 

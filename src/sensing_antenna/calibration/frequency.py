@@ -659,9 +659,10 @@ def points_on_link(
 
 
 def _unit_hint(x_c: float, length: float) -> str:
-    """ " (in cm?)" or " (in mm?)" when ``x_c`` (m) read in that unit lies on the link."""
+    """The hint " (in cm?)" or " (in mm?)" when ``x_c`` (m) read in that unit lies where
+    contacts are estimated on the link (from a fifth of its length to its tip), else ""."""
     for factor, unit in ((100.0, "cm"), (1000.0, "mm")):
-        if 0.0 < x_c / factor <= length:
+        if 0.2 * length <= x_c / factor <= length:
             return f" (in {unit}?)"
     return ""
 

@@ -185,7 +185,10 @@ def calibrate_sensor(
     )
     holds: list[_Hold] = []
     used: list[str] = []
-    for name, recording, x_c, on in zip(names, recordings, points_in, on_link, strict=True):
+    indices: list[int] = []  # of the recordings given, for each hold
+    for position, (name, recording, x_c, on) in enumerate(
+        zip(names, recordings, points_in, on_link, strict=True)
+    ):
         if not on:
             continue  # named in the notes
         hold = _hold(recording, plain, float(x_c))
@@ -194,6 +197,7 @@ def calibrate_sensor(
         else:
             holds.append(hold)
             used.append(name)
+            indices.append(position)
     sweeps = tuple(
         s for s in _PLANE_TERMS if sum(h.sweep == s for h in holds) >= MIN_SENSOR_RECORDINGS
     )
@@ -204,6 +208,7 @@ def calibrate_sensor(
             + (f" ({'; '.join(notes)})" if notes else "")
         )
     kept = [(h, n) for h, n in zip(holds, used, strict=True) if h.sweep in sweeps]
+    kept_at = [i for h, i in zip(holds, indices, strict=True) if h.sweep in sweeps]
     holds = [h for h, _ in kept]
     terms = _terms(sweeps)
     rigidity = 1.0 / antenna.link.bending_compliance
@@ -275,7 +280,7 @@ def calibrate_sensor(
             f" {100 * float(np.nanmedian(np.abs(np.delete(held_out, worst)))):.2g} % (median):"
             " loads on another scale than the others'?"
         )
-        rest = [k for k, n in enumerate(names) if n != name]
+        rest = [k for k in range(len(recordings)) if k != kept_at[worst]]
         try:
             fit = calibrate_sensor(
                 [recordings[k] for k in rest],
@@ -322,7 +327,7 @@ GROSS_RATIO_ERROR = 1.0
 def _gross_outlier(held_out: FloatArray) -> int | None:
     """The hold whose held-out relative ratio error is beyond :data:`GROSS_RATIO_ERROR` and ten
     times the others' median, or None: a file whose loads are on another scale (a torque in
-    N cm among N m), which would otherwise pull the correction and its scatter."""
+    N dm among N m), which would otherwise pull the correction and its scatter."""
     errors = np.abs(held_out)
     if errors.size < 3 or not np.any(np.isfinite(errors)):
         return None

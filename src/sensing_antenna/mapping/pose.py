@@ -87,7 +87,8 @@ class BasePose:
         if error > ORTHONORMAL_TOLERANCE or determinant < 0:
             raise FieldError(
                 BASE_POSE_KEY,
-                "rotation must be orthonormal with determinant +1 (within 1 %, then made so):"
+                "rotation must be orthonormal with determinant +1 (within"
+                f" {ORTHONORMAL_TOLERANCE:g}, then made so):"
                 f" R R^T is up to {error:.3g} off the identity, determinant {determinant:.4g}",
             )
         # the nearest rotation (polar decomposition): a printed matrix's rounding taken off

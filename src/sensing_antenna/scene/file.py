@@ -220,13 +220,17 @@ def _build(data: Mapping[str, Any], source: str, folder: Path | None) -> Scene:
     for i, base in enumerate(bases):
         for k, obj in enumerate(objects):
             if float(obj.signed_distance(base.position.reshape(1, 3))[0]) < 0.0:
-                where = f"bases[{i}].position" if "bases" in data else f"objects[{k}]"
+                # the field that put it there: the base's position, its table (the origin by
+                # default), or the object when the scene gives no bases
+                where = f"objects[{k}]"
+                if "bases" in data:
+                    own = "position" in base_tables[i]
+                    where = f"bases[{i}].position" if own else f"bases[{i}]"
                 raise fail(
                     where,
                     f"the base point {format_value([float(x) for x in base.position])} of"
-                    f" bases[{i}] lies"
-                    f" inside objects[{k}] ({obj.name!r}): a size or position in another unit"
-                    " than m?",
+                    f" bases[{i}] lies inside objects[{k}] ({obj.name!r}): a size or position"
+                    " in another unit than m?",
                 )
     return Scene(name, objects, bases, region, source, base_regions)
 
