@@ -196,22 +196,20 @@ _ANTENNA_COMPILED = (
 )
 
 
-def test_ctrl_c_inside_a_compiled_function_is_an_interruption(tmp_path: Path) -> None:
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            _ANTENNA_COMPILED,
-            *_SHORT_COMMAND,
-            "--out",
-            str(tmp_path / "r.csv"),
-        ],
+def _short_run(program: str, out: Path) -> subprocess.CompletedProcess[str]:
+    """The short command run to its end by ``program``, writing ``out``."""
+    return subprocess.run(
+        [sys.executable, "-c", program, *_SHORT_COMMAND, "--out", str(out)],
         capture_output=True,
         text=True,
         env=_environment(),
         timeout=120,
         check=False,
     )
+
+
+def test_ctrl_c_inside_a_compiled_function_is_an_interruption(tmp_path: Path) -> None:
+    done = _short_run(_ANTENNA_COMPILED, tmp_path / "r.csv")
     assert done.returncode == -signal.SIGINT, done.stderr
     assert done.stderr.strip() == "antenna simulate: interrupted"
 
@@ -219,21 +217,7 @@ def test_ctrl_c_inside_a_compiled_function_is_an_interruption(tmp_path: Path) ->
 def test_a_stop_the_command_swallowed_still_stops_it_when_it_returns(tmp_path: Path) -> None:
     # the command's own code caught the SIGTERM and went on to finish; the command line still
     # reports the stop and ends by it when the command returns
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            _ANTENNA_SWALLOWING,
-            *_SHORT_COMMAND,
-            "--out",
-            str(tmp_path / "r.csv"),
-        ],
-        capture_output=True,
-        text=True,
-        env=_environment(),
-        timeout=120,
-        check=False,
-    )
+    done = _short_run(_ANTENNA_SWALLOWING, tmp_path / "r.csv")
     assert done.returncode == 143, done.stderr
     assert done.stderr.strip() == "antenna simulate: stopped by SIGTERM"
 
