@@ -222,6 +222,14 @@ def test_angles_in_degrees_are_refused(simulated_free: Recording) -> None:
     assert str(raised.value).startswith(f"{simulated_free.source}: columns 'theta1'")
 
 
+def test_time_in_milliseconds_is_named(simulated_free: Recording) -> None:
+    # the motion read a thousand times slower: the fitted inertia a million times the rigid
+    # link's, which angles in degrees (1/57) or torques scaled by a unit cannot give
+    in_ms = dataclasses.replace(simulated_free, t=1000.0 * simulated_free.t)
+    with pytest.raises(IdentificationError, match=r"time stamps in ms\? the format's are in s$"):
+        identify_free_motion(in_ms, ANTENNA)
+
+
 def _glitch(recording: Recording) -> Recording:
     theta = recording.theta.copy()
     theta[1500, 0] = 1e300

@@ -314,11 +314,17 @@ def _check_inertia(inertia: float, rigid: float, where: str) -> None:
     ``MAX_INERTIA_FACTOR`` of the rigid link's ``rigid`` (kg m^2)."""
     if 1.0 / MAX_INERTIA_FACTOR <= inertia / rigid <= MAX_INERTIA_FACTOR:
         return
+    # time in ms reads the motion a thousand times slower: the inertia a million times larger
+    in_ms = 1e5 <= inertia / rigid <= 1e7
     raise IdentificationError(
         f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the observer's inertia "
         f"K / omega^2 = {inertia:.3g} kg m^2 is {inertia / rigid:.3g} times the rigid link's "
-        f"{rigid:.3g} kg m^2 (more than a factor {MAX_INERTIA_FACTOR:g}): angles in degrees, "
-        "or torques scaled?"
+        f"{rigid:.3g} kg m^2 (more than a factor {MAX_INERTIA_FACTOR:g}): "
+        + (
+            "time stamps in ms? the format's are in s"
+            if in_ms
+            else "angles in degrees, or torques scaled?"
+        )
     )
 
 
