@@ -6,6 +6,7 @@ import csv
 import dataclasses
 import json
 import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -472,6 +473,7 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
     )
     captured = capsys.readouterr()
     assert f"{out} holds 2 stored manoeuvres: resuming after them" in captured.err
+    assert re.search(r"\nmapping the \d estimated contacts: the surface and", captured.err)
     text = captured.out
     assert "3 manoeuvres (" in text and "; after the budget, aimed at recognition 1)" in text
     assert json.loads((out / "exploration.json").read_text())["aims"] == {

@@ -180,7 +180,17 @@ def _run(args: argparse.Namespace) -> int:
             " another exploration is refused)",
             file=sys.stderr,
         )
-    result = explore(scene, device, args.out, settings, None if args.quiet else show, meshes)
+
+    def mapping(n_points: int) -> None:
+        print(
+            f"mapping the {n_points} estimated contacts: the surface and the shape classes",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    result = explore(
+        scene, device, args.out, settings, None if args.quiet else show, meshes, mapping
+    )
     summary = result.summary()
     (args.out / "exploration.json").write_text(json.dumps(summary, indent=2) + "\n")
     outcomes = ", ".join(f"{k} {v}" for k, v in sorted(summary["outcomes"].items()))

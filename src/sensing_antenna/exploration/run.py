@@ -549,6 +549,7 @@ def explore(
     settings: ExploreSettings | None = None,
     progress: Callable[[Manoeuvre, int], None] | None = None,
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
+    mapping: Callable[[int], None] | None = None,
 ) -> Exploration:
     """Explore ``scene`` with the simulated ``device``, storing everything in ``out``.
 
@@ -565,6 +566,9 @@ def explore(
         budget and ``until_recognised``).
     meshes : mapping of str to trimesh.Trimesh, optional
         User meshes recognition registers beside the shape classes (``antenna map --objects``).
+    mapping : callable, optional
+        Called with the number of points once the sweeps are done and their map is being made
+        (the surface and recognition, which can take a minute).
 
     Raises
     ------
@@ -667,6 +671,8 @@ def explore(
             raise ExplorationInterrupted(number, len(manoeuvres), out) from None
         write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
+    if mapping is not None:
+        mapping(len(points))
     try:
         # the swept links are recognition's evidence only: the recognition that ended the
         # sweeps has weighed them already
