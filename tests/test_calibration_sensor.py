@@ -121,15 +121,21 @@ def test_calibration_undoes_the_cross_talk_on_new_contacts(
         assert estimate(recording, corrected, "paper").status.value == "ok"
 
 
-def test_one_recording_with_its_torque_in_another_unit_is_left_out(
+@pytest.mark.parametrize("unit", ["tz in N dm", "forces in lbf"])
+def test_one_recording_with_its_loads_in_another_unit_is_left_out(
+    unit: str,
     calibration_set: tuple[list, list[float]],  # type: ignore[type-arg]
 ) -> None:
-    # tz in N dm among N m (ten times): no leak explains one contact's ratio ten times off while
-    # the others' fit within per cents; left out, named, the correction is the others'
+    # tz in N dm among N m (ten times), or the forces in lbf (4.45 times too small): no leak
+    # explains one contact's ratio several times off while the others' fit within per cents;
+    # left out, named, the correction is the others'
     recordings, truth = calibration_set
     names = [f"c{i}.csv" for i in range(len(recordings))]
     bad = list(recordings)
-    bad[2] = dataclasses.replace(recordings[2], torque=recordings[2].torque * [1.0, 1.0, 10.0])
+    if unit == "tz in N dm":
+        bad[2] = dataclasses.replace(recordings[2], torque=recordings[2].torque * [1, 1, 10])
+    else:
+        bad[2] = dataclasses.replace(recordings[2], force=recordings[2].force / 4.448)
     fit = calibrate_sensor(bad, ANTENNA, truth, sources=names)
     assert "c2.csv" not in fit.sources and len(fit.sources) == len(names) - 1
     (note,) = [n for n in fit.notes if n.startswith("c2.csv: ")]
