@@ -101,8 +101,10 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
     # antenna, uses no point: a file of the old map beside the new report would contradict it
     out = tmp_path / "map"
     out.mkdir()
-    for name in ("points.ply", "surface.ply", "object.ply", "map.html", "recognition.json"):
+    earlier = ["points.ply", "surface.ply", "object.ply", "map.html"]
+    for name in earlier:
         (out / name).write_text("a previous map's\n")
+    (out / "recognition.json").write_text(json.dumps({"files": earlier}))
     assert main(["map", *map(str, recordings), "--out", str(out), "--no-progress"]) == 0
     assert "0 of 3 points used" in capsys.readouterr().out
     assert sorted(p.name for p in out.iterdir()) == [
@@ -111,12 +113,19 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
         "recognition.json",
         "report.md",
     ]
-    # a directory of the user's own, holding no map: their files are theirs
+    assert json.loads((out / "recognition.json").read_text())["files"] == [
+        "map.png",
+        "points.csv",
+        "recognition.json",
+        "report.md",
+    ]
+    # a directory of the user's own: their files are theirs, mapped into once or twice
     own = tmp_path / "scans"
     own.mkdir()
     (own / "object.ply").write_text("a scan of the object\n")
-    assert main(["map", *map(str, recordings), "--out", str(own), "--no-progress"]) == 0
-    assert (own / "object.ply").read_text() == "a scan of the object\n"
+    for _ in range(2):
+        assert main(["map", *map(str, recordings), "--out", str(own), "--no-progress"]) == 0
+        assert (own / "object.ply").read_text() == "a scan of the object\n"
 
 
 @pytest.mark.parametrize(

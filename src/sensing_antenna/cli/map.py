@@ -134,11 +134,12 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
     from sensing_antenna.mapping.view import write_map_html
     from sensing_antenna.plotting.mapping import plot_map
 
-    written = write_map(contact_map, out)
-    written.append(plot_map(contact_map, out / "map.png"))
+    out.mkdir(parents=True, exist_ok=True)
+    views = [plot_map(contact_map, out / "map.png")]
     html = write_map_html(contact_map, out / "map.html", truth)
     if html is not None:
-        written.append(html)
+        views.append(html)
+    written = [*write_map(contact_map, out, tuple(views)), *views]
     summary = contact_map.summary()
     recognition = contact_map.recognition
     if recognition is None:

@@ -86,18 +86,20 @@ def _number(value: float) -> str:
     return "" if not math.isfinite(value) else f"{value:.9g}"
 
 
-#: A map's files written only when it holds what they show: in a previous map's directory
-#: (one with its recognition.json) they are removed first, so that none contradicts the new
-#: report.
+#: A map's files written only when it holds what they show: those a previous map in the same
+#: directory wrote (recognition.json's ``files``) are removed first, so that none contradicts
+#: the new report.
 SOMETIMES_WRITTEN = ("points.ply", "surface.ply", "object.ply", "map.html")
 
 
-def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
+def write_map(contact_map: ContactMap, out: Path, also: tuple[Path, ...] = ()) -> list[Path]:
     """Write the map's files into ``out`` (created), after removing those of
-    :data:`SOMETIMES_WRITTEN` a previous map left there; returns the paths written."""
+    :data:`SOMETIMES_WRITTEN` a previous map wrote there and this one has not (``also``: the
+    files of this map its caller wrote already); returns the paths written. recognition.json
+    lists them all (``files``)."""
     out.mkdir(parents=True, exist_ok=True)
-    if (out / "recognition.json").is_file():
-        for name in SOMETIMES_WRITTEN:
+    for name in _previous_files(out):
+        if name in SOMETIMES_WRITTEN and name not in {p.name for p in also}:
             (out / name).unlink(missing_ok=True)
     written = []
     used = {id(p) for p in contact_map.used}
@@ -152,7 +154,9 @@ def write_map(contact_map: ContactMap, out: Path) -> list[Path]:
         _object_mesh(surface).export(path)
         written.append(path)
     path = out / "recognition.json"
-    path.write_text(json.dumps(contact_map.summary(), indent=2, allow_nan=False) + "\n")
+    files = sorted({p.name for p in (*written, *also)} | {"recognition.json", "report.md"})
+    summary = {**contact_map.summary(), "files": files}
+    path.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
     written.append(path)
     path = out / "report.md"
     path.write_text(report(contact_map))
@@ -176,6 +180,15 @@ def overdispersed(recognition: Any) -> str:
         " their deviations say: the object is none of the classes, or points are misplaced"
         " (a base pose, a calibration)"
     )
+
+
+def _previous_files(out: Path) -> list[str]:
+    """The files a previous map in ``out`` wrote (its recognition.json's ``files``), or none."""
+    try:
+        files = json.loads((out / "recognition.json").read_text("utf-8")).get("files", [])
+    except (OSError, ValueError, AttributeError):
+        return []
+    return [name for name in files if isinstance(name, str)] if isinstance(files, list) else []
 
 
 def _object_mesh(surface: ObjectSurface) -> trimesh.Trimesh:
