@@ -175,9 +175,11 @@ def _run(args: argparse.Namespace) -> int:
         )
     stored = len(list((args.out / MANOEUVRES_DIR).glob("*.json")))
     if stored:
+        beyond = args.budget is not None and stored > args.budget
         print(
             f"{args.out} holds {stored} stored manoeuvres: resuming after them (a directory of"
-            " another exploration is refused)",
+            " another exploration is refused)"
+            + (f"; more than --budget {args.budget}: the map takes all {stored}" if beyond else ""),
             file=sys.stderr,
         )
 

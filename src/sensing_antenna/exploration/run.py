@@ -287,6 +287,8 @@ class ExplorationInterrupted(KeyboardInterrupt):
     @property
     def message(self) -> str:
         """One line for the command line."""
+        if self.n_stored == 0:
+            return f"interrupted before a manoeuvre was stored in {self.out}"
         return (
             f"interrupted: {self.n_stored} manoeuvres are stored in {self.out}; the same command"
             " resumes from them"

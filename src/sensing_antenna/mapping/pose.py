@@ -29,10 +29,10 @@ __all__ = ["BASE_POSE_KEY", "BasePose", "base_pose_from_metadata"]
 BASE_POSE_KEY = "base_pose"
 
 #: How far from orthonormal a given rotation may be (largest entry of R R^T - I); it is then
-#: made orthonormal (the nearest rotation). 1 %: a rotation printed with three decimals, as a
-#: robot's log often does, is off by up to about 0.2 %, while one that is not a rotation (a
-#: reflection, a typo, a scaled matrix) is off by far more.
-ORTHONORMAL_TOLERANCE = 0.01
+#: made orthonormal (the nearest rotation). 0.003: a rotation printed with three decimals, as a
+#: robot's log often does, is off by up to about 0.0015; one printed with two (its point a few
+#: mm off at the link's reach), a reflection, a typo or a scaled matrix by more.
+ORTHONORMAL_TOLERANCE = 0.003
 
 #: Largest magnitude of any number of a pose: a rotation's entries and a unit quaternion's are
 #: at most 1, a position beyond 100 m is refused with its own message; this bound keeps every
