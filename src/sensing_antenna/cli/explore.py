@@ -116,7 +116,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.cli.map import read_objects, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
-    from sensing_antenna.exploration.run import ExplorationInterrupted
+    from sensing_antenna.exploration.run import stopped_as_stored
     from sensing_antenna.exploration.store import MANOEUVRES_DIR
     from sensing_antenna.scene import load_scene
 
@@ -202,10 +202,7 @@ def _run(args: argparse.Namespace) -> int:
         + (f"; after the budget, aimed at {after}" if after else "")
         + f"), {summary['sweep_time_s']:.0f} s of sweeping"
     )
-    try:
+    with stopped_as_stored(args.out, lambda: len(result.manoeuvres)):
         report_map(result.contact_map, args.out, scene.mesh)
-    except KeyboardInterrupt as exc:
-        number = int(getattr(exc, "signal_number", 2))
-        raise ExplorationInterrupted(number, len(result.manoeuvres), args.out) from None
     print(f"  {args.out / 'manoeuvres.csv'}\n  {args.out / 'scene.ply'}")
     return 0

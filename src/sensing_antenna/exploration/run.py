@@ -39,10 +39,12 @@ points, makes the same choices.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import os
-from collections.abc import Callable, Mapping, Sequence
+import signal
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -293,6 +295,21 @@ class ExplorationInterrupted(KeyboardInterrupt):
             f"interrupted: {self.n_stored} manoeuvres are stored in {self.out}; the same command"
             " resumes from them"
         )
+
+
+@contextlib.contextmanager
+def stopped_as_stored(out: Path, n_stored: Callable[[], int]) -> Iterator[None]:
+    """Within: Ctrl-C or a stop signal (also as the ``SystemError`` a compiled function raises
+    from one) ends as :class:`ExplorationInterrupted`, saying that ``n_stored()`` manoeuvres are
+    stored in ``out``."""
+    try:
+        yield
+    except (KeyboardInterrupt, SystemError) as exc:
+        interrupt = interruption_of(exc)
+        if interrupt is None or isinstance(exc, ExplorationInterrupted):
+            raise
+        number = int(getattr(interrupt, "signal_number", signal.SIGINT))
+        raise ExplorationInterrupted(number, n_stored(), out) from None
 
 
 @dataclass(frozen=True)
@@ -601,93 +618,85 @@ def explore(
         scene.mesh.export(out / "scene.ply")
         manoeuvres = load_manoeuvres(out)
         _check_stored_sweeps(out, manoeuvres, scene, grid, settings.strategy)
-        try:
-            antenna = _prepared(device, out, settings)
-            # the planner knows the device file's link; the simulated link sags as built
-            shape = LinkShape(device.link)
-            build = settings.imperfections(settings.seed, device.link.length)
-            built = LinkShape(device.link, device=build)
-            controlled = knowing_weight(device, antenna)
-            planner = NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
-            # the planner of the sweeps after the budget (next-best's own, or one made then)
-            chooser = planner
-            leaders: tuple[ClassFit, ...] = ()
-            final: Recognition | None = None  # the last recognition, when it ended the sweeps
-
-            def recognised(upto: list[Manoeuvre]) -> RecognitionState:
-                return _recognition_state(
-                    [m.point for m in upto if m.point is not None],
-                    settings.include_uncertain,
-                    swept_links(upto, scene, antenna, out, recorded),
-                    meshes,
+        with stopped_as_stored(out, lambda: len(manoeuvres)):
+            try:
+                antenna = _prepared(device, out, settings)
+                # the planner knows the device file's link; the simulated link sags as built
+                shape = LinkShape(device.link)
+                build = settings.imperfections(settings.seed, device.link.length)
+                built = LinkShape(device.link, device=build)
+                controlled = knowing_weight(device, antenna)
+                planner = (
+                    NextBestPlanner(scene, shape) if settings.strategy == "next-best" else None
                 )
+                # the planner of the sweeps after the budget (next-best's own, or one made then)
+                chooser = planner
+                leaders: tuple[ClassFit, ...] = ()
+                final: Recognition | None = None  # the last recognition, when it ended the sweeps
 
-            last = len(manoeuvres) - len(manoeuvres) % RECOGNITION_EVERY
-            if planner is not None and last < len(manoeuvres) < budget:
-                # resumed between recognitions: the leaders the last one found
-                _, leaders = recognised(manoeuvres[:last])
-            while True:
-                index = len(manoeuvres)
-                done = [m.sweep for m in manoeuvres]
-                free = [m.sweep for m in manoeuvres if m.outcome == "free"]
-                points = [m.point for m in manoeuvres if m.point is not None]
-                end = budget if planner is not None else _grid_end(done, grid, budget)
-                choice: Choice | None = None
-                aim = "plan"
-                if index < end and planner is None:
-                    following = _next_grid_sweep(grid, done)  # one is left until the grid ends
-                    assert following is not None
-                    choice = Choice(following, math.nan, np.full(3, np.nan))
-                elif index < end and planner is not None:
-                    surface = fit_surface(points, settings.include_uncertain)
-                    if index % RECOGNITION_EVERY == 0:
-                        _, leaders = recognised(manoeuvres)
-                    choice = planner.choose(done, surface, free, leaders)
-                elif index < end + settings.until_recognised:
-                    named, leaders = recognised(manoeuvres)
-                    within = settings.sizes_within
-                    # a recognition that names the object has it as its best fit
-                    if named is not None and (within is None or named.best.sizes_known(within)):
-                        final = named  # of every point and swept link: the map's own
+                def recognised(upto: list[Manoeuvre]) -> RecognitionState:
+                    return _recognition_state(
+                        [m.point for m in upto if m.point is not None],
+                        settings.include_uncertain,
+                        swept_links(upto, scene, antenna, out, recorded),
+                        meshes,
+                    )
+
+                last = len(manoeuvres) - len(manoeuvres) % RECOGNITION_EVERY
+                if planner is not None and last < len(manoeuvres) < budget:
+                    # resumed between recognitions: the leaders the last one found
+                    _, leaders = recognised(manoeuvres[:last])
+                while True:
+                    index = len(manoeuvres)
+                    done = [m.sweep for m in manoeuvres]
+                    free = [m.sweep for m in manoeuvres if m.outcome == "free"]
+                    points = [m.point for m in manoeuvres if m.point is not None]
+                    end = budget if planner is not None else _grid_end(done, grid, budget)
+                    choice: Choice | None = None
+                    aim = "plan"
+                    if index < end and planner is None:
+                        following = _next_grid_sweep(grid, done)  # one is left until the grid ends
+                        assert following is not None
+                        choice = Choice(following, math.nan, np.full(3, np.nan))
+                    elif index < end and planner is not None:
+                        surface = fit_surface(points, settings.include_uncertain)
+                        if index % RECOGNITION_EVERY == 0:
+                            _, leaders = recognised(manoeuvres)
+                        choice = planner.choose(done, surface, free, leaders)
+                    elif index < end + settings.until_recognised:
+                        named, leaders = recognised(manoeuvres)
+                        within = settings.sizes_within
+                        # a recognition that names the object has it as its best fit
+                        if named is not None and (within is None or named.best.sizes_known(within)):
+                            final = named  # of every point and swept link: the map's own
+                            break
+                        chooser = chooser if chooser is not None else NextBestPlanner(scene, shape)
+                        surface = fit_surface(points, settings.include_uncertain)
+                        choice = chooser.choose(done, surface, free, leaders)
+                        aim = "recognition" if named is None else "sizes"
+                    if choice is None:
                         break
-                    chooser = chooser if chooser is not None else NextBestPlanner(scene, shape)
-                    surface = fit_surface(points, settings.include_uncertain)
-                    choice = chooser.choose(done, surface, free, leaders)
-                    aim = "recognition" if named is None else "sizes"
-                if choice is None:
-                    break
-                manoeuvre = _run_one(
-                    scene, controlled, antenna, built, choice, index, settings, out, aim
-                )
-                write_manoeuvre(out, manoeuvre)
-                manoeuvres.append(manoeuvre)
-                if progress is not None:
-                    progress(manoeuvre, end + settings.until_recognised)
-                raise_if_signalled()
-        except (KeyboardInterrupt, SystemError) as exc:
-            interrupt = interruption_of(exc)  # a SystemError from compiled code interrupted
-            if interrupt is None:
-                raise
-            write_manoeuvre_table(out, manoeuvres)
-            number = int(getattr(interrupt, "signal_number", 2))
-            raise ExplorationInterrupted(number, len(manoeuvres), out) from None
-        write_manoeuvre_table(out, manoeuvres)
+                    manoeuvre = _run_one(
+                        scene, controlled, antenna, built, choice, index, settings, out, aim
+                    )
+                    write_manoeuvre(out, manoeuvre)
+                    manoeuvres.append(manoeuvre)
+                    if progress is not None:
+                        progress(manoeuvre, end + settings.until_recognised)
+                    raise_if_signalled()
+            finally:
+                # every manoeuvre stored so far, whatever stops the sweeps
+                write_manoeuvre_table(out, manoeuvres)
     points = [m.point for m in manoeuvres if m.point is not None]
     if mapping is not None:
         mapping(len(points))
-    try:
+    with stopped_as_stored(out, lambda: len(manoeuvres)):
         # the swept links are recognition's evidence only: the recognition that ended the
         # sweeps has weighed them already
         swept = () if final is not None else swept_links(manoeuvres, scene, antenna, out, recorded)
         contact_map = build_map(
             points, settings.include_uncertain, meshes=meshes, swept=swept, recognition=final
         )
-    except (KeyboardInterrupt, SystemError) as exc:
-        interrupt = interruption_of(exc)
-        if interrupt is None:
-            raise
-        number = int(getattr(interrupt, "signal_number", 2))
-        raise ExplorationInterrupted(number, len(manoeuvres), out) from None
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 
 
