@@ -172,7 +172,6 @@ def calibrate_sensor(
     SensorCalibrationError
         When no sweep direction has :data:`MIN_SENSOR_RECORDINGS` usable recordings.
     """
-    from sensing_antenna.estimation.front.ratio import perpendicular_ratio
 
     if len(recordings) != len(contact_points):
         raise SensorCalibrationError(
@@ -185,10 +184,7 @@ def calibrate_sensor(
     )
     holds: list[_Hold] = []
     used: list[str] = []
-    indices: list[int] = []  # of the recordings given, for each hold
-    for position, (name, recording, x_c, on) in enumerate(
-        zip(names, recordings, points_in, on_link, strict=True)
-    ):
+    for name, recording, x_c, on in zip(names, recordings, points_in, on_link, strict=True):
         if not on:
             continue  # named in the notes
         hold = _hold(recording, plain, float(x_c))
@@ -197,7 +193,16 @@ def calibrate_sensor(
         else:
             holds.append(hold)
             used.append(name)
-            indices.append(position)
+    return _fit(holds, used, notes, antenna)
+
+
+def _fit(
+    holds: list[_Hold], used: list[str], notes: list[str], antenna: Antenna
+) -> SensorCalibration:
+    """:func:`calibrate_sensor` on the holds read (``used``: their recordings' names; ``notes``:
+    why the others were left out)."""
+    from sensing_antenna.estimation.front.ratio import perpendicular_ratio
+
     sweeps = tuple(
         s for s in _PLANE_TERMS if sum(h.sweep == s for h in holds) >= MIN_SENSOR_RECORDINGS
     )
@@ -208,7 +213,6 @@ def calibrate_sensor(
             + (f" ({'; '.join(notes)})" if notes else "")
         )
     kept = [(h, n) for h, n in zip(holds, used, strict=True) if h.sweep in sweeps]
-    kept_at = [i for h, i in zip(holds, indices, strict=True) if h.sweep in sweeps]
     holds = [h for h, _ in kept]
     terms = _terms(sweeps)
     rigidity = 1.0 / antenna.link.bending_compliance
@@ -264,8 +268,6 @@ def calibrate_sensor(
                 best = found
         return np.asarray(best.x, dtype=float)
 
-    before = residuals(identity(terms), terms)[: len(holds)]
-    params = fitted(terms)
     held_out = np.array(
         [residuals(fitted(terms, rows != i), terms, rows == i)[0] for i in range(len(holds))],
         dtype=float,
@@ -280,17 +282,12 @@ def calibrate_sensor(
             f" {100 * float(np.nanmedian(np.abs(np.delete(held_out, worst)))):.2g} % (median):"
             " loads on another scale than the others'?"
         )
-        rest = [k for k in range(len(recordings)) if k != kept_at[worst]]
-        try:
-            fit = calibrate_sensor(
-                [recordings[k] for k in rest],
-                antenna,
-                [contact_points[k] for k in rest],
-                sources=[names[k] for k in rest],
-            )
-        except SensorCalibrationError as exc:
-            raise SensorCalibrationError(f"{exc}; {note}") from None
-        return replace(fit, notes=(*notes, note, *fit.notes[len(notes) :]))
+        others = [k for k in range(len(kept)) if k != worst]
+        return _fit(
+            [kept[k][0] for k in others], [kept[k][1] for k in others], [*notes, note], antenna
+        )
+    before = residuals(identity(terms), terms)[: len(holds)]
+    params = fitted(terms)
     # each sweep direction's terms are kept when they predict its holds left out of the fit
     # better than no correction
     direction = np.array([h.sweep for h in holds])
