@@ -510,7 +510,7 @@ def _bent_link_problem(evidence: Evidence, estimate: ContactEstimate) -> str | N
     bend = float(evidence.push_deflection_ratio(estimate.x_c))
     # the term grows as the deflection squared, the deflection as the push
     gentler = math.sqrt(limit / shift)
-    push = math.hypot(evidence.frame.reaction_m[1], evidence.frame.reaction_m[2])
+    push = evidence.frame.lateral_force
     return (
         f"the push bends the link by {100 * bend:.0f} % of x_c at x_c = {estimate.x_c:.3f} m: "
         f"the sensing curves are the straight link's, and the bent link's preload may move the "

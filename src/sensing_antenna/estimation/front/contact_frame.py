@@ -19,6 +19,7 @@ The frame (Section 5.3) is built from averages over [t_1, t_1 + frame_window]:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -186,6 +187,11 @@ class ContactFrame:
     def push_force(self) -> float:
         """|R| (N)."""
         return float(np.linalg.norm(self.reaction_m))
+
+    @property
+    def lateral_force(self) -> float:
+        """|R_perp| (N): the reaction across the undeflected link, the push."""
+        return math.hypot(float(self.reaction_m[1]), float(self.reaction_m[2]))
 
     @property
     def axial_fraction(self) -> float:

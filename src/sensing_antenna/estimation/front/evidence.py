@@ -260,8 +260,7 @@ class Evidence:
             return math.inf
         link = self.antenna.link
         x_c = min(max(x_c, 0.0), link.length)
-        reaction = self.frame.reaction_m
-        push = math.hypot(reaction[1], reaction[2])
+        push = self.frame.lateral_force
         if push <= 0.0:
             return math.inf
         offset_term = math.hypot(x_c * self.offset_error, self.torque_offset_error) / push
@@ -288,7 +287,7 @@ class Evidence:
         link = self.antenna.link
         x_c = np.asarray(x_c, dtype=float)
         reaction = self.frame.reaction_m
-        push = math.hypot(reaction[1], reaction[2])
+        push = self.frame.lateral_force
         if push <= 0.0:
             return np.full(x_c.shape, np.inf)
         # Eq. 13: y_c / x_c = |R_perp| x_c^2 / (3 E I)
@@ -342,7 +341,7 @@ class Evidence:
         """d = |R_perp| x_c^2 / (3 E I) (dimensionless, the shape of ``x_c``): the hold's push
         deflection over x_c (m) by the linear statics, as :meth:`bent_link_uncertainty` reads
         it."""
-        reaction = self.frame.reaction_m
-        push = math.hypot(reaction[1], reaction[2])
         x_c = np.asarray(x_c, dtype=float)
-        return np.asarray(push * x_c**2 * self.antenna.link.bending_compliance / 3.0)
+        return np.asarray(
+            self.frame.lateral_force * x_c**2 * self.antenna.link.bending_compliance / 3.0
+        )

@@ -494,7 +494,7 @@ def hold_push(
     if frame is None:
         problem = "the mean contact force over the hold is zero or along the link: no lateral push"
         return HoldPush(None, problem, stop, noise, standard_error, losses)
-    perpendicular = math.hypot(frame.reaction_m[1], frame.reaction_m[2])
+    perpendicular = frame.lateral_force
     limit = cfg.min_push_significance * standard_error
     if perpendicular <= limit:
         problem = (
@@ -541,7 +541,7 @@ def ratio_tolerance(
     assert hold.frame is not None
     noise = ratio_noise(
         hold.force_noise,
-        math.hypot(hold.frame.reaction_m[1], hold.frame.reaction_m[2]),
+        hold.frame.lateral_force,
         antenna.link.length,
         cfg.lowpass_cutoff,
         ts,
