@@ -660,9 +660,12 @@ def points_on_link(
 
 def _unit_hint(x_c: float, length: float) -> str:
     """The hint " (in cm?)" or " (in mm?)" when ``x_c`` (m) read in that unit lies where
-    contacts are estimated on the link (from a fifth of its length to its tip), else ""."""
+    contacts are estimated on the link (``EstimatorConfig.contact_range``), else ""."""
+    from sensing_antenna.estimation.config import EstimatorConfig
+
+    low, high = EstimatorConfig().contact_range
     for factor, unit in ((100.0, "cm"), (1000.0, "mm")):
-        if 0.2 * length <= x_c / factor <= length:
+        if low * length <= x_c / factor <= high * length:
             return f" (in {unit}?)"
     return ""
 

@@ -45,18 +45,16 @@ def contact_evidence(recording: Recording, antenna: Antenna) -> Evidence | str:
         return problem
     gathered = gather(recording, antenna)
     estimate = conclude(gathered, "paper")
-    if not isinstance(gathered, Evidence) or (
-        estimate.status in INPUT_FAULTS and not _long_enough(gathered, estimate.status)
-    ):
+    refused = estimate.status in INPUT_FAULTS
+    if estimate.status is Status.RECORDING_TOO_SHORT and isinstance(gathered, Evidence):
+        refused = not _holds_half_the_spectrum(gathered)
+    if refused or not isinstance(gathered, Evidence):
         return f"an estimate would be {estimate.status.value} ({estimate.reason})"
     return gathered
 
 
-def _long_enough(evidence: Evidence, status: Status) -> bool:
-    """Whether a record an estimate calls too short still holds half the spectrum window after
-    t_1: omega_1 read over it is at most twice as coarse (a set recorded a few ms short of the
-    window calibrates as well)."""
-    if status is not Status.RECORDING_TOO_SHORT:
-        return False
+def _holds_half_the_spectrum(evidence: Evidence) -> bool:
+    """Whether the samples after t_1 span half the spectrum window: omega_1 read over them is at
+    most twice as coarse (a set recorded a few ms short of the window calibrates as well)."""
     have = float(evidence.t[evidence.end_index] - evidence.t[evidence.rest_index])
     return have >= 0.5 * evidence.config.spectrum_window
