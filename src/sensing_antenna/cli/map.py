@@ -153,8 +153,9 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
         f"{summary['n_used']} of {summary['n_recordings']} points used ({statuses}); "
         f"surface faces {summary['surface_faces']}; object {decision}"
     )
-    if recognition is not None and overdispersed(recognition):
-        print(f"  {overdispersed(recognition)}")
+    spread = "" if recognition is None else overdispersed(recognition)
+    if spread:
+        print(f"  {spread}")
     if summary["n_used"] == 0 and summary["statuses"].get("uncertain"):
         print(
             "  no estimate is ok: an antenna that is not calibrated answers uncertain (give "

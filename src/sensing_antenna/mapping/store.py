@@ -98,8 +98,9 @@ def write_map(contact_map: ContactMap, out: Path, also: tuple[Path, ...] = ()) -
     files of this map its caller wrote already); returns the paths written. recognition.json
     lists them all (``files``)."""
     out.mkdir(parents=True, exist_ok=True)
+    kept = {p.name for p in also}
     for name in _previous_files(out):
-        if name in SOMETIMES_WRITTEN and name not in {p.name for p in also}:
+        if name in SOMETIMES_WRITTEN and name not in kept:
             (out / name).unlink(missing_ok=True)
     written = []
     used = {id(p) for p in contact_map.used}
@@ -257,6 +258,7 @@ def report(contact_map: ContactMap) -> str:
         lines.append("Recognition: not attempted (fewer than 10 points).")
     else:
         runner_up = "" if recognition.runner_up is None else f" ({recognition.runner_up})"
+        spread = overdispersed(recognition)
         lines += [
             f"Recognition: **{recognition.decision}**"
             + (
@@ -290,11 +292,7 @@ def report(contact_map: ContactMap) -> str:
                 else ""
             )
             + ".",
-            *(
-                [f"{overdispersed(recognition)[:1].upper()}{overdispersed(recognition)[1:]}.", ""]
-                if overdispersed(recognition)
-                else [""]
-            ),
+            *([f"{spread[:1].upper()}{spread[1:]}.", ""] if spread else [""]),
             "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md),"
             " each at most its outlier cap; the lines' and the swept links' own sums of squares,"
             " uncapped, are beside it.",
