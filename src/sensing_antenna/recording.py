@@ -24,7 +24,7 @@ import codecs
 import math
 import os
 import stat
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -57,6 +57,7 @@ __all__ = [
     "check_sampling",
     "clock_disagrees",
     "is_ground_truth_key",
+    "other_separator",
     "parse_header",
     "parse_metadata",
     "read_recording",
@@ -578,20 +579,30 @@ def _check_known_metadata(metadata: Mapping[str, str], lines: list[str], source:
         )
 
 
+def other_separator(names: Sequence[str]) -> str | None:
+    """What separates a CSV header's names when it reads as one column at its commas
+    ("semicolons", as a European spreadsheet writes, "tabs" or "spaces"), else None."""
+    if len(names) != 1:
+        return None
+    for separator, called in ((";", "semicolons"), ("\t", "tabs"), (" ", "spaces")):
+        if separator in names[0]:
+            return called
+    return None
+
+
 def parse_header(line: str, number: int, source: str) -> list[str]:
     """The column names of a header ``line`` (line ``number`` of ``source``): none empty or
     repeated, the nine required ones present."""
     names = [cell.strip() for cell in line.split(",")]
-    if len(names) == 1:
-        for separator, called in ((";", "semicolons"), ("\t", "tabs"), (" ", "spaces")):
-            if separator in names[0]:
-                raise RecordingError(
-                    source,
-                    number,
-                    None,
-                    f"the header is one column separated by {called}; columns are separated "
-                    "by commas (docs/recording-format.md)",
-                )
+    called = other_separator(names)
+    if called is not None:
+        raise RecordingError(
+            source,
+            number,
+            None,
+            f"the header is one column separated by {called}; columns are separated "
+            "by commas (docs/recording-format.md)",
+        )
     seen: set[str] = set()
     for name in names:
         if not name:

@@ -29,6 +29,7 @@ from scipy.optimize import least_squares
 
 from sensing_antenna.antenna import PARAMETER_RANGES, Antenna, Link
 from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.recording import other_separator
 
 __all__ = [
     "CALIBRATION_BAND",
@@ -841,14 +842,12 @@ def _read_points_table(table: Path) -> list[_PointRow]:
             reader.fieldnames = columns
             for column in ("file", "x_c"):
                 if column not in columns:
-                    separated = next(
-                        (
-                            f" (its header {columns[0]!r} is one column separated by {called};"
-                            " columns are separated by commas)"
-                            for separator, called in ((";", "semicolons"), ("\t", "tabs"))
-                            if len(columns) == 1 and separator in columns[0]
-                        ),
-                        "",
+                    called = other_separator(columns)
+                    separated = (
+                        ""
+                        if called is None
+                        else f" (its header {columns[0]!r} is one column separated by {called};"
+                        " columns are separated by commas)"
                     )
                     raise CalibrationError(f"{table}: line 1: missing column {column!r}{separated}")
             for record in reader:
