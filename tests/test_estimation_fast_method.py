@@ -908,7 +908,10 @@ def test_at_the_cap_an_interval_within_cap_tolerance_answers() -> None:
     answered = estimate(blind, antenna, FastMethod(waiting), STRAIGHT)
     held = estimate(blind, antenna, FastMethod(replace(waiting, cap_tolerance=0.005)), STRAIGHT)
     assert held.status is Status.UNCERTAIN and "interval" in (held.reason or "")
+    # its one fault is the width: a map may take its point with that interval's spread
+    assert held.held_back_by_width and held.to_dict()["diagnostics"]["held_back_by_width"]
     assert answered.status is Status.OK and answered.reason is None
+    assert not answered.held_back_by_width
     assert answered.t_e - answered.t_1 == pytest.approx(FastConfig().cap, abs=0.01)
     assert (answered.x_c, answered.interval) == (held.x_c, held.interval)
     assert answered.interval is not None
@@ -1011,6 +1014,9 @@ def test_the_second_mode_declares_a_noisy_far_contact_online_as_offline(
     caches: Any = ({}, {})  # the two settings differ in their checks only: one set of fits
     at_cap = FastMethod(replace(ON_CURVE, branch_by_second_mode=False)).conclude(evidence, caches)
     assert at_cap.status is Status.UNCERTAIN and at_cap.t_e - at_cap.t_1 >= 0.99
+    # a check that did not pass at the cap (the second mode's test of the posterior's branch)
+    # is more than a width
+    assert not at_cap.held_back_by_width
     offline = FastMethod(ON_CURVE).conclude(evidence, caches)
     assert offline.status is Status.OK
     assert offline.diagnostics["branch_chosen_by"] == "omega2"

@@ -170,6 +170,18 @@ class ContactEstimate:
         """True when the status is ``ok``."""
         return self.status is Status.OK
 
+    @property
+    def held_back_by_width(self) -> bool:
+        """True when an ``uncertain`` estimate's one fault is its 95 % interval's width: every
+        check passed, and the interval (wider than the method's tolerance) is what is known of
+        x_c; a map may take its point with that spread (``fast`` method)."""
+        return bool(
+            self.status is Status.UNCERTAIN
+            and self.interval is not None
+            and self.diagnostics.get("held_back_by_width", False)
+            and not self.diagnostics.get("other_reasons")
+        )
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-able dictionary (SI units; NaN becomes None)."""
         return {

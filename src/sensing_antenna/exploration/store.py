@@ -177,6 +177,7 @@ def point_to_dict(point: ContactPoint) -> dict[str, Any]:
         "tangent": _finite_list(point.tangent),
         "tangent_std": _finite_number(point.tangent_std),
         "link_beyond": _finite_number(point.link_beyond),
+        "held_back_by_width": point.held_back_by_width,
     }
 
 
@@ -195,6 +196,7 @@ def point_from_dict(data: dict[str, Any]) -> ContactPoint:
         tangent=_array(data.get("tangent", [None] * 3), (3,)),
         tangent_std=_number(data.get("tangent_std")),
         link_beyond=_number(data.get("link_beyond")),
+        held_back_by_width=bool(data.get("held_back_by_width", False)),
     )
 
 

@@ -171,6 +171,10 @@ class ContactPoint:
         Its standard deviation in angle (rad); NaN when not known.
     link_beyond : float
         Link length (m) between the contact and the tip; NaN when not known.
+    held_back_by_width : bool
+        An ``uncertain`` estimate whose one fault is its interval's width
+        (:attr:`~sensing_antenna.estimation.ContactEstimate.held_back_by_width`): its
+        covariance carries that width.
     """
 
     point: FloatArray
@@ -185,6 +189,7 @@ class ContactPoint:
     tangent: FloatArray = field(default_factory=lambda: np.full(3, np.nan))
     tangent_std: float = math.nan
     link_beyond: float = math.nan
+    held_back_by_width: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "status", Status(self.status))
@@ -267,6 +272,7 @@ def contact_point_from_estimate(
         tangent=pose.rotation @ tangent,
         tangent_std=tangent_std,
         link_beyond=max(antenna.link.length - x_c, 0.0) if usable else math.nan,
+        held_back_by_width=estimate.held_back_by_width,
     )
 
 

@@ -6,7 +6,9 @@ covariance's six entries ``cov_xx, cov_xy, cov_xz, cov_yy, cov_yz, cov_zz`` (m^2
 (the worst-direction sigma, m), ``x_c`` (m), the link's unit tangent at the contact
 ``tangent_x, tangent_y, tangent_z`` (world frame) and its angular ``tangent_std`` (rad),
 ``used`` (whether it entered the map),
-``true_x, true_y, true_z`` (ground truth when the recording had it) and ``reason``. The PLY
+``true_x, true_y, true_z`` (ground truth when the recording had it),
+``held_back_by_width`` (an ``uncertain`` estimate whose one fault is its interval's width) and
+``reason``. The PLY
 files colour points and surface vertices by their standard deviation, blue (smallest) to red
 (largest). object.ply, written when recognition names a bounded object, is the named class's
 fitted shape, the whole object (:class:`~sensing_antenna.mapping.contact_map.ObjectSurface`);
@@ -55,6 +57,7 @@ POINT_COLUMNS = (
     "true_x",
     "true_y",
     "true_z",
+    "held_back_by_width",
     "reason",
 )
 
@@ -126,6 +129,7 @@ def write_map(contact_map: ContactMap, out: Path, also: tuple[Path, ...] = ()) -
                     _number(p.tangent_std),
                     "true" if id(p) in used else "false",
                     *(_number(v) for v in p.true_point),
+                    "true" if p.held_back_by_width else "false",
                     p.reason or "",
                 ]
             )

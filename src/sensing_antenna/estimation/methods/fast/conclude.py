@@ -117,6 +117,14 @@ def conclude_fast(
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)
     narrowing = diag.get("second_mode_narrowing", {})
+    # the one fault at the cap is the interval's width: every check passed
+    diag["held_back_by_width"] = bool(
+        len(found) == 1
+        and status is Status.UNCERTAIN
+        and result.reached_cap
+        and final.checks_passed
+        and not narrowing.get("disagrees")
+    )
     if reason is not None and narrowing.get("disagrees"):
         reason += f"; {narrowing['disagrees']}"
     link = evidence.antenna.link
