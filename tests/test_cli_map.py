@@ -241,3 +241,38 @@ def test_recordings_of_another_antenna_mapped_with_the_default_are_warned_of(
     args = ["map", *paths, "--out", str(tmp_path / "b"), "--antenna", str(model), "--no-progress"]
     assert main(args) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_a_map_that_fails_leaves_no_directory_it_made(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "new" / "map"
+    argv = ["map", str(tmp_path / "absent.csv"), "--out", str(out), "--no-progress"]
+    assert main(argv) == 2
+    assert not out.exists()
+    # a directory that was there before stays, with what it held
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    assert main(argv) == 2
+    assert (out / "notes.txt").read_text() == "mine"
+    capsys.readouterr()
+
+
+def test_recordings_without_a_base_pose_among_posed_ones_are_noted(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # two recordings at the world's origin and one moved: consistent when the unposed ones were
+    # made there, so a note that says what was assumed, not a warning
+    args = ["--out", str(tmp_path / "a"), "--no-progress"]
+    assert main(["map", *map(str, recordings), *args]) == 0
+    notes = [line for line in capsys.readouterr().err.splitlines() if "base_pose" in line]
+    assert notes == [
+        f"antenna map: note: 2 of 3 recordings have no base_pose ({recordings[0]} and 1 more): "
+        "their points are placed with the antenna's base at the world's origin, unturned "
+        "(docs/recording-format.md)"
+    ]
+    # none posed, or all: nothing to say
+    assert main(["map", str(recordings[0]), str(recordings[1]), *args]) == 0
+    assert "base_pose" not in capsys.readouterr().err
+    assert main(["map", str(recordings[2]), *args]) == 0
+    assert "base_pose" not in capsys.readouterr().err

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -87,17 +89,38 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    distinct_files(args.recordings)
+    created = not args.out.exists()
+    args.out.mkdir(parents=True, exist_ok=True)  # a file in its way: said before estimating
+    try:
+        _map_into(args)
+    except BaseException:
+        if created:  # a map that failed leaves no empty directory behind
+            with contextlib.suppress(OSError):
+                args.out.rmdir()
+        raise
+    return 0
+
+
+def _map_into(args: argparse.Namespace) -> None:
+    """Estimate, build and write the map of ``args.recordings`` into ``args.out`` (made)."""
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.campaign.progress import Progress
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.mapping import build_map, map_inputs_from_recordings
+    from sensing_antenna.mapping.pose import BASE_POSE_KEY
 
-    distinct_files(args.recordings)
-    args.out.mkdir(parents=True, exist_ok=True)  # a file in its way: said before estimating
     meshes = read_objects(args.objects, "antenna map")
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
+    unposed: list[str] = []  # recordings without a base pose: in the antenna's own frame
+
+    def read(path: Path, metadata: Mapping[str, str]) -> None:
+        named.setdefault(metadata.get("antenna", ""), []).append(str(path))
+        if not metadata.get(BASE_POSE_KEY, "").strip():
+            unposed.append(str(path))
+
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"
     ) as bar:
@@ -109,12 +132,11 @@ def _run(args: argparse.Namespace) -> int:
             config=EstimatorConfig(t1_source=args.t1),
             progress=lambda _: bar.update(1),
             unreadable=lambda _, exc: left_out.append(str(exc)),
-            read=lambda path, metadata: named.setdefault(metadata.get("antenna", ""), []).append(
-                str(path)
-            ),
+            read=read,
         )
     if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(named, antenna.name)
+    note_unposed(unposed, sum(len(paths) for paths in named.values()))
     if not points:
         more = f" (and {len(left_out) - 1} more unreadable)" if len(left_out) > 1 else ""
         raise SensingAntennaError(f"{left_out[0]}{more}")
@@ -122,7 +144,21 @@ def _run(args: argparse.Namespace) -> int:
         print(f"antenna map: warning: left out {problem}", file=sys.stderr)
     contact_map = build_map(points, args.include_uncertain, meshes=meshes, swept=swept)
     report_map(contact_map, args.out)
-    return 0
+
+
+def note_unposed(unposed: list[str], count: int) -> None:
+    """One line when some of the ``count`` recordings read have a ``base_pose`` and
+    ``unposed`` have none: theirs is taken as the world's origin, unturned."""
+    if not unposed or len(unposed) == count:
+        return
+    more = f" and {len(unposed) - 1} more" if len(unposed) > 1 else ""
+    verb, theirs = ("has", "its point is") if len(unposed) == 1 else ("have", "their points are")
+    print(
+        f"antenna map: note: {len(unposed)} of {count} recordings {verb} no base_pose "
+        f"({unposed[0]}{more}): {theirs} placed with the antenna's base at the world's origin, "
+        "unturned (docs/recording-format.md)",
+        file=sys.stderr,
+    )
 
 
 def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
