@@ -472,7 +472,7 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
         == 0
     )
     captured = capsys.readouterr()
-    assert f"{out} holds 2 stored manoeuvres: resuming after them" in captured.err
+    assert f"{out} holds 2 stored manoeuvres of this exploration: resuming after" in captured.err
     assert re.search(r"\nmapping the \d estimated contacts: the surface and", captured.err)
     text = captured.out
     assert "3 manoeuvres (" in text and "; after the budget, aimed at recognition 1)" in text
@@ -480,6 +480,10 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
         "plan": 2,
         "recognition": 1,
     }
+    # another exploration's directory is refused without a word of resuming it
+    assert main(["explore", "post", "--out", str(out), "--method", "paper", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert 'method "fast" stored, "paper" given' in err and "resuming" not in err
 
 
 def test_a_scene_out_of_the_link_s_reach_is_warned_of(

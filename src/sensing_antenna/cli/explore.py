@@ -117,7 +117,6 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.cli.map import read_objects, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
     from sensing_antenna.exploration.run import stopped_as_stored
-    from sensing_antenna.exploration.store import MANOEUVRES_DIR
     from sensing_antenna.scene import load_scene
 
     if args.device_profile == "nominal" and args.device_build is not None:
@@ -173,12 +172,12 @@ def _run(args: argparse.Namespace) -> int:
             " sweep will be free",
             file=sys.stderr,
         )
-    stored = len(list((args.out / MANOEUVRES_DIR).glob("*.json")))
-    if stored:
+
+    def resuming(stored: int) -> None:
         beyond = args.budget is not None and stored > args.budget
         print(
-            f"{args.out} holds {stored} stored manoeuvres: resuming after them (a directory of"
-            " another exploration is refused)"
+            f"{args.out} holds {stored} stored manoeuvres of this exploration: resuming after "
+            "them"
             + (f"; more than --budget {args.budget}: the map takes all {stored}" if beyond else ""),
             file=sys.stderr,
         )
@@ -191,7 +190,7 @@ def _run(args: argparse.Namespace) -> int:
         )
 
     result = explore(
-        scene, device, args.out, settings, None if args.quiet else show, meshes, mapping
+        scene, device, args.out, settings, None if args.quiet else show, meshes, mapping, resuming
     )
     summary = result.summary()
     (args.out / "exploration.json").write_text(json.dumps(summary, indent=2) + "\n")

@@ -569,6 +569,7 @@ def explore(
     progress: Callable[[Manoeuvre, int], None] | None = None,
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
     mapping: Callable[[int], None] | None = None,
+    resuming: Callable[[int], None] | None = None,
 ) -> Exploration:
     """Explore ``scene`` with the simulated ``device``, storing everything in ``out``.
 
@@ -588,6 +589,9 @@ def explore(
     mapping : callable, optional
         Called with the number of points once the sweeps are done and their map is being made
         (the surface and recognition, which can take a minute).
+    resuming : callable, optional
+        Called with the number of manoeuvres ``out`` holds, when it holds some and its settings
+        are these (the exploration goes on after them).
 
     Raises
     ------
@@ -618,6 +622,8 @@ def explore(
         scene.mesh.export(out / "scene.ply")
         manoeuvres = load_manoeuvres(out)
         _check_stored_sweeps(out, manoeuvres, scene, grid, settings.strategy)
+        if manoeuvres and resuming is not None:
+            resuming(len(manoeuvres))
         with stopped_as_stored(out, lambda: len(manoeuvres)):
             try:
                 antenna = _prepared(device, out, settings)
