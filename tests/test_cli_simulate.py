@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import pytest
 
 from sensing_antenna.cli import main
-from sensing_antenna.recording import read_recording
+from sensing_antenna.recording import read_recording, write_recording
 
 
 def test_simulate_writes_a_readable_recording(
@@ -106,7 +107,7 @@ def test_simulate_says_when_the_push_is_not_reached(
     assert "nan" not in line
 
 
-def test_plot_recording_writes_pngs(tmp_path: Path) -> None:
+def test_plot_recording_writes_pngs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "rec.csv"
     assert (
         main(
@@ -114,10 +115,19 @@ def test_plot_recording_writes_pngs(tmp_path: Path) -> None:
         )
         == 0
     )
+    capsys.readouterr()
     assert main(["plot", "recording", str(out), "--out", str(tmp_path / "fig")]) == 0
     names = sorted(p.name for p in (tmp_path / "fig").iterdir())
     assert names == ["angles.png", "force.png", "torque.png", "torque_spectrum.png"]
     assert all((tmp_path / "fig" / n).stat().st_size > 5000 for n in names)
+    assert capsys.readouterr().err == ""
+    # torques logged in N mm are drawn as recorded, and said to be off the format's units
+    recording = read_recording(out)
+    write_recording(dataclasses.replace(recording, torque=1000 * recording.torque), out)
+    assert main(["plot", "recording", str(out), "--out", str(tmp_path / "fig")]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith(f"antenna plot recording: warning: {out}: columns 'tx', 'ty', 'tz'")
+    assert "torques in N mm" in err and err.count("\n") == 1
 
 
 def _device_of(path: Path) -> dict[str, object]:

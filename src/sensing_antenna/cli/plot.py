@@ -60,20 +60,33 @@ def _add_recording(kinds: Any) -> None:
         help="angles, forces and torques of a recording",
         description=(
             "The motor angles, the forces and the torques of a recording against time, and the "
-            "spectrum of the torques."
+            "spectrum of the torques; a line on stderr when its angles or its loads at rest "
+            "are not in the format's units (judged against --antenna's link)."
         ),
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
+    parser.add_argument(
+        "--antenna", default="paper-2021", help="built-in name or TOML file (its link's weight)"
+    )
     _add_out(parser)
     parser.set_defaults(func=_run_recording)
 
 
 def _run_recording(args: argparse.Namespace) -> int:
+    from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.calibration.observer import units_problem
     from sensing_antenna.plotting.recording import plot_recording
     from sensing_antenna.recording import read_recording
 
-    for path in plot_recording(read_recording(args.recording), args.out):
+    recording = read_recording(args.recording)
+    for path in plot_recording(recording, args.out):
         print(path)
+    problem = units_problem(recording, load_antenna(args.antenna))
+    if problem is not None:
+        print(
+            f"antenna plot recording: warning: {args.recording}: {problem}; drawn as recorded",
+            file=sys.stderr,
+        )
     return 0
 
 
