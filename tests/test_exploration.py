@@ -885,3 +885,26 @@ def test_a_realistic_devices_posts_reach_its_own_tip() -> None:
     )  # fmt: skip
     assert realistic_calibration_points(0.5) == (0.30, 0.35, 0.40, 0.45, 0.5)
     assert realistic_calibration_points(1.2)[-2:] == (0.98, 1.2)
+
+
+def test_a_stored_point_keeps_whether_its_width_alone_held_it_back() -> None:
+    from sensing_antenna.estimation.result import Status
+    from sensing_antenna.exploration.store import point_from_dict, point_to_dict
+    from sensing_antenna.mapping import ContactPoint
+
+    point = ContactPoint(
+        point=[0.5, 0.0, 0.1],
+        covariance=1e-6 * np.eye(3),
+        status=Status.UNCERTAIN,
+        source="000.csv",
+        method="fast",
+        x_c=0.5,
+        base_position=[0.0, 0.0, 0.0],
+        reason="not sure within 1 s after t_1 (the 95 % interval is 12 mm wide)",
+        held_back_by_width=True,
+    )
+    data = json.loads(json.dumps(point_to_dict(point)))
+    assert point_from_dict(data).held_back_by_width
+    # a point stored before the flag existed was not taken for one
+    del data["held_back_by_width"]
+    assert not point_from_dict(data).held_back_by_width

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -175,22 +176,46 @@ def test_covariance_matches_a_monte_carlo_of_the_geometry(y_c: float) -> None:
     assert np.all(np.abs(predicted / measured - 1) < 0.05), np.abs(predicted / measured - 1).max()
 
 
-def test_only_ok_points_enter_a_map_unless_uncertain_ones_are_asked_for() -> None:
-    def make(status: Status) -> ContactEstimate:
+def test_ok_points_and_those_held_back_by_their_width_alone_enter_a_map() -> None:
+    def make(status: Status, **more: Any) -> ContactEstimate:
         return ContactEstimate(
             status=status,
             reason=None if status is Status.OK else "because",
             method="paper",
             x_c=0.5,
             contact_point=[0.5, 0.0, -0.02],
+            **more,
         )
 
-    points = [
-        contact_point_from_estimate(make(s), ANTENNA, source=s.value)
-        for s in (Status.OK, Status.UNCERTAIN, Status.SLIP_SUSPECTED)
+    # an uncertain fast answer whose one fault is its interval: the point, with that spread
+    wide = make(
+        Status.UNCERTAIN,
+        interval=(0.49, 0.51),
+        diagnostics={"held_back_by_width": True, "other_reasons": []},
+    )
+    # the same with another problem the review found is not
+    also = dataclasses.replace(
+        wide, diagnostics={"held_back_by_width": True, "other_reasons": ["slid"]}
+    )
+    estimates = {
+        "ok": make(Status.OK),
+        "uncertain": make(Status.UNCERTAIN),
+        "slip": make(Status.SLIP_SUSPECTED),
+        "wide": wide,
+        "also": also,
+    }
+    points = [contact_point_from_estimate(e, ANTENNA, source=name) for name, e in estimates.items()]
+    assert [p.held_back_by_width for p in points] == [False, False, False, True, False]
+    assert [p.source for p in select_points(points)] == ["ok", "wide"]
+    assert [p.source for p in select_points(points, include_uncertain=True)] == [
+        "ok",
+        "uncertain",
+        "wide",
+        "also",
     ]
-    assert [p.source for p in select_points(points)] == ["ok"]
-    assert [p.source for p in select_points(points, include_uncertain=True)] == ["ok", "uncertain"]
+    # its covariance along the link is the interval's: 2 cm wide at 95 %
+    sigma = PointUncertainty().sigma_along(wide)
+    assert sigma == pytest.approx(0.02 / (2 * 1.959964), rel=1e-3)
     assert points[2].status is Status.SLIP_SUSPECTED and points[2].reason == "because"
     none = ContactEstimate(status=Status.NO_CONTACT, reason="no contact", method="paper")
     kept = contact_point_from_estimate(none, ANTENNA, source="empty")

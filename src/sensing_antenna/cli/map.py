@@ -21,7 +21,8 @@ def register(subparsers: Any) -> None:
         description=(
             "Estimates the contact point of each recording, places it in the world with its "
             "covariance (the recording's base_pose metadata; none: the recording's own frame), "
-            "fits a Gaussian-process implicit surface through the points with status ok, and "
+            "fits a Gaussian-process implicit surface through the points with status ok (and "
+            "uncertain ones whose interval's width was their one fault), and "
             "fits every shape class (sphere, cylinder, box, cone, capsule, torus, plane) and "
             "any --objects meshes, naming the best or abstaining when two explain the points "
             "equally. Writes points.csv, points.ply, surface.ply, object.ply (the named object's "
@@ -37,7 +38,7 @@ def register(subparsers: Any) -> None:
         "--method", choices=METHOD_NAMES, default="paper", help="the estimation method"
     )
     parser.add_argument("--out", type=Path, required=True, help="output directory")
-    add_map_options(parser, "the map (ok only without it)")
+    add_map_options(parser, "the map (without it, only those whose one fault is their width)")
     parser.add_argument(
         "--t1",
         choices=("rest", "push"),
@@ -84,7 +85,7 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
     parser.add_argument(
         "--include-uncertain",
         action="store_true",
-        help=f"let points with status uncertain into {uncertain_into}",
+        help=f"let every point with status uncertain into {uncertain_into}",
     )
 
 

@@ -410,9 +410,19 @@ def _covariance(
 def select_points(
     points: list[ContactPoint] | tuple[ContactPoint, ...], include_uncertain: bool = False
 ) -> list[ContactPoint]:
-    """The points that enter a map: usable ones with status ``ok`` (and ``uncertain`` if asked)."""
-    allowed = {Status.OK} | ({Status.UNCERTAIN} if include_uncertain else set())
-    return [p for p in points if p.status in allowed and p.usable]
+    """The points that enter a map: usable ones with status ``ok`` or held back by their
+    interval's width alone (:attr:`ContactPoint.held_back_by_width`: their covariance carries
+    it), and every ``uncertain`` one if asked."""
+    return [
+        p
+        for p in points
+        if p.usable
+        and (
+            p.status is Status.OK
+            or p.held_back_by_width
+            or (include_uncertain and p.status is Status.UNCERTAIN)
+        )
+    ]
 
 
 def _angles(value: object, point_a: FloatArray) -> FloatArray:

@@ -236,7 +236,11 @@ def report(contact_map: ContactMap) -> str:
         "# Contact map",
         "",
         f"{s['n_recordings']} recordings ({statuses}); {s['n_used']} points used"
-        + (" (ok and uncertain)" if s["include_uncertain"] else " (status ok)")
+        + (
+            " (ok and uncertain)"
+            if s["include_uncertain"]
+            else " (status ok, or uncertain by their interval's width alone)"
+        )
         + ".",
     ]
     if s["median_point_std_m"] is not None:
