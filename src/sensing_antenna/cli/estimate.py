@@ -171,4 +171,12 @@ def summary(name: str, data: dict[str, Any]) -> str:
     probability = data.get("branch_probability")
     if probability:
         lines.append("  branch prob.    " + ", ".join(f"{p:.3f}" for p in probability))
+    repaired = data.get("diagnostics", {}).get("repaired_samples", [])
+    if repaired:
+        where = ", ".join(
+            f"{_s(r['t'])} ({' '.join(r['channels'])}{', 2 samples' if r['samples'] > 1 else ''})"
+            for r in repaired[:3]
+        )
+        more = f" and {len(repaired) - 3} more" if len(repaired) > 3 else ""
+        lines.append(f"  put back        corrupted sensor samples at {where}{more}")
     return "\n".join(lines)

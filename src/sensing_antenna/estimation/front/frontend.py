@@ -47,6 +47,13 @@ from sensing_antenna.estimation.front.ratio import (
     perpendicular_ratio,
     window_mean,
 )
+from sensing_antenna.estimation.front.spikes import (
+    SPIKE_WINDOW,
+    WRENCH_CHANNELS,
+    find_spikes,
+    repair,
+    spike_floor,
+)
 from sensing_antenna.estimation.front.steps import (
     STEP_JITTER,
     ContactStart,
@@ -158,6 +165,8 @@ class FrontEnd:
         self._detector: ContactDetector | None = None
         self._monitor: PushMonitor | None = None
         self._loads_filter: FirstOrderLowPass | None = None
+        self._spike_floor = spike_floor(antenna)
+        self._spike_gate = self._spike_floor * (1.0 - 1e-9)
         if self._refused is None:
             self._detector = ContactDetector(antenna, ts)
             if cfg.t1_source == "push":
@@ -188,6 +197,18 @@ class FrontEnd:
         self._loads_done = self._ratio_done = self._mean_done = 0
         self._filled: list[tuple[int, tuple[float, float]]] = []  # (known at sample, interval)
         self._put_back_at: list[int] = []  # samples put back where stamps skip (ascending)
+        # samples received but held back until the samples that decide a suspect among them
+        # have come (spikes.find_spikes), and the raw wrench of the last ones released
+        self._pending: tuple[FloatArray, FloatArray, FloatArray] | None = None
+        self._history: FloatArray = np.empty((0, 6))
+        # an upper bound of the largest raw step in the window of SPIKE_WINDOW steps before the
+        # next sample: the largest step of the current run of up to SPIKE_WINDOW steps and of
+        # the run before it (the per-sample path's gate, spikes.find_spikes)
+        self._run_max = np.zeros(6)
+        self._step_bound = np.full(6, np.inf)  # the larger of the two runs' largest steps
+        self._run_count = 0
+        # the spikes put back: (first sample, length, channels)
+        self._spikes: list[tuple[int, int, tuple[int, ...]]] = []
         self._jump: str | None = None  # a step of the time stamps too long to fill
         self._contact: int | None = None
         self._start: ContactStart | None = None
@@ -280,7 +301,21 @@ class FrontEnd:
             return None
         if self._refused is None:
             times, angles, forces, moments = self._put_back(times, angles, forces, moments)
-            count = times.shape[0]
+            # after an outlier time stamp no sample follows: what is held back is released
+            final = self._jump is not None
+            times, angles, forces, moments = self._despike(times, angles, forces, moments, final)
+        return self._ingest(times, angles, forces, moments, filled_gaps)
+
+    def _ingest(
+        self,
+        times: FloatArray,
+        angles: FloatArray,
+        forces: FloatArray,
+        moments: FloatArray,
+        filled_gaps: Sequence[tuple[float, float]] = (),
+    ) -> Gathered | None:
+        """Store the samples released (spikes repaired) and run the steps on them."""
+        count = times.shape[0]
         first, stop = self._n, self._n + count
         self._reserve(stop)
         # the detectors read the samples where they now lie (writable, C-ordered: no copy)
@@ -310,23 +345,102 @@ class FrontEnd:
             return self._stop(self._early(Status.BAD_INPUT, self._jump))
         return outcome
 
+    def _despike(
+        self,
+        t: FloatArray,
+        theta: FloatArray,
+        force: FloatArray,
+        torque: FloatArray,
+        final: bool = False,
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """The samples decided so far, isolated corrupted wrench samples put back on the line
+        between their neighbours (:mod:`.spikes`); those from a suspect whose deciding samples
+        have not come yet are held back (all released, undecided ones as they are, when
+        ``final``). The decisions read the raw samples only, so they are the same however the
+        samples are cut into blocks."""
+        wrench = np.concatenate([force, torque], axis=1)
+        history = self._history
+        if self._pending is None and t.shape[0] == 1 and history.shape[0] == SPIKE_WINDOW + 2:
+            # one sample after calm ones: no suspect when its step and the largest step before
+            # it together stay below the floor (find_spikes' own gate, with a bound of that step)
+            step = np.abs(wrench[0] - history[-1])
+            if not (step + self._step_bound >= self._spike_gate).any():
+                self._history = np.concatenate([history[1:], wrench])
+                # the step folded into the runs (_note_steps), in place
+                np.maximum(self._run_max, step, out=self._run_max)
+                np.maximum(self._step_bound, step, out=self._step_bound)
+                self._run_count += 1
+                if self._run_count >= SPIKE_WINDOW:
+                    self._rotate_runs()
+                return t, theta, force, torque
+        if self._pending is not None:
+            pt, ptheta, pwrench = self._pending
+            t = np.concatenate([pt, t])
+            theta = np.concatenate([ptheta, theta])
+            wrench = np.concatenate([pwrench, wrench])
+        h = history.shape[0]
+        raw = np.concatenate([history, wrench]) if h else wrench
+        spikes, decided = find_spikes(raw, h, self._spike_floor, final=final)
+        released = decided - h
+        if spikes:
+            origin = self._n - h  # sample index of raw[0]
+            self._spikes.extend((origin + s.index, s.length, s.channels) for s in spikes)
+            out = repair(raw, spikes)[h:decided]
+            force, torque = out[:, 0:3], out[:, 3:6]
+        elif released < t.shape[0] or self._pending is not None:
+            force, torque = wrench[:released, 0:3], wrench[:released, 3:6]
+        self._pending = (
+            None if released == t.shape[0] else (t[released:], theta[released:], wrench[released:])
+        )
+        self._history = raw[:decided][-(SPIKE_WINDOW + 2) :]
+        if released:
+            with np.errstate(over="ignore", invalid="ignore"):
+                self._note_steps(np.abs(np.diff(raw[max(h - 1, 0) : decided], axis=0)))
+        return t[:released], theta[:released], force, torque
+
+    def _note_steps(self, steps: FloatArray) -> None:
+        """Fold the raw steps (absolute, (k, 6)) into the samples released into the runs'
+        largest steps (a run that reaches SPIKE_WINDOW steps or more becomes the last one)."""
+        if not steps.shape[0]:
+            return
+        largest = steps.max(axis=0)
+        self._run_max = np.maximum(self._run_max, largest)
+        self._step_bound = np.maximum(self._step_bound, largest)
+        self._run_count += steps.shape[0]
+        if self._run_count >= SPIKE_WINDOW:
+            self._rotate_runs()
+
+    def _rotate_runs(self) -> None:
+        self._step_bound = self._run_max
+        self._run_max, self._run_count = np.zeros(6), 0
+
+    def _last_received(self) -> tuple[float, FloatArray] | None:
+        """The last sample received (held back or stored): its time and values (theta, force,
+        torque), or None before the first."""
+        if self._pending is not None:
+            pt, ptheta, pwrench = self._pending
+            return float(pt[-1]), np.concatenate([ptheta[-1], pwrench[-1]])
+        n = self._n
+        if not n:
+            return None
+        return float(self._t[n - 1]), np.concatenate(
+            [self._theta[n - 1], self._force[n - 1], self._torque[n - 1]]
+        )
+
     def _put_back(
         self, t: FloatArray, theta: FloatArray, force: FloatArray, torque: FloatArray
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """The block with the samples its time stamps skip put back (:func:`fill_missing`), the
         long steps remembered as gaps from their first sample put back; cut before a step
         beyond any filling, which ends the run (``bad_input``) after the samples before it."""
-        n, ts = self._n, self.sample_period
-        if (
-            n
-            and t.shape[0] == 1
-            and (float(t[0]) - float(self._t[n - 1])) < (2.0 - STEP_JITTER) * ts
-        ):
-            return t, theta, force, torque  # the loop's case: the next sample, nothing skipped
-        previous = None
-        if n:
-            before = np.concatenate([self._theta[n - 1], self._force[n - 1], self._torque[n - 1]])
-            previous = (float(self._t[n - 1]), before)
+        ts = self.sample_period
+        pending = self._pending
+        n = self._n + (0 if pending is None else pending[0].shape[0])
+        if n and t.shape[0] == 1:
+            last = float(pending[0][-1]) if pending is not None else float(self._t[self._n - 1])
+            if (float(t[0]) - last) < (2.0 - STEP_JITTER) * ts:
+                return t, theta, force, torque  # the loop's case: the next sample, nothing skipped
+        previous = self._last_received()
         filled = fill_missing(
             t, np.hstack([theta, force, torque]), ts, self.config.max_gap, previous
         )
@@ -553,6 +667,17 @@ class FrontEnd:
         filled = bisect.bisect_right(self._put_back_at, last)
         if filled:
             notes["filled_samples"] = filled
+        repaired = [
+            {
+                "t": float(self._t[index]),
+                "samples": length,
+                "channels": [WRENCH_CHANNELS[c] for c in channels],
+            }
+            for index, length, channels in self._spikes
+            if index <= last
+        ]
+        if repaired:
+            notes["repaired_samples"] = repaired
         return notes
 
     def _diagnostics(self, end: int | None = None) -> dict[str, Any]:
@@ -595,6 +720,13 @@ class FrontEnd:
         """Close the run at the end of the samples: the outcome given, or the one they give."""
         if self._outcome is not None:
             return self._outcome
+        if self._pending is not None:
+            # the samples held back: decided as far as they can be, the rest as they are
+            empty = np.empty((0, 3))
+            released = self._despike(np.empty(0), np.empty((0, 2)), empty, empty, final=True)
+            outcome = self._ingest(*released)
+            if outcome is not None:
+                return outcome
         with _samples_arithmetic():
             return self._finish()
 
