@@ -905,6 +905,6 @@ def test_a_stored_point_keeps_whether_its_width_alone_held_it_back() -> None:
     )
     data = json.loads(json.dumps(point_to_dict(point)))
     assert point_from_dict(data).held_back_by_width
-    # a point stored before the flag existed was not taken for one
+    # a stored point without the key is not one
     del data["held_back_by_width"]
     assert not point_from_dict(data).held_back_by_width

@@ -207,6 +207,9 @@ def test_ok_points_and_those_held_back_by_their_width_alone_enter_a_map() -> Non
     points = [contact_point_from_estimate(e, ANTENNA, source=name) for name, e in estimates.items()]
     assert [p.held_back_by_width for p in points] == [False, False, False, True, False]
     assert [p.source for p in select_points(points)] == ["ok", "wide"]
+    # the flag stands for an uncertain answer only: on another status it lets nothing in
+    flagged = dataclasses.replace(points[2], held_back_by_width=True)
+    assert select_points([flagged], include_uncertain=True) == []
     assert [p.source for p in select_points(points, include_uncertain=True)] == [
         "ok",
         "uncertain",

@@ -91,14 +91,15 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     distinct_files(args.recordings)
-    created = not args.out.exists()
+    # the directories --out makes (itself and missing parents), removed again if left empty
+    made = [p for p in (args.out, *args.out.parents) if not p.exists()]
     args.out.mkdir(parents=True, exist_ok=True)  # a file in its way: said before estimating
     try:
         _map_into(args)
     except BaseException:
-        if created:  # a map that failed leaves no empty directory behind
+        for path in made:  # deepest first: a map that failed leaves no empty directory behind
             with contextlib.suppress(OSError):
-                args.out.rmdir()
+                path.rmdir()
         raise
     return 0
 

@@ -79,9 +79,10 @@ def _run_recording(args: argparse.Namespace) -> int:
     from sensing_antenna.recording import read_recording
 
     recording = read_recording(args.recording)
+    antenna = load_antenna(args.antenna)  # a bad file said before any figure is written
     for path in plot_recording(recording, args.out):
         print(path)
-    problem = units_problem(recording, load_antenna(args.antenna))
+    problem = units_problem(recording, antenna)
     if problem is not None:
         print(
             f"antenna plot recording: warning: {args.recording}: {problem}; drawn as recorded",

@@ -419,8 +419,7 @@ def select_points(
         if p.usable
         and (
             p.status is Status.OK
-            or p.held_back_by_width
-            or (include_uncertain and p.status is Status.UNCERTAIN)
+            or (p.status is Status.UNCERTAIN and (p.held_back_by_width or include_uncertain))
         )
     ]
 

@@ -2,8 +2,11 @@
 
 The front end turns samples into the :class:`~.evidence.Evidence` a method concludes from, or into
 an :class:`~.outcome.EarlyOutcome` when no estimate is possible. Its steps (Section 4), each
-causal, so an instant depends only on the samples up to it:
+causal, so an instant depends only on the samples up to it (and, where a sensor sample is
+suspected of corruption, on the three after it, which the stream waits for):
 
+0. Corrupted sensor samples, one or two between calm neighbours, put back on the line between
+   them (:mod:`.spikes`).
 1. t_c: the contact detector of Section 4.2
    (:class:`~sensing_antenna.detection.contact.ContactDetector`); the sensor offset and the rest
    tolerance from the samples up to t_c.
@@ -222,7 +225,8 @@ class FrontEnd:
     @property
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed, and those put back where the time stamps
-        skipped some (:meth:`update_block`)."""
+        skipped some (:meth:`update_block`); not those held back until the samples that decide
+        a suspected corruption among them have come (at most three)."""
         return self._n
 
     @property
@@ -363,7 +367,8 @@ class FrontEnd:
         if self._pending is None and t.shape[0] == 1 and history.shape[0] == SPIKE_WINDOW + 2:
             # one sample after calm ones: no suspect when its step and the largest step before
             # it together stay below the floor (find_spikes' own gate, with a bound of that step)
-            step = np.abs(wrench[0] - history[-1])
+            # a step that is no number (a NaN sample, inf - inf) bounds nothing: inf
+            step = np.nan_to_num(np.abs(wrench[0] - history[-1]), nan=np.inf)
             if not (step + self._step_bound >= self._spike_gate).any():
                 self._history = np.concatenate([history[1:], wrench])
                 # the step folded into the runs (_note_steps), in place
@@ -395,7 +400,8 @@ class FrontEnd:
         self._history = raw[:decided][-(SPIKE_WINDOW + 2) :]
         if released:
             with np.errstate(over="ignore", invalid="ignore"):
-                self._note_steps(np.abs(np.diff(raw[max(h - 1, 0) : decided], axis=0)))
+                steps = np.abs(np.diff(raw[max(h - 1, 0) : decided], axis=0))
+                self._note_steps(np.nan_to_num(steps, nan=np.inf))
         return t[:released], theta[:released], force, torque
 
     def _note_steps(self, steps: FloatArray) -> None:

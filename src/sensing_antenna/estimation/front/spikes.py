@@ -8,14 +8,16 @@ second and the spectrum's floor, and the statuses that follow name causes it is 
 units, a sign flipped, a tip mass). Here, per channel, sample j is a *suspect* when its step
 from j - 1 departs from the local trend (the median of the ``SPIKE_WINDOW`` first differences
 before it) by more than ``SPIKE_FACTOR`` robust deviations (1.4826 times their median absolute
-deviation); it is a *spike* when the signal comes back to the trend at j + 1 (one sample) or
-j + 2 (two) within the same bound, and then the corrupted samples are replaced by the straight
-line between their neighbours. A step that stays (an impact, a contact) is left alone. Every
-decision reads the raw samples j - SPIKE_WINDOW - 1 .. j + 2 only, so a stream decides as a
-whole recording does, holding a suspect back until the two samples after it have come.
+deviation) and by more than a floor (:func:`spike_floor`); it is a *spike* when the signal
+comes back to the trend at j + 1 (one sample) or j + 2 (two) within the same bound and goes on
+calmly, and then the corrupted samples are replaced by the straight line between their
+neighbours. A step that stays (a contact) is left alone; a single-sample pulse of an impact
+above the floor would not be. Every decision reads the raw samples j - SPIKE_WINDOW - 1 ..
+j + SPIKE_LOOKAHEAD only, so a stream decides as a whole recording does, holding a suspect back
+until the three samples after it have come.
 
-White noise departs from the trend by 10 deviations with probability below 1e-22 per sample
-and channel; a sample that does so and comes back is no sensor noise.
+The median absolute deviation of 31 steps is itself noisy, so white noise alone passes ten of
+them now and then; the floor, far above any sensor's noise, is what keeps its samples.
 """
 
 from __future__ import annotations
@@ -48,9 +50,8 @@ SPIKE_FACTOR = 10.0
 #: Samples after a suspect that decide it.
 SPIKE_LOOKAHEAD = 3
 #: Least spike, in the link's weight (forces) and its weight's moment, the link horizontal
-#: (torques): the link's own impacts ring single samples that calm neighbours surround, on the
-#: simulator up to 1.25 times the weight in a force and 0.11 times the moment in a torque (first
-#: touch and rebounds near the tip, 80 recordings over noise 0 to 4 and both devices).
+#: (torques): above the single-sample pulses the link's own impacts ring between calm
+#: neighbours (docs/design-notes.md, "Corrupted single samples").
 SPIKE_FLOOR_WEIGHTS = (2.0, 0.5)
 #: MAD to standard deviation for Gaussian noise.
 _MAD_TO_SIGMA = 1.4826
@@ -105,7 +106,7 @@ def find_spikes(
         # of those w steps, at most their largest in size) by more than the floor: only samples
         # whose step and largest window step together exceed it are judged (the same decisions,
         # without a median for every calm sample).
-        if size - w == 1:
+        if size - w == 1:  # one sample to judge (the stream's case): no sliding window
             largest = absd[:w].max(axis=0)[None, :]
         else:
             largest = np.lib.stride_tricks.sliding_window_view(absd[: size - 1], w, axis=0).max(
