@@ -683,9 +683,10 @@ def test_what_the_points_do_not_show_has_no_deviation() -> None:
 
 def test_an_end_a_few_wide_points_touch_is_held_loosely_or_bounded_below() -> None:
     # The side at 0.3 mm, each cap touched by three points of 4 mm: the height is measured with
-    # a deviation of the caps' order (4 mm / sqrt(3) each end), not the side's, or, where the
-    # caps' points lie too near the rim to be told from the side's, a lower bound below the
-    # truth; never the side's precision
+    # a deviation of the caps' order (4 mm / sqrt(3) each end; up to a few times that where
+    # the caps' points lie near the rim, whose growth releases them), not the side's, or, where
+    # they lie too near the rim to be told from the side's, a lower bound below the truth;
+    # never the side's precision
     rng = np.random.default_rng(6)
     outcomes = []
     for _ in range(5):
@@ -701,7 +702,7 @@ def test_an_end_a_few_wide_points_touch_is_held_loosely_or_bounded_below() -> No
             assert fit.size_at_least["height"] < 0.15
             outcomes.append("bound")
         else:
-            assert 0.001 < fit.size_std["height"] < 0.01
+            assert 0.001 < fit.size_std["height"] < 0.025
             assert abs(fit.sizes["height"] - 0.15) < 3 * fit.size_std["height"]
             outcomes.append("measured")
     assert "measured" in outcomes, outcomes

@@ -123,9 +123,10 @@ class Primitive:
         """Each way the shape can grow at one end of a size while the rest of it stays: the
         sizes it changes (indices into ``size_names``) and the parameter vector's change per
         metre the end moves outward along the shape's axis. A box's extent grows at either
-        face, a cylinder's height or a capsule's length at either end, a cone at its base
-        along its slant (its radius and height together; the base's rim moves sqrt(1 + (R /
-        h)^2) m per metre); a sphere's or a torus's sizes have no ends."""
+        face, a cylinder's height at either cap and its radius at its side, a capsule's length
+        at either end, a cone at its base along its slant (its radius and height together; the
+        base's rim moves sqrt(1 + (R / h)^2) m per metre); a sphere's or a torus's sizes have
+        no ends."""
         return self._growths(np.asarray(parameters, dtype=float))
 
     def mesh(self, parameters: FloatArray) -> trimesh.Trimesh | None:
@@ -281,6 +282,13 @@ def _box_growths(parameters: FloatArray) -> tuple[Growth, ...]:
     return tuple(g for axis in range(3) for g in _axis_ends(axis, axis)(parameters))
 
 
+def _cylinder_growths(parameters: FloatArray) -> tuple[Growth, ...]:
+    # the height at either cap, and the radius: the side moves out by one metre per metre
+    radial = np.zeros(len(parameters))
+    radial[6] = 1.0
+    return (*_axis_ends(1, 2)(parameters), ((0,), radial))
+
+
 def _cone_growth(parameters: FloatArray) -> tuple[Growth, ...]:
     # the base moves out along -Z by one metre and the slant goes on: the radius grows by R / h
     change = np.zeros(len(parameters))
@@ -351,7 +359,7 @@ PRIMITIVES: dict[str, Primitive] = {
             _cylinder,
             lambda p: p[6:8],
             _with_pose(lambda p: trimesh.creation.cylinder(radius=p[6], height=p[7], sections=64)),
-            _growths=_axis_ends(1, 2),
+            _growths=_cylinder_growths,
             _canonical=_canonical_pose,
         ),
         Primitive(
