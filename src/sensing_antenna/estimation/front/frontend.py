@@ -54,6 +54,7 @@ from sensing_antenna.estimation.front.spikes import (
     SPIKE_WINDOW,
     WRENCH_CHANNELS,
     find_spikes,
+    judged_from,
     repair,
     spike_floor,
 )
@@ -169,7 +170,7 @@ class FrontEnd:
         self._monitor: PushMonitor | None = None
         self._loads_filter: FirstOrderLowPass | None = None
         self._spike_floor = spike_floor(antenna)
-        self._spike_gate = self._spike_floor * (1.0 - 1e-9)
+        self._spike_gate = judged_from(self._spike_floor)
         if self._refused is None:
             self._detector = ContactDetector(antenna, ts)
             if cfg.t1_source == "push":
@@ -371,12 +372,7 @@ class FrontEnd:
             step = np.nan_to_num(np.abs(wrench[0] - history[-1]), nan=np.inf)
             if not (step + self._step_bound >= self._spike_gate).any():
                 self._history = np.concatenate([history[1:], wrench])
-                # the step folded into the runs (_note_steps), in place
-                np.maximum(self._run_max, step, out=self._run_max)
-                np.maximum(self._step_bound, step, out=self._step_bound)
-                self._run_count += 1
-                if self._run_count >= SPIKE_WINDOW:
-                    self._rotate_runs()
+                self._note_steps(step, 1)
                 return t, theta, force, torque
         if self._pending is not None:
             pt, ptheta, pwrench = self._pending
@@ -401,18 +397,17 @@ class FrontEnd:
         if released:
             with np.errstate(over="ignore", invalid="ignore"):
                 steps = np.abs(np.diff(raw[max(h - 1, 0) : decided], axis=0))
-                self._note_steps(np.nan_to_num(steps, nan=np.inf))
+            if steps.shape[0]:
+                self._note_steps(np.nan_to_num(steps, nan=np.inf).max(axis=0), steps.shape[0])
         return t[:released], theta[:released], force, torque
 
-    def _note_steps(self, steps: FloatArray) -> None:
-        """Fold the raw steps (absolute, (k, 6)) into the samples released into the runs'
-        largest steps (a run that reaches SPIKE_WINDOW steps or more becomes the last one)."""
-        if not steps.shape[0]:
-            return
-        largest = steps.max(axis=0)
-        self._run_max = np.maximum(self._run_max, largest)
-        self._step_bound = np.maximum(self._step_bound, largest)
-        self._run_count += steps.shape[0]
+    def _note_steps(self, largest: FloatArray, count: int) -> None:
+        """Fold ``count`` raw steps into the samples released, ``largest`` their largest size
+        per channel (shape (6,); inf for a step that is no number), into the runs' largest
+        steps (a run that reaches SPIKE_WINDOW steps or more becomes the last one)."""
+        np.maximum(self._run_max, largest, out=self._run_max)
+        np.maximum(self._step_bound, largest, out=self._step_bound)
+        self._run_count += count
         if self._run_count >= SPIKE_WINDOW:
             self._rotate_runs()
 

@@ -36,6 +36,7 @@ __all__ = [
     "WRENCH_CHANNELS",
     "Spike",
     "find_spikes",
+    "judged_from",
     "repair",
     "spike_floor",
 ]
@@ -113,7 +114,7 @@ def find_spikes(
                 axis=-1
             )
         step = d[w:]
-        candidate = absd[w:] + largest >= floor * (1.0 - 1e-9)
+        candidate = absd[w:] + largest >= judged_from(floor)
         rows = np.flatnonzero(candidate.any(axis=1))
         flagged = np.zeros(step.shape, dtype=bool)
         trend = np.zeros(step.shape)
@@ -149,6 +150,14 @@ def find_spikes(
         if single or double:
             skip_to = j + 1 + (2 if double else 1)
     return spikes, n
+
+
+def judged_from(floor: FloatArray) -> FloatArray:
+    """The least sum of a sample's step and the largest step of its window (N, N m, per
+    channel) that :func:`find_spikes` judges: below it the step cannot leave the trend (the
+    window's median, at most its largest step) by the ``floor``; a relative 1e-9 less, for
+    rounding."""
+    return np.asarray(floor * (1.0 - 1e-9))
 
 
 def spike_floor(antenna: Antenna) -> FloatArray:
