@@ -331,8 +331,7 @@ def _check_inertia(inertia: float, rigid: float, where: str) -> None:
 def units_problem(recording: Recording, antenna: Antenna) -> str | None:
     """Why a recording is not in the format's units, or None: its angles and its loads at rest at
     the start (:func:`~sensing_antenna.units_check.recording_problem`), at rest as the
-    estimators judge it (the rest tolerance and window of ``EstimatorConfig``). Identification
-    and calibration both ask it."""
+    estimators judge it (the rest tolerance and window of ``EstimatorConfig``)."""
     problem = angle_problem(recording.theta)
     if problem is not None:
         # before the rest tolerance, whose angle differences a glitch of 1e308 rad overflows

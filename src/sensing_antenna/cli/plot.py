@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from sensing_antenna.cli.arguments import add_actions
+from sensing_antenna.cli.estimate import DEFAULT_ANTENNA
 
 
 def register(subparsers: Any) -> None:
@@ -40,7 +41,7 @@ def _add_sensing_curves(kinds: Any) -> None:
             "of the link against the contact point; Figure 9, f2 - f1 against f1."
         ),
     )
-    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
+    parser.add_argument("--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file")
     _add_out(parser)
     parser.set_defaults(func=_run_sensing_curves)
 
@@ -66,7 +67,7 @@ def _add_recording(kinds: Any) -> None:
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
     parser.add_argument(
-        "--antenna", default="paper-2021", help="built-in name or TOML file (its link's weight)"
+        "--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file (its link's weight)"
     )
     _add_out(parser)
     parser.set_defaults(func=_run_recording)
@@ -102,7 +103,7 @@ def _add_estimate(kinds: Any) -> None:
         ),
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
-    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
+    parser.add_argument("--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file")
     _add_out(parser)
     parser.set_defaults(func=_run_estimate)
 
