@@ -216,7 +216,8 @@ def test_ok_points_and_those_held_back_by_their_width_alone_enter_a_map() -> Non
         "wide",
         "also",
     ]
-    # its covariance along the link is the interval's: 2 cm wide at 95 %
+    # its covariance along the link is the interval's: 2 cm wide at 95 %, the normal's
+    # 97.5 % quantile 1.959964 each side (to 1e-6, far inside the 1e-3 allowed)
     sigma = PointUncertainty().sigma_along(wide)
     assert sigma == pytest.approx(0.02 / (2 * 1.959964), rel=1e-3)
     assert points[2].status is Status.SLIP_SUSPECTED and points[2].reason == "because"
