@@ -368,9 +368,10 @@ class FrontEnd:
         if self._pending is None and t.shape[0] == 1 and history.shape[0] == SPIKE_WINDOW + 2:
             # one sample after calm ones: no suspect when its step and the largest step before
             # it together stay below the floor (find_spikes' own gate, with a bound of that step)
-            # a step that is no number (a NaN sample, inf - inf) bounds nothing: inf
-            step = np.nan_to_num(np.abs(wrench[0] - history[-1]), nan=np.inf)
-            if not (step + self._step_bound >= self._spike_gate).any():
+            # a step that is no number (a NaN sample, inf - inf) bounds nothing: NaN, carried
+            # by np.maximum into the bound, fails "below the gate" as inf would
+            step = np.abs(wrench[0] - history[-1])
+            if (step + self._step_bound < self._spike_gate).all():
                 self._history = np.concatenate([history[1:], wrench])
                 self._note_steps(step, 1)
                 return t, theta, force, torque
@@ -397,14 +398,15 @@ class FrontEnd:
         if released:
             with np.errstate(over="ignore", invalid="ignore"):
                 steps = np.abs(np.diff(raw[max(h - 1, 0) : decided], axis=0))
-            if steps.shape[0]:
-                self._note_steps(np.nan_to_num(steps, nan=np.inf).max(axis=0), steps.shape[0])
+                if steps.shape[0]:
+                    self._note_steps(steps.max(axis=0), steps.shape[0])
         return t[:released], theta[:released], force, torque
 
     def _note_steps(self, largest: FloatArray, count: int) -> None:
         """Fold ``count`` raw steps into the samples released, ``largest`` their largest size
-        per channel (shape (6,); inf for a step that is no number), into the runs' largest
-        steps (a run that reaches SPIKE_WINDOW steps or more becomes the last one)."""
+        per channel (shape (6,); NaN for a step that is no number, which np.maximum keeps),
+        into the runs' largest steps (a run that reaches SPIKE_WINDOW steps or more becomes the
+        last one)."""
         np.maximum(self._run_max, largest, out=self._run_max)
         np.maximum(self._step_bound, largest, out=self._step_bound)
         self._run_count += count
