@@ -1,0 +1,265 @@
+"""What corrupted force/torque samples (a sensor bus's glitches) do to the estimates.
+
+A measurement: simulated contacts of the paper antenna (the estimators given the device's own T),
+each recorded once clean and then many times with a burst of corrupted samples: one channel of
+the push's force, one of its torque, or all six, set to 5, 50 or 10^4 times the channel's largest
+clean value, sign-flipped, or zeroed, for 1 to 20 samples in a row, at instants from the initial
+rest to just before the paper method's t_e (2 s). For each burst length and method it counts
+the clean ``ok`` answers that stay ``ok`` within 2 mm of the clean answer, move further while
+``ok`` (more than 2 mm, more than 2 cm), or turn into another status (with the statuses and the
+most common reasons), and how many answers name the samples they put back.
+
+Usage::
+
+    python benchmarks/eval_glitches.py [--lengths 1 2 3 5 10 12 20] [--instants 8] [--workers 2]
+        [--json benchmarks/results/glitches.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from collections import Counter
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from machine import machine_info
+from sensing_antenna.antenna import load_antenna
+from sensing_antenna.estimation import conclude, gather
+from sensing_antenna.recording import Recording
+from sensing_antenna.simulator import Scenario, simulate
+
+METHODS = ("paper", "ratio", "two-frequency", "fast")
+CONTACTS = (
+    ("azimuthal", 0.30),
+    ("azimuthal", 0.55),
+    ("azimuthal", 0.80),
+    ("azimuthal", 0.95),
+    ("vertical", 0.40),
+    ("vertical", 0.65),
+    ("vertical", 0.90),
+)
+KINDS = ("x5", "x50", "x1e4", "flip", "zero")
+MOVED = 0.002  # m: an ok answer further than this from the clean one has moved
+WRONG = 0.02  # m: ... and further than this is wrong
+KEPT = 0.0005  # m: the results file keeps the estimates that moved further (or changed status)
+RESULTS = Path(__file__).parent / "results" / "glitches.json"
+
+
+def corrupt(
+    recording: Recording, start: int, length: int, channels: list[int], kind: str
+) -> Recording:
+    """``recording`` with samples ``start .. start + length - 1`` of ``channels`` corrupted."""
+    loads = np.hstack([recording.force, recording.torque])
+    rows = slice(start, start + length)
+    for c in channels:
+        largest = float(np.max(np.abs(loads[:, c])))
+        if kind == "flip":
+            loads[rows, c] = -loads[rows, c]
+        elif kind == "zero":
+            loads[rows, c] = 0.0
+        else:
+            loads[rows, c] = float(kind[1:]) * largest
+    return Recording(
+        t=recording.t,
+        theta=recording.theta,
+        force=loads[:, :3],
+        torque=loads[:, 3:],
+        metadata=dict(recording.metadata),
+    )
+
+
+def _estimates(recording: Recording, model: Any) -> dict[str, tuple[str, float, str, int]]:
+    """Per method: (status, x_c, reason, samples put back)."""
+    evidence = gather(recording, model)
+    out = {}
+    for method in METHODS:
+        result = conclude(evidence, method)
+        repaired = result.diagnostics.get("repaired_samples", []) or []
+        out[method] = (result.status.value, float(result.x_c), result.reason or "", len(repaired))
+    return out
+
+
+def run_contact(args: tuple[str, float, list[int], int]) -> list[dict[str, Any]]:
+    """Every glitch of one contact: one row per (glitch, method)."""
+    case, x_c, lengths, instants = args
+    antenna = load_antenna("paper-2021")
+    model = antenna.self_calibrated()
+    seed = round(1000 * x_c) + (0 if case == "azimuthal" else 7)
+    clean = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=seed))
+    clean = clean.without_ground_truth()
+    reference = _estimates(clean, model)
+    loads = np.hstack([clean.force, clean.torque])
+    spread = np.ptp(loads, axis=0)
+    groups = {
+        "force": [int(np.argmax(spread[:3]))],
+        "torque": [3 + int(np.argmax(spread[3:]))],
+        "all": list(range(6)),
+    }
+    end = float(np.searchsorted(clean.t, 2.0))  # before the paper method's t_e (t_1 + 1 s)
+    starts = np.linspace(0.2 / clean.sample_period, end - 12, instants).astype(int)
+    rows = []
+    for length in lengths:
+        for group, channels in groups.items():
+            for kind in KINDS:
+                for start in starts:
+                    glitched = corrupt(clean, int(start), length, channels, kind)
+                    for method, (status, x, reason, repaired) in _estimates(
+                        glitched, model
+                    ).items():
+                        ref_status, ref_x, _, _ = reference[method]
+                        rows.append(
+                            {
+                                "case": case,
+                                "x_c": x_c,
+                                "length": length,
+                                "channels": group,
+                                "kind": kind,
+                                "t": float(clean.t[int(start)]),
+                                "method": method,
+                                "clean_status": ref_status,
+                                "clean_x": ref_x,
+                                "status": status,
+                                "x": x,
+                                "reason": reason,
+                                "repaired": repaired,
+                            }
+                        )
+    return rows
+
+
+def _reason_key(reason: str) -> str:
+    """A reason without its numbers, to count alike reasons together."""
+    words = [
+        w
+        for w in reason.replace("(", " ").replace(")", " ").split()
+        if not any(ch.isdigit() for ch in w)
+    ]
+    return " ".join(words[:10])
+
+
+def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per (length, method), over the glitches of clean ``ok`` answers."""
+    table = []
+    for length in sorted({r["length"] for r in rows}):
+        for method in METHODS:
+            group = [
+                r
+                for r in rows
+                if r["length"] == length and r["method"] == method and r["clean_status"] == "ok"
+            ]
+            ok = [r for r in group if r["status"] == "ok"]
+            shift = [abs(r["x"] - r["clean_x"]) for r in ok]
+            turned = [r for r in group if r["status"] != "ok"]
+            table.append(
+                {
+                    "length": length,
+                    "method": method,
+                    "glitched": len(group),
+                    "ok_same": sum(1 for s in shift if s <= MOVED),
+                    "ok_moved": sum(1 for s in shift if not s <= MOVED),
+                    "ok_wrong": sum(1 for s in shift if not s <= WRONG),
+                    "ok_max_shift_mm": 1e3 * max(shift, default=0.0),
+                    "not_ok": len(turned),
+                    "statuses": dict(Counter(r["status"] for r in turned).most_common()),
+                    "reasons": dict(
+                        Counter(_reason_key(r["reason"]) for r in turned).most_common(5)
+                    ),
+                    "named_repairs": sum(1 for r in group if r["repaired"]),
+                }
+            )
+    return table
+
+
+def print_table(table: list[dict[str, Any]]) -> None:
+    header = (
+        f"{'len':>3} {'method':<14} {'glitched':>8} {'ok same':>7} {'ok >2mm':>7} "
+        f"{'ok >2cm':>7} {'max mm':>8} {'not ok':>6} {'put back':>8}"
+    )
+    print(header)
+    print("-" * len(header))
+    for row in table:
+        print(
+            f"{row['length']:>3} {row['method']:<14} {row['glitched']:>8} {row['ok_same']:>7} "
+            f"{row['ok_moved']:>7} {row['ok_wrong']:>7} {row['ok_max_shift_mm']:>8.1f} "
+            f"{row['not_ok']:>6} {row['named_repairs']:>8}"
+        )
+
+
+def _changed(row: dict[str, Any]) -> bool:
+    """Whether an estimate's status or x_c differs from the clean recording's (by ``KEPT``)."""
+    return row["status"] != row["clean_status"] or not abs(row["x"] - row["clean_x"]) <= KEPT
+
+
+def _short(value: Any) -> Any:
+    """Floats to 7 significant digits; not finite as null."""
+    if isinstance(value, float):
+        return float(f"{value:.7g}") if math.isfinite(value) else None
+    return value
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--lengths", type=int, nargs="+", default=[1, 2, 3, 5, 10, 12, 20])
+    parser.add_argument("--instants", type=int, default=8)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--json", type=Path, default=RESULTS)
+    parser.add_argument("--note", default="")
+    args = parser.parse_args()
+    start = time.perf_counter()
+    jobs = [(case, x_c, args.lengths, args.instants) for case, x_c in CONTACTS]
+    rows: list[dict[str, Any]] = []
+    with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        for (case, x_c), contact_rows in zip(CONTACTS, pool.map(run_contact, jobs), strict=True):
+            rows.extend(contact_rows)
+            print(f"  {case} {x_c:.2f} m: done ({time.perf_counter() - start:.0f} s)", flush=True)
+    table = summarise(rows)
+    print_table(table)
+    for row in table:
+        if row["not_ok"]:
+            print(f"{row['length']:>3} {row['method']:<14} {row['statuses']}")
+            for reason, count in row["reasons"].items():
+                print(f"      {count:>4}  {reason}")
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    fields = (
+        "case",
+        "x_c",
+        "length",
+        "channels",
+        "kind",
+        "t",
+        "method",
+        "clean_status",
+        "clean_x",
+        "status",
+        "x",
+        "repaired",
+    )
+    changed = [r for r in rows if _changed(r)]
+    payload = {
+        "note": args.note,
+        "lengths": args.lengths,
+        "instants": args.instants,
+        "machine": machine_info(),
+        "seconds": time.perf_counter() - start,
+        "moved_m": MOVED,
+        "wrong_m": WRONG,
+        "summary": table,
+        "rows_kept": f"the {len(changed)} of {len(rows)} estimates whose status changed or "
+        f"whose x_c moved by more than {1e3 * KEPT:g} mm",
+        "row_fields": list(fields),
+        "rows": [[_short(r[f]) for f in fields] for r in changed],
+    }
+    text = json.dumps({k: v for k, v in payload.items() if k != "rows"}, indent=1)
+    lines = ",\n".join(json.dumps(row, allow_nan=False) for row in payload["rows"])
+    args.json.write_text(text[:-2] + ',\n "rows": [\n' + lines + "\n ]\n}\n")
+    print(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()
