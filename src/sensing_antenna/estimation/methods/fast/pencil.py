@@ -93,10 +93,14 @@ def first_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
 
 
 def pencil_poles(y: FloatArray, n_modes: int) -> ComplexArray | None:
-    """Matrix-pencil poles for up to ``n_modes`` modes plus the polynomial and spare poles."""
+    """Matrix-pencil poles for up to ``n_modes`` modes plus the polynomial and spare poles;
+    None for too few samples, or samples whose squares overflow (a glitch beyond any sensor)."""
     n_poles = min(2 * n_modes + 4, y.shape[0] // 3)
     if n_poles < 2:
         return None
+    with np.errstate(over="ignore", invalid="ignore"):
+        if not math.isfinite(float(np.sum(np.square(y)))):
+            return None
     return matrix_pencil_poles(y, n_poles)
 
 
