@@ -20,6 +20,7 @@ from _models import calibrated
 from sensing_antenna.antenna import load_antenna, paper_antenna
 from sensing_antenna.cli.estimate import summary
 from sensing_antenna.estimation import OnlineEstimator, Status, estimate
+from sensing_antenna.estimation.front.spikes import SPIKE_LONGEST
 from sensing_antenna.recording import Recording
 from test_estimation_pipeline import Synthetic, comparable, synthetic_recording
 
@@ -137,13 +138,13 @@ def test_human_output_says_best_guess_for_doubtful_estimates() -> None:
     assert wrong.to_dict()["x_c"] == wrong.x_c  # JSON keeps the best guess
 
 
-def _glitched(column: int, value: float, count: int = 1) -> Recording:
-    """A clean synthetic push at 0.5 m with ``count`` load samples from 50 ms after t_1 set to
-    ``value``."""
+def _glitched(column: int, value: float, count: int = 1, after_t1: float = 0.05) -> Recording:
+    """A clean synthetic push at 0.5 m with ``count`` load samples from ``after_t1`` (s) after
+    t_1 set to ``value``."""
     recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
     clean = estimate(recording, calibrated())
     assert clean.status is Status.OK, clean.reason
-    k = int(np.searchsorted(recording.t, clean.t_1 + 0.05))
+    k = int(np.searchsorted(recording.t, clean.t_1 + after_t1))
     loads = np.hstack([recording.force, recording.torque])
     loads[k : k + count, column] = value
     return Recording(t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:])
@@ -154,11 +155,11 @@ def _glitched(column: int, value: float, count: int = 1) -> Recording:
 def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
     column: int, value: float
 ) -> None:
-    # Three samples of 1e300 N (or N m) after t_1, where the hold, the ratio and the spectrum
-    # read (more than the two in a row the front end puts back): sums, norms, the ratio's fixed
-    # point overflow. The suite runs with warnings as errors, so a NumPy warning here (lines on
-    # a user's terminal) fails the test. Found by the fuzz suite.
-    glitched = _glitched(column, value, count=3)
+    # Samples of 1e300 N (or N m) after t_1, where the hold, the ratio and the spectrum read,
+    # more in a row than the front end puts back: sums, norms, the ratio's fixed point
+    # overflow. The suite runs with warnings as errors, so a NumPy warning here (lines on a
+    # user's terminal) fails the test. Found by the fuzz suite.
+    glitched = _glitched(column, value, count=SPIKE_LONGEST + 2)
     for method in ("paper", "ratio", "two-frequency", "fast"):
         result = estimate(glitched, calibrated(), method)
         assert result.status is not Status.OK, (method, result.x_c)
@@ -170,17 +171,21 @@ def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
     ("column", "value"),
     [(1, 1e300), (1, -1.7976931348623157e308), (1, 0.5), (4, 1e300), (4, -0.3), (4, 0.0)],
 )
-@pytest.mark.parametrize("count", [1, 2])
-def test_one_or_two_corrupted_samples_are_put_back_and_named(
-    column: int, value: float, count: int
+@pytest.mark.parametrize(
+    ("count", "after_t1"),
+    [(1, 0.05), (2, 0.05), (5, 0.05), (SPIKE_LONGEST, 0.05), (SPIKE_LONGEST, -0.5)],
+)
+def test_a_run_of_corrupted_samples_is_put_back_and_named(
+    column: int, value: float, count: int, after_t1: float
 ) -> None:
-    # A sensor bus's glitch: one sample (or two in a row) of one channel far off, or zero,
+    # A sensor bus's glitch: one sample (or a run of them) of one channel far off, or zero,
     # between calm neighbours (a force at least twice the link's weight off, a torque half its
-    # weight's moment: the link's own impacts ring single samples below that). The front end
-    # puts it back on the line between them and says so; the estimate is the clean
-    # recording's, its status and x_c within 1 mm (the repaired samples are the line, not the
-    # clean values: the fast method's answer may move by a step or two of its 0.25 mm grid).
-    glitched = _glitched(column, value, count)
+    # weight's moment: the link's own impacts ring single samples below that), in the
+    # estimation window or at rest. The front end puts it back on the line between them and
+    # says so; the estimate is the clean recording's, its status and x_c within 1 mm (the
+    # repaired samples are the line, not the clean values: the fast method's answer may move
+    # by a step or two of its 0.25 mm grid).
+    glitched = _glitched(column, value, count, after_t1)
     clean = synthetic_recording(Synthetic(x_c=0.5, seed=4))
     k = int(np.flatnonzero(np.hstack([glitched.force, glitched.torque])[:, column] == value)[0])
     for method in ("paper", "ratio", "two-frequency", "fast"):
@@ -198,16 +203,38 @@ def test_one_or_two_corrupted_samples_are_put_back_and_named(
     # antenna estimate says so in one line
     line = summary("glitched.csv", result.to_dict()).splitlines()[-1]
     channel = ("fx", "fy", "fz", "tx", "ty", "tz")[column]
-    assert line.startswith("  put back        corrupted sensor samples at ")
-    assert f"s ({channel}{', 2 samples' if count == 2 else ''})" in line
+    assert line.startswith("  put back        sensor samples off their neighbours at ")
+    assert f"s ({channel}{f', {count} samples' if count > 1 else ''})" in line
+
+
+def test_runs_in_two_channels_that_overlap_are_each_put_back() -> None:
+    # The bus corrupts the push's force for three samples and, from the second of them, its
+    # moment for two: each channel's run is put back, and the estimate is the clean one's.
+    recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
+    clean = estimate(recording, calibrated())
+    k = int(np.searchsorted(recording.t, clean.t_1 + 0.05))
+    loads = np.hstack([recording.force, recording.torque])
+    loads[k : k + 3, 1] = 1e3
+    loads[k + 1 : k + 3, 4] = -50.0
+    glitched = Recording(
+        t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:]
+    )
+    result = estimate(glitched, calibrated())
+    assert result.diagnostics["repaired_samples"] == [
+        {"t": float(recording.t[k]), "samples": 3, "channels": ["fy"]},
+        {"t": float(recording.t[k + 1]), "samples": 2, "channels": ["ty"]},
+    ]
+    assert result.status is clean.status
+    assert abs(result.x_c - clean.x_c) < 0.001
 
 
 def test_a_corrupted_sample_is_put_back_in_a_stream_as_offline() -> None:
     # The stream holds a suspect back until the samples that decide it have come: the same
     # estimate, to the bit, whatever the blocks.
-    glitched = _glitched(4, -3.0, 2)
+    glitched = _glitched(4, -3.0, SPIKE_LONGEST, -0.5)
     model = calibrated()
     offline = estimate(glitched, model, "paper")
+    assert offline.status is Status.OK
     assert offline.diagnostics["repaired_samples"]
     for block in (1, 5, 64):
         online = OnlineEstimator(model, glitched.sample_period, "paper")

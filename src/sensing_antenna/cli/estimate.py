@@ -173,10 +173,14 @@ def summary(name: str, data: dict[str, Any]) -> str:
         lines.append("  branch prob.    " + ", ".join(f"{p:.3f}" for p in probability))
     repaired = data.get("diagnostics", {}).get("repaired_samples", [])
     if repaired:
-        where = ", ".join(
-            f"{_s(r['t'])} ({' '.join(r['channels'])}{', 2 samples' if r['samples'] > 1 else ''})"
-            for r in repaired[:3]
-        )
+        where = ", ".join(_put_back(r) for r in repaired[:3])
         more = f" and {len(repaired) - 3} more" if len(repaired) > 3 else ""
-        lines.append(f"  put back        corrupted sensor samples at {where}{more}")
+        lines.append(f"  put back        sensor samples off their neighbours at {where}{more}")
     return "\n".join(lines)
+
+
+def _put_back(repaired: dict[str, Any]) -> str:
+    """One run of samples put back: its time, channels and length (when more than one)."""
+    count = repaired["samples"]
+    length = f", {count} samples" if count > 1 else ""
+    return f"{_s(repaired['t'])} ({' '.join(repaired['channels'])}{length})"

@@ -51,8 +51,9 @@ class OnlineEstimator:
     Notes
     -----
     :meth:`update` returns the estimate exactly once, at the sample it is given (t_e, or the
-    earlier instant a method that stops early is ready at; up to three samples later when a
-    suspected corrupted sample near it waits for the samples that decide it), and None
+    earlier instant a method that stops early is ready at; up to ``SPIKE_LOOKAHEAD`` (11)
+    samples later when a suspected corrupted sample near it waits for the samples that decide
+    it, :mod:`.front.spikes`), and None
     otherwise (also after the estimate). :meth:`finalize` closes a run that ended first (no
     contact, no push, too short) and returns the estimate ``estimate`` gives on the same
     samples. Samples the time stamps skip are put back by linear interpolation as they become
@@ -88,8 +89,8 @@ class OnlineEstimator:
     @property
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed and those put back where the time stamps
-        skipped some, less those held back (at most three) until a suspected corruption among
-        them is decided."""
+        skipped some, less those held back (at most ``SPIKE_LOOKAHEAD``, 11) until a suspected
+        corruption among them is decided."""
         return self._front.n_samples
 
     @property

@@ -1,20 +1,22 @@
-"""Isolated corrupted samples of the force/torque sensor (a glitch of the bus or the DAQ): found
-against a robust local noise scale and put back by interpolation between their neighbours.
+"""Corrupted samples of the force/torque sensor (a glitch of the bus or the DAQ): runs of up to
+:data:`SPIKE_LONGEST` samples found against a robust local noise scale and put back by
+interpolation between their neighbours.
 
-A sensor read over EtherCAT or a serial line now and then delivers one sample, or two in a row,
+A sensor read over EtherCAT or a serial line now and then delivers a sample, or a few in a row,
 whose wrench is not the link's: a channel (or all six) with a huge value, a sign flipped, all
 zeros. One such sample moves the tare, the hold's mean push, the Eq. 20 filter's ratio for a
 second and the spectrum's floor, and the statuses that follow name causes it is not (slip,
 units, a sign flipped, a tip mass). Here, per channel, sample j is a *suspect* when its step
 from j - 1 departs from the local trend (the median of the ``SPIKE_WINDOW`` first differences
 before it) by more than ``SPIKE_FACTOR`` robust deviations (1.4826 times their median absolute
-deviation) and by more than a floor (:func:`spike_floor`); it is a *spike* when the signal
-comes back to the trend at j + 1 (one sample) or j + 2 (two) within the same bound and goes on
-calmly, and then the corrupted samples are replaced by the straight line between their
-neighbours. A step that stays (a contact) is left alone; a single-sample pulse of an impact
-above the floor would not be. Every decision reads the raw samples j - SPIKE_WINDOW - 1 ..
-j + SPIKE_LOOKAHEAD only, so a stream decides as a whole recording does, holding a suspect back
-until the three samples after it have come.
+deviation) and by more than a floor (:func:`spike_floor`); it starts a *spike* of m samples
+when those m samples lie off the trend by that bound and the signal comes back to the trend at
+j + m (m at most ``SPIKE_LONGEST``) and goes on calmly, and then the m samples are replaced by
+the straight line between their neighbours. A step that stays (a contact) is left alone; an
+impact's pulse as brief and above the floor cannot be told from a glitch and is put back too.
+Every decision reads the raw samples j - SPIKE_WINDOW - 1 .. j + SPIKE_LOOKAHEAD only, so a
+stream decides as a whole recording does, holding a suspect back until the samples after it
+that decide it have come.
 
 The median absolute deviation of 31 steps is itself noisy, so white noise alone passes ten of
 them now and then; the floor, far above any sensor's noise, is what keeps its samples.
@@ -31,6 +33,7 @@ from sensing_antenna.antenna import Antenna
 
 __all__ = [
     "SPIKE_FACTOR",
+    "SPIKE_LONGEST",
     "SPIKE_LOOKAHEAD",
     "SPIKE_WINDOW",
     "WRENCH_CHANNELS",
@@ -48,11 +51,14 @@ FloatArray = NDArray[np.float64]
 SPIKE_WINDOW = 31
 #: Robust deviations from the local trend beyond which a step is a suspect.
 SPIKE_FACTOR = 10.0
-#: Samples after a suspect that decide it.
-SPIKE_LOOKAHEAD = 3
+#: Most corrupted samples in a row that are put back: at 1 kHz a quarter of the shortest
+#: rebound (a contact lost and found again, 40 ms) the simulator shows, so none is taken for one.
+SPIKE_LONGEST = 10
+#: Samples after a suspect that decide it: the longest run and the landing after it.
+SPIKE_LOOKAHEAD = SPIKE_LONGEST + 1
 #: Least spike, in the link's weight (forces) and its weight's moment, the link horizontal
-#: (torques): above the single-sample pulses the link's own impacts ring between calm
-#: neighbours (docs/design-notes.md, "Corrupted single samples").
+#: (torques): above the single-sample pulses the simulated link's impacts ring between calm
+#: neighbours at its default contact (docs/design-notes.md, "Corrupted samples").
 SPIKE_FLOOR_WEIGHTS = (2.0, 0.5)
 #: MAD to standard deviation for Gaussian noise.
 _MAD_TO_SIGMA = 1.4826
@@ -63,7 +69,7 @@ WRENCH_CHANNELS = ("fx", "fy", "fz", "tx", "ty", "tz")
 @dataclass(frozen=True)
 class Spike:
     """Corrupted samples found: ``index`` (of the first, in the array searched), ``length``
-    (1 or 2) and the channels (0..5, fx..tz) whose values were put back."""
+    (1 to :data:`SPIKE_LONGEST`) and the channels (0..5, fx..tz) whose values were put back."""
 
     index: int
     length: int
@@ -127,28 +133,26 @@ def find_spikes(
             limit[rows] = np.maximum(SPIKE_FACTOR * scale, floor)
             flagged[rows] = np.abs(step[rows] - centre) > limit[rows]
     spikes: list[Spike] = []
-    skip_to = first
+    skip_to = np.full(6, first)  # per channel: the samples up to a spike's landing are judged
     for k in np.flatnonzero(flagged.any(axis=1)):
         j = first + int(k)
-        if j < skip_to:
+        channels = np.flatnonzero(flagged[k] & (skip_to <= j))
+        if not channels.size:
             continue  # the return of a spike just found
         if j + SPIKE_LOOKAHEAD > n - 1:
-            if final:
-                break
-            return spikes, j  # wait for the samples that decide it
-        single, double = [], []
-        for c in np.flatnonzero(flagged[k]):
-            length = _spike_length(raw[j - 2 : j + 4, c], float(trend[k, c]), float(limit[k, c]))
-            if length == 1:
-                single.append(int(c))
-            elif length == 2:
-                double.append(int(c))
-        if single:
-            spikes.append(Spike(j, 1, tuple(single)))
-        if double:
-            spikes.append(Spike(j, 2, tuple(double)))
-        if single or double:
-            skip_to = j + 1 + (2 if double else 1)
+            if not final:
+                return spikes, j  # wait for the samples that decide it
+            if j + 3 > n - 1:
+                break  # too near the end for a single sample's landing and the step after it
+        by_length: dict[int, list[int]] = {}
+        for c in channels:
+            x = raw[j - 2 : j + SPIKE_LONGEST + 2, c]
+            length = _spike_length(x, float(trend[k, c]), float(limit[k, c]))
+            if length:
+                by_length.setdefault(length, []).append(int(c))
+                skip_to[c] = j + 1 + length
+        for length in sorted(by_length):
+            spikes.append(Spike(j, length, tuple(by_length[length])))
     return spikes, n
 
 
@@ -171,25 +175,30 @@ def spike_floor(antenna: Antenna) -> FloatArray:
 
 
 def _spike_length(x: FloatArray, slope: float, limit: float) -> int:
-    """1 or 2 when x[2] (and x[3]) leave the trend and come back, else 0.
+    """The number of samples from x[2] on (1 to :data:`SPIKE_LONGEST`) that leave the trend and
+    come back, else 0.
 
-    ``x``: the samples j - 2 .. j + 3 of one channel; ``slope`` the local trend per sample and
-    ``limit`` the bound on a departure from it. A spike leaves a calm signal (the step into
-    j - 1 within the bound), its samples lie beyond the bound off the trend line from j - 1,
-    the next sample lands on that line within the bound and within a quarter of the spike's
-    least height, and the signal goes on calmly (the step after the landing within the bound).
-    A step that stays (a contact, an impact) does not come back; the ringing of an impact is not
-    calm on either side.
+    ``x``: the samples j - 2 .. j + SPIKE_LONGEST + 1 of one channel (fewer at the end of a
+    recording); ``slope`` the local trend per sample and ``limit`` the bound on a departure
+    from it. A spike leaves a calm signal (the step into j - 1 within the bound), each of its
+    samples lies beyond the bound off the trend line from j - 1, the next sample lands on that
+    line within the bound and within a quarter of the spike's least height, and the signal goes
+    on calmly (the step after the landing within the bound). A step that stays (a contact) does
+    not come back; the ringing of an impact is not calm on either side.
     """
     with np.errstate(over="ignore", invalid="ignore"):
         if not abs(x[1] - x[0] - slope) <= limit:
             return 0
-        # departures from the trend line through x[1], of x[2], x[3], x[4]
-        off = x[2:5] - x[1] - slope * np.arange(1.0, 4.0)
-        for m in (1, 2):
+        longest = min(SPIKE_LONGEST, x.shape[0] - 4)  # fewer at a recording's end
+        # departures from the trend line through x[1], of x[2] .. x[longest + 2]
+        off = x[2 : longest + 3] - x[1] - slope * np.arange(1.0, longest + 2.0)
+        beyond = np.abs(off) > limit
+        for m in range(1, longest + 1):
+            if not beyond[m - 1]:
+                return 0  # a sample back within the bound before a landing: no spike
             height = float(np.min(np.abs(off[:m])))
             after = x[m + 3] - x[m + 2] - slope
-            if height > limit and abs(off[m]) <= min(limit, 0.25 * height) and abs(after) <= limit:
+            if abs(off[m]) <= min(limit, 0.25 * height) and abs(after) <= limit:
                 return m
     return 0
 
