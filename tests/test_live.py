@@ -407,6 +407,14 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
             "metadata key 'sample_period': missing",
         ),
         (text[:2], "no header after the metadata"),
+        # a digit group is a number to Python's float, not to the file's reader
+        (
+            [
+                *text[: header_at + 3],
+                ",".join(["0.002", "1_0", *text[header_at + 3].split(",")[2:]]),
+            ],
+            f"<stdin>:{header_at + 4}: column 'theta1': not a number ('1_0')",
+        ),
         # a declared period 10 % off the time stamps' (1 ms): a file read whole would use the
         # steps, a stream's estimator was built for the declared one
         (

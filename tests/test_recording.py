@@ -529,3 +529,22 @@ def test_a_loggers_text_columns_and_footer_are_left_out(tmp_path: Path) -> None:
     with pytest.raises(RecordingError) as info:
         read_recording(text_required)
     assert (info.value.line, info.value.field) == (3, "theta1")
+    # beside a text column, a cell is read as in a file without one: a digit group or another
+    # script's digit (both numbers to Python) is no number there either
+    for typo in ("1_0", "\u0661"):
+        grouped = tmp_path / "grouped.csv"
+        grouped.write_text("\n".join([*rows[:2], rows[2].replace(",0.001,0.0,", f",{typo},0.0,")]))
+        with pytest.raises(RecordingError) as info:
+            read_recording(grouped)
+        assert (info.value.line, info.value.field) == (3, "theta1"), typo
+
+
+def test_a_sample_period_with_a_digit_group_is_refused(tmp_path: Path) -> None:
+    # '0_001' is 1.0 to Python's float: a typo that would stretch the recording a thousandfold
+    path = tmp_path / "grouped.csv"
+    path.write_text(
+        "# sample_period: 0_001\nt,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0,0,0\n"
+    )
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    assert (info.value.line, info.value.field) == (1, "sample_period")

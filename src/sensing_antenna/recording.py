@@ -60,6 +60,7 @@ __all__ = [
     "other_separator",
     "parse_header",
     "parse_metadata",
+    "parse_number",
     "read_recording",
     "resample_uniform",
     "sample_period_problem",
@@ -528,7 +529,7 @@ def _period_of(t: NDArray[np.float64], nominal: float | None) -> float:
 
 def _parse_period(text: str) -> float | None:
     try:
-        value = float(text)
+        value = parse_number(text)
     except ValueError:
         return None
     return value if math.isfinite(value) and value > 0 else None
@@ -664,7 +665,7 @@ def _numeric_columns(
             if k in text_columns:
                 continue
             try:
-                table[offset, k] = float(cell)
+                table[offset, k] = parse_number(cell)
             except ValueError:
                 if named[k]:
                     raise RecordingError(
@@ -673,6 +674,15 @@ def _numeric_columns(
                 text_columns.add(k)
     kept = [k for k in range(len(names)) if k not in text_columns]
     return table[:, kept], [names[k] for k in kept]
+
+
+def parse_number(cell: str) -> float:
+    """A cell's number as the whole-file reader (NumPy's) takes it, else ValueError: Python's
+    ``float`` would also take digit groups (``1_000``) and other scripts' digits, a typo read
+    as a value."""
+    if "_" in cell or not cell.isascii():
+        raise ValueError(cell)
+    return float(cell)
 
 
 #: The first bytes of compressed files a lab might give for a recording, and what they are.

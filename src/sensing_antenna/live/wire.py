@@ -28,6 +28,7 @@ from sensing_antenna.recording import (
     RecordingError,
     parse_header,
     parse_metadata,
+    parse_number,
     sample_period_problem,
 )
 
@@ -170,7 +171,7 @@ def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> 
     values = []
     for name, cell in zip(header.columns, cells, strict=True):
         try:
-            value = float(cell)
+            value = parse_number(cell)
         except ValueError:
             value = None
         if value is None or not math.isfinite(value):
