@@ -226,6 +226,20 @@ def test_runs_in_two_channels_that_overlap_are_each_put_back() -> None:
     ]
     assert result.status is clean.status
     assert abs(result.x_c - clean.x_c) < 0.001
+    # a stream that waits for the second run's samples decides as the whole recording does
+    for block in (1, 7, 64):
+        online = OnlineEstimator(calibrated(), glitched.sample_period, "paper")
+        streamed = None
+        for a in range(0, glitched.n_samples, block):
+            b = a + block
+            streamed = online.update_block(
+                glitched.t[a:b], glitched.theta[a:b], glitched.force[a:b], glitched.torque[a:b]
+            )
+            if streamed is not None:
+                break
+        streamed = streamed if streamed is not None else online.finalize()
+        assert (streamed.status, streamed.x_c) == (result.status, result.x_c), block
+        assert streamed.diagnostics["repaired_samples"] == result.diagnostics["repaired_samples"]
 
 
 def test_a_corrupted_sample_is_put_back_in_a_stream_as_offline() -> None:

@@ -227,7 +227,7 @@ class FrontEnd:
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed, and those put back where the time stamps
         skipped some (:meth:`update_block`); not those held back until the samples that decide
-        a suspected corruption among them have come (at most three)."""
+        a suspected corruption among them have come (at most ``SPIKE_LOOKAHEAD``)."""
         return self._n
 
     @property
@@ -358,11 +358,11 @@ class FrontEnd:
         torque: FloatArray,
         final: bool = False,
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """The samples decided so far, isolated corrupted wrench samples put back on the line
+        """The samples decided so far, runs of corrupted wrench samples put back on the line
         between their neighbours (:mod:`.spikes`); those from a suspect whose deciding samples
-        have not come yet are held back (all released, undecided ones as they are, when
-        ``final``). The decisions read the raw samples only, so they are the same however the
-        samples are cut into blocks."""
+        have not come yet (and from the first sample of a run that reaches it) are held back
+        (all released, undecided ones as they are, when ``final``). The decisions read the raw
+        samples only, so they are the same however the samples are cut into blocks."""
         wrench = np.concatenate([force, torque], axis=1)
         history = self._history
         if self._pending is None and t.shape[0] == 1 and history.shape[0] == SPIKE_WINDOW + 2:

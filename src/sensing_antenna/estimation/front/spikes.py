@@ -141,8 +141,8 @@ def find_spikes(
             continue  # the return of a spike just found
         if j + SPIKE_LOOKAHEAD > n - 1:
             if not final:
-                return spikes, j  # wait for the samples that decide it
-            if j + 3 > n - 1:
+                return _decided_before(spikes, j)  # wait for the samples that decide it
+            if j + 2 > n - 1:
                 break  # too near the end for a single sample's landing and the step after it
         by_length: dict[int, list[int]] = {}
         for c in channels:
@@ -154,6 +154,21 @@ def find_spikes(
         for length in sorted(by_length):
             spikes.append(Spike(j, length, tuple(by_length[length])))
     return spikes, n
+
+
+def _decided_before(spikes: list[Spike], j: int) -> tuple[list[Spike], int]:
+    """The spikes found before a suspect ``j`` that waits, and the samples decided: up to ``j``,
+    or up to the first sample of a spike whose samples or landing reach ``j`` (found again, with
+    its channels, when the samples after ``j`` have come, so a stream decides as a whole
+    recording does)."""
+    decided = j
+    moved = True
+    while moved:
+        moved = False
+        for spike in spikes:
+            if spike.index < decided <= spike.index + spike.length:
+                decided, moved = spike.index, True
+    return [s for s in spikes if s.index + s.length < decided], decided
 
 
 def judged_from(floor: FloatArray) -> FloatArray:
