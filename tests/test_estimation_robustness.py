@@ -19,7 +19,7 @@ import pytest
 from _models import calibrated
 from sensing_antenna.antenna import load_antenna, paper_antenna
 from sensing_antenna.cli.estimate import summary
-from sensing_antenna.estimation import OnlineEstimator, Status, estimate
+from sensing_antenna.estimation import ContactEstimate, OnlineEstimator, Status, estimate
 from sensing_antenna.estimation.front.spikes import SPIKE_LONGEST
 from sensing_antenna.recording import Recording
 from test_estimation_pipeline import Synthetic, comparable, synthetic_recording
@@ -150,6 +150,21 @@ def _glitched(column: int, value: float, count: int = 1, after_t1: float = 0.05)
     return Recording(t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:])
 
 
+def _streamed(recording: Recording, block: int, loads: np.ndarray | None = None) -> ContactEstimate:
+    """The paper method's estimate of ``recording`` fed to a stream ``block`` samples at a time,
+    with ``loads`` (n, 6; samples a recording refuses, such as inf) for its wrench if given."""
+    wrench = np.hstack([recording.force, recording.torque]) if loads is None else loads
+    online = OnlineEstimator(calibrated(), recording.sample_period, "paper")
+    for a in range(0, recording.n_samples, block):
+        b = a + block
+        result = online.update_block(
+            recording.t[a:b], recording.theta[a:b], wrench[a:b, :3], wrench[a:b, 3:]
+        )
+        if result is not None:
+            return result
+    return online.finalize()
+
+
 @pytest.mark.parametrize("column", [1, 4])  # fy, ty: the push's force and its moment
 @pytest.mark.parametrize("value", [1e300, -1.7976931348623157e308])
 def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
@@ -228,16 +243,7 @@ def test_runs_in_two_channels_that_overlap_are_each_put_back() -> None:
     assert abs(result.x_c - clean.x_c) < 0.001
     # a stream that waits for the second run's samples decides as the whole recording does
     for block in (1, 7, 64):
-        online = OnlineEstimator(calibrated(), glitched.sample_period, "paper")
-        streamed = None
-        for a in range(0, glitched.n_samples, block):
-            b = a + block
-            streamed = online.update_block(
-                glitched.t[a:b], glitched.theta[a:b], glitched.force[a:b], glitched.torque[a:b]
-            )
-            if streamed is not None:
-                break
-        streamed = streamed if streamed is not None else online.finalize()
+        streamed = _streamed(glitched, block)
         assert (streamed.status, streamed.x_c) == (result.status, result.x_c), block
         assert streamed.diagnostics["repaired_samples"] == result.diagnostics["repaired_samples"]
 
@@ -246,21 +252,11 @@ def test_a_corrupted_sample_is_put_back_in_a_stream_as_offline() -> None:
     # The stream holds a suspect back until the samples that decide it have come: the same
     # estimate, to the bit, whatever the blocks.
     glitched = _glitched(4, -3.0, SPIKE_LONGEST, -0.5)
-    model = calibrated()
-    offline = estimate(glitched, model, "paper")
+    offline = estimate(glitched, calibrated(), "paper")
     assert offline.status is Status.OK
     assert offline.diagnostics["repaired_samples"]
     for block in (1, 5, 64):
-        online = OnlineEstimator(model, glitched.sample_period, "paper")
-        result = None
-        for a in range(0, glitched.n_samples, block):
-            b = a + block
-            result = online.update_block(
-                glitched.t[a:b], glitched.theta[a:b], glitched.force[a:b], glitched.torque[a:b]
-            )
-            if result is not None:
-                break
-        result = result if result is not None else online.finalize()
+        result = _streamed(glitched, block)
         assert result.status is offline.status
         assert result.x_c == offline.x_c
         assert result.diagnostics["repaired_samples"] == offline.diagnostics["repaired_samples"]
@@ -330,19 +326,7 @@ def test_a_spike_after_two_inf_samples_is_put_back_sample_by_sample_as_in_blocks
     loads = np.hstack([glitched.force, glitched.torque])
     loads[100:102, 1] = np.inf
     loads[150, 1] += 5.0
-    model = calibrated()
-    results = []
-    for block in (1, 7, glitched.n_samples):
-        online = OnlineEstimator(model, glitched.sample_period, "paper")
-        result = None
-        for a in range(0, glitched.n_samples, block):
-            b = a + block
-            result = online.update_block(
-                glitched.t[a:b], glitched.theta[a:b], loads[a:b, :3], loads[a:b, 3:]
-            )
-            if result is not None:
-                break
-        results.append(result if result is not None else online.finalize())
+    results = [_streamed(glitched, block, loads) for block in (1, 7, glitched.n_samples)]
     for result in results:
         assert result.status is results[-1].status and result.x_c == results[-1].x_c
         times = [r["t"] for r in result.diagnostics["repaired_samples"]]
