@@ -3,7 +3,7 @@
 A measurement: simulated contacts of the paper antenna (the estimators given the device's own T),
 each recorded once clean and then many times with a burst of corrupted samples: one channel of
 the push's force, one of its torque, or all six, set to 5, 50 or 10^4 times the channel's largest
-clean value, sign-flipped, or zeroed, for 1 to 20 samples in a row, at instants from the initial
+clean value, sign-flipped, or zeroed, for 1 to 30 samples in a row, at instants from the initial
 rest to just before the paper method's t_e (2 s). For each burst length and method it counts
 the clean ``ok`` answers that stay ``ok`` within 2 mm of the clean answer, move further while
 ``ok`` (more than 2 mm, more than 2 cm), or turn into another status (with the statuses and the
@@ -11,7 +11,7 @@ most common reasons), and how many answers name the samples they put back.
 
 Usage::
 
-    python benchmarks/eval_glitches.py [--lengths 1 2 3 5 10 12 20] [--instants 8] [--workers 2]
+    python benchmarks/eval_glitches.py [--lengths 1 2 3 5 10 20 30] [--instants 8] [--workers 2]
         [--json benchmarks/results/glitches.json]
 """
 
@@ -205,7 +205,7 @@ def _short(value: Any) -> Any:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--lengths", type=int, nargs="+", default=[1, 2, 3, 5, 10, 12, 20])
+    parser.add_argument("--lengths", type=int, nargs="+", default=[1, 2, 3, 5, 10, 20, 30])
     parser.add_argument("--instants", type=int, default=8)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path, default=RESULTS)

@@ -51,7 +51,7 @@ class OnlineEstimator:
     Notes
     -----
     :meth:`update` returns the estimate exactly once, at the sample it is given (t_e, or the
-    earlier instant a method that stops early is ready at; up to ``SPIKE_LOOKAHEAD`` (11)
+    earlier instant a method that stops early is ready at; up to ``SPIKE_LOOKAHEAD`` (21)
     samples later when a suspected corrupted sample near it waits for the samples that decide
     it, :mod:`.front.spikes`), and None
     otherwise (also after the estimate). :meth:`finalize` closes a run that ended first (no
@@ -89,7 +89,7 @@ class OnlineEstimator:
     @property
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed and those put back where the time stamps
-        skipped some, less those held back (at most ``SPIKE_LOOKAHEAD``, 11) until a suspected
+        skipped some, less those held back (at most ``SPIKE_LOOKAHEAD``, 21) until a suspected
         corruption among them is decided."""
         return self._front.n_samples
 

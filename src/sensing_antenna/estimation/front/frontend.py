@@ -5,7 +5,7 @@ an :class:`~.outcome.EarlyOutcome` when no estimate is possible. Its steps (Sect
 causal, so an instant depends only on the samples up to it (and, where a sensor sample is
 suspected of corruption, on the few after it that decide it, which the stream waits for):
 
-0. Sensor samples off their neighbours (a run of up to ten between calm ones: a glitch, or an
+0. Sensor samples off their neighbours (a run of up to twenty between calm ones: a glitch, or an
    impact's pulse as brief) put back on the line between them (:mod:`.spikes`).
 1. t_c: the contact detector of Section 4.2
    (:class:`~sensing_antenna.detection.contact.ContactDetector`); the sensor offset and the rest

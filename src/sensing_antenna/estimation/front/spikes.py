@@ -51,9 +51,9 @@ FloatArray = NDArray[np.float64]
 SPIKE_WINDOW = 31
 #: Robust deviations from the local trend beyond which a step is a suspect.
 SPIKE_FACTOR = 10.0
-#: Most corrupted samples in a row that are put back: at 1 kHz a quarter of the shortest
-#: rebound (a contact lost and found again, 40 ms) the simulator shows, so none is taken for one.
-SPIKE_LONGEST = 10
+#: Most corrupted samples in a row that are put back: at 1 kHz half the shortest rebound (a
+#: contact lost and found again, 40 ms) the simulator shows, so none is taken for one.
+SPIKE_LONGEST = 20
 #: Samples after a suspect that decide it: the longest run and the landing after it.
 SPIKE_LOOKAHEAD = SPIKE_LONGEST + 1
 #: Least spike, in the link's weight (forces) and its weight's moment, the link horizontal
