@@ -53,7 +53,7 @@ class OnlineEstimator:
     :meth:`update` returns the estimate exactly once, at the sample it is given (t_e, or the
     earlier instant a method that stops early is ready at; up to ``SPIKE_LOOKAHEAD`` (21)
     samples later when a suspected corrupted sample near it waits for the samples that decide
-    it, :mod:`.front.spikes`), and None
+    it, more when it lies inside another channel's run, :mod:`.front.spikes`), and None
     otherwise (also after the estimate). :meth:`finalize` closes a run that ended first (no
     contact, no push, too short) and returns the estimate ``estimate`` gives on the same
     samples. Samples the time stamps skip are put back by linear interpolation as they become
@@ -89,8 +89,8 @@ class OnlineEstimator:
     @property
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed and those put back where the time stamps
-        skipped some, less those held back (at most ``SPIKE_LOOKAHEAD``, 21) until a suspected
-        corruption among them is decided."""
+        skipped some, less those held back until a suspected corruption among them is decided
+        (``SPIKE_LOOKAHEAD``, 21, or more from the start of another channel's run)."""
         return self._front.n_samples
 
     @property

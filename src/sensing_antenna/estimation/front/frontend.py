@@ -227,7 +227,8 @@ class FrontEnd:
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed, and those put back where the time stamps
         skipped some (:meth:`update_block`); not those held back until the samples that decide
-        a suspected corruption among them have come (at most ``SPIKE_LOOKAHEAD``)."""
+        a suspected corruption among them have come (``SPIKE_LOOKAHEAD``, or more from the
+        start of another channel's run that reaches the suspect)."""
         return self._n
 
     @property
