@@ -24,6 +24,7 @@ them now and then; the floor, far above any sensor's noise, is what keeps its sa
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -133,7 +134,7 @@ def find_spikes(
             limit[rows] = np.maximum(SPIKE_FACTOR * scale, floor)
             flagged[rows] = np.abs(step[rows] - centre) > limit[rows]
     spikes: list[Spike] = []
-    skip_to = np.full(6, first)  # per channel: the samples up to a spike's landing are judged
+    skip_to = np.full(6, first)  # per channel: the first sample after a spike's landing
     for k in np.flatnonzero(flagged.any(axis=1)):
         j = first + int(k)
         channels = np.flatnonzero(flagged[k] & (skip_to <= j))
@@ -207,11 +208,12 @@ def _spike_length(x: FloatArray, slope: float, limit: float) -> int:
         longest = min(SPIKE_LONGEST, x.shape[0] - 4)  # fewer at a recording's end
         # departures from the trend line through x[1], of x[2] .. x[longest + 2]
         off = x[2 : longest + 3] - x[1] - slope * np.arange(1.0, longest + 2.0)
-        beyond = np.abs(off) > limit
+        size = np.abs(off)
+        height = math.inf  # the least departure of the spike's samples so far
         for m in range(1, longest + 1):
-            if not beyond[m - 1]:
+            if not size[m - 1] > limit:
                 return 0  # a sample back within the bound before a landing: no spike
-            height = float(np.min(np.abs(off[:m])))
+            height = min(height, float(size[m - 1]))
             after = x[m + 3] - x[m + 2] - slope
             if abs(off[m]) <= min(limit, 0.25 * height) and abs(after) <= limit:
                 return m
