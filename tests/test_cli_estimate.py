@@ -136,3 +136,12 @@ def test_a_recording_of_another_antenna_estimated_with_the_default_is_warned_of(
     # the default named on the command line is chosen too
     assert main(["estimate", str(other), "--antenna", "paper-2021"]) == 0
     assert capsys.readouterr().err == ""
+    # the figures of a recording fall back on the default antenna alike, and say so
+    for kind, use in (("recording", "checked"), ("estimate", "estimated")):
+        figures = tmp_path / kind
+        assert main(["plot", kind, str(other), "--out", str(figures)]) == 0
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and "recorded with antenna 'lab-head'" in err
+        assert f"{use} with the default 'paper-2021'" in err
+        assert main(["plot", kind, str(other), "--out", str(figures), "--antenna", str(model)]) == 0
+        assert capsys.readouterr().err == ""

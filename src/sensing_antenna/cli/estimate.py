@@ -89,10 +89,13 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def warn_of_other_antennas(named: Mapping[str, Sequence[str]], model: str) -> None:
+def warn_of_other_antennas(
+    named: Mapping[str, Sequence[str]], model: str, use: str = "estimated"
+) -> None:
     """One line on stderr for each antenna that recordings' ``antenna`` metadata names
     (``named``: that name, "" when absent, to the recordings' sources) other than the built-in
-    ``model`` the estimates fall back on: the device's observer, threshold and stiffness are
+    ``model`` the command falls back on (``use``: what it does with them, "estimated" or
+    "checked"): the device's observer, threshold and stiffness are
     in its own file, and estimates with another's can go wrong in ways that look like bad data
     (a contact missed, a push that seems to turn the wrong way)."""
     for recorded, sources in named.items():
@@ -103,7 +106,7 @@ def warn_of_other_antennas(named: Mapping[str, Sequence[str]], model: str) -> No
             which = f"{len(sources)} recording(s) ({sources[0]} and {len(sources) - 1} more)"
         print(
             f"antenna: warning: {which} recorded with antenna {printable(recorded)!r} (its "
-            f"metadata) and estimated with the default {printable(model)!r}: give that "
+            f"metadata) and {use} with the default {printable(model)!r}: give that "
             "antenna's file with --antenna (with another's observer and stiffness a good "
             "recording can come back implausible_input or no_contact)",
             file=sys.stderr,

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from sensing_antenna.cli.arguments import add_actions
-from sensing_antenna.cli.estimate import DEFAULT_ANTENNA
+from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, warn_of_other_antennas
 
 
 def register(subparsers: Any) -> None:
@@ -67,20 +67,21 @@ def _add_recording(kinds: Any) -> None:
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
     parser.add_argument(
-        "--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file (its link's weight)"
+        "--antenna",
+        default=None,
+        help=f"built-in name or TOML file, its link's weight (default {DEFAULT_ANTENNA})",
     )
     _add_out(parser)
     parser.set_defaults(func=_run_recording)
 
 
 def _run_recording(args: argparse.Namespace) -> int:
-    from sensing_antenna.antenna import load_antenna
     from sensing_antenna.calibration.observer import units_problem
     from sensing_antenna.plotting.recording import plot_recording
     from sensing_antenna.recording import read_recording
 
     recording = read_recording(args.recording)
-    antenna = load_antenna(args.antenna)  # a bad file said before any figure is written
+    antenna = _model(args, recording, "checked")  # a bad file said before any figure
     for path in plot_recording(recording, args.out):
         print(path)
     problem = units_problem(recording, antenna)
@@ -90,6 +91,20 @@ def _run_recording(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     return 0
+
+
+def _model(args: argparse.Namespace, recording: Any, use: str) -> Any:
+    """The antenna of ``--antenna``, or the default one with a warning when the recording's
+    ``antenna`` metadata names another (as ``antenna estimate`` does; ``use`` as there)."""
+    from sensing_antenna.antenna import load_antenna
+
+    if args.antenna is not None:
+        return load_antenna(args.antenna)
+    antenna = load_antenna(DEFAULT_ANTENNA)
+    warn_of_other_antennas(
+        {recording.metadata.get("antenna", ""): [str(args.recording)]}, antenna.name, use
+    )
+    return antenna
 
 
 def _add_estimate(kinds: Any) -> None:
@@ -103,19 +118,20 @@ def _add_estimate(kinds: Any) -> None:
         ),
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
-    parser.add_argument("--antenna", default=DEFAULT_ANTENNA, help="built-in name or TOML file")
+    parser.add_argument(
+        "--antenna", default=None, help=f"built-in name or TOML file (default {DEFAULT_ANTENNA})"
+    )
     _add_out(parser)
     parser.set_defaults(func=_run_estimate)
 
 
 def _run_estimate(args: argparse.Namespace) -> int:
-    from sensing_antenna.antenna import load_antenna
     from sensing_antenna.estimation import EstimatorConfig, estimate
     from sensing_antenna.plotting.estimate import plot_contact_estimate
     from sensing_antenna.recording import read_recording
 
     recording = read_recording(args.recording)
-    antenna = load_antenna(args.antenna)
+    antenna = _model(args, recording, "estimated")
     result = estimate(recording, antenna)
     paths = plot_contact_estimate(result, antenna, args.out, EstimatorConfig().zero_padding)
     for path in paths:
