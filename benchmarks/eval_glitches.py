@@ -4,15 +4,19 @@ A measurement: simulated contacts of the paper antenna (the estimators given the
 each recorded once clean and then many times with a burst of corrupted samples: one channel of
 the push's force, one of its torque, or all six, set to 5, 50 or 10^4 times the channel's largest
 clean value, sign-flipped, or zeroed, for 1 to 30 samples in a row, at instants from the initial
-rest to just before the paper method's t_e (2 s). For each burst length and method it counts
-the clean ``ok`` answers that stay ``ok`` within 2 mm of the clean answer, move further while
-``ok`` (more than 2 mm, more than 2 cm), or turn into another status (with the statuses and the
-most common reasons), and how many answers name the samples they put back.
+rest to just before the paper method's t_e (2 s). The kind ``drop`` instead takes the samples out
+of the recording, every column with its time stamp (a bus that lost them). For each burst length
+and method it counts the clean ``ok`` answers that stay ``ok`` within 2 mm of the clean answer,
+move further while ``ok`` (more than 2 mm, more than 2 cm), or turn into another status (with the
+statuses and the most common reasons), and how many answers name the samples they put back or
+filled in.
 
 Usage::
 
     python benchmarks/eval_glitches.py [--lengths 1 2 3 5 10 20 30] [--instants 8] [--workers 2]
-        [--json benchmarks/results/glitches.json]
+        [--kinds x5 x50 x1e4 flip zero] [--max-gap N] [--json benchmarks/results/glitches.json]
+
+``--kinds drop --max-gap N`` measures lost samples with the estimators' ``max_gap`` set to N.
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ import numpy as np
 
 from machine import machine_info
 from sensing_antenna.antenna import load_antenna
-from sensing_antenna.estimation import conclude, gather
+from sensing_antenna.estimation import EstimatorConfig, conclude, gather
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate
 
@@ -45,6 +49,7 @@ CONTACTS = (
     ("vertical", 0.90),
 )
 KINDS = ("x5", "x50", "x1e4", "flip", "zero")
+DROP = "drop"
 MOVED = 0.002  # m: an ok answer further than this from the clean one has moved
 WRONG = 0.02  # m: ... and further than this is wrong
 KEPT = 0.0005  # m: the results file keeps the estimates that moved further (or changed status)
@@ -54,9 +59,20 @@ RESULTS = Path(__file__).parent / "results" / "glitches.json"
 def corrupt(
     recording: Recording, start: int, length: int, channels: list[int], kind: str
 ) -> Recording:
-    """``recording`` with samples ``start .. start + length - 1`` of ``channels`` corrupted."""
+    """``recording`` with samples ``start .. start + length - 1`` of ``channels`` corrupted
+    (or, for ``kind`` ``drop``, those samples taken out)."""
     loads = np.hstack([recording.force, recording.torque])
     rows = slice(start, start + length)
+    if kind == DROP:
+        kept = np.ones(len(recording.t), dtype=bool)
+        kept[rows] = False
+        return Recording(
+            t=recording.t[kept],
+            theta=recording.theta[kept],
+            force=recording.force[kept],
+            torque=recording.torque[kept],
+            metadata=dict(recording.metadata),
+        )
     for c in channels:
         largest = float(np.max(np.abs(loads[:, c])))
         if kind == "flip":
@@ -74,26 +90,37 @@ def corrupt(
     )
 
 
-def _estimates(recording: Recording, model: Any) -> dict[str, tuple[str, float, str, int]]:
-    """Per method: (status, x_c, reason, samples put back)."""
-    evidence = gather(recording, model)
+def _estimates(
+    recording: Recording, model: Any, config: EstimatorConfig
+) -> dict[str, tuple[str, float, str, int]]:
+    """Per method: (status, x_c, reason, samples put back or filled in)."""
+    evidence = gather(recording, model, config)
     out = {}
     for method in METHODS:
         result = conclude(evidence, method)
-        repaired = result.diagnostics.get("repaired_samples", []) or []
-        out[method] = (result.status.value, float(result.x_c), result.reason or "", len(repaired))
+        repaired = len(result.diagnostics.get("repaired_samples", []) or [])
+        dropped = int((result.diagnostics.get("sampling") or {}).get("n_dropped", 0))
+        out[method] = (
+            result.status.value,
+            float(result.x_c),
+            result.reason or "",
+            repaired or dropped,
+        )
     return out
 
 
-def run_contact(args: tuple[str, float, list[int], int]) -> list[dict[str, Any]]:
+def run_contact(
+    args: tuple[str, float, list[int], int, list[str], int | None],
+) -> list[dict[str, Any]]:
     """Every glitch of one contact: one row per (glitch, method)."""
-    case, x_c, lengths, instants = args
+    case, x_c, lengths, instants, kinds, max_gap = args
+    config = EstimatorConfig() if max_gap is None else EstimatorConfig(max_gap=max_gap)
     antenna = load_antenna("paper-2021")
     model = antenna.self_calibrated()
     seed = round(1000 * x_c) + (0 if case == "azimuthal" else 7)
     clean = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=seed))
     clean = clean.without_ground_truth()
-    reference = _estimates(clean, model)
+    reference = _estimates(clean, model, config)
     loads = np.hstack([clean.force, clean.torque])
     spread = np.ptp(loads, axis=0)
     groups = {
@@ -106,11 +133,13 @@ def run_contact(args: tuple[str, float, list[int], int]) -> list[dict[str, Any]]
     rows = []
     for length in lengths:
         for group, channels in groups.items():
-            for kind in KINDS:
+            for kind in kinds:
+                if kind == DROP and group != "all":
+                    continue  # a lost sample is lost on every channel
                 for start in starts:
                     glitched = corrupt(clean, int(start), length, channels, kind)
                     for method, (status, x, reason, repaired) in _estimates(
-                        glitched, model
+                        glitched, model, config
                     ).items():
                         ref_status, ref_x, _, _ = reference[method]
                         rows.append(
@@ -207,12 +236,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--lengths", type=int, nargs="+", default=[1, 2, 3, 5, 10, 20, 30])
     parser.add_argument("--instants", type=int, default=8)
+    parser.add_argument("--kinds", nargs="+", default=list(KINDS), choices=[*KINDS, DROP])
+    parser.add_argument("--max-gap", type=int, default=None)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path, default=RESULTS)
     parser.add_argument("--note", default="")
     args = parser.parse_args()
     start = time.perf_counter()
-    jobs = [(case, x_c, args.lengths, args.instants) for case, x_c in CONTACTS]
+    jobs = [
+        (case, x_c, args.lengths, args.instants, args.kinds, args.max_gap) for case, x_c in CONTACTS
+    ]
     rows: list[dict[str, Any]] = []
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         for (case, x_c), contact_rows in zip(CONTACTS, pool.map(run_contact, jobs), strict=True):
@@ -245,6 +278,8 @@ def main() -> None:
         "note": args.note,
         "lengths": args.lengths,
         "instants": args.instants,
+        "kinds": args.kinds,
+        "max_gap": args.max_gap if args.max_gap is not None else EstimatorConfig().max_gap,
         "machine": machine_info(),
         "seconds": time.perf_counter() - start,
         "moved_m": MOVED,
