@@ -248,10 +248,14 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
     recording = dataclasses.replace(
         original, theta=original.theta * np.array(theta), force=original.force * np.array(force)
     )
-    for name, result in all_methods(recording, antenna).items():
+    results = all_methods(recording, antenna)
+    for name, result in results.items():
         assert not result.ok, name
         assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
         assert "does not oppose the head's turn" in (result.reason or "")
+        # no 95 % interval is claimed from samples the status says are wrong
+        assert result.interval is None, name
+    assert results["fast"].diagnostics["interval_dropped"] is not None
 
 
 def test_a_link_that_slid_past_a_ball_is_slip_not_a_flipped_sign(antenna: Antenna) -> None:

@@ -47,7 +47,9 @@ the rest go to ``diagnostics["other_reasons"]``. Whatever the status, a best gue
 the reason gives the dropped value; an infinite torque/force ratio (loads that overflow Eq. 21)
 is no reading, NaN. An interval is cut to the link [0, l] (the contact lies on
 it), or dropped when it is not finite or lies off the link; a touched point farther from the base
-than the link can reach is dropped.
+than the link can reach is dropped. Under ``bad_input`` and ``implausible_input`` no interval is
+reported (it is kept in ``diagnostics["interval_dropped"]``): it would hold the contact only if
+the samples were what the format says, and the status says they are not.
 """
 
 from __future__ import annotations
@@ -74,6 +76,8 @@ from sensing_antenna.units_check import angle_problem, is_payload, rest_moment_s
 __all__ = ["review"]
 
 _RANK = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
+#: Statuses that say the samples are not what the format says: no interval is claimed under them.
+_INPUT_STATUSES = (Status.BAD_INPUT, Status.IMPLAUSIBLE_INPUT)
 
 
 def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
@@ -170,6 +174,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
             )
         changes.update(x_c=math.nan, contact_point=np.full(3, np.nan), interval=None)
     else:
+        if interval is not None and status in _INPUT_STATUSES:
+            diagnostics["interval_dropped"] = interval
+            interval = None
         if interval != estimate.interval:
             changes["interval"] = interval
         if not point_ok:
