@@ -247,14 +247,14 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
 ) -> None:
     """Stamps jittered by up to 0.2 ms (a logger's, not the sensor's): the clock keeps the
     sensor's period and every wrench message its own slot and value. One dropped message is
-    bridged; ten in a row are a gap whose samples are left out, so the recording shows them as
-    dropped."""
+    bridged; thirty in a row are a gap whose samples are left out, so the recording shows them
+    as dropped."""
     rng = np.random.default_rng(11)
     n = recording.n_samples
     exact = EPOCH_NS + np.arange(n, dtype=np.int64) * 1_000_000
     wrench_ns = exact + rng.integers(-200_000, 200_001, size=n)
     joints_ns = exact + rng.integers(-200_000, 200_001, size=n)
-    dropped = [500, *range(1000, 1010)]
+    dropped = [500, *range(960, 990)]
     kept = [k for k in range(n) if k not in dropped]
     bag = _write_bag(
         _bag_path(tmp_path, 2),
@@ -271,9 +271,9 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     # 2e-9 s one standard deviation
     assert abs(clock.period - 0.001) <= 1e-7
     assert clock.wrench.n_messages == n - len(dropped)
-    assert clock.wrench.n_missing == 11 and clock.wrench.n_gaps == 1
-    assert 0.0106 <= clock.wrench.largest_step <= 0.0114  # 11 steps of 1 ms, +-0.4 ms
-    assert clock.n_interpolated == 1 and clock.n_left_out == 10
+    assert clock.wrench.n_missing == 31 and clock.wrench.n_gaps == 1
+    assert 0.0306 <= clock.wrench.largest_step <= 0.0314  # 31 steps of 1 ms, +-0.4 ms
+    assert clock.n_interpolated == 1 and clock.n_left_out == 30
     # each message at its sample's instant: the stamps lie within their jitter of the line
     # (and its own small error), the messages on the grid
     assert 0.00015 < clock.wrench.jitter <= 0.00021
@@ -282,10 +282,10 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     # it stays under half a period, slot s holds sample first + s
     first = int(np.argmax(wrench_ns >= max(wrench_ns[0], joints_ns[0])))
     slots = np.rint(result.recording.t / clock.period).astype(int) + first
-    assert set(range(first, slots[-1] + 1)) - set(slots) == set(range(1000, 1010))
+    assert set(range(first, slots[-1] + 1)) - set(slots) == set(range(960, 990))
     own = np.isin(slots, kept)
     np.testing.assert_array_equal(result.recording.force[own], recording.force[slots[own]])
-    assert result.recording.sampling.n_dropped == 10
+    assert result.recording.sampling.n_dropped == 30
     # the angles, interpolated at their own samples' instants, the line through their stamps
     # jittered by up to 0.2 ms (0.115 ms standard): off the wrench's line by about 4 us, one
     # standard deviation of each line's place over 3,500 stamps; within 30 us of the sample's
@@ -296,7 +296,7 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     assert np.all(error <= speed * 3e-5 + 1e-12)
     assert np.any(error > 0)
     text = "\n".join(result.report.lines())
-    assert "1 sample(s) without their own wrench message, interpolated; 10 left out" in text
+    assert "1 sample(s) without their own wrench message, interpolated; 30 left out" in text
     # The gap lies in the push (t_c = 0.925 s, t_1 = 1.034 s on the original), outside the
     # vibration window the estimate is made from; there the loads are the sensor's own values
     # and only the windows' edges move, by the clock's origin (0.2 ms at most, under 1 % of their
@@ -304,7 +304,7 @@ def test_jittered_stamps_and_dropped_messages_are_reported(
     antenna = calibrated()
     original = estimate(recording, antenna)
     imported = estimate(result.recording, antenna)
-    assert original.t_c < 1.0 < 1.01 < original.t_1  # the gap, where the test says it is
+    assert original.t_c < 0.96 < 0.99 < original.t_1  # the gap, where the test says it is
     assert imported.status.value == "ok"
     assert abs(imported.x_c - original.x_c) < 1e-4
 

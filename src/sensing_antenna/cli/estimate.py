@@ -174,7 +174,13 @@ def summary(name: str, data: dict[str, Any]) -> str:
     probability = data.get("branch_probability")
     if probability:
         lines.append("  branch prob.    " + ", ".join(f"{p:.3f}" for p in probability))
-    repaired = data.get("diagnostics", {}).get("repaired_samples", [])
+    diagnostics = data.get("diagnostics", {})
+    sampling = diagnostics.get("sampling")
+    dropped = sampling.get("n_dropped") if isinstance(sampling, dict) else None
+    dropped = dropped or diagnostics.get("filled_samples")
+    if dropped:
+        lines.append(f"  missing         {dropped} sample(s), bridged by straight lines")
+    repaired = diagnostics.get("repaired_samples", [])
     if repaired:
         where = ", ".join(_put_back(r) for r in repaired[:3])
         more = f" and {len(repaired) - 3} more" if len(repaired) > 3 else ""

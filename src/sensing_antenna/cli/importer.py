@@ -13,7 +13,7 @@ from sensing_antenna.cli.arguments import add_actions, number
 #: Default gap threshold, in samples of a topic missing in a row (the value of
 #: ``sensing_antenna.importers.clock.DEFAULT_MAX_GAP``, written out so that parsing arguments
 #: does not import NumPy; ``tests/test_import_rosbag.py`` checks that they agree).
-DEFAULT_MAX_GAP = 3.0
+DEFAULT_MAX_GAP = 20.0
 
 
 def register(subparsers: Any) -> None:

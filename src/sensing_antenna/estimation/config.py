@@ -73,8 +73,12 @@ class EstimatorConfig:
         contact loss (reported in the diagnostics); 3 standard errors.
     max_gap : int
         Largest number of consecutive missing samples inside [t_1, t_e] that linear
-        interpolation may fill; 3 samples is a tenth of the fastest vibration period in the
-        band (about 25 ms at 250 rad/s), longer gaps give ``bad_input``.
+        interpolation may fill; longer gaps give ``bad_input``. 20 samples, as many as the
+        corrupted samples in a row put back on a line (:data:`.front.spikes.SPIKE_LONGEST`):
+        20 ms at 1 kHz is a fiftieth of the spectrum window and a tenth of the fast method's
+        first window, and a line across it moved no ``ok`` answer by more than about a
+        millimetre where it did not turn it into another status
+        (``benchmarks/eval_glitches.py --kinds drop``).
     spectrum_window : float
         Delta t_e1 (s), the record after t_1 analysed by Estimator 1. 1 s holds 5 periods of the
         lowest fundamental in the working range (31 rad/s, period 0.2 s) and gives a DFT bin of
@@ -222,7 +226,7 @@ class EstimatorConfig:
     min_push_significance: float = 5.0
     loss_window: float = 0.01
     loss_significance: float = 3.0
-    max_gap: int = 3
+    max_gap: int = 20
     spectrum_window: float = 1.0
     zero_padding: int = 16
     contact_range: tuple[float, float] = (0.2, 1.0)

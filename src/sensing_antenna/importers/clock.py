@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 from scipy.ndimage import median_filter
 
 from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.recording import MAX_SAMPLES
 
 __all__ = [
@@ -59,10 +60,11 @@ __all__ = [
     "sample_clock",
 ]
 
-#: More than this many samples of a stream missing in a row is a gap whose slots are left out
-#: (3: the estimators give ``bad_input`` for more than three samples missing in a row after the
-#: push, so a shorter hole is bridged and a longer one shown).
-DEFAULT_MAX_GAP = 3.0
+#: More than this many samples of a stream missing in a row is a gap whose slots are left out:
+#: the estimators' own ``max_gap`` (:class:`~sensing_antenna.estimation.EstimatorConfig`), beyond
+#: which a gap after the push gives ``bad_input``, so a shorter hole is bridged and a longer one
+#: shown.
+DEFAULT_MAX_GAP = float(EstimatorConfig().max_gap)
 
 #: The report says how much of the wrench the joints leave out beyond this many periods.
 _TRIM_NOTED = 10

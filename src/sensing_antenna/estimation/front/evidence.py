@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
+from sensing_antenna.estimation.front.steps import gap_problem
 
 if TYPE_CHECKING:
     from sensing_antenna.estimation.front.outcome import FrontTrace
@@ -180,8 +181,9 @@ class Evidence:
         stops early (``fast``) may not declare before it.
     offset_error, torque_offset_error : float
         Standard errors of the force (N) and torque (N m) offsets removed by the tare.
-    gap : str or None
-        A gap of missing samples inside [t_1, t_e] (bad input), described.
+    gaps : tuple of (float, float)
+        The steps of the time stamps (s, s) that missed more than ``config.max_gap`` samples,
+        known up to t_e; :meth:`gap_within` judges them over a method's own window.
     input_problem : str or None
         Why the samples up to t_c are not in the format's units and signs (the loads at rest
         against the link's weight, the free motion against the observer), None when they are;
@@ -215,10 +217,21 @@ class Evidence:
     hold_end: int = 0
     offset_error: float = 0.0
     torque_offset_error: float = 0.0
-    gap: str | None = None
+    gaps: tuple[tuple[float, float], ...] = ()
     input_problem: str | None = None
     diagnostics: dict[str, Any] = field(default_factory=dict)
     trace: FrontTrace | None = field(default=None, compare=False, repr=False)
+
+    def gap_within(self, t_end: float) -> str | None:
+        """The first of :attr:`gaps` overlapping [t_1, t_end] (s), described (bad input), or
+        None: a method that answers before the planned t_e is judged over its own samples."""
+        t_1 = float(self.t[self.rest_index])
+        return gap_problem(self.gaps, t_1, t_end, self.sample_period, self.config.max_gap)
+
+    @property
+    def gap(self) -> str | None:
+        """The first gap overlapping [t_1, t_e] (:meth:`gap_within` at the evidence's end)."""
+        return self.gap_within(float(self.t[self.end_index]))
 
     @property
     def spectrum_slice(self) -> slice:

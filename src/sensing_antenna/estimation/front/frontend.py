@@ -65,7 +65,6 @@ from sensing_antenna.estimation.front.steps import (
     at_contact,
     dead_channel,
     fill_missing,
-    gap_problem,
     hold_push,
     planned_end,
     ratio_tolerance,
@@ -658,7 +657,7 @@ class FrontEnd:
             hold_end=hold.stop - 1,
             offset_error=hold.force_noise / root,
             torque_offset_error=torque_noise / root,
-            gap=gap_problem(gaps, float(t[rest]), float(t[end]), ts),
+            gaps=tuple(gaps),
             input_problem=start.input_problem,
             diagnostics=diagnostics,
         )

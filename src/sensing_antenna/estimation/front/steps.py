@@ -282,20 +282,22 @@ def time_gaps(t: FloatArray, sample_period: float, max_gap: int) -> tuple[tuple[
 
 
 def gap_problem(
-    gaps: Sequence[tuple[float, float]], t_1: float, t_e: float, sample_period: float
+    gaps: Sequence[tuple[float, float]], t_1: float, t_e: float, sample_period: float, max_gap: int
 ) -> str | None:
-    """The first gap overlapping [t_1, t_e], described, or None.
+    """The first of ``gaps`` (each longer than ``max_gap`` samples) overlapping [t_1, t_e],
+    described, or None.
 
     After t_1 the estimators read the vibration (tens to hundreds of rad/s) and the hold's static
-    loads; a straight line across a gap of several samples replaces a part of a period and both
-    the spectrum and the fitted modes see a signal that was never there.
+    loads; a straight line across a long gap replaces whole periods and both the spectrum and
+    the fitted modes see a signal that was never there.
     """
     for start, end in gaps:
         if end > t_1 and start < t_e:
             missing = round((end - start) / sample_period) - 1
             return (
                 f"t: {missing} samples missing between {start:.4f} s and {end:.4f} s, inside "
-                f"the estimation window [{t_1:.3f}, {t_e:.3f}] s (only a few may be interpolated)"
+                f"the estimation window [{t_1:.3f}, {t_e:.3f}] s (at most {max_gap} in a row "
+                "are filled in)"
             )
     return None
 
