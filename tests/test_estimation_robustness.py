@@ -148,6 +148,7 @@ def test_a_gap_after_fast_answered_is_judged_only_by_the_methods_it_reaches() ->
     # before its answer, the gap is fast's too
     early = estimate(_drop(recording, i_1 + 100, 30), calibrated(), "fast")
     assert early.status is Status.BAD_INPUT and "30 samples missing" in (early.reason or "")
+    assert early.interval is None and early.diagnostics["interval_dropped"] is not None
 
 
 def test_gap_before_contact_is_interpolated() -> None:

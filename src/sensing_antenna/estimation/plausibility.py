@@ -148,6 +148,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     interval = _on_link(estimate.interval, link.length)
     point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
+        if interval is not None and estimate.status in _INPUT_STATUSES:
+            notes["interval_dropped"] = interval  # the method's own bad_input (a gap)
+            interval = None
         if interval != estimate.interval:
             notes["interval"] = interval
         if not point_ok:
