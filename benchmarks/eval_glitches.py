@@ -54,6 +54,7 @@ MOVED = 0.002  # m: an ok answer further than this from the clean one has moved
 WRONG = 0.02  # m: ... and further than this is wrong
 KEPT = 0.0005  # m: the results file keeps the estimates that moved further (or changed status)
 RESULTS = Path(__file__).parent / "results" / "glitches.json"
+RESULTS_DROP = RESULTS.with_name("glitches_drop.json")
 
 
 def corrupt(
@@ -239,9 +240,16 @@ def main() -> None:
     parser.add_argument("--kinds", nargs="+", default=list(KINDS), choices=[*KINDS, DROP])
     parser.add_argument("--max-gap", type=int, default=None)
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--json", type=Path, default=RESULTS)
+    parser.add_argument(
+        "--json",
+        type=Path,
+        default=None,
+        help=f"default {RESULTS.name}, or {RESULTS_DROP.name} for --kinds drop",
+    )
     parser.add_argument("--note", default="")
     args = parser.parse_args()
+    if args.json is None:
+        args.json = RESULTS_DROP if args.kinds == [DROP] else RESULTS
     start = time.perf_counter()
     jobs = [
         (case, x_c, args.lengths, args.instants, args.kinds, args.max_gap) for case, x_c in CONTACTS
@@ -279,7 +287,7 @@ def main() -> None:
         "lengths": args.lengths,
         "instants": args.instants,
         "kinds": args.kinds,
-        "max_gap": args.max_gap if args.max_gap is not None else EstimatorConfig().max_gap,
+        "max_gap": args.max_gap if args.max_gap is not None else EstimatorConfig().gap_limit(0.001),
         "machine": machine_info(),
         "seconds": time.perf_counter() - start,
         "moved_m": MOVED,

@@ -425,6 +425,16 @@ def test_the_bent_link_factor_may_be_zero_but_not_negative() -> None:
             EstimatorConfig(bent_link_factor=bad)
 
 
+def test_the_gap_limit_is_a_duration_unless_given_in_samples() -> None:
+    # 20 ms by default: 20 samples at 1 kHz, 5 at 250 Hz, 40 at 2 kHz, at least one
+    default = EstimatorConfig()
+    assert [default.gap_limit(ts) for ts in (1e-3, 4e-3, 5e-4, 0.05)] == [20, 5, 40, 1]
+    assert EstimatorConfig(max_gap=3).gap_limit(4e-3) == 3
+    for bad in (0, 2.5, -1):
+        with pytest.raises(EstimatorConfigError, match=r"max_gap: must be an integer >= 1"):
+            EstimatorConfig(max_gap=bad)  # type: ignore[arg-type]
+
+
 def _simulated(case: str) -> Recording:
     """A simulated manoeuvre (the project's simulator, an independent source of samples)."""
     x_c, seed = (0.45, 7) if case == "azimuthal" else (0.8, 8)

@@ -98,6 +98,12 @@ def warn_of_other_antennas(
     "checked"): the device's observer, threshold and stiffness are
     in its own file, and estimates with another's can go wrong in ways that look like bad data
     (a contact missed, a push that seems to turn the wrong way)."""
+    consequence = (
+        "its loads at rest are judged against another link's weight"
+        if use == "checked"
+        else "with another's observer and stiffness a good recording can come back "
+        "implausible_input or no_contact"
+    )
     for recorded, sources in named.items():
         if not recorded or recorded == model or not sources:
             continue
@@ -107,8 +113,7 @@ def warn_of_other_antennas(
         print(
             f"antenna: warning: {which} recorded with antenna {printable(recorded)!r} (its "
             f"metadata) and {use} with the default {printable(model)!r}: give that "
-            "antenna's file with --antenna (with another's observer and stiffness a good "
-            "recording can come back implausible_input or no_contact)",
+            f"antenna's file with --antenna ({consequence})",
             file=sys.stderr,
         )
 

@@ -10,7 +10,7 @@ from typing import Any
 
 from sensing_antenna.cli.arguments import add_actions, number
 
-#: Default gap threshold, in samples of a topic missing in a row (the value of
+#: Default gap threshold, in periods of the recording's clock (the value of
 #: ``sensing_antenna.importers.clock.DEFAULT_MAX_GAP``, written out so that parsing arguments
 #: does not import NumPy; ``tests/test_import_rosbag.py`` checks that they agree).
 DEFAULT_MAX_GAP = 20.0
@@ -90,8 +90,8 @@ def _add_rosbag(formats: Any) -> None:
         type=number(low=0.0),
         default=DEFAULT_MAX_GAP,
         metavar="SAMPLES",
-        help="more than this many samples of a topic missing in a row is a gap, whose samples "
-        "are left out",
+        help="a topic silent for longer than this many samples of the recording's clock is a "
+        "gap, whose samples are left out (default: the estimators' own limit at 1 kHz)",
     )
     parser.add_argument(
         "--stamps",

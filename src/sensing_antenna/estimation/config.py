@@ -12,7 +12,14 @@ from typing import Literal
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.errors import SensingAntennaError
 
-__all__ = ["EstimatorConfig", "EstimatorConfigError", "no_t1_reason"]
+__all__ = ["MAX_GAP_DURATION", "EstimatorConfig", "EstimatorConfigError", "no_t1_reason"]
+
+#: Longest run of missing samples (s) filled in on a straight line inside [t_1, t_e] by default:
+#: 20 samples at 1 kHz, as many as the corrupted samples in a row the front end puts back
+#: (:data:`.front.spikes.SPIKE_LONGEST`). A fiftieth of the spectrum window and a tenth of the
+#: fast method's first window; measured by ``benchmarks/eval_glitches.py --kinds drop``. Held
+#: in time, not samples: at 250 Hz twenty samples span 80 ms, three periods of the band's top.
+MAX_GAP_DURATION = 0.02
 
 
 class EstimatorConfigError(SensingAntennaError, ValueError):
@@ -71,14 +78,10 @@ class EstimatorConfig:
     loss_significance : float
         A short mean of the reaction along the push below this many of its standard errors is a
         contact loss (reported in the diagnostics); 3 standard errors.
-    max_gap : int
+    max_gap : int or None
         Largest number of consecutive missing samples inside [t_1, t_e] that linear
-        interpolation may fill; longer gaps give ``bad_input``. 20 samples, as many as the
-        corrupted samples in a row put back on a line (:data:`.front.spikes.SPIKE_LONGEST`):
-        20 ms at 1 kHz is a fiftieth of the spectrum window and a tenth of the fast method's
-        first window, and a line across it moved no ``ok`` answer by more than about a
-        millimetre where it did not turn it into another status
-        (``benchmarks/eval_glitches.py --kinds drop``).
+        interpolation may fill; longer gaps give ``bad_input``. None (the default): as many as
+        span :data:`MAX_GAP_DURATION` at the recording's sample period (:meth:`gap_limit`).
     spectrum_window : float
         Delta t_e1 (s), the record after t_1 analysed by Estimator 1. 1 s holds 5 periods of the
         lowest fundamental in the working range (31 rad/s, period 0.2 s) and gives a DFT bin of
@@ -226,7 +229,7 @@ class EstimatorConfig:
     min_push_significance: float = 5.0
     loss_window: float = 0.01
     loss_significance: float = 3.0
-    max_gap: int = 20
+    max_gap: int | None = None
     spectrum_window: float = 1.0
     zero_padding: int = 16
     contact_range: tuple[float, float] = (0.2, 1.0)
@@ -279,6 +282,8 @@ class EstimatorConfig:
                         f"{f.name}: must be a finite number >= 0, got {value!r}"
                     )
                 continue
+            if f.name == "max_gap" and value is None:
+                continue
             if f.name in ("zero_padding", "max_gap"):
                 if not (isinstance(value, int) and value >= 1):
                     raise EstimatorConfigError(f"{f.name}: must be an integer >= 1, got {value!r}")
@@ -302,6 +307,13 @@ class EstimatorConfig:
             )
         if self.max_ratio_wait < self.convergence_window:
             raise EstimatorConfigError("max_ratio_wait: must be >= convergence_window")
+
+    def gap_limit(self, sample_period: float) -> int:
+        """Most missing samples in a row filled in at ``sample_period`` (s): ``max_gap``, or
+        as many as span :data:`MAX_GAP_DURATION` (at least one)."""
+        if self.max_gap is not None:
+            return self.max_gap
+        return max(1, math.floor(MAX_GAP_DURATION / sample_period + 1e-9))
 
 
 def no_t1_reason(config: EstimatorConfig, rest_tolerance: float) -> str:

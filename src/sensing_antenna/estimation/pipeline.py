@@ -76,7 +76,9 @@ def gather(
         diagnostics={"sampling": dataclasses.asdict(sampling), "resampled": sampling.irregular},
     )
     filled = (
-        time_gaps(recording.t, recording.sample_period, cfg.max_gap) if sampling.irregular else ()
+        time_gaps(recording.t, recording.sample_period, cfg.gap_limit(recording.sample_period))
+        if sampling.irregular
+        else ()
     )
     front.update_block(uniform.t, uniform.theta, uniform.force, uniform.torque, filled)
     return front.finish()

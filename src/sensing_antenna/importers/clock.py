@@ -25,8 +25,8 @@ k T_s):
 - the joint angles by linear interpolation between the messages either side, at their samples'
   instants (at their stamps when they do not come at a steady rate; joint states usually come
   slower than the sensor, and the angles move smoothly);
-- a slot inside a gap of either stream, more than ``max_gap`` of its samples missing in a row,
-  is left out: the recording then shows the missing samples and the estimators treat them as
+- a slot inside a gap of either stream, missing for longer than ``max_gap`` periods T_s of the
+  clock, is left out: the recording then shows the missing samples and the estimators treat them as
   dropped (docs/recording-format.md), instead of estimating from straight lines drawn across the
   gap.
 
@@ -44,7 +44,7 @@ from numpy.typing import NDArray
 from scipy.ndimage import median_filter
 
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.config import MAX_GAP_DURATION
 from sensing_antenna.recording import MAX_SAMPLES
 
 __all__ = [
@@ -60,11 +60,12 @@ __all__ = [
     "sample_clock",
 ]
 
-#: More than this many samples of a stream missing in a row is a gap whose slots are left out:
-#: the estimators' own ``max_gap`` (:class:`~sensing_antenna.estimation.EstimatorConfig`), beyond
-#: which a gap after the push gives ``bad_input``, so a shorter hole is bridged and a longer one
-#: shown.
-DEFAULT_MAX_GAP = float(EstimatorConfig().max_gap)
+#: A stream missing for longer than this many periods of the clock is a gap whose slots are left
+#: out: the estimators' own limit at 1 kHz (:data:`~sensing_antenna.estimation.config.
+#: MAX_GAP_DURATION`), beyond which a gap after the push gives ``bad_input``, so a shorter hole
+#: is bridged and a longer one shown. Counted in the clock's periods for every stream, so a
+#: joint topic at 100 Hz is allowed as long a silence as the wrench.
+DEFAULT_MAX_GAP = float(round(MAX_GAP_DURATION * 1000.0))
 
 #: The report says how much of the wrench the joints leave out beyond this many periods.
 _TRIM_NOTED = 10
@@ -140,8 +141,8 @@ class StreamReport:
     largest_step : float
         Largest step between consecutive stamps (s).
     n_gaps : int
-        Runs of more than ``max_gap`` samples missing (for the joints, across which the angles
-        moved; none for joints not ``steady``).
+        Runs missing for longer than ``max_gap`` periods of the clock (for the joints, across
+        which the angles moved; none for joints not ``steady``).
     jitter : float
         Largest distance of a stamp from its sample's instant on the stream's own clock (s).
     steady : bool
@@ -213,7 +214,7 @@ class ClockReport:
         Largest distance between the instant of a wrench message used as it is and its slot
         (s): 0 on the wrench's own clock.
     max_gap : float
-        The gap threshold used (samples missing in a row).
+        The gap threshold used (periods of the clock).
     trimmed : tuple of float
         Time (s) of the wrench stream before the grid's first slot and after its last: where
         the joints do not cover it.
@@ -240,7 +241,7 @@ class ClockReport:
             f"clock: {self.n_samples} samples every {self.period:.6g} s"
             f" ({1.0 / self.period:.6g} Hz) over {span:.6g} s",
             f"{self.n_interpolated} sample(s) without their own wrench message, interpolated;"
-            f" {self.n_left_out} left out in gaps of more than {self.max_gap:g} samples missing",
+            f" {self.n_left_out} left out in gaps longer than {self.max_gap:g} samples",
         ]
         before, after = self.trimmed
         if max(before, after) > _TRIM_NOTED * self.period:
@@ -559,7 +560,7 @@ def put_on_clock(
     period : float, optional
         T_s (s); when None, the wrench stream's own period (:func:`sample_clock`).
     max_gap : float
-        More than this many samples of a stream missing in a row is a gap (>= 0).
+        A stream missing for longer than this many periods T_s of the clock is a gap (>= 0).
 
     Returns
     -------
@@ -634,13 +635,16 @@ def put_on_clock(
     joint_values = np.column_stack(
         [np.interp(slot_ns, joints_ns, column) for column in joints.values.T]
     )
-    wrench_gaps = _gaps(wrench_clock, max_gap)
+    # each stream's limit in its own samples: max_gap periods of the clock
+    wrench_gaps = _gaps(wrench_clock, max_gap * step_ns / wrench_clock.period)
     left_out = ~has_own & _in_gap(wrench_ns, wrench_gaps, slot_ns)
     # where the angles did not move across it, a silence of the joints (a publisher that sends
     # on change) is no gap: the straight line between its ends is the path
     moved = np.max(np.abs(np.diff(joints.values, axis=0)), axis=1) > _STILL
     # a joint topic not at a steady rate has no samples to count missing: no gaps
-    joints_gaps = _gaps(joints_clock, max_gap) & moved & joints_clock.steady()
+    joints_gaps = (
+        _gaps(joints_clock, max_gap * step_ns / joints_clock.period) & moved & joints_clock.steady()
+    )
     left_out |= _in_gap(joints_ns, joints_gaps, slot_ns)
     kept = np.flatnonzero(~left_out)
     if kept.shape[0] < 2:

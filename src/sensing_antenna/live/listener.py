@@ -260,7 +260,11 @@ class Listener:
         # reports are indices into these (after an outlier time stamp, which ends its run, the
         # rest as they came, for the contact's loss)
         filled = fill_missing(
-            t, rows, self.header.sample_period, self._estimator.config.max_gap, self._last
+            t,
+            rows,
+            self.header.sample_period,
+            self._estimator.config.gap_limit(self.header.sample_period),
+            self._last,
         )
         self._last = (float(t[-1]), rows[-1])
         first = self._t.size

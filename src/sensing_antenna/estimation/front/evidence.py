@@ -182,8 +182,9 @@ class Evidence:
     offset_error, torque_offset_error : float
         Standard errors of the force (N) and torque (N m) offsets removed by the tare.
     gaps : tuple of (float, float)
-        The steps of the time stamps (s, s) that missed more than ``config.max_gap`` samples,
-        known up to t_e; :meth:`gap_within` judges them over a method's own window.
+        The steps of the time stamps (s, s) that missed more than ``config.gap_limit`` samples
+        (those known by t_e in a stream); :meth:`gap_within` judges them over a method's own
+        window.
     input_problem : str or None
         Why the samples up to t_c are not in the format's units and signs (the loads at rest
         against the link's weight, the free motion against the observer), None when they are;
@@ -226,7 +227,8 @@ class Evidence:
         """The first of :attr:`gaps` overlapping [t_1, t_end] (s), described (bad input), or
         None: a method that answers before the planned t_e is judged over its own samples."""
         t_1 = float(self.t[self.rest_index])
-        return gap_problem(self.gaps, t_1, t_end, self.sample_period, self.config.max_gap)
+        limit = self.config.gap_limit(self.sample_period)
+        return gap_problem(self.gaps, t_1, t_end, self.sample_period, limit)
 
     @property
     def gap(self) -> str | None:

@@ -277,7 +277,7 @@ class FrontEnd:
             most: :func:`.steps.samples_missing`), the k - 1 samples missing are put back by
             linear interpolation (:func:`.steps.fill_missing`, as a whole recording is
             resampled) and counted in the diagnostics
-            (``filled_samples``); steps of more than ``config.max_gap`` missing samples are also
+            (``filled_samples``); steps of more than ``config.gap_limit`` missing samples are also
             gaps, and one beyond :data:`.steps.MAX_FILLED` makes the outcome ``bad_input``.
         theta : array_like, shape (n, 2)
             Motor angles (rad).
@@ -445,7 +445,7 @@ class FrontEnd:
                 return t, theta, force, torque  # the loop's case: the next sample, nothing skipped
         previous = self._last_received()
         filled = fill_missing(
-            t, np.hstack([theta, force, torque]), ts, self.config.max_gap, previous
+            t, np.hstack([theta, force, torque]), ts, self.config.gap_limit(ts), previous
         )
         if filled.jump is not None:
             self._jump = f"t: {filled.jump}"
@@ -471,9 +471,10 @@ class FrontEnd:
 
     def _gaps_known(self, end: int) -> list[tuple[float, float]]:
         """Gaps known at sample ``end``: those the caller filled in the blocks fed by then, and
-        steps of the time stamps up to ``end`` missing more than ``config.max_gap`` samples."""
+        steps of the time stamps up to ``end`` missing more than ``config.gap_limit`` samples."""
         filled = [gap for known, gap in self._filled if known <= end]
-        stamps = time_gaps(self._t[: end + 1], self.sample_period, self.config.max_gap)
+        limit = self.config.gap_limit(self.sample_period)
+        stamps = time_gaps(self._t[: end + 1], self.sample_period, limit)
         return filled + list(stamps)
 
     def _advance(self, first: int, stop: int) -> Gathered | None:

@@ -288,8 +288,8 @@ def gap_problem(
     described, or None.
 
     After t_1 the estimators read the vibration (tens to hundreds of rad/s) and the hold's static
-    loads; a straight line across a long gap replaces whole periods and both the spectrum and
-    the fitted modes see a signal that was never there.
+    loads; a straight line across a long gap replaces a large part of a period or more, and both
+    the spectrum and the fitted modes see a signal that was never there.
     """
     for start, end in gaps:
         if end > t_1 and start < t_e:
