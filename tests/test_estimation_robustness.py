@@ -20,9 +20,12 @@ from _models import calibrated
 from sensing_antenna.antenna import load_antenna, paper_antenna
 from sensing_antenna.cli.estimate import summary
 from sensing_antenna.estimation import ContactEstimate, OnlineEstimator, Status, estimate
-from sensing_antenna.estimation.front.spikes import SPIKE_LONGEST
+from sensing_antenna.estimation.front.spikes import spike_longest
 from sensing_antenna.recording import Recording
 from test_estimation_pipeline import Synthetic, comparable, synthetic_recording
+
+#: The longest run put back at the synthetic recordings' 1 kHz.
+SPIKE_LONGEST = spike_longest(1e-3)
 
 
 def test_push_judged_over_the_hold_despite_rebounds() -> None:
@@ -88,7 +91,7 @@ def _drop(recording: Recording, start: int, count: int) -> Recording:
         theta=recording.theta[keep],
         force=recording.force[keep],
         torque=recording.torque[keep],
-        metadata={"sample_period": "0.001"},
+        metadata={"sample_period": repr(recording.sample_period)},
     )
 
 
@@ -149,6 +152,31 @@ def test_a_gap_after_fast_answered_is_judged_only_by_the_methods_it_reaches() ->
     early = estimate(_drop(recording, i_1 + 100, 30), calibrated(), "fast")
     assert early.status is Status.BAD_INPUT and "30 samples missing" in (early.reason or "")
     assert early.interval is None and early.diagnostics["interval_dropped"] is not None
+
+
+def test_at_250_hz_runs_and_gaps_are_bridged_for_20_ms_not_20_samples() -> None:
+    # every fourth sample of a 1 kHz push: 20 ms are five samples, and a sixth in a row is
+    # neither put back (a corrupted run) nor filled in silently (a gap after t_1)
+    fine = synthetic_recording(Synthetic(x_c=0.5, seed=4))
+    coarse = Recording(
+        t=fine.t[::4],
+        theta=fine.theta[::4],
+        force=fine.force[::4],
+        torque=fine.torque[::4],
+        metadata={"sample_period": "0.004"},
+    )
+    clean = estimate(coarse, calibrated())
+    assert clean.ok, clean.reason
+    k = int(np.searchsorted(coarse.t, clean.t_1 + 0.05))
+    for count in (5, 6):
+        torque = coarse.torque.copy()
+        torque[k : k + count, 1] = 0.0
+        result = estimate(dataclasses.replace(coarse, torque=torque), calibrated())
+        repaired = result.diagnostics.get("repaired_samples", [])
+        assert [r["samples"] for r in repaired] == ([5] if count == 5 else []), count
+        holed = estimate(_drop(coarse, k, count), calibrated())
+        assert holed.status is (Status.OK if count == 5 else Status.BAD_INPUT), holed.reason
+        assert holed.diagnostics["sampling"]["n_dropped"] == count
 
 
 def test_gap_before_contact_is_interpolated() -> None:

@@ -51,9 +51,9 @@ class OnlineEstimator:
     Notes
     -----
     :meth:`update` returns the estimate exactly once, at the sample it is given (t_e, or the
-    earlier instant a method that stops early is ready at; up to ``SPIKE_LOOKAHEAD`` (21)
-    samples later when a suspected corrupted sample near it waits for the samples that decide
-    it, more when it lies inside another channel's run, :mod:`.front.spikes`), and None
+    earlier instant a method that stops early is ready at; up to 21 samples later at 1 kHz when
+    a suspected corrupted sample near it waits for the samples that decide it, more when it
+    lies inside another channel's run, :mod:`.front.spikes`), and None
     otherwise (also after the estimate). :meth:`finalize` closes a run that ended first (no
     contact, no push, too short) and returns the estimate ``estimate`` gives on the same
     samples. Samples the time stamps skip are put back by linear interpolation as they become
@@ -89,7 +89,8 @@ class OnlineEstimator:
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed and those put back where the time stamps
         skipped some, less those held back until a suspected corruption among them is decided
-        (``SPIKE_LOOKAHEAD``, 21, or more from the start of another channel's run)."""
+        (:func:`.front.spikes.spike_longest` + 1, 21 at 1 kHz, or more from the start of
+        another channel's run)."""
         return self._front.n_samples
 
     @property

@@ -57,6 +57,7 @@ from sensing_antenna.estimation.front.spikes import (
     judged_from,
     repair,
     spike_floor,
+    spike_longest,
 )
 from sensing_antenna.estimation.front.steps import (
     STEP_JITTER,
@@ -169,6 +170,7 @@ class FrontEnd:
         self._monitor: PushMonitor | None = None
         self._loads_filter: FirstOrderLowPass | None = None
         self._spike_floor = spike_floor(antenna)
+        self._spike_longest = spike_longest(ts)
         self._spike_gate = judged_from(self._spike_floor)
         if self._refused is None:
             self._detector = ContactDetector(antenna, ts)
@@ -226,7 +228,7 @@ class FrontEnd:
     def n_samples(self) -> int:
         """Samples held since :meth:`reset`: those fed, and those put back where the time stamps
         skipped some (:meth:`update_block`); not those held back until the samples that decide
-        a suspected corruption among them have come (``SPIKE_LOOKAHEAD``, or more from the
+        a suspected corruption among them have come (``spike_longest`` + 1, or more from the
         start of another channel's run that reaches the suspect)."""
         return self._n
 
@@ -382,7 +384,9 @@ class FrontEnd:
             wrench = np.concatenate([pwrench, wrench])
         h = history.shape[0]
         raw = np.concatenate([history, wrench]) if h else wrench
-        spikes, decided = find_spikes(raw, h, self._spike_floor, final=final)
+        spikes, decided = find_spikes(
+            raw, h, self._spike_floor, final=final, longest=self._spike_longest
+        )
         released = decided - h
         if spikes:
             origin = self._n - h  # sample index of raw[0]

@@ -1,6 +1,6 @@
 """Corrupted samples of the force/torque sensor (a glitch of the bus or the DAQ): runs of up to
-:data:`SPIKE_LONGEST` samples found against a robust local noise scale and put back by
-interpolation between their neighbours.
+:data:`SPIKE_DURATION` (:func:`spike_longest` samples) found against a robust local noise scale
+and put back by interpolation between their neighbours.
 
 A sensor read over EtherCAT or a serial line now and then delivers a sample, or a few in a row,
 whose wrench is not the link's: a channel (or all six) with a huge value, a sign flipped, all
@@ -11,10 +11,10 @@ from j - 1 departs from the local trend (the median of the ``SPIKE_WINDOW`` firs
 before it) by more than ``SPIKE_FACTOR`` robust deviations (1.4826 times their median absolute
 deviation) and by more than a floor (:func:`spike_floor`); it starts a *spike* of m samples
 when those m samples lie off the trend by that bound and the signal comes back to the trend at
-j + m (m at most ``SPIKE_LONGEST``) and goes on calmly, and then the m samples are replaced by
+j + m (m at most ``longest``) and goes on calmly, and then the m samples are replaced by
 the straight line between their neighbours. A step that stays (a contact) is left alone; an
 impact's pulse as brief and above the floor cannot be told from a glitch and is put back too.
-Every decision reads the raw samples j - SPIKE_WINDOW - 1 .. j + SPIKE_LOOKAHEAD only, so a
+Every decision reads the raw samples j - SPIKE_WINDOW - 1 .. j + longest + 1 only, so a
 stream decides as a whole recording does, holding a suspect back until the samples after it
 that decide it have come.
 
@@ -33,9 +33,8 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna
 
 __all__ = [
+    "SPIKE_DURATION",
     "SPIKE_FACTOR",
-    "SPIKE_LONGEST",
-    "SPIKE_LOOKAHEAD",
     "SPIKE_WINDOW",
     "WRENCH_CHANNELS",
     "Spike",
@@ -43,6 +42,7 @@ __all__ = [
     "judged_from",
     "repair",
     "spike_floor",
+    "spike_longest",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -52,11 +52,9 @@ FloatArray = NDArray[np.float64]
 SPIKE_WINDOW = 31
 #: Robust deviations from the local trend beyond which a step is a suspect.
 SPIKE_FACTOR = 10.0
-#: Most corrupted samples in a row that are put back: at 1 kHz half the shortest rebound (a
-#: contact lost and found again, 40 ms) the simulator shows, so none is taken for one.
-SPIKE_LONGEST = 20
-#: Samples after a suspect that decide it: the longest run and the landing after it.
-SPIKE_LOOKAHEAD = SPIKE_LONGEST + 1
+#: Longest run of corrupted samples put back (s): half the shortest rebound (a contact lost and
+#: found again, 40 ms) the simulator shows, so none is taken for one.
+SPIKE_DURATION = 0.02
 #: Least spike, in the link's weight (forces) and its weight's moment, the link horizontal
 #: (torques): above the single-sample pulses the simulated link's impacts ring between calm
 #: neighbours at its default contact (docs/design-notes.md, "Corrupted samples").
@@ -70,15 +68,26 @@ WRENCH_CHANNELS = ("fx", "fy", "fz", "tx", "ty", "tz")
 @dataclass(frozen=True)
 class Spike:
     """Corrupted samples found: ``index`` (of the first, in the array searched), ``length``
-    (1 to :data:`SPIKE_LONGEST`) and the channels (0..5, fx..tz) whose values were put back."""
+    (1 to :func:`spike_longest`) and the channels (0..5, fx..tz) whose values were put back."""
 
     index: int
     length: int
     channels: tuple[int, ...]
 
 
+def spike_longest(sample_period: float) -> int:
+    """Most corrupted samples in a row put back at ``sample_period`` (s): as many as span
+    :data:`SPIKE_DURATION`, at least one."""
+    return max(1, math.floor(SPIKE_DURATION / sample_period + 1e-9))
+
+
 def find_spikes(
-    raw: FloatArray, start: int, floor: FloatArray, final: bool = False
+    raw: FloatArray,
+    start: int,
+    floor: FloatArray,
+    final: bool = False,
+    *,
+    longest: int,
 ) -> tuple[list[Spike], int]:
     """The spikes among ``raw[start:]`` and how many leading samples are decided.
 
@@ -93,6 +102,9 @@ def find_spikes(
         not judged, however calm its neighbours (:func:`spike_floor`).
     final : bool
         No samples will follow: a suspect too near the end to decide is left as it is.
+    longest : int
+        Most samples in a run (:func:`spike_longest`); a suspect waits for ``longest + 1``
+        samples after it.
 
     Returns
     -------
@@ -140,15 +152,15 @@ def find_spikes(
         channels = np.flatnonzero(flagged[k] & (skip_to <= j))
         if not channels.size:
             continue  # the return of a spike just found
-        if j + SPIKE_LOOKAHEAD > n - 1:
+        if j + longest + 1 > n - 1:
             if not final:
                 return _decided_before(spikes, j)  # wait for the samples that decide it
             if j + 2 > n - 1:
                 break  # too near the end for a single sample's landing and the step after it
         by_length: dict[int, list[int]] = {}
         for c in channels:
-            x = raw[j - 2 : j + SPIKE_LONGEST + 2, c]
-            length = _spike_length(x, float(trend[k, c]), float(limit[k, c]))
+            x = raw[j - 2 : j + longest + 2, c]
+            length = _spike_length(x, float(trend[k, c]), float(limit[k, c]), longest)
             if length:
                 by_length.setdefault(length, []).append(int(c))
                 skip_to[c] = j + 1 + length
@@ -190,11 +202,11 @@ def spike_floor(antenna: Antenna) -> FloatArray:
     return np.array([force * weight] * 3 + [torque * moment] * 3)
 
 
-def _spike_length(x: FloatArray, slope: float, limit: float) -> int:
-    """The number of samples from x[2] on (1 to :data:`SPIKE_LONGEST`) that leave the trend and
-    come back, else 0.
+def _spike_length(x: FloatArray, slope: float, limit: float, most: int) -> int:
+    """The number of samples from x[2] on (1 to ``most``) that leave the trend and come back,
+    else 0.
 
-    ``x``: the samples j - 2 .. j + SPIKE_LONGEST + 1 of one channel (fewer at the end of a
+    ``x``: the samples j - 2 .. j + most + 1 of one channel (fewer at the end of a
     recording); ``slope`` the local trend per sample and ``limit`` the bound on a departure
     from it. A spike leaves a calm signal (the step into j - 1 within the bound), each of its
     samples lies beyond the bound off the trend line from j - 1, the next sample lands on that
@@ -205,7 +217,7 @@ def _spike_length(x: FloatArray, slope: float, limit: float) -> int:
     with np.errstate(over="ignore", invalid="ignore"):
         if not abs(x[1] - x[0] - slope) <= limit:
             return 0
-        longest = min(SPIKE_LONGEST, x.shape[0] - 4)  # fewer at a recording's end
+        longest = min(most, x.shape[0] - 4)  # fewer at a recording's end
         # departures from the trend line through x[1], of x[2] .. x[longest + 2]
         off = x[2 : longest + 3] - x[1] - slope * np.arange(1.0, longest + 2.0)
         size = np.abs(off)
