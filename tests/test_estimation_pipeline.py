@@ -430,7 +430,7 @@ def test_the_gap_limit_is_a_duration_unless_given_in_samples() -> None:
     default = EstimatorConfig()
     assert [default.gap_limit(ts) for ts in (1e-3, 4e-3, 5e-4, 0.05)] == [20, 5, 40, 1]
     assert EstimatorConfig(max_gap=3).gap_limit(4e-3) == 3
-    for bad in (0, 2.5, -1):
+    for bad in (0, 2.5, -1, True):
         with pytest.raises(EstimatorConfigError, match=r"max_gap: must be an integer >= 1"):
             EstimatorConfig(max_gap=bad)  # type: ignore[arg-type]
 

@@ -80,6 +80,38 @@ def test_slots_inside_a_joint_gap_are_left_out() -> None:
     assert gap.report.n_left_out == 0 and gap.report.joints.n_gaps == 0
 
 
+@pytest.mark.parametrize("period_ms", [1, 2, 4])
+def test_the_default_gap_is_the_estimators_20_ms_at_the_clock_s_rate(period_ms: int) -> None:
+    # a wrench at 1 kHz, 500 Hz or 250 Hz and joints at 100 Hz (10 ms): by default a silence
+    # of more than 20 ms is a gap in either stream, whatever its own rate, as the estimators
+    # refuse after the push; one of 20 ms is bridged
+    n = 2000 // period_ms
+    wrench = _wrench(n, period_ns=period_ms * MS)
+    allowed = 20 // period_ms  # samples of the clock in 20 ms
+    lost = np.arange(100, 100 + allowed + 1)  # one more: a gap
+    joints = _ramp_joints(EPOCH_NS + np.delete(np.arange(0, 2000, 10), [100, 101]) * MS)
+    lossy = Stream(
+        "/wrench", "wrench", np.delete(wrench.stamps, lost), np.delete(wrench.values, lost, axis=0)
+    )
+    clocked = put_on_clock(lossy, joints, source="log")
+    assert clocked.report.max_gap == allowed
+    assert clocked.report.wrench.n_gaps == 1 and clocked.report.joints.n_gaps == 0
+    bridged = put_on_clock(
+        Stream(
+            "/wrench",
+            "wrench",
+            np.delete(wrench.stamps, lost[1:]),
+            np.delete(wrench.values, lost[1:], axis=0),
+        ),
+        joints,
+        source="log",
+    )
+    assert bridged.report.n_left_out == 0 and bridged.report.wrench.n_gaps == 0
+    # three joint messages lost (30 ms of joints at 100 Hz): a gap too
+    silent = _ramp_joints(EPOCH_NS + np.delete(np.arange(0, 2000, 10), [100, 101, 102]) * MS)
+    assert put_on_clock(wrench, silent, source="log").report.joints.n_gaps == 1
+
+
 def test_streams_that_do_not_overlap_or_repeat_a_stamp_are_refused() -> None:
     wrench = _wrench(10)
     later = _ramp_joints(EPOCH_NS + np.arange(10, 20, dtype=np.int64) * MS)

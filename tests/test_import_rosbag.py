@@ -20,10 +20,9 @@ from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_typestore
 
 from _models import calibrated
-from sensing_antenna.cli import importer, main
+from sensing_antenna.cli import main
 from sensing_antenna.estimation import estimate
 from sensing_antenna.importers import AxesError, ImporterError, SensorAxes
-from sensing_antenna.importers.clock import DEFAULT_MAX_GAP
 from sensing_antenna.importers.rosbag import read_rosbag
 from sensing_antenna.recording import Recording, read_recording
 from sensing_antenna.simulator import Scenario, simulate
@@ -495,7 +494,3 @@ def test_sensor_axes_must_be_a_rotation(
         SensorAxes(axes)
     err = _run(_import(bag, "--wrench", WRENCH, "--joints", JOINTS, "--frame", axes), capsys)
     assert err.startswith(f"antenna import: error: --frame: {axes!r}: ")
-
-
-def test_the_command_s_default_gap_is_the_library_s() -> None:
-    assert importer.DEFAULT_MAX_GAP == DEFAULT_MAX_GAP

@@ -10,11 +10,6 @@ from typing import Any
 
 from sensing_antenna.cli.arguments import add_actions, number
 
-#: Default gap threshold, in periods of the recording's clock (the value of
-#: ``sensing_antenna.importers.clock.DEFAULT_MAX_GAP``, written out so that parsing arguments
-#: does not import NumPy; ``tests/test_import_rosbag.py`` checks that they agree).
-DEFAULT_MAX_GAP = 20.0
-
 
 def register(subparsers: Any) -> None:
     """Add ``antenna import`` and its formats."""
@@ -88,10 +83,11 @@ def _add_rosbag(formats: Any) -> None:
     parser.add_argument(
         "--max-gap",
         type=number(low=0.0),
-        default=DEFAULT_MAX_GAP,
+        default=None,
         metavar="SAMPLES",
         help="a topic silent for longer than this many samples of the recording's clock is a "
-        "gap, whose samples are left out (default: the estimators' own limit at 1 kHz)",
+        "gap, whose samples are left out (default: the estimators' own limit, 20 ms: 20 "
+        "samples at 1 kHz)",
     )
     parser.add_argument(
         "--stamps",

@@ -285,7 +285,7 @@ class EstimatorConfig:
             if f.name == "max_gap" and value is None:
                 continue
             if f.name in ("zero_padding", "max_gap"):
-                if not (isinstance(value, int) and value >= 1):
+                if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
                     raise EstimatorConfigError(f"{f.name}: must be an integer >= 1, got {value!r}")
                 continue
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):

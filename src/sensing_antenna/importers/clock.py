@@ -44,11 +44,10 @@ from numpy.typing import NDArray
 from scipy.ndimage import median_filter
 
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.estimation.config import MAX_GAP_DURATION
+from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.recording import MAX_SAMPLES
 
 __all__ = [
-    "DEFAULT_MAX_GAP",
     "STEADY_PERIODS",
     "ClockReport",
     "ClockedStreams",
@@ -60,12 +59,6 @@ __all__ = [
     "sample_clock",
 ]
 
-#: A stream missing for longer than this many periods of the clock is a gap whose slots are left
-#: out: the estimators' own limit at 1 kHz (:data:`~sensing_antenna.estimation.config.
-#: MAX_GAP_DURATION`), beyond which a gap after the push gives ``bad_input``, so a shorter hole
-#: is bridged and a longer one shown. Counted in the clock's periods for every stream, so a
-#: joint topic at 100 Hz is allowed as long a silence as the wrench.
-DEFAULT_MAX_GAP = float(round(MAX_GAP_DURATION * 1000.0))
 
 #: The report says how much of the wrench the joints leave out beyond this many periods.
 _TRIM_NOTED = 10
@@ -547,7 +540,7 @@ def put_on_clock(
     *,
     source: str,
     period: float | None = None,
-    max_gap: float = DEFAULT_MAX_GAP,
+    max_gap: float | None = None,
 ) -> ClockedStreams:
     """Lay the wrench and joint streams on one uniform clock (see the module's docstring).
 
@@ -559,8 +552,11 @@ def put_on_clock(
         The log's name, for messages.
     period : float, optional
         T_s (s); when None, the wrench stream's own period (:func:`sample_clock`).
-    max_gap : float
+    max_gap : float, optional
         A stream missing for longer than this many periods T_s of the clock is a gap (>= 0).
+        None: the estimators' own limit at T_s (``EstimatorConfig().gap_limit``, 20 ms),
+        beyond which a gap after the push gives ``bad_input``; so a shorter hole is bridged and
+        a longer one shown, for every topic alike.
 
     Returns
     -------
@@ -575,7 +571,7 @@ def put_on_clock(
     """
     for stream in (wrench, joints):
         _check_stream(stream, source)
-    if not (math.isfinite(max_gap) and max_gap >= 0.0):
+    if max_gap is not None and not (math.isfinite(max_gap) and max_gap >= 0.0):
         raise ValueError(f"max_gap must be a finite number >= 0, got {max_gap!r}")
     wrench_clock, joints_clock = sample_clock(wrench.stamps), sample_clock(joints.stamps)
     if wrench_clock.fall > 0.0:
@@ -598,6 +594,8 @@ def put_on_clock(
     step = wrench_clock.period / _NS if period is None else float(period)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"period must be finite and > 0, got {step!r}")
+    if max_gap is None:
+        max_gap = float(EstimatorConfig().gap_limit(step))
     step_ns = step * _NS
     first = int(np.searchsorted(instants, start, side="left"))
     origin = int(instants[first])

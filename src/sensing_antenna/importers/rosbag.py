@@ -22,7 +22,6 @@ import numpy as np
 
 from sensing_antenna.importers.axes import SensorAxes
 from sensing_antenna.importers.clock import (
-    DEFAULT_MAX_GAP,
     ClockReport,
     ImporterError,
     Stream,
@@ -354,7 +353,7 @@ def read_rosbag(
     joint2: str | None = None,
     axes: SensorAxes | None = None,
     sample_period: float | None = None,
-    max_gap: float = DEFAULT_MAX_GAP,
+    max_gap: float | None = None,
     stamps: Literal["header", "bag"] = "header",
     metadata: Mapping[str, str] | None = None,
 ) -> RosbagImport:
@@ -377,9 +376,9 @@ def read_rosbag(
     sample_period : float, optional
         The recording's T_s (s); the wrench topic's own period when None
         (:func:`.clock.sample_clock`).
-    max_gap : float
-        More than this many samples of a topic missing in a row is a gap, whose samples are
-        left out (>= 0).
+    max_gap : float, optional
+        A topic silent for longer than this many periods of the recording's clock is a gap,
+        whose samples are left out (>= 0); None: the estimators' own limit (20 ms).
     stamps : {"header", "bag"}
         Time of a message: its header stamp, or the time the bag recorded it.
     metadata : Mapping[str, str], optional

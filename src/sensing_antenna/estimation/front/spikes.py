@@ -1,6 +1,6 @@
 """Corrupted samples of the force/torque sensor (a glitch of the bus or the DAQ): runs of up to
-:data:`SPIKE_DURATION` (:func:`spike_longest` samples) found against a robust local noise scale
-and put back by interpolation between their neighbours.
+:func:`spike_longest` samples found against a robust local noise scale and put back by
+interpolation between their neighbours.
 
 A sensor read over EtherCAT or a serial line now and then delivers a sample, or a few in a row,
 whose wrench is not the link's: a channel (or all six) with a huge value, a sign flipped, all
@@ -35,6 +35,7 @@ from sensing_antenna.antenna import Antenna
 __all__ = [
     "SPIKE_DURATION",
     "SPIKE_FACTOR",
+    "SPIKE_LEAST",
     "SPIKE_WINDOW",
     "WRENCH_CHANNELS",
     "Spike",
@@ -52,9 +53,12 @@ FloatArray = NDArray[np.float64]
 SPIKE_WINDOW = 31
 #: Robust deviations from the local trend beyond which a step is a suspect.
 SPIKE_FACTOR = 10.0
-#: Longest run of corrupted samples put back (s): half the shortest rebound (a contact lost and
-#: found again, 40 ms) the simulator shows, so none is taken for one.
+#: Longest run of corrupted samples put back (s) at rates above 1 kHz: half the shortest rebound
+#: (a contact lost and found again, 40 ms) the simulator shows, so none is taken for one.
 SPIKE_DURATION = 0.02
+#: Fewest samples of that longest run, below 1 kHz: there a corrupted run left in place does more
+#: harm than a brief rebound put back (docs/design-notes.md, "Samples lost inside the window").
+SPIKE_LEAST = 20
 #: Least spike, in the link's weight (forces) and its weight's moment, the link horizontal
 #: (torques): above the single-sample pulses the simulated link's impacts ring between calm
 #: neighbours at its default contact (docs/design-notes.md, "Corrupted samples").
@@ -77,8 +81,8 @@ class Spike:
 
 def spike_longest(sample_period: float) -> int:
     """Most corrupted samples in a row put back at ``sample_period`` (s): as many as span
-    :data:`SPIKE_DURATION`, at least one."""
-    return max(1, math.floor(SPIKE_DURATION / sample_period + 1e-9))
+    :data:`SPIKE_DURATION`, and at least :data:`SPIKE_LEAST`."""
+    return max(SPIKE_LEAST, math.floor(SPIKE_DURATION / sample_period + 1e-9))
 
 
 def find_spikes(
