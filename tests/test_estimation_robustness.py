@@ -109,7 +109,7 @@ def test_gap_after_t1_is_bad_input_online_and_offline() -> None:
         online.update(gapped.t[k], gapped.theta[k], gapped.force[k], gapped.torque[k])
     final = online.finalize()
     assert final.status is Status.BAD_INPUT and "200 samples missing" in (final.reason or "")
-    # up to max_gap (20) in a row are filled in on a line, the answer within 1 mm (a line
+    # up to gap_limit (20 at 1 kHz) in a row are filled in on a line, the answer within 1 mm (a line
     # across 20 ms moves the spectrum's peak by far less: benchmarks/eval_glitches.py), and
     # antenna estimate says how many; 21 in a row are too many
     for count, expected in ((20, Status.OK), (21, Status.BAD_INPUT)):
@@ -157,8 +157,8 @@ def test_a_gap_after_fast_answered_is_judged_only_by_the_methods_it_reaches() ->
 def test_at_250_hz_gaps_are_bridged_for_20_ms_and_corrupted_runs_for_20_samples() -> None:
     # every fourth sample of a 1 kHz push. A gap is known from the time stamps, and one longer
     # than 20 ms (five samples) after t_1 is refused by name; a corrupted run is found only by
-    # its shape, and one left in place misleads (a run of tz x50 of six samples gave an ok
-    # answer 2.5 cm off), so twenty samples in a row are still put back, 80 ms here
+    # its shape, and one left in place misleads (docs/design-notes.md, "Samples lost inside
+    # the window"), so twenty samples in a row are still put back, 80 ms here
     fine = synthetic_recording(Synthetic(x_c=0.5, seed=4))
     coarse = Recording(
         t=fine.t[::4],

@@ -494,3 +494,14 @@ def test_sensor_axes_must_be_a_rotation(
         SensorAxes(axes)
     err = _run(_import(bag, "--wrench", WRENCH, "--joints", JOINTS, "--frame", axes), capsys)
     assert err.startswith(f"antenna import: error: --frame: {axes!r}: ")
+
+
+def test_the_command_s_help_names_the_estimators_gap(capsys: pytest.CaptureFixture[str]) -> None:
+    # the help writes the default out (parsing arguments imports no NumPy): it must be the
+    # library's
+    from sensing_antenna.estimation.config import MAX_GAP_DURATION
+
+    with pytest.raises(SystemExit):
+        main(["import", "rosbag", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"the estimators' own limit, {1000 * MAX_GAP_DURATION:g} ms" in text

@@ -85,9 +85,9 @@ def _add_rosbag(formats: Any) -> None:
         type=number(low=0.0),
         default=None,
         metavar="SAMPLES",
-        help="a topic silent for longer than this many samples of the recording's clock is a "
-        "gap, whose samples are left out (default: the estimators' own limit, 20 ms: 20 "
-        "samples at 1 kHz)",
+        help="a topic missing more than this many samples' worth of the recording's clock in a "
+        "row is a gap, whose samples are left out (default: the estimators' own limit, 20 "
+        "ms: 20 samples at 1 kHz)",
     )
     parser.add_argument(
         "--stamps",

@@ -17,8 +17,9 @@ __all__ = ["MAX_GAP_DURATION", "EstimatorConfig", "EstimatorConfigError", "no_t1
 #: Longest run of missing samples (s) filled in on a straight line inside [t_1, t_e] by default:
 #: 20 samples at 1 kHz, as many as the corrupted samples in a row the front end puts back
 #: (:data:`.front.spikes.SPIKE_DURATION`). A fiftieth of the spectrum window and a tenth of the
-#: fast method's first window; measured by ``benchmarks/eval_glitches.py --kinds drop``. Held
-#: in time, not samples: at 250 Hz twenty samples span 80 ms, three periods of the band's top.
+#: 0.2 s hold, the shortest record ``fast`` answers from; measured by
+#: ``benchmarks/eval_glitches.py --kinds drop``. Held in time, not samples: at 250 Hz twenty
+#: samples span 80 ms, three periods of the band's top.
 MAX_GAP_DURATION = 0.02
 
 

@@ -57,8 +57,8 @@ class OnlineEstimator:
     otherwise (also after the estimate). :meth:`finalize` closes a run that ended first (no
     contact, no push, too short) and returns the estimate ``estimate`` gives on the same
     samples. Samples the time stamps skip are put back by linear interpolation as they become
-    known (:meth:`~.front.frontend.FrontEnd.update_block`), and more than ``config.gap_limit``
-    in a row are remembered as gaps; the indices below count them.
+    known (:meth:`~.front.frontend.FrontEnd.update_block`), and more than
+    ``config.gap_limit(T_s)`` in a row are remembered as gaps; the indices below count them.
     """
 
     def __init__(

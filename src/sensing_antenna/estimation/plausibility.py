@@ -49,7 +49,7 @@ is no reading, NaN. An interval is cut to the link [0, l] (the contact lies on
 it), or dropped when it is not finite or lies off the link; a touched point farther from the base
 than the link can reach is dropped. Under ``bad_input`` and ``implausible_input`` no interval is
 reported (it is kept in ``diagnostics["interval_dropped"]``): it would hold the contact only if
-the samples were what the format says, and the status says they are not.
+the samples were whole and what the format says, and the status says they are not.
 """
 
 from __future__ import annotations

@@ -377,8 +377,8 @@ def read_rosbag(
         The recording's T_s (s); the wrench topic's own period when None
         (:func:`.clock.sample_clock`).
     max_gap : float, optional
-        A topic silent for longer than this many periods of the recording's clock is a gap,
-        whose samples are left out (>= 0); None: the estimators' own limit (20 ms).
+        A topic missing more than this many periods' worth of the recording's clock in a row is
+        a gap, whose samples are left out (>= 0); None: the estimators' own limit (20 ms).
     stamps : {"header", "bag"}
         Time of a message: its header stamp, or the time the bag recorded it.
     metadata : Mapping[str, str], optional

@@ -5,8 +5,9 @@ an :class:`~.outcome.EarlyOutcome` when no estimate is possible. Its steps (Sect
 causal, so an instant depends only on the samples up to it (and, where a sensor sample is
 suspected of corruption, on the few after it that decide it, which the stream waits for):
 
-0. Sensor samples off their neighbours (a run of up to twenty between calm ones: a glitch, or an
-   impact's pulse as brief) put back on the line between them (:mod:`.spikes`).
+0. Sensor samples off their neighbours (a run of up to 20 ms, at least twenty samples, between
+   calm ones: a glitch, or an impact's pulse as brief) put back on the line between them
+   (:mod:`.spikes`).
 1. t_c: the contact detector of Section 4.2
    (:class:`~sensing_antenna.detection.contact.ContactDetector`); the sensor offset and the rest
    tolerance from the samples up to t_c.
@@ -279,8 +280,8 @@ class FrontEnd:
             most: :func:`.steps.samples_missing`), the k - 1 samples missing are put back by
             linear interpolation (:func:`.steps.fill_missing`, as a whole recording is
             resampled) and counted in the diagnostics
-            (``filled_samples``); steps of more than ``config.gap_limit`` missing samples are also
-            gaps, and one beyond :data:`.steps.MAX_FILLED` makes the outcome ``bad_input``.
+            (``filled_samples``); steps of more than ``config.gap_limit(T_s)`` missing samples
+            are also gaps, and one beyond :data:`.steps.MAX_FILLED` makes the outcome ``bad_input``.
         theta : array_like, shape (n, 2)
             Motor angles (rad).
         force, torque : array_like, shape (n, 3)
@@ -475,7 +476,8 @@ class FrontEnd:
 
     def _gaps_known(self, end: int) -> list[tuple[float, float]]:
         """Gaps known at sample ``end``: those the caller filled in the blocks fed by then, and
-        steps of the time stamps up to ``end`` missing more than ``config.gap_limit`` samples."""
+        steps of the time stamps up to ``end`` missing more than ``config.gap_limit(T_s)``
+        samples."""
         filled = [gap for known, gap in self._filled if known <= end]
         limit = self.config.gap_limit(self.sample_period)
         stamps = time_gaps(self._t[: end + 1], self.sample_period, limit)
