@@ -148,9 +148,7 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     interval = _on_link(estimate.interval, link.length)
     point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
-        if interval is not None and estimate.status in _INPUT_STATUSES:
-            notes["interval_dropped"] = interval  # the method's own bad_input (a gap)
-            interval = None
+        interval = _claimed(interval, estimate.status, notes)  # the method's own bad_input
         if interval != estimate.interval:
             notes["interval"] = interval
         if not point_ok:
@@ -177,9 +175,7 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
             )
         changes.update(x_c=math.nan, contact_point=np.full(3, np.nan), interval=None)
     else:
-        if interval is not None and status in _INPUT_STATUSES:
-            diagnostics["interval_dropped"] = interval
-            interval = None
+        interval = _claimed(interval, status, diagnostics)
         if interval != estimate.interval:
             changes["interval"] = interval
         if not point_ok:
@@ -188,6 +184,17 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if kept != estimate.candidates:
         changes["candidates"] = kept
     return dataclasses.replace(estimate, **changes)
+
+
+def _claimed(
+    interval: tuple[float, float] | None, status: Status, diagnostics: dict[str, Any]
+) -> tuple[float, float] | None:
+    """``interval`` unless ``status`` says the samples are not what the format says; then None,
+    the interval kept in ``diagnostics["interval_dropped"]``."""
+    if interval is None or status not in _INPUT_STATUSES:
+        return interval
+    diagnostics["interval_dropped"] = interval
+    return None
 
 
 def _at_tip_when_just_past(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
