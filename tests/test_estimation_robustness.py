@@ -4,7 +4,7 @@
   (near the tip the link rebounds on the obstacle after the stop);
 - a frequency candidate inconsistent with the ratio beyond the ratio's uncertainty is
   ``estimators_disagree``, e.g. when T of the sensing curve is 7 % off (Section 5.1);
-- gaps of missing samples after t_1 are ``bad_input``;
+- gaps of missing samples after t_1, and corrupted runs too long to put back, are ``bad_input``;
 - the human-readable output of a doubtful estimate says it is a best guess.
 """
 
@@ -293,6 +293,37 @@ def test_a_run_of_corrupted_samples_is_put_back_and_named(
     channel = ("fx", "fy", "fz", "tx", "ty", "tz")[column]
     assert line.startswith("  put back        sensor samples off their neighbours at ")
     assert f"s ({channel}{f', {count} samples' if count > 1 else ''})" in line
+
+
+@pytest.mark.parametrize(("column", "value"), [(1, 0.5), (4, -0.3), (4, 0.0)])
+@pytest.mark.parametrize(
+    ("count", "after_t1"), [(SPIKE_LONGEST + 1, 0.05), (50, 0.05), (200, 0.05), (50, -0.5)]
+)
+def test_a_corrupted_run_too_long_to_put_back_is_bad_input_and_named(
+    column: int, value: float, count: int, after_t1: float
+) -> None:
+    # The same glitch, longer than the front end puts back (a straight line across it would
+    # make up part of a period of the vibration): the samples are not whole, every method says
+    # so and why, with its best guess but no interval, and a stream says the same.
+    glitched = _glitched(column, value, count, after_t1)
+    k = int(np.flatnonzero(np.hstack([glitched.force, glitched.torque])[:, column] == value)[0])
+    channel = ("fx", "fy", "fz", "tx", "ty", "tz")[column]
+    said = f"{channel}: {count} samples in a row from t = {glitched.t[k]:.4f} s"
+    for method in ("paper", "ratio", "two-frequency", "fast"):
+        result = estimate(glitched, calibrated(), method)
+        assert result.t_e > glitched.t[k + count], method  # the run lies before its t_e
+        assert result.status is Status.BAD_INPUT, (method, result.status, result.reason)
+        assert result.reason is not None and result.reason.startswith(said), result.reason
+        assert result.interval is None
+        assert "repaired_samples" not in result.diagnostics
+    offline = estimate(glitched, calibrated(), "paper")
+    for block in (1, 64):
+        streamed = _streamed(glitched, block)
+        assert (streamed.status, streamed.reason, streamed.x_c) == (
+            offline.status,
+            offline.reason,
+            offline.x_c,
+        )
 
 
 def test_runs_in_two_channels_that_overlap_are_each_put_back() -> None:

@@ -196,8 +196,9 @@ def omega1_of(gathered: Gathered, band: tuple[float, float]) -> FrequencyMeasure
         )
     # Estimator 1 on the evidence at t_e
     measurement = evidence_frequency(gathered, band)
-    if gathered.gap is not None:
-        return dataclasses.replace(measurement, reason=gathered.gap)
+    broken = gathered.sample_problem(float(gathered.t[gathered.end_index]))
+    if broken is not None:
+        return dataclasses.replace(measurement, reason=broken)
     if not gathered.complete:
         return dataclasses.replace(
             measurement, reason="fewer samples after t_1 than the spectrum window"

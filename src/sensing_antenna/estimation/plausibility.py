@@ -6,7 +6,9 @@ evidence it concluded from, offline and online alike, so ``paper``, ``ratio``,
 Every check reads only the samples up to the estimate's own t_e, so the batch and the streaming
 forms agree.
 
-1. The recording's units and signs (``implausible_input``): the loads at rest before t_c
+1. Whole samples (``bad_input``, :meth:`~.evidence.Evidence.sample_problem`): no gap longer
+   than the estimators fill in inside [t_1, t_e], no corrupted run too long to put back before
+   t_e. The recording's units and signs (``implausible_input``): the loads at rest before t_c
    against the link's weight and the free motion against the observer (found by the front end
    at t_c, ``Evidence.input_problem``), the angles up to t_e
    (:func:`~sensing_antenna.units_check.angle_problem`), and the push against the head's turn
@@ -103,6 +105,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
         estimate = dataclasses.replace(estimate, ratio_estimate=math.nan)
     notes: dict[str, Any] = {}
     found: list[tuple[Status, str]] = []
+    broken = evidence.sample_problem(estimate.t_e)
+    if broken is not None:
+        found.append((Status.BAD_INPUT, broken))
     if evidence.input_problem is not None:
         found.append((Status.IMPLAUSIBLE_INPUT, evidence.input_problem))
     angles = angle_problem(evidence.theta[: end + 1])

@@ -19,6 +19,13 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
+from sensing_antenna.estimation.front.spikes import (
+    LONG_RUN_DURATION,
+    describe_run,
+    find_long_runs,
+    spike_floor,
+    spike_longest,
+)
 from sensing_antenna.estimation.front.steps import gap_problem
 
 if TYPE_CHECKING:
@@ -230,10 +237,25 @@ class Evidence:
         limit = self.config.gap_limit(self.sample_period)
         return gap_problem(self.gaps, t_1, t_end, self.sample_period, limit)
 
-    @property
-    def gap(self) -> str | None:
-        """The first gap overlapping [t_1, t_e] (:meth:`gap_within` at the evidence's end)."""
-        return self.gap_within(float(self.t[self.end_index]))
+    def corrupted_within(self, t_end: float) -> str | None:
+        """The first run of wrench samples up to ``t_end`` (s) that leaves its neighbours and
+        comes back, too long to put back (:func:`.spikes.find_long_runs`), described (bad
+        input), or None."""
+        stop = int(np.searchsorted(self.t, t_end, side="right"))
+        ts = self.sample_period
+        longest = spike_longest(ts)
+        runs = find_long_runs(
+            np.hstack([self.force[:stop], self.torque[:stop]]),
+            spike_floor(self.antenna),
+            longest=longest,
+            most=max(longest, math.floor(LONG_RUN_DURATION / ts)),
+        )
+        return describe_run(runs[0], self.t, longest) if runs else None
+
+    def sample_problem(self, t_end: float) -> str | None:
+        """Why the samples up to ``t_end`` (s) are not whole (:meth:`gap_within`,
+        :meth:`corrupted_within`), or None: a method's answer from them is ``bad_input``."""
+        return self.gap_within(t_end) or self.corrupted_within(t_end)
 
     @property
     def spectrum_slice(self) -> slice:

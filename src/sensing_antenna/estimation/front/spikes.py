@@ -18,6 +18,11 @@ Every decision reads the raw samples j - SPIKE_WINDOW - 1 .. j + longest + 1 onl
 stream decides as a whole recording does, holding a suspect back until the samples after it
 that decide it have come.
 
+A longer run that leaves the trend and comes back the same way (:func:`find_long_runs`, up to
+``LONG_RUN_DURATION``) is not put back: a straight line across it would make up a large part of
+a period of the link's vibration. It is found over the samples up to an estimate's t_e, and the
+estimate is not ``ok`` (``Evidence.sample_problem``).
+
 The median absolute deviation of 31 steps is itself noisy, so white noise alone passes ten of
 them now and then; the floor, far above any sensor's noise, is what keeps its samples.
 """
@@ -33,12 +38,15 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna
 
 __all__ = [
+    "LONG_RUN_DURATION",
     "SPIKE_DURATION",
     "SPIKE_FACTOR",
     "SPIKE_LEAST",
     "SPIKE_WINDOW",
     "WRENCH_CHANNELS",
     "Spike",
+    "describe_run",
+    "find_long_runs",
     "find_spikes",
     "judged_from",
     "repair",
@@ -59,6 +67,9 @@ SPIKE_DURATION = 0.02
 #: Fewest samples of that longest run, below 1 kHz: there a corrupted run left in place does more
 #: harm than a brief rebound put back (docs/design-notes.md, "Samples lost inside the window").
 SPIKE_LEAST = 20
+#: Longest corrupted run looked for (s) beyond those put back: longer ones are not told from a
+#: step that stays (a contact, a push) by the same test.
+LONG_RUN_DURATION = 0.5
 #: Least spike, in the link's weight (forces) and its weight's moment, the link horizontal
 #: (torques): above the single-sample pulses the simulated link's impacts ring between calm
 #: neighbours at its default contact (docs/design-notes.md, "Corrupted samples").
@@ -92,6 +103,7 @@ def find_spikes(
     final: bool = False,
     *,
     longest: int,
+    to_level: bool = False,
 ) -> tuple[list[Spike], int]:
     """The spikes among ``raw[start:]`` and how many leading samples are decided.
 
@@ -109,6 +121,9 @@ def find_spikes(
     longest : int
         Most samples in a run (:func:`spike_longest`); a suspect waits for ``longest + 1``
         samples after it.
+    to_level : bool
+        Judge a run against the level before it rather than the trend line, and its landing
+        within a quarter of its least height only (:func:`find_long_runs`).
 
     Returns
     -------
@@ -164,13 +179,50 @@ def find_spikes(
         by_length: dict[int, list[int]] = {}
         for c in channels:
             x = raw[j - 2 : j + longest + 2, c]
-            length = _spike_length(x, float(trend[k, c]), float(limit[k, c]), longest)
+            length = _spike_length(
+                x, float(trend[k, c]), float(limit[k, c]), longest, to_level=to_level
+            )
             if length:
                 by_length.setdefault(length, []).append(int(c))
                 skip_to[c] = j + 1 + length
         for length in sorted(by_length):
             spikes.append(Spike(j, length, tuple(by_length[length])))
     return spikes, n
+
+
+def find_long_runs(
+    wrench: FloatArray, floor: FloatArray, *, longest: int, most: int
+) -> list[Spike]:
+    """The runs of ``longest + 1`` to ``most`` samples in ``wrench`` that leave their level and
+    come back to it, too long to put back.
+
+    A run starts as a spike does, a step off the local trend between calm samples, and its
+    samples lie off the level before it by more than the bound; it lands back on that level
+    within a quarter of its least height (over tens of samples the link's slow motion moves the
+    level by more than the noise) and goes on calmly.
+
+    Parameters
+    ----------
+    wrench : array, shape (n, 6)
+        Wrench samples (N, N m), spikes of up to ``longest`` samples already put back; all of
+        them are judged, as at the end of a recording.
+    floor : array, shape (6,)
+        Least departure from the trend per channel (N, N m, :func:`spike_floor`).
+    longest, most : int
+        Most samples a spike put back has (:func:`spike_longest`), and most samples of a run
+        looked for.
+    """
+    runs, _ = find_spikes(wrench, 0, floor, final=True, longest=most, to_level=True)
+    return [run for run in runs if run.length > longest]
+
+
+def describe_run(run: Spike, t: FloatArray, longest: int) -> str:
+    """One line on a corrupted run too long to put back, at sample times ``t`` (s)."""
+    channels = ", ".join(WRENCH_CHANNELS[c] for c in run.channels)
+    return (
+        f"{channels}: {run.length} samples in a row from t = {t[run.index]:.4f} s leave their "
+        f"neighbours and come back, a corrupted run longer than the {longest} put back"
+    )
 
 
 def _decided_before(spikes: list[Spike], j: int) -> tuple[list[Spike], int]:
@@ -206,9 +258,11 @@ def spike_floor(antenna: Antenna) -> FloatArray:
     return np.array([force * weight] * 3 + [torque * moment] * 3)
 
 
-def _spike_length(x: FloatArray, slope: float, limit: float, most: int) -> int:
+def _spike_length(
+    x: FloatArray, slope: float, limit: float, most: int, *, to_level: bool = False
+) -> int:
     """The number of samples from x[2] on (1 to ``most``) that leave the trend and come back,
-    else 0.
+    else 0 (``to_level``: the level x[1] and a landing within a quarter of the least height).
 
     ``x``: the samples j - 2 .. j + most + 1 of one channel (fewer at the end of a
     recording); ``slope`` the local trend per sample and ``limit`` the bound on a departure
@@ -223,7 +277,10 @@ def _spike_length(x: FloatArray, slope: float, limit: float, most: int) -> int:
             return 0
         longest = min(most, x.shape[0] - 4)  # fewer at a recording's end
         # departures from the trend line through x[1], of x[2] .. x[longest + 2]
-        off = x[2 : longest + 3] - x[1] - slope * np.arange(1.0, longest + 2.0)
+        off = x[2 : longest + 3] - x[1]
+        if not to_level:
+            off -= slope * np.arange(1.0, longest + 2.0)
+        land = math.inf if to_level else limit
         size = np.abs(off)
         height = math.inf  # the least departure of the spike's samples so far
         for m in range(1, longest + 1):
@@ -231,7 +288,7 @@ def _spike_length(x: FloatArray, slope: float, limit: float, most: int) -> int:
                 return 0  # a sample back within the bound before a landing: no spike
             height = min(height, float(size[m - 1]))
             after = x[m + 3] - x[m + 2] - slope
-            if abs(off[m]) <= min(limit, 0.25 * height) and abs(after) <= limit:
+            if abs(off[m]) <= min(land, 0.25 * height) and abs(after) <= limit:
                 return m
     return 0
 

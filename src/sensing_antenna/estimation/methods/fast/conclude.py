@@ -111,9 +111,6 @@ def conclude_fast(
     found = problems(result, config)
     if "second_mode_objection" in diag:
         found.append((Status.ESTIMATORS_DISAGREE, diag["second_mode_objection"]))
-    gap = evidence.gap_within(float(t[final.end_index]))  # its own samples, as online
-    if gap is not None:
-        found.append((Status.BAD_INPUT, gap))
     order = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)

@@ -193,8 +193,6 @@ def conclude(
     cfg = evidence.config
     e = evidence.end_index
     found: list[tuple[Status, str]] = list(problems)
-    if evidence.gap is not None:
-        found.append((Status.BAD_INPUT, evidence.gap))
     length = evidence.antenna.link.length
     ratio_end = float(evidence.ratio_mean[e])
     off_link = math.isfinite(ratio_end) and not 0.0 <= ratio_end <= _OFF_LINK * length
