@@ -131,6 +131,24 @@ def test_gap_after_t1_is_bad_input_online_and_offline() -> None:
             assert "at most 20 in a row are filled in" in (short.reason or "")
 
 
+@pytest.mark.parametrize("where", ["t_c", "t_1"])
+def test_a_gap_from_the_contact_on_is_bad_input_however_long(where: str) -> None:
+    # From t_c the estimators read the push and the head's stop, which fixes t_1: a straight line
+    # across a long gap there looks like the head at rest where it was still moving, and moves
+    # t_1. Any gap longer than the limit from t_c on is bad_input, the longer ones too.
+    recording = synthetic_recording(Synthetic(x_c=0.45, seed=2))
+    whole = estimate(recording, calibrated())
+    centre = int(np.searchsorted(recording.t, whole.t_c if where == "t_c" else whole.t_1))
+    for count in (10, 21, 40, 60, 100):
+        for method in ("paper", "fast"):
+            result = estimate(_drop(recording, centre - count // 2, count), calibrated(), method)
+            if count <= 20:
+                assert result.status is Status.OK, (count, method, result.reason)
+            else:
+                assert result.status is Status.BAD_INPUT, (count, method, result.status)
+                assert f"{count} samples missing" in (result.reason or "")
+
+
 def test_a_gap_after_fast_answered_is_judged_only_by_the_methods_it_reaches() -> None:
     # fast answers about 0.35 s after t_1 (online, from the samples it has): a gap of 30
     # samples 0.8 s after t_1 comes after its answer, batch and stream alike, and lies inside

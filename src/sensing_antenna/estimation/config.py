@@ -14,7 +14,7 @@ from sensing_antenna.errors import SensingAntennaError
 
 __all__ = ["MAX_GAP_DURATION", "EstimatorConfig", "EstimatorConfigError", "no_t1_reason"]
 
-#: Longest run of missing samples (s) filled in on a straight line inside [t_1, t_e] by default:
+#: Longest run of missing samples (s) filled in on a straight line inside [t_c, t_e] by default:
 #: 20 samples at 1 kHz, as many as the corrupted samples in a row the front end puts back
 #: (:data:`.front.spikes.SPIKE_DURATION`). A fiftieth of the spectrum window and a tenth of the
 #: 0.2 s hold, the shortest record ``fast`` answers from; measured by
@@ -80,7 +80,7 @@ class EstimatorConfig:
         A short mean of the reaction along the push below this many of its standard errors is a
         contact loss (reported in the diagnostics); 3 standard errors.
     max_gap : int or None
-        Largest number of consecutive missing samples inside [t_1, t_e] that linear
+        Largest number of consecutive missing samples inside [t_c, t_e] that linear
         interpolation may fill; longer gaps give ``bad_input``. None (the default): as many as
         span :data:`MAX_GAP_DURATION` at the recording's sample period (:meth:`gap_limit`).
     spectrum_window : float

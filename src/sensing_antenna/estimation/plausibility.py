@@ -7,7 +7,7 @@ Every check reads only the samples up to the estimate's own t_e, so the batch an
 forms agree.
 
 1. Whole samples (``bad_input``, :meth:`~.evidence.Evidence.sample_problem`): no gap longer
-   than the estimators fill in inside [t_1, t_e], no corrupted run too long to put back before
+   than the estimators fill in inside [t_c, t_e], no corrupted run too long to put back before
    t_e. The recording's units and signs (``implausible_input``): the loads at rest before t_c
    against the link's weight and the free motion against the observer (found by the front end
    at t_c, ``Evidence.input_problem``), the angles up to t_e

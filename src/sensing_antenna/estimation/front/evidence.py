@@ -231,11 +231,11 @@ class Evidence:
     trace: FrontTrace | None = field(default=None, compare=False, repr=False)
 
     def gap_within(self, t_end: float) -> str | None:
-        """The first of :attr:`gaps` overlapping [t_1, t_end] (s), described (bad input), or
+        """The first of :attr:`gaps` overlapping [t_c, t_end] (s), described (bad input), or
         None: a method that answers before the planned t_e is judged over its own samples."""
-        t_1 = float(self.t[self.rest_index])
+        t_c = float(self.t[self.contact_index])
         limit = self.config.gap_limit(self.sample_period)
-        return gap_problem(self.gaps, t_1, t_end, self.sample_period, limit)
+        return gap_problem(self.gaps, t_c, t_end, self.sample_period, limit)
 
     def corrupted_within(self, t_end: float) -> str | None:
         """The first run of wrench samples up to ``t_end`` (s) that leaves its neighbours and

@@ -282,22 +282,23 @@ def time_gaps(t: FloatArray, sample_period: float, max_gap: int) -> tuple[tuple[
 
 
 def gap_problem(
-    gaps: Sequence[tuple[float, float]], t_1: float, t_e: float, sample_period: float, max_gap: int
+    gaps: Sequence[tuple[float, float]], t_c: float, t_e: float, sample_period: float, max_gap: int
 ) -> str | None:
-    """The first of ``gaps`` (each longer than ``max_gap`` samples) overlapping [t_1, t_e],
+    """The first of ``gaps`` (each longer than ``max_gap`` samples) overlapping [t_c, t_e],
     described, or None.
 
-    After t_1 the estimators read the vibration (tens to hundreds of rad/s) and the hold's static
-    loads; a straight line across a long gap replaces a large part of a period or more, and both
-    the spectrum and the fitted modes see a signal that was never there.
+    From t_c the estimators read the push (its direction, the head's stop that fixes t_1, the
+    hold's static loads) and after t_1 the vibration (tens to hundreds of rad/s); a straight
+    line across a long gap replaces a large part of a period or more, or looks like the head at
+    rest where it was still moving, and the steps after it read a signal that was never there.
     """
     for start, end in gaps:
-        if end > t_1 and start < t_e:
+        if end > t_c and start < t_e:
             missing = round((end - start) / sample_period) - 1
             return (
                 f"t: {missing} samples missing between {start:.4f} s and {end:.4f} s, inside "
-                f"the estimation window [{t_1:.3f}, {t_e:.3f}] s (at most {max_gap} in a row "
-                "are filled in)"
+                f"the estimation window [{t_c:.3f}, {t_e:.3f}] s from the contact (at most "
+                f"{max_gap} in a row are filled in)"
             )
     return None
 
