@@ -94,11 +94,19 @@ def corrupt(
 def _estimates(
     recording: Recording, model: Any, config: EstimatorConfig
 ) -> dict[str, tuple[str, float, str, int]]:
-    """Per method: (status, x_c, reason, samples put back or filled in)."""
-    evidence = gather(recording, model, config)
+    """Per method: (status, x_c, reason, samples put back or filled in); an exception is the
+    status ``error`` with its text, so one does not lose the rest of the measurement."""
+    try:
+        evidence = gather(recording, model, config)
+    except Exception as exc:  # a bug to report, in every method's row
+        return {method: ("error", math.nan, repr(exc), 0) for method in METHODS}
     out = {}
     for method in METHODS:
-        result = conclude(evidence, method)
+        try:
+            result = conclude(evidence, method)
+        except Exception as exc:
+            out[method] = ("error", math.nan, repr(exc), 0)
+            continue
         repaired = len(result.diagnostics.get("repaired_samples", []) or [])
         dropped = int((result.diagnostics.get("sampling") or {}).get("n_dropped", 0))
         out[method] = (

@@ -22,6 +22,7 @@ from sensing_antenna.cli.estimate import summary
 from sensing_antenna.estimation import ContactEstimate, OnlineEstimator, Status, estimate
 from sensing_antenna.estimation.front.spikes import spike_longest
 from sensing_antenna.recording import Recording
+from sensing_antenna.simulator import Scenario, simulate
 from test_estimation_pipeline import Synthetic, comparable, synthetic_recording
 
 #: The longest run put back at the synthetic recordings' 1 kHz.
@@ -396,6 +397,20 @@ def test_a_glitch_whose_square_overflows_gives_an_answer_not_a_traceback(
     for method in ("paper", "ratio", "two-frequency", "fast"):
         result = estimate(glitched, calibrated(), method)
         assert result.status is not Status.OK or abs(result.x_c - 0.5) < 0.005, method
+
+
+def test_a_pencil_pole_that_grows_beyond_floats_gives_an_answer_not_a_traceback() -> None:
+    # Every channel at 10^4 times its largest value for 21 samples, in the vibration window of
+    # a simulated vertical contact: the fast method's pencil returns a pole whose envelope
+    # overflows over the window, and the least squares on it failed (SVD did not converge).
+    antenna = load_antenna("paper-2021")
+    clean = simulate(antenna, Scenario(case="vertical", contact_point=0.40, seed=407))
+    loads = np.hstack([clean.force, clean.torque])
+    loads[1630:1651] = 1e4 * np.max(np.abs(loads), axis=0)
+    glitched = Recording(t=clean.t, theta=clean.theta, force=loads[:, :3], torque=loads[:, 3:])
+    result = estimate(glitched, antenna.self_calibrated(), "fast")
+    assert result.status is Status.BAD_INPUT, result.reason
+    assert "21 samples in a row from t = 1.6300 s" in (result.reason or "")
 
 
 def test_a_ratio_that_overflows_is_no_reading() -> None:

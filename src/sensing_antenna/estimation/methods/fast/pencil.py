@@ -125,7 +125,8 @@ class PoleStrengths(NamedTuple):
         Continuous-time poles (-s + i w, 1/s and rad/s) with w > 0.
     power : array, shape (P,)
         Each pole's power in the weighted channels (sum over channels of the squared
-        coefficients of its exponential); -1 for a pole below the lowest frequency allowed.
+        coefficients of its exponential); -1 for a pole below the lowest frequency allowed or
+        whose envelope grows beyond ``exp(_LARGEST_GROWTH)`` over the window.
     band_peak : float
         The largest periodogram peak inside the target band (rad/s) when no pole above the
         lowest frequency lies in that band; NaN otherwise (or without a band).
@@ -135,6 +136,10 @@ class PoleStrengths(NamedTuple):
     power: FloatArray
     band_peak: float
 
+
+#: Largest growth of a pole's envelope over the window (its natural log) that the least squares
+#: of :func:`pole_strengths` holds: 1e100, far inside a float's range once squared.
+_LARGEST_GROWTH = math.log(1e100)
 
 #: Pole strengths already computed for one set of channels, keyed by the channel weights and
 #: the poles (their bytes) and the lowest frequency (rad/s): a model selection
@@ -151,7 +156,7 @@ def pole_strengths(
 ) -> PoleStrengths:
     """The oscillatory poles of ``z`` and the power of each in ``y`` (n, K), the weighted
     channels: least squares on the complex exponentials of all of them, with an offset and a
-    drift. Poles below ``lowest`` (rad/s) get power -1. They depend neither on the model order
+    drift. Poles below ``lowest`` (rad/s), or growing beyond a float's range, get power -1. They depend neither on the model order
     nor on the polynomial degree, so one model selection computes them once per pencil and
     weighting (:data:`StrengthMemo`).
     """
@@ -160,13 +165,17 @@ def pole_strengths(
         every = np.log(z) / sample_period
     keep = np.isfinite(every) & (every.imag > 0.0)
     s_plane: ComplexArray = np.asarray(every[keep], dtype=np.complex128)
-    # Amplitude of each pole: least squares on the complex exponentials of all kept poles
+    # Amplitude of each pole: least squares on the complex exponentials of the kept poles whose
+    # envelope over the window a float can hold (a pencil on samples far off the link's, a
+    # glitch, may return one that grows by more; no vibration of a passive link does)
+    bounded = s_plane.real * sample_period * (n - 1) <= _LARGEST_GROWTH
     idx = np.arange(n)
-    vander = np.exp(np.multiply.outer(idx * sample_period, s_plane))
+    vander = np.exp(np.multiply.outer(idx * sample_period, s_plane[bounded]))
     basis = np.hstack([np.ones((n, 1)), idx[:, None] * 1.0, vander.real, vander.imag])
     coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
-    m = s_plane.size
-    power = np.sum(coef[2 : 2 + m] ** 2 + coef[2 + m :] ** 2, axis=1)
+    m = vander.shape[1]
+    power = np.full(s_plane.size, -1.0)
+    power[bounded] = np.sum(coef[2 : 2 + m] ** 2 + coef[2 + m :] ** 2, axis=1)
     power = np.asarray(np.where(s_plane.imag >= lowest, power, -1.0), dtype=float)
     band_peak = math.nan
     if target_band is not None:
