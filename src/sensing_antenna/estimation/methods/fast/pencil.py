@@ -156,9 +156,9 @@ def pole_strengths(
 ) -> PoleStrengths:
     """The oscillatory poles of ``z`` and the power of each in ``y`` (n, K), the weighted
     channels: least squares on the complex exponentials of all of them, with an offset and a
-    drift. Poles below ``lowest`` (rad/s), or growing beyond a float's range, get power -1. They depend neither on the model order
-    nor on the polynomial degree, so one model selection computes them once per pencil and
-    weighting (:data:`StrengthMemo`).
+    drift. Poles below ``lowest`` (rad/s), or growing beyond a float's range over the window,
+    get power -1. They depend neither on the model order nor on the polynomial degree, so one
+    model selection computes them once per pencil and weighting (:data:`StrengthMemo`).
     """
     n = y.shape[0]
     with np.errstate(divide="ignore", invalid="ignore"):
