@@ -4,7 +4,8 @@
   (near the tip the link rebounds on the obstacle after the stop);
 - a frequency candidate inconsistent with the ratio beyond the ratio's uncertainty is
   ``estimators_disagree``, e.g. when T of the sensing curve is 7 % off (Section 5.1);
-- gaps of missing samples after t_1, and corrupted runs too long to put back, are ``bad_input``;
+- gaps of missing samples from t_c on, and corrupted runs too long to put back, are
+  ``bad_input``;
 - the human-readable output of a doubtful estimate says it is a best guess.
 """
 
@@ -19,6 +20,7 @@ import pytest
 from _models import calibrated
 from sensing_antenna.antenna import load_antenna, paper_antenna
 from sensing_antenna.cli.estimate import summary
+from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.estimation import ContactEstimate, OnlineEstimator, Status, estimate
 from sensing_antenna.estimation.front.spikes import spike_longest
 from sensing_antenna.recording import Recording
@@ -345,6 +347,47 @@ def test_a_corrupted_run_too_long_to_put_back_is_bad_input_and_named(
         )
 
 
+@pytest.mark.parametrize("value", [math.inf, 1e308])
+def test_a_long_run_of_samples_beyond_floats_in_a_stream_is_named_without_warnings(
+    value: float,
+) -> None:
+    # A stream takes samples a recording refuses (inf); thirty in a row of the push's force,
+    # sample by sample (the suite turns NumPy's warnings into errors): the run is named.
+    glitched = _glitched(1, 0.5, 30)
+    loads = np.hstack([glitched.force, glitched.torque])
+    k = int(np.flatnonzero(loads[:, 1] == 0.5)[0])
+    loads[k : k + 30, 1] = value
+    result = _streamed(glitched, 1, loads)
+    assert result.status is Status.BAD_INPUT
+    assert (result.reason or "").startswith(
+        f"fy: 30 samples in a row from t = {glitched.t[k]:.4f} s"
+    )
+
+
+def test_a_contact_lost_and_found_again_is_not_taken_for_a_corrupted_run() -> None:
+    # A fast sweep into a stiff bar: the link bounces during the push and fx leaves its level
+    # for 30 samples and comes back, as a corrupted run would; the push along the hold's falls
+    # to about zero meanwhile, so it is a rebound, and no reason blames the sensor.
+    antenna = load_antenna("paper-2021")
+    scenario = Scenario(
+        case="vertical",
+        contact_point=0.7325831481310732,
+        contact_stiffness=1e5,
+        seed=820075,
+        push=PushCriterion(threshold=0.1),
+        link_model="nonlinear",
+        sweep_speed=1.5,
+        accel_time=0.05,
+    )
+    recording = simulate(antenna, scenario)
+    k = int(np.searchsorted(recording.t, 0.513))
+    assert recording.force[k - 1, 0] < -0.1 < 0.0 < recording.force[k, 0]  # the loss
+    for method in ("paper", "fast"):
+        result = estimate(recording, antenna.self_calibrated(), method)
+        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
+        assert not any("like a corrupted run" in reason for reason in reasons), reasons
+
+
 def test_runs_in_two_channels_that_overlap_are_each_put_back() -> None:
     # The bus corrupts the push's force for three samples and, from the second of them, its
     # moment for two: each channel's run is put back, and the estimate is the clean one's.
@@ -402,7 +445,7 @@ def test_a_glitch_whose_square_overflows_gives_an_answer_not_a_traceback(
 def test_a_pencil_pole_that_grows_beyond_floats_gives_an_answer_not_a_traceback() -> None:
     # Every channel at 10^4 times its largest value for 21 samples, in the vibration window of
     # a simulated vertical contact: the fast method's pencil returns a pole whose envelope
-    # overflows over the window, and the least squares on it failed (SVD did not converge).
+    # overflows over the window; it is left out, and the run is named.
     antenna = load_antenna("paper-2021")
     clean = simulate(antenna, Scenario(case="vertical", contact_point=0.40, seed=407))
     loads = np.hstack([clean.force, clean.torque])

@@ -172,8 +172,8 @@ def measure_omega1(
     -------
     FrequencyMeasurement
         omega_1 (rad/s), peak quality, analysed window; ``reason`` set (and omega_1 NaN without
-        evidence) when the recording has no contact, no push, a gap in the window or too few
-        samples after t_1.
+        evidence) when the recording has no contact, no push, a gap in the window, a corrupted
+        run too long to put back, or too few samples after t_1.
     """
     cfg = config if config is not None else EstimatorConfig()
     search = band if band is not None else search_band(antenna.link, cfg)

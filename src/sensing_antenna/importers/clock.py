@@ -555,7 +555,7 @@ def put_on_clock(
     max_gap : float, optional
         A stream missing for longer than this many periods T_s of the clock is a gap (>= 0).
         None: the estimators' own limit at T_s (``EstimatorConfig().gap_limit``, 20 ms),
-        beyond which a gap after the push gives ``bad_input``; so a shorter hole is bridged and
+        beyond which a gap from the contact on gives ``bad_input``; so a shorter hole is bridged and
         a longer one shown, for every topic alike.
 
     Returns

@@ -19,10 +19,12 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
+from sensing_antenna.estimation.front.ratio import contact_loads
 from sensing_antenna.estimation.front.spikes import (
-    LONG_RUN_DURATION,
+    LEVEL_SAMPLES,
     describe_run,
     find_long_runs,
+    long_run_longest,
     spike_floor,
     spike_longest,
 )
@@ -239,18 +241,43 @@ class Evidence:
 
     def corrupted_within(self, t_end: float) -> str | None:
         """The first run of wrench samples up to ``t_end`` (s) that leaves its neighbours and
-        comes back, too long to put back (:func:`.spikes.find_long_runs`), described (bad
-        input), or None."""
+        comes back, too long to put back (:func:`.spikes.find_long_runs`) and not the contact
+        lost and found again (:meth:`_contact_lost`), described (bad input), or None."""
         stop = int(np.searchsorted(self.t, t_end, side="right"))
-        ts = self.sample_period
-        longest = spike_longest(ts)
+        longest = spike_longest(self.sample_period)
+        wrench = np.hstack([self.force[:stop], self.torque[:stop]])
         runs = find_long_runs(
-            np.hstack([self.force[:stop], self.torque[:stop]]),
+            wrench,
             spike_floor(self.antenna),
             longest=longest,
-            most=max(longest, math.floor(LONG_RUN_DURATION / ts)),
+            most=long_run_longest(self.sample_period),
         )
-        return describe_run(runs[0], self.t, longest) if runs else None
+        for run in runs:
+            samples = wrench[run.index : run.index + run.length, list(run.channels)]
+            one_value = bool(np.all(samples == samples[0]))  # stuck, zeroed: no sensor's noise
+            if one_value or not self._contact_lost(run.index, run.length):
+                return describe_run(run, self.t, longest)
+        return None
+
+    def _contact_lost(self, start: int, length: int) -> bool:
+        """Whether the push of the contact (its reaction along the hold's, N) over samples
+        ``start`` .. ``start + length - 1`` falls to within half the push just before them,
+        from at least a quarter of the hold's: a contact lost and found again (a rebound) leaves
+        the loads' level and comes back as a corrupted run does."""
+        held = self.frame.push_force
+        if not held > 0.0 or start < 1:
+            return False
+        direction = self.frame.reaction_m / held
+        before = max(start - LEVEL_SAMPLES, 0)
+        rows = slice(before, start + length)
+        with np.errstate(over="ignore", invalid="ignore"):
+            reaction, _ = contact_loads(
+                self.theta[rows], self.force[rows], self.torque[rows], self.antenna
+            )
+            push = (reaction - self.load_offset[:3]) @ direction
+            push_before = float(np.mean(push[: start - before]))
+            push_during = float(np.mean(push[start - before :]))
+        return push_before >= 0.25 * held and abs(push_during) <= 0.5 * push_before
 
     def sample_problem(self, t_end: float) -> str | None:
         """Why the samples up to ``t_end`` (s) are not whole (:meth:`gap_within`,

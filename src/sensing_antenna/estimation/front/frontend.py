@@ -373,8 +373,10 @@ class FrontEnd:
             # it together stay below the floor (find_spikes' own gate, with a bound of that step)
             # a step that is no number (a NaN sample, inf - inf) bounds nothing: NaN, carried
             # by np.maximum into the bound, fails "below the gate" as inf would
-            step = np.abs(wrench[0] - history[-1])
-            if (step + self._step_bound < self._spike_gate).all():
+            with np.errstate(over="ignore", invalid="ignore"):
+                step = np.abs(wrench[0] - history[-1])
+                calm = (step + self._step_bound < self._spike_gate).all()
+            if calm:
                 self._history = np.concatenate([history[1:], wrench])
                 self._note_steps(step, 1)
                 return t, theta, force, torque

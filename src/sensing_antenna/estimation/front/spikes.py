@@ -18,10 +18,11 @@ Every decision reads the raw samples j - SPIKE_WINDOW - 1 .. j + longest + 1 onl
 stream decides as a whole recording does, holding a suspect back until the samples after it
 that decide it have come.
 
-A longer run that leaves the trend and comes back the same way (:func:`find_long_runs`, up to
-``LONG_RUN_DURATION``) is not put back: a straight line across it would make up a large part of
-a period of the link's vibration. It is found over the samples up to an estimate's t_e, and the
-estimate is not ``ok`` (``Evidence.sample_problem``).
+A longer run (:func:`find_long_runs`, up to ``LONG_RUN_DURATION``) is not put back: a straight
+line across it would make up a large part of a period of the link's vibration. It starts as a
+spike does, lies off the level of the quiet samples before it and comes back to that level to
+stay; found over the samples up to an estimate's t_e, it makes the estimate ``bad_input``
+(``Evidence.sample_problem``).
 
 The median absolute deviation of 31 steps is itself noisy, so white noise alone passes ten of
 them now and then; the floor, far above any sensor's noise, is what keeps its samples.
@@ -38,6 +39,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna
 
 __all__ = [
+    "LEVEL_SAMPLES",
     "LONG_RUN_DURATION",
     "SPIKE_DURATION",
     "SPIKE_FACTOR",
@@ -49,6 +51,7 @@ __all__ = [
     "find_long_runs",
     "find_spikes",
     "judged_from",
+    "long_run_longest",
     "repair",
     "spike_floor",
     "spike_longest",
@@ -70,10 +73,15 @@ SPIKE_LEAST = 20
 #: Longest corrupted run looked for (s) beyond those put back: longer ones are not told from a
 #: step that stays (a contact, a push) by the same test.
 LONG_RUN_DURATION = 0.5
+#: Samples on either side of a long run that give the level it leaves and comes back to: quiet
+#: about their median within a quarter of the run's least height.
+LEVEL_SAMPLES = 5
 #: Least spike, in the link's weight (forces) and its weight's moment, the link horizontal
 #: (torques): above the single-sample pulses the simulated link's impacts ring between calm
 #: neighbours at its default contact (docs/design-notes.md, "Corrupted samples").
 SPIKE_FLOOR_WEIGHTS = (2.0, 0.5)
+#: Largest float: the height of a run of infinite samples.
+_LARGEST = float(np.finfo(np.float64).max)
 #: MAD to standard deviation for Gaussian noise.
 _MAD_TO_SIGMA = 1.4826
 
@@ -83,7 +91,7 @@ WRENCH_CHANNELS = ("fx", "fy", "fz", "tx", "ty", "tz")
 @dataclass(frozen=True)
 class Spike:
     """Corrupted samples found: ``index`` (of the first, in the array searched), ``length``
-    (1 to :func:`spike_longest`) and the channels (0..5, fx..tz) whose values were put back."""
+    (1 to the longest looked for) and the channels (0..5, fx..tz)."""
 
     index: int
     length: int
@@ -94,6 +102,12 @@ def spike_longest(sample_period: float) -> int:
     """Most corrupted samples in a row put back at ``sample_period`` (s): as many as span
     :data:`SPIKE_DURATION`, and at least :data:`SPIKE_LEAST`."""
     return max(SPIKE_LEAST, math.floor(SPIKE_DURATION / sample_period + 1e-9))
+
+
+def long_run_longest(sample_period: float) -> int:
+    """Most corrupted samples in a row looked for at ``sample_period`` (s): as many as span
+    :data:`LONG_RUN_DURATION`, and at least :func:`spike_longest`."""
+    return max(spike_longest(sample_period), math.floor(LONG_RUN_DURATION / sample_period + 1e-9))
 
 
 def find_spikes(
@@ -119,11 +133,11 @@ def find_spikes(
     final : bool
         No samples will follow: a suspect too near the end to decide is left as it is.
     longest : int
-        Most samples in a run (:func:`spike_longest`); a suspect waits for ``longest + 1``
-        samples after it.
+        Most samples in a run (:func:`spike_longest` for the spikes put back); a suspect waits
+        for ``longest + 1`` samples after it.
     to_level : bool
-        Judge a run against the level before it rather than the trend line, and its landing
-        within a quarter of its least height only (:func:`find_long_runs`).
+        Judge a run against the level of the quiet samples before it (:func:`find_long_runs`)
+        rather than the trend line.
 
     Returns
     -------
@@ -178,10 +192,12 @@ def find_spikes(
                 break  # too near the end for a single sample's landing and the step after it
         by_length: dict[int, list[int]] = {}
         for c in channels:
-            x = raw[j - 2 : j + longest + 2, c]
-            length = _spike_length(
-                x, float(trend[k, c]), float(limit[k, c]), longest, to_level=to_level
-            )
+            if to_level:
+                x = raw[j - LEVEL_SAMPLES : j + longest + LEVEL_SAMPLES, c]
+                length = _run_to_level(x, float(limit[k, c]), longest)
+            else:
+                x = raw[j - 2 : j + longest + 2, c]
+                length = _spike_length(x, float(trend[k, c]), float(limit[k, c]), longest)
             if length:
                 by_length.setdefault(length, []).append(int(c))
                 skip_to[c] = j + 1 + length
@@ -196,10 +212,12 @@ def find_long_runs(
     """The runs of ``longest + 1`` to ``most`` samples in ``wrench`` that leave their level and
     come back to it, too long to put back.
 
-    A run starts as a spike does, a step off the local trend between calm samples, and its
-    samples lie off the level before it by more than the bound; it lands back on that level
-    within a quarter of its least height (over tens of samples the link's slow motion moves the
-    level by more than the noise) and goes on calmly.
+    A run starts as a spike does, with a step off the local trend. The ``LEVEL_SAMPLES`` before
+    it give the level (their median) and lie within a quarter of the run's least height of it;
+    each of its samples lies off that level by more than the spike's bound; and the
+    ``LEVEL_SAMPLES`` from its landing on lie within a quarter of its least height of the level
+    (a level, not the trend line: over tens of samples the link's slow motion moves it by more
+    than the noise). An impact's ringing is not quiet on both sides.
 
     Parameters
     ----------
@@ -210,7 +228,7 @@ def find_long_runs(
         Least departure from the trend per channel (N, N m, :func:`spike_floor`).
     longest, most : int
         Most samples a spike put back has (:func:`spike_longest`), and most samples of a run
-        looked for.
+        looked for (:func:`long_run_longest`).
     """
     runs, _ = find_spikes(wrench, 0, floor, final=True, longest=most, to_level=True)
     return [run for run in runs if run.length > longest]
@@ -220,8 +238,9 @@ def describe_run(run: Spike, t: FloatArray, longest: int) -> str:
     """One line on a corrupted run too long to put back, at sample times ``t`` (s)."""
     channels = ", ".join(WRENCH_CHANNELS[c] for c in run.channels)
     return (
-        f"{channels}: {run.length} samples in a row from t = {t[run.index]:.4f} s leave their "
-        f"neighbours and come back, a corrupted run longer than the {longest} put back"
+        f"{channels}: {run.length} samples in a row from t = {t[run.index]:.4f} s leave the "
+        f"level of their neighbours and come back to it, like a corrupted run, longer than the "
+        f"{longest} in a row put back on a line"
     )
 
 
@@ -258,11 +277,33 @@ def spike_floor(antenna: Antenna) -> FloatArray:
     return np.array([force * weight] * 3 + [torque * moment] * 3)
 
 
-def _spike_length(
-    x: FloatArray, slope: float, limit: float, most: int, *, to_level: bool = False
-) -> int:
+def _run_to_level(x: FloatArray, limit: float, most: int) -> int:
+    """The number of samples from x[LEVEL_SAMPLES] on (1 to ``most``) that leave the level of
+    the quiet samples before them and come back to it to stay (:func:`find_long_runs`), else 0.
+
+    ``x``: the samples j - LEVEL_SAMPLES .. j + most + LEVEL_SAMPLES - 1 of one channel (fewer
+    at the end of a recording); ``limit`` the bound on a departure.
+    """
+    k = LEVEL_SAMPLES
+    with np.errstate(over="ignore", invalid="ignore"):
+        level = float(np.median(x[:k]))
+        quiet = float(np.max(np.abs(x[:k] - level)))
+        off = np.abs(x[k:] - level)
+        longest = min(most, off.shape[0] - k)
+        height = math.inf  # the least departure of the run's samples so far
+        for m in range(1, longest + 1):
+            if not off[m - 1] > limit:
+                return 0  # a sample back within the bound before a landing: no run
+            height = min(height, float(off[m - 1]))
+            bound = 0.25 * min(height, _LARGEST)  # a run of inf lands on finite samples only
+            if quiet <= bound and bool(np.all(off[m : m + k] <= bound)):
+                return m
+    return 0
+
+
+def _spike_length(x: FloatArray, slope: float, limit: float, most: int) -> int:
     """The number of samples from x[2] on (1 to ``most``) that leave the trend and come back,
-    else 0 (``to_level``: the level x[1] and a landing within a quarter of the least height).
+    else 0.
 
     ``x``: the samples j - 2 .. j + most + 1 of one channel (fewer at the end of a
     recording); ``slope`` the local trend per sample and ``limit`` the bound on a departure
@@ -277,10 +318,7 @@ def _spike_length(
             return 0
         longest = min(most, x.shape[0] - 4)  # fewer at a recording's end
         # departures from the trend line through x[1], of x[2] .. x[longest + 2]
-        off = x[2 : longest + 3] - x[1]
-        if not to_level:
-            off -= slope * np.arange(1.0, longest + 2.0)
-        land = math.inf if to_level else limit
+        off = x[2 : longest + 3] - x[1] - slope * np.arange(1.0, longest + 2.0)
         size = np.abs(off)
         height = math.inf  # the least departure of the spike's samples so far
         for m in range(1, longest + 1):
@@ -288,7 +326,7 @@ def _spike_length(
                 return 0  # a sample back within the bound before a landing: no spike
             height = min(height, float(size[m - 1]))
             after = x[m + 3] - x[m + 2] - slope
-            if abs(off[m]) <= min(land, 0.25 * height) and abs(after) <= limit:
+            if abs(off[m]) <= min(limit, 0.25 * height) and abs(after) <= limit:
                 return m
     return 0
 
