@@ -126,7 +126,7 @@ class PoleStrengths(NamedTuple):
     power : array, shape (P,)
         Each pole's power in the weighted channels (sum over channels of the squared
         coefficients of its exponential); -1 for a pole below the lowest frequency allowed or
-        whose envelope grows beyond ``exp(_LARGEST_GROWTH)`` over the window.
+        whose envelope grows by more than 1e100 over the window.
     band_peak : float
         The largest periodogram peak inside the target band (rad/s) when no pole above the
         lowest frequency lies in that band; NaN otherwise (or without a band).
@@ -156,8 +156,8 @@ def pole_strengths(
 ) -> PoleStrengths:
     """The oscillatory poles of ``z`` and the power of each in ``y`` (n, K), the weighted
     channels: least squares on the complex exponentials of all of them, with an offset and a
-    drift. Poles below ``lowest`` (rad/s), or growing beyond a float's range over the window,
-    get power -1. They depend neither on the model order nor on the polynomial degree, so one
+    drift. Poles below ``lowest`` (rad/s), or growing by more than 1e100 over the window, get
+    power -1. They depend neither on the model order nor on the polynomial degree, so one
     model selection computes them once per pencil and weighting (:data:`StrengthMemo`).
     """
     n = y.shape[0]
