@@ -1,22 +1,24 @@
 """What corrupted force/torque samples (a sensor bus's glitches) do to the estimates.
 
 A measurement: simulated contacts of the paper antenna (the estimators given the device's own T),
-each recorded once clean and then many times with a burst of corrupted samples: one channel of
-the push's force, one of its torque, or all six, set to 5, 50 or 10^4 times the channel's largest
-clean value, sign-flipped, or zeroed, for 1 to 30 samples in a row, at instants from the initial
-rest to just before the paper method's t_e (2 s). The kind ``drop`` instead takes the samples out
-of the recording, every column with its time stamp (a bus that lost them). For each burst length
-and method it counts the clean ``ok`` answers that stay ``ok`` within 2 mm of the clean answer,
-move further while ``ok`` (more than 2 mm, more than 2 cm), or turn into another status (with the
-statuses and the most common reasons), and how many answers name the samples they put back or
-filled in.
+each recorded once clean and then many times with a burst of corrupted samples: one channel of the
+push's force, one of its torque, or all six, set to 5, 50 or 10^4 times the channel's largest clean
+value, sign-flipped, or zeroed, for 1 to 30 samples in a row, at instants from the initial rest to
+just before the paper method's t_e (2 s). The kind ``hold`` repeats the reading before the burst
+instead (a sensor or driver that stalled and sent its last reading again), and ``drop`` takes the
+samples out of the recording, every column with its time stamp (a bus that lost them). For each
+burst length and method it counts the clean ``ok`` answers that stay ``ok`` within 2 mm of the
+clean answer, move further while ``ok`` (more than 2 mm, more than 2 cm), or turn into another
+status (with the statuses and the most common reasons), and how many answers name the samples they
+put back or filled in.
 
 Usage::
 
     python benchmarks/eval_glitches.py [--lengths 1 2 3 5 10 20 30] [--instants 8] [--workers 2]
-        [--kinds x5 x50 x1e4 flip zero] [--max-gap N] [--json benchmarks/results/glitches.json]
+        [--kinds x5 x50 x1e4 flip zero hold] [--max-gap N] [--json benchmarks/results/glitches.json]
 
-``--kinds drop --max-gap N`` measures lost samples with the estimators' ``max_gap`` set to N.
+``--kinds drop --max-gap N`` measures lost samples with the estimators' ``max_gap`` set to N;
+``--kinds hold`` stalled readings (``glitches_hold.json``).
 """
 
 from __future__ import annotations
@@ -50,11 +52,13 @@ CONTACTS = (
 )
 KINDS = ("x5", "x50", "x1e4", "flip", "zero")
 DROP = "drop"
+HOLD = "hold"
 MOVED = 0.002  # m: an ok answer further than this from the clean one has moved
 WRONG = 0.02  # m: ... and further than this is wrong
 KEPT = 0.0005  # m: the results file keeps the estimates that moved further (or changed status)
 RESULTS = Path(__file__).parent / "results" / "glitches.json"
 RESULTS_DROP = RESULTS.with_name("glitches_drop.json")
+RESULTS_HOLD = RESULTS.with_name("glitches_hold.json")
 
 
 def corrupt(
@@ -80,6 +84,8 @@ def corrupt(
             loads[rows, c] = -loads[rows, c]
         elif kind == "zero":
             loads[rows, c] = 0.0
+        elif kind == HOLD:
+            loads[rows, c] = loads[max(start - 1, 0), c]
         else:
             loads[rows, c] = float(kind[1:]) * largest
     return Recording(
@@ -245,19 +251,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--lengths", type=int, nargs="+", default=[1, 2, 3, 5, 10, 20, 30])
     parser.add_argument("--instants", type=int, default=8)
-    parser.add_argument("--kinds", nargs="+", default=list(KINDS), choices=[*KINDS, DROP])
+    parser.add_argument("--kinds", nargs="+", default=list(KINDS), choices=[*KINDS, HOLD, DROP])
     parser.add_argument("--max-gap", type=int, default=None)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument(
         "--json",
         type=Path,
         default=None,
-        help=f"default {RESULTS.name}, or {RESULTS_DROP.name} for --kinds drop",
+        help=f"default {RESULTS.name}; {RESULTS_DROP.name} for --kinds drop, {RESULTS_HOLD.name} "
+        "for --kinds hold",
     )
     parser.add_argument("--note", default="")
     args = parser.parse_args()
     if args.json is None:
-        args.json = RESULTS_DROP if args.kinds == [DROP] else RESULTS
+        args.json = {(DROP,): RESULTS_DROP, (HOLD,): RESULTS_HOLD}.get(tuple(args.kinds), RESULTS)
     start = time.perf_counter()
     jobs = [
         (case, x_c, args.lengths, args.instants, args.kinds, args.max_gap) for case, x_c in CONTACTS

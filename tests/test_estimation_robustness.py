@@ -21,14 +21,22 @@ from _models import calibrated
 from sensing_antenna.antenna import load_antenna, paper_antenna
 from sensing_antenna.cli.estimate import summary
 from sensing_antenna.detection.push import PushCriterion
-from sensing_antenna.estimation import ContactEstimate, OnlineEstimator, Status, estimate
+from sensing_antenna.estimation import (
+    ContactEstimate,
+    EstimatorConfig,
+    OnlineEstimator,
+    Status,
+    estimate,
+)
 from sensing_antenna.estimation.front.spikes import spike_longest
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate
+from sensing_antenna.simulator.scenario import ATI_NANO17_RESOLUTION
 from test_estimation_pipeline import Synthetic, comparable, synthetic_recording
 
 #: The longest run put back at the synthetic recordings' 1 kHz.
 SPIKE_LONGEST = spike_longest(1e-3)
+GAP_LIMIT = EstimatorConfig().gap_limit(1e-3)
 
 
 def test_push_judged_over_the_hold_despite_rebounds() -> None:
@@ -362,6 +370,121 @@ def test_a_long_run_of_samples_beyond_floats_in_a_stream_is_named_without_warnin
     assert (result.reason or "").startswith(
         f"fy: 30 samples in a row from t = {glitched.t[k]:.4f} s"
     )
+
+
+def _stalled(count: int, after_t1: float) -> tuple[Recording, int]:
+    """A clean synthetic push at 0.5 m whose sensor stalls ``after_t1`` (s) after t_1: the
+    reading before repeated ``count`` times on all six channels; and that reading's index."""
+    recording = synthetic_recording(Synthetic(x_c=0.5, seed=4))
+    clean = estimate(recording, calibrated())
+    k = int(np.searchsorted(recording.t, clean.t_1 + after_t1))
+    loads = np.hstack([recording.force, recording.torque])
+    loads[k : k + count] = loads[k - 1]
+    stalled = Recording(
+        t=recording.t, theta=recording.theta, force=loads[:, :3], torque=loads[:, 3:]
+    )
+    return stalled, k - 1
+
+
+@pytest.mark.parametrize(("count", "after_t1"), [(GAP_LIMIT, 0.05), (300, 0.05), (60, -0.05)])
+def test_a_stalled_sensor_repeating_its_reading_is_bad_input_and_named(
+    count: int, after_t1: float
+) -> None:
+    # A driver that stalls and sends the sensor's last reading again: the time stamps go on,
+    # all six channels stand still while the link rings. Longer than the gaps a recording may
+    # have (the reading itself and its repeats), it is named for every method, in a stream too.
+    stalled, k = _stalled(count, after_t1)
+    _named_for_every_method(stalled, k, count)
+
+
+def test_a_contact_made_while_the_sensor_stood_still_is_named() -> None:
+    # The sensor stalls for 0.3 s of the sweep, during which the link touches a post at 0.95 m:
+    # the contact is found when the readings move again, just after the run, which is named.
+    antenna = load_antenna("paper-2021")
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.95, seed=950))
+    loads = np.hstack([recording.force, recording.torque])
+    k = int(np.searchsorted(recording.t, 0.914 - 1e-9))
+    loads[k + 1 : k + 301] = loads[k]
+    stalled = dataclasses.replace(recording, force=loads[:, :3], torque=loads[:, 3:])
+    said = f"fx, fy, fz, tx, ty, tz: 301 samples in a row from t = {recording.t[k]:.4f} s hold"
+    for method in ("paper", "fast"):
+        result = estimate(stalled, antenna.self_calibrated(), method)
+        assert result.t_c > recording.t[k + 300]
+        assert result.status is Status.BAD_INPUT, (method, result.status, result.reason)
+        assert (result.reason or "").startswith(said), result.reason
+
+
+def _named_for_every_method(stalled: Recording, k: int, count: int) -> None:
+    """Every method's answer on ``stalled`` is bad input naming the held run from sample ``k``,
+    and a stream says so as offline."""
+    said = (
+        f"fx, fy, fz, tx, ty, tz: {count + 1} samples in a row from t = {stalled.t[k]:.4f} s "
+        "hold one value"
+    )
+    for method in ("paper", "ratio", "two-frequency", "fast"):
+        result = estimate(stalled, calibrated(), method)
+        assert result.status is Status.BAD_INPUT, (method, result.status, result.reason)
+        assert (result.reason or "").startswith(said), result.reason
+        assert result.interval is None
+    offline = estimate(stalled, calibrated(), "paper")
+    for block in (1, 64):
+        streamed = _streamed(stalled, block)
+        assert (streamed.status, streamed.reason, streamed.x_c) == (
+            offline.status,
+            offline.reason,
+            offline.x_c,
+        )
+
+
+def test_a_channel_zeroed_through_a_slow_ringing_is_bad_input_and_named() -> None:
+    # The push's force zeroed for 100 samples at a contact near the head (0.3 m), whose
+    # ringing (about 4.5 Hz) moves the level by more than the run's height meanwhile: no level
+    # to come back to, but one value held where the channel moves on both sides.
+    antenna = load_antenna("paper-2021")
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.3, seed=300))
+    loads = np.hstack([recording.force, recording.torque])
+    k = int(np.searchsorted(recording.t, 1.63 - 1e-9))
+    loads[k : k + 100, 1] = 0.0
+    zeroed = dataclasses.replace(recording, force=loads[:, :3], torque=loads[:, 3:])
+    judged = []
+    for method in ("paper", "fast"):
+        result = estimate(zeroed, antenna.self_calibrated(), method)
+        if result.t_e < recording.t[k]:
+            continue  # answered before the run
+        judged.append(method)
+        assert result.status is Status.BAD_INPUT, (method, result.status, result.reason)
+        assert (result.reason or "").startswith(
+            f"fy: 100 samples in a row from t = {recording.t[k]:.4f} s hold one value"
+        )
+    assert "paper" in judged  # its t_e is t_1 + 1 s
+
+
+@pytest.mark.parametrize(("count", "after_t1"), [(GAP_LIMIT - 1, 0.05), (100, -0.6)])
+def test_a_stall_as_short_as_a_gap_or_before_the_contact_is_not_named(
+    count: int, after_t1: float
+) -> None:
+    # As many samples in a row as a gap may miss (the reading and its repeats), or a stall
+    # during the free sweep that ends before the contact: not named.
+    stalled, k = _stalled(count, after_t1)
+    for method in ("paper", "fast"):
+        result = estimate(stalled, calibrated(), method)
+        assert result.t_c > stalled.t[k + count] or count < GAP_LIMIT
+        assert "hold one value" not in (result.reason or ""), result.reason
+
+
+@pytest.mark.parametrize(("case", "x_c"), [("vertical", 0.3), ("azimuthal", 0.9)])
+def test_a_sensor_read_to_its_resolution_is_not_taken_for_a_stall(case: str, x_c: float) -> None:
+    # A real sensor's readings are whole counts of its resolution: with its noise about a
+    # count, a quiet stretch repeats one channel's reading now and then, never all six over
+    # more samples than a gap. The slow ringing at 0.3 m and the quiet hold at 0.9 m.
+    antenna = load_antenna("paper-2021")
+    recording = simulate(antenna, Scenario(case=case, contact_point=x_c, seed=5))
+    counts = np.array(ATI_NANO17_RESOLUTION)
+    loads = np.round(np.hstack([recording.force, recording.torque]) / counts) * counts
+    read = dataclasses.replace(recording, force=loads[:, :3], torque=loads[:, 3:])
+    for method in ("paper", "fast"):
+        result = estimate(read, antenna.self_calibrated(), method)
+        assert result.status is not Status.BAD_INPUT, (method, result.reason)
 
 
 def test_a_contact_lost_and_found_again_is_not_taken_for_a_corrupted_run() -> None:

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
+from sensing_antenna.estimation.front.held import describe_held, find_held
 from sensing_antenna.estimation.front.ratio import contact_loads
 from sensing_antenna.estimation.front.spikes import (
     LEVEL_SAMPLES,
@@ -239,6 +240,18 @@ class Evidence:
         limit = self.config.gap_limit(self.sample_period)
         return gap_problem(self.gaps, t_c, t_end, self.sample_period, limit)
 
+    def held_within(self, t_end: float) -> str | None:
+        """The first run of one wrench value held where its neighbours change
+        (:func:`.held.find_held`), longer than ``config.gap_limit`` samples, up to ``t_end`` (s)
+        and reaching the contact (ending at most that many samples before t_c: a contact made
+        while the sensor stood still is found when it moves again), described (bad input), or
+        None."""
+        stop = int(np.searchsorted(self.t, t_end, side="right"))
+        limit = self.config.gap_limit(self.sample_period)
+        wrench = np.hstack([self.force[:stop], self.torque[:stop]])
+        runs = find_held(wrench, limit, first=max(self.contact_index - limit, 0))
+        return describe_held(runs[0], self.t, limit) if runs else None
+
     def corrupted_within(self, t_end: float) -> str | None:
         """The first run of wrench samples up to ``t_end`` (s) that leaves its neighbours and
         comes back, too long to put back (:func:`.spikes.find_long_runs`) and not the contact
@@ -281,8 +294,9 @@ class Evidence:
 
     def sample_problem(self, t_end: float) -> str | None:
         """Why the samples up to ``t_end`` (s) are not whole (:meth:`gap_within`,
-        :meth:`corrupted_within`), or None: a method's answer from them is ``bad_input``."""
-        return self.gap_within(t_end) or self.corrupted_within(t_end)
+        :meth:`held_within`, :meth:`corrupted_within`), or None: a method's answer from them is
+        ``bad_input``."""
+        return self.gap_within(t_end) or self.held_within(t_end) or self.corrupted_within(t_end)
 
     @property
     def spectrum_slice(self) -> slice:
