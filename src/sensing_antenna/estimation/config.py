@@ -12,7 +12,13 @@ from typing import Literal
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.errors import SensingAntennaError
 
-__all__ = ["MAX_GAP_DURATION", "EstimatorConfig", "EstimatorConfigError", "no_t1_reason"]
+__all__ = [
+    "MAX_GAP_DURATION",
+    "EstimatorConfig",
+    "EstimatorConfigError",
+    "no_t1_reason",
+    "periods_in",
+]
 
 #: Longest run of missing samples (s) filled in on a straight line inside [t_c, t_e] by default:
 #: 20 samples at 1 kHz, as many as the corrupted samples in a row the front end puts back
@@ -314,7 +320,13 @@ class EstimatorConfig:
         as many as span :data:`MAX_GAP_DURATION` (at least one)."""
         if self.max_gap is not None:
             return self.max_gap
-        return max(1, math.floor(MAX_GAP_DURATION / sample_period + 1e-9))
+        return max(1, periods_in(MAX_GAP_DURATION, sample_period))
+
+
+def periods_in(duration: float, sample_period: float) -> int:
+    """Whole sample periods in ``duration`` (s) at ``sample_period`` (s); a duration set as a
+    whole number of periods counts them all despite the division's rounding."""
+    return math.floor(duration / sample_period + 1e-9)
 
 
 def no_t1_reason(config: EstimatorConfig, rest_tolerance: float) -> str:

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.estimation.config import periods_in
 
 __all__ = [
     "LEVEL_SAMPLES",
@@ -101,13 +102,13 @@ class Spike:
 def spike_longest(sample_period: float) -> int:
     """Most corrupted samples in a row put back at ``sample_period`` (s): as many as span
     :data:`SPIKE_DURATION`, and at least :data:`SPIKE_LEAST`."""
-    return max(SPIKE_LEAST, math.floor(SPIKE_DURATION / sample_period + 1e-9))
+    return max(SPIKE_LEAST, periods_in(SPIKE_DURATION, sample_period))
 
 
 def long_run_longest(sample_period: float) -> int:
     """Most corrupted samples in a row looked for at ``sample_period`` (s): as many as span
     :data:`LONG_RUN_DURATION`, and at least :func:`spike_longest`."""
-    return max(spike_longest(sample_period), math.floor(LONG_RUN_DURATION / sample_period + 1e-9))
+    return max(spike_longest(sample_period), periods_in(LONG_RUN_DURATION, sample_period))
 
 
 def find_spikes(
