@@ -267,6 +267,19 @@ def _streamed(recording: Recording, block: int, loads: np.ndarray | None = None)
     return online.finalize()
 
 
+def _streamed_as_offline(recording: Recording) -> None:
+    """The paper method's status, reason and x_c on ``recording`` are the same streamed one
+    sample at a time, 64 at a time, and offline."""
+    offline = estimate(recording, calibrated(), "paper")
+    for block in (1, 64):
+        streamed = _streamed(recording, block)
+        assert (streamed.status, streamed.reason, streamed.x_c) == (
+            offline.status,
+            offline.reason,
+            offline.x_c,
+        ), block
+
+
 @pytest.mark.parametrize("column", [1, 4])  # fy, ty: the push's force and its moment
 @pytest.mark.parametrize("value", [1e300, -1.7976931348623157e308])
 def test_a_glitch_beyond_any_sensor_in_the_hold_gives_a_status_without_warnings(
@@ -345,14 +358,7 @@ def test_a_corrupted_run_too_long_to_put_back_is_bad_input_and_named(
         assert result.reason is not None and result.reason.startswith(said), result.reason
         assert result.interval is None
         assert "repaired_samples" not in result.diagnostics
-    offline = estimate(glitched, calibrated(), "paper")
-    for block in (1, 64):
-        streamed = _streamed(glitched, block)
-        assert (streamed.status, streamed.reason, streamed.x_c) == (
-            offline.status,
-            offline.reason,
-            offline.x_c,
-        )
+    _streamed_as_offline(glitched)
 
 
 @pytest.mark.parametrize("value", [math.inf, 1e308])
@@ -426,14 +432,7 @@ def _named_for_every_method(stalled: Recording, k: int, count: int) -> None:
         assert result.status is Status.BAD_INPUT, (method, result.status, result.reason)
         assert (result.reason or "").startswith(said), result.reason
         assert result.interval is None
-    offline = estimate(stalled, calibrated(), "paper")
-    for block in (1, 64):
-        streamed = _streamed(stalled, block)
-        assert (streamed.status, streamed.reason, streamed.x_c) == (
-            offline.status,
-            offline.reason,
-            offline.x_c,
-        )
+    _streamed_as_offline(stalled)
 
 
 def test_a_channel_zeroed_through_a_slow_ringing_is_bad_input_and_named() -> None:

@@ -27,7 +27,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.estimation.front.spikes import WRENCH_CHANNELS, Spike
+from sensing_antenna.estimation.front.spikes import Spike
 
 __all__ = [
     "HELD_CHANCE",
@@ -120,10 +120,8 @@ def _runs(same: NDArray[np.bool_]) -> list[tuple[int, int]]:
 
 def describe_held(run: Spike, t: FloatArray, longer_than: int) -> str:
     """One line on a held run, at sample times ``t`` (s)."""
-    channels = ", ".join(WRENCH_CHANNELS[c] for c in run.channels)
     return (
-        f"{channels}: {run.length} samples in a row from t = {t[run.index]:.4f} s hold one "
-        f"value where their neighbours change (a stalled sensor or driver, a channel stuck or "
-        f"at the end of its range), longer than the {longer_than} missing in a row a recording "
-        f"may have"
+        f"{run.describe(t)} hold one value where their neighbours change (a stalled sensor or "
+        f"driver, a channel stuck or at the end of its range), longer than the {longer_than} "
+        f"missing in a row a recording may have"
     )

@@ -98,6 +98,11 @@ class Spike:
     length: int
     channels: tuple[int, ...]
 
+    def describe(self, t: FloatArray) -> str:
+        """Its channels, length and start at sample times ``t`` (s), to begin a reason."""
+        channels = ", ".join(WRENCH_CHANNELS[c] for c in self.channels)
+        return f"{channels}: {self.length} samples in a row from t = {t[self.index]:.4f} s"
+
 
 def spike_longest(sample_period: float) -> int:
     """Most corrupted samples in a row put back at ``sample_period`` (s): as many as span
@@ -237,11 +242,9 @@ def find_long_runs(
 
 def describe_run(run: Spike, t: FloatArray, longest: int) -> str:
     """One line on a corrupted run too long to put back, at sample times ``t`` (s)."""
-    channels = ", ".join(WRENCH_CHANNELS[c] for c in run.channels)
     return (
-        f"{channels}: {run.length} samples in a row from t = {t[run.index]:.4f} s leave the "
-        f"level of their neighbours and come back to it, like a corrupted run, longer than the "
-        f"{longest} in a row put back on a line"
+        f"{run.describe(t)} leave the level of their neighbours and come back to it, like a "
+        f"corrupted run, longer than the {longest} in a row put back on a line"
     )
 
 
