@@ -486,10 +486,31 @@ def test_a_sensor_read_to_its_resolution_is_not_taken_for_a_stall(case: str, x_c
         assert result.status is not Status.BAD_INPUT, (method, result.reason)
 
 
+@pytest.mark.parametrize("after_t1", [0.05, -0.5])
+@pytest.mark.parametrize("block", [1, 64])
+def test_a_sample_that_is_not_a_number_ends_a_stream_as_bad_input(
+    after_t1: float, block: int
+) -> None:
+    # A driver in the loop that hands over NaN for a reading it did not get: a recording with
+    # one is refused, and a stream ends with bad input naming the column and the instant, not
+    # with a reason the NaN made up (a sign flipped, a ratio that did not settle).
+    glitched = _glitched(1, 0.5, 1, after_t1)
+    loads = np.hstack([glitched.force, glitched.torque])
+    k = int(np.flatnonzero(loads[:, 1] == 0.5)[0])
+    loads[k, 1] = math.nan
+    result = _streamed(glitched, block, loads)
+    assert result.status is Status.BAD_INPUT
+    assert result.reason == (
+        f"column 'fy': not a number (NaN) at t = {glitched.t[k]:.4f} s, a reading the device "
+        "did not give; a sample's values must all be numbers"
+    )
+
+
 def test_a_contact_lost_and_found_again_is_not_taken_for_a_corrupted_run() -> None:
-    # A fast sweep into a stiff bar: the link bounces during the push and fx leaves its level
-    # for 30 samples and comes back, as a corrupted run would; the push along the hold's falls
-    # to about zero meanwhile, so it is a rebound, and no reason blames the sensor.
+    # A fast sweep into a stiff bar on the nonlinear link: during the push fx leaves its level
+    # for 30 samples and comes back, as a corrupted run would (the friction along the link
+    # turns); the reaction along the hold's, mostly that axial part, falls to 0.38 of the push
+    # before meanwhile, so it is taken for a rebound, and no reason blames the sensor.
     antenna = load_antenna("paper-2021")
     scenario = Scenario(
         case="vertical",

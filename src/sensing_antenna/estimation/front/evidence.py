@@ -266,9 +266,7 @@ class Evidence:
             most=long_run_longest(self.sample_period),
         )
         for run in runs:
-            samples = wrench[run.index : run.index + run.length, list(run.channels)]
-            one_value = bool(np.all(samples == samples[0]))  # stuck, zeroed: no sensor's noise
-            if one_value or not self._contact_lost(run.index, run.length):
+            if not self._contact_lost(run.index, run.length):
                 return describe_run(run, self.t, longest)
         return None
 

@@ -84,6 +84,9 @@ FloatArray = NDArray[np.float64]
 Gathered = Evidence | EarlyOutcome
 
 # The buffers of FrontEnd (set in reset), grown by doubling, NaN where not written.
+#: The columns of a sample, as the recording format names them.
+_COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
+
 _BUFFERS = ("_t", "_theta", "_force", "_torque", "_reaction", "_moment", "_ratio", "_mean")
 
 
@@ -308,6 +311,7 @@ class FrontEnd:
         if self._outcome is not None or count == 0:
             return None
         if self._refused is None:
+            times, angles, forces, moments = self._before_nan(times, angles, forces, moments)
             times, angles, forces, moments = self._put_back(times, angles, forces, moments)
             # after an outlier time stamp no sample follows: what is held back is released
             final = self._jump is not None
@@ -349,7 +353,8 @@ class FrontEnd:
             with _samples_arithmetic():
                 outcome = self._advance(first, stop)
         if outcome is None and self._jump is not None:
-            # the samples before an outlier time stamp said what they could; it ends the run
+            # the samples before an outlier time stamp or a NaN said what they could; it ends
+            # the run
             return self._stop(self._early(Status.BAD_INPUT, self._jump))
         return outcome
 
@@ -436,6 +441,30 @@ class FrontEnd:
         return float(self._t[n - 1]), np.concatenate(
             [self._theta[n - 1], self._force[n - 1], self._torque[n - 1]]
         )
+
+    def _before_nan(
+        self, t: FloatArray, theta: FloatArray, force: FloatArray, torque: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """The block cut before its first sample with a NaN (a reading the device did not give,
+        which no repair can judge), which ends the run (``bad_input``) after the samples before
+        it, as a recording with one is refused."""
+        if self._jump is not None:
+            return t, theta, force, torque
+        values = np.hstack([t[:, None], theta, force, torque])
+        rows = np.flatnonzero(np.isnan(values).any(axis=1))
+        if rows.size == 0:
+            return t, theta, force, torque
+        k = int(rows[0])
+        column = _COLUMNS[int(np.flatnonzero(np.isnan(values[k]))[0])]
+        if column != "t":
+            where = f"at t = {t[k]:.4f} s"
+        else:
+            where = f"after t = {t[k - 1]:.4f} s" if k else "at a block's first sample"
+        self._jump = (
+            f"column '{column}': not a number (NaN) {where}, a reading the device did not "
+            "give; a sample's values must all be numbers"
+        )
+        return t[:k], theta[:k], force[:k], torque[:k]
 
     def _put_back(
         self, t: FloatArray, theta: FloatArray, force: FloatArray, torque: FloatArray
