@@ -255,7 +255,7 @@ def test_joints_sent_on_change_are_not_gaps_while_they_stand_still() -> None:
     assert clocked.report.n_left_out == 30 and clocked.report.joints.n_gaps == 1
     joints_report = clocked.report.joints
     assert (joints_report.n_missing, joints_report.n_still) == (529, 499)
-    assert "529 missing (499 of them while the angles stood still: sent on change)" in (
+    assert "529 missing (499 of them while the angles stood still: no gap, the angles held)" in (
         joints_report.line()
     )
     np.testing.assert_allclose(

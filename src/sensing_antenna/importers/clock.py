@@ -142,7 +142,7 @@ class StreamReport:
         Whether the stamps lie within :data:`STEADY_PERIODS` periods of that clock.
     n_still : int
         Of ``n_missing``, those in silences across which the angles stood still (a joint
-        publisher that sends on change): no gaps.
+        publisher that sends on change, or messages lost while the head rested): no gaps.
     """
 
     name: str
@@ -173,7 +173,7 @@ class StreamReport:
             f"{self.name} ({self.kind}): {self.n_messages} messages, rate {self.rate:.6g} Hz"
             f" (its stamps' line), {self.n_missing} missing"
             + (
-                f" ({self.n_still} of them while the angles stood still: sent on change)"
+                f" ({self.n_still} of them while the angles stood still: no gap, the angles held)"
                 if self.n_still
                 else ""
             )
