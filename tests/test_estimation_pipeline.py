@@ -259,6 +259,44 @@ def test_doubtful_recordings_get_a_status(spec: Synthetic, status: Status) -> No
     assert comparable(final) == comparable(result)
 
 
+def _turned_during_hold(spec: Synthetic, share: float, along: np.ndarray) -> Recording:
+    """The synthetic recording with a force at the contact growing over 0.6 s from the stop on
+    to ``share`` of the push, then held, along the unit vector ``along`` of the motor frame (its
+    moment about O with it)."""
+    recording = synthetic_recording(spec)
+    link = calibrated().link
+    push = 3.0 * link.flexural_rigidity * spec.deflection_ratio / spec.x_c**2  # Eq. 13 (N)
+    start = spec.contact_time + spec.deflection_ratio / spec.speed + 0.1  # after the stop
+    ramp = np.clip((recording.t - start) / 0.6, 0.0, 1.0)
+    added = share * push * ramp[:, None] * along
+    contact = spec.x_c * np.array([1.0, 0.0, 0.0])
+    return dataclasses.replace(
+        recording, force=recording.force + added, torque=recording.torque + np.cross(contact, added)
+    )
+
+
+@pytest.mark.parametrize("case", ["azimuthal", "vertical"])
+def test_a_force_turning_across_the_link_is_slip_and_along_it_is_not(case: str) -> None:
+    # A contact sliding over the obstacle across the link turns the reaction about the link's
+    # axis; a contact held by friction may take a growing share along the link as the servo
+    # settles, which turns the reaction too but moves nothing (and sliding along the link is
+    # the ratio's check). A quarter of the push is 14 deg, past the 8.6 deg limit either way.
+    spec = Synthetic(x_c=0.5, case=case, seed=3)
+    along_link = np.array([1.0, 0.0, 0.0])
+    across = np.array([0.0, 0.0, 1.0]) if case == "azimuthal" else np.array([0.0, 1.0, 0.0])
+    clean = estimate(synthetic_recording(spec), calibrated())
+    assert clean.status is Status.OK, clean.reason
+    held = estimate(_turned_during_hold(spec, 0.25, along_link), calibrated())
+    assert held.status is Status.OK, held.reason
+    assert held.x_c == pytest.approx(clean.x_c, abs=2e-3)
+    slid = _turned_during_hold(spec, 0.25, across)
+    result = estimate(slid, calibrated())
+    assert result.status is Status.SLIP_SUSPECTED
+    assert "turned about the link" in (result.reason or "")
+    _, final = run_online(slid)
+    assert comparable(final) == comparable(result)
+
+
 def test_no_contact() -> None:
     # A free sweep: the obstacle is never reached (contact far beyond the recording).
     recording = synthetic_recording(Synthetic(contact_time=50.0, stops=False, duration=2.0))

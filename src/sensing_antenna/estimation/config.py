@@ -179,8 +179,10 @@ class EstimatorConfig:
         cone by more than 3 of its standard errors cannot be a contact at rest: it slides, or
         it is not a point contact on the link's side.
     max_direction_drift : float
-        Largest angle (rad) between the filtered contact-force direction at t_1 + settle and at t_e
-        before a slip is suspected; 0.15 rad (8.6 deg) is well above noise at gentle pushes.
+        Largest angle (rad) about the link's axis between the hold's push direction and the
+        filtered contact force across the link over the last ``convergence_window`` before t_e,
+        before a slip over the obstacle is suspected; 0.15 rad (8.6 deg) is well above noise at
+        gentle pushes.
     max_ratio_drift : float
         Largest change (m) of the filtered ratio over the last ``convergence_window`` before t_e
         tolerated as a steady hold; beyond it the contact is drifting (slip). 2 cm.

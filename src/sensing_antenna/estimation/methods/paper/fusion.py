@@ -228,17 +228,15 @@ def conclude(
             )
         )
     reaction_now = evidence.reaction_f[e]
-    # Drift of the contact-force direction between t_1 (Y^c) and t_e: slip along the surface
-    cosine = float(
-        np.dot(reaction_now, evidence.frame.axes_m[1]) / max(np.linalg.norm(reaction_now), 1e-300)
-    )
-    drift = math.acos(min(1.0, max(-1.0, cosine)))
+    # Drift of the contact force's direction across the link between the hold (Y^c) and t_e:
+    # a contact sliding over the obstacle
+    drift = _direction_drift(evidence, e)
     if drift > cfg.max_direction_drift:
         found.append(
             (
                 Status.SLIP_SUSPECTED,
-                f"the contact force turned by {math.degrees(drift):.1f} deg between t_1 and t_e "
-                f"(limit {math.degrees(cfg.max_direction_drift):.1f} deg)",
+                f"the contact force turned about the link by {math.degrees(drift):.1f} deg "
+                f"between t_1 and t_e (limit {math.degrees(cfg.max_direction_drift):.1f} deg)",
             )
         )
     if evidence.converged_index is not None:
@@ -541,3 +539,19 @@ def _metres(value: float) -> str:
     """A length (m) to the millimetre, or to four digits when it is no link's (loads in another
     unit make ratios of 10^3 to 10^70 m)."""
     return f"{value:.3f}" if abs(value) < 1e3 else f"{value:.4g}"
+
+
+def _direction_drift(evidence: Evidence, end: int) -> float:
+    """Angle (rad) about the link's axis X^c between the hold's push direction Y^c and the
+    filtered reaction's part across the link, its mean over the last ``convergence_window`` up
+    to sample ``end``.
+
+    A contact that slides over the obstacle across the link turns that part; one that slides
+    along the link moves the ratio (its own check), and a contact held by friction may carry a
+    changing share along the link (the friction cone's check bounds it) as the servo settles.
+    The window holds a period of the slowest vibration or more, so what the low-pass leaves of
+    the ringing averages out and a slip's turn does not."""
+    t = evidence.t
+    start = int(np.searchsorted(t, t[end] - evidence.config.convergence_window, side="left"))
+    _, push, out = evidence.frame.axes_m @ np.mean(evidence.reaction_f[start : end + 1], axis=0)
+    return abs(math.atan2(float(out), float(push)))
