@@ -258,6 +258,48 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
     assert results["fast"].diagnostics["interval_dropped"] is not None
 
 
+@pytest.mark.parametrize(
+    ("case", "angles"),
+    [
+        ("vertical", "swapped"),  # the elevation read as the azimuth: turn across the push
+        ("azimuthal", "halved"),  # a gear ratio read twice too large
+        ("vertical", "halved"),
+    ],
+)
+def test_angles_that_turn_the_head_less_than_the_link_is_bent_are_a_model_mismatch(
+    request: pytest.FixtureRequest, antenna: Antenna, case: str, angles: str
+) -> None:
+    # A contact that sticks bends the link as far as the head turned into the object since the
+    # touch, one that slides less. Angle columns swapped on a vertical sweep keep the push
+    # opposing the (wrong) turn, so the sign check passes; the 3D point would be placed beside
+    # the object. Halved angles keep every direction and halve the turn.
+    original: Recording = request.getfixturevalue(case)
+    theta = original.theta[:, ::-1] if angles == "swapped" else 0.5 * original.theta
+    recording = dataclasses.replace(original, theta=np.ascontiguousarray(theta))
+    for name, result in all_methods(original, antenna).items():
+        assert 0.7 < result.diagnostics["bend_per_turn"] < 1.3, name
+    for name, result in all_methods(recording, antenna).items():
+        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
+        assert not result.ok, name
+        assert any("do not describe the head's turn" in text for text in reasons), name
+        assert result.diagnostics["bend_per_turn"] > 1.6, name
+
+
+def test_a_recording_joined_too_close_to_the_contact_to_tare_is_not_ok(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # Joined mid-sweep, 0.25 s before the touch: no rest and too little approach to read the
+    # sensor's offset on, which then stays in the push, the ratio and the touched point
+    t_c = all_methods(azimuthal, antenna)["paper"].t_c
+    assert t_c is not None
+    joined = samples_kept(azimuthal, azimuthal.t >= t_c - 0.25)
+    for name, result in all_methods(joined, antenna).items():
+        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
+        assert result.diagnostics["tare"] == "none", name
+        assert not result.ok, name
+        assert any("too little to tare the sensor on" in text for text in reasons), name
+
+
 def test_a_link_that_slid_past_a_ball_is_slip_not_a_flipped_sign(antenna: Antenna) -> None:
     # A sweep down onto a small ball hit 0.49 rad off its top: the exact link pushes it until
     # t_1, then slides over it and springs back against its underside, so the hold's reaction

@@ -226,6 +226,18 @@ class EstimatorConfig:
         x_c (y_c / x_c) is ``uncertain``: the statics and the frequencies of a link bent so far
         were checked against no independent reference (the rod engine's recordings reach 33 %),
         and a wrong answer far out on the link reads a push as such a bend. 0.4.
+    max_bend_per_turn : float
+        Plausibility (``model_mismatch``): how far the link's bend along the push from t_c to
+        t_e (the elastica's y_c at the answer from the measured reaction and the model's
+        stiffness) may lie outside what the head's turn into the object makes. A contact that
+        sticks bends the link exactly as far as the rigid link's point x_c moved against the
+        push; one sliding with friction up to ``max_friction_ratio``, at an angle phi between
+        the push and that motion, between 1 - mu tan(phi) times as far and as far. The bend
+        may lie up to this factor above the band or below it: 1.6 covers a calibrated
+        sensor's residual cross-talk and a stiffness known to a few percent. Beyond it: forces
+        that read high or low (an uncalibrated sensor), a link stiffer than the model, angles
+        that do not describe the head's turn, or an answer off the contact (the ratio moves
+        as the square of x_c over the contact's).
     """
 
     t1_source: Literal["rest", "push"] = "rest"
@@ -264,6 +276,7 @@ class EstimatorConfig:
     free_motion_gain_factor: float = 5.0
     max_curve_distance: float = 0.05
     max_deflection_ratio: float = 0.4
+    max_bend_per_turn: float = 1.6
 
     def __post_init__(self) -> None:
         if self.t1_source not in ("rest", "push"):

@@ -25,7 +25,11 @@ forms agree.
    ``max_friction_ratio`` about the normal across the link's tangent there (the elastica's;
    ``slip_suspected``, :func:`_friction_problem`). The answer agrees with the statics: the front
    end's settled ratio at its t_e lies within ``disagreement_sigmas`` of their uncertainties
-   (``estimators_disagree``; every method but ``ratio``, :func:`_statics_problem`).
+   (``estimators_disagree``; every method but ``ratio``, :func:`_statics_problem`). The push
+   bends the link as far as the head turned into the object since the touch, or, sliding with
+   friction, a little less (``model_mismatch``, :func:`_bend_against_turn`): forces that read
+   high, a stiffer link, angles that are not the head's or an answer too near the base say
+   otherwise.
 3. A real vibration: the fundamental omega_1 that the method measured, or, for a method that
    measures none (``ratio``), Estimator 1 on the samples from t_1 to t_e, must be a clear peak
    (``no_clear_peak``).
@@ -37,11 +41,12 @@ forms agree.
    grow with the loads' scale) cover the difference. The frequency does
    not depend on the scale of the loads, the ratio does: forces doubled halve the ratio, a
    synthetic sine in the wrench matches no contact point with both.
-5. A straight enough link (``uncertain``): the sensing curves are the straight link's, and a
-   push that bends the link shifts its frequencies (:func:`_bent_link_problem`); a method that
-   read omega_1 is not ``ok`` where that shift, in whichever plane, may move the vibration's
-   point by more than ``max_model_spread``; nor any method beyond
-   ``max_deflection_ratio``, where the statics were not checked.
+5. Loads a tare corrected (``uncertain``): a recording that starts too close to t_c leaves
+   the sensor's offset in every load. A straight enough link (``uncertain``): the sensing
+   curves are the straight link's, and a push that bends the link shifts its frequencies
+   (:func:`_bent_link_problem`); a method that read omega_1 is not ``ok`` where that shift, in
+   whichever plane, may move the vibration's point by more than ``max_model_spread``; nor any
+   method beyond ``max_deflection_ratio``, where the statics were not checked.
 
 The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the method's own included;
 the rest go to ``diagnostics["other_reasons"]``. Whatever the status, a best guess outside
@@ -67,8 +72,10 @@ from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.beam import SensingCurve, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.estimation.config import periods_in
+from sensing_antenna.estimation.front.contact_frame import motor_axes
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
-from sensing_antenna.estimation.front.ratio import lowpass_noise_gain
+from sensing_antenna.estimation.front.ratio import contact_loads, lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
@@ -147,9 +154,14 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
                 "curves were checked to",
             )
         )
+    if evidence.diagnostics.get("tare") == "none":
+        found.append((Status.UNCERTAIN, _untared(evidence)))
     payload = _payload_problem(evidence, estimate, notes)
     if payload is not None:
         found.append((Status.MODEL_MISMATCH, payload))
+    turn = _bend_against_turn(evidence, estimate, end, notes) if on_link and push is None else None
+    if turn is not None:
+        found.append((Status.MODEL_MISMATCH, turn))
     interval = _on_link(estimate.interval, link.length)
     point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
@@ -462,6 +474,154 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
         f"({_vector(turn)} rad from t_c to t_1); an obstacle can only push back: a sign "
         "flipped in an angle or in the forces, or forces read wrong by as much as the push "
         "(cross-talk from the torques, an offset)?"
+    )
+
+
+def _untared(evidence: Evidence) -> str:
+    """Why an answer from loads no tare corrected is not ``ok``."""
+    t_c = float(evidence.t[evidence.contact_index])
+    cfg = evidence.config
+    return (
+        f"the recording starts {1e3 * (t_c - float(evidence.t[0])):.0f} ms before the contact "
+        f"(t_c = {t_c:.3f} s), too little to tare the sensor on (at least "
+        f"{1e3 * (cfg.rest_window + cfg.tare_margin):.0f} ms free of contact): the push's size "
+        "and direction, the torque/force ratio and the touched point carry the sensor's whole "
+        "offset; start the recording with the head at rest for half a second"
+    )
+
+
+def _bend_at_touch(
+    evidence: Evidence, k: int, bend_over: Any, push: np.ndarray, x_c: float
+) -> tuple[float, float]:
+    """The link's bend at t_c (sample ``k``) and its standard error (m, m).
+
+    From t_c to t_1 the head turns into the object and the static bend grows along a line in
+    the distance the rigid link's point x_c moved against the push (unit vector ``push``),
+    while the touch sets the first two contact modes ringing: the bend from the unfiltered
+    contact moment is fitted by least squares with a line in that distance and a sine and a
+    cosine at each mode's frequency (the straight link's at x_c), and the line's value at t_c
+    is the bend there. A push shorter than half a period of the fundamental cannot tell the line
+    from the ringing: infinite error."""
+    last = max(evidence.rest_index, k)
+    bends = bend_over(k, last)
+    axes = motor_axes(evidence.theta[k : last + 1])[:, 0]
+    moved = x_c * (axes - axes[0])
+    moved = moved - np.einsum("ij,j->i", moved, axes[-1])[:, None] * axes[-1]
+    reach = -(moved @ push)
+    age = evidence.t[k : last + 1] - evidence.t[k]
+    columns = [np.ones_like(age), reach]
+    for omega in natural_frequencies(evidence.antenna.link, x_c, 2):
+        columns += [np.sin(omega * age), np.cos(omega * age)]
+    design = np.column_stack(columns)
+    free = bends.size - design.shape[1]
+    fundamental = float(sensing_curve(evidence.antenna.link).omega1(x_c))
+    if age[-1] * fundamental >= math.pi and free >= 3 and float(np.ptp(reach)) > 0.0:
+        fit, residual, rank, _ = np.linalg.lstsq(design, bends, rcond=None)
+        if rank == design.shape[1] and residual.size:
+            covariance = np.linalg.pinv(design.T @ design) * float(residual[0]) / free
+            return float(fit[0]), math.sqrt(max(float(covariance[0, 0]), 0.0))
+    return math.nan, math.inf
+
+
+def _bend_against_turn(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> str | None:
+    """Why the link's bend is not what the head's turn into the object makes, or None.
+
+    From t_c to t_e the rigid link's point at x_c moves by u = x_c (X^m(theta_e) -
+    X^m(theta_c)); the object holds the touched point back, so the link bends by y along the
+    reaction R, at an angle phi to -u. A contact that sticks stays where it touched: y = -u,
+    phi = 0. One that slides with Coulomb friction mu stays on the surface of normal n,
+    y (R^ . n) = -u . n, with R on the friction cone's edge between n and -u; then
+    1 - mu tan(phi) <= y / (-R^ . u) <= 1. Both vectors are taken across the link (X^m at t_e
+    removed), mu is ``max_friction_ratio``, and ``max_bend_per_turn`` widens the band both
+    ways for the forces' scale and the stiffness. The bends are the elastica's y_c of the
+    answer scaled by the contact moment across the link over the moment of the push y_c was
+    computed from (``push_force`` times the filtered torque/force ratio at t_e): at t_e the
+    mean over the hold's last period of the contact's fundamental, at t_c
+    :func:`_bend_at_touch` (the detector declares t_c once the push has built up), whose two
+    standard errors widen the band; not judged when the push from t_c to t_1 lasts less than
+    half a period of the fundamental. At a given push y grows as x_c^3 and u as x_c: an answer
+    off the contact moves the ratio as (x_c / true x_c)^2. ``notes`` gets
+    ``turn_against_push`` (-R^ . u, m) and ``bend_per_turn`` (y over it). Not judged when the
+    head turned by less than the rest tolerance (an object pushed into a still link).
+    """
+    bend = float(estimate.diagnostics.get("deflection", math.nan))
+    if not (math.isfinite(bend) and bend > 0.0):
+        return None
+    axes_c = np.asarray(
+        estimate.diagnostics.get("axes_c_absolute", evidence.frame.axes_a), dtype=float
+    )
+    k = evidence.contact_index
+    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
+    if float(np.max(np.abs(evidence.theta[end] - evidence.theta[k]))) <= tolerance:
+        return None  # the head did not turn: an object pushed into a still link
+    x_axis = motor_axes(evidence.theta[end])[0]
+    moved = estimate.x_c * (x_axis - motor_axes(evidence.theta[k])[0])
+    moved = moved - (moved @ x_axis) * x_axis
+    push = axes_c[1] - (axes_c[1] @ x_axis) * x_axis
+    norm = float(np.linalg.norm(push))
+    # the moment across the link that goes with the push y_c was computed from: the filtered
+    # torque/force ratio at t_e (both lag alike) times that push
+    filtered = np.asarray(evidence.torque_f[end, 1:], dtype=float)
+    force = float(np.linalg.norm(evidence.reaction_f[end, 1:]))
+    push_force = float(estimate.diagnostics.get("push_force", force))
+    scale = float(np.linalg.norm(filtered)) * push_force / force if force > 0.0 else math.nan
+    if not (norm > 0.0 and scale > 0.0):
+        return None
+    filtered = filtered / float(np.linalg.norm(filtered))
+
+    def bend_over(first: int, last: int) -> np.ndarray:
+        """The bend (m) the contact moment across the link gives at each sample."""
+        near = slice(max(first, 0), min(last, end) + 1)
+        _, moment = contact_loads(
+            evidence.theta[near], evidence.force[near], evidence.torque[near], evidence.antenna
+        )
+        return bend * ((moment[:, 1:] - evidence.load_offset[4:]) @ filtered) / scale
+
+    # the hold over one period of the contact's fundamental, which the touch sets ringing
+    omega = float(sensing_curve(evidence.antenna.link).omega1(estimate.x_c))
+    period = max(periods_in(2.0 * math.pi / omega, evidence.sample_period), 1)
+    held = float(np.mean(bend_over(max(end - period, evidence.rest_index), end)))
+    touch, error = _bend_at_touch(evidence, k, bend_over, push / norm, estimate.x_c)
+    # the bend since t_c, and its least and largest values within two standard errors
+    since = held - max(touch, 0.0)
+    least_since = held - max(touch + 2.0 * error, 0.0)
+    most_since = held - max(touch - 2.0 * error, 0.0)
+    turn = -float(push @ moved) / norm
+    notes["turn_against_push"] = turn
+    if turn > 0.0:
+        notes["bend_per_turn"] = since / turn
+    if not math.isfinite(error):
+        return None  # a push too short to tell the bend at t_c from the ringing
+    cfg = evidence.config
+    limit = cfg.max_bend_per_turn
+    t_c = float(evidence.t[k])
+    measured = (
+        f"the measured push bent the link by {1e3 * since:.3g} mm at x_c = {estimate.x_c:.3f} m "
+        f"from the touch at t_c = {t_c:.3f} s to t_e, while the angles move that point "
+        f"{1e3 * turn:.3g} mm against the push"
+    )
+    if not turn > 0.0 or least_since > limit * turn:
+        return (
+            f"{measured} (a contact that sticks bends the link as far as the head turned into "
+            f"it, one that slides less; up to {limit:g} times is allowed): forces that read "
+            "high for the model's stiffness (the sensor's gain or cross-talk, which antenna "
+            "calibrate fits), a link stiffer than the antenna file says, or angles that do not "
+            "describe the head's turn (columns 'theta1', 'theta2' swapped, a joint read from "
+            "the wrong column, a scale off)"
+        )
+    reach = float(np.linalg.norm(moved))
+    tan_phi = math.sqrt(max(reach**2 - turn**2, 0.0)) / turn
+    least = 1.0 - cfg.max_friction_ratio * tan_phi
+    if not most_since * limit < least * turn:
+        return None
+    return (
+        f"{measured}, {math.degrees(math.atan(tan_phi)):.0f} deg off the push (a contact "
+        f"sliding with friction up to {cfg.max_friction_ratio:g} bends it at least "
+        f"{least:.2f} times as far; down to 1/{limit:g} of that is allowed): an answer nearer "
+        "the base than the contact (the bend at a given push grows as x_c^3, the head's reach "
+        "as x_c), a contact found before the link touched, or forces that read low"
     )
 
 
