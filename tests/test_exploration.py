@@ -502,6 +502,23 @@ def test_a_scene_out_of_the_link_s_reach_is_warned_of(
     assert "1 manoeuvres (free 1)" in captured.out
 
 
+def test_a_scene_within_reach_that_no_sweep_touches_is_warned_of(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a ball 0.6 m behind the head: within the link's reach, outside every sweep's angles
+    scene = tmp_path / "behind.toml"
+    scene.write_text(
+        '[[objects]]\nshape = "sphere"\nradius = 0.06\nposition = [-0.6, 0.05, 0.04]\n'
+        "[explore]\nazimuthal_sweeps = 1\nvertical_sweeps = 1\n"
+    )
+    out = tmp_path / "behind"
+    assert main(["explore", str(scene), "--out", str(out), "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert "sweeps touched an object: it lies outside the sweeps' angles" in captured.err
+    assert "0 of 0 points used; surface" in captured.out
+    assert "()" not in (out / "report.md").read_text()
+
+
 def test_the_command_offers_the_librarys_strategies_scenes_and_devices() -> None:
     from sensing_antenna.cli import explore as command
     from sensing_antenna.exploration import STRATEGIES

@@ -201,6 +201,13 @@ def _run(args: argparse.Namespace) -> int:
         + (f"; after the budget, aimed at {after}" if after else "")
         + f"), {summary['sweep_time_s']:.0f} s of sweeping"
     )
+    if summary["manoeuvres"] and set(summary["outcomes"]) == {"free"}:
+        print(
+            f"antenna explore: warning: none of the {summary['manoeuvres']} sweeps touched an "
+            "object: it lies outside the sweeps' angles from every base (behind the head, or "
+            "beyond the elevation the sweeps reach); move a base or the object",
+            file=sys.stderr,
+        )
     with stopped_as_stored(args.out, lambda: len(result.manoeuvres)):
         report_map(result.contact_map, args.out, scene.mesh)
     print(f"  {args.out / 'manoeuvres.csv'}\n  {args.out / 'scene.ply'}")

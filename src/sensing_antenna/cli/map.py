@@ -188,7 +188,9 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
         decision = f"{recognition.decision} ({recognition.best.sizes_text()})"
     statuses = ", ".join(f"{k} {v}" for k, v in sorted(summary["statuses"].items()))
     print(
-        f"{summary['n_used']} of {summary['n_recordings']} points used ({statuses}); "
+        f"{summary['n_used']} of {summary['n_recordings']} points used"
+        + (f" ({statuses})" if statuses else "")
+        + "; "
         f"surface faces {summary['surface_faces']}; object {decision}"
     )
     spread = "" if recognition is None else overdispersed(recognition)

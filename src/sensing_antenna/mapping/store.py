@@ -235,7 +235,9 @@ def report(contact_map: ContactMap) -> str:
     lines = [
         "# Contact map",
         "",
-        f"{s['n_recordings']} recordings ({statuses}); {s['n_used']} points used"
+        f"{s['n_recordings']} recordings"
+        + (f" ({statuses})" if statuses else "")
+        + f"; {s['n_used']} points used"
         + (
             " (ok and uncertain)"
             if s["include_uncertain"]
