@@ -118,7 +118,7 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if evidence.input_problem is not None:
         found.append((Status.IMPLAUSIBLE_INPUT, evidence.input_problem))
     angles = angle_problem(evidence.theta[: end + 1])
-    if angles is not None:
+    if angles is not None and angles not in (evidence.input_problem or ""):
         found.append((Status.IMPLAUSIBLE_INPUT, angles))
     push = _push_direction_problem(evidence)
     if push is not None:

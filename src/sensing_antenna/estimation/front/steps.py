@@ -4,7 +4,9 @@
 2. Sensor offset (tare) and rest tolerance from the samples up to t_c (:func:`at_contact`), and
    the recording's own units check there: the loads the tare averages against the link's weight
    (:func:`sensing_antenna.units_check.rest_reading`), the free motion before t_c against the
-   observer (:func:`free_motion_gain`).
+   observer (:func:`free_motion_gain`), and the angles up to t_c
+   (:func:`sensing_antenna.units_check.angle_problem`), so that an outcome found before t_e
+   (no push, say) on angles in degrees names the degrees.
 3. The static push over the hold window [t_1, t_1 + frame_window] (:func:`hold_push`): the mean
    contact force, not the force at one instant, because near the tip the link bounces on the
    obstacle for a few tenths of a second after the stop while the static preload is small
@@ -36,7 +38,7 @@ from sensing_antenna.estimation.front.contact_frame import (
     signal_noise,
 )
 from sensing_antenna.estimation.front.ratio import contact_loads, load_offset, ratio_noise
-from sensing_antenna.units_check import initial_rest, rest_reading
+from sensing_antenna.units_check import angle_problem, initial_rest, rest_reading
 
 __all__ = [
     "MAX_FILLED",
@@ -349,6 +351,10 @@ def at_contact(
         checks["free_motion_gain"] = gain
         if problem is not None:
             problems.append(problem)
+    angles = angle_problem(theta[before])
+    if angles is not None:
+        # first: a push judged on angles that are no head's is no push (degrees, a glitch)
+        problems.insert(0, angles)
     if quiet >= w_rest + 1:
         # The head rests at the start: the link hangs still, the mean load is the offset.
         window, tare, where = slice(0, quiet), "rest", "at rest before the contact"
