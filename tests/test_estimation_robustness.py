@@ -213,6 +213,19 @@ def test_at_250_hz_gaps_are_bridged_for_20_ms_and_corrupted_runs_for_20_samples(
             assert result.ok and abs(result.x_c - clean.x_c) < 1e-3, (count, result.reason)
 
 
+def test_a_contact_found_inside_a_gap_is_said_to_be_maybe_the_gap() -> None:
+    # 0.3 s lost while the head turns: the straight line across the gap is a jump the observer
+    # of a low threshold cannot follow, and the detector fires on it
+    antenna = calibrated()
+    observer = dataclasses.replace(antenna.observer, contact_threshold=1e-4)
+    model = dataclasses.replace(antenna, observer=observer)
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.55, seed=1))
+    result = estimate(_drop(recording.without_ground_truth(), 300, 300), model)
+    assert result.status is Status.BAD_INPUT
+    assert "300 samples missing between 0.2990 s and 0.6000 s" in (result.reason or "")
+    assert "the contact was found inside the gap" in (result.reason or "")
+
+
 def test_gap_before_contact_is_interpolated() -> None:
     recording = synthetic_recording(Synthetic(x_c=0.45, seed=2))
     result = estimate(_drop(recording, 200, 50), calibrated())

@@ -297,10 +297,16 @@ def gap_problem(
     for start, end in gaps:
         if end > t_c and start < t_e:
             missing = round((end - start) / sample_period) - 1
+            within = (
+                "; the contact was found inside the gap, on the straight line that fills it: "
+                "it may be the gap's jump, not a touch"
+                if start <= t_c <= end
+                else ""
+            )
             return (
                 f"t: {missing} samples missing between {start:.4f} s and {end:.4f} s, inside "
                 f"the estimation window [{t_c:.3f}, {t_e:.3f}] s from the contact (at most "
-                f"{max_gap} in a row are filled in)"
+                f"{max_gap} in a row are filled in){within}"
             )
     return None
 
