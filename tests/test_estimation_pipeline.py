@@ -348,11 +348,13 @@ def test_bad_input_coarse_sampling_and_dead_sensor() -> None:
     result = estimate(coarse, calibrated())
     assert result.status is Status.BAD_INPUT and "Nyquist" in (result.reason or "")
     assert "in ms?" not in (result.reason or "")  # 25 ms is no period in ms
-    # time stamps in ms: 1 s read as the period, which the reason names
-    in_ms = dataclasses.replace(recording, t=1000.0 * recording.t)
-    result = estimate(in_ms, calibrated())
-    assert result.status is Status.BAD_INPUT
-    assert (result.reason or "").endswith("(time stamps in ms? the format's are in s)")
+    # time stamps in ms, us or ns: 1 s, 1000 s or 1e6 s read as the period, which the reason
+    # names
+    for unit, factor in (("ms", 1e3), ("us", 1e6), ("ns", 1e9)):
+        scaled = dataclasses.replace(recording, t=factor * recording.t)
+        result = estimate(scaled, calibrated())
+        assert result.status is Status.BAD_INPUT
+        assert (result.reason or "").endswith(f"(time stamps in {unit}? the format's are in s)")
     dead = Recording(
         t=recording.t, theta=recording.theta, force=recording.force, torque=0 * recording.torque
     )

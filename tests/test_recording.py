@@ -494,6 +494,32 @@ def test_a_required_name_written_otherwise_is_named_with_what_was_found(
         read_recording(path)
 
 
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        # numpy.savetxt(header=...) without comments=""
+        (lambda text: text.replace("t,theta1", "# t,theta1", 1), "numpy.savetxt writes '# '"),
+        # a blank line between the metadata and the header
+        (lambda text: text.replace("\nt,theta1", "\n\nt,theta1", 1), "blank line where the header"),
+        # pandas' to_csv with its index
+        (lambda text: text.replace("\nt,theta1", "\n,t,theta1", 1), "an index, as pandas writes"),
+        # a trailing comma after the last name
+        (lambda text: text.replace(",tz\n", ",tz,\n", 1), "a trailing comma?"),
+        # the time column spelled out
+        (lambda text: text.replace("\nt,theta1", "\ntime,theta1", 1), "found 'time': the time"),
+    ],
+    ids=["savetxt", "blank", "index", "trailing-comma", "time"],
+)
+def test_a_header_as_common_tools_write_it_is_named_with_the_fix(
+    change: object, message: str, tmp_path: Path
+) -> None:
+    path = tmp_path / "header.csv"
+    write_recording(_recording(), path)
+    path.write_text(change(path.read_text()))  # type: ignore[operator]
+    with pytest.raises(RecordingError, match=re.escape(message)):
+        read_recording(path)
+
+
 def test_a_loggers_text_columns_and_footer_are_left_out(tmp_path: Path) -> None:
     # A lab's logger writes a state column, a sensor temperature it did not always read and a
     # footer; the samples read as without them. A '#' line among the samples is refused

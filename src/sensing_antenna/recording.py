@@ -545,7 +545,19 @@ def parse_metadata(lines: list[str], source: str) -> tuple[dict[str, str], int]:
         key, sep, value = body.partition(":")
         key = key.strip()
         if not sep or not key:
-            raise RecordingError(source, index + 1, None, "metadata line must read '# key: value'")
+            looks_like_header = "," in body and body.split(",")[0].strip() in ("t", "time")
+            raise RecordingError(
+                source,
+                index + 1,
+                None,
+                "metadata line must read '# key: value'"
+                + (
+                    " (the header written as a comment? numpy.savetxt writes '# ' before it "
+                    "unless given comments='')"
+                    if looks_like_header
+                    else ""
+                ),
+            )
         if key in metadata:
             raise RecordingError(source, index + 1, key, "duplicate metadata key", metadata=True)
         metadata[key] = value.strip()
@@ -605,9 +617,21 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
             "by commas (docs/recording-format.md)",
         )
     seen: set[str] = set()
-    for name in names:
+    if not line.strip():
+        raise RecordingError(
+            source, number, None, "blank line where the header is due (it follows the metadata)"
+        )
+    for position, name in enumerate(names):
         if not name:
-            raise RecordingError(source, number, None, "empty column name in header")
+            where = (
+                " (a first column without a name: an index, as pandas writes unless given "
+                "index=False?)"
+                if position == 0
+                else " (a trailing comma?)"
+                if position == len(names) - 1
+                else ""
+            )
+            raise RecordingError(source, number, None, f"empty column name in header{where}")
         if name in seen:
             raise RecordingError(source, number, name, "duplicate column")
         seen.add(name)
@@ -622,8 +646,11 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
 def _near(name: str, names: list[str]) -> str:
     """ " (found 'T', ...: ...)" when a header name is ``name`` written otherwise (quoted, in
     another case, with a unit), else "" """
+    spelled = {"t": ("time", "timestamp", "time_s", "stamp")}.get(name, ())
     for found in names:
         bare = found.strip("\"' ").split("[")[0].split("(")[0].strip().lower()
+        if bare in spelled:
+            return f" (found {found!r}: the time column is named 't', in s)"
         if bare == name and found != name:
             return (
                 f" (found {found!r}: names are written bare and in lower case, without quotes"

@@ -84,13 +84,21 @@ def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig
     """
     nyquist = math.pi / sample_period
     if nyquist < cfg.min_nyquist_factor * band_top:
-        # stamps in ms read as s: a thousand times the period, which in s would do
-        in_ms = 1000.0 * nyquist >= cfg.min_nyquist_factor * band_top and sample_period >= 0.5
+        # stamps in ms, us or ns read as s: 1e3, 1e6 or 1e9 times a period that in s would do
+        unit = next(
+            (
+                name
+                for name, factor in (("ms", 1e3), ("us", 1e6), ("ns", 1e9))
+                if factor * nyquist >= cfg.min_nyquist_factor * band_top
+                and sample_period >= 0.5 * factor / 1e3
+            ),
+            None,
+        )
         return (
             f"sample period {sample_period:g} s: the Nyquist frequency {nyquist:.0f} rad/s is "
             f"below {cfg.min_nyquist_factor:g} times the top of the omega_1 band "
             f"({band_top:.0f} rad/s)"
-            + (" (time stamps in ms? the format's are in s)" if in_ms else "")
+            + (f" (time stamps in {unit}? the format's are in s)" if unit else "")
         )
     return None
 
