@@ -191,6 +191,26 @@ def test_cli_writes_the_fitted_motors_and_prints_their_gains(
     assert "and the motors of joint 1 identified" in written.description
 
 
+def test_cli_fits_the_motors_on_a_sweep_into_an_object_and_keeps_the_observer(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A sweep into a bar fits the elevation's Eq. 1 (docs/control.md), while its static contact
+    # torque is no free motion for the observer: the motors are written, the observer kept
+    path = tmp_path / "bar.csv"
+    recording = simulate(TRUE, Scenario(case="vertical", contact_point=0.5), record_commands=True)
+    write_recording(recording, path)
+    assert main(["identify", str(path), "--out", str(tmp_path / "observer.toml")]) == 2
+    assert "is this really free motion?" in capsys.readouterr().err
+    out = tmp_path / "lab.toml"
+    assert main(["identify", str(path), "--out", str(out), "--servo"]) == 0
+    text = capsys.readouterr().out
+    written = load_antenna(out)
+    assert "observer: not identified" in text and "observer and contact threshold kept" in text
+    assert written.observer == PAPER.observer
+    fit = identify_motors(read_recording(path), PAPER)
+    assert written.elevation_motor == fit.joints[0].motor(PAPER.elevation_motor)
+
+
 def test_servo_pole_needs_servo(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "free.csv"
     write_recording(simulate(PAPER, Scenario(case="free"), record_commands=True), path)

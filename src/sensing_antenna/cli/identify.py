@@ -84,7 +84,7 @@ def _run(args: argparse.Namespace) -> int:
 
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.motor import identify_motors
-    from sensing_antenna.calibration.observer import identify_free_motion
+    from sensing_antenna.calibration.observer import IdentificationError, identify_free_motion
     from sensing_antenna.control.servo import DEFAULT_SERVO_POLE, ControlConfigError
     from sensing_antenna.recording import read_recording
 
@@ -96,31 +96,46 @@ def _run(args: argparse.Namespace) -> int:
     antenna = load_antenna(args.antenna)
     recordings = [read_recording(path) for path in distinct_files(args.recordings)]
     motor_fit = identify_motors(recordings[0], antenna) if args.servo else None
-    fit = identify_free_motion(recordings, antenna, margin=args.margin)
-    what = "the free-motion observer and contact threshold"
+    try:
+        fit = identify_free_motion(recordings, antenna, margin=args.margin)
+    except IdentificationError as exc:
+        if motor_fit is None:
+            raise
+        # a sweep into an object fits the motors, not the free-motion observer
+        fit, kept = None, str(exc)
+    what = "the free-motion observer and contact threshold" if fit is not None else ""
     if motor_fit is not None:
         fitted = " and ".join(str(j.joint) for j in motor_fit.joints)
-        what += f" and the motors of joint{'s' if len(motor_fit.joints) > 1 else ''} {fitted}"
+        motors = f"the motors of joint{'s' if len(motor_fit.joints) > 1 else ''} {fitted}"
+        what = f"{what} and {motors}" if what else motors
     description = (
         f"antenna {printable(antenna.name)} with {what} identified by antenna identify from "
         f"{printable(', '.join(str(path) for path in args.recordings))}"
     )
     start = antenna if motor_fit is None else motor_fit.antenna(antenna)
-    identified = fit.apply(replace(start, name=name, description=description))
+    identified = replace(start, name=name, description=description)
+    if fit is not None:
+        identified = fit.apply(identified)
     save_antenna(identified, args.out)
-    joints = ", ".join(f"theta{j}" for j in fit.joints)
-    print(
-        f"gain = {fit.gain:.5g} N m/rad, natural_frequency = {fit.natural_frequency:.5g} "
-        f"rad/s ({fit.natural_frequency / (2 * math.pi):.4g} Hz), "
-        f"damping = {fit.damping:.4g} 1/s (zeta = {fit.damping_ratio:.3g})"
-    )
-    print(
-        f"contact_threshold = {fit.contact_threshold:.4g} N m "
-        f"({fit.margin:g} x the largest low-pass filtered residual of Eq. 16, "
-        f"{fit.max_filtered_residual:.4g} N m), rms of the unfiltered fit residual "
-        f"{fit.residual_rms:.3g} N m, joints used: {joints}"
-    )
-    _print_payload(fit.payload, antenna.link, identified.link)
+    if fit is None:
+        print(
+            f"observer: not identified ({kept}); the starting antenna's observer and contact "
+            "threshold kept: identify them on a free-motion recording"
+        )
+    else:
+        joints = ", ".join(f"theta{j}" for j in fit.joints)
+        print(
+            f"gain = {fit.gain:.5g} N m/rad, natural_frequency = {fit.natural_frequency:.5g} "
+            f"rad/s ({fit.natural_frequency / (2 * math.pi):.4g} Hz), "
+            f"damping = {fit.damping:.4g} 1/s (zeta = {fit.damping_ratio:.3g})"
+        )
+        print(
+            f"contact_threshold = {fit.contact_threshold:.4g} N m "
+            f"({fit.margin:g} x the largest low-pass filtered residual of Eq. 16, "
+            f"{fit.max_filtered_residual:.4g} N m), rms of the unfiltered fit residual "
+            f"{fit.residual_rms:.3g} N m, joints used: {joints}"
+        )
+        _print_payload(fit.payload, antenna.link, identified.link)
     if motor_fit is not None:
         _print_servo(motor_fit, antenna, pole)
     print(args.out)
