@@ -6,6 +6,7 @@ The recordings are made by ``antenna simulate`` (paper antenna, both cases)."""
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import io
 import json
@@ -118,6 +119,21 @@ def test_live_estimate_is_the_offline_one_to_the_bit(
     assert isinstance(push, PushEvent) and push.t_1 == offline.t_1
     assert (end.samples, end.dropped, end.t_last) == (recording.n_samples, 0, recording.t[-1])
     assert all(e.latency >= 0 for e in events)
+
+
+def test_a_contact_on_loads_in_another_unit_says_so_when_it_is_found(
+    recordings: dict[str, Path],
+) -> None:
+    # torques in N mm: the contact event already carries why the samples are not the format's,
+    # the estimate after it is implausible_input; the units' event of a whole recording none
+    recording = read_recording(recordings["azimuthal"])
+    in_n_mm = dataclasses.replace(recording, torque=1000.0 * recording.torque)
+    contact = _listen(_lines(in_n_mm))[0]
+    assert isinstance(contact, ContactEvent)
+    assert "columns 'tx', 'ty', 'tz'" in (contact.input_problem or "")
+    assert contact.to_dict()["input_problem"] == contact.input_problem
+    plain = _listen(_lines(recording))[0]
+    assert isinstance(plain, ContactEvent) and plain.input_problem is None
 
 
 #: The ``antenna`` command in a new interpreter.

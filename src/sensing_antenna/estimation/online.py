@@ -104,6 +104,12 @@ class OnlineEstimator:
         """Sample of t_1 (counted as :attr:`contact_index`), once found."""
         return self._front.rest_index
 
+    @property
+    def input_problem(self) -> str | None:
+        """Why the samples up to t_c are not in the format's units and signs, known at t_c
+        (the estimate's status will be ``implausible_input``), else None."""
+        return self._front.input_problem
+
     def update(
         self, t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
     ) -> ContactEstimate | None:

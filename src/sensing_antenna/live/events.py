@@ -33,11 +33,14 @@ def _plain(value: float) -> float | None:
 
 @dataclass(frozen=True)
 class ContactEvent:
-    """Contact detected: t_c (s), the contact detector's instant."""
+    """Contact detected: t_c (s), the contact detector's instant, and ``input_problem``: why
+    the samples up to t_c are not in the format's units and signs (angles in degrees, torques
+    in N mm), when they are not, in which case the contact may be no touch at all."""
 
     recording: int
     t_c: float
     latency: float
+    input_problem: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object of the event."""
@@ -45,6 +48,7 @@ class ContactEvent:
             "event": "contact",
             "recording": self.recording,
             "t_c": self.t_c,
+            "input_problem": self.input_problem,
             "latency": self.latency,
         }
 

@@ -346,7 +346,11 @@ class Listener:
         if contact is not None and "contact" not in self._said:
             self._said.add("contact")
             at = max(first, contact)
-            self._emit(ContactEvent(self.number, float(t[contact]), self._latency(at)))
+            self._emit(
+                ContactEvent(
+                    self.number, float(t[contact]), self._latency(at), estimator.input_problem
+                )
+            )
         if rest is not None and "push" not in self._said:
             self._said.add("push")
             at = max(first, rest)

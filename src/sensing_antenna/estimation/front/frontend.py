@@ -247,6 +247,12 @@ class FrontEnd:
         return self._rest
 
     @property
+    def input_problem(self) -> str | None:
+        """Why the samples up to t_c are not in the format's units and signs (found at t_c),
+        None when they are or before t_c."""
+        return None if self._start is None else self._start.input_problem
+
+    @property
     def first_evaluation_index(self) -> int | None:
         """First sample at which :meth:`evidence_at` may be asked: the end of the hold after t_1,
         once the push there was judged measurable; None before."""
