@@ -159,6 +159,7 @@ from sensing_antenna.mapping.primitives import (
     distance_gradient,
     local_coordinates,
 )
+from sensing_antenna.scene.proximity import closest_point, signed_distance
 
 __all__ = [
     "ABSTAIN_DELTA",
@@ -1681,7 +1682,7 @@ def fit_mesh(
         scale=False,
     )
     moved = trimesh.transform_points(p, points_to_mesh)
-    _, distance, faces = trimesh.proximity.closest_point(mesh, moved)
+    _, distance, faces = closest_point(mesh, moved)
     pose = np.linalg.inv(points_to_mesh)  # mesh to world
     normals = mesh.face_normals[faces] @ pose[:3, :3].T
     sigma = _normal_sigma(cov, normals)
@@ -1696,10 +1697,10 @@ def fit_mesh(
     if placed.is_watertight:
         # trimesh's signed distance is positive inside (and meaningful for a closed mesh only)
         def signed(q: FloatArray) -> FloatArray:
-            return -np.asarray(trimesh.proximity.signed_distance(placed, q))
+            return signed_distance(placed, q)
 
         def normals_at(q: FloatArray) -> FloatArray:
-            _, _, closest = trimesh.proximity.closest_point(placed, q)
+            _, _, closest = closest_point(placed, q)
             return np.asarray(placed.face_normals[closest])
 
         if lines is not None:
@@ -1810,7 +1811,7 @@ def _surface_distance(fit: ClassFit, samples: FloatArray) -> FloatArray:
     if fit.name in PRIMITIVES:
         return np.abs(PRIMITIVES[fit.name].signed_distance(fit.vector, samples))
     assert fit.mesh is not None
-    _, distance, _ = trimesh.proximity.closest_point(fit.mesh, samples)
+    _, distance, _ = closest_point(fit.mesh, samples)
     return np.asarray(distance)
 
 
@@ -1849,7 +1850,7 @@ def _fit_normals(fit: ClassFit, points: FloatArray) -> FloatArray:
     if fit.name in PRIMITIVES:
         return PRIMITIVES[fit.name].normals(fit.vector, points)
     assert fit.mesh is not None
-    _, _, faces = trimesh.proximity.closest_point(fit.mesh, points)
+    _, _, faces = closest_point(fit.mesh, points)
     return np.asarray(fit.mesh.face_normals[faces])
 
 

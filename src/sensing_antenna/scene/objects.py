@@ -23,6 +23,7 @@ from scipy.spatial.transform import Rotation
 
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.mapping.primitives import PRIMITIVES
+from sensing_antenna.scene.proximity import signed_distance
 
 __all__ = [
     "MAX_MESH_EXTENT",
@@ -150,8 +151,7 @@ class SceneObject:
         """d (m), shape (n,), of points of shape (n, 3) (m): positive outside."""
         p = np.asarray(points, dtype=float).reshape(-1, 3)
         if self.shape == "mesh":
-            # trimesh counts inside as positive
-            return np.asarray(-trimesh.proximity.signed_distance(self.mesh, p))
+            return signed_distance(self.mesh, p)
         return PRIMITIVES[self.shape].signed_distance(self.parameters, p)
 
     def normal(self, point: ArrayLike, step: float = 1e-6) -> FloatArray:
