@@ -473,6 +473,7 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
     )
     captured = capsys.readouterr()
     assert f"{out} holds 2 stored manoeuvres of this exploration: resuming after" in captured.err
+    assert "the first start prepares" not in captured.err  # it was prepared at the first start
     assert re.search(r"\nmapping the \d estimated contacts: the surface and", captured.err)
     text = captured.out
     assert "3 manoeuvres (" in text and "; after the budget, aimed at recognition 1)" in text
