@@ -261,7 +261,6 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
 @pytest.mark.parametrize(
     ("case", "angles"),
     [
-        ("vertical", "swapped"),  # the elevation read as the azimuth: turn across the push
         ("azimuthal", "halved"),  # a gear ratio read twice too large
         ("vertical", "halved"),
     ],
@@ -270,11 +269,10 @@ def test_angles_that_turn_the_head_less_than_the_link_is_bent_are_a_model_mismat
     request: pytest.FixtureRequest, antenna: Antenna, case: str, angles: str
 ) -> None:
     # A contact that sticks bends the link as far as the head turned into the object since the
-    # touch, one that slides less. Angle columns swapped on a vertical sweep keep the push
-    # opposing the (wrong) turn, so the sign check passes; the 3D point would be placed beside
-    # the object. Halved angles keep every direction and halve the turn.
+    # touch, one that slides over a flat surface less. Halved angles keep every direction, and
+    # the sign check passes, but halve the turn.
     original: Recording = request.getfixturevalue(case)
-    theta = original.theta[:, ::-1] if angles == "swapped" else 0.5 * original.theta
+    theta = 0.5 * original.theta
     recording = dataclasses.replace(original, theta=np.ascontiguousarray(theta))
     for name, result in all_methods(original, antenna).items():
         assert 0.7 < result.diagnostics["bend_per_turn"] < 1.3, name

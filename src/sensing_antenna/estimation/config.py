@@ -231,8 +231,9 @@ class EstimatorConfig:
         t_e (the elastica's y_c at the answer from the measured reaction and the model's
         stiffness) may lie outside what the head's turn into the object makes. A contact that
         sticks bends the link exactly as far as the rigid link's point x_c moved against the
-        push; one sliding with friction up to ``max_friction_ratio``, at an angle phi between
-        the push and that motion, between 1 - mu tan(phi) times as far and as far. The bend
+        push; one sliding over a flat surface with friction up to ``max_friction_ratio``, at an
+        angle phi between the push and that motion, between 1 - mu tan(phi) times as far and
+        as far (a convex surface allows a little more, docs/estimation.md). The bend
         may lie up to this factor above the band or below it: 1.6 covers a calibrated
         sensor's residual cross-talk and a stiffness known to a few percent. Beyond it: forces
         that read high or low (an uncalibrated sensor), a link stiffer than the model, angles

@@ -87,6 +87,9 @@ __all__ = ["review"]
 _RANK = {status: rank for rank, status in enumerate(STATUS_PRECEDENCE)}
 #: Statuses that say the samples are not what the format says: no interval is claimed under them.
 _INPUT_STATUSES = (Status.BAD_INPUT, Status.IMPLAUSIBLE_INPUT)
+#: Least radius (m) of an object's surface the bend check allows a contact to slide over: the
+#: simulator's default post is 10 mm.
+_LEAST_RADIUS = 0.01
 
 
 def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
@@ -533,9 +536,12 @@ def _bend_against_turn(
     reaction R, at an angle phi to -u. A contact that sticks stays where it touched: y = -u,
     phi = 0. One that slides with Coulomb friction mu stays on the surface of normal n,
     y (R^ . n) = -u . n, with R on the friction cone's edge between n and -u; then
-    1 - mu tan(phi) <= y / (-R^ . u) <= 1. Both vectors are taken across the link (X^m at t_e
-    removed), mu is ``max_friction_ratio``, and ``max_bend_per_turn`` widens the band both
-    ways for the forces' scale and the stiffness. The bends are the elastica's y_c of the
+    1 - mu tan(phi) <= y / (-R^ . u) <= 1 on a flat surface. Sliding over a convex one of
+    radius rho moves the contact out along the reaction by up to d^2 / (2 rho), d the head's
+    reach across the push, which the upper bound allows for ``_LEAST_RADIUS`` (a convex
+    surface only raises y, so the lower bound holds). Both vectors are taken across the link
+    (X^m at t_e removed), mu is ``max_friction_ratio``, and ``max_bend_per_turn`` widens the
+    band both ways for the forces' scale and the stiffness. The bends are the elastica's y_c of the
     answer scaled by the contact moment across the link over the moment of the push y_c was
     computed from (``push_force`` times the filtered torque/force ratio at t_e): at t_e the
     mean over the hold's last period of the contact's fundamental, at t_c
@@ -602,17 +608,22 @@ def _bend_against_turn(
         f"from the touch at t_c = {t_c:.3f} s to t_e, while the angles move that point "
         f"{1e3 * turn:.3g} mm against the push"
     )
-    if not turn > 0.0 or least_since > limit * turn:
+    # the head's reach across the push: a contact sliding over a convex object moves out along
+    # its normal by up to that squared over twice the surface's radius
+    reach = float(np.linalg.norm(moved))
+    across = math.sqrt(max(reach**2 - max(turn, 0.0) ** 2, 0.0))
+    curved = across**2 / (2.0 * _LEAST_RADIUS)
+    if not turn > 0.0 or least_since > limit * turn + curved:
         return (
             f"{measured} (a contact that sticks bends the link as far as the head turned into "
-            f"it, one that slides less; up to {limit:g} times is allowed): forces that read "
-            "high for the model's stiffness (the sensor's gain or cross-talk, which antenna "
-            "calibrate fits), a link stiffer than the antenna file says, or angles that do not "
-            "describe the head's turn (columns 'theta1', 'theta2' swapped, a joint read from "
-            "the wrong column, a scale off)"
+            f"it, one that slides over a flat surface less; up to {limit:g} times that, plus "
+            f"{1e3 * curved:.2g} mm for a slide over a surface curved to a radius of "
+            f"{1e3 * _LEAST_RADIUS:g} mm, is allowed): forces that read high for the model's "
+            "stiffness (the sensor's gain or cross-talk, which antenna calibrate fits), a link "
+            "stiffer than the antenna file says, or angles that do not describe the head's turn "
+            "(a joint read from the wrong column, a scale off)"
         )
-    reach = float(np.linalg.norm(moved))
-    tan_phi = math.sqrt(max(reach**2 - turn**2, 0.0)) / turn
+    tan_phi = across / turn
     least = 1.0 - cfg.max_friction_ratio * tan_phi
     if not most_since * limit < least * turn:
         return None
