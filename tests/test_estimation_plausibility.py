@@ -258,15 +258,9 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
     assert results["fast"].diagnostics["interval_dropped"] is not None
 
 
-@pytest.mark.parametrize(
-    ("case", "angles"),
-    [
-        ("azimuthal", "halved"),  # a gear ratio read twice too large
-        ("vertical", "halved"),
-    ],
-)
+@pytest.mark.parametrize("case", ["azimuthal", "vertical"])
 def test_angles_that_turn_the_head_less_than_the_link_is_bent_are_a_model_mismatch(
-    request: pytest.FixtureRequest, antenna: Antenna, case: str, angles: str
+    request: pytest.FixtureRequest, antenna: Antenna, case: str
 ) -> None:
     # A contact that sticks bends the link as far as the head turned into the object since the
     # touch, one that slides over a flat surface less. Halved angles keep every direction, and
@@ -274,6 +268,8 @@ def test_angles_that_turn_the_head_less_than_the_link_is_bent_are_a_model_mismat
     original: Recording = request.getfixturevalue(case)
     theta = 0.5 * original.theta
     recording = dataclasses.replace(original, theta=np.ascontiguousarray(theta))
+    # a sticking contact reads 1; the independent rod engine's right answers read 0.85 to 1.06
+    # (docs/estimation.md), and 0.7 to 1.3 leaves room for this fixture's late detector
     for name, result in all_methods(original, antenna).items():
         assert 0.7 < result.diagnostics["bend_per_turn"] < 1.3, name
     for name, result in all_methods(recording, antenna).items():

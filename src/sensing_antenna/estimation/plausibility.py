@@ -494,7 +494,7 @@ def _untared(evidence: Evidence) -> str:
 
 
 def _bend_at_touch(
-    evidence: Evidence, k: int, bend_over: Any, push: np.ndarray, x_c: float
+    evidence: Evidence, k: int, bend_over: Any, push: np.ndarray, x_c: float, omega1: float
 ) -> tuple[float, float]:
     """The link's bend at t_c (sample ``k``) and its standard error (m, m).
 
@@ -503,8 +503,8 @@ def _bend_at_touch(
     while the touch sets the first two contact modes ringing: the bend from the unfiltered
     contact moment is fitted by least squares with a line in that distance and a sine and a
     cosine at each mode's frequency (the straight link's at x_c), and the line's value at t_c
-    is the bend there. A push shorter than half a period of the fundamental cannot tell the line
-    from the ringing: infinite error."""
+    is the bend there. A push shorter than half a period of the fundamental (``omega1``, rad/s)
+    cannot tell the line from the ringing: infinite error."""
     last = max(evidence.rest_index, k)
     bends = bend_over(k, last)
     axes = motor_axes(evidence.theta[k : last + 1])[:, 0]
@@ -517,8 +517,7 @@ def _bend_at_touch(
         columns += [np.sin(omega * age), np.cos(omega * age)]
     design = np.column_stack(columns)
     free = bends.size - design.shape[1]
-    fundamental = float(sensing_curve(evidence.antenna.link).omega1(x_c))
-    if age[-1] * fundamental >= math.pi and free >= 3 and float(np.ptp(reach)) > 0.0:
+    if age[-1] * omega1 >= math.pi and free >= 3 and float(np.ptp(reach)) > 0.0:
         fit, residual, rank, _ = np.linalg.lstsq(design, bends, rcond=None)
         if rank == design.shape[1] and residual.size:
             covariance = np.linalg.pinv(design.T @ design) * float(residual[0]) / free
@@ -589,7 +588,7 @@ def _bend_against_turn(
     omega = float(sensing_curve(evidence.antenna.link).omega1(estimate.x_c))
     period = max(periods_in(2.0 * math.pi / omega, evidence.sample_period), 1)
     held = float(np.mean(bend_over(max(end - period, evidence.rest_index), end)))
-    touch, error = _bend_at_touch(evidence, k, bend_over, push / norm, estimate.x_c)
+    touch, error = _bend_at_touch(evidence, k, bend_over, push / norm, estimate.x_c, omega)
     # the bend since t_c, and its least and largest values within two standard errors
     since = held - max(touch, 0.0)
     least_since = held - max(touch + 2.0 * error, 0.0)
