@@ -120,6 +120,21 @@ def test_plot_estimate_says_why_figures_13_and_14_are_missing(
     assert "figure13" not in captured.out
 
 
+def test_a_sample_period_the_time_stamps_contradict_is_warned_of(
+    recording_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the stamps 1 ms apart, the metadata says 2 ms: the estimate goes by the stamps and says so
+    off = tmp_path / "off.csv"
+    write_recording(read_recording(recording_file).with_metadata(sample_period="0.002"), off)
+    assert main(["estimate", str(off), "--antenna", "paper-2021-calibrated", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert captured.err.count("\n") == 1 and str(off) in captured.err
+    assert "'sample_period'" in captured.err and "0.001 s" in captured.err
+    assert json.loads(captured.out)["status"] == "ok"
+    assert main(["estimate", str(recording_file), "--antenna", "paper-2021-calibrated"]) == 0
+    assert capsys.readouterr().err == ""
+
+
 def test_a_recording_of_another_antenna_estimated_with_the_default_is_warned_of(
     recording_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -283,6 +283,13 @@ def test_sample_period_falls_back_to_median_when_metadata_inconsistent() -> None
     assert _recording(metadata={"sample_period": "0.00101"}).sample_period == 0.00101
 
 
+def test_a_sample_period_the_time_stamps_contradict_is_named() -> None:
+    problem = _recording(metadata={"sample_period": "0.002"}).period_problem
+    assert problem is not None and "'sample_period'" in problem and "0.5 times" in problem
+    assert _recording(metadata={"sample_period": "0.00101"}).period_problem is None
+    assert _recording(metadata={}).period_problem is None
+
+
 def test_resample_uniform_is_exact_on_linear_signals() -> None:
     # Linear interpolation reproduces a linear signal exactly (to rounding): a clear reference.
     t = 1e-3 * np.delete(np.arange(50), [7, 20, 21]) + np.linspace(0, 2e-5, 47)

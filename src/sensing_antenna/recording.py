@@ -485,6 +485,21 @@ class Recording:
         return _period_of(self.t, self.nominal_period)
 
     @property
+    def period_problem(self) -> str | None:
+        """Why the ``sample_period`` metadata is not the period the estimators use, or None:
+        the time stamps' median step lies more than ``PERIOD_CONSISTENCY`` from it, and the
+        step is used (a file's stamps are the record of when each sample was taken)."""
+        nominal = self.nominal_period
+        used = self.sample_period
+        if nominal is None or used == nominal:
+            return None
+        return (
+            f"field 'sample_period': {format_value(nominal)} s in the metadata, while the time "
+            f"stamps' median step is {used:.6g} s ({used / nominal:.3g} times it); "
+            "the estimators use the step: correct the metadata or the time stamps"
+        )
+
+    @property
     def sampling(self) -> SamplingDiagnostics:
         """Jitter and dropped samples relative to :attr:`sample_period`."""
         return check_sampling(self.t, self.sample_period)

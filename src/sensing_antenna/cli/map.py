@@ -5,12 +5,19 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
-from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sensing_antenna.cli.arguments import distinct_files
-from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, METHOD_NAMES, warn_of_other_antennas
+from sensing_antenna.cli.estimate import (
+    DEFAULT_ANTENNA,
+    METHOD_NAMES,
+    warn_of_contradicted_period,
+    warn_of_other_antennas,
+)
+
+if TYPE_CHECKING:
+    from sensing_antenna.recording import Recording
 
 
 def register(subparsers: Any) -> None:
@@ -118,10 +125,12 @@ def _map_into(args: argparse.Namespace) -> None:
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     unposed: list[str] = []  # recordings without a base pose: in the antenna's own frame
 
-    def read(path: Path, metadata: Mapping[str, str]) -> None:
+    def read(path: Path, recording: Recording) -> None:
+        metadata = recording.metadata
         named.setdefault(metadata.get("antenna", ""), []).append(str(path))
         if not metadata.get(BASE_POSE_KEY, "").strip():
             unposed.append(str(path))
+        warn_of_contradicted_period(path, recording)
 
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"

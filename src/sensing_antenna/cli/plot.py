@@ -8,7 +8,11 @@ from pathlib import Path
 from typing import Any
 
 from sensing_antenna.cli.arguments import add_actions
-from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, warn_of_other_antennas
+from sensing_antenna.cli.estimate import (
+    DEFAULT_ANTENNA,
+    warn_of_contradicted_period,
+    warn_of_other_antennas,
+)
 
 
 def register(subparsers: Any) -> None:
@@ -98,6 +102,7 @@ def _model(args: argparse.Namespace, recording: Any, use: str) -> Any:
     ``antenna`` metadata names another (as ``antenna estimate`` does; ``use`` as there)."""
     from sensing_antenna.antenna import load_antenna
 
+    warn_of_contradicted_period(args.recording, recording)
     if args.antenna is not None:
         return load_antenna(args.antenna)
     antenna = load_antenna(DEFAULT_ANTENNA)

@@ -287,11 +287,11 @@ def map_inputs_from_recordings(
     config: Any = None,
     progress: Callable[[Path], None] | None = None,
     unreadable: Callable[[Path, SensingAntennaError], None] | None = None,
-    read: Callable[[Path, Mapping[str, str]], None] | None = None,
+    read: Callable[[Path, Recording], None] | None = None,
 ) -> tuple[list[ContactPoint], tuple[FreeSpace, Touches]]:
     """:func:`points_from_recordings` and :func:`swept_from_recordings` of the same recordings,
     each read once; ``progress`` is called with each path when it is done, ``read`` with each
-    recording's path and metadata once it is read. With ``unreadable``, a recording that cannot
+    recording's path and the recording once it is read. With ``unreadable``, a recording that cannot
     be read or whose base pose is malformed is handed to it with the error (one line naming the
     file) and left out; without, the error is raised.
 
@@ -317,7 +317,7 @@ def map_inputs_from_recordings(
                 progress(path)
             continue
         if read is not None:
-            read(path, recording.metadata)
+            read(path, recording)
         point = _point(recording, path, pose, antenna, method, uncertainty, config)
         points.append(point)
         links.append(recording_links(recording, antenna, point))
