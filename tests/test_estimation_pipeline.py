@@ -469,6 +469,9 @@ def test_the_gap_limit_is_a_duration_unless_given_in_samples() -> None:
     # 20 ms by default: 20 samples at 1 kHz, 5 at 250 Hz, 40 at 2 kHz, at least one
     default = EstimatorConfig()
     assert [default.gap_limit(ts) for ts in (1e-3, 4e-3, 5e-4, 0.05)] == [20, 5, 40, 1]
+    # a 1 kHz clock read as 999.995 Hz (an importer's fit of the stamps) is still 1 kHz's
+    assert default.gap_limit(1.0 / 999.995) == 20
+    assert default.gap_limit(1.0 / 990.0) == 19  # 1 % slow: 20 samples span 20.2 ms
     assert EstimatorConfig(max_gap=3).gap_limit(4e-3) == 3
     for bad in (0, 2.5, -1, True):
         with pytest.raises(EstimatorConfigError, match=r"max_gap: must be an integer >= 1"):

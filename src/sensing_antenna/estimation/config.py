@@ -11,6 +11,7 @@ from typing import Literal
 
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.recording import CLOCK_TOLERANCE
 
 __all__ = [
     "MAX_GAP_DURATION",
@@ -333,10 +334,12 @@ class EstimatorConfig:
 
     def gap_limit(self, sample_period: float) -> int:
         """Most missing samples in a row filled in at ``sample_period`` (s): ``max_gap``, or
-        as many as span :data:`MAX_GAP_DURATION` (at least one)."""
+        as many as span :data:`MAX_GAP_DURATION` (at least one) on a clock that may run
+        :data:`~sensing_antenna.recording.CLOCK_TOLERANCE` slow (a 1 kHz sensor whose stamps
+        say 999.995 Hz fills 20)."""
         if self.max_gap is not None:
             return self.max_gap
-        return max(1, periods_in(MAX_GAP_DURATION, sample_period))
+        return max(1, periods_in(MAX_GAP_DURATION * (1.0 + CLOCK_TOLERANCE), sample_period))
 
 
 def periods_in(duration: float, sample_period: float) -> int:
