@@ -61,7 +61,7 @@ from sensing_antenna.estimation.methods.fast.static_fit import SensorBias, Stati
 from sensing_antenna.estimation.methods.fast.window import (
     with_early_statics_of,
 )
-from sensing_antenna.estimation.methods.fast.window_fit import Fundamental
+from sensing_antenna.estimation.methods.fast.window_fit import Fundamental, misses_band_peak
 from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_frequency,
     evidence_spectrum,
@@ -1412,6 +1412,25 @@ def test_the_push_must_pass_the_same_checks_be_more_precise_and_agree() -> None:
     assert not push_agrees(through(35.0), from_t1._replace(mode=None), config)
     assert push_agrees(through(35.0, failed=periods), from_t1._replace(failed=periods), config)
     assert not push_agrees(through(35.0, failed=drift), from_t1._replace(failed=periods), config)
+
+
+def test_a_fit_that_leaves_the_bands_clear_peak_unread_is_caught() -> None:
+    # One second of five channels ringing at 80.9 rad/s (the contact's fundamental) and, weaker,
+    # at 101 rad/s (a slide's ring), both in the band: a fit holding only the second leaves the
+    # spectrum's highest peak unread. The Hann window's main lobe is 4 pi / T = 12.6 rad/s
+    # wide on each side, less than the 20 rad/s between the two.
+    n = 1000
+    t = TS * np.arange(n)
+    rng = np.random.default_rng(3)
+    noise = 0.1 * rng.standard_normal((n, 5))
+    rings = np.outer(np.sin(80.9 * t) + 0.6 * np.sin(101.0 * t + 0.4), np.ones(5)) + noise
+    config = FastConfig()
+    assert BAND[0] < 80.9 < 101.0 < BAND[1]
+    assert misses_band_peak(rings, _fit([101.0], n_samples=n), TS, BAND, config)
+    assert misses_band_peak(rings, None, TS, BAND, config)
+    assert not misses_band_peak(rings, _fit([81.5, 101.0], n_samples=n), TS, BAND, config)
+    # noise alone holds no clear peak to read
+    assert not misses_band_peak(noise, _fit([101.0], n_samples=n), TS, BAND, config)
 
 
 def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window() -> None:

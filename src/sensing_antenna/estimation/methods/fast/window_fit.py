@@ -8,7 +8,8 @@ with the head's angle along the push as a regressor and every mode restarted at 
 cached by the window's own samples (:data:`FitCache`), so a cache never serves a fit of other
 data. :func:`measure_fundamental` finds the fundamental in the fit and widens its standard
 error by the drift check (:func:`.checks.drift_check`) against the grid window of 2/3 the
-length.
+length; a fit that leaves the window's clear spectral peak in the band unread
+(:func:`misses_band_peak`) is not declared on.
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ __all__ = [
     "find_fundamental",
     "fit_window",
     "measure_fundamental",
+    "misses_band_peak",
     "push_phase",
     "window_key",
 ]
@@ -141,7 +143,7 @@ def fit_window(
     starts every candidate from the solutions of its drift check's reference window
     (:mod:`.warm_start`), fitted first (and cached) when not at hand, and tries
     ``long_window_min_modes`` modes or more; from the matrix pencil as well, the smaller BIC
-    kept, when that fit misses the band's clear spectral peak (:func:`_misses_band_peak`).
+    kept, when that fit misses the band's clear spectral peak (:func:`misses_band_peak`).
     """
     span = WindowSpan(
         channels, rest_index, end_index, sample_period, band, config, {} if cache is None else cache
@@ -198,7 +200,7 @@ def _fit_and_solutions(
         if (
             warm is not None
             and fits_at_all
-            and _misses_band_peak(signals, result[0], sample_period, band, config)
+            and misses_band_peak(signals, result[0], sample_period, band, config)
         ):
             # Started where a shorter window's fits were, the fit does not read the window's
             # clear vibration in the band (a window too short to part two close modes
@@ -216,12 +218,13 @@ def _fit_and_solutions(
 
 
 #: Power over the band's median a spectral peak needs before a fit is asked to read it
-#: (:func:`_misses_band_peak`): the paper method's clear peak, its default
-#: ``min_peak_quality``. A false alarm costs one more set of fits, nothing else.
+#: (:func:`misses_band_peak`): the paper method's clear peak, its default
+#: ``min_peak_quality``. A false alarm costs one more set of fits and leaves the window
+#: undeclared on (:func:`measure_fundamental`); a longer window sharpens the spectrum.
 _CLEAR_PEAK = EstimatorConfig.min_peak_quality
 
 
-def _misses_band_peak(
+def misses_band_peak(
     signals: FloatArray,
     fit: DampedSinusoidFit | None,
     sample_period: float,
@@ -322,7 +325,9 @@ class Fundamental(NamedTuple):
     notes : tuple of str
         Why the fundamental cannot be declared on (empty when every check passed).
     failed : frozenset of str
-        The checks that failed: "fundamental", "periods", "drift_reference".
+        The checks that failed: "fundamental", "periods", "band_peak" (no detected mode at
+        the window's clear spectral peak in the band, :func:`misses_band_peak`),
+        "drift_reference".
     """
 
     fit: DampedSinusoidFit | None
@@ -368,6 +373,14 @@ def measure_fundamental(
         if note:
             notes.append(note)
             failed.add("periods")
+        window = span.channels[span.rest_index : span.end_index + 1]
+        if misses_band_peak(window, fit, span.sample_period, band, config):
+            # A clear vibration of the band that no detected mode reads: the fundamental
+            # found may be another vibration (a slide's ring) beside the contact's own
+            notes.append(
+                "the fit leaves the window's clear spectral peak in the omega_1 band unread"
+            )
+            failed.add("band_peak")
         # The same fundamental on a window of 2/3 the length: its change measures how far
         # unmodelled content still moves the estimate (drift_factor times it, in quadrature)
         ref = reference_index(
