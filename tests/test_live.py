@@ -44,7 +44,7 @@ from sensing_antenna.live.wire import (
     decode_datagram,
     pack_samples,
 )
-from sensing_antenna.recording import Recording, read_recording
+from sensing_antenna.recording import Recording, RecordingError, read_recording
 
 CASES = {"azimuthal": 0.6, "vertical": 0.7}
 
@@ -403,6 +403,29 @@ def test_a_stream_too_short_to_tell_its_jitter_keeps_the_period_s_2_percent(
         events = _listen([line.encode() for line in lines])
         found = [e for e in events if isinstance(e, EstimateEvent)]
         assert [e.to_dict()["status"] for e in found] == ["recording_too_short"]
+
+
+def test_a_last_line_cut_short_ends_the_recording_with_its_estimate(
+    recordings: dict[str, Path],
+) -> None:
+    # a logger stopped in the middle of a line: the line has no line end and too few cells
+    recording = read_recording(recordings["azimuthal"])
+    lines = _lines(recording)
+    events: list[Event] = []
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, paper_antenna(), events.append, "paper", number=number)
+
+    with pytest.raises(RecordingError, match=r"<stdin>:\d+: expected .*truncated last line"):
+        listen_lines([*lines[:-1], lines[-1][:12]], make)
+    found, end = (e for e in events if isinstance(e, EstimateEvent | EndEvent))
+    assert isinstance(found, EstimateEvent) and isinstance(end, EndEvent)
+    assert end.reason == "end of input" and end.samples == recording.n_samples - 1
+    whole = estimate(recording.without_ground_truth(), paper_antenna(), method="paper")
+    assert found.to_dict()["x_c"] == pytest.approx(whole.x_c, abs=1e-3)
+    # a line that ends is malformed, not cut short
+    with pytest.raises(RecordingError, match=r"expected \d+ cells, found 2$"):
+        listen_lines([*lines[:-1], lines[-1][:12] + b"\n"], make)
 
 
 def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:

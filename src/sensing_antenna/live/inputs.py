@@ -69,7 +69,8 @@ def listen_lines(
     ------
     RecordingError
         At the first malformed line, naming ``source`` and the line: the recording being
-        received is closed without a final estimate.
+        received is closed without a final estimate, unless the line is the input's last, cut
+        short (no line end): the recording then ends before it, with its final estimate.
     """
     pending: list[str] = []
     pending_first = 0
@@ -98,7 +99,22 @@ def listen_lines(
                 pending = []
                 current, last_t = make(header, ended + 1), None
                 continue
-            values = parse_sample(line, current.header, number)
+            try:
+                values = parse_sample(line, current.header, number)
+            except RecordingError as exc:
+                if raw.endswith(b"\n" if isinstance(raw, bytes) else "\n"):
+                    raise
+                # the input's last line, cut short (a logger stopped mid-line): the recording
+                # ends before it, with its final estimate, and the line is named
+                current.close("end of input")
+                current, ended = None, ended + 1
+                raise RecordingError(
+                    source,
+                    number,
+                    exc.field,
+                    f"{exc.problem} (truncated last line: left out, the recording ended "
+                    "before it)",
+                ) from None
             t = values[current.header.required("t")]
             if last_t is not None and not t > last_t:
                 raise RecordingError(
