@@ -80,7 +80,8 @@ def listen_lines(
     try:
         for number, raw in enumerate(lines, start=1):
             received = clock()
-            line = _text(raw, source, number).rstrip("\r\n")
+            text = _text(raw, source, number)
+            line = text.rstrip("\r\n")
             if not line.strip():
                 continue
             if line.startswith("#"):
@@ -102,7 +103,7 @@ def listen_lines(
             try:
                 values = parse_sample(line, current.header, number)
             except RecordingError as exc:
-                if raw.endswith(b"\n" if isinstance(raw, bytes) else "\n"):
+                if text.endswith("\n"):
                     raise
                 # the input's last line, cut short (a logger stopped mid-line): the recording
                 # ends before it, with its final estimate, and the line is named
@@ -112,8 +113,7 @@ def listen_lines(
                     source,
                     number,
                     exc.field,
-                    f"{exc.problem} (truncated last line: left out, the recording ended "
-                    "before it)",
+                    f"{exc.problem} (truncated last line: left out, the recording ended before it)",
                 ) from None
             t = values[current.header.required("t")]
             if last_t is not None and not t > last_t:
