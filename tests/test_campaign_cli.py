@@ -70,7 +70,7 @@ def test_campaign_run_reports_a_bad_spec_on_one_line(
     )
     assert main(["campaign", "run", str(spec), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip()
-    assert err == f"antenna campaign: error: {spec}: repeats: must be >= 1, got 0"
+    assert err == f"antenna campaign run: error: {spec}: repeats: must be >= 1, got 0"
 
 
 def test_campaign_report_on_a_non_campaign_directory_fails_cleanly(
@@ -138,5 +138,6 @@ def test_campaign_run_exits_non_zero_while_runs_are_left_failed(
     captured = capsys.readouterr()
     assert captured.out.splitlines()[0] == "2 runs: 2 already done, 0 run now, 1 failed"
     assert captured.err.splitlines() == [
-        "antenna campaign: 1 run(s) failed (listed in the report); --retry-failed runs them again"
+        "antenna campaign run: 1 run(s) failed (listed in the report); "
+        "--retry-failed runs them again"
     ]

@@ -218,8 +218,8 @@ def test_a_signal_to_the_main_process_alone_stops_it_and_keeps_every_finished_ru
     assert process.returncode == exit_code
     n_stored = len(stored_runs(out))
     assert err.splitlines() == [
-        f"antenna campaign: interrupted by {stop.name}: {n_stored} of {N_SHORT} runs are stored in "
-        f"{out}; the same command again runs the others"
+        f"antenna campaign run: interrupted by {stop.name}: {n_stored} of {N_SHORT} runs are "
+        f"stored in {out}; the same command again runs the others"
     ]
     assert all_gone(workers, within=5.0), "a worker outlived its campaign"
     before = {p.name: p.stat().st_mtime_ns for p in stored_runs(out)}
@@ -267,7 +267,7 @@ def test_a_second_campaign_on_the_same_directory_is_refused_and_runs_nothing(
     assert second.returncode == 2
     assert printed == ""
     assert err.startswith(
-        f"antenna campaign: error: {out}: in use by another campaign (process {first.pid} on "
+        f"antenna campaign run: error: {out}: in use by another campaign (process {first.pid} on "
     )
     printed, err = first.communicate(timeout=300)
     assert first.returncode == 0, err

@@ -232,7 +232,7 @@ def test_an_interrupted_campaign_says_what_it_keeps(tmp_path: Path) -> None:
         name = signal.Signals(signal_number).name
         assert re.fullmatch(
             # before the campaign has begun (still importing), or while it sets up or runs
-            rf"antenna campaign: (interrupted|stopped by {name}|interrupted by {name}"
+            rf"antenna campaign run: (interrupted|stopped by {name}|interrupted by {name}"
             rf"(: \d+ of \d+ runs are stored in {re.escape(str(tmp_path / 'out'))}; the same "
             r"command again runs the others| before any run))",
             done.stderr.strip(),

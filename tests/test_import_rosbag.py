@@ -418,14 +418,14 @@ def test_a_missing_topic_is_one_line_naming_the_bag_and_the_topic(
     bag: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     err = _run(_import(bag, "--wrench", "/wrench", "--joints", JOINTS), capsys)
-    assert err.startswith(f"antenna import: error: {bag}: no topic '/wrench'")
+    assert err.startswith(f"antenna import rosbag: error: {bag}: no topic '/wrench'")
     assert WRENCH in err and JOINTS in err  # the topics the bag has
 
 
 def test_a_topic_of_another_type_is_one_line(bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
     err = _run(_import(bag, "--wrench", JOINTS, "--joints", WRENCH), capsys)
     assert err == (
-        f"antenna import: error: {bag}: topic {JOINTS!r}: message type"
+        f"antenna import rosbag: error: {bag}: topic {JOINTS!r}: message type"
         " sensor_msgs/msg/JointState, expected geometry_msgs/msg/WrenchStamped"
     )
 
@@ -446,7 +446,7 @@ def test_streams_that_do_not_overlap_are_refused(
     stamps = EPOCH_NS + np.arange(20, dtype=np.int64) * 1_000_000
     bag = _write_bag(_bag_path(tmp_path, 2), short, 2, wrench_ns=stamps, joints_ns=stamps + 10**9)
     err = _run(_import(bag, "--wrench", WRENCH, "--joints", JOINTS), capsys)
-    assert err.startswith(f"antenna import: error: {bag}: {WRENCH!r} (")
+    assert err.startswith(f"antenna import rosbag: error: {bag}: {WRENCH!r} (")
     assert err.endswith("do not overlap in time")
 
 
@@ -455,16 +455,16 @@ def test_a_missing_joint_and_a_missing_bag_are_one_line(
 ) -> None:
     err = _run(_import(bag, "--wrench", WRENCH, "--joints", JOINTS, "--joint2", "elbow"), capsys)
     assert err == (
-        f"antenna import: error: {bag}: topic {JOINTS!r}: 0 message(s) name both joints 'pan'"
-        " and 'elbow', at least 2 needed (the topic's joints: 'pan', 'tilt')"
+        f"antenna import rosbag: error: {bag}: topic {JOINTS!r}: 0 message(s) name both joints"
+        " 'pan' and 'elbow', at least 2 needed (the topic's joints: 'pan', 'tilt')"
     )
     missing = bag.parent / "nothing"
     err = _run(_import(missing, "--wrench", WRENCH, "--joints", JOINTS), capsys)
-    assert err == f"antenna import: error: {missing}: no such file or directory"
+    assert err == f"antenna import rosbag: error: {missing}: no such file or directory"
     text = bag.parent / "notes.bag"
     text.write_text("not a bag\n")
     err = _run(_import(text, "--wrench", WRENCH, "--joints", JOINTS), capsys)
-    assert err.startswith(f"antenna import: error: {text}: not a readable ROS 1 .bag file")
+    assert err.startswith(f"antenna import rosbag: error: {text}: not a readable ROS 1 .bag file")
 
 
 def test_without_rosbags_the_command_says_what_to_install(
@@ -474,7 +474,7 @@ def test_without_rosbags_the_command_says_what_to_install(
         monkeypatch.setitem(sys.modules, name, None)  # an import of it now fails
     err = _run(_import(bag, "--wrench", WRENCH, "--joints", JOINTS), capsys)
     assert err == (
-        "antenna import: error: reading ROS bags needs the rosbags library:"
+        "antenna import rosbag: error: reading ROS bags needs the rosbags library:"
         " pip install 'sensing-antenna[ros]'"
     )
 
@@ -495,7 +495,7 @@ def test_sensor_axes_must_be_a_rotation(
     with pytest.raises(AxesError, match=problem):
         SensorAxes(axes)
     err = _run(_import(bag, "--wrench", WRENCH, "--joints", JOINTS, "--frame", axes), capsys)
-    assert err.startswith(f"antenna import: error: --frame: {axes!r}: ")
+    assert err.startswith(f"antenna import rosbag: error: --frame: {axes!r}: ")
 
 
 def test_the_command_s_help_names_the_estimators_gap(capsys: pytest.CaptureFixture[str]) -> None:

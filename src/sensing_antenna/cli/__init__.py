@@ -201,9 +201,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                     parser.reject_unknown(extras)
                 parser.print_help()
                 return EXIT_BAD_INPUT
+            leaf = parser.leaf(sys.argv[1:] if argv is None else argv)
             if extras:
-                parser.leaf(sys.argv[1:] if argv is None else argv).reject_unknown(extras)
-            prog = f"{parser.prog} {args.command}"
+                leaf.reject_unknown(extras)
+            prog = leaf.prog  # "antenna import rosbag", as argparse's own errors name it
             forget_signals()
             try:
                 code = int(args.func(args))

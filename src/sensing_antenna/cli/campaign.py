@@ -104,7 +104,7 @@ def _run(args: argparse.Namespace) -> int:
     if foreign:
         more = f" and {len(foreign) - 10} more" if len(foreign) > 10 else ""
         print(
-            f"antenna campaign: left out {len(foreign)} run file(s) in "
+            f"antenna campaign run: left out {len(foreign)} run file(s) in "
             f"{outcome.out_dir / 'runs'} that are not runs of this spec: "
             f"{', '.join(foreign[:10])}{more}",
             file=sys.stderr,
@@ -112,7 +112,7 @@ def _run(args: argparse.Namespace) -> int:
     print(build_report(outcome.out_dir))
     if outcome.n_failed:
         print(
-            f"antenna campaign: {outcome.n_failed} run(s) failed (listed in the report); "
+            f"antenna campaign run: {outcome.n_failed} run(s) failed (listed in the report); "
             "--retry-failed runs them again",
             file=sys.stderr,
         )
