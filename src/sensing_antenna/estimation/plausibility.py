@@ -475,8 +475,9 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
         f"columns 'theta1', 'theta2', 'fx', 'fy', 'fz': the mean contact force over the hold "
         f"{_vector(reaction)} N does not oppose the head's turn into the contact "
         f"({_vector(turn)} rad from t_c to t_1); an obstacle can only push back: a sign "
-        "flipped in an angle or in the forces, or forces read wrong by as much as the push "
-        "(cross-talk from the torques, an offset)?"
+        "flipped in an angle or in the forces, the two angles swapped or one read from another "
+        "joint (the joint mapping), or forces read wrong by as much as the push (cross-talk "
+        "from the torques, an offset)?"
     )
 
 
