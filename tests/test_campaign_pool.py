@@ -276,6 +276,22 @@ def test_a_second_campaign_on_the_same_directory_is_refused_and_runs_nothing(
     assert len(stored_runs(out)) == 40
 
 
+def test_a_bar_opened_on_its_first_item_shows_nothing_for_work_not_done() -> None:
+    import io
+
+    from sensing_antenna.campaign.progress import Progress
+
+    for items in (0, 2):
+        stream = io.StringIO()
+        with Progress(enabled=True, stream=stream).bar_from_first(7, "recognising", "shape") as bar:
+            for _ in range(items):
+                bar()
+        if items:
+            assert "recognising" in stream.getvalue() and "2/7" in stream.getvalue()
+        else:
+            assert stream.getvalue() == ""
+
+
 def test_progress_bars_start_no_thread_in_the_process_that_forks_the_workers() -> None:
     import io
     import threading

@@ -9,6 +9,7 @@ with theirs. Lines go through ``tqdm.write`` so that they never break a bar. A d
 from __future__ import annotations
 
 import sys
+from types import TracebackType
 from typing import TextIO
 
 from tqdm import tqdm
@@ -58,3 +59,34 @@ class Progress:
             file=self.stream,
             disable=not self.enabled,
         )
+
+    def bar_from_first(self, total: int, description: str, unit: str) -> OpenedOnFirst:
+        """:meth:`bar`, opened when its first item is done (work that may not happen shows
+        none): call the result with each item, use it as a context manager."""
+        return OpenedOnFirst(self, total, description, unit)
+
+
+class OpenedOnFirst:
+    """A :meth:`Progress.bar` opened at its first item (see :meth:`Progress.bar_from_first`)."""
+
+    def __init__(self, progress: Progress, total: int, description: str, unit: str) -> None:
+        self._opening = (progress, total, description, unit)
+        self._bar: tqdm | None = None
+
+    def __call__(self, _item: object = None) -> None:
+        if self._bar is None:
+            progress, total, description, unit = self._opening
+            self._bar = progress.bar(total, description, unit)
+        self._bar.update(1)
+
+    def __enter__(self) -> OpenedOnFirst:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        value: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        if self._bar is not None:
+            self._bar.close()

@@ -108,16 +108,18 @@ def register(subparsers: Any) -> None:
         ),
     )
     add_map_options(parser, "the map and the planner's surface")
-    parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre")
+    parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre, no progress bar")
     parser.set_defaults(func=_run)
 
 
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
+    from sensing_antenna.campaign.progress import Progress
     from sensing_antenna.cli.map import read_objects, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
     from sensing_antenna.exploration.run import stopped_as_stored
     from sensing_antenna.exploration.store import SETTINGS_FILE
+    from sensing_antenna.mapping import PRIMITIVES
     from sensing_antenna.scene import load_scene
 
     if args.device_profile == "nominal" and args.device_build is not None:
@@ -196,9 +198,19 @@ def _run(args: argparse.Namespace) -> int:
             flush=True,
         )
 
-    result = explore(
-        scene, device, args.out, settings, None if args.quiet else show, meshes, mapping, resuming
-    )
+    shapes = len(PRIMITIVES) + len(meshes or {})
+    with Progress(not args.quiet).bar_from_first(shapes, "recognising", "shape") as bar:
+        result = explore(
+            scene,
+            device,
+            args.out,
+            settings,
+            None if args.quiet else show,
+            meshes,
+            mapping,
+            resuming,
+            bar,
+        )
     summary = result.summary()
     (args.out / "exploration.json").write_text(json.dumps(summary, indent=2) + "\n")
     outcomes = ", ".join(f"{k} {v}" for k, v in sorted(summary["outcomes"].items()))

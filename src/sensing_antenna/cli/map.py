@@ -117,7 +117,7 @@ def _map_into(args: argparse.Namespace) -> None:
     from sensing_antenna.campaign.progress import Progress
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.mapping import build_map, map_inputs_from_recordings
+    from sensing_antenna.mapping import PRIMITIVES, build_map, map_inputs_from_recordings
     from sensing_antenna.mapping.pose import BASE_POSE_KEY
 
     meshes = read_objects(args.objects, "antenna map")
@@ -153,7 +153,11 @@ def _map_into(args: argparse.Namespace) -> None:
         raise SensingAntennaError(f"{left_out[0]}{more}")
     for problem in left_out:  # one line each; the map is made of the others
         print(f"antenna map: warning: left out {problem}", file=sys.stderr)
-    contact_map = build_map(points, args.include_uncertain, meshes=meshes, swept=swept)
+    shapes = len(PRIMITIVES) + len(meshes or {})
+    with Progress(not args.no_progress).bar_from_first(shapes, "recognising", "shape") as bar:
+        contact_map = build_map(
+            points, args.include_uncertain, meshes=meshes, swept=swept, class_fitted=bar
+        )
     report_map(contact_map, args.out)
 
 

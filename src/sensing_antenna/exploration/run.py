@@ -570,6 +570,7 @@ def explore(
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
     mapping: Callable[[int], None] | None = None,
     resuming: Callable[[int], None] | None = None,
+    class_fitted: Callable[[str], None] | None = None,
 ) -> Exploration:
     """Explore ``scene`` with the simulated ``device``, storing everything in ``out``.
 
@@ -592,6 +593,9 @@ def explore(
     resuming : callable, optional
         Called with the number of manoeuvres ``out`` holds, when it holds some and its settings
         are these (the exploration goes on after them).
+    class_fitted : callable, optional
+        Called with each shape class's name as the map's recognition fits it (none when the
+        recognition that ended the sweeps is kept).
 
     Raises
     ------
@@ -701,7 +705,12 @@ def explore(
         # sweeps has weighed them already
         swept = () if final is not None else swept_links(manoeuvres, scene, antenna, out, recorded)
         contact_map = build_map(
-            points, settings.include_uncertain, meshes=meshes, swept=swept, recognition=final
+            points,
+            settings.include_uncertain,
+            meshes=meshes,
+            swept=swept,
+            recognition=final,
+            class_fitted=class_fitted,
         )
     return Exploration(scene, settings, tuple(manoeuvres), contact_map, antenna)
 

@@ -365,12 +365,14 @@ def build_map(
     rng: np.random.Generator | None = None,
     swept: Sequence[FreeSpace] = (),
     recognition: Recognition | None = None,
+    class_fitted: Callable[[str], None] | None = None,
 ) -> ContactMap:
     """The map from points (module docstring); the surface and recognition when possible,
     recognition also weighing ``swept``, where links swept untouched and where they touched.
     ``surface`` (its settings) is fitted to the points as :func:`fit_surface` fits it;
     ``recognition``, when given, is one already made of the same points, swept links and
-    meshes, and is kept (``rng`` then unused)."""
+    meshes, and is kept (``rng`` then unused); otherwise ``class_fitted`` is called with each
+    class's name as recognition fits it (:func:`.recognition.recognise`)."""
     used = select_points(list(points), include_uncertain)
     fitted = fit_surface(used, True, surface)
     mesh = None
@@ -378,7 +380,7 @@ def build_map(
     if fitted is not None:
         mesh, std = fitted.mesh()
     if recognition is None:
-        recognition = recognise_points(used, True, meshes, rng, swept)
+        recognition = recognise_points(used, True, meshes, rng, swept, class_fitted)
     return ContactMap(
         points=tuple(points),
         used=tuple(used),
@@ -412,9 +414,11 @@ def recognise_points(
     meshes: Mapping[str, trimesh.Trimesh] | None = None,
     rng: np.random.Generator | None = None,
     swept: Sequence[FreeSpace] = (),
+    class_fitted: Callable[[str], None] | None = None,
 ) -> Recognition | None:
     """The recognition of the points a map uses (None with fewer than
-    :data:`MIN_RECOGNITION_POINTS`), the mean direction to their bases the outer side."""
+    :data:`MIN_RECOGNITION_POINTS`), the mean direction to their bases the outer side;
+    ``class_fitted`` as in :func:`.recognition.recognise`."""
     used = select_points(list(points), include_uncertain)
     if len(used) < MIN_RECOGNITION_POINTS:
         return None
@@ -423,7 +427,14 @@ def recognise_points(
     bases = np.array([c.base_position for c in used]).reshape(-1, 3)
     outward = (bases - p).mean(axis=0)
     return recognise(
-        p, cov, meshes=meshes, outward=outward, rng=rng, lines=link_lines(used), swept=swept
+        p,
+        cov,
+        meshes=meshes,
+        outward=outward,
+        rng=rng,
+        lines=link_lines(used),
+        swept=swept,
+        class_fitted=class_fitted,
     )
 
 

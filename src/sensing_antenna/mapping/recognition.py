@@ -1880,6 +1880,7 @@ def recognise(
     rng: np.random.Generator | None = None,
     lines: LinkLines | None = None,
     swept: Sequence[FreeSpace] = (),
+    class_fitted: Callable[[str], None] | None = None,
 ) -> Recognition:
     """Fit every class (and mesh) to the points and decide (module docstring).
 
@@ -1904,6 +1905,8 @@ def recognise(
         The link's line at each contact (module docstring).
     swept : sequence of FreeSpace
         Where links swept untouched and where they touched (module docstring).
+    class_fitted : callable, optional
+        Called with each class's (or mesh's) name once it is fitted: a progress display's hook.
     """
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     cov = np.asarray(covariances, dtype=float).reshape(-1, 3, 3)
@@ -1911,9 +1914,15 @@ def recognise(
         raise ValueError(f"recognition needs at least 10 points, got {len(p)}")
     generator = rng if rng is not None else np.random.default_rng(0)
     names = list(classes) if classes is not None else list(PRIMITIVES)
-    fits = [fit_primitive(name, p, cov, outward, generator, lines, swept) for name in names]
+    fits = []
+    for name in names:
+        fits.append(fit_primitive(name, p, cov, outward, generator, lines, swept))
+        if class_fitted is not None:
+            class_fitted(name)
     for name, mesh in (meshes or {}).items():
         fits.append(fit_mesh(name, mesh, p, cov, generator, lines=lines, swept=swept))
+        if class_fitted is not None:
+            class_fitted(name)
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
     tightest = min(fits, key=lambda f: f.chi2)
     c = max(1.0, tightest.chi2 / max(tightest.counted - tightest.dof, 1.0))
