@@ -15,6 +15,7 @@ from _map_html import html_scene
 from _models import calibrated
 from sensing_antenna.antenna import save_antenna
 from sensing_antenna.cli import main
+from sensing_antenna.cli.map import read_objects
 from sensing_antenna.mapping import (
     BasePose,
     map_inputs_from_recordings,
@@ -134,8 +135,8 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
         ("missing", "absent.csv: cannot read file"),
         ("pose", "base_pose: not JSON"),
         ("mesh", "junk.stl: "),
-        # a mesh in mm: --objects has no scale to give, unlike a scene
-        ("mesh in mm", "a thousand times too large; --objects reads metres"),
+        # a mesh in mm read as metres: the message names the option that reads it
+        ("mesh in mm", "a thousand times too large; give the file's unit with --objects-unit"),
         ("out is a file", "out: File exists (a file where a directory is to be made?)"),
     ],
 )
@@ -184,6 +185,20 @@ def test_an_open_mesh_is_registered_with_a_warning(
     assert main([*argv, "--objects", str(mesh)]) == 0
     err = capsys.readouterr().err
     assert f"antenna map: warning: {mesh}: the mesh is not closed (watertight): points on" in err
+
+
+def test_a_mesh_in_millimetres_is_read_with_its_unit(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    box = trimesh.creation.box(extents=[0.06, 0.1, 0.14])
+    box.apply_scale(1000.0)  # a CAD export: 60 x 100 x 140 mm
+    mesh = tmp_path / "box_mm.stl"
+    box.export(mesh)
+    read = read_objects([mesh], "antenna map", "mm")["box_mm"]
+    assert np.allclose(sorted(read.extents), [0.06, 0.1, 0.14], rtol=1e-9)
+    argv = ["map", str(recordings[0]), "--out", str(tmp_path / "out"), "--no-progress"]
+    assert main([*argv, "--objects", str(mesh), "--objects-unit", "mm"]) == 0
+    assert capsys.readouterr().err == ""
 
 
 def test_a_bad_recording_among_good_ones_is_left_out_in_one_line(

@@ -108,7 +108,9 @@ def register(subparsers: Any) -> None:
         ),
     )
     add_map_options(parser, "the map and the planner's surface")
-    parser.add_argument("--quiet", action="store_true", help="no line per manoeuvre, no progress bar")
+    parser.add_argument(
+        "--quiet", action="store_true", help="no line per manoeuvre, no progress bar"
+    )
     parser.set_defaults(func=_run)
 
 
@@ -133,7 +135,7 @@ def _run(args: argparse.Namespace) -> int:
         )
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)
-    meshes = read_objects(args.objects, "antenna explore")
+    meshes = read_objects(args.objects, "antenna explore", args.objects_unit)
     settings = ExploreSettings(
         method=args.method,
         strategy=args.strategy,

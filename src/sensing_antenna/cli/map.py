@@ -56,18 +56,25 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(func=_run)
 
 
+#: The units ``--objects-unit`` reads a mesh file's coordinates in, as metres per unit.
+OBJECTS_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
+
 #: How ``--objects`` meshes in other units are to be read, for the size check's message.
-OBJECTS_UNIT_HINT = "--objects reads metres: write the file in metres"
+OBJECTS_UNIT_HINT = "give the file's unit with --objects-unit, e.g. --objects-unit mm"
 
 
-def read_objects(paths: Any, command: str) -> dict[str, Any]:
-    """The ``--objects`` meshes by file stem; one that is not closed is read with a warning on
-    stderr (a scan open where it stood: points on its missing faces count against it)."""
+def read_objects(paths: Any, command: str, unit: str = "m") -> dict[str, Any]:
+    """The ``--objects`` meshes by file stem, their coordinates read in ``unit`` (a key of
+    :data:`OBJECTS_UNITS`) and scaled to metres; one that is not closed is read with a warning
+    on stderr (a scan open where it stood: points on its missing faces count against it)."""
     from sensing_antenna.scene.objects import read_mesh
 
+    scale = OBJECTS_UNITS[unit]
     meshes = {}
     for path in paths:
-        mesh = read_mesh(path, unit_hint=OBJECTS_UNIT_HINT, closed=False)
+        mesh = read_mesh(path, scale, unit_hint=OBJECTS_UNIT_HINT, closed=False)
+        if scale != 1.0:
+            mesh.apply_scale(scale)
         if not mesh.is_watertight:
             print(
                 f"{command}: warning: {path}: the mesh is not closed (watertight): points on"
@@ -86,8 +93,14 @@ def add_map_options(parser: Any, uncertain_into: str) -> None:
         type=Path,
         default=(),
         metavar="MESH",
-        help="meshes (STL, OBJ, PLY; m; closed, else a warning) to register to the points "
+        help="meshes (STL, OBJ, PLY; closed, else a warning) to register to the points "
         "beside the shape classes",
+    )
+    parser.add_argument(
+        "--objects-unit",
+        choices=tuple(OBJECTS_UNITS),
+        default="m",
+        help="the unit of the --objects files' coordinates (a CAD export is often in mm)",
     )
     parser.add_argument(
         "--include-uncertain",
@@ -120,7 +133,7 @@ def _map_into(args: argparse.Namespace) -> None:
     from sensing_antenna.mapping import PRIMITIVES, build_map, map_inputs_from_recordings
     from sensing_antenna.mapping.pose import BASE_POSE_KEY
 
-    meshes = read_objects(args.objects, "antenna map")
+    meshes = read_objects(args.objects, "antenna map", args.objects_unit)
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     unposed: list[str] = []  # recordings without a base pose: in the antenna's own frame
