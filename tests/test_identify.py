@@ -222,12 +222,17 @@ def test_angles_in_degrees_are_refused(simulated_free: Recording) -> None:
     assert str(raised.value).startswith(f"{simulated_free.source}: columns 'theta1'")
 
 
-def test_time_in_milliseconds_is_named(simulated_free: Recording) -> None:
-    # the motion read a thousand times slower: the fitted inertia a million times the rigid
-    # link's, which angles in degrees (1/57) or torques scaled by a unit cannot give
-    in_ms = dataclasses.replace(simulated_free, t=1000.0 * simulated_free.t)
-    with pytest.raises(IdentificationError, match=r"time stamps in ms\? the format's are in s$"):
-        identify_free_motion(in_ms, ANTENNA)
+@pytest.mark.parametrize(("unit", "per_second"), [("ms", 1e3), ("us", 1e6)])
+def test_time_in_milliseconds_is_named(
+    simulated_free: Recording, unit: str, per_second: float
+) -> None:
+    # the motion read a thousand (a million) times slower: the fitted inertia a million (1e12)
+    # times the rigid link's, which angles in degrees (1/57) or torques scaled by a unit cannot
+    # give
+    slow = dataclasses.replace(simulated_free, t=per_second * simulated_free.t)
+    match = rf"time stamps in {unit}\? the format's are in s$"
+    with pytest.raises(IdentificationError, match=match):
+        identify_free_motion(slow, ANTENNA)
 
 
 def _glitch(recording: Recording) -> Recording:

@@ -19,6 +19,7 @@ The estimation front end (at t_c, on the window its tare averages), ``antenna id
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,7 @@ __all__ = [
     "REST_FORCE_FRACTION",
     "REST_TORQUE_FRACTION",
     "TARE_NOISES",
+    "TIME_UNITS",
     "RestReading",
     "angle_problem",
     "initial_rest",
@@ -40,9 +42,21 @@ __all__ = [
     "recording_problem",
     "rest_moment_std",
     "rest_reading",
+    "stamps_unit",
 ]
 
 FloatArray = NDArray[np.float64]
+
+#: Units a logger may write time stamps in, each with how many of it make a second.
+TIME_UNITS = (("ms", 1e3), ("us", 1e6), ("ns", 1e9))
+
+
+def stamps_unit(fits: Callable[[float], bool]) -> str | None:
+    """The first of :data:`TIME_UNITS` whose count per second, taken as the factor by which
+    stamps read as seconds stretch time, makes ``fits`` true: the unit such stamps were likely
+    written in; None when none does."""
+    return next((name for name, per_second in TIME_UNITS if fits(per_second)), None)
+
 
 #: Largest accepted distance |Gamma_rest - Gamma_g^m| as a fraction of the weight's moment
 #: m_b g l / 2 + m_t g l. A scale or unit error of the torques is a factor 2 or more (50 % of

@@ -62,6 +62,7 @@ from sensing_antenna.units_check import (
     recording_problem,
     rest_moment_std,
     rest_reading,
+    stamps_unit,
 )
 
 __all__ = [
@@ -315,14 +316,15 @@ def _check_inertia(inertia: float, rigid: float, where: str) -> None:
     if 1.0 / MAX_INERTIA_FACTOR <= inertia / rigid <= MAX_INERTIA_FACTOR:
         return
     # time in ms reads the motion a thousand times slower: the inertia a million times larger
-    in_ms = 1e5 <= inertia / rigid <= 1e7
+    ratio = inertia / rigid
+    unit = stamps_unit(lambda factor: 0.1 <= ratio / factor**2 <= 10.0)
     raise IdentificationError(
         f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the observer's inertia "
-        f"K / omega^2 = {inertia:.3g} kg m^2 is {inertia / rigid:.3g} times the rigid link's "
+        f"K / omega^2 = {inertia:.3g} kg m^2 is {ratio:.3g} times the rigid link's "
         f"{rigid:.3g} kg m^2 (more than a factor {MAX_INERTIA_FACTOR:g}): "
         + (
-            "time stamps in ms? the format's are in s"
-            if in_ms
+            f"time stamps in {unit}? the format's are in s"
+            if unit
             else "angles in degrees, or torques scaled?"
         )
     )

@@ -38,7 +38,7 @@ from sensing_antenna.estimation.front.contact_frame import (
     signal_noise,
 )
 from sensing_antenna.estimation.front.ratio import contact_loads, load_offset, ratio_noise
-from sensing_antenna.units_check import angle_problem, initial_rest, rest_reading
+from sensing_antenna.units_check import angle_problem, initial_rest, rest_reading, stamps_unit
 
 __all__ = [
     "MAX_FILLED",
@@ -85,14 +85,11 @@ def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig
     nyquist = math.pi / sample_period
     if nyquist < cfg.min_nyquist_factor * band_top:
         # stamps in ms, us or ns read as s: 1e3, 1e6 or 1e9 times a period that in s would do
-        unit = next(
-            (
-                name
-                for name, factor in (("ms", 1e3), ("us", 1e6), ("ns", 1e9))
-                if factor * nyquist >= cfg.min_nyquist_factor * band_top
+        unit = stamps_unit(
+            lambda factor: (
+                factor * nyquist >= cfg.min_nyquist_factor * band_top
                 and sample_period >= 0.5 * factor / 1e3
-            ),
-            None,
+            )
         )
         return (
             f"sample period {sample_period:g} s: the Nyquist frequency {nyquist:.0f} rad/s is "
