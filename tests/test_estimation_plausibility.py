@@ -279,6 +279,18 @@ def test_angles_that_turn_the_head_less_than_the_link_is_bent_are_a_model_mismat
         assert result.diagnostics["bend_per_turn"] > 1.6, name
 
 
+def test_swapped_angle_columns_that_pass_the_sign_check_are_named(
+    vertical: Recording, antenna: Antenna
+) -> None:
+    # The elevation read as the azimuth: the head seems to swing across the push that bent the
+    # link, which the sign check (the push against the turn) lets pass on this sweep
+    swapped = dataclasses.replace(vertical, theta=np.ascontiguousarray(vertical.theta[:, ::-1]))
+    for name, result in all_methods(swapped, antenna).items():
+        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
+        assert result.status is Status.MODEL_MISMATCH, (name, result.reason)
+        assert any("turn the head across the push that bent it" in r for r in reasons), name
+
+
 def test_angles_in_degrees_are_named_even_when_the_recording_ends_before_the_push(
     vertical: Recording, antenna: Antenna
 ) -> None:

@@ -614,6 +614,12 @@ def _bend_against_turn(
     across = math.sqrt(max(reach**2 - max(turn, 0.0) ** 2, 0.0))
     curved = across**2 / (2.0 * _LEAST_RADIUS)
     if not turn > 0.0 or least_since > limit * turn + curved:
+        if not turn > across:
+            return (
+                f"{measured}: the angles turn the head across the push that bent it, or away "
+                "from it, more than into it (two joints swapped, or one read from another "
+                "column or with its sign flipped; or an object that moved into the link)"
+            )
         return (
             f"{measured} (a contact that sticks bends the link as far as the head turned into "
             f"it, one that slides over a flat surface less; up to {limit:g} times that, plus "
