@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from _models import calibrated
 from _recordings import samples_kept
-from sensing_antenna.antenna import Antenna, paper_antenna
+from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.estimation import (
     METHODS,
@@ -29,7 +30,7 @@ from sensing_antenna.estimation import (
     estimate,
     gather,
 )
-from sensing_antenna.recording import Recording
+from sensing_antenna.recording import Recording, read_recording
 from sensing_antenna.simulator import Scenario, simulate
 
 #: Degrees per radian: the factor of a file whose angles are in degrees.
@@ -289,6 +290,25 @@ def test_swapped_angle_columns_that_pass_the_sign_check_are_named(
         reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
         assert result.status is Status.MODEL_MISMATCH, (name, result.reason)
         assert any("turn the head across the push that bent it" in r for r in reasons), name
+
+
+def test_a_link_that_slides_aside_on_a_steep_surface_is_not_a_flipped_sign() -> None:
+    # An exploration's vertical sweep up onto a lying cylinder's side, steep to the sweep: the
+    # link slid aside and pushes nearly across the head's turn (its component along the turn,
+    # 0.5 mN, within one standard error of the hold's reaction), while the turn moved the
+    # touched point 5.9 mm along the push. Neither is a sign flipped or a joint swapped.
+    recording = read_recording(Path(__file__).parent / "data" / "steep_side_vertical_0.75.csv")
+    truth = float(recording.metadata["true_xc"])
+    model = load_antenna(Path(__file__).parent / "data" / "explore-calibrated.toml")
+    results = all_methods(recording.without_ground_truth(), model)
+    for name, result in results.items():
+        assert result.status is not Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        assert result.status is not Status.MODEL_MISMATCH, (name, result.reason)
+        if result.ok:  # right: within 1 cm (the wrong-ok threshold of the explorations' map)
+            assert abs(result.x_c - truth) < 0.01, name
+    fast = results["fast"]
+    assert fast.ok and fast.interval is not None
+    assert fast.interval[0] <= truth <= fast.interval[1]
 
 
 def test_angles_in_degrees_are_named_even_when_the_recording_ends_before_the_push(

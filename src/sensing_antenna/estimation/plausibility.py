@@ -444,11 +444,13 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     Z^a moves X^m along cos theta_2 Y^m, the elevation along Z^m), and the mean reaction over the
     hold must have R . d < 0 (Y^c = -Y^m for an azimuthal push, Section 5.4). A sign flipped in
     one angle or in the forces turns it, during the push as over the hold
-    (``implausible_input``). When the push's filtered reaction at t_1 did oppose the turn, by
-    more than three of its standard errors (the low-passed noise and the tare's), and the
-    hold's does not, the signs are right and the contact moved: the link slid off the object or
-    past it, and touches it from the other side if at all (``slip_suspected``). Not judged when
-    the head turned by less than the rest tolerance.
+    (``implausible_input``): judged when R . d / |d| exceeds three of its standard errors (the
+    low-passed noise and the tare's), since a contact on a surface steep to the sweep, where
+    the link slides aside, pushes nearly across the turn. When the push's filtered reaction at
+    t_1 did oppose the turn, by more than three of those errors, and the hold's does not, the
+    signs are right and the contact moved: the link slid off the object or past it, and
+    touches it from the other side if at all (``slip_suspected``). Not judged when the head
+    turned by less than the rest tolerance.
     """
     theta = evidence.theta
     turn = theta[evidence.rest_index] - theta[evidence.contact_index]
@@ -456,16 +458,16 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
     if float(np.max(np.abs(turn))) <= tolerance:
         return None
+    unit = direction / float(np.linalg.norm(direction))
     reaction = evidence.frame.reaction_m
-    if float(reaction @ direction) < 0.0:
-        return None
-    pushed = np.asarray(evidence.reaction_f[evidence.rest_index], dtype=float)
     noise = float(evidence.diagnostics.get("force_noise", 0.0)) * lowpass_noise_gain(
         evidence.config.lowpass_cutoff, evidence.sample_period
     )
     error = math.hypot(noise, evidence.offset_error)
-    along = float(pushed @ direction) / float(np.linalg.norm(direction))
-    if along < -3.0 * error:
+    if float(reaction @ unit) <= 3.0 * error:
+        return None  # it opposes the turn, or lies across it within its noise and tare
+    pushed = np.asarray(evidence.reaction_f[evidence.rest_index], dtype=float)
+    if float(pushed @ unit) < -3.0 * error:
         return Status.SLIP_SUSPECTED, (
             f"the contact force opposed the head's turn into the contact while it pushed "
             f"({_vector(pushed)} N at t_1, filtered) but not over the hold after t_1 "
@@ -539,7 +541,10 @@ def _bend_against_turn(
     1 - mu tan(phi) <= y / (-R^ . u) <= 1 on a flat surface. Sliding over a convex one of
     radius rho moves the contact out along the reaction by up to d^2 / (2 rho), d the head's
     reach across the push, which the upper bound allows for ``_LEAST_RADIUS`` (a convex
-    surface only raises y, so the lower bound holds). Both vectors are taken across the link
+    surface only raises y, so the lower bound holds). A head that turned across the push or
+    away from it (-R^ . u <= 0: a slide aside over a steep or curved surface, or joints
+    swapped) is judged on the upper bound with no turn into the push, not on the lower one.
+    Both vectors are taken across the link
     (X^m at t_e removed), mu is ``max_friction_ratio``, and ``max_bend_per_turn`` widens the
     band both ways for the forces' scale and the stiffness. The bends are the elastica's y_c of the
     answer scaled by the contact moment across the link over the moment of the push y_c was
@@ -613,12 +618,14 @@ def _bend_against_turn(
     reach = float(np.linalg.norm(moved))
     across = math.sqrt(max(reach**2 - max(turn, 0.0) ** 2, 0.0))
     curved = across**2 / (2.0 * _LEAST_RADIUS)
-    if not turn > 0.0 or least_since > limit * turn + curved:
+    if least_since > limit * max(turn, 0.0) + curved:
         if not turn > across:
             return (
-                f"{measured}: the angles turn the head across the push that bent it, or away "
-                "from it, more than into it (two joints swapped, or one read from another "
-                "column or with its sign flipped; or an object that moved into the link)"
+                f"{measured}, and {1e3 * across:.3g} mm across it: more than a slide over a "
+                f"surface curved to a radius of {1e3 * _LEAST_RADIUS:g} mm allows "
+                f"({1e3 * curved:.2g} mm); the angles turn the head across the push that bent "
+                "it, or away from it, more than into it (two joints swapped, or one read from "
+                "another column or with its sign flipped; or an object that moved into the link)"
             )
         return (
             f"{measured} (a contact that sticks bends the link as far as the head turned into "
@@ -629,6 +636,8 @@ def _bend_against_turn(
             "stiffer than the antenna file says, or angles that do not describe the head's turn "
             "(a joint read from the wrong column, a scale off)"
         )
+    if not turn > 0.0:
+        return None  # no turn into the push to bend the link at least as far as
     tan_phi = across / turn
     least = 1.0 - cfg.max_friction_ratio * tan_phi
     if not most_since * limit < least * turn:
