@@ -1160,14 +1160,14 @@ def test_a_contact_force_that_turns_is_reported_as_slip_online_as_offline(
 ) -> None:
     # The slip check compares the static contact force fitted on the window's first half with
     # that of the whole window. Turned at 1.2 rad/s from t_1, the force at the centres of
-    # [t_1, t_1 + 0.5 s] and [t_1, t_1 + 1 s] differs by 0.3 rad (17.2 deg), twice
-    # max_direction_drift. With a tolerance no window meets (and no declaration for being near
-    # the floors' width) the estimate is the cap's: slip
+    # [t_1, t_1 + 0.5 s] and [t_1, t_1 + 1 s] differs by 0.3 rad (17.2 deg), twice the
+    # max_direction_drift it is asked to judge (by default none). With a tolerance no window
+    # meets (and no declaration for being near the floors' width) the estimate is the cap's: slip
     # suspected, by that angle within 3 of its standard errors. Fed online in blocks of 100
     # samples the method asks one window per block from the hold's end and the cap's, not the
     # instants skipped (a real-time loop would otherwise spend seconds at the cap), and
     # concludes on the cap's window with the same slip reference: the same estimate.
-    method = FastMethod(FastConfig(tolerance=1e-6, settled_margin=0.0))
+    method = FastMethod(FastConfig(tolerance=1e-6, settled_margin=0.0, max_direction_drift=0.15))
     turned = _turned(azimuthal, azimuthal_estimate.t_1, 1.2)
     offline = estimate(turned, calibrated(), method, STRAIGHT)
     assert offline.status is Status.SLIP_SUSPECTED

@@ -457,11 +457,12 @@ def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]
                     f"the samples ended before the estimate was sure ({final.note})",
                 )
             )
-    if final.statics is not None and final.early_statics is not None:
+    limit = config.max_direction_drift
+    if limit is not None and final.statics is not None and final.early_statics is not None:
         # Slip on the surface turns the static reaction: the fitted static loads of the window's
         # first half against the whole window (vibration is in the model, not in the statics)
         angle, se = direction_change(final.early_statics, final.statics)
-        if math.isfinite(angle) and angle > max(config.max_direction_drift, 3.0 * se):
+        if math.isfinite(angle) and angle > max(limit, 3.0 * se):
             found.append(
                 (
                     Status.SLIP_SUSPECTED,

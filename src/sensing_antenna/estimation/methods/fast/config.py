@@ -125,11 +125,12 @@ class FastConfig:
         Time (s) of the initial rest left out before the head is seen to move: the sweep's start
         loads the sensor (inertia) while the angles are still within the rest tolerance, and
         those samples would bias the rest's mean. 0.05 s, longer than that lead.
-    max_direction_drift : float
+    max_direction_drift : float or None
         Largest angle (rad) between the fitted static perpendicular reaction of the window's
         first half from t_1 (``WindowEstimate.early_statics``) and that of the whole window at
         t_e (both with the sensor bias removed) before a slip is suspected, or 3 standard
-        errors of that angle when larger; 0.15 rad as the pipeline's ``max_direction_drift``.
+        errors of that angle when larger; None (the default): not judged, as the pipeline's
+        ``max_direction_drift``.
     peak_margin : float
         No declaration while omega_1 is less than this many standard deviations below the
         maximum of the sensing curve: there the inverse is singular, and a short window's
@@ -243,7 +244,7 @@ class FastConfig:
     grid_step: float = 2.5e-4
     bias_min_samples: int = 20
     bias_guard: float = 0.05
-    max_direction_drift: float = 0.15
+    max_direction_drift: float | None = None
     peak_margin: float = 3.0
     max_disagreement: float = 3.0
     max_opening: float = 1.0
@@ -263,6 +264,8 @@ class FastConfig:
             if f.name in ("higher_modes", "branch_by_second_mode", "push_phase"):
                 if not isinstance(value, bool):
                     raise FastConfigError(f"{f.name}: must be true or false, got {value!r}")
+                continue
+            if f.name == "max_direction_drift" and value is None:
                 continue
             counts = ("max_modes", "bias_min_samples", "push_max_modes", "long_window_min_modes")
             degrees = ("polynomial_degree", "push_polynomial_degree")

@@ -231,7 +231,7 @@ def conclude(
     # Drift of the contact force's direction across the link between the hold (Y^c) and t_e:
     # a contact sliding over the obstacle
     drift = _direction_drift(evidence, e)
-    if drift > cfg.max_direction_drift:
+    if cfg.max_direction_drift is not None and drift > cfg.max_direction_drift:
         found.append(
             (
                 Status.SLIP_SUSPECTED,
