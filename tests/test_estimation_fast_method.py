@@ -61,7 +61,12 @@ from sensing_antenna.estimation.methods.fast.static_fit import SensorBias, Stati
 from sensing_antenna.estimation.methods.fast.window import (
     with_early_statics_of,
 )
-from sensing_antenna.estimation.methods.fast.window_fit import Fundamental, misses_band_peak
+from sensing_antenna.estimation.methods.fast.window_fit import (
+    Fundamental,
+    WindowSpan,
+    measure_fundamental,
+    misses_band_peak,
+)
 from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_frequency,
     evidence_spectrum,
@@ -1431,6 +1436,32 @@ def test_a_fit_that_leaves_the_bands_clear_peak_unread_is_caught() -> None:
     assert not misses_band_peak(rings, _fit([81.5, 101.0], n_samples=n), TS, BAND, config)
     # noise alone holds no clear peak to read
     assert not misses_band_peak(noise, _fit([101.0], n_samples=n), TS, BAND, config)
+
+
+def test_a_fundamental_taken_from_a_ring_beside_the_bands_clear_peak_is_not_declared() -> None:
+    # 0.8 s of five channels: the contact's undamped ring at 80.9 rad/s and, four times
+    # stronger at the start but decaying at 6 1/s, a slide's ring at 101 rad/s. The summed
+    # spectrum's clear peak is the contact's; a one-mode fit takes the stronger start of the
+    # slide's ring (least squares weighs energy) and leaves the peak unread: its fundamental
+    # fails the check. With three modes the fit reads both and the check passes: it asks that
+    # the peak be read, not which mode is the fundamental (the push plane's check of two
+    # fundamentals speaks to that).
+    n = 800
+    t = TS * np.arange(n)
+    rng = np.random.default_rng(1)
+    ring = np.sin(80.9 * t) + 4.0 * np.exp(-6.0 * t) * np.sin(101.0 * t + 0.3)
+    scale = np.array([1.0, 0.5, 1e-2, 1e-2, 5e-3])
+    noise = np.array([0.05, 0.05, 5e-4, 5e-4, 5e-4]) * rng.standard_normal((n, 5))
+    channels = np.outer(ring, scale) + noise
+    one = FastConfig(max_modes=1, long_window_min_modes=1)
+    read = measure_fundamental(WindowSpan(channels, 0, n - 1, TS, BAND, one, {}), None)
+    assert read.fit is not None and abs(read.omega1 - 101.0) < 2.0
+    assert "band_peak" in read.failed
+    assert any("clear spectral peak" in note for note in read.notes)
+    three = FastConfig(max_modes=3)
+    both = measure_fundamental(WindowSpan(channels, 0, n - 1, TS, BAND, three, {}), None)
+    assert both.fit is not None and "band_peak" not in both.failed
+    assert float(np.min(np.abs(both.fit.omega - 80.9))) < 0.1
 
 
 def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window() -> None:

@@ -223,7 +223,7 @@ def test_angles_in_degrees_are_refused(simulated_free: Recording) -> None:
 
 
 @pytest.mark.parametrize(("unit", "per_second"), [("ms", 1e3), ("us", 1e6)])
-def test_time_in_milliseconds_is_named(
+def test_time_stamps_in_a_smaller_unit_are_named(
     simulated_free: Recording, unit: str, per_second: float
 ) -> None:
     # the motion read a thousand (a million) times slower: the fitted inertia a million (1e12)

@@ -12,7 +12,6 @@ from sensing_antenna.cli.arguments import distinct_files
 from sensing_antenna.cli.estimate import (
     DEFAULT_ANTENNA,
     METHOD_NAMES,
-    warn_of_contradicted_period,
     warn_of_other_antennas,
 )
 
@@ -137,13 +136,15 @@ def _map_into(args: argparse.Namespace) -> None:
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     unposed: list[str] = []  # recordings without a base pose: in the antenna's own frame
+    contradicted: list[str] = []  # sample_period against the time stamps, said after the bar
 
     def read(path: Path, recording: Recording) -> None:
         metadata = recording.metadata
         named.setdefault(metadata.get("antenna", ""), []).append(str(path))
         if not metadata.get(BASE_POSE_KEY, "").strip():
             unposed.append(str(path))
-        warn_of_contradicted_period(path, recording)
+        if recording.period_problem is not None:
+            contradicted.append(f"{path}: {recording.period_problem}")
 
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"
@@ -158,6 +159,8 @@ def _map_into(args: argparse.Namespace) -> None:
             unreadable=lambda _, exc: left_out.append(str(exc)),
             read=read,
         )
+    for problem in contradicted:
+        print(f"antenna: warning: {problem}", file=sys.stderr)
     if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(named, antenna.name)
     note_unposed(unposed, sum(len(paths) for paths in named.values()))

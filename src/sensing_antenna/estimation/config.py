@@ -184,9 +184,8 @@ class EstimatorConfig:
         filtered contact force across the link over the last ``convergence_window`` before t_e,
         before a slip over the obstacle is suspected; None (the default): not judged. A contact
         that slides across the link, round the object, turns the force but moves neither x_c
-        nor the point placed at its instant; on explorations it turned 10 to 90 deg on right
-        answers as on wrong ones, which other checks caught (docs/design-notes.md, "The
-        direction check switched off").
+        nor the point placed at its instant (docs/design-notes.md, "The direction check
+        switched off").
     max_ratio_drift : float
         Largest change (m) of the filtered ratio over the last ``convergence_window`` before t_e
         tolerated as a steady hold; beyond it the contact is drifting (slip). 2 cm.

@@ -444,9 +444,10 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     Z^a moves X^m along cos theta_2 Y^m, the elevation along Z^m), and the mean reaction over the
     hold must have R . d < 0 (Y^c = -Y^m for an azimuthal push, Section 5.4). A sign flipped in
     one angle or in the forces turns it, during the push as over the hold
-    (``implausible_input``): judged when R . d / |d| exceeds three of its standard errors (the
-    low-passed noise and the tare's), since a contact on a surface steep to the sweep, where
-    the link slides aside, pushes nearly across the turn. When the push's filtered reaction at
+    (``implausible_input``), unless the reaction pushes across the turn by more than three of
+    its standard errors (the low-passed noise and the tare's) and along it by no more: a
+    contact on a surface steep to the sweep, where the link slides aside, pushes nearly across
+    the turn. When the push's filtered reaction at
     t_1 did oppose the turn, by more than three of those errors, and the hold's does not, the
     signs are right and the contact moved: the link slid off the object or past it, and
     touches it from the other side if at all (``slip_suspected``). Not judged when the head
@@ -464,8 +465,10 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
         evidence.config.lowpass_cutoff, evidence.sample_period
     )
     error = math.hypot(noise, evidence.offset_error)
-    if float(reaction @ unit) <= 3.0 * error:
-        return None  # it opposes the turn, or lies across it within its noise and tare
+    along = float(reaction @ unit)
+    across = float(np.linalg.norm(reaction[1:] - along * unit[1:]))
+    if along <= 0.0 or (along <= 3.0 * error and across > 3.0 * error):
+        return None  # it opposes the turn, or pushes across it, along it within its noise
     pushed = np.asarray(evidence.reaction_f[evidence.rest_index], dtype=float)
     if float(pushed @ unit) < -3.0 * error:
         return Status.SLIP_SUSPECTED, (
@@ -625,7 +628,8 @@ def _bend_against_turn(
                 f"surface curved to a radius of {1e3 * _LEAST_RADIUS:g} mm allows "
                 f"({1e3 * curved:.2g} mm); the angles turn the head across the push that bent "
                 "it, or away from it, more than into it (two joints swapped, or one read from "
-                "another column or with its sign flipped; or an object that moved into the link)"
+                "another column or with its sign flipped; or an object that moved into the link, "
+                "or forces that read high for the model's stiffness)"
             )
         return (
             f"{measured} (a contact that sticks bends the link as far as the head turned into "

@@ -63,7 +63,8 @@ def listen_lines(
     clock: Callable[[], float] = time.perf_counter,
 ) -> int:
     """Read CSV lines until they end (or ``count`` recordings ended); returns the number of
-    recordings ended.
+    recordings ended. ``lines`` keep their line ends, as a file or a pipe gives them: the one
+    without is the input's last, possibly cut short.
 
     Raises
     ------
