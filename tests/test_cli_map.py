@@ -136,7 +136,7 @@ def test_a_map_into_a_previous_map_s_directory_leaves_none_of_its_files_behind(
         ("pose", "base_pose: not JSON"),
         ("mesh", "junk.stl: "),
         # a mesh in mm read as metres: the message names the option that reads it
-        ("mesh in mm", "a thousand times too large; give the file's unit with --objects-unit"),
+        ("mesh in mm", "a thousand times too large; read in m; give the file's unit with"),
         ("out is a file", "out: File exists (a file where a directory is to be made?)"),
     ],
 )
@@ -199,6 +199,12 @@ def test_a_mesh_in_millimetres_is_read_with_its_unit(
     argv = ["map", str(recordings[0]), "--out", str(tmp_path / "out"), "--no-progress"]
     assert main([*argv, "--objects", str(mesh), "--objects-unit", "mm"]) == 0
     assert capsys.readouterr().err == ""
+    # a file in metres read as millimetres: the message names the unit it was read in
+    metres = tmp_path / "box_m.stl"
+    trimesh.creation.box(extents=[0.06, 0.1, 0.14]).export(metres)
+    assert main([*argv, "--objects", str(metres), "--objects-unit", "mm"]) == 2
+    err = capsys.readouterr().err
+    assert "read in mm; give the file's unit with --objects-unit m|cm|mm|in" in err
 
 
 def test_a_bad_recording_among_good_ones_is_left_out_in_one_line(

@@ -59,7 +59,7 @@ def register(subparsers: Any) -> None:
 OBJECTS_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
 
 #: How ``--objects`` meshes in other units are to be read, for the size check's message.
-OBJECTS_UNIT_HINT = "give the file's unit with --objects-unit, e.g. --objects-unit mm"
+OBJECTS_UNIT_HINT = "read in {unit}; give the file's unit with --objects-unit {units}"
 
 
 def read_objects(paths: Any, command: str, unit: str = "m") -> dict[str, Any]:
@@ -71,7 +71,8 @@ def read_objects(paths: Any, command: str, unit: str = "m") -> dict[str, Any]:
     scale = OBJECTS_UNITS[unit]
     meshes = {}
     for path in paths:
-        mesh = read_mesh(path, scale, unit_hint=OBJECTS_UNIT_HINT, closed=False)
+        hint = OBJECTS_UNIT_HINT.format(unit=unit, units="|".join(OBJECTS_UNITS))
+        mesh = read_mesh(path, scale, unit_hint=hint, closed=False)
         if scale != 1.0:
             mesh.apply_scale(scale)
         if not mesh.is_watertight:

@@ -68,7 +68,10 @@ def mesh_problem(
         return "vertices that are not finite numbers"
     extent = scale * float(np.max(vertices.max(axis=0) - vertices.min(axis=0)))
     if not extent >= MIN_OBJECT_SIZE:
-        return f"its largest extent is {extent:.4g} m, less than {MIN_OBJECT_SIZE:g} m: in metres?"
+        return (
+            f"its largest extent is {extent:.4g} m, less than {MIN_OBJECT_SIZE:g} m: read in the "
+            f"wrong unit? ({unit_hint})"
+        )
     if extent > MAX_MESH_EXTENT:
         return (
             f"its largest extent is {extent:.4g} m, more than {MAX_MESH_EXTENT:g} m: in metres? "
