@@ -422,6 +422,8 @@ def test_a_last_line_cut_short_ends_the_recording_with_its_estimate(
     assert isinstance(found, EstimateEvent) and isinstance(end, EndEvent)
     assert end.reason == "end of input" and end.samples == recording.n_samples - 1
     whole = estimate(recording.without_ground_truth(), paper_antenna(), method="paper")
+    # the stream's answer from the same samples, to 1 mm: batch and stream best guesses have
+    # been seen to differ by half a millimetre
     assert found.to_dict()["x_c"] == pytest.approx(whole.x_c, abs=1e-3)
     # a line that ends is malformed, not cut short
     with pytest.raises(RecordingError, match=r"expected \d+ cells, found 2$"):

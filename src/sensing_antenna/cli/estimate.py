@@ -8,12 +8,9 @@ import math
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from sensing_antenna.cli.arguments import number, printable
-
-if TYPE_CHECKING:
-    from sensing_antenna.recording import Recording
 
 #: The antenna an estimate uses without --antenna.
 DEFAULT_ANTENNA = "paper-2021"
@@ -79,7 +76,7 @@ def _run(args: argparse.Namespace) -> int:
         method = _fast_with_tolerance(args.method, args.tolerance)
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     recording = read_recording(args.recording)
-    warn_of_contradicted_period(args.recording, recording)
+    warn_of_contradicted_period(args.recording, recording.period_problem)
     if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(
             {recording.metadata.get("antenna", ""): [str(args.recording)]}, antenna.name
@@ -122,11 +119,11 @@ def warn_of_other_antennas(
         )
 
 
-def warn_of_contradicted_period(source: object, recording: Recording) -> None:
-    """One line on stderr when ``recording``'s ``sample_period`` metadata disagrees with its
-    time stamps (:attr:`~sensing_antenna.recording.Recording.period_problem`): the estimators
-    go by the stamps, and one of the two is wrong."""
-    problem = recording.period_problem
+def warn_of_contradicted_period(source: object, problem: str | None) -> None:
+    """One line on stderr naming ``source`` when its recording's ``sample_period`` metadata
+    disagrees with its time stamps (``problem``:
+    :attr:`~sensing_antenna.recording.Recording.period_problem`): the estimators go by the
+    stamps, and one of the two is wrong."""
     if problem is not None:
         print(f"antenna: warning: {source}: {problem}", file=sys.stderr)
 

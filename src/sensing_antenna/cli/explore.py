@@ -116,12 +116,10 @@ def register(subparsers: Any) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna
-    from sensing_antenna.campaign.progress import Progress
-    from sensing_antenna.cli.map import read_objects, report_map
+    from sensing_antenna.cli.map import read_objects, recognition_progress, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
     from sensing_antenna.exploration.run import stopped_as_stored
     from sensing_antenna.exploration.store import SETTINGS_FILE
-    from sensing_antenna.mapping import PRIMITIVES
     from sensing_antenna.scene import load_scene
 
     if args.device_profile == "nominal" and args.device_build is not None:
@@ -200,8 +198,7 @@ def _run(args: argparse.Namespace) -> int:
             flush=True,
         )
 
-    shapes = len(PRIMITIVES) + len(meshes or {})
-    with Progress(not args.quiet).bar_from_first(shapes, "recognising", "shape") as bar:
+    with recognition_progress(not args.quiet, meshes) as bar:
         result = explore(
             scene,
             device,

@@ -12,6 +12,7 @@ from sensing_antenna.cli.arguments import distinct_files
 from sensing_antenna.cli.estimate import (
     DEFAULT_ANTENNA,
     METHOD_NAMES,
+    warn_of_contradicted_period,
     warn_of_other_antennas,
 )
 
@@ -69,9 +70,9 @@ def read_objects(paths: Any, command: str, unit: str = "m") -> dict[str, Any]:
     from sensing_antenna.scene.objects import read_mesh
 
     scale = OBJECTS_UNITS[unit]
+    hint = OBJECTS_UNIT_HINT.format(unit=unit, units="|".join(OBJECTS_UNITS))
     meshes = {}
     for path in paths:
-        hint = OBJECTS_UNIT_HINT.format(unit=unit, units="|".join(OBJECTS_UNITS))
         mesh = read_mesh(path, scale, unit_hint=hint, closed=False)
         if scale != 1.0:
             mesh.apply_scale(scale)
@@ -83,6 +84,16 @@ def read_objects(paths: Any, command: str, unit: str = "m") -> dict[str, Any]:
             )
         meshes[path.stem] = mesh
     return meshes
+
+
+def recognition_progress(enabled: bool, meshes: Any) -> Any:
+    """The bar of recognition's fits, one step per shape class and ``--objects`` mesh, opened
+    at the first (``Progress.bar_from_first``): call it with each class fitted."""
+    from sensing_antenna.campaign.progress import Progress
+    from sensing_antenna.mapping import PRIMITIVES
+
+    shapes = len(PRIMITIVES) + len(meshes or {})
+    return Progress(enabled).bar_from_first(shapes, "recognising", "shape")
 
 
 def add_map_options(parser: Any, uncertain_into: str) -> None:
@@ -130,22 +141,23 @@ def _map_into(args: argparse.Namespace) -> None:
     from sensing_antenna.campaign.progress import Progress
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.mapping import PRIMITIVES, build_map, map_inputs_from_recordings
+    from sensing_antenna.mapping import build_map, map_inputs_from_recordings
     from sensing_antenna.mapping.pose import BASE_POSE_KEY
 
     meshes = read_objects(args.objects, "antenna map", args.objects_unit)
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     unposed: list[str] = []  # recordings without a base pose: in the antenna's own frame
-    contradicted: list[str] = []  # sample_period against the time stamps, said after the bar
+    contradicted: list[tuple[Path, str]] = []  # sample_period against the stamps: after the bar
 
     def read(path: Path, recording: Recording) -> None:
         metadata = recording.metadata
         named.setdefault(metadata.get("antenna", ""), []).append(str(path))
         if not metadata.get(BASE_POSE_KEY, "").strip():
             unposed.append(str(path))
-        if recording.period_problem is not None:
-            contradicted.append(f"{path}: {recording.period_problem}")
+        problem = recording.period_problem
+        if problem is not None:
+            contradicted.append((path, problem))
 
     with Progress(not args.no_progress).bar(
         len(args.recordings), f"estimating ({args.method})", unit="recording"
@@ -160,8 +172,8 @@ def _map_into(args: argparse.Namespace) -> None:
             unreadable=lambda _, exc: left_out.append(str(exc)),
             read=read,
         )
-    for problem in contradicted:
-        print(f"antenna: warning: {problem}", file=sys.stderr)
+    for path, problem in contradicted:
+        warn_of_contradicted_period(path, problem)
     if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(named, antenna.name)
     note_unposed(unposed, sum(len(paths) for paths in named.values()))
@@ -170,8 +182,7 @@ def _map_into(args: argparse.Namespace) -> None:
         raise SensingAntennaError(f"{left_out[0]}{more}")
     for problem in left_out:  # one line each; the map is made of the others
         print(f"antenna map: warning: left out {problem}", file=sys.stderr)
-    shapes = len(PRIMITIVES) + len(meshes or {})
-    with Progress(not args.no_progress).bar_from_first(shapes, "recognising", "shape") as bar:
+    with recognition_progress(not args.no_progress, meshes) as bar:
         contact_map = build_map(
             points, args.include_uncertain, meshes=meshes, swept=swept, class_fitted=bar
         )

@@ -102,7 +102,7 @@ def _model(args: argparse.Namespace, recording: Any, use: str) -> Any:
     ``antenna`` metadata names another (as ``antenna estimate`` does; ``use`` as there)."""
     from sensing_antenna.antenna import load_antenna
 
-    warn_of_contradicted_period(args.recording, recording)
+    warn_of_contradicted_period(args.recording, recording.period_problem)
     if args.antenna is not None:
         return load_antenna(args.antenna)
     antenna = load_antenna(DEFAULT_ANTENNA)

@@ -447,11 +447,10 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     (``implausible_input``), unless the reaction pushes across the turn by more than three of
     its standard errors (the low-passed noise and the tare's) and along it by no more: a
     contact on a surface steep to the sweep, where the link slides aside, pushes nearly across
-    the turn. When the push's filtered reaction at
-    t_1 did oppose the turn, by more than three of those errors, and the hold's does not, the
-    signs are right and the contact moved: the link slid off the object or past it, and
-    touches it from the other side if at all (``slip_suspected``). Not judged when the head
-    turned by less than the rest tolerance.
+    the turn. When the push's filtered reaction at t_1 did oppose the turn, by more than three
+    of those errors, and the hold's does not, the signs are right and the contact moved: the
+    link slid off the object or past it, and touches it from the other side if at all
+    (``slip_suspected``). Not judged when the head turned by less than the rest tolerance.
     """
     theta = evidence.theta
     turn = theta[evidence.rest_index] - theta[evidence.contact_index]
@@ -536,29 +535,27 @@ def _bend_against_turn(
 ) -> str | None:
     """Why the link's bend is not what the head's turn into the object makes, or None.
 
-    From t_c to t_e the rigid link's point at x_c moves by u = x_c (X^m(theta_e) -
-    X^m(theta_c)); the object holds the touched point back, so the link bends by y along the
-    reaction R, at an angle phi to -u. A contact that sticks stays where it touched: y = -u,
-    phi = 0. One that slides with Coulomb friction mu stays on the surface of normal n,
-    y (R^ . n) = -u . n, with R on the friction cone's edge between n and -u; then
-    1 - mu tan(phi) <= y / (-R^ . u) <= 1 on a flat surface. Sliding over a convex one of
-    radius rho moves the contact out along the reaction by up to d^2 / (2 rho), d the head's
-    reach across the push, which the upper bound allows for ``_LEAST_RADIUS`` (a convex
-    surface only raises y, so the lower bound holds). A head that turned across the push or
-    away from it (-R^ . u <= 0: a slide aside over a steep or curved surface, or joints
-    swapped) is judged on the upper bound with no turn into the push, not on the lower one.
-    Both vectors are taken across the link
-    (X^m at t_e removed), mu is ``max_friction_ratio``, and ``max_bend_per_turn`` widens the
-    band both ways for the forces' scale and the stiffness. The bends are the elastica's y_c of the
-    answer scaled by the contact moment across the link over the moment of the push y_c was
-    computed from (``push_force`` times the filtered torque/force ratio at t_e): at t_e the
-    mean over the hold's last period of the contact's fundamental, at t_c
+    From t_c to t_e the rigid link's point at x_c moves by u = x_c (X^m(theta_e) - X^m(theta_c));
+    the object holds the touched point back, so the link bends by y along the reaction R, at an
+    angle phi to -u. A contact that sticks stays where it touched: y = -u, phi = 0. One that slides
+    with Coulomb friction mu stays on the surface of normal n, y (R^ . n) = -u . n, with R on the
+    friction cone's edge between n and -u; then 1 - mu tan(phi) <= y / (-R^ . u) <= 1 on a flat
+    surface. Sliding over a convex one of radius rho moves the contact out along the reaction by up
+    to d^2 / (2 rho), d the head's reach across the push, which the upper bound allows for
+    ``_LEAST_RADIUS`` (a convex surface only raises y, so the lower bound holds). A head that turned
+    across the push or away from it (-R^ . u <= 0: a slide aside over a steep or curved surface, or
+    joints swapped) is judged on the upper bound with no turn into the push, not on the lower one.
+    Both vectors are taken across the link (X^m at t_e removed), mu is ``max_friction_ratio``, and
+    ``max_bend_per_turn`` widens the band both ways for the forces' scale and the stiffness. The
+    bends are the elastica's y_c of the answer scaled by the contact moment across the link over the
+    moment of the push y_c was computed from (``push_force`` times the filtered torque/force ratio
+    at t_e): at t_e the mean over the hold's last period of the contact's fundamental, at t_c
     :func:`_bend_at_touch` (the detector declares t_c once the push has built up), whose two
-    standard errors widen the band; not judged when the push from t_c to t_1 lasts less than
-    half a period of the fundamental. At a given push y grows as x_c^3 and u as x_c: an answer
-    off the contact moves the ratio as (x_c / true x_c)^2. ``notes`` gets
-    ``turn_against_push`` (-R^ . u, m) and ``bend_per_turn`` (y over it). Not judged when the
-    head turned by less than the rest tolerance (an object pushed into a still link).
+    standard errors widen the band; not judged when the push from t_c to t_1 lasts less than half a
+    period of the fundamental. At a given push y grows as x_c^3 and u as x_c: an answer off the
+    contact moves the ratio as (x_c / true x_c)^2. ``notes`` gets ``turn_against_push`` (-R^ . u, m)
+    and ``bend_per_turn`` (y over it). Not judged when the head turned by less than the rest
+    tolerance (an object pushed into a still link).
     """
     bend = float(estimate.diagnostics.get("deflection", math.nan))
     if not (math.isfinite(bend) and bend > 0.0):

@@ -1,10 +1,9 @@
 """Distances to triangle meshes, in bounded memory.
 
 trimesh's proximity queries take every face whose bounding box could hold a query point's
-closest point as a candidate; for a point far from the mesh that is every face, about a
-megabyte per 5,000 faces per point. A sweep's or a map's samples in one call exhausted memory
-on a mesh of 5,120 faces (2,000 points: 2.7 GB), so the queries here go in calls of
-:data:`CHUNK` points (the same 2,000 points: 0.46 GB, and faster).
+closest point as a candidate; for a point far from the mesh that is every face, so memory grows
+as points times faces. The queries here go in calls of :data:`CHUNK` points (docs/design-notes.md,
+"Meshes queried in bounded memory").
 """
 
 from __future__ import annotations
