@@ -884,8 +884,9 @@ def test_an_opening_contact_moves_the_window_start_to_the_end_of_the_hold(
     low, high = late[-1].posterior.interval
     assert low - 0.003 <= 0.6 <= high + 0.003
     # A restarted window's slip reference is the statics of its own first half (from its
-    # start), the same as the window of that half evaluated on its own
-    inputs = scan_inputs(evidence, FastConfig())._replace(push=None)
+    # start), the same as the window of that half evaluated on its own (fitted for the
+    # direction check only)
+    inputs = scan_inputs(evidence, FastConfig(max_direction_drift=0.15))._replace(push=None)
     end = evidence.hold_end + round(0.4 / TS)
     restarted = evaluate_window(*inputs._replace(rest_index=evidence.hold_end, end_index=end))
     cap = with_early_statics_of(inputs._replace(end_index=end), restarted)
@@ -1198,8 +1199,9 @@ def test_the_scan_concludes_on_the_first_sure_window_with_its_slip_reference(
     # window concluded on gets the slip check's reference, the statics of its first half, from
     # the scan's cached fits: the same as a computation from scratch. The window declared at
     # 0.237 s is too short for one (its half holds 1.2 periods); the cap's 1 s window has one.
+    # The reference serves the direction check alone: without it, none is fitted.
     evidence = azimuthal_evidence
-    config = FastConfig(tolerance=tolerance, settled_margin=0.0)
+    config = FastConfig(tolerance=tolerance, settled_margin=0.0, max_direction_drift=0.15)
     expected = next(
         (w for w in azimuthal_history if w.checks_passed and w.posterior.width <= tolerance),
         azimuthal_history[-1],
@@ -1221,6 +1223,11 @@ def test_the_scan_concludes_on_the_first_sure_window_with_its_slip_reference(
         assert final.early_statics is not None
         assert final.early_statics.ratio == fresh.early_statics.ratio
         assert np.array_equal(final.early_statics.reaction_perp, fresh.early_statics.reaction_perp)
+    unjudged = scan_inputs(evidence, dataclasses.replace(config, max_direction_drift=None))
+    result = scan(unjudged, evidence.hold_end, evidence.hold_end, second_mode_chooser(evidence))
+    assert result.final is not None
+    assert result.final.early_statics is None
+    assert result.final.posterior.x_c == final.posterior.x_c
 
 
 def test_windows_started_warm_declare_what_windows_started_from_the_pencil_declare(

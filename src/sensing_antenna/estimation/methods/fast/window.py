@@ -131,7 +131,8 @@ class WindowEstimate:
     early_statics : StaticRatio or None
         Statics of the window's first half (the slip reference); None when that half holds
         fewer than ``min_periods`` periods, has no mode near the whole window's fundamental, or
-        when not added (:func:`evaluate_window` leaves them to :func:`with_early_statics_of`).
+        when not added (:func:`evaluate_window` leaves them to :func:`with_early_statics_of`,
+        which adds them only for the direction check).
     ratio_z : float
         Distance of the ratio from the MAP x_c in its standard deviations.
     frequency_z : float
@@ -587,7 +588,10 @@ def with_early_statics_of(
     """``estimate`` (a window of :func:`evaluate_from_t1_or_hold` on ``inputs``' samples) with
     the slip check's early statics: those of its first half, with the fundamental of its fit
     from its own start (never through the push). Its fits come from ``caches`` (the windows
-    from t_1 or, when it was restarted, those from the hold's end); None refits them."""
+    from t_1 or, when it was restarted, those from the hold's end); None refits them. Unchanged
+    when the direction check is off (``max_direction_drift`` None), which alone reads them."""
+    if inputs.config.max_direction_drift is None:
+        return estimate
     restarted = estimate.start_index != inputs.rest_index
     cache = None if caches is None else caches[1 if restarted else 0]
     span = WindowSpan(
