@@ -1475,6 +1475,36 @@ def test_a_fundamental_taken_from_a_ring_beside_the_bands_clear_peak_is_not_decl
     assert float(np.min(np.abs(both.fit.omega - 80.9))) < 0.1
 
 
+def test_a_free_plane_ring_that_hides_the_push_planes_peak_in_the_sum_is_not_declared() -> None:
+    # One second of the five contact-load channels (R_y, R_z, Gamma_x, Gamma_y, Gamma_z),
+    # pushed along Z^m: the push plane (R_z, Gamma_y) rings at 68 rad/s, the contact's
+    # fundamental, and the free plane (R_y, Gamma_z) three times stronger at 98 rad/s, another
+    # vibration (as where the free plane's contact does not hold the link). The summed
+    # spectrum's peak is the free plane's; the push plane's own spectrum holds a clear one at
+    # 68 rad/s. A one-mode fit reads 98 rad/s alone: told the push's direction, the check
+    # finds the push plane's peak unread; not told, only the sum's, which that fit reads.
+    # With three modes the fit reads both, and the push plane's mode is the fundamental
+    # (the free plane's lies more than free_plane_margin above it).
+    n = 1000
+    t = TS * np.arange(n)
+    rng = np.random.default_rng(2)
+    push, free = np.sin(68.0 * t), 3.0 * np.sin(98.0 * t + 0.7)
+    channels = np.stack([free, push, 0.0 * t, 0.05 * push, 0.05 * free], axis=1)
+    channels += np.array([0.5, 0.5, 0.025, 0.025, 0.025]) * rng.standard_normal((n, 5))
+    along_z = np.array([0.0, 1.0])
+    assert BAND[0] < 68.0 < 98.0 < BAND[1]
+    one = FastConfig(max_modes=1, long_window_min_modes=1)
+    span = WindowSpan(channels, 0, n - 1, TS, BAND, one, {})
+    told = measure_fundamental(span, None, along_z)
+    assert told.fit is not None and abs(told.omega1 - 98.0) < 0.5
+    assert "band_peak" in told.failed
+    assert "band_peak" not in measure_fundamental(span, None).failed
+    three = FastConfig(max_modes=3)
+    both = measure_fundamental(WindowSpan(channels, 0, n - 1, TS, BAND, three, {}), None, along_z)
+    assert "band_peak" not in both.failed
+    assert abs(both.omega1 - 68.0) < 0.1
+
+
 def test_the_slip_reference_needs_the_same_fundamental_in_the_half_window() -> None:
     # The slip check compares the static loads of the window's first half with the whole
     # window's. A half window whose fit put a slow, fast-decaying mode where the fundamental is

@@ -230,27 +230,42 @@ def misses_band_peak(
     sample_period: float,
     band: tuple[float, float],
     config: FastConfig,
+    push_direction: FloatArray | None = None,
 ) -> bool:
-    """Whether ``fit`` (of ``signals``, shape (n, K)) misses the highest clear peak
-    (:data:`_CLEAR_PEAK`) in ``band`` (rad/s) of the channels' summed spectrum: none of its
-    modes detected at ``config.min_detection`` lies within the half width of the Hann window's
-    main lobe, 4 pi / T_w, of the peak (True without a fit, when the band holds a clear peak).
-    Each channel is divided by its noise (:func:`.pencil.difference_scale`, which no fit
-    changes) and rid of the fit's static part at ``config.polynomial_degree``
-    (:class:`.design.ModelDesign`'s polynomial columns); False when the band holds no clear
-    peak."""
+    """Whether ``fit`` (of ``signals``, the five contact-load channels, shape (n, 5)) misses
+    the highest clear peak (:data:`_CLEAR_PEAK`) in ``band`` (rad/s) of the channels' summed
+    spectrum or, with ``push_direction`` (as in :func:`find_fundamental`), of the push plane's
+    (:mod:`.planes`: the reaction along the push and the moment across it): none of its modes
+    detected at ``config.min_detection`` lies within the half width of the Hann window's main
+    lobe, 4 pi / T_w, of the peak (True without a fit, when the band holds a clear peak).
+    The push plane's own spectrum is asked because a strong vibration of the free plane can
+    hide its peak in the sum, and without the push plane's mode :func:`find_fundamental`
+    cannot tell the free plane's other vibrations from the fundamental. Each channel is
+    divided by its noise (:func:`.pencil.difference_scale`, which no fit changes) and rid of
+    the fit's static part at ``config.polynomial_degree`` (:class:`.design.ModelDesign`'s
+    polynomial columns); False when neither spectrum holds a clear peak."""
     n = signals.shape[0]
     scaled = signals / difference_scale(signals)
     static = ModelDesign(n, sample_period, config.polynomial_degree).fixed
     coef, *_ = np.linalg.lstsq(static, scaled, rcond=None)
-    omega, power = power_spectrum(scaled - static @ coef, sample_period, zero_padding=2)
-    peak = find_peak(omega, power.sum(axis=1), band)
-    if peak is None or peak.quality < _CLEAR_PEAK:
-        return False
-    if fit is None:
-        return True
-    near = np.abs(fit.omega - peak.omega) <= 4.0 * math.pi / (n * sample_period)
-    return not bool(np.any(near & (fit.detection() >= config.min_detection)))
+    residual = scaled - static @ coef
+    spectra = [residual]
+    if push_direction is not None and float(np.hypot(*push_direction)) > 0.0:
+        u = np.asarray(push_direction, dtype=float) / float(np.hypot(*push_direction))
+        v = np.array([-u[1], u[0]])
+        spectra.append(np.stack([residual[:, 0:2] @ u, residual[:, 3:5] @ v], axis=1))
+    lobe = 4.0 * math.pi / (n * sample_period)
+    for channels in spectra:
+        omega, power = power_spectrum(channels, sample_period, zero_padding=2)
+        peak = find_peak(omega, power.sum(axis=1), band)
+        if peak is None or peak.quality < _CLEAR_PEAK:
+            continue
+        if fit is None:
+            return True
+        near = np.abs(fit.omega - peak.omega) <= lobe
+        if not np.any(near & (fit.detection() >= config.min_detection)):
+            return True
+    return False
 
 
 @functools.cache
@@ -374,9 +389,10 @@ def measure_fundamental(
             notes.append(note)
             failed.add("periods")
         window = span.channels[span.rest_index : span.end_index + 1]
-        if misses_band_peak(window, fit, span.sample_period, band, config):
+        if misses_band_peak(window, fit, span.sample_period, band, config, push_direction):
             # A clear vibration of the band that no detected mode reads: the fundamental
-            # found may be another vibration (a slide's ring) beside the contact's own
+            # found may be another vibration (a slide's ring, the free plane's own) beside
+            # the contact's
             notes.append(
                 "the fit leaves the window's clear spectral peak in the omega_1 band unread"
             )
