@@ -2,7 +2,9 @@
 
 Each figure has four views (from the front, the side, above, and an oblique view), the points
 (in cm, display edge) coloured by their worst-direction standard deviation (mm), the surface's
-mesh in grey when there is one, and the recognised shape's mesh as a wire frame.
+mesh in grey when there is one, and the recognised shape's mesh as a wire frame. Every view is
+a cube, one span on all three axes (:func:`cube_limits`), so that points on one plane or one
+line keep their scale.
 """
 
 from __future__ import annotations
@@ -11,10 +13,11 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from sensing_antenna.mapping.contact_map import ContactMap
 
-__all__ = ["VIEWS", "plot_map"]
+__all__ = ["LEAST_SPAN_CM", "VIEWS", "cube_limits", "plot_map"]
 
 #: (title, elevation, azimuth, the axis seen end-on or None) of each view, degrees.
 VIEWS = (
@@ -23,6 +26,23 @@ VIEWS = (
     ("above", 90.0, -90.0, "z"),
     ("oblique", 25.0, -135.0, None),
 )
+
+
+#: Least span (cm) of the views' axes: a single point or a few close ones still get a box.
+LEAST_SPAN_CM = 2.0
+
+
+def cube_limits(coordinates: np.ndarray) -> np.ndarray | None:
+    """Limits (low, high) of x, y and z, shape (3, 2), one span for all three: the largest
+    extent of ``coordinates`` (n, 3), widened by 5 % and to at least :data:`LEAST_SPAN_CM`,
+    about each axis's middle; None without finite coordinates."""
+    finite = coordinates[np.all(np.isfinite(coordinates), axis=1)]
+    if not len(finite):
+        return None
+    low, high = finite.min(axis=0), finite.max(axis=0)
+    half = max(1.05 * float(np.max(high - low)), LEAST_SPAN_CM) / 2.0
+    middle = (low + high) / 2.0
+    return np.stack([middle - half, middle + half], axis=1)
 
 
 def plot_map(contact_map: ContactMap, path: Path) -> Path:
@@ -35,6 +55,12 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
     shape = None
     if contact_map.recognition is not None:
         shape = contact_map.recognition.best.mesh
+    parts = [points]
+    if mesh is not None and len(mesh.faces):
+        parts.append(mesh.vertices * 100.0)
+    if shape is not None:
+        parts.append(shape.vertices * 100.0)
+    limits = cube_limits(np.concatenate(parts))
     scatter = None
     for index, (title, elevation, azimuth, end_on) in enumerate(VIEWS, start=1):
         ax = fig.add_subplot(2, 2, index, projection="3d")
@@ -53,7 +79,11 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
         if len(points):
             scatter = ax.scatter(*points.T, c=std, cmap="viridis", s=18, depthshade=False)
         ax.view_init(elev=elevation, azim=azimuth)
-        ax.set_aspect("equal")
+        if limits is not None:
+            # one span on every axis in a cubic box: equal scales, even for points on one
+            # plane or one line, whose thin axis would otherwise squeeze the view to a sliver
+            ax.set(xlim=limits[0], ylim=limits[1], zlim=limits[2])
+            ax.set_box_aspect((1.0, 1.0, 1.0))
         ax.set_title(title)
         for name in "xyz":
             axis = getattr(ax, f"{name}axis")
@@ -61,6 +91,7 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
                 axis.set_ticklabels([])
                 axis.set_label_text("")
             else:
+                axis.set_major_locator(MaxNLocator(nbins=4))  # labels that do not run together
                 axis.set_label_text(f"{name} (cm)")
     if scatter is not None:
         fig.colorbar(
