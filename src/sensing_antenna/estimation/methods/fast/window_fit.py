@@ -244,20 +244,22 @@ def misses_band_peak(
     divided by its noise (:func:`.pencil.difference_scale`, which no fit changes) and rid of
     the fit's static part at ``config.polynomial_degree`` (:class:`.design.ModelDesign`'s
     polynomial columns); False when neither spectrum holds a clear peak."""
-    n = signals.shape[0]
+    n, k = signals.shape
     scaled = signals / difference_scale(signals)
-    static = ModelDesign(n, sample_period, config.polynomial_degree).fixed
-    coef, *_ = np.linalg.lstsq(static, scaled, rcond=None)
-    residual = scaled - static @ coef
-    spectra = [residual]
+    static = _static_basis(n, sample_period, config.polynomial_degree)
+    columns = [scaled - static @ (static.T @ scaled)]
     if push_direction is not None and float(np.hypot(*push_direction)) > 0.0:
         u = np.asarray(push_direction, dtype=float) / float(np.hypot(*push_direction))
         v = np.array([-u[1], u[0]])
-        spectra.append(np.stack([residual[:, 0:2] @ u, residual[:, 3:5] @ v], axis=1))
+        residual = columns[0]
+        columns.append(np.stack([residual[:, 0:2] @ u, residual[:, 3:5] @ v], axis=1))
+    # one transform for the channels and the push plane's two
+    omega, power = power_spectrum(np.hstack(columns), sample_period, zero_padding=2)
     lobe = 4.0 * math.pi / (n * sample_period)
-    for channels in spectra:
-        omega, power = power_spectrum(channels, sample_period, zero_padding=2)
-        peak = find_peak(omega, power.sum(axis=1), band)
+    for summed in (power[:, :k], power[:, k:]):
+        if not summed.shape[1]:
+            continue
+        peak = find_peak(omega, summed.sum(axis=1), band)
         if peak is None or peak.quality < _CLEAR_PEAK:
             continue
         if fit is None:
@@ -266,6 +268,14 @@ def misses_band_peak(
         if not np.any(near & (fit.detection() >= config.min_detection)):
             return True
     return False
+
+
+@functools.lru_cache(maxsize=64)
+def _static_basis(n: int, sample_period: float, degree: int) -> FloatArray:
+    """Orthonormal columns, shape (n, degree + 1), spanning the fit's polynomial part of a
+    window of ``n`` samples (:class:`.design.ModelDesign`'s polynomial columns)."""
+    basis, _ = np.linalg.qr(ModelDesign(n, sample_period, degree).fixed)
+    return np.asarray(basis, dtype=float)
 
 
 @functools.cache
