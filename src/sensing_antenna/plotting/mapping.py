@@ -13,11 +13,12 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from sensing_antenna.mapping.contact_map import ContactMap
 
-__all__ = ["LEAST_SPAN_CM", "VIEWS", "cube_limits", "plot_map"]
+__all__ = ["LEAST_SPAN_CM", "VIEWS", "cube_limits", "map_figure", "plot_map"]
 
 #: (title, elevation, azimuth, the axis seen end-on or None) of each view, degrees.
 VIEWS = (
@@ -30,6 +31,9 @@ VIEWS = (
 
 #: Least span (cm) of the views' axes: a single point or a few close ones still get a box.
 LEAST_SPAN_CM = 2.0
+
+#: Most faces of a recognised shape's mesh drawn as a wire frame (more would draw slowly).
+_WIRE_FRAME_FACES = 20000
 
 
 def cube_limits(coordinates: np.ndarray) -> np.ndarray | None:
@@ -47,14 +51,24 @@ def cube_limits(coordinates: np.ndarray) -> np.ndarray | None:
 
 def plot_map(contact_map: ContactMap, path: Path) -> Path:
     """Draw the map's points from the four :data:`VIEWS` into ``path``; returns ``path``."""
+    fig = map_figure(contact_map)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def map_figure(contact_map: ContactMap) -> Figure:
+    """The figure of :func:`plot_map`: four 3-D views (cm) of the map's used points, coloured
+    by their sigma, over the surface mesh and the recognised shape's wire frame."""
     used = contact_map.used
     fig = plt.figure(figsize=(11, 9))
     points = np.array([p.point for p in used]).reshape(-1, 3) * 100.0
     std = np.array([p.std for p in used]) * 1000.0
     mesh = contact_map.surface_mesh
-    shape = None
+    shape = None  # drawn as a wire frame when it has few enough faces to draw quickly
     if contact_map.recognition is not None:
-        shape = contact_map.recognition.best.mesh
+        best = contact_map.recognition.best.mesh
+        shape = best if best is not None and len(best.faces) < _WIRE_FRAME_FACES else None
     parts = [points]
     if mesh is not None and len(mesh.faces):
         parts.append(mesh.vertices * 100.0)
@@ -72,7 +86,7 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
                 alpha=0.35,
                 linewidth=0,
             )
-        if shape is not None and len(shape.faces) < 20000:
+        if shape is not None:
             edges = shape.vertices[shape.edges_unique] * 100.0
             for a, b in edges[:: max(1, len(edges) // 600)]:
                 ax.plot(*zip(a, b, strict=True), color="tab:green", linewidth=0.4, alpha=0.5)
@@ -102,6 +116,4 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
     decision = "" if contact_map.recognition is None else f": {contact_map.recognition.decision}"
     fig.suptitle(f"{len(used)} contact points{decision}")
     fig.subplots_adjust(left=0.02, right=0.85, wspace=0.1, hspace=0.15)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return fig
