@@ -154,9 +154,9 @@ def scan(
     """Evaluate the growing window on the evaluation grid until sure, the cap or the samples' end.
 
     The windows are those of :func:`evaluations` (``caches`` as there); ``earliest`` is the end
-    of the pipeline's hold, before which there is no contact frame. Only the window concluded on
-    gets the slip check's early statics (they do not decide ``sure``), added after from the
-    cached fits (:func:`.window.with_early_statics_of`).
+    of the pipeline's hold, before which there is no contact frame. With the direction check on,
+    only the window concluded on gets the slip check's early statics (they do not decide
+    ``sure``), added after from the cached fits (:func:`.window.with_early_statics_of`).
     """
     if caches is None:
         caches = ({}, {})

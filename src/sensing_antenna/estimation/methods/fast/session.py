@@ -130,18 +130,20 @@ class FastSession:
         """The shorter windows the evaluations from ``hold_end`` on read besides their own, as
         (start, end, cache: 0 from t_1, 1 from the hold's end, the first grid instant that reads
         it), by end: for every grid instant at or after ``hold_end``, the drift check's
-        reference (2/3) and the slip check's (1/2) of its window from t_1 and, once an
-        evaluation restarted at the hold's end, of its window from there."""
+        reference (2/3) and, with the direction check on, the slip check's (1/2) of its window
+        from t_1 and, once an evaluation restarted at the hold's end, of its window from
+        there."""
         key = (rest_index, hold_end, sample_period, self._restarted)
         if self._planned[0] == key:
             return self._planned[1]
         config = self.method.config
         instants = rest_index + evaluation_offsets(sample_period, config)
         starts = [(rest_index, 0)] + ([(hold_end, 1)] if self._restarted else [])
+        fractions = (2.0 / 3.0,) if config.max_direction_drift is None else (2.0 / 3.0, 0.5)
         first_reader: dict[tuple[int, int, int], int] = {}
         for j in instants[instants >= hold_end][::-1]:
             for begin, cache in starts:
-                for fraction in (2.0 / 3.0, 0.5):
+                for fraction in fractions:
                     end = reference_index(begin, int(j), fraction, sample_period, config)
                     if end is not None:
                         first_reader[(begin, end, cache)] = int(j)

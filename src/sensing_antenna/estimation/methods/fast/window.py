@@ -360,8 +360,8 @@ def evaluate_window(
         and config.tolerance < posterior.width <= config.cap_tolerance
         # the ratio's model term must bound it where its statistical error goes
         and (not math.isfinite(ratio) or bool(np.all(np.asarray(ratio_model) > 0.0)))
-        # long enough for the slip check's reference (its first half holds min_periods), which
-        # the cap's window would have had
+        # twice min_periods, as the cap's window would hold: with the direction check on, its
+        # first half is the slip check's reference
         and fit is not None
         and periods_held(fit, omega1) >= 2.0 * config.min_periods
         and posterior.width
@@ -558,7 +558,8 @@ def evaluate_from_t1_or_hold(
     (2 pi / their distance): one mode in a shorter one may be both.
     ``caches`` holds the fits of the windows from t_1 and of those restarted; None refits.
     ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
-    gets the slip check's early statics (:func:`with_early_statics_of`).
+    gets the slip check's early statics when the direction check is on
+    (:func:`with_early_statics_of`).
     """
     early, late = caches if caches is not None else (None, None)
     window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
