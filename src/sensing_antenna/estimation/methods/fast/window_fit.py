@@ -240,19 +240,24 @@ def misses_band_peak(
     lobe, 4 pi / T_w, of the peak (True without a fit, when the band holds a clear peak).
     The push plane's own spectrum is asked because a strong vibration of the free plane can
     hide its peak in the sum, and without the push plane's mode :func:`find_fundamental`
-    cannot tell the free plane's other vibrations from the fundamental. Each channel is
-    divided by its noise (:func:`.pencil.difference_scale`, which no fit changes) and rid of
-    the fit's static part at ``config.polynomial_degree`` (:class:`.design.ModelDesign`'s
-    polynomial columns); False when neither spectrum holds a clear peak."""
+    cannot tell the free plane's other vibrations from the fundamental. The channels are rid
+    of the fit's static part at ``config.polynomial_degree`` (:class:`.design.ModelDesign`'s
+    polynomial columns); each channel of either spectrum, the push plane's projected in
+    physical units first, is divided by its noise (:func:`.pencil.difference_scale`). False
+    when neither spectrum holds a clear peak."""
     n, k = signals.shape
-    scaled = signals / difference_scale(signals)
     static = _static_basis(n, sample_period, config.polynomial_degree)
-    columns = [scaled - static @ (static.T @ scaled)]
-    if push_direction is not None and float(np.hypot(*push_direction)) > 0.0:
-        u = np.asarray(push_direction, dtype=float) / float(np.hypot(*push_direction))
-        v = np.array([-u[1], u[0]])
-        residual = columns[0]
-        columns.append(np.stack([residual[:, 0:2] @ u, residual[:, 3:5] @ v], axis=1))
+    dynamic = signals - static @ (static.T @ signals)
+    columns = [dynamic / difference_scale(signals)]
+    if push_direction is not None and k == 5:
+        length = float(np.hypot(*push_direction))
+        if math.isfinite(length) and length > 0.0:
+            # projected in physical units, then each over its noise: scaling the channels
+            # first would turn the projection off the push plane when their noises differ
+            u = np.asarray(push_direction, dtype=float) / length
+            v = np.array([-u[1], u[0]])
+            plane = np.stack([dynamic[:, 0:2] @ u, dynamic[:, 3:5] @ v], axis=1)
+            columns.append(plane / difference_scale(plane))
     # one transform for the channels and the push plane's two
     omega, power = power_spectrum(np.hstack(columns), sample_period, zero_padding=2)
     lobe = 4.0 * math.pi / (n * sample_period)
@@ -275,7 +280,9 @@ def _static_basis(n: int, sample_period: float, degree: int) -> FloatArray:
     """Orthonormal columns, shape (n, degree + 1), spanning the fit's polynomial part of a
     window of ``n`` samples (:class:`.design.ModelDesign`'s polynomial columns)."""
     basis, _ = np.linalg.qr(ModelDesign(n, sample_period, degree).fixed)
-    return np.asarray(basis, dtype=float)
+    basis = np.asarray(basis, dtype=float)
+    basis.setflags(write=False)  # shared by every caller through the cache
+    return basis
 
 
 @functools.cache
