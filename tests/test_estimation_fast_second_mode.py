@@ -9,7 +9,9 @@ use); the reference is where the simulated link touched (``true_xc``).
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -246,3 +248,49 @@ def test_a_second_mode_short_of_a_choice_still_keeps_an_answer_on_the_ratios_bra
     assert result.t_e - result.t_1 > 0.5  # it waited (it had answered at 0.215 s)
     assert result.diagnostics["branch_chosen_by"] == "omega2"
     _held_back_on_the_touched_branch(result, truth, _streamed(recording, model))
+
+
+def test_omega2_does_not_choose_a_branch_when_both_branches_omega2_ring(
+    near_top: tuple[Recording, float],
+) -> None:
+    # A posterior holding the touch's branch (70 %) and, at 0.65 m, the other (30 %): the
+    # window's spectrum has a clear peak near the touch's omega_2 only, so omega_2 narrows the
+    # posterior onto the touch's branch. The same samples with a ring added after t_1 at
+    # omega_2 of 0.65 m (about 185 rad/s, away from 2 and 3 omega_1): a clear peak near each
+    # branch's omega_2, so omega_2 cannot choose and is not used.
+    recording, true_xc = near_top
+    rival_xc = 0.65
+    rival_omega2 = float(natural_frequencies(DEVICE.link, np.array([rival_xc]), 2)[0][1])
+
+    def two_branch_posterior(window: Any) -> ContactPosterior:
+        grid = window.posterior.grid
+        density = 0.7 * (np.abs(grid - true_xc) <= 0.003) / np.sum(np.abs(grid - true_xc) <= 0.003)
+        density += (
+            0.3 * (np.abs(grid - rival_xc) <= 0.003) / np.sum(np.abs(grid - rival_xc) <= 0.003)
+        )
+        blank = dataclasses.replace(window.posterior, density=density / density.sum())
+        posterior = blank.times(np.ones(grid.size))
+        assert posterior is not None
+        assert posterior.branch_of(rival_xc) != posterior.branch_of(posterior.x_c)
+        return posterior
+
+    evidence = gather(recording, WITH_MODE2)
+    assert isinstance(evidence, Evidence)
+    window = FastMethod().history(evidence)[-1]
+    narrowed, notes = narrowed_by_second_mode(
+        evidence, window, two_branch_posterior(window), FastConfig()
+    )
+    assert narrowed is not None and narrowed.branch_of(narrowed.x_c) == narrowed.branch_of(true_xc)
+
+    t_1 = float(evidence.t[evidence.rest_index])
+    after = recording.t >= t_1
+    ring = 1e-4 * np.sin(rival_omega2 * (recording.t - t_1)) * after
+    ringing = dataclasses.replace(recording, torque=recording.torque + ring[:, None])
+    evidence = gather(ringing, WITH_MODE2)
+    assert isinstance(evidence, Evidence)
+    window = FastMethod().history(evidence)[-1]
+    narrowed, notes = narrowed_by_second_mode(
+        evidence, window, two_branch_posterior(window), FastConfig()
+    )
+    assert narrowed is None
+    assert "both branches" in notes["not_used"]

@@ -17,6 +17,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.config import FastConfig
@@ -40,6 +41,8 @@ __all__ = [
     "second_mode_chooser",
     "second_mode_objection",
 ]
+
+FloatArray = NDArray[np.float64]
 
 #: Which of two candidate contact points (m) the window [start, end] (sample indices) with
 #: fundamental omega_1 (rad/s) supports: 0, 1 or None when it does not say, and the test's
@@ -231,6 +234,9 @@ def narrowed_by_second_mode(
     sigma and how far it lies from the model over the posterior's interval. A peak farther
     than ``max_disagreement`` sigmas from omega_2 at every x_c of the interval is not used and
     is said (``"disagrees"``): the device departs from the model more than its calibration.
+    Nor is it used when the posterior holds another branch whose own omega_2 has a clear peak
+    of its own (:func:`_rival_peak`): the likelihood would choose the branch the posterior's
+    maximum happened to lie on, where the second-mode test chose none.
     """
     link = evidence.antenna.link
     if link.mode2_scatter is None or link.calibrated_t is None:
@@ -249,6 +255,15 @@ def narrowed_by_second_mode(
     peak = second_mode_peak(samples, component, expected, window.omega1)
     if peak is None:
         return None, {"not_used": f"no clear peak of omega_2 near {expected:.1f} rad/s"}
+    rival = _rival_peak(samples, component, posterior, omega2_of_x, window.omega1, peak.omega)
+    if rival is not None:
+        return None, {
+            "not_used": (
+                f"clear peaks near the second contact modes of both branches of omega_1 "
+                f"({peak.omega:.1f} rad/s near {expected:.1f}, {rival[1]:.1f} rad/s near "
+                f"{rival[0]:.1f}, x_c = {rival[2]:.3f} m)"
+            )
+        }
     # the model's error, and the peak's own: the Cramer-Rao bound of a sinusoid's frequency in
     # white noise over T_w, 3 / (Q T_w^2) with Q the spectrum's signal to noise, doubled for
     # the windowed peak's estimator and the median the quality is taken over
@@ -275,3 +290,29 @@ def narrowed_by_second_mode(
         )
         return None, notes
     return posterior.times(np.exp(-0.5 * z**2)), notes
+
+
+def _rival_peak(
+    samples: Evidence,
+    component: str,
+    posterior: ContactPosterior,
+    omega2_of_x: FloatArray,
+    omega1: float,
+    found: float,
+) -> tuple[float, float, float] | None:
+    """A clear peak of omega_2 for another branch than the posterior's maximum's, apart from the
+    peak ``found`` (rad/s) there: (that branch's omega_2 at its own maximum, the peak, that
+    maximum x_c), all rad/s but x_c (m); None when no branch holding at least 1 - ``level`` of
+    the posterior mass has one. Peaks within ``omega2_window`` of ``found`` are the same peak
+    (near the top of omega_1(x_c) both branches' omega_2 meet)."""
+    window = samples.config.omega2_window
+    own = posterior.branch_of(posterior.x_c)
+    for branch, mass in enumerate(posterior.branch_probability):
+        if branch == own or mass < 1.0 - posterior.level:
+            continue
+        on_branch = posterior.given_branch(branch)
+        expected = float(np.interp(on_branch.x_c, posterior.grid, omega2_of_x))
+        peak = second_mode_peak(samples, component, expected, omega1)
+        if peak is not None and abs(peak.omega - found) > window * found:
+            return expected, peak.omega, on_branch.x_c
+    return None
