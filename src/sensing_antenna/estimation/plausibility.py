@@ -74,7 +74,7 @@ from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes
-from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve, two_frequency_curve
 from sensing_antenna.estimation.front.ratio import contact_loads, lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
@@ -518,7 +518,7 @@ def _bend_at_touch(
     reach = -(moved @ push)
     age = evidence.t[k : last + 1] - evidence.t[k]
     columns = [np.ones_like(age), reach]
-    for omega in natural_frequencies(evidence.antenna.link, x_c, 2):
+    for omega in _contact_modes(evidence, x_c):
         columns += [np.sin(omega * age), np.cos(omega * age)]
     design = np.column_stack(columns)
     free = bends.size - design.shape[1]
@@ -528,6 +528,19 @@ def _bend_at_touch(
             covariance = np.linalg.pinv(design.T @ design) * float(residual[0]) / free
             return float(fit[0]), math.sqrt(max(float(covariance[0, 0]), 0.0))
     return math.nan, math.inf
+
+
+def _contact_modes(evidence: Evidence, x_c: float) -> tuple[float, float]:
+    """omega_1 and omega_2 (rad/s) of the straight link in contact at ``x_c`` (m): from the
+    tabulated curve over the contact range (shared with the second-mode test), solved where
+    ``x_c`` lies outside it."""
+    link = evidence.antenna.link
+    low, high = (bound * link.length for bound in evidence.config.contact_range)
+    grid, omegas = two_frequency_curve(link, low, high)
+    if not grid[0] <= x_c <= grid[-1]:
+        first, second = natural_frequencies(link, x_c, 2)
+        return float(first), float(second)
+    return float(np.interp(x_c, grid, omegas[:, 0])), float(np.interp(x_c, grid, omegas[:, 1]))
 
 
 def _bend_against_turn(

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.ndimage import maximum_filter1d
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.estimation.config import periods_in
@@ -167,10 +168,8 @@ def find_spikes(
         # without a median for every calm sample).
         if size - w == 1:  # one sample to judge (the stream's case): no sliding window
             largest = absd[:w].max(axis=0)[None, :]
-        else:
-            largest = np.lib.stride_tricks.sliding_window_view(absd[: size - 1], w, axis=0).max(
-                axis=-1
-            )
+        else:  # the running maximum of w steps, each row's window starting at that row
+            largest = maximum_filter1d(absd[: size - 1], w, axis=0, origin=-(w // 2))[: size - w]
         step = d[w:]
         candidate = absd[w:] + largest >= judged_from(floor)
         rows = np.flatnonzero(candidate.any(axis=1))
