@@ -262,8 +262,14 @@ def test_a_second_campaign_on_the_same_directory_is_refused_and_runs_nothing(
     out = tmp_path / "out"
     first = start_campaign(spec, out)
     wait_for_runs(out, first, 2)
-    second = start_campaign(spec, out)
-    printed, err = second.communicate(timeout=120)
+    # the first paused while the second starts, so that it cannot finish its runs (and free the
+    # directory) before the second has looked: it still holds the directory, as a busy one does
+    os.kill(first.pid, signal.SIGSTOP)
+    try:
+        second = start_campaign(spec, out)
+        printed, err = second.communicate(timeout=120)
+    finally:
+        os.kill(first.pid, signal.SIGCONT)
     assert second.returncode == 2
     assert printed == ""
     assert err.startswith(
