@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import matplotlib.image
+import matplotlib.pyplot as plt
 import numpy as np
 
 from _contacts import contacts
@@ -56,6 +57,7 @@ def test_collinear_points_are_drawn_in_cubic_views_that_hold_them(tmp_path: Path
         assert np.allclose(spans, spans[0]) and spans[0] >= 21.0
         assert np.all(limits[:, 0] < points.min(axis=0) * 100.0)
         assert np.all(points.max(axis=0) * 100.0 < limits[:, 1])
+    plt.close(figure)
     path = plot_map(contact_map, tmp_path / "map.png")
     image = matplotlib.image.imread(path)
     assert image.shape[0] > 500 and image.shape[1] > 500

@@ -235,8 +235,9 @@ def narrowed_by_second_mode(
     than ``max_disagreement`` sigmas from omega_2 at every x_c of the interval is not used and
     is said (``"disagrees"``): the device departs from the model more than its calibration.
     Nor is it used when the posterior holds another branch whose own omega_2 has a clear peak
-    of its own (:func:`_rival_peak`): the likelihood would choose the branch the posterior's
-    maximum happened to lie on, where the second-mode test chose none.
+    of its own (:func:`_rival_peak`): a spectrum ringing near both branches' omega_2 does not
+    tell them apart, and the likelihood would choose the branch the posterior's maximum
+    happened to lie on.
     """
     link = evidence.antenna.link
     if link.mode2_scatter is None or link.calibrated_t is None:
@@ -308,7 +309,7 @@ def _rival_peak(
     window = samples.config.omega2_window
     own = posterior.branch_of(posterior.x_c)
     for branch, mass in enumerate(posterior.branch_probability):
-        if branch == own or mass < 1.0 - posterior.level:
+        if branch == own or not mass >= 1.0 - posterior.level:
             continue
         on_branch = posterior.given_branch(branch)
         expected = float(np.interp(on_branch.x_c, posterior.grid, omega2_of_x))

@@ -360,8 +360,8 @@ def evaluate_window(
         and config.tolerance < posterior.width <= config.cap_tolerance
         # the ratio's model term must bound it where its statistical error goes
         and (not math.isfinite(ratio) or bool(np.all(np.asarray(ratio_model) > 0.0)))
-        # twice min_periods, as the cap's window would hold: with the direction check on, its
-        # first half is the slip check's reference
+        # twice min_periods, which a window reaching the cap holds anyway; with the direction
+        # check on, its first half is the slip check's reference
         and fit is not None
         and periods_held(fit, omega1) >= 2.0 * config.min_periods
         and posterior.width

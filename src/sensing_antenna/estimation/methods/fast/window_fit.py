@@ -250,7 +250,7 @@ def misses_band_peak(
     dynamic = signals - static @ (static.T @ signals)
     columns = [dynamic / difference_scale(signals)]
     if push_direction is not None and k == 5:
-        length = float(np.hypot(*push_direction))
+        length = float(np.hypot(push_direction[0], push_direction[1]))
         if math.isfinite(length) and length > 0.0:
             # projected in physical units, then each over its noise: scaling the channels
             # first would turn the projection off the push plane when their noises differ
