@@ -74,7 +74,7 @@ from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes
-from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve, two_frequency_curve
+from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.front.ratio import contact_loads, lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
@@ -531,14 +531,11 @@ def _bend_at_touch(
 
 
 def _contact_modes(evidence: Evidence, x_c: float) -> tuple[float, float]:
-    """omega_1 and omega_2 (rad/s) of the straight link in contact at ``x_c`` (m): from the
-    tabulated curve over the contact range (shared with the second-mode test), solved where
-    ``x_c`` lies outside it."""
-    link = evidence.antenna.link
-    low, high = (bound * link.length for bound in evidence.config.contact_range)
-    grid, omegas = two_frequency_curve(link, low, high)
+    """omega_1 and omega_2 (rad/s) of the straight link in contact at ``x_c`` (m): read from
+    :attr:`Evidence.contact_modes`, solved where ``x_c`` lies outside its grid."""
+    grid, omegas = evidence.contact_modes
     if not grid[0] <= x_c <= grid[-1]:
-        first, second = natural_frequencies(link, x_c, 2)
+        first, second = natural_frequencies(evidence.antenna.link, x_c, 2)
         return float(first), float(second)
     return float(np.interp(x_c, grid, omegas[:, 0])), float(np.interp(x_c, grid, omegas[:, 1]))
 

@@ -297,6 +297,15 @@ class Evidence:
         return self.gap_within(t_end) or self.held_within(t_end) or self.corrupted_within(t_end)
 
     @property
+    def contact_modes(self) -> tuple[FloatArray, FloatArray]:
+        """The tabulated (omega_1, omega_2)(x_c) over the config's contact range
+        (:func:`two_frequency_curve`, cached): contact points (m), shape (m,), and the two
+        frequencies (rad/s), shape (m, 2)."""
+        link = self.antenna.link
+        low, high = self.config.contact_range
+        return two_frequency_curve(link, low * link.length, high * link.length)
+
+    @property
     def spectrum_slice(self) -> slice:
         """Samples of the Delta t_e1 window after t_1 (shortened if the samples end first)."""
         n_window = round(self.config.spectrum_window / self.sample_period)

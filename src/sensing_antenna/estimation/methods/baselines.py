@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.estimation.front.evidence import Evidence, two_frequency_curve
+from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.front.ratio import paper_ratio
 from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_frequency,
@@ -90,12 +90,10 @@ class TwoFrequencyMethod:
     def conclude(self, evidence: Evidence) -> ContactEstimate:
         """Measure omega_1 and omega_2 and locate them on the curve."""
         cfg = evidence.config
-        link = evidence.antenna.link
         measurement = evidence_frequency(evidence)
         problems: list[tuple[Status, str]] = []
         diag: dict[str, Any] = {"torque_component": measurement.component}
-        x_range = (cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length)
-        grid, omegas = two_frequency_curve(link, *x_range)
+        grid, omegas = evidence.contact_modes
         omega2 = math.nan
         x_c = math.nan
         if measurement.clear and measurement.component in ("y_c", "z_c", "sum"):

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve, two_frequency_curve
+from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_frequency,
     evidence_spectrum,
@@ -295,11 +295,7 @@ def predicted_omega2(evidence: Evidence, candidates: Sequence[float]) -> list[fl
     """omega_2 (rad/s) at each candidate contact point (m), from the tabulated (omega_1,
     omega_2) curve (0.5 mm grid, far finer than the ``omega2_window`` search) instead of solving
     the beam model at t_e."""
-    cfg = evidence.config
-    link = evidence.antenna.link
-    grid, omegas = two_frequency_curve(
-        link, cfg.contact_range[0] * link.length, cfg.contact_range[1] * link.length
-    )
+    grid, omegas = evidence.contact_modes
     return [float(np.interp(x, grid, omegas[:, 1])) for x in candidates]
 
 
