@@ -17,9 +17,11 @@ import matplotlib.pyplot as plt
 __all__ = ["save_figure"]
 
 
-def save_figure(fig: Any, path: Path, dpi: int = 120) -> Path:
-    """Lay out, write and close a figure; returns ``path``."""
-    fig.tight_layout()
+def save_figure(fig: Any, path: Path, dpi: int = 120, tight: bool = True) -> Path:
+    """Lay out (``tight``: Matplotlib's tight layout; False keeps the figure's own), write and
+    close a figure; returns ``path``."""
+    if tight:
+        fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path

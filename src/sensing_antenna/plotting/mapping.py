@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from sensing_antenna.mapping.contact_map import ContactMap
+from sensing_antenna.plotting import save_figure
 
 __all__ = ["LEAST_SPAN_CM", "VIEWS", "cube_limits", "map_figure", "plot_map"]
 
@@ -51,10 +52,8 @@ def cube_limits(coordinates: np.ndarray) -> np.ndarray | None:
 
 def plot_map(contact_map: ContactMap, path: Path) -> Path:
     """Draw the map's points from the four :data:`VIEWS` into ``path``; returns ``path``."""
-    fig = map_figure(contact_map)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    # laid out by hand (:func:`map_figure`: the colour bar's own axes beside four 3-D views)
+    return save_figure(map_figure(contact_map), path, dpi=110, tight=False)
 
 
 def map_figure(contact_map: ContactMap) -> Figure:
