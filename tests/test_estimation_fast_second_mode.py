@@ -275,21 +275,23 @@ def test_omega2_does_not_choose_a_branch_when_both_branches_omega2_ring(
         assert posterior.branch_of(rival_xc) != posterior.branch_of(posterior.x_c)
         return posterior
 
-    def narrowed(samples: Recording, rival_mass: float) -> tuple[Any, dict[str, Any]]:
+    def windows(samples: Recording) -> tuple[Evidence, Any]:
         evidence = gather(samples, WITH_MODE2)
         assert isinstance(evidence, Evidence)
-        window = FastMethod().history(evidence)[-1]
+        return evidence, FastMethod().history(evidence)[-1]
+
+    def narrowed(at: tuple[Evidence, Any], rival_mass: float) -> tuple[Any, dict[str, Any]]:
+        evidence, window = at
         posterior = two_branch_posterior(window, rival_mass)
         return narrowed_by_second_mode(evidence, window, posterior, FastConfig())
 
-    quiet, _ = narrowed(recording, 0.3)
-    assert quiet is not None and quiet.branch_of(quiet.x_c) == quiet.branch_of(true_xc)
+    quiet = windows(recording)
+    narrow, _ = narrowed(quiet, 0.3)
+    assert narrow is not None and narrow.branch_of(narrow.x_c) == narrow.branch_of(true_xc)
 
-    evidence = gather(recording, WITH_MODE2)
-    assert isinstance(evidence, Evidence)
-    t_1 = float(evidence.t[evidence.rest_index])
+    t_1 = float(quiet[0].t[quiet[0].rest_index])
     ring = 1e-4 * np.sin(rival_omega2 * (recording.t - t_1)) * (recording.t >= t_1)
-    ringing = dataclasses.replace(recording, torque=recording.torque + ring[:, None])
+    ringing = windows(dataclasses.replace(recording, torque=recording.torque + ring[:, None]))
     for rival_mass in (0.3, 0.06):
         both, notes = narrowed(ringing, rival_mass)
         assert both is None
