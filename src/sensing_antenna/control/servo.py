@@ -50,10 +50,10 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import Antenna, Motor
+from sensing_antenna.compiler import njit
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [

@@ -43,11 +43,11 @@ from dataclasses import dataclass
 from typing import Literal, TypeAlias
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import lfilter_zi
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.compiler import njit
 from sensing_antenna.detection.filters import (
     df2t_step,
     low_pass_coefficients,

@@ -25,11 +25,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import lfilter_zi
 
 from sensing_antenna.antenna import FreeMotionObserver
+from sensing_antenna.compiler import njit
 from sensing_antenna.errors import SensingAntennaError
 
 __all__ = [

@@ -51,11 +51,11 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import lfilter_zi
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.compiler import njit
 from sensing_antenna.detection.contact import (
     DEFAULT_RESIDUAL_CUTOFF,
     ContactDetection,

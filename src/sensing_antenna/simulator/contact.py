@@ -31,9 +31,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from sensing_antenna.compiler import njit
 from sensing_antenna.simulator.scenario import SIZED_KINDS, ScenarioError
 
 __all__ = [

@@ -28,9 +28,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from sensing_antenna.compiler import njit
 from sensing_antenna.control.servo import joint_coupling_torques, joint_servo_step
 from sensing_antenna.simulator.contact import distance_and_normal
 from sensing_antenna.simulator.nonlinear_link import (

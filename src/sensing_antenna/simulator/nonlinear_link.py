@@ -34,9 +34,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from sensing_antenna.compiler import njit
 from sensing_antenna.simulator.link import LinkModel
 
 __all__ = [
