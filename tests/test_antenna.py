@@ -395,3 +395,25 @@ def test_the_frequency_model_is_as_uncertain_as_what_is_known_of_t() -> None:
     assert own.link.t_param == nominal.link.t_param
     assert own.link.frequency_uncertainty == 0.001
     assert nominal.self_calibrated() == own  # by default the floor a calibration may claim
+
+
+def test_a_sensor_no_calibration_measured_carries_its_nominal_cross_talk(tmp_path: Path) -> None:
+    # 1 % of a Nano17's 25 N per 0.25 N m full scale, spread uniformly: 1 / sqrt(3) N per N m
+    nominal = paper_antenna().sensor
+    assert nominal.coupling_uncertainty == pytest.approx(1.0 / math.sqrt(3.0), rel=1e-12)
+    # a calibration that measured the ratio's scatter bounds the cross-talk left by it
+    measured = dataclasses.replace(nominal, fy_per_tz=0.8, ratio_scatter=0.03)
+    assert measured.coupling_uncertainty == 0.0
+    # a simulation study's device identical to its model has none to fear
+    assert paper_antenna().self_calibrated().sensor.coupling_uncertainty == 0.0
+    # the sensor's own figure, read from the antenna file, and kept by a round trip
+    path = tmp_path / "a.toml"
+    text = antenna_to_toml(paper_antenna()) + "\n[sensor]\nnominal_coupling = 0.2\n"
+    path.write_text(text)
+    stated = load_antenna(path)
+    assert stated.sensor.coupling_uncertainty == 0.2
+    save_antenna(stated, tmp_path / "b.toml")
+    assert load_antenna(tmp_path / "b.toml").sensor == stated.sensor
+    path.write_text(text.replace("nominal_coupling = 0.2", "nominal_coupling = -1.0"))
+    with pytest.raises(SensingAntennaError, match=r"sensor\.nominal_coupling"):
+        load_antenna(path)

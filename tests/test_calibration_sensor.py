@@ -77,8 +77,11 @@ def test_sensor_section_round_trips_and_bad_values_name_the_field(tmp_path: Path
     save_antenna(antenna, path)
     assert "[sensor]" in path.read_text()
     assert load_antenna(path).sensor == antenna.sensor
-    save_antenna(ANTENNA, path)
+    save_antenna(paper_antenna(), path)
     assert "[sensor]" not in path.read_text()  # no correction, no section
+    # a device identical to its model fears no cross-talk, and says so in its file
+    save_antenna(ANTENNA, path)
+    assert load_antenna(path).sensor.coupling_uncertainty == 0.0
     for text, field in (
         ("[sensor]\nfy_gain = 3.0\n", "sensor.fy_gain"),
         ("[sensor]\nfz_per_ty = 1e4\n", "sensor.fz_per_ty"),

@@ -517,6 +517,13 @@ MAX_SENSOR_GAIN_ERROR = 1.0
 #: torque range in N and N m (an ATI Nano17's 25 N and 0.25 N m); cross-talk is a few per cent.
 MAX_SENSOR_COUPLING = 100.0
 
+#: Standard uncertainty of the lateral force read per unit moment (N per N m = 1/m) of a sensor
+#: whose cross-talk no calibration measured: an accuracy of 1 % of full scale per axis (the
+#: figure docs/simulator.md's realistic profile draws its coupling from) read as cross-talk of
+#: the moments into the lateral forces, spread uniformly over +-1 %: 1 % / sqrt(3) of 25 N per
+#: 0.25 N m on an ATI Nano17 SI-25-0.25, the paper's sensor, 0.58 N per N m.
+NOMINAL_SENSOR_COUPLING = 0.01 / math.sqrt(3.0) * 25.0 / 0.25
+
 
 @dataclass(frozen=True)
 class SensorCorrection:
@@ -544,6 +551,10 @@ class SensorCorrection:
         Relative scatter of the torque/force ratio about the known points with the correction,
         as its calibration measured it (dimensionless): the ratio's model uncertainty is at
         least this fraction of x_c. 0: not measured.
+    nominal_coupling : float
+        Standard uncertainty of the force read per unit moment (1/m) while no calibration has
+        measured the ratio's scatter (:attr:`coupling_uncertainty`): the sensor's accuracy
+        read as cross-talk; by default :data:`NOMINAL_SENSOR_COUPLING`, the paper's Nano17.
     """
 
     fy_gain: float = 1.0
@@ -553,6 +564,7 @@ class SensorCorrection:
     fz_per_ty: float = 0.0
     fz_per_tz: float = 0.0
     ratio_scatter: float = 0.0
+    nominal_coupling: float = NOMINAL_SENSOR_COUPLING
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -578,11 +590,30 @@ class SensorCorrection:
             raise AntennaConfigError(
                 "sensor.ratio_scatter", f"must lie in [0, 1], got {self.ratio_scatter!r}"
             )
+        if not 0.0 <= self.nominal_coupling <= MAX_SENSOR_COUPLING:
+            raise AntennaConfigError(
+                "sensor.nominal_coupling",
+                f"must lie in [0, {MAX_SENSOR_COUPLING:g}] 1/m (N per N m), got "
+                f"{self.nominal_coupling!r}",
+            )
+
+    @property
+    def coupling_uncertainty(self) -> float:
+        """Standard uncertainty of the cross-talk of the moments into the lateral forces left
+        after the correction (N per N m = 1/m): ``nominal_coupling`` until a calibration has
+        measured the ratio's scatter, 0 after (``ratio_scatter`` then bounds what is left).
+
+        A force read c Gamma too high, Gamma = x_c R_perp, moves the torque/force ratio from
+        x_c to x_c / (1 + c x_c): by about c x_c^2.
+        """
+        return 0.0 if self.ratio_scatter > 0.0 else self.nominal_coupling
 
     @property
     def is_identity(self) -> bool:
         """True when the correction changes no force (its scatter aside)."""
-        return replace(self, ratio_scatter=0.0) == SensorCorrection()
+        return replace(self, ratio_scatter=0.0, nominal_coupling=NOMINAL_SENSOR_COUPLING) == (
+            SensorCorrection()
+        )
 
     def correct(
         self, reaction: NDArray[np.float64], moment: NDArray[np.float64]
@@ -674,8 +705,11 @@ class Antenna:
         calibration of a device identical to it gives, for simulation studies that give the
         estimators the simulated device's own antenna (its T exactly, so a simulated run is
         unchanged). The default scatter is :data:`MODEL_FREQUENCY_FLOOR`, 0.1 %, the order
-        calibrations of the simulated device measure (0.01 to 0.12 %)."""
-        return self.with_calibrated_t(self.link.t_param, scatter)
+        calibrations of the simulated device measure (0.01 to 0.12 %). Its sensor is the
+        model's own, so no cross-talk beyond its correction is feared
+        (``sensor.nominal_coupling`` 0)."""
+        calibrated = self.with_calibrated_t(self.link.t_param, scatter)
+        return replace(calibrated, sensor=replace(self.sensor, nominal_coupling=0.0))
 
 
 _SECTIONS: dict[str, type] = {
@@ -832,6 +866,9 @@ def antenna_to_toml(antenna: Antenna) -> str:
         lines += [
             f"{f.name} = {float(getattr(antenna.sensor, f.name))!r}"
             for f in fields(SensorCorrection)
+            # the sensor's stated cross-talk only where it is not the default's
+            if f.name != "nominal_coupling"
+            or antenna.sensor.nominal_coupling != NOMINAL_SENSOR_COUPLING
         ]
     return "\n".join(lines) + "\n"
 

@@ -373,7 +373,9 @@ def prepare_device(
     :data:`CALIBRATION_SEED`) touched by the device with that observer; every recording is
     written into ``folder`` when given.
 
-    A realistic device is prepared as a campaign prepares its own: each recording with a seed of
+    A nominal device's sensor is its model's: the estimators fear no cross-talk beyond its
+    correction (``sensor.nominal_coupling`` 0). A realistic device is prepared as a campaign
+    prepares its own: each recording with a seed of
     its own (the campaigns' free-motion and calibration streams of the build, so that no sweep
     shares its set-up or noise), the posts at :func:`realistic_calibration_points` touched by an
     azimuthal and by a vertical sweep, their planned x_c the known points, T_e fitted with the
@@ -449,7 +451,9 @@ def prepare_device(
             write_recording(run, folder / name)
     if not realistic:
         points = [float(run.metadata["true_xc"]) for run in runs]
-        return calibrate_from_recordings(runs, model, points).apply(model)
+        calibrated = calibrate_from_recordings(runs, model, points).apply(model)
+        # the nominal device's sensor is its model's, without cross-talk to fear
+        return replace(calibrated, sensor=replace(calibrated.sensor, nominal_coupling=0.0))
     blind = [run.without_ground_truth() for run in runs]
     planned = [x for _, x in posts]
     own = [i for i, (case, _) in enumerate(posts) if case == AZIMUTHAL]

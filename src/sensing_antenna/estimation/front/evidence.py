@@ -311,7 +311,9 @@ class Evidence:
         n_window = round(self.config.spectrum_window / self.sample_period)
         return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
 
-    def ratio_uncertainty(self, x_c: float, model: bool = True, statics: str = "elastica") -> float:
+    def ratio_uncertainty(
+        self, x_c: float, model: bool = True, statics: str = "elastica", coupling: bool = False
+    ) -> float:
         """Standard uncertainty (m) of the ratio estimate at a contact point ``x_c``.
 
         Three independent terms, added in quadrature:
@@ -336,7 +338,13 @@ class Evidence:
             left in the mean);
           - ``statics="small-deflection"`` (Eq. 21 as printed, the ``ratio`` baseline): the
             neglected moments, the axial force times the link's slope and the weight of the
-            bent link, ``ratio_model_factor`` d x_c.
+            bent link, ``ratio_model_factor`` d x_c;
+
+          and with either and ``coupling``, the cross-talk of a sensor no calibration has
+          measured, ``coupling_uncertainty`` x_c^2 (:attr:`.SensorCorrection.coupling_uncertainty`).
+          It is asked by an answer that rests on the ratio (the ``ratio`` baseline, the ``fast``
+          posterior), not by the checks that judge the ratio against the vibration: there a
+          cross-talk that moves the ratio shows as a disagreement, which is not ``ok`` either.
 
         The model holds on the link only: a reading outside it (a ratio of 10^5 m from torques
         in N mm) is judged at the nearest point of [0, l], where the terms stay finite.
@@ -353,19 +361,24 @@ class Evidence:
         deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
         model_term = 0.0
         if model and statics == "small-deflection":
-            model_term = self.config.ratio_model_factor * deflection_ratio * x_c
+            model_term = math.hypot(
+                self.config.ratio_model_factor * deflection_ratio * x_c,
+                self.antenna.sensor.coupling_uncertainty * x_c**2 if coupling else 0.0,
+            )
         elif model:
-            model_term = float(self.ratio_model_uncertainty(np.array(x_c)))
+            model_term = float(self.ratio_model_uncertainty(np.array(x_c), coupling))
         noise_term = self.ratio_noise * x_c / link.length
         # in quadrature without squaring (a torque noise of 1e297 N m must not overflow)
         return math.hypot(noise_term, offset_term, model_term)
 
-    def ratio_model_uncertainty(self, x_c: FloatArray) -> FloatArray:
+    def ratio_model_uncertainty(self, x_c: FloatArray, coupling: bool = False) -> FloatArray:
         """The elastica statics' model term of :meth:`ratio_uncertainty` (m), at contact points
         ``x_c`` (m, any shape, on the link): the stiffness's uncertainty on the statics'
         corrections, the bent link's weight (:func:`bent_weight_moment`), and the floor
         ``ratio_model_floor`` x_c (the sensor calibration's ``ratio_scatter`` x_c when larger),
-        in quadrature, for the hold's push (``frame``). A method
+        and with ``coupling`` an uncalibrated sensor's cross-talk (``coupling_uncertainty``
+        x_c^2, :meth:`ratio_uncertainty` says when), in quadrature, for the hold's push
+        (``frame``). A method
         with statics of its own that are the elastica's (``fast``) weighs them with it. Infinite
         where there is no push to read the ratio by, or where loads beyond any sensor overflow
         the term: the ratio says nothing there."""
@@ -397,8 +410,12 @@ class Evidence:
             / push
         )
         # the floor, or the scatter the sensor's calibration left on the ratio if larger
-        floor = max(self.config.ratio_model_floor, self.antenna.sensor.ratio_scatter) * x_c
-        term = np.asarray(np.hypot(np.hypot(stiffness, weight), floor), dtype=float)
+        sensor = self.antenna.sensor
+        floor = max(self.config.ratio_model_floor, sensor.ratio_scatter) * x_c
+        # an uncalibrated sensor's cross-talk: a force read c x_c R_perp too high moves the
+        # ratio by about c x_c^2
+        leak = sensor.coupling_uncertainty * x_c**2 if coupling else np.zeros(x_c.shape)
+        term = np.asarray(np.hypot(np.hypot(stiffness, weight), np.hypot(floor, leak)), dtype=float)
         return np.where(np.isnan(term), np.inf, term)
 
     def bent_link_uncertainty(self, x_c: float) -> float:

@@ -57,18 +57,25 @@ class RatioMethod:
         x_c = float(ratio[evidence.end_index])
         problems: list[tuple[Status, str]] = []
         spread = (
-            2.0 * evidence.ratio_uncertainty(x_c, statics="small-deflection")
+            2.0 * evidence.ratio_uncertainty(x_c, statics="small-deflection", coupling=True)
             if math.isfinite(x_c)
             else math.nan
         )
         if spread > evidence.config.max_model_spread:
             # the same bar as the paper method's candidate: 1 cm at two standard deviations
+            leak = evidence.antenna.sensor.coupling_uncertainty > 0.0
+            terms = "noise, tare, small-deflection model" + (
+                ", the sensor's cross-talk" if leak else ""
+            )
+            advice = "push harder or rest longer" + (
+                ", or calibrate the sensor's cross-talk (antenna calibrate)" if leak else ""
+            )
             problems.append(
                 (
                     Status.UNCERTAIN,
                     f"the torque/force ratio is uncertain by {100 * spread:.1f} cm at two "
-                    "standard deviations (noise, tare, small-deflection model), more than "
-                    f"{100 * evidence.config.max_model_spread:g} cm: push harder or rest longer",
+                    f"standard deviations ({terms}), more than "
+                    f"{100 * evidence.config.max_model_spread:g} cm: {advice}",
                 )
             )
         return conclude(

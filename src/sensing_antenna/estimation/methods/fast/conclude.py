@@ -250,7 +250,7 @@ def _judged_at(
     has no statics) and why it disagrees, then the frequency's (:func:`_frequency_judged`)."""
     ratio_z, ratio_note = final.ratio_z, ""
     if final.statics is not None:
-        model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c)))
+        model_sd = float(evidence.ratio_model_uncertainty(np.array(post.x_c), coupling=True))
         ratio_z, ratio_note = ratio_check(final.statics, post.x_c, model_sd, config)
     frequency_z, note = _frequency_judged(evidence, final.omega1, final.omega1_se, post, config)
     return ratio_z, ratio_note, frequency_z, note

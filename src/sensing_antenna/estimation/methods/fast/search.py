@@ -73,7 +73,7 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
     statics = StaticsModel(
         evidence.reaction_f[:, 0],
         table.grid,
-        evidence.ratio_model_uncertainty(table.grid),
+        evidence.ratio_model_uncertainty(table.grid, coupling=True),
         np.where(np.isfinite(bent), bent, 0.0),
         np.array(evidence.frame.reaction_m[1:], dtype=float),
     )
