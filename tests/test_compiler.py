@@ -103,3 +103,55 @@ def test_an_ignored_signal_during_a_compilation_stays_ignored() -> None:
             assert half(1.0) == 0.5
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+class _SignalsOnce(event.Listener):
+    """Sends each of ``numbers`` to this process at the first start of the events it hears."""
+
+    def __init__(self, *numbers: int) -> None:
+        self.numbers = numbers
+        self.sent = False
+
+    def on_start(self, ev: Any) -> None:
+        if not self.sent:
+            self.sent = True
+            for number in self.numbers:
+                os.kill(os.getpid(), number)
+
+    def on_end(self, ev: Any) -> None:
+        pass
+
+
+def test_two_stops_in_one_compilation_each_reach_their_handler_once() -> None:
+    @njit
+    def third(x: float) -> float:
+        return x / 3.0
+
+    @njit
+    def quarter(x: float) -> float:
+        return x / 4.0
+
+    stopped: list[int] = []
+
+    def note(number: int, frame: Any) -> None:
+        stopped.append(number)
+
+    previous = (
+        signal.signal(signal.SIGTERM, note),
+        signal.signal(signal.SIGINT, signal.default_int_handler),
+    )
+    try:
+        with (
+            event.install_listener("numba:llvm_lock", _SignalsOnce(signal.SIGTERM, signal.SIGINT)),
+            pytest.raises(KeyboardInterrupt),
+        ):
+            third(3.0)
+        assert stopped == [signal.SIGTERM]
+        assert signal.getsignal(signal.SIGTERM) is note
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        # nothing is left over for the next compilation
+        assert quarter(4.0) == 1.0
+        assert stopped == [signal.SIGTERM]
+    finally:
+        signal.signal(signal.SIGTERM, previous[0])
+        signal.signal(signal.SIGINT, previous[1])

@@ -304,7 +304,11 @@ def _fit(
     dof = max(finite.size - 2 * len(adopted), 1)
     scatter = min(math.sqrt(float(np.sum(finite**2)) / dof), 1.0)
     return SensorCalibration(
-        correction=replace(correction(params, names), ratio_scatter=scatter),
+        correction=replace(
+            correction(params, names),
+            ratio_scatter=scatter,
+            nominal_coupling=antenna.sensor.nominal_coupling,  # the sensor's stated figure
+        ),
         sweeps=sweeps,
         sources=tuple(n for _, n in kept),
         notes=tuple(notes),
