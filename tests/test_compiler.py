@@ -15,17 +15,18 @@ from sensing_antenna.compiler import njit
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 
 
-class _SignalOnce(event.Listener):
-    """Sends ``number`` to this process at the first start of the events it listens to."""
+class _SignalsOnce(event.Listener):
+    """Sends each of ``numbers`` to this process at the first start of the events it hears."""
 
-    def __init__(self, number: int) -> None:
-        self.number = number
+    def __init__(self, *numbers: int) -> None:
+        self.numbers = numbers
         self.sent = False
 
     def on_start(self, ev: Any) -> None:
         if not self.sent:
             self.sent = True
-            os.kill(os.getpid(), self.number)
+            for number in self.numbers:
+                os.kill(os.getpid(), number)
 
     def on_end(self, ev: Any) -> None:
         pass
@@ -80,7 +81,7 @@ def test_a_stop_during_a_compilation_is_handled_outside_llvm_and_numba_stays_who
     try:
         with (
             event.install_listener("numba:llvm_lock", inside),
-            event.install_listener("numba:llvm_lock", _SignalOnce(number)),
+            event.install_listener("numba:llvm_lock", _SignalsOnce(number)),
             pytest.raises(raised),
         ):
             twice(1.5)
@@ -99,27 +100,10 @@ def test_an_ignored_signal_during_a_compilation_stays_ignored() -> None:
 
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        with event.install_listener("numba:compile", _SignalOnce(signal.SIGINT)):
+        with event.install_listener("numba:compile", _SignalsOnce(signal.SIGINT)):
             assert half(1.0) == 0.5
     finally:
         signal.signal(signal.SIGINT, previous)
-
-
-class _SignalsOnce(event.Listener):
-    """Sends each of ``numbers`` to this process at the first start of the events it hears."""
-
-    def __init__(self, *numbers: int) -> None:
-        self.numbers = numbers
-        self.sent = False
-
-    def on_start(self, ev: Any) -> None:
-        if not self.sent:
-            self.sent = True
-            for number in self.numbers:
-                os.kill(os.getpid(), number)
-
-    def on_end(self, ev: Any) -> None:
-        pass
 
 
 def test_two_stops_in_one_compilation_each_reach_their_handler_once() -> None:

@@ -363,7 +363,7 @@ class Evidence:
         if model and statics == "small-deflection":
             model_term = math.hypot(
                 self.config.ratio_model_factor * deflection_ratio * x_c,
-                self.antenna.sensor.coupling_uncertainty * x_c**2 if coupling else 0.0,
+                float(self.cross_talk_uncertainty(np.array(x_c))) if coupling else 0.0,
             )
         elif model:
             model_term = float(self.ratio_model_uncertainty(np.array(x_c), coupling))
@@ -412,11 +412,15 @@ class Evidence:
         # the floor, or the scatter the sensor's calibration left on the ratio if larger
         sensor = self.antenna.sensor
         floor = max(self.config.ratio_model_floor, sensor.ratio_scatter) * x_c
-        # an uncalibrated sensor's cross-talk: a force read c x_c R_perp too high moves the
-        # ratio by about c x_c^2
-        leak = sensor.coupling_uncertainty * x_c**2 if coupling else np.zeros(x_c.shape)
+        leak = self.cross_talk_uncertainty(x_c) if coupling else np.zeros(x_c.shape)
         term = np.asarray(np.hypot(np.hypot(stiffness, weight), np.hypot(floor, leak)), dtype=float)
         return np.where(np.isnan(term), np.inf, term)
+
+    def cross_talk_uncertainty(self, x_c: FloatArray) -> FloatArray:
+        """Standard uncertainty (m) of the ratio at contact points ``x_c`` (m, any shape) from the
+        cross-talk of a sensor no calibration has measured: a force read c x_c R_perp too high
+        moves the ratio by about c x_c^2 (:attr:`.SensorCorrection.coupling_uncertainty`)."""
+        return np.asarray(self.antenna.sensor.coupling_uncertainty * np.square(x_c), dtype=float)
 
     def bent_link_uncertainty(self, x_c: float) -> float:
         """Standard uncertainty (m) of a contact point read from the vibration, from the push's
