@@ -400,18 +400,27 @@ def test_the_frequency_model_is_as_uncertain_as_what_is_known_of_t() -> None:
 def test_a_sensor_no_calibration_measured_carries_its_nominal_cross_talk(tmp_path: Path) -> None:
     # 1 % of a Nano17's 25 N per 0.25 N m full scale, spread uniformly: 1 / sqrt(3) N per N m
     nominal = paper_antenna().sensor
-    assert nominal.coupling_uncertainty == pytest.approx(1.0 / math.sqrt(3.0), rel=1e-12)
+    along_y, along_z, oblique = [0.0, 0.3, 0.0], [0.1, 0.0, -0.3], [0.0, 0.3, 0.4]
+    for push in (along_y, along_z, oblique, [0.0, 0.0, 0.0]):
+        assert nominal.coupling_uncertainty(push) == pytest.approx(1.0 / math.sqrt(3.0), rel=1e-12)
     # a calibration that measured the ratio's scatter bounds the cross-talk left by it
     measured = dataclasses.replace(nominal, fy_per_tz=0.8, ratio_scatter=0.03)
-    assert measured.coupling_uncertainty == 0.0
+    assert measured.coupling_uncertainty(oblique) == 0.0
+    # one that saw azimuthal sweeps only measured the terms a push along Y^m reads, not Z^m's:
+    # c^2 = u_y^2 c_az^2 + u_z^2 c_vert^2, the lateral direction u = (0.6, 0.8) here
+    one_way = dataclasses.replace(measured, unmeasured_sweeps=("vertical",))
+    assert one_way.coupling_uncertainty(along_y) == 0.0
+    assert one_way.coupling_uncertainty(along_z) == nominal.nominal_coupling
+    assert one_way.coupling_uncertainty(oblique) == pytest.approx(0.8 * nominal.nominal_coupling)
+    assert one_way.coupling_uncertainty([0.0, 0.0, 0.0]) == nominal.nominal_coupling
     # a simulation study's device identical to its model has none to fear
-    assert paper_antenna().self_calibrated().sensor.coupling_uncertainty == 0.0
+    assert paper_antenna().self_calibrated().sensor.coupling_uncertainty(along_z) == 0.0
     # the sensor's own figure, read from the antenna file, and kept by a round trip
     path = tmp_path / "a.toml"
     text = antenna_to_toml(paper_antenna()) + "\n[sensor]\nnominal_coupling = 0.2\n"
     path.write_text(text)
     stated = load_antenna(path)
-    assert stated.sensor.coupling_uncertainty == 0.2
+    assert stated.sensor.coupling_uncertainty(oblique) == 0.2
     save_antenna(stated, tmp_path / "b.toml")
     assert load_antenna(tmp_path / "b.toml").sensor == stated.sensor
     path.write_text(text.replace("nominal_coupling = 0.2", "nominal_coupling = -1.0"))

@@ -81,12 +81,21 @@ def test_sensor_section_round_trips_and_bad_values_name_the_field(tmp_path: Path
     assert "[sensor]" not in path.read_text()  # no correction, no section
     # a device identical to its model fears no cross-talk, and says so in its file
     save_antenna(ANTENNA, path)
-    assert load_antenna(path).sensor.coupling_uncertainty == 0.0
+    assert load_antenna(path).sensor.coupling_uncertainty([0.0, 0.1, 0.1]) == 0.0
+    # the sweep directions no calibration saw, kept in order and read back
+    one_way = dataclasses.replace(
+        antenna, sensor=dataclasses.replace(antenna.sensor, unmeasured_sweeps=["vertical"])
+    )  # type: ignore[arg-type]
+    assert one_way.sensor.unmeasured_sweeps == ("vertical",)
+    save_antenna(one_way, path)
+    assert load_antenna(path).sensor == one_way.sensor
     for text, field in (
         ("[sensor]\nfy_gain = 3.0\n", "sensor.fy_gain"),
         ("[sensor]\nfz_per_ty = 1e4\n", "sensor.fz_per_ty"),
         ("[sensor]\nfx_gain = 1.0\n", "sensor.fx_gain"),
         ("[sensor]\nratio_scatter = -0.1\n", "sensor.ratio_scatter"),
+        ('[sensor]\nunmeasured_sweeps = ["sideways"]\n', "sensor.unmeasured_sweeps"),
+        ('[sensor]\nunmeasured_sweeps = "vertical"\n', "sensor.unmeasured_sweeps"),
     ):
         path.write_text('base = "paper-2021"\n' + text)
         with pytest.raises(AntennaConfigError, match=field):
@@ -199,13 +208,21 @@ def test_one_sweep_direction_fits_its_own_terms_only(
 ) -> None:
     recordings, truth = calibration_set
     half = len(POINTS)
-    fit = calibrate_sensor(recordings[:half], ANTENNA, truth[:half])
+    stated = dataclasses.replace(ANTENNA, sensor=SensorCorrection())  # a Nano17's cross-talk
+    fit = calibrate_sensor(recordings[:half], stated, truth[:half])
     assert fit.sweeps == ("azimuthal",)
     assert (fit.correction.fz_gain, fit.correction.fz_per_ty, fit.correction.fy_per_ty) == (
         1.0,
         0.0,
         0.0,
     )
+    # the vertical terms are not measured: a push along Z^m keeps the sensor's stated cross-talk
+    assert fit.correction.unmeasured_sweeps == ("vertical",)
+    assert fit.correction.coupling_uncertainty([0.0, 0.2, 0.0]) == 0.0
+    assert fit.correction.coupling_uncertainty([0.0, 0.0, 0.2]) == stated.sensor.nominal_coupling
+    both = calibrate_sensor(recordings, stated, truth)
+    assert both.correction.unmeasured_sweeps == ()
+    assert both.correction.coupling_uncertainty([0.0, 0.0, 0.2]) == 0.0
     with pytest.raises(SensorCalibrationError, match="needs 4"):
         calibrate_sensor(recordings[:3], ANTENNA, truth[:3])
 
@@ -235,6 +252,11 @@ def test_cli_calibrate_writes_the_sensor_and_no_sensor_keeps_it(
     assert not load_antenna(out).sensor.is_identity
     assert main([*args, "--out", str(out), "--no-sensor"]) == 0
     assert load_antenna(out).sensor.is_identity
+    # azimuthal sweeps alone: the file and the output say the vertical terms were not measured
+    azimuthal = [*args[:1], *map(str, paths[: len(POINTS)]), *args[1 + len(paths) :]]
+    assert main([*azimuthal, "--out", str(out)]) == 0
+    assert "no vertical sweep calibrated it" in capsys.readouterr().out
+    assert load_antenna(out).sensor.unmeasured_sweeps == ("vertical",)
 
 
 def test_a_leak_that_nearly_cancels_the_push_near_the_tip_is_undone() -> None:

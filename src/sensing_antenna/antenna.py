@@ -47,6 +47,7 @@ __all__ = [
     "MODEL_FREQUENCY_FLOOR",
     "NOMINAL_T_UNCERTAINTY",
     "PARAMETER_RANGES",
+    "SENSOR_SWEEPS",
     "Antenna",
     "AntennaConfigError",
     "FreeMotionObserver",
@@ -524,6 +525,10 @@ MAX_SENSOR_COUPLING = 100.0
 #: 0.25 N m on an ATI Nano17 SI-25-0.25, the paper's sensor, 0.58 N per N m.
 NOMINAL_SENSOR_COUPLING = 0.01 / math.sqrt(3.0) * 25.0 / 0.25
 
+#: The sweep directions a sensor calibration tells apart, and the motor-frame axis each pushes
+#: along: an azimuthal sweep along Y^m (1), a vertical one along Z^m (2).
+SENSOR_SWEEPS = MappingProxyType({"azimuthal": 1, "vertical": 2})
+
 
 @dataclass(frozen=True)
 class SensorCorrection:
@@ -553,8 +558,13 @@ class SensorCorrection:
         least this fraction of x_c. 0: not measured.
     nominal_coupling : float
         Standard uncertainty of the force read per unit moment (1/m) while no calibration has
-        measured the ratio's scatter (:attr:`coupling_uncertainty`): the sensor's accuracy
+        measured the ratio's scatter (:meth:`coupling_uncertainty`): the sensor's accuracy
         read as cross-talk; by default :data:`NOMINAL_SENSOR_COUPLING`, the paper's Nano17.
+    unmeasured_sweeps : tuple of str
+        Sweep directions (:data:`SENSOR_SWEEPS`) of which the calibration that measured
+        ``ratio_scatter`` saw no contact: its terms for pushes that way are not measured, so
+        those pushes keep ``nominal_coupling``. Empty: every direction measured (or none, with
+        ``ratio_scatter`` 0).
     """
 
     fy_gain: float = 1.0
@@ -565,9 +575,26 @@ class SensorCorrection:
     fz_per_tz: float = 0.0
     ratio_scatter: float = 0.0
     nominal_coupling: float = NOMINAL_SENSOR_COUPLING
+    unmeasured_sweeps: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        sweeps = self.unmeasured_sweeps
+        if isinstance(sweeps, str) or not isinstance(sweeps, (list, tuple)):
+            raise AntennaConfigError(
+                "sensor.unmeasured_sweeps", f"must be a list of sweep directions, got {sweeps!r}"
+            )
+        for sweep in sweeps:
+            if sweep not in SENSOR_SWEEPS:
+                raise AntennaConfigError(
+                    "sensor.unmeasured_sweeps",
+                    f"{sweep!r} is no sweep direction (one of {', '.join(SENSOR_SWEEPS)})",
+                )
+        # a list from TOML becomes the tuple the frozen dataclass compares and hashes, in order
+        ordered = tuple(s for s in SENSOR_SWEEPS if s in sweeps)
+        object.__setattr__(self, "unmeasured_sweeps", ordered)
         for f in fields(self):
+            if f.name == "unmeasured_sweeps":
+                continue
             value = getattr(self, f.name)
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise AntennaConfigError(f"sensor.{f.name}", f"must be a number, got {value!r}")
@@ -597,22 +624,43 @@ class SensorCorrection:
                 f"{self.nominal_coupling!r}",
             )
 
-    @property
-    def coupling_uncertainty(self) -> float:
-        """Standard uncertainty of the cross-talk of the moments into the lateral forces left
-        after the correction (N per N m = 1/m): ``nominal_coupling`` until a calibration has
-        measured the ratio's scatter, 0 after (``ratio_scatter`` then bounds what is left).
+    def coupling_uncertainty(self, reaction: ArrayLike) -> float:
+        """Standard uncertainty of the cross-talk of the moments into the lateral force of a
+        push whose reaction is ``reaction`` (N, motor frame, shape (3,)), left after the
+        correction (N per N m = 1/m).
 
-        A force read c Gamma too high, Gamma = x_c R_perp, moves the torque/force ratio from
-        x_c to x_c / (1 + c x_c): by about c x_c^2.
+        Each sweep direction's terms are uncertain by ``nominal_coupling`` until a calibration
+        has measured the ratio's scatter on contacts of that direction, and 0 after
+        (``ratio_scatter`` then bounds what is left). A push with lateral direction (u_y, u_z)
+        reads the moments' leak through both directions' terms, so c^2 = u_y^2 c_az^2 +
+        u_z^2 c_vert^2 (a push with no lateral force: the larger). A force read c Gamma too
+        high, Gamma = x_c R_perp, moves the torque/force ratio from x_c to x_c / (1 + c x_c):
+        by about c x_c^2.
         """
-        return 0.0 if self.ratio_scatter > 0.0 else self.nominal_coupling
+        measured = self.ratio_scatter > 0.0
+        per_sweep = {
+            sweep: 0.0
+            if measured and sweep not in self.unmeasured_sweeps
+            else self.nominal_coupling
+            for sweep in SENSOR_SWEEPS
+        }
+        lateral = np.asarray(reaction, dtype=float)[[SENSOR_SWEEPS[s] for s in per_sweep]]
+        size = math.hypot(*lateral)
+        if not size > 0.0 or not math.isfinite(size):
+            return max(per_sweep.values())
+        return math.hypot(*(u / size * c for u, c in zip(lateral, per_sweep.values(), strict=True)))
 
     @property
     def is_identity(self) -> bool:
         """True when the correction changes no force (its scatter aside)."""
-        return replace(self, ratio_scatter=0.0, nominal_coupling=NOMINAL_SENSOR_COUPLING) == (
-            SensorCorrection()
+        return (
+            replace(
+                self,
+                ratio_scatter=0.0,
+                nominal_coupling=NOMINAL_SENSOR_COUPLING,
+                unmeasured_sweeps=(),
+            )
+            == SensorCorrection()
         )
 
     def correct(
@@ -706,10 +754,13 @@ class Antenna:
         estimators the simulated device's own antenna (its T exactly, so a simulated run is
         unchanged). The default scatter is :data:`MODEL_FREQUENCY_FLOOR`, 0.1 %, the order
         calibrations of the simulated device measure (0.01 to 0.12 %). Its sensor is the
-        model's own, so no cross-talk beyond its correction is feared
-        (``sensor.nominal_coupling`` 0)."""
-        calibrated = self.with_calibrated_t(self.link.t_param, scatter)
-        return replace(calibrated, sensor=replace(self.sensor, nominal_coupling=0.0))
+        model's own (:meth:`with_sensor_known`)."""
+        return self.with_calibrated_t(self.link.t_param, scatter).with_sensor_known()
+
+    def with_sensor_known(self) -> Antenna:
+        """This antenna as the model of a simulated device whose sensor is exactly its own: no
+        cross-talk beyond its correction is feared (``sensor.nominal_coupling`` 0)."""
+        return replace(self, sensor=replace(self.sensor, nominal_coupling=0.0))
 
 
 _SECTIONS: dict[str, type] = {
@@ -867,9 +918,15 @@ def antenna_to_toml(antenna: Antenna) -> str:
             f"{f.name} = {float(getattr(antenna.sensor, f.name))!r}"
             for f in fields(SensorCorrection)
             # the sensor's stated cross-talk only where it is not the default's
-            if f.name != "nominal_coupling"
-            or antenna.sensor.nominal_coupling != NOMINAL_SENSOR_COUPLING
+            if f.name not in ("nominal_coupling", "unmeasured_sweeps")
+            or (
+                f.name == "nominal_coupling"
+                and antenna.sensor.nominal_coupling != NOMINAL_SENSOR_COUPLING
+            )
         ]
+        if antenna.sensor.unmeasured_sweeps:
+            sweeps = ", ".join(_toml_str(s) for s in antenna.sensor.unmeasured_sweeps)
+            lines.append(f"unmeasured_sweeps = [{sweeps}]")
     return "\n".join(lines) + "\n"
 
 

@@ -33,7 +33,9 @@ held-out error with the terms is not below its error without them keeps no corre
 others are fitted again without its terms). With :data:`MIN_SENSOR_RECORDINGS` recordings of a
 direction, each held-out fit has one fewer than a fit needs, which leans towards refusing. The
 ratio's relative scatter about the known points left with the terms adopted is kept as
-``ratio_scatter``, a floor of the ratio's model uncertainty.
+``ratio_scatter``, a floor of the ratio's model uncertainty; a sweep direction without
+recordings enough is kept in ``unmeasured_sweeps``, so that pushes that way keep the sensor's
+nominal cross-talk uncertainty.
 """
 
 from __future__ import annotations
@@ -50,6 +52,7 @@ from scipy.optimize import least_squares
 from sensing_antenna.antenna import (
     MAX_SENSOR_COUPLING,
     MAX_SENSOR_GAIN_ERROR,
+    SENSOR_SWEEPS,
     Antenna,
     SensorCorrection,
 )
@@ -219,11 +222,12 @@ def _fit(
     reaction = np.array([h.reaction for h in holds])
     moment = np.array([h.moment for h in holds])
     points = np.array([h.x_c for h in holds])
-    lateral = np.array([1 if h.sweep == "azimuthal" else 2 for h in holds])
+    lateral = np.array([SENSOR_SWEEPS[h.sweep] for h in holds])
     rows = np.arange(len(holds))
 
     def correction(params: FloatArray, names: Sequence[str]) -> SensorCorrection:
-        return SensorCorrection(**dict(zip(names, (float(p) for p in params), strict=True)))
+        terms: dict[str, Any] = dict(zip(names, (float(p) for p in params), strict=True))
+        return SensorCorrection(**terms)
 
     def residuals(
         params: FloatArray, names: Sequence[str], keep: NDArray[np.bool_] | None = None
@@ -308,6 +312,8 @@ def _fit(
             correction(params, names),
             ratio_scatter=scatter,
             nominal_coupling=antenna.sensor.nominal_coupling,  # the sensor's stated figure
+            # pushes the other way read terms these contacts did not measure
+            unmeasured_sweeps=tuple(s for s in _PLANE_TERMS if s not in sweeps),
         ),
         sweeps=sweeps,
         sources=tuple(n for _, n in kept),

@@ -86,13 +86,20 @@ def _calibrate_sensor(
     antenna: Any, recordings: list[Any], points: list[float], paths: list[Path]
 ) -> tuple[Any, list[str]]:
     """``antenna`` with the sensor's cross-talk fitted to the recordings, and what to print."""
-    from sensing_antenna.calibration.sensor import SensorCalibrationError, calibrate_sensor
+    from sensing_antenna.calibration.sensor import (
+        MIN_SENSOR_RECORDINGS,
+        SensorCalibrationError,
+        calibrate_sensor,
+    )
 
     try:
         fit = calibrate_sensor(recordings, antenna, points, sources=[str(p) for p in paths])
     except SensorCalibrationError as exc:
         return antenna, [f"sensor: not calibrated, {exc}; the antenna's [sensor] is kept"]
-    terms = ", ".join(f"{k} = {v:.4g}" for k, v in vars(fit.correction).items())
+    unmeasured = fit.correction.unmeasured_sweeps
+    terms = ", ".join(
+        f"{k} = {v:.4g}" for k, v in vars(fit.correction).items() if k != "unmeasured_sweeps"
+    )
     fitted = f"on {len(fit.sources)} recordings ({', '.join(fit.sweeps)} sweeps)"
     lines = [
         f"sensor: lateral-force correction (a sensor's cross-talk, or the statics' bias at "
@@ -102,6 +109,12 @@ def _calibrate_sensor(
         f"ratio_scatter = {fit.correction.ratio_scatter:.4g}"
     ]
     lines += [f"  sensor, left out: {note}" for note in fit.notes]
+    if unmeasured:
+        lines.append(
+            f"  sensor: no {' or '.join(unmeasured)} sweep calibrated it, so pushes that way keep"
+            f" the sensor's nominal cross-talk uncertainty ({MIN_SENSOR_RECORDINGS} recordings"
+            " of a direction measure it)"
+        )
     return fit.apply(antenna), lines
 
 

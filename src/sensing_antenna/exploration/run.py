@@ -452,8 +452,7 @@ def prepare_device(
     if not realistic:
         points = [float(run.metadata["true_xc"]) for run in runs]
         calibrated = calibrate_from_recordings(runs, model, points).apply(model)
-        # the nominal device's sensor is its model's, without cross-talk to fear
-        return replace(calibrated, sensor=replace(calibrated.sensor, nominal_coupling=0.0))
+        return calibrated.with_sensor_known()  # the nominal device's sensor is its model's
     blind = [run.without_ground_truth() for run in runs]
     planned = [x for _, x in posts]
     own = [i for i, (case, _) in enumerate(posts) if case == AZIMUTHAL]

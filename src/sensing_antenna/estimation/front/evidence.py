@@ -341,7 +341,7 @@ class Evidence:
             bent link, ``ratio_model_factor`` d x_c;
 
           and with either and ``coupling``, the cross-talk of a sensor no calibration has
-          measured, ``coupling_uncertainty`` x_c^2 (:attr:`.SensorCorrection.coupling_uncertainty`).
+          measured, ``coupling_uncertainty`` x_c^2 (:meth:`.SensorCorrection.coupling_uncertainty`).
           It is asked by an answer that rests on the ratio (the ``ratio`` baseline, the ``fast``
           posterior), not by the checks that judge the ratio against the vibration: there a
           cross-talk that moves the ratio shows as a disagreement, which is not ``ok`` either.
@@ -418,9 +418,11 @@ class Evidence:
 
     def cross_talk_uncertainty(self, x_c: FloatArray) -> FloatArray:
         """Standard uncertainty (m) of the ratio at contact points ``x_c`` (m, any shape) from the
-        cross-talk of a sensor no calibration has measured: a force read c x_c R_perp too high
-        moves the ratio by about c x_c^2 (:attr:`.SensorCorrection.coupling_uncertainty`)."""
-        return np.asarray(self.antenna.sensor.coupling_uncertainty * np.square(x_c), dtype=float)
+        cross-talk of a sensor no calibration has measured for the hold's push: a force read
+        c x_c R_perp too high moves the ratio by about c x_c^2
+        (:meth:`.SensorCorrection.coupling_uncertainty`)."""
+        coupling = self.antenna.sensor.coupling_uncertainty(self.frame.reaction_m)
+        return np.asarray(coupling * np.square(x_c), dtype=float)
 
     def bent_link_uncertainty(self, x_c: float) -> float:
         """Standard uncertainty (m) of a contact point read from the vibration, from the push's

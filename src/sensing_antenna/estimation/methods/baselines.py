@@ -63,21 +63,7 @@ class RatioMethod:
         )
         if spread > evidence.config.max_model_spread:
             # the same bar as the paper method's candidate: 1 cm at two standard deviations
-            leak = evidence.antenna.sensor.coupling_uncertainty > 0.0
-            terms = "noise, tare, small-deflection model" + (
-                ", the sensor's cross-talk" if leak else ""
-            )
-            advice = "push harder or rest longer" + (
-                ", or calibrate the sensor's cross-talk (antenna calibrate)" if leak else ""
-            )
-            problems.append(
-                (
-                    Status.UNCERTAIN,
-                    f"the torque/force ratio is uncertain by {100 * spread:.1f} cm at two "
-                    f"standard deviations ({terms}), more than "
-                    f"{100 * evidence.config.max_model_spread:g} cm: {advice}",
-                )
-            )
+            problems.append((Status.UNCERTAIN, _uncertain_ratio(evidence, x_c, spread)))
         return conclude(
             evidence,
             self.name,
@@ -86,6 +72,33 @@ class RatioMethod:
             problems=problems,
             diagnostics={"ratio_spread": spread},
         )
+
+
+def _uncertain_ratio(evidence: Evidence, x_c: float, spread: float) -> str:
+    """Why the ratio ``x_c`` (m) with ``spread`` (m, two standard deviations) is uncertain, and
+    what would help: a push held longer, or a calibration of the sensor's cross-talk for the
+    push's direction, which alone brings the spread within the bar when it is most of it."""
+    bar = evidence.config.max_model_spread
+    leak = float(evidence.cross_talk_uncertainty(np.array(x_c))) > 0.0
+    terms = "noise, tare, small-deflection model" + (", the sensor's cross-talk" if leak else "")
+    sensor = evidence.antenna.sensor
+    calibrate = (
+        f"calibrate the sensor's cross-talk on {' and '.join(sensor.unmeasured_sweeps)} sweeps "
+        "too (antenna calibrate)"
+        if sensor.ratio_scatter > 0.0
+        else "calibrate the sensor's cross-talk (antenna calibrate)"
+    )
+    plain = 2.0 * evidence.ratio_uncertainty(x_c, statics="small-deflection")
+    if not leak:
+        advice = "push harder or rest longer"
+    elif plain <= bar:
+        advice = f"{calibrate}, which leaves {100 * plain:.1f} cm"
+    else:
+        advice = f"push harder or rest longer, and {calibrate}"
+    return (
+        f"the torque/force ratio is uncertain by {100 * spread:.1f} cm at two standard "
+        f"deviations ({terms}), more than {100 * bar:g} cm: {advice}"
+    )
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,8 @@ Model-error floors are added in quadrature to the statistical standard errors:
   precision; the model frequency is proportional to 1 / T), sigma_w^2 = se^2 + (eps omega_hat)^2;
 - ratio: what the elastica's statics do not hold, the front end's model term at each grid point
   (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.ratio_model_uncertainty`: the
-  stiffness's uncertainty on the statics' corrections, the bent link's weight, a floor),
+  stiffness's uncertainty on the statics' corrections, the bent link's weight, a floor, and
+  the cross-talk of a sensor no calibration has measured for the push's direction),
   sigma_r^2 = se^2 + model^2.
 
 Prior: flat on the contact range. The posterior is normalised on the grid; the point estimate is
