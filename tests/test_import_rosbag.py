@@ -8,6 +8,7 @@ estimate. Stamps with jitter and dropped messages must be reported as they were 
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -239,6 +240,25 @@ def test_the_sensor_s_axes_and_the_reaction_are_turned_back_onto_the_motor_frame
     unstated = read_rosbag(bag, WRENCH, JOINTS).recording
     assert not np.array_equal(unstated.force, recording.force)
     _assert_same_samples(read_rosbag(bag, WRENCH, JOINTS, axes=stated).recording, recording)
+
+
+def test_a_sensor_taking_its_torques_about_its_origin_is_moved_to_o(
+    recording: Recording, tmp_path: Path
+) -> None:
+    """A sensor turned half a turn about Z^m, its origin 25 mm along the link and 4 mm above
+    it: stating both gives back the torques about O (Gamma_O = Gamma_S + (S - O) x F)."""
+    point = (0.025, 0.0, 0.004)
+    stated = SensorAxes("-x,-y,z", torque_point=point)
+    about_s = dataclasses.replace(
+        recording, torque=recording.torque - np.cross(point, recording.force)
+    )
+    bag = _write_bag(_bag_path(tmp_path, 2), about_s, 2, sensor=stated.matrix.T)
+    imported = read_rosbag(bag, WRENCH, JOINTS, axes=stated).recording
+    np.testing.assert_array_equal(imported.force, recording.force)
+    np.testing.assert_allclose(imported.torque, recording.torque, rtol=0, atol=1e-15)
+    assert "torques about (0.025, 0, 0.004) m" in imported.metadata["ros_sensor_axes"]
+    with pytest.raises(AxesError, match="more than 1 m: in metres"):
+        SensorAxes(torque_point=(25.0, 0.0, 4.0))
 
 
 def test_jittered_stamps_and_dropped_messages_are_reported(

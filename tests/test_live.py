@@ -697,3 +697,33 @@ def test_a_stream_with_a_loggers_text_column_is_heard(recordings: dict[str, Path
     tagged += [line.rstrip(b"\r\n") + b",SWEEP\n" for line in lines[header_at + 1 :]]
     found = next(e for e in _listen(tagged, "paper") if isinstance(e, EstimateEvent))
     _same_estimate(found.to_dict(), estimate(recording, paper_antenna()).to_dict())
+
+
+def test_a_stream_whose_torques_are_about_the_sensors_origin_is_estimated_as_the_file(
+    recordings: dict[str, Path], tmp_path: Path
+) -> None:
+    # A sensor 25 mm along the link takes its torques about its origin and the stream says so
+    # (torque_point): live and from its file, the estimate is that of the torques about O.
+    point = [0.025, 0.0, 0.004]
+    recording = read_recording(recordings["azimuthal"])
+    lines = _lines(recording)
+    header = next(k for k, line in enumerate(lines) if not line.startswith(b"#"))
+    names = lines[header].decode().strip().split(",")
+    force = [names.index(n) for n in ("fx", "fy", "fz")]
+    torque = [names.index(n) for n in ("tx", "ty", "tz")]
+    moved = [*lines[:header], f"# torque_point: {point}\n".encode(), lines[header]]
+    for line in lines[header + 1 :]:
+        cells = line.decode().strip().split(",")
+        values = np.array([float(c) for c in cells])
+        values[torque] -= np.cross(point, values[force])
+        moved.append((",".join(repr(float(v)) for v in values) + "\n").encode())
+    path = tmp_path / "about_s.csv"
+    path.write_bytes(b"".join(moved))
+    from_file = read_recording(path)
+    np.testing.assert_allclose(from_file.torque, recording.torque, rtol=0, atol=1e-15)
+    offline = estimate(from_file, paper_antenna(), "paper")
+    about_o = estimate(recording, paper_antenna(), "paper")
+    assert offline.status is about_o.status and abs(offline.x_c - about_o.x_c) < 1e-6
+    found = [e for e in _listen(moved) if isinstance(e, EstimateEvent)]
+    assert len(found) == 1
+    _same_estimate(found[0].to_dict(), offline.to_dict())

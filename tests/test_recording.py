@@ -581,3 +581,60 @@ def test_a_sample_period_with_a_digit_group_is_refused(tmp_path: Path) -> None:
     with pytest.raises(RecordingError) as info:
         read_recording(path)
     assert (info.value.line, info.value.field) == (1, "sample_period")
+
+
+def _about(point: list[float], recording: Recording, path: Path) -> Path:
+    """``recording`` written with its torques taken about ``point`` (S - O, m) and saying so."""
+    moved = Recording(
+        t=recording.t,
+        theta=recording.theta,
+        force=recording.force,
+        torque=recording.torque - np.cross(point, recording.force),
+        metadata=recording.metadata,
+    )
+    write_recording(moved, path)
+    lines = path.read_text().splitlines(keepends=True)
+    lines.insert(2, f"# torque_point: {point}\n")
+    path.write_text("".join(lines))
+    return path
+
+
+def test_torques_taken_about_the_sensors_origin_are_moved_to_o(tmp_path: Path) -> None:
+    # Gamma_O = Gamma_S + (S - O) x F: a sensor 25 mm along the link and 4 mm above it
+    original = _recording(50, metadata={"description": "head at rest"})
+    path = _about([0.025, 0.0, 0.004], original, tmp_path / "s.csv")
+    read = read_recording(path)
+    np.testing.assert_allclose(read.torque, original.torque, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(read.force, original.force)
+    # the recording read is about O: written again, it reads the same, and says where from
+    assert "torque_point" not in read.metadata
+    assert read.metadata["torques_moved_from"] == "[0.025, 0.0, 0.004]"
+    write_recording(read, tmp_path / "again.csv")
+    assert read_recording(tmp_path / "again.csv") == read
+    # a recording in memory holds torques about O only
+    with pytest.raises(RecordingError, match=r"torque_point.*about O"):
+        _recording(metadata={"torque_point": "[0.025, 0, 0]"})
+
+
+@pytest.mark.parametrize(
+    ("value", "problem"),
+    [
+        ("[25, 0, 4]", "25.32 m from O, more than 1 m: in metres?"),
+        ("[0.02, 0]", "must be three numbers"),
+        ('{"x": 0.02}', "must be three numbers"),
+        ("[0.02, 0, NaN]", "must be finite"),
+        ("[true, 0, 0]", "must be three numbers"),
+    ],
+)
+def test_a_torque_point_that_is_no_point_on_the_head_is_named(
+    value: str, problem: str, tmp_path: Path
+) -> None:
+    path = tmp_path / "bad.csv"
+    path.write_text(
+        f"# format: {FORMAT_NAME}\n# sample_period: 0.001\n# torque_point: {value}\n"
+        "t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0,0,0\n0.001,0,0,0,0,0,0,0,0\n"
+    )
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    assert str(info.value).startswith(f"{path}:3: metadata key 'torque_point': ")
+    assert problem in info.value.problem

@@ -34,6 +34,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.errors import SensingAntennaError, format_value
+from sensing_antenna.torque_point import (
+    TORQUE_POINT_KEY,
+    moved_metadata,
+    torque_point_problem,
+    torques_about_base,
+)
 
 __all__ = [
     "CLOCK_TOLERANCE",
@@ -417,6 +423,15 @@ class Recording:
                     metadata=True,
                 )
             metadata[key] = text
+        if TORQUE_POINT_KEY in metadata:
+            raise RecordingError(
+                self.source,
+                None,
+                TORQUE_POINT_KEY,
+                "a Recording holds torques about O: read_recording moves a file's to O, "
+                "sensing_antenna.torque_point.torques_about_base moves any",
+                metadata=True,
+            )
         extra: dict[str, NDArray[np.float64]] = {}
         for name, values in self.extra.items():
             _check_name(name, "column name")
@@ -605,6 +620,12 @@ def _check_known_metadata(metadata: Mapping[str, str], lines: list[str], source:
             f"must be a number > 0 ({period!r})",
             metadata=True,
         )
+    point = metadata.get(TORQUE_POINT_KEY)
+    if point is not None:
+        _, wrong = torque_point_problem(point)
+        if wrong is not None:
+            line = line_of(TORQUE_POINT_KEY)
+            raise RecordingError(source, line, TORQUE_POINT_KEY, wrong, metadata=True)
 
 
 def other_separator(names: Sequence[str]) -> str | None:
@@ -878,11 +899,17 @@ def read_recording(path: str | Path) -> Recording:
     if span is not None:
         k, problem = span
         raise RecordingError(source, first_line + k, "t", problem)
+    force = np.column_stack([column["fx"], column["fy"], column["fz"]])
+    torque = np.column_stack([column["tx"], column["ty"], column["tz"]])
+    if TORQUE_POINT_KEY in metadata:  # checked by parse_metadata
+        point, _ = torque_point_problem(metadata[TORQUE_POINT_KEY])
+        torque = torques_about_base(force, torque, np.asarray(point))
+        metadata = moved_metadata(metadata)
     return Recording(
         t=t,
         theta=np.column_stack([column["theta1"], column["theta2"]]),
-        force=np.column_stack([column["fx"], column["fy"], column["fz"]]),
-        torque=np.column_stack([column["tx"], column["ty"], column["tz"]]),
+        force=force,
+        torque=torque,
         metadata=metadata,
         extra={name: column[name] for name in names if name not in REQUIRED_COLUMNS},
         source=source,

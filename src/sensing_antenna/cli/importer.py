@@ -74,6 +74,14 @@ def _add_rosbag(formats: Any) -> None:
         help="the sensor reports the wrench the head applies to the link: change both signs",
     )
     parser.add_argument(
+        "--torque-point",
+        type=_point,
+        default=(0.0, 0.0, 0.0),
+        metavar="X,Y,Z",
+        help="the point the sensor takes its torques about (its origin), from the base point O "
+        "on the motor axes, in m, such as 0.025,0,0: the torques are moved to O (default: O)",
+    )
+    parser.add_argument(
         "--rate",
         type=number(low=0.0, low_open=True, unit="Hz"),
         metavar="HZ",
@@ -106,7 +114,19 @@ def _add_rosbag(formats: Any) -> None:
         help="description metadata (default: the bag and its topics)",
     )
     parser.add_argument("--out", type=Path, required=True, help="the recording to write (CSV)")
-    parser.set_defaults(func=_run_rosbag, flags={"frame": "--frame"})
+    parser.set_defaults(
+        func=_run_rosbag, flags={"frame": "--frame", "torque_point": "--torque-point"}
+    )
+
+
+def _point(text: str) -> tuple[float, float, float]:
+    """An argparse ``type``: three numbers separated by commas (m)."""
+    parse = number(unit="m")
+    cells = text.split(",")
+    if len(cells) != 3:
+        raise argparse.ArgumentTypeError(f"must be three numbers X,Y,Z (m), got {text!r}")
+    x, y, z = (parse(cell) for cell in cells)
+    return x, y, z
 
 
 def _run_rosbag(args: argparse.Namespace) -> int:
@@ -114,7 +134,7 @@ def _run_rosbag(args: argparse.Namespace) -> int:
     from sensing_antenna.importers.rosbag import read_rosbag
     from sensing_antenna.recording import write_recording
 
-    axes = SensorAxes(args.frame, reaction=args.reaction)
+    axes = SensorAxes(args.frame, reaction=args.reaction, torque_point=args.torque_point)
     metadata = {
         "description": args.description
         or f"imported from ROS bag {args.bag.name} ({args.wrench}, {args.joints})"

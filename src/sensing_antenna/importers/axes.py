@@ -6,17 +6,21 @@ way round reports the same wrench on its own axes; :class:`SensorAxes` names, fo
 axis in turn, the sensor axis that lies along it with its sign (``"z,-y,x"``: X^m is the sensor's
 +z, Y^m its -y, Z^m its +x). Only right-handed choices are accepted: a rotation turns force and
 torque alike. A sensor that reports the wrench the head applies to the link (the reaction) is
-stated apart (``reaction=True``): both vectors change sign.
+stated apart (``reaction=True``): both vectors change sign. A sensor takes its torques about its
+own origin S; where S is not the base point O, ``torque_point`` (S - O on the motor axes, m)
+moves them there (:mod:`sensing_antenna.torque_point`).
 """
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.errors import FieldError
+from sensing_antenna.torque_point import torque_point_problem, torques_about_base
 
 __all__ = ["AxesError", "SensorAxes"]
 
@@ -41,13 +45,20 @@ class SensorAxes:
     reaction : bool
         True when the sensor reports the wrench the head applies to the link, the opposite of
         what the recording holds.
+    torque_point : tuple of 3 float
+        S - O, the sensor's origin from the base point O on the motor axes (m), about which it
+        takes its torques; (0, 0, 0): about O.
     """
 
     axes: str = "x,y,z"
     reaction: bool = False
+    torque_point: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
         self.matrix  # noqa: B018  (validates)
+        _, problem = torque_point_problem(json.dumps(list(self.torque_point)))
+        if problem is not None:
+            raise AxesError("torque_point", problem)
 
     @property
     def matrix(self) -> NDArray[np.float64]:
@@ -80,10 +91,17 @@ class SensorAxes:
         self, force: NDArray[np.float64], torque: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Force (N) and torque (N m) on the sensor's axes, shape (n, 3) each, to the motor
-        frame, the wrench by the link on the head; shapes kept."""
+        frame, the wrench by the link on the head, its torques about O; shapes kept."""
         matrix = self.matrix
-        return force @ matrix.T, torque @ matrix.T
+        force_m = force @ matrix.T
+        return force_m, torques_about_base(
+            force_m, torque @ matrix.T, np.array(self.torque_point, dtype=float)
+        )
 
     def describe(self) -> str:
-        """One line: the axes, and ``reaction`` when the sensor reports the reaction."""
-        return f"{self.axes}{', reaction' if self.reaction else ''}"
+        """One line: the axes, ``reaction`` when the sensor reports the reaction, and the point
+        its torques are taken about when it is not O."""
+        point = ""
+        if any(self.torque_point):
+            point = f", torques about ({', '.join(f'{v:g}' for v in self.torque_point)}) m"
+        return f"{self.axes}{', reaction' if self.reaction else ''}{point}"

@@ -44,6 +44,7 @@ from sensing_antenna.live.events import (
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.wire import StreamHeader, WireError
 from sensing_antenna.recording import CLOCK_TOLERANCE, PERIOD_CONSISTENCY
+from sensing_antenna.torque_point import TORQUE_POINT_KEY, torque_point_problem, torques_about_base
 
 __all__ = ["CONTACT_LOST_TIME", "Listener"]
 
@@ -168,6 +169,10 @@ class Listener:
             [header.required(name) for name in names]
             for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
         ]
+        # the torques about O of a sensor that takes them about its own origin (checked with
+        # the header); the recording keeps them as received, with the point
+        stated = header.metadata.get(TORQUE_POINT_KEY)
+        self._torque_point = None if stated is None else torque_point_problem(stated)[0]
         self._t = _Growing()  # with the samples missing put back
         self._received = _Growing()
         self._stamps = _Growing()  # the first time stamps received, for the period's check
@@ -253,6 +258,12 @@ class Listener:
         received = np.repeat([when for _, when in blocks], [a.shape[0] for a in arrays])
         if self._record is not None:
             self._record.write(rows)
+        if self._torque_point is not None:
+            forces, torques = self._columns[2], self._columns[3]
+            rows = rows.copy()
+            rows[:, torques] = torques_about_base(
+                rows[:, forces], rows[:, torques], self._torque_point
+            )
         t = rows[:, self._columns[0][0]]
         self._stamps.extend(t[: PERIOD_CHECK_STEPS + 1 - self._stamps.size])
         self._check_period()

@@ -1,0 +1,80 @@
+"""Torques a sensor takes about its own origin: the recording format's ``torque_point``.
+
+The format's torques are the link's on the head about the base point O. An F/T sensor reports
+them about its own origin S, which a mount may put a few centimetres from O along the link or
+beside it. A recording (or a stream) whose torques are about S says so in its metadata,
+
+    # torque_point: [S_x, S_y, S_z]
+
+S - O in metres on the motor axes (fixed to the head, as the sensor is), and the reader moves
+them to O: Gamma_O = Gamma_S + (S - O) x F, F the force read with them. Unstated, S = O.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "MAX_TORQUE_POINT",
+    "MOVED_KEY",
+    "TORQUE_POINT_KEY",
+    "moved_metadata",
+    "torque_point_problem",
+    "torques_about_base",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: The metadata key that names the point the torques are taken about.
+TORQUE_POINT_KEY = "torque_point"
+#: The key a reader leaves in its place once it has moved the torques to O (the point, as
+#: read): the recording it gives is about O, and a copy written from it is read as such.
+MOVED_KEY = "torques_moved_from"
+#: Farthest a sensor's origin may lie from O (m): a sensor sits on the head, within
+#: centimetres of the link's clamp; a point metres away is a number in another unit.
+MAX_TORQUE_POINT = 1.0
+
+
+def torque_point_problem(text: str) -> tuple[FloatArray | None, str | None]:
+    """The point S - O (m, shape (3,)) a ``torque_point`` value states, or what is wrong with
+    it: (point, None) or (None, problem)."""
+    try:
+        value: Any = json.loads(text)
+    except (json.JSONDecodeError, RecursionError, ValueError):
+        value = None
+    if not (
+        isinstance(value, list)
+        and len(value) == 3
+        and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+    ):
+        return None, f"must be three numbers [x, y, z] (m, motor axes), got {text!r}"
+    point = np.array(value, dtype=float)
+    if not np.all(np.isfinite(point)):
+        return None, f"must be finite, got {text!r}"
+    distance = math.hypot(*point)
+    if distance > MAX_TORQUE_POINT:
+        return None, (
+            f"{distance:.4g} m from O, more than {MAX_TORQUE_POINT:g} m: in metres? (a sensor "
+            "sits on the head)"
+        )
+    return point, None
+
+
+def torques_about_base(force: FloatArray, torque: FloatArray, point: FloatArray) -> FloatArray:
+    """Torques (N m, shape (n, 3)) about O of a wrench read as ``force`` (N) and ``torque``
+    (N m, about ``point`` S - O, m), all on the motor axes: Gamma_S + (S - O) x F."""
+    return np.asarray(torque + np.cross(point, force), dtype=float)
+
+
+def moved_metadata(metadata: Mapping[str, str]) -> dict[str, str]:
+    """``metadata`` of a recording whose torques were moved to O: ``torque_point`` replaced by
+    :data:`MOVED_KEY`, in its place."""
+    return {
+        (MOVED_KEY if key == TORQUE_POINT_KEY else key): value for key, value in metadata.items()
+    }
