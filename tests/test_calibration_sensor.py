@@ -96,6 +96,7 @@ def test_sensor_section_round_trips_and_bad_values_name_the_field(tmp_path: Path
         ("[sensor]\nratio_scatter = -0.1\n", "sensor.ratio_scatter"),
         ('[sensor]\nunmeasured_sweeps = ["sideways"]\n', "sensor.unmeasured_sweeps"),
         ('[sensor]\nunmeasured_sweeps = "vertical"\n', "sensor.unmeasured_sweeps"),
+        ('[sensor]\nunmeasured_sweeps = [["vertical"]]\n', "sensor.unmeasured_sweeps"),
     ):
         path.write_text('base = "paper-2021"\n' + text)
         with pytest.raises(AntennaConfigError, match=field):

@@ -584,7 +584,7 @@ class SensorCorrection:
                 "sensor.unmeasured_sweeps", f"must be a list of sweep directions, got {sweeps!r}"
             )
         for sweep in sweeps:
-            if sweep not in SENSOR_SWEEPS:
+            if not isinstance(sweep, str) or sweep not in SENSOR_SWEEPS:
                 raise AntennaConfigError(
                     "sensor.unmeasured_sweeps",
                     f"{sweep!r} is no sweep direction (one of {', '.join(SENSOR_SWEEPS)})",
