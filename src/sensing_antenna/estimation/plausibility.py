@@ -90,9 +90,6 @@ _INPUT_STATUSES = (Status.BAD_INPUT, Status.IMPLAUSIBLE_INPUT)
 #: Least radius (m) of an object's surface the bend check allows a contact to slide over: the
 #: simulator's default post is 10 mm.
 _LEAST_RADIUS = 0.01
-#: What the bend check adds to the measured turn of the contact moment about the link (rad):
-#: the noise of two means of the moment's direction and the ringing left in them, a few degrees.
-_TURN_TOLERANCE = 0.05
 
 
 def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
@@ -533,31 +530,6 @@ def _bend_at_touch(
     return math.nan, math.inf
 
 
-def _moment_turn(evidence: Evidence, k: int, end: int, period: int, link: np.ndarray) -> float:
-    """The angle (rad, in [0, pi]) by which the contact moment across the link (unit vector
-    ``link``, absolute frame, at t_e) turned about it from the touch (sample ``k``) to t_e
-    (sample ``end``): between its means over one ``period`` (samples) of the contact's
-    fundamental after t_c (or to t_1, if sooner) and before t_e, in the absolute frame. A contact
-    that slides over a convex surface turns its normal, and so its moment, by the arc it slid;
-    one that sticks, or slides over a flat surface, does not. NaN without a moment to read."""
-
-    def direction(first: int, last: int) -> np.ndarray:
-        near = slice(first, last + 1)
-        _, moment = contact_loads(
-            evidence.theta[near], evidence.force[near], evidence.torque[near], evidence.antenna
-        )
-        axes = motor_axes(evidence.theta[near])
-        mean = np.einsum("ni,nij->j", moment - evidence.load_offset[3:], axes) / moment.shape[0]
-        across = mean - (mean @ link) * link
-        size = float(np.linalg.norm(across))
-        return across / size if size > 0.0 else np.full(3, np.nan)
-
-    touch = direction(k, max(min(k + period, evidence.rest_index), k))
-    held = direction(max(end - period, evidence.rest_index), end)
-    cosine = float(touch @ held)
-    return math.acos(min(max(cosine, -1.0), 1.0)) if math.isfinite(cosine) else math.nan
-
-
 def _contact_modes(evidence: Evidence, x_c: float) -> tuple[float, float]:
     """omega_1 and omega_2 (rad/s) of the straight link in contact at ``x_c`` (m): read from
     :attr:`Evidence.contact_modes`, solved where ``x_c`` lies outside its grid."""
@@ -578,14 +550,9 @@ def _bend_against_turn(
     angle phi to -u. A contact that sticks stays where it touched: y = -u, phi = 0. One that slides
     with Coulomb friction mu stays on the surface of normal n, y (R^ . n) = -u . n, with R on the
     friction cone's edge between n and -u; then 1 - mu tan(phi) <= y / (-R^ . u) <= 1 on a flat
-    surface. Sliding over a convex one moves the contact out along the reaction, the chord of the
-    slide rising by d tan(alpha / 2) over d, the head's reach across the push, where alpha is the
-    turn of the surface's normal, and so of the reaction, about the link: at most d^2 / (2 rho)
-    over a radius rho. The upper bound allows the lesser of the two, with rho ``_LEAST_RADIUS``
-    and alpha the contact moment's measured turn about the link from the touch to t_e
-    (:func:`_moment_turn`, plus ``_TURN_TOLERANCE``): a head that moved across a push that kept
-    its direction slid over no curve (a convex surface only raises y, so the lower bound
-    holds). A head that turned
+    surface. Sliding over a convex one of radius rho moves the contact out along the reaction by up
+    to d^2 / (2 rho), d the head's reach across the push, which the upper bound allows for
+    ``_LEAST_RADIUS`` (a convex surface only raises y, so the lower bound holds). A head that turned
     across the push or away from it (-R^ . u <= 0: a slide aside over a steep or curved surface, or
     joints swapped) is judged on the upper bound with no turn into the push, not on the lower one.
     Both vectors are taken across the link (X^m at t_e removed), mu is ``max_friction_ratio``, and
@@ -596,9 +563,9 @@ def _bend_against_turn(
     :func:`_bend_at_touch` (the detector declares t_c once the push has built up), whose two
     standard errors widen the band; not judged when the push from t_c to t_1 lasts less than half a
     period of the fundamental. At a given push y grows as x_c^3 and u as x_c: an answer off the
-    contact moves the ratio as (x_c / true x_c)^2. ``notes`` gets ``turn_against_push``
-    (-R^ . u, m), ``bend_per_turn`` (y over it) and ``moment_turn`` (alpha, rad). Not judged when
-    the head turned by less than the rest tolerance (an object pushed into a still link).
+    contact moves the ratio as (x_c / true x_c)^2. ``notes`` gets ``turn_against_push`` (-R^ . u, m)
+    and ``bend_per_turn`` (y over it). Not judged when the head turned by less than the rest
+    tolerance (an object pushed into a still link).
     """
     bend = float(estimate.diagnostics.get("deflection", math.nan))
     if not (math.isfinite(bend) and bend > 0.0):
@@ -657,23 +624,15 @@ def _bend_against_turn(
         f"{1e3 * turn:.3g} mm against the push"
     )
     # the head's reach across the push: a contact sliding over a convex object moves out along
-    # its normal by that times tan(alpha / 2), alpha the normal's turn, and by up to that squared
-    # over twice the surface's radius
+    # its normal by up to that squared over twice the surface's radius
     reach = float(np.linalg.norm(moved))
     across = math.sqrt(max(reach**2 - max(turn, 0.0) ** 2, 0.0))
-    alpha = _moment_turn(evidence, k, end, period, x_axis)
-    notes["moment_turn"] = alpha
-    bound = min(alpha + _TURN_TOLERANCE, 0.5 * math.pi) if math.isfinite(alpha) else 0.5 * math.pi
-    curved = across * min(across / (2.0 * _LEAST_RADIUS), math.tan(0.5 * bound))
-    slide = (
-        f"a slide over a surface curved to a radius of {1e3 * _LEAST_RADIUS:g} mm or more, its "
-        f"normal turned by the {math.degrees(alpha):.1f} deg the contact moment turned about "
-        "the link"
-    )
+    curved = across**2 / (2.0 * _LEAST_RADIUS)
     if least_since > limit * max(turn, 0.0) + curved:
         if not turn > across:
             return (
-                f"{measured}, and {1e3 * across:.3g} mm across it: more than {slide} allows "
+                f"{measured}, and {1e3 * across:.3g} mm across it: more than a slide over a "
+                f"surface curved to a radius of {1e3 * _LEAST_RADIUS:g} mm allows "
                 f"({1e3 * curved:.2g} mm); the angles turn the head across the push that bent "
                 "it, or away from it, more than into it (two joints swapped, or one read from "
                 "another column or with its sign flipped; or an object that moved into the link, "
@@ -682,10 +641,11 @@ def _bend_against_turn(
         return (
             f"{measured} (a contact that sticks bends the link as far as the head turned into "
             f"it, one that slides over a flat surface less; up to {limit:g} times that, plus "
-            f"{1e3 * curved:.2g} mm for {slide}, is allowed): forces that read high for the "
-            "model's stiffness (the sensor's gain or cross-talk, which antenna calibrate fits), "
-            "a link stiffer than the antenna file says, or angles that do not describe the head's "
-            "turn (a joint read from the wrong column, a scale off)"
+            f"{1e3 * curved:.2g} mm for a slide over a surface curved to a radius of "
+            f"{1e3 * _LEAST_RADIUS:g} mm, is allowed): forces that read high for the model's "
+            "stiffness (the sensor's gain or cross-talk, which antenna calibrate fits), a link "
+            "stiffer than the antenna file says, or angles that do not describe the head's turn "
+            "(a joint read from the wrong column, a scale off)"
         )
     if not turn > 0.0:
         return None  # no turn into the push to bend the link at least as far as
