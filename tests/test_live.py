@@ -35,6 +35,7 @@ from sensing_antenna.live.events import (
 )
 from sensing_antenna.live.inputs import listen_lines, listen_udp
 from sensing_antenna.live.listener import CONTACT_LOST_TIME, Listener
+from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.replay import replay_datagrams, replay_lines, stream_of
 from sensing_antenna.live.warm_up import warm_up
 from sensing_antenna.live.wire import (
@@ -724,6 +725,16 @@ def test_a_stream_whose_torques_are_about_the_sensors_origin_is_estimated_as_the
     offline = estimate(from_file, paper_antenna(), "paper")
     about_o = estimate(recording, paper_antenna(), "paper")
     assert offline.status is about_o.status and abs(offline.x_c - about_o.x_c) < 1e-6
-    found = [e for e in _listen(moved) if isinstance(e, EstimateEvent)]
+    events: list[Event] = []
+    kept = tmp_path / "kept.csv"
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        record = RecordWriter(kept, header)
+        return Listener(header, paper_antenna(), events.append, number=number, record=record)
+
+    listen_lines(moved, make)
+    found = [e for e in events if isinstance(e, EstimateEvent)]
     assert len(found) == 1
     _same_estimate(found[0].to_dict(), offline.to_dict())
+    # what was received is kept as it came, the point with it: read back, about O again
+    assert read_recording(kept).torque.tolist() == from_file.torque.tolist()
