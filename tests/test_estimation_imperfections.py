@@ -166,3 +166,27 @@ def test_a_sensor_calibrated_on_azimuthal_sweeps_only_is_not_trusted_on_vertical
         ratio = estimate(blind, model, "ratio")
         assert ratio.status.value == "uncertain"
         assert "the sensor's cross-talk on vertical sweeps too" in ratio.reason
+
+
+def test_a_leak_that_tilts_the_push_it_bounds_does_not_shrink_its_own_term() -> None:
+    # A sensor whose elevation torque leaks into its azimuthal force (fy reads 1 N per N m of
+    # ty) reads a vertical push tilted by atan(x_c) towards Y^m, the direction whose terms its
+    # azimuthal-only calibration measured. Weighed by that reading alone, the term of the
+    # unmeasured vertical direction would shrink; the head turned vertically, so it keeps the
+    # whole nominal cross-talk: the ratio's spread holds 2 c x^2 at least, x the ratio read.
+    leak = [[0.0] * 6 for _ in range(6)]
+    leak[1][4] = 1.0
+    device = DeviceImperfections(sensor_coupling=tuple(tuple(row) for row in leak))
+    recording = simulate(
+        paper_antenna(), Scenario(case="vertical", contact_point=0.8, seed=4, device=device)
+    )
+    sensor = dataclasses.replace(
+        MODEL.sensor,
+        ratio_scatter=0.03,
+        unmeasured_sweeps=("vertical",),
+        nominal_coupling=paper_antenna().sensor.nominal_coupling,
+    )
+    model = dataclasses.replace(MODEL, sensor=sensor)
+    result = estimate(recording.without_ground_truth(), model, "ratio")
+    assert result.status.value != "ok"
+    assert result.diagnostics["ratio_spread"] >= 2.0 * sensor.nominal_coupling * result.x_c**2

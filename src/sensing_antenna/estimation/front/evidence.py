@@ -420,8 +420,16 @@ class Evidence:
         """Standard uncertainty (m) of the ratio at contact points ``x_c`` (m, any shape) from the
         cross-talk of a sensor no calibration has measured for the hold's push: a force read
         c x_c R_perp too high moves the ratio by about c x_c^2
-        (:meth:`.SensorCorrection.coupling_uncertainty`)."""
-        coupling = self.antenna.sensor.coupling_uncertainty(self.frame.reaction_m)
+        (:meth:`.SensorCorrection.coupling_uncertainty`). The push's direction is the one the
+        sensor reads, which the leak itself may tilt, or the head's turn from t_c to t_1 (Y^m
+        by theta1 cos theta2, Z^m by theta2), whichever gives the larger c."""
+        sensor = self.antenna.sensor
+        theta2 = float(self.theta[self.rest_index, 1])
+        turn = self.theta[self.rest_index] - self.theta[self.contact_index]
+        move = np.array([0.0, float(turn[0]) * math.cos(theta2), float(turn[1])])
+        coupling = max(
+            sensor.coupling_uncertainty(self.frame.reaction_m), sensor.coupling_uncertainty(move)
+        )
         return np.asarray(coupling * np.square(x_c), dtype=float)
 
     def bent_link_uncertainty(self, x_c: float) -> float:
