@@ -257,6 +257,7 @@ def test_a_sensor_taking_its_torques_about_its_origin_is_moved_to_o(
     np.testing.assert_array_equal(imported.force, recording.force)
     np.testing.assert_allclose(imported.torque, recording.torque, rtol=0, atol=1e-15)
     assert "torques about (0.025, 0, 0.004) m" in imported.metadata["ros_sensor_axes"]
+    assert imported.metadata["torques_moved_from"] == "[0.025, 0.0, 0.004]"  # as a reader keeps it
     with pytest.raises(AxesError, match="more than 1 m: in metres"):
         SensorAxes(torque_point=(25.0, 0.0, 4.0))
 

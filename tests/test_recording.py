@@ -624,6 +624,7 @@ def test_torques_taken_about_the_sensors_origin_are_moved_to_o(tmp_path: Path) -
         ('{"x": 0.02}', "must be three numbers"),
         ("[0.02, 0, NaN]", "must be finite"),
         ("[true, 0, 0]", "must be three numbers"),
+        (f"[1{'0' * 400}, 0, 0]", "must be finite"),  # an integer no float holds
     ],
 )
 def test_a_torque_point_that_is_no_point_on_the_head_is_named(
@@ -638,3 +639,29 @@ def test_a_torque_point_that_is_no_point_on_the_head_is_named(
         read_recording(path)
     assert str(info.value).startswith(f"{path}:3: metadata key 'torque_point': ")
     assert problem in info.value.problem
+
+
+@pytest.mark.parametrize(
+    ("lines", "key", "problem"),
+    [
+        ("# torque-point: [0.02, 0, 0]\n", "torque-point", "is spelled 'torque_point'"),
+        ("# Torque_Point: [0.02, 0, 0]\n", "Torque_Point", "is spelled 'torque_point'"),
+        (
+            "# torque_point: [0.02, 0, 0]\n# torques_moved_from: [0.01, 0, 0]\n",
+            "torques_moved_from",
+            "one says the torques are about O already",
+        ),
+    ],
+)
+def test_a_torque_point_misspelled_or_contradicted_is_refused(
+    lines: str, key: str, problem: str, tmp_path: Path
+) -> None:
+    # as written, the first two would leave the torques where they are, without a word
+    path = tmp_path / "bad.csv"
+    path.write_text(
+        f"# format: {FORMAT_NAME}\n# sample_period: 0.001\n{lines}"
+        "t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0,0,0\n0.001,0,0,0,0,0,0,0,0\n"
+    )
+    with pytest.raises(RecordingError) as info:
+        read_recording(path)
+    assert info.value.field == key and problem in info.value.problem

@@ -36,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from sensing_antenna.errors import SensingAntennaError, format_value
 from sensing_antenna.torque_point import (
     TORQUE_POINT_KEY,
+    key_problem,
     moved_metadata,
     torque_point_problem,
     torques_about_base,
@@ -620,6 +621,9 @@ def _check_known_metadata(metadata: Mapping[str, str], lines: list[str], source:
             f"must be a number > 0 ({period!r})",
             metadata=True,
         )
+    keys = key_problem(metadata)
+    if keys is not None:
+        raise RecordingError(source, line_of(keys[0]), keys[0], keys[1], metadata=True)
     point = metadata.get(TORQUE_POINT_KEY)
     if point is not None:
         _, wrong = torque_point_problem(point)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -24,6 +24,7 @@ __all__ = [
     "MAX_TORQUE_POINT",
     "MOVED_KEY",
     "TORQUE_POINT_KEY",
+    "key_problem",
     "moved_metadata",
     "torque_point_problem",
     "torques_about_base",
@@ -44,9 +45,9 @@ MAX_TORQUE_POINT = 1.0
 def torque_point_problem(text: str) -> tuple[FloatArray | None, str | None]:
     """The point S - O (m, shape (3,)) a ``torque_point`` value states, or what is wrong with
     it: (point, None) or (None, problem)."""
-    try:
-        value: Any = json.loads(text)
-    except (json.JSONDecodeError, RecursionError, ValueError):
+    try:  # every number a float: an integer of 400 digits is inf, refused below
+        value: Any = json.loads(text, parse_int=float, parse_constant=float)
+    except (json.JSONDecodeError, RecursionError, ValueError, OverflowError):
         value = None
     if not (
         isinstance(value, list)
@@ -64,6 +65,22 @@ def torque_point_problem(text: str) -> tuple[FloatArray | None, str | None]:
             "sits on the head)"
         )
     return point, None
+
+
+def key_problem(keys: Iterable[str]) -> tuple[str, str] | None:
+    """(key, problem) for metadata keys that would leave the torques where they are or say two
+    things of them: a spelling of ``torque_point`` other than its own (``torque-point``, as the
+    import's flag is spelled; another case), or ``torque_point`` beside :data:`MOVED_KEY`."""
+    names = list(keys)
+    for key in names:
+        if key != TORQUE_POINT_KEY and key.lower().replace("-", "_") == TORQUE_POINT_KEY:
+            return key, f"is spelled {TORQUE_POINT_KEY!r} (as written, the torques are not moved)"
+    if TORQUE_POINT_KEY in names and MOVED_KEY in names:
+        return MOVED_KEY, (
+            f"beside {TORQUE_POINT_KEY!r}: one says the torques are about O already, the other "
+            "about another point"
+        )
+    return None
 
 
 def torques_about_base(force: FloatArray, torque: FloatArray, point: FloatArray) -> FloatArray:

@@ -76,10 +76,12 @@ def _add_rosbag(formats: Any) -> None:
     parser.add_argument(
         "--torque-point",
         type=_point,
-        default=(0.0, 0.0, 0.0),
+        default=None,
         metavar="X,Y,Z",
         help="the point the sensor takes its torques about (its origin), from the base point O "
-        "on the motor axes, in m, such as 0.025,0,0: the torques are moved to O (default: O)",
+        "on the motor axes, in m: --torque-point=-0.025,0,0 for an origin 2.5 cm behind the "
+        "link's clamp (the equals sign when it begins with a minus); the torques are moved to O "
+        "(default: O itself)",
     )
     parser.add_argument(
         "--rate",
@@ -134,7 +136,8 @@ def _run_rosbag(args: argparse.Namespace) -> int:
     from sensing_antenna.importers.rosbag import read_rosbag
     from sensing_antenna.recording import write_recording
 
-    axes = SensorAxes(args.frame, reaction=args.reaction, torque_point=args.torque_point)
+    point = (0.0, 0.0, 0.0) if args.torque_point is None else args.torque_point
+    axes = SensorAxes(args.frame, reaction=args.reaction, torque_point=point)
     metadata = {
         "description": args.description
         or f"imported from ROS bag {args.bag.name} ({args.wrench}, {args.joints})"

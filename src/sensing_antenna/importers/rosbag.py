@@ -13,6 +13,7 @@ Reading uses the ``rosbags`` library, an optional dependency (``pip install
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +29,7 @@ from sensing_antenna.importers.clock import (
     put_on_clock,
 )
 from sensing_antenna.recording import Recording
+from sensing_antenna.torque_point import MOVED_KEY
 
 __all__ = [
     "INSTALL_HINT",
@@ -426,6 +428,7 @@ def read_rosbag(
         "ros_joints_topic": joints_topic,
         "ros_joints": f"theta1={names[0]}, theta2={names[1]}",
         "ros_sensor_axes": axes.describe(),
+        **({MOVED_KEY: json.dumps(list(axes.torque_point))} if any(axes.torque_point) else {}),
         "ros_time_origin": f"{clock.origin_ns // _NS}.{clock.origin_ns % _NS:09d}",
     }
     recording = Recording(
