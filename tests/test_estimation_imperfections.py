@@ -155,6 +155,7 @@ def test_a_sensor_calibrated_on_azimuthal_sweeps_only_is_not_trusted_on_vertical
     model = calibrate_sensor(recordings, calibrated.apply(model), points).apply(
         calibrated.apply(model)
     )
+    # the default campaign's seeds of vertical-x0200mm-r1 and vertical-x0220mm-r1 (base 2021)
     for x_c, seed in ((0.2, 439940406), (0.22, 3568536999)):
         touched, blind = record("vertical", x_c, seed)
         for method in sorted(METHODS):

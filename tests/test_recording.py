@@ -599,6 +599,15 @@ def _about(point: list[float], recording: Recording, path: Path) -> Path:
     return path
 
 
+def _with_metadata(path: Path, lines: str) -> Path:
+    """A two-sample file at ``path`` with the metadata ``lines`` after format and period."""
+    path.write_text(
+        f"# format: {FORMAT_NAME}\n# sample_period: 0.001\n{lines}"
+        "t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0,0,0\n0.001,0,0,0,0,0,0,0,0\n"
+    )
+    return path
+
+
 def test_torques_taken_about_the_sensors_origin_are_moved_to_o(tmp_path: Path) -> None:
     # Gamma_O = Gamma_S + (S - O) x F: a sensor 25 mm along the link and 4 mm above it
     original = _recording(50, metadata={"description": "head at rest"})
@@ -630,11 +639,7 @@ def test_torques_taken_about_the_sensors_origin_are_moved_to_o(tmp_path: Path) -
 def test_a_torque_point_that_is_no_point_on_the_head_is_named(
     value: str, problem: str, tmp_path: Path
 ) -> None:
-    path = tmp_path / "bad.csv"
-    path.write_text(
-        f"# format: {FORMAT_NAME}\n# sample_period: 0.001\n# torque_point: {value}\n"
-        "t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0,0,0\n0.001,0,0,0,0,0,0,0,0\n"
-    )
+    path = _with_metadata(tmp_path / "bad.csv", f"# torque_point: {value}\n")
     with pytest.raises(RecordingError) as info:
         read_recording(path)
     assert str(info.value).startswith(f"{path}:3: metadata key 'torque_point': ")
@@ -657,11 +662,7 @@ def test_a_torque_point_misspelled_or_contradicted_is_refused(
     lines: str, key: str, problem: str, tmp_path: Path
 ) -> None:
     # as written, the first two would leave the torques where they are, without a word
-    path = tmp_path / "bad.csv"
-    path.write_text(
-        f"# format: {FORMAT_NAME}\n# sample_period: 0.001\n{lines}"
-        "t,theta1,theta2,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0,0,0\n0.001,0,0,0,0,0,0,0,0\n"
-    )
+    path = _with_metadata(tmp_path / "bad.csv", lines)
     with pytest.raises(RecordingError) as info:
         read_recording(path)
     assert info.value.field == key and problem in info.value.problem

@@ -914,15 +914,13 @@ def antenna_to_toml(antenna: Antenna) -> str:
                 lines.append(f"{f.name} = {float(value)!r}")
     if antenna.sensor != SensorCorrection():
         lines += ["", "[sensor]"]
+        # the sensor's stated cross-talk only where it is not the default's
+        default = antenna.sensor.nominal_coupling == NOMINAL_SENSOR_COUPLING
+        skipped = {"unmeasured_sweeps", *(("nominal_coupling",) if default else ())}
         lines += [
             f"{f.name} = {float(getattr(antenna.sensor, f.name))!r}"
             for f in fields(SensorCorrection)
-            # the sensor's stated cross-talk only where it is not the default's
-            if f.name not in ("nominal_coupling", "unmeasured_sweeps")
-            or (
-                f.name == "nominal_coupling"
-                and antenna.sensor.nominal_coupling != NOMINAL_SENSOR_COUPLING
-            )
+            if f.name not in skipped
         ]
         if antenna.sensor.unmeasured_sweeps:
             sweeps = ", ".join(_toml_str(s) for s in antenna.sensor.unmeasured_sweeps)

@@ -71,6 +71,7 @@ __all__ = [
     "read_recording",
     "resample_uniform",
     "sample_period_problem",
+    "stated_torque_point",
     "tracked_contact",
     "write_recording",
 ]
@@ -624,12 +625,28 @@ def _check_known_metadata(metadata: Mapping[str, str], lines: list[str], source:
     keys = key_problem(metadata)
     if keys is not None:
         raise RecordingError(source, line_of(keys[0]), keys[0], keys[1], metadata=True)
-    point = metadata.get(TORQUE_POINT_KEY)
-    if point is not None:
-        _, wrong = torque_point_problem(point)
-        if wrong is not None:
-            line = line_of(TORQUE_POINT_KEY)
-            raise RecordingError(source, line, TORQUE_POINT_KEY, wrong, metadata=True)
+    if TORQUE_POINT_KEY in metadata:
+        stated_torque_point(metadata, source, line_of(TORQUE_POINT_KEY))
+
+
+def stated_torque_point(
+    metadata: Mapping[str, str], source: str | None, line: int | None = None
+) -> NDArray[np.float64] | None:
+    """The point S - O (m, shape (3,)) a file's or a stream's ``torque_point`` states, None
+    without one (docs/recording-format.md).
+
+    Raises
+    ------
+    RecordingError
+        Naming ``source``, ``line`` and the key, when the value is no point on the head.
+    """
+    text = metadata.get(TORQUE_POINT_KEY)
+    if text is None:
+        return None
+    point, problem = torque_point_problem(text)
+    if point is None:
+        raise RecordingError(source, line, TORQUE_POINT_KEY, str(problem), metadata=True)
+    return point
 
 
 def other_separator(names: Sequence[str]) -> str | None:
@@ -905,9 +922,9 @@ def read_recording(path: str | Path) -> Recording:
         raise RecordingError(source, first_line + k, "t", problem)
     force = np.column_stack([column["fx"], column["fy"], column["fz"]])
     torque = np.column_stack([column["tx"], column["ty"], column["tz"]])
-    if TORQUE_POINT_KEY in metadata:  # checked by parse_metadata
-        point, _ = torque_point_problem(metadata[TORQUE_POINT_KEY])
-        torque = torques_about_base(force, torque, np.asarray(point))
+    point = stated_torque_point(metadata, source)  # its value checked by parse_metadata
+    if point is not None:
+        torque = torques_about_base(force, torque, point)
         metadata = moved_metadata(metadata)
     return Recording(
         t=t,

@@ -26,6 +26,7 @@ __all__ = [
     "TORQUE_POINT_KEY",
     "key_problem",
     "moved_metadata",
+    "point_problem",
     "torque_point_problem",
     "torques_about_base",
 ]
@@ -56,15 +57,21 @@ def torque_point_problem(text: str) -> tuple[FloatArray | None, str | None]:
     ):
         return None, f"must be three numbers [x, y, z] (m, motor axes), got {text!r}"
     point = np.array(value, dtype=float)
+    problem = point_problem(point)
+    return (None, problem) if problem is not None else (point, None)
+
+
+def point_problem(point: FloatArray) -> str | None:
+    """What is wrong with ``point`` (S - O, m, shape (3,)) as a sensor's origin, or None."""
     if not np.all(np.isfinite(point)):
-        return None, f"must be finite, got {text!r}"
+        return f"must be finite, got {point.tolist()}"
     distance = math.hypot(*point)
     if distance > MAX_TORQUE_POINT:
-        return None, (
+        return (
             f"{distance:.4g} m from O, more than {MAX_TORQUE_POINT:g} m: in metres? (a sensor "
             "sits on the head)"
         )
-    return point, None
+    return None
 
 
 def key_problem(keys: Iterable[str]) -> tuple[str, str] | None:

@@ -313,7 +313,7 @@ def _fit(
             ratio_scatter=scatter,
             nominal_coupling=antenna.sensor.nominal_coupling,  # the sensor's stated figure
             # pushes the other way read terms these contacts did not measure
-            unmeasured_sweeps=tuple(s for s in _PLANE_TERMS if s not in sweeps),
+            unmeasured_sweeps=tuple(s for s in SENSOR_SWEEPS if s not in sweeps),
         ),
         sweeps=sweeps,
         sources=tuple(n for _, n in kept),

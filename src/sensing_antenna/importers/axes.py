@@ -13,14 +13,13 @@ moves them there (:mod:`sensing_antenna.torque_point`).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.errors import FieldError
-from sensing_antenna.torque_point import torque_point_problem, torques_about_base
+from sensing_antenna.torque_point import point_problem, torques_about_base
 
 __all__ = ["AxesError", "SensorAxes"]
 
@@ -56,7 +55,7 @@ class SensorAxes:
 
     def __post_init__(self) -> None:
         self.matrix  # noqa: B018  (validates)
-        _, problem = torque_point_problem(json.dumps(list(self.torque_point)))
+        problem = point_problem(np.array(self.torque_point, dtype=float))
         if problem is not None:
             raise AxesError("torque_point", problem)
 

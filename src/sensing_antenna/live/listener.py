@@ -43,8 +43,12 @@ from sensing_antenna.live.events import (
 )
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.wire import StreamHeader, WireError
-from sensing_antenna.recording import CLOCK_TOLERANCE, PERIOD_CONSISTENCY, RecordingError
-from sensing_antenna.torque_point import TORQUE_POINT_KEY, torque_point_problem, torques_about_base
+from sensing_antenna.recording import (
+    CLOCK_TOLERANCE,
+    PERIOD_CONSISTENCY,
+    stated_torque_point,
+)
+from sensing_antenna.torque_point import torques_about_base
 
 __all__ = ["CONTACT_LOST_TIME", "Listener"]
 
@@ -171,12 +175,7 @@ class Listener:
         ]
         # the torques about O of a sensor that takes them about its own origin (checked with
         # the header); the recording keeps them as received, with the point
-        stated = header.metadata.get(TORQUE_POINT_KEY)
-        self._torque_point = None
-        if stated is not None:
-            self._torque_point, problem = torque_point_problem(stated)
-            if problem is not None:
-                raise RecordingError(header.source, None, TORQUE_POINT_KEY, problem, metadata=True)
+        self._torque_point = stated_torque_point(header.metadata, header.source)
         self._t = _Growing()  # with the samples missing put back
         self._received = _Growing()
         self._stamps = _Growing()  # the first time stamps received, for the period's check
