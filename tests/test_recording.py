@@ -26,6 +26,7 @@ from sensing_antenna.recording import (
     resample_uniform,
     write_recording,
 )
+from sensing_antenna.torque_point import TORQUE_POINT_KEY
 
 DATA = Path(__file__).parent / "data"
 
@@ -161,7 +162,9 @@ def _recordings(draw: st.DrawFn) -> Recording:
         t = np.arange(n, dtype=float)
     grid = st.lists(_finite, min_size=n, max_size=n)
     columns = [draw(grid) for _ in range(8)]
-    keys = draw(st.lists(_key.filter(lambda k: k not in ("format", "sample_period")), unique=True))
+    # A stated torque point is read (the torques moved to O), not carried: tested on its own.
+    reserved = ("format", "sample_period", TORQUE_POINT_KEY)
+    keys = draw(st.lists(_key.filter(lambda k: k not in reserved), unique=True))
     metadata = {"format": FORMAT_NAME, "sample_period": repr(float(np.median(np.diff(t))))}
     metadata.update({k: draw(_value) for k in keys})
     extra_names = draw(
