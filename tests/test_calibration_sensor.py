@@ -140,8 +140,9 @@ def test_one_recording_with_its_loads_in_another_unit_is_left_out(
     calibration_set: tuple[list, list[float]],  # type: ignore[type-arg]
 ) -> None:
     # tz in N dm among N m (ten times), or the forces in lbf (4.45 times too small): no leak
-    # explains one contact's ratio several times off while the others' fit within per cents;
-    # left out, named, the correction is the others'
+    # explains one contact's ratio several times off while the others' fit within per cents,
+    # and torques ten times high take a tenth of the head's work the push needs; left out,
+    # named, the correction is the others'
     recordings, truth = calibration_set
     names = [f"c{i}.csv" for i in range(len(recordings))]
     bad = list(recordings)
@@ -152,7 +153,11 @@ def test_one_recording_with_its_loads_in_another_unit_is_left_out(
     fit = calibrate_sensor(bad, ANTENNA, truth, sources=names)
     assert "c2.csv" not in fit.sources and len(fit.sources) == len(names) - 1
     (note,) = [n for n in fit.notes if n.startswith("c2.csv: ")]
-    assert "times its known point with the correction fitted to the others" in note
+    if unit == "tz in N dm":
+        # the push's moment ten times its work: refused as an estimate would be
+        assert "would be implausible_input" in note and "torques read high" in note
+    else:
+        assert "times its known point with the correction fitted to the others" in note
     assert fit.adopted == ("azimuthal", "vertical") and fit.ratio_rms_after < 0.05
     others = [k for k in range(len(names)) if k != 2]
     alone = calibrate_sensor([recordings[k] for k in others], ANTENNA, [truth[k] for k in others])

@@ -242,6 +242,16 @@ class EstimatorConfig:
         that read high or low (an uncalibrated sensor), a link stiffer than the model, angles
         that do not describe the head's turn, or an answer off the contact (the ratio moves
         as the square of x_c over the contact's).
+    min_work_share : float
+        Plausibility (``implausible_input``): the work the head's turn did against the
+        contact's moment, from ``tare_margin`` before t_c (the link still free) to t_e, must be
+        at least this share of the energy the hold's push stores in the link bent at the
+        lesser of the answer and the torque/force ratio (linear statics, the model's E I).
+        The obstacle and the link only store or dissipate what the head puts in: a contact
+        that sticks takes the share 1, less the link's kinetic energy at the sweep's speed (a
+        few %); one that slides, a compliant clamp or obstacle, more; a link stiffer than the
+        model by a factor f, or torques read f times high, 1 / f. Angles or torque axes swapped
+        put the push's moment across the turn: a share near 0. 0.5.
     """
 
     t1_source: Literal["rest", "push"] = "rest"
@@ -281,6 +291,7 @@ class EstimatorConfig:
     max_curve_distance: float = 0.05
     max_deflection_ratio: float = 0.4
     max_bend_per_turn: float = 1.6
+    min_work_share: float = 0.5
 
     def __post_init__(self) -> None:
         if self.t1_source not in ("rest", "push"):

@@ -13,7 +13,10 @@ forms agree.
    at t_c, ``Evidence.input_problem``), the angles up to t_e
    (:func:`~sensing_antenna.units_check.angle_problem`), and the push against the head's turn
    into the contact (an obstacle only pushes back; a push that opposed the turn up to t_1 and
-   not over the hold after it is a link that slid off the object, ``slip_suspected``).
+   not over the hold after it is a link that slid off the object, ``slip_suspected``), and the
+   head's work against the contact's moment against the energy the push stores in the link
+   (an obstacle gives no energy: angles swapped turn the head across the push,
+   :func:`_work_problem`).
 2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``). An answer past the tip by
    no more than ``disagreement_sigmas`` statistical uncertainties of the ratio at the tip (noise
    and tare, :meth:`~.evidence.Evidence.ratio_uncertainty` without its model term, which grows
@@ -162,6 +165,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     payload = _payload_problem(evidence, estimate, notes)
     if payload is not None:
         found.append((Status.MODEL_MISMATCH, payload))
+    work = _work_problem(evidence, estimate, end, notes) if on_link and push is None else None
+    if work is not None:
+        found.append((Status.IMPLAUSIBLE_INPUT, work))
     turn = _bend_against_turn(evidence, estimate, end, notes) if on_link and push is None else None
     if turn is not None:
         found.append((Status.MODEL_MISMATCH, turn))
@@ -482,6 +488,79 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
         "flipped in an angle or in the forces, the two angles swapped or one read from another "
         "joint (the joint mapping), or forces read wrong by as much as the push (cross-talk "
         "from the torques, an offset)?"
+    )
+
+
+def _work_problem(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> str | None:
+    """Why the head's turn did not put into the link the energy its push holds, or None.
+
+    Passivity: the obstacle and the link store or dissipate what the head puts in. From
+    ``tare_margin`` before t_c, where the link is still free (the front end tares the sensor
+    there), or from the start when the record is shorter and began at rest, to t_e (sample
+    ``end``) the head turns by dphi = 1/2 sum_i e_i x de_i (e_i the motor axes, absolute
+    frame) and does the work W = -sum Gamma . dphi against the contact's moment about O (W
+    scales with the torques, E below with their square: torques read k times high take 1 / k
+    of the share). The
+    hold's push stores E = |Gamma_perp|^2 x_c / (6 E I) in the link bent at x_c, the lesser of
+    the answer and the torque/force ratio (an answer far out on the link, wrong, is not taken
+    for angles that do not describe the turn), Gamma_perp the moment across the link averaged
+    over the last period of the contact's fundamental there. W must be at least
+    ``min_work_share`` times E, with three times the tare's torque error over the head's path
+    as slack. ``notes`` gets ``work_share`` (W / E). Not judged when the recording starts less
+    than ``tare_margin`` before t_c with the head moving (the touch may precede it), the head
+    did not turn (an object pushed into a still link), or the loads are not finite (the
+    samples' own checks judge them).
+    """
+    cfg = evidence.config
+    t, k = evidence.t, evidence.contact_index
+    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
+    if not float(np.max(np.abs(evidence.theta[end] - evidence.theta[k]))) > tolerance:
+        return None
+    if float(t[k] - t[0]) >= cfg.tare_margin:
+        start = int(np.searchsorted(t, t[k] - cfg.tare_margin))
+    elif evidence.diagnostics.get("tare") == "rest":
+        start = 0  # the head rested at the start, the link hung free
+    else:
+        return None
+    theta = evidence.theta[start : end + 1]
+    axes = motor_axes(theta)
+    middle, step = 0.5 * (axes[1:] + axes[:-1]), np.diff(axes, axis=0)
+    turn = 0.5 * np.cross(middle, step).sum(axis=1)
+    _, moment = contact_loads(
+        theta, evidence.force[start : end + 1], evidence.torque[start : end + 1], evidence.antenna
+    )
+    moment = moment - evidence.load_offset[3:]
+    absolute = np.einsum("nj,nji->ni", moment, axes)
+    work = -float(np.einsum("ni,ni->", 0.5 * (absolute[1:] + absolute[:-1]), turn))
+    if not math.isfinite(work):
+        return None
+    link = evidence.antenna.link
+    # the lesser of the answer and the statics' reading: a wrong answer far out is no swap
+    ratio = estimate.ratio_estimate
+    x_c = min(estimate.x_c, ratio) if 0.0 < ratio < math.inf else estimate.x_c
+    omega = float(sensing_curve(link).omega1(x_c))
+    period = max(periods_in(2.0 * math.pi / omega, evidence.sample_period), 1)
+    first = min(max(end - period, evidence.rest_index), end) - start
+    held = np.mean(moment[first:, 1:], axis=0)
+    energy = float(held @ held) * x_c * link.bending_compliance / 6.0
+    if not energy > 0.0:
+        return None
+    notes["work_share"] = work / energy
+    slack = 3.0 * evidence.torque_offset_error * float(np.sum(np.linalg.norm(turn, axis=1)))
+    if work + slack >= cfg.min_work_share * energy:
+        return None
+    return (
+        f"columns 'theta1', 'theta2', 'tx', 'ty', 'tz': from {float(t[start]):.3f} s to t_e "
+        f"the head's turn did {1e3 * work:.3g} mJ of work against the contact's moment, "
+        f"{100.0 * work / energy:.0f} % of the {1e3 * energy:.3g} mJ the hold's push stores in "
+        f"the link bent at x_c = {x_c:.3f} m (at least {100.0 * cfg.min_work_share:g} "
+        "%: the object and the link only store or dissipate what the head puts in); the angles "
+        "do not describe the turn that pushed, or the torques read high (the share falls as "
+        "one over their scale): the two angles swapped, one read from another joint, the "
+        "torque axes swapped, torques in a unit smaller than N m, or an object that moved into "
+        "the link?"
     )
 
 
