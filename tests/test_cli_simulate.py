@@ -130,6 +130,26 @@ def test_plot_recording_writes_pngs(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert "torques in N mm" in err and err.count("\n") == 1
 
 
+def test_plot_recording_says_the_torques_were_moved_to_o(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A file whose torques were taken about the sensor's origin and moved to O on reading or
+    # import: drawn as the estimators read them, and said so
+    out = tmp_path / "rec.csv"
+    argv = ["simulate", "--case", "azimuthal", "--xc", "0.6", "--duration", "1.5"]
+    assert main([*argv, "--out", str(out)]) == 0
+    recording = read_recording(out)
+    moved = {**recording.metadata, "torques_moved_from": "[-0.025, 0.0, 0.0]"}
+    write_recording(dataclasses.replace(recording, metadata=moved), out)
+    capsys.readouterr()
+    assert main(["plot", "recording", str(out), "--out", str(tmp_path / "fig")]) == 0
+    err = capsys.readouterr().err
+    assert err == (
+        f"antenna plot recording: {out}: torques drawn about O, moved from the sensor's point "
+        "[-0.025, 0.0, 0.0] m (torques_moved_from), as the estimators read them\n"
+    )
+
+
 def _device_of(path: Path) -> dict[str, object]:
     import json
 

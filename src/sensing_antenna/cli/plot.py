@@ -83,11 +83,19 @@ def _run_recording(args: argparse.Namespace) -> int:
     from sensing_antenna.calibration.observer import units_problem
     from sensing_antenna.plotting.recording import plot_recording
     from sensing_antenna.recording import read_recording
+    from sensing_antenna.torque_point import MOVED_KEY
 
     recording = read_recording(args.recording)
     antenna = _model(args, recording, "checked")  # a bad file said before any figure
     for path in plot_recording(recording, args.out):
         print(path)
+    moved = recording.metadata.get(MOVED_KEY)
+    if moved is not None:
+        print(
+            f"antenna plot recording: {args.recording}: torques drawn about O, moved from the "
+            f"sensor's point {moved} m ({MOVED_KEY}), as the estimators read them",
+            file=sys.stderr,
+        )
     problem = units_problem(recording, antenna)
     if problem is not None:
         print(

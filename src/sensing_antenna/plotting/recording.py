@@ -1,8 +1,9 @@
 """Figures of one recording: motor angles, forces and torques over time, torque spectrum.
 
 In the style of the paper's Figures 11, 12, 13 and 20: time in s, angles in degrees (display
-edge), forces in N and torques in N m in the motor frame; the spectrum (Figures 13b and 19) is the
-magnitude of the FFT of each torque component after the motors stop.
+edge), forces in N and torques in N m about O in the motor frame (a recording whose torques
+were moved there from the sensor's own point says so in the title); the spectrum (Figures 13b
+and 19) is the magnitude of the FFT of each torque component after the motors stop.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 
 from sensing_antenna.plotting import save_figure
 from sensing_antenna.recording import REQUIRED_COLUMNS, Recording, RecordingError, resample_uniform
+from sensing_antenna.torque_point import MOVED_KEY
 
 __all__ = ["PLOT_LIMIT", "plot_recording"]
 
@@ -61,6 +63,14 @@ def _stop_time(recording: Recording) -> float | None:
     return value if math.isfinite(value) else None
 
 
+def _about(recording: Recording, name: str) -> str:
+    """Where the plotted torques are taken: about O, and from where they were moved."""
+    if name != "torque":
+        return ""
+    moved = recording.metadata.get(MOVED_KEY)
+    return " about O" if moved is None else f" about O (moved from the sensor's point {moved} m)"
+
+
 def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
     """Draw angles, forces, torques and the torque spectrum of ``recording`` as PNG files.
 
@@ -103,7 +113,10 @@ def plot_recording(recording: Recording, out_dir: str | Path) -> list[Path]:
             axes[i].plot(t, data[:, i], lw=0.8)
             _finish(axes[i], f"{name[0].upper()}_{axis_name}^m ({unit})", None, stop)
         # on two lines: a long description would run past the figure's edge
-        axes[0].set_title(f"{name} by the link on the head (motor frame)\n{title}", fontsize=9)
+        axes[0].set_title(
+            f"{name}{_about(recording, name)} by the link on the head (motor frame)\n{title}",
+            fontsize=9,
+        )
         axes[-1].set_xlabel("t (s)")
         paths.append(save_figure(fig, out / f"{name}.png", dpi=110))
 
