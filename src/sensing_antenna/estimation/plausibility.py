@@ -458,9 +458,7 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     link slid off the object or past it, and touches it from the other side if at all
     (``slip_suspected``). Not judged when the head turned by less than the rest tolerance.
     """
-    theta = evidence.theta
-    turn = theta[evidence.rest_index] - theta[evidence.contact_index]
-    direction = np.array([0.0, turn[0] * math.cos(theta[evidence.rest_index, 1]), turn[1]])
+    turn, direction = evidence.push_turn
     tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
     if float(np.max(np.abs(turn))) <= tolerance:
         return None

@@ -306,6 +306,16 @@ class Evidence:
         return two_frequency_curve(link, low * link.length, high * link.length)
 
     @property
+    def push_turn(self) -> tuple[FloatArray, FloatArray]:
+        """The head's turn into the contact from t_c to t_1: dtheta (rad), shape (2,), and the
+        move it gives the link in the motor frame at t_1, (0, dtheta_1 cos theta_2, dtheta_2)
+        (rad), shape (3,): the azimuth about Z^a moves X^m along cos theta_2 Y^m, the
+        elevation along Z^m."""
+        turn = self.theta[self.rest_index] - self.theta[self.contact_index]
+        theta2 = float(self.theta[self.rest_index, 1])
+        return turn, np.array([0.0, float(turn[0]) * math.cos(theta2), float(turn[1])])
+
+    @property
     def spectrum_slice(self) -> slice:
         """Samples of the Delta t_e1 window after t_1 (shortened if the samples end first)."""
         n_window = round(self.config.spectrum_window / self.sample_period)
@@ -421,12 +431,10 @@ class Evidence:
         cross-talk of a sensor no calibration has measured for the hold's push: a force read
         c x_c R_perp too high moves the ratio by about c x_c^2
         (:meth:`.SensorCorrection.coupling_uncertainty`). The push's direction is the one the
-        sensor reads, which the leak itself may tilt, or the head's turn from t_c to t_1 (Y^m
-        by theta1 cos theta2, Z^m by theta2), whichever gives the larger c."""
+        sensor reads, which the leak itself may tilt, or the head's turn from t_c to t_1
+        (:attr:`push_turn`), whichever gives the larger c."""
         sensor = self.antenna.sensor
-        theta2 = float(self.theta[self.rest_index, 1])
-        turn = self.theta[self.rest_index] - self.theta[self.contact_index]
-        move = np.array([0.0, float(turn[0]) * math.cos(theta2), float(turn[1])])
+        _, move = self.push_turn
         coupling = max(
             sensor.coupling_uncertainty(self.frame.reaction_m), sensor.coupling_uncertainty(move)
         )
