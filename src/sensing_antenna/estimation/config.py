@@ -244,7 +244,8 @@ class EstimatorConfig:
         as the square of x_c over the contact's).
     min_work_share : float
         Plausibility (``implausible_input``): the work the head's turn did against the
-        contact's moment, from ``tare_margin`` before t_c (the link still free) to t_e, must be
+        contact's moment, from ``tare_margin`` before t_c (the link free there when the
+        detector fires within that of the touch, as at the default sweep speed) to t_e, must be
         at least this share of the energy the hold's push stores in the link bent at the
         lesser of the answer and the torque/force ratio (linear statics, the model's E I).
         The obstacle and the link only store or dissipate what the head puts in: a contact

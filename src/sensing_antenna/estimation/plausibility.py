@@ -76,7 +76,7 @@ from sensing_antenna.beam import SensingCurve, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
-from sensing_antenna.estimation.front.contact_frame import motor_axes
+from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.front.ratio import contact_loads, lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
@@ -489,32 +489,49 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     )
 
 
+def _head_turned(evidence: Evidence, end: int) -> bool:
+    """Whether the head turned from t_c to sample ``end`` by more than the rest tolerance (an
+    object pushed into a still link leaves the angles within it)."""
+    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
+    turn = evidence.theta[end] - evidence.theta[evidence.contact_index]
+    return float(np.max(np.abs(turn))) > tolerance
+
+
+def _last_period_start(evidence: Evidence, omega: float, end: int) -> int:
+    """First sample of the hold's last period of a fundamental ``omega`` (rad/s) before
+    sample ``end``, not before t_1: the window over which the touch's ringing averages out."""
+    period = max(periods_in(2.0 * math.pi / omega, evidence.sample_period), 1)
+    return max(end - period, evidence.rest_index)
+
+
 def _work_problem(
     evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
 ) -> str | None:
     """Why the head's turn did not put into the link the energy its push holds, or None.
 
     Passivity: the obstacle and the link store or dissipate what the head puts in. From
-    ``tare_margin`` before t_c, where the link is still free (the front end tares the sensor
-    there), or from the start when the record is shorter and began at rest, to t_e (sample
-    ``end``) the head turns by dphi = 1/2 sum_i e_i x de_i (e_i the motor axes, absolute
-    frame) and does the work W = -sum Gamma . dphi against the contact's moment about O (W
-    scales with the torques, E below with their square: torques read k times high take 1 / k
-    of the share). The
-    hold's push stores E = |Gamma_perp|^2 x_c / (6 E I) in the link bent at x_c, the lesser of
-    the answer and the torque/force ratio (an answer far out on the link, wrong, is not taken
-    for angles that do not describe the turn), Gamma_perp the moment across the link averaged
-    over the last period of the contact's fundamental there. W must be at least
-    ``min_work_share`` times E, with three times the tare's torque error over the head's path
-    as slack. ``notes`` gets ``work_share`` (W / E). Not judged when the recording starts less
-    than ``tare_margin`` before t_c with the head moving (the touch may precede it), the head
-    did not turn (an object pushed into a still link), or the loads are not finite (the
-    samples' own checks judge them).
+    ``tare_margin`` before t_c (the link free there when the detector fires within that of the
+    touch, as at the simulator's default sweep speed; a slower sweep far out fires later, and
+    the energy stored before counts against the share), or from the start when the record is
+    shorter and began at rest, to t_e (sample ``end``) the head turns by
+    dphi = 1/2 sum_i e_i x de_i (e_i the motor axes, absolute frame) and does the work
+    W = -sum Gamma . dphi against the contact's moment about O. The hold's push stores
+    E = |Gamma_perp|^2 x_c / (6 E I) in the link bent at x_c, the lesser of the answer and the
+    torque/force ratio (an answer far out on the link, wrong, is not taken for angles that do
+    not describe the turn), Gamma_perp the moment across the link averaged over the last
+    period of the contact's fundamental there. W scales with the torques and E with their
+    square: torques read k times high, or a link k times stiffer than the model, take 1 / k of
+    the share. Two angle columns swapped on a sweep of one joint put the moment across the
+    turn (share near 0); on a turn at alpha to a joint's axis the share is sin 2 alpha. W must
+    be at least ``min_work_share`` times E, with three times the tare's torque error over the
+    head's path as slack. ``notes`` gets ``work_share`` (W / E). Not judged when the recording
+    starts less than ``tare_margin`` before t_c with the head moving (the touch may precede
+    it), the head did not turn (an object pushed into a still link), or the loads are not
+    finite (the samples' own checks judge them).
     """
     cfg = evidence.config
     t, k = evidence.t, evidence.contact_index
-    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
-    if not float(np.max(np.abs(evidence.theta[end] - evidence.theta[k]))) > tolerance:
+    if not _head_turned(evidence, end):
         return None
     if float(t[k] - t[0]) >= cfg.tare_margin:
         start = int(np.searchsorted(t, t[k] - cfg.tare_margin))
@@ -530,7 +547,7 @@ def _work_problem(
         theta, evidence.force[start : end + 1], evidence.torque[start : end + 1], evidence.antenna
     )
     moment = moment - evidence.load_offset[3:]
-    absolute = np.einsum("nj,nji->ni", moment, axes)
+    absolute = to_absolute(moment, theta)
     work = -float(np.einsum("ni,ni->", 0.5 * (absolute[1:] + absolute[:-1]), turn))
     if not math.isfinite(work):
         return None
@@ -538,10 +555,8 @@ def _work_problem(
     # the lesser of the answer and the statics' reading: a wrong answer far out is no swap
     ratio = estimate.ratio_estimate
     x_c = min(estimate.x_c, ratio) if 0.0 < ratio < math.inf else estimate.x_c
-    omega = float(sensing_curve(link).omega1(x_c))
-    period = max(periods_in(2.0 * math.pi / omega, evidence.sample_period), 1)
-    first = min(max(end - period, evidence.rest_index), end) - start
-    held = np.mean(moment[first:, 1:], axis=0)
+    first = min(_last_period_start(evidence, float(sensing_curve(link).omega1(x_c)), end), end)
+    held = np.mean(moment[first - start :, 1:], axis=0)
     energy = float(held @ held) * x_c * link.bending_compliance / 6.0
     if not energy > 0.0:
         return None
@@ -556,8 +571,8 @@ def _work_problem(
         f"the link bent at x_c = {x_c:.3f} m (at least {100.0 * cfg.min_work_share:g} "
         "%: the object and the link only store or dissipate what the head puts in); the angles "
         "do not describe the turn that pushed, or the torques read high (the share falls as "
-        "one over their scale): the two angles swapped, one read from another joint, the "
-        "torque axes swapped, torques in a unit smaller than N m, or an object that moved into "
+        "one over their scale): the two angles swapped, the torque axes swapped, torques in a "
+        "unit smaller than N m, a link stiffer than the model, or an object that moved into "
         "the link?"
     )
 
@@ -651,9 +666,8 @@ def _bend_against_turn(
         estimate.diagnostics.get("axes_c_absolute", evidence.frame.axes_a), dtype=float
     )
     k = evidence.contact_index
-    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
-    if float(np.max(np.abs(evidence.theta[end] - evidence.theta[k]))) <= tolerance:
-        return None  # the head did not turn: an object pushed into a still link
+    if not _head_turned(evidence, end):
+        return None
     x_axis = motor_axes(evidence.theta[end])[0]
     moved = estimate.x_c * (x_axis - motor_axes(evidence.theta[k])[0])
     moved = moved - (moved @ x_axis) * x_axis
@@ -679,8 +693,7 @@ def _bend_against_turn(
 
     # the hold over one period of the contact's fundamental, which the touch sets ringing
     omega = float(sensing_curve(evidence.antenna.link).omega1(estimate.x_c))
-    period = max(periods_in(2.0 * math.pi / omega, evidence.sample_period), 1)
-    held = float(np.mean(bend_over(max(end - period, evidence.rest_index), end)))
+    held = float(np.mean(bend_over(_last_period_start(evidence, omega, end), end)))
     touch, error = _bend_at_touch(evidence, k, bend_over, push / norm, estimate.x_c, omega)
     # the bend since t_c, and its least and largest values within two standard errors
     since = held - max(touch, 0.0)

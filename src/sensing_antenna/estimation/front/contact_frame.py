@@ -67,8 +67,9 @@ def motor_axes(theta: FloatArray) -> FloatArray:
 
 
 def to_absolute(vector_m: FloatArray, theta: FloatArray) -> FloatArray:
-    """A vector given in the motor frame, in absolute coordinates, shape (3,) or (n, 3)."""
-    return np.asarray(vector_m, dtype=float) @ motor_axes(theta)
+    """Vectors given in the motor frame, in absolute coordinates: shape (3,) or (n, 3), with
+    one pair of angles ``theta`` (2,) for all or a pair per vector (n, 2)."""
+    return np.einsum("...j,...ji->...i", np.asarray(vector_m, dtype=float), motor_axes(theta))
 
 
 def signal_noise(theta: FloatArray) -> tuple[float, float]:
