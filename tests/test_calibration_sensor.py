@@ -155,7 +155,7 @@ def test_one_recording_with_its_loads_in_another_unit_is_left_out(
     (note,) = [n for n in fit.notes if n.startswith("c2.csv: ")]
     if unit == "tz in N dm":
         # the push's moment ten times its work: refused as an estimate would be
-        assert "would be implausible_input" in note and "torques read high" in note
+        assert "would be implausible_input" in note and "a unit smaller than N m" in note
     else:
         assert "times its known point with the correction fitted to the others" in note
     assert fit.adopted == ("azimuthal", "vertical") and fit.ratio_rms_after < 0.05

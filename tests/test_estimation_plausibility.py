@@ -320,6 +320,80 @@ def test_the_head_puts_into_the_link_the_energy_its_push_holds(case: str) -> Non
         assert abs(result.diagnostics["work_share"]) < 0.05, name
 
 
+def test_a_slow_sweep_far_out_puts_in_what_the_push_holds_before_the_detector_fires() -> None:
+    # At 0.02 rad/s and 0.95 m the detector fires more than a second after the touch: the
+    # energy stored meanwhile must be counted, from the rest at the start (the link free and
+    # still there), or a right answer would be taken for swapped angles. Bounds as in the
+    # passivity test above.
+    model = load_antenna("paper-2021").self_calibrated()
+    scenario = Scenario(
+        case="azimuthal",
+        contact_point=0.95,
+        seed=3,
+        sweep_speed=0.02,
+        push=PushCriterion(threshold=0.015),
+        duration=12.0,
+    )
+    recording = simulate(model, scenario)
+    truth = float(recording.metadata["true_xc"])
+    plain = recording.without_ground_truth()
+    results = all_methods(plain, model)
+    assert any(result.status is Status.OK for result in results.values())
+    for name, result in results.items():
+        assert result.status is not Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        if "work_share" in result.diagnostics:
+            assert 0.85 < result.diagnostics["work_share"] < 1.1, name
+        if result.status is Status.OK:
+            assert abs(result.x_c - truth) < 0.01, name
+    swapped = dataclasses.replace(plain, theta=np.ascontiguousarray(plain.theta[:, ::-1]))
+    for name, result in all_methods(swapped, model).items():
+        if "work_share" in result.diagnostics:
+            assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+            assert abs(result.diagnostics["work_share"]) < 0.05, name
+
+
+def test_a_link_stiffer_than_the_model_is_a_mismatch_not_swapped_angles() -> None:
+    # A link 2.5 times stiffer stores 1 / 2.5 of the energy the model expects for the same
+    # push (E = Gamma^2 x_c / (6 E I)), so the head's work is 0.4 of it, less the kinetic
+    # energy term of the passivity test: the model is wrong, not the samples' columns or units.
+    nominal = load_antenna("paper-2021")
+    stiff_link = dataclasses.replace(nominal.link, youngs_modulus=2.5 * nominal.link.youngs_modulus)
+    device = dataclasses.replace(nominal, link=stiff_link)
+    recording = simulate(device, Scenario(case="azimuthal", contact_point=0.55, seed=3))
+    results = all_methods(recording.without_ground_truth(), nominal.self_calibrated())
+    shares = [
+        r.diagnostics["work_share"] for r in results.values() if "work_share" in r.diagnostics
+    ]
+    assert shares
+    for share in shares:
+        assert 0.3 < share < 0.5
+    for name, result in results.items():
+        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
+        assert result.status not in (Status.OK, Status.IMPLAUSIBLE_INPUT), (name, result.reason)
+        if "work_share" in result.diagnostics:
+            assert any("a link stiffer than the model" in r for r in reasons), name
+
+
+def test_samples_dropped_inside_the_push_do_not_hide_swapped_angles(
+    vertical: Recording, antenna: Antenna
+) -> None:
+    # Three samples dropped 0.1 s into the push (a gap the estimators fill in): swapped columns
+    # still do no work against the push's moment.
+    k = gather(vertical, antenna).contact_index + 100
+    kept = np.r_[0:k, k + 3 : vertical.t.size]
+    gapped = dataclasses.replace(
+        vertical,
+        t=vertical.t[kept],
+        theta=vertical.theta[kept, ::-1],
+        force=vertical.force[kept],
+        torque=vertical.torque[kept],
+        extra={},
+    )
+    for name, result in all_methods(gapped, antenna).items():
+        assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        assert abs(result.diagnostics["work_share"]) < 0.05, name
+
+
 def test_a_link_that_slides_aside_on_a_steep_surface_is_not_a_flipped_sign() -> None:
     # An exploration's vertical sweep up onto a lying cylinder's side, steep to the sweep: the
     # link slid aside and pushes nearly across the head's turn (its component along the turn,

@@ -242,17 +242,18 @@ class EstimatorConfig:
         that read high or low (an uncalibrated sensor), a link stiffer than the model, angles
         that do not describe the head's turn, or an answer off the contact (the ratio moves
         as the square of x_c over the contact's).
-    min_work_share : float
-        Plausibility (``implausible_input``): the work the head's turn did against the
-        contact's moment, from ``tare_margin`` before t_c (the link free there when the
-        detector fires within that of the touch, as at the default sweep speed) to t_e, must be
-        at least this share of the energy the hold's push stores in the link bent at the
-        lesser of the answer and the torque/force ratio (linear statics, the model's E I).
-        The obstacle and the link only store or dissipate what the head puts in: a contact
-        that sticks takes the share 1, less the link's kinetic energy at the sweep's speed (a
-        few %); one that slides, a compliant clamp or obstacle, more; a link stiffer than the
-        model by a factor f, or torques read f times high, 1 / f. Angles or torque axes swapped
-        put the push's moment across the turn: a share near 0. 0.5.
+    min_work_share, input_work_share : float
+        Plausibility: the work the head's turn did against the contact's moment, counted from
+        the start when the sensor was tared at rest there, else from ``tare_margin`` before
+        t_c, to t_e, against the energy the push stored in the link meanwhile, bent at the
+        lesser of the answer and the torque/force ratio (linear statics, the model's E I). The
+        obstacle and the link only store or dissipate what the head puts in: a contact that
+        sticks takes the share 1, less the link's kinetic energy at the sweep's speed (a few
+        %); one that slides, a compliant clamp or obstacle, more; a link stiffer than the
+        model by a factor f, or torques read f times high, 1 / f. Below ``min_work_share``
+        (0.5) the estimate is ``model_mismatch``. Angles or torque axes swapped put the push's
+        moment across the turn, a share near 0, and torques in N dm or a smaller unit take a
+        tenth or less: below ``input_work_share`` (0.2) it is ``implausible_input``.
     """
 
     t1_source: Literal["rest", "push"] = "rest"
@@ -293,6 +294,7 @@ class EstimatorConfig:
     max_deflection_ratio: float = 0.4
     max_bend_per_turn: float = 1.6
     min_work_share: float = 0.5
+    input_work_share: float = 0.2
 
     def __post_init__(self) -> None:
         if self.t1_source not in ("rest", "push"):
@@ -345,6 +347,11 @@ class EstimatorConfig:
             )
         if self.max_ratio_wait < self.convergence_window:
             raise EstimatorConfigError("max_ratio_wait: must be >= convergence_window")
+        if self.input_work_share > self.min_work_share:
+            raise EstimatorConfigError(
+                "input_work_share: must not exceed min_work_share (a share too low for a "
+                "mismatched model is too low for the samples' units)"
+            )
 
     def gap_limit(self, sample_period: float) -> int:
         """Most missing samples in a row filled in at ``sample_period`` (s): ``max_gap``, or

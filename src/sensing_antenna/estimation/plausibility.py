@@ -15,8 +15,9 @@ forms agree.
    into the contact (an obstacle only pushes back; a push that opposed the turn up to t_1 and
    not over the hold after it is a link that slid off the object, ``slip_suspected``), and the
    head's work against the contact's moment against the energy the push stores in the link
-   (an obstacle gives no energy: angles swapped turn the head across the push,
-   :func:`_work_problem`).
+   (an obstacle gives no energy: angles swapped turn the head across the push; a share short
+   by less than ``1 / input_work_share`` is a scale, torques that read high or a stiffer link,
+   ``model_mismatch``; :func:`_work_problem`).
 2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``). An answer past the tip by
    no more than ``disagreement_sigmas`` statistical uncertainties of the ratio at the tip (noise
    and tare, :meth:`~.evidence.Evidence.ratio_uncertainty` without its model term, which grows
@@ -167,7 +168,7 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
         found.append((Status.MODEL_MISMATCH, payload))
     work = _work_problem(evidence, estimate, end, notes) if on_link and push is None else None
     if work is not None:
-        found.append((Status.IMPLAUSIBLE_INPUT, work))
+        found.append(work)
     turn = _bend_against_turn(evidence, estimate, end, notes) if on_link and push is None else None
     if turn is not None:
         found.append((Status.MODEL_MISMATCH, turn))
@@ -506,74 +507,89 @@ def _last_period_start(evidence: Evidence, omega: float, end: int) -> int:
 
 def _work_problem(
     evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
-) -> str | None:
-    """Why the head's turn did not put into the link the energy its push holds, or None.
+) -> tuple[Status, str] | None:
+    """Why the head's turn did not put into the link the energy its push holds, with its
+    status, or None.
 
-    Passivity: the obstacle and the link store or dissipate what the head puts in. From
-    ``tare_margin`` before t_c (the link free there when the detector fires within that of the
-    touch, as at the simulator's default sweep speed; a slower sweep far out fires later, and
-    the energy stored before counts against the share), or from the start when the record is
-    shorter and began at rest, to t_e (sample ``end``) the head turns by
-    dphi = 1/2 sum_i e_i x de_i (e_i the motor axes, absolute frame) and does the work
-    W = -sum Gamma . dphi against the contact's moment about O. The hold's push stores
-    E = |Gamma_perp|^2 x_c / (6 E I) in the link bent at x_c, the lesser of the answer and the
-    torque/force ratio (an answer far out on the link, wrong, is not taken for angles that do
-    not describe the turn), Gamma_perp the moment across the link averaged over the last
-    period of the contact's fundamental there. W scales with the torques and E with their
-    square: torques read k times high, or a link k times stiffer than the model, take 1 / k of
-    the share. Two angle columns swapped on a sweep of one joint put the moment across the
-    turn (share near 0); on a turn at alpha to a joint's axis the share is sin 2 alpha. W must
-    be at least ``min_work_share`` times E, with three times the tare's torque error over the
-    head's path as slack. ``notes`` gets ``work_share`` (W / E). Not judged when the recording
-    starts less than ``tare_margin`` before t_c with the head moving (the touch may precede
-    it), the head did not turn (an object pushed into a still link), or the loads are not
-    finite (the samples' own checks judge them).
+    Passivity: the obstacle and the link store or dissipate what the head puts in. From the
+    start when the sensor was tared at rest there (the link hung free and still: no energy
+    stored, none moving), else from ``tare_margin`` before t_c, to t_e (sample ``end``), the
+    head turns by dphi = 1/2 sum_i e_i x de_i (e_i the motor axes, absolute frame) and does
+    the work W = -sum Gamma . dphi against the contact's moment about O. A push Gamma_perp
+    across the link bent at x_c holds E = |Gamma_perp|^2 x_c / (6 E I) in it; the head must
+    have put in what it holds at t_e (Gamma_perp averaged over the last period of the contact's
+    fundamental before it) less what it held where the count starts (over the first), x_c the
+    lesser of the answer and the torque/force ratio (an answer far out on the link, wrong, is
+    not taken for angles that do not describe the turn). Two angle columns swapped on a sweep
+    of one joint put the moment across the turn (share near 0); on a turn at alpha to a
+    joint's axis the share is sin 2 alpha. W scales with the torques and E with their square:
+    torques read k times high, or a link k times stiffer than the model, take 1 / k of the
+    share, a unit (N dm, N cm for N m) a tenth or less. W must be at least ``min_work_share``
+    of the energy put in (``model_mismatch``), and at least ``input_work_share`` of it
+    (``implausible_input``), with three times the tare's torque error over the head's path as
+    slack. Samples with a load or an angle not finite are left out, the turn across them
+    counted as one step. ``notes`` gets ``work_share`` (W over the energy put in). Not judged
+    when the recording starts less than ``tare_margin`` before t_c with the head moving (the
+    touch may precede it), the head did not turn (an object pushed into a still link), or the
+    push held no more energy at t_e than where the count starts.
     """
     cfg = evidence.config
     t, k = evidence.t, evidence.contact_index
     if not _head_turned(evidence, end):
         return None
-    if float(t[k] - t[0]) >= cfg.tare_margin:
+    if evidence.diagnostics.get("tare") == "rest":
+        start = 0
+    elif float(t[k] - t[0]) >= cfg.tare_margin:
         start = int(np.searchsorted(t, t[k] - cfg.tare_margin))
-    elif evidence.diagnostics.get("tare") == "rest":
-        start = 0  # the head rested at the start, the link hung free
     else:
         return None
     theta = evidence.theta[start : end + 1]
-    axes = motor_axes(theta)
-    middle, step = 0.5 * (axes[1:] + axes[:-1]), np.diff(axes, axis=0)
-    turn = 0.5 * np.cross(middle, step).sum(axis=1)
     _, moment = contact_loads(
         theta, evidence.force[start : end + 1], evidence.torque[start : end + 1], evidence.antenna
     )
     moment = moment - evidence.load_offset[3:]
+    whole = np.isfinite(theta).all(axis=1) & np.isfinite(moment).all(axis=1)
+    if np.count_nonzero(whole) < 2:
+        return None
+    theta, moment = theta[whole], moment[whole]
+    axes = motor_axes(theta)
+    middle, step = 0.5 * (axes[1:] + axes[:-1]), np.diff(axes, axis=0)
+    turn = 0.5 * np.cross(middle, step).sum(axis=1)
     absolute = to_absolute(moment, theta)
     work = -float(np.einsum("ni,ni->", 0.5 * (absolute[1:] + absolute[:-1]), turn))
-    if not math.isfinite(work):
-        return None
     link = evidence.antenna.link
     # the lesser of the answer and the statics' reading: a wrong answer far out is no swap
     ratio = estimate.ratio_estimate
     x_c = min(estimate.x_c, ratio) if 0.0 < ratio < math.inf else estimate.x_c
-    first = min(_last_period_start(evidence, float(sensing_curve(link).omega1(x_c)), end), end)
-    held = np.mean(moment[first - start :, 1:], axis=0)
-    energy = float(held @ held) * x_c * link.bending_compliance / 6.0
+    period = end - _last_period_start(evidence, float(sensing_curve(link).omega1(x_c)), end)
+    held = np.mean(moment[-max(period, 1) :, 1:], axis=0)
+    before = np.mean(moment[: max(period, 1), 1:], axis=0)
+    energy = float(held @ held - before @ before) * x_c * link.bending_compliance / 6.0
     if not energy > 0.0:
         return None
     notes["work_share"] = work / energy
     slack = 3.0 * evidence.torque_offset_error * float(np.sum(np.linalg.norm(turn, axis=1)))
     if work + slack >= cfg.min_work_share * energy:
         return None
-    return (
+    found = (
         f"columns 'theta1', 'theta2', 'tx', 'ty', 'tz': from {float(t[start]):.3f} s to t_e "
         f"the head's turn did {1e3 * work:.3g} mJ of work against the contact's moment, "
-        f"{100.0 * work / energy:.0f} % of the {1e3 * energy:.3g} mJ the hold's push stores in "
-        f"the link bent at x_c = {x_c:.3f} m (at least {100.0 * cfg.min_work_share:g} "
-        "%: the object and the link only store or dissipate what the head puts in); the angles "
-        "do not describe the turn that pushed, or the torques read high (the share falls as "
-        "one over their scale): the two angles swapped, the torque axes swapped, torques in a "
-        "unit smaller than N m, a link stiffer than the model, or an object that moved into "
-        "the link?"
+        f"{100.0 * work / energy:.0f} % of the {1e3 * energy:.3g} mJ the push stored in the "
+        f"link bent at x_c = {x_c:.3f} m meanwhile (at least "
+    )
+    if work + slack >= cfg.input_work_share * energy:
+        return Status.MODEL_MISMATCH, (
+            f"{found}{100.0 * cfg.min_work_share:g} %: the object and the link only store or "
+            "dissipate what the head puts in); torques that read high (the share falls as one "
+            "over their scale), a link stiffer than the model, or angles that do not describe "
+            "the turn (swapped on a sweep off a joint's axis)?"
+        )
+    return Status.IMPLAUSIBLE_INPUT, (
+        f"{found}{100.0 * cfg.input_work_share:g} %: the object and the link only store or "
+        "dissipate what the head puts in); the angles do not describe the turn that pushed, or "
+        "the torques are not in N m: the two angles swapped, the torque axes swapped, torques "
+        "in a unit smaller than N m, a link several times stiffer than the model, or an object "
+        "that moved into the link?"
     )
 
 
