@@ -30,7 +30,7 @@ from sensing_antenna.estimation import (
     estimate,
     gather,
 )
-from sensing_antenna.recording import Recording, read_recording
+from sensing_antenna.recording import Recording, read_recording, write_recording
 from sensing_antenna.simulator import Scenario, simulate
 
 #: Degrees per radian: the factor of a file whose angles are in degrees.
@@ -392,6 +392,36 @@ def test_samples_dropped_inside_the_push_do_not_hide_swapped_angles(
     for name, result in all_methods(gapped, antenna).items():
         assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
         assert abs(result.diagnostics["work_share"]) < 0.05, name
+
+
+def test_torques_about_an_unstated_sensor_origin_are_named_where_the_estimators_disagree(
+    antenna: Antenna, tmp_path: Path
+) -> None:
+    # A sensor whose origin S lies 25 mm behind the clamp, S - O = (-0.025, 0, 0), reads
+    # Gamma_S = Gamma_O - (S - O) x F: the ratio reads x_c + 0.025 m near the base, where it is
+    # sharp, and disagrees with the vibration. The reason names the metadata line that mends it;
+    # stated, the answer is right and ok.
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.3, seed=3))
+    truth = float(recording.metadata["true_xc"])
+    origin = np.array([-0.025, 0.0, 0.0])
+    about_s = dataclasses.replace(
+        recording.without_ground_truth(),
+        torque=recording.torque - np.cross(origin, recording.force),
+        extra={},
+    )
+    result = estimate(about_s, antenna, "paper")
+    assert result.status is Status.ESTIMATORS_DISAGREE, result.reason
+    assert "'# torque_point: [-0.0" in (result.reason or "")
+    stated = float((result.reason or "").split("torque_point: [")[1].split(",")[0])
+    assert -0.04 < stated < -0.01  # the ratio's shift, x_c - ratio, near the base
+    path = tmp_path / "about_s.csv"
+    write_recording(about_s, path)
+    lines = path.read_text().splitlines(keepends=True)
+    lines.insert(2, "# torque_point: [-0.025, 0, 0]\n")
+    path.write_text("".join(lines))
+    mended = estimate(read_recording(path), antenna, "paper")
+    assert mended.status is Status.OK, mended.reason
+    assert abs(mended.x_c - truth) < 0.005
 
 
 def test_a_link_that_slides_aside_on_a_steep_surface_is_not_a_flipped_sign() -> None:

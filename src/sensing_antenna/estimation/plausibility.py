@@ -112,6 +112,15 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
         The same estimate when every check passes and its guess lies on the link; otherwise the
         status of the first problem, the others in ``diagnostics["other_reasons"]``.
     """
+    reviewed = _reviewed(evidence, estimate)
+    if reviewed.status is Status.ESTIMATORS_DISAGREE and math.isfinite(reviewed.x_c):
+        hint = _torque_point_hint(evidence, reviewed.x_c, _index_at(evidence, estimate.t_e))
+        reviewed = dataclasses.replace(reviewed, reason=f"{reviewed.reason}{hint}")
+    return reviewed
+
+
+def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
+    """The estimate after the checks, before a disagreement's hint."""
     link = evidence.antenna.link
     end = _index_at(evidence, estimate.t_e)
     if math.isinf(estimate.ratio_estimate):
@@ -288,6 +297,33 @@ def _statics_problem(
         "with the answer's bent link), "
         f"{abs(x_c - reading):.3f} m from the answer {x_c:.3f} m: more than "
         f"{evidence.config.disagreement_sigmas:g} of their uncertainties"
+    )
+
+
+#: Farthest (m) a sensor's origin is taken to lie from the link's clamp along the link when a
+#: disagreement between the answer and the ratio is read as torques about it: a sensor sits on
+#: the head, its origin within centimetres of where the link is clamped.
+_SENSOR_ORIGIN_REACH = 0.05
+
+
+def _torque_point_hint(evidence: Evidence, x_c: float, end: int) -> str:
+    """What to check when the answer and the torque/force ratio disagree by no more than a
+    sensor's origin can lie from O along the link, or "".
+
+    Torques about a point S, (S - O) = (s, 0, 0) on the motor axes, read
+    Gamma_S = Gamma_O - (S - O) x F: the ratio reads x_c - s at every contact, the frequency
+    x_c.
+    """
+    reading = float(evidence.ratio_mean[end]) if end < evidence.ratio_mean.shape[0] else math.nan
+    shift = x_c - reading
+    if not (math.isfinite(shift) and abs(shift) <= _SENSOR_ORIGIN_REACH):
+        return ""
+    return (
+        f"; torque/force ratio {reading:.3f} m, {100 * abs(shift):.1f} cm "
+        f"{'short of' if shift > 0 else 'beyond'} the answer: torques taken about the sensor's "
+        "own origin, off the clamp along the link, and not stated (or stated with its sign "
+        f"flipped)? About '# torque_point: [{shift:.3f}, 0, 0]' would put the ratio on the answer "
+        "(docs/recording-format.md); a shift the same on every contact says so"
     )
 
 
