@@ -536,8 +536,9 @@ def test_a_contact_lost_and_found_again_is_not_taken_for_a_corrupted_run() -> No
         accel_time=0.05,
     )
     recording = simulate(antenna, scenario)
-    k = int(np.searchsorted(recording.t, 0.513))
-    assert recording.force[k - 1, 0] < -0.1 < 0.0 < recording.force[k, 0]  # the loss
+    # the loss, near 0.513 s (the sample it falls on moves with the platform's floating point)
+    around = recording.force[(recording.t > 0.505) & (recording.t < 0.52), 0]
+    assert around.min() < -0.1 < 0.0 < around.max()
     for method in ("paper", "fast"):
         result = estimate(recording, antenna.self_calibrated(), method)
         reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
