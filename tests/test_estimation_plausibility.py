@@ -31,7 +31,7 @@ from sensing_antenna.estimation import (
     gather,
 )
 from sensing_antenna.recording import Recording, read_recording, write_recording
-from sensing_antenna.simulator import Scenario, simulate
+from sensing_antenna.simulator import DeviceImperfections, Scenario, simulate
 
 #: Degrees per radian: the factor of a file whose angles are in degrees.
 DEGREES = 180.0 / math.pi
@@ -350,6 +350,30 @@ def test_a_slow_sweep_far_out_puts_in_what_the_push_holds_before_the_detector_fi
         if "work_share" in result.diagnostics:
             assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
             assert abs(result.diagnostics["work_share"]) < 0.05, name
+
+
+def test_a_drifting_sensor_over_a_long_approach_does_not_count_against_the_work() -> None:
+    # ty drifting by 2 counts/s over a 20 s approach: the tare at the start is 40 counts
+    # (1.25 mN m) off by the touch. Counted from the start, that offset against the whole
+    # sweep's turn (1 rad) takes the share to 0.18 on a right answer; counted from 0.3 s before
+    # t_c it weighs on the push's turn alone.
+    model = load_antenna("paper-2021").self_calibrated()
+    drift = (0.0, 0.0, 0.0, 0.0, -2.0 / 32000.0, 0.0)  # N m/s: 2 counts/s of 1/32000 N m
+    scenario = Scenario(
+        case="vertical",
+        contact_point=0.5,
+        seed=3,
+        sweep_speed=0.05,
+        push=PushCriterion(threshold=0.015),
+        approach_time=20.0,
+        duration=23.6,
+        device=DeviceImperfections(sensor_drift_rate=drift),
+    )
+    recording = simulate(load_antenna("paper-2021"), scenario)
+    for name, result in all_methods(recording.without_ground_truth(), model).items():
+        if "work_share" in result.diagnostics:
+            assert 0.85 < result.diagnostics["work_share"] < 1.3, name
+        assert result.status is not Status.IMPLAUSIBLE_INPUT, (name, result.reason)
 
 
 def test_a_link_stiffer_than_the_model_is_a_mismatch_not_swapped_angles() -> None:

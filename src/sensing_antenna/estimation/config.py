@@ -244,8 +244,8 @@ class EstimatorConfig:
         as the square of x_c over the contact's).
     min_work_share, input_work_share : float
         Plausibility: the work the head's turn did against the contact's moment, counted from
-        the start when the sensor was tared at rest there, else from ``tare_margin`` before
-        t_c, to t_e, against the energy the push stored in the link meanwhile, bent at the
+        ``tare_margin`` before t_c to t_e, against the energy the push stored in the link
+        meanwhile (what it holds at t_e less what it held where the count starts), bent at the
         lesser of the answer and the torque/force ratio (linear statics, the model's E I). The
         obstacle and the link only store or dissipate what the head puts in: a contact that
         sticks takes the share 1, less the link's kinetic energy at the sweep's speed (a few

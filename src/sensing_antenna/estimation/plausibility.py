@@ -541,17 +541,25 @@ def _last_period_start(evidence: Evidence, omega: float, end: int) -> int:
     return max(end - period, evidence.rest_index)
 
 
+#: Least share of the energy the hold's push holds that must have been stored within the work's
+#: count for the work to be judged against it: what was stored before is read from the moment
+#: there, and a few per cent error on it weighs E_0 / (E - E_0) times on the share (three times
+#: at this bound).
+_LEAST_STORED_SHARE = 0.25
+
+
 def _work_problem(
     evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
 ) -> tuple[Status, str] | None:
     """Why the head's turn did not put into the link the energy its push holds, with its
     status, or None.
 
-    Passivity: the obstacle and the link store or dissipate what the head puts in. From the
-    start when the sensor was tared at rest there (the link hung free and still: no energy
-    stored, none moving), else from ``tare_margin`` before t_c, to t_e (sample ``end``), the
-    head turns by dphi = 1/2 sum_i e_i x de_i (e_i the motor axes, absolute frame) and does
-    the work W = -sum Gamma . dphi against the contact's moment about O. A push Gamma_perp
+    Passivity: the obstacle and the link store or dissipate what the head puts in. From
+    ``tare_margin`` before t_c (not from the start: a sensor's drift over a long approach
+    would weigh on the whole turn), or from the start when the record is shorter and began at
+    rest, to t_e (sample ``end``), the head turns by dphi = 1/2 sum_i e_i x de_i (e_i the
+    motor axes, absolute frame) and does the work W = -sum Gamma . dphi against the contact's
+    moment about O. A push Gamma_perp
     across the link bent at x_c holds E = |Gamma_perp|^2 x_c / (6 E I) in it; the head must
     have put in what it holds at t_e (Gamma_perp averaged over the last period of the contact's
     fundamental before it) less what it held where the count starts (over the first), x_c the
@@ -567,16 +575,17 @@ def _work_problem(
     counted as one step. ``notes`` gets ``work_share`` (W over the energy put in). Not judged
     when the recording starts less than ``tare_margin`` before t_c with the head moving (the
     touch may precede it), the head did not turn (an object pushed into a still link), or the
-    push held no more energy at t_e than where the count starts.
+    push stored less than :data:`_LEAST_STORED_SHARE` of what it holds at t_e within the count
+    (a detector that fired at the end of a slow push).
     """
     cfg = evidence.config
     t, k = evidence.t, evidence.contact_index
     if not _head_turned(evidence, end):
         return None
-    if evidence.diagnostics.get("tare") == "rest":
-        start = 0
-    elif float(t[k] - t[0]) >= cfg.tare_margin:
+    if float(t[k] - t[0]) >= cfg.tare_margin:
         start = int(np.searchsorted(t, t[k] - cfg.tare_margin))
+    elif evidence.diagnostics.get("tare") == "rest":
+        start = 0
     else:
         return None
     theta = evidence.theta[start : end + 1]
@@ -600,8 +609,9 @@ def _work_problem(
     period = end - _last_period_start(evidence, float(sensing_curve(link).omega1(x_c)), end)
     held = np.mean(moment[-max(period, 1) :, 1:], axis=0)
     before = np.mean(moment[: max(period, 1), 1:], axis=0)
-    energy = float(held @ held - before @ before) * x_c * link.bending_compliance / 6.0
-    if not energy > 0.0:
+    stored = float(held @ held) * x_c * link.bending_compliance / 6.0
+    energy = stored - float(before @ before) * x_c * link.bending_compliance / 6.0
+    if not energy >= _LEAST_STORED_SHARE * stored > 0.0:
         return None
     notes["work_share"] = work / energy
     slack = 3.0 * evidence.torque_offset_error * float(np.sum(np.linalg.norm(turn, axis=1)))
