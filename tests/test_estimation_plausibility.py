@@ -435,8 +435,9 @@ def test_torques_about_an_unstated_sensor_origin_are_named_where_the_estimators_
     )
     result = estimate(about_s, antenna, "paper")
     assert result.status is Status.ESTIMATORS_DISAGREE, result.reason
-    assert "'# torque_point: [-0.0" in (result.reason or "")
-    stated = float((result.reason or "").split("torque_point: [")[1].split(",")[0])
+    reason = result.reason or ""
+    assert "'# torque_point' does not state" in reason
+    stated = float(reason.split("along X^m: ")[1].split(" m more")[0])
     assert -0.04 < stated < -0.01  # the ratio's shift, x_c - ratio, near the base
     path = tmp_path / "about_s.csv"
     write_recording(about_s, path)

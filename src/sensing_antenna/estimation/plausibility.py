@@ -319,11 +319,13 @@ def _torque_point_hint(evidence: Evidence, x_c: float, end: int) -> str:
     if not (math.isfinite(shift) and abs(shift) <= _SENSOR_ORIGIN_REACH):
         return ""
     return (
-        f"; torque/force ratio {reading:.3f} m, {100 * abs(shift):.1f} cm "
-        f"{'short of' if shift > 0 else 'beyond'} the answer: torques taken about the sensor's "
-        "own origin, off the clamp along the link, and not stated (or stated with its sign "
-        f"flipped)? About '# torque_point: [{shift:.3f}, 0, 0]' would put the ratio on the answer "
-        "(docs/recording-format.md); a shift the same on every contact says so"
+        f"; the torque/force ratio reads {reading:.3f} m, {100 * abs(shift):.1f} cm "
+        f"{'short of' if shift > 0 else 'beyond'} the answer. If every contact shows this "
+        "shift (drift, a gain or cross-talk vary it): torques about a point off the clamp along "
+        "the link, the sensor's own origin, that '# torque_point' does not state or states "
+        f"wrong? The ratio reads x_c less that point's offset along X^m: {shift:+.3f} m more "
+        "in its first number (the whole point, when none is stated) would put the ratio on the "
+        "answer (docs/recording-format.md)"
     )
 
 
@@ -627,8 +629,8 @@ def _work_problem(
         return Status.MODEL_MISMATCH, (
             f"{found}{100.0 * cfg.min_work_share:g} %: the object and the link only store or "
             "dissipate what the head puts in); torques that read high (the share falls as one "
-            "over their scale), a link stiffer than the model, or angles that do not describe "
-            "the turn (swapped on a sweep off a joint's axis)?"
+            "over their scale) or drifted since the tare, a link stiffer than the model, or "
+            "angles that do not describe the turn (swapped on a sweep off a joint's axis)?"
         )
     return Status.IMPLAUSIBLE_INPUT, (
         f"{found}{100.0 * cfg.input_work_share:g} %: the object and the link only store or "
