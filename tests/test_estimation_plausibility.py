@@ -322,8 +322,8 @@ def test_the_head_puts_into_the_link_the_energy_its_push_holds(case: str) -> Non
 
 def test_a_slow_sweep_far_out_puts_in_what_the_push_holds_before_the_detector_fires() -> None:
     # At 0.02 rad/s and 0.95 m the detector fires more than a second after the touch: the
-    # energy stored meanwhile must be counted, from the rest at the start (the link free and
-    # still there), or a right answer would be taken for swapped angles. Bounds as in the
+    # energy the push already held where the work's count starts must be taken off what it
+    # holds at the end, or a right answer would be taken for swapped angles. Bounds as in the
     # passivity test above.
     model = load_antenna("paper-2021").self_calibrated()
     scenario = Scenario(
