@@ -216,7 +216,9 @@ class EstimatorConfig:
         1/8 when the 57-fold prediction fires the contact detector within the first tens of
         milliseconds of motion (an identified observer's low threshold); the simulated device
         gives 0.8 to 3 with the paper's observer (the touch adds torque before t_c) and 1.0 with
-        an identified one. 5 sits between.
+        an identified one. 5 sits between. The same factor judges each joint's share on its
+        own (:func:`~.front.steps.joint_free_motion_gains`: an angle column copied from the
+        other joint's).
     max_curve_distance : float
         The ``two-frequency`` method's answer is a ``model_mismatch`` when the measured
         (omega_1, omega_2) lie farther than this from the nearest point of the straight link's

@@ -4,7 +4,8 @@
 2. Sensor offset (tare) and rest tolerance from the samples up to t_c (:func:`at_contact`), and
    the recording's own units check there: the loads the tare averages against the link's weight
    (:func:`sensing_antenna.units_check.rest_reading`), the free motion before t_c against the
-   observer (:func:`free_motion_gain`), and the angles up to t_c
+   observer (:func:`free_motion_gain`, and joint by joint :func:`joint_free_motion_gains`),
+   and the angles up to t_c
    (:func:`sensing_antenna.units_check.angle_problem`), so that an outcome found before t_e
    (no push, say) on angles in degrees names the degrees.
 3. The static push over the hold window [t_1, t_1 + frame_window] (:func:`hold_push`): the mean
@@ -54,6 +55,7 @@ __all__ = [
     "gap_problem",
     "hold_push",
     "hold_window",
+    "joint_free_motion_gains",
     "planned_end",
     "ratio_tolerance",
     "samples",
@@ -360,6 +362,16 @@ def at_contact(
             starts_at_rest=quiet >= w_rest + 1,
         )
         checks["free_motion_gain"] = gain
+        if problem is None:
+            gains, problem = joint_free_motion_gains(
+                theta[before],
+                torque[before],
+                predicted_torque[before],
+                antenna,
+                cfg,
+                stop=contact_index + 1 - samples(cfg.tare_margin, ts),
+            )
+            checks["joint_free_motion_gains"] = gains
         if problem is not None:
             problems.append(problem)
     angles = angle_problem(theta[before])
@@ -449,6 +461,86 @@ def free_motion_gain(
             else ", or a recording that does not start at rest (start it with the head still "
             "for half a second)?"
         )
+    )
+
+
+#: Each joint's angle column, the torque column its turn acts on and that torque's index in
+#: (X^m, Y^m, Z^m): the azimuth theta1 turns the head about Z^m, the elevation theta2 about Y^m.
+_JOINTS = (("theta1", "tz", 2), ("theta2", "ty", 1))
+
+
+def joint_free_motion_gains(
+    theta: FloatArray,
+    torque: FloatArray,
+    predicted_torque: FloatArray,
+    antenna: Antenna,
+    cfg: EstimatorConfig,
+    stop: int,
+) -> tuple[tuple[float, float], str | None]:
+    """How large the measured free-motion torque is against the observer's, joint by joint.
+
+    :func:`free_motion_gain` judges the torques about Y^m and Z^m together; an angle column
+    copied from the other joint's (the head seems to turn both joints when it turned one) or
+    the two columns swapped keep that sum and move it to the other axis. Here each joint's
+    torque is judged on its own over the samples before ``stop``, where the link is free of the
+    contact (t_c less ``tare_margin``, the tare's own margin). A joint whose turn the observer
+    predicts a torque for, at least 1 / ``free_motion_gain_factor`` of the other joint's, and
+    that shows less than 1 / ``free_motion_gain_factor`` of it, is named when the other joint's
+    torque does show (a copy), or when the other axis shows the torque of this turn (a swap); a
+    turn whose torque shows on neither axis is :func:`free_motion_gain`'s to name.
+
+    Parameters
+    ----------
+    theta : array, shape (n, 2)
+        Angles up to t_c (rad).
+    torque, predicted_torque : array, shape (n, 3)
+        Measured torque and the detector's Gamma_e^m + Gamma_g^m up to t_c (N m).
+    antenna : Antenna
+    cfg : EstimatorConfig
+    stop : int
+        One past the last sample judged.
+
+    Returns
+    -------
+    (gains, problem) : tuple of (float, float) and str or None
+        Measured over predicted root-mean-square torque of theta1's turn and of theta2's (NaN
+        for a joint not judged); ``problem`` names the joint's columns and its gain.
+    """
+    factor = cfg.free_motion_gain_factor
+    if stop < 2:
+        return (math.nan, math.nan), None
+    axes = [axis for _, _, axis in _JOINTS]
+    gravity = antenna.gravity_torque(np.asarray(theta, dtype=float)[:stop, 1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        predicted = (np.asarray(predicted_torque, dtype=float)[:stop] - gravity)[:, axes]
+        measured = (np.asarray(torque, dtype=float)[:stop] - gravity)[:, axes]
+        predicted_rms = np.sqrt(np.mean((predicted - predicted.mean(axis=0)) ** 2, axis=0))
+        measured_rms = np.sqrt(np.mean((measured - measured.mean(axis=0)) ** 2, axis=0))
+    largest = float(np.max(predicted_rms))
+    if not (math.isfinite(largest) and largest > 0.0 and np.all(np.isfinite(measured_rms))):
+        return (math.nan, math.nan), None
+    judged = predicted_rms >= largest / factor
+    with np.errstate(divide="ignore"):
+        gains = np.where(judged, measured_rms / predicted_rms, math.nan)
+    pair = (float(gains[0]), float(gains[1]))
+    low = [k for k in range(2) if judged[k] and gains[k] < 1.0 / factor]
+    if len(low) != 1:
+        return pair, None  # both low is the sum's to name (angles in degrees)
+    k = low[0]
+    angle, column, _ = _JOINTS[k]
+    other_angle, other_column, _ = _JOINTS[1 - k]
+    if judged[1 - k]:
+        # both joints turn, the other's torque is there and this one's is not
+        cause = f"'{angle}' a copy of '{other_angle}', or read from another joint?"
+    elif measured_rms[1 - k] >= predicted_rms[k] / factor:
+        cause = f"the two angles swapped ('{other_column}' shows the turn '{angle}' describes)?"
+    else:
+        # one joint turns and no torque shows anywhere: the sum's to name (degrees, observer)
+        return pair, None
+    return pair, (
+        f"columns '{angle}', '{column}': before the contact '{angle}' turns the head, but "
+        f"'{column}' shows {gains[k]:.3g} times the torque the observer predicts for that turn "
+        f"(at least 1/{factor:g}, from the link's inertia): {cause}"
     )
 
 
