@@ -72,7 +72,7 @@ from typing import Any
 
 import numpy as np
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Link
+from sensing_antenna.antenna import Link
 from sensing_antenna.beam import SensingCurve, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
@@ -84,7 +84,7 @@ from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
-from sensing_antenna.units_check import angle_problem, is_payload, rest_moment_std
+from sensing_antenna.units_check import angle_problem
 
 __all__ = ["review"]
 
@@ -116,7 +116,24 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if reviewed.status is Status.ESTIMATORS_DISAGREE and math.isfinite(reviewed.x_c):
         hint = _torque_point_hint(evidence, reviewed.x_c, _index_at(evidence, estimate.t_e))
         reviewed = dataclasses.replace(reviewed, reason=f"{reviewed.reason}{hint}")
+    if reviewed.status is Status.UNCERTAIN and reviewed.method != "ratio":
+        # the ratio's statics do not weigh the link
+        hint = _payload_hint(evidence)
+        reviewed = dataclasses.replace(reviewed, reason=f"{reviewed.reason}{hint}")
     return reviewed
+
+
+def _payload_hint(evidence: Evidence) -> str:
+    """What an unsure answer owes to a payload the weight at rest reads, or ""."""
+    mass = evidence.payload_mass()
+    if not mass > 0.0:
+        return ""
+    return (
+        f"; at rest the link's moment ty reads {float(evidence.load_offset[4]):.3g} N m more "
+        f"than the model's weight, as {1e3 * mass:.2g} g at the tip the antenna file does not "
+        "carry, which lowers omega_1 (the fast method's interval carries that shift): give the "
+        "payload in link.tip_mass (or calibrate with it on), or tare the sensor"
+    )
 
 
 def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
@@ -396,31 +413,22 @@ def _payload_problem(
     """Why the link's weight at rest disagrees with the model enough to move the frequency's
     contact point, or None.
 
-    Before the contact the loads are the link's weight, which the model removes
-    (:func:`~.front.ratio.load_offset` is what remains: the sensor's offset after taring, a few
-    resolution counts). A moment about Y^m left over beyond that is weight the model does not
-    carry, most often a payload at the tip (glue, a marker): a tip mass m_t adds m_t g l
-    cos(theta_2) to it, and lowers omega_1(x_c). The check reads it as such a mass and asks how
+    The weight at rest read as a payload at the tip
+    (:meth:`~.front.evidence.Evidence.payload_mass`) lowers omega_1(x_c). The check asks how
     far that would move the contact point the vibration gives (the point of the sensing curve a
     link with that mass would read the measured omega_1 at); beyond the paper method's
     ``max_model_spread`` the answer is a model mismatch. Methods that measure no
     vibration (``ratio``) are not judged: the weight does not enter the statics of the push.
     """
     link = evidence.antenna.link
-    if evidence.input_problem is not None:
-        return None  # loads not in the format's units say nothing of a payload
     if not (math.isfinite(estimate.omega1) and math.isfinite(estimate.x_c)):
         return None
     if not 0.0 < estimate.x_c <= link.length:
         return None
-    lever = STANDARD_GRAVITY * link.length * math.cos(float(evidence.theta[0, 1]))
+    mass = evidence.payload_mass()
+    if not mass > 0.0:
+        return None
     excess = float(evidence.load_offset[4])
-    # What a tare leaves: the mean's standard error and an offset of a few counts
-    noise = float(evidence.diagnostics.get("torque_noise", 0.0))
-    std = rest_moment_std(noise, evidence.torque_offset_error)
-    if not (lever > 0.0 and excess > 0.0 and is_payload(excess, std)):
-        return None  # a lighter reading is no payload: a sensor offset, which weighs nothing
-    mass = excess / lever
     try:
         heavier = dataclasses.replace(link, tip_mass=link.tip_mass + mass)
     except SensingAntennaError:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -469,3 +469,48 @@ class Evidence:
         return np.asarray(
             self.frame.lateral_force * x_c**2 * self.antenna.link.bending_compliance / 3.0
         )
+
+    def payload_mass(self) -> float:
+        """Tip mass (kg) the link's weight at rest reads beyond the model's, 0 when none.
+
+        Before the contact the loads are the link's weight, which the model removes
+        (``load_offset`` is what remains: the sensor's offset after taring, a few counts). A
+        moment about Y^m left over beyond what such an offset can be
+        (:func:`~sensing_antenna.units_check.is_payload`) is weight the model does not carry,
+        most often a payload at the tip (glue, a marker): m_t = excess / (g l cos theta_2). A
+        lighter reading is no payload (an offset weighs nothing); loads not in the format's
+        units say nothing of one.
+        """
+        from sensing_antenna.units_check import is_payload, rest_moment_std
+
+        if self.input_problem is not None:
+            return 0.0
+        lever = STANDARD_GRAVITY * self.antenna.link.length * math.cos(float(self.theta[0, 1]))
+        excess = float(self.load_offset[4])
+        noise = float(self.diagnostics.get("torque_noise", 0.0))
+        std = rest_moment_std(noise, self.torque_offset_error)
+        if not (lever > 0.0 and excess > 0.0 and is_payload(excess, std)):
+            return 0.0
+        return excess / lever
+
+    def payload_shifts(self, x_c: FloatArray) -> FloatArray:
+        """How much lower (rad/s) omega_1 rings at contact points ``x_c`` (m, shape (G,)) on a
+        link carrying :meth:`payload_mass` at its tip than on the model's: what the sensing
+        curve leaves out of a vibration read at ``x_c``; zeros without a payload, or with one
+        more than the link could carry (the plausibility layer names that)."""
+        from sensing_antenna.beam import natural_frequencies
+        from sensing_antenna.errors import SensingAntennaError
+
+        x_c = np.asarray(x_c, dtype=float)
+        mass = self.payload_mass()
+        link = self.antenna.link
+        if not mass > 0.0:
+            return np.zeros(x_c.shape)
+        try:
+            heavier = replace(link, tip_mass=link.tip_mass + mass)
+        except SensingAntennaError:
+            return np.zeros(x_c.shape)
+        points = np.clip(x_c, 1e-6 * link.length, link.length)
+        model = np.asarray(natural_frequencies(link, points, 1), dtype=float)[..., 0]
+        loaded = np.asarray(natural_frequencies(heavier, points, 1), dtype=float)[..., 0]
+        return np.asarray(np.maximum(model - loaded, 0.0), dtype=float)

@@ -15,7 +15,9 @@ Two measurements, each with a standard error:
 Model-error floors are added in quadrature to the statistical standard errors:
 
 - frequency: a relative error ``frequency_floor`` of omega_1 (T or T_e known to that relative
-  precision; the model frequency is proportional to 1 / T), sigma_w^2 = se^2 + (eps omega_hat)^2;
+  precision; the model frequency is proportional to 1 / T), sigma_w^2 = se^2 + (eps omega_hat)^2,
+  and the curve's own term at each grid point (``frequency_model``: the bent link's shift and a
+  payload's the weight at rest reads) in quadrature;
 - ratio: what the elastica's statics do not hold, the front end's model term at each grid point
   (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.ratio_model_uncertainty`: the
   stiffness's uncertainty on the statics' corrections, the bent link's weight, a floor, and

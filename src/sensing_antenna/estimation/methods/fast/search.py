@@ -70,11 +70,15 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
     # Loads beyond any sensor (a glitch of 1e155 N) overflow the bent link's term too (the
     # ratio's comes back infinite, which leaves the ratio out): not a number, no term
     bent = table.slope * evidence.bent_link_uncertainties(table.grid)
+    # a payload the weight at rest reads and the model does not carry lowers omega_1 by as
+    # much as its shift: the whole shift as the term's standard uncertainty, since the mass
+    # read is itself uncertain and a sensor's offset may be in it
+    payload = evidence.payload_shifts(table.grid)
     statics = StaticsModel(
         evidence.reaction_f[:, 0],
         table.grid,
         evidence.ratio_model_uncertainty(table.grid, coupling=True),
-        np.where(np.isfinite(bent), bent, 0.0),
+        np.hypot(np.where(np.isfinite(bent), bent, 0.0), payload),
         np.array(evidence.frame.reaction_m[1:], dtype=float),
     )
     return ScanInputs(

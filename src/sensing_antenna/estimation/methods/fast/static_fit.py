@@ -191,7 +191,10 @@ class StaticsModel:
         point: the sensing curves are the straight link's, and the bent link's preload shifts
         its frequencies; the front end's uncertainty of a contact point read from the vibration
         (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`),
-        times the curve's slope there. It enters the posterior's likelihood of omega_1 and
+        times the curve's slope there, and in quadrature the shift of a payload the weight at
+        rest reads and the model does not carry
+        (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.payload_shifts`). It
+        enters the posterior's likelihood of omega_1 and
         the frequency's consistency with the answer (:func:`.checks.frequency_check`), as
         the paper method's candidate carries it. None: none.
     push_direction : array, shape (2,), optional
