@@ -161,6 +161,19 @@ def test_calibrate_t_e_with_the_beam_model_recovers_t_e() -> None:
     assert calibrated.link.t_param == result.t_e
 
 
+def test_known_points_in_the_wrong_rows_are_named_not_a_calibration() -> None:
+    # Two rows of a points table swapped (0.30 and 0.90 m): one point off by more than 5 % is
+    # left out as a wrong point, two of five cannot be told apart, and the fit's scatter, above
+    # 100 %, was handed to the antenna as its calibration_scatter, which refused it with a
+    # message about that field
+    link = paper_antenna().link
+    points = np.array([0.30, 0.45, 0.60, 0.75, 0.90])
+    omega = synthetic_k(points) / PAPER_T_E
+    assert calibrate_t_e(points, omega, link).relative_scatter < 1e-6
+    with pytest.raises(CalibrationError, match=r"contact_points: no calibration: .* wrong rows"):
+        calibrate_t_e(points[[4, 1, 2, 3, 0]], omega, link)
+
+
 def test_relative_scatter_measures_the_model_error_and_travels_with_the_antenna(
     tmp_path: Path,
 ) -> None:

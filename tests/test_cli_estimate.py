@@ -88,6 +88,17 @@ def test_unknown_method_is_rejected(recording_file: Path) -> None:
     assert exc.value.code == 2
 
 
+def test_a_tolerance_no_contact_point_needs_is_rejected(
+    recording_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 5 meant as mm, or 1000: any interval would do, and every answer came back ok
+    for value in ("5", "1000"):
+        with pytest.raises(SystemExit) as exc:
+            main(["estimate", str(recording_file), "--method", "fast", "--tolerance", value])
+        assert exc.value.code == 2
+        assert "--tolerance: must be a finite number in (0, 0.1] m" in capsys.readouterr().err
+
+
 def test_plot_estimate_writes_four_figures(recording_file: Path, tmp_path: Path) -> None:
     out = tmp_path / "figs"
     assert main(["plot", "estimate", str(recording_file), "--out", str(out)]) == 0

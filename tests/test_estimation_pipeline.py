@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,7 +23,7 @@ from scipy.signal import lsim
 
 from _models import calibrated
 from _recordings import samples_kept
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.detection.contact import detect_contact
 from sensing_antenna.errors import FieldError
@@ -685,3 +686,10 @@ def test_the_point_turns_with_a_head_that_yields_after_t1(method: str) -> None:
     azimuth = [math.atan2(e.contact_point[1], e.contact_point[0]) for e in (before, after)]
     assert azimuth[1] - azimuth[0] == pytest.approx(turned, abs=1e-9)
     assert after.contact_point[2] == pytest.approx(before.contact_point[2], abs=1e-12)
+
+
+def test_a_path_for_a_recording_is_told_to_read_it_first(tmp_path: Path) -> None:
+    with pytest.raises(TypeError, match=r"read_recording\(path\)"):
+        estimate(str(tmp_path / "rec.csv"), paper_antenna())  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="a Recording is needed"):
+        estimate(None, paper_antenna())  # type: ignore[arg-type]

@@ -501,7 +501,7 @@ def calibrate_t_e(
             "others' fit, a wrong spectral peak or a wrong known point (left out of the fit)"
         )
     used = used & ~wrong
-    return FrequencyCalibration(
+    calibration = FrequencyCalibration(
         t_e=t_e,
         t_e_std_error=std_error,
         t_theoretical=link.theoretical_t,
@@ -515,6 +515,29 @@ def calibrate_t_e(
         notes=(*left_out, *notes),
         tip_mass=tip_mass,
         left_out_as_wrong=wrong,
+    )
+    scatter = calibration.relative_scatter
+    if math.isfinite(scatter) and scatter >= NO_FIT_SCATTER:
+        raise CalibrationError(
+            f"contact_points: no calibration: {scatter_problem(scatter, int(used.sum()))}"
+        )
+    return calibration
+
+
+#: The rms relative scatter (:attr:`FrequencyCalibration.relative_scatter`) from which a fit
+#: says nothing of the link (the antenna's bound on ``link.calibration_scatter``).
+NO_FIT_SCATTER = 1.0
+
+
+def scatter_problem(scatter: float, points: int) -> str:
+    """What a calibration whose frequencies scatter ``scatter`` (rms relative) about the fit
+    over ``points`` points says of its inputs."""
+    return (
+        f"the measured omega_1 lie {100 * scatter:.0f} % rms about the best fit over {points} "
+        f"points (a calibration's scatter is a fraction of a per cent, and one point "
+        f"{100 * WRONG_PEAK:g} % off the others is a wrong peak or point): known points in the "
+        "wrong rows or files, recordings of another link, or a link far from its model (a "
+        "payload: fit the tip mass)?"
     )
 
 

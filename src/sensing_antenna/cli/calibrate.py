@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from itertools import compress
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -131,6 +132,7 @@ def _run(args: argparse.Namespace) -> int:
         CalibrationError,
         calibrate_from_recordings,
         read_contact_points,
+        scatter_problem,
     )
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.recording import read_recording
@@ -147,14 +149,19 @@ def _run(args: argparse.Namespace) -> int:
     if len(recordings) < 2 and unread:
         raise CalibrationError(f"{unread[0]} (and fewer than 2 readable recordings left)")
     points = read_contact_points(paths, recordings, args.points)
-    calibration = calibrate_from_recordings(
-        recordings,
-        antenna,
-        points,
-        sources=[str(p) for p in paths],
-        loss=args.loss,
-        fit_tip_mass=args.tip_mass,
-    )
+    try:
+        calibration = calibrate_from_recordings(
+            recordings,
+            antenna,
+            points,
+            sources=[str(p) for p in paths],
+            loss=args.loss,
+            fit_tip_mass=args.tip_mass,
+        )
+    except CalibrationError as exc:
+        # the known points came from the table the user gave, or from each file's true_xc
+        where = f"--points {args.points}" if args.points is not None else "true_xc"
+        raise CalibrationError(str(exc).replace("contact_points:", f"{where}:", 1)) from None
     fitted = [path for path, used in zip(paths, calibration.used, strict=True) if used]
     description = _description(antenna.name, fitted)
     calibrated = replace(calibration.apply(antenna), name=name, description=description)
@@ -194,6 +201,12 @@ def _run(args: argparse.Namespace) -> int:
         if math.isfinite(scatter)
         else "model scatter: not measured (too few points: 3 needed, 4 with the tip mass)"
     )
+    if math.isfinite(scatter) and scatter > 2.0 * WRONG_PEAK:
+        # more than a wrong point's worth on most points: the estimates will be unsure
+        print(
+            f"antenna calibrate: warning: {scatter_problem(scatter, int(calibration.used.sum()))}",
+            file=sys.stderr,
+        )
     print(_mode2_line(calibration))
     wrong = calibration.wrong_peak_points
     doubtful = calibration.kept_far_points

@@ -44,12 +44,12 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument(
         "--tolerance",
-        type=number(low=0.0, low_open=True, unit="m"),
+        type=number(low=0.0, high=0.1, low_open=True, unit="m"),
         default=None,
         metavar="M",
-        help="fast method: declare when the 95 %% interval of x_c is narrower than this (m; "
-        "default: the fast method's, 0.005), or earlier within 1 cm when the model's floors "
-        "hold it wider; at the cap the answer is ok within 1 cm or this, if larger",
+        help="fast method: declare when the 95 %% interval of x_c is narrower than this (m, at "
+        "most 0.1; default: the fast method's, 0.005), or earlier within 1 cm when the model's "
+        "floors hold it wider; at the cap the answer is ok within 1 cm or this, if larger",
     )
     parser.add_argument(
         "--t1",

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -65,7 +66,19 @@ def gather(
     Evidence or EarlyOutcome
         The evidence at t_e, or why there is none; either carries the
         :class:`~.outcome.FrontTrace` of the whole recording.
+
+    Raises
+    ------
+    TypeError
+        When ``recording`` is not a :class:`Recording` (a file's path: read it first).
     """
+    if not isinstance(recording, Recording):
+        hint = (
+            ": read the file first, sensing_antenna.recording.read_recording(path)"
+            if isinstance(recording, (str, Path))
+            else ""
+        )
+        raise TypeError(f"recording: a Recording is needed, got {recording!r}{hint}")
     cfg = config if config is not None else EstimatorConfig()
     sampling = recording.sampling
     uniform = resample_uniform(recording) if sampling.irregular else recording
@@ -114,6 +127,8 @@ def estimate(
     ------
     UnknownMethodError
         For an unknown method name.
+    TypeError
+        When ``recording`` is not a :class:`Recording` (a file's path: read it first).
     """
     impl = resolve_method(method)
     return conclude(gather(recording, antenna, config), impl)
@@ -132,6 +147,8 @@ def conclude(gathered: Gathered, method: str | EstimationMethod = "paper") -> Co
     ------
     UnknownMethodError
         For an unknown method name.
+    TypeError
+        When ``recording`` is not a :class:`Recording` (a file's path: read it first).
     """
     impl = resolve_method(method)
     if isinstance(gathered, EarlyOutcome):
