@@ -81,6 +81,26 @@ def two_frequency_curve(link: Link, x_min: float, x_max: float) -> tuple[FloatAr
     return x, omegas
 
 
+@functools.lru_cache(maxsize=8)
+def _payload_shifts(link: Link, mass: float, points: bytes, shape: tuple[int, ...]) -> FloatArray:
+    """:meth:`Evidence.payload_shifts` of ``mass`` (kg) at the contact points held in
+    ``points`` (float64 bytes, of ``shape``); read-only."""
+    from sensing_antenna.beam import natural_frequencies
+    from sensing_antenna.errors import SensingAntennaError
+
+    x_c = np.frombuffer(points, dtype=float).reshape(shape)
+    try:
+        heavier = replace(link, tip_mass=link.tip_mass + mass)
+    except SensingAntennaError:
+        return np.zeros(shape)
+    x_c = np.clip(x_c, 1e-6 * link.length, link.length)
+    model = np.asarray(natural_frequencies(link, x_c, 1), dtype=float)[..., 0]
+    loaded = np.asarray(natural_frequencies(heavier, x_c, 1), dtype=float)[..., 0]
+    shifts = np.maximum(model - loaded, 0.0)
+    shifts.setflags(write=False)
+    return shifts
+
+
 def search_band(link: Link, config: EstimatorConfig) -> tuple[float, float]:
     """omega_1 band allowed by the sensing curve over the contact range, with the margin (rad/s).
 
@@ -498,19 +518,10 @@ class Evidence:
         link carrying :meth:`payload_mass` at its tip than on the model's: what the sensing
         curve leaves out of a vibration read at ``x_c``; zeros without a payload, or with one
         more than the link could carry (the plausibility layer names that)."""
-        from sensing_antenna.beam import natural_frequencies
-        from sensing_antenna.errors import SensingAntennaError
-
         x_c = np.asarray(x_c, dtype=float)
         mass = self.payload_mass()
-        link = self.antenna.link
         if not mass > 0.0:
             return np.zeros(x_c.shape)
-        try:
-            heavier = replace(link, tip_mass=link.tip_mass + mass)
-        except SensingAntennaError:
-            return np.zeros(x_c.shape)
-        points = np.clip(x_c, 1e-6 * link.length, link.length)
-        model = np.asarray(natural_frequencies(link, points, 1), dtype=float)[..., 0]
-        loaded = np.asarray(natural_frequencies(heavier, points, 1), dtype=float)[..., 0]
-        return np.asarray(np.maximum(model - loaded, 0.0), dtype=float)
+        # an online session asks at every window with the same grid and mass: computed once
+        shifts = _payload_shifts(self.antenna.link, mass, x_c.tobytes(), x_c.shape)
+        return np.array(shifts, dtype=float)
