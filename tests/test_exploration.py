@@ -494,7 +494,8 @@ def test_a_scene_out_of_the_link_s_reach_is_warned_of(
     scene = tmp_path / "far.toml"
     scene.write_text('[[objects]]\nshape = "sphere"\nradius = 0.05\nposition = [2.0, 0, 0]\n')
     out = tmp_path / "far"
-    assert main(["explore", str(scene), "--out", str(out), "--budget", "1", "--quiet"]) == 0
+    arguments = ["explore", str(scene), "--out", str(out), "--budget", "1", "--no-progress"]
+    assert main(arguments) == 0
     captured = capsys.readouterr()
     assert (
         "antenna explore: warning: no object lies within the link's reach (0.98 m) of a base"

@@ -528,6 +528,20 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
     assert main(["replay", str(recordings["azimuthal"]), "--speed", "1e-300"]) == 2
 
 
+def test_an_empty_input_is_said_to_hold_no_recording() -> None:
+    done = subprocess.run(
+        _cli("listen", "--no-warm-up"),
+        input="",
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0 and done.stdout == ""
+    assert done.stderr == "antenna listen: <stdin>: the input ended with no recording\n"
+
+
 def test_udp_address_errors_name_the_flag(
     recordings: dict[str, Path], capsys: pytest.CaptureFixture[str]
 ) -> None:

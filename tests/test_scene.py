@@ -512,6 +512,16 @@ def test_bad_scene_files_name_file_and_field(tmp_path: Path, text: str, field: s
     assert message.startswith(f"{path}: {field}: ") and "\n" not in message
 
 
+def test_a_size_in_millimetres_asks_for_metres(tmp_path: Path) -> None:
+    path = tmp_path / "mm.toml"
+    path.write_text('[[objects]]\nshape = "sphere"\nradius = 60\nposition = [0.5, 0, 0]\n')
+    with pytest.raises(SceneError) as caught:
+        load_scene(path)
+    assert (
+        str(caught.value) == f"{path}: objects[0].radius: must be at most 10 m, got 60: in metres?"
+    )
+
+
 def test_a_mesh_in_millimetres_or_a_directory_is_refused_in_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -8,7 +8,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from sensing_antenna.cli.arguments import add_actions, integer
+from sensing_antenna.cli.arguments import ArgumentError, add_actions, integer
+from sensing_antenna.cli.estimate import METHOD_NAMES
 
 #: Exit code of ``campaign run`` when every run was tried but some are stored as failed.
 EXIT_RUNS_FAILED = 1
@@ -84,7 +85,14 @@ def _run(args: argparse.Namespace) -> int:
     spec = load_campaign_spec(args.spec)
     if args.methods is not None:
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
-        # CampaignSpec validates the names (an unknown one is an error naming --methods' field)
+        unknown = [m for m in methods if m not in METHOD_NAMES]
+        if unknown or not methods:
+            # the flag's error, not the spec file's
+            raise ArgumentError(
+                "--methods",
+                (f"unknown {unknown[0]!r}" if unknown else "no method given")
+                + f" (comma-separated, from {', '.join(METHOD_NAMES)})",
+            )
         spec = dataclasses.replace(spec, methods=methods)
     # a signal stops the campaign as CampaignInterrupted, whose message says what is kept; the
     # command line ends on it as on any interruption

@@ -111,6 +111,11 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--quiet", action="store_true", help="no line per manoeuvre, no progress bar"
     )
+    parser.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress bar on stderr (the line per manoeuvre stays)",
+    )
     parser.set_defaults(func=_run)
 
 
@@ -198,7 +203,7 @@ def _run(args: argparse.Namespace) -> int:
             flush=True,
         )
 
-    with recognition_progress(not args.quiet, meshes) as bar:
+    with recognition_progress(not (args.quiet or args.no_progress), meshes) as bar:
         result = explore(
             scene,
             device,

@@ -101,7 +101,9 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.udp is None:
         ready()
-        listen_lines(sys.stdin.buffer, make, "<stdin>", args.count)
+        if listen_lines(sys.stdin.buffer, make, "<stdin>", args.count) == 0:
+            # an input that ended before any header: nothing was listened to, say so
+            print("antenna listen: <stdin>: the input ended with no recording", file=sys.stderr)
         return 0
     try:
         address = parse_address(args.udp)

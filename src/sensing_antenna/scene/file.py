@@ -331,7 +331,11 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
 
 def _size(value: object, where: str, fail: Any) -> float:
     """A primitive's size (m), from :data:`~.objects.MIN_OBJECT_SIZE` to :data:`MAX_OBJECT_SIZE`."""
-    size = _number(value, where, fail, 0.0, MAX_OBJECT_SIZE)
+    size = _number(value, where, fail, 0.0)
+    if size > MAX_OBJECT_SIZE:
+        raise fail(
+            where, f"must be at most {MAX_OBJECT_SIZE:g} m, got {format_value(value)}: in metres?"
+        )
     if size < MIN_OBJECT_SIZE:
         raise fail(
             where, f"must be at least {MIN_OBJECT_SIZE:g} m, got {format_value(value)}: in metres?"
