@@ -323,6 +323,23 @@ def test_an_angle_column_copied_from_the_turning_joints_is_named(
         assert result.diagnostics["joint_free_motion_gains"][still] < 0.2, name
 
 
+def test_an_encoders_flicker_on_the_still_joint_is_no_turn(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # 12-bit encoders (4,096 counts a turn) whose every sample flickers by a count: the
+    # observer predicts from the still joint's flicker a torque as large as the sweep's, which
+    # the sensor does not show; a joint whose angle stays within the rest tolerance (three
+    # steps) did not turn, and is not judged
+    step = 2.0 * math.pi / 4096
+    flicker = np.random.default_rng(0).integers(-1, 2, size=azimuthal.theta.shape)
+    theta = (np.round(azimuthal.theta / step) + flicker) * step
+    recording = dataclasses.replace(azimuthal, theta=np.ascontiguousarray(theta))
+    for name, result in all_methods(recording, antenna).items():
+        assert result.status is not Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        theta1, theta2 = result.diagnostics["joint_free_motion_gains"]
+        assert theta1 > 0.5 and math.isnan(theta2), name
+
+
 @pytest.mark.parametrize("case", ["azimuthal", "vertical"])
 def test_the_head_puts_into_the_link_the_energy_its_push_holds(case: str) -> None:
     # Passivity: the work of the head's turn against the contact's moment is the energy the

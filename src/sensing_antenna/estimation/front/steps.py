@@ -370,6 +370,7 @@ def at_contact(
                 antenna,
                 cfg,
                 stop=contact_index + 1 - samples(cfg.tare_margin, ts),
+                tolerance=tolerance,
             )
             checks["joint_free_motion_gains"] = gains
         if problem is not None:
@@ -476,6 +477,7 @@ def joint_free_motion_gains(
     antenna: Antenna,
     cfg: EstimatorConfig,
     stop: int,
+    tolerance: float = 0.0,
 ) -> tuple[tuple[float, float], str | None]:
     """How large the measured free-motion torque is against the observer's, joint by joint.
 
@@ -483,8 +485,9 @@ def joint_free_motion_gains(
     copied from the other joint's (the head seems to turn both joints when it turned one) or
     the two columns swapped keep that sum and move it to the other axis. Here each joint's
     torque is judged on its own over the samples before ``stop``, where the link is free of the
-    contact (t_c less ``tare_margin``, the tare's own margin). A joint whose turn the observer
-    predicts a torque for, at least 1 / ``free_motion_gain_factor`` of the other joint's, and
+    contact (t_c less ``tare_margin``, the tare's own margin). A joint that turned (by more
+    than the rest tolerance) and whose turn the observer predicts a torque for, at least
+    1 / ``free_motion_gain_factor`` of the other joint's, and
     that shows less than 1 / ``free_motion_gain_factor`` of it, is named when the other joint's
     torque does show (a copy), or when the other axis shows the torque of this turn (a swap); a
     turn whose torque shows on neither axis is :func:`free_motion_gain`'s to name.
@@ -499,6 +502,9 @@ def joint_free_motion_gains(
     cfg : EstimatorConfig
     stop : int
         One past the last sample judged.
+    tolerance : float
+        The rest tolerance (rad, peak to peak): a joint whose angle stays within it did not
+        turn, whatever torque the observer predicts from its encoder's flicker.
 
     Returns
     -------
@@ -519,7 +525,8 @@ def joint_free_motion_gains(
     largest = float(np.max(predicted_rms))
     if not (math.isfinite(largest) and largest > 0.0 and np.all(np.isfinite(measured_rms))):
         return (math.nan, math.nan), None
-    judged = predicted_rms >= largest / factor
+    turned = np.ptp(np.asarray(theta, dtype=float)[:stop], axis=0) > tolerance
+    judged = turned & (predicted_rms >= largest / factor)
     with np.errstate(divide="ignore"):
         gains = np.where(judged, measured_rms / predicted_rms, math.nan)
     pair = (float(gains[0]), float(gains[1]))
