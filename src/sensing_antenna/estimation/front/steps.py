@@ -438,13 +438,10 @@ def free_motion_gain(
         NaN gain when the observer predicts no motion (nothing to compare); ``problem`` names
         the columns and the gain.
     """
-    gravity = antenna.gravity_torque(np.asarray(theta, dtype=float)[:, 1])
+    predicted_axes, measured_axes = _dynamic_rms(theta, torque, predicted_torque, antenna)
     with np.errstate(over="ignore", invalid="ignore"):
-        predicted = (np.asarray(predicted_torque, dtype=float) - gravity)[:, 1:]
-        measured = (np.asarray(torque, dtype=float) - gravity)[:, 1:]
-        # less their means: the sensor's offset is not the link's inertia
-        predicted_rms = float(np.sqrt(np.mean((predicted - predicted.mean(axis=0)) ** 2)))
-        measured_rms = float(np.sqrt(np.mean((measured - measured.mean(axis=0)) ** 2)))
+        predicted_rms = float(np.sqrt(np.mean(predicted_axes**2)))
+        measured_rms = float(np.sqrt(np.mean(measured_axes**2)))
     if not (math.isfinite(predicted_rms) and predicted_rms > 0.0):
         return math.nan, None
     gain = measured_rms / predicted_rms
@@ -465,9 +462,25 @@ def free_motion_gain(
     )
 
 
-#: Each joint's angle column, the torque column its turn acts on and that torque's index in
-#: (X^m, Y^m, Z^m): the azimuth theta1 turns the head about Z^m, the elevation theta2 about Y^m.
-_JOINTS = (("theta1", "tz", 2), ("theta2", "ty", 1))
+def _dynamic_rms(
+    theta: FloatArray, torque: FloatArray, predicted_torque: FloatArray, antenna: Antenna
+) -> tuple[FloatArray, FloatArray]:
+    """Root-mean-square (N m) of the observer's predicted and the measured torque about Y^m
+    and Z^m, the link's weight taken off, each less its mean (the sensor's offset is not the
+    link's inertia); shapes (2,), (2,)."""
+    gravity = antenna.gravity_torque(np.asarray(theta, dtype=float)[:, 1])
+    with np.errstate(over="ignore", invalid="ignore"):
+        predicted = (np.asarray(predicted_torque, dtype=float) - gravity)[:, 1:]
+        measured = (np.asarray(torque, dtype=float) - gravity)[:, 1:]
+        return (
+            np.sqrt(np.mean((predicted - predicted.mean(axis=0)) ** 2, axis=0)),
+            np.sqrt(np.mean((measured - measured.mean(axis=0)) ** 2, axis=0)),
+        )
+
+
+#: Each joint's angle column and the torque column its turn acts on, and that torque's index in
+#: (Y^m, Z^m): the azimuth theta1 turns the head about Z^m, the elevation theta2 about Y^m.
+_JOINTS = (("theta1", "tz", 1), ("theta2", "ty", 0))
 
 
 def joint_free_motion_gains(
@@ -494,12 +507,8 @@ def joint_free_motion_gains(
 
     Parameters
     ----------
-    theta : array, shape (n, 2)
-        Angles up to t_c (rad).
-    torque, predicted_torque : array, shape (n, 3)
-        Measured torque and the detector's Gamma_e^m + Gamma_g^m up to t_c (N m).
-    antenna : Antenna
-    cfg : EstimatorConfig
+    theta, torque, predicted_torque, antenna, cfg
+        As :func:`free_motion_gain`.
     stop : int
         One past the last sample judged.
     tolerance : float
@@ -516,12 +525,10 @@ def joint_free_motion_gains(
     if stop < 2:
         return (math.nan, math.nan), None
     axes = [axis for _, _, axis in _JOINTS]
-    gravity = antenna.gravity_torque(np.asarray(theta, dtype=float)[:stop, 1])
-    with np.errstate(over="ignore", invalid="ignore"):
-        predicted = (np.asarray(predicted_torque, dtype=float)[:stop] - gravity)[:, axes]
-        measured = (np.asarray(torque, dtype=float)[:stop] - gravity)[:, axes]
-        predicted_rms = np.sqrt(np.mean((predicted - predicted.mean(axis=0)) ** 2, axis=0))
-        measured_rms = np.sqrt(np.mean((measured - measured.mean(axis=0)) ** 2, axis=0))
+    predicted_yz, measured_yz = _dynamic_rms(
+        theta[:stop], torque[:stop], predicted_torque[:stop], antenna
+    )
+    predicted_rms, measured_rms = predicted_yz[axes], measured_yz[axes]
     largest = float(np.max(predicted_rms))
     if not (math.isfinite(largest) and largest > 0.0 and np.all(np.isfinite(measured_rms))):
         return (math.nan, math.nan), None
