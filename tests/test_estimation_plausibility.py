@@ -716,6 +716,24 @@ def test_a_payload_too_light_for_a_mismatch_widens_the_fast_interval(case: str) 
         assert "link.tip_mass" in (result.reason or ""), result.reason
 
 
+def test_a_payload_is_named_when_the_second_mode_could_narrow_at_the_cap() -> None:
+    # With omega_2 calibrated (mode2_scatter), the cap's narrowing by the second mode and its
+    # check of the frequency read the model's curves without the payload: 0.05 g at 0.6 m came
+    # back estimators_disagree, omega_1 6.7 standard deviations off, and the reason asked about
+    # torque_point. The payload lowers omega_2 as well: no narrowing with one
+    base = paper_antenna().self_calibrated()
+    model = dataclasses.replace(base, link=dataclasses.replace(base.link, mode2_scatter=0.005))
+    device = DeviceImperfections(tip_mass=5e-5)
+    simulated = simulate(
+        model, Scenario(case="azimuthal", contact_point=0.6, seed=2, device=device)
+    )
+    truth = float(simulated.metadata["true_xc"])
+    result = estimate(simulated.without_ground_truth(), model, "fast")
+    assert result.interval is not None and result.interval[0] <= truth <= result.interval[1]
+    assert result.status is Status.UNCERTAIN, result.reason
+    assert "link.tip_mass" in (result.reason or "")
+
+
 def test_angles_in_degrees_are_caught_with_an_identified_observer() -> None:
     # An identified observer's contact threshold is low (about 0.2 mN m against the paper's
     # 20): with the angles in degrees it predicts 57 times the torque, and the detector fires

@@ -81,6 +81,11 @@ def two_frequency_curve(link: Link, x_min: float, x_max: float) -> tuple[FloatAr
     return x, omegas
 
 
+#: Smallest cos(theta_2) at which the weight at rest is read as a payload: beyond 60 deg of
+#: elevation the moment's lever shrinks, and a few counts of offset would read as grams.
+_PAYLOAD_COSINE = 0.5
+
+
 @functools.lru_cache(maxsize=8)
 def _payload_shifts(link: Link, mass: float, points: bytes, shape: tuple[int, ...]) -> FloatArray:
     """:meth:`Evidence.payload_shifts` of ``mass`` (kg) at the contact points held in
@@ -499,13 +504,18 @@ class Evidence:
         (:func:`~sensing_antenna.units_check.is_payload`) is weight the model does not carry,
         most often a payload at the tip (glue, a marker): m_t = excess / (g l cos theta_2). A
         lighter reading is no payload (an offset weighs nothing); loads not in the format's
-        units say nothing of one.
+        units and an elevation beyond 60 deg (the lever's cosine below a half) say nothing of
+        one; a tare read over the approach holds the head's motion too (see
+        :meth:`payload_shifts`).
         """
         from sensing_antenna.units_check import is_payload, rest_moment_std
 
         if self.input_problem is not None:
             return 0.0
-        lever = STANDARD_GRAVITY * self.antenna.link.length * math.cos(float(self.theta[0, 1]))
+        cosine = math.cos(float(self.theta[0, 1]))
+        if not cosine >= _PAYLOAD_COSINE:
+            return 0.0  # near a vertical link the weight's moment says little of a mass
+        lever = STANDARD_GRAVITY * self.antenna.link.length * cosine
         excess = float(self.load_offset[4])
         noise = float(self.diagnostics.get("torque_noise", 0.0))
         std = rest_moment_std(noise, self.torque_offset_error)
@@ -516,10 +526,13 @@ class Evidence:
     def payload_shifts(self, x_c: FloatArray) -> FloatArray:
         """How much lower (rad/s) omega_1 rings at contact points ``x_c`` (m, shape (G,)) on a
         link carrying :meth:`payload_mass` at its tip than on the model's: what the sensing
-        curve leaves out of a vibration read at ``x_c``; zeros without a payload, or with one
-        more than the link could carry (the plausibility layer names that)."""
+        curve leaves out of a vibration read at ``x_c``; zeros without a payload, with one read
+        over an approach's tare, or with one more than the link could carry (the plausibility
+        layer names those)."""
         x_c = np.asarray(x_c, dtype=float)
-        mass = self.payload_mass()
+        # a tare over the approach holds the head's motion, which the reading cannot tell
+        # from weight: no shift is carried on it (the plausibility layer says so)
+        mass = self.payload_mass() if self.diagnostics.get("tare") != "approach" else 0.0
         if not mass > 0.0:
             return np.zeros(x_c.shape)
         # an online session asks at every window with the same grid and mass: computed once

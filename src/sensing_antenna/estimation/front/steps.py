@@ -362,7 +362,9 @@ def at_contact(
             starts_at_rest=quiet >= w_rest + 1,
         )
         checks["free_motion_gain"] = gain
-        if problem is None:
+        if problem is None and quiet >= w_rest + 1:
+            # the observer starts from rest: a record that starts in motion misleads it, and
+            # one joint's share can then read low for right columns
             gains, problem = joint_free_motion_gains(
                 theta[before],
                 torque[before],

@@ -84,7 +84,13 @@ def conclude_fast(
                 final, posterior=post, ratio_z=ratio_z, frequency_z=frequency_z
             )
             result = dataclasses.replace(result, final=final)
-        if (final.checks_passed or final.near_top) and not accepted_at_cap(final, config):
+        # omega_2's narrowing reads the model's curves, which a payload the weight at rest
+        # reads lowers as well: not with one
+        if (
+            (final.checks_passed or final.near_top)
+            and not accepted_at_cap(final, config)
+            and not np.any(evidence.payload_shifts(np.array([post.x_c])) > 0.0)
+        ):
             final, narrowing = _narrowed(evidence, final, config)
             diag["second_mode_narrowing"] = narrowing
             result = dataclasses.replace(result, final=final)
@@ -264,15 +270,16 @@ def _frequency_judged(
     config: FastConfig,
 ) -> tuple[float, str]:
     """The frequency's distance from the sensing curve at ``post``'s maximum, in its standard
-    deviations (:func:`.checks.frequency_check`, the bent link's term included as the windows
-    have it, :func:`.search.scan_inputs`), and why it does not allow that maximum ("" when it
-    does): farther from the curve there than ``max_disagreement`` standard deviations, or as
-    far above the curve's top, where no contact point rings."""
+    deviations (:func:`.checks.frequency_check`, the bent link's and a payload's terms included
+    as the windows have them, :func:`.search.scan_inputs`), and why it does not allow that
+    maximum ("" when it does): farther from the curve there than ``max_disagreement`` standard
+    deviations, or as far above the curve's top, where no contact point rings."""
     link = evidence.antenna.link
     table = curve_table(link, post.branch_edges[0], post.branch_edges[-1], config.grid_step)
     slope = float(np.interp(post.x_c, table.grid, table.slope))
     bent = slope * evidence.bent_link_uncertainty(post.x_c)
-    sigma = frequency_sigma(omega1, omega1_se, model_floor(link, config), bent)
+    payload = float(evidence.payload_shifts(np.array([post.x_c]))[0])
+    sigma = frequency_sigma(omega1, omega1_se, model_floor(link, config), math.hypot(bent, payload))
     top = float(table.omega1.max())
     z, note = frequency_check(
         omega1, sigma, float(np.interp(post.x_c, table.grid, table.omega1)), post.x_c, top, config
