@@ -125,9 +125,9 @@ def review(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
 
 def _payload_hint(evidence: Evidence) -> str:
     """What an unsure answer owes to a payload the weight at rest reads, or ""."""
-    mass = evidence.payload_mass()
-    if not mass > 0.0 or evidence.diagnostics.get("tare") == "approach":
-        return ""  # read over the approach, it is the payload check's to word
+    mass = evidence.carried_payload_mass()
+    if not mass > 0.0:
+        return ""
     return (
         f"; at rest the link's moment ty reads {float(evidence.load_offset[4]):.3g} N m more "
         f"than the model's weight, as {1e3 * mass:.2g} g at the tip the antenna file does not "

@@ -523,6 +523,12 @@ class Evidence:
             return 0.0
         return excess / lever
 
+    def carried_payload_mass(self) -> float:
+        """:meth:`payload_mass` as the fast method carries it (kg): 0 when the tare was read
+        over the approach, whose loads hold the head's motion, which the reading cannot tell
+        from weight (the plausibility layer's payload check words that case)."""
+        return self.payload_mass() if self.diagnostics.get("tare") != "approach" else 0.0
+
     def payload_shifts(self, x_c: FloatArray) -> FloatArray:
         """How much lower (rad/s) omega_1 rings at contact points ``x_c`` (m, shape (G,)) on a
         link carrying :meth:`payload_mass` at its tip than on the model's: what the sensing
@@ -530,9 +536,7 @@ class Evidence:
         over an approach's tare, or with one more than the link could carry (the plausibility
         layer names those)."""
         x_c = np.asarray(x_c, dtype=float)
-        # a tare over the approach holds the head's motion, which the reading cannot tell
-        # from weight: no shift is carried on it (the plausibility layer says so)
-        mass = self.payload_mass() if self.diagnostics.get("tare") != "approach" else 0.0
+        mass = self.carried_payload_mass()
         if not mass > 0.0:
             return np.zeros(x_c.shape)
         # an online session asks at every window with the same grid and mass: computed once
