@@ -219,6 +219,13 @@ class EstimatorConfig:
         an identified one. 5 sits between. The same factor judges each joint's share on its
         own (:func:`~.front.steps.joint_free_motion_gains`: an angle column copied from the
         other joint's).
+    still_turn_factor : float
+        Plausibility (``implausible_input``): before t_c, with neither angle leaving the rest
+        tolerance, the torque about Y^m and Z^m (weight and mean taken off) may vary by at most
+        this many times the sensor's white noise (root mean square,
+        :func:`~.front.steps.still_angles_turn`): a head at rest reads about 1 (its noise), a
+        sensor's cross-talk from a turning axis a little more, a sweep's start on the turning
+        axis about 20 on the simulated devices. 8 sits between.
     max_curve_distance : float
         The ``two-frequency`` method's answer is a ``model_mismatch`` when the measured
         (omega_1, omega_2) lie farther than this from the nearest point of the straight link's
@@ -292,6 +299,7 @@ class EstimatorConfig:
     max_scale_mismatch: float = 1.5
     max_model_spread: float = 0.01
     free_motion_gain_factor: float = 5.0
+    still_turn_factor: float = 8.0
     max_curve_distance: float = 0.05
     max_deflection_ratio: float = 0.4
     max_bend_per_turn: float = 1.6
@@ -332,7 +340,7 @@ class EstimatorConfig:
                 continue
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise EstimatorConfigError(f"{f.name}: must be a finite number > 0, got {value!r}")
-        for name in ("max_scale_mismatch", "free_motion_gain_factor"):
+        for name in ("max_scale_mismatch", "free_motion_gain_factor", "still_turn_factor"):
             if getattr(self, name) <= 1.0:
                 raise EstimatorConfigError(
                     f"{name}: must be a factor > 1, got {getattr(self, name)!r}"

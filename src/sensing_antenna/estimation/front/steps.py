@@ -4,8 +4,8 @@
 2. Sensor offset (tare) and rest tolerance from the samples up to t_c (:func:`at_contact`), and
    the recording's own units check there: the loads the tare averages against the link's weight
    (:func:`sensing_antenna.units_check.rest_reading`), the free motion before t_c against the
-   observer (:func:`free_motion_gain`, and joint by joint :func:`joint_free_motion_gains`),
-   and the angles up to t_c
+   observer (:func:`free_motion_gain`, and joint by joint :func:`joint_free_motion_gains`;
+   a turn the still angles miss, :func:`still_angles_turn`), and the angles up to t_c
    (:func:`sensing_antenna.units_check.angle_problem`), so that an outcome found before t_e
    (no push, say) on angles in degrees names the degrees.
 3. The static push over the hold window [t_1, t_1 + frame_window] (:func:`hold_push`): the mean
@@ -61,6 +61,7 @@ __all__ = [
     "samples",
     "samples_missing",
     "sampling_problem",
+    "still_angles_turn",
     "time_gaps",
 ]
 
@@ -375,6 +376,17 @@ def at_contact(
                 tolerance=tolerance,
             )
             checks["joint_free_motion_gains"] = gains
+            if problem is None:
+                ratio, problem = still_angles_turn(
+                    theta[before],
+                    torque[before],
+                    antenna,
+                    cfg,
+                    stop=contact_index + 1 - samples(cfg.tare_margin, ts),
+                    tolerance=tolerance,
+                    window=w_rest,
+                )
+                checks["still_angles_turn"] = ratio
         if problem is not None:
             problems.append(problem)
     angles = angle_problem(theta[before])
@@ -467,17 +479,34 @@ def free_motion_gain(
 def _dynamic_rms(
     theta: FloatArray, torque: FloatArray, predicted_torque: FloatArray, antenna: Antenna
 ) -> tuple[FloatArray, FloatArray]:
-    """Root-mean-square (N m) of the observer's predicted and the measured torque about Y^m
-    and Z^m, the link's weight taken off, each less its mean (the sensor's offset is not the
-    link's inertia); shapes (2,), (2,)."""
+    """:func:`_moment_rms` of the observer's predicted and of the measured torque (N m);
+    shapes (2,), (2,)."""
+    return _moment_rms(theta, predicted_torque, antenna), _moment_rms(theta, torque, antenna)
+
+
+def _load_came_and_went(
+    theta: FloatArray, torque: FloatArray, antenna: Antenna, axis: int, window: int
+) -> bool:
+    """Whether the moment about Y^m (``axis`` 0) or Z^m (1), weight off and averaged over
+    ``window`` samples, ends nearer its start than half its largest excursion from it: a turn's
+    start loads the sensor and lets go, a touch builds its load up to t_c."""
+    from scipy.ndimage import uniform_filter1d
+
+    if window < 1 or theta.shape[0] < 2 * window:
+        return False
+    gravity = antenna.gravity_torque(theta[:, 1])
+    moment = uniform_filter1d((torque - gravity)[:, 1 + axis], window, mode="nearest")
+    excursion = np.abs(moment - moment[:window].mean())
+    return bool(excursion[-1] <= 0.5 * excursion.max())
+
+
+def _moment_rms(theta: FloatArray, torque: FloatArray, antenna: Antenna) -> FloatArray:
+    """Root-mean-square (N m) of a torque about Y^m and Z^m, the link's weight taken off, each
+    less its mean (the sensor's offset is not the link's inertia); shape (2,)."""
     gravity = antenna.gravity_torque(np.asarray(theta, dtype=float)[:, 1])
     with np.errstate(over="ignore", invalid="ignore"):
-        predicted = (np.asarray(predicted_torque, dtype=float) - gravity)[:, 1:]
-        measured = (np.asarray(torque, dtype=float) - gravity)[:, 1:]
-        return (
-            np.sqrt(np.mean((predicted - predicted.mean(axis=0)) ** 2, axis=0)),
-            np.sqrt(np.mean((measured - measured.mean(axis=0)) ** 2, axis=0)),
-        )
+        moment = (np.asarray(torque, dtype=float) - gravity)[:, 1:]
+        return np.sqrt(np.mean((moment - moment.mean(axis=0)) ** 2, axis=0))
 
 
 #: Each joint's angle column and the torque column its turn acts on, and that torque's index in
@@ -492,7 +521,7 @@ def joint_free_motion_gains(
     antenna: Antenna,
     cfg: EstimatorConfig,
     stop: int,
-    tolerance: float = 0.0,
+    tolerance: float,
 ) -> tuple[tuple[float, float], str | None]:
     """How large the measured free-motion torque is against the observer's, joint by joint.
 
@@ -557,6 +586,76 @@ def joint_free_motion_gains(
         f"columns '{angle}', '{column}': before the contact '{angle}' turns the head, but "
         f"'{column}' shows {gains[k]:.3g} times the torque the observer predicts for that turn "
         f"(at least 1/{factor:g}, from the link's inertia): {cause}"
+    )
+
+
+def still_angles_turn(
+    theta: FloatArray,
+    torque: FloatArray,
+    antenna: Antenna,
+    cfg: EstimatorConfig,
+    stop: int,
+    tolerance: float,
+    window: int,
+) -> tuple[float, str | None]:
+    """Whether the torque before the contact shows a turn the angles do not.
+
+    A head that turns loads the sensor with its link's inertia (about Z^m for theta1, Y^m for
+    theta2) well above the sensor's noise, while a head that rests, or one an object is moved
+    into, shows only noise before the touch. When neither angle leaves the rest tolerance over
+    the samples before ``stop`` (the link free of the contact, as for
+    :func:`joint_free_motion_gains`) and the torque about Y^m or Z^m, the link's weight and its
+    mean taken off, varies by more than ``still_turn_factor`` times the sensor's white noise
+    (root mean square against :func:`signal_noise`), and that load came and went (its mean over
+    ``window`` samples ends within half its largest excursion from the start), the angle
+    columns are not this head's motion: the still joint's angle written over the turning
+    one's, or a frozen column. A load still building at ``stop`` is not judged: an object moved
+    slowly into a still link builds it so, from its touch to t_c.
+
+    Parameters
+    ----------
+    theta : array, shape (n, 2)
+        Angles up to t_c (rad).
+    torque : array, shape (n, 3)
+        Measured torque up to t_c (N m).
+    antenna : Antenna
+    cfg : EstimatorConfig
+    stop : int
+        One past the last sample judged.
+    tolerance : float
+        The rest tolerance (rad, peak to peak).
+    window : int
+        Samples the load is averaged over to judge whether it came and went (the rest window).
+
+    Returns
+    -------
+    (ratio, problem) : tuple of float and str or None
+        The larger axis's root-mean-square torque over the noise, NaN when not judged (a joint
+        turned, fewer than 3 samples before ``stop``, or a load still building there);
+        ``problem`` names the columns.
+    """
+    theta = np.asarray(theta, dtype=float)[:stop]
+    if theta.shape[0] < 3 or np.any(np.ptp(theta, axis=0) > tolerance):
+        return math.nan, None
+    rms = _moment_rms(theta, np.asarray(torque, dtype=float)[:stop], antenna)
+    noise = signal_noise(np.asarray(torque, dtype=float)[:stop])[0]
+    if not (noise > 0.0 and np.all(np.isfinite(rms))):
+        return math.nan, None
+    ratios = rms / noise
+    k = int(np.argmax(ratios))
+    ratio = float(ratios[k])
+    factor = cfg.still_turn_factor
+    if ratio <= factor:
+        return ratio, None
+    if not _load_came_and_went(theta, np.asarray(torque, dtype=float)[:stop], antenna, k, window):
+        return math.nan, None
+    column = ("ty", "tz")[k]
+    return ratio, (
+        f"columns 'theta1', 'theta2', '{column}': before the contact neither angle turns by "
+        f"more than the rest tolerance ({tolerance:.3g} rad), yet '{column}' varies "
+        f"{ratio:.3g} times the sensor's noise (at most {factor:g} at rest), as a turning "
+        "head's inertia loads it: the still joint's angle written over the turning one's, or "
+        "a column that stopped updating?"
     )
 
 
