@@ -160,6 +160,23 @@ def test_calibrate_points_out_a_point_too_few_others_can_judge(
     assert len(flagged) == 1 and f"{contacts[1]}: x_c = 0.5500 m" in flagged[0]
 
 
+def test_calibrate_names_the_points_table_when_its_points_fit_no_curve(
+    contacts: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The first and last known points swapped: no T_e puts the measured omega_1 near the
+    # curve, and the refusal names the table the points came from, not the library's field
+    points = tmp_path / "points.csv"
+    rows = [f"{path.name},{x}" for path, x in zip(contacts, (0.8, 0.55, 0.4), strict=True)]
+    points.write_text("file,x_c\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    out = tmp_path / "set.toml"
+    args = ["calibrate", *map(str, contacts), "--points", str(points), "--out", str(out)]
+    assert main(args) != 0
+    error = capsys.readouterr().err
+    assert f"--points {points}: no calibration:" in error
+    assert "contact_points" not in error
+    assert not out.exists()
+
+
 def test_calibrate_keeps_a_point_it_left_out_out_of_the_sensor_fit(
     contacts: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

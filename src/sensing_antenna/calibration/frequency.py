@@ -73,7 +73,17 @@ WRONG_PEAK = 0.05
 
 
 class CalibrationError(SensingAntennaError, ValueError):
-    """Calibration input that cannot be used: too few points, bad values, missing contact points."""
+    """Calibration input that cannot be used: too few points, bad values, missing contact points.
+
+    ``field`` names the input at fault when the message blames one (``"contact_points"``), so a
+    caller that took that input from elsewhere (a table, a file's ``true_xc``) can name it
+    instead; ``problem`` is the message without it.
+    """
+
+    def __init__(self, problem: str, field: str | None = None) -> None:
+        self.field = field
+        self.problem = problem
+        super().__init__(problem if field is None else f"{field}: {problem}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -519,7 +529,7 @@ def calibrate_t_e(
     scatter = calibration.relative_scatter
     if math.isfinite(scatter) and scatter >= NO_FIT_SCATTER:
         raise CalibrationError(
-            f"contact_points: no calibration: {scatter_problem(scatter, int(used.sum()))}"
+            f"no calibration: {scatter_problem(scatter, int(used.sum()))}", field="contact_points"
         )
     return calibration
 

@@ -159,9 +159,11 @@ def _run(args: argparse.Namespace) -> int:
             fit_tip_mass=args.tip_mass,
         )
     except CalibrationError as exc:
+        if exc.field != "contact_points":
+            raise
         # the known points came from the table the user gave, or from each file's true_xc
         where = f"--points {args.points}" if args.points is not None else "true_xc"
-        raise CalibrationError(str(exc).replace("contact_points:", f"{where}:", 1)) from None
+        raise CalibrationError(exc.problem, field=where) from None
     fitted = [path for path, used in zip(paths, calibration.used, strict=True) if used]
     description = _description(antenna.name, fitted)
     calibrated = replace(calibration.apply(antenna), name=name, description=description)
