@@ -180,6 +180,28 @@ def test_replay_piped_to_listen_and_recorded(
     assert read_recording(kept) == read_recording(recordings[case])
 
 
+def test_a_stream_of_another_antenna_is_warned_of(
+    recordings: dict[str, Path],
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # A stream whose metadata names another antenna, listened to with the default one: its
+    # observer and stiffness are not this device's, which can make a good recording look bad;
+    # one line on stderr says so, as antenna estimate does. Given --antenna, no line.
+    text = [line.decode() for line in _lines(read_recording(recordings["azimuthal"]))]
+    lines = [line for line in text if not line.startswith("# antenna:")]
+    lines.insert(0, "# antenna: lab-3\n")
+    for given, warned in (([], True), (["--antenna", "paper-2021"], False)):
+        stream = io.TextIOWrapper(io.BytesIO("".join(lines).encode()))
+        monkeypatch.setattr(sys, "stdin", stream)
+        assert main(["listen", "--no-warm-up", *given]) == 0
+        captured = capsys.readouterr()
+        said = "<stdin> recording 1 recorded with antenna 'lab-3'"
+        assert (said in captured.err) is warned, captured.err
+        events = [json.loads(line)["event"] for line in captured.out.splitlines()]
+        assert events[-1] == "end"
+
+
 def test_udp_on_localhost(recordings: dict[str, Path], tmp_path: Path) -> None:
     kept = tmp_path / "kept.csv"
     listen = subprocess.Popen(

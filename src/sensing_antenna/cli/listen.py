@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from sensing_antenna.cli.arguments import integer
-from sensing_antenna.cli.estimate import METHOD_NAMES
+from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, METHOD_NAMES, warn_of_other_antennas
 
 
 def register(subparsers: Any) -> None:
@@ -33,7 +33,12 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("--method", choices=METHOD_NAMES, default="paper", help="as for estimate")
     parser.add_argument("--t1", choices=("rest", "push"), default="rest", help="as for estimate")
-    parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
+    parser.add_argument(
+        "--antenna",
+        default=None,
+        help=f"built-in name or TOML file (default {DEFAULT_ANTENNA}; a stream whose 'antenna' "
+        "metadata names another is warned of)",
+    )
     parser.add_argument(
         "--record",
         type=Path,
@@ -73,7 +78,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.live.warm_up import freeze_heap, warm_up
     from sensing_antenna.live.wire import StreamHeader, WireError
 
-    antenna = load_antenna(args.antenna)
+    antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     config = EstimatorConfig(t1_source=args.t1)
     lock = threading.Lock()
 
@@ -84,6 +89,9 @@ def _run(args: argparse.Namespace) -> int:
             sys.stdout.flush()
 
     def make(header: StreamHeader, number: int) -> Listener:
+        if args.antenna is None:  # the default: another antenna's stream is warned of
+            which = f"{header.source} recording {number}"
+            warn_of_other_antennas({header.metadata.get("antenna", ""): [which]}, antenna.name)
         record = None
         if args.record is not None:
             record = RecordWriter(numbered_path(args.record, number), header)
