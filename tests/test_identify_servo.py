@@ -191,6 +191,32 @@ def test_cli_writes_the_fitted_motors_and_prints_their_gains(
     assert "and the motors of joint 1 identified" in written.description
 
 
+def test_cli_fits_each_joints_motor_from_the_recording_that_moves_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A free sweep of each joint: joint 1 from the azimuthal one, joint 2 from the vertical
+    # one, each line naming its recording; the observer from both, as without --servo
+    paths = []
+    for case in ("free", "free-vertical"):
+        paths.append(tmp_path / f"{case}.csv")
+        write_recording(simulate(TRUE, Scenario(case=case), record_commands=True), paths[-1])
+    out = tmp_path / "lab.toml"
+    assert main(["identify", *map(str, paths), "--out", str(out), "--servo"]) == 0
+    text = capsys.readouterr().out
+    written = load_antenna(out)
+    azimuth, elevation = (identify_motors(read_recording(p), PAPER).joints[0] for p in paths)
+    assert (azimuth.joint, elevation.joint) == (1, 2)
+    assert written.azimuth_motor == azimuth.motor(PAPER.azimuth_motor)
+    assert written.elevation_motor == elevation.motor(PAPER.elevation_motor)
+    assert f"joint 1 (azimuth), Eq. 1 (from {paths[0]}):" in text
+    assert f"joint 2 (elevation), Eq. 1 (from {paths[1]}):" in text
+    assert "not fitted" not in text
+    assert "joints used: theta1, theta2" in text
+    # both within the fit's tolerance of the device's own motors
+    for fitted, true in zip(written.motors, TRUE.motors, strict=True):
+        assert fitted.inertia == pytest.approx(true.inertia, rel=0.1)
+
+
 def test_cli_fits_the_motors_on_a_sweep_into_an_object_and_keeps_the_observer(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

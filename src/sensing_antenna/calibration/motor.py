@@ -34,6 +34,7 @@ The servo's gains then follow from the fitted J and v by the pole placement of S
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -64,6 +65,7 @@ __all__ = [
     "JointFit",
     "MotorFit",
     "identify_motors",
+    "identify_motors_from",
 ]
 
 #: lambda of the state-variable filter lambda^2 / (s + lambda)^2 (rad/s): near the servo's
@@ -110,6 +112,8 @@ class JointFit:
         Standard errors of the three (same units).
     residual_rms : float
         RMS of the filtered equation's residual (N m).
+    source : str or None
+        Recording it was fitted on.
     """
 
     joint: int
@@ -120,6 +124,7 @@ class JointFit:
     viscous_error: float
     coulomb_error: float
     residual_rms: float
+    source: str | None = None
 
     def motor(self, base: Motor) -> Motor:
         """``base`` (K_m, n from the antenna file) with the fitted J, v and V^nlc =
@@ -344,7 +349,7 @@ def identify_motors(
             skipped.append((j + 1, reason))
         else:
             _check_inertia(fit.inertia, motor.inertia + link_inertia, j + 1, where)
-            fits.append(fit)
+            fits.append(replace(fit, source=recording.source))
     if not fits:
         reasons = "; ".join(f"joint {j}: {reason}" for j, reason in skipped)
         raise IdentificationError(
@@ -357,4 +362,41 @@ def identify_motors(
         filter_bandwidth=float(filter_bandwidth),
         sample_period=period,
         source=recording.source,
+    )
+
+
+def identify_motors_from(
+    recordings: Sequence[Recording],
+    antenna: Antenna,
+    filter_bandwidth: float = DEFAULT_FILTER_BANDWIDTH,
+) -> MotorFit:
+    """:func:`identify_motors` on each of ``recordings``, each joint taken from the one that
+    determines its J best (smallest relative standard error): a free sweep of each joint, say.
+    The servo's gains (:meth:`MotorFit.designs`) are designed at the first recording's period.
+
+    Raises
+    ------
+    IdentificationError
+        As :func:`identify_motors`, for the first recording that cannot be used (one that
+        moves no joint included); none given.
+    """
+    if not recordings:
+        raise IdentificationError("no recording to fit the motors to")
+    fits = [identify_motors(recording, antenna, filter_bandwidth) for recording in recordings]
+    best: dict[int, JointFit] = {}
+    for joint in (j for fit in fits for j in fit.joints):
+        kept = best.get(joint.joint)
+        if kept is None or joint.inertia_error / joint.inertia < kept.inertia_error / kept.inertia:
+            best[joint.joint] = joint
+    skipped: dict[int, str] = {}
+    for number, reason in (s for fit in fits for s in fit.skipped):
+        if number not in best:
+            skipped.setdefault(number, reason)
+    sources = [fit.source for fit in fits if fit.source]
+    return MotorFit(
+        joints=tuple(best[number] for number in sorted(best)),
+        skipped=tuple(sorted(skipped.items())),
+        filter_bandwidth=float(filter_bandwidth),
+        sample_period=fits[0].sample_period,
+        source=", ".join(sources) if sources else None,
     )

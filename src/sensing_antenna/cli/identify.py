@@ -37,10 +37,10 @@ def register(subparsers: Any) -> None:
             "filtered residual over them times the margin (Section 5.2), and writes the "
             "starting antenna with that observer as a new antenna: named after --out (or "
             "--name), its description saying which recordings it was identified from. With "
-            "--servo (one recording) it also fits each moving joint's Eq. 1 (inertia J, viscous "
-            "friction v, Coulomb torque) to the motor commands the recording carries (columns "
-            "u1, u2, V), writes them into the motors, and prints "
-            "the servo's gains designed from them (Section 4.1, Eq. 14)."
+            "--servo it also fits each moving joint's Eq. 1 (inertia J, viscous friction v, "
+            "Coulomb torque) to the motor commands the recordings carry (columns u1, u2, V; "
+            "each joint from the recording that tells its J best), writes them into the "
+            "motors, and prints the servo's gains designed from them (Section 4.1, Eq. 14)."
         ),
     )
     parser.add_argument(
@@ -83,7 +83,7 @@ def _run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
     from sensing_antenna.antenna import load_antenna, save_antenna
-    from sensing_antenna.calibration.motor import identify_motors
+    from sensing_antenna.calibration.motor import identify_motors_from
     from sensing_antenna.calibration.observer import IdentificationError, identify_free_motion
     from sensing_antenna.control.servo import DEFAULT_SERVO_POLE, ControlConfigError
     from sensing_antenna.recording import read_recording
@@ -91,11 +91,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.servo_pole is not None and not args.servo:
         raise ControlConfigError("--servo-pole: the gains are designed with --servo only")
     pole = DEFAULT_SERVO_POLE if args.servo_pole is None else args.servo_pole
-    if args.servo and len(args.recordings) > 1:
-        raise ControlConfigError("--servo: the motors are fitted to one recording; give one")
     antenna = load_antenna(args.antenna)
     recordings = [read_recording(path) for path in distinct_files(args.recordings)]
-    motor_fit = identify_motors(recordings[0], antenna) if args.servo else None
+    motor_fit = identify_motors_from(recordings, antenna) if args.servo else None
     try:
         fit = identify_free_motion(recordings, antenna, margin=args.margin)
     except IdentificationError as exc:
@@ -137,7 +135,7 @@ def _run(args: argparse.Namespace) -> int:
         )
         _print_payload(fit.payload, antenna.link, identified.link)
     if motor_fit is not None:
-        _print_servo(motor_fit, antenna, pole)
+        _print_servo(motor_fit, antenna, pole, several=len(recordings) > 1)
     print(args.out)
     return 0
 
@@ -163,14 +161,16 @@ def _print_payload(payload: Any, before: Any, after: Any) -> None:
         print(f"{read}: not significant, link.{field} kept at {before.weighed_tip_mass:.4g} kg")
 
 
-def _print_servo(motor_fit: Any, antenna: Any, pole: float) -> None:
-    """The fitted Eq. 1 of each joint and the servo's gains designed from it."""
+def _print_servo(motor_fit: Any, antenna: Any, pole: float, several: bool = False) -> None:
+    """The fitted Eq. 1 of each joint and the servo's gains designed from it; ``several``: the
+    joints were fitted from several recordings, each named."""
     names = {1: "azimuth", 2: "elevation"}
     for joint in motor_fit.joints:
         motor = antenna.motors[joint.joint - 1]
         volts = joint.coulomb_torque / (motor.gear_ratio * motor.torque_constant)
+        source = f" (from {printable(joint.source)})" if several and joint.source else ""
         print(
-            f"joint {joint.joint} ({names[joint.joint]}), Eq. 1: "
+            f"joint {joint.joint} ({names[joint.joint]}), Eq. 1{source}: "
             f"J = {joint.inertia:.4g} +- {joint.inertia_error:.2g} kg m^2, "
             f"v = {joint.viscous_friction:.4g} +- {joint.viscous_error:.2g} N m s/rad, "
             f"Gamma_nlc = {joint.coulomb_torque:.4g} +- {joint.coulomb_error:.2g} N m "
