@@ -734,7 +734,6 @@ class FrontEnd:
                 {
                     "rest_tolerance": self._start.rest_tolerance,
                     "tare": self._start.tare,
-                    "tare_samples": self._start.count,
                     "load_offset": self._start.offset,
                     **self._start.checks,
                 }

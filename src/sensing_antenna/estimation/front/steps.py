@@ -44,7 +44,6 @@ from sensing_antenna.units_check import angle_problem, initial_rest, rest_readin
 __all__ = [
     "MAX_FILLED",
     "OUTLIER_PERIODS",
-    "SETTLED_ERRORS",
     "STEP_JITTER",
     "ContactStart",
     "FilledSamples",
@@ -62,17 +61,11 @@ __all__ = [
     "samples",
     "samples_missing",
     "sampling_problem",
-    "settled_loads",
     "still_angles_turn",
     "time_gaps",
 ]
 
 FloatArray = NDArray[np.float64]
-
-#: Standard errors of a rest window's mean load by which the loads leave their level where the
-#: rest ends (:func:`settled_loads`): noise passes 5 with probability 6e-7 per window and
-#: channel, and the run must last to the end besides.
-SETTLED_ERRORS = 5.0
 
 
 def samples(duration: float, sample_period: float) -> int:
@@ -401,12 +394,8 @@ def at_contact(
         # first: a push judged on angles that are no head's is no push (degrees, a glitch)
         problems.insert(0, angles)
     if quiet >= w_rest + 1:
-        # The head rests at the start: the link hangs still, the mean load is the offset; a
-        # coarse encoder sees the sweep start late, the loads see it at once
-        seen = min(quiet + w_rest, contact_index + 1)  # a load that left by quiet shows by then
-        settled = settled_loads(theta[:seen], force[:seen], torque[:seen], antenna, w_rest)
-        window = slice(0, min(quiet, max(settled, w_rest + 1)))
-        tare, where = "rest", "at rest before the contact"
+        # The head rests at the start: the link hangs still, the mean load is the offset.
+        window, tare, where = slice(0, quiet), "rest", "at rest before the contact"
     else:
         end = contact_index - samples(cfg.tare_margin, ts)
         window, tare = slice(0, max(end, 0)), "approach"
@@ -419,40 +408,6 @@ def at_contact(
         problems.insert(0, reading.problem)
     offset = load_offset(theta[window], force[window], torque[window], antenna)
     return ContactStart(tolerance, offset, tare, window.stop, _joined(problems), checks)
-
-
-def settled_loads(
-    theta: FloatArray, force: FloatArray, torque: FloatArray, antenna: Antenna, window: int
-) -> int:
-    """Number of samples at the start over which the contact loads hold their level.
-
-    The head's angles say when it rests only to within the rest tolerance, which a coarse or
-    flickering encoder makes several counts wide: the sweep's start then counts as rest while
-    the link's inertia already loads the sensor, and a tare over it holds that load. Here the
-    loads R = F - F_g^m and Gamma - Gamma_g^m, averaged over each ``window`` samples, are
-    compared with their mean over all the samples before that window: the rest ends where a
-    run of windows begins that each lie more than :data:`SETTLED_ERRORS` standard errors of
-    such a mean from it (the channel's white noise over sqrt(window)) and that lasts to the
-    last sample. A link that rings at rest leaves that level and comes back, and keeps its
-    rest. Shapes (n, 2), (n, 3), (n, 3); returns n when the loads end at their level.
-    """
-    n = theta.shape[0]
-    if window < 1 or n < 2 * window:
-        return n
-    reaction, moment = contact_loads(theta, force, torque, antenna)
-    loads = np.hstack([reaction, moment])
-    limit = SETTLED_ERRORS / math.sqrt(window)
-    limits = np.array([signal_noise(force)[0]] * 3 + [signal_noise(torque)[0]] * 3) * limit
-    total = np.vstack([np.zeros((1, 6)), np.cumsum(loads, axis=0)])
-    starts = np.arange(window, n - window + 1)  # each window [s, s + window), s samples before
-    windows = (total[starts + window] - total[starts]) / window
-    before = total[starts] / starts[:, np.newaxis]
-    with np.errstate(invalid="ignore"):
-        left = np.any(np.abs(windows - before) > limits, axis=1)
-    if not left[-1]:
-        return n  # back at their level: a link that rang at rest, not a sweep's start
-    within = np.flatnonzero(~left)
-    return int(starts[within[-1] + 1]) if within.size else window
 
 
 def _joined(problems: list[str]) -> str | None:

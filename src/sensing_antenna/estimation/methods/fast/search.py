@@ -56,7 +56,6 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         tolerance,
         config.bias_min_samples,
         guard=round(config.bias_guard / evidence.sample_period),
-        settled=_rest_samples(evidence),
     )
     x_range = (
         evidence.config.contact_range[0] * link.length,
@@ -176,9 +175,3 @@ def scan(
         return ScanResult(None, 0, last <= inputs.end_index)
     final = with_early_statics_of(inputs, final, caches)
     return ScanResult(final, count, not final.sure and last <= inputs.end_index)
-
-
-def _rest_samples(evidence: Evidence) -> int | None:
-    """Samples of the front end's tare at rest (its loads settled), None without one."""
-    count = evidence.diagnostics.get("tare_samples")
-    return int(count) if evidence.diagnostics.get("tare") == "rest" and count else None

@@ -254,7 +254,6 @@ def sensor_bias(
     tolerance: float,
     min_samples: int = 20,
     guard: int = 0,
-    settled: int | None = None,
 ) -> SensorBias:
     """Bias of the contact-load channels from the initial rest before the sweep.
 
@@ -273,10 +272,6 @@ def sensor_bias(
     guard : int
         Samples left out before the first one where the head has moved, or before t_c (the
         motion, or the touch, loads the sensor before it is detected).
-    settled : int, optional
-        Samples at the start over which the loads hold their level (the front end's
-        tare at rest, :func:`~sensing_antenna.estimation.front.steps.settled_loads`): the rest
-        ends there at the latest, since a coarse encoder sees the sweep start late.
 
     Returns
     -------
@@ -285,8 +280,6 @@ def sensor_bias(
     theta = np.asarray(theta, dtype=float)
     moved = np.flatnonzero(np.any(np.abs(theta[:contact_index] - theta[0]) > tolerance, axis=1))
     stop = (int(moved[0]) if moved.size else contact_index) - guard
-    if settled is not None:
-        stop = min(stop, settled)
     k = channels.shape[1]
     if stop < min_samples:
         return SensorBias(np.zeros(k), np.zeros((k, k)), 0)
