@@ -365,6 +365,24 @@ def test_a_head_at_rest_shows_its_sensors_noise_not_a_turn(antenna: Antenna) -> 
     assert ratio == pytest.approx(1.0, abs=0.1)
 
 
+def test_a_still_head_whose_link_rings_is_no_turn(antenna: Antenna) -> None:
+    # Angles still, the link left ringing at its free mode (16.4 rad/s, damping ratio 0.005)
+    # with 1e-3 N m about Z^m, 30 times the noise: it swings both ways, a turn's start loads
+    # one way; at no phase is it called a frozen angle column
+    n = 1000
+    t = np.arange(n) * 1e-3
+    theta = np.tile([0.0, 0.1], (n, 1))
+    torque = antenna.gravity_torque(theta[:, 1])
+    torque = torque + np.random.default_rng(7).normal(0.0, 3e-5, (n, 3))
+    for phase in np.linspace(0.0, 2.0 * math.pi, 12, endpoint=False):
+        ringing = torque.copy()
+        ringing[:, 2] += 1e-3 * np.exp(-0.005 * 16.4 * t) * np.sin(16.4 * t + phase)
+        ratio, problem = still_angles_turn(
+            theta, ringing, antenna, EstimatorConfig(), stop=n, tolerance=1e-4, window=50
+        )
+        assert problem is None, (phase, ratio)
+
+
 def test_an_encoders_flicker_on_the_still_joint_is_no_turn(
     azimuthal: Recording, antenna: Antenna
 ) -> None:

@@ -488,16 +488,21 @@ def _load_came_and_went(
     theta: FloatArray, torque: FloatArray, antenna: Antenna, axis: int, window: int
 ) -> bool:
     """Whether the moment about Y^m (``axis`` 0) or Z^m (1), weight off and averaged over
-    ``window`` samples, ends nearer its start than half its largest excursion from it: a turn's
-    start loads the sensor and lets go, a touch builds its load up to t_c."""
+    ``window`` samples, made one excursion and came back: one peak or trough whose prominence
+    is at least half the moment's range, and an end nearer its start than half its largest
+    excursion from it. A turn's start loads the sensor one way and lets go; a touch builds its
+    load up to t_c (no peak); a link left ringing swings to and fro (peaks and troughs)."""
     from scipy.ndimage import uniform_filter1d
+    from scipy.signal import find_peaks
 
     if window < 1 or theta.shape[0] < 2 * window:
         return False
     gravity = antenna.gravity_torque(theta[:, 1])
     moment = uniform_filter1d((torque - gravity)[:, 1 + axis], window, mode="nearest")
-    excursion = np.abs(moment - moment[:window].mean())
-    return bool(excursion[-1] <= 0.5 * excursion.max())
+    deviation = moment - moment[:window].mean()
+    half = 0.5 * float(np.ptp(deviation))
+    extrema = sum(find_peaks(sign * deviation, prominence=half)[0].size for sign in (1.0, -1.0))
+    return bool(extrema == 1 and abs(deviation[-1]) <= 0.5 * float(np.max(np.abs(deviation))))
 
 
 def _moment_rms(theta: FloatArray, torque: FloatArray, antenna: Antenna) -> FloatArray:
