@@ -277,3 +277,26 @@ def test_a_request_too_large_for_the_memory_is_one_line(tmp_path: Path) -> None:
     err = done.stderr.strip()
     assert err.startswith("antenna simulate: error: ") and err.count("\n") == 0
     assert not (tmp_path / "rec.csv").exists()
+
+
+def test_an_interruption_while_a_class_is_made_is_an_interruption(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Ctrl-C while a module is imported can land in a dataclass field's __set_name__, which
+    # Python 3.11 reports as a RuntimeError raised from the KeyboardInterrupt: it is the
+    # interruption, one line and no traceback, not a failure
+    import sensing_antenna.cli.beam as beam
+    from sensing_antenna.cli import main
+
+    class Field:
+        def __set_name__(self, owner: type, name: str) -> None:
+            raise KeyboardInterrupt
+
+    def interrupted(args: object) -> int:
+        type("Made", (), {"peaks": Field()})
+        return 0
+
+    monkeypatch.setattr(beam, "run", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        main(["beam", "--xc", "0.5"])
+    assert capsys.readouterr().err.strip() == "antenna beam: interrupted"

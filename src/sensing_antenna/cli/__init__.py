@@ -213,8 +213,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             except SensingAntennaError as exc:
                 _say(f"{prog}: error: {_named_by_flag(exc, getattr(args, 'flags', {}))}")
                 return EXIT_BAD_INPUT
-            except SystemError as exc:
-                # a compiled function (numba's) turns an interruption inside it into this
+            except (SystemError, RuntimeError) as exc:
+                # a compiled function (numba's) turns an interruption inside it into the first,
+                # a class being made as a module is imported (its fields' __set_name__) into
+                # the second
                 interrupt = interruption_of(exc)
                 if interrupt is None:
                     raise
