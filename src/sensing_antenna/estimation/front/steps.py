@@ -365,14 +365,16 @@ def at_contact(
         checks["free_motion_gain"] = gain
         if problem is None and quiet >= w_rest + 1:
             # the observer starts from rest: a record that starts in motion misleads it, and
-            # one joint's share can then read low for right columns
+            # one joint's share can then read low for right columns; both checks judge the
+            # samples where the link is free of the contact, up to the tare's margin before t_c
+            free = contact_index + 1 - samples(cfg.tare_margin, ts)
             gains, problem = joint_free_motion_gains(
                 theta[before],
                 torque[before],
                 predicted_torque[before],
                 antenna,
                 cfg,
-                stop=contact_index + 1 - samples(cfg.tare_margin, ts),
+                stop=free,
                 tolerance=tolerance,
             )
             checks["joint_free_motion_gains"] = gains
@@ -382,7 +384,7 @@ def at_contact(
                     torque[before],
                     antenna,
                     cfg,
-                    stop=contact_index + 1 - samples(cfg.tare_margin, ts),
+                    stop=free,
                     tolerance=tolerance,
                     window=w_rest,
                 )
