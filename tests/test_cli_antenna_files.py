@@ -144,17 +144,28 @@ def test_calibrate_goes_on_without_a_file_it_cannot_use(
     assert "3 recording(s)" in load_antenna(out).description
 
 
+def _calibrate_args(files: list[Path], known: tuple[float, ...], folder: Path) -> list[str]:
+    """``antenna calibrate`` of ``files`` with a points table (``folder/points.csv``) giving
+    each its ``known`` x_c (m), writing ``folder/set.toml``."""
+    points = folder / "points.csv"
+    rows = [f"{path.name},{x}" for path, x in zip(files, known, strict=True)]
+    points.write_text("file,x_c\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    return [
+        "calibrate",
+        *map(str, files),
+        "--points",
+        str(points),
+        "--out",
+        str(folder / "set.toml"),
+    ]
+
+
 def test_calibrate_points_out_a_point_too_few_others_can_judge(
     contacts: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     # Three known points, the middle one written 5 cm short: below five points the fit cannot
     # leave it out as a wrong point, but the line says it lies far off the others
-    points = tmp_path / "points.csv"
-    rows = [f"{path.name},{x}" for path, x in zip(contacts, (0.4, 0.55, 0.8), strict=True)]
-    points.write_text("file,x_c\n" + "\n".join(rows) + "\n", encoding="utf-8")
-    out = tmp_path / "set.toml"
-    args = ["calibrate", *map(str, contacts), "--points", str(points), "--out", str(out)]
-    assert main(args) == 0
+    assert main(_calibrate_args(contacts, (0.4, 0.55, 0.8), tmp_path)) == 0
     lines = capsys.readouterr().out.splitlines()
     flagged = [line for line in lines if "check it" in line]
     assert len(flagged) == 1 and f"{contacts[1]}: x_c = 0.5500 m" in flagged[0]
@@ -165,16 +176,11 @@ def test_calibrate_names_the_points_table_when_its_points_fit_no_curve(
 ) -> None:
     # The first and last known points swapped: no T_e puts the measured omega_1 near the
     # curve, and the refusal names the table the points came from, not the library's field
-    points = tmp_path / "points.csv"
-    rows = [f"{path.name},{x}" for path, x in zip(contacts, (0.8, 0.55, 0.4), strict=True)]
-    points.write_text("file,x_c\n" + "\n".join(rows) + "\n", encoding="utf-8")
-    out = tmp_path / "set.toml"
-    args = ["calibrate", *map(str, contacts), "--points", str(points), "--out", str(out)]
-    assert main(args) != 0
+    assert main(_calibrate_args(contacts, (0.8, 0.55, 0.4), tmp_path)) != 0
     error = capsys.readouterr().err
-    assert f"--points {points}: no calibration:" in error
+    assert f"--points {tmp_path / 'points.csv'}: no calibration:" in error
     assert "contact_points" not in error
-    assert not out.exists()
+    assert not (tmp_path / "set.toml").exists()
 
 
 def test_calibrate_keeps_a_point_it_left_out_out_of_the_sensor_fit(
@@ -187,14 +193,7 @@ def test_calibrate_keeps_a_point_it_left_out_out_of_the_sensor_fit(
         scenario = Scenario(case="azimuthal", contact_point=x_c, duration=2.0, seed=20 + i)
         more.append(tmp_path / f"more-{i}.csv")
         write_recording(simulate(paper_antenna(), scenario), more[-1])
-    files = [*contacts, *more]
-    points = tmp_path / "points.csv"
-    known = (0.4, 0.55, 0.8, 0.5, 0.7)
-    rows = [f"{path.name},{x}" for path, x in zip(files, known, strict=True)]
-    points.write_text("file,x_c\n" + "\n".join(rows) + "\n", encoding="utf-8")
-    out = tmp_path / "set.toml"
-    args = ["calibrate", *map(str, files), "--points", str(points), "--out", str(out)]
-    assert main(args) == 0
+    assert main(_calibrate_args([*contacts, *more], (0.4, 0.55, 0.8, 0.5, 0.7), tmp_path)) == 0
     printed = capsys.readouterr().out
     assert f"{contacts[1]}: x_c = 0.5500 m" in printed and "left out of the fit" in printed
     assert f"sensor, left out: {contacts[1]}: a wrong spectral peak or known point" in printed

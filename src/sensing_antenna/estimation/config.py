@@ -225,7 +225,8 @@ class EstimatorConfig:
         this many times the sensor's white noise (root mean square,
         :func:`~.front.steps.still_angles_turn`): a head at rest reads about 1 (its noise), a
         sensor's cross-talk from a turning axis a little more, a sweep's start on the turning
-        axis about 20 on the simulated devices. 8 sits between.
+        axis an order of magnitude more (docs/design-notes.md, "A still joint's angle over the
+        turning one"). 8 sits between.
     max_curve_distance : float
         The ``two-frequency`` method's answer is a ``model_mismatch`` when the measured
         (omega_1, omega_2) lie farther than this from the nearest point of the straight link's

@@ -481,39 +481,44 @@ def free_motion_gain(
 def _dynamic_rms(
     theta: FloatArray, torque: FloatArray, predicted_torque: FloatArray, antenna: Antenna
 ) -> tuple[FloatArray, FloatArray]:
-    """:func:`_moment_rms` of the observer's predicted and of the measured torque (N m);
-    shapes (2,), (2,)."""
-    return _moment_rms(theta, predicted_torque, antenna), _moment_rms(theta, torque, antenna)
+    """Root-mean-square (N m) about Y^m and Z^m of the observer's predicted and of the measured
+    torque, weight off, each less its mean (:func:`_rms_about_mean`); shapes (2,), (2,)."""
+    return (
+        _rms_about_mean(_weightless_moment(theta, predicted_torque, antenna)),
+        _rms_about_mean(_weightless_moment(theta, torque, antenna)),
+    )
 
 
-def _load_came_and_went(
-    theta: FloatArray, torque: FloatArray, antenna: Antenna, axis: int, window: int
-) -> bool:
-    """Whether the moment about Y^m (``axis`` 0) or Z^m (1), weight off and averaged over
-    ``window`` samples, made one excursion and came back: one peak or trough whose prominence
-    is at least half the moment's range, and an end nearer its start than half its largest
-    excursion from it. A turn's start loads the sensor one way and lets go; a touch builds its
-    load up to t_c (no peak); a link left ringing swings to and fro (peaks and troughs)."""
+def _came_and_went(moment: FloatArray, window: int) -> bool:
+    """Whether a moment (N m, shape (n,)), averaged over ``window`` samples, made one excursion
+    and came back: one peak or trough whose prominence is at least half the moment's range, and
+    an end nearer its start than half its largest excursion from it. A turn's start loads the
+    sensor one way and lets go; a touch builds its load up to t_c (no peak); a link left
+    ringing swings to and fro (peaks and troughs)."""
     from scipy.ndimage import uniform_filter1d
     from scipy.signal import find_peaks
 
-    if window < 1 or theta.shape[0] < 2 * window:
+    if window < 1 or moment.shape[0] < 2 * window:
         return False
-    gravity = antenna.gravity_torque(theta[:, 1])
-    moment = uniform_filter1d((torque - gravity)[:, 1 + axis], window, mode="nearest")
-    deviation = moment - moment[:window].mean()
+    smooth = uniform_filter1d(moment, window, mode="nearest")
+    deviation = smooth - smooth[:window].mean()
     half = 0.5 * float(np.ptp(deviation))
     extrema = sum(find_peaks(sign * deviation, prominence=half)[0].size for sign in (1.0, -1.0))
     return bool(extrema == 1 and abs(deviation[-1]) <= 0.5 * float(np.max(np.abs(deviation))))
 
 
-def _moment_rms(theta: FloatArray, torque: FloatArray, antenna: Antenna) -> FloatArray:
-    """Root-mean-square (N m) of a torque about Y^m and Z^m, the link's weight taken off, each
-    less its mean (the sensor's offset is not the link's inertia); shape (2,)."""
+def _rms_about_mean(moment: FloatArray) -> FloatArray:
+    """Root-mean-square (N m) of each column of ``moment`` (n, k) less its mean (the sensor's
+    offset is not the link's inertia); shape (k,)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.sqrt(np.mean((moment - moment.mean(axis=0)) ** 2, axis=0))
+
+
+def _weightless_moment(theta: FloatArray, torque: FloatArray, antenna: Antenna) -> FloatArray:
+    """A torque about Y^m and Z^m less the link's weight moment (N m), shape (n, 2)."""
     gravity = antenna.gravity_torque(np.asarray(theta, dtype=float)[:, 1])
     with np.errstate(over="ignore", invalid="ignore"):
-        moment = (np.asarray(torque, dtype=float) - gravity)[:, 1:]
-        return np.sqrt(np.mean((moment - moment.mean(axis=0)) ** 2, axis=0))
+        return (np.asarray(torque, dtype=float) - gravity)[:, 1:]
 
 
 #: Each joint's angle column and the torque column its turn acts on, and that torque's index in
@@ -614,10 +619,11 @@ def still_angles_turn(
     :func:`joint_free_motion_gains`) and the torque about Y^m or Z^m, the link's weight and its
     mean taken off, varies by more than ``still_turn_factor`` times the sensor's white noise
     (root mean square against :func:`signal_noise`), and that load came and went (its mean over
-    ``window`` samples ends within half its largest excursion from the start), the angle
-    columns are not this head's motion: the still joint's angle written over the turning
-    one's, or a frozen column. A load still building at ``stop`` is not judged: an object moved
-    slowly into a still link builds it so, from its touch to t_c.
+    ``window`` samples makes one peak or trough and ends near its start), the angle columns are
+    not this head's motion: the still joint's angle written over the turning one's, or a frozen
+    column. A load still building at ``stop`` is not judged (an object moved slowly into a
+    still link builds it so, from its touch to t_c), nor one that swings to and fro (a link
+    left ringing).
 
     Parameters
     ----------
@@ -638,14 +644,16 @@ def still_angles_turn(
     -------
     (ratio, problem) : tuple of float and str or None
         The larger axis's root-mean-square torque over the noise, NaN when not judged (a joint
-        turned, fewer than 3 samples before ``stop``, or a load still building there);
+        turned, fewer than 3 samples before ``stop``, or a load that did not come and go);
         ``problem`` names the columns.
     """
     theta = np.asarray(theta, dtype=float)[:stop]
     if theta.shape[0] < 3 or np.any(np.ptp(theta, axis=0) > tolerance):
         return math.nan, None
-    rms = _moment_rms(theta, np.asarray(torque, dtype=float)[:stop], antenna)
-    noise = signal_noise(np.asarray(torque, dtype=float)[:stop])[0]
+    torque = np.asarray(torque, dtype=float)[:stop]
+    moment = _weightless_moment(theta, torque, antenna)
+    rms = _rms_about_mean(moment)
+    noise = signal_noise(torque)[0]
     if not (noise > 0.0 and np.all(np.isfinite(rms))):
         return math.nan, None
     ratios = rms / noise
@@ -654,7 +662,7 @@ def still_angles_turn(
     factor = cfg.still_turn_factor
     if ratio <= factor:
         return ratio, None
-    if not _load_came_and_went(theta, np.asarray(torque, dtype=float)[:stop], antenna, k, window):
+    if not _came_and_went(moment[:, k], window):
         return math.nan, None
     column = ("ty", "tz")[k]
     return ratio, (
