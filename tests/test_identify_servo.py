@@ -218,6 +218,34 @@ def test_cli_fits_each_joints_motor_from_the_recording_that_moves_it(
         assert abs(joint.inertia - true.inertia) < 3 * joint.inertia_error
 
 
+def test_cli_refuses_motors_fitted_from_recordings_of_two_loop_periods(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The servo's gains are designed at one period: a second sweep logged every other sample
+    # (2 ms) is named, in one line, and nothing is written
+    free = simulate(TRUE, Scenario(case="free"), record_commands=True)
+    vertical = simulate(TRUE, Scenario(case="free-vertical"), record_commands=True)
+    metadata = {k: v for k, v in vertical.metadata.items() if k != "sample_period"}
+    halved = dataclasses.replace(
+        vertical,
+        t=vertical.t[::2],
+        theta=vertical.theta[::2],
+        force=vertical.force[::2],
+        torque=vertical.torque[::2],
+        extra={name: column[::2] for name, column in vertical.extra.items()},
+        metadata=metadata,
+    )
+    paths = [tmp_path / "free.csv", tmp_path / "vertical-2ms.csv"]
+    for recording, path in zip((free, halved), paths, strict=True):
+        write_recording(recording, path)
+    out = tmp_path / "lab.toml"
+    assert main(["identify", *map(str, paths), "--out", str(out), "--servo"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert f"{paths[1]}: sampled every 0.002 s, {paths[0]} every 0.001 s" in err
+    assert not out.exists()
+
+
 def test_cli_fits_the_motors_on_a_sweep_into_an_object_and_keeps_the_observer(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

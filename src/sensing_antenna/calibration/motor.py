@@ -56,7 +56,12 @@ from sensing_antenna.control.servo import (
     coupling_torques,
     design_servo,
 )
-from sensing_antenna.recording import COMMAND_COLUMNS, Recording, resample_uniform
+from sensing_antenna.recording import (
+    COMMAND_COLUMNS,
+    PERIOD_CONSISTENCY,
+    Recording,
+    resample_uniform,
+)
 
 __all__ = [
     "DEFAULT_FILTER_BANDWIDTH",
@@ -372,17 +377,28 @@ def identify_motors_from(
 ) -> MotorFit:
     """:func:`identify_motors` on each of ``recordings``, each joint taken from the one that
     determines its J best (smallest relative standard error): a free sweep of each joint, say.
-    The servo's gains (:meth:`MotorFit.designs`) are designed at the first recording's period.
+    The servo's gains (:meth:`MotorFit.designs`) are designed at the recordings' period, the
+    loop's.
 
     Raises
     ------
     IdentificationError
         As :func:`identify_motors`, for the first recording that cannot be used (one that
-        moves no joint included); none given.
+        moves no joint included); none given; recordings whose sample periods differ by more
+        than ``PERIOD_CONSISTENCY`` (the gains hold at one period only).
     """
     if not recordings:
         raise IdentificationError("no recording to fit the motors to")
     fits = [identify_motors(recording, antenna, filter_bandwidth) for recording in recordings]
+    period = fits[0].sample_period
+    for recording, fit in zip(recordings[1:], fits[1:], strict=True):
+        if abs(fit.sample_period - period) > PERIOD_CONSISTENCY * period:
+            raise IdentificationError(
+                f"{recording.source or '<recording>'}: sampled every {fit.sample_period:g} s, "
+                f"{recordings[0].source or 'the first recording'} every {period:g} s: the "
+                "servo's gains hold at one period, the loop's; fit the motors from recordings "
+                "of one loop"
+            )
     best: dict[int, JointFit] = {}
     for joint in (j for fit in fits for j in fit.joints):
         kept = best.get(joint.joint)
