@@ -31,7 +31,7 @@ from sensing_antenna.estimation import (
     estimate,
     gather,
 )
-from sensing_antenna.estimation.front.steps import still_angles_turn
+from sensing_antenna.estimation.front.steps import settled_loads, still_angles_turn
 from sensing_antenna.recording import Recording, read_recording, write_recording
 from sensing_antenna.simulator import DeviceImperfections, Scenario, simulate
 
@@ -401,6 +401,79 @@ def test_an_encoders_flicker_on_the_still_joint_is_no_turn(
         assert result.status is not Status.IMPLAUSIBLE_INPUT, (name, result.reason)
         theta1, theta2 = result.diagnostics["joint_free_motion_gains"]
         assert theta1 > 0.5 and math.isnan(theta2), name
+
+
+def test_a_coarse_encoders_flicker_does_not_take_the_sweeps_start_for_rest(
+    antenna: Antenna,
+) -> None:
+    # 12-bit encoders flickering a count widen the rest tolerance to about 0.015 rad, which
+    # the sweep's slow start takes 0.4 s to leave: the tare then averaged the link's inertia
+    # (3.8e-4 N m about Y^m) and read it as 0.04 g of payload, model_mismatch. The loads
+    # show where the rest ends: the sweep starts at 0.1 s (the scenario's start_time), and
+    # the tare of the torque about Y^m ends within a rest window (50 ms) of it, as on the
+    # exact angles; the forces, where the start stays under the noise, keep the angles' rest.
+    recording = simulate(antenna, Scenario(case="vertical", contact_point=0.8, seed=3))
+    plain = recording.without_ground_truth()
+    step = 2.0 * math.pi / 4096
+    flicker = np.random.default_rng(0).integers(-1, 2, size=plain.theta.shape)
+    theta = (np.round(plain.theta / step) + flicker) * step
+    coarse = dataclasses.replace(plain, theta=np.ascontiguousarray(theta))
+    exact, read = gather(plain, antenna), gather(coarse, antenna)
+    start = round(0.1 / plain.sample_period)
+    for evidence in (exact, read):
+        assert evidence.diagnostics["tare"] == "rest"
+        counts = evidence.diagnostics["tare_samples"]
+        assert start <= counts[4] <= start + 50
+        assert min(counts[:3]) > start + 50
+    # the offsets differ by the weight's moment at a count of elevation (2.2e-2 N m x 1.5e-3)
+    assert abs(read.load_offset[4] - exact.load_offset[4]) < 3.5e-5
+    assert read.payload_mass() == 0.0
+    assert conclude(read, "paper").status is Status.OK
+
+
+def _resting_loads(antenna: Antenna, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A head at rest for n samples: still angles, the link's weight and white noise (1 mN,
+    10 uN m), shapes (n, 2), (n, 3), (n, 3)."""
+    rng = np.random.default_rng(7)
+    theta = np.tile([0.0, 0.1], (n, 1))
+    force = antenna.gravity_force(theta[:, 1]) + rng.normal(0.0, 1e-3, (n, 3))
+    torque = antenna.gravity_torque(theta[:, 1]) + rng.normal(0.0, 1e-5, (n, 3))
+    return theta, force, torque
+
+
+def test_the_rest_ends_where_a_load_starts_to_build(antenna: Antenna) -> None:
+    # A load about Z^m ramping from sample 300 (a sweep's start, 2e-7 N m per sample) leaves
+    # the level of a 50-sample mean (5 standard errors: 7e-6 N m) within 40 samples; that
+    # channel's rest ends where the first window of that run begins, a window before it at
+    # most, and the other channels keep all their samples
+    theta, force, torque = _resting_loads(antenna, 600)
+    torque[300:, 2] += 2e-7 * np.arange(300)
+    settled = settled_loads(theta, force, torque, antenna, 50)
+    assert 300 - 50 <= settled[5] <= 300 + 40
+    assert list(settled[:5]) == [600] * 5
+
+
+def test_a_link_ringing_at_rest_keeps_its_whole_rest(antenna: Antenna) -> None:
+    # Left ringing by the last manoeuvre: 16.4 rad/s (the paper link's free mode) of 1e-4 N m
+    # about Z^m, 14 times the limit of a 50-sample mean (7e-6 N m), decaying over the rest.
+    # Those means leave the level and come back; the rest is cut, if at all, at the last
+    # crossing, within half a period (192 samples) of the end, and the ringing averages out
+    # over what is kept (its mean within the limit of the weight)
+    theta, force, torque = _resting_loads(antenna, 1500)
+    t = np.arange(1500) * 1e-3
+    torque[:, 2] += 1e-4 * np.exp(-t / 0.5) * np.sin(16.4 * t)
+    settled = settled_loads(theta, force, torque, antenna, 50)[5]
+    assert 1500 - 192 <= settled <= 1500
+    kept = torque[:settled, 2] - antenna.gravity_torque(theta[:settled, 1])[:, 2]
+    assert abs(kept.mean()) < 7e-6
+
+
+def test_a_sensor_quieter_than_its_counts_keeps_its_rest(antenna: Antenna) -> None:
+    # Torque counts of 1e-4 N m with noise of a fifth of a count: the second differences read
+    # no noise at all, and the limit is then half a count's
+    theta, force, torque = _resting_loads(antenna, 600)
+    torque = np.round((torque + np.random.default_rng(3).normal(0.0, 2e-5, torque.shape)) / 1e-4)
+    assert list(settled_loads(theta, force, torque * 1e-4, antenna, 50)) == [600] * 6
 
 
 @pytest.mark.parametrize("case", ["azimuthal", "vertical"])

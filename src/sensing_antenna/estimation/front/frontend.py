@@ -664,7 +664,11 @@ class FrontEnd:
         # Standard errors of the tare's means; without a tare the offset is taken as one noise
         # deviation (a sensor tared shortly before, as the simulator's two-count offset).
         torque_noise = signal_noise(self._torque[: hold.stop])[0]
-        root = math.sqrt(start.count) if start.count else 1.0
+        # each group's error from its shortest tare (a channel cut where the sweep's start shows)
+        force_root, torque_root = (
+            math.sqrt(min(part)) if min(part) else 1.0
+            for part in (start.counts[:3], start.counts[3:])
+        )
         converged = self._converged
         diagnostics = self._diagnostics(end)
         diagnostics.update(
@@ -699,8 +703,8 @@ class FrontEnd:
             ratio_noise=noise,
             band=self.band,
             hold_end=hold.stop - 1,
-            offset_error=hold.force_noise / root,
-            torque_offset_error=torque_noise / root,
+            offset_error=hold.force_noise / force_root,
+            torque_offset_error=torque_noise / torque_root,
             gaps=tuple(gaps),
             input_problem=start.input_problem,
             diagnostics=diagnostics,
@@ -734,6 +738,7 @@ class FrontEnd:
                 {
                     "rest_tolerance": self._start.rest_tolerance,
                     "tare": self._start.tare,
+                    "tare_samples": list(self._start.counts),
                     "load_offset": self._start.offset,
                     **self._start.checks,
                 }

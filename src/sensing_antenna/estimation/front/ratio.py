@@ -28,6 +28,8 @@ filter, as in Eq. 21) would instead bias the ratio for several 1/omega_c.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -118,7 +120,11 @@ def filtered_contact_loads(
 
 
 def load_offset(
-    theta: FloatArray, force_m: FloatArray, torque_m: FloatArray, antenna: Antenna
+    theta: FloatArray,
+    force_m: FloatArray,
+    torque_m: FloatArray,
+    antenna: Antenna,
+    counts: Sequence[int] | None = None,
 ) -> FloatArray:
     """Sensor offset: the mean contact loads over samples known to be free of contact.
 
@@ -127,13 +133,19 @@ def load_offset(
     loads R = F - F_g^m and Gamma - Gamma_g^m are zero apart from the offset, the noise and the
     (zero-mean at rest) free vibration, so their mean is the offset.
 
+    ``counts`` (6,): each channel's mean over its own first samples (between 1 and n); all n
+    samples when None.
+
     Returns
     -------
     array, shape (6,)
         Offset of (fx, fy, fz, tx, ty, tz) (N, N m).
     """
     reaction, moment = contact_loads(theta, force_m, torque_m, antenna)
-    return np.asarray(np.hstack([reaction, moment]).mean(axis=0), dtype=float)
+    loads = np.hstack([reaction, moment])
+    if counts is None:
+        return np.asarray(loads.mean(axis=0), dtype=float)
+    return np.array([loads[:count, channel].mean() for channel, count in enumerate(counts)])
 
 
 def perpendicular_ratio(

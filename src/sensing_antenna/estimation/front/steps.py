@@ -44,6 +44,7 @@ from sensing_antenna.units_check import angle_problem, initial_rest, rest_readin
 __all__ = [
     "MAX_FILLED",
     "OUTLIER_PERIODS",
+    "SETTLED_ERRORS",
     "STEP_JITTER",
     "ContactStart",
     "FilledSamples",
@@ -61,11 +62,18 @@ __all__ = [
     "samples",
     "samples_missing",
     "sampling_problem",
+    "settled_loads",
     "still_angles_turn",
     "time_gaps",
 ]
 
 FloatArray = NDArray[np.float64]
+
+#: Standard errors of a rest window's mean load (the channel's white noise over its square
+#: root) by which the loads leave their level where the rest ends (:func:`settled_loads`): the
+#: mean before the window has its own error, so noise alone reaches 5 of these about as often
+#: as 3.5 standard deviations of the difference, and the run must last to the end besides.
+SETTLED_ERRORS = 5.0
 
 
 def samples(duration: float, sample_period: float) -> int:
@@ -322,14 +330,15 @@ def gap_problem(
 @dataclass(frozen=True)
 class ContactStart:
     """What is fixed at the contact sample: rest tolerance (rad), sensor offset (N, N m), the
-    kind of tare and the number of samples it averaged, and the units check of the samples up
-    to t_c: ``input_problem`` (why the recording's loads or angles are not in the format's units
-    and signs, None when they are) and ``checks`` (its numbers, for the diagnostics)."""
+    kind of tare and the number of samples it averaged on each channel (fx, fy, fz, tx, ty,
+    tz), and the units check of the samples up to t_c: ``input_problem`` (why the recording's
+    loads or angles are not in the format's units and signs, None when they are) and
+    ``checks`` (its numbers, for the diagnostics)."""
 
     rest_tolerance: float
     offset: FloatArray
     tare: str
-    count: int
+    counts: tuple[int, ...]
     input_problem: str | None = None
     checks: dict[str, Any] = field(default_factory=dict)
 
@@ -396,20 +405,68 @@ def at_contact(
         # first: a push judged on angles that are no head's is no push (degrees, a glitch)
         problems.insert(0, angles)
     if quiet >= w_rest + 1:
-        # The head rests at the start: the link hangs still, the mean load is the offset.
-        window, tare, where = slice(0, quiet), "rest", "at rest before the contact"
+        # The head rests at the start: the link hangs still, the mean load is the offset; a
+        # coarse encoder sees the sweep start late, the loads see it at once
+        seen = min(quiet + w_rest, contact_index + 1)  # a load that left by quiet shows by then
+        settled = settled_loads(theta[:seen], force[:seen], torque[:seen], antenna, w_rest)
+        counts = tuple(int(c) for c in np.minimum(quiet, np.maximum(settled, w_rest + 1)))
+        tare, where = "rest", "at rest before the contact"
     else:
         end = contact_index - samples(cfg.tare_margin, ts)
-        window, tare = slice(0, max(end, 0)), "approach"
+        counts, tare = (max(end, 0),) * 6, "approach"
         where = "of the approach before the contact"
         if end < w_rest + 1:
-            return ContactStart(tolerance, np.zeros(6), "none", 0, _joined(problems), checks)
-    reading = rest_reading(theta[window], force[window], torque[window], antenna, where)
+            return ContactStart(tolerance, np.zeros(6), "none", (0,) * 6, _joined(problems), checks)
+    # the rest's reading judges the samples every channel counts as rest
+    common, longest = slice(0, min(counts)), slice(0, max(counts))
+    reading = rest_reading(theta[common], force[common], torque[common], antenna, where)
     checks["rest_reading"] = reading.as_dict()
     if reading.problem is not None:
         problems.insert(0, reading.problem)
-    offset = load_offset(theta[window], force[window], torque[window], antenna)
-    return ContactStart(tolerance, offset, tare, window.stop, _joined(problems), checks)
+    offset = load_offset(theta[longest], force[longest], torque[longest], antenna, counts)
+    return ContactStart(tolerance, offset, tare, counts, _joined(problems), checks)
+
+
+def settled_loads(
+    theta: FloatArray, force: FloatArray, torque: FloatArray, antenna: Antenna, window: int
+) -> NDArray[np.int64]:
+    """Number of samples at the start over which each contact-load channel holds its level.
+
+    The head's angles say when it rests only to within the rest tolerance, which a coarse or
+    flickering encoder makes several counts wide: the sweep's start then counts as rest while
+    the link's inertia already loads the sensor, and a tare over it holds that load. Here the
+    loads R = F - F_g^m and Gamma - Gamma_g^m, averaged over each ``window`` samples, are
+    compared with their mean over all the samples before that window: a channel's rest ends
+    where a run of windows begins that each lie more than :data:`SETTLED_ERRORS` standard
+    errors of such a mean from it (the channel's white noise over sqrt(window)) and that lasts
+    to the last sample. Each channel keeps its own: the turn's start shows at once in the torque
+    about the turning axis, while its share in the forces stays under their noise, and a
+    channel's tare is the longer for it. A link that rings at rest leaves that level and comes
+    back, and keeps its rest. Shapes (n, 2), (n, 3), (n, 3); returns shape (6,) for (fx, fy,
+    fz, tx, ty, tz), n for a channel that ends at its level.
+    """
+    n = theta.shape[0]
+    ends = np.full(6, n, dtype=np.int64)
+    if window < 1 or n < 2 * window:
+        return ends
+    reaction, moment = contact_loads(theta, force, torque, antenna)
+    loads = np.hstack([reaction, moment])
+    # a sensor quieter than its resolution reads a zero noise: half a count then, the spread of
+    # a reading that flickers between two counts; a channel that never changes has no limit
+    noises = [max(noise, step / 2.0) for noise, step in map(signal_noise, (force, torque))]
+    per_channel = np.repeat(noises, 3)
+    limits = np.where(per_channel > 0.0, per_channel * SETTLED_ERRORS / math.sqrt(window), np.inf)
+    total = np.vstack([np.zeros((1, 6)), np.cumsum(loads, axis=0)])
+    starts = np.arange(window, n - window + 1)  # each window [s, s + window), s samples before
+    windows = (total[starts + window] - total[starts]) / window
+    before = total[starts] / starts[:, np.newaxis]
+    with np.errstate(invalid="ignore"):
+        left = np.abs(windows - before) > limits
+    for channel in np.flatnonzero(left[-1]):
+        # away from its level at the end: a sweep's start, not a link that rang at rest
+        within = np.flatnonzero(~left[:, channel])
+        ends[channel] = starts[within[-1] + 1] if within.size else window
+    return ends
 
 
 def _joined(problems: list[str]) -> str | None:

@@ -56,6 +56,7 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         tolerance,
         config.bias_min_samples,
         guard=round(config.bias_guard / evidence.sample_period),
+        settled=_rest_samples(evidence),
     )
     x_range = (
         evidence.config.contact_range[0] * link.length,
@@ -175,3 +176,12 @@ def scan(
         return ScanResult(None, 0, last <= inputs.end_index)
     final = with_early_statics_of(inputs, final, caches)
     return ScanResult(final, count, not final.sure and last <= inputs.end_index)
+
+
+def _rest_samples(evidence: Evidence) -> tuple[int, ...] | None:
+    """Samples of the front end's tare at rest on each contact channel (R_y, R_z, Gamma_x,
+    Gamma_y, Gamma_z: where each channel's load settled), None without one."""
+    counts = evidence.diagnostics.get("tare_samples")
+    if evidence.diagnostics.get("tare") != "rest" or not counts:
+        return None
+    return tuple(int(count) for count in counts[1:])

@@ -32,6 +32,7 @@ Without an initial rest the bias is taken as zero and the diagnostics say so.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -254,6 +255,7 @@ def sensor_bias(
     tolerance: float,
     min_samples: int = 20,
     guard: int = 0,
+    settled: Sequence[int] | None = None,
 ) -> SensorBias:
     """Bias of the contact-load channels from the initial rest before the sweep.
 
@@ -272,6 +274,11 @@ def sensor_bias(
     guard : int
         Samples left out before the first one where the head has moved, or before t_c (the
         motion, or the touch, loads the sensor before it is detected).
+    settled : sequence of int, shape (5,), optional
+        Samples at the start over which each channel's load holds its level (the front end's
+        tare at rest, :func:`~sensing_antenna.estimation.front.steps.settled_loads`): the
+        channel's rest ends there at the latest, since a coarse encoder sees the sweep start
+        late.
 
     Returns
     -------
@@ -281,8 +288,10 @@ def sensor_bias(
     moved = np.flatnonzero(np.any(np.abs(theta[:contact_index] - theta[0]) > tolerance, axis=1))
     stop = (int(moved[0]) if moved.size else contact_index) - guard
     k = channels.shape[1]
-    if stop < min_samples:
+    stops = np.full(k, stop) if settled is None else np.minimum(stop, np.asarray(settled))
+    if stops.min() < min_samples:
         return SensorBias(np.zeros(k), np.zeros((k, k)), 0)
-    rest = np.asarray(channels[:stop], dtype=float)
-    variance = rest.var(axis=0, ddof=1) / stop
-    return SensorBias(rest.mean(axis=0), np.diag(variance), stop)
+    rest = [np.asarray(channels[:count, j], dtype=float) for j, count in enumerate(stops)]
+    mean = np.array([part.mean() for part in rest])
+    variance = np.array([part.var(ddof=1) / part.size for part in rest])
+    return SensorBias(mean, np.diag(variance), int(stops.min()))
