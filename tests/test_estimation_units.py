@@ -22,6 +22,7 @@ from sensing_antenna.estimation.front.contact_frame import (
     contact_frame,
     first_rest_index,
     motor_axes,
+    rest_drift_tolerance,
     rest_tolerance,
     signal_noise,
 )
@@ -200,6 +201,32 @@ def test_rest_found_after_ramp_stops() -> None:
     # a window may include at most the last sample of the ramp: 599 or 600.
     assert index in (599, 600)
     assert first_rest_index(theta[:640], 300, 50, tolerance) is None
+
+
+@pytest.mark.parametrize("seed", range(5, 15))
+def test_a_slow_push_within_a_coarse_encoders_tolerance_is_no_rest(seed: int) -> None:
+    # A 12-bit encoder flickering a count (1.5e-3 rad; the peak-to-peak tolerance, 8 noise
+    # deviations, 0.015 rad): a head still turning at 0.1 rad/s moves 5e-3 rad over a 50 ms
+    # rest window, within that tolerance, but drifts 0.01 rad across the 200 ms hold, against a
+    # tolerance of 5 standard deviations of the noise's drift there (1.3e-3 rad). Rest is
+    # found where the turn stops (sample 600), not at the first window.
+    rng = np.random.default_rng(seed)
+    step = 2.0 * math.pi / 4096
+    n = 1200
+    exact = np.zeros((n, 2))
+    exact[:600, 1] = 0.1 * np.arange(600) * TS
+    exact[600:, 1] = exact[599, 1]
+    theta = (np.round(exact / step) + rng.integers(-1, 2, size=exact.shape)) * step
+    config = EstimatorConfig()
+    tolerance = rest_tolerance(theta[:300], config)
+    assert tolerance > 0.1 * 50 * TS  # the turn over a rest window stays within it
+    alone = first_rest_index(theta, 300, 50, tolerance)  # the spread alone: rest mid-turn
+    assert alone is not None and alone < 400
+    drift = rest_drift_tolerance(theta[:300], config, 50, 200, TS)
+    index = first_rest_index(theta, 300, 50, tolerance, drift, 200)
+    # the span's first half may hold the turn's last k samples while their drift, k^2 / 2 of
+    # 1e-4 rad a sample over its 100, stays within the tolerance: k up to about 51
+    assert index is not None and 600 - 60 <= index <= 600
 
 
 def test_signal_noise_estimate() -> None:

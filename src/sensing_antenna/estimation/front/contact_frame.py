@@ -28,10 +28,13 @@ from numpy.typing import NDArray
 from sensing_antenna.estimation.config import EstimatorConfig
 
 __all__ = [
+    "REST_DRIFT_SIGMAS",
+    "REST_SPEED_SHARE",
     "ContactFrame",
     "contact_frame",
     "first_rest_index",
     "motor_axes",
+    "rest_drift_tolerance",
     "rest_tolerance",
     "signal_noise",
     "to_absolute",
@@ -41,6 +44,16 @@ FloatArray = NDArray[np.float64]
 
 #: Candidate instants of t_1 tested per step of :func:`first_rest_index`.
 _REST_CHUNK = 256
+
+#: Standard deviations of the angle noise by which a resting head's drift over its hold may
+#: read (:func:`rest_drift_tolerance`): white noise passes 5 with probability 6e-7 per span.
+REST_DRIFT_SIGMAS = 5.0
+
+#: Share of the head's speed before the touch that a resting head may still turn at over its
+#: hold (:func:`rest_drift_tolerance`): a push still going on turns at about the sweep's speed,
+#: while the link's vibration and the servo's settling move a stopped head by a fraction of a
+#: milliradian either way.
+REST_SPEED_SHARE = 0.1
 
 
 def motor_axes(theta: FloatArray) -> FloatArray:
@@ -113,10 +126,55 @@ def rest_tolerance(theta_before_contact: FloatArray, config: EstimatorConfig) ->
     return max(config.rest_angle_tolerance, config.rest_noise_factor * noise, 3.0 * step)
 
 
+def rest_drift_tolerance(
+    theta_before_contact: FloatArray,
+    config: EstimatorConfig,
+    rest_samples: int,
+    drift_samples: int,
+    sample_period: float,
+) -> float:
+    """Largest drift (rad) of a resting head's angle across ``drift_samples`` intervals (the
+    hold after t_1): the mean of the span's second half less that of its first (h samples
+    each), or inf when the peak-to-peak test (:func:`rest_tolerance` over ``rest_samples``
+    intervals) already tells a push from rest.
+
+    A coarse or flickering encoder widens the peak-to-peak tolerance to several counts, which a
+    slow push stays within for a whole rest window: the test alone then bounds a resting head's
+    speed by more than ``REST_SPEED_SHARE`` of the head's speed over the ``tare_margin`` before
+    the touch. The push's drift still shows in the halves' means, while a stopped head only
+    sways. The tolerance is then the largest of ``REST_DRIFT_SIGMAS`` times what white angle
+    noise s gives the difference (s sqrt(2 / h)), the turn at that share of the speed across
+    the halves' distance, and the floor ``config.rest_angle_tolerance``. A head that did not
+    turn before the touch (an object moved into it) is not judged."""
+    theta = np.asarray(theta_before_contact, dtype=float)
+    back = min(round(config.tare_margin / sample_period), theta.shape[0] - 1)
+    if back < 1:
+        return math.inf
+    tolerance = rest_tolerance(theta, config)
+    turn = float(np.max(np.abs(theta[-1] - theta[-1 - back])))
+    speed = turn / (back * sample_period)
+    if turn <= tolerance or tolerance <= REST_SPEED_SHARE * speed * rest_samples * sample_period:
+        return math.inf
+    noise, _ = signal_noise(theta)
+    half = max((drift_samples + 1) // 2, 1)
+    distance = (drift_samples + 1 - half) * sample_period
+    return max(
+        config.rest_angle_tolerance,
+        REST_DRIFT_SIGMAS * noise * math.sqrt(2.0 / half),
+        REST_SPEED_SHARE * speed * distance,
+    )
+
+
 def first_rest_index(
-    theta: FloatArray, start: int, window_samples: int, tolerance: float
+    theta: FloatArray,
+    start: int,
+    window_samples: int,
+    tolerance: float,
+    drift_tolerance: float = math.inf,
+    drift_samples: int = 0,
 ) -> int | None:
-    """First index i >= start with both angles within ``tolerance`` peak-to-peak on [i, i + w].
+    """First index i >= start with both angles within ``tolerance`` peak-to-peak on [i, i + w]
+    and drifting by at most ``drift_tolerance`` across [i, i + d] (:func:`rest_drift_tolerance`).
 
     Parameters
     ----------
@@ -128,6 +186,13 @@ def first_rest_index(
         w, the number of sample intervals in the rest window.
     tolerance : float
         Peak-to-peak tolerance (rad).
+    drift_tolerance : float
+        Largest difference (rad) between the means of the last and the first halves of
+        [i, i + d].
+    drift_samples : int
+        d, the span the drift is judged over (sample intervals, at least w; w without a finite
+        ``drift_tolerance``): the head must hold for it, and a span longer than the rest window
+        tells a slow turn from noise.
 
     Returns
     -------
@@ -138,18 +203,29 @@ def first_rest_index(
 
     theta = np.asarray(theta, dtype=float)
     w = window_samples
+    d = max(drift_samples, w) if math.isfinite(drift_tolerance) else w
+    half = max((d + 1) // 2, 1)
     # The largest and smallest angle over every [i, i + w] by running filters, O(n) whatever w
     # (the window starts at i: origin -(w + 1) // 2); max and min are exact, so the spread is
     # the same number as over each window's own samples
     size, origin = w + 1, -((w + 1) // 2)
-    # candidates i in [start, n - w), looked at a few hundred at a time: the head usually rests
+    # candidates i in [start, n - d), looked at a few hundred at a time: the head usually rests
     # soon after t_c
-    for first in range(start, theta.shape[0] - w, _REST_CHUNK):
-        stop = min(first + _REST_CHUNK, theta.shape[0] - w)
-        segment = theta[first : stop + w]
+    for first in range(start, theta.shape[0] - d, _REST_CHUNK):
+        stop = min(first + _REST_CHUNK, theta.shape[0] - d)
+        segment = theta[first : stop + d]
         highest = maximum_filter1d(segment, size, axis=0, origin=origin)[: stop - first]
         lowest = minimum_filter1d(segment, size, axis=0, origin=origin)[: stop - first]
-        hits = np.flatnonzero(np.all(highest - lowest <= tolerance, axis=1))
+        still = np.all(highest - lowest <= tolerance, axis=1)
+        if math.isfinite(drift_tolerance):
+            # the halves [i, i + h) and [i + d + 1 - h, i + d + 1) of each span, by sums
+            total = np.vstack([np.zeros((1, theta.shape[1])), np.cumsum(segment, axis=0)])
+            first_half = total[half : half + stop - first] - total[: stop - first]
+            ends = np.arange(stop - first) + d + 1
+            second_half = total[ends] - total[ends - half]
+            drift = np.abs(second_half - first_half) / half
+            still &= np.all(drift <= drift_tolerance, axis=1)
+        hits = np.flatnonzero(still)
         if hits.size:
             return first + int(hits[0])
     return None

@@ -42,7 +42,11 @@ from sensing_antenna.detection.filters import FirstOrderLowPass
 from sensing_antenna.detection.push import PushCriterion, PushMonitor
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation.config import EstimatorConfig, no_t1_reason
-from sensing_antenna.estimation.front.contact_frame import first_rest_index, signal_noise
+from sensing_antenna.estimation.front.contact_frame import (
+    first_rest_index,
+    rest_drift_tolerance,
+    signal_noise,
+)
 from sensing_antenna.estimation.front.evidence import Evidence, search_band
 from sensing_antenna.estimation.front.outcome import EarlyOutcome, FrontTrace
 from sensing_antenna.estimation.front.ratio import (
@@ -68,6 +72,7 @@ from sensing_antenna.estimation.front.steps import (
     dead_channel,
     fill_missing,
     hold_push,
+    hold_samples,
     planned_end,
     ratio_tolerance,
     samples,
@@ -165,7 +170,7 @@ class FrontEnd:
         self.band = search_band(antenna.link, cfg)
         self._notes = dict(diagnostics) if diagnostics is not None else {"resampled": False}
         self._w_rest = samples(cfg.rest_window, ts)
-        self._w_hold = max(samples(cfg.frame_window, ts), self._w_rest)
+        self._w_hold = hold_samples(cfg, ts)
         self._w_conv = samples(cfg.convergence_window, ts)
         self._n_wait = samples(cfg.max_ratio_wait, ts)
         # Samples too coarse for the vibration are refused before any filter is built for them
@@ -543,10 +548,16 @@ class FrontEnd:
             if self._monitor is not None:
                 self._rest = self._monitor.push_index
             else:
-                # windows [i, i + w] from t_c on, those ending before this block tested already
-                start = max(self._contact, first - self._w_rest)
+                # spans [i, i + d] (the hold's) from t_c on, those ending before this block
+                # tested already
+                start = max(self._contact, first - self._w_hold)
                 self._rest = first_rest_index(
-                    self._theta[:stop], start, self._w_rest, self._start.rest_tolerance
+                    self._theta[:stop],
+                    start,
+                    self._w_rest,
+                    self._start.rest_tolerance,
+                    self._start.rest_drift,
+                    self._w_hold,
                 )
             if self._rest is None:
                 return None
@@ -825,6 +836,22 @@ class FrontEnd:
                 )
             return self._stop(outcome)
         assert self._start is not None
+        if self._rest is None and self._monitor is None:
+            # the samples ended within a hold of the head's rest: its drift judged over what
+            # is left, the rest window at the least
+            start = self._start
+            left = max(n - 1 - self._contact - self._w_rest, 0)
+            span = min(self._w_hold, max(left, self._w_rest))
+            drift = rest_drift_tolerance(
+                self._theta[: self._contact + 1],
+                self.config,
+                self._w_rest,
+                span,
+                self.sample_period,
+            )
+            self._rest = first_rest_index(
+                self._theta[:n], self._contact, self._w_rest, start.rest_tolerance, drift, span
+            )
         if self._rest is None:
             reason = no_t1_reason(self.config, self._start.rest_tolerance)
             return self._stop(self._early(Status.PUSH_NOT_REACHED, reason))

@@ -35,6 +35,7 @@ from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import (
     ContactFrame,
     contact_frame,
+    rest_drift_tolerance,
     rest_tolerance,
     signal_noise,
 )
@@ -55,6 +56,7 @@ __all__ = [
     "free_motion_gain",
     "gap_problem",
     "hold_push",
+    "hold_samples",
     "hold_window",
     "joint_free_motion_gains",
     "planned_end",
@@ -79,6 +81,12 @@ SETTLED_ERRORS = 5.0
 def samples(duration: float, sample_period: float) -> int:
     """Number of sample intervals in ``duration`` (at least one)."""
     return max(1, round(duration / sample_period))
+
+
+def hold_samples(cfg: EstimatorConfig, sample_period: float) -> int:
+    """Sample intervals of the hold after t_1 the front end judges (``frame_window``, at least
+    ``rest_window``), over which the head must not drift either."""
+    return max(samples(cfg.frame_window, sample_period), samples(cfg.rest_window, sample_period))
 
 
 def hold_window(rest_index: int, n: int, cfg: EstimatorConfig, ts: float) -> slice:
@@ -329,11 +337,12 @@ def gap_problem(
 
 @dataclass(frozen=True)
 class ContactStart:
-    """What is fixed at the contact sample: rest tolerance (rad), sensor offset (N, N m), the
-    kind of tare and the number of samples it averaged on each channel (fx, fy, fz, tx, ty,
-    tz), and the units check of the samples up to t_c: ``input_problem`` (why the recording's
-    loads or angles are not in the format's units and signs, None when they are) and
-    ``checks`` (its numbers, for the diagnostics)."""
+    """What is fixed at the contact sample: rest tolerance (rad, peak-to-peak; ``rest_drift``,
+    across the hold, inf when not judged: :func:`.contact_frame.first_rest_index`), sensor
+    offset (N, N m), the kind of tare and the number of samples it averaged on each channel
+    (fx, fy, fz, tx, ty, tz), and the units check of the samples up to t_c: ``input_problem``
+    (why the recording's loads or angles are not in the format's units and signs, None when
+    they are) and ``checks`` (its numbers, for the diagnostics)."""
 
     rest_tolerance: float
     offset: FloatArray
@@ -341,6 +350,7 @@ class ContactStart:
     counts: tuple[int, ...]
     input_problem: str | None = None
     checks: dict[str, Any] = field(default_factory=dict)
+    rest_drift: float = math.inf
 
 
 def at_contact(
@@ -359,6 +369,7 @@ def at_contact(
     before = slice(0, contact_index + 1)
     tolerance = rest_tolerance(theta[before], cfg)
     w_rest = samples(cfg.rest_window, ts)
+    drift = rest_drift_tolerance(theta[before], cfg, w_rest, hold_samples(cfg, ts), ts)
     quiet = initial_rest(theta[before], tolerance)
     problems: list[str] = []
     checks: dict[str, Any] = {}
@@ -416,7 +427,9 @@ def at_contact(
         counts, tare = (max(end, 0),) * 6, "approach"
         where = "of the approach before the contact"
         if end < w_rest + 1:
-            return ContactStart(tolerance, np.zeros(6), "none", (0,) * 6, _joined(problems), checks)
+            return ContactStart(
+                tolerance, np.zeros(6), "none", (0,) * 6, _joined(problems), checks, drift
+            )
     # the rest's reading judges the samples every channel counts as rest
     common, longest = slice(0, min(counts)), slice(0, max(counts))
     reading = rest_reading(theta[common], force[common], torque[common], antenna, where)
@@ -424,7 +437,7 @@ def at_contact(
     if reading.problem is not None:
         problems.insert(0, reading.problem)
     offset = load_offset(theta[longest], force[longest], torque[longest], antenna, counts)
-    return ContactStart(tolerance, offset, tare, counts, _joined(problems), checks)
+    return ContactStart(tolerance, offset, tare, counts, _joined(problems), checks, drift)
 
 
 def settled_loads(
@@ -439,11 +452,13 @@ def settled_loads(
     compared with their mean over all the samples before that window: a channel's rest ends
     where a run of windows begins that each lie more than :data:`SETTLED_ERRORS` standard
     errors of such a mean from it (the channel's white noise over sqrt(window)) and that lasts
-    to the last sample. Each channel keeps its own: the turn's start shows at once in the torque
-    about the turning axis, while its share in the forces stays under their noise, and a
-    channel's tare is the longer for it. A link that rings at rest leaves that level and comes
-    back, and keeps its rest. Shapes (n, 2), (n, 3), (n, 3); returns shape (6,) for (fx, fy,
-    fz, tx, ty, tz), n for a channel that ends at its level.
+    to the last sample, or where the first such window begins when the load, against the mean
+    before that window, went one way only (a sweep's short start that loaded the sensor and let
+    go before the angles moved). Each channel keeps its own: the turn's start shows at once in
+    the torque about the turning axis, while its share in the forces stays under their noise,
+    and a channel's tare is the longer for it. A link that rings at rest swings both ways about
+    its level and comes back, and keeps its rest. Shapes (n, 2), (n, 3), (n, 3); returns shape
+    (6,) for (fx, fy, fz, tx, ty, tz), n for a channel that ends at its level.
     """
     n = theta.shape[0]
     ends = np.full(6, n, dtype=np.int64)
@@ -462,10 +477,20 @@ def settled_loads(
     before = total[starts] / starts[:, np.newaxis]
     with np.errstate(invalid="ignore"):
         left = np.abs(windows - before) > limits
-    for channel in np.flatnonzero(left[-1]):
-        # away from its level at the end: a sweep's start, not a link that rang at rest
-        within = np.flatnonzero(~left[:, channel])
-        ends[channel] = starts[within[-1] + 1] if within.size else window
+    for channel in np.flatnonzero(left.any(axis=0)):
+        first = int(np.argmax(left[:, channel]))
+        start = int(starts[first])
+        # against the level before the load first left it, a load that went one way only (a
+        # sweep's start, or a pulse that came and went before the angles moved) ends the rest
+        # there, while a link ringing at rest swings both ways about it
+        level = total[start, channel] / start
+        away = windows[first:, channel] - level
+        if not (away.max() > limits[channel] and away.min() < -limits[channel]):
+            ends[channel] = start
+        elif left[-1, channel]:
+            # away from its level at the end: the last run of departures, where it began
+            within = np.flatnonzero(~left[:, channel])
+            ends[channel] = starts[within[-1] + 1] if within.size else window
     return ends
 
 
