@@ -995,11 +995,9 @@ def test_second_mode_chooses_the_branch_near_the_peak() -> None:
 def test_the_rest_bias_of_a_noiseless_device_is_zero(case: str) -> None:
     # No sensor offset, no noise, a device 15 % stiffer than the nominal link and a model with
     # the calibrated T_e: what the rest's mean holds besides the offset is the model's error.
-    # With the sag from T_e it is under 1e-6 (N, N m); the sweep's start would add 2e-5 N and
-    # 8e-6 N m, and the sag from the nominal E I 1.4e-5 N m (vertical). 2e-6 is under the rest
-    # mean's noise standard error at noise 1 (3e-6 N m). The rest ends before the sweep's
-    # start twice over: the guard before the angles move, and the front end's tare, which ends
-    # where the loads leave their first level.
+    # With the guard and the sag from T_e it is under 1e-6 (N, N m); without the guard the
+    # sweep's start adds 2e-5 N and 8e-6 N m, and the sag from the nominal E I 1.4e-5 N m
+    # (vertical). 2e-6 is under the rest mean's noise standard error at noise 1 (3e-6 N m).
     base = paper_antenna()
     device = replace(base, link=replace(base.link, youngs_modulus=132.65e9))
     model = base.with_calibrated_t(device.link.theoretical_t)
@@ -1009,8 +1007,7 @@ def test_the_rest_bias_of_a_noiseless_device_is_zero(case: str) -> None:
     assert bias.n_samples > 50
     np.testing.assert_allclose(bias.bias, 0.0, atol=2e-6)
     unguarded = scan_inputs(evidence, FastConfig(bias_guard=0.0)).bias
-    assert 0 < unguarded.n_samples <= min(evidence.diagnostics["tare_samples"])
-    np.testing.assert_allclose(unguarded.bias, 0.0, atol=2e-6)
+    assert np.max(np.abs(unguarded.bias)) > 5e-6
 
 
 def test_the_second_mode_declares_a_noisy_far_contact_online_as_offline(

@@ -147,15 +147,19 @@ def rest_drift_tolerance(
     the halves' distance, and the floor ``config.rest_angle_tolerance``. A head that did not
     turn before the touch (an object moved into it) is not judged."""
     theta = np.asarray(theta_before_contact, dtype=float)
-    back = min(round(config.tare_margin / sample_period), theta.shape[0] - 1)
-    if back < 1:
-        return math.inf
-    tolerance = rest_tolerance(theta, config)
-    turn = float(np.max(np.abs(theta[-1] - theta[-1 - back])))
-    speed = turn / (back * sample_period)
-    if turn <= tolerance or tolerance <= REST_SPEED_SHARE * speed * rest_samples * sample_period:
+    window = max(rest_samples, 1)
+    back = min(round(config.tare_margin / sample_period), theta.shape[0])
+    if back < 2 * window:
         return math.inf
     noise, _ = signal_noise(theta)
+    # the head's turn between the means of a rest window at each end of the margin, which an
+    # encoder's flicker does not blur
+    turn = float(np.max(np.abs(theta[-window:].mean(axis=0) - theta[-back:][:window].mean(axis=0))))
+    unseen = max(config.rest_angle_tolerance, REST_DRIFT_SIGMAS * noise * math.sqrt(2.0 / window))
+    speed = turn / ((back - window) * sample_period)
+    limit = REST_SPEED_SHARE * speed * rest_samples * sample_period
+    if turn <= unseen or rest_tolerance(theta, config) <= limit:
+        return math.inf
     half = max((drift_samples + 1) // 2, 1)
     distance = (drift_samples + 1 - half) * sample_period
     return max(

@@ -837,25 +837,32 @@ class FrontEnd:
             return self._stop(outcome)
         assert self._start is not None
         if self._rest is None and self._monitor is None:
-            # the samples ended within a hold of the head's rest: its drift judged over what
-            # is left, the rest window at the least
-            start = self._start
-            left = max(n - 1 - self._contact - self._w_rest, 0)
-            span = min(self._w_hold, max(left, self._w_rest))
-            drift = rest_drift_tolerance(
-                self._theta[: self._contact + 1],
-                self.config,
-                self._w_rest,
-                span,
-                self.sample_period,
-            )
-            self._rest = first_rest_index(
-                self._theta[:n], self._contact, self._w_rest, start.rest_tolerance, drift, span
-            )
+            # the samples ended within a hold of the head's rest: its drift judged over the
+            # longest span left after a candidate, a rest window at the least
+            self._rest = self._rest_in_what_is_left(n)
         if self._rest is None:
             reason = no_t1_reason(self.config, self._start.rest_tolerance)
             return self._stop(self._early(Status.PUSH_NOT_REACHED, reason))
         return self._stop(self._evidence(n - 1, complete=False))
+
+    def _rest_in_what_is_left(self, n: int) -> int | None:
+        """t_1 among the last samples, which hold less than a hold after it: the drift judged
+        over spans shrinking from the hold's to the rest window's, the first span that finds a
+        rest giving it."""
+        assert self._start is not None and self._contact is not None
+        theta = self._theta[:n]
+        w_rest, span = self._w_rest, self._w_hold
+        while span >= w_rest:
+            drift = rest_drift_tolerance(
+                theta[: self._contact + 1], self.config, w_rest, span, self.sample_period
+            )
+            rest = first_rest_index(
+                theta, self._contact, w_rest, self._start.rest_tolerance, drift, span
+            )
+            if rest is not None or not math.isfinite(drift):
+                return rest
+            span -= w_rest
+        return None
 
     def trace(self, outcome: Gathered | None = None) -> FrontTrace:
         """What the front end saw over every sample fed; ``outcome`` (or an evidence from

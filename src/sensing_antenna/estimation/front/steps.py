@@ -452,13 +452,15 @@ def settled_loads(
     compared with their mean over all the samples before that window: a channel's rest ends
     where a run of windows begins that each lie more than :data:`SETTLED_ERRORS` standard
     errors of such a mean from it (the channel's white noise over sqrt(window)) and that lasts
-    to the last sample, or where the first such window begins when the load, against the mean
-    before that window, went one way only (a sweep's short start that loaded the sensor and let
-    go before the angles moved). Each channel keeps its own: the turn's start shows at once in
-    the torque about the turning axis, while its share in the forces stays under their noise,
-    and a channel's tare is the longer for it. A link that rings at rest swings both ways about
-    its level and comes back, and keeps its rest. Shapes (n, 2), (n, 3), (n, 3); returns shape
-    (6,) for (fx, fy, fz, tx, ty, tz), n for a channel that ends at its level.
+    to the last sample, when the load went one way only against the mean before that run's
+    first window; or where the first departing window begins when the load went one way only
+    from there (a sweep's short start that loaded the sensor and let go before the angles
+    moved). Each channel keeps its own: the turn's start shows at once in the torque about the
+    turning axis, while its share in the forces stays under their noise, and a channel's tare is
+    the longer for it. A link that rings at rest swings both ways about its level, and keeps
+    its rest. Shapes (n, 2), (n, 3), (n, 3); returns shape (6,) for (fx, fy, fz, tx, ty, tz), n
+    for a channel that ends at its level, or whose level was not held over one and a half
+    windows (a link ringing from the start).
     """
     n = theta.shape[0]
     ends = np.full(6, n, dtype=np.int64)
@@ -466,9 +468,13 @@ def settled_loads(
         return ends
     reaction, moment = contact_loads(theta, force, torque, antenna)
     loads = np.hstack([reaction, moment])
-    # a sensor quieter than its resolution reads a zero noise: half a count then, the spread of
-    # a reading that flickers between two counts; a channel that never changes has no limit
-    noises = [max(noise, step / 2.0) for noise, step in map(signal_noise, (force, torque))]
+    # the noise of the loads compared (an angle's flicker reaches them through the weight); a
+    # sensor quieter than its resolution reads a zero noise: half a count then, the spread of a
+    # reading that flickers between two counts; a channel that never changes has no limit
+    noises = [
+        max(signal_noise(part)[0], signal_noise(raw)[1] / 2.0)
+        for part, raw in ((reaction, force), (moment, torque))
+    ]
     per_channel = np.repeat(noises, 3)
     limits = np.where(per_channel > 0.0, per_channel * SETTLED_ERRORS / math.sqrt(window), np.inf)
     total = np.vstack([np.zeros((1, 6)), np.cumsum(loads, axis=0)])
@@ -477,21 +483,40 @@ def settled_loads(
     before = total[starts] / starts[:, np.newaxis]
     with np.errstate(invalid="ignore"):
         left = np.abs(windows - before) > limits
-    for channel in np.flatnonzero(left.any(axis=0)):
-        first = int(np.argmax(left[:, channel]))
-        start = int(starts[first])
-        # against the level before the load first left it, a load that went one way only (a
-        # sweep's start, or a pulse that came and went before the angles moved) ends the rest
-        # there, while a link ringing at rest swings both ways about it
-        level = total[start, channel] / start
-        away = windows[first:, channel] - level
-        if not (away.max() > limits[channel] and away.min() < -limits[channel]):
-            ends[channel] = start
-        elif left[-1, channel]:
-            # away from its level at the end: the last run of departures, where it began
-            within = np.flatnonzero(~left[:, channel])
-            ends[channel] = starts[within[-1] + 1] if within.size else window
+    # a level is trusted once it held over one and a half rest windows: the first comparisons,
+    # against a mean of fewer samples, are those the record's first samples bias most (the last
+    # manoeuvre's ringing, which a sweep's start never precedes by less than a rest window)
+    trusted = 2 * starts >= 3 * window
+    for channel in map(int, np.flatnonzero((left & trusted[:, np.newaxis]).any(axis=0))):
+        runs = left[:, channel]
+        first = int(np.argmax(runs))
+        if trusted[first] and _one_way(total, windows, starts, first, channel, limits[channel]):
+            # a sweep's start, or a pulse that came and went before the angles moved
+            ends[channel] = starts[first]
+        elif runs[-1]:
+            # away at the end after swinging both ways: the last run of departures, if the
+            # load went one way from where it began (a sweep that started while the link rang)
+            last = int(np.flatnonzero(~runs)[-1]) + 1 if not runs.all() else 0
+            if trusted[last] and _one_way(total, windows, starts, last, channel, limits[channel]):
+                ends[channel] = starts[last]
     return ends
+
+
+def _one_way(
+    total: FloatArray,
+    windows: FloatArray,
+    starts: NDArray[np.int64],
+    first: int,
+    channel: int,
+    limit: float,
+) -> bool:
+    """Whether the window means of a load (``windows``, rest windows starting at ``starts``)
+    from the ``first`` on left the mean of the samples before it (``total``: cumulative sums)
+    on one side only, by more than ``limit``; a link ringing about its level swings both
+    ways."""
+    start = int(starts[first])
+    away = windows[first:, channel] - total[start, channel] / start
+    return not (away.max() > limit and away.min() < -limit)
 
 
 def _joined(problems: list[str]) -> str | None:
