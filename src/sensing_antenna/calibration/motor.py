@@ -413,6 +413,6 @@ def identify_motors_from(
         joints=tuple(best[number] for number in sorted(best)),
         skipped=tuple(sorted(skipped.items())),
         filter_bandwidth=float(filter_bandwidth),
-        sample_period=fits[0].sample_period,
+        sample_period=period,
         source=", ".join(sources) if sources else None,
     )

@@ -129,14 +129,15 @@ def rest_tolerance(theta_before_contact: FloatArray, config: EstimatorConfig) ->
 def rest_drift_tolerance(
     theta_before_contact: FloatArray,
     config: EstimatorConfig,
+    tolerance: float,
     rest_samples: int,
     drift_samples: int,
     sample_period: float,
 ) -> float:
     """Largest drift (rad) of a resting head's angle across ``drift_samples`` intervals (the
     hold after t_1): the mean of the span's second half less that of its first (h samples
-    each), or inf when the peak-to-peak test (:func:`rest_tolerance` over ``rest_samples``
-    intervals) already tells a push from rest.
+    each), or inf when the peak-to-peak test (``tolerance``, :func:`rest_tolerance` of the
+    same samples, over ``rest_samples`` intervals) already tells a push from rest.
 
     A coarse or flickering encoder widens the peak-to-peak tolerance to several counts, which a
     slow push stays within for a whole rest window: the test alone then bounds a resting head's
@@ -158,7 +159,7 @@ def rest_drift_tolerance(
     unseen = max(config.rest_angle_tolerance, REST_DRIFT_SIGMAS * noise * math.sqrt(2.0 / window))
     speed = turn / ((back - window) * sample_period)
     limit = REST_SPEED_SHARE * speed * rest_samples * sample_period
-    if turn <= unseen or rest_tolerance(theta, config) <= limit:
+    if turn <= unseen or tolerance <= limit:
         return math.inf
     half = max((drift_samples + 1) // 2, 1)
     distance = (drift_samples + 1 - half) * sample_period

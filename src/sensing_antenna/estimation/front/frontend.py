@@ -850,15 +850,13 @@ class FrontEnd:
         over spans shrinking from the hold's to the rest window's, the first span that finds a
         rest giving it."""
         assert self._start is not None and self._contact is not None
-        theta = self._theta[:n]
+        theta, tolerance = self._theta[:n], self._start.rest_tolerance
         w_rest, span = self._w_rest, self._w_hold
         while span >= w_rest:
             drift = rest_drift_tolerance(
-                theta[: self._contact + 1], self.config, w_rest, span, self.sample_period
+                theta[: self._contact + 1], self.config, tolerance, w_rest, span, self.sample_period
             )
-            rest = first_rest_index(
-                theta, self._contact, w_rest, self._start.rest_tolerance, drift, span
-            )
+            rest = first_rest_index(theta, self._contact, w_rest, tolerance, drift, span)
             if rest is not None or not math.isfinite(drift):
                 return rest
             span -= w_rest

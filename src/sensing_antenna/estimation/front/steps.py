@@ -369,7 +369,7 @@ def at_contact(
     before = slice(0, contact_index + 1)
     tolerance = rest_tolerance(theta[before], cfg)
     w_rest = samples(cfg.rest_window, ts)
-    drift = rest_drift_tolerance(theta[before], cfg, w_rest, hold_samples(cfg, ts), ts)
+    drift = rest_drift_tolerance(theta[before], cfg, tolerance, w_rest, hold_samples(cfg, ts), ts)
     quiet = initial_rest(theta[before], tolerance)
     problems: list[str] = []
     checks: dict[str, Any] = {}
@@ -493,10 +493,10 @@ def settled_loads(
         if trusted[first] and _one_way(total, windows, starts, first, channel, limits[channel]):
             # a sweep's start, or a pulse that came and went before the angles moved
             ends[channel] = starts[first]
-        elif runs[-1]:
+        elif runs[-1] and not runs.all():
             # away at the end after swinging both ways: the last run of departures, if the
             # load went one way from where it began (a sweep that started while the link rang)
-            last = int(np.flatnonzero(~runs)[-1]) + 1 if not runs.all() else 0
+            last = int(np.flatnonzero(~runs)[-1]) + 1
             if trusted[last] and _one_way(total, windows, starts, last, channel, limits[channel]):
                 ends[channel] = starts[last]
     return ends
