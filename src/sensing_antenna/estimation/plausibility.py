@@ -187,7 +187,7 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
                 "curves were checked to",
             )
         )
-    if evidence.diagnostics.get("tare") == "none":
+    if evidence.tare == "none":
         found.append((Status.UNCERTAIN, _untared(evidence)))
     payload = _payload_problem(evidence, estimate, notes)
     if payload is not None:
@@ -461,7 +461,7 @@ def _payload_problem(
     notes["payload_spread"] = spread
     if not spread > limit:
         return None
-    if evidence.diagnostics.get("tare") == "approach":
+    if evidence.tare == "approach":
         # no rest at the start: the moment was read while the head moved towards the contact
         return (
             f"before the contact the link's moment ty reads {excess:.3g} N m more than the "
@@ -594,7 +594,7 @@ def _work_problem(
         return None
     if float(t[k] - t[0]) >= cfg.tare_margin:
         start = int(np.searchsorted(t, t[k] - cfg.tare_margin))
-    elif evidence.diagnostics.get("tare") == "rest":
+    elif evidence.tare == "rest":
         start = 0
     else:
         return None

@@ -29,7 +29,7 @@ from sensing_antenna.estimation.front.spikes import (
     spike_floor,
     spike_longest,
 )
-from sensing_antenna.estimation.front.steps import gap_problem
+from sensing_antenna.estimation.front.steps import TareKind, gap_problem
 
 if TYPE_CHECKING:
     from sensing_antenna.estimation.front.outcome import FrontTrace
@@ -216,6 +216,11 @@ class Evidence:
         stops early (``fast``) may not declare before it.
     offset_error, torque_offset_error : float
         Standard errors of the force (N) and torque (N m) offsets removed by the tare.
+    tare : {"rest", "approach", "none"}
+        Where the offset was read (:data:`~.steps.TareKind`).
+    tare_samples : tuple of int, length 6
+        Samples the tare averaged on each channel (fx, fy, fz, tx, ty, tz): each channel's rest
+        ends where its load leaves its level (docs/estimation.md, step 2).
     gaps : tuple of (float, float)
         The steps of the time stamps (s, s) that missed more than ``config.gap_limit`` samples
         (those known by t_e in a stream); :meth:`gap_within` judges them over a method's own
@@ -253,6 +258,8 @@ class Evidence:
     hold_end: int = 0
     offset_error: float = 0.0
     torque_offset_error: float = 0.0
+    tare: TareKind = "rest"
+    tare_samples: tuple[int, ...] = ()
     gaps: tuple[tuple[float, float], ...] = ()
     input_problem: str | None = None
     diagnostics: dict[str, Any] = field(default_factory=dict)
@@ -527,7 +534,7 @@ class Evidence:
         """:meth:`payload_mass` as the fast method carries it (kg): 0 when the tare was read
         over the approach, whose loads hold the head's motion, which the reading cannot tell
         from weight (the plausibility layer's payload check words that case)."""
-        return self.payload_mass() if self.diagnostics.get("tare") != "approach" else 0.0
+        return self.payload_mass() if self.tare != "approach" else 0.0
 
     def payload_shifts(self, x_c: FloatArray) -> FloatArray:
         """How much lower (rad/s) omega_1 rings at contact points ``x_c`` (m, shape (G,)) on a

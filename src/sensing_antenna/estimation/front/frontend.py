@@ -716,6 +716,8 @@ class FrontEnd:
             hold_end=hold.stop - 1,
             offset_error=hold.force_noise / force_root,
             torque_offset_error=torque_noise / torque_root,
+            tare=start.tare,
+            tare_samples=start.counts,
             gaps=tuple(gaps),
             input_problem=start.input_problem,
             diagnostics=diagnostics,

@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,6 +50,7 @@ __all__ = [
     "ContactStart",
     "FilledSamples",
     "HoldPush",
+    "TareKind",
     "at_contact",
     "dead_channel",
     "fill_missing",
@@ -335,6 +336,12 @@ def gap_problem(
     return None
 
 
+#: Where the sensor offset was read: "rest" (the head still before the contact), "approach"
+#: (the approach's loads, the recording starting in motion) or "none" (too few samples to read
+#: it: the loads are taken as they are).
+TareKind = Literal["rest", "approach", "none"]
+
+
 @dataclass(frozen=True)
 class ContactStart:
     """What is fixed at the contact sample: rest tolerance (rad, peak-to-peak; ``rest_drift``,
@@ -346,7 +353,7 @@ class ContactStart:
 
     rest_tolerance: float
     offset: FloatArray
-    tare: str
+    tare: TareKind
     counts: tuple[int, ...]
     input_problem: str | None = None
     checks: dict[str, Any] = field(default_factory=dict)
@@ -421,7 +428,8 @@ def at_contact(
         seen = min(quiet + w_rest, contact_index + 1)  # a load that left by quiet shows by then
         settled = settled_loads(theta[:seen], force[:seen], torque[:seen], antenna, w_rest)
         counts = tuple(int(c) for c in np.minimum(quiet, np.maximum(settled, w_rest + 1)))
-        tare, where = "rest", "at rest before the contact"
+        tare: TareKind = "rest"
+        where = "at rest before the contact"
     else:
         end = contact_index - samples(cfg.tare_margin, ts)
         counts, tare = (max(end, 0),) * 6, "approach"

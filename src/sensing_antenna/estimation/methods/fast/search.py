@@ -181,7 +181,6 @@ def scan(
 def _rest_samples(evidence: Evidence) -> tuple[int, ...] | None:
     """Samples of the front end's tare at rest on each contact channel (R_y, R_z, Gamma_x,
     Gamma_y, Gamma_z: where each channel's load settled), None without one."""
-    counts = evidence.diagnostics.get("tare_samples")
-    if evidence.diagnostics.get("tare") != "rest" or not counts:
+    if evidence.tare != "rest" or not evidence.tare_samples:
         return None
-    return tuple(int(count) for count in counts[1:])
+    return evidence.tare_samples[1:]
