@@ -235,6 +235,30 @@ def test_device_and_calibration_sections_load(tmp_path: Path) -> None:
     assert plain.load_device() == plain.load_antenna()
 
 
+def test_the_calibration_may_push_otherwise_than_the_runs(tmp_path: Path) -> None:
+    from sensing_antenna.campaign.simulated import calibration_scenario, check_scenario
+
+    # a lab calibrates T_e with gentle pushes and then pushes its runs hard
+    hard = GOOD + "push = 0.25\n" + DEVICE_AND_CALIBRATION
+    gentle = hard + "[calibration.scenario]\npush = 0.03\n"
+    spec = load_campaign_spec(write(tmp_path, gentle))
+    assert spec.scenario == {"noise_scale": 0.5, "push": 0.25}
+    assert calibration_scenario(spec) == {"noise_scale": 0.5, "push": 0.03}
+    check_scenario(spec)
+    plain = load_campaign_spec(write(tmp_path, hard))
+    assert calibration_scenario(plain) == plain.scenario
+    assert spec.preparation_fingerprint() != plain.preparation_fingerprint()
+    # its fields are checked as the runs' are, and named as its own
+    bad = load_campaign_spec(write(tmp_path, hard + "[calibration.scenario]\npush = -1.0\n"))
+    with pytest.raises(CampaignSpecError, match=r"calibration\.scenario\.push: .*> 0"):
+        check_scenario(bad)
+    bad = load_campaign_spec(write(tmp_path, hard + "[calibration.scenario]\ncolour = 1\n"))
+    with pytest.raises(CampaignSpecError, match=r"calibration\.scenario\.colour: not a Scenario"):
+        check_scenario(bad)
+    with pytest.raises(CampaignSpecError, match=r"calibration\.scenario: must be a table"):
+        load_campaign_spec(write(tmp_path, hard.replace("loss", "scenario = 3\nloss")))
+
+
 def test_device_and_calibration_change_the_fingerprints(tmp_path: Path) -> None:
     a = load_campaign_spec(write(tmp_path, GOOD + DEVICE_AND_CALIBRATION))
     b = load_campaign_spec(write(tmp_path, GOOD + DEVICE_AND_CALIBRATION.replace("130e9", "131e9")))

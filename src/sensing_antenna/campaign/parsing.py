@@ -369,7 +369,16 @@ def _parse_device(data: Any, source: str, base_dir: Path | None) -> DeviceSpec:
 def _parse_calibration(data: Any, source: str) -> CalibrationStep:
     if not isinstance(data, Mapping):
         raise CampaignSpecError("calibration", "must be a table", source)
-    known = ("enabled", "case", "contact_points", "repeats", "loss", "sensor", "tip_mass")
+    known = (
+        "enabled",
+        "case",
+        "contact_points",
+        "repeats",
+        "loss",
+        "sensor",
+        "tip_mass",
+        "scenario",
+    )
     for key in data:
         if key not in known:
             raise CampaignSpecError(
@@ -395,6 +404,11 @@ def _parse_calibration(data: Any, source: str) -> CalibrationStep:
         )
     raw = data.get("contact_points", list(DEFAULT_CALIBRATION_POINTS))
     points = _numbers(raw, "calibration.contact_points", "m", source)
+    scenario = data.get("scenario", {})
+    if not isinstance(scenario, Mapping):
+        raise CampaignSpecError(
+            "calibration.scenario", "must be a table of Scenario fields", source
+        )
     try:
         return CalibrationStep(
             enabled=enabled,
@@ -404,6 +418,7 @@ def _parse_calibration(data: Any, source: str) -> CalibrationStep:
             loss=loss,
             sensor=sensor,
             tip_mass=tip_mass,
+            scenario=dict(scenario),
         )
     except CampaignSpecError as exc:
         raise CampaignSpecError(exc.field_name, exc.problem, source) from exc

@@ -291,6 +291,10 @@ class CalibrationStep:
         on the step's ``case`` alone.
     tip_mass : bool
         Fit the link's tip mass with T_e (``calibration.frequency.calibrate_t_e``).
+    scenario : dict
+        ``simulator.Scenario`` fields that the calibration recordings take instead of the
+        campaign's ``[scenario]`` ones (``[calibration.scenario]``): a lab calibrates with gentle
+        pushes, ``push = 0.03``, and may then push its runs hard.
     """
 
     enabled: bool = False
@@ -300,6 +304,7 @@ class CalibrationStep:
     loss: str = "soft_l1"
     sensor: bool = False
     tip_mass: bool = False
+    scenario: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.case not in CASES:
@@ -341,8 +346,8 @@ class CalibrationStep:
         return len(self.cases) * len(self.contact_points) * self.repeats
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data in the layout of the TOML section (``sensor`` and ``tip_mass`` only when
-        set, so a spec without them keeps its fingerprint)."""
+        """Plain data in the layout of the TOML section (``sensor``, ``tip_mass`` and
+        ``scenario`` only when set, so a spec without them keeps its fingerprint)."""
         data: dict[str, Any] = {
             "enabled": self.enabled,
             "case": self.case,
@@ -354,6 +359,8 @@ class CalibrationStep:
             data["sensor"] = True
         if self.tip_mass:
             data["tip_mass"] = True
+        if self.scenario:
+            data["scenario"] = dict(self.scenario)
         return data
 
 

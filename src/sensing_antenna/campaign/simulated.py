@@ -291,7 +291,7 @@ def calibrate_on_device(
     bar = progress.bar(len(planned), "calibration", "recording")
     with bar:
         for name, case, x_c, seed in planned:
-            extra = with_device(spec, spec.scenario, seed, device.link.length)
+            extra = with_device(spec, calibration_scenario(spec), seed, device.link.length)
             scenario = make_scenario(case, x_c, seed, extra)
             recordings.append(simulate(device, scenario).without_ground_truth())
             names.append(name)
@@ -327,6 +327,10 @@ def calibrate_on_device(
     return calibration, calibrated
 
 
+#: How :func:`check_scenario` prefixes a problem of the free motions' and the calibration's.
+FREE_MOTION, CALIBRATION = "the free motion: ", "the calibration: "
+
+
 def check_scenario(spec: CampaignSpec) -> None:
     """Check every scenario the campaign will simulate, before any work.
 
@@ -338,7 +342,8 @@ def check_scenario(spec: CampaignSpec) -> None:
     ------
     CampaignSpecError
         Naming the spec file and ``scenario.<field>`` (``free_motion.duration`` and
-        ``free_motion.case`` for the free motions'), on the first scenario that is not valid.
+        ``free_motion.case`` for the free motions', ``calibration.scenario.<field>`` for a field
+        the calibration sets), on the first scenario that is not valid.
     """
     from sensing_antenna.simulator.scenario import ScenarioError
 
@@ -358,13 +363,21 @@ def check_scenario(spec: CampaignSpec) -> None:
             make_scenario(case, x_c, 0, dict(extra))
         except ScenarioError as exc:
             field = exc.field_name
-            free = prefix and field in ("duration", "case")
-            name = f"free_motion.{field}" if free else f"scenario.{field}"
+            if prefix == FREE_MOTION and field in ("duration", "case"):
+                name = f"free_motion.{field}"
+            elif prefix == CALIBRATION and field in spec.calibration.scenario:
+                name = f"calibration.scenario.{field}"
+            else:
+                name = f"scenario.{field}"
             raise CampaignSpecError(
                 name, prefix + str(exc).split(": ", 1)[-1], spec.source or None
             ) from exc
         except CampaignSpecError as exc:
-            raise CampaignSpecError(exc.field_name, exc.problem, spec.source or None) from exc
+            name = exc.field_name
+            own = name.split(".")[1] if name.startswith("scenario.") else ""
+            if prefix == CALIBRATION and own in spec.calibration.scenario:
+                name = f"calibration.{name}"
+            raise CampaignSpecError(name, exc.problem, spec.source or None) from exc
         except TypeError as exc:
             raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc
 
@@ -373,10 +386,16 @@ def check_scenario(spec: CampaignSpec) -> None:
     if spec.free_motion.identify:
         extra = {**spec.scenario, "duration": spec.free_motion.duration}
         for case in spec.free_motion_cases():
-            check(case, None, extra, "the free motion: ")
+            check(case, None, extra, FREE_MOTION)
     if spec.calibration.enabled:
         for _, case, x_c, _ in calibration_runs(spec):
-            check(case, x_c, spec.scenario, "")
+            check(case, x_c, calibration_scenario(spec), CALIBRATION)
+
+
+def calibration_scenario(spec: CampaignSpec) -> dict[str, Any]:
+    """The scenario fields of the calibration recordings: ``[scenario]`` with
+    ``[calibration.scenario]`` over it."""
+    return {**spec.scenario, **spec.calibration.scenario}
 
 
 def prepare_campaign(spec: CampaignSpec, progress: Progress | None = None) -> Preparation:
