@@ -454,7 +454,11 @@ class Evidence:
         # the floor, or the scatter the sensor's calibration left on the ratio if larger
         sensor = self.antenna.sensor
         floor = max(self.config.ratio_model_floor, sensor.ratio_scatter) * x_c
-        leak = self.cross_talk_uncertainty(x_c) if coupling else np.zeros(x_c.shape)
+        leak = (
+            np.hypot(self.cross_talk_uncertainty(x_c), self.axial_cross_talk_uncertainty(x_c))
+            if coupling
+            else np.zeros(x_c.shape)
+        )
         term = np.asarray(np.hypot(np.hypot(stiffness, weight), np.hypot(floor, leak)), dtype=float)
         return np.where(np.isnan(term), np.inf, term)
 
@@ -471,6 +475,19 @@ class Evidence:
             sensor.coupling_uncertainty(self.frame.reaction_m), sensor.coupling_uncertainty(move)
         )
         return np.asarray(coupling * np.square(x_c), dtype=float)
+
+    def axial_cross_talk_uncertainty(self, x_c: FloatArray) -> FloatArray:
+        """Standard uncertainty (m) of the elastica's ratio at contact points ``x_c`` (m, any
+        shape) from the cross-talk of the moments into the force along the link, which no
+        calibration here measures (:mod:`~sensing_antenna.calibration.sensor` fits the lateral
+        forces' terms). The statics read x_c = (Gamma' + y_c R_x) / |R_perp|, so an axial force
+        read c Gamma' off moves the ratio by c y_c x_c = c d x_c^2, d the push's y_c / x_c
+        (:meth:`push_deflection_ratio`), c the sensor's ``nominal_coupling``: a few mm at a
+        gentle push, many cm at a third of x_c, where a calibration made at gentle pushes has
+        absorbed only its own push's share into the lateral terms."""
+        x_c = np.asarray(x_c, dtype=float)
+        coupling = self.antenna.sensor.nominal_coupling
+        return np.asarray(coupling * self.push_deflection_ratio(x_c) * np.square(x_c), dtype=float)
 
     def bent_link_uncertainty(self, x_c: float) -> float:
         """Standard uncertainty (m) of a contact point read from the vibration, from the push's

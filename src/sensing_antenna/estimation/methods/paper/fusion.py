@@ -440,7 +440,12 @@ class PaperMethod:
             )
             choice, notes = second_mode_choice(evidence, measurement.component, candidates_used)
             diag["second_mode"] = notes
-            if margin < cfg.ratio_resolution_sigmas * sigma_ratio and choice is not None:
+            # the branch rests on the ratio: at a deep push its uncertainty holds the axial
+            # force's cross-talk, which no calibration of the lateral forces measured
+            axial = float(evidence.axial_cross_talk_uncertainty(np.array(ratio_estimate)))
+            sigma_branch = math.hypot(sigma_ratio, axial)
+            diag["branch_ratio_uncertainty"] = sigma_branch
+            if margin < cfg.ratio_resolution_sigmas * sigma_branch and choice is not None:
                 x_pick = candidates_used[choice]
                 fusion = Fusion(
                     x_c=x_pick,
@@ -449,12 +454,12 @@ class PaperMethod:
                     agree=abs(x_pick - ratio_estimate) <= tolerance,
                 )
                 diag["discriminated_by"] = "omega2"
-            elif margin < cfg.ratio_resolution_sigmas * sigma_ratio:
+            elif margin < cfg.ratio_resolution_sigmas * sigma_branch:
                 other = candidates_used[1 - int(fusion.chosen or 0)]
                 problems.append(
                     (
                         Status.UNCERTAIN,
-                        f"the torque/force ratio ({ratio_estimate:.3f} m, +-{sigma_ratio:.3f} m) "
+                        f"the torque/force ratio ({ratio_estimate:.3f} m, +-{sigma_branch:.3f} m) "
                         f"cannot tell the candidate {fusion.x_c:.3f} m from {other:.3f} m and "
                         "the second contact mode is not clear",
                     )
