@@ -78,8 +78,8 @@ from bent_link_frequencies import in_plane_fundamental
 
 ELEMENTS = 200
 POISSON = 0.3
-CONTACTS = (0.3, 0.5, 0.7, 0.9)
-DEFLECTIONS = (0.03, 0.10, 0.20, 0.30)
+CONTACTS = (0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.975)
+DEFLECTIONS = (0.03, 0.05, 0.10, 0.20, 0.30, 0.40)
 OUT = Path(__file__).parent / "results" / "bent_link_free_plane.json"
 
 # 4-point Gauss-Legendre on [0, 1]

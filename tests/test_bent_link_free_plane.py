@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import math
 import sys
 from pathlib import Path
 
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 from sensing_antenna import paper_antenna
-from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.beam import free_plane_shift, natural_frequencies
 
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "bent_link_free_plane.py"
 
@@ -50,3 +51,33 @@ def test_free_plane_of_a_hard_push_stays_within_half_a_percent(model) -> None:
     for poisson in (0.2, 0.4):
         got = model.free_plane_fundamental(model.paper_rod(poisson), 0.5, 0.3)
         assert 0.0 < got / omega_1 - 1 < 0.005
+
+
+@pytest.mark.parametrize(("x_c", "d"), [(0.5, 0.3), (0.9, 0.2)])
+def test_the_estimators_free_plane_bound_is_the_models_largest_shift(model, x_c, d) -> None:
+    # The bound the paper method's plausibility check carries for the free plane's own mode
+    # (beam.free_plane_shift) is the table of this model's largest shift over friction's share
+    # along the link (+-0.6 of the push), a twist held at the contact and Poisson's ratios
+    # 0.2 to 0.4; at a node it is that largest shift, to its three stored digits
+    link = paper_antenna().link
+    omega_1 = float(np.ravel(natural_frequencies(link, np.array([x_c]), 1))[0])
+    variants = (
+        model.free_plane_fundamental(model.paper_rod(), x_c, d),
+        model.free_plane_fundamental(model.paper_rod(), x_c, d, beta=0.6),
+        model.free_plane_fundamental(model.paper_rod(), x_c, d, beta=-0.6),
+        model.free_plane_fundamental(model.paper_rod(), x_c, d, twist_held=True),
+        model.free_plane_fundamental(model.paper_rod(0.2), x_c, d),
+        model.free_plane_fundamental(model.paper_rod(0.4), x_c, d),
+    )
+    largest = max(abs(omega / omega_1 - 1) for omega in variants)
+    assert free_plane_shift(x_c / link.length, d) == pytest.approx(largest, rel=5e-3)
+
+
+def test_the_free_plane_bound_grows_with_the_push_and_ends_where_its_table_does() -> None:
+    pushes = np.linspace(0.0, 0.4, 41)
+    for span in (0.2, 0.5, 0.75, 1.0):
+        bounds = [free_plane_shift(span, d) for d in pushes]
+        assert bounds[0] == 0.0
+        assert np.all(np.diff(bounds) > 0)
+    # past the deepest push computed the bound is not known
+    assert free_plane_shift(0.5, 0.41) == math.inf

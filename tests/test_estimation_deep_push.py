@@ -32,6 +32,8 @@ OK_TOLERANCE = 0.02
         ("vertical", 0.6, 0.3),
         ("azimuthal", 0.5, 0.3),
         ("vertical", 0.35, 0.2),
+        ("azimuthal", 0.7, 0.2),
+        ("vertical", 0.9, 0.2),
     ],
 )
 def test_a_deep_push_is_right_or_said(case: str, x_c: float, push: float) -> None:

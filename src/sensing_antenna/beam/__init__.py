@@ -6,6 +6,8 @@
 - :mod:`~sensing_antenna.beam.modes`: natural frequencies in rad/s and mode shapes of a link.
 - :mod:`~sensing_antenna.beam.sensing`: the sensing curve omega_1(x_c) and its inverse.
 - :mod:`~sensing_antenna.beam.statics`: static deflection, base force and torque (Eqs. 7 to 13).
+- :mod:`~sensing_antenna.beam.free_plane`: how far a pushed link's fundamental out of its
+  bending plane may leave the straight link's.
 """
 
 from sensing_antenna.beam._validate import MAX_MODES, BeamInputError
@@ -15,6 +17,7 @@ from sensing_antenna.beam.characteristic import (
     eigenvalues,
     mode_count,
 )
+from sensing_antenna.beam.free_plane import free_plane_shift
 from sensing_antenna.beam.modes import (
     contact_ratio,
     contact_to_base_shear,
@@ -45,6 +48,7 @@ __all__ = [
     "contact_to_base_shear",
     "eigenvalue_slopes",
     "eigenvalues",
+    "free_plane_shift",
     "frequency_scale",
     "mode_count",
     "mode_shapes",

@@ -163,9 +163,11 @@ class EstimatorConfig:
         method's posterior carries it as the frequency's standard uncertainty at every x_c. The
         paper method charges it, at two standard deviations, to the status of a frequency read
         in the push plane alone (``max_model_spread``); beyond ``max_model_spread`` itself it
-        makes every answer read from the vibration ``uncertain``, in whichever plane (the
-        plausibility layer); a push plane that rings apart from the free one is judged by the
-        ratio (:mod:`~sensing_antenna.estimation.methods.paper.planes`). 0: a link whose
+        makes every answer read from the vibration ``uncertain``, in whichever plane, but for
+        the paper method's reading of the free plane's own mode, judged on that plane's own
+        bound (``beam.free_plane_shift``; the plausibility layer); a push plane that rings
+        apart from the free one is judged by the ratio
+        (:mod:`~sensing_antenna.estimation.methods.paper.planes`). 0: a link whose
         frequencies do not move with the push (the simulator's linear link).
     omega2_window : float
         Relative half-width of the search window around each candidate's predicted omega_2;

@@ -73,7 +73,7 @@ from typing import Any
 import numpy as np
 
 from sensing_antenna.antenna import Link
-from sensing_antenna.beam import SensingCurve, natural_frequencies
+from sensing_antenna.beam import SensingCurve, free_plane_shift, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
@@ -173,7 +173,7 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if statics is not None:
         found.append((Status.ESTIMATORS_DISAGREE, statics))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
-    bent = _bent_link_problem(evidence, estimate) if on_link else None
+    bent = _bent_link_problem(evidence, estimate, notes) if on_link else None
     if bent is not None:
         found.append((Status.UNCERTAIN, bent))
     bend = float(estimate.diagnostics.get("deflection_ratio", math.nan))
@@ -876,11 +876,15 @@ def _index_at(evidence: Evidence, t_e: float) -> int:
     return min(max(index, evidence.rest_index), evidence.end_index)
 
 
-def _bent_link_problem(evidence: Evidence, estimate: ContactEstimate) -> str | None:
+def _bent_link_problem(
+    evidence: Evidence, estimate: ContactEstimate, notes: dict[str, Any]
+) -> str | None:
     """Why the point the vibration gives may be more than ``max_model_spread`` off on a link
     the push bends, or None: the sensing curves are the straight link's, and the bent link's
     preload shifts its frequencies by up to ``Evidence.bent_link_uncertainty`` (a bound of the
-    shift the rod showed), in whichever plane it was read. Only for methods that read omega_1.
+    shift the rod showed), in whichever plane it was read; an omega_1 of the free plane's own
+    mode by up to its own, smaller bound (:func:`_free_plane_spread`). Only for methods that
+    read omega_1. Notes ``free_plane_spread`` when that bound was asked.
     """
     if not math.isfinite(estimate.omega1):
         return None
@@ -888,17 +892,52 @@ def _bent_link_problem(evidence: Evidence, estimate: ContactEstimate) -> str | N
     limit = evidence.config.max_model_spread
     if not shift > limit:
         return None
+    free = _free_plane_spread(evidence, estimate)
+    if free is not None:
+        notes["free_plane_spread"] = free
+        if free <= limit:
+            return None
     bend = float(evidence.push_deflection_ratio(estimate.x_c))
     # the term grows as the deflection squared, the deflection as the push
     gentler = math.sqrt(limit / shift)
     push = evidence.frame.lateral_force
+    read = "omega_1 was not read in the free plane's own mode"
+    if free is not None:
+        read = f"read in the free plane's own mode it may be up to {100 * free:.1f} cm off"
     return (
         f"the push bends the link by {100 * bend:.0f} % of x_c at x_c = {estimate.x_c:.3f} m: "
         f"the sensing curves are the straight link's, and the bent link's preload may move the "
-        f"point the vibration gives by up to {100 * shift:.1f} cm, more than {100 * limit:g} cm "
-        f"(a push of {gentler * push:.2g} N or less, {100 * gentler * bend:.0f} % of x_c, "
-        "keeps it within that here)"
+        f"point the vibration gives by up to {100 * shift:.1f} cm, more than {100 * limit:g} cm; "
+        f"{read} (a push of {gentler * push:.2g} N or less, {100 * gentler * bend:.0f} % of "
+        "x_c, keeps it within that here)"
     )
+
+
+def _free_plane_spread(evidence: Evidence, estimate: ContactEstimate) -> float | None:
+    """How far (m) from the answer the contact may lie when omega_1 is the free plane's own mode
+    (the method's ``free_plane_mode``: :func:`~.methods.paper.planes.free_plane_mode`), None
+    when it is not: out of its bending plane the pushed link rings within
+    :func:`~sensing_antenna.beam.free_plane.free_plane_shift` of the straight link's omega_1 at
+    the answer's deflection (the elastica's, else the linear statics'), widened by the mode's
+    distance to a push-plane peak it may be merged with and by the answer's own distance to it.
+    """
+    mode = estimate.diagnostics.get("free_plane_mode")
+    if not isinstance(mode, dict):
+        return None
+    link = evidence.antenna.link
+    x_c = estimate.x_c
+    omega = float(mode["omega"])
+    bend = float(estimate.diagnostics.get("deflection_ratio", math.nan))
+    if not math.isfinite(bend):
+        bend = float(evidence.push_deflection_ratio(x_c))
+    relative = (
+        free_plane_shift(x_c / link.length, bend)
+        + float(mode["separation"])
+        + abs(estimate.omega1 - omega) / omega
+    )
+    if not math.isfinite(relative):
+        return None
+    return model_spread(link, x_c, relative)
 
 
 def _vibration_problems(

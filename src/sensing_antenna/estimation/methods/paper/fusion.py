@@ -441,8 +441,9 @@ class PaperMethod:
             choice, notes = second_mode_choice(evidence, measurement.component, candidates_used)
             diag["second_mode"] = notes
             # the branch rests on the ratio: at a deep push its uncertainty holds the axial
-            # force's cross-talk, which no calibration of the lateral forces measured
-            axial = float(evidence.axial_cross_talk_uncertainty(np.array(ratio_estimate)))
+            # force's cross-talk, which no calibration of the lateral forces measured, as large
+            # as it would be were the contact the candidate farther out (it grows as x_c^4)
+            axial = float(evidence.axial_cross_talk_uncertainty(np.array(max(candidates_used))))
             sigma_branch = math.hypot(sigma_ratio, axial)
             diag["branch_ratio_uncertainty"] = sigma_branch
             if margin < cfg.ratio_resolution_sigmas * sigma_branch and choice is not None:

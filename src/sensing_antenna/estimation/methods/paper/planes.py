@@ -23,6 +23,13 @@ the free plane, clear or at least half as clear as a peak must be on its own, ca
 bound of a shift (the plausibility layer): on a bent link the push plane's mode leaks into the
 free plane's component (the sag tilts the planes), so the two can agree on the push plane's
 frequency.
+
+The free plane's own mode is known when its clear peak cannot be such a leak
+(:func:`free_plane_mode`): no peak of the push plane lies within the Hann window's main lobe of
+it, or the one there is weaker (a leak is weaker than its source). Where a push plane's peak lies
+within the lobe, the two may be merged in the free plane's component, and their distance counts
+in the frequency's uncertainty. A frequency of that mode is held by the free plane's own bound
+(:func:`~sensing_antenna.beam.free_plane.free_plane_shift`), not by the bent link's.
 """
 
 from __future__ import annotations
@@ -36,7 +43,7 @@ from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement, SpectralPeak
 from sensing_antenna.estimation.result import Status
 
-__all__ = ["PLANES", "bending_planes", "planes_agree"]
+__all__ = ["PLANES", "bending_planes", "free_plane_mode", "planes_agree"]
 
 #: Torque component of each bending plane: about Y^c the vibration out of the push plane
 #: ("free"), about Z^c the vibration in it ("push").
@@ -70,8 +77,9 @@ def bending_planes(
         The torque/force ratio's estimate and standard uncertainty (m).
     config : EstimatorConfig
     diagnostics : dict
-        Receives ``frequency_plane`` ("free", "push" or "both") and, when the planes
-        disagree, ``plane_candidates`` and ``plane_chosen_by``.
+        Receives ``frequency_plane`` ("free", "push" or "both"), ``free_plane_mode``
+        (:func:`free_plane_mode`) and, when the planes disagree, ``plane_candidates`` and
+        ``plane_chosen_by``.
 
     Returns
     -------
@@ -90,6 +98,7 @@ def bending_planes(
     agree = measurement.components_agree(config.component_agreement)
     if not measurement.clear:
         return measurement, None
+    diagnostics["free_plane_mode"] = free_plane_mode(measurement, config)
     if clear["free"] and clear["push"] and not agree:
         return _disagreeing(
             measurement, peaks, locate, ratio_estimate, sigma_ratio, config, diagnostics
@@ -102,6 +111,28 @@ def bending_planes(
         plane = "free"
     diagnostics["frequency_plane"] = plane
     return measurement, None
+
+
+def free_plane_mode(
+    measurement: FrequencyMeasurement, config: EstimatorConfig
+) -> dict[str, float] | None:
+    """The free plane's own mode, or None: ``omega`` (rad/s), its clear peak in the torque about
+    Y^c, and ``separation``, the relative distance to the push plane's peak when that lies within
+    the Hann window's main lobe (4 pi / T_w rad/s) and may be merged with it (0 beyond). None
+    without a clear free-plane peak, or with a stronger push-plane peak within the lobe: the
+    free plane's peak may then be the push plane's mode leaking into its component."""
+    free = measurement.peaks.get(PLANES["free"])
+    push = measurement.peaks.get(PLANES["push"])
+    if free is None or not free.quality >= config.min_peak_quality:
+        return None
+    window = measurement.t_end - measurement.t_start
+    lobe = 4.0 * math.pi / window if window > 0 else math.inf
+    separation = 0.0
+    if push is not None and abs(push.omega - free.omega) < lobe:
+        if push.quality > free.quality:
+            return None
+        separation = abs(push.omega - free.omega) / free.omega
+    return {"omega": free.omega, "separation": separation}
 
 
 def planes_agree(measurement: FrequencyMeasurement, config: EstimatorConfig) -> bool:
