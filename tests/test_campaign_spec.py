@@ -257,6 +257,10 @@ def test_the_calibration_may_push_otherwise_than_the_runs(tmp_path: Path) -> Non
         check_scenario(bad)
     with pytest.raises(CampaignSpecError, match=r"calibration\.scenario: must be a table"):
         load_campaign_spec(write(tmp_path, hard.replace("loss", "scenario = 3\nloss")))
+    # what the calibration sets for each recording is not the spec's to set
+    for key in ("seed = 7", 'case = "vertical"', "contact_point = 0.2"):
+        with pytest.raises(CampaignSpecError, match=r"calibration\.scenario\.\w+: is set by"):
+            load_campaign_spec(write(tmp_path, hard + f"[calibration.scenario]\n{key}\n"))
 
 
 def test_device_and_calibration_change_the_fingerprints(tmp_path: Path) -> None:

@@ -123,15 +123,19 @@ def test_a_hard_push_read_in_the_free_planes_own_mode_is_ok(name: str) -> None:
     ("push", "expected"),
     [
         (None, 0.0),  # the push plane silent
-        ((75.0, 5000.0), 0.0),  # beyond the main lobe of a 1 s window, 4 pi rad/s
-        ((61.0, 100.0), 1.0 / 60.0),  # within it and weaker: may be merged, its distance counts
-        ((61.0, 2000.0), None),  # within it and stronger: the free plane's peak may be its leak
+        ((75.0, 5.0, 5000.0), 0.0),  # beyond the main lobe of a 1 s window, 4 pi rad/s
+        ((61.0, 0.1, 100.0), 1.0 / 60.0),  # within it, less power: may be merged, distance counts
+        ((61.0, 0.1, 5.0), 0.0),  # within it, less power and noise (quality under 10)
+        # more power within the lobe: the free plane's peak may be its leak, however the two
+        # bands' medians make the qualities compare
+        ((61.0, 2.0, 2000.0), None),
+        ((61.0, 2.0, 100.0), None),
     ],
 )
 def test_the_free_planes_own_mode_is_a_peak_no_push_plane_peak_can_explain(push, expected) -> None:
     peaks = {"y_c": SpectralPeak(omega=60.0, power=1.0, quality=1000.0)}
     if push is not None:
-        peaks["z_c"] = SpectralPeak(omega=push[0], power=1.0, quality=push[1])
+        peaks["z_c"] = SpectralPeak(omega=push[0], power=push[1], quality=push[2])
     measurement = FrequencyMeasurement(
         omega1=60.0,
         quality=1000.0,

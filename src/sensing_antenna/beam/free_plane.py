@@ -18,7 +18,8 @@ the contact, and Poisson's ratios 0.2, 0.3 and 0.4. For a uniform rod of circula
 shift depends only on x_c / l and d = y_c / x_c (the reaction that bends the link by d scales
 with E I / x_c^2, and G J / E I = 1 / (1 + nu)), so the table serves any such link. Between its
 nodes the shift is interpolated linearly in x_c / l and in d: it is convex in d, so the
-interpolation in d lies above it, and the nodes in x_c lie at most 0.1 l apart. Below the first
+interpolation in d lies above it; between 0.6 and 0.8 m it is concave in x_c, where the
+interpolation may lie up to about 2 % of it below. Below the first
 contact the first row is used (the shift grows with x_c up to 0.8 l and is flat beyond); past
 the deepest push tabulated the bound is not known (inf).
 """

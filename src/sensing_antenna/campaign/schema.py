@@ -331,6 +331,14 @@ class CalibrationStep:
                 "calibration.loss",
                 f"unknown {self.loss!r}; known: {', '.join(_CALIBRATION_LOSSES)}",
             )
+        for key in self.scenario:
+            if key in _RESERVED_SCENARIO_KEYS:
+                where = (
+                    "comes from [device] (profile, imperfections)"
+                    if key == "device"
+                    else "is set by the calibration for each recording"
+                )
+                raise CampaignSpecError(f"calibration.scenario.{key}", f"{where}; remove it")
 
     @property
     def cases(self) -> tuple[str, ...]:

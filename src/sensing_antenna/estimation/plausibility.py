@@ -902,7 +902,9 @@ def _bent_link_problem(
     gentler = math.sqrt(limit / shift)
     push = evidence.frame.lateral_force
     read = "omega_1 was not read in the free plane's own mode"
-    if free is not None:
+    if free is not None and math.isinf(free):
+        read = "the free plane's own mode has no bound computed beyond 40 % deflection"
+    elif free is not None:
         read = f"read in the free plane's own mode it may be up to {100 * free:.1f} cm off"
     return (
         f"the push bends the link by {100 * bend:.0f} % of x_c at x_c = {estimate.x_c:.3f} m: "
@@ -916,10 +918,13 @@ def _bent_link_problem(
 def _free_plane_spread(evidence: Evidence, estimate: ContactEstimate) -> float | None:
     """How far (m) from the answer the contact may lie when omega_1 is the free plane's own mode
     (the method's ``free_plane_mode``: :func:`~.methods.paper.planes.free_plane_mode`), None
-    when it is not: out of its bending plane the pushed link rings within
-    :func:`~sensing_antenna.beam.free_plane.free_plane_shift` of the straight link's omega_1 at
-    the answer's deflection (the elastica's, else the linear statics'), widened by the mode's
-    distance to a push-plane peak it may be merged with and by the answer's own distance to it.
+    when it is not, inf where its bound is not known: out of its bending plane the pushed link
+    rings within :func:`~sensing_antenna.beam.free_plane.free_plane_shift` of the straight
+    link's omega_1 at the answer's deflection (the elastica's, else the linear statics'),
+    widened by the mode's distance to a push-plane peak it may be merged with and by the
+    answer's own distance to it; in quadrature with the frequency model's own spread at two
+    standard deviations, as the push plane's term is (the paper method's "read in the push
+    plane alone").
     """
     mode = estimate.diagnostics.get("free_plane_mode")
     if not isinstance(mode, dict):
@@ -936,8 +941,9 @@ def _free_plane_spread(evidence: Evidence, estimate: ContactEstimate) -> float |
         + abs(estimate.omega1 - omega) / omega
     )
     if not math.isfinite(relative):
-        return None
-    return model_spread(link, x_c, relative)
+        return math.inf
+    own = model_spread(link, x_c, 2.0 * link.frequency_uncertainty)
+    return math.hypot(model_spread(link, x_c, relative), own)
 
 
 def _vibration_problems(

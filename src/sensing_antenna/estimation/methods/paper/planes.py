@@ -118,9 +118,11 @@ def free_plane_mode(
 ) -> dict[str, float] | None:
     """The free plane's own mode, or None: ``omega`` (rad/s), its clear peak in the torque about
     Y^c, and ``separation``, the relative distance to the push plane's peak when that lies within
-    the Hann window's main lobe (4 pi / T_w rad/s) and may be merged with it (0 beyond). None
-    without a clear free-plane peak, or with a stronger push-plane peak within the lobe: the
-    free plane's peak may then be the push plane's mode leaking into its component."""
+    the Hann window's main lobe (4 pi / T_w rad/s) and may be merged with it (0 beyond, or when
+    that peak is not even half as clear as a peak must be: noise). None without a clear
+    free-plane peak, or with a push-plane peak within the lobe of more power (both components
+    are torques, N m; the two bands' median powers differ, so their qualities do not compare):
+    the free plane's peak may then be the push plane's mode leaking into its component."""
     free = measurement.peaks.get(PLANES["free"])
     push = measurement.peaks.get(PLANES["push"])
     if free is None or not free.quality >= config.min_peak_quality:
@@ -129,9 +131,10 @@ def free_plane_mode(
     lobe = 4.0 * math.pi / window if window > 0 else math.inf
     separation = 0.0
     if push is not None and abs(push.omega - free.omega) < lobe:
-        if push.quality > free.quality:
+        if not push.power <= free.power:
             return None
-        separation = abs(push.omega - free.omega) / free.omega
+        if push.quality >= 0.5 * config.min_peak_quality:
+            separation = abs(push.omega - free.omega) / free.omega
     return {"omega": free.omega, "separation": separation}
 
 
