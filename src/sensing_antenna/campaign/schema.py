@@ -269,6 +269,21 @@ class DeviceSpec:
         return data
 
 
+def _check_reserved(
+    scenario: Mapping[str, Any], section: str, setter: str, source: str | None = None
+) -> None:
+    """Refuse a Scenario field of ``section`` that the campaign sets itself (``setter`` says
+    who), naming it as ``section.<key>``."""
+    for key in scenario:
+        if key in _RESERVED_SCENARIO_KEYS:
+            where = (
+                "comes from [device] (profile, imperfections)"
+                if key == "device"
+                else f"is set by {setter}"
+            )
+            raise CampaignSpecError(f"{section}.{key}", f"{where}; remove it", source)
+
+
 @dataclass(frozen=True)
 class CalibrationStep:
     """Optional step before the runs: fit T_e of the frequency model on the device (Section 5.1).
@@ -331,14 +346,7 @@ class CalibrationStep:
                 "calibration.loss",
                 f"unknown {self.loss!r}; known: {', '.join(_CALIBRATION_LOSSES)}",
             )
-        for key in self.scenario:
-            if key in _RESERVED_SCENARIO_KEYS:
-                where = (
-                    "comes from [device] (profile, imperfections)"
-                    if key == "device"
-                    else "is set by the calibration for each recording"
-                )
-                raise CampaignSpecError(f"calibration.scenario.{key}", f"{where}; remove it")
+        _check_reserved(self.scenario, "calibration.scenario", "the calibration for each recording")
 
     @property
     def cases(self) -> tuple[str, ...]:
@@ -600,14 +608,7 @@ class CampaignSpec:
         duration = self.scenario.get("duration")
         if duration is not None and (problem := duration_problem(duration)):
             raise CampaignSpecError("scenario.duration", problem, src)
-        for key in self.scenario:
-            if key in _RESERVED_SCENARIO_KEYS:
-                where = (
-                    "comes from [device] (profile, imperfections)"
-                    if key == "device"
-                    else "is set by the campaign for each run"
-                )
-                raise CampaignSpecError(f"scenario.{key}", f"{where}; remove it", src)
+        _check_reserved(self.scenario, "scenario", "the campaign for each run", src)
         main = self.noise_scale
         for i, s in enumerate(self.noise_sweep.noise_scales):
             if math.isfinite(main) and noise_level_key(s) == noise_level_key(main):

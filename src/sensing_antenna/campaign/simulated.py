@@ -354,6 +354,16 @@ def check_scenario(spec: CampaignSpec) -> None:
         spec.second_device_spec().load_device()
     checked: set[tuple[str, float | None, tuple[tuple[str, str], ...]]] = set()
 
+    def section(field: str, prefix: str) -> str:
+        """The spec's name of a Scenario ``field`` (``push`` or ``push.kind``): its own step's
+        when the free motion or the calibration sets it, the ``[scenario]`` one's otherwise."""
+        head = field.split(".")[0]
+        if prefix == FREE_MOTION and head in ("duration", "case"):
+            return f"free_motion.{field}"
+        if prefix == CALIBRATION and head in spec.calibration.scenario:
+            return f"calibration.scenario.{field}"
+        return f"scenario.{field}"
+
     def check(case: str, x_c: float | None, extra: Mapping[str, Any], prefix: str) -> None:
         key = (case, x_c, tuple(sorted((k, repr(v)) for k, v in extra.items())))
         if key in checked:
@@ -362,21 +372,15 @@ def check_scenario(spec: CampaignSpec) -> None:
         try:
             make_scenario(case, x_c, 0, dict(extra))
         except ScenarioError as exc:
-            field = exc.field_name
-            if prefix == FREE_MOTION and field in ("duration", "case"):
-                name = f"free_motion.{field}"
-            elif prefix == CALIBRATION and field in spec.calibration.scenario:
-                name = f"calibration.scenario.{field}"
-            else:
-                name = f"scenario.{field}"
             raise CampaignSpecError(
-                name, prefix + str(exc).split(": ", 1)[-1], spec.source or None
+                section(exc.field_name, prefix),
+                prefix + str(exc).split(": ", 1)[-1],
+                spec.source or None,
             ) from exc
         except CampaignSpecError as exc:
             name = exc.field_name
-            own = name.split(".")[1] if name.startswith("scenario.") else ""
-            if prefix == CALIBRATION and own in spec.calibration.scenario:
-                name = f"calibration.{name}"
+            if name.startswith("scenario."):
+                name = section(name.removeprefix("scenario."), prefix)
             raise CampaignSpecError(name, exc.problem, spec.source or None) from exc
         except TypeError as exc:
             raise CampaignSpecError("scenario", str(exc), spec.source or None) from exc

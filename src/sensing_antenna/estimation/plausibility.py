@@ -75,6 +75,7 @@ import numpy as np
 from sensing_antenna.antenna import Link
 from sensing_antenna.beam import SensingCurve, free_plane_shift, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
+from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
@@ -903,7 +904,10 @@ def _bent_link_problem(
     push = evidence.frame.lateral_force
     read = "omega_1 was not read in the free plane's own mode"
     if free is not None and math.isinf(free):
-        read = "the free plane's own mode has no bound computed beyond 40 % deflection"
+        read = (
+            "the free plane's own mode has no bound computed beyond "
+            f"{100 * FREE_PLANE_DEFLECTIONS[-1]:.0f} % deflection"
+        )
     elif free is not None:
         read = f"read in the free plane's own mode it may be up to {100 * free:.1f} cm off"
     return (

@@ -26,10 +26,11 @@ frequency.
 
 The free plane's own mode is known when its clear peak cannot be such a leak
 (:func:`free_plane_mode`): no peak of the push plane lies within the Hann window's main lobe of
-it, or the one there is weaker (a leak is weaker than its source). Where a push plane's peak lies
-within the lobe, the two may be merged in the free plane's component, and their distance counts
-in the frequency's uncertainty. A frequency of that mode is held by the free plane's own bound
-(:func:`~sensing_antenna.beam.free_plane.free_plane_shift`), not by the bent link's.
+it, or the one there has less power (a leak is weaker than its source). Where a push plane's
+peak lies within the lobe, the two may be merged in the free plane's component, and their
+distance counts in the frequency's uncertainty. A frequency of that mode is held by the free
+plane's own bound (:func:`~sensing_antenna.beam.free_plane.free_plane_shift`), not by the bent
+link's.
 """
 
 from __future__ import annotations
