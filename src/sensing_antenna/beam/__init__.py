@@ -3,7 +3,8 @@
 - :mod:`~sensing_antenna.beam.characteristic`: the non-dimensional frequency equation, derived
   from the boundary conditions of Eq. 4 (not the printed Eq. 6), Wittrick-Williams root counting
   and the eigenvalues beta_i l (xi, R_m).
-- :mod:`~sensing_antenna.beam.modes`: natural frequencies in rad/s and mode shapes of a link.
+- :mod:`~sensing_antenna.beam.modes`: natural frequencies in rad/s and mode shapes of a link, and
+  how a contact held along the obstacle stiffens its first mode.
 - :mod:`~sensing_antenna.beam.sensing`: the sensing curve omega_1(x_c) and its inverse.
 - :mod:`~sensing_antenna.beam.statics`: static deflection, base force and torque (Eqs. 7 to 13).
 - :mod:`~sensing_antenna.beam.free_plane`: how far a pushed link's fundamental out of its
@@ -22,6 +23,7 @@ from sensing_antenna.beam.modes import (
     contact_ratio,
     contact_to_base_shear,
     frequency_scale,
+    held_contact_coupling,
     mode_shapes,
     natural_frequencies,
 )
@@ -50,6 +52,7 @@ __all__ = [
     "eigenvalues",
     "free_plane_shift",
     "frequency_scale",
+    "held_contact_coupling",
     "mode_count",
     "mode_shapes",
     "natural_frequencies",

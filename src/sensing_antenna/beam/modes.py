@@ -22,6 +22,7 @@ __all__ = [
     "contact_ratio",
     "contact_to_base_shear",
     "frequency_scale",
+    "held_contact_coupling",
     "mode_shapes",
     "natural_frequencies",
 ]
@@ -255,4 +256,56 @@ def contact_to_base_shear(link: Link, x_c: ArrayLike) -> FloatArray:
         if len(pieces) > 1:
             right = float(_basis(3, lam, pieces[1][0], zero)[0] @ pieces[1][1])
         out[index] = (right - left) / base
+    return out
+
+
+def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
+    """kappa(x_c): how much a contact held along the obstacle stiffens the first contact mode of
+    a link the push has bent, per unit of the axial force it makes the base feel (dimensionless).
+
+    A push deflecting the contact by d x_c bends the link to w_0(s) = d (3 x_c s^2 - s^3) /
+    (2 x_c^2) (Eq. 7) in its bending plane. Vibrating there as q phi(s), the arc from O to the
+    contact changes its projection along the link by -d q G at first order,
+
+        G = integral_0^x_c (w_0' / d) phi' ds = -(3 / x_c^2) integral_0^x_c (x_c - s) phi ds,
+
+    which a sliding contact lets go and one friction holds resists with an axial force k d G q
+    (k the hold's stiffness). The base then feels the shear E I phi'''(0) q across the link and
+    k d G q along it; the hold stores k (d G q)^2 / 2, so by Rayleigh's quotient the push
+    plane's omega_1 rises by
+
+        Delta omega / omega = r kappa d / 2,   kappa = E I phi'''(0) G / (m_b omega_1^2),
+
+    r the base's axial force over its shear at omega_1 (in phase). The straight link's model
+    (Eq. 4) lets the contact slide. Independent of T and l: kappa = phi'''(0) G / (beta_1 l)^4
+    with phi''' in units of 1 / l^3.
+
+    Parameters
+    ----------
+    link : Link
+    x_c : array_like
+        Contact points in (0, l] (m).
+
+    Returns
+    -------
+    ndarray
+        Shape ``x_c.shape``.
+    """
+    xi = contact_ratio(link, x_c)
+    ratio = link.tip_mass_ratio
+    lams = eigenvalues(xi, 1, ratio)[..., 0]
+    nodes, weights = np.polynomial.legendre.leggauss(_QUADRATURE_NODES)
+    zero = np.zeros(1)
+    out = np.empty(xi.shape)
+    for index in np.ndindex(xi.shape):
+        lam = float(lams[index])
+        pieces = _mode_coefficients(lam, float(xi[index]), ratio)
+        scale = _normalise(lam, pieces, ratio)
+        span, first = pieces[0]
+        shear = scale * float(_basis(3, lam, span, zero)[0] @ first)
+        u = 0.5 * span * (nodes + 1.0)
+        phi = scale * (_basis(0, lam, span, u) @ first)
+        # G = -(3 / xi^2) integral_0^xi (xi - u) phi du, Gauss-Legendre over the first span
+        chord = -1.5 / span * float(weights @ ((span - u) * phi))
+        out[index] = shear * chord / lam**4
     return out
