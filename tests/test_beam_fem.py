@@ -228,7 +228,8 @@ def _chord_vector(nodes: np.ndarray, contact: int) -> np.ndarray:
 def fe_held_rise(xi: float, ratio: float, target: float) -> tuple[float, float]:
     """The first mode's rise (omega / omega_0 - 1) when an axial spring resists the chord's
     change (E I = rho = l = 1, d = 1), stiff enough for Rayleigh's quotient to put the rise at
-    ``target``, and the base's axial force over its shear in the mode with that hold, r."""
+    ``target``, and the base's axial force over its bending moment in the mode with that hold,
+    r (the support's moment at the clamp's rotation DOF)."""
     values, nodes, contact, full, big_k, big_m = _fe_modes(xi, ratio, 1, ELEMENT_LENGTH)
     g = _chord_vector(nodes, contact)
     hold = 2.0 * target * values[0] / float(g @ full[:, 0]) ** 2
@@ -241,8 +242,8 @@ def fe_held_rise(xi: float, ratio: float, target: float) -> tuple[float, float]:
     mode = np.zeros(n_dof)
     mode[free] = vector[:, 0]
     lam = 1.0 / float(inverse[0])
-    shear = float(((big_k - lam * big_m) @ mode)[0])
-    return math.sqrt(lam / values[0]) - 1.0, hold * float(g @ mode) / shear
+    moment = float(((big_k - lam * big_m) @ mode)[1])
+    return math.sqrt(lam / values[0]) - 1.0, hold * float(g @ mode) / moment
 
 
 @pytest.mark.parametrize("ratio", (0.0, 0.3))

@@ -293,3 +293,39 @@ def _uncertain_only_for_the_bend(result: ContactEstimate) -> None:
     assert result.status is Status.UNCERTAIN, result.reason
     assert "bends the link" in (result.reason or "")
     assert not result.diagnostics.get("other_reasons"), result.diagnostics["other_reasons"]
+
+
+def test_a_push_plane_that_friction_holds_along_the_link_is_not_ok() -> None:
+    # The exact link pushed up into a bar at 0.70 m by the paper antenna's own push (9 % of
+    # x_c): friction (mu = 0.6) holds the contact along the link, the push plane rings 7 to 9 %
+    # above the straight link's omega_1 and the torque/force ratio reads long the same way, so
+    # the frequency's candidate (3 cm out) had nothing against it. The force along the link
+    # rings with the push plane's mode, at several times what a sliding contact, the sensor's
+    # cross-talk and the noise would make: the answer is not ok, and says why.
+    recording = simulate(
+        paper_antenna(),
+        Scenario(case="vertical", contact_point=0.7, seed=1, link_model="nonlinear"),
+    )
+    result = estimate(recording.without_ground_truth(), paper_antenna().self_calibrated())
+    assert result.diagnostics["frequency_plane"] == "push"
+    assert abs(result.x_c - float(recording.metadata["true_xc"])) > 0.02
+    assert result.status is not Status.OK
+    assert "friction holds the contact along the link" in (result.reason or "")
+    held = result.diagnostics["held_contact"]
+    assert held["ringing"] > 3.0 * held["leak"]
+    assert held["shift"] > 0.05
+
+
+def test_a_sliding_contact_read_in_the_push_plane_alone_stays_ok() -> None:
+    # The linear link's contact slides along it (its model has no axial motion): read in the
+    # push plane alone at 0.9 m, the force along the link rings with the contact force in the
+    # reaction's own direction, and what is left is within what cross-talk and noise make: no
+    # rise is bounded.
+    recording = simulate(paper_antenna(), Scenario(case="vertical", contact_point=0.9, seed=1))
+    result = estimate(recording.without_ground_truth(), paper_antenna().self_calibrated())
+    assert result.diagnostics["frequency_plane"] == "push"
+    assert result.status is Status.OK
+    assert abs(result.x_c - float(recording.metadata["true_xc"])) < 0.002
+    held = result.diagnostics["held_contact"]
+    assert held["ringing"] < held["leak"]
+    assert held["shift"] == 0.0

@@ -260,8 +260,9 @@ def contact_to_base_shear(link: Link, x_c: ArrayLike) -> FloatArray:
 
 
 def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
-    """kappa(x_c): how much a contact held along the obstacle stiffens the first contact mode of
-    a link the push has bent, per unit of the axial force it makes the base feel (dimensionless).
+    """kappa(x_c) (m): how much a contact held along the obstacle stiffens the first contact mode
+    of a link the push has bent, per unit of the axial force it makes the base feel over the
+    base's bending moment in that mode.
 
     A push deflecting the contact by d x_c bends the link to w_0(s) = d (3 x_c s^2 - s^3) /
     (2 x_c^2) (Eq. 7) in its bending plane. Vibrating there as q phi(s), the arc from O to the
@@ -270,15 +271,15 @@ def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
         G = integral_0^x_c (w_0' / d) phi' ds = -(3 / x_c^2) integral_0^x_c (x_c - s) phi ds,
 
     which a sliding contact lets go and one friction holds resists with an axial force k d G q
-    (k the hold's stiffness). The base then feels the shear E I phi'''(0) q across the link and
-    k d G q along it; the hold stores k (d G q)^2 / 2, so by Rayleigh's quotient the push
+    (k the hold's stiffness). The base then feels the bending moment E I phi''(0) q and the
+    axial force k d G q; the hold stores k (d G q)^2 / 2, so by Rayleigh's quotient the push
     plane's omega_1 rises by
 
-        Delta omega / omega = r kappa d / 2,   kappa = E I phi'''(0) G / (m_b omega_1^2),
+        Delta omega / omega = r kappa d / 2,   kappa = E I phi''(0) G / (m_b omega_1^2),
 
-    r the base's axial force over its shear at omega_1 (in phase). The straight link's model
-    (Eq. 4) lets the contact slide. Independent of T and l: kappa = phi'''(0) G / (beta_1 l)^4
-    with phi''' in units of 1 / l^3.
+    r the base's axial force over its bending moment at omega_1 (1/m, in phase). The straight
+    link's model (Eq. 4) lets the contact slide. In the link's own units kappa = l phi''(0) G /
+    (beta_1 l)^4, phi'' in units of 1 / l^2.
 
     Parameters
     ----------
@@ -289,7 +290,7 @@ def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
     Returns
     -------
     ndarray
-        Shape ``x_c.shape``.
+        Shape ``x_c.shape`` (m).
     """
     xi = contact_ratio(link, x_c)
     ratio = link.tip_mass_ratio
@@ -302,10 +303,10 @@ def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
         pieces = _mode_coefficients(lam, float(xi[index]), ratio)
         scale = _normalise(lam, pieces, ratio)
         span, first = pieces[0]
-        shear = scale * float(_basis(3, lam, span, zero)[0] @ first)
+        bending = scale * float(_basis(2, lam, span, zero)[0] @ first)
         u = 0.5 * span * (nodes + 1.0)
         phi = scale * (_basis(0, lam, span, u) @ first)
         # G = -(3 / xi^2) integral_0^xi (xi - u) phi du, Gauss-Legendre over the first span
         chord = -1.5 / span * float(weights @ ((span - u) * phi))
-        out[index] = shear * chord / lam**4
+        out[index] = link.length * bending * chord / lam**4
     return out

@@ -8,12 +8,15 @@
   from the curve (``EstimatorConfig.max_curve_distance``, or three times what the frequency
   model's own uncertainty allows) is a ``model_mismatch``, and an answer that the model's
   uncertainty (and, read in the push plane alone, the bent link's,
-  ``Evidence.bent_link_uncertainty``) may move by more than ``max_model_spread`` at two
-  standard deviations is ``uncertain``, as the paper method's candidate.
+  ``Evidence.bent_link_uncertainty``, and a held contact's rise,
+  :mod:`~sensing_antenna.estimation.methods.paper.held_contact`) may move by more than
+  ``max_model_spread`` at two standard deviations is ``uncertain``, as the paper method's
+  candidate.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -28,7 +31,8 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_spectrum,
     find_peak,
 )
-from sensing_antenna.estimation.methods.paper.fusion import conclude
+from sensing_antenna.estimation.methods.paper.fusion import conclude, model_spread
+from sensing_antenna.estimation.methods.paper.held_contact import HeldContact, held_contact
 from sensing_antenna.estimation.methods.paper.planes import planes_agree
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
@@ -133,8 +137,11 @@ class TwoFrequencyMethod:
                 diag["curve_distance"] = float(distance[k])
                 # read in the push plane alone: the free plane does not ring with it
                 push_plane = measurement.component == "z_c" and not planes_agree(measurement, cfg)
+                held = held_contact(evidence, measurement.omega1, x_c) if push_plane else None
+                if held is not None:
+                    diag["held_contact"] = dataclasses.asdict(held)
                 problems.extend(
-                    _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane)
+                    _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane, held)
                 )
             else:
                 problems.append(
@@ -165,12 +172,13 @@ def _curve_problems(
     k: int,
     distance: float,
     push_plane: bool,
+    held: HeldContact | None = None,
 ) -> list[tuple[Status, str]]:
     """Why the two-frequency answer ``grid[k]`` (m), whose measured pair lies ``distance``
     (relative) from the curve ``omegas`` (rad/s, (n, 2)), is not to be trusted: off the curve
     by more than the model allows, or moved by the model's own uncertainty and, for frequencies
-    read in the push plane alone (``push_plane``), by the bent link, as the paper method's
-    candidate."""
+    read in the push plane alone (``push_plane``), by the bent link and a contact held along
+    it (``held``: the bound of its rise of omega_1), as the paper method's candidate."""
     cfg = evidence.config
     x_c = float(grid[k])
     u = evidence.antenna.link.frequency_uncertainty
@@ -192,14 +200,17 @@ def _curve_problems(
     near = np.all(np.abs(omegas / omegas[k] - 1.0) <= 2.0 * u, axis=1)
     spread = float(np.max(np.abs(grid[near] - x_c))) if np.any(near) else 0.0
     bent = 2.0 * evidence.bent_link_uncertainty(x_c) if push_plane else 0.0
-    if math.hypot(spread, bent) > cfg.max_model_spread:
+    hold = model_spread(evidence.antenna.link, x_c, held.shift) if held is not None else 0.0
+    total = math.hypot(spread, bent, hold)
+    if total > cfg.max_model_spread:
         problems.append(
             (
                 Status.UNCERTAIN,
                 f"the frequency model's own uncertainty ({100 * u:.2g} % of each frequency) and "
-                f"the bent link (the curves are the straight link's) may move this answer by "
-                f"{100 * math.hypot(spread, bent):.1f} cm at two standard deviations, more "
-                f"than {100 * cfg.max_model_spread:g} cm",
+                f"the bent link (the curves are the straight link's"
+                + (", and friction may hold the contact along it" if hold > 0.0 else "")
+                + f") may move this answer by {100 * total:.1f} cm at two standard deviations, "
+                f"more than {100 * cfg.max_model_spread:g} cm",
             )
         )
     return problems

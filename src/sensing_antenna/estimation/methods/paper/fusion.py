@@ -11,6 +11,7 @@ every method shares (the 3D point and the physical consistency checks that set t
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -20,12 +21,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
+from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_frequency,
     evidence_spectrum,
     find_peak,
 )
+from sensing_antenna.estimation.methods.paper.held_contact import HeldContact, held_contact
 from sensing_antenna.estimation.methods.paper.planes import bending_planes
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
@@ -490,20 +493,18 @@ class PaperMethod:
             spread = model_spread(link, fusion.x_c, 2.0 * link.frequency_uncertainty)
             diag["model_spread"] = spread
             if diag.get("frequency_plane") == "push":
-                # a frequency of the push plane alone carries the bent link's preload
+                # a frequency of the push plane alone carries the bent link's preload, and the
+                # rise a contact held along the link makes, bounded by the force along it
                 preload = 2.0 * evidence.bent_link_uncertainty(fusion.x_c)
                 diag["preload_spread"] = preload
-                if math.hypot(spread, preload) > cfg.max_model_spread:
-                    problems.append(
-                        (
-                            Status.UNCERTAIN,
-                            f"omega_1 was read in the push plane alone, where the bent link's "
-                            f"preload shifts it: with the frequency model's own uncertainty "
-                            f"the candidate may be {100 * math.hypot(spread, preload):.1f} cm "
-                            f"off at two standard deviations, more than "
-                            f"{100 * cfg.max_model_spread:g} cm",
-                        )
-                    )
+                held = held_contact(evidence, measurement.omega1, fusion.x_c)
+                held_spread = 0.0
+                if held is not None:
+                    diag["held_contact"] = dataclasses.asdict(held)
+                    held_spread = model_spread(link, fusion.x_c, held.shift)
+                total = math.hypot(spread, preload, held_spread)
+                if total > cfg.max_model_spread:
+                    problems.append((Status.UNCERTAIN, _push_plane_reason(total, held, cfg)))
             if spread > cfg.max_model_spread:
                 problems.append(
                     (
@@ -535,6 +536,23 @@ class PaperMethod:
             problems=problems,
             diagnostics=diag,
         )
+
+
+def _push_plane_reason(total: float, held: HeldContact | None, cfg: EstimatorConfig) -> str:
+    """Why an omega_1 read in the push plane alone may put the candidate ``total`` (m) off."""
+    cause = "where the bent link's preload shifts it"
+    if held is not None and held.shift > 0.0:
+        cause += (
+            f", and the force along the link rings with it, {held.ringing:.2g} N per N m of "
+            f"the bending moment, more than sliding, cross-talk and noise make: friction holds "
+            f"the contact along the link, which may raise omega_1 by up to "
+            f"{100 * held.shift:.1f} %"
+        )
+    return (
+        f"omega_1 was read in the push plane alone, {cause}: with the frequency model's own "
+        f"uncertainty the candidate may be {100 * total:.1f} cm off at two standard deviations, "
+        f"more than {100 * cfg.max_model_spread:g} cm"
+    )
 
 
 def _metres(value: float) -> str:

@@ -1,0 +1,130 @@
+"""A contact friction holds along the link, read from the force along it.
+
+The straight link's model lets the contact slide along the link. On a link the push has bent,
+a contact that friction holds on the obstacle resists the in-plane vibration's change of the
+chord from O to the contact, and the push plane's modes rise (docs/estimation.md, "The two
+bending planes"; the free plane's do not). The force that resists rings at omega_1 along the
+link and reaches the base: with r its amplitude over that of the base's bending moment in the
+push plane (the torque omega_1 is read from), Rayleigh's quotient puts the rise at r kappa d / 2
+(:func:`~sensing_antenna.beam.modes.held_contact_coupling`, d the push's deflection over x_c).
+So the ringing of the force along the link, over the spectrum's own window, bounds how far a
+push plane's omega_1 may sit above the straight link's curve.
+
+What else rings along the link at omega_1 is taken off r before the bound:
+
+- a sliding contact's own axial share: its reaction keeps its direction, R_x / |R_perp| of the
+  contact force, which rings at -:func:`~sensing_antenna.beam.modes.contact_to_base_shear`
+  times the base's lateral reading (the ratio of the mode's support forces; the reading is the
+  base support's opposite); subtracted as a complex amplitude;
+- the sensor's cross-talk of the moments into F_x, up to ``nominal_coupling`` per N m of the
+  three torques' ringing (no calibration here measures it);
+- the force channel's noise: twice the median of its amplitude spectrum over the band (for
+  white noise the amplitude exceeds 2.08 medians with probability 5 %).
+
+The bound is three times Rayleigh's estimate: a stiff hold reshapes the mode, and against a
+finite-element link with a hold of any stiffness that keeps the rise within the band
+(tests/test_beam_fem.py) the estimate from the r of the reshaped mode reaches at least 0.36 of
+the rise (docs/design-notes.md, "A push plane that friction holds, read from the force along
+the link").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sensing_antenna.beam.modes import contact_to_base_shear, held_contact_coupling
+from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.front.ratio import contact_loads
+
+__all__ = ["HeldContact", "held_contact"]
+
+FloatArray = NDArray[np.float64]
+
+#: Multiple of Rayleigh's estimate of the rise that bounds it.
+BOUND_FACTOR = 3.0
+
+#: Medians of a white noise's Hann amplitude spectrum its amplitude exceeds with probability 5 %
+#: (Rayleigh-distributed: sqrt(2 ln 20) / sqrt(2 ln 2) = 2.08).
+NOISE_MEDIANS = 2.1
+
+
+@dataclass(frozen=True)
+class HeldContact:
+    """The force along the link ringing with the push plane's omega_1.
+
+    Attributes
+    ----------
+    ringing : float
+        Amplitude of the axial force at omega_1 beyond a sliding contact's own axial share, over
+        the push plane's bending moment at the base (1/m, N per N m).
+    leak : float
+        The part of it the sensor's cross-talk and the force channel's noise may make (1/m).
+    shift : float
+        Bound of the push plane's rise of omega_1 a hold would make, relative (dimensionless).
+    """
+
+    ringing: float
+    leak: float
+    shift: float
+
+
+def _noise_amplitude(
+    signal: FloatArray, t: FloatArray, band: tuple[float, float], omega: float
+) -> float:
+    """Median Hann amplitude of ``signal`` (n,), mean removed, over the band (rad/s) outside the
+    main lobe around ``omega`` (rad/s); 0 where none is left."""
+    window = np.hanning(signal.size)
+    amplitudes = np.abs(np.fft.rfft((signal - signal.mean()) * window)) * 2.0 / window.sum()
+    frequencies = 2.0 * math.pi * np.fft.rfftfreq(signal.size, float(t[1] - t[0]))
+    lobe = 4.0 * math.pi / float(t[-1] - t[0])
+    away = (frequencies >= band[0]) & (frequencies <= band[1])
+    away &= np.abs(frequencies - omega) > lobe
+    return float(np.median(amplitudes[away])) if np.any(away) else 0.0
+
+
+def _amplitude(signal: FloatArray, t: FloatArray, omega: float) -> FloatArray:
+    """Complex Hann amplitude at ``omega`` (rad/s) of each column of ``signal`` (n, k), mean
+    removed; shape (k,)."""
+    window = np.hanning(t.size)
+    centred = signal - signal.mean(axis=0)
+    phase = np.exp(-1j * omega * (t - t[0]))
+    return np.asarray(2.0 * (window * phase) @ centred / window.sum())
+
+
+def held_contact(evidence: Evidence, omega: float, x_c: float) -> HeldContact | None:
+    """How far a hold may have raised the push plane's omega_1 (``omega``, rad/s) at the contact
+    point ``x_c`` (m), from the loads over the spectrum's window; None where the window or the
+    push gives nothing to read."""
+    window = evidence.spectrum_slice
+    t = evidence.t[window]
+    reaction = evidence.frame.reaction_m
+    lateral = np.array([0.0, float(reaction[1]), float(reaction[2])])
+    push = float(np.linalg.norm(lateral))
+    if t.size < 16 or not (push > 0.0 and math.isfinite(omega) and omega > 0.0):
+        return None
+    across = lateral / push
+    normal = np.cross([1.0, 0.0, 0.0], across)
+    force, moment = contact_loads(
+        evidence.theta[window], evidence.force[window], evidence.torque[window], evidence.antenna
+    )
+    axial, shear, bending = _amplitude(
+        np.column_stack([force[:, 0], force @ across, moment @ normal]), t, omega
+    )
+    if not abs(bending) > 0.0:
+        return None
+    link = evidence.antenna.link
+    sliding = -float(reaction[0]) / push * float(contact_to_base_shear(link, x_c)) * shear
+    ringing = float(abs(axial - sliding) / abs(bending))
+    # what the cross-talk of the three torques and the force channel's noise may put there
+    torques = float(np.abs(_amplitude(moment, t, omega)).sum())
+    noise = _noise_amplitude(force[:, 0], t, evidence.band, omega)
+    coupling = evidence.antenna.sensor.nominal_coupling
+    leak = float((coupling * torques + NOISE_MEDIANS * noise) / abs(bending))
+    kappa = abs(float(held_contact_coupling(link, x_c)))
+    deflection = float(evidence.push_deflection_ratio(x_c))
+    shift = float(BOUND_FACTOR * 0.5 * max(ringing - leak, 0.0) * kappa * deflection)
+    return HeldContact(ringing=ringing, leak=leak, shift=shift)
