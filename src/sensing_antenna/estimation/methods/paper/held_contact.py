@@ -7,25 +7,28 @@ bending planes"; the free plane's do not). The force that resists rings at omega
 link and reaches the base: with r its amplitude over that of the base's bending moment in the
 push plane (the torque omega_1 is read from), Rayleigh's quotient puts the rise at r kappa d / 2
 (:func:`~sensing_antenna.beam.modes.held_contact_coupling`, d the push's deflection over x_c).
-So the ringing of the force along the link, over the spectrum's own window, bounds how far a
+So the ringing of the force along the link, over the spectrum's own window, tells how far a
 push plane's omega_1 may sit above the straight link's curve.
 
-What else rings along the link at omega_1 is taken off r before the bound:
+What else rings along the link at omega_1 is taken off r first:
 
 - a sliding contact's own axial share: its reaction keeps its direction, R_x / |R_perp| of the
   contact force, which rings at -:func:`~sensing_antenna.beam.modes.contact_to_base_shear`
   times the base's lateral reading (the ratio of the mode's support forces; the reading is the
   base support's opposite); subtracted as a complex amplitude;
-- the sensor's cross-talk of the moments into F_x, up to ``nominal_coupling`` per N m of the
-  three torques' ringing (no calibration here measures it);
-- the force channel's noise: twice the median of its amplitude spectrum over the band (for
-  white noise the amplitude exceeds 2.08 medians with probability 5 %).
+- the sensor's cross-talk of the moments into F_x: up to sqrt(3) ``nominal_coupling`` (the edge
+  of the uniform spread that standard uncertainty describes) per N m of the three torques'
+  ringing, which no calibration here measures;
+- the channels' noise: 2.1 medians of the force channel's amplitude spectrum over the band (a
+  white noise's amplitude exceeds 2.08 medians with probability 5 %), and the lateral channel's
+  through the sliding share.
 
-The bound is three times Rayleigh's estimate: a stiff hold reshapes the mode, and against a
-finite-element link with a hold of any stiffness that keeps the rise within the band
-(tests/test_beam_fem.py) the estimate from the r of the reshaped mode reaches at least 0.36 of
-the rise (docs/design-notes.md, "A push plane that friction holds, read from the force along
-the link").
+The rise taken is three times Rayleigh's estimate from what is left. Against a finite-element
+link whose chord a spring holds, the estimate from the r of the reshaped mode is at least the
+rise while the rise stays in the band (tests/test_beam_fem.py); on the simulator's exact link
+pushed up into a bar it came to 0.35 to 0.62 of the rise (docs/design-notes.md, "A push plane
+that friction holds, read from the force along the link"). A link's own axial inertia rings
+along it too; that only adds to the rise taken.
 """
 
 from __future__ import annotations
@@ -44,12 +47,15 @@ __all__ = ["HeldContact", "held_contact"]
 
 FloatArray = NDArray[np.float64]
 
-#: Multiple of Rayleigh's estimate of the rise that bounds it.
+#: Multiple of Rayleigh's estimate taken as the rise.
 BOUND_FACTOR = 3.0
 
 #: Medians of a white noise's Hann amplitude spectrum its amplitude exceeds with probability 5 %
 #: (Rayleigh-distributed: sqrt(2 ln 20) / sqrt(2 ln 2) = 2.08).
 NOISE_MEDIANS = 2.1
+
+#: The largest cross-talk over its standard uncertainty for a uniform spread.
+COUPLING_EDGE = math.sqrt(3.0)
 
 
 @dataclass(frozen=True)
@@ -62,9 +68,11 @@ class HeldContact:
         Amplitude of the axial force at omega_1 beyond a sliding contact's own axial share, over
         the push plane's bending moment at the base (1/m, N per N m).
     leak : float
-        The part of it the sensor's cross-talk and the force channel's noise may make (1/m).
+        The part of it the sensor's cross-talk and the channels' noise may make (1/m).
     shift : float
-        Bound of the push plane's rise of omega_1 a hold would make, relative (dimensionless).
+        The rise of the push plane's omega_1 taken for a hold: three times Rayleigh's estimate
+        from the ringing beyond the leak, relative (dimensionless); inf when the loads are not
+        finite.
     """
 
     ringing: float
@@ -72,18 +80,22 @@ class HeldContact:
     shift: float
 
 
-def _noise_amplitude(
+def _noise_amplitudes(
     signal: FloatArray, t: FloatArray, band: tuple[float, float], omega: float
-) -> float:
-    """Median Hann amplitude of ``signal`` (n,), mean removed, over the band (rad/s) outside the
-    main lobe around ``omega`` (rad/s); 0 where none is left."""
-    window = np.hanning(signal.size)
-    amplitudes = np.abs(np.fft.rfft((signal - signal.mean()) * window)) * 2.0 / window.sum()
-    frequencies = 2.0 * math.pi * np.fft.rfftfreq(signal.size, float(t[1] - t[0]))
+) -> FloatArray | None:
+    """Median Hann amplitude of each column of ``signal`` (n, k), mean removed, over the band
+    (rad/s) outside the main lobe around ``omega`` (rad/s), shape (k,); None where no frequency
+    is left there."""
+    window = np.hanning(signal.shape[0])
+    centred = (signal - signal.mean(axis=0)) * window[:, None]
+    amplitudes = np.abs(np.fft.rfft(centred, axis=0)) * 2.0 / window.sum()
+    frequencies = 2.0 * math.pi * np.fft.rfftfreq(signal.shape[0], float(t[1] - t[0]))
     lobe = 4.0 * math.pi / float(t[-1] - t[0])
     away = (frequencies >= band[0]) & (frequencies <= band[1])
     away &= np.abs(frequencies - omega) > lobe
-    return float(np.median(amplitudes[away])) if np.any(away) else 0.0
+    if np.count_nonzero(away) < 3:
+        return None
+    return np.asarray(np.median(amplitudes[away], axis=0), dtype=float)
 
 
 def _amplitude(signal: FloatArray, t: FloatArray, omega: float) -> FloatArray:
@@ -97,8 +109,8 @@ def _amplitude(signal: FloatArray, t: FloatArray, omega: float) -> FloatArray:
 
 def held_contact(evidence: Evidence, omega: float, x_c: float) -> HeldContact | None:
     """How far a hold may have raised the push plane's omega_1 (``omega``, rad/s) at the contact
-    point ``x_c`` (m), from the loads over the spectrum's window; None where the window or the
-    push gives nothing to read."""
+    point ``x_c`` (m), from the loads over the spectrum's window; None where the window, the band
+    or the push gives nothing to read."""
     window = evidence.spectrum_slice
     t = evidence.t[window]
     reaction = evidence.frame.reaction_m
@@ -111,20 +123,24 @@ def held_contact(evidence: Evidence, omega: float, x_c: float) -> HeldContact | 
     force, moment = contact_loads(
         evidence.theta[window], evidence.force[window], evidence.torque[window], evidence.antenna
     )
-    axial, shear, bending = _amplitude(
-        np.column_stack([force[:, 0], force @ across, moment @ normal]), t, omega
-    )
-    if not abs(bending) > 0.0:
+    loads = np.column_stack([force[:, 0], force @ across, moment @ normal])
+    axial, shear, bending = _amplitude(loads, t, omega)
+    if not np.all(np.isfinite([axial, shear, bending])):
+        return HeldContact(ringing=math.nan, leak=math.nan, shift=math.inf)
+    noise = _noise_amplitudes(loads[:, :2], t, evidence.band, omega)
+    if noise is None or not abs(bending) > 0.0:
         return None
     link = evidence.antenna.link
-    sliding = -float(reaction[0]) / push * float(contact_to_base_shear(link, x_c)) * shear
-    ringing = float(abs(axial - sliding) / abs(bending))
-    # what the cross-talk of the three torques and the force channel's noise may put there
+    share = -float(reaction[0]) / push * float(contact_to_base_shear(link, x_c))
+    ringing = float(abs(axial - share * shear) / abs(bending))
+    # what the cross-talk of the three torques and the channels' noise may put there
     torques = float(np.abs(_amplitude(moment, t, omega)).sum())
-    noise = _noise_amplitude(force[:, 0], t, evidence.band, omega)
-    coupling = evidence.antenna.sensor.nominal_coupling
-    leak = float((coupling * torques + NOISE_MEDIANS * noise) / abs(bending))
+    coupling = COUPLING_EDGE * evidence.antenna.sensor.nominal_coupling
+    noisy = NOISE_MEDIANS * (float(noise[0]) + abs(share) * float(noise[1]))
+    leak = float((coupling * torques + noisy) / abs(bending))
     kappa = abs(float(held_contact_coupling(link, x_c)))
     deflection = float(evidence.push_deflection_ratio(x_c))
     shift = float(BOUND_FACTOR * 0.5 * max(ringing - leak, 0.0) * kappa * deflection)
+    if not (math.isfinite(ringing) and math.isfinite(leak) and math.isfinite(shift)):
+        shift = math.inf
     return HeldContact(ringing=ringing, leak=leak, shift=shift)

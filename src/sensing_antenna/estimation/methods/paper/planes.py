@@ -18,11 +18,12 @@ other evidence can say which (docs/estimation.md, "The two bending planes"):
 
 A frequency read in the push plane alone (the free plane silent) carries the bent link's
 uncertainty (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.bent_link_uncertainty`)
-into the status at two standard deviations; one corroborated by a peak at the same frequency in
-the free plane, clear or at least half as clear as a peak must be on its own, carries it as the
-bound of a shift (the plausibility layer): on a bent link the push plane's mode leaks into the
-free plane's component (the sag tilts the planes), so the two can agree on the push plane's
-frequency.
+into the status at two standard deviations, and the rise a contact friction holds along the
+link may make (:mod:`~sensing_antenna.estimation.methods.paper.held_contact`); one
+corroborated by a peak at the same frequency in the free plane, clear or at least half as clear
+as a peak must be on its own, carries the first as the bound of a shift (the plausibility
+layer): on a bent link the push plane's mode leaks into the free plane's component (the sag
+tilts the planes), so the two can agree on the push plane's frequency.
 
 The free plane's own mode is known when its clear peak cannot be such a leak
 (:func:`free_plane_mode`): no peak of the push plane lies within the Hann window's main lobe of
