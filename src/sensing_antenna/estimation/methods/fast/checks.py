@@ -19,16 +19,15 @@ say why it is not sure.
 
 from __future__ import annotations
 
-import functools
 import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
 
 from sensing_antenna.antenna import Link
 from sensing_antenna.beam import contact_to_base_shear
+from sensing_antenna.estimation.front.evidence import first_mode_value
 from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.curves import CurveTable, contact_candidates
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
@@ -226,27 +225,6 @@ def frequency_check(
     )
 
 
-#: Knots of the spline the opening check reads the contact-to-base shear ratio from, evenly
-#: spaced over (0, l]: on the paper link 48 knots (2 cm apart) give it within 1e-4 of the
-#: direct computation, against a threshold of order 1, for the cost of 48 direct ones.
-_SHEAR_KNOTS = 48
-
-
-@functools.lru_cache(maxsize=16)
-def _shear_spline(link: Link) -> CubicSpline:
-    x = np.linspace(link.length / _SHEAR_KNOTS, link.length, _SHEAR_KNOTS)
-    return CubicSpline(x, contact_to_base_shear(link, x))
-
-
-def _contact_to_base_shear(link: Link, x_c: float) -> float:
-    """:func:`~sensing_antenna.beam.modes.contact_to_base_shear` at ``x_c`` (m), from a spline
-    of the link's (the MAP moves from window to window; each direct value solves the modes)."""
-    spline = _shear_spline(link)
-    if x_c < spline.x[0]:
-        return float(contact_to_base_shear(link, x_c))
-    return float(spline(x_c))
-
-
 def _opening(fit: DampedSinusoidFit, k: int, push: float, link: Link, x_c: float) -> float:
     """Fundamental's contact-force amplitude at the window start over the static push |R_perp|.
 
@@ -255,7 +233,7 @@ def _opening(fit: DampedSinusoidFit, k: int, push: float, link: Link, x_c: float
     """
     start = fit.start_amplitudes()
     base = math.hypot(float(start[0, k]), float(start[1, k]))
-    return abs(_contact_to_base_shear(link, x_c)) * base / push
+    return abs(first_mode_value(link, contact_to_base_shear, x_c)) * base / push
 
 
 def opening_check(

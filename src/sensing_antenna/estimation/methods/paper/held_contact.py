@@ -26,24 +26,21 @@ What else rings along the link at omega_1 is taken off r first:
 The rise taken is three times Rayleigh's estimate from what is left. Against a finite-element
 link whose chord a spring holds, the estimate from the r of the reshaped mode is at least the
 rise while the rise stays in the band (tests/test_beam_fem.py); on the simulator's exact link
-pushed up into a bar it came to 0.35 to 0.62 of the rise (docs/design-notes.md, "A push plane
-that friction holds, read from the force along the link"). A link's own axial inertia rings
-along it too; that only adds to the rise taken.
+pushed up into a bar it fell short of the rise, by less than three times (docs/design-notes.md,
+"A push plane that friction holds, read from the force along the link"). A link's own axial
+inertia rings along it too; that only adds to the rise taken.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
 
-from sensing_antenna.antenna import Link
 from sensing_antenna.beam.modes import contact_to_base_shear, held_contact_coupling
-from sensing_antenna.estimation.front.evidence import Evidence
+from sensing_antenna.estimation.front.evidence import Evidence, first_mode_value
 from sensing_antenna.estimation.front.ratio import contact_loads
 
 __all__ = ["HeldContact", "held_contact"]
@@ -59,22 +56,6 @@ NOISE_MEDIANS = 2.1
 
 #: The largest cross-talk over its standard uncertainty for a uniform spread.
 COUPLING_EDGE = math.sqrt(3.0)
-
-
-#: Knots of the splines kappa and the contact-to-base shear ratio are read from, evenly spaced
-#: over (0, l]: on the paper link 48 knots give both within 1e-4 of the direct computation (each
-#: direct value solves the modes, milliseconds) for the cost of 48 direct ones per link.
-_KNOTS = 48
-
-
-@functools.lru_cache(maxsize=16)
-def _mode_splines(link: Link) -> tuple[CubicSpline, CubicSpline]:
-    """Splines of :func:`held_contact_coupling` (m) and :func:`contact_to_base_shear` over x_c."""
-    x = np.linspace(link.length / _KNOTS, link.length, _KNOTS)
-    return (
-        CubicSpline(x, held_contact_coupling(link, x)),
-        CubicSpline(x, contact_to_base_shear(link, x)),
-    )
 
 
 @dataclass(frozen=True)
@@ -142,24 +123,24 @@ def held_contact(evidence: Evidence, omega: float, x_c: float) -> HeldContact | 
     force, moment = contact_loads(
         evidence.theta[window], evidence.force[window], evidence.torque[window], evidence.antenna
     )
-    loads = np.column_stack([force[:, 0], force @ across, moment @ normal])
-    axial, shear, bending = _amplitude(loads, t, omega)
-    if not np.all(np.isfinite([axial, shear, bending])):
+    # one amplitude per channel; the projections follow by linearity
+    amplitudes = _amplitude(np.hstack([force, moment]), t, omega)
+    axial, shear, bending = amplitudes[0], amplitudes[:3] @ across, amplitudes[3:] @ normal
+    if not np.all(np.isfinite(amplitudes)):
         return HeldContact(ringing=math.nan, leak=math.nan, shift=math.inf)
-    noise = _noise_amplitudes(loads[:, :2], t, evidence.band, omega)
+    lines = np.column_stack([force[:, 0], force @ across])
+    noise = _noise_amplitudes(lines, t, evidence.band, omega)
     if noise is None or not abs(bending) > 0.0:
         return None
     link = evidence.antenna.link
-    coupling_at, shear_ratio_at = _mode_splines(link)
-    x = min(max(x_c, link.length / _KNOTS), link.length)
-    share = -float(reaction[0]) / push * float(shear_ratio_at(x))
+    share = -float(reaction[0]) / push * first_mode_value(link, contact_to_base_shear, x_c)
     ringing = float(abs(axial - share * shear) / abs(bending))
     # what the cross-talk of the three torques and the channels' noise may put there
-    torques = float(np.abs(_amplitude(moment, t, omega)).sum())
+    torques = float(np.abs(amplitudes[3:]).sum())
     coupling = COUPLING_EDGE * evidence.antenna.sensor.nominal_coupling
     noisy = NOISE_MEDIANS * (float(noise[0]) + abs(share) * float(noise[1]))
     leak = float((coupling * torques + noisy) / abs(bending))
-    kappa = abs(float(coupling_at(x)))
+    kappa = abs(first_mode_value(link, held_contact_coupling, x_c))
     deflection = float(evidence.push_deflection_ratio(x_c))
     shift = float(BOUND_FACTOR * 0.5 * max(ringing - leak, 0.0) * kappa * deflection)
     if not (math.isfinite(ringing) and math.isfinite(leak) and math.isfinite(shift)):
