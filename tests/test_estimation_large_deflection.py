@@ -329,3 +329,20 @@ def test_a_sliding_contact_read_in_the_push_plane_alone_stays_ok() -> None:
     held = result.diagnostics["held_contact"]
     assert held["ringing"] < held["leak"]
     assert held["shift"] == 0.0
+
+
+def test_the_first_modes_ratios_read_from_splines_keep_the_direct_values() -> None:
+    # The per-link splines stand in for the direct mode solutions (milliseconds each) wherever a
+    # method reads them at an answer: on the paper link within 1e-4 of the direct value for the
+    # shear ratio (of order 1; the opening check's threshold is of order 1) and within 1e-4 of
+    # kappa relatively (a rise taken to three times an estimate). Below the first knot the
+    # value is the direct one.
+    from sensing_antenna.beam import contact_to_base_shear, held_contact_coupling
+    from sensing_antenna.estimation.front.evidence import first_mode_value
+
+    link = paper_antenna().self_calibrated().link
+    for x_c in (0.011, 0.3, 0.555, 0.7, 0.777, 0.9, 0.97, link.length):
+        shear = float(contact_to_base_shear(link, x_c))
+        kappa = float(held_contact_coupling(link, x_c))
+        assert first_mode_value(link, contact_to_base_shear, x_c) == pytest.approx(shear, abs=1e-4)
+        assert first_mode_value(link, held_contact_coupling, x_c) == pytest.approx(kappa, rel=1e-4)
