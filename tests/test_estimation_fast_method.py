@@ -25,6 +25,7 @@ from _models import calibrated
 from sensing_antenna.antenna import FreeMotionObserver, load_antenna, paper_antenna
 from sensing_antenna.beam import frequency_scale, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
+from sensing_antenna.beam.weight import pushed_weight_moment
 from sensing_antenna.cli.estimate import summary
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation import (
@@ -320,7 +321,7 @@ def _channels(
     The push is a dead load across the link at arc length x_c; its moment about the base is
     the push times the loaded end's distance along the link, the elastica's
     (:func:`~sensing_antenna.beam.elastica.loaded_end`; 1.5 % short of x_c at 0.8 m, where
-    the push deflects the link by 16 % of x_c).
+    the push deflects the link by 16 % of x_c), less what the sagging link's weight takes.
     ``excess``: the ring's frequency starts this fraction above omega_1 and relaxes to it with
     time constant ``relaxation`` (s). ``omega``: the ring's frequency (rad/s) instead of
     omega_1(x_c), as a biased reading would have it.
@@ -330,7 +331,9 @@ def _channels(
     phase = omega * t + omega * excess * relaxation * (1.0 - np.exp(-t / relaxation))
     r_y = -0.06 * (1.0 + amplitude * np.exp(-0.5 * t) * np.cos(phase + 0.3))
     zeros = np.zeros(n)
-    lever = loaded_end(x_c, 0.0, 0.06, 1.0 / LINK.bending_compliance).x
+    # the level link's own weight: its sag's shortening draws the contact in (beam.weight)
+    weight = float(pushed_weight_moment(LINK, x_c, 0.06, 0.0, 0.0, 0.0).sum())
+    lever = loaded_end(x_c, 0.0, 0.06, 1.0 / LINK.bending_compliance).x + weight / 0.06
     out = np.column_stack([r_y, zeros, zeros, zeros, lever * r_y])
     noise = np.array([6e-3, 6e-3, 3e-5, 3e-5, 3e-5])
     return out + noise * rng.standard_normal((n, 5))

@@ -17,6 +17,7 @@ import math
 import numpy as np
 import pytest
 
+from _models import weightless
 from sensing_antenna.estimation.methods.fast.crb import damped_sinusoid_crb
 from sensing_antenna.estimation.methods.fast.model_order import select_model, select_model_order
 from sensing_antenna.estimation.methods.fast.parametric import fit_damped_sinusoids
@@ -191,7 +192,7 @@ def test_static_ratio_covers_truth_with_bias_removed() -> None:
         assert bias.n_samples == 100
         fit = select_model_order(channels[100:], TS, 2, min_omega=20.0, degree=2)
         assert fit is not None
-        ratio = static_ratio(fit, bias, 0.0, STIFF)
+        ratio = static_ratio(fit, bias, 0.0, weightless(rigidity=STIFF), 0.0)
         hits += abs(ratio.ratio - 0.5) <= 1.96 * ratio.standard_error
     assert 0.88 <= hits / 120 <= 0.99
 

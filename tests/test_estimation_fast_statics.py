@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _models import weightless
 from sensing_antenna import paper_antenna
 from sensing_antenna.beam.elastica import tip_load_cantilever
 from sensing_antenna.estimation import FastMethod, OnlineEstimator, estimate
@@ -47,7 +48,7 @@ def test_a_large_deflection_reads_the_arc_length_not_the_lever() -> None:
     loads += np.array([1e-4, 1e-4, 1e-7, 1e-7, 1e-7]) * rng.standard_normal(loads.shape)
     fit = select_model_order(loads, TS, 1, min_omega=20.0, degree=1)
     assert fit is not None
-    statics = static_ratio(fit, None, 0.0, rigidity)
+    statics = static_ratio(fit, None, 0.0, weightless(rigidity=rigidity), 0.0)
     assert statics.ratio == pytest.approx(length, abs=2e-3)
     assert x_tip == pytest.approx(0.41968, abs=1e-4)
     assert 0.0 < statics.standard_error < 1e-3

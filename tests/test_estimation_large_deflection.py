@@ -16,14 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from sensing_antenna import paper_antenna
-from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.estimation import ContactEstimate, EstimatorConfig, Status, estimate
-from sensing_antenna.estimation.front.evidence import bent_weight_moment
-from sensing_antenna.estimation.front.ratio import perpendicular_ratio
 from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement, SpectralPeak
 from sensing_antenna.estimation.methods.paper.planes import free_plane_mode
 from sensing_antenna.recording import Recording, read_recording
@@ -189,87 +184,6 @@ def test_planes_ringing_apart_are_told_apart_by_a_precise_ratio() -> None:
     assert result.diagnostics["frequency_plane"] == "free"
     assert result.diagnostics["plane_chosen_by"] == "ratio"
     assert abs(result.x_c - truth) < 0.01
-
-
-@pytest.mark.parametrize(("x_c", "push"), [(0.5, 0.26), (0.9, 0.11), (0.98, 0.03)])
-def test_bent_weight_moment_is_the_weight_moved_by_the_bending(x_c: float, push: float) -> None:
-    # Independent reference: quadrature of the moment about v = X^m x u of the weights moved by
-    # the linear shape of the link loaded at x_c (Eq. 13's shape, its slope theta and the
-    # shortening of its projection a(s) = 1/2 integral of theta^2), a tip mass of 1 g added
-    link = dataclasses.replace(paper_antenna().link, tip_mass=1e-3)
-    ei = 1.0 / link.bending_compliance
-    s = np.linspace(0.0, link.length, 40001)
-    w = np.where(
-        s <= x_c, push * s**2 * (3 * x_c - s) / (6 * ei), push * x_c**2 * (3 * s - x_c) / (6 * ei)
-    )
-    theta = np.where(s <= x_c, push * s * (2 * x_c - s) / (2 * ei), push * x_c**2 / (2 * ei))
-    a = np.concatenate([[0.0], np.cumsum(np.diff(s) * 0.25 * (theta[1:] ** 2 + theta[:-1] ** 2))])
-    link_vertical, push_vertical = 0.3, 0.9
-    g = 9.80665
-    expected = g * link.linear_density * (
-        link_vertical * np.trapezoid(w, s) + push_vertical * np.trapezoid(a, s)
-    ) + g * link.tip_mass * (link_vertical * w[-1] + push_vertical * a[-1])
-    got = bent_weight_moment(link, x_c, push, link_vertical, push_vertical)
-    # the trapezoid rule on 40001 points: relative error below 1e-6
-    assert got == pytest.approx(float(expected), rel=1e-6)
-
-
-def _pushed_under_its_weight(
-    link: Link, theta2: float, x_c: float, push: float
-) -> tuple[np.ndarray, float]:
-    """Base loads of the planar elastica at elevation ``theta2`` (rad) carrying its own weight
-    and a frictionless push (N) normal to it at arc ``x_c`` (m), by shooting from the base (x
-    forward, z up): the force (2,) the link exerts on the head (N) and its moment (N m,
-    positive from x to z). Independent of the estimators' inversion table."""
-    ei, length = 1.0 / link.bending_compliance, link.length
-    q = link.linear_density * STANDARD_GRAVITY
-
-    def rhs(s: float, y: np.ndarray, fx: float, fz: float) -> list[float]:
-        # y = (x, z, slope, moment); (fx, fz): the loads outboard of s bar the weight
-        nz = fz - q * (length - s)
-        return [np.cos(y[2]), np.sin(y[2]), y[3] / ei, -(np.cos(y[2]) * nz - np.sin(y[2]) * fx)]
-
-    def shoot(m0: float, force: tuple[float, float]) -> tuple[float, float]:
-        inner = solve_ivp(rhs, (0, x_c), [0, 0, theta2, m0], args=force, rtol=1e-10, atol=1e-13)
-        outer = solve_ivp(rhs, (x_c, length), inner.y[:, -1], args=(0, 0), rtol=1e-10, atol=1e-13)
-        return float(outer.y[3, -1]), float(inner.y[2, -1])  # the tip's moment, x_c's slope
-
-    slope = theta2
-    for _ in range(20):
-        force = (push * np.sin(slope), -push * np.cos(slope))  # normal to the link at x_c
-        m0 = brentq(lambda m, f=force: shoot(m, f)[0], -1.0, 1.0, xtol=1e-14)
-        slope, previous = shoot(m0, force)[1], slope
-        if abs(slope - previous) < 1e-12:
-            break
-    return np.array([force[0], force[1] - q * length]), m0
-
-
-@pytest.mark.parametrize(("theta2", "x_c", "push"), [(0.07, 0.5, 0.078), (0.1, 0.9, 0.034)])
-def test_the_ratios_model_term_holds_the_weight_of_the_bent_sagging_link(
-    theta2: float, x_c: float, push: float
-) -> None:
-    # A vertical sweep's push (the default campaign's at 0.5 and 0.9 m, 7 and 10 % of x_c),
-    # the link tared at rest level: the gravity model removes the straight link's weight, the
-    # weight of the link bent by its sag and the push is left in the torque, and the ratio
-    # reads a few mm long. The model term the ratio's uncertainty carries for it,
-    # bent_weight_moment / |R_perp|, must hold that error.
-    link = paper_antenna().link
-    q = link.linear_density * STANDARD_GRAVITY
-    _, rest = _pushed_under_its_weight(link, 0.0, link.length / 2, 0.0)
-    offset = rest + q * link.length**2 / 2
-    force, moment = _pushed_under_its_weight(link, theta2, x_c, push)
-    reaction = force + np.array([0.0, q * link.length])
-    contact_moment = moment + q * np.cos(theta2) * link.length**2 / 2 - offset
-    along = np.array([np.cos(theta2), np.sin(theta2)])
-    across = np.array([-np.sin(theta2), np.cos(theta2)])
-    # motor axes: X^m along the link, Z^m across it in the plane; a moment from x to z is -Y^m
-    reading = perpendicular_ratio(
-        np.array([[reaction @ along, 0.0, reaction @ across]]),
-        np.array([[0.0, -contact_moment, 0.0]]),
-        1.0 / link.bending_compliance,
-    )[0]
-    bound = bent_weight_moment(link, x_c, push, np.sin(theta2), np.cos(theta2)) / push
-    assert 0.0 < reading - x_c <= bound
 
 
 def test_a_push_plane_frequency_corroborated_by_a_weaker_free_plane_is_ok() -> None:

@@ -25,6 +25,7 @@ from _models import calibrated
 from _recordings import samples_kept
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, paper_antenna
 from sensing_antenna.beam import natural_frequencies
+from sensing_antenna.beam.weight import pushed_weight_moment
 from sensing_antenna.detection.contact import detect_contact
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation import (
@@ -103,6 +104,13 @@ def synthetic_recording(spec: Synthetic, antenna: Antenna | None = None) -> Reco
     lever = x_c if spec.ratio_lever is None else spec.ratio_lever + 0 * x_c
     r_c = lever[:, None] * np.array([1.0, 0.0, 0.0]) - y_c[:, None] * push_dir
     moment = np.cross(r_c, reaction)
+    # the link's own weight: what the push moves of the sagging link adds about v = X^m x u,
+    # u = -push_dir the reaction's direction (beam.weight), gravity along z^m
+    up = np.column_stack([np.sin(theta[:, 1]), np.zeros(n), np.cos(theta[:, 1])])
+    weight_moment = pushed_weight_moment(
+        link, np.clip(x_c, 0.0, link.length), magnitude, 0.0, up[:, 0], -(up @ push_dir)
+    ).sum(axis=-1)
+    moment += weight_moment[:, None] * np.cross(np.array([1.0, 0.0, 0.0]), -push_dir)
     # Vibration from the impact on: first two contact modes, decaying.
     omegas = natural_frequencies(link, spec.x_c, 2)
     after = np.clip(t - spec.contact_time, 0.0, None)

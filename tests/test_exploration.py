@@ -616,7 +616,7 @@ def test_a_larger_budget_goes_on_from_the_stored_manoeuvres(tmp_path: Path) -> N
 def test_an_unrecognised_object_is_swept_on_after_the_budget(
     explored: tuple[Path, list[Manoeuvre]], tmp_path: Path
 ) -> None:
-    # four sweeps' points are too few to recognise anything by (but enough for a surface):
+    # five sweeps' points are too few to recognise anything by (but enough for a surface):
     # after the budget, the two sweeps until_recognised allows are run, both next-best
     # candidates the planner scored, stored as aimed at recognition; a second start with the
     # same settings runs nothing, and a larger budget goes on with the grid's next sweep
@@ -624,22 +624,22 @@ def test_an_unrecognised_object_is_swept_on_after_the_budget(
     out = tmp_path / "more"
     out.mkdir()
     (out / "calibrated.toml").write_text((explored[0] / "calibrated.toml").read_text())
-    settings = ExploreSettings(method="paper", budget=4, until_recognised=2)
+    settings = ExploreSettings(method="paper", budget=5, until_recognised=2)
     most: list[int] = []
     first = explore(scene, DEVICE, out, settings, lambda m, n: most.append(n))
-    assert most == [6] * 6
+    assert most == [7] * 7
     assert first.contact_map.recognition is None
     grid = grid_sweeps(scene)
     sweeps = [m.sweep for m in first.manoeuvres]
-    assert sweeps[:4] == grid[:4] and len(set(sweeps)) == 6
-    assert set(sweeps[4:]) <= set(candidate_sweeps(scene))
-    assert all(np.isfinite(m.score) for m in first.manoeuvres[4:])
-    assert [m.aim for m in first.manoeuvres] == ["plan"] * 4 + ["recognition"] * 2
-    assert first.summary()["aims"] == {"plan": 4, "recognition": 2}
+    assert sweeps[:5] == grid[:5] and len(set(sweeps)) == 7
+    assert set(sweeps[5:]) <= set(candidate_sweeps(scene))
+    assert all(np.isfinite(m.score) for m in first.manoeuvres[5:])
+    assert [m.aim for m in first.manoeuvres] == ["plan"] * 5 + ["recognition"] * 2
+    assert first.summary()["aims"] == {"plan": 5, "recognition": 2}
     again = explore(scene, DEVICE, out, settings)
     assert [m.to_dict() for m in again.manoeuvres] == [m.to_dict() for m in first.manoeuvres]
-    grown = explore(scene, DEVICE, out, ExploreSettings(method="paper", budget=7))
-    assert [m.sweep for m in grown.manoeuvres[6:]] == [grid[4]]
+    grown = explore(scene, DEVICE, out, ExploreSettings(method="paper", budget=8))
+    assert [m.sweep for m in grown.manoeuvres[7:]] == [grid[5]]
 
 
 def test_an_object_recognised_at_the_budget_ends_the_exploration(

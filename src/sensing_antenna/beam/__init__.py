@@ -9,6 +9,8 @@
 - :mod:`~sensing_antenna.beam.statics`: static deflection, base force and torque (Eqs. 7 to 13).
 - :mod:`~sensing_antenna.beam.free_plane`: how far a pushed link's fundamental out of its
   bending plane may leave the straight link's.
+- :mod:`~sensing_antenna.beam.weight`: what the pushed, sagging link's weight adds to the moment
+  the torque/force ratio reads.
 """
 
 from sensing_antenna.beam._validate import MAX_MODES, BeamInputError
@@ -35,6 +37,7 @@ from sensing_antenna.beam.statics import (
     static_deflection,
     torque_force_ratio,
 )
+from sensing_antenna.beam.weight import pushed_weight_moment, weight_residual
 
 __all__ = [
     "MAX_MODES",
@@ -56,6 +59,8 @@ __all__ = [
     "mode_count",
     "mode_shapes",
     "natural_frequencies",
+    "pushed_weight_moment",
     "static_deflection",
     "torque_force_ratio",
+    "weight_residual",
 ]

@@ -150,6 +150,7 @@ class _Hold:
     x_c: float
     reaction: FloatArray  # (3,) N, uncorrected
     moment: FloatArray  # (3,) N m
+    theta2: float  # rad, the link's elevation
 
 
 def calibrate_sensor(
@@ -218,8 +219,8 @@ def _fit(
     kept = [(h, n) for h, n in zip(holds, used, strict=True) if h.sweep in sweeps]
     holds = [h for h, _ in kept]
     terms = _terms(sweeps)
-    rigidity = 1.0 / antenna.link.bending_compliance
     reaction = np.array([h.reaction for h in holds])
+    elevation = np.array([h.theta2 for h in holds])
     moment = np.array([h.moment for h in holds])
     points = np.array([h.x_c for h in holds])
     lateral = np.array([SENSOR_SWEEPS[h.sweep] for h in holds])
@@ -236,7 +237,7 @@ def _fit(
         ``keep`` (all when None), with the terms ``names`` at ``params``."""
         chosen = rows if keep is None else rows[keep]
         corrected = correction(params, names).correct(reaction[chosen], moment[chosen])
-        ratio = perpendicular_ratio(corrected, moment[chosen], rigidity)
+        ratio = perpendicular_ratio(corrected, moment[chosen], antenna.link, elevation[chosen])
         along = corrected[np.arange(chosen.size), lateral[chosen]]
         across = corrected[np.arange(chosen.size), 3 - lateral[chosen]]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -431,4 +432,5 @@ def _hold(recording: Any, antenna: Antenna, x_c: float) -> _Hold | str:
         x_c=x_c,
         reaction=(reaction - offset[:3]).mean(axis=0),
         moment=(moment - offset[3:]).mean(axis=0),
+        theta2=float(evidence.theta[hold, 1].mean()),
     )

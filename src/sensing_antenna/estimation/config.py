@@ -141,10 +141,10 @@ class EstimatorConfig:
         (``Evidence.ratio_uncertainty``). For Eq. 21 as printed (the ``ratio`` baseline) the
         neglected moments are the axial force times the link's slope (1.5 y_c / x_c, Eq. 9,
         times R_x / R_perp up to the friction coefficient 0.6) and the weight of the bent link;
-        1.0 bounds 1.5 x 0.6 = 0.9. For the elastica's statics (the front end's ratio) only the
-        bent link's weight remains, whose moment is derived
-        (:func:`~sensing_antenna.estimation.front.evidence.bent_weight_moment`): 1.0 takes it
-        whole.
+        1.0 bounds 1.5 x 0.6 = 0.9. For the elastica's statics (the front end's ratio), which
+        take the link's weight off to first order, what those terms leave
+        (:func:`~sensing_antenna.beam.weight.weight_residual`, set against an exact solution):
+        1.0 takes it whole.
     ratio_model_floor : float
         Relative floor of the elastica statics' model term of the ratio uncertainty
         (``Evidence.ratio_uncertainty``): what no statics here holds, the contact's own size

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link
+from sensing_antenna.beam.weight import pushed_weight_moment, weight_residual
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 from sensing_antenna.estimation.front.held import describe_held, find_held
@@ -38,7 +39,6 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Evidence",
-    "bent_weight_moment",
     "first_mode_value",
     "search_band",
     "sensing_curve",
@@ -145,58 +145,6 @@ def search_band(link: Link, config: EstimatorConfig) -> tuple[float, float]:
         config.contact_range[0] * link.length, config.contact_range[1] * link.length
     )
     return float(low) / (1.0 + config.band_margin), float(high) * (1.0 + config.band_margin)
-
-
-def bent_weight_moment(
-    link: Link, x_c: float, push: float, link_vertical: float, push_vertical: float
-) -> float:
-    """Bound (N m) of the moment the push's bending adds to the link's weight, about the axis
-    the ratio reads (v = X^m x u, u the push's direction).
-
-    The gravity model removes the weight of the free link; the pushed link's points have moved
-    by w(s) along u (the deflection) and by -a(s) along X^m (the shortening of the bent
-    link's projection, a(s) = 1/2 of the integral of theta^2 up to s). A weight -g dm moved by
-    dr adds the moment dr x (-g dm z); along v = X^m x u that is g dm (w (X^m . z) - a (u . z)),
-    since (u x z) . (X^m x u) = -X^m . z and (X^m x z) . (X^m x u) = u . z. So
-
-        |dM| <= g (|X^m . z| integral of w dm + |u . z| integral of a dm),
-
-    the first term linear in the push (so its share of the ratio, dM / |R_perp|, does not
-    depend on the push: 0.6 cm at x_c = 0.5 m for a link 14 deg above the horizontal), the
-    second quadratic. A push in a horizontal bending plane by a horizontal link adds neither.
-    Linear shape of the link loaded at x_c by |R_perp| (Eq. 13), a = x_c, b = l - x_c, on the
-    uniform link and its tip mass:
-
-        integral of w ds = |R_perp| (a^4 / 8 + a^3 b / 3 + a^2 b^2 / 4) / (E I),
-        integral of a ds = |R_perp|^2 (8 l a^5 / 15 - 11 a^6 / 30 + a^4 b^2 / 2) / (8 (E I)^2),
-        w(l) = |R_perp| a^2 (3 l - a) / (6 E I),
-        a(l) = |R_perp|^2 (8 a^5 / 15 + a^4 b) / (8 (E I)^2).
-
-    Parameters
-    ----------
-    link : Link
-    x_c : float
-        Contact point (m), on the link.
-    push : float
-        |R_perp| (N).
-    link_vertical, push_vertical : float
-        |X^m . z| and |u . z|: the link's and the push's vertical shares.
-    """
-    a = x_c
-    b = link.length - x_c
-    compliance = link.bending_compliance
-    sweep = push * compliance * (a**4 / 8.0 + a**3 * b / 3.0 + a**2 * b**2 / 4.0)
-    shortening = (
-        push**2
-        * compliance**2
-        * (8.0 * link.length * a**5 / 15.0 - 11.0 * a**6 / 30.0 + a**4 * b**2 / 2.0)
-        / 8.0
-    )
-    tip_sweep = push * compliance * a**2 * (3.0 * link.length - a) / 6.0
-    tip_shortening = push**2 * compliance**2 * (8.0 * a**5 / 15.0 + a**4 * b) / 8.0
-    distributed = link.linear_density * (link_vertical * sweep + push_vertical * shortening)
-    tip = link.tip_mass * (link_vertical * tip_sweep + push_vertical * tip_shortening)
-    return STANDARD_GRAVITY * (distributed + tip)
 
 
 @dataclass(frozen=True)
@@ -401,9 +349,11 @@ class Evidence:
             the elastica holds the axial force's moment at any deflection; what it does not
             hold is the stiffness's own uncertainty, 2 u of E I (u the frequency model's
             relative uncertainty: E I = rho / T^2), on its corrections |R_x / R_perp| d x_c
-            and 0.6 d^2 x_c (first and second order); the weight of the bent link, which is
-            not the free link's the gravity model removes: ``ratio_model_factor`` times
-            :func:`bent_weight_moment` / |R_perp|; and a floor, ``ratio_model_floor`` x_c (or
+            and 0.6 d^2 x_c (first and second order); the error of the link's weight terms
+            the ratio takes off (:func:`~sensing_antenna.beam.weight.pushed_weight_moment`,
+            first order in the sag): ``ratio_model_factor`` times
+            :func:`~sensing_antenna.beam.weight.weight_residual` times the terms' magnitudes
+            over |R_perp|; and a floor, ``ratio_model_floor`` x_c (or
             the sensor calibration's ``ratio_scatter`` x_c when larger), for
             what no statics here holds (the contact's own size and compliance, dynamic loads
             left in the mean);
@@ -445,7 +395,8 @@ class Evidence:
     def ratio_model_uncertainty(self, x_c: FloatArray, coupling: bool = False) -> FloatArray:
         """The elastica statics' model term of :meth:`ratio_uncertainty` (m), at contact points
         ``x_c`` (m, any shape, on the link): the stiffness's uncertainty on the statics'
-        corrections, the bent link's weight (:func:`bent_weight_moment`), and the floor
+        corrections, what the link's weight leaves after the ratio took its terms off
+        (:data:`~sensing_antenna.beam.weight.WEIGHT_RESIDUAL`), and the floor
         ``ratio_model_floor`` x_c (the sensor calibration's ``ratio_scatter`` x_c when larger),
         and with ``coupling`` an uncalibrated sensor's cross-talk (``coupling_uncertainty``
         x_c^2, :meth:`ratio_uncertainty` says when), in quadrature, for the hold's push
@@ -469,17 +420,23 @@ class Evidence:
             * deflection_ratio
             * x_c
         )
-        weight = (
-            self.config.ratio_model_factor
-            * bent_weight_moment(
+        # what the first-order weight terms the ratio takes off leave (beam.weight)
+        theta2 = float(self.frame.theta[1])
+        with np.errstate(over="ignore", invalid="ignore"):
+            terms = pushed_weight_moment(
                 link,
-                x_c,  # type: ignore[arg-type]
+                x_c,
                 push,
-                abs(float(self.frame.motor_axes_a[0][2])),
-                abs(float(self.frame.axes_a[1][2])),
+                float(reaction[0]),
+                math.sin(theta2),
+                float(reaction[2]) * math.cos(theta2) / push,
             )
-            / push
-        )
+            weight = (
+                self.config.ratio_model_factor
+                * weight_residual(link, x_c, push)
+                * np.abs(terms).sum(axis=-1)
+                / push
+            )
         # the floor, or the scatter the sensor's calibration left on the ratio if larger
         sensor = self.antenna.sensor
         floor = max(self.config.ratio_model_floor, sensor.ratio_scatter) * x_c

@@ -632,7 +632,8 @@ class FrontEnd:
             self._ratio[a:stop] = perpendicular_ratio(
                 self._reaction[a:stop] - offset[:3],
                 self._moment[a:stop] - offset[3:],
-                1.0 / self.antenna.link.bending_compliance,
+                self.antenna.link,
+                self._theta[a:stop, 1],
             )
             self._ratio_done = stop
         if self._rest is None:

@@ -8,7 +8,8 @@ W the link weight:
 
 so the contact part of the loads is R = F - F_g^m and r_c x R = Gamma - Gamma_g^m (Section 4.2).
 Where r_c lies follows from the statics of the bent link: the planar elastica loaded at the contact
-alone (:mod:`sensing_antenna.beam.elastica`, :func:`perpendicular_ratio`), which for small
+(:mod:`sensing_antenna.beam.elastica`, :func:`perpendicular_ratio`), the moment its own weight
+adds taken off first (:mod:`sensing_antenna.beam.weight`), which for small
 deflections gives |Gamma - Gamma_g^m| = x_c |R_perp| up to the moment of the axial force through
 the deflection, R_perp the part of R perpendicular to the link. Eq. 19 divides by |R| instead,
 which equals |R_perp| when the reaction is normal to the link (the paper's Assumption 4) and
@@ -31,10 +32,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from sensing_antenna.antenna import Antenna
+from sensing_antenna.antenna import Antenna, Link
 from sensing_antenna.beam.elastica import contact_arc
+from sensing_antenna.beam.weight import weight_moment
 from sensing_antenna.detection.filters import FirstOrderLowPass, low_pass
 
 __all__ = [
@@ -53,6 +55,11 @@ FloatArray = NDArray[np.float64]
 #: Fixed-point steps of the small-deflection statics that :func:`perpendicular_ratio` falls back
 #: to beyond the elastica's table; four steps shrink the error of the first estimate by (0.1)^4.
 _FIXED_POINT_STEPS = 4
+
+#: Fixed-point steps that take the link's weight off the moment at the contact point read: the
+#: weight's moment changes with x_c by at most 0.2 |R_perp| (the paper link, pushes to 40 % of
+#: x_c, friction to 0.6), so two steps leave at most 4 % of the first step's error.
+_WEIGHT_STEPS = 2
 
 
 def contact_loads(
@@ -149,14 +156,14 @@ def load_offset(
 
 
 def perpendicular_ratio(
-    reaction_f: FloatArray, torque_f: FloatArray, flexural_rigidity: float
+    reaction_f: FloatArray, torque_f: FloatArray, link: Link, theta2: ArrayLike
 ) -> FloatArray:
     """Estimator 2 of the paper method: x_c(t), the contact's arc length, from the statics of the
     pushed link (m), (n,).
 
     With u the direction of R_perp (the reaction perpendicular to the link) and v = X^m x u, the
     sensor measures the reaction's moment about O in the bending plane, M_0 = Gamma' . v, and
-    R = (R_x, |R_perp|). The link is the planar elastica loaded at the contact alone
+    R = (R_x, |R_perp|). The link is the planar elastica loaded at the contact
     (:mod:`sensing_antenna.beam.elastica`): E I theta' = M_0 - (r(s) x R) from the base, and the
     contact is where that moment vanishes. The inversion is tabulated
     (:func:`~sensing_antenna.beam.elastica.contact_arc`), exact for any deflection the table
@@ -166,15 +173,21 @@ def perpendicular_ratio(
     fixed-point steps from x_c = M_0 / |R_perp|, for the plausibility layer to judge. Without
     axial force and deflection this is Eq. 21 with |R_perp|.
 
+    The link's own weight adds to M_0 what the elastica loaded at the contact alone does not
+    hold: the sag's lever on R_x and the masses and the contact the push moves
+    (:func:`~sensing_antenna.beam.weight.pushed_weight_moment`). It is taken off M_0 at the
+    contact point read, by :data:`_WEIGHT_STEPS` fixed-point steps.
+
     Parameters
     ----------
     reaction_f : array, shape (n, 3)
         Filtered reaction R (N), motor frame.
     torque_f : array, shape (n, 3)
         Filtered Gamma - Gamma_g^m (N m), motor frame.
-    flexural_rigidity : float
-        E I (N m^2), the stiffness the frequency model implies
-        (1 / :attr:`~sensing_antenna.antenna.Link.bending_compliance`).
+    link : Link
+        Its stiffness is ``1 / bending_compliance``, the one the frequency model implies.
+    theta2 : array_like, shape (n,) or scalar
+        The link's elevation (rad), which puts gravity in the motor frame.
 
     Returns
     -------
@@ -183,18 +196,44 @@ def perpendicular_ratio(
     """
     reaction_f = np.asarray(reaction_f, dtype=float)
     torque_f = np.asarray(torque_f, dtype=float)
+    theta2 = np.broadcast_to(np.asarray(theta2, dtype=float), reaction_f.shape[:-1])
     r_x, r_y, r_z = reaction_f[..., 0], reaction_f[..., 1], reaction_f[..., 2]
     perpendicular = np.hypot(r_y, r_z)
+    rigidity = 1.0 / link.bending_compliance
     with np.errstate(divide="ignore", invalid="ignore"):
         # M_0 = Gamma' . v with v = X^m x R_perp / |R_perp| = (0, -R_z, R_y) / |R_perp|
         moment_v = (torque_f[..., 2] * r_y - torque_f[..., 1] * r_z) / perpendicular
-    x_c = contact_arc(moment_v, r_x, perpendicular, flexural_rigidity)
+        # gravity along z = (sin theta2, 0, cos theta2) in the motor frame
+        push_vertical = r_z * np.cos(theta2) / perpendicular
+    x_c = _elastica_arc(moment_v, r_x, perpendicular, rigidity)
+    link_vertical = np.sin(theta2)
+    for _ in range(_WEIGHT_STEPS):
+        with np.errstate(over="ignore", invalid="ignore"):
+            weight = weight_moment(
+                link,
+                np.clip(x_c, 0.0, link.length),
+                perpendicular,
+                r_x,
+                link_vertical,
+                push_vertical,
+            )
+        # where nothing is read (no push, loads beyond the table) the weight is not taken off
+        weight = np.where(np.isfinite(weight), weight, 0.0)
+        x_c = _elastica_arc(moment_v - weight, r_x, perpendicular, rigidity)
+    return np.where(perpendicular > 0.0, x_c, np.nan)
+
+
+def _elastica_arc(
+    moment_v: FloatArray, r_x: FloatArray, perpendicular: FloatArray, rigidity: float
+) -> FloatArray:
+    """The elastica's contact arc (m), the linear statics beyond its table."""
+    x_c = contact_arc(moment_v, r_x, perpendicular, rigidity)
     outside = np.isnan(x_c) & (perpendicular > 0.0)
     if outside.any():
         x_c[outside] = _linear_statics(
-            moment_v[outside], r_x[outside], perpendicular[outside], flexural_rigidity
+            moment_v[outside], r_x[outside], perpendicular[outside], rigidity
         )
-    return np.where(perpendicular > 0.0, x_c, np.nan)
+    return x_c
 
 
 def _linear_statics(

@@ -20,8 +20,8 @@ Model-error floors are added in quadrature to the statistical standard errors:
   payload's the weight at rest reads) in quadrature;
 - ratio: what the elastica's statics do not hold, the front end's model term at each grid point
   (:meth:`~sensing_antenna.estimation.front.evidence.Evidence.ratio_model_uncertainty`: the
-  stiffness's uncertainty on the statics' corrections, the bent link's weight, a floor, and
-  the cross-talk of a sensor no calibration has measured for the push's direction),
+  stiffness's uncertainty on the statics' corrections, what the link's weight terms leave, a
+  floor, and the cross-talk of a sensor no calibration has measured for the push's direction),
   sigma_r^2 = se^2 + model^2.
 
 Prior: flat on the contact range. The posterior is normalised on the grid; the point estimate is

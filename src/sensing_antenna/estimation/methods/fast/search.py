@@ -81,6 +81,7 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
         evidence.ratio_model_uncertainty(table.grid, coupling=True),
         np.hypot(np.where(np.isfinite(bent), bent, 0.0), payload),
         np.array(evidence.frame.reaction_m[1:], dtype=float),
+        np.array(evidence.theta[:, 1], dtype=float),
     )
     return ScanInputs(
         channels,

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import Antenna
+from sensing_antenna.antenna import Antenna, Link
 from sensing_antenna.estimation.front.ratio import contact_loads, perpendicular_ratio
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
 
@@ -119,7 +119,8 @@ def static_ratio(
     fit: DampedSinusoidFit,
     bias: SensorBias | None,
     axial: float,
-    flexural_rigidity: float,
+    link: Link,
+    theta2: float,
 ) -> StaticRatio:
     """The contact's arc length from the fitted offsets, with its standard error.
 
@@ -131,8 +132,10 @@ def static_ratio(
         Subtracted from the offsets, its covariance added.
     axial : float
         R_x, the reaction along the link (N).
-    flexural_rigidity : float
-        E I (N m^2): 1 / ``Link.bending_compliance``, the stiffness of every statics.
+    link : Link
+        Its stiffness (``1 / bending_compliance``, that of every statics) and its weight.
+    theta2 : float
+        The link's elevation (rad) over the window.
 
     Returns
     -------
@@ -157,7 +160,7 @@ def static_ratio(
     loads = np.zeros((rows.shape[0], 3))
     loads[:, 0] = axial
     loads[:, 1:] = rows[:, list(FORCE_CHANNELS)]
-    arcs = perpendicular_ratio(loads, rows[:, list(TORQUE_CHANNELS)], flexural_rigidity)
+    arcs = perpendicular_ratio(loads, rows[:, list(TORQUE_CHANNELS)], link, theta2)
     ratio = float(arcs[0])
     gradient = (arcs[1:] - ratio) / steps
     variance = float(gradient @ cov @ gradient)
@@ -202,6 +205,9 @@ class StaticsModel:
         The hold's reaction across the link, (R_y, R_z) in the motor frame (N): which plane is
         the push's, so that the fundamental is read in the free plane when it rings
         (:mod:`.planes`). None: the strongest mode, whatever its plane.
+    elevation : array, shape (n,), optional
+        theta2 (rad) at every sample, which puts the link's weight in the statics; None: a
+        level link.
     """
 
     axial: FloatArray | None = None
@@ -209,12 +215,19 @@ class StaticsModel:
     model_sd: FloatArray | None = None
     omega1_sd: FloatArray | None = None
     push_direction: FloatArray | None = None
+    elevation: FloatArray | None = None
 
     def axial_at(self, index: int) -> float:
         """R_x (N) at sample ``index``; 0 without it."""
         if self.axial is None or not 0 <= index < self.axial.shape[0]:
             return 0.0
         return float(self.axial[index])
+
+    def elevation_at(self, index: int) -> float:
+        """theta2 (rad) at sample ``index``; 0 (a level link) without it."""
+        if self.elevation is None or not 0 <= index < self.elevation.shape[0]:
+            return 0.0
+        return float(self.elevation[index])
 
     def sd_at(self, x_c: float) -> float:
         """``model_sd`` at ``x_c`` (m), linearly between grid points; 0 without a model term."""

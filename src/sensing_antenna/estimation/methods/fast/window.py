@@ -264,9 +264,14 @@ def evaluate_window(
     # The statics from the window from t_1 always: a fit through the push has its static part
     # at the centre of [t_c, t], inside the push for short windows, while the opening check
     # compares it with the vibration at t_1
-    rigidity = 1.0 / link.bending_compliance
     statics = (
-        static_ratio(from_t1.fit, bias, statics_model.axial_at(end_index), rigidity)
+        static_ratio(
+            from_t1.fit,
+            bias,
+            statics_model.axial_at(end_index),
+            link,
+            statics_model.elevation_at(end_index),
+        )
         if from_t1.fit is not None
         else None
     )
@@ -495,7 +500,7 @@ def _early_statics(
     if half_fit is None or not is_slip_reference(half_fit, omega1, span.band, config):
         return None
     assert half is not None
-    return static_ratio(half_fit, bias, model.axial_at(half), 1.0 / link.bending_compliance)
+    return static_ratio(half_fit, bias, model.axial_at(half), link, model.elevation_at(half))
 
 
 def _held(window: WindowEstimate, config: FastConfig) -> bool:
