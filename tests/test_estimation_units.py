@@ -18,6 +18,7 @@ from scipy.optimize import brentq
 
 from _models import weightless
 from sensing_antenna.antenna import STANDARD_GRAVITY, paper_antenna
+from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation.config import EstimatorConfig, EstimatorConfigError
 from sensing_antenna.estimation.front.contact_frame import (
     contact_frame,
@@ -39,7 +40,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     measure_frequency,
     power_spectrum,
 )
-from sensing_antenna.estimation.methods.paper.fusion import fuse
+from sensing_antenna.estimation.methods.paper.fusion import fuse, model_spread
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
 TS = 1e-3
@@ -395,3 +396,26 @@ def test_touched_point_sag_is_the_finite_element_cantilever_sag_with_a_tip_mass(
         expected = STANDARD_GRAVITY * float(unit[k])  # negative: down
         assert point.sag == pytest.approx(-expected, rel=1e-5)
         assert point.point_a[2] == pytest.approx(expected, rel=1e-5)
+
+
+@pytest.mark.parametrize(("x_c", "relative"), [(0.3, 1.0), (0.45, 0.6), (0.9, 0.05)])
+def test_model_spread_walks_the_stretch_the_band_holds_to_its_end(
+    x_c: float, relative: float
+) -> None:
+    # Reference: the contiguous stretch around x_c whose omega_1, solved directly on 4,000
+    # points of the link, lies within the band; at 60 and 100 % it reaches the base, 30 and
+    # 45 cm away (a spread the reason reports must not stop at a search limit). Tolerance: the
+    # two grids' steps (0.5 mm and 0.25 mm).
+    link = paper_antenna().link
+    x = np.linspace(1e-3, link.length, 4000)
+    omega = np.asarray(natural_frequencies(link, x, 1), dtype=float)[:, 0]
+    centre = float(np.asarray(natural_frequencies(link, x_c, 1), dtype=float)[..., 0])
+    inside = np.abs(omega - centre) <= relative * centre
+    k = int(np.searchsorted(x, x_c))
+    low, high = k, k
+    while low > 0 and inside[low - 1]:
+        low -= 1
+    while high < x.size - 1 and inside[high + 1]:
+        high += 1
+    expected = max(x_c - x[low], x[high] - x_c)
+    assert model_spread(link, x_c, relative) == pytest.approx(expected, abs=1e-3)

@@ -131,8 +131,7 @@ def candidates_from_omega1(
     return (float(grid[k]),), notes
 
 
-#: Half-width (m) and step (m) of the neighbourhood :func:`model_spread` searches.
-_SPREAD_REACH = 0.25
+#: Step (m) of the points :func:`model_spread` walks along the link.
 _SPREAD_STEP = 5e-4
 
 
@@ -140,11 +139,12 @@ def model_spread(link: Link, x_c: float, relative: float) -> float:
     """How far (m) from ``x_c`` the contact may lie for the frequency omega_1(x_c) known to a
     relative ``relative``: the largest |x - x_c| over the points next to x_c, on the link,
     whose omega_1 lies within that of omega_1(x_c) (the contiguous stretch of the sensing
-    curve; across the curve's maximum when the band reaches it, where the inverse is singular).
+    curve; across the curve's maximum when the band reaches it, where the inverse is singular),
+    walked to the link's ends if need be.
     """
     curve = sensing_curve(link)
     omega = float(curve.omega1(x_c))
-    steps = int(_SPREAD_REACH / _SPREAD_STEP)
+    steps = math.ceil(link.length / _SPREAD_STEP)
     spread = 0.0
     for sign in (-1.0, 1.0):
         x = x_c + sign * _SPREAD_STEP * np.arange(1, steps + 1)
