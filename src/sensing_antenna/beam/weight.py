@@ -33,7 +33,10 @@ The elastica holds the push's own geometry (the contact's lateral lever on R_x a
 shortening); these terms are what the weight adds to it. Each integrand is a polynomial of
 degree 6 or less on [0, x_c] and on [x_c, l], so Gauss-Legendre quadrature with four nodes on
 each is exact, and each integral a polynomial of degree 8 or less in x_c, interpolated once
-per link. Against a shooting solution of the planar elastica carrying its weight and the push
+per link. Not among them: what the reaction along the link does to the sagging link (R_x
+bends it further, a lever for R_x itself, of order g zeta_u R_x^2 / (E I)) and the weight's
+share along the link bending the pushed link (of order g zeta_X P R_x). Against a shooting
+solution of the planar elastica carrying its weight and the push
 (``tests/test_beam_weight.py``) what the sum leaves grows with the deflection;
 :data:`WEIGHT_RESIDUAL` bounds it.
 """

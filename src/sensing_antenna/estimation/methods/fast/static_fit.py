@@ -13,12 +13,13 @@ elastica loaded at the contact
 (:func:`~sensing_antenna.estimation.front.ratio.perpendicular_ratio`,
 :mod:`sensing_antenna.beam.elastica`) inverted from M_0 = Gamma' . v (v = X^m x R_perp /
 |R_perp|), the axial R_x and |R_perp|, with the one stiffness of every statics,
-1 / :attr:`~sensing_antenna.antenna.Link.bending_compliance`. The axial force is not fitted
-(the five channels hold the vibration's information; R_x enters the statics at first order in
-the deflection only): it is the front end's filtered reaction along the link at the window's
-last sample. Without deflection this is x_c = |M_0| / |R_perp| (Eq. 21 with the perpendicular
-force). Its standard error propagates the offsets' covariance through the gradient of that
-inversion, by differences of the same function (first-order delta method).
+1 / :attr:`~sensing_antenna.antenna.Link.bending_compliance`, the link's weight taken off at
+the window's elevation. The axial force is not fitted (the five channels hold the vibration's
+information; R_x enters the statics through the deflection and the link's sag, the levers the
+contact's offset from X^m gives it): it is the front end's filtered reaction along the link at
+the window's last sample. Without deflection or weight this is x_c = |M_0| / |R_perp| (Eq. 21
+with the perpendicular force). Its standard error propagates the offsets' covariance through
+the gradient of that inversion, by differences of the same function (first-order delta method).
 
 Sensor bias. An F/T sensor keeps a small offset after taring (the simulator draws two resolution
 counts, 12.5 mN and 6e-5 N m, per run). Against pushes of 20 to 200 mN a force offset of 10 mN
