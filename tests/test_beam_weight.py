@@ -126,17 +126,19 @@ def _read(link: Link, reading_link: Link, theta2: float, x_c: float, push: float
     return float(perpendicular_ratio(loads, torque, reading_link, theta2)[0]), loads[0]
 
 
+@pytest.mark.parametrize("tip_mass", [0.0, 1e-3])
 @pytest.mark.parametrize("deflection", [0.05, 0.3])
 @pytest.mark.parametrize("theta2", [-0.3, 0.09])
 @pytest.mark.parametrize("x_c", [0.3, 0.75, 0.95])
 @pytest.mark.parametrize(("up", "friction"), [(1.0, 0.6), (-1.0, -0.6), (-1.0, 0.6)])
 def test_the_ratio_holds_the_links_weight_within_its_residual(
-    deflection: float, theta2: float, x_c: float, up: float, friction: float
+    tip_mass: float, deflection: float, theta2: float, x_c: float, up: float, friction: float
 ) -> None:
     # pushes of 5 and 30 % of x_c, up or down, with friction along the link of 0.6 of the push
-    # either way; the ratio within weight_residual times the terms' magnitudes, the model term
-    # the ratio's uncertainty carries for them
-    link = paper_antenna().link
+    # either way, on the paper link and with a drop of 1 g at its tip (a fifth of its mass);
+    # the ratio within weight_residual times the terms' magnitudes, the model term the ratio's
+    # uncertainty carries for them
+    link = dataclasses.replace(paper_antenna().link, tip_mass=tip_mass)
     push = deflection * 3.0 / (link.bending_compliance * x_c**2)
     reading, loads = _read(link, link, theta2, x_c, up * push, friction * push)
     lateral = abs(float(loads[2]))
