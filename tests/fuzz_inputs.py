@@ -12,8 +12,8 @@ to the package through its public API and returns the :class:`Outcome` of each t
 
 Anything else is a finding (:data:`BAD_KINDS`): another exception (``traceback``), an error of
 several lines, an ``ok`` estimate outside (0, l] or from an input that fails the plausibility
-layer's units check, a best guess that is neither on the link nor NaN, a command that ends other
-than with exit code 0 or 2 and one line.
+layer's units check (a lone glitched sample aside: the front end puts it back), a best guess that is
+neither on the link nor NaN, a command that ends other than with exit code 0 or 2 and one line.
 
 Estimator, identification and calibration inputs are simulated recordings perturbed the way
 users and machines get them wrong (forces in mN, a sign flipped, angles in degrees, noise,
@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 from hypothesis import strategies as st
+from scipy.ndimage import median_filter
 
 from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna, paper_antenna
 from sensing_antenna.errors import SensingAntennaError
@@ -420,6 +421,16 @@ def _up_to(recording: Recording, t_end: float) -> Recording:
     )
 
 
+def _without_lone_samples(recording: Recording) -> Recording:
+    """The recording with each wrench channel through a running median of three samples, so a
+    single sample off both its neighbours (a glitch of the bus) takes a neighbour's value."""
+    with np.errstate(all="ignore"):
+        loads = median_filter(
+            np.column_stack([recording.force, recording.torque]), size=(3, 1), mode="nearest"
+        )
+    return dataclasses.replace(recording, force=loads[:, :3], torque=loads[:, 3:])
+
+
 def _finite_or_nan(value: float) -> bool:
     return math.isfinite(value) or math.isnan(value)
 
@@ -441,10 +452,11 @@ def judge_estimate(estimate: Any, recording: Recording, antenna: Antenna) -> Out
     if estimate.status is Status.OK:
         if not on_link:
             return Outcome(OK_OUTSIDE_LINK, f"x_c = {x_c!r} m, l = {length} m", label)
-        # check 1 of the layer: the loads at rest before t_c, the angles up to t_e
-        problem = units_problem(_up_to(recording, estimate.t_c), antenna) or angle_problem(
-            _up_to(recording, estimate.t_e).theta
-        )
+        # check 1 of the layer: the loads at rest before t_c, the angles up to t_e; a lone
+        # sensor sample off its neighbours is a glitch the front end puts back, not units
+        problem = units_problem(
+            _without_lone_samples(_up_to(recording, estimate.t_c)), antenna
+        ) or angle_problem(_up_to(recording, estimate.t_e).theta)
         if problem is not None:
             return Outcome(OK_IMPLAUSIBLE, problem, label)
         if "vibration_contact_point" not in estimate.diagnostics:

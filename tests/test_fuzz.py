@@ -56,6 +56,9 @@ def test_reader_reads_or_names_the_problem(data: bytes) -> None:
 
 @FEWER
 @given(perturbation=fz.perturbations())
+# a glitch of 1 N m in 'tx' while the head rests: the front end puts the sample back and the
+# estimate is right, though the raw rest's mean reads past the units check's tolerance
+@example(perturbation=fz.Perturbation(base=0, glitch=(0.03125, 5, 1.0)))
 def test_estimators_ok_only_on_the_link_from_plausible_input(
     bases: fz.Bases, perturbation: fz.Perturbation
 ) -> None:
