@@ -175,12 +175,12 @@ def _factors(push: Any, axial: Any, zeta_x: Any, zeta_u: Any) -> list[Any]:
     ]
 
 
-def weight_residual(link: Link, x_c: ArrayLike, push: ArrayLike) -> FloatArray:
-    """(a + b d) of :data:`WEIGHT_RESIDUAL` at contact points ``x_c`` (m) and pushes ``push``
-    (|R_perp|, N): d = push x_c^2 / (3 E I), Eq. 13's deflection over x_c."""
-    deflection = np.asarray(push, dtype=float) * np.asarray(x_c, dtype=float) ** 2
-    deflection = deflection * link.bending_compliance / 3.0
-    return np.asarray(WEIGHT_RESIDUAL[0] + WEIGHT_RESIDUAL[1] * deflection, dtype=float)
+def weight_residual(deflection: ArrayLike) -> FloatArray:
+    """(a + b d) of :data:`WEIGHT_RESIDUAL` at the push's deflection over x_c ``deflection``
+    (d = |R_perp| x_c^2 / (3 E I), Eq. 13; dimensionless, any shape)."""
+    return np.asarray(
+        WEIGHT_RESIDUAL[0] + WEIGHT_RESIDUAL[1] * np.asarray(deflection, dtype=float), dtype=float
+    )
 
 
 def _slope(link: Link, x_c: FloatArray, s: FloatArray) -> FloatArray:

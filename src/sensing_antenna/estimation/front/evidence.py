@@ -23,7 +23,7 @@ from sensing_antenna.beam.weight import pushed_weight_moment, weight_residual
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 from sensing_antenna.estimation.front.held import describe_held, find_held
-from sensing_antenna.estimation.front.ratio import contact_loads
+from sensing_antenna.estimation.front.ratio import contact_loads, vertical_shares
 from sensing_antenna.estimation.front.spikes import (
     LEVEL_SAMPLES,
     describe_run,
@@ -378,8 +378,7 @@ class Evidence:
         if push <= 0.0:
             return math.inf
         offset_term = math.hypot(x_c * self.offset_error, self.torque_offset_error) / push
-        # Eq. 13: y_c / x_c = |R_perp| x_c^2 / (3 E I)
-        deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
+        deflection_ratio = float(self.push_deflection_ratio(x_c))
         model_term = 0.0
         if model and statics == "small-deflection":
             model_term = math.hypot(
@@ -410,8 +409,7 @@ class Evidence:
         push = self.frame.lateral_force
         if push <= 0.0:
             return np.full(x_c.shape, np.inf)
-        # Eq. 13: y_c / x_c = |R_perp| x_c^2 / (3 E I)
-        deflection_ratio = push * x_c**2 * link.bending_compliance / 3.0
+        deflection_ratio = self.push_deflection_ratio(x_c)
         axial = abs(float(reaction[0])) / push
         stiffness = (
             2.0
@@ -421,19 +419,14 @@ class Evidence:
             * x_c
         )
         # what the first-order weight terms the ratio takes off leave (beam.weight)
-        theta2 = float(self.frame.theta[1])
+        link_vertical, push_vertical = vertical_shares(reaction, self.frame.theta[1])
         with np.errstate(over="ignore", invalid="ignore"):
             terms = pushed_weight_moment(
-                link,
-                x_c,
-                push,
-                float(reaction[0]),
-                math.sin(theta2),
-                float(reaction[2]) * math.cos(theta2) / push,
+                link, x_c, push, float(reaction[0]), link_vertical, push_vertical
             )
             weight = (
                 self.config.ratio_model_factor
-                * weight_residual(link, x_c, push)
+                * weight_residual(deflection_ratio)
                 * np.abs(terms).sum(axis=-1)
                 / push
             )

@@ -47,6 +47,7 @@ __all__ = [
     "paper_ratio",
     "perpendicular_ratio",
     "ratio_noise",
+    "vertical_shares",
     "window_mean",
 ]
 
@@ -196,17 +197,14 @@ def perpendicular_ratio(
     """
     reaction_f = np.asarray(reaction_f, dtype=float)
     torque_f = np.asarray(torque_f, dtype=float)
-    theta2 = np.broadcast_to(np.asarray(theta2, dtype=float), reaction_f.shape[:-1])
     r_x, r_y, r_z = reaction_f[..., 0], reaction_f[..., 1], reaction_f[..., 2]
     perpendicular = np.hypot(r_y, r_z)
     rigidity = 1.0 / link.bending_compliance
     with np.errstate(divide="ignore", invalid="ignore"):
         # M_0 = Gamma' . v with v = X^m x R_perp / |R_perp| = (0, -R_z, R_y) / |R_perp|
         moment_v = (torque_f[..., 2] * r_y - torque_f[..., 1] * r_z) / perpendicular
-        # gravity along z = (sin theta2, 0, cos theta2) in the motor frame
-        push_vertical = r_z * np.cos(theta2) / perpendicular
+    link_vertical, push_vertical = vertical_shares(reaction_f, theta2)
     x_c = _elastica_arc(moment_v, r_x, perpendicular, rigidity)
-    link_vertical = np.sin(theta2)
     for _ in range(_WEIGHT_STEPS):
         with np.errstate(over="ignore", invalid="ignore"):
             weight = weight_moment(
@@ -221,6 +219,19 @@ def perpendicular_ratio(
         weight = np.where(np.isfinite(weight), weight, 0.0)
         x_c = _elastica_arc(moment_v - weight, r_x, perpendicular, rigidity)
     return np.where(perpendicular > 0.0, x_c, np.nan)
+
+
+def vertical_shares(reaction: ArrayLike, theta2: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """X^m . z and u . z (u = R_perp / |R_perp|), gravity along z = (sin theta2, 0, cos theta2)
+    in the motor frame: the link's and the push's vertical shares that
+    :func:`~sensing_antenna.beam.weight.pushed_weight_moment` reads, for reactions ``reaction``
+    (N, shape (..., 3), motor frame) at elevations ``theta2`` (rad, broadcast to (...)); the
+    push's share is NaN where R_perp is zero."""
+    reaction = np.asarray(reaction, dtype=float)
+    theta2 = np.broadcast_to(np.asarray(theta2, dtype=float), reaction.shape[:-1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        push = reaction[..., 2] * np.cos(theta2) / np.hypot(reaction[..., 1], reaction[..., 2])
+    return np.asarray(np.sin(theta2), dtype=float), np.asarray(push, dtype=float)
 
 
 def _elastica_arc(

@@ -16,7 +16,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -31,8 +30,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_spectrum,
     find_peak,
 )
-from sensing_antenna.estimation.methods.paper.fusion import conclude, model_spread
-from sensing_antenna.estimation.methods.paper.held_contact import HeldContact, held_contact
+from sensing_antenna.estimation.methods.paper.fusion import conclude, held_contact_spread
 from sensing_antenna.estimation.methods.paper.planes import planes_agree
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
@@ -137,11 +135,13 @@ class TwoFrequencyMethod:
                 diag["curve_distance"] = float(distance[k])
                 # read in the push plane alone: the free plane does not ring with it
                 push_plane = measurement.component == "z_c" and not planes_agree(measurement, cfg)
-                held = held_contact(evidence, measurement.omega1, x_c) if push_plane else None
-                if held is not None:
-                    diag["held_contact"] = dataclasses.asdict(held)
+                hold = (
+                    held_contact_spread(evidence, measurement.omega1, x_c, diag)[1]
+                    if push_plane
+                    else 0.0
+                )
                 problems.extend(
-                    _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane, held)
+                    _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane, hold)
                 )
             else:
                 problems.append(
@@ -172,13 +172,14 @@ def _curve_problems(
     k: int,
     distance: float,
     push_plane: bool,
-    held: HeldContact | None = None,
+    hold: float = 0.0,
 ) -> list[tuple[Status, str]]:
     """Why the two-frequency answer ``grid[k]`` (m), whose measured pair lies ``distance``
     (relative) from the curve ``omegas`` (rad/s, (n, 2)), is not to be trusted: off the curve
     by more than the model allows, or moved by the model's own uncertainty and, for frequencies
     read in the push plane alone (``push_plane``), by the bent link and a contact held along
-    it (``held``: the bound of its rise of omega_1), as the paper method's candidate."""
+    it (``hold``: how far (m) its rise of omega_1 may move the answer), as the paper method's
+    candidate."""
     cfg = evidence.config
     x_c = float(grid[k])
     u = evidence.antenna.link.frequency_uncertainty
@@ -200,7 +201,6 @@ def _curve_problems(
     near = np.all(np.abs(omegas / omegas[k] - 1.0) <= 2.0 * u, axis=1)
     spread = float(np.max(np.abs(grid[near] - x_c))) if np.any(near) else 0.0
     bent = 2.0 * evidence.bent_link_uncertainty(x_c) if push_plane else 0.0
-    hold = model_spread(evidence.antenna.link, x_c, held.shift) if held is not None else 0.0
     total = math.hypot(spread, bent, hold)
     if total > cfg.max_model_spread:
         problems.append(

@@ -156,6 +156,20 @@ def model_spread(link: Link, x_c: float, relative: float) -> float:
     return spread
 
 
+def held_contact_spread(
+    evidence: Evidence, omega1: float, x_c: float, diag: dict[str, Any]
+) -> tuple[HeldContact | None, float]:
+    """A contact held along the link (:func:`.held_contact.held_contact`) for an omega_1
+    (rad/s) read in the push plane alone at the answer ``x_c`` (m), and how far (m) its rise
+    may move that answer (:func:`model_spread`; 0 with nothing to read); stored in ``diag``
+    under ``held_contact``."""
+    held = held_contact(evidence, omega1, x_c)
+    if held is None:
+        return None, 0.0
+    diag["held_contact"] = dataclasses.asdict(held)
+    return held, model_spread(evidence.antenna.link, x_c, held.shift)
+
+
 #: A ratio beyond this many link lengths (or below zero) is off the link: no contact's.
 _OFF_LINK = 1.5
 
@@ -497,11 +511,9 @@ class PaperMethod:
                 # rise a contact held along the link makes, bounded by the force along it
                 preload = 2.0 * evidence.bent_link_uncertainty(fusion.x_c)
                 diag["preload_spread"] = preload
-                held = held_contact(evidence, measurement.omega1, fusion.x_c)
-                held_spread = 0.0
-                if held is not None:
-                    diag["held_contact"] = dataclasses.asdict(held)
-                    held_spread = model_spread(link, fusion.x_c, held.shift)
+                held, held_spread = held_contact_spread(
+                    evidence, measurement.omega1, fusion.x_c, diag
+                )
                 total = math.hypot(spread, preload, held_spread)
                 if total > cfg.max_model_spread:
                     problems.append((Status.UNCERTAIN, _push_plane_reason(total, held, cfg)))
