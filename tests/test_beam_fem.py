@@ -261,18 +261,23 @@ def test_held_contact_coupling_matches_finite_elements(xi: float, ratio: float) 
 
     kappa itself: the FE's support moment at the clamp and its chord's change, from Hermite
     derivatives without the integration by parts, agree to 1e-5 (the FE's error in shapes and
-    moments at this mesh is about 1e-7 to 1e-6). A soft hold of the chord (a rise of 1e-3) rises
-    by r kappa / 2 (per unit d) within 5e-2 (the estimate's own first-order error: 4e-2 at xi =
-    0.2, 2e-2 or less from 0.4 on). Stiffer, the mode reshapes; wherever the rise stays under 60 %
-    (which a push plane's peak inside the paper link's band cannot exceed) the estimate from the
-    r of the reshaped mode is at least the rise.
-    """
+    moments at this mesh is about 1e-7 to 1e-6). A soft hold of the chord (a rise of 1e-3) rises by
+    r kappa / 2 (per unit d) within 5e-2 (the estimate's own first-order error: 4e-2 at xi = 0.2,
+    2e-2 or less from 0.4 on), and a soft spring of the other sign falls by as much. Stiffer, the
+    mode reshapes; wherever the rise stays under 60 % (which a push plane's peak inside the paper
+    link's band cannot exceed) the estimate from the r of the reshaped mode is at least the rise."""
     from sensing_antenna.beam import held_contact_coupling
 
     kappa = float(held_contact_coupling(_link(ratio), xi))
     assert abs(kappa) == pytest.approx(abs(fe_held_coupling(xi, ratio)), rel=1e-5)
     rise, r = fe_held_rise(xi, ratio, 1e-3)
     assert 0.5 * abs(r * kappa) == pytest.approx(rise, rel=5e-2)
+    # signed, with the FE's own kappa: an axial force in phase the other way (a softening
+    # spring, as the link's axial inertia or slipping friction make) lowers omega_1 as much
+    fall, r_soft = fe_held_rise(xi, ratio, -1e-3)
+    assert fall < 0.0
+    assert 0.5 * r_soft * fe_held_coupling(xi, ratio) == pytest.approx(fall, rel=5e-2)
+    assert 0.5 * r * fe_held_coupling(xi, ratio) == pytest.approx(rise, rel=5e-2)
     for target in (1e-2, 1e-1, 3e-1, 1.0, 1e3):
         stiff_rise, stiff_r = fe_held_rise(xi, ratio, target)
         if stiff_rise < 0.6:

@@ -31,7 +31,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
     find_peak,
 )
 from sensing_antenna.estimation.methods.paper.fusion import conclude, held_contact_spread
-from sensing_antenna.estimation.methods.paper.planes import planes_agree
+from sensing_antenna.estimation.methods.paper.planes import free_plane_mode, planes_agree
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = ["RatioMethod", "TwoFrequencyMethod"]
@@ -133,13 +133,16 @@ class TwoFrequencyMethod:
                 k = int(np.argmin(distance))
                 x_c = float(grid[k])
                 diag["curve_distance"] = float(distance[k])
-                # read in the push plane alone: the free plane does not ring with it
-                push_plane = measurement.component == "z_c" and not planes_agree(measurement, cfg)
-                hold = (
-                    held_contact_spread(evidence, measurement.omega1, x_c, diag)[1]
-                    if push_plane
-                    else 0.0
-                )
+                # read in the push plane alone: the free plane does not ring with it; or with a
+                # free-plane peak that may be the push plane's leak, which a hold's stiffening
+                # voids as corroboration
+                agree = planes_agree(measurement, cfg)
+                push_plane = measurement.component == "z_c" and not agree
+                hold = 0.0
+                if push_plane or (agree and free_plane_mode(measurement, cfg) is None):
+                    held, spread = held_contact_spread(evidence, measurement.omega1, x_c, diag)
+                    if push_plane or (held is not None and held.stiffens):
+                        hold = spread
                 problems.extend(
                     _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane, hold)
                 )
@@ -176,8 +179,8 @@ def _curve_problems(
 ) -> list[tuple[Status, str]]:
     """Why the two-frequency answer ``grid[k]`` (m), whose measured pair lies ``distance``
     (relative) from the curve ``omegas`` (rad/s, (n, 2)), is not to be trusted: off the curve
-    by more than the model allows, or moved by the model's own uncertainty and, for frequencies
-    read in the push plane alone (``push_plane``), by the bent link and a contact held along
+    by more than the model allows, or moved by the model's own uncertainty, by the bent link
+    for frequencies read in the push plane alone (``push_plane``), and by a contact held along
     it (``hold``: how far (m) its rise of omega_1 may move the answer), as the paper method's
     candidate."""
     cfg = evidence.config

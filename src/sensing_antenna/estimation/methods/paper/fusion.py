@@ -160,7 +160,7 @@ def held_contact_spread(
     evidence: Evidence, omega1: float, x_c: float, diag: dict[str, Any]
 ) -> tuple[HeldContact | None, float]:
     """A contact held along the link (:func:`.held_contact.held_contact`) for an omega_1
-    (rad/s) read in the push plane alone at the answer ``x_c`` (m), and how far (m) its rise
+    (rad/s) of the push plane at the answer ``x_c`` (m), and how far (m) its rise
     may move that answer (:func:`model_spread`; 0 with nothing to read); stored in ``diag``
     under ``held_contact``."""
     held = held_contact(evidence, omega1, x_c)
@@ -506,17 +506,25 @@ class PaperMethod:
         if candidates_used and math.isfinite(fusion.x_c):
             spread = model_spread(link, fusion.x_c, 2.0 * link.frequency_uncertainty)
             diag["model_spread"] = spread
-            if diag.get("frequency_plane") == "push":
-                # a frequency of the push plane alone carries the bent link's preload, and the
-                # rise a contact held along the link makes, bounded by the force along it
-                preload = 2.0 * evidence.bent_link_uncertainty(fusion.x_c)
-                diag["preload_spread"] = preload
+            plane = diag.get("frequency_plane")
+            if plane == "push" or (plane == "both" and diag.get("free_plane_mode") is None):
+                # the push plane's frequency, alone or with a free-plane peak that may be its
+                # leak, carries the rise a contact held along the link makes, bounded by the
+                # force along it; read alone, the bent link's preload too
+                preload = 0.0
+                if plane == "push":
+                    preload = 2.0 * evidence.bent_link_uncertainty(fusion.x_c)
+                    diag["preload_spread"] = preload
                 held, held_spread = held_contact_spread(
                     evidence, measurement.omega1, fusion.x_c, diag
                 )
+                if plane == "both" and not (held is not None and held.stiffens):
+                    held_spread = 0.0  # the free plane's agreement stands
                 total = math.hypot(spread, preload, held_spread)
-                if total > cfg.max_model_spread:
-                    problems.append((Status.UNCERTAIN, _push_plane_reason(total, held, cfg)))
+                if total > cfg.max_model_spread and (plane == "push" or held_spread > 0.0):
+                    problems.append(
+                        (Status.UNCERTAIN, _push_plane_reason(total, held, plane == "push", cfg))
+                    )
             if spread > cfg.max_model_spread:
                 problems.append(
                     (
@@ -550,18 +558,28 @@ class PaperMethod:
         )
 
 
-def _push_plane_reason(total: float, held: HeldContact | None, cfg: EstimatorConfig) -> str:
-    """Why an omega_1 read in the push plane alone may put the candidate ``total`` (m) off."""
-    cause = "where the bent link's preload shifts it"
+def _push_plane_reason(
+    total: float, held: HeldContact | None, alone: bool, cfg: EstimatorConfig
+) -> str:
+    """Why an omega_1 of the push plane, read there ``alone`` or with a free-plane peak that may
+    be its leak, may put the candidate ``total`` (m) off."""
+    causes = ["where the bent link's preload shifts it"] if alone else []
     if held is not None and held.shift > 0.0:
-        cause += (
-            f", and the force along the link rings with it, {held.ringing:.2g} N per N m of "
-            f"the bending moment, more than sliding, cross-talk and noise make: friction holds "
-            f"the contact along the link, which may raise omega_1 by up to "
+        causes.append(
+            f"the force along the link rings with it, {held.ringing:.2g} N per N m of "
+            f"the bending moment ({held.in_phase:.2g} in phase), more than sliding, cross-talk "
+            f"and noise make: "
+            f"friction holds the contact along the link, which may raise omega_1 by up to "
             f"{100 * held.shift:.1f} %"
         )
+    where = (
+        "in the push plane alone"
+        if alone
+        else "in both planes, where the free plane's peak may be the push plane's leak"
+    )
+    cause = ", and ".join(causes)
     return (
-        f"omega_1 was read in the push plane alone, {cause}: with the frequency model's own "
+        f"omega_1 was read {where}, {cause}: with the frequency model's own "
         f"uncertainty the candidate may be {100 * total:.1f} cm off at two standard deviations, "
         f"more than {100 * cfg.max_model_spread:g} cm"
     )

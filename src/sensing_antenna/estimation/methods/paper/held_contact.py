@@ -10,6 +10,15 @@ push plane (the torque omega_1 is read from), Rayleigh's quotient puts the rise 
 So the ringing of the force along the link, over the spectrum's own window, tells how far a
 push plane's omega_1 may sit above the straight link's curve.
 
+Only the part of r in phase with the vibration stores energy, and the product's sign says
+which way it moves the frequency: a hold stiffens (Re(r) kappa > 0); the exact link pushed
+sideways into a post, where friction rings along the link in phase the other way, rings lower,
+by about what the product says. The rise taken still reads the whole amplitude: on the rod
+engine's vertical push at 0.7 m the force along the link rang mostly in quadrature and the push
+plane rose 4.5 % (docs/design-notes.md, "The hold's ringing in phase"). The part in phase is
+evidence that a hold stiffens the push plane: where the free plane's peak agrees with the push
+plane's and may be its leak, only that evidence voids the agreement.
+
 What else rings along the link at omega_1 is taken off r first:
 
 - a sliding contact's own axial share: its reaction keeps its direction, R_x / |R_perp| of the
@@ -67,6 +76,9 @@ class HeldContact:
     ringing : float
         Amplitude of the axial force at omega_1 beyond a sliding contact's own axial share, over
         the push plane's bending moment at the base (1/m, N per N m).
+    in_phase : float
+        Its part in phase with that moment (1/m), signed so that a hold's is positive (a
+        negative one lowers omega_1).
     leak : float
         The part of it the sensor's cross-talk and the channels' noise may make (1/m).
     shift : float
@@ -76,8 +88,14 @@ class HeldContact:
     """
 
     ringing: float
+    in_phase: float
     leak: float
     shift: float
+
+    @property
+    def stiffens(self) -> bool:
+        """Whether the part in phase is a hold's beyond what the leak may make."""
+        return bool(self.in_phase > self.leak)
 
 
 def _noise_amplitudes(
@@ -127,22 +145,24 @@ def held_contact(evidence: Evidence, omega: float, x_c: float) -> HeldContact | 
     amplitudes = _amplitude(np.hstack([force, moment]), t, omega)
     axial, shear, bending = amplitudes[0], amplitudes[:3] @ across, amplitudes[3:] @ normal
     if not np.all(np.isfinite(amplitudes)):
-        return HeldContact(ringing=math.nan, leak=math.nan, shift=math.inf)
+        return HeldContact(ringing=math.nan, in_phase=math.nan, leak=math.nan, shift=math.inf)
     lines = np.column_stack([force[:, 0], force @ across])
     noise = _noise_amplitudes(lines, t, evidence.band, omega)
     if noise is None or not abs(bending) > 0.0:
         return None
     link = evidence.antenna.link
     share = -float(reaction[0]) / push * first_mode_value(link, contact_to_base_shear, x_c)
-    ringing = float(abs(axial - share * shear) / abs(bending))
+    coupling = first_mode_value(link, held_contact_coupling, x_c)
+    ratio = (axial - share * shear) / bending
+    ringing, in_phase = float(abs(ratio)), float(ratio.real * math.copysign(1.0, coupling))
     # what the cross-talk of the three torques and the channels' noise may put there
     torques = float(np.abs(amplitudes[3:]).sum())
-    coupling = COUPLING_EDGE * evidence.antenna.sensor.nominal_coupling
+    cross_talk = COUPLING_EDGE * evidence.antenna.sensor.nominal_coupling
     noisy = NOISE_MEDIANS * (float(noise[0]) + abs(share) * float(noise[1]))
-    leak = float((coupling * torques + noisy) / abs(bending))
-    kappa = abs(first_mode_value(link, held_contact_coupling, x_c))
+    leak = float((cross_talk * torques + noisy) / abs(bending))
+    kappa = abs(coupling)
     deflection = float(evidence.push_deflection_ratio(x_c))
     shift = float(BOUND_FACTOR * 0.5 * max(ringing - leak, 0.0) * kappa * deflection)
     if not (math.isfinite(ringing) and math.isfinite(leak) and math.isfinite(shift)):
         shift = math.inf
-    return HeldContact(ringing=ringing, leak=leak, shift=shift)
+    return HeldContact(ringing=ringing, in_phase=in_phase, leak=leak, shift=shift)
