@@ -269,11 +269,14 @@ def test_held_contact_coupling_matches_finite_elements(xi: float, ratio: float) 
     from sensing_antenna.beam import held_contact_coupling
 
     kappa = float(held_contact_coupling(_link(ratio), xi))
-    assert abs(kappa) == pytest.approx(abs(fe_held_coupling(xi, ratio)), rel=1e-5)
+    # of the opposite sign: the FE's moment is the support's on the link, kappa's the link's on
+    # the base, as the sensor reads it (so is r's there, and a hold's r kappa stays positive)
+    assert kappa == pytest.approx(-fe_held_coupling(xi, ratio), rel=1e-5)
     rise, r = fe_held_rise(xi, ratio, 1e-3)
     assert 0.5 * abs(r * kappa) == pytest.approx(rise, rel=5e-2)
-    # signed, with the FE's own kappa: an axial force in phase the other way (a softening
-    # spring, as the link's axial inertia or slipping friction make) lowers omega_1 as much
+    # Rayleigh's quotient signed, in the FE's own convention: an axial force in phase the other
+    # way (a softening spring, as the link's axial inertia or slipping friction make) lowers
+    # omega_1 as much as a hold raises it
     fall, r_soft = fe_held_rise(xi, ratio, -1e-3)
     assert fall < 0.0
     assert 0.5 * r_soft * fe_held_coupling(xi, ratio) == pytest.approx(fall, rel=5e-2)

@@ -9,9 +9,10 @@
   model's own uncertainty allows) is a ``model_mismatch``, and an answer that the model's
   uncertainty (and, read in the push plane alone, the bent link's,
   ``Evidence.bent_link_uncertainty``, and a held contact's rise,
-  :mod:`~sensing_antenna.estimation.methods.paper.held_contact`) may move by more than
-  ``max_model_spread`` at two standard deviations is ``uncertain``, as the paper method's
-  candidate.
+  :mod:`~sensing_antenna.estimation.methods.paper.held_contact`; read in both planes where the
+  free plane's peak may be the push plane's leak, that rise when the force along the link rings
+  in phase as a hold's) may move by more than ``max_model_spread`` at two standard deviations
+  is ``uncertain``, as the paper method's candidate.
 """
 
 from __future__ import annotations

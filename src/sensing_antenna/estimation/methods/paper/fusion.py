@@ -563,8 +563,14 @@ def _push_plane_reason(
 ) -> str:
     """Why an omega_1 of the push plane, read there ``alone`` or with a free-plane peak that may
     be its leak, may put the candidate ``total`` (m) off."""
-    causes = ["where the bent link's preload shifts it"] if alone else []
-    if held is not None and held.shift > 0.0:
+    causes = [
+        "where the bent link's preload shifts it"
+        if alone
+        else "where the free plane's peak may be the push plane's leak"
+    ]
+    if held is not None and math.isinf(held.shift):
+        causes.append("the loads along the link are not finite: no bound of a hold's rise")
+    elif held is not None and held.shift > 0.0:
         causes.append(
             f"the force along the link rings with it, {held.ringing:.2g} N per N m of "
             f"the bending moment ({held.in_phase:.2g} in phase), more than sliding, cross-talk "
@@ -572,14 +578,9 @@ def _push_plane_reason(
             f"friction holds the contact along the link, which may raise omega_1 by up to "
             f"{100 * held.shift:.1f} %"
         )
-    where = (
-        "in the push plane alone"
-        if alone
-        else "in both planes, where the free plane's peak may be the push plane's leak"
-    )
-    cause = ", and ".join(causes)
+    where = "in the push plane alone" if alone else "in both planes"
     return (
-        f"omega_1 was read {where}, {cause}: with the frequency model's own "
+        f"omega_1 was read {where}, {', and '.join(causes)}: with the frequency model's own "
         f"uncertainty the candidate may be {100 * total:.1f} cm off at two standard deviations, "
         f"more than {100 * cfg.max_model_spread:g} cm"
     )

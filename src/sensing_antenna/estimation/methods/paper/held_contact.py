@@ -94,8 +94,9 @@ class HeldContact:
 
     @property
     def stiffens(self) -> bool:
-        """Whether the part in phase is a hold's beyond what the leak may make."""
-        return bool(self.in_phase > self.leak)
+        """Whether the part in phase is a hold's beyond what the leak may make, or the loads
+        give no bound (``shift`` infinite)."""
+        return bool(self.in_phase > self.leak or math.isinf(self.shift))
 
 
 def _noise_amplitudes(
@@ -154,7 +155,8 @@ def held_contact(evidence: Evidence, omega: float, x_c: float) -> HeldContact | 
     share = -float(reaction[0]) / push * first_mode_value(link, contact_to_base_shear, x_c)
     coupling = first_mode_value(link, held_contact_coupling, x_c)
     ratio = (axial - share * shear) / bending
-    ringing, in_phase = float(abs(ratio)), float(ratio.real * math.copysign(1.0, coupling))
+    sign = math.copysign(1.0, coupling) if math.isfinite(coupling) else math.nan
+    ringing, in_phase = float(abs(ratio)), float(ratio.real * sign)
     # what the cross-talk of the three torques and the channels' noise may put there
     torques = float(np.abs(amplitudes[3:]).sum())
     cross_talk = COUPLING_EDGE * evidence.antenna.sensor.nominal_coupling

@@ -23,7 +23,9 @@ link may make (:mod:`~sensing_antenna.estimation.methods.paper.held_contact`); o
 corroborated by a peak at the same frequency in the free plane, clear or at least half as clear
 as a peak must be on its own, carries the first as the bound of a shift (the plausibility
 layer): on a bent link the push plane's mode leaks into the free plane's component (the sag
-tilts the planes), so the two can agree on the push plane's frequency.
+tilts the planes), so the two can agree on the push plane's frequency. Where the free plane's
+peak may be such a leak (no free plane's own mode, below), a force along the link that rings
+in phase as a hold's voids the agreement, and the hold's rise is carried as when read alone.
 
 The free plane's own mode is known when its clear peak cannot be such a leak
 (:func:`free_plane_mode`): no peak of the push plane lies within the Hann window's main lobe of
