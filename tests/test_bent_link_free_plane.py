@@ -105,3 +105,16 @@ def test_the_free_plane_bound_grows_with_the_push_and_ends_where_its_table_does(
         assert np.all(np.diff(bounds) > 0)
     # past the deepest push computed the bound is not known
     assert free_plane_shift(0.5, 0.41) == math.inf
+
+
+def test_the_bound_over_arrays_is_the_tables_at_its_nodes_and_unknown_past_it() -> None:
+    # the posterior of the fast method reads the bound on its whole grid at once
+    from sensing_antenna.beam import free_plane_shifts
+    from sensing_antenna.beam.free_plane import FREE_PLANE_SHIFTS
+
+    spans, pushes = np.meshgrid(FREE_PLANE_SPANS, FREE_PLANE_DEFLECTIONS, indexing="ij")
+    assert free_plane_shifts(spans, pushes) == pytest.approx(np.array(FREE_PLANE_SHIFTS), rel=1e-12)
+    beyond = free_plane_shifts([0.5, 0.5, math.nan, 0.1], [0.41, math.nan, 0.1, -0.2])
+    assert np.all(np.isinf(beyond[:3]))
+    # below the first contact the first row; a push either way
+    assert beyond[3] == pytest.approx(free_plane_shifts(FREE_PLANE_SPANS[0], 0.2))

@@ -20,7 +20,7 @@ from sensing_antenna.beam.characteristic import (
     eigenvalues,
     mode_count,
 )
-from sensing_antenna.beam.free_plane import free_plane_shift
+from sensing_antenna.beam.free_plane import free_plane_shift, free_plane_shifts
 from sensing_antenna.beam.modes import (
     contact_ratio,
     contact_to_base_shear,
@@ -54,6 +54,7 @@ __all__ = [
     "eigenvalue_slopes",
     "eigenvalues",
     "free_plane_shift",
+    "free_plane_shifts",
     "frequency_scale",
     "held_contact_coupling",
     "mode_count",

@@ -27,12 +27,20 @@ the deepest push tabulated the bound is not known (inf).
 from __future__ import annotations
 
 import functools
-import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import RegularGridInterpolator
 
-__all__ = ["FREE_PLANE_DEFLECTIONS", "FREE_PLANE_SHIFTS", "FREE_PLANE_SPANS", "free_plane_shift"]
+__all__ = [
+    "FREE_PLANE_DEFLECTIONS",
+    "FREE_PLANE_SHIFTS",
+    "FREE_PLANE_SPANS",
+    "free_plane_shift",
+    "free_plane_shifts",
+]
+
+FloatArray = NDArray[np.float64]
 
 #: Contact points of the table, as x_c / l (the paper link's 0.3 to 0.975 m of l = 0.98 m).
 FREE_PLANE_SPANS = tuple(x / 0.98 for x in (0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.975))
@@ -79,8 +87,20 @@ def free_plane_shift(span: float, deflection_ratio: float) -> float:
         The bound, 0 for a straight link; inf beyond the deepest push tabulated (0.4) or for
         inputs that are not finite.
     """
-    d = abs(deflection_ratio)
-    if not (math.isfinite(span) and d <= FREE_PLANE_DEFLECTIONS[-1]):
-        return math.inf
-    u = min(max(span, FREE_PLANE_SPANS[0]), FREE_PLANE_SPANS[-1])
-    return float(_table()([[u, d]])[0])
+    return float(free_plane_shifts(span, deflection_ratio))
+
+
+def free_plane_shifts(span: ArrayLike, deflection_ratio: ArrayLike) -> FloatArray:
+    """:func:`free_plane_shift` elementwise over arrays that broadcast together."""
+    u, d = np.broadcast_arrays(np.asarray(span, dtype=float), np.abs(deflection_ratio))
+    known = np.isfinite(u) & (d <= FREE_PLANE_DEFLECTIONS[-1])
+    points = np.stack(
+        [
+            np.clip(
+                np.where(known, u, FREE_PLANE_SPANS[0]), FREE_PLANE_SPANS[0], FREE_PLANE_SPANS[-1]
+            ),
+            np.where(known, d, 0.0),
+        ],
+        axis=-1,
+    )
+    return np.where(known, _table()(points.reshape(-1, 2)).reshape(u.shape), np.inf)

@@ -170,6 +170,12 @@ def conclude_fast(
             "fit_through_push": final.fit is not None and final.fit.restart is not None,
             "modes": final.fit.omega if final.fit is not None else (),
             "free_plane_share": _free_plane_share(final, evidence.frame.reaction_m[1:]),
+            # the plausibility layer judges the straight enough link on that plane's bound
+            **(
+                {"free_plane_mode": {"omega": final.omega1, "separation": 0.0}}
+                if final.free_plane
+                else {}
+            ),
             "push_force": push,
             **placement(touch, frame, t_point),
             # the window's first sample: t_1, or later when the link bounced after t_1

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sensing_antenna.beam import free_plane_shifts
 from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.methods.fast.config import FastConfig
 from sensing_antenna.estimation.methods.fast.curves import curve_table
@@ -75,13 +76,22 @@ def scan_inputs(evidence: Evidence, config: FastConfig) -> ScanInputs:
     # much as its shift: the whole shift as the term's standard uncertainty, since the mass
     # read is itself uncertain and a sensor's offset may be in it
     payload = evidence.payload_shifts(table.grid)
+    push_term = np.hypot(np.where(np.isfinite(bent), bent, 0.0), payload)
+    # out of the push plane the bent link rings within the free plane's bound (taken as two
+    # standard uncertainties), where it is known
+    free = (
+        0.5
+        * table.omega1
+        * free_plane_shifts(table.grid / link.length, evidence.push_deflection_ratio(table.grid))
+    )
     statics = StaticsModel(
         evidence.reaction_f[:, 0],
         table.grid,
         evidence.ratio_model_uncertainty(table.grid, coupling=True),
-        np.hypot(np.where(np.isfinite(bent), bent, 0.0), payload),
+        push_term,
         np.array(evidence.frame.reaction_m[1:], dtype=float),
         np.array(evidence.theta[:, 1], dtype=float),
+        np.where(np.isfinite(free), np.hypot(free, payload), push_term),
     )
     return ScanInputs(
         channels,

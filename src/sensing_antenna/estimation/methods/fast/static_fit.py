@@ -209,6 +209,13 @@ class StaticsModel:
     elevation : array, shape (n,), optional
         theta2 (rad) at every sample, which puts the link's weight in the statics; None: a
         level link.
+    free_omega1_sd : array, shape (G,), optional
+        ``omega1_sd`` where omega_1 is the free plane's own mode (a fitted mode that vibrates mostly
+        out of the push plane): half the free plane's bound of its shift
+        (:func:`~sensing_antenna.beam.free_plane.free_plane_shifts`, a bound taken as two
+        standard uncertainties) at each grid point's deflection, times omega_1 there, the
+        payload's shift in quadrature; ``omega1_sd`` where that bound is not known. None: the
+        free plane's mode carries ``omega1_sd``.
     """
 
     axial: FloatArray | None = None
@@ -217,6 +224,7 @@ class StaticsModel:
     omega1_sd: FloatArray | None = None
     push_direction: FloatArray | None = None
     elevation: FloatArray | None = None
+    free_omega1_sd: FloatArray | None = None
 
     def axial_at(self, index: int) -> float:
         """R_x (N) at sample ``index``; 0 without it."""
@@ -236,11 +244,19 @@ class StaticsModel:
             return 0.0
         return float(np.interp(x_c, self.grid, self.model_sd))
 
-    def omega1_sd_at(self, x_c: float) -> float:
-        """``omega1_sd`` at ``x_c`` (m), linearly between grid points; 0 without it."""
-        if self.grid is None or self.omega1_sd is None:
+    def frequency_sd(self, free_plane: bool) -> FloatArray | None:
+        """The omega_1 term on the grid for a fundamental in the free plane (``free_omega1_sd``
+        where given) or not (``omega1_sd``)."""
+        if free_plane and self.free_omega1_sd is not None:
+            return self.free_omega1_sd
+        return self.omega1_sd
+
+    def omega1_sd_at(self, x_c: float, free_plane: bool = False) -> float:
+        """:meth:`frequency_sd` at ``x_c`` (m), linearly between grid points; 0 without it."""
+        term = self.frequency_sd(free_plane)
+        if self.grid is None or term is None:
             return 0.0
-        return float(np.interp(x_c, self.grid, self.omega1_sd))
+        return float(np.interp(x_c, self.grid, term))
 
 
 @dataclass(frozen=True)

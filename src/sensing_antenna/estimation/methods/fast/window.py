@@ -40,6 +40,7 @@ from sensing_antenna.estimation.methods.fast.curves import contact_candidates, c
 from sensing_antenna.estimation.methods.fast.evaluation_grid import reference_index
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior, contact_posterior
 from sensing_antenna.estimation.methods.fast.parametric import DampedSinusoidFit
+from sensing_antenna.estimation.methods.fast.planes import free_plane_share
 from sensing_antenna.estimation.methods.fast.second_mode import (
     BranchChooser,
     on_chosen_branch,
@@ -161,6 +162,10 @@ class WindowEstimate:
         True when every check passed but the peak margin: omega_1 is within ``peak_margin``
         standard deviations of the top of the sensing curve, or above it, where it does not
         place x_c.
+    free_plane : bool
+        True when omega_1 is the free plane's own mode (the fitted fundamental vibrates mostly
+        out of the push plane, :mod:`.planes`): its model term is the free plane's bound
+        (``StaticsModel.free_omega1_sd``), not the bent link's.
     """
 
     start_index: int
@@ -185,6 +190,7 @@ class WindowEstimate:
     second_mode: dict[str, Any] = field(default_factory=dict)
     settled: bool = False
     near_top: bool = False
+    free_plane: bool = False
 
 
 def evaluate_window(
@@ -284,7 +290,14 @@ def evaluate_window(
     ratio_se = statics.standard_error if statics is not None else math.nan
     push_force = statics.perpendicular_force if statics is not None else 0.0
     ratio_model = _on_grid(statics_model.model_sd, table.grid)
-    frequency_model = _on_grid(statics_model.omega1_sd, table.grid)
+    # a fundamental that vibrates mostly out of the push plane is the free plane's own mode
+    free_plane = bool(
+        direction is not None
+        and fit is not None
+        and k is not None
+        and free_plane_share(fit, direction)[k] > 0.5
+    )
+    frequency_model = _on_grid(statics_model.frequency_sd(free_plane), table.grid)
 
     def posterior_with(
         omega: float, frequency_se: float, ratio_se: float, higher_se: float
@@ -332,7 +345,10 @@ def evaluate_window(
         frequency_z, note = frequency_check(
             omega1,
             frequency_sigma(
-                omega1, omega1_se, frequency_floor, statics_model.omega1_sd_at(posterior.x_c)
+                omega1,
+                omega1_se,
+                frequency_floor,
+                statics_model.omega1_sd_at(posterior.x_c, free_plane),
             ),
             float(np.interp(posterior.x_c, table.grid, table.omega1)),
             posterior.x_c,
@@ -426,6 +442,7 @@ def evaluate_window(
         second_mode=second_mode,
         settled=settled and not notes,
         near_top=near_top,
+        free_plane=free_plane,
     )
 
 
