@@ -309,6 +309,22 @@ def test_fast_reads_the_free_planes_own_mode_on_that_planes_bound() -> None:
     assert abs(result.x_c - truth) < 0.005
 
 
+def test_two_frequency_takes_the_pairs_distance_from_the_curve_as_the_models_error() -> None:
+    # The exact link pushed up into a bar at 0.55 m: omega_1 and omega_2 lie 2.6 % from the
+    # nearest point of the (omega_1, omega_2) curve, far beyond the 0.1 % of the model's own
+    # uncertainty. The model is off by at least that much on this manoeuvre, and an error that
+    # large moves the answer along the curve by more than 1 cm: not ok, and the reason says why.
+    recording = simulate(
+        paper_antenna(),
+        Scenario(case="vertical", contact_point=0.55, seed=1, link_model="nonlinear"),
+    )
+    antenna = paper_antenna().self_calibrated()
+    result = estimate(recording.without_ground_truth(), antenna, method="two-frequency")
+    assert result.diagnostics["curve_distance"] > 10.0 * antenna.link.frequency_uncertainty
+    assert result.status is Status.UNCERTAIN
+    assert "distance from the curves" in (result.reason or "")
+
+
 def test_a_sliding_contact_read_in_the_push_plane_alone_stays_ok() -> None:
     # The linear link's contact slides along it (its model has no axial motion): read in the
     # push plane alone at 0.9 m, the force along the link rings with the contact force in the

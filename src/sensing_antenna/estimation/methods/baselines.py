@@ -7,8 +7,8 @@
   (omega_1, omega_2) sensing curve by the nearest point in relative distance; a pair too far
   from the curve (``EstimatorConfig.max_curve_distance``, or three times what the frequency
   model's own uncertainty allows) is a ``model_mismatch``, and an answer that the model's
-  uncertainty (and, read in the push plane alone, the bent link's,
-  ``Evidence.bent_link_uncertainty``, and a held contact's rise,
+  uncertainty (at least the pair's distance from the curve; and, read in the push plane alone,
+  the bent link's, ``Evidence.bent_link_uncertainty``, and a held contact's rise,
   :mod:`~sensing_antenna.estimation.methods.paper.held_contact`; read in both planes where the
   free plane's peak may be the push plane's leak, that rise when the force along the link rings
   in phase as a hold's) may move by more than ``max_model_spread`` at two standard deviations
@@ -201,17 +201,25 @@ def _curve_problems(
             )
         )
     # every point of the curve whose two frequencies lie within 2 u of the answer's could be
-    # the contact, for a model known to u (that of another branch too)
-    near = np.all(np.abs(omegas / omegas[k] - 1.0) <= 2.0 * u, axis=1)
+    # the contact, for a model known to u (that of another branch too); a pair that lies
+    # further from the curve shows the model off by at least that much on this manoeuvre, and
+    # an error that large moves the answer as far
+    off = distance > 2.0 * u
+    near = np.all(np.abs(omegas / omegas[k] - 1.0) <= max(2.0 * u, distance), axis=1)
     spread = float(np.max(np.abs(grid[near] - x_c))) if np.any(near) else 0.0
     bent = 2.0 * evidence.bent_link_uncertainty(x_c) if push_plane else 0.0
     total = math.hypot(spread, bent, hold)
     if total > cfg.max_model_spread:
+        model = (
+            f"the pair's distance from the curves ({100 * distance:.2g} %, more than the "
+            f"model's own {100 * u:.2g} % in each frequency allows)"
+            if off
+            else f"the frequency model's own uncertainty ({100 * u:.2g} % of each frequency)"
+        )
         problems.append(
             (
                 Status.UNCERTAIN,
-                f"the frequency model's own uncertainty ({100 * u:.2g} % of each frequency) and "
-                f"the bent link (the curves are the straight link's"
+                f"{model} and the bent link (the curves are the straight link's"
                 + (", and friction may hold the contact along it" if hold > 0.0 else "")
                 + f") may move this answer by {100 * total:.1f} cm at two standard deviations, "
                 f"more than {100 * cfg.max_model_spread:g} cm",
