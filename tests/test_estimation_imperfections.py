@@ -19,7 +19,7 @@ from sensing_antenna import Antenna, paper_antenna
 from sensing_antenna.antenna import FreeMotionObserver
 from sensing_antenna.calibration.frequency import calibrate_from_recordings
 from sensing_antenna.calibration.sensor import calibrate_sensor
-from sensing_antenna.estimation import METHODS, estimate
+from sensing_antenna.estimation import METHODS, Status, estimate
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import DeviceImperfections, Scenario, device_profile, simulate
 
@@ -191,3 +191,21 @@ def test_a_leak_that_tilts_the_push_it_bounds_does_not_shrink_its_own_term() -> 
     result = estimate(recording.without_ground_truth(), model, "ratio")
     assert result.status.value != "ok"
     assert result.diagnostics["ratio_spread"] >= 2.0 * sensor.nominal_coupling * result.x_c**2
+
+
+def test_a_pair_of_frequencies_off_the_curve_says_the_model_is_that_far_off() -> None:
+    # A clamp of 20 N m/rad, which the model takes for rigid, moves omega_2 otherwise than
+    # omega_1: pushed up into a bar at 0.8 m, near the top of the sensing curve, the pair
+    # (omega_1, omega_2) lies 1.1 % from the nearest point of the curves, ten times the model's
+    # own 0.1 %. omega_1 may be as far off, which there moves the candidate by more than 1 cm
+    # (it is 1 cm off): not ok, and the reason names the pair's distance.
+    device = DeviceImperfections(clamp_stiffness=20.0)
+    recording = simulate(
+        paper_antenna(), Scenario(case="vertical", contact_point=0.8, seed=1, device=device)
+    )
+    antenna = paper_antenna().self_calibrated()
+    result = estimate(recording.without_ground_truth(), antenna)
+    assert result.diagnostics["curve_distance"] > 5.0 * antenna.link.frequency_uncertainty
+    assert result.diagnostics["mismatch_spread"] > 0.01
+    assert result.status is not Status.OK
+    assert "from the nearest point of the sensing curves" in (result.reason or "")

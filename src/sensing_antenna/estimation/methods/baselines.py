@@ -28,10 +28,14 @@ from sensing_antenna.estimation.front.evidence import Evidence
 from sensing_antenna.estimation.front.ratio import paper_ratio
 from sensing_antenna.estimation.methods.paper.frequency import (
     evidence_frequency,
-    evidence_spectrum,
-    find_peak,
 )
-from sensing_antenna.estimation.methods.paper.fusion import conclude, held_contact_spread
+from sensing_antenna.estimation.methods.paper.fusion import (
+    conclude,
+    held_contact_spread,
+    pair_distance,
+    second_mode_band,
+    second_peak,
+)
 from sensing_antenna.estimation.methods.paper.planes import free_plane_mode, planes_agree
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
@@ -120,20 +124,14 @@ class TwoFrequencyMethod:
         omega2 = math.nan
         x_c = math.nan
         if measurement.clear and measurement.component in ("y_c", "z_c", "sum"):
-            omega, spectrum = evidence_spectrum(evidence, measurement.component)
-            low = max(float(omegas[:, 1].min()) / (1.0 + cfg.band_margin), 1.3 * measurement.omega1)
-            high = float(omegas[:, 1].max()) * (1.0 + cfg.band_margin)
-            peak2 = find_peak(omega, spectrum, (low, high))
-            if peak2 is not None and peak2.quality >= cfg.min_peak_quality:
+            peak2 = second_peak(evidence, measurement.component, measurement.omega1)
+            if peak2 is not None:
                 omega2 = peak2.omega
                 diag["omega2_quality"] = peak2.quality
                 # Nearest point of the (omega_1, omega_2) curve, relative distance
-                distance = np.hypot(
-                    omegas[:, 0] / measurement.omega1 - 1.0, omegas[:, 1] / omega2 - 1.0
-                )
-                k = int(np.argmin(distance))
+                k, distance = pair_distance(evidence, measurement.omega1, omega2)
                 x_c = float(grid[k])
-                diag["curve_distance"] = float(distance[k])
+                diag["curve_distance"] = distance
                 # read in the push plane alone: the free plane does not ring with it; or with a
                 # free-plane peak that may be the push plane's leak, which a hold's stiffening
                 # voids as corroboration
@@ -145,9 +143,10 @@ class TwoFrequencyMethod:
                     if push_plane or (held is not None and held.stiffens):
                         hold = spread
                 problems.extend(
-                    _curve_problems(evidence, grid, omegas, k, float(distance[k]), push_plane, hold)
+                    _curve_problems(evidence, grid, omegas, k, distance, push_plane, hold)
                 )
             else:
+                low, high = second_mode_band(evidence, measurement.omega1)
                 problems.append(
                     (
                         Status.NO_CLEAR_PEAK,

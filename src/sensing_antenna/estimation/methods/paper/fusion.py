@@ -24,6 +24,7 @@ from sensing_antenna.antenna import Link
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import (
+    SpectralPeak,
     evidence_frequency,
     evidence_spectrum,
     find_peak,
@@ -41,7 +42,10 @@ __all__ = [
     "conclude",
     "fuse",
     "model_spread",
+    "pair_distance",
     "second_mode_against",
+    "second_mode_band",
+    "second_peak",
     "sensing_curve",
 ]
 
@@ -356,6 +360,35 @@ def second_mode_choice(
     return None, notes
 
 
+def second_mode_band(evidence: Evidence, omega1: float) -> tuple[float, float]:
+    """The band (rad/s) the second contact mode is sought in: the curve's omega_2 range widened
+    by ``band_margin``, above 1.3 times ``omega1`` (rad/s)."""
+    margin = evidence.config.band_margin
+    omegas = evidence.contact_modes[1]
+    low = max(float(omegas[:, 1].min()) / (1.0 + margin), 1.3 * omega1)
+    return low, float(omegas[:, 1].max()) * (1.0 + margin)
+
+
+def second_peak(evidence: Evidence, component: str, omega1: float) -> SpectralPeak | None:
+    """The clearest peak of ``component``'s spectrum in :func:`second_mode_band`, None when it
+    is not clear (``min_peak_quality`` times the band's median)."""
+    omega, spectrum = evidence_spectrum(evidence, component)
+    peak = find_peak(omega, spectrum, second_mode_band(evidence, omega1))
+    clear = peak is not None and peak.quality >= evidence.config.min_peak_quality
+    return peak if clear else None
+
+
+def pair_distance(evidence: Evidence, omega1: float, omega2: float) -> tuple[int, float]:
+    """The nearest point of the (omega_1, omega_2) curve to the measured pair (rad/s) in relative
+    distance: its index on the evidence's ``contact_modes`` grid and the distance. A pair
+    further off than the frequency model's own uncertainty shows the model off by at least that
+    much on this manoeuvre."""
+    omegas = evidence.contact_modes[1]
+    distance = np.hypot(omegas[:, 0] / omega1 - 1.0, omegas[:, 1] / omega2 - 1.0)
+    k = int(np.argmin(distance))
+    return k, float(distance[k])
+
+
 def _uncertainty_source(link: Link) -> str:
     """Where the link's frequency uncertainty comes from, in words."""
     if link.calibrated_t is None:
@@ -524,6 +557,28 @@ class PaperMethod:
                 if total > cfg.max_model_spread and (plane == "push" or held_spread > 0.0):
                     problems.append(
                         (Status.UNCERTAIN, _push_plane_reason(total, held, plane == "push", cfg))
+                    )
+            peak2 = second_peak(evidence, measurement.component, measurement.omega1)
+            off = math.nan
+            if peak2 is not None:
+                off = pair_distance(evidence, measurement.omega1, peak2.omega)[1]
+                diag["curve_distance"] = off
+            if 2.0 * link.frequency_uncertainty < off <= cfg.max_curve_distance:
+                # the model is at least that far off on this manoeuvre: omega_1 may be too (a
+                # pair further off is no pair of contact modes: the peak is another vibration)
+                mismatch = model_spread(link, fusion.x_c, off)
+                diag["mismatch_spread"] = mismatch
+                if mismatch > cfg.max_model_spread:
+                    problems.append(
+                        (
+                            Status.UNCERTAIN,
+                            f"omega_1 and omega_2 lie {100 * off:.2g} % from the nearest point "
+                            f"of the sensing curves, more than the frequency model's own "
+                            f"{100 * link.frequency_uncertainty:.2g} % in each allows: the model "
+                            f"is that far off on this manoeuvre, and an error of omega_1 that "
+                            f"large moves the candidate by up to {100 * mismatch:.1f} cm, more "
+                            f"than {100 * cfg.max_model_spread:g} cm",
+                        )
                     )
             if spread > cfg.max_model_spread:
                 problems.append(
