@@ -198,7 +198,7 @@ def test_a_pair_of_frequencies_off_the_curve_says_the_model_is_that_far_off() ->
     # omega_1: pushed up into a bar at 0.8 m, near the top of the sensing curve, the pair
     # (omega_1, omega_2) lies 1.1 % from the nearest point of the curves, ten times the model's
     # own 0.1 %. omega_1 may be as far off, which there moves the candidate by more than 1 cm
-    # (it is 1 cm off): not ok, and the reason names the pair's distance.
+    # (it is 1 cm from where the link touched): not ok, and the reason names the distance.
     device = DeviceImperfections(clamp_stiffness=20.0)
     recording = simulate(
         paper_antenna(), Scenario(case="vertical", contact_point=0.8, seed=1, device=device)

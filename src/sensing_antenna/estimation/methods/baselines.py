@@ -31,6 +31,7 @@ from sensing_antenna.estimation.methods.paper.frequency import (
 )
 from sensing_antenna.estimation.methods.paper.fusion import (
     conclude,
+    curve_allowance,
     held_contact_spread,
     pair_distance,
     second_mode_band,
@@ -188,7 +189,7 @@ def _curve_problems(
     u = evidence.antenna.link.frequency_uncertainty
     problems: list[tuple[Status, str]] = []
     # the model's own error may put the pair off the curve by u in each frequency
-    allowed = max(cfg.max_curve_distance, cfg.disagreement_sigmas * math.sqrt(2.0) * u)
+    allowed = curve_allowance(evidence.antenna.link, cfg)
     if distance > allowed:
         problems.append(
             (
@@ -210,8 +211,8 @@ def _curve_problems(
     total = math.hypot(spread, bent, hold)
     if total > cfg.max_model_spread:
         model = (
-            f"the pair's distance from the curves ({100 * distance:.2g} %, more than the "
-            f"model's own {100 * u:.2g} % in each frequency allows)"
+            f"the pair's distance from the curves ({100 * distance:.2g} %, more than twice "
+            f"the model's own uncertainty, {100 * u:.2g} % in each frequency, allows)"
             if off
             else f"the frequency model's own uncertainty ({100 * u:.2g} % of each frequency)"
         )

@@ -40,6 +40,7 @@ __all__ = [
     "PaperMethod",
     "candidates_from_omega1",
     "conclude",
+    "curve_allowance",
     "fuse",
     "model_spread",
     "pair_distance",
@@ -378,6 +379,16 @@ def second_peak(evidence: Evidence, component: str, omega1: float) -> SpectralPe
     return peak if clear else None
 
 
+def curve_allowance(link: Link, config: EstimatorConfig) -> float:
+    """How far (relative) a pair (omega_1, omega_2) may lie from the sensing curves and still
+    be a contact's modes: ``max_curve_distance``, or three times what the frequency model's own
+    uncertainty allows in the two frequencies when that is larger."""
+    return max(
+        config.max_curve_distance,
+        config.disagreement_sigmas * math.sqrt(2.0) * link.frequency_uncertainty,
+    )
+
+
 def pair_distance(evidence: Evidence, omega1: float, omega2: float) -> tuple[int, float]:
     """The nearest point of the (omega_1, omega_2) curve to the measured pair (rad/s) in relative
     distance: its index on the evidence's ``contact_modes`` grid and the distance. A pair
@@ -563,24 +574,26 @@ class PaperMethod:
             if peak2 is not None:
                 off = pair_distance(evidence, measurement.omega1, peak2.omega)[1]
                 diag["curve_distance"] = off
-            if 2.0 * link.frequency_uncertainty < off <= cfg.max_curve_distance:
+            mismatch = 0.0
+            if 2.0 * link.frequency_uncertainty < off <= curve_allowance(link, cfg):
                 # the model is at least that far off on this manoeuvre: omega_1 may be too (a
                 # pair further off is no pair of contact modes: the peak is another vibration)
                 mismatch = model_spread(link, fusion.x_c, off)
                 diag["mismatch_spread"] = mismatch
-                if mismatch > cfg.max_model_spread:
-                    problems.append(
-                        (
-                            Status.UNCERTAIN,
-                            f"omega_1 and omega_2 lie {100 * off:.2g} % from the nearest point "
-                            f"of the sensing curves, more than the frequency model's own "
-                            f"{100 * link.frequency_uncertainty:.2g} % in each allows: the model "
-                            f"is that far off on this manoeuvre, and an error of omega_1 that "
-                            f"large moves the candidate by up to {100 * mismatch:.1f} cm, more "
-                            f"than {100 * cfg.max_model_spread:g} cm",
-                        )
+            if mismatch > cfg.max_model_spread:
+                # never less than the model's own spread: one reason, the larger
+                problems.append(
+                    (
+                        Status.UNCERTAIN,
+                        f"omega_1 and omega_2 lie {100 * off:.2g} % from the nearest point of "
+                        f"the sensing curves, more than twice the frequency model's own "
+                        f"uncertainty ({100 * link.frequency_uncertainty:.2g} % in each) "
+                        f"allows: the model is that far off on this manoeuvre, and an error of "
+                        f"omega_1 that large moves the candidate by up to "
+                        f"{100 * mismatch:.1f} cm, more than {100 * cfg.max_model_spread:g} cm",
                     )
-            if spread > cfg.max_model_spread:
+                )
+            elif spread > cfg.max_model_spread:
                 problems.append(
                     (
                         Status.UNCERTAIN,
