@@ -140,9 +140,9 @@ class TwoFrequencyMethod:
                 push_plane = measurement.component == "z_c" and not agree
                 hold = 0.0
                 if push_plane or (agree and free_plane_mode(measurement, cfg) is None):
-                    held, spread = held_contact_spread(evidence, measurement.omega1, x_c, diag)
-                    if push_plane or (held is not None and held.stiffens):
-                        hold = spread
+                    hold = held_contact_spread(
+                        evidence, measurement.omega1, x_c, diag, alone=push_plane
+                    )[1]
                 problems.extend(
                     _curve_problems(evidence, grid, omegas, k, distance, push_plane, hold)
                 )

@@ -162,16 +162,20 @@ def model_spread(link: Link, x_c: float, relative: float) -> float:
 
 
 def held_contact_spread(
-    evidence: Evidence, omega1: float, x_c: float, diag: dict[str, Any]
+    evidence: Evidence, omega1: float, x_c: float, diag: dict[str, Any], alone: bool = True
 ) -> tuple[HeldContact | None, float]:
     """A contact held along the link (:func:`.held_contact.held_contact`) for an omega_1
     (rad/s) of the push plane at the answer ``x_c`` (m), and how far (m) its rise
     may move that answer (:func:`model_spread`; 0 with nothing to read); stored in ``diag``
-    under ``held_contact``."""
+    under ``held_contact``. Read in the push plane ``alone``, any ringing counts; read in both
+    planes with a free-plane peak that may be the push plane's leak, only a hold that
+    stiffens (:attr:`.held_contact.HeldContact.stiffens`) voids that agreement, else 0."""
     held = held_contact(evidence, omega1, x_c)
     if held is None:
         return None, 0.0
     diag["held_contact"] = dataclasses.asdict(held)
+    if not (alone or held.stiffens):
+        return held, 0.0  # the free plane's agreement stands
     return held, model_spread(evidence.antenna.link, x_c, held.shift)
 
 
@@ -560,10 +564,8 @@ class PaperMethod:
                     preload = 2.0 * evidence.bent_link_uncertainty(fusion.x_c)
                     diag["preload_spread"] = preload
                 held, held_spread = held_contact_spread(
-                    evidence, measurement.omega1, fusion.x_c, diag
+                    evidence, measurement.omega1, fusion.x_c, diag, alone=plane == "push"
                 )
-                if plane == "both" and not (held is not None and held.stiffens):
-                    held_spread = 0.0  # the free plane's agreement stands
                 total = math.hypot(spread, preload, held_spread)
                 if total > cfg.max_model_spread and (plane == "push" or held_spread > 0.0):
                     problems.append(
