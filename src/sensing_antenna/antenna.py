@@ -653,15 +653,9 @@ class SensorCorrection:
     @property
     def is_identity(self) -> bool:
         """True when the correction changes no force (its scatter aside)."""
-        return (
-            replace(
-                self,
-                ratio_scatter=0.0,
-                nominal_coupling=NOMINAL_SENSOR_COUPLING,
-                unmeasured_sweeps=(),
-            )
-            == SensorCorrection()
-        )
+        gains = (self.fy_gain, self.fz_gain)
+        couplings = (self.fy_per_ty, self.fy_per_tz, self.fz_per_ty, self.fz_per_tz)
+        return gains == (1.0, 1.0) and couplings == (0.0, 0.0, 0.0, 0.0)
 
     def correct(
         self, reaction: NDArray[np.float64], moment: NDArray[np.float64]

@@ -80,7 +80,7 @@ from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
-from sensing_antenna.estimation.front.ratio import contact_loads, lowpass_noise_gain
+from sensing_antenna.estimation.front.ratio import lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
@@ -600,10 +600,7 @@ def _work_problem(
     else:
         return None
     theta = evidence.theta[start : end + 1]
-    _, moment = contact_loads(
-        theta, evidence.force[start : end + 1], evidence.torque[start : end + 1], evidence.antenna
-    )
-    moment = moment - evidence.load_offset[3:]
+    moment = evidence.contact_loads_unfiltered[1][start : end + 1] - evidence.load_offset[3:]
     whole = np.isfinite(theta).all(axis=1) & np.isfinite(moment).all(axis=1)
     if np.count_nonzero(whole) < 2:
         return None
@@ -758,10 +755,7 @@ def _bend_against_turn(
 
     def bend_over(first: int, last: int) -> np.ndarray:
         """The bend (m) the contact moment across the link gives at each sample."""
-        near = slice(max(first, 0), min(last, end) + 1)
-        _, moment = contact_loads(
-            evidence.theta[near], evidence.force[near], evidence.torque[near], evidence.antenna
-        )
+        moment = evidence.contact_loads_unfiltered[1][max(first, 0) : min(last, end) + 1]
         return bend * ((moment[:, 1:] - evidence.load_offset[4:]) @ filtered) / scale
 
     # the hold over one period of the contact's fundamental, which the touch sets ringing

@@ -24,6 +24,7 @@ from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 from sensing_antenna.estimation.front.held import describe_held, find_held
 from sensing_antenna.estimation.front.ratio import contact_loads, vertical_shares
+from sensing_antenna.estimation.front.spectrum import power_spectrum
 from sensing_antenna.estimation.front.spikes import (
     LEVEL_SAMPLES,
     describe_run,
@@ -290,10 +291,8 @@ class Evidence:
         direction = self.frame.reaction_m / held
         before = max(start - LEVEL_SAMPLES, 0)
         rows = slice(before, start + length)
+        reaction = self.contact_loads_unfiltered[0][rows]
         with np.errstate(over="ignore", invalid="ignore"):
-            reaction, _ = contact_loads(
-                self.theta[rows], self.force[rows], self.torque[rows], self.antenna
-            )
             push = (reaction - self.load_offset[:3]) @ direction
             push_before = float(np.mean(push[: start - before]))
             push_during = float(np.mean(push[start - before :]))
@@ -329,6 +328,27 @@ class Evidence:
         """Samples of the Delta t_e1 window after t_1 (shortened if the samples end first)."""
         n_window = round(self.config.spectrum_window / self.sample_period)
         return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
+
+    @functools.cached_property
+    def contact_loads_unfiltered(self) -> tuple[FloatArray, FloatArray]:
+        """The contact's loads at every sample, unfiltered (:func:`.ratio.contact_loads`),
+        computed once: reaction (N) and its moment about O (N m), shape (n, 3) each."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            reaction, moment = contact_loads(self.theta, self.force, self.torque, self.antenna)
+        reaction.flags.writeable = False
+        moment.flags.writeable = False
+        return reaction, moment
+
+    @functools.cached_property
+    def window_spectrum(self) -> tuple[FloatArray, FloatArray]:
+        """Power spectra of the torque about Y^c and Z^c over :attr:`spectrum_slice`, as
+        Estimator 1 reads them (:func:`~.spectrum.power_spectrum`), computed once: angular
+        frequencies (rad/s), shape (m,), and power (N^2 m^2), shape (m, 2)."""
+        projected = self.torque[self.spectrum_slice] @ self.frame.axes_m[1:].T
+        omega, power = power_spectrum(projected, self.sample_period, self.config.zero_padding)
+        omega.flags.writeable = False
+        power.flags.writeable = False
+        return omega, power
 
     def ratio_uncertainty(
         self, x_c: float, model: bool = True, statics: str = "elastica", coupling: bool = False

@@ -94,6 +94,10 @@ _COLUMNS = ("t", "theta1", "theta2", "fx", "fy", "fz", "tx", "ty", "tz")
 
 _BUFFERS = ("_t", "_theta", "_force", "_torque", "_reaction", "_moment", "_ratio", "_mean")
 
+#: Once t_e is planned, the filtered loads and the ratio are filled as soon as this many samples
+#: wait (the samples up to t_e only), so that the step at t_e has few left to fill.
+_FILL_AHEAD = 128
+
 
 def one_sample(
     t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
@@ -573,7 +577,11 @@ class FrontEnd:
             _, self._ratio_tolerance = ratio_tolerance(hold, self.antenna, cfg, ts)
         if self._planned is None:
             self._test_convergence(first, stop)
-        if self._planned is not None and last >= self._planned:
+        if self._planned is not None and last < self._planned:
+            if stop - self._ratio_done >= _FILL_AHEAD:
+                self._fill(stop)
+            return None
+        if self._planned is not None:
             return self._stop(self._evidence(self._planned, complete=True))
         return None
 

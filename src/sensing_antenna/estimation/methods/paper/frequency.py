@@ -30,6 +30,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from sensing_antenna.estimation.front.spectrum import power_spectrum
+
 if TYPE_CHECKING:
     from sensing_antenna.estimation.front.evidence import Evidence
 
@@ -110,45 +112,6 @@ class FrequencyMeasurement:
         if y is None or z is None:
             return None
         return abs(y.omega - z.omega) <= relative_tolerance * max(y.omega, z.omega)
-
-
-def power_spectrum(
-    signal: FloatArray, sample_period: float, zero_padding: int = 16
-) -> tuple[FloatArray, FloatArray]:
-    """One-sided power spectrum of detrended, Hann-windowed, zero-padded signals.
-
-    Parameters
-    ----------
-    signal : array, shape (n,) or (n, k)
-        Samples, time on axis 0.
-    sample_period : float
-        T_s (s).
-    zero_padding : int
-        The FFT length is the power of two at or above ``zero_padding * n``.
-
-    Returns
-    -------
-    omega : array, shape (m,)
-        Angular frequencies (rad/s).
-    power : array, shape (m,) or (m, k)
-        |FFT|^2 of each column (signal units squared).
-    """
-    x = np.asarray(signal, dtype=float)
-    n = x.shape[0]
-    if n < 4:
-        raise ValueError(f"a spectrum needs at least 4 samples, got {n}")
-    time = np.arange(n, dtype=float)
-    time -= time.mean()
-    centred = x - x.mean(axis=0)
-    slope = (time @ centred) / (time @ time)
-    detrended = centred - np.multiply.outer(time, slope)
-    window = np.hanning(n + 2)[1:-1]
-    tapered = detrended * (window if x.ndim == 1 else window[:, None])
-    n_fft = 1 << max(0, math.ceil(math.log2(zero_padding * n)))
-    spectrum = np.fft.rfft(tapered, n=n_fft, axis=0)
-    omega = 2.0 * np.pi * np.fft.rfftfreq(n_fft, d=sample_period)
-    power = np.asarray(spectrum.real**2 + spectrum.imag**2, dtype=float)
-    return np.asarray(omega, dtype=float), power
 
 
 def find_peak(
@@ -245,14 +208,28 @@ def measure_frequency(
     # Section 5.4: the torque components along Y^c and Z^c (projection on the contact frame)
     projected = torque @ np.asarray(axes_m, dtype=float)[1:].T
     omega, power = power_spectrum(projected, sample_period, zero_padding)
+    return _read_peaks(omega, power, torque.shape[0], sample_period, band, min_quality, t_start)
+
+
+def _read_peaks(
+    omega: FloatArray,
+    power: FloatArray,
+    n_samples: int,
+    sample_period: float,
+    band: tuple[float, float],
+    min_quality: float,
+    t_start: float,
+) -> FrequencyMeasurement:
+    """Estimator 1's choice among the y_c, z_c and summed spectra (``power`` shape (m, 2)) of
+    a window of ``n_samples``."""
     spectra = {"y_c": power[:, 0], "z_c": power[:, 1], "sum": power[:, 0] + power[:, 1]}
     # A side lobe of the Hann window is within 8 DFT bins of its peak (-50 dB beyond)
-    isolation = 8.0 * 2.0 * math.pi / (torque.shape[0] * sample_period)
+    isolation = 8.0 * 2.0 * math.pi / (n_samples * sample_period)
     peaks = {
         name: find_peak(omega, spectra[name], band, (min_quality, isolation)) for name in COMPONENTS
     }
     found = {name: peak for name, peak in peaks.items() if peak is not None}
-    t_end = t_start + (torque.shape[0] - 1) * sample_period
+    t_end = t_start + (n_samples - 1) * sample_period
     if not found:
         return FrequencyMeasurement(
             math.nan, math.nan, "none", t_start, t_end, band, False, peaks=peaks
@@ -279,14 +256,15 @@ def evidence_frequency(
     ``band`` (rad/s) defaults to the evidence's own omega_1 band.
     """
     window = evidence.spectrum_slice
-    return measure_frequency(
-        evidence.torque[window],
-        evidence.frame.axes_m,
+    omega, power = evidence.window_spectrum
+    return _read_peaks(
+        omega,
+        power,
+        window.stop - window.start,
         evidence.sample_period,
         evidence.band if band is None else band,
         evidence.config.min_peak_quality,
-        evidence.config.zero_padding,
-        t_start=float(evidence.t[window.start]),
+        float(evidence.t[window.start]),
     )
 
 
@@ -301,9 +279,7 @@ def evidence_spectrum(evidence: Evidence, component: str) -> tuple[FloatArray, F
         Angular frequencies (rad/s).
     power : array, shape (m,)
     """
-    window = evidence.spectrum_slice
-    projected = evidence.torque[window] @ evidence.frame.axes_m[1:].T
-    omega, power = power_spectrum(projected, evidence.sample_period, evidence.config.zero_padding)
+    omega, power = evidence.window_spectrum
     spectra = {"y_c": power[:, 0], "z_c": power[:, 1]}
     return omega, spectra.get(component, power.sum(axis=1))
 

@@ -149,15 +149,17 @@ def model_spread(link: Link, x_c: float, relative: float) -> float:
     """
     curve = sensing_curve(link)
     omega = float(curve.omega1(x_c))
-    steps = math.ceil(link.length / _SPREAD_STEP)
+    walk = _SPREAD_STEP * np.arange(1, math.ceil(link.length / _SPREAD_STEP) + 1)
+    # both ways at once: towards the base (row 0) and the tip (row 1), off the link masked
+    x = np.stack([x_c - walk, x_c + walk])
+    on_link = (x > 0.0) & (x <= link.length)
+    omegas = np.asarray(curve.omega1(np.where(on_link, x, x_c)), dtype=float)
+    inside = on_link & (np.abs(omegas - omega) <= relative * omega)
     spread = 0.0
-    for sign in (-1.0, 1.0):
-        x = x_c + sign * _SPREAD_STEP * np.arange(1, steps + 1)
-        x = x[(x > 0.0) & (x <= link.length)]
-        inside = np.abs(np.asarray(curve.omega1(x), dtype=float) - omega) <= relative * omega
-        stop = int(np.argmin(inside)) if not inside.all() else inside.size
+    for row in inside:
+        stop = int(np.argmin(row)) if not row.all() else row.size
         if stop:
-            spread = max(spread, abs(float(x[stop - 1]) - x_c))
+            spread = max(spread, float(walk[stop - 1]))
     return spread
 
 

@@ -50,7 +50,6 @@ from numpy.typing import NDArray
 
 from sensing_antenna.beam.modes import contact_to_base_shear, held_contact_coupling
 from sensing_antenna.estimation.front.evidence import Evidence, first_mode_value
-from sensing_antenna.estimation.front.ratio import contact_loads
 
 __all__ = ["HeldContact", "held_contact"]
 
@@ -139,9 +138,7 @@ def held_contact(evidence: Evidence, omega: float, x_c: float) -> HeldContact | 
         return None
     across = lateral / push
     normal = np.cross([1.0, 0.0, 0.0], across)
-    force, moment = contact_loads(
-        evidence.theta[window], evidence.force[window], evidence.torque[window], evidence.antenna
-    )
+    force, moment = (loads[window] for loads in evidence.contact_loads_unfiltered)
     # one amplitude per channel; the projections follow by linearity
     amplitudes = _amplitude(np.hstack([force, moment]), t, omega)
     axial, shear, bending = amplitudes[0], amplitudes[:3] @ across, amplitudes[3:] @ normal
