@@ -306,6 +306,11 @@ def test_link_length_limits_name_the_file_and_field(tmp_path: Path) -> None:
         with pytest.raises(AntennaConfigError) as info:
             load_antenna(path)
         assert str(info.value).startswith(f"{path}: link.length: {shown} is outside 0.001 to 100 m")
+        assert "(in " not in str(info.value)  # no unit makes these lengths
+    # a length written in mm (750 for 0.75 m), or cm: the units it would fit are named
+    path.write_text('base = "paper-2021"\n[link]\nlength = 750.0\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=r"750\.0 m is outside .*\(in cm or mm\?\)$"):
+        load_antenna(path)
 
 
 @pytest.mark.parametrize("key", sorted(PARAMETER_RANGES))

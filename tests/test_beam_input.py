@@ -57,6 +57,8 @@ def _run(argv: list[str]) -> int:
         (["--xc", "1e300"], "--xc: contact point must lie in (0, 0.98] m, got 1e+300"),
         (["--xc", "0.3", "nan"], "--xc: contact point must lie in (0, 0.98] m, got nan"),
         (["--xc", "-0.3"], "--xc: contact point must lie in (0, 0.98] m, got -0.3"),
+        # a contact point in mm: the unit it fits is named
+        (["--xc", "300"], "--xc: contact point must lie in (0, 0.98] m, got 300.0 (in mm?)"),
         (["--omega1", "inf"], "--omega1: must be a finite frequency > 0 rad/s, got inf"),
         (["--omega1", "-5"], "--omega1: must be a finite frequency > 0 rad/s, got -5.0"),
     ],

@@ -504,6 +504,24 @@ def test_a_required_name_written_otherwise_is_named_with_what_was_found(
         read_recording(path)
 
 
+@pytest.mark.parametrize(("name", "written"), [("theta2", "theta_2"), ("fy", "fy1")])
+def test_a_required_name_misspelled_is_named_with_the_near_one(
+    name: str, written: str, tmp_path: Path
+) -> None:
+    # a logger's own spelling of a column: the nearest unknown name is shown; a name the format
+    # knows is never offered for another (theta1 is not theta2's misspelling)
+    path = tmp_path / "header.csv"
+    write_recording(_recording(), path)
+    text = path.read_text().replace(f",{name},", f",{written},", 1)
+    path.write_text(text)
+    with pytest.raises(
+        RecordingError,
+        match=rf"column '{name}': required column missing from header \(found '{written}': "
+        rf"is it '{name}'\?",
+    ):
+        read_recording(path)
+
+
 @pytest.mark.parametrize(
     ("change", "message"),
     [

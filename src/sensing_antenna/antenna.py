@@ -109,11 +109,19 @@ class ParameterRange:
         """Raise AntennaConfigError naming ``field_name`` unless low <= value <= high."""
         if not self.low <= value <= self.high:
             unit = f" {self.unit}" if self.unit else ""
+            hint = metres_hint(value, self.low, self.high) if self.unit == "m" else ""
             raise AntennaConfigError(
                 field_name,
                 f"{format_value(value)}{unit} is outside {self.low:g} to {self.high:g}{unit}"
-                f" ({self.reason})",
+                f" ({self.reason}){hint}",
             )
+
+
+def metres_hint(value: float, low: float, high: float) -> str:
+    """ " (in mm?)", " (in cm or mm?)": the units in which a length ``value`` read as metres
+    would lie in [low, high] m; "" when none does."""
+    units = [name for name, factor in (("cm", 1e2), ("mm", 1e3)) if low <= value / factor <= high]
+    return f" (in {' or '.join(units)}?)" if units else ""
 
 
 #: Accepted range of each physical parameter, by ``section.field`` (``motor`` for both motors).
@@ -427,8 +435,11 @@ class Link:
     def check_contact_point(self, x_c: float) -> None:
         """Raise AntennaConfigError unless 0 < x_c <= l (m)."""
         if not (math.isfinite(x_c) and 0.0 < x_c <= self.length):
+            # a unit slip, where it puts the contact at least a tenth of the link out
+            hint = metres_hint(x_c, 0.1 * self.length, self.length) if x_c > self.length else ""
             raise AntennaConfigError(
-                "x_c", f"contact point must lie in (0, {self.length:g}] m, got {format_value(x_c)}"
+                "x_c",
+                f"contact point must lie in (0, {self.length:g}] m, got {format_value(x_c)}{hint}",
             )
 
 

@@ -21,6 +21,7 @@ periods per sample (an outlier time stamp or a gap), are refused naming the step
 from __future__ import annotations
 
 import codecs
+import difflib
 import math
 import os
 import stat
@@ -713,6 +714,10 @@ def _near(name: str, names: list[str]) -> str:
                 f" (found {found!r}: names are written bare and in lower case, without quotes"
                 " or units; the units are the format's, docs/recording-format.md)"
             )
+    unknown = [found for found in names if found not in NAMED_COLUMNS]
+    close = difflib.get_close_matches(name, unknown, n=1, cutoff=0.75)
+    if close:
+        return f" (found {close[0]!r}: is it '{name}'? the names are the format's own)"
     return ""
 
 

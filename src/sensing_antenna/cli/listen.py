@@ -8,6 +8,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from sensing_antenna.cli import EXIT_BAD_INPUT
 from sensing_antenna.cli.arguments import integer
 from sensing_antenna.cli.estimate import DEFAULT_ANTENNA, METHOD_NAMES, warn_of_other_antennas
 
@@ -58,7 +59,7 @@ def register(subparsers: Any) -> None:
         default=True,
         help="before listening, run one simulated manoeuvre of the antenna through the method, "
         "so that the first recording's events do not wait for the method's kernels to load "
-        "(about a second; default: on)",
+        "(about a second)",
     )
     parser.set_defaults(func=_run)
 
@@ -110,8 +111,10 @@ def _run(args: argparse.Namespace) -> int:
     if args.udp is None:
         ready()
         if listen_lines(sys.stdin.buffer, make, "<stdin>", args.count) == 0:
-            # an input that ended before any header: nothing was listened to, say so
+            # an input that ended before any header: nothing was listened to, say so, and fail
+            # (a pipe whose writer failed before writing must not look like a success)
             print("antenna listen: <stdin>: the input ended with no recording", file=sys.stderr)
+            return EXIT_BAD_INPUT
         return 0
     try:
         address = parse_address(args.udp)

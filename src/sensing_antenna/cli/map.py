@@ -32,9 +32,10 @@ def register(subparsers: Any) -> None:
             "uncertain ones whose interval's width was their one fault), and "
             "fits every shape class (sphere, cylinder, box, cone, capsule, torus, plane) and "
             "any --objects meshes, naming the best or abstaining when two explain the points "
-            "equally. Writes points.csv, points.ply, surface.ply, object.ply (the named object's "
-            "fitted shape), recognition.json, report.md, map.png and map.html (an interactive "
-            "3D view, self-contained) into --out (docs/mapping.md)."
+            "equally. Writes points.csv, recognition.json, report.md and map.png into --out, "
+            "and as far as the points allow points.ply (the points used), surface.ply (4 points "
+            "or more), object.ply (the named object's fitted shape, when one is named) and "
+            "map.html (an interactive 3D view, self-contained; docs/mapping.md)."
         ),
     )
     parser.add_argument("recordings", nargs="+", type=Path, help="recordings (CSV)")

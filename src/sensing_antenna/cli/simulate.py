@@ -231,11 +231,12 @@ def summary(out: str, scenario: Any, n_samples: int, meta: Any) -> str:
             f"the push was not reached within --duration {scenario.duration:g} s (the motors "
             "never stopped; a longer --duration or a shallower --push lets them)"
         )
+    deflection = float(meta.get("true_deflection_ratio", "nan"))
+    bend = f", y_c / x_c = {100 * deflection:.1f} %" if math.isfinite(deflection) else ""
     return (
         f"{text}, the link touched at x_c = {touched:.4f} m (--xc {x_c:g} m is where the "
         f"undeflected link meets the obstacle; it bends as it pushes), first touch "
-        f"{float(meta['true_t_contact']):.4g} s, {when}, "
-        f"y_c / x_c = {100 * float(meta['true_deflection_ratio']):.1f} %"
+        f"{float(meta['true_t_contact']):.4g} s, {when}{bend}"
     )
 
 
