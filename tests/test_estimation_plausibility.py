@@ -245,8 +245,9 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
     force: tuple[float, ...],
 ) -> None:
     # The obstacle can only push back: the mean reaction over the hold opposes the head's turn
-    # from t_c to t_1 (Y^c = -Y^m for an azimuthal push, Section 5.4 note (a)); a flipped sign
-    # turns one against the other, while the ratio (|R|) and the frequency do not see it
+    # from where the push began to t_1 (Y^c = -Y^m for an azimuthal push, Section 5.4 note
+    # (a)); a flipped sign turns one against the other, while the ratio (|R|) and the frequency
+    # do not see it
     original: Recording = request.getfixturevalue(case)
     recording = dataclasses.replace(
         original, theta=original.theta * np.array(theta), force=original.force * np.array(force)
@@ -259,6 +260,33 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
         # no 95 % interval is claimed from samples the status says are wrong
         assert result.interval is None, name
     assert results["fast"].diagnostics["interval_dropped"] is not None
+
+
+def test_a_detector_that_fires_after_the_head_stopped_still_judges_the_push_direction(
+    azimuthal: Recording, antenna: Antenna
+) -> None:
+    # An observer threshold above what the push reached while the head turned fires only after
+    # the head stopped, from the ringing: from t_c on the head is still, or settles back. The
+    # turn into the contact is counted from where the push began, so a force and torque across
+    # the link mirrored (a sensor's Y axis reversed, which the ratio and the frequency cannot
+    # see, and which puts the touched point on the wrong side of the bent link) are caught,
+    # and the right signs pass.
+    observer = dataclasses.replace(
+        antenna.observer, contact_threshold=2.0 * antenna.observer.contact_threshold
+    )
+    late = dataclasses.replace(antenna, observer=observer)
+    on_time = estimate(azimuthal, antenna)
+    right = estimate(azimuthal, late)
+    assert right.t_c >= on_time.t_1  # the premise: detected once the head had stopped
+    assert right.ok, right.reason
+    assert abs(right.x_c - on_time.x_c) < 1e-3
+    mirror = np.array([1.0, -1.0, 1.0]), np.array([1.0, 1.0, -1.0])
+    mirrored = dataclasses.replace(
+        azimuthal, force=azimuthal.force * mirror[0], torque=azimuthal.torque * mirror[1]
+    )
+    for name, result in all_methods(mirrored, late).items():
+        assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
+        assert "does not oppose the head's turn" in (result.reason or ""), name
 
 
 @pytest.mark.parametrize("case", ["azimuthal", "vertical"])

@@ -493,8 +493,10 @@ def _on_branch(curve: Any, x_c: float, candidates: Any) -> list[float]:
 def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     """Why the push does not oppose the head's motion into the contact, or None.
 
-    An obstacle can only push back: from t_c to t_1 the head turns into it by dtheta, which moves
-    the link along d = (0, dtheta_1 cos theta_2, dtheta_2) in the motor frame (the azimuth about
+    An obstacle can only push back: from where the push began (at t_c or a little before,
+    :attr:`Evidence.push_onset_index`: a detector may fire late, after the head stopped) to t_1
+    the head turns into it by dtheta, which moves the link along
+    d = (0, dtheta_1 cos theta_2, dtheta_2) in the motor frame (the azimuth about
     Z^a moves X^m along cos theta_2 Y^m, the elevation along Z^m), and the mean reaction over the
     hold must have R . d < 0 (Y^c = -Y^m for an azimuthal push, Section 5.4). A sign flipped in
     one angle or in the forces turns it, during the push as over the hold
@@ -530,7 +532,8 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     return Status.IMPLAUSIBLE_INPUT, (
         f"columns 'theta1', 'theta2', 'fx', 'fy', 'fz': the mean contact force over the hold "
         f"{_vector(reaction)} N does not oppose the head's turn into the contact "
-        f"({_vector(turn)} rad from t_c to t_1); an obstacle can only push back: a sign "
+        f"({_vector(turn)} rad from t = {float(evidence.t[evidence.push_onset_index]):.3f} s, "
+        "where the push began, to t_1); an obstacle can only push back: a sign "
         "flipped in an angle or in the forces, the two angles swapped or one read from another "
         "joint (the joint mapping), or forces read wrong by as much as the push (cross-talk "
         "from the torques, an offset)?"

@@ -23,7 +23,11 @@ from sensing_antenna.beam.weight import pushed_weight_moment, weight_residual
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 from sensing_antenna.estimation.front.held import describe_held, find_held
-from sensing_antenna.estimation.front.ratio import contact_loads, vertical_shares
+from sensing_antenna.estimation.front.ratio import (
+    contact_loads,
+    lowpass_noise_gain,
+    vertical_shares,
+)
 from sensing_antenna.estimation.front.spectrum import power_spectrum
 from sensing_antenna.estimation.front.spikes import (
     LEVEL_SAMPLES,
@@ -313,13 +317,33 @@ class Evidence:
         low, high = self.config.contact_range
         return two_frequency_curve(link, low * link.length, high * link.length)
 
+    @functools.cached_property
+    def push_onset_index(self) -> int:
+        """Sample where the push began: the last, up to t_c, at which the filtered contact force
+        along the hold's reaction lay within three of its standard errors (the low-passed noise
+        and the tare's) of none; t_c where none did. A detector fires once the push has built
+        up, a few samples after the touch, or, when its threshold lies above what the push
+        reached while the head turned, only after the head stopped (from the ringing): the
+        head's turn into the contact is counted from here."""
+        held = self.frame.push_force
+        k = self.contact_index
+        if not held > 0.0:
+            return k
+        noise = float(self.diagnostics.get("force_noise", 0.0)) * lowpass_noise_gain(
+            self.config.lowpass_cutoff, self.sample_period
+        )
+        error = math.hypot(noise, self.offset_error)
+        push = self.reaction_f[: k + 1] @ (self.frame.reaction_m / held)
+        quiet = np.flatnonzero(~(push > 3.0 * error))
+        return int(quiet[-1]) if quiet.size else k
+
     @property
     def push_turn(self) -> tuple[FloatArray, FloatArray]:
-        """The head's turn into the contact from t_c to t_1: dtheta (rad), shape (2,), and the
-        move it gives the link in the motor frame at t_1, (0, dtheta_1 cos theta_2, dtheta_2)
-        (rad), shape (3,): the azimuth about Z^a moves X^m along cos theta_2 Y^m, the
-        elevation along Z^m."""
-        turn = self.theta[self.rest_index] - self.theta[self.contact_index]
+        """The head's turn into the contact from where the push began
+        (:attr:`push_onset_index`) to t_1: dtheta (rad), shape (2,), and the move it gives the
+        link in the motor frame at t_1, (0, dtheta_1 cos theta_2, dtheta_2) (rad), shape (3,):
+        the azimuth about Z^a moves X^m along cos theta_2 Y^m, the elevation along Z^m."""
+        turn = self.theta[self.rest_index] - self.theta[self.push_onset_index]
         theta2 = float(self.theta[self.rest_index, 1])
         return turn, np.array([0.0, float(turn[0]) * math.cos(theta2), float(turn[1])])
 
@@ -466,8 +490,8 @@ class Evidence:
         cross-talk of a sensor no calibration has measured for the hold's push: a force read
         c x_c R_perp too high moves the ratio by about c x_c^2
         (:meth:`.SensorCorrection.coupling_uncertainty`). The push's direction is the one the
-        sensor reads, which the leak itself may tilt, or the head's turn from t_c to t_1
-        (:attr:`push_turn`), whichever gives the larger c."""
+        sensor reads, which the leak itself may tilt, or the head's turn from where the push
+        began to t_1 (:attr:`push_turn`), whichever gives the larger c."""
         sensor = self.antenna.sensor
         _, move = self.push_turn
         coupling = max(
