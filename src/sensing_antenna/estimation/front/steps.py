@@ -124,9 +124,15 @@ def dead_channel(force: FloatArray, torque: FloatArray) -> str | None:
     """Why the sensor samples cannot be used (every component of force or torque constant over
     them, a sensor not working), or None. ``force``, ``torque``: shape (n, 3)."""
     for name, values in (("force", force), ("torque", torque)):
-        if values.shape[0] > 1 and np.all(np.ptp(values, axis=0) == 0.0):
+        if values.shape[0] < 2 or np.any(np.ptp(values[:_FIRST_LOOK], axis=0) > 0.0):
+            continue  # a component that moves within the first samples: not all constant
+        if np.all(np.ptp(values, axis=0) == 0.0):
             return f"{name}: every component is constant over the recording (sensor not working)"
     return None
+
+
+#: Samples :func:`dead_channel` looks at first: a working sensor's noise moves them.
+_FIRST_LOOK = 64
 
 
 #: Most samples :func:`fill_missing` puts back in one step of the time stamps: 100,000 (100 s at
