@@ -20,7 +20,7 @@ import pytest
 from sensing_antenna import paper_antenna
 from sensing_antenna.estimation import ContactEstimate, EstimatorConfig, Status, estimate
 from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement, SpectralPeak
-from sensing_antenna.estimation.methods.paper.planes import free_plane_mode
+from sensing_antenna.estimation.methods.paper.planes import free_plane_mode, reading_plane
 from sensing_antenna.recording import Recording, read_recording
 from sensing_antenna.simulator import Scenario, simulate
 
@@ -149,6 +149,39 @@ def test_the_free_planes_own_mode_is_a_peak_no_push_plane_peak_can_explain(push,
     # a free-plane peak that is not clear is no mode of its own
     peaks["y_c"] = SpectralPeak(omega=60.0, power=1.0, quality=10.0)
     assert free_plane_mode(measurement, EstimatorConfig()) is None
+
+
+@pytest.mark.parametrize(
+    ("component", "free_quality", "push_quality", "expected"),
+    [
+        ("z_c", 3.0, 300.0, "push"),
+        # the summed spectra chosen where the free plane is silent: the push plane alone, which
+        # carries the bent link's term in both frequency methods
+        ("sum", 3.0, 300.0, "push"),
+        ("sum", 300.0, 3.0, "free"),
+        ("y_c", 300.0, 3.0, "free"),
+        ("z_c", 30.0, 300.0, "both"),  # both clear enough at the same omega_1
+    ],
+)
+def test_the_plane_omega_1_was_read_in(
+    component: str, free_quality: float, push_quality: float, expected: str
+) -> None:
+    peaks = {
+        "y_c": SpectralPeak(omega=60.0, power=1.0, quality=free_quality),
+        "z_c": SpectralPeak(omega=60.0, power=1.0, quality=push_quality),
+        "sum": SpectralPeak(omega=60.0, power=2.0, quality=free_quality + push_quality),
+    }
+    measurement = FrequencyMeasurement(
+        omega1=60.0,
+        quality=peaks[component].quality,
+        component=component,
+        t_start=1.0,
+        t_end=2.0,
+        band=(20.0, 120.0),
+        clear=True,
+        peaks=peaks,
+    )
+    assert reading_plane(measurement, EstimatorConfig()) == expected
 
 
 @pytest.mark.parametrize("name", ["vertical-xc050-push020", "vertical-xc050-push028"])

@@ -37,7 +37,7 @@ from sensing_antenna.estimation.methods.paper.fusion import (
     second_mode_band,
     second_peak,
 )
-from sensing_antenna.estimation.methods.paper.planes import free_plane_mode, planes_agree
+from sensing_antenna.estimation.methods.paper.planes import free_plane_mode, reading_plane
 from sensing_antenna.estimation.result import ContactEstimate, Status
 
 __all__ = ["RatioMethod", "TwoFrequencyMethod"]
@@ -135,11 +135,12 @@ class TwoFrequencyMethod:
                 diag["curve_distance"] = distance
                 # read in the push plane alone: the free plane does not ring with it; or with a
                 # free-plane peak that may be the push plane's leak, which a hold's stiffening
-                # voids as corroboration
-                agree = planes_agree(measurement, cfg)
-                push_plane = measurement.component == "z_c" and not agree
+                # voids as corroboration (the planes as the paper method reads them)
+                plane = reading_plane(measurement, cfg)
+                diag["frequency_plane"] = plane
+                push_plane = plane == "push"
                 hold = 0.0
-                if push_plane or (agree and free_plane_mode(measurement, cfg) is None):
+                if push_plane or (plane == "both" and free_plane_mode(measurement, cfg) is None):
                     hold = held_contact_spread(
                         evidence, measurement.omega1, x_c, diag, alone=push_plane
                     )[1]

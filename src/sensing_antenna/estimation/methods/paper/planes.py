@@ -47,7 +47,7 @@ from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.methods.paper.frequency import FrequencyMeasurement, SpectralPeak
 from sensing_antenna.estimation.result import Status
 
-__all__ = ["PLANES", "bending_planes", "free_plane_mode", "planes_agree"]
+__all__ = ["PLANES", "bending_planes", "free_plane_mode", "planes_agree", "reading_plane"]
 
 #: Torque component of each bending plane: about Y^c the vibration out of the push plane
 #: ("free"), about Z^c the vibration in it ("push").
@@ -107,14 +107,21 @@ def bending_planes(
         return _disagreeing(
             measurement, peaks, locate, ratio_estimate, sigma_ratio, config, diagnostics
         )
-    if planes_agree(measurement, config):
-        diagnostics["frequency_plane"] = "both"
-        return measurement, None
-    plane = "free" if measurement.component == PLANES["free"] else "push"
-    if measurement.component == "sum" and clear["free"]:
-        plane = "free"
-    diagnostics["frequency_plane"] = plane
+    diagnostics["frequency_plane"] = reading_plane(measurement, config)
     return measurement, None
+
+
+def reading_plane(measurement: FrequencyMeasurement, config: EstimatorConfig) -> str:
+    """The plane omega_1 was read in: "both" where the planes agree (:func:`planes_agree`),
+    "free" from the torque about Y^c, or from the summed spectra with a clear free-plane peak,
+    else "push" (the push plane alone, the free plane silent)."""
+    if planes_agree(measurement, config):
+        return "both"
+    free = measurement.peaks.get(PLANES["free"])
+    free_clear = free is not None and free.quality >= config.min_peak_quality
+    if measurement.component == PLANES["free"] or (measurement.component == "sum" and free_clear):
+        return "free"
+    return "push"
 
 
 def free_plane_mode(
