@@ -703,7 +703,8 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
 
 def _near(name: str, names: list[str]) -> str:
     """ " (found 'T', ...: ...)" when a header name is ``name`` written otherwise (quoted, in
-    another case, with a unit), else "" """
+    another case, with a unit) or misspelt (a name the format does not know, near ``name``),
+    else "" """
     spelled = {"t": ("time", "timestamp", "time_s", "stamp")}.get(name, ())
     for found in names:
         bare = found.strip("\"' ").split("[")[0].split("(")[0].strip().lower()

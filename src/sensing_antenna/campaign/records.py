@@ -112,7 +112,8 @@ class CampaignRow:
         The method's standard error and Cramer-Rao bound of omega_1 (rad/s), when reported.
     front_end_s : float
         Wall-clock time of the estimation front end on the recording (s), run once per run and
-        shared by its methods; ``estimate_s - front_end_s`` is the method's own time.
+        shared by its methods; ``estimate_s - front_end_s`` is the method's own time (the
+        first method to read what the evidence computes once pays for it).
     point_error_m : float
         Distance (m) from the estimate's touched point in 3D, on the link's surface (its
         ``contact_point``, absolute frame, moved by ``mapping.points.surface_offset``), to where

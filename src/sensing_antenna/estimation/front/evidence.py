@@ -53,6 +53,12 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 
 
+#: Share of the hold's push below which the contact force has not yet begun to push
+#: (:attr:`Evidence.push_onset_index`): above the link's own loads of a sweep, well below the
+#: push the detector fires on.
+ONSET_SHARE = 0.1
+
+
 def sensing_curve(link: Link) -> Any:
     """The omega_1(x_c) sensing curve of a link, built once per link."""
     return _sensing_curve(link)
@@ -320,11 +326,12 @@ class Evidence:
     @functools.cached_property
     def push_onset_index(self) -> int:
         """Sample where the push began: the last, up to t_c, at which the filtered contact force
-        along the hold's reaction lay within three of its standard errors (the low-passed noise
-        and the tare's) of none; t_c where none did. A detector fires once the push has built
-        up, a few samples after the touch, or, when its threshold lies above what the push
-        reached while the head turned, only after the head stopped (from the ringing): the
-        head's turn into the contact is counted from here."""
+        along the hold's reaction was at most :data:`ONSET_SHARE` of the hold's push or three
+        of its standard errors (the low-passed noise and the tare's), the larger; where no
+        sample was, the one where it was least. A detector fires once the push has built up
+        (tens of ms after the touch on the simulator) or, when its threshold lies above what
+        the push reached while the head turned, only after the head stopped (from the
+        ringing): the head's turn into the contact is counted from here."""
         held = self.frame.push_force
         k = self.contact_index
         if not held > 0.0:
@@ -332,10 +339,13 @@ class Evidence:
         noise = float(self.diagnostics.get("force_noise", 0.0)) * lowpass_noise_gain(
             self.config.lowpass_cutoff, self.sample_period
         )
-        error = math.hypot(noise, self.offset_error)
+        level = max(ONSET_SHARE * held, 3.0 * math.hypot(noise, self.offset_error))
         push = self.reaction_f[: k + 1] @ (self.frame.reaction_m / held)
-        quiet = np.flatnonzero(~(push > 3.0 * error))
-        return int(quiet[-1]) if quiet.size else k
+        quiet = np.flatnonzero(push <= level)
+        if quiet.size:
+            return int(quiet[-1])
+        finite = np.where(np.isfinite(push), push, np.inf)
+        return int(np.argmin(finite)) if np.isfinite(finite).any() else k
 
     @property
     def push_turn(self) -> tuple[FloatArray, FloatArray]:

@@ -17,12 +17,12 @@ suspected of corruption, on the few after it that decide it, which the stream wa
 3. At t_1 + hold: the static push and the contact frame (:func:`.steps.hold_push`).
 4. Estimator 2's ratio, its moving mean and convergence (:mod:`.ratio`); t_e (Section 4, step 6).
 
-Samples come in blocks (:meth:`FrontEnd.update_block`); a block of one is the per-sample form,
-and :func:`~sensing_antenna.estimation.pipeline.gather` feeds a whole recording as one block.
-The detectors are compiled kernels with their state carried; the Eq. 20 filter carries its state
-too; the ratio and its moving mean are elementwise and computed once per sample when first
-needed. So the evidence, its instants and every number in it are the same to the bit however the
-samples are cut into blocks.
+Samples come in blocks (:meth:`FrontEnd.update_block`); a block of one is the per-sample form, and
+:func:`~sensing_antenna.estimation.pipeline.gather` feeds a whole recording as one block. The
+detectors are compiled kernels with their state carried; the Eq. 20 filter carries its state too;
+the ratio and its moving mean are elementwise and computed once per sample, when first needed or,
+once t_e is planned, every :data:`_FILL_AHEAD` samples. So the evidence, its instants and every
+number in it are the same to the bit however the samples are cut into blocks.
 """
 
 from __future__ import annotations

@@ -1,7 +1,8 @@
 """The power spectrum Estimator 1 reads: detrended, Hann-windowed, zero-padded (Section 5.4).
 
-Shared by the front end, which computes the spectrum of the torque over the Delta t_e1 window once
-per evidence (:attr:`~.evidence.Evidence.window_spectrum`), the methods, and the figures.
+Shared by the evidence, whose spectrum of the torque over the Delta t_e1 window is computed once,
+when a method first reads it (:attr:`~.evidence.Evidence.window_spectrum`), the methods, and the
+figures.
 """
 
 from __future__ import annotations

@@ -161,7 +161,7 @@ def model_spread(link: Link, x_c: float, relative: float) -> float:
             inside = on_link & (np.abs(omegas - omega) <= relative * omega)
             stop = int(np.argmin(inside)) if not inside.all() else inside.size
             if stop:
-                spread = max(spread, float(walk[stop - 1]))
+                spread = max(spread, abs(float(x[stop - 1]) - x_c))
             if stop < inside.size:
                 break
     return spread
