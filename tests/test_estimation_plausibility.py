@@ -280,10 +280,12 @@ def test_a_detector_that_fires_after_the_head_stopped_still_judges_the_push_dire
     assert right.t_c >= on_time.t_1  # the premise: detected once the head had stopped
     evidence = gather(azimuthal, late)
     assert isinstance(evidence, Evidence)
-    # the push began while the head still turned, after the on-time detector's own t_c less
-    # the filter's lag
+    # the push began while the head still turned, after the touch: the on-time detector fires
+    # 50 to 200 ms after it on this simulator (docs/design-notes.md, "A detector that fires
+    # after the head stopped")
     assert on_time.t_c - 0.2 < evidence.t[evidence.push_onset_index] < on_time.t_1
     assert right.ok, right.reason
+    # the same hold, its spectrum window started later: well within the 1 cm an ok claims
     assert abs(right.x_c - on_time.x_c) < 1e-3
     mirror = np.array([1.0, -1.0, 1.0]), np.array([1.0, 1.0, -1.0])
     mirrored = dataclasses.replace(

@@ -57,6 +57,7 @@ __all__ = [
     "SensorCorrection",
     "antenna_to_toml",
     "load_antenna",
+    "metres_hint",
     "paper_antenna",
     "save_antenna",
 ]

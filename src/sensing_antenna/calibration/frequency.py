@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
-from sensing_antenna.antenna import PARAMETER_RANGES, Antenna, Link
+from sensing_antenna.antenna import PARAMETER_RANGES, Antenna, Link, metres_hint
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import other_separator
 
@@ -698,10 +698,7 @@ def _unit_hint(x_c: float, length: float) -> str:
     from sensing_antenna.estimation.config import EstimatorConfig
 
     low, high = EstimatorConfig().contact_range
-    for factor, unit in ((100.0, "cm"), (1000.0, "mm")):
-        if low * length <= x_c / factor <= high * length:
-            return f" (in {unit}?)"
-    return ""
+    return metres_hint(x_c, low * length, high * length)
 
 
 def calibrate_from_recordings(

@@ -80,7 +80,6 @@ from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
-from sensing_antenna.estimation.front.ratio import lowpass_noise_gain
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
@@ -514,10 +513,7 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
         return None
     unit = direction / float(np.linalg.norm(direction))
     reaction = evidence.frame.reaction_m
-    noise = float(evidence.diagnostics.get("force_noise", 0.0)) * lowpass_noise_gain(
-        evidence.config.lowpass_cutoff, evidence.sample_period
-    )
-    error = math.hypot(noise, evidence.offset_error)
+    error = evidence.filtered_force_error
     along = float(reaction @ unit)
     across = float(np.linalg.norm(reaction[1:] - along * unit[1:]))
     if along <= 0.0 or (along <= 3.0 * error and across > 3.0 * error):

@@ -323,6 +323,16 @@ class Evidence:
         low, high = self.config.contact_range
         return two_frequency_curve(link, low * link.length, high * link.length)
 
+    @property
+    def filtered_force_error(self) -> float:
+        """Standard error (N) of a filtered, tared contact force: the force channel's noise
+        through the Eq. 20 low-pass (:func:`.ratio.lowpass_noise_gain`) and the tare's offset
+        error, in quadrature."""
+        noise = float(self.diagnostics.get("force_noise", 0.0)) * lowpass_noise_gain(
+            self.config.lowpass_cutoff, self.sample_period
+        )
+        return math.hypot(noise, self.offset_error)
+
     @functools.cached_property
     def push_onset_index(self) -> int:
         """Sample where the push began: the last, up to t_c, at which the filtered contact force
@@ -336,10 +346,7 @@ class Evidence:
         k = self.contact_index
         if not held > 0.0:
             return k
-        noise = float(self.diagnostics.get("force_noise", 0.0)) * lowpass_noise_gain(
-            self.config.lowpass_cutoff, self.sample_period
-        )
-        level = max(ONSET_SHARE * held, 3.0 * math.hypot(noise, self.offset_error))
+        level = max(ONSET_SHARE * held, 3.0 * self.filtered_force_error)
         push = self.reaction_f[: k + 1] @ (self.frame.reaction_m / held)
         quiet = np.flatnonzero(push <= level)
         if quiet.size:

@@ -577,12 +577,12 @@ class FrontEnd:
             _, self._ratio_tolerance = ratio_tolerance(hold, self.antenna, cfg, ts)
         if self._planned is None:
             self._test_convergence(first, stop)
-        if self._planned is not None and last < self._planned:
-            if stop - self._ratio_done >= _FILL_AHEAD:
-                self._fill(stop)
+        if self._planned is None:
             return None
-        if self._planned is not None:
+        if last >= self._planned:
             return self._stop(self._evidence(self._planned, complete=True))
+        if stop - self._ratio_done >= _FILL_AHEAD:
+            self._fill(stop)  # the samples up to t_e only: last < planned
         return None
 
     def _judge_hold(self, end: int) -> HoldPush:
