@@ -479,6 +479,14 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
             ],
             f"<stdin>:{header_at + 4}: column 'theta1': not a number ('1_0')",
         ),
+        # a reading not given, worded as the file's reader words it
+        (
+            [
+                *text[: header_at + 3],
+                ",".join(["0.002", "nan", *text[header_at + 3].split(",")[2:]]),
+            ],
+            f"<stdin>:{header_at + 4}: column 'theta1': nan is not a finite number",
+        ),
         # a declared period 10 % off the time stamps' (1 ms): a file read whole would use the
         # steps, a stream's estimator was built for the declared one
         (

@@ -21,7 +21,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, format_value
 from sensing_antenna.recording import (
     FORMAT_NAME,
     NAMED_COLUMNS,
@@ -179,7 +179,9 @@ def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> 
                 values.append(math.nan)
                 continue
             problem = (
-                f"not a number ({cell.strip()!r})" if value is None else "NaN or infinite value"
+                f"not a number ({cell.strip()!r})"
+                if value is None
+                else f"{format_value(value)} is not a finite number"
             )
             raise RecordingError(header.source, number, name, problem)
         values.append(value)
