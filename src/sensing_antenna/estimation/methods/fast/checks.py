@@ -340,7 +340,7 @@ def branch_contradiction(
     """
     omega1 = float(fit.omega[k])
     tolerance = config.branch_mode_tolerance
-    candidates = contact_candidates(link, omega1, posterior)
+    candidates = contact_candidates(link, omega1, posterior, config)
     chosen = posterior.branch_of(posterior.x_c)
     own = [c for c in candidates if posterior.branch_of(c) == chosen]
     others = [c for c in candidates if posterior.branch_of(c) != chosen]

@@ -67,7 +67,7 @@ def conclude_fast(
         )
     post = final.posterior
     # The branch edges do not change with conditioning: the candidates serve before and after
-    candidates = contact_candidates(evidence.antenna.link, final.omega1, post)
+    candidates = contact_candidates(evidence.antenna.link, final.omega1, post, config)
     if final.second_mode:
         diag["second_mode"] = final.second_mode
     if final.branch_chosen_by_second_mode:
@@ -218,7 +218,7 @@ def _narrowed(
     ratio_z, ratio_note, frequency_z, frequency_note = _judged_at(evidence, final, post, config)
     objection, answer = second_mode_objection(
         post,
-        contact_candidates(evidence.antenna.link, final.omega1, post),
+        contact_candidates(evidence.antenna.link, final.omega1, post, config),
         final.omega1,
         final.start_index,
         final.end_index,

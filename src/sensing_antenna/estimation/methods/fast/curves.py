@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Link
 from sensing_antenna.beam import natural_frequencies
 from sensing_antenna.estimation.front.evidence import sensing_curve
+from sensing_antenna.estimation.methods.fast.config import FastConfig, model_floor
 from sensing_antenna.estimation.methods.fast.likelihood import ContactPosterior
 
 __all__ = ["CurveTable", "contact_candidates", "curve_table"]
@@ -58,11 +59,22 @@ def curve_table(link: Link, low: float, high: float, step: float) -> CurveTable:
     return CurveTable(grid, omega1, (low, *inner, high), higher, slope)
 
 
-def contact_candidates(link: Link, omega1: float, posterior: ContactPosterior) -> tuple[float, ...]:
-    """Contact points (m) whose omega_1 is ``omega1``, inside the posterior's range."""
+def contact_candidates(
+    link: Link, omega1: float, posterior: ContactPosterior, config: FastConfig
+) -> tuple[float, ...]:
+    """Contact points (m) whose omega_1 is ``omega1``, inside the posterior's range.
+
+    The last branch of the sensing curve ends at the tip: a frequency just past omega_1(l) on
+    that side, within ``max_disagreement`` of the model's floor (:func:`.config.model_floor`),
+    has the tip x_c = l as that branch's candidate, as for the paper method, so that the second
+    contact mode can still be asked between the branches (a touch at the tip rings there).
+    """
     if not math.isfinite(omega1):
         return ()
     low, high = posterior.branch_edges[0], posterior.branch_edges[-1]
+    tolerance = config.max_disagreement * model_floor(link, config) * omega1
     return tuple(
-        float(c.x_c) for c in sensing_curve(link).contact_points(omega1) if low <= c.x_c <= high
+        float(c.x_c)
+        for c in sensing_curve(link).contact_points(omega1, tolerance)
+        if low <= c.x_c <= high
     )

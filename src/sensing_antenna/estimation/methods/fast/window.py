@@ -327,7 +327,7 @@ def evaluate_window(
         and config.branch_by_second_mode
         and max(posterior.branch_probability) < posterior.level
     ):
-        candidates = contact_candidates(link, omega1, posterior)
+        candidates = contact_candidates(link, omega1, posterior, config)
         if len(candidates) == 2:
             choice, second_mode = choose_branch(rest_index, end_index, omega1, candidates)
             conditioned = on_chosen_branch(posterior, candidates, choice)
@@ -402,7 +402,7 @@ def evaluate_window(
         # the ratio that chose the branch, must not point to the other one
         objection, answer = second_mode_objection(
             posterior,
-            contact_candidates(link, omega1, posterior),
+            contact_candidates(link, omega1, posterior, config),
             omega1,
             rest_index,
             end_index,
