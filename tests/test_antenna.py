@@ -313,6 +313,18 @@ def test_link_length_limits_name_the_file_and_field(tmp_path: Path) -> None:
         load_antenna(path)
 
 
+def test_a_modulus_in_gigapascals_names_the_unit(tmp_path: Path) -> None:
+    path = tmp_path / "soft.toml"
+    # 210 meant as GPa (steel): read as Pa it is far below soft rubber
+    path.write_text('base = "paper-2021"\n[link]\nyoungs_modulus = 210.0\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=r"210\.0 Pa is outside .*\(in GPa or MPa\?\)$"):
+        load_antenna(path)
+    # 5e3 in GPa would be stiffer than diamond, in MPa (5 GPa) it fits: only that unit is named
+    path.write_text('base = "paper-2021"\n[link]\nyoungs_modulus = 5e3\n', encoding="utf-8")
+    with pytest.raises(AntennaConfigError, match=r"\(in MPa\?\)$"):
+        load_antenna(path)
+
+
 @pytest.mark.parametrize("key", sorted(PARAMETER_RANGES))
 def test_every_range_has_a_reason_and_refuses_just_outside(key: str) -> None:
     limits = PARAMETER_RANGES[key]

@@ -110,7 +110,9 @@ class ParameterRange:
         """Raise AntennaConfigError naming ``field_name`` unless low <= value <= high."""
         if not self.low <= value <= self.high:
             unit = f" {self.unit}" if self.unit else ""
-            hint = metres_hint(value, self.low, self.high) if self.unit == "m" else ""
+            hint = {"m": metres_hint, "Pa": _pascals_hint}.get(self.unit, _no_hint)(
+                value, self.low, self.high
+            )
             raise AntennaConfigError(
                 field_name,
                 f"{format_value(value)}{unit} is outside {self.low:g} to {self.high:g}{unit}"
@@ -123,6 +125,17 @@ def metres_hint(value: float, low: float, high: float) -> str:
     would lie in [low, high] m; "" when none does."""
     units = [name for name, factor in (("cm", 1e2), ("mm", 1e3)) if low <= value / factor <= high]
     return f" (in {' or '.join(units)}?)" if units else ""
+
+
+def _pascals_hint(value: float, low: float, high: float) -> str:
+    """ " (in GPa?)", " (in MPa?)": the units in which a modulus ``value`` read as pascals
+    would lie in [low, high] Pa; "" when none does."""
+    units = [name for name, factor in (("GPa", 1e9), ("MPa", 1e6)) if low <= value * factor <= high]
+    return f" (in {' or '.join(units)}?)" if units else ""
+
+
+def _no_hint(value: float, low: float, high: float) -> str:
+    return ""
 
 
 #: Accepted range of each physical parameter, by ``section.field`` (``motor`` for both motors).

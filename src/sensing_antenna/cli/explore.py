@@ -62,7 +62,7 @@ def register(subparsers: Any) -> None:
         help=(
             "after the budget, while the object is not recognised, up to N more sweeps, aimed "
             "at telling the two leading shapes apart (with --sizes-within, also while its "
-            "sizes are not known; default 0)"
+            "sizes are not known)"
         ),
     )
     parser.add_argument(
