@@ -65,6 +65,7 @@ __all__ = [
     "check_sampling",
     "clock_disagrees",
     "is_ground_truth_key",
+    "not_finite",
     "other_separator",
     "parse_header",
     "parse_metadata",
@@ -766,6 +767,12 @@ def _numeric_columns(
     return table[:, kept], [names[k] for k in kept]
 
 
+def not_finite(value: float) -> str:
+    """The problem of a named column's cell holding NaN or an infinity, as every reader words
+    it."""
+    return f"{format_value(value)} is not a finite number"
+
+
 def parse_number(cell: str) -> float:
     """A cell's number as the whole-file reader (NumPy's) takes it, else ValueError: Python's
     ``float`` would also take digit groups (``1_000``) and other scripts' digits, a typo read
@@ -905,7 +912,7 @@ def read_recording(path: str | Path) -> Recording:
             source,
             first_line + int(row),
             names[col],
-            f"{format_value(data[row, col])} is not a finite number",
+            not_finite(data[row, col]),
         )
     column = {name: data[:, k] for k, name in enumerate(names)}
     t = column["t"]

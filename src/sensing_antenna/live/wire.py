@@ -21,11 +21,12 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from sensing_antenna.errors import SensingAntennaError, format_value
+from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import (
     FORMAT_NAME,
     NAMED_COLUMNS,
     RecordingError,
+    not_finite,
     parse_header,
     parse_metadata,
     parse_number,
@@ -178,11 +179,7 @@ def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> 
             if name not in NAMED_COLUMNS:
                 values.append(math.nan)
                 continue
-            problem = (
-                f"not a number ({cell.strip()!r})"
-                if value is None
-                else f"{format_value(value)} is not a finite number"
-            )
+            problem = f"not a number ({cell.strip()!r})" if value is None else not_finite(value)
             raise RecordingError(header.source, number, name, problem)
         values.append(value)
     return values
