@@ -110,9 +110,7 @@ class ParameterRange:
         """Raise AntennaConfigError naming ``field_name`` unless low <= value <= high."""
         if not self.low <= value <= self.high:
             unit = f" {self.unit}" if self.unit else ""
-            hint = {"m": metres_hint, "Pa": _pascals_hint}.get(self.unit, _no_hint)(
-                value, self.low, self.high
-            )
+            hint = _unit_hint(value, self.low, self.high, _OTHER_UNITS.get(self.unit, ()))
             raise AntennaConfigError(
                 field_name,
                 f"{format_value(value)}{unit} is outside {self.low:g} to {self.high:g}{unit}"
@@ -123,19 +121,21 @@ class ParameterRange:
 def metres_hint(value: float, low: float, high: float) -> str:
     """ " (in mm?)", " (in cm or mm?)": the units in which a length ``value`` read as metres
     would lie in [low, high] m; "" when none does."""
-    units = [name for name, factor in (("cm", 1e2), ("mm", 1e3)) if low <= value / factor <= high]
-    return f" (in {' or '.join(units)}?)" if units else ""
+    return _unit_hint(value, low, high, _OTHER_UNITS["m"])
 
 
-def _pascals_hint(value: float, low: float, high: float) -> str:
-    """ " (in GPa?)", " (in MPa?)": the units in which a modulus ``value`` read as pascals
-    would lie in [low, high] Pa; "" when none does."""
-    units = [name for name, factor in (("GPa", 1e9), ("MPa", 1e6)) if low <= value * factor <= high]
-    return f" (in {' or '.join(units)}?)" if units else ""
+#: Units a number meant in them is most often written in instead of the SI one, each with how
+#: many of it make the SI unit: a length in cm or mm, a modulus in GPa or MPa.
+_OTHER_UNITS: Mapping[str, tuple[tuple[str, float], ...]] = MappingProxyType(
+    {"m": (("cm", 1e2), ("mm", 1e3)), "Pa": (("GPa", 1e-9), ("MPa", 1e-6))}
+)
 
 
-def _no_hint(value: float, low: float, high: float) -> str:
-    return ""
+def _unit_hint(value: float, low: float, high: float, units: tuple[tuple[str, float], ...]) -> str:
+    """ " (in cm or mm?)" and the like: those of ``units`` (name, how many make the SI unit) in
+    which ``value`` would lie in [low, high] SI; "" when none does."""
+    fits = [name for name, per_si in units if low <= value / per_si <= high]
+    return f" (in {' or '.join(fits)}?)" if fits else ""
 
 
 #: Accepted range of each physical parameter, by ``section.field`` (``motor`` for both motors).
