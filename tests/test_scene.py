@@ -804,3 +804,40 @@ def test_a_built_device_touches_where_its_own_sagged_link_meets_the_object(
     # a shape of another build is refused: the two touches would not meet
     with pytest.raises(ValueError, match="not the device's as built"):
         simulate_sweep(DEVICE, scene, sweep, shape=LinkShape(DEVICE.link), imperfections=device)
+
+
+def test_a_primitives_sizes_may_be_named_as_in_a_scene_file_or_as_the_object_names_them() -> None:
+    by_order = primitive_object("b", "box", [0.08, 0.05, 0.03])
+    by_key = primitive_object("b", "box", {"extents": [0.08, 0.05, 0.03]})
+    again = primitive_object("b", "box", by_order.sizes)
+    for obj in (by_key, again):
+        assert np.array_equal(obj.parameters, by_order.parameters)
+    torus = primitive_object("t", "torus", {"minor_radius": 0.02, "major_radius": 0.05})
+    assert torus.sizes == {"major_radius": 0.05, "minor_radius": 0.02}
+
+
+@pytest.mark.parametrize(
+    ("shape", "sizes", "words"),
+    [
+        ("cylinder", {"radius": 0.05}, "a cylinder takes radius, height, got radius"),
+        ("cylinder", [0.05], r"\(2 numbers, m\), got 1"),
+        ("cylinder", "wide", r"a cylinder takes radius, height \(m\)"),
+        ("sphere", -0.05, "each a length > 0"),
+        ("torus", [0.02, 0.05], "minor_radius must be smaller than its major_radius"),
+    ],
+)
+def test_a_primitives_wrong_sizes_are_named(shape: str, sizes: object, words: str) -> None:
+    with pytest.raises(ValueError, match=words):
+        primitive_object("it", shape, sizes)  # type: ignore[arg-type]
+
+
+def test_a_sweeps_base_is_an_index_of_the_scenes_bases() -> None:
+    with pytest.raises(TypeError, match="index of a base pose"):
+        Sweep(BasePose.identity(), "azimuthal", 0.0, -0.5, 0.5)  # type: ignore[arg-type]
+    scene = load_scene("post")
+    sweep = Sweep(3, "azimuthal", 0.0, -0.5, 0.5)
+    named = r"base 3: scene 'post' has 1 base pose \(indices 0 to 0\)"
+    with pytest.raises(ValueError, match=named):
+        first_touch(scene, sweep, LinkShape(DEVICE.link))
+    with pytest.raises(ValueError, match="base 3"):
+        scene.region_of(3)

@@ -362,7 +362,7 @@ class NextBestPlanner:
         samples, 3) (m); kept per sweep, as a candidate is followed at every choice."""
         kept = self._swept_cache.get(sweep)
         if kept is None:
-            base = self.scene.bases[sweep.base]
+            base = self.scene.base(sweep.base)
             kept = np.stack(
                 [
                     self.shape.points(sweep.angles(float(a)), base)[self._samples]

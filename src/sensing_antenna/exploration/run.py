@@ -217,7 +217,7 @@ class ExploreSettings:
         None: naming the object ends them.
     """
 
-    method: str = "fast"
+    method: str = "paper"
     strategy: str = "grid"
     budget: int | None = None
     seed: int = 0
@@ -745,7 +745,7 @@ def swept_links(
     for m in manoeuvres:
         sweep = m.sweep
         planned = sweep.swept_angles(PREDICTION_STEP)
-        base = scene.bases[sweep.base]
+        base = scene.base(sweep.base)
         pieces: list[Piece] = []
         if m.outcome == "free":
             end = math.inf * sweep.direction

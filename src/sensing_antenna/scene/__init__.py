@@ -12,7 +12,13 @@ Above ``simulator/`` (it calls ``simulate``) and ``mapping/`` (poses, shape clas
 """
 
 from sensing_antenna.scene.file import BUILTIN_SCENES, ExploreRegion, Scene, SceneError, load_scene
-from sensing_antenna.scene.objects import OBJECT_SHAPES, SceneObject, mesh_object, primitive_object
+from sensing_antenna.scene.objects import (
+    OBJECT_SHAPES,
+    SIZE_KEYS,
+    SceneObject,
+    mesh_object,
+    primitive_object,
+)
 from sensing_antenna.scene.simulate import OUTCOMES, SweepOutcome, simulate_sweep, touch_scenario
 from sensing_antenna.scene.sweep import LinkShape, Sweep, facing_region
 from sensing_antenna.scene.touch import SweepGeometry, Touch, first_touch
@@ -21,6 +27,7 @@ __all__ = [
     "BUILTIN_SCENES",
     "OBJECT_SHAPES",
     "OUTCOMES",
+    "SIZE_KEYS",
     "ExploreRegion",
     "LinkShape",
     "Scene",

@@ -53,6 +53,7 @@ from sensing_antenna.errors import FieldError, SensingAntennaError, format_value
 from sensing_antenna.mapping.pose import MAX_BASE_DISTANCE, BasePose
 from sensing_antenna.scene.objects import (
     MIN_OBJECT_SIZE,
+    SIZE_KEYS,
     SceneObject,
     mesh_object,
     primitive_object,
@@ -83,14 +84,6 @@ ANGLE_LIMIT = 2.0 * math.pi
 #: Most objects, bases and grid sweeps a scene may ask for (a scene is hand-written).
 _MAX_COUNT = 100
 
-_SIZE_KEYS: dict[str, tuple[str, ...]] = {
-    "sphere": ("radius",),
-    "cylinder": ("radius", "height"),
-    "capsule": ("radius", "length"),
-    "cone": ("radius", "height"),
-    "torus": ("major_radius", "minor_radius"),
-    "box": ("extents",),
-}
 _POSE_KEYS = ("name", "shape", "position", "rotation")
 
 
@@ -145,8 +138,19 @@ class Scene:
     source: str = ""
     base_regions: tuple[ExploreRegion | None, ...] = ()
 
+    def base(self, index: int) -> BasePose:
+        """The base pose of index ``index``; a ValueError names the indices there are."""
+        n = len(self.bases)
+        if not 0 <= index < n:
+            raise ValueError(
+                f"base {index}: scene {self.name!r} has {n} base pose{'s' if n != 1 else ''}"
+                f" (indices 0 to {n - 1})"
+            )
+        return self.bases[index]
+
     def region_of(self, base: int) -> ExploreRegion:
         """The region base ``base`` (index) explores."""
+        self.base(base)
         own = self.base_regions[base] if base < len(self.base_regions) else None
         return self.region if own is None else own
 
@@ -278,13 +282,13 @@ def _vector(value: object, n: int, where: str, fail: Any, limit: float | None = 
 def _object(value: object, where: str, index: int, folder: Path | None, fail: Any) -> SceneObject:
     table = _table(value, where, fail)
     shape = table.get("shape")
-    known = (*_SIZE_KEYS, "mesh")
+    known = (*SIZE_KEYS, "mesh")
     if shape not in known:
         raise fail(
             f"{where}.shape", f"must be one of {', '.join(known)}, got {format_value(shape)}"
         )
     allowed = set(_POSE_KEYS) | (
-        {"file", "scale"} if shape == "mesh" else set(_SIZE_KEYS[str(shape)])
+        {"file", "scale"} if shape == "mesh" else set(SIZE_KEYS[str(shape)])
     )
     unknown = set(table) - allowed
     if unknown:
@@ -310,10 +314,10 @@ def _object(value: object, where: str, index: int, folder: Path | None, fail: An
         mesh = _mesh_file(table.get("file"), f"{where}.file", folder, fail, scale)
         return mesh_object(name, mesh, position, rotation, scale)
     sizes: list[float] = []
-    for key in _SIZE_KEYS[str(shape)]:
+    for key in SIZE_KEYS[str(shape)]:
         if key not in table:
             raise fail(
-                f"{where}.{key}", f"missing (a {shape} needs {', '.join(_SIZE_KEYS[str(shape)])})"
+                f"{where}.{key}", f"missing (a {shape} needs {', '.join(SIZE_KEYS[str(shape)])})"
             )
         if key == "extents":
             if not isinstance(table[key], list) or len(table[key]) != 3:

@@ -13,8 +13,10 @@ faces for a mesh, which must therefore be closed (watertight) for its inside to 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -29,6 +31,7 @@ __all__ = [
     "MAX_MESH_EXTENT",
     "MIN_OBJECT_SIZE",
     "OBJECT_SHAPES",
+    "SIZE_KEYS",
     "SceneObject",
     "mesh_object",
     "mesh_problem",
@@ -40,6 +43,17 @@ FloatArray = NDArray[np.float64]
 
 #: The primitive shapes a scene may hold (``mesh`` is a user's file).
 OBJECT_SHAPES = ("sphere", "cylinder", "capsule", "cone", "torus", "box")
+
+#: Each primitive's sizes by name, in the order :func:`primitive_object` takes them (a box's
+#: ``extents`` is its three edge lengths); the scene file's keys.
+SIZE_KEYS: dict[str, tuple[str, ...]] = {
+    "sphere": ("radius",),
+    "cylinder": ("radius", "height"),
+    "capsule": ("radius", "length"),
+    "cone": ("radius", "height"),
+    "torus": ("major_radius", "minor_radius"),
+    "box": ("extents",),
+}
 
 #: Largest extent (m) of a user's mesh: 10 m, ten times an antenna's reach. A mesh written in
 #: millimetres and read as metres is a thousand times too large.
@@ -200,7 +214,7 @@ def _fine_mesh(shape: str, parameters: FloatArray) -> trimesh.Trimesh:
 def primitive_object(
     name: str,
     shape: str,
-    sizes: ArrayLike,
+    sizes: ArrayLike | Mapping[str, ArrayLike],
     position: ArrayLike = (0.0, 0.0, 0.0),
     rotation: ArrayLike = (0.0, 0.0, 0.0),
 ) -> SceneObject:
@@ -211,10 +225,11 @@ def primitive_object(
     name : str
     shape : str
         One of :data:`OBJECT_SHAPES`.
-    sizes : array
-        The class's sizes in ``mapping.primitives`` order (m): sphere (radius), cylinder
-        (radius, height), capsule (radius, segment length), cone (base radius, height), torus
-        (major, minor radius), box (three extents).
+    sizes : array or mapping of str to float
+        The shape's sizes (m), in the order of :data:`SIZE_KEYS` or by those names: sphere
+        ``radius``; cylinder ``radius``, ``height``; capsule ``radius``, ``length`` (of the
+        axis segment); cone ``radius`` (of the base), ``height``; torus ``major_radius``,
+        ``minor_radius``; box ``extents`` (its three edges, along its local x, y, z).
     position : array, shape (3,)
         Centre (a cone's base centre) in the world (m).
     rotation : array, shape (3,)
@@ -222,7 +237,7 @@ def primitive_object(
     """
     if shape not in OBJECT_SHAPES:
         raise ValueError(f"unknown shape {shape!r} (known: {', '.join(OBJECT_SHAPES)})")
-    s = PRIMITIVES[shape].size_parameters(np.asarray(sizes, dtype=float).reshape(-1))
+    s = PRIMITIVES[shape].size_parameters(_size_vector(shape, sizes))
     if shape == "sphere":
         parameters = np.concatenate([np.asarray(position, dtype=float), s])
     else:
@@ -230,6 +245,31 @@ def primitive_object(
             [np.asarray(position, dtype=float), np.asarray(rotation, dtype=float), s]
         )
     return SceneObject(name, shape, parameters, _fine_mesh(shape, parameters))
+
+
+def _size_vector(shape: str, sizes: ArrayLike | Mapping[str, ArrayLike]) -> FloatArray:
+    """``primitive_object``'s sizes (m) as one vector in :data:`SIZE_KEYS` order; a ValueError
+    names the sizes the shape takes when they are not those."""
+    keys = SIZE_KEYS[shape]
+    names = PRIMITIVES[shape].size_names  # as SceneObject.sizes names them
+    takes = f"a {shape} takes {', '.join(keys)}"
+    values: Any = sizes
+    if isinstance(sizes, Mapping):
+        given = set(sizes)
+        if given not in (set(keys), set(names)):
+            raise ValueError(f"sizes: {takes}, got {', '.join(map(str, sizes)) or 'none'}")
+        values = [sizes[key] for key in (keys if given == set(keys) else names)]
+    try:
+        vector = np.hstack([np.asarray(v, dtype=float).reshape(-1) for v in np.atleast_1d(values)])
+    except (TypeError, ValueError):
+        raise ValueError(f"sizes: {takes} (m), got {sizes!r}") from None
+    if vector.size != len(names):
+        raise ValueError(f"sizes: {takes} ({len(names)} numbers, m), got {vector.size}")
+    if not np.all(np.isfinite(vector) & (vector > 0.0)):
+        raise ValueError(f"sizes: {takes}, each a length > 0 (m), got {sizes!r}")
+    if shape == "torus" and not vector[1] < vector[0]:
+        raise ValueError("sizes: a torus's minor_radius must be smaller than its major_radius")
+    return vector
 
 
 def mesh_object(

@@ -166,7 +166,7 @@ def touch_scenario(
 
     Raises :class:`GlancingTouchError` with the reason when the touch is ``glancing``.
     """
-    base = scene.bases[sweep.base]
+    base = scene.base(sweep.base)
     rotation = base.rotation @ motor_frame(*touch.angles).T
     frame = BasePose(rotation, base.position)
     # in the recording's frame (X, Y, Z = X^m, Y^m, Z^m); d the sweep's direction

@@ -86,6 +86,14 @@ class Sweep:
     direction: int = 1
 
     def __post_init__(self) -> None:
+        if isinstance(self.base, bool) or not isinstance(self.base, int | np.integer):
+            raise TypeError(
+                "base is the index of a base pose in the scene's bases (an int), got "
+                f"{type(self.base).__name__}"
+            )
+        if self.base < 0:
+            raise ValueError(f"base is an index into the scene's bases (>= 0), got {self.base}")
+        object.__setattr__(self, "base", int(self.base))
         if self.case not in SWEEP_CASES:
             raise ValueError(f"case must be one of {', '.join(SWEEP_CASES)}, got {self.case!r}")
         if not self.start < self.end:

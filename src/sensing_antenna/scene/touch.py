@@ -163,7 +163,7 @@ def _gap(scene: Scene, shape: LinkShape, sweep: Sweep, base: BasePose, angle: fl
 def first_touch(scene: Scene, sweep: Sweep, shape: LinkShape) -> SweepGeometry:
     """Where the link of ``shape`` first touches ``scene`` during ``sweep``, followed from the
     sweep's first angle in its direction (module docstring)."""
-    base = scene.bases[sweep.base]
+    base = scene.base(sweep.base)
     reach = shape.reach
     sign = float(sweep.direction)
     angle = sweep.origin
