@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -297,3 +298,24 @@ def test_recordings_without_a_base_pose_among_posed_ones_are_noted(
     assert "base_pose" not in capsys.readouterr().err
     assert main(["map", str(recordings[2]), *args]) == 0
     assert "base_pose" not in capsys.readouterr().err
+
+
+def test_a_map_where_no_recording_shows_a_contact_says_which_antenna_may_be_wrong(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # an antenna whose threshold lies far above these touches' residual misses them all, as
+    # another device's file would: the map says what to check, not only "no_contact 3"
+    deaf = calibrated()
+    deaf = dataclasses.replace(
+        deaf, observer=dataclasses.replace(deaf.observer, contact_threshold=50.0)
+    )
+    model = tmp_path / "deaf.toml"
+    save_antenna(deaf, model)
+    args = ["--out", str(tmp_path / "m"), "--antenna", str(model), "--no-progress"]
+    assert main(["map", *map(str, recordings), *args]) == 0
+    out = capsys.readouterr().out
+    assert "no_contact 3" in out
+    assert "no recording shows a contact" in out and "--antenna" in out
+    # a map with a point used has nothing to say of it
+    assert main(["map", *map(str, recordings), "--out", str(tmp_path / "n"), "--no-progress"]) == 0
+    assert "no recording shows a contact" not in capsys.readouterr().out

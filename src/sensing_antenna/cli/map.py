@@ -244,5 +244,12 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
             "--antenna the file antenna calibrate wrote), or let such points in with "
             "--include-uncertain; each point's reason is in points.csv"
         )
+    elif summary["n_used"] == 0 and set(summary["statuses"]) == {"no_contact"}:
+        print(
+            "  no recording shows a contact: if the link touched, these may be another device's "
+            "recordings, whose touches this antenna's observer and threshold miss (give "
+            "--antenna the file antenna identify or calibrate wrote for that device); each "
+            "point's reason is in points.csv"
+        )
     for path in written:
         print(f"  {path}")
