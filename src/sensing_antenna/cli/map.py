@@ -210,7 +210,7 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
     (``antenna map`` and ``antenna explore`` share it); ``truth``, the true surface's mesh when
     known, is drawn in the view."""
     from sensing_antenna.mapping import write_map
-    from sensing_antenna.mapping.store import overdispersed
+    from sensing_antenna.mapping.store import overdispersed, unexplained
     from sensing_antenna.mapping.view import write_map_html
     from sensing_antenna.plotting.mapping import plot_map
 
@@ -235,9 +235,10 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
         + "; "
         f"surface faces {summary['surface_faces']}; object {decision}"
     )
-    spread = "" if recognition is None else overdispersed(recognition)
-    if spread:
-        print(f"  {spread}")
+    for warn in (overdispersed, unexplained):
+        text = "" if recognition is None else warn(recognition)
+        if text:
+            print(f"  {text}")
     if summary["n_used"] == 0 and summary["statuses"].get("uncertain"):
         print(
             "  no estimate is ok: an antenna that is not calibrated answers uncertain (give "

@@ -150,6 +150,7 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
+from scipy.stats import binom
 from scipy.stats import f as f_distribution
 
 from sensing_antenna.mapping.free_space import FreeSpace
@@ -527,6 +528,9 @@ class ClassFit:
         Weight exp(-score / 2) among the classes compared (0 to 1); NaN until compared.
     score : float
         chi2 / c + dof ln n (module docstring); NaN until compared.
+    n_wrong : int
+        Points the mixture counts wrong at the fit: z_i^2 beyond their :func:`outlier_cap`
+        (more likely wrong estimates than points of this shape).
     """
 
     name: str
@@ -549,6 +553,7 @@ class ClassFit:
     )
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
     measurements: float = math.nan
+    n_wrong: int = 0
 
     @property
     def counted(self) -> float:
@@ -569,6 +574,16 @@ class ClassFit:
         if not np.all(np.isfinite(self.covariance)):
             return np.full(len(q), np.nan)
         return _carried(lambda v: model.signed_distance(v, q), self.vector, self.covariance)
+
+    @property
+    def wrong_chance(self) -> float:
+        """The chance that :attr:`n_wrong` or more of the points are wrong estimates when each
+        is wrong with :data:`OUTLIER_FRACTION` (binomial upper tail; 1 when none is): a small
+        one says the points are not all of this shape (another object among them, points
+        misplaced)."""
+        if self.n_wrong <= 0:
+            return 1.0
+        return float(binom.sf(self.n_wrong - 1, self.n_points, OUTLIER_FRACTION))
 
     def sizes_known(self, within: float) -> bool:
         """Whether every size is known to within the share ``within`` of itself (0.05: 5 %):
@@ -621,6 +636,7 @@ class ClassFit:
             "dof": self.dof,
             "n_points": self.n_points,
             "measurements": self.counted,
+            "n_wrong": self.n_wrong,
             "weight": None if math.isnan(self.weight) else float(self.weight),
         }
 
@@ -1758,7 +1774,8 @@ def _scored(
     else:
         at, sigma_at, extra, share = touches
     # each point's and each sweep's part of chi^2; BIC = chi^2 + k ln n
-    parts = point_chi2(_z2(at, sigma_at, lines, extra), sigma, spread)
+    z2 = _z2(at, sigma_at, lines, extra)
+    parts = point_chi2(z2, sigma, spread)
     chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(
@@ -1775,6 +1792,7 @@ def _scored(
         measurements=float(n + np.sum(share)),
         vector=vector,
         mesh=mesh,
+        n_wrong=int(np.sum(z2 > outlier_cap(sigma, spread))),
     )
 
 

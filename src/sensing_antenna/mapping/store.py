@@ -187,6 +187,30 @@ def overdispersed(recognition: Any) -> str:
     )
 
 
+#: The chance (:attr:`ClassFit.wrong_chance`) below which the points the best class's fit counts
+#: wrong are more than wrong estimates make: one map in a thousand of one object.
+WRONG_CHANCE = 1e-3
+
+
+def unexplained(recognition: Any) -> str:
+    """What the best fit's points counted wrong say when wrong estimates alone would make that
+    many less often than :data:`WRONG_CHANCE`, or ""."""
+    best = recognition.best
+    chance = best.wrong_chance
+    if not chance < WRONG_CHANCE:
+        return ""
+    odds = (
+        "fewer than one map in a million"
+        if chance < 1e-6
+        else f"one map in {round(1 / chance, -int(math.log10(1 / chance)) + 1):,.0f}"
+    )
+    return (
+        f"{best.n_wrong} of {best.n_points} points lie farther from the {best.name} than its"
+        f" fit allows, where wrong estimates make that many in {odds}: the points are of more"
+        " than one object, or some are misplaced (a base pose, a calibration)"
+    )
+
+
 def _previous_files(out: Path) -> list[str]:
     """The files a previous map in ``out`` wrote (its recognition.json's ``files``), or none."""
     try:
@@ -269,6 +293,7 @@ def report(contact_map: ContactMap) -> str:
     else:
         runner_up = "" if recognition.runner_up is None else f" ({recognition.runner_up})"
         spread = overdispersed(recognition)
+        wrong = unexplained(recognition)
         lines += [
             f"Recognition: **{recognition.decision}**"
             + (
@@ -302,7 +327,8 @@ def report(contact_map: ContactMap) -> str:
                 else ""
             )
             + ".",
-            *([f"{spread[:1].upper()}{spread[1:]}.", ""] if spread else [""]),
+            *(f"{text[:1].upper()}{text[1:]}." for text in (spread, wrong) if text),
+            "",
             "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md),"
             " each at most its outlier cap; the lines' and the swept links' own sums of squares,"
             " uncapped, are beside it.",
