@@ -333,6 +333,26 @@ def test_payload_of_a_simulated_tip_mass(
     assert load_antenna(out).link.tip_mass == pytest.approx(1e-4, abs=2e-5)
 
 
+def test_a_tip_mass_too_heavy_to_pass_for_a_tare_is_named_with_its_weight() -> None:
+    # 1.1 g at the tip of the paper's 4.6 g link adds half of the weight's moment at rest,
+    # beyond what a tare or the link's datasheet mass leaves: refused as the units check
+    # refuses a scaled torque, but the line names the tip mass that reads so
+    from sensing_antenna.simulator import DeviceImperfections
+
+    scenario = Scenario(
+        case="free", duration=3.0, seed=2, device=DeviceImperfections(tip_mass=1.1e-3)
+    )
+    recording = simulate(ANTENNA, scenario).without_ground_truth()
+    with pytest.raises(IdentificationError, match="torques in N mm") as raised:
+        identify_free_motion(recording, ANTENNA)
+    assert "Or, as weight, 1.1 g at the tip" in str(raised.value)
+    # a torque doubled across the weight's moment is no weight: no tip mass is offered
+    turned = dataclasses.replace(recording, torque=recording.torque[:, [1, 0, 2]] * 1.5)
+    with pytest.raises(IdentificationError, match="columns 'tx', 'ty', 'tz'") as raised:
+        identify_free_motion(turned, ANTENNA)
+    assert "tip_mass" not in str(raised.value)
+
+
 def test_a_lighter_reading_never_gives_a_negative_tip_mass() -> None:
     fit = identify_free_motion(_with_payload(_free_motion(4, noise=1e-4), -2e-4), ANTENNA)
     assert fit.payload is not None and fit.payload.significant and fit.payload.mass < 0

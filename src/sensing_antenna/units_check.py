@@ -233,6 +233,7 @@ def rest_reading(
             "loads hold its weight), or torques scaled far down?"
             if tared
             else "torques in N mm, scaled, or a sign flipped?"
+            + _payload_hint(mean_torque, expected_torque, antenna, torque_tolerance)
         )
         problems.append(
             f"columns {_TORQUE_COLUMNS}: over {duration} the torque reads "
@@ -257,6 +258,30 @@ def rest_reading(
     if not problems:
         return reading
     return RestReading(**{**reading.__dict__, "problem": "; ".join(problems)})
+
+
+def _payload_hint(
+    torque: FloatArray, expected: FloatArray, antenna: Antenna, tolerance: float
+) -> str:
+    """ " Or ..." naming the tip mass (g) whose weight the torque at rest reads beyond the
+    model's, when the excess lies along the weight's moment (the rest across it within
+    ``tolerance``, N m) and adds to it; "" otherwise."""
+    link = antenna.link
+    size = float(np.linalg.norm(expected))
+    lever_mass = 0.5 * link.mass + link.weighed_tip_mass  # the moment's, per unit of g l
+    if not (size > 0.0 and lever_mass > 0.0):
+        return ""
+    along = expected / size
+    excess = torque - expected
+    extra = float(excess @ along)
+    across = float(np.linalg.norm(excess - extra * along))
+    if not (extra > 0.0 and across <= tolerance):
+        return ""
+    grams = 1e3 * extra * lever_mass / size
+    return (
+        f" Or, as weight, {grams:.2g} g at the tip that the antenna file does not carry"
+        " (its [link] tip_mass)"
+    )
 
 
 def _worst(read: FloatArray, expected: FloatArray, names: str) -> str:
