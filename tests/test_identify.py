@@ -353,6 +353,42 @@ def test_a_tip_mass_too_heavy_to_pass_for_a_tare_is_named_with_its_weight() -> N
     assert "tip_mass" not in str(raised.value)
 
 
+def test_torques_about_a_point_along_the_link_name_the_torque_point_that_moves_them(
+    tmp_path: Path,
+) -> None:
+    # A sensor whose origin lies 2.5 cm along the link from the clamp reports Gamma_S =
+    # Gamma_O - S x F: the weight and the link's inertial forces add a moment Eq. 15 cannot
+    # follow. Refused, and the line names the point, read by fitting it beside the observer's
+    # gain, and the metadata that moves the torques to O; with it the same files identify
+    point = np.array([0.025, 0.0, 0.0])
+    paths, about_o = [], []
+    for k, case in enumerate(("free", "free-vertical")):
+        recording = simulate(ANTENNA, Scenario(case=case, duration=3.0, seed=k))
+        about_o.append(recording)
+        about_s = dataclasses.replace(
+            recording, torque=recording.torque - np.cross(point, recording.force)
+        )
+        paths.append(tmp_path / f"{case}.csv")
+        write_recording(about_s, paths[-1])
+    from sensing_antenna.recording import read_recording
+
+    with pytest.raises(IdentificationError, match="really free motion") as raised:
+        identify_free_motion([read_recording(p) for p in paths], ANTENNA)
+    words = str(raised.value)
+    read = float(words.split("about a point ")[1].split(" m")[0])
+    # within 3 mm: the fitted point takes up what the observer's form leaves of the torque
+    assert read == pytest.approx(0.025, abs=0.003)
+    assert f"'# torque_point: [{read:.3f}, 0, 0]'" in words
+    for path in paths:
+        path.write_text(f"# torque_point: [{read:.3f}, 0, 0]\n" + path.read_text())
+    fit = identify_free_motion([read_recording(p) for p in paths], ANTENNA)
+    # the torques moved to within millimetres of O leave millimetres x F: gain and frequency
+    # within 2 % of the fit to the torques about O
+    truth = identify_free_motion(about_o, ANTENNA)
+    assert fit.gain == pytest.approx(truth.gain, rel=0.02)
+    assert fit.natural_frequency == pytest.approx(truth.natural_frequency, rel=0.02)
+
+
 def test_a_lighter_reading_never_gives_a_negative_tip_mass() -> None:
     fit = identify_free_motion(_with_payload(_free_motion(4, noise=1e-4), -2e-4), ANTENNA)
     assert fit.payload is not None and fit.payload.significant and fit.payload.mass < 0

@@ -39,7 +39,7 @@ holds (the weight's moment changing with theta_2, joint 2's own dynamics).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -55,6 +55,7 @@ from sensing_antenna.detection.contact import (
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
+from sensing_antenna.torque_point import MAX_TORQUE_POINT
 from sensing_antenna.units_check import (
     angle_problem,
     initial_rest,
@@ -249,26 +250,35 @@ def _targets(recording: Recording, antenna: Antenna) -> NDArray[np.float64]:
     return np.column_stack([sign_z * dynamic_z, sign_y * dynamic_y])
 
 
+def _levers(recording: Recording) -> NDArray[np.float64]:
+    """How the targets of :func:`_targets` change per metre the torques' point S lies along the
+    link from O (N m / m = N), shape (n, 2): Gamma_O = Gamma_S + (S - O) x F gives tz + s Fy
+    and ty - s Fz."""
+    sign_y, sign_z = OBSERVER_TORQUE_SIGNS
+    force = recording.force
+    return np.column_stack([sign_z * force[:, 1], -sign_y * force[:, 2]])
+
+
 def _fit(
-    data: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
+    data: Sequence[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]],
     period: float,
     guess: tuple[float, float, float],
     where: str,
 ) -> tuple[float, float, float, float]:
     """(K, omega, d) of Eq. 15 fitted to the measured coupling torques, and the residual rms
     (N m): a grid over omega and zeta with K solved linearly, then least squares. ``data``
-    holds, per recording, the moved joints' angles (rad) and measured torques (N m), each of
-    shape (n, joints). Raises IdentificationError when Eq. 15 explains the torque poorly (not
-    free motion)."""
+    holds, per recording, the moved joints' angles (rad), measured torques (N m) and their
+    :func:`_levers` (N), each of shape (n, joints). Raises IdentificationError when Eq. 15
+    explains the torque poorly (not free motion, or torques about another point than O)."""
     nyquist = math.pi / period
     k0, w0, d0 = guess
-    measured = np.concatenate([torques.ravel() for _, torques in data])
+    measured = np.concatenate([torques.ravel() for _, torques, _ in data])
 
     def unit_response(omega: float, damping: float) -> NDArray[np.float64]:
         observer = FreeMotionObserver(1.0, omega, damping, 1.0)
         # Eq. 15 with K = 1, discretised as online, each recording from its own rest
         return np.concatenate(
-            [observe_free_motion(angles, observer, period).ravel() for angles, _ in data]
+            [observe_free_motion(angles, observer, period).ravel() for angles, _, _ in data]
         )
 
     best = (math.inf, k0, min(w0, 0.5 * nyquist), d0)
@@ -305,9 +315,43 @@ def _fit(
             f"{where}: columns 'tx', 'ty', 'tz': Eq. 15 explains the coupling torque poorly "
             f"(residual rms {rms:.3g} N m against a signal rms of {signal_rms:.3g} N m); is this "
             "really free motion? A contact leaves a static torque that no free-motion observer "
-            "can follow"
+            "can follow" + _torque_point_hint(data, unit_response, omega, damping, signal_rms)
         )
     return gain, omega, damping, rms
+
+
+def _torque_point_hint(
+    data: Sequence[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]],
+    unit_response: Callable[[float, float], NDArray[np.float64]],
+    omega: float,
+    damping: float,
+    signal_rms: float,
+) -> str:
+    """ "; or ..." naming the point along the link the torques read as taken about, when Eq. 15
+    with that point (``K u + s w``, :func:`_levers`; K and s by linear least squares around
+    the failed fit's ``omega`` and ``damping``) explains the torque to the accepted residual
+    and the point lies within :data:`~sensing_antenna.torque_point.MAX_TORQUE_POINT`; ""
+    otherwise."""
+    measured = np.concatenate([torques.ravel() for _, torques, _ in data])
+    lever = np.concatenate([levers.ravel() for _, _, levers in data])
+    best = (math.inf, 0.0)
+    for scale in np.geomspace(0.5, 2.0, 15):
+        for zeta in _ZETA_GRID:
+            w = float(omega * scale)
+            u = unit_response(w, 2.0 * zeta * w if damping > 0 else 0.0)
+            basis = np.column_stack([u, lever])
+            (gain, shift), *_ = np.linalg.lstsq(basis, measured, rcond=None)
+            cost = float(np.mean((measured - basis @ (gain, shift)) ** 2))
+            if gain > 0 and cost < best[0]:
+                best = (cost, -float(shift))  # the torques read shift w short of O's
+    rms, point = math.sqrt(best[0]), best[1]
+    if not (rms <= MAX_RELATIVE_RESIDUAL * signal_rms and abs(point) <= MAX_TORQUE_POINT):
+        return ""
+    return (
+        f"; or torques about the sensor's own origin: they read as about a point {point:+.3f} m"
+        f" along the link from its clamp (residual rms {rms:.3g} N m), which '# torque_point:"
+        f" [{point:.3f}, 0, 0]' would state (docs/recording-format.md)"
+    )
 
 
 def _check_inertia(inertia: float, rigid: float, where: str) -> None:
@@ -443,7 +487,11 @@ def identify_free_motion(
     ]
     moved = [move for move in moves if move.joints]
     data = [
-        (move.recording.theta[:, move.joints], _targets(move.recording, weighed)[:, move.joints])
+        (
+            move.recording.theta[:, move.joints],
+            _targets(move.recording, weighed)[:, move.joints],
+            _levers(move.recording)[:, move.joints],
+        )
         for move in moved
     ]
     k0, w0, d0 = initial_guess(antenna)
