@@ -180,8 +180,10 @@ def test_contact_recording_is_refused() -> None:
     # observer of Eq. 15, so identification must refuse it rather than return a threshold
     # (on this recording an unchecked fit gives ~0.06 N m, three times the paper's 0.02).
     rec = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=0.6, seed=3))
-    with pytest.raises(IdentificationError, match="really free motion"):
+    with pytest.raises(IdentificationError, match="really free motion") as raised:
         identify_free_motion(rec.without_ground_truth(), ANTENNA)
+    # the contact's moment is its force on the touched point's lever, 0.6 m: no sensor origin
+    assert "torque_point" not in str(raised.value)
 
 
 @pytest.fixture(scope="module")

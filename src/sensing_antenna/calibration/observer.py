@@ -55,7 +55,6 @@ from sensing_antenna.detection.contact import (
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
-from sensing_antenna.torque_point import MAX_TORQUE_POINT
 from sensing_antenna.units_check import (
     angle_problem,
     initial_rest,
@@ -70,6 +69,7 @@ __all__ = [
     "CLAMPED_FREE_BETA_L",
     "DEFAULT_MARGIN",
     "MAX_INERTIA_FACTOR",
+    "SENSOR_OFFSET_SHARE",
     "IdentificationError",
     "ObserverFit",
     "Payload",
@@ -213,6 +213,11 @@ class ObserverFit:
 #: head whose link is not quite the antenna file's.
 MAX_INERTIA_FACTOR = 5.0
 
+#: Farthest from the clamp, as a share of the link's length, that a sensor's origin is named
+#: as the point the torques are about (a Nano17's mount: 2.5 cm of the paper's 0.98 m link);
+#: beyond, Eq. 15 with a lever is a contact's moment, the touched point's lever on its force.
+SENSOR_OFFSET_SHARE = 0.1
+
 #: Lower bound of the fitted gain K (N m / rad), 1e-11 of the paper's 0.37: keeps it positive.
 _MIN_GAIN = 1e-12
 
@@ -264,12 +269,14 @@ def _fit(
     period: float,
     guess: tuple[float, float, float],
     where: str,
+    reach: float = 0.0,
 ) -> tuple[float, float, float, float]:
     """(K, omega, d) of Eq. 15 fitted to the measured coupling torques, and the residual rms
     (N m): a grid over omega and zeta with K solved linearly, then least squares. ``data``
     holds, per recording, the moved joints' angles (rad), measured torques (N m) and their
     :func:`_levers` (N), each of shape (n, joints). Raises IdentificationError when Eq. 15
-    explains the torque poorly (not free motion, or torques about another point than O)."""
+    explains the torque poorly (not free motion, or torques about another point than O: named
+    when within ``reach`` (m) of O, :func:`_torque_point_hint`)."""
     nyquist = math.pi / period
     k0, w0, d0 = guess
     measured = np.concatenate([torques.ravel() for _, torques, _ in data])
@@ -311,11 +318,12 @@ def _fit(
     rms = float(np.sqrt(np.mean(fit.fun**2)))
     signal_rms = float(np.sqrt(np.mean(measured**2)))
     if rms > MAX_RELATIVE_RESIDUAL * signal_rms:
+        hint = _torque_point_hint(data, unit_response, omega, damping, signal_rms, reach)
         raise IdentificationError(
             f"{where}: columns 'tx', 'ty', 'tz': Eq. 15 explains the coupling torque poorly "
             f"(residual rms {rms:.3g} N m against a signal rms of {signal_rms:.3g} N m); is this "
             "really free motion? A contact leaves a static torque that no free-motion observer "
-            "can follow" + _torque_point_hint(data, unit_response, omega, damping, signal_rms)
+            f"can follow{hint}"
         )
     return gain, omega, damping, rms
 
@@ -326,12 +334,12 @@ def _torque_point_hint(
     omega: float,
     damping: float,
     signal_rms: float,
+    reach: float,
 ) -> str:
     """ "; or ..." naming the point along the link the torques read as taken about, when Eq. 15
     with that point (``K u + s w``, :func:`_levers`; K and s by linear least squares around
     the failed fit's ``omega`` and ``damping``) explains the torque to the accepted residual
-    and the point lies within :data:`~sensing_antenna.torque_point.MAX_TORQUE_POINT`; ""
-    otherwise."""
+    and the point lies within ``reach`` (m) of O; "" otherwise."""
     measured = np.concatenate([torques.ravel() for _, torques, _ in data])
     lever = np.concatenate([levers.ravel() for _, _, levers in data])
     best = (math.inf, 0.0)
@@ -345,7 +353,7 @@ def _torque_point_hint(
             if gain > 0 and cost < best[0]:
                 best = (cost, -float(shift))  # the torques read shift w short of O's
     rms, point = math.sqrt(best[0]), best[1]
-    if not (rms <= MAX_RELATIVE_RESIDUAL * signal_rms and abs(point) <= MAX_TORQUE_POINT):
+    if not (rms <= MAX_RELATIVE_RESIDUAL * signal_rms and abs(point) <= reach):
         return ""
     return (
         f"; or torques about the sensor's own origin: they read as about a point {point:+.3f} m"
@@ -498,7 +506,8 @@ def identify_free_motion(
     try:
         # Arithmetic that overflows means values no link gives (a wrench of 1e300 N m)
         with np.errstate(over="raise"):
-            gain, omega, damping, rms = _fit(data, period, (k0, w0, d0), where)
+            reach = SENSOR_OFFSET_SHARE * antenna.link.length
+            gain, omega, damping, rms = _fit(data, period, (k0, w0, d0), where, reach)
     except FloatingPointError:
         raise IdentificationError(
             f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the fit of Eq. 15 overflows: "
