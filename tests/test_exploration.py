@@ -40,6 +40,7 @@ from sensing_antenna.mapping import (
     recognise,
 )
 from sensing_antenna.scene import (
+    ExploreRegion,
     LinkShape,
     Scene,
     Sweep,
@@ -366,6 +367,10 @@ def test_other_settings_in_the_same_directory_are_refused(
     stored_nonlinear = r'settings.json: link "nonlinear" stored, "linear" given: '
     with pytest.raises(ExplorationStoreError, match=stored_nonlinear):
         explore(load_scene("post"), DEVICE, out, linear)
+    moved = dataclasses.replace(load_scene("post"), region=ExploreRegion(azimuth=(-0.5, 0.5)))
+    changed = r"settings.json: the scene's objects, base poses or explored region"
+    with pytest.raises(ExplorationStoreError, match=changed):
+        explore(moved, DEVICE, out, ExploreSettings(method="paper", budget=3))
 
 
 def test_the_device_is_identified_before_it_explores(

@@ -249,6 +249,8 @@ def write_settings(out: Path, settings: dict[str, Any]) -> None:
 
 def _change(key: str, stored: Any, given: Any) -> str:
     """A setting that differs, with both values when they are short (a device file is not)."""
+    if key == "scene_fingerprint":
+        return "the scene's objects, base poses or explored region (scene_fingerprint)"
     if max(len(json.dumps(stored)), len(json.dumps(given))) > 40:
         return key
     return f"{key} {json.dumps(stored)} stored, {json.dumps(given)} given"
