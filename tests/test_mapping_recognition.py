@@ -232,6 +232,23 @@ def test_a_user_mesh_is_registered_at_its_pose() -> None:
     assert distance.max() < 0.005
 
 
+@pytest.mark.parametrize(("seed", "n"), [(0, 12), (3, 24)])
+def test_a_user_mesh_is_registered_as_close_to_the_points_as_its_true_pose(
+    seed: int, n: int
+) -> None:
+    # A box's own mesh and 12 or 24 points of it: the registration ends in the true pose's basin
+    # (the points' RMS distance no larger than at the true pose), which few of its starts reach
+    rng = np.random.default_rng(seed)
+    mesh = trimesh.creation.box(extents=(0.06, 0.1, 0.16))
+    pose = _pose(rng)
+    placed = mesh.copy()
+    placed.apply_transform(pose)
+    points, covariances = _sample(placed, n, rng)
+    _, at_truth, _ = trimesh.proximity.closest_point(placed, points)
+    fit = fit_mesh("mybox", mesh, points, covariances, rng=np.random.default_rng(0))
+    assert fit.rms <= math.sqrt(np.mean(at_truth**2))
+
+
 def test_points_along_one_outline_of_a_torus_name_no_class_confidently() -> None:
     # contacts along the outer equator of a torus (axis Z), the half facing the base: its
     # outline seen along the axis, a band that a cylinder of radius R + r fits about as well;
