@@ -464,6 +464,28 @@ def _swept_touches(
     return points, covariances, lines
 
 
+@pytest.mark.parametrize("seed", [2, 5])
+def test_a_user_mesh_on_few_points_is_registered_where_the_links_that_touched_it_allow(
+    seed: int,
+) -> None:
+    # Ten touches of a box, their links' lines, and the box's own mesh: several poses put the
+    # mesh's faces on ten points, and the one that fits them best by a hair had links passing
+    # through the box (line chi^2 1,900 and 8,800); the pose kept is one the lines allow
+    rng = np.random.default_rng(seed)
+    own = SHAPES["box"][0]()
+    mesh = own.copy()
+    mesh.apply_transform(_pose(rng))
+    points, covariances, lines = _swept_touches(mesh, rng)
+    few = rng.choice(len(points), 10, replace=False)
+    touched = LinkLines(lines.tangents[few], lines.std[few], lines.behind[few], lines.beyond[few])
+    fit = fit_mesh(
+        "own", own, points[few], covariances[few], rng=np.random.default_rng(0), lines=touched
+    )
+    # the true pose's lines: each one-sided residual about a sigma at most, half of them 0
+    assert fit.line_chi2 < 10
+    assert fit.rms < 2 * NOISE
+
+
 @pytest.mark.parametrize("name", ["box", "cylinder"])
 def test_the_lines_that_touched_tell_a_box_from_a_cylinder(name: str) -> None:
     # a line swept towards a box first meets it on an edge, and a cylinder fits points on a

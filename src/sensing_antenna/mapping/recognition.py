@@ -256,6 +256,10 @@ RESIZED_STARTS = (0.5, 2.0)
 #: to the mesh changes by less than this share of their variance in one ICP iteration.
 ICP_TOLERANCE = 1e-2
 
+#: Registrations (:func:`fit_mesh`) refined and scored with the links' evidence, from the
+#: distinct starts that fit the points best.
+MESH_CANDIDATES = 8
+
 #: Most points a registration start (:func:`fit_mesh`) is run on.
 START_POINTS = 40
 
@@ -1707,18 +1711,57 @@ def fit_mesh(
             scale=False,
         )
         started.append((float(cost), np.asarray(matrix)))
-    # the best start refined to convergence
-    points_to_mesh, _, _ = trimesh.registration.icp(
-        p,
-        mesh,
-        initial=min(started, key=lambda start: start[0])[1],
-        max_iterations=300,
-        threshold=1e-10,
-        reflection=False,
-        scale=False,
-    )
-    moved = trimesh.transform_points(p, points_to_mesh)
-    _, distance, faces = closest_point(mesh, moved)
+    # the best start refined to convergence; with the links' lines or swept links (a closed
+    # mesh), the best MESH_CANDIDATES distinct starts, the pose the whole evidence fits best:
+    # few points fit several poses, some of which put the mesh where a link passed
+    started.sort(key=lambda start: start[0])
+    evidence = mesh.is_watertight and (lines is not None or len(swept) > 0)
+    candidates = _distinct_poses([m for _, m in started], MESH_CANDIDATES if evidence else 1)
+    fits = []
+    for start in candidates:
+        points_to_mesh, _, _ = trimesh.registration.icp(
+            p,
+            mesh,
+            initial=start,
+            max_iterations=300,
+            threshold=1e-10,
+            reflection=False,
+            scale=False,
+        )
+        fits.append(_registered(name, mesh, p, cov, points_to_mesh, lines, swept))
+    return min(fits, key=lambda fit: fit.chi2)
+
+
+def _distinct_poses(matrices: Sequence[FloatArray], most: int) -> list[FloatArray]:
+    """The first ``most`` of ``matrices`` (4 x 4, in order) that each move the points' frame
+    by more than a millimetre or a hundredth of a radian from those kept before."""
+    kept: list[FloatArray] = []
+    for matrix in matrices:
+        if len(kept) == most:
+            break
+        if all(
+            np.linalg.norm(matrix[:3, 3] - other[:3, 3]) > 1e-3
+            or np.linalg.norm(Rotation.from_matrix(matrix[:3, :3] @ other[:3, :3].T).as_rotvec())
+            > 1e-2
+            for other in kept
+        ):
+            kept.append(matrix)
+    return kept
+
+
+def _registered(
+    name: str,
+    mesh: trimesh.Trimesh,
+    p: FloatArray,
+    cov: FloatArray,
+    points_to_mesh: FloatArray,
+    lines: LinkLines | None,
+    swept: Sequence[FreeSpace],
+) -> ClassFit:
+    """The user mesh ``mesh`` registered by ``points_to_mesh`` (4 x 4, world to mesh) scored on
+    the points ``p`` (m, (n, 3)) with covariances ``cov`` (m^2, (n, 3, 3)), the links'
+    ``lines`` and the ``swept`` links (:func:`fit_mesh`)."""
+    _, distance, faces = closest_point(mesh, trimesh.transform_points(p, points_to_mesh))
     pose = np.linalg.inv(points_to_mesh)  # mesh to world
     normals = mesh.face_normals[faces] @ pose[:3, :3].T
     sigma = _normal_sigma(cov, normals)
@@ -1758,7 +1801,7 @@ def fit_mesh(
         np.asarray(distance),
         sigma,
         6,
-        pose.ravel(),
+        np.asarray(pose, dtype=float).ravel(),
         placed,
         _spread(p),
         line,
