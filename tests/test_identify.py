@@ -184,6 +184,12 @@ def test_contact_recording_is_refused() -> None:
         identify_free_motion(rec.without_ground_truth(), ANTENNA)
     # the contact's moment is its force on the touched point's lever, 0.6 m: no sensor origin
     assert "torque_point" not in str(raised.value)
+    # nor near the clamp, where the contact's lever is a sensor origin's: torques moved there
+    # still hold the contact's static moment
+    near = simulate(ANTENNA, Scenario(case="azimuthal", contact_point=0.08, seed=3))
+    with pytest.raises(IdentificationError, match="really free motion") as raised:
+        identify_free_motion(near.without_ground_truth(), ANTENNA)
+    assert "torque_point" not in str(raised.value)
 
 
 @pytest.fixture(scope="module")
@@ -355,14 +361,11 @@ def test_a_tip_mass_too_heavy_to_pass_for_a_tare_is_named_with_its_weight() -> N
     assert "tip_mass" not in str(raised.value)
 
 
-def test_torques_about_a_point_along_the_link_name_the_torque_point_that_moves_them(
-    tmp_path: Path,
-) -> None:
-    # A sensor whose origin lies 2.5 cm along the link from the clamp reports Gamma_S =
-    # Gamma_O - S x F: the weight and the link's inertial forces add a moment Eq. 15 cannot
-    # follow. Refused, and the line names the point, read by fitting it beside the observer's
-    # gain, and the metadata that moves the torques to O; with it the same files identify
-    point = np.array([0.025, 0.0, 0.0])
+def _about_point(offset: float, folder: Path) -> tuple[list[Path], list[Recording]]:
+    """Simulated free and free-vertical sweeps of the paper antenna with their torques taken
+    about S = (offset, 0, 0) m (Gamma_S = Gamma_O - (S - O) x F), written into ``folder``;
+    and the recordings about O."""
+    point = np.array([offset, 0.0, 0.0])
     paths, about_o = [], []
     for k, case in enumerate(("free", "free-vertical")):
         recording = simulate(ANTENNA, Scenario(case=case, duration=3.0, seed=k))
@@ -370,25 +373,64 @@ def test_torques_about_a_point_along_the_link_name_the_torque_point_that_moves_t
         about_s = dataclasses.replace(
             recording, torque=recording.torque - np.cross(point, recording.force)
         )
-        paths.append(tmp_path / f"{case}.csv")
+        paths.append(folder / f"{case}.csv")
         write_recording(about_s, paths[-1])
+    return paths, about_o
+
+
+@pytest.mark.parametrize("offset", [0.025, 0.05])
+def test_torques_about_a_point_along_the_link_name_the_torque_point_that_moves_them(
+    offset: float, tmp_path: Path
+) -> None:
+    # A sensor whose origin lies 2.5 or 5 cm in front of the clamp: the weight and the link's
+    # inertial forces times the offset are a moment Eq. 15 cannot follow. Refused, and the line
+    # names the point, fitted beside the observer's gain and a tip mass, and the metadata that
+    # moves the torques to O; with it the same files identify as the torques about O do
     from sensing_antenna.recording import read_recording
 
+    paths, about_o = _about_point(offset, tmp_path)
     with pytest.raises(IdentificationError, match="really free motion") as raised:
         identify_free_motion([read_recording(p) for p in paths], ANTENNA)
     words = str(raised.value)
     read = float(words.split("about a point ")[1].split(" m")[0])
     # within 3 mm: the fitted point takes up what the observer's form leaves of the torque
-    assert read == pytest.approx(0.025, abs=0.003)
-    assert f"'# torque_point: [{read:.3f}, 0, 0]'" in words
+    assert read == pytest.approx(offset, abs=0.003)
+    stated = f"[{read:.3f}, 0.000, 0.000]"
+    assert f"'# torque_point: {stated}'" in words
     for path in paths:
-        path.write_text(f"# torque_point: [{read:.3f}, 0, 0]\n" + path.read_text())
+        path.write_text(f"# torque_point: {stated}\n" + path.read_text())
     fit = identify_free_motion([read_recording(p) for p in paths], ANTENNA)
     # the torques moved to within millimetres of O leave millimetres x F: gain and frequency
     # within 2 % of the fit to the torques about O
     truth = identify_free_motion(about_o, ANTENNA)
     assert fit.gain == pytest.approx(truth.gain, rel=0.02)
     assert fit.natural_frequency == pytest.approx(truth.natural_frequency, rel=0.02)
+    assert fit.torque_point is None and truth.torque_point is None
+    # a point stated with its sign flipped: the line names the whole point, not the change
+    for path in paths:
+        path.write_text(path.read_text().replace(stated, f"[{-read:.3f}, 0, 0]"))
+    with pytest.raises(IdentificationError, match="beyond the '# torque_point'") as raised:
+        identify_free_motion([read_recording(p) for p in paths], ANTENNA)
+    assert f"'# torque_point: [{read:.3f}, 0.000, 0.000]'" in str(raised.value)
+
+
+@pytest.mark.parametrize("offset", [-0.025, -0.09])
+def test_torques_behind_the_clamp_identify_with_a_warning_naming_the_point(
+    offset: float, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Behind the clamp the offset reads heavier at rest, a tip mass, and Eq. 15 passes with a
+    # gain some % off: the fit says which point the torques read as about, and the command
+    # warns; torques about O raise no such point
+    from sensing_antenna.recording import read_recording
+
+    paths, about_o = _about_point(offset, tmp_path)
+    fit = identify_free_motion([read_recording(p) for p in paths], ANTENNA)
+    assert fit.torque_point == pytest.approx((offset, 0.0, 0.0), abs=0.003)
+    assert identify_free_motion(about_o, ANTENNA).torque_point is None
+    assert main(["identify", *map(str, paths), "--out", str(tmp_path / "fitted.toml")]) == 0
+    warning = capsys.readouterr().err
+    assert "antenna identify: warning: the torques read as taken about a point" in warning
+    assert f"'# torque_point: [{fit.torque_point[0]:.3f}, 0.000, 0.000]'" in warning
 
 
 def test_a_lighter_reading_never_gives_a_negative_tip_mass() -> None:

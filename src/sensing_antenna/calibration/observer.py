@@ -38,6 +38,7 @@ holds (the weight's moment changing with theta_2, joint 2's own dynamics).
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -55,6 +56,7 @@ from sensing_antenna.detection.contact import (
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
+from sensing_antenna.torque_point import MOVED_KEY
 from sensing_antenna.units_check import (
     angle_problem,
     initial_rest,
@@ -68,7 +70,9 @@ from sensing_antenna.units_check import (
 __all__ = [
     "CLAMPED_FREE_BETA_L",
     "DEFAULT_MARGIN",
+    "LEVER_GAIN",
     "MAX_INERTIA_FACTOR",
+    "SENSOR_OFFSET_NOTICED",
     "SENSOR_OFFSET_SHARE",
     "IdentificationError",
     "ObserverFit",
@@ -167,6 +171,10 @@ class ObserverFit:
         The recordings' files, comma-separated.
     payload : Payload or None
         Weight at the tip beyond the model's, read at rest (None: not read).
+    torque_point : (float, float, float) or None
+        The point (S - O on the motor axes, m) the torques read as taken about, when Eq. 15
+        with it explains the free motion much better (:data:`LEVER_GAIN`) though Eq. 15 alone
+        passed: the recordings' ``torque_point`` should say so, and the fit be made again.
     """
 
     gain: float
@@ -183,6 +191,7 @@ class ObserverFit:
     initial_damping: float
     source: str | None = None
     payload: Payload | None = None
+    torque_point: tuple[float, float, float] | None = None
 
     @property
     def observer(self) -> FreeMotionObserver:
@@ -217,6 +226,13 @@ MAX_INERTIA_FACTOR = 5.0
 #: as the point the torques are about (a Nano17's mount: 2.5 cm of the paper's 0.98 m link);
 #: beyond, Eq. 15 with a lever is a contact's moment, the touched point's lever on its force.
 SENSOR_OFFSET_SHARE = 0.1
+
+#: Nearest to the clamp (m) that a torque point is suspected in a fit that passes, and the
+#: share of Eq. 15's residual that Eq. 15 with the point must leave: on simulated free sweeps
+#: of the paper's link, torques about O left 0.8 to 1.4 of it with the point within 1 cm, and
+#: torques 2.5 cm behind the clamp, which pass, 0.13 to 0.35.
+SENSOR_OFFSET_NOTICED = 0.01
+LEVER_GAIN = 0.5
 
 #: Lower bound of the fitted gain K (N m / rad), 1e-11 of the paper's 0.37: keeps it positive.
 _MIN_GAIN = 1e-12
@@ -255,13 +271,17 @@ def _targets(recording: Recording, antenna: Antenna) -> NDArray[np.float64]:
     return np.column_stack([sign_z * dynamic_z, sign_y * dynamic_y])
 
 
-def _levers(recording: Recording) -> NDArray[np.float64]:
-    """How the targets of :func:`_targets` change per metre the torques' point S lies along the
-    link from O (N m / m = N), shape (n, 2): Gamma_O = Gamma_S + (S - O) x F gives tz + s Fy
-    and ty - s Fz."""
+def _static_terms(recording: Recording, length: float) -> NDArray[np.float64]:
+    """How the targets of :func:`_targets` change, shape (n, 2, 2): [..., 0] per metre the
+    torques' point S lies along the link from O (N; Gamma_O = Gamma_S + (S - O) x F gives
+    tz + s Fy and ty - s Fz), [..., 1] per kilogram of tip mass the weight leaves out (N m / kg,
+    g l cos theta2 on the elevation's target), for a link of ``length`` (m)."""
     sign_y, sign_z = OBSERVER_TORQUE_SIGNS
     force = recording.force
-    return np.column_stack([sign_z * force[:, 1], -sign_y * force[:, 2]])
+    lever = np.column_stack([sign_z * force[:, 1], -sign_y * force[:, 2]])
+    weight = np.zeros_like(lever)
+    weight[:, 1] = sign_y * STANDARD_GRAVITY * length * np.cos(recording.theta[:, 1])
+    return np.stack([lever, weight], axis=-1)
 
 
 def _fit(
@@ -270,13 +290,18 @@ def _fit(
     guess: tuple[float, float, float],
     where: str,
     reach: float = 0.0,
-) -> tuple[float, float, float, float]:
-    """(K, omega, d) of Eq. 15 fitted to the measured coupling torques, and the residual rms
-    (N m): a grid over omega and zeta with K solved linearly, then least squares. ``data``
-    holds, per recording, the moved joints' angles (rad), measured torques (N m) and their
-    :func:`_levers` (N), each of shape (n, joints). Raises IdentificationError when Eq. 15
-    explains the torque poorly (not free motion, or torques about another point than O: named
-    when within ``reach`` (m) of O, :func:`_torque_point_hint`)."""
+    stated: NDArray[np.float64] | None = None,
+) -> tuple[float, float, float, float, NDArray[np.float64] | None]:
+    """(K, omega, d) of Eq. 15 fitted to the measured coupling torques, the residual rms
+    (N m), and the point (S - O, m) the torques read as taken about when Eq. 15 with it
+    (:func:`_lever_fit`) leaves at most :data:`LEVER_GAIN` of that residual and it lies
+    from :data:`SENSOR_OFFSET_NOTICED` to ``reach`` (m) from O (else None): a grid over omega
+    and zeta with K solved linearly, then least squares. ``data``
+    holds, per recording, the moved joints' angles (rad) and measured torques (N m), each of
+    shape (n, joints), and their :func:`_static_terms`, shape (n, joints, 2). Raises
+    IdentificationError when Eq. 15 explains the torque poorly (not free motion, or torques
+    about another point than O: named when within ``reach`` (m) of O,
+    :func:`_torque_point_hint`, ``stated`` the point the recordings state)."""
     nyquist = math.pi / period
     k0, w0, d0 = guess
     measured = np.concatenate([torques.ravel() for _, torques, _ in data])
@@ -318,47 +343,94 @@ def _fit(
     rms = float(np.sqrt(np.mean(fit.fun**2)))
     signal_rms = float(np.sqrt(np.mean(measured**2)))
     if rms > MAX_RELATIVE_RESIDUAL * signal_rms:
-        hint = _torque_point_hint(data, unit_response, omega, damping, signal_rms, reach)
+        fitted = _lever_fit(data, unit_response, omega, damping)
+        hint = _torque_point_hint(fitted, reach, stated)
         raise IdentificationError(
             f"{where}: columns 'tx', 'ty', 'tz': Eq. 15 explains the coupling torque poorly "
             f"(residual rms {rms:.3g} N m against a signal rms of {signal_rms:.3g} N m); is this "
             "really free motion? A contact leaves a static torque that no free-motion observer "
             f"can follow{hint}"
         )
-    return gain, omega, damping, rms
+    point, lever_rms, _ = _lever_fit(data, unit_response, omega, damping)
+    along = point + (0.0 if stated is None else float(stated[0]))
+    noticed = lever_rms <= LEVER_GAIN * rms and abs(point) >= SENSOR_OFFSET_NOTICED
+    if not (noticed and abs(along) <= reach):
+        return gain, omega, damping, rms, None
+    return (
+        gain,
+        omega,
+        damping,
+        rms,
+        np.array([point, 0.0, 0.0]) + (0.0 if stated is None else stated),
+    )
 
 
-def _torque_point_hint(
+def _stated_point(
+    recordings: Sequence[Recording], antenna: Antenna
+) -> tuple[float, NDArray[np.float64] | None]:
+    """How far from O (m) a torque point is named (:data:`SENSOR_OFFSET_SHARE` of the link; 0
+    when the recordings state different points) and the point they state (S - O, m; None
+    when none does)."""
+    stated = {recording.metadata.get(MOVED_KEY) for recording in recordings}
+    if len(stated) > 1:
+        return 0.0, None
+    text = stated.pop()
+    point = None if text is None else np.array(json.loads(text), dtype=float)
+    return SENSOR_OFFSET_SHARE * antenna.link.length, point
+
+
+def _lever_fit(
     data: Sequence[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]],
     unit_response: Callable[[float, float], NDArray[np.float64]],
     omega: float,
     damping: float,
-    signal_rms: float,
-    reach: float,
-) -> str:
-    """ "; or ..." naming the point along the link the torques read as taken about, when Eq. 15
-    with that point (``K u + s w``, :func:`_levers`; K and s by linear least squares around
-    the failed fit's ``omega`` and ``damping``) explains the torque to the accepted residual
-    and the point lies within ``reach`` (m) of O; "" otherwise."""
+) -> tuple[float, float, float]:
+    """Eq. 15 with the torques' point and a tip mass, ``K u - s w + m v`` (:func:`_static_terms`:
+    the weight the rest read as payload is the lever's too; K, s, m by linear least squares
+    over a grid about ``omega`` and ``damping``): the point s (m along the link from O), the
+    residual rms and the rms of the torques moved to that point (N m); (0, inf, inf) when no
+    gain is positive."""
     measured = np.concatenate([torques.ravel() for _, torques, _ in data])
-    lever = np.concatenate([levers.ravel() for _, _, levers in data])
-    best = (math.inf, 0.0)
+    terms = np.concatenate([static.reshape(-1, 2) for _, _, static in data])
+    best = (math.inf, 0.0, math.inf)
     for scale in np.geomspace(0.5, 2.0, 15):
         for zeta in _ZETA_GRID:
             w = float(omega * scale)
             u = unit_response(w, 2.0 * zeta * w if damping > 0 else 0.0)
-            basis = np.column_stack([u, lever])
-            (gain, shift), *_ = np.linalg.lstsq(basis, measured, rcond=None)
-            cost = float(np.mean((measured - basis @ (gain, shift)) ** 2))
+            basis = np.column_stack([u, terms])
+            (gain, shift, mass), *_ = np.linalg.lstsq(basis, measured, rcond=None)
+            cost = float(np.mean((measured - basis @ (gain, shift, mass)) ** 2))
             if gain > 0 and cost < best[0]:
-                best = (cost, -float(shift))  # the torques read shift w short of O's
-    rms, point = math.sqrt(best[0]), best[1]
-    if not (rms <= MAX_RELATIVE_RESIDUAL * signal_rms and abs(point) <= reach):
+                # the torques read shift w short of O's; moved, they keep the dynamic part
+                moved = measured - shift * terms[:, 0] - mass * terms[:, 1]
+                best = (cost, -float(shift), float(np.sqrt(np.mean(moved**2))))
+    return best[1], math.sqrt(best[0]), best[2]
+
+
+def _point_text(point: float, stated: NDArray[np.float64] | None) -> str:
+    """The ``torque_point`` line (m) that states ``point`` (m along the link) beyond ``stated``."""
+    total = np.array([point, 0.0, 0.0]) + (0.0 if stated is None else stated)
+    return f"'# torque_point: [{', '.join(f'{v:.3f}' for v in total)}]'"
+
+
+def _torque_point_hint(
+    fitted: tuple[float, float, float], reach: float, stated: NDArray[np.float64] | None
+) -> str:
+    """ "; or ..." naming the point along the link the torques read as taken about, when Eq. 15
+    with it (:func:`_lever_fit`, ``fitted``) explains the torques moved there as Eq. 15 alone
+    must explain free motion (:data:`MAX_RELATIVE_RESIDUAL`) and the whole point lies within
+    ``reach`` (m) of O; "" otherwise. ``stated``: the point the recordings already state
+    (S - O, m), which the named one adds to."""
+    point, rms, moved_rms = fitted
+    if not (math.isfinite(rms) and rms <= MAX_RELATIVE_RESIDUAL * moved_rms):
         return ""
+    if not abs(point + (0.0 if stated is None else stated[0])) <= reach:
+        return ""
+    beyond = "" if stated is None else " beyond the '# torque_point' the recordings state"
     return (
         f"; or torques about the sensor's own origin: they read as about a point {point:+.3f} m"
-        f" along the link from its clamp (residual rms {rms:.3g} N m), which '# torque_point:"
-        f" [{point:.3f}, 0, 0]' would state (docs/recording-format.md)"
+        f" along the link from its clamp{beyond} (residual rms {rms:.3g} N m), which"
+        f" {_point_text(point, stated)} would state (docs/recording-format.md)"
     )
 
 
@@ -498,7 +570,7 @@ def identify_free_motion(
         (
             move.recording.theta[:, move.joints],
             _targets(move.recording, weighed)[:, move.joints],
-            _levers(move.recording)[:, move.joints],
+            _static_terms(move.recording, antenna.link.length)[:, move.joints],
         )
         for move in moved
     ]
@@ -506,8 +578,10 @@ def identify_free_motion(
     try:
         # Arithmetic that overflows means values no link gives (a wrench of 1e300 N m)
         with np.errstate(over="raise"):
-            reach = SENSOR_OFFSET_SHARE * antenna.link.length
-            gain, omega, damping, rms = _fit(data, period, (k0, w0, d0), where, reach)
+            reach, stated = _stated_point([move.recording for move in moved], antenna)
+            gain, omega, damping, rms, suspect = _fit(
+                data, period, (k0, w0, d0), where, reach, stated
+            )
     except FloatingPointError:
         raise IdentificationError(
             f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the fit of Eq. 15 overflows: "
@@ -547,6 +621,7 @@ def identify_free_motion(
         initial_damping=d0,
         source=where if named else None,
         payload=payload,
+        torque_point=None if suspect is None else (float(suspect[0]), 0.0, 0.0),
     )
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -134,6 +135,16 @@ def _run(args: argparse.Namespace) -> int:
             f"{fit.residual_rms:.3g} N m, joints used: {joints}"
         )
         _print_payload(fit.payload, antenna.link, identified.link)
+        if fit.torque_point is not None:
+            point = ", ".join(f"{v:.3f}" for v in fit.torque_point)
+            print(
+                "antenna identify: warning: the torques read as taken about a point off the"
+                " link's clamp (Eq. 15 with it explains them far better): if the sensor's"
+                f" origin lies there, state '# torque_point: [{point}]' in the recordings and"
+                " identify again (the gain and any tip mass read here carry that offset;"
+                " docs/real-antenna.md)",
+                file=sys.stderr,
+            )
     if motor_fit is not None:
         _print_servo(motor_fit, antenna, pole, several=len(recordings) > 1)
     print(args.out)
