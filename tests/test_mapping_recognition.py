@@ -232,21 +232,22 @@ def test_a_user_mesh_is_registered_at_its_pose() -> None:
     assert distance.max() < 0.005
 
 
-@pytest.mark.parametrize(("seed", "n"), [(0, 12), (3, 24)])
-def test_a_user_mesh_is_registered_as_close_to_the_points_as_its_true_pose(
-    seed: int, n: int
-) -> None:
-    # A box's own mesh and 12 or 24 points of it: the registration ends in the true pose's basin
-    # (the points' RMS distance no larger than at the true pose), which few of its starts reach
-    rng = np.random.default_rng(seed)
-    mesh = trimesh.creation.box(extents=(0.06, 0.1, 0.16))
-    pose = _pose(rng)
-    placed = mesh.copy()
-    placed.apply_transform(pose)
-    points, covariances = _sample(placed, n, rng)
-    _, at_truth, _ = trimesh.proximity.closest_point(placed, points)
-    fit = fit_mesh("mybox", mesh, points, covariances, rng=np.random.default_rng(0))
-    assert fit.rms <= math.sqrt(np.mean(at_truth**2))
+def test_a_user_mesh_is_registered_as_close_to_the_points_as_its_true_pose() -> None:
+    # A box's own mesh and 12 points of it at 20 poses: the registration ends in the true pose's
+    # basin (the points' RMS distance no larger than at the true pose), which few of its starts
+    # reach, on most of them (14 of 20 when written; 10 when each start stopped within an
+    # iteration or two)
+    ended = 0
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        mesh = trimesh.creation.box(extents=(0.06, 0.1, 0.16))
+        placed = mesh.copy()
+        placed.apply_transform(_pose(rng))
+        points, covariances = _sample(placed, 12, rng)
+        _, at_truth, _ = trimesh.proximity.closest_point(placed, points)
+        fit = fit_mesh("mybox", mesh, points, covariances, rng=np.random.default_rng(0))
+        ended += fit.rms <= math.sqrt(np.mean(at_truth**2))
+    assert ended >= 13
 
 
 def test_points_along_one_outline_of_a_torus_name_no_class_confidently() -> None:
@@ -464,26 +465,28 @@ def _swept_touches(
     return points, covariances, lines
 
 
-@pytest.mark.parametrize("seed", [2, 5])
-def test_a_user_mesh_on_few_points_is_registered_where_the_links_that_touched_it_allow(
-    seed: int,
-) -> None:
-    # Ten touches of a box, their links' lines, and the box's own mesh: several poses put the
-    # mesh's faces on ten points, and the one that fits them best by a hair had links passing
-    # through the box (line chi^2 1,900 and 8,800); the pose kept is one the lines allow
-    rng = np.random.default_rng(seed)
-    own = SHAPES["box"][0]()
-    mesh = own.copy()
-    mesh.apply_transform(_pose(rng))
-    points, covariances, lines = _swept_touches(mesh, rng)
-    few = rng.choice(len(points), 10, replace=False)
-    touched = LinkLines(lines.tangents[few], lines.std[few], lines.behind[few], lines.beyond[few])
-    fit = fit_mesh(
-        "own", own, points[few], covariances[few], rng=np.random.default_rng(0), lines=touched
-    )
-    # the true pose's lines: each one-sided residual about a sigma at most, half of them 0
-    assert fit.line_chi2 < 10
-    assert fit.rms < 2 * NOISE
+def test_a_user_mesh_on_few_points_is_registered_where_the_links_that_touched_it_allow() -> None:
+    # Ten touches of a box, their links' lines, and the box's own mesh, at ten poses: several
+    # poses put the mesh's faces on ten points, and the one that fits them best by a hair can
+    # have links passing through the box (line chi^2 in the thousands); the pose kept is one
+    # the lines allow on most (8 of 10 when written; 4 when the points alone chose)
+    allowed = 0
+    for seed in range(10):
+        rng = np.random.default_rng(seed)
+        own = SHAPES["box"][0]()
+        mesh = own.copy()
+        mesh.apply_transform(_pose(rng))
+        points, covariances, lines = _swept_touches(mesh, rng)
+        few = rng.choice(len(points), 10, replace=False)
+        touched = LinkLines(
+            lines.tangents[few], lines.std[few], lines.behind[few], lines.beyond[few]
+        )
+        fit = fit_mesh(
+            "own", own, points[few], covariances[few], rng=np.random.default_rng(0), lines=touched
+        )
+        # the true pose's lines: each one-sided residual about a sigma at most, half of them 0
+        allowed += fit.line_chi2 < 10 and fit.rms < 2 * NOISE
+    assert allowed >= 7
 
 
 @pytest.mark.parametrize("name", ["box", "cylinder"])

@@ -256,7 +256,7 @@ RESIZED_STARTS = (0.5, 2.0)
 #: to the mesh changes by less than this share of their variance in one ICP iteration.
 ICP_TOLERANCE = 1e-2
 
-#: Registrations (:func:`fit_mesh`) refined and scored with the links' evidence, from the
+#: Registrations (:func:`fit_mesh`) refined and scored with the links' lines, from the
 #: distinct starts that fit the points best.
 MESH_CANDIDATES = 8
 
@@ -1660,9 +1660,12 @@ def fit_mesh(
     The points are moved onto the mesh (trimesh.registration.icp, the closest point on the
     mesh for each point: right for points covering only part of the object) from ``n_starts``
     rotations about the points' centroid placed on the mesh's centre and from the alignment of
-    principal axes (trimesh.registration.mesh_other), each for up to 40 iterations until its
-    cost changes by less than :data:`ICP_TOLERANCE` of the points' variance; the lowest is
-    refined to convergence. ``lines`` adds
+    principal axes (trimesh.registration.mesh_other), each on at most :data:`START_POINTS` of
+    the points for up to 40 iterations until its cost changes by less than
+    :data:`ICP_TOLERANCE` of their variance; the lowest is refined to convergence on all
+    points. With ``lines`` and a closed mesh, the :data:`MESH_CANDIDATES` lowest distinct
+    starts are refined and the one whose points and lines give the lowest chi^2 kept.
+    ``lines`` adds
     the tangency residuals of the registered mesh and ``swept`` its swept links' residuals (not
     used to register it), for a closed (watertight) mesh only: an open one has no inside.
     """
@@ -1711,14 +1714,14 @@ def fit_mesh(
             scale=False,
         )
         started.append((float(cost), np.asarray(matrix)))
-    # the best start refined to convergence; with the links' lines or swept links (a closed
-    # mesh), the best MESH_CANDIDATES distinct starts, the pose the whole evidence fits best:
-    # few points fit several poses, some of which put the mesh where a link passed
+    # the best start refined to convergence; with the links' lines (a closed mesh), of the best
+    # MESH_CANDIDATES distinct starts the pose the points and lines fit best: few points fit
+    # several poses, some of which put the mesh where a link passed
     started.sort(key=lambda start: start[0])
-    evidence = mesh.is_watertight and (lines is not None or len(swept) > 0)
-    candidates = _distinct_poses([m for _, m in started], MESH_CANDIDATES if evidence else 1)
-    fits = []
-    for start in candidates:
+    evidence = mesh.is_watertight and lines is not None
+    starts = _distinct_poses([m for _, m in started], centroid, MESH_CANDIDATES if evidence else 1)
+    refined = []
+    for start in starts:
         points_to_mesh, _, _ = trimesh.registration.icp(
             p,
             mesh,
@@ -1728,19 +1731,28 @@ def fit_mesh(
             reflection=False,
             scale=False,
         )
-        fits.append(_registered(name, mesh, p, cov, points_to_mesh, lines, swept))
-    return min(fits, key=lambda fit: fit.chi2)
+        refined.append(points_to_mesh)
+    if len(refined) == 1:
+        return _registered(name, mesh, p, cov, refined[0], lines, swept)
+    # ranked on the points and the lines; the swept links, costly to place, are scored for the
+    # best alone
+    best = min(refined, key=lambda m: _registered(name, mesh, p, cov, m, lines, ()).chi2)
+    return _registered(name, mesh, p, cov, best, lines, swept)
 
 
-def _distinct_poses(matrices: Sequence[FloatArray], most: int) -> list[FloatArray]:
-    """The first ``most`` of ``matrices`` (4 x 4, in order) that each move the points' frame
-    by more than a millimetre or a hundredth of a radian from those kept before."""
+def _distinct_poses(
+    matrices: Sequence[FloatArray], centroid: FloatArray, most: int
+) -> list[FloatArray]:
+    """The first ``most`` of ``matrices`` (4 x 4, points to mesh, in order) that each place the
+    points' ``centroid`` (m) more than a millimetre, or turn them by more than a hundredth of a
+    radian, away from where those kept before do."""
     kept: list[FloatArray] = []
+    at = np.append(centroid, 1.0)
     for matrix in matrices:
         if len(kept) == most:
             break
         if all(
-            np.linalg.norm(matrix[:3, 3] - other[:3, 3]) > 1e-3
+            np.linalg.norm((matrix - other)[:3] @ at) > 1e-3
             or np.linalg.norm(Rotation.from_matrix(matrix[:3, :3] @ other[:3, :3].T).as_rotvec())
             > 1e-2
             for other in kept
