@@ -354,6 +354,14 @@ def test_a_tip_mass_too_heavy_to_pass_for_a_tare_is_named_with_its_weight() -> N
     with pytest.raises(IdentificationError, match="torques in N mm") as raised:
         identify_free_motion(recording, ANTENNA)
     assert "Or, as weight, 1.1 g at the tip" in str(raised.value)
+    # torques doubled read the moment of 2.3 g at the tip, but no heavier force: no tip mass
+    # is offered (a force sensor's tare leaves about 12 mN, a gram's weight, so a torque scaled
+    # by 1.5 still reads as a gram at the tip, beside the scale the line names first)
+    doubled = simulate(ANTENNA, Scenario(case="free", duration=3.0, seed=2))
+    doubled = dataclasses.replace(doubled, torque=2.0 * doubled.torque).without_ground_truth()
+    with pytest.raises(IdentificationError, match="torques in N mm") as raised:
+        identify_free_motion(doubled, ANTENNA)
+    assert "tip_mass" not in str(raised.value)
     # a torque doubled across the weight's moment is no weight: no tip mass is offered
     turned = dataclasses.replace(recording, torque=recording.torque[:, [1, 0, 2]] * 1.5)
     with pytest.raises(IdentificationError, match="columns 'tx', 'ty', 'tz'") as raised:

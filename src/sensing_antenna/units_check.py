@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import Antenna
+from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 
 __all__ = [
     "MAX_ANGLE_STEP",
@@ -233,7 +233,9 @@ def rest_reading(
             "loads hold its weight), or torques scaled far down?"
             if tared
             else "torques in N mm, scaled, or a sign flipped?"
-            + _payload_hint(mean_torque, expected_torque, antenna, torque_tolerance)
+            + _payload_hint(
+                mean_torque, expected_torque, antenna, torque_tolerance, force, expected_force
+            )
         )
         problems.append(
             f"columns {_TORQUE_COLUMNS}: over {duration} the torque reads "
@@ -261,15 +263,24 @@ def rest_reading(
 
 
 def _payload_hint(
-    torque: FloatArray, expected: FloatArray, antenna: Antenna, tolerance: float
+    torque: FloatArray,
+    expected: FloatArray,
+    antenna: Antenna,
+    tolerance: float,
+    force: FloatArray,
+    expected_force: FloatArray,
 ) -> str:
-    """ " Or ..." naming the tip mass (g) whose weight the torque at rest reads beyond the
-    model's, when the excess lies along the weight's moment (the rest across it within
-    ``tolerance``, N m) and adds to it; "" otherwise."""
+    """ " Or ..." naming the tip mass (g) whose weight the mean torque at rest (N m) reads beyond
+    the model's ``expected`` moment, when the excess lies along that moment (the rest across it
+    within ``tolerance``, N m), adds to it, and the forces at rest (N, shape (n, 3)) carry that
+    weight too beyond ``expected_force`` (N), within the offset a tare leaves
+    (:data:`TARE_NOISES` of their noise): a torque scaled up reads no heavier force; ""
+    otherwise."""
     link = antenna.link
     size = float(np.linalg.norm(expected))
     lever_mass = 0.5 * link.mass + link.weighed_tip_mass  # the moment's, per unit of g l
-    if not (size > 0.0 and lever_mass > 0.0):
+    weight = float(np.linalg.norm(expected_force))
+    if not (size > 0.0 and lever_mass > 0.0 and weight > 0.0 and len(force) > 1):
         return ""
     along = expected / size
     excess = torque - expected
@@ -277,9 +288,16 @@ def _payload_hint(
     across = float(np.linalg.norm(excess - extra * along))
     if not (extra > 0.0 and across <= tolerance):
         return ""
-    grams = 1e3 * extra * lever_mass / size
+    mass = extra * lever_mass / size  # kg
+    down = force @ (expected_force / weight)  # N, each sample's force along the weight
+    noise = float(np.std(down, ddof=1))
+    heavier = float(np.mean(down)) - weight
+    if not abs(heavier - mass * STANDARD_GRAVITY) <= noise * (
+        TARE_NOISES + 3.0 / math.sqrt(len(down))
+    ):
+        return ""
     return (
-        f" Or, as weight, {grams:.2g} g at the tip that the antenna file does not carry"
+        f" Or, as weight, {1e3 * mass:.2g} g at the tip that the antenna file does not carry"
         " (its [link] tip_mass)"
     )
 
