@@ -932,3 +932,16 @@ def test_a_stored_point_keeps_whether_its_width_alone_held_it_back() -> None:
     # a stored point without the key is not one
     del data["held_back_by_width"]
     assert not point_from_dict(data).held_back_by_width
+
+
+def test_the_library_explores_with_the_commands_defaults() -> None:
+    from sensing_antenna.cli import build_parser
+
+    args = build_parser().parse_args(["explore", "post", "--out", "somewhere"])
+    settings = ExploreSettings()
+    assert (settings.method, settings.strategy, settings.seed) == (
+        args.method,
+        args.strategy,
+        args.seed,
+    )
+    assert (settings.link, settings.device_profile) == (args.link, args.device_profile)
