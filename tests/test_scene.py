@@ -823,6 +823,7 @@ def test_a_primitives_sizes_may_be_named_as_in_a_scene_file_or_as_the_object_nam
         ("cylinder", [0.05], r"\(2 numbers, m\), got 1"),
         ("cylinder", "wide", r"a cylinder takes radius, height \(m\)"),
         ("sphere", -0.05, "each a length > 0"),
+        ("sphere", 60.0, r"each from 0.001 to 10 m, got 60.0: in metres\?"),
         ("torus", [0.02, 0.05], "minor_radius must be smaller than its major_radius"),
     ],
 )

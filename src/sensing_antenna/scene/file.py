@@ -52,6 +52,7 @@ import trimesh
 from sensing_antenna.errors import FieldError, SensingAntennaError, format_value
 from sensing_antenna.mapping.pose import MAX_BASE_DISTANCE, BasePose
 from sensing_antenna.scene.objects import (
+    MAX_OBJECT_SIZE,
     MIN_OBJECT_SIZE,
     SIZE_KEYS,
     SceneObject,
@@ -73,9 +74,6 @@ __all__ = [
 
 #: Scenes shipped with the package (``antenna explore sphere``).
 BUILTIN_SCENES = ("post", "sphere", "box", "cylinder")
-
-#: Largest size of a primitive (m): an object the antenna (1 m or so) can explore.
-MAX_OBJECT_SIZE = 10.0
 
 #: Largest angle (rad) of a yaw or an object's rotation vector: one turn reaches every
 #: orientation, and a larger number is most likely in degrees (90 for a quarter turn).

@@ -29,6 +29,7 @@ from sensing_antenna.scene.proximity import signed_distance
 
 __all__ = [
     "MAX_MESH_EXTENT",
+    "MAX_OBJECT_SIZE",
     "MIN_OBJECT_SIZE",
     "OBJECT_SHAPES",
     "SIZE_KEYS",
@@ -64,6 +65,9 @@ MAX_MESH_EXTENT = 10.0
 #: then stay within 1e-4 of each other (10 m at most), a ratio its mesh keeps non-empty
 #: (trimesh merges vertices closer than 1e-8 of the mesh's own size).
 MIN_OBJECT_SIZE = 1e-3
+
+#: Largest size of a primitive (m): an object the antenna (1 m or so) can explore.
+MAX_OBJECT_SIZE = 10.0
 
 
 #: How a scene reads a mesh in other units, for :func:`mesh_problem`'s messages.
@@ -267,6 +271,11 @@ def _size_vector(shape: str, sizes: ArrayLike | Mapping[str, ArrayLike]) -> Floa
         raise ValueError(f"sizes: {takes} ({len(names)} numbers, m), got {vector.size}")
     if not np.all(np.isfinite(vector) & (vector > 0.0)):
         raise ValueError(f"sizes: {takes}, each a length > 0 (m), got {sizes!r}")
+    if not np.all((vector >= MIN_OBJECT_SIZE) & (vector <= MAX_OBJECT_SIZE)):
+        raise ValueError(
+            f"sizes: {takes}, each from {MIN_OBJECT_SIZE:g} to {MAX_OBJECT_SIZE:g} m, got"
+            f" {sizes!r}: in metres?"
+        )
     if shape == "torus" and not vector[1] < vector[0]:
         raise ValueError("sizes: a torus's minor_radius must be smaller than its major_radius")
     return vector
