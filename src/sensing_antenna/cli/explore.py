@@ -232,6 +232,6 @@ def _run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     with stopped_as_stored(args.out, lambda: len(result.manoeuvres)):
-        report_map(result.contact_map, args.out, scene.mesh)
+        report_map(result.contact_map, args.out, scene.mesh, antenna_hints=False)
     print(f"  {args.out / 'manoeuvres.csv'}\n  {args.out / 'scene.ply'}")
     return 0

@@ -190,6 +190,26 @@ def _map_into(args: argparse.Namespace) -> None:
     report_map(contact_map, args.out)
 
 
+def _antenna_hint(summary: dict[str, Any]) -> None:
+    """One line on which antenna file to give when no point of the map (``summary``) is usable
+    for want of the device's own observer, threshold or calibration."""
+    if summary["n_used"] != 0:
+        return
+    if summary["statuses"].get("uncertain"):
+        print(
+            "  no estimate is ok: an antenna that is not calibrated answers uncertain (give "
+            "--antenna the file antenna calibrate wrote), or let such points in with "
+            "--include-uncertain; each point's reason is in points.csv"
+        )
+    elif set(summary["statuses"]) == {"no_contact"}:
+        print(
+            "  no recording shows a contact: if the link touched, these may be another device's "
+            "recordings, whose touches this antenna's observer and threshold miss (give "
+            "--antenna the file antenna identify or calibrate wrote for that device); each "
+            "point's reason is in points.csv"
+        )
+
+
 def note_unposed(unposed: list[str], count: int) -> None:
     """One line when some of the ``count`` recordings read have a ``base_pose`` and
     ``unposed`` have none: theirs is taken as the world's origin, unturned."""
@@ -205,10 +225,11 @@ def note_unposed(unposed: list[str], count: int) -> None:
     )
 
 
-def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
+def report_map(contact_map: Any, out: Path, truth: Any = None, antenna_hints: bool = True) -> None:
     """Write a map's files, figure and interactive view into ``out`` and print its summary
     (``antenna map`` and ``antenna explore`` share it); ``truth``, the true surface's mesh when
-    known, is drawn in the view."""
+    known, is drawn in the view; ``antenna_hints``: say which antenna file to give when no
+    point is usable (``antenna map``'s ``--antenna``)."""
     from sensing_antenna.mapping import write_map
     from sensing_antenna.mapping.store import overdispersed, unexplained
     from sensing_antenna.mapping.view import write_map_html
@@ -239,18 +260,7 @@ def report_map(contact_map: Any, out: Path, truth: Any = None) -> None:
         text = "" if recognition is None else warn(recognition)
         if text:
             print(f"  {text}")
-    if summary["n_used"] == 0 and summary["statuses"].get("uncertain"):
-        print(
-            "  no estimate is ok: an antenna that is not calibrated answers uncertain (give "
-            "--antenna the file antenna calibrate wrote), or let such points in with "
-            "--include-uncertain; each point's reason is in points.csv"
-        )
-    elif summary["n_used"] == 0 and set(summary["statuses"]) == {"no_contact"}:
-        print(
-            "  no recording shows a contact: if the link touched, these may be another device's "
-            "recordings, whose touches this antenna's observer and threshold miss (give "
-            "--antenna the file antenna identify or calibrate wrote for that device); each "
-            "point's reason is in points.csv"
-        )
+    if antenna_hints:
+        _antenna_hint(summary)
     for path in written:
         print(f"  {path}")

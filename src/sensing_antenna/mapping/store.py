@@ -205,7 +205,8 @@ def unexplained(recognition: Any) -> str:
         else f"one map in {round(1 / chance, -int(math.log10(1 / chance)) + 1):,.0f}"
     )
     return (
-        f"{best.n_wrong} of {best.n_points} points lie farther from the {best.name} than its"
+        f"{best.n_wrong} of {best.n_points} points lie farther from the"
+        f" {best.name.replace('mesh:', 'mesh ')} than its"
         f" fit allows, where wrong estimates make that many in {odds}: the points are of more"
         " than one object, or some are misplaced (a base pose, a calibration)"
     )
