@@ -18,13 +18,14 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "MAX_TORQUE_POINT",
     "MOVED_KEY",
     "TORQUE_POINT_KEY",
     "key_problem",
+    "metadata_line",
     "moved_metadata",
     "point_problem",
     "torque_point_problem",
@@ -88,6 +89,13 @@ def key_problem(keys: Iterable[str]) -> tuple[str, str] | None:
             "about another point"
         )
     return None
+
+
+def metadata_line(point: ArrayLike) -> str:
+    """The metadata line that states ``point`` (S - O on the motor axes, m, shape (3,)) to the
+    millimetre: ``# torque_point: [0.025, 0.000, 0.000]``."""
+    numbers = ", ".join(f"{float(v):.3f}" for v in np.asarray(point).reshape(3))
+    return f"# {TORQUE_POINT_KEY}: [{numbers}]"
 
 
 def torques_about_base(force: FloatArray, torque: FloatArray, point: FloatArray) -> FloatArray:

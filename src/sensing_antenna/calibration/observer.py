@@ -38,7 +38,6 @@ holds (the weight's moment changing with theta_2, joint 2's own dynamics).
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -56,7 +55,7 @@ from sensing_antenna.detection.contact import (
 from sensing_antenna.detection.filters import observe_free_motion
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, resample_uniform
-from sensing_antenna.torque_point import MOVED_KEY
+from sensing_antenna.torque_point import MOVED_KEY, metadata_line, torque_point_problem
 from sensing_antenna.units_check import (
     angle_problem,
     initial_rest,
@@ -342,8 +341,8 @@ def _fit(
     gain, omega, damping = (float(v) for v in fit.x)
     rms = float(np.sqrt(np.mean(fit.fun**2)))
     signal_rms = float(np.sqrt(np.mean(measured**2)))
+    fitted = _lever_fit(data, unit_response, omega, damping)
     if rms > MAX_RELATIVE_RESIDUAL * signal_rms:
-        fitted = _lever_fit(data, unit_response, omega, damping)
         hint = _torque_point_hint(fitted, reach, stated)
         raise IdentificationError(
             f"{where}: columns 'tx', 'ty', 'tz': Eq. 15 explains the coupling torque poorly "
@@ -351,18 +350,10 @@ def _fit(
             "really free motion? A contact leaves a static torque that no free-motion observer "
             f"can follow{hint}"
         )
-    point, lever_rms, _ = _lever_fit(data, unit_response, omega, damping)
-    along = point + (0.0 if stated is None else float(stated[0]))
+    point, lever_rms, _ = fitted
+    whole = _whole_point(point, stated)
     noticed = lever_rms <= LEVER_GAIN * rms and abs(point) >= SENSOR_OFFSET_NOTICED
-    if not (noticed and abs(along) <= reach):
-        return gain, omega, damping, rms, None
-    return (
-        gain,
-        omega,
-        damping,
-        rms,
-        np.array([point, 0.0, 0.0]) + (0.0 if stated is None else stated),
-    )
+    return gain, omega, damping, rms, whole if noticed and abs(whole[0]) <= reach else None
 
 
 def _stated_point(
@@ -375,7 +366,7 @@ def _stated_point(
     if len(stated) > 1:
         return 0.0, None
     text = stated.pop()
-    point = None if text is None else np.array(json.loads(text), dtype=float)
+    point = None if text is None else torque_point_problem(text)[0]  # checked by the reader
     return SENSOR_OFFSET_SHARE * antenna.link.length, point
 
 
@@ -407,10 +398,9 @@ def _lever_fit(
     return best[1], math.sqrt(best[0]), best[2]
 
 
-def _point_text(point: float, stated: NDArray[np.float64] | None) -> str:
-    """The ``torque_point`` line (m) that states ``point`` (m along the link) beyond ``stated``."""
-    total = np.array([point, 0.0, 0.0]) + (0.0 if stated is None else stated)
-    return f"'# torque_point: [{', '.join(f'{v:.3f}' for v in total)}]'"
+def _whole_point(point: float, stated: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """S - O (m, shape (3,)): ``point`` (m along the link) beyond the ``stated`` one."""
+    return np.array([point, 0.0, 0.0]) + (0.0 if stated is None else stated)
 
 
 def _torque_point_hint(
@@ -424,13 +414,14 @@ def _torque_point_hint(
     point, rms, moved_rms = fitted
     if not (math.isfinite(rms) and rms <= MAX_RELATIVE_RESIDUAL * moved_rms):
         return ""
-    if not abs(point + (0.0 if stated is None else stated[0])) <= reach:
+    whole = _whole_point(point, stated)
+    if not abs(whole[0]) <= reach:
         return ""
     beyond = "" if stated is None else " beyond the '# torque_point' the recordings state"
     return (
         f"; or torques about the sensor's own origin: they read as about a point {point:+.3f} m"
         f" along the link from its clamp{beyond} (residual rms {rms:.3g} N m), which"
-        f" {_point_text(point, stated)} would state (docs/recording-format.md)"
+        f" '{metadata_line(whole)}' would state (docs/recording-format.md)"
     )
 
 
@@ -621,7 +612,9 @@ def identify_free_motion(
         initial_damping=d0,
         source=where if named else None,
         payload=payload,
-        torque_point=None if suspect is None else (float(suspect[0]), 0.0, 0.0),
+        torque_point=None
+        if suspect is None
+        else (float(suspect[0]), float(suspect[1]), float(suspect[2])),
     )
 
 

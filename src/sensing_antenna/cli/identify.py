@@ -136,11 +136,13 @@ def _run(args: argparse.Namespace) -> int:
         )
         _print_payload(fit.payload, antenna.link, identified.link)
         if fit.torque_point is not None:
-            point = ", ".join(f"{v:.3f}" for v in fit.torque_point)
+            from sensing_antenna.torque_point import metadata_line
+
             print(
                 "antenna identify: warning: the torques read as taken about a point off the"
                 " link's clamp (Eq. 15 with it explains them far better): if the sensor's"
-                f" origin lies there, state '# torque_point: [{point}]' in the recordings and"
+                f" origin lies there, state '{metadata_line(fit.torque_point)}' in the"
+                " recordings and"
                 " identify again (the gain and any tip mass read here carry that offset;"
                 " docs/real-antenna.md)",
                 file=sys.stderr,
