@@ -273,9 +273,9 @@ def _payload_hint(
     """ " Or ..." naming the tip mass (g) whose weight the mean torque at rest (N m) reads beyond
     the model's ``expected`` moment, when the excess lies along that moment (the rest across it
     within ``tolerance``, N m), adds to it, and the forces at rest (N, shape (n, 3)) carry that
-    weight too beyond ``expected_force`` (N), within the offset a tare leaves
-    (:data:`TARE_NOISES` of their noise): a torque scaled up reads no heavier force; ""
-    otherwise."""
+    weight too beyond ``expected_force`` (N), as far as the offset a tare leaves tells
+    (:func:`is_payload` of the difference): a torque scaled up three times or more reads no
+    heavier force; "" otherwise."""
     link = antenna.link
     size = float(np.linalg.norm(expected))
     lever_mass = 0.5 * link.mass + link.weighed_tip_mass  # the moment's, per unit of g l
@@ -291,10 +291,10 @@ def _payload_hint(
     mass = extra * lever_mass / size  # kg
     down = force @ (expected_force / weight)  # N, each sample's force along the weight
     noise = float(np.std(down, ddof=1))
-    heavier = float(np.mean(down)) - weight
-    if not abs(heavier - mass * STANDARD_GRAVITY) <= noise * (
-        TARE_NOISES + 3.0 / math.sqrt(len(down))
-    ):
+    # the force's excess over the model's weight, less the tip mass's, judged as the moment's
+    # payload is: beyond the tare's offset and the mean's error, the force reads another weight
+    missing = float(np.mean(down)) - weight - mass * STANDARD_GRAVITY
+    if is_payload(missing, rest_moment_std(noise, noise / math.sqrt(len(down)))):
         return ""
     return (
         f" Or, as weight, {1e3 * mass:.2g} g at the tip that the antenna file does not carry"
