@@ -1736,8 +1736,9 @@ def fit_mesh(
         return _registered(name, mesh, p, cov, refined[0], lines, swept)
     # ranked on the points and the lines; the swept links, costly to place, are scored for the
     # best alone
-    best = min(refined, key=lambda m: _registered(name, mesh, p, cov, m, lines, ()).chi2)
-    return _registered(name, mesh, p, cov, best, lines, swept)
+    ranked = [_registered(name, mesh, p, cov, m, lines, ()) for m in refined]
+    k = min(range(len(ranked)), key=lambda i: ranked[i].chi2)
+    return _registered(name, mesh, p, cov, refined[k], lines, swept) if swept else ranked[k]
 
 
 def _distinct_poses(
