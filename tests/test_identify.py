@@ -440,7 +440,8 @@ def test_torques_behind_the_clamp_identify_with_a_warning_naming_the_point(
 
     paths, about_o = _about_point(offset, tmp_path)
     fit = identify_free_motion([read_recording(p) for p in paths], ANTENNA)
-    assert fit.torque_point == pytest.approx((offset, 0.0, 0.0), abs=0.003)
+    # to the millimetre the warning prints (measured: within 0.5 mm at -2.5 and -9 cm)
+    assert fit.torque_point == pytest.approx((offset, 0.0, 0.0), abs=0.001)
     assert identify_free_motion(about_o, ANTENNA).torque_point is None
     assert main(["identify", *map(str, paths), "--out", str(tmp_path / "fitted.toml")]) == 0
     warning = capsys.readouterr().err
