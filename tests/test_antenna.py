@@ -182,6 +182,16 @@ def test_gravity_terms_section_4_2() -> None:
     assert antenna.gravity_torque(0.0)[1] == pytest.approx(0.5 * w * 0.98)
 
 
+def test_the_tip_mass_a_moment_reads_is_its_weight_on_the_lever() -> None:
+    """A 2 g point mass at the tip of the straight link at theta2 has moment m g l cos(theta2):
+    the mean over two elevations; none from a link turned past the vertical."""
+    link = paper_antenna().link
+    theta2 = np.array([0.2, 0.4])
+    moment = 0.002 * 9.80665 * 0.98 * float(np.mean(np.cos(theta2)))
+    assert link.tip_mass_for_moment(moment, theta2) == pytest.approx(0.002, rel=1e-12)
+    assert math.isnan(link.tip_mass_for_moment(moment, [math.pi / 2 + 0.1]))
+
+
 @pytest.mark.parametrize("tip_mass", [0.0, 0.002])
 def test_sag_moment_matches_the_finite_element_link(tip_mass: float) -> None:
     """kappa = g^2 int u dm (closed form) against the simulator's finite elements, g^2 t K^-1 t.

@@ -412,6 +412,13 @@ class Link:
         cos2 = np.cos(theta2)
         return np.asarray(cos2 * (self.weight_moment + self.sag_moment * np.sin(theta2)))
 
+    def tip_mass_for_moment(self, moment: float, theta2: ArrayLike) -> float:
+        """The tip mass (kg) whose weight has the moment ``moment`` (N m) about the elevation
+        axis, the straight link held at ``theta2`` (rad; the samples' mean lever):
+        moment / (g l cos theta2); nan when that lever is not positive (past the vertical)."""
+        lever = float(np.mean(self.length * STANDARD_GRAVITY * np.cos(theta2)))
+        return moment / lever if lever > 0.0 else math.nan
+
     @property
     def tip_mass_ratio(self) -> float:
         """R_m = m_t / m_b of Eq. 4 (dimensionless)."""

@@ -234,7 +234,13 @@ def rest_reading(
             if tared
             else "torques in N mm, scaled, or a sign flipped?"
             + _payload_hint(
-                mean_torque, expected_torque, antenna, torque_tolerance, force, expected_force
+                mean_torque,
+                expected_torque,
+                antenna,
+                torque_tolerance,
+                force,
+                expected_force,
+                theta[:, 1],
             )
         )
         problems.append(
@@ -269,6 +275,7 @@ def _payload_hint(
     tolerance: float,
     force: FloatArray,
     expected_force: FloatArray,
+    theta2: FloatArray,
 ) -> str:
     """ " Or ..." naming the tip mass (g) whose weight the mean torque at rest (N m) reads beyond
     the model's ``expected`` moment, when the excess lies along that moment (the rest across it
@@ -276,11 +283,9 @@ def _payload_hint(
     weight too beyond ``expected_force`` (N), as far as the offset a tare leaves tells
     (:func:`is_payload` of the difference): a torque scaled up three times or more reads no
     heavier force; "" otherwise."""
-    link = antenna.link
     size = float(np.linalg.norm(expected))
-    lever_mass = 0.5 * link.mass + link.weighed_tip_mass  # the moment's, per unit of g l
     weight = float(np.linalg.norm(expected_force))
-    if not (size > 0.0 and lever_mass > 0.0 and weight > 0.0 and len(force) > 1):
+    if not (size > 0.0 and weight > 0.0 and len(force) > 1):
         return ""
     along = expected / size
     excess = torque - expected
@@ -288,7 +293,9 @@ def _payload_hint(
     across = float(np.linalg.norm(excess - extra * along))
     if not (extra > 0.0 and across <= tolerance):
         return ""
-    mass = extra * lever_mass / size  # kg
+    mass = antenna.link.tip_mass_for_moment(extra, theta2)
+    if not mass > 0.0:
+        return ""
     down = force @ (expected_force / weight)  # N, each sample's force along the weight
     noise = float(np.std(down, ddof=1))
     # the force's excess over the model's weight, less the tip mass's, judged as the moment's

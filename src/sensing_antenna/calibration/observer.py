@@ -481,13 +481,13 @@ def rest_payload(recording: Recording, antenna: Antenna) -> Payload:
     window = slice(0, rest)
     theta = recording.theta[window]
     reading = rest_reading(theta, recording.force[window], recording.torque[window], antenna)
-    lever = float(np.mean(antenna.link.length * STANDARD_GRAVITY * np.cos(theta[:, 1])))
-    if not lever > 0.0:
-        return Payload(0.0, math.nan, 0)
     excess = float(reading.torque[1] - reading.expected_torque[1])
+    mass = antenna.link.tip_mass_for_moment(excess, theta[:, 1])
+    if not math.isfinite(mass):
+        return Payload(0.0, math.nan, 0)
     noise = float(np.std(recording.torque[window, 1], ddof=1))
     error = rest_moment_std(noise, noise / math.sqrt(rest))
-    return Payload(excess / lever, error / lever, rest)
+    return Payload(mass, antenna.link.tip_mass_for_moment(error, theta[:, 1]), rest)
 
 
 def identify_free_motion(

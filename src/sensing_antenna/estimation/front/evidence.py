@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link
+from sensing_antenna.antenna import Antenna, Link
 from sensing_antenna.beam.weight import pushed_weight_moment, weight_residual
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
@@ -581,13 +581,12 @@ class Evidence:
         cosine = math.cos(float(self.theta[0, 1]))
         if not cosine >= _PAYLOAD_COSINE:
             return 0.0  # near a vertical link the weight's moment says little of a mass
-        lever = STANDARD_GRAVITY * self.antenna.link.length * cosine
         excess = float(self.load_offset[4])
         noise = float(self.diagnostics.get("torque_noise", 0.0))
         std = rest_moment_std(noise, self.torque_offset_error)
-        if not (lever > 0.0 and excess > 0.0 and is_payload(excess, std)):
+        if not (excess > 0.0 and is_payload(excess, std)):
             return 0.0
-        return excess / lever
+        return self.antenna.link.tip_mass_for_moment(excess, self.theta[0, 1])
 
     def carried_payload_mass(self) -> float:
         """:meth:`payload_mass` as the fast method carries it (kg): 0 when the tare was read
