@@ -500,3 +500,30 @@ def test_tip_mass_fitted_with_t_e_on_a_simulated_link_that_carries_one() -> None
     assert any(note.startswith("rec4: ") and "wrong spectral peak" in note for note in fit.notes)
     assert fit.tip_mass == pytest.approx(1e-4, abs=2e-5)
     assert fit.t_e == pytest.approx(both.t_e, rel=1e-3)
+
+
+def test_a_short_stiff_link_is_calibrated_on_its_own_frequencies() -> None:
+    # A 0.35 m carbon rod (E 120 GPa, 2 mm) rings at 232 to 776 rad/s where it is touched
+    # from 0.12 to 0.32 m: the search band follows the link, so every point is used (a band
+    # made for the paper's 1 m link, up to 400 rad/s, kept two and fitted T_e to them alone)
+    from sensing_antenna.calibration.frequency import calibrate_from_recordings, calibration_band
+    from sensing_antenna.simulator import Scenario, simulate
+
+    paper = paper_antenna()
+    rod = replace(
+        paper,
+        link=replace(paper.link, length=0.35, youngs_modulus=120e9, linear_density=5.0265e-3),
+    )
+    assert calibration_band(paper.link) == (10.0, 400.0)  # the paper's, with its margin
+    low, high = calibration_band(rod.link)
+    assert low == 10.0 and high > 2.0 * natural_frequencies(rod.link, 0.27, 1)[0]
+    points = [0.12, 0.17, 0.22, 0.27, 0.32]
+    recordings = [
+        simulate(rod, Scenario(case="azimuthal", contact_point=x, seed=i))
+        for i, x in enumerate(points)
+    ]
+    result = calibrate_from_recordings(recordings, rod, points)
+    assert result.used.all()
+    assert max(result.omega1_measured) > 700.0
+    # the simulated rod's own T, to the frequency readings' scatter (0.1 to 0.3 %)
+    assert result.t_e == pytest.approx(rod.link.theoretical_t, rel=5e-3)

@@ -33,6 +33,7 @@ from sensing_antenna.recording import other_separator
 
 __all__ = [
     "CALIBRATION_BAND",
+    "CALIBRATION_BAND_MARGIN",
     "LOSSES",
     "MIN_MODE2_POINTS",
     "MIN_TIP_MASS_POINTS",
@@ -51,10 +52,34 @@ __all__ = [
 #: Robust losses accepted by :func:`fit_inverse_t` (those of scipy.optimize.least_squares).
 LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
 
-#: Band (rad/s) searched for the fundamental frequency during calibration. It is deliberately
-#: wide (1.6 Hz to 64 Hz) and not derived from the model being fitted: it holds the paper's measured
-#: range 31.4 to 106.8 rad/s (Section 5.1) with a factor 3 of margin on each side.
+#: The narrowest band (rad/s) searched for the fundamental frequency during calibration (1.6 Hz
+#: to 64 Hz): the paper's measured range 31.4 to 106.8 rad/s (Section 5.1) with a factor 3 of
+#: margin on each side. :func:`calibration_band` widens it for another link.
 CALIBRATION_BAND = (10.0, 400.0)
+
+#: Margin (factor each side) of :func:`calibration_band` around the model's omega_1 range: a
+#: link whose T is twice its datasheet's (E I a quarter) still has its fundamental inside. A
+#: wider one reaches down to the head's own slow motions (peaks at 8 to 10 rad/s on the
+#: simulated realistic device, which a factor 3 below the paper link's 22 rad/s takes in).
+CALIBRATION_BAND_MARGIN = 2.0
+
+
+def calibration_band(link: Link) -> tuple[float, float]:
+    """Band (rad/s) searched for omega_1 when calibrating ``link``: the model's omega_1 over the
+    estimators' contact range, :data:`CALIBRATION_BAND_MARGIN` wider each side, and at least
+    :data:`CALIBRATION_BAND`. Wide, so that the measured frequencies hardly presuppose the
+    T being fitted; derived from the link, so that a short or stiff link's fundamental (a
+    0.35 m carbon rod rings at up to 770 rad/s) is not left out of its own calibration."""
+    from sensing_antenna.estimation.config import EstimatorConfig
+    from sensing_antenna.estimation.front.evidence import sensing_curve
+
+    low, high = EstimatorConfig().contact_range
+    bottom, top = sensing_curve(link).omega1_range(low * link.length, high * link.length)
+    return (
+        min(CALIBRATION_BAND[0], float(bottom) / CALIBRATION_BAND_MARGIN),
+        max(CALIBRATION_BAND[1], float(top) * CALIBRATION_BAND_MARGIN),
+    )
+
 
 #: Floor of the robust loss scale, relative to the median measured frequency. With noise-free data
 #: the MAD of the residuals is 0, which would make the robust scale zero; 1e-6 of the frequency
@@ -707,7 +732,7 @@ def calibrate_from_recordings(
     contact_points: Sequence[float],
     *,
     sources: Sequence[str] = (),
-    band: tuple[float, float] = CALIBRATION_BAND,
+    band: tuple[float, float] | None = None,
     loss: str = "soft_l1",
     fit_tip_mass: bool = False,
 ) -> FrequencyCalibration:
@@ -722,9 +747,10 @@ def calibrate_from_recordings(
         The antenna the recordings were made with (its link's T is the starting value).
     contact_points : sequence of float
         Known x_c (m) of each recording, same order.
-    band : (float, float)
-        Search band for the fundamental frequency (rad/s); wide by default so that the measured
-        frequencies do not presuppose the model being fitted.
+    band : (float, float) or None
+        Search band for the fundamental frequency (rad/s); None: :func:`calibration_band` of
+        the antenna's link, wide so that the measured frequencies hardly presuppose the model
+        being fitted.
 
     A recording that cannot be used is left out with a note naming it and why (the estimators'
     checks of their input, :func:`~.usable.contact_evidence`: not in the format's units,
@@ -744,6 +770,8 @@ def calibrate_from_recordings(
             f"contact points: {len(contact_points)} given for {len(recordings)} recordings"
         )
     names = list(sources) or [f"recording {i}" for i in range(len(recordings))]
+    if band is None:
+        band = calibration_band(antenna.link)
     omega = np.full(len(recordings), math.nan)
     components = ["none"] * len(recordings)
     evidences: list[Any] = [None] * len(recordings)

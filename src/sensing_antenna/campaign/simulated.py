@@ -268,8 +268,9 @@ def calibrate_on_device(
     and, with ``calibration.sensor``, the sensor's cross-talk from the same points swept both
     ways.
 
-    Each calibration manoeuvre is simulated on ``device``; omega_1 is measured with the wide band
-    ``calibration.frequency.CALIBRATION_BAND`` by Estimator 1's frequency measurement, using
+    Each calibration manoeuvre is simulated on ``device``; omega_1 is measured in the wide band
+    :func:`~sensing_antenna.calibration.frequency.calibration_band` by Estimator 1's frequency
+    measurement, using
     ``model`` (the observer for t_c and t_1); T_e is fitted to the model's beta_1(x_c)^2 on the
     step's case. The contact points are known by construction (a calibration), so they come from
     the spec, and the estimators never see the device's T. ``progress`` shows a bar of the
