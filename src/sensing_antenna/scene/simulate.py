@@ -76,6 +76,7 @@ from sensing_antenna.simulator.run import (
     minimum_contact_point,
     simulate_detailed,
 )
+from sensing_antenna.simulator.scenario import DEFAULT_CONTACT_STIFFNESS
 
 __all__ = [
     "BALL_RATIO",
@@ -109,7 +110,6 @@ OUTCOMES = ("touch", "free", "glancing", "near_head", "inside")
 
 _DEFAULTS = Scenario(case="free")
 _DEFAULT_SPEED = _DEFAULTS.sweep_speed
-_DEFAULT_STIFFNESS = _DEFAULTS.contact_stiffness
 
 
 @dataclass(frozen=True)
@@ -334,7 +334,7 @@ def simulate_sweep(
     approach = abs(touch.angle - sweep.origin) / speed
     link = device_link(device.link)
     smallest = minimum_contact_point(
-        link, float(scenario_fields.get("contact_stiffness", _DEFAULT_STIFFNESS))
+        link, float(scenario_fields.get("contact_stiffness") or DEFAULT_CONTACT_STIFFNESS)
     )
     if touch.x_c < smallest:
         return SweepOutcome(

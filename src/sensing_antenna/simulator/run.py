@@ -38,7 +38,13 @@ from sensing_antenna.simulator.integrator import (
 from sensing_antenna.simulator.link import LinkModel, build_link_model, rayleigh_coefficients
 from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_reference
 from sensing_antenna.simulator.nonlinear_link import node_masses, static_equilibrium
-from sensing_antenna.simulator.scenario import FREE_CASES, SIZED_KINDS, Scenario, ScenarioError
+from sensing_antenna.simulator.scenario import (
+    DEFAULT_CONTACT_STIFFNESS,
+    FREE_CASES,
+    SIZED_KINDS,
+    Scenario,
+    ScenarioError,
+)
 
 __all__ = [
     "FINAL_AVERAGE_TIME",
@@ -325,8 +331,12 @@ def simulate_detailed(
     t: NDArray[np.float64] = np.arange(n_samples, dtype=np.float64) * ts
     imperfect = scenario.device.link_part  # the key of the cached link set-up
     model, omega_free, omega_contact = _link_setup(link, scenario.n_elements, imperfect)
-    scenario = scenario.resolved(omega_free)
+    # the smallest contact point is judged on the stated stiffness: the default, resolved, is
+    # always firm enough, but the push forces near the clamp are not
+    stated = scenario.contact_stiffness or DEFAULT_CONTACT_STIFFNESS
+    scenario = scenario.resolved(omega_free, omega_contact, link.mass, ts)
     assert scenario.accel_time is not None and scenario.approach_time is not None
+    assert scenario.substeps is not None and scenario.contact_stiffness is not None
     alpha, beta = rayleigh_coefficients(scenario.damping_ratio, omega_free, omega_contact)
     step = ts / scenario.substeps
     damping, ainv, z = _effective_inverse(link, scenario.n_elements, step, alpha, beta, imperfect)
@@ -381,12 +391,12 @@ def simulate_detailed(
     if kind is not None:
         assert scenario.contact_point is not None
         link.check_contact_point(scenario.contact_point)
-        x_min = minimum_contact_point(link, scenario.contact_stiffness)
+        x_min = minimum_contact_point(link, stated)
         if scenario.contact_point < x_min:
             raise ScenarioError(
                 "contact_point",
                 f"{scenario.contact_point:g} m is below {x_min:.3g} m, where the contact"
-                f" stiffness {scenario.contact_stiffness:g} N/m is {MIN_STIFFNESS_RATIO:g} times"
+                f" stiffness {stated:g} N/m is {MIN_STIFFNESS_RATIO:g} times"
                 " the link's local stiffness 3 E I / x_c^3 (the contact would be no support and"
                 " the push force would leave the sensor's range)",
             )

@@ -11,13 +11,15 @@ from typing import Any, Literal
 
 import numpy as np
 
-from sensing_antenna.control.servo import DEFAULT_SERVO_POLE
+from sensing_antenna.control.servo import DEFAULT_SERVO_POLE, MAX_POLE_STEP
 from sensing_antenna.errors import SensingAntennaError, format_value
 from sensing_antenna.simulator.device import DeviceImperfections
 
 __all__ = [
     "ATI_NANO17_RESOLUTION",
     "CASES",
+    "CONTACT_STIFFNESS_RATIO",
+    "DEFAULT_CONTACT_STIFFNESS",
     "FREE_CASES",
     "FREE_CASE_OF",
     "LINK_MODELS",
@@ -25,7 +27,9 @@ __all__ = [
     "MAX_ELEMENTS",
     "MAX_NOISE_SCALE",
     "MAX_SIMULATED_SAMPLES",
+    "MAX_STEP_PHASE",
     "MAX_SUBSTEPS",
+    "MIN_SUBSTEPS",
     "OBSTACLE_KINDS",
     "PLACED_KINDS",
     "Scenario",
@@ -90,6 +94,24 @@ MAX_NOISE_SCALE = 1000.0
 #: Most internal Newmark steps per 1 ms sample: 100 (a 10 us step). The integrator is
 #: unconditionally stable, so more steps only refine the step error; the cost grows with them.
 MAX_SUBSTEPS = 100
+
+#: The default penalty contact's stiffness (N/m), the least :meth:`Scenario.resolved` gives:
+#: 1000 times the paper link's local stiffness 3 E I / x_c^3 at x_c = 0.3 m (10 N/m), 215 times
+#: its mass times its highest first contact frequency squared (46 N/m).
+DEFAULT_CONTACT_STIFFNESS = 1.0e4
+
+#: The default penalty contact's stiffness over the link's mass times the square of its highest
+#: first contact frequency over [0.3 l, l], the stiffness scale of the modes the contact holds:
+#: a softer support lowers omega_1 (by 1.6 % at 37 times, a 0.35 m carbon rod touched at
+#: 0.12 m with 1e4 N/m), 150 times keeps it within about 0.1 %.
+CONTACT_STIFFNESS_RATIO = 150.0
+
+#: Fewest Newmark steps per 1 ms sample by default.
+MIN_SUBSTEPS = 2
+
+#: Largest omega h (rad) of the default step at the link's highest first contact frequency:
+#: Newmark average acceleration lengthens a period by (omega h)^2 / 12, 0.1 % at 0.11.
+MAX_STEP_PHASE = 0.11
 
 
 #: Largest value of the scenario's unbounded physical fields, with the reason. Past them the
@@ -242,8 +264,12 @@ class Scenario:
         The sweep must then meet it near ``contact_point``, which still names
         the touch (a scene's sweeps place the touched object itself: ``scene.simulate``), and
         ``obstacle_tilt`` is not used. None: placed from ``contact_point``.
-    contact_stiffness : float
-        Normal penalty stiffness (N/m); also the tangential stick stiffness.
+    contact_stiffness : float or None
+        Normal penalty stiffness (N/m); also the tangential stick stiffness. None:
+        :data:`CONTACT_STIFFNESS_RATIO` times the link's mass times the square of its highest
+        first contact frequency, at least :data:`DEFAULT_CONTACT_STIFFNESS` (1e4 N/m for the
+        paper's link, 1.6e5 N/m for a 0.35 m carbon rod), so that a short or stiff link's
+        contact is as firm a support.
     contact_damping : float
         Normal and tangential contact damping (N s/m).
     sweep_speed : float
@@ -278,8 +304,11 @@ class Scenario:
         paper). "nonlinear": the geometrically exact inextensible rod (exact curvature, axial
         shortening, friction along the link; ``simulator.nonlinear_link``), for pushes beyond
         about 10 % of x_c; 3 to 6 times slower (docs/simulator.md, "Large deflection").
-    substeps : int
-        Internal Newmark steps per 1 ms sample.
+    substeps : int or None
+        Internal Newmark steps per 1 ms sample. None: enough that omega h stays within
+        :data:`MAX_STEP_PHASE` at the link's highest first contact frequency over [0.3 l, l]
+        (a period 0.1 % long at most), at least :data:`MIN_SUBSTEPS` (2 for the paper's link, 8
+        for a 0.35 m carbon rod ringing at up to 776 rad/s).
     sensor : SensorNoise
         Sensor noise model at noise_scale = 1.
     device : DeviceImperfections
@@ -307,7 +336,7 @@ class Scenario:
     obstacle_sizes: tuple[float, ...] = ()
     obstacle_tilt: float = 0.02
     obstacle_placement: tuple[float, ...] | None = None
-    contact_stiffness: float = 1.0e4
+    contact_stiffness: float | None = None
     contact_damping: float = 0.5
     sweep_speed: float = 0.3
     sweep_direction: int = 1
@@ -317,7 +346,7 @@ class Scenario:
     servo_pole: float = DEFAULT_SERVO_POLE
     compensate_servo_lag: bool = True
     n_elements: int = 16
-    substeps: int = 2
+    substeps: int | None = None
     link_model: Literal["linear", "nonlinear"] = "linear"
     sensor: SensorNoise = field(default_factory=SensorNoise)
     device: DeviceImperfections = field(default_factory=DeviceImperfections)
@@ -369,8 +398,10 @@ class Scenario:
                 f"must be at most {MAX_NOISE_SCALE:g} (times the sensor's noise), got "
                 f"{format_value(self.noise_scale)}",
             )
-        for name in ("obstacle_radius", "contact_stiffness", "sweep_speed"):
+        for name in ("obstacle_radius", "sweep_speed"):
             _finite(name, getattr(self, name), 0.0, strict=True)
+        if self.contact_stiffness is not None:
+            _finite("contact_stiffness", self.contact_stiffness, 0.0, strict=True)
         if isinstance(self.sweep_direction, bool) or self.sweep_direction not in (1, -1):
             raise ScenarioError(
                 "sweep_direction",
@@ -412,8 +443,10 @@ class Scenario:
             raise ScenarioError(
                 "servo_pole", f"must be < 0 (stable), got {format_value(self.servo_pole)}"
             )
-        if -self.servo_pole * 1e-3 > 0.3:
-            raise ScenarioError("servo_pole", "too fast for the 1 kHz controller (|p| T_s > 0.3)")
+        if -self.servo_pole * 1e-3 > MAX_POLE_STEP:
+            raise ScenarioError(
+                "servo_pole", f"too fast for the 1 kHz controller (|p| T_s > {MAX_POLE_STEP:g})"
+            )
         if not isinstance(self.compensate_servo_lag, bool):
             raise ScenarioError(
                 "compensate_servo_lag",
@@ -428,7 +461,7 @@ class Scenario:
                 "n_elements",
                 f"must be an integer from 4 to {MAX_ELEMENTS}, got {format_value(self.n_elements)}",
             )
-        if (
+        if self.substeps is not None and (
             isinstance(self.substeps, bool)
             or not isinstance(self.substeps, int)
             or not 1 <= self.substeps <= MAX_SUBSTEPS
@@ -500,14 +533,35 @@ class Scenario:
             )
         object.__setattr__(self, "obstacle_sizes", tuple(float(v) for v in sizes))
 
-    def resolved(self, omega_free: float) -> Scenario:
-        """This scenario with the default ramp times made explicit.
+    def resolved(
+        self,
+        omega_free: float,
+        omega_contact: float = 0.0,
+        link_mass: float = 0.0,
+        sample_period: float = 1e-3,
+    ) -> Scenario:
+        """This scenario with the default ramp times, contact stiffness and substeps made
+        explicit.
 
         Parameters
         ----------
         omega_free : float
             First free-mode frequency of the link (rad/s).
+        omega_contact : float
+            The link's highest first contact frequency over [0.3 l, l] (rad/s).
+        link_mass : float
+            The link's mass (kg).
+        sample_period : float
+            Period of the recorded samples (s).
         """
+        stiffness = self.contact_stiffness
+        if stiffness is None:
+            modal = link_mass * omega_contact**2
+            stiffness = max(DEFAULT_CONTACT_STIFFNESS, CONTACT_STIFFNESS_RATIO * modal)
+        substeps = self.substeps
+        if substeps is None:
+            needed = math.ceil(omega_contact * sample_period / MAX_STEP_PHASE)
+            substeps = min(max(MIN_SUBSTEPS, needed), MAX_SUBSTEPS)
         accel = self.accel_time if self.accel_time is not None else 3.0 * math.pi / omega_free
         approach = (
             self.approach_time if self.approach_time is not None else accel + CRUISE_BEFORE_TOUCH
@@ -517,7 +571,13 @@ class Scenario:
                 "approach_time",
                 f"must be >= accel_time ({accel:.3g} s), got {format_value(approach)}",
             )
-        return replace(self, accel_time=accel, approach_time=approach)
+        return replace(
+            self,
+            accel_time=accel,
+            approach_time=approach,
+            contact_stiffness=stiffness,
+            substeps=substeps,
+        )
 
     @property
     def swept_joint(self) -> int:
