@@ -167,6 +167,10 @@ def test_bad_controller_input_is_one_clear_error() -> None:
         HeadController(antenna, pole=10.0)
     with pytest.raises(ControlConfigError, match="sample_period"):
         HeadController(antenna, sample_period=0.0)
+    # four poles at -1500 rad/s sampled at 1 kHz: the discrete servo diverges; 300 is the most
+    with pytest.raises(ControlConfigError, match=r"too fast .* at most 300 rad/s"):
+        HeadController(antenna, pole=-1500.0)
+    HeadController(antenna, pole=-300.0)
     controller = HeadController(antenna)
     with pytest.raises(ValueError, match="reference"):
         controller.step((0.0, 0.0, 0.0), (0.0, 0.0), (0.0, 0.0))

@@ -291,6 +291,24 @@ def test_servo_pole_has_one_bound_and_one_message(
     assert not out.exists()
 
 
+def test_a_servo_pole_too_fast_for_the_recordings_period_is_refused_before_any_fit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "free.csv"
+    write_recording(simulate(PAPER, Scenario(case="free"), record_commands=True), path)
+    out = tmp_path / "x.toml"
+    argv = ["identify", str(path), "--out", str(out), "--servo", "--servo-pole=-3000"]
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""  # nothing fitted, nothing printed
+    assert captured.err.strip() == (
+        "antenna identify: error: --servo-pole: -3000 rad/s is too fast for the controller's "
+        "period 0.001 s (|p| T_s = 3, more than 0.3: its discrete form no longer follows the "
+        "design); at most 300 rad/s in magnitude"
+    )
+    assert not out.exists()
+
+
 def test_a_still_recording_fits_no_joint() -> None:
     recording = simulate(PAPER, Scenario(case="free"), record_commands=True)
     still = Recording(

@@ -86,7 +86,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.motor import identify_motors_from
     from sensing_antenna.calibration.observer import IdentificationError, identify_free_motion
-    from sensing_antenna.control.servo import DEFAULT_SERVO_POLE, ControlConfigError
+    from sensing_antenna.control.servo import DEFAULT_SERVO_POLE, ControlConfigError, design_servo
     from sensing_antenna.recording import read_recording
 
     if args.servo_pole is not None and not args.servo:
@@ -94,6 +94,11 @@ def _run(args: argparse.Namespace) -> int:
     pole = DEFAULT_SERVO_POLE if args.servo_pole is None else args.servo_pole
     antenna = load_antenna(args.antenna)
     recordings = [read_recording(path) for path in distinct_files(args.recordings)]
+    if args.servo:
+        try:  # before any fit: a pole the recordings' period cannot realise
+            design_servo(antenna.motors[0], pole, recordings[0].sample_period)
+        except ControlConfigError as exc:
+            raise ControlConfigError(f"--servo-pole: {str(exc).removeprefix('pole: ')}") from None
     motor_fit = identify_motors_from(recordings, antenna) if args.servo else None
     try:
         fit = identify_free_motion(recordings, antenna, margin=args.margin)

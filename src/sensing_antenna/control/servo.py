@@ -60,6 +60,7 @@ __all__ = [
     "DEFAULT_SERVO_POLE",
     "FRICTION_SPEED",
     "JOINT_STATE_SIZE",
+    "MAX_POLE_STEP",
     "ControlConfigError",
     "HeadController",
     "ServoDesign",
@@ -75,6 +76,11 @@ __all__ = [
 #: Closed-loop pole p of Eq. 14 used by default (rad/s): eps = 1/60 s, fast next to the link's
 #: free-motion mode (16.4 rad/s) and slow next to the 1 kHz sampling (|p| T_s = 0.06).
 DEFAULT_SERVO_POLE = -60.0
+
+#: Largest |p| T_s a servo is designed for: beyond it the four poles at p are a third of the
+#: sampling rate or more, where the controller's discrete (Tustin) form no longer follows the
+#: continuous design (a pole of -1500 rad/s at 1 kHz diverged on a rigid Eq. 1 plant).
+MAX_POLE_STEP = 0.3
 
 #: Regularisation speed omega_s of the motors' Coulomb friction, ``Gamma_nlc tanh(omega /
 #: omega_s)`` (rad/s): the friction model of Eq. 1 that the simulator integrates and the
@@ -163,12 +169,20 @@ def design_servo(motor: Motor, pole: float, sample_period: float = 1e-3) -> Serv
     Raises
     ------
     ControlConfigError
-        When ``pole`` is not a negative number or ``sample_period`` not a positive one.
+        When ``pole`` is not a negative number or ``sample_period`` not a positive one, or
+        the pole is too fast for the period (:data:`MAX_POLE_STEP`).
     """
     if not (math.isfinite(pole) and pole < 0):
         raise ControlConfigError(f"pole: must be a finite number < 0 (stable), got {pole!r}")
     if not (math.isfinite(sample_period) and sample_period > 0):
         raise ControlConfigError(f"sample_period: must be finite and > 0, got {sample_period!r}")
+    if -pole * sample_period > MAX_POLE_STEP:
+        raise ControlConfigError(
+            f"pole: {pole:g} rad/s is too fast for the controller's period {sample_period:g} s "
+            f"(|p| T_s = {-pole * sample_period:.3g}, more than {MAX_POLE_STEP:g}: its discrete "
+            f"form no longer follows the design); at most {MAX_POLE_STEP / sample_period:.0f} "
+            "rad/s in magnitude"
+        )
     j = motor.inertia
     v = motor.viscous_friction
     p = pole
