@@ -363,6 +363,8 @@ def test_bad_input_coarse_sampling_and_dead_sensor() -> None:
     result = estimate(coarse, calibrated())
     assert result.status is Status.BAD_INPUT and "Nyquist" in (result.reason or "")
     assert "in ms?" not in (result.reason or "")  # 25 ms is no period in ms
+    # what the link needs: 2 times the band's top (116 rad/s for the paper's link) over pi
+    assert (result.reason or "").endswith(": this link needs samples at 74 Hz or faster")
     # time stamps in ms, us or ns: 1 s, 1000 s or 1e6 s read as the period, which the reason
     # names
     for unit, factor in (("ms", 1e3), ("us", 1e6), ("ns", 1e9)):

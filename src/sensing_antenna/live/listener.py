@@ -180,6 +180,7 @@ class Listener:
         self._received = _Growing()
         self._stamps = _Growing()  # the first time stamps received, for the period's check
         self._last: tuple[float, NDArray[np.float64]] | None = None
+        self._grid: float | None = None  # the grid point of the last sample (fill_missing)
         self.dropped = 0
         self._period_checked = False
         self.lags: list[float] = []
@@ -279,8 +280,10 @@ class Listener:
             self.header.sample_period,
             self._estimator.config.gap_limit(self.header.sample_period),
             self._last,
+            self._grid,
         )
         self._last = (float(t[-1]), rows[-1])
+        self._grid = filled.grid
         first = self._t.size
         self._t.extend(filled.t)
         self._t.extend(t[filled.taken :])

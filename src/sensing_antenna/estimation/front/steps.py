@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.compiler import njit
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import (
     ContactFrame,
@@ -111,11 +112,16 @@ def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig
                 and sample_period >= 0.5 * factor / 1e3
             )
         )
+        rate = cfg.min_nyquist_factor * band_top / math.pi  # Hz
         return (
             f"sample period {sample_period:g} s: the Nyquist frequency {nyquist:.0f} rad/s is "
             f"below {cfg.min_nyquist_factor:g} times the top of the omega_1 band "
             f"({band_top:.0f} rad/s)"
-            + (f" (time stamps in {unit}? the format's are in s)" if unit else "")
+            + (
+                f" (time stamps in {unit}? the format's are in s)"
+                if unit
+                else f": this link needs samples at {math.ceil(rate)} Hz or faster"
+            )
         )
     return None
 
@@ -145,8 +151,15 @@ MAX_FILLED = 100_000
 #: counts as k (k - 1 samples missing). A sample lost with the stamps' jitter steps by 2 +- 0.25
 #: periods, while a stamp taken late after one taken early (a stream whose stamps jitter by a
 #: third of a period) steps by up to 1.67: filled, it would add a sample that never was and put
-#: every later instant a period late. Long steps are counted the same way.
+#: every later instant a period late. Long steps are counted the same way. A stream placed on
+#: its grid as it arrives (:func:`fill_missing`) counts its steps from the grid instead.
 STEP_JITTER = 0.25
+
+#: Share of each time stamp's offset from the stream's grid by which the grid moves towards it
+#: (:func:`fill_missing`): the grid averages the stamps' jitter over about 1 / GRID_GAIN
+#: samples, and follows a clock whose period is a little off the declared one (a clock 0.1 %
+#: fast leaves the grid 0.03 periods behind its stamps).
+GRID_GAIN = 1.0 / 32.0
 
 
 #: A step of the time stamps longer than this many sample periods is an outlier stamp: it would
@@ -186,10 +199,15 @@ class FilledSamples:
     gap_starts : array of int, shape (len(gaps),)
         Where each of ``gaps`` begins among the N samples: its first sample put back.
     taken : int
-        The block's samples these hold: all of them, or those before a ``jump``.
+        The block's samples these hold: all of them, or those before a ``jump``; ``late``
+        of them left out.
     jump : str or None
         Why the samples from ``taken`` on cannot be put on the grid: a step missing more than
         :data:`MAX_FILLED` samples, or one beyond any number (an outlier time stamp).
+    grid : float
+        The grid point (s) of the last sample placed.
+    late : int
+        The block's samples left out for a place already taken (a repeated or late stamp).
     """
 
     t: FloatArray
@@ -200,6 +218,32 @@ class FilledSamples:
     gap_starts: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
     taken: int = 0
     jump: str | None = None
+    grid: float = math.nan
+    late: int = 0
+
+
+@njit(cache=True)
+def _grid_places(
+    t: FloatArray, grid: float, sample_period: float, gain: float
+) -> tuple[FloatArray, NDArray[np.int64], float]:
+    """Each stamp's step from the grid point before it (periods), the grid steps it is placed
+    at (round of that; 0 or less: a stamp at or before a place taken, a late sample), and the
+    grid's last point (s) (:func:`fill_missing`)."""
+    n = t.shape[0]
+    periods = np.empty(n)
+    places = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        step = (t[i] - grid) / sample_period
+        periods[i] = step
+        if not (np.isfinite(step) and step <= OUTLIER_PERIODS):
+            places[i] = 1  # judged by the caller (an outlier ends the block)
+            grid += sample_period
+            continue
+        k = round(step)
+        places[i] = k
+        if k >= 1:
+            grid += k * sample_period + gain * (t[i] - grid - k * sample_period)
+    return periods, places, grid
 
 
 def fill_missing(
@@ -208,17 +252,22 @@ def fill_missing(
     sample_period: float,
     max_gap: int,
     previous: tuple[float, FloatArray] | None = None,
+    grid: float | None = None,
 ) -> FilledSamples:
     """The samples of a stream with those it missed put back on its grid, as they arrive.
 
-    Where consecutive time stamps step by k sample periods (k >= 2, less
-    :data:`STEP_JITTER` at most: :func:`samples_missing`), the k - 1 samples between are
-    filled in by linear interpolation, at equal steps, as reading a whole recording resamples
-    it onto its grid (:func:`~sensing_antenna.recording.resample_uniform`): every step of the
-    front end reads the samples as uniform, so a missing one left out would shift every instant
-    after it by a period (a stream missing one sample in 20 reads its vibration 5 % fast).
-    Other steps (jitter) are left as they are. A filled sample depends on the sample after its
-    gap: it is known when that one arrives.
+    Each sample is placed on the stream's grid of ``sample_period``: the nearest grid point
+    after the previous sample's, k periods on (its step from that point, rounded). The grid
+    follows the stamps by :data:`GRID_GAIN` of each one's offset, so that the stamps' jitter
+    does not move it, nor a sample lost between a stamp taken late and one taken early hide.
+    Where a sample lands k >= 2 periods on, the k - 1 samples between are filled in by linear
+    interpolation, at equal steps, as reading a whole recording resamples it onto its grid
+    (:func:`~sensing_antenna.recording.resample_uniform`): every step of the front end reads
+    the samples as uniform, so a missing one left out would shift every instant after it by a
+    period (a stream missing one sample in 20 reads its vibration 5 % fast). A sample whose
+    place is taken (a stamp repeated, or late after the next one) is left out and counted
+    (``late``). A filled sample depends on the sample after its gap: it is known when that one
+    arrives.
 
     Parameters
     ----------
@@ -232,57 +281,89 @@ def fill_missing(
         Steps missing more than this many samples are also reported as gaps.
     previous : (float, array of shape (m,)), optional
         The sample before the block (its time stamp and values); None at a stream's start.
+    grid : float, optional
+        The grid point (s) the sample before the block was placed at (the last block's
+        ``grid``); None: its time stamp.
 
     Returns
     -------
     FilledSamples
-        The block itself (the same arrays) when no sample is missing; up to the first outlier
-        step (``jump``) when there is one.
+        The block itself (the same arrays) when no sample is missing or late; up to the first
+        outlier step (``jump``) when there is one; ``grid``, the last sample's grid point.
     """
     t = np.asarray(t, dtype=np.float64)
     values = np.asarray(values, dtype=np.float64)
     n = t.shape[0]
     if n == 0:
-        return FilledSamples(t, values, np.zeros(0, dtype=np.intp), np.zeros(0, dtype=bool))
-    if previous is None:
-        left_t, left_values = np.concatenate([[t[0]], t[:-1]]), np.vstack([values[:1], values[:-1]])
-    else:
-        left_t = np.concatenate([[previous[0]], t[:-1]])
-        left_values = np.vstack([np.asarray(previous[1], dtype=np.float64), values[:-1]])
-    # one step per sample of the block: into it from the one before (none for a stream's first)
-    with np.errstate(over="ignore", invalid="ignore"):
-        steps = t - left_t
-        periods = steps / sample_period
-    missing = samples_missing(steps, sample_period)
+        return FilledSamples(
+            t, values, np.zeros(0, dtype=np.intp), np.zeros(0, dtype=bool), grid=_or_nan(grid)
+        )
+    if grid is None:
+        grid = t[0] - sample_period if previous is None else previous[0]
+    periods, places, last = _grid_places(t, float(grid), sample_period, GRID_GAIN)
     # beyond any filling, or beyond any number (finite stamps whose step overflows)
-    outlier = (periods > OUTLIER_PERIODS) & np.isfinite(t) & np.isfinite(left_t)
+    with np.errstate(invalid="ignore"):
+        outlier = (periods > OUTLIER_PERIODS) & np.isfinite(t) & np.isfinite(grid)
     jump = None
     taken = n
     if np.any(outlier):
         taken = int(np.argmax(outlier))
+        before = (
+            float(t[taken - 1]) if taken else _or_nan(None if previous is None else previous[0])
+        )
         jump = (
-            f"time jumps from {float(left_t[taken])!r} to {float(t[taken])!r} s, "
+            f"time jumps from {before!r} to {float(t[taken])!r} s, "
             f"{periods[taken]:.4g} sample periods of {sample_period!r} s in one "
             f"step: an outlier time stamp (at most {MAX_FILLED} missing samples are filled)"
         )
-        t, values, missing = t[:taken], values[:taken], missing[:taken]
-        left_t, left_values = left_t[:taken], left_values[:taken]
-    own = np.arange(taken, dtype=np.intp)
+        _, _, last = _grid_places(t[:taken], float(grid), sample_period, GRID_GAIN)
+    kept = np.flatnonzero(places[:taken] >= 1).astype(np.intp)
+    late = taken - kept.shape[0]
+    missing = places[kept].astype(np.float64) - 1.0
+    if late == 0 and not np.any(missing > 0.0):
+        own = np.arange(taken, dtype=np.intp)
+        if taken < n:
+            t, values = t[:taken], values[:taken]
+        return FilledSamples(
+            t,
+            values,
+            own,
+            np.zeros(taken, dtype=bool),
+            taken=taken,
+            jump=jump,
+            grid=last,
+        )
+    t, values, own = t[kept], values[kept], kept
+    if previous is None:
+        left_t, left_values = np.concatenate([t[:1], t[:-1]]), np.vstack([values[:1], values[:-1]])
+    else:
+        left_t = np.concatenate([[previous[0]], t[:-1]])
+        left_values = np.vstack([np.asarray(previous[1], dtype=np.float64), values[:-1]])
     if not np.any(missing > 0.0):
-        return FilledSamples(t, values, own, np.zeros(taken, dtype=bool), taken=taken, jump=jump)
+        return FilledSamples(
+            t,
+            values,
+            own,
+            np.zeros(t.shape[0], dtype=bool),
+            taken=taken,
+            jump=jump,
+            grid=last,
+            late=late,
+        )
     counts = missing.astype(np.intp) + 1
     origin = np.repeat(own, counts)
+    step_of = np.repeat(np.arange(own.shape[0]), counts)  # each output's step among the kept
     ends = np.cumsum(counts)  # one past each own sample's place among the output
     # position of each output sample within its step: 1 .. counts, the block's own at counts
     within = np.arange(origin.shape[0]) - np.repeat(ends - counts, counts) + 1
     fraction = within / np.repeat(counts, counts)
     is_own = within == np.repeat(counts, counts)
-    start_t, start_values = left_t[origin], left_values[origin]
-    filled_t = np.where(is_own, t[origin], start_t + fraction * (t[origin] - start_t))
+    start_t, start_values = left_t[step_of], left_values[step_of]
+    filled_t = np.where(is_own, t[step_of], start_t + fraction * (t[step_of] - start_t))
     filled_values = np.where(
         is_own[:, None],
-        values[origin],
-        start_values + fraction[:, None] * (values[origin] - start_values),
+        values[step_of],
+        start_values + fraction[:, None] * (values[step_of] - start_values),
     )
     long_steps = np.flatnonzero(missing > max_gap)
     return FilledSamples(
@@ -294,7 +375,13 @@ def fill_missing(
         (ends[long_steps] - counts[long_steps]).astype(np.intp),
         taken,
         jump,
+        last,
+        late,
     )
+
+
+def _or_nan(value: float | None) -> float:
+    return math.nan if value is None else float(value)
 
 
 def time_gaps(t: FloatArray, sample_period: float, max_gap: int) -> tuple[tuple[float, float], ...]:
