@@ -292,3 +292,23 @@ def test_a_failed_calibration_stops_the_campaign_with_one_error(
     with pytest.raises(CampaignSpecError, match=r"cal\.toml: calibration: .*got 0"):
         run_campaign(spec, tmp_path, workers=1, progress=False)
     assert not (tmp_path / "runs").exists()
+
+
+def test_a_tip_mass_asked_for_and_not_fitted_is_said_so(tmp_path: Path) -> None:
+    # three calibration points cannot fit T_e and a tip mass with any scatter left: the model
+    # keeps its tip mass, and the report says why rather than nothing
+    import dataclasses
+
+    from sensing_antenna.campaign.report import build_report
+
+    spec = dataclasses.replace(
+        device_spec(True),
+        contact_points=(0.5,),
+        free_motion=FreeMotionStep(identify=False),
+        calibration=CalibrationStep(enabled=True, contact_points=(0.4, 0.6, 0.8), tip_mass=True),
+    )
+    run_campaign(spec, tmp_path, workers=1, progress=False)
+    stored = read_calibration(tmp_path)
+    assert stored is not None and stored[1].tip_mass is None
+    text = build_report(tmp_path).read_text("utf-8")
+    assert "The tip mass (`tip_mass = true`) was not fitted: fewer than 4 points" in text

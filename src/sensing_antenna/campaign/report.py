@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from sensing_antenna.antenna import Antenna
+from sensing_antenna.calibration.frequency import MIN_TIP_MASS_POINTS
 from sensing_antenna.campaign.figures import ReportFigures, draw_figures
 from sensing_antenna.campaign.report_devices import devices_section
 from sensing_antenna.campaign.report_sections import (
@@ -136,6 +137,19 @@ def _plain_statement(summary: CampaignSummary, spec: CampaignSpec) -> list[str]:
     return [text, ""]
 
 
+def _tip_mass_lines(asked: bool, fitted: float | None) -> list[str]:
+    """What became of the tip mass the spec asked to fit with T_e (``tip_mass = true``)."""
+    if not asked:
+        return []
+    if fitted is not None:
+        return [f"The tip mass, fitted with T_e: {1e3 * fitted:.4g} g (the model's tip_mass).", ""]
+    return [
+        f"The tip mass (`tip_mass = true`) was not fitted: fewer than {MIN_TIP_MASS_POINTS} "
+        "points that agree with one another; the model keeps the antenna's link.tip_mass.",
+        "",
+    ]
+
+
 def _scatter_lines(check: CalibrationCheck) -> list[str]:
     calibration = check.calibration
     scatter = calibration.relative_scatter
@@ -236,6 +250,7 @@ def _calibration_section(
         f"Check available on the simulator only: the device's true T is {check.device_t:.4f} "
         f"s/m^2; T_e is {100 * check.t_e_vs_device:+.2f} % from it.",
         "",
+        *_tip_mass_lines(step.tip_mass, calibration.tip_mass),
         *_scatter_lines(check),
     ]
     if calibration.notes:

@@ -177,7 +177,9 @@ def _figure13(trace: FrontTrace, result: ContactEstimate, zero_padding: int, out
     ax_t.set_title("Figure 13 - " + _title(result), fontsize=9)
     if projected.shape[0] >= 4:
         omega, power = power_spectrum(projected, trace.sample_period, zero_padding)
-        keep = omega <= 400.0
+        # the searched band and as much again beyond it (a short link rings at hundreds of
+        # rad/s), at least up to 400 rad/s
+        keep = omega <= max(400.0, 2.0 * trace.band[1])
         ax_s.semilogy(omega[keep], power[keep, 0], lw=1.0, label="about Y^c")
         ax_s.semilogy(omega[keep], power[keep, 1], lw=1.0, label="about Z^c")
         ax_s.axvspan(trace.band[0], trace.band[1], color="0.9", label="searched band")

@@ -578,9 +578,12 @@ class PaperMethod:
                 )
                 total = math.hypot(spread, preload, held_spread)
                 if total > cfg.max_model_spread and (plane == "push" or held_spread > 0.0):
-                    problems.append(
-                        (Status.UNCERTAIN, _push_plane_reason(total, held, plane == "push", cfg))
-                    )
+                    # a nominal T's spread the larger share: calibrating is what narrows it
+                    nominal = not link.calibrated_t and spread >= math.hypot(preload, held_spread)
+                    reason = _push_plane_reason(total, held, plane == "push", cfg)
+                    if nominal:
+                        reason += ", most of it the frequency model's own: calibrate the antenna"
+                    problems.append((Status.UNCERTAIN, reason))
             peak2 = second_peak(evidence, measurement.component, measurement.omega1)
             off = math.nan
             if peak2 is not None:
