@@ -11,6 +11,7 @@ import gc
 import io
 import json
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -45,7 +46,7 @@ from sensing_antenna.live.wire import (
     decode_datagram,
     pack_samples,
 )
-from sensing_antenna.recording import Recording, RecordingError, read_recording
+from sensing_antenna.recording import REQUIRED_COLUMNS, Recording, RecordingError, read_recording
 from sensing_antenna.simulator import Scenario, simulate
 
 CASES = {"azimuthal": 0.6, "vertical": 0.7}
@@ -472,6 +473,14 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
             "metadata key 'sample_period': missing",
         ),
         (text[:2], "no header after the metadata"),
+        # a period in ms: said of the stream's metadata, not of the antenna's observer
+        (
+            [
+                "# sample_period: 1\n" if line.startswith("# sample_period") else line
+                for line in text[: header_at + 3]
+            ],
+            "<stdin>: metadata key 'sample_period': sample period 1 s: the Nyquist frequency",
+        ),
         # a digit group is a number to Python's float, not to the file's reader
         (
             [
@@ -731,6 +740,17 @@ def test_a_repeated_or_late_time_stamp_is_left_out_and_counted() -> None:
     assert result.diagnostics["filled_samples"] == 1  # 1500's place, before it came late
     assert result.status == reference.status
     assert result.x_c == pytest.approx(reference.x_c, abs=1e-4)
+
+
+def test_rows_that_do_not_fit_the_header_are_refused_at_put() -> None:
+    header = StreamHeader({"sample_period": "0.001"}, tuple(REQUIRED_COLUMNS), "<driver>")
+    listener = Listener(header, paper_antenna(), lambda event: None)
+    expected = "<driver>: put takes rows of 9 numbers (the columns t, theta1, theta2, fx, fy, "
+    with pytest.raises(ValueError, match=re.escape(expected) + r".*shape \(1, 8\)"):
+        listener.put([[0.0] * 8])
+    with pytest.raises(ValueError, match="rows of different lengths"):
+        listener.put([[0.0] * 9, [0.0] * 8])
+    listener.close(finish=False)  # nothing was queued: the worker ends cleanly
 
 
 def test_two_recordings_in_one_stream(recordings: dict[str, Path]) -> None:

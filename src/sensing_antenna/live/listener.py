@@ -29,7 +29,8 @@ from numpy.typing import NDArray
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.front.steps import fill_missing, samples_missing
+from sensing_antenna.estimation.front.evidence import search_band
+from sensing_antenna.estimation.front.steps import fill_missing, samples_missing, sampling_problem
 from sensing_antenna.estimation.methods import EstimationMethod
 from sensing_antenna.estimation.online import OnlineEstimator
 from sensing_antenna.estimation.result import ContactEstimate
@@ -46,6 +47,7 @@ from sensing_antenna.live.wire import StreamHeader, WireError
 from sensing_antenna.recording import (
     CLOCK_TOLERANCE,
     PERIOD_CONSISTENCY,
+    RecordingError,
     stated_torque_point,
 )
 from sensing_antenna.torque_point import torques_about_base
@@ -164,6 +166,12 @@ class Listener:
         self._record = record
         self._clock = clock
         ts = header.sample_period
+        # a period the antenna's vibration cannot be read at: said of the stream's metadata,
+        # before the estimator's filters refuse it in the antenna's terms
+        settings = EstimatorConfig() if config is None else config
+        coarse = sampling_problem(ts, search_band(antenna.link, settings)[1], settings)
+        if coarse is not None:
+            raise RecordingError(header.source, None, "sample_period", coarse, metadata=True)
         self._estimator = OnlineEstimator(antenna, ts, method, config)
         # a detector of its own, the front end's twin, for the residual after t_c (contact lost)
         self._residual = ContactDetector(antenna, ts)
@@ -205,9 +213,26 @@ class Listener:
         self, rows: NDArray[np.float64] | list[list[float]], received: float | None = None
     ) -> None:
         """Queue samples that arrived together (shape (k, n_columns), the header's order),
-        received at ``received`` (s on the listener's clock; now when None). Never waits."""
+        received at ``received`` (s on the listener's clock; now when None). Never waits.
+
+        Raises
+        ------
+        ValueError
+            When a row does not hold one number per column of the header.
+        """
         if self.error is not None:
             raise self.error
+        width = len(self.header.columns)
+        try:
+            shape: tuple[int, ...] | str = np.shape(rows)
+        except ValueError:
+            shape = "rows of different lengths"
+        if not (isinstance(shape, tuple) and len(shape) == 2 and shape[1] == width):
+            raise ValueError(
+                f"{self.header.source}: put takes rows of {width} numbers (the columns "
+                f"{', '.join(self.header.columns)}), got "
+                + (f"an array of shape {shape}" if isinstance(shape, tuple) else shape)
+            )
         self._queue.put((rows, self._clock() if received is None else received))
 
     def close(self, reason: str = "end of input", finish: bool = True) -> None:
