@@ -295,7 +295,7 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     assert "datagram 3: time 86400.0 s jumps from 0.002 s by more than" in reasons
     end = first[-1]
     assert end["event"] == "end" and end["samples"] == 3
-    assert end["reason"] == "end of stream; 1 samples datagrams lost"
+    assert end["reason"] == "end of stream; 1 datagram of samples lost"
     assert [e["status"] for e in first if e["event"] == "estimate"] == ["bad_input"]
 
 

@@ -171,7 +171,7 @@ class _UdpStream:
 
     def close(self, reason: str) -> None:
         if self.lost:
-            reason += f"; {self.lost} samples datagrams lost"
+            reason += f"; {self.lost} datagram{'' if self.lost == 1 else 's'} of samples lost"
         self.listener.close(reason)
 
 

@@ -142,6 +142,9 @@ class SimulationDetail:
     link_model : LinkModel
     rayleigh : (float, float)
         Damping coefficients alpha (1/s), beta (s).
+    scenario : Scenario
+        The scenario as simulated, its defaults made explicit (:meth:`Scenario.resolved`: the
+        ramp times, the contact stiffness and the substeps the link was given).
     """
 
     recording: Recording
@@ -159,6 +162,7 @@ class SimulationDetail:
     obstacle: Obstacle | None
     link_model: LinkModel
     rayleigh: tuple[float, float]
+    scenario: Scenario
 
 
 @lru_cache(maxsize=16)
@@ -612,6 +616,7 @@ def simulate_detailed(
         obstacle=obstacle,
         link_model=model,
         rayleigh=(alpha, beta),
+        scenario=scenario,
     )
 
 
