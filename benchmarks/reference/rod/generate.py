@@ -51,7 +51,7 @@ from engine import (  # noqa: E402
 from sensing_antenna import paper_antenna  # noqa: E402
 from sensing_antenna.detection.push import PushCriterion  # noqa: E402
 from sensing_antenna.recording import Recording, write_recording  # noqa: E402
-from sensing_antenna.simulator import Scenario, SensorNoise, simulate  # noqa: E402
+from sensing_antenna.simulator import Scenario, SensorNoise, simulate_detailed  # noqa: E402
 
 N_ELEMENTS = 40
 FAST_MODE_SCALE = 100.0
@@ -141,7 +141,8 @@ def run_case(
         noise_scale=0.0,
         push=PushCriterion(kind="rotation", threshold=push),
     )
-    kinematics = simulate(antenna, scenario)
+    detail = simulate_detailed(antenna, scenario)
+    kinematics, scenario = detail.recording, detail.scenario  # its defaults as simulated
     obstacle = json.loads(kinematics.metadata["true_obstacle"])
     angles = _angles(kinematics)
     link = RodLink(

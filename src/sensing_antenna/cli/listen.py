@@ -96,7 +96,13 @@ def _run(args: argparse.Namespace) -> int:
         record = None
         if args.record is not None:
             record = RecordWriter(numbered_path(args.record, number), header)
-        return Listener(header, antenna, emit, args.method, config, record, number)
+        try:
+            return Listener(header, antenna, emit, args.method, config, record, number)
+        except SensingAntennaError:
+            if record is not None:  # a stream refused before any sample: no recording of it
+                record.close()
+                record.path.unlink(missing_ok=True)
+            raise
 
     def ready() -> None:
         if not args.warm_up:

@@ -77,9 +77,9 @@ __all__ = [
 #: free-motion mode (16.4 rad/s) and slow next to the 1 kHz sampling (|p| T_s = 0.06).
 DEFAULT_SERVO_POLE = -60.0
 
-#: Largest |p| T_s a servo is designed for: beyond it the four poles at p are a third of the
-#: sampling rate or more, where the controller's discrete (Tustin) form no longer follows the
-#: continuous design (a pole of -1500 rad/s at 1 kHz diverged on a rigid Eq. 1 plant).
+#: Largest |p| T_s a servo is designed for (the simulator's bound): faster poles leave the
+#: controller's discrete (Tustin) form further from the continuous design it is made from (a
+#: pole of -1500 rad/s at 1 kHz, |p| T_s = 1.5, diverged on a rigid Eq. 1 plant).
 MAX_POLE_STEP = 0.3
 
 #: Regularisation speed omega_s of the motors' Coulomb friction, ``Gamma_nlc tanh(omega /

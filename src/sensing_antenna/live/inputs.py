@@ -258,8 +258,14 @@ def listen_udp(
                     current = None
                     if count is not None and ended >= count:
                         break
+                try:
+                    listener = make(header, numbered + 1)
+                except RecordingError as exc:  # its header refused for this antenna
+                    skip(f"{exc}: the stream is left out")
+                    refused.add(datagram.stream)
+                    continue
                 numbered += 1
-                current = _UdpStream(make(header, numbered), datagram)
+                current = _UdpStream(listener, datagram)
                 current.heard = received
                 joined.add(datagram.stream)
             elif not ours or datagram.kind == "header":

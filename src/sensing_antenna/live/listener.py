@@ -30,7 +30,13 @@ from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
-from sensing_antenna.estimation.front.steps import fill_missing, samples_missing, sampling_problem
+from sensing_antenna.estimation.front.steps import (
+    StreamGrid,
+    fill_missing,
+    grid_steps,
+    samples_missing,
+    sampling_problem,
+)
 from sensing_antenna.estimation.methods import EstimationMethod
 from sensing_antenna.estimation.online import OnlineEstimator
 from sensing_antenna.estimation.result import ContactEstimate
@@ -188,7 +194,7 @@ class Listener:
         self._received = _Growing()
         self._stamps = _Growing()  # the first time stamps received, for the period's check
         self._last: tuple[float, NDArray[np.float64]] | None = None
-        self._grid: float | None = None  # the grid point of the last sample (fill_missing)
+        self._grid: StreamGrid | None = None  # where the samples were placed (fill_missing)
         self.dropped = 0
         self._period_checked = False
         self.lags: list[float] = []
@@ -227,6 +233,8 @@ class Listener:
             shape: tuple[int, ...] | str = np.shape(rows)
         except ValueError:
             shape = "rows of different lengths"
+        if shape in ((0,), (0, width)):
+            return  # nothing arrived
         if not (isinstance(shape, tuple) and len(shape) == 2 and shape[1] == width):
             raise ValueError(
                 f"{self.header.source}: put takes rows of {width} numbers (the columns "
@@ -307,7 +315,8 @@ class Listener:
             self._last,
             self._grid,
         )
-        self._last = (float(t[-1]), rows[-1])
+        if filled.t.size:  # the last sample kept (a late one is left out), as the estimator's
+            self._last = (float(filled.t[-1]), filled.values[-1])
         self._grid = filled.grid
         first = self._t.size
         self._t.extend(filled.t)
@@ -359,8 +368,10 @@ class Listener:
             # stamp's jitter averages out over the line, where it stays in a median of steps (a
             # tenth of a period of jitter moves that by a few per cent). The drops are counted
             # as the line fits the stamps best: a step of 1.6 periods is a late stamp after an
-            # early one, or a lost sample with jitter, and only the others tell which
-            period, error = _period_of_line(stamps, [periods, np.maximum(np.rint(step / ts), 1.0)])
+            # early one, or a lost sample with jitter, and only the others tell which (the
+            # estimator's grid tells from them all)
+            countings = [periods, np.maximum(np.rint(step / ts), 1.0), grid_steps(stamps, ts)]
+            period, error = _period_of_line(stamps, countings)
             how = f"a line through its first {steps + 1} time stamps"
             # on its full first stamps, as close as their jitter lets the line tell, down to the
             # clock tolerance by which a file's stamps are trusted over its period (fewer, at

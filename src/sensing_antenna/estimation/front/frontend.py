@@ -65,9 +65,9 @@ from sensing_antenna.estimation.front.spikes import (
     spike_longest,
 )
 from sensing_antenna.estimation.front.steps import (
-    GRID_GAIN,
     ContactStart,
     HoldPush,
+    StreamGrid,
     at_contact,
     dead_channel,
     fill_missing,
@@ -215,8 +215,8 @@ class FrontEnd:
         self._loads_done = self._ratio_done = self._mean_done = 0
         self._filled: list[tuple[int, tuple[float, float]]] = []  # (known at sample, interval)
         self._put_back_at: list[int] = []  # samples put back where stamps skip (ascending)
-        self._grid: float | None = None  # the grid point of the last sample received
-        self._late = 0  # samples left out for a place on the grid already taken
+        self._grid: StreamGrid | None = None  # where the samples received were placed
+        self._late_at: list[int] = []  # samples left out, their place taken (ascending)
         # samples received but held back until the samples that decide a suspect among them
         # have come (spikes.find_spikes), and the raw wrench of the last ones released
         self._pending: tuple[FloatArray, FloatArray, FloatArray] | None = None
@@ -492,19 +492,23 @@ class FrontEnd:
         ts = self.sample_period
         pending = self._pending
         n = self._n + (0 if pending is None else pending[0].shape[0])
-        grid = self._grid
-        if n and t.shape[0] == 1 and grid is not None:
-            stamp = float(t[0])
-            if round((stamp - grid) / ts) == 1:
+        if n and t.shape[0] == 1 and self._grid is not None:
+            following = self._grid.next(float(t[0]))
+            if following is not None:
                 # the loop's case: the next place on the grid, nothing skipped (as fill_missing)
-                self._grid = grid + (ts + GRID_GAIN * (stamp - grid - ts))
+                self._grid = following
                 return t, theta, force, torque
         previous = self._last_received()
         filled = fill_missing(
-            t, np.hstack([theta, force, torque]), ts, self.config.gap_limit(ts), previous, grid
+            t,
+            np.hstack([theta, force, torque]),
+            ts,
+            self.config.gap_limit(ts),
+            previous,
+            self._grid,
         )
         self._grid = filled.grid
-        self._late += filled.late
+        self._late_at.extend((n + filled.late_at).tolist())
         if filled.jump is not None:
             self._jump = f"t: {filled.jump}"
         if filled.t is t:
@@ -747,8 +751,9 @@ class FrontEnd:
         filled = bisect.bisect_right(self._put_back_at, last)
         if filled:
             notes["filled_samples"] = filled
-        if self._late:
-            notes["late_samples"] = self._late
+        late = bisect.bisect_right(self._late_at, last)  # those that came before sample `last`
+        if late:
+            notes["late_samples"] = late
         repaired = [
             {
                 "t": float(self._t[index]),
