@@ -515,7 +515,25 @@ def test_a_sample_that_is_not_a_number_ends_a_stream_as_bad_input(
     assert result.status is Status.BAD_INPUT
     assert result.reason == (
         f"column 'fy': not a number (NaN) at t = {glitched.t[k]:.4f} s, a reading the device "
-        "did not give; a sample's values must all be numbers"
+        "did not give; a sample's values must all be numbers, its time stamp finite"
+    )
+
+
+@pytest.mark.parametrize("stamp", [math.inf, -math.inf])
+def test_an_infinite_time_stamp_ends_a_stream_as_bad_input(stamp: float) -> None:
+    # a stamp with no place in time ends the stream as a NaN does (it was taken for the next
+    # sample, and the answer went on as if nothing happened)
+    recording = simulate(paper_antenna(), Scenario(case="azimuthal", contact_point=0.55, seed=2))
+    online = OnlineEstimator(paper_antenna(), recording.sample_period)
+    result = None
+    for k in range(recording.n_samples):
+        t = stamp if k == 1500 else float(recording.t[k])
+        result = online.update(t, recording.theta[k], recording.force[k], recording.torque[k])
+        if result is not None:
+            break
+    assert result is not None and result.status is Status.BAD_INPUT
+    assert (result.reason or "").startswith(
+        f"column 't': infinite after t = {recording.t[1499]:.4f} s"
     )
 
 

@@ -463,23 +463,31 @@ class FrontEnd:
         self, t: FloatArray, theta: FloatArray, force: FloatArray, torque: FloatArray
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """The block cut before its first sample with a NaN (a reading the device did not give,
-        which no repair can judge), which ends the run (``bad_input``) after the samples before
-        it, as a recording with one is refused."""
+        which no repair can judge) or an infinite time stamp (no place in time), which ends
+        the run (``bad_input``) after the samples before it, as a recording with one is
+        refused."""
         if self._jump is not None:
             return t, theta, force, torque
         values = np.hstack([t[:, None], theta, force, torque])
-        rows = np.flatnonzero(np.isnan(values).any(axis=1))
+        unusable = np.isnan(values)
+        unusable[:, 0] |= np.isinf(t)
+        rows = np.flatnonzero(unusable.any(axis=1))
         if rows.size == 0:
             return t, theta, force, torque
         k = int(rows[0])
-        column = _COLUMNS[int(np.flatnonzero(np.isnan(values[k]))[0])]
+        column = _COLUMNS[int(np.flatnonzero(unusable[k])[0])]
+        previous = self._last_received()
+        before = float(t[k - 1]) if k else None if previous is None else previous[0]
         if column != "t":
             where = f"at t = {t[k]:.4f} s"
+        elif before is not None:
+            where = f"after t = {before:.4f} s"
         else:
-            where = f"after t = {t[k - 1]:.4f} s" if k else "at a block's first sample"
+            where = "at the stream's first sample"
+        what = "not a number (NaN)" if np.isnan(values[k, 0]) or column != "t" else "infinite"
         self._jump = (
-            f"column '{column}': not a number (NaN) {where}, a reading the device did not "
-            "give; a sample's values must all be numbers"
+            f"column '{column}': {what} {where}, a reading the device did not give; a sample's "
+            "values must all be numbers, its time stamp finite"
         )
         return t[:k], theta[:k], force[:k], torque[:k]
 
