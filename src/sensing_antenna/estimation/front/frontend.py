@@ -470,7 +470,8 @@ class FrontEnd:
             return t, theta, force, torque
         values = np.hstack([t[:, None], theta, force, torque])
         unusable = np.isnan(values)
-        unusable[:, 0] |= np.isinf(t)
+        if math.isinf(t[0]) if t.shape[0] == 1 else np.isinf(t).any():  # the loop's case cheap
+            unusable[:, 0] |= np.isinf(t)
         rows = np.flatnonzero(unusable.any(axis=1))
         if rows.size == 0:
             return t, theta, force, torque

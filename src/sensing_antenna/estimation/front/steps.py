@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -230,8 +230,7 @@ class FilledSamples:
     late_at: NDArray[np.intp] = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
 
 
-@dataclass(frozen=True)
-class StreamGrid:
+class StreamGrid(NamedTuple):
     """The grid a stream's samples are placed on as they arrive (:func:`fill_missing`).
 
     Attributes
