@@ -299,6 +299,17 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     assert [e["status"] for e in first if e["event"] == "estimate"] == ["bad_input"]
 
 
+def _declaring_period(recording: Recording, period: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """``recording``'s stream header lines declaring ``period`` (s) and 30 rows at rest, 1 ms
+    apart."""
+    header, _ = stream_of(recording)
+    lines = tuple(
+        f"# sample_period: {period}" if line.startswith("# sample_period") else line
+        for line in header.lines()
+    )
+    return lines, tuple(_resting_row(recording, 0.001 * k) for k in range(30))
+
+
 def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
     recordings: dict[str, Path],
 ) -> None:
@@ -307,12 +318,7 @@ def test_a_udp_stream_refused_for_its_period_is_skipped_and_the_next_is_heard(
     # the listener goes on and estimates the next stream: recording 2, the first counted
     # (--count 1 hears it)
     recording = read_recording(recordings["azimuthal"])
-    header, _ = stream_of(recording)
-    wrong = tuple(
-        "# sample_period: 0.0011" if line.startswith("# sample_period") else line
-        for line in header.lines()
-    )
-    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(30))
+    wrong, rows = _declaring_period(recording, "0.0011")
     events = _heard_over_udp(
         [
             Datagram("header", "w", 0, wrong).encode(),
@@ -336,12 +342,8 @@ def test_a_udp_stream_too_coarse_for_the_antenna_is_skipped_and_the_next_is_hear
     # when the stream would join: a skipped event names it, it takes no recording's number,
     # and the streams before and after it are heard
     recording = read_recording(recordings["azimuthal"])
+    coarse, rows = _declaring_period(recording, "1")
     header, _ = stream_of(recording)
-    coarse = tuple(
-        "# sample_period: 1" if line.startswith("# sample_period") else line
-        for line in header.lines()
-    )
-    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(30))
     events = _heard_over_udp(
         [
             Datagram("header", "v", 0, header.lines()).encode(),
