@@ -519,6 +519,23 @@ def test_a_sample_that_is_not_a_number_ends_a_stream_as_bad_input(
     )
 
 
+def test_a_stream_stamped_in_milliseconds_is_told_so() -> None:
+    # a driver's stamps in ms fed to an estimator of a 1 ms period: each step is a gap of 999
+    # samples, and the reason says what such a gap most likely is
+    recording = simulate(paper_antenna(), Scenario(case="azimuthal", contact_point=0.55, seed=2))
+    online = OnlineEstimator(paper_antenna(), recording.sample_period)
+    result = None
+    for k in range(recording.n_samples):
+        stamp = 1000.0 * float(recording.t[k])
+        result = online.update(stamp, recording.theta[k], recording.force[k], recording.torque[k])
+        if result is not None:
+            break
+    result = result if result is not None else online.finalize()
+    assert result.status is Status.BAD_INPUT
+    assert (result.reason or "").startswith("t: 999 samples missing between ")
+    assert (result.reason or "").endswith(" (time stamps in ms? the format's are in s)")
+
+
 @pytest.mark.parametrize("stamp", [math.inf, -math.inf])
 def test_an_infinite_time_stamp_ends_a_stream_as_bad_input(stamp: float) -> None:
     # a stamp with no place in time ends the stream as a NaN does (it was taken for the next

@@ -475,21 +475,26 @@ def gap_problem(
     line across a long gap replaces a large part of a period or more, or looks like the head at
     rest where it was still moving, and the steps after it read a signal that was never there.
     """
-    for start, end in gaps:
-        if end > t_c and start < t_e:
-            missing = round((end - start) / sample_period) - 1
-            within = (
-                "; the contact was found inside the gap, on the straight line that fills it: "
-                "it may be the gap's jump, not a touch"
-                if start <= t_c <= end
-                else ""
-            )
-            return (
-                f"t: {missing} samples missing between {start:.4f} s and {end:.4f} s, inside "
-                f"the estimation window [{t_c:.3f}, {t_e:.3f}] s from the contact (at most "
-                f"{max_gap} in a row are filled in){within}"
-            )
-    return None
+    overlapping = [(start, end) for start, end in gaps if end > t_c and start < t_e]
+    if not overlapping:
+        return None
+    start, end = overlapping[0]
+    missing = round((end - start) / sample_period) - 1
+    within = (
+        "; the contact was found inside the gap, on the straight line that fills it: "
+        "it may be the gap's jump, not a touch"
+        if start <= t_c <= end
+        else ""
+    )
+    # one step of 1000 (1e6, 1e9) periods: a stamp in ms (us, ns) read as seconds
+    steps = (end - start) / sample_period
+    unit = stamps_unit(lambda factor: abs(steps - factor) <= 0.01 * factor)
+    return (
+        f"t: {missing} samples missing between {start:.4f} s and {end:.4f} s, inside "
+        f"the estimation window [{t_c:.3f}, {t_e:.3f}] s from the contact (at most "
+        f"{max_gap} in a row are filled in){within}"
+        + (f" (time stamps in {unit}? the format's are in s)" if unit else "")
+    )
 
 
 #: Where the sensor offset was read: "rest" (the head still before the contact), "approach"
