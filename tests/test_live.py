@@ -811,6 +811,25 @@ def test_a_repeated_or_late_time_stamp_is_left_out_and_counted() -> None:
     assert block.diagnostics["late_samples"] == 2
 
 
+def test_a_row_put_twice_is_counted_as_received_and_left_out(recordings: dict[str, Path]) -> None:
+    # a driver that hands a sample over twice (a text stream refuses the line: its stamp does
+    # not increase): its place on the grid is taken, so the estimate leaves it out
+    whole = read_recording(recordings["azimuthal"])
+    header = StreamHeader({"sample_period": "0.001"}, tuple(REQUIRED_COLUMNS), "<driver>")
+    rows = np.column_stack([whole.t, whole.theta, whole.force, whole.torque])
+    sent = np.vstack([rows[:500], rows[499:]])
+    events: list[Event] = []
+    listener = Listener(header, paper_antenna(), events.append)
+    for k in range(0, sent.shape[0], 7):
+        listener.put(sent[k : k + 7])
+    listener.close()
+    end = next(e for e in events if isinstance(e, EndEvent))
+    assert (end.samples, end.dropped, listener.late) == (whole.n_samples + 1, 0, 1)
+    found = next(e for e in events if isinstance(e, EstimateEvent))
+    assert found.estimate.diagnostics["late_samples"] == 1
+    assert found.x_c == estimate(whole, paper_antenna()).x_c
+
+
 def test_rows_that_do_not_fit_the_header_are_refused_at_put() -> None:
     header = StreamHeader({"sample_period": "0.001"}, tuple(REQUIRED_COLUMNS), "<driver>")
     listener = Listener(header, paper_antenna(), lambda event: None)

@@ -144,6 +144,9 @@ class Listener:
     ----------
     dropped : int
         Samples missing so far (time steps of k sample periods count k - 1).
+    late : int
+        Samples received whose place on the stream's grid was taken (a repeated or late time
+        stamp), left out of the estimate.
     lags : list of float
         For each block the worker took, the wall time (s) from the receipt of its first sample
         to the end of its processing (estimator, events, recording): how far the worker runs
@@ -196,6 +199,7 @@ class Listener:
         self._last: tuple[float, NDArray[np.float64]] | None = None
         self._grid: StreamGrid | None = None  # where the samples were placed (fill_missing)
         self.dropped = 0
+        self.late = 0
         self._period_checked = False
         self.lags: list[float] = []
         self._said: set[str] = set()
@@ -207,8 +211,9 @@ class Listener:
 
     @property
     def samples(self) -> int:
-        """Samples the worker has taken so far (as received: without those put back)."""
-        return self._t.size - self.dropped
+        """Samples the worker has taken so far (as received: without those put back, with
+        those left out late)."""
+        return self._t.size - self.dropped + self.late
 
     @property
     def result(self) -> ContactEstimate | None:
@@ -324,6 +329,7 @@ class Listener:
         self._received.extend(received[filled.origin])
         self._received.extend(received[filled.taken :])
         self.dropped += int(filled.filled.sum())
+        self.late += int(filled.late_at.size)
         residual_rows = np.vstack([filled.values, rows[filled.taken :]])
         theta, force, torque = (rows[:, columns] for columns in self._columns[1:])
         estimator = self._estimator
