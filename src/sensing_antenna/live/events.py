@@ -117,8 +117,10 @@ class EstimateEvent:
 
 @dataclass(frozen=True)
 class ContactLostEvent:
-    """Contact lost: from ``t`` (s) on, the contact detector's filtered residual stayed at or
-    below its threshold for the listener's quiet time."""
+    """Contact lost at about ``t`` (s): the contact detector's residual, averaged over a period
+    of the link's free mode, fell to a fifth of the push's and to its threshold
+    (:data:`~sensing_antenna.live.listener.CONTACT_LOST_SHARE`), a free period or less after
+    ``t``."""
 
     recording: int
     t: float

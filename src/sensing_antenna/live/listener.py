@@ -58,14 +58,17 @@ from sensing_antenna.recording import (
 )
 from sensing_antenna.torque_point import torques_about_base
 
-__all__ = ["CONTACT_LOST_TIME", "Listener"]
+__all__ = ["CONTACT_LOST_SHARE", "Listener"]
 
-#: Contact counts as lost once the contact detector's filtered residual has stayed at or below
-#: its threshold for this long (s): 0.1 s, at least one period of the link's vibration in
-#: contact (its fundamental lies near 10 Hz on the paper's link touched at its middle, higher
-#: nearer the base), so that the residual swinging through the threshold while the link rings
-#: does not count as a loss.
-CONTACT_LOST_TIME = 0.1
+#: Contact counts as lost once the contact detector's residual, averaged over one period of the
+#: link's free mode (the observer's natural frequency), has fallen to this share of the largest
+#: such average since t_c (the push), and to the detector's threshold. Averaged over a free
+#: period, the link's free ringing after a release (and the observer's own, which a lightly
+#: damped observer predicts for tens of seconds after the head stops) comes to nearly nothing,
+#: while a contact's static push stays, bouncing or not: the filtered residual itself swung
+#: through the threshold while the link bounced on a post, and stayed above it for tens of
+#: seconds after a release.
+CONTACT_LOST_SHARE = 0.2
 
 #: The time steps from which the stream's period is read and compared with its declared
 #: ``sample_period``.
@@ -184,8 +187,12 @@ class Listener:
         self._estimator = OnlineEstimator(antenna, ts, method, config)
         # a detector of its own, the front end's twin, for the residual after t_c (contact lost)
         self._residual = ContactDetector(antenna, ts)
-        self._quiet_samples = max(1, round(CONTACT_LOST_TIME / ts))
-        self._quiet_from: int | None = None
+        # contact lost: the residual's running sums from t_c, averaged over a free period
+        self._free_period = max(1, round(2.0 * math.pi / (antenna.observer.natural_frequency * ts)))
+        self._sums = np.zeros((4096, 3))  # cumulative residual from t_c (row 0: none yet)
+        self._summed = 1  # rows of it in use
+        self._levels = _Growing()  # the averages' norms, from t_c
+        self._push_level = 0.0
         self._columns = [
             [header.required(name) for name in names]
             for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
@@ -422,25 +429,44 @@ class Listener:
         self._emit(EstimateEvent(self.number, result, self._latency(min(at, self._t.size - 1))))
 
     def _watch_contact(self, first: int) -> None:
-        """Contact lost: a run of :data:`CONTACT_LOST_TIME` at or below the threshold after t_c."""
+        """Contact lost (:data:`CONTACT_LOST_SHARE`): at the first sample whose free period's
+        mean residual is that low, the contact was lost about where the mean began to fall, one
+        free period back plus the share of it still held (a push that vanishes at once)."""
         contact = self._estimator.contact_index
         if contact is None or "contact_lost" in self._said:
             return
         detection = self._residual.detection()
-        start = max(first, contact + 1)
-        quiet = detection.filtered_residual_norm[start : self._t.size] <= detection.threshold
-        for offset, still in enumerate(quiet.tolist()):
-            index = start + offset
-            if not still:
-                self._quiet_from = None
-                continue
-            if self._quiet_from is None:
-                self._quiet_from = index
-            if index - self._quiet_from + 1 >= self._quiet_samples:
-                self._said.add("contact_lost")
-                t_lost = float(self._t.values[self._quiet_from])
-                self._emit(ContactLostEvent(self.number, t_lost, self._latency(max(first, index))))
-                return
+        done = contact + self._summed - 1  # samples summed so far
+        new = detection.residual[done : self._t.size]
+        if new.shape[0] == 0:
+            return
+        stop = self._summed + new.shape[0]
+        if stop > self._sums.shape[0]:
+            grown = np.zeros((max(stop, 2 * self._sums.shape[0]), 3))
+            grown[: self._summed] = self._sums[: self._summed]
+            self._sums = grown
+        self._sums[self._summed : stop] = self._sums[self._summed - 1] + np.cumsum(new, axis=0)
+        self._summed = stop
+        period = self._free_period
+        ends = np.arange(done - contact + 1, stop)  # rows: samples since t_c
+        starts = np.maximum(ends - period, 0)
+        means = (self._sums[ends] - self._sums[starts]) / (ends - starts)[:, None]
+        levels = np.linalg.norm(means, axis=1)
+        self._levels.extend(levels)
+        peaks = np.maximum.accumulate(np.maximum(levels, self._push_level))
+        self._push_level = float(peaks[-1])
+        limit = np.minimum(detection.threshold, CONTACT_LOST_SHARE * peaks)
+        lost = np.flatnonzero((ends >= period) & (levels <= limit))
+        if lost.size == 0:
+            return
+        k = int(lost[0])
+        row = int(ends[k])  # the mean over the free period ending at sample contact + row - 1
+        before = float(self._levels.values[row - period - 1]) if row > period else 0.0
+        held = min(1.0, float(levels[k]) / before) if before > 0.0 else 0.0
+        index = contact + row - 1
+        t_lost = float(self._t.values[index]) - (1.0 - held) * period * self.header.sample_period
+        self._said.add("contact_lost")
+        self._emit(ContactLostEvent(self.number, t_lost, self._latency(max(first, index))))
 
     def _finish(self, reason: str) -> None:
         self._check_period(final=True)
