@@ -71,14 +71,11 @@ def calibration_band(link: Link) -> tuple[float, float]:
     T being fitted; derived from the link, so that a short or stiff link's fundamental (a
     0.35 m carbon rod rings at up to 770 rad/s) is not left out of its own calibration."""
     from sensing_antenna.estimation.config import EstimatorConfig
-    from sensing_antenna.estimation.front.evidence import sensing_curve
+    from sensing_antenna.estimation.front.evidence import search_band
 
-    low, high = EstimatorConfig().contact_range
-    bottom, top = sensing_curve(link).omega1_range(low * link.length, high * link.length)
-    return (
-        min(CALIBRATION_BAND[0], float(bottom) / CALIBRATION_BAND_MARGIN),
-        max(CALIBRATION_BAND[1], float(top) * CALIBRATION_BAND_MARGIN),
-    )
+    # the estimators' own band, its margin a factor CALIBRATION_BAND_MARGIN
+    bottom, top = search_band(link, EstimatorConfig(band_margin=CALIBRATION_BAND_MARGIN - 1.0))
+    return min(CALIBRATION_BAND[0], bottom), max(CALIBRATION_BAND[1], top)
 
 
 #: Floor of the robust loss scale, relative to the median measured frequency. With noise-free data
