@@ -536,9 +536,9 @@ class Scenario:
     def resolved(
         self,
         omega_free: float,
-        omega_contact: float = 0.0,
-        link_mass: float = 0.0,
-        sample_period: float = 1e-3,
+        omega_contact: float,
+        link_mass: float,
+        sample_period: float,
     ) -> Scenario:
         """This scenario with the default ramp times, contact stiffness and substeps made
         explicit.
