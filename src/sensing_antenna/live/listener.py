@@ -87,16 +87,16 @@ _ABORT = "abort"
 
 
 class _Growing:
-    """A 1-D float history grown by doubling."""
+    """A float history grown by doubling: values, or rows of ``width`` values."""
 
-    def __init__(self) -> None:
-        self.values = np.empty(4096)
+    def __init__(self, width: int | None = None) -> None:
+        self.values = np.empty(4096 if width is None else (4096, width))
         self.size = 0
 
     def extend(self, block: NDArray[np.float64]) -> None:
         stop = self.size + block.shape[0]
         if stop > self.values.shape[0]:
-            grown = np.empty(max(stop, 2 * self.values.shape[0]))
+            grown = np.empty((max(stop, 2 * self.values.shape[0]), *self.values.shape[1:]))
             grown[: self.size] = self.values[: self.size]
             self.values = grown
         self.values[self.size : stop] = block
@@ -189,8 +189,8 @@ class Listener:
         self._residual = ContactDetector(antenna, ts)
         # contact lost: the residual's running sums from t_c, averaged over a free period
         self._free_period = max(1, round(2.0 * math.pi / (antenna.observer.natural_frequency * ts)))
-        self._sums = np.zeros((4096, 3))  # cumulative residual from t_c (row 0: none yet)
-        self._summed = 1  # rows of it in use
+        self._sums = _Growing(3)  # cumulative residual from t_c (row 0: none yet)
+        self._sums.extend(np.zeros((1, 3)))
         self._levels = _Growing()  # the averages' norms, from t_c
         self._push_level = 0.0
         self._columns = [
@@ -436,21 +436,16 @@ class Listener:
         if contact is None or "contact_lost" in self._said:
             return
         detection = self._residual.detection()
-        done = contact + self._summed - 1  # samples summed so far
+        done = contact + self._sums.size - 1  # samples summed so far
         new = detection.residual[done : self._t.size]
         if new.shape[0] == 0:
             return
-        stop = self._summed + new.shape[0]
-        if stop > self._sums.shape[0]:
-            grown = np.zeros((max(stop, 2 * self._sums.shape[0]), 3))
-            grown[: self._summed] = self._sums[: self._summed]
-            self._sums = grown
-        self._sums[self._summed : stop] = self._sums[self._summed - 1] + np.cumsum(new, axis=0)
-        self._summed = stop
+        self._sums.extend(self._sums.values[self._sums.size - 1] + np.cumsum(new, axis=0))
+        sums = self._sums.values
         period = self._free_period
-        ends = np.arange(done - contact + 1, stop)  # rows: samples since t_c
+        ends = np.arange(done - contact + 1, self._sums.size)  # rows: samples since t_c
         starts = np.maximum(ends - period, 0)
-        means = (self._sums[ends] - self._sums[starts]) / (ends - starts)[:, None]
+        means = (sums[ends] - sums[starts]) / (ends - starts)[:, None]
         levels = np.linalg.norm(means, axis=1)
         self._levels.extend(levels)
         peaks = np.maximum.accumulate(np.maximum(levels, self._push_level))

@@ -485,7 +485,7 @@ class FrontEnd:
             where = f"after t = {before:.4f} s"
         else:
             where = "at the stream's first sample"
-        what = "not a number (NaN)" if np.isnan(values[k, 0]) or column != "t" else "infinite"
+        what = "infinite" if column == "t" and np.isinf(t[k]) else "not a number (NaN)"
         self._jump = (
             f"column '{column}': {what} {where}, a reading the device did not give; a sample's "
             "values must all be numbers, its time stamp finite"
