@@ -170,11 +170,17 @@ def test_a_recording_without_commands_is_one_clear_error(
     assert "Eq. 1:" not in capsys.readouterr().out
 
 
+def _free_motion(antenna: Antenna, folder: Path) -> Path:
+    """A simulated free motion of ``antenna`` with its motor commands, written to ``folder``."""
+    path = folder / "free.csv"
+    write_recording(simulate(antenna, Scenario(case="free"), record_commands=True), path)
+    return path
+
+
 def test_cli_writes_the_fitted_motors_and_prints_their_gains(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    path = tmp_path / "free.csv"
-    write_recording(simulate(TRUE, Scenario(case="free"), record_commands=True), path)
+    path = _free_motion(TRUE, tmp_path)
     out = tmp_path / "lab.toml"
     # the form the help gives for a pole in exponent form
     assert main(["identify", str(path), "--out", str(out), "--servo", "--servo-pole=-4e1"]) == 0
@@ -267,8 +273,7 @@ def test_cli_fits_the_motors_on_a_sweep_into_an_object_and_keeps_the_observer(
 
 
 def test_servo_pole_needs_servo(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    path = tmp_path / "free.csv"
-    write_recording(simulate(PAPER, Scenario(case="free"), record_commands=True), path)
+    path = _free_motion(PAPER, tmp_path)
     assert (
         main(["identify", str(path), "--out", str(tmp_path / "x.toml"), "--servo-pole", "-40"]) == 2
     )
@@ -294,8 +299,7 @@ def test_servo_pole_has_one_bound_and_one_message(
 def test_a_servo_pole_too_fast_for_the_recordings_period_is_refused_before_any_fit(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    path = tmp_path / "free.csv"
-    write_recording(simulate(PAPER, Scenario(case="free"), record_commands=True), path)
+    path = _free_motion(PAPER, tmp_path)
     out = tmp_path / "x.toml"
     argv = ["identify", str(path), "--out", str(out), "--servo", "--servo-pole=-3000"]
     assert main(argv) == 2
