@@ -32,7 +32,10 @@ Taring (not in the paper, standard with strain-gauge sensors): a force/torque se
 offset of a few counts that drifts between runs, and the free-motion residual must not contain it,
 or the threshold identified on one run is crossed at the first sample of another. The mean residual
 over the first ``DEFAULT_TARE_TIME`` of the recording (the head at rest, or moving as the observer
-predicts) is taken as the offset and removed; no contact is declared during that window.
+predicts) is taken as the offset and removed; no contact is declared during that window. The
+residual filter then starts at rest, at that mean: started at its first input instead, it would
+hold that one sample's unfiltered noise, about four times the filtered noise at this cut-off, and
+an identified threshold would be crossed there.
 """
 
 from __future__ import annotations
@@ -44,7 +47,6 @@ from typing import Literal, TypeAlias
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import lfilter_zi
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.compiler import njit
@@ -114,12 +116,12 @@ def block_rows(values: SampleBlock, count: int, width: int) -> NDArray[np.float6
 
 
 # Layout of the contact kernel's parameters (``par``) and state (``mem``), float64 arrays:
-# par: observer b (3), a (3); residual low-pass b (2), a (2); its lfilter_zi; signs; weight
-# moments; threshold; taring samples. mem: observer states of both joints (2 + 2); first angles
+# par: observer b (3), a (3); residual low-pass b (2), a (2); signs; weight moments; threshold;
+# taring samples. mem: observer states of both joints (2 + 2); first angles
 # (2); tare sums (3); offset (3); low-pass states (3); samples fed; contact index (-1: none).
 _OBS_B, _OBS_A, _LP_B, _LP_A = slice(0, 3), slice(3, 6), slice(6, 8), slice(8, 10)
-_ZI, _SIGN_Y, _SIGN_Z, _WEIGHT_MOMENT, _SAG_MOMENT, _THRESHOLD, _N_TARE = range(10, 17)
-_N_PAR = 17
+_SIGN_Y, _SIGN_Z, _WEIGHT_MOMENT, _SAG_MOMENT, _THRESHOLD, _N_TARE = range(10, 16)
+_N_PAR = 16
 _Z1, _Z2, _LP_Z = slice(0, 2), slice(2, 4), slice(12, 15)
 _ORIGIN, _TARE_SUM, _OFFSET, _COUNT, _INDEX = 4, 6, 9, 15, 16
 _N_MEM = 17
@@ -179,9 +181,6 @@ def _contact_block(
         for c in range(3):
             tared = r[c] - mem[_OFFSET + c]
             residual[k, c] = tared
-            if k == n_tare:
-                # the residual filter starts in steady state at its first input
-                lp_z[c] = par[_ZI] * tared
             filtered = df2t_step(par[_LP_B], par[_LP_A], lp_z[c : c + 1], tared)
             total += filtered * filtered
         norm[k] = math.sqrt(total)
@@ -285,7 +284,6 @@ class ContactDetector:
         lp_b, lp_a = low_pass_coefficients(self.residual_cutoff, self.sample_period)
         par = np.zeros(_N_PAR)
         par[_OBS_B], par[_OBS_A], par[_LP_B], par[_LP_A] = obs_b, obs_a, lp_b, lp_a
-        par[_ZI] = lfilter_zi(lp_b, lp_a)[0]
         par[_SIGN_Y], par[_SIGN_Z] = OBSERVER_TORQUE_SIGNS
         par[_WEIGHT_MOMENT] = antenna.link.weight_moment
         par[_SAG_MOMENT] = antenna.link.sag_moment
