@@ -161,6 +161,34 @@ def test_servo_lag_compensation_stops_the_joint_where_it_was_at_t1(identified: A
     assert overshoot[1] <= eps * speed / math.e + 5e-4
 
 
+@pytest.mark.parametrize("case", ["azimuthal", "vertical"])
+def test_a_retraction_turns_the_head_back_and_the_link_leaves_the_obstacle(case: str) -> None:
+    """The same manoeuvre held and retracted 0.5 s after the stop: the same samples until the
+    head turns back, then the swept joint comes to rest 0.1 rad back and the link is free."""
+    held_scenario = Scenario(case=case, contact_point=0.55, duration=3.0, seed=1)
+    held = simulate_detailed(paper_antenna(), held_scenario)
+    back = simulate_detailed(
+        paper_antenna(), dataclasses.replace(held_scenario, retract_after=0.5, retract_angle=0.1)
+    )
+    assert held.stop_index == back.stop_index is not None
+    turn = held.stop_index + 500  # samples of 1 ms
+    assert np.array_equal(held.recording.torque[: turn + 1], back.recording.torque[: turn + 1])
+    joint = 1 if case == "vertical" else 0
+    # the ramp (0.59 s) and 0.33 s at speed end 0.92 s after the turn; the servo settles within
+    # 0.1 s (eps = 17 ms): 1 mrad for the encoder and what the link's ringing still moves
+    turned = held.true_theta[-1, joint] - back.true_theta[-1, joint]
+    assert turned == pytest.approx(0.1, abs=1e-3)
+    in_contact = back.recording.extra["true_in_contact"] > 0.5
+    assert held.recording.extra["true_in_contact"][-1] > 0.5 and not in_contact[-1]
+    released = int(np.flatnonzero(in_contact)[-1])
+    assert turn < released < turn + 920
+    assert back.recording.metadata["true_in_contact_at_end"] == "false"
+    with pytest.raises(ScenarioError, match=r"retract_after: the free case never stops"):
+        Scenario(case="free", retract_after=1.0)
+    with pytest.raises(ScenarioError, match=r"retract_angle: must be > 0"):
+        dataclasses.replace(held_scenario, retract_angle=0.0)
+
+
 def test_deep_push_is_flagged_and_tiny_contact_points_are_rejected() -> None:
     ok = Recording(
         t=np.arange(3) * 1e-3,

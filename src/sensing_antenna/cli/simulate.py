@@ -91,6 +91,14 @@ def register(subparsers: Any) -> None:
         "of the push criterion's default 0.03 rad: deeper pushes bend the link more",
     )
     parser.add_argument(
+        "--retract-after",
+        type=number(0.0, unit="s"),
+        default=None,
+        metavar="S",
+        help="turn the head back along the sweep by 0.1 rad this long after the stop, so the "
+        "link leaves the obstacle (Scenario.retract_after); default: hold to the end",
+    )
+    parser.add_argument(
         "--link",
         choices=("linear", "nonlinear"),
         default="linear",
@@ -134,6 +142,7 @@ def _run(args: argparse.Namespace) -> int:
         link_model=args.link,
         push=push,
         sweep_direction=1 if args.direction == "up" else -1,
+        retract_after=args.retract_after,
     )
     recording = simulate(antenna, scenario, record_commands=args.commands)
     write_recording(recording, args.out)

@@ -535,6 +535,16 @@ def simulate_detailed(
                     speed = (reference[k, sweep_joint] - reference[k - 1, sweep_joint]) / ts
                     hold -= 2.0 * servo[sweep_joint].time_constant * speed
                 reference[k + 1 :, sweep_joint] = hold
+                if scenario.retract_after is not None:
+                    back = t[k + 1 :] - (t[k] + scenario.retract_after)
+                    reference[k + 1 :, sweep_joint] -= sweep_reference(
+                        back,
+                        0.0,
+                        speed,
+                        scenario.accel_time,
+                        0.0,
+                        scenario.retract_angle / scenario.sweep_speed,
+                    )
                 break
             if progress is not None and k % 500 == 0:
                 progress(k / n_samples)

@@ -129,6 +129,8 @@ _UPPER_LIMITS: dict[str, tuple[float, str, str]] = {
     "accel_time": (MAX_DURATION, "s", "no phase of a manoeuvre outlasts the longest one"),
     "start_time": (MAX_DURATION, "s", "no phase of a manoeuvre outlasts the longest one"),
     "approach_time": (MAX_DURATION, "s", "no phase of a manoeuvre outlasts the longest one"),
+    "retract_after": (MAX_DURATION, "s", "no phase of a manoeuvre outlasts the longest one"),
+    "retract_angle": (math.pi, "rad", "half a turn back along the sweep"),
 }
 
 
@@ -297,6 +299,14 @@ class Scenario:
         At the stop (t_1) freeze the reference at r(t_1) - 2 eps omega*(t_1) instead of r(t_1),
         so that the joint comes to rest where it was at t_1 instead of 2 eps omega* further
         (the ramp lag of Eq. 14); see ``docs/simulator.md``, "The push criterion".
+    retract_after : float or None
+        Time after the stop (s) at which the swept joint turns back along the sweep by
+        ``retract_angle``, on the sweep's raised-cosine ramp at its speed, and holds there: the
+        link leaves the obstacle and rings free. None: the head holds to the end. Only for a
+        manoeuvre that stops at a contact (not the free cases).
+    retract_angle : float
+        How far the retraction turns the swept joint back (rad, > 0); it must exceed the push
+        past the touch for the link to leave the obstacle.
     n_elements : int
         Finite elements of the link.
     link_model : {"linear", "nonlinear"}
@@ -345,6 +355,8 @@ class Scenario:
     approach_time: float | None = None
     servo_pole: float = DEFAULT_SERVO_POLE
     compensate_servo_lag: bool = True
+    retract_after: float | None = None
+    retract_angle: float = 0.1
     n_elements: int = 16
     substeps: int | None = None
     link_model: Literal["linear", "nonlinear"] = "linear"
@@ -432,6 +444,13 @@ class Scenario:
             )
         if self.approach_time is not None:
             _finite("approach_time", self.approach_time, self.accel_time or 0.0)
+        if self.retract_after is not None:
+            _finite("retract_after", self.retract_after, 0.0)
+            if self.case in FREE_CASES:
+                raise ScenarioError(
+                    "retract_after", f"the {self.case} case never stops at a contact to retract"
+                )
+        _finite("retract_angle", self.retract_angle, 0.0, strict=True)
         for name, (high, unit, reason) in _UPPER_LIMITS.items():
             value = getattr(self, name)
             if value is not None and value > high:
