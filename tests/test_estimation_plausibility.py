@@ -729,15 +729,16 @@ def test_angles_in_degrees_are_named_even_when_the_recording_ends_before_the_pus
 ) -> None:
     # The elevation in degrees starts the sweep at -6.2 "rad"; with an observer of low
     # threshold and gain (as an identification on another device may give) the detector fires
-    # at once and the free motion's torque does not look 57 times too small. The recording ends
-    # 0.1 s later, before any push: the answer blames the degrees, not the missing push.
+    # within 50 ms of the turn's start (0.1 s) and the free motion's torque does not look 57
+    # times too small. The recording ends 0.1 s later, before any push: the answer blames the
+    # degrees, not the missing push.
     observer = dataclasses.replace(
         antenna.observer, contact_threshold=1e-4, gain=0.4 * antenna.observer.gain
     )
     model = dataclasses.replace(antenna, observer=observer)
     degrees = scaled(vertical, angle=DEGREES)
     t_c = estimate(degrees, model).t_c
-    assert t_c is not None and t_c < 0.1
+    assert t_c is not None and t_c < 0.15
     cut = samples_kept(degrees, degrees.t <= t_c + 0.1)
     for name, result in all_methods(cut, model).items():
         assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
