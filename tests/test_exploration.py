@@ -900,15 +900,22 @@ def test_another_device_in_the_same_directory_is_refused(
         ExploreSettings(device_build=5)
 
 
-def test_a_realistic_devices_posts_reach_its_own_tip() -> None:
+def test_a_devices_posts_reach_its_own_tip() -> None:
     # the campaigns' points short of the link's tip, then the tip: 15 on the paper's 0.98 m
-    from sensing_antenna.exploration.run import realistic_calibration_points
+    from sensing_antenna.exploration.run import calibration_points, realistic_calibration_points
 
     assert realistic_calibration_points(0.98) == (
         0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80, 0.85, 0.90, 0.95, 0.98
     )  # fmt: skip
-    assert realistic_calibration_points(0.5) == (0.30, 0.35, 0.40, 0.45, 0.5)
+    # a shorter link's at the same shares of its length, as many
+    assert realistic_calibration_points(0.49) == (
+        0.15, 0.175, 0.2, 0.225, 0.25, 0.275, 0.3, 0.325, 0.35, 0.375, 0.4, 0.425, 0.45, 0.475,
+        0.49,
+    )  # fmt: skip
     assert realistic_calibration_points(1.2)[-2:] == (0.98, 1.2)
+    assert calibration_points(0.98) == (0.3, 0.45, 0.6, 0.75, 0.9)
+    assert calibration_points(0.49) == (0.15, 0.225, 0.3, 0.375, 0.45)
+    assert calibration_points(2.0) == calibration_points(0.98)
 
 
 def test_a_stored_point_keeps_whether_its_width_alone_held_it_back() -> None:

@@ -121,6 +121,7 @@ __all__ = [
     "Exploration",
     "ExplorationInterrupted",
     "ExploreSettings",
+    "calibration_points",
     "explore",
     "prepare_device",
     "realistic_calibration_points",
@@ -131,8 +132,12 @@ __all__ = [
 #: name as theirs.
 CALIBRATED_NAME = "explore-calibrated"
 
-#: Where the calibration's posts are touched (m): the README's five points.
+#: Where the calibration's posts are touched on the paper's 0.98 m link (m): the README's five
+#: points; a shorter link's are these scaled to its length (:func:`calibration_points`).
 CALIBRATION_POINTS = (0.3, 0.45, 0.6, 0.75, 0.9)
+
+#: The link length the calibration's points are stated for (m): the paper's.
+POINTS_LENGTH = 0.98
 
 #: The calibration manoeuvres' seeds start here (the README's).
 CALIBRATION_SEED = 10
@@ -269,12 +274,26 @@ class ExploreSettings:
         return device_profile(self.device_profile, seed, length, self.build)
 
 
+def _scaled(points: tuple[float, ...], length: float) -> tuple[float, ...]:
+    """``points`` (m, stated for the paper's link) on a link of ``length`` (m): the same share of
+    a shorter link, the same points on a longer one."""
+    scale = min(1.0, length / POINTS_LENGTH)
+    return tuple(round(x * scale, 4) for x in points)
+
+
+def calibration_points(length: float) -> tuple[float, ...]:
+    """A nominal device's calibration posts (m) on a link of ``length`` (m):
+    :data:`CALIBRATION_POINTS`, scaled to a link shorter than the paper's."""
+    return _scaled(CALIBRATION_POINTS, length)
+
+
 def realistic_calibration_points(length: float) -> tuple[float, ...]:
     """A realistic device's calibration posts (m) on a link of ``length`` (m), each swept both
     ways (azimuthal and vertical) for T_e with the tip mass and the sensor's cross-talk: the
-    campaigns' points (``campaign.schema.DEFAULT_CALIBRATION_POINTS``) short of the tip, then
-    the tip."""
-    return (*(x for x in DEFAULT_CALIBRATION_POINTS if x < length), length)
+    campaigns' points (``campaign.schema.DEFAULT_CALIBRATION_POINTS``, scaled to a link shorter
+    than the paper's) short of the tip, then the tip."""
+    points = _scaled(DEFAULT_CALIBRATION_POINTS, length)
+    return (*(x for x in points if x < length - 1e-9), length)
 
 
 class ExplorationInterrupted(KeyboardInterrupt):
@@ -369,7 +388,7 @@ def prepare_device(
     """The preparation of the simulated ``device`` (module docstring), with the simulator's
     ``link`` model: the observer and contact threshold identified on :data:`FREE_MOTION_CASES`
     (seeds from :data:`FREE_MOTION_SEED`), then T_e calibrated on smooth posts
-    (:data:`CALIBRATION_FRICTION`) at :data:`CALIBRATION_POINTS` (seeds from
+    (:data:`CALIBRATION_FRICTION`) at :func:`calibration_points` (seeds from
     :data:`CALIBRATION_SEED`) touched by the device with that observer; every recording is
     written into ``folder`` when given.
 
@@ -426,7 +445,7 @@ def prepare_device(
         free.append(simulate(device, scenario))
     model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
     controlled = knowing_weight(device, model)
-    at = realistic_calibration_points(length) if realistic else CALIBRATION_POINTS
+    at = realistic_calibration_points(length) if realistic else calibration_points(length)
     posts: list[tuple[Literal["azimuthal", "vertical"], float]] = [(AZIMUTHAL, x) for x in at]
     if realistic:
         posts += [(VERTICAL, x) for x in at]
