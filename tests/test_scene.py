@@ -589,6 +589,18 @@ def test_unknown_scene_names_the_builtins() -> None:
         load_scene("nowhere-scene.toml")
 
 
+def test_a_directory_named_like_a_builtin_scene_does_not_hide_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # `antenna explore box --out box` run again: the output directory is not the scene
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "box").mkdir()
+    assert "built-in scene box" in load_scene("box").source
+    with pytest.raises(SceneError, match=r"out: file: a directory, not a scene file"):
+        (tmp_path / "out").mkdir()
+        load_scene("out")
+
+
 def test_outcomes_the_simulator_cannot_represent_are_named() -> None:
     shape = LinkShape(DEVICE.link)
     sweep = Sweep(0, "azimuthal", 0.0, -0.3, 0.3)

@@ -166,7 +166,8 @@ class Scene:
 
 
 def load_scene(name_or_path: str | Path) -> Scene:
-    """A built-in scene (:data:`BUILTIN_SCENES`) by name, or a scene file.
+    """A built-in scene (:data:`BUILTIN_SCENES`) by name, or a scene file (a file of that name
+    comes first; a directory of that name, such as an exploration's output, does not).
 
     Raises
     ------
@@ -174,7 +175,7 @@ def load_scene(name_or_path: str | Path) -> Scene:
         One line naming the file, the field and the problem.
     """
     text = str(name_or_path)
-    if text in BUILTIN_SCENES and not Path(text).exists():
+    if text in BUILTIN_SCENES and not Path(text).is_file():
         source = f"built-in scene {text}"
         data_text = (
             resources.files("sensing_antenna")
@@ -186,7 +187,8 @@ def load_scene(name_or_path: str | Path) -> Scene:
     path = Path(name_or_path)
     if not path.is_file():
         known = ", ".join(BUILTIN_SCENES)
-        raise SceneError("file", f"no such file (built-in scenes: {known})", str(path))
+        what = "a directory, not a scene file" if path.is_dir() else "no such file"
+        raise SceneError("file", f"{what} (built-in scenes: {known})", str(path))
     data = parse_toml_file(path, lambda f, p: SceneError(f, p, str(path)))
     return _build(data, str(path), path.parent)
 
