@@ -709,7 +709,12 @@ def free_motion_gain(
     Z^m, each less its mean): about 1 in free motion, more when the touch builds up torque
     before t_c, 1/57 with angles in degrees (the observer then predicts 57 times the torque).
     Only a gain below 1 / ``free_motion_gain_factor`` is a problem: the contact's torque before
-    t_c can only raise it, and torques too large are the rest reading's to find.
+    t_c can only raise it, and torques too large are the rest reading's to find. The sensor's
+    noise raises it too, where the predicted torque is not far above it (a contact detected
+    early in the turn: a tight threshold crossed by degrees' prediction itself). So a gain
+    below 1 is also judged by the measured torque projected on the predicted one, sum(m p) /
+    sum(p^2), which the noise does not bias: three of its standard errors (the noise over the
+    predicted torque's norm) above it must still lie below 1 / ``free_motion_gain_factor``.
 
     Parameters
     ----------
@@ -738,6 +743,10 @@ def free_motion_gain(
         return math.nan, None
     gain = measured_rms / predicted_rms
     factor = cfg.free_motion_gain_factor
+    if math.isfinite(gain) and 1.0 / factor <= gain < 1.0:
+        projected, error = _projected_gain(theta, torque, predicted_torque, antenna)
+        if projected + 3.0 * error < 1.0 / factor:
+            gain = projected
     if not math.isfinite(gain) or gain >= 1.0 / factor:
         return gain, None
     return gain, (
@@ -752,6 +761,23 @@ def free_motion_gain(
             "for half a second)?"
         )
     )
+
+
+def _projected_gain(
+    theta: FloatArray, torque: FloatArray, predicted_torque: FloatArray, antenna: Antenna
+) -> tuple[float, float]:
+    """The measured dynamic torque about Y^m and Z^m projected on the predicted one, each less
+    its mean, and its standard error from the measured torque's white noise
+    (:func:`~.contact_frame.signal_noise`); NaN without a prediction."""
+    predicted = _weightless_moment(theta, predicted_torque, antenna)
+    measured = _weightless_moment(theta, torque, antenna)
+    with np.errstate(over="ignore", invalid="ignore"):
+        p = predicted - predicted.mean(axis=0)
+        m = measured - measured.mean(axis=0)
+        norm = float(np.sum(p * p))
+        if not (math.isfinite(norm) and norm > 0.0):
+            return math.nan, math.nan
+        return float(np.sum(m * p)) / norm, signal_noise(measured)[0] / math.sqrt(norm)
 
 
 def _dynamic_rms(
