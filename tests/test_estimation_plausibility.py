@@ -31,7 +31,11 @@ from sensing_antenna.estimation import (
     estimate,
     gather,
 )
-from sensing_antenna.estimation.front.steps import settled_loads, still_angles_turn
+from sensing_antenna.estimation.front.steps import (
+    free_motion_gain,
+    settled_loads,
+    still_angles_turn,
+)
 from sensing_antenna.recording import Recording, read_recording, write_recording
 from sensing_antenna.simulator import DeviceImperfections, Scenario, simulate
 
@@ -974,6 +978,55 @@ def test_angles_in_degrees_are_caught_with_an_identified_observer() -> None:
     result = estimate(recording, other, "paper")
     assert result.status is Status.IMPLAUSIBLE_INPUT, result.reason
     assert "observer is not this device's" in (result.reason or "")
+
+
+def test_degrees_prediction_is_told_from_noise_over_a_short_free_motion() -> None:
+    # Half a second at rest, then 25 ms of a turn's start (torque growing as t^3) before a tight
+    # threshold fires: the prediction p reaches 0.5 mN m, the sensor's noise is 30 uN m. With
+    # the angles in degrees the measured torque is p / 57 plus noise, whose root mean square
+    # over the 525 samples is about a fifth of p's: the ratio of root mean squares cannot tell
+    # it from a free motion, the projection (noise 0.03 of it here) can
+    antenna = paper_antenna()
+    rng = np.random.default_rng(3)
+    n, turn = 525, 25
+    p = np.zeros(n)
+    p[-turn:] = 5e-4 * (np.arange(1, turn + 1) / turn) ** 3
+    theta = np.zeros((n, 2))
+    gravity = antenna.gravity_torque(theta[:, 1])
+    predicted = gravity.copy()
+    predicted[:, 2] += p
+
+    def gain(measured: np.ndarray) -> tuple[float, str | None]:
+        torque = gravity + 0.0
+        torque[:, 1:] += 3e-5 * rng.standard_normal((n, 2))
+        torque[:, 2] += measured
+        return free_motion_gain(theta, torque, predicted, antenna, EstimatorConfig())
+
+    value, problem = gain(p / DEGREES)
+    assert problem is not None and "degrees give 1/57" in problem
+    assert value == pytest.approx(1.0 / DEGREES, abs=3 * 0.03)
+    assert gain(p)[1] is None
+    # a prediction buried in the noise cannot be judged either way
+    p[-turn:] *= 0.05
+    predicted[:, 2] = gravity[:, 2] + p
+    assert gain(p / DEGREES)[1] is None
+
+
+@pytest.mark.parametrize("case", ["azimuthal", "vertical"])
+def test_a_head_turned_back_before_t_e_did_not_hold(case: str) -> None:
+    # The head turns back 0.8 s after the stop, 0.2 s before the paper method's t_e: 6 mrad of
+    # the sweep's ramp by then, a fifth of the 0.03 rad it turned past the touch. Held, the
+    # answer at 0.95 m is 0.1 mm off; turned back, it read 5 mm (azimuthal) and 11 mm
+    # (vertical) short, the vertical one said ok. Held, no method is told the head did not hold
+    scenario = Scenario(case=case, contact_point=0.95, duration=3.0, seed=2)
+    held = simulate(paper_antenna(), scenario).without_ground_truth()
+    back = simulate(paper_antenna(), dataclasses.replace(scenario, retract_after=0.8))
+    for name, result in all_methods(held, calibrated()).items():
+        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]  # type: ignore[attr-defined]
+        assert not any("hold the head still" in text for text in reasons), name
+    result = estimate(back.without_ground_truth(), calibrated(), "paper")
+    assert result.status is Status.RECORDING_TOO_SHORT, result.reason
+    assert "hold the head still from t_1 to t_e" in (result.reason or "")
 
 
 def test_torques_a_hundred_times_too_large_are_implausible_not_a_payload(
