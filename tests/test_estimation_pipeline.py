@@ -325,6 +325,31 @@ def test_no_contact() -> None:
     assert isinstance(early, EarlyOutcome)
     assert early.status is Status.NO_CONTACT
     assert early.reason == result.reason
+    assert "push deeper" not in (result.reason or "")
+
+
+def test_a_push_under_the_threshold_is_named_in_no_contact() -> None:
+    # Stopped 0.03 rad past the touch at 0.9 m, the link's moment at the base is about
+    # 3 E I 0.03 / x_c = 0.009 N m, under the datasheet's 0.02: no contact, but the residual
+    # holds that moment to the end where a free sweep's dies out
+
+    class PastTheTouch:
+        """Stop 0.03 rad past theta1 = 0, where the simulator's sweep meets the post."""
+
+        def reset(self) -> None:
+            pass
+
+        def update(self, t: float, theta: np.ndarray, force: object, torque: object) -> bool:
+            return bool(theta[0] >= 0.03)
+
+    antenna = paper_antenna()
+    scenario = Scenario(case="azimuthal", contact_point=0.9, duration=2.5, seed=1)
+    recording = simulate(antenna, scenario, stop_rule=PastTheTouch())
+    assert recording.metadata["true_in_contact_at_end"] == "true"
+    recording = recording.without_ground_truth()
+    result = estimate(recording, antenna)
+    assert result.status is Status.NO_CONTACT
+    assert "push deeper, or give the antenna the device's own threshold" in (result.reason or "")
 
 
 @pytest.mark.parametrize("count", [2, 50, 300])

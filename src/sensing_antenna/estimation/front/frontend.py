@@ -99,6 +99,37 @@ _BUFFERS = ("_t", "_theta", "_force", "_torque", "_reaction", "_moment", "_ratio
 _FILL_AHEAD = 128
 
 
+#: The last stretch of a recording without a contact (s) whose mean residual about the turned
+#: joint's axis, resisting the turn by more than :data:`HELD_UNDER_SHARE` of the threshold, says
+#: a push the threshold missed: a free motion's residual dies out once the head rests and its
+#: noise averages out, a push's static moment stays (the link's ringing on it averages out too),
+#: and a sensor's drift since the tare takes any direction.
+HELD_UNDER_TIME = 0.5
+HELD_UNDER_SHARE = 0.4
+
+
+def _held_under(detector: ContactDetector, theta: FloatArray, last: int) -> str:
+    """What a recording without a contact owes to a push under the detector's threshold: its
+    mean residual over the ``last`` samples about the axis of the joint that turned most
+    (``theta``, shape (n, 2), rad), "" unless it resists that turn by more than
+    :data:`HELD_UNDER_SHARE` of the threshold."""
+    residual = detector.detection().residual
+    if residual.shape[0] < 2 * last or last < 1 or theta.shape[0] != residual.shape[0]:
+        return ""
+    turn = theta[-1] - theta[0]
+    joint = int(np.argmax(np.abs(turn)))
+    mean = np.mean(residual[-last:], axis=0)
+    # the azimuth turns about Z^m, the elevation about Y^m; a push resists the turn
+    held = -mean[2] * np.sign(turn[0]) if joint == 0 else mean[1] * np.sign(turn[1])
+    if not held > HELD_UNDER_SHARE * detector.threshold:
+        return ""
+    return (
+        f"; but over its last {HELD_UNDER_TIME:g} s it holds {held:.3g} N m against the head's"
+        " turn, as a push gentler than the threshold does: push deeper, or give the antenna the"
+        " device's own threshold (antenna identify on a free sweep)"
+    )
+
+
 def one_sample(
     t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
@@ -838,6 +869,8 @@ class FrontEnd:
             assert self._detector is not None
             status = Status.NO_CONTACT
             reason = f"filtered residual stays at or below {self._detector.threshold:g} N m"
+            last = samples(HELD_UNDER_TIME, self.sample_period)
+            reason += _held_under(self._detector, self._theta[:n], last)
             shortest = 2.0 * self.config.rest_window + self.config.frame_window
             if n - 1 < samples(shortest, self.sample_period):
                 # too few samples to hold a contact the front end could use: not a free sweep
