@@ -123,6 +123,20 @@ def test_a_simulated_sweep_is_free_until_before_its_contact(case: str, x_c: floa
     assert recording.t[touching[-1]] >= true_contact
 
 
+def test_a_recording_not_in_the_formats_units_says_nothing_of_free_space() -> None:
+    # angles in degrees: its estimate is implausible_input, and the link its angles draw (57
+    # times the turn) is nowhere the link was; neither a free part nor a touch enters the map
+    antenna = paper_antenna()
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.5, duration=2.0))
+    degrees = dataclasses.replace(recording, theta=np.degrees(recording.theta))
+    result = estimate(degrees.without_ground_truth(), antenna)
+    assert result.status is Status.IMPLAUSIBLE_INPUT, result.reason
+    (_, free), touch = recording_links(
+        degrees, antenna, contact_point_from_estimate(result, antenna)
+    )
+    assert len(np.asarray(free)) == 0 and touch is None
+
+
 def test_the_touching_link_presses_the_object_on_an_identified_head() -> None:
     # the head as a lab prepares it: its observer identified on free sweeps, which leaves the
     # residual of a vertical sweep near the onset's level for a while before a contact, so the
