@@ -390,11 +390,11 @@ def test_the_device_is_identified_before_it_explores(
     prepared = load_antenna(out / "calibrated.toml")
     assert prepared.link.calibrated_t is not None
     assert prepared.observer.contact_threshold < 0.1 * DEVICE.observer.contact_threshold
-    bends = [
-        float(read_recording(out / m.recording).metadata["true_deflection_ratio"])
-        for m in manoeuvres
-        if m.recording is not None
-    ]
+    # named after the device, as its recordings name it: another antenna's are told apart
+    assert prepared.name == f"explore-calibrated-{DEVICE.name}"
+    recordings = [read_recording(out / m.recording) for m in manoeuvres if m.recording is not None]
+    assert all(r.metadata["antenna"] == prepared.name for r in recordings)
+    bends = [float(r.metadata["true_deflection_ratio"]) for r in recordings]
     assert bends and all(0.02 < bend < 0.045 for bend in bends), bends
 
 

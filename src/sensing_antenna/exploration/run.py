@@ -129,7 +129,8 @@ __all__ = [
 ]
 
 #: The name of the antenna the estimators use (``calibrated.toml``), which the recordings
-#: name as theirs.
+#: name as theirs, followed by ``-`` and the simulated device's name (so that ``antenna map``
+#: tells one antenna's recordings from another's); alone in a directory prepared before.
 CALIBRATED_NAME = "explore-calibrated"
 
 #: Where the calibration's posts are touched on the paper's 0.98 m link (m): the README's five
@@ -506,8 +507,12 @@ def _device_settings(settings: ExploreSettings) -> dict[str, Any]:
 def _prepared(device: Antenna, out: Path, settings: ExploreSettings) -> Antenna:
     path = out / CALIBRATED_FILE
     if path.is_file():
-        # a directory prepared before the model had its own name: its recordings name it too
-        return replace(load_antenna(path), name=CALIBRATED_NAME)
+        stored = load_antenna(path)
+        if stored.name.startswith(f"{CALIBRATED_NAME}-"):
+            return stored
+        # a directory prepared before the model had its device's name in its own, or any name
+        # of its own: its recordings name it so
+        return replace(stored, name=CALIBRATED_NAME)
     prepared = prepare_device(
         device,
         out / "calibration",
@@ -517,7 +522,7 @@ def _prepared(device: Antenna, out: Path, settings: ExploreSettings) -> Antenna:
     )
     prepared = replace(
         prepared,
-        name=CALIBRATED_NAME,
+        name=f"{CALIBRATED_NAME}-{device.name}",
         description=(
             f"{device.name} as the exploration's preparation identified and calibrated it on"
             " the simulated device (its recordings in calibration/ beside this file)"
