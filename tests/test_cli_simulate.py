@@ -96,6 +96,33 @@ def test_simulate_warns_when_the_stop_leaves_no_spectrum_window(
     assert "recording_too_short" not in capsys.readouterr().out
 
 
+def test_a_link_too_stiff_for_the_simulators_samples_is_said_and_not_explored(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a 0.2 m steel rod of 3 mm rings at up to 1,200 rad/s: the estimators need samples at
+    # 1.5 kHz, the simulator writes 1 kHz. The recording is written, with one line saying so;
+    # an exploration, which would estimate nothing, stops before it starts
+    steel = tmp_path / "steel.toml"
+    steel.write_text(
+        'name = "steel-20"\nbase = "paper-2021"\n[link]\nlength = 0.2\nradius = 1.5e-3\n'
+        "youngs_modulus = 200e9\nlinear_density = 0.0555\n"
+    )
+    argv = ["simulate", "--case", "azimuthal", "--xc", "0.15", "--antenna", str(steel)]
+    assert main([*argv, "--duration", "1.5", "--out", str(tmp_path / "s.csv")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert any(line.startswith("warning: the simulator records every 0.001 s") for line in err)
+    assert any("needs samples at 1527 Hz or faster" in line for line in err)
+    capsys.readouterr()
+    assert main(["explore", "sphere", "--antenna", str(steel), "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("antenna explore: error: steel-20: link: the simulator records")
+    assert (
+        main(["simulate", "--case", "azimuthal", "--xc", "0.5", "--out", str(tmp_path / "p.csv")])
+        == 0
+    )
+    assert "simulator records" not in capsys.readouterr().err
+
+
 def test_simulate_says_when_the_push_is_not_reached(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -121,7 +121,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.detection.push import PushConfigError, PushCriterion
     from sensing_antenna.recording import write_recording
     from sensing_antenna.simulator import Scenario, simulate
-    from sensing_antenna.simulator.run import deflection_warning
+    from sensing_antenna.simulator.run import deflection_warning, sampling_warning
 
     antenna = load_antenna(args.antenna)
     _check_contact_point(args.case, args.xc, antenna.link)
@@ -147,6 +147,9 @@ def _run(args: argparse.Namespace) -> int:
     recording = simulate(antenna, scenario, record_commands=args.commands)
     write_recording(recording, args.out)
     print(summary(str(args.out), scenario, recording.n_samples, recording.metadata))
+    coarse = sampling_warning(antenna)
+    if coarse is not None:
+        print(f"warning: {coarse}", file=sys.stderr)
     short = window_warning(scenario, recording.metadata)
     if short is not None:
         print(short, file=sys.stderr)

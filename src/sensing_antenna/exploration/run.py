@@ -53,7 +53,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from sensing_antenna.antenna import Antenna, antenna_to_toml, load_antenna
+from sensing_antenna.antenna import Antenna, AntennaConfigError, antenna_to_toml, load_antenna
 from sensing_antenna.campaign.runs import CALIBRATION_STREAM, FREE_MOTION_STREAM, derive_seed
 from sensing_antenna.campaign.schema import DEFAULT_CALIBRATION_POINTS
 from sensing_antenna.campaign.simulated import knowing_weight
@@ -630,7 +630,14 @@ def explore(
         On Ctrl-C or a stop signal, with every finished manoeuvre stored.
     ExplorationStoreError
         ``out`` holds another exploration or is in use.
+    AntennaConfigError
+        ``device``'s link rings faster than the simulator's samples resolve.
     """
+    from sensing_antenna.simulator.run import sampling_warning
+
+    coarse = sampling_warning(device)
+    if coarse is not None:
+        raise AntennaConfigError("link", coarse, device.name)
     settings = settings if settings is not None else ExploreSettings()
     recorded: dict[int, RecordedLinks] = {}  # each stored recording's links, read once
     grid = grid_sweeps(scene)

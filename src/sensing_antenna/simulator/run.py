@@ -57,6 +57,7 @@ __all__ = [
     "deflection_warning",
     "device_link",
     "minimum_contact_point",
+    "sampling_warning",
     "simulate",
     "simulate_detailed",
 ]
@@ -225,6 +226,24 @@ def _contact_deflection(
     sag = gravity * c2 * np.interp(truth[:, 3], grid, unit)
     deflection = np.hypot(v, w - sag)
     return np.where(truth[:, 2] > 0.5, deflection, np.nan)
+
+
+def sampling_warning(antenna: Antenna) -> str | None:
+    """A one-line warning when the estimators cannot read ``antenna``'s link from the samples
+    the simulator writes (every :data:`SAMPLE_PERIOD`): its contact frequencies reach beyond
+    what that period resolves (a short, stiff link), else None."""
+    from sensing_antenna.estimation.config import EstimatorConfig
+    from sensing_antenna.estimation.front.evidence import search_band
+    from sensing_antenna.estimation.front.steps import sampling_problem
+
+    config = EstimatorConfig()
+    problem = sampling_problem(SAMPLE_PERIOD, search_band(antenna.link, config)[1], config)
+    if problem is None:
+        return None
+    return (
+        f"the simulator records every {SAMPLE_PERIOD:g} s, too coarse for this antenna's link:"
+        f" {problem.split(': ', 1)[-1]}, so no estimator reads its recordings"
+    )
 
 
 def deflection_warning(recording: Recording) -> str | None:
