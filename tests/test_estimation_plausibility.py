@@ -910,6 +910,24 @@ def test_an_unmodelled_tip_mass_is_named_by_the_vibration_methods() -> None:
         assert result.diagnostics.get("payload_spread", 0.0) < 0.003  # absent: read lighter
 
 
+def test_torques_about_a_point_behind_the_clamp_read_as_a_payload_name_that_point() -> None:
+    # The sensor's origin 2.5 cm behind the clamp, not stated: at rest the weight W reads
+    # 0.025 W more moment, as 0.12 g at the tip would; with a third of the simulated sensor's
+    # noise (whose force noise the offset also moves into the moment) that is a payload. The
+    # reason gives both readings, the point within the millimetre the line prints plus what the
+    # tare's offset moves
+    scenario = Scenario(case="azimuthal", contact_point=0.35, seed=3, noise_scale=0.3)
+    simulated = simulate(paper_antenna(), scenario)
+    point = np.array([-0.025, 0.0, 0.0])
+    behind = dataclasses.replace(
+        simulated, torque=simulated.torque - np.cross(point, simulated.force)
+    ).without_ground_truth()
+    result = estimate(behind, calibrated(), "paper")
+    assert result.status is Status.MODEL_MISMATCH, result.reason
+    named = float((result.reason or "").split("'# torque_point: [")[1].split(",")[0])
+    assert named == pytest.approx(-0.025, abs=0.002)
+
+
 @pytest.mark.parametrize("case", ["azimuthal", "vertical"])
 def test_a_payload_too_light_for_a_mismatch_widens_the_fast_interval(case: str) -> None:
     # 0.05 g of glue at 0.55 m: the weight at rest reads it (3.8e-4 N m against a tare's

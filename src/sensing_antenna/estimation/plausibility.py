@@ -75,7 +75,7 @@ from typing import Any
 
 import numpy as np
 
-from sensing_antenna.antenna import Link
+from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.beam import SensingCurve, free_plane_shift, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
@@ -482,7 +482,21 @@ def _payload_problem(
         f"offset a tare leaves is a few sensor counts): {1e3 * mass:.2g} g at the tip that the "
         f"antenna file does not carry would move the contact point the vibration gives by "
         f"{100 * spread:.1f} cm, more than {100 * limit:g} cm; give the payload in "
-        "link.tip_mass, or tare the sensor"
+        f"link.tip_mass, or tare the sensor{_behind_the_clamp(link, excess)}"
+    )
+
+
+def _behind_the_clamp(link: Link, excess: float) -> str:
+    """The other reading of a moment ``excess`` (N m) at rest beyond the link's weight: torques
+    about a point s behind the clamp, where the weight W reads s W more (Gamma_S = Gamma_O -
+    (S - O) x F), when s is within a sensor's origin's reach; "" otherwise."""
+    behind = excess / ((link.mass + link.tip_mass) * STANDARD_GRAVITY)
+    if not 0.0 < behind <= _SENSOR_ORIGIN_REACH:
+        return ""
+    return (
+        f"; or, the same moment, torques taken about a point {100 * behind:.1f} cm behind the"
+        f" clamp that the recording does not state ('# torque_point: [{-behind:.3f}, 0, 0]',"
+        " docs/recording-format.md)"
     )
 
 
