@@ -504,9 +504,17 @@ def test_a_scene_out_of_the_link_s_reach_is_warned_of(
     captured = capsys.readouterr()
     assert (
         "antenna explore: warning: no object lies within the link's reach (0.98 m) of a base"
-        " (the nearest 1.95 m away): every sweep will be free" in captured.err
+        " (the nearest 1.95 m away): every sweep will be free\n" in captured.err
     )
     assert "1 manoeuvres (free 1)" in captured.out
+    assert "outside the sweeps' angles" not in captured.err  # said already: out of reach
+    # the same ball written in cm: 60 m away, named as a unit
+    scene.write_text('[[objects]]\nshape = "sphere"\nradius = 5\nposition = [60.0, 0, 0]\n')
+    arguments[3] = str(tmp_path / "far-cm")
+    assert main(arguments) == 0
+    assert (
+        "will be free; the scene's positions in cm or mm? they are in m" in capsys.readouterr().err
+    )
 
 
 def test_a_scene_within_reach_that_no_sweep_touches_is_warned_of(

@@ -179,11 +179,18 @@ def _run(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     nearest = min(float(scene.signed_distance(base.position)[0]) for base in scene.bases)
-    if nearest > device.link.length:
+    out_of_reach = nearest > device.link.length
+    if out_of_reach:
+        # ten reaches and more: a scene written in cm or mm reads 100 or 1000 times too far
+        unit = (
+            "; the scene's positions in cm or mm? they are in m"
+            if nearest > 10 * device.link.length
+            else ""
+        )
         print(
             f"antenna explore: warning: no object lies within the link's reach"
             f" ({device.link.length:g} m) of a base (the nearest {nearest:.3g} m away): every"
-            " sweep will be free",
+            f" sweep will be free{unit}",
             file=sys.stderr,
         )
 
@@ -224,7 +231,7 @@ def _run(args: argparse.Namespace) -> int:
         + (f"; after the budget, aimed at {after}" if after else "")
         + f"), {summary['sweep_time_s']:.0f} s of sweeping"
     )
-    if summary["manoeuvres"] and set(summary["outcomes"]) == {"free"}:
+    if summary["manoeuvres"] and set(summary["outcomes"]) == {"free"} and not out_of_reach:
         print(
             f"antenna explore: warning: none of the {summary['manoeuvres']} sweeps touched an "
             "object: it lies outside the sweeps' angles from every base (behind the head, or "
