@@ -333,3 +333,35 @@ def test_the_link_is_tangent_to_the_ball_it_pushes(case: str, centre: list[float
     theta = np.asarray(result.diagnostics["theta_at_point"], dtype=float)
     unbent = outcome.frame.rotation @ _axes(*theta)[0]
     assert abs(unbent @ normal) > abs(point.tangent @ normal)
+
+
+def test_a_point_metres_from_the_others_is_named_as_isolated() -> None:
+    # Sixteen points 2 cm apart on a 0.3 m square and one 60 m off (a base pose in cm): only
+    # that one is named, with its distance; points 2 cm apart on a grid a link long are not
+    from sensing_antenna.mapping import ContactPoint
+    from sensing_antenna.mapping.points import isolated_points
+
+    grid = [np.array([0.6, 0.02 * i, 0.02 * j]) for i in range(4) for j in range(4)]
+    far = np.array([60.0, 0.0, 0.0])
+    points = [
+        ContactPoint(
+            point=at,
+            covariance=1e-6 * np.eye(3),
+            status=Status.OK,
+            source=f"{k}.csv",
+            method="paper",
+            x_c=0.5,
+            base_position=np.zeros(3),
+        )
+        for k, at in enumerate([*grid, far])
+    ]
+    ((alone, distance, spacing),) = isolated_points(points, 0.98)
+    assert alone.source == "16.csv"
+    assert distance == pytest.approx(np.linalg.norm(far - grid[0]), rel=1e-9)
+    assert spacing == pytest.approx(0.02)
+    assert isolated_points(points[:-1], 0.98) == []
+    # on a grid 20 cm apart, a point 1.5 m from the nearest is more than a link's length off
+    # but within ten spacings: not isolated
+    wide = [dataclasses.replace(p, point=10.0 * np.asarray(p.point)) for p in points[:-1]]
+    off = dataclasses.replace(points[0], point=np.array([6.0, -1.5, 0.0]), source="off.csv")
+    assert isolated_points([*wide, off], 0.98) == []

@@ -143,6 +143,7 @@ def _map_into(args: argparse.Namespace) -> None:
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.mapping import build_map, map_inputs_from_recordings
+    from sensing_antenna.mapping.points import isolated_points
     from sensing_antenna.mapping.pose import BASE_POSE_KEY
 
     meshes = read_objects(args.objects, "antenna map", args.objects_unit)
@@ -183,6 +184,13 @@ def _map_into(args: argparse.Namespace) -> None:
         raise SensingAntennaError(f"{left_out[0]}{more}")
     for problem in left_out:  # one line each; the map is made of the others
         print(f"antenna map: warning: left out {problem}", file=sys.stderr)
+    for point, distance, spacing in isolated_points(points, antenna.link.length):
+        print(
+            f"antenna map: note: the point of {point.source} lies {distance:.3g} m from every"
+            f" other, where the points lie {1e3 * spacing:.3g} mm apart: its base_pose (a"
+            " position in cm or mm, a rotation transposed or a quaternion's order)?",
+            file=sys.stderr,
+        )
     with recognition_progress(not args.no_progress, meshes) as bar:
         contact_map = build_map(
             points, args.include_uncertain, meshes=meshes, swept=swept, class_fitted=bar

@@ -72,6 +72,7 @@ __all__ = [
     "ContactPoint",
     "PointUncertainty",
     "contact_point_from_estimate",
+    "isolated_points",
     "link_tangent",
     "select_points",
     "surface_offset",
@@ -422,6 +423,31 @@ def select_points(
             or (p.status is Status.UNCERTAIN and (p.held_back_by_width or include_uncertain))
         )
     ]
+
+
+#: A point whose nearest other lies farther than the link's length and than this many times
+#: the points' median spacing is named as isolated (:func:`isolated_points`): maps of one object
+#: keep their points within centimetres of a neighbour (a tenth of the link at most on the
+#: explorations' maps), while a base pose in cm or mm puts its point metres away.
+ISOLATED_SPACING = 10.0
+
+
+def isolated_points(
+    points: list[ContactPoint] | tuple[ContactPoint, ...], reach: float
+) -> list[tuple[ContactPoint, float, float]]:
+    """The points a map uses (:func:`select_points`) that lie alone: farther than ``reach``
+    (m, the link's length) and :data:`ISOLATED_SPACING` times the median spacing from every
+    other one, with that distance and the spacing (m); none with fewer than four points."""
+    used = select_points(points)
+    if len(used) < 4:
+        return []
+    at = np.array([p.point for p in used])
+    gaps = np.linalg.norm(at[:, None, :] - at[None, :, :], axis=-1)
+    np.fill_diagonal(gaps, np.inf)
+    nearest = gaps.min(axis=1)
+    spacing = float(np.median(nearest))
+    limit = max(reach, ISOLATED_SPACING * spacing)
+    return [(p, float(d), spacing) for p, d in zip(used, nearest, strict=True) if d > limit]
 
 
 def _angles(value: object, point_a: FloatArray) -> FloatArray:
