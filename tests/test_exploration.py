@@ -490,6 +490,15 @@ def test_antenna_explore_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert main(["explore", "post", "--out", str(out), "--method", "paper", "--quiet"]) == 2
     err = capsys.readouterr().err
     assert 'method "fast" stored, "paper" given' in err and "resuming" not in err
+    assert "the manoeuvres stored here come with other settings" in err
+    # a directory stopped before its first manoeuvre says it was begun so, not what it holds
+    from sensing_antenna.exploration.store import ExplorationStoreError, write_settings
+
+    begun = tmp_path / "begun"
+    begun.mkdir()
+    write_settings(begun, {"method": "fast"})
+    with pytest.raises(ExplorationStoreError, match="this directory was begun with other"):
+        write_settings(begun, {"method": "paper"})
 
 
 def test_a_scene_out_of_the_link_s_reach_is_warned_of(

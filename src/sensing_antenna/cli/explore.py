@@ -124,7 +124,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.cli.map import read_objects, recognition_progress, report_map
     from sensing_antenna.exploration import ExploreSettings, Manoeuvre, explore
     from sensing_antenna.exploration.run import stopped_as_stored
-    from sensing_antenna.exploration.store import SETTINGS_FILE
+    from sensing_antenna.exploration.store import CALIBRATED_FILE
     from sensing_antenna.scene import load_scene
 
     if args.device_profile == "nominal" and args.device_build is not None:
@@ -164,7 +164,7 @@ def _run(args: argparse.Namespace) -> int:
             what += f" ({manoeuvre.reason})"
         print(f"[{manoeuvre.index + 1}/{most}] {manoeuvre.sweep.label}: {what}", flush=True)
 
-    prepared = (args.out / SETTINGS_FILE).exists()
+    prepared = (args.out / CALIBRATED_FILE).exists()
     print(
         f"exploring scene {scene.name} ({len(scene.objects)} objects, {len(scene.bases)} base"
         f" poses) with the {args.method} method, {args.strategy} strategy"

@@ -238,10 +238,15 @@ def write_settings(out: Path, settings: dict[str, Any]) -> None:
             changed = sorted(
                 k for k in set(stored) | set(settings) if stored.get(k) != settings.get(k)
             )
+            stored_here = (
+                "the manoeuvres stored here come"
+                if any((out / MANOEUVRES_DIR).glob("*"))
+                else "this directory was begun"
+            )
             raise ExplorationStoreError(
                 f"{path}: {', '.join(_change(k, stored.get(k), settings.get(k)) for k in changed)}:"
-                " the manoeuvres stored here come from other settings; run with the same ones to"
-                " resume, or use another output directory"
+                f" {stored_here} with other settings; run with the same ones to resume, or use"
+                " another output directory"
             )
         return
     atomic_write_text(path, json.dumps(settings, indent=2, sort_keys=True) + "\n")
