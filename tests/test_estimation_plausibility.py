@@ -1030,23 +1030,6 @@ def test_degrees_prediction_is_told_from_noise_over_a_short_free_motion() -> Non
     assert gain(p / DEGREES)[1] is None
 
 
-@pytest.mark.parametrize("case", ["azimuthal", "vertical"])
-def test_a_head_turned_back_before_t_e_did_not_hold(case: str) -> None:
-    # The head turns back 0.8 s after the stop, 0.2 s before the paper method's t_e: 6 mrad of
-    # the sweep's ramp by then, a fifth of the 0.03 rad it turned past the touch. Held, the
-    # answer at 0.95 m is 0.1 mm off; turned back, it read 5 mm (azimuthal) and 11 mm
-    # (vertical) short, the vertical one said ok. Held, no method is told the head did not hold
-    scenario = Scenario(case=case, contact_point=0.95, duration=3.0, seed=2)
-    held = simulate(paper_antenna(), scenario).without_ground_truth()
-    back = simulate(paper_antenna(), dataclasses.replace(scenario, retract_after=0.8))
-    for name, result in all_methods(held, calibrated()).items():
-        reasons = [result.reason or "", *result.diagnostics.get("other_reasons", [])]  # type: ignore[attr-defined]
-        assert not any("hold the head still" in text for text in reasons), name
-    result = estimate(back.without_ground_truth(), calibrated(), "paper")
-    assert result.status is Status.RECORDING_TOO_SHORT, result.reason
-    assert "hold the head still from t_1 to t_e" in (result.reason or "")
-
-
 def test_torques_a_hundred_times_too_large_are_implausible_not_a_payload(
     azimuthal: Recording, antenna: Antenna
 ) -> None:

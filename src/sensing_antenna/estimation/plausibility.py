@@ -17,10 +17,7 @@ forms agree.
    head's work against the contact's moment against the energy the push stores in the link
    (an obstacle gives no energy: angles swapped turn the head across the push; a share short
    by less than ``1 / input_work_share`` is a scale, torques that read high or a stiffer link,
-   ``model_mismatch``; :func:`_work_problem`). The head held still from t_1 to t_e
-   (``recording_too_short``, :func:`_hold_problem`): a head that turned away from its rest by
-   more than a tenth of its turn from the touch eased the push the estimate reads, or left the
-   object.
+   ``model_mismatch``; :func:`_work_problem`).
 2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``). An answer past the tip by
    no more than ``disagreement_sigmas`` statistical uncertainties of the ratio at the tip (noise
    and tare, :meth:`~.evidence.Evidence.ratio_uncertainty` without its model term, which grows
@@ -159,9 +156,6 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     push = _push_direction_problem(evidence)
     if push is not None:
         found.append(push)
-    held = _hold_problem(evidence, end)
-    if held is not None:
-        found.append((Status.RECORDING_TOO_SHORT, held))
     estimate = _at_tip_when_just_past(evidence, estimate)
     x_c = estimate.x_c
     on_link = math.isfinite(x_c) and 0.0 < x_c <= link.length
@@ -880,50 +874,6 @@ def _on_link(interval: tuple[float, float] | None, length: float) -> tuple[float
     if 0.0 <= low and high <= length:
         return interval
     return (max(low, 0.0), min(high, length))
-
-
-#: Share of the head's turn from the touch to its rest at t_1 that it may turn from that rest
-#: before t_e: a held head creeps by a few per cent of the default push as its servo settles,
-#: while a head turned back by a tenth eases the push by a tenth.
-HOLD_TURN_SHARE = 0.1
-
-
-def _hold_problem(evidence: Evidence, end: int) -> str | None:
-    """Why the head did not hold from t_1 to the sample ``end``, or None.
-
-    The means of the angles over every rest window (``config.rest_window``) in [t_1, t_e]
-    against the first, at t_1: none may lie farther from it than :data:`HOLD_TURN_SHARE` of the
-    head's turn from t_c to that rest, nor than the rest tolerance (``rest_tolerance``, the
-    peak-to-peak of a resting head over one rest window) times the rest windows in [t_1, t_e],
-    the most a head at rest in each window could creep. A head that did not turn into the
-    contact (an object moved into it) is not judged.
-    """
-    rest = evidence.rest_index
-    window = max(1, round(evidence.config.rest_window / evidence.sample_period))
-    if end - rest < 2 * window:
-        return None
-    theta = evidence.theta[rest : end + 1]
-    sums = np.vstack([np.zeros((1, 2)), np.cumsum(theta - theta[0], axis=0)])
-    means = (sums[window:] - sums[:-window]) / window  # rest windows starting at each sample
-    at_rest = means[0]
-    push = float(np.max(np.abs(at_rest + theta[0] - evidence.theta[evidence.contact_index])))
-    tolerance = float(evidence.diagnostics.get("rest_tolerance", 0.0))
-    if not push > tolerance:
-        return None
-    limit = max(HOLD_TURN_SHARE * push, tolerance * (end - rest) / window)
-    turned = np.max(np.abs(means - at_rest), axis=1)
-    beyond = np.flatnonzero(turned > limit)
-    if beyond.size == 0:
-        return None
-    first = int(beyond[0])
-    t = evidence.t
-    return (
-        f"columns 'theta1', 'theta2': the head turned {float(turned.max()):.3g} rad from its"
-        f" rest at t_1 = {t[rest]:.3f} s from {t[rest + first + window]:.3f} s on, before"
-        f" t_e = {t[end]:.3f} s, more than {limit:.3g} rad (a tenth of its turn from the touch,"
-        f" {push:.3g} rad, or a resting head's creep): the push the estimate reads eased or"
-        " the link left the object; hold the head still from t_1 to t_e"
-    )
 
 
 def _index_at(evidence: Evidence, t_e: float) -> int:

@@ -34,8 +34,7 @@ class Status(str, enum.Enum):  # noqa: UP042 (a StrEnum's str() would read "ok",
     NO_CLEAR_PEAK = "no_clear_peak"
     #: The frequency candidates and the torque/force ratio disagree beyond tolerance.
     ESTIMATORS_DISAGREE = "estimators_disagree"
-    #: Too few samples after t_1 for the spectrum or for the ratio to converge, or a head that
-    #: turned away before t_e.
+    #: Too few samples after t_1 for the spectrum or for the ratio to converge.
     RECORDING_TOO_SHORT = "recording_too_short"
     #: The contact force or the ratio drifts during the hold, or the deflection is too large.
     SLIP_SUSPECTED = "slip_suspected"
