@@ -94,6 +94,11 @@ def test_simulate_warns_when_the_stop_leaves_no_spectrum_window(
     assert capsys.readouterr().err == ""
     main(["estimate", str(long)])
     assert "recording_too_short" not in capsys.readouterr().out
+    # a retraction within the window is said the same way
+    assert main([*common, "--retract-after", "0.3", "--out", str(long)]) == 0
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("warning: --retract-after 0.3 s turns the head back before")
+    assert err.endswith("--retract-after 1.1 leaves the whole window held")
 
 
 def test_a_link_too_stiff_for_the_simulators_samples_is_said_and_not_explored(

@@ -264,7 +264,9 @@ def window_warning(scenario: Any, meta: Any) -> str | None:
 
     The head comes to rest ``SETTLING_TIME_CONSTANTS`` servo time constants after the stop
     (``true_t_stop`` of the metadata ``meta``, s); the line suggests the ``--duration`` (rounded
-    up to 0.1 s) that leaves the whole window. No line without a stop (the summary says so).
+    up to 0.1 s) that leaves the whole window. Also one line when the head turns back
+    (``scenario.retract_after``) before that window ends. No line without a stop (the summary
+    says so).
     """
     from sensing_antenna.estimation import EstimatorConfig
 
@@ -272,7 +274,16 @@ def window_warning(scenario: Any, meta: Any) -> str | None:
     if not math.isfinite(stop):
         return None
     window = EstimatorConfig().spectrum_window
-    needed = stop + SETTLING_TIME_CONSTANTS / -scenario.servo_pole + window
+    settled = SETTLING_TIME_CONSTANTS / -scenario.servo_pole
+    needed = stop + settled + window
+    if scenario.retract_after is not None and scenario.retract_after < settled + window:
+        return (
+            f"warning: --retract-after {scenario.retract_after:g} s turns the head back before"
+            f" the estimators' {window:g} s spectrum window (EstimatorConfig.spectrum_window)"
+            " ends: their window then holds a push that eases, or no contact at all;"
+            f" --retract-after {math.ceil(10 * (settled + window)) / 10:g} leaves the whole"
+            " window held"
+        )
     if scenario.duration >= needed:
         return None
     return (

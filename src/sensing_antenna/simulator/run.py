@@ -551,10 +551,11 @@ def simulate_detailed(
                 # Eq. 14 lag of a ramp, 2 eps omega*: the joint comes to rest where it is now
                 hold = reference[k, sweep_joint]
                 if scenario.compensate_servo_lag and k > 0:
-                    speed = (reference[k, sweep_joint] - reference[k - 1, sweep_joint]) / ts
-                    hold -= 2.0 * servo[sweep_joint].time_constant * speed
+                    slope = (reference[k, sweep_joint] - reference[k - 1, sweep_joint]) / ts
+                    hold -= 2.0 * servo[sweep_joint].time_constant * slope
                 reference[k + 1 :, sweep_joint] = hold
                 if scenario.retract_after is not None:
+                    # back along the sweep at its own signed speed and ramp
                     back = t[k + 1 :] - (t[k] + scenario.retract_after)
                     reference[k + 1 :, sweep_joint] -= sweep_reference(
                         back,
