@@ -275,8 +275,9 @@ def recording_links(
     is not ``ok``: an ``ok`` point says more (None then, and without a detected contact); both
     in the recording's ``base_pose``. The onset, looked back for, can come well before the
     touch (where the free motion's residual is large); the link at t_c is pressing the object.
-    A recording whose estimate says its samples are not what the format says (``bad_input``,
-    ``implausible_input``: angles in degrees, loads in other units) says neither.
+    A recording whose estimate says its samples are not in the format's units and signs
+    (``implausible_input``: angles in degrees, loads in other units) says neither; one whose
+    samples could not be used (``bad_input``: a gap in the hold) keeps its angles' free sweep.
 
     Raises
     ------
@@ -284,7 +285,7 @@ def recording_links(
         One line naming the recording when its base pose is malformed.
     """
     pose = base_pose_from_metadata(recording.metadata, recording.source)
-    if point is not None and point.status in (Status.BAD_INPUT, Status.IMPLAUSIBLE_INPUT):
+    if point is not None and point.status is Status.IMPLAUSIBLE_INPUT:
         return (pose, recording.theta[:0]), None
     detection = detect_contact(recording, antenna)
     onset = contact_onset(detection)
