@@ -34,7 +34,7 @@ or the threshold identified on one run is crossed at the first sample of another
 over the first ``DEFAULT_TARE_TIME`` of the recording (the head at rest, or moving as the observer
 predicts) is taken as the offset and removed; no contact is declared during that window. The
 residual filter then starts at rest, at that mean: started at its first input instead, it would
-hold that one sample's unfiltered noise, about four times the filtered noise at this cut-off, and
+hold that one sample's unfiltered noise, about 4.6 times the filtered noise at this cut-off, and
 an identified threshold would be crossed there.
 """
 

@@ -732,8 +732,9 @@ def free_motion_gain(
     Returns
     -------
     (gain, problem) : tuple of float and str or None
-        NaN gain when the observer predicts no motion (nothing to compare); ``problem`` names
-        the columns and the gain.
+        The ratio of root-mean-square values, or the projection when it finds the problem the
+        ratio misses; NaN when the observer predicts no motion (nothing to compare).
+        ``problem`` names the columns and the gain.
     """
     predicted_axes, measured_axes = _dynamic_rms(theta, torque, predicted_torque, antenna)
     with np.errstate(over="ignore", invalid="ignore"):
