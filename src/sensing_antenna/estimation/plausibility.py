@@ -558,6 +558,20 @@ def _head_turned(evidence: Evidence, end: int) -> bool:
     return float(np.max(np.abs(turn))) > tolerance
 
 
+def _hold_end(evidence: Evidence, end: int) -> int:
+    """The last sample up to ``end`` before the head turned back from its rest at t_1, against
+    its turn from t_c, by half that turn (a retraction before t_e: the push eases and the link
+    may leave the object); ``end`` when it did not."""
+    rest, contact = evidence.rest_index, evidence.contact_index
+    push = evidence.theta[rest] - evidence.theta[contact]
+    size = float(np.linalg.norm(push))
+    if not size > float(evidence.diagnostics.get("rest_tolerance", 0.0)):
+        return end
+    back = -(evidence.theta[rest : end + 1] - evidence.theta[rest]) @ (push / size)
+    beyond = np.flatnonzero(back > 0.5 * size)
+    return end if beyond.size == 0 else max(rest + int(beyond[0]) - 1, rest)
+
+
 def _last_period_start(evidence: Evidence, omega: float, end: int) -> int:
     """First sample of the hold's last period of a fundamental ``omega`` (rad/s) before
     sample ``end``, not before t_1: the window over which the touch's ringing averages out."""
@@ -581,7 +595,8 @@ def _work_problem(
     Passivity: the obstacle and the link store or dissipate what the head puts in. From
     ``tare_margin`` before t_c (not from the start: a sensor's drift over a long approach
     would weigh on the whole turn), or from the start when the record is shorter and began at
-    rest, to t_e (sample ``end``), the head turns by dphi = 1/2 sum_i e_i x de_i (e_i the
+    rest, to t_e (sample ``end``; to where the head began to turn back when it did before t_e,
+    :func:`_hold_end`), the head turns by dphi = 1/2 sum_i e_i x de_i (e_i the
     motor axes, absolute frame) and does the work W = -sum Gamma . dphi against the contact's
     moment about O. A push Gamma_perp
     across the link bent at x_c holds E = |Gamma_perp|^2 x_c / (6 E I) in it; the head must
@@ -606,6 +621,7 @@ def _work_problem(
     t, k = evidence.t, evidence.contact_index
     if not _head_turned(evidence, end):
         return None
+    end = _hold_end(evidence, end)  # a head turned back before t_e: counted to the turn
     if float(t[k] - t[0]) >= cfg.tare_margin:
         start = int(np.searchsorted(t, t[k] - cfg.tare_margin))
     elif evidence.tare == "rest":
@@ -639,7 +655,8 @@ def _work_problem(
     if work + slack >= cfg.min_work_share * energy:
         return None
     found = (
-        f"columns 'theta1', 'theta2', 'tx', 'ty', 'tz': from {float(t[start]):.3f} s to t_e "
+        f"columns 'theta1', 'theta2', 'tx', 'ty', 'tz': from {float(t[start]):.3f} s to"
+        f" {'t_e' if end == evidence.end_index else f'{float(t[end]):.3f} s'} "
         f"the head's turn did {1e3 * work:.3g} mJ of work against the contact's moment, "
         f"{100.0 * work / energy:.0f} % of the {1e3 * energy:.3g} mJ the push stored in the "
         f"link bent at x_c = {x_c:.3f} m meanwhile (at least "
