@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -985,3 +986,26 @@ def test_sizes_are_known_when_twice_each_deviation_is_within_the_share() -> None
     # a user mesh is registered at its own size: its extents have no deviations to know
     extents = {"extent_x": 0.1, "extent_y": 0.05, "extent_z": 0.02}
     assert ClassFit("mesh:block", {}, extents, 0.0, 0.0, 0.0, 6, 20).sizes_known(0.01)
+
+
+def test_a_user_mesh_touched_on_its_side_slides_along_its_axis_to_where_the_lines_allow() -> None:
+    # 19 touches of a 40 x 220 mm cylinder standing at (0.6, 0.05, 0), from an exploration of
+    # the built-in cylinder scene kept as data, and the cylinder's own mesh (32 sections, as a
+    # user's STL would come): the points hold its radius and axis but not where along the axis
+    # it stands, and ICP left it 27 mm low, where the links' lines cross it (line chi^2 450).
+    # Slid along the axis to where points and lines fit best, it stands within 3 mm of its
+    # place, and the lines cross it nowhere
+    data = json.loads((Path(__file__).parent / "data" / "cylinder_side_touches.json").read_text())
+    lines = LinkLines(np.array(data["tangents"]), data["std"], data["behind"], data["beyond"])
+    mesh = trimesh.creation.cylinder(radius=0.04, height=0.22, sections=32)
+    fit = fit_mesh(
+        "bottle",
+        mesh,
+        np.array(data["points"]),
+        np.array(data["covariances"]),
+        rng=np.random.default_rng(0),
+        lines=lines,
+    )
+    centre = np.array([fit.parameters[f"m{i}3"] for i in range(3)])
+    np.testing.assert_allclose(centre, [0.6, 0.05, 0.0], atol=0.003)
+    assert fit.line_chi2 < 1.0

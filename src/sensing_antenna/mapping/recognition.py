@@ -148,7 +148,7 @@ from typing import Any
 import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, minimize_scalar
 from scipy.spatial.transform import Rotation
 from scipy.stats import binom
 from scipy.stats import f as f_distribution
@@ -262,6 +262,15 @@ MESH_CANDIDATES = 8
 
 #: Most points a registration start (:func:`fit_mesh`) is run on.
 START_POINTS = 40
+
+#: A direction the points leave a registered mesh free to slide along (:func:`fit_mesh`): its
+#: singular value of the points' normal distances against a translation, at most this share of
+#: the largest (a cylinder touched on its side slides along its axis, a box's face within it).
+FREE_SHARE = 1e-2
+
+#: Shifts along a free direction tried from a registration whose links' lines cross the mesh,
+#: over the mesh's largest extent, before the best of them is refined (:func:`fit_mesh`).
+FREE_SHIFTS = 9
 
 #: How far along the link each way from a contact its line is checked against a fit (m).
 LINE_STRETCH = 0.04
@@ -1664,7 +1673,8 @@ def fit_mesh(
     the points for up to 40 iterations until its cost changes by less than
     :data:`ICP_TOLERANCE` of their variance; the lowest is refined to convergence on all
     points. With ``lines`` and a closed mesh, the :data:`MESH_CANDIDATES` lowest distinct
-    starts are refined and the one whose points and lines give the lowest chi^2 kept.
+    starts are refined and the one whose points and lines give the lowest chi^2 kept, slid
+    along the directions the points leave free when its lines cross the mesh (:func:`_slid`).
     ``lines`` adds
     the tangency residuals of the registered mesh and ``swept`` its swept links' residuals (not
     used to register it), for a closed (watertight) mesh only: an open one has no inside.
@@ -1738,7 +1748,58 @@ def fit_mesh(
     # best alone
     ranked = [_registered(name, mesh, p, cov, m, lines, ()) for m in refined]
     k = min(range(len(ranked)), key=lambda i: ranked[i].chi2)
-    return _registered(name, mesh, p, cov, refined[k], lines, swept) if swept else ranked[k]
+    best, fitted = _slid(name, mesh, p, cov, refined[k], lines, ranked[k])
+    return _registered(name, mesh, p, cov, best, lines, swept) if swept else fitted
+
+
+def _slid(
+    name: str,
+    mesh: trimesh.Trimesh,
+    p: FloatArray,
+    cov: FloatArray,
+    points_to_mesh: FloatArray,
+    lines: LinkLines | None,
+    fitted: ClassFit,
+) -> tuple[FloatArray, ClassFit]:
+    """``points_to_mesh`` (4 x 4) and its fit ``fitted``, or, when the links' ``lines`` cross
+    the registered mesh, the pose slid along each direction the points leave free
+    (:data:`FREE_SHARE`) to where the points and the lines fit best: ICP moves a mesh only as
+    far as its points' distances ask, and points on a cylinder's side leave it anywhere along
+    its axis, where the links that passed beyond its end may cross it. Tried at
+    :data:`FREE_SHIFTS` shifts over the mesh's largest extent, the best refined between its
+    neighbours."""
+    if lines is None or not fitted.line_chi2 > 1.0:
+        return points_to_mesh, fitted
+    q = trimesh.transform_points(p, points_to_mesh)
+    _, _, faces = closest_point(mesh, q)
+    normals = np.asarray(mesh.face_normals[faces])
+    world = normals @ np.linalg.inv(points_to_mesh)[:3, :3].T
+    weighted = normals / _normal_sigma(cov, world)[:, None]
+    _, singular, directions = np.linalg.svd(weighted, full_matrices=False)
+    free = directions[singular <= FREE_SHARE * singular[0]]
+    reach = 0.5 * float(np.max(mesh.extents))
+    best, kept = points_to_mesh, fitted
+    for direction in free:
+
+        def moved(shift: float, start: FloatArray = best, v: FloatArray = direction) -> FloatArray:
+            step = np.eye(4)
+            step[:3, 3] = shift * v
+            return step @ start
+
+        def chi2(shift: float) -> float:
+            return _registered(name, mesh, p, cov, moved(shift), lines, ()).chi2
+
+        shifts = np.linspace(-reach, reach, FREE_SHIFTS)
+        costs = [chi2(float(shift)) for shift in shifts]
+        i = int(np.argmin(costs))
+        gap = shifts[1] - shifts[0]
+        low, high = shifts[i] - gap, shifts[i] + gap
+        found = minimize_scalar(chi2, bounds=(low, high), method="bounded", options={"maxiter": 8})
+        shift = float(found.x) if found.fun < costs[i] else float(shifts[i])
+        trial = _registered(name, mesh, p, cov, moved(shift), lines, ())
+        if trial.chi2 < kept.chi2:
+            best, kept = moved(shift), trial
+    return best, kept
 
 
 def _distinct_poses(
