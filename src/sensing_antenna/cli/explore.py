@@ -126,6 +126,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.exploration.run import stopped_as_stored
     from sensing_antenna.exploration.store import CALIBRATED_FILE
     from sensing_antenna.scene import load_scene
+    from sensing_antenna.simulator.run import sampling_warning
 
     if args.device_profile == "nominal" and args.device_build is not None:
         raise ArgumentError(
@@ -138,6 +139,9 @@ def _run(args: argparse.Namespace) -> int:
         )
     scene = load_scene(args.scene)
     device = load_antenna(args.antenna)
+    coarse = sampling_warning(device)
+    if coarse is not None:  # before the banner: nothing will be explored
+        raise ArgumentError("--antenna", f"{device.name}: link: {coarse}")
     meshes = read_objects(args.objects, "antenna explore", args.objects_unit)
     settings = ExploreSettings(
         method=args.method,
