@@ -70,6 +70,29 @@ def test_no_metadata_columns_in_other_order_and_extra_column() -> None:
     assert rec.sample_period == pytest.approx(0.001, rel=1e-12)
 
 
+def test_blank_lines_among_the_samples_are_left_out_and_every_line_keeps_its_number(
+    tmp_path: Path,
+) -> None:
+    # an empty line and one of spaces among the samples: no sample, left out; a text column
+    # the format does not name is still left out whole, and a bad cell or a time going back
+    # after them is named at its own line (lines 1 and 2: metadata and header)
+    header = "# sample_period: 0.001\nt,theta1,theta2,fx,fy,fz,tx,ty,tz,state\n"
+    rows = [f"{k / 1000},0,0,0,0,-0.045,0,0.022,0,idle" for k in range(4)]
+    path = tmp_path / "blank.csv"
+    path.write_text(header + "\n".join([rows[0], "", rows[1], "   ", rows[2], rows[3]]) + "\n")
+    rec = read_recording(path)
+    np.testing.assert_array_equal(rec.t, [0.0, 0.001, 0.002, 0.003])
+    assert "state" not in rec.extra
+    bad = rows[2].replace(",0,0,0,", ",x,0,0,", 1)  # theta1 on line 7
+    path.write_text(header + "\n".join([rows[0], "", rows[1], "   ", bad, rows[3]]) + "\n")
+    with pytest.raises(RecordingError, match=r"blank\.csv:7: column 'theta1': not a number"):
+        read_recording(path)
+    back = rows[3].replace("0.003,", "0.0005,", 1)  # line 8
+    path.write_text(header + "\n".join([rows[0], "", rows[1], "   ", rows[2], back]) + "\n")
+    with pytest.raises(RecordingError, match=r"blank\.csv:8: column 't': time does not"):
+        read_recording(path)
+
+
 def test_crlf_line_endings() -> None:
     rec = read_recording(DATA / "rec_crlf.csv")
     assert rec.metadata["antenna"] == "paper-2021"

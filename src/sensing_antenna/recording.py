@@ -724,18 +724,18 @@ def _near(name: str, names: list[str]) -> str:
 
 
 def _numeric_columns(
-    rows: list[str], first_line: int, names: list[str], source: str
+    rows: list[str], numbers: list[int], names: list[str], source: str
 ) -> tuple[NDArray[np.float64], list[str]]:
     """The table and its column names (slow path, only after the fast parse failed): every
     column but those the format does not name (:data:`NAMED_COLUMNS`) with a cell that is not a
     number. A row of the wrong length, a '#' line among the samples or a named column's cell
-    that is not a number is refused, naming its line."""
+    that is not a number is refused, naming its line (``numbers``, each row's)."""
     named = [name in NAMED_COLUMNS for name in names]
     text_columns: set[int] = set()
     table = np.empty((len(rows), len(names)))
     for offset, row in enumerate(rows):
         cells = row.split(",")
-        number = first_line + offset
+        number = numbers[offset]
         if row.lstrip().startswith("#"):
             raise RecordingError(
                 source,
@@ -886,9 +886,13 @@ def read_recording(path: str | Path) -> Recording:
         rows.pop()
         while rows and not rows[-1].strip():
             rows.pop()
-    first_line = header_index + 2
-    if not rows:
+    # a blank line among the samples (nothing, or only spaces) holds no sample: left out, each
+    # other row keeping its own line number
+    numbered = [(header_index + 2 + offset, row) for offset, row in enumerate(rows) if row.strip()]
+    if not numbered:
         raise RecordingError(source, header_index + 1, None, "header but no data rows")
+    numbers = [number for number, _ in numbered]
+    rows = [row for _, row in numbered]
     try:
         data = np.loadtxt(rows, delimiter=",", dtype=np.float64, comments=None, ndmin=2)
     except ValueError:
@@ -896,7 +900,7 @@ def read_recording(path: str | Path) -> Recording:
     if data is None or data.shape[1] != len(names):
         # a row of the wrong length or a cell not a number: named, unless it lies in a column
         # no reader needs (a logger's state or text column), which is left out whole
-        data, names = _numeric_columns(rows, first_line, names, source)
+        data, names = _numeric_columns(rows, numbers, names, source)
     extra_bad = [
         k
         for k, name in enumerate(names)
@@ -910,21 +914,21 @@ def read_recording(path: str | Path) -> Recording:
         row, col = np.argwhere(~finite)[0]
         raise RecordingError(
             source,
-            first_line + int(row),
+            numbers[int(row)],
             names[col],
             not_finite(data[row, col]),
         )
     column = {name: data[:, k] for k, name in enumerate(names)}
     t = column["t"]
     if t.shape[0] < 2:
-        raise RecordingError(source, first_line, None, "need at least 2 data rows")
+        raise RecordingError(source, numbers[0], None, "need at least 2 data rows")
     with np.errstate(over="ignore"):
         bad = np.flatnonzero(np.diff(t) <= 0)
     if bad.size:
         k = int(bad[0]) + 1
         raise RecordingError(
             source,
-            first_line + k,
+            numbers[k],
             "t",
             f"time does not increase ({format_value(t[k])} after {format_value(t[k - 1])})",
         )
@@ -932,7 +936,7 @@ def read_recording(path: str | Path) -> Recording:
     span = _time_span_problem(t, _period_of(t, None if nominal is None else _parse_period(nominal)))
     if span is not None:
         k, problem = span
-        raise RecordingError(source, first_line + k, "t", problem)
+        raise RecordingError(source, numbers[k], "t", problem)
     force = np.column_stack([column["fx"], column["fy"], column["fz"]])
     torque = np.column_stack([column["tx"], column["ty"], column["tz"]])
     point = stated_torque_point(metadata, source)  # its value checked by parse_metadata

@@ -87,7 +87,7 @@ def register(subparsers: Any) -> None:
         type=float,
         default=None,
         metavar="RAD",
-        help="stop the motors this far (rad of head rotation) past the first touch, instead "
+        help="stop the motors this far (rad of head rotation) past the detected contact, instead "
         "of the push criterion's default 0.03 rad: deeper pushes bend the link more",
     )
     parser.add_argument(
