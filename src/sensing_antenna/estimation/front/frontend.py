@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import Antenna
-from sensing_antenna.detection.contact import ContactDetector
+from sensing_antenna.detection.contact import OBSERVER_TORQUE_SIGNS, ContactDetector
 from sensing_antenna.detection.filters import FirstOrderLowPass
 from sensing_antenna.detection.push import PushCriterion, PushMonitor
 from sensing_antenna.errors import FieldError
@@ -119,8 +119,11 @@ def _held_under(detector: ContactDetector, theta: FloatArray, last: int) -> str:
     turn = theta[-1] - theta[0]
     joint = int(np.argmax(np.abs(turn)))
     mean = np.mean(residual[-last:], axis=0)
-    # the azimuth turns about Z^m, the elevation about Y^m; a push resists the turn
-    held = -mean[2] * np.sign(turn[0]) if joint == 0 else mean[1] * np.sign(turn[1])
+    # the azimuth turns about Z^m, the elevation about Y^m; a push resists the turn as the
+    # bent link's spring torque does, which the observer gives those signs
+    sign_y, sign_z = OBSERVER_TORQUE_SIGNS
+    axis, sign = (2, sign_z) if joint == 0 else (1, sign_y)
+    held = float(mean[axis] * sign * np.sign(turn[joint]))
     if not held > HELD_UNDER_SHARE * detector.threshold:
         return ""
     return (
