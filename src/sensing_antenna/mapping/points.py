@@ -59,6 +59,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna
 from sensing_antenna.estimation.front.contact_frame import motor_axes
@@ -442,9 +443,7 @@ def isolated_points(
     if len(used) < 4:
         return []
     at = np.array([p.point for p in used])
-    gaps = np.linalg.norm(at[:, None, :] - at[None, :, :], axis=-1)
-    np.fill_diagonal(gaps, np.inf)
-    nearest = gaps.min(axis=1)
+    nearest = cKDTree(at).query(at, k=2)[0][:, 1]  # the first neighbour found is the point
     spacing = float(np.median(nearest))
     limit = max(reach, ISOLATED_SPACING * spacing)
     return [(p, float(d), spacing) for p, d in zip(used, nearest, strict=True) if d > limit]
