@@ -724,7 +724,7 @@ def _near(name: str, names: list[str]) -> str:
 
 
 def _numeric_columns(
-    rows: list[str], numbers: list[int], names: list[str], source: str
+    rows: list[str], numbers: Sequence[int], names: list[str], source: str
 ) -> tuple[NDArray[np.float64], list[str]]:
     """The table and its column names (slow path, only after the fast parse failed): every
     column but those the format does not name (:data:`NAMED_COLUMNS`) with a cell that is not a
@@ -887,12 +887,13 @@ def read_recording(path: str | Path) -> Recording:
         while rows and not rows[-1].strip():
             rows.pop()
     # a blank line among the samples (nothing, or only spaces) holds no sample: left out, each
-    # other row keeping its own line number
-    numbered = [(header_index + 2 + offset, row) for offset, row in enumerate(rows) if row.strip()]
-    if not numbered:
+    # other row keeping its own line number (rebuilt only when a file has one)
+    numbers: Sequence[int] = range(header_index + 2, header_index + 2 + len(rows))
+    if not all(rows) or any(row.isspace() for row in rows):
+        kept = [k for k, row in enumerate(rows) if row and not row.isspace()]
+        numbers, rows = [numbers[k] for k in kept], [rows[k] for k in kept]
+    if not rows:
         raise RecordingError(source, header_index + 1, None, "header but no data rows")
-    numbers = [number for number, _ in numbered]
-    rows = [row for _, row in numbered]
     try:
         data = np.loadtxt(rows, delimiter=",", dtype=np.float64, comments=None, ndmin=2)
     except ValueError:
