@@ -1780,25 +1780,29 @@ def _slid(
     reach = 0.5 * float(np.max(mesh.extents))
     best, kept = points_to_mesh, fitted
     for direction in free:
+        tried: dict[float, tuple[FloatArray, ClassFit]] = {}  # each shift's pose and fit, once
 
-        def moved(shift: float, start: FloatArray = best, v: FloatArray = direction) -> FloatArray:
-            step = np.eye(4)
-            step[:3, 3] = shift * v
-            return step @ start
-
-        def chi2(shift: float) -> float:
-            return _registered(name, mesh, p, cov, moved(shift), lines, ()).chi2
+        def chi2(
+            shift: float,
+            start: FloatArray = best,
+            v: FloatArray = direction,
+            tried: dict[float, tuple[FloatArray, ClassFit]] = tried,
+        ) -> float:
+            if shift not in tried:
+                step = np.eye(4)
+                step[:3, 3] = shift * v
+                pose = step @ start
+                tried[shift] = (pose, _registered(name, mesh, p, cov, pose, lines, ()))
+            return tried[shift][1].chi2
 
         shifts = np.linspace(-reach, reach, FREE_SHIFTS)
-        costs = [chi2(float(shift)) for shift in shifts]
-        i = int(np.argmin(costs))
+        i = int(np.argmin([chi2(float(shift)) for shift in shifts]))
         gap = shifts[1] - shifts[0]
-        low, high = shifts[i] - gap, shifts[i] + gap
-        found = minimize_scalar(chi2, bounds=(low, high), method="bounded", options={"maxiter": 8})
-        shift = float(found.x) if found.fun < costs[i] else float(shifts[i])
-        trial = _registered(name, mesh, p, cov, moved(shift), lines, ())
+        bounds = (shifts[i] - gap, shifts[i] + gap)
+        minimize_scalar(chi2, bounds=bounds, method="bounded", options={"maxiter": 8})
+        pose, trial = min(tried.values(), key=lambda tried_fit: tried_fit[1].chi2)
         if trial.chi2 < kept.chi2:
-            best, kept = moved(shift), trial
+            best, kept = pose, trial
     return best, kept
 
 
