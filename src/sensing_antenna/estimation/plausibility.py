@@ -84,6 +84,7 @@ from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
+from sensing_antenna.torque_point import metadata_line
 from sensing_antenna.units_check import angle_problem
 
 __all__ = ["review"]
@@ -489,7 +490,7 @@ def _behind_the_clamp(link: Link, excess: float) -> str:
         return ""
     return (
         f"; or, the same moment, torques taken about a point {100 * behind:.1f} cm behind the"
-        f" clamp that the recording does not state ('# torque_point: [{-behind:.3f}, 0, 0]',"
+        f" clamp that the recording does not state ('{metadata_line((-behind, 0.0, 0.0))}',"
         " docs/recording-format.md)"
     )
 
