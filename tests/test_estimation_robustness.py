@@ -213,6 +213,23 @@ def test_at_250_hz_gaps_are_bridged_for_20_ms_and_corrupted_runs_for_20_samples(
             assert result.ok and abs(result.x_c - clean.x_c) < 1e-3, (count, result.reason)
 
 
+@pytest.mark.parametrize("sample_period", [5e-4, 2e-3])
+def test_a_device_sampled_at_2_khz_or_500_hz_is_read_as_at_1_khz(sample_period: float) -> None:
+    # the simulated head's controller and samples at another rate: the same manoeuvre, so both
+    # methods answer ok within the fast method's 3 mm target of the simulator's truth (at
+    # 1 kHz both are within 0.3 mm here; at 500 Hz the window holds half the samples)
+    antenna = calibrated()
+    scenario = Scenario(case="azimuthal", contact_point=0.5, seed=2, sample_period=sample_period)
+    recording = simulate(antenna, scenario)
+    assert float(recording.metadata["sample_period"]) == sample_period
+    assert recording.t[1] - recording.t[0] == pytest.approx(sample_period, rel=1e-9)
+    truth = float(recording.metadata["true_xc"])
+    for method in ("paper", "fast"):
+        result = estimate(recording, antenna, method=method)
+        assert result.ok, (method, result.reason)
+        assert abs(result.x_c - truth) < 3e-3, method
+
+
 def test_a_contact_found_inside_a_gap_is_said_to_be_maybe_the_gap() -> None:
     # 0.3 s lost while the head turns: the straight line across the gap is a jump the observer
     # of a low threshold cannot follow, and the detector fires on it

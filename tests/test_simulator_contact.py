@@ -133,10 +133,14 @@ def test_default_push_keeps_the_deflection_small(
     assert ratio == pytest.approx(turned, abs=1e-3)
 
 
-def test_servo_lag_compensation_stops_the_joint_where_it_was_at_t1(identified: Antenna) -> None:
+@pytest.mark.parametrize("sample_period", [1e-3, 4e-3, 2.5e-4])
+def test_servo_lag_compensation_stops_the_joint_where_it_was_at_t1(
+    identified: Antenna, sample_period: float
+) -> None:
     """Eq. 14 ramp lag: freezing the reference at r(t_1) the joint travels 2 eps omega* further;
     freezing it at r(t_1) - 2 eps omega* it comes back to rest at theta(t_1) after an overshoot of
-    eps omega* / e (the response of 1 / (1 + eps s)^2 to that input, docs/simulator.md)."""
+    eps omega* / e (the response of 1 / (1 + eps s)^2 to that input, docs/simulator.md). The
+    controller discretised at 250 Hz and 4 kHz follows the same continuous design."""
     eps = 1.0 / 60.0  # s, default servo pole -60 rad/s
     speed = 0.3  # rad/s, default sweep
     travel = []
@@ -148,6 +152,7 @@ def test_servo_lag_compensation_stops_the_joint_where_it_was_at_t1(identified: A
             noise_scale=0.0,
             duration=2.0,
             compensate_servo_lag=compensate,
+            sample_period=sample_period,
         )
         detail = simulate_detailed(identified, scenario)
         assert detail.stop_index is not None

@@ -10,8 +10,9 @@ import pytest
 from sensing_antenna.antenna import paper_antenna
 from sensing_antenna.recording import MAX_FILE_BYTES, MAX_SAMPLES
 from sensing_antenna.simulator import Scenario, ScenarioError
-from sensing_antenna.simulator.run import SAMPLE_PERIOD, simulate_detailed
+from sensing_antenna.simulator.run import simulate_detailed
 from sensing_antenna.simulator.scenario import (
+    DEFAULT_SAMPLE_PERIOD,
     MAX_DURATION,
     MAX_ELEMENTS,
     MAX_SIMULATED_SAMPLES,
@@ -28,7 +29,7 @@ def test_a_duration_past_the_budget_is_refused_up_front(case: str) -> None:
     with pytest.raises(ScenarioError) as info:
         Scenario(case=case, contact_point=contact, duration=1e9)  # type: ignore[arg-type]
     assert str(info.value) == (
-        "scenario.duration: 1000000000.0 s is more than 600 s: 600000 samples at 1 kHz, the"
+        "scenario.duration: 1000000000.0 s is more than 600 s: 600000 samples at 1000 Hz, the"
         " limit that keeps a simulation's memory and its recording bounded"
     )
     assert Scenario(case=case, contact_point=contact, duration=MAX_DURATION).duration == 600.0  # type: ignore[arg-type]
@@ -42,6 +43,12 @@ def test_duration_problem_is_the_check_a_campaign_runs_on_its_own_fields() -> No
     assert duration_problem(np.float64("nan")) == "must be a finite number, got nan"
     assert duration_problem("long") == "must be a finite number, got 'long'"
     assert duration_problem(True) == "must be a finite number, got True"
+    # the budget is in samples: at 10 kHz a tenth of the duration
+    assert duration_problem(60.0, 1e-4) is None
+    assert duration_problem(61.0, 1e-4) == (
+        "61.0 s is more than 60 s: 600000 samples at 10000 Hz, the limit that keeps a"
+        " simulation's memory and its recording bounded"
+    )
 
 
 def test_the_budget_fits_the_simulator_and_the_recording_reader() -> None:
@@ -55,7 +62,7 @@ def test_the_budget_fits_the_simulator_and_the_recording_reader() -> None:
     columns = 9 + len(recording.extra)
     assert columns == 17
     longest_row = columns * 24 + columns
-    assert round(MAX_DURATION / SAMPLE_PERIOD) == MAX_SIMULATED_SAMPLES
+    assert round(MAX_DURATION / DEFAULT_SAMPLE_PERIOD) == MAX_SIMULATED_SAMPLES
     assert MAX_SIMULATED_SAMPLES <= MAX_SAMPLES
     assert MAX_SIMULATED_SAMPLES * longest_row + 2**16 <= MAX_FILE_BYTES
 
@@ -77,6 +84,9 @@ def test_the_budget_fits_the_simulator_and_the_recording_reader() -> None:
         ("description", " padded", "one line"),
         ("noise_scale", np.float64("nan"), "must be a finite number, got nan"),
         ("noise_scale", 1e300, "must be at most 1000 (times the sensor's noise), got 1e+300"),
+        ("sample_period", 1.0, "must be between 0.0001 and 0.005 s (200 Hz to 10000 Hz)"),
+        ("sample_period", 0.0, "must be between 0.0001 and 0.005 s (200 Hz to 10000 Hz)"),
+        ("sample_period", np.float64("inf"), "must be a finite number, got inf"),
     ],
 )
 def test_each_limit_names_its_field_in_one_line(field: str, value: object, words: str) -> None:

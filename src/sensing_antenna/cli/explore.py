@@ -141,7 +141,10 @@ def _run(args: argparse.Namespace) -> int:
     device = load_antenna(args.antenna)
     coarse = sampling_warning(device)
     if coarse is not None:  # before the banner: nothing will be explored
-        raise ArgumentError("--antenna", f"{device.name}: link: {coarse}")
+        raise ArgumentError(
+            "--antenna",
+            f"{device.name}: link: {coarse}; antenna explore simulates a device sampled at 1 kHz",
+        )
     meshes = read_objects(args.objects, "antenna explore", args.objects_unit)
     settings = ExploreSettings(
         method=args.method,

@@ -106,6 +106,14 @@ def register(subparsers: Any) -> None:
         "for pushes beyond 10 %% of x_c; about 3 times slower)",
     )
     parser.add_argument(
+        "--sample-rate",
+        type=number(0.0, low_open=True, unit="Hz"),
+        default=None,
+        metavar="HZ",
+        help="the device's sampling and control rate: the recording's samples and the head's "
+        "controller loop (Hz; default 1000, the paper's device)",
+    )
+    parser.add_argument(
         "--commands",
         action="store_true",
         help="also record the motor voltages u1, u2 (what antenna identify --servo fits)",
@@ -122,7 +130,15 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.recording import write_recording
     from sensing_antenna.simulator import Scenario, simulate
     from sensing_antenna.simulator.run import deflection_warning, sampling_warning
+    from sensing_antenna.simulator.scenario import DEFAULT_SAMPLE_PERIOD, SAMPLE_PERIOD_RANGE
 
+    period = DEFAULT_SAMPLE_PERIOD if args.sample_rate is None else 1.0 / args.sample_rate
+    if not SAMPLE_PERIOD_RANGE[0] <= period <= SAMPLE_PERIOD_RANGE[1]:
+        raise ArgumentError(
+            "--sample-rate",
+            f"must be between {1 / SAMPLE_PERIOD_RANGE[1]:g} and {1 / SAMPLE_PERIOD_RANGE[0]:g}"
+            f" Hz, got {args.sample_rate:g}",
+        )
     antenna = load_antenna(args.antenna)
     _check_contact_point(args.case, args.xc, antenna.link)
     device = load_device(args.device, args.seed, antenna.link.length)
@@ -143,13 +159,14 @@ def _run(args: argparse.Namespace) -> int:
         push=push,
         sweep_direction=1 if args.direction == "up" else -1,
         retract_after=args.retract_after,
+        sample_period=period,
     )
     recording = simulate(antenna, scenario, record_commands=args.commands)
     write_recording(recording, args.out)
     print(summary(str(args.out), scenario, recording.n_samples, recording.metadata))
-    coarse = sampling_warning(antenna)
+    coarse = sampling_warning(antenna, scenario.sample_period)
     if coarse is not None:
-        print(f"warning: {coarse}", file=sys.stderr)
+        print(f"warning: {coarse} (--sample-rate)", file=sys.stderr)
     short = window_warning(scenario, recording.metadata)
     if short is not None:
         print(short, file=sys.stderr)

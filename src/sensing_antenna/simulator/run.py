@@ -40,6 +40,7 @@ from sensing_antenna.simulator.manoeuvre import ramp_displacement, sweep_referen
 from sensing_antenna.simulator.nonlinear_link import node_masses, static_equilibrium
 from sensing_antenna.simulator.scenario import (
     DEFAULT_CONTACT_STIFFNESS,
+    DEFAULT_SAMPLE_PERIOD,
     FREE_CASES,
     SIZED_KINDS,
     Scenario,
@@ -50,7 +51,6 @@ __all__ = [
     "FINAL_AVERAGE_TIME",
     "MIN_STIFFNESS_RATIO",
     "NONLINEAR_ANGLE_LIMIT_DEG",
-    "SAMPLE_PERIOD",
     "SMALL_DEFLECTION_LIMIT",
     "SimulationDetail",
     "StopRule",
@@ -61,9 +61,6 @@ __all__ = [
     "simulate",
     "simulate_detailed",
 ]
-
-#: Sampling and control period T_s of the paper's device (s).
-SAMPLE_PERIOD = 1e-3
 
 #: Contact search starts this fraction of l away from the clamp.
 CONTACT_SEARCH_START = 0.02
@@ -228,21 +225,23 @@ def _contact_deflection(
     return np.where(truth[:, 2] > 0.5, deflection, np.nan)
 
 
-def sampling_warning(antenna: Antenna) -> str | None:
-    """A one-line warning when the estimators cannot read ``antenna``'s link from the samples
-    the simulator writes (every :data:`SAMPLE_PERIOD`): its contact frequencies reach beyond
-    what that period resolves (a short, stiff link), else None."""
+def sampling_warning(antenna: Antenna, sample_period: float = DEFAULT_SAMPLE_PERIOD) -> str | None:
+    """A one-line warning when the estimators cannot read ``antenna``'s link from samples every
+    ``sample_period`` (s): its contact frequencies reach beyond what that period resolves (a
+    short, stiff link), else None. The line names the slowest sampling that does."""
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.estimation.front.evidence import search_band
-    from sensing_antenna.estimation.front.steps import sampling_problem
+    from sensing_antenna.estimation.front.steps import slowest_sample_rate
 
     config = EstimatorConfig()
-    problem = sampling_problem(SAMPLE_PERIOD, search_band(antenna.link, config)[1], config)
-    if problem is None:
+    band_top = search_band(antenna.link, config)[1]
+    rate = slowest_sample_rate(band_top, config)
+    if rate * sample_period <= 1.0:
         return None
     return (
-        f"the simulator records every {SAMPLE_PERIOD:g} s, too coarse for this antenna's link:"
-        f" {problem.split(': ', 1)[-1]}, so no estimator reads its recordings"
+        f"samples at {1.0 / sample_period:g} Hz are too slow for this antenna's link: its"
+        f" omega_1 reaches {band_top:.0f} rad/s, which needs samples at {math.ceil(rate)} Hz or"
+        " faster, so no estimator reads its recordings"
     )
 
 
@@ -280,11 +279,11 @@ def _effective_inverse(
     return damping, ainv, z
 
 
-def _default_stop_rule(antenna: Antenna, push: Any) -> StopRule:
+def _default_stop_rule(antenna: Antenna, push: Any, sample_period: float) -> StopRule:
     from sensing_antenna.detection.push import PushCriterion, PushMonitor
 
     criterion = PushCriterion() if push is None else push
-    return PushMonitor(criterion, antenna, SAMPLE_PERIOD)
+    return PushMonitor(criterion, antenna, sample_period)
 
 
 def simulate(
@@ -349,7 +348,7 @@ def simulate_detailed(
     """
     limits = (math.inf, math.inf) if torque_limit is None else tuple(map(float, torque_limit))
     link = device_link(antenna.link)
-    ts = SAMPLE_PERIOD
+    ts = scenario.sample_period
     n_samples = round(scenario.duration / ts)
     t: NDArray[np.float64] = np.arange(n_samples, dtype=np.float64) * ts
     imperfect = scenario.device.link_part  # the key of the cached link set-up
@@ -541,7 +540,7 @@ def simulate_detailed(
 
     stop_index: int | None = None
     if scenario.case not in FREE_CASES:
-        rule = _default_stop_rule(antenna, scenario.push) if stop_rule is None else stop_rule
+        rule = _default_stop_rule(antenna, scenario.push, ts) if stop_rule is None else stop_rule
         rule.reset()
         for k in range(n_samples):
             advance(k, k + 1)
@@ -585,6 +584,7 @@ def simulate_detailed(
         )
     in_contact = truth[:, 2] > 0.5
     deflection = _contact_deflection(link, scenario.n_elements, truth, gravity, imperfect)
+    final = max(1, round(FINAL_AVERAGE_TIME / ts))
     first_touch = float(cs[12]) if cs[12] >= 0 else None
     metadata: dict[str, str] = {
         "format": FORMAT_NAME,
@@ -603,7 +603,7 @@ def simulate_detailed(
         metadata["true_in_contact_at_end"] = "true" if in_contact[-1] else "false"
         metadata["true_t_stop"] = "nan" if stop_index is None else repr(float(t[stop_index]))
         metadata["true_deflection_ratio"] = repr(
-            _final_deflection_ratio(deflection, truth[:, 3], in_contact)
+            _final_deflection_ratio(deflection[-final:], truth[-final:, 3], in_contact[-final:])
         )
     metadata["seed"] = str(scenario.seed)
     metadata["simulation"] = json.dumps(
@@ -684,12 +684,12 @@ def _final_deflection_ratio(
     abscissa: NDArray[np.float64],
     in_contact: NDArray[np.bool_],
 ) -> float:
-    """Mean y_c / x_c over the last ``FINAL_AVERAGE_TIME`` (the hold), NaN unless the link is
-    in contact over all of it (the mean over a few periods removes most of the vibration)."""
-    n = max(1, round(FINAL_AVERAGE_TIME / SAMPLE_PERIOD))
-    if not in_contact[-n:].all():
+    """Mean y_c / x_c over the samples given (the hold's last ``FINAL_AVERAGE_TIME``), NaN
+    unless the link is in contact over all of them (the mean over a few periods removes most of
+    the vibration)."""
+    if not in_contact.all():
         return math.nan
-    return float(np.mean(deflection[-n:] / abscissa[-n:]))
+    return float(np.mean(deflection / abscissa))
 
 
 def _describe(scenario: Scenario, kind: str | None) -> str:

@@ -20,6 +20,7 @@ __all__ = [
     "CASES",
     "CONTACT_STIFFNESS_RATIO",
     "DEFAULT_CONTACT_STIFFNESS",
+    "DEFAULT_SAMPLE_PERIOD",
     "FREE_CASES",
     "FREE_CASE_OF",
     "LINK_MODELS",
@@ -32,6 +33,7 @@ __all__ = [
     "MIN_SUBSTEPS",
     "OBSTACLE_KINDS",
     "PLACED_KINDS",
+    "SAMPLE_PERIOD_RANGE",
     "Scenario",
     "ScenarioError",
     "SensorNoise",
@@ -68,9 +70,17 @@ ATI_NANO17_RESOLUTION = (
     1.0 / 32000.0,
 )
 
+#: Sampling and control period T_s of the paper's device (s), 1 kHz: the default
+#: ``Scenario.sample_period``.
+DEFAULT_SAMPLE_PERIOD = 1e-3
+
+#: Range of ``Scenario.sample_period`` (s): 10 kHz to 200 Hz. Faster than 10 kHz an F/T
+#: sensor's output is past its own filters; slower than 200 Hz the servo's default pole
+#: (|p| T_s over ``control.servo.MAX_POLE_STEP``) no longer follows its design.
+SAMPLE_PERIOD_RANGE = (1e-4, 5e-3)
 
 #: Largest number of samples one simulated manoeuvre may record: 600,000, ten minutes at the
-#: simulator's 1 kHz, where a manoeuvre lasts seconds (3.5 s by default). Memory grows with the
+#: paper device's 1 kHz, where a manoeuvre lasts seconds (3.5 s by default). Memory grows with the
 #: samples (references, measurements, ground truth, the recording and its text), so this keeps
 #: ``antenna simulate`` under a gigabyte (docs/simulator.md, "Scenario limits"), and the recording
 #: it writes, at most 425 bytes per sample (seventeen columns of at most 24 characters: the
@@ -78,9 +88,9 @@ ATI_NANO17_RESOLUTION = (
 #: ``recording.MAX_FILE_BYTES``.
 MAX_SIMULATED_SAMPLES = 600_000
 
-#: Longest ``duration`` (s): :data:`MAX_SIMULATED_SAMPLES` at the simulator's 1 kHz
-#: (``simulator.run.SAMPLE_PERIOD``), 600 s.
-MAX_DURATION = MAX_SIMULATED_SAMPLES * 1e-3
+#: Longest ``duration`` (s): :data:`MAX_SIMULATED_SAMPLES` at the default 1 kHz
+#: (:data:`DEFAULT_SAMPLE_PERIOD`), 600 s; a faster sampling shortens it in proportion.
+MAX_DURATION = MAX_SIMULATED_SAMPLES * DEFAULT_SAMPLE_PERIOD
 
 #: Most finite elements of the link: 128. The first free frequency converges as h^4 and 16
 #: elements already give 1e-6 (docs/simulator.md), so 128 give about 2e-10; each time step costs
@@ -91,7 +101,7 @@ MAX_ELEMENTS = 128
 #: noise sweep stops at 4); beyond it a typing error, and the samples could overflow.
 MAX_NOISE_SCALE = 1000.0
 
-#: Most internal Newmark steps per 1 ms sample: 100 (a 10 us step). The integrator is
+#: Most internal Newmark steps per sample: 100 (a 10 us step at 1 kHz). The integrator is
 #: unconditionally stable, so more steps only refine the step error; the cost grows with them.
 MAX_SUBSTEPS = 100
 
@@ -106,7 +116,7 @@ DEFAULT_CONTACT_STIFFNESS = 1.0e4
 #: 0.12 m with 1e4 N/m), 150 times keeps it within about 0.1 %.
 CONTACT_STIFFNESS_RATIO = 150.0
 
-#: Fewest Newmark steps per 1 ms sample by default.
+#: Fewest Newmark steps per sample by default.
 MIN_SUBSTEPS = 2
 
 #: Largest omega h (rad) of the default step at the link's highest first contact frequency:
@@ -134,11 +144,13 @@ _UPPER_LIMITS: dict[str, tuple[float, str, str]] = {
 }
 
 
-def duration_problem(duration: object) -> str | None:
-    """Why ``duration`` (s) cannot be the recorded time of a simulated manoeuvre, or None.
+def duration_problem(duration: object, sample_period: float = DEFAULT_SAMPLE_PERIOD) -> str | None:
+    """Why ``duration`` (s) cannot be the recorded time of a simulated manoeuvre sampled every
+    ``sample_period`` (s), or None.
 
-    It must be a finite number above 0.01 s and at most :data:`MAX_DURATION`. A campaign checks
-    its spec's durations with it before running anything, naming its own field.
+    It must be a finite number above 0.01 s and hold at most :data:`MAX_SIMULATED_SAMPLES`
+    samples (:data:`MAX_DURATION` at 1 kHz). A campaign checks its spec's durations with it
+    before running anything, naming its own field.
     """
     if (
         isinstance(duration, bool)
@@ -148,11 +160,12 @@ def duration_problem(duration: object) -> str | None:
         return f"must be a finite number, got {format_value(duration)}"
     if not duration > 0.01:
         return f"must be > 0.01 s, got {format_value(duration)}"
-    if duration > MAX_DURATION:
+    longest = MAX_SIMULATED_SAMPLES * sample_period
+    if duration > longest:
         return (
-            f"{format_value(duration)} s is more than {MAX_DURATION:g} s:"
-            f" {MAX_SIMULATED_SAMPLES} samples at 1 kHz, the limit that keeps a simulation's"
-            " memory and its recording bounded"
+            f"{format_value(duration)} s is more than {longest:g} s:"
+            f" {MAX_SIMULATED_SAMPLES} samples at {1.0 / sample_period:g} Hz, the limit that"
+            " keeps a simulation's memory and its recording bounded"
         )
     return None
 
@@ -307,6 +320,10 @@ class Scenario:
     retract_angle : float
         How far the retraction turns the swept joint back (rad, > 0); it must exceed the push
         past the touch for the link to leave the obstacle.
+    sample_period : float
+        Period T_s of the recorded samples and of the head's controller (s), within
+        :data:`SAMPLE_PERIOD_RANGE`; default 1 ms, the paper device's 1 kHz. The sensor's noise
+        (``sensor.wrench_std``) is per sample at any period.
     n_elements : int
         Finite elements of the link.
     link_model : {"linear", "nonlinear"}
@@ -315,7 +332,7 @@ class Scenario:
         shortening, friction along the link; ``simulator.nonlinear_link``), for pushes beyond
         about 10 % of x_c; 3 to 6 times slower (docs/simulator.md, "Large deflection").
     substeps : int or None
-        Internal Newmark steps per 1 ms sample. None: enough that omega h stays within
+        Internal Newmark steps per sample. None: enough that omega h stays within
         :data:`MAX_STEP_PHASE` at the link's highest first contact frequency over [0.3 l, l]
         (a period 0.1 % long at most), at least :data:`MIN_SUBSTEPS` (2 for the paper's link, 8
         for a 0.35 m carbon rod ringing at up to 776 rad/s).
@@ -357,6 +374,7 @@ class Scenario:
     compensate_servo_lag: bool = True
     retract_after: float | None = None
     retract_angle: float = 0.1
+    sample_period: float = DEFAULT_SAMPLE_PERIOD
     n_elements: int = 16
     substeps: int | None = None
     link_model: Literal["linear", "nonlinear"] = "linear"
@@ -397,7 +415,15 @@ class Scenario:
             )
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise ScenarioError("seed", f"must be an integer >= 0, got {format_value(self.seed)}")
-        problem = duration_problem(self.duration)
+        _finite("sample_period", self.sample_period)
+        low, high = SAMPLE_PERIOD_RANGE
+        if not low <= self.sample_period <= high:
+            raise ScenarioError(
+                "sample_period",
+                f"must be between {low:g} and {high:g} s ({1 / high:g} Hz to {1 / low:g} Hz),"
+                f" got {format_value(self.sample_period)}",
+            )
+        problem = duration_problem(self.duration, self.sample_period)
         if problem is not None:
             raise ScenarioError("duration", problem)
         for name in ("noise_scale", "damping_ratio", "friction_coefficient", "contact_damping"):
@@ -462,9 +488,11 @@ class Scenario:
             raise ScenarioError(
                 "servo_pole", f"must be < 0 (stable), got {format_value(self.servo_pole)}"
             )
-        if -self.servo_pole * 1e-3 > MAX_POLE_STEP:
+        if -self.servo_pole * self.sample_period > MAX_POLE_STEP:
             raise ScenarioError(
-                "servo_pole", f"too fast for the 1 kHz controller (|p| T_s > {MAX_POLE_STEP:g})"
+                "servo_pole",
+                f"too fast for the {1 / self.sample_period:g} Hz controller"
+                f" (|p| T_s > {MAX_POLE_STEP:g})",
             )
         if not isinstance(self.compensate_servo_lag, bool):
             raise ScenarioError(

@@ -67,6 +67,7 @@ __all__ = [
     "samples_missing",
     "sampling_problem",
     "settled_loads",
+    "slowest_sample_rate",
     "still_angles_turn",
     "time_gaps",
 ]
@@ -97,11 +98,17 @@ def hold_window(rest_index: int, n: int, cfg: EstimatorConfig, ts: float) -> sli
     return slice(rest_index, min(rest_index + samples(cfg.frame_window, ts) + 1, n))
 
 
+def slowest_sample_rate(band_top: float, cfg: EstimatorConfig) -> float:
+    """The slowest sampling (Hz) whose Nyquist frequency is ``cfg.min_nyquist_factor`` times
+    the top of the omega_1 band ``band_top`` (rad/s): what :func:`sampling_problem` asks."""
+    return cfg.min_nyquist_factor * band_top / math.pi
+
+
 def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig) -> str | None:
     """Why samples at this period cannot show the vibration (bad input), or None.
 
     The Nyquist frequency pi / T_s must exceed ``cfg.min_nyquist_factor`` times the top of the
-    omega_1 band ``band_top`` (rad/s).
+    omega_1 band ``band_top`` (rad/s): the sampling at least :func:`slowest_sample_rate`.
     """
     nyquist = math.pi / sample_period
     if nyquist < cfg.min_nyquist_factor * band_top:
@@ -112,7 +119,7 @@ def sampling_problem(sample_period: float, band_top: float, cfg: EstimatorConfig
                 and sample_period >= 0.5 * factor / 1e3
             )
         )
-        rate = cfg.min_nyquist_factor * band_top / math.pi  # Hz
+        rate = slowest_sample_rate(band_top, cfg)
         return (
             f"sample period {sample_period:g} s: the Nyquist frequency {nyquist:.0f} rad/s is "
             f"below {cfg.min_nyquist_factor:g} times the top of the omega_1 band "
