@@ -46,7 +46,7 @@ def _closed_loop(
     under a HeadController: the command held over each sample (zero-order hold), the motor
     integrated exactly over the sample (matrix exponential), a constant coupling torque Gamma
     measured without error. Returns the times (n,) and the angles (n, 2) at the samples."""
-    controller = HeadController(antenna, POLE, sample_period, coupling_feedback=coupling_feedback)
+    controller = HeadController(antenna, sample_period, POLE, coupling_feedback=coupling_feedback)
     controller.reset(origin=(0.0, 0.0))
     transitions = []
     for motor in antenna.motors:
@@ -121,7 +121,7 @@ def test_simulator_runs_the_library_controller_to_the_bit(scenario: Scenario) ->
     rec = detail.recording
     reference = np.column_stack([rec.extra["theta1_ref"], rec.extra["theta2_ref"]])
     coupling = coupling_torques(rec.theta, rec.torque)
-    controller = HeadController(antenna, scenario.servo_pole, rec.sample_period)
+    controller = HeadController(antenna, rec.sample_period, scenario.servo_pole)
     np.testing.assert_array_equal(
         controller.voltage(controller.step_block(reference, rec.theta, coupling)), detail.voltage
     )
@@ -164,18 +164,18 @@ def test_observer_step_equals_batch_and_the_detection_filter() -> None:
 def test_bad_controller_input_is_one_clear_error() -> None:
     antenna = paper_antenna()
     with pytest.raises(ControlConfigError, match="pole"):
-        HeadController(antenna, pole=10.0)
+        HeadController(antenna, TS, pole=10.0)
     with pytest.raises(ControlConfigError, match="sample_period"):
         HeadController(antenna, sample_period=0.0)
     # four poles at -1500 rad/s sampled at 1 kHz: the discrete servo diverges; 300 is the most
     with pytest.raises(ControlConfigError, match=r"too fast .* at most 300 rad/s"):
-        HeadController(antenna, pole=-1500.0)
-    HeadController(antenna, pole=-300.0)
-    controller = HeadController(antenna)
+        HeadController(antenna, TS, pole=-1500.0)
+    HeadController(antenna, TS, pole=-300.0)
+    controller = HeadController(antenna, TS)
     with pytest.raises(ValueError, match="reference"):
         controller.step((0.0, 0.0, 0.0), (0.0, 0.0), (0.0, 0.0))
     with pytest.raises(ValueError, match="measured"):
-        CouplingTorqueObserver(antenna.observer).step((0.0,))
+        CouplingTorqueObserver(antenna.observer, TS).step((0.0,))
 
 
 def test_a_glitch_is_refused_and_leaves_the_loop_as_it_was() -> None:
@@ -186,8 +186,8 @@ def test_a_glitch_is_refused_and_leaves_the_loop_as_it_was() -> None:
     reference = np.column_stack([np.linspace(0.0, 0.02, 50), np.zeros(50)])
     measured = 0.9 * reference
     coupling = np.full((50, 2), 1e-3)
-    clean, glitched = HeadController(antenna), HeadController(antenna)
-    observed, observed_glitched = (CouplingTorqueObserver(antenna.observer) for _ in range(2))
+    clean, glitched = HeadController(antenna, TS), HeadController(antenna, TS)
+    observed, observed_glitched = (CouplingTorqueObserver(antenna.observer, TS) for _ in range(2))
     for controller in (clean, glitched):
         controller.reset(origin=np.zeros(2))
     for k in range(50):
@@ -205,6 +205,6 @@ def test_a_glitch_is_refused_and_leaves_the_loop_as_it_was() -> None:
     bad = measured.copy()
     bad[7, 1] = math.nan
     with pytest.raises(ValueError, match=r"measured: .* at row 7"):
-        HeadController(antenna).step_block(reference, bad, coupling)
+        HeadController(antenna, TS).step_block(reference, bad, coupling)
     with pytest.raises(ValueError, match="at row 7"):
-        CouplingTorqueObserver(antenna.observer).step_block(bad)
+        CouplingTorqueObserver(antenna.observer, TS).step_block(bad)

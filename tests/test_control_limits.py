@@ -91,7 +91,7 @@ def _reference_loop(motor: Motor, limit: float, anti_windup: bool) -> tuple[np.n
 
 def _library_loop(antenna: Antenna, **limits: float) -> tuple[np.ndarray, np.ndarray]:
     """Both joints under HeadController on the same discretised motors: angles and commands."""
-    controller = HeadController(antenna, POLE, TS, **limits)
+    controller = HeadController(antenna, TS, POLE, **limits)
     controller.reset(origin=(0.0, 0.0))
     plants = [_motor_zoh(m) for m in antenna.motors]
     count = round(DURATION / TS)
@@ -159,7 +159,7 @@ def test_a_slack_limit_changes_nothing_to_the_bit() -> None:
 def test_voltage_limit_is_the_torque_limit_over_n_km() -> None:
     antenna = _without_coulomb(paper_antenna())
     gains = [m.gear_ratio * m.torque_constant for m in antenna.motors]
-    by_voltage = HeadController(antenna, voltage_limit=(2.0, 3.0))
+    by_voltage = HeadController(antenna, TS, voltage_limit=(2.0, 3.0))
     np.testing.assert_array_equal(by_voltage.torque_limits, [2.0 * gains[0], 3.0 * gains[1]])
     # per joint: the azimuth limited, the elevation free
     limit = _limits(antenna, 0.25)[0]
@@ -167,7 +167,7 @@ def test_voltage_limit_is_the_torque_limit_over_n_km() -> None:
     _, free_command = _library_loop(antenna)
     assert np.abs(command[:, 0]).max() == limit
     np.testing.assert_array_equal(command[:, 1], free_command[:, 1])
-    np.testing.assert_array_equal(HeadController(antenna).torque_limits, [np.inf, np.inf])
+    np.testing.assert_array_equal(HeadController(antenna, TS).torque_limits, [np.inf, np.inf])
 
 
 @pytest.mark.parametrize(
@@ -182,4 +182,4 @@ def test_voltage_limit_is_the_torque_limit_over_n_km() -> None:
 )
 def test_bad_limits_are_one_clear_error(limits: dict[str, object], match: str) -> None:
     with pytest.raises(ControlConfigError, match=match):
-        HeadController(paper_antenna(), **limits)  # type: ignore[arg-type]
+        HeadController(paper_antenna(), TS, **limits)  # type: ignore[arg-type]

@@ -549,8 +549,41 @@ def test_a_stream_stamped_in_milliseconds_is_told_so() -> None:
             break
     result = result if result is not None else online.finalize()
     assert result.status is Status.BAD_INPUT
-    assert (result.reason or "").startswith("t: 999 samples missing between ")
-    assert (result.reason or "").endswith(" (time stamps in ms? the format's are in s)")
+    assert (result.reason or "").startswith(
+        "sample_period: declared 0.001 s, but its time stamps step by 1 s"
+    )
+    assert " (time stamps in ms? the format's are in s)" in (result.reason or "")
+
+
+def test_a_stream_at_another_period_than_declared_is_bad_input() -> None:
+    # a 500 Hz loop's samples fed to an estimator built for 1 kHz: every step would be a sample
+    # put back, and the filters built for 1 kHz. The first twenty steps say so; built for the
+    # samples' period, the same samples are read
+    antenna = calibrated()
+    scenario = Scenario(case="azimuthal", contact_point=0.5, seed=2, sample_period=2e-3)
+    recording = simulate(antenna, scenario)
+
+    def fed(period: float, count: int) -> ContactEstimate:
+        online = OnlineEstimator(antenna, period)
+        for k in range(count):
+            result = online.update(
+                recording.t[k], recording.theta[k], recording.force[k], recording.torque[k]
+            )
+            if result is not None:
+                return result
+        return online.finalize()
+
+    wrong = fed(1e-3, recording.n_samples)
+    assert wrong.status is Status.BAD_INPUT
+    assert wrong.reason == (
+        "sample_period: declared 0.001 s, but its time stamps step by 0.002 s (the median of its"
+        " first 20 steps), more than 2 % apart: the estimates need the period the samples have"
+    )
+    assert wrong.t_c != wrong.t_c  # refused at the twentieth step, long before any contact
+    short = fed(1e-3, 10)  # a stream that ends first is judged on the steps it has
+    assert short.status is Status.BAD_INPUT
+    assert (short.reason or "").startswith("sample_period: declared 0.001 s, but its time stamps")
+    assert fed(2e-3, recording.n_samples).ok
 
 
 @pytest.mark.parametrize("stamp", [math.inf, -math.inf])

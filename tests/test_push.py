@@ -168,6 +168,56 @@ def test_streaming_equals_batch(kind: str, threshold: float) -> None:
     np.testing.assert_array_equal(blocks.measure, batch.measure)
 
 
+@pytest.mark.parametrize(("row", "channel"), [(1200, "theta"), (1600, "force"), (1700, "torque")])
+def test_a_sample_that_is_not_finite_is_refused_and_the_monitor_goes_on(
+    row: int, channel: str
+) -> None:
+    # a control loop's glitch: a NaN in one sample. Fed, it would hold the observer's and the
+    # filters' states at NaN, and neither t_c nor t_1 would ever come while the head swept on.
+    # Refused with the monitor's state unchanged, the loop skips the sample and the decisions
+    # come where the clean samples put them
+    rec = _manoeuvre()
+    clean = detect_push(rec, ANTENNA)
+    monitor = PushMonitor(PushCriterion(), ANTENNA, TS)
+    values = {"theta": rec.theta, "force": rec.force, "torque": rec.torque}
+    for k in range(rec.n_samples):
+        sample = {name: v[k].copy() for name, v in values.items()}
+        if k == row:
+            sample[channel][1] = math.nan
+            with pytest.raises(ValueError, match=rf"^{channel}: \[.*nan.*\] is not finite"):
+                monitor.update(rec.t[k], sample["theta"], sample["force"], sample["torque"])
+            continue
+        monitor.update(rec.t[k], sample["theta"], sample["force"], sample["torque"])
+    # one sample fewer before the push: the decisions move by one sample at most (1 % for the
+    # sums of stamps that are not exact in binary)
+    assert clean.t_c is not None and monitor.contact_time is not None
+    assert abs(monitor.contact_time - clean.t_c) <= 1.01 * TS
+    assert monitor.push_time is not None and abs(monitor.push_time - clean.t_1) <= 1.01 * TS
+
+
+def test_samples_at_another_period_than_the_monitors_are_refused() -> None:
+    # a monitor built for a 1 kHz loop fed a 500 Hz loop's samples: its observer and filters
+    # would run at half speed and find a contact in free motion. The time stamps say so once
+    # the first twenty steps are in
+    rec = _manoeuvre()
+    half = Recording(
+        t=rec.t[::2], theta=rec.theta[::2], force=rec.force[::2], torque=rec.torque[::2]
+    )
+    monitor = PushMonitor(PushCriterion(), ANTENNA, TS)
+    for k in range(20):
+        monitor.update(half.t[k], half.theta[k], half.force[k], half.torque[k])
+    with pytest.raises(ValueError) as info:
+        monitor.update(half.t[20], half.theta[20], half.force[20], half.torque[20])
+    assert str(info.value) == (
+        "t: the time stamps step by 0.002 s (the median of the first 20 steps), but the detector"
+        " was built for a sample_period of 0.001 s, more than 2 % apart: build it with the"
+        " samples' period"
+    )
+    built = PushMonitor(PushCriterion(), ANTENNA, 2 * TS)  # built for them: it decides
+    built.update_block(half.t, half.theta, half.force, half.torque)
+    assert built.contact_time is not None and built.push_time is not None
+
+
 def test_link_axis_angle_against_dot_product() -> None:
     # Reference: arccos of the dot product of the X^m unit vectors, accurate for angles that are
     # not tiny (here >= 0.05 rad; error of arccos ~ 1e-16 / angle).

@@ -34,7 +34,7 @@ def _without_coulomb(antenna: Antenna) -> Antenna:
 @pytest.mark.parametrize("motor_index", [0, 1])
 def test_servo_design_places_four_poles_and_gives_eq14(motor_index: int) -> None:
     motor = paper_antenna().motors[motor_index]
-    design = design_servo(motor, -60.0)
+    design = design_servo(motor, -60.0, 1e-3)
     j, v, p = motor.inertia, motor.viscous_friction, design.pole
     a2, a1, a0 = design.feedback
     # s^2 (s + b)(J s + v) + a2 s^2 + a1 s + a0, coefficients in increasing powers

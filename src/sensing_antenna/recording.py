@@ -57,6 +57,7 @@ __all__ = [
     "MAX_SAMPLES",
     "MIN_SAMPLE_PERIOD",
     "NAMED_COLUMNS",
+    "PERIOD_CHECK_STEPS",
     "REFERENCE_COLUMNS",
     "REQUIRED_COLUMNS",
     "Recording",
@@ -128,6 +129,10 @@ CLOCK_TOLERANCE = 1e-3
 #: ``sample_period`` metadata counts as consistent with the data when the median time step is
 #: within this fraction of it (2 %).
 PERIOD_CONSISTENCY = 0.02
+
+#: The time steps from which a stream's period is read and compared with the one declared
+#: before its samples came (the estimators' and the contact detector's checks).
+PERIOD_CHECK_STEPS = 20
 
 #: Largest file :func:`read_recording` reads (bytes): 256 MiB. One sample of the simulator's
 #: fifteen columns at full precision takes about 250 bytes, so this holds more than 15 minutes at

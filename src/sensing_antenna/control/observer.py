@@ -38,7 +38,7 @@ class CouplingTorqueObserver:
     observer : FreeMotionObserver
         K (N m / rad), omega (rad/s), d (1/s), e.g. ``antenna.observer``.
     sample_period : float
-        T_s (s); omega T_s must be below pi.
+        T_s (s), the loop's period (1e-3 for the paper's 1 kHz); omega T_s must be below pi.
 
     Notes
     -----
@@ -47,7 +47,7 @@ class CouplingTorqueObserver:
     (:data:`~sensing_antenna.detection.contact.OBSERVER_TORQUE_SIGNS`).
     """
 
-    def __init__(self, observer: FreeMotionObserver, sample_period: float = 1e-3) -> None:
+    def __init__(self, observer: FreeMotionObserver, sample_period: float) -> None:
         self.observer = observer
         self.sample_period = float(sample_period)
         self._filter = FreeMotionObserverFilter(observer, self.sample_period)
@@ -118,7 +118,7 @@ def _finite(angles: NDArray[np.float64]) -> None:
 
 
 def observe_coupling_torques(
-    measured: ArrayLike, observer: FreeMotionObserver, sample_period: float = 1e-3
+    measured: ArrayLike, observer: FreeMotionObserver, sample_period: float
 ) -> NDArray[np.float64]:
     """Batch Eq. 15 for both joints: a fresh :class:`CouplingTorqueObserver` fed one block.
 

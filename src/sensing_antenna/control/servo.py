@@ -154,7 +154,7 @@ class ServoDesign:
         return out
 
 
-def design_servo(motor: Motor, pole: float, sample_period: float = 1e-3) -> ServoDesign:
+def design_servo(motor: Motor, pole: float, sample_period: float) -> ServoDesign:
     """Place the four closed-loop poles and R1's zeros at ``pole`` (Section 4.1, Eq. 14).
 
     Parameters
@@ -421,10 +421,11 @@ class HeadController:
     antenna : Antenna
         Its motors (Table 1: J, v for the design; K_m, n for the voltage; the Coulomb torque for
         the feedforward).
+    sample_period : float
+        T_s (s), the loop's period: the device's own (1e-3 for the paper's 1 kHz), which the
+        discrete design follows.
     pole : float
         Closed-loop pole p (rad/s), negative.
-    sample_period : float
-        T_s (s), the loop's period.
     coupling_feedback : bool
         Feed the measured coupling torque back (Fig. 7); without it the servo sees the link.
     friction_feedforward : bool
@@ -449,8 +450,8 @@ class HeadController:
     def __init__(
         self,
         antenna: Antenna,
+        sample_period: float,
         pole: float = DEFAULT_SERVO_POLE,
-        sample_period: float = 1e-3,
         coupling_feedback: bool = True,
         friction_feedforward: bool = True,
         friction_speed: float = FRICTION_SPEED,

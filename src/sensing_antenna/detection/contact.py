@@ -56,7 +56,12 @@ from sensing_antenna.detection.filters import (
     observer_coefficients,
 )
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.recording import Recording, resample_uniform
+from sensing_antenna.recording import (
+    PERIOD_CHECK_STEPS,
+    PERIOD_CONSISTENCY,
+    Recording,
+    resample_uniform,
+)
 
 __all__ = [
     "DEFAULT_RESIDUAL_CUTOFF",
@@ -247,6 +252,13 @@ class ContactDetector:
         Cut-off of the residual low-pass filter (rad/s).
     tare_time : float
         Taring window at the start (s), see the module docstring.
+    check_input : bool
+        Refuse with a ValueError, the detector's state unchanged, a sample with a value that is
+        not finite (one would hold every later decision at NaN) and time stamps whose median
+        step over the first ``recording.PERIOD_CHECK_STEPS`` is not ``sample_period`` within
+        ``recording.PERIOD_CONSISTENCY`` (the observer and the filters built for another rate
+        would run at the wrong speed). Off where the caller has put the samples on their
+        period's grid and judged them itself (the estimators' front end).
 
     Attributes
     ----------
@@ -273,9 +285,12 @@ class ContactDetector:
         threshold: float | None = None,
         residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
         tare_time: float = DEFAULT_TARE_TIME,
+        *,
+        check_input: bool = True,
     ) -> None:
         self.antenna = antenna
         self.sample_period = float(sample_period)
+        self.check_input = check_input
         self.threshold = _check_threshold(
             antenna.observer.contact_threshold if threshold is None else threshold
         )
@@ -304,6 +319,8 @@ class ContactDetector:
         self.n_samples = 0
         self.contact_index: int | None = None
         self.contact_time: float | None = None
+        # the first time stamps, until the period is judged (check_input)
+        self._stamps: list[float] | None = [] if self.check_input else None
 
     @property
     def detected(self) -> bool:
@@ -341,7 +358,44 @@ class ContactDetector:
         """
         times = np.asarray(t, dtype=np.float64).reshape(-1)
         count = times.shape[0]
-        return self._feed(times, block_rows(theta, count, 2), block_rows(torque, count, 3))
+        angles, moments = block_rows(theta, count, 2), block_rows(torque, count, 3)
+        if self.check_input:
+            self._check(times, (("theta", angles), ("torque", moments)))
+        return self._feed(times, angles, moments)
+
+    def _check(
+        self, times: NDArray[np.float64], named: Sequence[tuple[str, NDArray[np.float64]]]
+    ) -> None:
+        """Raise a ValueError for a value of the block that is not finite, or for time stamps
+        whose first steps are not the detector's period (``check_input``), before any state
+        moves but the stamps kept for that check."""
+        for name, values in (("t", times[:, None]), *named):
+            if math.isfinite(float(values.sum())):  # the loop's case, cheap
+                continue
+            bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+            if bad.size:
+                where = f" at row {bad[0]}" if values.shape[0] > 1 else ""
+                raise ValueError(
+                    f"{name}: {values[bad[0]].tolist()}{where} is not finite (a glitch of the "
+                    "encoders or the sensor?): the block was not fed, the detector's state is "
+                    "unchanged"
+                )
+        stamps = self._stamps
+        if stamps is None:
+            return
+        stamps.extend(times[: PERIOD_CHECK_STEPS + 1 - len(stamps)].tolist())
+        if len(stamps) < PERIOD_CHECK_STEPS + 1:
+            return
+        self._stamps = None
+        step = float(np.median(np.diff(stamps)))
+        ts = self.sample_period
+        if not abs(step - ts) <= PERIOD_CONSISTENCY * ts:
+            raise ValueError(
+                f"t: the time stamps step by {step:.6g} s (the median of the first"
+                f" {PERIOD_CHECK_STEPS} steps), but the detector was built for a sample_period"
+                f" of {ts!r} s, more than {100 * PERIOD_CONSISTENCY:g} % apart: build it with"
+                " the samples' period"
+            )
 
     def _feed(
         self, times: NDArray[np.float64], angles: NDArray[np.float64], moments: NDArray[np.float64]

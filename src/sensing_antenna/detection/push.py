@@ -279,7 +279,11 @@ class PushMonitor:
         T_s (s).
     contact_detector : ContactDetector, optional
         Detector of t_c, updated by this monitor (do not update it separately); a default
-        ``ContactDetector(antenna, sample_period)`` when None.
+        ``ContactDetector(antenna, sample_period, check_input=check_input)`` when None.
+    check_input : bool
+        As the contact detector's: refuse a value that is not finite, the force too, and time
+        stamps off ``sample_period`` (ValueError, the state unchanged). A given
+        ``contact_detector`` keeps its own setting.
 
     Attributes
     ----------
@@ -304,12 +308,14 @@ class PushMonitor:
         antenna: Antenna,
         sample_period: float,
         contact_detector: ContactDetector | None = None,
+        *,
+        check_input: bool = True,
     ) -> None:
         self.criterion = criterion
         self.antenna = antenna
         self.sample_period = float(sample_period)
         self.contact_detector = (
-            ContactDetector(antenna, sample_period)
+            ContactDetector(antenna, sample_period, check_input=check_input)
             if contact_detector is None
             else contact_detector
         )
@@ -361,6 +367,8 @@ class PushMonitor:
         count = times.shape[0]
         angles = block_rows(theta, count, 2)
         forces, moments = block_rows(force, count, 3), block_rows(torque, count, 3)
+        if detector.check_input:
+            detector._check(times, (("theta", angles), ("force", forces), ("torque", moments)))
         detector._feed(times, angles, moments)
         if start + count > self._measures.shape[0]:
             grown = np.empty(max(start + count, 2 * self._measures.shape[0], 4096))

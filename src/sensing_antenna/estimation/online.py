@@ -39,6 +39,8 @@ class OnlineEstimator:
     antenna : Antenna
     sample_period : float
         T_s (s) of the samples that will be fed (those their time stamps skip are put back).
+        Samples whose first time stamps step by another period are ``bad_input``
+        (:func:`~.front.steps.declared_period_problem`).
     method : str or EstimationMethod
         As for ``estimate``.
     config : EstimatorConfig, optional
@@ -72,7 +74,7 @@ class OnlineEstimator:
         self.sample_period = float(sample_period)
         self.method = resolve_method(method)
         self.config = config if config is not None else EstimatorConfig()
-        self._front = FrontEnd(antenna, self.sample_period, self.config)
+        self._front = FrontEnd(antenna, self.sample_period, self.config, declared=True)
         self.reset()
 
     def reset(self) -> None:

@@ -32,9 +32,8 @@ from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
 from sensing_antenna.estimation.front.steps import (
     StreamGrid,
+    declared_period_problem,
     fill_missing,
-    grid_steps,
-    samples_missing,
     sampling_problem,
 )
 from sensing_antenna.estimation.methods import EstimationMethod
@@ -51,8 +50,7 @@ from sensing_antenna.live.events import (
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.wire import StreamHeader, WireError
 from sensing_antenna.recording import (
-    CLOCK_TOLERANCE,
-    PERIOD_CONSISTENCY,
+    PERIOD_CHECK_STEPS,
     RecordingError,
     stated_torque_point,
 )
@@ -69,18 +67,6 @@ __all__ = ["CONTACT_LOST_SHARE", "Listener"]
 #: through the threshold while the link bounced on a post, and stayed above it for tens of
 #: seconds after a release.
 CONTACT_LOST_SHARE = 0.2
-
-#: The time steps from which the stream's period is read and compared with its declared
-#: ``sample_period``.
-PERIOD_CHECK_STEPS = 20
-
-#: The stream's period may differ from its declared one by this many standard errors of the
-#: line through its first stamps (between ``CLOCK_TOLERANCE`` and ``PERIOD_CONSISTENCY``).
-_PERIOD_SIGMAS = 8.0
-
-#: Fewest steps whose median number of periods must be one (more are dropped samples or a
-#: period declared too short); fewer cannot tell.
-MIN_STEPS_FOR_DROPS = 5
 
 _END = "end"
 _ABORT = "abort"
@@ -101,26 +87,6 @@ class _Growing:
             self.values = grown
         self.values[self.size : stop] = block
         self.size = stop
-
-
-def _period_of_line(
-    stamps: NDArray[np.float64], countings: list[NDArray[np.float64]]
-) -> tuple[float, float]:
-    """The slope (s) of the least-squares line through ``stamps`` (shape (n,), n >= 2) against
-    their sample numbers, those numbered by the one of ``countings`` (periods of each step,
-    shape (n - 1,)) the line fits best, and its standard error (s; 0 for two stamps)."""
-    best = (math.inf, math.nan, 0.0)
-    relative = stamps - stamps[0]
-    for periods in countings:
-        number = np.concatenate([[0.0], np.cumsum(periods)])
-        number -= number.mean()
-        spread = float(number @ number)
-        slope = float(number @ relative / spread)
-        misfit = relative - relative.mean() - slope * number
-        residual = float(misfit @ misfit)
-        error = math.sqrt(residual / (stamps.shape[0] - 2) / spread) if stamps.shape[0] > 2 else 0.0
-        best = min(best, (residual, slope, error))
-    return best[1], best[2]
 
 
 class Listener:
@@ -186,7 +152,7 @@ class Listener:
             raise RecordingError(header.source, None, "sample_period", coarse, metadata=True)
         self._estimator = OnlineEstimator(antenna, ts, method, config)
         # a detector of its own, the front end's twin, for the residual after t_c (contact lost)
-        self._residual = ContactDetector(antenna, ts)
+        self._residual = ContactDetector(antenna, ts, check_input=False)  # the samples filled
         # contact lost: the residual's running sums from t_c, averaged over a free period
         self._free_period = max(1, round(2.0 * math.pi / (antenna.observer.natural_frequency * ts)))
         self._sums = _Growing(3)  # cumulative residual from t_c (row 0: none yet)
@@ -354,51 +320,22 @@ class Listener:
         self.lags.append(self._latency(first))
 
     def _check_period(self, final: bool = False) -> None:
-        """Refuse a stream whose time stamps do not step by its declared ``sample_period``: the
+        """Refuse a stream whose time stamps do not step by its declared ``sample_period``
+        (:func:`~sensing_antenna.estimation.front.steps.declared_period_problem`): the
         estimator was built for T_s before the samples came, and a file read whole would use
-        the steps instead (:data:`~sensing_antenna.recording.CLOCK_TOLERANCE`, or as much more
-        as the stamps' jitter leaves the line uncertain, up to
-        :data:`~sensing_antenna.recording.PERIOD_CONSISTENCY`). Judged on
-        the first :data:`PERIOD_CHECK_STEPS` steps, or at the end (``final``) on those a
-        shorter stream has."""
+        the steps instead. Judged on the first :data:`PERIOD_CHECK_STEPS` steps, or at the end
+        (``final``) on those a shorter stream has."""
         steps = min(self._stamps.size - 1, PERIOD_CHECK_STEPS)
         if self._period_checked or steps < (1 if final else PERIOD_CHECK_STEPS):
             return
         self._period_checked = True
         ts = self.header.sample_period
-        stamps = self._stamps.values[: steps + 1]
-        step = np.diff(stamps)
-        # a dropped sample is a step of whole periods (:func:`samples_missing`); but most
-        # steps are one period (a stream stepping by ten declared periods declares a tenth of
-        # its period). A few steps cannot tell drops from a wrong period: only their
-        # multiples are judged
-        periods = 1.0 + samples_missing(step, ts)
-        if steps >= MIN_STEPS_FOR_DROPS and float(np.median(periods)) != 1.0:
-            period, how = float(np.median(step)), f"the median of its first {steps} steps"
-            tolerance = PERIOD_CONSISTENCY
-        else:
-            # the period is the slope of the time stamps against their sample numbers: each
-            # stamp's jitter averages out over the line, where it stays in a median of steps (a
-            # tenth of a period of jitter moves that by a few per cent). The drops are counted
-            # as the line fits the stamps best: a step of 1.6 periods is a late stamp after an
-            # early one, or a lost sample with jitter, and only the others tell which (the
-            # estimator's grid tells from them all)
-            countings = [periods, np.maximum(np.rint(step / ts), 1.0), grid_steps(stamps, ts)]
-            period, error = _period_of_line(stamps, countings)
-            how = f"a line through its first {steps + 1} time stamps"
-            # on its full first stamps, as close as their jitter lets the line tell, down to the
-            # clock tolerance by which a file's stamps are trusted over its period (fewer, at
-            # a shorter stream's end, cannot tell their jitter)
-            tolerance = PERIOD_CONSISTENCY
-            if steps == PERIOD_CHECK_STEPS:
-                tolerance = min(tolerance, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
-            if abs(period - ts) <= tolerance * ts:
-                return
-        raise WireError(
-            f"{self.header.source}: sample_period: the stream declares {ts!r} s, but its "
-            f"time stamps step by {period:.6g} s ({how}), more than {100 * tolerance:.2g} %"
-            " apart: the estimates need the period the samples have"
-        )
+        problem = declared_period_problem(self._stamps.values[: steps + 1], ts)
+        if problem is not None:
+            raise WireError(
+                f"{self.header.source}: sample_period: the stream declares {ts!r} s, but"
+                f" {problem}: the estimates need the period the samples have"
+            )
 
     def _latency(self, index: int) -> float:
         return self._clock() - float(self._received.values[index])

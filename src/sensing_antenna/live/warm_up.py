@@ -42,6 +42,7 @@ def warm_up(
     antenna: Antenna,
     method: str | EstimationMethod = "paper",
     config: EstimatorConfig | None = None,
+    sample_period: float | None = None,
 ) -> float:
     """Run one simulated manoeuvre of ``antenna`` through a listener, then
     :func:`freeze_heap` (module docstring).
@@ -53,6 +54,9 @@ def warm_up(
     method : str or EstimationMethod
     config : EstimatorConfig, optional
         As the listeners will be given them.
+    sample_period : float, optional
+        The period (s) of the samples to come, the simulated manoeuvre's; the paper's 1 ms
+        when None.
 
     Returns
     -------
@@ -60,9 +64,14 @@ def warm_up(
         The wall time it took (s).
     """
     from sensing_antenna.simulator import Scenario, simulate
+    from sensing_antenna.simulator.scenario import DEFAULT_SAMPLE_PERIOD
 
     start = time.perf_counter()
-    scenario = Scenario(case="azimuthal", contact_point=WARM_UP_CONTACT * antenna.link.length)
+    scenario = Scenario(
+        case="azimuthal",
+        contact_point=WARM_UP_CONTACT * antenna.link.length,
+        sample_period=DEFAULT_SAMPLE_PERIOD if sample_period is None else sample_period,
+    )
     header, rows = stream_of(simulate(antenna, scenario).without_ground_truth(), "<warm-up>")
     listener = Listener(header, antenna, lambda event: None, method, config)
     listener.put(rows)

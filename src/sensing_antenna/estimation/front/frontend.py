@@ -70,6 +70,7 @@ from sensing_antenna.estimation.front.steps import (
     StreamGrid,
     at_contact,
     dead_channel,
+    declared_period_problem,
     fill_missing,
     hold_push,
     hold_samples,
@@ -80,6 +81,7 @@ from sensing_antenna.estimation.front.steps import (
     time_gaps,
 )
 from sensing_antenna.estimation.result import Status
+from sensing_antenna.recording import PERIOD_CHECK_STEPS
 
 __all__ = ["FrontEnd", "Gathered", "one_sample"]
 
@@ -185,6 +187,12 @@ class FrontEnd:
     diagnostics : Mapping, optional
         What the caller knows about the samples (the sampling report of a recording), put first
         in every outcome's diagnostics; ``{"resampled": False}`` when None.
+    declared : bool
+        ``sample_period`` was declared before the samples came (a stream, not a recording whose
+        period its reader took from its stamps): the first
+        :data:`~.steps.PERIOD_CHECK_STEPS` steps of the time stamps are judged against it
+        (:func:`~.steps.declared_period_problem`), and samples at another period are
+        ``bad_input``.
 
     Notes
     -----
@@ -201,8 +209,10 @@ class FrontEnd:
         config: EstimatorConfig | None = None,
         *,
         diagnostics: Mapping[str, Any] | None = None,
+        declared: bool = False,
     ) -> None:
         self.antenna = antenna
+        self.declared = declared
         self.sample_period = ts = float(sample_period)
         self.config = cfg = config if config is not None else EstimatorConfig()
         self.band = search_band(antenna.link, cfg)
@@ -220,7 +230,8 @@ class FrontEnd:
         self._spike_longest = spike_longest(ts)
         self._spike_gate = judged_from(self._spike_floor)
         if self._refused is None:
-            self._detector = ContactDetector(antenna, ts)
+            # the samples fed are on the period's grid, judged here (check_input off)
+            self._detector = ContactDetector(antenna, ts, check_input=False)
             if cfg.t1_source == "push":
                 # Section 4 step 4: t_1 is the push criterion's decision, on the same detector
                 rule = cfg.push_criterion or PushCriterion()
@@ -264,6 +275,8 @@ class FrontEnd:
         # the spikes put back: (first sample, length, channels)
         self._spikes: list[tuple[int, int, tuple[int, ...]]] = []
         self._jump: str | None = None  # a step of the time stamps too long to fill
+        # the first time stamps received, while the declared period is to be judged
+        self._stamps: list[float] | None = [] if self.declared else None
         self._contact: int | None = None
         self._start: ContactStart | None = None
         self._rest: int | None = None
@@ -363,11 +376,30 @@ class FrontEnd:
             return None
         if self._refused is None:
             times, angles, forces, moments = self._before_nan(times, angles, forces, moments)
+            if self._stamps is not None:
+                self._judge_period(times)
+        if self._refused is None:
             times, angles, forces, moments = self._put_back(times, angles, forces, moments)
             # after an outlier time stamp no sample follows: what is held back is released
             final = self._jump is not None
             times, angles, forces, moments = self._despike(times, angles, forces, moments, final)
         return self._ingest(times, angles, forces, moments, filled_gaps)
+
+    def _judge_period(self, times: FloatArray, final: bool = False) -> None:
+        """Keep the first time stamps and judge the declared period once they are enough (or
+        at the end, ``final``, on those there are): samples at another period are refused."""
+        stamps = self._stamps
+        assert stamps is not None
+        stamps.extend(times[: PERIOD_CHECK_STEPS + 1 - len(stamps)].tolist())
+        if len(stamps) < (2 if final else PERIOD_CHECK_STEPS + 1):
+            return
+        self._stamps = None
+        problem = declared_period_problem(np.asarray(stamps), self.sample_period)
+        if problem is not None:
+            self._refused = (
+                f"sample_period: declared {self.sample_period!r} s, but {problem}: the"
+                " estimates need the period the samples have"
+            )
 
     def _ingest(
         self,
@@ -851,6 +883,10 @@ class FrontEnd:
         """Close the run at the end of the samples: the outcome given, or the one they give."""
         if self._outcome is not None:
             return self._outcome
+        if self._stamps is not None and self._refused is None:
+            self._judge_period(np.empty(0), final=True)
+            if self._refused is not None:
+                return self._stop(self._early(Status.BAD_INPUT, self._refused))
         if self._pending is not None:
             # the samples held back: decided as far as they can be, the rest as they are
             empty = np.empty((0, 3))

@@ -41,10 +41,12 @@ from sensing_antenna.estimation.front.contact_frame import (
     signal_noise,
 )
 from sensing_antenna.estimation.front.ratio import contact_loads, load_offset, ratio_noise
+from sensing_antenna.recording import CLOCK_TOLERANCE, PERIOD_CHECK_STEPS, PERIOD_CONSISTENCY
 from sensing_antenna.units_check import angle_problem, initial_rest, rest_reading, stamps_unit
 
 __all__ = [
     "MAX_FILLED",
+    "MIN_STEPS_FOR_DROPS",
     "OUTLIER_PERIODS",
     "SETTLED_ERRORS",
     "STEP_JITTER",
@@ -54,6 +56,7 @@ __all__ = [
     "TareKind",
     "at_contact",
     "dead_channel",
+    "declared_period_problem",
     "fill_missing",
     "free_motion_gain",
     "gap_problem",
@@ -313,6 +316,74 @@ def grid_steps(t: FloatArray, sample_period: float) -> FloatArray:
     t = np.asarray(t, dtype=np.float64)
     _, places, _ = _placed(t, StreamGrid(float(t[0]) - sample_period, sample_period))
     return np.maximum(places[1:], 1).astype(np.float64)
+
+
+#: The stream's period may differ from its declared one by this many standard errors of the
+#: line through its first stamps (between ``CLOCK_TOLERANCE`` and ``PERIOD_CONSISTENCY``).
+_PERIOD_SIGMAS = 8.0
+
+#: Fewest steps whose median number of periods must be one (more are dropped samples or a
+#: period declared too short); fewer cannot tell.
+MIN_STEPS_FOR_DROPS = 5
+
+
+def _period_of_line(stamps: FloatArray, countings: list[FloatArray]) -> tuple[float, float]:
+    """The slope (s) of the least-squares line through ``stamps`` (shape (n,), n >= 2) against
+    their sample numbers, those numbered by the one of ``countings`` (periods of each step,
+    shape (n - 1,)) the line fits best, and its standard error (s; 0 for two stamps)."""
+    best = (math.inf, math.nan, 0.0)
+    relative = stamps - stamps[0]
+    for periods in countings:
+        number = np.concatenate([[0.0], np.cumsum(periods)])
+        number -= number.mean()
+        spread = float(number @ number)
+        slope = float(number @ relative / spread)
+        misfit = relative - relative.mean() - slope * number
+        residual = float(misfit @ misfit)
+        error = math.sqrt(residual / (stamps.shape[0] - 2) / spread) if stamps.shape[0] > 2 else 0.0
+        best = min(best, (residual, slope, error))
+    return best[1], best[2]
+
+
+def declared_period_problem(stamps: FloatArray, sample_period: float) -> str | None:
+    """Why a stream's first time stamps (s, shape (n,), 2 <= n <= :data:`PERIOD_CHECK_STEPS`
+    + 1) do not step by the ``sample_period`` (s) declared before they came, or None.
+
+    A dropped sample is a step of whole periods (:func:`samples_missing`), but most steps are
+    one period: from :data:`MIN_STEPS_FOR_DROPS` steps on, a median of more means the period
+    was declared too short, judged within ``PERIOD_CONSISTENCY``. Otherwise the period is the
+    slope of the stamps against their sample numbers, each stamp's jitter averaging out over
+    the line (it stays in a median of steps), the drops counted as the line fits the stamps
+    best. It must lie within ``CLOCK_TOLERANCE`` of the declared one (a file's stamps are
+    trusted over its period beyond it), or as much more as the stamps' jitter leaves the line
+    uncertain, up to ``PERIOD_CONSISTENCY``; fewer stamps than the full count cannot tell
+    their jitter and are judged within ``PERIOD_CONSISTENCY``.
+    """
+    stamps = np.asarray(stamps, dtype=np.float64)
+    steps = stamps.shape[0] - 1
+    ts = sample_period
+    step = np.diff(stamps)
+    periods = 1.0 + samples_missing(step, ts)
+    if steps >= MIN_STEPS_FOR_DROPS and float(np.median(periods)) != 1.0:
+        period, how = float(np.median(step)), f"the median of its first {steps} steps"
+        tolerance = PERIOD_CONSISTENCY
+    else:
+        # a step of 1.6 periods is a late stamp after an early one, or a lost sample with
+        # jitter, and only the others tell which (the estimator's grid tells from them all)
+        countings = [periods, np.maximum(np.rint(step / ts), 1.0), grid_steps(stamps, ts)]
+        period, error = _period_of_line(stamps, countings)
+        how = f"a line through its first {steps + 1} time stamps"
+        tolerance = PERIOD_CONSISTENCY
+        if steps == PERIOD_CHECK_STEPS:
+            tolerance = min(tolerance, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
+        if abs(period - ts) <= tolerance * ts:
+            return None
+    # stamps in ms (us, ns) read as seconds: 1000 (1e6, 1e9) times the period
+    unit = stamps_unit(lambda factor: abs(period / ts - factor) <= 0.01 * factor)
+    return (
+        f"its time stamps step by {period:.6g} s ({how}), more than {100 * tolerance:.2g} %"
+        " apart" + (f" (time stamps in {unit}? the format's are in s)" if unit else "")
+    )
 
 
 def fill_missing(
