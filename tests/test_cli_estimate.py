@@ -137,12 +137,14 @@ def test_a_sample_period_the_time_stamps_contradict_is_warned_of(
     # the stamps 1 ms apart, the metadata says 2 ms: the estimate goes by the stamps and says so
     off = tmp_path / "off.csv"
     write_recording(read_recording(recording_file).with_metadata(sample_period="0.002"), off)
-    assert main(["estimate", str(off), "--antenna", "paper-2021-calibrated", "--json"]) == 0
+    model = tmp_path / "model.toml"  # the recording's own link, calibrated
+    save_antenna(calibrated(), model)
+    assert main(["estimate", str(off), "--antenna", str(model), "--json"]) == 0
     captured = capsys.readouterr()
     assert captured.err.count("\n") == 1 and str(off) in captured.err
     assert "'sample_period'" in captured.err and "0.001 s" in captured.err
     assert json.loads(captured.out)["status"] == "ok"
-    assert main(["estimate", str(recording_file), "--antenna", "paper-2021-calibrated"]) == 0
+    assert main(["estimate", str(recording_file), "--antenna", str(model)]) == 0
     assert capsys.readouterr().err == ""
 
 

@@ -1118,3 +1118,29 @@ def test_loads_beyond_any_device_warn_no_more_online_than_offline(
     )
     result = given if given is not None else online.finalize()
     assert not result.ok and result.status is offline.status
+
+
+@pytest.mark.parametrize("method", ["paper", "fast"])
+def test_an_omega_1_the_model_misplaces_is_told_by_omega_2_and_the_statics(method: str) -> None:
+    # An antenna file whose E is 10 % high and claims a tight calibration: its omega_1 at every
+    # x_c is sqrt(1.1) times the device's. At 0.8 m, near the sensing curve's top, that moves
+    # the answer 3.8 cm with the ratio still within its uncertainty. omega_2 / omega_1, which T
+    # does not enter, and the statics agree where the link touched, and the measured omega_1
+    # is the model's there over sqrt(1.1): the status says so. With the right file the answer
+    # is right and not said to be off
+    device = paper_antenna().self_calibrated()
+    stiff = dataclasses.replace(
+        paper_antenna().link, youngs_modulus=1.1 * paper_antenna().link.youngs_modulus
+    )
+    wrong_file = dataclasses.replace(paper_antenna(), link=stiff).self_calibrated()
+    recording = simulate(device, Scenario(case="vertical", contact_point=0.8, seed=1))
+    truth = float(recording.metadata["true_xc"])
+    right = estimate(recording, device, method=method)  # fast: unsure at the curve's top
+    assert right.status in (Status.OK, Status.UNCERTAIN) and abs(right.x_c - truth) < 0.01
+    wrong = estimate(recording, wrong_file, method=method)
+    assert wrong.status is Status.MODEL_MISMATCH
+    assert "which T does not enter" in (wrong.reason or "")
+    # the two readings' point within the 1 cm the estimators aim at, the scale within the
+    # frequency floor of the fast method (0.3 %) of the modulus's
+    assert abs(wrong.diagnostics["mode_ratio_point"] - truth) < 0.01
+    assert wrong.diagnostics["mode_ratio_scale"] == pytest.approx(1.1**-0.5, abs=0.003)

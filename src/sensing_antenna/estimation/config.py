@@ -236,6 +236,15 @@ class EstimatorConfig:
         model rings so. 5 %: the pair lies within 2 % of the curve on gentle pushes of the
         calibrated realistic simulated device (median 0.2 %), and 37 to 40 % off it when a
         push bends the link by a third of x_c.
+    mode_ratio_uncertainty : float
+        Plausibility (``model_mismatch``): the relative standard uncertainty with which the
+        model's omega_2 / omega_1 at a contact point is taken to hold on a device. T does not
+        enter that ratio (a calibration of T_e leaves it as it is), so where it and the statics
+        agree on a point the answer's omega_1 puts far from both, the model's omega_1 is off
+        there: a wrong T, or time stamps on another clock. 2 %: the ratio lies within 2 % of
+        the model's on the independent rod engine's recordings, on a tapered, jointed or
+        compliantly clamped simulated device, and on the calibrated realistic one's gentle
+        pushes; an unknown payload moves it more, which its own check names.
     max_deflection_ratio : float
         An answer at which the measured push would bend the link by more than this fraction of
         x_c (y_c / x_c) is ``uncertain``: the statics and the frequencies of a link bent so far
@@ -304,6 +313,7 @@ class EstimatorConfig:
     free_motion_gain_factor: float = 5.0
     still_turn_factor: float = 8.0
     max_curve_distance: float = 0.05
+    mode_ratio_uncertainty: float = 0.02
     max_deflection_ratio: float = 0.4
     max_bend_per_turn: float = 1.6
     min_work_share: float = 0.5

@@ -45,7 +45,12 @@ forms agree.
    grow with the loads' scale) cover the difference. The frequency does
    not depend on the scale of the loads, the ratio does: forces doubled halve the ratio, a
    synthetic sine in the wrench matches no contact point with both.
-5. Loads a tare corrected (``uncertain``): a recording that starts too close to t_c leaves
+5. One stiffness (``model_mismatch``, :func:`_mode_ratio_problem`): omega_2 / omega_1, which
+   T does not enter, must fit the model's at the answer; where it does not, but fits it at a
+   point the statics allow, the answer's omega_1 is one the model misplaces there (a wrong T or
+   a clock of the time stamps). Asked of an answer that is ``ok`` or ``uncertain`` and that the
+   statics allow.
+6. Loads a tare corrected (``uncertain``): a recording that starts too close to t_c leaves
    the sensor's offset in every load. A straight enough link (``uncertain``): the sensing
    curves are the straight link's, and a push that bends the link shifts its frequencies
    (:func:`_bent_link_problem`); a method that read omega_1 is not ``ok`` where that shift, in
@@ -81,7 +86,11 @@ from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
 from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
-from sensing_antenna.estimation.methods.paper.fusion import candidates_from_omega1, model_spread
+from sensing_antenna.estimation.methods.paper.fusion import (
+    candidates_from_omega1,
+    model_spread,
+    second_peak,
+)
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
 from sensing_antenna.estimation.result import STATUS_PRECEDENCE, ContactEstimate, Status
 from sensing_antenna.torque_point import metadata_line
@@ -173,6 +182,11 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     statics = _statics_problem(evidence, estimate, end, notes)
     if statics is not None:
         found.append((Status.ESTIMATORS_DISAGREE, statics))
+    # an answer the statics, or the method itself, already disagree with keeps that reason
+    judged = on_link and not statics and estimate.status in (Status.OK, Status.UNCERTAIN)
+    scale = _mode_ratio_problem(evidence, estimate, end, notes) if judged else None
+    if scale is not None:
+        found.append((Status.MODEL_MISMATCH, scale))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
     bent = _bent_link_problem(evidence, estimate, notes) if on_link else None
     if bent is not None:
@@ -315,6 +329,85 @@ def _statics_problem(
         "with the answer's bent link), "
         f"{abs(x_c - reading):.3f} m from the answer {x_c:.3f} m: more than "
         f"{evidence.config.disagreement_sigmas:g} of their uncertainties"
+    )
+
+
+def _mode_ratio_problem(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> str | None:
+    """Why the answer's omega_1 puts the contact where omega_2 / omega_1, which T does not
+    enter, says it is not, while the statics allow where it says it is, or None.
+
+    The second contact mode's clear peak (the paper method's band, :func:`second_peak`; not
+    within ``omega2_window`` of 2 or 3 omega_1, where a harmonic may be what it is) over the
+    answer's omega_1 is held against the model's omega_2 / omega_1 curve, each point's known to
+    ``mode_ratio_uncertainty`` (or, a calibration having measured them, the scatters of omega_1
+    and omega_2 when larger). The answer must fit it within ``disagreement_sigmas`` somewhere
+    within ``disagreement_sigmas`` of its own uncertainty (the frequency model's,
+    ``Link.frequency_uncertainty``). Where it does not, and the statics (the settled
+    torque/force ratio at t_e, as :func:`_statics_problem` reads it) allow, within
+    ``disagreement_sigmas`` of theirs, a point that fits, more than ``max_model_spread`` from
+    the answer, the answer's omega_1 is one the model misplaces there: a T (a calibration) or a
+    clock of the time stamps that far off. A peak that no point the statics allow fits is no
+    contact mode, or the statics are off: it says nothing, nor where the points that fit lie
+    in stretches apart. Not asked where the bent link's
+    preload may move the vibration's point by more than ``max_model_spread``: the curves are
+    the straight link's, omega_2's too. Notes ``mode_ratio_point`` (the point both fit best)
+    and ``mode_ratio_scale`` (the measured omega_1 over the model's there).
+    """
+    x_c, omega1 = estimate.x_c, estimate.omega1
+    cfg = evidence.config
+    link = evidence.antenna.link
+    if estimate.method == "ratio" or not (math.isfinite(x_c) and math.isfinite(omega1)):
+        return None
+    if evidence.bent_link_uncertainty(x_c) > cfg.max_model_spread:
+        return None
+    settled = evidence.converged_index
+    if settled is None or settled > end or end >= evidence.ratio_mean.shape[0]:
+        return None
+    reading = float(evidence.ratio_mean[end])
+    if not math.isfinite(reading):
+        return None
+    component = str(estimate.diagnostics.get("torque_component", "sum"))
+    peak = second_peak(evidence, component, omega1)
+    if peak is None or any(
+        abs(peak.omega - k * omega1) < cfg.omega2_window * peak.omega for k in (2.0, 3.0)
+    ):
+        return None
+    points, omegas = evidence.contact_modes
+    ratio = peak.omega / omega1
+    measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
+    sigma = max(cfg.mode_ratio_uncertainty, measured) * ratio
+    misfit = np.abs(omegas[:, 1] / omegas[:, 0] - ratio) / sigma
+    limit = cfg.disagreement_sigmas
+    own = model_spread(link, x_c, link.frequency_uncertainty)
+    near = np.abs(points - x_c) <= limit * own
+    answer = float(misfit[near].min()) if near.any() else float(np.interp(x_c, points, misfit))
+    if answer <= limit:
+        return None
+    statics = math.hypot(
+        evidence.ratio_uncertainty(reading), evidence.bent_link_uncertainty(reading)
+    )
+    apart = np.abs(points - reading) / statics if statics > 0.0 else np.full(points.shape, np.inf)
+    allowed = (misfit <= limit) & (apart <= limit)
+    where = np.flatnonzero(allowed)
+    if where.size == 0 or np.any(np.diff(where) > 1):
+        # none, or apart stretches (the ratio's curve turns): no one point to name
+        return None
+    best = int(np.argmin(np.where(allowed, np.hypot(misfit, apart), np.inf)))
+    point = float(points[best])
+    if abs(point - x_c) <= cfg.max_model_spread:
+        return None
+    scale = omega1 / float(omegas[best, 0])
+    notes["mode_ratio_point"] = point
+    notes["mode_ratio_scale"] = scale
+    return (
+        f"omega_2 / omega_1 = {ratio:.3f}, which T does not enter, is {answer:.1f} of its "
+        f"uncertainties off the model's at the answer {x_c:.3f} m, and fits it where the "
+        f"statics allow the contact, at {point:.3f} m ({100 * abs(point - x_c):.1f} cm away): "
+        f"the model's omega_1 there is {100 * (scale - 1.0):+.1f} % off the measured one, as a "
+        "T (a calibration) or a clock of the time stamps that far off makes it: check the "
+        "calibration and the time stamps"
     )
 
 
