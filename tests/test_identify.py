@@ -18,7 +18,7 @@ from sensing_antenna.calibration.observer import (
 )
 from sensing_antenna.cli import main
 from sensing_antenna.detection.contact import detect_contact
-from sensing_antenna.recording import Recording, resample_uniform, write_recording
+from sensing_antenna.recording import Recording, read_recording, resample_uniform, write_recording
 from sensing_antenna.simulator import Scenario, simulate
 
 TS = 1e-3  # s
@@ -147,6 +147,17 @@ def test_cli_writes_antenna_with_fitted_observer(
     assert antenna.observer.natural_frequency == pytest.approx(TRUE_OMEGA, rel=0.01)
     assert antenna.link == ANTENNA.link
     assert math.isfinite(antenna.observer.contact_threshold)
+    assert capsys.readouterr().err == ""
+    # metadata that contradict the stamps: identification goes by the stamps, as the
+    # estimators do, and says so in one line naming the file
+    off = tmp_path / "off.csv"
+    write_recording(read_recording(rec_path).with_metadata(sample_period="0.002"), off)
+    assert main(["identify", str(off), "--out", str(tmp_path / "off.toml")]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(off) in err and "'sample_period'" in err
+    fitted = load_antenna(tmp_path / "off.toml").observer
+    assert fitted.natural_frequency == pytest.approx(antenna.observer.natural_frequency, rel=1e-6)
+    assert fitted.contact_threshold == pytest.approx(antenna.observer.contact_threshold, rel=1e-6)
 
 
 def test_cli_bad_file_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

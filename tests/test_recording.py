@@ -710,3 +710,15 @@ def test_a_torque_point_misspelled_or_contradicted_is_refused(
     with pytest.raises(RecordingError) as info:
         read_recording(path)
     assert info.value.field == key and problem in info.value.problem
+
+
+def test_a_sample_that_is_not_finite_is_named_by_column_and_row() -> None:
+    # a recording built in Python (a lab's converter) with one NaN: the line says where it is
+    t = 1e-3 * np.arange(5)
+    torque = np.zeros((5, 3))
+    torque[3, 1] = np.nan
+    with pytest.raises(RecordingError) as info:
+        Recording(t=t, theta=np.zeros((5, 2)), force=np.zeros((5, 3)), torque=torque)
+    assert str(info.value) == (
+        "<recording>: column 'torque': NaN or infinite value at row 3 (from 0): [0.0, nan, 0.0]"
+    )

@@ -341,8 +341,13 @@ def _frozen_array(values: ArrayLike, shape_tail: tuple[int, ...], name: str) -> 
     if array.ndim != 1 + len(shape_tail) or array.shape[1:] != shape_tail:
         expected = "(n" + "".join(f", {k}" for k in shape_tail) + ")"
         raise RecordingError(None, None, name, f"shape must be {expected}, got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise RecordingError(None, None, name, "NaN or infinite value")
+    finite = np.isfinite(array).reshape(array.shape[0], -1).all(axis=1)
+    if not finite.all():
+        row = int(np.flatnonzero(~finite)[0])
+        value = array[row].tolist() if array.ndim > 1 else float(array[row])
+        raise RecordingError(
+            None, None, name, f"NaN or infinite value at row {row} (from 0): {value}"
+        )
     array.flags.writeable = False
     return array
 

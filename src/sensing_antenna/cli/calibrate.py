@@ -134,6 +134,7 @@ def _run(args: argparse.Namespace) -> int:
         read_contact_points,
         scatter_problem,
     )
+    from sensing_antenna.cli.estimate import warn_of_contradicted_period
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.recording import read_recording
 
@@ -146,6 +147,7 @@ def _run(args: argparse.Namespace) -> int:
             unread.append(str(exc))  # one bad file does not sink the set
         else:
             paths.append(path)
+            warn_of_contradicted_period(path, recordings[-1].period_problem)
     if len(recordings) < 2 and unread:
         raise CalibrationError(f"{unread[0]} (and fewer than 2 readable recordings left)")
     points = read_contact_points(paths, recordings, args.points)

@@ -86,6 +86,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.antenna import load_antenna, save_antenna
     from sensing_antenna.calibration.motor import identify_motors_from
     from sensing_antenna.calibration.observer import IdentificationError, identify_free_motion
+    from sensing_antenna.cli.estimate import warn_of_contradicted_period
     from sensing_antenna.control.servo import DEFAULT_SERVO_POLE, ControlConfigError, design_servo
     from sensing_antenna.recording import read_recording
 
@@ -93,7 +94,10 @@ def _run(args: argparse.Namespace) -> int:
         raise ControlConfigError("--servo-pole: the gains are designed with --servo only")
     pole = DEFAULT_SERVO_POLE if args.servo_pole is None else args.servo_pole
     antenna = load_antenna(args.antenna)
-    recordings = [read_recording(path) for path in distinct_files(args.recordings)]
+    files = distinct_files(args.recordings)
+    recordings = [read_recording(path) for path in files]
+    for path, recording in zip(files, recordings, strict=True):
+        warn_of_contradicted_period(path, recording.period_problem)
     if args.servo:
         try:  # before any fit: a pole the recordings' period cannot realise
             design_servo(antenna.motors[0], pole, recordings[0].sample_period)
