@@ -29,6 +29,7 @@ from sensing_antenna.estimation import (
     estimate,
 )
 from sensing_antenna.estimation.front.spikes import spike_longest
+from sensing_antenna.estimation.front.steps import declared_period_problem
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate
 from sensing_antenna.simulator.scenario import ATI_NANO17_RESOLUTION
@@ -584,6 +585,15 @@ def test_a_stream_at_another_period_than_declared_is_bad_input() -> None:
     assert short.status is Status.BAD_INPUT
     assert (short.reason or "").startswith("sample_period: declared 0.001 s, but its time stamps")
     assert fed(2e-3, recording.n_samples).ok
+
+
+def test_stamps_off_the_declared_period_by_the_clock_tolerance_are_taken() -> None:
+    # the file's rule: stamps within CLOCK_TOLERANCE (0.1 %) of the period are trusted. Exactly
+    # 0.1 % off, they were refused by the stamps' last bit, "more than 0.1 % apart"
+    start = 5.0 + np.arange(21)
+    assert declared_period_problem(1.001e-3 * start, 1e-3) is None
+    assert declared_period_problem(0.999e-3 * start, 1e-3) is None
+    assert "more than 0.1 % apart" in str(declared_period_problem(1.0011e-3 * start, 1e-3))
 
 
 @pytest.mark.parametrize("stamp", [math.inf, -math.inf])

@@ -376,7 +376,7 @@ def declared_period_problem(stamps: FloatArray, sample_period: float) -> str | N
         tolerance = PERIOD_CONSISTENCY
         if steps == PERIOD_CHECK_STEPS:
             tolerance = min(tolerance, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
-        if abs(period - ts) <= tolerance * ts:
+        if abs(period - ts) <= tolerance * ts * (1.0 + 1e-9):  # a stamp's last bit aside
             return None
     # stamps in ms (us, ns) read as seconds: 1000 (1e6, 1e9) times the period
     unit = stamps_unit(lambda factor: abs(period / ts - factor) <= 0.01 * factor)
