@@ -46,7 +46,9 @@ def _closed_loop(
     under a HeadController: the command held over each sample (zero-order hold), the motor
     integrated exactly over the sample (matrix exponential), a constant coupling torque Gamma
     measured without error. Returns the times (n,) and the angles (n, 2) at the samples."""
-    controller = HeadController(antenna, sample_period, POLE, coupling_feedback=coupling_feedback)
+    controller = HeadController(
+        antenna, sample_period, pole=POLE, coupling_feedback=coupling_feedback
+    )
     controller.reset(origin=(0.0, 0.0))
     transitions = []
     for motor in antenna.motors:
@@ -121,7 +123,7 @@ def test_simulator_runs_the_library_controller_to_the_bit(scenario: Scenario) ->
     rec = detail.recording
     reference = np.column_stack([rec.extra["theta1_ref"], rec.extra["theta2_ref"]])
     coupling = coupling_torques(rec.theta, rec.torque)
-    controller = HeadController(antenna, rec.sample_period, scenario.servo_pole)
+    controller = HeadController(antenna, rec.sample_period, pole=scenario.servo_pole)
     np.testing.assert_array_equal(
         controller.voltage(controller.step_block(reference, rec.theta, coupling)), detail.voltage
     )

@@ -91,7 +91,7 @@ def _reference_loop(motor: Motor, limit: float, anti_windup: bool) -> tuple[np.n
 
 def _library_loop(antenna: Antenna, **limits: float) -> tuple[np.ndarray, np.ndarray]:
     """Both joints under HeadController on the same discretised motors: angles and commands."""
-    controller = HeadController(antenna, TS, POLE, **limits)
+    controller = HeadController(antenna, TS, pole=POLE, **limits)
     controller.reset(origin=(0.0, 0.0))
     plants = [_motor_zoh(m) for m in antenna.motors]
     count = round(DURATION / TS)

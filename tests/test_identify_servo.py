@@ -385,7 +385,7 @@ def test_simulator_limit_runs_the_library_controller_to_the_bit() -> None:
     scenario = Scenario(case="vertical", contact_point=0.5)
     detail = simulate_detailed(PAPER, scenario, torque_limit=limits)
     rec = detail.recording
-    controller = HeadController(PAPER, TS, scenario.servo_pole, torque_limit=limits)
+    controller = HeadController(PAPER, TS, pole=scenario.servo_pole, torque_limit=limits)
     reference = np.column_stack([rec.extra["theta1_ref"], rec.extra["theta2_ref"]])
     commands = controller.step_block(reference, rec.theta, coupling_torques(rec.theta, rec.torque))
     np.testing.assert_array_equal(controller.voltage(commands), detail.voltage)

@@ -451,6 +451,7 @@ class HeadController:
         self,
         antenna: Antenna,
         sample_period: float,
+        *,
         pole: float = DEFAULT_SERVO_POLE,
         coupling_feedback: bool = True,
         friction_feedforward: bool = True,

@@ -56,12 +56,7 @@ from sensing_antenna.detection.filters import (
     observer_coefficients,
 )
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.recording import (
-    PERIOD_CHECK_STEPS,
-    PERIOD_CONSISTENCY,
-    Recording,
-    resample_uniform,
-)
+from sensing_antenna.recording import PERIOD_CHECK_STEPS, Recording, resample_uniform
 
 __all__ = [
     "DEFAULT_RESIDUAL_CUTOFF",
@@ -71,6 +66,7 @@ __all__ = [
     "ContactDetection",
     "ContactDetector",
     "SampleBlock",
+    "SamplePeriodError",
     "SampleVector",
     "detect_contact",
     "free_motion_torque",
@@ -95,6 +91,13 @@ OBSERVER_TORQUE_SIGNS = (1.0, -1.0)
 
 class ContactConfigError(SensingAntennaError, ValueError):
     """An argument of the contact detector is out of range."""
+
+
+class SamplePeriodError(SensingAntennaError):
+    """Samples whose time stamps step by another period than the one a streaming detector was
+    built for: its observer and filters would run at the wrong speed. A set-up error, not a
+    glitch: not a ValueError, so a loop that leaves glitched samples out does not leave this
+    one unseen."""
 
 
 def _check_threshold(threshold: float, name: str = "threshold") -> float:
@@ -253,12 +256,13 @@ class ContactDetector:
     tare_time : float
         Taring window at the start (s), see the module docstring.
     check_input : bool
-        Refuse with a ValueError, the detector's state unchanged, a sample with a value that is
-        not finite (one would hold every later decision at NaN) and time stamps whose median
-        step over the first ``recording.PERIOD_CHECK_STEPS`` is not ``sample_period`` within
-        ``recording.PERIOD_CONSISTENCY`` (the observer and the filters built for another rate
-        would run at the wrong speed). Off where the caller has put the samples on their
-        period's grid and judged them itself (the estimators' front end).
+        Refuse a block with a value that is not finite (a ValueError, the detector's state
+        unchanged: one would hold every later decision at NaN), and samples whose first
+        ``recording.PERIOD_CHECK_STEPS`` time stamps do not step by ``sample_period``
+        (:class:`SamplePeriodError`, from then on until :meth:`reset`; the rule of a stream's
+        declared period, ``estimation.front.steps.declared_period_problem``). Off where the
+        caller has put the samples on their period's grid and judged them itself (the
+        estimators' front end).
 
     Attributes
     ----------
@@ -319,8 +323,10 @@ class ContactDetector:
         self.n_samples = 0
         self.contact_index: int | None = None
         self.contact_time: float | None = None
-        # the first time stamps, until the period is judged (check_input)
+        # the first time stamps, until the period is judged (check_input), and why it was
+        # refused
         self._stamps: list[float] | None = [] if self.check_input else None
+        self._period_refused: str | None = None
 
     @property
     def detected(self) -> bool:
@@ -366,9 +372,11 @@ class ContactDetector:
     def _check(
         self, times: NDArray[np.float64], named: Sequence[tuple[str, NDArray[np.float64]]]
     ) -> None:
-        """Raise a ValueError for a value of the block that is not finite, or for time stamps
-        whose first steps are not the detector's period (``check_input``), before any state
-        moves but the stamps kept for that check."""
+        """Raise a ValueError for a value of the block that is not finite, or a
+        :class:`SamplePeriodError` for time stamps whose first steps are not the detector's
+        period (``check_input``), before any state moves but the stamps kept for that check."""
+        if self._period_refused is not None:
+            raise SamplePeriodError(self._period_refused)
         for name, values in (("t", times[:, None]), *named):
             if math.isfinite(float(values.sum())):  # the loop's case, cheap
                 continue
@@ -386,16 +394,17 @@ class ContactDetector:
         stamps.extend(times[: PERIOD_CHECK_STEPS + 1 - len(stamps)].tolist())
         if len(stamps) < PERIOD_CHECK_STEPS + 1:
             return
-        self._stamps = None
-        step = float(np.median(np.diff(stamps)))
-        ts = self.sample_period
-        if not abs(step - ts) <= PERIOD_CONSISTENCY * ts:
-            raise ValueError(
-                f"t: the time stamps step by {step:.6g} s (the median of the first"
-                f" {PERIOD_CHECK_STEPS} steps), but the detector was built for a sample_period"
-                f" of {ts!r} s, more than {100 * PERIOD_CONSISTENCY:g} % apart: build it with"
-                " the samples' period"
-            )
+        from sensing_antenna.estimation.front.steps import declared_period_problem
+
+        problem = declared_period_problem(np.asarray(stamps), self.sample_period)
+        if problem is None:
+            self._stamps = None
+            return
+        self._period_refused = (
+            f"t: the detector was built for a sample_period of {self.sample_period!r} s, but"
+            f" {problem}: build it with the samples' period"
+        )
+        raise SamplePeriodError(self._period_refused)
 
     def _feed(
         self, times: NDArray[np.float64], angles: NDArray[np.float64], moments: NDArray[np.float64]

@@ -281,8 +281,9 @@ class PushMonitor:
         Detector of t_c, updated by this monitor (do not update it separately); a default
         ``ContactDetector(antenna, sample_period, check_input=check_input)`` when None.
     check_input : bool
-        As the contact detector's: refuse a value that is not finite, the force too, and time
-        stamps off ``sample_period`` (ValueError, the state unchanged). A given
+        As the contact detector's: refuse a block with a value that is not finite, the force's
+        too (ValueError, the state unchanged), and samples whose time stamps step by another
+        period than ``sample_period`` (``contact.SamplePeriodError``). A given
         ``contact_detector`` keeps its own setting.
 
     Attributes

@@ -84,7 +84,11 @@ from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
-from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.front.evidence import (
+    TWO_FREQUENCY_GRID_STEP,
+    Evidence,
+    sensing_curve,
+)
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import (
     candidates_from_omega1,
@@ -184,9 +188,9 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
         found.append((Status.ESTIMATORS_DISAGREE, statics))
     # an answer the statics, or the method itself, already disagree with keeps that reason
     judged = on_link and not statics and estimate.status in (Status.OK, Status.UNCERTAIN)
-    scale = _mode_ratio_problem(evidence, estimate, end, notes) if judged else None
-    if scale is not None:
-        found.append((Status.MODEL_MISMATCH, scale))
+    stiffness = _mode_ratio_problem(evidence, estimate, end, notes) if judged else None
+    if stiffness is not None:
+        found.append((Status.MODEL_MISMATCH, stiffness))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
     bent = _bent_link_problem(evidence, estimate, notes) if on_link else None
     if bent is not None:
@@ -344,15 +348,18 @@ def _mode_ratio_problem(
     ``mode_ratio_uncertainty`` (or, a calibration having measured them, the scatters of omega_1
     and omega_2 when larger). The answer must fit it within ``disagreement_sigmas`` somewhere
     within ``disagreement_sigmas`` of its own uncertainty (the frequency model's,
-    ``Link.frequency_uncertainty``). Where it does not, and the statics (the settled
-    torque/force ratio at t_e, as :func:`_statics_problem` reads it) allow, within
-    ``disagreement_sigmas`` of theirs, a point that fits, more than ``max_model_spread`` from
-    the answer, the answer's omega_1 is one the model misplaces there: a T (a calibration) or a
-    clock of the time stamps that far off. A peak that no point the statics allow fits is no
-    contact mode, or the statics are off: it says nothing, nor where the points that fit lie
-    in stretches apart. Not asked where the bent link's
-    preload may move the vibration's point by more than ``max_model_spread``: the curves are
-    the straight link's, omega_2's too. Notes ``mode_ratio_point`` (the point both fit best)
+    ``Link.frequency_uncertainty``). Where it does not, the points that fit and that the
+    statics allow (the settled torque/force ratio at t_e, as :func:`_statics_problem` reads
+    it, within ``disagreement_sigmas`` of theirs; before it settled, as ``fast`` answers, any)
+    must lie in one stretch of the curve; else the peak is no contact mode, or the statics are
+    off, or the curve turns within the stretch: nothing is said. The best of them (on each of
+    the curve's branches in the stretch, the one nearest the answer) is known to the ratio's
+    uncertainty over the curve's slope there, with the statics'; an answer farther from it
+    than ``disagreement_sigmas`` of that and its own, and than ``max_model_spread``, is read
+    from an omega_1 the model misplaces there: a T (a calibration) or a clock of the time
+    stamps that far off. Not asked where the bent link's preload may move the vibration's
+    point by more than ``max_model_spread``: the curves are the straight link's, omega_2's
+    too. Notes ``mode_ratio_stretch`` (the points that fit, m), ``mode_ratio_point`` (the best)
     and ``mode_ratio_scale`` (the measured omega_1 over the model's there).
     """
     x_c, omega1 = estimate.x_c, estimate.omega1
@@ -363,11 +370,9 @@ def _mode_ratio_problem(
     if evidence.bent_link_uncertainty(x_c) > cfg.max_model_spread:
         return None
     settled = evidence.converged_index
-    if settled is None or settled > end or end >= evidence.ratio_mean.shape[0]:
-        return None
-    reading = float(evidence.ratio_mean[end])
-    if not math.isfinite(reading):
-        return None
+    reading = math.nan
+    if settled is not None and settled <= end < evidence.ratio_mean.shape[0]:
+        reading = float(evidence.ratio_mean[end])
     component = str(estimate.diagnostics.get("torque_component", "sum"))
     peak = second_peak(evidence, component, omega1)
     if peak is None or any(
@@ -380,34 +385,65 @@ def _mode_ratio_problem(
     sigma = max(cfg.mode_ratio_uncertainty, measured) * ratio
     misfit = np.abs(omegas[:, 1] / omegas[:, 0] - ratio) / sigma
     limit = cfg.disagreement_sigmas
+    if not points[0] <= x_c <= points[-1]:
+        return None  # the curve is tabulated over the contact range only
     own = model_spread(link, x_c, link.frequency_uncertainty)
-    near = np.abs(points - x_c) <= limit * own
-    answer = float(misfit[near].min()) if near.any() else float(np.interp(x_c, points, misfit))
-    if answer <= limit:
+    near = np.abs(points - x_c) <= max(limit * own, TWO_FREQUENCY_GRID_STEP)
+    answer_misfit = float(misfit[near].min())
+    if answer_misfit <= limit:
         return None
-    statics = math.hypot(
-        evidence.ratio_uncertainty(reading), evidence.bent_link_uncertainty(reading)
-    )
-    apart = np.abs(points - reading) / statics if statics > 0.0 else np.full(points.shape, np.inf)
+    if math.isfinite(reading):
+        # the statics' uncertainty, at least the curve's grid step
+        statics = math.hypot(
+            evidence.ratio_uncertainty(reading),
+            evidence.bent_link_uncertainty(reading),
+            TWO_FREQUENCY_GRID_STEP,
+        )
+        apart = np.abs(points - reading) / statics
+    else:
+        # an answer before the ratio settled (fast): omega_2 / omega_1 alone, in one stretch
+        apart = np.zeros(points.shape)
     allowed = (misfit <= limit) & (apart <= limit)
     where = np.flatnonzero(allowed)
     if where.size == 0 or np.any(np.diff(where) > 1):
         # none, or apart stretches (the ratio's curve turns): no one point to name
         return None
-    best = int(np.argmin(np.where(allowed, np.hypot(misfit, apart), np.inf)))
+    # each branch's best point (the stretch may span the curve's turn), the nearest the answer
+    cost = np.where(allowed, np.hypot(misfit, apart), np.inf)
+    inner = (cost[1:-1] <= cost[:-2]) & (cost[1:-1] <= cost[2:])
+    best_points = np.flatnonzero(
+        np.concatenate([[cost[0] <= cost[1]], inner, [cost[-1] <= cost[-2]]])
+    )
+    best_points = best_points[np.isfinite(cost[best_points])]
+    best = int(best_points[np.argmin(np.abs(points[best_points] - x_c))])
     point = float(points[best])
-    if abs(point - x_c) <= cfg.max_model_spread:
+    # how well it is known: omega_2 / omega_1 over the curve's slope there, with the statics
+    steep = abs(float(np.gradient(omegas[:, 1] / omegas[:, 0], points)[best]))
+    sigma_point = sigma / steep if steep > 0.0 else math.inf
+    if math.isfinite(reading):
+        sigma_point = (sigma_point**-2 + statics**-2) ** -0.5
+    margin = max(cfg.max_model_spread, limit * math.hypot(sigma_point, own))
+    if not abs(point - x_c) > margin:
         return None
     scale = omega1 / float(omegas[best, 0])
+    low, high = float(points[where[0]]), float(points[where[-1]])
     notes["mode_ratio_point"] = point
     notes["mode_ratio_scale"] = scale
-    return (
-        f"omega_2 / omega_1 = {ratio:.3f}, which T does not enter, is {answer:.1f} of its "
-        f"uncertainties off the model's at the answer {x_c:.3f} m, and fits it where the "
-        f"statics allow the contact, at {point:.3f} m ({100 * abs(point - x_c):.1f} cm away): "
-        f"the model's omega_1 there is {100 * (scale - 1.0):+.1f} % off the measured one, as a "
-        "T (a calibration) or a clock of the time stamps that far off makes it: check the "
+    notes["mode_ratio_stretch"] = (low, high)
+    head = (
+        f"omega_2 / omega_1 = {ratio:.3f}, which T does not enter, is {answer_misfit:.1f} of "
+        f"its uncertainties off the model's at the answer {x_c:.3f} m"
+    )
+    cause = (
+        "as a T (a calibration) or a clock of the time stamps that far off makes it: check the "
         "calibration and the time stamps"
+    )
+    where_fits = "where the statics allow the contact" if math.isfinite(reading) else "alone"
+    return (
+        f"{head}, and fits it {where_fits} from {low:.3f} to {high:.3f} m, best at "
+        f"{point:.3f} m +-{sigma_point:.3f} m ({100 * abs(point - x_c):.1f} cm from the "
+        f"answer): the measured omega_1 is {100 * (scale - 1.0):+.1f} % off the model's there, "
+        f"{cause}"
     )
 
 

@@ -55,8 +55,9 @@ def warm_up(
     config : EstimatorConfig, optional
         As the listeners will be given them.
     sample_period : float, optional
-        The period (s) of the samples to come, the simulated manoeuvre's; the paper's 1 ms
-        when None.
+        The period (s) of the samples to come, the simulated manoeuvre's (the nearest the
+        simulator runs at, ``simulator.scenario.SAMPLE_PERIOD_RANGE``); the paper's 1 ms when
+        None.
 
     Returns
     -------
@@ -64,13 +65,16 @@ def warm_up(
         The wall time it took (s).
     """
     from sensing_antenna.simulator import Scenario, simulate
-    from sensing_antenna.simulator.scenario import DEFAULT_SAMPLE_PERIOD
+    from sensing_antenna.simulator.scenario import DEFAULT_SAMPLE_PERIOD, SAMPLE_PERIOD_RANGE
 
     start = time.perf_counter()
     scenario = Scenario(
         case="azimuthal",
         contact_point=WARM_UP_CONTACT * antenna.link.length,
-        sample_period=DEFAULT_SAMPLE_PERIOD if sample_period is None else sample_period,
+        # the nearest the simulator runs at: the compiled kernels are the same at any period
+        sample_period=DEFAULT_SAMPLE_PERIOD
+        if sample_period is None
+        else min(max(sample_period, SAMPLE_PERIOD_RANGE[0]), SAMPLE_PERIOD_RANGE[1]),
     )
     header, rows = stream_of(simulate(antenna, scenario).without_ground_truth(), "<warm-up>")
     listener = Listener(header, antenna, lambda event: None, method, config)

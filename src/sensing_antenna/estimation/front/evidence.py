@@ -43,6 +43,7 @@ if TYPE_CHECKING:
     from sensing_antenna.estimation.front.outcome import FrontTrace
 
 __all__ = [
+    "TWO_FREQUENCY_GRID_STEP",
     "Evidence",
     "first_mode_value",
     "search_band",
