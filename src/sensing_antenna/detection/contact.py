@@ -43,7 +43,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal, TypeAlias
+from typing import TYPE_CHECKING, Literal, TypeAlias
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -56,7 +56,10 @@ from sensing_antenna.detection.filters import (
     observer_coefficients,
 )
 from sensing_antenna.errors import SensingAntennaError
-from sensing_antenna.recording import PERIOD_CHECK_STEPS, Recording, resample_uniform
+from sensing_antenna.recording import Recording, resample_uniform
+
+if TYPE_CHECKING:
+    from sensing_antenna.estimation.front.steps import DeclaredPeriodCheck
 
 __all__ = [
     "DEFAULT_RESIDUAL_CUTOFF",
@@ -323,9 +326,12 @@ class ContactDetector:
         self.n_samples = 0
         self.contact_index: int | None = None
         self.contact_time: float | None = None
-        # the first time stamps, until the period is judged (check_input), and why it was
-        # refused
-        self._stamps: list[float] | None = [] if self.check_input else None
+        # the period judged on the first time stamps (check_input), and why it was refused
+        self._period: DeclaredPeriodCheck | None = None
+        if self.check_input:
+            from sensing_antenna.estimation.front.steps import DeclaredPeriodCheck
+
+            self._period = DeclaredPeriodCheck(self.sample_period)
         self._period_refused: str | None = None
 
     @property
@@ -388,17 +394,8 @@ class ContactDetector:
                     "encoders or the sensor?): the block was not fed, the detector's state is "
                     "unchanged"
                 )
-        stamps = self._stamps
-        if stamps is None:
-            return
-        stamps.extend(times[: PERIOD_CHECK_STEPS + 1 - len(stamps)].tolist())
-        if len(stamps) < PERIOD_CHECK_STEPS + 1:
-            return
-        from sensing_antenna.estimation.front.steps import declared_period_problem
-
-        problem = declared_period_problem(np.asarray(stamps), self.sample_period)
+        problem = None if self._period is None else self._period.feed(times)
         if problem is None:
-            self._stamps = None
             return
         self._period_refused = (
             f"t: the detector was built for a sample_period of {self.sample_period!r} s, but"

@@ -31,8 +31,8 @@ from sensing_antenna.detection.contact import ContactDetector
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
 from sensing_antenna.estimation.front.steps import (
+    DeclaredPeriodCheck,
     StreamGrid,
-    declared_period_problem,
     fill_missing,
     sampling_problem,
 )
@@ -50,7 +50,6 @@ from sensing_antenna.live.events import (
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.wire import StreamHeader, WireError
 from sensing_antenna.recording import (
-    PERIOD_CHECK_STEPS,
     RecordingError,
     stated_torque_point,
 )
@@ -168,12 +167,11 @@ class Listener:
         self._torque_point = stated_torque_point(header.metadata, header.source)
         self._t = _Growing()  # with the samples missing put back
         self._received = _Growing()
-        self._stamps = _Growing()  # the first time stamps received, for the period's check
+        self._period = DeclaredPeriodCheck(header.sample_period)  # on the first stamps
         self._last: tuple[float, NDArray[np.float64]] | None = None
         self._grid: StreamGrid | None = None  # where the samples were placed (fill_missing)
         self.dropped = 0
         self.late = 0
-        self._period_checked = False
         self.lags: list[float] = []
         self._said: set[str] = set()
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
@@ -280,8 +278,7 @@ class Listener:
                 rows[:, forces], rows[:, torques], self._torque_point
             )
         t = rows[:, self._columns[0][0]]
-        self._stamps.extend(t[: PERIOD_CHECK_STEPS + 1 - self._stamps.size])
-        self._check_period()
+        self._check_period(t)
         # the samples as the estimator holds them, missing ones put back: the instants it
         # reports are indices into these (after an outlier time stamp, which ends its run, the
         # rest as they came, for the contact's loss)
@@ -319,19 +316,16 @@ class Listener:
         self._watch_contact(first)
         self.lags.append(self._latency(first))
 
-    def _check_period(self, final: bool = False) -> None:
+    def _check_period(self, t: NDArray[np.float64], final: bool = False) -> None:
         """Refuse a stream whose time stamps do not step by its declared ``sample_period``
         (:func:`~sensing_antenna.estimation.front.steps.declared_period_problem`): the
         estimator was built for T_s before the samples came, and a file read whole would use
-        the steps instead. Judged on the first :data:`PERIOD_CHECK_STEPS` steps, or at the end
-        (``final``) on those a shorter stream has."""
-        steps = min(self._stamps.size - 1, PERIOD_CHECK_STEPS)
-        if self._period_checked or steps < (1 if final else PERIOD_CHECK_STEPS):
-            return
-        self._period_checked = True
-        ts = self.header.sample_period
-        problem = declared_period_problem(self._stamps.values[: steps + 1], ts)
+        the steps instead (:class:`~sensing_antenna.estimation.front.steps.DeclaredPeriodCheck`:
+        on the first stamps, or at the end, ``final``, on those a shorter stream has; ``t`` the
+        block's stamps, s)."""
+        problem = self._period.feed(t, final)
         if problem is not None:
+            ts = self.header.sample_period
             raise WireError(
                 f"{self.header.source}: sample_period: the stream declares {ts!r} s, but"
                 f" {problem}: the estimates need the period the samples have"
@@ -401,7 +395,7 @@ class Listener:
         self._emit(ContactLostEvent(self.number, t_lost, self._latency(max(first, index))))
 
     def _finish(self, reason: str) -> None:
-        self._check_period(final=True)
+        self._check_period(np.empty(0), final=True)
         estimator = self._estimator
         last = self._t.size - 1
         if estimator.result is None:

@@ -66,11 +66,11 @@ from sensing_antenna.estimation.front.spikes import (
 )
 from sensing_antenna.estimation.front.steps import (
     ContactStart,
+    DeclaredPeriodCheck,
     HoldPush,
     StreamGrid,
     at_contact,
     dead_channel,
-    declared_period_problem,
     fill_missing,
     hold_push,
     hold_samples,
@@ -81,7 +81,6 @@ from sensing_antenna.estimation.front.steps import (
     time_gaps,
 )
 from sensing_antenna.estimation.result import Status
-from sensing_antenna.recording import PERIOD_CHECK_STEPS
 
 __all__ = ["FrontEnd", "Gathered", "one_sample"]
 
@@ -189,9 +188,8 @@ class FrontEnd:
         in every outcome's diagnostics; ``{"resampled": False}`` when None.
     declared : bool
         ``sample_period`` was declared before the samples came (a stream, not a recording whose
-        period its reader took from its stamps): the first
-        :data:`~.steps.PERIOD_CHECK_STEPS` steps of the time stamps are judged against it
-        (:func:`~.steps.declared_period_problem`), and samples at another period are
+        period its reader took from its stamps): the first time stamps are judged against it
+        (:class:`~.steps.DeclaredPeriodCheck`), and samples at another period are
         ``bad_input``.
 
     Notes
@@ -275,8 +273,8 @@ class FrontEnd:
         # the spikes put back: (first sample, length, channels)
         self._spikes: list[tuple[int, int, tuple[int, ...]]] = []
         self._jump: str | None = None  # a step of the time stamps too long to fill
-        # the first time stamps received, while the declared period is to be judged
-        self._stamps: list[float] | None = [] if self.declared else None
+        # the declared period, judged on the first time stamps received
+        self._period = DeclaredPeriodCheck(self.sample_period) if self.declared else None
         self._contact: int | None = None
         self._start: ContactStart | None = None
         self._rest: int | None = None
@@ -376,8 +374,7 @@ class FrontEnd:
             return None
         if self._refused is None:
             times, angles, forces, moments = self._before_nan(times, angles, forces, moments)
-            if self._stamps is not None:
-                self._judge_period(times)
+            self._judge_period(times)
         if self._refused is None:
             times, angles, forces, moments = self._put_back(times, angles, forces, moments)
             # after an outlier time stamp no sample follows: what is held back is released
@@ -386,15 +383,8 @@ class FrontEnd:
         return self._ingest(times, angles, forces, moments, filled_gaps)
 
     def _judge_period(self, times: FloatArray, final: bool = False) -> None:
-        """Keep the first time stamps and judge the declared period once they are enough (or
-        at the end, ``final``, on those there are): samples at another period are refused."""
-        stamps = self._stamps
-        assert stamps is not None
-        stamps.extend(times[: PERIOD_CHECK_STEPS + 1 - len(stamps)].tolist())
-        if len(stamps) < (2 if final else PERIOD_CHECK_STEPS + 1):
-            return
-        self._stamps = None
-        problem = declared_period_problem(np.asarray(stamps), self.sample_period)
+        """Samples at another period than the declared one are refused (``declared``)."""
+        problem = None if self._period is None else self._period.feed(times, final)
         if problem is not None:
             self._refused = (
                 f"sample_period: declared {self.sample_period!r} s, but {problem}: the"
@@ -883,7 +873,7 @@ class FrontEnd:
         """Close the run at the end of the samples: the outcome given, or the one they give."""
         if self._outcome is not None:
             return self._outcome
-        if self._stamps is not None and self._refused is None:
+        if self._refused is None:
             self._judge_period(np.empty(0), final=True)
             if self._refused is not None:
                 return self._stop(self._early(Status.BAD_INPUT, self._refused))

@@ -51,6 +51,7 @@ __all__ = [
     "SETTLED_ERRORS",
     "STEP_JITTER",
     "ContactStart",
+    "DeclaredPeriodCheck",
     "FilledSamples",
     "HoldPush",
     "TareKind",
@@ -364,16 +365,15 @@ def declared_period_problem(stamps: FloatArray, sample_period: float) -> str | N
     ts = sample_period
     step = np.diff(stamps)
     periods = 1.0 + samples_missing(step, ts)
+    tolerance = PERIOD_CONSISTENCY
     if steps >= MIN_STEPS_FOR_DROPS and float(np.median(periods)) != 1.0:
         period, how = float(np.median(step)), f"the median of its first {steps} steps"
-        tolerance = PERIOD_CONSISTENCY
     else:
         # a step of 1.6 periods is a late stamp after an early one, or a lost sample with
         # jitter, and only the others tell which (the estimator's grid tells from them all)
         countings = [periods, np.maximum(np.rint(step / ts), 1.0), grid_steps(stamps, ts)]
         period, error = _period_of_line(stamps, countings)
         how = f"a line through its first {steps + 1} time stamps"
-        tolerance = PERIOD_CONSISTENCY
         if steps == PERIOD_CHECK_STEPS:
             tolerance = min(tolerance, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
         if abs(period - ts) <= tolerance * ts * (1.0 + 1e-9):  # a stamp's last bit aside
@@ -384,6 +384,30 @@ def declared_period_problem(stamps: FloatArray, sample_period: float) -> str | N
         f"its time stamps step by {period:.6g} s ({how}), more than {100 * tolerance:.2g} %"
         " apart" + (f" (time stamps in {unit}? the format's are in s)" if unit else "")
     )
+
+
+class DeclaredPeriodCheck:
+    """A stream's first time stamps, kept until :func:`declared_period_problem` can judge them
+    against the ``sample_period`` (s) declared before they came: judged once, on the first
+    :data:`~sensing_antenna.recording.PERIOD_CHECK_STEPS` steps, or at the stream's end on
+    those a shorter one has."""
+
+    def __init__(self, sample_period: float) -> None:
+        self.sample_period = sample_period
+        self._stamps: list[float] = []
+        self.judged = False
+
+    def feed(self, times: FloatArray, final: bool = False) -> str | None:
+        """Keep the time stamps ``times`` (s, shape (n,)) the check needs and, once it has
+        them (``final``: the stream ended, two stamps at least), judge them: the problem, else
+        None; None too before and after that one judgement."""
+        if self.judged:
+            return None
+        self._stamps.extend(times[: PERIOD_CHECK_STEPS + 1 - len(self._stamps)].tolist())
+        if len(self._stamps) < (2 if final else PERIOD_CHECK_STEPS + 1):
+            return None
+        self.judged = True
+        return declared_period_problem(np.asarray(self._stamps), self.sample_period)
 
 
 def fill_missing(
