@@ -9,6 +9,12 @@ unwinds like Ctrl-C's ``KeyboardInterrupt``, so the same clean-up code handles b
 from __future__ import annotations
 
 import signal
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # numpy is not loaded for the command line's parsing
+    import numpy as np
+    from numpy.typing import NDArray
 
 #: Stop signals received, in order (signal numbers): a handler records one before it raises, so
 #: that a stop whose exception was swallowed on its way up is still seen
@@ -101,3 +107,20 @@ def format_value(value: object) -> str:
     if type(value).__module__ == "numpy" and callable(item) and getattr(value, "ndim", 1) == 0:
         value = item()
     return repr(value)
+
+
+def refuse_non_finite(named: Iterable[tuple[str, NDArray[np.float64]]], output: str) -> None:
+    """Raise a ValueError naming the first input of a streaming object (a name and its samples,
+    rows of shape (n, k)) with a NaN or infinite value, and its row, before any state moves:
+    the ``output`` was not computed."""
+    import numpy as np
+
+    for name, values in named:
+        bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+        if bad.size:
+            where = f" at row {bad[0]}" if values.shape[0] > 1 else ""
+            raise ValueError(
+                f"{name}: {values[bad[0]].tolist()}{where} is not finite (a glitch of the "
+                f"encoders or the sensor?): the {output} was not computed, the state is "
+                "unchanged"
+            )

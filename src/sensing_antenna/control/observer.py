@@ -24,8 +24,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import FreeMotionObserver
-from sensing_antenna.control.servo import refuse_non_finite
 from sensing_antenna.detection.filters import FreeMotionObserverFilter
+from sensing_antenna.errors import refuse_non_finite
 
 __all__ = ["CouplingTorqueObserver", "observe_coupling_torques"]
 

@@ -46,7 +46,6 @@ Units: angles in rad, torques in N m. The command is the joint torque ``n K_m u`
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,7 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import Antenna, Motor
 from sensing_antenna.compiler import njit
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, refuse_non_finite
 
 __all__ = [
     "DEFAULT_SERVO_POLE",
@@ -69,7 +68,6 @@ __all__ = [
     "initial_servo_state",
     "joint_coupling_torques",
     "joint_servo_step",
-    "refuse_non_finite",
     "tustin_biquad",
 ]
 
@@ -621,20 +619,6 @@ def _finite(rows: list[NDArray[np.float64]]) -> None:
         if math.isfinite(a + b + c + d + e + f):  # one sample, the loop's case: cheap
             return
     refuse_non_finite(zip(("reference", "measured", "coupling"), rows, strict=True), "command")
-
-
-def refuse_non_finite(named: Iterable[tuple[str, NDArray[np.float64]]], output: str) -> None:
-    """Raise a ValueError naming the first input (a name and rows of shape (n, 2)) with a NaN or
-    infinite value, and its row, before any state moves: the ``output`` was not computed."""
-    for name, values in named:
-        bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
-        if bad.size:
-            where = f" at row {bad[0]}" if values.shape[0] > 1 else ""
-            raise ValueError(
-                f"{name}: {values[bad[0]].tolist()}{where} is not finite (a glitch of the "
-                f"encoders or the sensor?): the {output} was not computed, the state is "
-                "unchanged"
-            )
 
 
 def _pair(values: ArrayLike, name: str) -> NDArray[np.float64]:

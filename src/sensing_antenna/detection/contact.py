@@ -55,7 +55,7 @@ from sensing_antenna.detection.filters import (
     low_pass_coefficients,
     observer_coefficients,
 )
-from sensing_antenna.errors import SensingAntennaError
+from sensing_antenna.errors import SensingAntennaError, refuse_non_finite
 from sensing_antenna.recording import Recording, resample_uniform
 
 if TYPE_CHECKING:
@@ -383,17 +383,9 @@ class ContactDetector:
         period (``check_input``), before any state moves but the stamps kept for that check."""
         if self._period_refused is not None:
             raise SamplePeriodError(self._period_refused)
-        for name, values in (("t", times[:, None]), *named):
-            if math.isfinite(float(values.sum())):  # the loop's case, cheap
-                continue
-            bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
-            if bad.size:
-                where = f" at row {bad[0]}" if values.shape[0] > 1 else ""
-                raise ValueError(
-                    f"{name}: {values[bad[0]].tolist()}{where} is not finite (a glitch of the "
-                    "encoders or the sensor?): the block was not fed, the detector's state is "
-                    "unchanged"
-                )
+        columns = (("t", times[:, None]), *named)
+        if not all(math.isfinite(float(values.sum())) for _, values in columns):  # cheap
+            refuse_non_finite(columns, "contact decision")
         problem = None if self._period is None else self._period.feed(times)
         if problem is None:
             return

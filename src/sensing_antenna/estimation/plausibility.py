@@ -380,13 +380,14 @@ def _mode_ratio_problem(
     ):
         return None
     points, omegas = evidence.contact_modes
+    if not points[0] <= x_c <= points[-1]:
+        return None  # the curve is tabulated over the contact range only
+    curve = omegas[:, 1] / omegas[:, 0]
     ratio = peak.omega / omega1
     measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
     sigma = max(cfg.mode_ratio_uncertainty, measured) * ratio
-    misfit = np.abs(omegas[:, 1] / omegas[:, 0] - ratio) / sigma
+    misfit = np.abs(curve - ratio) / sigma
     limit = cfg.disagreement_sigmas
-    if not points[0] <= x_c <= points[-1]:
-        return None  # the curve is tabulated over the contact range only
     own = model_spread(link, x_c, link.frequency_uncertainty)
     near = np.abs(points - x_c) <= max(limit * own, TWO_FREQUENCY_GRID_STEP)
     answer_misfit = float(misfit[near].min())
@@ -418,7 +419,7 @@ def _mode_ratio_problem(
     best = int(best_points[np.argmin(np.abs(points[best_points] - x_c))])
     point = float(points[best])
     # how well it is known: omega_2 / omega_1 over the curve's slope there, with the statics
-    steep = abs(float(np.gradient(omegas[:, 1] / omegas[:, 0], points)[best]))
+    steep = abs(float(np.gradient(curve, points)[best]))
     sigma_point = sigma / steep if steep > 0.0 else math.inf
     if math.isfinite(reading):
         sigma_point = (sigma_point**-2 + statics**-2) ** -0.5
