@@ -55,7 +55,11 @@ forms agree.
    curves are the straight link's, and a push that bends the link shifts its frequencies
    (:func:`_bent_link_problem`); a method that read omega_1 is not ``ok`` where that shift, in
    whichever plane, may move the vibration's point by more than ``max_model_spread``; nor any
-   method beyond ``max_deflection_ratio``, where the statics were not checked.
+   method beyond ``max_deflection_ratio``, where the statics were not checked. One time base
+   (``uncertain``, :func:`_time_base_problem`): readings sent again in all six channels, more
+   than chance allows, would have stretched the time if stamped as new samples; a method that
+   read omega_1 is not ``ok`` where that stretch moves its point by more than
+   ``max_model_spread``.
 
 The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the method's own included;
 the rest go to ``diagnostics["other_reasons"]``. Whatever the status, a best guess outside
@@ -89,6 +93,7 @@ from sensing_antenna.estimation.front.evidence import (
     Evidence,
     sensing_curve,
 )
+from sensing_antenna.estimation.front.held import repeated_rows
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import (
     candidates_from_omega1,
@@ -195,6 +200,9 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     bent = _bent_link_problem(evidence, estimate, notes) if on_link else None
     if bent is not None:
         found.append((Status.UNCERTAIN, bent))
+    stretched = _time_base_problem(evidence, estimate, end, notes) if on_link else None
+    if stretched is not None:
+        found.append((Status.UNCERTAIN, stretched))
     bend = float(estimate.diagnostics.get("deflection_ratio", math.nan))
     if on_link and bend > evidence.config.max_deflection_ratio:
         found.append(
@@ -1071,6 +1079,46 @@ def _bent_link_problem(
         f"point the vibration gives by up to {100 * shift:.1f} cm, more than {100 * limit:g} cm; "
         f"{read} (a push of {gentler * push:.2g} N or less, {100 * gentler * bend:.0f} % of "
         "x_c, keeps it within that here)"
+    )
+
+
+def _time_base_problem(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> str | None:
+    """Why the time stamps from t_1 to t_e may run long by more than ``max_model_spread`` of
+    the answer, or None: readings sent again in all six channels, more than chance allows
+    (:func:`~.front.held.repeated_rows`), stretch the record's time by their share when a
+    logger stamped them as new samples, and omega_1 was read that much low. Only for methods
+    that read omega_1. Notes ``repeated_rows`` (count, steps, expected) when they are found.
+    """
+    if not math.isfinite(estimate.omega1):
+        return None
+    wrench = np.hstack([evidence.force[: end + 1], evidence.torque[: end + 1]])
+    rows = repeated_rows(wrench, first=evidence.rest_index)
+    if rows is None:
+        return None
+    notes["repeated_rows"] = {
+        "count": rows.count,
+        "steps": rows.steps,
+        "expected": rows.expected,
+    }
+    omega = estimate.omega1 / (1.0 - rows.share) if rows.share < 1.0 else math.inf
+    points = _vibration_points(evidence, omega) if math.isfinite(omega) else ()
+    limit = evidence.config.max_model_spread
+    if points:
+        point = min(points, key=lambda c: abs(c - estimate.x_c))
+        if abs(point - estimate.x_c) <= limit:
+            return None
+        there = f"would put the contact at {point:.3f} m, {100 * abs(point - estimate.x_c):.1f} cm"
+    else:
+        there = "lies on no point of the sensing curve,"
+    return (
+        f"{rows.count} of the {rows.steps} samples from t_1 to t_e repeat the one before in all "
+        f"six channels, where the channels' steps allow at most {rows.expected:.2g} by chance: "
+        "a sensor or driver that sends a reading again. Stamped as new samples they stretch "
+        f"the time by {100 * rows.share:.1f} %, and omega_1 = {omega:.1f} rad/s {there} from "
+        f"the answer, more than {100 * limit:g} cm; stamp the samples where they were read, or "
+        "leave out the repeats with their stamps"
     )
 
 

@@ -18,14 +18,24 @@ neither is a stall. A channel whose noise is under the sensor's resolution repea
 little; a wrench that stands still throughout (a noiseless simulation at rest) has no neighbours to
 judge by. A held run longer than the gaps a recording may have (``EstimatorConfig.gap_limit``) and
 reaching the contact makes an estimate ``bad_input`` (``Evidence.sample_problem``).
+
+Readings sent again one at a time, scattered, are counted by :func:`repeated_rows`: steps where
+all six channels repeat, against the most chance allows. A channel repeats by chance when its
+step rounds to nothing, about its finest step over its typical step, which :data:`NEIGHBOURS`
+steps at a time say; all six together at most as often as the one that repeats least (whatever
+their correlation). A logger that stamps such readings as new samples stretches the record's
+time by their share, and the frequencies read from it fall by as much (the plausibility layer's
+"time base" check).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.stats import poisson
 
 from sensing_antenna.estimation.front.spikes import Spike
 
@@ -34,8 +44,10 @@ __all__ = [
     "LEAST_NEIGHBOURS",
     "NEIGHBOURS",
     "ONE_CHANNEL_STEPS",
+    "RepeatedRows",
     "describe_held",
     "find_held",
+    "repeated_rows",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -109,6 +121,60 @@ def find_held(wrench: FloatArray, longer_than: int, first: int = 0) -> list[Spik
                 key = (start, length)
                 found[key] = tuple(sorted({*found.get(key, ()), *channels}))
     return [Spike(index, length, channels) for (index, length), channels in sorted(found.items())]
+
+
+@dataclass(frozen=True)
+class RepeatedRows:
+    """Steps whose six channels all repeat the sample before, more than chance allows.
+
+    Attributes
+    ----------
+    count : int
+        Such steps.
+    steps : int
+        Steps judged.
+    expected : float
+        Most such steps the channels' own steps allow by chance.
+    """
+
+    count: int
+    steps: int
+    expected: float
+
+    @property
+    def share(self) -> float:
+        """count / steps: the time a logger stamping each as a new sample adds (relative)."""
+        return self.count / self.steps
+
+
+def repeated_rows(wrench: FloatArray, first: int = 0) -> RepeatedRows | None:
+    """The steps from sample ``first`` on in ``wrench`` (n, 6; N, N m) where all six channels
+    repeat the sample before, when chance cannot explain their number (a Poisson tail under
+    :data:`HELD_CHANCE` about the most chance allows, the module docstring); None when it can.
+    Each channel's finest step is taken over all of ``wrench``; a channel that never moves
+    says nothing."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        step = np.abs(np.diff(wrench, axis=0))
+    finite = np.isfinite(step)
+    moving = np.where((step > 0.0) & finite, step, np.inf)
+    quantum = np.min(moving, axis=0, initial=np.inf)
+    judged = step[max(first, 0) :]
+    same = np.all(judged == 0.0, axis=1)
+    count = int(np.count_nonzero(same))
+    if count == 0:
+        return None
+    expected = 0.0
+    for start in range(0, judged.shape[0], NEIGHBOURS):
+        block = judged[start : start + NEIGHBOURS]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            typical = np.median(block, axis=0)
+            # a step rounds to nothing about once in typical / quantum; twice that, for tails
+            chance = np.where(typical > 0.0, 2.0 * quantum / typical, 1.0)
+        share = float(np.min(np.minimum(np.nan_to_num(chance, nan=1.0), 1.0)))
+        expected += share * block.shape[0]
+    if not float(poisson.sf(count - 1, expected)) < HELD_CHANCE:
+        return None
+    return RepeatedRows(count, int(judged.shape[0]), expected)
 
 
 def _runs(same: NDArray[np.bool_]) -> list[tuple[int, int]]:
