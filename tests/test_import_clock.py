@@ -284,3 +284,27 @@ def test_many_drops_on_stamps_without_jitter_are_each_counted(lost: str) -> None
     slots = np.rint(clocked.t / 0.001).astype(int)
     own = np.isin(slots, kept)
     np.testing.assert_array_equal(clocked.wrench[own], wrench.values[slots[own]])
+
+
+def test_stamps_in_floats_or_microseconds_are_refused_naming_the_unit() -> None:
+    # A lab's log stamped in float seconds, or in integer microseconds passed as nanoseconds:
+    # one line naming the stream and the unit, not a clock of 1e12 or 1e6 Hz written out.
+    wrench = _wrench(200)
+    joints = _ramp_joints(wrench.stamps)
+    seconds = Stream("/wrench", "wrench", wrench.stamps / 1e9, wrench.values)
+    with pytest.raises(ImporterError, match=r"^log: '/wrench': stamps must be whole nanoseconds"):
+        put_on_clock(seconds, joints, source="log")
+    micro = _wrench(200, period_ns=1000, start_ns=EPOCH_NS // 1000)
+    with pytest.raises(ImporterError, match=r"sensor reads \(100000 Hz\): stamps in"):
+        put_on_clock(micro, _ramp_joints(micro.stamps), source="log")
+
+
+def test_streams_passed_the_other_way_round_are_named() -> None:
+    wrench = _wrench(200)
+    joints = _ramp_joints(wrench.stamps)
+    with pytest.raises(ImporterError, match=r"other way round") as swapped:
+        put_on_clock(joints, wrench, source="log")
+    assert "'/joints': values of shape (200, 2) for 200 stamps" in str(swapped.value)
+    three = Stream("/wrench", "wrench", wrench.stamps, wrench.values[:, :3])
+    with pytest.raises(ImporterError, match=r"the wrench stream has 6 per stamp"):
+        put_on_clock(three, joints, source="log")

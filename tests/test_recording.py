@@ -527,6 +527,21 @@ def test_a_required_name_written_otherwise_is_named_with_what_was_found(
         read_recording(path)
 
 
+def test_a_log_in_another_format_is_told_every_missing_column_and_where_to_convert_it(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "lab.csv"
+    path.write_text(
+        "time_us,az_deg,el_deg,Fx,Fy,Fz,Mx,My,Mz\n0,0,0,0,0,0,0,0,0\n1000,0,0,0,0,0,0,0,0\n"
+    )
+    with pytest.raises(RecordingError) as error:
+        read_recording(path)
+    said = str(error.value)
+    assert "column 't': required column missing from header (found 'time_us': the time" in said
+    assert "; missing too: theta1, theta2, fx, fy, fz, tx, ty, tz (a log in another" in said
+    assert "docs/import.md" in said
+
+
 @pytest.mark.parametrize(("name", "written"), [("theta2", "theta_2"), ("fy", "fy1")])
 def test_a_required_name_misspelled_is_named_with_the_near_one(
     name: str, written: str, tmp_path: Path

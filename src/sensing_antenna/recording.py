@@ -704,11 +704,23 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
         if name in seen:
             raise RecordingError(source, number, name, "duplicate column")
         seen.add(name)
-    for name in REQUIRED_COLUMNS:
-        if name not in seen:
-            raise RecordingError(
-                source, number, name, f"required column missing from header{_near(name, names)}"
+    missing = [name for name in REQUIRED_COLUMNS if name not in seen]
+    if missing:
+        name = missing[0]
+        others = ""
+        if len(missing) > 1:
+            others = f"; missing too: {', '.join(missing[1:])}"
+        if len(missing) * 2 > len(REQUIRED_COLUMNS):
+            others += (
+                " (a log in another format? docs/import.md converts one: ROS bags with "
+                "'antenna import', any other log from Python)"
             )
+        raise RecordingError(
+            source,
+            number,
+            name,
+            f"required column missing from header{_near(name, names)}{others}",
+        )
     return names
 
 
@@ -719,7 +731,7 @@ def _near(name: str, names: list[str]) -> str:
     spelled = {"t": ("time", "timestamp", "time_s", "stamp")}.get(name, ())
     for found in names:
         bare = found.strip("\"' ").split("[")[0].split("(")[0].strip().lower()
-        if bare in spelled:
+        if bare in spelled or (spelled and bare.startswith(("time", "stamp"))):
             return f" (found {found!r}: the time column is named 't', in s)"
         if bare == name and found != name:
             return (

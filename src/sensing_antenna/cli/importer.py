@@ -19,7 +19,9 @@ def register(subparsers: Any) -> None:
         description=(
             "Makes a recording in the sensing-antenna format (docs/recording-format.md) from a "
             "log kept in another format, putting its streams onto one uniform clock and "
-            "reporting their rates and gaps on stderr. Formats: rosbag (ROS 1 and ROS 2 bags)."
+            "reporting their rates and gaps on stderr. Formats: rosbag (ROS 1 and ROS 2 bags). "
+            "A log in any other format (CSV files, a database export) goes through the same clock "
+            "from Python: docs/import.md, 'Another log, from Python'."
         ),
     )
     formats = add_actions(parser, "format", "FORMAT")

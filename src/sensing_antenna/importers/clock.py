@@ -48,6 +48,7 @@ from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.recording import MAX_SAMPLES
 
 __all__ = [
+    "FASTEST_SENSOR_PERIOD",
     "STEADY_PERIODS",
     "ClockReport",
     "ClockedStreams",
@@ -89,6 +90,11 @@ _FALL_SPLITS = 100
 _LEVEL_SIGMAS = 4.0
 
 _NS = 1e9  # nanoseconds per second
+
+
+#: Shortest sample period (s) a log's wrench stream may have: force/torque sensors read at up to
+#: tens of kHz; a shorter period is stamps in another unit than nanoseconds.
+FASTEST_SENSOR_PERIOD = 1e-5
 
 
 class ImporterError(SensingAntennaError, ValueError):
@@ -276,8 +282,23 @@ class ClockedStreams:
     report: ClockReport
 
 
-def _check_stream(stream: Stream, source: str) -> None:
-    stamps = stream.stamps
+def _check_stream(stream: Stream, source: str, role: str, columns: str, width: int) -> None:
+    """Refuse a stream whose stamps are not whole nanoseconds in order, or whose values are not
+    ``width`` per stamp (``columns``), as the ``role`` stream of :func:`put_on_clock`."""
+    stamps = np.asarray(stream.stamps)
+    if stamps.ndim != 1 or stamps.dtype.kind not in "iu":
+        raise ImporterError(
+            f"{source}: {stream.name!r}: stamps must be whole nanoseconds, a 1-D integer array"
+            f" (int64), got {stamps.dtype} of shape {stamps.shape}: seconds or nanoseconds in"
+            " floats? (a float64 holds an epoch in ns only to about 0.2 us)"
+        )
+    values = np.asarray(stream.values)
+    if values.shape != (stamps.shape[0], width):
+        raise ImporterError(
+            f"{source}: {stream.name!r}: values of shape {values.shape} for {stamps.shape[0]}"
+            f" stamps, where the {role} stream has {width} per stamp, {columns} (the wrench and"
+            " the joints passed the other way round?)"
+        )
     if stamps.shape[0] < 2:
         raise ImporterError(
             f"{source}: {stream.name!r}: {stamps.shape[0]} message(s), at least 2 needed"
@@ -547,7 +568,9 @@ def put_on_clock(
     Parameters
     ----------
     wrench, joints : Stream
-        The force/torque stream (the clock's reference) and the joint angles.
+        The force/torque stream (the clock's reference; values (n, 6): fx, fy, fz in N, tx, ty,
+        tz in N m) and the joint angles (values (n, 2): theta1, theta2 in rad), stamps in
+        integer nanoseconds.
     source : str
         The log's name, for messages.
     period : float, optional
@@ -565,12 +588,14 @@ def put_on_clock(
     Raises
     ------
     ImporterError
-        A stream with fewer than two messages or two at the same stamp; streams that do not
+        Stamps that are not integers, values of another shape, a wrench stream faster than any
+        sensor (stamps in another unit than ns); a stream with fewer than two messages or two
+        at the same stamp; streams that do not
         overlap in time; a grid with more than :data:`~sensing_antenna.recording.MAX_SAMPLES`
         slots; fewer than two slots kept.
     """
-    for stream in (wrench, joints):
-        _check_stream(stream, source)
+    _check_stream(wrench, source, "wrench", "fx, fy, fz (N), tx, ty, tz (N m)", 6)
+    _check_stream(joints, source, "joints", "theta1, theta2 (rad)", 2)
     if max_gap is not None and not (math.isfinite(max_gap) and max_gap >= 0.0):
         raise ValueError(f"max_gap must be a finite number >= 0, got {max_gap!r}")
     wrench_clock, joints_clock = sample_clock(wrench.stamps), sample_clock(joints.stamps)
@@ -581,6 +606,13 @@ def put_on_clock(
             f" {wrench_clock.fall / _NS:.3g} s for good near {at:.4g} s after its first: a clock"
             " set back while recording; its samples cannot be put in order (if only one of the"
             " sensor's and the recorder's clocks stepped, the other's stamps may hold: --stamps)"
+        )
+    if wrench_clock.period < FASTEST_SENSOR_PERIOD * _NS:
+        raise ImporterError(
+            f"{source}: {wrench.name!r}: its stamps step by {wrench_clock.period:.4g} ns, a"
+            f" sensor at {_NS / wrench_clock.period:.4g} Hz, faster than any force/torque sensor"
+            f" reads ({1 / FASTEST_SENSOR_PERIOD:.0f} Hz): stamps in another unit than"
+            " nanoseconds (microseconds read as ns give a thousand times the rate)?"
         )
     # the wrench messages at their samples' instants (their stamps without the jitter), ns
     instants = int(wrench.stamps[0]) + np.rint(wrench_clock.instants).astype(np.int64)
