@@ -127,6 +127,27 @@ def test_scaled_forces_are_never_ok(
     assert evidence in text
 
 
+@pytest.mark.parametrize(("turn", "said"), [(1, "turned 90 degrees about X^m"), (2, "180")])
+def test_a_sensor_turned_on_the_link_is_named_as_such(
+    azimuthal: Recording, antenna: Antenna, turn: int, said: str
+) -> None:
+    # A sensor mounted a quarter turn about the link's axis, read without turning it back: the
+    # moment of the link's weight at rest reads in full on tz instead of ty; the reason names the
+    # turn. Half a turn is two signs flipped, which the reason already names.
+    quarter = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # about X^m
+    rotation = np.linalg.matrix_power(quarter, turn)
+    turned = dataclasses.replace(
+        azimuthal, force=azimuthal.force @ rotation.T, torque=azimuthal.torque @ rotation.T
+    )
+    result = estimate(turned, antenna, "paper")
+    assert result.status is Status.IMPLAUSIBLE_INPUT
+    reason = result.reason or ""
+    if turn == 1:
+        assert "the sensor's axes turned on the link" in reason and said in reason, reason
+    else:
+        assert "axes turned" not in reason and "a sign flipped" in reason, reason
+
+
 @pytest.mark.parametrize("force", [1.0 / 9.81, 1.0 / 4.448], ids=["kgf", "lbf"])
 def test_forces_in_kgf_or_lbf_are_no_record_too_short(
     azimuthal: Recording, antenna: Antenna, force: float

@@ -233,6 +233,7 @@ def rest_reading(
             "loads hold its weight), or torques scaled far down?"
             if tared
             else "torques in N mm, scaled, or a sign flipped?"
+            + _turned_hint(mean_torque, expected_torque, torque_tolerance)
             + _payload_hint(
                 mean_torque,
                 expected_torque,
@@ -266,6 +267,31 @@ def rest_reading(
     if not problems:
         return reading
     return RestReading(**{**reading.__dict__, "problem": "; ".join(problems)})
+
+
+def _turned_hint(measured: FloatArray, expected: FloatArray, tolerance: float) -> str:
+    """ " Or ..." naming the turn about a motor axis that takes the ``expected`` moment at rest
+    (N m) to the ``measured`` one, when the two have one size within ``tolerance`` (N m) and lie
+    20 to 160 degrees apart about an axis within 25 degrees of X^m, Y^m or Z^m: a sensor's
+    axes turned on the link, not a unit; "" otherwise."""
+    size = float(np.linalg.norm(expected))
+    if not (size > 2.0 * tolerance and abs(float(np.linalg.norm(measured)) - size) <= tolerance):
+        return ""
+    normal = np.cross(expected, measured)
+    sine = float(np.linalg.norm(normal))
+    angle = math.degrees(math.atan2(sine, float(expected @ measured)))
+    if not (20.0 <= angle <= 160.0 and sine > 0.0):
+        return ""
+    axis = normal / sine
+    k = int(np.argmax(np.abs(axis)))
+    if abs(float(axis[k])) < math.cos(math.radians(25.0)):
+        return ""
+    sign = "" if axis[k] > 0 else "-"
+    return (
+        f" Or the sensor's axes turned on the link: the moment has the weight's size, turned "
+        f"{angle:.0f} degrees about {sign}{'XYZ'[k]}^m from it (docs/import.md, 'Frames and "
+        "signs')"
+    )
 
 
 def _payload_hint(

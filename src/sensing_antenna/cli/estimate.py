@@ -142,11 +142,13 @@ def _fast_with_tolerance(method: str, tolerance: float) -> Any:
 
 
 def _cm(value: Any) -> str:
-    """A length (m) in cm to the millimetre, or to four digits when it is no link's (loads in
+    """A length (m) in cm to the millimetre; in m, said to be no link's, from 1 km (loads in
     other units make ratios of 10^3 to 10^70 m)."""
     if value is None:
         return "-"
-    return f"{100 * value:.1f} cm" if abs(value) < 1e3 else f"{100 * value:.4g} cm"
+    if abs(value) < 1e3:
+        return f"{100 * value:.1f} cm"
+    return f"{value:.3g} m (no point of a link: loads in other units?)"
 
 
 def _s(value: Any) -> str:
