@@ -114,15 +114,8 @@ def _wrench(recording: Recording) -> np.ndarray:
 def test_free_sweep_without_gravity_equals_the_linear_link() -> None:
     # No gravity, a 1 rad/s sweep: slopes of 1e-2, so the nonlinear terms (relative order
     # slope^2) stay at 1e-4 of the wrench; the axial inertia adds at most 7e-5 N to F_x (the
-    # linear model has none), below the centripetal force both models neglect (2e-3 N). Without
-    # the motors' Coulomb friction: a joint come to rest dithers about zero speed, where the
-    # regularised friction's slope parts the two runs by far more than the link's terms do.
-    nominal = paper_antenna()
-    antenna = replace(
-        nominal,
-        azimuth_motor=replace(nominal.azimuth_motor, coulomb_voltage=0.0),
-        elevation_motor=replace(nominal.elevation_motor, coulomb_voltage=0.0),
-    )
+    # linear model has none), below the centripetal force both models neglect (2e-3 N).
+    antenna = paper_antenna()
     scenario = Scenario(case="free", seed=1, noise_scale=0.0, duration=2.0, sweep_speed=1.0)
     linear = simulate_detailed(antenna, scenario, gravity=0.0).recording
     exact = simulate_detailed(antenna, replace(scenario, link_model="nonlinear"), gravity=0.0)

@@ -16,10 +16,7 @@ J p^4`` gives unit DC gain.
 The controller runs at 1 kHz. Each R is discretised with the bilinear (Tustin) map
 ``s = (2 / T_s) (z - 1) / (z + 1)``; the command is held over the sample (zero-order hold).
 To the coupling-torque feedback the step adds a feedforward of the modelled Coulomb friction of
-Eq. 1 at the joint speed Eq. 14 predicts, ``Gamma_nlc tanh(omega_m / omega_s)``
-(``FRICTION_SPEED``), omega_m the reference through ``M(s) = s / (1 + eps s)^2`` (a third
-biquad): a ramp's omega* once the joint has caught up, and a smooth turn, not a spike, for a
-step of the reference such as the stop's lag compensation.
+Eq. 1 at the reference speed, ``Gamma_nlc tanh(omega* / omega_s)`` (``FRICTION_SPEED``).
 
 An optional command limit L (N m, per joint) stands for the amplifier's saturation: the command
 applied is clipped to [-L, L], with back-calculation anti-windup in the polynomial form of
@@ -35,9 +32,9 @@ applied with the closed loop's time constant eps = -1/p instead of winding up. W
 command stays inside a finite limit.
 
 One implementation: :func:`joint_servo_step`, compiled with numba, advances one joint by one
-sample on a state array (``JOINT_STATE_SIZE`` values: the PID's two biquads' direct form II
-transposed states, the angle origin, the reference model's biquad state, the command limit and
-the anti-windup's tracking gain). The simulator's compiled time
+sample on a state array (``JOINT_STATE_SIZE`` values: the two biquads' direct form II transposed
+states, the angle origin, the previous reference, a started flag, the command limit and the
+anti-windup's tracking gain). The simulator's compiled time
 loop calls it at every sample, and :class:`HeadController` calls it for a real device's loop
 (per sample with :meth:`HeadController.step`, or a block at a time with
 :meth:`HeadController.step_block`), so both run the same arithmetic to the bit.
@@ -91,13 +88,14 @@ FRICTION_SPEED = 0.05
 #: Values of one joint's servo state (:func:`initial_servo_state`).
 JOINT_STATE_SIZE = 9
 
-# Joint state layout: R1's biquad state (2), R2's (2), the angle origin, the reference model's
-# speed biquad state (2), the command limit (N m; inf: none), the tracking gain 1 - z_p of the
-# anti-windup.
+# Joint state layout: R1's biquad state (2), R2's (2), the angle origin, the previous reference,
+# 1.0 once a sample has been stepped, the command limit (N m; inf: none), the tracking gain
+# 1 - z_p of the anti-windup.
 _R1 = 0
 _R2 = 2
 _ORIGIN = 4
-_MODEL = 5
+_PREVIOUS = 5
+_STARTED = 6
 _LIMIT = 7
 _TRACKING = 8
 
@@ -144,17 +142,10 @@ class ServoDesign:
         return 1.0 - (1.0 + half) / (1.0 - half)
 
     def discrete(self) -> NDArray[np.float64]:
-        """Tustin biquads, shape (3, 2, 3): [R1, R2, M] x [numerator, denominator] in z^-1,
-        with M = s / (1 + eps s)^2 the joint speed Eq. 14 gives for a reference (1/s)."""
-        eps = self.time_constant
-        out = np.empty((3, 2, 3))
-        for i, (num, den) in enumerate(
-            (
-                (self.feedforward, (1.0, self.b, 0.0)),
-                (self.feedback, (1.0, self.b, 0.0)),
-                ((0.0, 1.0, 0.0), (eps * eps, 2.0 * eps, 1.0)),
-            )
-        ):
+        """Tustin biquads, shape (2, 2, 3): [R1, R2] x [numerator, denominator] in z^-1."""
+        den = (1.0, self.b, 0.0)
+        out = np.empty((2, 2, 3))
+        for i, num in enumerate((self.feedforward, self.feedback)):
             bz, az = tustin_biquad(num, den, self.sample_period)
             out[i, 0] = bz
             out[i, 1] = az
@@ -273,6 +264,7 @@ def joint_servo_step(
     coupling_gain: float,
     coulomb_torque: float,
     friction_speed: float,
+    sample_period: float,
 ) -> float:
     """One joint's command for one sample (Section 4.1, Fig. 7): the 2-DOF PID, the coupling
     torque and the Coulomb friction feedforward, clipped to the state's command limit with
@@ -280,8 +272,8 @@ def joint_servo_step(
 
     Parameters
     ----------
-    coefficients : ndarray, shape (3, 2, 3)
-        :meth:`ServoDesign.discrete`: [R1, R2, M] x [numerator, denominator] in z^-1.
+    coefficients : ndarray, shape (2, 2, 3)
+        :meth:`ServoDesign.discrete`: [R1, R2] x [numerator, denominator] in z^-1.
     state : ndarray, shape (JOINT_STATE_SIZE,)
         :func:`initial_servo_state`, updated in place.
     reference, measured : float
@@ -291,10 +283,11 @@ def joint_servo_step(
     coupling_gain : float
         Weight of the coupling-torque feedback (1 as designed, 0 without it).
     coulomb_torque : float
-        Gamma_nlc of Eq. 1 (N m), fed forward at the joint speed Eq. 14 gives for the
-        references so far (a step of the reference is a turn the joint makes, not a speed).
+        Gamma_nlc of Eq. 1 (N m), fed forward at the reference speed.
     friction_speed : float
         omega_s of the friction model (rad/s).
+    sample_period : float
+        T_s (s), for the reference speed.
 
     Returns
     -------
@@ -309,9 +302,12 @@ def joint_servo_step(
     command = y1 - y2
     # Fig. 7: feedback of the measured coupling torque
     command += coupling_gain * coupling
-    # feedforward of the modelled Coulomb friction of Eq. 1 at the speed Eq. 14 gives the joint
-    speed = _biquad(coefficients[2], state, _MODEL, reference - state[_ORIGIN])
-    command += coulomb_torque * math.tanh(speed / friction_speed)
+    # feedforward of the modelled Coulomb friction of Eq. 1 from the reference speed
+    if state[_STARTED] > 0.0:
+        speed = (reference - state[_PREVIOUS]) / sample_period
+        command += coulomb_torque * math.tanh(speed / friction_speed)
+    state[_PREVIOUS] = reference
+    state[_STARTED] = 1.0
     limit = state[_LIMIT]
     if command > limit or command < -limit:
         applied = math.copysign(limit, command)
@@ -392,8 +388,8 @@ def _head_block(
     coupling: NDArray[np.float64],
     out: NDArray[np.float64],
 ) -> None:
-    """Both joints over the rows of reference, measured, coupling (n, 2); parameters (2, 3) =
-    coupling gain, Coulomb torque, friction speed."""
+    """Both joints over the rows of reference, measured, coupling (n, 2); parameters (2, 4) =
+    coupling gain, Coulomb torque, friction speed, sample period."""
     for k in range(reference.shape[0]):
         for j in range(2):
             out[k, j] = joint_servo_step(
@@ -405,6 +401,7 @@ def _head_block(
                 parameters[j, 0],
                 parameters[j, 1],
                 parameters[j, 2],
+                parameters[j, 3],
             )
 
 
@@ -430,8 +427,7 @@ class HeadController:
     coupling_feedback : bool
         Feed the measured coupling torque back (Fig. 7); without it the servo sees the link.
     friction_feedforward : bool
-        Feed the motors' modelled Coulomb torque forward at the joint speed Eq. 14 predicts
-        from the references.
+        Feed the motors' modelled Coulomb torque forward at the reference speed.
     friction_speed : float
         omega_s of the friction model tanh(omega / omega_s) (rad/s).
     torque_limit : float or array_like of 2 float, optional
@@ -479,6 +475,7 @@ class HeadController:
                     1.0 if coupling_feedback else 0.0,
                     m.coulomb_torque if friction_feedforward else 0.0,
                     float(friction_speed),
+                    self.sample_period,
                 ]
                 for m in motors
             ]

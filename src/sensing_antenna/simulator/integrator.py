@@ -663,7 +663,7 @@ def run_samples(
     (n, TRUTH_COLUMNS): true angles (2), contact flag, x_c, contact point in the absolute frame
     (3), normal force, motor voltages (2), contact force on the link in the motor frame (3) and
     the stick flag (1 sticking, 0 slipping or no contact). The servo runs the controller's
-    compiled step on ``ctrl`` (2, JOINT_STATE_SIZE) with the coefficients ``servo`` (2, 3, 2, 3)
+    compiled step on ``ctrl`` (2, JOINT_STATE_SIZE) with the coefficients ``servo`` (2, 2, 2, 3)
     of :class:`~sensing_antenna.control.servo.ServoDesign`; each joint's command limit, if any,
     sits in its ``ctrl`` row (``initial_servo_state``).
 
@@ -676,6 +676,7 @@ def run_samples(
     nn = 2 * n + 2
     h = par[_P_STEP]
     nsub = int(par[_P_SUBSTEPS])
+    period = h * nsub
     g = par[_P_GRAVITY]
     s1m = par[_P_S1]
     s2m = par[_P_S2]
@@ -758,6 +759,7 @@ def run_samples(
                     par[_P_FEEDBACK],
                     par[_P_COULOMB1 + j],
                     par[_P_OMEGA_S],
+                    period,
                 )
         truth[k, 8] = tau[0] / par[_P_TORQUE_GAIN1]
         truth[k, 9] = tau[1] / par[_P_TORQUE_GAIN2]
