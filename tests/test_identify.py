@@ -574,3 +574,33 @@ def test_cli_identifies_from_several_recordings(
     assert main(["identify", *paths, "--out", str(out), "--servo"]) == 2
     error = capsys.readouterr().err
     assert error.count("\n") == 1 and "columns 'u1', 'u2' missing" in error
+
+
+def _angles_late(recording: Recording, samples: int) -> Recording:
+    """``recording`` with each sample's angles those of ``samples`` samples before (the first
+    held): an encoder on a clock that lags the sensor's."""
+    index = np.clip(np.arange(recording.t.size) - samples, 0, recording.t.size - 1)
+    return dataclasses.replace(recording, theta=np.ascontiguousarray(recording.theta[index]))
+
+
+@pytest.mark.parametrize("samples", [0, 5, -8])
+def test_angles_on_a_clock_that_lags_the_sensors_are_named(
+    samples: int, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Eq. 15's torque lags its angles by the observer's own phase only: angles read late (or
+    # early) leave a residual through every acceleration, which the threshold would take for
+    # free motion; the fit with the angles moved back says by how much, to a sample
+    recordings = [_angles_late(_free_motion(seed), samples) for seed in (1, 2)]
+    fit = identify_free_motion(recordings, ANTENNA)
+    if samples == 0:
+        assert fit.angle_lag is None
+    else:
+        assert fit.angle_lag == pytest.approx(samples * TS, abs=1.01 * TS)
+    paths = [tmp_path / f"free{seed}.csv" for seed in (1, 2)]
+    for recording, path in zip(recordings, paths, strict=True):
+        write_recording(recording, path)
+    assert main(["identify", *map(str, paths), "--out", str(tmp_path / "fitted.toml")]) == 0
+    warning = capsys.readouterr().err
+    late = "late" if samples > 0 else "early"
+    said = f"antenna identify: warning: the angles read about {abs(samples)} ms {late}"
+    assert (said in warning) == (samples != 0), warning

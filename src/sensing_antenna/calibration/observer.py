@@ -69,6 +69,8 @@ from sensing_antenna.units_check import (
 __all__ = [
     "CLAMPED_FREE_BETA_L",
     "DEFAULT_MARGIN",
+    "LAG_GAIN",
+    "LAG_SEARCH",
     "LEVER_GAIN",
     "MAX_INERTIA_FACTOR",
     "SENSOR_OFFSET_NOTICED",
@@ -174,6 +176,10 @@ class ObserverFit:
         The point (S - O on the motor axes, m) the torques read as taken about, when Eq. 15
         with it explains the free motion much better (:data:`LEVER_GAIN`) though Eq. 15 alone
         passed: the recordings' ``torque_point`` should say so, and the fit be made again.
+    angle_lag : float or None
+        How late (s) the angles read against the torques, when Eq. 15 with them moved that much
+        earlier leaves a largest free-motion residual :data:`LAG_GAIN` times smaller (clocks
+        that do not agree; the threshold here holds the lag's residual); None when it does not.
     """
 
     gain: float
@@ -191,6 +197,7 @@ class ObserverFit:
     source: str | None = None
     payload: Payload | None = None
     torque_point: tuple[float, float, float] | None = None
+    angle_lag: float | None = None
 
     @property
     def observer(self) -> FreeMotionObserver:
@@ -232,6 +239,13 @@ SENSOR_OFFSET_SHARE = 0.1
 #: torques 2.5 cm behind the clamp, which pass, 0.13 to 0.35.
 SENSOR_OFFSET_NOTICED = 0.01
 LEVER_GAIN = 0.5
+
+#: Farthest (s) either way the angles are tried against the torques for a lag between their
+#: clocks, and how many times smaller the largest free-motion residual must be with the best
+#: shift for the lag to be named: on simulated free sweeps of the paper's link, angles 3 ms late
+#: left a residual 1.95 times the shifted fit's, 5 ms 2.8 times; on time, 1.06 at most.
+LAG_SEARCH = 0.02
+LAG_GAIN = 1.5
 
 #: Lower bound of the fitted gain K (N m / rad), 1e-11 of the paper's 0.37: keeps it positive.
 _MIN_GAIN = 1e-12
@@ -556,6 +570,50 @@ def identify_free_motion(
         else replace(move, recording=resample_uniform(move.recording, period))
         for move in moves
     ]
+    gain, omega, damping, rms, suspect, peak = _observed(
+        moves, antenna, weighed, where, residual_cutoff
+    )
+    if not math.isfinite(margin * peak):
+        raise IdentificationError(
+            f"contact threshold: {margin!r} x the largest filtered residual ({peak!r} N m) is not "
+            "finite: a load sample of the free motion is far out of range"
+        )
+    lag = _angle_lag(moves, antenna, weighed, where, residual_cutoff, peak)
+    k0, w0, d0 = initial_guess(antenna)
+    joints = sorted({j + 1 for move in moves for j in move.joints})
+    return ObserverFit(
+        gain=gain,
+        natural_frequency=omega,
+        damping=damping,
+        contact_threshold=margin * peak,
+        max_filtered_residual=peak,
+        residual_rms=rms,
+        joints=tuple(joints),
+        margin=float(margin),
+        residual_cutoff=float(residual_cutoff),
+        initial_gain=k0,
+        initial_natural_frequency=w0,
+        initial_damping=d0,
+        source=where if named else None,
+        payload=payload,
+        torque_point=None
+        if suspect is None
+        else (float(suspect[0]), float(suspect[1]), float(suspect[2])),
+        angle_lag=lag,
+    )
+
+
+def _observed(
+    moves: Sequence[_FreeMotion],
+    antenna: Antenna,
+    weighed: Antenna,
+    where: str,
+    residual_cutoff: float,
+) -> tuple[float, float, float, float, NDArray[np.float64] | None, float]:
+    """Eq. 15 fitted to the moved joints of ``moves`` (one period) with the weight of
+    ``weighed``: (K, omega, d, the residual rms, the suspected torque point or None, the largest
+    filtered residual of Eq. 16 over all of ``moves``, N m)."""
+    period = next(move for move in moves if move.joints).recording.sample_period
     moved = [move for move in moves if move.joints]
     data = [
         (
@@ -591,31 +649,56 @@ def identify_free_motion(
         )
         for move in moves
     )
-    if not math.isfinite(margin * peak):
-        raise IdentificationError(
-            f"contact threshold: {margin!r} x the largest filtered residual ({peak!r} N m) is not "
-            "finite: a load sample of the free motion is far out of range"
-        )
-    joints = sorted({j + 1 for move in moved for j in move.joints})
-    return ObserverFit(
-        gain=gain,
-        natural_frequency=omega,
-        damping=damping,
-        contact_threshold=margin * peak,
-        max_filtered_residual=peak,
-        residual_rms=rms,
-        joints=tuple(joints),
-        margin=float(margin),
-        residual_cutoff=float(residual_cutoff),
-        initial_gain=k0,
-        initial_natural_frequency=w0,
-        initial_damping=d0,
-        source=where if named else None,
-        payload=payload,
-        torque_point=None
-        if suspect is None
-        else (float(suspect[0]), float(suspect[1]), float(suspect[2])),
-    )
+    return gain, omega, damping, rms, suspect, peak
+
+
+def _angle_lag(
+    moves: Sequence[_FreeMotion],
+    antenna: Antenna,
+    weighed: Antenna,
+    where: str,
+    residual_cutoff: float,
+    peak: float,
+) -> float | None:
+    """How late (s) the angles read against the torques, when Eq. 15 fitted with the angles
+    moved earlier by that much leaves a largest filtered residual :data:`LAG_GAIN` times
+    smaller than ``peak`` (N m), the lag at least two samples; else None. Whole samples, two at
+    a time from two either way, on in the direction the residual falls (up to
+    :data:`LAG_SEARCH`) while it falls, then the samples beside the best."""
+    period = next(move for move in moves if move.joints).recording.sample_period
+    most = max(2, round(LAG_SEARCH / period))
+    peaks = {0: peak}
+
+    def peak_at(shift: int) -> float:
+        if shift not in peaks:
+            moved = [
+                replace(move, recording=_angles_moved(move.recording, shift)) for move in moves
+            ]
+            try:
+                peaks[shift] = _observed(moved, antenna, weighed, where, residual_cutoff)[5]
+            except IdentificationError:
+                peaks[shift] = math.inf
+        return peaks[shift]
+
+    direction = 1 if peak_at(2) <= peak_at(-2) else -1
+    shift = 2 * direction
+    while abs(shift) + 2 <= most and peak_at(shift + 2 * direction) < peak_at(shift):
+        shift += 2 * direction
+    for beside in (shift - 1, shift + 1):
+        if abs(beside) <= most:
+            peak_at(beside)
+    best = min(peaks, key=peaks.__getitem__)
+    if abs(best) < 2 or not peaks[best] * LAG_GAIN <= peak:
+        return None
+    return best * period
+
+
+def _angles_moved(recording: Recording, shift: int) -> Recording:
+    """``recording`` with each sample's angles taken ``shift`` samples later (earlier when
+    negative), the ends held."""
+    theta = recording.theta
+    index = np.clip(np.arange(theta.shape[0]) + shift, 0, theta.shape[0] - 1)
+    return replace(recording, theta=np.ascontiguousarray(theta[index]))
 
 
 @dataclass(frozen=True)

@@ -144,6 +144,17 @@ def _run(args: argparse.Namespace) -> int:
             f"{fit.residual_rms:.3g} N m, joints used: {joints}"
         )
         _print_payload(fit.payload, antenna.link, identified.link)
+        if fit.angle_lag is not None:
+            late = "late" if fit.angle_lag > 0 else "early"
+            print(
+                f"antenna identify: warning: the angles read about {1e3 * abs(fit.angle_lag):.0f}"
+                f" ms {late} against the torques (Eq. 15 with them moved that much leaves a"
+                " largest free-motion residual well under this fit's), and the threshold here"
+                " holds the lag's residual. The encoder's and the sensor's"
+                " clocks do not agree? Synchronise them, or shift the joints' stamps, and"
+                " identify again (docs/import.md, 'Another log, from Python')",
+                file=sys.stderr,
+            )
         if fit.torque_point is not None:
             from sensing_antenna.torque_point import metadata_line
 
