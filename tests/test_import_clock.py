@@ -294,6 +294,13 @@ def test_stamps_in_floats_or_microseconds_are_refused_naming_the_unit() -> None:
     seconds = Stream("/wrench", "wrench", wrench.stamps / 1e9, wrench.values)
     with pytest.raises(ImporterError, match=r"^log: '/wrench': stamps must be whole nanoseconds"):
         put_on_clock(seconds, joints, source="log")
+    unsigned = Stream("/wrench", "wrench", wrench.stamps.astype(np.uint64), wrench.values)
+    with pytest.raises(ImporterError, match=r"got uint64 .*astype\(np.int64\)"):
+        put_on_clock(unsigned, joints, source="log")
+    backwards = wrench.stamps.copy()
+    backwards[[50, 51]] = backwards[[51, 50]]
+    with pytest.raises(ImporterError, match=r"messages 50 and 51 are not in time order"):
+        put_on_clock(Stream("/wrench", "wrench", backwards, wrench.values), joints, source="log")
     micro = _wrench(200, period_ns=1000, start_ns=EPOCH_NS // 1000)
     with pytest.raises(ImporterError, match=r"sensor reads \(100000 Hz\): stamps in"):
         put_on_clock(micro, _ramp_joints(micro.stamps), source="log")

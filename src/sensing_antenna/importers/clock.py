@@ -284,20 +284,31 @@ class ClockedStreams:
 
 def _check_stream(stream: Stream, source: str, role: str, columns: str, width: int) -> None:
     """Refuse a stream whose stamps are not whole nanoseconds in order, or whose values are not
-    ``width`` per stamp (``columns``), as the ``role`` stream of :func:`put_on_clock`."""
-    stamps = np.asarray(stream.stamps)
-    if stamps.ndim != 1 or stamps.dtype.kind not in "iu":
+    ``width`` per stamp (``columns``), as the ``role`` stream of :func:`put_on_clock`; the
+    other stream's width is ``8 - width``."""
+    stamps, values = stream.stamps, stream.values
+    if not (isinstance(stamps, np.ndarray) and isinstance(values, np.ndarray)):
         raise ImporterError(
-            f"{source}: {stream.name!r}: stamps must be whole nanoseconds, a 1-D integer array"
-            f" (int64), got {stamps.dtype} of shape {stamps.shape}: seconds or nanoseconds in"
-            " floats? (a float64 holds an epoch in ns only to about 0.2 us)"
+            f"{source}: {stream.name!r}: stamps and values must be numpy arrays, got"
+            f" {type(stamps).__name__} and {type(values).__name__}"
         )
-    values = np.asarray(stream.values)
+    if stamps.ndim != 1 or stamps.dtype.kind != "i":
+        hint = {
+            "M": ": .astype('datetime64[ns]').astype(np.int64) gives them",
+            "u": ": .astype(np.int64) gives them (differences of unsigned stamps wrap)",
+            "f": ": seconds or nanoseconds in floats? (a float64 holds an epoch in ns only to"
+            " about 0.2 us)",
+        }.get(stamps.dtype.kind, "")
+        raise ImporterError(
+            f"{source}: {stream.name!r}: stamps must be whole nanoseconds, a 1-D int64 array,"
+            f" got {stamps.dtype} of shape {stamps.shape}{hint}"
+        )
     if values.shape != (stamps.shape[0], width):
+        swapped = values.ndim == 2 and values.shape[1] == 8 - width
         raise ImporterError(
             f"{source}: {stream.name!r}: values of shape {values.shape} for {stamps.shape[0]}"
-            f" stamps, where the {role} stream has {width} per stamp, {columns} (the wrench and"
-            " the joints passed the other way round?)"
+            f" stamps, where the {role} stream has {width} per stamp, {columns}"
+            + (" (the wrench and the joints passed the other way round?)" if swapped else "")
         )
     if stamps.shape[0] < 2:
         raise ImporterError(
@@ -306,10 +317,14 @@ def _check_stream(stream: Stream, source: str, role: str, columns: str, width: i
     steps = np.diff(stamps)
     if not np.all(steps > 0):
         k = int(np.argmin(steps > 0))
-        raise ImporterError(
-            f"{source}: {stream.name!r}: messages {k} and {k + 1} (in time order) have the same"
-            f" stamp, {int(stamps[k])} ns"
-        )
+        if steps[k] == 0:
+            problem = f"have the same stamp, {int(stamps[k])} ns"
+        else:
+            problem = (
+                f"are not in time order ({int(stamps[k])} ns, then {int(stamps[k + 1])} ns):"
+                " sort the messages by stamp"
+            )
+        raise ImporterError(f"{source}: {stream.name!r}: messages {k} and {k + 1} {problem}")
 
 
 @dataclass(frozen=True)
