@@ -710,7 +710,10 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
         others = ""
         if len(missing) > 1:
             others = f"; missing too: {', '.join(missing[1:])}"
-        if len(missing) * 2 > len(REQUIRED_COLUMNS):
+        if all(_near(other, names) for other in missing):
+            if len(missing) > 1:
+                others += " (each written otherwise: the names are the format's own)"
+        elif len(missing) * 2 > len(REQUIRED_COLUMNS):
             others += (
                 " (a log in another format? docs/import.md converts one: ROS bags with "
                 "'antenna import', any other log from Python)"
