@@ -287,10 +287,16 @@ def _turned_hint(measured: FloatArray, expected: FloatArray, tolerance: float) -
     if abs(float(axis[k])) < math.cos(math.radians(25.0)):
         return ""
     sign = "" if axis[k] > 0 else "-"
+    # a quarter turn is one of the axes' permutations the importers name; another is not
+    quarter = abs(angle - 90.0) <= 15.0
+    how = (
+        "docs/import.md, 'Frames and signs'"
+        if quarter
+        else "the loads turned back by that angle before they are written"
+    )
     return (
         f" Or the sensor's axes turned on the link: the moment has the weight's size, turned "
-        f"{angle:.0f} degrees about {sign}{'XYZ'[k]}^m from it (docs/import.md, 'Frames and "
-        "signs')"
+        f"{angle:.0f} degrees about {sign}{'XYZ'[k]}^m from it ({how})"
     )
 
 
