@@ -71,6 +71,7 @@ __all__ = [
     "DEFAULT_MARGIN",
     "LAG_GAIN",
     "LAG_SEARCH",
+    "LAG_STRIDE",
     "LEVER_GAIN",
     "MAX_INERTIA_FACTOR",
     "SENSOR_OFFSET_NOTICED",
@@ -246,6 +247,10 @@ LEVER_GAIN = 0.5
 #: left a residual 1.95 times the shifted fit's, 5 ms 2.8 times; on time, 1.06 at most.
 LAG_SEARCH = 0.02
 LAG_GAIN = 1.5
+
+#: The search's first stride (s), two samples at least: whole milliseconds keep the number of
+#: fits a search makes about the same at any sample rate.
+LAG_STRIDE = 0.002
 
 #: Lower bound of the fitted gain K (N m / rad), 1e-11 of the paper's 0.37: keeps it positive.
 _MIN_GAIN = 1e-12
@@ -509,6 +514,8 @@ def identify_free_motion(
     antenna: Antenna,
     margin: float = DEFAULT_MARGIN,
     residual_cutoff: float = DEFAULT_RESIDUAL_CUTOFF,
+    *,
+    find_lag: bool = True,
 ) -> ObserverFit:
     """Fit the Eq. 15 observer and the contact threshold to free-motion recordings.
 
@@ -524,6 +531,9 @@ def identify_free_motion(
         Safety factor on the maximum free-motion residual (Section 5.2: 1.5).
     residual_cutoff : float
         Cut-off of the residual filter (rad/s); must match the detector's.
+    find_lag : bool
+        Look for angles read on a clock that lags the sensor's (:attr:`ObserverFit.angle_lag`;
+        a few more fits of Eq. 15); False: ``angle_lag`` is None.
 
     Returns
     -------
@@ -578,7 +588,7 @@ def identify_free_motion(
             f"contact threshold: {margin!r} x the largest filtered residual ({peak!r} N m) is not "
             "finite: a load sample of the free motion is far out of range"
         )
-    lag = _angle_lag(moves, antenna, weighed, where, residual_cutoff, peak)
+    lag = _angle_lag(moves, antenna, weighed, where, residual_cutoff, peak) if find_lag else None
     k0, w0, d0 = initial_guess(antenna)
     joints = sorted({j + 1 for move in moves for j in move.joints})
     return ObserverFit(
@@ -662,11 +672,13 @@ def _angle_lag(
 ) -> float | None:
     """How late (s) the angles read against the torques, when Eq. 15 fitted with the angles
     moved earlier by that much leaves a largest filtered residual :data:`LAG_GAIN` times
-    smaller than ``peak`` (N m), the lag at least two samples; else None. Whole samples, two at
-    a time from two either way, on in the direction the residual falls (up to
-    :data:`LAG_SEARCH`) while it falls, then the samples beside the best."""
+    smaller than ``peak`` (N m), the lag at least two samples; else None. Whole samples: a
+    stride of :data:`LAG_STRIDE` (two samples at least) from one stride either way, on in the
+    direction the residual falls (up to :data:`LAG_SEARCH`) while it falls, then half strides
+    about the best down to one sample."""
     period = next(move for move in moves if move.joints).recording.sample_period
-    most = max(2, round(LAG_SEARCH / period))
+    stride = max(2, round(LAG_STRIDE / period))
+    most = max(stride, round(LAG_SEARCH / period))
     peaks = {0: peak}
 
     def peak_at(shift: int) -> float:
@@ -680,14 +692,17 @@ def _angle_lag(
                 peaks[shift] = math.inf
         return peaks[shift]
 
-    direction = 1 if peak_at(2) <= peak_at(-2) else -1
-    shift = 2 * direction
-    while abs(shift) + 2 <= most and peak_at(shift + 2 * direction) < peak_at(shift):
-        shift += 2 * direction
-    for beside in (shift - 1, shift + 1):
-        if abs(beside) <= most:
-            peak_at(beside)
+    direction = 1 if peak_at(stride) <= peak_at(-stride) else -1
+    shift = stride * direction
+    while abs(shift) + stride <= most and peak_at(shift + stride * direction) < peak_at(shift):
+        shift += stride * direction
     best = min(peaks, key=peaks.__getitem__)
+    while stride > 1:
+        stride = max(1, stride // 2)
+        for beside in (best - stride, best + stride):
+            if abs(beside) <= most:
+                peak_at(beside)
+        best = min(peaks, key=peaks.__getitem__)
     if abs(best) < 2 or not peaks[best] * LAG_GAIN <= peak:
         return None
     return best * period

@@ -145,16 +145,7 @@ def _run(args: argparse.Namespace) -> int:
         )
         _print_payload(fit.payload, antenna.link, identified.link)
         if fit.angle_lag is not None:
-            late = "late" if fit.angle_lag > 0 else "early"
-            print(
-                f"antenna identify: warning: the angles read about {1e3 * abs(fit.angle_lag):.0f}"
-                f" ms {late} against the torques (Eq. 15 with them moved that much leaves a"
-                " largest free-motion residual well under this fit's), and the threshold here"
-                " holds the lag's residual. The encoder's and the sensor's"
-                " clocks do not agree? Synchronise them, or shift the joints' stamps, and"
-                " identify again (docs/import.md, 'Another log, from Python')",
-                file=sys.stderr,
-            )
+            print(_lag_warning(fit.angle_lag), file=sys.stderr)
         if fit.torque_point is not None:
             from sensing_antenna.torque_point import metadata_line
 
@@ -226,3 +217,27 @@ def _print_servo(motor_fit: Any, antenna: Any, pole: float, several: bool = Fals
             f"(s (s + b)) with b = {design.b:.6g} rad/s, feedback R2 (c2, c1, c0) = "
             f"({feedback}), feedforward R1 = ({feedforward})"
         )
+
+
+def _lag_warning(lag: float) -> str:
+    """The line warning of angles read ``lag`` (s) late (early when negative) against the
+    torques."""
+    from sensing_antenna.calibration.observer import LAG_SEARCH
+
+    size = f"about {1e3 * abs(lag):.0f} ms"
+    if abs(lag) >= LAG_SEARCH * (1.0 - 1e-9):
+        size = f"{1e3 * LAG_SEARCH:.0f} ms or more"
+    cause = "The encoder's and the sensor's clocks do not agree?"
+    if lag < 0.0:
+        cause = (
+            "The encoder's and the sensor's clocks do not agree, or the sensor's own filter"
+            " delays the loads (its cut-off)?"
+        )
+    return (
+        f"antenna identify: warning: the angles read {size} {'late' if lag > 0 else 'early'}"
+        " against the torques (Eq. 15 with them moved that much leaves a largest free-motion"
+        " residual well under this fit's), and the threshold here holds the lag's residual."
+        f" {cause} Synchronise them, or shift the joints' stamps, and identify again"
+        " (docs/import.md,"
+        " 'Another log, from Python')"
+    )

@@ -444,7 +444,8 @@ def prepare_device(
             device=profile.imperfections(seed, length),
         )
         free.append(simulate(device, scenario))
-    model = identify_free_motion([run.without_ground_truth() for run in free], device).apply(device)
+    free_runs = [run.without_ground_truth() for run in free]
+    model = identify_free_motion(free_runs, device, find_lag=False).apply(device)
     controlled = knowing_weight(device, model)
     at = realistic_calibration_points(length) if realistic else calibration_points(length)
     posts: list[tuple[Literal["azimuthal", "vertical"], float]] = [(AZIMUTHAL, x) for x in at]
