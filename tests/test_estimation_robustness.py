@@ -28,6 +28,7 @@ from sensing_antenna.estimation import (
     Status,
     estimate,
 )
+from sensing_antenna.estimation.front.held import repeated_rows
 from sensing_antenna.estimation.front.spikes import spike_longest
 from sensing_antenna.estimation.front.steps import declared_period_problem
 from sensing_antenna.recording import Recording
@@ -563,6 +564,43 @@ def test_readings_sent_again_and_stamped_as_new_are_not_an_ok_answer(case: str, 
     for block in (1, 64):
         streamed = _streamed(restamped, block, antenna=antenna)
         assert (streamed.status, streamed.reason) == (offline.status, offline.reason)
+
+
+@pytest.mark.parametrize(
+    "wrench",
+    [np.zeros((0, 6)), np.zeros((1, 6)), np.ones((50, 6)), np.full((50, 6), np.nan)],
+    ids=["empty", "one row", "still", "not a number"],
+)
+def test_repeats_are_not_judged_without_a_ringing_to_judge_them_by(wrench: np.ndarray) -> None:
+    assert repeated_rows(wrench) is None
+    assert repeated_rows(wrench, first=1000) is None
+
+
+@pytest.mark.parametrize("kind", ["in place of lost readings", "gauges read coarsely"])
+def test_repeats_the_time_base_does_not_explain_are_not_taken_for_a_stretch(kind: str) -> None:
+    # Readings sent again in place of lost ones keep the stamps right; a sensor whose six
+    # outputs mix gauges read to four counts repeats all six wherever every gauge stands still
+    # (about 6 % of the samples here). Neither stretches the time.
+    antenna = load_antenna("paper-2021-calibrated")
+    recording = simulate(antenna, Scenario(case="vertical", contact_point=0.3, seed=1))
+    loads = np.hstack([recording.force, recording.torque])
+    if kind == "in place of lost readings":
+        n = recording.t.size
+        lost = np.sort(np.random.default_rng(101).choice(np.arange(1, n), n // 20, replace=False))
+        rows = np.arange(n)
+        for k in lost:
+            rows[k] = rows[k - 1]
+        loads = loads[rows]
+    else:
+        counts = 4.0 * np.array(ATI_NANO17_RESOLUTION)
+        mixing = np.eye(6) + 0.3 * np.linalg.qr(np.random.default_rng(0).normal(size=(6, 6)))[0]
+        gauges = np.round(loads / counts @ np.linalg.inv(mixing).T)
+        loads = gauges @ mixing.T * counts
+    read = dataclasses.replace(recording, force=loads[:, :3], torque=loads[:, 3:])
+    result = estimate(read, antenna, "paper")
+    said = [result.reason or "", *result.diagnostics.get("other_reasons", [])]
+    assert not any("repeat the one before" in text for text in said), said
+    assert abs(result.x_c - float(recording.metadata["true_xc"])) < 2e-3
 
 
 def test_a_few_readings_sent_again_leave_the_answer_alone() -> None:

@@ -93,7 +93,7 @@ from sensing_antenna.estimation.front.evidence import (
     Evidence,
     sensing_curve,
 )
-from sensing_antenna.estimation.front.held import repeated_rows
+from sensing_antenna.estimation.front.held import FAST_PACE, channel_name, repeated_rows
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import (
     candidates_from_omega1,
@@ -1086,10 +1086,11 @@ def _time_base_problem(
     evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
 ) -> str | None:
     """Why the time stamps from t_1 to t_e may run long by more than ``max_model_spread`` of
-    the answer, or None: readings sent again in all six channels, more than chance allows
-    (:func:`~.front.held.repeated_rows`), stretch the record's time by their share when a
-    logger stamped them as new samples, and omega_1 was read that much low. Only for methods
-    that read omega_1. Notes ``repeated_rows`` (count, steps, expected) when they are found.
+    the answer, or None: readings sent again in all six channels where the loads move fast, more
+    than chance allows (:func:`~.front.held.repeated_rows`), stretch the record's time by their
+    share when a logger stamped them as new samples, and omega_1 was read that much low; not
+    when they stand in place of lost readings. Only for methods that read omega_1. Notes
+    ``repeated_rows`` (count, steps, fast, expected, channel, in_place) when they are found.
     """
     if not math.isfinite(estimate.omega1):
         return None
@@ -1100,25 +1101,35 @@ def _time_base_problem(
     notes["repeated_rows"] = {
         "count": rows.count,
         "steps": rows.steps,
+        "fast": rows.fast,
         "expected": rows.expected,
+        "channel": channel_name(rows.channel),
+        "in_place": rows.in_place,
     }
+    if rows.in_place:
+        return None
     omega = estimate.omega1 / (1.0 - rows.share) if rows.share < 1.0 else math.inf
     points = _vibration_points(evidence, omega) if math.isfinite(omega) else ()
     limit = evidence.config.max_model_spread
+    stretched = f"omega_1 = {omega:.1f} rad/s"
     if points:
         point = min(points, key=lambda c: abs(c - estimate.x_c))
         if abs(point - estimate.x_c) <= limit:
             return None
-        there = f"would put the contact at {point:.3f} m, {100 * abs(point - estimate.x_c):.1f} cm"
+        there = (
+            f"{stretched} would put the contact at {point:.3f} m, "
+            f"{100 * abs(point - estimate.x_c):.1f} cm from the answer"
+        )
     else:
-        there = "lies on no point of the sensing curve,"
+        there = f"{stretched}, which lies on no point of the sensing curve, would move the answer"
     return (
         f"{rows.count} of the {rows.steps} samples from t_1 to t_e repeat the one before in all "
-        f"six channels, where the channels' steps allow at most {rows.expected:.2g} by chance: "
-        "a sensor or driver that sends a reading again. Stamped as new samples they stretch "
-        f"the time by {100 * rows.share:.1f} %, and omega_1 = {omega:.1f} rad/s {there} from "
-        f"the answer, more than {100 * limit:g} cm; stamp the samples where they were read, or "
-        "leave out the repeats with their stamps"
+        f"six channels, {rows.fast} where the loads move fast ({channel_name(rows.channel)} at "
+        f"{FAST_PACE:g} times its typical step), where chance gives about "
+        f"{rows.expected:.2g}: a sensor or driver that sends a reading again. Stamped as new "
+        f"samples they stretch the time by {100 * rows.share:.1f} %, and {there}, more than "
+        f"{100 * limit:g} cm; stamp the samples where they were read, or leave out the repeats "
+        "with their stamps"
     )
 
 

@@ -20,12 +20,14 @@ judge by. A held run longer than the gaps a recording may have (``EstimatorConfi
 reaching the contact makes an estimate ``bad_input`` (``Evidence.sample_problem``).
 
 Readings sent again one at a time, scattered, are counted by :func:`repeated_rows`: steps where
-all six channels repeat, against the most chance allows. A channel repeats by chance when its
-step rounds to nothing, about its finest step over its typical step, which :data:`NEIGHBOURS`
-steps at a time say; all six together at most as often as the one that repeats least (whatever
-their correlation). A logger that stamps such readings as new samples stretches the record's
-time by their share, and the frequencies read from it fall by as much (the plausibility layer's
-"time base" check).
+all six channels repeat the sample before. A sensor read to its resolution makes such repeats
+where the loads stand nearly still, however its channels mix its gauges; a reading sent again
+makes them at any pace. Where they come while the smoothest-ringing channel moves fast, more
+often than that channel's own repeats there allow, they are readings sent again: in place of
+lost ones (the step after each is about two), or stamped as new samples, which stretches the
+record's time by their share and lowers the frequencies read from it by as much (the
+plausibility layer's "time base" check). A sensor read too coarsely for any channel to ring
+smoothly from one sample to the next is not judged.
 """
 
 from __future__ import annotations
@@ -40,11 +42,14 @@ from scipy.stats import poisson
 from sensing_antenna.estimation.front.spikes import Spike
 
 __all__ = [
+    "FAST_PACE",
     "HELD_CHANCE",
+    "IN_PLACE_RATIO",
     "LEAST_NEIGHBOURS",
     "NEIGHBOURS",
     "ONE_CHANNEL_STEPS",
     "RepeatedRows",
+    "channel_name",
     "describe_held",
     "find_held",
     "repeated_rows",
@@ -125,21 +130,35 @@ def find_held(wrench: FloatArray, longer_than: int, first: int = 0) -> list[Spik
 
 @dataclass(frozen=True)
 class RepeatedRows:
-    """Steps whose six channels all repeat the sample before, more than chance allows.
+    """Steps whose six channels all repeat the sample before, beyond what the sensor's
+    resolution explains (:func:`repeated_rows`).
 
     Attributes
     ----------
     count : int
-        Such steps.
+        Steps judged whose six channels all repeat the sample before, fast or slow.
     steps : int
         Steps judged.
+    fast : int
+        Of ``count``, those where ``channel`` moves at :data:`FAST_PACE` times its typical step
+        or more either side.
     expected : float
-        Most such steps the channels' own steps allow by chance.
+        The mean number of such fast repeats the resolution gives: ``channel``'s own repeats at
+        that pace where the other channels move on, as a rate, times its fast steps.
+    channel : int
+        The channel (0 to 5: fx, fy, fz, tx, ty, tz) that rings smoothest, whose pace judged them.
+    in_place : bool
+        Whether the step after a fast repeat is about twice the one before it: the repeats stand
+        in place of readings that were lost, on the right time stamps; not so when readings
+        were sent again and stamped as new samples.
     """
 
     count: int
     steps: int
+    fast: int
     expected: float
+    channel: int
+    in_place: bool
 
     @property
     def share(self) -> float:
@@ -147,34 +166,92 @@ class RepeatedRows:
         return self.count / self.steps
 
 
+#: Least correlation of a channel's successive steps for its ringing to judge repeats: a ringing
+#: resolved far above the noise and the resolution steps alike from one sample to the next
+#: (white noise's steps correlate at -0.5); a sensor read coarsely falls below.
+SMOOTH_CORRELATION = 0.75
+
+#: The pace, in the smooth channel's typical (median) steps, of the steps either side of a repeat
+#: for it to count as one where the loads move fast.
+FAST_PACE = 1.5
+
+#: Chance under which the fast repeats are not the sensor's resolution. Such readings make an
+#: answer ``uncertain`` at most, and only where they would move it (the plausibility layer).
+REPEAT_CHANCE = 1e-3
+
+#: The median ratio of the step after a fast repeat to the step before it from which the
+#: repeats stand in place of lost readings (about 2) rather than readings stamped as new
+#: samples (about 1).
+IN_PLACE_RATIO = 1.5
+
+_CHANNELS = ("fx", "fy", "fz", "tx", "ty", "tz")
+
+
 def repeated_rows(wrench: FloatArray, first: int = 0) -> RepeatedRows | None:
     """The steps from sample ``first`` on in ``wrench`` (n, 6; N, N m) where all six channels
-    repeat the sample before, when chance cannot explain their number (a Poisson tail under
-    :data:`HELD_CHANCE` about the most chance allows, the module docstring); None when it can.
-    Each channel's finest step is taken over all of ``wrench``; a channel that never moves
-    says nothing."""
+    repeat the sample before, when the sensor's resolution cannot explain those where the loads
+    move fast; None when it can, or when no channel rings smoothly enough to tell
+    (:data:`SMOOTH_CORRELATION`).
+
+    A sensor read to its resolution repeats all six channels where the loads stand nearly still,
+    however its channels mix its gauges; where the smoothest channel moves at
+    :data:`FAST_PACE` times its typical step on both sides, such a repeat needs that channel's
+    own step to round to nothing, which its other steps at that pace say how often happens. A
+    reading sent again repeats at any pace. Judged by a Poisson tail under
+    :data:`REPEAT_CHANCE`."""
     with np.errstate(invalid="ignore", over="ignore"):
-        step = np.abs(np.diff(wrench, axis=0))
-    finite = np.isfinite(step)
-    moving = np.where((step > 0.0) & finite, step, np.inf)
-    quantum = np.min(moving, axis=0, initial=np.inf)
-    judged = step[max(first, 0) :]
-    same = np.all(judged == 0.0, axis=1)
+        signed = np.diff(np.asarray(wrench, dtype=float), axis=0)
+    step = np.abs(signed)
+    begin = max(first, 1)  # each judged step has a step before it and one after it
+    rows = np.arange(begin, step.shape[0] - 1)
+    if rows.size < 3:
+        return None
+    here, before, after = step[rows], step[rows - 1], step[rows + 1]
+    same = np.all(here == 0.0, axis=1)
     count = int(np.count_nonzero(same))
     if count == 0:
         return None
-    expected = 0.0
-    for start in range(0, judged.shape[0], NEIGHBOURS):
-        block = judged[start : start + NEIGHBOURS]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            typical = np.median(block, axis=0)
-            # a step rounds to nothing about once in typical / quantum; twice that, for tails
-            chance = np.where(typical > 0.0, 2.0 * quantum / typical, 1.0)
-        share = float(np.min(np.minimum(np.nan_to_num(chance, nan=1.0), 1.0)))
-        expected += share * block.shape[0]
-    if not float(poisson.sf(count - 1, expected)) < HELD_CHANCE:
+    channel, smooth = _smoothest(signed[begin:])
+    if not smooth >= SMOOTH_CORRELATION:
         return None
-    return RepeatedRows(count, int(judged.shape[0]), expected)
+    typical = float(np.median(step[begin:, channel]))
+    with np.errstate(invalid="ignore", over="ignore"):
+        fast = before[:, channel] + after[:, channel] >= 2.0 * FAST_PACE * typical
+    repeats = int(np.count_nonzero(same & fast))
+    others = fast & ~same
+    alone = int(np.count_nonzero(others & (here[:, channel] == 0.0)))
+    expected = (alone + 1.0) / (int(np.count_nonzero(others)) + 2.0) * int(np.count_nonzero(fast))
+    if repeats == 0 or not float(poisson.sf(repeats - 1, expected)) < REPEAT_CHANCE:
+        return None
+    judged = same & fast & (before[:, channel] > 0.0)
+    ratio = float(np.median(after[judged, channel] / before[judged, channel]))
+    return RepeatedRows(
+        count=count,
+        steps=int(rows.size),
+        fast=repeats,
+        expected=expected,
+        channel=channel,
+        in_place=ratio >= IN_PLACE_RATIO,
+    )
+
+
+def _smoothest(signed: FloatArray) -> tuple[int, float]:
+    """The channel whose successive steps (``signed``, (m, 6)) correlate most, and that
+    correlation (NaN where no channel's steps vary)."""
+    best, value = 0, math.nan
+    for channel in range(signed.shape[1]):
+        a, b = signed[:-1, channel], signed[1:, channel]
+        if not (np.all(np.isfinite(a)) and a.std() > 0.0 and b.std() > 0.0):
+            continue
+        correlation = float(np.corrcoef(a, b)[0, 1])
+        if not value >= correlation:
+            best, value = channel, correlation
+    return best, value
+
+
+def channel_name(channel: int) -> str:
+    """The recording's column name of wrench channel ``channel`` (0 to 5)."""
+    return _CHANNELS[channel]
 
 
 def _runs(same: NDArray[np.bool_]) -> list[tuple[int, int]]:
