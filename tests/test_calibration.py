@@ -294,6 +294,15 @@ def test_points_table_as_a_spreadsheet_writes_it(tmp_path: Path) -> None:
     assert notes[1].endswith("(in mm?)")
 
 
+def test_known_points_all_in_millimetres_are_refused_naming_the_unit() -> None:
+    # every point off the link the same way: the unit, not "need at least 2 frequencies"
+    link = paper_antenna().link
+    with pytest.raises(CalibrationError, match=r"^x_c: none of the 3 known contact points lies"):
+        calibrate_t_e([300.0, 600.0, 900.0], [30.0, 65.0, 85.0], link, sources=["a", "b", "c"])
+    with pytest.raises(CalibrationError, match=r"in mm\? \(they are in m\): a: x_c = 300.0 m"):
+        calibrate_t_e([300.0, 600.0, 900.0], [30.0, 65.0, 85.0], link, sources=["a", "b", "c"])
+
+
 def test_points_table_that_is_not_utf8_is_one_line(tmp_path: Path) -> None:
     table = tmp_path / "points.csv"
     table.write_bytes(b"file,x_c\na.csv,0.4\n\xff\xfe.csv,0.8\n")

@@ -502,6 +502,15 @@ def calibrate_t_e(
     if x_c.shape != w.shape:
         raise CalibrationError(f"omega1: {w.size} frequencies for {x_c.size} contact points")
     x_c, on_link, left_out = points_on_link(x_c, link.length, sources)
+    given = np.isfinite(x_c)
+    hints = {_unit_hint(float(v), link.length) for v in x_c[given]}
+    if given.sum() >= 2 and not on_link.any() and len(hints) == 1 and "" not in hints:
+        # every known point off the link in one way: a unit, said first
+        unit = hints.pop().strip(" ()")
+        raise CalibrationError(
+            f"x_c: none of the {int(given.sum())} known contact points lies on the link (0, "
+            f"{link.length:g}] m, {unit} (they are in m): {left_out[0]}"
+        )
     used = on_link & np.isfinite(w) & (w > 0)
     if int(used.sum()) < 2:
         reasons = [*left_out, *notes]
