@@ -230,7 +230,8 @@ def rest_reading(
         tared = float(np.linalg.norm(mean_torque)) <= torque_tolerance
         causes = (
             "a sensor tared with the link on it (tare it without the link: the format's "
-            "loads hold its weight), or torques scaled far down?"
+            "loads hold its weight; docs/real-antenna.md gives recordings made so their weight "
+            "back), or torques scaled far down?"
             if tared
             else "torques in N mm, scaled, or a sign flipped?"
             + _turned_hint(mean_torque, expected_torque, torque_tolerance)
