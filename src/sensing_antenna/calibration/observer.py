@@ -367,7 +367,8 @@ def _fit(
             f"{where}: columns 'tx', 'ty', 'tz': Eq. 15 explains the coupling torque poorly "
             f"(residual rms {rms:.3g} N m against a signal rms of {signal_rms:.3g} N m); is this "
             "really free motion? A contact leaves a static torque that no free-motion observer "
-            f"can follow{hint}"
+            f"can follow{hint}; angles stamped tens of milliseconds off the torques' clock"
+            " leave such a residual too (docs/real-antenna.md)"
         )
     point, lever_rms, _ = fitted
     whole = _whole_point(point, stated)
