@@ -56,9 +56,10 @@ forms agree.
    (:func:`_bent_link_problem`); a method that read omega_1 is not ``ok`` where that shift, in
    whichever plane, may move the vibration's point by more than ``max_model_spread``; nor any
    method beyond ``max_deflection_ratio``, where the statics were not checked. One time base
-   (``uncertain``, :func:`_time_base_problem`): readings sent again in all six channels, more
-   than chance allows, would have stretched the time if stamped as new samples; a method that
-   read omega_1 is not ``ok`` where that stretch moves its point by more than
+   (``uncertain``, :func:`_time_base_problem`): readings sent again in all six channels where
+   the loads move fast, more than the sensor's resolution explains and not in place of lost
+   readings, would have stretched the time if stamped as new samples; a method that read
+   omega_1 is not ``ok`` where that stretch moves its point by more than
    ``max_model_spread``.
 
 The status is the first problem in :data:`~.result.STATUS_PRECEDENCE`, the method's own included;
