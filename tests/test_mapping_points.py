@@ -21,6 +21,7 @@ from sensing_antenna.mapping import (
     contact_point_from_estimate,
     select_points,
 )
+from sensing_antenna.mapping.pose import quaternion_order_hint
 from sensing_antenna.simulator import Scenario, simulate
 
 ANTENNA = load_antenna("paper-2021")
@@ -236,6 +237,25 @@ def test_a_quaternion_printed_to_three_decimals_is_normalised() -> None:
     assert math.degrees(math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])) == pytest.approx(
         30.0, abs=0.02
     )
+
+
+@pytest.mark.parametrize("turn", [45.0, 90.0, 150.0])
+def test_a_quaternion_in_ros_order_is_told_by_the_tilt_it_gives(turn: float) -> None:
+    # A level base turned about the vertical written in ROS's [x, y, z, w]: read as the format's
+    # [w, x, y, z] it is a half turn that tips the base over by the same angle; the line says
+    # both readings. Written in the format's order, nothing is said.
+    half = math.radians(turn) / 2.0
+    ros = [0.0, 0.0, math.sin(half), math.cos(half)]
+    ours = [math.cos(half), 0.0, 0.0, math.sin(half)]
+    said = quaternion_order_hint(
+        {"base_pose": json.dumps({"position": [0, 0, 0], "quaternion": ros})}
+    )
+    assert said is not None
+    assert f"tilted {turn:.0f} degrees" in said and f"level base turned {turn:.0f} degrees" in said
+    level = {"base_pose": json.dumps({"position": [0, 0, 0], "quaternion": ours})}
+    assert quaternion_order_hint(level) is None
+    assert quaternion_order_hint({}) is None
+    assert quaternion_order_hint({"base_pose": "not json"}) is None
 
 
 def test_a_rotation_printed_to_three_decimals_is_made_orthonormal() -> None:

@@ -144,19 +144,23 @@ def _map_into(args: argparse.Namespace) -> None:
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.mapping import build_map, map_inputs_from_recordings
     from sensing_antenna.mapping.points import isolated_points
-    from sensing_antenna.mapping.pose import BASE_POSE_KEY
+    from sensing_antenna.mapping.pose import BASE_POSE_KEY, quaternion_order_hint
 
     meshes = read_objects(args.objects, "antenna map", args.objects_unit)
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     named: dict[str, list[str]] = {}  # the antenna each recording names, to its sources
     unposed: list[str] = []  # recordings without a base pose: in the antenna's own frame
     contradicted: list[tuple[Path, str]] = []  # sample_period against the stamps: after the bar
+    ordered: list[str] = []  # quaternions that read level in another order: after the bar
 
     def read(path: Path, recording: Recording) -> None:
         metadata = recording.metadata
         named.setdefault(metadata.get("antenna", ""), []).append(str(path))
         if not metadata.get(BASE_POSE_KEY, "").strip():
             unposed.append(str(path))
+        order = quaternion_order_hint(metadata)
+        if order is not None:
+            ordered.append(f"antenna map: note: {path}: {order} (the order?)")
         problem = recording.period_problem
         if problem is not None:
             contradicted.append((path, problem))
@@ -176,6 +180,8 @@ def _map_into(args: argparse.Namespace) -> None:
         )
     for path, problem in contradicted:
         warn_of_contradicted_period(path, problem)
+    for line in ordered:
+        print(line, file=sys.stderr)
     if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(named, antenna.name)
     note_unposed(unposed, sum(len(paths) for paths in named.values()))

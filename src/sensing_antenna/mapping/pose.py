@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.errors import FieldError
 
-__all__ = ["BASE_POSE_KEY", "BasePose", "base_pose_from_metadata"]
+__all__ = ["BASE_POSE_KEY", "BasePose", "base_pose_from_metadata", "quaternion_order_hint"]
 
 #: The recording metadata key holding the base pose.
 BASE_POSE_KEY = "base_pose"
@@ -182,6 +182,36 @@ def base_pose_from_metadata(metadata: Mapping[str, str], source: str | None = No
         return _pose_from_json(data)
     except FieldError as exc:
         raise FieldError(BASE_POSE_KEY, exc.problem, source) from None
+
+
+def quaternion_order_hint(metadata: Mapping[str, str]) -> str | None:
+    """A line when a ``base_pose`` quaternion reads, in the format's ``[w, x, y, z]``, as a base
+    tilted more than 30 degrees from the world's vertical, while in the ``[x, y, z, w]`` order
+    of ROS and scipy it is a level base turned about the vertical (its first two numbers under
+    0.1); None otherwise, or when the pose is none (its own error says so)."""
+    try:
+        data = json.loads(metadata.get(BASE_POSE_KEY, ""))
+        q = np.asarray(data["quaternion"], dtype=float)
+    except (ValueError, TypeError, KeyError, IndexError, RecursionError):
+        return None
+    if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.linalg.norm(q) > 0.0:
+        return None
+    w, x, y, z = q / np.linalg.norm(q)
+    # read as [w, x, y, z], Z^a's world z is 1 - 2 (x^2 + y^2)
+    tilt = math.degrees(math.acos(min(1.0, max(-1.0, 1.0 - 2.0 * (x * x + y * y)))))
+    if not (abs(w) < 0.1 and abs(x) < 0.1 and tilt > 30.0):
+        return None
+    # read as [x, y, z, w]: a turn of 2 atan2(y, z) about the vertical, nearly
+    turn = math.degrees(2.0 * math.atan2(y, z))
+    return (
+        f"its base_pose quaternion {_listed(q)} reads as [w, x, y, z] (the format's order) as a "
+        f"base tilted {tilt:.0f} degrees from the vertical; in the [x, y, z, w] order of ROS "
+        f"and scipy it would be a level base turned {turn:.0f} degrees about the vertical"
+    )
+
+
+def _listed(values: FloatArray) -> str:
+    return "[" + ", ".join(f"{float(v):.3g}" for v in values) + "]"
 
 
 def _pose_from_json(data: Any) -> BasePose:
