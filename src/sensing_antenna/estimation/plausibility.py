@@ -8,9 +8,11 @@ forms agree.
 
 1. Whole samples (``bad_input``, :meth:`~.evidence.Evidence.sample_problem`): no gap longer
    than the estimators fill in inside [t_c, t_e], no corrupted run too long to put back before
-   t_e. The recording's units and signs (``implausible_input``): the loads at rest before t_c
-   against the link's weight and the free motion against the observer (found by the front end
-   at t_c, ``Evidence.input_problem``), the angles up to t_e
+   t_e; in a stream, no more than :data:`_LATE_SHARE` of the samples up to t_e left out for a
+   place another had taken (:func:`_misplaced_problem`). The recording's units and signs
+   (``implausible_input``): the loads at rest before t_c against the link's weight and the
+   free motion against the observer (found by the front end at t_c,
+   ``Evidence.input_problem``), the angles up to t_e
    (:func:`~sensing_antenna.units_check.angle_problem`), and the push against the head's turn
    into the contact (an obstacle only pushes back; a push that opposed the turn up to t_1 and
    not over the hold after it is a link that slid off the object, ``slip_suspected``), and the
@@ -168,6 +170,9 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     broken = evidence.sample_problem(estimate.t_e)
     if broken is not None:
         found.append((Status.BAD_INPUT, broken))
+    misplaced = _misplaced_problem(estimate, end)
+    if misplaced is not None:
+        found.append((Status.BAD_INPUT, misplaced))
     if evidence.input_problem is not None:
         found.append((Status.IMPLAUSIBLE_INPUT, evidence.input_problem))
     angles = angle_problem(evidence.theta[: end + 1])
@@ -265,6 +270,29 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if kept != estimate.candidates:
         changes["candidates"] = kept
     return dataclasses.replace(estimate, **changes)
+
+
+#: Most of a stream's samples up to t_e that may come for a place on the period's grid another
+#: has taken (``late_samples``): a stream stamped within a third of a period leaves a few in a
+#: thousand; one whose stamps jitter by half a period leaves a tenth, and its readings sit up
+#: to a period from where they were read.
+_LATE_SHARE = 0.05
+
+
+def _misplaced_problem(estimate: ContactEstimate, end: int) -> str | None:
+    """Why a stream's samples up to sample ``end`` do not sit where they were read, or None:
+    more than :data:`_LATE_SHARE` of them came for a place another had taken (left out, the
+    places put back; ``diagnostics["late_samples"]``, streams only)."""
+    late = estimate.diagnostics.get("late_samples")
+    samples = end + 1
+    if not (isinstance(late, int) and late > _LATE_SHARE * samples):
+        return None
+    return (
+        f"{late} of the {samples} samples up to t_e came for a place on the period's grid that "
+        "another had taken, and were left out: time stamps that jitter by half a period or "
+        "more place the readings no better than a period, and the frequencies read from them "
+        "move; stamp the samples on the device's own clock, or send them at a steady period"
+    )
 
 
 def _claimed(
