@@ -282,6 +282,7 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
             # a stamp a day ahead: left out, not kept to leave the good ones after it behind
             Datagram("samples", "b", 3, (row.replace("0.0,", "86400.0,", 1),)).encode(),
             Datagram("samples", "b", 4, (row.replace("0.0,", "0.003,", 1),)).encode(),
+            Datagram("samples", "b", 4, (row.replace("0.0,", "0.003,", 1),)).encode(),  # again
             Datagram("end", "b", 5).encode(),
         ],
         recording,
@@ -292,6 +293,7 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     assert "not UTF-8" in reasons
     assert f"stream b: datagram 0: expected {_cells(recording)} cells, found 2" in reasons
     assert "stream b: datagram 1 arrived after 2: left out" in reasons
+    assert "stream b: datagram 4 arrived again: left out" in reasons
     assert "datagram 3: time 86400.0 s jumps from 0.002 s by more than" in reasons
     end = first[-1]
     assert end["event"] == "end" and end["samples"] == 3
@@ -423,7 +425,7 @@ def test_a_udp_recording_first_heard_after_its_start_is_left_out(
     said = [e.to_dict() for e in events]
     skipped = [e for e in said if e["event"] == "skipped"]
     assert len(skipped) == 1 and skipped[0]["recording"] == 0
-    assert "stream m: first heard after 1 samples datagrams" in skipped[0]["reason"]
+    assert "stream m: first heard at its samples datagram 1" in skipped[0]["reason"]
     found = next(e for e in events if isinstance(e, EstimateEvent))
     assert found.recording == 1
     _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())

@@ -246,8 +246,8 @@ def listen_udp(
                     on_event(
                         SkippedEvent(
                             0,
-                            f"stream {datagram.stream}: first heard after {datagram.seq} "
-                            "samples datagrams: its start (the rest, the contact) was missed; "
+                            f"stream {datagram.stream}: first heard at its samples datagram "
+                            f"{datagram.seq}: its start (the rest, the contact) was missed; "
                             "left out, the next recording is heard",
                         )
                     )
@@ -294,10 +294,13 @@ def _receive_samples(
 ) -> None:
     """The samples of one datagram to the listener, or why (some of) they were left out."""
     if datagram.seq < current.expected:
-        skip(
-            f"stream {current.name}: datagram {datagram.seq} arrived after"
-            f" {current.expected - 1}: left out"
-        )
+        if datagram.seq == current.expected - 1:
+            skip(f"stream {current.name}: datagram {datagram.seq} arrived again: left out")
+        else:
+            skip(
+                f"stream {current.name}: datagram {datagram.seq} arrived after"
+                f" {current.expected - 1}: left out"
+            )
         return
     current.lost += datagram.seq - current.expected
     current.expected = datagram.seq + 1
