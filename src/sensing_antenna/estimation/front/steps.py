@@ -380,9 +380,17 @@ def declared_period_problem(stamps: FloatArray, sample_period: float) -> str | N
             return None
     # stamps in ms (us, ns) read as seconds: 1000 (1e6, 1e9) times the period
     unit = stamps_unit(lambda factor: abs(period / ts - factor) <= 0.01 * factor)
+    jitter = ""
+    spread = float(np.max(step) - np.min(step)) if steps else 0.0
+    if not unit and spread >= 0.6 * ts:
+        # single steps that far apart are stamps jittering by a large part of a period
+        jitter = (
+            f" (its steps spread from {float(np.min(step)):.3g} to {float(np.max(step)):.3g} s:"
+            " stamps that jitter by a large part of a period?)"
+        )
     return (
         f"its time stamps step by {period:.6g} s ({how}), more than {100 * tolerance:.2g} %"
-        " apart" + (f" (time stamps in {unit}? the format's are in s)" if unit else "")
+        " apart" + (f" (time stamps in {unit}? the format's are in s)" if unit else jitter)
     )
 
 
