@@ -96,7 +96,8 @@ from sensing_antenna.estimation.front.evidence import (
     Evidence,
     sensing_curve,
 )
-from sensing_antenna.estimation.front.held import FAST_PACE, channel_name, repeated_rows
+from sensing_antenna.estimation.front.held import FAST_PACE, repeated_rows
+from sensing_antenna.estimation.front.spikes import WRENCH_CHANNELS
 from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import (
     candidates_from_omega1,
@@ -1132,7 +1133,7 @@ def _time_base_problem(
         "steps": rows.steps,
         "fast": rows.fast,
         "expected": rows.expected,
-        "channel": channel_name(rows.channel),
+        "channel": WRENCH_CHANNELS[rows.channel],
         "in_place": rows.in_place,
     }
     if rows.in_place:
@@ -1153,7 +1154,7 @@ def _time_base_problem(
         there = f"{stretched}, which lies on no point of the sensing curve, would move the answer"
     return (
         f"{rows.count} of the {rows.steps} samples from t_1 to t_e repeat the one before in all "
-        f"six channels, {rows.fast} where the loads move fast ({channel_name(rows.channel)} at "
+        f"six channels, {rows.fast} where the loads move fast ({WRENCH_CHANNELS[rows.channel]} at "
         f"{FAST_PACE:g} times its typical step), where chance gives about "
         f"{rows.expected:.2g}: a sensor or driver that sends a reading again. Stamped as new "
         f"samples they stretch the time by {100 * rows.share:.1f} %, and {there}, more than "

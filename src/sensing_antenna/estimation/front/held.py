@@ -48,8 +48,9 @@ __all__ = [
     "LEAST_NEIGHBOURS",
     "NEIGHBOURS",
     "ONE_CHANNEL_STEPS",
+    "REPEAT_CHANCE",
+    "SMOOTH_CORRELATION",
     "RepeatedRows",
-    "channel_name",
     "describe_held",
     "find_held",
     "repeated_rows",
@@ -184,8 +185,6 @@ REPEAT_CHANCE = 1e-3
 #: samples (about 1).
 IN_PLACE_RATIO = 1.5
 
-_CHANNELS = ("fx", "fy", "fz", "tx", "ty", "tz")
-
 
 def repeated_rows(wrench: FloatArray, first: int = 0) -> RepeatedRows | None:
     """The steps from sample ``first`` on in ``wrench`` (n, 6; N, N m) where all six channels
@@ -247,11 +246,6 @@ def _smoothest(signed: FloatArray) -> tuple[int, float]:
         if not value >= correlation:
             best, value = channel, correlation
     return best, value
-
-
-def channel_name(channel: int) -> str:
-    """The recording's column name of wrench channel ``channel`` (0 to 5)."""
-    return _CHANNELS[channel]
 
 
 def _runs(same: NDArray[np.bool_]) -> list[tuple[int, int]]:
