@@ -707,10 +707,11 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
     missing = [name for name in REQUIRED_COLUMNS if name not in seen]
     if missing:
         name = missing[0]
+        hints = [_near(other, names) for other in missing]
         others = ""
         if len(missing) > 1:
             others = f"; missing too: {', '.join(missing[1:])}"
-        if all(_near(other, names) for other in missing):
+        if all(hints):
             if len(missing) > 1:
                 others += " (each written otherwise: the names are the format's own)"
         elif len(missing) * 2 > len(REQUIRED_COLUMNS):
@@ -722,7 +723,7 @@ def parse_header(line: str, number: int, source: str) -> list[str]:
             source,
             number,
             name,
-            f"required column missing from header{_near(name, names)}{others}",
+            f"required column missing from header{hints[0]}{others}",
         )
     return names
 
