@@ -282,10 +282,12 @@ class ClockedStreams:
     report: ClockReport
 
 
-def _check_stream(stream: Stream, source: str, role: str, columns: str, width: int) -> None:
+def _check_stream(
+    stream: Stream, source: str, role: str, columns: str, width: int, other: int
+) -> None:
     """Refuse a stream whose stamps are not whole nanoseconds in order, or whose values are not
-    ``width`` per stamp (``columns``), as the ``role`` stream of :func:`put_on_clock`; the
-    other stream's width is ``8 - width``."""
+    ``width`` per stamp (``columns``), as the ``role`` stream of :func:`put_on_clock`, whose
+    other stream has ``other`` per stamp."""
     stamps, values = stream.stamps, stream.values
     if not (isinstance(stamps, np.ndarray) and isinstance(values, np.ndarray)):
         raise ImporterError(
@@ -304,7 +306,7 @@ def _check_stream(stream: Stream, source: str, role: str, columns: str, width: i
             f" got {stamps.dtype} of shape {stamps.shape}{hint}"
         )
     if values.shape != (stamps.shape[0], width):
-        swapped = values.ndim == 2 and values.shape[1] == 8 - width
+        swapped = values.ndim == 2 and values.shape[1] == other
         raise ImporterError(
             f"{source}: {stream.name!r}: values of shape {values.shape} for {stamps.shape[0]}"
             f" stamps, where the {role} stream has {width} per stamp, {columns}"
@@ -609,8 +611,8 @@ def put_on_clock(
         overlap in time; a grid with more than :data:`~sensing_antenna.recording.MAX_SAMPLES`
         slots; fewer than two slots kept.
     """
-    _check_stream(wrench, source, "wrench", "fx, fy, fz (N), tx, ty, tz (N m)", 6)
-    _check_stream(joints, source, "joints", "theta1, theta2 (rad)", 2)
+    _check_stream(wrench, source, "wrench", "fx, fy, fz (N), tx, ty, tz (N m)", 6, 2)
+    _check_stream(joints, source, "joints", "theta1, theta2 (rad)", 2, 6)
     if max_gap is not None and not (math.isfinite(max_gap) and max_gap >= 0.0):
         raise ValueError(f"max_gap must be a finite number >= 0, got {max_gap!r}")
     wrench_clock, joints_clock = sample_clock(wrench.stamps), sample_clock(joints.stamps)
