@@ -25,6 +25,7 @@ import pytest
 import sensing_antenna
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
 from sensing_antenna.cli import main
+from sensing_antenna.errors import Terminated
 from sensing_antenna.estimation import METHODS, OnlineEstimator, estimate
 from sensing_antenna.live.events import (
     ContactEvent,
@@ -291,7 +292,9 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     reasons = " | ".join(e["reason"] for e in first if e["event"] == "skipped")
     assert "does not begin with 'sensing-antenna-udp/1 KIND STREAM SEQ'" in reasons
     assert "not UTF-8" in reasons
-    assert f"stream b: datagram 0: expected {_cells(recording)} cells, found 2" in reasons
+    assert (
+        f"stream b: datagram 0 line 2 of 2: expected {_cells(recording)} cells, found 2" in reasons
+    )
     assert "stream b: datagram 1 arrived after 2: left out" in reasons
     assert "stream b: datagram 4 arrived again: left out" in reasons
     assert "datagram 3: time 86400.0 s jumps from 0.002 s by more than" in reasons
@@ -1024,3 +1027,136 @@ def test_a_stream_whose_torques_are_about_the_sensors_origin_is_estimated_as_the
     _same_estimate(found[0].to_dict(), offline.to_dict())
     # what was received is kept as it came, the point with it: read back, about O again
     assert read_recording(kept).torque.tolist() == from_file.torque.tolist()
+
+
+@pytest.mark.parametrize(
+    ("interruption", "reason"),
+    [(KeyboardInterrupt(), "interrupted"), (Terminated(15), "terminated by signal 15")],
+)
+def test_an_interruption_ends_the_recording_in_progress_with_its_events(
+    recordings: dict[str, Path], interruption: KeyboardInterrupt, reason: str
+) -> None:
+    # Ctrl-C (or SIGTERM) after the hold, before the input ended and before the estimate was
+    # due: the recording begun gets its final estimate, that of the samples received, and its
+    # end, so that every recording whose contact was said is closed; the interruption goes on
+    recording = read_recording(recordings["azimuthal"])
+    lines = _lines(recording)
+    kept = len(lines) - recording.n_samples + np.searchsorted(recording.t, 1.6)
+
+    def interrupted() -> Any:
+        yield from lines[:kept]
+        raise interruption
+
+    events: list[Event] = []
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, paper_antenna(), events.append, "ratio", number=number)
+
+    with pytest.raises(type(interruption)):
+        listen_lines(interrupted(), make)
+    found, end = (e for e in events if isinstance(e, EstimateEvent | EndEvent))
+    assert isinstance(found, EstimateEvent) and isinstance(end, EndEvent)
+    assert end.reason == reason and end.t_last < 1.6
+    assert found.x_c == pytest.approx(CASES["azimuthal"], abs=0.02)
+
+
+class _Datagrams:
+    """A bound socket's stand-in that receives ``datagrams``, then raises ``then``."""
+
+    def __init__(self, datagrams: list[bytes], then: BaseException) -> None:
+        self.datagrams = list(datagrams)
+        self.then = then
+
+    def getsockname(self) -> tuple[str, int]:
+        return ("127.0.0.1", 9)
+
+    def settimeout(self, seconds: float) -> None:
+        pass
+
+    def recv(self, size: int) -> bytes:
+        if not self.datagrams:
+            raise self.then
+        return self.datagrams.pop(0)
+
+
+class _Sent:
+    """A sending socket's stand-in that keeps what it is given to send."""
+
+    def __init__(self) -> None:
+        self.datagrams: list[bytes] = []
+
+    def sendto(self, data: bytes, address: tuple[str, int]) -> int:
+        self.datagrams.append(data)
+        return len(data)
+
+
+def _sent(recording: Recording, stream: str) -> list[bytes]:
+    sent = _Sent()
+    replay_datagrams(recording, sent, ("127.0.0.1", 9), speed=0, stream=stream)  # type: ignore[arg-type]
+    return sent.datagrams
+
+
+def test_a_sender_that_begins_its_stream_again_under_its_name_starts_a_recording(
+    recordings: dict[str, Path],
+) -> None:
+    # A device restarted mid-recording that names its stream as before: its header numbered 0
+    # again and its samples from 0 end the first recording (said in its end) and begin the next,
+    # heard whole; a copy of a header come late (numbered 0 too) begins nothing
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(40))
+    first = [
+        Datagram("header", "s", 0, tuple(header.lines())).encode(),
+        *(Datagram("samples", "s", k, rows[10 * k : 10 * k + 10]).encode() for k in range(2)),
+        Datagram("header", "s", 0, tuple(header.lines())).encode(),  # a copy, late
+        *(Datagram("samples", "s", k, rows[10 * k : 10 * k + 10]).encode() for k in (2, 3)),
+    ]
+    events: list[Event] = []
+
+    def make(stream: StreamHeader, number: int) -> Listener:
+        return Listener(stream, paper_antenna(), events.append, "ratio", number=number)
+
+    datagrams = _Datagrams([*first, *_sent(recording, "s")], RuntimeError("not reached"))
+    assert listen_udp(datagrams, make, events.append, count=2) == 2  # type: ignore[arg-type]
+    said = [e.to_dict() for e in events]
+    assert not [e for e in said if e["event"] == "skipped"]
+    ends = [(e["recording"], e["reason"], e["samples"]) for e in said if e["event"] == "end"]
+    assert ends == [
+        (1, "the stream began again (datagrams from 0)", 40),
+        (2, "end of stream", recording.n_samples),
+    ]
+    found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
+    _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
+
+
+def test_an_interrupted_udp_listener_ends_its_recording_with_its_events(
+    recordings: dict[str, Path],
+) -> None:
+    recording = read_recording(recordings["vertical"])
+    sent = _sent(recording, "v")[:-10]  # without its end (and a few samples before it)
+    events: list[Event] = []
+
+    def make(stream: StreamHeader, number: int) -> Listener:
+        return Listener(stream, paper_antenna(), events.append, "ratio", number=number)
+
+    with pytest.raises(KeyboardInterrupt):
+        listen_udp(_Datagrams(sent, KeyboardInterrupt()), make, events.append)  # type: ignore[arg-type]
+    kinds = [e.to_dict()["event"] for e in events]
+    assert kinds[-2:] == ["estimate", "end"] and kinds.count("estimate") == 1
+    assert events[-1].to_dict()["reason"] == "interrupted"
+
+
+def test_the_docs_program_of_its_own_listens(recordings: dict[str, Path], tmp_path: Path) -> None:
+    # docs/live.md's example of a factory, run as written on a recording piped in
+    text = (Path(__file__).resolve().parents[1] / "docs" / "live.md").read_text()
+    program = re.search(r"A program of its own.*?```python\n(.*?)```", text, re.S)
+    assert program is not None
+    script = tmp_path / "listen_own.py"
+    script.write_text(program.group(1))
+    lines = b"".join(_lines(read_recording(recordings["azimuthal"])))
+    done = subprocess.run(
+        [sys.executable, str(script)], input=lines, capture_output=True, env=_env(), timeout=300
+    )
+    assert done.returncode == 0, done.stderr.decode()
+    said = done.stdout.decode()
+    assert re.fullmatch(r"recording 1: x_c = 0\.59\d\d m, \w+\n", said), said

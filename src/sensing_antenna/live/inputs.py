@@ -21,6 +21,7 @@ import socket
 import time
 from collections.abc import Callable, Iterable
 
+from sensing_antenna.errors import interruption_of
 from sensing_antenna.estimation.front.steps import MAX_FILLED, OUTLIER_PERIODS
 from sensing_antenna.live.events import Event, SkippedEvent
 from sensing_antenna.live.listener import Listener
@@ -53,6 +54,19 @@ def _close_quietly(listener: Listener | None) -> None:
     if listener is not None:
         with contextlib.suppress(Exception):
             listener.close("interrupted", finish=False)
+
+
+def _close_interrupted(exc: BaseException, close: Callable[[str], None]) -> bool:
+    """When ``exc`` is an interruption (Ctrl-C, a stop signal), end the recording being
+    received as its input's end would (``close(reason)``: its final estimate if none was
+    declared, and its ``end`` event), so that every recording begun has its end said; True
+    when it did. A second interruption while it finishes leaves it unfinished."""
+    interrupt = interruption_of(exc)
+    if interrupt is None:
+        return False
+    with contextlib.suppress(Exception):
+        close(str(interrupt) or "interrupted")  # a stop signal's says which
+    return True
 
 
 def listen_lines(
@@ -132,6 +146,10 @@ def listen_lines(
             current.close("end of input")
             current, ended = None, ended + 1
         return ended
+    except BaseException as exc:
+        if current is not None and _close_interrupted(exc, current.close):
+            current = None
+        raise
     finally:
         _close_quietly(current)
 
@@ -168,6 +186,7 @@ class _UdpStream:
         self.lost = 0
         self.heard = 0.0
         self.rejected = 0  # samples left out in a row for their time stamps
+        self.again: Datagram | None = None  # a header numbered before the samples heard
 
     def close(self, reason: str) -> None:
         if self.lost:
@@ -198,6 +217,48 @@ def listen_udp(
 
     def skip(reason: str) -> None:
         on_event(SkippedEvent(numbered if current is not None else numbered + 1, reason))
+
+    def join(datagram: Datagram, received: float, ending: str) -> bool:
+        """Begin the recording whose header ``datagram`` is, ending the one being received
+        (``ending``: its end's reason) unless the header is refused; False when that end
+        reached ``count``."""
+        nonlocal current, numbered, ended
+        name = datagram.stream
+        try:
+            header = read_header(list(datagram.lines), f"{source} stream {name}")
+        except RecordingError as exc:
+            skip(str(exc))
+            return True
+        if datagram.seq > 0 and name not in joined:
+            # heard first after samples were sent (listening began late, or the first header
+            # was lost): the recording's start, its rest and its contact, is gone. Never
+            # joined, it takes no recording's number (0) nor a --count
+            on_event(
+                SkippedEvent(
+                    0,
+                    f"stream {name}: first heard at its samples datagram {datagram.seq}: its "
+                    "start (the rest, the contact) was missed; left out, the next recording is "
+                    "heard",
+                )
+            )
+            refused.add(name)
+            return True
+        if current is not None:
+            ended += finish(current, ending)
+            current = None
+            if count is not None and ended >= count:
+                return False
+        try:
+            listener = make(header, numbered + 1)
+        except RecordingError as exc:  # its header refused for this antenna
+            skip(f"{exc}: the stream is left out")
+            refused.add(name)
+            return True
+        numbered += 1
+        current = _UdpStream(listener, datagram)
+        current.heard = received
+        joined.add(name)
+        return True
 
     def finish(stream: _UdpStream, reason: str) -> int:
         """End ``stream``: 1, or 0 when the listener refused it (its period, say): skipped,
@@ -233,41 +294,28 @@ def listen_udp(
             if ours:
                 assert current is not None
                 current.heard = received
-            if datagram.kind == "header" and not ours:
-                try:
-                    header = read_header(list(datagram.lines), f"{source} stream {datagram.stream}")
-                except RecordingError as exc:
-                    skip(str(exc))
+                if datagram.kind == "header" and datagram.seq == 0 < current.expected:
+                    # a stream's first header after samples of it: the sender began the stream
+                    # again under its name, as its next samples tell, or a copy come late
+                    current.again = datagram
                     continue
-                if datagram.seq > 0 and datagram.stream not in joined:
-                    # heard first after samples were sent (listening began late, or the first
-                    # header was lost): the recording's start, its rest and its contact, is
-                    # gone. Never joined, it takes no recording's number (0) nor a --count
-                    on_event(
-                        SkippedEvent(
-                            0,
-                            f"stream {datagram.stream}: first heard at its samples datagram "
-                            f"{datagram.seq}: its start (the rest, the contact) was missed; "
-                            "left out, the next recording is heard",
-                        )
-                    )
-                    refused.add(datagram.stream)
-                    continue
-                if current is not None:
-                    ended += finish(current, "another stream began")
-                    current = None
-                    if count is not None and ended >= count:
+                again = current.again
+                if (
+                    datagram.kind == "samples"
+                    and again is not None
+                    and datagram.seq < current.expected
+                ):
+                    # numbered from 0 again, before samples already heard: begun again
+                    if not join(again, received, "the stream began again (datagrams from 0)"):
                         break
-                try:
-                    listener = make(header, numbered + 1)
-                except RecordingError as exc:  # its header refused for this antenna
-                    skip(f"{exc}: the stream is left out")
-                    refused.add(datagram.stream)
-                    continue
-                numbered += 1
-                current = _UdpStream(listener, datagram)
-                current.heard = received
-                joined.add(datagram.stream)
+                    ours = current is not None and current.name == datagram.stream
+                    if not ours:
+                        continue
+                elif datagram.kind == "samples" and datagram.seq >= current.expected:
+                    current.again = None  # the header was a copy come late
+            if datagram.kind == "header" and not ours:
+                if not join(datagram, received, "another stream began"):
+                    break
             elif not ours or datagram.kind == "header":
                 continue  # a repeated header, or samples of a stream not joined
             elif datagram.kind == "end":
@@ -285,6 +333,10 @@ def listen_udp(
                     _close_quietly(current.listener)
                     current = None
         return ended
+    except BaseException as exc:
+        if current is not None and _close_interrupted(exc, current.close):
+            current = None
+        raise
     finally:
         _close_quietly(None if current is None else current.listener)
 
@@ -308,14 +360,16 @@ def _receive_samples(
     position = header.required("t")
     period = header.sample_period
     rows = []
-    for line in datagram.lines:
+    n = len(datagram.lines)
+    for k, line in enumerate(datagram.lines, start=1):
+        # which line of the datagram was left out, when it holds more than one
+        where = f"stream {current.name}: datagram {datagram.seq}" + (
+            f" line {k} of {n}" if n > 1 else ""
+        )
         try:
             values = parse_sample(line, header)
         except RecordingError as exc:
-            skip(
-                f"stream {current.name}: datagram {datagram.seq}: {exc.problem}"
-                + (f" (column {exc.field!r})" if exc.field else "")
-            )
+            skip(f"{where}: {exc.problem}" + (f" (column {exc.field!r})" if exc.field else ""))
             continue
         t = values[position]
         problem = None
@@ -333,10 +387,10 @@ def _receive_samples(
                 # not a stamp gone astray but a time line the samples no longer follow (the
                 # sender's clock stepped, or the first stamp was the outlier)
                 raise WireError(
-                    f"stream {current.name}: datagram {datagram.seq}: {_MAX_REJECTED} time "
-                    f"stamps in a row left out, the last {t!r} s after {current.last_t!r} s"
+                    f"{where}: {_MAX_REJECTED} time stamps in a row left out, the last {t!r} s "
+                    f"after {current.last_t!r} s"
                 )
-            skip(f"stream {current.name}: datagram {datagram.seq}: {problem}")
+            skip(f"{where}: {problem}")
             continue
         current.rejected = 0
         current.last_t = t
