@@ -234,7 +234,10 @@ def rest_reading(
             "back), or torques scaled far down?"
             if tared
             else "torques in N mm, scaled, or a sign flipped?"
-            + _turned_hint(mean_torque, expected_torque, torque_tolerance)
+            + (
+                _turned_hint(mean_torque, expected_torque, torque_tolerance)
+                or _pushed_hint(mean_torque, expected_torque, force, expected_force, link.length)
+            )
             + _payload_hint(
                 mean_torque,
                 expected_torque,
@@ -298,6 +301,60 @@ def _turned_hint(measured: FloatArray, expected: FloatArray, tolerance: float) -
     return (
         f" Or the sensor's axes turned on the link: the moment has the weight's size, turned "
         f"{angle:.0f} degrees about {sign}{'XYZ'[k]}^m from it ({how})"
+    )
+
+
+def _pushed_hint(
+    torque: FloatArray,
+    expected: FloatArray,
+    force: FloatArray,
+    expected_force: FloatArray,
+    length: float,
+) -> str:
+    """ " Or ..." naming a push on the link, when the mean moment at rest (``torque``, N m)
+    beyond the weight's (``expected``) is that of the mean force beyond the weight's (``force``,
+    N, shape (n, 3), less ``expected_force``) across the link at a point on it: the two at right
+    angles to each other and to the link (X^m) within 25 degrees, the lever within ``length``
+    (m) and 5 % more, and the force beyond two standard deviations of what a tare leaves (a
+    tare's offset that large lies in that direction once in tens: the geometry is the sharper
+    test); the lever's range is the force's two standard deviations. Not along the weight at
+    its own lever (within 15 %): that is the weight read scaled or half turned. The recording
+    began with the link touching (a sensor turned on the link reads the same of its weight's
+    lever: asked first); "" otherwise."""
+    excess = torque - expected
+    if len(force) < 2:
+        return ""
+    push = force.mean(axis=0) - expected_force
+    push[0] = 0.0  # across the link
+    size = float(np.linalg.norm(push))
+    noise = float(np.max(np.std(force[:, 1:], axis=0, ddof=1)))
+    spread = 2.0 * rest_moment_std(noise, noise / math.sqrt(len(force)))  # N
+    if not size > spread:
+        return ""
+    lever = np.cross([1.0, 0.0, 0.0], push)  # the moment of the push at 1 m along the link
+    distance = float(excess @ lever) / size**2  # m
+    cosine = float(excess @ lever) / (float(np.linalg.norm(excess)) * size)
+    if not (0.0 < distance <= 1.05 * length and cosine >= math.cos(math.radians(25.0))):
+        return ""
+    # along the weight at the weight's own lever: the weight misread (scaled, or a sensor
+    # turned half round), not a push
+    across = expected_force.copy()
+    across[0] = 0.0
+    weight = float(np.linalg.norm(across))
+    if weight > 0.0:
+        weight_lever = float(np.linalg.norm(expected)) / weight
+        along = abs(float(push @ across)) / (size * weight)
+        if (
+            along >= math.cos(math.radians(25.0))
+            and abs(distance - weight_lever) <= 0.15 * weight_lever
+        ):
+            return ""
+    near = distance * size / (size + spread)
+    far = min(distance * size / (size - spread), length)
+    return (
+        f" Or the link touching something as the recording began: the loads beyond the weight "
+        f"are those of a push of {size:.2g} N across the link, {near:.2g} to {far:.2g} m along "
+        "it (a recording starts with the head at rest and the link free)."
     )
 
 
