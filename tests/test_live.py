@@ -1160,3 +1160,50 @@ def test_the_docs_program_of_its_own_listens(recordings: dict[str, Path], tmp_pa
     assert done.returncode == 0, done.stderr.decode()
     said = done.stdout.decode()
     assert re.fullmatch(r"recording 1: x_c = 0\.59\d\d m, \w+\n", said), said
+
+
+def test_a_second_contact_in_one_recording_is_said_not_estimated(
+    identified: tuple[Antenna, Recording],
+) -> None:
+    # Two sweeps sent as one recording: the first touches, holds, turns back and leaves the
+    # post; the second, its angles carried on from where the first ended, touches again. The
+    # estimate is the first contact's; the second is said once, after the loss, as skipped
+    antenna, _ = identified
+    scenario = Scenario(case="azimuthal", contact_point=0.55, duration=3.5, retract_after=1.0)
+    first = simulate(antenna, dataclasses.replace(scenario, seed=1))
+    second = simulate(antenna, Scenario(case="azimuthal", contact_point=0.55, seed=2))
+    step = first.t[1] - first.t[0]
+    joined = dataclasses.replace(
+        first,
+        t=np.concatenate([first.t, first.t[-1] + step + second.t - second.t[0]]),
+        theta=np.concatenate([first.theta, second.theta - second.theta[0] + first.theta[-1]]),
+        force=np.concatenate([first.force, second.force]),
+        torque=np.concatenate([first.torque, second.torque]),
+        extra={},
+    ).without_ground_truth()
+    touched_again = first.t[-1] + step + float(second.metadata["true_t_contact"])
+    said = _listen_all(joined, antenna)
+    kinds = [e["event"] for e in said]
+    assert kinds.count("estimate") == 1 and kinds.count("contact_lost") == 1
+    assert kinds.index("contact_lost") < kinds.index("skipped") < kinds.index("end")
+    (again,) = [e for e in said if e["event"] == "skipped"]
+    assert "a second contact" in again["reason"]
+    known = float(re.search(r"known at t = (\S+) s", again["reason"]).group(1))  # type: ignore[union-attr]
+    # the mean over a free period (0.39 s) passes half the first push about half a period
+    # after the push has built up (the head stops 0.25 s after the touch)
+    assert touched_again < known < touched_again + 0.25 + 0.39
+    # one sweep, the same turn back, says nothing of it
+    alone = [
+        e for e in _listen_all(first.without_ground_truth(), antenna) if e["event"] == "skipped"
+    ]
+    assert not alone
+
+
+def _listen_all(recording: Recording, antenna: Antenna) -> list[dict[str, Any]]:
+    events: list[Event] = []
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, antenna, events.append, "ratio", number=number)
+
+    listen_lines(_lines(recording), make)
+    return [e.to_dict() for e in events]

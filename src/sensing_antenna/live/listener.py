@@ -46,6 +46,7 @@ from sensing_antenna.live.events import (
     EstimateEvent,
     Event,
     PushEvent,
+    SkippedEvent,
 )
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.wire import StreamHeader, WireError
@@ -55,7 +56,7 @@ from sensing_antenna.recording import (
 )
 from sensing_antenna.torque_point import torques_about_base
 
-__all__ = ["CONTACT_LOST_SHARE", "Listener"]
+__all__ = ["CONTACT_AGAIN_SHARE", "CONTACT_LOST_SHARE", "Listener"]
 
 #: Contact counts as lost once the contact detector's residual, averaged over one period of the
 #: link's free mode (the observer's natural frequency), has fallen to this share of the largest
@@ -66,6 +67,11 @@ __all__ = ["CONTACT_LOST_SHARE", "Listener"]
 #: through the threshold while the link bounced on a post, and stayed above it for tens of
 #: seconds after a release.
 CONTACT_LOST_SHARE = 0.2
+
+#: After the contact was lost, a touch again: the same average rising above the detector's
+#: threshold and this share of the first push's. The estimate is the first contact's; the
+#: second is said (a ``skipped`` event), not estimated.
+CONTACT_AGAIN_SHARE = 0.5
 
 _END = "end"
 _ABORT = "abort"
@@ -158,6 +164,7 @@ class Listener:
         self._sums.extend(np.zeros((1, 3)))
         self._levels = _Growing()  # the averages' norms, from t_c
         self._push_level = 0.0
+        self._lost = False  # the contact lost: a touch again is watched for
         self._columns = [
             [header.required(name) for name in names]
             for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
@@ -364,7 +371,7 @@ class Listener:
         mean residual is that low, the contact was lost about where the mean began to fall, one
         free period back plus the share of it still held (a push that vanishes at once)."""
         contact = self._estimator.contact_index
-        if contact is None or "contact_lost" in self._said:
+        if contact is None or "contact_again" in self._said:
             return
         detection = self._residual.detection()
         done = contact + self._sums.size - 1  # samples summed so far
@@ -379,6 +386,9 @@ class Listener:
         means = (sums[ends] - sums[starts]) / (ends - starts)[:, None]
         levels = np.linalg.norm(means, axis=1)
         self._levels.extend(levels)
+        if self._lost:
+            self._watch_again(first, ends, levels, detection.threshold)
+            return
         peaks = np.maximum.accumulate(np.maximum(levels, self._push_level))
         self._push_level = float(peaks[-1])
         limit = np.minimum(detection.threshold, CONTACT_LOST_SHARE * peaks)
@@ -392,7 +402,36 @@ class Listener:
         index = contact + row - 1
         t_lost = float(self._t.values[index]) - (1.0 - held) * period * self.header.sample_period
         self._said.add("contact_lost")
+        self._lost = True
         self._emit(ContactLostEvent(self.number, t_lost, self._latency(max(first, index))))
+        if k + 1 < ends.shape[0]:
+            self._watch_again(first, ends[k + 1 :], levels[k + 1 :], detection.threshold)
+
+    def _watch_again(
+        self,
+        first: int,
+        ends: NDArray[np.int_],
+        levels: NDArray[np.float64],
+        threshold: float,
+    ) -> None:
+        """A touch after the contact was lost (:data:`CONTACT_AGAIN_SHARE`), said once as a
+        ``skipped`` event: a recording holds one contact, the first's estimate stands."""
+        again = np.flatnonzero(levels > max(threshold, CONTACT_AGAIN_SHARE * self._push_level))
+        if again.size == 0:
+            return
+        contact = self._estimator.contact_index
+        assert contact is not None
+        index = contact + int(ends[again[0]]) - 1
+        self._said.add("contact_again")
+        self._emit(
+            SkippedEvent(
+                self.number,
+                f"a second contact, known at t = {float(self._t.values[index]):.3f} s, after "
+                "the first was lost: not estimated (a recording holds one contact: send each "
+                "sweep as a recording of its own)",
+                self._latency(max(first, index)),
+            )
+        )
 
     def _finish(self, reason: str) -> None:
         self._check_period(np.empty(0), final=True)
