@@ -164,7 +164,6 @@ class Listener:
         self._sums.extend(np.zeros((1, 3)))
         self._levels = _Growing()  # the averages' norms, from t_c
         self._push_level = 0.0
-        self._lost = False  # the contact lost: a touch again is watched for
         self._columns = [
             [header.required(name) for name in names]
             for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
@@ -386,7 +385,7 @@ class Listener:
         means = (sums[ends] - sums[starts]) / (ends - starts)[:, None]
         levels = np.linalg.norm(means, axis=1)
         self._levels.extend(levels)
-        if self._lost:
+        if "contact_lost" in self._said:
             self._watch_again(first, ends, levels, detection.threshold)
             return
         peaks = np.maximum.accumulate(np.maximum(levels, self._push_level))
@@ -402,7 +401,6 @@ class Listener:
         index = contact + row - 1
         t_lost = float(self._t.values[index]) - (1.0 - held) * period * self.header.sample_period
         self._said.add("contact_lost")
-        self._lost = True
         self._emit(ContactLostEvent(self.number, t_lost, self._latency(max(first, index))))
         if k + 1 < ends.shape[0]:
             self._watch_again(first, ends[k + 1 :], levels[k + 1 :], detection.threshold)
