@@ -6,16 +6,19 @@ The recordings are made by ``antenna simulate`` (paper antenna, both cases)."""
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import gc
 import io
 import json
+import math
 import os
 import re
 import socket
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +38,7 @@ from sensing_antenna.live.events import (
     Event,
     PushEvent,
 )
-from sensing_antenna.live.inputs import listen_lines, listen_udp
+from sensing_antenna.live.inputs import INTERRUPTED_WAIT, listen_lines, listen_udp
 from sensing_antenna.live.listener import Listener
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.replay import replay_datagrams, replay_lines, stream_of
@@ -293,7 +296,8 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     assert "does not begin with 'sensing-antenna-udp/1 KIND STREAM SEQ'" in reasons
     assert "not UTF-8" in reasons
     assert (
-        f"stream b: datagram 0 line 2 of 2: expected {_cells(recording)} cells, found 2" in reasons
+        f"stream b: datagram 0 sample line 2 of 2: expected {_cells(recording)} cells, found 2"
+        in reasons
     )
     assert "stream b: datagram 1 arrived after 2: left out" in reasons
     assert "stream b: datagram 4 arrived again: left out" in reasons
@@ -1096,54 +1100,138 @@ def _sent(recording: Recording, stream: str) -> list[bytes]:
     return sent.datagrams
 
 
-def test_a_sender_that_begins_its_stream_again_under_its_name_starts_a_recording(
-    recordings: dict[str, Path],
-) -> None:
-    # A device restarted mid-recording that names its stream as before: its header numbered 0
-    # again and its samples from 0 end the first recording (said in its end) and begin the next,
-    # heard whole; a copy of a header come late (numbered 0 too) begins nothing
-    recording = read_recording(recordings["azimuthal"])
-    header, _ = stream_of(recording)
-    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(40))
-    first = [
-        Datagram("header", "s", 0, tuple(header.lines())).encode(),
-        *(Datagram("samples", "s", k, rows[10 * k : 10 * k + 10]).encode() for k in range(2)),
-        Datagram("header", "s", 0, tuple(header.lines())).encode(),  # a copy, late
-        *(Datagram("samples", "s", k, rows[10 * k : 10 * k + 10]).encode() for k in (2, 3)),
-    ]
+def _heard(datagrams: list[bytes], count: int | None = None) -> list[dict[str, Any]]:
+    """The events of a UDP listener (``ratio``) sent ``datagrams`` (then interrupted, unless
+    ``count`` recordings ended first)."""
     events: list[Event] = []
 
     def make(stream: StreamHeader, number: int) -> Listener:
         return Listener(stream, paper_antenna(), events.append, "ratio", number=number)
 
-    datagrams = _Datagrams([*first, *_sent(recording, "s")], RuntimeError("not reached"))
-    assert listen_udp(datagrams, make, events.append, count=2) == 2  # type: ignore[arg-type]
-    said = [e.to_dict() for e in events]
+    with pytest.raises(KeyboardInterrupt) if count is None else contextlib.nullcontext():
+        listen_udp(_Datagrams(datagrams, KeyboardInterrupt()), make, events.append, count)  # type: ignore[arg-type]
+    return [e.to_dict() for e in events]
+
+
+def test_a_sender_that_begins_its_stream_again_under_its_name_starts_a_recording(
+    recordings: dict[str, Path],
+) -> None:
+    # A device restarted mid-recording that names its stream as before: its first header again
+    # and its samples numbered from 0 (three datagrams in order tell it) end the first
+    # recording, said in its end, and begin the next, heard whole
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(40))
+    first = [
+        Datagram("header", "s", 0, tuple(header.lines())).encode(),
+        *(Datagram("samples", "s", k, rows[10 * k : 10 * k + 10]).encode() for k in range(4)),
+    ]
+    said = _heard([*first, *_sent(recording, "s")], count=2)
     assert not [e for e in said if e["event"] == "skipped"]
     ends = [(e["recording"], e["reason"], e["samples"]) for e in said if e["event"] == "end"]
     assert ends == [
         (1, "the stream began again (datagrams from 0)", 40),
         (2, "end of stream", recording.n_samples),
     ]
-    found = next(e for e in events if isinstance(e, EstimateEvent) and e.recording == 2)
-    _same_estimate(found.to_dict(), estimate(recording, paper_antenna(), "ratio").to_dict())
+    found = next(e for e in said if e["event"] == "estimate" and e["recording"] == 2)
+    _same_estimate(found, estimate(recording, paper_antenna(), "ratio").to_dict())
+
+
+@pytest.mark.parametrize("late", ["one", "copies"])
+def test_a_late_copy_of_a_streams_first_header_begins_nothing(
+    recordings: dict[str, Path], late: str
+) -> None:
+    # A network delivers datagrams late and twice: a copy of the first header, then a samples
+    # datagram sent long before (one) or copies of the first two (copies), all numbered below
+    # those heard. They are left out as late; the recording goes on whole
+    recording = read_recording(recordings["azimuthal"])
+    sent = _sent(recording, "s")
+    at = 60  # the datagrams sent before this one have arrived
+    header, samples = sent[0], sent[1 : at + 1]
+    again = [samples[40]] if late == "one" else samples[:2]
+    said = _heard([*sent[:at], header, *again, *sent[at:]], count=1)
+    ends = [(e["recording"], e["reason"]) for e in said if e["event"] == "end"]
+    assert ends == [(1, "end of stream")]
+    skipped = [e["reason"] for e in said if e["event"] == "skipped"]
+    assert len(skipped) == len(again) and all("left out" in r for r in skipped), skipped
+    found = next(e for e in said if e["event"] == "estimate")
+    _same_estimate(found, estimate(recording, paper_antenna(), "ratio").to_dict())
+
+
+def test_a_stream_begun_again_after_its_recording_was_refused_is_heard_whole(
+    recordings: dict[str, Path],
+) -> None:
+    # The first recording is refused at its end (10 samples stamped 20 % off its period); the
+    # sender begins the stream again under its name, right: that recording is heard whole
+    recording = read_recording(recordings["azimuthal"])
+    header, _ = stream_of(recording)
+    rows = tuple(_resting_row(recording, 0.0012 * k) for k in range(10))
+    first = [
+        Datagram("header", "s", 0, tuple(header.lines())).encode(),
+        *(Datagram("samples", "s", k, rows[5 * k : 5 * k + 5]).encode() for k in range(2)),
+    ]
+    said = _heard([*first, *_sent(recording, "s")], count=1)
+    assert next(e["reason"] for e in said if e["event"] == "skipped").startswith(
+        "udp:127.0.0.1:9 stream s: sample_period: the stream declares 0.001 s"
+    )
+    ends = [(e["recording"], e["reason"], e["samples"]) for e in said if e["event"] == "end"]
+    assert ends == [(2, "end of stream", recording.n_samples)]
 
 
 def test_an_interrupted_udp_listener_ends_its_recording_with_its_events(
     recordings: dict[str, Path],
 ) -> None:
+    # Ctrl-C over UDP before the estimate was due (t_e 2.05 s): the final estimate of the
+    # samples received, then the end
     recording = read_recording(recordings["vertical"])
-    sent = _sent(recording, "v")[:-10]  # without its end (and a few samples before it)
+    sent = [d for d in _sent(recording, "v") if _first_time(d) < 1.6]
+    said = _heard(sent)
+    assert [e["event"] for e in said][-2:] == ["estimate", "end"]
+    assert said[-1]["reason"] == "interrupted" and said[-1]["t_last"] < 1.6
+    assert said[-2]["x_c"] == pytest.approx(CASES["vertical"], abs=0.02)
+
+
+def _first_time(datagram: bytes) -> float:
+    """The time stamp (s) of a datagram's first sample line (-inf for a header, inf for the
+    end)."""
+    decoded = decode_datagram(datagram)
+    if decoded.kind != "samples":
+        return -math.inf if decoded.kind == "header" else math.inf
+    return float(decoded.lines[0].split(",", 1)[0])
+
+
+def test_an_interruption_does_not_wait_for_a_reader_that_stopped_reading(
+    recordings: dict[str, Path],
+) -> None:
+    # Whoever reads the events stopped reading (a full pipe): the final estimate cannot be
+    # given, and an interruption still goes on up within INTERRUPTED_WAIT; the recording is
+    # abandoned, its end never said
+    recording = read_recording(recordings["azimuthal"])
+    lines = _lines(recording)
+    kept = len(lines) - recording.n_samples + int(np.searchsorted(recording.t, 1.6))
+    stuck = threading.Event()
     events: list[Event] = []
 
-    def make(stream: StreamHeader, number: int) -> Listener:
-        return Listener(stream, paper_antenna(), events.append, "ratio", number=number)
+    def on_event(event: Event) -> None:
+        if isinstance(event, EstimateEvent):
+            stuck.wait(30.0)
+        events.append(event)
 
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, paper_antenna(), on_event, "ratio", number=number)
+
+    def interrupted() -> Any:
+        yield from lines[:kept]
+        raise KeyboardInterrupt
+
+    began = time.perf_counter()
     with pytest.raises(KeyboardInterrupt):
-        listen_udp(_Datagrams(sent, KeyboardInterrupt()), make, events.append)  # type: ignore[arg-type]
-    kinds = [e.to_dict()["event"] for e in events]
-    assert kinds[-2:] == ["estimate", "end"] and kinds.count("estimate") == 1
-    assert events[-1].to_dict()["reason"] == "interrupted"
+        listen_lines(interrupted(), make)
+    waited = time.perf_counter() - began
+    stuck.set()  # the reader reads again: the estimate goes, the end is not given
+    assert waited < INTERRUPTED_WAIT + 10.0  # the samples' own feeding and the wait
+    time.sleep(0.2)
+    assert [type(e) for e in events][-1] is EstimateEvent
 
 
 def test_the_docs_program_of_its_own_listens(recordings: dict[str, Path], tmp_path: Path) -> None:

@@ -17,6 +17,7 @@ after its start is left out with a
 from __future__ import annotations
 
 import contextlib
+import itertools
 import socket
 import time
 from collections.abc import Callable, Iterable
@@ -36,11 +37,23 @@ from sensing_antenna.live.wire import (
 )
 from sensing_antenna.recording import RecordingError
 
-__all__ = ["IDLE_END", "MakeListener", "listen_lines", "listen_udp", "parse_address"]
+__all__ = [
+    "IDLE_END",
+    "INTERRUPTED_WAIT",
+    "MakeListener",
+    "listen_lines",
+    "listen_udp",
+    "parse_address",
+]
 
 #: A UDP recording whose sender fell silent for this long (s) is closed as if it had ended: a
 #: sender that stopped without its ``end`` datagram (the datagram lost, the program killed).
 IDLE_END = 2.0
+
+#: After Ctrl-C or a stop signal, the longest wait (s) for the recording's final estimate and
+#: end event: a reader of the events that stopped reading (its pipe full) must not hold the
+#: process (a fast method's final estimate takes well under a second).
+INTERRUPTED_WAIT = 2.0
 
 #: Samples left out in a row for their time stamps after which the stream is left out: its
 #: samples no longer follow one time line (the sender's clock stepped, or an outlier came first).
@@ -56,16 +69,17 @@ def _close_quietly(listener: Listener | None) -> None:
             listener.close("interrupted", finish=False)
 
 
-def _close_interrupted(exc: BaseException, close: Callable[[str], None]) -> bool:
+def _close_interrupted(exc: BaseException, close: Callable[[str, float], None]) -> bool:
     """When ``exc`` is an interruption (Ctrl-C, a stop signal), end the recording being
-    received as its input's end would (``close(reason)``: its final estimate if none was
+    received as its input's end would (``close(reason, wait)``: its final estimate if none was
     declared, and its ``end`` event), so that every recording begun has its end said; True
-    when it did. A second interruption while it finishes leaves it unfinished."""
+    when it did. Waited for :data:`INTERRUPTED_WAIT` at most; a second interruption while it
+    finishes, or a longer wait, leaves it unfinished."""
     interrupt = interruption_of(exc)
     if interrupt is None:
         return False
     with contextlib.suppress(Exception):
-        close(str(interrupt) or "interrupted")  # a stop signal's says which
+        close(str(interrupt) or "interrupted", INTERRUPTED_WAIT)  # a stop signal's says which
     return True
 
 
@@ -147,7 +161,10 @@ def listen_lines(
             current, ended = None, ended + 1
         return ended
     except BaseException as exc:
-        if current is not None and _close_interrupted(exc, current.close):
+        listener = current
+        if listener is not None and _close_interrupted(
+            exc, lambda reason, wait: listener.close(reason, wait=wait)
+        ):
             current = None
         raise
     finally:
@@ -186,12 +203,14 @@ class _UdpStream:
         self.lost = 0
         self.heard = 0.0
         self.rejected = 0  # samples left out in a row for their time stamps
-        self.again: Datagram | None = None  # a header numbered before the samples heard
+        self.again: Datagram | None = None  # a first header after samples of the stream
+        self.held: list[tuple[Datagram, float]] = []  # datagrams numbered below, since then
+        self.first: dict[int, tuple[str, ...]] = {}  # the lines of its first datagrams taken
 
-    def close(self, reason: str) -> None:
+    def close(self, reason: str, wait: float | None = None) -> None:
         if self.lost:
             reason += f"; {self.lost} datagram{'' if self.lost == 1 else 's'} of samples lost"
-        self.listener.close(reason)
+        self.listener.close(reason, wait=wait)
 
 
 def listen_udp(
@@ -248,6 +267,7 @@ def listen_udp(
             current = None
             if count is not None and ended >= count:
                 return False
+        refused.discard(name)  # its previous recording refused at its end
         try:
             listener = make(header, numbered + 1)
         except RecordingError as exc:  # its header refused for this antenna
@@ -259,6 +279,19 @@ def listen_udp(
         current.heard = received
         joined.add(name)
         return True
+
+    def take(datagram: Datagram, received: float) -> None:
+        """The samples of ``datagram`` to the recording being received; the stream left out
+        when its time stamps no longer follow one time line."""
+        nonlocal current
+        assert current is not None
+        try:
+            _receive_samples(current, datagram, received, skip)
+        except WireError as exc:
+            skip(f"{exc}: the stream is left out")
+            refused.add(current.name)
+            _close_quietly(current.listener)
+            current = None
 
     def finish(stream: _UdpStream, reason: str) -> int:
         """End ``stream``: 1, or 0 when the listener refused it (its period, say): skipped,
@@ -295,24 +328,41 @@ def listen_udp(
                 assert current is not None
                 current.heard = received
                 if datagram.kind == "header" and datagram.seq == 0 < current.expected:
-                    # a stream's first header after samples of it: the sender began the stream
-                    # again under its name, as its next samples tell, or a copy come late
-                    current.again = datagram
+                    # a stream's first header after samples of it: a copy come late, or the
+                    # sender began the stream again under its name, as its next samples tell
+                    try:
+                        read_header(list(datagram.lines), f"{source} stream {datagram.stream}")
+                    except RecordingError as exc:
+                        skip(str(exc))
+                    else:
+                        current.again, current.held = datagram, []
                     continue
-                again = current.again
-                if (
-                    datagram.kind == "samples"
-                    and again is not None
-                    and datagram.seq < current.expected
-                ):
-                    # numbered from 0 again, before samples already heard: begun again
-                    if not join(again, received, "the stream began again (datagrams from 0)"):
-                        break
-                    ours = current is not None and current.name == datagram.stream
-                    if not ours:
+                if current.again is not None:
+                    again, held = current.again, current.held
+                    if datagram.kind != "header" and datagram.seq < current.expected:
+                        held.append((datagram, received))
+                        if datagram.kind == "samples" and not _begun_again(held, current.first):
+                            continue  # held until their numbers or lines tell
+                        if not join(again, received, "the stream began again (datagrams from 0)"):
+                            break
+                        if current is None or current.name != datagram.stream:
+                            continue
+                        for late, when in held:  # the new recording's first datagrams
+                            if current is None:
+                                break
+                            if late.kind == "end":
+                                ended += finish(current, "end of stream")
+                                current = None
+                            else:
+                                take(late, when)
                         continue
-                elif datagram.kind == "samples" and datagram.seq >= current.expected:
-                    current.again = None  # the header was a copy come late
+                    # the stream's own numbers go on: the header was a copy come late, and the
+                    # datagrams held arrived late
+                    current.again, current.held = None, []
+                    for late, when in held:
+                        take(late, when)
+                    if current is None:
+                        continue
             if datagram.kind == "header" and not ours:
                 if not join(datagram, received, "another stream began"):
                     break
@@ -324,14 +374,7 @@ def listen_udp(
                 ended += finish(current, "end of stream")
                 current = None
             else:
-                assert current is not None
-                try:
-                    _receive_samples(current, datagram, received, skip)
-                except WireError as exc:
-                    skip(f"{exc}: the stream is left out")
-                    refused.add(current.name)
-                    _close_quietly(current.listener)
-                    current = None
+                take(datagram, received)
         return ended
     except BaseException as exc:
         if current is not None and _close_interrupted(exc, current.close):
@@ -339,6 +382,26 @@ def listen_udp(
         raise
     finally:
         _close_quietly(None if current is None else current.listener)
+
+
+#: After a stream's first header came again, datagrams numbered below those already heard:
+#: this many in order, the first numbered below it, or one of its first datagrams with other
+#: lines than it had, tell the sender began the stream again. Others are copies and late
+#: datagrams of the stream, which a network delivers too.
+_BEGUN_AGAIN = 3
+
+
+def _begun_again(held: list[tuple[Datagram, float]], first: dict[int, tuple[str, ...]]) -> bool:
+    """Whether the datagrams ``held`` since a stream's first header came again (in the order
+    they arrived) are the stream begun again (:data:`_BEGUN_AGAIN`); ``first``: the lines of
+    the stream's first datagrams, by number."""
+    numbers = [datagram.seq for datagram, _ in held]
+    other = any(d.seq in first and d.lines != first[d.seq] for d, _ in held)
+    return other or (
+        len(numbers) >= _BEGUN_AGAIN
+        and numbers[0] < _BEGUN_AGAIN
+        and all(a < b for a, b in itertools.pairwise(numbers))
+    )
 
 
 def _receive_samples(
@@ -356,15 +419,17 @@ def _receive_samples(
         return
     current.lost += datagram.seq - current.expected
     current.expected = datagram.seq + 1
+    if datagram.seq < _BEGUN_AGAIN:
+        current.first[datagram.seq] = datagram.lines
     header = current.listener.header
     position = header.required("t")
     period = header.sample_period
     rows = []
     n = len(datagram.lines)
     for k, line in enumerate(datagram.lines, start=1):
-        # which line of the datagram was left out, when it holds more than one
+        # which sample line of the datagram was left out, when it holds more than one
         where = f"stream {current.name}: datagram {datagram.seq}" + (
-            f" line {k} of {n}" if n > 1 else ""
+            f" sample line {k} of {n}" if n > 1 else ""
         )
         try:
             values = parse_sample(line, header)

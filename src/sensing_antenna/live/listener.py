@@ -183,6 +183,9 @@ class Listener:
         self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
         self._step_time = 0.0  # wall time of the estimator's last preparing step (s)
         self.error: BaseException | None = None
+        self._done = threading.Event()  # the worker has stopped
+        self._closing = False  # its end asked (close)
+        self._abandoned = False  # its events are no longer wanted (close gave up waiting)
         self._thread = threading.Thread(target=self._work, name="antenna-listen", daemon=True)
         self._thread.start()
 
@@ -225,11 +228,29 @@ class Listener:
             )
         self._queue.put((rows, self._clock() if received is None else received))
 
-    def close(self, reason: str = "end of input", finish: bool = True) -> None:
+    def close(
+        self, reason: str = "end of input", finish: bool = True, wait: float | None = None
+    ) -> None:
         """End the recording: the worker takes what is queued, then (``finish``) gives the
-        final estimate if none was declared and the end event. Waits for the worker."""
-        self._queue.put((_END if finish else _ABORT, reason))
-        self._thread.join()
+        final estimate if none was declared and the end event. Waits for the worker, at most
+        ``wait`` s (None: as long as it takes). Past that, or when such a bounded wait is
+        interrupted, the recording is abandoned: its worker gives no event more. Called again
+        after an interrupted wait, it waits for the end asked first; a recording abandoned is
+        not waited for."""
+        if self._abandoned:
+            return
+        if not self._closing:
+            self._closing = True
+            self._queue.put((_END if finish else _ABORT, reason))
+        try:
+            done = self._done.wait(wait)
+        except BaseException:
+            if wait is not None:
+                self._abandoned = True
+            raise
+        if not done:
+            self._abandoned = True
+            return
         if self._record is not None:
             self._record.close()
         if self.error is not None:
@@ -265,6 +286,8 @@ class Listener:
                     return
         except BaseException as exc:  # handed to the reader's thread
             self.error = exc
+        finally:
+            self._done.set()
 
     def _feed(self, blocks: list[tuple[Any, float]]) -> None:
         arrays = [
@@ -341,7 +364,8 @@ class Listener:
         return self._clock() - float(self._received.values[index])
 
     def _emit(self, event: Event) -> None:
-        self._on_event(event)
+        if not self._abandoned:
+            self._on_event(event)
 
     def _say_instants(self, first: int) -> None:
         estimator, t = self._estimator, self._t.values
