@@ -728,3 +728,24 @@ def test_a_path_for_a_recording_is_told_to_read_it_first(tmp_path: Path) -> None
         estimate(str(tmp_path / "rec.csv"), paper_antenna())  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="a Recording is needed"):
         estimate(None, paper_antenna())  # type: ignore[arg-type]
+
+
+def test_a_record_short_for_a_head_slow_to_rest_says_so() -> None:
+    # The head's angles keep swaying (1 mrad at 8 Hz, a servo or a mount ringing) for 0.8 s
+    # after the stop, and the record ends 0.7 s after the rest: too short, and the reason says
+    # the rest came late, not that the record was cut early
+    antenna = paper_antenna()
+    recording = simulate(antenna, Scenario(case="azimuthal", contact_point=0.6, duration=3.5))
+    stop = float(recording.metadata["true_t_stop"])
+    theta = recording.theta.copy()
+    sway = (recording.t > stop) & (recording.t < stop + 0.8)
+    theta[sway, 0] += 1e-3 * np.sin(2 * np.pi * 8.0 * (recording.t[sway] - stop))
+    swayed = dataclasses.replace(recording, theta=theta)
+    cut = samples_kept(swayed, swayed.t < stop + 0.8 + 0.7)
+    result = estimate(cut.without_ground_truth(), antenna, "paper")
+    assert result.status is Status.RECORDING_TOO_SHORT
+    assert "the head was slow to come to rest" in (result.reason or ""), result.reason
+    # the same record without the sway, cut as short after its rest, says nothing of it
+    plain = samples_kept(recording, recording.t < stop + 0.7)
+    reason = estimate(plain.without_ground_truth(), antenna, "paper").reason or ""
+    assert "only" in reason and "slow to come to rest" not in reason, reason

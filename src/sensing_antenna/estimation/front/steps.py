@@ -1156,7 +1156,10 @@ def hold_push(
             f"the mean contact force over the {count * ts:.3f} s after t_1 is "
             f"{1000 * perpendicular:.2f} mN, not above {cfg.min_push_significance:g} standard "
             f"errors ({1000 * limit:.2f} mN, force noise {1000 * noise:.2f} mN) of a push "
-            "(gravity and sensor offset removed)"
+            "(gravity and sensor offset removed): no touch pushed the link at t_c, or too "
+            "lightly. A detector that fires on the free motion (its threshold below this "
+            "device's residual: antenna identify on its free sweeps), or torques about a point "
+            "that '# torque_point' does not state?"
         )
         return HoldPush(None, problem, stop, noise, standard_error, losses)
     return HoldPush(frame, None, stop, noise, standard_error, losses)

@@ -76,6 +76,11 @@ class Fusion:
     agree: bool
 
 
+#: t_1 later than this share of the spectrum window after t_c is named in a record too short:
+#: the head was slow to rest (a servo or a mount ringing), not the record cut early.
+_LATE_REST = 0.5
+
+
 def fuse(candidates: Sequence[float], ratio_estimate: float, tolerance: float) -> Fusion:
     """Step 7 of Section 4: of the candidates of Estimator 1, the one nearest to Estimator 2.
 
@@ -249,6 +254,14 @@ def conclude(
             need = "the torque/force ratio had not settled yet"
         else:
             need = f"the spectrum needs {cfg.spectrum_window:g} s"
+        t_c, t_1 = evidence.t[evidence.contact_index], evidence.t[evidence.rest_index]
+        if t_1 - t_c > _LATE_REST * cfg.spectrum_window:
+            # the record is long enough for a head that rests soon after the touch
+            need += (
+                f" (t_1 came {t_1 - t_c:.2f} s after the contact: the head was slow to come to "
+                f"rest, its angles within {evidence.diagnostics.get('rest_tolerance', 0.0):.2g}"
+                f" rad for {cfg.rest_window:g} s)"
+            )
         found.append(
             (
                 Status.RECORDING_TOO_SHORT,
