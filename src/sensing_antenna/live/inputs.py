@@ -11,7 +11,10 @@ UDP port receives whatever anyone sends it: a datagram not in the format, a malf
 late datagram, a time that does not increase or one that jumps ahead beyond any filling (an
 outlier stamp, which would leave every good sample after it behind), a recording first heard
 after its start is left out with a
-:class:`~.events.SkippedEvent` saying why, and listening goes on.
+:class:`~.events.SkippedEvent` saying why, and listening goes on. A stream its sender began
+again under the same name (its first header, then datagrams numbered from 0 again) ends the
+recording and begins the next. Ctrl-C or a stop signal ends the recording being received with
+its final events (:data:`INTERRUPTED_WAIT`).
 """
 
 from __future__ import annotations
