@@ -146,6 +146,24 @@ def test_two_wrong_points_do_not_decide_the_class(name: str) -> None:
     assert unexplained(result) == ""
 
 
+@pytest.mark.parametrize("name", ["box", "cylinder"])
+def test_a_point_placed_far_from_the_rest_is_the_one_counted_wrong(name: str) -> None:
+    # One of 36 points half a metre from the object (a base pose written wrong): every start
+    # made of all the points lies between it and the object, and the fits from them were
+    # dragged (a plane or a cone named, sizes of tens of cm). The class and its sizes are the
+    # other points' own, and that point is the one the fit counts wrong
+    mesh, rng = _placed(name)
+    points, covariances = _sample(mesh, 35, rng)
+    away = mesh.centroid + 0.5 * _lattice(1)[0]
+    points = np.vstack([points[:7], away, points[7:]])
+    covariances = np.vstack([covariances, covariances[:1]])
+    result = recognise(points, covariances, rng=np.random.default_rng(0))
+    assert result.decision == name, (result.decision, result.candidates, result.delta_score)
+    assert _size_error(name, result.best.sizes) < SIZE_TOLERANCE, result.best.sizes
+    assert result.best.wrong == (7,)
+    assert result.best.distances(points[7:8])[0] > 0.3
+
+
 def test_points_of_another_object_among_a_spheres_are_said_to_be() -> None:
     # Six of 41 points lie on another object 2 to 6 cm beyond the ball (two explorations'
     # recordings mapped together): the ball is still the class that explains the most, but

@@ -551,6 +551,8 @@ class ClassFit:
     n_wrong : int
         Points the mixture counts wrong at the fit: z_i^2 beyond their :func:`outlier_cap`
         (more likely wrong estimates than points of this shape).
+    wrong : tuple of int
+        Which: their indices among the points fitted, farthest first.
     """
 
     name: str
@@ -574,11 +576,16 @@ class ClassFit:
     mesh: trimesh.Trimesh | None = field(default=None, compare=False, repr=False)
     measurements: float = math.nan
     n_wrong: int = 0
+    wrong: tuple[int, ...] = ()
 
     @property
     def counted(self) -> float:
         """:attr:`measurements`, n_points where it is not known."""
         return float(self.measurements if math.isfinite(self.measurements) else self.n_points)
+
+    def distances(self, points: ArrayLike) -> FloatArray:
+        """Distance (m) of ``points`` (m, shape (n, 3)) from the fitted surface, shape (n,)."""
+        return _surface_distance(self, np.asarray(points, dtype=float).reshape(-1, 3))
 
     def distance_std(self, points: ArrayLike) -> FloatArray:
         """Standard deviation (m) of the fitted shape's signed distance at each of ``points``
@@ -657,6 +664,7 @@ class ClassFit:
             "n_points": self.n_points,
             "measurements": self.counted,
             "n_wrong": self.n_wrong,
+            "wrong": list(self.wrong),
             "weight": None if math.isnan(self.weight) else float(self.weight),
         }
 
@@ -1168,6 +1176,19 @@ def _extent_prior(
     return np.asarray([max(extent - span[2], 0.0) / EXTENT_PRIOR])
 
 
+#: A point farther from the points' median than this many times their median distance from it
+#: lies apart from the rest: the fits also start from the rest's geometry (:func:`_gathered`).
+GATHERED_DISTANCES = 4.0
+
+
+def _gathered(points: FloatArray) -> NDArray[np.bool_]:
+    """Which ``points`` (m, shape (n, 3)) lie with the rest: within :data:`GATHERED_DISTANCES`
+    times the median distance from the coordinate-wise median (a compact object's points lie
+    within about twice it, those along one outline within twice it too)."""
+    distance = np.linalg.norm(points - np.median(points, axis=0), axis=1)
+    return np.asarray(distance <= GATHERED_DISTANCES * np.median(distance))
+
+
 def _spread(points: FloatArray) -> float:
     """The points' bounding box diagonal (m)."""
     return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
@@ -1430,6 +1451,21 @@ def fit_primitive(
     # there wrong, and the second refinement, from the first's shape, takes them back
     starts = [solution.x for solution in chosen] + direct
     candidates = [refine(refine(start, exclude=False)) for start in starts]
+    # a point far from the rest (a misplaced base pose) moves every start made of all the
+    # points; the starts of the rest, fitted without it, give the fits that count it wrong
+    kept = _gathered(p)
+    if not np.all(kept):
+        apart = np.where(kept, sigma, np.inf)
+        trimmed = []
+        for start in _starts(model, p[kept], direction, generator)[0]:
+            try:
+                trimmed.append(fit(np.clip(start, low, high), apart, False, MAX_EVALUATIONS))
+            except ValueError:
+                continue
+        trimmed.sort(key=lambda solution: solution.cost)
+        candidates += [
+            refine(refine(s.x)) for s in trimmed[: REFINED_STARTS if link_evidence else 1]
+        ]
     x = model.canonical(min(candidates, key=total) if len(candidates) > 1 else candidates[0])
     distance = model.signed_distance(x, p)
     sigma = normal_sigma(x)
@@ -1916,6 +1952,7 @@ def _scored(
         at, sigma_at, extra, share = touches
     # each point's and each sweep's part of chi^2; BIC = chi^2 + k ln n
     z2 = _z2(at, sigma_at, lines, extra)
+    wrong = z2 > outlier_cap(sigma, spread)
     parts = point_chi2(z2, sigma, spread)
     chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
     line_chi2 = float(np.sum(lines**2))
@@ -1933,7 +1970,8 @@ def _scored(
         measurements=float(n + np.sum(share)),
         vector=vector,
         mesh=mesh,
-        n_wrong=int(np.sum(z2 > outlier_cap(sigma, spread))),
+        n_wrong=int(np.sum(wrong)),
+        wrong=tuple(int(k) for k in np.flatnonzero(wrong)[np.argsort(-z2[wrong])]),
     )
 
 

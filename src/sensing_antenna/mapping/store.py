@@ -212,6 +212,33 @@ def unexplained(recognition: Any) -> str:
     )
 
 
+#: Points counted wrong by the best class that the report names, farthest first.
+NAMED_WRONG = 5
+
+
+def _counted_wrong(contact_map: ContactMap) -> list[str]:
+    """A line naming the recordings whose points the best class counts wrong (at most
+    :data:`NAMED_WRONG`), with their distance from its fit; none when there are none."""
+    recognition = contact_map.recognition
+    if recognition is None or not recognition.best.wrong:
+        return []
+    best = recognition.best
+    wrong = best.wrong[:NAMED_WRONG]
+    at = np.array([contact_map.used[k].point for k in wrong]).reshape(-1, 3)
+    distance = best.distances(at)
+    named = "; ".join(
+        f"{contact_map.used[k].source} ({1000 * d:.0f} mm from it)"
+        for k, d in zip(wrong, distance, strict=True)
+    )
+    more = len(best.wrong) - len(wrong)
+    return [
+        f"Points the {best.name.replace('mesh:', 'mesh ')}'s fit counts as wrong estimates (too"
+        f" far from it to be of it, left out of its shape): {named}"
+        + (f"; and {more} more" if more > 0 else "")
+        + ". Their base poses, or their estimates, to check."
+    ]
+
+
 def _previous_files(out: Path) -> list[str]:
     """The files a previous map in ``out`` wrote (its recognition.json's ``files``), or none."""
     try:
@@ -329,6 +356,7 @@ def report(contact_map: ContactMap) -> str:
             )
             + ".",
             *(f"{text[:1].upper()}{text[1:]}." for text in (spread, wrong) if text),
+            *_counted_wrong(contact_map),
             "",
             "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md),"
             " each at most its outlier cap; the lines' and the swept links' own sums of squares,"
