@@ -702,6 +702,11 @@ def test_a_box_touched_on_three_faces_gives_its_extents_as_lower_bounds() -> Non
     assert all(v is None for v in fit.to_dict()["size_std"].values())
     # the bounds lie below the truth (the box's axes are its own: compare sorted)
     assert np.all(np.sort(list(fit.size_at_least.values())) < extents), fit.size_at_least
+    # where the fitted box lies: held on the faces touched, anywhere beyond on the others
+    touched = np.vstack([0.5 * np.eye(3)[axis] * extents for axis in range(3)])
+    untouched = -touched
+    assert np.all(fit.distance_std(touched) < NOISE)
+    assert np.all(np.isinf(fit.distance_std(untouched)))
     # the same box touched on all six faces: every extent measured, within 3 sigma
     faces = []
     for axis in range(3):

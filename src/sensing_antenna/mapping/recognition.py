@@ -553,6 +553,9 @@ class ClassFit:
         (more likely wrong estimates than points of this shape).
     wrong : tuple of int
         Which: their indices among the points fitted, farthest first.
+    free_ends : tuple of array
+        The ends no evidence holds (:func:`size_std`): the change of :attr:`vector` per metre
+        each grows by.
     """
 
     name: str
@@ -577,6 +580,7 @@ class ClassFit:
     measurements: float = math.nan
     n_wrong: int = 0
     wrong: tuple[int, ...] = ()
+    free_ends: tuple[FloatArray, ...] = field(default=(), compare=False, repr=False)
 
     @property
     def counted(self) -> float:
@@ -591,8 +595,9 @@ class ClassFit:
         """Standard deviation (m) of the fitted shape's signed distance at each of ``points``
         (m, shape (n, 3)), from :attr:`covariance`: how far the fitted surface may lie from
         where it is drawn there, shape (n,). Where the surface moves with a direction the
-        evidence does not hold (a cylinder's untouched end) it is far beyond any size; NaN for
-        a user mesh or a covariance that is not finite (the evidence holds no direction)."""
+        evidence does not hold (a cylinder's untouched end: one of :attr:`free_ends`, the
+        distance moving at least half as fast as the end) it is inf; NaN for a user mesh or a
+        covariance that is not finite (the evidence holds no direction)."""
         q = np.asarray(points, dtype=float).reshape(-1, 3)
         model = PRIMITIVES.get(self.name)
         n = len(self.vector)
@@ -600,7 +605,12 @@ class ClassFit:
             return np.full(len(q), np.nan)
         if not np.all(np.isfinite(self.covariance)):
             return np.full(len(q), np.nan)
-        return _carried(lambda v: model.signed_distance(v, q), self.vector, self.covariance)
+        std = _carried(lambda v: model.signed_distance(v, q), self.vector, self.covariance)
+        here = model.signed_distance(self.vector, q)
+        for change in self.free_ends:
+            moved = model.signed_distance(self.vector + JACOBIAN_STEP * change, q) - here
+            std = np.where(np.abs(moved) >= 0.5 * JACOBIAN_STEP, np.inf, std)
+        return np.asarray(std)
 
     @property
     def wrong_chance(self) -> float:
@@ -1471,7 +1481,9 @@ def fit_primitive(
     sigma = normal_sigma(x)
     touches = touched(x, sigma)
 
-    def uncertainty(v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    def uncertainty(
+        v: FloatArray,
+    ) -> tuple[FloatArray, FloatArray, FloatArray, tuple[FloatArray, ...]]:
         # the covariance, the sizes' deviations and lower-bound margins at v (size_std), from
         # the evidence alone: without the extent prior, the points counted wrong at v left out
         kept = inlier_sigma(v, normal_sigma(v))
@@ -1498,7 +1510,7 @@ def fit_primitive(
             measured = None
         else:
             shaped = refit
-    covariance, std, margin = measured if measured is not None else uncertainty(x)
+    covariance, std, margin, free = measured if measured is not None else uncertainty(x)
 
     fitted = _scored(
         model.name,
@@ -1523,6 +1535,7 @@ def fit_primitive(
         vector=shaped,
         mesh=model.mesh(shaped),
         covariance=covariance,
+        free_ends=free,
         size_std=dict(zip(model.size_names, std.tolist(), strict=True)),
         size_at_least={
             n: float(at_least[i]) for i, n in enumerate(model.size_names) if np.isfinite(margin[i])
@@ -1616,10 +1629,11 @@ def size_std(
     residuals: Callable[[FloatArray], FloatArray],
     spread: float,
     point_std: FloatArray,
-) -> tuple[FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, tuple[FloatArray, ...]]:
     """Standard deviation (m) of each of ``shape``'s sizes at the fit ``x``, shape (n_sizes,),
-    and for a size that is only a lower bound how far below the fitted size the bound lies (m;
-    NaN for the others).
+    for a size that is only a lower bound how far below the fitted size the bound lies (m;
+    NaN for the others), and the free ends (below): the parameter vector's change per metre
+    each grows by.
 
     The parameters' ``covariance`` (:func:`parameter_covariance` of ``residuals``, a function of
     the parameter vector whose first len(``point_std``) entries are the points' d_i / sigma_i, at
@@ -1644,8 +1658,10 @@ def size_std(
     rate it moves at.
     """
     if np.all(np.isnan(covariance)):
-        return np.full(len(shape.size_names), np.inf), np.full(len(shape.size_names), np.nan)
+        nothing = np.full(len(shape.size_names), np.nan)
+        return np.full(len(shape.size_names), np.inf), nothing, ()
     at_x = residuals(x)
+    free: list[FloatArray] = []
     std = np.full(len(shape.size_names), np.inf)
     if np.all(np.isfinite(covariance)):
         deviation = _carried(shape.sizes, x, covariance)
@@ -1677,6 +1693,8 @@ def size_std(
             continue
         noise = float(np.max(widths))
         rates = np.abs(shape.sizes(x + change) - shape.sizes(x))  # per metre of growth
+        if rise < 1.0:
+            free.append(np.asarray(change, dtype=float))
         for index in sizes:
             if rise < 1.0:
                 # a free end: a size the prior held at the outermost points is a lower bound,
@@ -1687,7 +1705,7 @@ def size_std(
             elif math.isfinite(std[index]):
                 # the end's own deviation, carried to this size (a cone's radius moves by R / h)
                 std[index] = max(std[index], rates[index] * step * math.sqrt(3.0 / rise))
-    return np.asarray(std), margin
+    return np.asarray(std), margin, tuple(free)
 
 
 def fit_mesh(
