@@ -319,3 +319,21 @@ def test_a_map_where_no_recording_shows_a_contact_says_which_antenna_may_be_wron
     # a map with a point used has nothing to say of it
     assert main(["map", *map(str, recordings), "--out", str(tmp_path / "n"), "--no-progress"]) == 0
     assert "no recording shows a contact" not in capsys.readouterr().out
+
+
+def test_a_base_pose_key_written_otherwise_is_named(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # every file's key misspelled: no file has a base_pose, so the count says nothing, but
+    # each key written otherwise is named, with the key the format reads
+    posed = read_recording(recordings[2])
+    pose = posed.metadata["base_pose"]
+    metadata = {k: v for k, v in posed.metadata.items() if k != "base_pose"}
+    typo = tmp_path / "typo.csv"
+    write_recording(dataclasses.replace(posed, metadata={**metadata, "Base-Pos": pose}), typo)
+    assert main(["map", str(typo), "--out", str(tmp_path / "a"), "--no-progress"]) == 0
+    notes = [line for line in capsys.readouterr().err.splitlines() if "base_pose" in line]
+    assert notes == [
+        f"antenna map: note: {typo}: metadata key 'Base-Pos' is not read: 'base_pose'? (the "
+        "point is placed with the base at the world's origin)"
+    ]

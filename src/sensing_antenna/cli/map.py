@@ -158,6 +158,14 @@ def _map_into(args: argparse.Namespace) -> None:
         named.setdefault(metadata.get("antenna", ""), []).append(str(path))
         if not metadata.get(BASE_POSE_KEY, "").strip():
             unposed.append(str(path))
+            # a key written otherwise (base_pos, Base-Pose) is not read: said of every file
+            near = [key for key in metadata if _spelled_like(key, BASE_POSE_KEY)]
+            if near:
+                ordered.append(
+                    f"antenna map: note: {path}: metadata key '{near[0]}' is not read: "
+                    f"'{BASE_POSE_KEY}'? (the point is placed with the base at the world's "
+                    "origin)"
+                )
         order = quaternion_order_hint(metadata)
         if order is not None:
             ordered.append(f"antenna map: note: {path}: {order} (the order?)")
@@ -222,6 +230,15 @@ def _antenna_hint(summary: dict[str, Any]) -> None:
             "--antenna the file antenna identify or calibrate wrote for that device); each "
             "point's reason is in points.csv"
         )
+
+
+def _spelled_like(key: str, name: str) -> bool:
+    """Whether the metadata ``key`` is ``name`` written otherwise: in other capitals or
+    separators, or a letter or two off (difflib's ratio 0.8 and more)."""
+    import difflib
+
+    plain = key.strip().lower().replace("-", "_").replace(" ", "_")
+    return key != name and difflib.SequenceMatcher(None, plain, name).ratio() >= 0.8
 
 
 def note_unposed(unposed: list[str], count: int) -> None:
