@@ -254,6 +254,25 @@ def test_a_quaternion_in_ros_order_is_told_by_the_tilt_it_gives(turn: float) -> 
     assert f"tilted {turn:.0f} degrees" in said and f"level base turned {turn:.0f} degrees" in said
     level = {"base_pose": json.dumps({"position": [0, 0, 0], "quaternion": ours})}
     assert quaternion_order_hint(level) is None
+
+
+@pytest.mark.parametrize("turn", [0.0, 5.0, 20.0])
+def test_a_small_turn_in_ros_order_is_told_by_the_half_turn_it_gives(turn: float) -> None:
+    # The identity, or a small turn about the vertical, in ROS's [x, y, z, w]: read as the
+    # format's order it turns the base half round, tipped by the small angle, short of the 30
+    # degrees the tilt asks: the line says the two angles. A half turn about X^a is one in
+    # either order: nothing is said
+    half = math.radians(turn) / 2.0
+    ros = [0.0, 0.0, math.sin(half), math.cos(half)]
+    said = quaternion_order_hint(
+        {"base_pose": json.dumps({"position": [0, 0, 0], "quaternion": ros})}
+    )
+    assert said is not None
+    assert "turned 180 degrees" in said and f"would be turned {turn:.0f} degrees" in said
+    behind = {"base_pose": json.dumps({"position": [0, 0, 0], "quaternion": [0, 0, 0, 1]})}
+    assert quaternion_order_hint(behind) is not None  # the identity's ROS form: said
+    turned = {"base_pose": json.dumps({"position": [0, 0, 0], "quaternion": [0, 1, 0, 0]})}
+    assert quaternion_order_hint(turned) is None  # half round either way
     assert quaternion_order_hint({}) is None
     assert quaternion_order_hint({"base_pose": "not json"}) is None
 

@@ -185,10 +185,13 @@ def base_pose_from_metadata(metadata: Mapping[str, str], source: str | None = No
 
 
 def quaternion_order_hint(metadata: Mapping[str, str]) -> str | None:
-    """A line when a ``base_pose`` quaternion reads, in the format's ``[w, x, y, z]``, as a base
-    tilted more than 30 degrees from the world's vertical, while in the ``[x, y, z, w]`` order
-    of ROS and scipy it is a level base turned about the vertical (its first two numbers under
-    0.1); None otherwise, or when the pose is none (its own error says so)."""
+    """A line when a ``base_pose`` quaternion reads, in the format's ``[w, x, y, z]``, as a half
+    turn (its first number under 0.1: more than 168 degrees) while in the ``[x, y, z, w]`` order
+    of ROS and scipy it is a turn of under 90 degrees: as a base tilted more than 30 degrees
+    from the world's vertical against a level one turned about the vertical (its second number
+    under 0.1 too), else as the two turns' angles (the identity written in ROS's order reads as
+    a base turned half round); None otherwise, or when the pose is none (its own error says
+    so)."""
     try:
         data = json.loads(metadata.get(BASE_POSE_KEY, ""))
         q = np.asarray(data["quaternion"], dtype=float)
@@ -197,10 +200,20 @@ def quaternion_order_hint(metadata: Mapping[str, str]) -> str | None:
     if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.linalg.norm(q) > 0.0:
         return None
     w, x, y, z = q / np.linalg.norm(q)
+    # each order's angle of turn, 2 acos |scalar part|
+    ours, theirs = (math.degrees(2.0 * math.acos(min(1.0, abs(c)))) for c in (w, z))
+    if not abs(w) < 0.1:
+        return None
     # read as [w, x, y, z], Z^a's world z is 1 - 2 (x^2 + y^2)
     tilt = math.degrees(math.acos(min(1.0, max(-1.0, 1.0 - 2.0 * (x * x + y * y)))))
-    if not (abs(w) < 0.1 and abs(x) < 0.1 and tilt > 30.0):
-        return None
+    if not (abs(x) < 0.1 and tilt > 30.0):
+        if not theirs < 90.0:
+            return None
+        return (
+            f"its base_pose quaternion {_listed(q)} reads as [w, x, y, z] (the format's order) "
+            f"as a base turned {ours:.0f} degrees; in the [x, y, z, w] order of ROS and scipy "
+            f"it would be turned {theirs:.0f} degrees"
+        )
     # read as [x, y, z, w]: a turn of 2 atan2(y, z) about the vertical, nearly
     turn = math.degrees(2.0 * math.atan2(y, z))
     return (
