@@ -337,3 +337,6 @@ def test_a_base_pose_key_written_otherwise_is_named(
         f"antenna map: note: {typo}: metadata key 'Base-Pos' is not read: 'base_pose'? (the "
         "point is placed with the base at the world's origin)"
     ]
+    # what was said of the inputs stays with the map
+    report = (tmp_path / "a" / "report.md").read_text()
+    assert report.endswith(f"## The inputs\n\n- {notes[0].removeprefix('antenna map: ')}\n")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -188,28 +189,27 @@ def _map_into(args: argparse.Namespace) -> None:
         )
     for path, problem in contradicted:
         warn_of_contradicted_period(path, problem)
-    for line in ordered:
-        print(line, file=sys.stderr)
     if args.antenna is None:  # the default: recordings of another antenna are warned of
         warn_of_other_antennas(named, antenna.name)
-    note_unposed(unposed, sum(len(paths) for paths in named.values()))
+    # the notes on the inputs, said on stderr and kept in report.md
+    said = [*ordered, *note_unposed(unposed, sum(len(paths) for paths in named.values()))]
     if not points:
         more = f" (and {len(left_out) - 1} more unreadable)" if len(left_out) > 1 else ""
         raise SensingAntennaError(f"{left_out[0]}{more}")
-    for problem in left_out:  # one line each; the map is made of the others
-        print(f"antenna map: warning: left out {problem}", file=sys.stderr)
-    for point, distance, spacing in isolated_points(points, antenna.link.length):
-        print(
-            f"antenna map: note: the point of {point.source} lies {distance:.3g} m from every"
-            f" other, where the points lie {1e3 * spacing:.3g} mm apart: its base_pose (a"
-            " position in cm or mm, a rotation transposed or a quaternion's order)?",
-            file=sys.stderr,
-        )
+    said += [f"antenna map: warning: left out {problem}" for problem in left_out]
+    said += [
+        f"antenna map: note: the point of {point.source} lies {distance:.3g} m from every"
+        f" other, where the points lie {1e3 * spacing:.3g} mm apart: its base_pose (a"
+        " position in cm or mm, a rotation transposed or a quaternion's order)?"
+        for point, distance, spacing in isolated_points(points, antenna.link.length)
+    ]
+    for line in said:
+        print(line, file=sys.stderr)
     with recognition_progress(not args.no_progress, meshes) as bar:
         contact_map = build_map(
             points, args.include_uncertain, meshes=meshes, swept=swept, class_fitted=bar
         )
-    report_map(contact_map, args.out)
+    report_map(contact_map, args.out, notes=[line.removeprefix("antenna map: ") for line in said])
 
 
 def _antenna_hint(summary: dict[str, Any]) -> None:
@@ -241,26 +241,32 @@ def _spelled_like(key: str, name: str) -> bool:
     return key != name and difflib.SequenceMatcher(None, plain, name).ratio() >= 0.8
 
 
-def note_unposed(unposed: list[str], count: int) -> None:
-    """One line when some of the ``count`` recordings read have a ``base_pose`` and
-    ``unposed`` have none: theirs is taken as the world's origin, unturned."""
+def note_unposed(unposed: list[str], count: int) -> list[str]:
+    """The line to say when some of the ``count`` recordings read have a ``base_pose`` and
+    ``unposed`` have none (theirs is taken as the world's origin, unturned); none otherwise."""
     if not unposed or len(unposed) == count:
-        return
+        return []
     more = f" and {len(unposed) - 1} more" if len(unposed) > 1 else ""
     verb, theirs = ("has", "its point is") if len(unposed) == 1 else ("have", "their points are")
-    print(
+    return [
         f"antenna map: note: {len(unposed)} of {count} recordings {verb} no base_pose "
         f"({unposed[0]}{more}): {theirs} placed with the antenna's base at the world's origin, "
-        "unturned (docs/recording-format.md)",
-        file=sys.stderr,
-    )
+        "unturned (docs/recording-format.md)"
+    ]
 
 
-def report_map(contact_map: Any, out: Path, truth: Any = None, antenna_hints: bool = True) -> None:
+def report_map(
+    contact_map: Any,
+    out: Path,
+    truth: Any = None,
+    antenna_hints: bool = True,
+    notes: Sequence[str] = (),
+) -> None:
     """Write a map's files, figure and interactive view into ``out`` and print its summary
     (``antenna map`` and ``antenna explore`` share it); ``truth``, the true surface's mesh when
     known, is drawn in the view; ``antenna_hints``: say which antenna file to give when no
-    point is usable (``antenna map``'s ``--antenna``)."""
+    point is usable (``antenna map``'s ``--antenna``); ``notes``, what was said of the inputs,
+    kept in report.md."""
     from sensing_antenna.mapping import write_map
     from sensing_antenna.mapping.store import overdispersed, unexplained
     from sensing_antenna.mapping.view import write_map_html
@@ -271,7 +277,7 @@ def report_map(contact_map: Any, out: Path, truth: Any = None, antenna_hints: bo
     html = write_map_html(contact_map, out / "map.html", truth)
     if html is not None:
         views.append(html)
-    written = [*write_map(contact_map, out, tuple(views)), *views]
+    written = [*write_map(contact_map, out, tuple(views), notes), *views]
     summary = contact_map.summary()
     recognition = contact_map.recognition
     if recognition is None:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -95,11 +96,17 @@ def _number(value: float) -> str:
 SOMETIMES_WRITTEN = ("points.ply", "surface.ply", "object.ply", "map.html")
 
 
-def write_map(contact_map: ContactMap, out: Path, also: tuple[Path, ...] = ()) -> list[Path]:
+def write_map(
+    contact_map: ContactMap,
+    out: Path,
+    also: tuple[Path, ...] = (),
+    notes: Sequence[str] = (),
+) -> list[Path]:
     """Write the map's files into ``out`` (created), after removing those of
     :data:`SOMETIMES_WRITTEN` a previous map wrote there and this one has not (``also``: the
     files of this map its caller wrote already); returns the paths written. recognition.json
-    lists them all (``files``)."""
+    lists them all (``files``); report.md ends with ``notes`` (what was said of the inputs:
+    recordings left out, base poses)."""
     out.mkdir(parents=True, exist_ok=True)
     kept = {p.name for p in also}
     for name in _previous_files(out):
@@ -164,7 +171,7 @@ def write_map(contact_map: ContactMap, out: Path, also: tuple[Path, ...] = ()) -
     path.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
     written.append(path)
     path = out / "report.md"
-    path.write_text(report(contact_map))
+    path.write_text(report(contact_map, notes))
     written.append(path)
     return written
 
@@ -280,8 +287,9 @@ def _object_line(contact_map: ContactMap, summary: dict[str, Any] | None) -> str
     )
 
 
-def report(contact_map: ContactMap) -> str:
-    """A short Markdown report of the map (lengths in mm for reading)."""
+def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
+    """A short Markdown report of the map (lengths in mm for reading), ending with ``notes``
+    on its inputs when there are any."""
     s = contact_map.summary()
     statuses = ", ".join(f"{k} {v}" for k, v in sorted(s["statuses"].items()))
     lines = [
@@ -374,4 +382,6 @@ def report(contact_map: ContactMap) -> str:
                 f"{fit.swept_chi2:.1f} | {fit.score:.1f} | {fit.weight:.3f} | "
                 f"{fit.sizes_text()} |"
             )
+    if notes:
+        lines += ["", "## The inputs", "", *(f"- {note}" for note in notes)]
     return "\n".join(lines) + "\n"
