@@ -2030,6 +2030,45 @@ def _surface_distance(fit: ClassFit, samples: FloatArray) -> FloatArray:
     return np.asarray(distance)
 
 
+#: A user mesh counts as a member of a class when the class fitted to its surface lies within
+#: this share of the mesh's size from it (a box's mesh: its faces' own flatness).
+MEMBER_RMS_SHARE = 0.01
+
+#: Points sampled on a user mesh to fit a class to it.
+MEMBER_SAMPLES = 400
+
+
+def _one_a_member_of_the_other(
+    one: ClassFit, other: ClassFit, generator: np.random.Generator
+) -> bool:
+    """Whether of the two fits one is a user mesh's and the other a class's whose members, at
+    the sizes its fit allows, include that mesh: the class fitted to the registered mesh's
+    surface within :data:`MEMBER_RMS_SHARE` of its size, and each of that fit's sizes within 3
+    standard deviations of the class fit's, at or above its lower bound, or not measured."""
+    meshes = [f for f in (one, other) if f.name not in PRIMITIVES and f.mesh is not None]
+    classes = [f for f in (one, other) if f.name in PRIMITIVES and f.name != "plane"]
+    if len(meshes) != 1 or len(classes) != 1:
+        return False
+    mesh, fit = meshes[0].mesh, classes[0]
+    assert mesh is not None
+    size = float(np.max(trimesh.bounds.oriented_bounds(mesh)[1]))
+    samples, _ = trimesh.sample.sample_surface(
+        mesh, MEMBER_SAMPLES, seed=int(generator.integers(2**31))
+    )
+    tight = np.tile(np.eye(3) * (MEMBER_RMS_SHARE * size) ** 2, (len(samples), 1, 1))
+    member = fit_primitive(fit.name, samples, tight, rng=generator)
+    if not member.rms <= MEMBER_RMS_SHARE * size:
+        return False
+    for name, value in member.sizes.items():
+        std = fit.size_std.get(name, math.inf)
+        if name in fit.size_at_least:
+            if value < fit.size_at_least[name] - 3.0 * (0.0 if math.isinf(std) else std):
+                return False
+        elif math.isfinite(std) and abs(value - fit.sizes[name]) > 3.0 * std:
+            return False
+    return True
+
+
 def _scatter_narrowed(simpler: ClassFit, richer: ClassFit, level: float = NESTED_LEVEL) -> bool:
     """Whether a class that holds ``simpler``'s shape as its own special case narrows the
     points' scatter about it by more than its extra parameters would by fitting noise: the F
@@ -2178,8 +2217,12 @@ def recognise(
         # apart by no more than the points scatter about the best; or a class that holds the
         # best's shape as its own special case (a capsule of no segment is a ball), not apart
         # by as much as a rival must be, whose extra parameters narrow the points' own scatter
-        # no more than fitting noise does
+        # no more than fitting noise does; or a user's mesh and a class one of whose members,
+        # within the class fit's sizes, the mesh is (a box, where the points leave its height
+        # a lower bound the mesh's meets)
         if gap(f) <= best.rms:
+            return True
+        if _one_a_member_of_the_other(best, f, generator):
             return True
         return (
             f.name in PRIMITIVES
