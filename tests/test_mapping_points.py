@@ -91,6 +91,13 @@ def test_quaternion_and_matrix_metadata_give_one_pose() -> None:
         ('{"position": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, -1]]}', "orthonormal"),
         ('{"position": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0]]}', "3 x 3"),
         ('{"position": [0, 0, 0], "scale": 2}', "unknown"),
+        # a ROS pose as its message prints it
+        (
+            '{"position": {"x": 0.5, "y": 0, "z": 0}, "orientation": {"x": 0, "y": 0, "z": 0,'
+            ' "w": 1}}',
+            "written here as quaternion [w, x, y, z]",
+        ),
+        ('{"position": {"x": 0.5, "y": 0, "z": 0}, "quaternion": [1, 0, 0, 0]}', "[x, y, z]"),
         # JSON that is no pose: booleans and strings for numbers, a key twice, deep nesting,
         # a coordinate whose square overflows
         ('{"position": [true, false, 0], "quaternion": [1, 0, 0, 0]}', "three numbers"),

@@ -232,8 +232,18 @@ def _pose_from_json(data: Any) -> BasePose:
         raise FieldError(BASE_POSE_KEY, "must be a JSON object with position and rotation")
     unknown = set(data) - {"position", "quaternion", "rotation"}
     if unknown:
-        raise FieldError(BASE_POSE_KEY, f"unknown field(s) {', '.join(sorted(unknown))}")
-    position = _numbers(data.get("position"), (3,), "position: three numbers (m)")
+        ros = (
+            " (a ROS pose's orientation {x, y, z, w} is written here as quaternion [w, x, y, z])"
+            if "orientation" in unknown
+            else ""
+        )
+        raise FieldError(
+            BASE_POSE_KEY,
+            f"unknown field(s) {', '.join(sorted(unknown))}: it holds position, and quaternion"
+            f" or rotation{ros}",
+        )
+    listed = "" if not isinstance(data.get("position"), dict) else " as a list [x, y, z]"
+    position = _numbers(data.get("position"), (3,), f"position: three numbers (m){listed}")
     if ("quaternion" in data) == ("rotation" in data):
         raise FieldError(BASE_POSE_KEY, "give exactly one of quaternion and rotation")
     if "quaternion" in data:
