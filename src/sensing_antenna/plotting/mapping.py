@@ -13,7 +13,10 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from sensing_antenna.mapping.contact_map import ContactMap
@@ -112,7 +115,18 @@ def map_figure(contact_map: ContactMap) -> Figure:
             cax=fig.add_axes((0.9, 0.25, 0.02, 0.5)),
             label="point sigma, worst direction (mm)",
         )
-    decision = "" if contact_map.recognition is None else f": {contact_map.recognition.decision}"
+    recognition = contact_map.recognition
+    decision = "" if recognition is None else f": {recognition.decision}"
     fig.suptitle(f"{len(used)} contact points{decision}")
+    # what the grey and the green are (the green: the best class's fit, named or not)
+    handles: list[Artist] = []
+    if mesh is not None and len(mesh.faces):
+        handles.append(Patch(color="0.8", alpha=0.6, label="surface through the points"))
+    if shape is not None and recognition is not None:
+        fitted = recognition.best.name.replace("mesh:", "mesh ")
+        said = "recognised" if not recognition.undecided else "best fit, not recognised"
+        handles.append(Line2D([], [], color="tab:green", label=f"{fitted} ({said})"))
+    if handles:
+        fig.legend(handles=handles, loc="lower center", ncol=len(handles), frameon=False)
     fig.subplots_adjust(left=0.02, right=0.85, wspace=0.1, hspace=0.15)
     return fig
