@@ -1058,3 +1058,27 @@ def test_a_user_mesh_touched_on_its_side_slides_along_its_axis_to_where_the_line
     centre = np.array([fit.parameters[f"m{i}3"] for i in range(3)])
     np.testing.assert_allclose(centre, [0.6, 0.05, 0.0], atol=0.003)
     assert fit.line_chi2 < 1.0
+
+
+def test_a_touch_placed_far_from_the_rest_is_counted_wrong_with_the_links_lines() -> None:
+    # The swept touches of a box with their links' lines, one of them moved half a metre with
+    # its line (its base pose written wrong): the box and its sizes are the other touches' own,
+    # and that touch is the one its fit counts wrong (the fits from the others' starts, first
+    # without it, had been dragged towards it along the lines: a capsule or torus abstained)
+    mesh, rng = _placed("box")
+    points, covariances, lines = _swept_touches(mesh, rng)
+    n, k = len(points), 5
+    points = np.vstack([points, points[k] + [0.0, 0.5, 0.0]])
+    covariances = np.vstack([covariances, covariances[k : k + 1]])
+    tangents = np.vstack([lines.tangents, lines.tangents[k]])
+    lines = LinkLines(tangents, np.full(n + 1, 0.01), np.full(n + 1, 0.4), np.full(n + 1, 0.3))
+    result = recognise(
+        points,
+        covariances,
+        classes=["box", "capsule", "torus", "plane"],
+        rng=np.random.default_rng(0),
+        lines=lines,
+    )
+    assert result.decision == "box", (result.decision, result.candidates)
+    assert result.best.wrong == (n,)
+    assert _size_error("box", result.best.sizes) < SIZE_TOLERANCE, result.best.sizes

@@ -123,3 +123,41 @@ def test_points_far_from_every_class_are_said_to_be(tmp_path: Path) -> None:
     # the unshifted ball: nothing said
     clean = build_map(contacts(half_sphere(30, np.array([0.5, 0.0, 0.0]), 0.05)))
     assert clean.recognition is not None and overdispersed(clean.recognition) == ""
+
+
+def test_the_report_names_a_point_far_from_the_named_object(tmp_path: Path) -> None:
+    # one of 31 points half a metre from the ball (a base pose written wrong): the sphere is
+    # named, and the report names that point's recording, the one its fit counts wrong
+    centre, radius = np.array([0.5, 0.0, 0.0]), 0.05
+    points = np.vstack([half_sphere(30, centre, radius), centre + np.array([0.0, 0.5, 0.0])])
+    contact_map = build_map(contacts(points))
+    assert contact_map.recognition is not None
+    assert contact_map.recognition.decision == "sphere"
+    write_map(contact_map, tmp_path)
+    report = (tmp_path / "report.md").read_text()
+    assert "Points the sphere's fit counts as wrong estimates" in report
+    assert "r30 (451 mm from it)" in report and "r29" not in report  # 0.5 m less the radius
+
+
+def test_a_named_mesh_says_what_of_it_the_points_do_not_hold(tmp_path: Path) -> None:
+    # a box touched on five faces, its top never, and the user's mesh of it: the mesh is named,
+    # and the report says the box class bounds its height only from below
+    extents = np.array([0.06, 0.1, 0.16])
+    rng = np.random.default_rng(3)
+    faces = []
+    for axis in range(3):
+        for sense in (1.0, -1.0):
+            if axis == 2 and sense > 0:
+                continue
+            on_face = rng.uniform(-0.5, 0.5, (8, 3)) * extents
+            on_face[:, axis] = 0.5 * sense * extents[axis]
+            faces.append(on_face)
+    points = np.vstack(faces) + rng.normal(0.0, NOISE, (40, 3)) + [0.5, 0.1, 0.0]
+    block = trimesh.creation.box(extents=extents)
+    contact_map = build_map(contacts(points), meshes={"block": block})
+    assert contact_map.recognition is not None
+    assert contact_map.recognition.decision == "mesh:block"
+    write_map(contact_map, tmp_path)
+    report = (tmp_path / "report.md").read_text()
+    assert "The box class fits the same points with" in report and "at least" in report
+    assert "the mesh is one such box, and the points hold no more of its size than that" in report

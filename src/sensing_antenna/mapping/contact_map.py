@@ -85,9 +85,9 @@ class ObjectSurface:
         its size, so that faces, not only edges and corners, carry vertices.
     std : array, shape (n_vertices,)
         Standard deviation of where the surface lies at each vertex (m;
-        :meth:`ClassFit.distance_std`): far beyond the object's size where no evidence holds
-        it, NaN throughout for a user mesh (its registration carries none) or a fit whose
-        covariance is not finite.
+        :meth:`ClassFit.distance_std`): inf where no evidence holds it (an end no touch
+        reached), NaN throughout for a user mesh (its registration carries none) or a fit
+        whose covariance is not finite.
     size : float
         The object's size, the largest extent of its mesh's oriented bounding box (m), whatever
         its pose.

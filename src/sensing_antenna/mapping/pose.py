@@ -224,7 +224,8 @@ def quaternion_order_hint(metadata: Mapping[str, str]) -> str | None:
 
 
 def _listed(values: FloatArray) -> str:
-    return "[" + ", ".join(f"{float(v):.3g}" for v in values) + "]"
+    # to three digits, a rounding residue (6.12e-17) as 0
+    return "[" + ", ".join(f"{float(v) if abs(v) >= 5e-4 else 0.0:.3g}" for v in values) + "]"
 
 
 def _pose_from_json(data: Any) -> BasePose:

@@ -140,6 +140,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -524,7 +525,8 @@ class ClassFit:
         deviation of the points at that end, since the end was left at the outermost, noisy,
         points (widened by the overdispersion in :func:`recognise`).
     rms : float
-        RMS of the point-to-surface distances (m).
+        RMS of the point-to-surface distances (m) of the points it does not count wrong (all
+        of them when it counts every one wrong).
     chi2 : float
         sum over the points of their part of chi^2 (:func:`point_chi2`, of z_i^2 = (d_i /
         sigma_i)^2 + r_i^2; dimensionless) and the swept links' parts.
@@ -1375,8 +1377,13 @@ def fit_primitive(
             distance = distance_at(x, p).reshape(-1)
             line = line_residuals(x, s, distance, search=False) if with_lines else np.zeros(0)
             points_part = rows(x, [distance / np.tile(s, copies(x)), line])
+        # the span of the points the fit takes (those left out, inf, may lie far away)
+        taken = p[np.isfinite(s)] if np.any(np.isfinite(s)) else p
         prior = np.reshape(
-            [_extent_prior(model.name, v, p, free_apex) for v in np.reshape(x, (copies(x), -1))],
+            [
+                _extent_prior(model.name, v, taken, free_apex)
+                for v in np.reshape(x, (copies(x), -1))
+            ],
             (copies(x), -1),
         )
         return rows(x, [points_part, swept_residuals(x, regions), prior])
@@ -1420,12 +1427,20 @@ def fit_primitive(
         wrong = point_z2(x, s) > outlier_cap(s, spread)
         return np.where(wrong, np.inf, s)
 
-    def refine(x: FloatArray, free_apex: bool = False, exclude: bool = True) -> FloatArray:
+    def refine(
+        x: FloatArray,
+        free_apex: bool = False,
+        exclude: bool = True,
+        leave_out: NDArray[np.bool_] | None = None,
+    ) -> FloatArray:
         # each point's sigma across the link along the fitted surface's normal at its nearest
         # point, and the link's lines; with ``exclude`` the points counted wrong leave the
-        # refinement; free-space samples far outside the shape at x do
+        # refinement, and those of ``leave_out``; free-space samples far outside the shape at
+        # x do
         sigma_x = normal_sigma(x)
         kept = inlier_sigma(x, sigma_x) if exclude else sigma_x
+        if leave_out is not None:
+            kept = np.where(leave_out, np.inf, kept)
         regions = [
             space.within(model.signed_distance(x, space.samples), FREE_ACTIVE) for space in spaces
         ]
@@ -1438,7 +1453,8 @@ def fit_primitive(
         sigma_x = normal_sigma(x)
         parts = point_chi2(point_z2(x, sigma_x), sigma_x, spread)
         free_parts = _swept_chi2(swept_residuals(x, spaces), spaces, spread)
-        prior = _extent_prior(model.name, x, p)
+        kept = np.isfinite(inlier_sigma(x, sigma_x))
+        prior = _extent_prior(model.name, x, p[kept] if np.any(kept) else p)
         return float(np.sum(parts) + np.sum(free_parts) + np.sum(prior**2))
 
     # each start fitted on the points alone (a smooth problem); with lines, also from each
@@ -1469,12 +1485,14 @@ def fit_primitive(
         trimmed = []
         for start in _starts(model, p[kept], direction, generator)[0]:
             try:
-                trimmed.append(fit(np.clip(start, low, high), apart, False, MAX_EVALUATIONS))
+                start = np.clip(start, low, high)
+                trimmed.append(fit(start, apart, False, MAX_EVALUATIONS, search=False))
             except ValueError:
                 continue
         trimmed.sort(key=lambda solution: solution.cost)
         candidates += [
-            refine(refine(s.x)) for s in trimmed[: REFINED_STARTS if link_evidence else 1]
+            refine(refine(s.x, exclude=False, leave_out=~kept))
+            for s in trimmed[: REFINED_STARTS if link_evidence else 1]
         ]
     x = model.canonical(min(candidates, key=total) if len(candidates) > 1 else candidates[0])
     distance = model.signed_distance(x, p)
@@ -1978,7 +1996,8 @@ def _scored(
         name=name,
         parameters=parameters,
         sizes=sizes,
-        rms=float(np.sqrt(np.mean(distance**2))),
+        # over the points it takes: one far point counted wrong says nothing of the shape
+        rms=float(np.sqrt(np.mean(distance[~wrong] ** 2 if np.any(~wrong) else distance**2))),
         chi2=chi2,
         line_chi2=line_chi2,
         swept_chi2=float(np.sum(sweeps**2)),
@@ -2059,7 +2078,18 @@ def _one_a_member_of_the_other(
     member = fit_primitive(fit.name, samples, tight, rng=generator)
     if not member.rms <= MEMBER_RMS_SHARE * size:
         return False
-    for name, value in member.sizes.items():
+    names = list(member.sizes)
+    values = [member.sizes[name] for name in names]
+    # a box's extents are named in increasing order, which a lower bound need not keep: any
+    # assignment of the mesh's extents to the fit's
+    orders = itertools.permutations(values) if fit.name == "box" else [values]
+    return any(_sizes_allowed(dict(zip(names, order, strict=True)), fit) for order in orders)
+
+
+def _sizes_allowed(sizes: Mapping[str, float], fit: ClassFit) -> bool:
+    """Whether ``sizes`` (m, by name) are among those ``fit`` allows: each within 3 standard
+    deviations of its size, at or above its lower bound, or not measured."""
+    for name, value in sizes.items():
         std = fit.size_std.get(name, math.inf)
         if name in fit.size_at_least:
             if value < fit.size_at_least[name] - 3.0 * (0.0 if math.isinf(std) else std):

@@ -31,6 +31,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.mapping.contact_map import UNHELD_FRACTION, ContactMap, ObjectSurface
+from sensing_antenna.mapping.recognition import PRIMITIVES
 
 __all__ = ["POINT_COLUMNS", "std_colours", "write_map"]
 
@@ -224,25 +225,50 @@ NAMED_WRONG = 5
 
 
 def _counted_wrong(contact_map: ContactMap) -> list[str]:
-    """A line naming the recordings whose points the best class counts wrong (at most
-    :data:`NAMED_WRONG`), with their distance from its fit; none when there are none."""
+    """A line naming the recordings whose points the named class counts wrong (at most
+    :data:`NAMED_WRONG`, farthest from its fit first), with their distance from it; none when
+    recognition names no class or its fit counts none wrong."""
     recognition = contact_map.recognition
-    if recognition is None or not recognition.best.wrong:
+    if recognition is None or recognition.undecided or not recognition.best.wrong:
         return []
     best = recognition.best
-    wrong = best.wrong[:NAMED_WRONG]
-    at = np.array([contact_map.used[k].point for k in wrong]).reshape(-1, 3)
+    at = np.array([contact_map.used[k].point for k in best.wrong]).reshape(-1, 3)
     distance = best.distances(at)
+    order = np.argsort(-distance)[:NAMED_WRONG]
     named = "; ".join(
-        f"{contact_map.used[k].source} ({1000 * d:.0f} mm from it)"
-        for k, d in zip(wrong, distance, strict=True)
+        f"{contact_map.used[best.wrong[k]].source} ({1000 * distance[k]:.0f} mm from it)"
+        for k in order
     )
-    more = len(best.wrong) - len(wrong)
+    more = len(best.wrong) - len(order)
     return [
         f"Points the {best.name.replace('mesh:', 'mesh ')}'s fit counts as wrong estimates (too"
-        f" far from it to be of it, left out of its shape): {named}"
+        f" far from it, or their links' lines from it, to be of it; left out of its shape):"
+        f" {named}"
         + (f"; and {more} more" if more > 0 else "")
         + ". Their base poses, or their estimates, to check."
+    ]
+
+
+def _member_note(recognition: Any) -> list[str]:
+    """A line when a user mesh is named with a class that fits the same points with sizes the
+    points do not measure, or only bound: what of the mesh they hold; none otherwise."""
+    best = recognition.best
+    if best.name in PRIMITIVES or recognition.undecided:
+        return []
+    fits = {f.name: f for f in recognition.fits}
+    loose = [
+        fits[name]
+        for name in recognition.same_shape
+        if name in PRIMITIVES
+        and (
+            fits[name].size_at_least
+            or any(not math.isfinite(v) for v in fits[name].size_std.values())
+        )
+    ]
+    return [
+        f"The {f.name} class fits the same points with {f.sizes_text()}: the mesh is one such"
+        f" {f.name}, and the points hold no more of its size than that."
+        for f in loose
     ]
 
 
@@ -364,6 +390,7 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
             )
             + ".",
             *(f"{text[:1].upper()}{text[1:]}." for text in (spread, wrong) if text),
+            *_member_note(recognition),
             *_counted_wrong(contact_map),
             "",
             "chi^2 counts the points, the links' lines and the swept links (docs/mapping.md),"
