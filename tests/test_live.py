@@ -1113,19 +1113,30 @@ def _heard(datagrams: list[bytes], count: int | None = None) -> list[dict[str, A
     return [e.to_dict() for e in events]
 
 
+def _at_rest(
+    recording: Recording, stream: str, step: float, datagrams: int, each: int
+) -> list[bytes]:
+    """The header of ``recording`` as ``stream`` and ``datagrams`` samples datagrams of
+    ``each`` rows at rest, stamped ``step`` s apart."""
+    header, _ = stream_of(recording)
+    rows = [_resting_row(recording, step * k) for k in range(datagrams * each)]
+    return [
+        Datagram("header", stream, 0, tuple(header.lines())).encode(),
+        *(
+            Datagram("samples", stream, k, tuple(rows[each * k : each * (k + 1)])).encode()
+            for k in range(datagrams)
+        ),
+    ]
+
+
 def test_a_sender_that_begins_its_stream_again_under_its_name_starts_a_recording(
     recordings: dict[str, Path],
 ) -> None:
     # A device restarted mid-recording that names its stream as before: its first header again
-    # and its samples numbered from 0 (three datagrams in order tell it) end the first
-    # recording, said in its end, and begin the next, heard whole
+    # and its samples numbered from 0 (the first carrying other lines than the stream's first
+    # did tells it) end the first recording, said in its end, and begin the next, heard whole
     recording = read_recording(recordings["azimuthal"])
-    header, _ = stream_of(recording)
-    rows = tuple(_resting_row(recording, 0.001 * k) for k in range(40))
-    first = [
-        Datagram("header", "s", 0, tuple(header.lines())).encode(),
-        *(Datagram("samples", "s", k, rows[10 * k : 10 * k + 10]).encode() for k in range(4)),
-    ]
+    first = _at_rest(recording, "s", 0.001, datagrams=4, each=10)
     said = _heard([*first, *_sent(recording, "s")], count=2)
     assert not [e for e in said if e["event"] == "skipped"]
     ends = [(e["recording"], e["reason"], e["samples"]) for e in said if e["event"] == "end"]
@@ -1164,12 +1175,7 @@ def test_a_stream_begun_again_after_its_recording_was_refused_is_heard_whole(
     # The first recording is refused at its end (10 samples stamped 20 % off its period); the
     # sender begins the stream again under its name, right: that recording is heard whole
     recording = read_recording(recordings["azimuthal"])
-    header, _ = stream_of(recording)
-    rows = tuple(_resting_row(recording, 0.0012 * k) for k in range(10))
-    first = [
-        Datagram("header", "s", 0, tuple(header.lines())).encode(),
-        *(Datagram("samples", "s", k, rows[5 * k : 5 * k + 5]).encode() for k in range(2)),
-    ]
+    first = _at_rest(recording, "s", 0.0012, datagrams=2, each=5)
     said = _heard([*first, *_sent(recording, "s")], count=1)
     assert next(e["reason"] for e in said if e["event"] == "skipped").startswith(
         "udp:127.0.0.1:9 stream s: sample_period: the stream declares 0.001 s"

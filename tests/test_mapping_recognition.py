@@ -13,6 +13,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 from scipy.stats import binom
 
+from _contacts import box_but_its_top
 from sensing_antenna.mapping import (
     UNDECIDED,
     ClassFit,
@@ -237,16 +238,7 @@ def test_a_users_box_mesh_is_named_where_the_box_class_leaves_a_height_untouched
     # of that box, one of the boxes that bound allows, fits it as well. The two are one answer:
     # the mesh is named, the box class counting with it, where they had abstained between them
     extents = np.array([0.06, 0.1, 0.16])
-    rng = np.random.default_rng(3)
-    faces = []
-    for axis in range(3):
-        for sense in (1.0, -1.0):
-            if axis == 2 and sense > 0:
-                continue
-            on_face = rng.uniform(-0.5, 0.5, (8, 3)) * extents
-            on_face[:, axis] = 0.5 * sense * extents[axis]
-            faces.append(on_face)
-    points = np.vstack(faces) + rng.normal(0.0, NOISE, (40, 3)) + [0.5, 0.1, 0.0]
+    points = box_but_its_top(extents, 8, seed=3)
     covariances = np.tile(np.eye(3) * NOISE**2, (40, 1, 1))
     block = trimesh.creation.box(extents=extents)
     result = recognise(points, covariances, meshes={"block": block}, rng=np.random.default_rng(0))

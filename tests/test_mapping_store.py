@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from _contacts import NOISE, contacts, half_sphere
+from _contacts import NOISE, box_but_its_top, contacts, half_sphere
 from sensing_antenna.mapping import build_map, recognise, write_map
 from sensing_antenna.mapping.store import GREY, OVERDISPERSED, overdispersed
 
@@ -143,16 +143,7 @@ def test_a_named_mesh_says_what_of_it_the_points_do_not_hold(tmp_path: Path) -> 
     # a box touched on five faces, its top never, and the user's mesh of it: the mesh is named,
     # and the report says the box class bounds its height only from below
     extents = np.array([0.06, 0.1, 0.16])
-    rng = np.random.default_rng(3)
-    faces = []
-    for axis in range(3):
-        for sense in (1.0, -1.0):
-            if axis == 2 and sense > 0:
-                continue
-            on_face = rng.uniform(-0.5, 0.5, (8, 3)) * extents
-            on_face[:, axis] = 0.5 * sense * extents[axis]
-            faces.append(on_face)
-    points = np.vstack(faces) + rng.normal(0.0, NOISE, (40, 3)) + [0.5, 0.1, 0.0]
+    points = box_but_its_top(extents, 8, seed=3)
     block = trimesh.creation.box(extents=extents)
     contact_map = build_map(contacts(points), meshes={"block": block})
     assert contact_map.recognition is not None
