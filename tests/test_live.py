@@ -1301,3 +1301,18 @@ def _listen_all(recording: Recording, antenna: Antenna) -> list[dict[str, Any]]:
 
     listen_lines(_lines(recording), make)
     return [e.to_dict() for e in events]
+
+
+def test_a_stream_begun_again_whose_first_datagrams_were_lost_is_told_by_its_numbers(
+    recordings: dict[str, Path],
+) -> None:
+    # The first recording's datagrams 0 to 2 were lost, so no lines of them to compare: the
+    # stream begun again is told by three datagrams numbered in order from 0 after its header
+    recording = read_recording(recordings["azimuthal"])
+    first = _at_rest(recording, "s", 0.001, datagrams=8, each=5)
+    said = _heard([first[0], *first[4:], *_sent(recording, "s")], count=2)
+    ends = [(e["recording"], e["reason"], e["samples"]) for e in said if e["event"] == "end"]
+    assert ends == [
+        (1, "the stream began again (datagrams from 0); 3 datagrams of samples lost", 25),
+        (2, "end of stream", recording.n_samples),
+    ]
