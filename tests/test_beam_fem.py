@@ -24,6 +24,7 @@ from scipy.linalg import eigh
 
 from sensing_antenna.antenna import Link
 from sensing_antenna.beam import eigenvalues, mode_shapes
+from sensing_antenna.beam.modes import support_compliance_coefficients
 
 ELEMENT_LENGTH = 1.0 / 100.0
 
@@ -305,3 +306,24 @@ def test_held_contact_coupling_scales_with_the_link_alone() -> None:
         assert float(held_contact_coupling(longer, 2.0 * xi)) == pytest.approx(
             2.0 * float(held_contact_coupling(base, xi)), rel=1e-9
         )
+
+
+@pytest.mark.parametrize("ratio", RATIOS)
+def test_support_compliance_coefficients_match_finite_element_reactions(ratio: float) -> None:
+    # A pin relaxed into a spring of stiffness k lowers Lambda_i = (beta_i l)^4 by R_i^2 / k at
+    # first order (Rayleigh), R_i the FE constraint force at the contact in the mass-normalised
+    # mode i; in the link's units omega_i falls by the fraction c_i / k with
+    # c_i = (E I / l^3) R_i^2 / (2 Lambda_i), here E I = 10 N m^2 and l = 1 m.
+    link = _link(ratio)
+    for xi in XI_GRID:
+        values, _, contact, full, big_k, big_m = _fe_modes(xi, ratio, 2, ELEMENT_LENGTH)
+        expected = []
+        for i in range(2):
+            reaction = float(((big_k - values[i] * big_m) @ full[:, i])[2 * contact])
+            expected.append(10.0 * reaction**2 / (2.0 * values[i]))
+        got = support_compliance_coefficients(link, xi, 2)
+        # 1e-3 of the larger coefficient: the mesh's h = 1/100 leaves 1e-4 in the shear jump
+        # (its third derivatives are the least converged), and a node of mode 2's shear
+        # (xi = 0.5 without a tip mass) makes c_2 vanish
+        scale = max(expected)
+        assert got == pytest.approx(expected, abs=1e-3 * scale), (xi, ratio)

@@ -25,6 +25,7 @@ __all__ = [
     "held_contact_coupling",
     "mode_shapes",
     "natural_frequencies",
+    "support_compliance_coefficients",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -309,4 +310,55 @@ def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
         # G = -(3 / xi^2) integral_0^xi (xi - u) phi du, Gauss-Legendre over the first span
         chord = -1.5 / span * float(weights @ ((span - u) * phi))
         out[index] = link.length * bending * chord / lam**4
+    return out
+
+
+def support_compliance_coefficients(link: Link, x_c: float, n_modes: int = 2) -> FloatArray:
+    """c_i (N/m): a support of finite stiffness k (N/m) at ``x_c`` in place of the pin lowers
+    omega_i by the fraction c_i / k, to first order in 1 / k.
+
+    Relaxing the pin into a spring, omega_i^2 falls by R_i^2 / k (Rayleigh), R_i the pin's
+    reaction in mode i normalised to unit modal mass: the jump of E I times the third
+    derivative of the mode at x_c. In the link's own units (u = s / l, phi of unit modal mass
+    relative to the link) that is
+
+        c_i = (E I / l^3) J_i^2 / (2 (beta_i l)^4),   J_i = phi_i'''(xi+) - phi_i'''(xi-),
+
+    E I = rho / T^2 with the frequency model's T (a calibrated T_e measures that ratio). A soft
+    object (foam, rubber, a stem) is such a support; a mode whose shear is continuous at x_c
+    (there a node of the free link's next mode) does not feel it.
+
+    Parameters
+    ----------
+    link : Link
+    x_c : float
+        Contact point in (0, l] (m).
+    n_modes : int
+        Number of modes, >= 1.
+
+    Returns
+    -------
+    ndarray
+        Shape ``(n_modes,)`` (N/m).
+    """
+    xi_arr = contact_ratio(link, x_c)
+    if xi_arr.ndim != 0:
+        raise BeamInputError("x_c", f"must be a single contact point, got shape {xi_arr.shape}")
+    xi = float(xi_arr)
+    n = check_mode_count(n_modes)
+    ratio = link.tip_mass_ratio
+    lams = eigenvalues(xi, n, ratio)
+    stiffness = 1.0 / (link.bending_compliance * link.length**3)
+    out = np.empty(n)
+    for i, lam_value in enumerate(lams):
+        lam = float(lam_value)
+        pieces = _mode_coefficients(lam, xi, ratio)
+        scale = _normalise(lam, pieces, ratio)
+        first_length, first = pieces[0]
+        left = float(_basis(3, lam, first_length, np.array([first_length]))[0] @ first)
+        right = 0.0
+        if len(pieces) > 1:
+            right = float(_basis(3, lam, pieces[1][0], np.zeros(1))[0] @ pieces[1][1])
+        jump = scale * (right - left)
+        out[i] = stiffness * jump**2 / (2.0 * lam**4)
     return out

@@ -88,6 +88,7 @@ from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.beam import SensingCurve, free_plane_shift, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
+from sensing_antenna.beam.modes import support_compliance_coefficients
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
@@ -97,11 +98,14 @@ from sensing_antenna.estimation.front.evidence import (
     sensing_curve,
 )
 from sensing_antenna.estimation.front.held import FAST_PACE, repeated_rows
+from sensing_antenna.estimation.front.spectrum import power_spectrum
 from sensing_antenna.estimation.front.spikes import WRENCH_CHANNELS
-from sensing_antenna.estimation.methods.paper.frequency import measure_frequency
+from sensing_antenna.estimation.methods.fast.parametric import fit_damped_sinusoids
+from sensing_antenna.estimation.methods.paper.frequency import find_peak, measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import (
     candidates_from_omega1,
     model_spread,
+    second_mode_band,
     second_peak,
 )
 from sensing_antenna.estimation.methods.touch_point import placement, touched_point_filtered
@@ -203,6 +207,14 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     stiffness = _mode_ratio_problem(evidence, estimate, end, notes) if judged else None
     if stiffness is not None:
         found.append((Status.MODEL_MISMATCH, stiffness))
+    pinned = _pinned_contact_problem(evidence, estimate, end, notes) if judged else None
+    if pinned is not None:
+        found.append((Status.UNCERTAIN, pinned))
+    # the damping speaks only where the second mode could not (a stiff contact's friction damps)
+    told = "second_mode_quality" in notes
+    lossy = _lossy_contact_problem(evidence, estimate, end, notes) if judged and not told else None
+    if lossy is not None:
+        found.append((Status.UNCERTAIN, lossy))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
     bent = _bent_link_problem(evidence, estimate, notes) if on_link else None
     if bent is not None:
@@ -233,6 +245,8 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if turn is not None:
         found.append((Status.MODEL_MISMATCH, turn))
     interval = _on_link(estimate.interval, link.length)
+    if pinned is not None or lossy is not None:
+        interval = _widened_to_statics(evidence, interval, end, notes)
     point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
         interval = _claimed(interval, estimate.status, notes)  # the method's own bad_input
@@ -483,6 +497,189 @@ def _mode_ratio_problem(
         f"{point:.3f} m +-{sigma_point:.3f} m ({100 * abs(point - x_c):.1f} cm from the "
         f"answer): the measured omega_1 is {100 * (scale - 1.0):+.1f} % off the model's there, "
         f"{cause}"
+    )
+
+
+def _pinned_contact_problem(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> str | None:
+    """Why the answer's omega_1 may be that of a contact that gives (a soft object), or None.
+
+    The sensing curves are a pinned contact's. A support of finite stiffness k at x_c lowers
+    omega_i by c_i / k to first order (:func:`~sensing_antenna.beam.modes.
+    support_compliance_coefficients`), and the second mode, whose reaction at the contact is
+    larger, by more: at 0.4 m on the paper's link c_1 = 7.9 N/m, c_2 = 17 N/m, so an object of
+    50 N/m puts omega_1's point 5 cm short while omega_2 / omega_1 falls 20 %; a lossy one
+    (foam) also damps the second mode out. A pinned contact rings its second mode at omega_1
+    times the model's omega_2 / omega_1 at the answer; the spectrum over the same samples as
+    check 3 (t_1 to the estimate's t_e, at most Delta t_e1) must hold a clear peak
+    (``min_peak_quality`` times the median of the band :func:`second_mode_band` searches,
+    widened to the window) within ``disagreement_sigmas`` of the ratio's uncertainty (as
+    :func:`_mode_ratio_problem` takes it) of there. Judged only where that window tells: no
+    harmonic of omega_1 (2 or 3 omega_1) within the spectrum's resolution of it (near 0.73 m
+    2 omega_1 meets omega_2, near 0.63, 0.84 and 0.98 m 3 omega_1), and a
+    support soft enough to move omega_1's point by ``max_model_spread`` moves omega_2 /
+    omega_1 by at least one of its standard uncertainties (not where the contact sits on a
+    node of the second mode's shear, as near 0.49 m, nor where omega_2 moves with omega_1,
+    as near 0.9 m). Notes ``second_mode_quality`` (the best peak's quality in the window)
+    and ``support_coefficients`` (c_1, c_2, N/m).
+    """
+    x_c, omega1 = estimate.x_c, estimate.omega1
+    cfg = evidence.config
+    link = evidence.antenna.link
+    if estimate.method == "ratio" or not (math.isfinite(x_c) and math.isfinite(omega1)):
+        return None
+    if evidence.bent_link_uncertainty(x_c) > cfg.max_model_spread:
+        return None
+    points, omegas = evidence.contact_modes
+    if not points[0] <= x_c <= points[-1]:
+        return None
+    coefficients = support_compliance_coefficients(link, x_c, 2)
+    c_1, c_2 = float(coefficients[0]), float(coefficients[1])
+    measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
+    u = max(cfg.mode_ratio_uncertainty, measured)
+    slope = abs(float(sensing_curve(link).omega1_slope(x_c)))
+    # the stiffest support that moves omega_1's point by max_model_spread (inf at the top)
+    reach = slope * cfg.max_model_spread / omega1
+    if c_1 > 0.0 and reach > 0.0 and (c_2 - c_1) * reach / c_1 < u:
+        return None
+    ratio = float(np.interp(x_c, points, omegas[:, 1] / omegas[:, 0]))
+    expected = ratio * omega1
+    half = cfg.disagreement_sigmas * u
+    window = (expected / (1.0 + half), expected * (1.0 + half))
+    stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
+    samples = slice(evidence.rest_index, stop + 1)
+    if samples.stop - samples.start < 4:
+        return None
+    # a harmonic of omega_1 (a clipping contact's) within the spectrum's resolution of the
+    # window, the Hann main lobe's half-width 4 pi / duration, merges with the mode: unreadable
+    resolution = 4.0 * math.pi / ((samples.stop - samples.start) * evidence.sample_period)
+    if any(abs(k * omega1 - expected) < half * expected + resolution for k in (2.0, 3.0)):
+        return None
+    component = str(estimate.diagnostics.get("torque_component", "sum"))
+    projected = evidence.torque[samples] @ evidence.frame.axes_m[1:].T
+    omega, power = power_spectrum(projected, evidence.sample_period, cfg.zero_padding)
+    spectrum = {"y_c": power[:, 0], "z_c": power[:, 1]}.get(component, power.sum(axis=1))
+    low, high = second_mode_band(evidence, omega1)
+    band = (omega >= min(low, window[0])) & (omega <= max(high, window[1]))
+    if not np.any(band):
+        return None  # the second mode lies past the spectrum
+    floor = float(np.median(spectrum[band]))
+    peak = find_peak(omega, spectrum, window)
+    quality = peak.power / floor if peak is not None and floor > 0.0 else 0.0
+    notes["second_mode_quality"] = quality
+    notes["support_coefficients"] = (c_1, c_2)
+    if quality >= cfg.min_peak_quality:
+        return None
+    return (
+        f"no second contact mode where a pinned contact at the answer {x_c:.3f} m rings it: "
+        f"omega_1 {omega1:.1f} rad/s times the model's omega_2 / omega_1 = {ratio:.3f} puts it "
+        f"at {expected:.0f} rad/s, and the spectrum holds no clear peak within "
+        f"{100 * half:.0f} % of it (best {quality:.1f} times the median, "
+        f"{cfg.min_peak_quality:g} asked). A contact that gives (a soft object: foam, rubber, a "
+        f"stem) moves and damps the second mode and lowers omega_1 by {c_1:.1f} N/m over its "
+        f"stiffness: at 100 N/m omega_1's point moves "
+        f"{100 * c_1 / 100.0 * omega1 / slope if slope > 0 else math.inf:.1f} cm towards "
+        "lower omega_1"
+    )
+
+
+#: How far the link's own damping ratio in a contact mode is taken to exceed the free mode's
+#: (the free-motion observer's, Eq. 15): a material's loss factor changes little over the 2 to
+#: 20 Hz of the first contact modes, and a pin that holds the link takes no energy from it
+#: (an assumption, not a measured bound: docs/design-notes.md, "A slightly soft object").
+_OWN_DAMPING_FACTOR = 2.0
+
+
+def _widened_to_statics(
+    evidence: Evidence, interval: tuple[float, float] | None, end: int, notes: dict[str, Any]
+) -> tuple[float, float] | None:
+    """``interval`` widened to hold the statics' reading at ``end`` within
+    ``disagreement_sigmas`` of its uncertainty (noise, tare, statics model and the bent link at
+    the reading), when the vibration's point may be a contact that gives: a support's give moves
+    omega_1 by an amount nothing measured bounds, the torque/force ratio hardly (the object's
+    compliance is in series with the push, not in the lever). The interval before goes to
+    ``notes["interval_before_support"]``. None stays None: a method that gives no interval
+    is not given one."""
+    if interval is None or not end < evidence.ratio_mean.shape[0]:
+        return interval
+    reading = float(evidence.ratio_mean[end])
+    if not math.isfinite(reading) or reading <= 0.0:
+        return interval
+    sigma = math.hypot(evidence.ratio_uncertainty(reading), evidence.bent_link_uncertainty(reading))
+    reach = evidence.config.disagreement_sigmas * sigma
+    length = evidence.antenna.link.length
+    widened = (
+        max(0.0, min(interval[0], reading - reach)),
+        min(length, max(interval[1], reading + reach)),
+    )
+    if widened != interval:
+        notes["interval_before_support"] = interval
+    return widened
+
+
+def _lossy_contact_problem(
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
+) -> str | None:
+    """Why the fundamental's ringing loses energy at the contact, or None.
+
+    A pin holds the contact point still and takes no energy from the ringing; a contact that
+    gives (foam, rubber, a stem: lossy as well as soft) moves with it and damps it. The
+    fundamental's decay rate over the samples check 3 reads (t_1 to the estimate's t_e, at most
+    Delta t_e1) is fitted with a second mode and a quadratic static part to the torque about
+    Y^c and Z^c (:func:`~.methods.fast.parametric.fit_damped_sinusoids`); its damping ratio may
+    exceed the link's own, the free-motion observer's (``observer.damping_ratio``), by
+    :data:`_OWN_DAMPING_FACTOR`, plus ``disagreement_sigmas`` of its standard error. Beyond,
+    the contact gives and omega_1 reads low by an amount the damping does not tell (a
+    support's loss over its stiffness): ``uncertain``. A lossless soft support does not show
+    here (:func:`_pinned_contact_problem` sees its second mode). Asked only where that check
+    could not judge (the contact on a node of the second mode's shear, near 0.44 to 0.55 m and
+    0.85 to 0.90 m on the paper's link; a harmonic over the second mode; a bent link): where the
+    second mode rings in place it bounds the support's give, and a fundamental that still
+    decays fast loses its energy to a stiff contact's friction (a box edge's, an answer 1.4 mm
+    from the contact at 4 times the link's own damping), which moves omega_1 little. Notes
+    ``fundamental_damping`` (ratio, standard error).
+    """
+    omega1 = estimate.omega1
+    cfg = evidence.config
+    if estimate.method == "ratio" or not (math.isfinite(estimate.x_c) and math.isfinite(omega1)):
+        return None
+    own = evidence.antenna.observer.damping_ratio
+    if not own > 0.0:
+        return None
+    stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
+    samples = slice(evidence.rest_index, stop + 1)
+    projected = evidence.torque[samples] @ evidence.frame.axes_m[1:].T
+    try:
+        fit = fit_damped_sinusoids(
+            projected,
+            evidence.sample_period,
+            2,
+            min_omega=0.5 * omega1,
+            degree=2,
+            target_band=(omega1 / 1.1, omega1 * 1.1),
+        )
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    if fit is None or not fit.converged:
+        return None
+    k = int(np.argmin(np.abs(fit.omega - omega1)))
+    if abs(float(fit.omega[k]) / omega1 - 1.0) > 0.05:
+        return None  # not the answer's fundamental
+    zeta = float(fit.decay[k] / fit.omega[k])
+    sigma = float(fit.decay_se[k] / fit.omega[k])
+    if not (math.isfinite(zeta) and math.isfinite(sigma)):
+        return None
+    notes["fundamental_damping"] = (zeta, sigma)
+    bar = _OWN_DAMPING_FACTOR * own
+    if not zeta - cfg.disagreement_sigmas * sigma > bar:
+        return None
+    return (
+        f"the fundamental decays with a damping ratio of {zeta:.4f} +-{sigma:.4f}, more than "
+        f"{_OWN_DAMPING_FACTOR:g} times the link's own in free motion ({own:.4f}, the "
+        "observer's): the ringing loses energy at the contact, which a pin does not take. A "
+        "contact that gives (a soft object: foam, rubber, a stem) lowers omega_1, and the "
+        "answer with it, by an amount the damping does not tell"
     )
 
 
