@@ -417,9 +417,7 @@ def _mode_ratio_problem(
     x_c, omega1 = estimate.x_c, estimate.omega1
     cfg = evidence.config
     link = evidence.antenna.link
-    if estimate.method == "ratio" or not (math.isfinite(x_c) and math.isfinite(omega1)):
-        return None
-    if evidence.bent_link_uncertainty(x_c) > cfg.max_model_spread:
+    if not _modes_judge(evidence, estimate):
         return None
     settled = evidence.converged_index
     reading = math.nan
@@ -436,8 +434,7 @@ def _mode_ratio_problem(
         return None  # the curve is tabulated over the contact range only
     curve = omegas[:, 1] / omegas[:, 0]
     ratio = peak.omega / omega1
-    measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
-    sigma = max(cfg.mode_ratio_uncertainty, measured) * ratio
+    sigma = _mode_ratio_share(evidence) * ratio
     misfit = np.abs(curve - ratio) / sigma
     limit = cfg.disagreement_sigmas
     own = model_spread(link, x_c, link.frequency_uncertainty)
@@ -500,6 +497,33 @@ def _mode_ratio_problem(
     )
 
 
+def _modes_judge(evidence: Evidence, estimate: ContactEstimate) -> bool:
+    """Whether the contact modes' curves can judge the answer: a method that reads omega_1 (not
+    ``ratio``), a finite answer, and a bent link's preload that moves the vibration's point by no
+    more than ``max_model_spread`` (the curves are the straight link's)."""
+    if estimate.method == "ratio" or not (
+        math.isfinite(estimate.x_c) and math.isfinite(estimate.omega1)
+    ):
+        return False
+    return evidence.bent_link_uncertainty(estimate.x_c) <= evidence.config.max_model_spread
+
+
+def _mode_ratio_share(evidence: Evidence) -> float:
+    """The standard uncertainty of omega_2 / omega_1 as a share of it: ``mode_ratio_uncertainty``,
+    or a calibration's measured scatters of omega_1 and omega_2 in quadrature when larger."""
+    link = evidence.antenna.link
+    measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
+    return max(evidence.config.mode_ratio_uncertainty, measured)
+
+
+def _check3_window(evidence: Evidence, end: int) -> slice:
+    """The samples check 3 reads: from t_1 to ``end`` (the estimate's t_e), at most Delta t_e1
+    (``spectrum_window``)."""
+    cfg = evidence.config
+    stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
+    return slice(evidence.rest_index, stop + 1)
+
+
 def _pinned_contact_problem(
     evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
 ) -> str | None:
@@ -527,17 +551,14 @@ def _pinned_contact_problem(
     x_c, omega1 = estimate.x_c, estimate.omega1
     cfg = evidence.config
     link = evidence.antenna.link
-    if estimate.method == "ratio" or not (math.isfinite(x_c) and math.isfinite(omega1)):
-        return None
-    if evidence.bent_link_uncertainty(x_c) > cfg.max_model_spread:
+    if not _modes_judge(evidence, estimate):
         return None
     points, omegas = evidence.contact_modes
     if not points[0] <= x_c <= points[-1]:
         return None
     coefficients = support_compliance_coefficients(link, x_c, 2)
     c_1, c_2 = float(coefficients[0]), float(coefficients[1])
-    measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
-    u = max(cfg.mode_ratio_uncertainty, measured)
+    u = _mode_ratio_share(evidence)
     slope = abs(float(sensing_curve(link).omega1_slope(x_c)))
     # the stiffest support that moves omega_1's point by max_model_spread (inf at the top)
     reach = slope * cfg.max_model_spread / omega1
@@ -547,8 +568,7 @@ def _pinned_contact_problem(
     expected = ratio * omega1
     half = cfg.disagreement_sigmas * u
     window = (expected / (1.0 + half), expected * (1.0 + half))
-    stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
-    samples = slice(evidence.rest_index, stop + 1)
+    samples = _check3_window(evidence, end)
     if samples.stop - samples.start < 4:
         return None
     # a harmonic of omega_1 (a clipping contact's) within the spectrum's resolution of the
@@ -647,8 +667,7 @@ def _lossy_contact_problem(
     own = evidence.antenna.observer.damping_ratio
     if not own > 0.0:
         return None
-    stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
-    samples = slice(evidence.rest_index, stop + 1)
+    samples = _check3_window(evidence, end)
     projected = evidence.torque[samples] @ evidence.frame.axes_m[1:].T
     try:
         fit = fit_damped_sinusoids(
@@ -1400,8 +1419,7 @@ def _vibration_problems(
     omega1 = estimate.omega1
     if not math.isfinite(omega1):
         # Estimator 1 over the samples from t_1 to the estimate's t_e (at most Delta t_e1)
-        stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
-        window = slice(evidence.rest_index, stop + 1)
+        window = _check3_window(evidence, end)
         measurement = measure_frequency(
             evidence.torque[window],
             evidence.frame.axes_m,
