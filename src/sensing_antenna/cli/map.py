@@ -238,7 +238,7 @@ def _spelled_like(key: str, name: str) -> bool:
     import difflib
 
     plain = key.strip().lower().replace("-", "_").replace(" ", "_")
-    return key != name and difflib.SequenceMatcher(None, plain, name).ratio() >= 0.8
+    return key != name and bool(difflib.get_close_matches(plain, [name], n=1, cutoff=0.8))
 
 
 def note_unposed(unposed: list[str], count: int) -> list[str]:
