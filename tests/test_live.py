@@ -38,7 +38,13 @@ from sensing_antenna.live.events import (
     Event,
     PushEvent,
 )
-from sensing_antenna.live.inputs import INTERRUPTED_WAIT, listen_lines, listen_udp
+from sensing_antenna.live.inputs import (
+    INTERRUPTED_WAIT,
+    REORDER_DEPTH,
+    REORDER_WAIT,
+    listen_lines,
+    listen_udp,
+)
 from sensing_antenna.live.listener import Listener
 from sensing_antenna.live.record import RecordWriter
 from sensing_antenna.live.replay import replay_datagrams, replay_lines, stream_of
@@ -72,6 +78,16 @@ def _resting_row(recording: Recording, t: float) -> str:
     """A sample at rest (the link's weight on the sensor) at ``t`` (s), with a cell for each of
     the recording's columns (its extra columns zero)."""
     return ",".join([repr(t), "0,0,0,0,-0.0451,0,0.0221,0", *("0" * len(recording.extra))])
+
+
+def _t(k: int) -> float:
+    """The time stamp (s) of sample k at 1 kHz, as the tests' rows write it."""
+    return round(0.001 * k, 3)
+
+
+def _at(row: str, k: int) -> str:
+    """A resting row (stamped 0.0) stamped as sample k."""
+    return row.replace("0.0,", f"{_t(k)!r},", 1)
 
 
 def _cells(recording: Recording) -> int:
@@ -274,6 +290,8 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
     recording = read_recording(recordings["azimuthal"])
     header, _ = stream_of(recording)
     row = _resting_row(recording, 0.0)
+    last = REORDER_DEPTH + 2
+    waiting = [Datagram("samples", "b", k, (_at(row, k),)).encode() for k in range(2, last + 1)]
     events = _heard_over_udp(
         [
             b"hello",
@@ -281,13 +299,13 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
             Datagram("samples", "b", 0, (row,)).encode(),  # before its header: waits
             Datagram("header", "b", 0, tuple(header.lines())).encode(),
             Datagram("samples", "b", 0, (row, "0.001,x")).encode(),
-            Datagram("samples", "b", 2, (row.replace("0.0,", "0.002,", 1),)).encode(),
+            *waiting,  # for datagram 1, until too many wait
             Datagram("samples", "b", 1, (row,)).encode(),  # late
             # a stamp a day ahead: left out, not kept to leave the good ones after it behind
-            Datagram("samples", "b", 3, (row.replace("0.0,", "86400.0,", 1),)).encode(),
-            Datagram("samples", "b", 4, (row.replace("0.0,", "0.003,", 1),)).encode(),
-            Datagram("samples", "b", 4, (row.replace("0.0,", "0.003,", 1),)).encode(),  # again
-            Datagram("end", "b", 5).encode(),
+            Datagram("samples", "b", last + 1, (row.replace("0.0,", "86400.0,", 1),)).encode(),
+            Datagram("samples", "b", last + 2, (_at(row, last + 2),)).encode(),
+            Datagram("samples", "b", last + 2, (_at(row, last + 2),)).encode(),  # again
+            Datagram("end", "b", last + 3).encode(),
         ],
         recording,
     )
@@ -299,11 +317,11 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
         f"stream b: datagram 0 sample line 2 of 2: expected {_cells(recording)} cells, found 2"
         in reasons
     )
-    assert "stream b: datagram 1 arrived after 2: left out" in reasons
-    assert "stream b: datagram 4 arrived again: left out" in reasons
-    assert "datagram 3: time 86400.0 s jumps from 0.002 s by more than" in reasons
+    assert f"stream b: datagram 1 arrived after {last}: left out" in reasons
+    assert f"stream b: datagram {last + 2} arrived again: left out" in reasons
+    assert f"datagram {last + 1}: time 86400.0 s jumps from {_t(last)!r} s by more than" in reasons
     end = first[-1]
-    assert end["event"] == "end" and end["samples"] == 3
+    assert end["event"] == "end" and end["samples"] == REORDER_DEPTH + 3
     assert end["reason"] == "end of stream; 1 datagram of samples lost"
     assert [e["status"] for e in first if e["event"] == "estimate"] == ["bad_input"]
 
@@ -1065,22 +1083,34 @@ def test_an_interruption_ends_the_recording_in_progress_with_its_events(
 
 
 class _Datagrams:
-    """A bound socket's stand-in that receives ``datagrams``, then raises ``then``."""
+    """A bound socket's stand-in that receives ``datagrams``, then raises ``then``; a number
+    among them is a silence of that many seconds (its time out), on the clock :meth:`now`
+    (0.1 ms between datagrams)."""
 
-    def __init__(self, datagrams: list[bytes], then: BaseException) -> None:
+    def __init__(self, datagrams: list[bytes | float], then: BaseException) -> None:
         self.datagrams = list(datagrams)
         self.then = then
+        self.time = 0.0
+        self.timeouts: list[float] = []
 
     def getsockname(self) -> tuple[str, int]:
         return ("127.0.0.1", 9)
 
     def settimeout(self, seconds: float) -> None:
-        pass
+        self.timeouts.append(seconds)
+
+    def now(self) -> float:
+        return self.time
 
     def recv(self, size: int) -> bytes:
         if not self.datagrams:
             raise self.then
-        return self.datagrams.pop(0)
+        item = self.datagrams.pop(0)
+        if isinstance(item, float):
+            self.time += item
+            raise TimeoutError
+        self.time += 1e-4
+        return item
 
 
 class _Sent:
@@ -1100,16 +1130,17 @@ def _sent(recording: Recording, stream: str) -> list[bytes]:
     return sent.datagrams
 
 
-def _heard(datagrams: list[bytes], count: int | None = None) -> list[dict[str, Any]]:
+def _heard(datagrams: list[bytes | float], count: int | None = None) -> list[dict[str, Any]]:
     """The events of a UDP listener (``ratio``) sent ``datagrams`` (then interrupted, unless
-    ``count`` recordings ended first)."""
+    ``count`` recordings ended first; a number among them is a silence, :class:`_Datagrams`)."""
     events: list[Event] = []
 
     def make(stream: StreamHeader, number: int) -> Listener:
         return Listener(stream, paper_antenna(), events.append, "ratio", number=number)
 
+    sock = _Datagrams(datagrams, KeyboardInterrupt())
     with pytest.raises(KeyboardInterrupt) if count is None else contextlib.nullcontext():
-        listen_udp(_Datagrams(datagrams, KeyboardInterrupt()), make, events.append, count)  # type: ignore[arg-type]
+        listen_udp(sock, make, events.append, count, clock=sock.now)  # type: ignore[arg-type]
     return [e.to_dict() for e in events]
 
 
@@ -1316,3 +1347,52 @@ def test_a_stream_begun_again_whose_first_datagrams_were_lost_is_told_by_its_num
         (1, "the stream began again (datagrams from 0); 3 datagrams of samples lost", 25),
         (2, "end of stream", recording.n_samples),
     ]
+
+
+def test_datagrams_out_of_order_are_taken_in_their_place(recordings: dict[str, Path]) -> None:
+    # A network that delivers one datagram in 40 a place late and one in 97 three places late:
+    # each waits for its turn, the recording is heard whole and estimated as the file is
+    recording = read_recording(recordings["vertical"])
+    sent = _sent(recording, "v")
+    order = list(range(len(sent)))
+    for k in range(20, len(order) - 10, 40):
+        order[k], order[k + 1] = order[k + 1], order[k]
+    for k in range(57, len(order) - 10, 97):
+        order[k : k + 4] = [*order[k + 1 : k + 4], order[k]]
+    assert order != sorted(order)
+    said = _heard([sent[k] for k in order], count=1)
+    assert not [e for e in said if e["event"] == "skipped"]
+    end = said[-1]
+    assert (end["reason"], end["samples"], end["dropped"]) == (
+        "end of stream",
+        recording.n_samples,
+        0,
+    )
+    found = next(e for e in said if e["event"] == "estimate")
+    _same_estimate(found, estimate(recording, paper_antenna(), "ratio").to_dict())
+
+
+@pytest.mark.parametrize("silence", [0.5, 2.0])
+def test_a_datagram_waits_no_longer_than_the_reorder_wait(
+    recordings: dict[str, Path], silence: float
+) -> None:
+    # Datagram 1 is missing when datagram 2 arrives: 2 waits for it while the sender is silent
+    # for REORDER_WAIT (half of it: 2 still waits, and 1 is taken in its place; twice: 1 is
+    # counted lost and, when it comes, left out as late)
+    recording = read_recording(recordings["azimuthal"])
+    sent = _sent(recording, "s")
+    header, zero, one, two = sent[:4]  # the header, then samples datagrams 0, 1 and 2
+    said = _heard([header, zero, two, silence * REORDER_WAIT, one, *sent[4:]], count=1)
+    skipped = [e["reason"] for e in said if e["event"] == "skipped"]
+    end = said[-1]
+    if silence < 1:
+        assert not skipped
+        assert (end["reason"], end["samples"]) == ("end of stream", recording.n_samples)
+    else:
+        assert skipped == ["stream s: datagram 1 arrived after 2: left out"]
+        lost = len(decode_datagram(one).lines)
+        assert (end["reason"], end["samples"], end["dropped"]) == (
+            "end of stream; 1 datagram of samples lost",
+            recording.n_samples - lost,
+            lost,
+        )

@@ -8,13 +8,13 @@ estimates run in each listener's worker thread.
 Standard input is trusted as a file is: a malformed line or a time that does not increase
 stops the reader with a :class:`~sensing_antenna.recording.RecordingError` naming the line. A
 UDP port receives whatever anyone sends it: a datagram not in the format, a malformed line, a
-late datagram, a time that does not increase or one that jumps ahead beyond any filling (an
-outlier stamp, which would leave every good sample after it behind), a recording first heard
-after its start is left out with a
-:class:`~.events.SkippedEvent` saying why, and listening goes on. A stream its sender began
-again under the same name (its first header, then datagrams numbered from 0 again) ends the
-recording and begins the next. Ctrl-C or a stop signal ends the recording being received with
-its final events (:data:`INTERRUPTED_WAIT`).
+datagram whose turn has gone, a time that does not increase or one that jumps ahead beyond any
+filling (an outlier stamp, which would leave every good sample after it behind), a recording
+first heard after its start is left out with a :class:`~.events.SkippedEvent` saying why, and
+listening goes on. Datagrams out of order wait for their turn (:data:`REORDER_DEPTH`). A
+stream its sender began again under the same name (its first header, then datagrams numbered
+from 0 again) ends the recording and begins the next. Ctrl-C or a stop signal ends the
+recording being received with its final events (:data:`INTERRUPTED_WAIT`).
 """
 
 from __future__ import annotations
@@ -43,6 +43,8 @@ from sensing_antenna.recording import RecordingError
 __all__ = [
     "IDLE_END",
     "INTERRUPTED_WAIT",
+    "REORDER_DEPTH",
+    "REORDER_WAIT",
     "MakeListener",
     "listen_lines",
     "listen_udp",
@@ -57,6 +59,15 @@ IDLE_END = 2.0
 #: end event: a reader of the events that stopped reading (its pipe full) must not hold the
 #: process (a fast method's final estimate takes well under a second).
 INTERRUPTED_WAIT = 2.0
+
+#: A UDP datagram that arrives before one numbered below it waits for it, with those after it,
+#: until this many wait or the first waited :data:`REORDER_WAIT`: a network delivers datagrams
+#: out of order, mostly by a place or two (left out, a late datagram's samples would be put
+#: back by interpolation). Then the missing one counts as lost.
+REORDER_DEPTH = 8
+
+#: The longest a datagram waits (s) for one numbered below it (:data:`REORDER_DEPTH`).
+REORDER_WAIT = 0.02
 
 #: Samples left out in a row for their time stamps after which the stream is left out: its
 #: samples no longer follow one time line (the sender's clock stepped, or an outlier came first).
@@ -209,6 +220,12 @@ class _UdpStream:
         self.again: Datagram | None = None  # a first header after samples of the stream
         self.held: list[tuple[Datagram, float]] = []  # datagrams numbered below, since then
         self.first: dict[int, tuple[str, ...]] = {}  # the lines of its first datagrams taken
+        self.ahead: dict[int, tuple[Datagram, float]] = {}  # waiting for one numbered below
+
+    @property
+    def reached(self) -> int:
+        """The number after the highest of the stream's datagrams heard (taken or waiting)."""
+        return max(self.expected, max(self.ahead, default=-1) + 1)
 
     def close(self, reason: str, wait: float | None = None) -> None:
         if self.lost:
@@ -235,7 +252,7 @@ def listen_udp(
     ended = 0  # recordings ended, not counting streams left out (what ``count`` counts)
     refused: set[str] = set()  # streams left out, ignored until their end
     joined: set[str] = set()  # streams heard (one that resumes after the idle end is known)
-    sock.settimeout(min(idle, 0.2))
+    sock.settimeout(min(idle, 0.2))  # shorter while datagrams wait (REORDER_WAIT)
 
     def skip(reason: str) -> None:
         on_event(SkippedEvent(numbered if current is not None else numbered + 1, reason))
@@ -283,13 +300,17 @@ def listen_udp(
         joined.add(name)
         return True
 
-    def take(datagram: Datagram, received: float) -> None:
-        """The samples of ``datagram`` to the recording being received; the stream left out
-        when its time stamps no longer follow one time line."""
+    def take(datagram: Datagram | None, received: float, flush: bool = False) -> None:
+        """The samples of ``datagram`` to the recording being received, in their order
+        (:data:`REORDER_DEPTH`; None: those waiting whose wait is over at ``received``, all
+        of them with ``flush``); the stream left out when its time stamps no longer follow one
+        time line."""
         nonlocal current
         assert current is not None
         try:
-            _receive_samples(current, datagram, received, skip)
+            if datagram is not None:
+                _arrive(current, datagram, received, skip)
+            _release(current, received, skip, flush)
         except WireError as exc:
             skip(f"{exc}: the stream is left out")
             refused.add(current.name)
@@ -297,8 +318,16 @@ def listen_udp(
             current = None
 
     def finish(stream: _UdpStream, reason: str) -> int:
-        """End ``stream``: 1, or 0 when the listener refused it (its period, say): skipped,
-        not fatal (other streams may follow) and not counted."""
+        """End ``stream`` (the datagrams waiting taken first): 1, or 0 when the listener
+        refused it (its period, say): skipped, not fatal (other streams may follow) and not
+        counted."""
+        try:
+            _release(stream, clock(), skip, flush=True)
+        except WireError as exc:
+            skip(f"{exc}: the stream is left out")
+            refused.add(stream.name)
+            _close_quietly(stream.listener)
+            return 0
         try:
             stream.close(reason)
         except WireError as exc:
@@ -308,13 +337,19 @@ def listen_udp(
         return 1
 
     try:
+        timeout = min(idle, 0.2)
         while count is None or ended < count:
+            waiting = current is not None and bool(current.ahead)
+            if timeout != (wanted := REORDER_WAIT if waiting else min(idle, 0.2)):
+                sock.settimeout(timeout := wanted)
             try:
                 data = sock.recv(MAX_DATAGRAM_BYTES + 1)
             except TimeoutError:
                 if current is not None and clock() - current.heard > idle:
                     ended += finish(current, f"no datagram for {idle:g} s")
                     current = None
+                elif current is not None and current.ahead:
+                    take(None, clock())
                 continue
             received = clock()
             try:
@@ -330,7 +365,7 @@ def listen_udp(
             if ours:
                 assert current is not None
                 current.heard = received
-                if datagram.kind == "header" and datagram.seq == 0 < current.expected:
+                if datagram.kind == "header" and datagram.seq == 0 < current.reached:
                     # a stream's first header after samples of it: a copy come late, or the
                     # sender began the stream again under its name, as its next samples tell
                     try:
@@ -342,7 +377,7 @@ def listen_udp(
                     continue
                 if current.again is not None:
                     again, held = current.again, current.held
-                    if datagram.kind != "header" and datagram.seq < current.expected:
+                    if datagram.kind != "header" and datagram.seq < current.reached:
                         held.append((datagram, received))
                         if datagram.kind == "samples" and not _begun_again(held, current.first):
                             continue  # held until their numbers or lines tell
@@ -373,13 +408,18 @@ def listen_udp(
                 continue  # a repeated header, or samples of a stream not joined
             elif datagram.kind == "end":
                 assert current is not None
-                current.lost += max(0, datagram.seq - current.expected)
-                ended += finish(current, "end of stream")
-                current = None
+                take(None, received, flush=True)
+                if current is not None:
+                    current.lost += max(0, datagram.seq - current.expected)
+                    ended += finish(current, "end of stream")
+                    current = None
             else:
                 take(datagram, received)
         return ended
     except BaseException as exc:
+        if current is not None and interruption_of(exc) is not None:
+            with contextlib.suppress(Exception):
+                take(None, clock(), flush=True)  # the datagrams waiting are the recording's
         if current is not None and _close_interrupted(exc, current.close):
             current = None
         raise
@@ -405,6 +445,39 @@ def _begun_again(held: list[tuple[Datagram, float]], first: dict[int, tuple[str,
         and numbers[0] < _BEGUN_AGAIN
         and all(a < b for a, b in itertools.pairwise(numbers))
     )
+
+
+def _arrive(
+    current: _UdpStream, datagram: Datagram, received: float, skip: Callable[[str], None]
+) -> None:
+    """A samples datagram of the stream: taken when its turn has come or gone, else waiting
+    for those numbered below it (:data:`REORDER_DEPTH`)."""
+    if datagram.seq <= current.expected:
+        _receive_samples(current, datagram, received, skip)
+    elif datagram.seq in current.ahead:
+        skip(f"stream {current.name}: datagram {datagram.seq} arrived again: left out")
+    else:
+        current.ahead[datagram.seq] = (datagram, received)
+
+
+def _release(
+    current: _UdpStream, now: float, skip: Callable[[str], None], flush: bool = False
+) -> None:
+    """The datagrams waiting whose turn has come, in order; those numbered below them counted
+    lost when :data:`REORDER_DEPTH` wait, the first waited :data:`REORDER_WAIT` at ``now``
+    (s), or ``flush``."""
+    ahead = current.ahead
+    while ahead:
+        first = min(ahead)
+        over = (
+            flush
+            or len(ahead) > REORDER_DEPTH
+            or now - min(when for _, when in ahead.values()) > REORDER_WAIT
+        )
+        if first != current.expected and not over:
+            return
+        datagram, received = ahead.pop(first)
+        _receive_samples(current, datagram, received, skip)
 
 
 def _receive_samples(
