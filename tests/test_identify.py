@@ -281,12 +281,21 @@ def _glitch(recording: Recording) -> Recording:
     return dataclasses.replace(recording, theta=theta)
 
 
+def _force_glitch_at_rest(recording: Recording) -> Recording:
+    """A force sample at rest of 1e266 N, the torques' signs flipped: the rest check's search
+    for a push across the link squared it (found by the fuzz run)."""
+    force = recording.force.copy()
+    force[50, 1] = 1e266
+    return dataclasses.replace(recording, force=force, torque=-recording.torque)
+
+
 @pytest.mark.parametrize(
     ("make", "column"),
     [
         (lambda r: _scaled(r, wrench=1e-300), "'tx', 'ty', 'tz'"),
         (lambda r: _scaled(r, wrench=1e300), "'tx', 'ty', 'tz'"),
         (_glitch, "'theta1'"),
+        (_force_glitch_at_rest, "'fx', 'fy', 'fz'"),
         # no rest at the start to read the weight from: the fit itself must not overflow
         (
             lambda r: dataclasses.replace(
@@ -300,7 +309,13 @@ def _glitch(recording: Recording) -> Recording:
             "'theta1', 'theta2', 'ty', 'tz'",
         ),
     ],
-    ids=["wrench-1e-300", "wrench-1e300", "angle-1e300", "no-rest-wrench-1e300"],
+    ids=[
+        "wrench-1e-300",
+        "wrench-1e300",
+        "angle-1e300",
+        "force-at-rest-1e266",
+        "no-rest-wrench-1e300",
+    ],
 )
 def test_absurd_scales_are_one_line_errors(simulated_free: Recording, make, column: str) -> None:  # type: ignore[no-untyped-def]
     with pytest.raises(IdentificationError) as raised:

@@ -320,10 +320,22 @@ def _pushed_hint(
     test); the lever's range is the force's two standard deviations. Not along the weight at
     its own lever (within 15 %): that is the weight read scaled or half turned. The recording
     began with the link touching (a sensor turned on the link reads the same of its weight's
-    lever: asked first); "" otherwise."""
-    excess = torque - expected
+    lever: asked first); "" otherwise (loads too large to square: not a push)."""
     if len(force) < 2:
         return ""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _push_named(torque - expected, force, expected_force, expected, length)
+
+
+def _push_named(
+    excess: FloatArray,
+    force: FloatArray,
+    expected_force: FloatArray,
+    expected: FloatArray,
+    length: float,
+) -> str:
+    """:func:`_pushed_hint`'s test and sentence (``excess``: the mean moment beyond the
+    weight's, N m)."""
     push = force.mean(axis=0) - expected_force
     push[0] = 0.0  # across the link
     size = float(np.linalg.norm(push))
