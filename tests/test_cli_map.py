@@ -248,7 +248,7 @@ def test_recordings_of_another_antenna_mapped_with_the_default_are_warned_of(
 ) -> None:
     # A lab's recordings name their antenna's file; mapped without it, every estimate uses the
     # default's observer and stiffness, which can look like bad data: one warning line per
-    # antenna named, none when the antenna is given
+    # antenna named, kept in report.md, none when the antenna is given
     lab = [tmp_path / f"lab-{i}.csv" for i in range(2)]
     for source, path in zip(recordings, lab, strict=False):
         write_recording(read_recording(source).with_metadata(antenna="lab-antenna"), path)
@@ -260,9 +260,25 @@ def test_recordings_of_another_antenna_mapped_with_the_default_are_warned_of(
     assert len(warnings) == 1
     assert "2 recording(s)" in warnings[0] and "'lab-antenna'" in warnings[0]
     assert f"{lab[0]} and 1 more" in warnings[0] and "--antenna" in warnings[0]
+    report = (tmp_path / "a" / "report.md").read_text()
+    assert f"- {warnings[0].removeprefix('antenna map: ')}\n" in report
     args = ["map", *paths, "--out", str(tmp_path / "b"), "--antenna", str(model), "--no-progress"]
     assert main(args) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+def test_a_sample_period_its_stamps_contradict_is_warned_of_and_kept_in_the_report(
+    recordings: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # metadata saying 2 ms over stamps 1 ms apart: estimated by the stamps, the file named
+    wrong = tmp_path / "wrong-period.csv"
+    write_recording(read_recording(recordings[0]).with_metadata(sample_period="0.002"), wrong)
+    assert main(["map", str(wrong), str(recordings[1]), "--out", str(tmp_path / "a")]) == 0
+    warnings = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warnings) == 1 and warnings[0].startswith(f"antenna map: warning: {wrong}: ")
+    assert "sample_period" in warnings[0]
+    report = (tmp_path / "a" / "report.md").read_text()
+    assert f"- {warnings[0].removeprefix('antenna map: ')}\n" in report
 
 
 def test_a_map_that_fails_leaves_no_directory_it_made(

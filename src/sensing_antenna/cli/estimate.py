@@ -90,33 +90,42 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def warn_of_other_antennas(
+def other_antennas(
     named: Mapping[str, Sequence[str]], model: str, use: str = "estimated"
-) -> None:
-    """One line on stderr for each antenna that recordings' ``antenna`` metadata names
-    (``named``: that name, "" when absent, to the recordings' sources) other than the built-in
-    ``model`` the command falls back on (``use``: what it does with them, "estimated" or
-    "checked"): the device's observer, threshold and stiffness are
-    in its own file, and estimates with another's can go wrong in ways that look like bad data
-    (a contact missed, a push that seems to turn the wrong way)."""
+) -> list[str]:
+    """A warning for each antenna that recordings' ``antenna`` metadata names (``named``:
+    that name, "" when absent, to the recordings' sources) other than the built-in ``model``
+    the command falls back on (``use``: what it does with them, "estimated" or "checked"): the
+    device's observer, threshold and stiffness are in its own file, and estimates with
+    another's can go wrong in ways that look like bad data (a contact missed, a push that
+    seems to turn the wrong way)."""
     consequence = (
         "its loads at rest are judged against another link's weight"
         if use == "checked"
         else "with another's observer and stiffness a good recording can come back "
         "implausible_input or no_contact"
     )
+    warnings = []
     for recorded, sources in named.items():
         if not recorded or recorded == model or not sources:
             continue
         which = sources[0]
         if len(sources) > 1:
             which = f"{len(sources)} recording(s) ({sources[0]} and {len(sources) - 1} more)"
-        print(
-            f"antenna: warning: {which} recorded with antenna {printable(recorded)!r} (its "
-            f"metadata) and {use} with the default {printable(model)!r}: give that "
-            f"antenna's file with --antenna ({consequence})",
-            file=sys.stderr,
+        warnings.append(
+            f"{which} recorded with antenna {printable(recorded)!r} (its metadata) and {use} "
+            f"with the default {printable(model)!r}: give that antenna's file with --antenna "
+            f"({consequence})"
         )
+    return warnings
+
+
+def warn_of_other_antennas(
+    named: Mapping[str, Sequence[str]], model: str, use: str = "estimated"
+) -> None:
+    """:func:`other_antennas`' warnings, a line each on stderr."""
+    for warning in other_antennas(named, model, use):
+        print(f"antenna: warning: {warning}", file=sys.stderr)
 
 
 def warn_of_contradicted_period(source: object, problem: str | None) -> None:

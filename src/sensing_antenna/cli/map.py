@@ -13,8 +13,7 @@ from sensing_antenna.cli.arguments import distinct_files
 from sensing_antenna.cli.estimate import (
     DEFAULT_ANTENNA,
     METHOD_NAMES,
-    warn_of_contradicted_period,
-    warn_of_other_antennas,
+    other_antennas,
 )
 
 if TYPE_CHECKING:
@@ -187,12 +186,11 @@ def _map_into(args: argparse.Namespace) -> None:
             unreadable=lambda _, exc: left_out.append(str(exc)),
             read=read,
         )
-    for path, problem in contradicted:
-        warn_of_contradicted_period(path, problem)
-    if args.antenna is None:  # the default: recordings of another antenna are warned of
-        warn_of_other_antennas(named, antenna.name)
     # the notes on the inputs, said on stderr and kept in report.md
-    said = [*ordered, *note_unposed(unposed, sum(len(paths) for paths in named.values()))]
+    said = [f"antenna map: warning: {path}: {problem}" for path, problem in contradicted]
+    if args.antenna is None:  # the default: recordings of another antenna are warned of
+        said += [f"antenna map: warning: {text}" for text in other_antennas(named, antenna.name)]
+    said += [*ordered, *note_unposed(unposed, sum(len(paths) for paths in named.values()))]
     if not points:
         more = f" (and {len(left_out) - 1} more unreadable)" if len(left_out) > 1 else ""
         raise SensingAntennaError(f"{left_out[0]}{more}")
