@@ -309,9 +309,32 @@ def test_a_sign_flipped_in_the_angles_or_forces_is_implausible_input(
         assert not result.ok, name
         assert result.status is Status.IMPLAUSIBLE_INPUT, (name, result.reason)
         assert "does not oppose the head's turn" in (result.reason or "")
+        assert "touched nothing" not in (result.reason or "")  # a push far above the noise
         # no 95 % interval is claimed from samples the status says are wrong
         assert result.interval is None, name
     assert results["fast"].diagnostics["interval_dropped"] is not None
+
+
+def test_a_detector_firing_on_the_free_motion_is_named_beside_the_signs(
+    antenna: Antenna,
+) -> None:
+    # A device whose threshold lies below its residual (1e-4 N m, the sensor's noise 4 times
+    # the datasheet's) stops on a false contact during the sweep and touches nothing: the
+    # link's swing leaves a force over the hold of a few standard errors, in any direction.
+    # Where it does not oppose the turn, the reason names that reading beside the signs
+    observer = dataclasses.replace(antenna.observer, contact_threshold=1e-4)
+    device = dataclasses.replace(antenna, observer=observer)
+    named = 0
+    for seed in (2, 3, 4):
+        scenario = Scenario(case="vertical", contact_point=0.6, seed=seed, noise_scale=4.0)
+        recording = simulate(device, scenario)
+        assert math.isnan(float(recording.metadata["true_xc"]))  # the premise: no touch
+        result = estimate(recording.without_ground_truth(), device, "paper")
+        assert not result.ok, (seed, result.reason)
+        if "does not oppose the head's turn" in (result.reason or ""):
+            assert "or the link touched nothing" in (result.reason or ""), result.reason
+            named += 1
+    assert named
 
 
 def test_a_detector_that_fires_after_the_head_stopped_still_judges_the_push_direction(

@@ -888,6 +888,12 @@ def _on_branch(curve: Any, x_c: float, candidates: Any) -> list[float]:
     return [c.x_c for c in candidates if branch(c.x_c) == branch(x_c)]
 
 
+#: A push across the link within this many standard errors of a filtered, tared force (twice
+#: the push's own significance, ``min_push_significance``) may be no push: the push direction
+#: check then names a detector firing on the free motion beside the signs.
+_WEAK_PUSH = 10.0
+
+
 def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
     """Why the push does not oppose the head's motion into the contact, or None.
 
@@ -924,6 +930,15 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
             f"({_vector(pushed)} N at t_1, filtered) but not over the hold after t_1 "
             f"({_vector(reaction)} N): the link slid off the object or past it"
         )
+    lateral = float(np.linalg.norm(reaction[1:]))
+    untouched = (
+        f"; or the link touched nothing: a force of {lateral / error:.2g} standard errors is "
+        "what a link still swinging from the sweep leaves, a detector firing on the free "
+        "motion (its threshold below this device's residual: antenna identify on its free "
+        "sweeps)"
+        if lateral <= _WEAK_PUSH * error
+        else ""
+    )
     return Status.IMPLAUSIBLE_INPUT, (
         f"columns 'theta1', 'theta2', 'fx', 'fy', 'fz': the mean contact force over the hold "
         f"{_vector(reaction)} N does not oppose the head's turn into the contact "
@@ -931,7 +946,7 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
         "where the push began, to t_1); an obstacle can only push back: a sign "
         "flipped in an angle or in the forces, the two angles swapped or one read from another "
         "joint (the joint mapping), or forces read wrong by as much as the push (cross-talk "
-        "from the torques, an offset)?"
+        f"from the torques, an offset){untouched}?"
     )
 
 
