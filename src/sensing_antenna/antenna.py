@@ -197,6 +197,9 @@ PARAMETER_RANGES: Mapping[str, ParameterRange] = MappingProxyType(
         "motor.gear_ratio": ParameterRange(
             1.0, 1e4, "", "n of a 1:n reduction, from direct drive to several stages"
         ),
+        "motor.held_compliance": ParameterRange(
+            0.0, 1e3, "rad/(N m)", "a joint a link's torque turns by radians holds nothing"
+        ),
     }
 )
 
@@ -480,6 +483,11 @@ class Motor:
         V^nlc, Coulomb friction expressed as an input voltage (V).
     gear_ratio : float
         n, reduction ratio 1:n.
+    held_compliance : float or None
+        The held joint's angle per link torque about it at the contacts' fundamental
+        (rad/(N m)): the largest the calibration's posts on this joint measured
+        (:mod:`sensing_antenna.estimation.held_joint`; written by ``antenna calibrate``). None:
+        not measured, and a base moving near omega_1 is not looked for.
     """
 
     torque_constant: float
@@ -487,14 +495,19 @@ class Motor:
     viscous_friction: float
     coulomb_voltage: float
     gear_ratio: float
+    held_compliance: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("torque_constant", "inertia", "gear_ratio"):
             _require_positive("motor", name, getattr(self, name))
         _require_non_negative("motor", "viscous_friction", self.viscous_friction)
         _require_non_negative("motor", "coulomb_voltage", self.coulomb_voltage)
+        if self.held_compliance is not None:
+            _require_non_negative("motor", "held_compliance", self.held_compliance)
         for f in fields(self):
-            PARAMETER_RANGES[f"motor.{f.name}"].check(f"motor.{f.name}", getattr(self, f.name))
+            value = getattr(self, f.name)
+            if value is not None:
+                PARAMETER_RANGES[f"motor.{f.name}"].check(f"motor.{f.name}", value)
 
     @property
     def coulomb_torque(self) -> float:

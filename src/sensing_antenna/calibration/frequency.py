@@ -145,6 +145,13 @@ class FrequencyCalibration:
     left_out_as_wrong : ndarray of bool, shape (n,), or None
         Points the fit left out as wrong spectral peaks or wrong known points (more than
         :data:`WRONG_PEAK` from the others, and few); None when not recorded (older files).
+    held_joint : ndarray of int, shape (n,), or None
+        The joint each point's sweep turned (0 azimuth, 1 elevation; -1 not measured), None
+        when not looked for.
+    held_compliance_measured : ndarray, shape (n,), or None
+        The held joint's angle per link torque at each point's omega_1 (rad/(N m);
+        :mod:`~sensing_antenna.estimation.held_joint`; NaN where not measured), None when not
+        looked for.
     """
 
     t_e: float
@@ -161,6 +168,8 @@ class FrequencyCalibration:
     omega2_measured: NDArray[np.float64] | None = None
     omega2_fitted: NDArray[np.float64] | None = None
     left_out_as_wrong: NDArray[np.bool_] | None = None
+    held_joint: NDArray[np.int64] | None = None
+    held_compliance_measured: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         n = self.contact_points.shape
@@ -171,6 +180,8 @@ class FrequencyCalibration:
             "omega2_measured",
             "omega2_fitted",
             "left_out_as_wrong",
+            "held_joint",
+            "held_compliance_measured",
         ):
             value = getattr(self, name)
             if value is not None and value.shape != n:
@@ -284,16 +295,44 @@ class FrequencyCalibration:
         """(T_e - T) / T, dimensionless (the paper reports 7 %)."""
         return (self.t_e - self.t_theoretical) / self.t_theoretical
 
+    @property
+    def held_compliance(self) -> tuple[float | None, float | None]:
+        """Each joint's held compliance (rad/(N m)): the largest its points used measured, None
+        from fewer than :data:`~sensing_antenna.estimation.held_joint.MIN_POSTS`."""
+        from sensing_antenna.estimation.held_joint import MIN_POSTS
+
+        if self.held_joint is None or self.held_compliance_measured is None:
+            return None, None
+        values = self.held_compliance_measured
+        measured = self.used & np.isfinite(values)
+        found: list[float | None] = []
+        for joint in (0, 1):
+            on_joint = measured & (self.held_joint == joint)
+            count = int(np.count_nonzero(on_joint))
+            found.append(float(np.max(values[on_joint])) if count >= MIN_POSTS else None)
+        return found[0], found[1]
+
     def apply(self, antenna: Antenna) -> Antenna:
         """The antenna with this T_e as its calibrated T, :attr:`relative_scatter` and
-        :attr:`mode2_scatter` as its scatters (none when unknown) and the fitted tip mass, when
-        fitted (the weight keeps the antenna's tip mass, ``Link.weight_tip_mass``)."""
+        :attr:`mode2_scatter` as its scatters (none when unknown), the fitted tip mass, when
+        fitted (the weight keeps the antenna's tip mass, ``Link.weight_tip_mass``), and each
+        joint's :attr:`held_compliance` (kept where not measured)."""
         scatter, mode2 = self.relative_scatter, self.mode2_scatter
         if self.tip_mass is not None:
             # the weight the sensor reads at rest stays the antenna's (weight_tip_mass)
             link = antenna.link
             link = replace(link, tip_mass=self.tip_mass, weight_tip_mass=link.weighed_tip_mass)
             antenna = replace(antenna, link=link)
+        azimuth, elevation = self.held_compliance
+        if azimuth is not None:
+            antenna = replace(
+                antenna, azimuth_motor=replace(antenna.azimuth_motor, held_compliance=azimuth)
+            )
+        if elevation is not None:
+            antenna = replace(
+                antenna,
+                elevation_motor=replace(antenna.elevation_motor, held_compliance=elevation),
+            )
         return antenna.with_calibrated_t(
             self.t_e,
             scatter if math.isfinite(scatter) else None,
@@ -322,6 +361,7 @@ class FrequencyCalibration:
                     "used": bool(self.used[i]),
                     "wrong": bool(self.wrong_peak_points[i]),
                     **self._omega2_at(i),
+                    **self._held_at(i),
                 }
                 for i in range(self.contact_points.size)
             ],
@@ -335,6 +375,15 @@ class FrequencyCalibration:
         return {
             "omega2_measured": _json_float(float(self.omega2_measured[i])),
             "omega2_fitted": _json_float(float(self.omega2_fitted[i])),
+        }
+
+    def _held_at(self, i: int) -> dict[str, float | int | None]:
+        """Point ``i``'s held-joint entries of :meth:`to_dict`; none when not looked for."""
+        if self.held_joint is None or self.held_compliance_measured is None:
+            return {}
+        return {
+            "held_joint": int(self.held_joint[i]),
+            "held_compliance": _json_float(float(self.held_compliance_measured[i])),
         }
 
     @classmethod
@@ -353,6 +402,7 @@ class FrequencyCalibration:
             return np.array(values, dtype=float)
 
         with_omega2 = bool(points) and all("omega2_fitted" in p for p in points)
+        with_held = bool(points) and all("held_joint" in p for p in points)
         return cls(
             t_e=float(data["t_e"]),
             t_e_std_error=_float_or_nan(data.get("t_e_std_error")),
@@ -372,6 +422,12 @@ class FrequencyCalibration:
                 if points and all("wrong" in p for p in points)
                 else None
             ),
+            held_joint=(
+                np.array([int(p["held_joint"]) for p in points], dtype=np.int64)
+                if with_held
+                else None
+            ),
+            held_compliance_measured=column("held_compliance") if with_held else None,
         )
 
 
@@ -814,7 +870,8 @@ def calibrate_from_recordings(
         notes=notes,
         fit_tip_mass=fit_tip_mass,
     )
-    return _with_second_mode(calibration, evidences, antenna, components)
+    calibration = _with_second_mode(calibration, evidences, antenna, components)
+    return _with_held_joint(calibration, evidences)
 
 
 #: Fewest points with a measured second contact mode for its scatter
@@ -850,6 +907,35 @@ def _with_second_mode(
         if peak is not None:
             measured[i] = peak.omega
     return replace(calibration, omega2_measured=measured, omega2_fitted=fitted)
+
+
+def _with_held_joint(
+    calibration: FrequencyCalibration, evidences: Sequence[Any]
+) -> FrequencyCalibration:
+    """``calibration`` with the held joint's compliance measured at each point used, over the
+    window its omega_1 was read from (:func:`~sensing_antenna.estimation.held_joint.held_line`;
+    NaN and joint -1: no evidence)."""
+    from sensing_antenna.estimation.held_joint import held_line, swept_joint
+
+    n = calibration.contact_points.size
+    joints = np.full(n, -1, dtype=np.int64)
+    compliance = np.full(n, math.nan)
+    for i in map(int, np.flatnonzero(calibration.used)):
+        evidence = evidences[i]
+        if evidence is None:
+            continue
+        window = evidence.spectrum_slice
+        joint = swept_joint(evidence.push_turn[0])
+        line = held_line(
+            evidence.t[window],
+            evidence.theta[window],
+            evidence.torque[window],
+            joint,
+            float(calibration.omega1_measured[i]),
+        )
+        if line is not None and math.isfinite(line.compliance):
+            joints[i], compliance[i] = joint, line.compliance
+    return replace(calibration, held_joint=joints, held_compliance_measured=compliance)
 
 
 def read_contact_points(

@@ -57,8 +57,14 @@ PAPER_T_E = 0.2124
 
 #: Antenna sections whose parameters describe the hardware (compared between device and model).
 _HARDWARE_SECTIONS = ("link", "azimuth_motor", "elevation_motor")
-#: Link fields that belong to the model (found by calibration), not to the hardware.
-_MODEL_FIELDS = ("calibrated_t", "calibration_scatter", "mode2_scatter", "weight_tip_mass")
+#: Link and motor fields that belong to the model (found by calibration), not to the hardware.
+_MODEL_FIELDS = (
+    "calibrated_t",
+    "calibration_scatter",
+    "mode2_scatter",
+    "weight_tip_mass",
+    "held_compliance",
+)
 
 
 @dataclass(frozen=True)

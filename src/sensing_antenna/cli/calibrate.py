@@ -212,6 +212,7 @@ def _run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     print(_mode2_line(calibration))
+    print(_held_line(calibration))
     wrong = calibration.wrong_peak_points
     doubtful = calibration.kept_far_points
     for i, x_c in enumerate(calibration.contact_points):
@@ -263,6 +264,28 @@ def _mode2_line(calibration: FrequencyCalibration) -> str:
         f"second contact mode: found near the model's at {count} of "
         f"{int(calibration.used.sum())} points; its scatter needs {MIN_MODE2_POINTS} and two "
         "thirds of the points (link.mode2_scatter not written)"
+    )
+
+
+def _held_line(calibration: FrequencyCalibration) -> str:
+    """What the calibration measured of the held joints' compliance, in one line."""
+    from sensing_antenna.estimation.held_joint import MIN_POSTS
+
+    joints = calibration.held_joint
+    said = []
+    for joint, (name, value) in enumerate(
+        zip(("azimuth", "elevation"), calibration.held_compliance, strict=True)
+    ):
+        posts = 0 if joints is None else int(((joints == joint) & calibration.used).sum())
+        said.append(
+            f"{name} {value:.3g} rad/(N m) over {posts} points (written as "
+            f"{name}_motor.held_compliance)"
+            if value is not None
+            else f"{name} not written ({posts} points of its sweep, {MIN_POSTS} needed)"
+        )
+    return (
+        "held joints' angle per link torque at omega_1 (a base moving near omega_1 is looked "
+        f"for on the joints written): {'; '.join(said)}"
     )
 
 

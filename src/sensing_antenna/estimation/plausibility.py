@@ -100,6 +100,7 @@ from sensing_antenna.estimation.front.evidence import (
 from sensing_antenna.estimation.front.held import FAST_PACE, repeated_rows
 from sensing_antenna.estimation.front.spectrum import power_spectrum
 from sensing_antenna.estimation.front.spikes import WRENCH_CHANNELS
+from sensing_antenna.estimation.held_joint import COMPLIANCE_MARGIN, held_line, swept_joint
 from sensing_antenna.estimation.methods.fast.parametric import fit_damped_sinusoids
 from sensing_antenna.estimation.methods.paper.frequency import find_peak, measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import (
@@ -215,6 +216,9 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     lossy = _lossy_contact_problem(evidence, estimate, end, notes) if judged and not told else None
     if lossy is not None:
         found.append((Status.UNCERTAIN, lossy))
+    rocked = _base_motion_problem(evidence, estimate, notes) if judged else None
+    if rocked is not None:
+        found.append((Status.UNCERTAIN, rocked))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
     bent = _bent_link_problem(evidence, estimate, notes) if on_link else None
     if bent is not None:
@@ -245,7 +249,7 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if turn is not None:
         found.append((Status.MODEL_MISMATCH, turn))
     interval = _on_link(estimate.interval, link.length)
-    if pinned is not None or lossy is not None:
+    if pinned is not None or lossy is not None or rocked is not None:
         interval = _widened_to_statics(evidence, interval, end, notes)
     point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
@@ -611,16 +615,69 @@ def _pinned_contact_problem(
 _OWN_DAMPING_FACTOR = 2.0
 
 
+#: The held joint's angle near omega_1 is judged beyond this many times its median amplitude
+#: from half to twice omega_1 where that exceeds the encoder's count (an encoder read finer than
+#: its noise): the largest of a few hundred bins of noise lies within about three.
+_HELD_NOISE_FACTOR = 10.0
+
+
+def _base_motion_problem(
+    evidence: Evidence, estimate: ContactEstimate, notes: dict[str, Any]
+) -> str | None:
+    """Why the swept joint's angle says the base moved near omega_1, or None.
+
+    Over the window omega_1 was read from, the held joint's angle near omega_1 beyond
+    :data:`~.held_joint.COMPLIANCE_MARGIN` times what the link's torque turns it by (the
+    joint's ``held_compliance``, measured by the calibration's posts) by more than an encoder
+    count (or :data:`_HELD_NOISE_FACTOR` times the angle's noise, the larger): the base moving
+    near omega_1 drives the head besides the link, a line the window cannot part from the
+    contact's fundamental. Not judged without a measured compliance for the joint."""
+    omega1 = float(estimate.omega1)
+    if not (math.isfinite(omega1) and omega1 > 0.0):
+        return None
+    joint = swept_joint(evidence.push_turn[0])
+    compliance = evidence.antenna.motors[joint].held_compliance
+    if compliance is None:
+        return None
+    window = evidence.spectrum_slice
+    line = held_line(
+        evidence.t[window],
+        evidence.theta[window],
+        evidence.torque[window],
+        joint,
+        omega1,
+        compliance,
+    )
+    if line is None:
+        return None
+    floor = max(line.count, _HELD_NOISE_FACTOR * line.noise)
+    if not floor > 0.0:
+        return None
+    notes["held_angle_excess"] = line.excess / floor
+    if not line.excess > floor:
+        return None
+    counts = f", {line.excess / line.count:.0f} encoder counts" if line.count > 0.0 else ""
+    return (
+        f"the {('azimuth', 'elevation')[joint]} joint's angle rings near omega_1 "
+        f"({omega1:.1f} rad/s) by {line.excess:.2g} rad{counts} beyond what the link's torque "
+        f"turns the held joint by ({COMPLIANCE_MARGIN:g} times the {compliance:.2g} rad/(N m) "
+        "the calibration's posts measured): the base moving near omega_1 (a robot, a table "
+        "rocking) puts a line beside the contact's fundamental that one window cannot part "
+        "from it"
+    )
+
+
 def _widened_to_statics(
     evidence: Evidence, interval: tuple[float, float] | None, end: int, notes: dict[str, Any]
 ) -> tuple[float, float] | None:
     """``interval`` widened to hold the statics' reading at ``end`` within
     ``disagreement_sigmas`` of its uncertainty (noise, tare, statics model and the bent link at
-    the reading), when the vibration's point may be a contact that gives: a support's give moves
-    omega_1 by an amount nothing measured bounds, the torque/force ratio hardly (the object's
-    compliance is in series with the push, not in the lever). The interval before goes to
-    ``notes["interval_before_support"]``. None stays None: a method that gives no interval
-    is not given one."""
+    the reading), when the vibration's point may be a contact that gives, or a line beside the
+    fundamental: a support's give, or a base moving near omega_1, moves omega_1 by an amount
+    nothing measured bounds, the torque/force ratio hardly (the object's compliance is in
+    series with the push, not in the lever; the base's motion averages out of the hold). The
+    interval before goes to ``notes["interval_before_support"]``. None stays None: a method
+    that gives no interval is not given one."""
     if interval is None or not end < evidence.ratio_mean.shape[0]:
         return interval
     reading = float(evidence.ratio_mean[end])
