@@ -53,6 +53,7 @@ from sensing_antenna.campaign.summary import (
     CampaignSummary,
     summarize_campaign,
 )
+from sensing_antenna.simulator.device import DeviceImperfections
 
 __all__ = ["FIGURES_DIR", "REPORT_FILE", "build_report", "render_report"]
 
@@ -87,18 +88,39 @@ def _antenna_lines(model: Antenna, device: Antenna, summary: CampaignSummary) ->
     ]
 
 
-def _imperfection_lines(spec: CampaignSpec) -> list[str]:
-    """The device's imperfections the model does not know, when the spec sets any."""
+def _imperfection_lines(spec: CampaignSpec, length: float) -> list[str]:
+    """The device's imperfections the model does not know, when the spec sets any (``length``:
+    the device's link, m)."""
     if not spec.device.has_imperfections:
         return []
     fixed = ", ".join(f"{k} = {v}" for k, v in sorted(spec.device.imperfections.items()))
-    profile = (
-        f"realistic (device build {spec.device.build_of(spec.base_seed)}; its set-up drawn per "
-        "manoeuvre from its seed)"
-        if spec.device.profile == "realistic"
-        else spec.device.profile
-    )
+    profile = spec.device.profile
+    if profile == "realistic":
+        built = spec.device.imperfections_for(spec.base_seed, length, spec.base_seed)
+        profile = (
+            f"realistic (device build {spec.device.build_of(spec.base_seed)}: "
+            f"{_built_link(built)}; its set-up drawn per manoeuvre from its seed)"
+        )
     return [f"- Device imperfections: profile {profile}" + (f"; set: {fixed}" if fixed else "")]
+
+
+def _built_link(built: DeviceImperfections) -> str:
+    """What a build adds to the link, in a few words (SI)."""
+    clamp = (
+        "a rigid clamp"
+        if built.clamp_stiffness is None
+        else f"a clamp of {built.clamp_stiffness:.3g} N m/rad"
+    )
+    joint = (
+        f", a joint of {100 * built.joint_length:.2g} cm at {built.joint_start:.3g} m (E I x "
+        f"{built.joint_stiffness_factor:.3g}, rho x {built.joint_density_factor:.3g})"
+        if built.joint_length > 0.0
+        else ""
+    )
+    return (
+        f"{1e6 * built.tip_mass:.3g} mg at the tip, {clamp}, E I tapering to "
+        f"{built.stiffness_taper:.3g} of the root's{joint}"
+    )
 
 
 def _plain_statement(summary: CampaignSummary, spec: CampaignSpec) -> list[str]:
@@ -312,7 +334,7 @@ def _settings_lines(
         ),
         "- Scenario: "
         + (", ".join(f"{k} = {v}" for k, v in sorted(spec.scenario.items())) or "defaults"),
-        *_imperfection_lines(spec),
+        *_imperfection_lines(spec, device.link.length),
         f"- Per-run results: [{CSV_FILE}]({CSV_FILE}) (SI units, one row per run and method)",
     ]
 

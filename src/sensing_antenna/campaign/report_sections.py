@@ -526,18 +526,19 @@ def noise_section(
             "error, which adds the drift check's term. For a fixed record the bound is "
             "proportional to the noise, but `fast` stops when sure, so its record lengthens "
             "with the noise and its bound stays nearly level; the error cannot fall below the "
-            "model bias (the simulator's compliant contact and finite elements against the "
-            "pinned-contact beam model, and the unmodelled modes of docs/fast.md); the paper "
-            "method's 1 s spectrum has no bound reported here."
+            "model bias (the simulator's compliant contact against the pin, the push's bend, "
+            "and the unmodelled modes of docs/fast.md); the paper method's 1 s spectrum has no "
+            "bound reported here."
             if with_bounds
             else "None of these methods reports a Cramer-Rao bound or a standard error of "
             "omega_1 (`fast` does), so there are no bound columns; the error cannot fall below "
-            "the model bias (the simulator's compliant contact and finite elements against the "
-            "pinned-contact beam model)."
+            "the model bias (the simulator's compliant contact against the pin, the push's "
+            "bend)."
         )
         lines += [
             "omega_1 against the device's contact-mode fundamental at each run's contact "
-            "abscissa (`beam.natural_frequencies` of the device's link), relative, in %, over "
+            "abscissa (the simulator's finite-element model of the device's link, with the tip "
+            "mass, clamp, taper and joint of its build, pinned there), relative, in %, over "
             f"every run with an omega_1 (any status). {bounds_text}",
             "",
             *markdown_table(

@@ -309,6 +309,9 @@ def _summarize(
     rows = main_rows(every, spec.noise_scale)
     cases, methods = spec.cases, spec.methods
     sweep = spec.noise_sweep.enabled
+    # the link as built: what the device's build adds to its file (a tip mass, a clamp, ...)
+    built = spec.device.imperfections_for(spec.base_seed, device.link.length, spec.base_seed)
+    link = replace(device.link, tip_mass=device.link.tip_mass + built.tip_mass)
     return CampaignSummary(
         n_results=len(results),
         n_failed=sum(1 for r in results if r.status == RUN_FAILED),
@@ -325,14 +328,18 @@ def _summarize(
         if "fast" in methods
         else (),
         noise=tuple(noise_level_errors(every, methods, spec.noise_scale)) if sweep else (),
-        frequency=tuple(frequency_error_summaries(every, device.link, methods, spec.noise_scale))
+        frequency=tuple(
+            frequency_error_summaries(
+                every, device.link, methods, spec.noise_scale, built.link_part
+            )
+        )
         if sweep
         else (),
         cases=tuple(case_table(rows, case, methods) for case in cases),
         point_tables=tuple(point_table(rows, c, m) for c in cases for m in methods),
         paper_tables=tuple(paper_table(case) for case in cases),
         run_points=tuple(run_points(rows, c, m) for c in cases for m in methods),
-        device=compare_device(device, model),
+        device=compare_device(replace(device, link=link), model),
         calibration=check_calibration(calibration, model, device)
         if calibration is not None
         else None,

@@ -27,6 +27,7 @@ from sensing_antenna.accuracy import FrequencyErrorSummary, PointStats, PointTab
 from sensing_antenna.antenna import Link
 from sensing_antenna.campaign.records import CampaignRow
 from sensing_antenna.campaign.schema import noise_level_key, same_noise_level
+from sensing_antenna.simulator.device import DeviceImperfections
 
 __all__ = [
     "FIXED_DELAY_TOLERANCE",
@@ -483,16 +484,24 @@ def contact_offset(rows: Iterable[CampaignRow]) -> ContactOffset:
 
 
 def frequency_error_summaries(
-    rows: Iterable[CampaignRow], link: Link, methods: Sequence[str], main: float
+    rows: Iterable[CampaignRow],
+    link: Link,
+    methods: Sequence[str],
+    main: float,
+    imperfections: DeviceImperfections | None = None,
 ) -> list[FrequencyErrorSummary]:
     """omega_1 errors of every method that reports one, per noise level (ascending).
 
-    ``link`` is the device's link (the simulated hardware): the truth is its contact-mode
-    fundamental ``beam.natural_frequencies(link, x, 1)`` at each run's contact abscissa (the
-    nominal x_c when unknown). Methods without any finite omega_1 are left out.
+    ``link`` is the device's link (the simulated hardware), ``imperfections`` what its build
+    adds to it (tip mass, clamp, taper, joint; None: nothing): the truth is the contact-mode
+    fundamental of the simulator's finite-element model of that link pinned at each run's
+    contact abscissa (the nominal x_c when unknown). Methods without any finite omega_1 are
+    left out.
     """
-    from sensing_antenna.beam import natural_frequencies
+    from sensing_antenna.simulator.link import build_link_model
+    from sensing_antenna.simulator.scenario import N_ELEMENTS
 
+    model = build_link_model(link, N_ELEMENTS, imperfections)
     all_rows = list(rows)
     summaries = []
     for level in noise_levels(all_rows, main):
@@ -504,7 +513,7 @@ def frequency_error_summaries(
             if not keep.any():
                 continue
             x = truth(selected)[keep]
-            true = np.asarray(natural_frequencies(link, x, 1), dtype=float)[..., 0]
+            true = np.array([model.pinned_frequencies(float(v), 1)[0] for v in x])
             rel = omega[keep] / true - 1.0
             crb = _column(selected, "omega1_crb_rad_s")[keep] / true
             se = _column(selected, "omega1_se_rad_s")[keep] / true

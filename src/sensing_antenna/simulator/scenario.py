@@ -31,6 +31,7 @@ __all__ = [
     "MAX_STEP_PHASE",
     "MAX_SUBSTEPS",
     "MIN_SUBSTEPS",
+    "N_ELEMENTS",
     "OBSTACLE_KINDS",
     "PLACED_KINDS",
     "SAMPLE_PERIOD_RANGE",
@@ -220,6 +221,10 @@ class SensorNoise:
             raise ScenarioError("sensor.encoder_counts", "must be an integer >= 0 (0 = exact)")
 
 
+#: Finite elements of a simulated link unless a scenario says otherwise.
+N_ELEMENTS = 16
+
+
 @dataclass(frozen=True)
 class Scenario:
     """One simulated manoeuvre (Section 4 of the paper, steps 1 to 4).
@@ -325,7 +330,7 @@ class Scenario:
         :data:`SAMPLE_PERIOD_RANGE`; default 1 ms, the paper device's 1 kHz. The sensor's noise
         (``sensor.wrench_std``) is per sample at any period.
     n_elements : int
-        Finite elements of the link.
+        Finite elements of the link (default :data:`N_ELEMENTS`).
     link_model : {"linear", "nonlinear"}
         "linear": small-deflection bending about the undeformed line (Assumption 1 of the
         paper). "nonlinear": the geometrically exact inextensible rod (exact curvature, axial
@@ -375,7 +380,7 @@ class Scenario:
     retract_after: float | None = None
     retract_angle: float = 0.1
     sample_period: float = DEFAULT_SAMPLE_PERIOD
-    n_elements: int = 16
+    n_elements: int = N_ELEMENTS
     substeps: int | None = None
     link_model: Literal["linear", "nonlinear"] = "linear"
     sensor: SensorNoise = field(default_factory=SensorNoise)
