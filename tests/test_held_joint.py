@@ -19,11 +19,7 @@ from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate
 
 #: The posts of the calibration: three on each joint.
-POSTS = (("azimuthal", 0.4), ("azimuthal", 0.6), ("azimuthal", 0.8)) + (
-    ("vertical", 0.4),
-    ("vertical", 0.6),
-    ("vertical", 0.8),
-)
+POSTS = tuple((case, x_c) for case in ("azimuthal", "vertical") for x_c in (0.4, 0.6, 0.8))
 
 
 @pytest.fixture(scope="module")
