@@ -893,3 +893,23 @@ def test_a_spike_after_two_inf_samples_is_put_back_sample_by_sample_as_in_blocks
         assert result.status is results[-1].status and result.x_c == results[-1].x_c
         times = [r["t"] for r in result.diagnostics["repaired_samples"]]
         assert times[:2] == [float(glitched.t[100]), float(glitched.t[150])]
+
+
+def test_a_ratio_that_moves_after_settling_names_a_drifting_force_offset_beside_a_slide() -> None:
+    # A force offset that ramps by 4 mN/s from 0.3 s after t_1 under a push of about 30 mN at
+    # 0.9 m moves the settled ratio by 4 cm: not told from a slide along the link, the reason
+    # says how large an offset would do it, to set beside the sensor's drift
+    antenna = calibrated()
+    scenario = Scenario(case="azimuthal", contact_point=0.9, seed=2)
+    recording = simulate(antenna, scenario).without_ground_truth()
+    plain = estimate(recording, antenna, "paper")
+    assert plain.ok, plain.reason
+    force = recording.force.copy()
+    force[:, 1] += 4e-3 * np.clip(recording.t - (plain.t_1 + 0.3), 0.0, None)
+    drifted = estimate(dataclasses.replace(recording, force=force), antenna, "paper")
+    assert drifted.status is Status.SLIP_SUSPECTED, drifted.reason
+    reason = drifted.reason or ""
+    assert "the contact sliding along the link, or the sensor's force offset drifting by" in reason
+    said = float(reason.split("drifting by ")[1].split(" mN")[0])
+    # the offset at t_e (2.8 mN) against what the ratio's moving mean over its window saw
+    assert 0.5 < said < 2.8

@@ -12,7 +12,11 @@ import pytest
 
 from _models import calibrated
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna, save_antenna
-from sensing_antenna.calibration.frequency import FrequencyCalibration, calibrate_from_recordings
+from sensing_antenna.calibration.frequency import (
+    FrequencyCalibration,
+    calibrate_from_recordings,
+    held_compliance_from_recordings,
+)
 from sensing_antenna.estimation import Status, estimate
 from sensing_antenna.estimation.held_joint import held_line
 from sensing_antenna.recording import Recording
@@ -23,15 +27,19 @@ POSTS = tuple((case, x_c) for case in ("azimuthal", "vertical") for x_c in (0.4,
 
 
 @pytest.fixture(scope="module")
-def calibration() -> FrequencyCalibration:
+def posts() -> list[Recording]:
     device = paper_antenna()
-    recordings = [
+    return [
         simulate(device, Scenario(case=case, contact_point=x_c, seed=k))
         for k, (case, x_c) in enumerate(POSTS)
     ]
-    points = [float(r.metadata["true_xc"]) for r in recordings]
+
+
+@pytest.fixture(scope="module")
+def calibration(posts: list[Recording]) -> FrequencyCalibration:
+    points = [float(r.metadata["true_xc"]) for r in posts]
     return calibrate_from_recordings(
-        [r.without_ground_truth() for r in recordings], calibrated(), points
+        [r.without_ground_truth() for r in posts], calibrated(), points
     )
 
 
@@ -87,6 +95,15 @@ def test_the_calibration_measures_each_joint_s_held_compliance(
     # two posts on a joint say too little of its servo: not stored
     fewer = dataclasses.replace(calibration, used=calibration.used & (np.arange(6) != 5))
     assert fewer.held_compliance == (azimuth, None)
+
+
+def test_posts_at_unknown_points_measure_the_held_compliance_too(
+    posts: list[Recording], calibration: FrequencyCalibration
+) -> None:
+    # the sweeps a T_e fit does not take (a campaign fits one case) measure the same servo
+    blind = [r.without_ground_truth() for r in posts]
+    assert held_compliance_from_recordings(blind, calibrated()) == calibration.held_compliance
+    assert held_compliance_from_recordings(blind[:3], calibrated())[1] is None
 
 
 def _rocked(recording: Recording, omega: float, amplitude: float, t_from: float) -> Recording:

@@ -787,6 +787,18 @@ class Antenna:
         )
         return replace(self, link=link)
 
+    def with_held_compliance(self, azimuth: float | None, elevation: float | None) -> Antenna:
+        """A copy whose motors carry these held compliances (rad/(N m); None keeps a motor's
+        own, :attr:`Motor.held_compliance`)."""
+        antenna = self
+        if azimuth is not None:
+            motor = replace(antenna.azimuth_motor, held_compliance=azimuth)
+            antenna = replace(antenna, azimuth_motor=motor)
+        if elevation is not None:
+            motor = replace(antenna.elevation_motor, held_compliance=elevation)
+            antenna = replace(antenna, elevation_motor=motor)
+        return antenna
+
     def self_calibrated(self, scatter: float = MODEL_FREQUENCY_FLOOR) -> Antenna:
         """This antenna with its own T as a calibrated T_e and a relative ``scatter``: the model a
         calibration of a device identical to it gives, for simulation studies that give the

@@ -44,6 +44,7 @@ __all__ = [
     "calibrate_from_recordings",
     "calibrate_t_e",
     "fit_inverse_t",
+    "held_compliance_from_recordings",
     "model_beta1_squared",
     "points_on_link",
     "read_contact_points",
@@ -299,18 +300,10 @@ class FrequencyCalibration:
     def held_compliance(self) -> tuple[float | None, float | None]:
         """Each joint's held compliance (rad/(N m)): the largest its points used measured, None
         from fewer than :data:`~sensing_antenna.estimation.held_joint.MIN_POSTS`."""
-        from sensing_antenna.estimation.held_joint import MIN_POSTS
-
         if self.held_joint is None or self.held_compliance_measured is None:
             return None, None
-        values = self.held_compliance_measured
-        measured = self.used & np.isfinite(values)
-        found: list[float | None] = []
-        for joint in (0, 1):
-            on_joint = measured & (self.held_joint == joint)
-            count = int(np.count_nonzero(on_joint))
-            found.append(float(np.max(values[on_joint])) if count >= MIN_POSTS else None)
-        return found[0], found[1]
+        used = self.used & np.isfinite(self.held_compliance_measured)
+        return _largest_per_joint(self.held_joint[used], self.held_compliance_measured[used])
 
     def apply(self, antenna: Antenna) -> Antenna:
         """The antenna with this T_e as its calibrated T, :attr:`relative_scatter` and
@@ -323,16 +316,7 @@ class FrequencyCalibration:
             link = antenna.link
             link = replace(link, tip_mass=self.tip_mass, weight_tip_mass=link.weighed_tip_mass)
             antenna = replace(antenna, link=link)
-        azimuth, elevation = self.held_compliance
-        if azimuth is not None:
-            antenna = replace(
-                antenna, azimuth_motor=replace(antenna.azimuth_motor, held_compliance=azimuth)
-            )
-        if elevation is not None:
-            antenna = replace(
-                antenna,
-                elevation_motor=replace(antenna.elevation_motor, held_compliance=elevation),
-            )
+        antenna = antenna.with_held_compliance(*self.held_compliance)
         return antenna.with_calibrated_t(
             self.t_e,
             scatter if math.isfinite(scatter) else None,
@@ -913,29 +897,75 @@ def _with_held_joint(
     calibration: FrequencyCalibration, evidences: Sequence[Any]
 ) -> FrequencyCalibration:
     """``calibration`` with the held joint's compliance measured at each point used, over the
-    window its omega_1 was read from (:func:`~sensing_antenna.estimation.held_joint.held_line`;
-    NaN and joint -1: no evidence)."""
-    from sensing_antenna.estimation.held_joint import held_line, swept_joint
-
+    window its omega_1 was read from (:func:`_held_compliance_of`; NaN and joint -1: no
+    evidence)."""
     n = calibration.contact_points.size
     joints = np.full(n, -1, dtype=np.int64)
     compliance = np.full(n, math.nan)
     for i in map(int, np.flatnonzero(calibration.used)):
-        evidence = evidences[i]
-        if evidence is None:
-            continue
-        window = evidence.spectrum_slice
-        joint = swept_joint(evidence.push_turn[0])
-        line = held_line(
-            evidence.t[window],
-            evidence.theta[window],
-            evidence.torque[window],
-            joint,
-            float(calibration.omega1_measured[i]),
-        )
-        if line is not None and math.isfinite(line.compliance):
-            joints[i], compliance[i] = joint, line.compliance
+        if evidences[i] is not None:
+            joints[i], compliance[i] = _held_compliance_of(
+                evidences[i], float(calibration.omega1_measured[i])
+            )
     return replace(calibration, held_joint=joints, held_compliance_measured=compliance)
+
+
+def held_compliance_from_recordings(
+    recordings: Sequence[Any], antenna: Antenna, band: tuple[float, float] | None = None
+) -> tuple[float | None, float | None]:
+    """Each joint's held compliance (rad/(N m); :attr:`FrequencyCalibration.held_compliance`)
+    from contact recordings at any points (their omega_1 read in ``band``, None:
+    :func:`calibration_band`): the sweeps a T_e fit does not take (a calibration on one case,
+    the sensor's posts swept the other way) measure the other joint's servo. Recordings
+    without a clear fundamental are passed over."""
+    from sensing_antenna.calibration.usable import contact_evidence
+    from sensing_antenna.estimation import omega1_of
+
+    band = band if band is not None else calibration_band(antenna.link)
+    joints, values = [], []
+    for recording in recordings:
+        gathered = contact_evidence(recording, antenna)
+        if isinstance(gathered, str):
+            continue
+        measurement = omega1_of(gathered, band)
+        omega1 = float(measurement.omega1)
+        if not math.isfinite(omega1) or getattr(measurement, "clear", True) is False:
+            continue
+        joint, value = _held_compliance_of(gathered, omega1)
+        if math.isfinite(value):
+            joints.append(joint)
+            values.append(value)
+    return _largest_per_joint(np.array(joints, dtype=np.int64), np.array(values, dtype=float))
+
+
+def _held_compliance_of(evidence: Any, omega1: float) -> tuple[int, float]:
+    """The swept joint and its angle per link torque at ``omega1`` (rad/s) over the window the
+    fundamental was read from (:func:`~sensing_antenna.estimation.held_joint.held_line`);
+    (-1, NaN) when it cannot be read."""
+    from sensing_antenna.estimation.held_joint import held_line, swept_joint
+
+    window = evidence.spectrum_slice
+    joint = swept_joint(evidence.push_turn[0])
+    line = held_line(
+        evidence.t[window], evidence.theta[window], evidence.torque[window], joint, omega1
+    )
+    if line is None or not math.isfinite(line.compliance):
+        return -1, math.nan
+    return joint, line.compliance
+
+
+def _largest_per_joint(
+    joints: NDArray[np.int64], values: NDArray[np.float64]
+) -> tuple[float | None, float | None]:
+    """The largest of ``values`` on each joint (0, 1); None on a joint with fewer than
+    :data:`~sensing_antenna.estimation.held_joint.MIN_POSTS`."""
+    from sensing_antenna.estimation.held_joint import MIN_POSTS
+
+    found: list[float | None] = []
+    for joint in (0, 1):
+        on_joint = values[joints == joint]
+        found.append(float(np.max(on_joint)) if on_joint.size >= MIN_POSTS else None)
+    return found[0], found[1]
 
 
 def read_contact_points(

@@ -281,7 +281,11 @@ def calibrate_on_device(
     (FrequencyCalibration, Antenna)
         The T_e fit, and ``model`` with T_e (and the sensor's correction) applied.
     """
-    from sensing_antenna.calibration.frequency import CalibrationError, calibrate_from_recordings
+    from sensing_antenna.calibration.frequency import (
+        CalibrationError,
+        calibrate_from_recordings,
+        held_compliance_from_recordings,
+    )
     from sensing_antenna.calibration.sensor import SensorCalibrationError, calibrate_sensor
     from sensing_antenna.simulator import simulate
 
@@ -313,7 +317,10 @@ def calibrate_on_device(
         raise CampaignSpecError(
             "calibration", f"the calibration step failed: {exc}", spec.source or None
         ) from exc
-    calibrated = calibration.apply(model)
+    # the held joints' servos from every post, both sweeps: the fit takes the step's case only
+    calibrated = calibration.apply(model).with_held_compliance(
+        *held_compliance_from_recordings(recordings, model)
+    )
     if step.sensor:
         try:
             sensor = calibrate_sensor(recordings, calibrated, points, sources=names)

@@ -766,8 +766,9 @@ _SENSOR_ORIGIN_REACH = 0.05
 
 
 def _torque_point_hint(evidence: Evidence, x_c: float, end: int) -> str:
-    """What to check when the answer and the torque/force ratio disagree by no more than a
-    sensor's origin can lie from O along the link, or "".
+    """What to check when the answer and the torque/force ratio disagree, beyond the ratio's
+    uncertainty and by no more than a sensor's origin can lie from O along the link, or "" (a
+    ratio on the answer leaves the disagreement to other evidence: the second mode, say).
 
     Torques about a point S, (S - O) = (s, 0, 0) on the motor axes, read
     Gamma_S = Gamma_O - (S - O) x F: the ratio reads x_c - s at every contact, the frequency
@@ -776,6 +777,9 @@ def _torque_point_hint(evidence: Evidence, x_c: float, end: int) -> str:
     reading = float(evidence.ratio_mean[end]) if end < evidence.ratio_mean.shape[0] else math.nan
     shift = x_c - reading
     if not (math.isfinite(shift) and abs(shift) <= _SENSOR_ORIGIN_REACH):
+        return ""
+    agreed = evidence.config.disagreement_sigmas * evidence.ratio_uncertainty(reading)
+    if abs(shift) <= agreed:
         return ""
     return (
         f"; the torque/force ratio reads {reading:.3f} m, {100 * abs(shift):.1f} cm "

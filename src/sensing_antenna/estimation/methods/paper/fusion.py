@@ -288,19 +288,24 @@ def conclude(
                 f"between t_1 and t_e (limit {math.degrees(cfg.max_direction_drift):.1f} deg)",
             )
         )
+    push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
     if evidence.converged_index is not None:
-        ratio_drift = abs(evidence.ratio_mean[e] - evidence.ratio_mean[evidence.converged_index])
+        settled = float(evidence.ratio_mean[evidence.converged_index])
+        ratio_drift = abs(float(evidence.ratio_mean[e]) - settled)
         # Four standard deviations of the ratio's noise, at least the configured drift.
         drift_limit = max(cfg.max_ratio_drift, 4.0 * evidence.ratio_noise)
         if ratio_drift > drift_limit:
+            # the ratio is moment over force: a force offset d moves it by about r d / F
+            offset = push_force * ratio_drift / settled if settled > 0.0 else math.nan
             found.append(
                 (
                     Status.SLIP_SUSPECTED,
                     f"the torque/force ratio moved by {ratio_drift:.3f} m after it had settled "
-                    f"(limit {drift_limit:.3f} m)",
+                    f"(limit {drift_limit:.3f} m): the contact sliding along the link, or the "
+                    f"sensor's force offset drifting by {1e3 * offset:.2g} mN under this push "
+                    f"of {1e3 * push_force:.2g} mN, which moves the ratio as much",
                 )
             )
-    push_force = float(math.hypot(reaction_now[1], reaction_now[2]))
     touch, frame, t_point = touched_point_filtered(evidence, x_c, e)
     if not math.isfinite(x_c):
         found.append((Status.NO_CLEAR_PEAK, "no estimate of x_c could be formed"))
