@@ -74,7 +74,17 @@ def test_simulate_warns_when_the_push_exceeds_the_small_deflection_limit(
     assert float(read_recording(out).metadata["true_deflection_ratio"]) > 0.1
     err = captured.err.strip()
     assert err.startswith("warning:") and err.count("\n") == 0
-    assert "Assumption 1" in err and "antenna identify" in err
+    assert "Assumption 1" in err and "antenna identify" in err and "--controller" in err
+    # the same link, its controller given an identified file's threshold: detected on time
+    identified = tmp_path / "identified.toml"
+    identified.write_text(
+        'base = "paper-2021"\nname = "identified"\n[observer]\ncontact_threshold = 0.002\n',
+        encoding="utf-8",
+    )
+    controlled = [*args, "--antenna", str(antenna), "--controller", str(identified)]
+    assert main([*controlled, "--out", str(out)]) == 0
+    assert capsys.readouterr().err == ""
+    assert float(read_recording(out).metadata["true_deflection_ratio"]) < 0.1
 
 
 def test_simulate_warns_when_the_stop_leaves_no_spectrum_window(

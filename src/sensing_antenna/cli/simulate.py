@@ -74,6 +74,15 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("--antenna", default="paper-2021", help="built-in name or TOML file")
     parser.add_argument(
+        "--controller",
+        default=None,
+        metavar="FILE",
+        help="an antenna file (what antenna identify or calibrate wrote) whose observer and "
+        "contact threshold the simulated head's controller uses, as a lab's head uses its "
+        "identified file; the link simulated stays --antenna's, with --device's imperfections "
+        "(default: --antenna's observer)",
+    )
+    parser.add_argument(
         "--device",
         default="nominal",
         metavar="PROFILE|FILE",
@@ -140,6 +149,10 @@ def _run(args: argparse.Namespace) -> int:
             f" Hz, got {args.sample_rate:g}",
         )
     antenna = load_antenna(args.antenna)
+    if args.controller is not None:
+        from sensing_antenna.campaign.simulated import knowing_weight
+
+        antenna = knowing_weight(antenna, load_antenna(args.controller))
     _check_contact_point(args.case, args.xc, antenna.link)
     device = load_device(args.device, args.seed, antenna.link.length)
     push = None

@@ -258,7 +258,8 @@ def deflection_warning(recording: Recording) -> str | None:
         f"warning: final contact deflection y_c / x_c = {100 * ratio:.1f} % exceeds the"
         f" {100 * SMALL_DEFLECTION_LIMIT:.0f} % small-deflection limit (Assumption 1): the"
         " contact was detected late; identify the device's observer and contact threshold"
-        " (antenna identify) and simulate with that antenna"
+        " (antenna identify) and give the simulated head's controller that antenna file"
+        " (antenna simulate --controller)"
     )
 
 
