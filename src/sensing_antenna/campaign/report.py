@@ -53,6 +53,8 @@ from sensing_antenna.campaign.summary import (
     CampaignSummary,
     summarize_campaign,
 )
+from sensing_antenna.estimation.front.evidence import TWO_FREQUENCY_GRID_STEP
+from sensing_antenna.estimation.methods.fast import FastConfig
 from sensing_antenna.simulator.device import DeviceImperfections
 
 __all__ = ["FIGURES_DIR", "REPORT_FILE", "build_report", "render_report"]
@@ -394,7 +396,10 @@ def render_report(
         *devices_section(spec, summary, figures.devices, where),
         "## Figures",
         "",
-        "Main runs only (noise level of `[scenario]`).",
+        "Main runs only (noise level of `[scenario]`). The two-frequency method answers on its "
+        f"curve's {1e3 * TWO_FREQUENCY_GRID_STEP:g} mm grid and `fast` on its posterior's "
+        f"{1e3 * FastConfig().grid_step:g} mm grid, which hold the nominal points: an error "
+        "drawn at zero is a grid point on the contact, not an exact answer.",
         "",
     ]
     for path in figures.campaign:

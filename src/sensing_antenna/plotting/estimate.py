@@ -130,9 +130,12 @@ def _figure11(trace: FrontTrace, result: ContactEstimate, out: Path) -> Path:
     ax_t.set_title("Figure 11 - " + _title(result), fontsize=9)
     ax_r.plot(trace.t, trace.filtered_residual_norm, lw=1.0, label="|filtered residual|")
     ax_r.axhline(trace.contact_threshold, color="k", lw=0.8, label="threshold")
+    # on a log axis: an identified threshold lies far below the push's residual
+    ax_r.set_yscale("log", nonpositive="mask")
+    ax_r.set_ylim(bottom=trace.contact_threshold / 30.0)
     _mark(ax_r, result.t_c, "t_c", "C3")
     ax_r.set_xlabel("t (s)")
-    ax_r.set_ylabel("residual (N m)")
+    ax_r.set_ylabel("residual (N m, log)")
     ax_r.legend(fontsize=7)
     return save_figure(fig, out / "figure11-contact.png")
 
