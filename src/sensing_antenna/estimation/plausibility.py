@@ -91,6 +91,7 @@ from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
 from sensing_antenna.beam.modes import support_compliance_coefficients
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
+from sensing_antenna.estimation.disturbance import rest_line
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
 from sensing_antenna.estimation.front.evidence import (
     TWO_FREQUENCY_GRID_STEP,
@@ -219,6 +220,9 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     rocked = _base_motion_problem(evidence, estimate, notes) if judged else None
     if rocked is not None:
         found.append((Status.UNCERTAIN, rocked))
+    tone = _rest_line_problem(evidence, estimate, notes) if judged else None
+    if tone is not None:
+        found.append((Status.UNCERTAIN, tone))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
     bent = _bent_link_problem(evidence, estimate, notes) if on_link else None
     if bent is not None:
@@ -249,7 +253,7 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if turn is not None:
         found.append((Status.MODEL_MISMATCH, turn))
     interval = _on_link(estimate.interval, link.length)
-    if pinned is not None or lossy is not None or rocked is not None:
+    if pinned is not None or lossy is not None or rocked is not None or tone is not None:
         interval = _widened_to_statics(evidence, interval, end, notes)
     point_ok = _within_reach(estimate.contact_point, evidence)
     if not found and on_link:
@@ -664,6 +668,41 @@ def _base_motion_problem(
         "the calibration's posts measured): the base moving near omega_1 (a robot, a table "
         "rocking) puts a line beside the contact's fundamental that one window cannot part "
         "from it"
+    )
+
+
+#: Standard errors beyond which a line at omega_1 in the torques at rest before the contact is
+#: a disturbance: white noise leaves one there by chance about once in a hundred thousand.
+_REST_LINE_SIGMAS = 5.0
+
+
+def _rest_line_problem(
+    evidence: Evidence, estimate: ContactEstimate, notes: dict[str, Any]
+) -> str | None:
+    """Why the torques at rest before the contact hold a line at the answer's omega_1, or None.
+
+    Over each torque channel's rest at the start (the tare's, before t_c) a sinusoid at
+    omega_1 (:func:`~.disturbance.rest_line`) beyond :data:`_REST_LINE_SIGMAS` standard errors:
+    a steady disturbance in the band, which the ringing's fit may read for the contact's mode.
+    Not judged without a rest at the start or with less than half a period of omega_1 in it."""
+    omega1 = float(estimate.omega1)
+    if evidence.tare != "rest" or len(evidence.tare_samples) < 6:
+        return None
+    rests = tuple(min(n, evidence.contact_index) for n in evidence.tare_samples[3:6])
+    line = rest_line(evidence.t, evidence.torque, rests, omega1)
+    if line is None:
+        return None
+    notes["rest_line_sigmas"] = line.significance
+    if not line.significance > _REST_LINE_SIGMAS:
+        return None
+    return (
+        f"the torques at rest before the contact already ring at omega_1 ({omega1:.1f} rad/s): "
+        f"'{line.channel}' {line.amplitude:.2g} N m, {line.significance:.0f} standard errors, "
+        f"over the {line.samples} samples of its rest: a steady disturbance in the band (a "
+        "drive's PWM "
+        "or a switching supply aliased by a sampler without an anti-alias filter, a machine "
+        "nearby), which goes on through the hold and which the ringing's fit can take for the "
+        "contact's mode: filter or shield it before the samples are read"
     )
 
 
