@@ -54,12 +54,23 @@ def line_at(t: FloatArray, y: FloatArray, omega: float) -> tuple[float, float]:
     standard error from the residual (the parameters' covariance, so a window of about a
     period, where the sinusoid and the parabola trade, says so): (amplitude, standard error),
     in ``y``'s unit."""
+    with np.errstate(all="ignore"):  # loads beyond float range read as no line (NaN)
+        return _line_at(t, y, omega)
+
+
+def _line_at(t: FloatArray, y: FloatArray, omega: float) -> tuple[float, float]:
+    """:func:`line_at`, its arithmetic."""
+    if not np.all(np.isfinite(y)):
+        return math.nan, math.nan
     u = (t - t.mean()) / max(float(np.ptp(t)), 1e-12)
     design = np.column_stack(
         [np.cos(omega * t), np.sin(omega * t), np.ones_like(t), u, u**2 - 1.0 / 12.0]
     )
     columns = design.shape[1]
-    coefficients, _, rank, _ = np.linalg.lstsq(design, y, rcond=None)
+    try:
+        coefficients, _, rank, _ = np.linalg.lstsq(design, y, rcond=None)
+    except np.linalg.LinAlgError:
+        return math.nan, math.nan
     if rank < columns or t.size <= columns:
         return math.nan, math.nan
     residual = y - design @ coefficients

@@ -96,6 +96,24 @@ def held_line(
     torque about the joint (a line off each, Hann window). With ``compliance`` (rad/(N m)) the
     angle's excess over :data:`COMPLIANCE_MARGIN` times it. None when the window is too short
     or holds no finite spectrum."""
+    with np.errstate(all="ignore"):  # loads beyond float range read as no line (None)
+        line = _held_line(t, theta, torque, joint, omega1, compliance)
+    if line is None or not all(
+        math.isfinite(v) for v in (line.angle, line.torque, line.count, line.noise)
+    ):
+        return None
+    return line
+
+
+def _held_line(
+    t: FloatArray,
+    theta: FloatArray,
+    torque: FloatArray,
+    joint: int,
+    omega1: float,
+    compliance: float | None,
+) -> HeldLine | None:
+    """:func:`held_line`, its arithmetic."""
     n = t.shape[0]
     if n < 16 or not (math.isfinite(omega1) and omega1 > 0.0):
         return None
