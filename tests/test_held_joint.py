@@ -17,7 +17,7 @@ from sensing_antenna.calibration.frequency import (
     calibrate_from_recordings,
     held_compliance_from_recordings,
 )
-from sensing_antenna.estimation import Status, estimate
+from sensing_antenna.estimation import OnlineEstimator, Status, estimate
 from sensing_antenna.estimation.held_joint import held_line
 from sensing_antenna.recording import Recording
 from sensing_antenna.simulator import Scenario, simulate
@@ -136,3 +136,24 @@ def test_an_angle_ringing_beside_omega1_makes_the_answer_uncertain(
     # an antenna whose calibration did not measure the joint does not look for it
     unmeasured = estimate(rocked, calibrated(), "paper")
     assert "held_angle_excess" not in unmeasured.diagnostics
+
+
+def test_the_streaming_form_judges_the_held_angle_as_the_batch_form(
+    model: Antenna, manoeuvre: Recording
+) -> None:
+    # fast answers from a window shorter than the paper's second: the angle is judged over the
+    # samples the answer read, the same whether they came at once or one by one
+    plain = estimate(manoeuvre, model, "paper")
+    count = 2.0 * math.pi / 200_000
+    for amplitude in (0.0, 3.0):
+        rocked = _rocked(manoeuvre, 0.95 * plain.omega1, amplitude * count, plain.t_1)
+        offline = estimate(rocked, model, "fast")
+        online = OnlineEstimator(model, rocked.sample_period, "fast")
+        for k in range(rocked.n_samples):
+            found = online.update(rocked.t[k], rocked.theta[k], rocked.force[k], rocked.torque[k])
+            if found is not None:
+                break
+        assert found is not None
+        assert (found.status, found.x_c) == (offline.status, offline.x_c)
+        assert found.diagnostics["held_angle_excess"] == offline.diagnostics["held_angle_excess"]
+    assert offline.status is not Status.OK

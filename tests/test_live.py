@@ -1396,3 +1396,36 @@ def test_a_datagram_waits_no_longer_than_the_reorder_wait(
             recording.n_samples - lost,
             lost,
         )
+
+
+def test_an_end_that_overtakes_the_last_samples_waits_its_turn(
+    recordings: dict[str, Path],
+) -> None:
+    # the stream's end arrives a place early, before its last samples datagram: it waits, and
+    # the recording is heard whole
+    recording = read_recording(recordings["azimuthal"])
+    sent = _sent(recording, "s")
+    kinds = [decode_datagram(d).kind for d in sent]
+    last = max(k for k, kind in enumerate(kinds) if kind == "samples")
+    end = kinds.index("end")
+    said = _heard([*sent[:last], sent[end], *sent[last:end], *sent[end + 1 :]], count=1)
+    assert not [e for e in said if e["event"] == "skipped"]
+    assert (said[-1]["reason"], said[-1]["samples"]) == ("end of stream", recording.n_samples)
+
+
+def test_a_stream_begun_again_is_told_whatever_the_order_of_its_first_datagrams(
+    recordings: dict[str, Path],
+) -> None:
+    # the first recording's datagrams 0 to 2 lost (no lines to compare), the restarted
+    # stream's 0 and 1 swapped by the network: still three consecutive numbers from 0, the
+    # next recording begins with them and is heard whole
+    recording = read_recording(recordings["azimuthal"])
+    first = _at_rest(recording, "s", 0.001, datagrams=8, each=5)
+    again = _sent(recording, "s")
+    swapped = [again[0], again[2], again[1], *again[3:]]
+    said = _heard([first[0], *first[4:], *swapped], count=2)
+    ends = [(e["recording"], e["reason"], e["samples"]) for e in said if e["event"] == "end"]
+    assert ends == [
+        (1, "the stream began again (datagrams from 0); 3 datagrams of samples lost", 25),
+        (2, "end of stream", recording.n_samples),
+    ]

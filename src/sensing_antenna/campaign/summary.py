@@ -37,6 +37,7 @@ from sensing_antenna.campaign.tables import (
     run_points,
 )
 from sensing_antenna.campaign.targets import TargetSummary, target_summaries
+from sensing_antenna.simulator.scenario import N_ELEMENTS
 
 __all__ = [
     "PAPER_T",
@@ -330,7 +331,12 @@ def _summarize(
         noise=tuple(noise_level_errors(every, methods, spec.noise_scale)) if sweep else (),
         frequency=tuple(
             frequency_error_summaries(
-                every, device.link, methods, spec.noise_scale, built.link_part
+                every,
+                device.link,
+                methods,
+                spec.noise_scale,
+                built.link_part,
+                int(spec.scenario.get("n_elements", N_ELEMENTS)),
             )
         )
         if sweep

@@ -75,6 +75,10 @@ def _line_at(t: FloatArray, y: FloatArray, omega: float) -> tuple[float, float]:
         return math.nan, math.nan
     residual = y - design @ coefficients
     variance = float(residual @ residual) / (t.size - columns)
+    # noise that is not white (a sensor's own low-pass filter) has more power near omega than
+    # its variance says: the least-squares error scaled by the residual's spectral density at
+    # omega over its mean (never below 1)
+    variance *= _colour(residual, omega * float(np.median(np.diff(t))))
     covariance = variance * np.linalg.inv(design.T @ design)[:2, :2]
     amplitude = math.hypot(float(coefficients[0]), float(coefficients[1]))
     if amplitude > 0.0:
@@ -83,6 +87,26 @@ def _line_at(t: FloatArray, y: FloatArray, omega: float) -> tuple[float, float]:
     else:
         error = math.sqrt(max(float(np.trace(covariance)) / 2.0, 0.0))
     return amplitude, error
+
+
+def _colour(residual: FloatArray, phase: float) -> float:
+    """The residual's spectral density at ``phase`` (rad per sample) over its variance, at
+    least 1: that of an autoregressive model of order 2 fitted to it (Yule-Walker), which
+    takes a sensor's low-pass filter of second order."""
+    n = residual.size
+    centred = residual - residual.mean()
+    gamma = [float(centred[k:] @ centred[: n - k]) / n for k in range(3)]
+    if not gamma[0] > 0.0:
+        return 1.0
+    matrix = np.array([[gamma[0], gamma[1]], [gamma[1], gamma[0]]])
+    try:
+        a = np.linalg.solve(matrix, np.array([gamma[1], gamma[2]]))
+    except np.linalg.LinAlgError:
+        return 1.0
+    innovation = gamma[0] - float(a @ np.array([gamma[1], gamma[2]]))
+    response = 1.0 - a[0] * np.exp(-1j * phase) - a[1] * np.exp(-2j * phase)
+    density = innovation / max(float(abs(response) ** 2), 1e-12)
+    return max(1.0, density / gamma[0]) if math.isfinite(density) else 1.0
 
 
 #: The torque channels, in the recording's order.

@@ -60,7 +60,8 @@ class HeldLine:
     count : float
         The encoder's count: the angle column's smallest step over the window (rad).
     noise : float
-        The angle's median amplitude from half to twice omega_1 (rad).
+        The angle's median amplitude from half to twice omega_1 outside the window's main lobe
+        about omega_1 and the band searched (rad); NaN where nothing is left outside.
     """
 
     joint: int
@@ -98,9 +99,7 @@ def held_line(
     or holds no finite spectrum."""
     with np.errstate(all="ignore"):  # loads beyond float range read as no line (None)
         line = _held_line(t, theta, torque, joint, omega1, compliance)
-    if line is None or not all(
-        math.isfinite(v) for v in (line.angle, line.torque, line.count, line.noise)
-    ):
+    if line is None or not all(math.isfinite(v) for v in (line.angle, line.torque, line.count)):
         return None
     return line
 
@@ -132,9 +131,12 @@ def _held_line(
         line = np.polyval(np.polyfit(offset, signal, 1), offset)
         spectra.append(np.abs(np.fft.rfft((signal - line) * window, size)) * 2.0 / window.sum())
     frequencies = 2.0 * math.pi * np.fft.rfftfreq(size, duration / (n - 1))
-    near = np.abs(frequencies - omega1) <= min(4.0 * math.pi / duration, _NEAR_SHARE * omega1)
+    lobe = 4.0 * math.pi / duration
+    near = np.abs(frequencies - omega1) <= min(lobe, _NEAR_SHARE * omega1)
+    # the noise beside the band: a line within it spreads over the main lobe about it
     wide = (frequencies > 0.5 * omega1) & (frequencies < 2.0 * omega1)
-    if not np.any(near) or not np.any(wide):
+    wide &= np.abs(frequencies - omega1) > min(lobe, _NEAR_SHARE * omega1) + lobe
+    if not np.any(near):
         return None
     at = int(np.argmin(np.abs(frequencies - omega1)))
     steps = np.abs(np.diff(angle))
@@ -149,7 +151,7 @@ def _held_line(
         torque=float(spectra[1][at]),
         excess=excess,
         count=float(np.min(steps)) if steps.size else 0.0,
-        noise=float(np.median(spectra[0][wide])),
+        noise=float(np.median(spectra[0][wide])) if np.any(wide) else math.nan,
     )
 
 

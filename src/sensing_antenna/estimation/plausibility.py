@@ -91,7 +91,7 @@ from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
 from sensing_antenna.beam.modes import support_compliance_coefficients
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
-from sensing_antenna.estimation.disturbance import rest_line
+from sensing_antenna.estimation.disturbance import line_at, rest_line
 from sensing_antenna.estimation.front.contact_frame import motor_axes, to_absolute
 from sensing_antenna.estimation.front.evidence import (
     TWO_FREQUENCY_GRID_STEP,
@@ -217,10 +217,10 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     lossy = _lossy_contact_problem(evidence, estimate, end, notes) if judged and not told else None
     if lossy is not None:
         found.append((Status.UNCERTAIN, lossy))
-    rocked = _base_motion_problem(evidence, estimate, notes) if judged else None
+    rocked = _base_motion_problem(evidence, estimate, end, notes) if judged else None
     if rocked is not None:
         found.append((Status.UNCERTAIN, rocked))
-    tone = _rest_line_problem(evidence, estimate, notes) if judged else None
+    tone = _rest_line_problem(evidence, estimate, end, notes) if judged else None
     if tone is not None:
         found.append((Status.UNCERTAIN, tone))
     found.extend(_vibration_problems(evidence, estimate, end, notes))
@@ -626,11 +626,12 @@ _HELD_NOISE_FACTOR = 10.0
 
 
 def _base_motion_problem(
-    evidence: Evidence, estimate: ContactEstimate, notes: dict[str, Any]
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
 ) -> str | None:
     """Why the swept joint's angle says the base moved near omega_1, or None.
 
-    Over the window omega_1 was read from, the held joint's angle near omega_1 beyond
+    Over the samples check 3 reads (t_1 to the estimate's t_e, at most Delta t_e1: the same in
+    the batch and the streaming forms), the held joint's angle near omega_1 beyond
     :data:`~.held_joint.COMPLIANCE_MARGIN` times what the link's torque turns it by (the
     joint's ``held_compliance``, measured by the calibration's posts) by more than an encoder
     count (or :data:`_HELD_NOISE_FACTOR` times the angle's noise, the larger): the base moving
@@ -643,7 +644,7 @@ def _base_motion_problem(
     compliance = evidence.antenna.motors[joint].held_compliance
     if compliance is None:
         return None
-    window = evidence.spectrum_slice
+    window = _check3_window(evidence, end)
     line = held_line(
         evidence.t[window],
         evidence.theta[window],
@@ -654,6 +655,8 @@ def _base_motion_problem(
     )
     if line is None:
         return None
+    if not math.isfinite(line.noise):
+        return None  # a window too short to read the noise beside the band
     floor = max(line.count, _HELD_NOISE_FACTOR * line.noise)
     if not floor > 0.0:
         return None
@@ -672,12 +675,19 @@ def _base_motion_problem(
 
 
 #: Standard errors beyond which a line at omega_1 in the torques at rest before the contact is
-#: a disturbance: white noise leaves one there by chance about once in a hundred thousand.
-_REST_LINE_SIGMAS = 5.0
+#: a disturbance: white noise leaves one there by chance about once in 10^14; noise through a
+#: sensor's second-order low-pass filter (its colour in the error) about once in a thousand at
+#: 100 Hz, three times in a thousand at 50 Hz, over 80 to 200 samples of a channel.
+_REST_LINE_SIGMAS = 8.0
+
+#: Least amplitude of such a line over the contact's ringing at omega_1 (the torque channel
+#: that rings most, over the samples check 3 reads) for it to matter: a line far below the
+#: ringing moves no fit (a long, quiet rest finds lines of a fraction of a count).
+_REST_LINE_SHARE = 0.05
 
 
 def _rest_line_problem(
-    evidence: Evidence, estimate: ContactEstimate, notes: dict[str, Any]
+    evidence: Evidence, estimate: ContactEstimate, end: int, notes: dict[str, Any]
 ) -> str | None:
     """Why the torques at rest before the contact hold a line at the answer's omega_1, or None.
 
@@ -692,8 +702,14 @@ def _rest_line_problem(
     line = rest_line(evidence.t, evidence.torque, rests, omega1)
     if line is None:
         return None
+    window = _check3_window(evidence, end)
+    ringing = max(
+        line_at(evidence.t[window], evidence.torque[window, k], omega1)[0] for k in range(3)
+    )
+    share = line.amplitude / ringing if ringing > 0.0 else math.inf
     notes["rest_line_sigmas"] = line.significance
-    if not line.significance > _REST_LINE_SIGMAS:
+    notes["rest_line_share"] = share
+    if not (line.significance > _REST_LINE_SIGMAS and share > _REST_LINE_SHARE):
         return None
     return (
         f"the torques at rest before the contact already ring at omega_1 ({omega1:.1f} rad/s): "

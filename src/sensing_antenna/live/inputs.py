@@ -60,10 +60,11 @@ IDLE_END = 2.0
 #: process (a fast method's final estimate takes well under a second).
 INTERRUPTED_WAIT = 2.0
 
-#: A UDP datagram that arrives before one numbered below it waits for it, with those after it,
-#: until this many wait or the first waited :data:`REORDER_WAIT`: a network delivers datagrams
-#: out of order, mostly by a place or two (left out, a late datagram's samples would be put
-#: back by interpolation). Then the missing one counts as lost.
+#: A UDP datagram that arrives before one numbered below it waits for it, with those after it
+#: (the stream's ``end`` too), until more than this many wait or the first waited
+#: :data:`REORDER_WAIT`: a network delivers datagrams out of order, mostly by a place or two
+#: (left out, a late datagram's samples would be put back by interpolation). Then the missing
+#: one counts as lost.
 REORDER_DEPTH = 8
 
 #: The longest a datagram waits (s) for one numbered below it (:data:`REORDER_DEPTH`).
@@ -221,6 +222,7 @@ class _UdpStream:
         self.held: list[tuple[Datagram, float]] = []  # datagrams numbered below, since then
         self.first: dict[int, tuple[str, ...]] = {}  # the lines of its first datagrams taken
         self.ahead: dict[int, tuple[Datagram, float]] = {}  # waiting for one numbered below
+        self.ended = False  # its end came in its turn, after the datagrams that waited
 
     @property
     def reached(self) -> int:
@@ -339,6 +341,10 @@ def listen_udp(
     try:
         timeout = min(idle, 0.2)
         while count is None or ended < count:
+            if current is not None and current.ended:
+                ended += finish(current, "end of stream")
+                current = None
+                continue
             waiting = current is not None and bool(current.ahead)
             if timeout != (wanted := REORDER_WAIT if waiting else min(idle, 0.2)):
                 sock.settimeout(timeout := wanted)
@@ -357,6 +363,8 @@ def listen_udp(
             except WireError as exc:
                 skip(str(exc))
                 continue
+            if current is not None and current.ahead:
+                take(None, received)  # the wait is over whatever stream's datagram came
             if datagram.stream in refused:
                 if datagram.kind == "end":
                     refused.discard(datagram.stream)
@@ -408,11 +416,17 @@ def listen_udp(
                 continue  # a repeated header, or samples of a stream not joined
             elif datagram.kind == "end":
                 assert current is not None
-                take(None, received, flush=True)
-                if current is not None:
-                    current.lost += max(0, datagram.seq - current.expected)
-                    ended += finish(current, "end of stream")
-                    current = None
+                if datagram.seq > current.expected:
+                    # samples numbered below it are missing: it waits its turn as they do (a
+                    # repeated end already waiting adds nothing)
+                    current.ahead.setdefault(datagram.seq, (datagram, received))
+                    take(None, received)
+                else:
+                    take(None, received, flush=True)
+                    if current is not None:
+                        current.lost += max(0, datagram.seq - current.expected)
+                        ended += finish(current, "end of stream")
+                        current = None
             else:
                 take(datagram, received)
         return ended
@@ -428,9 +442,9 @@ def listen_udp(
 
 
 #: After a stream's first header came again, datagrams numbered below those already heard:
-#: this many in order, the first numbered below it, or one of its first datagrams with other
-#: lines than it had, tell the sender began the stream again. Others are copies and late
-#: datagrams of the stream, which a network delivers too.
+#: this many with consecutive numbers, the smallest below it (in any order of arrival), or one
+#: of its first datagrams with other lines than it had, tell the sender began the stream again.
+#: Others are copies and late datagrams of the stream, which a network delivers too.
 _BEGUN_AGAIN = 3
 
 
@@ -438,12 +452,13 @@ def _begun_again(held: list[tuple[Datagram, float]], first: dict[int, tuple[str,
     """Whether the datagrams ``held`` since a stream's first header came again (in the order
     they arrived) are the stream begun again (:data:`_BEGUN_AGAIN`); ``first``: the lines of
     the stream's first datagrams, by number."""
-    numbers = [datagram.seq for datagram, _ in held]
+    numbers = sorted({datagram.seq for datagram, _ in held})[:_BEGUN_AGAIN]
     other = any(d.seq in first and d.lines != first[d.seq] for d, _ in held)
+    # in any order of arrival (the network's), consecutive from below the count
     return other or (
-        len(numbers) >= _BEGUN_AGAIN
+        len(numbers) == _BEGUN_AGAIN
         and numbers[0] < _BEGUN_AGAIN
-        and all(a < b for a, b in itertools.pairwise(numbers))
+        and all(b == a + 1 for a, b in itertools.pairwise(numbers))
     )
 
 
@@ -477,6 +492,12 @@ def _release(
         if first != current.expected and not over:
             return
         datagram, received = ahead.pop(first)
+        if datagram.kind == "end":
+            # the stream's end in its turn: the datagrams numbered below it are lost
+            current.lost += max(0, datagram.seq - current.expected)
+            current.ended = True
+            ahead.clear()
+            return
         _receive_samples(current, datagram, received, skip)
 
 

@@ -297,13 +297,18 @@ def conclude(
         if ratio_drift > drift_limit:
             # the ratio is moment over force: a force offset d moves it by about r d / F
             offset = push_force * ratio_drift / settled if settled > 0.0 else math.nan
+            drifting = (
+                f": the contact sliding along the link, or the sensor's force offset drifting "
+                f"by {1e3 * offset:.2g} mN under this push of {1e3 * push_force:.2g} mN, which "
+                "moves the ratio as much"
+                if math.isfinite(offset)
+                else ""
+            )
             found.append(
                 (
                     Status.SLIP_SUSPECTED,
                     f"the torque/force ratio moved by {ratio_drift:.3f} m after it had settled "
-                    f"(limit {drift_limit:.3f} m): the contact sliding along the link, or the "
-                    f"sensor's force offset drifting by {1e3 * offset:.2g} mN under this push "
-                    f"of {1e3 * push_force:.2g} mN, which moves the ratio as much",
+                    f"(limit {drift_limit:.3f} m){drifting}",
                 )
             )
     touch, frame, t_point = touched_point_filtered(evidence, x_c, e)
