@@ -620,8 +620,9 @@ _OWN_DAMPING_FACTOR = 2.0
 
 
 #: The held joint's angle near omega_1 is judged beyond this many times its median amplitude
-#: from half to twice omega_1 where that exceeds the encoder's count (an encoder read finer than
-#: its noise): the largest of a few hundred bins of noise lies within about three.
+#: beside the band (half to twice omega_1, outside the main lobe about it) where that exceeds the
+#: encoder's count (an encoder read finer than its noise): the largest of a few hundred bins of
+#: noise lies within about three.
 _HELD_NOISE_FACTOR = 10.0
 
 
@@ -692,9 +693,10 @@ def _rest_line_problem(
     """Why the torques at rest before the contact hold a line at the answer's omega_1, or None.
 
     Over each torque channel's rest at the start (the tare's, before t_c) a sinusoid at
-    omega_1 (:func:`~.disturbance.rest_line`) beyond :data:`_REST_LINE_SIGMAS` standard errors:
-    a steady disturbance in the band, which the ringing's fit may read for the contact's mode.
-    Not judged without a rest at the start or with less than half a period of omega_1 in it."""
+    omega_1 (:func:`~.disturbance.rest_line`) beyond :data:`_REST_LINE_SIGMAS` standard errors
+    and :data:`_REST_LINE_SHARE` of the contact's ringing at omega_1: a steady disturbance in
+    the band, which the ringing's fit may read for the contact's mode. Not judged without a
+    rest at the start or with less than half a period of omega_1 in it."""
     omega1 = float(estimate.omega1)
     if evidence.tare != "rest" or len(evidence.tare_samples) < 6:
         return None
