@@ -704,14 +704,16 @@ def _rest_line_problem(
     line = rest_line(evidence.t, evidence.torque, rests, omega1)
     if line is None:
         return None
+    notes["rest_line_sigmas"] = line.significance
+    if not line.significance > _REST_LINE_SIGMAS:
+        return None
     window = _check3_window(evidence, end)
     ringing = max(
         line_at(evidence.t[window], evidence.torque[window, k], omega1)[0] for k in range(3)
     )
     share = line.amplitude / ringing if ringing > 0.0 else math.inf
-    notes["rest_line_sigmas"] = line.significance
     notes["rest_line_share"] = share
-    if not (line.significance > _REST_LINE_SIGMAS and share > _REST_LINE_SHARE):
+    if not share > _REST_LINE_SHARE:
         return None
     return (
         f"the torques at rest before the contact already ring at omega_1 ({omega1:.1f} rad/s): "
