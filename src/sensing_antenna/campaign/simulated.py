@@ -317,9 +317,12 @@ def calibrate_on_device(
         raise CampaignSpecError(
             "calibration", f"the calibration step failed: {exc}", spec.source or None
         ) from exc
-    # the held joints' servos from every post, both sweeps: the fit takes the step's case only
+    # the held joints' servos from every post, both sweeps (the fit takes the step's case
+    # only), those the fit left out excepted, as antenna calibrate leaves them out
+    left_out = {i for j, i in enumerate(own) if not calibration.used[j]}
+    posts = [r for i, r in enumerate(recordings) if i not in left_out]
     calibrated = calibration.apply(model).with_held_compliance(
-        *held_compliance_from_recordings(recordings, model)
+        *held_compliance_from_recordings(posts, model)
     )
     if step.sensor:
         try:
