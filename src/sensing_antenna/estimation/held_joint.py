@@ -16,6 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from sensing_antenna.estimation.front.contact_frame import motor_axes
+from sensing_antenna.estimation.front.spectrum import amplitude_spectrum
+
 FloatArray = NDArray[np.float64]
 
 __all__ = [
@@ -40,7 +43,8 @@ MIN_POSTS = 3
 #: fundamental.
 _NEAR_SHARE = 0.1
 
-#: Zero padding of the spectra: the peaks read between the bins.
+#: Zero padding of the spectra (to the power of two at or above this many times the window):
+#: the peaks read between the bins.
 _PAD = 8
 
 
@@ -120,17 +124,11 @@ def _held_line(
     if not duration > 0.0:
         return None
     angle = np.asarray(theta[:, joint], dtype=float)
-    about = _torque_about(theta, torque, joint)
-    window = np.hanning(n)
-    size = _PAD * n
-    spectra = []
-    offset = t - t[0]
-    for signal in (angle, about):
-        if not np.all(np.isfinite(signal)):
-            return None
-        line = np.polyval(np.polyfit(offset, signal, 1), offset)
-        spectra.append(np.abs(np.fft.rfft((signal - line) * window, size)) * 2.0 / window.sum())
-    frequencies = 2.0 * math.pi * np.fft.rfftfreq(size, duration / (n - 1))
+    signals = np.column_stack([angle, _torque_about(theta, torque, joint)])
+    if not np.all(np.isfinite(signals)):
+        return None
+    frequencies, amplitudes = amplitude_spectrum(signals, duration / (n - 1), _PAD)
+    spectra = (amplitudes[:, 0], amplitudes[:, 1])
     lobe = 4.0 * math.pi / duration
     near = np.abs(frequencies - omega1) <= min(lobe, _NEAR_SHARE * omega1)
     # the noise beside the band: a line within it spreads over the main lobe about it
@@ -157,9 +155,9 @@ def _held_line(
 
 def _torque_about(theta: FloatArray, torque: FloatArray, joint: int) -> FloatArray:
     """The link's moment about the joint's axis (N m), from the motor frame's torques: the
-    elevation's axis is Y^m, the azimuth's Z^a = sin theta_2 X^m + cos theta_2 Z^m (up to
-    signs, which an amplitude does not see)."""
+    elevation's axis is Y^m, the azimuth's the absolute Z^a, whose motor-frame components are
+    the last column of :func:`~.front.contact_frame.motor_axes`."""
     if joint == 1:
         return np.asarray(torque[:, 1], dtype=float)
-    theta2 = np.asarray(theta[:, 1], dtype=float)
-    return np.asarray(np.sin(theta2) * torque[:, 0] + np.cos(theta2) * torque[:, 2], dtype=float)
+    vertical = motor_axes(np.asarray(theta, dtype=float))[:, :, 2]
+    return np.asarray(np.einsum("ij,ij->i", torque, vertical), dtype=float)

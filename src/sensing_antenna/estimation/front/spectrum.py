@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["power_spectrum"]
+__all__ = ["amplitude_spectrum", "power_spectrum"]
 
 FloatArray = NDArray[np.float64]
 
@@ -38,6 +38,33 @@ def power_spectrum(
     power : array, shape (m,) or (m, k)
         |FFT|^2 of each column (signal units squared).
     """
+    omega, spectrum, _ = _transform(signal, sample_period, zero_padding)
+    power = np.asarray(spectrum.real**2 + spectrum.imag**2, dtype=float)
+    return omega, power
+
+
+def amplitude_spectrum(
+    signal: FloatArray, sample_period: float, zero_padding: int = 16
+) -> tuple[FloatArray, FloatArray]:
+    """The same transform as :func:`power_spectrum`, scaled to amplitudes: a sinusoid of
+    amplitude A reads A at its frequency's bin (the window's gain taken off).
+
+    Returns
+    -------
+    omega : array, shape (m,)
+        Angular frequencies (rad/s).
+    amplitude : array, shape (m,) or (m, k)
+        Amplitudes of each column (signal units).
+    """
+    omega, spectrum, gain = _transform(signal, sample_period, zero_padding)
+    return omega, np.asarray(2.0 * np.abs(spectrum) / gain, dtype=float)
+
+
+def _transform(
+    signal: FloatArray, sample_period: float, zero_padding: int
+) -> tuple[FloatArray, NDArray[np.complex128], float]:
+    """Angular frequencies, the one-sided FFT of the detrended, Hann-windowed, zero-padded
+    signals, and the window's sum (its gain at a bin's centre)."""
     x = np.asarray(signal, dtype=float)
     n = x.shape[0]
     if n < 4:
@@ -52,5 +79,4 @@ def power_spectrum(
     n_fft = 1 << max(0, math.ceil(math.log2(zero_padding * n)))
     spectrum = np.fft.rfft(tapered, n=n_fft, axis=0)
     omega = 2.0 * np.pi * np.fft.rfftfreq(n_fft, d=sample_period)
-    power = np.asarray(spectrum.real**2 + spectrum.imag**2, dtype=float)
-    return np.asarray(omega, dtype=float), power
+    return np.asarray(omega, dtype=float), spectrum, float(window.sum())
