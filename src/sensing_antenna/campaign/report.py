@@ -98,7 +98,7 @@ def _imperfection_lines(spec: CampaignSpec, length: float) -> list[str]:
     fixed = ", ".join(f"{k} = {v}" for k, v in sorted(spec.device.imperfections.items()))
     profile = spec.device.profile
     if profile == "realistic":
-        built = spec.device.imperfections_for(spec.base_seed, length, spec.base_seed)
+        built = spec.device.as_built(length, spec.base_seed)
         profile = (
             f"realistic (device build {spec.device.build_of(spec.base_seed)}: "
             f"{_built_link(built)}; its set-up drawn per manoeuvre from its seed)"

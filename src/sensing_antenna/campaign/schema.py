@@ -251,6 +251,11 @@ class DeviceSpec:
         given = {key: getattr(fixed, key) for key in self.imperfections}
         return replace(drawn, **given)
 
+    def as_built(self, length: float, base_seed: int) -> DeviceImperfections:
+        """The imperfections every manoeuvre of the device shares, its build's (tip mass,
+        clamp, taper, joint, sensor), with the set-up of the campaign's first seed."""
+        return self.imperfections_for(base_seed, length, base_seed)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data in the layout of the TOML section (the profile and imperfections only
         when set, so a spec without them keeps its fingerprint)."""

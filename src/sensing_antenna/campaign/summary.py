@@ -311,7 +311,7 @@ def _summarize(
     cases, methods = spec.cases, spec.methods
     sweep = spec.noise_sweep.enabled
     # the link as built: what the device's build adds to its file (a tip mass, a clamp, ...)
-    built = spec.device.imperfections_for(spec.base_seed, device.link.length, spec.base_seed)
+    built = spec.device.as_built(device.link.length, spec.base_seed)
     link = replace(device.link, tip_mass=device.link.tip_mass + built.tip_mass)
     return CampaignSummary(
         n_results=len(results),

@@ -212,7 +212,7 @@ def _run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     print(_mode2_line(calibration))
-    print(_held_line(calibration))
+    print(_held_joints_line(calibration))
     wrong = calibration.wrong_peak_points
     doubtful = calibration.kept_far_points
     for i, x_c in enumerate(calibration.contact_points):
@@ -267,7 +267,7 @@ def _mode2_line(calibration: FrequencyCalibration) -> str:
     )
 
 
-def _held_line(calibration: FrequencyCalibration) -> str:
+def _held_joints_line(calibration: FrequencyCalibration) -> str:
     """What the calibration measured of the held joints' compliance, in one line."""
     from sensing_antenna.estimation.held_joint import MIN_POSTS
 

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from sensing_antenna.estimation.front.spikes import WRENCH_CHANNELS
+
 FloatArray = NDArray[np.float64]
 
 __all__ = ["RestLine", "line_at", "rest_line"]
@@ -109,10 +111,6 @@ def _colour(residual: FloatArray, phase: float) -> float:
     return max(1.0, density / gamma[0]) if math.isfinite(density) else 1.0
 
 
-#: The torque channels, in the recording's order.
-_TORQUES = ("tx", "ty", "tz")
-
-
 def rest_line(
     t: FloatArray, torque: FloatArray, rests: tuple[int, ...], omega: float
 ) -> RestLine | None:
@@ -122,7 +120,7 @@ def rest_line(
     if not (math.isfinite(omega) and omega > 0.0):
         return None
     best: RestLine | None = None
-    for k, name in enumerate(_TORQUES):
+    for k, name in enumerate(WRENCH_CHANNELS[3:]):
         n = min(int(rests[k]), t.shape[0])
         if n < 16 or float(t[n - 1] - t[0]) < math.pi / omega:
             continue

@@ -259,6 +259,11 @@ def listen_udp(
     def skip(reason: str) -> None:
         on_event(SkippedEvent(numbered if current is not None else numbered + 1, reason))
 
+    def leave_out(name: str, exc: Exception) -> None:
+        """Say why the stream ``name`` is left out, and ignore it until its end."""
+        skip(f"{exc}: the stream is left out")
+        refused.add(name)
+
     def join(datagram: Datagram, received: float, ending: str) -> bool:
         """Begin the recording whose header ``datagram`` is, ending the one being received
         (``ending``: its end's reason) unless the header is refused; False when that end
@@ -293,8 +298,7 @@ def listen_udp(
         try:
             listener = make(header, numbered + 1)
         except RecordingError as exc:  # its header refused for this antenna
-            skip(f"{exc}: the stream is left out")
-            refused.add(name)
+            leave_out(name, exc)
             return True
         numbered += 1
         current = _UdpStream(listener, datagram)
@@ -314,8 +318,7 @@ def listen_udp(
                 _arrive(current, datagram, received, skip)
             _release(current, received, skip, flush)
         except WireError as exc:
-            skip(f"{exc}: the stream is left out")
-            refused.add(current.name)
+            leave_out(current.name, exc)
             _close_quietly(current.listener)
             current = None
 
@@ -326,15 +329,13 @@ def listen_udp(
         try:
             _release(stream, clock(), skip, flush=True)
         except WireError as exc:
-            skip(f"{exc}: the stream is left out")
-            refused.add(stream.name)
+            leave_out(stream.name, exc)
             _close_quietly(stream.listener)
             return 0
         try:
             stream.close(reason)
         except WireError as exc:
-            skip(f"{exc}: the stream is left out")
-            refused.add(stream.name)
+            leave_out(stream.name, exc)
             return 0
         return 1
 
