@@ -28,6 +28,7 @@ from sensing_antenna.antenna import Link
 from sensing_antenna.campaign.records import CampaignRow
 from sensing_antenna.campaign.schema import noise_level_key, same_noise_level
 from sensing_antenna.simulator.device import DeviceImperfections
+from sensing_antenna.simulator.scenario import N_ELEMENTS
 
 __all__ = [
     "FIXED_DELAY_TOLERANCE",
@@ -489,20 +490,19 @@ def frequency_error_summaries(
     methods: Sequence[str],
     main: float,
     imperfections: DeviceImperfections | None = None,
-    n_elements: int | None = None,
+    n_elements: int = N_ELEMENTS,
 ) -> list[FrequencyErrorSummary]:
     """omega_1 errors of every method that reports one, per noise level (ascending).
 
     ``link`` is the device's link (the simulated hardware), ``imperfections`` what its build
     adds to it (tip mass, clamp, taper, joint; None: nothing): the truth is the contact-mode
     fundamental of the simulator's finite-element model of that link pinned at each run's
-    contact abscissa (the nominal x_c when unknown), of ``n_elements`` elements as the runs'
-    (None: the simulator's default). Methods without any finite omega_1 are left out.
+    contact abscissa (the nominal x_c when unknown), of ``n_elements`` elements as the runs'.
+    Methods without any finite omega_1 are left out.
     """
     from sensing_antenna.simulator.link import build_link_model
-    from sensing_antenna.simulator.scenario import N_ELEMENTS
 
-    model = build_link_model(link, N_ELEMENTS if n_elements is None else n_elements, imperfections)
+    model = build_link_model(link, n_elements, imperfections)
     all_rows = list(rows)
     summaries = []
     for level in noise_levels(all_rows, main):

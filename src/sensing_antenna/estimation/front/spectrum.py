@@ -1,4 +1,5 @@
-"""The power spectrum Estimator 1 reads: detrended, Hann-windowed, zero-padded (Section 5.4).
+"""The spectrum Estimator 1 reads: detrended, Hann-windowed, zero-padded (Section 5.4), as
+power or, for the held joint's check, amplitude.
 
 Shared by the evidence, whose spectrum of the torque over the Delta t_e1 window is computed once,
 when a method first reads it (:attr:`~.evidence.Evidence.window_spectrum`), the methods, and the
