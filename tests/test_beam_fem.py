@@ -315,13 +315,15 @@ def test_support_compliance_coefficients_match_finite_element_reactions(ratio: f
     # mode i; in the link's units omega_i falls by the fraction c_i / k with
     # c_i = (E I / l^3) R_i^2 / (2 Lambda_i), here E I = 10 N m^2 and l = 1 m.
     link = _link(ratio)
-    for xi in XI_GRID:
+    # one call over the grid (shape (points, modes)), each row against its own FE model
+    every = support_compliance_coefficients(link, np.array(XI_GRID), 2)
+    assert every.shape == (len(XI_GRID), 2)
+    for xi, got in zip(XI_GRID, every, strict=True):
         values, _, contact, full, big_k, big_m = _fe_modes(xi, ratio, 2, ELEMENT_LENGTH)
         expected = []
         for i in range(2):
             reaction = float(((big_k - values[i] * big_m) @ full[:, i])[2 * contact])
             expected.append(10.0 * reaction**2 / (2.0 * values[i]))
-        got = support_compliance_coefficients(link, xi, 2)
         # 1e-3 of the larger coefficient: the mesh's h = 1/100 leaves 1e-4 in the shear jump
         # (its third derivatives are the least converged), and a node of mode 2's shear
         # (xi = 0.5 without a tip mass) makes c_2 vanish

@@ -38,6 +38,7 @@ _KRYLOV_TERMS = 12
 #: Gauss-Legendre nodes per span for the modal-mass integral; exact for polynomials of degree
 #: 2 * 48 - 1 and far more than the few half-waves of the modes this module is used for.
 _QUADRATURE_NODES = 48
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(_QUADRATURE_NODES)
 
 
 def frequency_scale(link: Link) -> float:
@@ -167,7 +168,7 @@ def _evaluate(lam: float, pieces: list[tuple[float, FloatArray]], s: FloatArray)
 
 def _normalise(lam: float, pieces: list[tuple[float, FloatArray]], ratio: float) -> float:
     """Factor giving int_0^1 phi^2 ds + R_m phi(1)^2 = 1, signed so the largest value is > 0."""
-    nodes, weights = np.polynomial.legendre.leggauss(_QUADRATURE_NODES)
+    nodes, weights = _NODES, _WEIGHTS
     mass = 0.0
     samples = []
     start = 0.0
@@ -296,7 +297,7 @@ def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
     xi = contact_ratio(link, x_c)
     ratio = link.tip_mass_ratio
     lams = eigenvalues(xi, 1, ratio)[..., 0]
-    nodes, weights = np.polynomial.legendre.leggauss(_QUADRATURE_NODES)
+    nodes, weights = _NODES, _WEIGHTS
     zero = np.zeros(1)
     out = np.empty(xi.shape)
     for index in np.ndindex(xi.shape):
@@ -313,7 +314,7 @@ def held_contact_coupling(link: Link, x_c: ArrayLike) -> FloatArray:
     return out
 
 
-def support_compliance_coefficients(link: Link, x_c: float, n_modes: int = 2) -> FloatArray:
+def support_compliance_coefficients(link: Link, x_c: ArrayLike, n_modes: int = 2) -> FloatArray:
     """c_i (N/m): a support of finite stiffness k (N/m) at ``x_c`` in place of the pin lowers
     omega_i by the fraction c_i / k, to first order in 1 / k.
 
@@ -331,28 +332,25 @@ def support_compliance_coefficients(link: Link, x_c: float, n_modes: int = 2) ->
     Parameters
     ----------
     link : Link
-    x_c : float
-        Contact point in (0, l] (m).
+    x_c : array_like
+        Contact points in (0, l] (m).
     n_modes : int
         Number of modes, >= 1.
 
     Returns
     -------
     ndarray
-        Shape ``(n_modes,)`` (N/m).
+        Shape ``x_c.shape + (n_modes,)`` (N/m).
     """
-    xi_arr = contact_ratio(link, x_c)
-    if xi_arr.ndim != 0:
-        raise BeamInputError("x_c", f"must be a single contact point, got shape {xi_arr.shape}")
-    xi = float(xi_arr)
+    xi = contact_ratio(link, x_c)
     n = check_mode_count(n_modes)
     ratio = link.tip_mass_ratio
     lams = eigenvalues(xi, n, ratio)
     stiffness = 1.0 / (link.bending_compliance * link.length**3)
-    out = np.empty(n)
-    for i, lam_value in enumerate(lams):
-        lam = float(lam_value)
-        pieces = _mode_coefficients(lam, xi, ratio)
+    out = np.empty((*xi.shape, n))
+    for index in np.ndindex(out.shape):
+        lam = float(lams[index])
+        pieces = _mode_coefficients(lam, float(xi[index[:-1]]), ratio)
         scale = _normalise(lam, pieces, ratio)
         first_length, first = pieces[0]
         left = float(_basis(3, lam, first_length, np.array([first_length]))[0] @ first)
@@ -360,5 +358,5 @@ def support_compliance_coefficients(link: Link, x_c: float, n_modes: int = 2) ->
         if len(pieces) > 1:
             right = float(_basis(3, lam, pieces[1][0], np.zeros(1))[0] @ pieces[1][1])
         jump = scale * (right - left)
-        out[i] = stiffness * jump**2 / (2.0 * lam**4)
+        out[index] = stiffness * jump**2 / (2.0 * lam**4)
     return out

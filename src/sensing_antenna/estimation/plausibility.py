@@ -88,7 +88,6 @@ from sensing_antenna.antenna import STANDARD_GRAVITY, Link
 from sensing_antenna.beam import SensingCurve, free_plane_shift, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
-from sensing_antenna.beam.modes import support_compliance_coefficients
 from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.estimation.config import periods_in
 from sensing_antenna.estimation.disturbance import line_at, rest_line
@@ -97,6 +96,7 @@ from sensing_antenna.estimation.front.evidence import (
     TWO_FREQUENCY_GRID_STEP,
     Evidence,
     sensing_curve,
+    support_coefficients,
 )
 from sensing_antenna.estimation.front.held import FAST_PACE, repeated_rows
 from sensing_antenna.estimation.front.spectrum import power_spectrum
@@ -564,8 +564,7 @@ def _pinned_contact_problem(
     points, omegas = evidence.contact_modes
     if not points[0] <= x_c <= points[-1]:
         return None
-    coefficients = support_compliance_coefficients(link, x_c, 2)
-    c_1, c_2 = float(coefficients[0]), float(coefficients[1])
+    c_1, c_2 = support_coefficients(link, float(points[0]), x_c)
     u = _mode_ratio_share(evidence)
     slope = abs(float(sensing_curve(link).omega1_slope(x_c)))
     # the stiffest support that moves omega_1's point by max_model_spread (inf at the top)

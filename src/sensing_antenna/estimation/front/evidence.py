@@ -43,11 +43,13 @@ if TYPE_CHECKING:
     from sensing_antenna.estimation.front.outcome import FrontTrace
 
 __all__ = [
+    "SUPPORT_KNOTS",
     "TWO_FREQUENCY_GRID_STEP",
     "Evidence",
     "first_mode_value",
     "search_band",
     "sensing_curve",
+    "support_coefficients",
     "two_frequency_curve",
 ]
 
@@ -96,6 +98,29 @@ def first_mode_value(
     if x_c < spline.x[0]:
         return float(quantity(link, x_c))
     return float(spline(min(x_c, link.length)))
+
+
+#: Knots of the spline :func:`support_coefficients` reads from over [x_min, l], closer
+#: together towards the tip (u -> 1 - (1 - u)^1.5 of the span), where a tip mass sharpens the
+#: second mode's reaction: 48 hold c_1 and c_2 within 2e-3 of their largest value on the paper
+#: link with tip masses up to its own (each direct value solves the modes, milliseconds).
+SUPPORT_KNOTS = 48
+
+
+@functools.lru_cache(maxsize=16)
+def _support_spline(link: Link, x_min: float) -> CubicSpline:
+    from sensing_antenna.beam.modes import support_compliance_coefficients
+
+    u = 1.0 - (1.0 - np.linspace(0.0, 1.0, SUPPORT_KNOTS)) ** 1.5
+    x = x_min + (link.length - x_min) * u
+    return CubicSpline(x, support_compliance_coefficients(link, x, 2))
+
+
+def support_coefficients(link: Link, x_min: float, x_c: float) -> tuple[float, float]:
+    """(c_1, c_2) (N/m) of :func:`~sensing_antenna.beam.modes.support_compliance_coefficients`
+    at ``x_c`` in [``x_min``, l] (m), from a spline built once per link and ``x_min``."""
+    c_1, c_2 = np.maximum(_support_spline(link, x_min)(min(x_c, link.length)), 0.0)
+    return float(c_1), float(c_2)
 
 
 #: Spacing of the x_c grid on which the (omega_1, omega_2) curve is tabulated (m); 0.5 mm is
