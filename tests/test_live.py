@@ -309,10 +309,13 @@ def test_udp_reader_skips_what_is_not_the_format(recordings: dict[str, Path]) ->
         ],
         recording,
     )
-    first = [e.to_dict() for e in events if e.to_dict()["recording"] == 1]
+    said = [e.to_dict() for e in events]
+    first = [e for e in said if e["recording"] == 1]
     reasons = " | ".join(e["reason"] for e in first if e["event"] == "skipped")
-    assert "does not begin with 'sensing-antenna-udp/1 KIND STREAM SEQ'" in reasons
-    assert "not UTF-8" in reasons
+    # datagrams of no recording carry 0, the stream's own its number
+    stray = " | ".join(e["reason"] for e in said if e["event"] == "skipped" and not e["recording"])
+    assert "does not begin with 'sensing-antenna-udp/1 KIND STREAM SEQ'" in stray
+    assert "not UTF-8" in stray
     assert (
         f"stream b: datagram 0 sample line 2 of 2: expected {_cells(recording)} cells, found 2"
         in reasons
@@ -382,11 +385,12 @@ def test_a_udp_stream_too_coarse_for_the_antenna_is_skipped_and_the_next_is_hear
         ],
         recording,
     )
-    skipped = [e.to_dict()["reason"] for e in events if e.to_dict()["event"] == "skipped"]
+    skipped = [e.to_dict() for e in events if e.to_dict()["event"] == "skipped"]
     assert any(
-        "stream c: metadata key 'sample_period': sample period 1 s" in r
-        and r.endswith("the stream is left out")
-        for r in skipped
+        "stream c: metadata key 'sample_period': sample period 1 s" in e["reason"]
+        and e["reason"].endswith("the stream is left out")
+        and e["recording"] == 0
+        for e in skipped
     )
 
 
@@ -627,6 +631,37 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
     assert exc.value.code == 2
     # a pace that would take longer than a day to replay the recording
     assert main(["replay", str(recordings["azimuthal"]), "--speed", "1e-300"]) == 2
+
+
+def test_a_record_path_that_would_write_over_or_has_no_folder_is_refused_before_listening(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a session's recordings are never written over, and a folder that is not there is said
+    # before a manoeuvre arrives, not when its first samples are lost
+    kept = tmp_path / "kept.csv"
+    kept.write_text("the first session's")
+    assert main(["listen", "--no-warm-up", "--record", str(kept)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"--record: {kept} exists" in err, err
+    assert kept.read_text() == "the first session's"
+    kept.unlink()
+    (tmp_path / "kept-3.csv").write_text("a later recording of it")
+    assert main(["listen", "--no-warm-up", "--record", str(kept)]) == 2
+    assert f"{tmp_path / 'kept-3.csv'} exists" in capsys.readouterr().err
+    nowhere = tmp_path / "no" / "run.csv"
+    assert main(["listen", "--no-warm-up", "--record", str(nowhere)]) == 2
+    assert f"the folder {nowhere.parent} does not exist" in capsys.readouterr().err
+
+
+def test_the_udp_reader_asks_for_a_receive_buffer_a_burst_fits_in() -> None:
+    # the system's default (about 200 kB) drops most of a recording replayed at full speed
+    # while an estimate runs; the reader asks for more itself (the system may grant less)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        sock.bind(("127.0.0.1", 0))
+        before = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        assert listen_udp(sock, lambda header, number: None, lambda event: None, count=0) == 0
+        assert sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) > before
 
 
 def test_an_empty_input_is_said_to_hold_no_recording() -> None:
@@ -1092,9 +1127,16 @@ class _Datagrams:
         self.then = then
         self.time = 0.0
         self.timeouts: list[float] = []
+        self.options: dict[tuple[int, int], int] = {}
 
     def getsockname(self) -> tuple[str, int]:
         return ("127.0.0.1", 9)
+
+    def getsockopt(self, level: int, option: int) -> int:
+        return self.options.get((level, option), 0)
+
+    def setsockopt(self, level: int, option: int, value: int) -> None:
+        self.options[level, option] = value
 
     def settimeout(self, seconds: float) -> None:
         self.timeouts.append(seconds)

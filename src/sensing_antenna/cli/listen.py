@@ -75,10 +75,14 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.live.events import Event
     from sensing_antenna.live.inputs import listen_lines, listen_udp, parse_address
     from sensing_antenna.live.listener import Listener
-    from sensing_antenna.live.record import RecordWriter, numbered_path
+    from sensing_antenna.live.record import RecordWriter, numbered_path, record_path_problem
     from sensing_antenna.live.warm_up import freeze_heap, warm_up
     from sensing_antenna.live.wire import StreamHeader, WireError
 
+    if args.record is not None:
+        problem = record_path_problem(args.record)
+        if problem is not None:
+            raise ArgumentError("--record", problem)
     antenna = load_antenna(DEFAULT_ANTENNA if args.antenna is None else args.antenna)
     config = EstimatorConfig(t1_source=args.t1)
     lock = threading.Lock()
@@ -129,7 +133,6 @@ def _run(args: argparse.Namespace) -> int:
     with socket.socket(
         socket.AF_INET6 if ":" in address[0] else socket.AF_INET, socket.SOCK_DGRAM
     ) as sock:
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
         try:
             sock.bind(address)
         except OSError as exc:

@@ -43,6 +43,7 @@ from sensing_antenna.recording import RecordingError
 __all__ = [
     "IDLE_END",
     "INTERRUPTED_WAIT",
+    "RECEIVE_BUFFER",
     "REORDER_DEPTH",
     "REORDER_WAIT",
     "MakeListener",
@@ -69,6 +70,11 @@ REORDER_DEPTH = 8
 
 #: The longest a datagram waits (s) for one numbered below it (:data:`REORDER_DEPTH`).
 REORDER_WAIT = 0.02
+
+#: Receive buffer (bytes) :func:`listen_udp` asks of its socket when it has less: 4 MiB hold
+#: several seconds of a 1 kHz stream sent as fast as it can be (a replay, a burst after a
+#: pause), which the system's default (about 200 kB on Linux) drops while an estimate runs.
+RECEIVE_BUFFER = 1 << 22
 
 #: Samples left out in a row for their time stamps after which the stream is left out: its
 #: samples no longer follow one time line (the sender's clock stepped, or an outlier came first).
@@ -247,6 +253,8 @@ def listen_udp(
     None; streams left out are not counted, though they keep their numbers); returns the
     number ended. ``on_event`` receives the reader's own :class:`~.events.SkippedEvent`s (from
     this thread: the listeners' events come from theirs)."""
+    if sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) < RECEIVE_BUFFER:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, RECEIVE_BUFFER)
     host, port = sock.getsockname()[:2]
     source = f"udp:{host}:{port}"
     current: _UdpStream | None = None
@@ -256,12 +264,19 @@ def listen_udp(
     joined: set[str] = set()  # streams heard (one that resumes after the idle end is known)
     sock.settimeout(min(idle, 0.2))  # shorter while datagrams wait (REORDER_WAIT)
 
-    def skip(reason: str) -> None:
-        on_event(SkippedEvent(numbered if current is not None else numbered + 1, reason))
+    def skip(reason: str, number: int = 0) -> None:
+        """A ``skipped`` event for what belongs to no recording (0) or to recording
+        ``number``."""
+        on_event(SkippedEvent(number, reason))
 
-    def leave_out(name: str, exc: Exception) -> None:
-        """Say why the stream ``name`` is left out, and ignore it until its end."""
-        skip(f"{exc}: the stream is left out")
+    def skip_current(reason: str) -> None:
+        """A ``skipped`` event for the recording being received (the last joined)."""
+        skip(reason, numbered)
+
+    def leave_out(name: str, exc: Exception, number: int = 0) -> None:
+        """Say why the stream ``name`` (recording ``number``, 0 when never joined) is left
+        out, and ignore it until its end."""
+        skip(f"{exc}: the stream is left out", number)
         refused.add(name)
 
     def join(datagram: Datagram, received: float, ending: str) -> bool:
@@ -279,13 +294,10 @@ def listen_udp(
             # heard first after samples were sent (listening began late, or the first header
             # was lost): the recording's start, its rest and its contact, is gone. Never
             # joined, it takes no recording's number (0) nor a --count
-            on_event(
-                SkippedEvent(
-                    0,
-                    f"stream {name}: first heard at its samples datagram {datagram.seq}: its "
-                    "start (the rest, the contact) was missed; left out, the next recording is "
-                    "heard",
-                )
+            skip(
+                f"stream {name}: first heard at its samples datagram {datagram.seq}: its "
+                "start (the rest, the contact) was missed; left out, the next recording is "
+                "heard"
             )
             refused.add(name)
             return True
@@ -315,10 +327,10 @@ def listen_udp(
         assert current is not None
         try:
             if datagram is not None:
-                _arrive(current, datagram, received, skip)
-            _release(current, received, skip, flush)
+                _arrive(current, datagram, received, skip_current)
+            _release(current, received, skip_current, flush)
         except WireError as exc:
-            leave_out(current.name, exc)
+            leave_out(current.name, exc, numbered)
             _close_quietly(current.listener)
             current = None
 
@@ -327,15 +339,15 @@ def listen_udp(
         refused it (its period, say): skipped, not fatal (other streams may follow) and not
         counted."""
         try:
-            _release(stream, clock(), skip, flush=True)
+            _release(stream, clock(), skip_current, flush=True)
         except WireError as exc:
-            leave_out(stream.name, exc)
+            leave_out(stream.name, exc, numbered)
             _close_quietly(stream.listener)
             return 0
         try:
             stream.close(reason)
         except WireError as exc:
-            leave_out(stream.name, exc)
+            leave_out(stream.name, exc, numbered)
             return 0
         return 1
 
@@ -380,7 +392,7 @@ def listen_udp(
                     try:
                         read_header(list(datagram.lines), f"{source} stream {datagram.stream}")
                     except RecordingError as exc:
-                        skip(str(exc))
+                        skip_current(str(exc))
                     else:
                         current.again, current.held = datagram, []
                     continue

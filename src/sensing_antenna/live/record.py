@@ -9,6 +9,7 @@ every number at ``repr`` precision, flushed after each block of samples. A recor
 
 from __future__ import annotations
 
+import glob
 from pathlib import Path
 from types import TracebackType
 
@@ -17,7 +18,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.live.wire import StreamHeader, format_sample
 
-__all__ = ["RecordWriter", "numbered_path"]
+__all__ = ["RecordWriter", "numbered_path", "record_path_problem"]
 
 
 def numbered_path(path: Path, number: int) -> Path:
@@ -26,20 +27,38 @@ def numbered_path(path: Path, number: int) -> Path:
     return path if number == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
 
 
+def record_path_problem(path: Path) -> str | None:
+    """Why recordings cannot be kept at ``path`` and its numbered next ones, or None: a folder
+    that does not exist, or a file of that name there already (a session's recordings are not
+    written over)."""
+    folder = path.parent
+    if not folder.is_dir():
+        return f"{path}: the folder {folder} does not exist"
+    taken = [path] if path.exists() else []
+    taken += sorted(folder.glob(f"{glob.escape(path.stem)}-[0-9]*{glob.escape(path.suffix)}"))
+    taken = [p for p in taken if p == path or p.stem[len(path.stem) + 1 :].isdigit()]
+    if taken:
+        return (
+            f"{taken[0]} exists: recordings are not written over; give another name or move "
+            "the earlier ones"
+        )
+    return None
+
+
 class RecordWriter:
     """A recording file written as samples arrive.
 
     Parameters
     ----------
     path : Path
-        Destination, overwritten.
+        Destination, a new file (an existing one is not written over: ``FileExistsError``).
     header : StreamHeader
         Metadata and columns of the stream.
     """
 
     def __init__(self, path: Path, header: StreamHeader) -> None:
         self.path = path
-        self._file = open(path, "w", encoding="utf-8", newline="")
+        self._file = open(path, "x", encoding="utf-8", newline="")
         self._file.write("\n".join(header.lines()) + "\n")
         self._file.flush()
 
