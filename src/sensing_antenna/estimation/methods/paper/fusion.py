@@ -437,6 +437,46 @@ def pair_distance(evidence: Evidence, omega1: float, omega2: float) -> tuple[int
     return k, float(distance[k])
 
 
+def _pair_elsewhere(
+    evidence: Evidence, omega1: float, omega2: float, x_c: float, nearest: int, off: float
+) -> str | None:
+    """Why the second contact mode puts the contact away from the answer ``x_c`` (m), or None.
+
+    The measured pair (``omega1``, ``omega2``, rad/s; not a harmonic of omega_1 within
+    ``omega2_window``) lies ``off`` from the curves' point ``nearest`` (its index on
+    ``contact_modes``), within what a contact's modes may (:func:`curve_allowance`), and more
+    than that from the model's pair at the answer, which lies farther than ``max_model_spread``
+    from it: the second mode is another contact point's. An answer with one frequency
+    candidate (omega_1 below the sensing curve's value at the tip by more than its
+    uncertainty, as a link softer than its calibration makes it) meets no other evidence on
+    the frequency's side but this."""
+    cfg = evidence.config
+    link = evidence.antenna.link
+    points, omegas = evidence.contact_modes
+    if not points[0] <= x_c <= points[-1]:
+        return None
+    if any(abs(omega2 - k * omega1) < cfg.omega2_window * omega2 for k in (2.0, 3.0)):
+        return None  # a harmonic of omega_1 may be what the peak is
+    allowance = curve_allowance(link, cfg)
+    other = float(points[nearest])
+    if not (off <= allowance and abs(other - x_c) > cfg.max_model_spread):
+        return None
+    model1 = float(np.interp(x_c, points, omegas[:, 0]))
+    model2 = float(np.interp(x_c, points, omegas[:, 1]))
+    at_answer = math.hypot(model1 / omega1 - 1.0, model2 / omega2 - 1.0)
+    if not at_answer > allowance:
+        return None
+    return (
+        f"the second contact mode at {omega2:.1f} rad/s is that of x_c = {other:.3f} m (with "
+        f"omega_1 = {omega1:.1f} rad/s, {100 * off:.1f} % from the model's pair there), not of "
+        f"the answer {x_c:.3f} m, where the model puts omega_2 at {model2:.1f} rad/s "
+        f"({100 * at_answer:.1f} % off the pair, more than the {100 * allowance:.0f} % a "
+        "contact's modes may lie from the curves): the device departs from the model by more "
+        "than its uncertainty (a stiffness changed since the calibration, a mass at the tip), "
+        "or the peak is another vibration"
+    )
+
+
 def _uncertainty_source(link: Link) -> str:
     """Where the link's frequency uncertainty comes from, in words."""
     if link.calibrated_t is None:
@@ -610,8 +650,15 @@ class PaperMethod:
             peak2 = second_peak(evidence, measurement.component, measurement.omega1)
             off = math.nan
             if peak2 is not None:
-                off = pair_distance(evidence, measurement.omega1, peak2.omega)[1]
+                nearest, off = pair_distance(evidence, measurement.omega1, peak2.omega)
                 diag["curve_distance"] = off
+                elsewhere = None
+                if len(candidates_used) == 1:
+                    elsewhere = _pair_elsewhere(
+                        evidence, measurement.omega1, peak2.omega, fusion.x_c, nearest, off
+                    )
+                if elsewhere is not None:
+                    problems.append((Status.ESTIMATORS_DISAGREE, elsewhere))
             mismatch = 0.0
             if 2.0 * link.frequency_uncertainty < off <= curve_allowance(link, cfg):
                 # the model is at least that far off on this manoeuvre: omega_1 may be too (a
