@@ -26,8 +26,9 @@ import numpy as np
 import pytest
 
 import sensing_antenna
-from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
+from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna, save_antenna
 from sensing_antenna.cli import main
+from sensing_antenna.detection.contact_watch import contact_changes
 from sensing_antenna.errors import Terminated
 from sensing_antenna.estimation import METHODS, OnlineEstimator, estimate
 from sensing_antenna.live.events import (
@@ -56,7 +57,13 @@ from sensing_antenna.live.wire import (
     decode_datagram,
     pack_samples,
 )
-from sensing_antenna.recording import REQUIRED_COLUMNS, Recording, RecordingError, read_recording
+from sensing_antenna.recording import (
+    REQUIRED_COLUMNS,
+    Recording,
+    RecordingError,
+    read_recording,
+    write_recording,
+)
 from sensing_antenna.simulator import Scenario, simulate
 
 CASES = {"azimuthal": 0.6, "vertical": 0.7}
@@ -1330,7 +1337,7 @@ def test_the_docs_program_of_its_own_listens(recordings: dict[str, Path], tmp_pa
 
 
 def test_a_second_contact_in_one_recording_is_said_not_estimated(
-    identified: tuple[Antenna, Recording],
+    identified: tuple[Antenna, Recording], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     # Two sweeps sent as one recording: the first touches, holds, turns back and leaves the
     # post; the second, its angles carried on from where the first ended, touches again. The
@@ -1359,6 +1366,24 @@ def test_a_second_contact_in_one_recording_is_said_not_estimated(
     # the mean over a free period (0.39 s) passes half the first push about half a period
     # after the push has built up (the head stops 0.25 s after the touch)
     assert touched_again < known < touched_again + 0.25 + 0.39
+    # read whole after the fact, the recording says the same (antenna estimate warns of it)
+    t_c = next(e["t_c"] for e in said if e["event"] == "contact")
+    changes = {change.kind: change for change in contact_changes(joined, antenna, t_c)}
+    assert changes["again"].t == pytest.approx(known, abs=1e-3)
+    assert changes["lost"].t == pytest.approx(
+        next(e["t"] for e in said if e["event"] == "contact_lost"), abs=1e-9
+    )
+    write_recording(joined, tmp_path / "session.csv")
+    save_antenna(antenna, tmp_path / "antenna.toml")
+    capsys.readouterr()
+    assert (
+        main(
+            ["estimate", str(tmp_path / "session.csv"), "--antenna", str(tmp_path / "antenna.toml")]
+        )
+        == 0
+    )
+    warning = capsys.readouterr().err
+    assert f"the link touched again at t = {known:.3f} s" in warning, warning
     # one sweep, the same turn back, says nothing of it
     alone = [
         e for e in _listen_all(first.without_ground_truth(), antenna) if e["event"] == "skipped"

@@ -82,6 +82,7 @@ def _run(args: argparse.Namespace) -> int:
             {recording.metadata.get("antenna", ""): [str(args.recording)]}, antenna.name
         )
     result = estimate(recording, antenna, method=method, config=EstimatorConfig(t1_source=args.t1))
+    warn_of_a_second_contact(args.recording, recording, antenna, result.t_c)
     if args.json:
         data = {"recording": str(args.recording), **result.to_dict()}
         print(json.dumps(data, allow_nan=False))
@@ -126,6 +127,31 @@ def warn_of_other_antennas(
     """:func:`other_antennas`' warnings, a line each on stderr."""
     for warning in other_antennas(named, model, use):
         print(f"antenna: warning: {warning}", file=sys.stderr)
+
+
+def warn_of_a_second_contact(source: object, recording: Any, antenna: Any, t_c: float) -> None:
+    """A line on stderr when ``recording`` touches again after its contact at ``t_c`` (s) was
+    lost (:func:`~sensing_antenna.detection.contact_watch.contact_changes`): the estimate is
+    the first contact's, the second is not estimated."""
+    from sensing_antenna.detection.contact_watch import contact_changes
+    from sensing_antenna.errors import SensingAntennaError
+
+    if not math.isfinite(t_c):
+        return
+    try:
+        found = contact_changes(recording, antenna, t_c)
+    except SensingAntennaError:
+        return  # samples the detector refuses: the estimate's status says what is wrong
+    changes = {change.kind: change for change in found}
+    if "again" not in changes:
+        return
+    print(
+        f"antenna: warning: {source}: the link touched again at t = {changes['again'].t:.3f} s, "
+        f"after the contact at t_c = {t_c:.3f} s was lost at {changes['lost'].t:.3f} s: not "
+        "estimated (a recording holds one contact, the estimate is the first's: cut a log of "
+        "several sweeps into one recording per sweep, docs/import.md)",
+        file=sys.stderr,
+    )
 
 
 def warn_of_contradicted_period(source: object, problem: str | None) -> None:

@@ -119,8 +119,8 @@ class EstimateEvent:
 class ContactLostEvent:
     """Contact lost at about ``t`` (s): the contact detector's residual, averaged over a period
     of the link's free mode, fell to a fifth of the push's and to its threshold
-    (:data:`~sensing_antenna.live.listener.CONTACT_LOST_SHARE`), a free period or less after
-    ``t``."""
+    (:data:`~sensing_antenna.detection.contact_watch.CONTACT_LOST_SHARE`), a free period or
+    less after ``t``."""
 
     recording: int
     t: float

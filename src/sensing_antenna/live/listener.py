@@ -28,6 +28,12 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
+from sensing_antenna.detection.contact_watch import (
+    CONTACT_AGAIN_SHARE,
+    CONTACT_LOST_SHARE,
+    ContactWatch,
+    free_period_samples,
+)
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
 from sensing_antenna.estimation.front.steps import (
@@ -58,20 +64,6 @@ from sensing_antenna.torque_point import torques_about_base
 
 __all__ = ["CONTACT_AGAIN_SHARE", "CONTACT_LOST_SHARE", "Listener"]
 
-#: Contact counts as lost once the contact detector's residual, averaged over one period of the
-#: link's free mode (the observer's natural frequency), has fallen to this share of the largest
-#: such average since t_c (the push), and to the detector's threshold. Averaged over a free
-#: period, the link's free ringing after a release (and the observer's own, which a lightly
-#: damped observer predicts for tens of seconds after the head stops) comes to nearly nothing,
-#: while a contact's static push stays, bouncing or not: the filtered residual itself swung
-#: through the threshold while the link bounced on a post, and stayed above it for tens of
-#: seconds after a release.
-CONTACT_LOST_SHARE = 0.2
-
-#: After the contact was lost, a touch again: the same average rising above the detector's
-#: threshold and this share of the first push's. The estimate is the first contact's; the
-#: second is said (a ``skipped`` event), not estimated.
-CONTACT_AGAIN_SHARE = 0.5
 
 _END = "end"
 _ABORT = "abort"
@@ -158,12 +150,9 @@ class Listener:
         self._estimator = OnlineEstimator(antenna, ts, method, config)
         # a detector of its own, the front end's twin, for the residual after t_c (contact lost)
         self._residual = ContactDetector(antenna, ts, check_input=False)  # the samples filled
-        # contact lost: the residual's running sums from t_c, averaged over a free period
-        self._free_period = max(1, round(2.0 * math.pi / (antenna.observer.natural_frequency * ts)))
-        self._sums = _Growing(3)  # cumulative residual from t_c (row 0: none yet)
-        self._sums.extend(np.zeros((1, 3)))
-        self._levels = _Growing()  # the averages' norms, from t_c
-        self._push_level = 0.0
+        # contact lost, and a touch again: the residual from t_c, averaged over a free period
+        self._free_period = free_period_samples(antenna, ts)
+        self._watch: ContactWatch | None = None
         self._columns = [
             [header.required(name) for name in names]
             for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
@@ -390,70 +379,34 @@ class Listener:
         self._emit(EstimateEvent(self.number, result, self._latency(min(at, self._t.size - 1))))
 
     def _watch_contact(self, first: int) -> None:
-        """Contact lost (:data:`CONTACT_LOST_SHARE`): at the first sample whose free period's
-        mean residual is that low, the contact was lost about where the mean began to fall, one
-        free period back plus the share of it still held (a push that vanishes at once)."""
+        """The contact lost and a touch again (:class:`~sensing_antenna.detection.contact_watch.
+        ContactWatch`), each said once: lost as a ``contact_lost`` event, a touch again as a
+        ``skipped`` one (a recording holds one contact, the first's estimate stands)."""
         contact = self._estimator.contact_index
-        if contact is None or "contact_again" in self._said:
+        if contact is None or (self._watch is not None and self._watch.again is not None):
             return
         detection = self._residual.detection()
-        done = contact + self._sums.size - 1  # samples summed so far
-        new = detection.residual[done : self._t.size]
-        if new.shape[0] == 0:
-            return
-        self._sums.extend(self._sums.values[self._sums.size - 1] + np.cumsum(new, axis=0))
-        sums = self._sums.values
-        period = self._free_period
-        ends = np.arange(done - contact + 1, self._sums.size)  # rows: samples since t_c
-        starts = np.maximum(ends - period, 0)
-        means = (sums[ends] - sums[starts]) / (ends - starts)[:, None]
-        levels = np.linalg.norm(means, axis=1)
-        self._levels.extend(levels)
-        if "contact_lost" in self._said:
-            self._watch_again(first, ends, levels, detection.threshold)
-            return
-        peaks = np.maximum.accumulate(np.maximum(levels, self._push_level))
-        self._push_level = float(peaks[-1])
-        limit = np.minimum(detection.threshold, CONTACT_LOST_SHARE * peaks)
-        lost = np.flatnonzero((ends >= period) & (levels <= limit))
-        if lost.size == 0:
-            return
-        k = int(lost[0])
-        row = int(ends[k])  # the mean over the free period ending at sample contact + row - 1
-        before = float(self._levels.values[row - period - 1]) if row > period else 0.0
-        held = min(1.0, float(levels[k]) / before) if before > 0.0 else 0.0
-        index = contact + row - 1
-        t_lost = float(self._t.values[index]) - (1.0 - held) * period * self.header.sample_period
-        self._said.add("contact_lost")
-        self._emit(ContactLostEvent(self.number, t_lost, self._latency(max(first, index))))
-        if k + 1 < ends.shape[0]:
-            self._watch_again(first, ends[k + 1 :], levels[k + 1 :], detection.threshold)
-
-    def _watch_again(
-        self,
-        first: int,
-        ends: NDArray[np.int_],
-        levels: NDArray[np.float64],
-        threshold: float,
-    ) -> None:
-        """A touch after the contact was lost (:data:`CONTACT_AGAIN_SHARE`), said once as a
-        ``skipped`` event: a recording holds one contact, the first's estimate stands."""
-        again = np.flatnonzero(levels > max(threshold, CONTACT_AGAIN_SHARE * self._push_level))
-        if again.size == 0:
-            return
-        contact = self._estimator.contact_index
-        assert contact is not None
-        index = contact + int(ends[again[0]]) - 1
-        self._said.add("contact_again")
-        self._emit(
-            SkippedEvent(
-                self.number,
-                f"a second contact, known at t = {float(self._t.values[index]):.3f} s, after "
-                "the first was lost: not estimated (a recording holds one contact: send each "
-                "sweep as a recording of its own)",
-                self._latency(max(first, index)),
+        if self._watch is None:
+            self._watch = ContactWatch(
+                self._free_period, detection.threshold, self.header.sample_period
             )
-        )
+        done = contact + self._watch.rows  # samples watched so far
+        stop = self._t.size
+        changes = self._watch.feed(detection.residual[done:stop], self._t.values[done:stop])
+        for change in changes:
+            latency = self._latency(max(first, contact + change.row))
+            if change.kind == "lost":
+                self._emit(ContactLostEvent(self.number, change.t, latency))
+                continue
+            self._emit(
+                SkippedEvent(
+                    self.number,
+                    f"a second contact, known at t = {change.t:.3f} s, after the first was "
+                    "lost: not estimated (a recording holds one contact: send each sweep as a "
+                    "recording of its own)",
+                    latency,
+                )
+            )
 
     def _finish(self, reason: str) -> None:
         self._check_period(np.empty(0), final=True)
