@@ -82,7 +82,7 @@ def _run(args: argparse.Namespace) -> int:
             {recording.metadata.get("antenna", ""): [str(args.recording)]}, antenna.name
         )
     result = estimate(recording, antenna, method=method, config=EstimatorConfig(t1_source=args.t1))
-    warn_of_a_second_contact(args.recording, recording, antenna, result.t_c)
+    warn_of_a_second_contact(args.recording, recording, antenna, result.t_c, result.t_1)
     if args.json:
         data = {"recording": str(args.recording), **result.to_dict()}
         print(json.dumps(data, allow_nan=False))
@@ -129,10 +129,13 @@ def warn_of_other_antennas(
         print(f"antenna: warning: {warning}", file=sys.stderr)
 
 
-def warn_of_a_second_contact(source: object, recording: Any, antenna: Any, t_c: float) -> None:
+def warn_of_a_second_contact(
+    source: object, recording: Any, antenna: Any, t_c: float, t_1: float
+) -> None:
     """A line on stderr when ``recording`` touches again after its contact at ``t_c`` (s) was
-    lost (:func:`~sensing_antenna.detection.contact_watch.contact_changes`): the estimate is
-    the first contact's, the second is not estimated."""
+    lost after the head's rest at ``t_1`` (s) (:func:`~sensing_antenna.detection.
+    contact_watch.contact_changes`): the estimate is the first contact's, the second is not
+    estimated. A contact lost before t_1 was no touch; the estimate's status says so."""
     from sensing_antenna.detection.contact_watch import contact_changes
     from sensing_antenna.errors import SensingAntennaError
 
@@ -143,7 +146,7 @@ def warn_of_a_second_contact(source: object, recording: Any, antenna: Any, t_c: 
     except SensingAntennaError:
         return  # samples the detector refuses: the estimate's status says what is wrong
     changes = {change.kind: change for change in found}
-    if "again" not in changes:
+    if "again" not in changes or not changes["lost"].t >= t_1:
         return
     print(
         f"antenna: warning: {source}: the link touched again at t = {changes['again'].t:.3f} s, "

@@ -114,6 +114,7 @@ class ContactWatch:
         self._push_level = 0.0
         self.lost: ContactChange | None = None
         self.again: ContactChange | None = None
+        self._t_c = math.nan  # the first sample's time
 
     @property
     def rows(self) -> int:
@@ -126,6 +127,8 @@ class ContactWatch:
         if self.again is not None or residual.shape[0] == 0:
             return []
         done = self.rows
+        if done == 0:
+            self._t_c = float(t[0])
         self._sums.extend(self._sums.values[self._sums.size - 1] + np.cumsum(residual, axis=0))
         sums = self._sums.values
         period = self.free_period
@@ -146,7 +149,7 @@ class ContactWatch:
         row = int(ends[k])  # the mean over the free period ending at this row's sample
         before = float(self._levels.values[row - period - 1]) if row > period else 0.0
         held = min(1.0, float(levels[k]) / before) if before > 0.0 else 0.0
-        when = float(t[k]) - (1.0 - held) * period * self.sample_period
+        when = max(float(t[k]) - (1.0 - held) * period * self.sample_period, self._t_c)
         self.lost = ContactChange("lost", row - 1, when)
         changes = [self.lost]
         if k + 1 < ends.shape[0]:

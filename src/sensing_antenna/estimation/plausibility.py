@@ -19,7 +19,10 @@ forms agree.
    head's work against the contact's moment against the energy the push stores in the link
    (an obstacle gives no energy: angles swapped turn the head across the push; a share short
    by less than ``1 / input_work_share`` is a scale, torques that read high or a stiffer link,
-   ``model_mismatch``; :func:`_work_problem`).
+   ``model_mismatch``; :func:`_work_problem`). The contact found at t_c holds until the head
+   rests at t_1 (``uncertain``, :func:`_detected_before_touch`: a detection on something else
+   fades while the head sweeps on to the touch; the work and the bend, which start at t_c,
+   are then not judged).
 2. The answer lies on the link: 0 < x_c <= l (``model_mismatch``). An answer past the tip by
    no more than ``disagreement_sigmas`` statistical uncertainties of the ratio at the tip (noise
    and tare, :meth:`~.evidence.Evidence.ratio_uncertainty` without its model term, which grows
@@ -246,10 +249,15 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     payload = _payload_problem(evidence, estimate, notes)
     if payload is not None:
         found.append((Status.MODEL_MISMATCH, payload))
-    work = _work_problem(evidence, estimate, end, notes) if on_link and push is None else None
+    early = _detected_before_touch(evidence)
+    if early is not None:
+        found.append((Status.UNCERTAIN, early))
+    # the head's work and its turn into the push are read from t_c: judged when it was the touch
+    from_touch = on_link and push is None and early is None
+    work = _work_problem(evidence, estimate, end, notes) if from_touch else None
     if work is not None:
         found.append(work)
-    turn = _bend_against_turn(evidence, estimate, end, notes) if on_link and push is None else None
+    turn = _bend_against_turn(evidence, estimate, end, notes) if from_touch else None
     if turn is not None:
         found.append((Status.MODEL_MISMATCH, turn))
     interval = _on_link(estimate.interval, link.length)
@@ -1067,6 +1075,28 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
         "flipped in an angle or in the forces, the two angles swapped or one read from another "
         "joint (the joint mapping), or forces read wrong by as much as the push (cross-talk "
         f"from the torques, an offset){untouched}?"
+    )
+
+
+def _detected_before_touch(evidence: Evidence) -> str | None:
+    """Why t_c is not the touch the hold reads, or None: the contact found at t_c was lost
+    before the head came to rest at t_1 (the front end's ``contact_lost_before_rest``: the
+    contact detector's residual, averaged over a free period, fell to a fifth of its largest
+    and to the threshold). The answer reads the hold after t_1 and may be right; the checks
+    that start at t_c (the head's work and its turn against the push's bend) cannot be made."""
+    lost = evidence.diagnostics.get("contact_lost_before_rest")
+    if lost is None:
+        return None
+    t_c = float(evidence.t[evidence.contact_index])
+    t_1 = float(evidence.t[evidence.rest_index])
+    return (
+        f"the contact found at t_c = {t_c:.3f} s was lost at {float(lost):.3f} s, before the "
+        f"head came to rest at t_1 = {t_1:.3f} s: the contact detector fired on something "
+        "other than the touch the hold reads, and what starts at the touch (the push's bend "
+        "against the head's turn) cannot be checked. Angles stamped late against the loads "
+        "make the free-motion observer's prediction lag through the sweep's start (antenna "
+        "identify names such a lag); a knock, hum on the torques, or a link that swings more "
+        "than the one the threshold was identified on do the same"
     )
 
 
