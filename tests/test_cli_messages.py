@@ -185,3 +185,19 @@ def test_one_file_by_two_names_is_given_twice(
         assert main(["map", str(first), str(tmp_path / other), "--out", str(tmp_path / "m")]) == 2
         err = capsys.readouterr().err
         assert f"recordings: {tmp_path / other} given twice (as {first})" in err
+
+
+def test_calibrating_a_real_devices_recordings_without_a_points_table_asks_for_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a real device writes no true_xc: what is missing is --points, said first
+    from sensing_antenna.recording import write_recording
+    from sensing_antenna.simulator import Scenario, simulate
+
+    files = []
+    for x_c in (0.4, 0.7):
+        recording = simulate(paper_antenna(), Scenario(case="azimuthal", contact_point=x_c, seed=1))
+        files.append(str(tmp_path / f"post-{x_c}.csv"))
+        write_recording(recording.without_ground_truth(), files[-1])
+    err = _error(["calibrate", *files, "--out", str(tmp_path / "a.toml")], capsys)
+    assert ": error: --points: none given, and none of the 2 recordings states its contact" in err

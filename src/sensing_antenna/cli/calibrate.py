@@ -134,6 +134,7 @@ def _run(args: argparse.Namespace) -> int:
         read_contact_points,
         scatter_problem,
     )
+    from sensing_antenna.cli.arguments import ArgumentError
     from sensing_antenna.cli.estimate import warn_of_contradicted_period
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.recording import read_recording
@@ -151,6 +152,14 @@ def _run(args: argparse.Namespace) -> int:
     if len(recordings) < 2 and unread:
         raise CalibrationError(f"{unread[0]} (and fewer than 2 readable recordings left)")
     points = read_contact_points(paths, recordings, args.points)
+    if args.points is None and not any(math.isfinite(point) for point in points):
+        # a real device's recordings carry no true_xc: the table is what is missing
+        raise ArgumentError(
+            "--points",
+            f"none given, and none of the {len(paths)} recordings states its contact point "
+            "(true_xc metadata, which only a simulator writes): give --points FILE, a CSV with "
+            "columns file,x_c (m), one row per recording (docs/real-antenna.md)",
+        )
     try:
         calibration = calibrate_from_recordings(
             recordings,
