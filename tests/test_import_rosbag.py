@@ -178,13 +178,22 @@ def test_the_command_writes_the_recording_and_reports_on_stderr(
     assert written.metadata["ros_joints"] == "theta1=pan, theta2=tilt"
 
 
-def test_joints_default_to_the_first_two_names_of_the_first_message(
+def test_joints_default_to_the_two_names_of_the_first_message_and_more_must_be_named(
     recording: Recording, tmp_path: Path
 ) -> None:
-    bag = _write_bag(_bag_path(tmp_path, 2), recording, 2, names=("tilt", "pan", "gripper"))
+    bag = _write_bag(_bag_path(tmp_path, 2), recording, 2, names=("tilt", "pan"))
     result = read_rosbag(bag, WRENCH, JOINTS)
     assert result.report.joint_names == ("tilt", "pan")
     np.testing.assert_array_equal(result.recording.theta, recording.theta[:, ::-1])
+    # of three (ROS lists them in any order: a gripper's first, say), which two are the head's
+    # is not guessed
+    three = _write_bag(
+        _bag_path(tmp_path / "three", 2), recording, 2, names=("gripper", "tilt", "pan")
+    )
+    with pytest.raises(
+        ImporterError, match=r"names 3 joint\(s\) \('gripper', 'tilt', 'pan'\); name"
+    ):
+        read_rosbag(three, WRENCH, JOINTS)
 
 
 def test_messages_of_another_publisher_on_the_joint_topic_are_left_aside(

@@ -2,9 +2,9 @@
 
 A bag with a ``geometry_msgs/WrenchStamped`` topic (the force/torque sensor) and a
 ``sensor_msgs/JointState`` topic (the head's joints) becomes a recording: two joints, named or
-the first two of the first message, give theta1 (azimuth) and theta2 (elevation); the wrench,
-turned onto the motor axes by :class:`~sensing_antenna.importers.axes.SensorAxes`, gives the
-force and torque; both are put on one uniform clock by
+the two of the first message when it names two, give theta1 (azimuth) and theta2 (elevation);
+the wrench, turned onto the motor axes by :class:`~sensing_antenna.importers.axes.SensorAxes`,
+gives the force and torque; both are put on one uniform clock by
 :func:`~sensing_antenna.importers.clock.put_on_clock`, which reports their rates and gaps.
 
 Reading uses the ``rosbags`` library, an optional dependency (``pip install
@@ -312,15 +312,16 @@ def _choose_joints(
     topic: str,
 ) -> tuple[str, str]:
     """The joints read as theta1, theta2: those named, else the first and the second name of
-    the topic's first message."""
+    the topic's first message when it names two (of more, which are the head's is not known)."""
     chosen = []
     for position, name in enumerate(wanted):
         if name is None:
-            if len(message_names) < 2:
+            if len(message_names) != 2:
                 listed = ", ".join(repr(n) for n in message_names) or "none"
                 raise ImporterError(
                     f"{source}: topic {topic!r}: the first message names {len(message_names)}"
-                    f" joint(s) ({listed}); name the two to read (theta1, theta2)"
+                    f" joint(s) ({listed}); name the two to read (theta1, theta2) with --joint1"
+                    " and --joint2"
                 )
             name = message_names[position]
         chosen.append(name)
