@@ -101,6 +101,12 @@ def test_the_simulator_s_limits_are_named_by_the_flag(
         (["map", "r.csv", "./r.csv", "--out", "m"], "recordings: r.csv given twice"),
         (["calibrate", "r.csv", "r.csv", "--out", "a.toml"], "recordings: r.csv given twice"),
         (["identify", "r.csv", "r.csv", "--out", "a.toml"], "recordings: r.csv given twice"),
+        # a flipped axis first reads as an option
+        (
+            ["import", "rosbag", "x.bag", "--wrench", "/w", "--joints", "/j", "--frame", "-x,y,z"],
+            "--frame: expected one argument (a value that begins with '-' goes after '=': "
+            "--frame=-VALUE)",
+        ),
     ],
 )
 def test_other_bad_arguments_name_their_flag(

@@ -173,6 +173,14 @@ def test_bad_controller_input_is_one_clear_error() -> None:
     with pytest.raises(ControlConfigError, match=r"too fast .* at most 300 rad/s"):
         HeadController(antenna, TS, pole=-1500.0)
     HeadController(antenna, TS, pole=-300.0)
+    # a loop's rate in Hz passed for its period
+    with pytest.raises(ControlConfigError, match=r"sample_period: 1000 s, the period in s"):
+        HeadController(antenna, 1000)
+    # a sample's angles and torques swapped, or one missing: the argument named
+    with pytest.raises(ValueError, match=r"torque: expected three torques .* shape \(2,\)"):
+        coupling_torques([0.0, 0.0], [0.0, 0.02])
+    with pytest.raises(ValueError, match=r"theta: expected two angles .* shape \(3,\)"):
+        coupling_torques([0.0, 0.02, 0.0], [0.0, 0.0])
     controller = HeadController(antenna, TS)
     with pytest.raises(ValueError, match="reference"):
         controller.step((0.0, 0.0, 0.0), (0.0, 0.0), (0.0, 0.0))

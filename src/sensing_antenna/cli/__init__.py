@@ -131,7 +131,12 @@ class OneLineParser(argparse.ArgumentParser):
         return action
 
     def error(self, message: str) -> NoReturn:
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message.removeprefix('argument ')}\n")
+        message = message.removeprefix("argument ")
+        if message.endswith(": expected one argument"):
+            # a value that begins with '-' (a sign, a flipped axis) reads as an option
+            flag = message.split(":", 1)[0].split("/")[-1]
+            message += f" (a value that begins with '-' goes after '=': {flag}=-VALUE)"
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
 
     def reject_unknown(self, extras: Sequence[str]) -> NoReturn:
         """Error on arguments the command does not take, suggesting a close option name."""

@@ -174,6 +174,11 @@ def design_servo(motor: Motor, pole: float, sample_period: float) -> ServoDesign
         raise ControlConfigError(f"pole: must be a finite number < 0 (stable), got {pole!r}")
     if not (math.isfinite(sample_period) and sample_period > 0):
         raise ControlConfigError(f"sample_period: must be finite and > 0, got {sample_period!r}")
+    if -pole * sample_period > MAX_POLE_STEP and sample_period >= 1.0:
+        raise ControlConfigError(
+            f"sample_period: {sample_period!r} s, the period in s of the loop (not its rate in "
+            f"Hz: 1 kHz is 0.001 s)"
+        )
     if -pole * sample_period > MAX_POLE_STEP:
         raise ControlConfigError(
             f"pole: {pole:g} rad/s is too fast for the controller's period {sample_period:g} s "
@@ -368,6 +373,10 @@ def coupling_torques(theta: ArrayLike, torque: ArrayLike) -> NDArray[np.float64]
     """
     angles = np.asarray(theta, dtype=np.float64)
     loads = np.asarray(torque, dtype=np.float64)
+    if angles.ndim not in (1, 2) or angles.shape[-1] != 2:
+        raise ValueError(f"theta: expected two angles (joints 1 and 2), got shape {angles.shape}")
+    if loads.ndim not in (1, 2) or loads.shape[-1] != 3:
+        raise ValueError(f"torque: expected three torques (tx, ty, tz), got shape {loads.shape}")
     single = angles.ndim == 1
     angles2 = np.ascontiguousarray(angles.reshape(-1, 2))
     loads2 = np.ascontiguousarray(loads.reshape(-1, 3))
