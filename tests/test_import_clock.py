@@ -58,6 +58,25 @@ def test_a_clock_faster_than_the_sensor_interpolates_the_samples_between() -> No
     np.testing.assert_allclose(clocked.wrench[1::2], (wrench.values[1:] + wrench.values[:-1]) / 2)
 
 
+def test_motor_commands_are_held_from_each_to_the_next_and_start_the_clock() -> None:
+    # a program that sends a new command every 10 ms, 2.5 ms after the sensor's ticks, from
+    # 30 ms on: each slot carries the last command sent at or before it, and the clock begins
+    # at the first slot after the first command
+    wrench = _wrench(201)
+    joints = _ramp_joints(wrench.stamps)
+    stamps = EPOCH_NS + 30 * MS + MS // 2 * 5 + np.arange(17, dtype=np.int64) * 10 * MS
+    volts = np.column_stack([np.arange(17.0), -np.arange(17.0)])
+    clocked = put_on_clock(
+        wrench, joints, source="log", commands=Stream("/servo", "commands", stamps, volts)
+    )
+    assert clocked.commands is not None
+    assert clocked.report.origin_ns == int(wrench.stamps[33])  # 32.5 ms: the next tick
+    slots = clocked.report.origin_ns + np.rint(clocked.t * 1e9).astype(np.int64)
+    sent = (slots - stamps[0]) // (10 * MS)  # the command in force at each slot
+    np.testing.assert_array_equal(clocked.commands, volts[np.minimum(sent, 16)])
+    assert put_on_clock(wrench, joints, source="log").commands is None
+
+
 def test_the_clock_covers_only_the_time_both_streams_cover() -> None:
     wrench = _wrench(100)
     joints = _ramp_joints(EPOCH_NS + np.arange(20, 80, dtype=np.int64) * MS + MS // 3)

@@ -274,12 +274,16 @@ class ClockedStreams:
     joints : ndarray, shape (m, j)
         The joint stream's values at those slots.
     report : ClockReport
+    commands : ndarray, shape (m, 2), or None
+        The motor commands u1, u2 (V) in force at those slots (the last sent at or before
+        each), when a commands stream was given.
     """
 
     t: NDArray[np.float64]
     wrench: NDArray[np.float64]
     joints: NDArray[np.float64]
     report: ClockReport
+    commands: NDArray[np.float64] | None = None
 
 
 def _check_stream(
@@ -579,6 +583,7 @@ def put_on_clock(
     source: str,
     period: float | None = None,
     max_gap: float | None = None,
+    commands: Stream | None = None,
 ) -> ClockedStreams:
     """Lay the wrench and joint streams on one uniform clock (see the module's docstring).
 
@@ -597,6 +602,10 @@ def put_on_clock(
         None: the estimators' own limit at T_s (``EstimatorConfig().gap_limit``, 20 ms),
         beyond which a gap from the contact on gives ``bad_input``; so a shorter hole is bridged and
         a longer one shown, for every topic alike.
+    commands : Stream, optional
+        The motor commands (values (n, 2): u1, u2 in V), held from each to the next (a servo
+        drive holds the last command it received): the clock then starts at the first. What
+        ``antenna identify --servo`` fits the motors to.
 
     Returns
     -------
@@ -613,6 +622,8 @@ def put_on_clock(
     """
     _check_stream(wrench, source, "wrench", "fx, fy, fz (N), tx, ty, tz (N m)", 6, 2)
     _check_stream(joints, source, "joints", "theta1, theta2 (rad)", 2, 6)
+    if commands is not None:
+        _check_stream(commands, source, "commands", "u1, u2 (V)", 2, 6)
     if max_gap is not None and not (math.isfinite(max_gap) and max_gap >= 0.0):
         raise ValueError(f"max_gap must be a finite number >= 0, got {max_gap!r}")
     wrench_clock, joints_clock = sample_clock(wrench.stamps), sample_clock(joints.stamps)
@@ -635,6 +646,8 @@ def put_on_clock(
     instants = int(wrench.stamps[0]) + np.rint(wrench_clock.instants).astype(np.int64)
     start = max(int(instants[0]), int(joints.stamps[0]))
     end = min(int(instants[-1]), int(joints.stamps[-1]))
+    if commands is not None:
+        start = max(start, int(commands.stamps[0]))
     if start >= end:
         raise ImporterError(
             f"{source}: {wrench.name!r} ({_span(wrench)}) and {joints.name!r} ({_span(joints)})"
@@ -724,11 +737,17 @@ def put_on_clock(
             max(int(instants[-1]) - last_slot, 0.0) / _NS,
         ),
     )
+    held = None
+    if commands is not None:
+        # the last command sent at or before each slot (whole nanoseconds: no rounding)
+        slot_at = origin + np.rint(slot_ns[kept]).astype(np.int64)
+        held = commands.values[np.searchsorted(commands.stamps, slot_at, side="right") - 1]
     return ClockedStreams(
         t=kept.astype(np.float64) * step,
         wrench=wrench_values[kept],
         joints=joint_values[kept],
         report=report,
+        commands=held,
     )
 
 
