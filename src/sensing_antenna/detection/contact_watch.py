@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import detect_contact
+from sensing_antenna.history import GrowingArray
 from sensing_antenna.recording import Recording
 
 __all__ = [
@@ -73,23 +74,6 @@ def free_period_samples(antenna: Antenna, sample_period: float) -> int:
     return max(1, round(2.0 * math.pi / (antenna.observer.natural_frequency * sample_period)))
 
 
-class _Growing:
-    """A float history grown by doubling: values, or rows of ``width`` values."""
-
-    def __init__(self, width: int | None = None) -> None:
-        self.values = np.empty(4096 if width is None else (4096, width))
-        self.size = 0
-
-    def extend(self, block: FloatArray) -> None:
-        stop = self.size + block.shape[0]
-        if stop > self.values.shape[0]:
-            grown = np.empty((max(stop, 2 * self.values.shape[0]), *self.values.shape[1:]))
-            grown[: self.size] = self.values[: self.size]
-            self.values = grown
-        self.values[self.size : stop] = block
-        self.size = stop
-
-
 class ContactWatch:
     """Watches the residual from t_c on, block by block, for the contact lost and a touch
     again (each said once; after a touch again, nothing more).
@@ -108,9 +92,9 @@ class ContactWatch:
         self.free_period = free_period
         self.threshold = threshold
         self.sample_period = sample_period
-        self._sums = _Growing(3)  # cumulative residual from t_c (row 0: none yet)
+        self._sums = GrowingArray(3)  # cumulative residual from t_c (row 0: none yet)
         self._sums.extend(np.zeros((1, 3)))
-        self._levels = _Growing()  # the averages' norms, from t_c
+        self._levels = GrowingArray()  # the averages' norms, from t_c
         self._push_level = 0.0
         self.lost: ContactChange | None = None
         self.again: ContactChange | None = None

@@ -45,6 +45,7 @@ from sensing_antenna.estimation.front.steps import (
 from sensing_antenna.estimation.methods import EstimationMethod
 from sensing_antenna.estimation.online import OnlineEstimator
 from sensing_antenna.estimation.result import ContactEstimate
+from sensing_antenna.history import GrowingArray
 from sensing_antenna.live.events import (
     ContactEvent,
     ContactLostEvent,
@@ -67,23 +68,6 @@ __all__ = ["CONTACT_AGAIN_SHARE", "CONTACT_LOST_SHARE", "Listener"]
 
 _END = "end"
 _ABORT = "abort"
-
-
-class _Growing:
-    """A float history grown by doubling: values, or rows of ``width`` values."""
-
-    def __init__(self, width: int | None = None) -> None:
-        self.values = np.empty(4096 if width is None else (4096, width))
-        self.size = 0
-
-    def extend(self, block: NDArray[np.float64]) -> None:
-        stop = self.size + block.shape[0]
-        if stop > self.values.shape[0]:
-            grown = np.empty((max(stop, 2 * self.values.shape[0]), *self.values.shape[1:]))
-            grown[: self.size] = self.values[: self.size]
-            self.values = grown
-        self.values[self.size : stop] = block
-        self.size = stop
 
 
 class Listener:
@@ -160,8 +144,8 @@ class Listener:
         # the torques about O of a sensor that takes them about its own origin (checked with
         # the header); the recording keeps them as received, with the point
         self._torque_point = stated_torque_point(header.metadata, header.source)
-        self._t = _Growing()  # with the samples missing put back
-        self._received = _Growing()
+        self._t = GrowingArray()  # with the samples missing put back
+        self._received = GrowingArray()
         self._period = DeclaredPeriodCheck(header.sample_period)  # on the first stamps
         self._last: tuple[float, NDArray[np.float64]] | None = None
         self._grid: StreamGrid | None = None  # where the samples were placed (fill_missing)
