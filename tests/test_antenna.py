@@ -16,6 +16,7 @@ from sensing_antenna.antenna import (
     BUILTIN_ANTENNAS,
     PARAMETER_RANGES,
     AntennaConfigError,
+    SensorRange,
     antenna_to_toml,
     load_antenna,
     paper_antenna,
@@ -104,6 +105,11 @@ def test_toml_override_with_base(tmp_path: Path) -> None:
         ("[motor]\ninertia = 1.0\n", "motor"),
         ("[azimuth_motor]\ninertia = -1.0\n", "azimuth_motor.inertia"),
         ("[observer]\nnatural_frequency = 0.0\n", "observer.natural_frequency"),
+        ("[sensor_range]\nforce = [25.0, 25.0, 35.0]\n", "sensor_range.torque"),
+        ("[sensor_range]\nforce = [25, 25]\ntorque = [1, 1, 1]\n", "sensor_range.force"),
+        ("[sensor_range]\nforce = [25, 25, 0]\ntorque = [1, 1, 1]\n", "sensor_range.force"),
+        ('[sensor_range]\nforce = [25, 25, 25]\ntorque = [1, "a", 1]\n', "sensor_range.torque"),
+        ("[sensor_range]\nforce = [1, 1, 1]\ntorque = [1, 1, 1]\nfz = 3\n", "sensor_range.fz"),
     ],
 )
 def test_invalid_values_name_field_and_file(tmp_path: Path, body: str, field: str) -> None:
@@ -157,6 +163,7 @@ def test_save_load_round_trip(tmp_path: Path) -> None:
         name='odd "name"',
         description="tip payload",
         link=dataclasses.replace(original.link, tip_mass=0.0012, calibrated_t=0.21),
+        sensor_range=SensorRange(force=(25.0, 25.0, 35.0), torque=(0.25, 0.25, 0.25)),
     )
     for antenna in (original, load_antenna("paper-2021-calibrated"), variant):
         path = tmp_path / "round.toml"

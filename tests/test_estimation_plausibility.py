@@ -1303,3 +1303,29 @@ def test_a_detection_on_a_knock_before_the_touch_is_said_and_the_hold_still_read
     assert result.status is Status.UNCERTAIN
     assert re.search(r"the contact found at t_c = 0\.3\d\d s was lost at", result.reason or "")
     assert abs(result.x_c - 0.6) < 0.01
+
+
+def test_readings_at_the_sensors_range_are_bad_input_when_the_range_is_stated() -> None:
+    # A sensor sized close to the loads: its torque channels clip at 90 % of what the push
+    # reached, with one count of noise on the clipped samples (a saturated gauge read through
+    # the calibration matrix with live ones). Stated in the antenna (sensor_range), the range
+    # makes the answer bad_input naming the column; twice the loads, nothing changes.
+    from sensing_antenna.antenna import SensorRange
+
+    recording = simulate(
+        paper_antenna(), Scenario(case="azimuthal", contact_point=0.6, seed=3)
+    ).without_ground_truth()
+    peak = float(np.max(np.abs(recording.torque)))
+    limit = 0.9 * peak
+    clipped = np.clip(recording.torque, -limit, limit)
+    hit = np.abs(recording.torque) > limit
+    clipped[hit] += np.random.default_rng(0).normal(0.0, 3.1e-5, int(hit.sum()))
+    sized = SensorRange(force=(25.0, 25.0, 35.0), torque=(limit, limit, limit))
+    model = dataclasses.replace(calibrated(), sensor_range=sized)
+    result = estimate(dataclasses.replace(recording, torque=clipped), model, "paper")
+    assert result.status is Status.BAD_INPUT
+    assert re.search(r"column 't[xyz]': .* % of the sensor's range of", result.reason or "")
+    roomy = SensorRange(force=(25.0, 25.0, 35.0), torque=(2 * peak, 2 * peak, 2 * peak))
+    plain = estimate(recording, calibrated(), "paper")
+    within = estimate(recording, dataclasses.replace(calibrated(), sensor_range=roomy), "paper")
+    assert (within.status, within.x_c) == (plain.status, plain.x_c)

@@ -47,6 +47,7 @@ __all__ = [
     "MODEL_FREQUENCY_FLOOR",
     "NOMINAL_T_UNCERTAINTY",
     "PARAMETER_RANGES",
+    "RANGE_SHARE",
     "SENSOR_SWEEPS",
     "Antenna",
     "AntennaConfigError",
@@ -55,6 +56,7 @@ __all__ = [
     "Motor",
     "ParameterRange",
     "SensorCorrection",
+    "SensorRange",
     "antenna_to_toml",
     "load_antenna",
     "metres_hint",
@@ -718,6 +720,53 @@ class SensorCorrection:
 
 
 @dataclass(frozen=True)
+class SensorRange:
+    """The F/T sensor's measuring range on each recording column: readings at
+    :data:`RANGE_SHARE` of it or beyond may be clipped. For a sensor mounted with its axes
+    along the motor axes (up to signs), its datasheet's per-axis ranges.
+
+    Parameters
+    ----------
+    force : tuple of 3 float
+        fx, fy, fz ranges (N), > 0.
+    torque : tuple of 3 float
+        tx, ty, tz ranges (N m), > 0.
+    """
+
+    force: tuple[float, float, float]
+    torque: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        for name, unit in (("force", "N"), ("torque", "N m")):
+            values = getattr(self, name)
+            if isinstance(values, str) or not isinstance(values, (list, tuple)) or len(values) != 3:
+                raise AntennaConfigError(
+                    f"sensor_range.{name}", f"must be a list of 3 numbers ({unit}), got {values!r}"
+                )
+            for value in values:
+                if isinstance(value, bool) or not isinstance(value, (int, float)):
+                    raise AntennaConfigError(
+                        f"sensor_range.{name}", f"must hold numbers, got {value!r}"
+                    )
+                if not (math.isfinite(value) and value > 0.0):
+                    raise AntennaConfigError(
+                        f"sensor_range.{name}", f"must be finite and > 0 {unit}, got {value!r}"
+                    )
+            object.__setattr__(self, name, tuple(float(v) for v in values))
+
+    @property
+    def limits(self) -> NDArray[np.float64]:
+        """fx, fy, fz, tx, ty, tz ranges (N, N m), shape (6,)."""
+        return np.array([*self.force, *self.torque])
+
+
+#: Share of a channel's range at which its readings may be clipped: a strain-gauge sensor's
+#: gauges saturate at about their rated load, and combined loads reach it on one gauge before
+#: any axis reads its full range.
+RANGE_SHARE = 0.95
+
+
+@dataclass(frozen=True)
 class Antenna:
     """A complete sensing antenna: link, azimuth motor (1), elevation motor (2), observer, and
     the F/T sensor's correction (none by default)."""
@@ -730,6 +779,7 @@ class Antenna:
     description: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
     sensor: SensorCorrection = field(default_factory=SensorCorrection)
+    sensor_range: SensorRange | None = None
 
     def __post_init__(self) -> None:
         name = self.name
@@ -820,7 +870,7 @@ _SECTIONS: dict[str, type] = {
     "elevation_motor": Motor,
     "observer": FreeMotionObserver,
 }
-_TOP_LEVEL_KEYS = {"name", "base", "description", "sensor", *_SECTIONS}
+_TOP_LEVEL_KEYS = {"name", "base", "description", "sensor", "sensor_range", *_SECTIONS}
 
 #: Names of the antenna sets shipped with the package.
 BUILTIN_ANTENNAS = ("paper-2021", "paper-2021-calibrated")
@@ -893,6 +943,22 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
         parts["sensor"] = SensorCorrection(**sensor)
     except AntennaConfigError as exc:
         raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
+    span = data.get("sensor_range")
+    if span is not None:
+        if not isinstance(span, Mapping):
+            raise AntennaConfigError("sensor_range", "must be a table", source)
+        for key in ("force", "torque"):
+            if key not in span:
+                raise AntennaConfigError(
+                    f"sensor_range.{key}", "missing (a list of 3 numbers is required)", source
+                )
+        for key in span:
+            if key not in ("force", "torque"):
+                raise AntennaConfigError(f"sensor_range.{key}", "unknown key", source)
+        try:
+            parts["sensor_range"] = SensorRange(force=span["force"], torque=span["torque"])
+        except AntennaConfigError as exc:
+            raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
     name = data.get("name", "unnamed")
     if not isinstance(name, str) or not name:
         raise AntennaConfigError("name", "must be a non-empty string", source)
@@ -905,6 +971,7 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
             elevation_motor=parts["elevation_motor"],
             observer=parts["observer"],
             sensor=parts["sensor"],
+            sensor_range=parts.get("sensor_range"),
         )
     except AntennaConfigError as exc:
         raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
@@ -976,6 +1043,11 @@ def antenna_to_toml(antenna: Antenna) -> str:
         if antenna.sensor.unmeasured_sweeps:
             sweeps = ", ".join(_toml_str(s) for s in antenna.sensor.unmeasured_sweeps)
             lines.append(f"unmeasured_sweeps = [{sweeps}]")
+    if antenna.sensor_range is not None:
+        lines += ["", "[sensor_range]"]
+        for name in ("force", "torque"):
+            values = ", ".join(repr(v) for v in getattr(antenna.sensor_range, name))
+            lines.append(f"{name} = [{values}]")
     return "\n".join(lines) + "\n"
 
 

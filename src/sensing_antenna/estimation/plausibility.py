@@ -87,7 +87,7 @@ from typing import Any
 
 import numpy as np
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, Link
+from sensing_antenna.antenna import RANGE_SHARE, STANDARD_GRAVITY, Link
 from sensing_antenna.beam import SensingCurve, free_plane_shift, natural_frequencies
 from sensing_antenna.beam.elastica import loaded_end
 from sensing_antenna.beam.free_plane import FREE_PLANE_DEFLECTIONS
@@ -180,6 +180,9 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     broken = evidence.sample_problem(estimate.t_e)
     if broken is not None:
         found.append((Status.BAD_INPUT, broken))
+    clipped = _clipped_problem(evidence, end)
+    if clipped is not None:
+        found.append((Status.BAD_INPUT, clipped))
     misplaced = _misplaced_problem(estimate, end)
     if misplaced is not None:
         found.append((Status.BAD_INPUT, misplaced))
@@ -1097,6 +1100,33 @@ def _detected_before_touch(evidence: Evidence) -> str | None:
         "make the free-motion observer's prediction lag through the sweep's start (antenna "
         "identify names such a lag); a knock, hum on the torques, or a link that swings more "
         "than the one the threshold was identified on do the same"
+    )
+
+
+def _clipped_problem(evidence: Evidence, end: int) -> str | None:
+    """Why the loads up to sample ``end`` may be clipped, or None: a reading at
+    :data:`~sensing_antenna.antenna.RANGE_SHARE` of the sensor's range on its column or beyond
+    (the antenna's ``sensor_range``; not judged without one). A clipped reading is a load the
+    estimators cannot tell from one within range: the ratio, the push and the ringing all read
+    it."""
+    span = evidence.antenna.sensor_range
+    if span is None:
+        return None
+    loads = np.column_stack([evidence.force[: end + 1], evidence.torque[: end + 1]])
+    with np.errstate(invalid="ignore"):
+        share = np.abs(loads) / span.limits
+    worst = np.nanmax(np.where(np.isfinite(share), share, 0.0), axis=0)
+    channel = int(np.argmax(worst))
+    if not worst[channel] >= RANGE_SHARE:
+        return None
+    k = int(np.nanargmax(np.where(np.isfinite(share[:, channel]), share[:, channel], 0.0)))
+    unit = "N" if channel < 3 else "N m"
+    return (
+        f"column {WRENCH_CHANNELS[channel]!r}: {float(loads[k, channel]):.4g} {unit} at t = "
+        f"{float(evidence.t[k]):.3f} s, {100 * float(worst[channel]):.0f} % of the sensor's "
+        f"range of {float(span.limits[channel]):g} {unit} (sensor_range): readings there may be "
+        "clipped, which no estimate can tell from a load; push less far or less fast, or use a "
+        "sensor of a larger range"
     )
 
 
