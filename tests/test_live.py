@@ -30,7 +30,7 @@ from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna, save_a
 from sensing_antenna.cli import main
 from sensing_antenna.detection.contact_watch import contact_changes
 from sensing_antenna.errors import Terminated
-from sensing_antenna.estimation import METHODS, OnlineEstimator, estimate
+from sensing_antenna.estimation import METHODS, OnlineEstimator, Status, estimate
 from sensing_antenna.live.events import (
     ContactEvent,
     ContactLostEvent,
@@ -1389,6 +1389,32 @@ def test_a_second_contact_in_one_recording_is_said_not_estimated(
         e for e in _listen_all(first.without_ground_truth(), antenna) if e["event"] == "skipped"
     ]
     assert not alone
+
+
+def test_a_contact_found_on_a_knock_before_the_touch_is_no_contact_lost_nor_a_second() -> None:
+    # A knock during the sweep (a 50 Hz burst, 0.3 to 0.8 s) fires the detector before the link
+    # touches; the head sweeps on to the touch, whose hold is estimated. The knock's fading is
+    # no contact lost and the touch no second contact: live says neither, as offline, and the
+    # estimate says its t_c was no touch
+    antenna = paper_antenna().self_calibrated()
+    recording = simulate(
+        paper_antenna(), Scenario(case="azimuthal", contact_point=0.6, seed=1)
+    ).without_ground_truth()
+    t = recording.t
+    burst = np.sin(2.0 * np.pi * 50.0 * t) * ((t > 0.3) & (t < 0.8))
+    knocked = dataclasses.replace(
+        recording,
+        force=recording.force + 0.3 * burst[:, None],
+        torque=recording.torque + 0.03 * burst[:, None],
+    )
+    said = _listen_all(knocked, antenna)
+    kinds = [e["event"] for e in said]
+    assert "contact_lost" not in kinds and "skipped" not in kinds, said
+    (result,) = [e for e in said if e["event"] == "estimate"]
+    offline = estimate(knocked, antenna, "ratio")
+    assert offline.status is not Status.OK
+    assert any("had gone by" in r for r in [offline.reason, *offline.diagnostics["other_reasons"]])
+    assert (result["status"], result["x_c"]) == (offline.status.value, offline.x_c)
 
 
 def _listen_all(recording: Recording, antenna: Antenna) -> list[dict[str, Any]]:

@@ -60,12 +60,15 @@ class ContactChange:
         Samples from t_c (its sample 0) to the one at which the change is known.
     t : float
         When (s): for ``lost`` where the push began to vanish (one free period back from
-        ``row``, plus the share of it still held); for ``again``, the sample at ``row``.
+        ``row``, plus the share of it still held, not before t_c); for ``again``, ``known``.
+    known : float
+        The time stamp (s) of the sample at ``row``: by then the change had happened.
     """
 
     kind: Literal["lost", "again"]
     row: int
     t: float
+    known: float
 
 
 def free_period_samples(antenna: Antenna, sample_period: float) -> int:
@@ -134,7 +137,7 @@ class ContactWatch:
         before = float(self._levels.values[row - period - 1]) if row > period else 0.0
         held = min(1.0, float(levels[k]) / before) if before > 0.0 else 0.0
         when = max(float(t[k]) - (1.0 - held) * period * self.sample_period, self._t_c)
-        self.lost = ContactChange("lost", row - 1, when)
+        self.lost = ContactChange("lost", row - 1, when, float(t[k]))
         changes = [self.lost]
         if k + 1 < ends.shape[0]:
             changes += self._watch_again(ends[k + 1 :], levels[k + 1 :], t[k + 1 :])
@@ -147,7 +150,7 @@ class ContactWatch:
         if again.size == 0:
             return []
         first = int(again[0])
-        self.again = ContactChange("again", int(ends[first]) - 1, float(t[first]))
+        self.again = ContactChange("again", int(ends[first]) - 1, float(t[first]), float(t[first]))
         return [self.again]
 
 

@@ -1093,7 +1093,7 @@ def _detected_before_touch(evidence: Evidence) -> str | None:
     t_c = float(evidence.t[evidence.contact_index])
     t_1 = float(evidence.t[evidence.rest_index])
     return (
-        f"the contact found at t_c = {t_c:.3f} s was lost at {float(lost):.3f} s, before the "
+        f"the contact found at t_c = {t_c:.3f} s had gone by {float(lost):.3f} s, before the "
         f"head came to rest at t_1 = {t_1:.3f} s: the contact detector fired on something "
         "other than the touch the hold reads, and what starts at the touch (the push's bend "
         "against the head's turn) cannot be checked. Angles stamped late against the loads "

@@ -137,6 +137,7 @@ class Listener:
         # contact lost, and a touch again: the residual from t_c, averaged over a free period
         self._free_period = free_period_samples(antenna, ts)
         self._watch: ContactWatch | None = None
+        self._watching = True  # until a touch again, or a contact lost before t_1
         self._columns = [
             [header.required(name) for name in names]
             for names in (("t",), ("theta1", "theta2"), ("fx", "fy", "fz"), ("tx", "ty", "tz"))
@@ -365,9 +366,11 @@ class Listener:
     def _watch_contact(self, first: int) -> None:
         """The contact lost and a touch again (:class:`~sensing_antenna.detection.contact_watch.
         ContactWatch`), each said once: lost as a ``contact_lost`` event, a touch again as a
-        ``skipped`` one (a recording holds one contact, the first's estimate stands)."""
+        ``skipped`` one (a recording holds one contact, the first's estimate stands). A contact
+        lost before the head rested at t_1 was no touch: nothing is said (the estimate's status
+        says it), and the watch ends."""
         contact = self._estimator.contact_index
-        if contact is None or (self._watch is not None and self._watch.again is not None):
+        if contact is None or not self._watching:
             return
         detection = self._residual.detection()
         if self._watch is None:
@@ -380,8 +383,15 @@ class Listener:
         for change in changes:
             latency = self._latency(max(first, contact + change.row))
             if change.kind == "lost":
+                rest = self._estimator.rest_index
+                if rest is None or change.t < float(self._t.values[rest]):
+                    # lost before the head rested: t_c was no touch (the estimate says so), and
+                    # the touch the watch would call a second is the one estimated
+                    self._watching = False
+                    return
                 self._emit(ContactLostEvent(self.number, change.t, latency))
                 continue
+            self._watching = False
             self._emit(
                 SkippedEvent(
                     self.number,

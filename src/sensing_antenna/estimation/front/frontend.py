@@ -813,8 +813,8 @@ class FrontEnd:
         )
 
     def _lost_before_rest(self, rest: int) -> float | None:
-        """When (s) the contact found at t_c was lost before the head came to rest at t_1
-        (sample ``rest``), or None: the contact detector's residual from t_c to t_1, averaged
+        """By when (s) the contact found at t_c had been lost, before the head came to rest at
+        t_1 (sample ``rest``), or None: the contact detector's residual from t_c to t_1, averaged
         over a free period (:class:`~sensing_antenna.detection.contact_watch.ContactWatch`).
         A detection on something other than the touch (angles stamped late against the loads,
         a knock, hum) that the head turned on from."""
@@ -824,7 +824,7 @@ class FrontEnd:
         ts, k = self.sample_period, self._contact
         watch = ContactWatch(free_period_samples(self.antenna, ts), detection.threshold, ts)
         changes = watch.feed(detection.residual[k : rest + 1], self._t[k : rest + 1])
-        return next((change.t for change in changes if change.kind == "lost"), None)
+        return next((change.known for change in changes if change.kind == "lost"), None)
 
     def _notes_now(self, end: int | None = None) -> dict[str, Any]:
         """What the caller said of the samples, and how many missing ones were put back up to
