@@ -104,8 +104,8 @@ def test_the_simulator_s_limits_are_named_by_the_flag(
         # a flipped axis first reads as an option
         (
             ["import", "rosbag", "x.bag", "--wrench", "/w", "--joints", "/j", "--frame", "-x,y,z"],
-            "--frame: expected one argument (a value that begins with '-' goes after '=': "
-            "--frame=-VALUE)",
+            "--frame: expected one argument (none followed it, or it began with '-', which "
+            "reads as an option: write --frame=VALUE)",
         ),
     ],
 )

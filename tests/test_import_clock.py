@@ -75,6 +75,10 @@ def test_motor_commands_are_held_from_each_to_the_next_and_start_the_clock() -> 
     sent = (slots - stamps[0]) // (10 * MS)  # the command in force at each slot
     np.testing.assert_array_equal(clocked.commands, volts[np.minimum(sent, 16)])
     assert put_on_clock(wrench, joints, source="log").commands is None
+    # commands that begin after the other two end are named, not the two
+    late = Stream("/servo", "commands", stamps + 500 * MS, volts)
+    with pytest.raises(ImporterError, match=r"'/servo' \(.*\) begins after the wrench and"):
+        put_on_clock(wrench, joints, source="log", commands=late)
 
 
 def test_the_clock_covers_only_the_time_both_streams_cover() -> None:

@@ -47,7 +47,7 @@ from sensing_antenna.live.inputs import (
     listen_udp,
 )
 from sensing_antenna.live.listener import Listener
-from sensing_antenna.live.record import RecordWriter
+from sensing_antenna.live.record import RecordWriter, record_path_problem
 from sensing_antenna.live.replay import replay_datagrams, replay_lines, stream_of
 from sensing_antenna.live.warm_up import warm_up
 from sensing_antenna.live.wire import (
@@ -655,6 +655,13 @@ def test_a_record_path_that_would_write_over_or_has_no_folder_is_refused_before_
     (tmp_path / "kept-3.csv").write_text("a later recording of it")
     assert main(["listen", "--no-warm-up", "--record", str(kept)]) == 2
     assert f"{tmp_path / 'kept-3.csv'} exists" in capsys.readouterr().err
+    # names numbered_path never writes are not in the way: FILE-1, or FILE-2.csv for a FILE
+    # without a suffix (its next recording goes to FILE-2)
+    (tmp_path / "kept-3.csv").unlink()
+    (tmp_path / "kept-1.csv").write_text("another session's")
+    (tmp_path / "plain-2.csv").write_text("another session's")
+    assert record_path_problem(kept) is None
+    assert record_path_problem(tmp_path / "plain") is None
     nowhere = tmp_path / "no" / "run.csv"
     assert main(["listen", "--no-warm-up", "--record", str(nowhere)]) == 2
     assert f"the folder {nowhere.parent} does not exist" in capsys.readouterr().err

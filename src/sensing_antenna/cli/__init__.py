@@ -133,9 +133,12 @@ class OneLineParser(argparse.ArgumentParser):
     def error(self, message: str) -> NoReturn:
         message = message.removeprefix("argument ")
         if message.endswith(": expected one argument"):
-            # a value that begins with '-' (a sign, a flipped axis) reads as an option
+            # no value, or one that begins with '-' (a sign, a flipped axis): read as an option
             flag = message.split(":", 1)[0].split("/")[-1]
-            message += f" (a value that begins with '-' goes after '=': {flag}=-VALUE)"
+            message += (
+                f" (none followed it, or it began with '-', which reads as an option: write "
+                f"{flag}=VALUE)"
+            )
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
 
     def reject_unknown(self, extras: Sequence[str]) -> NoReturn:

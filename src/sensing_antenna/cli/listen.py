@@ -78,6 +78,7 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.live.record import RecordWriter, numbered_path, record_path_problem
     from sensing_antenna.live.warm_up import freeze_heap, warm_up
     from sensing_antenna.live.wire import StreamHeader, WireError
+    from sensing_antenna.recording import RecordingError
 
     if args.record is not None:
         problem = record_path_problem(args.record)
@@ -99,7 +100,13 @@ def _run(args: argparse.Namespace) -> int:
             warn_of_other_antennas({header.metadata.get("antenna", ""): [which]}, antenna.name)
         record = None
         if args.record is not None:
-            record = RecordWriter(numbered_path(args.record, number), header)
+            kept = numbered_path(args.record, number)
+            try:
+                record = RecordWriter(kept, header)
+            except OSError as exc:  # a file made since the start, a folder removed: this stream
+                raise RecordingError(
+                    header.source, None, "--record", f"{kept}: {exc.strerror or exc}"
+                ) from None
         try:
             return Listener(header, antenna, emit, args.method, config, record, number)
         except SensingAntennaError:

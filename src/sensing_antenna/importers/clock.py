@@ -646,13 +646,18 @@ def put_on_clock(
     instants = int(wrench.stamps[0]) + np.rint(wrench_clock.instants).astype(np.int64)
     start = max(int(instants[0]), int(joints.stamps[0]))
     end = min(int(instants[-1]), int(joints.stamps[-1]))
-    if commands is not None:
-        start = max(start, int(commands.stamps[0]))
     if start >= end:
         raise ImporterError(
             f"{source}: {wrench.name!r} ({_span(wrench)}) and {joints.name!r} ({_span(joints)})"
             " do not overlap in time"
         )
+    if commands is not None:
+        if int(commands.stamps[0]) >= end:
+            raise ImporterError(
+                f"{source}: {commands.name!r} ({_span(commands)}) begins after the wrench and"
+                f" the joints end ({end / _NS:.9f} s): no sample has a command"
+            )
+        start = max(start, int(commands.stamps[0]))
     step = wrench_clock.period / _NS if period is None else float(period)
     if not (math.isfinite(step) and step > 0):
         raise ValueError(f"period must be finite and > 0, got {step!r}")

@@ -35,8 +35,10 @@ def record_path_problem(path: Path) -> str | None:
     if not folder.is_dir():
         return f"{path}: the folder {folder} does not exist"
     taken = [path] if path.exists() else []
-    taken += sorted(folder.glob(f"{glob.escape(path.stem)}-[0-9]*{glob.escape(path.suffix)}"))
-    taken = [p for p in taken if p == path or p.stem[len(path.stem) + 1 :].isdigit()]
+    for found in sorted(folder.glob(f"{glob.escape(path.stem)}-[0-9]*{glob.escape(path.suffix)}")):
+        number = found.name[len(path.stem) + 1 : len(found.name) - len(path.suffix)]
+        if number.isdigit() and int(number) >= 2 and found == numbered_path(path, int(number)):
+            taken.append(found)
     if taken:
         return (
             f"{taken[0]} exists: recordings are not written over; give another name or move "
