@@ -1062,14 +1062,26 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
             f"({_vector(reaction)} N): the link slid off the object or past it"
         )
     lateral = float(np.linalg.norm(reaction[1:]))
-    untouched = (
-        f"; or the link touched nothing: a force of {lateral / error:.2g} standard errors is "
-        "what a link still swinging from the sweep leaves, a detector firing on the free "
-        "motion (its threshold below this device's residual: antenna identify on its free "
-        "sweeps)"
-        if lateral <= _WEAK_PUSH * error
-        else ""
-    )
+    # a contact that sticks anywhere on the link bends it by the head's turn there: at the tip,
+    # the weakest, it pushes back with 3 E I |turn| / l^2
+    link = evidence.antenna.link
+    sticking = 3.0 * float(np.linalg.norm(direction)) / (link.bending_compliance * link.length**2)
+    untouched = ""
+    if lateral <= _WEAK_PUSH * error:
+        untouched = (
+            f"; or the link touched nothing: a force of {lateral / error:.2g} standard errors "
+            "is what a link still swinging from the sweep leaves, a detector firing on the free "
+            "motion (its threshold below this device's residual: antenna identify on its free "
+            "sweeps)"
+        )
+    elif lateral < sticking:
+        untouched = (
+            f"; or the link touched nothing: {1e3 * lateral:.3g} mN is less than a contact that "
+            f"sticks anywhere on the link pushes back with for the head's turn "
+            f"({1e3 * sticking:.3g} mN at the tip), a detector firing on the free motion (its "
+            "threshold below what this link's swing leaves, or a link that swings more than "
+            "the one it was identified on: antenna identify on its free sweeps)"
+        )
     return Status.IMPLAUSIBLE_INPUT, (
         f"columns 'theta1', 'theta2', 'fx', 'fy', 'fz': the mean contact force over the hold "
         f"{_vector(reaction)} N does not oppose the head's turn into the contact "
