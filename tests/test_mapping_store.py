@@ -137,6 +137,8 @@ def test_the_report_names_a_point_far_from_the_named_object(tmp_path: Path) -> N
     report = (tmp_path / "report.md").read_text()
     assert "Points the sphere's fit counts as wrong estimates" in report
     assert "r30 (451 mm from it)" in report and "r29" not in report  # 0.5 m less the radius
+    # what a named class is of: a straight link touches the convex hull only
+    assert "The class is the one of the object's convex hull" in report
 
 
 def test_a_named_mesh_says_what_of_it_the_points_do_not_hold(tmp_path: Path) -> None:

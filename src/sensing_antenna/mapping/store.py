@@ -177,6 +177,15 @@ def write_map(
     return written
 
 
+#: What a named class is of: a straight link meets an object first where it is tangent to it,
+#: so its contacts and free sweeps see the object's convex hull only.
+HULL_NOTE = (
+    "The class is the one of the object's convex hull, which is all a straight link touches: a"
+    " concave object (two balls side by side, a groove, a bowl seen from outside) is named as"
+    " its hull's class (docs/mapping.md)."
+)
+
+
 #: Overdispersion (the best class's reduced chi^2) beyond which the points are said to lie
 #: farther from every class than their covariances allow: 4, residuals twice their deviations
 #: (docs/mapping.md has what it was on right and on misplaced points).
@@ -390,6 +399,7 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
             )
             + ".",
             *(f"{text[:1].upper()}{text[1:]}." for text in (spread, wrong) if text),
+            *(() if recognition.undecided else (HULL_NOTE,)),
             *_member_note(recognition),
             *_counted_wrong(contact_map),
             "",
