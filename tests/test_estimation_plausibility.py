@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from _models import calibrated
-from _recordings import samples_kept
+from _recordings import knocked, samples_kept
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna
 from sensing_antenna.detection.push import PushCriterion
 from sensing_antenna.estimation import (
@@ -1291,14 +1291,8 @@ def test_a_detection_on_a_knock_before_the_touch_is_said_and_the_hold_still_read
     recording = simulate(
         paper_antenna(), Scenario(case="azimuthal", contact_point=0.6, seed=1)
     ).without_ground_truth()
-    t = recording.t
-    burst = np.sin(2.0 * np.pi * 50.0 * t) * ((t > 0.3) & (t < 0.8))
-    knocked = dataclasses.replace(
-        recording,
-        force=recording.force + 0.3 * burst[:, None],
-        torque=recording.torque + 0.03 * burst[:, None],
-    )
-    result = estimate(knocked, calibrated(), method)
+    knock = knocked(recording)
+    result = estimate(knock, calibrated(), method)
     assert result.t_c < 0.4
     assert result.status is Status.UNCERTAIN
     assert re.search(r"the contact found at t_c = 0\.3\d\d s had gone by", result.reason or "")

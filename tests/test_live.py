@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 import sensing_antenna
+from _recordings import knocked
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna, save_antenna
 from sensing_antenna.cli import main
 from sensing_antenna.detection.contact_watch import contact_changes
@@ -1407,18 +1408,12 @@ def test_a_contact_found_on_a_knock_before_the_touch_is_no_contact_lost_nor_a_se
     recording = simulate(
         paper_antenna(), Scenario(case="azimuthal", contact_point=0.6, seed=1)
     ).without_ground_truth()
-    t = recording.t
-    burst = np.sin(2.0 * np.pi * 50.0 * t) * ((t > 0.3) & (t < 0.8))
-    knocked = dataclasses.replace(
-        recording,
-        force=recording.force + 0.3 * burst[:, None],
-        torque=recording.torque + 0.03 * burst[:, None],
-    )
-    said = _listen_all(knocked, antenna)
+    knock = knocked(recording)
+    said = _listen_all(knock, antenna)
     kinds = [e["event"] for e in said]
     assert "contact_lost" not in kinds and "skipped" not in kinds, said
     (result,) = [e for e in said if e["event"] == "estimate"]
-    offline = estimate(knocked, antenna, "ratio")
+    offline = estimate(knock, antenna, "ratio")
     assert offline.status is not Status.OK
     assert any("had gone by" in r for r in [offline.reason, *offline.diagnostics["other_reasons"]])
     assert (result["status"], result["x_c"]) == (offline.status.value, offline.x_c)
