@@ -22,7 +22,11 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Link
 from sensing_antenna.estimation.config import EstimatorConfig
-from sensing_antenna.estimation.front.evidence import Evidence, sensing_curve
+from sensing_antenna.estimation.front.evidence import (
+    TWO_FREQUENCY_GRID_STEP,
+    Evidence,
+    sensing_curve,
+)
 from sensing_antenna.estimation.methods.paper.frequency import (
     SpectralPeak,
     evidence_frequency,
@@ -477,6 +481,51 @@ def _pair_elsewhere(
     )
 
 
+def _tip_alternative(evidence: Evidence, omega1: float, omega2: float, x_c: float) -> str | None:
+    """Why a contact at the tip may be what rings, though ``omega1`` (rad/s) has its one point
+    at ``x_c`` (m), or None.
+
+    Where the sensing curve falls towards the tip, an omega_1 a little below its value at l
+    (within ``band_margin``) has no point near the tip, yet a link softer than its calibration
+    touched there rings so. omega_2 / omega_1, which the stiffness does not enter, then says
+    which: more than two of its standard uncertainties (``mode_ratio_uncertainty``, or the
+    calibration's measured scatters when larger) off the model's at ``x_c`` and within one of
+    the tip's is the tip's (not asked within ``omega2_window`` of 2 or 3 omega_1)."""
+    cfg = evidence.config
+    link = evidence.antenna.link
+    points, omegas = evidence.contact_modes
+    if not (points[0] <= x_c <= points[-1]) or link.length - x_c <= cfg.max_model_spread:
+        return None
+    at_tip = float(omegas[-1, 0])
+    if link.length - points[-1] > TWO_FREQUENCY_GRID_STEP:
+        return None  # the contact range stops short of the tip
+    if not at_tip / (1.0 + cfg.band_margin) <= omega1 < at_tip:
+        return None
+    if float(omegas[-2, 0]) <= at_tip:
+        return None  # the curve does not fall towards the tip
+    if any(abs(omega2 - k * omega1) < cfg.omega2_window * omega2 for k in (2.0, 3.0)):
+        return None
+    share = max(
+        cfg.mode_ratio_uncertainty,
+        math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0),
+    )
+    ratio = omega2 / omega1
+    here = float(np.interp(x_c, points, omegas[:, 1] / omegas[:, 0]))
+    tip = float(omegas[-1, 1] / omegas[-1, 0])
+    misfit_here, misfit_tip = abs(ratio / here - 1.0) / share, abs(ratio / tip - 1.0) / share
+    if not (misfit_here > 2.0 and misfit_tip < 1.0):
+        return None
+    return (
+        f"omega_1 = {omega1:.1f} rad/s lies {100 * (1.0 - omega1 / at_tip):.1f} % below the "
+        f"sensing curve's value at the tip ({at_tip:.1f} rad/s), where a link that much softer "
+        f"than its calibration touched there rings, and omega_2 / omega_1 = {ratio:.3f}, which "
+        f"the stiffness does not enter, fits the tip's ({tip:.3f}, {misfit_tip:.1f} of its "
+        f"uncertainties) rather than the answer's ({here:.3f} at {x_c:.3f} m, "
+        f"{misfit_here:.1f}): the contact may be at the tip; calibrate again if the link's "
+        "temperature changed"
+    )
+
+
 def _uncertainty_source(link: Link) -> str:
     """Where the link's frequency uncertainty comes from, in words."""
     if link.calibrated_t is None:
@@ -659,6 +708,10 @@ class PaperMethod:
                     )
                 if elsewhere is not None:
                     problems.append((Status.ESTIMATORS_DISAGREE, elsewhere))
+                elif len(candidates_used) == 1:
+                    tip = _tip_alternative(evidence, measurement.omega1, peak2.omega, fusion.x_c)
+                    if tip is not None:
+                        problems.append((Status.UNCERTAIN, tip))
             mismatch = 0.0
             if 2.0 * link.frequency_uncertainty < off <= curve_allowance(link, cfg):
                 # the model is at least that far off on this manoeuvre: omega_1 may be too (a
