@@ -95,7 +95,8 @@ def test_calibrate_without_known_contact_points_fails_cleanly(
     code = main(["calibrate", str(path), "--out", str(tmp_path / "cal.toml")])
     assert code == 2
     err = capsys.readouterr().err
-    assert f"left out: {path}: no known contact point (no row in the --points table or" in err
+    # no --points and no true_xc: the table is what is missing, said first
+    assert "--points: none given, and no recording states its contact point" in err
     assert not (tmp_path / "cal.toml").exists()
 
 

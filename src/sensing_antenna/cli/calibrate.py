@@ -156,9 +156,9 @@ def _run(args: argparse.Namespace) -> int:
         # a real device's recordings carry no true_xc: the table is what is missing
         raise ArgumentError(
             "--points",
-            f"none given, and none of the {len(paths)} recordings states its contact point "
-            "(true_xc metadata, which only a simulator writes): give --points FILE, a CSV with "
-            "columns file,x_c (m), one row per recording (docs/real-antenna.md)",
+            "none given, and no recording states its contact point (true_xc metadata, which "
+            "only a simulator writes): give --points FILE, a CSV with columns file,x_c (m), one "
+            "row per recording (docs/real-antenna.md)",
         )
     try:
         calibration = calibrate_from_recordings(
