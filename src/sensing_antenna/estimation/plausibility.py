@@ -109,6 +109,8 @@ from sensing_antenna.estimation.methods.fast.parametric import fit_damped_sinuso
 from sensing_antenna.estimation.methods.paper.frequency import find_peak, measure_frequency
 from sensing_antenna.estimation.methods.paper.fusion import (
     candidates_from_omega1,
+    harmonic_of,
+    mode_ratio_share,
     model_spread,
     second_mode_band,
     second_peak,
@@ -444,16 +446,14 @@ def _mode_ratio_problem(
         reading = float(evidence.ratio_mean[end])
     component = str(estimate.diagnostics.get("torque_component", "sum"))
     peak = second_peak(evidence, component, omega1)
-    if peak is None or any(
-        abs(peak.omega - k * omega1) < cfg.omega2_window * peak.omega for k in (2.0, 3.0)
-    ):
+    if peak is None or harmonic_of(omega1, peak.omega, cfg):
         return None
     points, omegas = evidence.contact_modes
     if not points[0] <= x_c <= points[-1]:
         return None  # the curve is tabulated over the contact range only
     curve = omegas[:, 1] / omegas[:, 0]
     ratio = peak.omega / omega1
-    sigma = _mode_ratio_share(evidence) * ratio
+    sigma = mode_ratio_share(evidence) * ratio
     misfit = np.abs(curve - ratio) / sigma
     limit = cfg.disagreement_sigmas
     own = model_spread(link, x_c, link.frequency_uncertainty)
@@ -527,14 +527,6 @@ def _modes_judge(evidence: Evidence, estimate: ContactEstimate) -> bool:
     return evidence.bent_link_uncertainty(estimate.x_c) <= evidence.config.max_model_spread
 
 
-def _mode_ratio_share(evidence: Evidence) -> float:
-    """The standard uncertainty of omega_2 / omega_1 as a share of it: ``mode_ratio_uncertainty``,
-    or a calibration's measured scatters of omega_1 and omega_2 in quadrature when larger."""
-    link = evidence.antenna.link
-    measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
-    return max(evidence.config.mode_ratio_uncertainty, measured)
-
-
 def _check3_window(evidence: Evidence, end: int) -> slice:
     """The samples check 3 reads: from t_1 to ``end`` (the estimate's t_e), at most Delta t_e1
     (``spectrum_window``)."""
@@ -576,7 +568,7 @@ def _pinned_contact_problem(
     if not points[0] <= x_c <= points[-1]:
         return None
     c_1, c_2 = support_coefficients(link, float(points[0]), x_c)
-    u = _mode_ratio_share(evidence)
+    u = mode_ratio_share(evidence)
     slope = abs(float(sensing_curve(link).omega1_slope(x_c)))
     # the stiffest support that moves omega_1's point by max_model_spread (inf at the top)
     reach = slope * cfg.max_model_spread / omega1

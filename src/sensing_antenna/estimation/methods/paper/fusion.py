@@ -46,6 +46,8 @@ __all__ = [
     "conclude",
     "curve_allowance",
     "fuse",
+    "harmonic_of",
+    "mode_ratio_share",
     "model_spread",
     "pair_distance",
     "second_mode_against",
@@ -441,6 +443,21 @@ def pair_distance(evidence: Evidence, omega1: float, omega2: float) -> tuple[int
     return k, float(distance[k])
 
 
+def harmonic_of(omega1: float, omega2: float, config: EstimatorConfig) -> bool:
+    """Whether a peak at ``omega2`` (rad/s) lies within ``omega2_window`` of 2 or 3
+    ``omega1``: a harmonic of the fundamental (a clipping or bouncing contact's) may be what it
+    is, not the second contact mode."""
+    return any(abs(omega2 - k * omega1) < config.omega2_window * omega2 for k in (2.0, 3.0))
+
+
+def mode_ratio_share(evidence: Evidence) -> float:
+    """The standard uncertainty of omega_2 / omega_1 as a share of it: ``mode_ratio_uncertainty``,
+    or a calibration's measured scatters of omega_1 and omega_2 in quadrature when larger."""
+    link = evidence.antenna.link
+    measured = math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0)
+    return max(evidence.config.mode_ratio_uncertainty, measured)
+
+
 def _pair_elsewhere(
     evidence: Evidence, omega1: float, omega2: float, x_c: float, nearest: int, off: float
 ) -> str | None:
@@ -459,8 +476,8 @@ def _pair_elsewhere(
     points, omegas = evidence.contact_modes
     if not points[0] <= x_c <= points[-1]:
         return None
-    if any(abs(omega2 - k * omega1) < cfg.omega2_window * omega2 for k in (2.0, 3.0)):
-        return None  # a harmonic of omega_1 may be what the peak is
+    if harmonic_of(omega1, omega2, cfg):
+        return None
     allowance = curve_allowance(link, cfg)
     other = float(points[nearest])
     if not (off <= allowance and abs(other - x_c) > cfg.max_model_spread):
@@ -503,12 +520,9 @@ def _tip_alternative(evidence: Evidence, omega1: float, omega2: float, x_c: floa
         return None
     if float(omegas[-2, 0]) <= at_tip:
         return None  # the curve does not fall towards the tip
-    if any(abs(omega2 - k * omega1) < cfg.omega2_window * omega2 for k in (2.0, 3.0)):
+    if harmonic_of(omega1, omega2, cfg):
         return None
-    share = max(
-        cfg.mode_ratio_uncertainty,
-        math.hypot(link.calibration_scatter or 0.0, link.mode2_scatter or 0.0),
-    )
+    share = mode_ratio_share(evidence)
     ratio = omega2 / omega1
     here = float(np.interp(x_c, points, omegas[:, 1] / omegas[:, 0]))
     tip = float(omegas[-1, 1] / omegas[-1, 0])
@@ -701,16 +715,13 @@ class PaperMethod:
             if peak2 is not None:
                 nearest, off = pair_distance(evidence, measurement.omega1, peak2.omega)
                 diag["curve_distance"] = off
-                elsewhere = None
                 if len(candidates_used) == 1:
-                    elsewhere = _pair_elsewhere(
-                        evidence, measurement.omega1, peak2.omega, fusion.x_c, nearest, off
-                    )
-                if elsewhere is not None:
-                    problems.append((Status.ESTIMATORS_DISAGREE, elsewhere))
-                elif len(candidates_used) == 1:
-                    tip = _tip_alternative(evidence, measurement.omega1, peak2.omega, fusion.x_c)
-                    if tip is not None:
+                    # one candidate: the second mode is the frequency side's only other word
+                    omega1, x_c = measurement.omega1, fusion.x_c
+                    elsewhere = _pair_elsewhere(evidence, omega1, peak2.omega, x_c, nearest, off)
+                    if elsewhere is not None:
+                        problems.append((Status.ESTIMATORS_DISAGREE, elsewhere))
+                    elif (tip := _tip_alternative(evidence, omega1, peak2.omega, x_c)) is not None:
                         problems.append((Status.UNCERTAIN, tip))
             mismatch = 0.0
             if 2.0 * link.frequency_uncertainty < off <= curve_allowance(link, cfg):
