@@ -28,12 +28,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
-from sensing_antenna.detection.contact_watch import (
-    CONTACT_AGAIN_SHARE,
-    CONTACT_LOST_SHARE,
-    ContactWatch,
-    free_period_samples,
-)
+from sensing_antenna.detection.contact_watch import ContactWatch, free_period_samples
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
 from sensing_antenna.estimation.front.steps import (
@@ -63,7 +58,7 @@ from sensing_antenna.recording import (
 )
 from sensing_antenna.torque_point import torques_about_base
 
-__all__ = ["CONTACT_AGAIN_SHARE", "CONTACT_LOST_SHARE", "Listener"]
+__all__ = ["Listener"]
 
 
 _END = "end"
