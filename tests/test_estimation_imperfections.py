@@ -17,12 +17,18 @@ from pathlib import Path
 import pytest
 
 from sensing_antenna import Antenna, paper_antenna
-from sensing_antenna.antenna import FreeMotionObserver
+from sensing_antenna.antenna import FreeMotionObserver, load_antenna
 from sensing_antenna.calibration.frequency import calibrate_from_recordings
 from sensing_antenna.calibration.sensor import calibrate_sensor
-from sensing_antenna.estimation import METHODS, Status, estimate
+from sensing_antenna.estimation import METHODS, ContactEstimate, Status, estimate
 from sensing_antenna.recording import Recording
-from sensing_antenna.simulator import DeviceImperfections, Scenario, device_profile, simulate
+from sensing_antenna.simulator import (
+    DeviceImperfections,
+    Scenario,
+    device_profile,
+    realistic_device,
+    simulate,
+)
 
 MODEL = paper_antenna().self_calibrated()
 
@@ -212,6 +218,25 @@ def test_a_pair_of_frequencies_off_the_curve_says_the_model_is_that_far_off() ->
     assert "from the nearest point of the sensing curves" in (result.reason or "")
 
 
+def _softer_at_the_tip(
+    softer: float, case: str, x_c: float, seed: int
+) -> tuple[ContactEstimate, float]:
+    """The paper method's answer and the true contact point (m) for the default campaign's
+    realistic device (build 2021, tests/data) whose link is ``softer`` times as stiff as when
+    its calibration (``realistic-2021-model.toml``) was made, touched at ``x_c`` (m)."""
+    data = Path(__file__).parent / "data"
+    device = load_antenna(data / "realistic-2021-device.toml")
+    link = dataclasses.replace(device.link, youngs_modulus=softer * device.link.youngs_modulus)
+    imperfections = realistic_device(seed, device.link.length, build=2021)
+    recording = simulate(
+        dataclasses.replace(device, link=link),
+        Scenario(case=case, contact_point=x_c, seed=seed, device=imperfections),
+    )
+    model = load_antenna(data / "realistic-2021-model.toml")
+    result = estimate(recording.without_ground_truth(), model, "paper")
+    return result, float(recording.metadata["true_xc"])
+
+
 def test_a_link_softer_than_its_calibration_touched_at_the_tip_is_not_an_ok_answer() -> None:
     # The default campaign's realistic device (build 2021) and the model its calibration gave,
     # the link then 5 % softer (a warmer day, a polymer link ageing): touched at 0.97 m, its
@@ -220,22 +245,7 @@ def test_a_link_softer_than_its_calibration_touched_at_the_tip_is_not_an_ok_answ
     # torque/force ratio, which the sensor's cross-talk pulls low at a tip's light push,
     # agrees with it. The second contact mode is the tip's (omega_2 / omega_1 of 0.64 m lies
     # 7 % off it): not ok, and the reason names it.
-    from sensing_antenna.antenna import load_antenna
-    from sensing_antenna.simulator import realistic_device
-
-    data = Path(__file__).parent / "data"
-    device = load_antenna(data / "realistic-2021-device.toml")
-    softer = dataclasses.replace(
-        device,
-        link=dataclasses.replace(device.link, youngs_modulus=0.95 * device.link.youngs_modulus),
-    )
-    imperfections = realistic_device(9030, device.link.length, build=2021)
-    recording = simulate(
-        softer, Scenario(case="azimuthal", contact_point=0.97, seed=9030, device=imperfections)
-    )
-    truth = float(recording.metadata["true_xc"])
-    model = load_antenna(data / "realistic-2021-model.toml")
-    result = estimate(recording.without_ground_truth(), model, "paper")
+    result, truth = _softer_at_the_tip(0.95, "azimuthal", 0.97, 9030)
     assert abs(result.x_c - truth) > 0.2  # the frequency's one candidate is the other branch's
     assert result.status is not Status.OK
     assert "the second contact mode at" in (result.reason or "")
@@ -247,22 +257,7 @@ def test_a_softer_link_at_the_tip_whose_pair_fits_both_is_told_by_omega_2_over_o
     # a contact's modes may lie from the curves, but omega_2 / omega_1, which the stiffness does
     # not enter, fits the tip's within 0.3 of its uncertainties and the answer's 2.5 off: not
     # ok, the reason says the contact may be at the tip
-    from sensing_antenna.antenna import load_antenna
-    from sensing_antenna.simulator import realistic_device
-
-    data = Path(__file__).parent / "data"
-    device = load_antenna(data / "realistic-2021-device.toml")
-    softer = dataclasses.replace(
-        device,
-        link=dataclasses.replace(device.link, youngs_modulus=0.96 * device.link.youngs_modulus),
-    )
-    imperfections = realistic_device(7081, device.link.length, build=2021)
-    recording = simulate(
-        softer, Scenario(case="vertical", contact_point=0.98, seed=7081, device=imperfections)
-    )
-    truth = float(recording.metadata["true_xc"])
-    model = load_antenna(data / "realistic-2021-model.toml")
-    result = estimate(recording.without_ground_truth(), model, "paper")
+    result, truth = _softer_at_the_tip(0.96, "vertical", 0.98, 7081)
     assert abs(result.x_c - truth) > 0.2
     assert result.status is Status.UNCERTAIN
     assert "the contact may be at the tip" in (result.reason or "")
