@@ -251,6 +251,21 @@ def test_a_link_softer_than_its_calibration_touched_at_the_tip_is_not_an_ok_answ
     assert "the second contact mode at" in (result.reason or "")
 
 
+def test_a_contact_barely_made_after_a_detection_on_the_free_motion_is_not_an_ok_answer() -> None:
+    # The same device 5 % softer, swept up into a bar at 0.97 m: its swing crosses the
+    # detector's threshold 93 ms before the touch, so the head's push, counted from there,
+    # ends 9 ms after the touch. The link rests against the bar at a few mN and rings mostly
+    # free: the paper method's omega_1 reads 0.24 m, where the ratio agrees within its wide
+    # uncertainty. The head turned that point 7 mm into the push from t_c, too short a push to
+    # tell the bend at t_c from the ringing; but the bend since t_c is at most the held one,
+    # 0.08 mm, far less than a contact sliding at the answer makes: not ok, and the reason
+    # names a contact found before the link touched
+    result, truth = _softer_at_the_tip(0.95, "vertical", 0.97, 19111)
+    assert abs(result.x_c - truth) > 0.5  # the free link's ringing read as a contact
+    assert result.status is Status.MODEL_MISMATCH
+    assert "a contact found before the link touched" in (result.reason or "")
+
+
 def test_a_softer_link_at_the_tip_whose_pair_fits_both_is_told_by_omega_2_over_omega_1() -> None:
     # The same device 4 % softer, touched at 0.98 m in the vertical case: the pair (omega_1,
     # omega_2) lies 3.1 % from the tip's and 4.8 % from the answer's (0.64 m), both within what

@@ -1337,11 +1337,14 @@ def _bend_against_turn(
     moment of the push y_c was computed from (``push_force`` times the filtered torque/force ratio
     at t_e): at t_e the mean over the hold's last period of the contact's fundamental, at t_c
     :func:`_bend_at_touch` (the detector declares t_c once the push has built up), whose two
-    standard errors widen the band; not judged when the push from t_c to t_1 lasts less than half a
-    period of the fundamental. At a given push y grows as x_c^3 and u as x_c: an answer off the
-    contact moves the ratio as (x_c / true x_c)^2. ``notes`` gets ``turn_against_push`` (-R^ . u, m)
-    and ``bend_per_turn`` (y over it). Not judged when the head turned by less than the rest
-    tolerance (an object pushed into a still link).
+    standard errors widen the band. A push from t_c to t_1 shorter than half a period of the
+    fundamental cannot tell the bend at t_c from the ringing: it is taken as none (the static
+    bend before the touch), so the bend since t_c is at most the held one, and only the band's
+    lower end is judged (a detector that fired on the free motion before a touch barely made
+    counts a turn the link never felt). At a given push y grows as x_c^3 and u as x_c: an answer
+    off the contact moves the ratio as (x_c / true x_c)^2. ``notes`` gets ``turn_against_push``
+    (-R^ . u, m) and ``bend_per_turn`` (y over it). Not judged when the head turned by less than
+    the rest tolerance (an object pushed into a still link).
     """
     bend = float(estimate.diagnostics.get("deflection", math.nan))
     if not (math.isfinite(bend) and bend > 0.0):
@@ -1376,6 +1379,8 @@ def _bend_against_turn(
     omega = float(sensing_curve(evidence.antenna.link).omega1(estimate.x_c))
     held = float(np.mean(bend_over(_last_period_start(evidence, omega, end), end)))
     touch, error = _bend_at_touch(evidence, k, bend_over, push / norm, estimate.x_c, omega)
+    if not math.isfinite(error):
+        touch = 0.0  # a push too short to tell: at least the bend before the touch, none
     # the bend since t_c, and its least and largest values within two standard errors
     since = held - max(touch, 0.0)
     least_since = held - max(touch + 2.0 * error, 0.0)
@@ -1384,8 +1389,6 @@ def _bend_against_turn(
     notes["turn_against_push"] = turn
     if turn > 0.0:
         notes["bend_per_turn"] = since / turn
-    if not math.isfinite(error):
-        return None  # a push too short to tell the bend at t_c from the ringing
     cfg = evidence.config
     limit = cfg.max_bend_per_turn
     t_c = float(evidence.t[k])
