@@ -1415,7 +1415,9 @@ def test_a_contact_found_on_a_knock_before_the_touch_is_no_contact_lost_nor_a_se
     (result,) = [e for e in said if e["event"] == "estimate"]
     offline = estimate(knock, antenna, "ratio")
     assert offline.status is not Status.OK
-    assert any("had gone by" in r for r in [offline.reason, *offline.diagnostics["other_reasons"]])
+    assert any(
+        "was lost at about" in r for r in [offline.reason, *offline.diagnostics["other_reasons"]]
+    )
     assert (result["status"], result["x_c"]) == (offline.status.value, offline.x_c)
 
 

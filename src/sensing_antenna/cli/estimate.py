@@ -136,7 +136,7 @@ def warn_of_a_second_contact(
     lost after the head's rest at ``t_1`` (s) (:func:`~sensing_antenna.detection.
     contact_watch.contact_changes`): the estimate is the first contact's, the second is not
     estimated. A contact lost before t_1 was no touch; the estimate's status says so."""
-    from sensing_antenna.detection.contact_watch import contact_changes
+    from sensing_antenna.detection.contact_watch import contact_changes, lost_before_rest
     from sensing_antenna.errors import SensingAntennaError
 
     if not math.isfinite(t_c):
@@ -146,7 +146,7 @@ def warn_of_a_second_contact(
     except SensingAntennaError:
         return  # samples the detector refuses: the estimate's status says what is wrong
     changes = {change.kind: change for change in found}
-    if "again" not in changes or not changes["lost"].t >= t_1:
+    if "again" not in changes or not math.isfinite(t_1) or lost_before_rest(found, t_1):
         return
     print(
         f"antenna: warning: {source}: the link touched again at t = {changes['again'].t:.3f} s, "

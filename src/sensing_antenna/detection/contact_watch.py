@@ -29,6 +29,7 @@ __all__ = [
     "ContactWatch",
     "contact_changes",
     "free_period_samples",
+    "lost_before_rest",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -152,6 +153,16 @@ class ContactWatch:
         first = int(again[0])
         self.again = ContactChange("again", int(ends[first]) - 1, float(t[first]), float(t[first]))
         return [self.again]
+
+
+def lost_before_rest(changes: list[ContactChange], t_1: float) -> ContactChange | None:
+    """The loss among ``changes`` when the push began to vanish before the head came to rest
+    at ``t_1`` (s), else None: the contact found at t_c was no touch the hold reads (a
+    detection on something else), and the touch a watch would call a second is the one
+    estimated. Judged by the loss's time, not by when it became known (up to a free period
+    later), so the front end, the live listener and ``antenna estimate`` say the same."""
+    lost = next((change for change in changes if change.kind == "lost"), None)
+    return lost if lost is not None and lost.t < t_1 else None
 
 
 def contact_changes(recording: Recording, antenna: Antenna, t_c: float) -> list[ContactChange]:

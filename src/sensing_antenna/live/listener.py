@@ -28,7 +28,11 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
-from sensing_antenna.detection.contact_watch import ContactWatch, free_period_samples
+from sensing_antenna.detection.contact_watch import (
+    ContactWatch,
+    free_period_samples,
+    lost_before_rest,
+)
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
 from sensing_antenna.estimation.front.steps import (
@@ -379,7 +383,7 @@ class Listener:
             latency = self._latency(max(first, contact + change.row))
             if change.kind == "lost":
                 rest = self._estimator.rest_index
-                if rest is None or change.t < float(self._t.values[rest]):
+                if rest is None or lost_before_rest([change], float(self._t.values[rest])):
                     # lost before the head rested: t_c was no touch (the estimate says so), and
                     # the touch the watch would call a second is the one estimated
                     self._watching = False

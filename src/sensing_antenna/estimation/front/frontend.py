@@ -38,7 +38,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import OBSERVER_TORQUE_SIGNS, ContactDetector
-from sensing_antenna.detection.contact_watch import ContactWatch, free_period_samples
+from sensing_antenna.detection.contact_watch import (
+    ContactWatch,
+    free_period_samples,
+    lost_before_rest,
+)
 from sensing_antenna.detection.filters import FirstOrderLowPass
 from sensing_antenna.detection.push import PushCriterion, PushMonitor
 from sensing_antenna.errors import FieldError
@@ -776,7 +780,7 @@ class FrontEnd:
                 "torque_noise": torque_noise,
             }
         )
-        lost = self._lost_before_rest(rest)
+        lost = self._lost_before_rest(rest, end)
         if lost is not None:
             diagnostics["contact_lost_before_rest"] = lost
         gaps = self._gaps_known(end)
@@ -812,19 +816,20 @@ class FrontEnd:
             diagnostics=diagnostics,
         )
 
-    def _lost_before_rest(self, rest: int) -> float | None:
-        """By when (s) the contact found at t_c had been lost, before the head came to rest at
-        t_1 (sample ``rest``), or None: the contact detector's residual from t_c to t_1, averaged
-        over a free period (:class:`~sensing_antenna.detection.contact_watch.ContactWatch`).
-        A detection on something other than the touch (angles stamped late against the loads,
-        a knock, hum) that the head turned on from."""
+    def _lost_before_rest(self, rest: int, end: int) -> float | None:
+        """When (s) the contact found at t_c began to be lost, before the head came to rest at
+        t_1 (sample ``rest``), or None: the contact detector's residual from t_c to sample
+        ``end``, averaged over a free period (:func:`~sensing_antenna.detection.contact_watch.
+        lost_before_rest`). A detection on something other than the touch (angles stamped late
+        against the loads, a knock, hum) that the head turned on from."""
         if self._detector is None or self._contact is None:
             return None
         detection = self._detector.detection()
         ts, k = self.sample_period, self._contact
         watch = ContactWatch(free_period_samples(self.antenna, ts), detection.threshold, ts)
-        changes = watch.feed(detection.residual[k : rest + 1], self._t[k : rest + 1])
-        return next((change.known for change in changes if change.kind == "lost"), None)
+        changes = watch.feed(detection.residual[k : end + 1], self._t[k : end + 1])
+        lost = lost_before_rest(changes, float(self._t[rest]))
+        return None if lost is None else lost.t
 
     def _notes_now(self, end: int | None = None) -> dict[str, Any]:
         """What the caller said of the samples, and how many missing ones were put back up to
