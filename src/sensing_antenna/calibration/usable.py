@@ -57,4 +57,4 @@ def _holds_half_the_spectrum(evidence: Evidence) -> bool:
     """Whether the samples after t_1 span half the spectrum window: omega_1 read over them is at
     most twice as coarse (a set recorded a few ms short of the window calibrates as well)."""
     have = float(evidence.t[evidence.end_index] - evidence.t[evidence.rest_index])
-    return have >= 0.5 * evidence.config.spectrum_window
+    return have >= 0.5 * evidence.spectrum_window

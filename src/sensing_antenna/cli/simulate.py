@@ -180,7 +180,7 @@ def _run(args: argparse.Namespace) -> int:
     coarse = sampling_warning(antenna, scenario.sample_period)
     if coarse is not None:
         print(f"warning: {coarse} (--sample-rate)", file=sys.stderr)
-    short = window_warning(scenario, recording.metadata)
+    short = window_warning(scenario, recording.metadata, antenna)
     if short is not None:
         print(short, file=sys.stderr)
     warning = None if args.link == "nonlinear" else deflection_warning(recording)
@@ -288,9 +288,10 @@ def summary(out: str, scenario: Any, n_samples: int, meta: Any) -> str:
 SETTLING_TIME_CONSTANTS = 5.0
 
 
-def window_warning(scenario: Any, meta: Any) -> str | None:
-    """One line when the recording ends less than the estimators' spectrum window
-    (``EstimatorConfig.spectrum_window``) after the head comes to rest, or None.
+def window_warning(scenario: Any, meta: Any, antenna: Any) -> str | None:
+    """One line when the recording ends less than the estimators' spectrum window for
+    ``antenna``'s link (``EstimatorConfig.spectrum_window``) after the head comes to rest, or
+    None.
 
     The head comes to rest ``SETTLING_TIME_CONSTANTS`` servo time constants after the stop
     (``true_t_stop`` of the metadata ``meta``, s); the line suggests the ``--duration`` (rounded
@@ -299,11 +300,12 @@ def window_warning(scenario: Any, meta: Any) -> str | None:
     says so).
     """
     from sensing_antenna.estimation import EstimatorConfig
+    from sensing_antenna.estimation.front.evidence import spectrum_window
 
     stop = float(meta.get("true_t_stop", "nan"))
     if not math.isfinite(stop):
         return None
-    window = EstimatorConfig().spectrum_window
+    window = spectrum_window(antenna.link, EstimatorConfig())
     settled = SETTLING_TIME_CONSTANTS / -scenario.servo_pole
     needed = stop + settled + window
     if scenario.retract_after is not None and scenario.retract_after < settled + window:

@@ -15,6 +15,7 @@ from sensing_antenna.recording import CLOCK_TOLERANCE
 
 __all__ = [
     "MAX_GAP_DURATION",
+    "PAPER_SPECTRUM_WINDOW",
     "EstimatorConfig",
     "EstimatorConfigError",
     "no_t1_reason",
@@ -28,6 +29,9 @@ __all__ = [
 #: ``benchmarks/eval_glitches.py --kinds drop``. Held in time, not samples: at 250 Hz twenty
 #: samples span 80 ms, three periods of the band's top.
 MAX_GAP_DURATION = 0.02
+
+#: Delta t_e1 of Section 5.4 (s): the record after t_1 the paper's Estimator 1 reads.
+PAPER_SPECTRUM_WINDOW = 1.0
 
 
 class EstimatorConfigError(SensingAntennaError, ValueError):
@@ -90,10 +94,15 @@ class EstimatorConfig:
         Largest number of consecutive missing samples inside [t_c, t_e] that linear
         interpolation may fill; longer gaps give ``bad_input``. None (the default): as many as
         span :data:`MAX_GAP_DURATION` at the recording's sample period (:meth:`gap_limit`).
-    spectrum_window : float
-        Delta t_e1 (s), the record after t_1 analysed by Estimator 1. 1 s holds 5 periods of the
-        lowest fundamental in the working range (31 rad/s, period 0.2 s) and gives a DFT bin of
-        6.3 rad/s that zero padding and interpolation refine far below the bin.
+    spectrum_window : float or None
+        Delta t_e1 (s), the record after t_1 analysed by Estimator 1. The paper's 1 s
+        (:data:`PAPER_SPECTRUM_WINDOW`) holds 5 periods of the lowest fundamental of its tested
+        range (31 rad/s at 0.3 m, period 0.2 s) and gives a DFT bin of 6.3 rad/s that zero
+        padding and interpolation refine far below the bin. None (the default): 1 s, or, for a
+        link whose lowest fundamental over the contact range lies below the lowest the paper
+        link's band searches (with ``band_margin``), as much longer as it holds fewer of its
+        periods (:func:`~sensing_antenna.estimation.front.evidence.spectrum_window`): the
+        touch's transients and the head's settling last periods of the link, not seconds.
     zero_padding : int
         The spectrum is computed on ``zero_padding`` times the window length (power of two above),
         so that the parabolic peak interpolation has a negligible bias (< 1e-3 bin at 16).
@@ -288,7 +297,7 @@ class EstimatorConfig:
     loss_window: float = 0.01
     loss_significance: float = 3.0
     max_gap: int | None = None
-    spectrum_window: float = 1.0
+    spectrum_window: float | None = None
     zero_padding: int = 16
     contact_range: tuple[float, float] = (0.2, 1.0)
     band_margin: float = 0.15
@@ -345,7 +354,7 @@ class EstimatorConfig:
                         f"{f.name}: must be a finite number >= 0, got {value!r}"
                     )
                 continue
-            if f.name in ("max_gap", "max_direction_drift") and value is None:
+            if f.name in ("max_gap", "max_direction_drift", "spectrum_window") and value is None:
                 continue
             if f.name in ("zero_padding", "max_gap"):
                 if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):

@@ -530,8 +530,8 @@ def _modes_judge(evidence: Evidence, estimate: ContactEstimate) -> bool:
 def _check3_window(evidence: Evidence, end: int) -> slice:
     """The samples check 3 reads: from t_1 to ``end`` (the estimate's t_e), at most Delta t_e1
     (``spectrum_window``)."""
-    cfg = evidence.config
-    stop = min(evidence.rest_index + round(cfg.spectrum_window / evidence.sample_period), end)
+    window = round(evidence.spectrum_window / evidence.sample_period)
+    stop = min(evidence.rest_index + window, end)
     return slice(evidence.rest_index, stop + 1)
 
 

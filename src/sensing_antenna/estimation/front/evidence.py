@@ -20,7 +20,7 @@ from scipy.interpolate import CubicSpline
 
 from sensing_antenna.antenna import Antenna, Link
 from sensing_antenna.beam.weight import pushed_weight_moment, weight_residual
-from sensing_antenna.estimation.config import EstimatorConfig
+from sensing_antenna.estimation.config import PAPER_SPECTRUM_WINDOW, EstimatorConfig
 from sensing_antenna.estimation.front.contact_frame import ContactFrame
 from sensing_antenna.estimation.front.held import describe_held, find_held
 from sensing_antenna.estimation.front.ratio import (
@@ -183,6 +183,32 @@ def search_band(link: Link, config: EstimatorConfig) -> tuple[float, float]:
         config.contact_range[0] * link.length, config.contact_range[1] * link.length
     )
     return float(low) / (1.0 + config.band_margin), float(high) * (1.0 + config.band_margin)
+
+
+def spectrum_window(link: Link, config: EstimatorConfig) -> float:
+    """Delta t_e1 (s) for ``link``: ``config.spectrum_window`` when set, else the paper's 1 s
+    (:data:`~sensing_antenna.estimation.config.PAPER_SPECTRUM_WINDOW`) times how many times
+    lower than the lowest omega_1 the paper link's band searches (:func:`search_band`, its
+    margin for calibration error included) this link's lowest over the contact range lies, when
+    it does: the window then holds as many of the link's periods as the paper's holds of its
+    own. A link within the paper's band, calibrated or not, keeps 1 s."""
+    if config.spectrum_window is not None:
+        return config.spectrum_window
+    return _scaled_window(link, config.contact_range, config.band_margin)
+
+
+@functools.lru_cache(maxsize=16)
+def _scaled_window(link: Link, contact_range: tuple[float, float], margin: float) -> float:
+    from sensing_antenna.antenna import paper_antenna
+
+    def lowest(of: Link) -> float:
+        low, _ = sensing_curve(of).omega1_range(
+            contact_range[0] * of.length, contact_range[1] * of.length
+        )
+        return float(low)
+
+    floor = lowest(paper_antenna().link) / (1.0 + margin)
+    return PAPER_SPECTRUM_WINDOW * max(1.0, floor / lowest(link))
 
 
 @dataclass(frozen=True)
@@ -392,9 +418,14 @@ class Evidence:
         return turn, np.array([0.0, float(turn[0]) * math.cos(theta2), float(turn[1])])
 
     @property
+    def spectrum_window(self) -> float:
+        """Delta t_e1 (s) for this antenna's link (:func:`spectrum_window`)."""
+        return spectrum_window(self.antenna.link, self.config)
+
+    @property
     def spectrum_slice(self) -> slice:
         """Samples of the Delta t_e1 window after t_1 (shortened if the samples end first)."""
-        n_window = round(self.config.spectrum_window / self.sample_period)
+        n_window = round(self.spectrum_window / self.sample_period)
         return slice(self.rest_index, min(self.rest_index + n_window, self.end_index + 1))
 
     @functools.cached_property

@@ -52,7 +52,7 @@ from sensing_antenna.estimation.front.contact_frame import (
     rest_drift_tolerance,
     signal_noise,
 )
-from sensing_antenna.estimation.front.evidence import Evidence, search_band
+from sensing_antenna.estimation.front.evidence import Evidence, search_band, spectrum_window
 from sensing_antenna.estimation.front.outcome import EarlyOutcome, FrontTrace
 from sensing_antenna.estimation.front.ratio import (
     converged_index,
@@ -219,6 +219,7 @@ class FrontEnd:
         self.sample_period = ts = float(sample_period)
         self.config = cfg = config if config is not None else EstimatorConfig()
         self.band = search_band(antenna.link, cfg)
+        self._window = spectrum_window(antenna.link, cfg)  # Delta t_e1 (s)
         self._notes = dict(diagnostics) if diagnostics is not None else {"resampled": False}
         self._w_rest = samples(cfg.rest_window, ts)
         self._w_hold = hold_samples(cfg, ts)
@@ -693,10 +694,12 @@ class FrontEnd:
             found = converged_index(self._mean[: last + 1], first_end - w, w, self._ratio_tolerance)
             if found is not None:
                 self._converged = found
-                self._planned = planned_end(rest, found, self.config, self.sample_period)
+                self._planned = planned_end(
+                    rest, found, self.config, self.sample_period, self._window
+                )
                 return
         if stop - 1 >= rest + self._n_wait:
-            self._planned = planned_end(rest, None, self.config, self.sample_period)
+            self._planned = planned_end(rest, None, self.config, self.sample_period, self._window)
 
     def _fill(self, stop: int) -> None:
         """Filtered loads, ratio (once t_c fixed the offset) and its moving mean (from t_1 + w)

@@ -1209,11 +1209,16 @@ def ratio_tolerance(
 
 
 def planned_end(
-    rest_index: int, converged: int | None, cfg: EstimatorConfig, sample_period: float
+    rest_index: int,
+    converged: int | None,
+    cfg: EstimatorConfig,
+    sample_period: float,
+    spectrum_window: float,
 ) -> int:
-    """Index of t_e planned from t_1 and the ratio's convergence."""
+    """Index of t_e planned from t_1 and the ratio's convergence, with Delta t_e1
+    ``spectrum_window`` (s, :func:`~.evidence.spectrum_window`)."""
     # Section 4, step 6: t_e = t_1 + max(Delta t_e1, Delta t_e2)
-    spectrum_end = rest_index + samples(cfg.spectrum_window, sample_period)
+    spectrum_end = rest_index + samples(spectrum_window, sample_period)
     ratio_end = (
         converged
         if converged is not None

@@ -259,9 +259,9 @@ def conclude(
         if evidence.converged_index is None:
             need = "the torque/force ratio had not settled yet"
         else:
-            need = f"the spectrum needs {cfg.spectrum_window:g} s"
+            need = f"the spectrum needs {evidence.spectrum_window:.3g} s"
         t_c, t_1 = evidence.t[evidence.contact_index], evidence.t[evidence.rest_index]
-        if t_1 - t_c > _LATE_REST * cfg.spectrum_window:
+        if t_1 - t_c > _LATE_REST * evidence.spectrum_window:
             # the record is long enough for a head that rests soon after the touch
             need += (
                 f" (t_1 came {t_1 - t_c:.2f} s after the contact: the head was slow to come to "
