@@ -256,11 +256,15 @@ def conclude(
         )
     elif not evidence.complete:
         have = evidence.t[e] - evidence.t[evidence.rest_index]
+        t_c, t_1 = evidence.t[evidence.contact_index], evidence.t[evidence.rest_index]
         if evidence.converged_index is None:
-            need = "the torque/force ratio had not settled yet"
+            wait = max(cfg.max_ratio_wait, evidence.spectrum_window)
+            need = (
+                "the torque/force ratio had not settled yet (it is waited for up to "
+                f"{wait:g} s after t_1: record to t = {t_1 + wait:.2f} s)"
+            )
         else:
             need = f"the spectrum needs {evidence.spectrum_window:.3g} s"
-        t_c, t_1 = evidence.t[evidence.contact_index], evidence.t[evidence.rest_index]
         if t_1 - t_c > _LATE_REST * evidence.spectrum_window:
             # the record is long enough for a head that rests soon after the touch
             need += (
