@@ -543,8 +543,8 @@ def _pinned_contact_problem(
     The sensing curves are a pinned contact's. A support of finite stiffness k at x_c lowers
     omega_i by c_i / k to first order (:func:`~sensing_antenna.beam.modes.
     support_compliance_coefficients`), and the second mode, whose reaction at the contact is
-    larger, by more: at 0.4 m on the paper's link c_1 = 7.9 N/m, c_2 = 17 N/m, so an object of
-    50 N/m puts omega_1's point 5 cm short while omega_2 / omega_1 falls 20 %; a lossy one
+    larger, by more: at 0.4 m on the paper's link c_1 = 7.1 N/m, c_2 = 15.2 N/m, so an object
+    of 100 N/m puts omega_1's point 3 cm short while omega_2 / omega_1 falls 8 %; a lossy one
     (foam) also damps the second mode out. A pinned contact rings its second mode at omega_1
     times the model's omega_2 / omega_1 at the answer; the spectrum over the same samples as
     check 3 (t_1 to the estimate's t_e, at most Delta t_e1) must hold a clear peak
