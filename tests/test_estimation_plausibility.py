@@ -780,6 +780,26 @@ def test_torques_about_an_unstated_sensor_origin_are_named_where_the_estimators_
     assert abs(mended.x_c - truth) < 0.005
 
 
+def test_a_disagreement_on_an_uncalibrated_model_names_calibration_first() -> None:
+    # A lab that skipped calibration, its datasheet E 20 % high: the frequency puts the contact
+    # at 0.3 m some 4 cm short, the ratio does not follow. A torque point would shift every
+    # contact alike, an uncalibrated T by an amount that varies along the link: the reason
+    # says to calibrate first when no calibration measured T, and not once one did
+    device = paper_antenna()
+    stiff = dataclasses.replace(device.link, youngs_modulus=1.2 * device.link.youngs_modulus)
+    model = dataclasses.replace(device, link=stiff)
+    assert model.link.calibrated_t is None
+    recording = simulate(device, Scenario(case="azimuthal", contact_point=0.3, seed=3))
+    result = estimate(recording.without_ground_truth(), model, "paper")
+    assert result.status is Status.ESTIMATORS_DISAGREE, result.reason
+    assert "calibrate first (antenna calibrate)" in (result.reason or "")
+    calibrated_t = dataclasses.replace(stiff, calibrated_t=stiff.t_param)
+    claimed = estimate(
+        recording.without_ground_truth(), dataclasses.replace(model, link=calibrated_t), "paper"
+    )
+    assert "calibrate first" not in (claimed.reason or "")
+
+
 def test_a_link_that_slides_aside_on_a_steep_surface_is_not_a_flipped_sign() -> None:
     # An exploration's vertical sweep up onto a lying cylinder's side, steep to the sweep: the
     # link slid aside and pushes nearly across the head's turn (its component along the turn,

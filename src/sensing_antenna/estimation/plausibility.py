@@ -841,6 +841,13 @@ def _torque_point_hint(evidence: Evidence, x_c: float, end: int) -> str:
     agreed = evidence.config.disagreement_sigmas * evidence.ratio_uncertainty(reading)
     if abs(shift) <= agreed:
         return ""
+    uncalibrated = ""
+    if evidence.antenna.link.calibrated_t is None:
+        # an uncalibrated T moves the frequency's answer by an amount that varies along the link
+        uncalibrated = (
+            "; if it varies from contact to contact, calibrate first (antenna calibrate): no "
+            "calibration measured the frequency model's T here"
+        )
     return (
         f"; the torque/force ratio reads {reading:.3f} m, {100 * abs(shift):.1f} cm "
         f"{'short of' if shift > 0 else 'beyond'} the answer. If every contact shows this "
@@ -848,7 +855,7 @@ def _torque_point_hint(evidence: Evidence, x_c: float, end: int) -> str:
         "the link, the sensor's own origin, that '# torque_point' does not state or states "
         f"wrong? The ratio reads x_c less that point's offset along X^m: {shift:+.3f} m more "
         "in its first number (the whole point, when none is stated) would put the ratio on the "
-        "answer (docs/recording-format.md)"
+        f"answer (docs/recording-format.md){uncalibrated}"
     )
 
 
