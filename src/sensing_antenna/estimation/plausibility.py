@@ -878,7 +878,10 @@ def _friction_problem(
     small-deflection slope 3 y_c / (2 x_c), Eq. 9). At rest the reaction
     lies inside the friction cone, |R_t| <= mu R_n (``max_friction_ratio``). Each component of
     the hold's mean reaction carries the tare's standard error and the hold mean's, bounded by
-    twice the tare's; the ratio's standard error follows. Notes ``friction_ratio`` (R_t / R_n).
+    twice the tare's; the force along the link also the moments' cross-talk into it, which no
+    calibration here measures (the sensor's ``nominal_coupling`` times the moment x_c |R_perp|:
+    on a long link the moment dwarfs the force); the ratio's standard error follows. Notes
+    ``friction_ratio`` (R_t / R_n).
     """
     link = evidence.antenna.link
     x_c = estimate.x_c
@@ -902,7 +905,11 @@ def _friction_problem(
     else:
         ratio = tangential / normal
         component = 2.0 * evidence.offset_error
-        sigma = component * math.hypot(1.0, ratio) / normal
+        # the axial force read c x_c |R_perp| off moves R_t by cos and R_n by -sin of the slope
+        leak = evidence.antenna.sensor.nominal_coupling * x_c * across
+        sigma = (
+            math.hypot(component * math.hypot(1.0, ratio), leak * (cos_t + ratio * sin_t)) / normal
+        )
     notes["friction_ratio"] = ratio
     mu = evidence.config.max_friction_ratio
     if abs(ratio) <= mu + _FRICTION_SIGMAS * sigma:
