@@ -480,13 +480,19 @@ def test_a_link_slower_than_the_papers_reads_as_many_of_its_periods() -> None:
     )
     antenna = dataclasses.replace(base, link=link)
     scenario = Scenario(case="vertical", contact_point=0.7, seed=1, sample_period=0.002)
-    recording = simulate(antenna, scenario)
-    result = estimate(recording.without_ground_truth(), antenna.self_calibrated(), "paper")
-    truth = float(recording.metadata["true_xc"])
+    simulated = simulate(antenna, scenario)
+    truth = float(simulated.metadata["true_xc"])
+    recording, model = simulated.without_ground_truth(), antenna.self_calibrated()
+    result = estimate(recording, model, "paper")
+    paper_window = estimate(recording, model, "paper", EstimatorConfig(spectrum_window=1.0))
     assert result.t_e - result.t_1 == pytest.approx(1.32, abs=0.01)
+    assert abs(result.x_c - truth) < 0.75 * abs(paper_window.x_c - truth)
     assert abs(result.x_c - truth) < 0.01
     for paper in (base, base.self_calibrated(), calibrated()):
         assert spectrum_window(paper.link, EstimatorConfig()) == 1.0
+    # a contact range given as a list is the same range
+    listed = EstimatorConfig(contact_range=[0.2, 1.0])  # type: ignore[arg-type]
+    assert spectrum_window(link, listed) == spectrum_window(link, EstimatorConfig())
 
 
 def test_t1_from_the_push_criterion_is_the_controllers_stop_and_online_equals_offline() -> None:

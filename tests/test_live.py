@@ -1416,7 +1416,8 @@ def test_a_contact_found_on_a_knock_before_the_touch_is_no_contact_lost_nor_a_se
     offline = estimate(knock, antenna, "ratio")
     assert offline.status is not Status.OK
     assert any(
-        "was lost at about" in r for r in [offline.reason, *offline.diagnostics["other_reasons"]]
+        "faded before the head came to rest" in r
+        for r in [offline.reason, *offline.diagnostics["other_reasons"]]
     )
     assert (result["status"], result["x_c"]) == (offline.status.value, offline.x_c)
 

@@ -1101,9 +1101,10 @@ def _push_direction_problem(evidence: Evidence) -> tuple[Status, str] | None:
 
 def _detected_before_touch(evidence: Evidence) -> str | None:
     """Why t_c is not the touch the hold reads, or None: the contact found at t_c was lost
-    before the head came to rest at t_1 (the front end's ``contact_lost_before_rest``, when: the
-    contact detector's residual, averaged over a free period, fell to a fifth of its largest
-    and to the threshold, :func:`~sensing_antenna.detection.contact_watch.lost_before_rest`).
+    before the head came to rest at t_1 (the contact detector's residual, averaged over a free
+    period, fell to a fifth of its largest and to the threshold, the fall dated before t_1:
+    :func:`~sensing_antenna.detection.contact_watch.lost_before_rest`; the front end's
+    ``contact_lost_before_rest`` is by when it had gone).
     The answer reads the hold after t_1 and may be right; the checks that start at t_c (the
     head's work and its turn against the push's bend) cannot be made."""
     lost = evidence.diagnostics.get("contact_lost_before_rest")
@@ -1112,8 +1113,8 @@ def _detected_before_touch(evidence: Evidence) -> str | None:
     t_c = float(evidence.t[evidence.contact_index])
     t_1 = float(evidence.t[evidence.rest_index])
     return (
-        f"the contact found at t_c = {t_c:.3f} s was lost at about {float(lost):.3f} s, before "
-        f"the head came to rest at t_1 = {t_1:.3f} s: the contact detector fired on something "
+        f"the contact found at t_c = {t_c:.3f} s faded before the head came to rest at t_1 = "
+        f"{t_1:.3f} s (gone by {float(lost):.3f} s): the contact detector fired on something "
         "other than the touch the hold reads, and what starts at the touch (the push's bend "
         "against the head's turn) cannot be checked. Angles stamped late against the loads "
         "make the free-motion observer's prediction lag through the sweep's start (antenna "

@@ -194,7 +194,8 @@ def spectrum_window(link: Link, config: EstimatorConfig) -> float:
     own. A link within the paper's band, calibrated or not, keeps 1 s."""
     if config.spectrum_window is not None:
         return config.spectrum_window
-    return _scaled_window(link, config.contact_range, config.band_margin)
+    low, high = config.contact_range  # a list or an array too: the cache needs a tuple
+    return _scaled_window(link, (float(low), float(high)), config.band_margin)
 
 
 @functools.lru_cache(maxsize=16)

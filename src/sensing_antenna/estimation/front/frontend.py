@@ -820,11 +820,12 @@ class FrontEnd:
         )
 
     def _lost_before_rest(self, rest: int, end: int) -> float | None:
-        """When (s) the contact found at t_c began to be lost, before the head came to rest at
-        t_1 (sample ``rest``), or None: the contact detector's residual from t_c to sample
-        ``end``, averaged over a free period (:func:`~sensing_antenna.detection.contact_watch.
-        lost_before_rest`). A detection on something other than the touch (angles stamped late
-        against the loads, a knock, hum) that the head turned on from."""
+        """By when (s) the contact found at t_c had gone, when it began to go before the head
+        came to rest at t_1 (sample ``rest``), or None: the contact detector's residual from t_c
+        to sample ``end``, averaged over a free period
+        (:func:`~sensing_antenna.detection.contact_watch.lost_before_rest`). A detection on
+        something other than the touch (angles stamped late against the loads, a knock, hum)
+        that the head turned on from."""
         if self._detector is None or self._contact is None:
             return None
         detection = self._detector.detection()
@@ -832,7 +833,7 @@ class FrontEnd:
         watch = ContactWatch(free_period_samples(self.antenna, ts), detection.threshold, ts)
         changes = watch.feed(detection.residual[k : end + 1], self._t[k : end + 1])
         lost = lost_before_rest(changes, float(self._t[rest]))
-        return None if lost is None else lost.t
+        return None if lost is None else lost.known
 
     def _notes_now(self, end: int | None = None) -> dict[str, Any]:
         """What the caller said of the samples, and how many missing ones were put back up to

@@ -55,8 +55,10 @@ class FastConfig:
         fundamental in the range.
     cap : float
         Last evaluation this long after t_1 (s); if still unsure, the estimate is given with
-        status ``uncertain``. 1 s, the record of the paper's spectrum: an unsure case is never
-        later than the paper method in data time and has at least its information.
+        status ``uncertain``. 1 s, the record of the paper's spectrum on its link: an unsure
+        case is never later than the paper method in data time and has at least its information
+        there (on a link slower than the paper's the paper method reads longer,
+        ``EstimatorConfig.spectrum_window``).
     drift_factor : float
         Non-stationarity of omega_1 measured on the recording itself: the fundamental of the
         window [t_1, t] is compared with that of [t_1, t_1 + 2/3 (t - t_1)]; ``drift_factor``
