@@ -279,11 +279,13 @@ def conclude(
             )
         )
     elif evidence.converged_index is None:
+        rings, how = _unsettled_ratio(evidence, e)
         found.append(
             (
-                Status.SLIP_SUSPECTED,
+                Status.UNCERTAIN if rings else Status.SLIP_SUSPECTED,
                 f"the torque/force ratio did not stay within {cfg.convergence_tolerance:g} m "
-                f"for {cfg.convergence_window:g} s within {cfg.max_ratio_wait:g} s after t_1",
+                f"for {cfg.convergence_window:g} s within {cfg.max_ratio_wait:g} s after t_1"
+                f"{how}",
             )
         )
     reaction_now = evidence.reaction_f[e]
@@ -357,6 +359,40 @@ def conclude(
         t_e=float(evidence.t[e]),
         contact_point=touch.point_a,
         diagnostics=diag,
+    )
+
+
+def _unsettled_ratio(evidence: Evidence, end: int) -> tuple[bool, str]:
+    """Whether a ratio that never settled rang rather than drifted over its last second to
+    sample ``end``, and what it did: the swing of its moving average over the last convergence
+    window against its drift (a least-squares line's rise over the second). A contact that slides
+    drifts (``slip_suspected``); a link that rings slower than the window (a period longer than
+    ``convergence_window``: a link slower than the paper's) swings about a steady mean, which
+    says nothing of a slide (``uncertain``). False and "" when the record holds no such
+    second."""
+    cfg = evidence.config
+    width = max(1, round(cfg.convergence_window / evidence.sample_period))
+    first = end + 1 - round(1.0 / evidence.sample_period)
+    if first < evidence.rest_index:
+        return False, ""
+    mean = evidence.ratio_mean[first : end + 1]
+    swing = float(np.ptp(mean[-width:]))
+    # the least-squares line's rise over the second: a ripple of a few periods barely tilts it
+    t = evidence.t[first : end + 1]
+    drift = abs(float(np.polyfit(t - t[0], mean, 1)[0]) * float(t[-1] - t[0]))
+    if not (math.isfinite(swing) and math.isfinite(drift)):
+        return False, ""
+    if drift >= 0.5 * swing:
+        return False, (
+            f": it drifted by {100 * drift:.1f} cm over the last second, as a contact that "
+            "slides makes"
+        )
+    return True, (
+        f": it swung by {100 * swing:.1f} cm over the last {cfg.convergence_window:g} s about a "
+        f"steady mean (drift {100 * drift:.1f} cm over the last second), as a link that rings "
+        "slower than that window leaves it (a link slower than the paper's: "
+        "EstimatorConfig.convergence_window a period of its omega_1), more than a contact that "
+        "slides"
     )
 
 
