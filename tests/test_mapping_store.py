@@ -44,13 +44,23 @@ def test_a_named_sphere_is_the_whole_object_within_its_deviation(tmp_path: Path)
     summary = contact_map.summary()["object_surface"]
     assert summary["class"] == "sphere" and summary["held_share"] == 1.0
     assert 0 < summary["held_std_median_m"] < summary["held_std_p90_m"] < NOISE
+    # held everywhere by the class, but touched on the front half only: the points' reach (their
+    # median spacing, or a tenth of the size) leaves the back uncounted, less than 60 % in all
+    assert 0.3 < summary["touched_share"] < 0.6
+    assert np.all(
+        np.linalg.norm(vertices[back][:, None] - half_sphere(30, centre, radius)[None], axis=2).min(
+            axis=1
+        )
+        > summary["touch_reach_m"]
+    )
     # coloured from blue (no deviation) towards red (a tenth of the size): all held, all bluish
     colours = _colours(tmp_path / "object.ply")
     assert len(colours) == len(vertices) and np.all(colours[:, 0] < 0.1 * 255)
     assert np.corrcoef(colours[:, 0].astype(float), std)[0, 1] > 0.99
-    assert "Object surface: the sphere's fitted shape (object.ply); 100 % of its area" in (
-        (tmp_path / "report.md").read_text()
-    )
+    report = (tmp_path / "report.md").read_text()
+    assert "Object surface: the sphere's fitted shape (object.ply); " in report
+    assert "% of its area within" in report and "mm of a contact point" in report
+    assert "; 100 % of its area held by the fit" in report
 
 
 def test_an_end_no_touch_reached_is_not_held(tmp_path: Path) -> None:

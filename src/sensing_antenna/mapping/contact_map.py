@@ -121,15 +121,43 @@ class ObjectSurface:
         np.add.at(areas, self.mesh.faces.ravel(), np.repeat(self.mesh.area_faces / 3.0, 3))
         return areas
 
-    def summary(self) -> dict[str, Any]:
-        """JSON-able: the class, the faces, the size (m), and where the surface is held (its
-        deviation below :attr:`unheld`; a vertex without a finite one is not): that share of the
-        area, and the deviation's median and 90th percentile there by area (m); the three null
-        when no vertex has a deviation (a user mesh), the two quantiles when none is held."""
+    def touch_reach(self, points: FloatArray) -> float:
+        """How far from a contact point (m) the surface counts as touched: :attr:`unheld`, or
+        the points' median spacing (each one's distance to its nearest other) when larger, so
+        that the area between neighbouring touches counts; ``points`` (m, shape (n, 3))."""
+        if len(points) < 2:
+            return self.unheld
+        from scipy.spatial import cKDTree
+
+        spacing, _ = cKDTree(np.asarray(points, dtype=float)).query(points, k=2)
+        return max(self.unheld, float(np.median(spacing[:, 1])))
+
+    def touched_share(self, points: FloatArray) -> float:
+        """The share of the surface's area within :meth:`touch_reach` of one of ``points`` (m,
+        shape (n, 3)): where the touches were, not the class's shape carried past them; 0
+        without points."""
+        if not len(points):
+            return 0.0
+        from scipy.spatial import cKDTree
+
+        distance, _ = cKDTree(np.asarray(points, dtype=float)).query(self.mesh.vertices)
+        areas = self.vertex_areas()
+        return float(areas[distance <= self.touch_reach(points)].sum() / areas.sum())
+
+    def summary(self, points: FloatArray | None = None) -> dict[str, Any]:
+        """JSON-able: the class, the faces, the size (m), the share of its area near a touch
+        (:meth:`touched_share` of the contact ``points``, and :meth:`touch_reach`, m; null
+        without them), and where the
+        surface is held (its deviation below :attr:`unheld`; a vertex without a finite one is
+        not): that share of the area, and the deviation's median and 90th percentile there by
+        area (m); the three null when no vertex has a deviation (a user mesh), the two quantiles
+        when none is held."""
         summary: dict[str, Any] = {
             "class": self.name,
             "faces": len(self.mesh.faces),
             "size_m": self.size,
+            "touched_share": None if points is None else self.touched_share(points),
+            "touch_reach_m": None if points is None else self.touch_reach(points),
             "held_share": None,
             "held_std_median_m": None,
             "held_std_p90_m": None,
@@ -219,7 +247,7 @@ class ContactMap:
             "recognition": None if self.recognition is None else self.recognition.to_dict(),
             "object_surface": None
             if self._object_surface is None
-            else self._object_surface.summary(),
+            else self._object_surface.summary(np.array([p.point for p in self.used])),
         }
 
 

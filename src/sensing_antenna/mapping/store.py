@@ -308,10 +308,16 @@ def _object_line(contact_map: ContactMap, summary: dict[str, Any] | None) -> str
         why = "recognition names no object" if named is None else f"the {named.name} is unbounded"
         return f"Object surface: none ({why})."
     line = f"Object surface: the {surface.name}'s fitted shape (object.ply)"
+    if summary.get("touched_share") is not None:
+        line += (
+            f"; {100 * summary['touched_share']:.0f} % of its area within "
+            f"{1000 * summary['touch_reach_m']:.1f} mm of a contact point (the rest is the "
+            "class's shape carried past the touches, as sure as the class is right)"
+        )
     if summary["held_share"] is None:
         return line + "; it carries no deviation (a registered mesh, or a fit not held at all)."
     line += (
-        f"; {100 * summary['held_share']:.0f} % of its area held by the evidence (deviation"
+        f"; {100 * summary['held_share']:.0f} % of its area held by the fit (deviation"
         f" below {1000 * surface.unheld:.1f} mm, {UNHELD_FRACTION:g} of its size)"
     )
     if summary["held_std_median_m"] is None:
