@@ -376,12 +376,12 @@ def _unsettled_ratio(evidence: Evidence, end: int) -> tuple[bool, str]:
     if first < evidence.rest_index:
         return False, ""
     mean = evidence.ratio_mean[first : end + 1]
+    t = evidence.t[first : end + 1]
+    if not np.all(np.isfinite(mean)):
+        return False, ""  # loads the ratio cannot read (its status says so)
     swing = float(np.ptp(mean[-width:]))
     # the least-squares line's rise over the second: a ripple of a few periods barely tilts it
-    t = evidence.t[first : end + 1]
     drift = abs(float(np.polyfit(t - t[0], mean, 1)[0]) * float(t[-1] - t[0]))
-    if not (math.isfinite(swing) and math.isfinite(drift)):
-        return False, ""
     if drift >= 0.5 * swing:
         return False, (
             f": it drifted by {100 * drift:.1f} cm over the last second, as a contact that "
