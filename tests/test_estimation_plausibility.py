@@ -1373,3 +1373,7 @@ def test_a_detector_firing_on_a_damped_links_swing_says_the_link_may_have_touche
         r"or the link touched nothing: \S+ mN is less than a contact that sticks",
         result.reason or "",
     )
+    # the swing the detector fired on fades after the head rests, dated before it: t_c was no
+    # touch, though known only after t_1 (one rule: by when the fade began)
+    faded = [r for r in result.diagnostics["other_reasons"] if "faded before the head" in r]
+    assert faded and result.diagnostics["contact_lost_before_rest"] > result.t_1
