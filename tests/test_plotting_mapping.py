@@ -7,9 +7,11 @@ from pathlib import Path
 import matplotlib.image
 import matplotlib.pyplot as plt
 import numpy as np
+from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-from _contacts import contacts
+from _contacts import contacts, half_sphere
 from sensing_antenna.mapping import build_map
+from sensing_antenna.mapping.contact_map import touched
 from sensing_antenna.plotting.mapping import (
     LEAST_SPAN_CM,
     VIEWS,
@@ -61,3 +63,22 @@ def test_collinear_points_are_drawn_in_cubic_views_that_hold_them(tmp_path: Path
     path = plot_map(contact_map, tmp_path / "map.png")
     image = matplotlib.image.imread(path)
     assert image.shape[0] > 500 and image.shape[1] > 500
+
+
+def test_a_named_shapes_part_beyond_the_touches_is_drawn_faint() -> None:
+    # A ball touched on the half facing the base (x below its centre): the fitted sphere's
+    # points behind it lie beyond the touches' reach, those in front within it; its wire frame
+    # is drawn in two collections, solid and dotted, and the legend says what the dotted is
+    centre, radius = np.array([0.5, 0.0, 0.0]), 0.05
+    points = half_sphere(30, centre, radius)
+    contact_map = build_map(contacts(points))
+    sphere = centre + radius * np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    assert list(touched(points, sphere, 0.1 * 2 * radius)) == [True, False]
+    figure = map_figure(contact_map)
+    view = next(ax for ax in figure.axes if hasattr(ax, "get_zlim"))
+    frames = [c for c in view.collections if isinstance(c, Line3DCollection)]
+    styles = sorted(c.get_alpha() for c in frames)
+    assert len(frames) == 2 and styles[0] < styles[1]
+    labels = [text.get_text() for legend in figure.legends for text in legend.get_texts()]
+    assert "beyond the touches" in labels
+    plt.close(figure)

@@ -59,6 +59,8 @@ __all__ = [
     "points_from_recordings",
     "recognise_points",
     "swept_from_recordings",
+    "touch_reach",
+    "touched",
 ]
 
 FloatArray = NDArray[np.float64]
@@ -70,6 +72,29 @@ MIN_RECOGNITION_POINTS = 10
 #: Where the named object's surface deviates by this fraction of its size or more, the
 #: evidence does not hold it (an untouched end, a hidden face).
 UNHELD_FRACTION = 0.1
+
+
+def touch_reach(points: FloatArray, least: float) -> float:
+    """How far from a contact point (m) a shape counts as touched: ``least`` (m), or the
+    points' median spacing (each one's distance to its nearest other) when larger, so that the
+    area between neighbouring touches counts; ``points`` (m, shape (n, 3))."""
+    if len(points) < 2:
+        return least
+    from scipy.spatial import cKDTree
+
+    spacing, _ = cKDTree(np.asarray(points, dtype=float)).query(points, k=2)
+    return max(least, float(np.median(spacing[:, 1])))
+
+
+def touched(points: FloatArray, where: FloatArray, least: float) -> NDArray[np.bool_]:
+    """Which of ``where`` (m, shape (k, 3)) lie within :func:`touch_reach` of one of
+    ``points`` (m, shape (n, 3)); none without points."""
+    if not len(points):
+        return np.zeros(len(where), dtype=bool)
+    from scipy.spatial import cKDTree
+
+    distance, _ = cKDTree(np.asarray(points, dtype=float)).query(where)
+    return np.asarray(distance <= touch_reach(points, least))
 
 
 @dataclass(frozen=True)
@@ -122,15 +147,9 @@ class ObjectSurface:
         return areas
 
     def touch_reach(self, points: FloatArray) -> float:
-        """How far from a contact point (m) the surface counts as touched: :attr:`unheld`, or
-        the points' median spacing (each one's distance to its nearest other) when larger, so
-        that the area between neighbouring touches counts; ``points`` (m, shape (n, 3))."""
-        if len(points) < 2:
-            return self.unheld
-        from scipy.spatial import cKDTree
-
-        spacing, _ = cKDTree(np.asarray(points, dtype=float)).query(points, k=2)
-        return max(self.unheld, float(np.median(spacing[:, 1])))
+        """How far from one of ``points`` (m, shape (n, 3)) this surface counts as touched (m,
+        :func:`touch_reach` at :attr:`unheld`)."""
+        return touch_reach(points, self.unheld)
 
     def touched_share(self, points: FloatArray) -> float:
         """The share of the surface's area within :meth:`touch_reach` of one of ``points`` (m,
@@ -138,11 +157,9 @@ class ObjectSurface:
         without points."""
         if not len(points):
             return 0.0
-        from scipy.spatial import cKDTree
-
-        distance, _ = cKDTree(np.asarray(points, dtype=float)).query(self.mesh.vertices)
         areas = self.vertex_areas()
-        return float(areas[distance <= self.touch_reach(points)].sum() / areas.sum())
+        near = touched(points, np.asarray(self.mesh.vertices), self.unheld)
+        return float(areas[near].sum() / areas.sum())
 
     def summary(self, points: FloatArray | None = None) -> dict[str, Any]:
         """JSON-able: the class, the faces, the size (m), the share of its area near a touch

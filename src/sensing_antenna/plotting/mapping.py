@@ -18,8 +18,10 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
+from mpl_toolkits.mplot3d.art3d import Line3DCollection
+from numpy.typing import NDArray
 
-from sensing_antenna.mapping.contact_map import ContactMap
+from sensing_antenna.mapping.contact_map import UNHELD_FRACTION, ContactMap, touched
 from sensing_antenna.plotting import save_figure
 
 __all__ = ["LEAST_SPAN_CM", "VIEWS", "cube_limits", "map_figure", "plot_map"]
@@ -59,6 +61,18 @@ def plot_map(contact_map: ContactMap, path: Path) -> Path:
     return save_figure(map_figure(contact_map), path, dpi=110, tight=False)
 
 
+#: Pieces each drawn edge of the recognised shape is cut into, each drawn solid or faint by
+#: whether a touch was near it (a cone's edges run from its apex to its base).
+_EDGE_PIECES = 8
+
+
+def _pieces(edges: NDArray[np.float64], count: int) -> NDArray[np.float64]:
+    """Each edge (shape (n, 2, 3)) cut into ``count`` equal segments, shape (n count, 2, 3)."""
+    steps = np.linspace(0.0, 1.0, count + 1)
+    along = edges[:, :1] + steps[None, :, None] * (edges[:, 1:] - edges[:, :1])
+    return np.stack([along[:, :-1], along[:, 1:]], axis=2).reshape(-1, 2, 3)
+
+
 def map_figure(contact_map: ContactMap) -> Figure:
     """The figure of :func:`plot_map`: four 3-D views (cm) of the map's used points, coloured
     by their sigma, over the surface mesh and the recognised shape's wire frame."""
@@ -77,6 +91,15 @@ def map_figure(contact_map: ContactMap) -> Figure:
     if shape is not None:
         parts.append(shape.vertices * 100.0)
     limits = cube_limits(np.concatenate(parts))
+    segments = np.zeros((0, 2, 3))
+    near = np.zeros(0, dtype=bool)
+    if shape is not None:
+        # each drawn edge in short pieces: one near a touch is the touched shape, the others
+        # carry the class's shape past the touches, drawn faint: as sure as the class is right
+        edges = shape.vertices[shape.edges_unique]
+        segments = _pieces(edges[:: max(1, len(edges) // 600)], _EDGE_PIECES)
+        size = float(np.max(shape.extents))
+        near = touched(points / 100.0, segments.mean(axis=1), UNHELD_FRACTION * size)
     scatter = None
     for index, (title, elevation, azimuth, end_on) in enumerate(VIEWS, start=1):
         ax = fig.add_subplot(2, 2, index, projection="3d")
@@ -88,10 +111,17 @@ def map_figure(contact_map: ContactMap) -> Figure:
                 alpha=0.35,
                 linewidth=0,
             )
-        if shape is not None:
-            edges = shape.vertices[shape.edges_unique] * 100.0
-            for a, b in edges[:: max(1, len(edges) // 600)]:
-                ax.plot(*zip(a, b, strict=True), color="tab:green", linewidth=0.4, alpha=0.5)
+        for chosen, alpha, style in ((near, 0.5, "-"), (~near, 0.25, ":")):
+            if chosen.any():
+                ax.add_collection3d(
+                    Line3DCollection(
+                        segments[chosen] * 100.0,
+                        colors="tab:green",
+                        linewidths=0.4,
+                        alpha=alpha,
+                        linestyles=style,
+                    )
+                )
         if len(points):
             scatter = ax.scatter(*points.T, c=std, cmap="viridis", s=18, depthshade=False)
         ax.view_init(elev=elevation, azim=azimuth)
@@ -126,6 +156,12 @@ def map_figure(contact_map: ContactMap) -> Figure:
         fitted = recognition.best.name.replace("mesh:", "mesh ")
         said = "recognised" if not recognition.undecided else "best fit, not recognised"
         handles.append(Line2D([], [], color="tab:green", label=f"{fitted} ({said})"))
+        if not near.all():
+            handles.append(
+                Line2D(
+                    [], [], color="tab:green", alpha=0.4, linestyle=":", label="beyond the touches"
+                )
+            )
     if handles:
         fig.legend(handles=handles, loc="lower center", ncol=len(handles), frameon=False)
     fig.subplots_adjust(left=0.02, right=0.85, wspace=0.1, hspace=0.15)
