@@ -352,8 +352,9 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
         )
     if s["point_error_rms_m"] is not None:
         lines.append(
-            "Distance to the ground truth the recordings carry (RMS): "
-            f"{1000 * s['point_error_rms_m']:.2f} mm."
+            "Distance of the points to the true contact points the recordings carry (RMS; "
+            "along the surface as well as across it, so more than their distance to the "
+            f"object's surface): {1000 * s['point_error_rms_m']:.2f} mm."
         )
     if s["surface_faces"]:
         lines.append(
