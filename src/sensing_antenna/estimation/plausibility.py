@@ -1301,7 +1301,8 @@ def _bend_at_touch(
     contact moment is fitted by least squares with a line in that distance and a sine and a
     cosine at each mode's frequency (the straight link's at x_c), and the line's value at t_c
     is the bend there. A push shorter than half a period of the fundamental (``omega1``, rad/s)
-    cannot tell the line from the ringing: infinite error."""
+    cannot tell the line from the ringing: the bend before the touch, none, with infinite error
+    (the bend since t_c is then at most the held one)."""
     last = max(evidence.rest_index, k)
     bends = bend_over(k, last)
     axes = motor_axes(evidence.theta[k : last + 1])[:, 0]
@@ -1319,7 +1320,7 @@ def _bend_at_touch(
         if rank == design.shape[1] and residual.size:
             covariance = np.linalg.pinv(design.T @ design) * float(residual[0]) / free
             return float(fit[0]), math.sqrt(max(float(covariance[0, 0]), 0.0))
-    return math.nan, math.inf
+    return 0.0, math.inf
 
 
 def _contact_modes(evidence: Evidence, x_c: float) -> tuple[float, float]:
@@ -1395,8 +1396,6 @@ def _bend_against_turn(
     omega = float(sensing_curve(evidence.antenna.link).omega1(estimate.x_c))
     held = float(np.mean(bend_over(_last_period_start(evidence, omega, end), end)))
     touch, error = _bend_at_touch(evidence, k, bend_over, push / norm, estimate.x_c, omega)
-    if not math.isfinite(error):
-        touch = 0.0  # a push too short to tell: at least the bend before the touch, none
     # the bend since t_c, and its least and largest values within two standard errors
     since = held - max(touch, 0.0)
     least_since = held - max(touch + 2.0 * error, 0.0)
