@@ -104,6 +104,12 @@ class ContactWatch:
         self.again: ContactChange | None = None
         self._t_c = math.nan  # the first sample's time
 
+    @classmethod
+    def for_antenna(cls, antenna: Antenna, threshold: float, sample_period: float) -> ContactWatch:
+        """A watch over ``antenna``'s free period (:func:`free_period_samples`) at
+        ``sample_period`` (s), with the contact detector's ``threshold`` (N m)."""
+        return cls(free_period_samples(antenna, sample_period), threshold, sample_period)
+
     @property
     def rows(self) -> int:
         """Samples fed so far (from t_c)."""
@@ -176,5 +182,5 @@ def contact_changes(recording: Recording, antenna: Antenna, t_c: float) -> list[
         return []
     period = float(t[1] - t[0])
     start = int(np.searchsorted(t, t_c - 0.5 * period))
-    watch = ContactWatch(free_period_samples(antenna, period), detection.threshold, period)
+    watch = ContactWatch.for_antenna(antenna, detection.threshold, period)
     return watch.feed(detection.residual[start:], t[start:])

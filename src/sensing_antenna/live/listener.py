@@ -28,11 +28,7 @@ from numpy.typing import NDArray
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import ContactDetector
-from sensing_antenna.detection.contact_watch import (
-    ContactWatch,
-    free_period_samples,
-    lost_before_rest,
-)
+from sensing_antenna.detection.contact_watch import ContactWatch, lost_before_rest
 from sensing_antenna.estimation.config import EstimatorConfig
 from sensing_antenna.estimation.front.evidence import search_band
 from sensing_antenna.estimation.front.steps import (
@@ -134,8 +130,7 @@ class Listener:
         # a detector of its own, the front end's twin, for the residual after t_c (contact lost)
         self._residual = ContactDetector(antenna, ts, check_input=False)  # the samples filled
         # contact lost, and a touch again: the residual from t_c, averaged over a free period
-        self._free_period = free_period_samples(antenna, ts)
-        self._watch: ContactWatch | None = None
+        self._watch = ContactWatch.for_antenna(antenna, self._residual.threshold, ts)
         self._watching = True  # until a touch again, or a contact lost before t_1
         self._columns = [
             [header.required(name) for name in names]
@@ -372,10 +367,6 @@ class Listener:
         if contact is None or not self._watching:
             return
         detection = self._residual.detection()
-        if self._watch is None:
-            self._watch = ContactWatch(
-                self._free_period, detection.threshold, self.header.sample_period
-            )
         done = contact + self._watch.rows  # samples watched so far
         stop = self._t.size
         changes = self._watch.feed(detection.residual[done:stop], self._t.values[done:stop])

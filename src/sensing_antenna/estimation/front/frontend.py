@@ -38,11 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import Antenna
 from sensing_antenna.detection.contact import OBSERVER_TORQUE_SIGNS, ContactDetector
-from sensing_antenna.detection.contact_watch import (
-    ContactWatch,
-    free_period_samples,
-    lost_before_rest,
-)
+from sensing_antenna.detection.contact_watch import ContactWatch, lost_before_rest
 from sensing_antenna.detection.filters import FirstOrderLowPass
 from sensing_antenna.detection.push import PushCriterion, PushMonitor
 from sensing_antenna.errors import FieldError
@@ -830,7 +826,7 @@ class FrontEnd:
             return None
         detection = self._detector.detection()
         ts, k = self.sample_period, self._contact
-        watch = ContactWatch(free_period_samples(self.antenna, ts), detection.threshold, ts)
+        watch = ContactWatch.for_antenna(self.antenna, detection.threshold, ts)
         changes = watch.feed(detection.residual[k : end + 1], self._t[k : end + 1])
         lost = lost_before_rest(changes, float(self._t[rest]))
         return None if lost is None else lost.known
