@@ -11,7 +11,7 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from _contacts import contacts, half_sphere
 from sensing_antenna.mapping import build_map
-from sensing_antenna.mapping.contact_map import touched
+from sensing_antenna.mapping.contact_map import touch_reach, touched
 from sensing_antenna.plotting.mapping import (
     LEAST_SPAN_CM,
     VIEWS,
@@ -73,7 +73,7 @@ def test_a_named_shapes_part_beyond_the_touches_is_drawn_faint() -> None:
     points = half_sphere(30, centre, radius)
     contact_map = build_map(contacts(points))
     sphere = centre + radius * np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
-    assert list(touched(points, sphere, 0.1 * 2 * radius)) == [True, False]
+    assert list(touched(points, sphere, touch_reach(points, 0.1 * 2 * radius))) == [True, False]
     figure = map_figure(contact_map)
     view = next(ax for ax in figure.axes if hasattr(ax, "get_zlim"))
     frames = [c for c in view.collections if isinstance(c, Line3DCollection)]

@@ -41,7 +41,13 @@ from sensing_antenna.mapping.points import (
     select_points,
 )
 from sensing_antenna.mapping.pose import BasePose, base_pose_from_metadata
-from sensing_antenna.mapping.recognition import ClassFit, LinkLines, Recognition, recognise
+from sensing_antenna.mapping.recognition import (
+    ClassFit,
+    LinkLines,
+    Recognition,
+    recognise,
+    shape_size,
+)
 from sensing_antenna.mapping.surface import MIN_SURFACE_POINTS, ImplicitSurface
 
 if TYPE_CHECKING:
@@ -86,15 +92,15 @@ def touch_reach(points: FloatArray, least: float) -> float:
     return max(least, float(np.median(spacing[:, 1])))
 
 
-def touched(points: FloatArray, where: FloatArray, least: float) -> NDArray[np.bool_]:
-    """Which of ``where`` (m, shape (k, 3)) lie within :func:`touch_reach` of one of
-    ``points`` (m, shape (n, 3)); none without points."""
+def touched(points: FloatArray, where: FloatArray, reach: float) -> NDArray[np.bool_]:
+    """Which of ``where`` (m, shape (k, 3)) lie within ``reach`` (m, :func:`touch_reach`) of
+    one of ``points`` (m, shape (n, 3)); none without points."""
     if not len(points):
         return np.zeros(len(where), dtype=bool)
     from scipy.spatial import cKDTree
 
     distance, _ = cKDTree(np.asarray(points, dtype=float)).query(where)
-    return np.asarray(distance <= touch_reach(points, least))
+    return np.asarray(distance <= reach)
 
 
 @dataclass(frozen=True)
@@ -127,7 +133,7 @@ class ObjectSurface:
     def of(cls, fit: ClassFit) -> ObjectSurface:
         """The surface of ``fit`` (its mesh must have faces)."""
         assert fit.mesh is not None
-        size = float(np.max(trimesh.bounds.oriented_bounds(fit.mesh)[1]))
+        size = shape_size(fit.mesh)
         vertices, faces = trimesh.remesh.subdivide_to_size(
             fit.mesh.vertices, fit.mesh.faces, max_edge=size / 20
         )
@@ -158,7 +164,7 @@ class ObjectSurface:
         if not len(points):
             return 0.0
         areas = self.vertex_areas()
-        near = touched(points, np.asarray(self.mesh.vertices), self.unheld)
+        near = touched(points, np.asarray(self.mesh.vertices), self.touch_reach(points))
         return float(areas[near].sum() / areas.sum())
 
     def summary(self, points: FloatArray | None = None) -> dict[str, Any]:

@@ -180,6 +180,7 @@ __all__ = [
     "point_chi2",
     "recognise",
     "shape_gap",
+    "shape_size",
     "size_std",
 ]
 
@@ -2057,6 +2058,12 @@ MEMBER_RMS_SHARE = 0.01
 MEMBER_SAMPLES = 400
 
 
+def shape_size(mesh: trimesh.Trimesh) -> float:
+    """A shape's size (m): the largest extent of its mesh's oriented bounding box, whatever its
+    pose."""
+    return float(np.max(trimesh.bounds.oriented_bounds(mesh)[1]))
+
+
 def _one_a_member_of_the_other(
     one: ClassFit, other: ClassFit, generator: np.random.Generator
 ) -> bool:
@@ -2070,7 +2077,7 @@ def _one_a_member_of_the_other(
         return False
     mesh, fit = meshes[0].mesh, classes[0]
     assert mesh is not None
-    size = float(np.max(trimesh.bounds.oriented_bounds(mesh)[1]))
+    size = shape_size(mesh)
     samples, _ = trimesh.sample.sample_surface(
         mesh, MEMBER_SAMPLES, seed=int(generator.integers(2**31))
     )

@@ -21,7 +21,8 @@ from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Line3DCollection
 from numpy.typing import NDArray
 
-from sensing_antenna.mapping.contact_map import UNHELD_FRACTION, ContactMap, touched
+from sensing_antenna.mapping.contact_map import UNHELD_FRACTION, ContactMap, touch_reach, touched
+from sensing_antenna.mapping.recognition import shape_size
 from sensing_antenna.plotting import save_figure
 
 __all__ = ["LEAST_SPAN_CM", "VIEWS", "cube_limits", "map_figure", "plot_map"]
@@ -98,8 +99,10 @@ def map_figure(contact_map: ContactMap) -> Figure:
         # carry the class's shape past the touches, drawn faint: as sure as the class is right
         edges = shape.vertices[shape.edges_unique]
         segments = _pieces(edges[:: max(1, len(edges) // 600)], _EDGE_PIECES)
-        size = float(np.max(shape.extents))
-        near = touched(points / 100.0, segments.mean(axis=1), UNHELD_FRACTION * size)
+        # the reach the report's touched share counts with (the same size, a tenth of it)
+        touches = points / 100.0
+        reach = touch_reach(touches, UNHELD_FRACTION * shape_size(shape))
+        near = touched(touches, segments.mean(axis=1), reach)
     scatter = None
     for index, (title, elevation, azimuth, end_on) in enumerate(VIEWS, start=1):
         ax = fig.add_subplot(2, 2, index, projection="3d")
