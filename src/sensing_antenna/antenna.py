@@ -898,6 +898,30 @@ def _merge(base: dict[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
     return merged
 
 
+def _optional_table(
+    data: Mapping[str, Any], name: str, cls: type, source: str, required: str = "required"
+) -> Any:
+    """The optional table ``name`` of ``data`` built as ``cls`` (a dataclass whose checks raise
+    :class:`AntennaConfigError`), or None when absent; its unknown keys and missing fields
+    (``required`` says what each needs) named with ``source``."""
+    values = data.get(name)
+    if values is None:
+        return None
+    if not isinstance(values, Mapping):
+        raise AntennaConfigError(name, "must be a table", source)
+    for f in fields(cls):
+        if f.default is MISSING and f.default_factory is MISSING and f.name not in values:
+            raise AntennaConfigError(f"{name}.{f.name}", f"missing ({required})", source)
+    allowed = {f.name for f in fields(cls)}
+    for key in values:
+        if key not in allowed:
+            raise AntennaConfigError(f"{name}.{key}", "unknown key", source)
+    try:
+        return cls(**values)
+    except AntennaConfigError as exc:
+        raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
+
+
 def _build(data: Mapping[str, Any], source: str) -> Antenna:
     unknown = set(data) - _TOP_LEVEL_KEYS
     if unknown:
@@ -932,33 +956,10 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
             _, dot, name = exc.field_name.partition(".")
             field_name = f"{section}.{name}" if dot else section
             raise AntennaConfigError(field_name, exc.problem, source) from exc
-    sensor = data.get("sensor", {})
-    if not isinstance(sensor, Mapping):
-        raise AntennaConfigError("sensor", "must be a table", source)
-    allowed = {f.name for f in fields(SensorCorrection)}
-    for key in sensor:
-        if key not in allowed:
-            raise AntennaConfigError(f"sensor.{key}", "unknown key", source)
-    try:
-        parts["sensor"] = SensorCorrection(**sensor)
-    except AntennaConfigError as exc:
-        raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
-    span = data.get("sensor_range")
-    if span is not None:
-        if not isinstance(span, Mapping):
-            raise AntennaConfigError("sensor_range", "must be a table", source)
-        for key in ("force", "torque"):
-            if key not in span:
-                raise AntennaConfigError(
-                    f"sensor_range.{key}", "missing (a list of 3 numbers is required)", source
-                )
-        for key in span:
-            if key not in ("force", "torque"):
-                raise AntennaConfigError(f"sensor_range.{key}", "unknown key", source)
-        try:
-            parts["sensor_range"] = SensorRange(force=span["force"], torque=span["torque"])
-        except AntennaConfigError as exc:
-            raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
+    parts["sensor"] = _optional_table(data, "sensor", SensorCorrection, source)
+    parts["sensor_range"] = _optional_table(
+        data, "sensor_range", SensorRange, source, "a list of 3 numbers is required"
+    )
     name = data.get("name", "unnamed")
     if not isinstance(name, str) or not name:
         raise AntennaConfigError("name", "must be a non-empty string", source)
@@ -970,8 +971,8 @@ def _build(data: Mapping[str, Any], source: str) -> Antenna:
             azimuth_motor=parts["azimuth_motor"],
             elevation_motor=parts["elevation_motor"],
             observer=parts["observer"],
-            sensor=parts["sensor"],
-            sensor_range=parts.get("sensor_range"),
+            sensor=parts["sensor"] or SensorCorrection(),
+            sensor_range=parts["sensor_range"],
         )
     except AntennaConfigError as exc:
         raise AntennaConfigError(exc.field_name, exc.problem, source) from exc
