@@ -1135,11 +1135,12 @@ def _clipped_problem(evidence: Evidence, end: int) -> str | None:
     loads = np.column_stack([evidence.force[: end + 1], evidence.torque[: end + 1]])
     with np.errstate(invalid="ignore"):
         share = np.abs(loads) / span.limits
-    worst = np.nanmax(np.where(np.isfinite(share), share, 0.0), axis=0)
+    share = np.where(np.isfinite(share), share, 0.0)  # a missing reading is no clipped one
+    worst = share.max(axis=0)
     channel = int(np.argmax(worst))
     if not worst[channel] >= RANGE_SHARE:
         return None
-    k = int(np.nanargmax(np.where(np.isfinite(share[:, channel]), share[:, channel], 0.0)))
+    k = int(np.argmax(share[:, channel]))
     unit = "N" if channel < 3 else "N m"
     return (
         f"column {WRENCH_CHANNELS[channel]!r}: {float(loads[k, channel]):.4g} {unit} at t = "

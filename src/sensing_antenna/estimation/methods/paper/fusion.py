@@ -27,6 +27,7 @@ from sensing_antenna.estimation.front.evidence import (
     Evidence,
     sensing_curve,
 )
+from sensing_antenna.estimation.front.steps import samples
 from sensing_antenna.estimation.methods.paper.frequency import (
     SpectralPeak,
     evidence_frequency,
@@ -362,17 +363,23 @@ def conclude(
     )
 
 
+#: The span (s), ending at t_e, over which an unsettled ratio's drift is read: two periods of a
+#: fundamental down to 12.6 rad/s (a 1.5 m carbon rod's lowest over its contact range is 14.8),
+#: over which a ripple barely tilts the least-squares line.
+_DRIFT_SPAN = 1.0
+
+
 def _unsettled_ratio(evidence: Evidence, end: int) -> tuple[bool, str]:
-    """Whether a ratio that never settled rang rather than drifted over its last second to
-    sample ``end``, and what it did: the swing of its moving average over the last convergence
-    window against its drift (a least-squares line's rise over the second). A contact that slides
-    drifts (``slip_suspected``); a link that rings slower than the window (a period longer than
-    ``convergence_window``: a link slower than the paper's) swings about a steady mean, which
-    says nothing of a slide (``uncertain``). False and "" when the record holds no such
-    second."""
+    """Whether a ratio that never settled rang rather than drifted over the :data:`_DRIFT_SPAN`
+    to sample ``end``, and what it did: the swing of its moving average over the last
+    convergence window against its drift (a least-squares line's rise over the span). A contact
+    that slides drifts (``slip_suspected``); a link that rings slower than the window (a period
+    longer than ``convergence_window``: a link slower than the paper's) swings about a steady
+    mean, which says nothing of a slide (``uncertain``). False and "" when the record holds no
+    such span after t_1."""
     cfg = evidence.config
-    width = max(1, round(cfg.convergence_window / evidence.sample_period))
-    first = end + 1 - round(1.0 / evidence.sample_period)
+    width = samples(cfg.convergence_window, evidence.sample_period)
+    first = end + 1 - samples(_DRIFT_SPAN, evidence.sample_period)
     if first < evidence.rest_index:
         return False, ""
     mean = evidence.ratio_mean[first : end + 1]
@@ -384,13 +391,13 @@ def _unsettled_ratio(evidence: Evidence, end: int) -> tuple[bool, str]:
     drift = abs(float(np.polyfit(t - t[0], mean, 1)[0]) * float(t[-1] - t[0]))
     if drift >= 0.5 * swing:
         return False, (
-            f": it drifted by {100 * drift:.1f} cm over the last second, as a contact that "
-            "slides makes"
+            f": it drifted by {100 * drift:.1f} cm over the last {_DRIFT_SPAN:g} s, as a contact "
+            "that slides makes"
         )
     return True, (
         f": it swung by {100 * swing:.1f} cm over the last {cfg.convergence_window:g} s about a "
-        f"steady mean (drift {100 * drift:.1f} cm over the last second), as a link that rings "
-        "slower than that window leaves it (a link slower than the paper's: "
+        f"steady mean (drift {100 * drift:.1f} cm over the last {_DRIFT_SPAN:g} s), as a link "
+        "that rings slower than that window leaves it (a link slower than the paper's: "
         "EstimatorConfig.convergence_window a period of its omega_1), more than a contact that "
         "slides"
     )
