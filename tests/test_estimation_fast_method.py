@@ -218,6 +218,41 @@ def test_interval_coverage_on_synthetic_measurements() -> None:
     assert 0.92 <= hits / draws <= 0.98
 
 
+def test_the_region_of_a_posterior_on_two_branches_is_two_parts() -> None:
+    # omega_1 of 0.9 m, which 0.67 m on the rising branch shares, and a ratio half way between
+    # with 0.1 m of error: x_c is near one candidate or the other and nowhere between, so the
+    # highest-density region is two parts, each a few millimetres about a candidate, together
+    # holding the level's mass; the interval is their hull
+    omega = float(CURVE.omega1(0.9))
+    other = CURVE.contact_points(omega)[0].x_c
+    post = _posterior(omega, 0.05, 0.5 * (other + 0.9), 0.1)
+    parts = post.pieces()
+    assert len(parts) == 2
+    (low_a, high_a, mass_a), (low_b, high_b, mass_b) = parts
+    assert low_a < other < high_a and low_b < 0.9 < high_b
+    assert high_a - low_a < 0.01 and high_b - low_b < 0.01
+    assert mass_a > 0.05 and mass_b > 0.05 and mass_a + mass_b >= post.level
+    assert (low_a, high_b) == post.interval
+    # a ratio that picks the branch leaves one part, the interval
+    picked = _posterior(omega, 0.05, 0.9, 0.02)
+    ((low, high, mass),) = picked.pieces()
+    assert (low, high) == picked.interval and mass >= picked.level
+
+
+def test_an_answer_on_two_branches_at_the_cap_names_them_and_is_no_spread() -> None:
+    # A contact at 0.9 m with eight times the sensor noise and no second contact mode to choose
+    # the branch: the ratio leaves 0.9 m and 0.67 m open at the cap. The answer is uncertain,
+    # naming both places, and a map cannot take it as one point with the interval's spread.
+    recording = synthetic_recording(Synthetic(x_c=0.9, seed=2, noise=8.0, second_mode=0.0))
+    result = estimate(recording, calibrated(), FastMethod(ON_CURVE), STRAIGHT)
+    assert result.status is Status.UNCERTAIN
+    places = re.findall(r"(\d\.\d{3}) to (\d\.\d{3}) m \((\d\.\d{2})\)", result.reason or "")
+    assert "2 separate parts" in (result.reason or "") and len(places) == 2
+    (a_low, a_high, _), (b_low, b_high, _) = [tuple(map(float, p)) for p in places]
+    assert a_low <= 0.671 <= a_high and b_low <= 0.9 <= b_high
+    assert not result.held_back_by_width
+
+
 def test_a_model_term_the_same_everywhere_adds_to_the_standard_error_in_quadrature() -> None:
     # A model uncertainty of omega_1 that does not vary with x_c is one more Gaussian error of
     # the measurement: 0.3 and 0.4 rad/s together are 0.5 rad/s

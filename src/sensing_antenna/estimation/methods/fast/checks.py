@@ -398,6 +398,23 @@ def accepted_at_cap(final: WindowEstimate, config: FastConfig) -> bool:
     return final.checks_passed and final.posterior.width <= config.cap_tolerance
 
 
+def _too_wide(posterior: ContactPosterior, config: FastConfig) -> str:
+    """Why an interval wider than ``cap_tolerance`` is not sure: its width, or, when the
+    highest-density region is in parts (x_c near one of two points, one on each branch), the
+    parts and their probabilities."""
+    pieces = posterior.pieces()
+    if len(pieces) > 1:
+        places = " or ".join(f"{lo:.3f} to {hi:.3f} m ({mass:.2f})" for lo, hi, mass in pieces)
+        return (
+            f"the 95 % region is {len(pieces)} separate parts, {places}, which omega_1 and the"
+            " torque/force ratio do not tell apart"
+        )
+    return (
+        f"the 95 % interval is {1000 * posterior.width:.1f} mm wide, more than "
+        f"the {1000 * config.cap_tolerance:g} mm allowed at the cap"
+    )
+
+
 def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]:
     """What is wrong with the scan's final window, as (status, reason) pairs; empty when nothing.
 
@@ -423,10 +440,7 @@ def problems(result: ScanResult, config: FastConfig) -> list[tuple[Status, str]]
         if result.reached_cap:
             why = final.note
             if final.checks_passed:  # only the width held it back, and the cap's is wider
-                why = (
-                    f"the 95 % interval is {1000 * final.posterior.width:.1f} mm wide, more than "
-                    f"the {1000 * config.cap_tolerance:g} mm allowed at the cap"
-                )
+                why = _too_wide(final.posterior, config)
             found.append((Status.UNCERTAIN, f"not sure within {config.cap:g} s after t_1 ({why})"))
         else:
             found.append(

@@ -121,13 +121,15 @@ def conclude_fast(
     found.sort(key=lambda item: order.get(item[0], len(order)))
     status, reason = found[0] if found else (Status.OK, None)
     narrowing = diag.get("second_mode_narrowing", {})
-    # the one fault at the cap is the interval's width: every check passed
+    # the one fault at the cap is the interval's width: every check passed, and the interval
+    # is one (x_c near one of two points is no spread a map can take)
     diag["held_back_by_width"] = bool(
         len(found) == 1
         and status is Status.UNCERTAIN
         and result.reached_cap
         and final.checks_passed
         and not narrowing.get("disagrees")
+        and len(post.pieces()) == 1
     )
     if reason is not None and narrowing.get("disagrees"):
         reason += f"; {narrowing['disagrees']}"

@@ -26,9 +26,10 @@ Model-error floors are added in quadrature to the statistical standard errors:
 
 Prior: flat on the contact range. The posterior is normalised on the grid; the point estimate is
 its maximum (MAP); the 95 % interval is the highest-density region, reported as [lowest, highest]
-point of that region (conservative when the region has two parts, one on each branch); the branch
-probabilities are the posterior mass on each monotone branch of omega_1(x_c). Another
-measurement's likelihood on the grid updates it (:meth:`ContactPosterior.times`).
+point of that region (conservative when the region has two parts, one on each branch:
+:meth:`ContactPosterior.pieces` gives the parts); the branch probabilities are the posterior
+mass on each monotone branch of omega_1(x_c). Another measurement's likelihood on the grid
+updates it (:meth:`ContactPosterior.times`).
 """
 
 from __future__ import annotations
@@ -80,6 +81,26 @@ class ContactPosterior:
         """high - low of the interval (m)."""
         return self.interval[1] - self.interval[0]
 
+    def pieces(self) -> tuple[tuple[float, float, float], ...]:
+        """The highest-density region's separate parts as (low, high, mass) (m, m, probability),
+        ascending: one when the region is one interval, two when x_c is near one of two points
+        (one on each branch of omega_1(x_c)) and nowhere between."""
+        chosen = np.zeros(self.grid.size, dtype=bool)
+        chosen[_hpd_cells(self.density, self.level)] = True
+        inside = np.flatnonzero(chosen)
+        breaks = np.flatnonzero(np.diff(inside) > 1)
+        first = np.concatenate(([0], breaks + 1))
+        last = np.concatenate((breaks, [inside.size - 1]))
+        half = 0.5 * float(self.grid[1] - self.grid[0]) if self.grid.size > 1 else 0.0
+        return tuple(
+            (
+                float(self.grid[inside[a]] - half),
+                float(self.grid[inside[b]] + half),
+                float(self.density[inside[a] : inside[b] + 1].sum()),
+            )
+            for a, b in zip(first, last, strict=True)
+        )
+
     def branch_of(self, x_c: float) -> int:
         """Index of the branch holding ``x_c``."""
         inner = self.branch_edges[1:-1]
@@ -128,11 +149,16 @@ def _branch_indices(branch_edges: tuple[float, ...], grid: FloatArray) -> NDArra
     return np.asarray(np.clip(np.searchsorted(edges[1:-1], grid), 0, edges.size - 2), dtype=int)
 
 
-def _hpd_bounds(density: FloatArray, grid: FloatArray, level: float) -> tuple[float, float]:
+def _hpd_cells(density: FloatArray, level: float) -> NDArray[np.int_]:
+    """Indices of the highest-density cells that hold ``level`` of the mass."""
     order = np.argsort(density)[::-1]
     cumulative = np.cumsum(density[order])
     count = int(np.searchsorted(cumulative, level)) + 1
-    chosen = order[: min(count, order.size)]
+    return np.asarray(order[: min(count, order.size)], dtype=int)
+
+
+def _hpd_bounds(density: FloatArray, grid: FloatArray, level: float) -> tuple[float, float]:
+    chosen = _hpd_cells(density, level)
     step = float(grid[1] - grid[0]) if grid.size > 1 else 0.0
     # Each grid point stands for a cell of one step: the region reaches half a step beyond
     return float(grid[chosen].min() - 0.5 * step), float(grid[chosen].max() + 0.5 * step)
