@@ -233,10 +233,14 @@ def test_the_region_of_a_posterior_on_two_branches_is_two_parts() -> None:
     assert high_a - low_a < 0.01 and high_b - low_b < 0.01
     assert mass_a > 0.05 and mass_b > 0.05 and mass_a + mass_b >= post.level
     assert (low_a, high_b) == post.interval
-    # a ratio that picks the branch leaves one part, the interval
+    # a ratio that picks the branch leaves one part, the interval; so does a region across
+    # the curve's top, where the two branches meet
     picked = _posterior(omega, 0.05, 0.9, 0.02)
-    ((low, high, mass),) = picked.pieces()
-    assert (low, high) == picked.interval and mass >= picked.level
+    top = _posterior(float(CURVE.omega1(0.765)), 0.2, 0.765, 0.03)
+    assert top.branch_of(top.interval[0]) != top.branch_of(top.interval[1])
+    for one in (picked, top):
+        ((low, high, mass),) = one.pieces()
+        assert (low, high) == one.interval and mass >= one.level
 
 
 def test_an_answer_on_two_branches_at_the_cap_names_them_and_is_no_spread() -> None:

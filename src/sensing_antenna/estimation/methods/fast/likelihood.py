@@ -82,24 +82,27 @@ class ContactPosterior:
         return self.interval[1] - self.interval[0]
 
     def pieces(self) -> tuple[tuple[float, float, float], ...]:
-        """The highest-density region's separate parts as (low, high, mass) (m, m, probability),
-        ascending: one when the region is one interval, two when x_c is near one of two points
-        (one on each branch of omega_1(x_c)) and nowhere between."""
-        chosen = np.zeros(self.grid.size, dtype=bool)
-        chosen[_hpd_cells(self.density, self.level)] = True
-        inside = np.flatnonzero(chosen)
-        breaks = np.flatnonzero(np.diff(inside) > 1)
-        first = np.concatenate(([0], breaks + 1))
-        last = np.concatenate((breaks, [inside.size - 1]))
+        """The highest-density region's parts on separate branches of omega_1(x_c), as (low,
+        high, mass) (m, m, probability), ascending: one when the region is one interval or
+        lies on one branch, two when x_c is near one point on each of two branches and nowhere
+        between (gaps within a branch are kept inside its part)."""
+        cells = np.sort(_hpd_cells(self.density, self.level))
+        branch = _branch_indices(self.branch_edges, self.grid)[cells]
+        # a new part where the region skips cells and the branch changes across the gap
+        starts = (np.diff(cells) > 1) & (np.diff(branch) != 0)
+        labels = np.concatenate(([0], np.cumsum(starts)))
         half = 0.5 * float(self.grid[1] - self.grid[0]) if self.grid.size > 1 else 0.0
-        return tuple(
-            (
-                float(self.grid[inside[a]] - half),
-                float(self.grid[inside[b]] + half),
-                float(self.density[inside[a] : inside[b] + 1].sum()),
+        parts = []
+        for label in range(int(labels[-1]) + 1):
+            mine = cells[labels == label]
+            parts.append(
+                (
+                    float(self.grid[mine[0]] - half),
+                    float(self.grid[mine[-1]] + half),
+                    float(self.density[mine].sum()),
+                )
             )
-            for a, b in zip(first, last, strict=True)
-        )
+        return tuple(parts)
 
     def branch_of(self, x_c: float) -> int:
         """Index of the branch holding ``x_c``."""
