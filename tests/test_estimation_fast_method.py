@@ -232,13 +232,21 @@ def test_the_region_of_a_posterior_on_two_branches_is_two_parts() -> None:
     assert low_a < other < high_a and low_b < 0.9 < high_b
     assert high_a - low_a < 0.01 and high_b - low_b < 0.01
     assert mass_a > 0.05 and mass_b > 0.05 and mass_a + mass_b >= post.level
+    # each part's mass is the posterior's over it: its branch's, up to the tails left outside
+    assert mass_a <= post.branch_probability[0] and mass_b <= post.branch_probability[-1]
     assert (low_a, high_b) == post.interval
     # a ratio that picks the branch leaves one part, the interval; so does a region across
-    # the curve's top, where the two branches meet
+    # the curve's top, where the two branches meet (omega_1 1.5 standard deviations below the
+    # top: the region skips the cell at the branch edge, a gap far narrower than either side);
+    # and two places on one branch (another measurement's likelihood peaked at 0.48 and 0.52 m)
     picked = _posterior(omega, 0.05, 0.9, 0.02)
-    top = _posterior(float(CURVE.omega1(0.765)), 0.2, 0.765, 0.03)
+    top = _posterior(float(CURVE.omega1(0.765)) - 0.3, 0.2, 0.765, 0.03)
     assert top.branch_of(top.interval[0]) != top.branch_of(top.interval[1])
-    for one in (picked, top):
+    wide = _posterior(float(CURVE.omega1(0.5)), 5.0, 0.5, 0.5)
+    peaks = sum(np.exp(-0.5 * ((GRID - x) / 0.002) ** 2) for x in (0.48, 0.52))
+    one_branch = wide.times(peaks)
+    assert one_branch is not None and one_branch.interval[1] - one_branch.interval[0] > 0.03
+    for one in (picked, top, one_branch):
         ((low, high, mass),) = one.pieces()
         assert (low, high) == one.interval and mass >= one.level
 
@@ -250,7 +258,7 @@ def test_an_answer_on_two_branches_at_the_cap_names_them_and_is_no_spread() -> N
     recording = synthetic_recording(Synthetic(x_c=0.9, seed=2, noise=8.0, second_mode=0.0))
     result = estimate(recording, calibrated(), FastMethod(ON_CURVE), STRAIGHT)
     assert result.status is Status.UNCERTAIN
-    places = re.findall(r"(\d\.\d{3}) to (\d\.\d{3}) m \((\d\.\d{2})\)", result.reason or "")
+    places = re.findall(r"(\d\.\d{4}) to (\d\.\d{4}) m \((\d\.\d{2})\)", result.reason or "")
     assert "2 separate parts" in (result.reason or "") and len(places) == 2
     (a_low, a_high, _), (b_low, b_high, _) = [tuple(map(float, p)) for p in places]
     assert a_low <= 0.671 <= a_high and b_low <= 0.9 <= b_high

@@ -173,8 +173,9 @@ class ContactEstimate:
     @property
     def held_back_by_width(self) -> bool:
         """True when an ``uncertain`` estimate's one fault is its 95 % interval's width: every
-        check passed, and the interval (wider than the method's tolerance) is what is known of
-        x_c; a map may take its point with that spread (``fast`` method)."""
+        check passed, and the interval (wider than the method's tolerance, one spread: not x_c
+        near one of two points) is what is known of x_c; a map may take its point with that
+        spread (``fast`` method)."""
         return bool(
             self.status is Status.UNCERTAIN
             and self.interval is not None

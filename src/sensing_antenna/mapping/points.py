@@ -174,7 +174,7 @@ class ContactPoint:
     link_beyond : float
         Link length (m) between the contact and the tip; NaN when not known.
     held_back_by_width : bool
-        An ``uncertain`` estimate whose one fault is its interval's width
+        An ``uncertain`` estimate whose one fault is its interval's width, one spread
         (:attr:`~sensing_antenna.estimation.ContactEstimate.held_back_by_width`): its
         covariance carries that width.
     """

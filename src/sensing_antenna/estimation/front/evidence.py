@@ -479,8 +479,8 @@ class Evidence:
             left in the mean);
           - ``statics="small-deflection"`` (Eq. 21 as printed, the ``ratio`` baseline): the
             neglected moments, the axial force times the link's slope and the weight of the
-            bent link, ``ratio_model_factor`` d x_c, and the same floor as the elastica's
-            (what no statics here holds, or what the sensor's calibration left);
+            bent link, ``ratio_model_factor`` d x_c, and the scatter the sensor's calibration
+            measured about its known points, ``ratio_scatter`` x_c;
 
           and with either and ``coupling``, the cross-talk of a sensor no calibration has
           measured, ``coupling_uncertainty`` x_c^2 (:meth:`.SensorCorrection.coupling_uncertainty`).
@@ -502,10 +502,9 @@ class Evidence:
         deflection_ratio = float(self.push_deflection_ratio(x_c))
         model_term = 0.0
         if model and statics == "small-deflection":
-            floor = max(self.config.ratio_model_floor, self.antenna.sensor.ratio_scatter) * x_c
             model_term = math.hypot(
                 self.config.ratio_model_factor * deflection_ratio * x_c,
-                floor,
+                self.antenna.sensor.ratio_scatter * x_c,
                 float(self.cross_talk_uncertainty(np.array(x_c))) if coupling else 0.0,
             )
         elif model:

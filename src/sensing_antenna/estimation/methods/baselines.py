@@ -85,11 +85,19 @@ class RatioMethod:
 def _uncertain_ratio(evidence: Evidence, x_c: float, spread: float) -> str:
     """Why the ratio ``x_c`` (m) with ``spread`` (m, two standard deviations) is uncertain, and
     what would help: a push held longer, or a calibration of the sensor's cross-talk for the
-    push's direction, which alone brings the spread within the bar when it is most of it."""
+    push's direction, which alone brings the spread within the bar when it is most of it; not
+    when the scatter the sensor's calibration measured is beyond the bar on its own, which
+    neither a push nor a rest narrows."""
     bar = evidence.config.max_model_spread
     leak = float(evidence.cross_talk_uncertainty(np.array(x_c))) > 0.0
-    terms = "noise, tare, small-deflection model" + (", the sensor's cross-talk" if leak else "")
     sensor = evidence.antenna.sensor
+    scatter = 2.0 * sensor.ratio_scatter * min(max(x_c, 0.0), evidence.antenna.link.length)
+    terms = "noise, tare, small-deflection model" + (", the sensor's cross-talk" if leak else "")
+    if sensor.ratio_scatter > 0.0:
+        terms += (
+            f", the scatter of {100 * sensor.ratio_scatter:.2g} % of x_c the sensor's"
+            f" calibration left ({100 * scatter:.1f} cm alone)"
+        )
     calibrate = (
         f"calibrate the sensor's cross-talk on {' and '.join(sensor.unmeasured_sweeps)} sweeps "
         "too (antenna calibrate)"
@@ -97,7 +105,12 @@ def _uncertain_ratio(evidence: Evidence, x_c: float, spread: float) -> str:
         else "calibrate the sensor's cross-talk (antenna calibrate)"
     )
     plain = 2.0 * evidence.ratio_uncertainty(x_c, statics="small-deflection")
-    if not leak:
+    if scatter > bar:
+        advice = (
+            "no push or rest narrows that scatter; a method that reads the vibration (paper,"
+            " fast) places the contact" + (f"; {calibrate}" if leak else "")
+        )
+    elif not leak:
         advice = "push harder or rest longer"
     elif plain <= bar:
         advice = f"{calibrate}, which leaves {100 * plain:.1f} cm"

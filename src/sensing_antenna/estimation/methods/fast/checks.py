@@ -404,7 +404,7 @@ def _too_wide(posterior: ContactPosterior, config: FastConfig) -> str:
     parts and their probabilities."""
     pieces = posterior.pieces()
     if len(pieces) > 1:
-        places = " or ".join(f"{lo:.3f} to {hi:.3f} m ({mass:.2f})" for lo, hi, mass in pieces)
+        places = " or ".join(f"{lo:.4f} to {hi:.4f} m ({mass:.2f})" for lo, hi, mass in pieces)
         return (
             f"the 95 % region is {len(pieces)} separate parts, {places}, which omega_1 and the"
             " torque/force ratio do not tell apart"

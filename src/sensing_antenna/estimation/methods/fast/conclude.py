@@ -77,9 +77,11 @@ def conclude_fast(
         answers = accepted_at_cap(final, config)
         post, second_mode = branch_at_cap(evidence, final, candidates, answers)
         diag.update(second_mode)
-        if post is not final.posterior and final.statics is not None:
-            # The ratio's and the frequency's agreement judged again at the branch's maximum
-            ratio_z, _, frequency_z, _ = _judged_at(evidence, final, post, config)
+        if post is not final.posterior:
+            ratio_z, frequency_z = final.ratio_z, final.frequency_z
+            if final.statics is not None:
+                # The ratio's and the frequency's agreement judged again at the branch's maximum
+                ratio_z, _, frequency_z, _ = _judged_at(evidence, final, post, config)
             final = dataclasses.replace(
                 final, posterior=post, ratio_z=ratio_z, frequency_z=frequency_z
             )
@@ -122,14 +124,15 @@ def conclude_fast(
     status, reason = found[0] if found else (Status.OK, None)
     narrowing = diag.get("second_mode_narrowing", {})
     # the one fault at the cap is the interval's width: every check passed, and the interval
-    # is one (x_c near one of two points is no spread a map can take)
+    # is one spread (x_c near one of two points is none a map can take, unless one branch
+    # holds the level's mass and the other a sliver the hull also covers)
     diag["held_back_by_width"] = bool(
         len(found) == 1
         and status is Status.UNCERTAIN
         and result.reached_cap
         and final.checks_passed
         and not narrowing.get("disagrees")
-        and len(post.pieces()) == 1
+        and (len(post.pieces()) == 1 or max(post.branch_probability) >= post.level)
     )
     if reason is not None and narrowing.get("disagrees"):
         reason += f"; {narrowing['disagrees']}"

@@ -82,27 +82,34 @@ class ContactPosterior:
         return self.interval[1] - self.interval[0]
 
     def pieces(self) -> tuple[tuple[float, float, float], ...]:
-        """The highest-density region's parts on separate branches of omega_1(x_c), as (low,
-        high, mass) (m, m, probability), ascending: one when the region is one interval or
-        lies on one branch, two when x_c is near one point on each of two branches and nowhere
-        between (gaps within a branch are kept inside its part)."""
+        """The highest-density region's separate parts as (low, high, mass) (m, m, posterior
+        mass over [low, high]), ascending: one when the region is one interval, two when x_c is
+        near one point on each of two branches of omega_1(x_c) and nowhere between. A gap
+        within one branch (a dip between the ratio's and the frequency's likelihoods) stays
+        inside its part, as does a gap narrower than the narrower part beside it (a region
+        across the curve's top, where the branches meet): the hull of such parts is one
+        spread."""
         cells = np.sort(_hpd_cells(self.density, self.level))
         branch = _branch_indices(self.branch_edges, self.grid)[cells]
-        # a new part where the region skips cells and the branch changes across the gap
-        starts = (np.diff(cells) > 1) & (np.diff(branch) != 0)
-        labels = np.concatenate(([0], np.cumsum(starts)))
+        # runs of the region's cells that skip a cell where the branch changes across the gap
+        starts = np.flatnonzero((np.diff(cells) > 1) & (np.diff(branch) != 0)) + 1
+        runs = [[int(c[0]), int(c[-1])] for c in np.split(cells, starts)]
+        merged = [runs[0]]
+        for low, high in runs[1:]:
+            gap = low - merged[-1][1] - 1
+            if gap < min(high - low + 1, merged[-1][1] - merged[-1][0] + 1):
+                merged[-1][1] = high
+            else:
+                merged.append([low, high])
         half = 0.5 * float(self.grid[1] - self.grid[0]) if self.grid.size > 1 else 0.0
-        parts = []
-        for label in range(int(labels[-1]) + 1):
-            mine = cells[labels == label]
-            parts.append(
-                (
-                    float(self.grid[mine[0]] - half),
-                    float(self.grid[mine[-1]] + half),
-                    float(self.density[mine].sum()),
-                )
+        return tuple(
+            (
+                float(self.grid[low] - half),
+                float(self.grid[high] + half),
+                float(self.density[low : high + 1].sum()),
             )
-        return tuple(parts)
+            for low, high in merged
+        )
 
     def branch_of(self, x_c: float) -> int:
         """Index of the branch holding ``x_c``."""
