@@ -101,7 +101,7 @@ class ContactPosterior:
                 merged[-1][1] = high
             else:
                 merged.append([low, high])
-        half = 0.5 * float(self.grid[1] - self.grid[0]) if self.grid.size > 1 else 0.0
+        half = _half_cell(self.grid)
         return tuple(
             (
                 float(self.grid[low] - half),
@@ -167,11 +167,16 @@ def _hpd_cells(density: FloatArray, level: float) -> NDArray[np.int_]:
     return np.asarray(order[: min(count, order.size)], dtype=int)
 
 
+def _half_cell(grid: FloatArray) -> float:
+    """Half the grid's step (m): each grid point stands for a cell of one step, so a region
+    reaches half a step beyond its outermost points; 0 on a grid of one point."""
+    return 0.5 * float(grid[1] - grid[0]) if grid.size > 1 else 0.0
+
+
 def _hpd_bounds(density: FloatArray, grid: FloatArray, level: float) -> tuple[float, float]:
     chosen = _hpd_cells(density, level)
-    step = float(grid[1] - grid[0]) if grid.size > 1 else 0.0
-    # Each grid point stands for a cell of one step: the region reaches half a step beyond
-    return float(grid[chosen].min() - 0.5 * step), float(grid[chosen].max() + 0.5 * step)
+    half = _half_cell(grid)
+    return float(grid[chosen].min() - half), float(grid[chosen].max() + half)
 
 
 def _check_model_term(name: str, term: float | FloatArray, infinite: bool) -> None:
