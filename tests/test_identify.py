@@ -543,6 +543,21 @@ def test_joints_identified_from_separate_recordings_match_one_recording_of_both(
         identify_free_motion([], ANTENNA)
 
 
+def test_one_recording_in_degrees_among_several_is_named() -> None:
+    # The azimuth logged in degrees (its elevation, at rest, in radians) beside an elevation's
+    # sweep in radians: fitted together, Eq. 15 explains neither; fitted alone, the first reads
+    # 1/57 of the rigid link's inertia, which names the file and the unit, as it does when it
+    # is identified alone
+    azimuth = _free_motion(5, joints=(True, False))
+    theta = azimuth.theta.copy()
+    theta[:, 0] *= 180.0 / math.pi
+    degrees = dataclasses.replace(azimuth, theta=theta)
+    elevation = dataclasses.replace(_free_motion(6, joints=(False, True)), source="free2.csv")
+    with pytest.raises(IdentificationError, match="degrees") as raised:
+        identify_free_motion([elevation, degrees], ANTENNA)
+    assert str(raised.value).startswith(f"{azimuth.source}: columns 'theta1'")
+
+
 def test_a_vertical_free_sweep_with_an_unknown_tip_mass_identifies() -> None:
     # A device carrying 0.1 g at its tip that the antenna file lacks. In a vertical sweep the
     # torque about Y^m holds that mass's weight moment, about 1e-3 N m, ten times the link's

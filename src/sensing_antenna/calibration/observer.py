@@ -445,15 +445,39 @@ def _torque_point_hint(
     )
 
 
+def _check_scale_alone(
+    recording: Recording,
+    data: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
+    period: float,
+    guess: tuple[float, float, float],
+) -> None:
+    """IdentificationError naming ``recording`` when Eq. 15 fitted to it alone (``data`` as
+    one entry of :func:`_fit`'s) gives an effective inertia on another scale than the rigid
+    link's (:func:`_check_inertia`: angles in degrees, time stamps in ms); nothing when its own
+    fit fails otherwise or passes."""
+    where = recording.source or "<recording>"
+    try:
+        gain, omega, *_ = _fit([data], period, guess, where)
+    except _WrongScale:
+        raise
+    except IdentificationError:
+        return
+    _check_inertia(gain / omega**2, guess[0] / guess[1] ** 2, where)
+
+
+class _WrongScale(IdentificationError):
+    """An effective inertia on another scale than the rigid link's (:func:`_check_inertia`)."""
+
+
 def _check_inertia(inertia: float, rigid: float, where: str) -> None:
-    """IdentificationError unless the effective inertia K / omega^2 (kg m^2) lies within
-    ``MAX_INERTIA_FACTOR`` of the rigid link's ``rigid`` (kg m^2)."""
+    """_WrongScale (an IdentificationError) unless the effective inertia K / omega^2 (kg m^2)
+    lies within ``MAX_INERTIA_FACTOR`` of the rigid link's ``rigid`` (kg m^2)."""
     if 1.0 / MAX_INERTIA_FACTOR <= inertia / rigid <= MAX_INERTIA_FACTOR:
         return
     # time in ms reads the motion a thousand times slower: the inertia a million times larger
     ratio = inertia / rigid
     unit = stamps_unit(lambda factor: 0.1 <= ratio / factor**2 <= 10.0)
-    raise IdentificationError(
+    raise _WrongScale(
         f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the observer's inertia "
         f"K / omega^2 = {inertia:.3g} kg m^2 is {ratio:.3g} times the rigid link's "
         f"{rigid:.3g} kg m^2 (more than a factor {MAX_INERTIA_FACTOR:g}): "
@@ -639,15 +663,22 @@ def _observed(
         # Arithmetic that overflows means values no link gives (a wrench of 1e300 N m)
         with np.errstate(over="raise"):
             reach, stated = _stated_point([move.recording for move in moved], antenna)
-            gain, omega, damping, rms, suspect = _fit(
-                data, period, (k0, w0, d0), where, reach, stated
-            )
+            try:
+                gain, omega, damping, rms, suspect = _fit(
+                    data, period, (k0, w0, d0), where, reach, stated
+                )
+                _check_inertia(gain / omega**2, k0 / w0**2, where)
+            except IdentificationError:
+                # one recording on another scale spoils the joint fit: it names itself
+                if len(moved) > 1:
+                    for move, one in zip(moved, data, strict=True):
+                        _check_scale_alone(move.recording, one, period, (k0, w0, d0))
+                raise
     except FloatingPointError:
         raise IdentificationError(
             f"{where}: columns 'theta1', 'theta2', 'ty', 'tz': the fit of Eq. 15 overflows: "
             "angles or torques far beyond a head's (units?)"
         ) from None
-    _check_inertia(gain / omega**2, k0 / w0**2, where)
     provisional = FreeMotionObserver(gain, omega, damping, contact_threshold=1.0)
     provisional_antenna = replace(weighed, observer=provisional)
     peak = max(
