@@ -25,6 +25,7 @@ from sensing_antenna.calibration.frequency import (
     fit_inverse_t,
     points_on_link,
     read_contact_points,
+    unmatched_point_rows,
 )
 
 #: The paper's calibrated T_e (Section 5.1), s/m^2.
@@ -274,6 +275,11 @@ def test_contact_points_from_table_or_metadata(tmp_path: Path) -> None:
     table.write_text("file,x_c\nc.csv,0.4\n", encoding="utf-8")
     with pytest.raises(CalibrationError, match=r"points\.csv: file: no row names any of the 2"):
         read_contact_points(paths, recordings, table)
+    # a row with a typo in its file name leaves its recording without a point and is named
+    table.write_text("file,x_c\na.csv,0.4\nbb.csv,0.8\nsub/b.csv,0.8\n", encoding="utf-8")
+    assert unmatched_point_rows(table, paths) == [
+        f"{table}: line 3: file 'bb.csv' names none of the recordings given"
+    ]
 
 
 def test_points_table_as_a_spreadsheet_writes_it(tmp_path: Path) -> None:

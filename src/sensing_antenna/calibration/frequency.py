@@ -48,6 +48,7 @@ __all__ = [
     "model_beta1_squared",
     "points_on_link",
     "read_contact_points",
+    "unmatched_point_rows",
 ]
 
 #: Robust losses accepted by :func:`fit_inverse_t` (those of scipy.optimize.least_squares).
@@ -1064,6 +1065,18 @@ def _point_row(table: Path, line: int, row: dict[str | Any, Any]) -> _PointRow:
     if not name:
         raise CalibrationError(f"{table}: line {line}: file: empty")
     return _PointRow(line, name, value)
+
+
+def unmatched_point_rows(table: Path, paths: Sequence[Path]) -> list[str]:
+    """One line per row of the ``--points`` ``table`` that matches none of the recordings
+    ``paths`` (by path as given or by file name, as :func:`read_contact_points` matches them):
+    a typo in a file name leaves that recording without a point, and the row unused. Raises
+    as :func:`read_contact_points` on a table it cannot read."""
+    return [
+        f"{table}: line {row.line}: file {row.file!r} names none of the recordings given"
+        for row in _read_points_table(table)
+        if not any(row.file == str(path) or Path(row.file).name == path.name for path in paths)
+    ]
 
 
 def _point_of(table: Path, rows: Sequence[_PointRow], path: Path) -> float:

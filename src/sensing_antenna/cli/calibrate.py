@@ -133,6 +133,7 @@ def _run(args: argparse.Namespace) -> int:
         calibrate_from_recordings,
         read_contact_points,
         scatter_problem,
+        unmatched_point_rows,
     )
     from sensing_antenna.cli.arguments import ArgumentError
     from sensing_antenna.cli.estimate import warn_of_contradicted_period
@@ -152,6 +153,9 @@ def _run(args: argparse.Namespace) -> int:
     if len(recordings) < 2 and unread:
         raise CalibrationError(f"{unread[0]} (and fewer than 2 readable recordings left)")
     points = read_contact_points(paths, recordings, args.points)
+    if args.points is not None:
+        for line in unmatched_point_rows(args.points, paths):
+            print(f"antenna calibrate: warning: {line}", file=sys.stderr)
     if args.points is None and not any(math.isfinite(point) for point in points):
         # a real device's recordings carry no true_xc: the table is what is missing
         raise ArgumentError(
