@@ -373,6 +373,11 @@ def test_static_sag_and_the_links_that_would_sag_more_than_their_length() -> Non
         dataclasses.replace(link, length=3.0)
     with pytest.raises(AntennaConfigError, match=r"^link\.radius: .* slender"):
         dataclasses.replace(link, radius=0.15, linear_density=100.0)
+    # the paper's 1 mm radius typed as 1 (m): the radius is named, not the linear density
+    # whose bulk density (1.5e-3 kg/m^3) it throws out, with the units in which both fit (1 cm
+    # would be a hollow tube of 15 kg/m^3)
+    with pytest.raises(AntennaConfigError, match=r"^link\.radius: .* \(in cm or mm\?\)$"):
+        dataclasses.replace(link, radius=1.0)
 
 
 @pytest.mark.parametrize("name", ["two\nlines", "tab\there", " padded", "", "sep\u2028arator"])

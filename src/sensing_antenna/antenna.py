@@ -294,8 +294,25 @@ class Link:
             value = getattr(self, name)
             if value is not None:
                 PARAMETER_RANGES[f"link.{name}"].check(f"link.{name}", value)
-        bulk = self.linear_density / (math.pi * self.radius**2)
         bulk_range = PARAMETER_RANGES["link.bulk_density"]
+        if self.length < MIN_SLENDERNESS * self.radius:
+            # before the bulk density, which a radius in mm read as m also throws out
+            fits = [
+                name
+                for name, per_m in _OTHER_UNITS["m"]
+                if self.length >= MIN_SLENDERNESS * self.radius / per_m
+                and bulk_range.low
+                <= self.linear_density / (math.pi * (self.radius / per_m) ** 2)
+                <= bulk_range.high
+            ]
+            raise AntennaConfigError(
+                "link.radius",
+                f"{format_value(self.radius)} m is more than 1/{MIN_SLENDERNESS:g} of the"
+                f" length {format_value(self.length)} m: Euler-Bernoulli theory, which every"
+                " model here uses, needs a slender link"
+                + (f" (in {' or '.join(fits)}?)" if fits else ""),
+            )
+        bulk = self.linear_density / (math.pi * self.radius**2)
         if not bulk_range.low <= bulk <= bulk_range.high:
             raise AntennaConfigError(
                 "link.linear_density",
@@ -312,13 +329,6 @@ class Link:
                 "link.mode2_scatter",
                 "is the scatter of a calibration's omega_2 about the model with its T_e: it "
                 "needs link.calibrated_t (antenna calibrate writes both)",
-            )
-        if self.length < MIN_SLENDERNESS * self.radius:
-            raise AntennaConfigError(
-                "link.radius",
-                f"{format_value(self.radius)} m is more than 1/{MIN_SLENDERNESS:g} of the"
-                f" length {format_value(self.length)} m: Euler-Bernoulli theory, which every"
-                " model here uses, needs a slender link",
             )
         sag = self.static_sag
         if not sag <= self.length:
