@@ -157,6 +157,20 @@ def test_a_contact_point_beyond_the_link_is_refused(tmp_path: Path) -> None:
     spec = load_campaign_spec(write(tmp_path, GOOD.replace("0.5]", "1.2]")))
     with pytest.raises(CampaignSpecError, match=r"contact_points\[1\]: 1.2 m is beyond"):
         spec.load_antenna()
+    # 500 read as metres lies on the link in mm: said so
+    spec = load_campaign_spec(write(tmp_path, GOOD.replace("0.5]", "500]")))
+    with pytest.raises(CampaignSpecError, match=r"link length 0.98 m \(in mm\?\)$"):
+        spec.load_antenna()
+
+
+def test_an_antenna_file_that_does_not_exist_is_named_with_the_spec(tmp_path: Path) -> None:
+    path = write(tmp_path, GOOD.replace('antenna = "paper-2021"', 'antenna = "mine.toml"'))
+    spec = load_campaign_spec(path)
+    with pytest.raises(CampaignSpecError) as raised:
+        spec.load_antenna()
+    assert str(raised.value).startswith(f"{path}: antenna: ") and "mine.toml: no such file" in (
+        str(raised.value)
+    )
 
 
 def test_missing_file_and_bad_toml_are_reported(tmp_path: Path) -> None:

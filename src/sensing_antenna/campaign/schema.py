@@ -18,9 +18,10 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
-from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna
+from sensing_antenna.antenna import Antenna, AntennaConfigError, load_antenna, metres_hint
 from sensing_antenna.campaign import limits
 from sensing_antenna.errors import FieldError
 from sensing_antenna.simulator.device import (
@@ -713,9 +714,19 @@ class CampaignSpec:
 
     def load_antenna(self) -> Antenna:
         """The campaign's nominal model; checks every contact point lies on its link."""
-        antenna = load_antenna(self.antenna)
+        antenna = self._named_antenna("antenna", self.antenna)
         self._check_points(antenna, "")
         return antenna
+
+    def _named_antenna(self, key: str, name: str) -> Antenna:
+        """:func:`~sensing_antenna.antenna.load_antenna` of the spec's field ``key``; a file
+        that does not exist is named with the spec and the field that names it."""
+        try:
+            return load_antenna(name)
+        except AntennaConfigError as exc:
+            if exc.field_name != "antenna" or Path(name).is_file():
+                raise
+            raise CampaignSpecError(key, f"{name}: {exc.problem}", self.source or None) from None
 
     def load_device(self) -> Antenna:
         """The simulated hardware: the device's antenna with its overrides applied.
@@ -726,7 +737,11 @@ class CampaignSpec:
             Naming ``device.<section>.<field>`` when an override is out of range, or a contact
             point beyond the device's link.
         """
-        antenna = load_antenna(self.device.antenna or self.antenna)
+        antenna = (
+            self._named_antenna("device.antenna", self.device.antenna)
+            if self.device.antenna
+            else self._named_antenna("antenna", self.antenna)
+        )
         for section, values in self.device.overrides.items():
             if not values:
                 continue
@@ -771,9 +786,10 @@ class CampaignSpec:
         for key, points in self._point_lists():
             for i, x in enumerate(points):
                 if x > antenna.link.length:
+                    hint = metres_hint(x, 0.0, antenna.link.length)
                     raise CampaignSpecError(
                         f"{key}[{i}]",
-                        f"{what}{x!r} m is beyond the link length {antenna.link.length:g} m",
+                        f"{what}{x!r} m is beyond the link length {antenna.link.length:g} m{hint}",
                         self.source or None,
                     )
 
