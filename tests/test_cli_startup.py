@@ -174,11 +174,22 @@ def test_a_mistyped_option_is_answered_with_the_close_one(
     assert f"(did you mean {suggestion}?)" in err
 
 
-def test_an_unexpected_argument_is_named_without_a_guess(
+def test_a_second_recording_to_estimate_says_it_reads_one(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     with pytest.raises(SystemExit) as exc:
-        main(["estimate", "rec.csv", "extra"])
+        main(["estimate", "rec.csv", "rec2.csv"])
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert err == "antenna estimate: error: unrecognized arguments: extra"
+    assert err.startswith("antenna estimate: error: unrecognized arguments: rec2.csv (")
+    assert "estimate reads one recording" in err and "antenna map" in err
+
+
+def test_an_unexpected_option_is_named_without_a_guess(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["estimate", "rec.csv", "--zzz"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "antenna estimate: error: unrecognized arguments: --zzz"

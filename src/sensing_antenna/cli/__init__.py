@@ -107,6 +107,9 @@ class OneLineParser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", HelpFormatter)
         self.option_names: list[str] = []
         self.commands: dict[str, OneLineParser] = {}
+        # What an argument beyond the positional ones most likely meant (a second file to a
+        # command that reads one), said after "unrecognized arguments"; "" for nothing
+        self.extra_positional_hint = ""
         super().__init__(*args, **kwargs)
 
     def add_subparsers(self, **kwargs: Any) -> Any:
@@ -144,6 +147,8 @@ class OneLineParser(argparse.ArgumentParser):
     def reject_unknown(self, extras: Sequence[str]) -> NoReturn:
         """Error on arguments the command does not take, suggesting a close option name."""
         message = f"unrecognized arguments: {' '.join(extras)}"
+        if self.extra_positional_hint and not any(extra.startswith("-") for extra in extras):
+            message += f" ({self.extra_positional_hint})"
         for extra in extras:
             if extra.startswith("--"):
                 close = difflib.get_close_matches(extra.split("=", 1)[0], self.option_names, n=1)

@@ -36,6 +36,10 @@ def register(subparsers: Any) -> None:
         ),
     )
     parser.add_argument("recording", type=Path, help="recording in the sensing-antenna format")
+    parser.extra_positional_hint = (
+        "estimate reads one recording: run it once per file, or give them all to antenna map"
+        " or antenna calibrate"
+    )
     parser.add_argument(
         "--method",
         choices=METHOD_NAMES,
