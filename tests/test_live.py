@@ -691,7 +691,7 @@ def test_an_empty_input_is_said_to_hold_no_recording() -> None:
     )
     # a failure, so that a pipe whose writer failed before writing does not look like a success
     assert done.returncode == 2 and done.stdout == ""
-    assert done.stderr == "antenna listen: <stdin>: the input ended with no recording\n"
+    assert done.stderr == "antenna listen: error: <stdin>: the input ended with no recording\n"
 
 
 def test_udp_address_errors_name_the_flag(

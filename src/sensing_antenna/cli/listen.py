@@ -130,7 +130,10 @@ def _run(args: argparse.Namespace) -> int:
         if listen_lines(sys.stdin.buffer, make, "<stdin>", args.count) == 0:
             # an input that ended before any header: nothing was listened to, say so, and fail
             # (a pipe whose writer failed before writing must not look like a success)
-            print("antenna listen: <stdin>: the input ended with no recording", file=sys.stderr)
+            print(
+                "antenna listen: error: <stdin>: the input ended with no recording",
+                file=sys.stderr,
+            )
             return EXIT_BAD_INPUT
         return 0
     try:
