@@ -26,7 +26,9 @@ pipeline's ``OnlineEstimator`` asking a :class:`~.session.FastSession`'s ``due``
 at every sample) and the batch form (:class:`FastMethod` in ``estimate``, or :func:`.search.scan`)
 declare at the same sample with the same numbers. Fed in blocks
 (``OnlineEstimator.update_block``), the streaming form asks at each block's last evaluation
-instant only.
+instant only, and a bounce of the link that only an instant it skipped would have seen is not
+carried to the later windows (:func:`.window.evaluate_from_t1_or_hold`): its answer may then
+differ from the batch form's.
 """
 
 from __future__ import annotations

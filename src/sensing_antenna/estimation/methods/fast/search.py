@@ -28,6 +28,7 @@ from sensing_antenna.estimation.methods.fast.static_fit import (
 from sensing_antenna.estimation.methods.fast.window import (
     ScanInputs,
     WindowEstimate,
+    bounced_from_t1,
     evaluate_from_t1_or_hold,
     with_early_statics_of,
 )
@@ -141,23 +142,35 @@ def evaluations(
     The grid is t_1 + :func:`~.evaluation_grid.evaluation_offsets`; evaluation starts at the
     first grid point at or after ``earliest`` and ends at the cap or at ``inputs.end_index``,
     whichever comes first. Each window starts at t_1, or at ``hold_end`` when the link bounced
+    in this evaluation's window from t_1 or an earlier one's
     (:func:`.window.evaluate_from_t1_or_hold`; -1: always t_1). The fits of one recording are
     cached, so the drift check's shorter windows are fitted once; ``caches`` (windows from t_1,
     windows from the hold's end) are used and filled when given, else new ones (a cache never
     serves a fit made with other settings). ``choose_branch`` and ``with_early_statics`` as in
-    :func:`.window.evaluate_from_t1_or_hold`.
+    :func:`.window.evaluate_from_t1_or_hold`. A bounce is carried to later evaluations from
+    those at or after ``hold_end``, the method's own (:meth:`.FastMethod.history` from t_1 and
+    the information bound read earlier ones too, which must not change the method's windows).
     """
     if caches is None:
         caches = ({}, {})
+    bounced: tuple[float, float] | None = None
     for offset in evaluation_offsets(inputs.sample_period, inputs.config):
         j = inputs.rest_index + int(offset)
         if j < earliest:
             continue
         if j > inputs.end_index:
             return
-        yield evaluate_from_t1_or_hold(
-            inputs._replace(end_index=j), hold_end, caches, choose_branch, with_early_statics
+        window = evaluate_from_t1_or_hold(
+            inputs._replace(end_index=j),
+            hold_end,
+            caches,
+            choose_branch,
+            with_early_statics,
+            bounced,
         )
+        if j >= hold_end:
+            bounced = bounced_from_t1(window, inputs, bounced)
+        yield window
 
 
 def scan(

@@ -19,6 +19,7 @@ from sensing_antenna.estimation.methods.fast.static_fit import contact_channels
 from sensing_antenna.estimation.methods.fast.window import (
     ScanInputs,
     WindowEstimate,
+    bounced_from_t1,
     evaluate_from_t1_or_hold,
     with_early_statics_of,
 )
@@ -41,7 +42,8 @@ class FastSession:
     before the end of the samples (the one :meth:`ready` has just found sure, or the cap, or
     the last before the samples ended). Asked at every grid instant, it gives the answers of
     the method without a session; asked at fewer (``OnlineEstimator.update_block``), the
-    windows it skipped are never fitted.
+    windows it skipped are never fitted, and a bounce of the link that only they would have
+    shown is not carried to the later windows (``evaluate_from_t1_or_hold``'s ``bounced``).
 
     Between evaluations, :meth:`prepare` fits ahead of time, as soon as their samples have
     arrived, the shorter windows the coming evaluations read (their drift check's reference and,
@@ -57,6 +59,9 @@ class FastSession:
         self._asked: dict[int, bytes] = {}
         # Whether an evaluation restarted its window at the end of the hold (the link bounced)
         self._restarted = False
+        # What the evaluations so far saw of the link bouncing in their windows from t_1
+        # (evaluate_from_t1_or_hold's ``bounced``: None for nothing)
+        self._bounced: tuple[float, float] | None = None
         # Windows (start, end, which cache) prepared, and the plan of those to prepare
         self._prepared: set[tuple[int, int, int]] = set()
         self._planned: tuple[object, list[tuple[int, int, int, int]]] = (None, [])
@@ -87,8 +92,11 @@ class FastSession:
             self._caches,
             second_mode_chooser(evidence),
             with_early_statics=final,
+            bounced=self._bounced,
         )
         self._restarted |= window.start_index != inputs.rest_index
+        if end >= evidence.hold_end:
+            self._bounced = bounced_from_t1(window, inputs, self._bounced)
         self._asked[end] = window_key(
             inputs.channels,
             inputs.rest_index,
@@ -131,14 +139,15 @@ class FastSession:
         (start, end, cache: 0 from t_1, 1 from the hold's end, the first grid instant that reads
         it), by end: for every grid instant at or after ``hold_end``, the drift check's
         reference (2/3) and, with the direction check on, the slip check's (1/2) of its window
-        from t_1 and, once an evaluation restarted at the hold's end, of its window from
-        there."""
-        key = (rest_index, hold_end, sample_period, self._restarted)
+        from t_1 and, once an evaluation restarted at the hold's end or saw the link bounce, of
+        its window from there."""
+        from_hold = self._restarted or self._bounced is not None
+        key = (rest_index, hold_end, sample_period, from_hold)
         if self._planned[0] == key:
             return self._planned[1]
         config = self.method.config
         instants = rest_index + evaluation_offsets(sample_period, config)
-        starts = [(rest_index, 0)] + ([(hold_end, 1)] if self._restarted else [])
+        starts = [(rest_index, 0)] + ([(hold_end, 1)] if from_hold else [])
         fractions = (2.0 / 3.0,) if config.max_direction_drift is None else (2.0 / 3.0, 0.5)
         first_reader: dict[tuple[int, int, int], int] = {}
         for j in instants[instants >= hold_end][::-1]:

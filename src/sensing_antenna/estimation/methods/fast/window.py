@@ -7,8 +7,9 @@ push when that fit stands, :func:`.checks.push_agrees`) and its static torque/fo
 contact mode choose between two branches (:mod:`.second_mode`) and runs the checks
 (:mod:`.checks`). :func:`evaluate_from_t1_or_hold` restarts the window at the end of the
 pipeline's hold when the link bounced (the contact opened, or the push plane rang at two
-fundamentals); :func:`with_early_statics_of` adds the slip check's reference, the statics of
-the window's first half.
+fundamentals), and keeps it there at later evaluations once it has (:func:`bounced_from_t1`);
+:func:`with_early_statics_of` adds the slip check's reference, the statics of the window's
+first half.
 """
 
 from __future__ import annotations
@@ -63,6 +64,7 @@ from sensing_antenna.estimation.methods.fast.window_fit import (
 __all__ = [
     "ScanInputs",
     "WindowEstimate",
+    "bounced_from_t1",
     "evaluate_from_t1_or_hold",
     "evaluate_window",
     "with_early_statics_of",
@@ -546,11 +548,16 @@ def _resolving(
     length = (window.end_index - window.start_index) * sample_period
     if length >= needed or not (window.checks_passed or window.near_top):
         return window
-    note = (
+    return _not_sure(
+        window,
         f"the window ({length:.2f} s) is too short to tell apart the push plane's two "
         f"fundamentals of an earlier one, {pair[0]:.2f} and {pair[1]:.2f} rad/s "
-        f"({needed:.2f} s)"
+        f"({needed:.2f} s)",
     )
+
+
+def _not_sure(window: WindowEstimate, note: str) -> WindowEstimate:
+    """``window`` with every check failed, for the reason ``note`` added to its own."""
     return dataclasses.replace(
         window,
         sure=False,
@@ -567,6 +574,7 @@ def evaluate_from_t1_or_hold(
     caches: tuple[FitCache, FitCache] | None = None,
     choose_branch: BranchChooser | None = None,
     with_early_statics: bool = True,
+    bounced: tuple[float, float] | None = None,
 ) -> WindowEstimate:
     """:func:`evaluate_window` on [t_1, ``inputs.end_index``]; from the end of the hold when the
     link bounced.
@@ -578,6 +586,13 @@ def evaluate_from_t1_or_hold(
     one still shows it, the window from a hold's length later, and so on. A restarted window
     after two fundamentals is sure only when it is long enough to tell them apart
     (2 pi / their distance): one mode in a shorter one may be both.
+    ``bounced``: None, or an earlier evaluation's window from t_1 showed it, and these are the
+    closest two fundamentals seen then (rad/s; NaN, NaN after openings only;
+    :func:`bounced_from_t1`). This window from t_1 holds those samples, and a fit over a longer
+    window may merge the bouncing into one fundamental that no check tells from the contact's,
+    read low; so the window starts at the end of the hold as above whatever this one from t_1
+    shows, is not sure while that is too short, and must tell those two fundamentals apart as
+    well. No effect when ``hold_end`` is not after t_1.
     ``caches`` holds the fits of the windows from t_1 and of those restarted; None refits.
     ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
     gets the slip check's early statics when the direction check is on
@@ -585,12 +600,13 @@ def evaluate_from_t1_or_hold(
     """
     early, late = caches if caches is not None else (None, None)
     window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
-    pair = window.fundamentals
     first = round(inputs.config.first_window / inputs.sample_period)
     start, step = hold_end, hold_end - inputs.rest_index
-    while (
-        not _held(window, inputs.config) and inputs.rest_index < start <= inputs.end_index - first
-    ):
+    if step <= 0:
+        bounced = None
+    pair = window.fundamentals if bounced is None else _closer(window.fundamentals, bounced)
+    restart = bounced is not None or not _held(window, inputs.config)
+    while restart and inputs.rest_index < start <= inputs.end_index - first:
         window = evaluate_window(
             *inputs._replace(rest_index=start, push=None),
             cache=late,
@@ -598,9 +614,28 @@ def evaluate_from_t1_or_hold(
         )
         pair = _closer(window.fundamentals, pair)
         start += step
+        restart = not _held(window, inputs.config)
+    if bounced is not None and window.start_index == inputs.rest_index:
+        window = _not_sure(
+            window,
+            "the link bounced on the obstacle in an earlier window from t_1, whose samples"
+            " this one holds, and the window from the end of the hold is still too short",
+        )
     if window.start_index != inputs.rest_index and math.isfinite(pair[1]):
         window = _resolving(window, pair, inputs.sample_period)
     return with_early_statics_of(inputs, window, caches) if with_early_statics else window
+
+
+def bounced_from_t1(
+    window: WindowEstimate, inputs: ScanInputs, carried: tuple[float, float] | None
+) -> tuple[float, float] | None:
+    """What the next evaluation takes as its ``bounced`` (:func:`evaluate_from_t1_or_hold`),
+    after the one on ``inputs`` that gave ``window`` with ``carried`` as its own: None while no
+    evaluation restarted its window or returned the one from t_1 showing the contact opening or
+    two fundamentals; else the closest two fundamentals seen (rad/s; NaN, NaN for none)."""
+    if carried is None and window.start_index == inputs.rest_index and _held(window, inputs.config):
+        return None
+    return _closer(window.fundamentals, carried if carried is not None else (math.nan, math.nan))
 
 
 def with_early_statics_of(
