@@ -143,10 +143,18 @@ def noisy_far() -> Recording:
     return synthetic_recording(Synthetic(x_c=0.9, seed=1, noise=8.0))
 
 
-def _online(recording: Recording, method: Any, block: int | None = None) -> ContactEstimate:
+def _online(
+    recording: Recording,
+    method: Any,
+    block: int | None = None,
+    antenna: Antenna | None = None,
+    config: EstimatorConfig = STRAIGHT,
+) -> ContactEstimate:
     """The estimate the online form returns while fed ``recording``: sample by sample with
-    ``update`` (``block`` None) or in blocks of ``block`` samples with ``update_block``."""
-    online = OnlineEstimator(calibrated(), recording.sample_period, method, STRAIGHT)
+    ``update`` (``block`` None) or in blocks of ``block`` samples with ``update_block``; with
+    ``antenna`` (the calibrated model when None) and ``config``."""
+    model = antenna if antenna is not None else calibrated()
+    online = OnlineEstimator(model, recording.sample_period, method, config)
     t, theta, force, torque = recording.t, recording.theta, recording.force, recording.torque
     step = 1 if block is None else block
     for k in range(0, t.shape[0], step):
@@ -1764,14 +1772,7 @@ def test_a_bounce_seen_from_t1_keeps_the_later_windows_after_the_hold(
     assert later and all(w.start_index > evidence.rest_index or not w.sure for w in later)
     assert any(w.start_index > evidence.rest_index and w.sure for w in later)
     offline = estimate(recording, antenna, "fast")
-    online = OnlineEstimator(antenna, recording.sample_period, FastMethod())
-    streamed = None
-    for k in range(recording.n_samples):
-        out = online.update(
-            recording.t[k], recording.theta[k], recording.force[k], recording.torque[k]
-        )
-        streamed = out if out is not None else streamed
-    streamed = streamed or online.finalize()
+    streamed = _online(recording, FastMethod(), antenna=antenna, config=EstimatorConfig())
     assert (streamed.status, streamed.x_c, streamed.t_e) == (
         offline.status,
         offline.x_c,
