@@ -591,21 +591,25 @@ def evaluate_from_t1_or_hold(
     :func:`bounced_from_t1`). This window from t_1 holds those samples, and a fit over a longer
     window may merge the bouncing into one fundamental that no check tells from the contact's,
     read low; so the window starts at the end of the hold as above whatever this one from t_1
-    shows, is not sure while that is too short, and must tell those two fundamentals apart as
-    well. No effect when ``hold_end`` is not after t_1.
+    shows (it is then not fitted), is not sure while that is too short, and must tell those two
+    fundamentals apart as well. No effect when ``hold_end`` is not after t_1.
     ``caches`` holds the fits of the windows from t_1 and of those restarted; None refits.
     ``choose_branch`` as in :func:`evaluate_window`; ``with_early_statics``: the returned window
     gets the slip check's early statics when the direction check is on
     (:func:`with_early_statics_of`).
     """
     early, late = caches if caches is not None else (None, None)
-    window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
     first = round(inputs.config.first_window / inputs.sample_period)
     start, step = hold_end, hold_end - inputs.rest_index
     if step <= 0:
         bounced = None
-    pair = window.fundamentals if bounced is None else _closer(window.fundamentals, bounced)
-    restart = bounced is not None or not _held(window, inputs.config)
+    window: WindowEstimate | None = None
+    if bounced is None or not start <= inputs.end_index - first:
+        # the window from t_1; not even fitted once a bounce keeps it out and a later one fits
+        window = evaluate_window(*inputs, cache=early, choose_branch=choose_branch)
+    none = (math.nan, math.nan)
+    pair = _closer(none if window is None else window.fundamentals, bounced or none)
+    restart = window is None or not _held(window, inputs.config)
     while restart and inputs.rest_index < start <= inputs.end_index - first:
         window = evaluate_window(
             *inputs._replace(rest_index=start, push=None),
@@ -615,6 +619,7 @@ def evaluate_from_t1_or_hold(
         pair = _closer(window.fundamentals, pair)
         start += step
         restart = not _held(window, inputs.config)
+    assert window is not None
     if bounced is not None and window.start_index == inputs.rest_index:
         window = _not_sure(
             window,
