@@ -296,21 +296,21 @@ class Link:
                 PARAMETER_RANGES[f"link.{name}"].check(f"link.{name}", value)
         bulk_range = PARAMETER_RANGES["link.bulk_density"]
         if self.length < MIN_SLENDERNESS * self.radius:
-            # before the bulk density, which a radius in mm read as m also throws out
-            fits = [
-                name
-                for name, per_m in _OTHER_UNITS["m"]
-                if self.length >= MIN_SLENDERNESS * self.radius / per_m
-                and bulk_range.low
-                <= self.linear_density / (math.pi * (self.radius / per_m) ** 2)
-                <= bulk_range.high
-            ]
+            # before the bulk density, which a radius in mm read as m also throws out; the
+            # hint names the units in which the radius is slender and the bulk density in range
+            hint = metres_hint(
+                self.radius,
+                math.sqrt(self.linear_density / (math.pi * bulk_range.high)),
+                min(
+                    self.length / MIN_SLENDERNESS,
+                    math.sqrt(self.linear_density / (math.pi * bulk_range.low)),
+                ),
+            )
             raise AntennaConfigError(
                 "link.radius",
                 f"{format_value(self.radius)} m is more than 1/{MIN_SLENDERNESS:g} of the"
                 f" length {format_value(self.length)} m: Euler-Bernoulli theory, which every"
-                " model here uses, needs a slender link"
-                + (f" (in {' or '.join(fits)}?)" if fits else ""),
+                f" model here uses, needs a slender link{hint}",
             )
         bulk = self.linear_density / (math.pi * self.radius**2)
         if not bulk_range.low <= bulk <= bulk_range.high:
