@@ -294,6 +294,26 @@ def test_a_failed_calibration_stops_the_campaign_with_one_error(
     assert not (tmp_path / "runs").exists()
 
 
+def test_a_failed_identification_names_the_step_and_its_recording(tmp_path: Path) -> None:
+    # a drop of 2 g at the tip that the model does not carry: the free motion's rest reads
+    # about twice the link's weight, and the units check refuses the recording
+    import dataclasses
+
+    from sensing_antenna.campaign.schema import CampaignSpecError
+
+    spec = dataclasses.replace(
+        device_spec(False),
+        device=DeviceSpec(imperfections={"tip_mass": 2e-3}),
+        free_motion=FreeMotionStep(identify=True, duration=3.0, case="free"),
+        source="heavy.toml",
+    )
+    with pytest.raises(
+        CampaignSpecError, match=r"heavy\.toml: free_motion: .* free motion 'free': .*weight"
+    ):
+        run_campaign(spec, tmp_path, workers=1, progress=False)
+    assert not (tmp_path / "runs").exists()
+
+
 def test_a_tip_mass_asked_for_and_not_fitted_is_said_so(tmp_path: Path) -> None:
     # three calibration points cannot fit T_e and a tip mass with any scatter left: the model
     # keeps its tip mass, and the report says why rather than nothing

@@ -36,6 +36,7 @@ from sensing_antenna.campaign.runs import (
 )
 from sensing_antenna.campaign.schema import CampaignSpec, CampaignSpecError
 from sensing_antenna.campaign.store import Preparation
+from sensing_antenna.errors import SensingAntennaError
 from sensing_antenna.recording import Recording, tracked_contact
 
 if TYPE_CHECKING:
@@ -244,8 +245,15 @@ def identify_observer(
         extra = with_device(spec, spec.scenario, seed, device.link.length)
         extra["duration"] = spec.free_motion.duration
         scenario = make_scenario(case, None, seed, extra)
-        recordings.append(simulate(device, scenario).without_ground_truth())
-    return identify_free_motion(recordings, model or device, find_lag=False)
+        recording = simulate(device, scenario).without_ground_truth()
+        # named in the step's errors as the calibration recordings are
+        recordings.append(dataclasses.replace(recording, source=f"free motion '{case}'"))
+    try:
+        return identify_free_motion(recordings, model or device, find_lag=False)
+    except SensingAntennaError as exc:
+        raise CampaignSpecError(
+            "free_motion", f"the free-motion step failed: {exc}", spec.source or None
+        ) from exc
 
 
 def knowing_weight(device: Antenna, identified: Antenna) -> Antenna:
