@@ -168,8 +168,7 @@ def evaluations(
             with_early_statics,
             bounced,
         )
-        if j >= hold_end:
-            bounced = bounced_from_t1(window, inputs, bounced)
+        bounced = bounced_from_t1(window, inputs, bounced, hold_end)
         yield window
 
 

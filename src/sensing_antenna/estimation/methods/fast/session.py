@@ -95,8 +95,7 @@ class FastSession:
             bounced=self._bounced,
         )
         self._restarted |= window.start_index != inputs.rest_index
-        if end >= evidence.hold_end:
-            self._bounced = bounced_from_t1(window, inputs, self._bounced)
+        self._bounced = bounced_from_t1(window, inputs, self._bounced, evidence.hold_end)
         self._asked[end] = window_key(
             inputs.channels,
             inputs.rest_index,

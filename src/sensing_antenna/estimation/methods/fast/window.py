@@ -632,12 +632,18 @@ def evaluate_from_t1_or_hold(
 
 
 def bounced_from_t1(
-    window: WindowEstimate, inputs: ScanInputs, carried: tuple[float, float] | None
+    window: WindowEstimate, inputs: ScanInputs, carried: tuple[float, float] | None, hold_end: int
 ) -> tuple[float, float] | None:
     """What the next evaluation takes as its ``bounced`` (:func:`evaluate_from_t1_or_hold`),
     after the one on ``inputs`` that gave ``window`` with ``carried`` as its own: None while no
     evaluation restarted its window or returned the one from t_1 showing the contact opening or
-    two fundamentals; else the closest two fundamentals seen (rad/s; NaN, NaN for none)."""
+    two fundamentals; else the closest two fundamentals seen (rad/s; NaN, NaN for none).
+
+    Only windows ending at or after ``hold_end`` (the pipeline's hold) carry a bounce: earlier
+    ones are evaluated by the information bound and the history from t_1, not by the method,
+    and must not change its windows; before it ``carried`` is returned as it is."""
+    if window.end_index < hold_end:
+        return carried
     if carried is None and window.start_index == inputs.rest_index and _held(window, inputs.config):
         return None
     return _closer(window.fundamentals, carried if carried is not None else (math.nan, math.nan))
