@@ -620,6 +620,24 @@ def test_outcomes_the_simulator_cannot_represent_are_named() -> None:
     assert glancing.outcome == "glancing" and glancing.touch is not None
 
 
+def test_a_push_that_would_press_a_second_object_is_reported_not_kept() -> None:
+    # two 1 cm posts near one line of the link: the sweep meets the far one first, and the
+    # push bends the link's part before the contact forward by several mm, into the near one
+    # 2 mm behind that line; the simulator holds one obstacle and would push through it
+    sweep = Sweep(0, "azimuthal", 0.0, -0.3, 0.3)
+    far = primitive_object("far", "cylinder", [0.01, 0.6], [0.79845, 0.05096, 0.0])
+    near = primitive_object("near", "cylinder", [0.01, 0.6], [0.29848, 0.02685, 0.0])
+    pressed = simulate_sweep(DEVICE, _scene(far, near), sweep, seed=4)
+    assert pressed.outcome == "second_object" and pressed.recording is None
+    assert pressed.touch is not None and pressed.touch.object_name == "far"
+    assert pressed.reason is not None and "presses on 'near'" in pressed.reason
+    # 2 cm further back the near post stays clear of the bent link: the touch is kept
+    clear = primitive_object("near", "cylinder", [0.01, 0.6], [0.29848, 0.04685, 0.0])
+    kept = simulate_sweep(DEVICE, _scene(far, clear), sweep, seed=4)
+    assert kept.outcome == "touch" and kept.recording is not None
+    assert kept.touch is not None and kept.touch.object_name == "far"
+
+
 def test_a_base_may_explore_its_own_angles(tmp_path: Path) -> None:
     from sensing_antenna.exploration import grid_sweeps
 

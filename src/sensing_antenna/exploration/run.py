@@ -761,10 +761,11 @@ def swept_links(
 
     Free: the whole sweep when it touched nothing; up to the touch otherwise, the recording's
     own angles before its detected contact's onset when it has one (in its own frame,
-    ``base_pose``) after the unrecorded approach as planned, else (a glancing touch, not
-    simulated) the planned angles short of the geometric touch by the onset turn of a contact at
-    the tip. Touched: the link at the detection of each contact whose point is not ``ok``
-    (an ``ok`` point says more), and at each glancing touch. ``recorded`` keeps each
+    ``base_pose``) after the unrecorded approach as planned, else (a glancing touch, or one
+    whose push would press a second object: nothing kept) the planned angles short of the
+    geometric touch by the onset turn of a contact at the tip. Touched: the link at the
+    detection of each contact whose point is not ``ok`` (an ``ok`` point says more), and at
+    each glancing or second-object touch. ``recorded`` keeps each
     manoeuvre's recording's :func:`~sensing_antenna.mapping.free_space.recording_links` and
     first angles by its index between calls (a stored recording does not change), so that each
     is read once.
@@ -781,7 +782,7 @@ def swept_links(
         pieces: list[Piece] = []
         if m.outcome == "free":
             end = math.inf * sweep.direction
-        elif m.outcome not in ("touch", "glancing") or m.touch is None:
+        elif m.outcome not in ("touch", "glancing", "second_object") or m.touch is None:
             continue
         elif m.recording is not None and (out / m.recording).exists():
             if m.index not in links:

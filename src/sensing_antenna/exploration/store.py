@@ -81,7 +81,8 @@ class Manoeuvre:
         Its number, from 0.
     sweep : Sweep
     outcome : str
-        ``touch``, ``free``, ``glancing``, ``near_head`` or ``inside`` (``scene.simulate``).
+        ``touch``, ``free``, ``glancing``, ``near_head``, ``inside`` or ``second_object``
+        (``scene.simulate``).
     reason : str or None
     touch : dict or None
         The geometric touch (``Touch.to_dict``: the true surface point and normal, SI).

@@ -48,7 +48,10 @@ itself is as it is: beyond the friction cone the link slides along it, as on a r
 A touch the simulator cannot
 represent is reported instead of simulated: the normal turned more than
 :data:`GLANCING_ANGLE` (``glancing``: the link would slide over it), or x_c below the
-simulator's smallest contact point (``near_head``).
+simulator's smallest contact point (``near_head``). The simulator has one obstacle: a run
+whose link, holding its push at the end, reaches into another object of the scene by more
+than :data:`SECOND_OBJECT_DEPTH` went through it, where a real link would touch it too, and
+is reported instead of kept (``second_object``, naming that object).
 """
 
 from __future__ import annotations
@@ -72,6 +75,7 @@ from sensing_antenna.simulator import Scenario
 from sensing_antenna.simulator.contact import motor_frame
 from sensing_antenna.simulator.device import DeviceImperfections
 from sensing_antenna.simulator.run import (
+    SimulationDetail,
     device_link,
     minimum_contact_point,
     simulate_detailed,
@@ -83,6 +87,7 @@ __all__ = [
     "GLANCING_ANGLE",
     "MAX_TILT",
     "OUTCOMES",
+    "SECOND_OBJECT_DEPTH",
     "GlancingTouchError",
     "SweepOutcome",
     "simulate_sweep",
@@ -106,7 +111,12 @@ MAX_TILT = 0.49
 GLANCING_ANGLE = 1.0
 
 #: What a sweep can end in.
-OUTCOMES = ("touch", "free", "glancing", "near_head", "inside")
+OUTCOMES = ("touch", "free", "glancing", "near_head", "inside", "second_object")
+
+#: How far (m) the simulated link, as it holds its push, may reach into an object it was not
+#: simulated against before the sweep is ``second_object``: 0.5 mm, beyond the penalty contact
+#: and the hold's last ringing.
+SECOND_OBJECT_DEPTH = 5e-4
 
 _DEFAULTS = Scenario(case="free")
 _DEFAULT_SPEED = _DEFAULTS.sweep_speed
@@ -121,8 +131,8 @@ class SweepOutcome:
     sweep : Sweep
     outcome : str
         ``touch`` (simulated: ``recording`` holds it), ``free`` (nothing within the reach: the
-        swept region is free space), ``glancing``, ``near_head`` or ``inside`` (module
-        docstring; nothing simulated).
+        swept region is free space), ``glancing``, ``near_head``, ``inside`` or
+        ``second_object`` (module docstring; nothing simulated, or nothing kept).
     touch : Touch or None
         The geometric first touch.
     scenario : Scenario or None
@@ -349,6 +359,9 @@ def simulate_sweep(
     except GlancingTouchError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     detail = simulate_detailed(device, scenario)
+    pressed = _second_object(detail, scene, frame, touch.object_name, device.link.radius)
+    if pressed:
+        return SweepOutcome(sweep, "second_object", touch, reason=pressed, sweep_time=approach)
     recording = detail.recording
     metadata = dict(recording.metadata)
     metadata["base_pose"] = frame.to_json()
@@ -367,3 +380,39 @@ def simulate_sweep(
         frame,
         sweep_time=approach + float(after),
     )
+
+
+def _second_object(
+    detail: SimulationDetail, scene: Scene, frame: BasePose, touched: str, radius: float
+) -> str:
+    """Why the simulated link, as it holds its push at the run's end, reaches into an object of
+    ``scene`` other than ``touched`` by more than :data:`SECOND_OBJECT_DEPTH`; "" when it does
+    not. The simulator has one obstacle, so such a run pushed the link through the other one."""
+    others = [obj for obj in scene.objects if obj.name != touched]
+    if not others:
+        return ""
+    model = detail.link_model
+    x = np.linspace(0.0, model.length, 8 * model.n_elements + 1)[1:]
+    rows = np.array([model.shape_at(float(s)) for s in x])
+    v_q, w_q = detail.final_deflection
+    v, w = rows @ v_q, rows @ w_q
+    along = x
+    if detail.scenario.link_model == "nonlinear":
+        # an inextensible link's axis point at arc length x lies short of x along X^m
+        slopes = np.array([model.slope_at(float(s)) for s in x])
+        tilt = (slopes @ v_q) ** 2 + (slopes @ w_q) ** 2
+        shortening = np.cumsum(1.0 - np.sqrt(np.clip(1.0 - tilt, 0.0, 1.0))) * (x[1] - x[0])
+        along = x - shortening
+    rows_m = motor_frame(*detail.true_theta[-1])
+    points = frame.point_to_world(
+        along[:, None] * rows_m[0] + v[:, None] * rows_m[1] + w[:, None] * rows_m[2]
+    )
+    for obj in others:
+        gap = obj.signed_distance(points) - radius
+        k = int(np.argmin(gap))
+        if gap[k] < -SECOND_OBJECT_DEPTH:
+            return (
+                f"the pushed link presses on '{obj.name}' too, {1000 * -gap[k]:.1f} mm into it"
+                f" at {x[k]:.3f} m along the link: the simulator holds one contact at a time"
+            )
+    return ""
