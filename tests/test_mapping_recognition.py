@@ -31,7 +31,7 @@ from sensing_antenna.mapping.recognition import (
     LinkLines,
     shape_gap,
 )
-from sensing_antenna.mapping.store import unexplained
+from sensing_antenna.mapping.store import crossed, unexplained
 
 #: Noise of the synthetic points (m, isotropic 1 sigma): about the points' sigma across the link.
 NOISE = 0.001
@@ -1074,3 +1074,31 @@ def test_a_touch_placed_far_from_the_rest_is_counted_wrong_with_the_links_lines(
     assert result.decision == "box", (result.decision, result.candidates)
     assert result.best.wrong == (n,)
     assert _size_error("box", result.best.sizes) < SIZE_TOLERANCE, result.best.sizes
+
+
+def test_a_link_swept_through_the_best_shape_names_no_class() -> None:
+    # points all round a 5 cm ball (touched from several bases) fit the ball and leave no
+    # shape that misses its middle; a link that swept untouched through that middle (as one
+    # does through the gap between two balls whose points fit one capsule) runs 5 cm inside
+    # it, far beyond its deviation: the ball is not the object's whole shape, or that sweep is
+    # wrong, and no class is named
+    rng = np.random.default_rng(5)
+    directions = rng.normal(size=(24, 3))
+    centre = np.array([0.6, 0.0, 0.0])
+    points = centre + 0.05 * directions / np.linalg.norm(directions, axis=1)[:, None]
+    points += rng.normal(0.0, NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * NOISE**2, (len(points), 1, 1))
+    across = np.linspace(-0.1, 0.1, 41)
+    line = centre + np.column_stack([np.zeros_like(across), across, np.zeros_like(across)])
+
+    def swept(samples: np.ndarray) -> list[FreeSpace]:
+        return [FreeSpace(samples, np.full(len(samples), 0.002), np.zeros(41, int), 1, 0.0005)]
+
+    through = recognise(points, covariances, swept=swept(line))
+    assert through.best.name == "sphere" and through.best.n_crossed == 1
+    assert through.undecided
+    assert "1 swept link contradicts the best-fitting sphere" in crossed(through)
+    # the same link 8 cm behind the ball's centre, clear of it: the ball is named
+    behind = recognise(points, covariances, swept=swept(line + np.array([0.08, 0.0, 0.0])))
+    assert behind.decision == "sphere" and behind.best.n_crossed == 0
+    assert crossed(behind) == ""

@@ -556,6 +556,11 @@ class ClassFit:
         (more likely wrong estimates than points of this shape).
     wrong : tuple of int
         Which: their indices among the points fitted, farthest first.
+    n_crossed : int
+        Swept links the fit contradicts beyond their :func:`outlier_cap`: a link that swept
+        untouched through the fitted shape, or one that touched nowhere near it. Such a fit is
+        not named (:func:`recognise`): the object is not one such shape (two objects, a gap
+        between parts), or a sweep is wrong.
     free_ends : tuple of array
         The ends no evidence holds (:func:`size_std`): the change of :attr:`vector` per metre
         each grows by.
@@ -583,6 +588,7 @@ class ClassFit:
     measurements: float = math.nan
     n_wrong: int = 0
     wrong: tuple[int, ...] = ()
+    n_crossed: int = 0
     free_ends: tuple[FloatArray, ...] = field(default=(), compare=False, repr=False)
 
     @property
@@ -678,6 +684,7 @@ class ClassFit:
             "measurements": self.counted,
             "n_wrong": self.n_wrong,
             "wrong": list(self.wrong),
+            "n_crossed": self.n_crossed,
             "weight": None if math.isnan(self.weight) else float(self.weight),
         }
 
@@ -1991,6 +1998,7 @@ def _scored(
     z2 = _z2(at, sigma_at, lines, extra)
     wrong = z2 > outlier_cap(sigma, spread)
     parts = point_chi2(z2, sigma, spread)
+    crossed = sweeps**2 > outlier_cap(_sweep_sigma(spaces), spread) if len(sweeps) else sweeps > 0
     chi2 = float(np.sum(parts) + np.sum(_swept_chi2(sweeps, spaces, spread)))
     line_chi2 = float(np.sum(lines**2))
     return ClassFit(
@@ -2010,6 +2018,7 @@ def _scored(
         mesh=mesh,
         n_wrong=int(np.sum(wrong)),
         wrong=tuple(int(k) for k in np.flatnonzero(wrong)[np.argsort(-z2[wrong])]),
+        n_crossed=int(np.sum(crossed)),
     )
 
 
@@ -2034,10 +2043,16 @@ def _swept_chi2(r: FloatArray, spaces: Sequence[FreeSpace], spread: float) -> Fl
     in order; empty without them."""
     if not len(r):
         return np.zeros(0)
-    sigma = np.concatenate(
+    return point_chi2(np.asarray(r, dtype=float) ** 2, _sweep_sigma(spaces), spread)
+
+
+def _sweep_sigma(spaces: Sequence[FreeSpace]) -> FloatArray:
+    """Each sweep's or contact's standard deviation for the mixture (m): its evidence's median
+    sample standard deviation, shape (n,) for ``spaces`` in order."""
+    return np.concatenate(
         [np.full(s.n_sweeps, float(np.median(s.std)) if len(s.std) else 1.0) for s in spaces]
+        or [np.zeros(0)]
     )
-    return point_chi2(np.asarray(r, dtype=float) ** 2, sigma, spread)
 
 
 def _surface_distance(fit: ClassFit, samples: FloatArray) -> FloatArray:
@@ -2294,7 +2309,10 @@ def recognise(
         # the best's weight against the rival on the likelihood alone
         confidence = confidence_floor((rival.chi2 - best.chi2) / c)
     sure = confidence >= confidence_floor(threshold)
-    decision = best.name if delta >= threshold and rival is None and sure else UNDECIDED
+    # a swept link through the best shape, or a touching one far from it, refutes it as the
+    # object's whole shape whatever the other classes score
+    whole = best.n_crossed == 0
+    decision = best.name if delta >= threshold and rival is None and sure and whole else UNDECIDED
     leaders = (best, rival) if rival is not None else (best, *others[:1])
     return Recognition(
         decision=decision,

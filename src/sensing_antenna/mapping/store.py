@@ -229,6 +229,23 @@ def unexplained(recognition: Any) -> str:
     )
 
 
+def crossed(recognition: Any) -> str:
+    """What the best fit's swept links beyond their outlier cap say (:attr:`ClassFit.n_crossed`:
+    recognition then names no class), or ""."""
+    best = recognition.best
+    if best.n_crossed <= 0:
+        return ""
+    many = best.n_crossed > 1
+    name = best.name.replace("mesh:", "mesh ")
+    return (
+        f"{best.n_crossed} swept link{'s' if many else ''} contradict{'' if many else 's'} the"
+        f" best-fitting {name} beyond what {'their' if many else 'its'} deviations allow (a"
+        " link passed through it untouched, or touched nowhere near it), so no class is named:"
+        " the object is not one such shape (two objects, a gap between its parts), or a sweep"
+        " missed a light contact"
+    )
+
+
 #: Points counted wrong by the best class that the report names, farthest first.
 NAMED_WRONG = 5
 
@@ -372,6 +389,7 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
         runner_up = "" if recognition.runner_up is None else f" ({recognition.runner_up})"
         spread = overdispersed(recognition)
         wrong = unexplained(recognition)
+        through = crossed(recognition)
         lines += [
             f"Recognition: **{recognition.decision}**"
             + (
@@ -391,6 +409,7 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
                 if recognition.undecided
                 and recognition.rival is None
                 and recognition.delta_score >= recognition.threshold
+                and recognition.confidence < recognition.confidence_floor
                 else ""
             )
             + (
@@ -405,7 +424,7 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
                 else ""
             )
             + ".",
-            *(f"{text[:1].upper()}{text[1:]}." for text in (spread, wrong) if text),
+            *(f"{text[:1].upper()}{text[1:]}." for text in (spread, wrong, through) if text),
             *(() if recognition.undecided else (HULL_NOTE,)),
             *_member_note(recognition),
             *_counted_wrong(contact_map),
