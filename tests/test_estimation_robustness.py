@@ -717,6 +717,35 @@ def test_a_stream_at_another_period_than_declared_is_bad_input() -> None:
     assert fed(2e-3, recording.n_samples).ok
 
 
+def test_a_stream_a_few_per_cent_off_its_declared_period_is_bad_input_at_the_estimate() -> None:
+    # a loop that samples at 982 Hz but declares 1 ms, its stamps jittering by +-0.2 ms: the
+    # first twenty stamps' line cannot tell 1.8 % from their jitter, and the estimate read on a
+    # 1 ms period was `ok` 5 mm off; a line through every stamp up to the estimate can
+    antenna = calibrated()
+    rng = np.random.default_rng(1)
+
+    def fed(recording: Recording) -> ContactEstimate:
+        online = OnlineEstimator(antenna, 1e-3, method="fast")
+        stamps = recording.t + rng.uniform(-2e-4, 2e-4, recording.n_samples)
+        for k in range(recording.n_samples):
+            result = online.update(
+                stamps[k], recording.theta[k], recording.force[k], recording.torque[k]
+            )
+            if result is not None:
+                return result
+        return online.finalize()
+
+    slow = simulate(
+        antenna, Scenario(case="azimuthal", contact_point=0.55, seed=3, sample_period=1 / 982)
+    )
+    wrong = fed(slow)
+    assert wrong.status is Status.BAD_INPUT
+    assert (wrong.reason or "").startswith("sample_period: declared 0.001 s, but a line through")
+    assert "(+1.8" in (wrong.reason or "")
+    # the same jitter on a loop that does sample at 1 kHz passes
+    assert fed(simulate(antenna, Scenario(case="azimuthal", contact_point=0.55, seed=3))).ok
+
+
 def test_stamps_off_the_declared_period_by_the_clock_tolerance_are_taken() -> None:
     # the file's rule: stamps within CLOCK_TOLERANCE (0.1 %) of the period are trusted. Exactly
     # 0.1 % off, they were refused by the stamps' last bit, "more than 0.1 % apart"

@@ -9,7 +9,8 @@ forms agree.
 1. Whole samples (``bad_input``, :meth:`~.evidence.Evidence.sample_problem`): no gap longer
    than the estimators fill in inside [t_c, t_e], no corrupted run too long to put back before
    t_e; in a stream, no more than :data:`_LATE_SHARE` of the samples up to t_e left out for a
-   place another had taken (:func:`_misplaced_problem`). The recording's units and signs
+   place another had taken (:func:`_misplaced_problem`), and its time stamps up to t_e
+   stepping by the declared period (:func:`_clock_problem`). The recording's units and signs
    (``implausible_input``): the loads at rest before t_c against the link's weight and the
    free motion against the observer (found by the front end at t_c,
    ``Evidence.input_problem``), the angles up to t_e
@@ -104,6 +105,7 @@ from sensing_antenna.estimation.front.evidence import (
 from sensing_antenna.estimation.front.held import FAST_PACE, repeated_rows
 from sensing_antenna.estimation.front.spectrum import power_spectrum
 from sensing_antenna.estimation.front.spikes import WRENCH_CHANNELS
+from sensing_antenna.estimation.front.steps import stream_period_problem
 from sensing_antenna.estimation.held_joint import COMPLIANCE_MARGIN, held_line, swept_joint
 from sensing_antenna.estimation.methods.fast.parametric import fit_damped_sinusoids
 from sensing_antenna.estimation.methods.paper.frequency import find_peak, measure_frequency
@@ -186,8 +188,10 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if clipped is not None:
         found.append((Status.BAD_INPUT, clipped))
     misplaced = _misplaced_problem(estimate, end)
-    if misplaced is not None:
-        found.append((Status.BAD_INPUT, misplaced))
+    clock = _clock_problem(evidence, end) if misplaced is None else None
+    for problem in (misplaced, clock):
+        if problem is not None:
+            found.append((Status.BAD_INPUT, problem))
     if evidence.input_problem is not None:
         found.append((Status.IMPLAUSIBLE_INPUT, evidence.input_problem))
     angles = angle_problem(evidence.theta[: end + 1])
@@ -328,6 +332,23 @@ def _misplaced_problem(estimate: ContactEstimate, end: int) -> str | None:
         "another had taken, and were left out: time stamps that jitter by half a period or "
         "more place the readings no better than a period, and the frequencies read from them "
         "move; stamp the samples on the device's own clock, or send them at a steady period"
+    )
+
+
+def _clock_problem(evidence: Evidence, end: int) -> str | None:
+    """Why the samples up to ``end`` were not taken a sample period apart, or None: the line
+    through their time stamps against their places steps by another period
+    (:func:`~.front.steps.stream_period_problem`). A recording's reader has put its samples on
+    the period its stamps keep, so this is a stream's: one a few per mille off the period it
+    declared, its jitter hiding that from its first stamps, reads every frequency as far off."""
+    problem = stream_period_problem(
+        evidence.t[: end + 1], np.arange(end + 1), evidence.sample_period
+    )
+    if problem is None:
+        return None
+    return (
+        f"sample_period: declared {evidence.sample_period!r} s, but {problem}: the estimates"
+        " need the period the samples have"
     )
 
 

@@ -73,6 +73,7 @@ __all__ = [
     "settled_loads",
     "slowest_sample_rate",
     "still_angles_turn",
+    "stream_period_problem",
     "time_gaps",
 ]
 
@@ -344,6 +345,36 @@ def _period_of_line(stamps: FloatArray, countings: list[FloatArray]) -> tuple[fl
         error = math.sqrt(residual / (stamps.shape[0] - 2) / spread) if stamps.shape[0] > 2 else 0.0
         best = min(best, (residual, slope, error))
     return best[1], best[2]
+
+
+def stream_period_problem(
+    stamps: FloatArray, places: NDArray[np.int64], sample_period: float
+) -> str | None:
+    """Why the time stamps a stream has sent so far (s, shape (n,), n >= 3) do not step by the
+    ``sample_period`` (s) declared before they came, or None, their grid places (``places``,
+    shape (n,), increasing: dropped samples skipped) numbering them.
+
+    The period is the slope of the least-squares line through the stamps against their places,
+    the stamps' jitter averaging out over the line; it must lie within ``CLOCK_TOLERANCE`` of
+    the declared one, or as many more of the line's standard errors as the first stamps are
+    given (``_PERIOD_SIGMAS``), up to ``PERIOD_CONSISTENCY``. Read at the estimate, on a
+    second or more of samples, it sees a clock a few per mille off that the first stamps' line,
+    their jitter comparable with the offset, cannot: a frequency read on samples taken as one
+    period apart is off by as much as the two clocks disagree. The places are those the samples
+    were given (:func:`fill_missing`), so places miscounted where the stamps jitter by nearly
+    half a period show as well.
+    """
+    stamps = np.asarray(stamps, dtype=np.float64)
+    ts = sample_period
+    period, error = _period_of_line(stamps, [np.diff(places).astype(np.float64)])
+    tolerance = min(PERIOD_CONSISTENCY, max(CLOCK_TOLERANCE, _PERIOD_SIGMAS * error / ts))
+    if abs(period - ts) <= tolerance * ts * (1.0 + 1e-9):
+        return None
+    return (
+        f"a line through its {stamps.shape[0]} time stamps up to {float(stamps[-1]):.3f} s steps"
+        f" by {period:.6g} s ({100 * (period / ts - 1):+.2f} %), more than"
+        f" {100 * tolerance:.2g} % off: a frequency read on them would be as far off"
+    )
 
 
 def declared_period_problem(stamps: FloatArray, sample_period: float) -> str | None:
