@@ -127,7 +127,7 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.udp is None:
         ready()
-        if listen_lines(sys.stdin.buffer, make, "<stdin>", args.count) == 0:
+        if listen_lines(sys.stdin.buffer, make, "<stdin>", args.count, on_event=emit) == 0:
             # an input that ended before any header: nothing was listened to, say so, and fail
             # (a pipe whose writer failed before writing must not look like a success)
             print(

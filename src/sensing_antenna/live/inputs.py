@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import itertools
+import math
 import socket
 import time
 from collections.abc import Callable, Iterable
@@ -38,7 +39,7 @@ from sensing_antenna.live.wire import (
     parse_sample,
     read_header,
 )
-from sensing_antenna.recording import RecordingError
+from sensing_antenna.recording import NAMED_COLUMNS, RecordingError
 
 __all__ = [
     "IDLE_END",
@@ -110,10 +111,14 @@ def listen_lines(
     source: str = "<stdin>",
     count: int | None = None,
     clock: Callable[[], float] = time.perf_counter,
+    on_event: Callable[[Event], None] | None = None,
 ) -> int:
     """Read CSV lines until they end (or ``count`` recordings ended); returns the number of
     recordings ended. ``lines`` keep their line ends, as a file or a pipe gives them: the one
-    without is the input's last, possibly cut short.
+    without is the input's last, possibly cut short. With ``on_event``, a sample whose reading
+    in a named column is NaN or infinite (a reading the device did not get) is left out with a
+    :class:`~.events.SkippedEvent` to it, and put back from its neighbours by the estimator as a
+    sample that never came; without, it stops the reader as any malformed line does.
 
     Raises
     ------
@@ -151,7 +156,7 @@ def listen_lines(
                 current, last_t = make(header, ended + 1), None
                 continue
             try:
-                values = parse_sample(line, current.header, number)
+                values = parse_sample(line, current.header, number, on_event is not None)
             except RecordingError as exc:
                 if text.endswith("\n"):
                     raise
@@ -165,6 +170,10 @@ def listen_lines(
                     exc.field,
                     f"{exc.problem} (truncated last line: left out, the recording ended before it)",
                 ) from None
+            glitch = _not_finite(values, current.header)
+            if glitch and on_event is not None:
+                on_event(SkippedEvent(ended + 1, f"{source}:{number}: {glitch}"))
+                continue
             t = values[current.header.required("t")]
             if last_t is not None and not t > last_t:
                 raise RecordingError(
@@ -190,6 +199,22 @@ def listen_lines(
         raise
     finally:
         _close_quietly(current)
+
+
+def _not_finite(values: list[float], header: StreamHeader) -> str:
+    """What of a sample's named columns is NaN or infinite, with what happens to it, or ""."""
+    bad = [
+        name
+        for name, value in zip(header.columns, values, strict=True)
+        if name in NAMED_COLUMNS and not math.isfinite(value)
+    ]
+    if not bad:
+        return ""
+    columns = ", ".join(repr(name) for name in bad)
+    return (
+        f"column{'s' if len(bad) > 1 else ''} {columns} not a finite number: the sample is left"
+        " out, and put back from its neighbours as one that never came"
+    )
 
 
 def _text(raw: bytes | str, source: str, number: int) -> str:

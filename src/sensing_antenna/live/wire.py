@@ -153,17 +153,20 @@ def read_header(lines: Sequence[str], source: str, first_line: int = 1) -> Strea
     return StreamHeader(metadata, tuple(columns), source)
 
 
-def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> list[float]:
+def parse_sample(
+    line: str, header: StreamHeader, number: int | None = None, glitches: bool = False
+) -> list[float]:
     """The numbers of one sample line, in the header's column order. A cell that is not a finite
     number in a column the format does not name (a logger's state name, a reading not taken;
     :data:`~sensing_antenna.recording.NAMED_COLUMNS`) is NaN: a file read back leaves that
-    column out.
+    column out. With ``glitches``, a named column's NaN or infinite number is kept as it is (a
+    reading the device did not get; the caller leaves the sample out).
 
     Raises
     ------
     RecordingError
         Naming the stream, the line ``number`` and the column: a wrong number of cells, a cell
-        of a named column that is not a number, NaN or infinite.
+        of a named column that is not a number, NaN or infinite (unless ``glitches``).
     """
     cells = line.split(",")
     if len(cells) != len(header.columns):
@@ -176,8 +179,8 @@ def parse_sample(line: str, header: StreamHeader, number: int | None = None) -> 
         except ValueError:
             value = None
         if value is None or not math.isfinite(value):
-            if name not in NAMED_COLUMNS:
-                values.append(math.nan)
+            if name not in NAMED_COLUMNS or (glitches and value is not None):
+                values.append(math.nan if value is None else value)
                 continue
             problem = f"not a number ({cell.strip()!r})" if value is None else not_finite(value)
             raise RecordingError(header.source, number, name, problem)
