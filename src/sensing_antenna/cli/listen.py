@@ -68,6 +68,8 @@ def _run(args: argparse.Namespace) -> int:
     import json
     import socket
 
+    from threadpoolctl import threadpool_limits
+
     from sensing_antenna.antenna import load_antenna
     from sensing_antenna.cli.arguments import ArgumentError
     from sensing_antenna.errors import SensingAntennaError
@@ -80,6 +82,9 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.live.wire import StreamHeader, WireError
     from sensing_antenna.recording import RecordingError
 
+    # one BLAS thread: the estimates' matrices are small, and a second thread only waits for a
+    # core that another process holds, delaying the answer (docs/live.md, "Latency")
+    threadpool_limits(limits=1)
     if args.record is not None:
         problem = record_path_problem(args.record)
         if problem is not None:
