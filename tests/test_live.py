@@ -167,6 +167,30 @@ def test_a_contact_on_loads_in_another_unit_says_so_when_it_is_found(
     assert isinstance(plain, ContactEvent) and plain.input_problem is None
 
 
+def test_a_contact_in_a_stream_joined_in_the_sweep_says_it_was_not_tared(
+    recordings: dict[str, Path],
+) -> None:
+    # a listener started 50 ms before the touch, the head already turning: too few samples
+    # free of contact to tare on, and on an identified head's sensitive detector the contact
+    # may be the detector's start rather than the touch. The contact event says no tare was
+    # possible (a loop may not stop the sweep on it); a whole stream's says it was tared
+    recording = read_recording(recordings["azimuthal"])
+    joined = recording.t >= float(recording.metadata["true_t_contact"]) - 0.05
+    late = dataclasses.replace(
+        recording,
+        t=recording.t[joined],
+        theta=recording.theta[joined],
+        force=recording.force[joined],
+        torque=recording.torque[joined],
+        extra={k: v[joined] for k, v in recording.extra.items()},
+    )
+    contact = _listen(_lines(late))[0]
+    assert isinstance(contact, ContactEvent) and contact.tare == "none"
+    assert contact.to_dict()["tare"] == "none"
+    whole = _listen(_lines(recording))[0]
+    assert isinstance(whole, ContactEvent) and whole.tare == "rest"
+
+
 #: The ``antenna`` command in a new interpreter.
 _ANTENNA = "import sys; from sensing_antenna.cli import main; sys.exit(main(sys.argv[1:]))"
 

@@ -112,6 +112,13 @@ class OnlineEstimator:
         (the estimate's status will be ``implausible_input``), else None."""
         return self._front.input_problem
 
+    @property
+    def tare(self) -> str | None:
+        """How the sensor was tared at t_c: ``rest``, ``approach``, or ``none`` when the samples
+        began too soon before it (a stream joined in the sweep: the contact may be the contact
+        detector's start, not a touch, and the estimate will not be ``ok``); None before t_c."""
+        return self._front.tare
+
     def update(
         self, t: float, theta: ArrayLike, force: ArrayLike, torque: ArrayLike
     ) -> ContactEstimate | None:

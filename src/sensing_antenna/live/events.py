@@ -33,14 +33,18 @@ def _plain(value: float) -> float | None:
 
 @dataclass(frozen=True)
 class ContactEvent:
-    """Contact detected: t_c (s), the contact detector's instant, and ``input_problem``: why
-    the samples up to t_c are not in the format's units and signs (angles in degrees, torques
-    in N mm), when they are not, in which case the contact may be no touch at all."""
+    """Contact detected: t_c (s), the contact detector's instant, ``input_problem``: why the
+    samples up to t_c are not in the format's units and signs (angles in degrees, torques in N
+    mm), when they are not, in which case the contact may be no touch at all, and ``tare``:
+    how the sensor was tared (``rest``, ``approach``, or ``none`` when the samples began too
+    soon before t_c to tare on, a stream joined in the sweep, whose contact may be the contact
+    detector's start rather than a touch)."""
 
     recording: int
     t_c: float
     latency: float
     input_problem: str | None = None
+    tare: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object of the event."""
@@ -49,6 +53,7 @@ class ContactEvent:
             "recording": self.recording,
             "t_c": self.t_c,
             "input_problem": self.input_problem,
+            "tare": self.tare,
             "latency": self.latency,
         }
 

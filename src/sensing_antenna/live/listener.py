@@ -343,7 +343,11 @@ class Listener:
             at = max(first, contact)
             self._emit(
                 ContactEvent(
-                    self.number, float(t[contact]), self._latency(at), estimator.input_problem
+                    self.number,
+                    float(t[contact]),
+                    self._latency(at),
+                    estimator.input_problem,
+                    estimator.tare,
                 )
             )
         if rest is not None and "push" not in self._said:

@@ -311,6 +311,12 @@ class FrontEnd:
         return None if self._start is None else self._start.input_problem
 
     @property
+    def tare(self) -> str | None:
+        """How the sensor was tared at t_c (``rest``, ``approach`` or ``none``: too few samples
+        free of contact before it), None before t_c."""
+        return None if self._start is None else self._start.tare
+
+    @property
     def first_evaluation_index(self) -> int | None:
         """First sample at which :meth:`evidence_at` may be asked: the end of the hold after t_1,
         once the push there was judged measurable; None before."""
