@@ -10,7 +10,9 @@ several periods and come in bursts). The period is the median of the steps over 
 divided by the samples they span; a drop is a lasting rise of the stamps against the messages'
 count, where a running median of the stamps' lead over that count rises by half a period beyond
 its noise and stays up (a recorder that stalls and catches up does not drop); the two are
-read in turn until they agree. The line through the stamps against their sample numbers then
+read in turn until they agree; stamps whose every step lies near a whole number of periods
+(jitter of up to a fifth of a period) have each step's drops counted by its own length instead,
+as long as no stall then shows. The line through the stamps against their sample numbers then
 gives the period and each message's instant without its jitter. A drop shorter than the jitter
 cannot be told and is not counted; stamps that fall back for good (a clock set back while
 recording) cannot be put in order and are refused.
@@ -79,8 +81,9 @@ STEADY_PERIODS = 8.0
 #: estimators' floor of the head's rest tolerance.
 _STILL = 1.0e-4
 #: Stamps whose every step lies within this fraction of a period of a whole number of periods
-#: have their drops counted step by step.
-_CLEAN_STEP = 0.25
+#: have their drops counted step by step: jitter of up to about a fifth of a period on each
+#: stamp, whose steps then never come near half-way between two counts.
+_CLEAN_STEP = 0.45
 #: Most passes of the steps' period and the drops counted on it (they settle in two or three).
 _PASSES = 4
 #: Messages a stream is split after, evenly spread, to look for stamps lower for good.
@@ -394,17 +397,23 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
     single = float(np.median(steps))
     mean = float(s[-1]) / (n - 1)
     ratio = steps / single if single > 0.0 else steps
+    numbers = None
     if (
         2.0 * single > mean  # not bursts: fewer drops than messages
         and np.all(ratio > 1.0 - _CLEAN_STEP)
         and np.all(np.abs(ratio - np.rint(ratio)) < _CLEAN_STEP)
     ):
-        # every step within a quarter period of a whole number of them: each step's own
+        # every step nearer a whole number of periods than half a period: each step's own
         # rounding counts its drops, however many (the running medians need most messages
-        # without one)
-        numbers = np.concatenate([[0], np.cumsum(np.maximum(np.rint(steps / single), 1.0))])
-        numbers = numbers.astype(np.int64)
-    else:
+        # without one), unless the stamps' running median then leaves their line by half a
+        # period somewhere (a recorder that stalled by more than half a period and caught up
+        # would have a drop counted, and the stamps after it lie a period early for good)
+        stepped = np.concatenate([[0], np.cumsum(np.maximum(np.rint(steps / single), 1.0))])
+        slope, intercept = np.polyfit(stepped, s, 1)
+        lead = (s - (intercept + slope * stepped)) / slope
+        if np.ptp(median_filter(lead, size=_window(n), mode="nearest")) < 0.5:
+            numbers = stepped.astype(np.int64)
+    if numbers is None:
         numbers = _counted(s, count, lag)
     slope, intercept = np.polyfit(numbers.astype(np.float64), s, 1)
     period = float(slope)
