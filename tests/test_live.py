@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 import sensing_antenna
-from _recordings import knocked
+from _recordings import knocked, samples_kept
 from sensing_antenna.antenna import Antenna, load_antenna, paper_antenna, save_antenna
 from sensing_antenna.cli import main
 from sensing_antenna.detection.contact_watch import contact_changes
@@ -175,14 +175,8 @@ def test_a_contact_in_a_stream_joined_in_the_sweep_says_it_was_not_tared(
     # may be the detector's start rather than the touch. The contact event says no tare was
     # possible (a loop may not stop the sweep on it); a whole stream's says it was tared
     recording = read_recording(recordings["azimuthal"])
-    joined = recording.t >= float(recording.metadata["true_t_contact"]) - 0.05
-    late = dataclasses.replace(
-        recording,
-        t=recording.t[joined],
-        theta=recording.theta[joined],
-        force=recording.force[joined],
-        torque=recording.torque[joined],
-        extra={k: v[joined] for k, v in recording.extra.items()},
+    late = samples_kept(
+        recording, recording.t >= float(recording.metadata["true_t_contact"]) - 0.05
     )
     contact = _listen(_lines(late))[0]
     assert isinstance(contact, ContactEvent) and contact.tare == "none"
@@ -552,6 +546,19 @@ def test_a_last_line_cut_short_ends_the_recording_with_its_estimate(
         listen_lines([*lines[:-1], lines[-1][:12] + b"\n"], make)
 
 
+def _listen_cli(lines: list[str]) -> subprocess.CompletedProcess[str]:
+    """``antenna listen --no-warm-up`` in a new interpreter, ``lines`` on its standard input."""
+    return subprocess.run(
+        _cli("listen", "--no-warm-up"),
+        input="".join(lines),
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=120,
+        check=False,
+    )
+
+
 def test_a_reading_not_given_on_stdin_is_left_out_and_the_recording_goes_on(
     recordings: dict[str, Path],
 ) -> None:
@@ -565,15 +572,8 @@ def test_a_reading_not_given_on_stdin_is_left_out_and_the_recording_goes_on(
     glitched = [*text[:at], ",".join([cells[0], cells[1], "nan", *cells[3:]]), *text[at + 1 :]]
 
     def listened(lines: list[str]) -> list[dict[str, Any]]:
-        done = subprocess.run(
-            _cli("listen", "--no-warm-up"),
-            input="".join(lines),
-            capture_output=True,
-            text=True,
-            env=_env(),
-            timeout=120,
-            check=True,
-        )
+        done = _listen_cli(lines)
+        assert done.returncode == 0, done.stderr
         return [json.loads(line) for line in done.stdout.splitlines()]
 
     events = listened(glitched)
@@ -668,15 +668,7 @@ def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:
         ),
     ]
     for lines, message in cases:
-        done = subprocess.run(
-            _cli("listen", "--no-warm-up"),
-            input="".join(lines),
-            capture_output=True,
-            text=True,
-            env=_env(),
-            timeout=120,
-            check=False,
-        )
+        done = _listen_cli(lines)
         assert done.returncode == 2, done.stderr
         assert done.stderr.count("\n") == 1 and message in done.stderr, done.stderr
     with pytest.raises(SystemExit) as exc:
