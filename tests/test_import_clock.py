@@ -219,6 +219,24 @@ def test_scattered_drops_under_a_fifth_of_a_period_of_jitter_are_each_counted(se
     assert report.wrench.n_missing == n - kept.size
 
 
+def test_drops_are_counted_step_by_step_on_a_clock_whose_rate_drifts() -> None:
+    # a sensor whose rate drifts by 2e-4 over 20 s (a host clock slewed by NTP), a third of
+    # its messages lost, stamps jittered by 0.05 ms: the stamps bend away from one line by
+    # more than half a period over the stream, but never step; each step's rounding counts
+    # every drop
+    rng = np.random.default_rng(1)
+    n = 20_000
+    k = np.arange(n)
+    kept = np.union1d(np.flatnonzero(rng.random(n) > 0.3), [0, n - 1])
+    instants = MS * k * (1.0 + 1e-4 * k / n)
+    stamps = EPOCH_NS + np.rint(instants[kept] + rng.uniform(-50_000, 50_000, kept.size))
+    wrench = _wrench(n)
+    lossy = Stream("/wrench", "wrench", stamps.astype(np.int64), wrench.values[kept])
+    joints = _ramp_joints(EPOCH_NS + np.arange(-10, n + 20, 10, dtype=np.int64) * MS)
+    report = put_on_clock(lossy, joints, source="log").report
+    assert report.wrench.n_missing == n - kept.size
+
+
 def test_a_recorder_that_stalls_by_more_than_half_a_period_counts_no_drop() -> None:
     # stamps on their grid but for a stall: one message 0.6 ms late, the next two catching up.
     # Each step lies within 0.45 of a whole period, but rounding would count a drop at the

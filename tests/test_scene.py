@@ -631,6 +631,9 @@ def test_a_push_that_would_press_a_second_object_is_reported_not_kept() -> None:
     assert pressed.outcome == "second_object" and pressed.recording is None
     assert pressed.touch is not None and pressed.touch.object_name == "far"
     assert pressed.reason is not None and "presses on 'near'" in pressed.reason
+    # names need not be unique: two posts both called "far" are told apart by where the touch is
+    twin = primitive_object("far", "cylinder", [0.01, 0.6], [0.29848, 0.02685, 0.0])
+    assert simulate_sweep(DEVICE, _scene(far, twin), sweep, seed=4).outcome == "second_object"
     # 2 cm further back the near post stays clear of the bent link: the touch is kept
     clear = primitive_object("near", "cylinder", [0.01, 0.6], [0.29848, 0.04685, 0.0])
     kept = simulate_sweep(DEVICE, _scene(far, clear), sweep, seed=4)

@@ -188,7 +188,9 @@ def _reviewed(evidence: Evidence, estimate: ContactEstimate) -> ContactEstimate:
     if clipped is not None:
         found.append((Status.BAD_INPUT, clipped))
     misplaced = _misplaced_problem(estimate, end)
-    clock = _clock_problem(evidence, end) if misplaced is None else None
+    clock = (
+        _clock_problem(evidence, end) if misplaced is None and evidence.declared_period else None
+    )
     for problem in (misplaced, clock):
         if problem is not None:
             found.append((Status.BAD_INPUT, problem))
@@ -336,11 +338,12 @@ def _misplaced_problem(estimate: ContactEstimate, end: int) -> str | None:
 
 
 def _clock_problem(evidence: Evidence, end: int) -> str | None:
-    """Why the samples up to ``end`` were not taken a sample period apart, or None: the line
-    through their time stamps against their places steps by another period
-    (:func:`~.front.steps.stream_period_problem`). A recording's reader has put its samples on
-    the period its stamps keep, so this is a stream's: one a few per mille off the period it
-    declared, its jitter hiding that from its first stamps, reads every frequency as far off."""
+    """Why a stream's samples up to ``end`` were not taken the period it declared apart, or
+    None: the line through their time stamps against their places steps by another period
+    (:func:`~.front.steps.stream_period_problem`). A stream a few per mille off the period it
+    declared, its jitter hiding that from its first stamps, reads every frequency as far off.
+    A recording's period is read from its stamps by its reader (``Evidence.declared_period``
+    false), which resamples it when they disagree, and is not judged here."""
     problem = stream_period_problem(
         evidence.t[: end + 1], np.arange(end + 1), evidence.sample_period
     )

@@ -405,13 +405,15 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
     ):
         # every step nearer a whole number of periods than half a period: each step's own
         # rounding counts its drops, however many (the running medians need most messages
-        # without one), unless the stamps' running median then leaves their line by half a
-        # period somewhere (a recorder that stalled by more than half a period and caught up
-        # would have a drop counted, and the stamps after it lie a period early for good)
+        # without one), unless the stamps' running median then steps by half a period within
+        # a window (a recorder that stalled by more than half a period and caught up would
+        # have a drop counted, and the stamps after it lie a period early for good; a clock
+        # whose rate drifts bends the stamps away from one line slowly, not in a step)
         stepped = np.concatenate([[0], np.cumsum(np.maximum(np.rint(steps / single), 1.0))])
         slope, intercept = np.polyfit(stepped, s, 1)
-        lead = (s - (intercept + slope * stepped)) / slope
-        if np.ptp(median_filter(lead, size=_window(n), mode="nearest")) < 0.5:
+        width = _window(n)
+        level = median_filter((s - (intercept + slope * stepped)) / slope, width, mode="nearest")
+        if n <= width or np.max(np.abs(level[width:] - level[:-width])) < 0.5:
             numbers = stepped.astype(np.int64)
     if numbers is None:
         numbers = _counted(s, count, lag)

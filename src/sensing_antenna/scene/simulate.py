@@ -359,7 +359,7 @@ def simulate_sweep(
     except GlancingTouchError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     detail = simulate_detailed(device, scenario)
-    pressed = _second_object(detail, scene, frame, touch.object_name, device.link.radius)
+    pressed = _second_object(detail, scene, frame, touch, device.link.radius)
     if pressed:
         return SweepOutcome(sweep, "second_object", touch, reason=pressed, sweep_time=approach)
     recording = detail.recording
@@ -383,12 +383,19 @@ def simulate_sweep(
 
 
 def _second_object(
-    detail: SimulationDetail, scene: Scene, frame: BasePose, touched: str, radius: float
+    detail: SimulationDetail, scene: Scene, frame: BasePose, touch: Touch, radius: float
 ) -> str:
     """Why the simulated link, as it holds its push at the run's end, reaches into an object of
-    ``scene`` other than ``touched`` by more than :data:`SECOND_OBJECT_DEPTH`; "" when it does
-    not. The simulator has one obstacle, so such a run pushed the link through the other one."""
-    others = [obj for obj in scene.objects if obj.name != touched]
+    ``scene`` other than the one ``touch`` met by more than :data:`SECOND_OBJECT_DEPTH`; "" when
+    it does not. The simulator has one obstacle, so such a run pushed the link through the other
+    one. The object met is the one of the touch's name whose surface is nearest its point (names
+    need not be unique)."""
+    point = np.asarray(touch.surface_point, dtype=float).reshape(1, 3)
+    met = min(
+        (obj for obj in scene.objects if obj.name == touch.object_name),
+        key=lambda obj: abs(float(obj.signed_distance(point)[0])),
+    )
+    others = [obj for obj in scene.objects if obj is not met]
     if not others:
         return ""
     model = detail.link_model

@@ -271,6 +271,10 @@ class Evidence:
         Why the samples up to t_c are not in the format's units and signs (the loads at rest
         against the link's weight, the free motion against the observer), None when they are;
         the plausibility layer makes it the status ``implausible_input``.
+    declared_period : bool
+        ``sample_period`` was declared before the samples came (a stream), not read from their
+        stamps (a recording, put on the period they keep by its reader): the plausibility
+        layer then holds the stamps up to t_e to it.
     diagnostics : dict
         Front-end diagnostics (sampling, rest tolerance, rebounds, ...).
     trace : FrontTrace or None
@@ -304,6 +308,7 @@ class Evidence:
     tare_samples: tuple[int, ...] = ()
     gaps: tuple[tuple[float, float], ...] = ()
     input_problem: str | None = None
+    declared_period: bool = False
     diagnostics: dict[str, Any] = field(default_factory=dict)
     trace: FrontTrace | None = field(default=None, compare=False, repr=False)
 

@@ -818,6 +818,7 @@ class FrontEnd:
             tare_samples=start.counts,
             gaps=tuple(gaps),
             input_problem=start.input_problem,
+            declared_period=self.declared,
             diagnostics=diagnostics,
         )
 
