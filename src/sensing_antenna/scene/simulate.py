@@ -69,6 +69,7 @@ from sensing_antenna.mapping.pose import BasePose
 from sensing_antenna.mapping.primitives import PRIMITIVES
 from sensing_antenna.recording import Recording
 from sensing_antenna.scene.file import Scene
+from sensing_antenna.scene.objects import SceneObject
 from sensing_antenna.scene.sweep import LinkShape, Sweep
 from sensing_antenna.scene.touch import MAX_RADIUS, SweepGeometry, Touch, first_touch
 from sensing_antenna.simulator import Scenario
@@ -240,6 +241,13 @@ def touch_scenario(
     return scenario, frame
 
 
+def _met_object(touch: Touch, scene: Scene) -> SceneObject:
+    """The object ``touch`` met: of those of its name (names need not be unique), the one
+    whose surface is nearest its point."""
+    named = [obj for obj in scene.objects if obj.name == touch.object_name]
+    return min(named, key=lambda obj: abs(float(obj.signed_distance(touch.surface_point)[0])))
+
+
 def _touched_shape(touch: Touch, scene: Scene, frame: BasePose) -> dict[str, Any] | None:
     """The touched object itself as the simulator's obstacle (module docstring): the
     scenario's fields ``obstacle`` (``ball``, ``capsule``, ``cylinder``, ``box``, ``cone`` or
@@ -248,8 +256,7 @@ def _touched_shape(touch: Touch, scene: Scene, frame: BasePose) -> dict[str, Any
     (m), the capsule's segment or the cylinder's height grown by twice the link's radius as
     ``obstacle_length`` (m), or a box's, a cone's or a torus's own ``obstacle_sizes`` (the
     simulator grows it); None for a user's mesh."""
-    named = [obj for obj in scene.objects if obj.name == touch.object_name]
-    touched = min(named, key=lambda obj: abs(float(obj.signed_distance(touch.surface_point)[0])))
+    touched = _met_object(touch, scene)
     if touched.shape == "mesh":
         return None
     p = touched.parameters
@@ -359,7 +366,7 @@ def simulate_sweep(
     except GlancingTouchError as exc:
         return SweepOutcome(sweep, "glancing", touch, reason=str(exc), sweep_time=approach)
     detail = simulate_detailed(device, scenario)
-    pressed = _second_object(detail, scene, frame, touch, device.link.radius)
+    pressed = _second_object(detail, scene, frame, touch)
     if pressed:
         return SweepOutcome(sweep, "second_object", touch, reason=pressed, sweep_time=approach)
     recording = detail.recording
@@ -382,19 +389,12 @@ def simulate_sweep(
     )
 
 
-def _second_object(
-    detail: SimulationDetail, scene: Scene, frame: BasePose, touch: Touch, radius: float
-) -> str:
+def _second_object(detail: SimulationDetail, scene: Scene, frame: BasePose, touch: Touch) -> str:
     """Why the simulated link, as it holds its push at the run's end, reaches into an object of
-    ``scene`` other than the one ``touch`` met by more than :data:`SECOND_OBJECT_DEPTH`; "" when
-    it does not. The simulator has one obstacle, so such a run pushed the link through the other
-    one. The object met is the one of the touch's name whose surface is nearest its point (names
-    need not be unique)."""
-    point = np.asarray(touch.surface_point, dtype=float).reshape(1, 3)
-    met = min(
-        (obj for obj in scene.objects if obj.name == touch.object_name),
-        key=lambda obj: abs(float(obj.signed_distance(point)[0])),
-    )
+    ``scene`` other than the one ``touch`` met (:func:`_met_object`) by more than
+    :data:`SECOND_OBJECT_DEPTH`; "" when it does not. The simulator has one obstacle, so such a
+    run pushed the link through the other one."""
+    met = _met_object(touch, scene)
     others = [obj for obj in scene.objects if obj is not met]
     if not others:
         return ""
@@ -415,7 +415,7 @@ def _second_object(
         along[:, None] * rows_m[0] + v[:, None] * rows_m[1] + w[:, None] * rows_m[2]
     )
     for obj in others:
-        gap = obj.signed_distance(points) - radius
+        gap = obj.signed_distance(points) - touch.link_radius
         k = int(np.argmin(gap))
         if gap[k] < -SECOND_OBJECT_DEPTH:
             return (
