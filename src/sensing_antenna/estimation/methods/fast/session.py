@@ -57,10 +57,9 @@ class FastSession:
         self._caches: tuple[FitCache, FitCache] = ({}, {})
         # Digest of each window asked, by its last index (for the evaluation count)
         self._asked: dict[int, bytes] = {}
-        # Whether an evaluation restarted its window at the end of the hold (the link bounced)
-        self._restarted = False
         # What the evaluations so far saw of the link bouncing in their windows from t_1
-        # (evaluate_from_t1_or_hold's ``bounced``: None for nothing)
+        # (evaluate_from_t1_or_hold's ``bounced``: None for nothing; not None once one
+        # restarted its window at the end of the hold)
         self._bounced: tuple[float, float] | None = None
         # Windows (start, end, which cache) prepared, and the plan of those to prepare
         self._prepared: set[tuple[int, int, int]] = set()
@@ -94,7 +93,6 @@ class FastSession:
             with_early_statics=final,
             bounced=self._bounced,
         )
-        self._restarted |= window.start_index != inputs.rest_index
         self._bounced = bounced_from_t1(window, inputs, self._bounced, evidence.hold_end)
         self._asked[end] = window_key(
             inputs.channels,
@@ -140,7 +138,7 @@ class FastSession:
         reference (2/3) and, with the direction check on, the slip check's (1/2) of its window
         from t_1 and, once an evaluation restarted at the hold's end or saw the link bounce, of
         its window from there."""
-        from_hold = self._restarted or self._bounced is not None
+        from_hold = self._bounced is not None
         key = (rest_index, hold_end, sample_period, from_hold)
         if self._planned[0] == key:
             return self._planned[1]
