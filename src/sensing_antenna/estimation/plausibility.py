@@ -105,7 +105,7 @@ from sensing_antenna.estimation.front.evidence import (
 from sensing_antenna.estimation.front.held import FAST_PACE, repeated_rows
 from sensing_antenna.estimation.front.spectrum import power_spectrum
 from sensing_antenna.estimation.front.spikes import WRENCH_CHANNELS
-from sensing_antenna.estimation.front.steps import stream_period_problem
+from sensing_antenna.estimation.front.steps import declared_period_refused, stream_period_problem
 from sensing_antenna.estimation.held_joint import COMPLIANCE_MARGIN, held_line, swept_joint
 from sensing_antenna.estimation.methods.fast.parametric import fit_damped_sinusoids
 from sensing_antenna.estimation.methods.paper.frequency import find_peak, measure_frequency
@@ -347,12 +347,7 @@ def _clock_problem(evidence: Evidence, end: int) -> str | None:
     problem = stream_period_problem(
         evidence.t[: end + 1], np.arange(end + 1), evidence.sample_period
     )
-    if problem is None:
-        return None
-    return (
-        f"sample_period: declared {evidence.sample_period!r} s, but {problem}: the estimates"
-        " need the period the samples have"
-    )
+    return None if problem is None else declared_period_refused(evidence.sample_period, problem)
 
 
 def _claimed(

@@ -72,6 +72,7 @@ from sensing_antenna.estimation.front.steps import (
     StreamGrid,
     at_contact,
     dead_channel,
+    declared_period_refused,
     fill_missing,
     hold_push,
     hold_samples,
@@ -394,10 +395,7 @@ class FrontEnd:
         """Samples at another period than the declared one are refused (``declared``)."""
         problem = None if self._period is None else self._period.feed(times, final)
         if problem is not None:
-            self._refused = (
-                f"sample_period: declared {self.sample_period!r} s, but {problem}: the"
-                " estimates need the period the samples have"
-            )
+            self._refused = declared_period_refused(self.sample_period, problem)
 
     def _ingest(
         self,

@@ -58,6 +58,7 @@ __all__ = [
     "at_contact",
     "dead_channel",
     "declared_period_problem",
+    "declared_period_refused",
     "fill_missing",
     "free_motion_gain",
     "gap_problem",
@@ -345,6 +346,16 @@ def _period_of_line(stamps: FloatArray, countings: list[FloatArray]) -> tuple[fl
         error = math.sqrt(residual / (stamps.shape[0] - 2) / spread) if stamps.shape[0] > 2 else 0.0
         best = min(best, (residual, slope, error))
     return best[1], best[2]
+
+
+def declared_period_refused(sample_period: float, problem: str) -> str:
+    """The ``bad_input`` reason of a stream whose time stamps do not step by the
+    ``sample_period`` (s) it declared, ``problem`` saying how
+    (:func:`declared_period_problem`, :func:`stream_period_problem`)."""
+    return (
+        f"sample_period: declared {sample_period!r} s, but {problem}: the estimates need the"
+        " period the samples have"
+    )
 
 
 def stream_period_problem(
