@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import contextlib
 import itertools
-import math
 import socket
 import time
 from collections.abc import Callable, Iterable
@@ -34,12 +33,13 @@ from sensing_antenna.live.wire import (
     MAX_DATAGRAM_BYTES,
     Datagram,
     StreamHeader,
+    UnreadReadings,
     WireError,
     decode_datagram,
     parse_sample,
     read_header,
 )
-from sensing_antenna.recording import NAMED_COLUMNS, RecordingError
+from sensing_antenna.recording import RecordingError
 
 __all__ = [
     "IDLE_END",
@@ -157,6 +157,10 @@ def listen_lines(
                 continue
             try:
                 values = parse_sample(line, current.header, number, on_event is not None)
+            except UnreadReadings as exc:
+                assert on_event is not None  # raised only when asked for (glitches)
+                on_event(SkippedEvent(ended + 1, f"{source}:{number}: {_left_out(exc.columns)}"))
+                continue
             except RecordingError as exc:
                 if text.endswith("\n"):
                     raise
@@ -170,10 +174,6 @@ def listen_lines(
                     exc.field,
                     f"{exc.problem} (truncated last line: left out, the recording ended before it)",
                 ) from None
-            glitch = _not_finite(values, current.header)
-            if glitch and on_event is not None:
-                on_event(SkippedEvent(ended + 1, f"{source}:{number}: {glitch}"))
-                continue
             t = values[current.header.required("t")]
             if last_t is not None and not t > last_t:
                 raise RecordingError(
@@ -201,18 +201,11 @@ def listen_lines(
         _close_quietly(current)
 
 
-def _not_finite(values: list[float], header: StreamHeader) -> str:
-    """What of a sample's named columns is NaN or infinite, with what happens to it, or ""."""
-    bad = [
-        name
-        for name, value in zip(header.columns, values, strict=True)
-        if name in NAMED_COLUMNS and not math.isfinite(value)
-    ]
-    if not bad:
-        return ""
-    columns = ", ".join(repr(name) for name in bad)
+def _left_out(columns: tuple[str, ...]) -> str:
+    """Why a sample whose named ``columns`` are NaN or infinite is left out, and what then."""
+    named = ", ".join(repr(name) for name in columns)
     return (
-        f"column{'s' if len(bad) > 1 else ''} {columns} not a finite number: the sample is left"
+        f"column{'s' if len(columns) > 1 else ''} {named} not a finite number: the sample is left"
         " out, and put back from its neighbours as one that never came"
     )
 

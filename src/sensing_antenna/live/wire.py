@@ -40,6 +40,7 @@ __all__ = [
     "SAMPLE_DATAGRAM_BYTES",
     "Datagram",
     "StreamHeader",
+    "UnreadReadings",
     "WireError",
     "decode_datagram",
     "format_sample",
@@ -153,38 +154,57 @@ def read_header(lines: Sequence[str], source: str, first_line: int = 1) -> Strea
     return StreamHeader(metadata, tuple(columns), source)
 
 
+class UnreadReadings(RecordingError):
+    """A sample line whose named ``columns`` (all of them, in the header's order) hold NaN or
+    infinite numbers, every other cell read: readings the device did not get
+    (:func:`parse_sample` with ``glitches``)."""
+
+    def __init__(self, source: str | None, line: int | None, columns: list[str]) -> None:
+        super().__init__(source, line, columns[0], "not a finite number")
+        self.columns = tuple(columns)
+
+
 def parse_sample(
     line: str, header: StreamHeader, number: int | None = None, glitches: bool = False
 ) -> list[float]:
     """The numbers of one sample line, in the header's column order. A cell that is not a finite
     number in a column the format does not name (a logger's state name, a reading not taken;
     :data:`~sensing_antenna.recording.NAMED_COLUMNS`) is NaN: a file read back leaves that
-    column out. With ``glitches``, a named column's NaN or infinite number is kept as it is (a
-    reading the device did not get; the caller leaves the sample out).
+    column out.
 
     Raises
     ------
     RecordingError
         Naming the stream, the line ``number`` and the column: a wrong number of cells, a cell
-        of a named column that is not a number, NaN or infinite (unless ``glitches``).
+        of a named column that is not a number, NaN or infinite.
+    UnreadReadings
+        With ``glitches``, in place of the last: a line whose named columns' cells are all
+        numbers but some NaN or infinite (a reading the device did not get; the caller may
+        leave the sample out), naming them all.
     """
     cells = line.split(",")
     if len(cells) != len(header.columns):
         problem = f"expected {len(header.columns)} cells, found {len(cells)}"
         raise RecordingError(header.source, number, None, problem)
     values = []
+    unread = []
     for name, cell in zip(header.columns, cells, strict=True):
         try:
             value = parse_number(cell)
         except ValueError:
             value = None
         if value is None or not math.isfinite(value):
-            if name not in NAMED_COLUMNS or (glitches and value is not None):
-                values.append(math.nan if value is None else value)
+            if name not in NAMED_COLUMNS:
+                values.append(math.nan)
+                continue
+            if glitches and value is not None:
+                unread.append(name)
                 continue
             problem = f"not a number ({cell.strip()!r})" if value is None else not_finite(value)
             raise RecordingError(header.source, number, name, problem)
         values.append(value)
+    if unread:
+        raise UnreadReadings(header.source, number, unread)
     return values
 
 
