@@ -266,7 +266,7 @@ def report_map(
     point is usable (``antenna map``'s ``--antenna``); ``notes``, what was said of the inputs,
     kept in report.md."""
     from sensing_antenna.mapping import write_map
-    from sensing_antenna.mapping.store import crossed, overdispersed, unexplained
+    from sensing_antenna.mapping.store import recognition_warnings
     from sensing_antenna.mapping.view import write_map_html
     from sensing_antenna.plotting.mapping import plot_map
 
@@ -291,10 +291,8 @@ def report_map(
         + "; "
         f"surface faces {summary['surface_faces']}; object {decision}"
     )
-    for warn in (overdispersed, unexplained, crossed):
-        text = "" if recognition is None else warn(recognition)
-        if text:
-            print(f"  {text}")
+    for text in [] if recognition is None else recognition_warnings(recognition):
+        print(f"  {text}")
     if antenna_hints:
         _antenna_hint(summary)
     for path in written:

@@ -246,6 +246,13 @@ def crossed(recognition: Any) -> str:
     )
 
 
+def recognition_warnings(recognition: Any) -> list[str]:
+    """What the map says of its recognition beyond the decision, in order: the points' spread
+    (:func:`overdispersed`), the points counted wrong (:func:`unexplained`) and the swept links
+    beyond their cap (:func:`crossed`); those that have something to say."""
+    return [text for warn in (overdispersed, unexplained, crossed) if (text := warn(recognition))]
+
+
 #: Points counted wrong by the best class that the report names, farthest first.
 NAMED_WRONG = 5
 
@@ -387,9 +394,6 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
         lines.append("Recognition: not attempted (fewer than 10 points).")
     else:
         runner_up = "" if recognition.runner_up is None else f" ({recognition.runner_up})"
-        spread = overdispersed(recognition)
-        wrong = unexplained(recognition)
-        through = crossed(recognition)
         lines += [
             f"Recognition: **{recognition.decision}**"
             + (
@@ -424,7 +428,7 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
                 else ""
             )
             + ".",
-            *(f"{text[:1].upper()}{text[1:]}." for text in (spread, wrong, through) if text),
+            *(f"{text[:1].upper()}{text[1:]}." for text in recognition_warnings(recognition)),
             *(() if recognition.undecided else (HULL_NOTE,)),
             *_member_note(recognition),
             *_counted_wrong(contact_map),
