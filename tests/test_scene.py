@@ -875,3 +875,26 @@ def test_a_sweeps_base_is_an_index_of_the_scenes_bases() -> None:
         first_touch(scene, sweep, LinkShape(DEVICE.link))
     with pytest.raises(ValueError, match="base 3"):
         scene.region_of(3)
+
+
+@pytest.mark.parametrize("as_mesh", [False, True])
+def test_a_tip_pushed_across_a_slanted_face_stays_on_it(as_mesh: bool) -> None:
+    # The tip meets a box's side face with the link 12 degrees off it (the face's normal 78
+    # degrees from the link) and is pushed across it. The simulator's obstacle is the box
+    # itself, or for a mesh the plane of the face at the touch, so the contact's track stays on
+    # the face throughout, within the penalty contact's penetration (0.1 mm, as above); an
+    # obstacle at an angle of the simulator's own put this track 0.6 mm off the face.
+    box = primitive_object("box", "box", [0.2, 0.2, 0.3], [1.0, 0.3, 0.0])
+    touched = box
+    if as_mesh:
+        touched = mesh_object("box", trimesh.creation.box(extents=[0.2, 0.2, 0.3]), [1.0, 0.3, 0])
+    outcome = simulate_sweep(DEVICE, _scene(touched), Sweep(0, "azimuthal", 0.0, -0.3, 0.6), seed=2)
+    assert outcome.touch is not None and outcome.touch.tip
+    assert outcome.recording is not None and outcome.frame is not None, outcome.reason
+    assert outcome.scenario is not None
+    assert outcome.scenario.obstacle == ("plane" if as_mesh else "box")
+    recording = outcome.recording
+    touching = recording.extra[IN_CONTACT_COLUMN] > 0.5
+    track = np.column_stack([recording.extra[name] for name in CONTACT_POINT_COLUMNS])
+    on_world = outcome.frame.point_to_world(track[touching])
+    assert np.abs(box.signed_distance(on_world)).max() < 1e-4

@@ -16,15 +16,15 @@ touch, placed by the simulator from x_c as for any of its runs:
   rounded part) a ball of the radius along the link instead, on which a link sliding across
   stays on the surface. An edge is curved one way only, whichever way the link crosses it:
   a cylinder, along which a link sliding across stays on the edge, as it does on a real one;
-- a contact at the tip (on any object): the simulator's plane, touched by the tip (its normal
-  is the simulator's, not the face's: the touched point is the same).
+- a contact at the tip: the plane of the surface at the touch, along its normal there, on
+  which a tip pushed across a face it meets at a slant slides as it would on the face.
 
 A round link touches with its surface, its radius a off its axis (``scene.touch``), while the
 simulator's link touches with its axis: each obstacle, the object itself or a local one, is
 the surface grown by a (a cylinder, a capsule or a ball of radius R + a about the same axis or
 centre, a capped cylinder also a longer at each end with its rim rounded by a; a box, a cone
-or a torus grown by a, its edges, rim and apex rounded by it; the tip's plane through the
-tip's axis, a from the face), which the axis meets where the link's surface meets the surface.
+or a torus grown by a, its edges, rim and apex rounded by it; the tip's plane a from the
+face), which the axis meets where the link's surface meets the surface.
 
 The simulator's manoeuvre touches at the angles (0, 0) of its absolute frame, so the recording's
 frame is the base's turned to the touch angles: R = R_base M(theta)^T, with M(theta) the motor
@@ -217,11 +217,11 @@ def touch_scenario(
     # touched point, a push held as if the surface faced the sweep more
     tilt = max(-MAX_TILT, min(MAX_TILT, tilt))
     obstacle: dict[str, Any] = {"obstacle": kind, "obstacle_radius": radius, "obstacle_tilt": tilt}
-    if touch.tip:
-        obstacle = {"obstacle": "plane", "obstacle_radius": radius, "obstacle_tilt": 0.0}
-    elif (placed := _touched_shape(touch, scene, frame)) is not None:
+    if (placed := _touched_shape(touch, scene, frame)) is not None:
         # the object itself is not turned: the link slides where friction cannot hold it
         obstacle = placed | {"obstacle_tilt": 0.0}
+    elif touch.tip:
+        obstacle = _tip_plane(touch, frame)
     towards = ""
     if sweep.direction == -1:
         towards = " towards -Y" if sweep.case == "azimuthal" else " down"
@@ -239,6 +239,15 @@ def touch_scenario(
         **scenario_fields,
     )
     return scenario, frame
+
+
+def _tip_plane(touch: Touch, frame: BasePose) -> dict[str, Any]:
+    """The plane of the surface at a tip's touch of a user's mesh, as the simulator's obstacle
+    placed in the recording's frame (``frame``): through the touched point grown by the link's
+    radius (where the tip's axis meets it), along the surface's normal there."""
+    to_frame = frame.rotation.T
+    point = to_frame @ (touch.surface_point + touch.link_radius * touch.normal - frame.position)
+    return {"obstacle": "plane", "obstacle_placement": (*point, *(to_frame @ touch.normal))}
 
 
 def _met_object(touch: Touch, scene: Scene) -> SceneObject:
