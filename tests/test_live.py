@@ -39,13 +39,16 @@ from sensing_antenna.live.events import (
     EstimateEvent,
     Event,
     PushEvent,
+    SkippedEvent,
 )
 from sensing_antenna.live.inputs import (
+    IDLE_END,
     INTERRUPTED_WAIT,
     REORDER_DEPTH,
     REORDER_WAIT,
     listen_lines,
     listen_udp,
+    paced_lines,
 )
 from sensing_antenna.live.listener import Listener
 from sensing_antenna.live.record import RecordWriter, record_path_problem
@@ -585,6 +588,102 @@ def test_a_reading_not_given_on_stdin_is_left_out_and_the_recording_goes_on(
     assert estimate["status"] == clean["status"]
     assert estimate["x_c"] == pytest.approx(clean["x_c"], abs=1e-4)
     assert events[-1]["event"] == "end"
+
+
+def test_a_recording_whose_writer_falls_silent_ends_after_the_idle_time(
+    recordings: dict[str, Path],
+) -> None:
+    # A writer that stops 1.5 s into the recording without closing its end: after IDLE_END
+    # (2 s) of pauses the recording ends with its final estimate; samples of it that come after
+    # are left out, said once; the next '#' block is the next recording.
+    recording = read_recording(recordings["azimuthal"])
+    lines = _lines(recording)
+    first = len(lines) - recording.n_samples + int(np.searchsorted(recording.t, 1.5))
+    now = [0.0]
+
+    def paced() -> Any:
+        for k, line in enumerate(lines[:first]):
+            now[0] = k * 1e-3
+            yield line
+        for _ in range(12):  # 0.25 s pauses: the end is due after the ninth
+            now[0] += 0.25
+            yield None
+        yield from lines[first : first + 5]
+        yield from lines
+
+    events: list[Event] = []
+
+    def make(header: StreamHeader, number: int) -> Listener:
+        return Listener(header, paper_antenna(), events.append, "paper", number=number)
+
+    ended = listen_lines(paced(), make, clock=lambda: now[0], on_event=events.append, idle=IDLE_END)
+    assert ended == 2
+    ends = [e for e in events if isinstance(e, EndEvent)]
+    assert [e.reason for e in ends] == ["no sample for 2 s", "end of input"]
+    assert ends[0].t_last < 1.5
+    skipped = [e for e in events if isinstance(e, SkippedEvent)]
+    assert len(skipped) == 1 and "samples after the recording ended" in skipped[0].reason
+    assert skipped[0].reason.startswith(f"<stdin>:{first + 1}: ")
+    finals = [e for e in events if isinstance(e, EstimateEvent)]
+    assert finals[-1].x_c == pytest.approx(CASES["azimuthal"], abs=0.02)
+    # without idle, pauses are only waited through: the first recording goes on after it
+    events.clear()
+    assert listen_lines(paced(), make, clock=lambda: now[0], on_event=events.append) == 2
+    ends = [e for e in events if isinstance(e, EndEvent)]
+    assert ends[0].reason == "a '#' line after the samples"
+    assert not any(isinstance(e, SkippedEvent) for e in events)
+
+
+def test_paced_lines_reads_a_pipe_as_it_comes() -> None:
+    # lines as they are written, a pause as None, the last line without its end
+    read_end, write_end = os.pipe()
+    lines = paced_lines(read_end, pause=0.05)
+    try:
+        os.write(write_end, b"a,b\nc,")
+        assert next(lines) == b"a,b\n"
+        assert next(lines) is None  # "c," waits for its line's end
+        os.write(write_end, b"d\ne")
+        assert next(lines) == b"c,d\n"
+        os.close(write_end)
+        assert list(lines) == [b"e"]
+    finally:
+        os.close(read_end)
+
+
+def test_listen_ends_a_recording_whose_writer_stalls_without_closing(
+    recordings: dict[str, Path],
+) -> None:
+    # antenna listen on a pipe whose writer stops mid-recording and holds it open: the
+    # recording's end event comes after about IDLE_END, before the pipe is closed
+    text = recordings["azimuthal"].read_text().splitlines(keepends=True)
+    header_at = next(k for k, line in enumerate(text) if not line.startswith("#"))
+    events = []
+    with subprocess.Popen(
+        _cli("listen", "--no-warm-up", "--method", "ratio"),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        env=_env(),
+    ) as listen:
+        assert listen.stdin is not None and listen.stdout is not None
+        watchdog = threading.Timer(120.0, listen.kill)
+        watchdog.start()
+        try:
+            listen.stdin.write("".join(text[: header_at + 1500]))
+            listen.stdin.flush()
+            for line in listen.stdout:
+                events.append(json.loads(line))
+                if events[-1]["event"] == "end":
+                    break
+            assert listen.poll() is None  # still listening: the pipe is open
+            listen.stdin.close()
+            assert listen.wait(timeout=60) == 0
+        finally:
+            watchdog.cancel()
+            listen.kill()
+    assert events[-1]["event"] == "end"
+    assert events[-1]["reason"] == "no sample for 2 s"
 
 
 def test_stdin_errors_are_one_line_exit_2(recordings: dict[str, Path]) -> None:

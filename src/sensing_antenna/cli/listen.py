@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 import threading
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -75,7 +77,13 @@ def _run(args: argparse.Namespace) -> int:
     from sensing_antenna.errors import SensingAntennaError
     from sensing_antenna.estimation.config import EstimatorConfig
     from sensing_antenna.live.events import Event
-    from sensing_antenna.live.inputs import listen_lines, listen_udp, parse_address
+    from sensing_antenna.live.inputs import (
+        IDLE_END,
+        listen_lines,
+        listen_udp,
+        paced_lines,
+        parse_address,
+    )
     from sensing_antenna.live.listener import Listener
     from sensing_antenna.live.record import RecordWriter, numbered_path, record_path_problem
     from sensing_antenna.live.warm_up import freeze_heap, warm_up
@@ -132,7 +140,11 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.udp is None:
         ready()
-        if listen_lines(sys.stdin.buffer, make, "<stdin>", args.count, on_event=emit) == 0:
+        lines: Iterable[bytes | None] = sys.stdin.buffer
+        idle = None
+        with contextlib.suppress(AttributeError, OSError, ValueError):  # no descriptor: a test's
+            lines, idle = paced_lines(sys.stdin.fileno()), IDLE_END
+        if listen_lines(lines, make, "<stdin>", args.count, on_event=emit, idle=idle) == 0:
             # an input that ended before any header: nothing was listened to, say so, and fail
             # (a pipe whose writer failed before writing must not look like a success)
             print(

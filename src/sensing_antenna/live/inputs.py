@@ -6,7 +6,9 @@ wall time they arrived, and closes it when the recording ends. A reader only par
 estimates run in each listener's worker thread.
 
 Standard input is trusted as a file is: a malformed line or a time that does not increase
-stops the reader with a :class:`~sensing_antenna.recording.RecordingError` naming the line. A
+stops the reader with a :class:`~sensing_antenna.recording.RecordingError` naming the line.
+Read through :func:`paced_lines`, a recording whose writer falls silent without closing the
+pipe ends after :data:`IDLE_END`, as over UDP. A
 UDP port receives whatever anyone sends it: a datagram not in the format, a malformed line, a
 datagram whose turn has gone, a time that does not increase or one that jumps ahead beyond any
 filling (an outlier stamp, which would leave every good sample after it behind), a recording
@@ -21,9 +23,12 @@ from __future__ import annotations
 
 import contextlib
 import itertools
+import os
+import queue
 import socket
+import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 
 from sensing_antenna.errors import interruption_of
 from sensing_antenna.estimation.front.steps import MAX_FILLED, OUTLIER_PERIODS
@@ -50,12 +55,17 @@ __all__ = [
     "MakeListener",
     "listen_lines",
     "listen_udp",
+    "paced_lines",
     "parse_address",
 ]
 
-#: A UDP recording whose sender fell silent for this long (s) is closed as if it had ended: a
-#: sender that stopped without its ``end`` datagram (the datagram lost, the program killed).
+#: A recording whose sender fell silent for this long (s) is closed as if it had ended: a UDP
+#: sender that stopped without its ``end`` datagram (the datagram lost, the program killed), a
+#: writer to standard input that stalled without closing the pipe (:func:`paced_lines`).
 IDLE_END = 2.0
+
+#: How often (s) :func:`paced_lines` says that no line came.
+_PAUSE = 0.2
 
 #: After Ctrl-C or a stop signal, the longest wait (s) for the recording's final estimate and
 #: end event: a reader of the events that stopped reading (its pipe full) must not hold the
@@ -106,12 +116,13 @@ def _close_interrupted(exc: BaseException, close: Callable[[str, float], None]) 
 
 
 def listen_lines(
-    lines: Iterable[bytes | str],
+    lines: Iterable[bytes | str | None],
     make: MakeListener,
     source: str = "<stdin>",
     count: int | None = None,
     clock: Callable[[], float] = time.perf_counter,
     on_event: Callable[[Event], None] | None = None,
+    idle: float | None = None,
 ) -> int:
     """Read CSV lines until they end (or ``count`` recordings ended); returns the number of
     recordings ended. ``lines`` keep their line ends, as a file or a pipe gives them: the one
@@ -119,6 +130,11 @@ def listen_lines(
     in a named column is NaN or infinite (a reading the device did not get) is left out with a
     :class:`~.events.SkippedEvent` to it, and put back from its neighbours by the estimator as a
     sample that never came; without, it stops the reader as any malformed line does.
+
+    A None among ``lines`` is a pause in the input (:func:`paced_lines`): with ``idle`` (s), a
+    recording whose last line came longer ago than that on ``clock`` ends (``no sample for 2
+    s``), and the samples that follow it up to the next ``#`` line are left out, said once to
+    ``on_event``: they belong to a recording already ended.
 
     Raises
     ------
@@ -132,14 +148,27 @@ def listen_lines(
     current: Listener | None = None
     ended = 0
     last_t: float | None = None
+    heard = clock()  # when the last line came
+    silenced = told = False  # a recording ended for its silence: its samples left out up to
+    # the next '#' line, said once
+    number = 0
     try:
-        for number, raw in enumerate(lines, start=1):
+        for raw in lines:
             received = clock()
+            if raw is None:
+                if current is not None and idle is not None and received - heard > idle:
+                    current.close(f"no sample for {idle:g} s")
+                    current, ended, silenced, told = None, ended + 1, True, False
+                    if count is not None and ended >= count:
+                        return ended
+                continue
+            number, heard = number + 1, received
             text = _text(raw, source, number)
             line = text.rstrip("\r\n")
             if not line.strip():
                 continue
             if line.startswith("#"):
+                silenced = False
                 if current is not None:
                     current.close("a '#' line after the samples")
                     current, ended = None, ended + 1
@@ -148,6 +177,17 @@ def listen_lines(
                 if not pending:
                     pending_first = number
                 pending.append(line)
+                continue
+            if silenced:
+                if not told and on_event is not None:
+                    on_event(
+                        SkippedEvent(
+                            ended,
+                            f"{source}:{number}: samples after the recording ended for its"
+                            " silence: left out up to the next '#' line",
+                        )
+                    )
+                told = True
                 continue
             if current is None:
                 first = pending_first if pending else number
@@ -199,6 +239,43 @@ def listen_lines(
         raise
     finally:
         _close_quietly(current)
+
+
+def paced_lines(fd: int, pause: float = _PAUSE) -> Iterator[bytes | None]:
+    """The lines read from the file descriptor ``fd`` (standard input: 0) as they come, each
+    with its line end (the last without one when the input ends without it), and None each
+    ``pause`` (s) in which none came, for :func:`listen_lines` to notice a writer gone silent.
+
+    A thread of its own reads the descriptor (``os.read``, no buffered file object whose lock
+    it could hold when the program ends); an error reading it is raised here.
+    """
+    arrived: queue.SimpleQueue[bytes | BaseException | None] = queue.SimpleQueue()
+
+    def read() -> None:
+        rest = b""
+        try:
+            while chunk := os.read(fd, 1 << 16):
+                *complete, rest = (rest + chunk).split(b"\n")
+                for line in complete:
+                    arrived.put(line + b"\n")
+            if rest:
+                arrived.put(rest)
+            arrived.put(None)
+        except BaseException as exc:  # passed on to the reader of the lines
+            arrived.put(exc)
+
+    threading.Thread(target=read, name="stdin-lines", daemon=True).start()
+    while True:
+        try:
+            item = arrived.get(timeout=pause)
+        except queue.Empty:
+            yield None
+            continue
+        if item is None:
+            return
+        if isinstance(item, BaseException):
+            raise item
+        yield item
 
 
 def _left_out(columns: tuple[str, ...]) -> str:
