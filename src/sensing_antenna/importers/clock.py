@@ -398,6 +398,7 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
     mean = float(s[-1]) / (n - 1)
     ratio = steps / single if single > 0.0 else steps
     numbers = None
+    line: tuple[float, float] | None = None  # slope and intercept of the stamps on the numbers
     if (
         2.0 * single > mean  # not bursts: fewer drops than messages
         and np.all(ratio > 1.0 - _CLEAN_STEP)
@@ -414,10 +415,12 @@ def sample_clock(stamps: NDArray[np.int64]) -> SampleClock:
         width = _window(n)
         level = median_filter((s - (intercept + slope * stepped)) / slope, width, mode="nearest")
         if n <= width or np.max(np.abs(level[width:] - level[:-width])) < 0.5:
-            numbers = stepped.astype(np.int64)
-    if numbers is None:
+            numbers, line = stepped.astype(np.int64), (slope, intercept)
+    if numbers is None or line is None:
         numbers = _counted(s, count, lag)
-    slope, intercept = np.polyfit(numbers.astype(np.float64), s, 1)
+        fitted = np.polyfit(numbers.astype(np.float64), s, 1)
+        line = (float(fitted[0]), float(fitted[1]))
+    slope, intercept = line
     period = float(slope)
     instants = intercept + period * numbers.astype(np.float64)
     if np.max(np.abs(s - instants)) <= 1.0:  # stamps on their grid: kept to the nanosecond
