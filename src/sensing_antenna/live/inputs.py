@@ -67,6 +67,9 @@ IDLE_END = 2.0
 #: How often (s) :func:`paced_lines` says that no line came.
 _PAUSE = 0.2
 
+#: Reads of standard input (64 KiB each) :func:`paced_lines` holds ahead of its reader.
+_QUEUED_READS = 64
+
 #: After Ctrl-C or a stop signal, the longest wait (s) for the recording's final estimate and
 #: end event: a reader of the events that stopped reading (its pipe full) must not hold the
 #: process (a fast method's final estimate takes well under a second).
@@ -247,19 +250,24 @@ def paced_lines(fd: int, pause: float = _PAUSE) -> Iterator[bytes | None]:
     ``pause`` (s) in which none came, for :func:`listen_lines` to notice a writer gone silent.
 
     A thread of its own reads the descriptor (``os.read``, no buffered file object whose lock
-    it could hold when the program ends); an error reading it is raised here.
+    it could hold when the program ends), at most :data:`_QUEUED_READS` reads ahead of the
+    lines taken (a file given whole is not held in memory); an error reading it is raised here.
     """
-    arrived: queue.SimpleQueue[bytes | BaseException | None] = queue.SimpleQueue()
+    arrived: queue.Queue[list[bytes] | BaseException | None] = queue.Queue(_QUEUED_READS)
 
     def read() -> None:
-        rest = b""
+        pieces: list[bytes] = []  # of the line not yet ended
         try:
             while chunk := os.read(fd, 1 << 16):
-                *complete, rest = (rest + chunk).split(b"\n")
-                for line in complete:
-                    arrived.put(line + b"\n")
-            if rest:
-                arrived.put(rest)
+                *ended, rest = chunk.split(b"\n")
+                if ended:
+                    ended[0] = b"".join([*pieces, ended[0]])
+                    pieces = []
+                    arrived.put([line + b"\n" for line in ended])
+                if rest:
+                    pieces.append(rest)
+            if pieces:
+                arrived.put([b"".join(pieces)])
             arrived.put(None)
         except BaseException as exc:  # passed on to the reader of the lines
             arrived.put(exc)
@@ -275,7 +283,7 @@ def paced_lines(fd: int, pause: float = _PAUSE) -> Iterator[bytes | None]:
             return
         if isinstance(item, BaseException):
             raise item
-        yield item
+        yield from item
 
 
 def _left_out(columns: tuple[str, ...]) -> str:
