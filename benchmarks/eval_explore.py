@@ -494,6 +494,7 @@ def run(
             abstained=recognition.decision == UNDECIDED,
             confident_wrong=recognition.decision not in (name, UNDECIDED),
             confidence=recognition.confidence,
+            overdispersion=recognition.overdispersion,
             candidates=list(recognition.candidates),
             rival=recognition.rival,
         )
