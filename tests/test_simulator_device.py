@@ -29,10 +29,12 @@ from sensing_antenna.simulator import (
     DeviceError,
     DeviceImperfections,
     Scenario,
+    ScenarioError,
     realistic_device,
     simulate,
     simulate_detailed,
 )
+from sensing_antenna.simulator.contact import motor_frame
 from sensing_antenna.simulator.device import NANO17_FULL_SCALE
 from sensing_antenna.simulator.link import build_link_model
 
@@ -84,6 +86,7 @@ def test_neutral_values_of_each_imperfection_are_bit_identical() -> None:
         joint_density_factor=1.0,
         sensor_gain=(1.0,) * 6,  # type: ignore[arg-type]
         encoder_offset=(0.0, 0.0),
+        bow=(0.0, 0.0),
     )
     plain = simulate_detailed(antenna, scenario)
     other = simulate_detailed(antenna, dataclasses.replace(scenario, device=neutral))
@@ -406,6 +409,7 @@ def test_campaign_device_errors_name_the_field(device: dict[str, object], field:
         ({"sensor_gain": (1.0, 1.0)}, "sensor_gain"),
         ({"sensor_coupling": tuple((1.0,) * 6 for _ in range(6))}, "sensor_coupling"),
         ({"encoder_offset": (math.nan, 0.0)}, "encoder_offset"),
+        ({"bow": (0.2, 0.0)}, "bow"),
     ],
 )
 def test_bad_imperfection_names_its_field(kwargs: dict[str, object], field: str) -> None:
@@ -448,3 +452,83 @@ def test_a_joint_off_the_link_is_refused() -> None:
     scenario = Scenario(case="azimuthal", contact_point=0.5, device=device)
     with pytest.raises(DeviceError, match=r"device\.joint_start"):
         simulate(antenna, scenario)
+
+
+def test_a_bowed_links_rest_moment_about_its_axis_is_its_weight_aside() -> None:
+    # A link bowed sideways by d at the tip (the arc d (x / l)^2) hangs its weight beside the
+    # root's line: at rest, level, the torque about X^m is -g (rho l d / 3 + m_tip d) (the
+    # recorded torque's sign as in test_simulator_contact's statics); bowed up instead, none.
+    antenna = paper_antenna()
+    link = antenna.link
+    d = 0.02
+    scenario = Scenario(case="azimuthal", contact_point=0.6, seed=1, noise_scale=0.0)
+    side = simulate(antenna, dataclasses.replace(scenario, device=DeviceImperfections(bow=(d, 0))))
+    up = simulate(antenna, dataclasses.replace(scenario, device=DeviceImperfections(bow=(0, d))))
+    rest = slice(0, 100)  # before the sweep starts (the head still, the link at rest)
+    expected = -9.80665 * (link.linear_density * link.length / 3.0 + link.tip_mass) * d
+    assert side.torque[rest, 0].mean() == pytest.approx(expected, rel=1e-3)
+    assert abs(up.torque[rest, 0].mean()) < 1e-3 * abs(expected)
+
+
+@pytest.mark.parametrize("bow", [(0.02, 0.0), (0.0, -0.02)])
+def test_a_bowed_link_pushed_meets_the_obstacle_at_its_rest_shape(bow: tuple[float, float]) -> None:
+    # The link touches the obstacle where its rest shape puts it, deflects from that shape,
+    # and its recorded wrench is the contact's and the weight's about O from where the link is
+    # (rest shape and deflection), as for the straight link (test_simulator_contact).
+    antenna = paper_antenna()
+    x_c = 0.7
+    scenario = Scenario(
+        case="azimuthal",
+        contact_point=x_c,
+        noise_scale=0.0,
+        duration=3.5,
+        damping_ratio=0.1,
+        device=DeviceImperfections(bow=bow),
+    )
+    detail = simulate_detailed(antenna, scenario)
+    straight = simulate_detailed(
+        antenna, dataclasses.replace(scenario, device=DeviceImperfections())
+    )
+    rec = detail.recording
+    arc = np.array(bow) * (x_c / antenna.link.length) ** 2
+
+    def first_touch_point(run):  # type: ignore[no-untyped-def]
+        touch = int(np.flatnonzero(run.recording.extra["true_in_contact"] > 0.5)[0])
+        return motor_frame(*run.true_theta[touch]) @ run.contact_point[touch]
+
+    # at the first touch the link's point lies off the straight link's by its rest shape
+    moved = first_touch_point(detail) - first_touch_point(straight)
+    np.testing.assert_allclose(moved[1:], arc, atol=5e-5)
+    window = slice(-1000, None)
+    points = np.array(
+        [
+            motor_frame(*th) @ p
+            for th, p in zip(detail.true_theta, detail.contact_point, strict=True)
+        ]
+    )
+    moment = np.cross(points[window], detail.contact_force[window]).mean(axis=0)
+    model = detail.link_model
+    length = antenna.link.length
+    nodes = model.nodes
+    shape = np.zeros(2 * nodes.size)
+    shape[0::2], shape[1::2] = (nodes / length) ** 2, 2.0 * nodes / length**2
+    rest = shape[model.root_dofs :]
+    v_integral, _ = model.translation_load @ (detail.final_deflection.T + np.outer(rest, bow))
+    g_z = -9.80665 * math.cos(detail.true_theta[-1, 1])
+    weight = antenna.link.mass * 9.80665
+    # the straight, level link's weight moment is (0, m g l / 2, 0); the rest of it from v, w
+    expected = moment + np.array([g_z * v_integral, 0.5 * weight * length, 0.0])
+    np.testing.assert_allclose(rec.torque[window].mean(axis=0), expected, atol=2e-5)
+
+
+def test_a_bowed_link_is_simulated_on_the_linear_link_only() -> None:
+    scenario = Scenario(
+        case="azimuthal",
+        contact_point=0.6,
+        link_model="nonlinear",
+        device=DeviceImperfections(bow=(0.01, 0.0)),
+    )
+    with pytest.raises(
+        ScenarioError, match=r"device\.bow: a bowed link is simulated on the linear"
+    ):
+        simulate(paper_antenna(), scenario)

@@ -200,6 +200,7 @@ def _run_free_hub(n_el: int, step: float, n_samples: int) -> tuple[np.ndarray, l
         np.zeros((n_samples, TRUTH_COLUMNS)),
         model.element_rigidity,
         np.zeros(model.n_elements + 1),
+        np.zeros(2 * model.n_dof),
     )
     return out_theta, [e0, energy()]
 

@@ -435,6 +435,7 @@ def test_large_free_vibration_conserves_energy() -> None:
             np.zeros((600, TRUTH_COLUMNS)),
             model.element_rigidity,
             masses,
+            np.zeros(2 * n),
         )
         if k % 20 == 19:
             energies.append(_nonlinear_energy(model, masses, x, v))

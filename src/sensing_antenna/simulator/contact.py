@@ -356,6 +356,7 @@ def place_obstacle(
     tilt: float,
     sweep_joint: int,
     direction: int = 1,
+    lateral: tuple[float, float] = (0.0, 0.0),
 ) -> Obstacle:
     """Place an obstacle that the sagged link touches at ``contact_point`` at ``theta_touch``.
 
@@ -381,6 +382,9 @@ def place_obstacle(
         0 when theta1 sweeps (towards +Y^m), 1 when theta2 sweeps (towards +Z^m).
     direction : {1, -1}
         The sweep's sense: -1 turns the joint down, towards -Y^m or -Z^m.
+    lateral : (float, float)
+        A bowed link's rest shape along Y^m at x_c, its offset (m) and slope (the vertical
+        bow's part is in ``sag``). Default 0.
 
     Returns
     -------
@@ -390,8 +394,9 @@ def place_obstacle(
     xm, ym, zm = frame
     ahead = direction * (ym if sweep_joint == 0 else zm)
     aside = zm if sweep_joint == 0 else ym
-    p_touch = contact_point * xm + sag * zm
-    tangent = _unit(xm + sag_slope * zm)
+    # a bowed link's rest shape lies along Y^m by lateral[0], at the slope lateral[1]
+    p_touch = contact_point * xm + lateral[0] * ym + sag * zm
+    tangent = _unit(xm + lateral[1] * ym + sag_slope * zm)
     if kind == "plane":
         if not math.isclose(contact_point, length, rel_tol=1e-9):
             raise ScenarioError(

@@ -27,6 +27,7 @@ from sensing_antenna.errors import SensingAntennaError, format_value
 __all__ = [
     "DEVICE_PROFILES",
     "DEVICE_STREAM",
+    "MAX_BOW",
     "NANO17_FULL_SCALE",
     "DeviceError",
     "DeviceImperfections",
@@ -37,6 +38,10 @@ __all__ = [
 
 #: Names of the device profiles: the exact nominal device and the realistic spread.
 DEVICE_PROFILES = ("nominal", "realistic")
+
+#: Largest tip offset of a bowed link's rest shape (m, ``DeviceImperfections.bow``): the
+#: linear link's small slopes.
+MAX_BOW = 0.1
 
 #: Spawn key that separates the device's random draws (its realistic profile, the sensor's
 #: random-walk drift) from the scenario's noise stream of the same seed.
@@ -114,6 +119,10 @@ class DeviceImperfections:
     encoder_offset : tuple of 2 float
         Constant added to the recorded theta1 and theta2 (rad): the encoders' zero is off the
         head's geometric zero. Default 0.
+    bow : tuple of 2 float
+        The unloaded link's tip offset from its root's line along Y^m and Z^m (m), a circular
+        arc d (x / l)^2 (a link not quite straight): its rest shape, from which it deflects.
+        Linear link only. Default 0: straight.
 
     Notes
     -----
@@ -135,6 +144,7 @@ class DeviceImperfections:
     sensor_drift_rate: _SIX = _ZERO6
     sensor_drift_walk: _SIX = _ZERO6
     encoder_offset: tuple[float, float] = (0.0, 0.0)
+    bow: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -178,6 +188,9 @@ class DeviceImperfections:
             )
         set_(self, "sensor_coupling", coupling)
         set_(self, "encoder_offset", _vector("encoder_offset", self.encoder_offset, 2))
+        set_(self, "bow", _vector("bow", self.bow, 2))
+        if max(abs(v) for v in self.bow) > MAX_BOW:
+            raise DeviceError("bow", f"must be within +-{MAX_BOW:g} m, got {self.bow!r}")
 
     @property
     def is_nominal(self) -> bool:
@@ -266,8 +279,11 @@ class DeviceImperfections:
         return stiffness, density
 
     def to_json_dict(self) -> dict[str, Any]:
-        """Every field as JSON-compatible values (tuples as lists)."""
+        """Every field as JSON-compatible values (tuples as lists); ``bow`` only when the link
+        has one (a straight link's metadata as it has always been written)."""
         data = asdict(self)
+        if not any(self.bow):
+            del data["bow"]
         return {
             key: [list(v) if isinstance(v, tuple) else v for v in value]
             if isinstance(value, tuple)

@@ -559,8 +559,13 @@ def sensor_wrench(
     cs: NDArray[np.float64],
     out: NDArray[np.float64],
     axial_sums: NDArray[np.float64],
+    rest: NDArray[np.float64],
 ) -> None:
     """Wrench by the link on the head about O, motor frame: out = [F (3), torque (3)].
+
+    ``rest`` = [q_v0, q_w0], a bowed link's rest shape (zeros for a straight link), from
+    which the link deflects: its points lie at the rest shape plus the deflection, the arm of
+    their weight and inertia.
 
     ``axial_sums`` = (sum m_i u_i, sum m_i u_i'') of the nonlinear link's axial motion (kg m,
     N; zeros for the linear link): the weight's arm along X^m shrinks by the first, the second
@@ -597,8 +602,8 @@ def sensor_wrench(
     maw = mq @ A[n : 2 * n]
     sav = sq @ A[0:n]
     saw = sq @ A[n : 2 * n]
-    mv = mq @ X[0:n]
-    mw = mq @ X[n : 2 * n]
+    mv = mq @ X[0:n] + mq @ rest[0:n]
+    mw = mq @ X[n : 2 * n] + mq @ rest[n : 2 * n]
     # int rho (v a_z - w a_y) dx about X^m: q_v.M q_w'' - q_w.M q_v'' over M's band (no
     # temporaries), plus the rigid accelerations' part
     spin = 0.0
@@ -608,7 +613,7 @@ def sensor_wrench(
         for j in range(max(i - _MASS_BAND, 0), min(i + _MASS_BAND + 1, n)):
             row_w += mass_m[i, j] * A[n + j]
             row_v += mass_m[i, j] * A[j]
-        spin += X[i] * row_w - X[n + i] * row_v
+        spin += (X[i] + rest[i]) * row_w - (X[n + i] + rest[n + i]) * row_v
     fcx = cs[_FORCE_M]
     fcy = cs[_FORCE_M + 1]
     fcz = cs[_FORCE_M + 2]
@@ -656,6 +661,7 @@ def run_samples(
     truth: NDArray[np.float64],
     rigidity: NDArray[np.float64],
     node_mass: NDArray[np.float64],
+    rest: NDArray[np.float64],
 ) -> None:
     """Advance samples k0..k1-1: sense at t_k, command the motors, integrate to t_{k+1}.
 
@@ -671,6 +677,10 @@ def run_samples(
     :mod:`~sensing_antenna.simulator.nonlinear_link`, with E I of each element ``rigidity``
     (n_el,) and the axial masses ``node_mass`` (n_el + 1,); each step is then iterated on its
     extra forces (fixed point with the linear step's matrix) to ``ITERATION_TOLERANCE``.
+
+    ``rest`` (2 n,) is the linear link's rest shape (a bow; zeros for a straight link): the
+    elastic forces act on the coordinates, the deflection from it, while the contact, the
+    weight and the inertial moments see the link where it is, at the rest shape plus them.
     """
     n = mass_m.shape[0]
     nn = 2 * n + 2
@@ -698,6 +708,7 @@ def run_samples(
     v_iter = np.zeros(nn)
     a_iter = np.zeros(nn)
     rhs_iter = np.zeros(nn)
+    placed = np.zeros(nn)  # the link's coordinates where it is (rest shape and deflection)
     wn = np.empty(4)
     wd = np.empty(4)
     un = np.zeros(nn)
@@ -722,7 +733,7 @@ def run_samples(
             for i in range(n_el + 1):
                 axial_sums[0] += node_mass[i] * axial1[i, 0]
                 axial_sums[1] += node_mass[i] * axial1[i, 1]
-        sensor_wrench(X, A, n, mass_m, mq, sq, par, cs, wrench, axial_sums)
+        sensor_wrench(X, A, n, mass_m, mq, sq, par, cs, wrench, axial_sums, rest)
         for i in range(6):
             meas_wrench[k, i] = wrench[i] + bias[i] + noise[k, i]
         quantum = par[_P_ENCODER]
@@ -792,7 +803,7 @@ def run_samples(
             rw = rw - g * c2 * mq
             rhs[0:n] = rv
             rhs[n : 2 * n] = rw
-            mw = mq @ X[n : 2 * n]
+            mw = mq @ X[n : 2 * n] + mq @ rest[n : 2 * n]
             rhs[2 * n] = (
                 c2 * (sq @ acoef[0:n])
                 + j1 * acoef[2 * n]
@@ -838,12 +849,28 @@ def run_samples(
             dth1 = np.zeros(3)
             dth2 = np.zeros(3)
             if obst[0] > 0.0:
+                # where the link is: its rest shape plus its deflection
+                for i in range(nn):
+                    placed[i] = X[i]
+                for i in range(2 * n):
+                    placed[i] += rest[i]
                 xc, g0 = _closest(
-                    X, n, n_el, h_el, fr, obst, par[_P_X_MIN], length, wn, wd, axial0, nonlinear
+                    placed,
+                    n,
+                    n_el,
+                    h_el,
+                    fr,
+                    obst,
+                    par[_P_X_MIN],
+                    length,
+                    wn,
+                    wd,
+                    axial0,
+                    nonlinear,
                 )
                 e = _shape(xc, n_el, h_el, wn, wd)
-                v_c, dv_c = _interp(X[0:n], e, wn, wd, drop)
-                w_c, dw_c = _interp(X[n : 2 * n], e, wn, wd, drop)
+                v_c, dv_c = _interp(placed[0:n], e, wn, wd, drop)
+                w_c, dw_c = _interp(placed[n : 2 * n], e, wn, wd, drop)
                 x_axis = xc
                 if nonlinear:
                     u_c = shortening_at(xc, X, n, n_el, h_el, axial0)
@@ -1034,6 +1061,10 @@ def run_samples(
                     dp[i] = dth1[i] * dx[2 * n] + dth2[i] * dx[2 * n + 1]
                 v_new, _ = _interp(x_new[0:n], e, wn, wd, drop)
                 w_new, _ = _interp(x_new[n : 2 * n], e, wn, wd, drop)
+                v_rest, _ = _interp(rest[0:n], e, wn, wd, drop)
+                w_rest, _ = _interp(rest[n : 2 * n], e, wn, wd, drop)
+                v_new += v_rest
+                w_new += w_rest
                 for i in range(3):
                     dp[i] += (v_new - v_c) * fr[1, i] + (w_new - w_c) * fr[2, i]
                 if nonlinear:

@@ -205,14 +205,29 @@ def minimum_contact_point(link: Link, contact_stiffness: float) -> float:
     return float(ratio ** (1.0 / 3.0))
 
 
+def rest_shape(model: LinkModel, bow: tuple[float, float]) -> NDArray[np.float64]:
+    """The unloaded link's rest shape as the linear link's coordinates [q_v, q_w], shape
+    (2 n_dof,): the arcs v0 = d_y (x / l)^2 along Y^m and w0 = d_z (x / l)^2 along Z^m of tip
+    offsets ``bow`` (m), exact in the Hermite elements (values and slopes at the nodes)."""
+    nodes = model.nodes
+    length = float(nodes[-1])
+    values = np.zeros(2 * nodes.size)
+    values[0::2] = (nodes / length) ** 2
+    values[1::2] = 2.0 * nodes / length**2
+    free = values[model.root_dofs :]
+    return np.concatenate([bow[0] * free, bow[1] * free])
+
+
 def _contact_deflection(
     link: Link,
     n_elements: int,
     truth: NDArray[np.float64],
     gravity: float,
     device: DeviceImperfections | None = None,
+    bow: tuple[float, float] = (0.0, 0.0),
 ) -> NDArray[np.float64]:
-    """|(v, w - w_g)| at the contact point of each sample (m), NaN without contact."""
+    """|(v - v0, w - w0 - w_g)| at the contact point of each sample (m), from the link's rest
+    shape (a ``bow``'s arcs v0, w0) and its sag w_g; NaN without contact."""
     theta1, theta2 = truth[:, 0], truth[:, 1]
     c1, s1, c2, s2 = np.cos(theta1), np.sin(theta1), np.cos(theta2), np.sin(theta2)
     point = truth[:, 4:7]
@@ -221,7 +236,8 @@ def _contact_deflection(
     w = -s2 * c1 * point[:, 0] - s2 * s1 * point[:, 1] + c2 * point[:, 2]
     grid, unit = _unit_sag(link, n_elements, device)
     sag = gravity * c2 * np.interp(truth[:, 3], grid, unit)
-    deflection = np.hypot(v, w - sag)
+    arc = (truth[:, 3] / link.length) ** 2
+    deflection = np.hypot(v - bow[0] * arc, w - bow[1] * arc - sag)
     return np.where(truth[:, 2] > 0.5, deflection, np.nan)
 
 
@@ -365,6 +381,10 @@ def simulate_detailed(
     step = ts / scenario.substeps
     damping, ainv, z = _effective_inverse(link, scenario.n_elements, step, alpha, beta, imperfect)
     n = model.n_dof
+    bow = scenario.device.bow
+    if any(bow) and scenario.link_model == "nonlinear":
+        raise ScenarioError("device.bow", "a bowed link is simulated on the linear link only")
+    rest = rest_shape(model, bow)  # the link's position is its rest shape and its deflection
 
     # --- reference trajectory (Section 4 step 1) -----------------------------------------------
     sweep_joint = scenario.swept_joint
@@ -429,6 +449,10 @@ def simulate_detailed(
         )
         sag = float(model.shape_at(scenario.contact_point) @ q_sag)
         sag_slope = float(model.slope_at(scenario.contact_point) @ q_sag)
+        # a bowed link touches where its rest shape puts it: its arc w0 beside the sag, v0 aside
+        arc = (scenario.contact_point / link.length) ** 2
+        arc_slope = 2.0 * scenario.contact_point / link.length**2
+        sag, sag_slope = sag + bow[1] * arc, sag_slope + bow[1] * arc_slope
         placement = (
             None if scenario.obstacle_placement is None else np.asarray(scenario.obstacle_placement)
         )
@@ -457,6 +481,7 @@ def simulate_detailed(
                 scenario.obstacle_tilt,
                 sweep_joint,
                 scenario.sweep_direction,
+                lateral=(bow[0] * arc, bow[0] * arc_slope),
             )
         obst_array = obstacle.as_array()
 
@@ -536,6 +561,7 @@ def simulate_detailed(
             truth,
             model.element_rigidity,
             lumped,
+            rest,
         )
         if record is not None:
             record(k0, k1)
@@ -585,7 +611,7 @@ def simulate_detailed(
             " 50 % of x_c), where its step no longer converges; push less deep",
         )
     in_contact = truth[:, 2] > 0.5
-    deflection = _contact_deflection(link, scenario.n_elements, truth, gravity, imperfect)
+    deflection = _contact_deflection(link, scenario.n_elements, truth, gravity, imperfect, bow)
     final = max(1, round(FINAL_AVERAGE_TIME / ts))
     first_touch = float(cs[12]) if cs[12] >= 0 else None
     metadata: dict[str, str] = {
