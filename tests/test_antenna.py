@@ -101,6 +101,8 @@ def test_toml_override_with_base(tmp_path: Path) -> None:
         ("[link]\nmode2_scatter = -0.001\n", "link.mode2_scatter"),
         ('[link]\nmode2_scatter = "x"\n', "link.mode2_scatter"),
         ("[link]\nmode2_scatter = 2.0\n", "link.mode2_scatter"),
+        ("[link]\nbow_std = -0.001\n", "link.bow_std"),
+        ("[link]\nbow_std = 2.0\n", "link.bow_std"),
         ("[link]\ncolour = 3.0\n", "link.colour"),
         ("[motor]\ninertia = 1.0\n", "motor"),
         ("[azimuth_motor]\ninertia = -1.0\n", "azimuth_motor.inertia"),

@@ -5,12 +5,13 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
-from sensing_antenna.antenna import STANDARD_GRAVITY, load_antenna
+from sensing_antenna.antenna import STANDARD_GRAVITY, load_antenna, paper_antenna
 from sensing_antenna.errors import FieldError
 from sensing_antenna.estimation import estimate
 from sensing_antenna.estimation.result import ContactEstimate, Status
@@ -19,10 +20,12 @@ from sensing_antenna.mapping import (
     PointUncertainty,
     base_pose_from_metadata,
     contact_point_from_estimate,
+    points_from_recordings,
     select_points,
 )
 from sensing_antenna.mapping.pose import quaternion_order_hint
-from sensing_antenna.simulator import Scenario, simulate
+from sensing_antenna.recording import write_recording
+from sensing_antenna.simulator import DeviceImperfections, Scenario, simulate
 
 ANTENNA = load_antenna("paper-2021")
 
@@ -411,3 +414,41 @@ def test_a_point_metres_from_the_others_is_named_as_isolated() -> None:
     wide = [dataclasses.replace(p, point=10.0 * np.asarray(p.point)) for p in points[:-1]]
     off = dataclasses.replace(points[0], point=np.array([6.0, -1.5, 0.0]), source="off.csv")
     assert isolated_points([*wide, off], 0.98) == []
+
+
+def test_a_bowed_link_moves_the_point_by_its_arc_which_bow_std_covers(
+    tmp_path: Path,
+) -> None:
+    # The device's link is bowed 2 cm at the tip, across the vertical sweep's push; the model's
+    # is straight. x_c reads as on the straight link (within 1 mm: the frequencies and the
+    # ratio hardly change), and so does the estimated point, but the touched point moves with
+    # the link, by the arc d (x_c / l)^2 (1.7 cm at 0.9 m) across it: far outside the
+    # covariance of a straight link, within it once the antenna states the bow's spread
+    # (link.bow_std).
+    device = paper_antenna()
+    model = device.self_calibrated()
+    told = dataclasses.replace(model, link=dataclasses.replace(model.link, bow_std=0.02))
+    x_c, bow = 0.9, 0.02
+    paths = []
+    for name, shape in (("straight", (0.0, 0.0)), ("bowed", (bow, 0.0))):
+        scenario = Scenario(
+            case="vertical", contact_point=x_c, seed=11, device=DeviceImperfections(bow=shape)
+        )
+        paths.append(tmp_path / f"{name}.csv")
+        write_recording(simulate(device, scenario), paths[-1])
+    straight, bowed = points_from_recordings(paths, model, "paper")
+    assert straight.status == bowed.status == Status.OK
+    assert bowed.x_c == pytest.approx(straight.x_c, abs=1e-3)
+    arc = bow * (x_c / device.link.length) ** 2
+    moved = bowed.true_point - straight.true_point
+    assert moved[1] == pytest.approx(arc, abs=1e-3)
+    # the estimate, on its straight link, stays where it was
+    assert np.linalg.norm(bowed.point - straight.point) < 1e-3
+
+    def deviations(point: Any) -> float:
+        error = point.point - point.true_point
+        return math.sqrt(float(error @ np.linalg.solve(point.covariance, error)))
+
+    assert deviations(bowed) > 10.0
+    [covered] = points_from_recordings(paths[1:], told, "paper")
+    assert deviations(covered) < 3.0

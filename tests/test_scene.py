@@ -30,7 +30,7 @@ from sensing_antenna.scene import (
     simulate_sweep,
 )
 from sensing_antenna.scene.file import ExploreRegion
-from sensing_antenna.simulator import Scenario, simulate_detailed
+from sensing_antenna.simulator import DeviceImperfections, Scenario, simulate_detailed
 
 DEVICE = paper_antenna()
 BALL = '[[objects]]\nshape = "sphere"\nradius = 0.1\nposition = [0, 0, 0]\n'
@@ -792,8 +792,6 @@ def test_the_sag_carries_a_built_devices_tip_mass_and_clamp() -> None:
     # Euler-Bernoulli in closed form: a tip load P adds P x^2 (3 l - x) / (6 E I) to the sag,
     # a root spring k turns the whole link by its moment M = (rho l / 2 + m_t) g l over k,
     # adding M x / k. The Hermite elements are exact for both (cubic and linear in x).
-    from sensing_antenna.simulator import DeviceImperfections
-
     link = DEVICE.link
     mass, spring, g = 0.5e-3, 30.0, 9.80665
     nominal = LinkShape(link, gravity=g)
@@ -898,3 +896,14 @@ def test_a_tip_pushed_across_a_slanted_face_stays_on_it(as_mesh: bool) -> None:
     track = np.column_stack([recording.extra[name] for name in CONTACT_POINT_COLUMNS])
     on_world = outcome.frame.point_to_world(track[touching])
     assert np.abs(box.signed_distance(on_world)).max() < 1e-4
+
+
+def test_a_bowed_link_is_refused_in_a_scene() -> None:
+    # the scene's link shape is straight: a bowed device's touch would not be where it is found
+    with pytest.raises(ValueError, match="a bowed link"):
+        simulate_sweep(
+            DEVICE,
+            load_scene("post"),
+            Sweep(0, "azimuthal", 0.0, -0.3, 0.3),
+            imperfections=DeviceImperfections(bow=(0.01, 0.0)),
+        )

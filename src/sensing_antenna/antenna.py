@@ -263,6 +263,12 @@ class Link:
         frequencies (it also takes up a taper or a joint, so it is an effective mass) keeps the
         weight the sensor read here. The weight, its moment and the sag use it; None:
         ``tip_mass``.
+    bow_std : float or None
+        Standard deviation (m) of the unloaded link's tip offset from its root's line in each
+        direction across it: a link not quite straight, bowed by an amount not measured. The
+        model's link is straight; a bow d at the tip moves the touched point by about
+        d (x_c / l)^2 across the link, which the map's points then carry in their covariance
+        (docs/mapping.md). None: straight.
     """
 
     length: float
@@ -275,6 +281,7 @@ class Link:
     calibration_scatter: float | None = None
     mode2_scatter: float | None = None
     weight_tip_mass: float | None = None
+    bow_std: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("length", "radius", "youngs_modulus", "linear_density"):
@@ -287,9 +294,15 @@ class Link:
             _require_positive("link", "second_moment", self.second_moment)
         if self.calibrated_t is not None:
             _require_positive("link", "calibrated_t", self.calibrated_t)
-        for name in ("calibration_scatter", "mode2_scatter"):
+        for name in ("calibration_scatter", "mode2_scatter", "bow_std"):
             if getattr(self, name) is not None:
                 _require_non_negative("link", name, getattr(self, name))
+        if self.bow_std is not None and not self.bow_std <= 0.1 * self.length:
+            raise AntennaConfigError(
+                "link.bow_std",
+                f"must be at most a tenth of the link's length ({0.1 * self.length:g} m: a"
+                f" small bow, in m), got {format_value(self.bow_std)}",
+            )
         for name in ("length", "radius", "youngs_modulus", "tip_mass", "second_moment"):
             value = getattr(self, name)
             if value is not None:

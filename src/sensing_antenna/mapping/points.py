@@ -40,9 +40,15 @@ the link's thickness
     variance r^2 / 2 in each of the two directions across the link, as for an offset in an
     unknown direction, covers both.
 
+the link's straightness
+    the model's link is straight; a real one may be bowed (its unloaded tip off its root's line
+    by d), which moves the contact by the arc d (x_c / l)^2 across the link. With the antenna's
+    ``link.bow_std`` (the tip offset's standard deviation in each direction across the link),
+    (bow_std (x_c / l)^2)^2 in each direction across it.
+
 Sigma_a = sigma_x^2 J_x J_x^T + sum_i q_i^2 / 12 J_i J_i^T + rho^2 (J_d J_d^T + s^2 A A^T)
-+ r^2 / 2 (I - X^m X^mT), J_d = y_c Y^c - 2 delta X^m, and in the world Sigma_w = R Sigma_a R^T
-with the base pose's rotation R.
++ (r^2 / 2 + b^2) (I - X^m X^mT), J_d = y_c Y^c - 2 delta X^m, b = bow_std (x_c / l)^2, and in
+the world Sigma_w = R Sigma_a R^T with the base pose's rotation R.
 
 The link's tangent at the contact, t ~ X^m + (3 y_c / (2 x_c)) Y^c + (ds/dx_c) A (the end slope
 of a cantilever of length x_c loaded at its end, y' = 3 y_c / (2 x_c), and the sag's slope),
@@ -404,8 +410,12 @@ def _covariance(
         # direction unknown: rho y_c in every direction, plus the sag's rho s
         covariance += rho2 * deflection**2 * np.eye(3)
         covariance += rho2 * sag**2 * np.outer(sag_axis, sag_axis)
+    across = np.eye(3) - np.outer(x_m, x_m)
     # the link's thickness: r^2 / 2 in each direction across the link
-    covariance += 0.5 * link.radius**2 * (np.eye(3) - np.outer(x_m, x_m))
+    covariance += 0.5 * link.radius**2 * across
+    # a bow the model does not hold: its arc d (x_c / l)^2 in each direction across the link
+    if link.bow_std:
+        covariance += (link.bow_std * (x_c / link.length) ** 2) ** 2 * across
     return np.asarray(0.5 * (covariance + covariance.T))
 
 

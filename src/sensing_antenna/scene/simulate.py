@@ -331,9 +331,15 @@ def simulate_sweep(
     ------
     ValueError
         ``shape`` is another link's (its radius or length not the device's, or its build not
-        ``imperfections``'): the geometric touch and the simulated one would not meet.
+        ``imperfections``'), or ``imperfections`` bow the link: the geometric touch and the
+        simulated one would not meet.
     """
     shape = shape if shape is not None else LinkShape(device.link, device=imperfections)
+    if imperfections is not None and any(imperfections.bow):
+        raise ValueError(
+            "simulate_sweep: a bowed link (imperfections.bow) is not simulated in scenes: the"
+            " scene's link shape is straight, and the geometric touch would miss the simulated one"
+        )
     if imperfections is not None:
         scenario_fields["device"] = imperfections
     built = None if shape.device is None else shape.device.link_part
