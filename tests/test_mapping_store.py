@@ -164,3 +164,5 @@ def test_a_named_mesh_says_what_of_it_the_points_do_not_hold(tmp_path: Path) -> 
     report = (tmp_path / "report.md").read_text()
     assert "The box class fits the same points with" in report and "at least" in report
     assert "the mesh is one such box, and the points hold no more of its size than that" in report
+    # a user's mesh is the object's own shape, not its hull's class
+    assert "convex hull" not in report

@@ -152,6 +152,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares, minimize_scalar
 from scipy.spatial.transform import Rotation
 from scipy.stats import binom
+from scipy.stats import chi2 as chi2_distribution
 from scipy.stats import f as f_distribution
 
 from sensing_antenna.mapping.free_space import FreeSpace
@@ -191,6 +192,11 @@ FloatArray = NDArray[np.float64]
 #: Section 3.2) put "strong" evidence (a factor of 20, a posterior of about 95 % for the better
 #: of two under equal priors).
 ABSTAIN_DELTA = 6.0
+
+#: The chance below which points scattered as their covariances say would lie as far from the
+#: best-fitting class as they do (its chi^2 against the chi^2 distribution of its degrees of
+#: freedom): no class fits them, and none is named (:attr:`Recognition.fit_chance`).
+FIT_CHANCE = 1e-3
 
 #: Two fitted shapes farther apart than this many of the points' median standard deviations
 #: (along the normal) somewhere are different objects: points there would have told them apart.
@@ -556,6 +562,10 @@ class ClassFit:
         (more likely wrong estimates than points of this shape).
     wrong : tuple of int
         Which: their indices among the points fitted, farthest first.
+    wrong_chi2 : float
+        Their part of :attr:`chi2` (each near its cap).
+    wrong_measurements : float
+        Their part of :attr:`measurements`.
     n_crossed : int
         Swept links the fit contradicts beyond their :func:`outlier_cap`: a link that swept
         untouched through the fitted shape, or one that touched nowhere near it. Such a fit is
@@ -588,6 +598,8 @@ class ClassFit:
     measurements: float = math.nan
     n_wrong: int = 0
     wrong: tuple[int, ...] = ()
+    wrong_chi2: float = 0.0
+    wrong_measurements: float = 0.0
     n_crossed: int = 0
     free_ends: tuple[FloatArray, ...] = field(default=(), compare=False, repr=False)
 
@@ -713,6 +725,11 @@ class Recognition:
         The abstention threshold used.
     overdispersion : float
         c, the reduced chi^2 of the best-fitting class when above 1 (else 1).
+    fit_chance : float
+        The chance that points of the best-fitting class, scattered as their covariances say
+        and wrong as often as estimates are, lie as far from it as these do (:func:`_fit_chance`:
+        the chi^2 of the points it takes, and with them the count it takes as wrong): below
+        :data:`FIT_CHANCE` no class fits them and none is named.
     rival : str or None
         A class the points do not rule out that is a different shape from the best's.
     same_shape : tuple of str
@@ -729,6 +746,7 @@ class Recognition:
     confidence: float
     threshold: float
     overdispersion: float = 1.0
+    fit_chance: float = 1.0
     rival: str | None = None
     same_shape: tuple[str, ...] = ()
     runner_up: str | None = None
@@ -762,11 +780,26 @@ class Recognition:
             "confidence": float(self.confidence),
             "abstain_delta": float(self.threshold),
             "overdispersion": float(self.overdispersion),
+            "fit_chance": float(self.fit_chance),
             "rival": self.rival,
             "same_shape": list(self.same_shape),
             "runner_up": self.runner_up,
             "fits": [f.to_dict() for f in self.fits],
         }
+
+
+def _fit_chance(fit: ClassFit) -> float:
+    """The chance that points of ``fit``'s shape, scattered as their covariances say and wrong
+    with :data:`OUTLIER_FRACTION`, lie as far from it as these do (:attr:`Recognition.fit_chance`):
+    the smaller of the tail of the chi^2 of the points it takes (those it counts wrong aside)
+    and that tail combined with the chance of as many wrong (:attr:`ClassFit.wrong_chance`) by
+    Fisher's method (-2 ln of their product, chi^2 with 4 degrees of freedom): a few points
+    off a shape that fits the rest, each of which wrong estimates could make, are as telling
+    together as far as they lie."""
+    taken = max(fit.counted - fit.wrong_measurements - fit.dof, 1.0)
+    fitted = float(chi2_distribution.sf(fit.chi2 - fit.wrong_chi2, taken))
+    product = max(fitted, 1e-300) * max(fit.wrong_chance, 1e-300)
+    return min(fitted, float(chi2_distribution.sf(-2.0 * math.log(product), 4)))
 
 
 def _normal_sigma(covariances: FloatArray, normals: FloatArray) -> FloatArray:
@@ -2018,6 +2051,8 @@ def _scored(
         mesh=mesh,
         n_wrong=int(np.sum(wrong)),
         wrong=tuple(int(k) for k in np.flatnonzero(wrong)[np.argsort(-z2[wrong])]),
+        wrong_chi2=float(np.sum(parts[wrong])),
+        wrong_measurements=float(np.sum(1.0 + share[wrong])),
         n_crossed=int(np.sum(crossed)),
     )
 
@@ -2232,6 +2267,7 @@ def recognise(
     # overdispersion: the best-fitting class's reduced chi^2 when above 1
     tightest = min(fits, key=lambda f: f.chi2)
     c = max(1.0, tightest.chi2 / max(tightest.counted - tightest.dof, 1.0))
+    fit_chance = _fit_chance(tightest)
     n_log = math.log(len(p))
     # the sizes' standard deviations widened by the same overdispersion
     fits = [
@@ -2312,7 +2348,10 @@ def recognise(
     # a swept link through the best shape, or a touching one far from it, refutes it as the
     # object's whole shape whatever the other classes score
     whole = best.n_crossed == 0
-    decision = best.name if delta >= threshold and rival is None and sure and whole else UNDECIDED
+    # and points farther from every class than their deviations allow are of none of them
+    fits_points = fit_chance >= FIT_CHANCE
+    named = delta >= threshold and rival is None and sure and whole and fits_points
+    decision = best.name if named else UNDECIDED
     leaders = (best, rival) if rival is not None else (best, *others[:1])
     return Recognition(
         decision=decision,
@@ -2322,6 +2361,7 @@ def recognise(
         confidence=confidence,
         threshold=threshold,
         overdispersion=float(c),
+        fit_chance=fit_chance,
         rival=None if rival is None else rival.name,
         same_shape=tuple(f.name for f in same),
         runner_up=others[0].name if others else None,

@@ -31,7 +31,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.mapping.contact_map import UNHELD_FRACTION, ContactMap, ObjectSurface
-from sensing_antenna.mapping.recognition import PRIMITIVES
+from sensing_antenna.mapping.recognition import FIT_CHANCE, PRIMITIVES
 
 __all__ = ["POINT_COLUMNS", "std_colours", "write_map"]
 
@@ -193,15 +193,32 @@ OVERDISPERSED = 4.0
 
 
 def overdispersed(recognition: Any) -> str:
-    """What an overdispersion beyond :data:`OVERDISPERSED` says, or ""."""
+    """What points farther from every class than their covariances allow say: when chance
+    makes that spread less often than :data:`~.recognition.FIT_CHANCE` (recognition then names
+    no class), or the overdispersion is beyond :data:`OVERDISPERSED`; else ""."""
     c = float(recognition.overdispersion)
-    if not c > OVERDISPERSED:
+    chance = float(recognition.fit_chance)
+    refused = chance < FIT_CHANCE
+    if not (refused or c > OVERDISPERSED):
         return ""
-    return (
+    far = (
         f"the points lie {math.sqrt(c):.1f} times farther from the best-fitting class than"
-        " their deviations say: the object is none of the classes, or points are misplaced"
-        " (a base pose, a calibration)"
+        " their deviations say"
     )
+    if refused:
+        far += f", which chance makes in {_odds(chance, 'set of points')}, so no class is named"
+    return (
+        f"{far}: the object is none of the classes, or points are misplaced (a base pose, a"
+        " calibration)"
+    )
+
+
+def _odds(chance: float, what: str) -> str:
+    """``chance`` in words: "one <what> in N" (two figures), or "fewer than one <what> in a
+    million"."""
+    if chance < 1e-6:
+        return f"fewer than one {what} in a million"
+    return f"one {what} in {round(1 / chance, -int(math.log10(1 / chance)) + 1):,.0f}"
 
 
 #: The chance (:attr:`ClassFit.wrong_chance`) below which the points the best class's fit counts
@@ -216,11 +233,7 @@ def unexplained(recognition: Any) -> str:
     chance = best.wrong_chance
     if not chance < WRONG_CHANCE:
         return ""
-    odds = (
-        "fewer than one map in a million"
-        if chance < 1e-6
-        else f"one map in {round(1 / chance, -int(math.log10(1 / chance)) + 1):,.0f}"
-    )
+    odds = _odds(chance, "map")
     return (
         f"{best.n_wrong} of {best.n_points} points lie farther from the"
         f" {best.name.replace('mesh:', 'mesh ')} than its"
@@ -429,7 +442,12 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
             )
             + ".",
             *(f"{text[:1].upper()}{text[1:]}." for text in recognition_warnings(recognition)),
-            *(() if recognition.undecided else (HULL_NOTE,)),
+            # a user's mesh is the object's own shape, concave parts and all
+            *(
+                ()
+                if recognition.undecided or recognition.best.name.startswith("mesh:")
+                else (HULL_NOTE,)
+            ),
             *_member_note(recognition),
             *_counted_wrong(contact_map),
             "",
