@@ -969,3 +969,23 @@ def test_the_library_explores_with_the_commands_defaults() -> None:
         args.seed,
     )
     assert (settings.link, settings.device_profile) == (args.link, args.device_profile)
+
+
+def test_a_base_tilted_off_level_is_warned_of(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the simulated gravity acts along the base's -Z: a base rolled by 33 degrees is said so; a
+    # level one turned about Z is not (the ball out of reach: every sweep free, quickly)
+    scene = tmp_path / "tilted.toml"
+    ball = '[[objects]]\nshape = "sphere"\nradius = 0.05\nposition = [2.0, 0, 0]\n'
+    scene.write_text(ball + "[[bases]]\nquaternion = [0.9578, 0.2873, 0, 0]\n")
+    arguments = ["explore", str(scene), "--out", str(tmp_path / "a"), "--budget", "1"]
+    assert main([*arguments, "--no-progress"]) == 0
+    assert (
+        "antenna explore: warning: base 0 is tilted 33.4 deg off level: the simulated gravity"
+        " tilts with it" in capsys.readouterr().err
+    )
+    scene.write_text(ball + "[[bases]]\nyaw = 1.0\n")
+    arguments[3] = str(tmp_path / "b")
+    assert main([*arguments, "--no-progress"]) == 0
+    assert "off level" not in capsys.readouterr().err

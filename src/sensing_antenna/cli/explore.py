@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -19,6 +20,10 @@ BUILTIN_SCENES = ("post", "sphere", "box", "cylinder")
 DEVICE_PROFILES = ("nominal", "realistic")
 #: ``exploration.run.DEFAULT_BUILD``, written out for the same reason.
 DEFAULT_BUILD = 2021
+
+#: A base tilted further off level than this (degrees) is warned of: the simulated gravity acts
+#: along the base's -Z.
+LEVEL_TOLERANCE_DEG = 0.1
 
 
 def register(subparsers: Any) -> None:
@@ -200,6 +205,17 @@ def _run(args: argparse.Namespace) -> int:
             f" sweep will be free{unit}",
             file=sys.stderr,
         )
+
+    for index, base in enumerate(scene.bases):
+        # the simulated gravity acts along the base's -Z: a tilted base tilts it (docs/explore.md)
+        tilt = math.degrees(math.acos(min(1.0, max(-1.0, float(base.rotation[2, 2])))))
+        if tilt > LEVEL_TOLERANCE_DEG:
+            print(
+                f"antenna explore: warning: base {index} is tilted {tilt:.1f} deg off level: the"
+                ' simulated gravity tilts with it (docs/explore.md, "Scenes"); keep bases level'
+                " and raise or lower them instead",
+                file=sys.stderr,
+            )
 
     def resuming(stored: int) -> None:
         beyond = args.budget is not None and stored > args.budget
