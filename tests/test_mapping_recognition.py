@@ -1157,3 +1157,17 @@ def test_a_truncated_cone_with_its_top_is_not_named() -> None:
     assert result.best.name == "cone"
     assert result.fit_chance < recognition.FIT_CHANCE
     assert result.decision == UNDECIDED
+
+
+def test_many_points_a_little_noisier_than_their_covariances_still_name_their_class() -> None:
+    # 120 points of a ball whose errors are 1.3 times the deviations their covariances state
+    # (an overdispersion of about 1.7): the chi^2 of so many is far in its tail, but a spread
+    # within FIT_OVERDISPERSION is the covariances' shortfall, not another shape: named
+    mesh, rng = _placed("sphere")
+    points, _ = trimesh.sample.sample_surface(mesh, 120, seed=int(rng.integers(2**31)))
+    points = points + rng.normal(0.0, 1.3 * NOISE, points.shape)
+    covariances = np.tile(np.eye(3) * NOISE**2, (120, 1, 1))
+    result = recognise(points, covariances, rng=np.random.default_rng(0))
+    assert result.fit_chance < recognition.FIT_CHANCE
+    assert result.overdispersion < recognition.FIT_OVERDISPERSION
+    assert not result.none_fits and result.decision == "sphere"

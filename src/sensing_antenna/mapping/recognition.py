@@ -198,6 +198,12 @@ ABSTAIN_DELTA = 6.0
 #: freedom): no class fits them, and none is named (:attr:`Recognition.fit_chance`).
 FIT_CHANCE = 1e-3
 
+#: The overdispersion up to which points are taken to be of the best-fitting class whatever
+#: their chi^2 says: their covariances may be narrower than their errors by this much (the
+#: realistic device's right answers reach 2), and with many points any such shortfall falls in
+#: the chi^2 tail (:attr:`Recognition.none_fits`).
+FIT_OVERDISPERSION = 2.0
+
 #: Two fitted shapes farther apart than this many of the points' median standard deviations
 #: (along the normal) somewhere are different objects: points there would have told them apart.
 SAME_SHAPE_SIGMAS = 3.0
@@ -729,7 +735,8 @@ class Recognition:
         The chance that points of the best-fitting class, scattered as their covariances say
         and wrong as often as estimates are, lie as far from it as these do (:func:`_fit_chance`:
         the chi^2 of the points it takes, and with them the count it takes as wrong): below
-        :data:`FIT_CHANCE` no class fits them and none is named.
+        :data:`FIT_CHANCE`, with an overdispersion beyond :data:`FIT_OVERDISPERSION`, no class
+        fits them and none is named (:attr:`none_fits`).
     rival : str or None
         A class the points do not rule out that is a different shape from the best's.
     same_shape : tuple of str
@@ -765,6 +772,13 @@ class Recognition:
     def undecided(self) -> bool:
         """True when the decision abstains."""
         return self.decision == UNDECIDED
+
+    @property
+    def none_fits(self) -> bool:
+        """True when no class fits the points within their deviations: chance scatters points
+        so far from the best-fitting one less often than :data:`FIT_CHANCE`, and they lie
+        beyond what narrow covariances make (:data:`FIT_OVERDISPERSION`)."""
+        return self.fit_chance < FIT_CHANCE and self.overdispersion > FIT_OVERDISPERSION
 
     @property
     def confidence_floor(self) -> float:
@@ -2349,7 +2363,7 @@ def recognise(
     # object's whole shape whatever the other classes score
     whole = best.n_crossed == 0
     # and points farther from every class than their deviations allow are of none of them
-    fits_points = fit_chance >= FIT_CHANCE
+    fits_points = fit_chance >= FIT_CHANCE or c <= FIT_OVERDISPERSION
     named = delta >= threshold and rival is None and sure and whole and fits_points
     decision = best.name if named else UNDECIDED
     leaders = (best, rival) if rival is not None else (best, *others[:1])

@@ -31,7 +31,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from sensing_antenna.mapping.contact_map import UNHELD_FRACTION, ContactMap, ObjectSurface
-from sensing_antenna.mapping.recognition import FIT_CHANCE, PRIMITIVES
+from sensing_antenna.mapping.recognition import PRIMITIVES
 
 __all__ = ["POINT_COLUMNS", "std_colours", "write_map"]
 
@@ -193,12 +193,12 @@ OVERDISPERSED = 4.0
 
 
 def overdispersed(recognition: Any) -> str:
-    """What points farther from every class than their covariances allow say: when chance
-    makes that spread less often than :data:`~.recognition.FIT_CHANCE` (recognition then names
-    no class), or the overdispersion is beyond :data:`OVERDISPERSED`; else ""."""
+    """What points farther from every class than their covariances allow say: when no class
+    fits them (:attr:`~.recognition.Recognition.none_fits`: recognition then names none), or the
+    overdispersion is beyond :data:`OVERDISPERSED`; else ""."""
     c = float(recognition.overdispersion)
     chance = float(recognition.fit_chance)
-    refused = chance < FIT_CHANCE
+    refused = bool(recognition.none_fits)
     if not (refused or c > OVERDISPERSED):
         return ""
     far = (
