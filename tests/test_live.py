@@ -626,6 +626,24 @@ def test_a_recording_whose_writer_falls_silent_ends_after_the_idle_time(
     assert skipped[0].reason.startswith(f"<stdin>:{first + 1}: ")
     finals = [e for e in events if isinstance(e, EstimateEvent)]
     assert finals[-1].x_c == pytest.approx(CASES["azimuthal"], abs=0.02)
+    # a header that waits longer than that for its first sample is no silence of a recording
+    events.clear()
+    start = len(lines) - recording.n_samples
+
+    def header_waits() -> Any:
+        now[0] = 0.0
+        yield from lines[:start]
+        for _ in range(12):
+            now[0] += 0.25
+            yield None
+        for k, line in enumerate(lines[start:]):
+            now[0] = 3.0 + k * 1e-3
+            yield line
+
+    assert listen_lines(header_waits(), make, clock=lambda: now[0], idle=IDLE_END) == 1
+    ends = [e for e in events if isinstance(e, EndEvent)]
+    assert [e.reason for e in ends] == ["end of input"]
+    assert ends[0].samples == recording.n_samples
     # without idle, pauses are only waited through: the first recording goes on after it
     events.clear()
     assert listen_lines(paced(), make, clock=lambda: now[0], on_event=events.append) == 2
@@ -648,6 +666,18 @@ def test_paced_lines_reads_a_pipe_as_it_comes() -> None:
         assert list(lines) == [b"e"]
     finally:
         os.close(read_end)
+    # a line without its end beyond a mebibyte is no recording's: said, not gathered for ever
+    read_end, write_end = os.pipe()
+    lines = paced_lines(read_end, pause=0.05)
+    writer = threading.Thread(target=os.write, args=(write_end, b"x" * (1 << 21)), daemon=True)
+    writer.start()
+    try:
+        with pytest.raises(RecordingError, match=r"<stdin>: a line of more than 1,048,576 bytes"):
+            list(lines)
+    finally:
+        os.close(read_end)
+        writer.join(timeout=10)
+        os.close(write_end)
 
 
 def test_listen_ends_a_recording_whose_writer_stalls_without_closing(

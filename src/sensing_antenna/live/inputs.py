@@ -70,6 +70,10 @@ _PAUSE = 0.2
 #: Reads of standard input (64 KiB each) :func:`paced_lines` holds ahead of its reader.
 _QUEUED_READS = 64
 
+#: The longest line (bytes) :func:`paced_lines` gathers: a recording's line is some hundred
+#: bytes, so longer is no recording (binary data, a stream without line ends).
+_LONGEST_LINE = 1 << 20
+
 #: After Ctrl-C or a stop signal, the longest wait (s) for the recording's final estimate and
 #: end event: a reader of the events that stopped reading (its pipe full) must not hold the
 #: process (a fast method's final estimate takes well under a second).
@@ -135,9 +139,9 @@ def listen_lines(
     sample that never came; without, it stops the reader as any malformed line does.
 
     A None among ``lines`` is a pause in the input (:func:`paced_lines`): with ``idle`` (s), a
-    recording whose last line came longer ago than that on ``clock`` ends (``no sample for 2
-    s``), and the samples that follow it up to the next ``#`` line are left out, said once to
-    ``on_event``: they belong to a recording already ended.
+    recording with samples whose last line came longer ago than that on ``clock`` ends (``no
+    sample for 2 s``), and the samples that follow it up to the next ``#`` line are left out,
+    said once to ``on_event``: they belong to a recording already ended.
 
     Raises
     ------
@@ -159,7 +163,13 @@ def listen_lines(
         for raw in lines:
             received = clock()
             if raw is None:
-                if current is not None and idle is not None and received - heard > idle:
+                # a recording's silence counts from its samples: a header may wait for the first
+                if (
+                    current is not None
+                    and last_t is not None
+                    and idle is not None
+                    and received - heard > idle
+                ):
                     current.close(f"no sample for {idle:g} s")
                     current, ended, silenced, told = None, ended + 1, True, False
                     if count is not None and ended >= count:
@@ -244,28 +254,41 @@ def listen_lines(
         _close_quietly(current)
 
 
-def paced_lines(fd: int, pause: float = _PAUSE) -> Iterator[bytes | None]:
+def paced_lines(fd: int, pause: float = _PAUSE, source: str = "<stdin>") -> Iterator[bytes | None]:
     """The lines read from the file descriptor ``fd`` (standard input: 0) as they come, each
     with its line end (the last without one when the input ends without it), and None each
     ``pause`` (s) in which none came, for :func:`listen_lines` to notice a writer gone silent.
 
     A thread of its own reads the descriptor (``os.read``, no buffered file object whose lock
     it could hold when the program ends), at most :data:`_QUEUED_READS` reads ahead of the
-    lines taken (a file given whole is not held in memory); an error reading it is raised here.
+    lines taken (a file given whole is not held in memory); bytes that come without ending a
+    line are no pause. An error reading it, or a line longer than :data:`_LONGEST_LINE`
+    (a :class:`~sensing_antenna.recording.RecordingError` naming ``source``), is raised here.
     """
     arrived: queue.Queue[list[bytes] | BaseException | None] = queue.Queue(_QUEUED_READS)
 
     def read() -> None:
         pieces: list[bytes] = []  # of the line not yet ended
+        gathered = 0
         try:
             while chunk := os.read(fd, 1 << 16):
                 *ended, rest = chunk.split(b"\n")
                 if ended:
                     ended[0] = b"".join([*pieces, ended[0]])
-                    pieces = []
-                    arrived.put([line + b"\n" for line in ended])
+                    pieces, gathered = [], 0
+                # a read that ended no line still says the writer writes (no pause)
+                arrived.put([line + b"\n" for line in ended])
                 if rest:
                     pieces.append(rest)
+                    gathered += len(rest)
+                    if gathered > _LONGEST_LINE:
+                        raise RecordingError(
+                            source,
+                            None,
+                            None,
+                            f"a line of more than {_LONGEST_LINE:,} bytes without its end: not"
+                            " the recording format (binary data, or no line ends)",
+                        )
             if pieces:
                 arrived.put([b"".join(pieces)])
             arrived.put(None)
