@@ -133,7 +133,9 @@ shape, and, when there is a rival, the best's weight against the rival on the li
 1 / (1 + exp(-delta chi^2 / (2 c))). A decision needs the weight a runner-up
 :data:`ABSTAIN_DELTA` behind leaves the best, 1 / (1 + exp(-3)) = 0.95: several classes each
 that far behind share more than 5 % between them, and the decision abstains. So a named class
-always carries a confidence of at least 0.95, and an abstention one below it.
+always carries a confidence of at least 0.95. An abstention whose best class is refused as the
+object's whole shape (a swept link through it, :attr:`ClassFit.n_crossed`) or because no class
+fits the points within their deviations (:attr:`Recognition.none_fits`) may carry more.
 """
 
 from __future__ import annotations
@@ -805,8 +807,10 @@ class Recognition:
 def _fit_chance(fit: ClassFit) -> float:
     """The chance that points of ``fit``'s shape, scattered as their covariances say and wrong
     with :data:`OUTLIER_FRACTION`, lie as far from it as these do (:attr:`Recognition.fit_chance`):
-    the smaller of the tail of the chi^2 of the points it takes (those it counts wrong aside)
-    and that tail combined with the chance of as many wrong (:attr:`ClassFit.wrong_chance`) by
+    the smaller of the tail of its chi^2 without the points it counts wrong (over their
+    measurements less its parameters; the swept links' part, mostly none, counted in without
+    degrees of freedom of its own) and that tail combined with the chance of as many wrong
+    (:attr:`ClassFit.wrong_chance`) by
     Fisher's method (-2 ln of their product, chi^2 with 4 degrees of freedom): a few points
     off a shape that fits the rest, each of which wrong estimates could make, are as telling
     together as far as they lie."""

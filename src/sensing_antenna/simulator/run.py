@@ -127,13 +127,15 @@ class SimulationDetail:
     sticking : ndarray of bool, shape (n,)
         True while the contact sticks, False while it slips or there is no contact.
     contact_deflection : ndarray, shape (n,)
-        Deflection of the link at the contact point, |(v, w - w_g)(x_c)| with w_g the static
-        gravity sag at the current theta2 (m); NaN without contact.
+        Deflection of the link at the contact point, |(v - v0, w - w0 - w_g)(x_c)| with w_g the
+        static gravity sag at the current theta2 and (v0, w0) a bowed link's rest shape
+        (``DeviceImperfections.bow``; zero for a straight link) (m); NaN without contact.
     voltage : ndarray, shape (n, 2)
         Motor input voltages u_i (V).
     final_deflection : ndarray, shape (2, n_dof)
         Finite-element coordinates of v (row 0) and w (row 1) at the end of the run (m, rad);
-        ``link_model.shape_at(x) @ final_deflection[0]`` is v(x).
+        ``link_model.shape_at(x) @ final_deflection[0]`` is v(x), the deflection from the
+        link's rest shape (a bowed link's lies beside it, :func:`rest_shape`).
     stop_index : int or None
         Sample at which the stop rule fired (t_1), or None.
     obstacle : Obstacle or None
