@@ -907,3 +907,23 @@ def test_a_bowed_link_is_refused_in_a_scene() -> None:
             Sweep(0, "azimuthal", 0.0, -0.3, 0.3),
             imperfections=DeviceImperfections(bow=(0.01, 0.0)),
         )
+
+
+def test_a_drooping_tip_on_a_mesh_face_above_the_root_is_simulated_at_the_tip() -> None:
+    # The link, nearly level, rises from its root and droops onto the top face of a mesh box
+    # 5 mm above the root's height with its tip: the face's plane, which has no edge, would
+    # cut the link near its root (the simulated contact 83 cm from the box, at x = 0.02 m), so
+    # the simulator's own plane through the tip stands in; the contact stays at the tip, on the
+    # face to within a millimetre (that plane's normal is not the face's)
+    box = mesh_object("box", trimesh.creation.box(extents=[0.45, 0.3, 0.305]), [1.075, 0, -0.1475])
+    outcome = simulate_sweep(
+        DEVICE, _scene(box), Sweep(0, "vertical", 0.0, -0.3, 0.3, direction=-1), seed=1
+    )
+    assert outcome.touch is not None and outcome.touch.tip
+    assert outcome.recording is not None and outcome.frame is not None, outcome.reason
+    recording = outcome.recording
+    touching = recording.extra[IN_CONTACT_COLUMN] > 0.5
+    track = np.column_stack([recording.extra[name] for name in CONTACT_POINT_COLUMNS])
+    on_world = outcome.frame.point_to_world(track[touching])
+    assert np.all(on_world[:, 0] > 0.97)
+    assert np.abs(box.signed_distance(on_world)).max() < 1e-3

@@ -17,7 +17,9 @@ touch, placed by the simulator from x_c as for any of its runs:
   stays on the surface. An edge is curved one way only, whichever way the link crosses it:
   a cylinder, along which a link sliding across stays on the edge, as it does on a real one;
 - a contact at the tip: the plane of the surface at the touch, along its normal there, on
-  which a tip pushed across a face it meets at a slant slides as it would on the face.
+  which a tip pushed across a face it meets at a slant slides as it would on the face; where
+  the link's root lies behind that plane (the link passes beside the face to reach it), a plane
+  of the simulator's own through the tip, which clears the link (its normal not the face's).
 
 A round link touches with its surface, its radius a off its axis (``scene.touch``), while the
 simulator's link touches with its axis: each obstacle, the object itself or a local one, is
@@ -221,7 +223,13 @@ def touch_scenario(
         # the object itself is not turned: the link slides where friction cannot hold it
         obstacle = placed | {"obstacle_tilt": 0.0}
     elif touch.tip:
-        obstacle = _tip_plane(touch, frame)
+        # the face's plane; where it would cut the link, a plane of the simulator's own through
+        # the tip (its normal not the face's: the touched point is the same)
+        obstacle = _tip_plane(touch, frame) or {
+            "obstacle": "plane",
+            "obstacle_radius": radius,
+            "obstacle_tilt": 0.0,
+        }
     towards = ""
     if sweep.direction == -1:
         towards = " towards -Y" if sweep.case == "azimuthal" else " down"
@@ -241,12 +249,17 @@ def touch_scenario(
     return scenario, frame
 
 
-def _tip_plane(touch: Touch, frame: BasePose) -> dict[str, Any]:
+def _tip_plane(touch: Touch, frame: BasePose) -> dict[str, Any] | None:
     """The plane of the surface at a tip's touch of a user's mesh, as the simulator's obstacle
     placed in the recording's frame (``frame``): through the touched point grown by the link's
-    radius (where the tip's axis meets it), along the surface's normal there."""
+    radius (where the tip's axis meets it), along the surface's normal there. None when the
+    link's root lies behind that plane: the link then passes beside the face to reach it, and
+    the plane, which has no edge, would cut the link there."""
+    grown = touch.surface_point + touch.link_radius * touch.normal
+    if not float(touch.normal @ (frame.position - grown)) > 0.0:
+        return None
     to_frame = frame.rotation.T
-    point = to_frame @ (touch.surface_point + touch.link_radius * touch.normal - frame.position)
+    point = to_frame @ (grown - frame.position)
     return {"obstacle": "plane", "obstacle_placement": (*point, *(to_frame @ touch.normal))}
 
 
