@@ -864,6 +864,17 @@ def test_an_empty_input_is_said_to_hold_no_recording() -> None:
     # a failure, so that a pipe whose writer failed before writing does not look like a success
     assert done.returncode == 2 and done.stdout == ""
     assert done.stderr == "antenna listen: error: <stdin>: the input ended with no recording\n"
+    # started with standard input closed: one line, no traceback
+    closed = subprocess.run(
+        ["sh", "-c", 'exec "$@" <&-', "sh", *_cli("listen", "--no-warm-up")],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        timeout=120,
+        check=False,
+    )
+    assert closed.returncode == 2
+    assert closed.stderr == "antenna listen: error: <stdin>: closed, nothing to listen to\n"
 
 
 def test_udp_address_errors_name_the_flag(

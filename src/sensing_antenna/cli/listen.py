@@ -139,6 +139,9 @@ def _run(args: argparse.Namespace) -> int:
             print(f"antenna listen: warm-up skipped: {exc}", file=sys.stderr, flush=True)
 
     if args.udp is None:
+        if sys.stdin is None:  # started with standard input closed
+            print("antenna listen: error: <stdin>: closed, nothing to listen to", file=sys.stderr)
+            return EXIT_BAD_INPUT
         ready()
         lines: Iterable[bytes | None] = sys.stdin.buffer
         idle = None
