@@ -16,7 +16,7 @@ from functools import lru_cache
 from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from sensing_antenna.antenna import STANDARD_GRAVITY, Antenna, Link, antenna_to_toml
 from sensing_antenna.control.servo import FRICTION_SPEED, design_servo, initial_servo_state
@@ -207,15 +207,19 @@ def minimum_contact_point(link: Link, contact_stiffness: float) -> float:
     return float(ratio ** (1.0 / 3.0))
 
 
+def bow_arc(x: ArrayLike, length: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A bowed link's rest shape per metre of tip offset (``DeviceImperfections.bow``) at the
+    abscissae ``x`` (m) of a link ``length`` long: the arc (x / l)^2 and its slope 2 x / l^2."""
+    x = np.asarray(x, dtype=np.float64)
+    return (x / length) ** 2, 2.0 * x / length**2
+
+
 def rest_shape(model: LinkModel, bow: tuple[float, float]) -> NDArray[np.float64]:
     """The unloaded link's rest shape as the linear link's coordinates [q_v, q_w], shape
-    (2 n_dof,): the arcs v0 = d_y (x / l)^2 along Y^m and w0 = d_z (x / l)^2 along Z^m of tip
-    offsets ``bow`` (m), exact in the Hermite elements (values and slopes at the nodes)."""
-    nodes = model.nodes
-    length = float(nodes[-1])
-    values = np.zeros(2 * nodes.size)
-    values[0::2] = (nodes / length) ** 2
-    values[1::2] = 2.0 * nodes / length**2
+    (2 n_dof,): the arcs (:func:`bow_arc`) of tip offsets ``bow`` (m) along Y^m and Z^m, exact
+    in the Hermite elements (values and slopes at the nodes)."""
+    values = np.zeros(2 * model.nodes.size)
+    values[0::2], values[1::2] = bow_arc(model.nodes, float(model.nodes[-1]))
     free = values[model.root_dofs :]
     return np.concatenate([bow[0] * free, bow[1] * free])
 
@@ -238,7 +242,7 @@ def _contact_deflection(
     w = -s2 * c1 * point[:, 0] - s2 * s1 * point[:, 1] + c2 * point[:, 2]
     grid, unit = _unit_sag(link, n_elements, device)
     sag = gravity * c2 * np.interp(truth[:, 3], grid, unit)
-    arc = (truth[:, 3] / link.length) ** 2
+    arc, _ = bow_arc(truth[:, 3], link.length)
     deflection = np.hypot(v - bow[0] * arc, w - bow[1] * arc - sag)
     return np.where(truth[:, 2] > 0.5, deflection, np.nan)
 
@@ -384,8 +388,6 @@ def simulate_detailed(
     damping, ainv, z = _effective_inverse(link, scenario.n_elements, step, alpha, beta, imperfect)
     n = model.n_dof
     bow = scenario.device.bow
-    if any(bow) and scenario.link_model == "nonlinear":
-        raise ScenarioError("device.bow", "a bowed link is simulated on the linear link only")
     rest = rest_shape(model, bow)  # the link's position is its rest shape and its deflection
 
     # --- reference trajectory (Section 4 step 1) -----------------------------------------------
@@ -452,8 +454,7 @@ def simulate_detailed(
         sag = float(model.shape_at(scenario.contact_point) @ q_sag)
         sag_slope = float(model.slope_at(scenario.contact_point) @ q_sag)
         # a bowed link touches where its rest shape puts it: its arc w0 beside the sag, v0 aside
-        arc = (scenario.contact_point / link.length) ** 2
-        arc_slope = 2.0 * scenario.contact_point / link.length**2
+        arc, arc_slope = (float(v) for v in bow_arc(scenario.contact_point, link.length))
         sag, sag_slope = sag + bow[1] * arc, sag_slope + bow[1] * arc_slope
         placement = (
             None if scenario.obstacle_placement is None else np.asarray(scenario.obstacle_placement)

@@ -526,6 +526,8 @@ class Scenario:
             raise ScenarioError(
                 "device", f"must be a DeviceImperfections, got {format_value(self.device)}"
             )
+        if any(self.device.bow) and self.link_model == "nonlinear":
+            raise ScenarioError("device.bow", "a bowed link is simulated on the linear link only")
         description = self.description
         if not isinstance(description, str) or (
             description
