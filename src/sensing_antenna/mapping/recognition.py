@@ -168,6 +168,8 @@ from sensing_antenna.scene.proximity import closest_point, signed_distance
 
 __all__ = [
     "ABSTAIN_DELTA",
+    "FIT_CHANCE",
+    "FIT_OVERDISPERSION",
     "LINE_STRETCH",
     "OUTLIER_FRACTION",
     "UNDECIDED",
@@ -178,6 +180,7 @@ __all__ = [
     "confidence_floor",
     "fit_mesh",
     "fit_primitive",
+    "no_class_fits",
     "outlier_cap",
     "parameter_covariance",
     "point_chi2",
@@ -195,15 +198,15 @@ FloatArray = NDArray[np.float64]
 #: of two under equal priors).
 ABSTAIN_DELTA = 6.0
 
-#: The chance below which points scattered as their covariances say would lie as far from the
-#: best-fitting class as they do (its chi^2 against the chi^2 distribution of its degrees of
-#: freedom): no class fits them, and none is named (:attr:`Recognition.fit_chance`).
+#: The chance below which points of the best-fitting class would lie as far from it as they do
+#: (:attr:`Recognition.fit_chance`): with an overdispersion beyond :data:`FIT_OVERDISPERSION`,
+#: no class fits them, and none is named (:func:`no_class_fits`).
 FIT_CHANCE = 1e-3
 
 #: The overdispersion up to which points are taken to be of the best-fitting class whatever
 #: their chi^2 says: their covariances may be narrower than their errors by this much (the
 #: realistic device's right answers reach 2), and with many points any such shortfall falls in
-#: the chi^2 tail (:attr:`Recognition.none_fits`).
+#: the chi^2 tail (:func:`no_class_fits`).
 FIT_OVERDISPERSION = 2.0
 
 #: Two fitted shapes farther apart than this many of the points' median standard deviations
@@ -777,10 +780,9 @@ class Recognition:
 
     @property
     def none_fits(self) -> bool:
-        """True when no class fits the points within their deviations: chance scatters points
-        so far from the best-fitting one less often than :data:`FIT_CHANCE`, and they lie
-        beyond what narrow covariances make (:data:`FIT_OVERDISPERSION`)."""
-        return self.fit_chance < FIT_CHANCE and self.overdispersion > FIT_OVERDISPERSION
+        """True when no class fits the points within their deviations (:func:`no_class_fits`):
+        recognition then names none."""
+        return no_class_fits(self.fit_chance, self.overdispersion)
 
     @property
     def confidence_floor(self) -> float:
@@ -804,16 +806,22 @@ class Recognition:
         }
 
 
+def no_class_fits(fit_chance: float, overdispersion: float) -> bool:
+    """True when chance scatters points so far from the best-fitting class less often than
+    :data:`FIT_CHANCE` (``fit_chance``) and they lie beyond what covariances narrower than the
+    errors make (``overdispersion`` above :data:`FIT_OVERDISPERSION`)."""
+    return fit_chance < FIT_CHANCE and overdispersion > FIT_OVERDISPERSION
+
+
 def _fit_chance(fit: ClassFit) -> float:
     """The chance that points of ``fit``'s shape, scattered as their covariances say and wrong
     with :data:`OUTLIER_FRACTION`, lie as far from it as these do (:attr:`Recognition.fit_chance`):
     the smaller of the tail of its chi^2 without the points it counts wrong (over their
     measurements less its parameters; the swept links' part, mostly none, counted in without
     degrees of freedom of its own) and that tail combined with the chance of as many wrong
-    (:attr:`ClassFit.wrong_chance`) by
-    Fisher's method (-2 ln of their product, chi^2 with 4 degrees of freedom): a few points
-    off a shape that fits the rest, each of which wrong estimates could make, are as telling
-    together as far as they lie."""
+    (:attr:`ClassFit.wrong_chance`) by Fisher's method (-2 ln of their product, chi^2 with 4
+    degrees of freedom): a few points off a shape that fits the rest, each of which wrong
+    estimates could make, are as telling together as far as they lie."""
     taken = max(fit.counted - fit.wrong_measurements - fit.dof, 1.0)
     fitted = float(chi2_distribution.sf(fit.chi2 - fit.wrong_chi2, taken))
     product = max(fitted, 1e-300) * max(fit.wrong_chance, 1e-300)
@@ -2367,8 +2375,9 @@ def recognise(
     # object's whole shape whatever the other classes score
     whole = best.n_crossed == 0
     # and points farther from every class than their deviations allow are of none of them
-    fits_points = fit_chance >= FIT_CHANCE or c <= FIT_OVERDISPERSION
-    named = delta >= threshold and rival is None and sure and whole and fits_points
+    named = (
+        delta >= threshold and rival is None and sure and whole and not no_class_fits(fit_chance, c)
+    )
     decision = best.name if named else UNDECIDED
     leaders = (best, rival) if rival is not None else (best, *others[:1])
     return Recognition(

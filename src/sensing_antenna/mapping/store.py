@@ -445,7 +445,7 @@ def report(contact_map: ContactMap, notes: Sequence[str] = ()) -> str:
             # a user's mesh is the object's own shape, concave parts and all
             *(
                 ()
-                if recognition.undecided or recognition.best.name.startswith("mesh:")
+                if recognition.undecided or recognition.best.name not in PRIMITIVES
                 else (HULL_NOTE,)
             ),
             *_member_note(recognition),
