@@ -113,6 +113,12 @@ def _lines(recording: Recording) -> list[bytes]:
     return [line.encode() for line in out.getvalue().splitlines(keepends=True)]
 
 
+def _line_at(recording: Recording, lines: list[bytes], t: float) -> int:
+    """Index in ``lines`` (:func:`_lines` of ``recording``) of its first sample at ``t`` (s) or
+    after."""
+    return len(lines) - recording.n_samples + int(np.searchsorted(recording.t, t))
+
+
 def _listen(lines: list[bytes], method: str = "paper", **kwargs: Any) -> list[Event]:
     events: list[Event] = []
 
@@ -598,7 +604,7 @@ def test_a_recording_whose_writer_falls_silent_ends_after_the_idle_time(
     # are left out, said once; the next '#' block is the next recording.
     recording = read_recording(recordings["azimuthal"])
     lines = _lines(recording)
-    first = len(lines) - recording.n_samples + int(np.searchsorted(recording.t, 1.5))
+    first = _line_at(recording, lines, 1.5)
     now = [0.0]
 
     def paced() -> Any:
@@ -1296,7 +1302,7 @@ def test_an_interruption_ends_the_recording_in_progress_with_its_events(
     # end, so that every recording whose contact was said is closed; the interruption goes on
     recording = read_recording(recordings["azimuthal"])
     lines = _lines(recording)
-    kept = len(lines) - recording.n_samples + np.searchsorted(recording.t, 1.6)
+    kept = _line_at(recording, lines, 1.6)
 
     def interrupted() -> Any:
         yield from lines[:kept]
@@ -1485,7 +1491,7 @@ def test_an_interruption_does_not_wait_for_a_reader_that_stopped_reading(
     # abandoned, its end never said
     recording = read_recording(recordings["azimuthal"])
     lines = _lines(recording)
-    kept = len(lines) - recording.n_samples + int(np.searchsorted(recording.t, 1.6))
+    kept = _line_at(recording, lines, 1.6)
     stuck = threading.Event()
     events: list[Event] = []
 
