@@ -438,11 +438,13 @@ def test_a_bowed_link_moves_the_point_by_its_arc_which_bow_std_covers(
         write_recording(simulate(device, scenario), paths[-1])
     straight, bowed = points_from_recordings(paths, model, "paper")
     assert straight.status == bowed.status == Status.OK
+    # within the paper method's own deviation along the link (1 mm; measured 2 um)
     assert bowed.x_c == pytest.approx(straight.x_c, abs=1e-3)
     arc = bow * (x_c / device.link.length) ** 2
     moved = bowed.true_point - straight.true_point
-    assert moved[1] == pytest.approx(arc, abs=1e-3)
-    # the estimate, on its straight link, stays where it was
+    # the two contacts slide under the push by amounts a few tens of micrometres apart
+    assert moved[1] == pytest.approx(arc, abs=1e-4)
+    # the estimate, on its straight link, stays where it was, within that 1 mm (measured 0.4)
     assert np.linalg.norm(bowed.point - straight.point) < 1e-3
 
     def deviations(point: Any) -> float:
